@@ -1,0 +1,57 @@
+"""Shared helpers for the benchmarks: one result shape, a timer, and the JSON writer.
+
+Every benchmark module in ``bench/`` is named ``bench_*.py`` and has a
+``run() -> list[Result]``. ``python -m bench.run`` imports them all, prints a
+table and writes ``bench/results.json``.
+"""
+
+from __future__ import annotations
+
+import time
+from collections.abc import Callable
+from dataclasses import dataclass
+
+
+@dataclass
+class Result:
+    name: str
+    """Stable, dotted, lower-case, e.g. ``codec.status_decode_rate``."""
+    value: float
+    unit: str
+    baseline: float | None = None
+    """The simple way, measured in the same run."""
+
+    @property
+    def ratio(self) -> float | None:
+        if self.baseline in (None, 0):
+            return None
+        return self.value / self.baseline
+
+    def as_json(self) -> dict[str, object]:
+        out: dict[str, object] = {"name": self.name, "value": round(self.value, 6), "unit": self.unit}
+        if self.baseline is not None:
+            out["baseline"] = round(self.baseline, 6)
+            ratio = self.ratio
+            if ratio is not None:
+                out["ratio"] = round(ratio, 4)
+        return out
+
+
+def best_time(fn: Callable[[], object], *, repeat: int = 5, min_seconds: float = 0.2) -> float:
+    """Seconds per call of ``fn``: the best of ``repeat`` rounds, each at least ``min_seconds`` long."""
+    calls = 1
+    while True:
+        t0 = time.perf_counter()
+        for _ in range(calls):
+            fn()
+        elapsed = time.perf_counter() - t0
+        if elapsed >= min_seconds / 4 or calls > 1 << 24:
+            break
+        calls *= 4
+    best = elapsed / calls
+    for _ in range(repeat - 1):
+        t0 = time.perf_counter()
+        for _ in range(calls):
+            fn()
+        best = min(best, (time.perf_counter() - t0) / calls)
+    return best

@@ -1,0 +1,5 @@
+"""``python -m rtmu``: the same as the ``rtmu`` command."""
+
+from rtmu.cli import main
+
+raise SystemExit(main())

@@ -1,0 +1,59 @@
+"""The ``rtmu`` command: argument parsing and wiring; each subcommand lives in ``rtmu.subcommands``.
+
+A subcommand module defines ``register(subparsers)`` that adds its parser and
+sets ``handler=`` (a function taking the parsed namespace and returning the exit
+code). Adding a subcommand touches one new file.
+"""
+
+from __future__ import annotations
+
+import argparse
+import importlib
+import importlib.util
+import pkgutil
+import sys
+from collections.abc import Sequence
+
+from . import __version__, subcommands
+
+EXIT_OK = 0
+EXIT_USAGE = 2
+EXIT_CONNECTION = 3
+EXIT_UNSUPPORTED = 4
+EXIT_TIMEOUT = 5
+
+
+def build_parser() -> argparse.ArgumentParser:
+    parser = argparse.ArgumentParser(
+        prog="rtmu",
+        description="Teleoperate an ARIA (ArNetworking) robot; with no subcommand, open the window.",
+    )
+    parser.add_argument("--version", action="version", version=f"rtmu {__version__}")
+    sub = parser.add_subparsers(dest="subcommand", metavar="SUBCOMMAND")
+    for info in sorted(pkgutil.iter_modules(subcommands.__path__), key=lambda m: m.name):
+        if info.name.startswith("_"):
+            continue
+        module = importlib.import_module(f"{subcommands.__name__}.{info.name}")
+        register = getattr(module, "register", None)
+        if register is not None:
+            register(sub)
+    gui = importlib.util.find_spec("rtmu.ui.app")
+    if gui is not None:
+        from .ui import app as gui_app
+
+        gui_app.add_gui_arguments(parser)
+    return parser
+
+
+def main(argv: Sequence[str] | None = None) -> int:
+    parser = build_parser()
+    args = parser.parse_args(argv)
+    handler = getattr(args, "handler", None)
+    if handler is None:
+        if importlib.util.find_spec("rtmu.ui.app") is None:
+            print("rtmu: the operator window is not built yet; try 'rtmu --help'", file=sys.stderr)
+            return EXIT_USAGE
+        from .ui import app as gui_app
+
+        return gui_app.run_gui(args)
+    return int(handler(args) or 0)

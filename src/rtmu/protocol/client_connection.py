@@ -1,0 +1,185 @@
+"""The client end of an ArNetworking connection, sans-I/O (protocol §2.3–2.14, §3).
+
+Feed received bytes to :meth:`ClientConnection.receive_data`; it returns
+events. Calls such as :meth:`request` queue bytes; :meth:`data_to_send` hands
+them over for the caller's socket. No sockets, no asyncio, no clocks here.
+
+The client is TCP-only: it declares UDP port 0 and sends TCP_ONLY right after
+its INTRODUCTION (what ``ArClientBase`` does with a server without UDP), so
+every reply arrives on the one socket.
+"""
+
+from __future__ import annotations
+
+from enum import Enum, auto
+
+from .auth import password_digest
+from .commands import ClientCommand, ClientType, ServerCommand, describe_reject, is_control_command
+from .datalist import DataList
+from .decoder import PacketDecoder
+from .errors import FieldUnderrun, ProtocolError
+from .events import (
+    Connected,
+    DataListReady,
+    DataReceived,
+    Event,
+    Ignored,
+    PeerShutdown,
+    Rejected,
+    ServerIntroduction,
+)
+from .fields import FieldReader, FieldWriter
+from .packet import Packet, encode_packet
+
+
+class ClientState(Enum):
+    WAITING_INTRODUCTION = auto()
+    EXCHANGED_INTROS = auto()
+    WAITING_LIST = auto()
+    CONNECTED = auto()
+    REJECTED = auto()
+    CLOSED = auto()
+
+
+class UnknownData(ProtocolError):
+    """The server's data list has no such name."""
+
+
+class ClientConnection:
+    def __init__(
+        self,
+        user: str = "",
+        password: str = "",
+        *,
+        server_key: str = "",
+        protocol_version: str = "",
+        client_type: ClientType = ClientType.UNSPECIFIED,
+    ) -> None:
+        self.user = user
+        self._password = password
+        self.server_key = server_key
+        self.protocol_version = protocol_version
+        self.client_type = client_type
+        self.state = ClientState.WAITING_INTRODUCTION
+        self.datalist = DataList()
+        self.decoder = PacketDecoder()
+        self.introduction: ServerIntroduction | None = None
+        self._out = bytearray()
+
+    # -- output -------------------------------------------------------------
+    def data_to_send(self) -> bytes:
+        out = bytes(self._out)
+        self._out.clear()
+        return out
+
+    def _send(self, command: int, payload: bytes = b"") -> None:
+        self._out += encode_packet(command, payload)
+
+    def number_of(self, name: str) -> int:
+        number = self.datalist.number(name)
+        if number is None:
+            raise UnknownData(f"the server offers no data named {name!r}")
+        return number
+
+    def request(self, name: str, interval_ms: int, args: bytes = b"") -> None:
+        """Subscribe: the server answers now and then every ``interval_ms`` (−1: broadcasts only)."""
+        self._require_connected()
+        payload = FieldWriter().ubyte2(self.number_of(name)).byte4(interval_ms).bytes() + args
+        self._send(ClientCommand.REQUEST, payload)
+
+    def request_stop(self, name: str) -> None:
+        self._require_connected()
+        self._send(ClientCommand.REQUESTSTOP, FieldWriter().ubyte2(self.number_of(name)).bytes())
+
+    def request_once(self, name: str, args: bytes = b"") -> None:
+        """Run data ``name`` once: a packet whose command is the data number, payload the arguments."""
+        self._require_connected()
+        self._send(self.number_of(name), args)
+
+    def shutdown(self) -> None:
+        """Say goodbye; the caller then closes the socket."""
+        if self.state not in (ClientState.CLOSED, ClientState.REJECTED):
+            self._send(ClientCommand.SHUTDOWN)
+        self.state = ClientState.CLOSED
+
+    def _require_connected(self) -> None:
+        if self.state is not ClientState.CONNECTED:
+            raise ProtocolError(f"not connected (state {self.state.name})")
+
+    # -- input --------------------------------------------------------------
+    def receive_data(self, data: bytes) -> list[Event]:
+        events: list[Event] = []
+        for packet in self.decoder.feed(data):
+            events.extend(self._handle(packet))
+        return events
+
+    def _handle(self, packet: Packet) -> list[Event]:
+        cmd = packet.command
+        state = self.state
+        if state in (ClientState.CLOSED, ClientState.REJECTED):
+            return [Ignored(cmd, f"connection is {state.name.lower()}")]
+        if cmd == ServerCommand.SHUTDOWN:
+            self.state = ClientState.CLOSED
+            return [PeerShutdown()]
+        if state is ClientState.WAITING_INTRODUCTION:
+            if cmd != ServerCommand.INTRODUCTION:
+                return [Ignored(cmd, "waiting for the server's introduction")]
+            return [self._on_introduction(packet)]
+        if cmd in (ServerCommand.TCP_ONLY, ServerCommand.UDP_CONFIRMATION, ServerCommand.UDP_INTRODUCTION):
+            return [Ignored(cmd, "TCP-only client: UDP bookkeeping is not needed")]
+        if state is ClientState.EXCHANGED_INTROS:
+            if cmd == ServerCommand.CONNECTED:
+                self.state = ClientState.WAITING_LIST
+                return [Connected()]
+            if cmd == ServerCommand.REJECTED:
+                return [self._on_rejected(packet)]
+            return [Ignored(cmd, "waiting for CONNECTED or REJECTED")]
+        if cmd == ServerCommand.REJECTED and state is ClientState.WAITING_LIST:
+            return [self._on_rejected(packet)]
+        if is_control_command(cmd):
+            if self.datalist.absorb(packet):
+                if self.state is ClientState.WAITING_LIST and self.datalist.complete:
+                    self.state = ClientState.CONNECTED
+                    return [DataListReady(self.datalist)]
+                return []
+            return [Ignored(cmd, "unexpected control command")]
+        if state is not ClientState.CONNECTED:
+            return [Ignored(cmd, "data before the data list was complete")]
+        return [DataReceived(cmd, self.datalist.name(cmd), packet.payload)]
+
+    def _on_introduction(self, packet: Packet) -> ServerIntroduction:
+        r = FieldReader(packet.payload)
+        try:
+            intro = ServerIntroduction(
+                version_tag=r.string("version tag"),
+                udp_port=r.ubyte2("server UDP port"),
+                auth_key=r.ubyte4("auth key"),
+                intro_key=r.ubyte4("intro key"),
+                password_key=r.string("password key"),
+                protocol_version=r.string("protocol version", default=""),
+            )
+        except FieldUnderrun as exc:
+            raise ProtocolError(f"malformed server introduction: {exc}") from exc
+        self.introduction = intro
+        digest = password_digest(self._password, intro.password_key, self.server_key)
+        self._password = ""  # not kept longer than needed
+        payload = (
+            FieldWriter()
+            .ubyte2(0)
+            .string(self.user)
+            .raw(digest)
+            .string(self.protocol_version)
+            .byte(int(self.client_type))
+            .bytes()
+        )
+        self._send(ClientCommand.INTRODUCTION, payload)
+        self._send(ClientCommand.TCP_ONLY)
+        self.state = ClientState.EXCHANGED_INTROS
+        return intro
+
+    def _on_rejected(self, packet: Packet) -> Rejected:
+        r = FieldReader(packet.payload)
+        reason = r.byte2("reason", default=0)
+        text = r.string("text", default="")
+        self.state = ClientState.REJECTED
+        return Rejected(reason, text, describe_reject(reason, text))

@@ -1,0 +1,146 @@
+"""Incremental, resynchronising packet decoder (protocol §1.8), fed arbitrary chunks.
+
+It follows ARIA's receiver (scan for ``0F 0C``, accept ``8 <= length <= 32000``,
+verify the checksum, drop bad packets and keep the connection) and is more
+tolerant in two documented ways, so that a valid packet is never lost behind
+garbage:
+
+* a failed second sync byte is looked at again as a possible first sync byte;
+* after a checksum failure scanning resumes two bytes after the false sync,
+  not ``length`` bytes later, so a real packet hidden inside the span that a
+  bogus header claimed is still found.
+
+At the end of a stream :meth:`PacketDecoder.close` gives up on a header whose
+body never arrived and rescans the bytes behind it.
+
+Nothing in here raises on network input; every dropped byte is counted.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Iterator
+from dataclasses import dataclass, fields
+
+from .checksum import checksum
+from .packet import MAX_LENGTH, MIN_LENGTH, SYNC, Packet
+
+_COMPACT_AT = 64 * 1024
+
+
+@dataclass(slots=True)
+class DropStats:
+    """What the decoder threw away, and why."""
+
+    garbage_bytes: int = 0
+    """Bytes skipped while looking for a sync pair."""
+    bad_length: int = 0
+    """Headers whose length field was outside 8..32000."""
+    bad_checksum: int = 0
+    """Complete packets whose checksum did not match."""
+    truncated_at_close: int = 0
+    """Headers still waiting for their body when the stream ended."""
+    packets: int = 0
+    """Good packets delivered."""
+
+    @property
+    def dropped(self) -> int:
+        return self.bad_length + self.bad_checksum + self.truncated_at_close
+
+    def as_dict(self) -> dict[str, int]:
+        return {f.name: getattr(self, f.name) for f in fields(self)}
+
+
+@dataclass(frozen=True, slots=True)
+class BadPacket:
+    """A framed packet that failed its checksum; reported to tools such as ``rtmu decode``."""
+
+    command: int
+    length: int
+    raw: bytes
+
+
+class PacketDecoder:
+    """Feed bytes with :meth:`feed`; it returns the good packets found so far.
+
+    Memory is bounded: at most one packet's worth (32000 bytes) plus the last
+    chunk is ever held, whatever the peer sends.
+    """
+
+    __slots__ = ("_buf", "_pos", "bad_packets", "keep_bad", "stats")
+
+    def __init__(self, *, keep_bad: bool = False) -> None:
+        self._buf = bytearray()
+        self._pos = 0
+        self.stats = DropStats()
+        self.keep_bad = keep_bad
+        self.bad_packets: list[BadPacket] = []
+
+    @property
+    def buffered(self) -> int:
+        """Bytes held while waiting for the rest of a packet."""
+        return len(self._buf) - self._pos
+
+    def feed(self, data: bytes | bytearray | memoryview) -> list[Packet]:
+        if data:
+            self._buf += data
+        return list(self._drain())
+
+    def close(self) -> list[Packet]:
+        """End of stream: abandon an incomplete packet and rescan what lies behind its header."""
+        found: list[Packet] = []
+        while self.buffered >= 2:
+            found.extend(self._drain())
+            if self.buffered < 2:
+                break
+            start = self._buf.find(SYNC, self._pos)
+            if start < 0:
+                break
+            self.stats.truncated_at_close += 1
+            self._pos = start + 2
+        self.stats.garbage_bytes += self.buffered
+        self._buf.clear()
+        self._pos = 0
+        return found
+
+    def _drain(self) -> Iterator[Packet]:
+        buf = self._buf
+        pos = self._pos
+        stats = self.stats
+        end = len(buf)
+        try:
+            while True:
+                start = buf.find(SYNC, pos)
+                if start < 0:
+                    # Keep a trailing 0x0F: it may be the first half of a sync pair.
+                    keep = 1 if end > pos and buf[end - 1] == 0x0F else 0
+                    stats.garbage_bytes += end - pos - keep
+                    pos = end - keep
+                    return
+                stats.garbage_bytes += start - pos
+                pos = start
+                if end - pos < 4:
+                    return
+                length = buf[pos + 2] | buf[pos + 3] << 8
+                if length < MIN_LENGTH or length > MAX_LENGTH:
+                    stats.bad_length += 1
+                    pos += 4
+                    continue
+                if end - pos < length:
+                    return
+                body_end = pos + length - 2
+                if checksum(buf, body_end, pos) != (buf[body_end] << 8 | buf[body_end + 1]):
+                    stats.bad_checksum += 1
+                    if self.keep_bad:
+                        command = buf[pos + 4] | buf[pos + 5] << 8
+                        self.bad_packets.append(BadPacket(command, length, bytes(buf[pos : pos + length])))
+                    stats.garbage_bytes += 2
+                    pos += 2
+                    continue
+                stats.packets += 1
+                yield Packet(buf[pos + 4] | buf[pos + 5] << 8, bytes(buf[pos + 6 : body_end]))
+                pos += length
+        finally:
+            if pos >= _COMPACT_AT or pos == end:
+                del buf[:pos]
+                pos = 0
+            self._pos = pos

@@ -1,0 +1,126 @@
+"""Events the sans-I/O connections report, as frozen dataclasses (the h11 / wsproto style)."""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+from .datalist import DataList
+
+
+@dataclass(frozen=True, slots=True)
+class ServerIntroduction:
+    version_tag: str
+    udp_port: int
+    auth_key: int
+    intro_key: int
+    password_key: str
+    protocol_version: str
+
+
+@dataclass(frozen=True, slots=True)
+class Connected:
+    """The server accepted the login; the data list follows."""
+
+
+@dataclass(frozen=True, slots=True)
+class Rejected:
+    reason: int
+    text: str
+    message: str
+    """A readable sentence built from the reason code and text."""
+
+
+@dataclass(frozen=True, slots=True)
+class DataListReady:
+    """The catalogue is complete (LISTGROUPANDFLAGS arrived); requests may use any name."""
+
+    datalist: DataList
+
+
+@dataclass(frozen=True, slots=True)
+class DataReceived:
+    """A reply or broadcast for one data."""
+
+    command: int
+    name: str | None
+    payload: bytes
+
+
+@dataclass(frozen=True, slots=True)
+class PeerShutdown:
+    """The peer sent SHUTDOWN: it is closing the connection."""
+
+
+@dataclass(frozen=True, slots=True)
+class ClientIntroduced:
+    """Server side: the client's INTRODUCTION was accepted."""
+
+    user: str
+    udp_port: int
+    protocol_version: str
+    client_type: int
+
+
+@dataclass(frozen=True, slots=True)
+class LoginRefused:
+    """Server side: we sent REJECTED and the connection should close after the flush."""
+
+    reason: int
+    text: str
+
+
+@dataclass(frozen=True, slots=True)
+class RequestReceived:
+    """Server side: REQUEST — subscribe to ``name`` every ``interval_ms`` (−1 = broadcasts only)."""
+
+    number: int
+    name: str
+    interval_ms: int
+    args: bytes
+    new: bool
+    """False when it only replaced the interval/arguments of an existing subscription."""
+
+
+@dataclass(frozen=True, slots=True)
+class RequestStopped:
+    number: int
+    name: str
+
+
+@dataclass(frozen=True, slots=True)
+class RequestOnce:
+    """Server side: a packet whose command is a data number — run that data once."""
+
+    number: int
+    name: str
+    args: bytes
+
+
+@dataclass(frozen=True, slots=True)
+class TcpOnlyRequested:
+    """Server side: the client wants everything over TCP."""
+
+
+@dataclass(frozen=True, slots=True)
+class Ignored:
+    """A packet that the protocol says to ignore in this state (kept for logs and tools)."""
+
+    command: int
+    why: str
+
+
+Event = (
+    ServerIntroduction
+    | Connected
+    | Rejected
+    | DataListReady
+    | DataReceived
+    | PeerShutdown
+    | ClientIntroduced
+    | LoginRefused
+    | RequestReceived
+    | RequestStopped
+    | RequestOnce
+    | TcpOnlyRequested
+    | Ignored
+)

@@ -1,0 +1,1 @@
+"""One module per ``rtmu`` subcommand; each defines ``register(subparsers)``."""
