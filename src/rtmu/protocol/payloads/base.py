@@ -5,6 +5,16 @@ used by the client and the simulator alike. Requests and replies of the same
 data often differ (``getSensorCurrent`` asks with names and answers with
 readings), so each type says which side it is: ``ARGS`` (what a client sends
 in a request) or ``REPLY`` (what a server sends back or broadcasts).
+
+Some data names are families rather than names: camera data carry the camera's
+name as a suffix (``getPictureCam1``) and range devices publish
+``<device>Current``. A type says so with :attr:`Payload.NAME_MATCH`, and
+:func:`payload_type_for` finds it for any member of the family.
+
+Decoders raise only :class:`~rtmu.protocol.errors.ProtocolError` subclasses
+(``FieldUnderrun`` naming the field, ``PayloadError`` for bad counts/values);
+bytes after the last field are ignored, as ARIA does, unless a type keeps them
+(forwarded video) so that ``encode(decode(b)) == b`` holds for wire payloads.
 """
 
 from __future__ import annotations
@@ -13,17 +23,33 @@ import dataclasses
 from enum import Enum
 from typing import Any, ClassVar, Self, TypeVar
 
+from ..errors import PayloadError
+from ..fields import FieldReader
+
 
 class Side(Enum):
     ARGS = "args"
     REPLY = "reply"
 
 
+class NameMatch(Enum):
+    """How a type's ``DATA_NAME`` relates to the data names it decodes."""
+
+    EXACT = "exact"
+    PREFIX = "prefix"
+    """``DATA_NAME`` + anything, e.g. ``getPicture`` → ``getPictureCam1`` (camera suffix)."""
+    SUFFIX = "suffix"
+    """anything + ``DATA_NAME``, e.g. ``Current`` → ``sonarCurrent`` (range devices)."""
+
+
 class Payload:
-    """Base of typed payloads; subclasses are frozen dataclasses."""
+    """Base of typed payloads; subclasses are frozen, slotted dataclasses."""
+
+    __slots__ = ()
 
     DATA_NAME: ClassVar[str]
     SIDE: ClassVar[Side]
+    NAME_MATCH: ClassVar[NameMatch] = NameMatch.EXACT
 
     def encode(self) -> bytes:
         raise NotImplementedError
@@ -70,9 +96,64 @@ def register(cls: P) -> P:
 
 
 def payload_type(data_name: str, side: Side) -> type[Payload] | None:
-    """The payload type for a data name, or None when we have no decoder for it."""
+    """The payload type registered under exactly this data name, or None."""
     return _REGISTRY.get((data_name, side))
+
+
+def payload_type_for(data_name: str, side: Side) -> type[Payload] | None:
+    """The payload type for a data name as a server lists it, or None when we have no decoder.
+
+    An exact registration wins; otherwise the longest ``PREFIX`` type the name
+    starts with (camera data: ``getPictureCam1``), then the longest ``SUFFIX``
+    type it ends with (range devices: ``sonarCurrent``).
+    """
+    exact = _REGISTRY.get((data_name, side))
+    if exact is not None:
+        return exact
+    best: type[Payload] | None = None
+    for match, fits in (
+        (NameMatch.PREFIX, data_name.startswith),
+        (NameMatch.SUFFIX, data_name.endswith),
+    ):
+        for (name, s), cls in _REGISTRY.items():
+            fitting = s is side and cls.NAME_MATCH is match and fits(name) and len(name) < len(data_name)
+            if fitting and (best is None or len(name) > len(best.DATA_NAME)):
+                best = cls
+        if best is not None:
+            return best
+    return None
+
+
+def decode_payload(data_name: str, side: Side, data: bytes) -> Payload | None:
+    """Decode ``data`` with the type for ``data_name`` (see :func:`payload_type_for`); None if unknown."""
+    cls = payload_type_for(data_name, side)
+    return None if cls is None else cls.decode(data)
 
 
 def registered() -> dict[tuple[str, Side], type[Payload]]:
     return dict(_REGISTRY)
+
+
+# -- small helpers the payload modules share ------------------------------------
+
+
+def checked_count(count: int, item_size: int, reader: FieldReader, field: str) -> int:
+    """Refuse a count that cannot fit in the bytes left, before anything is allocated.
+
+    ``item_size`` is the smallest number of bytes one item can take (1 for a string).
+    """
+    if count < 0:
+        raise PayloadError(f"{field} is negative ({count})")
+    if count * item_size > reader.remaining:
+        raise PayloadError(
+            f"{field} claims {count} items of at least {item_size} bytes, only {reader.remaining} bytes left"
+        )
+    return count
+
+
+def read_strings_to_end(reader: FieldReader, field: str) -> tuple[str, ...]:
+    """Strings until the payload ends: lists that carry no count (``getGoals``, ``getStrings``)."""
+    out: list[str] = []
+    while not reader.at_end():
+        out.append(reader.string(field))
+    return tuple(out)

@@ -1,0 +1,29 @@
+"""Typed payloads of the standard ArNetworking services (protocol §4).
+
+Importing this package registers every type, so :func:`payload_type_for`
+finds a decoder by data name.
+"""
+
+from . import robot
+from .base import (
+    NameMatch,
+    Payload,
+    Side,
+    decode_payload,
+    payload_type,
+    payload_type_for,
+    register,
+    registered,
+)
+
+__all__ = [
+    "NameMatch",
+    "Payload",
+    "Side",
+    "decode_payload",
+    "payload_type",
+    "payload_type_for",
+    "register",
+    "registered",
+    "robot",
+]
