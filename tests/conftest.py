@@ -1,0 +1,26 @@
+"""Suite-wide settings and the path to the shared ARIA captures and maps (``../shared`` beside the repo)."""
+
+from __future__ import annotations
+
+import os
+from pathlib import Path
+
+import pytest
+from hypothesis import settings
+
+REPO_ROOT = Path(__file__).resolve().parents[1]
+SHARED_DIR = REPO_ROOT.parent / "shared"
+
+# Hypothesis's own "ci" profile (deterministic, no deadline) loads itself when CI is set. Locally we
+# only drop the 200 ms deadline: other work shares these two cores, and speed is bench/'s business.
+if "CI" not in os.environ:
+    settings.register_profile("rtmu-local", deadline=None)
+    settings.load_profile("rtmu-local")
+
+
+@pytest.fixture(scope="session")
+def shared_dir() -> Path:
+    """``../shared`` (captures, ARIA maps, docs); CI checks it out beside the repository."""
+    if not SHARED_DIR.is_dir():
+        pytest.fail(f"{SHARED_DIR} is missing: clone or link the shared/ folder beside the repository")
+    return SHARED_DIR
