@@ -4,7 +4,7 @@ Importing this package registers every type, so :func:`payload_type_for`
 finds a decoder by data name.
 """
 
-from . import robot
+from . import drive, robot
 from .base import (
     NameMatch,
     Payload,
@@ -21,6 +21,7 @@ __all__ = [
     "Payload",
     "Side",
     "decode_payload",
+    "drive",
     "payload_type",
     "payload_type_for",
     "register",
