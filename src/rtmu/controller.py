@@ -1,0 +1,389 @@
+"""Operator intents → client calls, with the robot's safety rules in one place.
+
+The controller runs on the UI thread. It is GTK-free: it talks to the window
+through the small :class:`View` protocol and to the network through
+:class:`ClientLink` (implemented by ``rtmu.client.ClientRunner``), and reads
+time from an injected clock, so every rule below is tested without a display.
+
+Driving rules
+-------------
+* ``press(direction)`` / ``release(direction)``: move only **while held**. The
+  first press grants a drive lease (``rtmu.client.lease``); :meth:`tick`, called
+  by the UI's own timer every :data:`TICK` seconds, renews it while keys are
+  held; the network side resends ``ratioDrive`` at 10 Hz while the lease is
+  fresh. Two held directions combine into a curve (forward+left = forward with
+  half rotation); opposite directions cancel. Releasing the last key sends zero
+  ratios and ``stop``.
+* :meth:`stop` always wins and is always sent, even when the link looks stale.
+* Focus loss, disconnect, a stale or lost link, and a lapsed lease (the UI froze
+  for more than 300 ms) stop the robot. Keys still held at that moment are
+  *blocked* until released: the robot stays still until a fresh key press —
+  also after a reconnect.
+* Speed: 10…100 % in 10 % steps; it is the ``ratioDrive`` throttle and applies at
+  once to a drive in progress.
+"""
+
+from __future__ import annotations
+
+import time
+from collections.abc import Callable, Mapping
+from enum import Enum
+from typing import Protocol
+
+from .client.lease import DriveLease, DriveRatios, EndReason
+from .commands import COMMANDS, CommandRegistry, CommandState
+from .model import ZOOM_LEVELS, ConnectionState, LinkHealth, LinkLevel, Model, Phase
+from .settings import Profile
+
+TICK = 0.1
+"""Seconds between :meth:`Controller.tick` calls the UI timer should make (10 Hz renewal)."""
+CURVE_ROT = 50.0
+"""Rotation ratio (%) used when a turn key is held together with forward or backward."""
+
+DIRECTIONS = ("forward", "backward", "left", "right")
+
+
+class Notice(Enum):
+    INFO = "info"
+    WARNING = "warning"
+    ERROR = "error"
+
+
+class View(Protocol):
+    """What the controller needs from a window (GTK, a test fake, or nothing at all)."""
+
+    def notify(self, level: Notice, text: str) -> None:
+        """Show a short message (banner/toast) to the operator."""
+
+    def commands_changed(self, states: Mapping[str, CommandState]) -> None:
+        """Enable/disable commands; ``states`` holds every command whose state changed."""
+
+    def ask_password(self, profile: Profile, answer: Callable[[str | None], None]) -> None:
+        """Ask for the password of ``profile`` without blocking; call ``answer`` (None = cancelled)."""
+
+
+class ClientLink(Protocol):
+    """The network side as the controller sees it (``rtmu.client.ClientRunner``); every call returns at once.
+
+    Results come back through the model (connection, robot, map, camera) on the
+    UI thread; problems the operator should hear about go to ``on_notice``.
+    """
+
+    lease: DriveLease
+    on_notice: Callable[[str, str], None] | None
+    """Set by the controller: ``on_notice(level, text)`` with level ``info``/``warning``/``error``."""
+
+    def connect(
+        self,
+        host: str,
+        port: int,
+        user: str = "",
+        password: str = "",
+        *,
+        profile: str = "",
+        auto_reconnect: bool = True,
+    ) -> None: ...
+
+    def disconnect(self) -> None: ...
+
+    def stop(self) -> None:
+        """Zero ratios and ``stop``, sent whatever the link health says."""
+
+    def command(self, name: str, *args: object) -> None:
+        """Fire-and-forget request-once (``turnByAngle``, ``moveDist``…)."""
+
+    def request_image(self) -> None: ...
+
+    def set_safe_drive(self, on: bool) -> None: ...
+
+
+class SecretStore(Protocol):
+    """Where remembered passwords live (``rtmu.settings`` provides the keyring-backed one)."""
+
+    def get(self, profile: Profile) -> str | None: ...
+
+
+def ratios_for(held: set[str] | frozenset[str], throttle: float) -> DriveRatios:
+    """The ``ratioDrive`` for a set of held directions (empty or cancelling → zero motion)."""
+    trans = 100.0 * (("forward" in held) - ("backward" in held))
+    rot = 100.0 * (("left" in held) - ("right" in held))
+    if trans and rot:
+        rot = CURVE_ROT if rot > 0 else -CURVE_ROT
+    return DriveRatios(trans, rot, float(throttle))
+
+
+class Controller:
+    """See the module notes. Construct once per window; call everything from the UI thread."""
+
+    def __init__(
+        self,
+        model: Model,
+        link: ClientLink,
+        view: View,
+        *,
+        clock: Callable[[], float] = time.monotonic,
+        registry: CommandRegistry = COMMANDS,
+        secrets: SecretStore | None = None,
+        profile: Profile | None = None,
+    ) -> None:
+        self.model = model
+        self.link = link
+        self.view = view
+        self.clock = clock
+        self.registry = registry
+        self.secrets = secrets
+        self.profile = profile or Profile()
+        self._held: set[str] = set()
+        self._blocked: set[str] = set()
+        """Keys that were held when motion was stopped for them; ignored until released."""
+        self._generation: int | None = None
+        self._states: dict[str, CommandState] = {}
+        link.on_notice = self._on_link_notice
+        model.connection.observe(self._on_connection)
+        model.health.observe(self._on_health)
+        self.refresh_commands()
+
+    # -- CommandContext ----------------------------------------------------------------------
+    @property
+    def connected(self) -> bool:
+        return self.model.connection.value.connected
+
+    def supports(self, name: str) -> bool:
+        return self.model.connection.value.supports(name)
+
+    def image_source(self) -> str | None:
+        """The data a picture is requested with: the first getPicture…, else sendVideo, else None."""
+        offers = self.model.connection.value.offers
+        pictures = sorted(n for n in offers if n.startswith("getPicture"))
+        if pictures:
+            return pictures[0]
+        return "sendVideo" if "sendVideo" in offers else None
+
+    # -- commands ----------------------------------------------------------------------------
+    def run(self, name: str) -> bool:
+        """Run (or, for hold commands, press) command ``name``; False if it is disabled."""
+        cmd = self.registry.get(name)
+        reason = cmd.unavailable(self)
+        if reason is not None:
+            self.view.notify(Notice.WARNING, f"{cmd.label}: {reason}")
+            return False
+        cmd.activate(self)
+        return True
+
+    def release_command(self, name: str) -> None:
+        """Key of a hold command released (always honoured, even if the command became disabled)."""
+        cmd = self.registry.get(name)
+        if cmd.hold:
+            cmd.deactivate(self)
+
+    def command_states(self) -> dict[str, CommandState]:
+        return dict(self._states)
+
+    def refresh_commands(self) -> None:
+        """Recompute every command's state and tell the view about those that changed."""
+        states = self.registry.states(self)
+        changed = {k: v for k, v in states.items() if self._states.get(k) != v}
+        self._states = states
+        if changed:
+            self.view.commands_changed(changed)
+
+    # -- held motion -------------------------------------------------------------------------
+    @property
+    def held(self) -> frozenset[str]:
+        return frozenset(self._held)
+
+    def press(self, direction: str) -> None:
+        if direction not in DIRECTIONS:
+            raise ValueError(f"unknown direction {direction!r}")
+        if direction in self._held or direction in self._blocked:
+            return  # key auto-repeat, or a key held through a stop: wait for its release
+        if not self.connected or not self.supports("ratioDrive"):
+            self._blocked.add(direction)
+            return
+        self._held.add(direction)
+        self._apply()
+
+    def release(self, direction: str) -> None:
+        self._blocked.discard(direction)
+        if direction not in self._held:
+            return
+        self._held.discard(direction)
+        self._apply()
+
+    def tick(self) -> None:
+        """Renew the lease while keys are held. Call every :data:`TICK` s from the UI thread's timer."""
+        if not self._held:
+            return
+        if not self.link.lease.renew():
+            reason = self.link.lease.ended or EndReason.LAPSED
+            self._halt_held(reason)
+
+    def _apply(self) -> None:
+        ratios = ratios_for(self._held, self.model.speed.value.percent)
+        lease = self.link.lease
+        if not ratios.moving:
+            if self._generation is not None:
+                lease.release()
+                self._generation = None
+            return
+        if self._generation is None or not lease.change(ratios):
+            if self._generation is not None:
+                # The lease died under us (lapsed/stale); the keys pressed before are stale too.
+                self._halt_held(lease.ended or EndReason.LAPSED)
+                return
+            self._generation = lease.grant(ratios)
+
+    def _halt_held(self, reason: EndReason) -> None:
+        """Motion was stopped for ``reason`` while keys were held: block them until released."""
+        had = bool(self._held)
+        self._blocked |= self._held
+        self._held.clear()
+        if self._generation is not None:
+            self.link.lease.end(reason, self._generation)
+            self._generation = None
+        if had and reason is EndReason.LAPSED:
+            self.view.notify(
+                Notice.WARNING, "Stopped: the window did not respond in time. Press again to drive."
+            )
+
+    def stop(self) -> None:
+        """Stop now. Always sent, whatever the link looks like; held keys must be pressed again."""
+        self._halt_held(EndReason.STOPPED)
+        self.link.lease.end(EndReason.STOPPED)
+        if self.model.connection.value.phase in (Phase.CONNECTED, Phase.RECONNECTING, Phase.CONNECTING):
+            self.link.stop()
+
+    def focus_lost(self) -> None:
+        """The window lost keyboard focus: key releases may never arrive, so stop."""
+        if self._held or self._generation is not None:
+            self.stop()
+        self._blocked.clear()  # no key can be "still held" once focus is gone
+
+    # -- speed -------------------------------------------------------------------------------
+    def speed_up(self) -> None:
+        self._set_speed(self.model.speed.value.faster(), "maximum")
+
+    def speed_down(self) -> None:
+        self._set_speed(self.model.speed.value.slower(), "minimum")
+
+    def _set_speed(self, new, limit: str) -> None:  # type: ignore[no-untyped-def]
+        if not self.model.speed.set(new):
+            self.view.notify(Notice.INFO, f"Speed is already at its {limit} ({new.percent} %)")
+            return
+        self.view.notify(Notice.INFO, f"Speed {new.percent} %")
+        if self._held and self._generation is not None:
+            self._apply()
+
+    # -- bounded moves, sensing, modes -------------------------------------------------------
+    def turn_by(self, degrees: float) -> None:
+        """Turn in place by ``degrees`` (positive = left), the server's ``turnByAngle``."""
+        if self._require("turnByAngle"):
+            self._halt_held(EndReason.STOPPED)
+            self.link.command("turnByAngle", float(degrees))
+
+    def move_distance(self, mm: float) -> None:
+        """Drive ``mm`` straight (negative = backwards), the server's ``moveDist``."""
+        if self._require("moveDist"):
+            self._halt_held(EndReason.STOPPED)
+            self.link.command("moveDist", float(mm))
+
+    def request_image(self) -> None:
+        if not self.connected:
+            self.view.notify(Notice.WARNING, "Camera picture: not connected")
+        elif self.image_source() is None:
+            self.view.notify(Notice.WARNING, "This server offers no camera pictures")
+        else:
+            self.link.request_image()
+
+    def set_safe_drive(self, on: bool) -> None:
+        if self._require("setSafeDrive"):
+            self.link.set_safe_drive(on)
+
+    def _require(self, name: str) -> bool:
+        if not self.connected:
+            self.view.notify(Notice.WARNING, "Not connected")
+            return False
+        if not self.supports(name):
+            self.view.notify(Notice.WARNING, f"This server does not offer {name}")
+            return False
+        return True
+
+    # -- connection --------------------------------------------------------------------------
+    def select_profile(self, profile: Profile) -> None:
+        self.profile = profile
+        self.model.view.update(
+            zoom=profile.zoom, follow_robot=profile.follow_robot, show_sonar=profile.show_sonar
+        )
+
+    def connect(self, password: str | None = None) -> None:
+        """Connect with the current profile; asks the view for the password when none is known."""
+        profile = self.profile
+        if self.model.connection.value.phase in (Phase.CONNECTING, Phase.CONNECTED, Phase.RECONNECTING):
+            return
+        if password is None and profile.user:
+            if profile.remember_password and self.secrets is not None:
+                password = self.secrets.get(profile)
+            if password is None:
+                self.view.ask_password(profile, self._password_answered)
+                return
+        self._start_connect(password or "")
+
+    def _password_answered(self, password: str | None) -> None:
+        if password is None:
+            self.view.notify(Notice.INFO, "Connection cancelled")
+            return
+        self._start_connect(password)
+
+    def _start_connect(self, password: str) -> None:
+        p = self.profile
+        self._halt_held(EndReason.DISCONNECTED)
+        self.link.connect(p.host, p.port, p.user, password, profile=p.name, auto_reconnect=p.auto_reconnect)
+
+    def disconnect(self) -> None:
+        self.stop()
+        self.link.disconnect()
+
+    # -- map view ----------------------------------------------------------------------------
+    def set_zoom(self, zoom: float) -> None:
+        self.model.view.update(zoom=max(0.0, min(ZOOM_LEVELS[-1], float(zoom))))
+
+    def zoom_in(self) -> None:
+        current = self.model.view.value.zoom
+        bigger = [z for z in ZOOM_LEVELS if z > current + 1e-9]
+        self.set_zoom(bigger[0] if bigger else ZOOM_LEVELS[-1])
+
+    def zoom_out(self) -> None:
+        current = self.model.view.value.zoom
+        if current == 0.0:
+            return  # already "fit"
+        smaller = [z for z in ZOOM_LEVELS if z < current - 1e-9]
+        self.set_zoom(smaller[-1] if smaller else ZOOM_LEVELS[0])
+
+    # -- reactions to the model --------------------------------------------------------------
+    def _on_connection(self, old: ConnectionState, new: ConnectionState) -> None:
+        if new.phase is not Phase.CONNECTED and old.phase is Phase.CONNECTED:
+            self._halt_held(EndReason.DISCONNECTED)
+        if new.phase is Phase.CONNECTED and old.phase is not Phase.CONNECTED:
+            self.view.notify(Notice.INFO, f"Connected to {new.host}:{new.port}")
+        elif new.phase is Phase.FAILED and new.error and new.error != old.error:
+            self.view.notify(Notice.ERROR, new.error)
+        elif new.phase is Phase.RECONNECTING and old.phase is Phase.CONNECTED:
+            self.view.notify(
+                Notice.WARNING, f"Link lost: reconnecting ({new.error})" if new.error else "Reconnecting"
+            )
+        self.refresh_commands()
+
+    def _on_health(self, old: LinkHealth, new: LinkHealth) -> None:
+        if new.level in (LinkLevel.STALE, LinkLevel.LOST) and old.level is LinkLevel.OK:
+            moving = bool(self._held) or self._generation is not None
+            self._halt_held(EndReason.LINK)
+            if moving:
+                self.link.stop()
+                self.view.notify(Notice.WARNING, f"Stopped: the link is {new.level.value}")
+
+    def _on_link_notice(self, level: str, text: str) -> None:
+        try:
+            notice = Notice(level)
+        except ValueError:
+            notice = Notice.INFO
+        self.view.notify(notice, text)
