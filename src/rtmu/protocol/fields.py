@@ -14,6 +14,7 @@ behaviour for optional trailing arguments).
 from __future__ import annotations
 
 import math
+import re
 import struct
 from typing import Final, TypeVar
 
@@ -47,20 +48,42 @@ def format_double(value: float) -> str:
     return "%g" % value  # noqa: UP031 -- C printf semantics, on purpose
 
 
+# What C's strtod accepts in the "C" locale, as one whole string: leading C whitespace, a sign, then
+# decimal, hexadecimal, inf/infinity or nan(...). Python's float() is laxer (trailing and Unicode
+# whitespace, underscores), so it only converts text that matched this first.
+_STRTOD_TEXT: Final = re.compile(
+    r"""[ \t\n\v\f\r]*[+-]?(?:
+        (?P<hex>0x(?:[0-9a-f]+(?:\.[0-9a-f]*)?|\.[0-9a-f]+)(?:p[+-]?[0-9]+)?)
+        | (?P<nan>nan(?:\([0-9a-z_]*\))?)
+        | inf(?:inity)?
+        | (?:[0-9]+(?:\.[0-9]*)?|\.[0-9]+)(?:e[+-]?[0-9]+)?
+    )""",
+    re.IGNORECASE | re.VERBOSE | re.ASCII,
+)
+
+
 def parse_double(text: str) -> float:
-    """Read a double as ARIA's ``bufToDouble`` does: exact ``INF``/``-INF``, else strtod, else 0.0."""
+    """Read a double as ARIA's ``bufToDouble`` does.
+
+    Exactly ``INF``/``-INF`` are the infinities; otherwise the text must be one whole number as
+    C's ``strtod`` reads it (``"12abc"``, ``""`` and ``"5 "`` are not), else the value is 0.0.
+    """
     if text == "INF":
         return math.inf
     if text == "-INF":
         return -math.inf
-    try:
-        value = float(text)
-    except ValueError:
+    match = _STRTOD_TEXT.fullmatch(text)
+    if match is None:
+        return 0.0
+    number = text.lstrip(" \t\n\v\f\r")
+    if match["hex"] is not None:
         try:
-            value = float.fromhex(text)
-        except ValueError:
-            return 0.0
-    return value
+            return float.fromhex(number)
+        except OverflowError:  # strtod saturates to HUGE_VAL
+            return -math.inf if number.startswith("-") else math.inf
+    if match["nan"] is not None:
+        return -math.nan if number.startswith("-") else math.nan
+    return float(number)
 
 
 def encode_text(text: str) -> bytes:
