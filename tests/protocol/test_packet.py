@@ -60,18 +60,13 @@ def wire(hex_bytes: str) -> bytes:
         # §1.1 captured from a real server
         pytest.param(ClientCommand.TCP_ONLY, b"", "0F 0C 08 00 05 00 00 05", id="1.1-client-tcp-only"),
         pytest.param(ServerCommand.TCP_ONLY, b"", "0F 0C 08 00 07 00 00 07", id="1.1-server-tcp-only"),
-        pytest.param(0x0119, FieldWriter().byte(1).bytes(), "0F 0C 09 00 19 01 01 00 18", id="1.1-safe-drive"),
+        pytest.param(0x0119, b"\x01", "0F 0C 09 00 19 01 01 00 18", id="1.1-safe-drive"),
         # §2.5 the C++ client's INTRODUCTION: UDP port 10000, no user, md5("") digest
         pytest.param(
             ClientCommand.INTRODUCTION,
-            FieldWriter()
-            .ubyte2(10000)
-            .string("")
-            .raw(hashlib.md5(b"").digest())
-            .string("")
-            .byte(0)
-            .bytes(),
-            "0F 0C 1D 00 02 00 | 10 27 | 00 | D4 1D 8C D9 8F 00 B2 04 E9 80 09 98 EC F8 42 7E | 00 | 00 | EB 9A",
+            FieldWriter().ubyte2(10000).string("").raw(hashlib.md5(b"").digest()).string("").byte(0).bytes(),
+            "0F 0C 1D 00 02 00 | 10 27 | 00 | D4 1D 8C D9 8F 00 B2 04 E9 80 09 98 EC F8 42 7E"
+            " | 00 | 00 | EB 9A",
             id="2.5-client-introduction",
         ),
     ],
@@ -95,7 +90,8 @@ def test_server_introduction_prefix_matches_the_capture() -> None:
         .bytes()
     )
     data = encode_packet(ServerCommand.INTRODUCTION, payload)
-    assert data.startswith(wire("0F 0C 31 00 02 00 61 6C 70 68 61 00 78 43 27 44 56 1E AF 1C E5 35 5F 79 44 4B"))
+    captured = "0F 0C 31 00 02 00 61 6C 70 68 61 00 78 43 | 27 44 56 1E | AF 1C E5 35 | 5F 79 44 4B"
+    assert data.startswith(wire(captured))
     assert len(data) == 0x31
 
 
