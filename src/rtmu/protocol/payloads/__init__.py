@@ -4,7 +4,7 @@ Importing this package registers every type, so :func:`payload_type_for`
 finds a decoder by data name.
 """
 
-from . import drive, robot
+from . import drive, map, mapstream, robot
 from .base import (
     NameMatch,
     Payload,
@@ -22,6 +22,8 @@ __all__ = [
     "Side",
     "decode_payload",
     "drive",
+    "map",
+    "mapstream",
     "payload_type",
     "payload_type_for",
     "register",
