@@ -1,0 +1,565 @@
+"""One logged-in ArNetworking connection on asyncio streams: :class:`AriaClient`.
+
+It wraps the sans-I/O ``ClientConnection`` (all wire knowledge lives there and
+in the typed payloads) and adds what needs a clock and a socket:
+
+* ``connect`` returns once the login is done and the data list is complete;
+* ``request`` subscribes a handler; ``request_once`` awaits a reply, collecting
+  multi-packet replies (maps) to their end marker; ``stream`` yields them one by
+  one; ``send`` fires a command that has no reply;
+* **every await has a timeout** — connect, login, each reply packet, the close —
+  so nothing can hang on a server that accepts and never answers;
+* every failure is a typed :mod:`~rtmu.client.errors` error.
+
+Replies carry no request id in ArNetworking: a reply is matched to the oldest
+pending request of the same data number (ARIA answers in order).
+
+Everything here runs on one asyncio loop (the network thread's, see
+``runner``); handlers are called on that loop and must be quick.
+"""
+
+from __future__ import annotations
+
+import asyncio
+import contextlib
+import logging
+import socket
+import time
+from collections import deque
+from collections.abc import AsyncIterator, Callable
+from dataclasses import dataclass, field
+
+from ..protocol.client_connection import ClientConnection, ClientState
+from ..protocol.datalist import DataList
+from ..protocol.decoder import DropStats
+from ..protocol.errors import ProtocolError
+from ..protocol.events import DataListReady, DataReceived, PeerShutdown, Rejected
+from ..protocol.fields import FieldWriter
+from ..protocol.payloads import Payload, Side, decode_payload
+from .errors import (
+    ClientError,
+    ClientTimeout,
+    ConnectionFailed,
+    ConnectionRefused,
+    LoginRejected,
+    NotSupported,
+    ProtocolFault,
+    ServerClosed,
+)
+
+log = logging.getLogger(__name__)
+
+DEFAULT_PORT = 7272
+CONNECT_TIMEOUT = 10.0
+"""ARIA's own client gives up connecting after 10 s."""
+REPLY_TIMEOUT = 5.0
+"""Default wait for a reply, and for each further packet of a multi-packet reply."""
+CLOSE_TIMEOUT = 0.2
+"""How long ``disconnect`` lets the goodbye flush before cutting the socket."""
+MAX_WRITE_BUFFER = 1 << 20
+"""A server that stops reading is dropped once this much output is queued (it would grow forever)."""
+READ_CHUNK = 1 << 16
+
+Arg = Payload | bytes | bytearray | str | float | int | bool
+
+
+def encode_args(args: tuple[Arg, ...]) -> bytes:
+    """Request arguments → payload bytes.
+
+    A typed :class:`Payload` encodes itself; ``bytes`` go as they are; ``str`` is an
+    ARIA string; ``bool`` a ubyte 0/1; other numbers an ARIA double (as text).
+    Integer fields of other sizes: pass bytes built with ``FieldWriter`` or a typed payload.
+    """
+    w = FieldWriter()
+    for arg in args:
+        if isinstance(arg, Payload):
+            w.raw(arg.encode())
+        elif isinstance(arg, (bytes, bytearray)):
+            w.raw(arg)
+        elif isinstance(arg, str):
+            w.string(arg)
+        elif isinstance(arg, bool):
+            w.ubyte(1 if arg else 0)
+        elif isinstance(arg, (int, float)):
+            w.double(float(arg))
+        else:
+            raise TypeError(f"cannot encode request argument {arg!r}")
+    return w.bytes()
+
+
+@dataclass(frozen=True, slots=True)
+class Reply:
+    """The packet(s) answering one request: ``payloads`` in arrival order (one for most data)."""
+
+    name: str
+    payloads: tuple[bytes, ...]
+    received_at: float = field(compare=False)
+
+    @property
+    def payload(self) -> bytes:
+        """The first (usually only) payload; ``b""`` if there was none."""
+        return self.payloads[0] if self.payloads else b""
+
+    def decode(self) -> Payload:
+        """The first payload as its typed reply class (``rtmu.protocol.payloads``)."""
+        typed = decode_payload(self.name, Side.REPLY, self.payload)
+        if typed is None:
+            raise NotSupported(self.name, f"RTMU has no decoder for {self.name!r} replies")
+        return typed
+
+
+@dataclass(frozen=True, slots=True)
+class Packet:
+    """One reply or broadcast packet handed to a subscription handler."""
+
+    name: str
+    payload: bytes
+    received_at: float
+
+    def decode(self) -> Payload:
+        typed = decode_payload(self.name, Side.REPLY, self.payload)
+        if typed is None:
+            raise NotSupported(self.name, f"RTMU has no decoder for {self.name!r} packets")
+        return typed
+
+
+Handler = Callable[[Packet], None]
+
+
+# -- how a reply ends -----------------------------------------------------------------------------
+# ArNetworking has no end-of-reply framing; each data has its own pattern (protocol §3.7, §4.5).
+
+
+class _EndRule:
+    """Decides, packet by packet, whether a reply is complete."""
+
+    def done(self, payload: bytes, count_before: int) -> bool:
+        raise NotImplementedError
+
+
+class _Single(_EndRule):
+    def __init__(self, n: int = 1) -> None:
+        self.n = n
+
+    def done(self, payload: bytes, count_before: int) -> bool:
+        return count_before + 1 >= self.n
+
+
+class _UntilEmpty(_EndRule):
+    """RETURN_UNTIL_EMPTY: a zero-length packet ends the series."""
+
+    def done(self, payload: bytes, count_before: int) -> bool:
+        return not payload
+
+
+class _MapStream(_EndRule):
+    """``getMap``/``getMapBinary``: ends with a zero-length packet, or at once with one ``00`` (no map)."""
+
+    def done(self, payload: bytes, count_before: int) -> bool:
+        return not payload or (count_before == 0 and payload == b"\x00")
+
+
+_MAP_STREAMS = frozenset({"getMap", "getMapBinary", "getMapMultiScans", "getMapWithMaxCategory"})
+
+
+def _end_rule(entry_flags: frozenset[str], name: str, expect: int | None) -> _EndRule | None:
+    """None = the data has no reply (RETURN_NONE)."""
+    if expect is not None:
+        return _Single(expect)
+    if name in _MAP_STREAMS:
+        return _MapStream()
+    if name == "popupList" or "RETURN_UNTIL_EMPTY" in entry_flags:
+        return _UntilEmpty()
+    if "RETURN_NONE" in entry_flags:
+        return None
+    return _Single()
+
+
+class _Pending:
+    """One request waiting for its reply packets."""
+
+    __slots__ = ("error", "finished", "payloads", "progress", "queue", "rule")
+
+    def __init__(self, rule: _EndRule, streaming: bool) -> None:
+        self.rule = rule
+        self.payloads: list[bytes] = []
+        self.queue: asyncio.Queue[bytes | None] | None = asyncio.Queue() if streaming else None
+        self.progress = asyncio.Event()
+        self.finished = False
+        self.error: ClientError | None = None
+
+    def feed(self, payload: bytes) -> bool:
+        if self.finished:
+            return True
+        self.finished = self.rule.done(payload, len(self.payloads))
+        self.payloads.append(payload)
+        if self.queue is not None:
+            self.queue.put_nowait(payload)
+            if self.finished:
+                self.queue.put_nowait(None)
+        self.progress.set()
+        return self.finished
+
+    def fail(self, error: ClientError) -> None:
+        if self.finished:
+            return
+        self.finished = True
+        self.error = error
+        if self.queue is not None:
+            self.queue.put_nowait(None)
+        self.progress.set()
+
+
+class AriaClient:
+    """One connection. Create, ``await connect(...)``, use, ``await disconnect()``.
+
+    ``on_close(error)`` is called once when the connection ends for any reason
+    other than :meth:`disconnect` (``error`` says why, e.g. :class:`ServerClosed`).
+    """
+
+    def __init__(
+        self,
+        *,
+        on_close: Callable[[ClientError], None] | None = None,
+        clock: Callable[[], float] = time.monotonic,
+    ) -> None:
+        self.on_close = on_close
+        self.clock = clock
+        self.host = ""
+        self.port = 0
+        self.user = ""
+        self._conn: ClientConnection | None = None
+        self._reader: asyncio.StreamReader | None = None
+        self._writer: asyncio.StreamWriter | None = None
+        self._read_task: asyncio.Task[None] | None = None
+        self._handlers: dict[int, Handler] = {}
+        self._pending: dict[int, deque[_Pending]] = {}
+        self._closed_error: ClientError | None = None
+        self._closing = False
+        self.handler_errors = 0
+        """Exceptions raised by subscription handlers (logged, never fatal)."""
+        self.last_packet_at: float | None = None
+        self.packets_received = 0
+
+    # -- state -----------------------------------------------------------------------------
+    @property
+    def connected(self) -> bool:
+        return (
+            self._conn is not None
+            and self._conn.state is ClientState.CONNECTED
+            and not self._closing
+            and self._closed_error is None
+        )
+
+    @property
+    def datalist(self) -> DataList:
+        return self._conn.datalist if self._conn is not None else DataList()
+
+    @property
+    def drops(self) -> DropStats:
+        """What the decoder threw away on this connection (bad checksums, garbage bytes…)."""
+        return self._conn.decoder.stats if self._conn is not None else DropStats()
+
+    @property
+    def closed_error(self) -> ClientError | None:
+        """Why the connection ended (None while open or after a plain ``disconnect``)."""
+        return self._closed_error
+
+    def supports(self, name: str) -> bool:
+        """True if the server offers ``name`` to this user (after ``connect``)."""
+        return self._conn is not None and name in self._conn.datalist
+
+    # -- connect ---------------------------------------------------------------------------
+    async def connect(
+        self,
+        host: str,
+        port: int = DEFAULT_PORT,
+        user: str | None = None,
+        password: str | None = None,
+        *,
+        timeout: float = CONNECT_TIMEOUT,
+        server_key: str = "",
+    ) -> DataList:
+        """Open the socket, log in and wait for the complete data list, all within ``timeout`` s."""
+        if self._conn is not None:
+            raise RuntimeError("AriaClient objects are single-use: make a new one to connect again")
+        self.host, self.port, self.user = host, port, user or ""
+        self._conn = ClientConnection(user or "", password or "", server_key=server_key)
+        deadline = asyncio.get_running_loop().time() + timeout
+        try:
+            async with asyncio.timeout_at(deadline):
+                self._reader, self._writer = await asyncio.open_connection(host, port)
+        except TimeoutError:
+            raise ClientTimeout(f"connecting to {host}:{port} timed out after {timeout:g} s") from None
+        except ConnectionRefusedError:
+            raise ConnectionRefused(
+                f"connection refused by {host}:{port} (is the robot server running on that port?)"
+            ) from None
+        except socket.gaierror as exc:
+            raise ConnectionFailed(f"cannot find host {host!r}: {exc.strerror or exc}") from None
+        except OSError as exc:
+            raise ConnectionFailed(f"cannot connect to {host}:{port}: {exc.strerror or exc}") from None
+        sock = self._writer.get_extra_info("socket")
+        if sock is not None:
+            with contextlib.suppress(OSError):
+                sock.setsockopt(socket.IPPROTO_TCP, socket.TCP_NODELAY, 1)
+        try:
+            async with asyncio.timeout_at(deadline):
+                await self._login()
+        except TimeoutError:
+            self._abort()
+            raise ClientTimeout(
+                f"{host}:{port} accepted the connection but did not complete the login within {timeout:g} s"
+            ) from None
+        except BaseException:
+            self._abort()
+            raise
+        self._read_task = asyncio.get_running_loop().create_task(self._read_loop(), name="aria-read")
+        return self._conn.datalist
+
+    async def _login(self) -> None:
+        assert self._reader is not None and self._conn is not None
+        while True:
+            try:
+                data = await self._reader.read(READ_CHUNK)
+            except OSError as exc:
+                raise ServerClosed(f"the connection broke during login: {exc.strerror or exc}") from None
+            if not data:
+                raise ServerClosed(f"{self.host}:{self.port} closed the connection during login")
+            try:
+                events = self._conn.receive_data(data)
+            except ProtocolError as exc:
+                raise ProtocolFault(f"{self.host}:{self.port} is not an ArNetworking server: {exc}") from None
+            self._flush()
+            ready = False
+            for event in events:
+                if isinstance(event, Rejected):
+                    raise LoginRejected(event.reason, event.text)
+                if isinstance(event, PeerShutdown):
+                    raise ServerClosed(f"{self.host}:{self.port} shut the connection down during login")
+                if isinstance(event, DataListReady):
+                    ready = True
+                elif isinstance(event, DataReceived):
+                    self._dispatch(event)
+            if ready:
+                return
+
+    # -- requests --------------------------------------------------------------------------
+    def _number(self, name: str) -> int:
+        conn = self._require_open()
+        number = conn.datalist.number(name)
+        if number is None:
+            raise NotSupported(name)
+        return number
+
+    def _require_open(self) -> ClientConnection:
+        if self._closed_error is not None:
+            raise self._closed_error
+        if self._conn is None or not self.connected:
+            raise ServerClosed("not connected")
+        return self._conn
+
+    def request(self, name: str, interval_ms: int, handler: Handler, *args: Arg) -> None:
+        """Subscribe: ``handler(packet)`` now and every ``interval_ms`` (−1: broadcasts only).
+
+        Requesting the same name again replaces the handler and interval (ARIA then sends no
+        immediate reply).
+        """
+        number = self._number(name)
+        self._handlers[number] = handler
+        self._conn.request(name, interval_ms, encode_args(args))  # type: ignore[union-attr]
+        self._flush()
+
+    def stop_request(self, name: str) -> None:
+        """End a subscription (no reply). Unknown or unsubscribed names are ignored."""
+        number = self._conn.datalist.number(name) if self._conn is not None else None
+        if number is None or not self.connected:
+            return
+        self._handlers.pop(number, None)
+        self._conn.request_stop(name)  # type: ignore[union-attr]
+        self._flush()
+
+    def send(self, name: str, *args: Arg) -> None:
+        """Run ``name`` once without waiting for anything (``stop``, ``ratioDrive``, ``turnByAngle``…)."""
+        self._number(name)
+        self._conn.request_once(name, encode_args(args))  # type: ignore[union-attr]
+        self._flush()
+
+    async def request_once(
+        self, name: str, *args: Arg, timeout: float = REPLY_TIMEOUT, expect: int | None = None
+    ) -> Reply:
+        """Run ``name`` once and await its reply.
+
+        Multi-packet replies (``getMap``, ``getMapBinary``, RETURN_UNTIL_EMPTY data) are
+        collected to their end marker; ``timeout`` bounds the wait for *each* packet, so a big
+        map may take longer overall but a stalled one fails. ``expect=n`` waits for exactly n
+        packets (``getSensorCurrent`` with n names). Data that has no reply (RETURN_NONE) is
+        sent and an empty :class:`Reply` returned at once.
+        """
+        pending = self._start(name, args, expect, streaming=False)
+        if pending is None:
+            return Reply(name, (), self.clock())
+        while not pending.finished:
+            pending.progress.clear()
+            try:
+                async with asyncio.timeout(timeout):
+                    await pending.progress.wait()
+            except TimeoutError:
+                got = len(pending.payloads)
+                self._abandon(name, pending)
+                raise ClientTimeout(
+                    f"no reply to {name!r} from {self.host}:{self.port} within {timeout:g} s"
+                    + (f" (after {got} packets)" if got else "")
+                ) from None
+        if pending.error is not None:
+            raise pending.error
+        return Reply(name, tuple(pending.payloads), self.clock())
+
+    async def stream(
+        self, name: str, *args: Arg, timeout: float = REPLY_TIMEOUT, expect: int | None = None
+    ) -> AsyncIterator[bytes]:
+        """Like :meth:`request_once` but yields each payload as it arrives (progress for big maps)."""
+        pending = self._start(name, args, expect, streaming=True)
+        if pending is None:
+            return
+        assert pending.queue is not None
+        try:
+            while True:
+                try:
+                    async with asyncio.timeout(timeout):
+                        payload = await pending.queue.get()
+                except TimeoutError:
+                    raise ClientTimeout(
+                        f"{name!r} from {self.host}:{self.port} stalled for {timeout:g} s "
+                        f"after {len(pending.payloads)} packets"
+                    ) from None
+                if payload is None:
+                    if pending.error is not None:
+                        raise pending.error
+                    return
+                yield payload
+        finally:
+            if not pending.finished:
+                self._abandon(name, pending)
+
+    def _start(
+        self, name: str, args: tuple[Arg, ...], expect: int | None, streaming: bool
+    ) -> _Pending | None:
+        number = self._number(name)
+        entry = self._conn.datalist.entry(number)  # type: ignore[union-attr]
+        rule = _end_rule(entry.flag_set if entry else frozenset(), name, expect)
+        payload = encode_args(args)
+        if rule is None:
+            self._conn.request_once(name, payload)  # type: ignore[union-attr]
+            self._flush()
+            return None
+        pending = _Pending(rule, streaming)
+        self._pending.setdefault(number, deque()).append(pending)
+        self._conn.request_once(name, payload)  # type: ignore[union-attr]
+        self._flush()
+        return pending
+
+    def _abandon(self, name: str, pending: _Pending) -> None:
+        """A waiter gave up: keep its slot so late packets still line up, but stop caring."""
+        pending.fail(ClientTimeout(f"{name!r} abandoned"))
+
+    # -- I/O -------------------------------------------------------------------------------
+    def _flush(self) -> None:
+        if self._conn is None or self._writer is None:
+            return
+        data = self._conn.data_to_send()
+        if not data or self._writer.is_closing():
+            return
+        self._writer.write(data)
+        if self._writer.transport.get_write_buffer_size() > MAX_WRITE_BUFFER:
+            self._fail(ServerClosed(f"{self.host}:{self.port} stopped reading; the connection was dropped"))
+
+    async def _read_loop(self) -> None:
+        assert self._reader is not None and self._conn is not None
+        try:
+            while True:
+                data = await self._reader.read(READ_CHUNK)
+                if not data:
+                    self._fail(ServerClosed(f"{self.host}:{self.port} closed the connection"))
+                    return
+                for event in self._conn.receive_data(data):
+                    if isinstance(event, DataReceived):
+                        self._dispatch(event)
+                    elif isinstance(event, PeerShutdown):
+                        self._fail(ServerClosed(f"{self.host}:{self.port} shut down"))
+                        return
+                self._flush()
+        except asyncio.CancelledError:
+            raise
+        except ProtocolError as exc:
+            self._fail(ProtocolFault(f"{self.host}:{self.port} broke the protocol: {exc}"))
+        except OSError as exc:
+            reason = exc.strerror or exc
+            self._fail(ServerClosed(f"the connection to {self.host}:{self.port} broke: {reason}"))
+
+    def _dispatch(self, event: DataReceived) -> None:
+        now = self.clock()
+        self.last_packet_at = now
+        self.packets_received += 1
+        number = event.command
+        queue = self._pending.get(number)
+        if queue:
+            head = queue[0]
+            if head.feed(event.payload):
+                queue.popleft()
+        handler = self._handlers.get(number)
+        if handler is not None:
+            try:
+                handler(Packet(event.name or str(number), event.payload, now))
+            except Exception:
+                self.handler_errors += 1
+                log.exception("handler for %s failed", event.name)
+
+    def _fail(self, error: ClientError) -> None:
+        """The connection is over (not by our choice): fail every waiter, tell ``on_close`` once."""
+        if self._closed_error is not None or self._closing:
+            return
+        self._closed_error = error
+        self._teardown(error)
+        if self.on_close is not None:
+            try:
+                self.on_close(error)
+            except Exception:
+                log.exception("on_close callback failed")
+
+    def _teardown(self, error: ClientError) -> None:
+        for queue in self._pending.values():
+            for pending in queue:
+                pending.fail(error)
+        self._pending.clear()
+        self._handlers.clear()
+        self._abort()
+
+    def _abort(self) -> None:
+        if self._writer is not None:
+            transport = self._writer.transport
+            if not transport.is_closing():
+                transport.abort()
+
+    async def disconnect(self) -> None:
+        """Say goodbye and close within :data:`CLOSE_TIMEOUT` s. Safe to call twice, or unconnected."""
+        if self._closing:
+            return
+        self._closing = True
+        task = self._read_task
+        if task is not None and task is not asyncio.current_task():
+            task.cancel()
+        if self._conn is not None and self._writer is not None and self._closed_error is None:
+            self._conn.shutdown()
+            data = self._conn.data_to_send()
+            writer = self._writer
+            if not writer.is_closing():
+                with contextlib.suppress(OSError):
+                    writer.write(data)
+                writer.close()
+                with contextlib.suppress(Exception):
+                    await asyncio.wait_for(writer.wait_closed(), CLOSE_TIMEOUT)
+        self._teardown(ServerClosed("disconnected"))
+        if task is not None and task is not asyncio.current_task():
+            with contextlib.suppress(asyncio.CancelledError, Exception):
+                await task

@@ -1,0 +1,76 @@
+"""Errors an operator (or a script) can act on, each with the exit code ``rtmu`` uses for it.
+
+Every failure of the client surfaces as one of these, never as a bare
+``OSError`` or ``asyncio.TimeoutError``: the window shows ``str(error)`` as is,
+and the command line prints it on one line and exits with ``error.exit_code``.
+"""
+
+from __future__ import annotations
+
+from ..cli import EXIT_CONNECTION, EXIT_TIMEOUT, EXIT_UNSUPPORTED
+from ..protocol.commands import RejectReason, describe_reject
+
+
+class ClientError(Exception):
+    """Base of every client failure."""
+
+    exit_code = EXIT_CONNECTION
+    kind = "error"
+    """Short machine-readable class (``ConnectionState.error_kind``)."""
+
+
+class ConnectionRefused(ClientError):
+    """Nothing listens on that host and port (the server is not running, or a wrong port)."""
+
+    kind = "refused"
+
+
+class ConnectionFailed(ClientError):
+    """The TCP connection could not be made for another reason (unknown host, no route…)."""
+
+    kind = "unreachable"
+
+
+class ClientTimeout(ClientError, TimeoutError):
+    """The server did not answer in time (connect, login, or a request)."""
+
+    exit_code = EXIT_TIMEOUT
+    kind = "timeout"
+
+
+class LoginRejected(ClientError):
+    """The server refused the login; ``reason`` is ARIA's REJECTED code, ``text`` its own words."""
+
+    kind = "login"
+
+    def __init__(self, reason: int, text: str = "") -> None:
+        self.reason = reason
+        self.text = text
+        super().__init__(f"login refused: {describe_reject(reason, text)}")
+
+    @property
+    def bad_credentials(self) -> bool:
+        return self.reason == RejectReason.BAD_USER_OR_PASSWORD
+
+
+class ServerClosed(ClientError):
+    """The connection ended: the server said goodbye, died, or we disconnected."""
+
+    kind = "closed"
+
+
+class ProtocolFault(ClientError):
+    """The server sent something that is not ArNetworking (or not in the state we were in)."""
+
+    kind = "protocol"
+
+
+class NotSupported(ClientError):
+    """This server (or this user's permissions) does not offer the data a command needs."""
+
+    exit_code = EXIT_UNSUPPORTED
+    kind = "unsupported"
+
+    def __init__(self, name: str, detail: str = "") -> None:
+        self.name = name
+        super().__init__(detail or f"this server does not offer {name!r} (or this user may not use it)")

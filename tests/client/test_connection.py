@@ -1,0 +1,326 @@
+"""AriaClient against scripted servers over real loopback sockets: every call and every failure."""
+
+from __future__ import annotations
+
+import asyncio
+import socket
+
+import pytest
+
+from rtmu.client.connection import AriaClient
+from rtmu.client.errors import (
+    ClientTimeout,
+    ConnectionRefused,
+    LoginRejected,
+    NotSupported,
+    ProtocolFault,
+    ServerClosed,
+)
+from rtmu.protocol.auth import UserTable
+from rtmu.protocol.fields import FieldReader
+from rtmu.protocol.packet import encode_packet
+from rtmu.protocol.payloads.robot import UpdateNumbers
+
+from .servers import MAP_LINES, TestServer, run
+
+USERS = UserTable.parse("UserInfoVersion1\nuser alice secret1 all\nuser bob pw2 RobotInfo Stop\n")
+
+
+def free_port() -> int:
+    with socket.socket() as s:
+        s.bind(("127.0.0.1", 0))
+        return s.getsockname()[1]
+
+
+async def connected(server: TestServer, **kw: object) -> AriaClient:
+    client = AriaClient()
+    await client.connect("127.0.0.1", server.port, timeout=5, **kw)  # type: ignore[arg-type]
+    return client
+
+
+def test_connect_lists_data_and_supports() -> None:
+    async def go() -> None:
+        server = TestServer()
+        await server.start()
+        client = await connected(server)
+        assert client.connected
+        assert client.supports("ratioDrive") and not client.supports("wander")
+        assert [e.name for e in client.datalist][:2] == ["updateNumbers", "updateStrings"]
+        await client.disconnect()
+        await server.stop()
+
+    run(go())
+
+
+def test_request_once_single_reply_and_typed_decode() -> None:
+    async def go() -> None:
+        server = TestServer()
+        await server.start()
+        client = await connected(server)
+        reply = await client.request_once("updateNumbers", timeout=2)
+        numbers = reply.decode()
+        assert isinstance(numbers, UpdateNumbers)
+        assert (numbers.x, numbers.y, numbers.th) == (1000, 2000, 90)
+        await client.disconnect()
+        await server.stop()
+
+    run(go())
+
+
+def test_request_once_without_reply_returns_at_once_and_arrives() -> None:
+    async def go() -> None:
+        server = TestServer()
+        await server.start()
+        client = await connected(server)
+        reply = await client.request_once("turnByAngle", 90)
+        assert reply.payloads == ()
+        await client.request_once("getSafeDrive")  # a round trip: the server has seen the turn by now
+        turn = [r for r in server.received if r.name == "turnByAngle"]
+        assert FieldReader(turn[0].args).double() == 90.0
+        await client.disconnect()
+        await server.stop()
+
+    run(go())
+
+
+def test_subscription_streams_and_stop_request_ends_it() -> None:
+    async def go() -> None:
+        server = TestServer()
+        await server.start()
+        client = await connected(server)
+        got: list[UpdateNumbers] = []
+        arrived = asyncio.Event()
+
+        def on_numbers(packet):  # type: ignore[no-untyped-def]
+            got.append(packet.decode())
+            if len(got) >= 3:
+                arrived.set()
+
+        client.request("updateNumbers", 20, on_numbers)
+        await asyncio.wait_for(arrived.wait(), 3)
+        client.stop_request("updateNumbers")
+        await client.request_once("getSafeDrive")  # round trip: REQUESTSTOP processed
+        count = len(got)
+        await asyncio.sleep(0.1)
+        assert len(got) == count
+        assert "updateNumbers" in [r.name for r in server.received if r.kind == "stop"]
+        await client.disconnect()
+        await server.stop()
+
+    run(go())
+
+
+def test_map_collected_text_and_binary_and_streamed() -> None:
+    async def go() -> None:
+        server = TestServer()
+        await server.start()
+        client = await connected(server)
+        text = await client.request_once("getMap")
+        assert [FieldReader(p).string() for p in text.payloads[: len(MAP_LINES)]] == MAP_LINES
+        assert text.payloads[-2:] == (b"\x00", b"")
+        binary = await client.request_once("getMapBinary")
+        assert binary.payloads[-1] == b"" and len(binary.payloads) > 5
+        streamed = [p async for p in client.stream("getMapBinary")]
+        assert tuple(streamed) == binary.payloads
+        # No map: a single 00 ends the reply, and the next request still lines up.
+        server.map_lines = []
+        none = await client.request_once("getMap")
+        assert none.payloads == (b"\x00",)
+        assert (await client.request_once("getMapName")).payload == b"test.map\x00"
+        await client.disconnect()
+        await server.stop()
+
+    run(go())
+
+
+def test_replies_match_requests_in_order() -> None:
+    async def go() -> None:
+        server = TestServer()
+        await server.start()
+        client = await connected(server)
+        counter = iter(range(100))
+        server.handlers["getMapName"] = lambda s, a: [f"map{next(counter)}".encode() + b"\x00"]
+        replies = await asyncio.gather(*(client.request_once("getMapName") for _ in range(5)))
+        assert [r.payload for r in replies] == [f"map{i}".encode() + b"\x00" for i in range(5)]
+        await client.disconnect()
+        await server.stop()
+
+    run(go())
+
+
+def test_not_supported_is_typed() -> None:
+    async def go() -> None:
+        server = TestServer()
+        await server.start()
+        client = await connected(server)
+        with pytest.raises(NotSupported) as info:
+            await client.request_once("wander")
+        assert info.value.exit_code == 4 and "wander" in str(info.value)
+        with pytest.raises(NotSupported):
+            client.send("wander")
+        await client.disconnect()
+        await server.stop()
+
+    run(go())
+
+
+def test_connection_refused() -> None:
+    async def go() -> None:
+        with pytest.raises(ConnectionRefused) as info:
+            await AriaClient().connect("127.0.0.1", free_port(), timeout=2)
+        assert info.value.exit_code == 3 and "refused" in str(info.value)
+
+    run(go())
+
+
+def test_wrong_password_and_unknown_user_carry_arias_reason() -> None:
+    async def go() -> None:
+        server = TestServer(users=USERS)
+        await server.start()
+        for user, password in (("alice", "wrong"), ("mallory", "x"), ("", "")):
+            with pytest.raises(LoginRejected) as info:
+                await AriaClient().connect("127.0.0.1", server.port, user, password, timeout=2)
+            assert info.value.reason == 1 and info.value.bad_credentials
+            assert "wrong user name or password" in str(info.value)
+        client = await connected(server, user="ALICE", password="secret1")
+        assert client.supports("ratioDrive")
+        await client.disconnect()
+        bob = await connected(server, user="bob", password="pw2")
+        assert bob.supports("stop") and not bob.supports("ratioDrive")  # groups limit the list
+        await bob.disconnect()
+        await server.stop()
+
+    run(go())
+
+
+def test_server_that_accepts_but_never_answers_times_out() -> None:
+    async def go() -> None:
+        server = TestServer(silent=True)
+        await server.start()
+        loop = asyncio.get_running_loop()
+        t0 = loop.time()
+        with pytest.raises(ClientTimeout) as info:
+            await AriaClient().connect("127.0.0.1", server.port, timeout=0.3)
+        assert loop.time() - t0 < 2
+        assert info.value.exit_code == 5 and "did not complete the login" in str(info.value)
+        await server.stop()
+
+    run(go())
+
+
+def test_request_that_is_never_answered_times_out() -> None:
+    async def go() -> None:
+        server = TestServer()
+        server.handlers["getMapName"] = lambda s, a: None
+        await server.start()
+        client = await connected(server)
+        with pytest.raises(ClientTimeout):
+            await client.request_once("getMapName", timeout=0.2)
+        assert client.connected
+        await client.disconnect()
+        await server.stop()
+
+    run(go())
+
+
+def test_server_killed_mid_request() -> None:
+    async def go() -> None:
+        server = TestServer()
+        server.handlers["getMapName"] = lambda s, a: None
+        await server.start()
+        closed: list[Exception] = []
+        client = AriaClient(on_close=closed.append)
+        await client.connect("127.0.0.1", server.port, timeout=2)
+        waiting = asyncio.create_task(client.request_once("getMapName", timeout=5))
+        await asyncio.sleep(0.05)
+        server.kill(server.sides[0])
+        with pytest.raises(ServerClosed):
+            await waiting
+        assert len(closed) == 1 and isinstance(closed[0], ServerClosed)
+        assert not client.connected
+        with pytest.raises(ServerClosed):
+            await client.request_once("getMapName")
+        await client.disconnect()
+        await server.stop()
+
+    run(go())
+
+
+def test_server_closing_during_map_download() -> None:
+    async def go() -> None:
+        server = TestServer()
+        await server.start()
+
+        def half_map(side, args):  # type: ignore[no-untyped-def]
+            for line in MAP_LINES[:5]:
+                side.conn.send_data("getMap", line.encode() + b"\x00")
+            side.writer.write(side.conn.data_to_send())
+            asyncio.get_running_loop().call_later(0.05, server.kill, side)
+            return None
+
+        server.handlers["getMap"] = half_map
+        client = await connected(server)
+        with pytest.raises(ServerClosed):
+            await client.request_once("getMap", timeout=5)
+        await client.disconnect()
+        await server.stop()
+
+    run(go())
+
+
+def test_garbage_mid_stream_is_counted_and_the_stream_goes_on() -> None:
+    async def go() -> None:
+        server = TestServer()
+        await server.start()
+        client = await connected(server)
+        got: list[bytes] = []
+        client.request("updateNumbers", -1, lambda p: got.append(p.payload))
+        await client.request_once("getSafeDrive")
+        side = server.sides[0]
+        good = encode_packet(client.datalist.number("updateNumbers"), bytes(19))  # type: ignore[arg-type]
+        corrupt = bytearray(good)
+        corrupt[-1] ^= 0xFF
+        side.writer.write(b"\x00\x11\x0f\x22" + bytes(corrupt) + b"\x0f\x0c\x07\x00" + good)
+        await client.request_once("getSafeDrive")
+        assert got[-1] == bytes(19)
+        assert client.drops.bad_checksum == 1 and client.drops.bad_length == 1
+        assert client.connected
+        await client.disconnect()
+        await server.stop()
+
+    run(go())
+
+
+def test_not_arnetworking_is_a_protocol_error() -> None:
+    async def go() -> None:
+        async def bad(reader, writer):  # type: ignore[no-untyped-def]
+            writer.write(encode_packet(2, b"alpha"))  # an introduction cut short
+            await writer.drain()
+            await reader.read()
+
+        srv = await asyncio.start_server(bad, "127.0.0.1", 0)
+        port = srv.sockets[0].getsockname()[1]
+        with pytest.raises(ProtocolFault):
+            await AriaClient().connect("127.0.0.1", port, timeout=2)
+        srv.close()
+
+    run(go())
+
+
+def test_disconnect_is_clean_and_instant() -> None:
+    async def go() -> None:
+        server = TestServer()
+        await server.start()
+        client = await connected(server)
+        client.request("updateNumbers", 10, lambda p: None)
+        loop = asyncio.get_running_loop()
+        t0 = loop.time()
+        await client.disconnect()
+        assert loop.time() - t0 < 0.3
+        await asyncio.sleep(0.05)
+        assert "SHUTDOWN" in server.names()
+        assert client.closed_error is None  # our own choice, not a failure
+        await client.disconnect()  # twice is fine
+        await server.stop()
+
+    run(go())
