@@ -32,7 +32,8 @@ class DropStats:
     """What the decoder threw away, and why."""
 
     garbage_bytes: int = 0
-    """Bytes skipped while looking for a sync pair."""
+    """Every byte not delivered in a good packet: noise between packets and the bytes of bad
+    headers and packets. After :meth:`PacketDecoder.close`, bytes fed = good packets' bytes + this."""
     bad_length: int = 0
     """Headers whose length field was outside 8..32000."""
     bad_checksum: int = 0
@@ -96,6 +97,7 @@ class PacketDecoder:
             if start < 0:
                 break
             self.stats.truncated_at_close += 1
+            self.stats.garbage_bytes += start + 2 - self._pos
             self._pos = start + 2
         self.stats.garbage_bytes += self.buffered
         self._buf.clear()
@@ -123,6 +125,7 @@ class PacketDecoder:
                 length = buf[pos + 2] | buf[pos + 3] << 8
                 if length < MIN_LENGTH or length > MAX_LENGTH:
                     stats.bad_length += 1
+                    stats.garbage_bytes += 4
                     pos += 4
                     continue
                 if end - pos < length:
