@@ -4,7 +4,7 @@ Importing this package registers every type, so :func:`payload_type_for`
 finds a decoder by data name.
 """
 
-from . import drive, map, mapstream, robot
+from . import drive, map, mapstream, robot, sensors
 from .base import (
     NameMatch,
     Payload,
@@ -29,4 +29,5 @@ __all__ = [
     "register",
     "registered",
     "robot",
+    "sensors",
 ]
