@@ -15,7 +15,7 @@ from pathlib import Path
 
 from .fields import encode_text
 
-_ALNUM = re.compile(r"^[A-Za-z0-9]+$")
+_ALNUM = re.compile(r"[A-Za-z0-9]+")
 PASSWORD_KEY_ALPHABET = "".join(chr(c) for c in range(0x30, 0x7A))
 """Characters ARIA draws a connection's password key from: ``0`` through ``y``."""
 
@@ -69,7 +69,7 @@ class UserTable:
             elif keyword == "donotuse":
                 return None
             elif keyword == "user":
-                if len(words) < 3 or not _ALNUM.match(words[1]) or not _ALNUM.match(words[2]):
+                if len(words) < 3 or not _ALNUM.fullmatch(words[1]) or not _ALNUM.fullmatch(words[2]):
                     raise UserFileError(f"{source}:{number}: expected 'user NAME PASSWORD [GROUP ...]'")
                 table.users[words[1].lower()] = User(words[1], words[2], frozenset(words[3:]))
             else:
@@ -85,7 +85,7 @@ class UserTable:
 
     def check(self, name: str, digest: bytes, password_key: str, server_key: str = "") -> User | None:
         """The user if name and digest match, else None (ARIA's reason 1 covers every failure)."""
-        if not _ALNUM.match(name):
+        if not _ALNUM.fullmatch(name):
             return None
         user = self.users.get(name.lower())
         if user is None:

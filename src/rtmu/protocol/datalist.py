@@ -140,13 +140,19 @@ class DataList:
 
 def _triples(packet: Packet, counted: bool) -> Iterator[tuple[int, str, str]]:
     reader = FieldReader(packet.payload)
-    count = reader.ubyte2("count") if counted else 1
+    count = reader.ubyte2("count", default=0) if counted else 1  # ARIA reads a missing count as 0
     if count * 4 > reader.remaining + 4 * 3:
         raise PayloadError(f"list packet claims {count} entries in {len(packet.payload)} bytes")
     for _ in range(count):
-        if reader.at_end():
-            return  # ARIA may drop trailing entries that did not fit; take what is there
-        yield reader.ubyte2("data number"), reader.string("first text"), reader.string("second text")
+        # ARIA's writer silently drops entries, or single fields, that do not fit in the packet: take
+        # what is there, with a missing text read as "" as ARIA's own reader does.
+        if reader.remaining < 2:
+            return
+        yield (
+            reader.ubyte2("data number"),
+            reader.string("first text", default=""),
+            reader.string("second text", default=""),
+        )
 
 
 def _pack(command: int, rows: list[tuple[int, str, str]]) -> list[Packet]:
