@@ -4,7 +4,7 @@ Importing this package registers every type, so :func:`payload_type_for`
 finds a decoder by data name.
 """
 
-from . import drive, map, mapstream, robot, sensors
+from . import camera, drive, map, mapstream, robot, sensors
 from .base import (
     NameMatch,
     Payload,
@@ -20,6 +20,7 @@ __all__ = [
     "NameMatch",
     "Payload",
     "Side",
+    "camera",
     "decode_payload",
     "drive",
     "map",
