@@ -4,7 +4,7 @@ Importing this package registers every type, so :func:`payload_type_for`
 finds a decoder by data name.
 """
 
-from . import camera, drive, map, mapstream, robot, sensors
+from . import camera, commands, drive, map, mapstream, popup, robot, sensors, server, strings
 from .base import (
     NameMatch,
     Payload,
@@ -21,14 +21,18 @@ __all__ = [
     "Payload",
     "Side",
     "camera",
+    "commands",
     "decode_payload",
     "drive",
     "map",
     "mapstream",
     "payload_type",
     "payload_type_for",
+    "popup",
     "register",
     "registered",
     "robot",
     "sensors",
+    "server",
+    "strings",
 ]
