@@ -1,0 +1,133 @@
+"""``rtmu mapinfo FILE [--json]``: what an ARIA map holds, and where its header disagrees with its data."""
+
+from __future__ import annotations
+
+import argparse
+import json
+import sys
+from collections import Counter
+from typing import Any
+
+from rtmu.maps import Bounds, MapData, MapFormatError, read_map
+
+EXIT_OK = 0
+EXIT_BAD_MAP = 2
+
+
+def register(subparsers: argparse._SubParsersAction) -> None:
+    parser = subparsers.add_parser(
+        "mapinfo",
+        help="summarise an ARIA .map file (counts, bounds, objects)",
+        description="Summarise an ARIA .map file: category, counts found and claimed by the header, bounds, "
+        "resolution, map objects by type, goal names and unknown header keywords. Exit 2 if unreadable.",
+    )
+    parser.add_argument("file", metavar="FILE", help="the .map file")
+    parser.add_argument("--json", action="store_true", help="print one JSON object instead of text")
+    parser.set_defaults(handler=run)
+
+
+def run(args: argparse.Namespace) -> int:
+    try:
+        data = read_map(args.file)
+    except MapFormatError as exc:
+        print(f"rtmu mapinfo: {exc}", file=sys.stderr)
+        return EXIT_BAD_MAP
+    summary = summarise(data)
+    if args.json:
+        print(json.dumps(summary))
+    else:
+        print(render_text(summary))
+    return EXIT_OK
+
+
+def summarise(data: MapData) -> dict[str, Any]:
+    """Everything ``mapinfo`` reports, as plain JSON-ready values."""
+    scans = []
+    for scan in data.scans:
+        scans.append(
+            {
+                "name": scan.name,
+                "points": len(scan.points),
+                "claimed_points": scan.claimed.num_points,
+                "lines": len(scan.segments),
+                "claimed_lines": scan.claimed.num_lines,
+                "point_bounds": _box(scan.point_bounds()),
+                "claimed_point_bounds": _box(scan.claimed.point_bounds),
+                "line_bounds": _box(scan.line_bounds()),
+                "claimed_line_bounds": _box(scan.claimed.line_bounds),
+                "resolution": scan.resolution,
+            }
+        )
+    home = data.home()
+    unknown = [line.split(None, 1)[0] for line in data.unknown_lines]
+    return {
+        "file": data.source,
+        "category": data.category,
+        "points": data.num_points,
+        "claimed_points": data.claimed.num_points,
+        "lines": data.num_lines,
+        "claimed_lines": data.claimed.num_lines,
+        "bounds": _box(data.bounds()),
+        "resolution": data.resolution,
+        "scans": scans,
+        "objects": len(data.objects),
+        "objects_by_type": dict(Counter(obj.type for obj in data.objects)),
+        "goals": data.goal_names(),
+        "home": None if home is None else {"x": home.x, "y": home.y, "th": home.th},
+        "map_info": len(data.map_info),
+        "unknown_keywords": sorted(set(unknown)),
+        "unknown_lines": len(data.unknown_lines),
+        "skipped_lines": data.skipped_lines,
+        "warnings": data.warning_count,
+    }
+
+
+def render_text(summary: dict[str, Any]) -> str:
+    def claim(found: int, claimed: int | None) -> str:
+        if claimed is None:
+            return f"{found} (header: none)"
+        note = "" if claimed == found else "  <- header is stale"
+        return f"{found} (header: {claimed}){note}"
+
+    def box(value: list[int] | None) -> str:
+        return "none" if value is None else f"({value[0]}, {value[1]}) .. ({value[2]}, {value[3]})"
+
+    rows: list[tuple[str, str]] = [("file", summary["file"]), ("category", summary["category"])]
+    for scan in summary["scans"]:
+        title = f" [{scan['name']}]" if scan["name"] else ""
+        resolution = "none" if scan["resolution"] is None else f"{scan['resolution']} mm"
+        rows += [
+            (f"points{title}", claim(scan["points"], scan["claimed_points"])),
+            (f"lines{title}", claim(scan["lines"], scan["claimed_lines"])),
+            (
+                f"point bounds{title}",
+                f"{box(scan['point_bounds'])}  (header: {box(scan['claimed_point_bounds'])})",
+            ),
+            (
+                f"line bounds{title}",
+                f"{box(scan['line_bounds'])}  (header: {box(scan['claimed_line_bounds'])})",
+            ),
+            (f"resolution{title}", resolution),
+        ]
+    rows.append(("bounds", box(summary["bounds"])))
+    by_type = ", ".join(f"{name} {count}" for name, count in sorted(summary["objects_by_type"].items()))
+    rows.append(("objects", f"{summary['objects']}" + (f" ({by_type})" if by_type else "")))
+    goals = summary["goals"]
+    rows.append(
+        ("goals", f"{len(goals)}" + (": " + ", ".join(json.dumps(g) for g in goals) if goals else ""))
+    )
+    home = summary["home"]
+    rows.append(("home", "none" if home is None else f"x={home['x']:g} y={home['y']:g} th={home['th']:g}"))
+    unknown = summary["unknown_keywords"]
+    rows.append(
+        ("unknown lines", f"{summary['unknown_lines']}" + (f": {' '.join(unknown)}" if unknown else ""))
+    )
+    if summary["skipped_lines"] or summary["warnings"]:
+        rows.append(("warnings", f"{summary['warnings']} ({summary['skipped_lines']} data line(s) skipped)"))
+    width = max(len(label) for label, _ in rows) + 1
+    lines = [f"{label + ':':<{width}} {value}" for label, value in rows]
+    return "\n".join(lines)
+
+
+def _box(bounds: Bounds | None) -> list[int] | None:
+    return None if bounds is None else list(bounds)
