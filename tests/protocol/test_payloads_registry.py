@@ -1,0 +1,173 @@
+"""Every registered payload type: lookup rules, hostile bytes, truncation, JSON output."""
+
+from __future__ import annotations
+
+import contextlib
+import json
+
+import numpy as np
+import pytest
+from hypothesis import given, settings
+from hypothesis import strategies as st
+
+from rtmu.protocol.errors import ProtocolError
+from rtmu.protocol.payloads import (
+    NameMatch,
+    Payload,
+    Side,
+    commands,
+    decode_payload,
+    drive,
+    payload_type_for,
+    popup,
+    registered,
+    robot,
+    sensors,
+    server,
+    strings,
+)
+from rtmu.protocol.payloads import camera as cam
+from rtmu.protocol.payloads import map as mp
+
+SAMPLES: list[Payload] = [
+    robot.UpdateNumbers(12.3, -1000, 2000, -45, 300, -20, 0, 31),
+    robot.UpdateStrings("Driving", "Drive", "Driving"),
+    robot.Update("Stopped", "Stop", robot.UpdateNumbers(13.0, 0, 0, 0, 0, 0, 0)),
+    robot.BatteryInfo(11.5, 11.0, False),
+    robot.PhysicalInfo("Pioneer", "p3dx", 381, 210, 255, False),
+    robot.ActivityTimeInfo(-1),
+    robot.ModeInfo("ratioDrive", False, False),
+    robot.ModeDataList((robot.ModeData("stop", "stop"),)),
+    robot.ModeBusyChanged(True),
+    drive.RatioDrive(50, 0, 100, 0),
+    drive.SetSafeDrive(True),
+    drive.SafeDrive(True),
+    drive.MoveDist(300),
+    drive.TurnByAngle(90),
+    drive.TurnToHeading(-90),
+    mp.MapName("office.map"),
+    mp.MapId("", "office.map", bytes(range(16)), 2291, 1795237141),
+    mp.Goals(("Kitchen", "Door")),
+    mp.MapUpdated(),
+    mp.GoalsUpdated(),
+    mp.MapTextPacket("2D-Map"),
+    mp.MapBinaryPacket.point_block(np.array([[1, 2], [3, 4]])),
+    mp.MapWithMaxCategoryPacket.segment_block(np.array([[1, 2, 3, 4]])),
+    mp.MapMultiScansPacket.text_line("DATA"),
+    mp.MapWithMaxCategoryRequest("2D-Map-Ex"),
+    sensors.SensorList(("sonar", "sim_lms2xx_1")),
+    sensors.SensorCurrentRequest(("sonar",)),
+    sensors.SensorCumulativeRequest(("sonar",)),
+    sensors.SensorReadings("sonar", ((1, 2), (3, 4))),
+    sensors.SensorCumulativeReadings("sonar", ((1, 2),)),
+    sensors.RangeDeviceReadings(((1, 2),)),
+    sensors.RangeDeviceCumulative(((5, 6),)),
+    sensors.DrawingListPacket(
+        sensors.Drawing("sonarCurrent", "polyArrows", 0x33CCFF, 80, 75, 5000, 255, "On")
+    ),
+    sensors.DrawingList((sensors.Drawing("sonarCurrent", "polyArrows", 1, 2, 3, 4, 5),)),
+    cam.VideoFrame(320, 240, b"\xff\xd8jpeg\xff\xd9", b"\x05\xaa"),
+    cam.Picture(2, 1, b"\xff\xd8\xff\xd9"),
+    cam.VideoRequest(90),
+    cam.PictureRequest(50),
+    cam.VideoSize(320, 240),
+    cam.CameraList(
+        (
+            cam.Camera(
+                "Cam1",
+                "VCC4",
+                "Camera",
+                "",
+                (cam.CameraCommand("getPicture", "getPictureCam1", -1),),
+                (cam.ClientArg("Speed", "", 1, "D", 1.5, 0.0, 3.0),),
+            ),
+        )
+    ),
+    cam.CameraListUpdated(),
+    cam.CameraData(10.5, -3.0, 50.0),
+    cam.CameraInfo(-98, 98, -30, 88, 0, 100, True),
+    cam.SetCameraAbs(10, 20, 30),
+    cam.SetCameraRel(1, -1),
+    cam.SetCameraPct(50, -50),
+    cam.CameraModeList(("Position", "LookAtPoint")),
+    cam.SetCameraMode("LookAtPoint", (100, 200)),
+    cam.CameraModeUpdated("Position"),
+    cam.CameraUpdate(10, -5, 50),
+    cam.LegacyCameraInfo(-98, 98, -30, 88, 0, 100, True),
+    strings.StringsInfo((strings.StringItem("Answer", 10),)),
+    strings.Strings(("42",)),
+    commands.CommandList((commands.CommandEntry("safeRatioDrivingEnable", "Enables"),)),
+    commands.StringCommandList((commands.CommandEntry("MicroControllerCommand", "Sends"),)),
+    popup.PopupCreate(7, "dock", "Docking", "Dock now?", popup.PopupType.QUESTION, ("Yes", "No", ""), 0, 1),
+    popup.PopupClose(7, "Yes"),
+    popup.PopupClicked(7, 0),
+    popup.PopupListEnd(),
+    server.IdleProcessingPending(False),
+    server.RequestClientRestart(1, "config"),
+    server.HeartbeatInterval(500),
+    server.HeartbeatTcp(),
+    server.HeartbeatUdp(),
+    server.SelfIdentifier("rtmu"),
+]
+TYPES = sorted(registered().values(), key=lambda c: (c.DATA_NAME, c.SIDE.value))
+
+
+def test_every_registered_type_has_a_sample() -> None:
+    assert {type(s) for s in SAMPLES} == set(TYPES)
+
+
+@pytest.mark.parametrize("sample", SAMPLES, ids=lambda s: type(s).__name__)
+def test_sample_round_trips_and_prints_as_json(sample: Payload) -> None:
+    raw = sample.encode()
+    assert type(sample).decode(raw) == sample
+    assert type(sample).decode(raw).encode() == raw
+    json.dumps(sample.to_fields())
+
+
+@pytest.mark.parametrize("sample", SAMPLES, ids=lambda s: type(s).__name__)
+def test_every_truncation_is_a_protocol_error_or_a_shorter_valid_payload(sample: Payload) -> None:
+    raw = sample.encode()
+    for cut in range(len(raw)):
+        with contextlib.suppress(ProtocolError):
+            type(sample).decode(raw[:cut])
+
+
+@pytest.mark.parametrize("cls", TYPES, ids=lambda c: c.__name__)
+@settings(max_examples=150, deadline=None)
+@given(raw=st.binary(max_size=64))
+def test_random_bytes_never_raise_anything_but_protocol_errors(cls: type[Payload], raw: bytes) -> None:
+    try:
+        decoded = cls.decode(raw)
+    except ProtocolError:
+        return
+    json.dumps(decoded.to_fields())
+
+
+def test_lookup_rules() -> None:
+    assert payload_type_for("getPictureCam1", Side.REPLY) is cam.Picture
+    assert payload_type_for("setCameraAbsPTZ_2", Side.ARGS) is cam.SetCameraAbs
+    assert payload_type_for("getCameraModeListCam1", Side.REPLY) is cam.CameraModeList
+    assert payload_type_for("urg_1Current", Side.REPLY) is sensors.RangeDeviceReadings
+    assert payload_type_for("cameraInfo", Side.REPLY) is cam.LegacyCameraInfo  # exact beats families
+    assert payload_type_for("getPictureCam1", Side.ARGS) is cam.PictureRequest
+    assert payload_type_for("noSuchData", Side.REPLY) is None
+    assert decode_payload("noSuchData", Side.REPLY, b"") is None
+    # a family name needs something added to it to count as a member
+    assert cam.Picture.NAME_MATCH is NameMatch.PREFIX
+    assert payload_type_for("Current", Side.REPLY) is sensors.RangeDeviceReadings  # registered exactly
+
+
+def test_hostile_counts_are_refused_without_allocating() -> None:
+    big = b"\xff\xff\xff\x7f"
+    for cls, raw in [
+        (robot.ModeDataList, big),
+        (sensors.RangeDeviceReadings, big),
+        (sensors.DrawingList, big),
+        (mp.MapId, b"\0\0" + big),
+        (sensors.SensorReadings, b"\xff\x7fsonar\0"),
+        (strings.StringsInfo, b"\xff\xff"),
+        (cam.CameraList, b"\xff\x7f"),
+        (commands.CommandList, b"\xff\x7f"),
+    ]:
+        with pytest.raises(ProtocolError):
+            cls.decode(raw)
