@@ -1,4 +1,5 @@
-"""Adversarial input for the decoder: it never raises, never grows, and never loses a good packet."""
+"""Adversarial input: the decoder never raises, never grows and never loses a good packet; the
+connections above it never fail in any way but a ProtocolError."""
 
 from __future__ import annotations
 
@@ -7,7 +8,9 @@ import random
 from hypothesis import given
 from hypothesis import strategies as st
 
-from rtmu.protocol import MAX_LENGTH, MAX_PAYLOAD, Packet, PacketDecoder
+from rtmu.protocol import MAX_LENGTH, MAX_PAYLOAD, DataList, Packet, PacketDecoder, ProtocolError
+from rtmu.protocol.client_connection import ClientConnection
+from rtmu.protocol.server_connection import ServerConnection
 
 from .test_decoder import feed_in_chunks, mixed_packets, packets_st
 
@@ -105,3 +108,48 @@ def test_largest_payload_through_a_fragmented_stream() -> None:
     for i in range(0, len(data), 999):
         out += decoder.feed(data[i : i + 999])
     assert out == [packet] * 3
+
+
+# -- the connections above the decoder --------------------------------------------------------
+
+CONTROL_COMMANDS = st.sampled_from([1, 2, 3, 4, 5, 6, 7, 128, 129, 130, 131, 132, 133, 134])
+fuzz_packets = st.lists(
+    st.builds(Packet, st.one_of(CONTROL_COMMANDS, st.integers(0, 0xFFFF)), st.binary(max_size=80)),
+    max_size=12,
+)
+
+
+def _connected_pair() -> tuple[ClientConnection, ServerConnection]:
+    server = ServerConnection(DataList.build([("updateNumbers", "", "", "", "", "")]), rng=random.Random(1))
+    client = ClientConnection()
+    client.receive_data(server.data_to_send())
+    server.receive_data(client.data_to_send())
+    client.receive_data(server.data_to_send())
+    return client, server
+
+
+@given(fuzz_packets, st.integers(0, 2))
+def test_client_connection_only_ever_raises_protocol_errors(packets: list[Packet], stage: int) -> None:
+    """Whatever a hostile server sends, in any state, the client reports events or a ProtocolError."""
+    client, _ = _connected_pair()
+    if stage == 0:
+        client = ClientConnection()
+    elif stage == 1:
+        client = ClientConnection()
+        intro = b"alpha\x00\x00\x00" + bytes(8) + b"key\x00\x00"
+        client.receive_data(Packet(2, intro).encode())
+    for packet in packets:
+        try:
+            client.receive_data(packet.encode())
+        except ProtocolError:
+            return  # the caller closes the connection
+    client.data_to_send()
+
+
+@given(fuzz_packets, st.booleans())
+def test_server_connection_never_raises(packets: list[Packet], logged_in: bool) -> None:
+    """Whatever a hostile client sends, the server side answers with events, never an exception."""
+    server = _connected_pair()[1] if logged_in else ServerConnection(DataList(), rng=random.Random(2))
+    for packet in packets:
+        server.receive_data(packet.encode())
+    server.data_to_send()
