@@ -7,6 +7,7 @@ import subprocess
 from pathlib import Path
 
 import pytest
+
 from capture_builders import (
     ACK,
     FIN,
@@ -25,7 +26,6 @@ from capture_builders import (
     udp,
     udp_frame,
 )
-
 from rtmu.capture import (
     CaptureError,
     Datagram,
@@ -304,7 +304,7 @@ def _xxd_like(data: bytes, group: int = 2) -> str:
     for off in range(0, len(data), 16):
         chunk = data[off : off + 16]
         groups = [chunk[i : i + group].hex() for i in range(0, len(chunk), group)]
-        hexpart = " ".join(groups).ljust((32 + (16 // group) - 1))
+        hexpart = " ".join(groups).ljust(32 + (16 // group) - 1)
         text = "".join(chr(b) if 32 <= b < 127 else "." for b in chunk)
         lines.append(f"{off:08x}: {hexpart}  {text}")
     return "\n".join(lines) + "\n"
