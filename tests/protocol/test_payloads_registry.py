@@ -152,9 +152,8 @@ def test_lookup_rules() -> None:
     assert payload_type_for("getPictureCam1", Side.ARGS) is cam.PictureRequest
     assert payload_type_for("noSuchData", Side.REPLY) is None
     assert decode_payload("noSuchData", Side.REPLY, b"") is None
-    # a family name needs something added to it to count as a member
     assert cam.Picture.NAME_MATCH is NameMatch.PREFIX
-    assert payload_type_for("Current", Side.REPLY) is sensors.RangeDeviceReadings  # registered exactly
+    assert sensors.RangeDeviceReadings.NAME_MATCH is NameMatch.SUFFIX
 
 
 def test_hostile_counts_are_refused_without_allocating() -> None:

@@ -83,6 +83,7 @@ def _jsonable(value: Any) -> Any:
 
 
 _REGISTRY: dict[tuple[str, Side], type[Payload]] = {}
+_LOOKUP_CACHE: dict[tuple[str, Side], type[Payload] | None] = {}
 P = TypeVar("P", bound=type[Payload])
 
 
@@ -92,6 +93,7 @@ def register(cls: P) -> P:
     if key in _REGISTRY:
         raise RuntimeError(f"two payload types for {key}")
     _REGISTRY[key] = cls
+    _LOOKUP_CACHE.clear()
     return cls
 
 
@@ -107,6 +109,18 @@ def payload_type_for(data_name: str, side: Side) -> type[Payload] | None:
     starts with (camera data: ``getPictureCam1``), then the longest ``SUFFIX``
     type it ends with (range devices: ``sonarCurrent``).
     """
+    key = (data_name, side)
+    try:
+        return _LOOKUP_CACHE[key]
+    except KeyError:
+        pass
+    found = _lookup(data_name, side)
+    if len(_LOOKUP_CACHE) < 4096:  # names come from the server: keep the cache bounded
+        _LOOKUP_CACHE[key] = found
+    return found
+
+
+def _lookup(data_name: str, side: Side) -> type[Payload] | None:
     exact = _REGISTRY.get((data_name, side))
     if exact is not None:
         return exact

@@ -265,7 +265,7 @@ class MapBinaryAssembler:
         if n == 0:
             self._state = _State.BETWEEN
         else:
-            chunks.append(coords)
+            chunks.append(bytes(coords))  # own the bytes even if the caller reuses a buffer
 
     def result(self) -> BinaryMap:
         if not self.done:
