@@ -152,6 +152,16 @@ class _UntilEmpty(_EndRule):
         return not payload
 
 
+class _Until(_EndRule):
+    """The caller's own end test (a map assembler's ``feed``)."""
+
+    def __init__(self, until: Callable[[bytes], bool]) -> None:
+        self.until = until
+
+    def done(self, payload: bytes, count_before: int) -> bool:
+        return self.until(payload)
+
+
 class _MapStream(_EndRule):
     """``getMap``/``getMapBinary``: ends with a zero-length packet, or at once with one ``00`` (no map)."""
 
@@ -162,8 +172,12 @@ class _MapStream(_EndRule):
 _MAP_STREAMS = frozenset({"getMap", "getMapBinary", "getMapMultiScans", "getMapWithMaxCategory"})
 
 
-def _end_rule(entry_flags: frozenset[str], name: str, expect: int | None) -> _EndRule | None:
+def _end_rule(
+    entry_flags: frozenset[str], name: str, expect: int | None, until: Callable[[bytes], bool] | None
+) -> _EndRule | None:
     """None = the data has no reply (RETURN_NONE)."""
+    if until is not None:
+        return _Until(until)
     if expect is not None:
         return _Single(expect)
     if name in _MAP_STREAMS:
@@ -191,7 +205,12 @@ class _Pending:
     def feed(self, payload: bytes) -> bool:
         if self.finished:
             return True
-        self.finished = self.rule.done(payload, len(self.payloads))
+        try:
+            finished = self.rule.done(payload, len(self.payloads))
+        except ProtocolError as exc:  # the caller's end test found the reply malformed
+            self.fail(ProtocolFault(f"malformed reply: {exc}"))
+            return True
+        self.finished = finished
         self.payloads.append(payload)
         if self.queue is not None:
             self.queue.put_nowait(payload)
@@ -386,17 +405,24 @@ class AriaClient:
         self._flush()
 
     async def request_once(
-        self, name: str, *args: Arg, timeout: float = REPLY_TIMEOUT, expect: int | None = None
+        self,
+        name: str,
+        *args: Arg,
+        timeout: float = REPLY_TIMEOUT,
+        expect: int | None = None,
+        until: Callable[[bytes], bool] | None = None,
     ) -> Reply:
         """Run ``name`` once and await its reply.
 
         Multi-packet replies (``getMap``, ``getMapBinary``, RETURN_UNTIL_EMPTY data) are
         collected to their end marker; ``timeout`` bounds the wait for *each* packet, so a big
         map may take longer overall but a stalled one fails. ``expect=n`` waits for exactly n
-        packets (``getSensorCurrent`` with n names). Data that has no reply (RETURN_NONE) is
-        sent and an empty :class:`Reply` returned at once.
+        packets (``getSensorCurrent`` with n names); ``until(payload) -> bool`` lets the caller
+        decide where the reply ends (e.g. a map assembler's ``feed``; a ``ProtocolError`` it
+        raises fails the request with :class:`ProtocolFault`). Data that has no reply
+        (RETURN_NONE) is sent and an empty :class:`Reply` returned at once.
         """
-        pending = self._start(name, args, expect, streaming=False)
+        pending = self._start(name, args, expect, until, streaming=False)
         if pending is None:
             return Reply(name, (), self.clock())
         while not pending.finished:
@@ -416,10 +442,15 @@ class AriaClient:
         return Reply(name, tuple(pending.payloads), self.clock())
 
     async def stream(
-        self, name: str, *args: Arg, timeout: float = REPLY_TIMEOUT, expect: int | None = None
+        self,
+        name: str,
+        *args: Arg,
+        timeout: float = REPLY_TIMEOUT,
+        expect: int | None = None,
+        until: Callable[[bytes], bool] | None = None,
     ) -> AsyncIterator[bytes]:
         """Like :meth:`request_once` but yields each payload as it arrives (progress for big maps)."""
-        pending = self._start(name, args, expect, streaming=True)
+        pending = self._start(name, args, expect, until, streaming=True)
         if pending is None:
             return
         assert pending.queue is not None
@@ -443,11 +474,16 @@ class AriaClient:
                 self._abandon(name, pending)
 
     def _start(
-        self, name: str, args: tuple[Arg, ...], expect: int | None, streaming: bool
+        self,
+        name: str,
+        args: tuple[Arg, ...],
+        expect: int | None,
+        until: Callable[[bytes], bool] | None,
+        streaming: bool,
     ) -> _Pending | None:
         number = self._number(name)
         entry = self._conn.datalist.entry(number)  # type: ignore[union-attr]
-        rule = _end_rule(entry.flag_set if entry else frozenset(), name, expect)
+        rule = _end_rule(entry.flag_set if entry else frozenset(), name, expect, until)
         payload = encode_args(args)
         if rule is None:
             self._conn.request_once(name, payload)  # type: ignore[union-attr]

@@ -1,0 +1,663 @@
+"""One operator session on the network loop: connection, subscriptions, map, drive, health, reconnect.
+
+The :class:`Session` lives entirely on the network thread's asyncio loop (see
+``runner`` for the thread and the UI-facing facade). It keeps a *shadow* of
+every model part (robot, map, camera, connection, health) and hands a new
+frozen value to ``publish(part, value)`` only when it really changed, so an
+unchanged 10 Hz status costs the UI thread nothing.
+
+Its heart is one task that wakes at the exact moments something is due — a
+``ratioDrive`` resend, the lease's expiry, the status going stale — or when the
+UI changes the lease, and then asks the pure :class:`DriveGovernor` and
+:class:`HealthMonitor` what to do. Because it never waits for the UI thread,
+a long redraw cannot delay a packet; because motion needs a lease the UI keeps
+renewing, a frozen UI cannot keep the robot moving.
+"""
+
+from __future__ import annotations
+
+import asyncio
+import contextlib
+import logging
+import time
+from collections.abc import Callable
+from dataclasses import dataclass, field, replace
+from typing import Any
+
+from ..model import (
+    CameraImage,
+    ConnectionState,
+    LinkHealth,
+    LinkLevel,
+    MapModel,
+    Phase,
+    RobotState,
+)
+from ..protocol.errors import ProtocolError
+from ..protocol.payloads import Side, decode_payload, payload_type_for
+from ..protocol.payloads.drive import RatioDrive, SafeDrive, SetSafeDrive
+from ..protocol.payloads.map import MapName
+from ..protocol.payloads.robot import BatteryInfo, ModeInfo, Update, UpdateNumbers, UpdateStrings
+from .connection import AriaClient, Packet
+from .errors import ClientError, ClientTimeout, NotSupported, ServerClosed
+from .health import HealthMonitor, ping_data
+from .lease import DriveGovernor, DriveLease, EndReason, SendRatios, SendStop
+from .reconnect import Backoff, worth_retrying
+
+log = logging.getLogger(__name__)
+
+Publish = Callable[[str, Any], None]
+"""``publish(part, value)``: part is a :class:`~rtmu.model.Model` attribute name."""
+NoticeFn = Callable[[str, str], None]
+"""``notice(level, text)``, level ``info``/``warning``/``error``."""
+
+HEART_MAX_SLEEP = 0.25
+
+
+@dataclass
+class SessionConfig:
+    status_interval_ms: int = 100
+    """``updateNumbers`` period: the status stream is also the link's heartbeat."""
+    sonar_interval_ms: int = 200
+    wifi_interval_ms: int = 1000
+    ping_interval: float = 1.0
+    connect_timeout: float = 10.0
+    reply_timeout: float = 5.0
+    lost_after: float = 2.0
+    fetch_map: bool = True
+    backoff: Callable[[], Backoff] = field(default=Backoff)
+
+
+@dataclass
+class _Target:
+    host: str
+    port: int
+    user: str
+    password: str
+    profile: str
+    auto_reconnect: bool
+
+
+class Session:
+    """See the module notes. Create on the loop; every method runs on the loop's thread."""
+
+    def __init__(
+        self,
+        lease: DriveLease,
+        publish: Publish,
+        notice: NoticeFn | None = None,
+        *,
+        clock: Callable[[], float] = time.monotonic,
+        config: SessionConfig | None = None,
+    ) -> None:
+        self.lease = lease
+        self.publish_fn = publish
+        self.notice_fn = notice or (lambda level, text: None)
+        self.clock = clock
+        self.config = config or SessionConfig()
+        self.health = HealthMonitor(
+            self.config.status_interval_ms / 1000.0, lost_after=self.config.lost_after
+        )
+        self.governor = DriveGovernor(lease)
+        self.client: AriaClient | None = None
+        self._target: _Target | None = None
+        self._published: dict[str, Any] = {}
+        self._robot = RobotState()
+        self._map = MapModel()
+        self._connection = ConnectionState()
+        self._extra_subs: dict[str, tuple[int, Callable[[Packet], None]]] = {}
+        self._tasks: set[asyncio.Task[Any]] = set()
+        self._reconnect_task: asyncio.Task[None] | None = None
+        self._heart_task: asyncio.Task[None] | None = None
+        self._kick = asyncio.Event()
+        self._stepped: asyncio.Event = asyncio.Event()
+        self._image_sequence = 0
+        self._map_generation = 0
+        self._wifi_labels: tuple[str, ...] = ()
+        self.packets_sent = 0
+
+    # -- publishing --------------------------------------------------------------------------
+    def _publish(self, part: str, value: Any) -> None:
+        if part in self._published and self._published[part] == value:
+            return
+        self._published[part] = value
+        try:
+            self.publish_fn(part, value)
+        except Exception:
+            log.exception("publishing %s failed", part)
+
+    def _robot_update(self, **changes: Any) -> None:
+        self._robot = replace(self._robot, **changes)
+        self._publish("robot", self._robot)
+
+    def _set_connection(self, **changes: Any) -> None:
+        self._connection = replace(self._connection, **changes)
+        self._publish("connection", self._connection)
+
+    def _set_map(self, value: MapModel) -> None:
+        self._map = value
+        self._publish("map", value)
+
+    def _notice(self, level: str, text: str) -> None:
+        try:
+            self.notice_fn(level, text)
+        except Exception:
+            log.exception("notice callback failed")
+
+    # -- connect / disconnect ----------------------------------------------------------------
+    @property
+    def connected(self) -> bool:
+        return self.client is not None and self.client.connected
+
+    async def connect(
+        self,
+        host: str,
+        port: int,
+        user: str = "",
+        password: str = "",
+        *,
+        profile: str = "",
+        auto_reconnect: bool = True,
+    ) -> None:
+        """Connect and set up the session; raises the :class:`ClientError` after publishing FAILED."""
+        await self._drop_client()
+        self._cancel_reconnect()
+        self._target = _Target(host, port, user, password, profile, auto_reconnect)
+        self._robot = RobotState()
+        self._publish("robot", self._robot)
+        self._set_map(MapModel())
+        self._publish("camera", None)
+        self._set_connection(
+            phase=Phase.CONNECTING, host=host, port=port, user=user, profile=profile,
+            offers=frozenset(), error="", error_kind="", attempt=0, retry_in=None,
+        )  # fmt: skip
+        self._ensure_heart()
+        try:
+            await self._open(self._target)
+        except ClientError as exc:
+            self._set_connection(phase=Phase.FAILED, error=str(exc), error_kind=exc.kind)
+            raise
+
+    async def _open(self, target: _Target) -> None:
+        client = AriaClient(on_close=lambda error: self._on_client_closed(client, error), clock=self.clock)
+        await client.connect(
+            target.host, target.port, target.user, target.password, timeout=self.config.connect_timeout
+        )
+        self.client = client
+        # Whatever happened before, the robot stays still until a fresh key press.
+        self.lease.end(EndReason.DISCONNECTED)
+        self.governor.reset()
+        self.health.start(self.clock())
+        offers = frozenset(e.name for e in client.datalist)
+        self._setup_subscriptions(client)
+        self._set_connection(phase=Phase.CONNECTED, offers=offers, error="", error_kind="", retry_in=None)
+        self._spawn(self._ping_loop(client), "ping")
+        self._spawn(self._fetch_once_infos(client), "infos")
+        if self.config.fetch_map:
+            self._spawn(self.load_map(), "map")
+        self.kick()
+
+    async def disconnect(self) -> None:
+        """Stop the robot, say goodbye, forget the robot's values. Returns within a fraction of a second."""
+        self._cancel_reconnect()
+        self._target = None
+        if self.connected:
+            self._send_stop()
+        self.lease.end(EndReason.DISCONNECTED)
+        await self._drop_client()
+        self._robot = RobotState()
+        self._publish("robot", self._robot)
+        self._set_map(MapModel())
+        self._publish("camera", None)
+        self._set_connection(
+            phase=Phase.DISCONNECTED, offers=frozenset(), error="", error_kind="", retry_in=None
+        )
+        self._publish_health()
+
+    async def close(self) -> None:
+        """Disconnect and end every task (runner shutdown)."""
+        await self.disconnect()
+        for task in (self._heart_task,):
+            if task is not None:
+                task.cancel()
+                with contextlib.suppress(asyncio.CancelledError, Exception):
+                    await task
+        self._heart_task = None
+
+    async def _drop_client(self) -> None:
+        client, self.client = self.client, None
+        for task in list(self._tasks):
+            task.cancel()
+        self.health.stop()
+        self.governor.reset()
+        if client is not None:
+            await client.disconnect()
+
+    def _on_client_closed(self, client: AriaClient, error: ClientError) -> None:
+        if client is not self.client:
+            return
+        self._connection_lost(error)
+
+    def _connection_lost(self, error: ClientError) -> None:
+        """Not our choice: the server died, closed, or the link was lost."""
+        client, self.client = self.client, None
+        for task in list(self._tasks):
+            task.cancel()
+        if client is not None:
+            self._spawn_detached(client.disconnect())
+        self.lease.end(EndReason.DISCONNECTED)
+        self.governor.reset()
+        self.health.stop()
+        self._publish_health()
+        target = self._target
+        if target is not None and target.auto_reconnect and worth_retrying(error):
+            self._set_connection(phase=Phase.RECONNECTING, error=str(error), error_kind=error.kind, attempt=0)
+            self._reconnect_task = asyncio.get_running_loop().create_task(self._reconnect(target))
+        else:
+            self._set_connection(phase=Phase.FAILED, error=str(error), error_kind=error.kind, retry_in=None)
+
+    async def _reconnect(self, target: _Target) -> None:
+        backoff = self.config.backoff()
+        while self._target is target:
+            delay = backoff.next_delay()
+            self._set_connection(phase=Phase.RECONNECTING, attempt=backoff.attempt, retry_in=round(delay, 1))
+            await asyncio.sleep(delay)
+            if self._target is not target:
+                return
+            try:
+                await self._open(target)
+            except ClientError as exc:
+                if not worth_retrying(exc):
+                    self._set_connection(
+                        phase=Phase.FAILED, error=str(exc), error_kind=exc.kind, retry_in=None
+                    )
+                    return
+                self._set_connection(error=str(exc), error_kind=exc.kind)
+                continue
+            self._notice("info", f"Reconnected to {target.host}:{target.port}; press a key to drive again")
+            return
+
+    def _cancel_reconnect(self) -> None:
+        task, self._reconnect_task = self._reconnect_task, None
+        if task is not None and task is not asyncio.current_task():
+            task.cancel()
+
+    def _spawn(self, coro: Any, name: str) -> None:
+        task = asyncio.get_running_loop().create_task(coro, name=f"session-{name}")
+        self._tasks.add(task)
+        task.add_done_callback(self._task_done)
+
+    def _spawn_detached(self, coro: Any) -> None:
+        task = asyncio.get_running_loop().create_task(coro)
+        task.add_done_callback(lambda t: t.cancelled() or t.exception())
+
+    def _task_done(self, task: asyncio.Task[Any]) -> None:
+        self._tasks.discard(task)
+        if not task.cancelled() and task.exception() is not None:
+            exc = task.exception()
+            if not isinstance(exc, ClientError):
+                log.error("session task %s failed", task.get_name(), exc_info=exc)
+
+    # -- subscriptions -----------------------------------------------------------------------
+    def _setup_subscriptions(self, client: AriaClient) -> None:
+        cfg = self.config
+        if client.supports("updateNumbers"):
+            client.request("updateNumbers", cfg.status_interval_ms, self._on_numbers)
+            if client.supports("updateStrings"):
+                client.request("updateStrings", -1, self._on_strings)
+        elif client.supports("update"):
+            client.request("update", cfg.status_interval_ms, self._on_update)
+        if client.supports("getModeInfo"):
+            client.request("getModeInfo", -1, self._on_mode_info)
+        if client.supports("mapUpdated"):
+            client.request("mapUpdated", -1, self._on_map_updated)
+        if client.supports("sonarCurrent"):
+            client.request("sonarCurrent", cfg.sonar_interval_ms, self._on_sonar)
+        for name, (interval, handler) in self._extra_subs.items():
+            if client.supports(name):
+                client.request(name, interval, handler)
+
+    def subscribe(self, name: str, interval_ms: int, handler: Callable[[Packet], None]) -> None:
+        """An extra subscription, restored after every reconnect."""
+        self._extra_subs[name] = (interval_ms, handler)
+        if self.client is not None and self.client.connected:
+            self.client.request(name, interval_ms, handler)
+
+    def unsubscribe(self, name: str) -> None:
+        self._extra_subs.pop(name, None)
+        if self.client is not None:
+            self.client.stop_request(name)
+
+    async def _fetch_once_infos(self, client: AriaClient) -> None:
+        timeout = self.config.reply_timeout
+        with contextlib.suppress(ClientError, ProtocolError):
+            if client.supports("batteryInfo"):
+                info = (await client.request_once("batteryInfo", timeout=timeout)).decode()
+                assert isinstance(info, BatteryInfo)
+                self._robot_update(
+                    battery_low=info.low_battery,
+                    battery_shutdown=info.shutdown,
+                    battery_is_soc=info.state_of_charge,
+                )
+            if client.supports("getSafeDrive"):
+                self._on_safe_drive((await client.request_once("getSafeDrive", timeout=timeout)).payload)
+        await self._watch_wifi(client)
+
+    def _decode(self, name: str, payload: bytes) -> Any:
+        try:
+            return decode_payload(name, Side.REPLY, payload)
+        except ProtocolError as exc:
+            self.health.bad_payloads += 1
+            log.warning("undecodable %s packet: %s", name, exc)
+            return None
+
+    def _on_numbers(self, packet: Packet) -> None:
+        numbers = self._decode(packet.name, packet.payload)
+        if isinstance(numbers, UpdateNumbers):
+            self._apply_numbers(numbers, packet.received_at)
+
+    def _apply_numbers(self, n: UpdateNumbers, at: float) -> None:
+        was_ok = self.health.level(at) is LinkLevel.OK
+        self.health.note_status(at)
+        self._robot_update(
+            x=float(n.x), y=float(n.y), th=float(n.th), vel=float(n.vel), rot_vel=float(n.rot_vel),
+            lat_vel=float(n.lat_vel), battery_v=n.battery,
+            temperature=float(n.temperature) if n.temperature_known else None, numbers_at=at,
+        )  # fmt: skip
+        if not was_ok:
+            self.kick()  # the link came back: re-evaluate at once
+
+    def _on_strings(self, packet: Packet) -> None:
+        s = self._decode(packet.name, packet.payload)
+        if isinstance(s, UpdateStrings):
+            self._robot_update(
+                status=s.status, mode=s.mode, extended_status=s.extended_status, strings_at=packet.received_at
+            )
+
+    def _on_update(self, packet: Packet) -> None:
+        u = self._decode(packet.name, packet.payload)
+        if isinstance(u, Update):
+            self._robot_update(status=u.status, mode=u.mode, strings_at=packet.received_at)
+            self._apply_numbers(u.numbers, packet.received_at)
+
+    def _on_mode_info(self, packet: Packet) -> None:
+        m = self._decode(packet.name, packet.payload)
+        if isinstance(m, ModeInfo):
+            self._robot_update(mode_name=m.mode_name)
+
+    def _on_safe_drive(self, payload: bytes) -> None:
+        s = self._decode("getSafeDrive", payload)
+        if isinstance(s, SafeDrive):
+            self._robot_update(safe_drive=s.safe)
+
+    def _on_sonar(self, packet: Packet) -> None:
+        readings = self._decode(packet.name, packet.payload)
+        if readings is not None and hasattr(readings, "readings"):
+            self._robot_update(sonar=tuple(readings.readings), sonar_at=packet.received_at)
+
+    def _on_map_updated(self, packet: Packet) -> None:
+        if self.config.fetch_map:
+            self._spawn(self.load_map(), "map")
+
+    # -- Wi-Fi (optional getStrings items, protocol §4.11) ------------------------------------
+    async def _watch_wifi(self, client: AriaClient) -> None:
+        if not (client.supports("getStringsInfo") and client.supports("getStrings")):
+            return
+        info = self._decode("getStringsInfo", (await client.request_once("getStringsInfo")).payload)
+        items = getattr(info, "items", None)
+        if not items:
+            return
+        self._wifi_labels = tuple(getattr(item, "label", getattr(item, "name", "")) for item in items)
+        if not any(_wifi_role(label) for label in self._wifi_labels):
+            return
+        client.request("getStrings", self.config.wifi_interval_ms, self._on_strings_values)
+
+    def _on_strings_values(self, packet: Packet) -> None:
+        values = self._decode(packet.name, packet.payload)
+        texts = getattr(values, "values", None)
+        if texts is None:
+            return
+        changes: dict[str, int | None] = {}
+        for label, text in zip(self._wifi_labels, texts, strict=False):
+            role = _wifi_role(label)
+            if role is not None:
+                changes[role] = _int_or_none(text)
+        if changes:
+            self._robot_update(**changes)
+
+    # -- RTT ---------------------------------------------------------------------------------
+    async def _ping_loop(self, client: AriaClient) -> None:
+        name = ping_data(client.datalist)
+        if name is None:
+            return
+        while client.connected:
+            started = time.perf_counter()
+            try:
+                reply = await client.request_once(name, timeout=self.config.lost_after)
+            except ClientTimeout:
+                pass
+            except ClientError:
+                return
+            else:
+                self.health.note_rtt(time.perf_counter() - started)
+                if name == "getSafeDrive":
+                    self._on_safe_drive(reply.payload)
+                self._publish_health()
+            await asyncio.sleep(self.config.ping_interval)
+
+    # -- the heart: drive governor + health, on exact deadlines -------------------------------
+    def kick(self) -> None:
+        """Run the heart now (the lease changed, or status came back). Loop thread only."""
+        self._kick.set()
+
+    def _ensure_heart(self) -> None:
+        if self._heart_task is None or self._heart_task.done():
+            self._heart_task = asyncio.get_running_loop().create_task(self._heart(), name="session-heart")
+
+    async def step(self) -> None:
+        """Wait until the heart has run once more (tests drive a fake clock with this)."""
+        self._ensure_heart()
+        self._stepped.clear()
+        self.kick()
+        await self._stepped.wait()
+
+    async def _heart(self) -> None:
+        while True:
+            self._kick.clear()
+            now = self.clock()
+            try:
+                self._beat(now)
+            except Exception:
+                log.exception("session heart step failed")
+            self._stepped.set()
+            wake = min(self.governor.next_wakeup(now), self.health.next_change(now))
+            delay = min(HEART_MAX_SLEEP, max(0.0, wake - self.clock()))
+            with contextlib.suppress(TimeoutError):
+                async with asyncio.timeout(delay):
+                    await self._kick.wait()
+
+    def _beat(self, now: float) -> None:
+        level = self.health.level(now)
+        link_ok = level is LinkLevel.OK and self.connected
+        for action in self.governor.step(now, link_ok):
+            if isinstance(action, SendRatios):
+                r = action.ratios
+                self._send("ratioDrive", RatioDrive(r.trans, r.rot, r.throttle, r.lat or None))
+            elif isinstance(action, SendStop):
+                self._send_stop()
+        self._publish_health(now)
+        if level is LinkLevel.LOST and self.client is not None:
+            target = self._target
+            if target is not None and target.auto_reconnect:
+                self._connection_lost(
+                    ServerClosed(
+                        f"no status from {target.host}:{target.port} for {self.health.lost_after:g} s"
+                    )
+                )
+
+    def _publish_health(self, now: float | None = None) -> None:
+        now = self.clock() if now is None else now
+        if self.client is None or not self.health.running:
+            self._publish("health", LinkHealth(rtt_ms=None))
+            return
+        self._publish("health", self.health.snapshot(now, self.client.drops))
+
+    def _send(self, name: str, *args: Any) -> bool:
+        client = self.client
+        if client is None or not client.connected or not client.supports(name):
+            return False
+        try:
+            client.send(name, *args)
+        except ClientError:
+            return False
+        self.packets_sent += 1
+        return True
+
+    def _send_stop(self) -> None:
+        """Zero ratios, then ``stop`` — whatever the link health looks like."""
+        self._send("ratioDrive", RatioDrive(0.0, 0.0, 0.0))
+        self._send("stop")
+
+    # -- operator commands -------------------------------------------------------------------
+    def stop_now(self) -> None:
+        """The stop key: always sent at once, even when the link looks stale."""
+        self.lease.end(EndReason.STOPPED)
+        self._send_stop()
+        self.governor.reset()
+        self.kick()
+
+    def command(self, name: str, *args: Any) -> None:
+        """Fire-and-forget request-once (``turnByAngle``, ``moveDist``, custom commands)."""
+        client = self._require(name)
+        client.send(name, *args)
+
+    def set_safe_drive(self, on: bool) -> None:
+        client = self._require("setSafeDrive")
+        client.send("setSafeDrive", SetSafeDrive(on))
+        if client.supports("getSafeDrive"):
+            self._spawn(self._refresh_safe_drive(client), "safe-drive")
+
+    async def _refresh_safe_drive(self, client: AriaClient) -> None:
+        reply = await client.request_once("getSafeDrive", timeout=self.config.reply_timeout)
+        self._on_safe_drive(reply.payload)
+
+    def image_source(self) -> str | None:
+        client = self.client
+        if client is None:
+            return None
+        names = sorted(e.name for e in client.datalist if e.name.startswith("getPicture"))
+        if names:
+            return names[0]
+        return "sendVideo" if client.supports("sendVideo") else None
+
+    async def request_image(self) -> CameraImage:
+        """One camera picture; also published as the model's ``camera`` part."""
+        source = self.image_source()
+        if source is None:
+            raise NotSupported(
+                "getPicture", "this server offers no camera pictures (getPicture… or sendVideo)"
+            )
+        client = self._require(source)
+        reply = await client.request_once(source, timeout=self.config.reply_timeout)
+        if payload_type_for(source, Side.REPLY) is None:
+            raise NotSupported(source, f"RTMU cannot decode {source!r} pictures")
+        try:
+            picture = reply.decode()
+        except ProtocolError as exc:
+            self.health.bad_payloads += 1
+            raise ClientError(f"the picture from {source!r} is malformed: {exc}") from None
+        self._image_sequence += 1
+        image = CameraImage(
+            jpeg=bytes(picture.jpeg),  # type: ignore[attr-defined]
+            width=int(picture.width),  # type: ignore[attr-defined]
+            height=int(picture.height),  # type: ignore[attr-defined]
+            source=source,
+            received_at=reply.received_at,
+            sequence=self._image_sequence,
+        )
+        self._publish("camera", image)
+        return image
+
+    def _require(self, name: str) -> AriaClient:
+        client = self.client
+        if client is None or not client.connected:
+            raise ServerClosed("not connected")
+        if not client.supports(name):
+            raise NotSupported(name)
+        return client
+
+    # -- map ---------------------------------------------------------------------------------
+    async def load_map(self) -> MapModel:
+        """Download the map (``getMapBinary`` when offered, else ``getMap``) and publish it."""
+        from ..protocol.payloads.mapstream import MapBinaryAssembler, MapTextAssembler
+
+        client = self.client
+        if client is None or not client.connected:
+            raise ServerClosed("not connected")
+        binary = client.supports("getMapBinary")
+        name = "getMapBinary" if binary else "getMap"
+        if not client.supports(name):
+            self._set_map(MapModel(state="unsupported"))
+            return self._map
+        map_name = ""
+        if client.supports("getMapName"):
+            with contextlib.suppress(ClientError, ProtocolError):
+                typed = (await client.request_once("getMapName", timeout=self.config.reply_timeout)).decode()
+                map_name = typed.file_name if isinstance(typed, MapName) else ""
+        self._set_map(MapModel(state="loading", name=map_name, generation=self._map.generation))
+        assembler: MapBinaryAssembler | MapTextAssembler = (
+            MapBinaryAssembler() if binary else MapTextAssembler()
+        )
+        count = 0
+        try:
+            async for _ in client.stream(name, timeout=self.config.reply_timeout, until=assembler.feed):
+                count += 1
+                if count % 200 == 0:
+                    self._set_map(replace(self._map, received=count))
+            data = await asyncio.get_running_loop().run_in_executor(None, _map_data, assembler)
+        except (ClientError, ProtocolError, ValueError) as exc:
+            self._set_map(replace(self._map, state="failed", error=str(exc), received=count))
+            self._notice("warning", f"The map could not be loaded: {exc}")
+            return self._map
+        if data is None:
+            self._set_map(
+                MapModel(state="none", name=map_name, generation=self._map.generation, received=count)
+            )
+            return self._map
+        self._map_generation = self._map.generation + 1
+        self._set_map(
+            MapModel(state="ready", data=data, name=map_name, generation=self._map_generation, received=count)
+        )
+        return self._map
+
+
+def _map_data(assembler: Any) -> Any:
+    """Assembled packets → ``rtmu.maps.MapData`` (None if the server has no map). Runs in an executor."""
+    from .. import maps
+
+    result = assembler.result()
+    if not result.has_map:
+        return None
+    if hasattr(result, "segments"):
+        return maps.from_stream(result.header_lines, result.segments, result.points)
+    return maps.parse_map_lines(result.lines)
+
+
+_WIFI_WORDS = ("wireless", "wifi", "wi-fi", "wlan")
+
+
+def _wifi_role(label: str) -> str | None:
+    """Which RobotState field a ``getStrings`` item feeds, judged from its label."""
+    low = label.lower()
+    if "quality" in low and (any(w in low for w in _WIFI_WORDS) or "link" in low):
+        return "wifi_quality"
+    if "signal" in low or ("dbm" in low and any(w in low for w in _WIFI_WORDS)):
+        return "wifi_signal"
+    return None
+
+
+def _int_or_none(text: str) -> int | None:
+    try:
+        return round(float(text.split()[0]))
+    except (ValueError, IndexError):
+        return None

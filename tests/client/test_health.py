@@ -1,0 +1,57 @@
+"""Link health levels from status age, and the reconnect backoff."""
+
+from __future__ import annotations
+
+import random
+
+from rtmu.client.errors import ClientTimeout, LoginRejected, ServerClosed
+from rtmu.client.health import HealthMonitor, ping_data
+from rtmu.client.reconnect import Backoff, worth_retrying
+from rtmu.model import LinkLevel
+from rtmu.protocol.decoder import DropStats
+
+
+def test_levels_follow_the_status_age() -> None:
+    h = HealthMonitor(0.1, lost_after=2.0)
+    assert h.level(0.0) is LinkLevel.DOWN
+    h.start(10.0)
+    assert h.level(10.2) is LinkLevel.OK
+    assert h.level(10.31) is LinkLevel.STALE  # 3 intervals without status
+    h.note_status(10.31)
+    assert h.level(10.5) is LinkLevel.OK
+    assert h.level(12.32) is LinkLevel.LOST
+    assert abs(h.next_change(10.5) - 10.61) < 1e-3
+    assert abs(h.next_change(10.7) - 12.31) < 1e-3
+    h.stop()
+    assert h.level(20.0) is LinkLevel.DOWN
+
+
+def test_snapshot_counts_drops_and_rounds_rtt() -> None:
+    h = HealthMonitor(0.1)
+    h.start(0.0)
+    h.note_rtt(0.00123456)
+    h.bad_payloads = 2
+    snap = h.snapshot(0.05, DropStats(bad_checksum=3, garbage_bytes=40))
+    assert snap.rtt_ms == 1.2 and snap.dropped == 5 and snap.garbage_bytes == 40
+    assert snap.level is LinkLevel.OK
+    # The age is not part of equality: a fresh-but-same health costs no redraw.
+    assert snap == h.snapshot(0.09, DropStats(bad_checksum=3, garbage_bytes=40))
+
+
+def test_ping_prefers_cheap_data() -> None:
+    assert ping_data({"getMapName", "getSafeDrive"}) == "getSafeDrive"
+    assert ping_data({"stop"}) is None
+
+
+def test_backoff_grows_caps_and_resets() -> None:
+    b = Backoff(initial=0.5, factor=2, maximum=4, jitter=0.0, rng=random.Random(1))
+    assert [b.next_delay() for _ in range(6)] == [0.5, 1, 2, 4, 4, 4]
+    b.reset()
+    assert b.next_delay() == 0.5
+    j = Backoff(jitter=0.2, rng=random.Random(1))
+    assert all(0.4 <= j.next_delay() <= 0.6 for _ in range(1)) and j.attempt == 1
+
+
+def test_only_healable_failures_are_retried() -> None:
+    assert worth_retrying(ServerClosed("x")) and worth_retrying(ClientTimeout("x"))
+    assert not worth_retrying(LoginRejected(1))

@@ -1,0 +1,169 @@
+"""ClientRunner + Session over real sockets against a scripted server: model updates, lease, stale stop."""
+
+from __future__ import annotations
+
+import time
+
+import pytest
+
+from rtmu.client.lease import DriveRatios
+from rtmu.client.runner import ClientRunner
+from rtmu.client.session import SessionConfig
+from rtmu.model import LinkLevel, Model, Phase
+from rtmu.protocol.payloads.drive import RatioDrive
+
+from .fakeclock import FakeClock
+from .servers import ServerThread, TestServer
+from .uiqueue import UiQueue
+
+
+def ratio_drives(server: TestServer) -> list[RatioDrive]:
+    return [RatioDrive.decode(r.args) for r in server.received if r.name == "ratioDrive"]
+
+
+@pytest.fixture
+def server():  # type: ignore[no-untyped-def]
+    with ServerThread(TestServer()) as srv:
+        yield srv
+
+
+def start(server: TestServer, clock=None, **config):  # type: ignore[no-untyped-def]
+    model, ui = Model(), UiQueue()
+    runner = ClientRunner(model, post=ui.post, clock=clock or time.monotonic, config=SessionConfig(**config))
+    runner.start()
+    runner.connect("127.0.0.1", server.port, profile="test").result(5)
+    ui.wait_for(lambda: model.connection.value.phase is Phase.CONNECTED and model.robot.value.status != "")
+    return runner, model, ui
+
+
+def test_connect_fills_the_model(server: TestServer) -> None:
+    runner, model, ui = start(server)
+    try:
+        ui.wait_for(lambda: model.map.value.state == "ready" and model.robot.value.battery_low is not None)
+        robot = model.robot.value
+        assert (robot.x, robot.y, robot.th) == (1000.0, 2000.0, 90.0)
+        assert robot.status == "Stopped" and robot.mode == "Stop" and robot.battery_v == 12.5
+        assert robot.battery_low == 11.5 and robot.safe_drive is True and robot.temperature == 25
+        conn = model.connection.value
+        assert conn.profile == "test" and conn.supports("ratioDrive")
+        assert model.map.value.name == "test.map"
+        assert model.map.value.data.num_lines == 2  # type: ignore[attr-defined]
+        ui.wait_for(lambda: model.health.value.rtt_ms is not None)
+        assert model.health.value.level is LinkLevel.OK
+    finally:
+        runner.close()
+
+
+def test_observers_hear_only_real_changes(server: TestServer) -> None:
+    runner, model, ui = start(server)
+    try:
+        ui.wait_for(
+            lambda: model.robot.value.battery_low is not None and model.robot.value.safe_drive is not None
+        )
+        changes: list[str] = []
+        model.robot.observe(lambda old, new: changes.append("robot"))
+        time.sleep(0.5)  # five identical statuses
+        ui.drain()
+        assert changes == []
+        server.state["x"] = 1234
+        ui.wait_for(lambda: model.robot.value.x == 1234.0)
+        assert changes == ["robot"]
+    finally:
+        runner.close()
+
+
+def test_hold_lapse_and_release_with_a_fake_clock(server: TestServer) -> None:
+    clock = FakeClock()
+    # Status every 1 s: the link stays "fresh" for 3 s of fake time without real waiting.
+    runner, _model, _ui = start(server, clock=clock, status_interval_ms=1000)
+    try:
+        runner.lease.grant(DriveRatios(100, 0, 40))
+        runner.sync()
+        time.sleep(0.05)
+        assert ratio_drives(server)[-1] == RatioDrive(100, 0, 40)
+        n = len(ratio_drives(server))
+        for _ in range(5):  # held: renewed by the UI every 100 ms of (fake) time
+            clock.advance(0.1)
+            assert runner.lease.renew()
+            runner.sync()
+        time.sleep(0.05)
+        assert len(ratio_drives(server)) == n + 5
+        # The UI freezes: 0.35 s without renewal.
+        clock.advance(0.35)
+        runner.sync()
+        time.sleep(0.05)
+        assert ratio_drives(server)[-1] == RatioDrive(0, 0, 0)
+        assert server.names()[-1] == "stop"
+        assert runner.lease.renew() is False
+        # A fresh grant drives again; releasing sends zeros and stop once.
+        runner.lease.grant(DriveRatios(0, 100, 40))
+        runner.sync()
+        runner.lease.release()
+        runner.sync()
+        time.sleep(0.05)
+        names = server.names()
+        assert names[-3:] == ["ratioDrive", "ratioDrive", "stop"]
+        assert ratio_drives(server)[-2:] == [RatioDrive(0, 100, 40), RatioDrive(0, 0, 0)]
+    finally:
+        runner.close()
+
+
+def test_stale_status_stops_the_robot_even_while_the_lease_is_renewed(server: TestServer) -> None:
+    clock = FakeClock()
+    runner, model, ui = start(server, clock=clock)
+    try:
+        runner.lease.grant(DriveRatios(100, 0, 50))
+        runner.sync()
+        server.handlers["updateNumbers"] = lambda s, a: None  # the status stream dries up
+        time.sleep(0.15)
+        for _ in range(4):
+            clock.advance(0.1)
+            runner.lease.renew()
+            runner.sync()
+        time.sleep(0.05)
+        assert server.names()[-1] == "stop"
+        ui.wait_for(lambda: model.health.value.level is LinkLevel.STALE)
+        assert runner.lease.renew() is False
+    finally:
+        runner.close()
+
+
+def test_stop_is_sent_even_when_the_link_looks_stale(server: TestServer) -> None:
+    clock = FakeClock()
+    runner, model, ui = start(server, clock=clock)
+    try:
+        server.handlers["updateNumbers"] = lambda s, a: None
+        time.sleep(0.15)
+        clock.advance(1.0)
+        runner.sync()
+        ui.wait_for(lambda: model.health.value.level is LinkLevel.STALE)
+        before = server.names().count("stop")
+        runner.stop()
+        runner.sync()
+        time.sleep(0.05)
+        assert server.names().count("stop") == before + 1
+    finally:
+        runner.close()
+
+
+def test_disconnect_is_instant_and_clears_the_model(server: TestServer) -> None:
+    runner, model, ui = start(server)
+    try:
+        t0 = time.monotonic()
+        runner.disconnect().result(2)
+        assert time.monotonic() - t0 < 0.5
+        ui.wait_for(lambda: model.connection.value.phase is Phase.DISCONNECTED)
+        assert model.robot.value.status == ""
+        assert model.health.value.level is LinkLevel.DOWN
+    finally:
+        runner.close()
+
+
+def test_connect_failure_is_shown_in_the_model() -> None:
+    model, ui = Model(), UiQueue()
+    with ClientRunner(model, post=ui.post) as runner:
+        with pytest.raises(Exception):  # noqa: B017 -- the model is what we check
+            runner.connect("127.0.0.1", 1, profile="x").result(5)
+        ui.wait_for(lambda: model.connection.value.phase is Phase.FAILED)
+        assert model.connection.value.error_kind == "refused"
+        assert "refused" in model.connection.value.error
