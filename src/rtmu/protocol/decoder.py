@@ -18,7 +18,6 @@ Nothing in here raises on network input; every dropped byte is counted.
 
 from __future__ import annotations
 
-from collections.abc import Iterator
 from dataclasses import dataclass, fields
 
 from .checksum import checksum
@@ -84,7 +83,7 @@ class PacketDecoder:
     def feed(self, data: bytes | bytearray | memoryview) -> list[Packet]:
         if data:
             self._buf += data
-        return list(self._drain())
+        return self._drain()
 
     def close(self) -> list[Packet]:
         """End of stream: abandon an incomplete packet and rescan what lies behind its header."""
@@ -104,46 +103,50 @@ class PacketDecoder:
         self._pos = 0
         return found
 
-    def _drain(self) -> Iterator[Packet]:
+    def _drain(self) -> list[Packet]:
+        """Take every complete packet out of the buffer (one tight loop: this is the hot path)."""
         buf = self._buf
+        find = buf.find
         pos = self._pos
-        stats = self.stats
         end = len(buf)
-        try:
-            while True:
-                start = buf.find(SYNC, pos)
-                if start < 0:
-                    # Keep a trailing 0x0F: it may be the first half of a sync pair.
-                    keep = 1 if end > pos and buf[end - 1] == 0x0F else 0
-                    stats.garbage_bytes += end - pos - keep
-                    pos = end - keep
-                    return
-                stats.garbage_bytes += start - pos
-                pos = start
-                if end - pos < 4:
-                    return
-                length = buf[pos + 2] | buf[pos + 3] << 8
-                if length < MIN_LENGTH or length > MAX_LENGTH:
-                    stats.bad_length += 1
-                    stats.garbage_bytes += 4
-                    pos += 4
-                    continue
-                if end - pos < length:
-                    return
-                body_end = pos + length - 2
-                if checksum(buf, body_end, pos) != (buf[body_end] << 8 | buf[body_end + 1]):
-                    stats.bad_checksum += 1
-                    if self.keep_bad:
-                        command = buf[pos + 4] | buf[pos + 5] << 8
-                        self.bad_packets.append(BadPacket(command, length, bytes(buf[pos : pos + length])))
-                    stats.garbage_bytes += 2
-                    pos += 2
-                    continue
-                stats.packets += 1
-                yield Packet(buf[pos + 4] | buf[pos + 5] << 8, bytes(buf[pos + 6 : body_end]))
-                pos += length
-        finally:
-            if pos >= _COMPACT_AT or pos == end:
-                del buf[:pos]
-                pos = 0
-            self._pos = pos
+        stats = self.stats
+        found: list[Packet] = []
+        garbage = 0
+        while True:
+            start = find(SYNC, pos)
+            if start < 0:
+                # Keep a trailing 0x0F: it may be the first half of a sync pair.
+                keep = 1 if end > pos and buf[end - 1] == 0x0F else 0
+                garbage += end - pos - keep
+                pos = end - keep
+                break
+            garbage += start - pos
+            pos = start
+            if end - pos < 4:
+                break
+            length = buf[pos + 2] | buf[pos + 3] << 8
+            if length < MIN_LENGTH or length > MAX_LENGTH:
+                stats.bad_length += 1
+                garbage += 4
+                pos += 4
+                continue
+            if end - pos < length:
+                break
+            body_end = pos + length - 2
+            if checksum(buf, body_end, pos) != (buf[body_end] << 8 | buf[body_end + 1]):
+                stats.bad_checksum += 1
+                if self.keep_bad:
+                    command = buf[pos + 4] | buf[pos + 5] << 8
+                    self.bad_packets.append(BadPacket(command, length, bytes(buf[pos : pos + length])))
+                garbage += 2
+                pos += 2
+                continue
+            found.append(Packet(buf[pos + 4] | buf[pos + 5] << 8, bytes(buf[pos + 6 : body_end])))
+            pos += length
+        stats.garbage_bytes += garbage
+        stats.packets += len(found)
+        if pos >= _COMPACT_AT or pos == end:
+            del buf[:pos]
+            pos = 0
+        self._pos = pos
+        return found
