@@ -1,0 +1,143 @@
+"""A forward camera on the robot: ray-cast the map's walls into a first-person JPEG.
+
+One ray per image column (numpy, all columns at once) finds the nearest wall;
+its distance gives the wall's height on screen and its brightness (nearer is
+taller and lighter). Floor and ceiling are shaded bands. The camera has a
+VC-C4-like pan/tilt/zoom head, so ``setCameraAbs`` and friends change the view.
+Frames are cached by pose, so fifty clients watching one robot cost one render.
+"""
+
+from __future__ import annotations
+
+import io
+import math
+from collections import OrderedDict
+from dataclasses import dataclass
+
+import numpy as np
+from PIL import Image
+
+from .geometry import Obstacles
+
+SIZES = ((320, 240), (640, 480))
+DEFAULT_SIZE = (320, 240)
+MAX_JPEG_BYTES = 31988 - 2
+"""A frame must fit one packet with its width, height and the forwarder's 2 trailing bytes."""
+
+CAMERA_X_MM = 100.0
+"""Mounted on the top plate, a little ahead of the centre of rotation."""
+CAMERA_HEIGHT_MM = 450.0
+WALL_HEIGHT_MM = 2000.0
+VIEW_RANGE_MM = 25000.0
+WIDE_FOV_DEG = 48.0
+TELE_FOV_DEG = 4.0
+
+# VC-C4 limits, as ARIA's camera handler reports them (protocol §4.6).
+PAN_RANGE = (-98.0, 98.0)
+TILT_RANGE = (-30.0, 88.0)
+ZOOM_RANGE = (0.0, 100.0)
+
+
+@dataclass
+class PanTiltZoom:
+    pan: float = 0.0
+    tilt: float = 0.0
+    zoom: float = 0.0
+    """Percent of the zoom range."""
+
+    def clamp(self) -> None:
+        self.pan = min(max(self.pan, PAN_RANGE[0]), PAN_RANGE[1])
+        self.tilt = min(max(self.tilt, TILT_RANGE[0]), TILT_RANGE[1])
+        self.zoom = min(max(self.zoom, ZOOM_RANGE[0]), ZOOM_RANGE[1])
+
+    @property
+    def fov_deg(self) -> float:
+        # Zoom in equal optical steps: the field of view shrinks geometrically.
+        ratio = TELE_FOV_DEG / WIDE_FOV_DEG
+        return WIDE_FOV_DEG * ratio ** (self.zoom / 100.0)
+
+
+class Camera:
+    def __init__(self, obstacles: Obstacles, cache_size: int = 16) -> None:
+        self.obstacles = obstacles
+        self.ptz = PanTiltZoom()
+        self._cache: OrderedDict[tuple, bytes] = OrderedDict()
+        self._cache_size = cache_size
+        self.renders = 0
+
+    def jpeg(self, x: float, y: float, th: float, size: tuple[int, int], quality: int = 75) -> bytes:
+        """The JPEG the camera sees from robot pose (x, y, th), cached by pose and settings."""
+        quality = int(min(max(quality, 1), 95))
+        p = self.ptz
+        key = (
+            round(x),
+            round(y),
+            round(th, 1),
+            size,
+            quality,
+            round(p.pan, 2),
+            round(p.tilt, 2),
+            round(p.zoom, 2),
+        )
+        cached = self._cache.get(key)
+        if cached is not None:
+            self._cache.move_to_end(key)
+            return cached
+        pixels = self.render(x, y, th, size)
+        data = encode_jpeg(pixels, quality)
+        self._cache[key] = data
+        if len(self._cache) > self._cache_size:
+            self._cache.popitem(last=False)
+        return data
+
+    def render(self, x: float, y: float, th: float, size: tuple[int, int]) -> np.ndarray:
+        """An (h, w, 3) uint8 picture from robot pose (x, y, th degrees)."""
+        self.renders += 1
+        w, h = size
+        p = self.ptz
+        f = (w / 2) / math.tan(math.radians(p.fov_deg) / 2)
+        heading = math.radians(th + p.pan)
+        t = math.radians(th)
+        cx = x + CAMERA_X_MM * math.cos(t)
+        cy = y + CAMERA_X_MM * math.sin(t)
+        cols = np.arange(w, dtype=np.float64)
+        offsets = np.arctan((w / 2 - cols - 0.5) / f)
+        dist = self.obstacles.cast(cx, cy, heading + offsets, VIEW_RANGE_MM)
+        perp = dist * np.cos(offsets)
+        horizon = h / 2 + f * math.tan(math.radians(p.tilt))
+        rows = np.arange(h, dtype=np.float64)[:, None]
+
+        img = np.empty((h, w, 3), dtype=np.float64)
+        # Ceiling: pale, darkening towards the horizon; floor: grey-brown, lighter near the robot.
+        above = np.clip((horizon - rows) / max(h, 1), 0.0, 1.0)
+        below = np.clip((rows - horizon) / max(h, 1), 0.0, 1.0)
+        sky = np.array([170.0, 180.0, 195.0])
+        floor = np.array([95.0, 85.0, 75.0])
+        img[:] = np.where(rows < horizon, 1.0, 0.0)[..., None] * (sky * (0.75 + 0.25 * above))[:, None, :]
+        img += np.where(rows >= horizon, 1.0, 0.0)[..., None] * (floor * (0.55 + 0.9 * below))[:, None, :]
+
+        finite = np.isfinite(perp)
+        safe_perp = np.where(finite, np.maximum(perp, 1.0), 1.0)
+        top = horizon - f * (WALL_HEIGHT_MM - CAMERA_HEIGHT_MM) / safe_perp
+        bottom = horizon + f * CAMERA_HEIGHT_MM / safe_perp
+        wall = finite[None, :] & (rows >= top[None, :]) & (rows <= bottom[None, :])
+        light = np.clip(1.15 - safe_perp / 9000.0, 0.25, 1.0)
+        wall_colour = np.array([225.0, 205.0, 170.0])[None, :] * light[:, None]
+        # A darker skirting band at the foot of the wall gives a sense of the floor line.
+        skirting = (rows > bottom[None, :] - np.maximum((bottom - top) * 0.06, 1.0)[None, :]) & wall
+        img = np.where(wall[..., None], wall_colour[None, :, :], img)
+        img = np.where(skirting[..., None], img * 0.6, img)
+        return np.clip(img, 0, 255).astype(np.uint8)
+
+
+def encode_jpeg(pixels: np.ndarray, quality: int) -> bytes:
+    """JPEG bytes small enough for one ArNetworking packet (quality is lowered until it fits)."""
+    image = Image.fromarray(pixels, "RGB")
+    q = quality
+    while True:
+        buf = io.BytesIO()
+        image.save(buf, "JPEG", quality=q)
+        data = buf.getvalue()
+        if len(data) <= MAX_JPEG_BYTES or q <= 5:
+            return data
+        q = max(5, q - 10)

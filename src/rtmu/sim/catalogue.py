@@ -1,0 +1,669 @@
+# ruff: noqa: E501
+"""The simulator's catalogue of data, shaped like ARIA's serverDemo (protocol §2.7–2.8, Appendix A).
+
+Names, descriptions, argument and return texts, command groups and flags are
+the ones serverDemo puts on the wire for the same data (they are part of the
+protocol a client sees), in serverDemo's registration order, numbered from 256.
+Data serverDemo has that the simulator does not serve (configuration editing,
+micro-controller pass-through, the laser) are left out; the simulator adds
+ARIA's popup handler and a few harmless commands of its own.
+"""
+
+from __future__ import annotations
+
+from rtmu.protocol.datalist import DataList
+
+Row = tuple[str, str, str, str, str, str]
+"""(name, description, argument description, return description, command group, flags)"""
+
+CORE: tuple[Row, ...] = (
+    (
+        "identSetSelfIdentifier",
+        "Sets an arbitrary self identifier for this connection, this can be used by programs to send information back to the same client (if this and the identSetHereGoal)",
+        "string: selfID",
+        "none",
+        "RobotInfo",
+        "RETURN_SINGLE",
+    ),
+    (
+        "identSetHereGoal",
+        "Sets an string for the here goal for this connection, this can be used by programs to send information back to the same client (if this and the identSetSelfID match)",
+        "string: hereGoal",
+        "none",
+        "RobotInfo",
+        "RETURN_SINGLE",
+    ),
+    (
+        "requestOnceReturnIsAlwaysTcp",
+        "The presence of this command means that any requestOnce commands will have the data sent back to them as tcp... any requestOnceUdp will be returned either as tcp or udp (that is up to the callback sending the data)",
+        "none",
+        "none",
+        "RobotInfo",
+        "RETURN_NONE",
+    ),
+    (
+        "idleProcessingPending",
+        "The presence of this command means that the server will process packets flagged IDLE_PACKET only when the robot is idle.  This packet will be broadcast when the state of idle processing changes.",
+        "none",
+        "byte: 1 for idle processing pending, 0 for idle processing not pending",
+        "RobotInfo",
+        "RETURN_SINGLE",
+    ),
+    (
+        "requestClientRestart",
+        "If certain changes on the robot happen the clients may need to restart, this message is broadcast when those changes occur.",
+        "none",
+        "byte: restartNumber, which is 1 for a restart because of config changes (there will likely be more reasons later); string: human readable reason for restart.   (The restartNumber is intended for heavy weight clients, the string is intended for lighter weight clients.)",
+        "RobotInfo",
+        "RETURN_NONE",
+    ),
+    (
+        "startRequestTransaction",
+        "Special packet that marks the beginning of a multiple-packet request-response sequence. Must be followed by an endRequestTransaction packet upon completion.",
+        "none",
+        "",
+        "RobotInfo",
+        "RETURN_NONE",
+    ),
+    (
+        "endRequestTransaction",
+        "Special packet that marks the end of a multiple-packet request-response sequence. Idle processing does not proceed until transaction is ended.",
+        "none",
+        "",
+        "RobotInfo",
+        "RETURN_NONE",
+    ),
+    (
+        "update",
+        "gets an update about the important robot status (you should request this at an interval)... for bandwidth savings this is deprecated in favor of updateNumbers and updateStrings",
+        "none",
+        "string: status; string: mode; byte2: 10 * battery; byte4: x; byte4: y; byte2: th; byte2: transVel; byte2: rotVel, byte2: latVel, byte: temperature (deg c, -128 means unknown)",
+        "RobotInfo",
+        "RETURN_SINGLE",
+    ),
+    (
+        "updateNumbers",
+        "gets an update about the important robot status (you should request this at an interval)",
+        "none",
+        "byte2: 10 * battery; byte4: x; byte4: y; byte2: th; byte2: transVel; byte2: rotVel, byte2: latVel, byte: temperature (deg c, -128 means unknown)",
+        "RobotInfo",
+        "RETURN_SINGLE",
+    ),
+    (
+        "updateStrings",
+        "gets an update about the important robot status (you should ask for this at -1 interval since it is broadcast when the strings change)",
+        "none",
+        "string: status; string: mode; string: extended status (this has newlines)",
+        "RobotInfo",
+        "RETURN_SINGLE",
+    ),
+    (
+        "batteryInfo",
+        "gets the low battery voltage and shutdown voltage (you only need to request this once)",
+        "none",
+        "double: low battery voltage, double: shutdown battery voltage: ubyte: voltageIsStateOfCharge, if 0 voltage (including update voltage) is really voltage, if 1 voltage (including update voltage) is state of charge",
+        "RobotInfo",
+        "RETURN_SINGLE",
+    ),
+    (
+        "physicalInfo",
+        "gets the information about the physical robot (you only need to request this once)",
+        "none",
+        "string: robotType; string: robotSubType; byte2: robotWidth; byte2: robotLengthFront; byte2: robotLengthRear; byte: 0 means no lateral control, 1 means lateral control",
+        "RobotInfo",
+        "RETURN_SINGLE",
+    ),
+    (
+        "activityTimeInfo",
+        "Returns information about the active server mode's last activity time",
+        "none",
+        "byte4: seconds since",
+        "RobotInfo",
+        "RETURN_SINGLE",
+    ),
+    (
+        "getSensorList",
+        "gets a list of sensors attached to the robot",
+        "none",
+        "byte2: numSensors,  repeating for numSensors: string: sensorName",
+        "SensorInfo",
+        "RETURN_COMPLEX",
+    ),
+    (
+        "getSensorCurrent",
+        "gets the current sensor readings for requested sensors",
+        "string: sensorName",
+        "byte2: numReadings string: sensorName, repeating for numReadings times: byte4: x byte4: y.... if numReadings is -1 it means no sensor by that name",
+        "SensorInfo",
+        "RETURN_COMPLEX",
+    ),
+    (
+        "getSensorCumulative",
+        "gets the cumulative sensor readings for requested sensors",
+        "string: sensorName",
+        "byte2: numReadings string: sensorName, repeating for numReadings times: byte4: x byte4: y.... if numReadings is -1 it means no sensor by that name",
+        "SensorInfo",
+        "RETURN_COMPLEX",
+    ),
+    (
+        "listDrawings",
+        "Deprecated; use getDrawingList instead. Gets a list of things that can be drawn",
+        "none",
+        "byte4: numDrawings, <repeats numDrawings> string: name, string: shape, byte4: primaryColor(0RGB), byte4: size, byte4: layer, byte4: defaultRefreshTime(0 == don't request refresh), byte4: secondaryColor(0RGB)",
+        "SensorInfo",
+        "RETURN_SINGLE",
+    ),
+    (
+        "getDrawingList",
+        "Gets a list of items to be drawn on the map. Each packet contains one drawing.  Terminates on empty packet.",
+        "none",
+        "For each drawing, a packet that contains: string: name, string: shape, byte4: primaryColor(0RGB), byte4: size, byte4: layer, byte4: defaultRefreshTime(0 == don't request refresh), byte4: secondaryColor(0RGB), string: visibility",
+        "SensorInfo",
+        "RETURN_UNTIL_EMPTY",
+    ),
+    (
+        "getMapId",
+        "Gets the ID of the map being used",
+        "none",
+        "string: map name (empty string if no maps)",
+        "Map",
+        "RETURN_SINGLE",
+    ),
+    (
+        "getMapName",
+        "gets the name of the map being used",
+        "none",
+        "string: map name (empty string if no maps)",
+        "Map",
+        "RETURN_SINGLE",
+    ),
+    (
+        "getMapBinary",
+        "gets the map objects as ascii and the data points as binary",
+        "none",
+        "packets of '<string>: line' for header, followed by packets of '<byte4>: numPtsInPacket, (<double>:x, <double>:y)*' until numPtsInPacket == 0",
+        "Map",
+        "RETURN_UNTIL_EMPTY",
+    ),
+    (
+        "getMapMultiScans",
+        "Deprecated; getMapWithMaxCategory is preferred",
+        "none",
+        "packets of '<string>: line' for header, followed by packets of '<byte4>: numPtsInPacket, (<double>:x, <double>:y)*' until numPtsInPacket == 0",
+        "Map",
+        "RETURN_UNTIL_EMPTY",
+    ),
+    (
+        "getMapWithMaxCategory",
+        "Requests the map with the specified maximum features; header and info are ascii, data points and lines are binary",
+        "string: category (one of the constants defined in ArMapInterface)",
+        "packets of '<string>: line' for header, followed by packets of '<byte4>: numPtsInPacket, (<double>:x, <double>:y)*' until numPtsInPacket == 0",
+        "Map",
+        "RETURN_UNTIL_EMPTY",
+    ),
+    (
+        "getMap",
+        "gets the map as a set of ascii lines",
+        "none",
+        "packets of '<string>: line' followed by a packet with an empty string to denote end (if only empty string then no map)",
+        "Map",
+        "RETURN_UNTIL_EMPTY",
+    ),
+    (
+        "mapUpdated",
+        "a single packet is sent to this when the map is updated and this denotes a new getMap and getMapName should be requested",
+        "none",
+        "none",
+        "Map",
+        "RETURN_SINGLE",
+    ),
+    ("getGoals", "gets the list of goals", "none", "<repeat> string: goal", "Map", "RETURN_SINGLE"),
+    (
+        "goalsUpdated",
+        "a single packet is sent to this when the goals are updated and this denotes a new getGoals should be requested",
+        "none",
+        "none",
+        "Map",
+        "RETURN_SINGLE",
+    ),
+    (
+        "checkMap",
+        "Requests that the server check whether the map needs to be read",
+        "none",
+        "none",
+        "Map",
+        "RETURN_NONE|IDLE_PACKET",
+    ),
+    (
+        "getModeDataList",
+        "Gets the list of commands associated with modes.",
+        "none",
+        "ubyte4: numData;  repeating numData times, string: mode; string: data",
+        "RobotInfo",
+        "RETURN_SINGLE",
+    ),
+    (
+        "getModeInfo",
+        "Gets the current mode active and if its locked and will or won't unlock (for lists of which commands are with which modes use getModeDataList) commands associated with modes.",
+        "none",
+        "string: mode; uByte: locked (1 == locked, 0 == unlocked); uByte: willUnlockIfRequested (1 == will, 0 == won't)",
+        "RobotInfo",
+        "RETURN_SINGLE",
+    ),
+    (
+        "modeBusyChanged",
+        "Broadcast when the busy state (non-zero idle time) of the active mode changes",
+        "None",
+        "byte: 1 if busy, 0 if idle",
+        "RobotInfo",
+        "RETURN_SINGLE",
+    ),
+    ("stop", "stops the robot", "none", "none", "Stop", "RETURN_NONE"),
+    (
+        "ratioDrive",
+        "drives the robot as with a joystick",
+        "double: transRatio (0,100); double: rotRatio (0,100); double: throttleRatio (0,100); [double: lateralRatio (0,100)] ",
+        "none",
+        "Movement",
+        "RETURN_NONE",
+    ),
+    (
+        "setSafeDrive",
+        "sets whether we drive the robot safely or not",
+        "byte: 1 == drive safely, 0 == drive unsafely",
+        "none",
+        "UnsafeMovement",
+        "RETURN_NONE",
+    ),
+    (
+        "getSafeDrive",
+        "gets whether we drive the robot safely or not",
+        "none",
+        "byte: 1 == driving safely, 0 == driving unsafely",
+        "Movement",
+        "RETURN_SINGLE",
+    ),
+    ("wander", "makes the robot wander", "none", "none", "Movement", "RETURN_NONE"),
+    (
+        "moveDist",
+        "drives the robot forward/backwards the given distance (mm)",
+        "double: distanceToMove",
+        "none",
+        "Movement",
+        "RETURN_NONE",
+    ),
+    (
+        "turnByAngle",
+        "rotate the robot by the given angle (deg)",
+        "double: angleToTurn",
+        "none",
+        "Movement",
+        "RETURN_NONE",
+    ),
+    (
+        "turnToHeading",
+        "rotate the robot to the given absolute heading (deg)",
+        "double: heading",
+        "none",
+        "Movement",
+        "RETURN_NONE",
+    ),
+    (
+        "listCommands",
+        "Gets a list of simple commands that can be sent to the server",
+        "none",
+        "byte2: numberOfCommands, <repeats numberOfCommands> string: name, string: description",
+        "CustomCommands",
+        "RETURN_SINGLE",
+    ),
+    (
+        "listStringCommands",
+        "Gets a list of commands that can be sent to the server with string arguments",
+        "none",
+        "byte2: numberOfCommands, <repeats numberOfCommands> string: name, string: description",
+        "CustomCommands",
+        "RETURN_SINGLE",
+    ),
+    (
+        "ResetTripOdometer",
+        "Resets the robot's trip odometer",
+        "none",
+        "none",
+        "CustomCommands",
+        "RETURN_NONE",
+    ),
+)
+
+SIM_COMMANDS: tuple[Row, ...] = (
+    (
+        "SimulatorResetPose",
+        "Puts the simulated robot back on its home cairn, stopped",
+        "none",
+        "none",
+        "CustomCommands",
+        "RETURN_NONE",
+    ),
+    (
+        "SimulatorLowBattery",
+        "Drains the simulated battery to just under the low-battery threshold (raises the low battery popup)",
+        "none",
+        "none",
+        "CustomCommands",
+        "RETURN_NONE",
+    ),
+    (
+        "SimulatorRecharge",
+        "Recharges the simulated battery to full",
+        "none",
+        "none",
+        "CustomCommands",
+        "RETURN_NONE",
+    ),
+    (
+        "SimulatorSetBattery",
+        "Sets the simulated battery voltage (string argument, volts)",
+        "string: argumentToCommand",
+        "none",
+        "CustomCommands",
+        "RETURN_NONE",
+    ),
+)
+
+VIDEO_COMMANDS: tuple[Row, ...] = (
+    (
+        "SimulatorVideo320x240",
+        "Makes the simulated camera send 320x240 pictures (the default)",
+        "none",
+        "none",
+        "CustomCommands",
+        "RETURN_NONE",
+    ),
+    (
+        "SimulatorVideo640x480",
+        "Makes the simulated camera send 640x480 pictures",
+        "none",
+        "none",
+        "CustomCommands",
+        "RETURN_NONE",
+    ),
+)
+
+UNSAFE_COMMANDS: tuple[Row, ...] = (
+    (
+        "safeRatioDrivingEnable",
+        "Enables safe driving with ratioDrive, which will attempt to prevent collisions (default)",
+        "none",
+        "none",
+        "UnsafeMovement",
+        "RETURN_NONE",
+    ),
+    (
+        "safeRatioDrivingDisable",
+        "Disables safe driving with ratioDrive, this is UNSAFE and will let you drive your robot into things or down stairs, use at your own risk",
+        "none",
+        "none",
+        "UnsafeMovement",
+        "RETURN_NONE",
+    ),
+)
+
+CAMERA: tuple[Row, ...] = (
+    (
+        "videoSize",
+        "gets the width and height of the video data",
+        "none",
+        "uByte2: width, uByte2: height",
+        "Video",
+        "RETURN_SINGLE",
+    ),
+    (
+        "sendVideo",
+        "gets video from the robot's camera (you should requestOnce this, you shouldn't request it, since you could easily fill the bandwidth that way)",
+        "uByte: quality (0 - 100)",
+        "out: uByte2: width, uByte2: height, (len - readLen)*uByte: jpegData",
+        "Video",
+        "RETURN_VIDEO",
+    ),
+    (
+        "getCameraDataCam1",
+        'Get "double" information about camera position. (factor == 100)',
+        "None",
+        "byte2: pan * factor, byte2: tilt * factor, byte2: zoomPercent * factor (optional)",
+        "CameraInfo",
+        "RETURN_SINGLE",
+    ),
+    (
+        "getCameraInfoCam1",
+        'Get ("double") information about the camera\'s pan, tilt, and (optional) zoom ranges. (factor == 100)',
+        "None",
+        "byte2: minPan * factor, byte2: maxPan * factor byte2: minTilt * factor, byte2: maxTilt * factor, byte2: minZoom * factor, byte2: maxZoom * factor, byte: isZoomAvailable",
+        "CameraInfo",
+        "RETURN_SINGLE",
+    ),
+    (
+        "setCameraAbsCam1",
+        'Sends absolute ("double") pan, tilt, and zoom (optional) commands to the camera. (factor == 100)',
+        "None",
+        "byte2: pan * factor, byte2: tilt * factor, byte2: zoom * factor (optional)",
+        "CameraControl",
+        "RETURN_SINGLE",
+    ),
+    (
+        "setCameraPctCam1",
+        'Sends ("double") pan, tilt, and zoom (optional) commands to point camera, as percent of visible frame. (factor == 100)',
+        "None",
+        "byte2: panOffset * factor, byte2: tiltOffset * factor, byte2: zoom * factor (optional)",
+        "CameraControl",
+        "RETURN_SINGLE",
+    ),
+    (
+        "setCameraRelCam1",
+        'Sends ("double") pan, tilt, and zoom (optional) commands to the camera, relative to its current position. (factor == 100)',
+        "None",
+        "byte2: relPan * factor, byte2: relTilt * factor, byte2: relZoom * factor (optional)",
+        "CameraControl",
+        "RETURN_SINGLE",
+    ),
+    (
+        "getCameraModeListCam1",
+        "Gets the list of modes this camera supports",
+        "None",
+        "ubyte2: numModes; <repeating numModes times> string: modeName",
+        "CameraInfo",
+        "RETURN_SINGLE",
+    ),
+    (
+        "cameraModeUpdatedCam1",
+        "Sent whenever the camera mode is updated",
+        "None",
+        "string: modeName; <other data depends on mode>",
+        "CameraInfo",
+        "RETURN_SINGLE",
+    ),
+    (
+        "setCameraModeCam1",
+        "Sets the mode of the camera",
+        "string: modeName; <other data depends on mode>",
+        "None",
+        "CameraControl",
+        "RETURN_SINGLE",
+    ),
+    (
+        "resetCameraCam1",
+        "Resets the camera to 0 0 0 and may reinitialize it (depending on camera)",
+        "None",
+        "None",
+        "CameraControl",
+        "RETURN_SINGLE",
+    ),
+    (
+        "cameraUpdate",
+        "Get (integer) information about camera position",
+        "None",
+        "byte2: pan, byte2: tilt, byte2: zoom (optional)",
+        "CameraInfo",
+        "RETURN_SINGLE",
+    ),
+    (
+        "cameraInfo",
+        "Get (integer) information about the camera's pan, tilt, and (optional) zoom ranges",
+        "None",
+        "byte2: minPan, byte2: maxPan byte2: minTilt, byte2: maxTilt, byte2: minZoom, byte2: maxZoom, byte: isZoomAvailable",
+        "CameraInfo",
+        "RETURN_SINGLE",
+    ),
+    (
+        "camera",
+        "Sends (integer) pan, tilt, and zoom (optional) commands to the camera, relative to its current position",
+        "None",
+        "byte: relPan, byte: relTilt, byte: relZoom (optional)",
+        "CameraControl",
+        "RETURN_SINGLE",
+    ),
+    (
+        "cameraAbs",
+        "Sends absolute (integer) pan, tilt, and zoom (optional) commands to the camera",
+        "None",
+        "byte: pan, byte: tilt, byte: zoom (optional)",
+        "CameraControl",
+        "RETURN_SINGLE",
+    ),
+    (
+        "cameraPct",
+        "Sends (integer) pan, tilt commands to the camera, as percent of visible frame",
+        "None",
+        "byte: pan, byte: tilt, byte: zoom (optional)",
+        "CameraControl",
+        "RETURN_SINGLE",
+    ),
+    (
+        "getPictureCam1",
+        "Gets video from the robot's camera",
+        "uByte: quality (0 - 100)",
+        "out: uByte2: width, uByte2: height, (len - readLen)*uByte: jpegData",
+        "Video",
+        "",
+    ),
+    (
+        "getCameraList",
+        "Gets information about the robot's cameras.",
+        "none",
+        "byte2: numCameras, repeating for numCameras: { string: cameraName, string: cameraType, string: displayName, string: displayType, byte2: numCommands, repeating for numCommands: {string: command, string: cameraCommandName byte4: requestInterval } byte2: numParams, repeating for numParams: {see ArConfigArg format}}",
+        "CameraInfo",
+        "RETURN_SINGLE",
+    ),
+    (
+        "setCameraParams",
+        "Sets the specified camera parameters.",
+        "string: cameraName, repeating for each param: { string: paramName, <param value - see ArConfigArg format> }, empty paramName terminates list",
+        "string: cameraName, repeating for each modified param: { string: paramName, <param value - see ArConfigArg format> }, empty paramName terminates list",
+        "CameraInfo",
+        "RETURN_SINGLE",
+    ),
+    (
+        "cameraListUpdated",
+        "Single packet is sent when the camera collection has been modified.",
+        "none",
+        "none",
+        "CameraInfo",
+        "RETURN_SINGLE",
+    ),
+    (
+        "cameraParamUpdated",
+        "Packet is sent when the camera parameters have been modified.",
+        "none",
+        "string: cameraName, repeating for each modified param: { string: paramName, <param value - see ArConfigArg format> }, empty paramName terminates list",
+        "CameraInfo",
+        "RETURN_SINGLE",
+    ),
+)
+
+STRINGS: tuple[Row, ...] = (
+    (
+        "getStringsInfo",
+        "Gets the information about the 'getStrings' command",
+        "none",
+        "uByte2: count; repeating count times  string: name, uByte2: maxlength",
+        "NavigationInfo",
+        "RETURN_SINGLE",
+    ),
+    (
+        "getStrings",
+        "Gets the strings, for info about them see getStringsInfo",
+        "none",
+        "repeating: string",
+        "NavigationInfo",
+        "RETURN_SINGLE",
+    ),
+)
+
+POPUPS: tuple[Row, ...] = (
+    (
+        "popupCreate",
+        "Tells the gui to create a new popup",
+        "none (you can't send this command to the server)",
+        "byte4: id of this particular popup; string: ignoreIdentifier; string: title; string: message; byte: popupType (0 = NoIcon, 1 = Information, 2 = Warning, 3 = Critical, 4 = Question); string: button0Label; string: button1Label; string: button2Label; byte: defaultButton; byte: escapeButton",
+        "PopupGui",
+        "RETURN_SINGLE",
+    ),
+    (
+        "popupClose",
+        "Closes a popup that was created",
+        "none (you can't send this command to the server)",
+        "byte4: id of the popup to close; string: string to display",
+        "PopupGui",
+        "RETURN_SINGLE",
+    ),
+    (
+        "popupClicked",
+        "Returns the clicked data of a popup ",
+        "byte4: id of the popup that was clicked; byte: buttonClicked",
+        "no response",
+        "PopupGui",
+        "RETURN_NONE",
+    ),
+    (
+        "popupList",
+        "Resends all the popupCreates to this client that asked for this",
+        "none",
+        "technically none, but it resends all the popupCreate events that are active",
+        "PopupGui",
+        "RETURN_NONE",
+    ),
+)
+
+DRAWINGS: tuple[Row, ...] = (
+    (
+        "sonarCurrent",
+        "",
+        "none",
+        "See getDrawingList for the information on how this drawing should be drawn, and the documentation in ArDrawingData for that information means.",
+        "SensorInfo",
+        "RETURN_SINGLE",
+    ),
+)
+
+STRING_COMMANDS = frozenset({"SimulatorSetBattery"})
+"""Simple commands that take one string argument (``listStringCommands``)."""
+
+
+def custom_commands(camera: bool = True) -> tuple[Row, ...]:
+    """What ``listCommands``/``listStringCommands`` list, in registration order."""
+    rows = [r for r in CORE if r[0] == "ResetTripOdometer"]
+    rows += SIM_COMMANDS
+    if camera:
+        rows += VIDEO_COMMANDS
+    rows += UNSAFE_COMMANDS
+    return tuple(rows)
+
+
+def build_catalogue(camera: bool = True) -> DataList:
+    """The data list a simulator serves; without a camera the video and camera data are absent."""
+    rows = [*CORE, *SIM_COMMANDS]
+    if camera:
+        rows += VIDEO_COMMANDS
+    rows += UNSAFE_COMMANDS
+    if camera:
+        rows += CAMERA
+    rows += [*STRINGS, *POPUPS, *DRAWINGS]
+    return DataList.build(rows)

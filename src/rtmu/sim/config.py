@@ -1,0 +1,45 @@
+"""Everything a simulator can be told, in one place (the ``rtmu sim`` options map onto it)."""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+from pathlib import Path
+
+from . import p3dx
+
+
+@dataclass
+class SimConfig:
+    host: str = "127.0.0.1"
+    port: int = 7272
+    """0 picks a free port (read it back from ``SimServer.port``)."""
+    map_path: Path | None = None
+    """None: serve no map (the robot is in an empty world)."""
+    users_path: Path | None = None
+    """An ARIA user-info file; None: anyone may log in and see everything."""
+    camera: bool = True
+    seed: int = 1
+    drive_timeout: float = 2.0
+    """ARIA's ratio-drive watchdog (seconds without a ratioDrive while moving); 0 disables it."""
+    realtime: bool = True
+    """False: the clock stands still until ``SimServer.advance`` moves it (for tests)."""
+    battery_v: float = p3dx.BATTERY_FULL_V
+    server_key: str = ""
+    max_clients: int | None = None
+    """ARIA's maxClientsAllowed: one more is refused with reason 5."""
+    protocol_version: str | None = None
+    """Enforce a protocol version (reason 4 for a client that differs)."""
+    client_type: int | None = None
+    """Enforce a client type (reason 6), as ``ArServerBase::enforceType`` does."""
+    central_server: str | None = None
+    """Pretend to be managed by a central server at this address: every login gets reason 2."""
+    video_trailer: bool = True
+    """Append the 2 bytes ARIA's video forwarder leaves after each JPEG (serverDemo does this)."""
+    intro_timeout: float = 60.0
+    backup_timeout: float = 5.0
+    """Drop a client whose queued output has not moved for this long (ARIA's backup timeout)."""
+    max_queued_bytes: int = 64 * 1024 * 1024
+    """Drop a client at once when this much output is waiting for it."""
+    skip_periodic_above: int = 1024 * 1024
+    """Skip periodic sends to a client with this much output still queued (it is not keeping up)."""
+    verbose: bool = False

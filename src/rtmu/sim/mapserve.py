@@ -1,0 +1,122 @@
+"""The map a simulator serves: its obstacles, goals, home, id, and the two map streams pre-encoded.
+
+``getMap`` sends the file's own lines, one per packet, unchanged (so ARIA's
+maps and ours reach the client byte for byte); ``getMapBinary`` sends the
+header ARIA's way and the geometry as int32 blocks. Both streams are framed
+once per data number and then handed to every client as one ``bytes``.
+"""
+
+from __future__ import annotations
+
+import hashlib
+import os
+from dataclasses import dataclass, field
+from pathlib import Path
+
+import numpy as np
+
+from rtmu.protocol.packet import encode_packet
+from rtmu.protocol.payloads.map import Goals, MapId, MapName
+from rtmu.protocol.payloads.mapstream import map_binary_payloads, map_text_payloads
+
+from .geometry import Obstacles
+
+DEFAULT_POINT_CELL_MM = 40.0
+MIN_POINT_CELL_MM = 20.0
+
+
+@dataclass
+class ServedMap:
+    path: Path | None
+    name: str
+    """As configured (ARIA sends the path it was given)."""
+    lines: list[str] = field(default_factory=list)
+    header: list[str] = field(default_factory=list)
+    segments: np.ndarray = field(default_factory=lambda: np.zeros((0, 4), np.int32))
+    points: np.ndarray = field(default_factory=lambda: np.zeros((0, 2), np.int32))
+    home: tuple[float, float, float] = (0.0, 0.0, 0.0)
+    has_home: bool = False
+    goals: tuple[str, ...] = ()
+    md5: bytes = b""
+    size: int = 0
+    mtime: int = 0
+    resolution: int | None = None
+    access_point: tuple[float, float] | None = None
+    _framed: dict[tuple[str, int], bytes] = field(default_factory=dict, repr=False)
+
+    @property
+    def present(self) -> bool:
+        return self.path is not None
+
+    def obstacles(self) -> Obstacles:
+        cell = float(self.resolution) if self.resolution and self.resolution > 0 else DEFAULT_POINT_CELL_MM
+        return Obstacles(self.segments, self.points, point_cell_mm=max(cell, MIN_POINT_CELL_MM))
+
+    # -- replies -----------------------------------------------------------------
+    def name_payload(self) -> bytes:
+        return MapName(self.name).encode()
+
+    def id_payload(self) -> bytes:
+        return MapId("", self.name, self.md5, self.size, self.mtime).encode()
+
+    def goals_payload(self) -> bytes:
+        return Goals(self.goals).encode()
+
+    def text_stream(self, number: int) -> bytes:
+        """Every ``getMap`` reply packet, framed for data ``number``."""
+        key = ("text", number)
+        if key not in self._framed:
+            payloads = map_text_payloads(self.lines if self.present else None)
+            self._framed[key] = b"".join(encode_packet(number, p) for p in payloads)
+        return self._framed[key]
+
+    def binary_stream(self, number: int, first_line: str | None = None) -> bytes:
+        """Every ``getMapBinary`` reply packet (``getMapWithMaxCategory`` may rename the first line)."""
+        key = ("binary:" + (first_line or ""), number)
+        if key not in self._framed:
+            if self.present:
+                header = list(self.header) or ["2D-Map"]
+                header[0] = first_line or "2D-Map"
+                payloads = map_binary_payloads(header, self.segments, self.points)
+            else:
+                payloads = map_binary_payloads(None)
+            self._framed[key] = b"".join(encode_packet(number, p) for p in payloads)
+        return self._framed[key]
+
+
+def load_map(path: Path | None) -> ServedMap:
+    """Read ``path`` with the project's map reader; None = serve no map (an empty 10 m room to drive in)."""
+    if path is None:
+        return ServedMap(None, "")
+    from rtmu.maps import read_map
+
+    raw = path.read_bytes()
+    data = read_map(path)
+    text = raw.decode("latin-1")
+    lines = [line.rstrip("\r") for line in text.split("\n")]
+    lines = [line for line in lines if line.strip()]
+    home = data.home()
+    goals = tuple(obj.name for obj in data.goals())
+    ap = None
+    for obj in data.objects:
+        label = f"{obj.type} {obj.name}".lower()
+        if "access point" in label or "accesspoint" in label or "wifi" in label:
+            ap = (float(obj.pose.x), float(obj.pose.y))
+            break
+    st = os.stat(path)
+    return ServedMap(
+        path=path,
+        name=str(path),
+        lines=lines,
+        header=data.header_lines(),
+        segments=np.asarray(data.segments, dtype=np.int32).reshape(-1, 4),
+        points=np.asarray(data.points, dtype=np.int32).reshape(-1, 2),
+        home=(float(home.x), float(home.y), float(home.th)) if home is not None else (0.0, 0.0, 0.0),
+        has_home=home is not None,
+        goals=goals,
+        md5=hashlib.md5(raw).digest(),
+        size=len(raw),
+        mtime=int(st.st_mtime),
+        resolution=data.resolution,
+        access_point=ap,
+    )

@@ -1,0 +1,548 @@
+"""The simulator's asyncio TCP server: sessions over the sans-I/O codec, a 10 ms cycle, a world.
+
+Like ARIA's ``ArServerBase``: every client gets its own session (its
+subscriptions: data number → interval, arguments, last time served); a cycle
+every 10 ms steps the world and sends what is due; broadcasts go only to
+clients subscribed to that data. A client that vanishes, sends garbage or
+stops reading costs the others nothing: its bytes are decoded (and dropped)
+by its own codec, and output that it does not drain gets it disconnected.
+"""
+
+from __future__ import annotations
+
+import asyncio
+import contextlib
+import logging
+import math
+import random
+import time
+from collections.abc import Callable
+from dataclasses import dataclass
+from itertools import count
+
+from rtmu.protocol.auth import UserTable
+from rtmu.protocol.commands import RejectReason
+from rtmu.protocol.datalist import DataList
+from rtmu.protocol.events import (
+    ClientIntroduced,
+    LoginRefused,
+    PeerShutdown,
+    RequestOnce,
+    RequestReceived,
+    RequestStopped,
+)
+from rtmu.protocol.fields import FieldReader
+from rtmu.protocol.packet import Packet, encode_packet
+from rtmu.protocol.server_connection import ServerConnection, ServerState
+
+from .catalogue import Row, build_catalogue, custom_commands
+from .config import SimConfig
+from .handlers import (
+    BROADCAST_ONLY,
+    HANDLERS,
+    Call,
+    Framed,
+    Other,
+    mode_info_payload,
+    popup_close_payload,
+    popup_payload,
+    strings_payload,
+)
+from .mapserve import ServedMap, load_map
+from .world import PHYSICS_DT, World, free_spot_near
+
+log = logging.getLogger("rtmu.sim")
+
+CYCLE_S = 0.01
+"""ARIA's server loop sleeps 10 ms between cycles."""
+MAX_CATCH_UP_STEPS = 50
+READ_CHUNK = 65536
+
+
+class SimServerConnection(ServerConnection):
+    """ARIA's other refusals on top of the codec's user check: central server, too many clients,
+    protocol version and client type (reasons 2, 5, 4, 6). A simulator refuses and closes."""
+
+    def __init__(self, *args, general_reject: tuple[int, str] | None = None, config: SimConfig, **kw) -> None:
+        super().__init__(*args, **kw)
+        self._general_reject = general_reject
+        self._config = config
+
+    def _on_introduction(self, packet: Packet):
+        if self._general_reject is not None:
+            reason, text = self._general_reject
+            return self.reject(RejectReason(reason), text)
+        r = FieldReader(packet.payload)
+        version, client_type = "", 0
+        with contextlib.suppress(Exception):
+            r.ubyte2()
+            r.string()
+            r.raw(16)
+            version = r.string(default="")
+            client_type = r.byte(default=0)
+        cfg = self._config
+        if cfg.protocol_version is not None and version != cfg.protocol_version:
+            return self.reject(
+                RejectReason.PROTOCOL_VERSION_MISMATCH,
+                "Server rejecting client connection since protocol version does not match",
+            )
+        if cfg.client_type is not None and (client_type != cfg.client_type or cfg.client_type == 3):
+            return self.reject(
+                RejectReason.CLIENT_TYPE_MISMATCH,
+                "Server rejecting client connection since type (real or sim) does not match "
+                "(but is specified)",
+            )
+        return super()._on_introduction(packet)
+
+
+@dataclass(slots=True)
+class Subscription:
+    name: str
+    interval_ms: int
+    args: bytes
+    last: float
+
+
+class Session:
+    """One connected client: its codec, its subscriptions, its socket."""
+
+    def __init__(
+        self,
+        server: SimServer,
+        ident: int,
+        reader: asyncio.StreamReader,
+        writer: asyncio.StreamWriter,
+        conn: SimServerConnection,
+    ) -> None:
+        self.server = server
+        self.ident = ident
+        self.reader = reader
+        self.writer = writer
+        self.conn = conn
+        self.subscriptions: dict[int, Subscription] = {}
+        self.accepted_at = time.monotonic()
+        self.closed = False
+        self.self_identifier = ""
+        self.here_goal = ""
+        self._stall_since: float | None = None
+        self._last_buffered = 0
+        self.bytes_out = 0
+        peer = writer.get_extra_info("peername")
+        self.peer = f"{peer[0]}:{peer[1]}" if isinstance(peer, tuple) else str(peer)
+
+    # -- output -----------------------------------------------------------------------
+    @property
+    def buffered(self) -> int:
+        transport = self.writer.transport
+        return 0 if transport is None or transport.is_closing() else transport.get_write_buffer_size()
+
+    def write(self, data: bytes) -> None:
+        if self.closed or not data:
+            return
+        if self.buffered + len(data) > self.server.config.max_queued_bytes:
+            log.info("client %s: %d bytes queued and not read; dropping it", self.peer, self.buffered)
+            self.abort()
+            return
+        try:
+            self.writer.write(data)
+            self.bytes_out += len(data)
+        except (ConnectionError, RuntimeError, OSError):
+            self.abort()
+
+    def flush_codec(self) -> None:
+        self.write(self.conn.data_to_send())
+
+    def send(self, number: int, payload: bytes) -> None:
+        self.write(encode_packet(number, payload))
+
+    def may_use(self, group: str) -> bool:
+        user = self.conn.user
+        return True if user is None else user.may_use(group)
+
+    # -- lifetime ---------------------------------------------------------------------
+    def abort(self) -> None:
+        """Gone: no goodbye, just close (a vanished client, a slow one, a killed server)."""
+        if self.closed:
+            return
+        self.closed = True
+        transport = self.writer.transport
+        if transport is not None:
+            transport.abort()
+        self.server.forget(self)
+
+    def close_after_flush(self, delay: float = 0.02) -> None:
+        if self.closed:
+            return
+        self.closed = True
+        self.server.forget(self)
+
+        def finish() -> None:
+            with contextlib.suppress(Exception):
+                self.writer.close()
+
+        asyncio.get_running_loop().call_later(delay, finish)
+
+    def check_health(self, now_real: float) -> None:
+        """Intro deadline and ARIA's backup timeout (queued output that does not move)."""
+        cfg = self.server.config
+        if (
+            self.conn.state is ServerState.SENT_INTRODUCTION
+            and now_real - self.accepted_at > cfg.intro_timeout
+        ):
+            self.abort()
+            return
+        size = self.buffered
+        if size == 0 or size < self._last_buffered:
+            self._stall_since = None
+        elif self._stall_since is None:
+            self._stall_since = now_real
+        elif now_real - self._stall_since > cfg.backup_timeout:
+            log.info("client %s: output stuck for %.0f s; dropping it", self.peer, cfg.backup_timeout)
+            self.abort()
+        self._last_buffered = size
+
+    async def run(self) -> None:
+        self.flush_codec()  # the server INTRODUCTION
+        try:
+            while not self.closed:
+                data = await self.reader.read(READ_CHUNK)
+                if not data:
+                    break
+                self.receive(data)
+        except (ConnectionError, OSError, asyncio.IncompleteReadError):
+            pass
+        except asyncio.CancelledError:
+            raise
+        except Exception:  # a bug must cost this client only
+            log.exception("client %s: handler failed; closing it", self.peer)
+        finally:
+            self.abort()
+
+    def receive(self, data: bytes) -> None:
+        for event in self.conn.receive_data(data):
+            if isinstance(event, RequestOnce):
+                self.server.invoke(self, event.number, event.name, event.args, once=True)
+            elif isinstance(event, RequestReceived):
+                self._on_request(event)
+            elif isinstance(event, RequestStopped):
+                self.subscriptions.pop(event.number, None)
+            elif isinstance(event, ClientIntroduced):
+                self.flush_codec()
+                log.info("client %s logged in as %r", self.peer, event.user)
+            elif isinstance(event, LoginRefused):
+                self.flush_codec()
+                log.info("client %s refused (reason %d)", self.peer, event.reason)
+                self.close_after_flush()
+                return
+            elif isinstance(event, PeerShutdown):
+                self.abort()
+                return
+            if self.closed:
+                return
+        self.flush_codec()
+
+    def _on_request(self, event: RequestReceived) -> None:
+        now = self.server.world.time
+        sub = self.subscriptions.get(event.number)
+        if sub is not None:
+            sub.interval_ms, sub.args = event.interval_ms, event.args
+            return
+        self.subscriptions[event.number] = Subscription(event.name, event.interval_ms, event.args, now)
+        if event.name not in BROADCAST_ONLY:
+            self.server.invoke(self, event.number, event.name, event.args, once=True)
+
+
+class SimServer:
+    def __init__(self, config: SimConfig | None = None) -> None:
+        self.config = config or SimConfig()
+        cfg = self.config
+        self.map: ServedMap = load_map(cfg.map_path)
+        obstacles = self.map.obstacles()
+        home = self.map.home
+        x, y = free_spot_near(obstacles, home[0], home[1], 250.0) if self.map.present else (home[0], home[1])
+        self.world = World(
+            obstacles,
+            home=(x, y, home[2]),
+            access_point=self.map.access_point,
+            seed=cfg.seed,
+            drive_timeout=cfg.drive_timeout,
+            battery_v=cfg.battery_v,
+        )
+        self.home = (x, y, home[2])
+        self.datalist: DataList = build_catalogue(camera=cfg.camera)
+        self.users: UserTable | None = UserTable.load(cfg.users_path) if cfg.users_path else None
+        self.sessions: list[Session] = []
+        self._rng = random.Random(cfg.seed)
+        self._ids = count(1)
+        self._server: asyncio.base_events.Server | None = None
+        self._cycle_task: asyncio.Task[None] | None = None
+        self._tasks: set[asyncio.Task[None]] = set()
+        self._cycle_cache: dict[str, bytes] = {}
+        self._real_start = 0.0
+        self._steps_done = 0
+        self.port = 0
+        self.cycles = 0
+        self.cpu = CpuMeter()
+        self.video_size: tuple[int, int] = (320, 240)
+
+    @property
+    def robot(self):
+        return RobotView(self.world)
+
+    # -- lifetime ----------------------------------------------------------------------
+    async def start(self) -> None:
+        cfg = self.config
+        self._server = await asyncio.start_server(self._accept, cfg.host, cfg.port, limit=READ_CHUNK)
+        sock = self._server.sockets[0]
+        self.port = sock.getsockname()[1]
+        self._real_start = time.monotonic()
+        if cfg.realtime:
+            self._cycle_task = asyncio.create_task(self._run_realtime(), name="rtmu-sim-cycle")
+
+    async def stop(self) -> None:
+        """Say SHUTDOWN to every client, let the bytes go, close everything."""
+        if self._cycle_task is not None:
+            self._cycle_task.cancel()
+            with contextlib.suppress(asyncio.CancelledError):
+                await self._cycle_task
+            self._cycle_task = None
+        if self._server is not None:
+            self._server.close()
+        for s in list(self.sessions):
+            s.conn.shutdown()
+            s.flush_codec()
+            s.closed = True
+            with contextlib.suppress(Exception):
+                s.writer.close()
+        for s in list(self.sessions):
+            with contextlib.suppress(Exception):
+                await asyncio.wait_for(s.writer.wait_closed(), 1.0)
+        self.sessions.clear()
+        for task in list(self._tasks):
+            task.cancel()
+        if self._tasks:
+            await asyncio.wait(self._tasks, timeout=1.0)
+        if self._server is not None:
+            with contextlib.suppress(Exception):
+                await asyncio.wait_for(self._server.wait_closed(), 1.0)
+            self._server = None
+
+    def kill(self) -> None:
+        """Die abruptly: no SHUTDOWN, sockets reset (for lost-link tests)."""
+        if self._cycle_task is not None:
+            self._cycle_task.cancel()
+            self._cycle_task = None
+        if self._server is not None:
+            self._server.close()
+        for s in list(self.sessions):
+            s.abort()
+
+    def forget(self, session: Session) -> None:
+        with contextlib.suppress(ValueError):
+            self.sessions.remove(session)
+
+    async def _accept(self, reader: asyncio.StreamReader, writer: asyncio.StreamWriter) -> None:
+        cfg = self.config
+        general: tuple[int, str] | None = None
+        if cfg.central_server is not None:
+            general = (int(RejectReason.USING_CENTRAL_SERVER), cfg.central_server)
+        elif cfg.max_clients is not None and len(self.sessions) >= cfg.max_clients:
+            general = (
+                int(RejectReason.TOO_MANY_CLIENTS),
+                "Server rejecting connection since it would exceed the maximum number of allowed "
+                f"connections (which is {cfg.max_clients})",
+            )
+        conn = SimServerConnection(
+            self.datalist,
+            self.users,
+            server_key=cfg.server_key,
+            udp_port=0,
+            rng=random.Random(self._rng.getrandbits(64)),
+            general_reject=general,
+            config=cfg,
+        )
+        session = Session(self, next(self._ids), reader, writer, conn)
+        self.sessions.append(session)
+        task = asyncio.current_task()
+        if task is not None:
+            self._tasks.add(task)  # type: ignore[arg-type]
+        try:
+            await session.run()
+        finally:
+            if task is not None:
+                self._tasks.discard(task)  # type: ignore[arg-type]
+
+    # -- serving ------------------------------------------------------------------------
+    def cycle_cached(self, key: str, make: Callable[[], bytes]) -> bytes:
+        """One payload per cycle however many clients ask (status, sonar)."""
+        value = self._cycle_cache.get(key)
+        if value is None:
+            value = make()
+            self._cycle_cache[key] = value
+        return value
+
+    def invoke(self, session: Session, number: int, name: str, args: bytes, *, once: bool) -> None:
+        handler = HANDLERS.get(name)
+        if handler is None:
+            return
+        replies = handler(Call(self, session, name, number, args, once))
+        for reply in replies:
+            if isinstance(reply, bytes):
+                session.send(number, reply)
+            elif isinstance(reply, Framed):
+                session.write(reply.data)
+            elif isinstance(reply, Other):
+                other = self.datalist.number(reply.name)
+                if other is not None:
+                    session.send(other, reply.payload)
+
+    def broadcast(self, name: str, payload: bytes = b"") -> int:
+        """Send data ``name`` to every client subscribed to it; returns how many got it."""
+        number = self.datalist.number(name)
+        if number is None:
+            return 0
+        packet = encode_packet(number, payload)
+        sent = 0
+        for s in list(self.sessions):
+            if number in s.subscriptions and not s.closed:
+                s.write(packet)
+                sent += 1
+        return sent
+
+    def _serve_due(self) -> None:
+        now = self.world.time
+        limit = self.config.skip_periodic_above
+        for s in list(self.sessions):
+            if s.closed or not s.subscriptions:
+                continue
+            backlog = s.buffered > limit
+            for number, sub in list(s.subscriptions.items()):
+                if sub.interval_ms == -1 or sub.name in BROADCAST_ONLY:
+                    continue
+                if sub.interval_ms > 0 and (now - sub.last) * 1000.0 < sub.interval_ms - 1e-6:
+                    continue
+                sub.last = now
+                if backlog:
+                    continue  # like a lost UDP packet: a client that is behind misses this one
+                self.invoke(s, number, sub.name, sub.args, once=False)
+                if s.closed:
+                    break
+
+    def _broadcast_changes(self) -> None:
+        ch = self.world.changes
+        if ch.mode_info:
+            self.broadcast("getModeInfo", mode_info_payload(self.world))
+        if ch.strings:
+            self.broadcast("updateStrings", strings_payload(self.world))
+        for popup in ch.popups_created:
+            self.broadcast("popupCreate", popup_payload(popup))
+        for popup_id, text in ch.popups_closed:
+            self.broadcast("popupClose", popup_close_payload(popup_id, text))
+        ch.clear()
+
+    def cycle(self) -> None:
+        """One server cycle (10 ms of simulated time): step, broadcast what changed, send what is due."""
+        for _ in range(round(CYCLE_S / PHYSICS_DT)):
+            self.world.step(PHYSICS_DT)
+        self._cycle_cache.clear()
+        self._broadcast_changes()
+        self._serve_due()
+        self.cpu.sample()
+        now_real = time.monotonic()
+        for s in list(self.sessions):
+            s.check_health(now_real)
+        self.cycles += 1
+
+    async def advance(self, seconds: float) -> None:
+        """Manual clock: run the cycles that fit in ``seconds`` of simulated time, sending as they go."""
+        for _ in range(3):
+            await asyncio.sleep(0)  # let bytes already received be handled first
+        n = max(math.floor(seconds / CYCLE_S + 1e-9), 0)
+        for i in range(n):
+            self.cycle()
+            if i % 10 == 9:
+                await asyncio.sleep(0)
+        await asyncio.sleep(0)
+
+    async def _run_realtime(self) -> None:
+        cycles_done = 0
+        start = time.monotonic()
+        while True:
+            due = int((time.monotonic() - start) / CYCLE_S)
+            behind = due - cycles_done
+            if behind > MAX_CATCH_UP_STEPS:  # we were starved: skip time rather than race
+                cycles_done = due - MAX_CATCH_UP_STEPS
+                behind = MAX_CATCH_UP_STEPS
+            for _ in range(max(behind, 0)):
+                try:
+                    self.cycle()
+                except Exception:
+                    log.exception("simulator cycle failed")
+                cycles_done += 1
+            await asyncio.sleep(CYCLE_S)
+
+    def custom_commands(self) -> tuple[Row, ...]:
+        return custom_commands(self.config.camera)
+
+    def video_trailer(self) -> bytes:
+        """The 2 bytes ARIA's video forwarder leaves after a picture (the upstream packet's checksum)."""
+        return b"\x5a\xa5" if self.config.video_trailer else b""
+
+    # -- tools for tests and the demo -------------------------------------------------------
+    def reset_pose(self) -> None:
+        b = self.world.body
+        b.x, b.y, b.th = self.home
+        b.vel = b.rot_vel = 0.0
+        b.stalled = False
+        self.world.stop()
+
+
+class CpuMeter:
+    """This process's CPU use in percent over the last second (what ARIA's ``CPU Use`` string shows)."""
+
+    def __init__(self) -> None:
+        self._t0 = time.monotonic()
+        self._c0 = time.process_time()
+        self.percent = 0.0
+
+    def sample(self) -> None:
+        t = time.monotonic()
+        if t - self._t0 >= 1.0:
+            c = time.process_time()
+            self.percent = 100.0 * (c - self._c0) / (t - self._t0)
+            self._t0, self._c0 = t, c
+
+
+class RobotView:
+    """``server.robot``: the live state by the names the API promises (x, y, th, vel, rot_vel, …)."""
+
+    def __init__(self, world: World) -> None:
+        self._world = world
+
+    def __getattr__(self, name: str):
+        w = self._world
+        b, r = w.body, w.ratio_mode
+        table = {
+            "x": lambda: b.x,
+            "y": lambda: b.y,
+            "th": lambda: b.th,
+            "vel": lambda: b.vel,
+            "rot_vel": lambda: b.rot_vel,
+            "battery_v": lambda: b.battery_v,
+            "status": lambda: w.strings()[0],
+            "mode": lambda: w.strings()[1],
+            "mode_name": lambda: w.mode.NAME,
+            "trans_ratio": lambda: r.trans_ratio,
+            "rot_ratio": lambda: r.rot_ratio,
+            "throttle": lambda: r.throttle_ratio,
+            "throttle_ratio": lambda: r.throttle_ratio,
+            "lat_ratio": lambda: r.lat_ratio,
+            "safe_drive": lambda: r.safe,
+            "stalled": lambda: b.stalled,
+            "collisions": lambda: b.collisions,
+            "watchdog_stops": lambda: r.timeouts,
+            "last_drive_time": lambda: r.last_command,
+        }
+        if name in table:
+            return table[name]()
+        raise AttributeError(name)

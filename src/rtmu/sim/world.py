@@ -1,0 +1,282 @@
+"""One simulated world: the map's obstacles, the robot, its modes, sensors and a clock.
+
+The world knows nothing about sockets. The server steps it (``advance``) and
+asks it questions; the world reports what changed that clients subscribed to
+broadcasts want to hear (mode, status strings, popups) through ``changes``.
+"""
+
+from __future__ import annotations
+
+import math
+import random
+from dataclasses import dataclass, field
+
+import numpy as np
+
+from . import p3dx
+from .camera import Camera
+from .geometry import Obstacles
+from .modes import JogMode, Mode, RatioDriveMode, StopMode, WanderMode
+from .robot import Body
+from .sonar import sonar_readings
+from .wifi import AccessPoint, Link
+
+PHYSICS_DT = 0.01
+"""100 Hz integration in simulated time."""
+
+
+@dataclass(frozen=True, slots=True)
+class RobotSnapshot:
+    """A copy of the robot's state, safe to hand to another thread."""
+
+    time: float
+    x: float
+    y: float
+    th: float
+    vel: float
+    rot_vel: float
+    battery_v: float
+    status: str
+    mode: str
+    mode_name: str
+    extended_status: str
+    trans_ratio: float
+    rot_ratio: float
+    throttle_ratio: float
+    lat_ratio: float
+    safe_drive: bool
+    stalled: bool
+    collisions: int
+    watchdog_stops: int
+
+
+@dataclass
+class Popup:
+    id: int
+    ignore_identifier: str
+    title: str
+    message: str
+    kind: int
+    buttons: tuple[str, str, str]
+    default_button: int = 0
+    escape_button: int = 0
+    timeout: float = 0.0
+
+
+@dataclass
+class Changes:
+    """What happened since the server last looked (it broadcasts these, then clears them)."""
+
+    mode_info: bool = False
+    strings: bool = False
+    popups_created: list[Popup] = field(default_factory=list)
+    popups_closed: list[tuple[int, str]] = field(default_factory=list)
+
+    def clear(self) -> None:
+        self.mode_info = False
+        self.strings = False
+        self.popups_created.clear()
+        self.popups_closed.clear()
+
+
+class World:
+    def __init__(
+        self,
+        obstacles: Obstacles,
+        *,
+        home: tuple[float, float, float] = (0.0, 0.0, 0.0),
+        access_point: tuple[float, float] | None = None,
+        seed: int = 1,
+        drive_timeout: float = 2.0,
+        battery_v: float = p3dx.BATTERY_FULL_V,
+    ) -> None:
+        self.obstacles = obstacles
+        self.rng = random.Random(seed)
+        self.time = 0.0
+        self.body = Body(obstacles, *home, battery_v=battery_v)
+        self.stop_mode = StopMode()
+        self.ratio_mode = RatioDriveMode(drive_timeout)
+        self.wander_mode = WanderMode(random.Random(self.rng.random()))
+        self.jog_mode = JogMode()
+        self.modes: tuple[Mode, ...] = (self.stop_mode, self.ratio_mode, self.wander_mode, self.jog_mode)
+        self.mode: Mode = self.stop_mode
+        self.camera = Camera(obstacles)
+        if access_point is None:
+            lo_x, lo_y, hi_x, hi_y = obstacles.bounds
+            access_point = ((lo_x + hi_x) / 2, (lo_y + hi_y) / 2)
+        self.access_point = AccessPoint(obstacles, *access_point)
+        self.changes = Changes()
+        self._strings = self.strings()
+        self._sonar_cache: tuple[tuple[float, float, float], list[tuple[int, int]]] | None = None
+        self.popups: dict[int, Popup] = {}
+        self._next_popup_id = 1
+        self._low_battery_warned = False
+        self.last_activity = 0.0
+
+    # -- modes ----------------------------------------------------------------
+    def touch(self) -> None:
+        """A client asked for something: the active mode is busy now."""
+        self.last_activity = self.time
+
+    def seconds_since_activity(self) -> float:
+        return max(self.time - self.last_activity, 0.0)
+
+    def activate(self, mode: Mode) -> None:
+        self.touch()
+        if mode is self.mode:
+            return
+        self.mode = mode
+        mode.activate(self.body, self.time)
+        self.changes.mode_info = True
+        self._check_strings()
+
+    def stop(self) -> None:
+        self.activate(self.stop_mode)
+
+    def ratio_drive(self, trans: float, rot: float, throttle: float, lat: float = 0.0) -> None:
+        self.touch()
+        if self.mode is not self.ratio_mode:
+            self.activate(self.ratio_mode)
+        self.ratio_mode.set_ratios(trans, rot, throttle, lat, self.time)
+
+    def set_safe_drive(self, safe: bool) -> None:
+        """ARIA: changing safety while driving zeroes the ratios; the mode string follows."""
+        mode = self.ratio_mode
+        mode.safe = safe
+        if self.mode is mode:
+            last = mode.last_command
+            mode.set_ratios(0.0, 0.0, 0.0, 0.0, self.time)
+            mode.last_command = last
+        self._check_strings()
+
+    def wander(self) -> None:
+        self.activate(self.wander_mode)
+
+    def move_distance(self, distance: float) -> None:
+        self.touch()
+        self._jog().move(self.body, distance)
+        self._check_strings()
+
+    def turn_by(self, angle: float) -> None:
+        self.touch()
+        self._jog().turn_by(self.body, angle)
+        self._check_strings()
+
+    def turn_to(self, heading: float) -> None:
+        self.touch()
+        self._jog().turn_to(heading)
+        self._check_strings()
+
+    def _jog(self) -> JogMode:
+        if self.mode is not self.jog_mode:
+            self.activate(self.jog_mode)
+        return self.jog_mode
+
+    # -- time -----------------------------------------------------------------
+    def step(self, dt: float = PHYSICS_DT) -> None:
+        self.time += dt
+        cmd = self.mode.command(self.body, self.time, dt)
+        self.body.step(dt, cmd)
+        if not self.body.is_stopped():
+            self.last_activity = self.time
+        if self.body.battery_v <= p3dx.BATTERY_SHUTDOWN_V and self.mode is not self.stop_mode:
+            self.stop()
+        self._check_battery()
+        self._check_strings()
+
+    def _check_strings(self) -> None:
+        now = self.strings()
+        if now != self._strings:
+            self._strings = now
+            self.changes.strings = True
+
+    def _check_battery(self) -> None:
+        v = self.body.battery_v
+        if not self._low_battery_warned and v <= p3dx.BATTERY_LOW_V:
+            self._low_battery_warned = True
+            self.create_popup(
+                "Low battery",
+                f"The battery is down to {v:.1f} V. Dock or charge the robot soon; "
+                f"it stops at {p3dx.BATTERY_SHUTDOWN_V:.1f} V.",
+                kind=2,
+                buttons=("OK", "", ""),
+            )
+
+    def set_battery(self, volts: float) -> None:
+        """Set the pack's voltage; crossing back above the low threshold re-arms the warning."""
+        self.body.battery_v = volts
+        if volts > p3dx.BATTERY_LOW_V:
+            self._low_battery_warned = False
+
+    def recharge(self) -> None:
+        self.set_battery(p3dx.BATTERY_FULL_V)
+
+    # -- popups ---------------------------------------------------------------
+    def create_popup(self, title: str, message: str, *, kind: int = 1, buttons=("OK", "", "")) -> Popup:
+        popup = Popup(self._next_popup_id, "", title, message, kind, tuple(buttons))  # type: ignore[arg-type]
+        self._next_popup_id += 1
+        self.popups[popup.id] = popup
+        self.changes.popups_created.append(popup)
+        return popup
+
+    def click_popup(self, popup_id: int, button: int) -> None:
+        popup = self.popups.pop(popup_id, None)
+        if popup is None:
+            return
+        label = popup.buttons[button] if 0 <= button < 3 else ""
+        self.changes.popups_closed.append((popup_id, label))
+
+    # -- questions --------------------------------------------------------------
+    def strings(self) -> tuple[str, str, str]:
+        m = self.mode
+        return (m.status, m.mode_string, m.extended_status)
+
+    def sonar(self) -> list[tuple[int, int]]:
+        pose = (self.body.x, self.body.y, self.body.th)
+        if self._sonar_cache is None or self._sonar_cache[0] != pose:
+            self._sonar_cache = (pose, sonar_readings(self.obstacles, *pose))
+        return self._sonar_cache[1]
+
+    def wifi(self) -> Link:
+        return self.access_point.link(self.body.x, self.body.y)
+
+    def camera_jpeg(self, size: tuple[int, int], quality: int) -> bytes:
+        b = self.body
+        return self.camera.jpeg(b.x, b.y, b.th, size, quality)
+
+    def snapshot(self) -> RobotSnapshot:
+        b, r = self.body, self.ratio_mode
+        status, mode, extended = self.strings()
+        return RobotSnapshot(
+            self.time,
+            b.x,
+            b.y,
+            b.th,
+            b.vel,
+            b.rot_vel,
+            b.battery_v,
+            status,
+            mode,
+            self.mode.NAME,
+            extended,
+            r.trans_ratio,
+            r.rot_ratio,
+            r.throttle_ratio,
+            r.lat_ratio,
+            r.safe,
+            b.stalled,
+            b.collisions,
+            r.timeouts,
+        )
+
+
+def free_spot_near(obstacles: Obstacles, x: float, y: float, radius: float) -> tuple[float, float]:
+    """(x, y) itself when the robot fits there, else the nearest point on a spiral where it does."""
+    if obstacles.clearance(x, y, radius + 20) == math.inf:
+        return (x, y)
+    for r in np.arange(100.0, 5000.0, 100.0):
+        for a in np.linspace(0, 2 * math.pi, 24, endpoint=False):
+            px, py = x + r * math.cos(a), y + r * math.sin(a)
+            if obstacles.clearance(px, py, radius + 20) == math.inf:
+                return (float(px), float(py))
+    return (x, y)
