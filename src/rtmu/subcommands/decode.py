@@ -1,0 +1,503 @@
+"""``rtmu decode FILE``: show every ArNetworking packet of a capture, hex dump or raw byte file.
+
+The tool for when a robot misbehaves: which end said what, in which order,
+with which fields, and what the receiver would have thrown away. Text output
+folds long runs of one packet kind (a 63 824-line map) to their first and last
+few lines and ends with a per-connection summary; ``--all`` prints everything
+in full; ``--json`` prints one object per packet per line.
+"""
+
+from __future__ import annotations
+
+import argparse
+import json
+import math
+import os
+import sys
+from collections import deque
+from collections.abc import Iterable
+from typing import Any, TextIO
+
+from ..capture import CaptureError, CaptureSource, UnreadableInput, open_capture
+from ..capture.reader import DIRECTIONS, FORMATS
+from ..session_decoder import C2S, S2C, CaptureDecoder, DecodedPacket, DecodeItem, DropReport, Session
+
+EXIT_OK = 0
+EXIT_UNREADABLE = 1
+EXIT_UNRECOGNISED = 4
+RUN_HEAD = 3
+RUN_TAIL = 2
+SHORT_TEXT = 72
+SHORT_LIST = 6
+SHORT_ENTRIES = 12
+SHORT_ENTRY = 40
+PREVIEW_BYTES = 24
+LINK_NAMES = {
+    0: "BSD loopback",
+    1: "Ethernet",
+    12: "raw IP",
+    14: "raw IP",
+    101: "raw IP",
+    108: "OpenBSD loopback",
+    113: "Linux cooked",
+    228: "raw IPv4",
+    229: "raw IPv6",
+    276: "Linux cooked v2",
+}
+DROP_WORDS = {
+    "garbage_bytes": "garbage bytes",
+    "bad_length": "bad length fields",
+    "bad_checksum": "bad checksums",
+    "truncated_at_close": "packets cut off at the end",
+    "capture_gap_bytes": "bytes missing from the capture",
+}
+
+
+def register(subparsers: argparse._SubParsersAction) -> None:  # type: ignore[type-arg]
+    parser = subparsers.add_parser(
+        "decode",
+        help="decode ArNetworking traffic from a pcap/pcapng capture, a hex dump or raw bytes",
+        description=__doc__,
+        formatter_class=argparse.RawDescriptionHelpFormatter,
+    )
+    parser.add_argument("file", metavar="FILE", help="capture (pcap, pcapng), hex dump or raw bytes")
+    parser.add_argument("--format", choices=FORMATS, default="auto", help="input format (default: detect)")
+    parser.add_argument(
+        "--direction",
+        choices=DIRECTIONS,
+        default="auto",
+        help="hex/raw input: who sent the bytes (default: guess from the packets, else s2c)",
+    )
+    parser.add_argument("--json", action="store_true", help="one JSON object per packet per line")
+    parser.add_argument("--all", action="store_true", help="print every packet and every field in full")
+    parser.add_argument(
+        "--conn", type=int, action="append", metavar="N", help="only connection N (repeatable)"
+    )
+    parser.add_argument(
+        "--name",
+        action="append",
+        metavar="NAME",
+        help="only packets with this name or command number (repeatable)",
+    )
+    parser.add_argument("--payload", action="store_true", help="add each payload in hex")
+    parser.add_argument(
+        "--summary",
+        action=argparse.BooleanOptionalAction,
+        default=None,
+        help="per-connection summary at the end (default: on for text, off for --json)",
+    )
+    parser.set_defaults(handler=run)
+
+
+def run(args: argparse.Namespace) -> int:
+    try:
+        source = open_capture(args.file, args.format, args.direction)
+    except UnreadableInput as exc:
+        print(f"rtmu decode: {exc}", file=sys.stderr)
+        return EXIT_UNREADABLE
+    except CaptureError as exc:
+        print(f"rtmu decode: {exc}", file=sys.stderr)
+        return EXIT_UNRECOGNISED
+    decoder = CaptureDecoder()
+    summary = args.summary if args.summary is not None else not args.json
+    out = sys.stdout
+    try:
+        items = _filtered(decoder.run(source.events()), args)
+        if args.json:
+            _write_json(out, items, source, args.payload)
+        else:
+            _write_text(out, items, source, full=args.all, payload=args.payload)
+        if summary:
+            if args.json:
+                _write_json_summary(out, decoder, source)
+            else:
+                _write_text_summary(out, decoder, source, full=args.all)
+        out.flush()
+    except UnreadableInput as exc:
+        print(f"rtmu decode: {exc}", file=sys.stderr)
+        return EXIT_UNREADABLE
+    except CaptureError as exc:
+        print(f"rtmu decode: {exc}", file=sys.stderr)
+        return EXIT_UNRECOGNISED
+    except BrokenPipeError:  # `rtmu decode x | head`: the reader has seen enough
+        devnull = os.open(os.devnull, os.O_WRONLY)
+        os.dup2(devnull, sys.stdout.fileno())
+        return EXIT_OK
+    for warning in source.stats.warnings:
+        print(f"rtmu decode: warning: {warning}", file=sys.stderr)
+    return EXIT_OK
+
+
+def _filtered(items: Iterable[DecodeItem], args: argparse.Namespace) -> Iterable[DecodeItem]:
+    conns = set(args.conn or ())
+    names = set(args.name or ())
+    if not conns and not names:
+        return items
+    return (
+        item
+        for item in items
+        if (not conns or item.conn in conns)
+        and (
+            not names
+            or (isinstance(item, DecodedPacket) and (item.name in names or str(item.command) in names))
+        )
+    )
+
+
+def _relative(time: float | None, source: CaptureSource) -> float | None:
+    base = source.stats.first_time
+    if time is None or base is None:
+        return None
+    return round(time - base, 6)
+
+
+# -- JSON -------------------------------------------------------------------
+def packet_json(packet: DecodedPacket, source: CaptureSource, payload: bool = False) -> dict[str, Any]:
+    record: dict[str, Any] = {
+        "conn": packet.conn,
+        "dir": packet.direction,
+        "transport": packet.transport,
+        "time": _relative(packet.time, source),
+        "command": packet.command,
+        "name": packet.name,
+        "length": packet.length,
+        "checksum_ok": packet.checksum_ok,
+        "fields": packet.fields,
+    }
+    if packet.error:
+        record["error"] = packet.error
+    if packet.note:
+        record["note"] = packet.note
+    if packet.dropped_before:
+        record["dropped_before"] = packet.dropped_before
+    if payload:
+        record["payload"] = packet.payload.hex()
+    return record
+
+
+def _dumps(record: dict[str, Any]) -> str:
+    try:
+        return json.dumps(
+            record, ensure_ascii=False, separators=(",", ":"), allow_nan=False, default=_json_default
+        )
+    except ValueError:  # an infinity (ARIA's "INF" doubles): spell it as ARIA does
+        return json.dumps(_finite(record), ensure_ascii=False, separators=(",", ":"), default=_json_default)
+
+
+def _json_default(value: Any) -> Any:
+    if isinstance(value, (bytes, bytearray, memoryview)):
+        return bytes(value).hex()
+    if hasattr(value, "tolist"):
+        return value.tolist()
+    if isinstance(value, (set, frozenset)):
+        return sorted(value)
+    return str(value)
+
+
+def _finite(value: Any) -> Any:
+    if isinstance(value, float) and not math.isfinite(value):
+        return None if math.isnan(value) else ("INF" if value > 0 else "-INF")
+    if isinstance(value, dict):
+        return {k: _finite(v) for k, v in value.items()}
+    if isinstance(value, (list, tuple)):
+        return [_finite(v) for v in value]
+    return value
+
+
+def _write_json(out: TextIO, items: Iterable[DecodeItem], source: CaptureSource, payload: bool) -> None:
+    batch: list[str] = []
+    for item in items:
+        if isinstance(item, DecodedPacket):
+            batch.append(_dumps(packet_json(item, source, payload)))
+            if len(batch) >= 2048:
+                out.write("\n".join(batch) + "\n")
+                batch.clear()
+    if batch:
+        out.write("\n".join(batch) + "\n")
+
+
+def _write_json_summary(out: TextIO, decoder: CaptureDecoder, source: CaptureSource) -> None:
+    for session in decoder.sessions:
+        record = {"kind": "summary", "conn": session.id, **_session_facts(session, source)}
+        out.write(_dumps(record) + "\n")
+    stats = source.stats
+    capture = {
+        "kind": "capture",
+        "format": stats.kind,
+        "link_type": stats.link_type,
+        "frames": stats.frames,
+        "not_ip_frames": stats.not_ip,
+        "ip_fragments": stats.ip_fragments,
+        "truncated_frames": stats.truncated_frames,
+        "retransmitted_bytes": stats.retransmitted_bytes,
+        "out_of_order_segments": stats.out_of_order_segments,
+        "tcp_gaps": stats.tcp_gaps,
+        "ignored_tcp_connections": decoder.ignored_tcp_flows,
+        "ignored_udp_datagrams": decoder.ignored_datagrams,
+        "warnings": stats.warnings,
+    }
+    out.write(_dumps(capture) + "\n")
+
+
+def _session_facts(session: Session, source: CaptureSource) -> dict[str, Any]:
+    return {
+        "transport": session.transport,
+        "client": str(session.client) if session.client else None,
+        "server": str(session.server) if session.server else None,
+        "server_guessed": session.server_guessed,
+        "start": _relative(session.first_time, source),
+        "end": _relative(session.last_time, source),
+        "udp_datagrams": session.udp_datagrams,
+        "data_names": len(session.datalist),
+        "rejected": session.rejected,
+        "directions": {
+            d: {
+                "packets": t.packets,
+                "bytes": t.bytes,
+                "by_name": dict(t.by_name.most_common()),
+                "dropped": dict(t.drops),
+            }
+            for d, t in session.totals.items()
+        },
+    }
+
+
+# -- text -----------------------------------------------------------------------
+class _TextWriter:
+    """Prints packets; folds runs of one (conn, dir, transport, command) to head and tail."""
+
+    def __init__(self, out: TextIO, source: CaptureSource, full: bool, payload: bool) -> None:
+        self.out = out
+        self.source = source
+        self.full = full
+        self.payload = payload
+        self.lines: list[str] = []
+        self.run_key: tuple[Any, ...] | None = None
+        self.run_count = 0
+        self.run_first_time: float | None = None
+        self.tail: deque[DecodedPacket] = deque(maxlen=RUN_TAIL)
+        self.hidden = 0
+        self.hidden_last: DecodedPacket | None = None
+
+    def item(self, item: DecodeItem) -> None:
+        if isinstance(item, DropReport):
+            self._end_run()
+            self._emit(self._drop_line(item))
+            return
+        if self.full:
+            self._emit(self._packet_line(item))
+            return
+        plain = item.checksum_ok and not item.error
+        key = (item.conn, item.direction, item.transport, item.command) if plain else None
+        if key is None or key != self.run_key:
+            self._end_run()
+            self.run_key = key
+            self.run_count = 0
+        self.run_count += 1
+        if self.run_count <= RUN_HEAD or key is None:
+            self._emit(self._packet_line(item))
+            return
+        if len(self.tail) == RUN_TAIL:
+            self.hidden += 1
+            self.hidden_last = self.tail[0]
+            if self.hidden == 1:
+                self.run_first_time = self.tail[0].time
+        self.tail.append(item)
+
+    def _end_run(self) -> None:
+        if self.hidden:
+            last = self.hidden_last
+            assert last is not None
+            span = ""
+            start = _relative(self.run_first_time, self.source)
+            end = _relative(last.time, self.source)
+            if start is not None and end is not None:
+                span = f" over {end - start:.3f} s"
+            label = last.name or f"command {last.command}"
+            self._emit(
+                f"{'':>10} {last.conn:>3} {last.direction} {last.transport:<6}"
+                f" … {self.hidden} more {label} packets{span} (--all shows them) …"
+            )
+        for packet in self.tail:
+            self._emit(self._packet_line(packet))
+        self.tail.clear()
+        self.hidden = 0
+        self.hidden_last = None
+        self.run_key = None
+
+    def finish(self) -> None:
+        self._end_run()
+        self.flush()
+
+    def _emit(self, line: str) -> None:
+        self.lines.append(line)
+        if len(self.lines) >= 2048:
+            self.flush()
+
+    def flush(self) -> None:
+        if self.lines:
+            self.out.write("\n".join(self.lines) + "\n")
+            self.lines.clear()
+
+    def _time(self, time: float | None) -> str:
+        rel = _relative(time, self.source)
+        return f"{rel:>10.6f}" if rel is not None else f"{'-':>10}"
+
+    def _drop_line(self, drop: DropReport) -> str:
+        what = ", ".join(f"{n} {DROP_WORDS.get(k, k)}" for k, n in drop.counts.items())
+        return (
+            f"{self._time(drop.time)} {drop.conn:>3} {drop.direction} {drop.transport:<6} !! dropped: {what}"
+        )
+
+    def _packet_line(self, p: DecodedPacket) -> str:
+        name = p.name or ("?" if p.is_data else "(unknown control)")
+        where = f"{self._time(p.time)} {p.conn:>3} {p.direction} {p.transport:<6}"
+        head = f"{where} {p.command:>5} {name:<22} {p.length:>5}"
+        parts: list[str] = []
+        if not p.checksum_ok:
+            parts.append("BAD CHECKSUM")
+        if p.fields:
+            parts.append(format_fields(p.fields, self.full))
+        if p.note:
+            parts.append(f"({p.note})")
+        if p.error:
+            parts.append(f"!! {p.error}")
+        if p.payload and (
+            self.payload or (not p.fields and not p.error and p.note is None) or not p.checksum_ok
+        ):
+            parts.append(_preview(p.payload, self.full or self.payload))
+        return f"{head}  {' '.join(parts)}" if parts else head
+
+
+def _write_text(
+    out: TextIO, items: Iterable[DecodeItem], source: CaptureSource, *, full: bool, payload: bool
+) -> None:
+    writer = _TextWriter(out, source, full, payload)
+    kind = source.kind
+    out.write(f"# {source.path.name}: {kind}{_link(source)}\n")
+    out.write(f"# {'time':>8} {'conn':>3} dir transport cmd name{' ' * 21}length  fields\n")
+    for item in items:
+        writer.item(item)
+    writer.finish()
+
+
+def _link(source: CaptureSource) -> str:
+    lt = source.stats.link_type
+    if lt is None:
+        return ""
+    return f", link type {lt} ({LINK_NAMES.get(lt, 'unsupported')})"
+
+
+def _preview(payload: bytes, full: bool) -> str:
+    shown = payload if full else payload[:PREVIEW_BYTES]
+    more = "" if len(shown) == len(payload) else f" …(+{len(payload) - len(shown)} bytes)"
+    text = "".join(chr(b) if 32 <= b < 127 else "." for b in shown)
+    return f"[{shown.hex(' ')}{more}] |{text}|"
+
+
+def format_fields(fields: dict[str, Any], full: bool = False) -> str:
+    """``key=value`` pairs; long strings and lists are shortened unless ``full``."""
+    entries = fields.get("entries")
+    if isinstance(entries, list) and entries and isinstance(entries[0], dict) and "number" in entries[0]:
+        rest = {k: v for k, v in fields.items() if k != "entries"}
+        shown = entries if full else entries[:SHORT_ENTRIES]
+        text = ", ".join(_entry(e, full) for e in shown)
+        if len(shown) < len(entries):
+            text += f", … +{len(entries) - len(shown)}"
+        return (format_fields(rest, full) + " " if rest else "") + f"entries: {text}"
+    return " ".join(f"{k}={_value(v, full)}" for k, v in fields.items())
+
+
+def _entry(entry: dict[str, Any], full: bool) -> str:
+    """One list entry: its number and texts (only the name, or the group and flags, when short)."""
+    values = [str(v) for k, v in entry.items() if k != "number" and v != ""]
+    if not full and "name" in entry:
+        values = [str(entry["name"])]
+    text = "/".join(values)
+    if not full and len(text) > SHORT_ENTRY:
+        text = text[:SHORT_ENTRY] + "…"
+    return f"{entry['number']} {text}" if text else str(entry["number"])
+
+
+def _value(value: Any, full: bool) -> str:
+    if isinstance(value, str):
+        if not full and len(value) > SHORT_TEXT:
+            value = value[:SHORT_TEXT] + "…"
+        return repr(value)
+    if isinstance(value, float):
+        return f"{value:g}"
+    if isinstance(value, dict):
+        return "{" + " ".join(f"{k}={_value(v, full)}" for k, v in value.items()) + "}"
+    if isinstance(value, (list, tuple)):
+        shown = value if full else value[:SHORT_LIST]
+        inner = ", ".join(_value(v, full) for v in shown)
+        if len(shown) < len(value):
+            inner += f", … +{len(value) - len(shown)} (n={len(value)})"
+        return f"[{inner}]"
+    return str(value)
+
+
+def _write_text_summary(out: TextIO, decoder: CaptureDecoder, source: CaptureSource, *, full: bool) -> None:
+    stats = source.stats
+    lines = ["", "== summary"]
+    span = ""
+    if stats.first_time is not None and stats.last_time is not None:
+        span = f", {stats.last_time - stats.first_time:.3f} s"
+    if stats.kind in ("pcap", "pcapng"):
+        lines.append(f"capture: {stats.frames} frames{span}")
+    if not decoder.sessions:
+        lines.append("no ArNetworking packets found")
+    for session in decoder.sessions:
+        lines.extend(_session_lines(session, source, full))
+    notes = [
+        (stats.not_ip, "frames were not TCP/UDP over IP (skipped)"),
+        (stats.ip_fragments, "IP fragments (not reassembled, skipped)"),
+        (stats.truncated_frames, "frames cut by the snap length"),
+        (stats.retransmitted_bytes, "TCP bytes retransmitted (counted once)"),
+        (stats.out_of_order_segments, "TCP segments arrived out of order (reordered)"),
+        (stats.tcp_gaps, "holes in TCP streams (bytes never captured)"),
+        (decoder.ignored_tcp_flows, "TCP connections carried no ArNetworking packet (ignored)"),
+        (decoder.ignored_datagrams, "UDP datagrams were not ArNetworking (ignored)"),
+    ]
+    lines.extend(f"note: {n} {text}" for n, text in notes if n)
+    out.write("\n".join(lines) + "\n")
+
+
+def _session_lines(session: Session, source: CaptureSource, full: bool) -> list[str]:
+    start = _relative(session.first_time, source)
+    end = _relative(session.last_time, source)
+    when = f"  {start:.3f}–{end:.3f} s" if start is not None and end is not None else ""
+    if session.transport == "stream":
+        who = f"bytes sent by the {'server' if session.server == session.ends[0] else 'client'}"
+        if session.server_guessed:
+            who += " (guessed; use --direction to say)"
+    else:
+        guess = " (guessed)" if session.server_guessed else ""
+        who = f"client {session.client}  server {session.server}{guess}"
+    lines = [f"conn {session.id}: {session.transport} {who}{when}"]
+    if session.udp_datagrams and session.transport != "udp":
+        flows = sorted({" ↔ ".join(sorted((str(a), str(b)))) for a, b in session.udp_flows})
+        lines.append(f"  + {session.udp_datagrams} UDP datagrams ({'; '.join(flows)})")
+    if session.rejected:
+        lines.append(f"  rejected: {session.rejected}")
+    if session.datalist.have_list:
+        lines.append(f"  data list: {len(session.datalist)} names")
+    for direction in (C2S, S2C):
+        totals = session.totals[direction]
+        if not totals.packets and not totals.drops:
+            continue
+        names = totals.by_name.most_common()
+        shown = names if full else names[:10]
+        text = ", ".join(f"{n} ×{c}" for n, c in shown)
+        if len(shown) < len(names):
+            text += f", … +{len(names) - len(shown)} names"
+        lines.append(f"  {direction} {totals.packets} packets, {totals.bytes} bytes: {text}")
+    drops = [
+        f"{d} " + ", ".join(f"{n} {DROP_WORDS.get(k, k)}" for k, n in session.totals[d].drops.items())
+        for d in (C2S, S2C)
+        if session.totals[d].drops
+    ]
+    lines.append("  dropped: " + ("; ".join(drops) if drops else "nothing"))
+    if session.held_overflow:
+        lines.append(f"  ({session.held_overflow} bad packets before the first good one were not shown)")
+    return lines
