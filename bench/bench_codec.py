@@ -1,0 +1,195 @@
+"""How fast the wire codec turns bytes into packets and typed status updates.
+
+Figures (MB = 10^6 bytes), each against the simple way measured in the same run:
+
+* ``codec.stream_decode_rate`` / ``codec.stream_decode_throughput``: a realistic client stream —
+  ``updateNumbers`` status packets (19-byte payload, 27 bytes framed) with one full 32 000-byte
+  map/image packet per 200 of them — fed in the chunk sizes a TCP reader gets (single packets,
+  MSS-sized segments, 4–64 KB reads). Baseline: ARIA's receiver written the obvious way, a per-byte
+  state machine with the per-byte checksum loop.
+* ``codec.status_decode_rate``: status packets all the way to typed ``UpdateNumbers`` (framing,
+  checksum, typed decode), same chunking. Baseline: the per-byte receiver plus ``FieldReader``
+  field by field. Target: ≥ 100 000 packets/s on the 2-core reference machine.
+* ``codec.checksum_throughput``: the checksum of 32 000-byte packets. Baseline: ``checksum_naive``.
+  Target: ≥ 200 MB/s.
+"""
+
+from __future__ import annotations
+
+import random
+from itertools import cycle
+
+from bench.common import Result, best_time
+from rtmu.protocol import MAX_LENGTH, MAX_PAYLOAD, FieldReader, PacketDecoder, encode_packet
+from rtmu.protocol.checksum import checksum, checksum_naive
+from rtmu.protocol.payloads.robot import UpdateNumbers
+
+UPDATE_NUMBERS = 0x0108
+MAP_DATA = 0x0120
+READ_SIZES = (65536, 1448, 27, 4096, 2896, 16384, 27, 1448)
+"""What successive ``recv`` calls return on a busy link: whole bursts, segments, single packets."""
+
+
+class NaiveDecoder:
+    """The baseline: ARIA's TCP receiver (§1.8) as a per-byte state machine, per-byte checksum."""
+
+    def __init__(self) -> None:
+        self.state = 0
+        self.packet = bytearray()
+        self.length = 0
+
+    def feed(self, data: bytes) -> list[tuple[int, bytes]]:
+        out: list[tuple[int, bytes]] = []
+        for byte in data:
+            state = self.state
+            if state == 0:
+                if byte == 0x0F:
+                    self.packet = bytearray((byte,))
+                    self.state = 1
+            elif state == 1:
+                if byte == 0x0C:
+                    self.packet.append(byte)
+                    self.state = 2
+                else:
+                    self.state = 0
+            elif state == 2:
+                self.packet.append(byte)
+                self.state = 3
+            elif state == 3:
+                self.packet.append(byte)
+                self.length = self.packet[2] | byte << 8
+                self.state = 4 if 8 <= self.length <= MAX_LENGTH else 0
+            else:
+                packet = self.packet
+                packet.append(byte)
+                if len(packet) == self.length:
+                    if checksum_naive(packet[:-2]) == (packet[-2] << 8 | packet[-1]):
+                        out.append((packet[4] | packet[5] << 8, bytes(packet[6:-2])))
+                    self.state = 0
+        return out
+
+
+def naive_update_numbers(payload: bytes) -> UpdateNumbers:
+    """The baseline's typed decode: one FieldReader call per field."""
+    r = FieldReader(payload)
+    return UpdateNumbers(
+        battery=r.byte2("battery") / 10,
+        x=r.byte4("x"),
+        y=r.byte4("y"),
+        th=r.byte2("th"),
+        vel=r.byte2("vel"),
+        rot_vel=r.byte2("rotVel"),
+        lat_vel=r.byte2("latVel"),
+        temperature=r.byte("temperature"),
+    )
+
+
+def status_packets(rng: random.Random, count: int) -> list[bytes]:
+    out = []
+    for _ in range(count):
+        status = UpdateNumbers(
+            battery=rng.randrange(110, 135) / 10,
+            x=rng.randrange(-50_000, 50_000),
+            y=rng.randrange(-50_000, 50_000),
+            th=rng.randrange(-179, 181),
+            vel=rng.randrange(-750, 751),
+            rot_vel=rng.randrange(-100, 101),
+            lat_vel=0,
+            temperature=rng.choice((-128, 25, 31)),
+        )
+        out.append(encode_packet(UPDATE_NUMBERS, status.encode()))
+    return out
+
+
+def chunked(stream: bytes) -> list[bytes]:
+    chunks = []
+    pos = 0
+    for size in cycle(READ_SIZES):
+        if pos >= len(stream):
+            return chunks
+        chunks.append(stream[pos : pos + size])
+        pos += size
+    raise AssertionError("unreachable")
+
+
+def mixed_stream(rng: random.Random, status_count: int, per_big: int = 200) -> tuple[bytes, int]:
+    parts = []
+    count = 0
+    for i, packet in enumerate(status_packets(rng, status_count)):
+        parts.append(packet)
+        count += 1
+        if i % per_big == per_big - 1:
+            parts.append(encode_packet(MAP_DATA, rng.randbytes(MAX_PAYLOAD)))
+            count += 1
+    return b"".join(parts), count
+
+
+def count_packets(chunks: list[bytes]) -> int:
+    decoder = PacketDecoder()
+    feed = decoder.feed
+    return sum(len(feed(chunk)) for chunk in chunks)
+
+
+def count_packets_naive(chunks: list[bytes]) -> int:
+    decoder = NaiveDecoder()
+    return sum(len(decoder.feed(chunk)) for chunk in chunks)
+
+
+def decode_statuses(chunks: list[bytes]) -> int:
+    decoder = PacketDecoder()
+    decode = UpdateNumbers.decode
+    count = 0
+    for chunk in chunks:
+        for packet in decoder.feed(chunk):
+            if packet.command == UPDATE_NUMBERS:
+                decode(packet.payload)
+                count += 1
+    return count
+
+
+def decode_statuses_naive(chunks: list[bytes]) -> int:
+    decoder = NaiveDecoder()
+    count = 0
+    for chunk in chunks:
+        for command, payload in decoder.feed(chunk):
+            if command == UPDATE_NUMBERS:
+                naive_update_numbers(payload)
+                count += 1
+    return count
+
+
+def bench_stream() -> list[Result]:
+    stream, expected = mixed_stream(random.Random(1), 10_000)
+    chunks = chunked(stream)
+    assert count_packets(chunks) == expected == count_packets_naive(chunks)
+    fast = best_time(lambda: count_packets(chunks))
+    slow = best_time(lambda: count_packets_naive(chunks), repeat=3)
+    return [
+        Result("codec.stream_decode_rate", expected / fast, "packets/s", expected / slow),
+        Result("codec.stream_decode_throughput", len(stream) / fast / 1e6, "MB/s", len(stream) / slow / 1e6),
+    ]
+
+
+def bench_status() -> list[Result]:
+    packets = status_packets(random.Random(2), 20_000)
+    chunks = chunked(b"".join(packets))
+    first = UpdateNumbers.decode(packets[0][6:-2])
+    assert naive_update_numbers(packets[0][6:-2]) == first
+    assert decode_statuses(chunks) == len(packets) == decode_statuses_naive(chunks)
+    fast = best_time(lambda: decode_statuses(chunks))
+    slow = best_time(lambda: decode_statuses_naive(chunks), repeat=3)
+    return [Result("codec.status_decode_rate", len(packets) / fast, "packets/s", len(packets) / slow)]
+
+
+def bench_checksum() -> list[Result]:
+    rng = random.Random(3)
+    bodies = [encode_packet(MAP_DATA, rng.randbytes(MAX_PAYLOAD))[:-2] for _ in range(8)]
+    assert all(checksum(b) == checksum_naive(b) for b in bodies)
+    size = sum(len(b) + 2 for b in bodies)  # the whole 32 000-byte packets
+    fast = best_time(lambda: [checksum(b) for b in bodies])
+    slow = best_time(lambda: [checksum_naive(b) for b in bodies], repeat=3)
+    return [Result("codec.checksum_throughput", size / fast / 1e6, "MB/s", size / slow / 1e6)]
+
+
+def run() -> list[Result]:
+    return bench_stream() + bench_status() + bench_checksum()
