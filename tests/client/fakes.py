@@ -1,0 +1,64 @@
+"""A view that records what the controller tells it, and a link that records what it is asked to do.
+
+The link is not a protocol mock: it holds the real :class:`DriveLease` and only
+stands in for the network thread, so the controller's own rules can be tested
+one by one. End-to-end tests use the real ``ClientRunner`` against the simulator.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Callable, Mapping
+
+from rtmu.client.lease import DriveLease
+from rtmu.commands import CommandState
+from rtmu.controller import Notice
+from rtmu.settings import Profile
+
+
+class FakeView:
+    def __init__(self) -> None:
+        self.notices: list[tuple[Notice, str]] = []
+        self.states: dict[str, CommandState] = {}
+        self.state_calls = 0
+        self.password_asks: list[tuple[Profile, Callable[[str | None], None]]] = []
+
+    def notify(self, level: Notice, text: str) -> None:
+        self.notices.append((level, text))
+
+    def commands_changed(self, states: Mapping[str, CommandState]) -> None:
+        self.state_calls += 1
+        self.states.update(states)
+
+    def ask_password(self, profile: Profile, answer: Callable[[str | None], None]) -> None:
+        self.password_asks.append((profile, answer))
+
+    def texts(self) -> list[str]:
+        return [t for _, t in self.notices]
+
+
+class RecordingLink:
+    def __init__(self, clock: Callable[[], float]) -> None:
+        self.lease = DriveLease(clock=clock)
+        self.on_notice: Callable[[str, str], None] | None = None
+        self.calls: list[tuple[object, ...]] = []
+
+    def connect(self, host: str, port: int, user: str = "", password: str = "", **kw: object) -> None:
+        self.calls.append(("connect", host, port, user, password, kw.get("profile")))
+
+    def disconnect(self) -> None:
+        self.calls.append(("disconnect",))
+
+    def stop(self) -> None:
+        self.calls.append(("stop",))
+
+    def command(self, name: str, *args: object) -> None:
+        self.calls.append(("command", name, *args))
+
+    def request_image(self) -> None:
+        self.calls.append(("request_image",))
+
+    def set_safe_drive(self, on: bool) -> None:
+        self.calls.append(("set_safe_drive", on))
+
+    def names(self) -> list[object]:
+        return [c[0] for c in self.calls]

@@ -1,0 +1,288 @@
+"""The controller's rules, one by one, on a fake clock with a recording view (no GTK, no sockets)."""
+
+from __future__ import annotations
+
+import pytest
+
+from rtmu.client.lease import DriveRatios, EndReason
+from rtmu.commands import Command, CommandRegistry
+from rtmu.controller import Controller, Notice, ratios_for
+from rtmu.model import ConnectionState, LinkHealth, LinkLevel, Model, Phase, SpeedSetting
+from rtmu.settings import Profile
+
+from .fakeclock import FakeClock
+from .fakes import FakeView, RecordingLink
+
+ALL = frozenset({"ratioDrive", "stop", "turnByAngle", "moveDist", "setSafeDrive", "getPictureCam1"})
+
+
+class Rig:
+    def __init__(self, offers: frozenset[str] = ALL, connected: bool = True) -> None:
+        self.clock = FakeClock()
+        self.model = Model()
+        self.view = FakeView()
+        self.link = RecordingLink(self.clock)
+        self.ctl = Controller(self.model, self.link, self.view, clock=self.clock)
+        if connected:
+            self.connect(offers)
+
+    def connect(self, offers: frozenset[str] = ALL) -> None:
+        self.model.connection.set(ConnectionState(Phase.CONNECTED, "127.0.0.1", 7272, offers=offers))
+        self.model.health.set(LinkHealth(LinkLevel.OK))
+
+    def hold(self, seconds: float) -> None:
+        """Keep the keys held: the UI timer ticks every 100 ms."""
+        for _ in range(round(seconds / 0.1)):
+            self.clock.advance(0.1)
+            self.ctl.tick()
+
+    @property
+    def lease(self):  # type: ignore[no-untyped-def]
+        return self.link.lease.view()
+
+
+def test_ratios_combine_into_curves_and_cancel() -> None:
+    assert ratios_for({"forward"}, 50) == DriveRatios(100, 0, 50)
+    assert ratios_for({"backward"}, 50) == DriveRatios(-100, 0, 50)
+    assert ratios_for({"left"}, 30) == DriveRatios(0, 100, 30)
+    assert ratios_for({"forward", "right"}, 50) == DriveRatios(100, -50, 50)
+    assert ratios_for({"backward", "left"}, 50) == DriveRatios(-100, 50, 50)
+    assert not ratios_for({"forward", "backward"}, 50).moving
+    assert not ratios_for(set(), 50).moving
+
+
+def test_hold_drives_and_release_stops() -> None:
+    rig = Rig()
+    rig.ctl.press("forward")
+    assert rig.lease.live and rig.lease.ratios == DriveRatios(100, 0, 50)
+    rig.hold(2.0)
+    assert rig.lease.live
+    rig.ctl.release("forward")
+    assert not rig.lease.live and rig.lease.ended is EndReason.RELEASED
+
+
+def test_auto_repeat_presses_do_not_regrant() -> None:
+    rig = Rig()
+    rig.ctl.press("forward")
+    generation = rig.lease.generation
+    rig.ctl.press("forward")
+    rig.ctl.press("forward")
+    assert rig.lease.generation == generation
+
+
+def test_two_keys_curve_and_releasing_one_keeps_driving() -> None:
+    rig = Rig()
+    rig.ctl.press("forward")
+    rig.ctl.press("left")
+    assert rig.lease.ratios == DriveRatios(100, 50, 50)
+    generation = rig.lease.generation
+    rig.ctl.release("forward")
+    assert rig.lease.live and rig.lease.ratios == DriveRatios(0, 100, 50)
+    assert rig.lease.generation == generation
+    rig.ctl.press("right")  # left + right cancel: stop
+    assert not rig.lease.live
+
+
+def test_a_frozen_ui_lapses_the_lease_and_held_keys_need_a_fresh_press() -> None:
+    rig = Rig()
+    rig.ctl.press("forward")
+    rig.clock.advance(0.5)  # no tick for 500 ms: the UI was frozen
+    rig.ctl.tick()
+    assert not rig.lease.live and rig.ctl.held == frozenset()
+    assert any("did not respond" in t for t in rig.view.texts())
+    rig.ctl.press("forward")  # auto-repeat of the key still down
+    assert not rig.lease.live
+    rig.ctl.release("forward")
+    rig.ctl.press("forward")
+    assert rig.lease.live
+
+
+def test_stop_always_wins_and_is_sent_even_when_stale() -> None:
+    rig = Rig()
+    rig.ctl.press("forward")
+    rig.model.health.set(LinkHealth(LinkLevel.STALE))
+    rig.link.calls.clear()
+    rig.ctl.stop()
+    assert rig.link.names() == ["stop"]
+    assert not rig.lease.live
+    rig.ctl.press("forward")  # still held through the stop
+    assert not rig.lease.live
+
+
+def test_focus_loss_stops() -> None:
+    rig = Rig()
+    rig.ctl.press("left")
+    rig.ctl.focus_lost()
+    assert "stop" in rig.link.names() and not rig.lease.live
+    rig.ctl.press("left")  # focus is back and the key is pressed anew
+    assert rig.lease.live
+
+
+def test_a_stale_link_stops_and_tells_the_operator() -> None:
+    rig = Rig()
+    rig.ctl.press("forward")
+    rig.model.health.set(LinkHealth(LinkLevel.STALE))
+    assert not rig.lease.live and rig.lease.ended is EndReason.LINK
+    assert "stop" in rig.link.names()
+    assert any("stale" in t for t in rig.view.texts())
+
+
+def test_after_a_reconnect_the_robot_stays_still_until_a_fresh_press() -> None:
+    rig = Rig()
+    rig.ctl.press("forward")
+    rig.model.connection.update(phase=Phase.RECONNECTING)
+    assert not rig.lease.live
+    rig.connect()
+    rig.hold(0.5)
+    rig.ctl.press("forward")  # key auto-repeat while it is still held
+    assert not rig.lease.live  # the key held all along does not restart the robot
+    rig.ctl.release("forward")
+    rig.ctl.press("forward")
+    assert rig.lease.live
+
+
+def test_press_while_disconnected_does_nothing_until_released() -> None:
+    rig = Rig(connected=False)
+    rig.ctl.press("forward")
+    rig.connect()
+    rig.ctl.press("forward")
+    assert not rig.lease.live
+    rig.ctl.release("forward")
+    rig.ctl.press("forward")
+    assert rig.lease.live
+
+
+def test_speed_steps_and_limits_and_applies_to_a_drive_in_progress() -> None:
+    rig = Rig()
+    rig.model.speed.set(SpeedSetting(90))
+    rig.ctl.press("forward")
+    rig.ctl.speed_up()
+    assert rig.model.speed.value.percent == 100 and rig.lease.ratios.throttle == 100
+    rig.ctl.speed_up()
+    assert rig.model.speed.value.percent == 100
+    assert "maximum" in rig.view.texts()[-1]
+    for _ in range(12):
+        rig.ctl.speed_down()
+    assert rig.model.speed.value.percent == 10 and rig.lease.ratios.throttle == 10
+    assert "minimum" in rig.view.texts()[-1]
+    with pytest.raises(ValueError):
+        SpeedSetting(55)
+
+
+def test_bounded_moves_need_server_support() -> None:
+    rig = Rig(offers=frozenset({"ratioDrive", "stop"}))
+    rig.ctl.turn_by(90)
+    rig.ctl.move_distance(1000)
+    assert rig.link.calls == []
+    assert any("turnByAngle" in t for t in rig.view.texts())
+    rig.connect(ALL)
+    rig.ctl.press("forward")
+    rig.ctl.turn_by(-90)
+    rig.ctl.move_distance(500)
+    assert rig.link.calls == [("command", "turnByAngle", -90.0), ("command", "moveDist", 500.0)]
+    assert not rig.lease.live  # a bounded move replaces held driving
+
+
+def test_image_and_safe_drive() -> None:
+    rig = Rig()
+    assert rig.ctl.image_source() == "getPictureCam1"
+    rig.ctl.request_image()
+    rig.ctl.set_safe_drive(False)
+    assert rig.link.calls == [("request_image",), ("set_safe_drive", False)]
+    rig.connect(frozenset({"ratioDrive"}))
+    rig.ctl.request_image()
+    assert rig.view.notices[-1] == (Notice.WARNING, "This server offers no camera pictures")
+
+
+def test_command_states_follow_the_server_and_only_changes_are_sent() -> None:
+    rig = Rig(connected=False)
+    assert rig.view.states["drive_forward"].reason == "not connected"
+    assert rig.view.states["speed_up"].enabled
+    rig.connect(frozenset({"ratioDrive", "stop"}))
+    states = rig.view.states
+    assert states["drive_forward"].enabled and states["stop"].enabled
+    assert not states["turn_left_90"].enabled
+    assert states["turn_left_90"].reason == "this server does not offer turnByAngle"
+    assert not states["request_image"].enabled and not states["connect"].enabled
+    calls = rig.view.state_calls
+    rig.ctl.refresh_commands()
+    assert rig.view.state_calls == calls  # nothing changed, nothing sent
+    assert rig.ctl.run("turn_left_90") is False
+    assert rig.ctl.run("drive_forward") and rig.lease.live
+    rig.ctl.release_command("drive_forward")
+    assert not rig.lease.live
+
+
+def test_connect_asks_for_the_password_and_uses_the_keyring_when_remembered() -> None:
+    rig = Rig(connected=False)
+    rig.ctl.select_profile(Profile("lab", "10.0.0.5", 7272, user="alice", zoom=0.5))
+    assert rig.model.view.value.zoom == 0.5
+    rig.ctl.connect()
+    assert rig.link.calls == [] and len(rig.view.password_asks) == 1
+    rig.view.password_asks[0][1]("secret1")
+    assert rig.link.calls == [("connect", "10.0.0.5", 7272, "alice", "secret1", "lab")]
+    rig.view.password_asks.clear()
+    rig.ctl.connect()  # not connected in the model yet, so it may ask again; cancel this time
+    rig.view.password_asks[0][1](None)
+    assert rig.view.texts()[-1] == "Connection cancelled"
+
+    class Keyring:
+        def get(self, profile: Profile) -> str | None:
+            return "fromkeyring"
+
+    rig2 = Rig(connected=False)
+    rig2.ctl.secrets = Keyring()
+    rig2.ctl.select_profile(Profile("lab", "h", 1, user="alice", remember_password=True))
+    rig2.ctl.connect()
+    assert rig2.link.calls[-1][4] == "fromkeyring" and rig2.view.password_asks == []
+
+
+def test_disconnect_stops_first() -> None:
+    rig = Rig()
+    rig.ctl.press("forward")
+    rig.ctl.disconnect()
+    assert rig.link.names() == ["stop", "disconnect"]
+    assert not rig.lease.live
+
+
+def test_zoom_steps() -> None:
+    rig = Rig()
+    rig.ctl.zoom_in()
+    assert rig.model.view.value.zoom == 0.1
+    for _ in range(20):
+        rig.ctl.zoom_in()
+    assert rig.model.view.value.zoom == 1.0
+    rig.ctl.zoom_out()
+    assert rig.model.view.value.zoom == 0.9
+    rig.ctl.set_zoom(0)
+    rig.ctl.zoom_out()
+    assert rig.model.view.value.zoom == 0.0
+
+
+def test_link_notices_reach_the_view() -> None:
+    rig = Rig()
+    assert rig.link.on_notice is not None
+    rig.link.on_notice("error", "the map could not be loaded")
+    assert rig.view.notices[-1] == (Notice.ERROR, "the map could not be loaded")
+
+
+def test_adding_a_command_is_one_class() -> None:
+    registry = CommandRegistry()
+
+    @registry.register
+    class Wander(Command):
+        name = "wander"
+        label = "Wander"
+        default_key = "w"
+        needs = ("wander",)
+
+        def activate(self, controller: Controller) -> None:
+            controller.link.command("wander")
+
+    rig = Rig()
+    ctl = Controller(rig.model, rig.link, rig.view, clock=rig.clock, registry=registry)
+    assert ctl.command_states()["wander"].reason == "this server does not offer wander"
+    rig.connect(ALL | {"wander"})
+    assert ctl.run("wander")
+    assert rig.link.calls[-1] == ("command", "wander")
+    assert registry.default_keys() == {"w": "wander"}
