@@ -318,10 +318,10 @@ class SimServer:
             with contextlib.suppress(Exception):
                 await asyncio.wait_for(s.writer.wait_closed(), 1.0)
         self.sessions.clear()
+        if self._tasks:
+            await asyncio.wait(list(self._tasks), timeout=1.0)
         for task in list(self._tasks):
             task.cancel()
-        if self._tasks:
-            await asyncio.wait(self._tasks, timeout=1.0)
         if self._server is not None:
             with contextlib.suppress(Exception):
                 await asyncio.wait_for(self._server.wait_closed(), 1.0)
@@ -368,6 +368,8 @@ class SimServer:
             self._tasks.add(task)  # type: ignore[arg-type]
         try:
             await session.run()
+        except asyncio.CancelledError:
+            pass  # the server is stopping; asyncio's stream callback would log a cancelled handler
         finally:
             if task is not None:
                 self._tasks.discard(task)  # type: ignore[arg-type]
