@@ -9,7 +9,7 @@ from rtmu.sim import SimConfig, SimServer
 from .wire import WireClient, run
 
 
-async def _start(map_path=None, **kw) -> tuple[SimServer, WireClient]:  # noqa: ANN001
+async def _start(map_path=None, **kw) -> tuple[SimServer, WireClient]:
     server = SimServer(SimConfig(port=0, realtime=False, map_path=map_path, **kw))
     await server.start()
     client = await WireClient().open(server.port)
@@ -79,7 +79,8 @@ def test_drive_accelerates_like_a_p3dx_then_stop_brings_it_to_rest(arena_map):
         await server.advance(2.0)
         assert server.robot.vel == 0 and server.robot.status == "Stopped"
         assert [ModeInfo.decode(p).mode_name for p in c.received["getModeInfo"]][-1] == "stop"
-        assert UpdateStrings.decode(c.received["updateStrings"][-1]) == UpdateStrings("Stopped", "Stop", "Stopped")
+        last = UpdateStrings.decode(c.received["updateStrings"][-1])
+        assert last == UpdateStrings("Stopped", "Stop", "Stopped")
         await _end(server, c)
 
     run(scenario())
