@@ -185,6 +185,12 @@ def test_string_at_the_end_is_an_underrun_naming_the_field() -> None:
         FieldReader(b"").string_bytes()
 
 
+def test_string_default_comes_back_as_given() -> None:
+    assert FieldReader(b"").string("name", default=None) is None
+    assert FieldReader(b"").string("name", default="?") == "?"
+    assert FieldReader(b"").string_bytes("name", default=b"") == b""
+
+
 def test_empty_string_is_not_an_underrun() -> None:
     reader = FieldReader(b"\x00\x00")
     assert reader.string("first") == ""

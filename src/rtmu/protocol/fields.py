@@ -230,7 +230,7 @@ class FieldReader:
 
     def string(self, field: str = "", default: object = _MISSING) -> str:
         raw = self.string_bytes(field, default)
-        return raw if isinstance(raw, str) else raw.decode(TEXT_ENCODING)
+        return raw.decode(TEXT_ENCODING) if isinstance(raw, bytes) else raw  # a default comes back as given
 
     def fixed_string(self, length: int, field: str = "") -> str:
         raw = self.raw(length, field or "fixed string")
