@@ -29,7 +29,7 @@ from .reader import (
     parse_map_lines,
     read_map,
 )
-from .tokens import info_fields, split_tokens
+from .tokens import info_fields, split_keyword, split_tokens
 from .writer import object_text, to_bytes, to_lines, write_map
 
 __all__ = [
@@ -54,6 +54,7 @@ __all__ = [
     "parse_map",
     "parse_map_lines",
     "read_map",
+    "split_keyword",
     "split_tokens",
     "to_bytes",
     "to_lines",

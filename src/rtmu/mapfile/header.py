@@ -22,24 +22,36 @@ from .model import (
     MapObject,
     MapScan,
 )
-from .tokens import TokenError, parse_float, parse_int, split_tokens, unquote
+from .tokens import (
+    SPACE,
+    TokenError,
+    parse_float,
+    parse_int,
+    split_keyword,
+    split_tokens,
+    split_words,
+    unquote,
+)
 
 _CATEGORY_BY_LOWER = {c.lower(): c for c in CATEGORIES}
 _INFO_BY_LOWER = {f"{k.lower()}:": k for k in INFO_KEYWORDS} | {
     f"_{k.lower()}:": f"_{k}" for k in INFO_KEYWORDS
 }
-_SCAN_FIELDS = (
-    "display",
-    "minpos",
-    "maxpos",
-    "numpoints",
-    "pointsaresorted",
-    "resolution",
-    "lineminpos",
-    "linemaxpos",
-    "numlines",
-    "linesaresorted",
-)
+_SCAN_KEYWORDS = {
+    name.lower(): name
+    for name in (
+        "Display",
+        "MinPos",
+        "MaxPos",
+        "NumPoints",
+        "PointsAreSorted",
+        "Resolution",
+        "LineMinPos",
+        "LineMaxPos",
+        "NumLines",
+        "LinesAreSorted",
+    )
+}
 
 _CLAIM_FIELDS = {
     "minpos": "min_pos",
@@ -72,11 +84,9 @@ class HeaderReader:
     # -- public -------------------------------------------------------------------------------------
 
     def feed(self, line: str, line_no: int) -> Section | None:
-        parts = line.split(None, 1)
-        if not parts:
+        keyword, args = split_keyword(line)
+        if not keyword:
             return None  # blank lines are ignored
-        keyword = parts[0]
-        args = parts[1].strip() if len(parts) > 1 else ""
         if not self.got_category:
             self._category(keyword, args, line_no)
             return None
@@ -100,7 +110,7 @@ class HeaderReader:
     def _category(self, keyword: str, args: str, line_no: int) -> None:
         category = _CATEGORY_BY_LOWER.get(keyword.lower())
         if category is None:
-            shown = f"{keyword} {args}".strip()[:40]
+            shown = f"{keyword} {args}".strip(SPACE)[:40]
             raise MapFormatError(
                 f"not an ARIA map: first line is {shown!r}, expected one of {', '.join(CATEGORIES)}",
                 self.map.source,
@@ -149,7 +159,7 @@ class HeaderReader:
         self._index_scans()
 
     def _origin(self, args: str, line_no: int) -> None:
-        values = [parse_float(t) for t in args.split()]
+        values = [parse_float(t) for t in split_words(args)]
         if len(values) != 3 or any(v is None for v in values):
             self._bad("OriginLatLongAlt: needs three numbers (latitude longitude altitude)", args, line_no)
         lat, lon, alt = (float(v) for v in values if v is not None)
@@ -179,7 +189,7 @@ class HeaderReader:
         self._tags = {}
         for index, scan in enumerate(self.map.scans):
             prefix = scan.prefix.lower()
-            for name in _SCAN_FIELDS:
+            for name in _SCAN_KEYWORDS:
                 self._scan_keywords[f"{prefix}{name}:"] = (index, name)
             self._tags[scan.points_tag.lower()] = Section(index, False)
             self._tags[scan.lines_tag.lower()] = Section(index, True)
@@ -187,8 +197,8 @@ class HeaderReader:
     def _scan_field(self, index: int, name: str, args: str, line_no: int) -> None:
         scan = self.map.scans[index]
         claims = scan.claimed
-        keyword = f"{scan.prefix}{name}:"
-        tokens = args.split()
+        keyword = f"{scan.prefix}{_SCAN_KEYWORDS[name]}:"
+        tokens = split_words(args)
         if name == "display":
             scan.display = unquote(args)
         elif name in ("minpos", "maxpos", "lineminpos", "linemaxpos"):
@@ -219,7 +229,7 @@ class HeaderReader:
 
     def _note_boundary_type(self, args: str) -> None:
         """Remember custom line/rectangle types so their Cairn lines are checked for end points."""
-        tokens = args.split()
+        tokens = split_words(args)
         if not tokens or tokens[0] not in ("BoundaryType", "SectorType"):
             return
         for token in split_tokens(args)[1:]:

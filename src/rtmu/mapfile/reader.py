@@ -261,5 +261,5 @@ def _read_sections(
 
 def _finish(result: MapData, log: WarningLog) -> None:
     result.skipped_lines = log.skipped_lines
-    result.warnings = list(log.kept)
+    result.warnings = sorted(log.kept)
     result.warning_count = log.count

@@ -11,13 +11,28 @@ from __future__ import annotations
 import math
 import re
 
-_TOKEN = re.compile(r"\S+")
+SPACE = " \t\n\v\f\r"
+"""Whitespace as C's isspace() sees it; str.split() would also split on latin-1's NBSP and NEL."""
+_TOKEN = re.compile(r"[^ \t\n\v\f\r]+")
 _FLOAT = re.compile(r"[+-]?(?:\d+\.?\d*|\.\d+)(?:[eE][+-]?\d+)?")
 _INT = re.compile(r"[+-]?\d+")
 
 
 class TokenError(ValueError):
     """A line's tokens cannot be split (an opening quote never closes)."""
+
+
+def split_words(text: str) -> list[str]:
+    """Whitespace-separated words, no quote handling (numbers, flags)."""
+    return _TOKEN.findall(text)
+
+
+def split_keyword(line: str) -> tuple[str, str]:
+    """A header line as (first word, the rest without surrounding whitespace); ("", "") when blank."""
+    match = _TOKEN.search(line)
+    if match is None:
+        return "", ""
+    return match.group(), line[match.end() :].strip(SPACE)
 
 
 def split_tokens(text: str) -> list[str]:

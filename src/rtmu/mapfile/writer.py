@@ -9,7 +9,7 @@ from pathlib import Path
 
 from .model import CATEGORIES, INFO_KEYWORDS, MapData, MapObject, MapScan, as_rows, rows_bounds
 from .numeric import format_rows
-from .tokens import format_heading, format_number
+from .tokens import SPACE, format_heading, format_number
 
 _CATEGORY_BY_LOWER = {c.lower(): c for c in CATEGORIES}
 
@@ -143,4 +143,4 @@ def _checked(line: str) -> str:
 
 
 def _has_space(text: str) -> bool:
-    return any(ch.isspace() for ch in text)
+    return any(ch in SPACE for ch in text)

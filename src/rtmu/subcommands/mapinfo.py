@@ -8,7 +8,7 @@ import sys
 from collections import Counter
 from typing import Any
 
-from rtmu.maps import Bounds, MapData, MapFormatError, read_map
+from rtmu.maps import Bounds, MapData, MapFormatError, read_map, split_keyword
 
 EXIT_OK = 0
 EXIT_BAD_MAP = 2
@@ -59,7 +59,7 @@ def summarise(data: MapData) -> dict[str, Any]:
             }
         )
     home = data.home()
-    unknown = [line.split(None, 1)[0] for line in data.unknown_lines]
+    unknown = [split_keyword(line)[0] for line in data.unknown_lines]
     return {
         "file": data.source,
         "category": data.category,
