@@ -1,10 +1,55 @@
-"""Connection profiles and view choices, kept in the user's config directory (skeleton; see below)."""
+"""Connection profiles and view choices in the user's config directory; passwords only in a keyring.
+
+File: ``$XDG_CONFIG_HOME/rtmu/settings.toml`` (``~/.config/rtmu/settings.toml``
+when the variable is unset), a small flat TOML document::
+
+    version = 1
+    last_profile = "lab"
+
+    [profiles."lab"]
+    host = "10.0.0.5"
+    port = 7272
+    user = "alice"
+    remember_password = true
+    auto_reconnect = true
+    zoom = 0.5
+    follow_robot = true
+    show_sonar = true
+    speed = 50
+
+It is read with ``tomllib`` and written by hand (the schema is flat, so no
+writer library is needed), atomically, readable by the user only.
+
+Rules:
+
+* A password is **never** written to this file. With ``remember_password`` it
+  goes to the desktop keyring (the optional ``keyring`` package, service
+  ``rtmu``); when no keyring is usable, the operator is asked at connect time.
+* A corrupt or foreign file never crashes RTMU: :func:`load_settings` returns
+  the defaults plus **one** warning, and moves the bad file aside
+  (``settings.toml.bad-<timestamp>``) so it is kept, not overwritten.
+"""
 
 from __future__ import annotations
 
-from dataclasses import dataclass
+import contextlib
+import logging
+import math
+import os
+import time
+import tomllib
+from collections.abc import Mapping
+from dataclasses import dataclass, field, fields, replace
+from pathlib import Path
+from typing import Any
+
+log = logging.getLogger(__name__)
 
 DEFAULT_PORT = 7272
+SCHEMA_VERSION = 1
+KEYRING_SERVICE = "rtmu"
+MAX_SETTINGS_BYTES = 1 << 20
+"""A settings file larger than this is not ours."""
 
 
 @dataclass(frozen=True, slots=True)
@@ -19,6 +64,314 @@ class Profile:
     """Keep the password in the desktop keyring (never in the settings file)."""
     auto_reconnect: bool = True
     zoom: float = 0.0
+    """0 = fit the map."""
     follow_robot: bool = True
     show_sonar: bool = True
     speed: int = 50
+    """Drive throttle in %, 10…100 in steps of 10."""
+
+    def validate(self) -> None:
+        """Raise ValueError if a field is out of range (used on everything read from disk)."""
+        if not self.name or len(self.name) > 200:
+            raise ValueError("profile name must be 1…200 characters")
+        if not self.host or len(self.host) > 255:
+            raise ValueError(f"profile {self.name!r}: bad host")
+        if not 1 <= self.port <= 65535:
+            raise ValueError(f"profile {self.name!r}: port {self.port} is not 1…65535")
+        if len(self.user) > 200:
+            raise ValueError(f"profile {self.name!r}: user name too long")
+        if not (0.0 <= self.zoom <= 100.0) or math.isnan(self.zoom):
+            raise ValueError(f"profile {self.name!r}: zoom {self.zoom} out of range")
+        if not 10 <= self.speed <= 100 or self.speed % 10:
+            raise ValueError(f"profile {self.name!r}: speed {self.speed} is not 10…100 in steps of 10")
+
+    @property
+    def keyring_user(self) -> str:
+        """The keyring entry's user name: one password per (user, host, port)."""
+        return f"{self.user}@{self.host}:{self.port}"
+
+
+_TYPES: dict[str, type] = {
+    "host": str,
+    "port": int,
+    "user": str,
+    "remember_password": bool,
+    "auto_reconnect": bool,
+    "zoom": float,
+    "follow_robot": bool,
+    "show_sonar": bool,
+    "speed": int,
+}
+
+
+@dataclass
+class Settings:
+    profiles: dict[str, Profile] = field(default_factory=dict)
+    last_profile: str | None = None
+
+    def current(self) -> Profile:
+        """The profile used last, else the first one, else a default local one."""
+        if self.last_profile in self.profiles:
+            return self.profiles[self.last_profile]  # type: ignore[index]
+        return next(iter(self.profiles.values()), Profile())
+
+    def put(self, profile: Profile) -> None:
+        """Add or replace a profile (by name) and make it the current one."""
+        profile.validate()
+        self.profiles[profile.name] = profile
+        self.last_profile = profile.name
+
+    def remove(self, name: str) -> None:
+        self.profiles.pop(name, None)
+        if self.last_profile == name:
+            self.last_profile = None
+
+    def remember_view(self, name: str, **view: Any) -> None:
+        """Store the view options a profile was left with (``zoom``, ``follow_robot``, ``speed``…)."""
+        old = self.profiles.get(name)
+        if old is not None:
+            self.put(replace(old, **view))
+
+
+# -- where ------------------------------------------------------------------------------------
+
+
+def config_dir(env: Mapping[str, str] | None = None) -> Path:
+    """``$XDG_CONFIG_HOME/rtmu`` (an unset or relative value means ``~/.config``, as the spec says)."""
+    env = os.environ if env is None else env
+    base = env.get("XDG_CONFIG_HOME", "")
+    root = Path(base) if base and os.path.isabs(base) else Path.home() / ".config"
+    return root / "rtmu"
+
+
+def settings_path(env: Mapping[str, str] | None = None) -> Path:
+    return config_dir(env) / "settings.toml"
+
+
+# -- read ------------------------------------------------------------------------------------
+
+
+class SettingsError(ValueError):
+    """The settings file is not one RTMU wrote (corrupt, foreign, or from a newer version)."""
+
+
+def parse_settings(text: str) -> Settings:
+    """Settings from TOML text; raises :class:`SettingsError` for anything unexpected."""
+    try:
+        doc = tomllib.loads(text)
+    except tomllib.TOMLDecodeError as exc:
+        raise SettingsError(f"not valid TOML: {exc}") from None
+    version = doc.get("version")
+    if version != SCHEMA_VERSION:
+        raise SettingsError(f"unknown settings version {version!r} (this RTMU writes {SCHEMA_VERSION})")
+    unknown = set(doc) - {"version", "last_profile", "profiles"}
+    if unknown:
+        raise SettingsError(f"unknown settings: {', '.join(sorted(unknown))}")
+    raw_profiles = doc.get("profiles", {})
+    if not isinstance(raw_profiles, dict):
+        raise SettingsError("'profiles' must be a table")
+    settings = Settings()
+    for name, raw in raw_profiles.items():
+        if not isinstance(raw, dict):
+            raise SettingsError(f"profile {name!r} must be a table")
+        settings.profiles[name] = _profile(name, raw)
+    last = doc.get("last_profile")
+    if last is not None and not isinstance(last, str):
+        raise SettingsError("'last_profile' must be a string")
+    settings.last_profile = last if last in settings.profiles else None
+    return settings
+
+
+def _profile(name: str, raw: dict[str, Any]) -> Profile:
+    values: dict[str, Any] = {"name": name}
+    for key, value in raw.items():
+        expected = _TYPES.get(key)
+        if expected is None:
+            raise SettingsError(f"profile {name!r}: unknown key {key!r}")
+        if expected is float and isinstance(value, int) and not isinstance(value, bool):
+            value = float(value)
+        if type(value) is not expected:
+            raise SettingsError(f"profile {name!r}: {key} must be {expected.__name__}, not {value!r}")
+        values[key] = value
+    profile = Profile(**values)
+    try:
+        profile.validate()
+    except ValueError as exc:
+        raise SettingsError(str(exc)) from None
+    return profile
+
+
+@dataclass
+class Loaded:
+    settings: Settings
+    warning: str | None = None
+    """One operator-readable sentence when the file could not be used."""
+    moved_to: Path | None = None
+
+
+def load_settings(path: Path | None = None) -> Loaded:
+    """Read the settings; never raises. Missing file → defaults, no warning."""
+    path = path or settings_path()
+    try:
+        with path.open("rb") as f:
+            data = f.read(MAX_SETTINGS_BYTES + 1)
+    except FileNotFoundError:
+        return Loaded(Settings())
+    except OSError as exc:
+        warning = f"could not read {path}: {exc.strerror or exc}; using default settings"
+        log.warning(warning)
+        return Loaded(Settings(), warning)
+    try:
+        if len(data) > MAX_SETTINGS_BYTES:
+            raise SettingsError("the file is too large to be RTMU's")
+        try:
+            text = data.decode("utf-8")
+        except UnicodeDecodeError:
+            raise SettingsError("the file is not UTF-8 text") from None
+        return Loaded(parse_settings(text))
+    except SettingsError as exc:
+        moved = _set_aside(path)
+        where = f"; it was kept as {moved.name}" if moved else ""
+        warning = f"ignoring the settings file {path} ({exc}){where}; using default settings"
+        log.warning(warning)
+        return Loaded(Settings(), warning, moved)
+
+
+def _set_aside(path: Path) -> Path | None:
+    """Rename a bad settings file so the next save cannot overwrite it."""
+    stamp = time.strftime("%Y%m%d-%H%M%S")
+    for n in range(100):
+        target = path.with_name(f"{path.name}.bad-{stamp}" + (f"-{n}" if n else ""))
+        if target.exists():
+            continue
+        try:
+            path.rename(target)
+        except OSError:
+            return None
+        return target
+    return None
+
+
+# -- write -----------------------------------------------------------------------------------
+
+
+def format_settings(settings: Settings) -> str:
+    lines = ["# RTMU settings. Passwords are never stored here (see the desktop keyring).", ""]
+    lines.append(f"version = {SCHEMA_VERSION}")
+    if settings.last_profile is not None:
+        lines.append(f"last_profile = {_toml_string(settings.last_profile)}")
+    for profile in settings.profiles.values():
+        profile.validate()
+        lines += ["", f"[profiles.{_toml_string(profile.name)}]"]
+        for f in fields(profile):
+            if f.name == "name":
+                continue
+            lines.append(f"{f.name} = {_toml_value(getattr(profile, f.name))}")
+    return "\n".join(lines) + "\n"
+
+
+def save_settings(settings: Settings, path: Path | None = None) -> Path:
+    """Write atomically (temp file + rename), mode 0600, creating the directory."""
+    path = path or settings_path()
+    path.parent.mkdir(parents=True, exist_ok=True)
+    text = format_settings(settings)
+    tmp = path.with_name(f".{path.name}.{os.getpid()}.tmp")
+    fd = os.open(tmp, os.O_WRONLY | os.O_CREAT | os.O_TRUNC, 0o600)
+    try:
+        with os.fdopen(fd, "w", encoding="utf-8") as f:
+            f.write(text)
+            f.flush()
+            os.fsync(f.fileno())
+        os.replace(tmp, path)
+    except BaseException:
+        tmp.unlink(missing_ok=True)
+        raise
+    return path
+
+
+def _toml_value(value: Any) -> str:
+    if isinstance(value, bool):
+        return "true" if value else "false"
+    if isinstance(value, int):
+        return str(value)
+    if isinstance(value, float):
+        return repr(float(value))
+    if isinstance(value, str):
+        return _toml_string(value)
+    raise TypeError(f"cannot write {value!r} to the settings file")
+
+
+def _toml_string(text: str) -> str:
+    out = ['"']
+    for ch in text:
+        code = ord(ch)
+        if ch == '"':
+            out.append('\\"')
+        elif ch == "\\":
+            out.append("\\\\")
+        elif code < 0x20 or code == 0x7F:
+            out.append(f"\\u{code:04x}")
+        else:
+            out.append(ch)
+    out.append('"')
+    return "".join(out)
+
+
+# -- passwords ---------------------------------------------------------------------------------
+
+
+class KeyringSecrets:
+    """Passwords in the desktop keyring via the optional ``keyring`` package.
+
+    ``available`` is False when the package is missing or has no usable backend
+    (no Secret Service on this desktop): then nothing is stored and the
+    operator is asked for the password at connect time.
+    """
+
+    def __init__(self, backend: Any | None = None) -> None:
+        self._keyring = backend if backend is not None else _load_keyring()
+
+    @property
+    def available(self) -> bool:
+        return self._keyring is not None
+
+    def get(self, profile: Profile) -> str | None:
+        if self._keyring is None or not profile.user:
+            return None
+        try:
+            return self._keyring.get_password(KEYRING_SERVICE, profile.keyring_user)  # type: ignore[no-any-return]
+        except Exception as exc:  # a locked or broken keyring must not stop a connection
+            log.warning("keyring lookup failed: %s", exc)
+            return None
+
+    def set(self, profile: Profile, password: str) -> bool:
+        """Remember ``password``; False when no keyring is usable (the caller should then not promise it)."""
+        if self._keyring is None or not profile.user:
+            return False
+        try:
+            self._keyring.set_password(KEYRING_SERVICE, profile.keyring_user, password)
+        except Exception as exc:
+            log.warning("keyring store failed: %s", exc)
+            return False
+        return True
+
+    def forget(self, profile: Profile) -> None:
+        if self._keyring is None or not profile.user:
+            return
+        with contextlib.suppress(Exception):  # nothing stored is fine
+            self._keyring.delete_password(KEYRING_SERVICE, profile.keyring_user)
+
+
+def _load_keyring() -> Any | None:
+    try:
+        import keyring  # type: ignore[import-not-found]
+    except ImportError:
+        return None
+    try:
+        backend = keyring.get_keyring()
+    except Exception:
+        return None
+    module = type(backend).__module__
+    if module.startswith(("keyring.backends.fail", "keyring.backends.null")):
+        return None  # keyring's "no backend" placeholders
+    return keyring
