@@ -1,0 +1,124 @@
+"""Map services over loopback: the text stream byte for byte, the binary stream point for point."""
+
+from __future__ import annotations
+
+import hashlib
+
+import numpy as np
+import pytest
+
+from rtmu.maps import read_map
+from rtmu.protocol.payloads.map import Goals, MapId, MapName, MapPacketKind, binary_block_kind
+from rtmu.protocol.payloads.mapstream import MapBinaryAssembler, MapTextAssembler
+from rtmu.sim import SimConfig, SimServer
+
+from .wire import WireClient, run
+
+
+def file_lines(path) -> list[str]:
+    text = path.read_bytes().decode("latin-1")
+    return [line.rstrip("\r") for line in text.split("\n") if line.strip()]
+
+
+async def _fetch(map_path, *names: str) -> dict[str, list[bytes]]:
+    server = SimServer(SimConfig(port=0, realtime=False, map_path=map_path))
+    await server.start()
+    c = await WireClient().open(server.port)
+    out = {}
+    for name in names:
+        if name in ("getMap", "getMapBinary"):
+            c.once(name)
+            await c.until(
+                lambda name=name: (
+                    (c.received[name] and c.received[name][-1] == b"")
+                    or (name == "getMap" and c.received[name] == [b"\x00"])
+                )
+            )
+        else:
+            await c.ask(name)
+        out[name] = list(c.received[name])
+    await c.close()
+    await server.stop()
+    return out
+
+
+def _text_map(payloads: list[bytes]) -> list[str]:
+    asm = MapTextAssembler()
+    done = False
+    for p in payloads:
+        done = asm.feed(p)
+    assert done
+    return asm.result().lines
+
+
+def _binary_map(payloads: list[bytes]):
+    asm = MapBinaryAssembler()
+    done = False
+    for p in payloads:
+        done = asm.feed(p)
+    assert done
+    return asm.result()
+
+
+@pytest.mark.parametrize("which", ["arena", "office", "columbia"])
+def test_get_map_streams_the_files_lines_and_binary_carries_its_geometry(which, arena_map, shared_dir):
+    path = {
+        "arena": arena_map,
+        "office": arena_map.parent / "office.map",
+        "columbia": shared_dir / "aria-maps" / "columbia.map",
+    }[which]
+    got = run(_fetch(path, "getMap", "getMapBinary", "getMapName", "getMapId", "getGoals"), timeout=120)
+    # getMap: every line of the file, one per packet, then "" and the empty packet.
+    assert got["getMap"][-2:] == [b"\x00", b""]
+    assert _text_map(got["getMap"]) == file_lines(path)
+    # getMapBinary: the same points and segments as the file, as int32.
+    data = read_map(path)
+    binary = _binary_map(got["getMapBinary"])
+    assert binary.header_lines[0] == "2D-Map"
+    np.testing.assert_array_equal(binary.points, np.asarray(data.points).reshape(-1, 2))
+    np.testing.assert_array_equal(binary.segments, np.asarray(data.segments).reshape(-1, 4))
+    assert MapName.decode(got["getMapName"][0]).file_name == str(path)
+    map_id = MapId.decode(got["getMapId"][0])
+    raw = path.read_bytes()
+    assert (map_id.checksum, map_id.size, map_id.file_name) == (
+        hashlib.md5(raw).digest(),
+        len(raw),
+        str(path),
+    )
+    assert list(Goals.decode(got["getGoals"][0]).goals) == [g.name for g in data.goals()]
+
+
+def test_columbia_binary_blocks_are_at_most_1000_points(shared_dir):
+    path = shared_dir / "aria-maps" / "columbia.map"
+    got = run(_fetch(path, "getMapBinary"), timeout=120)
+    blocks = [p for p in got["getMapBinary"] if binary_block_kind(p) is MapPacketKind.POINTS]
+    counts = [int.from_bytes(p[:4], "little") for p in blocks]
+    assert sum(counts) == 63311 and max(counts) == 1000
+    assert len(blocks) == 64  # as the captured serverDemo sent columbia
+
+
+def test_without_a_map_only_the_empty_string_comes():
+    got = run(_fetch(None, "getMap", "getMapName", "getGoals"))
+    assert got["getMap"] == [b"\x00"]
+    assert MapName.decode(got["getMapName"][0]).file_name == ""
+    assert Goals.decode(got["getGoals"][0]).goals == ()
+
+
+def test_broadcast_only_data_give_no_immediate_reply(arena_map):
+    async def scenario() -> None:
+        server = SimServer(SimConfig(port=0, realtime=False, map_path=arena_map))
+        await server.start()
+        c = await WireClient().open(server.port)
+        other = await WireClient().open(server.port)
+        c.request("mapUpdated", -1)
+        await c.barrier()
+        assert c.received["mapUpdated"] == []
+        assert server.broadcast("mapUpdated") == 1  # only the subscriber
+        await c.wait_for("mapUpdated")
+        await other.barrier()
+        assert other.received["mapUpdated"] == []
+        for x in (c, other):
+            await x.close()
+        await server.stop()
+
+    run(scenario())
