@@ -467,9 +467,16 @@ class CaptureDecoder:
     ) -> tuple[dict[str, Any], str | None]:
         entry = session.datalist.entry(command)
         if not payload:
-            if direction == S2C and entry and "RETURN_UNTIL_EMPTY" in entry.flag_set:
-                return {}, "end of reply"
-            return {}, "empty"
+            note = (
+                "end of reply"
+                if direction == S2C and entry and "RETURN_UNTIL_EMPTY" in entry.flag_set
+                else "empty"
+            )
+            try:  # a type that gives the empty packet a meaning says so; for the others it is no error
+                fields = self._typed(entry.name, side_of(direction), payload)[0] if entry else {}
+            except Exception:
+                fields = {}
+            return fields, note
         if entry is None:
             return {}, "unknown data number" if session.datalist.have_list else None
         return self._typed(entry.name, side_of(direction), payload)

@@ -410,13 +410,21 @@ def format_fields(fields: dict[str, Any], full: bool = False) -> str:
 
 def _entry(entry: dict[str, Any], full: bool) -> str:
     """One list entry: its number and texts (only the name, or the group and flags, when short)."""
-    values = [str(v) for k, v in entry.items() if k != "number" and v != ""]
+    values = [_one_line(str(v)) for k, v in entry.items() if k != "number" and v != ""]
     if not full and "name" in entry:
         values = [str(entry["name"])]
     text = "/".join(values)
     if not full and len(text) > SHORT_ENTRY:
         text = text[:SHORT_ENTRY] + "…"
     return f"{entry['number']} {text}" if text else str(entry["number"])
+
+
+_CONTROL = {c: f"\\x{c:02x}" for c in range(32)} | {10: "\\n", 13: "\\r", 9: "\\t"}
+
+
+def _one_line(text: str) -> str:
+    """Control characters escaped, so one packet stays one line (server texts do hold newlines)."""
+    return text.translate(_CONTROL)
 
 
 def _value(value: Any, full: bool) -> str:
