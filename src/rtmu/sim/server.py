@@ -120,7 +120,7 @@ class Session:
         self.writer = writer
         self.conn = conn
         self.subscriptions: dict[int, Subscription] = {}
-        self.accepted_at = time.monotonic()
+        self.accepted_at = server.clock()
         self.closed = False
         self.self_identifier = ""
         self.here_goal = ""
@@ -450,9 +450,9 @@ class SimServer:
         self._broadcast_changes()
         self._serve_due()
         self.cpu.sample()
-        now_real = time.monotonic()
+        now = self.clock()
         for s in list(self.sessions):
-            s.check_health(now_real)
+            s.check_health(now)
         self.cycles += 1
 
     async def advance(self, seconds: float) -> None:
@@ -482,6 +482,10 @@ class SimServer:
                     log.exception("simulator cycle failed")
                 cycles_done += 1
             await asyncio.sleep(CYCLE_S)
+
+    def clock(self) -> float:
+        """Seconds for connection deadlines: wall time, or simulated time on the manual clock."""
+        return time.monotonic() if self.config.realtime else self.world.time
 
     def custom_commands(self) -> tuple[Row, ...]:
         return custom_commands(self.config.camera)

@@ -1,0 +1,121 @@
+"""Many clients, vanishing clients, garbage and clients that stop reading: none of it costs the others."""
+
+from __future__ import annotations
+
+import asyncio
+import random
+
+from rtmu.protocol.packet import encode_packet
+from rtmu.protocol.payloads.robot import UpdateNumbers
+from rtmu.sim import SimConfig, SimServer
+
+from .wire import SHARED, WireClient, run
+
+COLUMBIA = SHARED / "aria-maps" / "columbia.map"
+
+
+def test_fifty_clients_each_get_their_own_interval(arena_map):
+    async def scenario() -> None:
+        server = SimServer(SimConfig(port=0, realtime=False, map_path=arena_map))
+        await server.start()
+        clients = await asyncio.gather(*(WireClient().open(server.port) for _ in range(50)))
+        intervals = [100, 200, 500, 0, -5]
+        for i, c in enumerate(clients):
+            c.request("updateNumbers", intervals[i % 5])
+            c.request("updateStrings", -1)
+        await asyncio.gather(*(c.wait_for("updateNumbers") for c in clients))
+        await server.advance(1.0)
+        expected = {100: 11, 200: 6, 500: 3, 0: 101, -5: 101}  # the first reply + the periodic ones
+        for i, c in enumerate(clients):
+            want = expected[intervals[i % 5]]
+            await c.wait_for("updateNumbers", want)
+            assert len(c.received["updateNumbers"]) == want, (i, intervals[i % 5])
+            assert len(c.received["updateStrings"]) == 1  # no change happened: no broadcast
+        assert len(server.sessions) == 50
+        await asyncio.gather(*(c.close() for c in clients))
+        await server.stop()
+
+    run(scenario(), timeout=120)
+
+
+def test_vanishing_and_garbage_clients_cost_the_others_nothing(arena_map):
+    async def scenario() -> None:
+        server = SimServer(SimConfig(port=0, realtime=False, map_path=COLUMBIA))
+        await server.start()
+        watcher = await WireClient().open(server.port)
+        watcher.request("updateNumbers", 100)
+        await watcher.wait_for("updateNumbers")
+
+        # 1. A client asks for a 1 MB map and vanishes (reset) while it streams.
+        leaver = await WireClient().open(server.port)
+        leaver.once("getMap")
+        leaver.writer.transport.abort()
+        # 2. A client dies half-way through a packet.
+        half = await WireClient().open(server.port)
+        half.send_raw(encode_packet(half.conn.number_of("ratioDrive"), b"50\x000\x00100\x00")[:9])
+        await asyncio.sleep(0)
+        half.writer.transport.abort()
+        # 3. Garbage, before and after a login: random bytes, false syncs, absurd lengths, bad checksums.
+        rng = random.Random(7)
+        _, junk_writer = await asyncio.open_connection("127.0.0.1", server.port)
+        junk = bytes(rng.getrandbits(8) for _ in range(20000))
+        junk += b"\x0f\x0c\xff\xff" + b"\x0f\x0c\x07\x00" + b"\x0f\x0c\x20\x00\x01\x01" + bytes(30)
+        junk_writer.write(junk)
+        garbled = await WireClient().open(server.port)
+        garbled.send_raw(junk)
+        await garbled.barrier()  # still served after all that
+
+        await server.advance(1.0)
+        got = await watcher.wait_for("updateNumbers", 11)
+        assert len(got) == 11
+        assert UpdateNumbers.decode(got[-1]).battery > 12
+        await asyncio.sleep(0.05)
+        assert leaver.writer.transport.is_closing() and half.writer.transport.is_closing()
+        assert server.robot.vel == 0  # the half ratioDrive never counted
+        junk_writer.close()
+        for c in (watcher, garbled):
+            await c.close()
+        await server.stop()
+
+    run(scenario(), timeout=120)
+
+
+def test_a_client_that_stops_reading_is_dropped_after_the_backup_timeout():
+    async def scenario() -> None:
+        server = SimServer(SimConfig(port=0, realtime=False, map_path=COLUMBIA, backup_timeout=5.0))
+        await server.start()
+        watcher = await WireClient().open(server.port)
+        watcher.request("updateNumbers", 100)
+        stuck = await WireClient().open(server.port)
+        stuck._task.cancel()  # stop reading, keep the socket open
+        for _ in range(20):
+            stuck.once("getMap")
+        await watcher.barrier()
+        port = str(stuck.writer.get_extra_info("sockname")[1])
+        stuck_session = [s for s in server.sessions if s.peer.endswith(":" + port)]
+        assert stuck_session and stuck_session[0].buffered > 0
+        await server.advance(3.0)
+        assert stuck_session[0] in server.sessions  # not yet
+        await server.advance(3.0)
+        assert stuck_session[0] not in server.sessions
+        got = await watcher.wait_for("updateNumbers", 61)
+        assert len(got) >= 61
+        await watcher.close()
+        await stuck.close(goodbye=False)
+        await server.stop()
+
+    run(scenario(), timeout=120)
+
+
+def test_shutdown_tells_every_client():
+    async def scenario() -> None:
+        server = SimServer(SimConfig(port=0, realtime=False))
+        await server.start()
+        clients = [await WireClient().open(server.port) for _ in range(3)]
+        await server.stop()
+        for c in clients:
+            await c.until(lambda c=c: c.eof)
+            assert c.shutdown
+            await c.close(goodbye=False)
+
+    run(scenario())
