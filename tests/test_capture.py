@@ -2,11 +2,14 @@
 
 from __future__ import annotations
 
+import itertools
 import shutil
 import subprocess
 from pathlib import Path
 
 import pytest
+from hypothesis import given, settings
+from hypothesis import strategies as st
 
 from capture_builders import (
     ACK,
@@ -176,6 +179,20 @@ def test_unrecognised_inputs_are_refused_with_one_sentence(tmp_path, content, me
     path.write_bytes(content)
     with pytest.raises(CaptureError, match=message):
         open_capture(path)
+
+
+def test_unsupported_link_type_is_refused_or_skipped(tmp_path):
+    frames = _conversation().frames(101)
+    path = tmp_path / "wifi.pcap"
+    path.write_bytes(pcap_file(frames, 105))
+    with pytest.raises(CaptureError, match="link type 105 is not supported"):
+        open_capture(path)
+    path = tmp_path / "wifi.pcapng"
+    path.write_bytes(pcapng_file(frames, 105))
+    streams, _, source = _streams(path)
+    assert streams == {}
+    assert source.stats.not_ip == len(frames)
+    assert source.stats.warnings == ["link type 105 is not supported; its frames were skipped"]
 
 
 def test_missing_file_is_unreadable(tmp_path):
@@ -422,3 +439,40 @@ def test_forced_formats(tmp_path):
     pcap.write_bytes(pcap_file([Frame(1.0, ethernet(ip_packet("1.1.1.1", "2.2.2.2", 17, udp(1, 2, b"x"))))]))
     with pytest.raises(CaptureError, match="not hexadecimal"):
         open_capture(pcap, "hex")
+
+
+@settings(max_examples=150)
+@given(
+    data=st.binary(min_size=1, max_size=2000),
+    cuts=st.lists(st.integers(1, 1999), max_size=25),
+    extra=st.lists(st.tuples(st.integers(0, 1999), st.integers(1, 300)), max_size=6),
+    isn=st.integers(0, 0xFFFFFFFF),
+    rnd=st.randoms(use_true_random=False),
+)
+def test_any_segmentation_order_and_duplication_gives_back_the_stream(data, cuts, extra, isn, rnd):
+    c, s = CLIENT, SERVER
+    edges = sorted({0, len(data), *(x for x in cuts if x < len(data))})
+    pieces = [(a, data[a:b]) for a, b in itertools.pairwise(edges)]
+    pieces += [(a, data[a : a + n]) for a, n in extra if a < len(data)]  # retransmissions, overlaps
+    rnd.shuffle(pieces)
+    segs = [(s, c, isn, SYN | ACK, b"")]
+    segs += [(s, c, (isn + 1 + a) & 0xFFFFFFFF, ACK, chunk) for a, chunk in pieces]
+    streams, events, _ = _reassemble(segs)
+    assert streams == {(1, s): data}
+    assert not any(isinstance(e, StreamGap) for e in events)
+
+
+def test_too_much_data_behind_a_hole_gives_up_on_the_hole(monkeypatch):
+    monkeypatch.setattr("rtmu.capture.tcp.MAX_PENDING_BYTES", 100)
+    c, s = CLIENT, SERVER
+    segs = [(s, c, 0, SYN | ACK, b""), (s, c, 1, ACK, b"start")]
+    segs += [(s, c, 16 + 40 * i, ACK, bytes([65 + i]) * 40) for i in range(4)]  # 10 bytes never arrive
+    stats = CaptureStats()
+    tcp_ = TcpReassembler(stats)
+    events = []
+    for i, (src, dst, seq, flags, payload) in enumerate(segs):
+        events.extend(tcp_.segment(Segment(6, src, dst, payload, 0, seq, flags), float(i)))
+    kinds = [(type(e).__name__, getattr(e, "missing", None)) for e in events]
+    assert kinds[:2] == [("StreamData", None), ("StreamGap", 10)]  # before the end of the capture
+    data = b"".join(e.data for e in events if isinstance(e, StreamData))
+    assert data == b"start" + b"A" * 40 + b"B" * 40 + b"C" * 40 + b"D" * 40

@@ -14,7 +14,7 @@ from pathlib import Path
 
 from .base import CaptureError, CaptureEvent, CaptureStats, Datagram, Endpoint, Flow, StreamData, StreamEnd
 from .hexdump import parse_hex
-from .net import TCP, NotTcpUdp, ip_payload, parse_ip
+from .net import SUPPORTED_LINK_TYPES, TCP, NotTcpUdp, ip_payload, parse_ip
 from .pcap import PCAP_MAGICS, PCAPNG_MAGIC, FrameReader, PcapngReader, PcapReader
 from .tcp import TcpReassembler
 
@@ -58,11 +58,16 @@ class CaptureSource:
             else:
                 stats.link_type = reader.link_type
             last = None
+            unsupported: set[int] = set()
             for frame in reader:
                 stats.frames += 1
                 if stats.first_time is None:
                     stats.first_time = frame.time
                 last = frame.time
+                if frame.link_type not in SUPPORTED_LINK_TYPES:
+                    unsupported.add(frame.link_type)
+                    stats.not_ip += 1
+                    continue
                 cut = max(0, frame.original_length - len(frame.data))
                 if cut:
                     stats.truncated_frames += 1
@@ -83,6 +88,9 @@ class CaptureSource:
                     yield Datagram(seg.src, seg.dst, frame.time, seg.payload, truncated=seg.lost > 0)
             stats.last_time = last
             stats.warnings.extend(reader.warnings)
+            stats.warnings.extend(
+                f"link type {lt} is not supported; its frames were skipped" for lt in sorted(unsupported)
+            )
             if stats.link_type is None and len(reader.link_types) == 1:
                 stats.link_type = next(iter(reader.link_types))
         yield from tcp.finish(last)
@@ -154,6 +162,11 @@ def open_capture(path: str | Path, fmt: str = "auto", direction: str = "auto") -
             if len(sample) < 24:
                 raise CaptureError(f"{path} is cut short: a pcap header needs 24 bytes")
             header = PcapReader(_BytesStream(sample), sample[:24])  # validates version and header
+            if header.link_type not in SUPPORTED_LINK_TYPES:
+                raise CaptureError(
+                    f"{path}: link type {header.link_type} is not supported "
+                    "(Ethernet, BSD loopback, raw IP, Linux cooked SLL/SLL2)"
+                )
             source = CaptureSource(path, "pcap")
             source.stats.link_type = header.link_type
             return source

@@ -9,6 +9,8 @@ becomes a :class:`StreamGap` once too much data waits behind it, or at the end.
 
 from __future__ import annotations
 
+import heapq
+
 from .base import CaptureEvent, CaptureStats, Endpoint, Flow, StreamData, StreamEnd, StreamGap
 from .net import ACK, FIN, RST, SYN, Segment
 
@@ -23,13 +25,29 @@ def _delta(seq: int, ref: int) -> int:
 
 
 class _Direction:
-    __slots__ = ("ended", "fin_seq", "next_seq", "pending", "pending_bytes", "started", "syn_seq")
+    __slots__ = (
+        "ended",
+        "fin_seq",
+        "next_seq",
+        "order",
+        "pending",
+        "pending_bytes",
+        "position",
+        "started",
+        "syn_seq",
+    )
 
     def __init__(self) -> None:
         self.next_seq: int | None = None
+        """The next sequence number expected (32-bit, wraps)."""
+        self.position = 0
+        """Bytes of the stream accounted for so far (delivered or reported missing); never wraps."""
         self.syn_seq: int | None = None
         self.fin_seq: int | None = None
         self.pending: dict[int, tuple[bytes, int]] = {}
+        """Out-of-order segments by stream position: (captured bytes, bytes cut by the snap length)."""
+        self.order: list[int] = []
+        """A heap of the positions in ``pending``."""
         self.pending_bytes = 0
         self.started = False
         self.ended = False
@@ -120,10 +138,13 @@ class TcpReassembler:
         offset = _delta(seq, d.next_seq)
         if offset > 0:
             self._stats.out_of_order_segments += 1
-            old = d.pending.get(seq)
+            position = d.position + offset
+            old = d.pending.get(position)
+            if old is None:
+                heapq.heappush(d.order, position)
             if old is None or len(old[0]) + old[1] < len(data) + lost:
                 d.pending_bytes += len(data) - (len(old[0]) if old else 0)
-                d.pending[seq] = (data, lost)
+                d.pending[position] = (data, lost)
             if d.pending_bytes > MAX_PENDING_BYTES:
                 self._skip_hole(conn, src, d, time, events)
             return
@@ -162,31 +183,28 @@ class TcpReassembler:
             self._stats.tcp_gaps += 1
             events.append(StreamGap(conn.flow, src, time, lost))
         d.next_seq = (d.next_seq + len(data) + lost) & 0xFFFFFFFF
+        d.position += len(data) + lost
 
     def _drain(
         self, conn: _Connection, src: Endpoint, d: _Direction, time: float | None, events: list[CaptureEvent]
     ) -> None:
-        while d.pending:
-            assert d.next_seq is not None
-            ready = [s for s in d.pending if _delta(s, d.next_seq) <= 0]
-            if not ready:
-                return
-            for s in ready:
-                data, lost = d.pending.pop(s)
-                d.pending_bytes -= len(data)
-                self._deliver(conn, src, d, _delta(s, d.next_seq), data, lost, time, events)
+        """Deliver the pending segments that now start at or before the stream position, in order."""
+        while d.order and d.order[0] <= d.position:
+            position = heapq.heappop(d.order)
+            data, lost = d.pending.pop(position)
+            d.pending_bytes -= len(data)
+            self._deliver(conn, src, d, position - d.position, data, lost, time, events)
 
     def _skip_hole(
         self, conn: _Connection, src: Endpoint, d: _Direction, time: float | None, events: list[CaptureEvent]
     ) -> None:
         """Give up on the hole in front of the pending data: report it and go on after it."""
         assert d.next_seq is not None
-        ref = d.next_seq
-        first = min(d.pending, key=lambda s: _delta(s, ref))
-        missing = _delta(first, ref)
+        missing = d.order[0] - d.position
         self._stats.tcp_gaps += 1
         events.append(StreamGap(conn.flow, src, time, missing))
-        d.next_seq = first
+        d.next_seq = (d.next_seq + missing) & 0xFFFFFFFF
+        d.position += missing
         d.started = True
         self._drain(conn, src, d, time, events)
 
