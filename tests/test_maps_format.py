@@ -271,6 +271,12 @@ def test_cairn_with_custom_type_and_icon() -> None:
     assert not obj.is_goal
 
 
+def test_quotes_inside_a_name_survive_when_they_can() -> None:
+    data = parse_map('2D-Map\nCairn: Goal 1 2 0 "" ICON "Bob"s desk"\nDATA\n')
+    assert data.goal_names() == ['Bob"s desk']
+    assert parse_map(data.to_bytes()) == data
+
+
 def test_latin1_names() -> None:
     data = parse_map('2D-Map\nCairn: Goal 1 2 0 "" ICON "Küche"\nDATA\n'.encode("latin-1"))
     assert data.goal_names() == ["Küche"]
@@ -366,8 +372,12 @@ def test_lines_with_line_breaks_are_refused() -> None:
 
 
 def test_writer_refuses_what_cannot_be_read_back() -> None:
-    with pytest.raises(ValueError, match="quote"):
-        new_map(objects=[MapObject("Goal", 0, 0, name='say "hi"')]).to_bytes()
+    with pytest.raises(ValueError, match="read back"):
+        new_map(objects=[MapObject("Goal", 0, 0, name='a" b')]).to_bytes()
+    with pytest.raises(ValueError, match="unknown header line"):
+        MapData(unknown_lines=["data"]).to_bytes()
+    with pytest.raises(ValueError, match="unknown header line"):
+        MapData(unknown_lines=["   "]).to_bytes()
     with pytest.raises(ValueError, match="one word"):
         new_map(objects=[MapObject("Big Goal", 0, 0)]).to_bytes()
     with pytest.raises(ValueError, match="latin-1"):
@@ -465,3 +475,13 @@ def test_written_maps_read_back_equal(
     assert again == data
     assert again.skipped_lines == 0
     assert parse_map_lines(data.to_lines()) == data
+
+
+@given(st.text(st.characters(min_codepoint=1, max_codepoint=255), max_size=12))
+def test_any_name_is_written_exactly_or_refused(name: str) -> None:
+    data = new_map(objects=[MapObject("Goal", 1, 2, name=name, description=name)])
+    try:
+        written = data.to_bytes()
+    except ValueError:
+        return
+    assert parse_map(written).objects == data.objects

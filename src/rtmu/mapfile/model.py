@@ -7,7 +7,6 @@ The data is the truth and the header's counts and bounding boxes are claims
 
 from __future__ import annotations
 
-from collections.abc import Iterator
 from dataclasses import dataclass, field
 from typing import NamedTuple
 
@@ -353,9 +352,6 @@ class MapData:
         from .writer import to_bytes
 
         return to_bytes(self)
-
-    def iter_scans(self) -> Iterator[MapScan]:
-        return iter(self.scans)
 
     def __eq__(self, other: object) -> bool:
         """Same map content: provenance (source, warnings) and the header's stale claims do not count."""

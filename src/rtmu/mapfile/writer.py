@@ -9,7 +9,7 @@ from pathlib import Path
 
 from .model import CATEGORIES, INFO_KEYWORDS, MapData, MapObject, MapScan, as_rows, rows_bounds
 from .numeric import format_rows
-from .tokens import SPACE, format_heading, format_number
+from .tokens import SPACE, format_heading, format_number, split_keyword, split_tokens
 
 _CATEGORY_BY_LOWER = {c.lower(): c for c in CATEGORIES}
 
@@ -35,7 +35,7 @@ def header_lines(data: MapData) -> list[str]:
     lines.extend(_info_lines(data, "_"))
     lines.extend(_checked(f"_Cairn: {args}") for args in data.inactive_objects)
     lines.extend(_checked(f"ChildCairn: {args}") for args in data.child_objects)
-    lines.extend(_checked(line) for line in data.unknown_lines)
+    lines.extend(_unknown(line, data) for line in data.unknown_lines)
     return lines
 
 
@@ -45,8 +45,9 @@ def object_text(obj: MapObject) -> str:
         if not value or _has_space(value) or '"' in value:
             raise ValueError(f"map object {label} must be one word, got {value!r}")
     for label, value in (("name", obj.name), ("description", obj.description)):
-        if '"' in value or "\n" in value or "\r" in value:
-            raise ValueError(f"map object {label} cannot hold a quote or a line break: {value!r}")
+        # A quote inside is fine as long as the quoted text still reads back as one token.
+        if "\n" in value or "\r" in value or split_tokens(f'"{value}"') != [f'"{value}"']:
+            raise ValueError(f"map object {label} cannot be quoted and read back: {value!r}")
     text = (
         f"{obj.type} {format_number(obj.x)} {format_number(obj.y)} {format_heading(obj.th)}"
         f' "{obj.description}" {obj.icon} "{obj.name}"'
@@ -134,6 +135,15 @@ def _info_lines(data: MapData, prefix: str) -> list[str]:
     if strays and prefix == "":
         raise ValueError(f"unknown info keyword(s) {strays}; keep such lines in unknown_lines")
     return lines
+
+
+def _unknown(line: str, data: MapData) -> str:
+    """A kept line, unless written back it would read as something else (blank, or a data tag)."""
+    keyword = split_keyword(_checked(line))[0].lower()
+    tags = {tag.lower() for scan in data.scans for tag in (scan.points_tag, scan.lines_tag)}
+    if not keyword or keyword in tags:
+        raise ValueError(f"{line!r} cannot be kept as an unknown header line")
+    return line
 
 
 def _checked(line: str) -> str:
