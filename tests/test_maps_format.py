@@ -324,6 +324,16 @@ def test_malformed_maps_name_file_and_line(text: str, line: int, words: str) -> 
     assert str(error).startswith(f"bad.map:{line}: ")
 
 
+def test_lenient_where_aria_is() -> None:
+    text = '2D-Map extra\nResolution: 20.0\nNumPoints: 1e1\nMapInfo: BoundaryType "Name=Odd\nDATA\n'
+    data = parse_map(text)
+    assert data.resolution == 20 and data.claimed.num_points == 10
+    assert data.map_info == ['BoundaryType "Name=Odd']
+    assert data.warning_count == 1 and "extra" in data.warnings[0].message and data.skipped_lines == 0
+    with pytest.raises(MapFormatError, match="whole number"):
+        parse_map("2D-Map\nResolution: 20.5\nDATA\n")
+
+
 def test_empty_input() -> None:
     assert "empty" in str(_error(""))
     assert "empty" in str(_error("\n \n"))

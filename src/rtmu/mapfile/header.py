@@ -26,7 +26,6 @@ from .tokens import (
     SPACE,
     TokenError,
     parse_float,
-    parse_int,
     split_keyword,
     split_tokens,
     split_words,
@@ -102,7 +101,10 @@ class HeaderReader:
 
     def data_tags(self) -> list[tuple[bytes, Section]]:
         """Tags that start a data section, lower-case, longest first (a data line matches them by prefix)."""
-        tags = [(tag.encode("latin-1"), section) for tag, section in self._tags.items()]
+        tags = []
+        for index, scan in enumerate(self.map.scans):
+            tags.append((scan.points_tag.encode("latin-1").lower(), Section(index, False)))
+            tags.append((scan.lines_tag.encode("latin-1").lower(), Section(index, True)))
         return sorted(tags, key=lambda item: -len(item[0]))
 
     # -- category and keywords ----------------------------------------------------------------------
@@ -208,9 +210,10 @@ class HeaderReader:
             x, y = (round(v) for v in values if v is not None)
             setattr(claims, _CLAIM_FIELDS[name], (x, y))
         elif name in ("numpoints", "numlines", "resolution"):
-            value = parse_int(tokens[0]) if len(tokens) == 1 else None
-            if value is None or (value < 0 and name != "resolution"):
+            number = parse_float(tokens[0]) if len(tokens) == 1 else None
+            if number is None or not number.is_integer() or (number < 0 and name != "resolution"):
                 self._bad(f"{keyword} needs one whole number", args, line_no)
+            value = int(number)
             if name == "resolution":
                 scan.resolution = None if value < 0 else value
             elif name == "numpoints":
@@ -232,7 +235,11 @@ class HeaderReader:
         tokens = split_words(args)
         if not tokens or tokens[0] not in ("BoundaryType", "SectorType"):
             return
-        for token in split_tokens(args)[1:]:
+        try:
+            tokens = split_tokens(args)
+        except TokenError:
+            return  # the line is kept verbatim anyway; only the end-point check is lost
+        for token in tokens[1:]:
             key, _, value = unquote(token).partition("=")
             if key == "Name" and value:
                 self._boundary_types.add(value.lower())

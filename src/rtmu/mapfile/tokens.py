@@ -15,7 +15,6 @@ SPACE = " \t\n\v\f\r"
 """Whitespace as C's isspace() sees it; str.split() would also split on latin-1's NBSP and NEL."""
 _TOKEN = re.compile(r"[^ \t\n\v\f\r]+")
 _FLOAT = re.compile(r"[+-]?(?:\d+\.?\d*|\.\d+)(?:[eE][+-]?\d+)?")
-_INT = re.compile(r"[+-]?\d+")
 
 
 class TokenError(ValueError):
@@ -67,11 +66,6 @@ def parse_float(token: str) -> float | None:
         return None
     value = float(token)
     return value if math.isfinite(value) else None
-
-
-def parse_int(token: str) -> int | None:
-    """A decimal integer, or None."""
-    return int(token) if _INT.fullmatch(token) else None
 
 
 def format_number(value: float) -> str:
