@@ -495,3 +495,24 @@ def test_any_name_is_written_exactly_or_refused(name: str) -> None:
     except ValueError:
         return
     assert parse_map(written).objects == data.objects
+
+
+def test_repeated_sections_append_and_bytes_lines_work() -> None:
+    lines = [b"2D-Map", b"DATA", b"1 2", b"LINES", b"0 0 1 1", b"DATA", b"3 4", b"lines", b"2 2 3 3"]
+    data = parse_map_lines(lines)
+    assert data.points.tolist() == [[1, 2], [3, 4]]
+    assert data.segments.tolist() == [[0, 0, 1, 1], [2, 2, 3, 3]]
+
+
+def test_big_sections_are_parsed_in_slices(monkeypatch: pytest.MonkeyPatch) -> None:
+    from rtmu.mapfile import numeric
+
+    rows = [f"{i} {-i}" for i in range(300)]
+    rows[7] = "bad line"
+    rows[250] = "9 9 9"
+    text = "2D-Map\nDATA\n" + "\n".join(rows) + "\n"
+    whole = parse_map(text)
+    monkeypatch.setattr(numeric, "CHUNK_BYTES", 64)
+    sliced = parse_map(text)
+    assert sliced == whole and sliced.num_points == 298
+    assert [w.line for w in sliced.warnings] == [w.line for w in whole.warnings] == [10, 253]
