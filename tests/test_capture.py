@@ -476,3 +476,18 @@ def test_too_much_data_behind_a_hole_gives_up_on_the_hole(monkeypatch):
     assert kinds[:2] == [("StreamData", None), ("StreamGap", 10)]  # before the end of the capture
     data = b"".join(e.data for e in events if isinstance(e, StreamData))
     assert data == b"start" + b"A" * 40 + b"B" * 40 + b"C" * 40 + b"D" * 40
+
+
+def test_late_retransmission_after_the_close_is_not_a_new_connection():
+    c, s = CLIENT, SERVER
+    segs = [
+        (c, s, 10, SYN, b""),
+        (s, c, 50, SYN | ACK, b""),
+        (s, c, 51, ACK, b"data"),
+        (s, c, 55, FIN | ACK, b""),
+        (c, s, 11, FIN | ACK, b""),
+        (s, c, 51, ACK, b"data"),  # a late copy
+    ]
+    streams, events, stats = _reassemble(segs)
+    assert streams == {(1, s): b"data"}
+    assert {e.flow.id for e in events} == {1}

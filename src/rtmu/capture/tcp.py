@@ -10,10 +10,12 @@ becomes a :class:`StreamGap` once too much data waits behind it, or at the end.
 from __future__ import annotations
 
 import heapq
+from collections import OrderedDict
 
 from .base import CaptureEvent, CaptureStats, Endpoint, Flow, StreamData, StreamEnd, StreamGap
 from .net import ACK, FIN, RST, SYN, Segment
 
+MAX_CLOSED = 4096
 MAX_PENDING_BYTES = 8 << 20
 """Out-of-order data held per direction before the hole in front of it is declared lost."""
 
@@ -67,6 +69,8 @@ class TcpReassembler:
     def __init__(self, stats: CaptureStats, first_flow_id: int = 1) -> None:
         self._stats = stats
         self._connections: dict[tuple[Endpoint, Endpoint], _Connection] = {}
+        self._closed: OrderedDict[tuple[Endpoint, Endpoint], _Connection] = OrderedDict()
+        """Recently finished connections: late retransmissions land here, not in a new connection."""
         self._next_id = first_flow_id
 
     def _key(self, a: Endpoint, b: Endpoint) -> tuple[Endpoint, Endpoint]:
@@ -75,13 +79,23 @@ class TcpReassembler:
     def _new(self, src: Endpoint, dst: Endpoint) -> _Connection:
         conn = _Connection(Flow(self._next_id, "tcp", src, dst))
         self._next_id += 1
-        self._connections[self._key(src, dst)] = conn
+        key = self._key(src, dst)
+        self._connections[key] = conn
+        self._closed.pop(key, None)
         return conn
+
+    def _retire(self, key: tuple[Endpoint, Endpoint], conn: _Connection) -> None:
+        """Both directions ended: keep only a bounded memory of the connection."""
+        if self._connections.get(key) is conn:
+            del self._connections[key]
+            self._closed[key] = conn
+            if len(self._closed) > MAX_CLOSED:
+                self._closed.popitem(last=False)
 
     def segment(self, seg: Segment, time: float | None) -> list[CaptureEvent]:
         events: list[CaptureEvent] = []
         key = self._key(seg.src, seg.dst)
-        conn = self._connections.get(key)
+        conn = self._connections.get(key) or self._closed.get(key)
         flags = seg.flags
         if flags & SYN and not flags & ACK:
             # A fresh SYN on a pair that already carried a connection starts a new one.
@@ -121,6 +135,8 @@ class TcpReassembler:
         elif d.fin_seq is not None and d.next_seq == d.fin_seq and not d.pending:
             d.ended = True
             events.append(StreamEnd(conn.flow, seg.src, time))
+        if all(x.ended for x in conn.directions.values()):
+            self._retire(key, conn)
         return events
 
     def _accept(
@@ -225,4 +241,5 @@ class TcpReassembler:
         for conn in self._connections.values():
             events.extend(self._close(conn, time))
         self._connections.clear()
+        self._closed.clear()
         return events
