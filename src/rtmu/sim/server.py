@@ -240,6 +240,7 @@ class Session:
             if self.closed:
                 return
         self.flush_codec()
+        self.server.broadcast_changes()  # what a request changed (mode, popups) goes out now, as in ARIA
 
     def _on_request(self, event: RequestReceived) -> None:
         now = self.server.world.time
@@ -430,7 +431,7 @@ class SimServer:
                 if s.closed:
                     break
 
-    def _broadcast_changes(self) -> None:
+    def broadcast_changes(self) -> None:
         ch = self.world.changes
         if ch.mode_info:
             self.broadcast("getModeInfo", mode_info_payload(self.world))
@@ -447,7 +448,7 @@ class SimServer:
         for _ in range(round(CYCLE_S / PHYSICS_DT)):
             self.world.step(PHYSICS_DT)
         self._cycle_cache.clear()
-        self._broadcast_changes()
+        self.broadcast_changes()
         self._serve_due()
         self.cpu.sample()
         now = self.clock()

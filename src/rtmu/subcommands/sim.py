@@ -1,0 +1,153 @@
+"""``rtmu sim``: run the bundled ARIA robot simulator (a Pioneer 3-DX behind an ArNetworking server).
+
+It behaves on the wire like ARIA's serverDemo driving MobileSim, so the RTMU
+window, ARIA's own example clients and MobileEyes-style tools can connect to
+it. It listens on 127.0.0.1 unless told otherwise; Ctrl-C stops it cleanly
+(every client is told SHUTDOWN). ``--make-map FILE`` writes a generated
+building map instead of serving.
+"""
+
+from __future__ import annotations
+
+import argparse
+import asyncio
+import contextlib
+import signal
+import sys
+from pathlib import Path
+
+EXIT_OK = 0
+EXIT_BAD_INPUT = 2
+EXIT_CANNOT_LISTEN = 3
+
+
+def default_map() -> Path | None:
+    """The project's arena map, when the checkout has it."""
+    here = Path(__file__).resolve()
+    for parent in here.parents:
+        candidate = parent / "data" / "maps" / "arena.map"
+        if candidate.is_file():
+            return candidate
+    return None
+
+
+def register(subparsers: argparse._SubParsersAction) -> None:  # type: ignore[type-arg]
+    p = subparsers.add_parser(
+        "sim",
+        help="run the bundled ARIA robot simulator (ArNetworking server, simulated Pioneer 3-DX)",
+        description=__doc__,
+        formatter_class=argparse.RawDescriptionHelpFormatter,
+    )
+    p.add_argument("--host", default="127.0.0.1", help="address to listen on (default 127.0.0.1)")
+    p.add_argument(
+        "--port", type=int, default=7272, help="TCP port (default 7272, ARIA's; 0 = any free port)"
+    )
+    maps = p.add_mutually_exclusive_group()
+    maps.add_argument("--map", type=Path, help="ARIA .map file to serve (default: the project's arena)")
+    maps.add_argument("--no-map", action="store_true", help="serve no map (an empty world)")
+    p.add_argument(
+        "--users", type=Path, help="ARIA user-info file (UserInfoVersion1); default: open to anyone"
+    )
+    p.add_argument(
+        "--no-camera", action="store_true", help="no camera: video and camera data are not offered"
+    )
+    p.add_argument("--seed", type=int, default=1, help="seed for everything random (default 1)")
+    p.add_argument(
+        "--drive-timeout",
+        type=float,
+        default=2.0,
+        help="seconds without ratioDrive before a moving robot is stopped (ARIA's 2 s; 0 disables)",
+    )
+    p.add_argument("--battery", type=float, default=None, help="starting battery voltage (default 12.8)")
+    p.add_argument("--server-key", default="", help="ARIA server key mixed into password digests")
+    p.add_argument("--max-clients", type=int, default=None, help="refuse more clients than this (reason 5)")
+    p.add_argument("-v", "--verbose", action="store_true", help="log connections and refusals")
+    gen = p.add_argument_group("map generator (writes a map and exits)")
+    gen.add_argument("--make-map", type=Path, metavar="FILE", help="write a generated building map to FILE")
+    gen.add_argument("--points", type=int, default=100_000, help="points in the generated map")
+    gen.add_argument("--lines", type=int, default=5_000, help="line segments in the generated map")
+    p.set_defaults(handler=run)
+
+
+def run(args: argparse.Namespace) -> int:
+    if args.make_map is not None:
+        return make_map(args)
+    from ..sim import SimConfig
+
+    map_path = None if args.no_map else (args.map or default_map())
+    if map_path is not None and not map_path.is_file():
+        print(f"rtmu sim: no such map file: {map_path}", file=sys.stderr)
+        return EXIT_BAD_INPUT
+    if args.users is not None and not args.users.is_file():
+        print(f"rtmu sim: no such user file: {args.users}", file=sys.stderr)
+        return EXIT_BAD_INPUT
+    cfg = SimConfig(
+        host=args.host,
+        port=args.port,
+        map_path=map_path,
+        users_path=args.users,
+        camera=not args.no_camera,
+        seed=args.seed,
+        drive_timeout=args.drive_timeout,
+        server_key=args.server_key,
+        max_clients=args.max_clients,
+        verbose=args.verbose,
+    )
+    if args.battery is not None:
+        cfg.battery_v = args.battery
+    if args.verbose:
+        import logging
+
+        logging.basicConfig(level=logging.INFO, format="%(asctime)s %(name)s: %(message)s")
+    try:
+        return asyncio.run(serve(cfg))
+    except KeyboardInterrupt:
+        return EXIT_OK
+
+
+async def serve(cfg) -> int:
+    from ..maps import MapFormatError
+    from ..sim import SimServer
+
+    try:
+        server = SimServer(cfg)
+    except (OSError, MapFormatError, ValueError) as exc:
+        print(f"rtmu sim: cannot load: {exc}", file=sys.stderr)
+        return EXIT_BAD_INPUT
+    try:
+        await server.start()
+    except OSError as exc:
+        print(f"rtmu sim: cannot listen on {cfg.host}:{cfg.port}: {exc.strerror or exc}", file=sys.stderr)
+        return EXIT_CANNOT_LISTEN
+    served = f"map {cfg.map_path}" if cfg.map_path else "no map"
+    home = server.home
+    extras = "" if cfg.camera else "; no camera"
+    if cfg.users_path:
+        extras += f"; users from {cfg.users_path}"
+    print(
+        f"rtmu sim: ARIA robot server listening on {cfg.host}:{server.port}, serving {served}; "
+        f"Pioneer 3-DX at ({home[0]:.0f}, {home[1]:.0f}) mm, {home[2]:.0f} deg{extras}",
+        flush=True,
+    )
+    stop = asyncio.Event()
+    loop = asyncio.get_running_loop()
+    for sig in (signal.SIGINT, signal.SIGTERM):
+        with contextlib.suppress(NotImplementedError, RuntimeError):
+            loop.add_signal_handler(sig, stop.set)
+    await stop.wait()
+    print("rtmu sim: stopping (telling clients SHUTDOWN)", flush=True)
+    await server.stop()
+    return EXIT_OK
+
+
+def make_map(args: argparse.Namespace) -> int:
+    from ..maps import write_map
+    from ..sim.mapgen import generate_map
+
+    if args.points < 0 or args.lines < 0:
+        print("rtmu sim: --points and --lines cannot be negative", file=sys.stderr)
+        return EXIT_BAD_INPUT
+    data = generate_map(args.points, args.lines, seed=args.seed)
+    write_map(data, args.make_map)
+    print(f"rtmu sim: wrote {args.make_map} ({data.num_points} points, {data.num_lines} lines)")
+    return EXIT_OK
