@@ -53,11 +53,36 @@ DROP_WORDS = {
 }
 
 
+_DESCRIPTION = """\
+Show every ArNetworking packet of a capture: which end sent it, its command and
+name (control commands by direction, data names from that connection's own
+LIST), length, checksum, decoded fields, and what a receiver would drop.
+
+Inputs: pcap or pcapng (TCP reassembled on any port, UDP datagrams attributed
+to their connection), a hex dump (xxd, hexdump, od, tshark, plain hex) or raw
+bytes (one stream; --direction says who sent it when the packets do not)."""
+
+_EPILOG = """\
+text output folds runs of one packet kind to their first 3 and last 2 lines;
+--all prints everything. --json prints one object per packet and line:
+  conn dir transport time command name length checksum_ok fields
+  [error] [note] [dropped_before] [payload]
+exit status: 0 the file was read (even with bad packets), 1 it cannot be read,
+4 it is not a recognised format.
+
+examples:
+  rtmu decode session.pcap
+  rtmu decode --json session.pcap | jq 'select(.name == "ratioDrive") | .fields'
+  rtmu decode --name getMapBinary --all session.pcap
+  xxd bytes.bin > dump.txt && rtmu decode --direction c2s dump.txt"""
+
+
 def register(subparsers: argparse._SubParsersAction) -> None:  # type: ignore[type-arg]
     parser = subparsers.add_parser(
         "decode",
         help="decode ArNetworking traffic from a pcap/pcapng capture, a hex dump or raw bytes",
-        description=__doc__,
+        description=_DESCRIPTION,
+        epilog=_EPILOG,
         formatter_class=argparse.RawDescriptionHelpFormatter,
     )
     parser.add_argument("file", metavar="FILE", help="capture (pcap, pcapng), hex dump or raw bytes")
@@ -375,7 +400,10 @@ def _write_text(
     writer = _TextWriter(out, source, full, payload)
     kind = source.kind
     out.write(f"# {source.path.name}: {kind}{_link(source)}\n")
-    out.write(f"# {'time':>8} {'conn':>3} dir transport cmd name{' ' * 21}length  fields\n")
+    out.write(
+        f"# {'time':>8} {'conn':>3} dir transport cmd name{' ' * 21}length  "
+        "fields (checksum ok unless marked)\n"
+    )
     for item in items:
         writer.item(item)
     writer.finish()
