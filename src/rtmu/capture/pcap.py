@@ -124,7 +124,11 @@ class PcapngReader(FrameReader):
                 body = self._body(length, 8)
                 if body is None:
                     return
-                frame = self._block(block_type, body)
+                try:
+                    frame = self._block(block_type, body)
+                except (struct.error, IndexError):
+                    self.warnings.append(f"damaged pcapng block of type {block_type}; reading stopped there")
+                    return
                 if frame is not None:
                     yield frame
             if body is None:
@@ -171,7 +175,7 @@ def _tsresol(options: bytes, order: str) -> float:
         code, length = struct.unpack(order + "HH", options[pos : pos + 4])
         if code == 0:
             break
-        if code == 9 and length >= 1:
+        if code == 9 and length >= 1 and pos + 4 < len(options):
             value = options[pos + 4]
             return 2.0 ** -(value & 0x7F) if value & 0x80 else 10.0**-value
         pos += 4 + (length + 3) // 4 * 4

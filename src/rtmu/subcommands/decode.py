@@ -375,7 +375,7 @@ class _TextWriter:
         )
 
     def _packet_line(self, p: DecodedPacket) -> str:
-        name = p.name or ("?" if p.is_data else "(unknown control)")
+        name = _one_line(p.name) if p.name else ("?" if p.is_data else "(unknown control)")
         where = f"{self._time(p.time)} {p.conn:>3} {p.direction} {p.transport:<6}"
         head = f"{where} {p.command:>5} {name:<22} {p.length:>5}"
         parts: list[str] = []
@@ -524,7 +524,7 @@ def _session_lines(session: Session, source: CaptureSource, full: bool) -> list[
             continue
         names = totals.by_name.most_common()
         shown = names if full else names[:10]
-        text = ", ".join(f"{n} ×{c}" for n, c in shown)
+        text = ", ".join(f"{_one_line(n)} ×{c}" for n, c in shown)
         if len(shown) < len(names):
             text += f", … +{len(names) - len(shown)} names"
         lines.append(f"  {direction} {totals.packets} packets, {totals.bytes} bytes: {text}")
