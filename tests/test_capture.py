@@ -488,6 +488,6 @@ def test_late_retransmission_after_the_close_is_not_a_new_connection():
         (c, s, 11, FIN | ACK, b""),
         (s, c, 51, ACK, b"data"),  # a late copy
     ]
-    streams, events, stats = _reassemble(segs)
+    streams, events, _ = _reassemble(segs)
     assert streams == {(1, s): b"data"}
     assert {e.flow.id for e in events} == {1}
