@@ -202,3 +202,35 @@ def test_wander_roams_without_hitting_anything_and_is_deterministic(arena_map):
     b = run(trip(3))
     assert a == b
     assert a != (0.0, 0.0)
+
+
+def test_the_other_status_data_answer_as_serverdemo(arena_map):
+    from rtmu.protocol.payloads.camera import CameraList
+    from rtmu.protocol.payloads.robot import (
+        ActivityTimeInfo,
+        BatteryInfo,
+        ModeDataList,
+        PhysicalInfo,
+        Update,
+    )
+
+    async def scenario() -> None:
+        server, c = await _start(arena_map)
+        assert BatteryInfo.decode((await c.ask("batteryInfo"))[0]) == BatteryInfo(11.5, 11.0, False)
+        assert PhysicalInfo.decode((await c.ask("physicalInfo"))[0]) == PhysicalInfo(
+            "Pioneer", "p3dx", 425, 210, 301, False
+        )
+        update = Update.decode((await c.ask("update"))[0])
+        assert (update.status, update.mode, update.numbers.x) == ("Stopped", "Stop", 0)
+        rows = ModeDataList.decode((await c.ask("getModeDataList"))[0]).entries
+        pairs = {(r.mode_name, r.data_name) for r in rows}
+        assert {("ratioDrive", "ratioDrive"), ("stop", "stop"), ("wander", "wander")} <= pairs
+        assert ("jogPositionMode", "moveDist") in pairs
+        await server.advance(3.0)
+        assert ActivityTimeInfo.decode((await c.ask("activityTimeInfo"))[0]).seconds == 3
+        cams = CameraList.decode((await c.ask("getCameraList"))[0]).cameras
+        assert cams[0].name == "Cam1" and cams[0].data_name("getPicture") == "getPictureCam1"
+        assert cams[0].data_name("getVideo") == "sendVideo"
+        await _end(server, c)
+
+    run(scenario())

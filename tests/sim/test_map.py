@@ -122,3 +122,28 @@ def test_broadcast_only_data_give_no_immediate_reply(arena_map):
         await server.stop()
 
     run(scenario())
+
+
+def test_check_map_reloads_a_changed_file_and_tells_subscribers(arena_map, tmp_path):
+    path = tmp_path / "arena.map"
+    path.write_bytes(arena_map.read_bytes())
+
+    async def scenario() -> None:
+        server = SimServer(SimConfig(port=0, realtime=False, map_path=path))
+        await server.start()
+        c = await WireClient().open(server.port)
+        c.request("mapUpdated", -1)
+        c.request("goalsUpdated", -1)
+        c.once("checkMap")
+        await c.barrier()
+        assert c.received["mapUpdated"] == []  # unchanged file: nothing to say
+        path.write_text(path.read_text().replace('"Far corner"', '"Far away corner"'))
+        c.once("checkMap")
+        await c.wait_for("mapUpdated")
+        await c.wait_for("goalsUpdated")
+        goals = Goals.decode((await c.ask("getGoals"))[0]).goals
+        assert "Far away corner" in goals
+        await c.close()
+        await server.stop()
+
+    run(scenario())

@@ -156,7 +156,6 @@ def decode_lenient(cls, args: bytes):
     "requestOnceReturnIsAlwaysTcp",
     "startRequestTransaction",
     "endRequestTransaction",
-    "checkMap",
 )
 def _silent(call: Call) -> Iterable[Reply]:
     return ()
@@ -389,6 +388,12 @@ def _get_map_category(call: Call) -> Iterable[Reply]:
         else "2D-Map-Ex2"
     )
     return (Framed(call.server.map.binary_stream(call.number, first)),)
+
+
+@handles("checkMap")
+def _check_map(call: Call) -> Iterable[Reply]:
+    call.server.check_map()
+    return ()
 
 
 @handles("getGoals")

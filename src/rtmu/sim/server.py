@@ -12,6 +12,7 @@ from __future__ import annotations
 
 import asyncio
 import contextlib
+import hashlib
 import logging
 import math
 import random
@@ -494,6 +495,25 @@ class SimServer:
     def video_trailer(self) -> bytes:
         """The 2 bytes ARIA's video forwarder leaves after a picture (the upstream packet's checksum)."""
         return b"\x5a\xa5" if self.config.video_trailer else b""
+
+    def check_map(self) -> bool:
+        """ARIA's ``checkMap``: reload the map file if it changed, move the robot home, tell subscribers."""
+        path = self.config.map_path
+        if path is None or not path.is_file():
+            return False
+        raw_md5 = hashlib.md5(path.read_bytes()).digest()
+        if raw_md5 == self.map.md5:
+            return False
+        self.map = load_map(path)
+        obstacles = self.map.obstacles()
+        home = self.map.home
+        x, y = free_spot_near(obstacles, home[0], home[1], 250.0)
+        self.home = (x, y, home[2])
+        self.world.replace_obstacles(obstacles)
+        self.reset_pose()
+        self.broadcast("mapUpdated")
+        self.broadcast("goalsUpdated")
+        return True
 
     # -- tools for tests and the demo -------------------------------------------------------
     def reset_pose(self) -> None:
