@@ -36,12 +36,12 @@ from ..model import (
 from ..protocol.errors import ProtocolError
 from ..protocol.payloads import Side, decode_payload, payload_type_for
 from ..protocol.payloads.drive import RatioDrive, SafeDrive, SetSafeDrive
-from ..protocol.payloads.map import MapName
 from ..protocol.payloads.robot import BatteryInfo, ModeInfo, Update, UpdateNumbers, UpdateStrings
 from .connection import AriaClient, Packet
 from .errors import ClientError, ClientTimeout, NotSupported, ServerClosed
 from .health import HealthMonitor, ping_data
 from .lease import DriveGovernor, DriveLease, EndReason, SendRatios, SendStop
+from .mapload import download_map, map_source
 from .reconnect import Backoff, worth_retrying
 
 log = logging.getLogger(__name__)
@@ -112,7 +112,6 @@ class Session:
         self._kick = asyncio.Event()
         self._stepped: asyncio.Event = asyncio.Event()
         self._image_sequence = 0
-        self._map_generation = 0
         self._wifi_labels: tuple[str, ...] = ()
         self.packets_sent = 0
 
@@ -589,58 +588,34 @@ class Session:
     # -- map ---------------------------------------------------------------------------------
     async def load_map(self) -> MapModel:
         """Download the map (``getMapBinary`` when offered, else ``getMap``) and publish it."""
-        from ..protocol.payloads.mapstream import MapBinaryAssembler, MapTextAssembler
-
         client = self.client
         if client is None or not client.connected:
             raise ServerClosed("not connected")
-        binary = client.supports("getMapBinary")
-        name = "getMapBinary" if binary else "getMap"
-        if not client.supports(name):
+        if map_source(client) is None:
             self._set_map(MapModel(state="unsupported"))
             return self._map
-        map_name = ""
-        if client.supports("getMapName"):
-            with contextlib.suppress(ClientError, ProtocolError):
-                typed = (await client.request_once("getMapName", timeout=self.config.reply_timeout)).decode()
-                map_name = typed.file_name if isinstance(typed, MapName) else ""
-        self._set_map(MapModel(state="loading", name=map_name, generation=self._map.generation))
-        assembler: MapBinaryAssembler | MapTextAssembler = (
-            MapBinaryAssembler() if binary else MapTextAssembler()
-        )
-        count = 0
+        generation = self._map.generation
+        self._set_map(MapModel(state="loading", name=self._map.name, generation=generation))
+
+        def progress(count: int) -> None:
+            self._set_map(replace(self._map, received=count))
+
         try:
-            async for _ in client.stream(name, timeout=self.config.reply_timeout, until=assembler.feed):
-                count += 1
-                if count % 200 == 0:
-                    self._set_map(replace(self._map, received=count))
-            data = await asyncio.get_running_loop().run_in_executor(None, _map_data, assembler)
-        except (ClientError, ProtocolError, ValueError) as exc:
-            self._set_map(replace(self._map, state="failed", error=str(exc), received=count))
-            self._notice("warning", f"The map could not be loaded: {exc}")
+            got = await download_map(client, timeout=self.config.reply_timeout, progress=progress)
+        except ClientError as exc:
+            self._set_map(replace(self._map, state="failed", error=str(exc)))
+            if client.connected:
+                self._notice("warning", f"The map could not be loaded: {exc}")
             return self._map
-        if data is None:
-            self._set_map(
-                MapModel(state="none", name=map_name, generation=self._map.generation, received=count)
-            )
+        if got.data is None:
+            self._set_map(MapModel(state="none", name=got.name, generation=generation, received=got.packets))
             return self._map
-        self._map_generation = self._map.generation + 1
         self._set_map(
-            MapModel(state="ready", data=data, name=map_name, generation=self._map_generation, received=count)
+            MapModel(
+                state="ready", data=got.data, name=got.name, generation=generation + 1, received=got.packets
+            )
         )
         return self._map
-
-
-def _map_data(assembler: Any) -> Any:
-    """Assembled packets → ``rtmu.maps.MapData`` (None if the server has no map). Runs in an executor."""
-    from .. import maps
-
-    result = assembler.result()
-    if not result.has_map:
-        return None
-    if hasattr(result, "segments"):
-        return maps.from_stream(result.header_lines, result.segments, result.points)
-    return maps.parse_map_lines(result.lines)
 
 
 _WIFI_WORDS = ("wireless", "wifi", "wi-fi", "wlan")

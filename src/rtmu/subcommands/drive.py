@@ -1,0 +1,129 @@
+"""``rtmu drive HOST[:PORT] --trans PCT --rot PCT [--throttle PCT] --seconds S``: drive, then stop.
+
+Sends ``ratioDrive`` every 100 ms for S seconds (ARIA's watchdog stops a robot
+that hears nothing for 2 s), then zero ratios and ``stop`` — also on Ctrl-C or
+any error — and prints the pose before and after (``--json``: one object
+``{"before": STATUS, "after": STATUS, "seconds": S}`` with the keys of
+``rtmu status``).
+"""
+
+from __future__ import annotations
+
+import argparse
+import asyncio
+import contextlib
+import sys
+from typing import Any
+
+from ..cli import EXIT_OK
+from ..client.connection import AriaClient
+from ..client.errors import ClientError, NotSupported
+from ..protocol.payloads.drive import RatioDrive
+from ._common import (
+    UsageError,
+    add_connection_arguments,
+    fetch_status,
+    print_json,
+    run_with_client,
+    status_line,
+)
+
+RESEND = 0.1
+MAX_SECONDS = 600.0
+SETTLE = 3.0
+"""At most this long to wait for the robot to come to rest before printing the final pose."""
+
+
+def register(subparsers: Any) -> None:
+    p = subparsers.add_parser(
+        "drive",
+        help="drive for some seconds, then stop",
+        description="Drive with ratioDrive for S seconds, then stop; print the pose before and after.",
+    )
+    add_connection_arguments(p)
+    p.add_argument(
+        "--trans", type=float, default=0.0, metavar="PCT", help="−100…100 % of max speed (+ forward)"
+    )
+    p.add_argument(
+        "--rot", type=float, default=0.0, metavar="PCT", help="−100…100 % of max rotation (+ left)"
+    )
+    p.add_argument("--throttle", type=float, default=50.0, metavar="PCT", help="0…100 % (default 50)")
+    p.add_argument("--seconds", type=float, required=True, metavar="S", help=f"0…{MAX_SECONDS:g}")
+    p.add_argument("--json", action="store_true", help='one object {"before", "after", "seconds"}')
+    p.set_defaults(handler=handle)
+
+
+def check(args: argparse.Namespace) -> None:
+    for name in ("trans", "rot"):
+        value = getattr(args, name)
+        if not -100.0 <= value <= 100.0:
+            raise UsageError(f"--{name} must be −100…100, not {value:g}")
+    if not 0.0 <= args.throttle <= 100.0:
+        raise UsageError(f"--throttle must be 0…100, not {args.throttle:g}")
+    if not 0.0 < args.seconds <= MAX_SECONDS:
+        raise UsageError(f"--seconds must be more than 0 and at most {MAX_SECONDS:g}")
+
+
+def handle(args: argparse.Namespace) -> int:
+    async def body(client: AriaClient) -> int:
+        check(args)
+        if not client.supports("ratioDrive"):
+            raise NotSupported(
+                "ratioDrive", "this server (or this user) may not drive the robot (no ratioDrive)"
+            )
+        before = await fetch_status(client, args.timeout)
+        if not args.json:
+            print(f"before: {status_line(before)}", flush=True)
+        try:
+            await drive(client, RatioDrive(args.trans, args.rot, args.throttle), args.seconds)
+        finally:
+            stop(client)
+        after = await settle(client, args.timeout)
+        if args.json:
+            print_json({"before": before, "after": after, "seconds": args.seconds})
+        else:
+            print(f"after:  {status_line(after)}", flush=True)
+        return EXIT_OK
+
+    try:
+        check(args)
+    except UsageError as exc:
+        print(f"rtmu drive: {exc}", file=sys.stderr)
+        return 2
+    return run_with_client("drive", args, body)
+
+
+async def drive(client: AriaClient, ratios: RatioDrive, seconds: float) -> None:
+    loop = asyncio.get_running_loop()
+    end = loop.time() + seconds
+    next_send = loop.time()
+    while True:
+        now = loop.time()
+        if now >= end:
+            return
+        if now >= next_send:
+            client.send("ratioDrive", ratios)
+            next_send += RESEND
+        if client.closed_error is not None:
+            raise client.closed_error
+        await asyncio.sleep(max(0.0, min(next_send, end) - loop.time()))
+
+
+def stop(client: AriaClient) -> None:
+    """Zero ratios and ``stop``; never raises (we are often in a ``finally``)."""
+    with contextlib.suppress(ClientError):
+        client.send("ratioDrive", RatioDrive(0.0, 0.0, 0.0))
+    if client.supports("stop"):
+        with contextlib.suppress(ClientError):
+            client.send("stop")
+
+
+async def settle(client: AriaClient, timeout: float) -> dict[str, Any]:
+    """The status once the robot stands still (or after :data:`SETTLE` s)."""
+    loop = asyncio.get_running_loop()
+    deadline = loop.time() + SETTLE
+    while True:
+        status = await fetch_status(client, timeout)
+        if (status["vel"] == 0 and status["rot_vel"] == 0) or loop.time() >= deadline:
+            return status
+        await asyncio.sleep(0.1)

@@ -1,0 +1,45 @@
+"""``rtmu map HOST[:PORT] --out FILE``: download the server's map and write it as an ARIA ``.map`` file."""
+
+from __future__ import annotations
+
+import argparse
+import sys
+from pathlib import Path
+from typing import Any
+
+from ..cli import EXIT_OK, EXIT_UNSUPPORTED
+from ..client.connection import AriaClient
+from ..client.mapload import download_map
+from ._common import add_connection_arguments, fail, run_with_client
+
+
+def register(subparsers: Any) -> None:
+    p = subparsers.add_parser(
+        "map",
+        help="download the robot's map to a .map file",
+        description="Download the server's map (getMapBinary when offered; --text forces getMap) "
+        "and write it in ARIA's .map format.",
+    )
+    add_connection_arguments(p)
+    p.add_argument("--out", type=Path, required=True, metavar="FILE", help="where to write the map")
+    p.add_argument("--text", action="store_true", help="use getMap (one text line per packet)")
+    p.set_defaults(handler=handle)
+
+
+def handle(args: argparse.Namespace) -> int:
+    async def body(client: AriaClient) -> int:
+        from .. import maps
+
+        got = await download_map(client, prefer_binary=not args.text, timeout=args.timeout)
+        if got.data is None:
+            return fail("map", f"{args.server[0]}:{args.server[1]} has no map loaded", EXIT_UNSUPPORTED)
+        maps.write_map(got.data, args.out)
+        name = f" ({got.name})" if got.name else ""
+        print(
+            f"wrote {args.out}{name}: {got.data.num_points} points, {got.data.num_lines} lines "
+            f"via {got.source} in {got.packets} packets",
+            file=sys.stderr,
+        )
+        return EXIT_OK
+
+    return run_with_client("map", args, body)

@@ -1,0 +1,113 @@
+"""``rtmu status HOST[:PORT]``: print the robot's status once, or stream it.
+
+``--json`` prints one JSON object per status (one line each when streaming) with
+the keys ``x``, ``y`` (mm), ``th`` (degrees), ``vel`` (mm/s), ``rot_vel``
+(deg/s), ``battery_v`` (volts, or % charge if the robot reports state of
+charge), ``status`` and ``mode``.
+"""
+
+from __future__ import annotations
+
+import argparse
+import asyncio
+import contextlib
+from typing import Any
+
+from ..cli import EXIT_OK
+from ..client.connection import AriaClient, Packet
+from ..client.errors import ClientTimeout, NotSupported
+from ..protocol.errors import ProtocolError
+from ..protocol.payloads.robot import Update, UpdateNumbers, UpdateStrings
+from ._common import (
+    add_connection_arguments,
+    fetch_status,
+    print_json,
+    run_with_client,
+    status_line,
+    status_object,
+)
+
+
+def register(subparsers: Any) -> None:
+    p = subparsers.add_parser(
+        "status",
+        help="print or stream the robot status",
+        description="Print the robot status once (--once) or stream it until interrupted. "
+        "JSON keys: x, y (mm), th (deg), vel (mm/s), rot_vel (deg/s), battery_v, status, mode.",
+    )
+    add_connection_arguments(p)
+    p.add_argument("--once", action="store_true", help="print one status and exit")
+    p.add_argument("--json", action="store_true", help="JSON: one object (one per line when streaming)")
+    p.add_argument(
+        "--interval", type=int, default=100, metavar="MS", help="update interval when streaming (default 100)"
+    )
+    p.add_argument("--count", type=int, default=0, metavar="N", help="stop after N updates (0 = never)")
+    p.set_defaults(handler=handle)
+
+
+def handle(args: argparse.Namespace) -> int:
+    if args.interval < 10:
+        args.interval = 10
+
+    def show(obj: dict[str, Any]) -> None:
+        if args.json:
+            print_json(obj)
+        else:
+            print(status_line(obj), flush=True)
+
+    async def body(client: AriaClient) -> int:
+        if args.once:
+            show(await fetch_status(client, args.timeout))
+            return EXIT_OK
+        return await stream(client, args, show)
+
+    return run_with_client("status", args, body)
+
+
+async def stream(client: AriaClient, args: argparse.Namespace, show: Any) -> int:
+    strings = {"status": "", "mode": ""}
+    queue: asyncio.Queue[dict[str, Any]] = asyncio.Queue()
+
+    def on_numbers(packet: Packet) -> None:
+        try:
+            n = packet.decode()
+        except ProtocolError:
+            return
+        if isinstance(n, UpdateNumbers):
+            queue.put_nowait(status_object(n, strings["status"], strings["mode"]))
+        elif isinstance(n, Update):
+            queue.put_nowait(status_object(n.numbers, n.status, n.mode))
+
+    def on_strings(packet: Packet) -> None:
+        try:
+            s = packet.decode()
+        except ProtocolError:
+            return
+        if isinstance(s, UpdateStrings):
+            strings["status"], strings["mode"] = s.status, s.mode
+
+    if client.supports("updateNumbers"):
+        if client.supports("updateStrings"):
+            client.request("updateStrings", -1, on_strings)
+        client.request("updateNumbers", args.interval, on_numbers)
+    elif client.supports("update"):
+        client.request("update", args.interval, on_numbers)
+    else:
+        raise NotSupported("updateNumbers", "this server offers no robot status (updateNumbers or update)")
+    shown = 0
+    # A status must come within the interval plus the timeout, or the link is dead.
+    gap = args.interval / 1000.0 + args.timeout
+    loop = asyncio.get_running_loop()
+    while args.count <= 0 or shown < args.count:
+        deadline = loop.time() + gap
+        while queue.empty():
+            if client.closed_error is not None:
+                raise client.closed_error
+            if loop.time() >= deadline:
+                raise ClientTimeout(f"no status from the server for {gap:g} s")
+            with contextlib.suppress(TimeoutError):
+                async with asyncio.timeout(min(0.1, max(0.0, deadline - loop.time()))):
+                    await queue.put(await queue.get())  # wait for one without taking it
+        show(queue.get_nowait())
+        shown += 1
+    return EXIT_OK

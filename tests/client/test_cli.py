@@ -1,0 +1,195 @@
+"""``rtmu probe/status/map/drive/image`` against the simulator and scripted servers: output and exit codes."""
+
+from __future__ import annotations
+
+import io
+import json
+from collections.abc import Iterator
+from pathlib import Path
+
+import pytest
+
+from rtmu import maps
+from rtmu.cli import EXIT_CONNECTION, EXIT_OK, EXIT_TIMEOUT, EXIT_UNSUPPORTED, EXIT_USAGE, main
+from rtmu.sim import SimConfig, SimThread
+from rtmu.subcommands._common import host_port
+
+from .servers import SPECS, ServerThread, TestServer
+from .test_connection import free_port
+
+REPO = Path(__file__).resolve().parents[2]
+ARENA = REPO / "data" / "maps" / "arena.map"
+STATUS_KEYS = {"x", "y", "th", "vel", "rot_vel", "battery_v", "status", "mode"}
+
+
+@pytest.fixture(scope="module")
+def sim(tmp_path_factory: pytest.TempPathFactory) -> Iterator[SimThread]:
+    users = tmp_path_factory.mktemp("users") / "users.txt"
+    users.write_text("UserInfoVersion1\nuser alice secret1 all\nuser bob pw2 RobotInfo\n")
+    with SimThread(SimConfig(port=0, map_path=ARENA, users_path=users)) as s:
+        yield s
+
+
+@pytest.fixture
+def pwfile(tmp_path: Path) -> Path:
+    p = tmp_path / "pw"
+    p.write_text("secret1\n")
+    return p
+
+
+def addr(sim: SimThread) -> str:
+    return f"127.0.0.1:{sim.port}"
+
+
+def login(sim: SimThread, pwfile: Path) -> list[str]:
+    return [addr(sim), "--user", "alice", "--password-file", str(pwfile), "--timeout", "5"]
+
+
+def test_host_port_forms() -> None:
+    assert host_port("robot") == ("robot", 7272)
+    assert host_port("10.0.0.5:8000") == ("10.0.0.5", 8000)
+    assert host_port("[::1]:7000") == ("::1", 7000)
+    assert host_port("::1") == ("::1", 7272)
+    with pytest.raises(Exception):  # noqa: B017
+        host_port("robot:99999")
+
+
+def test_probe_json_is_one_object(sim: SimThread, pwfile: Path, capsys: pytest.CaptureFixture[str]) -> None:
+    assert main(["probe", *login(sim, pwfile), "--json"]) == EXIT_OK
+    out = capsys.readouterr().out
+    obj = json.loads(out)
+    assert out.count("\n") == 1 and obj["count"] == len(obj["data"]) > 50
+    ratio = next(d for d in obj["data"] if d["name"] == "ratioDrive")
+    assert (
+        ratio["group"] == "Movement"
+        and ratio["flags"] == ["RETURN_NONE"]
+        and "transRatio" in ratio["arguments"]
+    )
+
+
+def test_probe_text_groups(sim: SimThread, pwfile: Path, capsys: pytest.CaptureFixture[str]) -> None:
+    assert main(["probe", *login(sim, pwfile)]) == EXIT_OK
+    out = capsys.readouterr().out
+    assert "Movement:" in out and "ratioDrive" in out and "offers" in out.splitlines()[0]
+
+
+def test_status_once_and_streamed_json(
+    sim: SimThread, pwfile: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    assert main(["status", *login(sim, pwfile), "--once", "--json"]) == EXIT_OK
+    obj = json.loads(capsys.readouterr().out)
+    assert set(obj) == STATUS_KEYS and obj["battery_v"] > 10
+    assert main(["status", *login(sim, pwfile), "--json", "--count", "3", "--interval", "50"]) == EXIT_OK
+    lines = capsys.readouterr().out.splitlines()
+    assert len(lines) == 3 and all(set(json.loads(line)) == STATUS_KEYS for line in lines)
+    assert main(["status", *login(sim, pwfile), "--once"]) == EXIT_OK
+    assert "battery=" in capsys.readouterr().out
+
+
+def test_password_from_a_pipe(sim: SimThread, monkeypatch: pytest.MonkeyPatch, capsys) -> None:  # type: ignore[no-untyped-def]
+    monkeypatch.setattr("sys.stdin", io.StringIO("secret1\n"))
+    assert main(["status", addr(sim), "--user", "alice", "--once"]) == EXIT_OK
+    monkeypatch.setattr("sys.stdin", io.StringIO("wrong\n"))
+    assert main(["status", addr(sim), "--user", "alice", "--once"]) == EXIT_CONNECTION
+    err = capsys.readouterr().err
+    assert err.count("\n") == 1 and err.startswith("rtmu status: login refused: wrong user name or password")
+
+
+def test_map_binary_and_text(sim: SimThread, pwfile: Path, tmp_path: Path) -> None:
+    expected = maps.read_map(ARENA)
+    for extra, name in (([], "bin.map"), (["--text"], "text.map")):
+        out = tmp_path / name
+        assert main(["map", *login(sim, pwfile), "--out", str(out), *extra]) == EXIT_OK
+        got = maps.read_map(out)
+        assert got.num_points == expected.num_points and got.num_lines == expected.num_lines
+
+
+def test_image(sim: SimThread, pwfile: Path, tmp_path: Path) -> None:
+    out = tmp_path / "cam.jpg"
+    assert main(["image", *login(sim, pwfile), "--out", str(out)]) == EXIT_OK
+    data = out.read_bytes()
+    assert data[:2] == b"\xff\xd8" and data.rstrip(b"\x00")[-2:] == b"\xff\xd9"
+    assert main(["image", *login(sim, pwfile), "--out", str(out), "--camera", "Nope"]) == EXIT_UNSUPPORTED
+
+
+def test_drive_moves_then_stops(sim: SimThread, pwfile: Path, capsys: pytest.CaptureFixture[str]) -> None:
+    code = main(["drive", *login(sim, pwfile), "--trans", "60", "--seconds", "0.5", "--json"])
+    assert code == EXIT_OK
+    obj = json.loads(capsys.readouterr().out)
+    assert set(obj["before"]) == STATUS_KEYS and obj["seconds"] == 0.5
+    moved = abs(obj["after"]["x"] - obj["before"]["x"]) + abs(obj["after"]["y"] - obj["before"]["y"])
+    assert moved > 20
+    snap = sim.snapshot()
+    assert snap.trans_ratio == 0 and snap.mode_name == "stop" and snap.vel == 0
+
+
+def test_user_without_movement_rights_cannot_drive(sim: SimThread, tmp_path: Path, capsys) -> None:  # type: ignore[no-untyped-def]
+    pw = tmp_path / "bob"
+    pw.write_text("pw2")
+    args = [
+        "drive",
+        addr(sim),
+        "--user",
+        "bob",
+        "--password-file",
+        str(pw),
+        "--trans",
+        "10",
+        "--seconds",
+        "1",
+    ]
+    assert main(args) == EXIT_UNSUPPORTED
+    assert "ratioDrive" in capsys.readouterr().err
+
+
+def test_usage_errors_exit_2(capsys: pytest.CaptureFixture[str], tmp_path: Path) -> None:
+    assert main(["drive", "127.0.0.1", "--trans", "500", "--seconds", "1"]) == EXIT_USAGE
+    assert main(["drive", "127.0.0.1", "--seconds", "0"]) == EXIT_USAGE
+    with pytest.raises(SystemExit) as info:
+        main(["status", "127.0.0.1:70000"])
+    assert info.value.code == EXIT_USAGE
+    missing = tmp_path / "nope"
+    assert main(["status", "127.0.0.1", "--password-file", str(missing), "--once"]) == EXIT_USAGE
+    assert "cannot read the password file" in capsys.readouterr().err
+
+
+def test_refused_exits_3(capsys: pytest.CaptureFixture[str]) -> None:
+    assert main(["probe", f"127.0.0.1:{free_port()}", "--timeout", "2"]) == EXIT_CONNECTION
+    err = capsys.readouterr().err
+    assert err.count("\n") == 1 and "refused" in err
+
+
+def test_silent_server_times_out_with_5(capsys: pytest.CaptureFixture[str]) -> None:
+    with ServerThread(TestServer(silent=True)) as server:
+        assert main(["status", f"127.0.0.1:{server.port}", "--once", "--timeout", "0.3"]) == EXIT_TIMEOUT
+    assert "did not complete the login" in capsys.readouterr().err
+
+
+def test_unsupported_exits_4(capsys: pytest.CaptureFixture[str], tmp_path: Path) -> None:
+    bare = [row for row in SPECS if row[0] in ("updateNumbers", "stop")]
+    with ServerThread(TestServer(bare)) as server:
+        target = f"127.0.0.1:{server.port}"
+        assert main(["image", target, "--out", str(tmp_path / "x.jpg")]) == EXIT_UNSUPPORTED
+        assert main(["map", target, "--out", str(tmp_path / "x.map")]) == EXIT_UNSUPPORTED
+        assert main(["drive", target, "--trans", "10", "--seconds", "1"]) == EXIT_UNSUPPORTED
+    lines = capsys.readouterr().err.splitlines()
+    assert len(lines) == 3 and all(line.startswith("rtmu ") for line in lines)
+
+
+def test_server_killed_while_streaming_status_exits_3(capsys: pytest.CaptureFixture[str]) -> None:
+    sent = [0]
+
+    def numbers_then_die(side, args):  # type: ignore[no-untyped-def]
+        sent[0] += 1
+        if sent[0] > 3:
+            server.kill(side)
+            return None
+        return [bytes(19)]
+
+    with ServerThread(TestServer()) as server:
+        server.handlers["updateNumbers"] = numbers_then_die
+        code = main(
+            ["status", f"127.0.0.1:{server.port}", "--interval", "20", "--timeout", "2", "--count", "50"]
+        )
+    assert code == EXIT_CONNECTION
+    assert "closed" in capsys.readouterr().err
