@@ -111,6 +111,7 @@ def test_watchdog_stops_a_drive_that_is_not_renewed(arena_map):
         await server.advance(0.2)
         assert server.robot.watchdog_stops == 1
         assert (server.robot.trans_ratio, server.robot.rot_ratio, server.robot.throttle) == (0, 0, 0)
+        assert server.robot.received_ratios == (0, 60, 100, 0) and server.robot.received_throttle == 100
         await server.advance(1.0)
         assert server.robot.rot_vel == 0 and server.robot.status == "Stopped"
         assert server.robot.mode == "Drive"  # still in ratio drive, as ARIA

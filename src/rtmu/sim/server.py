@@ -541,7 +541,13 @@ class CpuMeter:
 
 
 class RobotView:
-    """``server.robot``: the live state by the names the API promises (x, y, th, vel, rot_vel, …)."""
+    """``server.robot``: the live state by the names the API promises.
+
+    x, y (mm), th (deg), vel (mm/s), rot_vel (deg/s), battery_v, status, mode (display string),
+    mode_name, the ratio-drive mode's current ratios (trans_ratio, rot_ratio, throttle, lat_ratio —
+    zeroed by the watchdog, as ARIA does) and the last ratioDrive as received (received_ratios,
+    received_throttle, ratio_drives_received), safe_drive, stalled, collisions, watchdog_stops.
+    """
 
     def __init__(self, world: World) -> None:
         self._world = world
@@ -569,6 +575,9 @@ class RobotView:
             "collisions": lambda: b.collisions,
             "watchdog_stops": lambda: r.timeouts,
             "last_drive_time": lambda: r.last_command,
+            "received_ratios": lambda: w.received_ratios,
+            "received_throttle": lambda: None if w.received_ratios is None else w.received_ratios[2],
+            "ratio_drives_received": lambda: w.ratio_drives_received,
         }
         if name in table:
             return table[name]()

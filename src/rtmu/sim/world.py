@@ -112,6 +112,9 @@ class World:
         self._next_popup_id = 1
         self._low_battery_warned = False
         self.last_activity = 0.0
+        self.received_ratios: tuple[float, float, float, float] | None = None
+        """The last ratioDrive exactly as received (the watchdog zeroes the mode's ratios, not this)."""
+        self.ratio_drives_received = 0
 
     def replace_obstacles(self, obstacles: Obstacles) -> None:
         """A new map: the body, sensors, camera and radio all see the new walls."""
@@ -147,6 +150,8 @@ class World:
         if self.mode is not self.ratio_mode:
             self.activate(self.ratio_mode)
         self.ratio_mode.set_ratios(trans, rot, throttle, lat, self.time)
+        self.received_ratios = (trans, rot, throttle, lat)
+        self.ratio_drives_received += 1
 
     def set_safe_drive(self, safe: bool) -> None:
         """ARIA: changing safety while driving zeroes the ratios; the mode string follows."""
