@@ -58,6 +58,7 @@ CYCLE_S = 0.01
 """ARIA's server loop sleeps 10 ms between cycles."""
 MAX_CATCH_UP_STEPS = 50
 READ_CHUNK = 65536
+WARM_STREAMS_ABOVE_LINES = 100_000
 
 
 class SimServerConnection(ServerConnection):
@@ -300,6 +301,16 @@ class SimServer:
         self._real_start = time.monotonic()
         if cfg.realtime:
             self._cycle_task = asyncio.create_task(self._run_realtime(), name="rtmu-sim-cycle")
+            if len(self.map.lines) > WARM_STREAMS_ABOVE_LINES:
+                # Frame a big map's streams on a worker thread now, not in the first client's request.
+                loop = asyncio.get_running_loop()
+                for name, make in (
+                    ("getMap", self.map.text_stream),
+                    ("getMapBinary", self.map.binary_stream),
+                ):
+                    number = self.datalist.number(name)
+                    if number is not None:
+                        loop.run_in_executor(None, make, number)
 
     async def stop(self) -> None:
         """Say SHUTDOWN to every client, let the bytes go, close everything."""
