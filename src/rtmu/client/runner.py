@@ -242,3 +242,15 @@ class ClientRunner:
     def sync(self, timeout: float = 2.0) -> None:
         """Wait until the network side has handled everything submitted so far and run one heart step."""
         self.call(self._session.step, timeout=timeout)
+
+    def status_age(self) -> float | None:
+        """Seconds since the last status packet, read now; None when not connected.
+
+        For a UI timer that shows how old the data is: the model hears only real
+        changes (a robot standing still publishes nothing new), so the age cannot
+        be derived from it. A plain read of two floats the network thread writes.
+        """
+        session = self.session
+        if session is None or session.client is None:
+            return None
+        return session.health.status_age(self.clock())
