@@ -164,7 +164,7 @@ def test_raw_bytes_with_garbage_and_a_bad_checksum(tmp_path):
     text = rtmu(path).stdout
     assert "BAD CHECKSUM" in text and "!! dropped: " in text
     assert "s2c 4 garbage bytes" not in text  # drops are worded per kind
-    assert f"{4 + len(bad)} garbage bytes, 1 bad checksums" in text
+    assert f"{4 + len(bad)} garbage bytes, 1 bad checksum" in text
 
 
 def test_raw_bytes_direction_can_be_given(tmp_path):

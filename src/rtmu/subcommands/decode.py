@@ -45,12 +45,17 @@ LINK_NAMES = {
     276: "Linux cooked v2",
 }
 DROP_WORDS = {
-    "garbage_bytes": "garbage bytes",
-    "bad_length": "bad length fields",
-    "bad_checksum": "bad checksums",
-    "truncated_at_close": "packets cut off at the end",
-    "capture_gap_bytes": "bytes missing from the capture",
+    "garbage_bytes": ("garbage byte", "garbage bytes"),
+    "bad_length": ("bad length field", "bad length fields"),
+    "bad_checksum": ("bad checksum", "bad checksums"),
+    "truncated_at_close": ("packet cut off at the end", "packets cut off at the end"),
+    "capture_gap_bytes": ("byte missing from the capture", "bytes missing from the capture"),
 }
+
+
+def _drops_text(counts: dict[str, int]) -> str:
+    words = (DROP_WORDS.get(k, (k, k)) for k in counts)
+    return ", ".join(f"{n} {w[0] if n == 1 else w[1]}" for n, w in zip(counts.values(), words, strict=True))
 
 
 _DESCRIPTION = """\
@@ -369,7 +374,7 @@ class _TextWriter:
         return f"{rel:>10.6f}" if rel is not None else f"{'-':>10}"
 
     def _drop_line(self, drop: DropReport) -> str:
-        what = ", ".join(f"{n} {DROP_WORDS.get(k, k)}" for k, n in drop.counts.items())
+        what = _drops_text(drop.counts)
         return (
             f"{self._time(drop.time)} {drop.conn:>3} {drop.direction} {drop.transport:<6} !! dropped: {what}"
         )
@@ -528,11 +533,7 @@ def _session_lines(session: Session, source: CaptureSource, full: bool) -> list[
         if len(shown) < len(names):
             text += f", … +{len(names) - len(shown)} names"
         lines.append(f"  {direction} {totals.packets} packets, {totals.bytes} bytes: {text}")
-    drops = [
-        f"{d} " + ", ".join(f"{n} {DROP_WORDS.get(k, k)}" for k, n in session.totals[d].drops.items())
-        for d in (C2S, S2C)
-        if session.totals[d].drops
-    ]
+    drops = [f"{d} " + _drops_text(session.totals[d].drops) for d in (C2S, S2C) if session.totals[d].drops]
     lines.append("  dropped: " + ("; ".join(drops) if drops else "nothing"))
     if session.held_overflow:
         lines.append(f"  ({session.held_overflow} bad packets before the first good one were not shown)")
