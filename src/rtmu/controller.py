@@ -25,14 +25,16 @@ Driving rules
 
 from __future__ import annotations
 
+import contextlib
 import time
 from collections.abc import Callable, Mapping
+from dataclasses import replace
 from enum import Enum
 from typing import Protocol
 
 from .client.lease import DriveLease, DriveRatios, EndReason
 from .commands import COMMANDS, CommandRegistry, CommandState
-from .model import ZOOM_LEVELS, ConnectionState, LinkHealth, LinkLevel, Model, Phase
+from .model import ZOOM_LEVELS, ConnectionState, LinkHealth, LinkLevel, Model, Phase, SpeedSetting
 from .settings import Profile
 
 TICK = 0.1
@@ -310,9 +312,23 @@ class Controller:
 
     # -- connection --------------------------------------------------------------------------
     def select_profile(self, profile: Profile) -> None:
+        """Use ``profile`` for the next connect and restore the view and speed it was left with."""
         self.profile = profile
+        with contextlib.suppress(ValueError):
+            self.model.speed.set(SpeedSetting(profile.speed))
         self.model.view.update(
             zoom=profile.zoom, follow_robot=profile.follow_robot, show_sonar=profile.show_sonar
+        )
+
+    def current_profile(self) -> Profile:
+        """The profile with the view options and speed as they are now (save it on exit)."""
+        v = self.model.view.value
+        return replace(
+            self.profile,
+            zoom=v.zoom,
+            follow_robot=v.follow_robot,
+            show_sonar=v.show_sonar,
+            speed=self.model.speed.value.percent,
         )
 
     def connect(self, password: str | None = None) -> None:

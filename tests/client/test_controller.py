@@ -286,3 +286,13 @@ def test_adding_a_command_is_one_class() -> None:
     assert ctl.run("wander")
     assert rig.link.calls[-1] == ("command", "wander")
     assert registry.default_keys() == {"w": "wander"}
+
+
+def test_profile_view_options_round_trip() -> None:
+    rig = Rig()
+    rig.ctl.select_profile(Profile("lab", zoom=0.3, speed=70, follow_robot=False))
+    assert rig.model.speed.value.percent == 70 and rig.model.view.value.follow_robot is False
+    rig.ctl.zoom_in()
+    rig.ctl.speed_down()
+    saved = rig.ctl.current_profile()
+    assert (saved.name, saved.zoom, saved.speed, saved.follow_robot) == ("lab", 0.4, 60, False)

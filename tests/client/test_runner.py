@@ -7,6 +7,7 @@ import time
 import pytest
 
 from rtmu.client.lease import DriveRatios
+from rtmu.client.reconnect import Backoff
 from rtmu.client.runner import ClientRunner
 from rtmu.client.session import SessionConfig
 from rtmu.model import LinkLevel, Model, Phase
@@ -167,3 +168,28 @@ def test_connect_failure_is_shown_in_the_model() -> None:
         ui.wait_for(lambda: model.connection.value.phase is Phase.FAILED)
         assert model.connection.value.error_kind == "refused"
         assert "refused" in model.connection.value.error
+
+
+def test_lost_link_reconnects_and_comes_back_without_motion(server: TestServer) -> None:
+    clock = FakeClock()
+    runner, model, ui = start(server, clock=clock, backoff=lambda: Backoff(initial=0.01, jitter=0.0))
+    try:
+        runner.lease.grant(DriveRatios(100, 0, 50))
+        runner.sync()
+        numbers = server.handlers["updateNumbers"]
+        server.handlers["updateNumbers"] = lambda s, a: None  # TCP stays up, the status stops
+        time.sleep(0.15)
+        clock.advance(2.5)
+        runner.sync()
+        ui.wait_for(lambda: model.connection.value.phase is Phase.RECONNECTING)
+        assert "no status" in model.connection.value.error
+        server.handlers["updateNumbers"] = numbers
+        ui.wait_for(lambda: model.connection.value.phase is Phase.CONNECTED)
+        assert len(server.sides) == 2  # a new connection
+        drives = len(ratio_drives(server))
+        runner.lease.renew()
+        runner.sync()
+        time.sleep(0.05)
+        assert len(ratio_drives(server)) == drives  # nothing resumed
+    finally:
+        runner.close()

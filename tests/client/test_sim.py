@@ -52,6 +52,7 @@ def test_model_from_the_simulator_map_image_wifi_safe_drive() -> None:
             assert robot.mode_name != "" or robot.mode != ""
             assert model.map.value.data.num_lines > 0  # type: ignore[attr-defined]
             ui.wait_for(lambda: model.robot.value.wifi_quality is not None, timeout=5)
+            ui.wait_for(lambda: len(model.robot.value.sonar) > 0, timeout=5)
             assert model.robot.value.wifi_signal is not None and model.robot.value.wifi_signal < 0
             image = runner.request_image().result(5)
             assert image.jpeg[:2] == b"\xff\xd8" and image.width > 0
