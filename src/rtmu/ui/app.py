@@ -1,0 +1,112 @@
+"""The ``rtmu`` window's entry points: options (``--demo``, ``--host``, ``--fullscreen``…) and ``run_gui``.
+
+GTK is imported only when the window really opens (``application`` module), so
+``rtmu --help`` and the headless subcommands never initialise a display. With
+``--demo`` the bundled simulator runs on a free loopback port beside the window
+for as long as it lives.
+"""
+
+from __future__ import annotations
+
+import argparse
+import os
+import sys
+import tempfile
+from dataclasses import dataclass, replace
+from pathlib import Path
+
+from ..settings import DEFAULT_PORT
+
+APP_ID = "io.github.rtmu.Rtmu"
+
+
+@dataclass
+class GuiOptions:
+    host: str | None = None
+    port: int | None = None
+    user: str | None = None
+    profile: str | None = None
+    fullscreen: bool = False
+    connect: bool | None = None
+    """None: connect when a profile was given or saved before; False: never at start."""
+    demo: bool = False
+    settings_path: Path | None = None
+    """None: the user's settings file; tests point it into a temporary directory."""
+    persist: bool = True
+    report_first_frame: bool = False
+
+
+def add_gui_arguments(parser: argparse.ArgumentParser) -> None:
+    """The options of the window (``rtmu`` without a subcommand)."""
+    g = parser.add_argument_group("operator window (no subcommand)")
+    g.add_argument(
+        "--demo",
+        action="store_true",
+        help="run the bundled robot simulator (office map) on a free loopback port and connect to it",
+    )
+    g.add_argument("--host", help="robot server to connect to (default: the last profile)")
+    g.add_argument("--port", type=int, help=f"its port (default {DEFAULT_PORT})")
+    g.add_argument("--user", help="user name for the server (asks for the password)")
+    g.add_argument("--profile", help="use this saved connection profile")
+    g.add_argument("--fullscreen", action="store_true", help="start full screen (F11 toggles)")
+    g.add_argument("--no-connect", action="store_true", help="open the window without connecting")
+    g.add_argument("--report-first-frame", action="store_true", help=argparse.SUPPRESS)
+
+
+def options_from_args(args: argparse.Namespace) -> GuiOptions:
+    return GuiOptions(
+        host=getattr(args, "host", None),
+        port=getattr(args, "port", None),
+        user=getattr(args, "user", None),
+        profile=getattr(args, "profile", None),
+        fullscreen=bool(getattr(args, "fullscreen", False)),
+        connect=False if getattr(args, "no_connect", False) else None,
+        demo=bool(getattr(args, "demo", False)),
+        report_first_frame=bool(getattr(args, "report_first_frame", False)),
+    )
+
+
+def run_gui(args: argparse.Namespace) -> int:
+    """Open the window; with ``--demo`` run the simulator beside it for as long as the window lives."""
+    options = options_from_args(args)
+    if options.port is not None and not 1 <= options.port <= 65535:
+        print(f"rtmu: --port {options.port} is not 1…65535", file=sys.stderr)
+        return 2
+    sim = None
+    if options.demo:
+        try:
+            sim = start_demo_simulator()
+        except Exception as exc:  # the window is useless without it: say why and stop
+            print(f"rtmu: the demo simulator did not start: {exc}", file=sys.stderr)
+            return 3
+        options = replace(options, host="127.0.0.1", port=sim.port, user=None, persist=False, connect=True)
+    try:
+        from .application import RtmuApplication
+
+        app = RtmuApplication(options)
+        return int(app.run([sys.argv[0]]))
+    finally:
+        if sim is not None:
+            sim.stop()
+
+
+def demo_map_path() -> Path:
+    """``data/maps/office.map`` of the checkout; an installed RTMU writes the same map to a temp file."""
+    here = Path(__file__).resolve()
+    for parent in here.parents:
+        candidate = parent / "data" / "maps" / "office.map"
+        if candidate.is_file():
+            return candidate
+    from ..maps import write_map
+    from ..sim.project_maps import office_map
+
+    target = Path(tempfile.gettempdir()) / f"rtmu-demo-{os.getuid()}" / "office.map"
+    target.parent.mkdir(parents=True, exist_ok=True)
+    write_map(office_map(), target)
+    return target
+
+
+def start_demo_simulator():  # type: ignore[no-untyped-def]
+    from ..sim import SimConfig, SimThread
+
+    return SimThread(SimConfig(host="127.0.0.1", port=0, map_path=demo_map_path(), camera=True)).start()

@@ -1,0 +1,221 @@
+"""The ``Gtk.Application``: settings → profile, model, network thread, window; a safe shutdown.
+
+Wiring only. The network thread is :class:`rtmu.client.runner.ClientRunner` with
+``GLib.idle_add`` as its way back to the GTK thread. Shutting down stops the
+robot first, then closes the network thread with a bounded wait, then saves the
+profile's view choices (zoom, follow, sonar, speed).
+"""
+
+from __future__ import annotations
+
+import signal
+import sys
+import threading
+from dataclasses import replace
+
+import gi
+
+gi.require_version("Gtk", "4.0")
+from gi.repository import Gio, GLib, Gtk  # noqa: E402
+
+from ..client.runner import ClientRunner  # noqa: E402
+from ..model import Model, Phase  # noqa: E402
+from ..settings import (  # noqa: E402
+    DEFAULT_PORT,
+    KeyringSecrets,
+    Profile,
+    Settings,
+    load_settings,
+    save_settings,
+)
+from .app import APP_ID, GuiOptions  # noqa: E402
+from .keys import accels_for  # noqa: E402
+from .style import install_css  # noqa: E402
+from .window import MainWindow  # noqa: E402
+
+RUNNER_CLOSE_TIMEOUT = 1.5
+
+
+class SessionSecrets:
+    """The keyring when there is one; otherwise passwords are kept in memory for this session only."""
+
+    def __init__(self, keyring: KeyringSecrets) -> None:
+        self.keyring = keyring
+        self._memory: dict[str, str] = {}
+
+    @property
+    def available(self) -> bool:
+        return self.keyring.available
+
+    def get(self, profile: Profile) -> str | None:
+        found = self.keyring.get(profile)
+        return found if found is not None else self._memory.get(profile.keyring_user)
+
+    def set(self, profile: Profile, password: str) -> None:
+        if not self.keyring.set(profile, password):
+            self._memory[profile.keyring_user] = password
+
+
+class RtmuApplication(Gtk.Application):
+    def __init__(self, options: GuiOptions | None = None) -> None:
+        super().__init__(application_id=APP_ID, flags=Gio.ApplicationFlags.NON_UNIQUE)
+        self.options = options or GuiOptions()
+        self.model: Model | None = None
+        self.runner: ClientRunner | None = None
+        self.window: MainWindow | None = None
+        self.settings = Settings()
+        self.secrets = SessionSecrets(KeyringSecrets())
+        self.settings_warning: str | None = None
+        self._signal_sources: list[int] = []
+
+    # -- lifecycle -----------------------------------------------------------------------------
+    def do_startup(self) -> None:
+        Gtk.Application.do_startup(self)
+        if GLib.get_application_name() != "RTMU":
+            GLib.set_application_name("RTMU")
+        install_css()
+        quit_action = Gio.SimpleAction.new("quit", None)
+        quit_action.connect("activate", lambda _a, _p: self.quit_safely())
+        self.add_action(quit_action)
+        for target in ("app.quit", "win.fullscreen", "win.toolbar", "win.connect", "win.disconnect",
+                       "win.settings", "win.show-help-overlay"):  # fmt: skip
+            self.set_accels_for_action(target, accels_for(target))
+        for signum in (signal.SIGINT, signal.SIGTERM):
+            self._signal_sources.append(GLib.unix_signal_add(GLib.PRIORITY_DEFAULT, signum, self._on_signal))
+
+    def do_activate(self) -> None:
+        if self.window is not None:
+            self.window.present()
+            return
+        loaded = load_settings(self.options.settings_path)
+        self.settings = loaded.settings
+        self.settings_warning = loaded.warning
+        profile, auto_connect = self.choose_profile()
+        self.model = Model()
+        self.runner = ClientRunner(self.model, post=GLib.idle_add).start()
+        window = MainWindow(
+            self,
+            self.model,
+            self.runner,
+            profile=profile,
+            profiles=self.settings.profiles,
+            secrets=self.secrets,
+            keyring_available=self.secrets.available,
+            profile_saved=self.profile_saved,
+        )
+        self.window = window
+        if self.options.report_first_frame:
+            window.stage.on_first_map_frame = self._report_first_frame
+        if self.options.fullscreen:
+            window.fullscreen()
+        window.present()
+        if loaded.warning:
+            window.banners.show("notice:settings", "warning", loaded.warning, timeout=10.0)
+        if auto_connect:
+            window.connect_now()
+        elif not self.settings.profiles:
+            window.banners.show(
+                "notice:hint", "info", "Set up a robot in Connection settings (Ctrl+,), or run rtmu --demo",
+                timeout=8.0,
+            )  # fmt: skip
+
+    def do_shutdown(self) -> None:
+        self.close_session()
+        Gtk.Application.do_shutdown(self)
+
+    def close_session(self) -> None:
+        """Stop the robot, close the network thread, save view choices. Idempotent (tests call it too)."""
+        window, self.window = self.window, None
+        if window is not None:
+            window.controller.stop()
+            self._remember_view(window)
+            window.shutdown()
+        runner, self.runner = self.runner, None
+        if runner is not None:
+            runner.close(RUNNER_CLOSE_TIMEOUT)
+        if self.options.persist and window is not None:
+            self._save(background=False)
+        for source in self._signal_sources:
+            GLib.source_remove(source)
+        self._signal_sources = []
+
+    def quit_safely(self) -> None:
+        """Stop the robot, then close every window (the shutdown handler does the rest)."""
+        if self.window is not None:
+            self.window.controller.stop()
+        for w in list(self.get_windows()):
+            w.close()
+        self.quit()
+
+    def _on_signal(self) -> bool:
+        self.quit_safely()
+        return True
+
+    # -- profiles ------------------------------------------------------------------------------
+    def choose_profile(self) -> tuple[Profile, bool]:
+        """The profile to open with and whether to connect at once."""
+        o = self.options
+        s = self.settings
+        if o.host:
+            port = o.port or DEFAULT_PORT
+            user = o.user or ""
+            match = next(
+                (p for p in s.profiles.values() if (p.host, p.port, p.user) == (o.host, port, user)), None
+            )
+            name = o.profile or (match.name if match else f"{user + '@' if user else ''}{o.host}:{port}")
+            base = match or s.profiles.get(name) or Profile(name=name)
+            profile = replace(base, name=name, host=o.host, port=port, user=user)
+            if o.persist:
+                s.put(profile)
+            return profile, o.connect is not False
+        if o.profile and o.profile in s.profiles:
+            s.last_profile = o.profile
+            return s.profiles[o.profile], o.connect is not False
+        profile = s.current()
+        if o.port:
+            profile = replace(profile, port=o.port)
+        return profile, bool(s.profiles) and o.connect is not False
+
+    def profile_saved(self, profile: Profile, password: str | None) -> None:
+        self.settings.put(profile)
+        if password is not None and profile.remember_password:
+            self.secrets.set(profile, password)
+        if self.options.persist:
+            self._save(background=True)
+
+    def _remember_view(self, window: MainWindow) -> None:
+        view = self.model.view.value if self.model is not None else None
+        name = window.controller.profile.name
+        if view is None or name not in self.settings.profiles:
+            return
+        zoom = max(0.0, min(100.0, view.zoom))
+        self.settings.remember_view(
+            name,
+            zoom=zoom,
+            follow_robot=view.follow_robot,
+            show_sonar=view.show_sonar,
+            speed=self.model.speed.value.percent if self.model is not None else 50,
+        )
+
+    def _save(self, *, background: bool) -> None:
+        snapshot = Settings(dict(self.settings.profiles), self.settings.last_profile)
+        path = self.options.settings_path
+
+        def write() -> None:
+            try:
+                save_settings(snapshot, path)
+            except (OSError, ValueError) as exc:
+                print(f"rtmu: could not save the settings: {exc}", file=sys.stderr)
+
+        if background:
+            threading.Thread(target=write, name="rtmu-save-settings", daemon=True).start()
+        else:
+            write()
+
+    # -- benchmark hook ------------------------------------------------------------------------
+    def _report_first_frame(self, _when: float) -> None:
+        print("rtmu: first map frame", flush=True)
+
+    @property
+    def connected(self) -> bool:
+        return self.model is not None and self.model.connection.value.phase is Phase.CONNECTED

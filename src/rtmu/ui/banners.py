@@ -1,0 +1,153 @@
+"""Non-modal banners over the stage: one per topic, updated in place, gone after a timeout.
+
+A topic ("link", "speed", "camera" …) owns at most one banner: a new message
+on the same topic replaces the text of the banner already shown instead of
+stacking a second one, which is how a lost link shows ONE banner counting its
+reconnect attempts. Text is always set with ``Gtk.Label.set_text`` (plain text:
+strings from the server are never parsed as markup).
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import gi
+
+gi.require_version("Gtk", "4.0")
+from gi.repository import GLib, Gtk  # noqa: E402
+
+MAX_BANNERS = 4
+MAX_CHARS = 300
+ICONS = {
+    "info": "dialog-information-symbolic",
+    "warning": "dialog-warning-symbolic",
+    "error": "dialog-error-symbolic",
+}
+
+
+@dataclass
+class _Banner:
+    revealer: Gtk.Revealer
+    box: Gtk.Box
+    icon: Gtk.Image
+    label: Gtk.Label
+    bar: Gtk.LevelBar
+    level: str = "info"
+    timer: int = 0
+
+
+class BannerStack(Gtk.Box):
+    """A column of banners, meant to sit at the top of a ``Gtk.Overlay``."""
+
+    def __init__(self) -> None:
+        super().__init__(orientation=Gtk.Orientation.VERTICAL, spacing=6)
+        self.add_css_class("banner-stack")
+        self.set_halign(Gtk.Align.CENTER)
+        self.set_valign(Gtk.Align.START)
+        self.set_margin_top(8)
+        self.set_can_target(True)
+        self._banners: dict[str, _Banner] = {}
+        self._order: list[str] = []
+
+    # -- public ------------------------------------------------------------------------------
+    def show(
+        self,
+        topic: str,
+        level: str,
+        text: str,
+        *,
+        timeout: float | None = 4.0,
+        fraction: float | None = None,
+    ) -> None:
+        """Show ``text`` for ``topic`` (replacing its banner's text); ``timeout`` None = until dismissed.
+
+        ``fraction`` (0…1) adds a level bar, e.g. the speed setting.
+        """
+        banner = self._banners.get(topic)
+        if banner is None:
+            banner = self._make(topic)
+        text = _one_paragraph(text)
+        banner.label.set_text(text)
+        banner.label.set_tooltip_text(text)
+        if banner.level != level:
+            banner.box.remove_css_class(banner.level)
+            banner.box.add_css_class(level)
+            banner.level = level
+        banner.icon.set_from_icon_name(ICONS.get(level, ICONS["info"]))
+        banner.bar.set_visible(fraction is not None)
+        if fraction is not None:
+            banner.bar.set_value(max(0.0, min(1.0, fraction)))
+        if banner.timer:
+            GLib.source_remove(banner.timer)
+            banner.timer = 0
+        if timeout is not None:
+            banner.timer = GLib.timeout_add(int(timeout * 1000), self._expire, topic)
+        banner.revealer.set_reveal_child(True)
+
+    def dismiss(self, topic: str) -> None:
+        banner = self._banners.pop(topic, None)
+        if banner is None:
+            return
+        self._order.remove(topic)
+        if banner.timer:
+            GLib.source_remove(banner.timer)
+            banner.timer = 0
+        self.remove(banner.revealer)
+
+    def dismiss_all(self) -> None:
+        for topic in list(self._banners):
+            self.dismiss(topic)
+
+    def text(self, topic: str) -> str | None:
+        """The text shown for ``topic`` (None when no banner) — for tests and screen readers alike."""
+        banner = self._banners.get(topic)
+        return None if banner is None else banner.label.get_text()
+
+    def topics(self) -> list[str]:
+        return list(self._order)
+
+    # -- internals ---------------------------------------------------------------------------
+    def _make(self, topic: str) -> _Banner:
+        while len(self._order) >= MAX_BANNERS:
+            self.dismiss(self._order[0])
+        box = Gtk.Box(orientation=Gtk.Orientation.HORIZONTAL, spacing=10)
+        box.add_css_class("banner")
+        box.add_css_class("info")
+        icon = Gtk.Image.new_from_icon_name(ICONS["info"])
+        label = Gtk.Label(xalign=0.0, wrap=True, max_width_chars=48)
+        label.set_use_markup(False)
+        label.set_selectable(False)
+        bar = Gtk.LevelBar(min_value=0.0, max_value=1.0, visible=False)
+        bar.set_size_request(140, 10)
+        bar.set_valign(Gtk.Align.CENTER)
+        close = Gtk.Button.new_from_icon_name("window-close-symbolic")
+        close.add_css_class("flat")
+        close.add_css_class("circular")
+        close.set_focusable(False)
+        close.set_tooltip_text("Dismiss")
+        close.connect("clicked", lambda _b: self.dismiss(topic))
+        for child in (icon, label, bar, close):
+            box.append(child)
+        label.set_hexpand(True)
+        revealer = Gtk.Revealer(
+            transition_type=Gtk.RevealerTransitionType.SLIDE_DOWN, transition_duration=150
+        )
+        revealer.set_child(box)
+        self.append(revealer)
+        banner = _Banner(revealer, box, icon, label, bar)
+        self._banners[topic] = banner
+        self._order.append(topic)
+        return banner
+
+    def _expire(self, topic: str) -> bool:
+        banner = self._banners.get(topic)
+        if banner is not None:
+            banner.timer = 0
+            self.dismiss(topic)
+        return False
+
+
+def _one_paragraph(text: str) -> str:
+    """Bounded, without control characters other than spaces (server text can be anything)."""
+    clean = "".join(ch if ch.isprintable() else " " for ch in text).strip()
+    return clean if len(clean) <= MAX_CHARS else clean[: MAX_CHARS - 1] + "…"

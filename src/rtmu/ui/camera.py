@@ -1,0 +1,256 @@
+"""The camera page (request → "coming…" → picture scaled to fit, with its age) and the map inset.
+
+JPEG bytes from the robot are untrusted: they are decoded with Pillow on a
+worker thread (never on the GTK thread), refused above :data:`MAX_SIDE` pixels,
+and only the newest picture is kept — a slow decode never queues up behind
+newer ones. The texture is made on the GTK thread from plain RGB bytes.
+"""
+
+from __future__ import annotations
+
+import io
+import threading
+import time
+from collections.abc import Callable
+
+import gi
+
+gi.require_version("Gtk", "4.0")
+gi.require_version("Gdk", "4.0")
+from gi.repository import Gdk, GLib, Gtk  # noqa: E402
+
+from ..model import CameraImage  # noqa: E402
+
+MAX_SIDE = 4096
+MAX_JPEG_BYTES = 16 * 1024 * 1024
+REQUEST_TIMEOUT = 7.0
+"""Seconds the page waits for a requested picture before saying none came."""
+
+
+def decode_jpeg(data: bytes) -> tuple[int, int, bytes]:
+    """(width, height, RGB bytes); ValueError for anything that is not a sane picture."""
+    from PIL import Image, UnidentifiedImageError
+
+    if len(data) > MAX_JPEG_BYTES:
+        raise ValueError("the picture is too large")
+    try:
+        with Image.open(io.BytesIO(data)) as img:
+            w, h = img.size
+            if not (0 < w <= MAX_SIDE and 0 < h <= MAX_SIDE):
+                raise ValueError(f"a {w}×{h} picture is out of range")
+            rgb = img.convert("RGB")
+            return w, h, rgb.tobytes()
+    except (UnidentifiedImageError, OSError, Image.DecompressionBombError) as exc:
+        raise ValueError(f"the picture cannot be decoded ({exc})") from None
+
+
+class PictureDecoder:
+    """Decode on one worker thread; ``deliver(image, texture_or_None, error)`` runs on the GTK thread."""
+
+    def __init__(self, deliver: Callable[[CameraImage, Gdk.Texture | None, str], None]) -> None:
+        self._deliver = deliver
+        self._lock = threading.Condition()
+        self._next: CameraImage | None = None
+        self._closed = False
+        self._thread = threading.Thread(target=self._work, name="rtmu-jpeg", daemon=True)
+        self._thread.start()
+
+    def decode(self, image: CameraImage) -> None:
+        with self._lock:
+            self._next = image
+            self._lock.notify()
+
+    def close(self) -> None:
+        with self._lock:
+            self._closed = True
+            self._lock.notify()
+
+    def _work(self) -> None:
+        while True:
+            with self._lock:
+                self._lock.wait_for(lambda: self._closed or self._next is not None)
+                if self._closed:
+                    return
+                image, self._next = self._next, None
+            assert image is not None
+            try:
+                w, h, rgb = decode_jpeg(image.jpeg)
+            except ValueError as exc:
+                GLib.idle_add(self._hand_over, image, None, str(exc))
+            else:
+                GLib.idle_add(self._hand_over, image, (w, h, rgb), "")
+
+    def _hand_over(self, image: CameraImage, pixels: tuple[int, int, bytes] | None, error: str) -> bool:
+        texture = None
+        if pixels is not None:
+            w, h, rgb = pixels
+            texture = Gdk.MemoryTexture.new(w, h, Gdk.MemoryFormat.R8G8B8, GLib.Bytes.new(rgb), w * 3)
+        if not self._closed:
+            self._deliver(image, texture, error)
+        return False
+
+
+class CameraView(Gtk.Box):
+    """The camera page. ``on_request`` asks for a picture; ``on_back`` returns to the map."""
+
+    def __init__(
+        self,
+        *,
+        on_request: Callable[[], None],
+        on_back: Callable[[], None],
+        clock: Callable[[], float] = time.monotonic,
+    ) -> None:
+        super().__init__(orientation=Gtk.Orientation.VERTICAL, spacing=0)
+        self.add_css_class("camera-page")
+        self.clock = clock
+        self._on_request = on_request
+        self.image: CameraImage | None = None
+        self.texture: Gdk.Texture | None = None
+        self.requested_at: float | None = None
+        self.error = ""
+
+        overlay = Gtk.Overlay()
+        overlay.set_vexpand(True)
+        self.picture = Gtk.Picture()
+        self.picture.set_can_shrink(True)
+        if hasattr(self.picture, "set_content_fit"):
+            self.picture.set_content_fit(Gtk.ContentFit.CONTAIN)
+        self.picture.add_css_class("camera-picture")
+        overlay.set_child(self.picture)
+        self.status_box = Gtk.Box(orientation=Gtk.Orientation.VERTICAL, spacing=8)
+        self.status_box.add_css_class("camera-status")
+        self.status_box.set_halign(Gtk.Align.CENTER)
+        self.status_box.set_valign(Gtk.Align.CENTER)
+        self.spinner = Gtk.Spinner()
+        self.spinner.set_size_request(32, 32)
+        self.status_label = Gtk.Label(wrap=True, max_width_chars=40, justify=Gtk.Justification.CENTER)
+        self.status_label.set_use_markup(False)
+        self.status_box.append(self.spinner)
+        self.status_box.append(self.status_label)
+        overlay.add_overlay(self.status_box)
+        self.append(overlay)
+
+        bar = Gtk.Box(orientation=Gtk.Orientation.HORIZONTAL, spacing=8)
+        bar.add_css_class("camera-bar")
+        self.info = Gtk.Label(xalign=0.0, hexpand=True)
+        self.info.set_use_markup(False)
+        self.info.set_ellipsize(3)
+        self.refresh_button = Gtk.Button.new_with_label("New picture")
+        self.refresh_button.set_focusable(False)
+        self.refresh_button.connect("clicked", lambda _b: on_request())
+        back = Gtk.Button.new_with_label("Back to map (Esc)")
+        back.set_focusable(False)
+        back.connect("clicked", lambda _b: on_back())
+        for w in (self.info, self.refresh_button, back):
+            bar.append(w)
+        self.append(bar)
+        self._show_status("No picture yet.", busy=False)
+
+    # -- state -------------------------------------------------------------------------------
+    @property
+    def waiting(self) -> bool:
+        return self.requested_at is not None
+
+    def requesting(self) -> None:
+        """A picture was asked for: show that it is coming (the old one stays, dimmed)."""
+        self.requested_at = self.clock()
+        self.error = ""
+        self.picture.add_css_class("dimmed")
+        self._show_status("Requesting a picture…", busy=True)
+        self.tick()
+
+    def show_picture(self, image: CameraImage, texture: Gdk.Texture | None, error: str) -> None:
+        if texture is None:
+            self.failed(f"The picture could not be shown: {error}")
+            return
+        self.image, self.texture = image, texture
+        self.requested_at = None
+        self.error = ""
+        self.picture.set_paintable(texture)
+        self.picture.remove_css_class("dimmed")
+        self.status_box.set_visible(False)
+        self.spinner.stop()
+        self.tick()
+
+    def failed(self, reason: str) -> None:
+        self.requested_at = None
+        self.error = reason
+        self.picture.remove_css_class("dimmed")
+        self._show_status(reason, busy=False)
+        self.tick()
+
+    def clear(self) -> None:
+        """Disconnected: forget the picture (an old picture must not pass for the robot's view)."""
+        self.image = self.texture = None
+        self.picture.set_paintable(None)
+        self.requested_at = None
+        self._show_status("No picture yet.", busy=False)
+        self.tick()
+
+    def set_available(self, enabled: bool, reason: str) -> None:
+        self.refresh_button.set_sensitive(enabled)
+        self.refresh_button.set_tooltip_text(None if enabled else f"Camera picture: {reason}")
+
+    def tick(self) -> None:
+        """Update the age line; give up on a request that took too long."""
+        now = self.clock()
+        if self.requested_at is not None and now - self.requested_at > REQUEST_TIMEOUT:
+            self.failed(f"No picture arrived within {REQUEST_TIMEOUT:.0f} s.")
+            return
+        if self.image is None:
+            self.info.set_text("Requesting…" if self.waiting else (self.error or "No picture"))
+            return
+        age = max(0.0, now - self.image.received_at)
+        text = f"{self.image.width}×{self.image.height} from {self.image.source} · {_age(age)} old"
+        if self.waiting:
+            text += " · requesting a new one…"
+        self.info.set_text(text)
+
+    def _show_status(self, text: str, *, busy: bool) -> None:
+        self.status_label.set_text(text)
+        self.status_box.set_visible(True)
+        self.spinner.set_visible(busy)
+        if busy:
+            self.spinner.start()
+        else:
+            self.spinner.stop()
+
+
+class CameraInset(Gtk.Box):
+    """The last picture as a small translucent inset on the map; a click opens the camera page."""
+
+    def __init__(self, on_open: Callable[[], None]) -> None:
+        super().__init__()
+        self.add_css_class("camera-inset")
+        self.set_halign(Gtk.Align.END)
+        self.set_valign(Gtk.Align.START)
+        self.set_margin_top(8)
+        self.set_margin_end(8)
+        self.picture = Gtk.Picture()
+        self.picture.set_size_request(168, 126)
+        self.picture.set_can_shrink(True)
+        if hasattr(self.picture, "set_content_fit"):
+            self.picture.set_content_fit(Gtk.ContentFit.CONTAIN)
+        self.append(self.picture)
+        self.set_tooltip_text("Last camera picture (click or Esc for the camera view)")
+        click = Gtk.GestureClick()
+        click.connect("released", lambda *_a: on_open())
+        self.add_controller(click)
+        self.enabled = True
+        self.set_visible(False)
+
+    def show_texture(self, texture: Gdk.Texture | None) -> None:
+        self.picture.set_paintable(texture)
+        self.set_visible(self.enabled and texture is not None)
+
+    def set_enabled(self, on: bool) -> None:
+        self.enabled = on
+        self.set_visible(on and self.picture.get_paintable() is not None)
+
+
+def _age(seconds: float) -> str:
+    if seconds < 60:
+        return f"{seconds:.1f} s"
+    if seconds < 3600:
+        return f"{seconds / 60:.0f} min"
+    return f"{seconds / 3600:.1f} h"

@@ -1,0 +1,411 @@
+"""The map stage: a ``Gtk.DrawingArea`` that blits cached map tiles and draws the robot on top.
+
+Per frame it paints the background, the visible tiles from :class:`TileCache`
+(or the stretched overview where a tile is still being rendered, or a metric
+grid when the server has no map), then cairns, trail, sonar and the robot —
+nothing that scales with the map's size. It reads the model and never writes
+the network; zoom and follow are view state, remembered in ``model.view``.
+
+Input: drag to pan (turns Follow off), scroll or pinch to zoom about the
+pointer, and the zoom/fit/follow methods the window binds to keys and buttons.
+Follow keeps the robot inside the middle of the view (a dead zone, so the map
+does not slide on every status update).
+"""
+
+from __future__ import annotations
+
+import math
+import time
+from collections import deque
+from collections.abc import Callable
+
+import cairo
+import gi
+
+gi.require_version("Gtk", "4.0")
+from gi.repository import GLib, Gtk  # noqa: E402
+
+from ..model import LinkLevel, MapModel, Model, RobotState  # noqa: E402
+from . import overlays  # noqa: E402
+from .tiles import BACKGROUND_RGB, TILE, TileCache  # noqa: E402
+from .viewport import ZOOM_MAX, Viewport, clamp_zoom, fit_view, nearest_step, step_zoom  # noqa: E402
+
+TRAIL_MAX = 1500
+TRAIL_MIN_STEP_MM = 30.0
+FOLLOW_BOX = 0.3
+"""Follow pans when the robot leaves the middle (1 − 2 × 0.3 = 40 %) of the view."""
+STALE_AFTER = 1.0
+"""Seconds without a pose update after which the robot is drawn as stale."""
+FRAME_LOG = 240
+
+
+class MapStage(Gtk.DrawingArea):
+    """See the module notes. ``on_view_changed`` tells the window zoom/follow changed (to update controls)."""
+
+    def __init__(
+        self,
+        model: Model,
+        *,
+        clock: Callable[[], float] = time.monotonic,
+        status_age: Callable[[], float | None] | None = None,
+    ) -> None:
+        super().__init__()
+        self.model = model
+        self.clock = clock
+        self.status_age = status_age
+        self.add_css_class("map-stage")
+        self.set_hexpand(True)
+        self.set_vexpand(True)
+        self.set_focusable(False)
+        self.viewport = Viewport(800, 480, 1.0, 0.0, 0.0)
+        self.follow = model.view.value.follow_robot
+        self.fitted = model.view.value.zoom == 0.0
+        """The zoom is "fit the map" (re-fitted when the widget is resized or a map arrives)."""
+        self.on_view_changed: Callable[[], None] | None = None
+        self.on_first_map_frame: Callable[[float], None] | None = None
+        """Called once per map with the time of the first frame that showed it completely."""
+        self.frame_times: deque[float] = deque(maxlen=FRAME_LOG)
+        """Seconds spent in each recent draw (the benchmark and the GUI tests read them)."""
+        self.frames = 0
+        self.last_frame_complete = False
+        """The last frame showed a map with every visible tile ready."""
+        self.trail: deque[tuple[float, float]] = deque(maxlen=TRAIL_MAX)
+        self.labels = overlays.LabelCache()
+        self.tiles = TileCache(self._tiles_ready_from_worker)
+        self._tiles_pending = False
+        self._map_shown_generation = -1
+        self._objects: list[object] = []
+        self._map_generation = -1
+        self._drag_start: Viewport | None = None
+        self._dragged = False
+        self._pinch_start: Viewport | None = None
+        self._pointer: tuple[float, float] | None = None
+        self._scroll_accum = 0.0
+        self.set_draw_func(self._draw)
+        self._install_input()
+        self._unobserve = [
+            model.robot.observe(self._on_robot),
+            model.map.observe(self._on_map),
+            model.view.observe(self._on_view_options),
+            model.health.observe(lambda old, new: self.queue_draw()),
+        ]
+        self.connect("resize", self._on_resize)
+        self._on_map(MapModel(), model.map.value)
+
+    def close(self) -> None:
+        for remove in self._unobserve:
+            remove()
+        self._unobserve = []
+        self.tiles.close()
+
+    # -- model -------------------------------------------------------------------------------
+    @property
+    def map_data(self) -> object | None:
+        m = self.model.map.value
+        return m.data if m.state == "ready" else None
+
+    def _on_map(self, old: MapModel, new: MapModel) -> None:
+        if new.state == "ready" and new.data is not None:
+            if new.generation != self._map_generation:
+                self._map_generation = new.generation
+                data = new.data
+                self.tiles.set_map(getattr(data, "points", None), getattr(data, "segments", None))
+                self._objects = list(getattr(data, "objects", []))
+                self.trail.clear()
+                if self.fitted:
+                    self._fit_to_map(data)
+                self._keep_robot_visible(centre=not self.fitted)
+        elif new.state != old.state or new.state != "ready":
+            if old.state == "ready" or self._map_generation != -1:
+                self._map_generation = -1
+                self.tiles.set_map(None, None)
+                self._objects = []
+            if new.state in ("none", "unsupported", "unknown") and self.fitted:
+                self._fit_no_map()
+        self.queue_draw()
+
+    def _on_robot(self, old: RobotState, new: RobotState) -> None:
+        if new.numbers_at is None:
+            self.trail.clear()
+        elif (new.x, new.y) != (old.x, old.y):
+            if not self.trail or math.dist(self.trail[-1], (new.x, new.y)) >= TRAIL_MIN_STEP_MM:
+                self.trail.append((new.x, new.y))
+            if self.follow:
+                self._keep_robot_visible()
+        self.queue_draw()
+
+    def _on_view_options(self, old, new) -> None:  # type: ignore[no-untyped-def]
+        """A profile switch (or the controller) changed zoom/follow: apply what differs from ours."""
+        if new.follow_robot != self.follow:
+            self.set_follow(new.follow_robot)
+        if new.zoom == 0.0 and not self.fitted:
+            self.fit()
+        elif new.zoom and abs(new.zoom - self.viewport.zoom) > 1e-6:
+            self.set_zoom(new.zoom)
+        self.queue_draw()
+
+    def robot_is_stale(self) -> bool:
+        r = self.model.robot.value
+        if r.numbers_at is None:
+            return True
+        if self.model.health.value.level is not LinkLevel.OK:
+            return True
+        age = self.status_age() if self.status_age is not None else None
+        return (age if age is not None else self.clock() - r.numbers_at) > STALE_AFTER
+
+    # -- view state --------------------------------------------------------------------------
+    def _publish_view(self) -> None:
+        self.model.view.update(zoom=0.0 if self.fitted else self.viewport.zoom, follow_robot=self.follow)
+        if self.on_view_changed is not None:
+            self.on_view_changed()
+
+    def set_zoom(self, zoom: float, anchor: tuple[float, float] | None = None) -> None:
+        if self.follow and anchor is None and self.model.robot.value.numbers_at is not None:
+            r = self.model.robot.value
+            anchor = self.viewport.to_screen(r.x, r.y)
+        self.viewport = self.viewport.zoomed(clamp_zoom(zoom, allow_fit=zoom < self.viewport.zoom), anchor)
+        self.fitted = False
+        if self.follow:
+            self._keep_robot_visible()
+        self._publish_view()
+        self.queue_draw()
+
+    def zoom_in(self, anchor: tuple[float, float] | None = None) -> None:
+        self.set_zoom(step_zoom(self.viewport.zoom, +1), anchor)
+
+    def zoom_out(self, anchor: tuple[float, float] | None = None) -> None:
+        self.set_zoom(step_zoom(self.viewport.zoom, -1), anchor)
+
+    def fit(self) -> None:
+        """Show the whole map (or 10 m around the robot without one); Follow stays as it is."""
+        self.fitted = True
+        data = self.map_data
+        if data is not None:
+            self._fit_to_map(data)
+        else:
+            self._fit_no_map()
+        self._publish_view()
+        self.queue_draw()
+
+    def set_follow(self, on: bool) -> None:
+        self.follow = on
+        if on:
+            self._keep_robot_visible(centre=True)
+        self._publish_view()
+        self.queue_draw()
+
+    def _fit_to_map(self, data: object) -> None:
+        bounds = self.tiles.bounds or _data_bounds(data)
+        if bounds is None:
+            self._fit_no_map()
+            return
+        vp = fit_view(bounds, self.viewport.width, self.viewport.height)
+        self.viewport = vp
+
+    def _fit_no_map(self) -> None:
+        r = self.model.robot.value
+        self.viewport = fit_view((r.x - 5000, r.y - 5000, r.x + 5000, r.y + 5000), *self._size())
+
+    def _size(self) -> tuple[int, int]:
+        return self.viewport.width, self.viewport.height
+
+    def _keep_robot_visible(self, *, centre: bool = False) -> None:
+        r = self.model.robot.value
+        if r.numbers_at is None or not self.follow:
+            return
+        vp = self.viewport
+        sx, sy = vp.to_screen(r.x, r.y)
+        if centre:
+            self.viewport = vp.centred(r.x, r.y)
+            return
+        mx, my = vp.width * FOLLOW_BOX, vp.height * FOLLOW_BOX
+        dx = min(0.0, sx - mx) + max(0.0, sx - (vp.width - mx))
+        dy = min(0.0, sy - my) + max(0.0, sy - (vp.height - my))
+        if dx or dy:
+            # Re-centre on the robot (one jump, rather than creeping along the edge every update).
+            self.viewport = vp.centred(r.x, r.y)
+
+    def _on_resize(self, _area: Gtk.DrawingArea, width: int, height: int) -> None:
+        self.viewport = self.viewport.sized(width, height)
+        if self.fitted:
+            data = self.map_data
+            if data is not None:
+                self._fit_to_map(data)
+            else:
+                self._fit_no_map()
+            if self.on_view_changed is not None:
+                self.on_view_changed()
+        elif self.follow:
+            self._keep_robot_visible(centre=True)
+
+    # -- tiles -------------------------------------------------------------------------------
+    def _tiles_ready_from_worker(self) -> None:
+        """Worker thread: new tiles; ask for one redraw on the GTK thread."""
+        GLib.idle_add(self._tiles_ready)
+
+    def _tiles_ready(self) -> bool:
+        if self.map_data is not None and self.fitted and self.tiles.bounds is not None:
+            # The index knows the true bounds now (the header's may lie): fit again once.
+            vp = fit_view(self.tiles.bounds, *self._size())
+            if abs(vp.zoom - self.viewport.zoom) > 1e-9 or (vp.cx, vp.cy) != (
+                self.viewport.cx,
+                self.viewport.cy,
+            ):
+                self.viewport = vp
+                if self.on_view_changed is not None:
+                    self.on_view_changed()
+        self.queue_draw()
+        return False
+
+    # -- drawing -----------------------------------------------------------------------------
+    def _draw(self, _area: Gtk.DrawingArea, ctx: cairo.Context, width: int, height: int) -> None:
+        started = time.perf_counter()
+        if (width, height) != self._size():
+            self.viewport = self.viewport.sized(width, height)
+        complete = self.draw_frame(ctx, self.viewport)
+        elapsed = time.perf_counter() - started
+        self.frame_times.append(elapsed)
+        self.frames += 1
+        self.last_frame_complete = complete
+        if complete and self._map_shown_generation != self._map_generation:
+            self._map_shown_generation = self._map_generation
+            if self.on_first_map_frame is not None:
+                self.on_first_map_frame(time.perf_counter())
+
+    def draw_frame(self, ctx: cairo.Context, vp: Viewport) -> bool:
+        """Draw one frame; True when a map is shown with every visible tile ready."""
+        ctx.set_source_rgb(*BACKGROUND_RGB)
+        ctx.paint()
+        state = self.model.map.value.state
+        complete = False
+        if state == "ready" and self.tiles.ready:
+            complete = self._draw_tiles(ctx, vp)
+        else:
+            overlays.draw_grid(ctx, vp)
+        if self._objects:
+            overlays.draw_cairns(ctx, vp, self._objects, self.labels)
+        r = self.model.robot.value
+        if r.numbers_at is not None:
+            overlays.draw_trail(ctx, vp, self.trail)
+            stale = self.robot_is_stale()
+            if self.model.view.value.show_sonar and r.sonar and not stale:
+                overlays.draw_sonar(ctx, vp, (r.x, r.y), r.sonar)
+            overlays.draw_robot(ctx, vp, r.x, r.y, r.th, stale=stale, footprint=state == "ready")
+        return complete
+
+    def _draw_tiles(self, ctx: cairo.Context, vp: Viewport) -> bool:
+        spots = self.tiles.visible(vp.scale, vp.origin, vp.width, vp.height)
+        overview = self.tiles.overview
+        complete = True
+        from .tiles import EMPTY
+
+        for spot in spots:
+            surface = spot.surface
+            if surface is EMPTY:
+                continue
+            if surface is None:
+                complete = False
+                if overview is not None:
+                    self._draw_from_overview(ctx, vp, overview, spot.x, spot.y)
+                continue
+            ctx.set_source_surface(surface, spot.x, spot.y)  # type: ignore[arg-type]
+            ctx.rectangle(spot.x, spot.y, TILE, TILE)
+            ctx.fill()
+        return complete
+
+    @staticmethod
+    def _draw_from_overview(ctx: cairo.Context, vp: Viewport, overview, x: int, y: int) -> None:  # type: ignore[no-untyped-def]
+        ratio = vp.scale / overview.scale
+        ox, oy = vp.origin
+        ctx.save()
+        ctx.rectangle(x, y, TILE, TILE)
+        ctx.clip()
+        ctx.translate(ox, oy)
+        ctx.scale(ratio, ratio)
+        ctx.set_source_surface(overview.surface, overview.gx0, overview.gy0)
+        ctx.get_source().set_filter(cairo.FILTER_FAST)
+        ctx.paint()
+        ctx.restore()
+
+    # -- input -------------------------------------------------------------------------------
+    def _install_input(self) -> None:
+        drag = Gtk.GestureDrag()
+        drag.connect("drag-begin", self._drag_begin)
+        drag.connect("drag-update", self._drag_update)
+        drag.connect("drag-end", self._drag_end)
+        self.add_controller(drag)
+
+        motion = Gtk.EventControllerMotion()
+        motion.connect("motion", lambda _c, x, y: setattr(self, "_pointer", (x, y)))
+        motion.connect("leave", lambda _c: setattr(self, "_pointer", None))
+        self.add_controller(motion)
+
+        scroll = Gtk.EventControllerScroll.new(Gtk.EventControllerScrollFlags.VERTICAL)
+        scroll.connect("scroll", self._scroll)
+        self.add_controller(scroll)
+
+        pinch = Gtk.GestureZoom()
+        pinch.connect("begin", self._pinch_begin)
+        pinch.connect("scale-changed", self._pinch_changed)
+        pinch.connect("end", self._pinch_end)
+        self.add_controller(pinch)
+        drag.group(pinch)
+
+    def _drag_begin(self, _g: Gtk.GestureDrag, _x: float, _y: float) -> None:
+        self._drag_start = self.viewport
+        self._dragged = False
+
+    def _drag_update(self, _g: Gtk.GestureDrag, dx: float, dy: float) -> None:
+        if self._drag_start is None or self._pinch_start is not None:
+            return
+        if not self._dragged and math.hypot(dx, dy) < 6:
+            return
+        if not self._dragged:
+            self._dragged = True
+            self.fitted = False
+            if self.follow:
+                self.follow = False
+                self._publish_view()
+        self.viewport = self._drag_start.panned(dx, dy)
+        self.queue_draw()
+
+    def _drag_end(self, _g: Gtk.GestureDrag, _dx: float, _dy: float) -> None:
+        if self._dragged:
+            self._publish_view()
+        self._drag_start = None
+
+    def _scroll(self, _c: Gtk.EventControllerScroll, _dx: float, dy: float) -> bool:
+        self._scroll_accum += dy
+        steps = int(self._scroll_accum)
+        if steps == 0:
+            return True
+        self._scroll_accum -= steps
+        anchor = None if self.follow else self._pointer
+        self.set_zoom(step_zoom(self.viewport.zoom, -steps), anchor)
+        return True
+
+    def _pinch_begin(self, _g: Gtk.GestureZoom, _seq: object) -> None:
+        self._pinch_start = self.viewport
+
+    def _pinch_changed(self, g: Gtk.GestureZoom, scale: float) -> None:
+        start = self._pinch_start
+        if start is None:
+            return
+        ok, cx, cy = g.get_bounding_box_center()
+        anchor = (cx, cy) if ok and not self.follow else None
+        self.viewport = start.zoomed(min(ZOOM_MAX, start.zoom * scale), anchor)
+        self.fitted = False
+        self.queue_draw()
+
+    def _pinch_end(self, _g: Gtk.GestureZoom, _seq: object) -> None:
+        if self._pinch_start is not None:
+            self.viewport = self.viewport.zoomed(nearest_step(self.viewport.zoom))
+            self._pinch_start = None
+            self._publish_view()
+            self.queue_draw()
+
+
+def _data_bounds(data: object) -> tuple[float, float, float, float] | None:
+    bounds = getattr(data, "bounds", None)
+    b = bounds() if callable(bounds) else None
+    return None if b is None else (float(b[0]), float(b[1]), float(b[2]), float(b[3]))

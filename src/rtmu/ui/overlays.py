@@ -1,0 +1,370 @@
+"""What is drawn over the static map every frame: grid, cairns, trail, sonar and the robot.
+
+Plain cairo (plus PangoCairo for names) on a :class:`~rtmu.ui.viewport.Viewport`,
+no widgets, so the benchmark draws exactly what the window draws. Everything is
+culled to the visible rectangle; names from the server are laid out with
+``Pango.Layout.set_text`` (plain text, never markup) and cached per string.
+"""
+
+from __future__ import annotations
+
+import math
+from collections.abc import Iterable, Sequence
+
+import cairo
+import gi
+
+gi.require_version("Pango", "1.0")
+gi.require_version("PangoCairo", "1.0")
+from gi.repository import Pango, PangoCairo  # noqa: E402
+
+from .viewport import Viewport  # noqa: E402
+
+# A Pioneer 3-DX (ARIA's p3dx parameters): 511 mm long, 210 mm of it in front of the
+# centre of rotation, 425 mm wide, 250 mm radius. The server does not send its size.
+ROBOT_FRONT_MM = 210.0
+ROBOT_REAR_MM = 301.0
+ROBOT_HALF_WIDTH_MM = 212.5
+ROBOT_RADIUS_MM = 250.0
+ROBOT_MIN_PX = 22.0
+"""Below this length the robot is drawn as a marker of this size, so it never vanishes."""
+
+ROBOT_RGB = (0.11, 0.44, 0.85)
+STALE_RGB = (0.55, 0.55, 0.58)
+TRAIL_RGBA = (0.11, 0.44, 0.85, 0.45)
+SONAR_RGB = (0.90, 0.38, 0.0)
+HOME_RGB = (0.15, 0.60, 0.30)
+GOAL_RGB = (0.85, 0.45, 0.0)
+DOCK_RGB = (0.50, 0.30, 0.70)
+FORBIDDEN_RGB = (0.85, 0.10, 0.10)
+AREA_RGB = (0.85, 0.65, 0.0)
+GRID_MINOR = (0.0, 0.0, 0.0, 0.07)
+GRID_MAJOR = (0.0, 0.0, 0.0, 0.16)
+LABEL_MAX_CHARS = 40
+
+
+class LabelCache:
+    """Pango layouts for names, made once per string (a frame only positions them)."""
+
+    def __init__(self, font: str = "Sans 9") -> None:
+        self._context = PangoCairo.FontMap.get_default().create_context()
+        self._font = Pango.FontDescription.from_string(font)
+        self._layouts: dict[str, Pango.Layout] = {}
+
+    def layout(self, text: str) -> Pango.Layout:
+        text = _printable(text)
+        layout = self._layouts.get(text)
+        if layout is None:
+            if len(self._layouts) > 2000:
+                self._layouts.clear()
+            layout = Pango.Layout.new(self._context)
+            layout.set_font_description(self._font)
+            layout.set_text(text, -1)
+            self._layouts[text] = layout
+        return layout
+
+
+def _printable(text: str) -> str:
+    """One line, bounded length, no control characters (names come from the network)."""
+    clean = "".join(ch if ch.isprintable() else " " for ch in text).strip()
+    return clean if len(clean) <= LABEL_MAX_CHARS else clean[: LABEL_MAX_CHARS - 1] + "…"
+
+
+# -- grid (no map) ----------------------------------------------------------------------------------
+
+
+def grid_step_mm(scale: float, min_px: float = 28.0) -> float:
+    """The smallest of 0.1, 0.2, 0.5, 1, 2, 5, 10 … m whose lines are at least ``min_px`` apart."""
+    step = 100.0
+    factors = (2.0, 2.5, 2.0)
+    k = 0
+    while step * scale < min_px:
+        step *= factors[k % 3]
+        k += 1
+    return step
+
+
+def draw_grid(ctx: cairo.Context, vp: Viewport) -> float:
+    """A metric grid (major line every 5 steps); returns the minor step in mm for the legend."""
+    step = grid_step_mm(vp.scale)
+    x0, y0, x1, y1 = vp.visible_world()
+    ctx.save()
+    ctx.set_line_width(1.0)
+    for major in (False, True):
+        ctx.set_source_rgba(*(GRID_MAJOR if major else GRID_MINOR))
+        every = step * 5 if major else step
+        i = math.floor(x0 / every)
+        while i * every <= x1:
+            sx, _ = vp.to_screen(i * every, 0)
+            ctx.move_to(round(sx) + 0.5, 0)
+            ctx.line_to(round(sx) + 0.5, vp.height)
+            i += 1
+        j = math.floor(y0 / every)
+        while j * every <= y1:
+            _, sy = vp.to_screen(0, j * every)
+            ctx.move_to(0, round(sy) + 0.5)
+            ctx.line_to(vp.width, round(sy) + 0.5)
+            j += 1
+        ctx.stroke()
+    ctx.restore()
+    return step
+
+
+# -- cairns -----------------------------------------------------------------------------------------
+
+
+def draw_cairns(ctx: cairo.Context, vp: Viewport, objects: Sequence[object], labels: LabelCache) -> None:
+    """Home, goals (with names), docks, forbidden lines and areas, other areas; off-screen ones skipped."""
+    wx0, wy0, wx1, wy1 = vp.visible_world(margin_px=120)
+    for obj in objects:
+        kind = str(getattr(obj, "type", "")).lower()
+        from_xy = getattr(obj, "from_xy", None)
+        to_xy = getattr(obj, "to_xy", None)
+        if from_xy is not None and to_xy is not None:
+            xs = (from_xy[0], to_xy[0])
+            ys = (from_xy[1], to_xy[1])
+            outside = max(xs) < wx0 or min(xs) > wx1 or max(ys) < wy0 or min(ys) > wy1
+            if outside and not getattr(obj, "th", 0.0):
+                continue
+            if kind.endswith("line"):
+                _draw_forbidden_line(ctx, vp, from_xy, to_xy)
+            else:
+                _draw_area(ctx, vp, obj, from_xy, to_xy, labels, forbidden="forbidden" in kind)
+            continue
+        x, y = float(getattr(obj, "x", 0.0)), float(getattr(obj, "y", 0.0))
+        if not (wx0 <= x <= wx1 and wy0 <= y <= wy1):
+            continue
+        sx, sy = vp.to_screen(x, y)
+        name = str(getattr(obj, "name", ""))
+        th = float(getattr(obj, "th", 0.0))
+        if kind in ("robothome", "home"):
+            _marker(ctx, sx, sy, HOME_RGB, "house")
+            _label(ctx, labels, name or "Home", sx, sy + 10, HOME_RGB)
+        elif kind.startswith("goal"):
+            _marker(ctx, sx, sy, GOAL_RGB, "flag")
+            if kind == "goalwithheading":
+                _heading_tick(ctx, sx, sy, th, GOAL_RGB)
+            _label(ctx, labels, name, sx, sy + 10, GOAL_RGB)
+        elif kind.startswith("dock"):
+            _marker(ctx, sx, sy, DOCK_RGB, "dock")
+            _label(ctx, labels, name or "Dock", sx, sy + 10, DOCK_RGB)
+        else:
+            _marker(ctx, sx, sy, AREA_RGB, "dot")
+            if name:
+                _label(ctx, labels, name, sx, sy + 8, AREA_RGB)
+
+
+def region_corners(
+    obj: object, from_xy: tuple[float, float], to_xy: tuple[float, float]
+) -> list[tuple[float, float]]:
+    """The four corners of a rectangle cairn: the from/to box rotated by ``th`` about the map origin."""
+    (fx, fy), (tx, ty) = from_xy, to_xy
+    th = math.radians(float(getattr(obj, "th", 0.0)))
+    c, s = math.cos(th), math.sin(th)
+    return [(px * c - py * s, px * s + py * c) for px, py in ((fx, fy), (tx, fy), (tx, ty), (fx, ty))]
+
+
+def _draw_area(
+    ctx: cairo.Context,
+    vp: Viewport,
+    obj: object,
+    from_xy: tuple[float, float],
+    to_xy: tuple[float, float],
+    labels: LabelCache,
+    *,
+    forbidden: bool,
+) -> None:
+    rgb = FORBIDDEN_RGB if forbidden else AREA_RGB
+    corners = [vp.to_screen(x, y) for x, y in region_corners(obj, from_xy, to_xy)]
+    ctx.save()
+    ctx.move_to(*corners[0])
+    for c in corners[1:]:
+        ctx.line_to(*c)
+    ctx.close_path()
+    ctx.set_source_rgba(*rgb, 0.16 if forbidden else 0.12)
+    ctx.fill_preserve()
+    ctx.set_source_rgba(*rgb, 0.8)
+    ctx.set_line_width(1.5)
+    ctx.set_dash([6.0, 4.0] if forbidden else [2.0, 3.0])
+    ctx.stroke()
+    ctx.restore()
+    name = str(getattr(obj, "name", ""))
+    if name:
+        cx = sum(c[0] for c in corners) / 4
+        cy = sum(c[1] for c in corners) / 4
+        _label(ctx, labels, name, cx, cy - 6, rgb)
+
+
+def _draw_forbidden_line(
+    ctx: cairo.Context, vp: Viewport, from_xy: tuple[float, float], to_xy: tuple[float, float]
+) -> None:
+    ctx.save()
+    ctx.set_source_rgba(*FORBIDDEN_RGB, 0.9)
+    ctx.set_line_width(3.0)
+    ctx.set_dash([8.0, 5.0])
+    ctx.move_to(*vp.to_screen(*from_xy))
+    ctx.line_to(*vp.to_screen(*to_xy))
+    ctx.stroke()
+    ctx.restore()
+
+
+def _marker(ctx: cairo.Context, sx: float, sy: float, rgb: tuple[float, float, float], shape: str) -> None:
+    ctx.save()
+    ctx.translate(sx, sy)
+    ctx.set_line_width(1.5)
+    if shape == "house":
+        ctx.move_to(0, -9)
+        for px, py in ((8, -1), (6, -1), (6, 7), (-6, 7), (-6, -1), (-8, -1)):
+            ctx.line_to(px, py)
+        ctx.close_path()
+    elif shape == "flag":
+        ctx.move_to(-1, 8)
+        ctx.line_to(-1, -9)
+        ctx.line_to(9, -5)
+        ctx.line_to(-1, -1)
+        ctx.close_path()
+    elif shape == "dock":
+        ctx.rectangle(-7, -5, 14, 10)
+    else:
+        ctx.arc(0, 0, 4, 0, 2 * math.pi)
+    ctx.set_source_rgb(*rgb)
+    ctx.fill_preserve()
+    ctx.set_source_rgba(1, 1, 1, 0.9)
+    ctx.set_line_width(1.0)
+    ctx.stroke()
+    ctx.restore()
+
+
+def _heading_tick(
+    ctx: cairo.Context, sx: float, sy: float, th_deg: float, rgb: tuple[float, float, float]
+) -> None:
+    th = math.radians(th_deg)
+    ctx.save()
+    ctx.set_source_rgb(*rgb)
+    ctx.set_line_width(2.0)
+    ctx.move_to(sx, sy)
+    ctx.line_to(sx + 16 * math.cos(th), sy - 16 * math.sin(th))
+    ctx.stroke()
+    ctx.restore()
+
+
+def _label(
+    ctx: cairo.Context, labels: LabelCache, text: str, sx: float, sy: float, rgb: tuple[float, float, float]
+) -> None:
+    """A name centred under (sx, sy) on a light halo, so it stays legible over walls."""
+    if not text:
+        return
+    layout = labels.layout(text)
+    _ink, logical = layout.get_pixel_extents()
+    w, h = logical.width, logical.height
+    x, y = round(sx - w / 2), round(sy)
+    ctx.save()
+    ctx.set_source_rgba(1, 1, 1, 0.78)
+    ctx.rectangle(x - 3, y - 1, w + 6, h + 2)
+    ctx.fill()
+    ctx.set_source_rgb(*(c * 0.75 for c in rgb))
+    ctx.move_to(x, y)
+    PangoCairo.show_layout(ctx, layout)
+    ctx.restore()
+
+
+# -- trail, sonar, robot ------------------------------------------------------------------------------
+
+
+def draw_trail(ctx: cairo.Context, vp: Viewport, trail: Iterable[tuple[float, float]]) -> None:
+    points = [vp.to_screen(x, y) for x, y in trail]
+    if len(points) < 2:
+        return
+    ctx.save()
+    ctx.set_source_rgba(*TRAIL_RGBA)
+    ctx.set_line_width(3.0)
+    ctx.set_line_join(cairo.LINE_JOIN_ROUND)
+    ctx.set_line_cap(cairo.LINE_CAP_ROUND)
+    ctx.move_to(*points[0])
+    for p in points[1:]:
+        ctx.line_to(*p)
+    ctx.stroke()
+    ctx.restore()
+
+
+def draw_sonar(
+    ctx: cairo.Context, vp: Viewport, robot_xy: tuple[float, float], readings: Iterable[tuple[int, int]]
+) -> None:
+    """Each reading as a dot on a faint ray from the robot."""
+    rx, ry = vp.to_screen(*robot_xy)
+    dots = [vp.to_screen(x, y) for x, y in readings]
+    if not dots:
+        return
+    ctx.save()
+    ctx.set_source_rgba(*SONAR_RGB, 0.22)
+    ctx.set_line_width(1.0)
+    for sx, sy in dots:
+        ctx.move_to(rx, ry)
+        ctx.line_to(sx, sy)
+    ctx.stroke()
+    ctx.set_source_rgba(*SONAR_RGB, 0.95)
+    for sx, sy in dots:
+        ctx.arc(sx, sy, 3.0, 0, 2 * math.pi)
+        ctx.close_path()
+    ctx.fill()
+    ctx.restore()
+
+
+def draw_robot(
+    ctx: cairo.Context,
+    vp: Viewport,
+    x: float,
+    y: float,
+    th_deg: float,
+    *,
+    stale: bool,
+    footprint: bool = True,
+) -> None:
+    """The robot to scale (footprint, or a circle when there is no map) with a heading mark.
+
+    A robot smaller than :data:`ROBOT_MIN_PX` on screen is drawn at that size so it stays findable.
+    """
+    sx, sy = vp.to_screen(x, y)
+    s = vp.scale
+    length_px = (ROBOT_FRONT_MM + ROBOT_REAR_MM) * s
+    k = max(1.0, ROBOT_MIN_PX / length_px) * s  # px per robot-mm
+    th = math.radians(th_deg)
+    rgb = STALE_RGB if stale else ROBOT_RGB
+    ctx.save()
+    ctx.translate(sx, sy)
+    ctx.rotate(-th)  # screen y is down: a counter-clockwise heading turns the other way on screen
+    if footprint:
+        _rounded_rect(ctx, -ROBOT_REAR_MM * k, -ROBOT_HALF_WIDTH_MM * k, (ROBOT_FRONT_MM + ROBOT_REAR_MM) * k,
+                      2 * ROBOT_HALF_WIDTH_MM * k, 60 * k)  # fmt: skip
+    else:
+        ctx.arc(0, 0, ROBOT_RADIUS_MM * k, 0, 2 * math.pi)
+    ctx.set_source_rgba(*rgb, 0.55 if stale else 0.9)
+    ctx.fill_preserve()
+    ctx.set_source_rgba(0.05, 0.1, 0.2, 0.9)
+    ctx.set_line_width(1.5)
+    ctx.stroke()
+    # Heading: a white arrow from the centre to the front.
+    front = (ROBOT_FRONT_MM if footprint else ROBOT_RADIUS_MM) * k
+    ctx.set_source_rgb(1, 1, 1)
+    ctx.set_line_width(max(1.5, 25 * k))
+    ctx.move_to(0, 0)
+    ctx.line_to(front * 0.98, 0)
+    ctx.stroke()
+    tip = front * 0.98
+    head = max(4.0, 90 * k)
+    ctx.move_to(tip, 0)
+    ctx.line_to(tip - head, -head * 0.6)
+    ctx.line_to(tip - head, head * 0.6)
+    ctx.close_path()
+    ctx.fill()
+    ctx.restore()
+
+
+def _rounded_rect(ctx: cairo.Context, x: float, y: float, w: float, h: float, r: float) -> None:
+    r = min(r, w / 2, h / 2)
+    ctx.new_sub_path()
+    ctx.arc(x + w - r, y + r, r, -math.pi / 2, 0)
+    ctx.arc(x + w - r, y + h - r, r, 0, math.pi / 2)
+    ctx.arc(x + r, y + h - r, r, math.pi / 2, math.pi)
+    ctx.arc(x + r, y + r, r, math.pi, 3 * math.pi / 2)
+    ctx.close_path()

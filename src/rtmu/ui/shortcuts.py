@@ -1,0 +1,58 @@
+"""The keyboard-shortcuts window, generated from the one key table in ``keys.BINDINGS``.
+
+GTK 4.8 builds a ``GtkShortcutsWindow`` only from builder XML, so the table is
+written out as XML (escaped) and built; a key added to the table shows up here
+without a second list to keep in step.
+"""
+
+from __future__ import annotations
+
+from xml.sax.saxutils import escape
+
+import gi
+
+gi.require_version("Gtk", "4.0")
+from gi.repository import Gtk  # noqa: E402
+
+from .keys import BINDINGS, Binding  # noqa: E402
+
+
+def shortcuts_xml(bindings: tuple[Binding, ...] = BINDINGS) -> str:
+    groups: dict[str, list[Binding]] = {}
+    for b in bindings:
+        groups.setdefault(b.group, []).append(b)
+    out = [
+        '<?xml version="1.0" encoding="UTF-8"?>',
+        "<interface>",
+        '<object class="GtkShortcutsWindow" id="shortcuts">',
+        '<property name="modal">1</property>',
+        "<child>",
+        '<object class="GtkShortcutsSection">',
+        '<property name="section-name">main</property>',
+        '<property name="max-height">14</property>',
+    ]
+    for title, items in groups.items():
+        out += [
+            "<child>",
+            '<object class="GtkShortcutsGroup">',
+            f'<property name="title">{escape(title)}</property>',
+        ]
+        for b in items:
+            out += [
+                "<child>",
+                '<object class="GtkShortcutsShortcut">',
+                f'<property name="title">{escape(b.title)}</property>',
+                f'<property name="accelerator">{escape(" ".join(b.accels))}</property>',
+                "</object>",
+                "</child>",
+            ]
+        out += ["</object>", "</child>"]
+    out += ["</object>", "</child>", "</object>", "</interface>"]
+    return "\n".join(out)
+
+
+def build_shortcuts_window() -> Gtk.ShortcutsWindow:
+    builder = Gtk.Builder.new_from_string(shortcuts_xml(), -1)
+    window = builder.get_object("shortcuts")
+    assert isinstance(window, Gtk.ShortcutsWindow)
+    return window

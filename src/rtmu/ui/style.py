@@ -1,0 +1,73 @@
+"""RTMU's stylesheet: legible at 800×480 and at arm's length, greyed means stale."""
+
+from __future__ import annotations
+
+import gi
+
+gi.require_version("Gtk", "4.0")
+gi.require_version("Gdk", "4.0")
+from gi.repository import Gdk, Gtk  # noqa: E402
+
+CSS = """
+.status-toolbar { background: @theme_bg_color; border-bottom: 1px solid alpha(black, 0.14);
+                  padding: 1px 4px; }
+.status-toolbar flowboxchild { padding: 0; }
+.status-cell { padding: 1px 5px; border-radius: 6px; }
+.status-cell .caption { font-size: 7.5pt; opacity: 0.62; }
+.status-cell .value { font-size: 10.5pt; font-weight: bold; font-feature-settings: "tnum"; }
+.status-cell.stale .value { opacity: 0.38; font-weight: normal; }
+.status-cell.low .value { color: #b56d00; }
+.status-cell.critical { background: alpha(#c01c28, 0.14); }
+.status-cell.critical .value { color: #c01c28; }
+.status-cell.alarm .value { color: #c01c28; }
+.status-cell.link-ok .value { color: #1e7a3f; }
+.status-cell.link-stale .value { color: #b56d00; opacity: 1; }
+.status-cell.link-lost .value { color: #c01c28; opacity: 1; }
+
+.title-box .title { font-weight: bold; }
+.title-box .subtitle { font-size: 8.5pt; opacity: 0.7; }
+button.connect-button { min-width: 96px; }
+
+.banner { background: alpha(#242424, 0.90); color: white; border-radius: 10px;
+          padding: 4px 4px 4px 12px; box-shadow: 0 2px 8px alpha(black, 0.35); }
+.banner.warning { background: alpha(#9c5300, 0.94); }
+.banner.error { background: alpha(#a51d2d, 0.95); }
+.banner label { font-size: 10.5pt; }
+.banner button { color: white; min-height: 24px; min-width: 24px; }
+.banner levelbar block.filled { background: #62a0ea; }
+
+.map-osd { background: alpha(#242424, 0.62); border-radius: 10px; padding: 3px; }
+.map-osd button, .map-osd label { color: white; }
+.map-osd label.zoom-label { min-width: 56px; font-feature-settings: "tnum"; font-weight: bold; }
+.map-osd togglebutton:checked { background: alpha(#3584e4, 0.85); }
+.map-note { background: alpha(white, 0.88); border-radius: 8px; padding: 6px 12px; color: #333; }
+
+.dpad-button { background: alpha(#242424, 0.45); color: white; border-radius: 16px; }
+.dpad-button.held { background: #1c71d8; box-shadow: 0 0 0 3px alpha(#99c1f1, 0.8); }
+.dpad-button.stop { background: alpha(#c01c28, 0.82); font-weight: bold; }
+.dpad-button:disabled { opacity: 0.35; }
+
+.camera-page { background: #111; color: white; }
+.camera-picture.dimmed { opacity: 0.4; }
+.camera-status { background: alpha(black, 0.6); border-radius: 10px; padding: 12px 18px; }
+.camera-bar { padding: 6px 8px; background: #1d1d1d; }
+.camera-bar button { color: white; background: alpha(white, 0.12); border-color: alpha(white, 0.25);
+                     box-shadow: none; text-shadow: none; }
+.camera-bar button:hover { background: alpha(white, 0.2); }
+.camera-bar button:disabled { color: alpha(white, 0.4); }
+.camera-bar label { color: alpha(white, 0.85); }
+.camera-inset { border: 2px solid alpha(white, 0.85); border-radius: 6px; opacity: 0.86;
+                box-shadow: 0 2px 8px alpha(black, 0.4); background: black; }
+
+.field-error { color: #c01c28; font-size: 9pt; margin-bottom: 4px; }
+entry.error { border-color: #c01c28; }
+"""
+
+
+def install_css() -> None:
+    display = Gdk.Display.get_default()
+    if display is None:
+        return
+    provider = Gtk.CssProvider()
+    provider.load_from_data(CSS, -1)
+    Gtk.StyleContext.add_provider_for_display(display, provider, Gtk.STYLE_PROVIDER_PRIORITY_APPLICATION)

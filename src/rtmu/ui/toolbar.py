@@ -1,0 +1,237 @@
+"""The status toolbar: pose, motion, battery, Wi-Fi, mode, safe drive, throttle and link health.
+
+Values come from the model; :meth:`StatusToolbar.refresh` runs on the window's
+timer as well, because *age* changes without any new value: a value older than
+:data:`STALE_AFTER` (or any value while the link is not OK) is greyed and its
+tooltip says how old it is. Stale data never looks fresh. A value the server
+does not publish (Wi-Fi on most servers) is greyed with a tooltip saying so.
+"""
+
+from __future__ import annotations
+
+import time
+from collections.abc import Callable
+
+import gi
+
+gi.require_version("Gtk", "4.0")
+from gi.repository import Gtk  # noqa: E402
+
+from ..model import ConnectionState, LinkLevel, Model, Phase  # noqa: E402
+from .gauges import BatteryGauge, WifiGauge, battery_fraction, wifi_bars  # noqa: E402
+
+STALE_AFTER = 1.0
+"""Seconds after which a pose/battery value is shown as stale (status arrives at 10 Hz)."""
+DASH = "—"
+
+
+class Cell(Gtk.Box):
+    """A caption over a value, optionally with a small gauge before the value."""
+
+    def __init__(self, caption: str, *, width_chars: int = 5, gauge: Gtk.Widget | None = None) -> None:
+        super().__init__(orientation=Gtk.Orientation.VERTICAL, spacing=0)
+        self.add_css_class("status-cell")
+        self.caption = Gtk.Label(label=caption, xalign=0.0)
+        self.caption.add_css_class("caption")
+        self.value = Gtk.Label(label=DASH, xalign=0.0, width_chars=width_chars)
+        self.value.add_css_class("value")
+        self.value.set_use_markup(False)
+        self.value.set_ellipsize(3)  # Pango.EllipsizeMode.END
+        self.value.set_max_width_chars(max(width_chars, 14))
+        self.append(self.caption)
+        row = Gtk.Box(orientation=Gtk.Orientation.HORIZONTAL, spacing=4)
+        if gauge is not None:
+            row.append(gauge)
+        row.append(self.value)
+        self.append(row)
+        self.stale = False
+
+    def show_value(self, text: str, *, stale: bool, tooltip: str | None = None) -> None:
+        if self.value.get_text() != text:
+            self.value.set_text(text)
+        if stale != self.stale:
+            self.stale = stale
+            if stale:
+                self.add_css_class("stale")
+            else:
+                self.remove_css_class("stale")
+        self.set_tooltip_text(tooltip)
+
+
+class StatusToolbar(Gtk.Box):
+    """One row of cells; the mode cell gives way (ellipsizes) first when the window is narrow.
+
+    ``status_age()`` returns the seconds since the last status packet (the
+    network side measures it: a robot standing still publishes no new values,
+    so the model alone cannot tell fresh from old); None falls back to the time
+    of the last value change.
+    """
+
+    def __init__(
+        self,
+        model: Model,
+        *,
+        clock: Callable[[], float] = time.monotonic,
+        status_age: Callable[[], float | None] | None = None,
+    ) -> None:
+        super().__init__(orientation=Gtk.Orientation.HORIZONTAL, spacing=0)
+        self.model = model
+        self.clock = clock
+        self.status_age = status_age
+        self.add_css_class("status-toolbar")
+        self.set_can_focus(False)
+        self.battery_gauge = BatteryGauge()
+        self.wifi_gauge = WifiGauge()
+        self.cells: dict[str, Cell] = {
+            "x": Cell("X m", width_chars=5),
+            "y": Cell("Y m", width_chars=5),
+            "th": Cell("Heading", width_chars=4),
+            "vel": Cell("mm/s", width_chars=4),
+            "rot": Cell("deg/s", width_chars=3),
+            "battery": Cell("Battery", width_chars=5, gauge=self.battery_gauge),
+            "wifi": Cell("Wi-Fi", width_chars=4, gauge=self.wifi_gauge),
+            "mode": Cell("Mode · status", width_chars=6),
+            "safe": Cell("Safe", width_chars=3),
+            "speed": Cell("Throttle", width_chars=4),
+            "link": Cell("Link: rtt, age", width_chars=11),
+        }
+        for cell in self.cells.values():
+            self.append(cell)
+        self.cells["mode"].set_hexpand(True)
+        self._unobserve = [
+            model.robot.observe(lambda o, n: self.refresh()),
+            model.health.observe(lambda o, n: self.refresh()),
+            model.connection.observe(lambda o, n: self.refresh()),
+            model.speed.observe(lambda o, n: self.refresh()),
+        ]
+        self.refresh()
+
+    def close(self) -> None:
+        for remove in self._unobserve:
+            remove()
+        self._unobserve = []
+
+    def refresh(self) -> None:
+        """Show the model's values and how old they are (called on changes and by the window's timer)."""
+        now = self.clock()
+        robot = self.model.robot.value
+        conn: ConnectionState = self.model.connection.value
+        health = self.model.health.value
+        link_ok = conn.phase is Phase.CONNECTED and health.level is LinkLevel.OK
+        age = self._age(now)
+        have = age is not None
+        stale = not have or not link_ok or (age is not None and age > STALE_AFTER)
+        why = _stale_reason(have, age, conn, health.level)
+        c = self.cells
+        c["x"].show_value(f"{robot.x / 1000:.2f}" if have else DASH, stale=stale, tooltip=why)
+        c["y"].show_value(f"{robot.y / 1000:.2f}" if have else DASH, stale=stale, tooltip=why)
+        c["th"].show_value(f"{robot.th:.0f}°" if have else DASH, stale=stale, tooltip=why)
+        c["vel"].show_value(f"{robot.vel:.0f}" if have else DASH, stale=stale, tooltip=why)
+        c["rot"].show_value(f"{robot.rot_vel:.0f}" if have else DASH, stale=stale, tooltip=why)
+        self._battery(robot, stale, why)
+        self._wifi(robot, have and link_ok, why)
+        strings_known = robot.strings_at is not None and (robot.mode or robot.status)
+        mode = robot.mode if robot.status in ("", robot.mode) else f"{robot.mode} · {robot.status}"
+        mode_tip = robot.extended_status or mode
+        c["mode"].show_value(
+            mode if strings_known else DASH,
+            stale=not strings_known or not link_ok,
+            tooltip=(why + "\n" if why and strings_known else "") + mode_tip if strings_known else why,
+        )
+        if robot.safe_drive is None:
+            c["safe"].show_value(DASH, stale=True, tooltip="The server has not said whether safe drive is on")
+        else:
+            c["safe"].show_value("On" if robot.safe_drive else "OFF", stale=not link_ok, tooltip=why)
+            if robot.safe_drive:
+                c["safe"].remove_css_class("alarm")
+            else:
+                c["safe"].add_css_class("alarm")
+        c["speed"].show_value(f"{self.model.speed.value.percent} %", stale=False, tooltip="+ / − to change")
+        self._link(conn, health, age)
+
+    def _age(self, now: float) -> float | None:
+        numbers_at = self.model.robot.value.numbers_at
+        if numbers_at is None:
+            return None
+        measured = self.status_age() if self.status_age is not None else None
+        return max(0.0, measured if measured is not None else now - numbers_at)
+
+    def _battery(self, robot, stale: bool, why: str | None) -> None:  # type: ignore[no-untyped-def]
+        cell = self.cells["battery"]
+        if robot.battery_v is None:
+            cell.show_value(DASH, stale=True, tooltip=why or "No battery reading")
+            self.battery_gauge.set_level(0.0, "unknown")
+            return
+        unit = "%" if robot.battery_is_soc else "V"
+        text = f"{robot.battery_v:.0f} %" if robot.battery_is_soc else f"{robot.battery_v:.1f} V"
+        state = robot.battery_state
+        levels = []
+        if robot.battery_low is not None:
+            levels.append(f"low at {robot.battery_low:g} {unit}")
+        if robot.battery_shutdown is not None:
+            levels.append(f"shutdown at {robot.battery_shutdown:g} {unit}")
+        tip = {"low": "Battery LOW", "critical": "Battery at SHUTDOWN level"}.get(state, "Battery")
+        tip += f" ({', '.join(levels)})" if levels else ""
+        cell.show_value(text, stale=stale, tooltip=(why + "\n" + tip) if why else tip)
+        for cls in ("low", "critical"):
+            if cls == state and not stale:
+                cell.add_css_class(cls)
+            else:
+                cell.remove_css_class(cls)
+        fraction = battery_fraction(robot.battery_v, robot.battery_shutdown, is_soc=robot.battery_is_soc)
+        self.battery_gauge.set_level(fraction, "stale" if stale else state)
+
+    def _wifi(self, robot, live: bool, why: str | None) -> None:  # type: ignore[no-untyped-def]
+        cell = self.cells["wifi"]
+        q, s = robot.wifi_quality, robot.wifi_signal
+        if q is None and s is None:
+            cell.show_value(DASH, stale=True, tooltip="The server does not publish Wi-Fi quality or signal")
+            self.wifi_gauge.set_bars(0, False)
+            return
+        text = f"{q} %" if q is not None else f"{s} dBm"
+        parts = [f"quality {q} %" if q is not None else "", f"signal {s} dBm" if s is not None else ""]
+        tip = "Wi-Fi " + ", ".join(p for p in parts if p)
+        cell.show_value(text, stale=not live, tooltip=(why + "\n" + tip) if why and not live else tip)
+        self.wifi_gauge.set_bars(wifi_bars(q, s), live)
+
+    def _link(self, conn: ConnectionState, health, age: float | None) -> None:  # type: ignore[no-untyped-def]
+        cell = self.cells["link"]
+        for level in LinkLevel:
+            cell.remove_css_class(f"link-{level.value}")
+        if conn.phase is not Phase.CONNECTED:
+            text = {Phase.CONNECTING: "connecting", Phase.RECONNECTING: "reconnecting"}.get(
+                conn.phase, "down"
+            )
+            cell.show_value(text, stale=True, tooltip=f"Not connected ({conn.phase.value})")
+            cell.add_css_class(f"link-{LinkLevel.DOWN.value}")
+            return
+        rtt = (
+            DASH
+            if health.rtt_ms is None
+            else f"{health.rtt_ms:.1f} ms"
+            if health.rtt_ms < 10
+            else f"{health.rtt_ms:.0f} ms"
+        )
+        age_text = DASH if age is None else f"{age:.1f} s"
+        tip = (
+            f"Link {health.level.value}: round trip {rtt}, last status {age_text} ago, "
+            f"{health.dropped} bad packets dropped"
+        )
+        cell.show_value(f"{rtt} {age_text}", stale=health.level is not LinkLevel.OK, tooltip=tip)
+        cell.add_css_class(f"link-{health.level.value}")
+
+
+def _stale_reason(have: bool, age: float | None, conn: ConnectionState, level: LinkLevel) -> str | None:
+    if conn.phase is not Phase.CONNECTED:
+        return f"Not connected: the last known values ({conn.phase.value})" if have else "Not connected"
+    if not have:
+        return "No status from the robot yet"
+    if level is not LinkLevel.OK:
+        return (
+            f"Link {level.value}: no fresh status for {age:.1f} s"
+            if age is not None
+            else f"Link {level.value}"
+        )
+    if age is not None and age > STALE_AFTER:
+        return f"No update for {age:.1f} s"
+    return None

@@ -1,0 +1,643 @@
+"""The main window: header bar, status toolbar, map ⇄ camera stack, banners, D-pad; the controller's View.
+
+The window wires widgets to the controller and the model and owns nothing
+else: no socket, no packet, no blocking call. Its two timers are the UI's
+heartbeat: every :data:`rtmu.controller.TICK` it renews the drive lease
+(``controller.tick``) — if this loop ever stalls, the lease lapses and the
+network side stops the robot — and a slower one refreshes ages (stale values,
+picture age).
+
+Banners have topics (see ``banners``): the connection's life (connecting,
+connected, failed, lost → reconnecting (n)) is drawn from the model into ONE
+``link`` banner updated in place; the controller's own sentences about the same
+events are folded into it instead of stacking; a deliberate disconnect shows
+nothing.
+"""
+
+from __future__ import annotations
+
+import time
+from collections.abc import Callable, Mapping
+
+import gi
+
+gi.require_version("Gtk", "4.0")
+gi.require_version("Gdk", "4.0")
+from gi.repository import Gdk, Gio, GLib, Gtk  # noqa: E402
+
+from ..commands import COMMANDS, CommandState  # noqa: E402
+from ..controller import TICK, ClientLink, Controller, Notice, SecretStore  # noqa: E402
+from ..model import SPEED_MAX, SPEED_MIN, ConnectionState, MapModel, Model, Phase, SpeedSetting  # noqa: E402
+from ..settings import Profile  # noqa: E402
+from .banners import BannerStack  # noqa: E402
+from .camera import CameraInset, CameraView, PictureDecoder  # noqa: E402
+from .dpad import DPad  # noqa: E402
+from .keys import KeyRouter  # noqa: E402
+from .mapview import MapStage  # noqa: E402
+from .move_dialogs import go_dialog, turn_dialog  # noqa: E402
+from .settings_dialog import ConnectionDialog, PasswordPrompt  # noqa: E402
+from .shortcuts import build_shortcuts_window  # noqa: E402
+from .toolbar import StatusToolbar  # noqa: E402
+from .viewport import zoom_label  # noqa: E402
+
+REFRESH_EVERY = 3
+"""Ticks between refreshes of ages (toolbar, picture): 0.3 s."""
+_LINK_WORDS = ("Connected to", "Link lost", "Reconnecting", "Connection cancelled")
+
+
+def touch_only(display: Gdk.Display | None = None) -> bool:
+    """True when the only pointing device is a touchscreen (a tablet): then the D-pad shows by default."""
+    display = display or Gdk.Display.get_default()
+    seat = display.get_default_seat() if display is not None else None
+    if seat is None:
+        return False
+    caps = seat.get_capabilities()
+    if not caps & Gdk.SeatCapabilities.TOUCH:
+        return False
+    pointers = [
+        d
+        for d in seat.get_devices(Gdk.SeatCapabilities.POINTER)
+        if d.get_source() in (Gdk.InputSource.MOUSE, Gdk.InputSource.TOUCHPAD, Gdk.InputSource.TRACKPOINT)
+    ]
+    return not pointers
+
+
+class _View:
+    """The controller's ``View`` (a separate object: ``notify`` is a GObject method on the window)."""
+
+    def __init__(self, window: MainWindow) -> None:
+        self.window = window
+
+    def notify(self, level: Notice, text: str) -> None:
+        self.window.show_notice(level, text)
+
+    def commands_changed(self, states: Mapping[str, CommandState]) -> None:
+        self.window.commands_changed(states)
+
+    def ask_password(self, profile: Profile, answer: Callable[[str | None], None]) -> None:
+        self.window.ask_password(profile, answer)
+
+
+class MainWindow(Gtk.ApplicationWindow):
+    """See the module notes. ``profile_saved(profile, password)`` is the app's hook for settings."""
+
+    def __init__(
+        self,
+        app: Gtk.Application,
+        model: Model,
+        link: ClientLink,
+        *,
+        profile: Profile,
+        profiles: Mapping[str, Profile] | None = None,
+        secrets: SecretStore | None = None,
+        keyring_available: bool = False,
+        profile_saved: Callable[[Profile, str | None], None] | None = None,
+        clock: Callable[[], float] = time.monotonic,
+    ) -> None:
+        super().__init__(application=app, title="RTMU")
+        self.set_default_size(800, 480)
+        self.set_size_request(480, 320)
+        self.model = model
+        self.clock = clock
+        self.profiles = dict(profiles or {})
+        self.keyring_available = keyring_available
+        self._profile_saved = profile_saved
+        self._passwords: dict[str, str] = {}
+        self.ticks = 0
+        """Counts timer ticks: proof for tests that the main loop is alive."""
+        self._states: dict[str, CommandState] = {}
+        self._dialog: Gtk.Window | None = None
+
+        status_age = getattr(link, "status_age", None)
+        self.banners = BannerStack()
+        self.stage = MapStage(model, clock=clock, status_age=status_age)
+        self.stage.on_view_changed = self._view_changed
+        self.toolbar = StatusToolbar(model, clock=clock, status_age=status_age)
+        self.camera = CameraView(on_request=self._request_picture, on_back=self.show_map, clock=clock)
+        self.inset = CameraInset(self.show_camera)
+        self.decoder = PictureDecoder(self._picture_decoded)
+        self.dpad = DPad(hold=self._hold, release=self._release, stop=lambda: self.controller.run("stop"))
+        self.keys = KeyRouter(
+            hold=self._hold, release=self._release, command=self._command, view=self.view_intent
+        )
+        self.add_controller(self.keys.controller)
+
+        self._build()
+        self.controller = Controller(model, link, _View(self), clock=clock, secrets=secrets, profile=profile)
+        self.controller.select_profile(profile)
+        self._set_speed_from_profile(profile)
+        self._install_actions()
+        self.set_help_overlay(build_shortcuts_window())
+
+        self._unobserve = [
+            model.connection.observe(self._on_connection),
+            model.speed.observe(self._on_speed),
+            model.camera.observe(self._on_camera),
+            model.map.observe(self._on_map),
+        ]
+        self.connect("notify::is-active", self._on_active)
+        self.connect("close-request", self._on_close_request)
+        self._tick_source = GLib.timeout_add(int(TICK * 1000), self._tick)
+        self.commands_changed(self.controller.command_states())
+        self._on_connection(ConnectionState(), model.connection.value)
+        self._on_map(MapModel(), model.map.value)
+        self._view_changed()
+
+    # -- layout ------------------------------------------------------------------------------
+    def _build(self) -> None:
+        header = Gtk.HeaderBar()
+        self.connect_button = Gtk.Button(label="Connect")
+        self.connect_button.add_css_class("connect-button")
+        self.connect_button.set_focusable(False)
+        self.connect_button.connect("clicked", lambda _b: self.toggle_connection())
+        header.pack_start(self.connect_button)
+        title_box = Gtk.Box(orientation=Gtk.Orientation.VERTICAL, valign=Gtk.Align.CENTER)
+        title_box.add_css_class("title-box")
+        self.title_label = Gtk.Label(label="RTMU")
+        self.title_label.add_css_class("title")
+        self.subtitle_label = Gtk.Label(label="")
+        self.subtitle_label.add_css_class("subtitle")
+        self.subtitle_label.set_ellipsize(3)
+        self.subtitle_label.set_max_width_chars(48)
+        title_box.append(self.title_label)
+        title_box.append(self.subtitle_label)
+        header.set_title_widget(title_box)
+        menu_button = Gtk.MenuButton(icon_name="open-menu-symbolic", tooltip_text="Menu")
+        menu_button.set_focusable(False)
+        menu_button.set_menu_model(self._menu())
+        header.pack_end(menu_button)
+        self.camera_button = Gtk.ToggleButton(icon_name="camera-photo-symbolic")
+        self.camera_button.set_focusable(False)
+        self.camera_button.set_tooltip_text("Camera picture (Esc)")
+        self.camera_button.connect("clicked", self._camera_button_clicked)
+        header.pack_end(self.camera_button)
+        self.set_titlebar(header)
+
+        self.toolbar_revealer = Gtk.Revealer(transition_type=Gtk.RevealerTransitionType.SLIDE_DOWN)
+        self.toolbar_revealer.set_transition_duration(120)
+        self.toolbar_revealer.set_child(self.toolbar)
+        self.toolbar_revealer.set_reveal_child(True)
+
+        map_page = Gtk.Overlay()
+        map_page.set_child(self.stage)
+        map_page.add_overlay(self._osd())
+        map_page.add_overlay(self.dpad)
+        map_page.add_overlay(self.inset)
+        self.map_note = Gtk.Label(halign=Gtk.Align.CENTER, valign=Gtk.Align.END, visible=False)
+        self.map_note.add_css_class("map-note")
+        self.map_note.set_margin_bottom(14)
+        self.map_note.set_use_markup(False)
+        self.map_note.set_can_target(False)
+        map_page.add_overlay(self.map_note)
+        self.dpad.set_visible(touch_only())
+
+        self.stack = Gtk.Stack(transition_type=Gtk.StackTransitionType.NONE)
+        self.stack.add_named(map_page, "map")
+        self.stack.add_named(self.camera, "camera")
+        self.stack.set_visible_child_name("map")
+        outer = Gtk.Overlay()
+        outer.set_child(self.stack)
+        outer.add_overlay(self.banners)
+
+        box = Gtk.Box(orientation=Gtk.Orientation.VERTICAL)
+        box.append(self.toolbar_revealer)
+        box.append(outer)
+        outer.set_vexpand(True)
+        self.set_child(box)
+
+    def _osd(self) -> Gtk.Widget:
+        """Zoom −/label/+, Fit and Follow: big enough for a thumb, over the map's bottom right."""
+        osd = Gtk.Box(spacing=2, halign=Gtk.Align.END, valign=Gtk.Align.END)
+        osd.add_css_class("map-osd")
+        osd.set_margin_end(10)
+        osd.set_margin_bottom(10)
+
+        def button(icon: str, tip: str, fn: Callable[[], None]) -> Gtk.Button:
+            b = Gtk.Button(icon_name=icon, tooltip_text=tip)
+            b.add_css_class("flat")
+            b.set_focusable(False)
+            b.connect("clicked", lambda _b: fn())
+            return b
+
+        osd.append(button("zoom-out-symbolic", "Zoom out (Ctrl+minus)", self.stage.zoom_out))
+        self.zoom_label = Gtk.Label(label="100 %")
+        self.zoom_label.add_css_class("zoom-label")
+        osd.append(self.zoom_label)
+        osd.append(button("zoom-in-symbolic", "Zoom in (Ctrl+plus)", self.stage.zoom_in))
+        osd.append(button("zoom-fit-best-symbolic", "Fit map (Ctrl+0)", self.stage.fit))
+        self.follow_button = Gtk.ToggleButton(
+            icon_name="find-location-symbolic", tooltip_text="Follow the robot (F)"
+        )
+        self.follow_button.add_css_class("flat")
+        self.follow_button.set_focusable(False)
+        self.follow_button.set_active(self.stage.follow)
+        self.follow_button.connect("toggled", self._follow_toggled)
+        osd.append(self.follow_button)
+        return osd
+
+    def _menu(self) -> Gio.Menu:
+        menu = Gio.Menu()
+        conn = Gio.Menu()
+        conn.append("Connection settings…", "win.settings")
+        menu.append_section(None, conn)
+        view = Gio.Menu()
+        view.append("Show toolbar", "win.toolbar")
+        view.append("Full screen", "win.fullscreen")
+        view.append("Touch D-pad", "win.dpad")
+        view.append("Camera inset on the map", "win.inset")
+        view.append("Sonar readings", "win.sonar")
+        menu.append_section(None, view)
+        robot = Gio.Menu()
+        robot.append("Turn by an angle…", "win.turn")
+        robot.append("Go a distance…", "win.go")
+        robot.append("Camera picture", "win.camera")
+        robot.append("Safe drive", "win.safe-drive")
+        menu.append_section(None, robot)
+        app = Gio.Menu()
+        app.append("Keyboard shortcuts", "win.show-help-overlay")
+        app.append("About RTMU", "win.about")
+        app.append("Quit", "app.quit")
+        menu.append_section(None, app)
+        return menu
+
+    def _install_actions(self) -> None:
+        def plain(name: str, fn: Callable[[], None]) -> Gio.SimpleAction:
+            action = Gio.SimpleAction.new(name, None)
+            action.connect("activate", lambda _a, _p: fn())
+            self.add_action(action)
+            return action
+
+        def toggle(name: str, initial: bool, fn: Callable[[bool], None]) -> Gio.SimpleAction:
+            action = Gio.SimpleAction.new_stateful(name, None, GLib.Variant.new_boolean(initial))
+
+            def flip(a: Gio.SimpleAction, _p: object) -> None:
+                new = not a.get_state().get_boolean()
+                a.set_state(GLib.Variant.new_boolean(new))
+                fn(new)
+
+            action.connect("activate", flip)
+            self.add_action(action)
+            return action
+
+        plain("settings", self.open_settings)
+        plain("connect", self.connect_now)
+        plain("disconnect", lambda: self.controller.run("disconnect"))
+        plain("turn", lambda: self.view_intent("turn_dialog"))
+        plain("go", lambda: self.view_intent("go_dialog"))
+        plain("camera", lambda: self.view_intent("toggle_camera"))
+        plain("about", self.show_about)
+        self.toolbar_action = toggle("toolbar", True, self.toolbar_revealer.set_reveal_child)
+        self.fullscreen_action = toggle("fullscreen", False, self._set_fullscreen)
+        self.dpad_action = toggle("dpad", self.dpad.get_visible(), self.dpad.set_visible)
+        self.inset_action = toggle("inset", True, self.inset.set_enabled)
+        self.sonar_action = toggle("sonar", self.model.view.value.show_sonar, self._set_sonar)
+        self.safe_action = toggle("safe-drive", True, self._set_safe_drive)
+        self.connect("notify::fullscreened", self._fullscreen_changed)
+
+    # -- the controller's View -----------------------------------------------------------------
+    def show_notice(self, level: Notice, text: str) -> None:
+        """Show a controller/network message; connection and speed messages fold into their banners."""
+        phase = self.model.connection.value.phase
+        if text.startswith(_LINK_WORDS) or (text and text == self.model.connection.value.error):
+            return  # the link banner shows the connection's life from the model
+        if text.startswith("Reconnected to"):
+            self.banners.show("link", "info", text, timeout=4.0)
+        elif text.startswith("Stopped: the link"):
+            if phase is Phase.CONNECTED:
+                self.banners.show("link", "warning", text, timeout=None)
+        elif text.startswith("Speed is already"):
+            pct = self.model.speed.value.percent
+            limit = "maximum" if pct >= SPEED_MAX else "minimum"
+            self.banners.show("speed", "warning", f"Speed at its {limit}: {pct} %", timeout=2.5,
+                              fraction=pct / SPEED_MAX)  # fmt: skip
+        elif text.startswith("Speed "):
+            return  # the speed banner follows the model
+        elif "camera" in text.lower() or "picture" in text.lower():
+            if self.camera.waiting:
+                self.camera.failed(text)
+            self.banners.show("camera", level.value, text, timeout=5.0)
+        else:
+            self.banners.show(
+                f"notice:{text}", level.value, text, timeout=6.0 if level is Notice.ERROR else 4.0
+            )
+
+    def commands_changed(self, states: Mapping[str, CommandState]) -> None:
+        self._states.update(states)
+        for name, state in states.items():
+            label = COMMANDS.get(name).label if name in COMMANDS else name
+            self.dpad.set_command_state(name, state.enabled, state.reason, label)
+            if name == "request_image":
+                self.camera_button.set_sensitive(
+                    state.enabled or self.stack.get_visible_child_name() == "camera"
+                )
+                self.camera_button.set_tooltip_text(
+                    "Camera picture (Esc)" if state.enabled else f"Camera picture: {state.reason}"
+                )
+                self.camera.set_available(state.enabled, state.reason)
+                self._enable("camera", state.enabled or self.stack.get_visible_child_name() == "camera")
+            elif name == "turn_left_90":
+                self._enable("turn", state.enabled)
+            elif name == "move_forward_1m":
+                self._enable("go", state.enabled)
+            elif name == "safe_drive_on":
+                self._enable("safe-drive", state.enabled)
+            elif name in ("connect", "disconnect"):
+                self._enable(name, state.enabled)
+
+    def ask_password(self, profile: Profile, answer: Callable[[str | None], None]) -> None:
+        remembered = self._passwords.get(profile.name)
+        if remembered is not None:
+            answer(remembered)
+            return
+        prompt = PasswordPrompt(self, profile, answer)
+        prompt.present()
+
+    def command_state(self, name: str) -> CommandState:
+        return self._states.get(name, CommandState(False, "unknown command"))
+
+    def _enable(self, action: str, enabled: bool) -> None:
+        a = self.lookup_action(action)
+        if isinstance(a, Gio.SimpleAction):
+            a.set_enabled(enabled)
+
+    # -- intents -------------------------------------------------------------------------------
+    def _hold(self, name: str) -> None:
+        if self.stack.get_visible_child_name() == "camera":
+            self.show_map()  # driving blind from a still picture is not allowed to surprise anyone
+        self.controller.run(name)
+
+    def _release(self, name: str) -> None:
+        self.controller.release_command(name)
+
+    def _command(self, name: str) -> None:
+        self.controller.run(name)
+
+    def view_intent(self, name: str) -> None:
+        """Window-level intents from keys, menu and buttons."""
+        if name == "toggle_camera":
+            if self.stack.get_visible_child_name() == "camera":
+                self.show_map()
+            else:
+                self.show_camera(request=True)
+        elif name == "turn_dialog":
+            self._open_move_dialog("turn_left_90", lambda: turn_dialog(self, self.controller.turn_by))
+        elif name == "go_dialog":
+            self._open_move_dialog("move_forward_1m", lambda: go_dialog(self, self.controller.move_distance))
+        elif name == "zoom_in":
+            self.stage.zoom_in()
+        elif name == "zoom_out":
+            self.stage.zoom_out()
+        elif name == "zoom_fit":
+            self.stage.fit()
+        elif name == "follow":
+            self.stage.set_follow(not self.stage.follow)
+
+    def _open_move_dialog(self, command: str, make: Callable[[], Gtk.Window]) -> None:
+        state = self.command_state(command)
+        if not state.enabled:
+            label = "Turn by an angle" if command.startswith("turn") else "Go a distance"
+            self.banners.show(f"notice:{command}", "warning", f"{label}: {state.reason}", timeout=4.0)
+            return
+        self.controller.stop()
+        dialog = make()
+        dialog.present()
+
+    def toggle_connection(self) -> None:
+        phase = self.model.connection.value.phase
+        if phase in (Phase.DISCONNECTED, Phase.FAILED):
+            self.connect_now()
+        else:
+            self.controller.disconnect()
+
+    def connect_now(self) -> None:
+        profile = self.controller.profile
+        self.controller.connect(password=self._passwords.get(profile.name))
+
+    def show_camera(self, request: bool = False) -> None:
+        state = self.command_state("request_image")
+        if request and not state.enabled:
+            self.banners.show("camera", "warning", f"Camera picture: {state.reason}", timeout=4.0)
+            self.camera_button.set_active(False)
+            return
+        self.controller.stop()
+        self.stack.set_visible_child_name("camera")
+        self.camera_button.set_active(True)
+        if request or self.camera.image is None:
+            self._request_picture()
+
+    def show_map(self) -> None:
+        self.stack.set_visible_child_name("map")
+        self.camera_button.set_active(False)
+        self.commands_changed({"request_image": self.command_state("request_image")})
+
+    def _camera_button_clicked(self, button: Gtk.ToggleButton) -> None:
+        showing = self.stack.get_visible_child_name() == "camera"
+        if button.get_active() != showing:
+            self.view_intent("toggle_camera")
+
+    def _request_picture(self) -> None:
+        if self.controller.run("request_image"):
+            self.camera.requesting()
+
+    # -- model reactions ---------------------------------------------------------------------
+    def _on_connection(self, old: ConnectionState, new: ConnectionState) -> None:
+        where = f"{new.host}:{new.port}" if new.host else ""
+        phase = new.phase
+        if phase is Phase.CONNECTING and old.phase is not Phase.CONNECTING:
+            self.banners.show("link", "info", f"Connecting to {where}…", timeout=None)
+        elif phase is Phase.CONNECTED and old.phase is not Phase.CONNECTED:
+            if old.phase is Phase.RECONNECTING:
+                self.banners.show(
+                    "link", "info", f"Reconnected to {where}: press a key to drive again", timeout=4.0
+                )
+            else:
+                self.banners.show("link", "info", f"Connected to {where}", timeout=3.0)
+        elif phase is Phase.RECONNECTING:
+            count = f" ({new.attempt})" if new.attempt else ""
+            self.banners.show("link", "warning", f"Link lost — reconnecting{count}…", timeout=None)
+        elif phase is Phase.FAILED and (new.error != old.error or old.phase is not Phase.FAILED):
+            lost = old.phase in (Phase.CONNECTED, Phase.RECONNECTING)
+            reason = new.error or "no reason given"
+            text = f"Link lost: {reason}" if lost else f"Could not connect to {where}: {reason}"
+            self.banners.show("link", "error", text, timeout=10.0)
+        elif phase is Phase.DISCONNECTED and old.phase is not Phase.DISCONNECTED:
+            self.banners.dismiss("link")  # deliberate: no banner at all
+        if phase is Phase.DISCONNECTED or (phase is Phase.CONNECTING and old.phase is not Phase.RECONNECTING):
+            self.camera.clear()
+            self.inset.show_texture(None)
+            if self.stack.get_visible_child_name() == "camera":
+                self.show_map()
+        # Held keys stay held in the key router (their auto-repeat is swallowed); the controller
+        # has blocked them, so only a fresh press drives after the link comes back.
+        self._update_header(new)
+
+    def _update_header(self, conn: ConnectionState) -> None:
+        phase = conn.phase
+        connected_ish = phase in (Phase.CONNECTED, Phase.CONNECTING, Phase.RECONNECTING)
+        self.connect_button.set_label("Disconnect" if connected_ish else "Connect")
+        for cls in ("suggested-action", "destructive-action"):
+            self.connect_button.remove_css_class(cls)
+        self.connect_button.add_css_class("destructive-action" if connected_ish else "suggested-action")
+        self.connect_button.set_tooltip_text(
+            "Disconnect (Ctrl+D); stops the robot first" if connected_ish else "Connect (Ctrl+O)"
+        )
+        profile = self.controller.profile
+        where = f"{conn.host}:{conn.port}" if conn.host else f"{profile.host}:{profile.port}"
+        state = {
+            Phase.DISCONNECTED: "not connected",
+            Phase.CONNECTING: "connecting…",
+            Phase.CONNECTED: "connected",
+            Phase.RECONNECTING: f"reconnecting ({conn.error})" if conn.error else "reconnecting",
+            Phase.FAILED: f"failed: {conn.error}" if conn.error else "failed",
+        }[phase]
+        name = self.model.map.value.name.replace("\\", "/").rsplit("/", 1)[-1]
+        parts = ([profile.name] if profile.name != where else []) + [where, state]
+        parts += [name] if name and phase is Phase.CONNECTED else []
+        self.subtitle_label.set_text(" · ".join(parts))
+
+    def _on_map(self, _old: MapModel, new: MapModel) -> None:
+        conn = self.model.connection.value
+        text = ""
+        if conn.phase is not Phase.CONNECTED:
+            text = "" if conn.phase is Phase.RECONNECTING else "Not connected: press Connect (Ctrl+O)"
+        elif new.state == "loading":
+            text = f"Loading the map… ({new.received} packets)" if new.received else "Loading the map…"
+        elif new.state in ("none", "unsupported"):
+            text = "The server has no map: robot and 1 m grid only"
+        elif new.state == "failed":
+            text = f"The map could not be loaded: {new.error}"
+        self.map_note.set_text(text)
+        self.map_note.set_visible(bool(text))
+        self._update_header(conn)
+
+    def _on_speed(self, _old: SpeedSetting, new: SpeedSetting) -> None:
+        self.banners.show(
+            "speed", "info", f"Speed {new.percent} %", timeout=2.5, fraction=new.percent / SPEED_MAX
+        )
+
+    def _on_camera(self, _old: object, new: object) -> None:
+        if new is not None:
+            self.decoder.decode(new)  # type: ignore[arg-type]
+
+    def _picture_decoded(self, image: object, texture: Gdk.Texture | None, error: str) -> None:
+        current = self.model.camera.value
+        if current is None or image is not current:
+            return  # a newer picture (or a disconnect) overtook this one
+        self.camera.show_picture(image, texture, error)  # type: ignore[arg-type]
+        if texture is not None:
+            self.inset.show_texture(texture)
+
+    def _view_changed(self) -> None:
+        label = "Fit" if self.stage.fitted else ""
+        self.zoom_label.set_text(
+            zoom_label(self.stage.viewport.zoom)
+            if not label
+            else f"{label} {zoom_label(self.stage.viewport.zoom)}"
+        )
+        if self.follow_button.get_active() != self.stage.follow:
+            self.follow_button.set_active(self.stage.follow)
+
+    def _follow_toggled(self, button: Gtk.ToggleButton) -> None:
+        if button.get_active() != self.stage.follow:
+            self.stage.set_follow(button.get_active())
+
+    # -- toggles -------------------------------------------------------------------------------
+    def _set_fullscreen(self, on: bool) -> None:
+        if on:
+            self.fullscreen()
+        else:
+            self.unfullscreen()
+
+    def _fullscreen_changed(self, *_a: object) -> None:
+        state = self.is_fullscreen()
+        if self.fullscreen_action.get_state().get_boolean() != state:
+            self.fullscreen_action.set_state(GLib.Variant.new_boolean(state))
+
+    def _set_sonar(self, on: bool) -> None:
+        self.model.view.update(show_sonar=on)
+
+    def _set_safe_drive(self, on: bool) -> None:
+        self.controller.run("safe_drive_on" if on else "safe_drive_off")
+
+    def set_toolbar_visible(self, on: bool) -> None:
+        self.toolbar_revealer.set_reveal_child(on)
+        self.toolbar_action.set_state(GLib.Variant.new_boolean(on))
+
+    def _set_speed_from_profile(self, profile: Profile) -> None:
+        pct = max(SPEED_MIN, min(SPEED_MAX, profile.speed // 10 * 10))
+        self.model.speed.set(SpeedSetting(pct))
+
+    # -- dialogs -------------------------------------------------------------------------------
+    def open_settings(self) -> None:
+        profiles = dict(self.profiles)
+        current = self.controller.profile
+        profiles.setdefault(current.name, current)
+        dialog = ConnectionDialog(
+            self, profiles, current, on_save=self._settings_saved, keyring_available=self.keyring_available
+        )
+        self._dialog = dialog
+        dialog.present()
+
+    def _settings_saved(self, profile: Profile, password: str | None) -> None:
+        self.profiles[profile.name] = profile
+        if password is not None:
+            self._passwords[profile.name] = password
+        if self._profile_saved is not None:
+            self._profile_saved(profile, password)
+        changed = profile != self.controller.profile
+        self.controller.select_profile(profile)
+        self._update_header(self.model.connection.value)
+        if changed and self.model.connection.value.phase is not Phase.DISCONNECTED:
+            self.banners.show(
+                "notice:saved", "info", f"Saved “{profile.name}”: reconnect to use it", timeout=4.0
+            )
+
+    def show_about(self) -> None:
+        from .. import __version__
+
+        about = Gtk.AboutDialog(
+            transient_for=self,
+            modal=True,
+            program_name="RTMU",
+            version=__version__,
+            comments="Robot Teleoperation, Mobile User interface: drive an ARIA (ArNetworking) robot "
+            "from a tablet or a laptop.",
+            logo_icon_name="io.github.rtmu.Rtmu",
+            license_type=Gtk.License.MIT_X11,
+        )
+        about.present()
+
+    # -- focus, timers, closing ----------------------------------------------------------------
+    def _on_active(self, *_a: object) -> None:
+        if not self.is_active():
+            self.controller.focus_lost()
+            self.keys.release_all()
+            self.dpad.release_all()
+
+    def _tick(self) -> bool:
+        self.ticks += 1
+        self.controller.tick()
+        if self.ticks % REFRESH_EVERY == 0:
+            self.toolbar.refresh()
+            self.camera.tick()
+            if self.stage.robot_is_stale() and self.model.robot.value.numbers_at is not None:
+                self.stage.queue_draw()
+        return True
+
+    def _on_close_request(self, _w: Gtk.Window) -> bool:
+        """Closing while driving stops the robot first; then the app shuts the network down."""
+        self.controller.stop()
+        self.shutdown()
+        return False
+
+    def shutdown(self) -> None:
+        """Stop timers and workers (idempotent)."""
+        if self._tick_source:
+            GLib.source_remove(self._tick_source)
+            self._tick_source = 0
+        for remove in self._unobserve:
+            remove()
+        self._unobserve = []
+        self.stage.close()
+        self.toolbar.close()
+        self.decoder.close()

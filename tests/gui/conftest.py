@@ -1,0 +1,131 @@
+"""GUI tests: one Xvfb for the session, the real app, the real simulator, real key events (xdotool).
+
+The display is started when this file is loaded — before any test module
+imports GTK — and ``DISPLAY``/``GSK_RENDERER=cairo`` are exported (the cairo
+renderer gives the same pixels on every machine). Settings go to a temporary
+``XDG_CONFIG_HOME``. Every test saves PNGs of the window into one folder,
+printed at the start and at the end of the run.
+
+No wait here is open-ended: ``pump`` and ``xdotool`` fail after a timeout, and
+each app is shut down and its window destroyed after its test.
+"""
+
+from __future__ import annotations
+
+import atexit
+import os
+import shutil
+import subprocess
+import tempfile
+import time
+from pathlib import Path
+
+import pytest
+
+REPO = Path(__file__).resolve().parents[2]
+_XVFB = shutil.which("Xvfb")
+_XDOTOOL = shutil.which("xdotool")
+_proc: subprocess.Popen[bytes] | None = None
+SKIP_REASON = ""
+
+
+def _start_xvfb() -> str | None:
+    """Start Xvfb on a free display number; returns ':N' or None."""
+    global _proc
+    read_fd, write_fd = os.pipe()
+    _proc = subprocess.Popen(
+        [
+            _XVFB or "Xvfb",
+            "-displayfd",
+            str(write_fd),
+            "-screen",
+            "0",
+            "1280x1024x24",
+            "-nolisten",
+            "tcp",
+            "-noreset",
+        ],
+        pass_fds=(write_fd,),
+        stdout=subprocess.DEVNULL,
+        stderr=subprocess.DEVNULL,
+    )
+    os.close(write_fd)
+    deadline = time.monotonic() + 15
+    data = b""
+    os.set_blocking(read_fd, False)
+    while time.monotonic() < deadline and not data.endswith(b"\n"):
+        try:
+            chunk = os.read(read_fd, 16)
+        except BlockingIOError:
+            time.sleep(0.02)
+            if _proc.poll() is not None:
+                break
+            continue
+        if not chunk:
+            break
+        data += chunk
+    os.close(read_fd)
+    if not data.strip():
+        _stop_xvfb()
+        return None
+    atexit.register(_stop_xvfb)
+    return f":{data.strip().decode()}"
+
+
+def _stop_xvfb() -> None:
+    global _proc
+    proc, _proc = _proc, None
+    if proc is not None and proc.poll() is None:
+        proc.terminate()
+        try:
+            proc.wait(5)
+        except subprocess.TimeoutExpired:
+            proc.kill()
+
+
+if _XVFB is None or _XDOTOOL is None:
+    SKIP_REASON = "Xvfb and xdotool are needed for the GUI tests (apt-get install xvfb xdotool)"
+else:
+    display = _start_xvfb()
+    if display is None:
+        SKIP_REASON = "Xvfb did not start"
+    else:
+        os.environ["DISPLAY"] = display
+        os.environ.pop("WAYLAND_DISPLAY", None)
+        os.environ["GDK_BACKEND"] = "x11"
+        os.environ["GSK_RENDERER"] = "cairo"
+        os.environ["NO_AT_BRIDGE"] = "1"
+        os.environ["GSETTINGS_BACKEND"] = "memory"
+        os.environ["XDG_CONFIG_HOME"] = tempfile.mkdtemp(prefix="rtmu-gui-config-")
+
+SCREENSHOTS = Path(
+    os.environ.get("RTMU_SCREENSHOTS")
+    or Path(tempfile.gettempdir()) / f"rtmu-gui-screens-{time.strftime('%Y%m%d-%H%M%S')}"
+)
+
+
+def pytest_report_header(config: pytest.Config) -> list[str]:
+    if SKIP_REASON:
+        return [f"rtmu gui: skipped ({SKIP_REASON})"]
+    return [f"rtmu gui: Xvfb on {os.environ.get('DISPLAY')}, screenshots in {SCREENSHOTS}"]
+
+
+def pytest_collection_modifyitems(config: pytest.Config, items: list[pytest.Item]) -> None:
+    here = Path(__file__).parent
+    for item in items:
+        if here in Path(str(item.fspath)).parents:
+            item.add_marker(pytest.mark.gui)
+            if SKIP_REASON:
+                item.add_marker(pytest.mark.skip(reason=SKIP_REASON))
+
+
+def pytest_terminal_summary(terminalreporter, exitstatus: int, config: pytest.Config) -> None:  # type: ignore[no-untyped-def]
+    if SCREENSHOTS.is_dir():
+        shots = sorted(SCREENSHOTS.glob("*.png"))
+        terminalreporter.write_line(f"rtmu gui: {len(shots)} screenshots in {SCREENSHOTS}")
+
+
+@pytest.fixture(scope="session")
+def screenshots() -> Path:
+    SCREENSHOTS.mkdir(parents=True, exist_ok=True)
+    return SCREENSHOTS

@@ -1,0 +1,169 @@
+"""Drive the real RTMU window in-process: pump its main loop, press real keys, take screenshots.
+
+The test thread *is* the GTK thread: :meth:`Gui.pump` iterates the default
+main context until a condition holds or a timeout fails the test, so nothing
+here can hang. Keys go through the X server with xdotool (started without
+waiting; the loop keeps running while it types).
+"""
+
+from __future__ import annotations
+
+import subprocess
+import tempfile
+import time
+from collections.abc import Callable
+from pathlib import Path
+
+import gi
+import numpy as np
+
+gi.require_version("Gtk", "4.0")
+gi.require_version("Gdk", "4.0")
+gi.require_version("GdkX11", "4.0")
+gi.require_version("Graphene", "1.0")
+from gi.repository import GdkX11, GLib, Graphene, Gtk  # noqa: E402
+from PIL import Image  # noqa: E402
+
+from rtmu.model import Phase  # noqa: E402
+from rtmu.ui.app import GuiOptions  # noqa: E402
+from rtmu.ui.application import RtmuApplication  # noqa: E402
+from rtmu.ui.window import MainWindow  # noqa: E402
+
+REPO = Path(__file__).resolve().parents[2]
+OFFICE_MAP = REPO / "data" / "maps" / "office.map"
+
+
+def pump(condition: Callable[[], bool], timeout: float = 5.0, what: str = "condition") -> None:
+    """Run the GTK main loop until ``condition()`` is true; fail after ``timeout`` seconds."""
+    ctx = GLib.MainContext.default()
+    deadline = time.monotonic() + timeout
+    while True:
+        while ctx.pending():
+            ctx.iteration(False)
+        if condition():
+            return
+        if time.monotonic() > deadline:
+            raise AssertionError(f"timed out after {timeout:g} s waiting for {what}")
+        ctx.iteration(False) or time.sleep(0.004)
+
+
+def idle(seconds: float) -> None:
+    """Let the main loop run for ``seconds`` (used only where the point is that time passes)."""
+    end = time.monotonic() + seconds
+    pump(lambda: time.monotonic() >= end, seconds + 5, "time to pass")
+
+
+class Gui:
+    """One RTMU application connected to a simulator, and what a test does with it."""
+
+    def __init__(self, app: RtmuApplication, shots: Path, name: str) -> None:
+        self.app = app
+        self.shots = shots
+        self.name = name
+        self._shot_no = 0
+
+    @classmethod
+    def start(cls, shots: Path, name: str, host: str, port: int, *, connect: bool = True) -> Gui:
+        settings = Path(tempfile.mkdtemp(prefix="rtmu-gui-settings-")) / "settings.toml"
+        options = GuiOptions(
+            host=host, port=port, settings_path=settings, persist=False, connect=None if connect else False
+        )
+        app = RtmuApplication(options)
+        app.register(None)
+        app.activate()
+        gui = cls(app, shots, name)
+        pump(lambda: app.window is not None and app.window.get_mapped(), 10, "the window to be mapped")
+        gui.focus()
+        if connect:
+            gui.wait_connected()
+        return gui
+
+    # -- accessors ---------------------------------------------------------------------------
+    @property
+    def window(self) -> MainWindow:
+        assert self.app.window is not None
+        return self.app.window
+
+    @property
+    def model(self):  # type: ignore[no-untyped-def]
+        return self.window.model
+
+    @property
+    def stage(self):  # type: ignore[no-untyped-def]
+        return self.window.stage
+
+    @property
+    def phase(self) -> Phase:
+        return self.model.connection.value.phase
+
+    def wait_connected(self, timeout: float = 10.0) -> None:
+        pump(lambda: self.phase is Phase.CONNECTED, timeout, "the connection")
+        pump(lambda: self.model.map.value.state in ("ready", "none", "unsupported"), timeout, "the map")
+        pump(lambda: self.model.robot.value.numbers_at is not None, timeout, "the first robot status")
+        if self.model.map.value.state == "ready":
+            pump(lambda: self.stage.last_frame_complete, timeout, "a frame with the whole map drawn")
+
+    # -- keys ----------------------------------------------------------------------------------
+    def xid(self) -> int:
+        return GdkX11.X11Surface.get_xid(self.window.get_surface())
+
+    def xdotool(self, *args: str, timeout: float = 10.0) -> None:
+        proc = subprocess.Popen(["xdotool", *args], stdout=subprocess.DEVNULL, stderr=subprocess.PIPE)
+        try:
+            pump(lambda: proc.poll() is not None, timeout, f"xdotool {' '.join(args)}")
+        finally:
+            if proc.poll() is None:
+                proc.kill()
+                proc.wait(2)
+        assert proc.returncode == 0, (
+            f"xdotool {args} failed: {proc.stderr.read().decode() if proc.stderr else ''}"
+        )
+
+    def focus(self) -> None:
+        self.xdotool("windowfocus", "--sync", str(self.xid()))
+        pump(self.window.is_active, 5, "the window to have the keyboard focus")
+
+    def key(self, *names: str) -> None:
+        self.xdotool("key", "--delay", "30", *names)
+
+    def keydown(self, name: str) -> None:
+        self.xdotool("keydown", name)
+
+    def keyup(self, name: str) -> None:
+        self.xdotool("keyup", name)
+
+    # -- pictures ------------------------------------------------------------------------------
+    def render(self, widget: Gtk.Widget, path: Path) -> Path:
+        """``widget`` as it looks now, to a PNG (the renderer of its window, as GTK itself draws it)."""
+        idle(0.05)
+        w, h = widget.get_width(), widget.get_height()
+        snapshot = Gtk.Snapshot()
+        Gtk.WidgetPaintable.new(widget).snapshot(snapshot, w, h)
+        node = snapshot.to_node()
+        assert node is not None, "nothing drawn"
+        renderer = widget.get_native().get_renderer()
+        texture = renderer.render_texture(node, Graphene.Rect().init(0, 0, w, h))
+        texture.save_to_png(str(path))
+        return path
+
+    def shot(self, label: str) -> Path:
+        """Save the whole window as ``<test>-<n>-<label>.png`` in the screenshot folder."""
+        self._shot_no += 1
+        path = self.shots / f"{self.name}-{self._shot_no:02d}-{label}.png"
+        return self.render(self.window, path)
+
+    def stage_pixels(self) -> np.ndarray:
+        """The map stage as an (H, W, 3) uint8 array in its own coordinates."""
+        path = Path(tempfile.mkdtemp(prefix="rtmu-stage-")) / "stage.png"
+        self.render(self.stage, path)
+        with Image.open(path) as img:
+            return np.asarray(img.convert("RGB"))
+
+    # -- teardown ------------------------------------------------------------------------------
+    def close(self) -> None:
+        app = self.app
+        windows = list(app.get_windows())
+        app.close_session()
+        for w in windows:
+            w.destroy()
+        pump(lambda: not app.get_windows(), 5, "the windows to go")

@@ -1,0 +1,254 @@
+"""The real window against the real simulator, with real key presses through the X server.
+
+Each test leaves PNGs of the window in the screenshot folder the run prints.
+Motion is real time (the simulator runs on its own clock); every wait has a
+timeout, and what is checked is the simulator's own state, not the window's
+idea of it.
+"""
+
+from __future__ import annotations
+
+import math
+from collections.abc import Iterator
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+from rtmu.model import Phase
+from rtmu.sim import SimConfig, SimThread
+
+from .harness import OFFICE_MAP, Gui, idle, pump
+
+
+@pytest.fixture
+def sim() -> Iterator[SimThread]:
+    with SimThread(SimConfig(port=0, map_path=OFFICE_MAP, camera=True, seed=1)) as s:
+        yield s
+
+
+@pytest.fixture
+def gui(request: pytest.FixtureRequest, screenshots: Path, sim: SimThread) -> Iterator[Gui]:
+    g = Gui.start(screenshots, request.node.name, "127.0.0.1", sim.port)
+    try:
+        yield g
+    finally:
+        g.close()
+
+
+def received(sim: SimThread) -> tuple[float, float, float, float] | None:
+    """The last ratioDrive the simulator received (trans, rot, throttle, lat)."""
+    return sim.call(lambda: sim.server.robot.received_ratios)
+
+
+def moving(sim: SimThread) -> bool:
+    return abs(sim.snapshot().vel) > 1.0
+
+
+def stopped(sim: SimThread) -> bool:
+    snap = sim.snapshot()
+    return abs(snap.vel) < 1e-6 and abs(snap.rot_vel) < 1e-6 and snap.trans_ratio == 0
+
+
+def dark(pixels: np.ndarray, x: float, y: float, radius: int = 2) -> bool:
+    """A map-wall-dark pixel near (x, y)."""
+    xi, yi = round(x), round(y)
+    patch = pixels[max(0, yi - radius) : yi + radius + 1, max(0, xi - radius) : xi + radius + 1].astype(int)
+    return bool((patch.sum(axis=2) < 3 * 90).any())
+
+
+def robot_blue(pixels: np.ndarray, x: float, y: float, radius: int = 2) -> bool:
+    xi, yi = round(x), round(y)
+    patch = pixels[max(0, yi - radius) : yi + radius + 1, max(0, xi - radius) : xi + radius + 1].astype(int)
+    r, g, b = patch[..., 0], patch[..., 1], patch[..., 2]
+    return bool(((b > 170) & (r < 90) & (b - g > 60)).any())
+
+
+# -- connect and draw -------------------------------------------------------------------------------
+
+
+def test_connects_and_draws_the_map_walls_and_the_robot_where_the_simulator_has_it(
+    gui: Gui, sim: SimThread
+) -> None:
+    gui.shot("connected")
+    pixels = gui.stage_pixels()
+    vp = gui.stage.viewport
+    data = gui.model.map.value.data
+    # A known wall: every segment of the office map is a wall; sample along the first ten.
+    hits = 0
+    tried = 0
+    for x0, y0, x1, y1 in np.asarray(data.segments)[:10].tolist():
+        for t in (0.3, 0.5, 0.7):
+            sx, sy = vp.to_screen(x0 + t * (x1 - x0), y0 + t * (y1 - y0))
+            if 3 <= sx < vp.width - 3 and 3 <= sy < vp.height - 3:
+                tried += 1
+                hits += dark(pixels, sx, sy)
+    assert tried >= 10 and hits >= 0.8 * tried, f"{hits}/{tried} wall samples are dark"
+    # Empty floor is not dark: the middle of the corridor.
+    sx, sy = vp.to_screen(8000, 6000)
+    assert not dark(pixels, sx, sy, radius=0)
+    # The robot, drawn where the simulator says it is (a point on its body behind the heading mark).
+    snap = sim.snapshot()
+    th = math.radians(snap.th)
+    sx, sy = vp.to_screen(snap.x - 120 * math.cos(th), snap.y - 120 * math.sin(th))
+    assert robot_blue(pixels, sx, sy), "no fresh (blue) robot at the simulator's pose"
+    # The toolbar shows the same pose, fresh.
+    assert gui.window.toolbar.cells["x"].value.get_text() == f"{snap.x / 1000:.2f}"
+    assert not gui.window.toolbar.cells["x"].stale
+
+
+# -- driving with real keys ---------------------------------------------------------------------------
+
+
+def test_holding_up_drives_forward_and_releasing_stops(gui: Gui, sim: SimThread) -> None:
+    start = sim.snapshot()
+    gui.keydown("Up")
+    try:
+        pump(lambda: sim.snapshot().x > start.x + 150, 8, "the robot to drive 150 mm forward")
+        assert received(sim)[0] > 0  # type: ignore[index]
+        gui.shot("driving")
+    finally:
+        gui.keyup("Up")
+    pump(lambda: stopped(sim), 8, "the robot to stop after the key was released")
+    assert gui.window.controller.held == frozenset()
+    gui.shot("released")
+
+
+def test_space_stops_even_while_a_drive_key_is_still_held(gui: Gui, sim: SimThread) -> None:
+    gui.keydown("Up")
+    try:
+        pump(lambda: moving(sim), 8, "the robot to move")
+        gui.key("space")
+        pump(lambda: stopped(sim), 8, "Space to stop the robot")
+        idle(0.6)  # the key is still down: the robot must stay still (lease ended, no resend)
+        assert stopped(sim)
+        gui.shot("stopped-with-up-held")
+    finally:
+        gui.keyup("Up")
+
+
+def test_plus_and_minus_change_the_throttle_the_simulator_receives(gui: Gui, sim: SimThread) -> None:
+    assert gui.model.speed.value.percent == 50
+    gui.key("plus")
+    pump(lambda: gui.model.speed.value.percent == 60, 3, "the speed to rise to 60 %")
+    assert gui.window.banners.text("speed") == "Speed 60 %"
+    gui.shot("speed-banner")
+    gui.keydown("Up")
+    try:
+        pump(lambda: (received(sim) or (0, 0, 0, 0))[2] == 60, 5, "ratioDrive with throttle 60")
+    finally:
+        gui.keyup("Up")
+    pump(lambda: stopped(sim), 8, "the robot to stop")
+    gui.key("minus", "minus", "minus")
+    pump(lambda: gui.model.speed.value.percent == 30, 3, "the speed to drop to 30 %")
+    gui.keydown("Up")
+    try:
+        pump(lambda: (received(sim) or (0, 0, 0, 0))[2] == 30, 5, "ratioDrive with throttle 30")
+    finally:
+        gui.keyup("Up")
+
+
+# -- views --------------------------------------------------------------------------------------------
+
+
+def test_escape_shows_the_camera_picture_and_escape_returns_to_the_map(gui: Gui) -> None:
+    window = gui.window
+    gui.key("Escape")
+    pump(lambda: window.stack.get_visible_child_name() == "camera", 3, "the camera page")
+    pump(lambda: window.camera.texture is not None, 8, "the picture to arrive and be decoded")
+    assert "getPicture" in window.camera.info.get_text()
+    gui.shot("camera")
+    gui.key("Escape")
+    pump(lambda: window.stack.get_visible_child_name() == "map", 3, "the map page")
+    pump(lambda: window.inset.get_visible(), 3, "the picture inset on the map")
+    gui.shot("map-with-inset")
+
+
+def test_ctrl_t_toggles_the_status_toolbar(gui: Gui) -> None:
+    revealer = gui.window.toolbar_revealer
+    assert revealer.get_reveal_child()
+    gui.key("ctrl+t")
+    pump(
+        lambda: not revealer.get_reveal_child() and not revealer.get_child_revealed(),
+        3,
+        "the toolbar to hide",
+    )
+    gui.shot("toolbar-hidden")
+    gui.key("ctrl+t")
+    pump(lambda: revealer.get_reveal_child() and revealer.get_child_revealed(), 3, "the toolbar to show")
+    gui.shot("toolbar-shown")
+
+
+# -- connection life ----------------------------------------------------------------------------------
+
+
+def test_disconnect_and_reconnect_without_restarting(gui: Gui, sim: SimThread) -> None:
+    window = gui.window
+    gui.key("ctrl+d")
+    pump(lambda: gui.phase is Phase.DISCONNECTED, 3, "the disconnect")
+    assert window.banners.text("link") is None, "a deliberate disconnect shows no banner"
+    assert window.connect_button.get_label() == "Connect"
+    assert window.toolbar.cells["x"].stale
+    gui.shot("disconnected")
+    gui.key("ctrl+o")
+    gui.wait_connected()
+    gui.shot("reconnected")
+    start = sim.snapshot()
+    gui.keydown("Up")
+    try:
+        pump(lambda: sim.snapshot().x > start.x + 100, 8, "driving after the reconnect")
+    finally:
+        gui.keyup("Up")
+    pump(lambda: stopped(sim), 8, "the robot to stop")
+
+
+def test_simulator_killed_while_driving(gui: Gui, sim: SimThread) -> None:
+    """Lost link: one banner counting attempts, robot stopped, window alive; then only a new press drives."""
+    window = gui.window
+    port = sim.port
+    gui.keydown("Up")
+    try:
+        pump(lambda: moving(sim), 8, "the robot to move")
+        sim.kill()
+        pump(lambda: gui.phase is Phase.RECONNECTING, 5, "the client to notice the lost link")
+        pump(
+            lambda: (window.banners.text("link") or "").startswith("Link lost — reconnecting"),
+            3,
+            "the banner",
+        )
+        assert window.controller.held == frozenset(), "held keys are dropped when the link goes"
+        assert not window.controller.link.lease.view().live, "no drive lease survives the lost link"
+        ticks = window.ticks
+        idle(1.0)
+        assert window.ticks >= ticks + 5, "the main loop keeps ticking"
+        pump(lambda: gui.model.connection.value.attempt >= 2, 10, "a second reconnect attempt")
+        texts = [window.banners.text(t) for t in window.banners.topics()]
+        assert sum("Link lost" in (t or "") for t in texts) == 1, texts
+        assert (
+            window.banners.text("link") == f"Link lost — reconnecting ({gui.model.connection.value.attempt})…"
+        )
+        gui.shot("link-lost")
+        # The robot comes back on the same port; the key is STILL held, yet nothing moves.
+        with SimThread(SimConfig(port=port, map_path=OFFICE_MAP, seed=1)) as again:
+            gui.wait_connected(timeout=20)
+            idle(0.8)
+            assert stopped(again), "a key held through a reconnect must not drive"
+            assert received(again) is None
+            gui.shot("reconnected-key-still-held")
+            gui.keyup("Up")
+            gui.keydown("Up")
+            pump(lambda: moving(again), 8, "a fresh press to drive again")
+            gui.keyup("Up")
+            pump(lambda: stopped(again), 8, "the robot to stop")
+    finally:
+        gui.keyup("Up")
+
+
+def test_closing_the_window_while_driving_stops_the_robot(gui: Gui, sim: SimThread) -> None:
+    gui.keydown("Up")
+    try:
+        pump(lambda: moving(sim), 8, "the robot to move")
+        gui.window.close()
+        pump(lambda: stopped(sim), 8, "the robot to stop when the window closes")
+    finally:
+        gui.keyup("Up")
