@@ -11,4 +11,52 @@ One job per module:
 * ``runner``     — :class:`ClientRunner`: the network thread and its thread-safe facade for a UI.
 
 Nothing here imports GTK.
+
+Wiring a window (what the GTK view does)::
+
+    model = Model()
+    runner = ClientRunner(model, post=GLib.idle_add).start()     # network thread
+    controller = Controller(model, runner, view)                   # UI thread
+    GLib.timeout_add(100, lambda: controller.tick() or True)       # renews the drive lease at 10 Hz
+    controller.select_profile(settings.current()); controller.connect()
+    ...
+    runner.close()                                                 # stops the robot, disconnects
+
+Scripts without a UI use :class:`AriaClient` directly under ``asyncio.run`` (see ``rtmu.subcommands``).
 """
+
+from .connection import AriaClient, Packet, Reply
+from .errors import (
+    ClientError,
+    ClientTimeout,
+    ConnectionFailed,
+    ConnectionRefused,
+    LoginRejected,
+    NotSupported,
+    ProtocolFault,
+    ServerClosed,
+)
+from .lease import DriveLease, DriveRatios, EndReason
+from .runner import ClientRunner, call_directly
+from .session import Session, SessionConfig
+
+__all__ = [
+    "AriaClient",
+    "ClientError",
+    "ClientRunner",
+    "ClientTimeout",
+    "ConnectionFailed",
+    "ConnectionRefused",
+    "DriveLease",
+    "DriveRatios",
+    "EndReason",
+    "LoginRejected",
+    "NotSupported",
+    "Packet",
+    "ProtocolFault",
+    "Reply",
+    "ServerClosed",
+    "Session",
+    "SessionConfig",
+    "call_directly",
+]
