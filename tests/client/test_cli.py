@@ -4,6 +4,7 @@ from __future__ import annotations
 
 import io
 import json
+import time
 from collections.abc import Iterator
 from pathlib import Path
 
@@ -193,3 +194,26 @@ def test_server_killed_while_streaming_status_exits_3(capsys: pytest.CaptureFixt
         )
     assert code == EXIT_CONNECTION
     assert "closed" in capsys.readouterr().err
+
+
+def test_drive_interrupted_still_stops_the_robot(sim: SimThread, pwfile: Path) -> None:
+    import signal
+    import subprocess
+    import sys
+
+    args = [sys.executable, "-m", "rtmu", "drive", *login(sim, pwfile), "--trans", "80", "--seconds", "20"]
+    for sig in (signal.SIGINT, signal.SIGTERM):
+        proc = subprocess.Popen(args, stdout=subprocess.PIPE, stderr=subprocess.DEVNULL, text=True)
+        try:
+            assert proc.stdout is not None and proc.stdout.readline().startswith("before:")
+            deadline = time.monotonic() + 5
+            while sim.snapshot().trans_ratio != 80 and time.monotonic() < deadline:
+                time.sleep(0.02)
+            assert sim.snapshot().trans_ratio == 80
+            proc.send_signal(sig)
+            assert proc.wait(5) == EXIT_OK
+        finally:
+            if proc.poll() is None:
+                proc.kill()
+        snap = sim.snapshot()
+        assert snap.trans_ratio == 0 and snap.mode_name == "stop" and snap.watchdog_stops == 0

@@ -19,6 +19,7 @@ from __future__ import annotations
 
 import argparse
 import asyncio
+import contextlib
 import getpass
 import sys
 from collections.abc import Awaitable, Callable
@@ -107,6 +108,19 @@ def read_password(args: argparse.Namespace) -> str:
     return line.rstrip("\r\n")
 
 
+def _cancel_on_terminate() -> None:
+    """SIGTERM (e.g. ``timeout``, a service manager) ends a command like Ctrl-C does: through the
+    ``finally`` blocks, so ``rtmu drive`` always sends its stop before the process goes."""
+    import signal
+
+    task = asyncio.current_task()
+    if task is None:
+        return
+    loop = asyncio.get_running_loop()
+    with contextlib.suppress(NotImplementedError, RuntimeError, ValueError):
+        loop.add_signal_handler(signal.SIGTERM, task.cancel)
+
+
 def fail(name: str, message: str, code: int) -> int:
     print(f"rtmu {name}: {message}", file=sys.stderr)
     return code
@@ -124,6 +138,7 @@ def run_with_client(name: str, args: argparse.Namespace, body: Callable[[AriaCli
     async def main() -> int:
         host, port = args.server
         client = AriaClient()
+        _cancel_on_terminate()
         try:
             await client.connect(host, port, args.user, password, timeout=args.timeout)
             return await body(client)
@@ -136,7 +151,7 @@ def run_with_client(name: str, args: argparse.Namespace, body: Callable[[AriaCli
         return fail(name, str(exc), exc.exit_code)
     except UsageError as exc:
         return fail(name, str(exc), EXIT_USAGE)
-    except KeyboardInterrupt:
+    except (KeyboardInterrupt, asyncio.CancelledError):
         print(file=sys.stderr)
         return EXIT_OK
     except BrokenPipeError:  # e.g. piped into ``head``: the reader has what it wanted
