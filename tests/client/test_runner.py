@@ -193,3 +193,18 @@ def test_lost_link_reconnects_and_comes_back_without_motion(server: TestServer) 
         assert len(ratio_drives(server)) == drives  # nothing resumed
     finally:
         runner.close()
+
+
+def test_disconnect_while_logging_in_cancels_at_once() -> None:
+    model, ui = Model(), UiQueue()
+    with ServerThread(TestServer(silent=True)) as server, ClientRunner(model, post=ui.post) as runner:
+        attempt = runner.connect("127.0.0.1", server.port)
+        ui.wait_for(lambda: model.connection.value.phase is Phase.CONNECTING)
+        t0 = time.monotonic()
+        runner.disconnect().result(2)
+        assert time.monotonic() - t0 < 0.5
+        ui.wait_for(lambda: model.connection.value.phase is Phase.DISCONNECTED)
+        assert attempt.cancelled() or attempt.exception() is not None
+        time.sleep(0.1)
+        ui.drain()
+        assert model.connection.value.phase is Phase.DISCONNECTED

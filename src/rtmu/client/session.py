@@ -108,6 +108,7 @@ class Session:
         self._extra_subs: dict[str, tuple[int, Callable[[Packet], None]]] = {}
         self._tasks: set[asyncio.Task[Any]] = set()
         self._reconnect_task: asyncio.Task[None] | None = None
+        self._connecting: asyncio.Task[Any] | None = None
         self._heart_task: asyncio.Task[None] | None = None
         self._kick = asyncio.Event()
         self._stepped: asyncio.Event = asyncio.Event()
@@ -158,10 +159,15 @@ class Session:
         profile: str = "",
         auto_reconnect: bool = True,
     ) -> None:
-        """Connect and set up the session; raises the :class:`ClientError` after publishing FAILED."""
+        """Connect and set up the session; raises the :class:`ClientError` after publishing FAILED.
+
+        A :meth:`disconnect` (or another ``connect``) while this one is still logging in cancels it.
+        """
+        self._cancel_connecting()
+        self._connecting = asyncio.current_task()
         await self._drop_client()
         self._cancel_reconnect()
-        self._target = _Target(host, port, user, password, profile, auto_reconnect)
+        target = self._target = _Target(host, port, user, password, profile, auto_reconnect)
         self._robot = RobotState()
         self._publish("robot", self._robot)
         self._set_map(MapModel())
@@ -172,16 +178,28 @@ class Session:
         )  # fmt: skip
         self._ensure_heart()
         try:
-            await self._open(self._target)
+            await self._open(target)
         except ClientError as exc:
-            self._set_connection(phase=Phase.FAILED, error=str(exc), error_kind=exc.kind)
+            if self._target is target:
+                self._set_connection(phase=Phase.FAILED, error=str(exc), error_kind=exc.kind)
             raise
+        finally:
+            if self._connecting is asyncio.current_task():
+                self._connecting = None
+
+    def _cancel_connecting(self) -> None:
+        task, self._connecting = self._connecting, None
+        if task is not None and task is not asyncio.current_task() and not task.done():
+            task.cancel()
 
     async def _open(self, target: _Target) -> None:
         client = AriaClient(on_close=lambda error: self._on_client_closed(client, error), clock=self.clock)
         await client.connect(
             target.host, target.port, target.user, target.password, timeout=self.config.connect_timeout
         )
+        if self._target is not target:  # disconnected (or re-targeted) meanwhile
+            await client.disconnect()
+            raise ServerClosed("the connection attempt was cancelled")
         self.client = client
         # Whatever happened before, the robot stays still until a fresh key press.
         self.lease.end(EndReason.DISCONNECTED)
@@ -198,6 +216,7 @@ class Session:
 
     async def disconnect(self) -> None:
         """Stop the robot, say goodbye, forget the robot's values. Returns within a fraction of a second."""
+        self._cancel_connecting()
         self._cancel_reconnect()
         self._target = None
         if self.connected:
