@@ -12,6 +12,7 @@ import io
 import threading
 import time
 from collections.abc import Callable
+from dataclasses import dataclass
 
 import gi
 
@@ -22,13 +23,26 @@ from gi.repository import Gdk, GLib, Gtk  # noqa: E402
 from ..model import CameraImage  # noqa: E402
 
 MAX_SIDE = 4096
+INSET_SIZE = (176, 132)
 MAX_JPEG_BYTES = 16 * 1024 * 1024
 REQUEST_TIMEOUT = 7.0
 """Seconds the page waits for a requested picture before saying none came."""
 
 
-def decode_jpeg(data: bytes) -> tuple[int, int, bytes]:
-    """(width, height, RGB bytes); ValueError for anything that is not a sane picture."""
+@dataclass(frozen=True, slots=True)
+class Decoded:
+    """RGB pixels of a picture and of its thumbnail for the map inset."""
+
+    width: int
+    height: int
+    rgb: bytes
+    thumb_width: int
+    thumb_height: int
+    thumb_rgb: bytes
+
+
+def decode_jpeg(data: bytes) -> Decoded:
+    """The picture and its inset thumbnail; ValueError for anything that is not a sane picture."""
     from PIL import Image, UnidentifiedImageError
 
     if len(data) > MAX_JPEG_BYTES:
@@ -39,15 +53,22 @@ def decode_jpeg(data: bytes) -> tuple[int, int, bytes]:
             if not (0 < w <= MAX_SIDE and 0 < h <= MAX_SIDE):
                 raise ValueError(f"a {w}×{h} picture is out of range")
             rgb = img.convert("RGB")
-            return w, h, rgb.tobytes()
+            thumb = rgb.copy()
+            thumb.thumbnail(INSET_SIZE)
+            return Decoded(w, h, rgb.tobytes(), thumb.width, thumb.height, thumb.tobytes())
     except (UnidentifiedImageError, OSError, Image.DecompressionBombError) as exc:
         raise ValueError(f"the picture cannot be decoded ({exc})") from None
 
 
 class PictureDecoder:
-    """Decode on one worker thread; ``deliver(image, texture_or_None, error)`` runs on the GTK thread."""
+    """Decode on one worker thread; ``deliver(image, textures_or_None, error)`` runs on the GTK thread.
 
-    def __init__(self, deliver: Callable[[CameraImage, Gdk.Texture | None, str], None]) -> None:
+    ``textures`` is (picture, thumbnail).
+    """
+
+    def __init__(
+        self, deliver: Callable[[CameraImage, tuple[Gdk.Texture, Gdk.Texture] | None, str], None]
+    ) -> None:
         self._deliver = deliver
         self._lock = threading.Condition()
         self._next: CameraImage | None = None
@@ -74,20 +95,26 @@ class PictureDecoder:
                 image, self._next = self._next, None
             assert image is not None
             try:
-                w, h, rgb = decode_jpeg(image.jpeg)
+                decoded = decode_jpeg(image.jpeg)
             except ValueError as exc:
                 GLib.idle_add(self._hand_over, image, None, str(exc))
             else:
-                GLib.idle_add(self._hand_over, image, (w, h, rgb), "")
+                GLib.idle_add(self._hand_over, image, decoded, "")
 
-    def _hand_over(self, image: CameraImage, pixels: tuple[int, int, bytes] | None, error: str) -> bool:
-        texture = None
-        if pixels is not None:
-            w, h, rgb = pixels
-            texture = Gdk.MemoryTexture.new(w, h, Gdk.MemoryFormat.R8G8B8, GLib.Bytes.new(rgb), w * 3)
+    def _hand_over(self, image: CameraImage, decoded: Decoded | None, error: str) -> bool:
+        textures = None
+        if decoded is not None:
+            textures = (
+                _texture(decoded.width, decoded.height, decoded.rgb),
+                _texture(decoded.thumb_width, decoded.thumb_height, decoded.thumb_rgb),
+            )
         if not self._closed:
-            self._deliver(image, texture, error)
+            self._deliver(image, textures, error)
         return False
+
+
+def _texture(width: int, height: int, rgb: bytes) -> Gdk.Texture:
+    return Gdk.MemoryTexture.new(width, height, Gdk.MemoryFormat.R8G8B8, GLib.Bytes.new(rgb), width * 3)
 
 
 class CameraView(Gtk.Box):
@@ -227,10 +254,7 @@ class CameraInset(Gtk.Box):
         self.set_margin_top(8)
         self.set_margin_end(8)
         self.picture = Gtk.Picture()
-        self.picture.set_size_request(168, 126)
-        self.picture.set_can_shrink(True)
-        if hasattr(self.picture, "set_content_fit"):
-            self.picture.set_content_fit(Gtk.ContentFit.CONTAIN)
+        self.picture.set_can_shrink(False)
         self.append(self.picture)
         self.set_tooltip_text("Last camera picture (click or Esc for the camera view)")
         click = Gtk.GestureClick()

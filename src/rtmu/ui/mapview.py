@@ -34,6 +34,8 @@ TRAIL_MAX = 1500
 TRAIL_MIN_STEP_MM = 30.0
 FOLLOW_BOX = 0.3
 """Follow pans when the robot leaves the middle (1 − 2 × 0.3 = 40 %) of the view."""
+FOLLOW_BOX_FITTED = 0.04
+"""…or, while the whole map is fitted, only when it is about to leave the view."""
 STALE_AFTER = 1.0
 """Seconds without a pose update after which the robot is drawn as stale."""
 FRAME_LOG = 240
@@ -215,15 +217,21 @@ class MapStage(Gtk.DrawingArea):
             return
         vp = self.viewport
         sx, sy = vp.to_screen(r.x, r.y)
-        if centre:
-            self.viewport = vp.centred(r.x, r.y)
+        # A fitted map shows everything: move only when the robot is about to leave the view.
+        box = FOLLOW_BOX_FITTED if self.fitted else FOLLOW_BOX
+        mx, my = vp.width * box, vp.height * box
+        outside = not (mx <= sx <= vp.width - mx and my <= sy <= vp.height - my)
+        if self.fitted and self.map_data is None:
+            if outside or centre:
+                self._fit_no_map()  # "fit" without a map = the 10 m around the robot
             return
-        mx, my = vp.width * FOLLOW_BOX, vp.height * FOLLOW_BOX
-        dx = min(0.0, sx - mx) + max(0.0, sx - (vp.width - mx))
-        dy = min(0.0, sy - my) + max(0.0, sy - (vp.height - my))
-        if dx or dy:
+        if centre or outside:
             # Re-centre on the robot (one jump, rather than creeping along the edge every update).
             self.viewport = vp.centred(r.x, r.y)
+            if self.fitted:
+                self.fitted = False
+                if self.on_view_changed is not None:
+                    self.on_view_changed()
 
     def _on_resize(self, _area: Gtk.DrawingArea, width: int, height: int) -> None:
         self.viewport = self.viewport.sized(width, height)
@@ -281,7 +289,8 @@ class MapStage(Gtk.DrawingArea):
         if state == "ready" and self.tiles.ready:
             complete = self._draw_tiles(ctx, vp)
         else:
-            overlays.draw_grid(ctx, vp)
+            step = overlays.draw_grid(ctx, vp)
+            overlays.draw_scale_note(ctx, self.labels, f"grid {overlays.metres(step)}")
         if self._objects:
             overlays.draw_cairns(ctx, vp, self._objects, self.labels)
         r = self.model.robot.value

@@ -10,6 +10,7 @@ from __future__ import annotations
 
 import math
 from collections.abc import Iterable, Sequence
+from typing import NamedTuple
 
 import cairo
 import gi
@@ -110,12 +111,34 @@ def draw_grid(ctx: cairo.Context, vp: Viewport) -> float:
     return step
 
 
+def metres(mm: float) -> str:
+    """``"1 m"``, ``"20 cm"``, ``"2.5 m"``."""
+    if mm < 1000:
+        return f"{mm / 10:g} cm"
+    return f"{mm / 1000:g} m"
+
+
+def draw_scale_note(ctx: cairo.Context, labels: LabelCache, text: str) -> None:
+    """A small legend at the top left (e.g. the grid's step)."""
+    layout = labels.layout(text)
+    _ink, logical = layout.get_pixel_extents()
+    ctx.save()
+    ctx.set_source_rgba(1, 1, 1, 0.8)
+    ctx.rectangle(6, 6, logical.width + 10, logical.height + 4)
+    ctx.fill()
+    ctx.set_source_rgba(0, 0, 0, 0.7)
+    ctx.move_to(11, 8)
+    PangoCairo.show_layout(ctx, layout)
+    ctx.restore()
+
+
 # -- cairns -----------------------------------------------------------------------------------------
 
 
 def draw_cairns(ctx: cairo.Context, vp: Viewport, objects: Sequence[object], labels: LabelCache) -> None:
     """Home, goals (with names), docks, forbidden lines and areas, other areas; off-screen ones skipped."""
     wx0, wy0, wx1, wy1 = vp.visible_world(margin_px=120)
+    pending: list[_Label] = []
     for obj in objects:
         kind = str(getattr(obj, "type", "")).lower()
         from_xy = getattr(obj, "from_xy", None)
@@ -129,7 +152,7 @@ def draw_cairns(ctx: cairo.Context, vp: Viewport, objects: Sequence[object], lab
             if kind.endswith("line"):
                 _draw_forbidden_line(ctx, vp, from_xy, to_xy)
             else:
-                _draw_area(ctx, vp, obj, from_xy, to_xy, labels, forbidden="forbidden" in kind)
+                _draw_area(ctx, vp, obj, from_xy, to_xy, pending, forbidden="forbidden" in kind)
             continue
         x, y = float(getattr(obj, "x", 0.0)), float(getattr(obj, "y", 0.0))
         if not (wx0 <= x <= wx1 and wy0 <= y <= wy1):
@@ -139,19 +162,20 @@ def draw_cairns(ctx: cairo.Context, vp: Viewport, objects: Sequence[object], lab
         th = float(getattr(obj, "th", 0.0))
         if kind in ("robothome", "home"):
             _marker(ctx, sx, sy, HOME_RGB, "house")
-            _label(ctx, labels, name or "Home", sx, sy + 10, HOME_RGB)
+            pending.append(_Label(0, name or "Home", sx, sy + 10, HOME_RGB))
         elif kind.startswith("goal"):
             _marker(ctx, sx, sy, GOAL_RGB, "flag")
             if kind == "goalwithheading":
                 _heading_tick(ctx, sx, sy, th, GOAL_RGB)
-            _label(ctx, labels, name, sx, sy + 10, GOAL_RGB)
+            pending.append(_Label(1, name, sx, sy + 10, GOAL_RGB))
         elif kind.startswith("dock"):
             _marker(ctx, sx, sy, DOCK_RGB, "dock")
-            _label(ctx, labels, name or "Dock", sx, sy + 10, DOCK_RGB)
+            pending.append(_Label(2, name or "Dock", sx, sy + 10, DOCK_RGB))
         else:
             _marker(ctx, sx, sy, AREA_RGB, "dot")
             if name:
-                _label(ctx, labels, name, sx, sy + 8, AREA_RGB)
+                pending.append(_Label(4, name, sx, sy + 8, AREA_RGB))
+    _draw_labels(ctx, labels, pending)
 
 
 def region_corners(
@@ -170,7 +194,7 @@ def _draw_area(
     obj: object,
     from_xy: tuple[float, float],
     to_xy: tuple[float, float],
-    labels: LabelCache,
+    pending: list[_Label],
     *,
     forbidden: bool,
 ) -> None:
@@ -192,7 +216,7 @@ def _draw_area(
     if name:
         cx = sum(c[0] for c in corners) / 4
         cy = sum(c[1] for c in corners) / 4
-        _label(ctx, labels, name, cx, cy - 6, rgb)
+        pending.append(_Label(3, name, cx, cy - 6, rgb))
 
 
 def _draw_forbidden_line(
@@ -248,24 +272,37 @@ def _heading_tick(
     ctx.restore()
 
 
-def _label(
-    ctx: cairo.Context, labels: LabelCache, text: str, sx: float, sy: float, rgb: tuple[float, float, float]
-) -> None:
-    """A name centred under (sx, sy) on a light halo, so it stays legible over walls."""
-    if not text:
-        return
-    layout = labels.layout(text)
-    _ink, logical = layout.get_pixel_extents()
-    w, h = logical.width, logical.height
-    x, y = round(sx - w / 2), round(sy)
-    ctx.save()
-    ctx.set_source_rgba(1, 1, 1, 0.78)
-    ctx.rectangle(x - 3, y - 1, w + 6, h + 2)
-    ctx.fill()
-    ctx.set_source_rgb(*(c * 0.75 for c in rgb))
-    ctx.move_to(x, y)
-    PangoCairo.show_layout(ctx, layout)
-    ctx.restore()
+class _Label(NamedTuple):
+    priority: int
+    """Lower wins a collision: home, goals, docks, areas, the rest."""
+    text: str
+    sx: float
+    sy: float
+    rgb: tuple[float, float, float]
+
+
+def _draw_labels(ctx: cairo.Context, labels: LabelCache, pending: list[_Label]) -> None:
+    """Names under their marks on a light halo; one that would overlap a more important one is left out."""
+    taken: list[tuple[float, float, float, float]] = []
+    for item in sorted(pending, key=lambda p: p.priority):
+        if not item.text:
+            continue
+        layout = labels.layout(item.text)
+        _ink, logical = layout.get_pixel_extents()
+        w, h = logical.width, logical.height
+        x, y = round(item.sx - w / 2), round(item.sy)
+        box = (x - 3, y - 1, x + w + 3, y + h + 1)
+        if any(box[0] < b[2] and b[0] < box[2] and box[1] < b[3] and b[1] < box[3] for b in taken):
+            continue
+        taken.append(box)
+        ctx.save()
+        ctx.set_source_rgba(1, 1, 1, 0.78)
+        ctx.rectangle(box[0], box[1], box[2] - box[0], box[3] - box[1])
+        ctx.fill()
+        ctx.set_source_rgb(*(c * 0.75 for c in item.rgb))
+        ctx.move_to(x, y)
+        PangoCairo.show_layout(ctx, layout)
+        ctx.restore()
 
 
 # -- trail, sonar, robot ------------------------------------------------------------------------------

@@ -519,13 +519,15 @@ class MainWindow(Gtk.ApplicationWindow):
         if new is not None:
             self.decoder.decode(new)  # type: ignore[arg-type]
 
-    def _picture_decoded(self, image: object, texture: Gdk.Texture | None, error: str) -> None:
+    def _picture_decoded(
+        self, image: object, textures: tuple[Gdk.Texture, Gdk.Texture] | None, error: str
+    ) -> None:
         current = self.model.camera.value
         if current is None or image is not current:
             return  # a newer picture (or a disconnect) overtook this one
-        self.camera.show_picture(image, texture, error)  # type: ignore[arg-type]
-        if texture is not None:
-            self.inset.show_texture(texture)
+        self.camera.show_picture(image, None if textures is None else textures[0], error)  # type: ignore[arg-type]
+        if textures is not None:
+            self.inset.show_texture(textures[1])
 
     def _view_changed(self) -> None:
         label = "Fit" if self.stage.fitted else ""

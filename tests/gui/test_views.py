@@ -1,0 +1,220 @@
+"""The window's other states: no map, no camera, zoom and pan, the D-pad, focus loss, dialogs, plain text."""
+
+from __future__ import annotations
+
+import math
+from collections.abc import Callable, Iterator
+from pathlib import Path
+
+import gi
+import numpy as np
+import pytest
+
+from rtmu.controller import Notice
+from rtmu.maps import MapObject, new_map, write_map
+from rtmu.model import Phase
+from rtmu.sim import SimConfig, SimThread
+
+from .harness import OFFICE_MAP, Gui, idle, pump
+from .test_window import moving, robot_blue, stopped
+
+gi.require_version("Gtk", "4.0")
+gi.require_version("Graphene", "1.0")
+from gi.repository import Graphene, Gtk  # noqa: E402
+
+Start = Callable[..., tuple[Gui, SimThread]]
+
+
+@pytest.fixture
+def start(request: pytest.FixtureRequest, screenshots: Path) -> Iterator[Start]:
+    """``start(**sim_config)`` → (gui, sim), both torn down after the test."""
+    opened: list[tuple[Gui, SimThread]] = []
+
+    def make(**config: object) -> tuple[Gui, SimThread]:
+        config.setdefault("map_path", OFFICE_MAP)
+        sim = SimThread(SimConfig(port=0, seed=1, **config)).start()  # type: ignore[arg-type]
+        try:
+            gui = Gui.start(screenshots, request.node.name, "127.0.0.1", sim.port)
+        except BaseException:
+            sim.stop()
+            raise
+        opened.append((gui, sim))
+        return gui, sim
+
+    yield make
+    for gui, sim in opened:
+        try:
+            gui.close()
+        finally:
+            sim.stop()
+
+
+def widget_centre_on_surface(widget: Gtk.Widget) -> tuple[int, int]:
+    """Where the middle of ``widget`` is on its X window (surface) — for pointer events."""
+    pump(lambda: widget.get_mapped() and widget.get_width() > 0, 3, "the widget to be laid out")
+    idle(0.1)
+    native = widget.get_native()
+    ok, point = widget.compute_point(
+        native, Graphene.Point().init(widget.get_width() / 2, widget.get_height() / 2)
+    )
+    assert ok
+    dx, dy = native.get_surface_transform()
+    return round(point.x + dx), round(point.y + dy)
+
+
+def test_without_a_map_the_stage_shows_a_grid_the_robot_as_a_circle_and_says_so(start: Start) -> None:
+    gui, sim = start(map_path=None)
+    assert gui.model.map.value.state in ("none", "unsupported")
+    note = gui.window.map_note
+    assert note.get_visible() and "no map" in note.get_text()
+    gui.shot("no-map")
+    pixels = gui.stage_pixels()
+    vp = gui.stage.viewport
+    snap = sim.snapshot()
+    th = math.radians(snap.th)
+    sx, sy = vp.to_screen(snap.x - 150 * math.cos(th), snap.y - 150 * math.sin(th))
+    assert robot_blue(pixels, sx, sy)
+    # Grid lines: columns of slightly darker pixels recur across an empty row.
+    row = pixels[20, :, :].astype(int).sum(axis=1)
+    background = np.median(row)
+    assert (row < background - 6).sum() >= 5, "no grid lines"
+
+
+def test_without_a_camera_the_command_is_disabled_and_says_why(start: Start) -> None:
+    gui, _sim = start(camera=False)
+    window = gui.window
+    assert not window.camera_button.get_sensitive()
+    assert "no camera" in (window.camera_button.get_tooltip_text() or "")
+    gui.key("Escape")
+    pump(lambda: window.banners.text("camera") is not None, 3, "the camera banner")
+    assert "no camera" in window.banners.text("camera")  # type: ignore[operator]
+    assert window.stack.get_visible_child_name() == "map"
+    gui.shot("no-camera")
+
+
+def test_zoom_keys_fit_and_a_drag_that_turns_follow_off(start: Start) -> None:
+    gui, _sim = start()
+    stage = gui.stage
+    assert stage.fitted and stage.follow
+    fitted_zoom = stage.viewport.zoom
+    gui.key("ctrl+plus", "ctrl+plus", "ctrl+plus", "ctrl+plus", "ctrl+plus")
+    pump(lambda: stage.viewport.zoom > fitted_zoom * 2, 3, "zooming in")
+    assert not stage.fitted
+    pump(lambda: stage.last_frame_complete, 5, "the zoomed tiles")
+    r = gui.model.robot.value
+    sx, sy = stage.viewport.to_screen(r.x, r.y)
+    assert 0 <= sx < stage.viewport.width and 0 <= sy < stage.viewport.height, (
+        "follow keeps the robot in view"
+    )
+    gui.shot("zoomed-in")
+    x, y = widget_centre_on_surface(stage)
+    before = (stage.viewport.cx, stage.viewport.cy)
+    gui.xdotool("mousemove", "--window", str(gui.xid()), str(x), str(y), "mousedown", "1")
+    gui.xdotool("mousemove", "--window", str(gui.xid()), str(x - 120), str(y - 60))
+    gui.xdotool("mousemove", "--window", str(gui.xid()), str(x - 200), str(y - 90), "mouseup", "1")
+    pump(lambda: (stage.viewport.cx, stage.viewport.cy) != before, 3, "the drag to pan")
+    assert not stage.follow and not gui.window.follow_button.get_active()
+    gui.shot("panned")
+    gui.key("ctrl+0")
+    pump(lambda: stage.fitted and abs(stage.viewport.zoom - fitted_zoom) < 1e-9, 3, "fit")
+    gui.key("f")
+    pump(lambda: stage.follow, 3, "follow back on")
+
+
+def test_the_touch_dpad_drives_while_held_and_shows_the_release(start: Start) -> None:
+    gui, sim = start()
+    window = gui.window
+    window.activate_action("win.dpad", None)
+    pump(lambda: window.dpad.get_visible() and window.dpad.get_mapped(), 3, "the D-pad")
+    pad = window.dpad.pads["drive_forward"]
+    x, y = widget_centre_on_surface(pad)
+    start_x = sim.snapshot().x
+    gui.xdotool("mousemove", "--window", str(gui.xid()), str(x), str(y), "mousedown", "1")
+    try:
+        pump(lambda: sim.snapshot().x > start_x + 100, 8, "the D-pad to drive forward")
+        assert pad.has_css_class("held")
+        gui.shot("dpad-held")
+    finally:
+        gui.xdotool("mouseup", "1")
+    pump(lambda: not pad.has_css_class("held"), 3, "the pad to show the release")
+    pump(lambda: stopped(sim), 8, "the robot to stop on release")
+    gui.shot("dpad-released")
+
+
+def test_focus_loss_while_driving_stops_the_robot(start: Start) -> None:
+    gui, sim = start()
+    other = Gtk.Window(title="elsewhere")
+    other.present()
+    try:
+        pump(other.get_mapped, 3, "the other window")
+        gui.focus()
+        gui.keydown("Up")
+        try:
+            pump(lambda: moving(sim), 8, "the robot to move")
+            from gi.repository import GdkX11
+
+            gui.xdotool("windowfocus", "--sync", str(GdkX11.X11Surface.get_xid(other.get_surface())))
+            pump(lambda: not gui.window.is_active(), 3, "the RTMU window to lose focus")
+            pump(lambda: stopped(sim), 8, "the robot to stop on focus loss")
+        finally:
+            gui.keyup("Up")
+    finally:
+        other.destroy()
+
+
+def test_settings_dialog_validates_inline_and_saves_a_profile(start: Start) -> None:
+    gui, _sim = start()
+    window = gui.window
+    gui.key("ctrl+comma")
+    pump(lambda: window._dialog is not None and window._dialog.get_mapped(), 3, "the settings dialog")
+    dialog = window._dialog
+    dialog.port.set_text("99999")
+    dialog.host.set_text("bad host!")
+    assert not dialog.save.get_sensitive()
+    assert dialog.errors["port"].get_visible() and "65535" in dialog.errors["port"].get_text()
+    assert dialog.errors["host"].get_visible()
+    gui.render(dialog, gui.shots / f"{gui.name}-01-invalid.png")
+    dialog.port.set_text("7373")
+    dialog.host.set_text("robot.local")
+    dialog.profile_entry.set_text("lab robot")
+    assert dialog.save.get_sensitive() and not dialog.errors["port"].get_visible()
+    dialog.save.emit("clicked")
+    pump(lambda: not dialog.get_visible(), 3, "the dialog to close")
+    profile = window.controller.profile
+    assert (profile.name, profile.host, profile.port) == ("lab robot", "robot.local", 7373)
+    assert gui.app.settings.profiles["lab robot"].port == 7373
+    assert gui.phase is Phase.CONNECTED, "saving does not drop the current connection"
+
+
+def test_shortcuts_window_lists_the_keys(start: Start) -> None:
+    gui, _sim = start()
+    overlay = gui.window.get_help_overlay()
+    gui.key("F1")
+    pump(overlay.get_mapped, 3, "the shortcuts window")
+    gui.render(overlay, gui.shots / f"{gui.name}-01-shortcuts.png")
+    overlay.close()
+
+
+def test_server_strings_are_plain_text_never_markup(start: Start, tmp_path: Path) -> None:
+    odd = "<b>Lab</b> & <i>co"
+    path = tmp_path / "<b>odd & map.map"
+    write_map(
+        new_map(
+            [[0, 0], [5000, 0]],
+            [[0, 0, 5000, 0], [0, 0, 0, 4000], [5000, 0, 5000, 4000], [0, 4000, 5000, 4000]],
+            objects=[
+                MapObject("RobotHome", 1000, 2000, 0, name="Home"),
+                MapObject("Goal", 3000, 2000, name=odd),
+            ],
+        ),
+        path,
+    )
+    gui, _sim = start(map_path=path)
+    assert "<b>odd & map.map" in gui.window.subtitle_label.get_text()
+    assert not gui.window.subtitle_label.get_use_markup()
+    layout = gui.stage.labels.layout(odd)
+    assert layout.get_text() == odd
+    gui.window.show_notice(Notice.ERROR, odd)
+    assert gui.window.banners.text(f"notice:{odd}") == odd
+    idle(0.2)
+    gui.shot("odd-strings")
