@@ -1,0 +1,86 @@
+"""Small parts of the view on their own: form validation, gauges, the key table, the shortcuts XML."""
+
+from __future__ import annotations
+
+import xml.etree.ElementTree as ET
+
+import gi
+import pytest
+
+from rtmu.commands import COMMANDS
+from rtmu.ui.gauges import battery_fraction, wifi_bars
+from rtmu.ui.keys import BINDINGS, KeyRouter
+from rtmu.ui.settings_dialog import validate
+from rtmu.ui.shortcuts import shortcuts_xml
+
+gi.require_version("Gdk", "4.0")
+gi.require_version("Gtk", "4.0")
+from gi.repository import Gdk, Gtk  # noqa: E402
+
+
+@pytest.mark.parametrize(
+    ("host", "port", "field"),
+    [
+        ("", "7272", "host"),
+        ("two words", "7272", "host"),
+        ("robot.local", "", "port"),
+        ("robot.local", "0", "port"),
+        ("robot.local", "65536", "port"),
+        ("robot.local", "72x", "port"),
+    ],
+)
+def test_the_form_names_the_wrong_field(host: str, port: str, field: str) -> None:
+    assert field in validate("lab", host, port, "", False)
+
+
+@pytest.mark.parametrize("host", ["robot.local", "10.0.0.5", "::1", "fe80::1", "localhost", "pioneer-3"])
+def test_good_hosts_pass(host: str) -> None:
+    assert validate("lab", host, "7272", "", False) == {}
+
+
+def test_remembering_a_password_needs_a_user_and_a_profile_needs_a_name() -> None:
+    assert "remember" in validate("lab", "robot", "7272", "", True)
+    assert validate("lab", "robot", "7272", "alice", True) == {}
+    assert "name" in validate("  ", "robot", "7272", "", False)
+
+
+def test_battery_gauge_levels() -> None:
+    assert battery_fraction(None, 11.0) == 0.0
+    assert battery_fraction(13.0, 11.0) == 1.0
+    assert battery_fraction(12.0, 11.0) == pytest.approx(0.5)
+    assert battery_fraction(10.0, 11.0) == 0.0
+    assert battery_fraction(42.0, None, is_soc=True) == pytest.approx(0.42)
+
+
+def test_wifi_bars_from_quality_or_signal() -> None:
+    assert wifi_bars(None, None) == 0
+    assert [wifi_bars(q, None) for q in (0, 10, 30, 60, 100)] == [0, 1, 2, 3, 4]
+    assert [wifi_bars(None, s) for s in (-50, -60, -70, -80, -90)] == [4, 3, 2, 1, 0]
+
+
+def test_every_bound_command_exists_and_keys_do_not_clash() -> None:
+    seen: dict[tuple[int, int], str] = {}
+    router = KeyRouter(hold=print, release=print, command=print, view=print)
+    for b in BINDINGS:
+        if b.kind in ("hold", "command"):
+            assert b.target in COMMANDS, b.target
+        for accel in b.accels:
+            ok, keyval, mods = Gtk.accelerator_parse(accel)
+            assert ok, accel
+            key = (Gdk.keyval_to_lower(keyval), int(mods))
+            assert key not in seen, f"{accel} is bound twice ({seen.get(key)} and {b.title})"
+            seen[key] = b.title
+    # Shift typed the key: "+" is Shift+= on most layouts, a capital W is Shift+w.
+    shift = Gdk.ModifierType.SHIFT_MASK
+    assert router.lookup(Gdk.KEY_plus, shift).target == "speed_up"  # type: ignore[union-attr]
+    assert router.lookup(Gdk.KEY_W, shift).target == "drive_forward"  # type: ignore[union-attr]
+    assert router.lookup(Gdk.KEY_Up, shift).target == "move_forward_1m"  # type: ignore[union-attr]
+    assert router.lookup(Gdk.KEY_space, Gdk.ModifierType(0)).target == "stop"  # type: ignore[union-attr]
+    assert router.lookup(Gdk.KEY_q, Gdk.ModifierType.CONTROL_MASK) is None  # left to the app accelerator
+
+
+def test_shortcuts_xml_escapes_and_lists_every_binding() -> None:
+    root = ET.fromstring(shortcuts_xml())
+    titles = [p.text for p in root.iter("property") if p.get("name") == "title"]
+    for b in BINDINGS:
+        assert b.title in titles
