@@ -21,7 +21,7 @@ from rtmu.sim import SimConfig, SimThread
 from .fakeclock import FakeClock
 from .fakes import FakeView
 from .servers import run
-from .uiqueue import UiQueue
+from .uiqueue import UiQueue, eventually
 
 REPO = Path(__file__).resolve().parents[2]
 ARENA = REPO / "data" / "maps" / "arena.map"
@@ -81,7 +81,10 @@ def test_controller_hold_release_and_frozen_ui_on_a_manual_clock() -> None:
                     ctl.tick()
                 runner.sync()
                 sim.advance(seconds)
-                runner.call(lambda: None)  # let the status in
+                session = runner.session
+                assert session is not None
+                # Wait until the status the simulator just sent has been read (its age is then 0).
+                eventually(lambda: runner.call(lambda: session.health.status_age(clock()) == 0.0))
                 ui.drain()
 
             step()

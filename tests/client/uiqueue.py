@@ -39,3 +39,12 @@ class UiQueue:
             except queue.Empty:
                 continue
             fn()
+
+
+def eventually(predicate: Callable[[], bool], timeout: float = 3.0) -> None:
+    """Poll ``predicate`` until it holds (bytes still in flight between threads); fail after ``timeout``."""
+    deadline = time.monotonic() + timeout
+    while not predicate():
+        if time.monotonic() > deadline:
+            raise AssertionError("condition not reached in time")
+        time.sleep(0.005)
