@@ -27,7 +27,8 @@ from gi.repository import GLib, Gtk  # noqa: E402
 
 from ..model import LinkLevel, MapModel, Model, RobotState  # noqa: E402
 from . import overlays  # noqa: E402
-from .tiles import BACKGROUND_RGB, TILE, TileCache  # noqa: E402
+from .frame import Scene, draw_frame  # noqa: E402
+from .tiles import TileCache  # noqa: E402
 from .viewport import ZOOM_MAX, Viewport, clamp_zoom, fit_view, nearest_step, step_zoom  # noqa: E402
 
 TRAIL_MAX = 1500
@@ -282,59 +283,19 @@ class MapStage(Gtk.DrawingArea):
 
     def draw_frame(self, ctx: cairo.Context, vp: Viewport) -> bool:
         """Draw one frame; True when a map is shown with every visible tile ready."""
-        ctx.set_source_rgb(*BACKGROUND_RGB)
-        ctx.paint()
-        state = self.model.map.value.state
-        complete = False
-        if state == "ready" and self.tiles.ready:
-            complete = self._draw_tiles(ctx, vp)
-        else:
-            step = overlays.draw_grid(ctx, vp)
-            overlays.draw_scale_note(ctx, self.labels, f"grid {overlays.metres(step)}")
-        if self._objects:
-            overlays.draw_cairns(ctx, vp, self._objects, self.labels)
         r = self.model.robot.value
-        if r.numbers_at is not None:
-            overlays.draw_trail(ctx, vp, self.trail)
-            stale = self.robot_is_stale()
-            if self.model.view.value.show_sonar and r.sonar and not stale:
-                overlays.draw_sonar(ctx, vp, (r.x, r.y), r.sonar)
-            overlays.draw_robot(ctx, vp, r.x, r.y, r.th, stale=stale, footprint=state == "ready")
-        return complete
-
-    def _draw_tiles(self, ctx: cairo.Context, vp: Viewport) -> bool:
-        spots = self.tiles.visible(vp.scale, vp.origin, vp.width, vp.height)
-        overview = self.tiles.overview
-        complete = True
-        from .tiles import EMPTY
-
-        for spot in spots:
-            surface = spot.surface
-            if surface is EMPTY:
-                continue
-            if surface is None:
-                complete = False
-                if overview is not None:
-                    self._draw_from_overview(ctx, vp, overview, spot.x, spot.y)
-                continue
-            ctx.set_source_surface(surface, spot.x, spot.y)  # type: ignore[arg-type]
-            ctx.rectangle(spot.x, spot.y, TILE, TILE)
-            ctx.fill()
-        return complete
-
-    @staticmethod
-    def _draw_from_overview(ctx: cairo.Context, vp: Viewport, overview, x: int, y: int) -> None:  # type: ignore[no-untyped-def]
-        ratio = vp.scale / overview.scale
-        ox, oy = vp.origin
-        ctx.save()
-        ctx.rectangle(x, y, TILE, TILE)
-        ctx.clip()
-        ctx.translate(ox, oy)
-        ctx.scale(ratio, ratio)
-        ctx.set_source_surface(overview.surface, overview.gx0, overview.gy0)
-        ctx.get_source().set_filter(cairo.FILTER_FAST)
-        ctx.paint()
-        ctx.restore()
+        has_map = self.model.map.value.state == "ready"
+        stale = self.robot_is_stale()
+        scene = Scene(
+            labels=self.labels,
+            tiles=self.tiles if has_map else None,
+            objects=self._objects,
+            robot=(r.x, r.y, r.th) if r.numbers_at is not None else None,
+            stale=stale,
+            trail=self.trail,
+            sonar=r.sonar if self.model.view.value.show_sonar else (),
+        )
+        return draw_frame(ctx, vp, scene)
 
     # -- input -------------------------------------------------------------------------------
     def _install_input(self) -> None:
