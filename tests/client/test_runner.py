@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import concurrent.futures
 import time
 
 import pytest
@@ -204,6 +205,8 @@ def test_disconnect_while_logging_in_cancels_at_once() -> None:
         runner.disconnect().result(2)
         assert time.monotonic() - t0 < 0.5
         ui.wait_for(lambda: model.connection.value.phase is Phase.DISCONNECTED)
+        concurrent.futures.wait([attempt], timeout=2)
+        assert attempt.done()
         assert attempt.cancelled() or attempt.exception() is not None
         time.sleep(0.1)
         ui.drain()
