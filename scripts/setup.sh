@@ -107,3 +107,4 @@ ensure_project() {
 ensure_system_packages
 ensure_venv
 ensure_project
+bash scripts/install-desktop.sh || say "the desktop entry was not installed (RTMU still runs as .venv/bin/rtmu)"
