@@ -268,7 +268,7 @@ class Controller:
     def speed_down(self) -> None:
         self._set_speed(self.model.speed.value.slower(), "minimum")
 
-    def _set_speed(self, new, limit: str) -> None:  # type: ignore[no-untyped-def]
+    def _set_speed(self, new: SpeedSetting, limit: str) -> None:
         if not self.model.speed.set(new):
             self.view.notify(Notice.INFO, f"Speed is already at its {limit} ({new.percent} %)")
             return
