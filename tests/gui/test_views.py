@@ -62,6 +62,18 @@ def widget_centre_on_surface(widget: Gtk.Widget) -> tuple[int, int]:
     return round(point.x + dx), round(point.y + dy)
 
 
+def wait_for_window(title: str) -> Gtk.Window:
+    def find() -> Gtk.Window | None:
+        return next(
+            (w for w in Gtk.Window.list_toplevels() if w.get_title() == title and w.get_mapped()), None
+        )
+
+    pump(lambda: find() is not None, 3, f"the window {title!r}")
+    window = find()
+    assert window is not None
+    return window
+
+
 def test_without_a_map_the_stage_shows_a_grid_the_robot_as_a_circle_and_says_so(start: Start) -> None:
     gui, sim = start(map_path=None)
     assert gui.model.map.value.state in ("none", "unsupported")
@@ -218,3 +230,54 @@ def test_server_strings_are_plain_text_never_markup(start: Start, tmp_path: Path
     assert gui.window.banners.text(f"notice:{odd}") == odd
     idle(0.2)
     gui.shot("odd-strings")
+
+
+def test_banners_tell_connecting_connected_and_a_failure_with_its_reason(screenshots: Path) -> None:
+    with SimThread(SimConfig(port=0, map_path=None, seed=1)) as sim:
+        gui = Gui.start(screenshots, "test_banners_connect", "127.0.0.1", sim.port)
+        try:
+            told = [(topic, text) for topic, _level, text in gui.window.banners.history]
+            assert ("link", f"Connecting to 127.0.0.1:{sim.port}…") in told
+            assert ("link", f"Connected to 127.0.0.1:{sim.port}") in told
+        finally:
+            gui.close()
+    import socket
+
+    with socket.socket() as s:  # a port with nobody listening
+        s.bind(("127.0.0.1", 0))
+        port = s.getsockname()[1]
+    gui = Gui.start(screenshots, "test_banners_refused", "127.0.0.1", port, connect=False)
+    try:
+        gui.window.connect_now()
+        pump(lambda: gui.phase is Phase.FAILED, 10, "the connection to fail")
+        text = gui.window.banners.text("link") or ""
+        assert text.startswith(f"Could not connect to 127.0.0.1:{port}: ") and len(text) > 40, text
+        gui.shot("refused")
+    finally:
+        gui.close()
+
+
+def test_speed_at_its_limit_says_so(start: Start) -> None:
+    gui, _sim = start()
+    gui.key(*["plus"] * 6)
+    pump(lambda: gui.model.speed.value.percent == 100, 3, "full speed")
+    gui.key("plus")
+    pump(lambda: gui.window.banners.text("speed") == "Speed at its maximum: 100 %", 3, "the limit banner")
+    gui.shot("speed-limit")
+
+
+def test_t_opens_turn_by_angle_and_the_robot_turns(start: Start) -> None:
+    from gi.repository import GdkX11
+
+    gui, sim = start()
+    window = gui.window
+    gui.key("t")
+    dialog = wait_for_window("Turn by an angle")
+    gui.render(dialog, gui.shots / f"{gui.name}-01-turn-dialog.png")
+    gui.xdotool("windowfocus", "--sync", str(GdkX11.X11Surface.get_xid(dialog.get_surface())))
+    gui.key("ctrl+a", "4", "5", "Return")  # type 45, Enter = Go
+    pump(lambda: abs(sim.snapshot().th - 45) < 3, 15, "the robot to turn 45° left")
+    assert window.get_mapped()
+    gui.focus()
+    gui.key("g")
+    wait_for_window("Go a distance").close()

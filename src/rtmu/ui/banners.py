@@ -9,6 +9,7 @@ strings from the server are never parsed as markup).
 
 from __future__ import annotations
 
+from collections import deque
 from dataclasses import dataclass
 
 import gi
@@ -17,6 +18,7 @@ gi.require_version("Gtk", "4.0")
 from gi.repository import GLib, Gtk  # noqa: E402
 
 MAX_BANNERS = 4
+HISTORY = 50
 MAX_CHARS = 300
 ICONS = {
     "info": "dialog-information-symbolic",
@@ -48,6 +50,8 @@ class BannerStack(Gtk.Box):
         self.set_can_target(True)
         self._banners: dict[str, _Banner] = {}
         self._order: list[str] = []
+        self.history: deque[tuple[str, str, str]] = deque(maxlen=HISTORY)
+        """The last (topic, level, text) shown, newest last: what the operator was told."""
 
     # -- public ------------------------------------------------------------------------------
     def show(
@@ -67,6 +71,8 @@ class BannerStack(Gtk.Box):
         if banner is None:
             banner = self._make(topic)
         text = _one_paragraph(text)
+        if not self.history or self.history[-1] != (topic, level, text):
+            self.history.append((topic, level, text))
         banner.label.set_text(text)
         banner.label.set_tooltip_text(text)
         if banner.level != level:

@@ -45,7 +45,6 @@ class AmountDialog(Gtk.Window):
         adjustment = Gtk.Adjustment(value=initial, lower=lower, upper=upper, step_increment=step,
                                     page_increment=step * 10)  # fmt: skip
         self.spin = Gtk.SpinButton(adjustment=adjustment, digits=digits, numeric=True, hexpand=True)
-        self.spin.set_activates_default(True)
         row.append(self.spin)
         row.append(Gtk.Label(label=unit))
         box.append(row)
@@ -67,12 +66,17 @@ class AmountDialog(Gtk.Window):
         self.set_child(box)
         self.set_default_widget(go)
         keys = Gtk.EventControllerKey()
+        keys.set_propagation_phase(Gtk.PropagationPhase.CAPTURE)  # Enter in the number field = Go
         keys.connect("key-pressed", self._key)
         self.add_controller(keys)
 
     def _key(self, _c: Gtk.EventControllerKey, keyval: int, _code: int, _state: object) -> bool:
         if keyval == Gdk.KEY_Escape:
             self.close()
+            return True
+        if keyval in (Gdk.KEY_Return, Gdk.KEY_KP_Enter, Gdk.KEY_ISO_Enter):
+            self.spin.update()
+            self._go(self.spin.get_value())
             return True
         return False
 

@@ -27,7 +27,16 @@ from gi.repository import Gdk, Gio, GLib, Gtk  # noqa: E402
 
 from ..commands import COMMANDS, CommandState  # noqa: E402
 from ..controller import TICK, ClientLink, Controller, Notice, SecretStore  # noqa: E402
-from ..model import SPEED_MAX, SPEED_MIN, ConnectionState, MapModel, Model, Phase, SpeedSetting  # noqa: E402
+from ..model import (  # noqa: E402
+    SPEED_MAX,
+    SPEED_MIN,
+    ConnectionState,
+    MapModel,
+    Model,
+    Phase,
+    RobotState,
+    SpeedSetting,
+)
 from ..settings import Profile  # noqa: E402
 from .banners import BannerStack  # noqa: E402
 from .camera import CameraInset, CameraView, PictureDecoder  # noqa: E402
@@ -134,6 +143,7 @@ class MainWindow(Gtk.ApplicationWindow):
             model.speed.observe(self._on_speed),
             model.camera.observe(self._on_camera),
             model.map.observe(self._on_map),
+            model.robot.observe(self._on_robot),
         ]
         self.connect("notify::is-active", self._on_active)
         self.connect("close-request", self._on_close_request)
@@ -509,6 +519,10 @@ class MainWindow(Gtk.ApplicationWindow):
         self.map_note.set_text(text)
         self.map_note.set_visible(bool(text))
         self._update_header(conn)
+
+    def _on_robot(self, old: RobotState, new: RobotState) -> None:
+        if new.safe_drive is not None and new.safe_drive != old.safe_drive:
+            self.safe_action.set_state(GLib.Variant.new_boolean(new.safe_drive))
 
     def _on_speed(self, _old: SpeedSetting, new: SpeedSetting) -> None:
         self.banners.show(
