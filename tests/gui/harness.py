@@ -135,12 +135,15 @@ class Gui:
     # -- pictures ------------------------------------------------------------------------------
     def render(self, widget: Gtk.Widget, path: Path) -> Path:
         """``widget`` as it looks now, to a PNG (the renderer of its window, as GTK itself draws it)."""
-        idle(0.05)
-        w, h = widget.get_width(), widget.get_height()
-        snapshot = Gtk.Snapshot()
-        Gtk.WidgetPaintable.new(widget).snapshot(snapshot, w, h)
-        node = snapshot.to_node()
-        assert node is not None, "nothing drawn"
+        node = None
+        deadline = time.monotonic() + 3.0
+        while node is None:  # right after a relayout the widget may have no render node yet
+            idle(0.05)
+            w, h = widget.get_width(), widget.get_height()
+            snapshot = Gtk.Snapshot()
+            Gtk.WidgetPaintable.new(widget).snapshot(snapshot, w, h)
+            node = snapshot.to_node()
+            assert node is not None or time.monotonic() < deadline, "nothing drawn"
         renderer = widget.get_native().get_renderer()
         texture = renderer.render_texture(node, Graphene.Rect().init(0, 0, w, h))
         texture.save_to_png(str(path))
