@@ -63,10 +63,17 @@ class Gui:
         self._shot_no = 0
 
     @classmethod
-    def start(cls, shots: Path, name: str, host: str, port: int, *, connect: bool = True) -> Gui:
+    def start(
+        cls, shots: Path, name: str, host: str, port: int, *, connect: bool = True, user: str | None = None
+    ) -> Gui:
         settings = Path(tempfile.mkdtemp(prefix="rtmu-gui-settings-")) / "settings.toml"
         options = GuiOptions(
-            host=host, port=port, settings_path=settings, persist=False, connect=None if connect else False
+            host=host,
+            port=port,
+            user=user,
+            settings_path=settings,
+            persist=False,
+            connect=None if connect else False,
         )
         app = RtmuApplication(options)
         app.register(None)
@@ -151,6 +158,7 @@ class Gui:
 
     def shot(self, label: str) -> Path:
         """Save the whole window as ``<test>-<n>-<label>.png`` in the screenshot folder."""
+        idle(0.2)  # let banner and toolbar animations finish: the picture shows the state, not a transition
         self._shot_no += 1
         path = self.shots / f"{self.name}-{self._shot_no:02d}-{label}.png"
         return self.render(self.window, path)

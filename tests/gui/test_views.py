@@ -281,3 +281,44 @@ def test_t_opens_turn_by_angle_and_the_robot_turns(start: Start) -> None:
     gui.focus()
     gui.key("g")
     wait_for_window("Go a distance").close()
+
+
+def test_the_window_grows_gracefully(start: Start) -> None:
+    gui, _sim = start()
+    window = gui.window
+    small = (gui.stage.get_width(), gui.stage.get_height())
+    window.set_default_size(1280, 800)
+    pump(lambda: window.get_width() >= 1200, 5, "the window to grow")
+    pump(
+        lambda: gui.stage.get_width() > small[0] + 300 and gui.stage.last_frame_complete, 5, "a bigger stage"
+    )
+    assert gui.stage.fitted, "a fitted map is fitted again to the new size"
+    gui.shot("1280x800")
+
+
+def test_a_user_is_asked_for_the_password_and_a_wrong_one_is_reported(
+    screenshots: Path, tmp_path: Path
+) -> None:
+    from gi.repository import GdkX11
+
+    users = tmp_path / "users.txt"
+    users.write_text("UserInfoVersion1\nuser alice secret1 all\n")
+    with SimThread(SimConfig(port=0, map_path=None, users_path=users, seed=1)) as sim:
+        gui = Gui.start(screenshots, "test_password", "127.0.0.1", sim.port, connect=False, user="alice")
+        try:
+            for password, ok in (("nope", False), ("secret1", True)):
+                gui.focus()
+                gui.key("ctrl+o")
+                prompt = wait_for_window("Password")
+                gui.render(prompt, gui.shots / f"{gui.name}-prompt.png")
+                gui.xdotool("windowfocus", "--sync", str(GdkX11.X11Surface.get_xid(prompt.get_surface())))
+                gui.xdotool("type", "--delay", "20", password)
+                gui.key("Return")
+                if ok:
+                    gui.wait_connected()
+                else:
+                    pump(lambda: gui.phase is Phase.FAILED, 10, "the login to be rejected")
+                    assert (gui.window.banners.text("link") or "").startswith("Could not connect")
+                    gui.shot("wrong-password")
+        finally:
+            gui.close()

@@ -113,7 +113,7 @@ class RtmuApplication(Gtk.Application):
             window.banners.show("notice:settings", "warning", loaded.warning, timeout=10.0)
         if auto_connect:
             window.connect_now()
-        elif not self.settings.profiles:
+        elif not self.settings.profiles and not self.options.host:
             window.banners.show(
                 "notice:hint", "info", "Set up a robot in Connection settings (Ctrl+,), or run rtmu --demo",
                 timeout=8.0,

@@ -501,7 +501,7 @@ class MainWindow(Gtk.ApplicationWindow):
             Phase.FAILED: f"failed: {conn.error}" if conn.error else "failed",
         }[phase]
         name = self.model.map.value.name.replace("\\", "/").rsplit("/", 1)[-1]
-        parts = ([profile.name] if profile.name != where else []) + [where, state]
+        parts = [profile.name, state] if where in profile.name else [profile.name, where, state]
         parts += [name] if name and phase is Phase.CONNECTED else []
         self.subtitle_label.set_text(" · ".join(parts))
 
