@@ -202,12 +202,18 @@ class MapStage(Gtk.DrawingArea):
         if bounds is None:
             self._fit_no_map()
             return
-        vp = fit_view(bounds, self.viewport.width, self.viewport.height)
-        self.viewport = vp
+        self.viewport = fit_view(bounds, self.viewport.width, self.viewport.height)
+        self._view_moved()
 
     def _fit_no_map(self) -> None:
         r = self.model.robot.value
         self.viewport = fit_view((r.x - 5000, r.y - 5000, r.x + 5000, r.y + 5000), *self._size())
+        self._view_moved()
+
+    def _view_moved(self) -> None:
+        """Zoom or centre changed without the operator: let the window's zoom label follow."""
+        if self.on_view_changed is not None:
+            self.on_view_changed()
 
     def _size(self) -> tuple[int, int]:
         return self.viewport.width, self.viewport.height

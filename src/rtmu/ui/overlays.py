@@ -27,7 +27,7 @@ ROBOT_FRONT_MM = 210.0
 ROBOT_REAR_MM = 301.0
 ROBOT_HALF_WIDTH_MM = 212.5
 ROBOT_RADIUS_MM = 250.0
-ROBOT_MIN_PX = 22.0
+ROBOT_MIN_PX = 10.0
 """Below this length the robot is drawn as a marker of this size, so it never vanishes."""
 
 ROBOT_RGB = (0.11, 0.44, 0.85)
