@@ -75,6 +75,11 @@ class Gui:
             persist=False,
             connect=None if connect else False,
         )
+        return cls.open(options, shots, name, connect=connect)
+
+    @classmethod
+    def open(cls, options: GuiOptions, shots: Path, name: str, *, connect: bool = True) -> Gui:
+        """The app with these options, activated as ``rtmu`` would; waits for the connection if asked."""
         app = RtmuApplication(options)
         app.register(None)
         app.activate()

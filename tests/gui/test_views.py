@@ -322,3 +322,72 @@ def test_a_user_is_asked_for_the_password_and_a_wrong_one_is_reported(
                     gui.shot("wrong-password")
         finally:
             gui.close()
+
+
+def test_plain_rtmu_opens_the_last_profile_and_connects(screenshots: Path, tmp_path: Path) -> None:
+    from rtmu.settings import Profile, Settings, save_settings
+    from rtmu.ui.app import GuiOptions
+
+    with SimThread(SimConfig(port=0, map_path=OFFICE_MAP, seed=1)) as sim:
+        settings = Settings()
+        settings.put(Profile(name="elsewhere", host="127.0.0.1", port=1))
+        settings.put(Profile(name="lab", host="127.0.0.1", port=sim.port, zoom=1.0, speed=70))
+        path = save_settings(settings, tmp_path / "settings.toml")
+        gui = Gui.open(GuiOptions(settings_path=path), screenshots, "test_last_profile")
+        try:
+            assert gui.window.controller.profile.name == "lab"
+            assert gui.model.speed.value.percent == 70
+            assert abs(gui.stage.viewport.zoom - 1.0) < 1e-9 and not gui.stage.fitted
+            gui.key("minus")
+            pump(lambda: gui.model.speed.value.percent == 60, 3, "the speed to drop")
+        finally:
+            gui.close()
+        from rtmu.settings import load_settings
+
+        saved = load_settings(path).settings
+        assert saved.last_profile == "lab" and saved.profiles["lab"].speed == 60, (
+            "view choices are remembered"
+        )
+
+
+@pytest.mark.parametrize(("volts", "state"), [(11.3, "low"), (10.8, "critical")])
+def test_battery_turns_amber_at_the_low_level_and_red_at_shutdown(
+    start: Start, volts: float, state: str
+) -> None:
+    gui, _sim = start(map_path=None, battery_v=volts)
+    cell = gui.window.toolbar.cells["battery"]
+    pump(lambda: cell.has_css_class(state), 5, f"the battery cell to show {state}")
+    assert gui.window.toolbar.battery_gauge.state == state
+    assert ("LOW" if state == "low" else "SHUTDOWN") in (cell.get_tooltip_text() or "")
+    gui.shot(f"battery-{state}")
+
+
+def test_unsupported_commands_are_disabled_with_the_reason(start: Start) -> None:
+    from rtmu.commands import CommandState
+
+    gui, _sim = start(map_path=None)
+    window = gui.window
+    window.activate_action("win.dpad", None)
+    reason = "this server does not offer ratioDrive"
+    window.commands_changed({"drive_forward": CommandState(False, reason)})
+    pad = window.dpad.pads["drive_forward"]
+    assert not pad.get_sensitive() and reason in (pad.get_tooltip_text() or "")
+    window.commands_changed({"turn_left_90": CommandState(False, "this server does not offer turnByAngle")})
+    assert not window.lookup_action("turn").get_enabled()
+    gui.key("t")
+    pump(lambda: "turnByAngle" in (window.banners.text("notice:turn_left_90") or ""), 3, "the reason banner")
+
+
+def test_wifi_not_published_is_greyed_with_a_reason(screenshots: Path) -> None:
+    import time as _time
+
+    from rtmu.model import RobotState
+
+    gui = Gui.start(screenshots, "test_wifi", "127.0.0.1", 1, connect=False)
+    try:
+        gui.model.robot.set(RobotState(x=1.0, battery_v=12.5, numbers_at=_time.monotonic()))
+        cell = gui.window.toolbar.cells["wifi"]
+        assert cell.stale and "does not publish" in (cell.get_tooltip_text() or "")
+        assert gui.window.toolbar.cells["x"].stale, "values while not connected are never shown as fresh"
+    finally:
+        gui.close()

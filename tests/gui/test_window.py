@@ -217,6 +217,7 @@ def test_simulator_killed_while_driving(gui: Gui, sim: SimThread) -> None:
             "the banner",
         )
         assert window.controller.held == frozenset(), "held keys are dropped when the link goes"
+        assert window.toolbar.cells["x"].stale and window.stage.robot_is_stale(), "old values look old"
         assert not window.controller.link.lease.view().live, "no drive lease survives the lost link"
         ticks = window.ticks
         idle(1.0)
