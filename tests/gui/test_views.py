@@ -391,3 +391,21 @@ def test_wifi_not_published_is_greyed_with_a_reason(screenshots: Path) -> None:
         assert gui.window.toolbar.cells["x"].stale, "values while not connected are never shown as fresh"
     finally:
         gui.close()
+
+
+def test_f11_full_screen_and_ctrl_q_quits_after_stopping_the_robot(start: Start) -> None:
+    gui, sim = start()
+    window = gui.window
+    gui.key("F11")
+    pump(lambda: window.lookup_action("fullscreen").get_state().get_boolean(), 3, "the full-screen request")
+    # Xvfb has no window manager to honour the request: what is checked is that F11 reached the window.
+    gui.key("F11")
+    pump(lambda: not window.lookup_action("fullscreen").get_state().get_boolean(), 3, "leaving full screen")
+    gui.keydown("Up")
+    try:
+        pump(lambda: moving(sim), 8, "the robot to move")
+        gui.key("ctrl+q")
+        pump(lambda: not window.get_visible(), 3, "the window to close")
+        pump(lambda: stopped(sim), 8, "the robot to stop on quit")
+    finally:
+        gui.keyup("Up")
