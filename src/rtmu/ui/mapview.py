@@ -29,7 +29,7 @@ from ..model import LinkLevel, MapModel, Model, RobotState  # noqa: E402
 from . import overlays  # noqa: E402
 from .frame import Scene, draw_frame  # noqa: E402
 from .tiles import TileCache  # noqa: E402
-from .viewport import ZOOM_MAX, Viewport, clamp_zoom, fit_view, nearest_step, step_zoom  # noqa: E402
+from .viewport import ZOOM_MAX, Viewport, fit_view, nearest_step, step_zoom  # noqa: E402
 
 TRAIL_MAX = 1500
 TRAIL_MIN_STEP_MM = 30.0
@@ -166,7 +166,7 @@ class MapStage(Gtk.DrawingArea):
         if self.follow and anchor is None and self.model.robot.value.numbers_at is not None:
             r = self.model.robot.value
             anchor = self.viewport.to_screen(r.x, r.y)
-        self.viewport = self.viewport.zoomed(clamp_zoom(zoom, allow_fit=zoom < self.viewport.zoom), anchor)
+        self.viewport = self.viewport.zoomed(zoom, anchor)
         self.fitted = False
         if self.follow:
             self._keep_robot_visible()

@@ -372,8 +372,7 @@ class MainWindow(Gtk.ApplicationWindow):
 
     # -- intents -------------------------------------------------------------------------------
     def _hold(self, name: str) -> None:
-        if self.stack.get_visible_child_name() == "camera":
-            self.show_map()  # driving blind from a still picture is not allowed to surprise anyone
+        # On the camera page too: the picture shows its age, and a fresh press is the operator's intent.
         self.controller.run(name)
 
     def _release(self, name: str) -> None:
