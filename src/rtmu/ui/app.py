@@ -18,6 +18,7 @@ from pathlib import Path
 from ..settings import DEFAULT_PORT
 
 APP_ID = "io.github.rtmu.Rtmu"
+EXIT_NO_DISPLAY = 6
 
 
 @dataclass
@@ -72,6 +73,13 @@ def run_gui(args: argparse.Namespace) -> int:
     if options.port is not None and not 1 <= options.port <= 65535:
         print(f"rtmu: --port {options.port} is not 1…65535", file=sys.stderr)
         return 2
+    if not display_available():
+        print(
+            "rtmu: cannot open a display (is DISPLAY or WAYLAND_DISPLAY set?); "
+            "without one, use the headless subcommands (rtmu status, rtmu drive, rtmu sim …)",
+            file=sys.stderr,
+        )
+        return EXIT_NO_DISPLAY
     sim = None
     if options.demo:
         try:
@@ -84,10 +92,22 @@ def run_gui(args: argparse.Namespace) -> int:
         from .application import RtmuApplication
 
         app = RtmuApplication(options)
-        return int(app.run([sys.argv[0]]))
+        status = int(app.run([sys.argv[0]]))
+        return 1 if app.failed and status == 0 else status
     finally:
         if sim is not None:
             sim.stop()
+
+
+def display_available() -> bool:
+    """GTK can open a display (imports GTK: call only when the window is really wanted)."""
+    import gi
+
+    gi.require_version("Gtk", "4.0")
+    gi.require_version("Gdk", "4.0")
+    from gi.repository import Gdk, Gtk
+
+    return bool(Gtk.init_check()) and Gdk.Display.get_default() is not None
 
 
 def demo_map_path() -> Path:

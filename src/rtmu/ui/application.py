@@ -66,6 +66,8 @@ class RtmuApplication(Gtk.Application):
         self.settings = Settings()
         self.secrets = SessionSecrets(KeyringSecrets())
         self.settings_warning: str | None = None
+        self.failed = False
+        """The window could not be built (the error was printed); ``run_gui`` exits non-zero."""
         self._signal_sources: list[int] = []
 
     # -- lifecycle -----------------------------------------------------------------------------
@@ -93,16 +95,22 @@ class RtmuApplication(Gtk.Application):
         profile, auto_connect = self.choose_profile()
         self.model = Model()
         self.runner = ClientRunner(self.model, post=GLib.idle_add).start()
-        window = MainWindow(
-            self,
-            self.model,
-            self.runner,
-            profile=profile,
-            profiles=self.settings.profiles,
-            secrets=self.secrets,
-            keyring_available=self.secrets.available,
-            profile_saved=self.profile_saved,
-        )
+        try:
+            window = MainWindow(
+                self,
+                self.model,
+                self.runner,
+                profile=profile,
+                profiles=self.settings.profiles,
+                secrets=self.secrets,
+                keyring_available=self.secrets.available,
+                profile_saved=self.profile_saved,
+            )
+        except Exception:
+            self.failed = True
+            self.close_session()
+            self.quit()
+            raise
         self.window = window
         if self.options.report_first_frame:
             window.stage.on_first_map_frame = self._report_first_frame
