@@ -198,10 +198,11 @@ class MapStage(Gtk.DrawingArea):
         self.queue_draw()
 
     def _fit_to_map(self, data: object) -> None:
-        bounds = self.tiles.bounds or _data_bounds(data)
+        """Fit to the map's true extent, which the tile worker measures (not on this thread)."""
+        bounds = self.tiles.bounds
         if bounds is None:
-            self._fit_no_map()
-            return
+            return  # the index is being built; _tiles_ready fits again when it is
+
         self.viewport = fit_view(bounds, self.viewport.width, self.viewport.height)
         self._view_moved()
 
@@ -379,9 +380,3 @@ class MapStage(Gtk.DrawingArea):
             self._pinch_start = None
             self._publish_view()
             self.queue_draw()
-
-
-def _data_bounds(data: object) -> tuple[float, float, float, float] | None:
-    bounds = getattr(data, "bounds", None)
-    b = bounds() if callable(bounds) else None
-    return None if b is None else (float(b[0]), float(b[1]), float(b[2]), float(b[3]))
