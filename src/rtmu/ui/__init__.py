@@ -1,11 +1,13 @@
 """RTMU's GTK4 window: the view layer over ``rtmu.controller`` and ``rtmu.model``.
 
-One module per job: ``app`` (Gtk.Application, actions, entry points), ``window``
-(the main window and the controller's ``View``), ``keys`` (the key table and the
-capture-phase key router), ``toolbar`` + ``gauges`` (status), ``mapview`` (the
-map stage) over ``viewport`` (pure screen/world maths), ``tiles`` (the static
-map rendered off the GTK thread) and ``overlays`` (robot, trail, sonar, cairns),
-``camera``, ``banners``, ``settings_dialog``, ``move_dialogs``, ``dpad`` and
-``shortcuts``. No module here touches a socket or a packet; GTK is imported only
-by the widget modules (``viewport``, ``tiles`` and ``overlays`` run headless too).
+One module per job: ``app`` (entry points and options, no GTK import),
+``application`` (Gtk.Application: settings, network thread, window, shutdown),
+``window`` (the main window and the controller's ``View``), ``keys`` (the key
+table and the capture-phase key router), ``toolbar`` + ``gauges`` (status),
+``mapview`` (the map stage widget) over ``frame`` (one frame, GTK-free),
+``viewport`` (screen/world maths), ``tiles`` (the static map rendered off the
+GTK thread) and ``overlays`` (robot, trail, sonar, cairns), ``camera``,
+``banners``, ``settings_dialog``, ``move_dialogs``, ``dpad``, ``shortcuts`` and
+``style``. No module here touches a socket or a packet; ``viewport``, ``tiles``,
+``overlays`` and ``frame`` run without a display (the benchmark uses them).
 """
