@@ -42,12 +42,12 @@ def register(subparsers: Any) -> None:
     )
     add_connection_arguments(p)
     p.add_argument(
-        "--trans", type=float, default=0.0, metavar="PCT", help="−100…100 % of max speed (+ forward)"
+        "--trans", type=float, default=0.0, metavar="PCT", help="−100…100 %% of max speed (+ forward)"
     )
     p.add_argument(
-        "--rot", type=float, default=0.0, metavar="PCT", help="−100…100 % of max rotation (+ left)"
+        "--rot", type=float, default=0.0, metavar="PCT", help="−100…100 %% of max rotation (+ left)"
     )
-    p.add_argument("--throttle", type=float, default=50.0, metavar="PCT", help="0…100 % (default 50)")
+    p.add_argument("--throttle", type=float, default=50.0, metavar="PCT", help="0…100 %% (default 50)")
     p.add_argument("--seconds", type=float, required=True, metavar="S", help=f"0…{MAX_SECONDS:g}")
     p.add_argument("--json", action="store_true", help='one object {"before", "after", "seconds"}')
     p.set_defaults(handler=handle)
