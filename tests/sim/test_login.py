@@ -171,4 +171,21 @@ def test_server_introduction_has_fresh_keys_and_no_udp():
     assert all(all("0" <= ch <= "y" for ch in i.password_key) for i in intros)
 
 
+def test_same_seed_does_not_repeat_login_keys():
+    """Keys come from the OS, not ``--seed``: a restarted server must not reuse a recorded login's key."""
+
+    async def first_intro():
+        server = SimServer(SimConfig(port=0, realtime=False, seed=1))
+        await server.start()
+        c = await WireClient().open(server.port)
+        intro = c.conn.introduction
+        await c.close()
+        await server.stop()
+        return intro
+
+    a, b = run(first_intro()), run(first_intro())
+    assert a.password_key != b.password_key
+    assert (a.auth_key, a.intro_key) != (b.auth_key, b.intro_key)
+
+
 _ = SHARED

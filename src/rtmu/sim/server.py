@@ -59,6 +59,9 @@ CYCLE_S = 0.01
 MAX_CATCH_UP_STEPS = 50
 READ_CHUNK = 65536
 WARM_STREAMS_ABOVE_LINES = 100_000
+KEY_RNG = random.SystemRandom()
+"""Password, auth and intro keys come from the OS, never from ``--seed``: a seeded key would repeat on
+every restart, and a recorded login could then be replayed. The seed drives physics, wander and noise."""
 
 
 class SimServerConnection(ServerConnection):
@@ -275,7 +278,6 @@ class SimServer:
         self.datalist: DataList = build_catalogue(camera=cfg.camera)
         self.users: UserTable | None = UserTable.load(cfg.users_path) if cfg.users_path else None
         self.sessions: list[Session] = []
-        self._rng = random.Random(cfg.seed)
         self._ids = count(1)
         self._server: asyncio.base_events.Server | None = None
         self._cycle_task: asyncio.Task[None] | None = None
@@ -370,7 +372,7 @@ class SimServer:
             self.users,
             server_key=cfg.server_key,
             udp_port=0,
-            rng=random.Random(self._rng.getrandbits(64)),
+            rng=KEY_RNG,
             general_reject=general,
             config=cfg,
         )
