@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import hashlib
 from pathlib import Path
 
 import pytest
@@ -9,6 +10,7 @@ import pytest
 from rtmu.protocol.client_connection import ClientState
 from rtmu.protocol.commands import ClientType
 from rtmu.sim import SimConfig, SimServer
+from rtmu.sim.catalogue import build_catalogue
 
 from .wire import SHARED, WireClient, captured_datalist, run
 
@@ -78,6 +80,44 @@ def test_data_list_matches_serverdemo_capture_for_shared_names(shared_dir):
     # Same relative order as serverDemo registered them.
     order = [captured.number(e.name) for e in shared]
     assert order == sorted(order)
+
+
+OWN_WORDS = {
+    "SimulatorResetPose",
+    "SimulatorLowBattery",
+    "SimulatorRecharge",
+    "SimulatorSetBattery",
+    "SimulatorVideo320x240",
+    "SimulatorVideo640x480",
+    "popupCreate",
+    "popupClose",
+    "popupClicked",
+    "popupList",
+}
+# SHA-256 prefixes of the texts in ARIA's (GPL) popup handler source, which no capture carries: the
+# catalogue once had them word for word. Digests, so the test does not carry the texts either.
+ARIA_POPUP_SOURCE_TEXTS = {
+    "51292fa01b26c56b",
+    "12f81e9d98ad5be2",
+    "eeee65e85183546a",
+    "3e4df4c408e83f16",
+    "723f69e5ce38b48b",
+    "d5162f1cda6c2bf1",
+    "210cc8b51275c533",
+    "8078d62be7894fe8",
+    "fd1776d8405a4f91",
+}
+
+
+def test_texts_not_in_a_capture_are_our_own(shared_dir):
+    """Captured wire texts may be served as recorded; anything else must not be ARIA's source text."""
+    captured = captured_datalist(shared_dir / "captures" / "clientCommandLister-serverDemoMap.pcap")
+    ours = build_catalogue(camera=True)
+    assert {e.name for e in ours if e.name not in captured} == OWN_WORDS
+    for e in ours:
+        if e.name in OWN_WORDS:
+            for text in (e.description, e.argument_description, e.return_description):
+                assert hashlib.sha256(text.encode()).hexdigest()[:16] not in ARIA_POPUP_SOURCE_TEXTS, e.name
 
 
 def test_no_camera_removes_video_and_camera_data():

@@ -1,12 +1,15 @@
 # ruff: noqa: E501
 """The simulator's catalogue of data, shaped like ARIA's serverDemo (protocol §2.7–2.8, Appendix A).
 
-Names, descriptions, argument and return texts, command groups and flags are
-the ones serverDemo puts on the wire for the same data (they are part of the
-protocol a client sees), in serverDemo's registration order, numbered from 256.
-Data serverDemo has that the simulator does not serve (configuration editing,
-micro-controller pass-through, the laser) are left out; the simulator adds
-ARIA's popup handler and a few harmless commands of its own.
+Names, command groups and flags follow serverDemo, in its registration order,
+numbered from 256. Where serverDemo offers the same data, the description,
+argument and return texts are the wire texts an ARIA server sends and clients
+display, taken from a recording of serverDemo's list
+(``shared/captures/clientCommandLister-serverDemoMap.pcap``; a test checks
+them against it). Every text that appears in no capture — the popup data and
+the simulator's own commands — is written in our own words. Data serverDemo
+has that the simulator does not serve (configuration editing,
+micro-controller pass-through, the laser) are left out.
 """
 
 from __future__ import annotations
@@ -598,35 +601,36 @@ STRINGS: tuple[Row, ...] = (
 )
 
 POPUPS: tuple[Row, ...] = (
+    # No capture has ARIA's popup handler, so these texts are our own (names, groups and flags are ARIA's).
     (
         "popupCreate",
-        "Tells the gui to create a new popup",
-        "none (you can't send this command to the server)",
-        "byte4: id of this particular popup; string: ignoreIdentifier; string: title; string: message; byte: popupType (0 = NoIcon, 1 = Information, 2 = Warning, 3 = Critical, 4 = Question); string: button0Label; string: button1Label; string: button2Label; byte: defaultButton; byte: escapeButton",
+        "Broadcast when the robot raises a message box for the operator",
+        "none (sent by the server only)",
+        "byte4: popup id; string: ignoreIdentifier; string: title; string: message; byte: icon (0 none, 1 information, 2 warning, 3 critical, 4 question); string: label of button 0; string: label of button 1; string: label of button 2 (empty = no button); byte: default button; byte: escape button",
         "PopupGui",
         "RETURN_SINGLE",
     ),
     (
         "popupClose",
-        "Closes a popup that was created",
-        "none (you can't send this command to the server)",
-        "byte4: id of the popup to close; string: string to display",
+        "Broadcast when a message box is gone (answered or timed out)",
+        "none (sent by the server only)",
+        "byte4: popup id; string: text to show in its place",
         "PopupGui",
         "RETURN_SINGLE",
     ),
     (
         "popupClicked",
-        "Returns the clicked data of a popup ",
-        "byte4: id of the popup that was clicked; byte: buttonClicked",
-        "no response",
+        "Tells the robot which button the operator pressed in a message box",
+        "byte4: popup id; byte: button pressed (0-2)",
+        "none",
         "PopupGui",
         "RETURN_NONE",
     ),
     (
         "popupList",
-        "Resends all the popupCreates to this client that asked for this",
+        "Asks for every message box still open, to show them after connecting",
         "none",
-        "technically none, but it resends all the popupCreate events that are active",
+        "one popupCreate packet per open message box, then an empty packet",
         "PopupGui",
         "RETURN_NONE",
     ),
