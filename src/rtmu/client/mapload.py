@@ -15,6 +15,7 @@ from collections.abc import Callable
 from dataclasses import dataclass
 from typing import Any
 
+from ..mapfile.errors import MapFormatError
 from ..protocol.errors import ProtocolError
 from ..protocol.payloads.map import MapName
 from ..protocol.payloads.mapstream import MapBinaryAssembler, MapTextAssembler
@@ -58,7 +59,12 @@ async def download_map(
     timeout: float = REPLY_TIMEOUT,
     progress: Callable[[int], None] | None = None,
 ) -> Download:
-    """The whole map; ``timeout`` bounds the wait for each packet. Raises ClientError subclasses."""
+    """The whole map; ``timeout`` bounds the wait for each packet. Raises ClientError subclasses only.
+
+    A map the server got wrong (a bad header, broken binary blocks, a line break inside a
+    line) is a :class:`ProtocolFault` saying why — never a bare ``MapFormatError`` that would
+    leave a window "loading" for ever or print a traceback.
+    """
     source = map_source(client, prefer_binary)
     if source is None:
         raise NotSupported("getMap", "this server offers no map (neither getMapBinary nor getMap)")
@@ -73,7 +79,7 @@ async def download_map(
             progress(count)
     try:
         data = await asyncio.get_running_loop().run_in_executor(None, assembled_map, assembler)
-    except (ProtocolError, ValueError) as exc:
+    except (ProtocolError, MapFormatError, ValueError) as exc:
         raise ProtocolFault(f"the map from {source!r} is malformed: {exc}") from None
     return Download(data, name, source, count)
 

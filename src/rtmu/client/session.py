@@ -622,10 +622,10 @@ class Session:
         try:
             got = await download_map(client, timeout=self.config.reply_timeout, progress=progress)
         except ClientError as exc:
-            self._set_map(replace(self._map, state="failed", error=str(exc)))
-            if client.connected:
-                self._notice("warning", f"The map could not be loaded: {exc}")
-            return self._map
+            return self._map_failed(client, str(exc))
+        except Exception as exc:  # a bug must still end "loading": the window would wait for ever
+            log.exception("loading the map failed")
+            return self._map_failed(client, f"internal error: {exc}")
         if got.data is None:
             self._set_map(MapModel(state="none", name=got.name, generation=generation, received=got.packets))
             return self._map
@@ -634,6 +634,12 @@ class Session:
                 state="ready", data=got.data, name=got.name, generation=generation + 1, received=got.packets
             )
         )
+        return self._map
+
+    def _map_failed(self, client: AriaClient, reason: str) -> MapModel:
+        self._set_map(replace(self._map, state="failed", error=reason))
+        if client.connected:
+            self._notice("warning", f"The map could not be loaded: {reason}")
         return self._map
 
 

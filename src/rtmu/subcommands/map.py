@@ -9,7 +9,9 @@ from typing import Any
 
 from ..cli import EXIT_OK, EXIT_UNSUPPORTED
 from ..client.connection import AriaClient
+from ..client.errors import ProtocolFault
 from ..client.mapload import download_map
+from ..mapfile.errors import MapFormatError
 from ._common import add_connection_arguments, fail, run_with_client
 
 
@@ -33,7 +35,11 @@ def handle(args: argparse.Namespace) -> int:
         got = await download_map(client, prefer_binary=not args.text, timeout=args.timeout)
         if got.data is None:
             return fail("map", f"{args.server[0]}:{args.server[1]} has no map loaded", EXIT_UNSUPPORTED)
-        maps.write_map(got.data, args.out)
+        try:
+            maps.write_map(got.data, args.out)
+        except (MapFormatError, ValueError) as exc:  # parsed, yet not writable as a .map file
+            reason = f"the map from {got.source!r} cannot be written as a .map file: {exc}"
+            raise ProtocolFault(reason) from None
         name = f" ({got.name})" if got.name else ""
         print(
             f"wrote {args.out}{name}: {got.data.num_points} points, {got.data.num_lines} lines "

@@ -1,0 +1,79 @@
+"""Malformed data from a server: a typed one-line failure or a counted drop; never a hang or a traceback."""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+import pytest
+
+from rtmu.cli import EXIT_CONNECTION, main
+from rtmu.client.runner import ClientRunner
+from rtmu.client.session import SessionConfig
+from rtmu.model import Model, Phase
+
+from .servers import MAP_LINES, ServerThread, TestServer
+from .uiqueue import UiQueue
+
+BAD_HEADER_MAP = ["2D-Map", "NumPoints: many", *MAP_LINES[4:]]
+
+
+Connected = tuple[ClientRunner, Model, UiQueue, list[tuple[str, str]]]
+
+
+def _connected(server: TestServer, **config: object) -> Connected:
+    model, ui = Model(), UiQueue()
+    runner = ClientRunner(model, post=ui.post, config=SessionConfig(**config))  # type: ignore[arg-type]
+    notices: list[tuple[str, str]] = []
+    runner.on_notice = lambda level, text: notices.append((level, text))
+    runner.start()
+    runner.connect("127.0.0.1", server.port).result(5)
+    ui.wait_for(lambda: model.connection.value.phase is Phase.CONNECTED)
+    return runner, model, ui, notices
+
+
+@pytest.mark.parametrize("binary", [True, False])
+def test_a_map_with_a_bad_header_ends_as_failed_with_the_reason(binary: bool) -> None:
+    specs = None
+    if not binary:
+        from .servers import SPECS
+
+        specs = [row for row in SPECS if row[0] != "getMapBinary"]
+    with ServerThread(TestServer(specs, map_lines=BAD_HEADER_MAP)) as server:
+        runner, model, ui, notices = _connected(server)
+        try:
+            ui.wait_for(lambda: model.map.value.state == "failed")
+            assert "NumPoints" in model.map.value.error and "malformed" in model.map.value.error
+            ui.wait_for(lambda: any("map could not be loaded" in text for _, text in notices))
+            assert model.connection.value.phase is Phase.CONNECTED  # the link itself is fine
+        finally:
+            runner.close()
+
+
+def test_garbage_binary_blocks_end_as_failed() -> None:
+    server_obj = TestServer()
+
+    def broken(side, args):  # type: ignore[no-untyped-def]
+        # header, LINES, then a block whose length is not a whole number of segments
+        return [b"2D-Map\x00", b"LINES\x00", b"\x01\x02\x03", b""]
+
+    server_obj.handlers["getMapBinary"] = broken
+    with ServerThread(server_obj) as server:
+        runner, model, ui, _notices = _connected(server)
+        try:
+            ui.wait_for(lambda: model.map.value.state == "failed")
+            assert model.map.value.error
+        finally:
+            runner.close()
+
+
+@pytest.mark.parametrize("extra", [[], ["--text"]])
+def test_rtmu_map_with_a_bad_map_exits_3_with_one_line(
+    extra: list[str], tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    out = tmp_path / "x.map"
+    with ServerThread(TestServer(map_lines=BAD_HEADER_MAP)) as server:
+        code = main(["map", f"127.0.0.1:{server.port}", "--out", str(out), "--timeout", "5", *extra])
+    err = capsys.readouterr().err
+    assert code == EXIT_CONNECTION
+    assert err.count("\n") == 1 and err.startswith("rtmu map: ") and "NumPoints" in err
+    assert not out.exists()
