@@ -12,6 +12,10 @@ Figures (MB = 10^6 bytes), each against the simple way measured in the same run:
   field by field. Target: ≥ 100 000 packets/s on the 2-core reference machine.
 * ``codec.checksum_throughput``: the checksum of 32 000-byte packets. Baseline: ``checksum_naive``.
   Target: ≥ 200 MB/s.
+* ``codec.hostile_garbage_throughput``: ``0F 0C 00 7D`` repeated (a fake 32 000-byte header every 4
+  bytes, each failing its checksum) in 1448-byte segments: what one hostile peer can make the decoder
+  chew through. Baseline: the same tolerant rescan with each claimed span summed afresh (the decoder
+  before it kept prefix sums).
 """
 
 from __future__ import annotations
@@ -191,5 +195,47 @@ def bench_checksum() -> list[Result]:
     return [Result("codec.checksum_throughput", size / fast / 1e6, "MB/s", size / slow / 1e6)]
 
 
+def rescan_summing_each_span(chunks: list[bytes]) -> int:
+    """The baseline for hostile input: the decoder's tolerant rules, every span's checksum from scratch."""
+    buf = bytearray()
+    pos = bad = 0
+    for chunk in chunks:
+        buf += chunk
+        while (start := buf.find(b"\x0f\x0c", pos)) >= 0 and len(buf) - start >= 4:
+            length = buf[start + 2] | buf[start + 3] << 8
+            if not 8 <= length <= MAX_LENGTH:
+                pos = start + 4
+                continue
+            if len(buf) - start < length:
+                break
+            end = start + length - 2
+            if checksum(buf, end, start) != (buf[end] << 8 | buf[end + 1]):
+                bad += 1
+                pos = start + 2
+            else:
+                pos = start + length
+        if start < 0:
+            pos = len(buf)
+    return bad
+
+
+def hostile_bad_checksums(chunks: list[bytes]) -> int:
+    decoder = PacketDecoder()
+    for chunk in chunks:
+        decoder.feed(chunk)
+    return decoder.stats.bad_checksum
+
+
+def bench_hostile() -> list[Result]:
+    data = bytes.fromhex("0F 0C 00 7D") * (256 * 1024 // 4)
+    chunks = [data[i : i + 1448] for i in range(0, len(data), 1448)]
+    assert hostile_bad_checksums(chunks) == rescan_summing_each_span(chunks) > 0
+    fast = best_time(lambda: hostile_bad_checksums(chunks), repeat=3)
+    slow = best_time(lambda: rescan_summing_each_span(chunks), repeat=1, min_seconds=0)
+    return [
+        Result("codec.hostile_garbage_throughput", len(data) / fast / 1e6, "MB/s", len(data) / slow / 1e6)
+    ]
+
+
 def run() -> list[Result]:
-    return bench_stream() + bench_status() + bench_checksum()
+    return bench_stream() + bench_status() + bench_checksum() + bench_hostile()

@@ -9,6 +9,8 @@ from hypothesis import given
 from hypothesis import strategies as st
 
 from rtmu.protocol import MAX_LENGTH, Packet, PacketDecoder, encode_packet
+from rtmu.protocol import decoder as decoder_module
+from rtmu.protocol.checksum import SpanChecksums, checksum
 from rtmu.protocol.decoder import BadPacket, DropStats
 
 GOOD = encode_packet(0x0119, b"\x01")  # the §1.1 getSafeDrive reply: 0F 0C 09 00 19 01 01 00 18
@@ -233,3 +235,91 @@ def test_counters_for_a_hand_built_stream() -> None:
     )
     assert decoder.stats.dropped == 3
     assert decoder.stats.as_dict()["bad_checksum"] == 1
+
+
+# -- hostile input costs linear work -------------------------------------------------------------
+
+FAKE_HEADER = bytes.fromhex("0F 0C 00 7D")
+"""Sync plus length 32000: repeated, a fake full-size header every 4 bytes, each failing its checksum."""
+
+
+@pytest.fixture
+def summed_bytes(monkeypatch: pytest.MonkeyPatch) -> list[int]:
+    """Counts every byte the decoder sums: whole-span checksums and prefix-sum extensions."""
+    counter = [0]
+
+    def counting_checksum(data: bytes | bytearray, end: int | None = None, start: int = 0) -> int:
+        counter[0] += (len(data) if end is None else end) - start
+        return checksum(data, end, start)
+
+    real_extend = SpanChecksums.extend
+
+    def counting_extend(self: SpanChecksums, data: bytes | bytearray, stop: int) -> None:
+        counter[0] += max(0, stop - self.stop)
+        real_extend(self, data, stop)
+
+    monkeypatch.setattr(decoder_module, "checksum", counting_checksum)
+    monkeypatch.setattr(SpanChecksums, "extend", counting_extend)
+    return counter
+
+
+def hostile_stream() -> tuple[bytes, list[Packet]]:
+    """200 KB of fake headers with real packets planted inside the spans the fakes claim.
+
+    About 8000 fakes cover each planted packet, so one of them passes its checksum by chance now and
+    then (a genuine packet-shaped accident); these payloads were picked so that none does.
+    """
+    packets = [Packet(0x0200 + i, bytes([i]) * (i * 5 % 300)) for i in range(6)]
+    parts = []
+    for packet in packets:
+        parts += [FAKE_HEADER * 8000, packet.encode()]
+    return b"".join(parts) + FAKE_HEADER * 2000, packets
+
+
+@pytest.mark.parametrize("chunk", [1 << 20, 65536, 1460, 7])
+def test_fake_headers_cost_work_linear_in_the_bytes_fed(chunk: int, summed_bytes: list[int]) -> None:
+    """Before prefix sums every fake header cost a 32 KB checksum: 8000 times the input."""
+    data, planted = hostile_stream()
+    decoder = PacketDecoder()
+    found = []
+    for i in range(0, len(data), chunk):
+        found += decoder.feed(data[i : i + chunk])
+    found += decoder.close()
+    assert found == planted  # still tolerant: packets inside the fake spans are found
+    assert decoder.stats.bad_checksum > len(data) // 8
+    assert summed_bytes[0] <= 4 * len(data)
+
+
+def test_one_byte_feeds_of_fake_headers_cost_linear_work(summed_bytes: list[int]) -> None:
+    """Each byte completes another fake span: re-summing the buffer per feed would be quadratic."""
+    data = FAKE_HEADER * 12000 + GOOD
+    decoder = PacketDecoder()
+    found = [p for i in range(len(data)) for p in decoder.feed(data[i : i + 1])] + decoder.close()
+    assert found == [Packet(0x0119, b"\x01")]
+    assert decoder.stats.bad_checksum > 4000
+    assert summed_bytes[0] <= 4 * len(data)
+
+
+def test_kept_bad_packets_hold_at_most_the_bytes_fed() -> None:
+    """``keep_bad`` keeps a bad packet only clear of the last one kept, so fakes cannot multiply memory."""
+    data = FAKE_HEADER * 40000
+    decoder = PacketDecoder(keep_bad=True)
+    decoder.feed(data)
+    kept = decoder.bad_packets
+    assert kept and decoder.stats.bad_checksum > len(kept)
+    assert sum(len(bad.raw) for bad in kept) <= len(data)
+
+
+@given(st.binary(min_size=8, max_size=3000), st.data())
+def test_span_checksums_agree_with_the_checksum(data: bytes, draw: st.DataObject) -> None:
+    base = draw.draw(st.integers(0, len(data) - 8))
+    sums = SpanChecksums()
+    stops = sorted(draw.draw(st.lists(st.integers(base + 1, len(data)), min_size=1, max_size=5)))
+    sums.start(data, base, stops[0])
+    for stop in [*stops[1:], len(data)]:
+        sums.extend(data, stop)
+    assert sums.stop == len(data)
+    for _ in range(20):
+        start = draw.draw(st.integers(base, len(data) - 8))
+        end = draw.draw(st.integers(start + 6, len(data)))
+        assert sums.checksum(data, end, start) == checksum(data, end, start)

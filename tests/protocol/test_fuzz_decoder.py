@@ -9,7 +9,9 @@ from hypothesis import given
 from hypothesis import strategies as st
 
 from rtmu.protocol import MAX_LENGTH, MAX_PAYLOAD, DataList, Packet, PacketDecoder, ProtocolError
+from rtmu.protocol.checksum import checksum_naive
 from rtmu.protocol.client_connection import ClientConnection
+from rtmu.protocol.packet import MIN_LENGTH
 from rtmu.protocol.server_connection import ServerConnection
 
 from .test_decoder import feed_in_chunks, mixed_packets, packets_st
@@ -56,6 +58,80 @@ def test_every_valid_packet_in_garbage_is_found(
     accidental = [p for p in found if p not in planted]
     if not accidental:
         assert found == planted
+
+
+def reference_decode(stream: bytes) -> tuple[list[Packet], int, int, int]:
+    """The documented rules read literally, on the whole stream at once, with the per-byte checksum.
+
+    Returns the packets and the bad-length, bad-checksum and cut-off counts.
+    """
+    found: list[Packet] = []
+    bad_length = bad_checksum = truncated = 0
+    pos = 0
+    while (start := stream.find(b"\x0f\x0c", pos)) >= 0:
+        length = int.from_bytes(stream[start + 2 : start + 4], "little")
+        if len(stream) - start < 4:  # a sync pair cut off before its length field
+            truncated += 1
+            pos = start + 2
+        elif not MIN_LENGTH <= length <= MAX_LENGTH:
+            bad_length += 1
+            pos = start + 4
+        elif len(stream) - start < length:  # cut off by the end of the stream: rescan behind the header
+            truncated += 1
+            pos = start + 2
+        elif checksum_naive(stream[start : start + length - 2]) != int.from_bytes(
+            stream[start + length - 2 : start + length], "big"
+        ):
+            bad_checksum += 1
+            pos = start + 2
+        else:
+            found.append(
+                Packet(
+                    int.from_bytes(stream[start + 4 : start + 6], "little"),
+                    stream[start + 6 : start + length - 2],
+                )
+            )
+            pos = start + length
+    return found, bad_length, bad_checksum, truncated
+
+
+def _corrupted(packet: Packet, flip: int) -> bytes:
+    raw = bytearray(packet.encode())
+    raw[4 + flip % (len(raw) - 4)] ^= 0x5A
+    return bytes(raw)
+
+
+FALSE_HEADERS = st.builds(
+    lambda length, body: b"\x0f\x0c" + length.to_bytes(2, "little") + body,
+    st.integers(MIN_LENGTH, 200),
+    st.binary(max_size=6),
+)
+"""Headers with short, plausible lengths: their spans end inside the stream, so their checksums run."""
+hostile_piece = st.one_of(
+    garbage_st,
+    FALSE_HEADERS,
+    packets_st.map(Packet.encode),
+    st.builds(_corrupted, packets_st, st.integers(0, 1000)),
+)
+
+
+@given(st.lists(hostile_piece, max_size=40), st.data())
+def test_decoder_matches_the_literal_rules_on_hostile_streams(
+    pieces: list[bytes], data: st.DataObject
+) -> None:
+    """Failed checksums switch the decoder to prefix sums; the packets and counts must not change."""
+    stream = b"".join(pieces)
+    cuts = data.draw(st.lists(st.integers(0, len(stream)), max_size=10))
+    decoder = PacketDecoder()
+    found = feed_in_chunks(decoder, stream, cuts) + decoder.close()
+    packets, bad_length, bad_checksum, truncated = reference_decode(stream)
+    assert found == packets
+    stats = decoder.stats
+    assert (stats.bad_length, stats.bad_checksum, stats.truncated_at_close) == (
+        bad_length,
+        bad_checksum,
+        truncated,
+    )
 
 
 def test_planted_packets_survive_heavy_noise() -> None:

@@ -13,6 +13,15 @@ garbage:
 At the end of a stream :meth:`PacketDecoder.close` gives up on a header whose
 body never arrived and rescans the bytes behind it.
 
+The second point invites abuse: ``0F 0C 00 7D`` repeated is a fake 32000-byte
+header every 4 bytes, and checking each span afresh would cost 8000 times the
+bytes received (seconds of CPU per MB). So once a checksum fails, the decoder
+keeps prefix sums of the buffer's 16-bit words (:class:`SpanChecksums`) and
+checks every further span in O(1) until the buffer is next compacted; a clean
+stream never pays for them. Bad packets kept for tools (``keep_bad``) never
+overlap, so what they hold is bounded by the bytes fed as well. Total work is
+O(bytes fed) for any input.
+
 Nothing in here raises on network input; every dropped byte is counted.
 """
 
@@ -20,7 +29,7 @@ from __future__ import annotations
 
 from dataclasses import dataclass, fields
 
-from .checksum import checksum
+from .checksum import SpanChecksums, checksum
 from .packet import MAX_LENGTH, MIN_LENGTH, SYNC, Packet
 
 _COMPACT_AT = 64 * 1024
@@ -63,14 +72,19 @@ class PacketDecoder:
     """Feed bytes with :meth:`feed`; it returns the good packets found so far.
 
     Memory is bounded: at most one packet's worth (32000 bytes) plus the last
-    chunk is ever held, whatever the peer sends.
+    chunk is ever held, whatever the peer sends (after a bad checksum, plus 8
+    bytes of prefix sums per byte held).
     """
 
-    __slots__ = ("_buf", "_pos", "bad_packets", "keep_bad", "stats")
+    __slots__ = ("_bad_until", "_buf", "_pos", "_sums", "bad_packets", "keep_bad", "stats")
 
     def __init__(self, *, keep_bad: bool = False) -> None:
         self._buf = bytearray()
         self._pos = 0
+        self._sums = SpanChecksums()
+        """Active only after a checksum failed, until the buffer is compacted."""
+        self._bad_until = 0
+        """Where the last kept bad packet ends in the buffer: the next kept one starts there or later."""
         self.stats = DropStats()
         self.keep_bad = keep_bad
         self.bad_packets: list[BadPacket] = []
@@ -101,6 +115,9 @@ class PacketDecoder:
         self.stats.garbage_bytes += self.buffered
         self._buf.clear()
         self._pos = 0
+        self._bad_until = 0
+        if self._sums.active:
+            self._sums.clear()
         return found
 
     def _drain(self) -> list[Packet]:
@@ -110,6 +127,8 @@ class PacketDecoder:
         pos = self._pos
         end = len(buf)
         stats = self.stats
+        sums = self._sums
+        spans_summed = sums.active
         found: list[Packet] = []
         garbage = 0
         while True:
@@ -133,11 +152,21 @@ class PacketDecoder:
             if end - pos < length:
                 break
             body_end = pos + length - 2
-            if checksum(buf, body_end, pos) != (buf[body_end] << 8 | buf[body_end + 1]):
+            if spans_summed:
+                if sums.stop < end:
+                    sums.extend(buf, end)
+                good = sums.checksum(buf, body_end, pos) == (buf[body_end] << 8 | buf[body_end + 1])
+            else:
+                good = checksum(buf, body_end, pos) == (buf[body_end] << 8 | buf[body_end + 1])
+            if not good:
                 stats.bad_checksum += 1
-                if self.keep_bad:
+                if not spans_summed:
+                    sums.start(buf, pos, end)
+                    spans_summed = True
+                if self.keep_bad and pos >= self._bad_until:
                     command = buf[pos + 4] | buf[pos + 5] << 8
                     self.bad_packets.append(BadPacket(command, length, bytes(buf[pos : pos + length])))
+                    self._bad_until = pos + length
                 garbage += 2
                 pos += 2
                 continue
@@ -147,6 +176,9 @@ class PacketDecoder:
         stats.packets += len(found)
         if pos >= _COMPACT_AT or pos == end:
             del buf[:pos]
+            self._bad_until = max(0, self._bad_until - pos)
             pos = 0
+            if spans_summed:
+                sums.clear()  # offsets moved; the next failure starts afresh from its own position
         self._pos = pos
         return found
