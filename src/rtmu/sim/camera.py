@@ -4,14 +4,16 @@ One ray per image column (numpy, all columns at once) finds the nearest wall;
 its distance gives the wall's height on screen and its brightness (nearer is
 taller and lighter). Floor and ceiling are shaded bands. The camera has a
 VC-C4-like pan/tilt/zoom head, so ``setCameraAbs`` and friends change the view.
-Frames are cached by pose, so fifty clients watching one robot cost one render.
+
+A :class:`View` is a frozen copy of everything a picture depends on, so it can
+be rendered on another thread while the world moves on; :mod:`.video` decides
+when to render and shares each frame between clients.
 """
 
 from __future__ import annotations
 
 import io
 import math
-from collections import OrderedDict
 from dataclasses import dataclass
 
 import numpy as np
@@ -57,83 +59,96 @@ class PanTiltZoom:
         return WIDE_FOV_DEG * ratio ** (self.zoom / 100.0)
 
 
+@dataclass(frozen=True, slots=True)
+class View:
+    """What the camera sees from: robot pose (mm, mm, degrees), head settings, picture size and the walls.
+
+    Equal views give equal pictures (pose rounded to 1 mm and 0.1 degree; the walls compared by identity).
+    """
+
+    x: float
+    y: float
+    th: float
+    pan: float
+    tilt: float
+    zoom: float
+    size: tuple[int, int]
+    obstacles: Obstacles
+
+
 class Camera:
-    def __init__(self, obstacles: Obstacles, cache_size: int = 16) -> None:
+    def __init__(self, obstacles: Obstacles) -> None:
         self.obstacles = obstacles
         self.ptz = PanTiltZoom()
-        self._cache: OrderedDict[tuple, bytes] = OrderedDict()
-        self._cache_size = cache_size
-        self.renders = 0
 
-    def jpeg(self, x: float, y: float, th: float, size: tuple[int, int], quality: int = 75) -> bytes:
-        """The JPEG the camera sees from robot pose (x, y, th), cached by pose and settings."""
-        quality = int(min(max(quality, 1), 95))
+    def view(self, x: float, y: float, th: float, size: tuple[int, int]) -> View:
+        """A snapshot of what a picture from robot pose (x, y, th degrees) would show now."""
         p = self.ptz
-        key = (
-            round(x),
-            round(y),
+        return View(
+            float(round(x)),
+            float(round(y)),
             round(th, 1),
-            size,
-            quality,
             round(p.pan, 2),
             round(p.tilt, 2),
             round(p.zoom, 2),
+            size,
+            self.obstacles,
         )
-        cached = self._cache.get(key)
-        if cached is not None:
-            self._cache.move_to_end(key)
-            return cached
-        pixels = self.render(x, y, th, size)
-        data = encode_jpeg(pixels, quality)
-        self._cache[key] = data
-        if len(self._cache) > self._cache_size:
-            self._cache.popitem(last=False)
-        return data
 
     def render(self, x: float, y: float, th: float, size: tuple[int, int]) -> np.ndarray:
         """An (h, w, 3) uint8 picture from robot pose (x, y, th degrees)."""
-        self.renders += 1
-        w, h = size
-        p = self.ptz
-        f = (w / 2) / math.tan(math.radians(p.fov_deg) / 2)
-        heading = math.radians(th + p.pan)
-        t = math.radians(th)
-        cx = x + CAMERA_X_MM * math.cos(t)
-        cy = y + CAMERA_X_MM * math.sin(t)
-        cols = np.arange(w, dtype=np.float64)
-        offsets = np.arctan((w / 2 - cols - 0.5) / f)
-        dist = self.obstacles.cast(cx, cy, heading + offsets, VIEW_RANGE_MM)
-        perp = dist * np.cos(offsets)
-        horizon = h / 2 + f * math.tan(math.radians(p.tilt))
-        rows = np.arange(h, dtype=np.float64)[:, None]
+        return render_view(self.view(x, y, th, size))
 
-        img = np.empty((h, w, 3), dtype=np.float64)
-        # Ceiling: pale, darkening towards the horizon; floor: grey-brown, lighter near the robot.
-        above = np.clip((horizon - rows) / max(h, 1), 0.0, 1.0)
-        below = np.clip((rows - horizon) / max(h, 1), 0.0, 1.0)
-        sky = np.array([170.0, 180.0, 195.0])
-        floor = np.array([95.0, 85.0, 75.0])
-        img[:] = np.where(rows < horizon, 1.0, 0.0)[..., None] * (sky * (0.75 + 0.25 * above))[:, None, :]
-        img += np.where(rows >= horizon, 1.0, 0.0)[..., None] * (floor * (0.55 + 0.9 * below))[:, None, :]
 
-        finite = np.isfinite(perp)
-        safe_perp = np.where(finite, np.maximum(perp, 1.0), 1.0)
-        top = horizon - f * (WALL_HEIGHT_MM - CAMERA_HEIGHT_MM) / safe_perp
-        bottom = horizon + f * CAMERA_HEIGHT_MM / safe_perp
-        wall = finite[None, :] & (rows >= top[None, :]) & (rows <= bottom[None, :])
-        light = np.clip(1.15 - safe_perp / 9000.0, 0.25, 1.0)
-        wall_colour = np.array([225.0, 205.0, 170.0])[None, :] * light[:, None]
-        # A darker skirting band at the foot of the wall gives a sense of the floor line.
-        skirting = (rows > bottom[None, :] - np.maximum((bottom - top) * 0.06, 1.0)[None, :]) & wall
-        img = np.where(wall[..., None], wall_colour[None, :, :], img)
-        img = np.where(skirting[..., None], img * 0.6, img)
-        return np.clip(img, 0, 255).astype(np.uint8)
+def render_view(view: View) -> np.ndarray:
+    """An (h, w, 3) uint8 picture of ``view``. Touches nothing shared, so it may run on a worker thread."""
+    x, y, th = view.x, view.y, view.th
+    w, h = view.size
+    ptz = PanTiltZoom(view.pan, view.tilt, view.zoom)
+    f = (w / 2) / math.tan(math.radians(ptz.fov_deg) / 2)
+    heading = math.radians(th + ptz.pan)
+    t = math.radians(th)
+    cx = x + CAMERA_X_MM * math.cos(t)
+    cy = y + CAMERA_X_MM * math.sin(t)
+    cols = np.arange(w, dtype=np.float64)
+    offsets = np.arctan((w / 2 - cols - 0.5) / f)
+    dist = view.obstacles.cast(cx, cy, heading + offsets, VIEW_RANGE_MM)
+    perp = dist * np.cos(offsets)
+    horizon = h / 2 + f * math.tan(math.radians(ptz.tilt))
+    rows = np.arange(h, dtype=np.float64)[:, None]
+
+    img = np.empty((h, w, 3), dtype=np.float64)
+    # Ceiling: pale, darkening towards the horizon; floor: grey-brown, lighter near the robot.
+    above = np.clip((horizon - rows) / max(h, 1), 0.0, 1.0)
+    below = np.clip((rows - horizon) / max(h, 1), 0.0, 1.0)
+    sky = np.array([170.0, 180.0, 195.0])
+    floor = np.array([95.0, 85.0, 75.0])
+    img[:] = np.where(rows < horizon, 1.0, 0.0)[..., None] * (sky * (0.75 + 0.25 * above))[:, None, :]
+    img += np.where(rows >= horizon, 1.0, 0.0)[..., None] * (floor * (0.55 + 0.9 * below))[:, None, :]
+
+    finite = np.isfinite(perp)
+    safe_perp = np.where(finite, np.maximum(perp, 1.0), 1.0)
+    top = horizon - f * (WALL_HEIGHT_MM - CAMERA_HEIGHT_MM) / safe_perp
+    bottom = horizon + f * CAMERA_HEIGHT_MM / safe_perp
+    wall = finite[None, :] & (rows >= top[None, :]) & (rows <= bottom[None, :])
+    light = np.clip(1.15 - safe_perp / 9000.0, 0.25, 1.0)
+    wall_colour = np.array([225.0, 205.0, 170.0])[None, :] * light[:, None]
+    # A darker skirting band at the foot of the wall gives a sense of the floor line.
+    skirting = (rows > bottom[None, :] - np.maximum((bottom - top) * 0.06, 1.0)[None, :]) & wall
+    img = np.where(wall[..., None], wall_colour[None, :, :], img)
+    img = np.where(skirting[..., None], img * 0.6, img)
+    return np.clip(img, 0, 255).astype(np.uint8)
+
+
+def render_jpeg(view: View, quality: int) -> bytes:
+    """``view`` rendered and JPEG-encoded: the whole cost of one frame, in one call for a worker thread."""
+    return encode_jpeg(render_view(view), quality)
 
 
 def encode_jpeg(pixels: np.ndarray, quality: int) -> bytes:
     """JPEG bytes small enough for one ArNetworking packet (quality is lowered until it fits)."""
     image = Image.fromarray(pixels, "RGB")
-    q = quality
+    q = int(min(max(quality, 1), 95))
     while True:
         buf = io.BytesIO()
         image.save(buf, "JPEG", quality=q)

@@ -35,6 +35,8 @@ class SimConfig:
     """Pretend to be managed by a central server at this address: every login gets reason 2."""
     video_trailer: bool = True
     """Append the 2 bytes ARIA's video forwarder leaves after each JPEG (serverDemo does this)."""
+    render_in_thread: bool | None = None
+    """Render camera frames on a worker thread; None: in real-time mode only (inline on the manual clock)."""
     intro_timeout: float = 60.0
     backup_timeout: float = 5.0
     """Drop a client whose queued output has not moved for this long (ARIA's backup timeout)."""

@@ -422,27 +422,37 @@ CAMERA_COMMANDS = (
     ("setCameraRelInt", "camera", -1),
 )
 CAMERA_MODES = ("Position",)
-DEFAULT_QUALITY = 75
 
 
-def _frame(call: Call, cls: type[VideoFrame]) -> bytes:
+def _frame(call: Call, cls: type[VideoFrame]) -> Iterable[Reply]:
+    """The shared latest frame (see :mod:`.video`); when it is being rendered the reply follows later."""
     try:
         quality = VideoRequest.decode(call.args).quality
     except (FieldUnderrun, PayloadError, ValueError):
         quality = None
-    size = call.server.video_size
-    jpeg = call.world.camera_jpeg(size, DEFAULT_QUALITY if quality is None else quality)
-    return cls(size[0], size[1], jpeg, call.server.video_trailer()).encode()
+    server, session, number = call.server, call.session, call.number
+    size = server.video_size
+    trailer = server.video_trailer()
+
+    def payload(jpeg: bytes) -> bytes:
+        return cls(size[0], size[1], jpeg, trailer).encode()
+
+    def deliver(jpeg: bytes) -> None:
+        session.send(number, payload(jpeg))
+
+    view = call.world.camera_view(size)
+    jpeg = server.video.picture(view, call.world.time, quality, (session.ident, number), deliver)
+    return () if jpeg is None else (payload(jpeg),)
 
 
 @handles("sendVideo")
 def _send_video(call: Call) -> Iterable[Reply]:
-    return (_frame(call, VideoFrame),)
+    return _frame(call, VideoFrame)
 
 
 @handles("getPictureCam1")
 def _get_picture(call: Call) -> Iterable[Reply]:
-    return (_frame(call, Picture),)
+    return _frame(call, Picture)
 
 
 @handles("videoSize")

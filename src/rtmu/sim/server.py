@@ -50,6 +50,7 @@ from .handlers import (
     strings_payload,
 )
 from .mapserve import ServedMap, load_map
+from .video import VideoFeed
 from .world import PHYSICS_DT, World, free_spot_near
 
 log = logging.getLogger("rtmu.sim")
@@ -289,6 +290,8 @@ class SimServer:
         self.cycles = 0
         self.cpu = CpuMeter()
         self.video_size: tuple[int, int] = (320, 240)
+        threaded = cfg.realtime if cfg.render_in_thread is None else cfg.render_in_thread
+        self.video = VideoFeed(threaded=threaded)
 
     @property
     def robot(self):
@@ -321,6 +324,8 @@ class SimServer:
             with contextlib.suppress(asyncio.CancelledError):
                 await self._cycle_task
             self._cycle_task = None
+        await self.video.settle()
+        self.video.close()
         if self._server is not None:
             self._server.close()
         for s in list(self.sessions):
@@ -349,6 +354,7 @@ class SimServer:
             self._cycle_task = None
         if self._server is not None:
             self._server.close()
+        self.video.close()
         for s in list(self.sessions):
             s.abort()
 

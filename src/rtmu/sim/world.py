@@ -14,7 +14,7 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from . import p3dx
-from .camera import Camera
+from .camera import Camera, View
 from .geometry import Obstacles
 from .modes import JogMode, Mode, RatioDriveMode, StopMode, WanderMode
 from .robot import Body
@@ -254,9 +254,10 @@ class World:
     def wifi(self) -> Link:
         return self.access_point.link(self.body.x, self.body.y)
 
-    def camera_jpeg(self, size: tuple[int, int], quality: int) -> bytes:
+    def camera_view(self, size: tuple[int, int]) -> View:
+        """What a picture of ``size`` taken now would show (render it with :func:`.camera.render_view`)."""
         b = self.body
-        return self.camera.jpeg(b.x, b.y, b.th, size, quality)
+        return self.camera.view(b.x, b.y, b.th, size)
 
     def snapshot(self) -> RobotSnapshot:
         b, r = self.body, self.ratio_mode
