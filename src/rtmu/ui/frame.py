@@ -34,6 +34,7 @@ class Scene:
 
 def draw_frame(ctx: cairo.Context, vp: Viewport, scene: Scene) -> bool:
     """Draw one frame; True when a map is shown with every visible tile ready."""
+    ctx.new_path()  # every helper starts its own path too; a frame never inherits one
     ctx.set_source_rgb(*BACKGROUND_RGB)
     ctx.paint()
     complete = False
@@ -58,6 +59,7 @@ def draw_tiles(ctx: cairo.Context, vp: Viewport, tiles: TileCache) -> bool:
     spots = tiles.visible(vp.scale, vp.origin, vp.width, vp.height)
     overview = tiles.overview
     complete = True
+    ctx.new_path()
     for spot in spots:
         surface = spot.surface
         if surface is EMPTY:
@@ -78,6 +80,7 @@ def _from_overview(ctx: cairo.Context, vp: Viewport, overview: Overview, x: int,
     ratio = vp.scale / overview.scale
     ox, oy = vp.origin
     ctx.save()
+    ctx.new_path()
     ctx.rectangle(x, y, TILE, TILE)
     ctx.clip()
     ctx.translate(ox, oy)

@@ -90,6 +90,7 @@ def draw_grid(ctx: cairo.Context, vp: Viewport) -> float:
     step = grid_step_mm(vp.scale)
     x0, y0, x1, y1 = vp.visible_world()
     ctx.save()
+    ctx.new_path()
     ctx.set_line_width(1.0)
     for major in (False, True):
         ctx.set_source_rgba(*(GRID_MAJOR if major else GRID_MINOR))
@@ -123,12 +124,14 @@ def draw_scale_note(ctx: cairo.Context, labels: LabelCache, text: str) -> None:
     layout = labels.layout(text)
     _ink, logical = layout.get_pixel_extents()
     ctx.save()
+    ctx.new_path()
     ctx.set_source_rgba(1, 1, 1, 0.8)
     ctx.rectangle(6, 6, logical.width + 10, logical.height + 4)
     ctx.fill()
     ctx.set_source_rgba(0, 0, 0, 0.7)
     ctx.move_to(11, 8)
     PangoCairo.show_layout(ctx, layout)
+    ctx.new_path()  # show_layout leaves the current point at the text: the next shape must not join it
     ctx.restore()
 
 
@@ -201,6 +204,7 @@ def _draw_area(
     rgb = FORBIDDEN_RGB if forbidden else AREA_RGB
     corners = [vp.to_screen(x, y) for x, y in region_corners(obj, from_xy, to_xy)]
     ctx.save()
+    ctx.new_path()
     ctx.move_to(*corners[0])
     for c in corners[1:]:
         ctx.line_to(*c)
@@ -223,6 +227,7 @@ def _draw_forbidden_line(
     ctx: cairo.Context, vp: Viewport, from_xy: tuple[float, float], to_xy: tuple[float, float]
 ) -> None:
     ctx.save()
+    ctx.new_path()
     ctx.set_source_rgba(*FORBIDDEN_RGB, 0.9)
     ctx.set_line_width(3.0)
     ctx.set_dash([8.0, 5.0])
@@ -234,6 +239,7 @@ def _draw_forbidden_line(
 
 def _marker(ctx: cairo.Context, sx: float, sy: float, rgb: tuple[float, float, float], shape: str) -> None:
     ctx.save()
+    ctx.new_path()
     ctx.translate(sx, sy)
     ctx.set_line_width(1.5)
     if shape == "house":
@@ -251,6 +257,7 @@ def _marker(ctx: cairo.Context, sx: float, sy: float, rgb: tuple[float, float, f
         ctx.rectangle(-7, -5, 14, 10)
     else:
         ctx.arc(0, 0, 4, 0, 2 * math.pi)
+        ctx.close_path()
     ctx.set_source_rgb(*rgb)
     ctx.fill_preserve()
     ctx.set_source_rgba(1, 1, 1, 0.9)
@@ -264,6 +271,7 @@ def _heading_tick(
 ) -> None:
     th = math.radians(th_deg)
     ctx.save()
+    ctx.new_path()
     ctx.set_source_rgb(*rgb)
     ctx.set_line_width(2.0)
     ctx.move_to(sx, sy)
@@ -296,12 +304,14 @@ def _draw_labels(ctx: cairo.Context, labels: LabelCache, pending: list[_Label]) 
             continue
         taken.append(box)
         ctx.save()
+        ctx.new_path()
         ctx.set_source_rgba(1, 1, 1, 0.78)
         ctx.rectangle(box[0], box[1], box[2] - box[0], box[3] - box[1])
         ctx.fill()
         ctx.set_source_rgb(*(c * 0.75 for c in item.rgb))
         ctx.move_to(x, y)
         PangoCairo.show_layout(ctx, layout)
+        ctx.new_path()
         ctx.restore()
 
 
@@ -313,6 +323,7 @@ def draw_trail(ctx: cairo.Context, vp: Viewport, trail: Iterable[tuple[float, fl
     if len(points) < 2:
         return
     ctx.save()
+    ctx.new_path()
     ctx.set_source_rgba(*TRAIL_RGBA)
     ctx.set_line_width(3.0)
     ctx.set_line_join(cairo.LINE_JOIN_ROUND)
@@ -333,6 +344,7 @@ def draw_sonar(
     if not dots:
         return
     ctx.save()
+    ctx.new_path()
     ctx.set_source_rgba(*SONAR_RGB, 0.22)
     ctx.set_line_width(1.0)
     for sx, sy in dots:
@@ -341,6 +353,7 @@ def draw_sonar(
     ctx.stroke()
     ctx.set_source_rgba(*SONAR_RGB, 0.95)
     for sx, sy in dots:
+        ctx.new_sub_path()  # each dot on its own: no line from the previous one
         ctx.arc(sx, sy, 3.0, 0, 2 * math.pi)
         ctx.close_path()
     ctx.fill()
@@ -368,13 +381,16 @@ def draw_robot(
     th = math.radians(th_deg)
     rgb = STALE_RGB if stale else ROBOT_RGB
     ctx.save()
+    ctx.new_path()  # whatever an earlier helper left as the current point must not join the body
     ctx.translate(sx, sy)
     ctx.rotate(-th)  # screen y is down: a counter-clockwise heading turns the other way on screen
     if footprint:
         _rounded_rect(ctx, -ROBOT_REAR_MM * k, -ROBOT_HALF_WIDTH_MM * k, (ROBOT_FRONT_MM + ROBOT_REAR_MM) * k,
                       2 * ROBOT_HALF_WIDTH_MM * k, 60 * k)  # fmt: skip
     else:
+        ctx.new_sub_path()
         ctx.arc(0, 0, ROBOT_RADIUS_MM * k, 0, 2 * math.pi)
+        ctx.close_path()
     ctx.set_source_rgba(*rgb, 0.55 if stale else 0.9)
     ctx.fill_preserve()
     ctx.set_source_rgba(0.05, 0.1, 0.2, 0.9)
