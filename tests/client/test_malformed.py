@@ -77,3 +77,62 @@ def test_rtmu_map_with_a_bad_map_exits_3_with_one_line(
     assert code == EXIT_CONNECTION
     assert err.count("\n") == 1 and err.startswith("rtmu map: ") and "NumPoints" in err
     assert not out.exists()
+
+
+def _bad_status_server() -> TestServer:
+    server = TestServer()
+    server.handlers["updateNumbers"] = lambda s, a: [b"\x01"]  # one byte of a 19-byte status
+    return server
+
+
+@pytest.mark.parametrize(
+    "args",
+    [
+        ["status", "--once"],
+        ["status", "--count", "2", "--interval", "20"],
+        ["drive", "--trans", "10", "--seconds", "0.2"],
+    ],
+)
+def test_a_malformed_status_exits_3_with_one_line(
+    args: list[str], capsys: pytest.CaptureFixture[str]
+) -> None:
+    with ServerThread(_bad_status_server()) as server:
+        code = main([args[0], f"127.0.0.1:{server.port}", *args[1:], "--timeout", "0.5"])
+    err = capsys.readouterr().err
+    assert code == EXIT_CONNECTION, err
+    assert err.count("\n") == 1 and err.startswith(f"rtmu {args[0]}: ") and "malformed" in err
+    assert "Traceback" not in err
+
+
+def test_a_bad_status_packet_is_counted_and_the_session_goes_on() -> None:
+    from .fakeclock import FakeClock
+
+    sent = [0]
+    server_obj = TestServer()
+
+    def every_other_bad(side, args):  # type: ignore[no-untyped-def]
+        sent[0] += 1
+        if sent[0] % 2 == 0:
+            return [b"\x01"]
+        server_obj.state["x"] = sent[0]
+        from .servers import _numbers
+
+        return [_numbers(server_obj.state)]
+
+    server_obj.handlers["updateNumbers"] = every_other_bad
+    with ServerThread(server_obj) as server:
+        model, ui = Model(), UiQueue()
+        runner = ClientRunner(
+            model, post=ui.post, clock=FakeClock(), config=SessionConfig(status_interval_ms=20)
+        )
+        runner.start()
+        try:
+            runner.connect("127.0.0.1", server.port).result(5)
+            ui.wait_for(lambda: model.connection.value.phase is Phase.CONNECTED)
+            ui.wait_for(lambda: model.health.value.dropped >= 3 and model.robot.value.x >= 7)
+            runner.sync()
+            ui.drain()
+            assert model.connection.value.phase is Phase.CONNECTED
+            assert runner.call(lambda: runner.session.client.connected)  # type: ignore[union-attr]
+        finally:
+            runner.close()

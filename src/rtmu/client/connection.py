@@ -42,6 +42,7 @@ from .errors import (
     ConnectionFailed,
     ConnectionRefused,
     LoginRejected,
+    MalformedReply,
     NotSupported,
     ProtocolFault,
     ServerClosed,
@@ -101,11 +102,8 @@ class Reply:
         return self.payloads[0] if self.payloads else b""
 
     def decode(self) -> Payload:
-        """The first payload as its typed reply class (``rtmu.protocol.payloads``)."""
-        typed = decode_payload(self.name, Side.REPLY, self.payload)
-        if typed is None:
-            raise NotSupported(self.name, f"RTMU has no decoder for {self.name!r} replies")
-        return typed
+        """The first payload as its typed reply class; :class:`MalformedReply` if it does not decode."""
+        return _decode_typed(self.name, self.payload, "replies")
 
 
 @dataclass(frozen=True, slots=True)
@@ -117,10 +115,17 @@ class Packet:
     received_at: float
 
     def decode(self) -> Payload:
-        typed = decode_payload(self.name, Side.REPLY, self.payload)
-        if typed is None:
-            raise NotSupported(self.name, f"RTMU has no decoder for {self.name!r} packets")
-        return typed
+        return _decode_typed(self.name, self.payload, "packets")
+
+
+def _decode_typed(name: str, payload: bytes, what: str) -> Payload:
+    try:
+        typed = decode_payload(name, Side.REPLY, payload)
+    except ProtocolError as exc:
+        raise MalformedReply(f"the server sent a malformed {name!r} packet: {exc}") from None
+    if typed is None:
+        raise NotSupported(name, f"RTMU has no decoder for {name!r} {what}")
+    return typed
 
 
 Handler = Callable[[Packet], None]

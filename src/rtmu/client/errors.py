@@ -9,6 +9,7 @@ from __future__ import annotations
 
 from ..cli import EXIT_CONNECTION, EXIT_TIMEOUT, EXIT_UNSUPPORTED
 from ..protocol.commands import RejectReason, describe_reject
+from ..protocol.errors import ProtocolError
 
 
 class ClientError(Exception):
@@ -63,6 +64,15 @@ class ProtocolFault(ClientError):
     """The server sent something that is not ArNetworking (or not in the state we were in)."""
 
     kind = "protocol"
+
+
+class MalformedReply(ProtocolFault, ProtocolError):
+    """A reply arrived intact (checksum good) but its payload does not decode as that data's type.
+
+    Also a :class:`~rtmu.protocol.errors.ProtocolError`, so code that already catches the
+    protocol layer's errors keeps working; as a :class:`ClientError` it reaches the operator
+    as one line (exit 3) instead of a traceback.
+    """
 
 
 class NotSupported(ClientError):

@@ -365,8 +365,11 @@ class Session:
         try:
             return decode_payload(name, Side.REPLY, payload)
         except ProtocolError as exc:
+            # Counted (the health shows it), logged sparingly: a 10 Hz stream of bad packets must
+            # neither flood the log nor end the link; the next good packet is used as usual.
             self.health.bad_payloads += 1
-            log.warning("undecodable %s packet: %s", name, exc)
+            if self.health.bad_payloads <= 10 or self.health.bad_payloads % 1000 == 0:
+                log.warning("undecodable %s packet (%d so far): %s", name, self.health.bad_payloads, exc)
             return None
 
     def _on_numbers(self, packet: Packet) -> None:

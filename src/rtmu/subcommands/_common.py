@@ -29,6 +29,7 @@ from typing import Any
 from ..cli import EXIT_CONNECTION, EXIT_OK, EXIT_USAGE
 from ..client.connection import CONNECT_TIMEOUT, DEFAULT_PORT, AriaClient
 from ..client.errors import ClientError
+from ..protocol.errors import ProtocolError
 
 MAX_PASSWORD_FILE = 4096
 
@@ -149,6 +150,8 @@ def run_with_client(name: str, args: argparse.Namespace, body: Callable[[AriaCli
         return asyncio.run(main())
     except ClientError as exc:
         return fail(name, str(exc), exc.exit_code)
+    except ProtocolError as exc:  # a reply that does not decode, wherever a command looked at it
+        return fail(name, f"the server sent something malformed: {exc}", EXIT_CONNECTION)
     except UsageError as exc:
         return fail(name, str(exc), EXIT_USAGE)
     except (KeyboardInterrupt, asyncio.CancelledError):

@@ -15,7 +15,7 @@ from typing import Any
 
 from ..cli import EXIT_OK
 from ..client.connection import AriaClient, Packet
-from ..client.errors import ClientTimeout, NotSupported
+from ..client.errors import ClientTimeout, NotSupported, ProtocolFault
 from ..protocol.errors import ProtocolError
 from ..protocol.payloads.robot import Update, UpdateNumbers, UpdateStrings
 from ._common import (
@@ -67,11 +67,14 @@ def handle(args: argparse.Namespace) -> int:
 async def stream(client: AriaClient, args: argparse.Namespace, show: Any) -> int:
     strings = {"status": "", "mode": ""}
     queue: asyncio.Queue[dict[str, Any]] = asyncio.Queue()
+    malformed: list[ProtocolError] = []
+    """Status packets that did not decode: skipped, and named if no good one comes in time."""
 
     def on_numbers(packet: Packet) -> None:
         try:
             n = packet.decode()
-        except ProtocolError:
+        except ProtocolError as exc:
+            malformed[:] = [exc]
             return
         if isinstance(n, UpdateNumbers):
             queue.put_nowait(status_object(n, strings["status"], strings["mode"]))
@@ -104,6 +107,8 @@ async def stream(client: AriaClient, args: argparse.Namespace, show: Any) -> int
             if client.closed_error is not None:
                 raise client.closed_error
             if loop.time() >= deadline:
+                if malformed:
+                    raise ProtocolFault(f"no usable status for {gap:g} s: {malformed[0]}")
                 raise ClientTimeout(f"no status from the server for {gap:g} s")
             with contextlib.suppress(TimeoutError):
                 async with asyncio.timeout(min(0.1, max(0.0, deadline - loop.time()))):
