@@ -80,6 +80,50 @@ def test_vanishing_and_garbage_clients_cost_the_others_nothing(arena_map):
     run(scenario(), timeout=120)
 
 
+def test_a_client_flooding_fake_headers_gets_one_slice_per_loop_turn(arena_map):
+    """Its input is handled a slice at a time between everybody else's turns, so others keep their service."""
+    flood = b"\x0f\x0c\x20\x00" * (2_000_000 // 4)  # a header every 4 bytes, none with a good checksum
+
+    async def scenario() -> None:
+        server = SimServer(SimConfig(port=0, realtime=False, map_path=arena_map))
+        await server.start()
+        watcher = await WireClient().open(server.port)
+        watcher.request("updateNumbers", 100)
+        await watcher.wait_for("updateNumbers")
+        _, flood_writer = await asyncio.open_connection("127.0.0.1", server.port)
+        port = flood_writer.get_extra_info("sockname")[1]
+        await watcher.barrier()
+        flooder = next(s for s in server.sessions if s.peer.endswith(f":{port}"))
+
+        per_turn: list[int] = []
+        cycles_while_flooding: list[int] = []
+
+        async def probe() -> None:
+            last = flooder.bytes_in
+            while flooder.bytes_in < len(flood) and not flooder.closed:
+                await asyncio.sleep(0)
+                per_turn.append(flooder.bytes_in - last)
+                last = flooder.bytes_in
+                if 0 < flooder.bytes_in < len(flood):
+                    cycles_while_flooding.append(server.cycles)
+
+        flood_writer.write(flood)
+        watching = asyncio.create_task(probe())
+        await server.advance(2.0)
+        await asyncio.wait_for(watching, 60)
+
+        assert max(per_turn) <= 4096
+        assert len(set(cycles_while_flooding)) > 10  # the cycle ran while the flood was being read
+        await watcher.barrier()
+        assert len(watcher.received["updateNumbers"]) == 21
+        assert flooder in server.sessions  # garbage costs only its sender's bytes, not the link
+        flood_writer.close()
+        await watcher.close()
+        await server.stop()
+
+    run(scenario(), timeout=120)
+
+
 def test_a_client_that_stops_reading_is_dropped_after_the_backup_timeout():
     async def scenario() -> None:
         server = SimServer(SimConfig(port=0, realtime=False, map_path=COLUMBIA, backup_timeout=5.0))

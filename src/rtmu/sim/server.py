@@ -59,6 +59,9 @@ CYCLE_S = 0.01
 """ARIA's server loop sleeps 10 ms between cycles."""
 MAX_CATCH_UP_STEPS = 50
 READ_CHUNK = 65536
+RECEIVE_SLICE = 4096
+"""At most this many bytes of one client's input are decoded and handled before the loop turns, so a
+client that floods (garbage, fake headers, a burst of requests) cannot hold up the cycle or the others."""
 WARM_STREAMS_ABOVE_LINES = 100_000
 KEY_RNG = random.SystemRandom()
 """Password, auth and intro keys come from the OS, never from ``--seed``: a seeded key would repeat on
@@ -133,6 +136,7 @@ class Session:
         self._stall_since: float | None = None
         self._last_buffered = 0
         self.bytes_out = 0
+        self.bytes_in = 0
         peer = writer.get_extra_info("peername")
         self.peer = f"{peer[0]}:{peer[1]}" if isinstance(peer, tuple) else str(peer)
 
@@ -214,7 +218,15 @@ class Session:
                 data = await self.reader.read(READ_CHUNK)
                 if not data:
                     break
-                self.receive(data)
+                view = memoryview(data)
+                for start in range(0, len(data), RECEIVE_SLICE):
+                    piece = bytes(view[start : start + RECEIVE_SLICE])
+                    self.bytes_in += len(piece)
+                    self.receive(piece)
+                    if self.closed:
+                        break
+                    # A read that finds bytes already buffered does not yield: let the others run.
+                    await asyncio.sleep(0)
         except (ConnectionError, OSError, asyncio.IncompleteReadError):
             pass
         except asyncio.CancelledError:
