@@ -84,3 +84,23 @@ def test_shortcuts_xml_escapes_and_lists_every_binding() -> None:
     titles = [p.text for p in root.iter("property") if p.get("name") == "title"]
     for b in BINDINGS:
         assert b.title in titles
+
+
+def test_the_map_note_follows_the_connection_phase_then_the_map() -> None:
+    from rtmu.model import ConnectionState, MapModel, Phase
+    from rtmu.ui.notes import map_note
+
+    here = dict(host="127.0.0.1", port=7272)
+    no_map = MapModel(state="none")
+    ready = MapModel(state="ready")
+    assert map_note(ConnectionState(Phase.DISCONNECTED), ready).startswith("Not connected: press Connect")
+    assert "try again" in map_note(ConnectionState(Phase.FAILED, error="refused"), no_map)
+    assert map_note(ConnectionState(Phase.CONNECTING, **here), MapModel()) == "Connecting to 127.0.0.1:7272…"
+    assert map_note(ConnectionState(Phase.RECONNECTING, **here), ready).startswith("Link lost, reconnecting")
+    connected = ConnectionState(Phase.CONNECTED, **here)
+    assert map_note(connected, ready) == ""
+    assert map_note(connected, MapModel(state="loading", received=12)) == "Loading the map… (12 packets)"
+    assert map_note(connected, MapModel(state="failed", error="bad header")).endswith(": bad header")
+    text = map_note(connected, no_map)
+    assert "no map" in text and "grid" in text
+    assert not any(ch.isdigit() for ch in text), "the grid step is the legend's, never repeated in the note"

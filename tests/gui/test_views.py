@@ -92,6 +92,46 @@ def test_without_a_map_the_stage_shows_a_grid_the_robot_as_a_circle_and_says_so(
     assert (row < background - 6).sum() >= 5, "no grid lines"
 
 
+def test_the_map_note_says_connecting_connected_and_not_connected(start: Start, screenshots: Path) -> None:
+    """One note, from the connection phase: never "not connected" beside a Disconnect button."""
+    import socket
+
+    from rtmu.model import MapModel
+
+    with socket.socket() as deaf:  # accepts the TCP connection (backlog) and never says a word
+        deaf.bind(("127.0.0.1", 0))
+        deaf.listen(1)
+        port = deaf.getsockname()[1]
+        gui = Gui.start(screenshots, "test_map_note_phases", "127.0.0.1", port, connect=False)
+        try:
+            note = gui.window.map_note
+            assert note.get_visible() and note.get_text().startswith("Not connected: press Connect")
+            gui.shot("not-connected")
+            gui.window.connect_now()
+            pump(lambda: gui.phase is Phase.CONNECTING, 3, "connecting")
+            pump(lambda: note.get_text() == f"Connecting to 127.0.0.1:{port}…", 3, "the connecting note")
+            assert note.get_visible() and gui.window.connect_button.get_label() == "Disconnect"
+            gui.shot("connecting")
+            gui.key("ctrl+d")
+            pump(lambda: gui.phase is Phase.DISCONNECTED, 3, "the disconnect")
+            assert note.get_visible() and note.get_text().startswith("Not connected: press Connect")
+        finally:
+            gui.close()
+    gui, _sim = start()
+    note = gui.window.map_note
+    assert gui.model.map.value.state == "ready" and not note.get_visible(), "a shown map needs no note"
+    gui.model.map.set(MapModel(state="loading", received=7))
+    assert note.get_visible() and note.get_text() == "Loading the map… (7 packets)"
+    gui.shot("loading")
+    gui.model.map.set(MapModel(state="failed", error="line 3: not a number"))
+    assert note.get_text() == "The map could not be loaded: line 3: not a number"
+    gui.shot("map-error")
+    gui.key("ctrl+d")
+    pump(lambda: gui.phase is Phase.DISCONNECTED, 3, "the disconnect")
+    assert note.get_visible() and note.get_text().startswith("Not connected: press Connect")
+    gui.shot("after-ctrl-d")
+
+
 def test_without_a_camera_the_command_is_disabled_and_says_why(start: Start) -> None:
     gui, _sim = start(camera=False)
     window = gui.window

@@ -44,6 +44,7 @@ from .dpad import DPad  # noqa: E402
 from .keys import KeyRouter  # noqa: E402
 from .mapview import MapStage  # noqa: E402
 from .move_dialogs import go_dialog, turn_dialog  # noqa: E402
+from .notes import map_note  # noqa: E402
 from .settings_dialog import ConnectionDialog, PasswordPrompt  # noqa: E402
 from .shortcuts import build_shortcuts_window  # noqa: E402
 from .toolbar import StatusToolbar  # noqa: E402
@@ -291,7 +292,9 @@ class MainWindow(Gtk.ApplicationWindow):
 
         plain("settings", self.open_settings)
         plain("connect", self.connect_now)
-        plain("disconnect", lambda: self.controller.run("disconnect"))
+        # Disconnect also cancels an attempt in progress (connecting, reconnecting): the button says
+        # "Disconnect" then, so Ctrl+D must do what it says. Enabled from the phase (_update_header).
+        plain("disconnect", self.controller.disconnect)
         plain("turn", lambda: self.view_intent("turn_dialog"))
         plain("go", lambda: self.view_intent("go_dialog"))
         plain("camera", lambda: self.view_intent("toggle_camera"))
@@ -351,8 +354,6 @@ class MainWindow(Gtk.ApplicationWindow):
                 self._enable("go", state.enabled)
             elif name == "safe_drive_on":
                 self._enable("safe-drive", state.enabled)
-            elif name in ("connect", "disconnect"):
-                self._enable(name, state.enabled)
 
     def ask_password(self, profile: Profile, answer: Callable[[str | None], None]) -> None:
         remembered = self._passwords.get(profile.name)
@@ -479,6 +480,7 @@ class MainWindow(Gtk.ApplicationWindow):
         # Held keys stay held in the key router (their auto-repeat is swallowed); the controller
         # has blocked them, so only a fresh press drives after the link comes back.
         self._update_header(new)
+        self._update_map_note()
 
     def _update_header(self, conn: ConnectionState) -> None:
         phase = conn.phase
@@ -490,6 +492,8 @@ class MainWindow(Gtk.ApplicationWindow):
         self.connect_button.set_tooltip_text(
             "Disconnect (Ctrl+D); stops the robot first" if connected_ish else "Connect (Ctrl+O)"
         )
+        self._enable("connect", not connected_ish)
+        self._enable("disconnect", connected_ish)
         profile = self.controller.profile
         where = f"{conn.host}:{conn.port}" if conn.host else f"{profile.host}:{profile.port}"
         state = {
@@ -504,20 +508,16 @@ class MainWindow(Gtk.ApplicationWindow):
         parts += [name] if name and phase is Phase.CONNECTED else []
         self.subtitle_label.set_text(" · ".join(parts))
 
-    def _on_map(self, _old: MapModel, new: MapModel) -> None:
-        conn = self.model.connection.value
-        text = ""
-        if conn.phase is not Phase.CONNECTED:
-            text = "" if conn.phase is Phase.RECONNECTING else "Not connected: press Connect (Ctrl+O)"
-        elif new.state == "loading":
-            text = f"Loading the map… ({new.received} packets)" if new.received else "Loading the map…"
-        elif new.state in ("none", "unsupported"):
-            text = "The server has no map: robot and 1 m grid only"
-        elif new.state == "failed":
-            text = f"The map could not be loaded: {new.error}"
-        self.map_note.set_text(text)
+    def _on_map(self, _old: MapModel, _new: MapModel) -> None:
+        self._update_map_note()
+        self._update_header(self.model.connection.value)
+
+    def _update_map_note(self) -> None:
+        """The note under the map, from the connection phase and the map (``notes.map_note``)."""
+        text = map_note(self.model.connection.value, self.model.map.value)
+        if self.map_note.get_text() != text:
+            self.map_note.set_text(text)
         self.map_note.set_visible(bool(text))
-        self._update_header(conn)
 
     def _on_robot(self, old: RobotState, new: RobotState) -> None:
         if new.safe_drive is not None and new.safe_drive != old.safe_drive:

@@ -1,0 +1,39 @@
+"""The note at the bottom of the map: one sentence from the connection phase and the map's state.
+
+One function decides it, from the model alone, and the window calls it on
+every connection change and every map change — so the note can never say "not
+connected" next to a Disconnect button, or vanish after a disconnect. GTK-free.
+
+The grid's step is not repeated here: it changes with the zoom, and the legend
+drawn on the map (``grid 2 m``) is its one source of truth.
+"""
+
+from __future__ import annotations
+
+from ..model import ConnectionState, MapModel, Phase
+
+CONNECT_HINT = "press Connect (Ctrl+O)"
+
+
+def map_note(conn: ConnectionState, m: MapModel) -> str:
+    """What the map area should say now; "" when the map speaks for itself."""
+    where = f" to {conn.host}:{conn.port}" if conn.host else ""
+    phase = conn.phase
+    if phase is Phase.DISCONNECTED:
+        return f"Not connected: {CONNECT_HINT}"
+    if phase is Phase.FAILED:
+        return f"Not connected (the last attempt failed): {CONNECT_HINT} to try again"
+    if phase is Phase.CONNECTING:
+        return f"Connecting{where}…"
+    if phase is Phase.RECONNECTING:
+        return "Link lost, reconnecting…: the robot shown is where it was last seen"
+    # Connected: the map's own state.
+    if m.state == "loading":
+        return f"Loading the map… ({m.received} packets)" if m.received else "Loading the map…"
+    if m.state in ("none", "unsupported"):
+        return "Connected; the server has no map: the robot on a metric grid (scale at the top left)"
+    if m.state == "failed":
+        return f"The map could not be loaded: {m.error or 'no reason given'}"
+    if m.state == "unknown":
+        return "Connected; asking for the map…"
+    return ""
