@@ -9,6 +9,7 @@ import pytest
 
 from rtmu.client.connection import AriaClient
 from rtmu.client.errors import (
+    ClientError,
     ClientTimeout,
     ConnectionRefused,
     LoginRejected,
@@ -21,7 +22,7 @@ from rtmu.protocol.fields import FieldReader
 from rtmu.protocol.packet import encode_packet
 from rtmu.protocol.payloads.robot import UpdateNumbers
 
-from .servers import MAP_LINES, TestServer, run
+from .servers import MAP_LINES, TestServer, run, text_map_packets
 
 USERS = UserTable.parse("UserInfoVersion1\nuser alice secret1 all\nuser bob pw2 RobotInfo Stop\n")
 
@@ -321,6 +322,111 @@ def test_disconnect_is_clean_and_instant() -> None:
         assert "SHUTDOWN" in server.names()
         assert client.closed_error is None  # our own choice, not a failure
         await client.disconnect()  # twice is fine
+        await server.stop()
+
+    run(go())
+
+
+def _numbered_map_names(server: TestServer, lose: set[int]) -> list[int]:
+    """getMapName answers ``mapN`` for the N-th request (1-based), except the calls in ``lose``."""
+    calls = [0]
+
+    def answer(side, args):  # type: ignore[no-untyped-def]
+        calls[0] += 1
+        return None if calls[0] in lose else [f"map{calls[0]}".encode() + b"\x00"]
+
+    server.handlers["getMapName"] = answer
+    return calls
+
+
+def test_one_lost_reply_does_not_shift_the_later_ones() -> None:
+    from .fakeclock import FakeClock
+
+    async def go() -> None:
+        server = TestServer()
+        _numbered_map_names(server, lose={1})
+        await server.start()
+        clock = FakeClock()
+        client = AriaClient(clock=clock)
+        await client.connect("127.0.0.1", server.port, timeout=5)
+        with pytest.raises(ClientTimeout):
+            await client.request_once("getMapName", timeout=0.1)
+        clock.advance(client.abandon_grace)  # the lost reply stays lost
+        for n in range(2, 7):
+            assert (await client.request_once("getMapName", timeout=2)).payload == f"map{n}".encode() + b"\0"
+        await client.disconnect()
+        await server.stop()
+
+    run(go())
+
+
+def test_a_late_reply_within_the_grace_still_lines_up() -> None:
+    from .fakeclock import FakeClock
+
+    async def go() -> None:
+        server = TestServer()
+        _numbered_map_names(server, lose={1})
+        await server.start()
+        client = AriaClient(clock=FakeClock())
+        await client.connect("127.0.0.1", server.port, timeout=5)
+        with pytest.raises(ClientTimeout):
+            await client.request_once("getMapName", timeout=0.05)
+        side = server.sides[0]
+        side.conn.send_data("getMapName", b"late\x00")  # the first reply, after the waiter gave up
+        side.writer.write(side.conn.data_to_send())
+        assert (await client.request_once("getMapName", timeout=2)).payload == b"map2\x00"
+        await client.disconnect()
+        await server.stop()
+
+    run(go())
+
+
+def test_an_abandoned_map_swallows_its_own_late_packets() -> None:
+    async def go() -> None:
+        server = TestServer()
+        calls = [0]
+        first: list[object] = []
+
+        def maps(side, args):  # type: ignore[no-untyped-def]
+            calls[0] += 1
+            packets = text_map_packets(MAP_LINES)
+            if calls[0] == 1:
+                first.append(side)
+                return packets[:4]  # stalls half way
+            return packets
+
+        server.handlers["getMap"] = maps
+        await server.start()
+        client = await connected(server)
+        with pytest.raises(ClientTimeout):
+            await client.request_once("getMap", timeout=0.1)
+        side = server.sides[0]
+        for payload in text_map_packets(MAP_LINES)[4:]:  # the rest of the first map, late
+            side.conn.send_data("getMap", payload)
+        side.writer.write(side.conn.data_to_send())
+        second = await client.request_once("getMap", timeout=2)
+        assert second.payloads == tuple(text_map_packets(MAP_LINES))
+        await client.disconnect()
+        await server.stop()
+
+    run(go())
+
+
+def test_requests_waiting_per_data_are_capped() -> None:
+    async def go() -> None:
+        server = TestServer()
+        server.handlers["getMapName"] = lambda s, a: None
+        await server.start()
+        client = await connected(server)
+        client.max_pending = 4
+        waiting = [asyncio.create_task(client.request_once("getMapName", timeout=5)) for _ in range(4)]
+        await asyncio.sleep(0)
+        with pytest.raises(ClientError, match="already waiting"):
+            await client.request_once("getMapName", timeout=5)
+        for task in waiting:
+            task.cancel()
+        await asyncio.gather(*waiting, return_exceptions=True)
+        await client.disconnect()
         await server.stop()
 
     run(go())

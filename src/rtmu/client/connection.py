@@ -12,7 +12,10 @@ in the typed payloads) and adds what needs a clock and a socket:
 * every failure is a typed :mod:`~rtmu.client.errors` error.
 
 Replies carry no request id in ArNetworking: a reply is matched to the oldest
-pending request of the same data number (ARIA answers in order).
+pending request of the same data number (ARIA answers in order). A request whose
+waiter gave up keeps its place for :data:`ABANDON_GRACE` s of quiet so a late reply
+still lines up, then counts as lost so one lost reply cannot shift all later ones;
+at most :data:`MAX_PENDING_PER_DATA` requests per data number wait at once.
 
 Everything here runs on one asyncio loop (the network thread's, see
 ``runner``); handlers are called on that loop and must be quick.
@@ -60,6 +63,10 @@ CLOSE_TIMEOUT = 0.2
 MAX_WRITE_BUFFER = 1 << 20
 """A server that stops reading is dropped once this much output is queued (it would grow forever)."""
 READ_CHUNK = 1 << 16
+ABANDON_GRACE = 0.5
+"""Seconds an abandoned request's slot waits quietly for a late reply before the reply counts as lost."""
+MAX_PENDING_PER_DATA = 64
+"""Requests of one data number that may wait for replies at once (abandoned slots included)."""
 
 Arg = Payload | bytes | bytearray | str | float | int | bool
 
@@ -195,26 +202,52 @@ def _end_rule(
 
 
 class _Pending:
-    """One request waiting for its reply packets."""
+    """One request waiting for its reply packets (one slot in its data number's queue).
 
-    __slots__ = ("error", "finished", "payloads", "progress", "queue", "rule")
+    A waiter that gives up (timeout, a stream closed early) *abandons* the slot: the slot stays
+    so that a late reply still lines up with it, swallows that reply's packets without keeping
+    them, and is dropped once it has been quiet for the client's ``abandon_grace`` (the reply
+    is lost, not late) — otherwise one lost reply would shift every later one by one for good.
+    """
 
-    def __init__(self, rule: _EndRule, streaming: bool) -> None:
+    __slots__ = (
+        "abandoned_at",
+        "count",
+        "error",
+        "fallback",
+        "finished",
+        "last_activity",
+        "payloads",
+        "progress",
+        "queue",
+        "rule",
+    )
+
+    def __init__(self, rule: _EndRule, streaming: bool, fallback: _EndRule | None = None) -> None:
         self.rule = rule
+        self.fallback = fallback or rule
+        """Where the reply ends without the caller's own test (used once the caller is gone)."""
         self.payloads: list[bytes] = []
+        self.count = 0
         self.queue: asyncio.Queue[bytes | None] | None = asyncio.Queue() if streaming else None
         self.progress = asyncio.Event()
         self.finished = False
         self.error: ClientError | None = None
+        self.abandoned_at: float | None = None
+        self.last_activity = 0.0
 
-    def feed(self, payload: bytes) -> bool:
+    def feed(self, payload: bytes, now: float) -> bool:
+        """One packet of this reply; True when the slot is done (take it off the queue)."""
+        if self.abandoned_at is not None:
+            return self._swallow(payload, now)
         if self.finished:
             return True
         try:
-            finished = self.rule.done(payload, len(self.payloads))
+            finished = self.rule.done(payload, self.count)
         except ProtocolError as exc:  # the caller's end test found the reply malformed
             self.fail(ProtocolFault(f"malformed reply: {exc}"))
             return True
+        self.count += 1
         self.finished = finished
         self.payloads.append(payload)
         if self.queue is not None:
@@ -223,6 +256,25 @@ class _Pending:
                 self.queue.put_nowait(None)
         self.progress.set()
         return self.finished
+
+    def _swallow(self, payload: bytes, now: float) -> bool:
+        self.last_activity = now
+        try:
+            done = self.fallback.done(payload, self.count)
+        except ProtocolError:
+            done = True
+        self.count += 1
+        return done
+
+    def abandon(self, error: ClientError, now: float) -> None:
+        """The waiter is gone: fail it, keep the slot for a late reply (see the class notes)."""
+        self.fail(error)
+        self.abandoned_at = self.last_activity = now
+        self.payloads = []
+        self.queue = None
+
+    def expired(self, now: float, grace: float) -> bool:
+        return self.abandoned_at is not None and now - self.last_activity >= grace
 
     def fail(self, error: ClientError) -> None:
         if self.finished:
@@ -246,9 +298,12 @@ class AriaClient:
         *,
         on_close: Callable[[ClientError], None] | None = None,
         clock: Callable[[], float] = time.monotonic,
+        abandon_grace: float = ABANDON_GRACE,
     ) -> None:
         self.on_close = on_close
         self.clock = clock
+        self.abandon_grace = abandon_grace
+        self.max_pending = MAX_PENDING_PER_DATA
         self.host = ""
         self.port = 0
         self.user = ""
@@ -430,18 +485,22 @@ class AriaClient:
         pending = self._start(name, args, expect, until, streaming=False)
         if pending is None:
             return Reply(name, (), self.clock())
-        while not pending.finished:
-            pending.progress.clear()
-            try:
-                async with asyncio.timeout(timeout):
-                    await pending.progress.wait()
-            except TimeoutError:
-                got = len(pending.payloads)
+        try:
+            while not pending.finished:
+                pending.progress.clear()
+                try:
+                    async with asyncio.timeout(timeout):
+                        await pending.progress.wait()
+                except TimeoutError:
+                    got = pending.count
+                    self._abandon(name, pending)
+                    raise ClientTimeout(
+                        f"no reply to {name!r} from {self.host}:{self.port} within {timeout:g} s"
+                        + (f" (after {got} packets)" if got else "")
+                    ) from None
+        finally:
+            if not pending.finished:  # cancelled: the slot must not wait for ever either
                 self._abandon(name, pending)
-                raise ClientTimeout(
-                    f"no reply to {name!r} from {self.host}:{self.port} within {timeout:g} s"
-                    + (f" (after {got} packets)" if got else "")
-                ) from None
         if pending.error is not None:
             raise pending.error
         return Reply(name, tuple(pending.payloads), self.clock())
@@ -467,7 +526,7 @@ class AriaClient:
                 except TimeoutError:
                     raise ClientTimeout(
                         f"{name!r} from {self.host}:{self.port} stalled for {timeout:g} s "
-                        f"after {len(pending.payloads)} packets"
+                        f"after {pending.count} packets"
                     ) from None
                 if payload is None:
                     if pending.error is not None:
@@ -488,21 +547,36 @@ class AriaClient:
     ) -> _Pending | None:
         number = self._number(name)
         entry = self._conn.datalist.entry(number)  # type: ignore[union-attr]
-        rule = _end_rule(entry.flag_set if entry else frozenset(), name, expect, until)
+        flags = entry.flag_set if entry else frozenset()
+        rule = _end_rule(flags, name, expect, until)
         payload = encode_args(args)
         if rule is None:
             self._conn.request_once(name, payload)  # type: ignore[union-attr]
             self._flush()
             return None
-        pending = _Pending(rule, streaming)
-        self._pending.setdefault(number, deque()).append(pending)
+        queue = self._pending.setdefault(number, deque())
+        self._expire(queue, self.clock())
+        while len(queue) >= self.max_pending and queue[0].abandoned_at is not None:
+            queue.popleft()  # make room: the oldest abandoned slot goes first
+        if len(queue) >= self.max_pending:
+            raise ClientError(
+                f"{len(queue)} requests for {name!r} are already waiting for {self.host}:{self.port} "
+                "to answer; not sending more"
+            )
+        pending = _Pending(rule, streaming, fallback=_end_rule(flags, name, expect, None))
+        queue.append(pending)
         self._conn.request_once(name, payload)  # type: ignore[union-attr]
         self._flush()
         return pending
 
     def _abandon(self, name: str, pending: _Pending) -> None:
         """A waiter gave up: keep its slot so late packets still line up, but stop caring."""
-        pending.fail(ClientTimeout(f"{name!r} abandoned"))
+        pending.abandon(ClientTimeout(f"{name!r} abandoned"), self.clock())
+
+    def _expire(self, queue: deque[_Pending], now: float) -> None:
+        """Drop abandoned slots at the head that stayed quiet past the grace: their replies are lost."""
+        while queue and queue[0].expired(now, self.abandon_grace):
+            queue.popleft()
 
     # -- I/O -------------------------------------------------------------------------------
     def _flush(self) -> None:
@@ -545,8 +619,8 @@ class AriaClient:
         number = event.command
         queue = self._pending.get(number)
         if queue:
-            head = queue[0]
-            if head.feed(event.payload):
+            self._expire(queue, now)
+            if queue and queue[0].feed(event.payload, now):
                 queue.popleft()
         handler = self._handlers.get(number)
         if handler is not None:
