@@ -144,6 +144,24 @@ class Gui:
     def keyup(self, name: str) -> None:
         self.xdotool("keyup", name)
 
+    def centre_on_surface(self, widget: Gtk.Widget) -> tuple[int, int]:
+        """Where the middle of ``widget`` is on its X window (surface), for pointer events."""
+        pump(lambda: widget.get_mapped() and widget.get_width() > 0, 3, "the widget to be laid out")
+        idle(0.1)
+        native = widget.get_native()
+        ok, point = widget.compute_point(
+            native, Graphene.Point().init(widget.get_width() / 2, widget.get_height() / 2)
+        )
+        assert ok
+        dx, dy = native.get_surface_transform()
+        return round(point.x + dx), round(point.y + dy)
+
+    def click(self, widget: Gtk.Widget) -> None:
+        """A real left click (through the X server) in the middle of ``widget``."""
+        x, y = self.centre_on_surface(widget)
+        xid = str(GdkX11.X11Surface.get_xid(widget.get_native().get_surface()))
+        self.xdotool("mousemove", "--window", xid, str(x), str(y), "click", "1")
+
     # -- pictures ------------------------------------------------------------------------------
     def render(self, widget: Gtk.Widget, path: Path) -> Path:
         """``widget`` as it looks now, to a PNG (the renderer of its window, as GTK itself draws it)."""

@@ -114,6 +114,27 @@ def test_holding_up_drives_forward_and_releasing_stops(gui: Gui, sim: SimThread)
     gui.shot("released")
 
 
+def test_the_red_stop_in_the_header_stops_the_robot_while_a_drive_key_is_held(
+    gui: Gui, sim: SimThread
+) -> None:
+    window = gui.window
+    stop = window.stop_button
+    assert stop.get_mapped() and stop.has_css_class("destructive-action"), "STOP is on screen, in red"
+    assert not window.connect_button.has_css_class("destructive-action"), "only STOP is red"
+    gui.keydown("Up")
+    try:
+        pump(lambda: moving(sim), 8, "the robot to move")
+        assert sim.call(lambda: sim.server.robot.mode_name) == "ratioDrive"
+        gui.click(stop)
+        pump(lambda: sim.call(lambda: sim.server.robot.mode_name) == "stop", 3, "the simulator to get stop")
+        pump(lambda: stopped(sim), 8, "the robot to stop")
+        idle(0.6)  # the key is still down: it stays blocked until let go
+        assert stopped(sim)
+        gui.shot("stopped-by-the-header-button")
+    finally:
+        gui.keyup("Up")
+
+
 def test_space_stops_even_while_a_drive_key_is_still_held(gui: Gui, sim: SimThread) -> None:
     gui.keydown("Up")
     try:

@@ -27,6 +27,7 @@ CSS = """
 .title-box .title { font-weight: bold; }
 .title-box .subtitle { font-size: 8.5pt; opacity: 0.7; }
 button.connect-button { min-width: 96px; }
+button.stop-button { min-width: 92px; font-weight: bold; letter-spacing: 1px; }
 
 .banner { background: alpha(#242424, 0.90); color: white; border-radius: 10px;
           padding: 4px 4px 4px 12px; box-shadow: 0 2px 8px alpha(black, 0.35); }

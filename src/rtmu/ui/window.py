@@ -72,6 +72,19 @@ def touch_only(display: Gdk.Display | None = None) -> bool:
     return not pointers
 
 
+def stop_button(on_stop: Callable[[], None]) -> Gtk.Button:
+    """A red STOP button (icon and word: readable at arm's length, not only by colour)."""
+    box = Gtk.Box(spacing=6, halign=Gtk.Align.CENTER)
+    box.append(Gtk.Image.new_from_icon_name("media-playback-stop-symbolic"))
+    box.append(Gtk.Label(label="STOP"))
+    button = Gtk.Button(child=box, tooltip_text="Stop the robot now (Space)")
+    button.add_css_class("destructive-action")
+    button.add_css_class("stop-button")
+    button.set_focusable(False)
+    button.connect("clicked", lambda _b: on_stop())
+    return button
+
+
 class _View:
     """The controller's ``View`` (a separate object: ``notify`` is a GObject method on the window)."""
 
@@ -157,6 +170,9 @@ class MainWindow(Gtk.ApplicationWindow):
     # -- layout ------------------------------------------------------------------------------
     def _build(self) -> None:
         header = Gtk.HeaderBar()
+        # Safety: STOP is always on screen, first in the bar and the only red button in it.
+        self.stop_button = stop_button(self.stop_now)
+        header.pack_start(self.stop_button)
         self.connect_button = Gtk.Button(label="Connect")
         self.connect_button.add_css_class("connect-button")
         self.connect_button.set_focusable(False)
@@ -412,6 +428,15 @@ class MainWindow(Gtk.ApplicationWindow):
         dialog = make()
         dialog.present()
 
+    def stop_now(self) -> None:
+        """The on-screen STOP: the same as Space, and sent whatever the link looks like.
+
+        Keys still held stay blocked by the controller until they are let go (as after Space), so
+        their auto-repeat cannot start the robot again; a finger on the D-pad is let go of here.
+        """
+        self.controller.stop()
+        self.dpad.release_all()
+
     def toggle_connection(self) -> None:
         phase = self.model.connection.value.phase
         if phase in (Phase.DISCONNECTED, Phase.FAILED):
@@ -486,9 +511,6 @@ class MainWindow(Gtk.ApplicationWindow):
         phase = conn.phase
         connected_ish = phase in (Phase.CONNECTED, Phase.CONNECTING, Phase.RECONNECTING)
         self.connect_button.set_label("Disconnect" if connected_ish else "Connect")
-        for cls in ("suggested-action", "destructive-action"):
-            self.connect_button.remove_css_class(cls)
-        self.connect_button.add_css_class("destructive-action" if connected_ish else "suggested-action")
         self.connect_button.set_tooltip_text(
             "Disconnect (Ctrl+D); stops the robot first" if connected_ish else "Connect (Ctrl+O)"
         )
