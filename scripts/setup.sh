@@ -2,7 +2,8 @@
 # Prepare this checkout to run RTMU on Debian 12 / Ubuntu, from nothing, without questions:
 #   1. the system packages GTK 4 and the PyGObject build need (apt, only when some are missing);
 #   2. a virtualenv in .venv;
-#   3. the project and its dev tools in it (pip, only when pyproject.toml changed since last time).
+#   3. the project and its dev tools in it, at the versions in constraints.txt (pip, only when
+#      pyproject.toml or constraints.txt changed since last time).
 # Every make target runs this first, so a re-run must stay quick: it checks and skips.
 # Environment: PYTHON picks the interpreter (default python3, needs >= 3.11).
 set -euo pipefail
@@ -16,6 +17,7 @@ APT_PACKAGES=(
 )
 VENV=.venv
 STAMP="$VENV/.rtmu-setup-stamp"
+CONSTRAINTS=constraints.txt
 PYTHON="${PYTHON:-python3}"
 
 say() { printf 'setup: %s\n' "$*"; }
@@ -92,14 +94,14 @@ ensure_venv() {
 # -- 3. the project -------------------------------------------------------------------------
 ensure_project() {
     local want
-    want="$(sha256sum pyproject.toml | cut -d' ' -f1) $("$VENV/bin/python" -V 2>&1)"
+    want="$(sha256sum pyproject.toml "$CONSTRAINTS" | cut -d' ' -f1 | tr '\n' ' ')$("$VENV/bin/python" -V 2>&1)"
     if [ -f "$STAMP" ] && [ "$(cat "$STAMP")" = "$want" ] && [ -x "$VENV/bin/rtmu" ]; then
         say "python packages up to date"
         return
     fi
     say "installing rtmu and its dev tools into $VENV (PyGObject builds from source: a minute or two)"
-    "$VENV/bin/python" -m pip install -q --disable-pip-version-check -e '.[dev]' </dev/null ||
-        die "pip install -e '.[dev]' failed (see above)"
+    "$VENV/bin/python" -m pip install -q --disable-pip-version-check -c "$CONSTRAINTS" -e '.[dev]' </dev/null ||
+        die "pip install -c $CONSTRAINTS -e '.[dev]' failed (see above)"
     printf '%s\n' "$want" >"$STAMP"
     say "python packages installed"
 }
