@@ -13,9 +13,14 @@ in the typed payloads) and adds what needs a clock and a socket:
 
 Replies carry no request id in ArNetworking: a reply is matched to the oldest
 pending request of the same data number (ARIA answers in order). A request whose
-waiter gave up keeps its place for :data:`ABANDON_GRACE` s of quiet so a late reply
-still lines up, then counts as lost so one lost reply cannot shift all later ones;
-at most :data:`MAX_PENDING_PER_DATA` requests per data number wait at once.
+waiter gave up (timeout, cancel) is *abandoned*: its slot stays, so a late reply
+still lines up with it and cannot be taken for the next request's. But a reply that
+never comes must not shift every later reply by one for good, so an abandoned slot
+that has received nothing is dropped as soon as a newer request of the same data is
+sent (a reply later than its requester's whole timeout is treated as lost), and any
+abandoned slot is dropped after :data:`ABANDON_GRACE` s without a packet (a map that
+stalled half way). At most :data:`MAX_PENDING_PER_DATA` requests per data number
+wait at once.
 
 Everything here runs on one asyncio loop (the network thread's, see
 ``runner``); handlers are called on that loop and must be quick.
@@ -204,10 +209,10 @@ def _end_rule(
 class _Pending:
     """One request waiting for its reply packets (one slot in its data number's queue).
 
-    A waiter that gives up (timeout, a stream closed early) *abandons* the slot: the slot stays
-    so that a late reply still lines up with it, swallows that reply's packets without keeping
-    them, and is dropped once it has been quiet for the client's ``abandon_grace`` (the reply
-    is lost, not late) — otherwise one lost reply would shift every later one by one for good.
+    A waiter that gives up (timeout, cancel, a stream closed early) *abandons* the slot: it
+    stays so that a late reply still lines up with it, and swallows that reply's packets
+    (to the data's own end marker) without keeping them. See the module notes for when an
+    abandoned slot is dropped.
     """
 
     __slots__ = (
@@ -555,7 +560,7 @@ class AriaClient:
             self._flush()
             return None
         queue = self._pending.setdefault(number, deque())
-        self._expire(queue, self.clock())
+        self._expire(queue, self.clock(), newer_request=True)
         while len(queue) >= self.max_pending and queue[0].abandoned_at is not None:
             queue.popleft()  # make room: the oldest abandoned slot goes first
         if len(queue) >= self.max_pending:
@@ -573,9 +578,14 @@ class AriaClient:
         """A waiter gave up: keep its slot so late packets still line up, but stop caring."""
         pending.abandon(ClientTimeout(f"{name!r} abandoned"), self.clock())
 
-    def _expire(self, queue: deque[_Pending], now: float) -> None:
-        """Drop abandoned slots at the head that stayed quiet past the grace: their replies are lost."""
-        while queue and queue[0].expired(now, self.abandon_grace):
+    def _expire(self, queue: deque[_Pending], now: float, *, newer_request: bool = False) -> None:
+        """Drop abandoned slots at the head whose replies count as lost (see the module notes)."""
+        while queue:
+            head = queue[0]
+            if head.abandoned_at is None:
+                return
+            if not (head.expired(now, self.abandon_grace) or (newer_request and head.count == 0)):
+                return
             queue.popleft()
 
     # -- I/O -------------------------------------------------------------------------------
