@@ -1,11 +1,14 @@
 #!/usr/bin/env bash
 # Prepare this checkout to run RTMU on Debian 12 / Ubuntu, from nothing, without questions:
-#   1. the system packages GTK 4 and the PyGObject build need (apt, only when some are missing);
+#   0. a Python >= 3.11 (python3 where the distribution's is new enough; Ubuntu 22.04's is 3.10, so
+#      there python3.11 from its archive);
+#   1. the system packages that Python, GTK 4 and the PyGObject build need (apt, only when some are
+#      missing);
 #   2. a virtualenv in .venv;
 #   3. the project and its dev tools in it, at the versions in constraints.txt (pip, only when
 #      pyproject.toml or constraints.txt changed since last time).
-# Every make target runs this first, so a re-run must stay quick: it checks and skips.
-# Environment: PYTHON picks the interpreter (default python3, needs >= 3.11).
+# ./rtmu-dev runs this before every command, so a re-run must stay quick: it checks and skips.
+# Needs only bash (and apt on a bare machine). Environment: PYTHON picks the interpreter (>= 3.11).
 set -euo pipefail
 
 cd "$(dirname "${BASH_SOURCE[0]}")/.."
@@ -13,12 +16,16 @@ export DEBIAN_FRONTEND=noninteractive
 
 APT_PACKAGES=(
     gir1.2-gtk-4.0 gir1.2-adw-1 libgirepository1.0-dev libcairo2-dev pkg-config
-    python3-dev python3-venv build-essential xvfb xdotool
+    build-essential xvfb xdotool
 )
 VENV=.venv
 STAMP="$VENV/.rtmu-setup-stamp"
 CONSTRAINTS=constraints.txt
-PYTHON="${PYTHON:-python3}"
+PYTHON="${PYTHON:-}"
+PYTHON_PACKAGES=()
+APT_PYTHON3=
+SUDO=()
+APT_UPDATED=0
 
 say() { printf 'setup: %s\n' "$*"; }
 die() { printf 'setup: error: %s\n' "$*" >&2; exit 1; }
@@ -33,45 +40,134 @@ quiet() {
     return "$rc"
 }
 
+have() { command -v "$1" >/dev/null 2>&1; }
+
+# -- 0. which Python ------------------------------------------------------------------------
+python_ok() { # python_ok CMD: CMD runs and is Python >= 3.11
+    have "$1" && "$1" -c 'import sys; sys.exit(sys.version_info < (3, 11))' >/dev/null 2>&1
+}
+
+packages_for_python() { # the apt packages behind an interpreter name: python3 or python3.N
+    case "$1" in
+        python3) PYTHON_PACKAGES=(python3 python3-venv python3-dev) ;;
+        python3.[0-9]*) PYTHON_PACKAGES=("$1" "$1-venv" "$1-dev") ;;
+        *) PYTHON_PACKAGES=() ;; # an interpreter of the user's own (a path, pyenv...): theirs to equip
+    esac
+}
+
+apt_candidate() { # apt_candidate PACKAGE: the version apt would install, or nothing
+    LC_ALL=C apt-cache policy "$1" 2>/dev/null | awk '$1 == "Candidate:" && $2 != "(none)" { print $2; exit }'
+}
+
+version_at_least_3_11() { # version_at_least_3_11 DEBIAN_VERSION (e.g. 3.10.6-1~22.04, 3.11.2-1+b1)
+    local v="${1#*:}" major minor
+    major="${v%%.*}"
+    minor="${v#*.}"
+    minor="${minor%%[!0-9]*}"
+    [[ "$major" =~ ^[0-9]+$ && "$minor" =~ ^[0-9]+$ ]] || return 1
+    [ "$major" -gt 3 ] || { [ "$major" -eq 3 ] && [ "$minor" -ge 11 ]; }
+}
+
+no_python_hint() {
+    printf 'setup: no Python >= 3.11 found. Install one, then try again:\n' >&2
+    printf '  Debian 12:    sudo apt-get update && sudo apt-get install -y python3 python3-venv python3-dev\n' >&2
+    printf '  Ubuntu 22.04: sudo apt-get update && sudo apt-get install -y python3.11 python3.11-venv python3.11-dev\n' >&2
+    exit 1
+}
+
+# Sets PYTHON and PYTHON_PACKAGES. No apt query when a good interpreter is already installed.
+choose_python() {
+    if [ -n "$PYTHON" ]; then
+        packages_for_python "$PYTHON"
+        return
+    fi
+    local v
+    for v in python3 python3.11 python3.12 python3.13 python3.14; do
+        if python_ok "$v"; then
+            PYTHON=$v
+            packages_for_python "$v"
+            return
+        fi
+    done
+    # Nothing suitable installed: ask apt (after an update when its lists are empty or too old to say).
+    have apt-cache || die "no Python >= 3.11 found: install one (with its venv module), or set PYTHON=..."
+    python_from_apt && return
+    can_be_root || no_python_hint
+    apt_update
+    python_from_apt ||
+        die "no Python >= 3.11 installed or available from apt (python3: ${APT_PYTHON3:-none}); install one, set PYTHON=..."
+}
+
+# Debian 12's python3 is 3.11; Ubuntu 22.04's is 3.10 and its archive has python3.11 beside it.
+python_from_apt() {
+    APT_PYTHON3=$(apt_candidate python3)
+    if [ -n "$APT_PYTHON3" ] && version_at_least_3_11 "$APT_PYTHON3"; then
+        PYTHON=python3
+        packages_for_python python3
+        return 0
+    fi
+    local v
+    for v in python3.11 python3.12 python3.13; do
+        if [ -n "$(apt_candidate "$v")" ] && [ -n "$(apt_candidate "$v-venv")" ]; then
+            say "the distribution's python3 is ${APT_PYTHON3:-not available}; using $v"
+            PYTHON=$v
+            packages_for_python "$v"
+            return 0
+        fi
+    done
+    return 1
+}
+
 # -- 1. system packages ---------------------------------------------------------------------
+can_be_root() { # sets SUDO when needed; false when apt cannot be run without a password
+    [ "$(id -u)" -eq 0 ] && return 0
+    have sudo && sudo -n true 2>/dev/null || return 1
+    SUDO=(sudo -n env DEBIAN_FRONTEND=noninteractive)
+}
+
+need_root() { # need_root PACKAGE...: be able to run apt, or print the command to run and stop
+    can_be_root && return
+    printf 'setup: missing system packages: %s\n' "$*" >&2
+    printf 'setup: run this, then try again:\n  sudo apt-get update && sudo apt-get install -y %s\n' "$*" >&2
+    exit 1
+}
+
+apt_update() { # callers made sure apt can run (need_root, can_be_root)
+    [ "$APT_UPDATED" -eq 0 ] || return 0
+    say "apt-get update"
+    quiet "${SUDO[@]}" apt-get update -q || die "apt-get update failed"
+    APT_UPDATED=1
+}
+
 missing_packages() {
     # One dpkg-query for all; packages dpkg has never heard of are simply absent from its output.
-    local installed
-    installed=$(dpkg-query -W -f='${Package} ${db:Status-Status}\n' "${APT_PACKAGES[@]}" 2>/dev/null |
+    local installed all=("${PYTHON_PACKAGES[@]}" "${APT_PACKAGES[@]}")
+    installed=$(dpkg-query -W -f='${Package} ${db:Status-Status}\n' "${all[@]}" 2>/dev/null |
         awk '$2 == "installed" { print $1 }' || true)
     local p
-    for p in "${APT_PACKAGES[@]}"; do
+    for p in "${all[@]}"; do
         grep -qxF "$p" <<<"$installed" || printf '%s\n' "$p"
     done
 }
 
 ensure_system_packages() {
-    if ! command -v dpkg-query >/dev/null 2>&1; then
+    if ! have dpkg-query; then
         say "not a Debian-like system: make sure the equivalents of ${APT_PACKAGES[*]} are installed"
+        [ -n "$PYTHON" ] || PYTHON=python3
         return
     fi
+    choose_python
     local missing
     mapfile -t missing < <(missing_packages)
     if [ "${#missing[@]}" -eq 0 ]; then
-        say "system packages present (${#APT_PACKAGES[@]} checked)"
+        say "system packages present ($((${#PYTHON_PACKAGES[@]} + ${#APT_PACKAGES[@]})) checked)"
         return
     fi
-    local install=(apt-get install -y -q -o Dpkg::Options::=--force-confdef -o Dpkg::Options::=--force-confold
-        "${missing[@]}")
-    local -a sudo=()
-    if [ "$(id -u)" -ne 0 ]; then
-        if command -v sudo >/dev/null 2>&1 && sudo -n true 2>/dev/null; then
-            sudo=(sudo -n env DEBIAN_FRONTEND=noninteractive)
-        else
-            printf 'setup: missing system packages: %s\n' "${missing[*]}" >&2
-            printf 'setup: run this, then try again:\n  sudo apt-get update && sudo apt-get install -y %s\n' \
-                "${missing[*]}" >&2
-            exit 1
-        fi
-    fi
+    need_root "${missing[@]}"
+    apt_update
     say "installing system packages: ${missing[*]}"
-    quiet "${sudo[@]}" apt-get update -q || die "apt-get update failed"
-    quiet "${sudo[@]}" "${install[@]}" || die "apt-get install ${missing[*]} failed"
+    quiet "${SUDO[@]}" apt-get install -y -q -o Dpkg::Options::=--force-confdef \
+        -o Dpkg::Options::=--force-confold "${missing[@]}" || die "apt-get install ${missing[*]} failed"
     mapfile -t missing < <(missing_packages)
     [ "${#missing[@]}" -eq 0 ] || die "still missing after apt-get: ${missing[*]}"
 }
@@ -82,11 +178,11 @@ ensure_venv() {
         say "virtualenv $VENV present"
         return
     fi
-    command -v "$PYTHON" >/dev/null 2>&1 || die "$PYTHON not found (install python3, or set PYTHON=...)"
-    "$PYTHON" -c 'import sys; sys.exit(sys.version_info < (3, 11))' ||
+    have "$PYTHON" || die "$PYTHON not found (install Python >= 3.11, or set PYTHON=...)"
+    python_ok "$PYTHON" ||
         die "RTMU needs Python >= 3.11; $PYTHON is $("$PYTHON" -V 2>&1) (set PYTHON=python3.11 or newer)"
     rm -rf "$VENV"
-    "$PYTHON" -m venv "$VENV" || die "'$PYTHON -m venv' failed (on Debian/Ubuntu: apt-get install python3-venv)"
+    "$PYTHON" -m venv "$VENV" || die "'$PYTHON -m venv' failed (on Debian/Ubuntu: apt-get install $PYTHON-venv)"
     rm -f "$STAMP"
     say "virtualenv $VENV created with $("$VENV/bin/python" -V 2>&1)"
 }
@@ -106,7 +202,14 @@ ensure_project() {
     say "python packages installed"
 }
 
-ensure_system_packages
-ensure_venv
-ensure_project
-bash scripts/install-desktop.sh || say "the desktop entry was not installed (RTMU still runs as .venv/bin/rtmu)"
+main() {
+    ensure_system_packages
+    ensure_venv
+    ensure_project
+    bash scripts/install-desktop.sh || say "the desktop entry was not installed (RTMU still runs as .venv/bin/rtmu)"
+}
+
+# Sourcing this file (to try its functions) defines them without running anything.
+if [ "${BASH_SOURCE[0]}" = "$0" ]; then
+    main
+fi
