@@ -120,16 +120,7 @@ class Gui:
         return GdkX11.X11Surface.get_xid(self.window.get_surface())
 
     def xdotool(self, *args: str, timeout: float = 10.0) -> None:
-        proc = subprocess.Popen(["xdotool", *args], stdout=subprocess.DEVNULL, stderr=subprocess.PIPE)
-        try:
-            pump(lambda: proc.poll() is not None, timeout, f"xdotool {' '.join(args)}")
-        finally:
-            if proc.poll() is None:
-                proc.kill()
-                proc.wait(2)
-        assert proc.returncode == 0, (
-            f"xdotool {args} failed: {proc.stderr.read().decode() if proc.stderr else ''}"
-        )
+        self.run_tool("xdotool", *args, timeout=timeout)
 
     def focus(self) -> None:
         self.xdotool("windowfocus", "--sync", str(self.xid()))
@@ -185,6 +176,25 @@ class Gui:
         self._shot_no += 1
         path = self.shots / f"{self.name}-{self._shot_no:02d}-{label}.png"
         return self.render(self.window, path)
+
+    def screen_shot(self, label: str) -> Path:
+        """The whole X screen (menus and popovers are surfaces of their own, outside the window's picture)."""
+        idle(0.2)
+        self._shot_no += 1
+        path = self.shots / f"{self.name}-{self._shot_no:02d}-{label}.png"
+        self.run_tool("import", "-window", "root", str(path))
+        return path
+
+    def run_tool(self, *argv: str, timeout: float = 10.0) -> None:
+        """An X client program, run while the main loop keeps running (so GTK can answer it)."""
+        proc = subprocess.Popen(list(argv), stdout=subprocess.DEVNULL, stderr=subprocess.PIPE)
+        try:
+            pump(lambda: proc.poll() is not None, timeout, " ".join(argv))
+        finally:
+            if proc.poll() is None:
+                proc.kill()
+                proc.wait(2)
+        assert proc.returncode == 0, f"{argv} failed: {proc.stderr.read().decode() if proc.stderr else ''}"
 
     def stage_pixels(self) -> np.ndarray:
         """The map stage as an (H, W, 3) uint8 array in its own coordinates."""

@@ -449,3 +449,75 @@ def test_f11_full_screen_and_ctrl_q_quits_after_stopping_the_robot(start: Start)
         pump(lambda: stopped(sim), 8, "the robot to stop on quit")
     finally:
         gui.keyup("Up")
+
+
+def test_full_screen_keeps_stop_connect_the_menu_and_a_way_out(screenshots: Path, tmp_path: Path) -> None:
+    """``rtmu --fullscreen``: GTK hides the header bar, so a slim bar must offer the essentials."""
+    from rtmu.ui.app import GuiOptions
+
+    with SimThread(SimConfig(port=0, map_path=OFFICE_MAP, seed=1)) as sim:
+        options = GuiOptions(
+            host="127.0.0.1", port=sim.port, fullscreen=True, connect=False,
+            settings_path=tmp_path / "settings.toml", persist=False,
+        )  # fmt: skip
+        gui = Gui.open(options, screenshots, "test_fullscreen", connect=False)
+        try:
+            window = gui.window
+            bar = window.fullscreen_bar
+            pump(window.is_fullscreen, 3, "full screen")
+            pump(lambda: bar.get_child_revealed(), 3, "the full-screen bar")
+            assert not window.get_titlebar().get_mapped(), "GTK hides the header bar in full screen"
+            for button in (bar.stop_button, bar.connect_button, bar.menu_button, bar.leave_button):
+                assert button.get_mapped() and button.get_sensitive()
+            assert bar.stop_button.has_css_class("destructive-action")
+            assert bar.connect_button.get_label() == "Connect"
+            gui.shot("fullscreen-not-connected")
+            gui.click(bar.connect_button)
+            gui.wait_connected()
+            assert bar.connect_button.get_label() == "Disconnect"
+            assert "connected" in bar.status_label.get_text()
+            gui.keydown("Up")
+            try:
+                pump(lambda: moving(sim), 8, "the robot to move")
+                gui.click(bar.stop_button)
+                pump(lambda: sim.call(lambda: sim.server.robot.mode_name) == "stop", 3, "stop from the bar")
+                pump(lambda: stopped(sim), 8, "the robot to stop")
+            finally:
+                gui.keyup("Up")
+            gui.shot("fullscreen-connected")
+            gui.click(bar.menu_button)
+            popover = bar.menu_button.get_popover()
+            pump(lambda: popover is not None and popover.get_mapped(), 3, "the menu")
+            gui.screen_shot("fullscreen-menu")
+            popover.popdown()
+            pump(lambda: not popover.get_mapped(), 3, "the menu to close")
+            # Xvfb has no window manager: once mapped, the window's full-screen state cannot change,
+            # so what is checked is that the click (and F11) reached the window as a request.
+            action = window.lookup_action("fullscreen")
+            assert action.get_state().get_boolean()
+            gui.click(bar.leave_button)
+            pump(lambda: not action.get_state().get_boolean(), 3, "the request to leave full screen")
+            gui.key("F11")
+            pump(lambda: action.get_state().get_boolean(), 3, "F11: full screen again")
+            assert bar.get_child_revealed(), "the bar stays while the window is full screen"
+        finally:
+            gui.close()
+
+
+def test_first_run_hint_in_full_screen_points_at_the_menu_on_screen(
+    screenshots: Path, tmp_path: Path
+) -> None:
+    from rtmu.ui.app import GuiOptions
+    from rtmu.ui.application import FIRST_RUN_HINT
+
+    options = GuiOptions(fullscreen=True, settings_path=tmp_path / "settings.toml", persist=False)
+    gui = Gui.open(options, screenshots, "test_first_run_fullscreen", connect=False)
+    try:
+        window = gui.window
+        pump(lambda: window.fullscreen_bar.get_child_revealed(), 3, "the full-screen bar")
+        assert window.banners.text("notice:hint") == FIRST_RUN_HINT
+        assert "menu" in FIRST_RUN_HINT and window.fullscreen_bar.menu_button.get_mapped()
+        assert "rtmu --demo" in FIRST_RUN_HINT.replace("\u2060", "").replace("\u00a0", " ")
+        gui.shot("first-run-hint")
+    finally:
+        gui.close()

@@ -34,6 +34,12 @@ from .style import install_css  # noqa: E402
 from .window import MainWindow  # noqa: E402
 
 RUNNER_CLOSE_TIMEOUT = 1.5
+_NO_BREAK = "\u2060"  # WORD JOINER: the line may not break here (not after the hyphens of "--demo")
+FIRST_RUN_HINT = (
+    "No robot set up yet: open the menu ☰ → Connection settings (Ctrl+,) — or try the simulator: "
+    f"rtmu{_NO_BREAK}\u00a0-{_NO_BREAK}-{_NO_BREAK}demo"
+)
+"""Said on the first start; the menu button is on screen in a window and in full screen alike."""
 
 
 class SessionSecrets:
@@ -122,10 +128,7 @@ class RtmuApplication(Gtk.Application):
         if auto_connect:
             window.connect_now()
         elif not self.settings.profiles and not self.options.host:
-            window.banners.show(
-                "notice:hint", "info", "Set up a robot in Connection settings (Ctrl+,), or run rtmu --demo",
-                timeout=8.0,
-            )  # fmt: skip
+            window.banners.show("notice:hint", "info", FIRST_RUN_HINT, timeout=12.0)
 
     def do_shutdown(self) -> None:
         self.close_session()

@@ -155,5 +155,9 @@ class BannerStack(Gtk.Box):
 
 def _one_paragraph(text: str) -> str:
     """Bounded, without control characters other than spaces (server text can be anything)."""
-    clean = "".join(ch if ch.isprintable() else " " for ch in text).strip()
+    clean = "".join(ch if ch.isprintable() or ch in _NO_BREAKS else " " for ch in text).strip()
     return clean if len(clean) <= MAX_CHARS else clean[: MAX_CHARS - 1] + "…"
+
+
+_NO_BREAKS = "\u00a0\u2060"
+"""No-break space and word joiner: harmless, and they keep "rtmu --demo" on one line."""

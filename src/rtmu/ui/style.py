@@ -24,6 +24,9 @@ CSS = """
 .status-cell.link-stale .value { color: #b56d00; opacity: 1; }
 .status-cell.link-lost .value { color: #c01c28; opacity: 1; }
 
+.fullscreen-bar { background: @theme_bg_color; padding: 4px 6px;
+                  border-bottom: 1px solid alpha(black, 0.14); }
+.fullscreen-bar .subtitle { font-size: 9pt; opacity: 0.75; margin: 0 6px; }
 .title-box .title { font-weight: bold; }
 .title-box .subtitle { font-size: 8.5pt; opacity: 0.7; }
 button.connect-button { min-width: 96px; }

@@ -39,6 +39,7 @@ from ..model import (  # noqa: E402
 )
 from ..settings import Profile  # noqa: E402
 from .banners import BannerStack  # noqa: E402
+from .bars import FullscreenBar, connect_button, menu_button, show_connection, stop_button  # noqa: E402
 from .camera import CameraInset, CameraView, PictureDecoder  # noqa: E402
 from .dpad import DPad  # noqa: E402
 from .keys import KeyRouter  # noqa: E402
@@ -70,19 +71,6 @@ def touch_only(display: Gdk.Display | None = None) -> bool:
         if d.get_source() in (Gdk.InputSource.MOUSE, Gdk.InputSource.TOUCHPAD, Gdk.InputSource.TRACKPOINT)
     ]
     return not pointers
-
-
-def stop_button(on_stop: Callable[[], None]) -> Gtk.Button:
-    """A red STOP button (icon and word: readable at arm's length, not only by colour)."""
-    box = Gtk.Box(spacing=6, halign=Gtk.Align.CENTER)
-    box.append(Gtk.Image.new_from_icon_name("media-playback-stop-symbolic"))
-    box.append(Gtk.Label(label="STOP"))
-    button = Gtk.Button(child=box, tooltip_text="Stop the robot now (Space)")
-    button.add_css_class("destructive-action")
-    button.add_css_class("stop-button")
-    button.set_focusable(False)
-    button.connect("clicked", lambda _b: on_stop())
-    return button
 
 
 class _View:
@@ -173,10 +161,7 @@ class MainWindow(Gtk.ApplicationWindow):
         # Safety: STOP is always on screen, first in the bar and the only red button in it.
         self.stop_button = stop_button(self.stop_now)
         header.pack_start(self.stop_button)
-        self.connect_button = Gtk.Button(label="Connect")
-        self.connect_button.add_css_class("connect-button")
-        self.connect_button.set_focusable(False)
-        self.connect_button.connect("clicked", lambda _b: self.toggle_connection())
+        self.connect_button = connect_button(self.toggle_connection)
         header.pack_start(self.connect_button)
         title_box = Gtk.Box(orientation=Gtk.Orientation.VERTICAL, valign=Gtk.Align.CENTER)
         title_box.add_css_class("title-box")
@@ -189,10 +174,9 @@ class MainWindow(Gtk.ApplicationWindow):
         title_box.append(self.title_label)
         title_box.append(self.subtitle_label)
         header.set_title_widget(title_box)
-        menu_button = Gtk.MenuButton(icon_name="open-menu-symbolic", tooltip_text="Menu")
-        menu_button.set_focusable(False)
-        menu_button.set_menu_model(self._menu())
-        header.pack_end(menu_button)
+        self.menu_model = self._menu()
+        self.menu_button = menu_button(self.menu_model)
+        header.pack_end(self.menu_button)
         self.camera_button = Gtk.ToggleButton(icon_name="camera-photo-symbolic")
         self.camera_button.set_focusable(False)
         self.camera_button.set_tooltip_text("Camera picture (Esc)")
@@ -226,7 +210,15 @@ class MainWindow(Gtk.ApplicationWindow):
         outer.set_child(self.stack)
         outer.add_overlay(self.banners)
 
+        # Full screen hides the header bar: this bar keeps STOP, Connect, the menu and a way out.
+        self.fullscreen_bar = FullscreenBar(
+            on_stop=self.stop_now,
+            on_connect=self.toggle_connection,
+            on_leave=self.leave_fullscreen,
+            menu=self.menu_model,
+        )
         box = Gtk.Box(orientation=Gtk.Orientation.VERTICAL)
+        box.append(self.fullscreen_bar)
         box.append(self.toolbar_revealer)
         box.append(outer)
         outer.set_vexpand(True)
@@ -510,10 +502,8 @@ class MainWindow(Gtk.ApplicationWindow):
     def _update_header(self, conn: ConnectionState) -> None:
         phase = conn.phase
         connected_ish = phase in (Phase.CONNECTED, Phase.CONNECTING, Phase.RECONNECTING)
-        self.connect_button.set_label("Disconnect" if connected_ish else "Connect")
-        self.connect_button.set_tooltip_text(
-            "Disconnect (Ctrl+D); stops the robot first" if connected_ish else "Connect (Ctrl+O)"
-        )
+        for button in (self.connect_button, self.fullscreen_bar.connect_button):
+            show_connection(button, connected_ish)
         self._enable("connect", not connected_ish)
         self._enable("disconnect", connected_ish)
         profile = self.controller.profile
@@ -529,6 +519,7 @@ class MainWindow(Gtk.ApplicationWindow):
         parts = [profile.name, state] if where in profile.name else [profile.name, where, state]
         parts += [name] if name and phase is Phase.CONNECTED else []
         self.subtitle_label.set_text(" · ".join(parts))
+        self.fullscreen_bar.status_label.set_text(" · ".join(parts))
 
     def _on_map(self, _old: MapModel, _new: MapModel) -> None:
         self._update_map_note()
@@ -585,8 +576,14 @@ class MainWindow(Gtk.ApplicationWindow):
         else:
             self.unfullscreen()
 
+    def leave_fullscreen(self) -> None:
+        """The bar's way out (as F11): the request is recorded in the action's state at once."""
+        self.fullscreen_action.set_state(GLib.Variant.new_boolean(False))
+        self.unfullscreen()
+
     def _fullscreen_changed(self, *_a: object) -> None:
         state = self.is_fullscreen()
+        self.fullscreen_bar.set_reveal_child(state)
         if self.fullscreen_action.get_state().get_boolean() != state:
             self.fullscreen_action.set_state(GLib.Variant.new_boolean(state))
 

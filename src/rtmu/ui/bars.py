@@ -1,0 +1,88 @@
+"""The window's bars: the header bar, and the slim bar that stands in for it in full screen.
+
+GTK hides a window's title bar in full screen, and with it Connect/Disconnect,
+the menu and every way out — a trap on a touch tablet without a keyboard. So in
+full screen a slim bar with the same essentials (STOP, Connect/Disconnect, the
+status line, the menu and "leave full screen") is revealed at the top edge.
+
+STOP comes first in both and is the only red button: it is how the operator
+stops the robot without a keyboard, so it never hides.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Callable
+
+import gi
+
+gi.require_version("Gtk", "4.0")
+from gi.repository import Gio, Gtk  # noqa: E402
+
+
+def stop_button(on_stop: Callable[[], None]) -> Gtk.Button:
+    """A red STOP button (icon and word: readable at arm's length, not only by colour)."""
+    box = Gtk.Box(spacing=6, halign=Gtk.Align.CENTER)
+    box.append(Gtk.Image.new_from_icon_name("media-playback-stop-symbolic"))
+    box.append(Gtk.Label(label="STOP"))
+    button = Gtk.Button(child=box, tooltip_text="Stop the robot now (Space)")
+    button.add_css_class("destructive-action")
+    button.add_css_class("stop-button")
+    button.set_focusable(False)
+    button.connect("clicked", lambda _b: on_stop())
+    return button
+
+
+def connect_button(on_click: Callable[[], None]) -> Gtk.Button:
+    """Connect ⇄ Disconnect: a plain button (the window sets its label from the connection phase)."""
+    button = Gtk.Button(label="Connect")
+    button.add_css_class("connect-button")
+    button.set_focusable(False)
+    button.connect("clicked", lambda _b: on_click())
+    return button
+
+
+def menu_button(menu: Gio.MenuModel) -> Gtk.MenuButton:
+    button = Gtk.MenuButton(icon_name="open-menu-symbolic", tooltip_text="Menu")
+    button.set_focusable(False)
+    button.set_menu_model(menu)
+    return button
+
+
+def show_connection(button: Gtk.Button, connected_ish: bool) -> None:
+    button.set_label("Disconnect" if connected_ish else "Connect")
+    button.set_tooltip_text(
+        "Disconnect (Ctrl+D); stops the robot first" if connected_ish else "Connect (Ctrl+O)"
+    )
+
+
+class FullscreenBar(Gtk.Revealer):
+    """STOP, Connect/Disconnect, the status line, the menu and "leave full screen", at the top edge."""
+
+    def __init__(
+        self,
+        *,
+        on_stop: Callable[[], None],
+        on_connect: Callable[[], None],
+        on_leave: Callable[[], None],
+        menu: Gio.MenuModel,
+    ) -> None:
+        super().__init__(transition_type=Gtk.RevealerTransitionType.SLIDE_DOWN, transition_duration=120)
+        box = Gtk.Box(spacing=6)
+        box.add_css_class("fullscreen-bar")
+        self.stop_button = stop_button(on_stop)
+        self.connect_button = connect_button(on_connect)
+        self.status_label = Gtk.Label(xalign=0.0, hexpand=True)
+        self.status_label.add_css_class("subtitle")
+        self.status_label.set_ellipsize(3)  # Pango.EllipsizeMode.END
+        self.status_label.set_use_markup(False)
+        self.menu_button = menu_button(menu)
+        self.leave_button = Gtk.Button(
+            icon_name="view-restore-symbolic", tooltip_text="Leave full screen (F11)"
+        )
+        self.leave_button.set_focusable(False)
+        self.leave_button.connect("clicked", lambda _b: on_leave())
+        for child in (self.stop_button, self.connect_button, self.status_label, self.menu_button):
+            box.append(child)
+        box.append(self.leave_button)
+        self.set_child(box)
+        self.set_reveal_child(False)
