@@ -4,7 +4,9 @@ from __future__ import annotations
 
 import io
 import json
-import time
+import signal
+import subprocess
+import sys
 from collections.abc import Iterator
 from pathlib import Path
 
@@ -17,6 +19,7 @@ from rtmu.subcommands._common import host_port
 
 from .servers import SPECS, ServerThread, TestServer
 from .test_connection import free_port
+from .uiqueue import eventually
 
 REPO = Path(__file__).resolve().parents[2]
 ARENA = REPO / "data" / "maps" / "arena.map"
@@ -196,24 +199,63 @@ def test_server_killed_while_streaming_status_exits_3(capsys: pytest.CaptureFixt
     assert "closed" in capsys.readouterr().err
 
 
-def test_drive_interrupted_still_stops_the_robot(sim: SimThread, pwfile: Path) -> None:
-    import signal
-    import subprocess
-    import sys
-
+def _drive_process(sim: SimThread, pwfile: Path) -> subprocess.Popen[str]:
     args = [sys.executable, "-m", "rtmu", "drive", *login(sim, pwfile), "--trans", "80", "--seconds", "20"]
-    for sig in (signal.SIGINT, signal.SIGTERM):
-        proc = subprocess.Popen(args, stdout=subprocess.PIPE, stderr=subprocess.DEVNULL, text=True)
-        try:
-            assert proc.stdout is not None and proc.stdout.readline().startswith("before:")
-            deadline = time.monotonic() + 5
-            while sim.snapshot().trans_ratio != 80 and time.monotonic() < deadline:
-                time.sleep(0.02)
-            assert sim.snapshot().trans_ratio == 80
-            proc.send_signal(sig)
-            assert proc.wait(5) == EXIT_OK
-        finally:
-            if proc.poll() is None:
-                proc.kill()
-        snap = sim.snapshot()
-        assert snap.trans_ratio == 0 and snap.mode_name == "stop" and snap.watchdog_stops == 0
+    # Its own process group, so that Ctrl-Z (SIGTSTP) really suspends it wherever the tests run.
+    proc = subprocess.Popen(args, stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True, process_group=0)
+    assert proc.stdout is not None and proc.stdout.readline().startswith("before:")
+    eventually(lambda: sim.snapshot().trans_ratio == 80, timeout=5)
+    return proc
+
+
+def _stopped_by_us(sim: SimThread) -> bool:
+    snap = sim.snapshot()
+    return snap.trans_ratio == 0 and snap.mode_name == "stop" and snap.watchdog_stops == 0
+
+
+@pytest.mark.parametrize(
+    "sig", [signal.SIGINT, signal.SIGTERM, signal.SIGHUP, signal.SIGQUIT, signal.SIGUSR1]
+)
+def test_drive_ended_by_a_signal_stops_the_robot_and_exits_128_plus_n(
+    sim: SimThread, pwfile: Path, sig: signal.Signals
+) -> None:
+    proc = _drive_process(sim, pwfile)
+    try:
+        proc.send_signal(sig)
+        assert proc.wait(10) == 128 + sig
+        err = proc.stderr.read()  # type: ignore[union-attr]
+    finally:
+        if proc.poll() is None:
+            proc.kill()
+            proc.wait()
+    assert _stopped_by_us(sim)  # our zero ratios and stop, not the server's 2 s watchdog
+    assert err.count("\n") == 1 and err.startswith("rtmu drive: interrupted by " + sig.name), err
+
+
+def test_ctrl_z_stops_the_robot_before_suspending_and_fg_does_not_drive_again(
+    sim: SimThread, pwfile: Path
+) -> None:
+    proc = _drive_process(sim, pwfile)
+    try:
+        proc.send_signal(signal.SIGTSTP)
+        eventually(lambda: _process_state(proc.pid) in ("T", "t"), timeout=5)  # suspended…
+        assert _stopped_by_us(sim)  # …after stopping the robot
+        drives = sim.call(lambda: sim.server.robot.ratio_drives_received)  # type: ignore[union-attr]
+        proc.send_signal(signal.SIGCONT)
+        assert proc.wait(10) == 128 + signal.SIGTSTP
+        assert sim.call(lambda: sim.server.robot.received_ratios)[:2] == (0.0, 0.0)  # type: ignore[union-attr]
+        assert sim.call(lambda: sim.server.robot.ratio_drives_received) <= drives + 1  # type: ignore[union-attr]
+    finally:
+        if proc.poll() is None:
+            proc.kill()
+            proc.wait()
+    assert _stopped_by_us(sim)
+
+
+def _process_state(pid: int) -> str:
+    """The one-letter state of a process from /proc (``T`` = stopped); ``?`` once it is gone."""
+    try:
+        stat = Path(f"/proc/{pid}/stat").read_text()
+    except OSError:
+        return "?"
+    return stat.rpartition(")")[2].split()[0]

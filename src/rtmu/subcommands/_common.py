@@ -6,13 +6,21 @@ accepted on the command line, where other users could read it in ``ps``) and
 ``--timeout``. Failures print ONE line on stderr (``rtmu NAME: what went wrong``)
 and exit with a code scripts can rely on (constants in ``rtmu.cli``):
 
-====  =========================================================
-0     ok
-2     usage error (bad arguments)
-3     connection or login failure (refused, unreachable, rejected, closed)
-4     the server does not offer what is needed
-5     timeout
-====  =========================================================
+=======  =========================================================
+0        ok
+2        usage error (bad arguments)
+3        connection or login failure (refused, unreachable, rejected, closed),
+         or the server sent something malformed
+4        the server does not offer what is needed
+5        timeout
+128 + N  ended by signal N, shell style: 129 SIGHUP, 130 SIGINT (Ctrl-C),
+         131 SIGQUIT, 143 SIGTERM, 148 SIGTSTP (``rtmu drive`` after Ctrl-Z)
+=======  =========================================================
+
+Signals: SIGINT, SIGTERM, SIGHUP (a closed terminal or SSH session), SIGQUIT, SIGUSR1/2 and
+SIGALRM end a command through its ``finally`` blocks — ``rtmu drive`` always sends zero ratios and
+``stop`` before it goes. SIGTSTP (Ctrl-Z) first runs the command's suspend hooks
+(``rtmu drive``: stop the robot), then suspends the process as usual.
 """
 
 from __future__ import annotations
@@ -20,7 +28,10 @@ from __future__ import annotations
 import argparse
 import asyncio
 import contextlib
+import contextvars
 import getpass
+import os
+import signal
 import sys
 from collections.abc import Awaitable, Callable
 from pathlib import Path
@@ -109,17 +120,104 @@ def read_password(args: argparse.Namespace) -> str:
     return line.rstrip("\r\n")
 
 
-def _cancel_on_terminate() -> None:
-    """SIGTERM (e.g. ``timeout``, a service manager) ends a command like Ctrl-C does: through the
-    ``finally`` blocks, so ``rtmu drive`` always sends its stop before the process goes."""
-    import signal
+INTERRUPT_SIGNALS = (
+    signal.SIGINT,
+    signal.SIGTERM,
+    signal.SIGHUP,
+    signal.SIGQUIT,
+    signal.SIGUSR1,
+    signal.SIGUSR2,
+    signal.SIGALRM,
+)
+"""Every catchable signal whose default action would end the process on the spot: each ends a
+command through its ``finally`` blocks instead (exit 128 + the signal's number)."""
 
-    task = asyncio.current_task()
-    if task is None:
-        return
-    loop = asyncio.get_running_loop()
-    with contextlib.suppress(NotImplementedError, RuntimeError, ValueError):
-        loop.add_signal_handler(signal.SIGTERM, task.cancel)
+
+class Interrupted(Exception):
+    """The command was ended by a signal; ``exit_code`` is 128 + its number, as shells report it."""
+
+    def __init__(self, signum: int, detail: str = "") -> None:
+        self.signum = signum
+        self.exit_code = 128 + signum
+        self.detail = detail
+        super().__init__(f"interrupted by {signal_name(signum)}" + (f"; {detail}" if detail else ""))
+
+
+def signal_name(signum: int) -> str:
+    try:
+        return signal.Signals(signum).name
+    except ValueError:
+        return f"signal {signum}"
+
+
+class Interrupts:
+    """Turns the ending signals into a cancel of the command's task, remembering which one came.
+
+    ``signum`` is the first ending signal (None until one arrives). ``take()`` lets a command
+    that caught the cancel carry on cleaning up (stop, print a last status) before it raises
+    :class:`Interrupted`. ``on_suspend(hook)`` registers what must happen before Ctrl-Z
+    suspends the process (``rtmu drive`` stops the robot there).
+    """
+
+    def __init__(self) -> None:
+        self.signum: int | None = None
+        self._task: asyncio.Task[Any] | None = None
+        self._loop: asyncio.AbstractEventLoop | None = None
+        self._suspend_hooks: list[Callable[[], None]] = []
+
+    def install(self) -> None:
+        """Handle the signals on the running loop, for the current task (call from that task)."""
+        self._task = asyncio.current_task()
+        self._loop = asyncio.get_running_loop()
+        for signum in INTERRUPT_SIGNALS:
+            with contextlib.suppress(NotImplementedError, RuntimeError, ValueError):
+                self._loop.add_signal_handler(signum, self.interrupt, signum)
+        with contextlib.suppress(NotImplementedError, RuntimeError, ValueError):
+            self._loop.add_signal_handler(signal.SIGTSTP, self._suspend)
+
+    def interrupt(self, signum: int) -> None:
+        """End the command as if ``signum`` had arrived (a second signal cancels again)."""
+        if self.signum is None:
+            self.signum = signum
+        if self._task is not None and not self._task.done():
+            self._task.cancel()
+
+    def take(self) -> int | None:
+        """The signal behind the cancel just caught, accepting it (None: not ours, re-raise it)."""
+        if self.signum is None:
+            return None
+        if self._task is not None and self._task.cancelling():
+            self._task.uncancel()
+        return self.signum
+
+    def on_suspend(self, hook: Callable[[], None]) -> None:
+        self._suspend_hooks.append(hook)
+
+    def _suspend(self) -> None:
+        for hook in list(self._suspend_hooks):
+            try:
+                hook()
+            except Exception as exc:  # the suspension must happen anyway
+                print(f"rtmu: before suspending: {exc}", file=sys.stderr)
+        loop = self._loop
+        if loop is None:
+            return
+        # Suspend for real: the default action, then handle Ctrl-Z again once resumed (fg/SIGCONT).
+        loop.remove_signal_handler(signal.SIGTSTP)
+        os.kill(os.getpid(), signal.SIGTSTP)
+        with contextlib.suppress(NotImplementedError, RuntimeError, ValueError):
+            loop.add_signal_handler(signal.SIGTSTP, self._suspend)
+
+
+_INTERRUPTS: contextvars.ContextVar[Interrupts | None] = contextvars.ContextVar(
+    "rtmu_interrupts", default=None
+)
+
+
+def current_interrupts() -> Interrupts:
+    """The running command's :class:`Interrupts` (a fresh, uninstalled one outside a command)."""
+    found = _INTERRUPTS.get()
+    return found if found is not None else Interrupts()
 
 
 def fail(name: str, message: str, code: int) -> int:
@@ -133,30 +231,40 @@ def run_with_client(name: str, args: argparse.Namespace, body: Callable[[AriaCli
         password = read_password(args)
     except UsageError as exc:
         return fail(name, str(exc), EXIT_USAGE)
-    except (KeyboardInterrupt, EOFError):
+    except KeyboardInterrupt:
+        return fail(name, "cancelled", 128 + signal.SIGINT)
+    except EOFError:
         return fail(name, "cancelled", EXIT_USAGE)
 
     async def main() -> int:
         host, port = args.server
         client = AriaClient()
-        _cancel_on_terminate()
+        interrupts = Interrupts()
+        interrupts.install()
+        _INTERRUPTS.set(interrupts)
         try:
             await client.connect(host, port, args.user, password, timeout=args.timeout)
             return await body(client)
+        except asyncio.CancelledError:
+            signum = interrupts.take()
+            if signum is None:
+                raise
+            raise Interrupted(signum) from None
         finally:
             await client.disconnect()
 
     try:
         return asyncio.run(main())
+    except Interrupted as exc:
+        return fail(name, str(exc), exc.exit_code)
     except ClientError as exc:
         return fail(name, str(exc), exc.exit_code)
     except ProtocolError as exc:  # a reply that does not decode, wherever a command looked at it
         return fail(name, f"the server sent something malformed: {exc}", EXIT_CONNECTION)
     except UsageError as exc:
         return fail(name, str(exc), EXIT_USAGE)
-    except (KeyboardInterrupt, asyncio.CancelledError):
-        print(file=sys.stderr)
-        return EXIT_OK
+    except (KeyboardInterrupt, asyncio.CancelledError):  # Ctrl-C before the handlers were in place
+        return fail(name, "interrupted by SIGINT", 128 + signal.SIGINT)
     except BrokenPipeError:  # e.g. piped into ``head``: the reader has what it wanted
         _silence_stdout()
         return EXIT_OK

@@ -1,10 +1,12 @@
 """``rtmu drive HOST[:PORT] --trans PCT --rot PCT [--throttle PCT] --seconds S``: drive, then stop.
 
 Sends ``ratioDrive`` every 100 ms for S seconds (ARIA's watchdog stops a robot
-that hears nothing for 2 s), then zero ratios and ``stop`` — also on Ctrl-C or
-any error — and prints the pose before and after (``--json``: one object
-``{"before": STATUS, "after": STATUS, "seconds": S}`` with the keys of
-``rtmu status``).
+that hears nothing for 2 s), then zero ratios and ``stop`` — also on Ctrl-C, SIGTERM,
+SIGHUP (the terminal or SSH session went away), SIGQUIT or any error — and prints the
+pose before and after (``--json``: one object ``{"before": STATUS, "after": STATUS,
+"seconds": S}`` with the keys of ``rtmu status``). Ctrl-Z (SIGTSTP) stops the robot
+before the process is suspended, and the drive is not resumed by ``fg``: it ends there
+(exit 148). Exit codes after a signal follow the shell: 128 + the signal's number.
 """
 
 from __future__ import annotations
@@ -12,6 +14,7 @@ from __future__ import annotations
 import argparse
 import asyncio
 import contextlib
+import signal
 import sys
 from typing import Any
 
@@ -22,6 +25,7 @@ from ..protocol.payloads.drive import RatioDrive
 from ._common import (
     UsageError,
     add_connection_arguments,
+    current_interrupts,
     fetch_status,
     print_json,
     run_with_client,
@@ -74,6 +78,13 @@ def handle(args: argparse.Namespace) -> int:
         before = await fetch_status(client, args.timeout)
         if not args.json:
             print(f"before: {status_line(before)}", flush=True)
+        interrupts = current_interrupts()
+
+        def before_suspending() -> None:
+            stop(client)  # Ctrl-Z: the robot must not drive on while the process sleeps
+            interrupts.interrupt(signal.SIGTSTP)  # and ``fg`` must not start it again
+
+        interrupts.on_suspend(before_suspending)
         try:
             await drive(client, RatioDrive(args.trans, args.rot, args.throttle), args.seconds)
         finally:
