@@ -147,3 +147,48 @@ def test_check_map_reloads_a_changed_file_and_tells_subscribers(arena_map, tmp_p
         await server.stop()
 
     run(scenario())
+
+
+def test_a_million_point_binary_map_reaches_a_reading_client_though_it_exceeds_the_queue_limit(
+    million_point_map,
+):
+    async def scenario() -> None:
+        server = SimServer(SimConfig(port=0, realtime=False, map_path=million_point_map))
+        await server.start()
+        number = server.datalist.number("getMapBinary")
+        size = sum(len(c) for c in server.map.binary_stream(number))
+        assert size > server.config.max_queued_bytes  # 8 MB against a limit of a few MB
+        c = await WireClient().open(server.port)
+        c.once("getMapBinary")
+        await c.until(lambda: c.received["getMapBinary"][-1:] == [b""], timeout=60)
+        binary = _binary_map(c.received["getMapBinary"])
+        assert len(binary.points) == 1_000_000
+        assert len(server.sessions) == 1  # still connected
+        await c.close()
+        await server.stop()
+
+    run(scenario(), timeout=120)
+
+
+def test_a_map_asked_for_again_while_it_is_being_sent_comes_once_more(shared_dir):
+    columbia = shared_dir / "aria-maps" / "columbia.map"
+
+    async def scenario() -> None:
+        server = SimServer(SimConfig(port=0, realtime=False, map_path=columbia))
+        await server.start()
+        c = await WireClient().open(server.port)
+        for _ in range(5):  # five in one write: the first is still being sent when the others arrive
+            c.conn.request_once("getMap")
+        c.conn.request_once("getMapBinary")
+        c._flush()
+        await c.until(lambda: c.received["getMapBinary"][-1:] == [b""], timeout=60)
+        await c.barrier()
+        text = c.received["getMap"]
+        assert text.count(b"") == 2  # the one being sent, then one more; not five 1.2 MB copies
+        end = text.index(b"") + 1
+        assert _text_map(text[:end]) == _text_map(text[end:]) == file_lines(columbia)
+        assert _binary_map(c.received["getMapBinary"]).points.shape[0] == 63311
+        await c.close()
+        await server.stop()
+
+    run(scenario(), timeout=120)

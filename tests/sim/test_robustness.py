@@ -5,11 +5,13 @@ from __future__ import annotations
 import asyncio
 import random
 
+from rtmu.protocol.client_connection import ClientState
 from rtmu.protocol.packet import encode_packet
 from rtmu.protocol.payloads.robot import UpdateNumbers
 from rtmu.sim import SimConfig, SimServer
+from rtmu.sim.server import REFUSING_SLOTS
 
-from .wire import SHARED, WireClient, run
+from .wire import SHARED, WireClient, eventually, run
 
 COLUMBIA = SHARED / "aria-maps" / "columbia.map"
 
@@ -124,20 +126,21 @@ def test_a_client_flooding_fake_headers_gets_one_slice_per_loop_turn(arena_map):
     run(scenario(), timeout=120)
 
 
-def test_a_client_that_stops_reading_is_dropped_after_the_backup_timeout():
+def test_a_client_that_stops_reading_is_dropped_after_the_backup_timeout(million_point_map):
     async def scenario() -> None:
-        server = SimServer(SimConfig(port=0, realtime=False, map_path=COLUMBIA, backup_timeout=5.0))
+        cfg = SimConfig(port=0, realtime=False, map_path=million_point_map, backup_timeout=5.0)
+        server = SimServer(cfg)
         await server.start()
         watcher = await WireClient().open(server.port)
         watcher.request("updateNumbers", 100)
         stuck = await WireClient().open(server.port)
         stuck._task.cancel()  # stop reading, keep the socket open
-        for _ in range(20):
-            stuck.once("getMap")
+        stuck.once("getMapBinary")  # 8 MB: more than the kernel's socket buffers hold
         await watcher.barrier()
         port = str(stuck.writer.get_extra_info("sockname")[1])
         stuck_session = [s for s in server.sessions if s.peer.endswith(":" + port)]
-        assert stuck_session and stuck_session[0].buffered > 0
+        assert stuck_session
+        await eventually(lambda: stuck_session[0].buffered > 0, what="the download to stall")
         await server.advance(3.0)
         assert stuck_session[0] in server.sessions  # not yet
         await server.advance(3.0)
@@ -149,6 +152,62 @@ def test_a_client_that_stops_reading_is_dropped_after_the_backup_timeout():
         await server.stop()
 
     run(scenario(), timeout=120)
+
+
+def test_a_client_that_queues_more_than_a_few_megabytes_is_dropped_at_once(arena_map):
+    async def scenario() -> None:
+        server = SimServer(SimConfig(port=0, realtime=False, map_path=arena_map))
+        await server.start()
+        assert server.config.max_queued_bytes <= 8 * 1024 * 1024
+        watcher = await WireClient().open(server.port)
+        greedy = await WireClient().open(server.port)
+        greedy.once("SimulatorVideo640x480")
+        await greedy.barrier()
+        greedy._task.cancel()  # it stops reading and asks for 1600 pictures (about 16 MB)
+        for _ in range(1600):
+            greedy.conn.request_once("getPictureCam1")
+        greedy._flush()
+        port = str(greedy.writer.get_extra_info("sockname")[1])
+        session = next(s for s in server.sessions if s.peer.endswith(":" + port))
+        await eventually(lambda: session.closed, what="the greedy client to be dropped")
+        assert session not in server.sessions
+        assert session.bytes_out <= server.config.max_queued_bytes + 8 * 1024 * 1024  # kernel buffers
+        await watcher.barrier()  # the others are still served
+        await watcher.close()
+        await greedy.close(goodbye=False)
+        await server.stop()
+
+    run(scenario(), timeout=120)
+
+
+def test_connections_beyond_the_client_limit_are_refused_then_closed_at_once():
+    async def scenario() -> None:
+        assert SimConfig().max_clients == 100  # there is a limit unless one asks for none
+        server = SimServer(SimConfig(port=0, realtime=False, max_clients=2))
+        await server.start()
+        admitted = [await WireClient().open(server.port) for _ in range(2)]
+        refused = await WireClient().open(server.port)
+        assert refused.rejected is not None and refused.rejected.reason == 5  # ARIA's "too many clients"
+        await refused.until(lambda: refused.eof)
+        # Sockets that never introduce themselves are kept only up to a few refusal slots.
+        silent = [await asyncio.open_connection("127.0.0.1", server.port) for _ in range(40)]
+        await admitted[0].barrier()
+        assert len(server.sessions) <= 2 + REFUSING_SLOTS
+        closed_at_once = 0
+        for reader, _ in silent:
+            first = await asyncio.wait_for(reader.read(1), 5)
+            closed_at_once += first == b""  # no INTRODUCTION, just closed
+        assert closed_at_once >= 40 - REFUSING_SLOTS
+        for c in admitted:
+            await c.barrier()
+            assert c.conn.state is ClientState.CONNECTED
+        for _, writer in silent:
+            writer.close()
+        for c in (*admitted, refused):
+            await c.close(goodbye=False)
+        await server.stop()
+
+    run(scenario())
 
 
 def test_shutdown_tells_every_client():

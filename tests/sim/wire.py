@@ -23,6 +23,19 @@ def run(coro, timeout: float = 60.0):
     return asyncio.run(asyncio.wait_for(coro, timeout))
 
 
+async def eventually(predicate, timeout: float = TIMEOUT, what: str = "the condition") -> None:
+    """Poll server-side state that no client packet announces (a socket's queue, a session closing)."""
+
+    async def poll() -> None:
+        while not predicate():
+            await asyncio.sleep(0.005)
+
+    try:
+        await asyncio.wait_for(poll(), timeout)
+    except TimeoutError:
+        raise AssertionError(f"timed out waiting for {what}") from None
+
+
 class WireClient:
     def __init__(self, user: str = "", password: str = "", **kw) -> None:
         self.conn = ClientConnection(user, password, **kw)

@@ -25,8 +25,9 @@ class SimConfig:
     """False: the clock stands still until ``SimServer.advance`` moves it (for tests)."""
     battery_v: float = p3dx.BATTERY_FULL_V
     server_key: str = ""
-    max_clients: int | None = None
-    """ARIA's maxClientsAllowed: one more is refused with reason 5."""
+    max_clients: int | None = 100
+    """ARIA's maxClientsAllowed: one more is refused with reason 5 (None: no limit, as ARIA's default —
+    but every client may queue up to ``max_queued_bytes``, so a simulator keeps a limit)."""
     protocol_version: str | None = None
     """Enforce a protocol version (reason 4 for a client that differs)."""
     client_type: int | None = None
@@ -40,8 +41,9 @@ class SimConfig:
     intro_timeout: float = 60.0
     backup_timeout: float = 5.0
     """Drop a client whose queued output has not moved for this long (ARIA's backup timeout)."""
-    max_queued_bytes: int = 64 * 1024 * 1024
-    """Drop a client at once when this much output is waiting for it."""
+    max_queued_bytes: int = 4 * 1024 * 1024
+    """Drop a client at once when this much output is waiting for it. Map downloads are sent as the
+    client reads (a 1 M-point map is 8 MB binary, 21 MB as text), so they never count whole."""
     skip_periodic_above: int = 1024 * 1024
     """Skip periodic sends to a client with this much output still queued (it is not keeping up)."""
     verbose: bool = False

@@ -3,7 +3,7 @@
 A handler gets a :class:`Call` (who asked, for which data, with which
 arguments) and returns the replies: payload bytes sent under the data's own
 number, :class:`Other` for a packet under another data's number, or
-:class:`Framed` for bytes already framed (the cached map streams). Every
+:class:`Stream` for a download already framed (the cached map streams). Every
 payload is built with the typed payloads of :mod:`rtmu.protocol.payloads`.
 """
 
@@ -92,13 +92,16 @@ class Other:
 
 
 @dataclass(frozen=True, slots=True)
-class Framed:
-    """Packets already framed with this data's number."""
+class Stream:
+    """A download: packets already framed with this data's number, in chunks of whole packets.
 
-    data: bytes
+    The server sends it as the client reads, one download per client at a time (see ``Session.stream``).
+    """
+
+    chunks: tuple[bytes, ...]
 
 
-Reply = bytes | Other | Framed
+Reply = bytes | Other | Stream
 
 
 @dataclass(slots=True)
@@ -364,17 +367,17 @@ def _map_id(call: Call) -> Iterable[Reply]:
 
 @handles("getMap")
 def _get_map(call: Call) -> Iterable[Reply]:
-    return (Framed(call.server.map.text_stream(call.number)),)
+    return (Stream(call.server.map.text_stream(call.number)),)
 
 
 @handles("getMapBinary")
 def _get_map_binary(call: Call) -> Iterable[Reply]:
-    return (Framed(call.server.map.binary_stream(call.number)),)
+    return (Stream(call.server.map.binary_stream(call.number)),)
 
 
 @handles("getMapMultiScans")
 def _get_map_multi(call: Call) -> Iterable[Reply]:
-    return (Framed(call.server.map.binary_stream(call.number, "2D-Map-Ex")),)
+    return (Stream(call.server.map.binary_stream(call.number, "2D-Map-Ex")),)
 
 
 @handles("getMapWithMaxCategory")
@@ -387,7 +390,7 @@ def _get_map_category(call: Call) -> Iterable[Reply]:
         if category in ("2D-Map-Ex", "2D-Map-Ex2")
         else "2D-Map-Ex2"
     )
-    return (Framed(call.server.map.binary_stream(call.number, first)),)
+    return (Stream(call.server.map.binary_stream(call.number, first)),)
 
 
 @handles("checkMap")

@@ -3,13 +3,16 @@
 ``getMap`` sends the file's own lines, one per packet, unchanged (so ARIA's
 maps and ours reach the client byte for byte); ``getMapBinary`` sends the
 header ARIA's way and the geometry as int32 blocks. Both streams are framed
-once per data number and then handed to every client as one ``bytes``.
+once per data number and shared by every client, cut into chunks of whole
+packets so a big map can be sent a chunk at a time as the client reads it
+(a 1 M-point map is 8 MB binary, 21 MB as text).
 """
 
 from __future__ import annotations
 
 import hashlib
 import os
+from collections.abc import Iterable
 from dataclasses import dataclass, field
 from pathlib import Path
 
@@ -23,6 +26,24 @@ from .geometry import Obstacles
 
 DEFAULT_POINT_CELL_MM = 40.0
 MIN_POINT_CELL_MM = 20.0
+STREAM_CHUNK_BYTES = 64 * 1024
+"""Framed map streams are cut into chunks of whole packets of about this size."""
+
+Chunks = tuple[bytes, ...]
+
+
+def frame_in_chunks(number: int, payloads: Iterable[bytes], chunk: int = STREAM_CHUNK_BYTES) -> Chunks:
+    """Packets for data ``number``, framed and grouped into chunks of about ``chunk`` bytes (never split)."""
+    out: list[bytes] = []
+    buf = bytearray()
+    for payload in payloads:
+        buf += encode_packet(number, payload)
+        if len(buf) >= chunk:
+            out.append(bytes(buf))
+            buf.clear()
+    if buf:
+        out.append(bytes(buf))
+    return tuple(out)
 
 
 @dataclass
@@ -42,7 +63,7 @@ class ServedMap:
     mtime: int = 0
     resolution: int | None = None
     access_point: tuple[float, float] | None = None
-    _framed: dict[tuple[str, int], bytes] = field(default_factory=dict, repr=False)
+    _framed: dict[tuple[str, int], Chunks] = field(default_factory=dict, repr=False)
 
     @property
     def present(self) -> bool:
@@ -62,15 +83,15 @@ class ServedMap:
     def goals_payload(self) -> bytes:
         return Goals(self.goals).encode()
 
-    def text_stream(self, number: int) -> bytes:
+    def text_stream(self, number: int) -> Chunks:
         """Every ``getMap`` reply packet, framed for data ``number``."""
         key = ("text", number)
         if key not in self._framed:
             payloads = map_text_payloads(self.lines if self.present else None)
-            self._framed[key] = b"".join(encode_packet(number, p) for p in payloads)
+            self._framed[key] = frame_in_chunks(number, payloads)
         return self._framed[key]
 
-    def binary_stream(self, number: int, first_line: str | None = None) -> bytes:
+    def binary_stream(self, number: int, first_line: str | None = None) -> Chunks:
         """Every ``getMapBinary`` reply packet (``getMapWithMaxCategory`` may rename the first line)."""
         key = ("binary:" + (first_line or ""), number)
         if key not in self._framed:
@@ -80,7 +101,7 @@ class ServedMap:
                 payloads = map_binary_payloads(header, self.segments, self.points)
             else:
                 payloads = map_binary_payloads(None)
-            self._framed[key] = b"".join(encode_packet(number, p) for p in payloads)
+            self._framed[key] = frame_in_chunks(number, payloads)
         return self._framed[key]
 
 

@@ -42,14 +42,14 @@ from .handlers import (
     BROADCAST_ONLY,
     HANDLERS,
     Call,
-    Framed,
     Other,
+    Stream,
     mode_info_payload,
     popup_close_payload,
     popup_payload,
     strings_payload,
 )
-from .mapserve import ServedMap, load_map
+from .mapserve import Chunks, ServedMap, load_map
 from .video import VideoFeed
 from .world import PHYSICS_DT, World, free_spot_near
 
@@ -63,6 +63,12 @@ RECEIVE_SLICE = 4096
 """At most this many bytes of one client's input are decoded and handled before the loop turns, so a
 client that floods (garbage, fake headers, a burst of requests) cannot hold up the cycle or the others."""
 WARM_STREAMS_ABOVE_LINES = 100_000
+SMALL_STREAM_BYTES = 256 * 1024
+"""A download this small is written at once, in order with the replies around it; a bigger one is
+sent a chunk at a time as the client reads it, so no client ever has a whole big map queued."""
+REFUSING_SLOTS = 16
+"""Connections beyond ``max_clients`` that are kept long enough to be told reason 5; past these, a new
+connection is closed at once (each one costs a socket and a codec until it introduces itself)."""
 KEY_RNG = random.SystemRandom()
 """Password, auth and intro keys come from the OS, never from ``--seed``: a seeded key would repeat on
 every restart, and a recorded login could then be replayed. The seed drives physics, wander and noise."""
@@ -137,6 +143,8 @@ class Session:
         self._last_buffered = 0
         self.bytes_out = 0
         self.bytes_in = 0
+        self._download: asyncio.Task[None] | None = None
+        self._queued_downloads: dict[int, Chunks] = {}
         peer = writer.get_extra_info("peername")
         self.peer = f"{peer[0]}:{peer[1]}" if isinstance(peer, tuple) else str(peer)
 
@@ -159,6 +167,50 @@ class Session:
         except (ConnectionError, RuntimeError, OSError):
             self.abort()
 
+    def stream(self, number: int, chunks: Chunks) -> None:
+        """Send a download (a map): one at a time per client, a chunk at a time as the client reads.
+
+        A download asked for while another is being sent waits for it; asking again for one that is
+        already waiting does not queue a second copy (the client gets it once, the newest version).
+        """
+        if self.closed:
+            return
+        if self._download is not None:
+            if number in self._queued_downloads:
+                log.info("client %s: map %d asked for again while queued; sending it once", self.peer, number)
+            self._queued_downloads[number] = chunks
+            return
+        if sum(len(c) for c in chunks) <= SMALL_STREAM_BYTES:
+            for chunk in chunks:
+                self.write(chunk)
+            return
+        self._download = asyncio.get_running_loop().create_task(self._send_downloads(chunks))
+
+    async def _send_downloads(self, chunks: Chunks) -> None:
+        try:
+            while True:
+                for chunk in chunks:
+                    if self.closed:
+                        return
+                    self.write(chunk)
+                    await self.writer.drain()  # waits while more than 64 KiB is queued for this client
+                    await asyncio.sleep(0)
+                if not self._queued_downloads or self.closed:
+                    return
+                chunks = self._queued_downloads.pop(next(iter(self._queued_downloads)))
+        except (ConnectionError, OSError, RuntimeError):
+            self.abort()
+        finally:
+            if self._download is asyncio.current_task():
+                self._download = None
+                self._queued_downloads.clear()
+
+    def cancel_download(self) -> None:
+        self._queued_downloads.clear()
+        task, self._download = self._download, None
+        if task is not None and task is not asyncio.current_task():
+            task.cancel()
+
     def flush_codec(self) -> None:
         self.write(self.conn.data_to_send())
 
@@ -175,6 +227,7 @@ class Session:
         if self.closed:
             return
         self.closed = True
+        self.cancel_download()
         transport = self.writer.transport
         if transport is not None:
             transport.abort()
@@ -184,6 +237,7 @@ class Session:
         if self.closed:
             return
         self.closed = True
+        self.cancel_download()
         self.server.forget(self)
 
         def finish() -> None:
@@ -341,6 +395,7 @@ class SimServer:
         if self._server is not None:
             self._server.close()
         for s in list(self.sessions):
+            s.cancel_download()
             s.conn.shutdown()
             s.flush_codec()
             s.closed = True
@@ -376,6 +431,12 @@ class SimServer:
 
     async def _accept(self, reader: asyncio.StreamReader, writer: asyncio.StreamWriter) -> None:
         cfg = self.config
+        if cfg.max_clients is not None and len(self.sessions) >= cfg.max_clients + REFUSING_SLOTS:
+            log.info("%d connections open; closing a new one at once", len(self.sessions))
+            transport = writer.transport
+            if transport is not None:
+                transport.abort()
+            return
         general: tuple[int, str] | None = None
         if cfg.central_server is not None:
             general = (int(RejectReason.USING_CENTRAL_SERVER), cfg.central_server)
@@ -424,8 +485,8 @@ class SimServer:
         for reply in replies:
             if isinstance(reply, bytes):
                 session.send(number, reply)
-            elif isinstance(reply, Framed):
-                session.write(reply.data)
+            elif isinstance(reply, Stream):
+                session.stream(number, reply.chunks)
             elif isinstance(reply, Other):
                 other = self.datalist.number(reply.name)
                 if other is not None:

@@ -60,7 +60,12 @@ def register(subparsers: argparse._SubParsersAction) -> None:  # type: ignore[ty
     )
     p.add_argument("--battery", type=float, default=None, help="starting battery voltage (default 12.8)")
     p.add_argument("--server-key", default="", help="ARIA server key mixed into password digests")
-    p.add_argument("--max-clients", type=int, default=None, help="refuse more clients than this (reason 5)")
+    p.add_argument(
+        "--max-clients",
+        type=int,
+        default=100,
+        help="refuse more clients than this, ARIA's reason 5 (default 100; 0 = no limit)",
+    )
     p.add_argument("-v", "--verbose", action="store_true", help="log connections and refusals")
     gen = p.add_argument_group("map generator (writes a map and exits)")
     gen.add_argument("--make-map", type=Path, metavar="FILE", help="write a generated building map to FILE")
@@ -90,7 +95,7 @@ def run(args: argparse.Namespace) -> int:
         seed=args.seed,
         drive_timeout=args.drive_timeout,
         server_key=args.server_key,
-        max_clients=args.max_clients,
+        max_clients=args.max_clients if args.max_clients > 0 else None,
         verbose=args.verbose,
     )
     if args.battery is not None:
