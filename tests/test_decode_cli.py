@@ -9,7 +9,14 @@ from pathlib import Path
 
 import pytest
 
-from capture_builders import Conversation, catalogue, pcapng_file, server_greeting, update_numbers
+from capture_builders import (
+    Conversation,
+    catalogue,
+    pcap_file,
+    pcapng_file,
+    server_greeting,
+    update_numbers,
+)
 from rtmu.protocol.packet import encode_packet
 
 CAPTURES = Path(__file__).resolve().parents[1].parent / "shared" / "captures"
@@ -165,6 +172,41 @@ def test_raw_bytes_with_garbage_and_a_bad_checksum(tmp_path):
     assert "BAD CHECKSUM" in text and "!! dropped: " in text
     assert "s2c 4 garbage bytes" not in text  # drops are worded per kind
     assert f"{4 + len(bad)} garbage bytes, 1 bad checksum" in text
+
+
+def test_json_reports_bytes_dropped_at_the_very_end_of_a_stream(tmp_path):
+    """Drops reach --json through the next packet's dropped_before; at the end none follows."""
+    good = encode_packet(5)
+    path = tmp_path / "tail.bin"
+    path.write_bytes(good + b"\x0f\x0c\x10\x00\x05")  # then a header whose packet never arrives
+    result = rtmu("--json", path)
+    assert result.returncode == 0, result.stderr
+    packet, dropped = json_lines(result.stdout)
+    assert packet["name"] == "CONNECTED" and "kind" not in packet
+    assert dropped.keys() >= PACKET_KEYS
+    assert dropped["kind"] == "dropped" and dropped["command"] is None and dropped["name"] is None
+    assert (dropped["conn"], dropped["dir"], dropped["transport"]) == (1, "s2c", "stream")
+    assert dropped["length"] == 5 and dropped["checksum_ok"] is False
+    assert dropped["fields"] == {"garbage_bytes": 5, "truncated_at_close": 1}
+    text = rtmu(path).stdout  # the text output showed it already, once
+    assert text.count("!! dropped: 5 garbage bytes, 1 packet cut off at the end") == 1
+
+
+def test_json_reports_trailing_garbage_of_each_tcp_direction(tmp_path):
+    conv = Conversation().handshake().send(False, server_stream()).send(False, b"\x00junk\x0f")
+    conv.send(True, encode_packet(5)).send(True, b"\xff" * 7).close()
+    path = tmp_path / "tail.pcap"
+    path.write_bytes(pcap_file(conv.frames()))
+    records = json_lines(rtmu("--json", path).stdout)
+    dropped = {r["dir"]: r for r in records if r.get("kind") == "dropped"}
+    assert dropped.keys() == {"s2c", "c2s"}
+    assert dropped["s2c"]["length"] == 6 and dropped["s2c"]["fields"] == {"garbage_bytes": 6}
+    assert dropped["c2s"]["length"] == 7 and dropped["c2s"]["fields"] == {"garbage_bytes": 7}
+    assert all(r["transport"] == "tcp" and r["conn"] == 1 and r["time"] is not None for r in dropped.values())
+    assert records[-1]["kind"] == "dropped"  # at the end of the stream, after its last packet
+    assert (
+        sum(r.get("kind") == "dropped" for r in json_lines(rtmu("--json", "--no-summary", path).stdout)) == 2
+    )
 
 
 def test_raw_bytes_direction_can_be_given(tmp_path):

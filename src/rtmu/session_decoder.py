@@ -102,7 +102,23 @@ class DropReport:
     counts: dict[str, int]
 
 
-DecodeItem = DecodedPacket | DropReport
+@dataclass(slots=True)
+class TrailingDrops:
+    """Drops that no later packet carries as ``dropped_before``: what ended a stream or a datagram.
+
+    Only yielded by ``CaptureDecoder(report_trailing_drops=True)``: ``rtmu decode --json`` shows
+    drops through the next packet's ``dropped_before``, so without these the garbage or cut-off
+    packet at the very end of a stream would vanish from its output.
+    """
+
+    conn: int
+    direction: str
+    transport: str
+    time: float | None
+    counts: dict[str, int]
+
+
+DecodeItem = DecodedPacket | DropReport | TrailingDrops
 
 
 @dataclass(slots=True)
@@ -168,8 +184,9 @@ class Session:
 class CaptureDecoder:
     """Run capture events through per-connection sessions; iterate :meth:`run` for the packets."""
 
-    def __init__(self, *, decode_payloads: bool = True) -> None:
+    def __init__(self, *, decode_payloads: bool = True, report_trailing_drops: bool = False) -> None:
         self.decode_payloads = decode_payloads
+        self.report_trailing_drops = report_trailing_drops
         self.sessions: list[Session] = []
         """Sessions with a connection id, in id order."""
         self._by_flow: dict[int, Session] = {}
@@ -276,8 +293,9 @@ class CaptureDecoder:
         before = decoder.stats.as_dict()
         packets = decoder.close()
         items = self._framed(session, direction, event.flow.transport, event.time, decoder, before, packets)
+        leftover = session.pending_drops.pop((direction, event.flow.transport), None)  # nothing follows
+        self._trailing(session, direction, event.flow.transport, event.time, leftover, items)
         yield from self._emit(session, items)
-        session.pending_drops.pop((direction, event.flow.transport), None)  # nothing follows to carry them
         session.ended.add(direction)
         if len(session.ended) == 2 or event.flow.transport == "stream":
             del self._by_flow[event.flow.id]
@@ -322,6 +340,18 @@ class CaptureDecoder:
                 pending.clear()
         return items
 
+    def _trailing(
+        self,
+        session: Session,
+        direction: str,
+        transport: str,
+        time: float | None,
+        leftover: Counter[str] | None,
+        items: list[DecodeItem],
+    ) -> None:
+        if leftover and self.report_trailing_drops:
+            items.append(TrailingDrops(session.id or 0, direction, transport, time, dict(leftover)))
+
     # -- UDP -----------------------------------------------------------------
     def _datagram(self, event: Datagram) -> Iterator[DecodeItem]:
         if not event.data.startswith(SYNC):
@@ -341,7 +371,8 @@ class CaptureDecoder:
         packets += decoder.close()
         before = dict.fromkeys(DROP_KEYS, 0)
         items = self._framed(session, direction, "udp", event.time, decoder, before, packets)
-        session.pending_drops.pop((direction, "udp"), None)  # a datagram stands alone
+        leftover = session.pending_drops.pop((direction, "udp"), None)  # a datagram stands alone
+        self._trailing(session, direction, "udp", event.time, leftover, items)
         yield from self._emit(session, items)
 
     def _orphan(self, event: Datagram) -> Session:

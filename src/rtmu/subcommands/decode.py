@@ -20,7 +20,16 @@ from typing import Any, TextIO
 
 from ..capture import CaptureError, CaptureSource, UnreadableInput, open_capture
 from ..capture.reader import DIRECTIONS, FORMATS
-from ..session_decoder import C2S, S2C, CaptureDecoder, DecodedPacket, DecodeItem, DropReport, Session
+from ..session_decoder import (
+    C2S,
+    S2C,
+    CaptureDecoder,
+    DecodedPacket,
+    DecodeItem,
+    DropReport,
+    Session,
+    TrailingDrops,
+)
 
 EXIT_OK = 0
 EXIT_UNREADABLE = 1
@@ -72,6 +81,9 @@ text output folds runs of one packet kind to their first 3 and last 2 lines;
 --all prints everything. --json prints one object per packet and line:
   conn dir transport time command name length checksum_ok fields
   [error] [note] [dropped_before] [payload]
+and, where a stream (or datagram) ends in bytes no packet follows, one line
+with "kind": "dropped", command and name null, length = the bytes dropped,
+checksum_ok false and the drop counts as fields.
 exit status: 0 the file was read (even with bad packets), 1 it cannot be read,
 4 it is not a recognised format.
 
@@ -128,7 +140,7 @@ def run(args: argparse.Namespace) -> int:
     except CaptureError as exc:
         print(f"rtmu decode: {exc}", file=sys.stderr)
         return EXIT_UNRECOGNISED
-    decoder = CaptureDecoder()
+    decoder = CaptureDecoder(report_trailing_drops=args.json)
     summary = args.summary if args.summary is not None else not args.json
     out = sys.stdout
     try:
@@ -205,6 +217,22 @@ def packet_json(packet: DecodedPacket, source: CaptureSource, payload: bool = Fa
     return record
 
 
+def trailing_drops_json(drops: TrailingDrops, source: CaptureSource) -> dict[str, Any]:
+    """The packet keys, so a consumer can treat every line alike; ``kind`` says it is no packet."""
+    return {
+        "conn": drops.conn,
+        "dir": drops.direction,
+        "transport": drops.transport,
+        "time": _relative(drops.time, source),
+        "kind": "dropped",
+        "command": None,
+        "name": None,
+        "length": drops.counts.get("garbage_bytes", 0),
+        "checksum_ok": False,
+        "fields": drops.counts,
+    }
+
+
 def _dumps(record: dict[str, Any]) -> str:
     try:
         return json.dumps(
@@ -239,9 +267,13 @@ def _write_json(out: TextIO, items: Iterable[DecodeItem], source: CaptureSource,
     for item in items:
         if isinstance(item, DecodedPacket):
             batch.append(_dumps(packet_json(item, source, payload)))
-            if len(batch) >= 2048:
-                out.write("\n".join(batch) + "\n")
-                batch.clear()
+        elif isinstance(item, TrailingDrops):
+            batch.append(_dumps(trailing_drops_json(item, source)))
+        else:
+            continue
+        if len(batch) >= 2048:
+            out.write("\n".join(batch) + "\n")
+            batch.clear()
     if batch:
         out.write("\n".join(batch) + "\n")
 
@@ -310,6 +342,8 @@ class _TextWriter:
         self.hidden_last: DecodedPacket | None = None
 
     def item(self, item: DecodeItem) -> None:
+        if isinstance(item, TrailingDrops):
+            return  # its drops were printed as they happened
         if isinstance(item, DropReport):
             self._end_run()
             self._emit(self._drop_line(item))
