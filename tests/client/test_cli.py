@@ -199,11 +199,13 @@ def test_server_killed_while_streaming_status_exits_3(capsys: pytest.CaptureFixt
     assert "closed" in capsys.readouterr().err
 
 
-def _drive_process(sim: SimThread, pwfile: Path) -> subprocess.Popen[str]:
+def _drive_process(sim: SimThread, pwfile: Path, *extra: str) -> subprocess.Popen[str]:
     args = [sys.executable, "-m", "rtmu", "drive", *login(sim, pwfile), "--trans", "80", "--seconds", "20"]
+    args += extra
     # Its own process group, so that Ctrl-Z (SIGTSTP) really suspends it wherever the tests run.
     proc = subprocess.Popen(args, stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True, process_group=0)
-    assert proc.stdout is not None and proc.stdout.readline().startswith("before:")
+    if "--json" not in extra:
+        assert proc.stdout is not None and proc.stdout.readline().startswith("before:")
     eventually(lambda: sim.snapshot().trans_ratio == 80, timeout=5)
     return proc
 
@@ -223,13 +225,14 @@ def test_drive_ended_by_a_signal_stops_the_robot_and_exits_128_plus_n(
     try:
         proc.send_signal(sig)
         assert proc.wait(10) == 128 + sig
-        err = proc.stderr.read()  # type: ignore[union-attr]
+        out, err = proc.stdout.read(), proc.stderr.read()  # type: ignore[union-attr]
     finally:
         if proc.poll() is None:
             proc.kill()
             proc.wait()
     assert _stopped_by_us(sim)  # our zero ratios and stop, not the server's 2 s watchdog
-    assert err.count("\n") == 1 and err.startswith("rtmu drive: interrupted by " + sig.name), err
+    assert out.startswith("after:  x=") and out.count("\n") == 1  # the pose after the stop
+    assert err == f"rtmu drive: interrupted by {sig.name}; the robot was stopped\n"
 
 
 def test_ctrl_z_stops_the_robot_before_suspending_and_fg_does_not_drive_again(
@@ -243,6 +246,7 @@ def test_ctrl_z_stops_the_robot_before_suspending_and_fg_does_not_drive_again(
         drives = sim.call(lambda: sim.server.robot.ratio_drives_received)  # type: ignore[union-attr]
         proc.send_signal(signal.SIGCONT)
         assert proc.wait(10) == 128 + signal.SIGTSTP
+        assert proc.stdout.read().startswith("after:")  # type: ignore[union-attr]
         assert sim.call(lambda: sim.server.robot.received_ratios)[:2] == (0.0, 0.0)  # type: ignore[union-attr]
         assert sim.call(lambda: sim.server.robot.ratio_drives_received) <= drives + 1  # type: ignore[union-attr]
     finally:
@@ -259,3 +263,16 @@ def _process_state(pid: int) -> str:
     except OSError:
         return "?"
     return stat.rpartition(")")[2].split()[0]
+
+
+def test_drive_json_after_ctrl_c_says_it_was_interrupted(sim: SimThread, pwfile: Path) -> None:
+    proc = _drive_process(sim, pwfile, "--json")
+    try:
+        proc.send_signal(signal.SIGINT)
+        assert proc.wait(10) == 130
+        obj = json.loads(proc.stdout.read())  # type: ignore[union-attr]
+    finally:
+        if proc.poll() is None:
+            proc.kill()
+            proc.wait()
+    assert obj["interrupted"] == "SIGINT" and set(obj["after"]) == STATUS_KEYS and obj["seconds"] == 20

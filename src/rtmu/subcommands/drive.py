@@ -5,8 +5,13 @@ that hears nothing for 2 s), then zero ratios and ``stop`` — also on Ctrl-C, S
 SIGHUP (the terminal or SSH session went away), SIGQUIT or any error — and prints the
 pose before and after (``--json``: one object ``{"before": STATUS, "after": STATUS,
 "seconds": S}`` with the keys of ``rtmu status``). Ctrl-Z (SIGTSTP) stops the robot
-before the process is suspended, and the drive is not resumed by ``fg``: it ends there
-(exit 148). Exit codes after a signal follow the shell: 128 + the signal's number.
+before the process is suspended, and the drive is not resumed by ``fg``: it ends there.
+
+After a signal the stop goes out first, then the pose is printed if a status comes
+within :data:`AFTER_INTERRUPT` s (``after: unknown`` / ``"after": null`` otherwise; the
+JSON object gains ``"interrupted": "SIGINT"``), one line on stderr says so, and the exit
+code is 128 + the signal's number as shells report it: 130 Ctrl-C, 143 SIGTERM,
+129 SIGHUP, 131 SIGQUIT, 148 Ctrl-Z.
 """
 
 from __future__ import annotations
@@ -23,12 +28,14 @@ from ..client.connection import AriaClient
 from ..client.errors import ClientError, NotSupported
 from ..protocol.payloads.drive import RatioDrive
 from ._common import (
+    Interrupted,
     UsageError,
     add_connection_arguments,
     current_interrupts,
     fetch_status,
     print_json,
     run_with_client,
+    signal_name,
     status_line,
 )
 
@@ -36,6 +43,8 @@ RESEND = 0.1
 MAX_SECONDS = 600.0
 SETTLE = 3.0
 """At most this long to wait for the robot to come to rest before printing the final pose."""
+AFTER_INTERRUPT = 1.0
+"""After a signal, at most this long (stop already sent) for the pose printed as ``after``."""
 
 
 def register(subparsers: Any) -> None:
@@ -85,16 +94,25 @@ def handle(args: argparse.Namespace) -> int:
             interrupts.interrupt(signal.SIGTSTP)  # and ``fg`` must not start it again
 
         interrupts.on_suspend(before_suspending)
+        signum: int | None = None
         try:
             await drive(client, RatioDrive(args.trans, args.rot, args.throttle), args.seconds)
+        except asyncio.CancelledError:
+            signum = interrupts.take()
+            if signum is None:
+                raise
         finally:
             stop(client)
-        after = await settle(client, args.timeout)
-        if args.json:
-            print_json({"before": before, "after": after, "seconds": args.seconds})
-        else:
-            print(f"after:  {status_line(after)}", flush=True)
-        return EXIT_OK
+        if signum is None:
+            report(args, before, await settle(client, args.timeout))
+            return EXIT_OK
+        # Interrupted: the stop is out; the last pose is worth a short wait, not a long one.
+        after: dict[str, Any] | None = None
+        with contextlib.suppress(TimeoutError, ClientError):
+            async with asyncio.timeout(AFTER_INTERRUPT):
+                after = await settle(client, min(args.timeout, AFTER_INTERRUPT))
+        report(args, before, after, interrupted=signal_name(signum))
+        raise Interrupted(signum, "the robot was stopped")
 
     try:
         check(args)
@@ -102,6 +120,24 @@ def handle(args: argparse.Namespace) -> int:
         print(f"rtmu drive: {exc}", file=sys.stderr)
         return 2
     return run_with_client("drive", args, body)
+
+
+def report(
+    args: argparse.Namespace,
+    before: dict[str, Any],
+    after: dict[str, Any] | None,
+    interrupted: str | None = None,
+) -> None:
+    """The poses on stdout; ``after`` None: the status did not come in time after an interrupt."""
+    if args.json:
+        obj: dict[str, Any] = {"before": before, "after": after, "seconds": args.seconds}
+        if interrupted is not None:
+            obj["interrupted"] = interrupted
+        print_json(obj)
+    elif after is not None:
+        print(f"after:  {status_line(after)}", flush=True)
+    else:
+        print("after:  unknown (no status in time)", flush=True)
 
 
 async def drive(client: AriaClient, ratios: RatioDrive, seconds: float) -> None:
