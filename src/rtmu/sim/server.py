@@ -5,7 +5,10 @@ subscriptions: data number → interval, arguments, last time served); a cycle
 every 10 ms steps the world and sends what is due; broadcasts go only to
 clients subscribed to that data. A client that vanishes, sends garbage or
 stops reading costs the others nothing: its bytes are decoded (and dropped)
-by its own codec, and output that it does not drain gets it disconnected.
+by its own codec a slice at a time between everybody else's turns, maps are
+sent to it only as fast as it reads them, and output that it does not drain
+(past a few MB, or stuck for the backup timeout) gets it disconnected. Camera
+frames are shared between clients and rendered off the loop (:mod:`.video`).
 """
 
 from __future__ import annotations
