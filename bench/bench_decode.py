@@ -22,12 +22,16 @@ from rtmu.session_decoder import CaptureDecoder
 
 CAPTURE = Path(__file__).resolve().parents[1].parent / "shared" / "captures" / "map-binary-columbia.pcap"
 
+# The child's own high-water mark. Not getrusage's ru_maxrss: Linux carries that across fork and exec,
+# so every child reported the benchmark process's peak (all figures were equal). VmHWM belongs to the
+# address space, which exec replaces.
 _PEAK = (
-    "import os, resource, sys\n"
+    "import os, sys\n"
     "from rtmu.cli import main\n"
     "sys.stdout = open(os.devnull, 'w')\n"
     "main(sys.argv[1:])\n"
-    "print(resource.getrusage(resource.RUSAGE_SELF).ru_maxrss, file=sys.stderr)\n"
+    "with open('/proc/self/status') as status:\n"
+    "    print(next(line.split()[1] for line in status if line.startswith('VmHWM:')), file=sys.stderr)\n"
 )
 
 
@@ -46,7 +50,7 @@ def _wall(args: list[str], repeat: int = 3) -> float:
 
 def _peak_mb(args: list[str]) -> float:
     done = subprocess.run([sys.executable, "-c", _PEAK, *args], capture_output=True, text=True, check=True)
-    return int(done.stderr.split()[-1]) / 1024  # ru_maxrss is in KiB on Linux
+    return int(done.stderr.split()[-1]) / 1024  # VmHWM is in kB
 
 
 def _repeated(copies: int, out: Path) -> None:
