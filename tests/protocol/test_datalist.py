@@ -12,7 +12,7 @@ from hypothesis import strategies as st
 from rtmu.protocol import DataEntry, DataList, FieldWriter, Packet, PacketDecoder, PayloadError, ServerCommand
 from rtmu.protocol.packet import MAX_LENGTH
 
-from .captures import tcp_streams
+from .test_packet import tcp_streams
 
 ROWS = [
     ("identSetSelfIdentifier", "sets our identifier", "string: id", "none", "", "RETURN_NONE"),

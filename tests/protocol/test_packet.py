@@ -9,6 +9,7 @@ import pytest
 from hypothesis import given
 from hypothesis import strategies as st
 
+from rtmu.capture import StreamData, StreamGap, open_capture
 from rtmu.protocol import (
     MAX_LENGTH,
     MAX_PAYLOAD,
@@ -22,8 +23,6 @@ from rtmu.protocol import (
     encode_packet,
 )
 from rtmu.protocol.checksum import checksum_naive
-
-from .captures import tcp_streams
 
 
 def wire(hex_bytes: str) -> bytes:
@@ -142,6 +141,23 @@ def test_command_must_fit_16_bits(command: int) -> None:
 
 
 # -- real ARIA sessions -----------------------------------------------------------------------
+
+
+Direction = tuple[str, int, str, int]
+"""(source address, source port, destination address, destination port)"""
+
+
+def tcp_streams(path: Path) -> dict[Direction, bytes]:
+    """Each TCP direction's bytes, reassembled by the product's capture reader (``rtmu.capture``)."""
+    streams: dict[Direction, bytearray] = {}
+    for event in open_capture(path).events():
+        if isinstance(event, StreamGap):
+            raise AssertionError(f"{path.name}: {event.missing} bytes missing from {event.src}")
+        if isinstance(event, StreamData):
+            dst = event.flow.peer_of(event.src)
+            key = (event.src.host, event.src.port, dst.host, dst.port)
+            streams.setdefault(key, bytearray()).extend(event.data)
+    return {key: bytes(data) for key, data in streams.items()}
 
 
 def capture_files(shared: Path) -> list[Path]:
