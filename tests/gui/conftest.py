@@ -18,6 +18,7 @@ import shutil
 import subprocess
 import tempfile
 import time
+from collections.abc import Iterator
 from pathlib import Path
 
 import pytest
@@ -29,18 +30,17 @@ _proc: subprocess.Popen[bytes] | None = None
 SKIP_REASON = ""
 
 
-def _start_xvfb() -> str | None:
-    """Start Xvfb on a free display number; returns ':N' or None."""
-    global _proc
+def _spawn_xvfb(size: str) -> tuple[subprocess.Popen[bytes] | None, str | None]:
+    """Start Xvfb with one screen of ``size`` (e.g. ``1280x1024``) on a free display: (process, ':N')."""
     read_fd, write_fd = os.pipe()
-    _proc = subprocess.Popen(
+    proc = subprocess.Popen(
         [
             _XVFB or "Xvfb",
             "-displayfd",
             str(write_fd),
             "-screen",
             "0",
-            "1280x1024x24",
+            f"{size}x24",
             "-nolisten",
             "tcp",
             "-noreset",
@@ -58,7 +58,7 @@ def _start_xvfb() -> str | None:
             chunk = os.read(read_fd, 16)
         except BlockingIOError:
             time.sleep(0.02)
-            if _proc.poll() is not None:
+            if proc.poll() is not None:
                 break
             continue
         if not chunk:
@@ -66,21 +66,32 @@ def _start_xvfb() -> str | None:
         data += chunk
     os.close(read_fd)
     if not data.strip():
-        _stop_xvfb()
-        return None
-    atexit.register(_stop_xvfb)
-    return f":{data.strip().decode()}"
+        _terminate(proc)
+        return None, None
+    atexit.register(_terminate, proc)
+    return proc, f":{data.strip().decode()}"
 
 
-def _stop_xvfb() -> None:
+def _start_xvfb() -> str | None:
+    """Start the session's Xvfb on a free display number; returns ':N' or None."""
     global _proc
-    proc, _proc = _proc, None
+    _proc, display = _spawn_xvfb("1280x1024")
+    return display
+
+
+def _terminate(proc: subprocess.Popen[bytes] | None) -> None:
     if proc is not None and proc.poll() is None:
         proc.terminate()
         try:
             proc.wait(5)
         except subprocess.TimeoutExpired:
             proc.kill()
+
+
+def _stop_xvfb() -> None:
+    global _proc
+    proc, _proc = _proc, None
+    _terminate(proc)
 
 
 if _XVFB is None or _XDOTOOL is None:
@@ -139,3 +150,15 @@ def pytest_terminal_summary(terminalreporter, exitstatus: int, config: pytest.Co
 def screenshots() -> Path:
     SCREENSHOTS.mkdir(parents=True, exist_ok=True)
     return SCREENSHOTS
+
+
+@pytest.fixture(scope="session")
+def small_screen() -> Iterator[str]:
+    """A second X server whose only screen is 800×480 (the smallest the window is made for): ':N'."""
+    proc, display = _spawn_xvfb("800x480")
+    if display is None:
+        pytest.fail("a second Xvfb (800x480) did not start")
+    try:
+        yield display
+    finally:
+        _terminate(proc)

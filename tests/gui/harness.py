@@ -8,10 +8,12 @@ waiting; the loop keeps running while it types).
 
 from __future__ import annotations
 
+import contextlib
+import os
 import subprocess
 import tempfile
 import time
-from collections.abc import Callable
+from collections.abc import Callable, Iterator
 from pathlib import Path
 
 import gi
@@ -21,7 +23,7 @@ gi.require_version("Gtk", "4.0")
 gi.require_version("Gdk", "4.0")
 gi.require_version("GdkX11", "4.0")
 gi.require_version("Graphene", "1.0")
-from gi.repository import GdkX11, GLib, Graphene, Gtk  # noqa: E402
+from gi.repository import Gdk, GdkX11, GLib, Graphene, Gtk  # noqa: E402
 from PIL import Image  # noqa: E402
 
 from rtmu.model import Phase  # noqa: E402
@@ -31,6 +33,27 @@ from rtmu.ui.window import MainWindow  # noqa: E402
 
 REPO = Path(__file__).resolve().parents[2]
 OFFICE_MAP = REPO / "data" / "maps" / "office.map"
+
+
+@contextlib.contextmanager
+def on_display(name: str) -> Iterator[Gdk.Display]:
+    """Open the X display ``name`` and make it GTK's default (and ``DISPLAY`` for xdotool) meanwhile."""
+    manager = Gdk.DisplayManager.get()
+    before = manager.get_default_display()
+    env_before = os.environ.get("DISPLAY")
+    display = manager.open_display(name)
+    assert display is not None, f"cannot open {name}"
+    manager.set_default_display(display)
+    os.environ["DISPLAY"] = name
+    try:
+        yield display
+    finally:
+        manager.set_default_display(before)
+        if env_before is None:
+            os.environ.pop("DISPLAY", None)
+        else:
+            os.environ["DISPLAY"] = env_before
+        display.close()
 
 
 def pump(condition: Callable[[], bool], timeout: float = 5.0, what: str = "condition") -> None:
@@ -185,16 +208,30 @@ class Gui:
         self.run_tool("import", "-window", "root", str(path))
         return path
 
-    def run_tool(self, *argv: str, timeout: float = 10.0) -> None:
-        """An X client program, run while the main loop keeps running (so GTK can answer it)."""
-        proc = subprocess.Popen(list(argv), stdout=subprocess.DEVNULL, stderr=subprocess.PIPE)
+    def run_tool(self, *argv: str, timeout: float = 10.0) -> str:
+        """An X client program, run while the main loop keeps running (so GTK can answer it); its stdout."""
+        proc = subprocess.Popen(list(argv), stdout=subprocess.PIPE, stderr=subprocess.PIPE)
         try:
             pump(lambda: proc.poll() is not None, timeout, " ".join(argv))
         finally:
             if proc.poll() is None:
                 proc.kill()
                 proc.wait(2)
-        assert proc.returncode == 0, f"{argv} failed: {proc.stderr.read().decode() if proc.stderr else ''}"
+        out, err = proc.communicate()
+        assert proc.returncode == 0, f"{argv} failed: {err.decode()}"
+        return out.decode()
+
+    def screen_rect(self, widget: Gtk.Widget) -> tuple[int, int, int, int]:
+        """(x, y, width, height) of the X window of ``widget``'s surface on the screen (xwininfo)."""
+        xid = GdkX11.X11Surface.get_xid(widget.get_native().get_surface())
+        info = self.run_tool("xwininfo", "-id", str(xid))
+        field = {k.strip(): v.strip() for k, _, v in (ln.partition(":") for ln in info.splitlines()) if v}
+        return (
+            int(field["Absolute upper-left X"]),
+            int(field["Absolute upper-left Y"]),
+            int(field["Width"]),
+            int(field["Height"]),
+        )
 
     def stage_pixels(self) -> np.ndarray:
         """The map stage as an (H, W, 3) uint8 array in its own coordinates."""

@@ -2,7 +2,9 @@
 
 GTK 4.8 builds a ``GtkShortcutsWindow`` only from builder XML, so the table is
 written out as XML (escaped) and built; a key added to the table shows up here
-without a second list to keep in step.
+without a second list to keep in step. Small groups, short columns and at most
+two keys per line keep the window inside an 800×480 screen (GTK pages the
+columns); the window is built when it is first asked for.
 """
 
 from __future__ import annotations
@@ -16,8 +18,22 @@ from gi.repository import Gtk  # noqa: E402
 
 from .keys import BINDINGS, Binding  # noqa: E402
 
+COLUMN_LINES = 6
+"""Lines per column of the shortcuts window: small enough for an 800×480 screen (pages of columns)."""
 
-def shortcuts_xml(bindings: tuple[Binding, ...] = BINDINGS) -> str:
+
+def shown_accels(b: Binding) -> list[str]:
+    """The keys worth printing: no keypad twins, one combination where there are modifiers, at most two.
+
+    The window still answers to every key of the table; the help stays narrow enough for 800 px.
+    """
+    keys = [a for a in b.accels if "KP_" not in a] or list(b.accels[:1])
+    if any("<" in a for a in keys):
+        keys = keys[:1]
+    return keys[:2]
+
+
+def shortcuts_xml(bindings: tuple[Binding, ...] = BINDINGS, column_lines: int = COLUMN_LINES) -> str:
     groups: dict[str, list[Binding]] = {}
     for b in bindings:
         groups.setdefault(b.group, []).append(b)
@@ -29,7 +45,7 @@ def shortcuts_xml(bindings: tuple[Binding, ...] = BINDINGS) -> str:
         "<child>",
         '<object class="GtkShortcutsSection">',
         '<property name="section-name">main</property>',
-        '<property name="max-height">14</property>',
+        f'<property name="max-height">{column_lines}</property>',
     ]
     for title, items in groups.items():
         out += [
@@ -42,7 +58,7 @@ def shortcuts_xml(bindings: tuple[Binding, ...] = BINDINGS) -> str:
                 "<child>",
                 '<object class="GtkShortcutsShortcut">',
                 f'<property name="title">{escape(b.title)}</property>',
-                f'<property name="accelerator">{escape(" ".join(b.accels))}</property>',
+                f'<property name="accelerator">{escape(" ".join(shown_accels(b)))}</property>',
                 "</object>",
                 "</child>",
             ]

@@ -12,7 +12,7 @@ CSS = """
 .status-toolbar { background: @theme_bg_color; border-bottom: 1px solid alpha(black, 0.14);
                   padding: 1px 4px; }
 .status-toolbar flowboxchild { padding: 0; }
-.status-cell { padding: 1px 5px; border-radius: 6px; }
+.status-cell { padding: 1px 3px; border-radius: 6px; }
 .status-cell .caption { font-size: 7.5pt; opacity: 0.62; }
 .status-cell .value { font-size: 10.5pt; font-weight: bold; font-feature-settings: "tnum"; }
 .status-cell.stale .value { opacity: 0.38; font-weight: normal; }
@@ -62,6 +62,10 @@ button.stop-button { min-width: 92px; font-weight: bold; letter-spacing: 1px; }
 .camera-bar label { color: alpha(white, 0.85); }
 .camera-inset { border: 2px solid alpha(white, 0.85); border-radius: 6px; opacity: 0.86;
                 box-shadow: 0 2px 8px alpha(black, 0.4); background: black; }
+
+/* GTK's own theme gives the shortcuts window's page buttons (1 2 3) negative label margins:
+   "GtkLabel reported min width -4" warnings. Plain margins, same look. */
+stackswitcher.circular > button > label { margin: 0; padding: 0; }
 
 .field-error { color: #c01c28; font-size: 9pt; margin-bottom: 4px; }
 entry.error { border-color: #c01c28; }

@@ -5,6 +5,11 @@ timer as well, because *age* changes without any new value: a value older than
 :data:`STALE_AFTER` (or any value while the link is not OK) is greyed and its
 tooltip says how old it is. Stale data never looks fresh. A value the server
 does not publish (Wi-Fi on most servers) is greyed with a tooltip saying so.
+
+Every column has a fixed width (its value label is exactly ``width_chars`` wide),
+so nothing shifts sideways when "—" becomes "12.8 V". A narrow window hides the
+least important columns first (:data:`HIDE_FIRST`) and shows them again when
+there is room; battery, mode and link always stay.
 """
 
 from __future__ import annotations
@@ -15,7 +20,7 @@ from collections.abc import Callable
 import gi
 
 gi.require_version("Gtk", "4.0")
-from gi.repository import Gtk  # noqa: E402
+from gi.repository import GLib, Gtk  # noqa: E402
 
 from ..model import ConnectionState, LinkLevel, Model, Phase  # noqa: E402
 from .gauges import BatteryGauge, WifiGauge, battery_fraction, wifi_bars  # noqa: E402
@@ -23,6 +28,8 @@ from .gauges import BatteryGauge, WifiGauge, battery_fraction, wifi_bars  # noqa
 STALE_AFTER = 1.0
 """Seconds after which a pose/battery value is shown as stale (status arrives at 10 Hz)."""
 DASH = "—"
+HIDE_FIRST = ("rot", "vel", "wifi", "th", "safe", "y", "x", "speed")
+"""Columns a narrow window gives up, in this order (the last one given up comes back first)."""
 
 
 class Cell(Gtk.Box):
@@ -37,7 +44,7 @@ class Cell(Gtk.Box):
         self.value.add_css_class("value")
         self.value.set_use_markup(False)
         self.value.set_ellipsize(3)  # Pango.EllipsizeMode.END
-        self.value.set_max_width_chars(max(width_chars, 14))
+        self.value.set_max_width_chars(width_chars)  # = width_chars: a fixed column, whatever the text
         self.append(self.caption)
         row = Gtk.Box(orientation=Gtk.Orientation.HORIZONTAL, spacing=4)
         if gauge is not None:
@@ -58,8 +65,11 @@ class Cell(Gtk.Box):
         self.set_tooltip_text(tooltip)
 
 
-class StatusToolbar(Gtk.Box):
-    """One row of cells; the mode cell gives way (ellipsizes) first when the window is narrow.
+class StatusToolbar(Gtk.ScrolledWindow):
+    """One row of cells; the mode cell ellipsizes, then whole columns give way when the window is narrow.
+
+    The row sits in a scrolled window without scroll bars so that it never sets the window's
+    minimum width; :meth:`fit` then hides or shows columns so that what is shown fits.
 
     ``status_age()`` returns the seconds since the last status packet (the
     network side measures it: a robot standing still publishes no new values,
@@ -74,30 +84,38 @@ class StatusToolbar(Gtk.Box):
         clock: Callable[[], float] = time.monotonic,
         status_age: Callable[[], float | None] | None = None,
     ) -> None:
-        super().__init__(orientation=Gtk.Orientation.HORIZONTAL, spacing=0)
+        super().__init__()
         self.model = model
         self.clock = clock
         self.status_age = status_age
+        self.row = Gtk.Box(orientation=Gtk.Orientation.HORIZONTAL, spacing=0)
         self.add_css_class("status-toolbar")
         self.set_can_focus(False)
+        self.set_policy(Gtk.PolicyType.EXTERNAL, Gtk.PolicyType.NEVER)
+        self.set_propagate_natural_height(True)
+        self.set_child(self.row)
         self.battery_gauge = BatteryGauge()
         self.wifi_gauge = WifiGauge()
         self.cells: dict[str, Cell] = {
-            "x": Cell("X m", width_chars=5),
-            "y": Cell("Y m", width_chars=5),
-            "th": Cell("Heading", width_chars=4),
-            "vel": Cell("mm/s", width_chars=4),
-            "rot": Cell("deg/s", width_chars=3),
-            "battery": Cell("Battery", width_chars=5, gauge=self.battery_gauge),
-            "wifi": Cell("Wi-Fi", width_chars=4, gauge=self.wifi_gauge),
+            "x": Cell("X m", width_chars=6),
+            "y": Cell("Y m", width_chars=6),
+            "th": Cell("Heading", width_chars=5),
+            "vel": Cell("mm/s", width_chars=5),
+            "rot": Cell("deg/s", width_chars=4),
+            "battery": Cell("Battery", width_chars=6, gauge=self.battery_gauge),
+            "wifi": Cell("Wi-Fi", width_chars=5, gauge=self.wifi_gauge),
             "mode": Cell("Mode · status", width_chars=6),
             "safe": Cell("Safe", width_chars=3),
-            "speed": Cell("Throttle", width_chars=4),
-            "link": Cell("Link: rtt, age", width_chars=11),
+            "speed": Cell("Throttle", width_chars=5),
+            "link": Cell("Link: rtt, age", width_chars=12),
         }
         for cell in self.cells.values():
-            self.append(cell)
-        self.cells["mode"].set_hexpand(True)
+            self.row.append(cell)
+        mode = self.cells["mode"]
+        mode.set_hexpand(True)
+        mode.value.set_max_width_chars(40)  # the one column that takes the spare room
+        self._fit_source = 0
+        self.get_hadjustment().connect("changed", lambda _a: self._queue_fit())
         self._unobserve = [
             model.robot.observe(lambda o, n: self.refresh()),
             model.health.observe(lambda o, n: self.refresh()),
@@ -110,6 +128,47 @@ class StatusToolbar(Gtk.Box):
         for remove in self._unobserve:
             remove()
         self._unobserve = []
+        if self._fit_source:
+            GLib.source_remove(self._fit_source)
+            self._fit_source = 0
+
+    # -- width -------------------------------------------------------------------------------
+    def _queue_fit(self) -> None:
+        """The width changed (the adjustment follows every allocation): fit after this layout."""
+        if not self._fit_source:
+            self._fit_source = GLib.idle_add(self._fit_idle)
+
+    def _fit_idle(self) -> bool:
+        self._fit_source = 0
+        for _ in range(2 * len(HIDE_FIRST)):  # measuring is immediate: settle in one go
+            if not self.fit():
+                break
+        return False
+
+    def fit(self) -> bool:
+        """Hide or show one column so that the row fits; True if something changed (runs again)."""
+        room = self.get_width()
+        if room <= 0:
+            return False
+        need = self.row.measure(Gtk.Orientation.HORIZONTAL, -1)[0]
+        if need > room:
+            for name in HIDE_FIRST:
+                if self.cells[name].get_visible():
+                    self.cells[name].set_visible(False)
+                    return True
+            return False
+        hidden = [n for n in HIDE_FIRST if not self.cells[n].get_visible()]
+        if hidden:
+            cell = self.cells[hidden[-1]]
+            cell.set_visible(True)
+            if self.row.measure(Gtk.Orientation.HORIZONTAL, -1)[0] > room:
+                cell.set_visible(False)  # still no room for it
+                return False
+            return True
+        return False
+
+    def hidden_columns(self) -> list[str]:
+        return [n for n, c in self.cells.items() if not c.get_visible()]
 
     def refresh(self) -> None:
         """Show the model's values and how old they are (called on changes and by the window's timer)."""
