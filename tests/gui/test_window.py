@@ -266,11 +266,49 @@ def test_simulator_killed_while_driving(gui: Gui, sim: SimThread) -> None:
         gui.keyup("Up")
 
 
-def test_closing_the_window_while_driving_stops_the_robot(gui: Gui, sim: SimThread) -> None:
+def header_close_button(gui: Gui):  # type: ignore[no-untyped-def]
+    """The × of the header bar's window controls (what the operator clicks to close)."""
+    from gi.repository import Gtk
+
+    def walk(widget):  # type: ignore[no-untyped-def]
+        yield widget
+        child = widget.get_first_child()
+        while child is not None:
+            yield from walk(child)
+            child = child.get_next_sibling()
+
+    found = [
+        w for w in walk(gui.window.get_titlebar()) if isinstance(w, Gtk.Button) and w.has_css_class("close")
+    ]
+    assert len(found) == 1, found
+    return found[0]
+
+
+@pytest.mark.parametrize("how", ["close-button", "ctrl-q"])
+def test_closing_while_driving_sends_an_explicit_stop(gui: Gui, sim: SimThread, how: str) -> None:
+    """Closing must stop the robot by itself, not leave it to the drive lease running out.
+
+    The lease is made long (30 s) for this test, so if closing sent no stop the robot would
+    keep driving (the client resends ratioDrive while the lease lives, so the simulator's own
+    watchdog never fires either) and the wait for the stop would time out.
+    """
+    window = gui.window
+    window.controller.link.lease.ttl = 30.0
+    watchdog_stops = sim.call(lambda: sim.server.robot.watchdog_stops)
     gui.keydown("Up")
     try:
         pump(lambda: moving(sim), 8, "the robot to move")
-        gui.window.close()
-        pump(lambda: stopped(sim), 8, "the robot to stop when the window closes")
+        assert sim.call(lambda: sim.server.robot.mode_name) == "ratioDrive"
+        gui.shot(f"driving-before-{how}")
+        if how == "close-button":
+            gui.click(header_close_button(gui))
+        else:
+            gui.key("ctrl+q")
+        pump(lambda: not window.get_visible(), 3, "the window to close")
+        pump(lambda: sim.call(lambda: sim.server.robot.mode_name) == "stop", 3, "an explicit stop")
+        pump(lambda: stopped(sim), 8, "the robot to stop")
+        assert sim.call(lambda: sim.server.robot.watchdog_stops) == watchdog_stops, (
+            "stopped by us, not by ARIA"
+        )
     finally:
         gui.keyup("Up")
