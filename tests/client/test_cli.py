@@ -157,6 +157,36 @@ def test_usage_errors_exit_2(capsys: pytest.CaptureFixture[str], tmp_path: Path)
     assert "cannot read the password file" in capsys.readouterr().err
 
 
+@pytest.mark.parametrize(
+    "given",
+    [
+        ["--password", "secret1"],
+        ["--password=secret1"],
+        ["--pass", "secret1"],
+        ["--password-file", "secret1"],
+    ],
+)
+def test_a_password_on_the_command_line_is_refused_and_never_repeated(
+    given: list[str], capsys: pytest.CaptureFixture[str]
+) -> None:
+    try:
+        code = main(["status", f"127.0.0.1:{free_port()}", "--user", "alice", *given, "--once"])
+    except SystemExit as exc:
+        code = exc.code  # type: ignore[assignment]
+    err = capsys.readouterr().err
+    assert code == EXIT_USAGE
+    assert "secret1" not in err
+
+
+def test_password_file_is_not_abbreviated(capsys: pytest.CaptureFixture[str], tmp_path: Path) -> None:
+    pw = tmp_path / "pw"
+    pw.write_text("secret1")
+    with pytest.raises(SystemExit) as info:
+        main(["status", "127.0.0.1", "--password-f", str(pw), "--once"])
+    assert info.value.code == EXIT_USAGE
+    assert "--password-f" in capsys.readouterr().err
+
+
 def test_refused_exits_3(capsys: pytest.CaptureFixture[str]) -> None:
     assert main(["probe", f"127.0.0.1:{free_port()}", "--timeout", "2"]) == EXIT_CONNECTION
     err = capsys.readouterr().err

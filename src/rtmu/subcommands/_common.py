@@ -78,11 +78,49 @@ def positive_float(text: str) -> float:
     return value
 
 
+class _RefusePassword(argparse.Action):
+    """``--password``: refused without repeating the value (it would land in the error and in logs)."""
+
+    def __call__(
+        self, parser: argparse.ArgumentParser, namespace: Any, values: Any, option: Any = None
+    ) -> None:
+        parser.error(
+            "a password is never accepted on the command line (other users can read it with ps); "
+            "use --password-file FILE, or give --user alone to be asked for it"
+        )
+
+
+def _refuse_unknown_quietly(parser: argparse.ArgumentParser) -> None:
+    """Unknown arguments are an error that names the options but not the values around them.
+
+    argparse would repeat ``--pass hunter2`` verbatim in "unrecognized arguments"; a value
+    typed after a mistyped option may be a password.
+    """
+    parse_known = parser.parse_known_args
+
+    def parse_known_args(args: Any = None, namespace: Any = None) -> tuple[argparse.Namespace, list[str]]:
+        namespace, extras = parse_known(args, namespace)
+        if extras:
+            options = [a.split("=", 1)[0] for a in extras if a.startswith("-")]
+            others = len(extras) - len(options)
+            shown = " ".join(options)
+            if others:
+                shown += f"{' and ' if options else ''}{others} other argument{'s' if others > 1 else ''}"
+            parser.error(f"unrecognized arguments: {shown} (values not shown)")
+        return namespace, extras
+
+    parser.parse_known_args = parse_known_args  # type: ignore[method-assign]
+
+
 def add_connection_arguments(parser: argparse.ArgumentParser) -> None:
+    # No abbreviations: "--password secret" must not be taken for "--password-file secret".
+    parser.allow_abbrev = False
+    _refuse_unknown_quietly(parser)
     parser.add_argument(
         "server", type=host_port, metavar="HOST[:PORT]", help="robot server (port 7272 by default)"
     )
     parser.add_argument("--user", default="", help="user name, if the server has a user file")
+    parser.add_argument("--password", nargs="?", action=_RefusePassword, help=argparse.SUPPRESS)
     parser.add_argument(
         "--password-file",
         type=Path,
@@ -109,6 +147,12 @@ def read_password(args: argparse.Namespace) -> str:
         try:
             with path.open("rb") as f:
                 data = f.read(MAX_PASSWORD_FILE)
+        except FileNotFoundError:
+            # Not named: what was typed there may be the password itself rather than a file name.
+            raise UsageError(
+                "cannot read the password file given with --password-file: no such file "
+                "(its name is not shown, in case a password was typed there)"
+            ) from None
         except OSError as exc:
             raise UsageError(f"cannot read the password file {path}: {exc.strerror or exc}") from None
         return data.decode("utf-8", "replace").splitlines()[0] if data else ""
