@@ -15,7 +15,7 @@ from rtmu.model import LinkLevel, Model, Phase
 from rtmu.protocol.payloads.drive import RatioDrive
 
 from .fakeclock import FakeClock
-from .servers import ServerThread, TestServer
+from .servers import MAP_LINES, ServerSide, ServerThread, TestServer, binary_map_packets
 from .uiqueue import UiQueue, eventually
 
 
@@ -211,3 +211,36 @@ def test_disconnect_while_logging_in_cancels_at_once() -> None:
         time.sleep(0.1)
         ui.drain()
         assert model.connection.value.phase is Phase.DISCONNECTED
+
+
+def test_a_storm_of_map_updates_costs_one_more_download_not_hundreds() -> None:
+    server_obj = TestServer()
+    withheld: list[ServerSide] = []
+
+    def maps(side: ServerSide, args: bytes) -> list[bytes] | None:
+        if not withheld:
+            withheld.append(side)  # the first download hangs until the storm has been sent
+            return None
+        return binary_map_packets(MAP_LINES)
+
+    def storm_then_answer() -> None:
+        side = withheld[0]
+        for _ in range(200):
+            server_obj.broadcast("mapUpdated")
+        for payload in binary_map_packets(MAP_LINES):  # then the first download completes
+            side.conn.send_data("getMapBinary", payload)
+        side.writer.write(side.conn.data_to_send())
+
+    server_obj.handlers["getMapBinary"] = maps
+    thread = ServerThread(server_obj)
+    with thread as server:
+        runner, model, ui = start(server)
+        try:
+            eventually(lambda: bool(withheld))
+            thread.call(storm_then_answer)
+            ui.wait_for(lambda: model.map.value.state == "ready" and model.map.value.generation == 2)
+            runner.sync()
+            assert server.names().count("getMapBinary") == 2
+            assert runner.call(lambda: len(runner.session._tasks)) <= 3  # type: ignore[union-attr]
+        finally:
+            runner.close()

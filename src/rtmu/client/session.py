@@ -110,6 +110,9 @@ class Session:
         self._reconnect_task: asyncio.Task[None] | None = None
         self._connecting: asyncio.Task[Any] | None = None
         self._heart_task: asyncio.Task[None] | None = None
+        self._map_task: asyncio.Task[MapModel] | None = None
+        self._map_dirty = False
+        """The map changed (or was asked for) while a download was in flight: fetch once more."""
         self._kick = asyncio.Event()
         self._stepped: asyncio.Event = asyncio.Event()
         self._image_sequence = 0
@@ -211,7 +214,7 @@ class Session:
         self._spawn(self._ping_loop(client), "ping")
         self._spawn(self._fetch_once_infos(client), "infos")
         if self.config.fetch_map:
-            self._spawn(self.load_map(), "map")
+            self._request_map()
         self.kick()
 
     async def disconnect(self) -> None:
@@ -418,7 +421,7 @@ class Session:
 
     def _on_map_updated(self, packet: Packet) -> None:
         if self.config.fetch_map:
-            self._spawn(self.load_map(), "map")
+            self._request_map()
 
     # -- Wi-Fi (optional getStrings items, protocol §4.11) ------------------------------------
     async def _watch_wifi(self, client: AriaClient) -> None:
@@ -609,7 +612,36 @@ class Session:
 
     # -- map ---------------------------------------------------------------------------------
     async def load_map(self) -> MapModel:
-        """Download the map (``getMapBinary`` when offered, else ``getMap``) and publish it."""
+        """Download the map (``getMapBinary`` when offered, else ``getMap``), publish it, return it.
+
+        Requests merge: while a download is in flight, asking again (this call, or any number
+        of ``mapUpdated`` broadcasts) only marks the map dirty, and ONE more download starts
+        when the current one ends — a storm of broadcasts costs two downloads, not hundreds.
+        """
+        client = self.client
+        if client is None or not client.connected:
+            raise ServerClosed("not connected")
+        return await asyncio.shield(self._request_map())
+
+    def _request_map(self) -> asyncio.Task[MapModel]:
+        task = self._map_task
+        if task is not None and not task.done():
+            self._map_dirty = True
+            return task
+        self._map_dirty = False
+        task = self._map_task = asyncio.get_running_loop().create_task(self._map_loader(), name="session-map")
+        self._tasks.add(task)
+        task.add_done_callback(self._task_done)
+        return task
+
+    async def _map_loader(self) -> MapModel:
+        while True:
+            self._map_dirty = False
+            result = await self._load_map_once()
+            if not self._map_dirty or not self.connected:
+                return result
+
+    async def _load_map_once(self) -> MapModel:
         client = self.client
         if client is None or not client.connected:
             raise ServerClosed("not connected")
