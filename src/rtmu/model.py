@@ -240,9 +240,9 @@ class LinkLevel(Enum):
     """Not connected."""
     OK = "ok"
     STALE = "stale"
-    """No status for 3 update intervals: driving is stopped."""
+    """No status for 3 update intervals, or a ping went unanswered: driving is stopped."""
     LOST = "lost"
-    """No status for 2 s: the link is considered gone (reconnect if enabled)."""
+    """No status for 2 s, or 3 pings unanswered: the link is considered gone (reconnect if enabled)."""
 
 
 @dataclass(frozen=True, slots=True)
@@ -256,6 +256,8 @@ class LinkHealth:
     """Bytes skipped while resynchronising."""
     status_age: float | None = field(default=None, compare=False)
     """Seconds since the last status packet (not compared: it changes all the time)."""
+    ping_failures: int = 0
+    """Pings in a row the server did not answer: it may no longer hear us (RTT is then None)."""
 
 
 # -- operator settings ---------------------------------------------------------------------------

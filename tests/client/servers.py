@@ -165,6 +165,9 @@ class TestServer:
         }
         self._server: asyncio.base_events.Server | None = None
         self.port = 0
+        self.hearing = asyncio.Event()
+        """Cleared by :meth:`stop_reading`: the server keeps sending but reads nothing more."""
+        self.hearing.set()
         self.on_once: Callable[[ServerSide, str, bytes], None] | None = None
 
     def _set_safe(self, side: ServerSide, args: bytes) -> Reply:
@@ -172,6 +175,7 @@ class TestServer:
         return None
 
     async def start(self) -> int:
+        self._loop = asyncio.get_running_loop()
         self._server = await asyncio.start_server(self._serve, "127.0.0.1", 0)
         self.port = self._server.sockets[0].getsockname()[1]
         return self.port
@@ -184,6 +188,16 @@ class TestServer:
         if self._server is not None:
             with contextlib.suppress(Exception):
                 await asyncio.wait_for(self._server.wait_closed(), 1)
+
+    def stop_reading(self) -> None:
+        """Stop reading requests (like a server whose input thread hangs); subscriptions go on.
+
+        Thread-safe: runs on the server's loop.
+        """
+        self._loop.call_soon_threadsafe(self.hearing.clear)
+
+    def resume_reading(self) -> None:
+        self._loop.call_soon_threadsafe(self.hearing.set)
 
     def kill(self, side: ServerSide) -> None:
         """Drop a connection abruptly (no SHUTDOWN), like a crashed server."""
@@ -203,6 +217,7 @@ class TestServer:
                 return
             writer.write(side.conn.data_to_send())
             while True:
+                await self.hearing.wait()
                 data = await reader.read(65536)
                 if not data:
                     return

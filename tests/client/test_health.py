@@ -55,3 +55,19 @@ def test_backoff_grows_caps_and_resets() -> None:
 def test_only_healable_failures_are_retried() -> None:
     assert worth_retrying(ServerClosed("x")) and worth_retrying(ClientTimeout("x"))
     assert not worth_retrying(LoginRejected(1))
+
+
+def test_unanswered_pings_spoil_the_link_even_while_status_flows() -> None:
+    h = HealthMonitor(0.1, lost_after=2.0, ping_failures_lost=3)
+    h.start(0.0)
+    h.note_rtt(0.002)
+    assert h.level(0.05) is LinkLevel.OK
+    h.note_ping_timeout()
+    h.note_status(0.1)  # the status stream is fine…
+    assert h.rtt is None and h.level(0.1) is LinkLevel.STALE  # …but our requests are not heard
+    assert h.snapshot(0.1).rtt_ms is None and h.snapshot(0.1).ping_failures == 1
+    h.note_ping_timeout()
+    h.note_ping_timeout()
+    assert h.level(0.1) is LinkLevel.LOST and h.requests_unanswered
+    h.note_rtt(0.003)  # one answer is enough
+    assert h.level(0.1) is LinkLevel.OK and not h.requests_unanswered

@@ -244,3 +244,45 @@ def test_a_storm_of_map_updates_costs_one_more_download_not_hundreds() -> None:
             assert runner.call(lambda: len(runner.session._tasks)) <= 3  # type: ignore[union-attr]
         finally:
             runner.close()
+
+
+def test_unanswered_pings_make_the_rtt_unknown_stop_driving_and_recover(server: TestServer) -> None:
+    clock = FakeClock()  # the status stays fresh: only the pings can spoil the link
+    runner, model, ui = start(server, clock=clock, ping_interval=0.02, ping_timeout=0.1)
+    try:
+        ui.wait_for(lambda: model.health.value.rtt_ms is not None)
+        runner.lease.grant(DriveRatios(100, 0, 50))
+        runner.sync()
+        eventually(lambda: drive_names(server)[-1:] == ["ratioDrive"])
+        answer = server.handlers["getSafeDrive"]
+        server.handlers["getSafeDrive"] = lambda s, a: None  # status goes on, pings go unanswered
+        ui.wait_for(lambda: model.health.value.level is LinkLevel.STALE)
+        assert model.health.value.rtt_ms is None and model.health.value.ping_failures >= 1
+        eventually(lambda: drive_names(server)[-1] == "stop")
+        assert runner.lease.renew() is False
+        server.handlers["getSafeDrive"] = answer
+        ui.wait_for(
+            lambda: model.health.value.level is LinkLevel.OK and model.health.value.rtt_ms is not None
+        )
+        assert model.connection.value.phase is Phase.CONNECTED
+    finally:
+        runner.close()
+
+
+def test_a_server_that_stops_reading_is_stale_then_lost(server: TestServer) -> None:
+    clock = FakeClock()
+    runner, model, ui = start(server, clock=clock, ping_interval=0.02, ping_timeout=0.1)
+    try:
+        ui.wait_for(lambda: model.health.value.rtt_ms is not None)
+        runner.lease.grant(DriveRatios(100, 0, 50))
+        runner.sync()
+        seen: list[tuple[Phase, str]] = []
+        model.connection.observe(lambda old, new: seen.append((new.phase, new.error)))
+        levels: list[LinkLevel] = []
+        model.health.observe(lambda old, new: levels.append(new.level))
+        server.stop_reading()
+        ui.wait_for(lambda: any(p is Phase.RECONNECTING and "pings" in e for p, e in seen))
+        assert LinkLevel.STALE in levels
+        assert runner.lease.renew() is False  # driving stopped on the first unanswered ping
+    finally:
+        runner.close()

@@ -10,7 +10,12 @@ So the status subscription *is* the heartbeat:
   gone (the session reconnects if the profile asks for it).
 
 Round-trip time comes from a cheap request-once every second (the first of
-:data:`PING_CANDIDATES` the server offers). Pure logic over an injected clock.
+:data:`PING_CANDIDATES` the server offers). A ping that gets no answer matters as
+much as a missing status: a server that keeps *sending* status but has stopped
+*reading* (or answering) would never hear our ``stop``. So an unanswered ping makes
+the RTT unknown and the link at least **stale** (driving stops); after
+:data:`PING_FAILURES_LOST` in a row the link is **lost**. Pure logic over an
+injected clock.
 """
 
 from __future__ import annotations
@@ -21,6 +26,8 @@ from ..protocol.decoder import DropStats
 STALE_INTERVALS = 3
 LOST_AFTER = 2.0
 PING_INTERVAL = 1.0
+PING_FAILURES_LOST = 3
+"""Unanswered pings in a row after which the link counts as lost (a server that stopped reading)."""
 PING_CANDIDATES = ("ackCommTcp", "getSafeDrive", "getMapName", "batteryInfo", "physicalInfo", "getModeInfo")
 """Data with a small single reply and no side effect, in order of preference."""
 
@@ -32,13 +39,17 @@ class HealthMonitor:
         *,
         stale_intervals: int = STALE_INTERVALS,
         lost_after: float = LOST_AFTER,
+        ping_failures_lost: int = PING_FAILURES_LOST,
     ) -> None:
         self.status_interval = status_interval
         self.stale_after = stale_intervals * status_interval
         self.lost_after = max(lost_after, self.stale_after)
+        self.ping_failures_lost = ping_failures_lost
         self._started: float | None = None
         self._last_status: float | None = None
         self.rtt: float | None = None
+        self.ping_failures = 0
+        """Pings in a row that got no answer (0 after any answered one)."""
         self.bad_payloads = 0
         """Packets that arrived intact but could not be decoded (counted with the decoder's drops)."""
 
@@ -51,6 +62,7 @@ class HealthMonitor:
         self._started = now
         self._last_status = None
         self.rtt = None
+        self.ping_failures = 0
         self.bad_payloads = 0
 
     def stop(self) -> None:
@@ -62,6 +74,17 @@ class HealthMonitor:
 
     def note_rtt(self, seconds: float) -> None:
         self.rtt = seconds
+        self.ping_failures = 0
+
+    def note_ping_timeout(self) -> None:
+        """A ping got no answer in time: the RTT is unknown, and the link no better than stale."""
+        self.rtt = None
+        self.ping_failures += 1
+
+    @property
+    def requests_unanswered(self) -> bool:
+        """True when the link is lost because pings go unanswered (not because status stopped)."""
+        return self.ping_failures >= self.ping_failures_lost
 
     def status_age(self, now: float) -> float | None:
         if self._started is None:
@@ -72,9 +95,9 @@ class HealthMonitor:
         age = self.status_age(now)
         if age is None:
             return LinkLevel.DOWN
-        if age > self.lost_after:
+        if age > self.lost_after or self.ping_failures >= self.ping_failures_lost:
             return LinkLevel.LOST
-        if age > self.stale_after:
+        if age > self.stale_after or self.ping_failures:
             return LinkLevel.STALE
         return LinkLevel.OK
 
@@ -98,6 +121,7 @@ class HealthMonitor:
             dropped=drops.dropped + self.bad_payloads,
             garbage_bytes=drops.garbage_bytes,
             status_age=self.status_age(now),
+            ping_failures=self.ping_failures,
         )
 
 

@@ -64,6 +64,8 @@ class SessionConfig:
     connect_timeout: float = 10.0
     reply_timeout: float = 5.0
     lost_after: float = 2.0
+    ping_timeout: float | None = None
+    """How long a ping may go unanswered (None: ``lost_after``)."""
     fetch_map: bool = True
     backoff: Callable[[], Backoff] = field(default=Backoff)
 
@@ -454,12 +456,16 @@ class Session:
         name = ping_data(client.datalist)
         if name is None:
             return
+        timeout = self.config.ping_timeout or self.config.lost_after
         while client.connected:
             started = time.perf_counter()
             try:
-                reply = await client.request_once(name, timeout=self.config.lost_after)
+                reply = await client.request_once(name, timeout=timeout)
             except ClientTimeout:
-                pass
+                # The server may have stopped reading: it would not hear a stop either.
+                self.health.note_ping_timeout()
+                self._publish_health()
+                self.kick()
             except ClientError:
                 return
             else:
@@ -513,11 +519,12 @@ class Session:
         if level is LinkLevel.LOST and self.client is not None:
             target = self._target
             if target is not None and target.auto_reconnect:
-                self._connection_lost(
-                    ServerClosed(
-                        f"no status from {target.host}:{target.port} for {self.health.lost_after:g} s"
-                    )
-                )
+                where = f"{target.host}:{target.port}"
+                if self.health.requests_unanswered:
+                    why = f"{where} answered none of the last {self.health.ping_failures} pings"
+                else:
+                    why = f"no status from {where} for {self.health.lost_after:g} s"
+                self._connection_lost(ServerClosed(why))
 
     def _publish_health(self, now: float | None = None) -> None:
         now = self.clock() if now is None else now
