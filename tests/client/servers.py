@@ -117,6 +117,8 @@ class Received:
     name: str
     args: bytes
     kind: str = "once"
+    side: int = 0
+    """Which connection (index into ``TestServer.sides``) it came on."""
 
 
 @dataclass
@@ -238,13 +240,14 @@ class TestServer:
 
     def _handle(self, side: ServerSide, event: object) -> None:
         now = time.monotonic()
+        n = self.sides.index(side)
         if isinstance(event, RequestOnce):
-            self.received.append(Received(now, event.name, event.args))
+            self.received.append(Received(now, event.name, event.args, side=n))
             if self.on_once is not None:
                 self.on_once(side, event.name, event.args)
             self.reply(side, event.name, event.args)
         elif isinstance(event, RequestReceived):
-            self.received.append(Received(now, event.name, event.args, f"request {event.interval_ms}"))
+            self.received.append(Received(now, event.name, event.args, f"request {event.interval_ms}", n))
             old = side.subs.pop(event.name, None)
             if old is not None:
                 old.cancel()  # ARIA: a re-subscription gets no immediate reply
@@ -255,12 +258,12 @@ class TestServer:
                     self._periodic(side, event.name, event.args, event.interval_ms)
                 )
         elif isinstance(event, RequestStopped):
-            self.received.append(Received(now, event.name, b"", "stop"))
+            self.received.append(Received(now, event.name, b"", "stop", n))
             task = side.subs.pop(event.name, None)
             if task is not None:
                 task.cancel()
         elif isinstance(event, PeerShutdown):
-            self.received.append(Received(now, "SHUTDOWN", b"", "control"))
+            self.received.append(Received(now, "SHUTDOWN", b"", "control", n))
 
     def reply(self, side: ServerSide, name: str, args: bytes) -> None:
         handler = self.handlers.get(name)

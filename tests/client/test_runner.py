@@ -286,3 +286,24 @@ def test_a_server_that_stops_reading_is_stale_then_lost(server: TestServer) -> N
         assert runner.lease.renew() is False  # driving stopped on the first unanswered ping
     finally:
         runner.close()
+
+
+def test_connecting_again_while_driving_stops_the_robot_on_the_old_link_first(server: TestServer) -> None:
+    runner, model, ui = start(server)
+    try:
+        runner.lease.grant(DriveRatios(100, 0, 50))
+        runner.sync()
+        eventually(lambda: drive_names(server)[-1:] == ["ratioDrive"])
+        runner.connect("127.0.0.1", server.port, profile="other").result(5)
+        ui.wait_for(
+            lambda: (
+                model.connection.value.phase is Phase.CONNECTED and model.connection.value.profile == "other"
+            )
+        )
+        eventually(lambda: "SHUTDOWN" in [r.name for r in server.received if r.side == 0])
+        old = [r for r in server.received if r.side == 0 and r.name in ("ratioDrive", "stop", "SHUTDOWN")]
+        assert [r.name for r in old[-3:]] == ["ratioDrive", "stop", "SHUTDOWN"]
+        assert RatioDrive.decode(old[-3].args) == RatioDrive(0, 0, 0)
+        assert not any(r.name == "ratioDrive" for r in server.received if r.side == 1)  # nothing resumed
+    finally:
+        runner.close()

@@ -170,6 +170,9 @@ class Session:
         """
         self._cancel_connecting()
         self._connecting = asyncio.current_task()
+        if self.connected:
+            self._send_stop()  # connecting again (another profile) while driving: stop on the old link first
+        self.lease.end(EndReason.DISCONNECTED)
         await self._drop_client()
         self._cancel_reconnect()
         target = self._target = _Target(host, port, user, password, profile, auto_reconnect)
