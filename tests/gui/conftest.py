@@ -162,3 +162,14 @@ def small_screen() -> Iterator[str]:
         yield display
     finally:
         _terminate(proc)
+
+
+@pytest.fixture(autouse=True)
+def every_window_test_saves_a_picture() -> Iterator[None]:
+    """A test that opened the window and saved no PNG fails: each state a test checks is also seen."""
+    from .harness import COUNTS
+
+    before = dict(COUNTS)
+    yield
+    if COUNTS["windows"] > before["windows"] and COUNTS["pictures"] == before["pictures"]:
+        pytest.fail("this test opened the window but saved no screenshot (gui.shot or gui.render)")

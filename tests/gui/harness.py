@@ -33,6 +33,8 @@ from rtmu.ui.window import MainWindow  # noqa: E402
 
 REPO = Path(__file__).resolve().parents[2]
 OFFICE_MAP = REPO / "data" / "maps" / "office.map"
+COUNTS = {"windows": 0, "pictures": 0}
+"""Windows opened and pictures saved so far: every test that opens a window must leave a picture."""
 
 
 @contextlib.contextmanager
@@ -106,6 +108,7 @@ class Gui:
         app = RtmuApplication(options)
         app.register(None)
         app.activate()
+        COUNTS["windows"] += 1
         gui = cls(app, shots, name)
         pump(lambda: app.window is not None and app.window.get_mapped(), 10, "the window to be mapped")
         gui.focus()
@@ -191,6 +194,7 @@ class Gui:
         renderer = widget.get_native().get_renderer()
         texture = renderer.render_texture(node, Graphene.Rect().init(0, 0, w, h))
         texture.save_to_png(str(path))
+        COUNTS["pictures"] += 1
         return path
 
     def shot(self, label: str) -> Path:
@@ -206,6 +210,7 @@ class Gui:
         self._shot_no += 1
         path = self.shots / f"{self.name}-{self._shot_no:02d}-{label}.png"
         self.run_tool("import", "-window", "root", str(path))
+        COUNTS["pictures"] += 1
         return path
 
     def run_tool(self, *argv: str, timeout: float = 10.0) -> str:

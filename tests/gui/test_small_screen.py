@@ -57,10 +57,10 @@ def test_menu_and_shortcuts_fit_an_800x480_screen(small: Gui, capfd: pytest.Capt
     assert inside_screen(rect), f"the menu at {rect} leaves the 800×480 screen"
     popover.popdown()
     pump(lambda: not popover.get_mapped(), 3, "the menu to close")
-    gui.focus()
-    gui.key("F1")
+    # F1 itself is tested on the big screen; here the menu's keyboard grab may still be ending.
+    window.activate_action("win.show-help-overlay", None)
     shortcuts = window.get_help_overlay()
-    pump(shortcuts.get_mapped, 3, "the shortcuts window")
+    pump(shortcuts.get_mapped, 5, "the shortcuts window")
     rect = gui.screen_rect(shortcuts)
     gui.screen_shot("shortcuts")
     assert inside_screen(rect), f"the shortcuts window at {rect} leaves the 800×480 screen"

@@ -208,6 +208,7 @@ def test_focus_loss_while_driving_stops_the_robot(start: Start) -> None:
             gui.xdotool("windowfocus", "--sync", str(GdkX11.X11Surface.get_xid(other.get_surface())))
             pump(lambda: not gui.window.is_active(), 3, "the RTMU window to lose focus")
             pump(lambda: stopped(sim), 8, "the robot to stop on focus loss")
+            gui.shot("stopped-after-focus-loss")
         finally:
             gui.keyup("Up")
     finally:
@@ -380,6 +381,7 @@ def test_plain_rtmu_opens_the_last_profile_and_connects(screenshots: Path, tmp_p
             assert abs(gui.stage.viewport.zoom - 1.0) < 1e-9 and not gui.stage.fitted
             gui.key("minus")
             pump(lambda: gui.model.speed.value.percent == 60, 3, "the speed to drop")
+            gui.shot("last-profile-at-100pct-speed-60")
         finally:
             gui.close()
         from rtmu.settings import load_settings
@@ -416,6 +418,7 @@ def test_unsupported_commands_are_disabled_with_the_reason(start: Start) -> None
     assert not window.lookup_action("turn").get_enabled()
     gui.key("t")
     pump(lambda: "turnByAngle" in (window.banners.text("notice:turn_left_90") or ""), 3, "the reason banner")
+    gui.shot("turn-unsupported")
 
 
 def test_wifi_not_published_is_greyed_with_a_reason(screenshots: Path) -> None:
@@ -429,6 +432,7 @@ def test_wifi_not_published_is_greyed_with_a_reason(screenshots: Path) -> None:
         cell = gui.window.toolbar.cells["wifi"]
         assert cell.stale and "does not publish" in (cell.get_tooltip_text() or "")
         assert gui.window.toolbar.cells["x"].stale, "values while not connected are never shown as fresh"
+        gui.shot("wifi-not-published")
     finally:
         gui.close()
 
@@ -438,12 +442,14 @@ def test_f11_full_screen_and_ctrl_q_quits_after_stopping_the_robot(start: Start)
     window = gui.window
     gui.key("F11")
     pump(lambda: window.lookup_action("fullscreen").get_state().get_boolean(), 3, "the full-screen request")
+    gui.shot("f11-requested")
     # Xvfb has no window manager to honour the request: what is checked is that F11 reached the window.
     gui.key("F11")
     pump(lambda: not window.lookup_action("fullscreen").get_state().get_boolean(), 3, "leaving full screen")
     gui.keydown("Up")
     try:
         pump(lambda: moving(sim), 8, "the robot to move")
+        gui.shot("driving-before-ctrl-q")
         gui.key("ctrl+q")
         pump(lambda: not window.get_visible(), 3, "the window to close")
         pump(lambda: stopped(sim), 8, "the robot to stop on quit")
