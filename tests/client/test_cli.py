@@ -199,6 +199,32 @@ def test_silent_server_times_out_with_5(capsys: pytest.CaptureFixture[str]) -> N
     assert "did not complete the login" in capsys.readouterr().err
 
 
+def test_a_web_server_is_named_with_3_not_timed_out(capsys: pytest.CaptureFixture[str]) -> None:
+    import socket
+    import threading
+
+    listener = socket.create_server(("127.0.0.1", 0))
+    port = listener.getsockname()[1]
+    held: list[socket.socket] = []
+
+    def serve() -> None:  # a chatty non-ArNetworking peer that never closes
+        conn, _ = listener.accept()
+        held.append(conn)
+        conn.sendall(b"<html><body>nothing to see</body></html>\n" * 200)
+
+    thread = threading.Thread(target=serve, daemon=True)
+    thread.start()
+    try:
+        assert main(["probe", f"127.0.0.1:{port}", "--timeout", "30"]) == EXIT_CONNECTION
+    finally:
+        thread.join(5)
+        for conn in held:
+            conn.close()
+        listener.close()
+    err = capsys.readouterr().err
+    assert err.count("\n") == 1 and "not an ArNetworking server" in err
+
+
 def test_unsupported_exits_4(capsys: pytest.CaptureFixture[str], tmp_path: Path) -> None:
     bare = [row for row in SPECS if row[0] in ("updateNumbers", "stop")]
     with ServerThread(TestServer(bare)) as server:

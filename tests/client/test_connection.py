@@ -308,6 +308,39 @@ def test_not_arnetworking_is_a_protocol_error() -> None:
     run(go())
 
 
+async def _garbage_server(opening: bytes, repeat: int = 1) -> asyncio.base_events.Server:
+    """Sends ``opening`` ``repeat`` times, then keeps the connection open without a word more."""
+
+    async def serve(reader, writer):  # type: ignore[no-untyped-def]
+        writer.write(opening * repeat)
+        await writer.drain()
+        await reader.read()
+
+    return await asyncio.start_server(serve, "127.0.0.1", 0)
+
+
+@pytest.mark.parametrize(
+    ("opening", "repeat", "said"),
+    [
+        (b"<html><body>It works!</body></html>\n", 200, "bytes without a single valid packet"),
+        (b"\x00\x0f\x0c\x7d\x7d" + bytes(range(256)), 40, "bytes without a single valid packet"),
+        (b"SSH-2.0-OpenSSH_9.6\r\n", 1, "SSH-2.0"),
+        (b"HTTP/1.1 400 Bad Request\r\n\r\n", 1, "HTTP/1.1 400"),
+    ],
+)
+def test_a_server_that_is_not_arnetworking_is_named_at_once(opening: bytes, repeat: int, said: str) -> None:
+    async def go() -> None:
+        srv = await _garbage_server(opening, repeat)
+        port = srv.sockets[0].getsockname()[1]
+        with pytest.raises(ProtocolFault) as info:  # long before the 60 s login timeout
+            await AriaClient().connect("127.0.0.1", port, timeout=60)
+        assert "not an ArNetworking server" in str(info.value) and said in str(info.value)
+        assert info.value.exit_code == 3
+        srv.close()
+
+    run(go(), timeout=10)
+
+
 def test_disconnect_is_clean_and_instant() -> None:
     async def go() -> None:
         server = TestServer()

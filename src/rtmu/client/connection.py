@@ -68,6 +68,11 @@ CLOSE_TIMEOUT = 0.2
 MAX_WRITE_BUFFER = 1 << 20
 """A server that stops reading is dropped once this much output is queued (it would grow forever)."""
 READ_CHUNK = 1 << 16
+NOT_ARIA_AFTER = 4096
+"""Bytes received during login without one valid packet after which the peer is not ArNetworking
+(a real server's introduction is one small packet, sent at once)."""
+TEXT_BANNERS = (b"HTTP/", b"SSH-", b"RFB ", b"220 ", b"220-", b"+OK", b"* OK")
+"""How other common servers open a connection: such a peer is reported at once, not after --timeout."""
 ABANDON_GRACE = 0.5
 """Seconds an abandoned request's slot waits quietly for a late reply before the reply counts as lost."""
 MAX_PENDING_PER_DATA = 64
@@ -403,6 +408,7 @@ class AriaClient:
 
     async def _login(self) -> None:
         assert self._reader is not None and self._conn is not None
+        received = 0
         while True:
             try:
                 data = await self._reader.read(READ_CHUNK)
@@ -410,10 +416,21 @@ class AriaClient:
                 raise ServerClosed(f"the connection broke during login: {exc.strerror or exc}") from None
             if not data:
                 raise ServerClosed(f"{self.host}:{self.port} closed the connection during login")
+            if received == 0 and data.startswith(TEXT_BANNERS):
+                banner = data[:40].split(b"\n")[0].decode("ascii", "replace").strip()
+                raise ProtocolFault(
+                    f"{self.host}:{self.port} is not an ArNetworking server (it said {banner!r})"
+                )
+            received += len(data)
             try:
                 events = self._conn.receive_data(data)
             except ProtocolError as exc:
                 raise ProtocolFault(f"{self.host}:{self.port} is not an ArNetworking server: {exc}") from None
+            if received >= NOT_ARIA_AFTER and self._conn.decoder.stats.packets == 0:
+                raise ProtocolFault(
+                    f"{self.host}:{self.port} is not an ArNetworking server "
+                    f"({received} bytes without a single valid packet)"
+                )
             self._flush()
             ready = False
             for event in events:
