@@ -164,12 +164,25 @@ def small_screen() -> Iterator[str]:
         _terminate(proc)
 
 
+@pytest.hookimpl(wrapper=True)
+def pytest_runtest_makereport(item: pytest.Item, call: pytest.CallInfo[None]):  # type: ignore[no-untyped-def]
+    report = yield
+    if report.when == "call":
+        item.stash[_CALL_PASSED] = report.passed
+    return report
+
+
+_CALL_PASSED = pytest.StashKey[bool]()
+
+
 @pytest.fixture(autouse=True)
-def every_window_test_saves_a_picture() -> Iterator[None]:
-    """A test that opened the window and saved no PNG fails: each state a test checks is also seen."""
+def every_window_test_saves_a_picture(request: pytest.FixtureRequest) -> Iterator[None]:
+    """A passing test that opened the window and saved no PNG fails: each state it checks is also seen."""
     from .harness import COUNTS
 
     before = dict(COUNTS)
     yield
-    if COUNTS["windows"] > before["windows"] and COUNTS["pictures"] == before["pictures"]:
+    opened = COUNTS["windows"] > before["windows"]
+    passed = request.node.stash.get(_CALL_PASSED, False)
+    if opened and passed and COUNTS["pictures"] == before["pictures"]:
         pytest.fail("this test opened the window but saved no screenshot (gui.shot or gui.render)")

@@ -9,6 +9,7 @@ idea of it.
 from __future__ import annotations
 
 import math
+import re
 from collections.abc import Iterator
 from pathlib import Path
 
@@ -183,6 +184,39 @@ def test_escape_shows_the_camera_picture_and_escape_returns_to_the_map(gui: Gui)
     pump(lambda: window.stack.get_visible_child_name() == "map", 3, "the map page")
     pump(lambda: window.inset.get_visible(), 3, "the picture inset on the map")
     gui.shot("map-with-inset")
+
+
+def test_the_camera_inset_shows_its_age_greys_on_a_lost_link_and_clears_on_reconnect(
+    gui: Gui, sim: SimThread
+) -> None:
+    window, inset, stage = gui.window, gui.window.inset, gui.stage
+    gui.key("Escape")
+    pump(lambda: window.camera.texture is not None, 8, "a picture")
+    gui.key("Escape")
+    pump(lambda: inset.get_visible() and inset.get_mapped(), 3, "the inset on the map")
+    first = inset.age_label.get_text()
+    assert re.fullmatch(r"\d+\.\d s", first), first
+    pump(lambda: inset.age_label.get_text() != first, 3, "the age to count up")
+    # Small (about a sixth of the map's width) and out of the way: the bottom-left corner.
+    assert inset.get_width() <= 0.18 * stage.get_width(), (inset.get_width(), stage.get_width())
+    ok, corner = inset.compute_bounds(stage)
+    assert ok and corner.get_x() < 20 and corner.get_y() + corner.get_height() > stage.get_height() - 20
+    gui.shot("inset-with-age")
+    gui.click(inset)
+    pump(lambda: window.stack.get_visible_child_name() == "camera", 3, "a click to open the camera page")
+    gui.key("Escape")
+    pump(lambda: window.stack.get_visible_child_name() == "map", 3, "the map again")
+    port = sim.port
+    sim.kill()
+    pump(lambda: gui.phase is Phase.RECONNECTING, 5, "the lost link")
+    pump(lambda: inset.has_css_class("stale"), 3, "the inset to grey")
+    assert inset.get_visible() and inset.age_label.get_text().endswith("link lost")
+    assert "before the link was lost" in (inset.get_tooltip_text() or "")
+    gui.shot("inset-link-lost")
+    with SimThread(SimConfig(port=port, map_path=OFFICE_MAP, camera=True, seed=1)):
+        gui.wait_connected(timeout=20)
+        assert not inset.get_visible() and inset.picture.get_paintable() is None, "an old picture is gone"
+        gui.shot("reconnected-without-the-old-picture")
 
 
 def test_ctrl_t_toggles_the_status_toolbar(gui: Gui) -> None:

@@ -24,6 +24,8 @@ from ..model import CameraImage  # noqa: E402
 
 MAX_SIDE = 4096
 INSET_SIZE = (176, 132)
+"""The inset's largest size (and its thumbnail's)."""
+INSET_MIN_WIDTH = 96
 MAX_JPEG_BYTES = 16 * 1024 * 1024
 REQUEST_TIMEOUT = 7.0
 """Seconds the page waits for a requested picture before saying none came."""
@@ -244,32 +246,105 @@ class CameraView(Gtk.Box):
 
 
 class CameraInset(Gtk.Box):
-    """The last picture as a small translucent inset on the map; a click opens the camera page."""
+    """The last picture as a small inset on the map, with its age; a click opens the camera page.
 
-    def __init__(self, on_open: Callable[[], None]) -> None:
+    An old picture must never pass for the robot's view: the inset shows how old it is, turns
+    grey while the link is lost (:meth:`set_live`), and the window clears it on a new
+    connection. It sits in the bottom-left corner (top right while the touch D-pad is there)
+    and takes about a sixth of the map's width, between :data:`INSET_MIN_WIDTH` and
+    :data:`INSET_SIZE`.
+    """
+
+    def __init__(self, on_open: Callable[[], None], clock: Callable[[], float] = time.monotonic) -> None:
         super().__init__()
         self.add_css_class("camera-inset")
-        self.set_halign(Gtk.Align.END)
-        self.set_valign(Gtk.Align.START)
-        self.set_margin_top(8)
-        self.set_margin_end(8)
-        self.picture = Gtk.Picture()
-        self.picture.set_can_shrink(False)
-        self.append(self.picture)
-        self.set_tooltip_text("Last camera picture (click or Esc for the camera view)")
+        self.clock = clock
+        self.received_at: float | None = None
+        self.live = True
+        self.picture = _SizedPicture()
+        overlay = Gtk.Overlay()
+        overlay.set_child(self.picture)
+        self.age_label = Gtk.Label(halign=Gtk.Align.END, valign=Gtk.Align.END)
+        self.age_label.add_css_class("inset-age")
+        self.age_label.set_can_target(False)
+        overlay.add_overlay(self.age_label)
+        self.append(overlay)
         click = Gtk.GestureClick()
         click.connect("released", lambda *_a: on_open())
         self.add_controller(click)
         self.enabled = True
         self.set_visible(False)
+        self.place(corner_free=True)
+        self.fit_to(800)
 
-    def show_texture(self, texture: Gdk.Texture | None) -> None:
+    def show_texture(self, texture: Gdk.Texture | None, received_at: float | None = None) -> None:
+        """A new picture (live again), or None to forget the picture."""
         self.picture.set_paintable(texture)
+        self.received_at = received_at if texture is not None else None
+        if texture is not None:
+            self.set_live(True)
         self.set_visible(self.enabled and texture is not None)
+        self.tick()
 
     def set_enabled(self, on: bool) -> None:
         self.enabled = on
         self.set_visible(on and self.picture.get_paintable() is not None)
+
+    def set_live(self, live: bool) -> None:
+        """False while the link is lost: the picture is greyed, and says so."""
+        self.live = live
+        if live:
+            self.remove_css_class("stale")
+        else:
+            self.add_css_class("stale")
+        self.tick()
+
+    def tick(self) -> None:
+        """Update the age (the window calls this on its slow timer)."""
+        if self.received_at is None:
+            self.age_label.set_text("")
+            self.set_tooltip_text(None)
+            return
+        age = _age(max(0.0, self.clock() - self.received_at))
+        self.age_label.set_text(age if self.live else f"{age} · link lost")
+        self.set_tooltip_text(
+            f"Camera picture taken {age} ago (click or Esc for the camera view)"
+            if self.live
+            else f"Camera picture taken {age} ago, before the link was lost"
+        )
+
+    def place(self, *, corner_free: bool) -> None:
+        """Bottom left (away from the banners, the zoom buttons and the note); top right if the D-pad
+        is in that corner."""
+        self.set_halign(Gtk.Align.START if corner_free else Gtk.Align.END)
+        self.set_valign(Gtk.Align.END if corner_free else Gtk.Align.START)
+        for side in ("top", "bottom", "start", "end"):
+            getattr(self, f"set_margin_{side}")(10)
+
+    def fit_to(self, map_width: int) -> None:
+        """About a sixth of the map's width (so 128 px on an 800 px screen), 4:3."""
+        width = max(INSET_MIN_WIDTH, min(INSET_SIZE[0], map_width // 6))
+        self.picture.set_size(width, width * 3 // 4)
+
+
+class _SizedPicture(Gtk.Picture):
+    """A picture of exactly the size it is given (a plain ``Gtk.Picture`` asks for its texture's size)."""
+
+    def __init__(self) -> None:
+        super().__init__()
+        self.set_can_shrink(True)
+        if hasattr(self, "set_content_fit"):
+            self.set_content_fit(Gtk.ContentFit.CONTAIN)
+        self._size = INSET_SIZE
+
+    def set_size(self, width: int, height: int) -> None:
+        if (width, height) != self._size:
+            self._size = (width, height)
+            self.queue_resize()
+
+    def do_measure(self, orientation: Gtk.Orientation, _for_size: int) -> tuple[int, int, int, int]:
+        n = self._size[0] if orientation == Gtk.Orientation.HORIZONTAL else self._size[1]
+        return n, n, -1, -1
 
 
 def _age(seconds: float) -> str:

@@ -60,8 +60,13 @@ button.stop-button { min-width: 92px; font-weight: bold; letter-spacing: 1px; }
 .camera-bar button:hover { background: alpha(white, 0.2); }
 .camera-bar button:disabled { color: alpha(white, 0.4); }
 .camera-bar label { color: alpha(white, 0.85); }
-.camera-inset { border: 2px solid alpha(white, 0.85); border-radius: 6px; opacity: 0.86;
+.camera-inset { border: 2px solid alpha(white, 0.85); border-radius: 6px;
                 box-shadow: 0 2px 8px alpha(black, 0.4); background: black; }
+.camera-inset.stale { opacity: 0.8; border-color: alpha(#9c5300, 0.9); }
+.camera-inset.stale picture { filter: grayscale(1); }
+.camera-inset .inset-age { background: alpha(black, 0.62); color: white; font-size: 8.5pt;
+                           padding: 0 4px; border-radius: 4px; margin: 3px; }
+.camera-inset.stale .inset-age { background: alpha(#9c5300, 0.92); }
 
 /* GTK's own theme gives the shortcuts window's page buttons (1 2 3) negative label margins:
    "GtkLabel reported min width -4" warnings. Plain margins, same look. */

@@ -125,7 +125,7 @@ class MainWindow(Gtk.ApplicationWindow):
         self.stage.on_view_changed = self._view_changed
         self.toolbar = StatusToolbar(model, clock=clock, status_age=status_age)
         self.camera = CameraView(on_request=self._request_picture, on_back=self.show_map, clock=clock)
-        self.inset = CameraInset(self.show_camera)
+        self.inset = CameraInset(self.show_camera, clock=clock)
         self.decoder = PictureDecoder(self._picture_decoded)
         self.dpad = DPad(hold=self._hold, release=self._release, stop=lambda: self.controller.run("stop"))
         self.keys = KeyRouter(
@@ -206,6 +206,8 @@ class MainWindow(Gtk.ApplicationWindow):
         self.map_note.set_can_target(False)
         map_page.add_overlay(self.map_note)
         self.dpad.set_visible(touch_only())
+        self.inset.place(corner_free=not self.dpad.get_visible())
+        self.stage.connect("resize", lambda _s, width, _h: self.inset.fit_to(width))
 
         self.stack = Gtk.Stack(transition_type=Gtk.StackTransitionType.NONE)
         self.stack.add_named(map_page, "map")
@@ -317,7 +319,7 @@ class MainWindow(Gtk.ApplicationWindow):
         plain("about", self.show_about)
         self.toolbar_action = toggle("toolbar", True, self.toolbar_revealer.set_reveal_child)
         self.fullscreen_action = toggle("fullscreen", False, self._set_fullscreen)
-        self.dpad_action = toggle("dpad", self.dpad.get_visible(), self.dpad.set_visible)
+        self.dpad_action = toggle("dpad", self.dpad.get_visible(), self._set_dpad)
         self.inset_action = toggle("inset", True, self.inset.set_enabled)
         self.sonar_action = toggle("sonar", self.model.view.value.show_sonar, self._set_sonar)
         self.safe_action = toggle("safe-drive", True, self._set_safe_drive)
@@ -499,9 +501,16 @@ class MainWindow(Gtk.ApplicationWindow):
             self.banners.dismiss("link")  # deliberate: no banner at all
         if phase is Phase.DISCONNECTED or (phase is Phase.CONNECTING and old.phase is not Phase.RECONNECTING):
             self.camera.clear()
-            self.inset.show_texture(None)
             if self.stack.get_visible_child_name() == "camera":
                 self.show_map()
+        # The inset is a glance at the robot's view: a picture from an earlier connection is not
+        # one. Greyed (with its age) while the link is lost, gone once a new connection is made.
+        if phase in (Phase.DISCONNECTED, Phase.CONNECTING) or (
+            phase is Phase.CONNECTED and old.phase is not Phase.CONNECTED
+        ):
+            self.inset.show_texture(None)
+        elif phase in (Phase.RECONNECTING, Phase.FAILED):
+            self.inset.set_live(False)
         # Held keys stay held in the key router (their auto-repeat is swallowed); the controller
         # has blocked them, so only a fresh press drives after the link comes back.
         self._update_header(new)
@@ -561,7 +570,7 @@ class MainWindow(Gtk.ApplicationWindow):
             return  # a newer picture (or a disconnect) overtook this one
         self.camera.show_picture(image, None if textures is None else textures[0], error)  # type: ignore[arg-type]
         if textures is not None:
-            self.inset.show_texture(textures[1])
+            self.inset.show_texture(textures[1], image.received_at)  # type: ignore[attr-defined]
 
     def _view_changed(self) -> None:
         label = "Fit" if self.stage.fitted else ""
@@ -594,6 +603,10 @@ class MainWindow(Gtk.ApplicationWindow):
         self.fullscreen_bar.set_reveal_child(state)
         if self.fullscreen_action.get_state().get_boolean() != state:
             self.fullscreen_action.set_state(GLib.Variant.new_boolean(state))
+
+    def _set_dpad(self, on: bool) -> None:
+        self.dpad.set_visible(on)
+        self.inset.place(corner_free=not on)  # the D-pad takes the bottom-left corner
 
     def _set_sonar(self, on: bool) -> None:
         self.model.view.update(show_sonar=on)
@@ -662,6 +675,7 @@ class MainWindow(Gtk.ApplicationWindow):
         if self.ticks % REFRESH_EVERY == 0:
             self.toolbar.refresh()
             self.camera.tick()
+            self.inset.tick()
             if self.stage.robot_is_stale() and self.model.robot.value.numbers_at is not None:
                 self.stage.queue_draw()
         return True
