@@ -527,3 +527,37 @@ def test_first_run_hint_in_full_screen_points_at_the_menu_on_screen(
         gui.shot("first-run-hint")
     finally:
         gui.close()
+
+
+def test_greyed_menu_items_say_why(start: Start) -> None:
+    """GTK menus have no tooltips: a disabled robot command carries its reason in its label."""
+    gui, _sim = start(camera=False)
+    window = gui.window
+
+    def labels() -> dict[str, str]:
+        menu = window.robot_menu
+        out = {}
+        for i in range(menu.get_n_items()):
+            action = menu.get_item_attribute_value(i, "action", None).get_string()
+            out[action] = menu.get_item_attribute_value(i, "label", None).get_string()
+        return out
+
+    def open_menu(label: str) -> None:
+        gui.click(window.menu_button)
+        popover = window.menu_button.get_popover()
+        pump(lambda: popover.get_mapped(), 3, "the menu")
+        gui.screen_shot(label)
+        popover.popdown()
+        pump(lambda: not popover.get_mapped(), 3, "the menu to close")
+
+    assert labels()["win.camera"] == "Camera picture — not offered by the server"
+    assert not window.lookup_action("camera").get_enabled()
+    assert labels()["win.turn"] == "Turn by an angle…" and window.lookup_action("turn").get_enabled()
+    open_menu("menu-no-camera")
+    gui.focus()
+    gui.key("ctrl+d")
+    pump(lambda: gui.phase is Phase.DISCONNECTED, 3, "the disconnect")
+    for action, label in labels().items():
+        assert label.endswith(" — not connected"), (action, label)
+        assert not window.lookup_action(action.removeprefix("win.")).get_enabled()
+    open_menu("menu-not-connected")

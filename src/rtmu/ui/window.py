@@ -73,6 +73,22 @@ def touch_only(display: Gdk.Display | None = None) -> bool:
     return not pointers
 
 
+ROBOT_MENU = (
+    ("Turn by an angle…", "win.turn", "turn_left_90"),
+    ("Go a distance…", "win.go", "move_forward_1m"),
+    ("Camera picture", "win.camera", "request_image"),
+    ("Safe drive", "win.safe-drive", "safe_drive_on"),
+)
+"""The menu's robot section: label, action, the command whose state enables it."""
+
+
+def short_reason(reason: str) -> str:
+    """A reason short enough for a menu row ("this server does not offer X" → "not offered by the server")."""
+    if reason.startswith(("this server does not offer", "this server offers no")):
+        return "not offered by the server"
+    return reason or "unavailable"
+
+
 class _View:
     """The controller's ``View`` (a separate object: ``notify`` is a GObject method on the window)."""
 
@@ -267,12 +283,9 @@ class MainWindow(Gtk.ApplicationWindow):
         conn = Gio.Menu()
         conn.append("Connection settings…", "win.settings")
         menu.append_section(None, conn)
-        robot = Gio.Menu()
-        robot.append("Turn by an angle…", "win.turn")
-        robot.append("Go a distance…", "win.go")
-        robot.append("Camera picture", "win.camera")
-        robot.append("Safe drive", "win.safe-drive")
-        menu.append_section(None, robot)
+        self.robot_menu = Gio.Menu()
+        self._fill_robot_menu()
+        menu.append_section(None, self.robot_menu)
         view = Gio.Menu()
         view.append("Status toolbar", "win.toolbar")
         view.append("Full screen", "win.fullscreen")
@@ -288,6 +301,25 @@ class MainWindow(Gtk.ApplicationWindow):
         app.append("Quit", "app.quit")
         menu.append_section(None, app)
         return menu
+
+    def _fill_robot_menu(self) -> None:
+        """The robot's commands; a greyed one says why (GTK menus have no tooltips): "… — not connected"."""
+        items = []
+        for label, action, command in ROBOT_MENU:
+            found = self.lookup_action(action.removeprefix("win."))
+            state = self._states.get(command)
+            if found is not None and not found.get_enabled() and state is not None:
+                label = f"{label} — {short_reason(state.reason)}"
+            items.append((label, action))
+        shown = []
+        for i in range(self.robot_menu.get_n_items()):
+            value = self.robot_menu.get_item_attribute_value(i, "label", None)
+            shown.append(value.get_string() if value is not None else "")
+        if shown == [label for label, _ in items]:
+            return
+        self.robot_menu.remove_all()
+        for label, action in items:
+            self.robot_menu.append(label, action)
 
     def _install_actions(self) -> None:
         def plain(name: str, fn: Callable[[], None]) -> Gio.SimpleAction:
@@ -372,6 +404,8 @@ class MainWindow(Gtk.ApplicationWindow):
                 self._enable("go", state.enabled)
             elif name == "safe_drive_on":
                 self._enable("safe-drive", state.enabled)
+        if any(name in states for _label, _action, name in ROBOT_MENU):
+            self._fill_robot_menu()
 
     def ask_password(self, profile: Profile, answer: Callable[[str | None], None]) -> None:
         remembered = self._passwords.get(profile.name)
