@@ -11,7 +11,9 @@ from __future__ import annotations
 import signal
 import sys
 import threading
+from collections.abc import Callable
 from dataclasses import replace
+from types import FrameType
 
 import gi
 
@@ -34,6 +36,8 @@ from .style import install_css  # noqa: E402
 from .window import MainWindow  # noqa: E402
 
 RUNNER_CLOSE_TIMEOUT = 1.5
+GLIB_SIGNALS = (signal.SIGINT, signal.SIGTERM, signal.SIGHUP)
+"""Signals GLib's main loop can watch (``GLib.unix_signal_add``); SIGQUIT is handled in Python."""
 _NO_BREAK = "\u2060"  # WORD JOINER: the line may not break here (not after the hyphens of "--demo")
 FIRST_RUN_HINT = (
     "No robot set up yet: open the menu ☰ → Connection settings (Ctrl+,) — or try the simulator: "
@@ -75,6 +79,7 @@ class RtmuApplication(Gtk.Application):
         self.failed = False
         """The window could not be built (the error was printed); ``run_gui`` exits non-zero."""
         self._signal_sources: list[int] = []
+        self._old_sigquit: Callable[[int, FrameType | None], object] | int | None = None
 
     # -- lifecycle -----------------------------------------------------------------------------
     def do_startup(self) -> None:
@@ -88,8 +93,13 @@ class RtmuApplication(Gtk.Application):
         for target in ("app.quit", "win.fullscreen", "win.toolbar", "win.connect", "win.disconnect",
                        "win.settings", "win.show-help-overlay"):  # fmt: skip
             self.set_accels_for_action(target, accels_for(target))
-        for signum in (signal.SIGINT, signal.SIGTERM):
+        # Ctrl+C, kill, a closed terminal (SIGHUP) and Ctrl+\ (SIGQUIT) all end the window the same
+        # way: stop the robot first, then quit. Left to their default, SIGHUP and SIGQUIT would kill
+        # the process with the robot still driving until the server's watchdog noticed.
+        for signum in GLIB_SIGNALS:
             self._signal_sources.append(GLib.unix_signal_add(GLib.PRIORITY_DEFAULT, signum, self._on_signal))
+        # GLib does not watch SIGQUIT: a Python handler (PyGObject wakes the main loop for it).
+        self._old_sigquit = signal.signal(signal.SIGQUIT, self._on_python_signal)
 
     def do_activate(self) -> None:
         if self.window is not None:
@@ -149,6 +159,9 @@ class RtmuApplication(Gtk.Application):
         for source in self._signal_sources:
             GLib.source_remove(source)
         self._signal_sources = []
+        if self._old_sigquit is not None:
+            signal.signal(signal.SIGQUIT, self._old_sigquit)
+            self._old_sigquit = None
 
     def quit_safely(self) -> None:
         """Stop the robot, then close every window (the shutdown handler does the rest)."""
@@ -161,6 +174,9 @@ class RtmuApplication(Gtk.Application):
     def _on_signal(self) -> bool:
         self.quit_safely()
         return True
+
+    def _on_python_signal(self, _signum: int, _frame: object) -> None:
+        GLib.idle_add(lambda: self._on_signal() and False)
 
     # -- profiles ------------------------------------------------------------------------------
     def choose_profile(self) -> tuple[Profile, bool]:

@@ -1,0 +1,89 @@
+"""``rtmu --host … --port …`` as a process, driving with a held key, then SIGHUP or SIGQUIT.
+
+Both must end the window like Ctrl+C and kill do: the robot is stopped first (the
+simulator switches to its stop mode before its own 2 s watchdog could fire),
+then the process exits with status 0. Left to their default, these signals
+killed the process and left the robot driving.
+"""
+
+from __future__ import annotations
+
+import os
+import signal
+import subprocess
+import sys
+import time
+from collections.abc import Callable
+from pathlib import Path
+
+import pytest
+
+from rtmu.sim import SimConfig, SimThread
+
+from .harness import OFFICE_MAP
+
+
+def wait(condition: Callable[[], bool], timeout: float, what: str) -> None:
+    deadline = time.monotonic() + timeout
+    while not condition():
+        if time.monotonic() > deadline:
+            raise AssertionError(f"timed out after {timeout:g} s waiting for {what}")
+        time.sleep(0.02)
+
+
+def xdotool(*args: str) -> str:
+    return subprocess.run(["xdotool", *args], capture_output=True, text=True, timeout=15, check=True).stdout
+
+
+@pytest.mark.parametrize("signum", [signal.SIGHUP, signal.SIGQUIT], ids=["SIGHUP", "SIGQUIT"])
+def test_a_hangup_or_quit_signal_stops_the_robot_then_exits(
+    signum: int, tmp_path: Path, screenshots: Path
+) -> None:
+    with SimThread(SimConfig(port=0, map_path=OFFICE_MAP, seed=1)) as sim:
+        env = dict(os.environ, XDG_CONFIG_HOME=str(tmp_path))
+        proc = subprocess.Popen(
+            [sys.executable, "-m", "rtmu", "--host", "127.0.0.1", "--port", str(sim.port)],
+            stdout=subprocess.DEVNULL,
+            stderr=subprocess.PIPE,
+            text=True,
+            env=env,
+        )
+        held = False
+
+        def subscribed() -> bool:
+            return any(session.subscriptions for session in sim.server.sessions)
+
+        try:
+            found = xdotool("search", "--sync", "--onlyvisible", "--pid", str(proc.pid), "--name", "RTMU")
+            window = found.split()[0]
+            wait(lambda: sim.call(subscribed), 15, "the window to connect and subscribe")
+            xdotool("windowfocus", "--sync", window)
+            for _attempt in range(5):  # a press that beat the "connected" state to the window is refused
+                xdotool("keydown", "Up")
+                held = True
+                try:
+                    wait(lambda: abs(sim.snapshot().vel) > 1.0, 2, "the robot to drive")
+                    break
+                except AssertionError:
+                    xdotool("keyup", "Up")
+                    held = False
+            assert held, "the held key never drove the robot"
+            name = signal.Signals(signum).name
+            subprocess.run(
+                ["import", "-window", window, str(screenshots / f"test_signals-{name}-01-driving.png")],
+                timeout=15,
+                check=True,
+            )
+            watchdog_stops = sim.call(lambda: sim.server.robot.watchdog_stops)
+            proc.send_signal(signum)
+            # The simulator's stop mode comes only from a "stop" request (its watchdog and a client
+            # that vanishes leave the mode as it is), and it must come before the watchdog fired.
+            wait(lambda: sim.call(lambda: sim.server.robot.mode_name) == "stop", 5, "an explicit stop")
+            assert sim.call(lambda: sim.server.robot.watchdog_stops) == watchdog_stops, "the watchdog fired"
+            assert proc.wait(10) == 0, proc.stderr.read() if proc.stderr else ""
+        finally:
+            if held:
+                xdotool("keyup", "Up")
+            if proc.poll() is None:
+                proc.kill()
+                proc.wait(5)
