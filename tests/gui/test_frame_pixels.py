@@ -88,3 +88,27 @@ def test_every_helper_starts_its_own_path(screenshots: Path, name: str) -> None:
     pixels = np.stack([(data >> 16) & 0xFF, (data >> 8) & 0xFF, data & 0xFF], axis=-1).astype(np.uint8)
     target = vp.to_screen(3000.0, -2000.0)
     assert darkest_along(pixels, (0, 0), target) > 3 * 240, f"{name} joined the previous current point"
+
+
+def test_a_stale_robot_on_home_at_fit_zoom_stays_distinct_and_home_keeps_its_label(screenshots: Path) -> None:
+    """At Fit zoom the robot often stands on Home: it must not melt into the marker or hide its name."""
+    from types import SimpleNamespace
+
+    vp = Viewport(W, H, 0.25, 0.0, 0.0)  # "Fit 25 %"
+    home = SimpleNamespace(type="RobotHome", x=0.0, y=0.0, name="Home")
+    labels = overlays.LabelCache()
+    scene = Scene(labels=labels, objects=[home], robot=(0.0, 0.0, 0.0), stale=True)
+    pixels = render(scene, vp, screenshots / "frame-stale-robot-on-home.png")
+    sx, sy = (round(v) for v in vp.to_screen(0.0, 0.0))
+    r, g, b = (int(c) for c in pixels[sy + 3, sx - 5])  # on the body, behind the heading mark
+    assert abs(r - g) < 12 and abs(g - b) < 12 and 120 < g < 190, f"not the stale grey: {(r, g, b)}"
+    # Big enough to find: the body spans at least ROBOT_MIN_PX along its heading.
+    row = pixels[sy, sx - 20 : sx + 20].astype(int).sum(axis=1)
+    assert (row < 3 * 200).sum() >= overlays.ROBOT_MIN_PX - 2
+    # The name "Home" is drawn, and not under the robot.
+    surface = cairo.ImageSurface(cairo.FORMAT_RGB24, W, H)
+    robot = overlays.robot_box(vp, 0.0, 0.0)
+    drawn = dict(overlays.draw_cairns(cairo.Context(surface), vp, [home], labels, robot))
+    assert "Home" in drawn
+    box = drawn["Home"]
+    assert box[1] >= robot[3] or box[3] <= robot[1] or box[0] >= robot[2] or box[2] <= robot[0]

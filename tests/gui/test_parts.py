@@ -104,3 +104,26 @@ def test_the_map_note_follows_the_connection_phase_then_the_map() -> None:
     text = map_note(connected, no_map)
     assert "no map" in text and "grid" in text
     assert not any(ch.isdigit() for ch in text), "the grid step is the legend's, never repeated in the note"
+
+
+def test_the_first_run_hint_never_breaks_rtmu_demo_across_lines() -> None:
+    gi.require_version("Pango", "1.0")
+    gi.require_version("PangoCairo", "1.0")
+    from gi.repository import Pango, PangoCairo
+
+    from rtmu.ui.application import FIRST_RUN_HINT
+    from rtmu.ui.banners import _one_paragraph
+
+    text = _one_paragraph(FIRST_RUN_HINT)  # what the banner shows
+    start = text.index("rtmu\u2060")
+    end = text.index("demo", start) + len("demo")
+    byte_start, byte_end = len(text[:start].encode()), len(text[:end].encode())
+    layout = Pango.Layout.new(PangoCairo.FontMap.get_default().create_context())
+    layout.set_font_description(Pango.FontDescription.from_string("Sans 10.5"))
+    layout.set_wrap(Pango.WrapMode.WORD)
+    layout.set_text(text, -1)
+    for width in range(120, 900, 7):
+        layout.set_width(width * Pango.SCALE)
+        for line in layout.get_lines_readonly():
+            inside = byte_start < line.start_index < byte_end
+            assert not inside, f"a line starts inside 'rtmu --demo' at {width} px"

@@ -561,3 +561,27 @@ def test_greyed_menu_items_say_why(start: Start) -> None:
         assert label.endswith(" — not connected"), (action, label)
         assert not window.lookup_action(action.removeprefix("win.")).get_enabled()
     open_menu("menu-not-connected")
+
+
+def test_toolbar_columns_stay_put_between_connected_and_disconnected(start: Start) -> None:
+    """Fixed column widths: "—" and "12.8 V" take the same room, so nothing shifts sideways."""
+    gui, _sim = start()
+    toolbar = gui.window.toolbar
+
+    def lefts() -> dict[str, float]:
+        out = {}
+        for name, cell in toolbar.cells.items():
+            ok, bounds = cell.compute_bounds(toolbar)
+            assert ok
+            out[name] = round(bounds.get_x())
+        return out
+
+    pump(lambda: not toolbar.cells["battery"].stale, 3, "fresh values")
+    connected = lefts()
+    gui.shot("connected")
+    gui.key("ctrl+d")
+    pump(lambda: gui.phase is Phase.DISCONNECTED, 3, "the disconnect")
+    idle(0.2)
+    assert lefts() == connected
+    assert gui.window.get_focus() is None, "no widget holds the focus (no ring on the menu button)"
+    gui.shot("disconnected")

@@ -44,6 +44,11 @@ def connect_button(on_click: Callable[[], None]) -> Gtk.Button:
 def menu_button(menu: Gio.MenuModel) -> Gtk.MenuButton:
     button = Gtk.MenuButton(icon_name="open-menu-symbolic", tooltip_text="Menu")
     button.set_focusable(False)
+    # The menu button's own inner toggle would take the window's first focus and then wear a focus
+    # ring after any key press; keys go to the capture-phase router, so nothing here needs focus.
+    inner = button.get_first_child()
+    if inner is not None:
+        inner.set_focusable(False)
     button.set_menu_model(menu)
     return button
 

@@ -45,7 +45,8 @@ def draw_frame(ctx: cairo.Context, vp: Viewport, scene: Scene) -> bool:
         step = overlays.draw_grid(ctx, vp)
         overlays.draw_scale_note(ctx, scene.labels, f"grid {overlays.metres(step)}")
     if scene.objects:
-        overlays.draw_cairns(ctx, vp, scene.objects, scene.labels)
+        avoid = overlays.robot_box(vp, *scene.robot[:2]) if scene.robot is not None else None
+        overlays.draw_cairns(ctx, vp, scene.objects, scene.labels, avoid)
     if scene.robot is not None:
         x, y, th = scene.robot
         overlays.draw_trail(ctx, vp, scene.trail)

@@ -27,11 +27,14 @@ ROBOT_FRONT_MM = 210.0
 ROBOT_REAR_MM = 301.0
 ROBOT_HALF_WIDTH_MM = 212.5
 ROBOT_RADIUS_MM = 250.0
-ROBOT_MIN_PX = 10.0
-"""Below this length the robot is drawn as a marker of this size, so it never vanishes."""
+ROBOT_MIN_PX = 16.0
+"""Below this length the robot is drawn as a marker of this size, so it never vanishes (and is as big
+as the Home marker it often stands on)."""
 
 ROBOT_RGB = (0.11, 0.44, 0.85)
-STALE_RGB = (0.55, 0.55, 0.58)
+STALE_RGB = (0.60, 0.61, 0.64)
+"""An opaque mid grey (with a dashed dark outline): old, yet never mistaken for a marker or a wall."""
+OUTLINE_RGB = (0.05, 0.1, 0.2)
 TRAIL_RGBA = (0.11, 0.44, 0.85, 0.45)
 SONAR_RGB = (0.90, 0.38, 0.0)
 HOME_RGB = (0.15, 0.60, 0.30)
@@ -138,8 +141,22 @@ def draw_scale_note(ctx: cairo.Context, labels: LabelCache, text: str) -> None:
 # -- cairns -----------------------------------------------------------------------------------------
 
 
-def draw_cairns(ctx: cairo.Context, vp: Viewport, objects: Sequence[object], labels: LabelCache) -> None:
-    """Home, goals (with names), docks, forbidden lines and areas, other areas; off-screen ones skipped."""
+Box = tuple[float, float, float, float]
+"""x0, y0, x1, y1 on the screen."""
+
+
+def draw_cairns(
+    ctx: cairo.Context,
+    vp: Viewport,
+    objects: Sequence[object],
+    labels: LabelCache,
+    avoid: Box | None = None,
+) -> list[tuple[str, Box]]:
+    """Home, goals (with names), docks, forbidden lines and areas, other areas; off-screen ones skipped.
+
+    A name that would sit under ``avoid`` (the robot, drawn later on top) is moved below it.
+    Returns the names drawn and their boxes.
+    """
     wx0, wy0, wx1, wy1 = vp.visible_world(margin_px=120)
     pending: list[_Label] = []
     for obj in objects:
@@ -178,7 +195,7 @@ def draw_cairns(ctx: cairo.Context, vp: Viewport, objects: Sequence[object], lab
             _marker(ctx, sx, sy, AREA_RGB, "dot")
             if name:
                 pending.append(_Label(4, name, sx, sy + 8, AREA_RGB))
-    _draw_labels(ctx, labels, pending)
+    return _draw_labels(ctx, labels, pending, avoid)
 
 
 def region_corners(
@@ -289,9 +306,16 @@ class _Label(NamedTuple):
     rgb: tuple[float, float, float]
 
 
-def _draw_labels(ctx: cairo.Context, labels: LabelCache, pending: list[_Label]) -> None:
+def _overlap(a: Box, b: Box) -> bool:
+    return a[0] < b[2] and b[0] < a[2] and a[1] < b[3] and b[1] < a[3]
+
+
+def _draw_labels(
+    ctx: cairo.Context, labels: LabelCache, pending: list[_Label], avoid: Box | None = None
+) -> list[tuple[str, Box]]:
     """Names under their marks on a light halo; one that would overlap a more important one is left out."""
-    taken: list[tuple[float, float, float, float]] = []
+    taken: list[Box] = []
+    drawn: list[tuple[str, Box]] = []
     for item in sorted(pending, key=lambda p: p.priority):
         if not item.text:
             continue
@@ -300,9 +324,13 @@ def _draw_labels(ctx: cairo.Context, labels: LabelCache, pending: list[_Label]) 
         w, h = logical.width, logical.height
         x, y = round(item.sx - w / 2), round(item.sy)
         box = (x - 3, y - 1, x + w + 3, y + h + 1)
-        if any(box[0] < b[2] and b[0] < box[2] and box[1] < b[3] and b[1] < box[3] for b in taken):
+        if avoid is not None and _overlap(box, avoid):
+            y = round(avoid[3]) + 2  # under the robot instead of hidden by it
+            box = (x - 3, y - 1, x + w + 3, y + h + 1)
+        if any(_overlap(box, b) for b in taken):
             continue
         taken.append(box)
+        drawn.append((item.text, box))
         ctx.save()
         ctx.new_path()
         ctx.set_source_rgba(1, 1, 1, 0.78)
@@ -313,6 +341,7 @@ def _draw_labels(ctx: cairo.Context, labels: LabelCache, pending: list[_Label]) 
         PangoCairo.show_layout(ctx, layout)
         ctx.new_path()
         ctx.restore()
+    return drawn
 
 
 # -- trail, sonar, robot ------------------------------------------------------------------------------
@@ -372,12 +401,12 @@ def draw_robot(
 ) -> None:
     """The robot to scale (footprint, or a circle when there is no map) with a heading mark.
 
-    A robot smaller than :data:`ROBOT_MIN_PX` on screen is drawn at that size so it stays findable.
+    A robot smaller than :data:`ROBOT_MIN_PX` on screen is drawn at that size so it stays findable;
+    a white halo keeps it apart from walls and markers under it. Stale (no fresh pose): opaque grey
+    with a dashed outline.
     """
     sx, sy = vp.to_screen(x, y)
-    s = vp.scale
-    length_px = (ROBOT_FRONT_MM + ROBOT_REAR_MM) * s
-    k = max(1.0, ROBOT_MIN_PX / length_px) * s  # px per robot-mm
+    k = _robot_px_per_mm(vp)
     th = math.radians(th_deg)
     rgb = STALE_RGB if stale else ROBOT_RGB
     ctx.save()
@@ -391,11 +420,17 @@ def draw_robot(
         ctx.new_sub_path()
         ctx.arc(0, 0, ROBOT_RADIUS_MM * k, 0, 2 * math.pi)
         ctx.close_path()
-    ctx.set_source_rgba(*rgb, 0.55 if stale else 0.9)
+    ctx.set_source_rgba(1, 1, 1, 0.9)  # halo
+    ctx.set_line_width(5.0)
+    ctx.stroke_preserve()
+    ctx.set_source_rgba(*rgb, 1.0 if stale else 0.92)
     ctx.fill_preserve()
-    ctx.set_source_rgba(0.05, 0.1, 0.2, 0.9)
+    ctx.set_source_rgba(*OUTLINE_RGB, 0.9)
     ctx.set_line_width(1.5)
+    if stale:
+        ctx.set_dash([3.0, 2.0])
     ctx.stroke()
+    ctx.set_dash([])
     # Heading: a white arrow from the centre to the front.
     front = (ROBOT_FRONT_MM if footprint else ROBOT_RADIUS_MM) * k
     ctx.set_source_rgb(1, 1, 1)
@@ -411,6 +446,19 @@ def draw_robot(
     ctx.close_path()
     ctx.fill()
     ctx.restore()
+
+
+def _robot_px_per_mm(vp: Viewport) -> float:
+    length_px = (ROBOT_FRONT_MM + ROBOT_REAR_MM) * vp.scale
+    return max(1.0, ROBOT_MIN_PX / length_px) * vp.scale
+
+
+def robot_box(vp: Viewport, x: float, y: float) -> Box:
+    """The screen box the robot (with its halo) covers, whatever its heading."""
+    sx, sy = vp.to_screen(x, y)
+    reach = max(ROBOT_RADIUS_MM, math.hypot(ROBOT_REAR_MM, ROBOT_HALF_WIDTH_MM))
+    r = reach * _robot_px_per_mm(vp) + 3.0
+    return (sx - r, sy - r, sx + r, sy + r)
 
 
 def _rounded_rect(ctx: cairo.Context, x: float, y: float, w: float, h: float, r: float) -> None:

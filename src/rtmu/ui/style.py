@@ -15,7 +15,7 @@ CSS = """
 .status-cell { padding: 1px 3px; border-radius: 6px; }
 .status-cell .caption { font-size: 7.5pt; opacity: 0.62; }
 .status-cell .value { font-size: 10.5pt; font-weight: bold; font-feature-settings: "tnum"; }
-.status-cell.stale .value { opacity: 0.38; font-weight: normal; }
+.status-cell.stale .value { opacity: 0.4; }  /* same weight: a fixed column keeps its width */
 .status-cell.low .value { color: #b56d00; }
 .status-cell.critical { background: alpha(#c01c28, 0.14); }
 .status-cell.critical .value { color: #c01c28; }
