@@ -702,6 +702,6 @@ class AriaClient:
                 with contextlib.suppress(Exception):
                     await asyncio.wait_for(writer.wait_closed(), CLOSE_TIMEOUT)
         self._teardown(ServerClosed("disconnected"))
-        if task is not None and task is not asyncio.current_task():
-            with contextlib.suppress(asyncio.CancelledError, Exception):
-                await task
+        if task is not None and task is not asyncio.current_task() and not task.done():
+            # Bounded: a reader that will not end must not keep the caller (a window closing) waiting.
+            await asyncio.wait({task}, timeout=CLOSE_TIMEOUT)

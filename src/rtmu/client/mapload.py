@@ -4,7 +4,7 @@
 and packets than text); ``getMap`` is the fallback, or forced with
 ``prefer_binary=False``. Packets go straight into the protocol layer's bounded
 assemblers; the (CPU-heavy) conversion to arrays runs in an executor so the
-network loop keeps its timing.
+network loop keeps its timing, and is bounded by :data:`CONVERT_TIMEOUT`.
 """
 
 from __future__ import annotations
@@ -20,7 +20,7 @@ from ..protocol.errors import ProtocolError
 from ..protocol.payloads.map import MapName
 from ..protocol.payloads.mapstream import MapBinaryAssembler, MapTextAssembler
 from .connection import REPLY_TIMEOUT, AriaClient
-from .errors import ClientError, NotSupported, ProtocolFault
+from .errors import ClientError, ClientTimeout, NotSupported, ProtocolFault
 
 
 @dataclass
@@ -52,12 +52,17 @@ async def map_name(client: AriaClient, timeout: float = REPLY_TIMEOUT) -> str:
     return ""
 
 
+CONVERT_TIMEOUT = 60.0
+"""At most this long for the packets → arrays conversion (0.15 s for a million points)."""
+
+
 async def download_map(
     client: AriaClient,
     *,
     prefer_binary: bool = True,
     timeout: float = REPLY_TIMEOUT,
     progress: Callable[[int], None] | None = None,
+    convert_timeout: float = CONVERT_TIMEOUT,
 ) -> Download:
     """The whole map; ``timeout`` bounds the wait for each packet. Raises ClientError subclasses only.
 
@@ -78,7 +83,12 @@ async def download_map(
         if progress is not None and count % 200 == 0:
             progress(count)
     try:
-        data = await asyncio.get_running_loop().run_in_executor(None, assembled_map, assembler)
+        async with asyncio.timeout(convert_timeout):
+            data = await asyncio.get_running_loop().run_in_executor(None, assembled_map, assembler)
+    except TimeoutError:
+        raise ClientTimeout(
+            f"converting the map from {source!r} took more than {convert_timeout:g} s"
+        ) from None
     except (ProtocolError, MapFormatError, ValueError) as exc:
         raise ProtocolFault(f"the map from {source!r} is malformed: {exc}") from None
     return Download(data, name, source, count)

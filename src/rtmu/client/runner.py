@@ -41,6 +41,8 @@ from .session import Session, SessionConfig
 log = logging.getLogger(__name__)
 
 T = TypeVar("T")
+SHUTDOWN_TIMEOUT = 0.5
+"""How long the network thread waits for its cancelled tasks to finish before it ends anyway."""
 Post = Callable[[Callable[[], None]], Any]
 
 
@@ -104,7 +106,8 @@ class ClientRunner:
                 pending = asyncio.all_tasks(self.loop)
                 for task in pending:
                     task.cancel()
-                self.loop.run_until_complete(asyncio.gather(*pending, return_exceptions=True))
+                if pending:  # bounded: a task that ignores its cancel must not keep the thread alive
+                    self.loop.run_until_complete(asyncio.wait(pending, timeout=SHUTDOWN_TIMEOUT))
             self.loop.close()
 
     def close(self, timeout: float = 2.0) -> None:

@@ -52,6 +52,10 @@ NoticeFn = Callable[[str, str], None]
 """``notice(level, text)``, level ``info``/``warning``/``error``."""
 
 HEART_MAX_SLEEP = 0.25
+STEP_TIMEOUT = 2.0
+"""``step()`` gives up (ClientTimeout) if the heart has not run within this many seconds."""
+TASK_END_TIMEOUT = 0.5
+"""How long closing waits for a cancelled task to finish before leaving it behind."""
 
 
 @dataclass
@@ -241,14 +245,12 @@ class Session:
         self._publish_health()
 
     async def close(self) -> None:
-        """Disconnect and end every task (runner shutdown)."""
+        """Disconnect and end every task (runner shutdown); each wait is bounded."""
         await self.disconnect()
-        for task in (self._heart_task,):
-            if task is not None:
-                task.cancel()
-                with contextlib.suppress(asyncio.CancelledError, Exception):
-                    await task
-        self._heart_task = None
+        task, self._heart_task = self._heart_task, None
+        if task is not None:
+            task.cancel()
+            await asyncio.wait({task}, timeout=TASK_END_TIMEOUT)
 
     async def _drop_client(self) -> None:
         client, self.client = self.client, None
@@ -487,12 +489,19 @@ class Session:
         if self._heart_task is None or self._heart_task.done():
             self._heart_task = asyncio.get_running_loop().create_task(self._heart(), name="session-heart")
 
-    async def step(self) -> None:
-        """Wait until the heart has run once more (tests drive a fake clock with this)."""
+    async def step(self, timeout: float = STEP_TIMEOUT) -> None:
+        """Wait until the heart has run once more (tests drive a fake clock with this).
+
+        Raises :class:`ClientTimeout` if it has not run within ``timeout`` s.
+        """
         self._ensure_heart()
         self._stepped.clear()
         self.kick()
-        await self._stepped.wait()
+        try:
+            async with asyncio.timeout(timeout):
+                await self._stepped.wait()
+        except TimeoutError:
+            raise ClientTimeout(f"the session heart did not run within {timeout:g} s") from None
 
     async def _heart(self) -> None:
         while True:
