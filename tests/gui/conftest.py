@@ -94,6 +94,11 @@ def _stop_xvfb() -> None:
     _terminate(proc)
 
 
+TMP_ROOT = tempfile.mkdtemp(prefix="rtmu-gui-")
+"""Everything the GUI tests write besides screenshots (config, settings, stage pictures); removed at the
+end of the session. The harness finds it through RTMU_GUI_TMP."""
+os.environ["RTMU_GUI_TMP"] = TMP_ROOT
+
 if _XVFB is None or _XDOTOOL is None:
     SKIP_REASON = "Xvfb and xdotool are needed for the GUI tests (apt-get install xvfb xdotool)"
 else:
@@ -107,7 +112,7 @@ else:
         os.environ["GSK_RENDERER"] = "cairo"
         os.environ["NO_AT_BRIDGE"] = "1"
         os.environ["GSETTINGS_BACKEND"] = "memory"
-        os.environ["XDG_CONFIG_HOME"] = tempfile.mkdtemp(prefix="rtmu-gui-config-")
+        os.environ["XDG_CONFIG_HOME"] = str(Path(TMP_ROOT) / "config")
 
 SCREENSHOTS = Path(
     os.environ.get("RTMU_SCREENSHOTS")
@@ -144,6 +149,13 @@ def pytest_terminal_summary(terminalreporter, exitstatus: int, config: pytest.Co
     if SCREENSHOTS.is_dir():
         shots = sorted(SCREENSHOTS.glob("*.png"))
         terminalreporter.write_line(f"rtmu gui: {len(shots)} screenshots in {SCREENSHOTS}")
+
+
+def pytest_sessionfinish(session: pytest.Session, exitstatus: int) -> None:
+    """Leave only the screenshot folder behind (and not even that when it is empty)."""
+    shutil.rmtree(TMP_ROOT, ignore_errors=True)
+    if SCREENSHOTS.is_dir() and not any(SCREENSHOTS.iterdir()):
+        SCREENSHOTS.rmdir()
 
 
 @pytest.fixture(scope="session")

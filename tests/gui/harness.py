@@ -58,6 +58,14 @@ def on_display(name: str) -> Iterator[Gdk.Display]:
         display.close()
 
 
+def scratch_dir(prefix: str) -> Path:
+    """A new directory under the session's scratch root (conftest removes it at the end)."""
+    root = os.environ.get("RTMU_GUI_TMP")
+    if root:
+        Path(root).mkdir(parents=True, exist_ok=True)
+    return Path(tempfile.mkdtemp(prefix=prefix, dir=root))
+
+
 def pump(condition: Callable[[], bool], timeout: float = 5.0, what: str = "condition") -> None:
     """Run the GTK main loop until ``condition()`` is true; fail after ``timeout`` seconds."""
     ctx = GLib.MainContext.default()
@@ -91,7 +99,7 @@ class Gui:
     def start(
         cls, shots: Path, name: str, host: str, port: int, *, connect: bool = True, user: str | None = None
     ) -> Gui:
-        settings = Path(tempfile.mkdtemp(prefix="rtmu-gui-settings-")) / "settings.toml"
+        settings = scratch_dir("settings-") / "settings.toml"
         options = GuiOptions(
             host=host,
             port=port,
@@ -240,7 +248,7 @@ class Gui:
 
     def stage_pixels(self) -> np.ndarray:
         """The map stage as an (H, W, 3) uint8 array in its own coordinates."""
-        path = Path(tempfile.mkdtemp(prefix="rtmu-stage-")) / "stage.png"
+        path = scratch_dir("stage-") / "stage.png"
         self.render(self.stage, path)
         with Image.open(path) as img:
             return np.asarray(img.convert("RGB"))
