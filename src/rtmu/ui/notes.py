@@ -26,12 +26,12 @@ def map_note(conn: ConnectionState, m: MapModel) -> str:
     if phase is Phase.CONNECTING:
         return f"Connecting{where}…"
     if phase is Phase.RECONNECTING:
-        return "Link lost, reconnecting…: the robot shown is where it was last seen"
+        return "Link lost: the robot is shown where it was last seen"
     # Connected: the map's own state.
     if m.state == "loading":
         return f"Loading the map… ({m.received} packets)" if m.received else "Loading the map…"
     if m.state in ("none", "unsupported"):
-        return "Connected; the server has no map: the robot on a metric grid (scale at the top left)"
+        return "This server has no map: the robot on a metric grid (scale at the top left)"
     if m.state == "failed":
         return f"The map could not be loaded: {m.error or 'no reason given'}"
     if m.state == "unknown":
