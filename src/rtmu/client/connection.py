@@ -683,6 +683,24 @@ class AriaClient:
             if not transport.is_closing():
                 transport.abort()
 
+    async def flush(self, timeout: float = CLOSE_TIMEOUT) -> bool:
+        """Wait, at most ``timeout`` s, until everything sent has been handed to the kernel.
+
+        True when nothing is left in our buffer (``rtmu drive`` checks that its stop has left
+        before the process is suspended). Never raises.
+        """
+        writer = self._writer
+        if writer is None or writer.is_closing():
+            return False
+        loop = asyncio.get_running_loop()
+        deadline = loop.time() + timeout
+        with contextlib.suppress(TimeoutError, OSError):
+            async with asyncio.timeout_at(deadline):
+                await writer.drain()
+                while writer.transport.get_write_buffer_size() > 0:
+                    await asyncio.sleep(0.005)
+        return not writer.is_closing() and writer.transport.get_write_buffer_size() == 0
+
     async def disconnect(self) -> None:
         """Say goodbye and close within :data:`CLOSE_TIMEOUT` s. Safe to call twice, or unconnected."""
         if self._closing:

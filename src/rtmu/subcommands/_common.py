@@ -30,6 +30,7 @@ import asyncio
 import contextlib
 import contextvars
 import getpass
+import inspect
 import os
 import signal
 import sys
@@ -200,14 +201,19 @@ class Interrupts:
     ``signum`` is the first ending signal (None until one arrives). ``take()`` lets a command
     that caught the cancel carry on cleaning up (stop, print a last status) before it raises
     :class:`Interrupted`. ``on_suspend(hook)`` registers what must happen before Ctrl-Z
-    suspends the process (``rtmu drive`` stops the robot there).
+    suspends the process (``rtmu drive`` stops the robot and waits, briefly, until the stop
+    has left); ``end_on_resume`` makes the command end once the process runs again.
     """
 
     def __init__(self) -> None:
         self.signum: int | None = None
+        self.suspending = False
+        """True from Ctrl-Z until the process runs again: nothing may start motion meanwhile."""
         self._task: asyncio.Task[Any] | None = None
         self._loop: asyncio.AbstractEventLoop | None = None
-        self._suspend_hooks: list[Callable[[], None]] = []
+        self._suspend_hooks: list[Callable[[], Awaitable[Any] | None]] = []
+        self._end_on_resume = False
+        self._suspender: asyncio.Task[None] | None = None
 
     def install(self) -> None:
         """Handle the signals on the running loop, for the current task (call from that task)."""
@@ -217,7 +223,7 @@ class Interrupts:
             with contextlib.suppress(NotImplementedError, RuntimeError, ValueError):
                 self._loop.add_signal_handler(signum, self.interrupt, signum)
         with contextlib.suppress(NotImplementedError, RuntimeError, ValueError):
-            self._loop.add_signal_handler(signal.SIGTSTP, self._suspend)
+            self._loop.add_signal_handler(signal.SIGTSTP, self._on_tstp)
 
     def interrupt(self, signum: int) -> None:
         """End the command as if ``signum`` had arrived (a second signal cancels again)."""
@@ -234,23 +240,42 @@ class Interrupts:
             self._task.uncancel()
         return self.signum
 
-    def on_suspend(self, hook: Callable[[], None]) -> None:
+    def on_suspend(self, hook: Callable[[], Awaitable[Any] | None], *, end_on_resume: bool = False) -> None:
+        """Run ``hook`` (plain or async, bounded by :data:`SUSPEND_HOOK_TIMEOUT`) before Ctrl-Z suspends."""
         self._suspend_hooks.append(hook)
+        self._end_on_resume = self._end_on_resume or end_on_resume
 
-    def _suspend(self) -> None:
-        for hook in list(self._suspend_hooks):
-            try:
-                hook()
-            except Exception as exc:  # the suspension must happen anyway
-                print(f"rtmu: before suspending: {exc}", file=sys.stderr)
-        loop = self._loop
-        if loop is None:
+    def _on_tstp(self) -> None:
+        if self._loop is None or self.suspending:
             return
-        # Suspend for real: the default action, then handle Ctrl-Z again once resumed (fg/SIGCONT).
-        loop.remove_signal_handler(signal.SIGTSTP)
-        os.kill(os.getpid(), signal.SIGTSTP)
-        with contextlib.suppress(NotImplementedError, RuntimeError, ValueError):
-            loop.add_signal_handler(signal.SIGTSTP, self._suspend)
+        self.suspending = True
+        self._suspender = self._loop.create_task(self._suspend())
+
+    async def _suspend(self) -> None:
+        loop = self._loop
+        assert loop is not None
+        try:
+            for hook in list(self._suspend_hooks):
+                try:
+                    result = hook()
+                    if inspect.isawaitable(result):
+                        async with asyncio.timeout(SUSPEND_HOOK_TIMEOUT):
+                            await result
+                except Exception as exc:  # the suspension must happen anyway
+                    print(f"rtmu: before suspending: {exc or type(exc).__name__}", file=sys.stderr)
+            # Suspend for real (the default action); we are back here after fg / SIGCONT.
+            loop.remove_signal_handler(signal.SIGTSTP)
+            os.kill(os.getpid(), signal.SIGTSTP)
+            with contextlib.suppress(NotImplementedError, RuntimeError, ValueError):
+                loop.add_signal_handler(signal.SIGTSTP, self._on_tstp)
+        finally:
+            self.suspending = False
+        if self._end_on_resume:
+            self.interrupt(signal.SIGTSTP)
+
+
+SUSPEND_HOOK_TIMEOUT = 0.5
+"""At most this long for the suspend hooks (e.g. until a stop has left) before Ctrl-Z suspends."""
 
 
 _INTERRUPTS: contextvars.ContextVar[Interrupts | None] = contextvars.ContextVar(

@@ -19,8 +19,8 @@ from __future__ import annotations
 import argparse
 import asyncio
 import contextlib
-import signal
 import sys
+from collections.abc import Callable
 from typing import Any
 
 from ..cli import EXIT_OK
@@ -89,14 +89,16 @@ def handle(args: argparse.Namespace) -> int:
             print(f"before: {status_line(before)}", flush=True)
         interrupts = current_interrupts()
 
-        def before_suspending() -> None:
-            stop(client)  # Ctrl-Z: the robot must not drive on while the process sleeps
-            interrupts.interrupt(signal.SIGTSTP)  # and ``fg`` must not start it again
+        async def before_suspending() -> None:
+            stop(client)  # Ctrl-Z: the robot must not drive on while the process sleeps…
+            await client.flush()  # …so the stop must have left before it does
 
-        interrupts.on_suspend(before_suspending)
+        # ``fg`` ends the drive (stop, pose, exit 148) rather than starting the robot again.
+        interrupts.on_suspend(before_suspending, end_on_resume=True)
         signum: int | None = None
         try:
-            await drive(client, RatioDrive(args.trans, args.rot, args.throttle), args.seconds)
+            ratios = RatioDrive(args.trans, args.rot, args.throttle)
+            await drive(client, ratios, args.seconds, held=lambda: interrupts.suspending)
         except asyncio.CancelledError:
             signum = interrupts.take()
             if signum is None:
@@ -140,7 +142,10 @@ def report(
         print("after:  unknown (no status in time)", flush=True)
 
 
-async def drive(client: AriaClient, ratios: RatioDrive, seconds: float) -> None:
+async def drive(
+    client: AriaClient, ratios: RatioDrive, seconds: float, held: Callable[[], bool] = lambda: False
+) -> None:
+    """Resend ``ratios`` every :data:`RESEND` s for ``seconds``; nothing while ``held()`` (Ctrl-Z)."""
     loop = asyncio.get_running_loop()
     end = loop.time() + seconds
     next_send = loop.time()
@@ -149,7 +154,8 @@ async def drive(client: AriaClient, ratios: RatioDrive, seconds: float) -> None:
         if now >= end:
             return
         if now >= next_send:
-            client.send("ratioDrive", ratios)
+            if not held():
+                client.send("ratioDrive", ratios)
             next_send += RESEND
         if client.closed_error is not None:
             raise client.closed_error
