@@ -15,6 +15,7 @@ from rtmu.client.errors import (
     LoginRejected,
     NotSupported,
     ProtocolFault,
+    ReplyTooLarge,
     ServerClosed,
 )
 from rtmu.protocol.auth import UserTable
@@ -480,6 +481,45 @@ def test_requests_waiting_per_data_are_capped() -> None:
         for task in waiting:
             task.cancel()
         await asyncio.gather(*waiting, return_exceptions=True)
+        await client.disconnect()
+        await server.stop()
+
+    run(go())
+
+
+def test_a_reply_past_its_bound_is_refused_and_the_next_still_lines_up() -> None:
+    async def go() -> None:
+        server = TestServer()
+        await server.start()
+        client = await connected(server)
+        with pytest.raises(ReplyTooLarge, match="5 packets"):
+            await client.request_once("getMap", max_packets=5)
+        with pytest.raises(ReplyTooLarge, match="20 bytes"):
+            await client.request_once("getMap", max_bytes=20)
+        whole = await client.request_once("getMap")  # the refused replies were swallowed to their end
+        assert whole.payloads == tuple(text_map_packets(MAP_LINES))
+        await client.disconnect()
+        await server.stop()
+
+    run(go())
+
+
+def test_a_stream_holds_each_packet_once_and_bounds_what_is_unread() -> None:
+    async def go() -> None:
+        server = TestServer()
+        await server.start()
+        client = await connected(server)
+        number = client.datalist.number("getMap")
+        got = []
+        async for payload in client.stream("getMap"):
+            got.append(payload)
+            slot = client._pending[number][0] if client._pending[number] else None  # type: ignore[index]
+            assert slot is None or slot.payloads == []  # yielded packets are not kept a second time
+        assert got == text_map_packets(MAP_LINES)
+        with pytest.raises(ReplyTooLarge, match="3 packets of 'getMap' not read yet"):
+            async for _ in client.stream("getMap", max_packets=3):  # the map arrives faster than that
+                await client.request_once("getSafeDrive")  # a slow reader
+        assert (await client.request_once("getMap")).payloads == tuple(text_map_packets(MAP_LINES))
         await client.disconnect()
         await server.stop()
 

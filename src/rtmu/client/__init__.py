@@ -35,6 +35,7 @@ from .errors import (
     MalformedReply,
     NotSupported,
     ProtocolFault,
+    ReplyTooLarge,
     ServerClosed,
 )
 from .lease import DriveLease, DriveRatios, EndReason
@@ -57,6 +58,7 @@ __all__ = [
     "Packet",
     "ProtocolFault",
     "Reply",
+    "ReplyTooLarge",
     "ServerClosed",
     "Session",
     "SessionConfig",

@@ -53,6 +53,7 @@ from .errors import (
     MalformedReply,
     NotSupported,
     ProtocolFault,
+    ReplyTooLarge,
     ServerClosed,
 )
 
@@ -73,6 +74,10 @@ NOT_ARIA_AFTER = 4096
 (a real server's introduction is one small packet, sent at once)."""
 TEXT_BANNERS = (b"HTTP/", b"SSH-", b"RFB ", b"220 ", b"220-", b"+OK", b"* OK")
 """How other common servers open a connection: such a peer is reported at once, not after --timeout."""
+MAX_REPLY_PACKETS = 1_000_000
+"""Default bound on the packets of one collected reply (``request_once``) or of a stream's unread ones."""
+MAX_REPLY_BYTES = 64 << 20
+"""Default bound on the payload bytes of one collected reply, or of a stream's unread packets."""
 ABANDON_GRACE = 0.5
 """Seconds an abandoned request's slot waits quietly for a late reply before the reply counts as lost."""
 MAX_PENDING_PER_DATA = 64
@@ -218,6 +223,11 @@ class _Pending:
     stays so that a late reply still lines up with it, and swallows that reply's packets
     (to the data's own end marker) without keeping them. See the module notes for when an
     abandoned slot is dropped.
+
+    What the slot holds is bounded: a collected reply by ``max_packets``/``max_bytes`` in all,
+    a streamed one by the packets/bytes its reader has not taken yet (each payload is held
+    once: in the list, or in the stream's queue). Past a bound the waiter gets
+    :class:`ReplyTooLarge` and the slot swallows the rest of the reply.
     """
 
     __slots__ = (
@@ -226,19 +236,37 @@ class _Pending:
         "error",
         "fallback",
         "finished",
+        "held_bytes",
         "last_activity",
+        "max_bytes",
+        "max_packets",
+        "name",
         "payloads",
         "progress",
         "queue",
         "rule",
     )
 
-    def __init__(self, rule: _EndRule, streaming: bool, fallback: _EndRule | None = None) -> None:
+    def __init__(
+        self,
+        name: str,
+        rule: _EndRule,
+        streaming: bool,
+        fallback: _EndRule | None = None,
+        *,
+        max_packets: int = MAX_REPLY_PACKETS,
+        max_bytes: int = MAX_REPLY_BYTES,
+    ) -> None:
+        self.name = name
         self.rule = rule
         self.fallback = fallback or rule
         """Where the reply ends without the caller's own test (used once the caller is gone)."""
         self.payloads: list[bytes] = []
         self.count = 0
+        self.held_bytes = 0
+        """Bytes held for the waiter: all of them (collected), or those not read yet (streamed)."""
+        self.max_packets = max_packets
+        self.max_bytes = max_bytes
         self.queue: asyncio.Queue[bytes | None] | None = asyncio.Queue() if streaming else None
         self.progress = asyncio.Event()
         self.finished = False
@@ -259,13 +287,32 @@ class _Pending:
             return True
         self.count += 1
         self.finished = finished
-        self.payloads.append(payload)
+        self.held_bytes += len(payload)
         if self.queue is not None:
             self.queue.put_nowait(payload)
-            if self.finished:
+            held_packets = self.queue.qsize()
+            if finished:
                 self.queue.put_nowait(None)
+        else:
+            self.payloads.append(payload)
+            held_packets = len(self.payloads)
+        if not finished and (held_packets > self.max_packets or self.held_bytes > self.max_bytes):
+            self._overflow(held_packets > self.max_packets, now)
+            return False
         self.progress.set()
-        return self.finished
+        return finished
+
+    def taken(self, payload: bytes) -> None:
+        """A stream's reader took ``payload``: it is no longer held here."""
+        self.held_bytes -= len(payload)
+
+    def _overflow(self, by_count: bool, now: float) -> None:
+        limit = f"{self.max_packets} packets" if by_count else f"{self.max_bytes} bytes"
+        waiting = "not read yet" if self.queue is not None else "in one reply"
+        if self.queue is not None:
+            while not self.queue.empty():  # the reader gets the error next, not stale packets first
+                self.queue.get_nowait()
+        self.abandon(ReplyTooLarge(f"more than {limit} of {self.name!r} {waiting}; the rest is dropped"), now)
 
     def _swallow(self, payload: bytes, now: float) -> bool:
         self.last_activity = now
@@ -277,11 +324,11 @@ class _Pending:
         return done
 
     def abandon(self, error: ClientError, now: float) -> None:
-        """The waiter is gone: fail it, keep the slot for a late reply (see the class notes)."""
+        """The waiter is gone (or must stop waiting): fail it, keep the slot for the rest of the reply."""
         self.fail(error)
         self.abandoned_at = self.last_activity = now
         self.payloads = []
-        self.queue = None
+        self.held_bytes = 0
 
     def expired(self, now: float, grace: float) -> bool:
         return self.abandoned_at is not None and now - self.last_activity >= grace
@@ -493,6 +540,8 @@ class AriaClient:
         timeout: float = REPLY_TIMEOUT,
         expect: int | None = None,
         until: Callable[[bytes], bool] | None = None,
+        max_packets: int = MAX_REPLY_PACKETS,
+        max_bytes: int = MAX_REPLY_BYTES,
     ) -> Reply:
         """Run ``name`` once and await its reply.
 
@@ -502,9 +551,11 @@ class AriaClient:
         packets (``getSensorCurrent`` with n names); ``until(payload) -> bool`` lets the caller
         decide where the reply ends (e.g. a map assembler's ``feed``; a ``ProtocolError`` it
         raises fails the request with :class:`ProtocolFault`). Data that has no reply
-        (RETURN_NONE) is sent and an empty :class:`Reply` returned at once.
+        (RETURN_NONE) is sent and an empty :class:`Reply` returned at once. A reply longer
+        than ``max_packets`` packets or ``max_bytes`` payload bytes fails with
+        :class:`ReplyTooLarge` (for big maps use ``rtmu.client.mapload`` or :meth:`stream`).
         """
-        pending = self._start(name, args, expect, until, streaming=False)
+        pending = self._start(name, args, expect, until, False, max_packets, max_bytes)
         if pending is None:
             return Reply(name, (), self.clock())
         try:
@@ -534,17 +585,24 @@ class AriaClient:
         timeout: float = REPLY_TIMEOUT,
         expect: int | None = None,
         until: Callable[[bytes], bool] | None = None,
+        max_packets: int = MAX_REPLY_PACKETS,
+        max_bytes: int = MAX_REPLY_BYTES,
     ) -> AsyncIterator[bytes]:
-        """Like :meth:`request_once` but yields each payload as it arrives (progress for big maps)."""
-        pending = self._start(name, args, expect, until, streaming=True)
+        """Like :meth:`request_once` but yields each payload as it arrives (progress for big maps).
+
+        Nothing is kept after it is yielded; the bounds apply to packets received but not
+        read yet (a reader that falls that far behind gets :class:`ReplyTooLarge`).
+        """
+        pending = self._start(name, args, expect, until, True, max_packets, max_bytes)
         if pending is None:
             return
-        assert pending.queue is not None
+        queue = pending.queue
+        assert queue is not None
         try:
             while True:
                 try:
                     async with asyncio.timeout(timeout):
-                        payload = await pending.queue.get()
+                        payload = await queue.get()
                 except TimeoutError:
                     raise ClientTimeout(
                         f"{name!r} from {self.host}:{self.port} stalled for {timeout:g} s "
@@ -554,6 +612,7 @@ class AriaClient:
                     if pending.error is not None:
                         raise pending.error
                     return
+                pending.taken(payload)
                 yield payload
         finally:
             if not pending.finished:
@@ -566,6 +625,8 @@ class AriaClient:
         expect: int | None,
         until: Callable[[bytes], bool] | None,
         streaming: bool,
+        max_packets: int = MAX_REPLY_PACKETS,
+        max_bytes: int = MAX_REPLY_BYTES,
     ) -> _Pending | None:
         number = self._number(name)
         entry = self._conn.datalist.entry(number)  # type: ignore[union-attr]
@@ -585,7 +646,8 @@ class AriaClient:
                 f"{len(queue)} requests for {name!r} are already waiting for {self.host}:{self.port} "
                 "to answer; not sending more"
             )
-        pending = _Pending(rule, streaming, fallback=_end_rule(flags, name, expect, None))
+        fallback = _end_rule(flags, name, expect, None)
+        pending = _Pending(name, rule, streaming, fallback, max_packets=max_packets, max_bytes=max_bytes)
         queue.append(pending)
         self._conn.request_once(name, payload)  # type: ignore[union-attr]
         self._flush()

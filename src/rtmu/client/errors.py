@@ -75,6 +75,10 @@ class MalformedReply(ProtocolFault, ProtocolError):
     """
 
 
+class ReplyTooLarge(ProtocolFault):
+    """A reply went past the bound its caller set (packets or bytes); the rest of it was dropped."""
+
+
 class NotSupported(ClientError):
     """This server (or this user's permissions) does not offer the data a command needs."""
 
