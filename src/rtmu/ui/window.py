@@ -1,7 +1,9 @@
 """The main window: header bar, status toolbar, map ⇄ camera stack, banners, D-pad; the controller's View.
 
 The window wires widgets to the controller and the model and owns nothing
-else: no socket, no packet, no blocking call. Its two timers are the UI's
+else: no socket, no packet, no blocking call. A red STOP is always on screen:
+first in the header bar, and in the slim bar that replaces the header in full
+screen (``bars``). Its two timers are the UI's
 heartbeat: every :data:`rtmu.controller.TICK` it renews the drive lease
 (``controller.tick``) — if this loop ever stalls, the lease lapses and the
 network side stops the robot — and a slower one refreshes ages (stale values,
