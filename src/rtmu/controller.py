@@ -98,6 +98,9 @@ class ClientLink(Protocol):
 
     def set_safe_drive(self, on: bool) -> None: ...
 
+    # Optional (the controller looks for it with getattr): ``run_blocking(fn, done)`` runs ``fn``
+    # off the UI thread and posts ``done(result)`` back; keyring lookups go through it.
+
 
 class SecretStore(Protocol):
     """Where remembered passwords live (``rtmu.settings`` provides the keyring-backed one)."""
@@ -140,6 +143,8 @@ class Controller:
         """Keys that were held when motion was stopped for them; ignored until released."""
         self._generation: int | None = None
         self._states: dict[str, CommandState] = {}
+        self._lookup_pending = False
+        """A keyring lookup runs off the UI thread; connect() waits for its answer."""
         link.on_notice = self._on_link_notice
         model.connection.observe(self._on_connection)
         model.health.observe(self._on_health)
@@ -332,17 +337,47 @@ class Controller:
         )
 
     def connect(self, password: str | None = None) -> None:
-        """Connect with the current profile; asks the view for the password when none is known."""
+        """Connect with the current profile; asks the view for the password when none is known.
+
+        A remembered password is looked up off the UI thread (a keyring may block on D-Bus or
+        an unlock prompt) when the link offers ``run_blocking``; the connection starts when
+        the answer comes back, unless the profile changed meanwhile.
+        """
         profile = self.profile
-        if self.model.connection.value.phase in (Phase.CONNECTING, Phase.CONNECTED, Phase.RECONNECTING):
+        if self._busy_connecting():
             return
         if password is None and profile.user:
             if profile.remember_password and self.secrets is not None:
-                password = self.secrets.get(profile)
-            if password is None:
-                self.view.ask_password(profile, self._password_answered)
+                self._look_up_password(profile, self.secrets)
                 return
+            self.view.ask_password(profile, self._password_answered)
+            return
         self._start_connect(password or "")
+
+    def _busy_connecting(self) -> bool:
+        phase = self.model.connection.value.phase
+        return self._lookup_pending or phase in (Phase.CONNECTING, Phase.CONNECTED, Phase.RECONNECTING)
+
+    def _look_up_password(self, profile: Profile, secrets: SecretStore) -> None:
+        run_blocking = getattr(self.link, "run_blocking", None)
+        if run_blocking is None:  # a link without a worker: look it up here
+            self._password_found(profile, secrets.get(profile))
+            return
+        self._lookup_pending = True
+
+        def found(password: str | None) -> None:
+            self._lookup_pending = False
+            self._password_found(profile, password)
+
+        run_blocking(lambda: secrets.get(profile), found)
+
+    def _password_found(self, profile: Profile, password: str | None) -> None:
+        if profile != self.profile or self._busy_connecting():
+            return  # another profile was chosen, or a connection started, while we looked
+        if password is None:
+            self.view.ask_password(profile, self._password_answered)
+            return
+        self._start_connect(password)
 
     def _password_answered(self, password: str | None) -> None:
         if password is None:

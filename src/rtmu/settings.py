@@ -23,8 +23,13 @@ writer library is needed), atomically, readable by the user only.
 Rules:
 
 * A password is **never** written to this file. With ``remember_password`` it
-  goes to the desktop keyring (the optional ``keyring`` package, service
-  ``rtmu``); when no keyring is usable, the operator is asked at connect time.
+  goes to the desktop keyring (the ``keyring`` package, service ``rtmu``) —
+  but only to a backend that keeps it encrypted (Secret Service, libsecret,
+  KWallet, macOS Keychain, Windows Vault). Plain-text or file backends
+  (``keyrings.alt`` and the like) are refused: then, as with no keyring at all,
+  the operator is asked at connect time.
+* A keyring call may block (D-Bus, an unlock prompt): the controller makes it
+  off the UI thread when the link offers ``run_blocking``.
 * A corrupt or foreign file never crashes RTMU: :func:`load_settings` returns
   the defaults plus **one** warning, and moves the bad file aside
   (``settings.toml.bad-<timestamp>``) so it is kept, not overwritten.
@@ -321,11 +326,12 @@ def _toml_string(text: str) -> str:
 
 
 class KeyringSecrets:
-    """Passwords in the desktop keyring via the optional ``keyring`` package.
+    """Passwords in the desktop keyring via the ``keyring`` package.
 
-    ``available`` is False when the package is missing or has no usable backend
-    (no Secret Service on this desktop): then nothing is stored and the
-    operator is asked for the password at connect time.
+    ``available`` is False when the package is missing or has no secure backend
+    (no Secret Service on this desktop, or only a plain-text one): then nothing
+    is stored and the operator is asked for the password at connect time.
+    Calls may block (D-Bus): make them off the UI thread.
     """
 
     def __init__(self, backend: Any | None = None) -> None:
@@ -362,6 +368,36 @@ class KeyringSecrets:
             self._keyring.delete_password(KEYRING_SERVICE, profile.keyring_user)
 
 
+_PLACEHOLDERS = ("keyring.backends.fail", "keyring.backends.null", "keyring.backends.chainer")
+_INSECURE_WORDS = ("plaintext", "insecure", "unencrypted", "uncrypted", "file")
+
+
+def is_secure_backend(backend: object) -> bool:
+    """True for the keyring package's own encrypted stores (Secret Service, KWallet, Keychain…).
+
+    Everything else is refused: ``keyrings.alt`` (``PlaintextKeyring`` writes passwords to a
+    file in plain text; its "encrypted" file asks for a master password on the terminal),
+    unknown third-party backends, and keyring's "no backend" placeholders.
+    """
+    cls = type(backend)
+    module, name = cls.__module__, cls.__name__.lower()
+    if not module.startswith("keyring.backends.") or module.startswith(_PLACEHOLDERS):
+        return False
+    return not any(word in name for word in _INSECURE_WORDS)
+
+
+def choose_backend(backend: Any) -> Any | None:
+    """The backend to use from what ``keyring.get_keyring()`` returned, or None if none is safe.
+
+    A chain (several backends installed) is reduced to its best secure member, so a set
+    can never fall through to a plain-text store.
+    """
+    if type(backend).__module__.startswith("keyring.backends.chainer"):
+        members = getattr(backend, "backends", ())
+        return next((b for b in members if is_secure_backend(b)), None)
+    return backend if is_secure_backend(backend) else None
+
+
 def _load_keyring() -> Any | None:
     try:
         import keyring  # type: ignore[import-not-found]
@@ -371,7 +407,11 @@ def _load_keyring() -> Any | None:
         backend = keyring.get_keyring()
     except Exception:
         return None
-    module = type(backend).__module__
-    if module.startswith(("keyring.backends.fail", "keyring.backends.null")):
-        return None  # keyring's "no backend" placeholders
-    return keyring
+    chosen = choose_backend(backend)
+    if chosen is None and not type(backend).__module__.startswith(
+        ("keyring.backends.fail", "keyring.backends.null")
+    ):
+        log.warning(
+            "not using the keyring backend %s: it does not keep passwords encrypted", type(backend).__name__
+        )
+    return chosen

@@ -41,6 +41,7 @@ class RecordingLink:
         self.lease = DriveLease(clock=clock)
         self.on_notice: Callable[[str, str], None] | None = None
         self.calls: list[tuple[object, ...]] = []
+        self.blocking: list[tuple[Callable[[], object], Callable[[object], None]]] = []
 
     def connect(self, host: str, port: int, user: str = "", password: str = "", **kw: object) -> None:
         self.calls.append(("connect", host, port, user, password, kw.get("profile")))
@@ -59,6 +60,30 @@ class RecordingLink:
 
     def set_safe_drive(self, on: bool) -> None:
         self.calls.append(("set_safe_drive", on))
+
+    def run_blocking(self, fn: Callable[[], object], done: Callable[[object], None]) -> None:
+        """Like the runner: ``fn`` must not run on the UI (test) thread; :meth:`finish_blocking` runs it."""
+        self.calls.append(("run_blocking",))
+        self.blocking.append((fn, done))
+
+    def finish_blocking(self) -> list[int]:
+        """Run the pending blocking calls on another thread, then deliver the answers here."""
+        import threading
+
+        ran: list[int] = []
+        jobs, self.blocking = self.blocking, []
+        for fn, done in jobs:
+            result: list[object] = []
+
+            def work(fn: Callable[[], object] = fn, result: list[object] = result) -> None:
+                ran.append(threading.get_ident())
+                result.append(fn())
+
+            worker = threading.Thread(target=work)
+            worker.start()
+            worker.join(5)
+            done(result[0] if result else None)
+        return ran
 
     def names(self) -> list[object]:
         return [c[0] for c in self.calls]

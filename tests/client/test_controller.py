@@ -2,6 +2,8 @@
 
 from __future__ import annotations
 
+import threading
+
 import pytest
 
 from rtmu.client.lease import DriveRatios, EndReason
@@ -227,14 +229,46 @@ def test_connect_asks_for_the_password_and_uses_the_keyring_when_remembered() ->
     assert rig.view.texts()[-1] == "Connection cancelled"
 
     class Keyring:
+        def __init__(self, answer: str | None) -> None:
+            self.answer = answer
+            self.threads: list[int] = []
+
         def get(self, profile: Profile) -> str | None:
-            return "fromkeyring"
+            self.threads.append(threading.get_ident())
+            return self.answer
 
     rig2 = Rig(connected=False)
-    rig2.ctl.secrets = Keyring()
+    keyring = Keyring("fromkeyring")
+    rig2.ctl.secrets = keyring
     rig2.ctl.select_profile(Profile("lab", "h", 1, user="alice", remember_password=True))
     rig2.ctl.connect()
+    rig2.ctl.connect()  # a second click while the lookup runs: still one lookup
+    assert keyring.threads == [] and rig2.link.names() == ["run_blocking"]  # not on the UI thread
+    rig2.link.finish_blocking()
+    assert keyring.threads and threading.get_ident() not in keyring.threads
     assert rig2.link.calls[-1][4] == "fromkeyring" and rig2.view.password_asks == []
+    # Nothing remembered: the operator is asked, once the (background) answer is in.
+    rig3 = Rig(connected=False)
+    rig3.ctl.secrets = Keyring(None)
+    rig3.ctl.select_profile(Profile("lab", "h", 1, user="alice", remember_password=True))
+    rig3.ctl.connect()
+    assert rig3.view.password_asks == []
+    rig3.link.finish_blocking()
+    assert len(rig3.view.password_asks) == 1
+
+
+def test_a_keyring_answer_for_a_profile_left_meanwhile_is_dropped() -> None:
+    class Keyring:
+        def get(self, profile: Profile) -> str | None:
+            return "old"
+
+    rig = Rig(connected=False)
+    rig.ctl.secrets = Keyring()
+    rig.ctl.select_profile(Profile("lab", "h", 1, user="alice", remember_password=True))
+    rig.ctl.connect()
+    rig.ctl.select_profile(Profile("other", "h2", 1, user="bob"))
+    rig.link.finish_blocking()
+    assert "connect" not in rig.link.names()
 
 
 def test_disconnect_stops_first() -> None:

@@ -307,3 +307,26 @@ def test_connecting_again_while_driving_stops_the_robot_on_the_old_link_first(se
         assert not any(r.name == "ratioDrive" for r in server.received if r.side == 1)  # nothing resumed
     finally:
         runner.close()
+
+
+def test_run_blocking_runs_off_the_ui_and_network_threads_and_answers_on_the_ui_thread() -> None:
+    import threading
+
+    model, ui = Model(), UiQueue()
+    with ClientRunner(model, post=ui.post) as runner:
+        ran_on: list[int] = []
+        answers: list[tuple[object, int]] = []
+
+        def lookup() -> str:
+            ran_on.append(threading.get_ident())
+            return "secret1"
+
+        def failing() -> str:
+            raise RuntimeError("the keyring is locked")
+
+        runner.run_blocking(lookup, lambda r: answers.append((r, threading.get_ident())))
+        runner.run_blocking(failing, lambda r: answers.append((r, threading.get_ident())))
+        ui.wait_for(lambda: len(answers) == 2)
+        network = runner._thread.ident
+        assert ran_on and ran_on[0] not in (threading.get_ident(), network)
+        assert answers == [("secret1", threading.get_ident()), (None, threading.get_ident())]

@@ -12,8 +12,10 @@ from rtmu.settings import (
     KeyringSecrets,
     Profile,
     Settings,
+    choose_backend,
     config_dir,
     format_settings,
+    is_secure_backend,
     load_settings,
     parse_settings,
     save_settings,
@@ -137,3 +139,35 @@ def test_without_a_keyring_nothing_is_stored_and_the_operator_is_asked() -> None
         pytest.skip("a real keyring is installed here")
     p = Profile("lab", user="alice", remember_password=True)
     assert secrets.get(p) is None and secrets.set(p, "x") is False
+
+
+def _backend(module: str, name: str) -> object:
+    """An object whose class looks like keyring backend ``module.name``."""
+    cls = type(name, (MemoryKeyring,), {"__module__": module})
+    return cls()
+
+
+def test_only_encrypted_keyring_backends_are_used(monkeypatch: pytest.MonkeyPatch) -> None:
+    plaintext = _backend("keyrings.alt.file", "PlaintextKeyring")
+    encrypted_file = _backend("keyrings.alt.file", "EncryptedKeyring")
+    secret_service = _backend("keyring.backends.SecretService", "Keyring")
+    assert is_secure_backend(secret_service)
+    assert is_secure_backend(_backend("keyring.backends.kwallet", "DBusKeyring"))
+    for bad in (plaintext, encrypted_file, _backend("keyring.backends.fail", "Keyring"),
+                _backend("some.thirdparty", "Keyring")):  # fmt: skip
+        assert not is_secure_backend(bad) and choose_backend(bad) is None
+    chain = _backend("keyring.backends.chainer", "ChainerBackend")
+    chain.backends = [plaintext, secret_service]  # type: ignore[attr-defined]
+    assert choose_backend(chain) is secret_service  # a set can never fall through to plain text
+    chain.backends = [plaintext]  # type: ignore[attr-defined]
+    assert choose_backend(chain) is None
+    # As the settings load it: a plain-text default backend means "no keyring".
+    import keyring
+
+    monkeypatch.setattr(keyring, "get_keyring", lambda: plaintext)
+    secrets = KeyringSecrets()
+    assert not secrets.available
+    assert secrets.set(Profile("lab", user="alice", remember_password=True), "secret1") is False
+    assert plaintext.store == {}  # type: ignore[attr-defined]
+    monkeypatch.setattr(keyring, "get_keyring", lambda: secret_service)
+    assert KeyringSecrets().available

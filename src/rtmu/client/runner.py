@@ -80,6 +80,8 @@ class ClientRunner:
         self._thread = threading.Thread(target=self._run, name="rtmu-network", daemon=True)
         self._ready = threading.Event()
         self._closed = False
+        self._blocking = concurrent.futures.ThreadPoolExecutor(1, thread_name_prefix="rtmu-blocking")
+        """One worker for :meth:`run_blocking` (keyring calls), apart from the network loop."""
 
     # -- lifecycle ---------------------------------------------------------------------------
     def start(self) -> ClientRunner:
@@ -114,6 +116,7 @@ class ClientRunner:
         """Stop the robot, disconnect, end the thread. Idempotent; returns within ``timeout``."""
         if self._closed or not self._thread.is_alive():
             self._closed = True
+            self._blocking.shutdown(wait=False, cancel_futures=True)
             return
         self._closed = True
         self.lease.on_change = None
@@ -121,6 +124,7 @@ class ClientRunner:
             self.submit(self._session.close).result(timeout)
         self.loop.call_soon_threadsafe(self.loop.stop)
         self._thread.join(timeout)
+        self._blocking.shutdown(wait=False, cancel_futures=True)
 
     @property
     def _session(self) -> Session:
@@ -237,6 +241,38 @@ class ClientRunner:
 
     def load_map(self) -> concurrent.futures.Future[Any]:
         return self._fire(self._session.load_map)
+
+    def run_blocking(
+        self, fn: Callable[[], T], done: Callable[[T | None], None], *, timeout: float = 30.0
+    ) -> concurrent.futures.Future[T]:
+        """Run a call that may block (a keyring lookup: D-Bus, an unlock prompt) off the UI thread.
+
+        ``fn`` runs in a worker thread — neither the UI thread nor the network loop, which must
+        keep its timing — and ``done(result)`` is then posted to the UI thread; ``done(None)``
+        if ``fn`` raised or took longer than ``timeout`` s.
+        """
+        future: concurrent.futures.Future[T] = self._blocking.submit(fn)
+        answered = threading.Event()
+
+        def deliver(result: T | None) -> None:
+            if not answered.is_set():
+                answered.set()
+                self.post(lambda: done(result))
+
+        def finished(f: concurrent.futures.Future[T]) -> None:
+            if f.cancelled() or f.exception() is not None:
+                if f.exception() is not None:
+                    log.warning("background call failed: %s", f.exception())
+                deliver(None)
+            else:
+                deliver(f.result())
+
+        future.add_done_callback(finished)
+        timer = threading.Timer(timeout, lambda: deliver(None))
+        timer.daemon = True
+        timer.start()
+        future.add_done_callback(lambda f: timer.cancel())
+        return future
 
     def subscribe(self, name: str, interval_ms: int, handler: Callable[[Packet], None]) -> None:
         """An extra subscription (restored after reconnects); ``handler`` runs on the network thread."""
