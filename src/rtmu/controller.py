@@ -18,7 +18,12 @@ Driving rules
 * Focus loss, disconnect, a stale or lost link, and a lapsed lease (the UI froze
   for more than 300 ms) stop the robot. Keys still held at that moment are
   *blocked* until released: the robot stays still until a fresh key press —
-  also after a reconnect.
+  also after a reconnect, and also after focus comes back: a key held through
+  the focus loss auto-repeats as presses, which must not restart motion. While
+  the window is unfocused no real key release can arrive, so releases then
+  (a window "releasing everything" on focus loss) do not unblock; the first
+  press after focus returns marks the window focused again (a key released
+  while unfocused therefore needs one press to clear it, then a fresh press).
 * Speed: 10…100 % in 10 % steps; it is the ``ratioDrive`` throttle and applies at
   once to a drive in progress.
 """
@@ -145,6 +150,8 @@ class Controller:
         self._states: dict[str, CommandState] = {}
         self._lookup_pending = False
         """A keyring lookup runs off the UI thread; connect() waits for its answer."""
+        self._unfocused = False
+        """Between focus loss and the next key press: releases seen then are not real key-ups."""
         link.on_notice = self._on_link_notice
         model.connection.observe(self._on_connection)
         model.health.observe(self._on_health)
@@ -202,6 +209,7 @@ class Controller:
     def press(self, direction: str) -> None:
         if direction not in DIRECTIONS:
             raise ValueError(f"unknown direction {direction!r}")
+        self._unfocused = False  # key presses reach a focused window only
         if direction in self._held or direction in self._blocked:
             return  # key auto-repeat, or a key held through a stop: wait for its release
         if not self.connected or not self.supports("ratioDrive"):
@@ -211,7 +219,8 @@ class Controller:
         self._apply()
 
     def release(self, direction: str) -> None:
-        self._blocked.discard(direction)
+        if not self._unfocused:  # a real key-up: the key may drive again on its next press
+            self._blocked.discard(direction)
         if direction not in self._held:
             return
         self._held.discard(direction)
@@ -261,10 +270,20 @@ class Controller:
             self.link.stop()
 
     def focus_lost(self) -> None:
-        """The window lost keyboard focus: key releases may never arrive, so stop."""
+        """The window lost keyboard focus: key releases may never arrive, so stop.
+
+        Keys held now stay blocked until a real release is seen after focus returns (see the
+        module notes): auto-repeat of a key held all along must not start the robot again.
+        """
         if self._held or self._generation is not None:
             self.stop()
-        self._blocked.clear()  # no key can be "still held" once focus is gone
+        self._blocked |= self._held
+        self._held.clear()
+        self._unfocused = True
+
+    def focus_gained(self) -> None:
+        """The window has the keyboard again: releases from now on are real (optional for a view)."""
+        self._unfocused = False
 
     # -- speed -------------------------------------------------------------------------------
     def speed_up(self) -> None:

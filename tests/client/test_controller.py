@@ -116,7 +116,32 @@ def test_focus_loss_stops() -> None:
     rig.ctl.press("left")
     rig.ctl.focus_lost()
     assert "stop" in rig.link.names() and not rig.lease.live
-    rig.ctl.press("left")  # focus is back and the key is pressed anew
+    rig.ctl.press("right")  # another key, pressed after focus came back, drives at once
+    assert rig.lease.live
+
+
+def test_a_key_held_through_focus_loss_stays_blocked_until_its_release_is_seen() -> None:
+    rig = Rig()
+    rig.ctl.press("forward")
+    rig.ctl.focus_lost()
+    rig.ctl.release("forward")  # the window forgets its held keys on focus loss: not a real key-up
+    assert not rig.lease.live
+    rig.ctl.press("forward")  # focus is back; the key, held all along, auto-repeats
+    rig.hold(0.5)
+    rig.ctl.press("forward")
+    assert not rig.lease.live and rig.ctl.held == frozenset()
+    rig.ctl.release("forward")  # the real key-up
+    rig.ctl.press("forward")  # a fresh press drives
+    assert rig.lease.live
+
+
+def test_focus_gained_makes_releases_real_again() -> None:
+    rig = Rig()
+    rig.ctl.press("forward")
+    rig.ctl.focus_lost()
+    rig.ctl.focus_gained()
+    rig.ctl.release("forward")
+    rig.ctl.press("forward")
     assert rig.lease.live
 
 
