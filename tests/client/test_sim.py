@@ -180,3 +180,25 @@ def test_wrong_password_against_the_simulator(tmp_path: Path) -> None:
             await client.disconnect()
 
     run(go())
+
+
+@pytest.mark.parametrize("how", ["disconnect", "close"])
+def test_disconnect_and_close_while_driving_send_zero_ratios_and_stop(how: str) -> None:
+    """On a manual-clock simulator, so only our own stop can stop it (its watchdog never runs)."""
+    with SimThread(sim_config(realtime=False)) as sim:
+        clock = FakeClock()
+        runner, _model, _ui = connected_runner(sim.port, clock=clock, fetch_map=False)
+        try:
+            runner.lease.grant(DriveRatios(100, 0, 50))
+            runner.sync()
+            eventually(lambda: sim.snapshot().trans_ratio == 100)
+            if how == "disconnect":
+                runner.disconnect().result(5)
+            else:
+                runner.close()
+            eventually(lambda: sim.snapshot().mode_name == "stop")
+            snap = sim.snapshot()
+            assert snap.trans_ratio == 0 and snap.watchdog_stops == 0
+            assert sim.call(lambda: sim.server.robot.received_ratios)[:3] == (0.0, 0.0, 0.0)  # type: ignore[union-attr]
+        finally:
+            runner.close()

@@ -120,8 +120,8 @@ class ClientRunner:
             return
         self._closed = True
         self.lease.on_change = None
-        with contextlib.suppress(Exception):
-            self.submit(self._session.close).result(timeout)
+        with contextlib.suppress(Exception):  # on the loop even though submit() now refuses work
+            self._on_loop(self._session.close).result(timeout)
         self.loop.call_soon_threadsafe(self.loop.stop)
         self._thread.join(timeout)
         self._blocking.shutdown(wait=False, cancel_futures=True)
@@ -138,7 +138,9 @@ class ClientRunner:
             failed: concurrent.futures.Future[T] = concurrent.futures.Future()
             failed.set_exception(ClientError("the client has been closed"))
             return failed
+        return self._on_loop(fn, *args)
 
+    def _on_loop(self, fn: Callable[..., Awaitable[T] | T], *args: Any) -> concurrent.futures.Future[T]:
         async def run() -> T:
             result = fn(*args)
             if asyncio.iscoroutine(result) or isinstance(result, asyncio.Future):

@@ -174,8 +174,8 @@ class Session:
         """
         self._cancel_connecting()
         self._connecting = asyncio.current_task()
-        if self.connected:
-            self._send_stop()  # connecting again (another profile) while driving: stop on the old link first
+        if self.connected:  # connecting again (another profile) while driving: stop on the old link first
+            self._send_stop()
         self.lease.end(EndReason.DISCONNECTED)
         await self._drop_client()
         self._cancel_reconnect()
