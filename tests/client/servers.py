@@ -170,6 +170,9 @@ class TestServer:
         self.hearing = asyncio.Event()
         """Cleared by :meth:`stop_reading`: the server keeps sending but reads nothing more."""
         self.hearing.set()
+        self.admitting = asyncio.Event()
+        """Cleared by :meth:`hold_logins`: new connections wait before the server says a word."""
+        self.admitting.set()
         self.on_once: Callable[[ServerSide, str, bytes], None] | None = None
 
     def _set_safe(self, side: ServerSide, args: bytes) -> Reply:
@@ -201,8 +204,15 @@ class TestServer:
     def resume_reading(self) -> None:
         self._loop.call_soon_threadsafe(self.hearing.set)
 
+    def hold_logins(self) -> None:
+        """New connections are accepted but wait (no introduction) until :meth:`admit_logins`."""
+        self._loop.call_soon_threadsafe(self.admitting.clear)
+
+    def admit_logins(self) -> None:
+        self._loop.call_soon_threadsafe(self.admitting.set)
+
     def kill(self, side: ServerSide) -> None:
-        """Drop a connection abruptly (no SHUTDOWN), like a crashed server."""
+        """Drop a connection abruptly (no SHUTDOWN), like a crashed server. Server loop only."""
         for task in side.subs.values():
             task.cancel()
         side.writer.transport.abort()
@@ -217,6 +227,7 @@ class TestServer:
             if self.silent:
                 await reader.read()  # until the client goes away
                 return
+            await self.admitting.wait()
             writer.write(side.conn.data_to_send())
             while True:
                 await self.hearing.wait()

@@ -330,3 +330,25 @@ def test_run_blocking_runs_off_the_ui_and_network_threads_and_answers_on_the_ui_
         network = runner._thread.ident
         assert ran_on and ran_on[0] not in (threading.get_ident(), network)
         assert answers == [("secret1", threading.get_ident()), (None, threading.get_ident())]
+
+
+def test_a_lease_granted_while_reconnecting_is_ended_when_the_link_comes_back() -> None:
+    clock = FakeClock()  # the grant stays "fresh" for as long as the test likes
+    thread = ServerThread(TestServer())
+    with thread as server:
+        runner, model, ui = start(server, clock=clock, backoff=lambda: Backoff(initial=0.01, jitter=0.0))
+        try:
+            server.hold_logins()
+            thread.call(lambda: server.kill(server.sides[0]))
+            ui.wait_for(lambda: model.connection.value.phase is Phase.RECONNECTING)
+            eventually(lambda: len(server.sides) == 2)  # the next attempt waits at the server's door
+            runner.lease.grant(DriveRatios(100, 0, 50))  # a grant slips in meanwhile (no controller)
+            runner.sync()
+            server.admit_logins()
+            ui.wait_for(lambda: model.connection.value.phase is Phase.CONNECTED)
+            runner.sync()
+            runner.call(lambda: runner.session.client.request_once("getSafeDrive"))  # type: ignore[union-attr]
+            assert not [r for r in server.received if r.side == 1 and r.name == "ratioDrive"]
+            assert runner.lease.renew() is False
+        finally:
+            runner.close()
