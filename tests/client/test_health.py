@@ -48,8 +48,19 @@ def test_backoff_grows_caps_and_resets() -> None:
     assert [b.next_delay() for _ in range(6)] == [0.5, 1, 2, 4, 4, 4]
     b.reset()
     assert b.next_delay() == 0.5
-    j = Backoff(jitter=0.2, rng=random.Random(1))
-    assert all(0.4 <= j.next_delay() <= 0.6 for _ in range(1)) and j.attempt == 1
+
+
+def test_backoff_jitter_stays_within_its_spread_and_really_spreads() -> None:
+    rng = random.Random(7)
+    for attempt, base in enumerate([0.5, 1.0, 2.0, 4.0, 8.0, 10.0, 10.0]):
+        delays = []
+        for _ in range(500):
+            b = Backoff(initial=0.5, factor=2, maximum=10, jitter=0.2, rng=rng, attempt=attempt)
+            delays.append(b.next_delay())
+            assert b.attempt == attempt + 1
+        assert all(base * 0.8 <= d <= base * 1.2 for d in delays)
+        assert min(delays) < base * 0.9 and max(delays) > base * 1.1  # spread over the range
+        assert len(set(delays)) > 400  # not one value repeated
 
 
 def test_only_healable_failures_are_retried() -> None:

@@ -34,6 +34,32 @@ def server():  # type: ignore[no-untyped-def]
         yield srv
 
 
+def round_trip(runner: ClientRunner) -> None:
+    """One request answered: what either side sent before it has now been read by the other."""
+    runner.call(lambda: runner.session.client.request_once("getSafeDrive"))  # type: ignore[union-attr]
+
+
+def dry_up_status(runner: ClientRunner, server: TestServer) -> None:
+    """Stop the status stream (TCP stays up) and wait until no status is still on its way."""
+    asked: list[int] = []
+    server.handlers["updateNumbers"] = lambda s, a: asked.append(1)  # type: ignore[func-returns-value]
+    eventually(lambda: bool(asked))  # the server's periodic task now sends nothing
+    round_trip(runner)
+
+
+def count_statuses(server: TestServer) -> list[int]:
+    """Count the statuses the server sends from now on (same content as before)."""
+    sent: list[int] = []
+    answer = server.handlers["updateNumbers"]
+
+    def counting(side: ServerSide, args: bytes) -> list[bytes] | None:
+        sent.append(1)
+        return answer(side, args)
+
+    server.handlers["updateNumbers"] = counting
+    return sent
+
+
 def start(server: TestServer, clock=None, **config):  # type: ignore[no-untyped-def]
     model, ui = Model(), UiQueue()
     runner = ClientRunner(model, post=ui.post, clock=clock or time.monotonic, config=SessionConfig(**config))
@@ -62,14 +88,17 @@ def test_connect_fills_the_model(server: TestServer) -> None:
 
 
 def test_observers_hear_only_real_changes(server: TestServer) -> None:
-    runner, model, ui = start(server)
+    runner, model, ui = start(server, status_interval_ms=20)
     try:
         ui.wait_for(
             lambda: model.robot.value.battery_low is not None and model.robot.value.safe_drive is not None
         )
         changes: list[str] = []
         model.robot.observe(lambda old, new: changes.append("robot"))
-        time.sleep(0.5)  # five identical statuses
+        sent = count_statuses(server)
+        eventually(lambda: len(sent) >= 5)  # five identical statuses…
+        round_trip(runner)  # …all read by the client
+        runner.sync()
         ui.drain()
         assert changes == []
         server.state["x"] = 1234
@@ -119,8 +148,7 @@ def test_stale_status_stops_the_robot_even_while_the_lease_is_renewed(server: Te
     try:
         runner.lease.grant(DriveRatios(100, 0, 50))
         runner.sync()
-        server.handlers["updateNumbers"] = lambda s, a: None  # the status stream dries up
-        time.sleep(0.15)
+        dry_up_status(runner, server)
         for _ in range(4):
             clock.advance(0.1)
             runner.lease.renew()
@@ -136,8 +164,7 @@ def test_stop_is_sent_even_when_the_link_looks_stale(server: TestServer) -> None
     clock = FakeClock()
     runner, model, ui = start(server, clock=clock)
     try:
-        server.handlers["updateNumbers"] = lambda s, a: None
-        time.sleep(0.15)
+        dry_up_status(runner, server)
         clock.advance(1.0)
         runner.sync()
         ui.wait_for(lambda: model.health.value.level is LinkLevel.STALE)
@@ -149,12 +176,10 @@ def test_stop_is_sent_even_when_the_link_looks_stale(server: TestServer) -> None
         runner.close()
 
 
-def test_disconnect_is_instant_and_clears_the_model(server: TestServer) -> None:
+def test_disconnect_clears_the_model(server: TestServer) -> None:
     runner, model, ui = start(server)
     try:
-        t0 = time.monotonic()
-        runner.disconnect().result(2)
-        assert time.monotonic() - t0 < 0.5
+        runner.disconnect().result(5)
         ui.wait_for(lambda: model.connection.value.phase is Phase.DISCONNECTED)
         assert model.robot.value.status == ""
         assert model.health.value.level is LinkLevel.DOWN
@@ -180,8 +205,7 @@ def test_lost_link_reconnects_and_comes_back_without_motion(server: TestServer) 
         runner.sync()
         seen: list[tuple[Phase, str]] = []
         model.connection.observe(lambda old, new: seen.append((new.phase, new.error)))
-        server.handlers["updateNumbers"] = lambda s, a: None  # TCP stays up, the status stops
-        time.sleep(0.15)
+        dry_up_status(runner, server)  # TCP stays up, the status stops
         clock.advance(2.5)
         runner.sync()
         ui.wait_for(lambda: any(p is Phase.RECONNECTING and "no status" in e for p, e in seen))
@@ -190,25 +214,27 @@ def test_lost_link_reconnects_and_comes_back_without_motion(server: TestServer) 
         drives = len(ratio_drives(server))
         assert runner.lease.renew() is False
         runner.sync()
-        time.sleep(0.05)
+        round_trip(runner)  # anything the heart sent has reached the server by now
         assert len(ratio_drives(server)) == drives  # nothing resumed
     finally:
         runner.close()
 
 
-def test_disconnect_while_logging_in_cancels_at_once() -> None:
+def test_disconnect_while_logging_in_cancels_the_attempt() -> None:
     model, ui = Model(), UiQueue()
-    with ServerThread(TestServer(silent=True)) as server, ClientRunner(model, post=ui.post) as runner:
+    config = SessionConfig(connect_timeout=600)  # only a cancel can end this attempt during the test
+    with (
+        ServerThread(TestServer(silent=True)) as server,
+        ClientRunner(model, post=ui.post, config=config) as runner,
+    ):
         attempt = runner.connect("127.0.0.1", server.port)
         ui.wait_for(lambda: model.connection.value.phase is Phase.CONNECTING)
-        t0 = time.monotonic()
-        runner.disconnect().result(2)
-        assert time.monotonic() - t0 < 0.5
+        runner.disconnect().result(5)
         ui.wait_for(lambda: model.connection.value.phase is Phase.DISCONNECTED)
-        concurrent.futures.wait([attempt], timeout=2)
+        concurrent.futures.wait([attempt], timeout=5)
         assert attempt.done()
         assert attempt.cancelled() or attempt.exception() is not None
-        time.sleep(0.1)
+        runner.sync()  # whatever the cancelled attempt still published has been posted
         ui.drain()
         assert model.connection.value.phase is Phase.DISCONNECTED
 
