@@ -378,3 +378,42 @@ def test_a_lease_granted_while_reconnecting_is_ended_when_the_link_comes_back() 
             assert runner.lease.renew() is False
         finally:
             runner.close()
+
+
+def test_loop_lag_shows_a_blocked_network_loop() -> None:
+    import threading
+
+    clock = FakeClock()
+    runner = ClientRunner(clock=clock)
+    assert runner.loop_lag() is None  # not started
+    runner.start()
+    try:
+        eventually(lambda: runner.loop_lag() == 0.0)
+        release, blocked = threading.Event(), threading.Event()
+
+        def block_the_loop() -> None:  # slow work on the loop: exactly what must never happen
+            blocked.set()
+            release.wait(5)
+
+        runner.submit(block_the_loop)
+        assert blocked.wait(5)
+        clock.advance(1.5)
+        assert runner.loop_lag() == 1.5  # no beat can run while the loop is blocked
+        release.set()
+        eventually(lambda: runner.loop_lag() == 0.0)  # the next beat, once the loop runs again
+    finally:
+        runner.close()
+    assert runner.loop_lag() is None
+
+
+def test_subscription_handlers_run_on_the_ui_thread(server: TestServer) -> None:
+    import threading
+
+    runner, _model, ui = start(server)
+    try:
+        threads: list[int] = []
+        runner.subscribe("batteryInfo", 20, lambda packet: threads.append(threading.get_ident()))
+        ui.wait_for(lambda: len(threads) >= 3)
+        assert set(threads) == {threading.get_ident()}  # posted, never run on the network loop
+    finally:
+        runner.close()

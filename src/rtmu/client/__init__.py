@@ -18,9 +18,12 @@ Wiring a window (what the GTK view does)::
     runner = ClientRunner(model, post=GLib.idle_add).start()     # network thread
     controller = Controller(model, runner, view)                   # UI thread
     GLib.timeout_add(100, lambda: controller.tick() or True)       # renews the drive lease at 10 Hz
+    GLib.timeout_add(500, warn_if_slow)   # (runner.loop_lag() or 0) > 0.5: "drive commands are not going out"
     controller.select_profile(settings.current()); controller.connect()
     ...
     runner.close()                                                 # stops the robot, disconnects
+
+The safety design (lease, governor, loop heartbeat, server watchdog) is written up in ``runner``.
 
 Scripts without a UI use :class:`AriaClient` directly under ``asyncio.run`` (see ``rtmu.subcommands``).
 """

@@ -69,6 +69,8 @@ CLOSE_TIMEOUT = 0.2
 MAX_WRITE_BUFFER = 1 << 20
 """A server that stops reading is dropped once this much output is queued (it would grow forever)."""
 READ_CHUNK = 1 << 16
+SLOW_HANDLER = 0.02
+"""A subscription handler that runs longer than this on the loop is counted and logged."""
 NOT_ARIA_AFTER = 4096
 """Bytes received during login without one valid packet after which the peer is not ArNetworking
 (a real server's introduction is one small packet, sent at once)."""
@@ -374,6 +376,8 @@ class AriaClient:
         self._closing = False
         self.handler_errors = 0
         """Exceptions raised by subscription handlers (logged, never fatal)."""
+        self.slow_handlers = 0
+        """Handler calls that took longer than :data:`SLOW_HANDLER` (logged: they delay every packet)."""
         self.last_packet_at: float | None = None
         self.packets_received = 0
 
@@ -713,11 +717,19 @@ class AriaClient:
                 queue.popleft()
         handler = self._handlers.get(number)
         if handler is not None:
+            started = time.perf_counter()
             try:
                 handler(Packet(event.name or str(number), event.payload, now))
             except Exception:
                 self.handler_errors += 1
                 log.exception("handler for %s failed", event.name)
+            spent = time.perf_counter() - started
+            if spent > SLOW_HANDLER:  # it held up the loop that sends the stops: say so
+                self.slow_handlers += 1
+                if self.slow_handlers <= 10 or self.slow_handlers % 1000 == 0:
+                    log.warning(
+                        "the handler for %s took %.0f ms on the network loop", event.name, spent * 1e3
+                    )
 
     def _fail(self, error: ClientError) -> None:
         """The connection is over (not by our choice): fail every waiter, tell ``on_close`` once."""

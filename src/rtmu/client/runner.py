@@ -15,10 +15,37 @@ Concurrency design
   direct call or a queue. Posted functions return None, so ``idle_add`` runs
   them once. With a :class:`~rtmu.model.Model`, every published value is set on
   the matching model part on the UI thread; only real changes get posted.
-* **Driving** goes through the shared :class:`DriveLease`: the UI grants and
-  renews it (no cross-thread call for a renewal, just a lock), the network side
-  sends ``ratioDrive`` only while it is fresher than 300 ms and a stop the moment
-  it lapses. A busy or frozen UI therefore stops the robot.
+* Calls that may block (keyring lookups) go to :meth:`ClientRunner.run_blocking`:
+  a worker thread that is neither the UI thread nor the network loop.
+
+Safety design
+-------------
+The robot moves only while the operator keeps asking, and every layer that can
+fail has something behind it:
+
+1. **The UI renews a lease.** A drive key grants a :class:`DriveLease`; the UI's
+   own 10 Hz timer renews it while the key is held. Release, focus loss, a stop,
+   a stale link or a lease not renewed for 300 ms (a frozen or busy UI) end it,
+   and a dead lease never comes back without a fresh key press (also after a
+   reconnect).
+2. **The network loop sends ``ratioDrive`` only while the lease is fresh**, at
+   10 Hz, and zero ratios + ``stop`` the moment it ends or lapses, or the link
+   health is not OK (no status for 300 ms, or a ping unanswered). It wakes at the
+   exact expiry, so a lapse costs at most the lease's 300 ms. ``disconnect``,
+   ``close``, connecting elsewhere and ``stop()`` all send zero ratios + ``stop``.
+3. **If the network loop itself is blocked**, nothing can be sent — neither the
+   resends nor the stop: a release or a stop waits until the loop runs again. So
+   the loop must never run slow work: map packets → arrays runs in an executor
+   (:mod:`~rtmu.client.mapload`), payload decoding is a few microseconds, session
+   handlers only update a shadow and ``post`` to the UI, and
+   :meth:`ClientRunner.subscribe` handlers are posted to the UI thread too. The
+   loop beats every :data:`LOOP_BEAT` s; :meth:`ClientRunner.loop_lag` says how
+   long ago it last did, so a window can warn (e.g. above 0.5 s) that driving
+   commands may not be getting out.
+4. **ARIA's own watchdog** on the server stops a robot that hears no drive
+   command for 2 s — the last backstop when this process is frozen, suspended or
+   killed (``rtmu drive`` handles the signals that would kill it: see
+   ``rtmu.subcommands._common``).
 """
 
 from __future__ import annotations
@@ -41,6 +68,8 @@ from .session import Session, SessionConfig
 log = logging.getLogger(__name__)
 
 T = TypeVar("T")
+LOOP_BEAT = 0.1
+"""Seconds between the network loop's heartbeats (see :meth:`ClientRunner.loop_lag`)."""
 SHUTDOWN_TIMEOUT = 0.5
 """How long the network thread waits for its cancelled tasks to finish before it ends anyway."""
 Post = Callable[[Callable[[], None]], Any]
@@ -80,6 +109,7 @@ class ClientRunner:
         self._thread = threading.Thread(target=self._run, name="rtmu-network", daemon=True)
         self._ready = threading.Event()
         self._closed = False
+        self._beat_at: float | None = None
         self._blocking = concurrent.futures.ThreadPoolExecutor(1, thread_name_prefix="rtmu-blocking")
         """One worker for :meth:`run_blocking` (keyring calls), apart from the network loop."""
 
@@ -100,6 +130,7 @@ class ClientRunner:
         asyncio.set_event_loop(self.loop)
         self.session = Session(self.lease, self._publish, self._notice, clock=self.clock, config=self.config)
         self.lease.on_change = self._lease_changed
+        self._beat()
         self._ready.set()
         try:
             self.loop.run_forever()
@@ -125,6 +156,23 @@ class ClientRunner:
         self.loop.call_soon_threadsafe(self.loop.stop)
         self._thread.join(timeout)
         self._blocking.shutdown(wait=False, cancel_futures=True)
+
+    def _beat(self) -> None:
+        """The loop's heartbeat: a plain timestamp, rescheduled; it only runs if the loop does."""
+        self._beat_at = self.clock()
+        self.loop.call_later(LOOP_BEAT, self._beat)
+
+    def loop_lag(self) -> float | None:
+        """Seconds since the network loop last ran its heartbeat; None before start or after close.
+
+        Normally at most :data:`LOOP_BEAT` (plus scheduling noise). Much more means the loop
+        is blocked: drive resends and stops are not going out either — a window should say
+        so. Any thread may call it (a plain read of one float).
+        """
+        beat = self._beat_at
+        if beat is None or self._closed or not self._thread.is_alive():
+            return None
+        return max(0.0, self.clock() - beat)
 
     @property
     def _session(self) -> Session:
@@ -277,8 +325,16 @@ class ClientRunner:
         return future
 
     def subscribe(self, name: str, interval_ms: int, handler: Callable[[Packet], None]) -> None:
-        """An extra subscription (restored after reconnects); ``handler`` runs on the network thread."""
-        self._fire(self._session.subscribe, name, interval_ms, handler)
+        """An extra subscription (restored after reconnects); ``handler(packet)`` runs on the UI thread.
+
+        It is posted there (like every model update) so that no handler, however slow, can
+        hold up the network loop that sends the drive commands and the stops.
+        """
+
+        def deliver(packet: Packet) -> None:
+            self.post(lambda: handler(packet))
+
+        self._fire(self._session.subscribe, name, interval_ms, deliver)
 
     def sync(self, timeout: float = 2.0) -> None:
         """Wait until the network side has handled everything submitted so far and run one heart step."""
