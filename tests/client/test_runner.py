@@ -417,3 +417,18 @@ def test_subscription_handlers_run_on_the_ui_thread(server: TestServer) -> None:
         assert set(threads) == {threading.get_ident()}  # posted, never run on the network loop
     finally:
         runner.close()
+
+
+def test_stop_and_wait_returns_once_the_stop_has_left(server: TestServer) -> None:
+    runner, _model, _ui = start(server)
+    try:
+        runner.lease.grant(DriveRatios(100, 0, 50))
+        runner.sync()
+        eventually(lambda: drive_names(server)[-1:] == ["ratioDrive"])
+        assert runner.stop_and_wait(1.0) is True
+        assert runner.lease.renew() is False
+        eventually(lambda: drive_names(server)[-2:] == ["ratioDrive", "stop"])
+        assert ratio_drives(server)[-1] == RatioDrive(0, 0, 0)
+    finally:
+        runner.close()
+    assert runner.stop_and_wait(0.1) is False  # closed: nothing to send it with

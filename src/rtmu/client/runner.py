@@ -280,6 +280,23 @@ class ClientRunner:
         self.lease.end(EndReason.STOPPED)
         self.submit(self._session.stop_now)
 
+    def stop_and_wait(self, timeout: float = 0.5) -> bool:
+        """Blocking :meth:`stop`: True once zero ratios + ``stop`` have left this process.
+
+        For a UI about to be suspended or killed (a SIGTSTP or SIGQUIT handler): call it first,
+        then let the signal take its course. False after ``timeout`` s (the loop is blocked or the
+        server does not read) or once the runner is closed. Not from the network thread.
+        """
+        self.lease.end(EndReason.STOPPED)
+        if self._closed or self.session is None or not self._thread.is_alive():
+            return False
+        future = self._on_loop(self._session.stop_and_flush, timeout)
+        try:
+            return bool(future.result(timeout + 0.1))
+        except (concurrent.futures.TimeoutError, Exception):
+            future.cancel()
+            return False
+
     def command(self, name: str, *args: object) -> concurrent.futures.Future[None]:
         return self._fire(self._session.command, name, *args)
 

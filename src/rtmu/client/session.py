@@ -569,6 +569,18 @@ class Session:
         self.governor.reset()
         self.kick()
 
+    async def stop_and_flush(self, timeout: float = 0.5) -> bool:
+        """:meth:`stop_now`, then wait (bounded) until the stop has been handed to the kernel.
+
+        True when it has (or there was no connection to stop); for callers about to freeze the
+        process (Ctrl-Z) or end it abruptly.
+        """
+        self.stop_now()
+        client = self.client
+        if client is None or not client.connected:
+            return True
+        return await client.flush(timeout)
+
     def command(self, name: str, *args: Any) -> None:
         """Fire-and-forget request-once (``turnByAngle``, ``moveDist``, custom commands)."""
         client = self._require(name)
