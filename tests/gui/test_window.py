@@ -346,3 +346,21 @@ def test_closing_while_driving_sends_an_explicit_stop(gui: Gui, sim: SimThread, 
         )
     finally:
         gui.keyup("Up")
+
+
+def test_a_stalled_network_thread_is_reported_and_the_warning_goes_when_it_runs_again(gui: Gui) -> None:
+    """``runner.loop_lag()`` above 0.5 s: the window says drive commands and stops are not going out."""
+    window = gui.window
+    runner = window.controller.link
+    assert runner.loop_lag() is not None, "the real runner beats"
+    idle(0.4)
+    assert window.banners.text("loop") is None, "a running loop raises no warning"
+    lag = [0.8]
+    runner.loop_lag = lambda: lag[0]  # a stalled loop, as the runner would report it
+    pump(lambda: window.banners.text("loop") is not None, 3, "the stall warning")
+    text = window.banners.text("loop") or ""
+    assert "0.8 s" in text and "watchdog" in text, text
+    gui.shot("network-thread-stalled")
+    lag[0] = 0.05
+    pump(lambda: window.banners.text("loop") is None, 3, "the warning to go")
+    gui.shot("network-thread-running-again")

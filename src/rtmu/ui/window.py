@@ -55,6 +55,9 @@ from .viewport import zoom_label  # noqa: E402
 
 REFRESH_EVERY = 3
 """Ticks between refreshes of ages (toolbar, picture): 0.3 s."""
+LOOP_LAG_WARN = 0.5
+"""Seconds without a network-loop heartbeat after which the window warns that drive commands (and
+stops) are not going out; the warning goes once the lag is under half of this again."""
 _LINK_WORDS = ("Connected to", "Link lost", "Reconnecting", "Connection cancelled")
 
 
@@ -712,9 +715,26 @@ class MainWindow(Gtk.ApplicationWindow):
             self.toolbar.refresh()
             self.camera.tick()
             self.inset.tick()
+            self._check_loop_lag()
             if self.stage.robot_is_stale() and self.model.robot.value.numbers_at is not None:
                 self.stage.queue_draw()
         return True
+
+    def _check_loop_lag(self) -> None:
+        """Warn while the network thread is stalled: then even a stop cannot leave this process."""
+        loop_lag = getattr(self.controller.link, "loop_lag", None)
+        lag = loop_lag() if callable(loop_lag) else None
+        connected = self.model.connection.value.phase is Phase.CONNECTED
+        if connected and lag is not None and lag > LOOP_LAG_WARN:
+            self.banners.show(
+                "loop",
+                "error",
+                f"The network thread has not run for {lag:.1f} s: drive commands and stops are not going "
+                "out; the robot may keep moving until the server's watchdog stops it",
+                timeout=None,
+            )
+        elif "loop" in self.banners.topics() and (not connected or lag is None or lag < LOOP_LAG_WARN / 2):
+            self.banners.dismiss("loop")
 
     def _on_close_request(self, _w: Gtk.Window) -> bool:
         """Closing while driving stops the robot first; then the app shuts the network down."""
