@@ -96,7 +96,9 @@ def test_the_map_note_follows_the_connection_phase_then_the_map() -> None:
     assert map_note(ConnectionState(Phase.DISCONNECTED), ready).startswith("Not connected: press Connect")
     assert "try again" in map_note(ConnectionState(Phase.FAILED, error="refused"), no_map)
     assert map_note(ConnectionState(Phase.CONNECTING, **here), MapModel()) == "Connecting to 127.0.0.1:7272…"
-    assert map_note(ConnectionState(Phase.RECONNECTING, **here), ready).startswith("Link lost: the robot is shown where")
+    assert map_note(ConnectionState(Phase.RECONNECTING, **here), ready).startswith(
+        "Link lost: the robot is shown where"
+    )
     connected = ConnectionState(Phase.CONNECTED, **here)
     assert map_note(connected, ready) == ""
     assert map_note(connected, MapModel(state="loading", received=12)) == "Loading the map… (12 packets)"
