@@ -35,7 +35,7 @@ def main(argv: list[str]) -> int:
     print(f"{'name':<{width}}  {'value':>14}  {'unit':<12} {'baseline':>14}  {'ratio':>9}")
     for r in results:
         base = f"{r.baseline:14.4g}" if r.baseline is not None else " " * 14
-        ratio = f"{r.ratio:9.2f}" if r.ratio is not None else ""
+        ratio = f"{r.ratio:9.3g}" if r.ratio is not None else ""
         print(f"{r.name:<{width}}  {r.value:14.4g}  {r.unit:<12} {base}  {ratio}")
     out = HERE / "results.json"
     previous: list[dict[str, object]] = []
