@@ -168,7 +168,7 @@ class TestServer:
         self._server: asyncio.base_events.Server | None = None
         self.port = 0
         self.hearing = asyncio.Event()
-        """Cleared by :meth:`stop_reading`: the server keeps sending but reads nothing more."""
+        """Cleared by :meth:`deafen`: the server keeps sending but reads nothing more."""
         self.hearing.set()
         self.admitting = asyncio.Event()
         """Cleared by :meth:`hold_logins`: new connections wait before the server says a word."""
@@ -194,14 +194,14 @@ class TestServer:
             with contextlib.suppress(Exception):
                 await asyncio.wait_for(self._server.wait_closed(), 1)
 
-    def stop_reading(self) -> None:
+    def deafen(self) -> None:
         """Stop reading requests (like a server whose input thread hangs); subscriptions go on.
 
         Thread-safe: runs on the server's loop.
         """
         self._loop.call_soon_threadsafe(self.hearing.clear)
 
-    def resume_reading(self) -> None:
+    def undeafen(self) -> None:
         self._loop.call_soon_threadsafe(self.hearing.set)
 
     def hold_logins(self) -> None:

@@ -306,7 +306,7 @@ def test_a_server_that_stops_reading_is_stale_then_lost(server: TestServer) -> N
         model.connection.observe(lambda old, new: seen.append((new.phase, new.error)))
         levels: list[LinkLevel] = []
         model.health.observe(lambda old, new: levels.append(new.level))
-        server.stop_reading()
+        server.deafen()
         ui.wait_for(lambda: any(p is Phase.RECONNECTING and "pings" in e for p, e in seen))
         assert LinkLevel.STALE in levels
         assert runner.lease.renew() is False  # driving stopped on the first unanswered ping
