@@ -38,7 +38,7 @@ from ..protocol.payloads import Side, decode_payload, payload_type_for
 from ..protocol.payloads.drive import RatioDrive, SafeDrive, SetSafeDrive
 from ..protocol.payloads.robot import BatteryInfo, ModeInfo, Update, UpdateNumbers, UpdateStrings
 from .connection import AriaClient, Packet
-from .errors import ClientError, ClientTimeout, NotSupported, ServerClosed
+from .errors import ClientError, ClientTimeout, MalformedReply, NotSupported, ServerClosed
 from .health import HealthMonitor, ping_data
 from .lease import DriveGovernor, DriveLease, EndReason, SendRatios, SendStop
 from .mapload import download_map, map_source
@@ -618,9 +618,9 @@ class Session:
             raise NotSupported(source, f"RTMU cannot decode {source!r} pictures")
         try:
             picture = reply.decode()
-        except ProtocolError as exc:
+        except MalformedReply:
             self.health.bad_payloads += 1
-            raise ClientError(f"the picture from {source!r} is malformed: {exc}") from None
+            raise
         self._image_sequence += 1
         image = CameraImage(
             jpeg=bytes(picture.jpeg),  # type: ignore[attr-defined]

@@ -9,8 +9,7 @@ from typing import Any
 
 from ..cli import EXIT_OK
 from ..client.connection import AriaClient
-from ..client.errors import NotSupported, ProtocolFault
-from ..protocol.errors import ProtocolError
+from ..client.errors import NotSupported
 from ._common import add_connection_arguments, run_with_client
 
 
@@ -48,10 +47,7 @@ def handle(args: argparse.Namespace) -> int:
         if args.quality is not None:
             extra = (bytes([max(0, min(100, args.quality))]),)
         reply = await client.request_once(source, *extra, timeout=args.timeout)
-        try:
-            picture = reply.decode()
-        except ProtocolError as exc:
-            raise ProtocolFault(f"the picture from {source!r} is malformed: {exc}") from None
+        picture = reply.decode()  # MalformedReply (exit 3, one line) if it does not decode
         jpeg = bytes(picture.jpeg)  # type: ignore[attr-defined]
         args.out.write_bytes(jpeg)
         size = f"{picture.width}x{picture.height}"  # type: ignore[attr-defined]
