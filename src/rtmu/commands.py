@@ -17,8 +17,13 @@ from collections.abc import Iterator
 from dataclasses import dataclass
 from typing import TYPE_CHECKING, ClassVar, Protocol
 
+from .model import Phase
+
 if TYPE_CHECKING:
     from .controller import Controller
+
+LINKING = (Phase.CONNECTING, Phase.RECONNECTING, Phase.CONNECTED)
+"""Phases in which there is something to disconnect (an attempt in progress can be cancelled)."""
 
 
 class CommandContext(Protocol):
@@ -30,6 +35,8 @@ class CommandContext(Protocol):
     def supports(self, name: str) -> bool: ...
 
     def image_source(self) -> str | None: ...
+
+    def connection_phase(self) -> Phase: ...
 
 
 @dataclass(frozen=True, slots=True)
@@ -310,6 +317,10 @@ class Disconnect(Command):
     name = "disconnect"
     label = "Disconnect"
     default_key = "<Control>d"
+
+    def unavailable(self, ctx: CommandContext) -> str | None:
+        # Also while connecting or reconnecting: the button says "Disconnect" then and cancels.
+        return None if ctx.connection_phase() in LINKING else "not connected"
 
     def activate(self, controller: Controller) -> None:
         controller.disconnect()

@@ -165,6 +165,9 @@ class Controller:
     def supports(self, name: str) -> bool:
         return self.model.connection.value.supports(name)
 
+    def connection_phase(self) -> Phase:
+        return self.model.connection.value.phase
+
     def image_source(self) -> str | None:
         """The data a picture is requested with: the first getPicture…, else sendVideo, else None."""
         offers = self.model.connection.value.offers

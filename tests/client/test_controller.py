@@ -355,3 +355,21 @@ def test_profile_view_options_round_trip() -> None:
     rig.ctl.speed_down()
     saved = rig.ctl.current_profile()
     assert (saved.name, saved.zoom, saved.speed, saved.follow_robot) == ("lab", 0.4, 60, False)
+
+
+@pytest.mark.parametrize(
+    ("phase", "enabled"),
+    [
+        (Phase.DISCONNECTED, False),
+        (Phase.CONNECTING, True),
+        (Phase.CONNECTED, True),
+        (Phase.RECONNECTING, True),
+        (Phase.FAILED, False),
+    ],
+)
+def test_disconnect_is_enabled_whenever_there_is_something_to_cancel(phase: Phase, enabled: bool) -> None:
+    rig = Rig(connected=False)
+    rig.model.connection.set(ConnectionState(phase, "127.0.0.1", 7272))
+    assert rig.ctl.command_states()["disconnect"].enabled is enabled
+    assert rig.ctl.run("disconnect") is enabled
+    assert ("disconnect" in rig.link.names()) is enabled

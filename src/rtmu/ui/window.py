@@ -347,8 +347,7 @@ class MainWindow(Gtk.ApplicationWindow):
 
         plain("settings", self.open_settings)
         plain("connect", self.connect_now)
-        # Disconnect also cancels an attempt in progress (connecting, reconnecting): the button says
-        # "Disconnect" then, so Ctrl+D must do what it says. Enabled from the phase (_update_header).
+        # Disconnect also cancels an attempt in progress: its command is enabled while connecting.
         plain("disconnect", self.controller.disconnect)
         plain("turn", lambda: self.view_intent("turn_dialog"))
         plain("go", lambda: self.view_intent("go_dialog"))
@@ -409,6 +408,8 @@ class MainWindow(Gtk.ApplicationWindow):
                 self._enable("go", state.enabled)
             elif name == "safe_drive_on":
                 self._enable("safe-drive", state.enabled)
+            elif name == "disconnect":
+                self._enable("disconnect", state.enabled)
         if any(name in states for _label, _action, name in ROBOT_MENU):
             self._fill_robot_menu()
 
@@ -561,7 +562,6 @@ class MainWindow(Gtk.ApplicationWindow):
         for button in (self.connect_button, self.fullscreen_bar.connect_button):
             show_connection(button, connected_ish)
         self._enable("connect", not connected_ish)
-        self._enable("disconnect", connected_ish)
         profile = self.controller.profile
         where = f"{conn.host}:{conn.port}" if conn.host else f"{profile.host}:{profile.port}"
         state = {
