@@ -8,10 +8,12 @@ import gi
 import pytest
 
 from rtmu.commands import COMMANDS
+from rtmu.model import ConnectionState, LinkHealth, LinkLevel, Model, Phase
 from rtmu.ui.gauges import battery_fraction, wifi_bars
 from rtmu.ui.keys import BINDINGS, KeyRouter
 from rtmu.ui.settings_dialog import validate
 from rtmu.ui.shortcuts import shortcuts_xml
+from rtmu.ui.toolbar import StatusToolbar
 
 gi.require_version("Gdk", "4.0")
 gi.require_version("Gtk", "4.0")
@@ -129,3 +131,19 @@ def test_the_first_run_hint_never_breaks_rtmu_demo_across_lines() -> None:
         for line in layout.get_lines_readonly():
             inside = byte_start < line.start_index < byte_end
             assert not inside, f"a line starts inside 'rtmu --demo' at {width} px"
+
+
+def test_the_link_cell_says_when_the_server_does_not_answer_pings() -> None:
+    model = Model()
+    model.connection.set(ConnectionState(Phase.CONNECTED, "127.0.0.1", 7272))
+    model.health.set(LinkHealth(LinkLevel.OK, rtt_ms=1.5))
+    toolbar = StatusToolbar(model, status_age=lambda: 0.1)
+    cell = toolbar.cells["link"]
+    assert "ping" not in cell.value.get_text() and not cell.stale
+    model.health.set(LinkHealth(LinkLevel.STALE, rtt_ms=None, ping_failures=2))
+    assert cell.value.get_text() == "no ping ×2"
+    assert cell.stale
+    assert "not answering pings (2 in a row)" in (cell.get_tooltip_text() or "")
+    model.health.set(LinkHealth(LinkLevel.OK, rtt_ms=1.5))
+    assert "ping" not in cell.value.get_text() and "pings" not in (cell.get_tooltip_text() or "")
+    toolbar.close()

@@ -276,7 +276,15 @@ class StatusToolbar(Gtk.ScrolledWindow):
             f"Link {health.level.value}: round trip {rtt}, last status {age_text} ago, "
             f"{health.dropped} bad packets dropped"
         )
-        cell.show_value(f"{rtt} {age_text}", stale=health.level is not LinkLevel.OK, tooltip=tip)
+        text = f"{rtt} {age_text}"
+        if health.ping_failures > 0:
+            # The link may look alive (status still arriving) while the server no longer hears us.
+            text = f"no ping ×{health.ping_failures}"
+            tip = (
+                f"Server not answering pings ({health.ping_failures} in a row): it may not hear our "
+                f"commands; driving is stopped\n{tip}"
+            )
+        cell.show_value(text, stale=health.level is not LinkLevel.OK or health.ping_failures > 0, tooltip=tip)
         cell.add_css_class(f"link-{health.level.value}")
 
 
