@@ -206,9 +206,24 @@ class RtmuApplication(Gtk.Application):
     def profile_saved(self, profile: Profile, password: str | None) -> None:
         self.settings.put(profile)
         if password is not None and profile.remember_password:
-            self.secrets.set(profile, password)
+            self._store_password(profile, password)
         if self.options.persist:
             self._save(background=True)
+
+    def _store_password(self, profile: Profile, password: str) -> None:
+        """Into the keyring off the GTK thread: D-Bus or an unlock prompt may block for seconds.
+
+        The runner's one worker also does the lookups, so a later lookup sees this password.
+        """
+        secrets, runner = self.secrets, self.runner
+        if runner is None:
+            secrets.set(profile, password)
+            return
+
+        def stored(_result: None) -> None:
+            pass  # SessionSecrets falls back to memory itself; nothing to tell the operator
+
+        runner.run_blocking(lambda: secrets.set(profile, password), stored)
 
     def _remember_view(self, window: MainWindow) -> None:
         view = self.model.view.value if self.model is not None else None
