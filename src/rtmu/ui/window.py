@@ -703,10 +703,22 @@ class MainWindow(Gtk.ApplicationWindow):
 
     # -- focus, timers, closing ----------------------------------------------------------------
     def _on_active(self, *_a: object) -> None:
-        if not self.is_active():
-            self.controller.focus_lost()
-            self.keys.release_all()
-            self.dpad.release_all()
+        if self.is_active():
+            self.controller.focus_gained()  # key releases from now on are real ones
+        else:
+            self.end_held_drive()
+
+    def end_held_drive(self, *, keep_focus: bool = False) -> None:
+        """Stop, and forget held keys and fingers as on a focus loss: they stay blocked until released.
+
+        ``keep_focus``: the window still has the keyboard (the process is being suspended), so a
+        release seen afterwards is a real one and unblocks its key.
+        """
+        self.controller.focus_lost()
+        self.keys.release_all()
+        self.dpad.release_all()
+        if keep_focus and self.is_active():
+            self.controller.focus_gained()
 
     def _tick(self) -> bool:
         self.ticks += 1
