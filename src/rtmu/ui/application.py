@@ -8,6 +8,7 @@ profile's view choices (zoom, follow, sonar, speed).
 
 from __future__ import annotations
 
+import os
 import signal
 import sys
 import threading
@@ -36,6 +37,8 @@ from .style import install_css  # noqa: E402
 from .window import MainWindow  # noqa: E402
 
 RUNNER_CLOSE_TIMEOUT = 1.5
+SUSPEND_STOP_TIMEOUT = 0.5
+"""How long Ctrl+Z (SIGTSTP) waits for the stop to leave the process before the process freezes anyway."""
 GLIB_SIGNALS = (signal.SIGINT, signal.SIGTERM, signal.SIGHUP)
 """Signals GLib's main loop can watch (``GLib.unix_signal_add``); SIGQUIT is handled in Python."""
 _NO_BREAK = "\u2060"  # WORD JOINER: the line may not break here (not after the hyphens of "--demo")
@@ -80,6 +83,9 @@ class RtmuApplication(Gtk.Application):
         """The window could not be built (the error was printed); ``run_gui`` exits non-zero."""
         self._signal_sources: list[int] = []
         self._old_sigquit: Callable[[int, FrameType | None], object] | int | None = None
+        self._old_sigtstp: Callable[[int, FrameType | None], object] | int | None = None
+        self.suspensions = 0
+        """Times the process was suspended (Ctrl+Z) and resumed."""
 
     # -- lifecycle -----------------------------------------------------------------------------
     def do_startup(self) -> None:
@@ -100,6 +106,8 @@ class RtmuApplication(Gtk.Application):
             self._signal_sources.append(GLib.unix_signal_add(GLib.PRIORITY_DEFAULT, signum, self._on_signal))
         # GLib does not watch SIGQUIT: a Python handler (PyGObject wakes the main loop for it).
         self._old_sigquit = signal.signal(signal.SIGQUIT, self._on_python_signal)
+        # Ctrl+Z freezes the process, network thread included: stop the robot before that happens.
+        self._old_sigtstp = signal.signal(signal.SIGTSTP, self._on_suspend)
 
     def do_activate(self) -> None:
         if self.window is not None:
@@ -162,6 +170,9 @@ class RtmuApplication(Gtk.Application):
         if self._old_sigquit is not None:
             signal.signal(signal.SIGQUIT, self._old_sigquit)
             self._old_sigquit = None
+        if self._old_sigtstp is not None:
+            signal.signal(signal.SIGTSTP, self._old_sigtstp)
+            self._old_sigtstp = None
 
     def quit_safely(self) -> None:
         """Stop the robot, then close every window (the shutdown handler does the rest)."""
@@ -177,6 +188,34 @@ class RtmuApplication(Gtk.Application):
 
     def _on_python_signal(self, _signum: int, _frame: object) -> None:
         GLib.idle_add(lambda: self._on_signal() and False)
+
+    def _on_suspend(self, _signum: int, _frame: object) -> None:
+        """SIGTSTP: end any held drive (as a focus loss), make sure the stop is out, then really stop.
+
+        A frozen process sends nothing — neither drive commands nor a stop — so the stop must
+        leave before the freeze. Then the default action is restored and the signal raised again
+        (the shell sees a normal job stop); once SIGCONT resumes us, ``raise_signal`` returns and
+        this handler is put back. Held keys stay blocked until released: no drive resumes alone.
+        """
+        window, runner = self.window, self.runner
+        if window is not None:
+            window.end_held_drive(keep_focus=True)
+        if runner is not None:
+            runner.stop_and_wait(SUSPEND_STOP_TIMEOUT)
+        signal.signal(signal.SIGTSTP, signal.SIG_DFL)
+        try:
+            signal.raise_signal(signal.SIGTSTP)  # the process stops here until SIGCONT
+        finally:
+            if self._old_sigtstp is not None:  # not closed meanwhile
+                signal.signal(signal.SIGTSTP, self._on_suspend)
+        self.suspensions += 1
+        if self.window is not None:
+            self.window.banners.show(
+                "notice:suspended",
+                "warning",
+                f"The window was suspended (pid {os.getpid()}): the robot was stopped. Press a key to drive.",
+                timeout=6.0,
+            )
 
     # -- profiles ------------------------------------------------------------------------------
     def choose_profile(self) -> tuple[Profile, bool]:

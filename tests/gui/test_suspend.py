@@ -1,0 +1,109 @@
+"""Ctrl+Z (SIGTSTP) on ``rtmu`` while a key drives: the robot is stopped before the process freezes.
+
+A stopped process sends nothing, so the stop must be out first: the simulator is in its stop
+mode (only an explicit ``stop`` request puts it there) before its own 2 s watchdog fired, and
+the process is really stopped ('T'). After SIGCONT the key still held down must not start the
+robot again: only a fresh press does.
+"""
+
+from __future__ import annotations
+
+import os
+import signal
+import subprocess
+import sys
+import time
+from pathlib import Path
+
+from rtmu.sim import SimConfig, SimThread
+
+from .harness import OFFICE_MAP
+from .test_signals import wait, xdotool
+
+
+def process_state(pid: int) -> str:
+    """The state letter of /proc/PID/stat ('T' = stopped by a signal)."""
+    stat = Path(f"/proc/{pid}/stat").read_text()
+    return stat.rsplit(")", 1)[1].split()[0]
+
+
+def test_ctrl_z_stops_the_robot_then_the_process_and_nothing_drives_after_resume(
+    tmp_path: Path, screenshots: Path
+) -> None:
+    with SimThread(SimConfig(port=0, map_path=OFFICE_MAP, seed=1)) as sim:
+        env = dict(os.environ, XDG_CONFIG_HOME=str(tmp_path))
+        # Its own process group in our session: a stop signal to an orphaned group would be discarded.
+        proc = subprocess.Popen(
+            [sys.executable, "-m", "rtmu", "--host", "127.0.0.1", "--port", str(sim.port)],
+            stdout=subprocess.DEVNULL,
+            stderr=subprocess.PIPE,
+            text=True,
+            env=env,
+            process_group=0,
+        )
+        held = False
+        robot = sim.server.robot
+
+        def subscribed() -> bool:
+            return any(session.subscriptions for session in sim.server.sessions)
+
+        def drives_received() -> int:
+            return int(sim.call(lambda: robot.ratio_drives_received))
+
+        try:
+            found = xdotool("search", "--sync", "--onlyvisible", "--pid", str(proc.pid), "--name", "RTMU")
+            window = found.split()[0]
+            wait(lambda: sim.call(subscribed), 15, "the window to connect and subscribe")
+            xdotool("windowfocus", "--sync", window)
+            for _attempt in range(5):  # a press that beat the "connected" state to the window is refused
+                xdotool("keydown", "Up")
+                held = True
+                try:
+                    wait(lambda: abs(sim.snapshot().vel) > 1.0, 2, "the robot to drive")
+                    break
+                except AssertionError:
+                    xdotool("keyup", "Up")
+                    held = False
+            assert held, "the held key never drove the robot"
+            watchdog_stops = sim.call(lambda: robot.watchdog_stops)
+
+            proc.send_signal(signal.SIGTSTP)
+            wait(lambda: process_state(proc.pid) == "T", 5, "the process to stop")
+            assert sim.call(lambda: robot.mode_name) == "stop", "no explicit stop before the freeze"
+            assert sim.call(lambda: robot.watchdog_stops) == watchdog_stops, "the watchdog fired"
+            frozen_at = drives_received()
+
+            proc.send_signal(signal.SIGCONT)
+            wait(lambda: process_state(proc.pid) != "T", 5, "the process to resume")
+            # Up is still held (X repeats it): nothing may drive. The point is that time passes.
+            time.sleep(0.6)
+            assert drives_received() == frozen_at, "a drive resumed without a fresh press"
+            assert sim.call(lambda: robot.mode_name) == "stop"
+            assert proc.poll() is None
+            subprocess.run(
+                ["import", "-window", window, str(screenshots / "test_suspend-01-resumed.png")],
+                timeout=15,
+                check=True,
+            )
+
+            xdotool("keyup", "Up")  # a real release, then a fresh press drives again
+            held = False
+            xdotool("keydown", "Up")
+            held = True
+            wait(lambda: drives_received() > frozen_at, 5, "a fresh press to drive again")
+            # The handler is back after the resume: a second Ctrl+Z stops the robot again first.
+            proc.send_signal(signal.SIGTSTP)
+            wait(lambda: process_state(proc.pid) == "T", 5, "the process to stop a second time")
+            assert sim.call(lambda: robot.mode_name) == "stop", "the second suspend did not stop first"
+            proc.send_signal(signal.SIGCONT)
+            xdotool("keyup", "Up")
+            held = False
+            proc.send_signal(signal.SIGTERM)
+            assert proc.wait(10) == 0, proc.stderr.read() if proc.stderr else ""
+        finally:
+            if held:
+                xdotool("keyup", "Up")
+            if proc.poll() is None:
+                proc.send_signal(signal.SIGCONT)
+                proc.kill()
+                proc.wait(5)
