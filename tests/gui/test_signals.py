@@ -1,6 +1,6 @@
-"""``rtmu --host … --port …`` as a process, driving with a held key, then SIGHUP or SIGQUIT.
+"""``rtmu --host … --port …`` as a process, driving with a held key, then a signal that would kill it.
 
-Both must end the window like Ctrl+C and kill do: the robot is stopped first (the
+Each must end the window like Ctrl+C and kill do: the robot is stopped first (the
 simulator switches to its stop mode before its own 2 s watchdog could fire),
 then the process exits with status 0. Left to their default, these signals
 killed the process and left the robot driving.
@@ -35,7 +35,10 @@ def xdotool(*args: str) -> str:
     return subprocess.run(["xdotool", *args], capture_output=True, text=True, timeout=15, check=True).stdout
 
 
-@pytest.mark.parametrize("signum", [signal.SIGHUP, signal.SIGQUIT], ids=["SIGHUP", "SIGQUIT"])
+SIGNALS = [signal.SIGHUP, signal.SIGQUIT, signal.SIGUSR1, signal.SIGUSR2, signal.SIGALRM]
+
+
+@pytest.mark.parametrize("signum", SIGNALS, ids=[signal.Signals(s).name for s in SIGNALS])
 def test_a_hangup_or_quit_signal_stops_the_robot_then_exits(
     signum: int, tmp_path: Path, screenshots: Path
 ) -> None:

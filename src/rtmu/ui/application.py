@@ -39,8 +39,10 @@ from .window import MainWindow  # noqa: E402
 RUNNER_CLOSE_TIMEOUT = 1.5
 SUSPEND_STOP_TIMEOUT = 0.5
 """How long Ctrl+Z (SIGTSTP) waits for the stop to leave the process before the process freezes anyway."""
-GLIB_SIGNALS = (signal.SIGINT, signal.SIGTERM, signal.SIGHUP)
-"""Signals GLib's main loop can watch (``GLib.unix_signal_add``); SIGQUIT is handled in Python."""
+GLIB_SIGNALS = (signal.SIGINT, signal.SIGTERM, signal.SIGHUP, signal.SIGUSR1, signal.SIGUSR2)
+"""Signals GLib's main loop can watch (``GLib.unix_signal_add``); the others are handled in Python."""
+PYTHON_SIGNALS = (signal.SIGQUIT, signal.SIGALRM)
+"""Signals that would kill the process by default and that GLib cannot watch: a Python handler."""
 _NO_BREAK = "\u2060"  # WORD JOINER: the line may not break here (not after the hyphens of "--demo")
 FIRST_RUN_HINT = (
     "No robot set up yet: open the menu ☰ → Connection settings (Ctrl+,) — or try the simulator: "
@@ -82,7 +84,7 @@ class RtmuApplication(Gtk.Application):
         self.failed = False
         """The window could not be built (the error was printed); ``run_gui`` exits non-zero."""
         self._signal_sources: list[int] = []
-        self._old_sigquit: Callable[[int, FrameType | None], object] | int | None = None
+        self._old_handlers: dict[int, Callable[[int, FrameType | None], object] | int | None] = {}
         self._old_sigtstp: Callable[[int, FrameType | None], object] | int | None = None
         self.suspensions = 0
         """Times the process was suspended (Ctrl+Z) and resumed."""
@@ -99,13 +101,14 @@ class RtmuApplication(Gtk.Application):
         for target in ("app.quit", "win.fullscreen", "win.toolbar", "win.connect", "win.disconnect",
                        "win.settings", "win.show-help-overlay"):  # fmt: skip
             self.set_accels_for_action(target, accels_for(target))
-        # Ctrl+C, kill, a closed terminal (SIGHUP) and Ctrl+\ (SIGQUIT) all end the window the same
-        # way: stop the robot first, then quit. Left to their default, SIGHUP and SIGQUIT would kill
+        # Ctrl+C, kill, a closed terminal (SIGHUP), Ctrl+\ (SIGQUIT), SIGUSR1/2 and SIGALRM all end the
+        # window the same way: stop the robot first, then quit. Left to their default, they would kill
         # the process with the robot still driving until the server's watchdog noticed.
         for signum in GLIB_SIGNALS:
             self._signal_sources.append(GLib.unix_signal_add(GLib.PRIORITY_DEFAULT, signum, self._on_signal))
-        # GLib does not watch SIGQUIT: a Python handler (PyGObject wakes the main loop for it).
-        self._old_sigquit = signal.signal(signal.SIGQUIT, self._on_python_signal)
+        # GLib does not watch these: a Python handler (PyGObject wakes the main loop for it).
+        for signum in PYTHON_SIGNALS:
+            self._old_handlers[signum] = signal.signal(signum, self._on_python_signal)
         # Ctrl+Z freezes the process, network thread included: stop the robot before that happens.
         self._old_sigtstp = signal.signal(signal.SIGTSTP, self._on_suspend)
 
@@ -167,9 +170,10 @@ class RtmuApplication(Gtk.Application):
         for source in self._signal_sources:
             GLib.source_remove(source)
         self._signal_sources = []
-        if self._old_sigquit is not None:
-            signal.signal(signal.SIGQUIT, self._old_sigquit)
-            self._old_sigquit = None
+        for signum, old in self._old_handlers.items():
+            if old is not None:
+                signal.signal(signum, old)
+        self._old_handlers = {}
         if self._old_sigtstp is not None:
             signal.signal(signal.SIGTSTP, self._old_sigtstp)
             self._old_sigtstp = None
