@@ -28,6 +28,7 @@ OTHER_PACKAGES = [
     "build-essential",
     "xvfb",
     "xdotool",
+    "openbox",
 ]
 TOOLS = [
     "awk",
@@ -215,7 +216,7 @@ def test_a_ready_machine_asks_apt_nothing(tmp_path: Path) -> None:
     )
     result = machine.run()
     assert result.returncode == 0, result.stderr
-    assert "system packages present (11 checked)" in result.stdout
+    assert "system packages present (12 checked)" in result.stdout
     assert machine.apt_calls() == []
 
 
