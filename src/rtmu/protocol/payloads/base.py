@@ -24,7 +24,7 @@ from enum import Enum
 from typing import Any, ClassVar, Self, TypeVar
 
 from ..errors import PayloadError
-from ..fields import FieldReader
+from ..fields import FieldReader, FieldWriter
 
 
 class Side(Enum):
@@ -64,6 +64,56 @@ class Payload:
         for f in dataclasses.fields(self):  # type: ignore[arg-type]
             out[f.name] = _jsonable(getattr(self, f.name))
         return out
+
+
+class EmptyPayload(Payload):
+    """A payload with no fields: the data's name is the whole message (``mapUpdated``, heartbeats)."""
+
+    __slots__ = ()
+
+    def encode(self) -> bytes:
+        return b""
+
+    @classmethod
+    def decode(cls, data: bytes) -> Self:
+        return cls()
+
+
+class SingleField(Payload):
+    """A payload of exactly one field, carried by one :class:`FieldWriter`/:class:`FieldReader` kind.
+
+    Subclasses are dataclasses with a single field and name its wire kind, so
+    the many one-number and one-string payloads share one codec.
+    """
+
+    __slots__ = ()
+
+    FIELD_KIND: ClassVar[str]
+    """The writer/reader method that carries the field: ``"double"``, ``"string"``, ``"ubyte4"``…"""
+    FIELD_LABEL: ClassVar[str]
+    """The field's name in a decode error."""
+
+    def encode(self) -> bytes:
+        (field,) = dataclasses.fields(self)  # type: ignore[arg-type]
+        return getattr(FieldWriter(), self.FIELD_KIND)(getattr(self, field.name)).bytes()
+
+    @classmethod
+    def decode(cls, data: bytes) -> Self:
+        return cls(getattr(FieldReader(data), cls.FIELD_KIND)(cls.FIELD_LABEL))  # type: ignore[call-arg]
+
+
+class SingleFlag(SingleField):
+    """A :class:`SingleField` holding a bool: sent as 1 or 0, and any non-zero value reads as True."""
+
+    __slots__ = ()
+
+    def encode(self) -> bytes:
+        (field,) = dataclasses.fields(self)  # type: ignore[arg-type]
+        return getattr(FieldWriter(), self.FIELD_KIND)(1 if getattr(self, field.name) else 0).bytes()
+
+    @classmethod
+    def decode(cls, data: bytes) -> Self:
+        return cls(getattr(FieldReader(data), cls.FIELD_KIND)(cls.FIELD_LABEL) != 0)  # type: ignore[call-arg]
 
 
 def _jsonable(value: Any) -> Any:

@@ -15,7 +15,7 @@ from typing import Final, Self
 
 from ..errors import PayloadError
 from ..fields import FieldReader, FieldWriter
-from .base import NameMatch, Payload, Side, checked_count, register
+from .base import EmptyPayload, NameMatch, Payload, Side, checked_count, register
 
 JPEG_END: Final = b"\xff\xd9"
 MAX_ARG_DEPTH: Final = 16
@@ -277,18 +277,11 @@ class CameraList(Payload):
 
 @register
 @dataclass(frozen=True, slots=True)
-class CameraListUpdated(Payload):
+class CameraListUpdated(EmptyPayload):
     """``cameraListUpdated`` broadcast (empty): ask ``getCameraList`` again."""
 
     DATA_NAME = "cameraListUpdated"
     SIDE = Side.REPLY
-
-    def encode(self) -> bytes:
-        return b""
-
-    @classmethod
-    def decode(cls, data: bytes) -> Self:
-        return cls()
 
 
 # -- pan / tilt / zoom (byte2 hundredths) ---------------------------------------------

@@ -11,7 +11,7 @@ from dataclasses import dataclass
 from typing import Self
 
 from ..fields import FieldReader, FieldWriter
-from .base import Payload, Side, checked_count, register
+from .base import Payload, Side, SingleField, checked_count, register
 
 
 @dataclass(frozen=True, slots=True)
@@ -55,7 +55,7 @@ class StringCommandList(CommandList):
 
 
 @dataclass(frozen=True, slots=True)
-class StringCommandArgs(Payload):
+class StringCommandArgs(SingleField):
     """The argument of a listed string command (the server splits it into words).
 
     Not registered: each string command is its own data name.
@@ -63,12 +63,7 @@ class StringCommandArgs(Payload):
 
     DATA_NAME = ""
     SIDE = Side.ARGS
+    FIELD_KIND = "string"
+    FIELD_LABEL = "argument"
 
     argument: str
-
-    def encode(self) -> bytes:
-        return FieldWriter().string(self.argument).bytes()
-
-    @classmethod
-    def decode(cls, data: bytes) -> Self:
-        return cls(FieldReader(data).string("argument"))

@@ -10,7 +10,7 @@ from dataclasses import dataclass
 from typing import Self
 
 from ..fields import FieldReader, FieldWriter
-from .base import Payload, Side, register
+from .base import Payload, Side, SingleField, SingleFlag, register
 
 
 @register
@@ -61,89 +61,64 @@ class RatioDrive(Payload):
 
 @register
 @dataclass(frozen=True, slots=True)
-class SetSafeDrive(Payload):
+class SetSafeDrive(SingleFlag):
     """``setSafeDrive`` args: ``False`` turns the obstacle limiters off (group UnsafeMovement)."""
 
     DATA_NAME = "setSafeDrive"
     SIDE = Side.ARGS
+    FIELD_KIND = "ubyte"
+    FIELD_LABEL = "safe flag"
 
     safe: bool
-
-    def encode(self) -> bytes:
-        return FieldWriter().ubyte(1 if self.safe else 0).bytes()
-
-    @classmethod
-    def decode(cls, data: bytes) -> Self:
-        return cls(FieldReader(data).ubyte("safe flag") != 0)
 
 
 @register
 @dataclass(frozen=True, slots=True)
-class SafeDrive(Payload):
+class SafeDrive(SingleFlag):
     """``getSafeDrive`` reply: whether safe driving is on."""
 
     DATA_NAME = "getSafeDrive"
     SIDE = Side.REPLY
+    FIELD_KIND = "ubyte"
+    FIELD_LABEL = "safe flag"
 
     safe: bool
-
-    def encode(self) -> bytes:
-        return FieldWriter().ubyte(1 if self.safe else 0).bytes()
-
-    @classmethod
-    def decode(cls, data: bytes) -> Self:
-        return cls(FieldReader(data).ubyte("safe flag") != 0)
 
 
 @register
 @dataclass(frozen=True, slots=True)
-class MoveDist(Payload):
+class MoveDist(SingleField):
     """``moveDist`` args (jog mode): drive this many mm, forward positive."""
 
     DATA_NAME = "moveDist"
     SIDE = Side.ARGS
+    FIELD_KIND = "double"
+    FIELD_LABEL = "distance"
 
     distance: float
-
-    def encode(self) -> bytes:
-        return FieldWriter().double(self.distance).bytes()
-
-    @classmethod
-    def decode(cls, data: bytes) -> Self:
-        return cls(FieldReader(data).double("distance"))
 
 
 @register
 @dataclass(frozen=True, slots=True)
-class TurnByAngle(Payload):
+class TurnByAngle(SingleField):
     """``turnByAngle`` args (jog mode): turn by this many degrees, counter-clockwise positive."""
 
     DATA_NAME = "turnByAngle"
     SIDE = Side.ARGS
+    FIELD_KIND = "double"
+    FIELD_LABEL = "angle"
 
     angle: float
-
-    def encode(self) -> bytes:
-        return FieldWriter().double(self.angle).bytes()
-
-    @classmethod
-    def decode(cls, data: bytes) -> Self:
-        return cls(FieldReader(data).double("angle"))
 
 
 @register
 @dataclass(frozen=True, slots=True)
-class TurnToHeading(Payload):
+class TurnToHeading(SingleField):
     """``turnToHeading`` args (jog mode): turn to this absolute heading in degrees."""
 
     DATA_NAME = "turnToHeading"
     SIDE = Side.ARGS
+    FIELD_KIND = "double"
+    FIELD_LABEL = "heading"
 
     heading: float
-
-    def encode(self) -> bytes:
-        return FieldWriter().double(self.heading).bytes()
-
-    @classmethod
-    def decode(cls, data: bytes) -> Self:
-        return cls(FieldReader(data).double("heading"))

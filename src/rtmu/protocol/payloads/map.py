@@ -17,7 +17,7 @@ import numpy as np
 
 from ..errors import FieldUnderrun, PayloadError
 from ..fields import FieldReader, FieldWriter
-from .base import Payload, Side, checked_count, read_strings_to_end, register
+from .base import EmptyPayload, Payload, Side, SingleField, checked_count, read_strings_to_end, register
 
 SEGMENT_BYTES: Final = 16
 """``byte4 x1, y1, x2, y2``."""
@@ -29,21 +29,16 @@ COORD_DTYPE: Final = np.dtype("<i4")
 
 @register
 @dataclass(frozen=True, slots=True)
-class MapName(Payload):
+class MapName(SingleField):
     """``getMapName`` reply: the map file as the server configured it (may be a full path)."""
 
     DATA_NAME = "getMapName"
     SIDE = Side.REPLY
+    FIELD_KIND = "string"
+    FIELD_LABEL = "map file name"
 
     file_name: str
     """``""`` when the server has no map."""
-
-    def encode(self) -> bytes:
-        return FieldWriter().string(self.file_name).bytes()
-
-    @classmethod
-    def decode(cls, data: bytes) -> Self:
-        return cls(FieldReader(data).string("map file name"))
 
 
 @register
@@ -113,34 +108,20 @@ class Goals(Payload):
 
 @register
 @dataclass(frozen=True, slots=True)
-class MapUpdated(Payload):
+class MapUpdated(EmptyPayload):
     """``mapUpdated`` broadcast (empty): the server changed its map; fetch it again."""
 
     DATA_NAME = "mapUpdated"
     SIDE = Side.REPLY
 
-    def encode(self) -> bytes:
-        return b""
-
-    @classmethod
-    def decode(cls, data: bytes) -> Self:
-        return cls()
-
 
 @register
 @dataclass(frozen=True, slots=True)
-class GoalsUpdated(Payload):
+class GoalsUpdated(EmptyPayload):
     """``goalsUpdated`` broadcast (empty): the goal list changed; ask ``getGoals`` again."""
 
     DATA_NAME = "goalsUpdated"
     SIDE = Side.REPLY
-
-    def encode(self) -> bytes:
-        return b""
-
-    @classmethod
-    def decode(cls, data: bytes) -> Self:
-        return cls()
 
 
 @register
@@ -323,20 +304,15 @@ class MapMultiScansPacket(MapBinaryPacket):
 
 @register
 @dataclass(frozen=True, slots=True)
-class MapWithMaxCategoryRequest(Payload):
+class MapWithMaxCategoryRequest(SingleField):
     """``getMapWithMaxCategory`` args: ``""`` or ``2D-Map`` = ``getMapBinary``; ``2D-Map-Ex(2)`` add scans."""
 
     DATA_NAME = "getMapWithMaxCategory"
     SIDE = Side.ARGS
+    FIELD_KIND = "string"
+    FIELD_LABEL = "category"
 
     category: str = ""
-
-    def encode(self) -> bytes:
-        return FieldWriter().string(self.category).bytes()
-
-    @classmethod
-    def decode(cls, data: bytes) -> Self:
-        return cls(FieldReader(data).string("category"))
 
 
 def coords_bytes(array: object, columns: int) -> bytes:

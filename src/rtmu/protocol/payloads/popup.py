@@ -11,7 +11,7 @@ from enum import IntEnum
 from typing import Self
 
 from ..fields import FieldReader, FieldWriter
-from .base import Payload, Side, register
+from .base import EmptyPayload, Payload, Side, register
 
 
 class PopupType(IntEnum):
@@ -107,15 +107,8 @@ class PopupClicked(Payload):
 
 @register
 @dataclass(frozen=True, slots=True)
-class PopupListEnd(Payload):
+class PopupListEnd(EmptyPayload):
     """``popupList`` reply: the empty packet after the re-sent ``popupCreate`` packets."""
 
     DATA_NAME = "popupList"
     SIDE = Side.REPLY
-
-    def encode(self) -> bytes:
-        return b""
-
-    @classmethod
-    def decode(cls, data: bytes) -> Self:
-        return cls()

@@ -14,7 +14,7 @@ from typing import Final, Self
 
 from ..errors import FieldUnderrun
 from ..fields import FieldReader, FieldWriter
-from .base import Payload, Side, checked_count, register
+from .base import Payload, Side, SingleField, SingleFlag, checked_count, register
 
 TEMPERATURE_UNKNOWN: Final = -128
 """ARIA's temperature byte when the robot does not report one (MobileSim sends -127)."""
@@ -228,21 +228,16 @@ class PhysicalInfo(Payload):
 
 @register
 @dataclass(frozen=True, slots=True)
-class ActivityTimeInfo(Payload):
+class ActivityTimeInfo(SingleField):
     """``activityTimeInfo`` reply: seconds since the active mode last reported activity."""
 
     DATA_NAME = "activityTimeInfo"
     SIDE = Side.REPLY
+    FIELD_KIND = "byte4"
+    FIELD_LABEL = "seconds since activity"
 
     seconds: int
     """−1 when no mode is active."""
-
-    def encode(self) -> bytes:
-        return FieldWriter().byte4(self.seconds).bytes()
-
-    @classmethod
-    def decode(cls, data: bytes) -> Self:
-        return cls(FieldReader(data).byte4("seconds since activity"))
 
 
 @register
@@ -306,17 +301,12 @@ class ModeDataList(Payload):
 
 @register
 @dataclass(frozen=True, slots=True)
-class ModeBusyChanged(Payload):
+class ModeBusyChanged(SingleFlag):
     """``modeBusyChanged`` reply/broadcast: whether the active mode is busy right now."""
 
     DATA_NAME = "modeBusyChanged"
     SIDE = Side.REPLY
+    FIELD_KIND = "byte"
+    FIELD_LABEL = "busy"
 
     busy: bool
-
-    def encode(self) -> bytes:
-        return FieldWriter().byte(1 if self.busy else 0).bytes()
-
-    @classmethod
-    def decode(cls, data: bytes) -> Self:
-        return cls(FieldReader(data).byte("busy") != 0)

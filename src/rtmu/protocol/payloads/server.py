@@ -6,25 +6,20 @@ from dataclasses import dataclass
 from typing import Self
 
 from ..fields import FieldReader, FieldWriter
-from .base import Payload, Side, register
+from .base import EmptyPayload, Payload, Side, SingleField, SingleFlag, register
 
 
 @register
 @dataclass(frozen=True, slots=True)
-class IdleProcessingPending(Payload):
+class IdleProcessingPending(SingleFlag):
     """``idleProcessingPending`` reply/broadcast: the server holds idle-only requests for later."""
 
     DATA_NAME = "idleProcessingPending"
     SIDE = Side.REPLY
+    FIELD_KIND = "byte"
+    FIELD_LABEL = "pending"
 
     pending: bool
-
-    def encode(self) -> bytes:
-        return FieldWriter().byte(1 if self.pending else 0).bytes()
-
-    @classmethod
-    def decode(cls, data: bytes) -> Self:
-        return cls(FieldReader(data).byte("pending") != 0)
 
 
 @register
@@ -49,36 +44,24 @@ class RequestClientRestart(Payload):
 
 @register
 @dataclass(frozen=True, slots=True)
-class HeartbeatInterval(Payload):
+class HeartbeatInterval(SingleField):
     """``getHeartbeatInterval`` reply: ms between ``heartbeatTcp``/``heartbeatUdp`` broadcasts."""
 
     DATA_NAME = "getHeartbeatInterval"
     SIDE = Side.REPLY
+    FIELD_KIND = "ubyte4"
+    FIELD_LABEL = "heartbeat interval"
 
     interval_ms: int
-
-    def encode(self) -> bytes:
-        return FieldWriter().ubyte4(self.interval_ms).bytes()
-
-    @classmethod
-    def decode(cls, data: bytes) -> Self:
-        return cls(FieldReader(data).ubyte4("heartbeat interval"))
 
 
 @register
 @dataclass(frozen=True, slots=True)
-class HeartbeatTcp(Payload):
+class HeartbeatTcp(EmptyPayload):
     """``heartbeatTcp`` broadcast (empty), to subscribers only."""
 
     DATA_NAME = "heartbeatTcp"
     SIDE = Side.REPLY
-
-    def encode(self) -> bytes:
-        return b""
-
-    @classmethod
-    def decode(cls, data: bytes) -> Self:
-        return cls()
 
 
 @register
@@ -91,17 +74,12 @@ class HeartbeatUdp(HeartbeatTcp):
 
 @register
 @dataclass(frozen=True, slots=True)
-class SelfIdentifier(Payload):
+class SelfIdentifier(SingleField):
     """``identSetSelfIdentifier`` args: a free-form name for this client."""
 
     DATA_NAME = "identSetSelfIdentifier"
     SIDE = Side.ARGS
+    FIELD_KIND = "string"
+    FIELD_LABEL = "identifier"
 
     identifier: str
-
-    def encode(self) -> bytes:
-        return FieldWriter().string(self.identifier).bytes()
-
-    @classmethod
-    def decode(cls, data: bytes) -> Self:
-        return cls(FieldReader(data).string("identifier"))
