@@ -29,7 +29,7 @@ from ..model import LinkLevel, MapModel, Model, RobotState  # noqa: E402
 from . import overlays  # noqa: E402
 from .frame import Scene, draw_frame  # noqa: E402
 from .tiles import TileCache  # noqa: E402
-from .viewport import ZOOM_MAX, Viewport, fit_view, nearest_step, step_zoom  # noqa: E402
+from .viewport import ZOOM_MAX, ZOOM_MIN, Viewport, fit_view, nearest_step, step_zoom  # noqa: E402
 
 TRAIL_MAX = 1500
 TRAIL_MIN_STEP_MM = 30.0
@@ -82,6 +82,7 @@ class MapStage(Gtk.DrawingArea):
         self._drag_start: Viewport | None = None
         self._dragged = False
         self._pinch_start: Viewport | None = None
+        self._pinch_anchor: tuple[float, float] | None = None
         self._pointer: tuple[float, float] | None = None
         self._scroll_accum = 0.0
         self.set_draw_func(self._draw)
@@ -363,6 +364,7 @@ class MapStage(Gtk.DrawingArea):
 
     def _pinch_begin(self, _g: Gtk.GestureZoom, _seq: object) -> None:
         self._pinch_start = self.viewport
+        self._pinch_anchor = None
 
     def _pinch_changed(self, g: Gtk.GestureZoom, scale: float) -> None:
         start = self._pinch_start
@@ -370,13 +372,18 @@ class MapStage(Gtk.DrawingArea):
             return
         ok, cx, cy = g.get_bounding_box_center()
         anchor = (cx, cy) if ok and not self.follow else None
-        self.viewport = start.zoomed(min(ZOOM_MAX, start.zoom * scale), anchor)
+        self._pinch_anchor = anchor
+        low = min(ZOOM_MIN, start.zoom)  # a "fit" below 10 % may stay there, but a pinch goes no lower
+        self.viewport = start.zoomed(min(ZOOM_MAX, max(low, start.zoom * scale)), anchor)
         self.fitted = False
         self.queue_draw()
 
     def _pinch_end(self, _g: Gtk.GestureZoom, _seq: object) -> None:
         if self._pinch_start is not None:
-            self.viewport = self.viewport.zoomed(nearest_step(self.viewport.zoom))
+            zoom = self.viewport.zoom
+            if zoom >= ZOOM_MIN:  # end on a stop (tiles reused), about the fingers' point so it stays put
+                self.viewport = self.viewport.zoomed(nearest_step(zoom), self._pinch_anchor)
             self._pinch_start = None
+            self._pinch_anchor = None
             self._publish_view()
             self.queue_draw()
