@@ -15,7 +15,7 @@ import signal
 import subprocess
 import sys
 import time
-from collections.abc import Callable, Iterator
+from collections.abc import Iterator
 from pathlib import Path
 
 import pytest
@@ -23,18 +23,11 @@ import pytest
 from rtmu.sim import SimConfig, SimThread
 
 from .harness import OFFICE_MAP
+from .process import subscribed, wait
 
 SCREEN = (1024, 768)
 OPENBOX = shutil.which("openbox")
 CI = os.environ.get("CI", "").lower() in ("true", "1")  # as in conftest: on CI a missing tool fails
-
-
-def wait(condition: Callable[[], bool], timeout: float, what: str) -> None:
-    deadline = time.monotonic() + timeout
-    while not condition():
-        if time.monotonic() > deadline:
-            raise AssertionError(f"timed out after {timeout:g} s waiting for {what}")
-        time.sleep(0.05)
 
 
 def _stop(proc: subprocess.Popen[bytes]) -> None:
@@ -164,10 +157,6 @@ class Rtmu:
             self.proc.wait(5)
 
 
-def _subscribed(sim: SimThread) -> Callable[[], bool]:
-    return lambda: sim.call(lambda: any(session.subscriptions for session in sim.server.sessions))
-
-
 def test_f11_makes_the_window_fill_the_screen_and_back(
     wm_display: dict[str, str], tmp_path: Path, screenshots: Path
 ) -> None:
@@ -175,7 +164,7 @@ def test_f11_makes_the_window_fill_the_screen_and_back(
     with SimThread(SimConfig(port=0, map_path=OFFICE_MAP, seed=1)) as sim:
         app = Rtmu(env, sim.port, tmp_path)
         try:
-            wait(_subscribed(sim), 15, "the window to connect and subscribe")
+            wait(lambda: subscribed(sim), 15, "the window to connect and subscribe")
             window = app.window
             normal = _geometry(env, window)
             assert not _is_fullscreen(env, window)
@@ -203,7 +192,7 @@ def test_the_fullscreen_option_starts_full_screen(
         app = Rtmu(env, sim.port, tmp_path, "--fullscreen")
         try:
             wait(lambda: _fills_screen(env, app.window), 10, "--fullscreen to open the window full screen")
-            wait(_subscribed(sim), 15, "the window to connect and subscribe")
+            wait(lambda: subscribed(sim), 15, "the window to connect and subscribe")
             _shot(env, screenshots / "test_fullscreen_wm-03-option-fullscreen.png")
             assert app.proc.poll() is None, "rtmu exited"
         finally:

@@ -12,8 +12,6 @@ import os
 import signal
 import subprocess
 import sys
-import time
-from collections.abc import Callable
 from pathlib import Path
 
 import pytest
@@ -21,19 +19,7 @@ import pytest
 from rtmu.sim import SimConfig, SimThread
 
 from .harness import OFFICE_MAP
-
-
-def wait(condition: Callable[[], bool], timeout: float, what: str) -> None:
-    deadline = time.monotonic() + timeout
-    while not condition():
-        if time.monotonic() > deadline:
-            raise AssertionError(f"timed out after {timeout:g} s waiting for {what}")
-        time.sleep(0.02)
-
-
-def xdotool(*args: str) -> str:
-    return subprocess.run(["xdotool", *args], capture_output=True, text=True, timeout=15, check=True).stdout
-
+from .process import connect_and_hold_up, wait, xdotool
 
 SIGNALS = [signal.SIGHUP, signal.SIGQUIT, signal.SIGUSR1, signal.SIGUSR2, signal.SIGALRM]
 
@@ -53,24 +39,9 @@ def test_a_hangup_or_quit_signal_stops_the_robot_then_exits(
         )
         held = False
 
-        def subscribed() -> bool:
-            return any(session.subscriptions for session in sim.server.sessions)
-
         try:
-            found = xdotool("search", "--sync", "--onlyvisible", "--pid", str(proc.pid), "--name", "RTMU")
-            window = found.split()[0]
-            wait(lambda: sim.call(subscribed), 15, "the window to connect and subscribe")
-            xdotool("windowfocus", "--sync", window)
-            for _attempt in range(5):  # a press that beat the "connected" state to the window is refused
-                xdotool("keydown", "Up")
-                held = True
-                try:
-                    wait(lambda: abs(sim.snapshot().vel) > 1.0, 2, "the robot to drive")
-                    break
-                except AssertionError:
-                    xdotool("keyup", "Up")
-                    held = False
-            assert held, "the held key never drove the robot"
+            window = connect_and_hold_up(proc, sim)
+            held = True
             name = signal.Signals(signum).name
             subprocess.run(
                 ["import", "-window", window, str(screenshots / f"test_signals-{name}-01-driving.png")],

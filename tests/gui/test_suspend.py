@@ -18,7 +18,7 @@ from pathlib import Path
 from rtmu.sim import SimConfig, SimThread
 
 from .harness import OFFICE_MAP
-from .test_signals import wait, xdotool
+from .process import connect_and_hold_up, wait, xdotool
 
 
 def process_state(pid: int) -> str:
@@ -44,27 +44,12 @@ def test_ctrl_z_stops_the_robot_then_the_process_and_nothing_drives_after_resume
         held = False
         robot = sim.server.robot
 
-        def subscribed() -> bool:
-            return any(session.subscriptions for session in sim.server.sessions)
-
         def drives_received() -> int:
             return int(sim.call(lambda: robot.ratio_drives_received))
 
         try:
-            found = xdotool("search", "--sync", "--onlyvisible", "--pid", str(proc.pid), "--name", "RTMU")
-            window = found.split()[0]
-            wait(lambda: sim.call(subscribed), 15, "the window to connect and subscribe")
-            xdotool("windowfocus", "--sync", window)
-            for _attempt in range(5):  # a press that beat the "connected" state to the window is refused
-                xdotool("keydown", "Up")
-                held = True
-                try:
-                    wait(lambda: abs(sim.snapshot().vel) > 1.0, 2, "the robot to drive")
-                    break
-                except AssertionError:
-                    xdotool("keyup", "Up")
-                    held = False
-            assert held, "the held key never drove the robot"
+            window = connect_and_hold_up(proc, sim)
+            held = True
             watchdog_stops = sim.call(lambda: robot.watchdog_stops)
 
             proc.send_signal(signal.SIGTSTP)

@@ -1,0 +1,47 @@
+"""Helpers for GUI tests that run ``rtmu`` as a real process against a :class:`SimThread`."""
+
+from __future__ import annotations
+
+import subprocess
+import time
+from collections.abc import Callable
+
+from rtmu.sim import SimThread
+
+
+def wait(condition: Callable[[], bool], timeout: float, what: str, *, poll: float = 0.02) -> None:
+    """Poll ``condition`` until it holds; fail naming ``what`` after ``timeout`` seconds."""
+    deadline = time.monotonic() + timeout
+    while not condition():
+        if time.monotonic() > deadline:
+            raise AssertionError(f"timed out after {timeout:g} s waiting for {what}")
+        time.sleep(poll)
+
+
+def xdotool(*args: str) -> str:
+    return subprocess.run(["xdotool", *args], capture_output=True, text=True, timeout=15, check=True).stdout
+
+
+def subscribed(sim: SimThread) -> bool:
+    """True once some client has subscribed to data: the window is connected."""
+    return bool(sim.call(lambda: any(session.subscriptions for session in sim.server.sessions)))
+
+
+def connect_and_hold_up(proc: subprocess.Popen[str], sim: SimThread) -> str:
+    """Wait for the window of ``proc`` to connect, then hold Up until the robot drives; the window id.
+
+    A press that beats the "connected" state to the window is refused (no motion
+    without a fresh press), so the key is released and pressed again, a few times.
+    """
+    found = xdotool("search", "--sync", "--onlyvisible", "--pid", str(proc.pid), "--name", "RTMU")
+    window = found.split()[0]
+    wait(lambda: subscribed(sim), 15, "the window to connect and subscribe")
+    xdotool("windowfocus", "--sync", window)
+    for _attempt in range(5):
+        xdotool("keydown", "Up")
+        try:
+            wait(lambda: abs(sim.snapshot().vel) > 1.0, 2, "the robot to drive")
+            return window
+        except AssertionError:
+            xdotool("keyup", "Up")
+    raise AssertionError("the held key never drove the robot")
