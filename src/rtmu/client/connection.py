@@ -378,6 +378,8 @@ class AriaClient:
         """Exceptions raised by subscription handlers (logged, never fatal)."""
         self.slow_handlers = 0
         """Handler calls that took longer than :data:`SLOW_HANDLER` (logged: they delay every packet)."""
+        self.max_handler_seconds = 0.0
+        """The longest one handler call has held the loop (soak and health figures)."""
         self.last_packet_at: float | None = None
         self.packets_received = 0
 
@@ -724,6 +726,7 @@ class AriaClient:
                 self.handler_errors += 1
                 log.exception("handler for %s failed", event.name)
             spent = time.perf_counter() - started
+            self.max_handler_seconds = max(self.max_handler_seconds, spent)
             if spent > SLOW_HANDLER:  # it held up the loop that sends the stops: say so
                 self.slow_handlers += 1
                 if self.slow_handlers <= 10 or self.slow_handlers % 1000 == 0:
