@@ -49,6 +49,7 @@ class ServerConnection:
         server_key: str = "",
         udp_port: int = 0,
         rng: random.Random | None = None,
+        protocol_version: str = "",
     ) -> None:
         self._full_datalist = datalist
         self.datalist = datalist
@@ -71,7 +72,7 @@ class ServerConnection:
             .ubyte4(self.auth_key)
             .ubyte4(self.intro_key)
             .string(self.password_key)
-            .string("")
+            .string(protocol_version)  # ARIA advertises the string it enforces (§2.4 field 6)
             .bytes()
         )
         self._send(ServerCommand.INTRODUCTION, intro)

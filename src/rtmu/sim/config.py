@@ -29,7 +29,9 @@ class SimConfig:
     """ARIA's maxClientsAllowed: one more is refused with reason 5 (None: no limit, as ARIA's default —
     but every client may queue up to ``max_queued_bytes``, so a simulator keeps a limit)."""
     protocol_version: str | None = None
-    """Enforce a protocol version (reason 4 for a client that differs)."""
+    """Enforce a protocol version (reason 4 for a client that differs); None: the profile's."""
+    profile: str = "default"
+    """Which kind of server to be (:mod:`rtmu.sim.profiles`): ``default`` or ``aram``."""
     client_type: int | None = None
     """Enforce a client type (reason 6), as ``ArServerBase::enforceType`` does."""
     central_server: str | None = None

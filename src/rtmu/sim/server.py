@@ -39,11 +39,10 @@ from rtmu.protocol.fields import FieldReader
 from rtmu.protocol.packet import Packet, encode_packet
 from rtmu.protocol.server_connection import ServerConnection, ServerState
 
-from .catalogue import Row, build_catalogue, custom_commands
+from .catalogue import Row, custom_commands
 from .config import SimConfig
 from .handlers import (
     BROADCAST_ONLY,
-    HANDLERS,
     Call,
     Other,
     Stream,
@@ -53,6 +52,7 @@ from .handlers import (
     strings_payload,
 )
 from .mapserve import Chunks, ServedMap, load_map
+from .profiles import get_profile
 from .video import VideoFeed
 from .world import PHYSICS_DT, World, free_spot_near
 
@@ -98,8 +98,9 @@ class SimServerConnection(ServerConnection):
             r.raw(16)
             version = r.string(default="")
             client_type = r.byte(default=0)
+        enforced = self._config.protocol_version
         cfg = self._config
-        if cfg.protocol_version is not None and version != cfg.protocol_version:
+        if enforced is not None and version != enforced:
             return self.reject(
                 RejectReason.PROTOCOL_VERSION_MISMATCH,
                 "Server rejecting client connection since protocol version does not match",
@@ -332,7 +333,11 @@ class SimServer:
     def __init__(self, config: SimConfig | None = None) -> None:
         self.config = config or SimConfig()
         cfg = self.config
-        self.map: ServedMap = load_map(cfg.map_path)
+        self.profile = get_profile(cfg.profile)
+        if cfg.protocol_version is None:
+            cfg.protocol_version = self.profile.protocol_version
+        self.handlers = self.profile.handler_table()
+        self.map: ServedMap = self._load_map(cfg.map_path)
         obstacles = self.map.obstacles()
         home = self.map.home
         x, y = free_spot_near(obstacles, home[0], home[1], 250.0) if self.map.present else (home[0], home[1])
@@ -345,7 +350,7 @@ class SimServer:
             battery_v=cfg.battery_v,
         )
         self.home = (x, y, home[2])
-        self.datalist: DataList = build_catalogue(camera=cfg.camera)
+        self.datalist: DataList = self.profile.catalogue(camera=cfg.camera)
         self.users: UserTable | None = UserTable.load(cfg.users_path) if cfg.users_path else None
         self.sessions: list[Session] = []
         self._ids = count(1)
@@ -455,6 +460,7 @@ class SimServer:
             server_key=cfg.server_key,
             udp_port=0,
             rng=KEY_RNG,
+            protocol_version=cfg.protocol_version or "",
             general_reject=general,
             config=cfg,
         )
@@ -481,7 +487,7 @@ class SimServer:
         return value
 
     def invoke(self, session: Session, number: int, name: str, args: bytes, *, once: bool) -> None:
-        handler = HANDLERS.get(name)
+        handler = self.handlers.get(name)
         if handler is None:
             return
         replies = handler(Call(self, session, name, number, args, once))
@@ -599,7 +605,7 @@ class SimServer:
         raw_md5 = hashlib.md5(path.read_bytes()).digest()
         if raw_md5 == self.map.md5:
             return False
-        self.map = load_map(path)
+        self.map = self._load_map(path)
         obstacles = self.map.obstacles()
         home = self.map.home
         x, y = free_spot_near(obstacles, home[0], home[1], 250.0)
@@ -609,6 +615,16 @@ class SimServer:
         self.broadcast("mapUpdated")
         self.broadcast("goalsUpdated")
         return True
+
+    def _load_map(self, path):
+        """The map file, served with the profile's first line (an LD robot's ``2D-Map-Ex4``)."""
+        served = load_map(path)
+        header = self.profile.map_header
+        if header and served.present and served.lines:
+            served.lines[0] = header
+            if served.header:
+                served.header[0] = header
+        return served
 
     # -- tools for tests and the demo -------------------------------------------------------
     def reset_pose(self) -> None:

@@ -21,11 +21,11 @@ EXIT_BAD_INPUT = 2
 EXIT_CANNOT_LISTEN = 3
 
 
-def default_map() -> Path | None:
-    """The project's arena map, when the checkout has it."""
+def default_map(name: str = "arena.map") -> Path | None:
+    """One of the project's maps (the arena unless named), when the checkout has it."""
     here = Path(__file__).resolve()
     for parent in here.parents:
-        candidate = parent / "data" / "maps" / "arena.map"
+        candidate = parent / "data" / "maps" / name
         if candidate.is_file():
             return candidate
     return None
@@ -66,6 +66,20 @@ def register(subparsers: argparse._SubParsersAction) -> None:  # type: ignore[ty
         default=100,
         help="refuse more clients than this, ARIA's reason 5 (default 100; 0 = no limit)",
     )
+    p.add_argument(
+        "--profile",
+        choices=("default", "aram"),
+        default="default",
+        help="which server to be: default (serverDemo, Pioneer 3-DX) or aram (an Omron LD robot: "
+        "protocol 6MTX, state of charge, Ex4 map, ~950 data)",
+    )
+    p.add_argument(
+        "--protocol",
+        metavar="STRING",
+        default=None,
+        help="enforce and advertise this protocol string, refusing others with reason 4 "
+        "(default: the profile's — none, or 6MTX for aram)",
+    )
     p.add_argument("-v", "--verbose", action="store_true", help="log connections and refusals")
     gen = p.add_argument_group("map generator (writes a map and exits)")
     gen.add_argument("--make-map", type=Path, metavar="FILE", help="write a generated building map to FILE")
@@ -79,7 +93,11 @@ def run(args: argparse.Namespace) -> int:
         return make_map(args)
     from ..sim import SimConfig
 
-    map_path = None if args.no_map else (args.map or default_map())
+    map_path = (
+        None
+        if args.no_map
+        else (args.map or default_map("office.map" if args.profile == "aram" else "arena.map"))
+    )
     if map_path is not None and not map_path.is_file():
         print(f"rtmu sim: no such map file: {map_path}", file=sys.stderr)
         return EXIT_BAD_INPUT
@@ -96,6 +114,8 @@ def run(args: argparse.Namespace) -> int:
         drive_timeout=args.drive_timeout,
         server_key=args.server_key,
         max_clients=args.max_clients if args.max_clients > 0 else None,
+        protocol_version=args.protocol,
+        profile=args.profile,
         verbose=args.verbose,
     )
     if args.battery is not None:
@@ -129,6 +149,10 @@ async def serve(cfg) -> int:
     extras = "" if cfg.camera else "; no camera"
     if cfg.users_path:
         extras += f"; users from {cfg.users_path}"
+    if cfg.profile != "default":
+        extras += f"; profile {cfg.profile}"
+    if cfg.protocol_version:
+        extras += f"; protocol {cfg.protocol_version!r} enforced"
     print(
         f"rtmu sim: ARIA robot server listening on {cfg.host}:{server.port}, serving {served}; "
         f"Pioneer 3-DX at ({home[0]:.0f}, {home[1]:.0f}) mm, {home[2]:.0f} deg{extras}",
