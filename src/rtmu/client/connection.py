@@ -421,12 +421,15 @@ class AriaClient:
         *,
         timeout: float = CONNECT_TIMEOUT,
         server_key: str = "",
+        protocol: str | None = None,
     ) -> DataList:
         """Open the socket, log in and wait for the complete data list, all within ``timeout`` s."""
         if self._conn is not None:
             raise RuntimeError("AriaClient objects are single-use: make a new one to connect again")
         self.host, self.port, self.user = host, port, user or ""
-        self._conn = ClientConnection(user or "", password or "", server_key=server_key)
+        self._conn = ClientConnection(
+            user or "", password or "", server_key=server_key, protocol_version=protocol
+        )
         deadline = asyncio.get_running_loop().time() + timeout
         try:
             async with asyncio.timeout_at(deadline):
@@ -488,7 +491,9 @@ class AriaClient:
             ready = False
             for event in events:
                 if isinstance(event, Rejected):
-                    raise LoginRejected(event.reason, event.text)
+                    raise LoginRejected(
+                        event.reason, event.text, event.message, self._conn.wanted_protocol()
+                    )
                 if isinstance(event, PeerShutdown):
                     raise ServerClosed(f"{self.host}:{self.port} shut the connection down during login")
                 if isinstance(event, DataListReady):

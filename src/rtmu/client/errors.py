@@ -44,10 +44,14 @@ class LoginRejected(ClientError):
 
     kind = "login"
 
-    def __init__(self, reason: int, text: str = "") -> None:
+    def __init__(
+        self, reason: int, text: str = "", advice: str = "", wanted_protocol: str | None = None
+    ) -> None:
         self.reason = reason
         self.text = text
-        super().__init__(f"login refused: {describe_reject(reason, text)}")
+        self.wanted_protocol = wanted_protocol
+        """Reason 4: the protocol string the server advertised (None: not known)."""
+        super().__init__(f"login refused: {advice or describe_reject(reason, text)}")
 
     @property
     def bad_credentials(self) -> bool:

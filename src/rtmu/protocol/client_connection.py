@@ -14,7 +14,14 @@ from __future__ import annotations
 from enum import Enum, auto
 
 from .auth import password_digest
-from .commands import ClientCommand, ClientType, ServerCommand, describe_reject, is_control_command
+from .commands import (
+    ClientCommand,
+    ClientType,
+    RejectReason,
+    ServerCommand,
+    describe_reject,
+    is_control_command,
+)
 from .datalist import DataList
 from .decoder import PacketDecoder
 from .errors import FieldUnderrun, ProtocolError
@@ -52,13 +59,15 @@ class ClientConnection:
         password: str = "",
         *,
         server_key: str = "",
-        protocol_version: str = "",
+        protocol_version: str | None = None,
         client_type: ClientType = ClientType.UNSPECIFIED,
     ) -> None:
         self.user = user
         self._password = password
         self.server_key = server_key
         self.protocol_version = protocol_version
+        """What we answer; None: the string the server advertises (what an enforcing server wants)."""
+        self.sent_protocol_version: str | None = None
         self.client_type = client_type
         self.state = ClientState.WAITING_INTRODUCTION
         self.datalist = DataList()
@@ -163,12 +172,14 @@ class ClientConnection:
         self.introduction = intro
         digest = password_digest(self._password, intro.password_key, self.server_key)
         self._password = ""  # not kept longer than needed
+        answer = intro.protocol_version if self.protocol_version is None else self.protocol_version
+        self.sent_protocol_version = answer
         payload = (
             FieldWriter()
             .ubyte2(0)
             .string(self.user)
             .raw(digest)
-            .string(self.protocol_version)
+            .string(answer)
             .byte(int(self.client_type))
             .bytes()
         )
@@ -182,4 +193,22 @@ class ClientConnection:
         reason = r.byte2("reason", default=0)
         text = r.string("text", default="")
         self.state = ClientState.REJECTED
-        return Rejected(reason, text, describe_reject(reason, text))
+        message = describe_reject(reason, text)
+        wanted = self.wanted_protocol()
+        if reason == RejectReason.PROTOCOL_VERSION_MISMATCH and wanted is not None:
+            message = protocol_advice(wanted, self.sent_protocol_version or "")
+        return Rejected(reason, text, message)
+
+    def wanted_protocol(self) -> str | None:
+        """The protocol string the server advertised (None before its introduction)."""
+        return None if self.introduction is None else self.introduction.protocol_version
+
+
+def protocol_advice(wanted: str, sent: str) -> str:
+    """What a reason-4 refusal means, and what to do about it."""
+    if wanted:
+        return f"the server wants protocol {wanted!r}; we sent {sent!r}. Use --protocol {wanted}"
+    return (
+        f"the server refuses our protocol string {sent!r} and does not say which it wants; "
+        "try --protocol 6MTX (Omron LD robots; older ones 5MTX)"
+    )

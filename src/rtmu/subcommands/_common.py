@@ -129,6 +129,13 @@ def add_connection_arguments(parser: argparse.ArgumentParser) -> None:
         help="read the password from the first line of FILE (else it is asked for when --user is given)",
     )
     parser.add_argument(
+        "--protocol",
+        metavar="STRING",
+        default=None,
+        help="protocol string to log in with (default: the one the server advertises, e.g. 6MTX on "
+        "Omron LD robots)",
+    )
+    parser.add_argument(
         "--timeout",
         type=positive_float,
         default=CONNECT_TIMEOUT,
@@ -312,7 +319,9 @@ def run_with_client(name: str, args: argparse.Namespace, body: Callable[[AriaCli
         interrupts.install()
         _INTERRUPTS.set(interrupts)
         try:
-            await client.connect(host, port, args.user, password, timeout=args.timeout)
+            await client.connect(
+                host, port, args.user, password, timeout=args.timeout, protocol=args.protocol
+            )
             return await body(client)
         except asyncio.CancelledError:
             signum = interrupts.take()
@@ -359,28 +368,43 @@ def print_json(obj: Any) -> None:
 
 
 STATUS_KEYS = ("x", "y", "th", "vel", "rot_vel", "battery_v", "status", "mode")
-"""The documented keys of a status object: mm, mm, degrees, mm/s, deg/s, volts (or % charge), text, text."""
+"""The documented keys of a status object: mm, mm, degrees, mm/s, deg/s, volts, text, text. A robot
+that reports state of charge gives ``battery_pct`` (percent) in place of ``battery_v``."""
 
 
-def status_object(numbers: Any, status: str, mode: str) -> dict[str, Any]:
-    """One status as the JSON object ``rtmu status`` and ``rtmu drive`` print."""
+def status_object(numbers: Any, status: str, mode: str, *, soc: bool = False) -> dict[str, Any]:
+    """One status as the JSON object ``rtmu status`` and ``rtmu drive`` print.
+
+    ``soc``: the server's ``batteryInfo`` says the battery figure is percent of charge, not volts.
+    """
     return {
         "x": numbers.x,
         "y": numbers.y,
         "th": numbers.th,
         "vel": numbers.vel,
         "rot_vel": numbers.rot_vel,
-        "battery_v": numbers.battery,
+        "battery_pct" if soc else "battery_v": numbers.battery,
         "status": status,
         "mode": mode,
     }
 
 
 def status_line(obj: dict[str, Any]) -> str:
+    battery = f"{obj['battery_pct']:.0f} %" if "battery_pct" in obj else f"{obj['battery_v']:.1f} V"
     return (
         f"x={obj['x']} mm  y={obj['y']} mm  th={obj['th']}°  vel={obj['vel']} mm/s  "
-        f"rot={obj['rot_vel']}°/s  battery={obj['battery_v']:.1f}  {obj['status']} ({obj['mode']})"
+        f"rot={obj['rot_vel']}°/s  battery={battery}  {obj['status']} ({obj['mode']})"
     )
+
+
+async def battery_is_soc(client: AriaClient, timeout: float) -> bool:
+    """True when ``batteryInfo`` says the battery figures are state of charge (percent)."""
+    from ..protocol.payloads.robot import BatteryInfo
+
+    if not client.supports("batteryInfo"):
+        return False
+    info = (await client.request_once("batteryInfo", timeout=timeout)).decode()
+    return isinstance(info, BatteryInfo) and info.state_of_charge
 
 
 async def fetch_status(client: AriaClient, timeout: float) -> dict[str, Any]:
@@ -396,9 +420,10 @@ async def fetch_status(client: AriaClient, timeout: float) -> dict[str, Any]:
             strings = (await client.request_once("updateStrings", timeout=timeout)).decode()
             assert isinstance(strings, UpdateStrings)
             status, mode = strings.status, strings.mode
-        return status_object(numbers, status, mode)
+        return status_object(numbers, status, mode, soc=await battery_is_soc(client, timeout))
     if client.supports("update"):
         update = (await client.request_once("update", timeout=timeout)).decode()
         assert isinstance(update, Update)
-        return status_object(update.numbers, update.status, update.mode)
+        soc = await battery_is_soc(client, timeout)
+        return status_object(update.numbers, update.status, update.mode, soc=soc)
     raise NotSupported("updateNumbers", "this server offers no robot status (updateNumbers or update)")

@@ -2,8 +2,8 @@
 
 ``--json`` prints one JSON object per status (one line each when streaming) with
 the keys ``x``, ``y`` (mm), ``th`` (degrees), ``vel`` (mm/s), ``rot_vel``
-(deg/s), ``battery_v`` (volts, or % charge if the robot reports state of
-charge), ``status`` and ``mode``.
+(deg/s), ``battery_v`` (volts) — or ``battery_pct`` instead when the robot
+reports state of charge (``batteryInfo``) — ``status`` and ``mode``.
 """
 
 from __future__ import annotations
@@ -20,6 +20,7 @@ from ..protocol.errors import ProtocolError
 from ..protocol.payloads.robot import Update, UpdateNumbers, UpdateStrings
 from ._common import (
     add_connection_arguments,
+    battery_is_soc,
     fetch_status,
     print_json,
     run_with_client,
@@ -33,7 +34,8 @@ def register(subparsers: Any) -> None:
         "status",
         help="print or stream the robot status",
         description="Print the robot status once (--once) or stream it until interrupted. "
-        "JSON keys: x, y (mm), th (deg), vel (mm/s), rot_vel (deg/s), battery_v, status, mode.",
+        "JSON keys: x, y (mm), th (deg), vel (mm/s), rot_vel (deg/s), battery_v (volts) or "
+        "battery_pct (state of charge), status, mode.",
     )
     add_connection_arguments(p)
     p.add_argument("--once", action="store_true", help="print one status and exit")
@@ -66,6 +68,7 @@ def handle(args: argparse.Namespace) -> int:
 
 async def stream(client: AriaClient, args: argparse.Namespace, show: Any) -> int:
     strings = {"status": "", "mode": ""}
+    soc = await battery_is_soc(client, args.timeout)
     queue: asyncio.Queue[dict[str, Any]] = asyncio.Queue()
     malformed: list[ProtocolError] = []
     """Status packets that did not decode: skipped, and named if no good one comes in time."""
@@ -77,9 +80,9 @@ async def stream(client: AriaClient, args: argparse.Namespace, show: Any) -> int
             malformed[:] = [exc]
             return
         if isinstance(n, UpdateNumbers):
-            queue.put_nowait(status_object(n, strings["status"], strings["mode"]))
+            queue.put_nowait(status_object(n, strings["status"], strings["mode"], soc=soc))
         elif isinstance(n, Update):
-            queue.put_nowait(status_object(n.numbers, n.status, n.mode))
+            queue.put_nowait(status_object(n.numbers, n.status, n.mode, soc=soc))
 
     def on_strings(packet: Packet) -> None:
         try:

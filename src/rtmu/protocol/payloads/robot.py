@@ -166,7 +166,8 @@ class BatteryInfo(Payload):
     low_battery: float
     shutdown: float
     state_of_charge: bool = False
-    """True: battery values (``updateNumbers.battery`` too) are % charge; False: volts."""
+    """True: battery values (``updateNumbers.battery`` too) are % charge; False: volts (also when an
+    older server leaves the flag out)."""
 
     def encode(self) -> bytes:
         return (
@@ -180,7 +181,9 @@ class BatteryInfo(Payload):
     @classmethod
     def decode(cls, data: bytes) -> Self:
         r = FieldReader(data)
-        return cls(r.double("low battery"), r.double("shutdown"), r.ubyte("state of charge flag") != 0)
+        return cls(
+            r.double("low battery"), r.double("shutdown"), r.ubyte("state of charge flag", default=0) != 0
+        )
 
 
 @register
