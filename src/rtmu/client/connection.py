@@ -49,6 +49,7 @@ from .errors import (
     ClientTimeout,
     ConnectionFailed,
     ConnectionRefused,
+    HostNotFound,
     LoginRejected,
     MalformedReply,
     NotSupported,
@@ -441,7 +442,7 @@ class AriaClient:
                 f"connection refused by {host}:{port} (is the robot server running on that port?)"
             ) from None
         except socket.gaierror as exc:
-            raise ConnectionFailed(f"cannot find host {host!r}: {exc.strerror or exc}") from None
+            raise HostNotFound(f"cannot find host {host!r}: {exc.strerror or exc}") from None
         except OSError as exc:
             raise ConnectionFailed(f"cannot connect to {host}:{port}: {exc.strerror or exc}") from None
         sock = self._writer.get_extra_info("socket")

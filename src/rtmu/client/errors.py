@@ -32,6 +32,10 @@ class ConnectionFailed(ClientError):
     kind = "unreachable"
 
 
+class HostNotFound(ConnectionFailed):
+    """The host name does not resolve (a typo, or no DNS for it on this network)."""
+
+
 class ClientTimeout(ClientError, TimeoutError):
     """The server did not answer in time (connect, login, or a request)."""
 

@@ -1,0 +1,163 @@
+"""The words for "why does it not connect": one table shared by ``rtmu doctor`` and the window.
+
+A connection walks through steps (name → TCP → the server's introduction → login → data list →
+UDP → first status). Each failure is told as the step it happened at, what went wrong in plain
+words, and what to do next. ``rtmu doctor`` prints these step by step; the window's
+"Could not connect" banner shows the same sentence (:func:`explain`).
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+from enum import Enum
+
+from ..protocol.commands import RejectReason
+from .errors import (
+    ClientError,
+    ClientTimeout,
+    ConnectionFailed,
+    ConnectionRefused,
+    HostNotFound,
+    LoginRejected,
+    ProtocolFault,
+    ServerClosed,
+)
+
+
+class Step(Enum):
+    """The steps of a connection, in order; the value is ``rtmu doctor``'s exit code when it fails."""
+
+    RESOLVE = 10
+    TCP = 11
+    INTRODUCTION = 12
+    LOGIN = 13
+    DATA_LIST = 14
+    UDP = 16
+    """Never fails ``rtmu doctor`` (RTMU uses TCP only)."""
+    STATUS = 15
+
+    @property
+    def key(self) -> str:
+        return self.name.lower()
+
+    @property
+    def title(self) -> str:
+        return STEP_TITLES[self]
+
+
+STEP_TITLES = {
+    Step.RESOLVE: "name resolution",
+    Step.TCP: "TCP connection",
+    Step.INTRODUCTION: "server introduction",
+    Step.LOGIN: "login",
+    Step.DATA_LIST: "data list",
+    Step.UDP: "UDP",
+    Step.STATUS: "first status",
+}
+
+
+@dataclass(frozen=True)
+class Finding:
+    """One failed step: what happened and what to do about it."""
+
+    step: Step
+    problem: str
+    advice: str
+
+    def sentence(self) -> str:
+        """One line for a banner or a log: "<problem> — <advice>"."""
+        return f"{self.problem} — {self.advice}" if self.advice else self.problem
+
+
+# -- the table ------------------------------------------------------------------------------------
+ADVICE = {
+    "resolve": "check the spelling, or use the robot's IP address instead of its name",
+    "refused": "nothing listens on that port: check that the robot's server (ARAM / the ARIA server) "
+    "is running and that the port is right (ARIA and Omron LD robots use 7272)",
+    "connect_timeout": "no answer at all: the robot may be off, on another network, or a firewall "
+    "drops the packets; check that this computer is on the robot's network (try ping)",
+    "unreachable": "there is no route to that address: check the network (Wi-Fi, cable, VPN) and "
+    "the robot's IP address",
+    "not_aria": "something answers on that port, but it is not an ARIA robot server: check the port "
+    "(ARIA and Omron LD robots use 7272)",
+    "no_introduction": "the server accepted the connection but never introduced itself: it may be "
+    "busy or hung; restart the robot's server software and try again",
+    "closed_early": "the server closed the connection before the login finished: it may be "
+    "restarting, or it drops clients it does not like; try again in a minute",
+    "login_timeout": "the server did not finish the login in time: it may be overloaded; try again",
+    "status_missing": "this server offers no robot status (updateNumbers/update): RTMU can connect "
+    "but will show no pose or battery",
+    "status_timeout": "the server did not send a status in time: the robot's base may be "
+    "disconnected from its server; check the robot",
+}
+
+REJECT_ADVICE = {
+    RejectReason.BAD_USER_OR_PASSWORD: (
+        "wrong user name or password",
+        "check --user and the password (user names are letters and digits only, case-insensitive); "
+        "without a user name the server must have no user file",
+    ),
+    RejectReason.USING_CENTRAL_SERVER: (
+        "this robot is managed by a central server",
+        "connect to the central server (its address is given above) instead of the robot",
+    ),
+    RejectReason.TOO_MANY_CLIENTS: (
+        "the server has as many clients as it allows",
+        "close another client connected to this robot (MobilePlanner, another RTMU), then retry",
+    ),
+    RejectReason.CLIENT_TYPE_MISMATCH: (
+        "the server only accepts clients of another type (real vs simulated robot)",
+        "this server is set to refuse clients of RTMU's type; ask its administrator",
+    ),
+}
+
+
+def login_finding(reason: int, text: str = "", wanted: str | None = None, sent: str = "") -> Finding:
+    """A REJECTED packet in plain words, with what to do."""
+    if reason == RejectReason.PROTOCOL_VERSION_MISMATCH:
+        if wanted:
+            return Finding(
+                Step.LOGIN,
+                f"the server wants protocol {wanted!r}; we sent {sent!r}",
+                f"use --protocol {wanted} (or leave --protocol out: RTMU then answers with the "
+                "string the server advertises)",
+            )
+        return Finding(
+            Step.LOGIN,
+            f"the server refuses our protocol string {sent!r} and does not say which it wants",
+            "try --protocol 6MTX (Omron LD robots; older ones 5MTX)",
+        )
+    try:
+        problem, advice = REJECT_ADVICE[RejectReason(reason)]
+    except (ValueError, KeyError):
+        problem, advice = f"the server refused the login (reason {reason})", "ask the robot's administrator"
+    if text and reason == RejectReason.USING_CENTRAL_SERVER:
+        problem += f" at {text}"
+    elif text and reason not in (RejectReason.TOO_MANY_CLIENTS,):
+        problem += f" ({text})"
+    return Finding(Step.LOGIN, problem, advice)
+
+
+def explain(error: ClientError) -> Finding:
+    """The step and the plain words for a failed connection attempt (the window's banner text)."""
+    message = str(error)
+    if isinstance(error, HostNotFound):
+        return Finding(Step.RESOLVE, message, ADVICE["resolve"])
+    if isinstance(error, ConnectionRefused):
+        return Finding(Step.TCP, message, ADVICE["refused"])
+    if isinstance(error, ClientTimeout):
+        if message.startswith("connecting to"):
+            return Finding(Step.TCP, message, ADVICE["connect_timeout"])
+        return Finding(Step.LOGIN, message, ADVICE["login_timeout"])
+    if isinstance(error, ConnectionFailed):
+        return Finding(Step.TCP, message, ADVICE["unreachable"])
+    if isinstance(error, LoginRejected):
+        finding = login_finding(error.reason, error.text, error.wanted_protocol)
+        if error.reason == RejectReason.PROTOCOL_VERSION_MISMATCH:  # its message names both strings
+            return Finding(Step.LOGIN, message.removeprefix("login refused: "), finding.advice)
+        return finding
+    if isinstance(error, ProtocolFault):
+        return Finding(Step.INTRODUCTION, message, ADVICE["not_aria"])
+    if isinstance(error, ServerClosed):
+        return Finding(Step.LOGIN, message, ADVICE["closed_early"])
+    return Finding(Step.LOGIN, message, "")

@@ -1,0 +1,449 @@
+"""``rtmu doctor HOST[:PORT]``: walk the whole way to a robot and say, step by step, what worked.
+
+"It doesn't connect and I can't tell why" is what owners of ARIA robots ask most. The doctor
+tries each step on its own — name resolution, TCP connect, the server's introduction (its version
+tag and protocol string), the login, the data list (and which RTMU features the server offers),
+UDP, the first status — and for the first step that fails says in plain words what went wrong
+and what to do next (the same words the window uses, :mod:`rtmu.client.diagnosis`). It stops
+there; the exit code names the step (10 name … 15 status; UDP never fails it, RTMU uses TCP).
+"""
+
+from __future__ import annotations
+
+import argparse
+import asyncio
+import contextlib
+import socket
+import sys
+import time
+from dataclasses import dataclass, field
+from typing import Any
+
+from ..cli import EXIT_OK, EXIT_USAGE
+from ..client.diagnosis import ADVICE, Step, login_finding
+from ..protocol.client_connection import ClientConnection
+from ..protocol.commands import ClientCommand, ServerCommand
+from ..protocol.decoder import PacketDecoder
+from ..protocol.errors import ProtocolError
+from ..protocol.events import (
+    Connected,
+    DataListReady,
+    DataReceived,
+    PeerShutdown,
+    Rejected,
+    ServerIntroduction,
+)
+from ..protocol.fields import FieldReader, FieldWriter
+from ..protocol.packet import encode_packet
+from ..protocol.payloads import Side, decode_payload
+from ..protocol.payloads.robot import BatteryInfo, Update, UpdateNumbers, UpdateStrings
+from ._common import UsageError, add_connection_arguments, print_json, read_password
+
+READ_CHUNK = 65536
+NOT_ARIA_AFTER = 4096
+"""Bytes without a single valid packet after which the peer is taken for something else."""
+UDP_WAIT_S = 2.0
+
+FEATURES: tuple[tuple[str, str, tuple[str, ...]], ...] = (
+    ("teleop", "drive with the keys", ("ratioDrive",)),
+    ("stop", "stop button", ("stop",)),
+    ("navigation", "go to goals and poses", ("gotoGoal", "gotoPose", "goto", "gotoRouteGoal")),
+    ("map", "map download", ("getMapBinary", "getMap")),
+    ("camera", "camera pictures", ("getPicture*", "sendVideo", "getVideo*")),
+    ("sensors", "sonar and laser drawing", ("sonarCurrent", "Laser_*Current", "getSensorCurrent")),
+    ("configuration", "server configuration", ("getConfig*",)),
+    ("popups", "the robot's message boxes", ("popupCreate",)),
+    ("custom_commands", "the robot's custom commands", ("listCommands", "listStringCommands")),
+    ("status", "pose, battery and status", ("updateNumbers", "update")),
+)
+"""(key, what it gives the operator, data names — a trailing ``*`` matches a prefix)."""
+
+
+@dataclass
+class StepResult:
+    step: Step
+    result: str
+    """``ok``, ``fail``, ``warn`` (not fatal), ``not_checked`` or ``skipped`` (an earlier step failed)."""
+    summary: str
+    advice: str = ""
+    details: dict[str, Any] = field(default_factory=dict)
+
+    def as_json(self) -> dict[str, Any]:
+        return {
+            "step": self.step.key,
+            "title": self.step.title,
+            "result": self.result,
+            "summary": self.summary,
+            "advice": self.advice,
+            **self.details,
+        }
+
+
+class StepFailed(Exception):
+    def __init__(self, result: StepResult) -> None:
+        super().__init__(result.summary)
+        self.result = result
+
+
+def fail(step: Step, summary: str, advice: str = "", **details: Any) -> StepFailed:
+    return StepFailed(StepResult(step, "fail", summary, advice, dict(details)))
+
+
+def features_of(names: set[str]) -> dict[str, bool]:
+    def offered(pattern: str) -> bool:
+        if pattern.endswith("*"):
+            return any(n.startswith(pattern[:-1]) for n in names)
+        if "*" in pattern:
+            head, tail = pattern.split("*", 1)
+            return any(n.startswith(head) and n.endswith(tail) for n in names)
+        return pattern in names
+
+    return {key: any(offered(p) for p in patterns) for key, _, patterns in FEATURES}
+
+
+class Doctor:
+    """One walk to one server; :meth:`run` fills :attr:`steps` and returns the exit code."""
+
+    def __init__(self, host: str, port: int, user: str, password: str, protocol: str | None, timeout: float):
+        self.host, self.port, self.user = host, port, user
+        self._password = password
+        self.protocol = protocol
+        self.timeout = timeout
+        self.steps: list[StepResult] = []
+        self.features: dict[str, bool] = {}
+        self.conn: ClientConnection | None = None
+        self.reader: asyncio.StreamReader | None = None
+        self.writer: asyncio.StreamWriter | None = None
+        self.address = ""
+
+    def ok(self, step: Step, summary: str, result: str = "ok", advice: str = "", **details: Any) -> None:
+        self.steps.append(StepResult(step, result, summary, advice, dict(details)))
+
+    async def run(self) -> int:
+        try:
+            await self._resolve()
+            await self._connect()
+            intro = await self._introduction()
+            await self._login(intro)
+            await self._data_list()
+            await self._udp(intro)
+            await self._status()
+        except StepFailed as exc:
+            self.steps.append(exc.result)
+            done = {s.step for s in self.steps}
+            for step in Step:
+                if step not in done:
+                    self.steps.append(StepResult(step, "skipped", "not tried (an earlier step failed)"))
+            return exc.result.step.value
+        finally:
+            await self._close()
+        return EXIT_OK
+
+    # -- steps ------------------------------------------------------------------------------------
+    async def _resolve(self) -> None:
+        loop = asyncio.get_running_loop()
+        try:
+            async with asyncio.timeout(self.timeout):
+                infos = await loop.getaddrinfo(self.host, self.port, type=socket.SOCK_STREAM)
+        except TimeoutError:
+            raise fail(
+                Step.RESOLVE, f"looking up {self.host!r} took over {self.timeout:g} s", ADVICE["resolve"]
+            ) from None
+        except socket.gaierror as exc:
+            raise fail(
+                Step.RESOLVE, f"cannot find host {self.host!r}: {exc.strerror or exc}", ADVICE["resolve"]
+            ) from None
+        addresses = sorted({info[4][0] for info in infos})
+        self.address = addresses[0]
+        self.ok(Step.RESOLVE, f"{self.host} is {', '.join(addresses)}", addresses=addresses)
+
+    async def _connect(self) -> None:
+        where = f"{self.host}:{self.port}"
+        started = time.monotonic()
+        try:
+            async with asyncio.timeout(self.timeout):
+                self.reader, self.writer = await asyncio.open_connection(self.host, self.port)
+        except TimeoutError:
+            raise fail(
+                Step.TCP,
+                f"connecting to {where} timed out after {self.timeout:g} s",
+                ADVICE["connect_timeout"],
+            ) from None
+        except ConnectionRefusedError:
+            raise fail(Step.TCP, f"{where} refused the connection", ADVICE["refused"]) from None
+        except OSError as exc:
+            raise fail(
+                Step.TCP, f"cannot connect to {where}: {exc.strerror or exc}", ADVICE["unreachable"]
+            ) from None
+        ms = (time.monotonic() - started) * 1000.0
+        self.ok(Step.TCP, f"connected to {where} in {ms:.0f} ms", connect_ms=round(ms, 1))
+
+    async def _read_events(self, step: Step, what: str) -> list[Any]:
+        """The next events from the server, or the step fails (EOF, timeout, not ArNetworking)."""
+        assert self.reader is not None and self.conn is not None
+        while True:
+            try:
+                async with asyncio.timeout(self.timeout):
+                    data = await self.reader.read(READ_CHUNK)
+            except TimeoutError:
+                advice = ADVICE["no_introduction"] if step is Step.INTRODUCTION else ADVICE["login_timeout"]
+                raise fail(step, f"no {what} within {self.timeout:g} s", advice) from None
+            except OSError as exc:
+                raise fail(
+                    step, f"the connection broke: {exc.strerror or exc}", ADVICE["closed_early"]
+                ) from None
+            if not data:
+                raise fail(
+                    step, f"the server closed the connection before its {what}", ADVICE["closed_early"]
+                )
+            self._received += len(data)
+            try:
+                events = self.conn.receive_data(data)
+            except ProtocolError as exc:
+                raise fail(
+                    step, f"the server's {what} is not ArNetworking: {exc}", ADVICE["not_aria"]
+                ) from None
+            if self._received >= NOT_ARIA_AFTER and self.conn.decoder.stats.packets == 0:
+                raise fail(
+                    step, f"{self._received} bytes without a single ArNetworking packet", ADVICE["not_aria"]
+                )
+            self._flush()
+            if events:
+                return events
+
+    def _flush(self) -> None:
+        assert self.writer is not None and self.conn is not None
+        out = self.conn.data_to_send()
+        if out:
+            self.writer.write(out)
+
+    async def _introduction(self) -> ServerIntroduction:
+        self.conn = ClientConnection(self.user, self._password, protocol_version=self.protocol)
+        self._password = ""
+        self._received = 0
+        while True:
+            for event in await self._read_events(Step.INTRODUCTION, "introduction"):
+                if isinstance(event, ServerIntroduction):
+                    return self._describe_intro(event)
+
+    def _describe_intro(self, intro: ServerIntroduction) -> ServerIntroduction:
+        wanted = intro.protocol_version
+        assert self.conn is not None
+        sent = self.conn.sent_protocol_version or ""
+        if wanted:
+            proto = f"protocol string {wanted!r} (enforced; we answer {sent!r})"
+        else:
+            proto = "no protocol string (not enforced)"
+        udp = f"UDP port {intro.udp_port}" if intro.udp_port else "no UDP (TCP only)"
+        self.ok(
+            Step.INTRODUCTION,
+            f"an ArNetworking server (tag {intro.version_tag!r}), {proto}, {udp}",
+            version_tag=intro.version_tag,
+            protocol=wanted,
+            sent_protocol=sent,
+            udp_port=intro.udp_port,
+        )
+        return intro
+
+    async def _login(self, intro: ServerIntroduction) -> None:
+        assert self.conn is not None
+        while True:
+            for event in await self._read_events(Step.LOGIN, "answer to our login"):
+                if isinstance(event, Rejected):
+                    finding = login_finding(
+                        event.reason,
+                        event.text,
+                        intro.protocol_version,
+                        self.conn.sent_protocol_version or "",
+                    )
+                    raise fail(
+                        Step.LOGIN, finding.problem, finding.advice, reason=event.reason, text=event.text
+                    )
+                if isinstance(event, PeerShutdown):
+                    raise fail(Step.LOGIN, "the server shut the connection down", ADVICE["closed_early"])
+                if isinstance(event, Connected):
+                    who = f"as {self.user!r}" if self.user else "without a user name"
+                    self.ok(Step.LOGIN, f"logged in {who}", user=self.user)
+                    return
+                if isinstance(event, DataListReady):  # CONNECTED came in the same read
+                    return
+
+    async def _data_list(self) -> None:
+        assert self.conn is not None
+        while not self.conn.datalist.complete:
+            await self._read_events(Step.DATA_LIST, "data list")
+        entries = list(self.conn.datalist)
+        names = {e.name for e in entries}
+        self.features = features_of(names)
+        groups = {e.command_group for e in entries}
+        have = [k for k, v in self.features.items() if v]
+        missing = [k for k, v in self.features.items() if not v]
+        summary = f"{len(entries)} data in {len(groups)} groups; RTMU can use: {', '.join(have) or 'nothing'}"
+        if missing:
+            summary += f"; not offered: {', '.join(missing)}"
+        advice = ""
+        if not self.features["teleop"] and self.user:
+            advice = "driving is not offered to this user: log in as a user whose groups include Movement"
+        self.ok(
+            Step.DATA_LIST,
+            summary,
+            "ok" if not advice else "warn",
+            advice,
+            count=len(entries),
+            groups=len(groups),
+            features=self.features,
+        )
+
+    async def _udp(self, intro: ServerIntroduction) -> None:
+        if intro.udp_port == 0:
+            self.ok(Step.UDP, "not used: the server is TCP-only (UDP port 0)", "not_checked")
+            return
+        loop = asyncio.get_running_loop()
+        answered = loop.create_future()
+
+        class Listener(asyncio.DatagramProtocol):
+            def datagram_received(self, data: bytes, addr: Any) -> None:
+                for packet in PacketDecoder().feed(data):
+                    if packet.command == ServerCommand.UDP_INTRODUCTION and not answered.done():
+                        key = FieldReader(packet.payload).byte4("intro key", default=-1)
+                        answered.set_result(key == intro.intro_key)
+
+        transport, _ = await loop.create_datagram_endpoint(
+            Listener, remote_addr=(self.address, intro.udp_port)
+        )
+        try:
+            hello = encode_packet(
+                ClientCommand.UDP_INTRODUCTION, FieldWriter().ubyte4(intro.auth_key).bytes()
+            )
+            transport.sendto(hello)
+            try:
+                async with asyncio.timeout(UDP_WAIT_S):
+                    good = await answered
+            except TimeoutError:
+                self.ok(
+                    Step.UDP,
+                    f"no answer on UDP port {intro.udp_port} within {UDP_WAIT_S:g} s",
+                    "warn",
+                    "UDP may be blocked between here and the robot; RTMU uses TCP only, so this does not "
+                    "stop RTMU (ARIA's own clients fall back to TCP after a few seconds)",
+                )
+                return
+            if good:
+                self.ok(Step.UDP, f"UDP port {intro.udp_port} answers (the server knew our key)")
+            else:
+                self.ok(Step.UDP, f"UDP port {intro.udp_port} answered with a wrong key", "warn")
+        finally:
+            transport.close()
+
+    async def _status(self) -> None:
+        conn = self.conn
+        assert conn is not None
+        name = "updateNumbers" if "updateNumbers" in conn.datalist else "update"
+        if name not in conn.datalist:
+            raise fail(Step.STATUS, "the server offers no robot status", ADVICE["status_missing"])
+        soc = False
+        if "batteryInfo" in conn.datalist:
+            info = await self._once("batteryInfo")
+            soc = isinstance(info, BatteryInfo) and info.state_of_charge
+        numbers = await self._once(name)
+        status = mode = ""
+        if isinstance(numbers, Update):
+            status, mode, numbers = numbers.status, numbers.mode, numbers.numbers
+        elif "updateStrings" in conn.datalist:
+            strings = await self._once("updateStrings")
+            if isinstance(strings, UpdateStrings):
+                status, mode = strings.status, strings.mode
+        if not isinstance(numbers, UpdateNumbers):
+            raise fail(Step.STATUS, f"the server's {name} reply does not decode", ADVICE["status_timeout"])
+        battery = f"{numbers.battery:.0f} % charge" if soc else f"{numbers.battery:.1f} V"
+        text = f"robot at ({numbers.x}, {numbers.y}) mm, {numbers.th}°, battery {battery}"
+        if status:
+            text += f", {status} ({mode})"
+        details: dict[str, Any] = {"x": numbers.x, "y": numbers.y, "th": numbers.th, "status": status}
+        details["battery_pct" if soc else "battery_v"] = numbers.battery
+        self.ok(Step.STATUS, text, **details)
+
+    async def _once(self, name: str) -> Any:
+        conn = self.conn
+        assert conn is not None
+        number = conn.number_of(name)
+        conn.request_once(name)
+        self._flush()
+        while True:
+            for event in await self._read_events(Step.STATUS, f"{name} reply"):
+                if isinstance(event, DataReceived) and event.command == number:
+                    try:
+                        return decode_payload(name, Side.REPLY, event.payload)
+                    except (ProtocolError, ValueError) as exc:
+                        raise fail(Step.STATUS, f"the server's {name} reply does not decode: {exc}") from None
+                if isinstance(event, PeerShutdown):
+                    raise fail(Step.STATUS, "the server shut the connection down", ADVICE["closed_early"])
+
+    async def _close(self) -> None:
+        if self.writer is None:
+            return
+        with contextlib.suppress(Exception):
+            if self.conn is not None:
+                self.conn.shutdown()
+                self._flush()
+            self.writer.close()
+            async with asyncio.timeout(1.0):
+                await self.writer.wait_closed()
+
+
+# -- command line -------------------------------------------------------------------------------------
+def register(subparsers: Any) -> None:
+    p = subparsers.add_parser(
+        "doctor",
+        help="find out why a robot does not connect, step by step",
+        description=__doc__,
+        formatter_class=argparse.RawDescriptionHelpFormatter,
+    )
+    add_connection_arguments(p)
+    p.add_argument(
+        "--json",
+        action="store_true",
+        help='one JSON object: {"server", "ok", "failed_step", "exit_code", "features", "steps": '
+        '[{"step", "title", "result", "summary", "advice", ...}]}',
+    )
+    p.set_defaults(handler=handle)
+
+
+MARKS = {"ok": "ok  ", "fail": "FAIL", "warn": "warn", "not_checked": "--  ", "skipped": "..  "}
+
+
+def handle(args: argparse.Namespace) -> int:
+    host, port = args.server
+    try:
+        password = read_password(args)
+    except UsageError as exc:
+        print(f"rtmu doctor: {exc}", file=sys.stderr)
+        return EXIT_USAGE
+    doctor = Doctor(host, port, args.user, password, args.protocol, args.timeout)
+    try:
+        code = asyncio.run(doctor.run())
+    except KeyboardInterrupt:
+        return 130
+    failed = next((s for s in doctor.steps if s.result == "fail"), None)
+    if args.json:
+        print_json(
+            {
+                "server": f"{host}:{port}",
+                "ok": failed is None,
+                "failed_step": failed.step.key if failed else None,
+                "exit_code": code,
+                "features": doctor.features,
+                "steps": [s.as_json() for s in doctor.steps],
+            }
+        )
+        return code
+    print(f"rtmu doctor {host}:{port}" + (f" (user {args.user})" if args.user else ""))
+    for s in doctor.steps:
+        print(f"  [{MARKS.get(s.result, s.result)}] {s.step.title}: {s.summary}")
+        if s.advice:
+            print(f"         what to do: {s.advice}")
+    if failed is None:
+        print("All steps passed: RTMU can connect to this robot.")
+    else:
+        print(f"Stopped at the {failed.step.title} step (exit {code}).")
+    return code
