@@ -18,6 +18,7 @@ from rtmu.protocol.payloads import (
     commands,
     decode_payload,
     drive,
+    ld,
     payload_type_for,
     popup,
     registered,
@@ -108,6 +109,13 @@ SAMPLES: list[Payload] = [
     server.HeartbeatTcp(),
     server.HeartbeatUdp(),
     server.SelfIdentifier("rtmu"),
+    ld.DockInfo(2, True, 300),
+    ld.DockInfoChanged(1),
+    ld.Routes(("Loop", "Night patrol")),
+    ld.Patrol("Loop"),
+    ld.GotoRouteGoal("Kitchen"),
+    ld.Say("Hello"),
+    ld.DataStoreValue("87"),
 ]
 TYPES = sorted(registered().values(), key=lambda c: (c.DATA_NAME, c.SIDE.value))
 

@@ -4,7 +4,7 @@ Importing this package registers every type, so :func:`payload_type_for`
 finds a decoder by data name.
 """
 
-from . import camera, commands, drive, map, mapstream, popup, robot, sensors, server, strings
+from . import camera, commands, drive, ld, map, mapstream, popup, robot, sensors, server, strings
 from .base import (
     NameMatch,
     Payload,
@@ -24,6 +24,7 @@ __all__ = [
     "commands",
     "decode_payload",
     "drive",
+    "ld",
     "map",
     "mapstream",
     "payload_type",
