@@ -24,6 +24,8 @@ from collections.abc import Callable
 from dataclasses import dataclass, field, replace
 from typing import Any
 
+from ..guardian.handle import BEAT_PERIOD, GuardianHandle
+from ..guardian.messages import Hello
 from ..model import (
     CameraImage,
     ConnectionState,
@@ -38,6 +40,7 @@ from ..protocol.payloads import Side, decode_payload, payload_type_for
 from ..protocol.payloads.drive import RatioDrive, SafeDrive, SetSafeDrive
 from ..protocol.payloads.robot import BatteryInfo, ModeInfo, Update, UpdateNumbers, UpdateStrings
 from .connection import AriaClient, Packet
+from .diagnosis import explain
 from .errors import ClientError, ClientTimeout, MalformedReply, NotSupported, ServerClosed
 from .health import HealthMonitor, ping_data
 from .lease import DriveGovernor, DriveLease, EndReason, SendRatios, SendStop
@@ -72,6 +75,9 @@ class SessionConfig:
     """How long a ping may go unanswered (None: ``lost_after``)."""
     fetch_map: bool = True
     backoff: Callable[[], Backoff] = field(default=Backoff)
+    guardian: bool = False
+    """Start a guardian process (:mod:`rtmu.guardian`) for each connection that may drive: it stops
+    the robot if this process is killed or frozen while driving. The window and ``rtmu drive`` do."""
 
 
 @dataclass
@@ -124,6 +130,7 @@ class Session:
         self._image_sequence = 0
         self._wifi_labels: tuple[str, ...] = ()
         self.packets_sent = 0
+        self.guardian: GuardianHandle | None = None
 
     # -- publishing --------------------------------------------------------------------------
     def _publish(self, part: str, value: Any) -> None:
@@ -193,7 +200,8 @@ class Session:
             await self._open(target)
         except ClientError as exc:
             if self._target is target:
-                self._set_connection(phase=Phase.FAILED, error=str(exc), error_kind=exc.kind)
+                # The same words as ``rtmu doctor``: what failed, then what to do next.
+                self._set_connection(phase=Phase.FAILED, error=explain(exc).sentence(), error_kind=exc.kind)
             raise
         finally:
             if self._connecting is asyncio.current_task():
@@ -213,6 +221,8 @@ class Session:
             await client.disconnect()
             raise ServerClosed("the connection attempt was cancelled")
         self.client = client
+        if self.config.guardian and client.supports("ratioDrive"):
+            self._start_guardian(target)
         # Whatever happened before, the robot stays still until a fresh key press.
         self.lease.end(EndReason.DISCONNECTED)
         self.governor.reset()
@@ -254,6 +264,7 @@ class Session:
 
     async def _drop_client(self) -> None:
         client, self.client = self.client, None
+        self._close_guardian(goodbye=True)
         for task in list(self._tasks):
             task.cancel()
         self.health.stop()
@@ -269,6 +280,8 @@ class Session:
     def _connection_lost(self, error: ClientError) -> None:
         """Not our choice: the server died, closed, or the link was lost."""
         client, self.client = self.client, None
+        # Our link died while driving: we cannot stop the robot, the guardian (its own link) can.
+        self._close_guardian(goodbye=not self.governor.driving)
         for task in list(self._tasks):
             task.cancel()
         if client is not None:
@@ -519,11 +532,14 @@ class Session:
                     await self._kick.wait()
 
     def _beat(self, now: float) -> None:
+        self._poll_guardian()
         level = self.health.level(now)
         link_ok = level is LinkLevel.OK and self.connected
         for action in self.governor.step(now, link_ok):
             if isinstance(action, SendRatios):
                 r = action.ratios
+                if self.guardian is not None:
+                    self.guardian.arm()  # before the first ratioDrive of a drive
                 self._send("ratioDrive", RatioDrive(r.trans, r.rot, r.throttle, r.lat or None))
             elif isinstance(action, SendStop):
                 self._send_stop()
@@ -560,6 +576,53 @@ class Session:
         """Zero ratios, then ``stop`` — whatever the link health looks like."""
         self._send("ratioDrive", RatioDrive(0.0, 0.0, 0.0))
         self._send("stop")
+        if self.guardian is not None:
+            self.guardian.disarm()
+
+    # -- the guardian (rtmu.guardian): a stop that survives this process ----------------------
+    def _start_guardian(self, target: _Target) -> None:
+        self._close_guardian(goodbye=True)
+        try:
+            self.guardian = GuardianHandle.start(
+                Hello(target.host, target.port, target.user, target.password, self.config.connect_timeout)
+            )
+        except OSError as exc:
+            self._guardian_unavailable(f"it could not be started: {exc.strerror or exc}")
+            return
+        self._guardian_beat(self.guardian)
+
+    def _guardian_beat(self, guardian: GuardianHandle) -> None:
+        """The network thread's heartbeat to the guardian, every BEAT_PERIOD while it lives."""
+        if self.guardian is not guardian:
+            return
+        guardian.beat_net()
+        asyncio.get_running_loop().call_later(BEAT_PERIOD, self._guardian_beat, guardian)
+
+    def _close_guardian(self, *, goodbye: bool) -> None:
+        guardian, self.guardian = self.guardian, None
+        if guardian is not None:
+            guardian.close(goodbye=goodbye)
+
+    def _poll_guardian(self) -> None:
+        guardian = self.guardian
+        if guardian is None:
+            return
+        for word, text in guardian.poll():
+            if word == "stopped":
+                # It stopped the robot (we were frozen, or too slow): no drive resumes without a fresh press.
+                self.lease.end(EndReason.STOPPED)
+                self._notice("error", f"The guardian stopped the robot: {text}")
+            elif word in ("unavailable", "lost", "ended"):
+                self.guardian = None
+                guardian.close(goodbye=True)
+                self._guardian_unavailable(text)
+
+    def _guardian_unavailable(self, reason: str) -> None:
+        self._notice(
+            "warning",
+            f"Guardian not available ({reason}): if this window is killed or frozen while driving, "
+            "only the server's own 2 s watchdog stops the robot",
+        )
 
     # -- operator commands -------------------------------------------------------------------
     def stop_now(self) -> None:

@@ -1,0 +1,104 @@
+"""``rtmu sim --profile aram``: an LD robot on the wire (protocol, state of charge, Ex4 map, LD-size list)."""
+
+from __future__ import annotations
+
+import asyncio
+from collections.abc import Iterator
+from pathlib import Path
+
+import pytest
+
+from rtmu.client.connection import AriaClient
+from rtmu.protocol.payloads.robot import BatteryInfo, UpdateNumbers
+from rtmu.sim import SimConfig, SimThread
+from rtmu.sim.profiles import ARAM, EX4_HEADER, LD_CATALOGUE_SIZE, filler_rows, get_profile
+
+REPO = Path(__file__).resolve().parents[2]
+OFFICE = REPO / "data" / "maps" / "office.map"
+
+
+@pytest.fixture(scope="module")
+def aram() -> Iterator[SimThread]:
+    with SimThread(SimConfig(port=0, profile="aram", map_path=OFFICE)) as s:
+        yield s
+
+
+async def _with_client(port: int, body):  # type: ignore[no-untyped-def]
+    client = AriaClient()
+    await client.connect("127.0.0.1", port, timeout=5.0)
+    try:
+        return await body(client)
+    finally:
+        await client.disconnect()
+
+
+def test_unknown_profile_is_refused() -> None:
+    with pytest.raises(ValueError, match="no simulator profile"):
+        get_profile("nope")
+
+
+def test_catalogue_is_ld_sized_with_long_descriptions(aram: SimThread) -> None:
+    async def body(client: AriaClient):  # type: ignore[no-untyped-def]
+        return list(client.datalist)
+
+    entries = asyncio.run(_with_client(aram.port, body))
+    names = [e.name for e in entries]
+    assert len(names) == LD_CATALOGUE_SIZE == len(set(names))
+    assert max(len(e.return_description) for e in entries) >= 16_000  # arrived whole, over many packets
+    assert {"ratioDrive", "updateNumbers", "getMapBinary"} <= set(names)
+
+
+def test_filler_rows_are_unique_and_stable() -> None:
+    a = filler_rows(2000, {"getArm"})
+    assert len(a) == 2000 and len({r[0] for r in a}) == 2000 and "getArm" not in {r[0] for r in a}
+    assert a == filler_rows(2000, {"getArm"})
+
+
+def test_battery_is_state_of_charge(aram: SimThread) -> None:
+    async def body(client: AriaClient):  # type: ignore[no-untyped-def]
+        info = (await client.request_once("batteryInfo", timeout=5)).decode()
+        numbers = (await client.request_once("updateNumbers", timeout=5)).decode()
+        return info, numbers
+
+    server = aram.server
+    assert server is not None
+    aram.call(lambda: setattr(server.world.body, "battery_v", 12.366))  # 76 % of 11.0…12.8 V
+    info, numbers = asyncio.run(_with_client(aram.port, body))
+    assert isinstance(info, BatteryInfo) and info.state_of_charge is True
+    assert isinstance(numbers, UpdateNumbers)
+    assert numbers.battery == pytest.approx(75.9, abs=0.2)
+
+
+def test_map_served_as_ex4_text_and_binary(aram: SimThread) -> None:
+    async def body(client: AriaClient):  # type: ignore[no-untyped-def]
+        text = [p async for p in client.stream("getMap", timeout=5)]
+        binary = [p async for p in client.stream("getMapBinary", timeout=5)]
+        return text, binary
+
+    text, binary = asyncio.run(_with_client(aram.port, body))
+    assert text[0] == EX4_HEADER.encode() + b"\x00"
+    assert binary[0] == EX4_HEADER.encode() + b"\x00"
+    assert OFFICE.read_text().startswith("2D-Map\n")  # the file itself stays ours, unchanged
+
+
+def test_default_profile_is_unchanged() -> None:
+    with SimThread(SimConfig(port=0)) as sim:
+        assert sim.server is not None
+        assert sim.server.profile.name == "default"
+        assert len(list(sim.server.datalist)) < 200
+        assert sim.server.config.protocol_version is None
+
+
+def test_modules_extend_a_profile(tmp_path: Path, monkeypatch: pytest.MonkeyPatch) -> None:
+    mod = tmp_path / "h8a_probe_data.py"
+    mod.write_text(
+        "ROWS = (('sayHello', 'Says hello', 'none', 'none', 'Audio', 'RETURN_SINGLE'),)\n"
+        "def _hello(call):\n    return (b'hi\\x00',)\n"
+        "HANDLERS = {'sayHello': _hello}\n"
+    )
+    monkeypatch.syspath_prepend(str(tmp_path))
+    from dataclasses import replace
+
+    profile = replace(ARAM, modules=("h8a_probe_data",))
+    assert "sayHello" in profile.catalogue(camera=True)
+    assert profile.handler_table()["sayHello"].__name__ == "_hello"
