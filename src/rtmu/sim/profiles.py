@@ -204,7 +204,7 @@ ARAM = SimProfile(
     state_of_charge=True,
     map_header=EX4_HEADER,
     catalogue_size=LD_CATALOGUE_SIZE,
-    modules=(),  # h8b: add "rtmu.sim.<your module>" here (see scratch/aram-profile.md)
+    modules=("rtmu.sim.ld_data",),
     handlers={
         "updateNumbers": _soc_numbers,
         "batteryInfo": _soc_battery_info,

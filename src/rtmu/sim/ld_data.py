@@ -1,0 +1,269 @@
+"""The data an Omron LD robot offers beyond serverDemo, for ``rtmu sim --profile aram``.
+
+A data module of the profile extension point (:mod:`rtmu.sim.profiles`): ``ROWS`` for the catalogue
+and ``HANDLERS`` for the server. Two lasers seen from the world's walls by the same ray caster as
+the sonar at one ray per degree, a docking state that ``dock``/``undock`` move through
+docking → docked (and back) in :data:`DOCK_SECONDS` of simulated time, a few routes that ``patrol``
+starts (recorded, no driving), ``DataStore_*`` strings from the simulator's real values and
+``say`` (recorded). What was asked is kept per server in :func:`ld_state` so tests can look.
+"""
+
+from __future__ import annotations
+
+import math
+import weakref
+from collections.abc import Iterable
+from dataclasses import dataclass, field
+from typing import TYPE_CHECKING
+
+import numpy as np
+
+from rtmu.protocol.errors import FieldUnderrun, PayloadError
+from rtmu.protocol.payloads.ld import (
+    DataStoreValue,
+    DockInfo,
+    DockInfoChanged,
+    DockState,
+    Patrol,
+    Routes,
+    Say,
+)
+from rtmu.protocol.payloads.sensors import Drawing, DrawingList, DrawingListPacket, RangeDeviceReadings
+
+from .catalogue import Row
+from .handlers import SONAR_DRAWING, Call, Handler, Reply
+
+if TYPE_CHECKING:
+    from .server import SimServer
+
+LASER_MAX_RANGE_MM = 15_000.0
+LASER_FIELD_DEG = 270
+LASER_OFFSETS_MM = {"Laser_1Current": 250.0, "Laser_2Current": -250.0}
+"""Front laser ahead of the centre, rear laser behind it (facing backwards)."""
+LASER_DRAWINGS = (
+    Drawing("Laser_1Current", "polyDots", 0x0000FF, 60, 75, 200, 0x000000, "DefaultOn"),
+    Drawing("Laser_2Current", "polyDots", 0x0000C0, 60, 75, 200, 0x000000, "DefaultOn"),
+)
+DOCK_SECONDS = 2.0
+ROUTES = ("Loop", "Kitchen run", "Night patrol")
+SAY_LIMIT = 100
+"""Texts kept in :attr:`LdState.said` (the oldest go first)."""
+
+
+@dataclass
+class LdState:
+    dock: DockState = DockState.UNDOCKED
+    since: float = 0.0
+    """Simulated time the current dock transition started."""
+    patrols: list[str] = field(default_factory=list)
+    said: list[str] = field(default_factory=list)
+
+
+_STATES: weakref.WeakKeyDictionary[SimServer, LdState] = weakref.WeakKeyDictionary()
+
+
+def ld_state(server: SimServer) -> LdState:
+    """This server's LD state (created on first use)."""
+    state = _STATES.get(server)
+    if state is None:
+        state = _STATES[server] = LdState()
+    return state
+
+
+# -- laser -----------------------------------------------------------------------------------
+def laser_points(call: Call, name: str) -> tuple[tuple[int, int], ...]:
+    """Global (x, y) mm of each hit within range, one ray per degree over the laser's field."""
+    body = call.world.body
+    offset = LASER_OFFSETS_MM[name]
+    th = math.radians(body.th)
+    facing = th if offset >= 0 else th + math.pi
+    ox = body.x + offset * math.cos(th)
+    oy = body.y + offset * math.sin(th)
+    half = math.radians(LASER_FIELD_DEG / 2)
+    angles = facing + np.linspace(-half, half, LASER_FIELD_DEG + 1)
+    ranges = call.world.obstacles.cast(ox, oy, angles, LASER_MAX_RANGE_MM)
+    hit = np.isfinite(ranges)
+    xs = np.rint(ox + ranges[hit] * np.cos(angles[hit])).astype(int)
+    ys = np.rint(oy + ranges[hit] * np.sin(angles[hit])).astype(int)
+    return tuple(zip(xs.tolist(), ys.tolist(), strict=True))
+
+
+def _laser(call: Call) -> Iterable[Reply]:
+    name = call.name
+    return (call.server.cycle_cached(name, lambda: RangeDeviceReadings(laser_points(call, name)).encode()),)
+
+
+def _drawing_list(call: Call) -> Iterable[Reply]:
+    packets = [DrawingListPacket(d).encode() for d in (SONAR_DRAWING, *LASER_DRAWINGS)]
+    return (*packets, DrawingListPacket(None).encode())
+
+
+def _list_drawings(call: Call) -> Iterable[Reply]:
+    return (DrawingList((SONAR_DRAWING, *LASER_DRAWINGS)).encode(),)
+
+
+# -- docking ----------------------------------------------------------------------------------
+def _dock_now(call: Call) -> DockInfo:
+    """The dock state at the world's time: a transition that has run DOCK_SECONDS completes."""
+    state = ld_state(call.server)
+    done = call.world.time - state.since >= DOCK_SECONDS
+    if done and state.dock in (DockState.DOCKING, DockState.UNDOCKING):
+        state.dock = DockState.DOCKED if state.dock is DockState.DOCKING else DockState.UNDOCKED
+        state.since = call.world.time
+        call.server.broadcast("dockInfoChanged", DockInfoChanged(state.dock).encode())
+    return DockInfo(state.dock)
+
+
+def _dock_info(call: Call) -> Iterable[Reply]:
+    return (_dock_now(call).encode(),)
+
+
+def _start(call: Call, target: DockState, unless: DockState) -> None:
+    state = ld_state(call.server)
+    _dock_now(call)
+    if state.dock in (target, unless):
+        return
+    state.dock = target
+    state.since = call.world.time
+    call.server.broadcast("dockInfoChanged", DockInfoChanged(target).encode())
+
+
+def _dock(call: Call) -> Iterable[Reply]:
+    _start(call, DockState.DOCKING, DockState.DOCKED)
+    return ()
+
+
+def _undock(call: Call) -> Iterable[Reply]:
+    _start(call, DockState.UNDOCKING, DockState.UNDOCKED)
+    return ()
+
+
+# -- routes and speech ---------------------------------------------------------------------------
+def _routes(call: Call) -> Iterable[Reply]:
+    return (Routes(ROUTES).encode(),)
+
+
+def _patrol(call: Call) -> Iterable[Reply]:
+    try:
+        route = Patrol.decode(call.args).route
+    except (FieldUnderrun, PayloadError, ValueError):
+        return ()
+    if route in ROUTES:
+        ld_state(call.server).patrols.append(route)
+    return ()
+
+
+def _say(call: Call) -> Iterable[Reply]:
+    try:
+        text = Say.decode(call.args).text
+    except (FieldUnderrun, PayloadError, ValueError):
+        return ()
+    said = ld_state(call.server).said
+    said.append(text)
+    del said[:-SAY_LIMIT]
+    return ()
+
+
+# -- data store --------------------------------------------------------------------------------
+def _closest_obstacle_mm(call: Call) -> float:
+    body = call.world.body
+    points = laser_points(call, "Laser_1Current") + laser_points(call, "Laser_2Current")
+    if not points:
+        return math.inf
+    return min(math.hypot(x - body.x, y - body.y) for x, y in points)
+
+
+DATA_STORE: dict[str, tuple[str, object]] = {
+    "DataStore_Localization_Score": ("Localization score (0–100)", lambda call: "100"),
+    "DataStore_WiFi_Quality": ("Wi-Fi link quality (0–70)", lambda call: str(call.world.wifi().quality)),
+    "DataStore_Distance_To_Goal": ("Distance to the goal in mm (0: no goal)", lambda call: "0"),
+    "DataStore_Closest_Obstacle": (
+        "Distance to the closest obstacle in mm",
+        lambda call: (lambda d: "none" if d == math.inf else str(round(d)))(_closest_obstacle_mm(call)),
+    ),
+    "DataStore_Dock_State": ("Docking state", lambda call: _dock_now(call).state_label),
+}
+
+
+def _data_store(call: Call) -> Iterable[Reply]:
+    entry = DATA_STORE.get(call.name)
+    if entry is None:
+        return ()
+    value = entry[1](call)  # type: ignore[operator]
+    return (DataStoreValue(str(value)).encode(),)
+
+
+ROWS: tuple[Row, ...] = (
+    (
+        "Laser_1Current",
+        "",
+        "none",
+        "byte4: count, then byte4: x, byte4: y per point (mm)",
+        "SensorInfo",
+        "RETURN_SINGLE",
+    ),
+    (
+        "Laser_2Current",
+        "",
+        "none",
+        "byte4: count, then byte4: x, byte4: y per point (mm)",
+        "SensorInfo",
+        "RETURN_SINGLE",
+    ),
+    ("dock", "Sends the robot to its dock", "none", "none", "Navigation", "RETURN_NONE"),
+    ("undock", "Undocks the robot", "none", "none", "Navigation", "RETURN_NONE"),
+    (
+        "dockInfo",
+        "The docking state",
+        "none",
+        "ubyte: 0 undocked, 1 docking, 2 docked, 3 undocking; ubyte: 1 docking forced; "
+        "ubyte2: seconds to shutdown (0 none)",
+        "NavigationInfo",
+        "RETURN_SINGLE",
+    ),
+    (
+        "dockInfoChanged",
+        "Broadcast when the docking state changes",
+        "none",
+        "as dockInfo",
+        "NavigationInfo",
+        "RETURN_SINGLE",
+    ),
+    (
+        "getRoutes",
+        "The routes of the map",
+        "none",
+        "string: route name, repeated",
+        "Navigation",
+        "RETURN_SINGLE",
+    ),
+    ("routesUpdated", "Broadcast when the routes change", "none", "none", "Navigation", "RETURN_NONE"),
+    ("patrol", "Patrols a route", "string: route name", "none", "Navigation", "RETURN_NONE"),
+    (
+        "gotoRouteGoal",
+        "Drives to a goal of the route",
+        "string: goal name",
+        "none",
+        "Navigation",
+        "RETURN_NONE",
+    ),
+    ("say", "Speaks a text", "string: text", "none", "Audio", "RETURN_NONE"),
+    *(
+        (name, desc, "none", "string: value", "DataStore", "RETURN_SINGLE")
+        for name, (desc, _) in DATA_STORE.items()
+    ),
+)
+
+HANDLERS: dict[str, Handler] = {
+    "Laser_1Current": _laser,
+    "Laser_2Current": _laser,
+    "getDrawingList": _drawing_list,
+    "listDrawings": _list_drawings,
+    "dock": _dock,
+    "undock": _undock,
+    "dockInfo": _dock_info,
+    "getRoutes": _routes,
+    "patrol": _patrol,
+    "say": _say,
+    **dict.fromkeys(DATA_STORE, _data_store),
+}

@@ -1,0 +1,105 @@
+"""What ``rtmu sim --profile aram`` serves beyond serverDemo, as a client on loopback sees it."""
+
+from __future__ import annotations
+
+import math
+
+from rtmu.protocol.payloads.ld import (
+    DataStoreValue,
+    DockInfo,
+    DockInfoChanged,
+    DockState,
+    Patrol,
+    Routes,
+    Say,
+)
+from rtmu.protocol.payloads.sensors import DrawingListPacket, RangeDeviceReadings
+from rtmu.sim import SimConfig, SimServer
+from rtmu.sim.ld_data import DOCK_SECONDS, ROUTES, ld_state
+
+from .wire import WireClient, eventually, run
+
+WALL_AHEAD = """2D-Map
+Cairn: RobotHome 0 0 0.000000 "" ICON "Home"
+LINES
+2000 -4000 2000 4000
+DATA
+"""
+
+
+async def _start(map_path, profile: str = "aram"):
+    server = SimServer(SimConfig(port=0, realtime=False, map_path=map_path, profile=profile))
+    await server.start()
+    return server, await WireClient().open(server.port)
+
+
+def test_front_laser_sees_the_wall_at_one_ray_per_degree(tmp_path):
+    path = tmp_path / "wall.map"
+    path.write_text(WALL_AHEAD)
+
+    async def scenario() -> None:
+        server, c = await _start(path)
+        front = RangeDeviceReadings.decode((await c.ask("Laser_1Current"))[0]).readings
+        rear = RangeDeviceReadings.decode((await c.ask("Laser_2Current"))[0]).readings
+        # The wall at x = 2000 spans ±4 m: most rays of the front laser hit it; the rear laser, facing
+        # away, sees it only at the edges of its 270° field.
+        assert len(front) > 100 and all(x == 2000 for x, _ in front)
+        assert 0 < len(rear) < len(front) / 2 and all(x == 2000 for x, _ in rear)
+        names = [DrawingListPacket.decode(p).drawing for p in await c.ask("getDrawingList", count=4)]
+        assert [d.name for d in names if d] == ["sonarCurrent", "Laser_1Current", "Laser_2Current"]
+        await c.close()
+        await server.stop()
+
+    run(scenario())
+
+
+def test_dock_moves_through_docking_to_docked_and_broadcasts(arena_map):
+    async def scenario() -> None:
+        server, c = await _start(arena_map)
+        assert DockInfo.decode((await c.ask("dockInfo"))[0]).state == DockState.UNDOCKED
+        c.request("dockInfoChanged", -1)
+        await c.barrier()
+        c.once("dock")
+        (first,) = await c.wait_for("dockInfoChanged")
+        assert DockInfoChanged.decode(first).state == DockState.DOCKING
+        await server.advance(DOCK_SECONDS + 0.5)
+        assert DockInfo.decode((await c.ask("dockInfo"))[0]).state == DockState.DOCKED
+        await eventually(lambda: len(c.received["dockInfoChanged"]) >= 2, what="the docked broadcast")
+        assert DockInfoChanged.decode(c.received["dockInfoChanged"][1]).state == DockState.DOCKED
+        await c.close()
+        await server.stop()
+
+    run(scenario())
+
+
+def test_routes_patrol_say_and_data_store(arena_map):
+    async def scenario() -> None:
+        server, c = await _start(arena_map)
+        assert Routes.decode((await c.ask("getRoutes"))[0]).routes == ROUTES
+        c.once("patrol", Patrol(ROUTES[1]).encode())
+        c.once("patrol", Patrol("no such route").encode())
+        c.once("say", Say("Hello from RTMU").encode())
+        await c.barrier()
+        state = ld_state(server)
+        assert state.patrols == [ROUTES[1]]
+        assert state.said == ["Hello from RTMU"]
+        wifi = DataStoreValue.decode((await c.ask("DataStore_WiFi_Quality"))[0]).value
+        assert wifi == str(server.world.wifi().quality)
+        closest = DataStoreValue.decode((await c.ask("DataStore_Closest_Obstacle"))[0]).value
+        assert closest == "none" or 0 < float(closest) < math.inf
+        await c.close()
+        await server.stop()
+
+    run(scenario())
+
+
+def test_default_profile_lists_none_of_it(arena_map):
+    async def scenario() -> None:
+        server, c = await _start(arena_map, profile="default")
+        assert len(c.conn.datalist) > 50  # the list did arrive
+        for name in ("Laser_1Current", "dockInfo", "getRoutes", "patrol", "say", "DataStore_WiFi_Quality"):
+            assert name not in c.conn.datalist
+        await c.close()
+        await server.stop()
+
+    run(scenario())
