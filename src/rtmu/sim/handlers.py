@@ -65,7 +65,7 @@ from rtmu.protocol.payloads.sensors import (
     SensorList,
     SensorReadings,
 )
-from rtmu.protocol.payloads.server import IdleProcessingPending
+from rtmu.protocol.payloads.server import IdleProcessingPending, SelfIdentifier
 from rtmu.protocol.payloads.strings import StringItem, Strings, StringsInfo
 
 from . import p3dx
@@ -153,8 +153,14 @@ def decode_lenient(cls, args: bytes):
 
 
 # -- nothing to say -------------------------------------------------------------------
+@handles("identSetSelfIdentifier")
+def _self_identifier(call: Call) -> Iterable[Reply]:
+    """Remembered per client, so tests can tell who sent a ``stop`` (``SimServer.stop_log``)."""
+    call.session.self_identifier = decode_lenient(SelfIdentifier, call.args).identifier
+    return ()
+
+
 @handles(
-    "identSetSelfIdentifier",
     "identSetHereGoal",
     "requestOnceReturnIsAlwaysTcp",
     "startRequestTransaction",
@@ -249,6 +255,7 @@ def _mode_busy(call: Call) -> Iterable[Reply]:
 # -- driving -----------------------------------------------------------------------------
 @handles("stop")
 def _stop(call: Call) -> Iterable[Reply]:
+    call.server.stop_log.append((call.world.time, call.session.ident, call.session.self_identifier))
     call.world.stop()
     return ()
 

@@ -20,6 +20,7 @@ import logging
 import math
 import random
 import time
+from collections import deque
 from collections.abc import Callable
 from dataclasses import dataclass
 from itertools import count
@@ -353,6 +354,8 @@ class SimServer:
         self.datalist: DataList = self.profile.catalogue(camera=cfg.camera)
         self.users: UserTable | None = UserTable.load(cfg.users_path) if cfg.users_path else None
         self.sessions: list[Session] = []
+        self.stop_log: deque[tuple[float, int, str]] = deque(maxlen=1000)
+        """Every ``stop`` received: (world time, session ident, the client's self identifier)."""
         self._ids = count(1)
         self._server: asyncio.base_events.Server | None = None
         self._cycle_task: asyncio.Task[None] | None = None

@@ -1,0 +1,158 @@
+"""The parent's side of a guardian: start it, hand it the credentials, arm, beat, disarm, say goodbye.
+
+Every method is thread-safe and never blocks: records go to a non-blocking pipe
+with one ``os.write`` each (the UI thread and the network thread both beat). A
+full pipe means the guardian has stopped reading: it is then ended and reported
+unavailable rather than let a lost disarm become a false stop later.
+"""
+
+from __future__ import annotations
+
+import contextlib
+import os
+import subprocess
+import sys
+import threading
+import time
+from collections.abc import Callable
+
+from . import messages as m
+
+BEAT_PERIOD = 0.04
+"""Seconds between heartbeats from each thread (the guardian wants one at least every 50 ms)."""
+
+
+class GuardianHandle:
+    """One guardian process. :meth:`start` it, then :meth:`poll` its reports from time to time."""
+
+    def __init__(self, proc: subprocess.Popen[bytes], clock: Callable[[], float] = time.monotonic) -> None:
+        self.proc = proc
+        self.clock = clock
+        self._lock = threading.Lock()
+        assert proc.stdin is not None and proc.stdout is not None
+        self._fd = proc.stdin.fileno()
+        self._out = proc.stdout.fileno()
+        os.set_blocking(self._out, False)
+        self._partial = b""
+        self.armed = False
+        self.state = "starting"
+        """starting → ready, or unavailable/lost/ended (with :attr:`reason`)."""
+        self.reason = ""
+
+    @classmethod
+    def start(cls, hello: m.Hello) -> GuardianHandle:
+        """Spawn ``python -m rtmu.guardian`` in its own session; credentials go down the pipe only."""
+        proc = subprocess.Popen(
+            [sys.executable, "-m", "rtmu.guardian"],
+            stdin=subprocess.PIPE,
+            stdout=subprocess.PIPE,
+            start_new_session=True,
+        )
+        handle = cls(proc)
+        assert proc.stdin is not None
+        os.write(handle._fd, hello.encode())  # far below the pipe's 64 KiB: never blocks
+        os.set_blocking(handle._fd, False)
+        return handle
+
+    # -- records ---------------------------------------------------------------------------
+    def _send(self, kind: bytes) -> bool:
+        with self._lock:
+            if self._fd < 0:
+                return False
+            try:
+                os.write(self._fd, m.record(kind, self.clock()))
+                return True
+            except BlockingIOError:
+                stuck = True
+            except OSError:
+                stuck = False
+        self._gone("ended", "the guardian stopped reading its pipe" if stuck else "the guardian ended")
+        return False
+
+    def arm(self) -> None:
+        """Before the first nonzero ``ratioDrive`` of a drive."""
+        if not self.armed:
+            self.armed = True
+            self._send(m.ARM)
+
+    def disarm(self) -> None:
+        """After our own zero ratios + ``stop`` have been sent."""
+        if self.armed:
+            self.armed = False
+            self._send(m.DISARM)
+
+    def beat_ui(self) -> None:
+        if self.armed:
+            self._send(m.BEAT_UI)
+
+    def beat_net(self) -> None:
+        if self.armed:
+            self._send(m.BEAT_NET)
+
+    # -- reports ---------------------------------------------------------------------------
+    def poll(self) -> list[tuple[str, str]]:
+        """The guardian's reports since the last call, as (word, text); never blocks."""
+        out: list[tuple[str, str]] = []
+        while self._out >= 0:
+            try:
+                data = os.read(self._out, 4096)
+            except BlockingIOError:
+                break
+            except OSError:
+                data = b""
+            if not data:
+                self._out = -1
+                if self.state in ("starting", "ready"):
+                    code = self.proc.poll()
+                    self._gone("ended", f"the guardian ended unexpectedly (exit code {code})")
+                    out.append(("ended", self.reason))
+                break
+            self._partial += data
+            *lines, self._partial = self._partial.split(b"\n")
+            for line in lines:
+                word, _, text = line.decode("utf-8", "replace").partition(" ")
+                out.append((word, text))
+                if word == m.READY and self.state == "starting":
+                    self.state = "ready"
+                elif word in (m.UNAVAILABLE, m.LOST):
+                    self.state, self.reason = word, text
+        return out
+
+    # -- ending ----------------------------------------------------------------------------
+    def close(self, *, goodbye: bool = True) -> None:
+        """End the guardian: with ``goodbye`` it exits without a stop; without it and while armed,
+        the closed pipe makes it stop the robot (our own connection died while driving)."""
+        if goodbye:
+            self.armed = False
+            self._send(m.BYE)
+        self._close_pipe()
+        out, self._out = self._out, -1  # poll() runs on the same (network) thread as close()
+        if out >= 0 and self.proc.stdout is not None:
+            with contextlib.suppress(OSError, ValueError):
+                self.proc.stdout.close()
+        if self.state in ("starting", "ready"):
+            self.state = "ended"
+        threading.Thread(target=self._reap, name="rtmu-guardian-reap", daemon=True).start()
+
+    def _reap(self) -> None:
+        try:
+            self.proc.wait(3.0)
+        except subprocess.TimeoutExpired:
+            self.proc.kill()
+            with contextlib.suppress(subprocess.TimeoutExpired):
+                self.proc.wait(1.0)
+
+    def _close_pipe(self) -> None:
+        """Close our end of its stdin once (the fd number must never be closed twice)."""
+        with self._lock:
+            fd, self._fd = self._fd, -1
+            if fd >= 0 and self.proc.stdin is not None:
+                with contextlib.suppress(OSError, ValueError):
+                    self.proc.stdin.close()
+
+    def _gone(self, state: str, reason: str) -> None:
+        self._close_pipe()
+        if state == "ended" and self.proc.poll() is None:
+            with contextlib.suppress(OSError):
+                self.proc.kill()
+        self.state, self.reason = state, reason
