@@ -25,6 +25,7 @@ from typing import Any
 
 from ..cli import EXIT_OK
 from ..client.connection import AriaClient
+from ..client.drive_guard import DriveGuard, LinkFault
 from ..client.errors import ClientError, NotSupported
 from ..protocol.payloads.drive import RatioDrive
 from ._common import (
@@ -84,6 +85,8 @@ def handle(args: argparse.Namespace) -> int:
             raise NotSupported(
                 "ratioDrive", "this server (or this user) may not drive the robot (no ratioDrive)"
             )
+        guard = DriveGuard(client)
+        guard.start()  # before the first status fetch, so the link is watched from the start
         before = await fetch_status(client, args.timeout)
         if not args.json:
             print(f"before: {status_line(before)}", flush=True)
@@ -98,13 +101,23 @@ def handle(args: argparse.Namespace) -> int:
         signum: int | None = None
         try:
             ratios = RatioDrive(args.trans, args.rot, args.throttle)
-            await drive(client, ratios, args.seconds, held=lambda: interrupts.suspending)
+            await drive(client, ratios, args.seconds, held=lambda: interrupts.suspending, guard=guard)
         except asyncio.CancelledError:
             signum = interrupts.take()
             if signum is None:
                 raise
+        except LinkFault as fault:
+            stop(client)
+            await guard.close()
+            if client.closed_error is not None:
+                raise LinkFault(
+                    f"{fault}; the stop could not be sent (the server's watchdog stops the robot)"
+                ) from None
+            await client.flush()
+            raise LinkFault(f"{fault}; zero ratioDrive and stop sent at once") from None
         finally:
             stop(client)
+        await guard.close()
         if signum is None:
             report(args, before, await settle(client, args.timeout))
             return EXIT_OK
@@ -143,23 +156,45 @@ def report(
 
 
 async def drive(
-    client: AriaClient, ratios: RatioDrive, seconds: float, held: Callable[[], bool] = lambda: False
+    client: AriaClient,
+    ratios: RatioDrive,
+    seconds: float,
+    held: Callable[[], bool] = lambda: False,
+    guard: DriveGuard | None = None,
 ) -> None:
-    """Resend ``ratios`` every :data:`RESEND` s for ``seconds``; nothing while ``held()`` (Ctrl-Z)."""
-    loop = asyncio.get_running_loop()
-    end = loop.time() + seconds
-    next_send = loop.time()
+    """Resend ``ratios`` every :data:`RESEND` s for ``seconds``; nothing while ``held()`` (Ctrl-Z).
+
+    With a ``guard``, a link fault raises :class:`LinkFault` the moment it is seen (the guard
+    wakes this loop when status arrives or a ping fails, and at the instant status would go stale).
+    """
+    clock = client.clock
+    end = clock() + seconds
+    next_send = clock()
     while True:
-        now = loop.time()
+        now = clock()
         if now >= end:
             return
+        if guard is not None and not held():
+            why = guard.fault(now)
+            if why is not None:
+                raise LinkFault(why)
         if now >= next_send:
             if not held():
                 client.send("ratioDrive", ratios)
             next_send += RESEND
         if client.closed_error is not None:
+            if guard is not None:
+                raise LinkFault(f"lost the link: {client.closed_error}")
             raise client.closed_error
-        await asyncio.sleep(max(0.0, min(next_send, end) - loop.time()))
+        wake = min(next_send, end)
+        if guard is None:
+            await asyncio.sleep(max(0.0, wake - clock()))
+            continue
+        guard.changed.clear()
+        wake = min(wake, guard.next_check(now))
+        with contextlib.suppress(TimeoutError):
+            async with asyncio.timeout(max(0.0, wake - clock())):
+                await guard.changed.wait()
 
 
 def stop(client: AriaClient) -> None:

@@ -1,0 +1,107 @@
+"""The command line's link watch while it drives: the window's health rules, without a window.
+
+``rtmu drive`` must not drive blind. :class:`DriveGuard` subscribes to ``updateNumbers``
+(the status stream is the link's heartbeat, as in the window's session) and pings the
+server, feeding both into the same :class:`~rtmu.client.health.HealthMonitor` the window
+uses. :meth:`DriveGuard.fault` says, in words, why driving must stop now — stale status,
+an unanswered or too slow ping, or a lost connection — or None while the link is OK.
+
+The ping here is tighter than the window's (every :data:`PING_INTERVAL` s, answered within
+:data:`MAX_RTT` s): a script has no operator watching the link cell, and a server that
+stopped reading would never hear its ``stop``.
+"""
+
+from __future__ import annotations
+
+import asyncio
+import contextlib
+import time
+
+from ..cli import EXIT_TIMEOUT
+from ..model import LinkLevel
+from .connection import AriaClient, Packet
+from .errors import ClientError, ClientTimeout
+from .health import HealthMonitor, ping_data
+
+STATUS_INTERVAL_MS = 100
+PING_INTERVAL = 0.25
+MAX_RTT = 0.5
+"""A ping not answered within this many seconds counts as a link fault (round trip too high)."""
+
+
+class LinkFault(ClientError):
+    """Driving was stopped because the link went bad (exit 5, like a timeout)."""
+
+    exit_code = EXIT_TIMEOUT
+    kind = "link"
+
+
+class DriveGuard:
+    """Status subscription + pings → :meth:`fault`. Create after login; ``start()``; ``close()``."""
+
+    def __init__(self, client: AriaClient, *, max_rtt: float = MAX_RTT, ping_interval: float = PING_INTERVAL):
+        self.client = client
+        self.max_rtt = max_rtt
+        self.ping_interval = ping_interval
+        self.health = HealthMonitor(STATUS_INTERVAL_MS / 1000.0)
+        self.changed = asyncio.Event()
+        """Set whenever something arrives or fails that may change :meth:`fault` (a wake-up)."""
+        self._ping_task: asyncio.Task[None] | None = None
+        self._status_name = "updateNumbers" if client.supports("updateNumbers") else "update"
+
+    def start(self) -> None:
+        """Subscribe to status at 10 Hz and start pinging; the status age counts from now."""
+        self.health.start(self.client.clock())
+        if self.client.on_close is None:  # a lost connection wakes the drive loop at once
+            self.client.on_close = lambda error: self.changed.set()
+        self.client.request(self._status_name, STATUS_INTERVAL_MS, self._on_status)
+        if ping_data(self.client.datalist) is not None:
+            self._ping_task = asyncio.get_running_loop().create_task(self._ping_loop(), name="drive-ping")
+
+    def _on_status(self, packet: Packet) -> None:
+        self.health.note_status(packet.received_at)
+        self.changed.set()
+
+    async def _ping_loop(self) -> None:
+        name = ping_data(self.client.datalist)
+        assert name is not None
+        while self.client.connected:
+            started = time.perf_counter()
+            try:
+                await self.client.request_once(name, timeout=self.max_rtt)
+            except ClientTimeout:
+                self.health.note_ping_timeout()
+                self.changed.set()
+            except ClientError:
+                self.changed.set()
+                return
+            else:
+                self.health.note_rtt(time.perf_counter() - started)
+            await asyncio.sleep(self.ping_interval)
+
+    def next_check(self, now: float) -> float:
+        """When :meth:`fault` could next turn non-None without anything arriving."""
+        return self.health.next_change(now)
+
+    def fault(self, now: float) -> str | None:
+        """Why driving must stop now (one sentence naming the fault), or None while the link is OK."""
+        where = f"{self.client.host}:{self.client.port}"
+        error = self.client.closed_error
+        if error is not None:
+            return f"lost the link: {error}"
+        if self.health.level(now) is LinkLevel.OK:
+            return None
+        if self.health.ping_failures:
+            return f"{where} did not answer a ping within {self.max_rtt * 1000:.0f} ms (round trip too high)"
+        age = self.health.status_age(now) or 0.0
+        return f"no status from {where} for {age * 1000:.0f} ms (the link is stale)"
+
+    async def close(self) -> None:
+        """Stop pinging (the subscription ends with the connection)."""
+        task, self._ping_task = self._ping_task, None
+        if task is not None:
+            task.cancel()
+            with contextlib.suppress(asyncio.CancelledError, Exception):
+                await asyncio.wait({task}, timeout=0.5)
+        with contextlib.suppress(ClientError):
+            self.client.stop_request(self._status_name)
