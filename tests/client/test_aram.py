@@ -77,7 +77,7 @@ def test_cli_wrong_protocol_exits_3_with_the_wanted_string(
     code = main(["probe", addr(aram), "--protocol", "wrong", "--timeout", "5"])
     err = capsys.readouterr().err
     assert code == EXIT_CONNECTION
-    assert "the server wants protocol '6MTX'" in err and "--protocol 6MTX" in err
+    assert "wants protocol '6MTX'; we sent 'wrong'" in err and "--protocol 6MTX" in err
 
 
 def test_cli_explicit_right_protocol_logs_in(aram: SimThread, capsys: pytest.CaptureFixture[str]) -> None:

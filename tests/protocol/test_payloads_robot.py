@@ -140,8 +140,10 @@ def test_battery_info_captured_defaults() -> None:
 
 
 def test_battery_info_truncated() -> None:
-    with pytest.raises(FieldUnderrun, match="state of charge"):
-        BatteryInfo.decode(b"11.5\x0011\x00")
+    # Older servers leave the state-of-charge flag out: their figures are volts.
+    assert BatteryInfo.decode(b"11.5\x0011\x00") == BatteryInfo(11.5, 11.0, False)
+    with pytest.raises(FieldUnderrun, match="shutdown"):
+        BatteryInfo.decode(b"11.5\x00")
 
 
 def test_physical_info_captured() -> None:

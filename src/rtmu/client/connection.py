@@ -37,7 +37,8 @@ from collections import deque
 from collections.abc import AsyncIterator, Callable
 from dataclasses import dataclass, field
 
-from ..protocol.client_connection import ClientConnection, ClientState
+from ..protocol.client_connection import ClientConnection, ClientState, protocol_advice
+from ..protocol.commands import RejectReason
 from ..protocol.datalist import DataList
 from ..protocol.decoder import DropStats
 from ..protocol.errors import ProtocolError
@@ -492,9 +493,7 @@ class AriaClient:
             ready = False
             for event in events:
                 if isinstance(event, Rejected):
-                    raise LoginRejected(
-                        event.reason, event.text, event.message, self._conn.wanted_protocol()
-                    )
+                    raise login_rejected(self._conn, event)
                 if isinstance(event, PeerShutdown):
                     raise ServerClosed(f"{self.host}:{self.port} shut the connection down during login")
                 if isinstance(event, DataListReady):
@@ -806,3 +805,12 @@ class AriaClient:
         if task is not None and task is not asyncio.current_task() and not task.done():
             # Bounded: a reader that will not end must not keep the caller (a window closing) waiting.
             await asyncio.wait({task}, timeout=CLOSE_TIMEOUT)
+
+
+def login_rejected(conn: ClientConnection, event: Rejected) -> LoginRejected:
+    """The refusal as the operator's error; reason 4 names the protocol string the server wants."""
+    wanted = conn.wanted_protocol()
+    advice = ""
+    if event.reason == RejectReason.PROTOCOL_VERSION_MISMATCH and wanted is not None:
+        advice = protocol_advice(wanted, conn.sent_protocol_version or "")
+    return LoginRejected(event.reason, event.text, advice, wanted)

@@ -193,11 +193,7 @@ class ClientConnection:
         reason = r.byte2("reason", default=0)
         text = r.string("text", default="")
         self.state = ClientState.REJECTED
-        message = describe_reject(reason, text)
-        wanted = self.wanted_protocol()
-        if reason == RejectReason.PROTOCOL_VERSION_MISMATCH and wanted is not None:
-            message = protocol_advice(wanted, self.sent_protocol_version or "")
-        return Rejected(reason, text, message)
+        return Rejected(reason, text, describe_reject(reason, text))
 
     def wanted_protocol(self) -> str | None:
         """The protocol string the server advertised (None before its introduction)."""
@@ -205,10 +201,11 @@ class ClientConnection:
 
 
 def protocol_advice(wanted: str, sent: str) -> str:
-    """What a reason-4 refusal means, and what to do about it."""
+    """What a reason-4 refusal means, and what to do about it (the client's error text)."""
+    base = RejectReason.PROTOCOL_VERSION_MISMATCH.explanation
     if wanted:
-        return f"the server wants protocol {wanted!r}; we sent {sent!r}. Use --protocol {wanted}"
+        return f"{base}: it wants protocol {wanted!r}; we sent {sent!r}. Use --protocol {wanted}"
     return (
-        f"the server refuses our protocol string {sent!r} and does not say which it wants; "
+        f"{base}: we sent {sent!r} and it does not say which it wants; "
         "try --protocol 6MTX (Omron LD robots; older ones 5MTX)"
     )
