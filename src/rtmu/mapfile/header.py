@@ -21,6 +21,7 @@ from .model import (
     MapData,
     MapObject,
     MapScan,
+    map_category,
 )
 from .tokens import (
     SPACE,
@@ -32,7 +33,6 @@ from .tokens import (
     unquote,
 )
 
-_CATEGORY_BY_LOWER = {c.lower(): c for c in CATEGORIES}
 _INFO_BY_LOWER = {f"{k.lower()}:": k for k in INFO_KEYWORDS} | {
     f"_{k.lower()}:": f"_{k}" for k in INFO_KEYWORDS
 }
@@ -110,11 +110,12 @@ class HeaderReader:
     # -- category and keywords ----------------------------------------------------------------------
 
     def _category(self, keyword: str, args: str, line_no: int) -> None:
-        category = _CATEGORY_BY_LOWER.get(keyword.lower())
+        category = map_category(keyword)
         if category is None:
             shown = f"{keyword} {args}".strip(SPACE)[:40]
             raise MapFormatError(
-                f"not an ARIA map: first line is {shown!r}, expected one of {', '.join(CATEGORIES)}",
+                f"not an ARIA map: first line is {shown!r}, expected one of {', '.join(CATEGORIES)}"
+                " (or a later 2D-Map-ExN)",
                 self.map.source,
                 line_no,
             )

@@ -7,6 +7,7 @@ The data is the truth and the header's counts and bounding boxes are claims
 
 from __future__ import annotations
 
+import re
 from dataclasses import dataclass, field
 from typing import NamedTuple
 
@@ -15,8 +16,23 @@ from numpy.typing import ArrayLike
 
 from .errors import MapWarning
 
-CATEGORIES = ("2D-Map", "2D-Map-Ex", "2D-Map-Ex2", "2D-Map-Ex3")
-"""The accepted first lines, in ARIA's spelling (matched case-insensitively)."""
+CATEGORIES = ("2D-Map", "2D-Map-Ex", "2D-Map-Ex2", "2D-Map-Ex3", "2D-Map-Ex4")
+"""The known first lines, in ARIA's spelling (matched case-insensitively). Later ``2D-Map-ExN`` are
+accepted too (see :func:`map_category`): each new ARIA/ARAM generation only adds header lines, which
+are kept verbatim, so refusing an unknown N would lose whole maps for nothing."""
+
+_LATER_EX = re.compile(r"2D-Map-Ex([1-9][0-9]{0,3})", re.IGNORECASE)
+_CATEGORY_BY_LOWER = {c.lower(): c for c in CATEGORIES}
+
+
+def map_category(word: str) -> str | None:
+    """The category named by a map's first word in ARIA's spelling, or None when it is not a map."""
+    known = _CATEGORY_BY_LOWER.get(word.lower())
+    if known is not None:
+        return known
+    match = _LATER_EX.fullmatch(word)
+    return f"2D-Map-Ex{int(match.group(1))}" if match else None
+
 
 INFO_KEYWORDS = (
     "MapInfo",

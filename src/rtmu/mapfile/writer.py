@@ -7,16 +7,14 @@ import os
 import secrets
 from pathlib import Path
 
-from .model import CATEGORIES, INFO_KEYWORDS, MapData, MapObject, MapScan, as_rows, rows_bounds
+from .model import CATEGORIES, INFO_KEYWORDS, MapData, MapObject, MapScan, as_rows, map_category, rows_bounds
 from .numeric import format_rows
 from .tokens import SPACE, format_heading, format_number, split_keyword, split_tokens
-
-_CATEGORY_BY_LOWER = {c.lower(): c for c in CATEGORIES}
 
 
 def header_lines(data: MapData) -> list[str]:
     """Every line before the data sections."""
-    category = _CATEGORY_BY_LOWER.get(data.category.lower())
+    category = map_category(data.category)
     if category is None:
         raise ValueError(f"unknown map category {data.category!r}; use one of {', '.join(CATEGORIES)}")
     lines = [category]
