@@ -3,7 +3,8 @@
 ``--json`` prints one JSON object per status (one line each when streaming) with
 the keys ``x``, ``y`` (mm), ``th`` (degrees), ``vel`` (mm/s), ``rot_vel``
 (deg/s), ``battery_v`` (volts) — or ``battery_pct`` instead when the robot
-reports state of charge (``batteryInfo``) — ``status`` and ``mode``.
+reports state of charge (``batteryInfo``) — ``status`` and ``mode``, and ``dock`` (Undocked,
+Docking, Docked, Undocking) when the server offers ``dockInfo`` (LD robots).
 """
 
 from __future__ import annotations
@@ -14,9 +15,11 @@ import contextlib
 from typing import Any
 
 from ..cli import EXIT_OK
+from ..client import ld_data
 from ..client.connection import AriaClient, Packet
 from ..client.errors import ClientTimeout, NotSupported, ProtocolFault
 from ..protocol.errors import ProtocolError
+from ..protocol.payloads.ld import DockInfo
 from ..protocol.payloads.robot import Update, UpdateNumbers, UpdateStrings
 from ._common import (
     add_connection_arguments,
@@ -55,11 +58,14 @@ def handle(args: argparse.Namespace) -> int:
         if args.json:
             print_json(obj)
         else:
-            print(status_line(obj), flush=True)
+            dock = f"  dock={obj['dock']}" if "dock" in obj else ""
+            print(status_line(obj) + dock, flush=True)
 
     async def body(client: AriaClient) -> int:
         if args.once:
-            show(await fetch_status(client, args.timeout))
+            obj = await fetch_status(client, args.timeout)
+            dock = await ld_data.dock_info(client, args.timeout)
+            show(obj if dock is None else {**obj, "dock": dock.state_label})
             return EXIT_OK
         return await stream(client, args, show)
 
@@ -69,6 +75,20 @@ def handle(args: argparse.Namespace) -> int:
 async def stream(client: AriaClient, args: argparse.Namespace, show: Any) -> int:
     strings = {"status": "", "mode": ""}
     soc = await battery_is_soc(client, args.timeout)
+    dock: dict[str, str] = {}
+    """``{"dock": label}`` when the server offers dockInfo, kept current by dockInfoChanged."""
+    first_dock = await ld_data.dock_info(client, args.timeout)
+    if first_dock is not None:
+        dock["dock"] = first_dock.state_label
+
+    def on_dock(packet: Packet) -> None:
+        with contextlib.suppress(ProtocolError):
+            d = packet.decode()
+            if isinstance(d, DockInfo):
+                dock["dock"] = d.state_label
+
+    if first_dock is not None and client.supports("dockInfoChanged"):
+        client.request("dockInfoChanged", -1, on_dock)
     queue: asyncio.Queue[dict[str, Any]] = asyncio.Queue()
     malformed: list[ProtocolError] = []
     """Status packets that did not decode: skipped, and named if no good one comes in time."""
@@ -80,9 +100,9 @@ async def stream(client: AriaClient, args: argparse.Namespace, show: Any) -> int
             malformed[:] = [exc]
             return
         if isinstance(n, UpdateNumbers):
-            queue.put_nowait(status_object(n, strings["status"], strings["mode"], soc=soc))
+            queue.put_nowait({**status_object(n, strings["status"], strings["mode"], soc=soc), **dock})
         elif isinstance(n, Update):
-            queue.put_nowait(status_object(n.numbers, n.status, n.mode, soc=soc))
+            queue.put_nowait({**status_object(n.numbers, n.status, n.mode, soc=soc), **dock})
 
     def on_strings(packet: Packet) -> None:
         try:

@@ -1,0 +1,37 @@
+"""``rtmu patrol HOST[:PORT] ROUTE``: start patrolling one of the server's routes (LD robots)."""
+
+from __future__ import annotations
+
+import argparse
+import sys
+from typing import Any
+
+from ..cli import EXIT_OK, EXIT_USAGE
+from ..client import ld_data
+from ..client.connection import AriaClient
+from ._common import add_connection_arguments, run_with_client
+
+
+def register(subparsers: Any) -> None:
+    p = subparsers.add_parser(
+        "patrol",
+        help="patrol one of the server's routes (LD robots)",
+        description="Send patrol ROUTE; the route must be one getRoutes lists (exit 2 otherwise).",
+    )
+    add_connection_arguments(p)
+    p.add_argument("route", metavar="ROUTE", help="route name, as `rtmu routes` lists it")
+    p.set_defaults(handler=handle)
+
+
+def handle(args: argparse.Namespace) -> int:
+    async def body(client: AriaClient) -> int:
+        known = await ld_data.routes(client, args.timeout)
+        if args.route not in known:
+            listed = ", ".join(known) or "none"
+            print(f"rtmu patrol: no route {args.route!r} on this server (routes: {listed})", file=sys.stderr)
+            return EXIT_USAGE
+        ld_data.patrol(client, args.route)
+        print(f"patrolling {args.route}", file=sys.stderr)
+        return EXIT_OK
+
+    return run_with_client("patrol", args, body)

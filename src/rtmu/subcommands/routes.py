@@ -1,0 +1,35 @@
+"""``rtmu routes HOST[:PORT]``: list the routes an LD (ARAM) server offers (``getRoutes``)."""
+
+from __future__ import annotations
+
+import argparse
+from typing import Any
+
+from ..cli import EXIT_OK
+from ..client import ld_data
+from ..client.connection import AriaClient
+from ._common import add_connection_arguments, print_json, run_with_client
+
+
+def register(subparsers: Any) -> None:
+    p = subparsers.add_parser(
+        "routes",
+        help="list the server's routes (LD robots)",
+        description="List the routes the server offers (getRoutes), one per line; exit 4 if it has none.",
+    )
+    add_connection_arguments(p)
+    p.add_argument("--json", action="store_true", help="a JSON list of route names")
+    p.set_defaults(handler=handle)
+
+
+def handle(args: argparse.Namespace) -> int:
+    async def body(client: AriaClient) -> int:
+        names = await ld_data.routes(client, args.timeout)
+        if args.json:
+            print_json(list(names))
+        else:
+            for name in names:
+                print(name)
+        return EXIT_OK
+
+    return run_with_client("routes", args, body)

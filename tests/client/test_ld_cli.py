@@ -1,0 +1,96 @@
+"""``rtmu routes / patrol / say / status`` against ``rtmu sim --profile aram`` and the default profile."""
+
+from __future__ import annotations
+
+import asyncio
+import json
+from collections.abc import Iterator
+from pathlib import Path
+
+import pytest
+
+from rtmu.cli import EXIT_OK, EXIT_UNSUPPORTED, EXIT_USAGE, main
+from rtmu.client import ld_data
+from rtmu.client.connection import AriaClient
+from rtmu.sim import SimConfig, SimThread
+from rtmu.sim.ld_data import ROUTES, ld_state
+
+from .uiqueue import eventually
+
+REPO = Path(__file__).resolve().parents[2]
+OFFICE = REPO / "data" / "maps" / "office.map"
+
+
+@pytest.fixture(scope="module")
+def aram() -> Iterator[SimThread]:
+    with SimThread(SimConfig(port=0, profile="aram", map_path=OFFICE)) as s:
+        yield s
+
+
+@pytest.fixture(scope="module")
+def plain() -> Iterator[SimThread]:
+    with SimThread(SimConfig(port=0, map_path=OFFICE)) as s:
+        yield s
+
+
+def addr(sim: SimThread) -> str:
+    return f"127.0.0.1:{sim.port}"
+
+
+def _state(sim: SimThread):  # type: ignore[no-untyped-def]
+    assert sim.server is not None
+    return sim.call(lambda: ld_state(sim.server))  # type: ignore[arg-type]
+
+
+def test_routes_lists_the_servers_routes(aram: SimThread, capsys: pytest.CaptureFixture[str]) -> None:
+    assert main(["routes", addr(aram), "--timeout", "5"]) == EXIT_OK
+    assert capsys.readouterr().out.splitlines() == list(ROUTES)
+    assert main(["routes", addr(aram), "--json", "--timeout", "5"]) == EXIT_OK
+    assert json.loads(capsys.readouterr().out) == list(ROUTES)
+
+
+def test_patrol_sends_the_route_and_refuses_an_unknown_one(
+    aram: SimThread, capsys: pytest.CaptureFixture[str]
+) -> None:
+    before = len(_state(aram).patrols)
+    assert main(["patrol", addr(aram), ROUTES[2], "--timeout", "5"]) == EXIT_OK
+    eventually(lambda: _state(aram).patrols[before:] == [ROUTES[2]])
+    assert main(["patrol", addr(aram), "Nowhere", "--timeout", "5"]) == EXIT_USAGE
+    assert "no route 'Nowhere'" in capsys.readouterr().err
+    assert _state(aram).patrols[before:] == [ROUTES[2]]
+
+
+def test_say_sends_the_text(aram: SimThread) -> None:
+    assert main(["say", addr(aram), "Mind the gap", "--timeout", "5"]) == EXIT_OK
+    eventually(lambda: "Mind the gap" in _state(aram).said)
+    assert main(["say", addr(aram), "   ", "--timeout", "5"]) == EXIT_USAGE
+
+
+def test_status_says_the_dock_state(aram: SimThread, capsys: pytest.CaptureFixture[str]) -> None:
+    assert main(["status", addr(aram), "--once", "--json", "--timeout", "5"]) == EXIT_OK
+    assert json.loads(capsys.readouterr().out)["dock"] == "Undocked"
+    assert main(["status", addr(aram), "--once", "--timeout", "5"]) == EXIT_OK
+    assert "dock=Undocked" in capsys.readouterr().out
+
+
+def test_data_store_strings_are_read_by_name(aram: SimThread) -> None:
+    async def go() -> dict[str, str]:
+        client = AriaClient()
+        await client.connect("127.0.0.1", aram.port, timeout=5.0)
+        try:
+            return await ld_data.data_store(client, 5.0)
+        finally:
+            await client.disconnect()
+
+    values = asyncio.run(go())
+    assert set(values) >= {"DataStore_WiFi_Quality", "DataStore_Localization_Score", "DataStore_Dock_State"}
+    assert 0 <= int(values["DataStore_WiFi_Quality"]) <= 70
+
+
+def test_default_profile_offers_none_of_it(plain: SimThread, capsys: pytest.CaptureFixture[str]) -> None:
+    assert main(["routes", addr(plain), "--timeout", "5"]) == EXIT_UNSUPPORTED
+    assert main(["patrol", addr(plain), "Loop", "--timeout", "5"]) == EXIT_UNSUPPORTED
+    assert main(["say", addr(plain), "hello", "--timeout", "5"]) == EXIT_UNSUPPORTED
+    capsys.readouterr()
+    assert main(["status", addr(plain), "--once", "--json", "--timeout", "5"]) == EXIT_OK
+    assert "dock" not in json.loads(capsys.readouterr().out)
