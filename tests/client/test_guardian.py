@@ -1,0 +1,250 @@
+"""The guardian (``rtmu.guardian``): a stop that survives the process that drives.
+
+A real parent process (the client core: runner + lease + guardian, as the window
+builds it) drives the real simulator over loopback; then it is killed, frozen or
+closed. The simulator records every ``stop`` with the sender's self identifier,
+so each test asserts WHO stopped the robot (the guardian's own connection) and
+that the simulator's 2 s watchdog did not have to — never how many ms it took
+(``bench/bench_safety.py`` measures that).
+"""
+
+from __future__ import annotations
+
+import ast
+import os
+import signal
+import subprocess
+import sys
+import time
+from collections.abc import Iterator
+from pathlib import Path
+
+import pytest
+
+from rtmu.client.lease import DriveRatios
+from rtmu.client.runner import ClientRunner
+from rtmu.client.session import SessionConfig
+from rtmu.guardian import halt
+from rtmu.guardian.halt import IDENTIFIER, ZERO_RATIO_DRIVE
+from rtmu.protocol.payloads.drive import RatioDrive
+from rtmu.sim import SimConfig, SimThread
+
+from .uiqueue import eventually
+
+PASSWORD = "guardianSecret7f3a"
+GUARDIAN_DIR = Path(halt.__file__).parent
+
+PARENT = r"""
+import sys, threading, time
+from rtmu.client.lease import DriveRatios
+from rtmu.client.runner import ClientRunner
+from rtmu.client.session import SessionConfig
+port, user, password, guardian, drive = sys.stdin.readline().split()
+runner = ClientRunner(config=SessionConfig(fetch_map=False, guardian=guardian == "1")).start()
+runner.connect("127.0.0.1", int(port), user, password).result(10)
+deadline = time.monotonic() + 10
+while runner.session.guardian is not None and runner.session.guardian.state == "starting":
+    runner.sync()
+    if time.monotonic() > deadline:
+        break
+def ui_thread():
+    while True:  # what the window's 40 ms timer does: renew the lease, beat for the guardian
+        runner.lease.renew()
+        runner.ui_heartbeat()
+        time.sleep(0.04)
+threading.Thread(target=ui_thread, daemon=True).start()
+if drive == "1":
+    runner.lease.grant(DriveRatios(50.0, 0.0, 50.0))
+print("ready", runner.session.guardian.proc.pid if runner.session.guardian else 0, flush=True)
+if sys.stdin.readline().strip() == "close":
+    runner.close()
+    print("closed", flush=True)
+"""
+
+
+@pytest.fixture
+def sim(tmp_path: Path) -> Iterator[SimThread]:
+    users = tmp_path / "users.txt"
+    users.write_text(f"UserInfoVersion1\nuser alice {PASSWORD} all\n")
+    with SimThread(SimConfig(port=0, seed=1, users_path=users)) as s:
+        yield s
+
+
+class Parent:
+    """The driving process; ``guardian_pid`` is its guardian's (0 without one)."""
+
+    def __init__(self, sim: SimThread, *, guardian: bool = True, drive: bool = True) -> None:
+        self.sim = sim
+        self.proc = subprocess.Popen(
+            [sys.executable, "-c", PARENT],
+            stdin=subprocess.PIPE,
+            stdout=subprocess.PIPE,
+            text=True,
+        )
+        assert self.proc.stdin is not None and self.proc.stdout is not None
+        self.proc.stdin.write(f"{sim.port} alice {PASSWORD} {int(guardian)} {int(drive)}\n")
+        self.proc.stdin.flush()
+        line = self.proc.stdout.readline().split()
+        assert line and line[0] == "ready", line
+        self.guardian_pid = int(line[1])
+
+    def close_cleanly(self) -> None:
+        assert self.proc.stdin is not None and self.proc.stdout is not None
+        self.proc.stdin.write("close\n")
+        self.proc.stdin.flush()
+        assert self.proc.stdout.readline().strip() == "closed"
+        assert self.proc.wait(10) == 0
+
+    def end(self) -> None:
+        if self.proc.poll() is None:
+            self.proc.send_signal(signal.SIGCONT)
+            self.proc.kill()
+        self.proc.wait(10)
+        if self.guardian_pid:
+            eventually(lambda: not _alive(self.guardian_pid), timeout=10)
+
+
+def _alive(pid: int) -> bool:
+    try:
+        state = Path(f"/proc/{pid}/stat").read_text().rsplit(")", 1)[1].split()[0]
+    except OSError:
+        return False
+    return state != "Z"
+
+
+def stops_by(sim: SimThread, identifier: str) -> int:
+    return sum(1 for _t, _ident, who in sim.call(lambda: list(sim.server.stop_log)) if who == identifier)
+
+
+def watchdog_stops(sim: SimThread) -> int:
+    return int(sim.call(lambda: sim.server.robot.watchdog_stops))
+
+
+def driving(sim: SimThread) -> bool:
+    return abs(sim.snapshot().vel) > 1.0
+
+
+@pytest.mark.parametrize("signum", [signal.SIGKILL, signal.SIGSTOP], ids=["SIGKILL", "SIGSTOP"])
+def test_a_killed_or_frozen_parent_is_stopped_by_its_guardian_not_the_watchdog(
+    sim: SimThread, signum: int
+) -> None:
+    parent = Parent(sim)
+    try:
+        assert parent.guardian_pid, "no guardian was started"
+        eventually(lambda: driving(sim), timeout=5)
+        watchdog = watchdog_stops(sim)
+        os.kill(parent.proc.pid, signum)
+        eventually(lambda: stops_by(sim, IDENTIFIER) == 1, timeout=5)
+        assert sim.call(lambda: sim.server.robot.mode_name) == "stop"
+        assert watchdog_stops(sim) == watchdog, "the server's watchdog had to stop the robot"
+    finally:
+        parent.end()
+
+
+def test_without_a_guardian_only_the_watchdog_stops_a_frozen_parent(sim: SimThread) -> None:
+    """The baseline the guardian improves on (and proof the test above can fail)."""
+    parent = Parent(sim, guardian=False)
+    try:
+        eventually(lambda: driving(sim), timeout=5)
+        watchdog = watchdog_stops(sim)
+        os.kill(parent.proc.pid, signal.SIGSTOP)
+        eventually(lambda: watchdog_stops(sim) == watchdog + 1, timeout=5)
+        assert stops_by(sim, IDENTIFIER) == 0
+    finally:
+        parent.end()
+
+
+def test_a_clean_exit_while_driving_stops_by_the_parent_and_never_by_the_guardian(sim: SimThread) -> None:
+    parent = Parent(sim)
+    try:
+        eventually(lambda: driving(sim), timeout=5)
+        parent.close_cleanly()
+        eventually(lambda: not _alive(parent.guardian_pid), timeout=10)
+        assert sim.call(lambda: sim.server.robot.mode_name) == "stop"
+        assert stops_by(sim, "") == 1, "the parent's own stop"
+        assert stops_by(sim, IDENTIFIER) == 0
+    finally:
+        parent.end()
+
+
+@pytest.mark.parametrize("signum", [signal.SIGKILL, signal.SIGSTOP], ids=["SIGKILL", "SIGSTOP"])
+def test_a_disarmed_guardian_never_stops(sim: SimThread, signum: int) -> None:
+    """Connected but not driving: killing or freezing the parent must not reset the server's mode."""
+    parent = Parent(sim, drive=False)
+    try:
+        assert parent.guardian_pid
+        os.kill(parent.proc.pid, signum)
+        if signum == signal.SIGKILL:
+            eventually(lambda: not _alive(parent.guardian_pid), timeout=10)
+        else:
+            time.sleep(1.0)  # the point is that time passes with the parent frozen
+        assert sim.call(lambda: list(sim.server.stop_log)) == []
+    finally:
+        parent.end()
+
+
+def test_the_password_reaches_the_guardian_only_through_its_pipe(sim: SimThread) -> None:
+    parent = Parent(sim, drive=False)
+    try:
+        pid = parent.guardian_pid
+        assert pid
+        cmdline = Path(f"/proc/{pid}/cmdline").read_bytes()
+        environ = Path(f"/proc/{pid}/environ").read_bytes()
+        assert b"guardian" in cmdline  # we are looking at the right process
+        assert PASSWORD.encode() not in cmdline
+        assert PASSWORD.encode() not in environ
+        # …and it did log in with it: the simulator has two sessions as alice.
+        assert len(sim.call(lambda: list(sim.server.sessions))) == 2
+    finally:
+        parent.end()
+
+
+def test_a_refused_second_login_is_said_plainly_and_driving_still_works() -> None:
+    notices: list[tuple[str, str]] = []
+    with SimThread(SimConfig(port=0, seed=1, max_clients=1)) as sim:
+        runner = ClientRunner(config=SessionConfig(fetch_map=False, guardian=True))
+        runner.on_notice = lambda level, text: notices.append((level, text))
+        with runner:
+            runner.connect("127.0.0.1", sim.port).result(10)
+
+            def told() -> bool:
+                runner.sync()
+                return any("Guardian not available" in text for _level, text in notices)
+
+            eventually(told, timeout=10)
+            assert runner.session is not None and runner.session.guardian is None
+            runner.lease.grant(DriveRatios(50.0, 0.0, 50.0))
+            eventually(lambda: (runner.lease.renew(), driving(sim))[1], timeout=5)
+            runner.stop()
+            eventually(lambda: sim.call(lambda: sim.server.robot.mode_name) == "stop", timeout=5)
+    level, text = next(n for n in notices if "Guardian" in n[1])
+    assert level == "warning"
+    assert "maximum number" in text or "refus" in text.lower(), text
+
+
+def test_the_guardian_can_only_send_zero_ratios_and_stop() -> None:
+    """Structural: every send in the guardian package is in halt.py, of a constant or a literal."""
+    assert RatioDrive.decode(ZERO_RATIO_DRIVE) == RatioDrive(0.0, 0.0, 0.0)
+    assert not RatioDrive.decode(ZERO_RATIO_DRIVE).moving
+    sends: list[tuple[str, list[str]]] = []
+    for path in sorted(GUARDIAN_DIR.glob("*.py")):
+        tree = ast.parse(path.read_text())
+        for node in ast.walk(tree):
+            if (
+                isinstance(node, ast.Call)
+                and isinstance(node.func, ast.Attribute)
+                and node.func.attr in ("send", "request", "request_once", "stream", "write")
+            ):
+                if node.func.attr == "write" and path.name != "halt.py":
+                    continue  # pipe and stdout writes
+                sends.append((path.name, [ast.unparse(a) for a in node.args]))
+    assert sends, "found no sends: the check itself is broken"
+    allowed = {
+        ("halt.py", ("'ratioDrive'", "ZERO_RATIO_DRIVE")),
+        ("halt.py", ("'stop'",)),
+        ("halt.py", ("'identSetSelfIdentifier'", "IDENTIFIER")),
+    }
+    assert {(name, tuple(args)) for name, args in sends} <= allowed, sends
+    # The Halter offers nothing but halt (and flush/connected): no way to reach the connection.
+    public = {n for n in dir(halt.Halter) if not n.startswith("_")}
+    assert public == {"halt", "flush", "connected"}
