@@ -35,6 +35,8 @@ class GuiOptions:
     """None: the user's settings file; tests point it into a temporary directory."""
     persist: bool = True
     report_first_frame: bool = False
+    guardian: bool = True
+    """Start a guardian process per connection (``rtmu.guardian``); off only to measure without it."""
 
 
 def add_gui_arguments(parser: argparse.ArgumentParser) -> None:
@@ -52,6 +54,7 @@ def add_gui_arguments(parser: argparse.ArgumentParser) -> None:
     g.add_argument("--fullscreen", action="store_true", help="start full screen (F11 toggles)")
     g.add_argument("--no-connect", action="store_true", help="open the window without connecting")
     g.add_argument("--report-first-frame", action="store_true", help=argparse.SUPPRESS)
+    g.add_argument("--no-guardian", action="store_true", help=argparse.SUPPRESS)  # bench baselines only
 
 
 def options_from_args(args: argparse.Namespace) -> GuiOptions:
@@ -64,6 +67,7 @@ def options_from_args(args: argparse.Namespace) -> GuiOptions:
         connect=False if getattr(args, "no_connect", False) else None,
         demo=bool(getattr(args, "demo", False)),
         report_first_frame=bool(getattr(args, "report_first_frame", False)),
+        guardian=not getattr(args, "no_guardian", False),
     )
 
 

@@ -22,6 +22,7 @@ gi.require_version("Gtk", "4.0")
 from gi.repository import Gio, GLib, Gtk  # noqa: E402
 
 from ..client.runner import ClientRunner  # noqa: E402
+from ..client.session import SessionConfig  # noqa: E402
 from ..model import Model, Phase  # noqa: E402
 from ..settings import (  # noqa: E402
     DEFAULT_PORT,
@@ -121,7 +122,9 @@ class RtmuApplication(Gtk.Application):
         self.settings_warning = loaded.warning
         profile, auto_connect = self.choose_profile()
         self.model = Model()
-        self.runner = ClientRunner(self.model, post=GLib.idle_add).start()
+        # The guardian: a separate process that stops the robot if this one is killed or frozen.
+        config = SessionConfig(guardian=self.options.guardian)
+        self.runner = ClientRunner(self.model, post=GLib.idle_add, config=config).start()
         try:
             window = MainWindow(
                 self,

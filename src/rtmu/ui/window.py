@@ -29,6 +29,7 @@ from gi.repository import Gdk, Gio, GLib, Gtk  # noqa: E402
 
 from ..commands import COMMANDS, CommandState  # noqa: E402
 from ..controller import TICK, ClientLink, Controller, Notice, SecretStore  # noqa: E402
+from ..guardian.handle import BEAT_PERIOD as GUARDIAN_BEAT  # noqa: E402
 from ..model import (  # noqa: E402
     SPEED_MAX,
     SPEED_MIN,
@@ -171,6 +172,14 @@ class MainWindow(Gtk.ApplicationWindow):
         self.connect("notify::is-active", self._on_active)
         self.connect("close-request", self._on_close_request)
         self._tick_source = GLib.timeout_add(int(TICK * 1000), self._tick)
+        # The UI thread's heartbeat to the guardian process (rtmu.guardian): it stops the robot
+        # if these stop while driving because this process was killed or frozen.
+        ui_heartbeat = getattr(link, "ui_heartbeat", None)
+        self._beat_source = (
+            GLib.timeout_add(int(GUARDIAN_BEAT * 1000), lambda: ui_heartbeat() or True)
+            if callable(ui_heartbeat)
+            else 0
+        )
         self.commands_changed(self.controller.command_states())
         self._on_connection(ConnectionState(), model.connection.value)
         self._on_map(MapModel(), model.map.value)
@@ -759,6 +768,9 @@ class MainWindow(Gtk.ApplicationWindow):
         if self._tick_source:
             GLib.source_remove(self._tick_source)
             self._tick_source = 0
+        if self._beat_source:
+            GLib.source_remove(self._beat_source)
+            self._beat_source = 0
         for remove in self._unobserve:
             remove()
         self._unobserve = []
