@@ -17,6 +17,8 @@ import pytest
 
 from linkfaults import FAKE_HEADER, GARBAGE, TO_CLIENT, TO_SERVER, FaultProxy
 from rtmu.cli import EXIT_TIMEOUT
+from rtmu.protocol.decoder import PacketDecoder
+from rtmu.protocol.packet import encode_packet
 from rtmu.sim import SimConfig, SimThread
 
 from .uiqueue import eventually
@@ -109,6 +111,18 @@ def test_noise_never_leaves_the_drive_blind(sim: SimThread, proxy: FaultProxy, n
         assert sim.snapshot().trans_ratio == 0
         assert _received(sim) - at_fault <= AFTER_FAULT_MAX
         return
-    proc.send_signal(signal.SIGINT)  # the decoder resynchronised: status flowed, driving was safe
+    # Still driving: right only if our decoder reads on past such bytes (status kept flowing).
+    assert _decoder_reads_on_past(noise), "the stream stalled behind the noise, yet the drive went on"
+    proc.send_signal(signal.SIGINT)
     assert _finish(proc)[0] == 128 + signal.SIGINT
     assert sim.snapshot().trans_ratio == 0
+
+
+def _decoder_reads_on_past(noise: bytes) -> bool:
+    """True when the project's decoder delivers status packets sent right after ``noise`` (3 s worth)."""
+    status = encode_packet(1000, bytes(19))
+    decoder = PacketDecoder()
+    got = decoder.feed(status + noise)
+    for _ in range(30):
+        got += decoder.feed(status)
+    return len(got) >= 25
