@@ -138,6 +138,15 @@ class RobotState:
     strings_at: float | None = field(default=None, compare=False)
     """Monotonic time of the last status/mode update."""
     sonar_at: float | None = field(default=None, compare=False)
+    laser: tuple[tuple[int, int], ...] = ()
+    """Current laser points of every listed ``Laser_*Current`` (LD robots), global mm."""
+    laser_at: float | None = field(default=None, compare=False)
+    dock_state: str | None = None
+    """``Undocked``, ``Docking``, ``Docked``, ``Undocking`` (``dockInfo``); None if not offered."""
+    routes: tuple[str, ...] = ()
+    """Route names (``getRoutes``, LD robots)."""
+    data_store: tuple[tuple[str, str], ...] = ()
+    """(data name, value) of every listed ``DataStore_*`` string, sorted by name."""
 
     @property
     def battery_state(self) -> str:
