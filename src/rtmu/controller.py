@@ -89,6 +89,7 @@ class ClientLink(Protocol):
         *,
         profile: str = "",
         auto_reconnect: bool = True,
+        protocol: str | None = None,
     ) -> None: ...
 
     def disconnect(self) -> None: ...
@@ -410,7 +411,15 @@ class Controller:
     def _start_connect(self, password: str) -> None:
         p = self.profile
         self._halt_held(EndReason.DISCONNECTED)
-        self.link.connect(p.host, p.port, p.user, password, profile=p.name, auto_reconnect=p.auto_reconnect)
+        self.link.connect(
+            p.host,
+            p.port,
+            p.user,
+            password,
+            profile=p.name,
+            auto_reconnect=p.auto_reconnect,
+            protocol=p.protocol or None,
+        )
 
     def disconnect(self) -> None:
         self.stop()

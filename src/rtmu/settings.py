@@ -74,6 +74,8 @@ class Profile:
     show_sonar: bool = True
     speed: int = 50
     """Drive throttle in %, 10…100 in steps of 10."""
+    protocol: str = ""
+    """Protocol string to log in with; "" answers with the one the server advertises (LD robots: 6MTX)."""
 
     def validate(self) -> None:
         """Raise ValueError if a field is out of range (used on everything read from disk)."""
@@ -106,6 +108,7 @@ _TYPES: dict[str, type] = {
     "follow_robot": bool,
     "show_sonar": bool,
     "speed": int,
+    "protocol": str,
 }
 
 

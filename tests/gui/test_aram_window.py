@@ -50,3 +50,31 @@ def test_connection_error_uses_the_doctors_words(screenshots: Path, request: pyt
             gui.shot("refused-banner")
         finally:
             gui.close()
+
+
+def test_window_protocol_option_overrides_and_a_refusal_names_the_wanted_string(
+    screenshots: Path, request: pytest.FixtureRequest
+) -> None:
+    from rtmu.ui.app import GuiOptions
+
+    from .harness import scratch_dir
+
+    with SimThread(SimConfig(port=0, profile="aram", map_path=OFFICE_MAP)) as sim:
+        options = GuiOptions(
+            host="127.0.0.1",
+            port=sim.port,
+            settings_path=scratch_dir("settings-") / "settings.toml",
+            persist=False,
+            connect=False,
+            protocol="5MTX",
+        )
+        gui = Gui.open(options, screenshots, request.node.name, connect=False)
+        try:
+            assert gui.window.controller.profile.protocol == "5MTX"
+            gui.window.controller.connect()
+            banners = gui.window.banners
+            pump(lambda: "--protocol 6MTX" in (banners.text("link") or ""), 10, "the protocol banner")
+            assert "we sent '5MTX'" in (banners.text("link") or "")
+            gui.shot("protocol-refused")
+        finally:
+            gui.close()

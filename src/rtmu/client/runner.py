@@ -261,12 +261,13 @@ class ClientRunner:
         *,
         profile: str = "",
         auto_reconnect: bool = True,
+        protocol: str | None = None,
     ) -> concurrent.futures.Future[None]:
         """Connect in the background; the model's ``connection`` shows progress and failure."""
         session = self._session
         future = self.submit(
             lambda: session.connect(
-                host, port, user, password, profile=profile, auto_reconnect=auto_reconnect
+                host, port, user, password, profile=profile, auto_reconnect=auto_reconnect, protocol=protocol
             )
         )
         future.add_done_callback(lambda f: f.cancelled() or f.exception())  # failure is shown by the model

@@ -88,6 +88,8 @@ class _Target:
     password: str
     profile: str
     auto_reconnect: bool
+    protocol: str | None = None
+    """None: answer with the protocol string the server advertises."""
 
 
 class Session:
@@ -174,6 +176,7 @@ class Session:
         *,
         profile: str = "",
         auto_reconnect: bool = True,
+        protocol: str | None = None,
     ) -> None:
         """Connect and set up the session; raises the :class:`ClientError` after publishing FAILED.
 
@@ -186,7 +189,7 @@ class Session:
         self.lease.end(EndReason.DISCONNECTED)
         await self._drop_client()
         self._cancel_reconnect()
-        target = self._target = _Target(host, port, user, password, profile, auto_reconnect)
+        target = self._target = _Target(host, port, user, password, profile, auto_reconnect, protocol)
         self._robot = RobotState()
         self._publish("robot", self._robot)
         self._set_map(MapModel())
@@ -215,7 +218,12 @@ class Session:
     async def _open(self, target: _Target) -> None:
         client = AriaClient(on_close=lambda error: self._on_client_closed(client, error), clock=self.clock)
         await client.connect(
-            target.host, target.port, target.user, target.password, timeout=self.config.connect_timeout
+            target.host,
+            target.port,
+            target.user,
+            target.password,
+            timeout=self.config.connect_timeout,
+            protocol=target.protocol,
         )
         if self._target is not target:  # disconnected (or re-targeted) meanwhile
             await client.disconnect()

@@ -35,6 +35,8 @@ class GuiOptions:
     """None: the user's settings file; tests point it into a temporary directory."""
     persist: bool = True
     report_first_frame: bool = False
+    protocol: str | None = None
+    """Protocol string to log in with (None: the profile's; by default the server's own)."""
     guardian: bool = True
     """Start a guardian process per connection (``rtmu.guardian``); off only to measure without it."""
 
@@ -51,6 +53,11 @@ def add_gui_arguments(parser: argparse.ArgumentParser) -> None:
     g.add_argument("--port", type=int, help=f"its port (default {DEFAULT_PORT})")
     g.add_argument("--user", help="user name for the server (asks for the password)")
     g.add_argument("--profile", help="use this saved connection profile")
+    g.add_argument(
+        "--protocol",
+        metavar="STRING",
+        help="protocol string to log in with (default: the one the server advertises, e.g. 6MTX)",
+    )
     g.add_argument("--fullscreen", action="store_true", help="start full screen (F11 toggles)")
     g.add_argument("--no-connect", action="store_true", help="open the window without connecting")
     g.add_argument("--report-first-frame", action="store_true", help=argparse.SUPPRESS)
@@ -67,6 +74,7 @@ def options_from_args(args: argparse.Namespace) -> GuiOptions:
         connect=False if getattr(args, "no_connect", False) else None,
         demo=bool(getattr(args, "demo", False)),
         report_first_frame=bool(getattr(args, "report_first_frame", False)),
+        protocol=getattr(args, "protocol", None),
         guardian=not getattr(args, "no_guardian", False),
     )
 

@@ -121,6 +121,8 @@ class RtmuApplication(Gtk.Application):
         self.settings = loaded.settings
         self.settings_warning = loaded.warning
         profile, auto_connect = self.choose_profile()
+        if self.options.protocol is not None:  # --protocol: this run only, the saved profile keeps its own
+            profile = replace(profile, protocol=self.options.protocol)
         self.model = Model()
         # The guardian: a separate process that stops the robot if this one is killed or frozen.
         config = SessionConfig(guardian=self.options.guardian)
