@@ -87,6 +87,8 @@ class Profile:
             raise ValueError(f"profile {self.name!r}: port {self.port} is not 1…65535")
         if len(self.user) > 200:
             raise ValueError(f"profile {self.name!r}: user name too long")
+        if len(self.protocol) > 200:
+            raise ValueError(f"profile {self.name!r}: protocol string too long")
         if not (0.0 <= self.zoom <= 100.0) or math.isnan(self.zoom):
             raise ValueError(f"profile {self.name!r}: zoom {self.zoom} out of range")
         if not 10 <= self.speed <= 100 or self.speed % 10:

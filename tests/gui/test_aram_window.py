@@ -78,3 +78,23 @@ def test_window_protocol_option_overrides_and_a_refusal_names_the_wanted_string(
             gui.shot("protocol-refused")
         finally:
             gui.close()
+
+
+def test_settings_dialog_keeps_a_protocol_string(screenshots: Path, request: pytest.FixtureRequest) -> None:
+    with SimThread(SimConfig(port=0, profile="aram", map_path=OFFICE_MAP)) as sim:
+        gui = Gui.start(screenshots, request.node.name, "127.0.0.1", sim.port)
+        try:
+            window = gui.window
+            gui.key("ctrl+comma")
+            pump(lambda: window._dialog is not None and window._dialog.get_mapped(), 3, "the settings dialog")
+            dialog = window._dialog
+            assert dialog.protocol.get_text() == ""  # empty: answer as the server asks
+            dialog.protocol.set_text(" 6MTX ")
+            gui.render(dialog, gui.shots / f"{gui.name}-01-protocol.png")
+            dialog.save.emit("clicked")
+            pump(lambda: not dialog.get_visible(), 3, "the dialog to close")
+            assert window.controller.profile.protocol == "6MTX"
+            name = window.controller.profile.name
+            assert gui.app.settings.profiles[name].protocol == "6MTX"
+        finally:
+            gui.close()

@@ -86,6 +86,11 @@ class ConnectionDialog(Gtk.Window):
         if not keyring_available:
             self.remember.set_label("Remember the password (this session only: no keyring)")
         self.reconnect = Gtk.CheckButton(label="Reconnect automatically when the link is lost")
+        self.protocol = Gtk.Entry(placeholder_text="(the one the server asks for)", max_length=200)
+        self.protocol.set_tooltip_text(
+            "Protocol string sent at login. Leave empty: RTMU answers with the string the server "
+            "advertises (Omron LD robots: 6MTX)."
+        )
         self.errors: dict[str, Gtk.Label] = {}
         rows = (
             ("name", "Profile", self.profile),
@@ -95,6 +100,7 @@ class ConnectionDialog(Gtk.Window):
             ("password", "Password", self.password),
             ("remember", "", self.remember),
             ("reconnect", "", self.reconnect),
+            ("protocol", "Protocol", self.protocol),
         )
         for i, (key, caption, widget) in enumerate(rows):
             if caption:
@@ -155,6 +161,7 @@ class ConnectionDialog(Gtk.Window):
         self.password.set_text("")
         self.remember.set_active(profile.remember_password)
         self.reconnect.set_active(profile.auto_reconnect)
+        self.protocol.set_text(profile.protocol)
         self._loading = False
 
     def _profile_changed(self, combo: Gtk.ComboBoxText) -> None:
@@ -201,6 +208,7 @@ class ConnectionDialog(Gtk.Window):
             user=f["user"].strip(),
             remember_password=self.remember.get_active(),
             auto_reconnect=self.reconnect.get_active(),
+            protocol=self.protocol.get_text().strip(),
         )
         password = self.password.get_text()
         self._on_save(profile, password or None)
