@@ -1,0 +1,109 @@
+"""How fast ``rtmu drive`` stops the robot after a link fault, as the simulator sees it.
+
+``rtmu drive`` runs as its own process, through the tests' fault-injecting proxy
+(``tests/linkfaults.py``) to the simulator in this process. Each trial: drive, apply one fault,
+then poll the simulator every few ms until the robot's commanded velocity is zero; the figure is
+that instant minus the moment the proxy applied the fault (``safety.cli_drive_stop_after_fault_ms
+.<fault>`` p50/p95/max). The baseline is what a drive that goes blind leaves to the server: the
+same drive SIGSTOPped, stopped only by the simulator's 2 s ratioDrive watchdog, measured in this run.
+
+``rtt_800ms`` includes the proxy's own 400 ms on the way to the server (the stop cannot arrive
+sooner); ``reset`` leaves nothing to carry a stop, so it measures the server's watchdog too.
+``RTMU_LINKFAULT_TRIALS`` sets the trials per fault (default 5).
+"""
+
+from __future__ import annotations
+
+import os
+import signal
+import statistics
+import subprocess
+import sys
+import time
+from collections.abc import Callable
+from pathlib import Path
+
+from bench.common import Result
+from rtmu.sim import SimConfig, SimThread
+
+REPO = Path(__file__).resolve().parents[1]
+sys.path.insert(0, str(REPO / "tests"))
+from linkfaults import FAKE_HEADER, TO_CLIENT, FaultProxy  # noqa: E402
+
+ARENA = REPO / "data" / "maps" / "arena.map"
+POLL = 0.005
+GIVE_UP = 6.0
+
+FAULTS: dict[str, Callable[[FaultProxy], float]] = {
+    "mute_to_client": lambda p: p.mute(TO_CLIENT),
+    "fake_header": lambda p: p.inject(FAKE_HEADER),
+    "rtt_800ms": lambda p: p.delay(0.4),
+    "reset": lambda p: p.reset(),
+}
+
+
+def _wait(cond: Callable[[], bool], timeout: float) -> bool:
+    end = time.monotonic() + timeout
+    while time.monotonic() < end:
+        if cond():
+            return True
+        time.sleep(POLL)
+    return False
+
+
+def _trial(sim: SimThread, apply: Callable[[FaultProxy], float] | None) -> float | None:
+    """ms from the fault (or SIGSTOP of the drive, when ``apply`` is None) to zero commanded velocity."""
+    with FaultProxy("127.0.0.1", sim.port) as proxy:
+        args = [sys.executable, "-m", "rtmu", "drive", f"127.0.0.1:{proxy.port}", "--trans", "60"]
+        proc = subprocess.Popen(
+            [*args, "--seconds", "30", "--timeout", "5"],
+            stdout=subprocess.DEVNULL,
+            stderr=subprocess.DEVNULL,
+        )
+        try:
+            if not _wait(lambda: sim.snapshot().trans_ratio == 60, 10):
+                return None
+            time.sleep(0.3)
+            if apply is None:
+                proc.send_signal(signal.SIGSTOP)
+                at = time.monotonic()
+            else:
+                at = apply(proxy)
+            if not _wait(lambda: sim.snapshot().trans_ratio == 0, GIVE_UP):
+                return None
+            return (time.monotonic() - at) * 1000.0
+        finally:
+            proc.kill()
+            proc.wait()
+            _wait(lambda: sim.snapshot().trans_ratio == 0, 3)
+
+
+def _stats(name: str, values: list[float], baseline: float | None) -> list[Result]:
+    if not values:
+        return []
+    values = sorted(values)
+    p95 = values[min(len(values) - 1, round(0.95 * (len(values) - 1)))]
+    return [
+        Result(f"{name}.p50", statistics.median(values), "ms", baseline),
+        Result(f"{name}.p95", p95, "ms", baseline),
+        Result(f"{name}.max", values[-1], "ms", baseline),
+    ]
+
+
+def run() -> list[Result]:
+    trials = int(os.environ.get("RTMU_LINKFAULT_TRIALS", "5"))
+    out: list[Result] = []
+    with SimThread(SimConfig(port=0, map_path=ARENA)) as sim:
+        blind = [v for v in (_trial(sim, None) for _ in range(2)) if v is not None]
+        baseline = statistics.median(blind) if blind else None
+        if baseline is not None:
+            out.append(Result("safety.cli_drive_stop_after_fault_ms.watchdog_only", baseline, "ms"))
+        for fault, apply in FAULTS.items():
+            values = [v for v in (_trial(sim, apply) for _ in range(trials)) if v is not None]
+            out += _stats(f"safety.cli_drive_stop_after_fault_ms.{fault}", values, baseline)
+    return out
+
+
+if __name__ == "__main__":
+    for r in run():
+        print(f"{r.name:60s} {r.value:9.1f} {r.unit}  (baseline {r.baseline})")
