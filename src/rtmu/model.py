@@ -149,6 +149,11 @@ class RobotState:
     """(data name, value) of every listed ``DataStore_*`` string, sorted by name."""
 
     @property
+    def battery_pct(self) -> float | None:
+        """State of charge in %, when ``batteryInfo`` says the robot reports it; None when volts."""
+        return self.battery_v if self.battery_is_soc else None
+
+    @property
     def battery_state(self) -> str:
         """``ok``, ``low``, ``critical`` (at or under the shutdown level) or ``unknown``."""
         if self.battery_v is None:

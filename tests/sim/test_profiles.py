@@ -102,3 +102,20 @@ def test_modules_extend_a_profile(tmp_path: Path, monkeypatch: pytest.MonkeyPatc
     profile = replace(ARAM, modules=("h8a_probe_data",))
     assert "sayHello" in profile.catalogue(camera=True)
     assert profile.handler_table()["sayHello"].__name__ == "_hello"
+
+
+def test_deprecated_update_also_reports_state_of_charge(aram: SimThread) -> None:
+    from rtmu.protocol.payloads.robot import Update
+
+    async def body(client: AriaClient):  # type: ignore[no-untyped-def]
+        return (await client.request_once("update", timeout=5)).decode()
+
+    update = asyncio.run(_with_client(aram.port, body))
+    assert isinstance(update, Update) and 0.0 <= update.numbers.battery <= 100.0
+
+
+def test_robot_state_battery_pct_follows_the_flag() -> None:
+    from rtmu.model import RobotState
+
+    assert RobotState(battery_v=87.0, battery_is_soc=True).battery_pct == 87.0
+    assert RobotState(battery_v=12.8).battery_pct is None

@@ -20,7 +20,7 @@ from collections.abc import Iterable
 from dataclasses import dataclass, field
 
 from rtmu.protocol.datalist import DataList
-from rtmu.protocol.payloads.robot import BatteryInfo
+from rtmu.protocol.payloads.robot import BatteryInfo, Update
 
 from . import p3dx
 from .catalogue import Row, build_catalogue
@@ -95,6 +95,12 @@ def _soc_numbers(call: Call) -> Iterable[Reply]:
         ).encode()
 
     return (call.server.cycle_cached("updateNumbers", make),)
+
+
+def _soc_update(call: Call) -> Iterable[Reply]:
+    status, mode, _ = call.world.strings()
+    n = dataclasses.replace(numbers(call), battery=percent_of_charge(call.world.body.battery_v))
+    return (Update(status, mode, n).encode(),)
 
 
 def _soc_battery_info(call: Call) -> Iterable[Reply]:
@@ -208,6 +214,7 @@ ARAM = SimProfile(
     handlers={
         "updateNumbers": _soc_numbers,
         "batteryInfo": _soc_battery_info,
+        "update": _soc_update,
         "getMapBinary": _ex4_map_binary,
     },
 )
