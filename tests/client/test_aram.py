@@ -191,3 +191,96 @@ def test_doctor_text_output(aram: SimThread, capsys: pytest.CaptureFixture[str])
     assert "[FAIL] login: the server wants protocol '6MTX'" in out
     assert "what to do: use --protocol 6MTX" in out
     assert "Stopped at the login step (exit 13)." in out
+
+
+# -- doctor against hand-made servers: not ArNetworking, and a server with UDP ---------------------------
+def test_doctor_names_a_server_that_is_not_arnetworking(capsys: pytest.CaptureFixture[str]) -> None:
+    import threading
+
+    listener = socket.socket()
+    listener.bind(("127.0.0.1", 0))
+    listener.listen(1)
+    port = listener.getsockname()[1]
+
+    def serve() -> None:
+        conn, _ = listener.accept()
+        with conn:
+            conn.sendall(b"SSH-2.0-OpenSSH_9.2\r\n")
+            conn.recv(1024)
+
+    thread = threading.Thread(target=serve, daemon=True)
+    thread.start()
+    try:
+        code, report = doctor_json(capsys, f"127.0.0.1:{port}")
+    finally:
+        listener.close()
+        thread.join(5)
+    assert code == Step.INTRODUCTION.value == 12
+    intro = next(s for s in report["steps"] if s["step"] == "introduction")
+    assert "SSH-2.0" in intro["summary"] and "not an ARIA robot server" in intro["advice"]
+
+
+@pytest.mark.parametrize("answers", [True, False])
+def test_doctor_udp_handshake(answers: bool) -> None:
+    """A server that announces a UDP port: the doctor's UDP_INTRODUCTION gets the intro key back, or not."""
+    from rtmu.protocol.datalist import DataList
+    from rtmu.protocol.decoder import PacketDecoder
+    from rtmu.protocol.events import RequestOnce
+    from rtmu.protocol.fields import FieldReader, FieldWriter
+    from rtmu.protocol.packet import encode_packet
+    from rtmu.protocol.payloads.robot import UpdateNumbers
+    from rtmu.protocol.server_connection import ServerConnection
+    from rtmu.subcommands.doctor import Doctor
+
+    rows = [
+        ("updateNumbers", "status", "none", "numbers", "RobotInfo", "RETURN_SINGLE"),
+        ("ratioDrive", "drive", "doubles", "none", "Movement", "RETURN_NONE"),
+    ]
+    conns: list[ServerConnection] = []
+
+    class UdpSide(asyncio.DatagramProtocol):
+        def connection_made(self, transport) -> None:  # type: ignore[no-untyped-def]
+            self.transport = transport
+
+        def datagram_received(self, data: bytes, addr) -> None:  # type: ignore[no-untyped-def]
+            for packet in PacketDecoder().feed(data):
+                key = FieldReader(packet.payload).ubyte4("auth key", default=-1)
+                for conn in conns:
+                    if packet.command == 3 and key == conn.auth_key and answers:
+                        reply = encode_packet(3, FieldWriter().byte4(conn.intro_key).bytes())
+                        self.transport.sendto(reply, addr)
+
+    async def go() -> Doctor:
+        loop = asyncio.get_running_loop()
+        udp, _ = await loop.create_datagram_endpoint(UdpSide, local_addr=("127.0.0.1", 0))
+        udp_port = udp.get_extra_info("sockname")[1]
+
+        async def on_client(reader: asyncio.StreamReader, writer: asyncio.StreamWriter) -> None:
+            conn = ServerConnection(DataList.build(rows), udp_port=udp_port)
+            conns.append(conn)
+            writer.write(conn.data_to_send())
+            while data := await reader.read(65536):
+                for event in conn.receive_data(data):
+                    if isinstance(event, RequestOnce) and event.name == "updateNumbers":
+                        conn.send_data("updateNumbers", UpdateNumbers(87.0, 1, 2, 3, 0, 0, 0, 20).encode())
+                writer.write(conn.data_to_send())
+            writer.close()
+
+        server = await asyncio.start_server(on_client, "127.0.0.1", 0)
+        port = server.sockets[0].getsockname()[1]
+        try:
+            doctor = Doctor("127.0.0.1", port, "", "", None, 5.0)
+            assert await doctor.run() == EXIT_OK
+            return doctor
+        finally:
+            server.close()
+            udp.close()
+
+    doctor = asyncio.run(go())
+    udp_step = next(s for s in doctor.steps if s.step is Step.UDP)
+    if answers:
+        assert udp_step.result == "ok" and "answers" in udp_step.summary
+    else:
+        assert udp_step.result == "warn" and "does not stop RTMU" in udp_step.advice
+    status = next(s for s in doctor.steps if s.step is Step.STATUS)
+    assert status.details["battery_v"] == 87.0  # no batteryInfo listed: the figure is volts

@@ -20,6 +20,7 @@ from dataclasses import dataclass, field
 from typing import Any
 
 from ..cli import EXIT_OK, EXIT_USAGE
+from ..client.connection import TEXT_BANNERS
 from ..client.diagnosis import ADVICE, Step, login_finding
 from ..protocol.client_connection import ClientConnection
 from ..protocol.commands import ClientCommand, ServerCommand
@@ -196,6 +197,9 @@ class Doctor:
                 raise fail(
                     step, f"the server closed the connection before its {what}", ADVICE["closed_early"]
                 )
+            if self._received == 0 and data.startswith(TEXT_BANNERS):
+                said = data[:40].split(b"\n")[0].decode("ascii", "replace").strip()
+                raise fail(step, f"the server said {said!r}: that is not ArNetworking", ADVICE["not_aria"])
             self._received += len(data)
             try:
                 events = self.conn.receive_data(data)
