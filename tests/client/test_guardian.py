@@ -248,3 +248,35 @@ def test_the_guardian_can_only_send_zero_ratios_and_stop() -> None:
     # The Halter offers nothing but halt (and flush/connected): no way to reach the connection.
     public = {n for n in dir(halt.Halter) if not n.startswith("_")}
     assert public == {"halt", "flush", "connected"}
+
+
+def _rtmu_drive(sim: SimThread, pwfile: Path) -> subprocess.Popen[str]:
+    argv = [sys.executable, "-m", "rtmu", "drive", f"127.0.0.1:{sim.port}", "--user", "alice"]
+    argv += ["--password-file", str(pwfile), "--trans", "50", "--throttle", "50", "--seconds", "30"]
+    return subprocess.Popen(argv, stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
+
+
+def test_a_killed_rtmu_drive_is_stopped_by_its_guardian(sim: SimThread, tmp_path: Path) -> None:
+    pwfile = tmp_path / "pw"
+    pwfile.write_text(PASSWORD + "\n")
+    proc = _rtmu_drive(sim, pwfile)
+    try:
+        eventually(lambda: driving(sim), timeout=15)
+        watchdog = watchdog_stops(sim)
+        proc.kill()
+        eventually(lambda: stops_by(sim, IDENTIFIER) == 1, timeout=5)
+        assert watchdog_stops(sim) == watchdog
+    finally:
+        if proc.poll() is None:
+            proc.kill()
+        proc.wait(10)
+
+
+def test_rtmu_drive_warns_in_one_line_when_the_guardian_is_refused_and_drives(tmp_path: Path) -> None:
+    with SimThread(SimConfig(port=0, seed=1, max_clients=1)) as sim:
+        argv = [sys.executable, "-m", "rtmu", "drive", f"127.0.0.1:{sim.port}", "--trans", "50"]
+        done = subprocess.run([*argv, "--seconds", "0.5"], capture_output=True, text=True, timeout=60)
+        assert done.returncode == 0, done.stderr
+        warnings = [line for line in done.stderr.splitlines() if "guardian not available" in line]
+        assert len(warnings) == 1 and warnings[0].startswith("rtmu drive: warning:"), done.stderr
+        assert sim.call(lambda: sim.server.robot.ratio_drives_received) > 0

@@ -156,3 +156,37 @@ class GuardianHandle:
             with contextlib.suppress(OSError):
                 self.proc.kill()
         self.state, self.reason = state, reason
+
+
+class GuardianUnavailable(Exception):
+    """The guardian could not log in (client limit, rights) or start; the text says why."""
+
+
+async def start_ready(hello: m.Hello, timeout: float) -> GuardianHandle:
+    """For scripts (``rtmu drive``): start a guardian and wait until it has logged in."""
+    import asyncio
+
+    try:
+        handle = GuardianHandle.start(hello)
+    except OSError as exc:
+        raise GuardianUnavailable(f"it could not be started: {exc.strerror or exc}") from None
+    deadline = time.monotonic() + timeout + 5.0  # its own login has ``timeout``; plus its start-up
+    while handle.state == "starting":
+        handle.poll()
+        if time.monotonic() > deadline:
+            handle.close(goodbye=True)
+            raise GuardianUnavailable("it did not log in in time")
+        await asyncio.sleep(0.02)
+    if handle.state != "ready":
+        handle.close(goodbye=True)
+        raise GuardianUnavailable(handle.reason or "it ended")
+    return handle
+
+
+async def beat_network(handle: GuardianHandle) -> None:
+    """A script's network-loop heartbeat: every :data:`BEAT_PERIOD` s until cancelled."""
+    import asyncio
+
+    while True:
+        handle.beat_net()
+        await asyncio.sleep(BEAT_PERIOD)

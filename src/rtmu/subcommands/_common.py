@@ -296,6 +296,14 @@ def current_interrupts() -> Interrupts:
     return found if found is not None else Interrupts()
 
 
+_PASSWORD: contextvars.ContextVar[str] = contextvars.ContextVar("rtmu_password", default="")
+
+
+def current_password() -> str:
+    """The running command's password, for its guardian's own login (``rtmu drive``), never asked twice."""
+    return _PASSWORD.get()
+
+
 def fail(name: str, message: str, code: int) -> int:
     print(f"rtmu {name}: {message}", file=sys.stderr)
     return code
@@ -318,6 +326,7 @@ def run_with_client(name: str, args: argparse.Namespace, body: Callable[[AriaCli
         interrupts = Interrupts()
         interrupts.install()
         _INTERRUPTS.set(interrupts)
+        _PASSWORD.set(password)
         try:
             await client.connect(
                 host, port, args.user, password, timeout=args.timeout, protocol=args.protocol

@@ -27,12 +27,15 @@ from ..cli import EXIT_OK
 from ..client.connection import AriaClient
 from ..client.drive_guard import DriveGuard, LinkFault
 from ..client.errors import ClientError, NotSupported
+from ..guardian.handle import GuardianHandle, GuardianUnavailable, beat_network, start_ready
+from ..guardian.messages import Hello
 from ..protocol.payloads.drive import RatioDrive
 from ._common import (
     Interrupted,
     UsageError,
     add_connection_arguments,
     current_interrupts,
+    current_password,
     fetch_status,
     print_json,
     run_with_client,
@@ -85,6 +88,7 @@ def handle(args: argparse.Namespace) -> int:
             raise NotSupported(
                 "ratioDrive", "this server (or this user) may not drive the robot (no ratioDrive)"
             )
+        guardian = await start_guardian(args)
         guard = DriveGuard(client)
         guard.start()  # before the first status fetch, so the link is watched from the start
         before = await fetch_status(client, args.timeout)
@@ -94,11 +98,16 @@ def handle(args: argparse.Namespace) -> int:
 
         async def before_suspending() -> None:
             stop(client)  # Ctrl-Z: the robot must not drive on while the process sleeps…
+            if guardian is not None:
+                guardian.disarm()  # our own stop is out: a suspended process is no alarm
             await client.flush()  # …so the stop must have left before it does
 
         # ``fg`` ends the drive (stop, pose, exit 148) rather than starting the robot again.
         interrupts.on_suspend(before_suspending, end_on_resume=True)
         signum: int | None = None
+        beats = asyncio.create_task(beat_network(guardian)) if guardian is not None else None
+        if guardian is not None:
+            guardian.arm()  # it stops the robot if this process is killed or frozen from here on
         try:
             ratios = RatioDrive(args.trans, args.rot, args.throttle)
             await drive(client, ratios, args.seconds, held=lambda: interrupts.suspending, guard=guard)
@@ -117,6 +126,13 @@ def handle(args: argparse.Namespace) -> int:
             raise LinkFault(f"{fault}; zero ratioDrive and stop sent at once") from None
         finally:
             stop(client)
+            if beats is not None:
+                beats.cancel()
+            if guardian is not None:
+                # Our stop is out: goodbye. If our link is dead, an armed EOF makes the guardian stop.
+                if client.closed_error is None:
+                    guardian.disarm()
+                guardian.close(goodbye=client.closed_error is None)
         await guard.close()
         if signum is None:
             report(args, before, await settle(client, args.timeout))
@@ -135,6 +151,21 @@ def handle(args: argparse.Namespace) -> int:
         print(f"rtmu drive: {exc}", file=sys.stderr)
         return 2
     return run_with_client("drive", args, body)
+
+
+async def start_guardian(args: argparse.Namespace) -> GuardianHandle | None:
+    """The guardian for this drive (``rtmu.guardian``); None, with one line on stderr, if it cannot log in."""
+    host, port = args.server
+    try:
+        return await start_ready(Hello(host, port, args.user, current_password(), args.timeout), args.timeout)
+    except GuardianUnavailable as exc:
+        print(
+            f"rtmu drive: warning: guardian not available ({exc}); if this process is killed or frozen, "
+            "only the server's 2 s watchdog stops the robot",
+            file=sys.stderr,
+            flush=True,
+        )
+        return None
 
 
 def report(
