@@ -16,6 +16,10 @@ Figures (MB = 10^6 bytes), each against the simple way measured in the same run:
   bytes, each failing its checksum) in 1448-byte segments: what one hostile peer can make the decoder
   chew through. Baseline: the same tolerant rescan with each claimed span summed afresh (the decoder
   before it kept prefix sums).
+* ``codec.decode.fake_header_flood_mb_s``: the realistic stream above with a lying header
+  ``0F 0C 00 7D`` (a fake 32 000-byte packet) before every tenth packet, same chunking; every real
+  packet must come out, none held behind a liar. Baseline: the same stream without the liars, so
+  the ratio is what looking behind waiting headers costs.
 """
 
 from __future__ import annotations
@@ -237,5 +241,36 @@ def bench_hostile() -> list[Result]:
     ]
 
 
+FAKE_HEADER = bytes.fromhex("0F 0C 00 7D")
+
+
+def liars_before_every_tenth(stream: bytes) -> bytes:
+    """Insert a fake 32 000-byte header before every tenth packet of a clean stream."""
+    out = bytearray()
+    pos = index = 0
+    while pos < len(stream):
+        length = stream[pos + 2] | stream[pos + 3] << 8
+        if index % 10 == 9:
+            out += FAKE_HEADER
+        out += stream[pos : pos + length]
+        pos += length
+        index += 1
+    return bytes(out)
+
+
+def bench_fake_header_flood() -> list[Result]:
+    clean, expected = mixed_stream(random.Random(4), 10_000)
+    lying = liars_before_every_tenth(clean)
+    clean_chunks, lying_chunks = chunked(clean), chunked(lying)
+    assert count_packets(lying_chunks) == expected == count_packets(clean_chunks)
+    fast = best_time(lambda: count_packets(lying_chunks))
+    base = best_time(lambda: count_packets(clean_chunks))
+    return [
+        Result(
+            "codec.decode.fake_header_flood_mb_s", len(lying) / fast / 1e6, "MB/s", len(clean) / base / 1e6
+        )
+    ]
+
+
 def run() -> list[Result]:
-    return bench_stream() + bench_status() + bench_checksum() + bench_hostile()
+    return bench_stream() + bench_status() + bench_checksum() + bench_hostile() + bench_fake_header_flood()
