@@ -43,6 +43,7 @@ from .connection import AriaClient, Packet
 from .diagnosis import explain
 from .errors import ClientError, ClientTimeout, MalformedReply, NotSupported, ServerClosed
 from .health import HealthMonitor, ping_data
+from .ld_session import LdFeed
 from .lease import DriveGovernor, DriveLease, EndReason, SendRatios, SendStop
 from .mapload import download_map, map_source
 from .reconnect import Backoff, worth_retrying
@@ -133,6 +134,8 @@ class Session:
         self._wifi_labels: tuple[str, ...] = ()
         self.packets_sent = 0
         self.guardian: GuardianHandle | None = None
+        self.ld = LdFeed(self._robot_update, self._decode, self._spawn, self.config.reply_timeout)
+        """LD (ARAM) data: lasers, docking state, routes, DataStore_* — only where listed."""
 
     # -- publishing --------------------------------------------------------------------------
     def _publish(self, part: str, value: Any) -> None:
@@ -362,6 +365,7 @@ class Session:
             client.request("mapUpdated", -1, self._on_map_updated)
         if client.supports("sonarCurrent"):
             client.request("sonarCurrent", cfg.sonar_interval_ms, self._on_sonar)
+        self.ld.subscribe(client)
         for name, (interval, handler) in self._extra_subs.items():
             if client.supports(name):
                 client.request(name, interval, handler)
@@ -390,6 +394,7 @@ class Session:
                 )
             if client.supports("getSafeDrive"):
                 self._on_safe_drive((await client.request_once("getSafeDrive", timeout=timeout)).payload)
+        await self.ld.fetch(client)
         await self._watch_wifi(client)
 
     def _decode(self, name: str, payload: bytes) -> Any:

@@ -1,0 +1,58 @@
+"""The window's model hears LD data from ``rtmu sim --profile aram`` and none of it from the default."""
+
+from __future__ import annotations
+
+import time
+from pathlib import Path
+
+from rtmu.client.runner import ClientRunner
+from rtmu.client.session import SessionConfig
+from rtmu.model import Model, Phase
+from rtmu.sim import SimConfig, SimThread
+from rtmu.sim.ld_data import ROUTES
+
+from .uiqueue import UiQueue
+
+REPO = Path(__file__).resolve().parents[2]
+OFFICE = REPO / "data" / "maps" / "office.map"
+
+
+def connected(port: int) -> tuple[ClientRunner, Model, UiQueue]:
+    model, ui = Model(), UiQueue()
+    runner = ClientRunner(model, post=ui.post, clock=time.monotonic, config=SessionConfig(fetch_map=False))
+    runner.start()
+    runner.connect("127.0.0.1", port, profile="sim").result(10)
+    ui.wait_for(lambda: model.connection.value.phase is Phase.CONNECTED)
+    return runner, model, ui
+
+
+def test_model_gets_laser_dock_routes_and_data_store_from_aram() -> None:
+    with SimThread(SimConfig(port=0, profile="aram", map_path=OFFICE)) as sim:
+        runner, model, ui = connected(sim.port)
+        try:
+            ui.wait_for(lambda: len(model.robot.value.laser) > 50, timeout=5)
+            ui.wait_for(lambda: model.robot.value.dock_state == "Undocked", timeout=5)
+            ui.wait_for(lambda: model.robot.value.routes == ROUTES, timeout=5)
+            ui.wait_for(lambda: len(model.robot.value.data_store) >= 5, timeout=5)
+            names = dict(model.robot.value.data_store)
+            assert 0 <= int(names["DataStore_WiFi_Quality"]) <= 70
+            runner.command("dock").result(5)
+            ui.wait_for(lambda: model.robot.value.dock_state == "Docking", timeout=5)
+            ui.wait_for(lambda: model.robot.value.dock_state == "Docked", timeout=10)
+        finally:
+            runner.close()
+
+
+def test_default_profile_publishes_none_of_it() -> None:
+    with SimThread(SimConfig(port=0, map_path=OFFICE)) as sim:
+        runner, model, ui = connected(sim.port)
+        try:
+            ui.wait_for(lambda: len(model.robot.value.sonar) > 0, timeout=5)
+            ui.wait_for(lambda: model.robot.value.wifi_quality is not None, timeout=5)
+            robot = model.robot.value
+            assert robot.laser == () and robot.dock_state is None
+            assert robot.routes == () and robot.data_store == ()
+            offers = model.connection.value.offers
+            assert "updateNumbers" in offers and "getRoutes" not in offers
+        finally:
+            runner.close()
