@@ -30,6 +30,8 @@ class Scene:
     stale: bool = False
     trail: Iterable[tuple[float, float]] = ()
     sonar: Sequence[tuple[int, int]] = field(default_factory=tuple)
+    laser: Sequence[tuple[int, int]] = field(default_factory=tuple)
+    """Laser points (LD robots' ``Laser_*Current``), global mm; drawn under the sonar."""
 
 
 def draw_frame(ctx: cairo.Context, vp: Viewport, scene: Scene) -> bool:
@@ -50,6 +52,8 @@ def draw_frame(ctx: cairo.Context, vp: Viewport, scene: Scene) -> bool:
     if scene.robot is not None:
         x, y, th = scene.robot
         overlays.draw_trail(ctx, vp, scene.trail)
+        if scene.laser and not scene.stale:
+            overlays.draw_laser(ctx, vp, scene.laser)
         if scene.sonar and not scene.stale:
             overlays.draw_sonar(ctx, vp, (x, y), scene.sonar)
         overlays.draw_robot(ctx, vp, x, y, th, stale=scene.stale, footprint=has_map)

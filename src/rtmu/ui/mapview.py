@@ -302,6 +302,7 @@ class MapStage(Gtk.DrawingArea):
             stale=stale,
             trail=self.trail,
             sonar=r.sonar if self.model.view.value.show_sonar else (),
+            laser=r.laser if self.model.view.value.show_sonar else (),
         )
         return draw_frame(ctx, vp, scene)
 

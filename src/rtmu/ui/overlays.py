@@ -37,6 +37,9 @@ STALE_RGB = (0.60, 0.61, 0.64)
 OUTLINE_RGB = (0.05, 0.1, 0.2)
 TRAIL_RGBA = (0.11, 0.44, 0.85, 0.45)
 SONAR_RGB = (0.90, 0.38, 0.0)
+LASER_RGB = (0.85, 0.05, 0.55)
+"""Laser points: magenta, apart from the orange sonar and the map's black."""
+LASER_DOT_PX = 3.0
 HOME_RGB = (0.15, 0.60, 0.30)
 GOAL_RGB = (0.85, 0.45, 0.0)
 DOCK_RGB = (0.50, 0.30, 0.70)
@@ -385,6 +388,18 @@ def draw_sonar(
         ctx.new_sub_path()  # each dot on its own: no line from the previous one
         ctx.arc(sx, sy, 3.0, 0, 2 * math.pi)
         ctx.close_path()
+    ctx.fill()
+    ctx.restore()
+
+
+def draw_laser(ctx: cairo.Context, vp: Viewport, points: Iterable[tuple[int, int]]) -> None:
+    """Each laser point as a small square: hundreds per scan, so no rays (they would hide the map)."""
+    ctx.save()
+    ctx.new_path()
+    ctx.set_source_rgba(*LASER_RGB, 0.9)
+    for x, y in points:
+        sx, sy = vp.to_screen(x, y)
+        ctx.rectangle(sx - LASER_DOT_PX / 2, sy - LASER_DOT_PX / 2, LASER_DOT_PX, LASER_DOT_PX)
     ctx.fill()
     ctx.restore()
 

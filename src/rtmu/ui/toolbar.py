@@ -108,9 +108,11 @@ class StatusToolbar(Gtk.ScrolledWindow):
             "safe": Cell("Safe", width_chars=3),
             "speed": Cell("Throttle", width_chars=5),
             "link": Cell("Link: rtt, age", width_chars=12),
+            "dock": Cell("Dock", width_chars=9),
         }
         for cell in self.cells.values():
             self.row.append(cell)
+        self.cells["dock"].set_visible(False)  # only for servers with dockInfo (LD robots)
         mode = self.cells["mode"]
         mode.set_hexpand(True)
         mode.value.set_max_width_chars(40)  # the one column that takes the spare room
@@ -168,7 +170,8 @@ class StatusToolbar(Gtk.ScrolledWindow):
         return False
 
     def hidden_columns(self) -> list[str]:
-        return [n for n, c in self.cells.items() if not c.get_visible()]
+        """Columns given up for width (the dock column is absent, not given up, without dockInfo)."""
+        return [n for n, c in self.cells.items() if not c.get_visible() and n != "dock"]
 
     def refresh(self) -> None:
         """Show the model's values and how old they are (called on changes and by the window's timer)."""
@@ -207,6 +210,16 @@ class StatusToolbar(Gtk.ScrolledWindow):
                 c["safe"].add_css_class("alarm")
         c["speed"].show_value(f"{self.model.speed.value.percent} %", stale=False, tooltip="+ / − to change")
         self._link(conn, health, age)
+        self._dock(robot.dock_state, link_ok)
+
+    def _dock(self, state: str | None, live: bool) -> None:
+        """The docking state, shown only while the server reports one (``dockInfo``)."""
+        cell = self.cells["dock"]
+        if state is None:
+            cell.set_visible(False)
+            return
+        cell.set_visible(True)
+        cell.show_value(state, stale=not live, tooltip=f"Docking state: {state} (dockInfo)")
 
     def _age(self, now: float) -> float | None:
         numbers_at = self.model.robot.value.numbers_at

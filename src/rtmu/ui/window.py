@@ -44,11 +44,13 @@ from ..settings import Profile  # noqa: E402
 from .banners import BannerStack  # noqa: E402
 from .bars import FullscreenBar, connect_button, menu_button, show_connection, stop_button  # noqa: E402
 from .camera import CameraInset, CameraView, PictureDecoder  # noqa: E402
+from .details import DetailsWindow  # noqa: E402
 from .dpad import DPad  # noqa: E402
 from .keys import KeyRouter  # noqa: E402
 from .mapview import MapStage  # noqa: E402
 from .move_dialogs import go_dialog, turn_dialog  # noqa: E402
 from .notes import map_note  # noqa: E402
+from .routes_panel import RoutesPanel  # noqa: E402
 from .settings_dialog import ConnectionDialog, PasswordPrompt  # noqa: E402
 from .shortcuts import build_shortcuts_window  # noqa: E402
 from .toolbar import StatusToolbar  # noqa: E402
@@ -212,6 +214,8 @@ class MainWindow(Gtk.ApplicationWindow):
         self.camera_button.set_tooltip_text("Camera picture (Esc)")
         self.camera_button.connect("clicked", self._camera_button_clicked)
         header.pack_end(self.camera_button)
+        self.routes_panel = RoutesPanel(self.model, self.send_data)  # only when the server lists getRoutes
+        header.pack_end(self.routes_panel)
         self.set_titlebar(header)
 
         self.toolbar_revealer = Gtk.Revealer(transition_type=Gtk.RevealerTransitionType.SLIDE_DOWN)
@@ -306,6 +310,7 @@ class MainWindow(Gtk.ApplicationWindow):
         view.append("Touch D-pad", "win.dpad")
         view.append("Camera inset on the map", "win.inset")
         view.append("Sonar readings", "win.sonar")
+        view.append("Robot details…", "win.details")
         views = Gio.Menu()
         views.append_submenu("View", view)
         menu.append_section(None, views)
@@ -362,6 +367,7 @@ class MainWindow(Gtk.ApplicationWindow):
         plain("go", lambda: self.view_intent("go_dialog"))
         plain("camera", lambda: self.view_intent("toggle_camera"))
         plain("about", self.show_about)
+        plain("details", self.show_details)
         self.toolbar_action = toggle("toolbar", True, self.toolbar_revealer.set_reveal_child)
         self.fullscreen_action = toggle("fullscreen", False, self._set_fullscreen)
         self.dpad_action = toggle("dpad", self.dpad.get_visible(), self._set_dpad)
@@ -695,6 +701,17 @@ class MainWindow(Gtk.ApplicationWindow):
                 "notice:saved", "info", f"Saved “{profile.name}”: reconnect to use it", timeout=4.0
             )
 
+    def send_data(self, name: str, payload: object) -> None:
+        """Fire-and-forget request of an LD panel (patrol, say) through the controller's link."""
+        self.controller.link.command(name, payload)
+
+    def show_details(self) -> None:
+        """The details window (DataStore strings, docking, say): one at a time."""
+        details = getattr(self, "details", None)
+        if details is None or not details.get_visible():
+            self.details = DetailsWindow(self, self.model, self.send_data)
+        self.details.present()
+
     def show_about(self) -> None:
         from .. import __version__
 
@@ -776,4 +793,5 @@ class MainWindow(Gtk.ApplicationWindow):
         self._unobserve = []
         self.stage.close()
         self.toolbar.close()
+        self.routes_panel.close()
         self.decoder.close()

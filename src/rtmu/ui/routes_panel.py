@@ -1,0 +1,101 @@
+"""The routes button of LD robots: a header-bar button whose popover lists the server's routes.
+
+Shown only while the connected server lists ``getRoutes``; each route has a Patrol button that
+sends ``patrol`` (only when listed, too). The popover holds buttons only, no text fields, so the
+window's drive keys keep working as everywhere else. Route names come from the model
+(``RobotState.routes``), which the session fills from ``getRoutes`` / ``routesUpdated``.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Callable
+
+import gi
+
+gi.require_version("Gtk", "4.0")
+from gi.repository import Gtk  # noqa: E402
+
+from ..model import ConnectionState, Model, Phase, RobotState  # noqa: E402
+from ..protocol.payloads.ld import Patrol  # noqa: E402
+
+Send = Callable[[str, object], None]
+"""``send(data name, payload)``: a fire-and-forget request through the controller's link."""
+
+
+class RoutesPanel(Gtk.MenuButton):
+    """Header-bar button + popover listing routes, each with Patrol."""
+
+    def __init__(self, model: Model, send: Send) -> None:
+        super().__init__(icon_name="mark-location-symbolic", tooltip_text="Routes (patrol)")
+        self.set_focusable(False)
+        inner = self.get_first_child()
+        if inner is not None:
+            inner.set_focusable(False)  # keys go to the window's router, as for the menu button
+        self.model = model
+        self._send = send
+        self.list = Gtk.Box(orientation=Gtk.Orientation.VERTICAL, spacing=4)
+        for side in ("top", "bottom", "start", "end"):
+            getattr(self.list, f"set_margin_{side}")(8)
+        self.empty = Gtk.Label(label="This map has no routes", xalign=0.0)
+        self.empty.add_css_class("dim-label")
+        self.rows: dict[str, Gtk.Button] = {}
+        """Route name → its Patrol button (what is shown now)."""
+        popover = Gtk.Popover()
+        popover.set_child(self.list)
+        self.set_popover(popover)
+        self._shown: tuple[str, ...] | None = None
+        self._unobserve = [
+            model.robot.observe(self._on_robot),
+            model.connection.observe(self._on_connection),
+        ]
+        self._on_connection(ConnectionState(), model.connection.value)
+        self._fill(model.robot.value.routes)
+
+    def close(self) -> None:
+        for remove in self._unobserve:
+            remove()
+        self._unobserve = []
+
+    def _on_connection(self, _old: ConnectionState, new: ConnectionState) -> None:
+        offered = new.phase is Phase.CONNECTED and "getRoutes" in new.offers
+        self.set_visible(offered)
+        can_patrol = offered and "patrol" in new.offers
+        for button in self.rows.values():
+            button.set_sensitive(can_patrol)
+
+    def _on_robot(self, old: RobotState, new: RobotState) -> None:
+        if new.routes != old.routes:
+            self._fill(new.routes)
+
+    def _fill(self, routes: tuple[str, ...]) -> None:
+        if routes == self._shown:
+            return
+        self._shown = routes
+        child = self.list.get_first_child()
+        while child is not None:
+            nxt = child.get_next_sibling()
+            self.list.remove(child)
+            child = nxt
+        self.rows = {}
+        if not routes:
+            self.list.append(self.empty)
+            return
+        can_patrol = "patrol" in self.model.connection.value.offers
+        for name in routes:
+            row = Gtk.Box(spacing=8)
+            label = Gtk.Label(label=name, xalign=0.0, hexpand=True)
+            button = Gtk.Button.new_with_label("Patrol")
+            button.set_tooltip_text(f"Patrol the route {name!r} (the robot drives by itself; STOP ends it)")
+            button.set_sensitive(can_patrol)
+            button.connect("clicked", lambda _b, n=name: self.patrol(n))
+            row.append(label)
+            row.append(button)
+            self.list.append(row)
+            self.rows[name] = button
+
+    def patrol(self, route: str) -> None:
+        if "patrol" in self.model.connection.value.offers:
+            self._send("patrol", Patrol(route))
+            popover = self.get_popover()
+            if popover is not None:
+                popover.popdown()

@@ -1,0 +1,78 @@
+"""The real window against ``rtmu sim --profile aram``: laser layer, dock cell, routes panel, details and say.
+
+And against the default profile: the LD controls stay hidden.
+"""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+from rtmu.sim import SimConfig, SimThread
+from rtmu.sim.ld_data import ROUTES, ld_state
+
+from .harness import OFFICE_MAP, Gui, pump
+
+
+def magenta(pixels: np.ndarray) -> int:
+    """How many stage pixels have the laser's colour (strong red and blue, little green)."""
+    r, g, b = (pixels[..., i].astype(int) for i in range(3))
+    return int(np.count_nonzero((r > 170) & (b > 90) & (g < 80)))
+
+
+def _sim_state(sim: SimThread):  # type: ignore[no-untyped-def]
+    return sim.call(lambda: ld_state(sim.server))  # type: ignore[arg-type]
+
+
+def test_laser_dock_routes_and_say_in_the_window(screenshots: Path, request: pytest.FixtureRequest) -> None:
+    with SimThread(SimConfig(port=0, profile="aram", map_path=OFFICE_MAP)) as sim:
+        gui = Gui.start(screenshots, request.node.name, "127.0.0.1", sim.port)
+        try:
+            window, robot = gui.window, gui.model.robot
+            pump(lambda: len(robot.value.laser) > 50, 5, "laser points in the model")
+            pump(lambda: magenta(gui.stage_pixels()) > 30, 5, "laser points drawn on the stage")
+            gui.shot("laser")
+            # The layer goes with the sonar toggle: off, and no laser pixel is left.
+            window.sonar_action.activate(None)
+            pump(lambda: magenta(gui.stage_pixels()) == 0, 5, "the laser layer to be hidden")
+            window.sonar_action.activate(None)
+
+            dock = window.toolbar.cells["dock"]
+            pump(lambda: dock.get_visible() and dock.value.get_text() == "Undocked", 5, "the dock cell")
+
+            panel = window.routes_panel
+            pump(lambda: panel.get_visible() and list(panel.rows) == list(ROUTES), 5, "the routes panel")
+            panel.popup()
+            gui.click(panel.rows[ROUTES[0]])
+            pump(lambda: _sim_state(sim).patrols == [ROUTES[0]], 5, "the patrol at the simulator")
+
+            window.show_details()
+            details = window.details
+            pump(lambda: "WiFi Quality" in details.values, 5, "the data-store table")
+            assert details.values["Docking"].get_text() == "Undocked"
+            assert details.say_row.get_visible()
+            details.say_entry.set_text("Hello from the window")
+            gui.click(details.say_button)
+            pump(lambda: _sim_state(sim).said == ["Hello from the window"], 5, "the text at the simulator")
+            gui.render(details, gui.shots / f"{gui.name}-details.png")
+        finally:
+            gui.close()
+
+
+def test_default_profile_hides_the_ld_controls(screenshots: Path, request: pytest.FixtureRequest) -> None:
+    with SimThread(SimConfig(port=0, map_path=OFFICE_MAP)) as sim:
+        gui = Gui.start(screenshots, request.node.name, "127.0.0.1", sim.port)
+        try:
+            window = gui.window
+            pump(lambda: len(gui.model.robot.value.sonar) > 0, 5, "sonar readings")
+            assert not window.routes_panel.get_visible()
+            assert not window.toolbar.cells["dock"].get_visible()
+            assert magenta(gui.stage_pixels()) == 0
+            window.show_details()
+            assert not window.details.say_row.get_visible()
+            assert window.details.none_label.get_visible()
+            gui.shot("default-profile")
+        finally:
+            gui.close()
