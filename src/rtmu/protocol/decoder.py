@@ -60,10 +60,11 @@ from .packet import MAX_LENGTH, MIN_LENGTH, SYNC, Packet
 
 _COMPACT_AT = 64 * 1024
 
-STREAM_GOES_ON: Final = 6
+STREAM_GOES_ON: Final = 4
 """Back-to-back valid packets behind a waiting header that prove the stream went on without it.
-Six is about half a second of ARIA status traffic at worst (so the link watchdog, 3 status
-intervals, never fires), and far more than chance can build inside a real packet."""
+Four is one or two 100 ms cycles of what the window subscribes to (status, strings, sonar), under
+its 3-interval stale-status limit, and still far more than chance builds inside a real packet
+(each packet needs a sync pair, a fitting length and a 16-bit checksum: below 2^-100 for four)."""
 
 CHAIN_START_MAX: Final = 4095
 """The first packet of such a chain is at most this long (its length's high byte ≤ 0x0F)."""
