@@ -1,0 +1,167 @@
+"""The real window, Up held, with a fault-injecting proxy between it and the simulator.
+
+For each fault: what the operator sees (link banner, toolbar link cell; a screenshot), that the
+robot stops — by our stop where the link still carries it, by the server's 2 s watchdog where it
+cannot — and that after the link returns the still-held key does not drive again; only a fresh
+press does. Times are checked on the simulator's own clock and generously (README, Safety).
+"""
+
+from __future__ import annotations
+
+import threading
+import time
+from collections.abc import Callable, Iterator
+from dataclasses import dataclass
+from pathlib import Path
+
+import pytest
+
+from linkfaults import GARBAGE, TO_CLIENT, TO_SERVER, FaultProxy
+from rtmu.model import LinkLevel, Phase
+from rtmu.sim import SimConfig, SimThread
+
+from .harness import OFFICE_MAP, Gui, idle, pump
+
+OUR_STOP_WITHIN = 1.0
+"""Simulator seconds from the fault to our stop, where the link carries it (documented: 0.3 s)."""
+WATCHDOG_WITHIN = 3.0
+"""Simulator seconds from the fault to a stop where nothing of ours can arrive (watchdog: 2 s)."""
+
+
+@dataclass(frozen=True)
+class Fault:
+    apply: Callable[[FaultProxy], float]
+    stop_reaches_server: bool
+    """False: the server→... direction that would carry our stop is cut; the watchdog stops."""
+
+
+FAULTS = {
+    "mute_to_client": Fault(lambda p: p.mute(TO_CLIENT), True),
+    "mute_to_server": Fault(lambda p: p.mute(TO_SERVER), False),
+    "mute_both": Fault(lambda p: p.mute(TO_CLIENT, TO_SERVER), False),
+    "delay_400ms_each_way": Fault(lambda p: p.delay(0.4), True),
+    "reset": Fault(lambda p: p.reset(), False),
+}
+
+
+@pytest.fixture
+def rig(request: pytest.FixtureRequest, screenshots: Path) -> Iterator[tuple[Gui, SimThread, FaultProxy]]:
+    with (
+        SimThread(SimConfig(port=0, map_path=OFFICE_MAP, seed=1)) as sim,
+        FaultProxy("127.0.0.1", sim.port) as proxy,
+    ):
+        gui = Gui.start(screenshots, request.node.name, "127.0.0.1", proxy.port)
+        try:
+            yield gui, sim, proxy
+        finally:
+            gui.xdotool("keyup", "Up")
+            gui.close()
+
+
+class _StopWatch:
+    """Watches the simulator from a thread of its own: ``at`` is its clock when the robot's commanded
+    velocity first went to zero (the GUI thread may be busy waiting for something else then)."""
+
+    def __init__(self, sim: SimThread) -> None:
+        self.at: float | None = None
+        self._sim = sim
+        self._done = threading.Event()
+        self._thread = threading.Thread(target=self._watch, daemon=True)
+        self._thread.start()
+
+    def _watch(self) -> None:
+        deadline = time.monotonic() + WATCHDOG_WITHIN + 5
+        while not self._done.is_set() and time.monotonic() < deadline:
+            snap = self._sim.snapshot()
+            if snap.trans_ratio == 0:
+                self.at = snap.time
+                return
+            time.sleep(0.01)
+
+
+def _robot(sim: SimThread, name: str) -> object:
+    return sim.call(lambda: getattr(sim.server.robot, name))  # type: ignore[union-attr]
+
+
+def _hold_up_until_driving(gui: Gui, sim: SimThread) -> None:
+    for _attempt in range(5):  # a press that beats "connected" to the window is refused: press again
+        gui.keydown("Up")
+        try:
+            pump(lambda: abs(sim.snapshot().vel) > 1.0, 3, "the robot to drive")
+            return
+        except AssertionError:
+            gui.keyup("Up")
+    raise AssertionError("the held key never drove the robot")
+
+
+def _link_ok(gui: Gui) -> bool:
+    return gui.phase is Phase.CONNECTED and gui.model.health.value.level is LinkLevel.OK
+
+
+def _link_cell_says_fault(gui: Gui) -> bool:
+    return bool(gui.window.toolbar.cells["link"].stale)
+
+
+def _link_cell(gui: Gui) -> str:
+    return str(gui.window.toolbar.cells["link"].value.get_text())
+
+
+@pytest.mark.parametrize("name", list(FAULTS))
+def test_a_link_fault_stops_the_robot_and_a_held_key_does_not_drive_again(
+    rig: tuple[Gui, SimThread, FaultProxy], name: str
+) -> None:
+    gui, sim, proxy = rig
+    fault = FAULTS[name]
+    _hold_up_until_driving(gui, sim)
+    stop_seen = _StopWatch(sim)
+    sim_at_fault = sim.snapshot().time
+    fault.apply(proxy)
+
+    # The operator is told at once: the link cell leaves its OK state and the link banner speaks.
+    pump(lambda: not _link_ok(gui), 5, "the window to see the fault")
+    pump(lambda: _link_cell_says_fault(gui), 3, "the link cell to show the fault")
+    cell = _link_cell(gui)
+    gui.shot(f"{name}-fault")
+    pump(lambda: stop_seen.at is not None, WATCHDOG_WITHIN + 2, "the robot to stop")
+    stopped_after = float(stop_seen.at) - sim_at_fault  # type: ignore[arg-type]
+    said = [text for topic, _level, text in list(gui.window.banners.history) if topic == "link"]
+    assert any(t.startswith(("Stopped: the link", "Link lost")) for t in said), (said, cell)
+    if fault.stop_reaches_server:
+        assert stopped_after <= OUR_STOP_WITHIN, f"stopped {stopped_after:.2f} s after the fault"
+        assert _robot(sim, "watchdog_stops") == 0
+    else:
+        assert stopped_after <= WATCHDOG_WITHIN, f"stopped {stopped_after:.2f} s after the fault"
+
+    # The link returns while Up is still held: the robot stays still.
+    proxy.restore()
+    pump(lambda: _link_ok(gui), 15, "the link to be OK again")
+    idle(0.3)  # bytes held during the fault (older drives, then our stop) have been delivered
+    last_at_return = _robot(sim, "received_ratios")
+    idle(1.5)
+    assert sim.snapshot().trans_ratio == 0 and abs(sim.snapshot().vel) < 1.0, "drove without a fresh press"
+    last = _robot(sim, "received_ratios")
+    assert last == last_at_return or tuple(last)[:2] == (0.0, 0.0), last  # type: ignore[arg-type]
+    gui.shot(f"{name}-restored-key-still-held")
+
+    # A fresh press drives again.
+    gui.keyup("Up")
+    _hold_up_until_driving(gui, sim)
+    gui.keyup("Up")
+    pump(lambda: sim.snapshot().trans_ratio == 0, 3, "the release to stop the robot")
+
+
+def test_garbage_bytes_are_dropped_and_shown_without_a_false_stop(
+    rig: tuple[Gui, SimThread, FaultProxy],
+) -> None:
+    """Line noise between packets costs nothing: counted in the link cell's tooltip, no stop."""
+    gui, sim, proxy = rig
+    _hold_up_until_driving(gui, sim)
+    proxy.inject(GARBAGE)
+    pump(lambda: gui.model.health.value.garbage_bytes >= len(GARBAGE) // 2, 5, "the garbage to be counted")
+    idle(0.5)
+    assert _link_ok(gui) and abs(sim.snapshot().vel) > 1.0, "a false stop (or a lost link) after noise"
+    tip = gui.window.toolbar.cells["link"].get_tooltip_text() or ""
+    gui.shot("garbage-still-driving")
+    assert "bad packets dropped" in tip
+    gui.keyup("Up")
+    pump(lambda: sim.snapshot().trans_ratio == 0, 3, "the release to stop the robot")
