@@ -2,7 +2,7 @@
 
 A data module of the profile extension point (:mod:`rtmu.sim.profiles`): ``ROWS`` for the catalogue
 and ``HANDLERS`` for the server. Two lasers seen from the world's walls by the same ray caster as
-the sonar at one ray per degree, a docking state that ``dock``/``undock`` move through
+the sonar, one ray per degree, a docking state that ``dock``/``undock`` move through
 docking → docked (and back) in :data:`DOCK_SECONDS` of simulated time, a few routes that ``patrol``
 starts (recorded, no driving), ``DataStore_*`` strings from the simulator's real values and
 ``say`` (recorded). What was asked is kept per server in :func:`ld_state` so tests can look.
@@ -36,10 +36,12 @@ from .handlers import SONAR_DRAWING, Call, Handler, Reply
 if TYPE_CHECKING:
     from .server import SimServer
 
-LASER_MAX_RANGE_MM = 15_000.0
-LASER_FIELD_DEG = 270
-LASER_OFFSETS_MM = {"Laser_1Current": 250.0, "Laser_2Current": -250.0}
-"""Front laser ahead of the centre, rear laser behind it (facing backwards)."""
+LASERS: dict[str, tuple[float, int, float]] = {
+    "Laser_1Current": (250.0, 240, 15_000.0),
+    "Laser_2Current": (200.0, 126, 4_000.0),
+}
+"""Data name → (mm ahead of the centre, field of view in degrees, range in mm): an LD90's main
+safety laser and its low front laser, as public LD bridges configure them."""
 LASER_DRAWINGS = (
     Drawing("Laser_1Current", "polyDots", 0x0000FF, 60, 75, 200, 0x000000, "DefaultOn"),
     Drawing("Laser_2Current", "polyDots", 0x0000C0, 60, 75, 200, 0x000000, "DefaultOn"),
@@ -74,14 +76,13 @@ def ld_state(server: SimServer) -> LdState:
 def laser_points(call: Call, name: str) -> tuple[tuple[int, int], ...]:
     """Global (x, y) mm of each hit within range, one ray per degree over the laser's field."""
     body = call.world.body
-    offset = LASER_OFFSETS_MM[name]
+    offset, field_deg, max_range = LASERS[name]
     th = math.radians(body.th)
-    facing = th if offset >= 0 else th + math.pi
     ox = body.x + offset * math.cos(th)
     oy = body.y + offset * math.sin(th)
-    half = math.radians(LASER_FIELD_DEG / 2)
-    angles = facing + np.linspace(-half, half, LASER_FIELD_DEG + 1)
-    ranges = call.world.obstacles.cast(ox, oy, angles, LASER_MAX_RANGE_MM)
+    half = math.radians(field_deg / 2)
+    angles = th + np.linspace(-half, half, field_deg + 1)
+    ranges = call.world.obstacles.cast(ox, oy, angles, max_range)
     hit = np.isfinite(ranges)
     xs = np.rint(ox + ranges[hit] * np.cos(angles[hit])).astype(int)
     ys = np.rint(oy + ranges[hit] * np.sin(angles[hit])).astype(int)
