@@ -2,7 +2,8 @@
 
 Laser scans need no type here: ``Laser_1Current`` / ``Laser_2Current`` are range-device drawings and
 decode with :class:`~rtmu.protocol.payloads.sensors.RangeDeviceReadings` (``byte4`` count, then
-``byte4`` x, ``byte4`` y per point, map mm), found by its ``Current`` suffix.
+``byte4`` x, ``byte4`` y per point, map mm), found by its ``Current`` suffix. Confirmed: public ROS
+bridges for LD robots read ``Laser_1Current`` / ``Laser_2Current`` exactly so.
 
 Confirmation of each layout:
 
