@@ -44,6 +44,7 @@ from ..protocol.decoder import DropStats
 from ..protocol.errors import ProtocolError
 from ..protocol.events import DataListReady, DataReceived, PeerShutdown, Rejected
 from ..protocol.fields import FieldWriter
+from ..protocol.packet import MAX_LENGTH
 from ..protocol.payloads import Payload, Side, decode_payload
 from .errors import (
     ClientError,
@@ -404,6 +405,17 @@ class AriaClient:
         """What the decoder threw away on this connection (bad checksums, garbage bytes…)."""
         return self._conn.decoder.stats if self._conn is not None else DropStats()
 
+    def _no_reply(self, message: str) -> ClientError:
+        """A timeout, unless the server sent a packet over ARIA's limit: that is then why (dropped)."""
+        size = self.drops.largest_over_limit
+        if size:
+            limit = f"{MAX_LENGTH:,}".replace(",", " ")
+            return ProtocolFault(
+                f"{message}: the server sent a packet of {size} bytes, over ArNetworking's "
+                f"{limit}-byte limit, so it was dropped"
+            )
+        return ClientTimeout(message)
+
     @property
     def closed_error(self) -> ClientError | None:
         """Why the connection ended (None while open or after a plain ``disconnect``)."""
@@ -578,7 +590,7 @@ class AriaClient:
                 except TimeoutError:
                     got = pending.count
                     self._abandon(name, pending)
-                    raise ClientTimeout(
+                    raise self._no_reply(
                         f"no reply to {name!r} from {self.host}:{self.port} within {timeout:g} s"
                         + (f" (after {got} packets)" if got else "")
                     ) from None
@@ -615,7 +627,7 @@ class AriaClient:
                     async with asyncio.timeout(timeout):
                         payload = await queue.get()
                 except TimeoutError:
-                    raise ClientTimeout(
+                    raise self._no_reply(
                         f"{name!r} from {self.host}:{self.port} stalled for {timeout:g} s "
                         f"after {pending.count} packets"
                     ) from None
