@@ -42,7 +42,11 @@ fail has something behind it:
    loop beats every :data:`LOOP_BEAT` s; :meth:`ClientRunner.loop_lag` says how
    long ago it last did, so a window can warn (e.g. above 0.5 s) that driving
    commands may not be getting out.
-4. **ARIA's own watchdog** on the server stops a robot that hears no drive
+4. **The guardian** (``SessionConfig(guardian=True)``, :mod:`rtmu.guardian`): a
+   separate process with its own login that stops the robot when this process
+   is killed, stopped by a signal, or silent past its lease while driving; the
+   network loop and the UI (:meth:`ClientRunner.ui_heartbeat`) beat for it.
+5. **ARIA's own watchdog** on the server stops a robot that hears no drive
    command for 2 s — the last backstop when this process is frozen, suspended or
    killed (``rtmu drive`` handles the signals that would kill it: see
    ``rtmu.subcommands._common``).
