@@ -5,7 +5,8 @@
 then poll the simulator every few ms until the robot's commanded velocity is zero; the figure is
 that instant minus the moment the proxy applied the fault (``safety.cli_drive_stop_after_fault_ms
 .<fault>`` p50/p95/max). The baseline is what a drive that goes blind leaves to the server: the
-same drive SIGSTOPped, stopped only by the simulator's 2 s ratioDrive watchdog, measured in this run.
+same drive SIGSTOPped together with its guardian, stopped only by the simulator's 2 s ratioDrive
+watchdog, measured in this run.
 
 ``rtt_800ms`` includes the proxy's own 400 ms on the way to the server (the stop cannot arrive
 sooner); ``reset`` leaves nothing to carry a stop, so it measures the server's watchdog too.
@@ -64,8 +65,9 @@ def _trial(sim: SimThread, apply: Callable[[FaultProxy], float] | None) -> float
             if not _wait(lambda: sim.snapshot().trans_ratio == 60, 10):
                 return None
             time.sleep(0.3)
-            if apply is None:
-                proc.send_signal(signal.SIGSTOP)
+            if apply is None:  # freeze the drive and its guardian: only the server's watchdog is left
+                for pid in (proc.pid, *_children(proc.pid)):
+                    os.kill(pid, signal.SIGSTOP)
                 at = time.monotonic()
             else:
                 at = apply(proxy)
@@ -76,6 +78,15 @@ def _trial(sim: SimThread, apply: Callable[[FaultProxy], float] | None) -> float
             proc.kill()
             proc.wait()
             _wait(lambda: sim.snapshot().trans_ratio == 0, 3)
+
+
+def _children(pid: int) -> list[int]:
+    """The child processes of ``pid`` (its guardian), from /proc."""
+    try:
+        text = Path(f"/proc/{pid}/task/{pid}/children").read_text()
+    except OSError:
+        return []
+    return [int(p) for p in text.split()]
 
 
 def _stats(name: str, values: list[float], baseline: float | None) -> list[Result]:

@@ -6,9 +6,9 @@ server, feeding both into the same :class:`~rtmu.client.health.HealthMonitor` th
 uses. :meth:`DriveGuard.fault` says, in words, why driving must stop now — stale status,
 an unanswered or too slow ping, or a lost connection — or None while the link is OK.
 
-The ping here is tighter than the window's (every :data:`PING_INTERVAL` s, answered within
-:data:`MAX_RTT` s): a script has no operator watching the link cell, and a server that
-stopped reading would never hear its ``stop``.
+Status comes at 20 Hz (stale after 200 ms), and the ping is tighter than the window's
+(every :data:`PING_INTERVAL` s, answered within :data:`MAX_RTT` s): a script has no operator
+watching the link cell, and a server that stopped reading would never hear its ``stop``.
 """
 
 from __future__ import annotations
@@ -23,7 +23,10 @@ from .connection import AriaClient, Packet
 from .errors import ClientError, ClientTimeout
 from .health import HealthMonitor, ping_data
 
-STATUS_INTERVAL_MS = 100
+STATUS_INTERVAL_MS = 50
+STALE_INTERVALS = 4
+"""Stale after 200 ms without status: with the fault falling anywhere between two status packets,
+the stop leaves 150–200 ms after it, inside the window's 300 ms promise with room for a busy machine."""
 PING_INTERVAL = 0.25
 MAX_RTT = 0.5
 """A ping not answered within this many seconds counts as a link fault (round trip too high)."""
@@ -43,7 +46,7 @@ class DriveGuard:
         self.client = client
         self.max_rtt = max_rtt
         self.ping_interval = ping_interval
-        self.health = HealthMonitor(STATUS_INTERVAL_MS / 1000.0)
+        self.health = HealthMonitor(STATUS_INTERVAL_MS / 1000.0, stale_intervals=STALE_INTERVALS)
         self.changed = asyncio.Event()
         """Set whenever something arrives or fails that may change :meth:`fault` (a wake-up)."""
         self._ping_task: asyncio.Task[None] | None = None
