@@ -42,7 +42,9 @@ class LinkFault(ClientError):
 class DriveGuard:
     """Status subscription + pings → :meth:`fault`. Create after login; ``start()``; ``close()``."""
 
-    def __init__(self, client: AriaClient, *, max_rtt: float = MAX_RTT, ping_interval: float = PING_INTERVAL):
+    def __init__(
+        self, client: AriaClient, *, max_rtt: float = MAX_RTT, ping_interval: float = PING_INTERVAL
+    ) -> None:
         self.client = client
         self.max_rtt = max_rtt
         self.ping_interval = ping_interval
