@@ -82,3 +82,18 @@ def test_unanswered_pings_spoil_the_link_even_while_status_flows() -> None:
     assert h.level(0.1) is LinkLevel.LOST and h.requests_unanswered
     h.note_rtt(0.003)  # one answer is enough
     assert h.level(0.1) is LinkLevel.OK and not h.requests_unanswered
+
+
+def test_traffic_during_a_download_keeps_the_link_from_lost_but_not_from_stale() -> None:
+    h = HealthMonitor(0.1, lost_after=2.0)
+    h.start(10.0)
+    h.note_status(10.0)
+    h.note_traffic(11.9)  # map packets, no status
+    assert h.level(12.5) is LinkLevel.STALE  # driving still stops: status is old
+    assert abs(h.next_change(12.5) - 13.9) < 1e-3
+    assert h.level(13.95) is LinkLevel.LOST  # the traffic stopped too
+    h.note_traffic(None)
+    h.note_traffic(5.0)  # an older time never moves it back
+    assert h.level(13.95) is LinkLevel.LOST
+    h.start(20.0)  # a new connection forgets the old traffic
+    assert h.level(22.1) is LinkLevel.LOST

@@ -52,6 +52,7 @@ class HealthMonitor:
         """Pings in a row that got no answer (0 after any answered one)."""
         self.bad_payloads = 0
         """Packets that arrived intact but could not be decoded (counted with the decoder's drops)."""
+        self._last_traffic: float | None = None
 
     @property
     def running(self) -> bool:
@@ -64,6 +65,7 @@ class HealthMonitor:
         self.rtt = None
         self.ping_failures = 0
         self.bad_payloads = 0
+        self._last_traffic = None
 
     def stop(self) -> None:
         self._started = None
@@ -71,6 +73,19 @@ class HealthMonitor:
 
     def note_status(self, now: float) -> None:
         self._last_status = now
+
+    def note_traffic(self, at: float | None) -> None:
+        """Packets arrived at ``at`` (during a map download): the link is alive, if not fresh.
+
+        A server streaming a long map may send no status meanwhile; calling the link
+        *lost* then would reconnect and download the map again, for ever. Traffic only
+        keeps the link from LOST: STALE still follows the status age, so driving stops.
+        """
+        if at is not None and (self._last_traffic is None or at > self._last_traffic):
+            self._last_traffic = at
+
+    def _traffic_alive(self, now: float) -> bool:
+        return self._last_traffic is not None and now - self._last_traffic <= self.lost_after
 
     def note_rtt(self, seconds: float) -> None:
         self.rtt = seconds
@@ -95,7 +110,9 @@ class HealthMonitor:
         age = self.status_age(now)
         if age is None:
             return LinkLevel.DOWN
-        if age > self.lost_after or self.ping_failures >= self.ping_failures_lost:
+        if self.ping_failures >= self.ping_failures_lost:
+            return LinkLevel.LOST
+        if age > self.lost_after and not self._traffic_alive(now):
             return LinkLevel.LOST
         if age > self.stale_after or self.ping_failures:
             return LinkLevel.STALE
@@ -110,6 +127,8 @@ class HealthMonitor:
         for limit in (self.stale_after, self.lost_after):
             if age <= limit:
                 return since + limit + 1e-4
+        if self._last_traffic is not None and self._traffic_alive(now):
+            return self._last_traffic + self.lost_after + 1e-4
         return float("inf")
 
     def snapshot(self, now: float, drops: DropStats | None = None) -> LinkHealth:

@@ -546,6 +546,9 @@ class Session:
 
     def _beat(self, now: float) -> None:
         self._poll_guardian()
+        map_task = self._map_task
+        if map_task is not None and not map_task.done() and self.client is not None:
+            self.health.note_traffic(self.client.last_packet_at)  # map bytes keep the link alive
         level = self.health.level(now)
         link_ok = level is LinkLevel.OK and self.connected
         for action in self.governor.step(now, link_ok):
