@@ -305,7 +305,9 @@ def current_password() -> str:
 
 
 def fail(name: str, message: str, code: int) -> int:
-    print(f"rtmu {name}: {message}", file=sys.stderr)
+    from ..textsafe import visible
+
+    print(f"rtmu {name}: {visible(message)}", file=sys.stderr)
     return code
 
 
@@ -399,10 +401,12 @@ def status_object(numbers: Any, status: str, mode: str, *, soc: bool = False) ->
 
 
 def status_line(obj: dict[str, Any]) -> str:
+    from ..textsafe import visible
+
     battery = f"{obj['battery_pct']:.0f} %" if "battery_pct" in obj else f"{obj['battery_v']:.1f} V"
     return (
         f"x={obj['x']} mm  y={obj['y']} mm  th={obj['th']}°  vel={obj['vel']} mm/s  "
-        f"rot={obj['rot_vel']}°/s  battery={battery}  {obj['status']} ({obj['mode']})"
+        f"rot={obj['rot_vel']}°/s  battery={battery}  {visible(obj['status'])} ({visible(obj['mode'])})"
     )
 
 

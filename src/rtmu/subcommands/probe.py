@@ -7,6 +7,7 @@ from typing import Any
 
 from ..cli import EXIT_OK
 from ..client.connection import AriaClient
+from ..textsafe import visible
 from ._common import add_connection_arguments, print_json, run_with_client
 
 
@@ -52,20 +53,22 @@ def handle(args: argparse.Namespace) -> int:
                 }
             )
             return EXIT_OK
-        print(f"{host}:{port} offers {len(entries)} data" + (f" to {args.user}" if args.user else ""))
+        print(
+            f"{host}:{port} offers {len(entries)} data" + (f" to {visible(args.user)}" if args.user else "")
+        )
         groups: dict[str, list[Any]] = {}
         for e in entries:
             groups.setdefault(e.command_group or "(no group)", []).append(e)
         for group in sorted(groups):
-            print(f"\n{group}:")
+            print(f"\n{visible(group)}:")
             for e in groups[group]:
-                print(f"  {e.number:5d}  {e.name}  [{e.flags}]")
+                print(f"  {e.number:5d}  {visible(e.name)}  [{visible(e.flags)}]")
                 if e.description:
-                    print(f"         {e.description}")
+                    print(f"         {visible(e.description)}")
                 if e.argument_description and e.argument_description.lower() not in ("none", ""):
-                    print(f"         args:    {e.argument_description}")
+                    print(f"         args:    {visible(e.argument_description)}")
                 if e.return_description and e.return_description.lower() not in ("none", ""):
-                    print(f"         returns: {e.return_description}")
+                    print(f"         returns: {visible(e.return_description)}")
         return EXIT_OK
 
     return run_with_client("probe", args, body)
