@@ -7,10 +7,40 @@ import sys
 from pathlib import Path
 from typing import Any
 
-from ..cli import EXIT_OK
+from ..cli import EXIT_CONNECTION, EXIT_OK
 from ..client.connection import AriaClient
 from ..client.errors import NotSupported
-from ._common import add_connection_arguments, run_with_client
+from ._common import add_connection_arguments, fail, run_with_client
+
+MAX_SIDE = 8192
+"""Largest width or height accepted from a server; no robot camera comes near it."""
+
+
+def picture_problem(jpeg: bytes, width: int, height: int) -> str | None:
+    """Why ``jpeg`` is not a sane picture of the claimed size, in plain words; None when it is.
+
+    Decoding (not just trusting the header) catches bytes that are not a JPEG, truncated
+    pictures and size fields that lie, before anything lands on disk as ``.jpg``.
+    """
+    import io
+
+    from PIL import Image
+
+    if width > MAX_SIDE or height > MAX_SIDE:
+        return f"the server claims a {width}x{height} picture, over the {MAX_SIDE}x{MAX_SIDE} limit"
+    try:
+        with Image.open(io.BytesIO(jpeg)) as img:
+            if img.format != "JPEG":
+                return f"the server sent a {img.format or 'non-JPEG'} picture, not a JPEG"
+            w, h = img.size
+            if w > MAX_SIDE or h > MAX_SIDE:
+                return f"the picture is {w}x{h}, over the {MAX_SIDE}x{MAX_SIDE} limit"
+            if (width, height) != (0, 0) and (w, h) != (width, height):
+                return f"the server says {width}x{height} but the picture is {w}x{h}"
+            img.load()
+    except (OSError, SyntaxError, ValueError, Image.DecompressionBombError):
+        return f"the {len(jpeg)} bytes the server sent are not a complete JPEG picture"
+    return None
 
 
 def register(subparsers: Any) -> None:
@@ -49,6 +79,9 @@ def handle(args: argparse.Namespace) -> int:
         reply = await client.request_once(source, *extra, timeout=args.timeout)
         picture = reply.decode()  # MalformedReply (exit 3, one line) if it does not decode
         jpeg = bytes(picture.jpeg)  # type: ignore[attr-defined]
+        problem = picture_problem(jpeg, picture.width, picture.height)  # type: ignore[attr-defined]
+        if problem is not None:
+            return fail("image", f"{problem}; nothing saved", EXIT_CONNECTION)
         args.out.write_bytes(jpeg)
         size = f"{picture.width}x{picture.height}"  # type: ignore[attr-defined]
         print(f"wrote {args.out}: {size}, {len(jpeg)} bytes from {source}", file=sys.stderr)
