@@ -58,8 +58,13 @@ def decode_jpeg(data: bytes) -> Decoded:
             thumb = rgb.copy()
             thumb.thumbnail(INSET_SIZE)
             return Decoded(w, h, rgb.tobytes(), thumb.width, thumb.height, thumb.tobytes())
-    except (UnidentifiedImageError, OSError, Image.DecompressionBombError) as exc:
-        raise ValueError(f"the picture cannot be decoded ({exc})") from None
+    except UnidentifiedImageError:
+        # Pillow's own text names a Python object ("<_io.BytesIO object at 0x…>"): say it plainly.
+        raise ValueError(f"the {len(data)} bytes received are not a picture") from None
+    except Image.DecompressionBombError:
+        raise ValueError("the picture claims too many pixels") from None
+    except OSError:
+        raise ValueError(f"the picture is damaged or cut short ({len(data)} bytes)") from None
 
 
 class PictureDecoder:
