@@ -12,6 +12,7 @@ from __future__ import annotations
 import argparse
 import asyncio
 import contextlib
+import sys
 from typing import Any
 
 from ..cli import EXIT_OK
@@ -72,6 +73,11 @@ def handle(args: argparse.Namespace) -> int:
     return run_with_client("status", args, body)
 
 
+def say(message: str) -> None:
+    """A note for the operator on stderr, apart from the status lines (or JSON) on stdout."""
+    print(f"rtmu status: {message}", file=sys.stderr, flush=True)
+
+
 async def stream(client: AriaClient, args: argparse.Namespace, show: Any) -> int:
     strings = {"status": "", "mode": ""}
     soc = await battery_is_soc(client, args.timeout)
@@ -124,9 +130,16 @@ async def stream(client: AriaClient, args: argparse.Namespace, show: Any) -> int
     # A status must come within the interval plus the timeout, or the link is dead.
     gap = args.interval / 1000.0 + args.timeout
     loop = asyncio.get_running_loop()
+    quiet_after = max(1.0, 5 * args.interval / 1000.0)
+    """Silence this long is worth a word on stderr before the timeout ends the stream."""
+    last = loop.time()
+    quiet = False
     while args.count <= 0 or shown < args.count:
         deadline = loop.time() + gap
         while queue.empty():
+            if not quiet and loop.time() - last >= quiet_after:
+                quiet = True
+                say(f"no status for {loop.time() - last:.1f} s — the server has gone quiet")
             if client.closed_error is not None:
                 raise client.closed_error
             if loop.time() >= deadline:
@@ -136,6 +149,10 @@ async def stream(client: AriaClient, args: argparse.Namespace, show: Any) -> int
             with contextlib.suppress(TimeoutError):
                 async with asyncio.timeout(min(0.1, max(0.0, deadline - loop.time()))):
                     await queue.put(await queue.get())  # wait for one without taking it
+        if quiet:
+            quiet = False
+            say(f"status resumed after {loop.time() - last:.1f} s")
+        last = loop.time()
         show(queue.get_nowait())
         shown += 1
     return EXIT_OK
