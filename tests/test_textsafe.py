@@ -43,3 +43,18 @@ def test_status_line_escapes_status_and_mode() -> None:
 
 def test_json_keeps_the_exact_strings() -> None:
     assert json.loads(json.dumps({"s": HOSTILE}, ensure_ascii=False))["s"] == HOSTILE
+
+
+def test_mapinfo_escapes_map_file_text(tmp_path, capsys) -> None:  # type: ignore[no-untyped-def]
+    from rtmu.cli import main
+
+    path = tmp_path / "evil.map"
+    path.write_text(
+        "2D-Map\nMinPos: 0 0\nMaxPos: 10 10\n"
+        'Ev\x1b[2J\x07\u202eil: 1\nCairn: GoalWithHeading 5 5 0 "" ICON "g\x1b[2J\x07\u202eoal"\nDATA\n1 1\n'
+    )
+    main(["mapinfo", str(path)])
+    out = capsys.readouterr()
+    assert "Ev\\x1b[2J\\x07" in out.out  # the reader reads latin-1: U+202E arrives as C1 bytes
+    for text in (out.out, out.err):
+        assert not any(ch in text for ch in "\x1b\x07\u202e"), text

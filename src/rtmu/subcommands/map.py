@@ -12,6 +12,7 @@ from ..client.connection import AriaClient
 from ..client.errors import ProtocolFault
 from ..client.mapload import download_map
 from ..mapfile.errors import MapFormatError
+from ..textsafe import visible
 from ._common import add_connection_arguments, fail, run_with_client
 
 
@@ -40,7 +41,7 @@ def handle(args: argparse.Namespace) -> int:
         except (MapFormatError, ValueError) as exc:  # parsed, yet not writable as a .map file
             reason = f"the map from {got.source!r} cannot be written as a .map file: {exc}"
             raise ProtocolFault(reason) from None
-        name = f" ({got.name})" if got.name else ""
+        name = f" ({visible(got.name)})" if got.name else ""
         print(
             f"wrote {args.out}{name}: {got.data.num_points} points, {got.data.num_lines} lines "
             f"via {got.source} in {got.packets} packets",

@@ -9,6 +9,7 @@ from collections import Counter
 from typing import Any
 
 from rtmu.maps import Bounds, MapData, MapFormatError, read_map, split_keyword
+from rtmu.textsafe import visible
 
 EXIT_OK = 0
 EXIT_BAD_MAP = 2
@@ -30,13 +31,14 @@ def run(args: argparse.Namespace) -> int:
     try:
         data = read_map(args.file)
     except MapFormatError as exc:
-        print(f"rtmu mapinfo: {exc}", file=sys.stderr)
+        print(f"rtmu mapinfo: {visible(str(exc))}", file=sys.stderr)
         return EXIT_BAD_MAP
     summary = summarise(data)
     if args.json:
         print(json.dumps(summary))
     else:
-        print(render_text(summary))
+        # Map file text is untrusted: escape control characters line by line.
+        print("\n".join(visible(line) for line in render_text(summary).split("\n")))
     return EXIT_OK
 
 
