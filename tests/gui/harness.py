@@ -31,6 +31,8 @@ from rtmu.ui.app import GuiOptions  # noqa: E402
 from rtmu.ui.application import RtmuApplication  # noqa: E402
 from rtmu.ui.window import MainWindow  # noqa: E402
 
+from .process import screenshot  # noqa: E402
+
 REPO = Path(__file__).resolve().parents[2]
 OFFICE_MAP = REPO / "data" / "maps" / "office.map"
 COUNTS = {"windows": 0, "pictures": 0}
@@ -217,7 +219,7 @@ class Gui:
         idle(0.2)
         self._shot_no += 1
         path = self.shots / f"{self.name}-{self._shot_no:02d}-{label}.png"
-        self.run_tool("import", "-window", "root", str(path))
+        screenshot(path)  # Pillow grabs the X screen itself; the server answers, not GTK
         COUNTS["pictures"] += 1
         return path
 

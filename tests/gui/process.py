@@ -2,9 +2,13 @@
 
 from __future__ import annotations
 
+import os
 import subprocess
 import time
 from collections.abc import Callable
+from pathlib import Path
+
+from PIL import ImageGrab
 
 from rtmu.sim import SimThread
 
@@ -20,6 +24,30 @@ def wait(condition: Callable[[], bool], timeout: float, what: str, *, poll: floa
 
 def xdotool(*args: str) -> str:
     return subprocess.run(["xdotool", *args], capture_output=True, text=True, timeout=15, check=True).stdout
+
+
+def screenshot(path: Path, window: str | None = None, display: str | None = None) -> Path:
+    """Save the X screen (or one window of it) as PNG, in-process with Pillow's XCB grab.
+
+    Why: no external screenshot tool (ImageMagick's ``import``) to install. ``window`` is an X window
+    id; the picture is the screen cropped to its geometry (xdotool), as the operator sees it.
+    """
+    display = display or os.environ["DISPLAY"]
+    image = ImageGrab.grab(xdisplay=display)
+    if window is not None:
+        out = subprocess.run(
+            ["xdotool", "getwindowgeometry", "--shell", window],
+            capture_output=True,
+            text=True,
+            timeout=15,
+            check=True,
+            env=dict(os.environ, DISPLAY=display),
+        ).stdout
+        geo = dict(line.split("=", 1) for line in out.split() if "=" in line)
+        x, y, w, h = (int(geo[k]) for k in ("X", "Y", "WIDTH", "HEIGHT"))
+        image = image.crop((x, y, x + w, y + h))
+    image.save(path)
+    return path
 
 
 def subscribed(sim: SimThread) -> bool:

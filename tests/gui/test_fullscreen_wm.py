@@ -23,7 +23,7 @@ import pytest
 from rtmu.sim import SimConfig, SimThread
 
 from .harness import OFFICE_MAP
-from .process import subscribed, wait
+from .process import screenshot, subscribed, wait
 
 SCREEN = (1024, 768)
 OPENBOX = shutil.which("openbox")
@@ -119,7 +119,7 @@ def _fills_screen(env: dict[str, str], window: str) -> bool:
 
 
 def _shot(env: dict[str, str], path: Path) -> None:
-    _x(env, "import", "-window", "root", str(path))
+    screenshot(path, display=env["DISPLAY"])
     assert path.stat().st_size > 0
 
 

@@ -19,7 +19,7 @@ import pytest
 from rtmu.sim import SimConfig, SimThread
 
 from .harness import OFFICE_MAP
-from .process import connect_and_hold_up, wait, xdotool
+from .process import connect_and_hold_up, screenshot, wait, xdotool
 
 SIGNALS = [signal.SIGHUP, signal.SIGQUIT, signal.SIGUSR1, signal.SIGUSR2, signal.SIGALRM]
 
@@ -43,11 +43,7 @@ def test_a_hangup_or_quit_signal_stops_the_robot_then_exits(
             window = connect_and_hold_up(proc, sim)
             held = True
             name = signal.Signals(signum).name
-            subprocess.run(
-                ["import", "-window", window, str(screenshots / f"test_signals-{name}-01-driving.png")],
-                timeout=15,
-                check=True,
-            )
+            screenshot(screenshots / f"test_signals-{name}-01-driving.png", window)
             watchdog_stops = sim.call(lambda: sim.server.robot.watchdog_stops)
             proc.send_signal(signum)
             # The simulator's stop mode comes only from a "stop" request (its watchdog and a client

@@ -18,7 +18,7 @@ from pathlib import Path
 from rtmu.sim import SimConfig, SimThread
 
 from .harness import OFFICE_MAP
-from .process import connect_and_hold_up, wait, xdotool
+from .process import connect_and_hold_up, screenshot, wait, xdotool
 
 
 def process_state(pid: int) -> str:
@@ -65,11 +65,7 @@ def test_ctrl_z_stops_the_robot_then_the_process_and_nothing_drives_after_resume
             assert drives_received() == frozen_at, "a drive resumed without a fresh press"
             assert sim.call(lambda: robot.mode_name) == "stop"
             assert proc.poll() is None
-            subprocess.run(
-                ["import", "-window", window, str(screenshots / "test_suspend-01-resumed.png")],
-                timeout=15,
-                check=True,
-            )
+            screenshot(screenshots / "test_suspend-01-resumed.png", window)
 
             xdotool("keyup", "Up")  # a real release, then a fresh press drives again
             held = False
