@@ -16,7 +16,7 @@ export DEBIAN_FRONTEND=noninteractive
 
 APT_PACKAGES=(
     gir1.2-gtk-4.0 gir1.2-adw-1 libgirepository1.0-dev libcairo2-dev pkg-config
-    build-essential xvfb xdotool openbox
+    build-essential xvfb xdotool openbox x11-utils
 )
 VENV=.venv
 STAMP="$VENV/.rtmu-setup-stamp"

@@ -29,6 +29,7 @@ OTHER_PACKAGES = [
     "xvfb",
     "xdotool",
     "openbox",
+    "x11-utils",
 ]
 TOOLS = [
     "awk",
@@ -216,7 +217,7 @@ def test_a_ready_machine_asks_apt_nothing(tmp_path: Path) -> None:
     )
     result = machine.run()
     assert result.returncode == 0, result.stderr
-    assert "system packages present (12 checked)" in result.stdout
+    assert "system packages present (13 checked)" in result.stdout
     assert machine.apt_calls() == []
 
 
