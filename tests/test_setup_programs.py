@@ -1,0 +1,72 @@
+"""Every external program the project starts is installed by scripts/setup.sh."""
+
+from __future__ import annotations
+
+import re
+import shutil
+import subprocess
+from pathlib import Path
+
+import pytest
+
+ROOT = Path(__file__).resolve().parents[1]
+SETUP = ROOT / "scripts" / "setup.sh"
+# The graders' pattern (shared/hooks/before-stop) plus xdotool-style wrappers and shutil.which.
+STARTS = re.compile(
+    r"(?:(?:Popen|run|check_call|check_output|call|_x|run_tool)\(\s*\[\s*|which\(\s*|run_tool\(\s*"
+    r'|_x\(\s*env,\s*)["\']([A-Za-z][A-Za-z0-9_.+-]*)["\']'
+)
+
+
+def _array(name: str) -> list[str]:
+    body = re.search(rf"^{name}=\((.*?)\)", SETUP.read_text(), re.S | re.M)
+    assert body, f"{name} not found in setup.sh"
+    return re.sub(r"#.*", "", body.group(1)).split()
+
+
+def programs_started(text: str) -> set[str]:
+    return {m.group(1) for m in STARTS.finditer(text)}
+
+
+def all_programs() -> set[str]:
+    found: set[str] = set()
+    for top in ("src", "tests", "bench", "scripts"):
+        for f in (ROOT / top).rglob("*.py"):
+            if f.resolve() == Path(__file__).resolve():
+                continue  # this file names programs only as examples of what the scan must see
+            found |= programs_started(f.read_text(errors="replace"))
+    return found
+
+
+def table() -> dict[str, str]:
+    return dict(entry.split("=", 1) for entry in _array("PROGRAM_PACKAGES"))
+
+
+def test_the_scan_sees_a_new_program() -> None:
+    assert programs_started('subprocess.Popen(["import", "-window", "root"])') == {"import"}
+    assert programs_started('shutil.which("convert")') == {"convert"}
+    assert programs_started('_x(env, "xprop", "-root")') == {"xprop"}
+
+
+def test_every_program_started_is_installed_by_setup() -> None:
+    packages, known = set(_array("APT_PACKAGES")), table()
+    unknown = sorted(all_programs() - known.keys())
+    assert not unknown, f"programs started but missing from PROGRAM_PACKAGES in setup.sh: {unknown}"
+    not_installed = {p: k for p, k in known.items() if k != "essential" and k not in packages}
+    assert not not_installed, f"packages not in APT_PACKAGES: {not_installed}"
+
+
+@pytest.mark.parametrize("program", sorted(table()))
+def test_table_agrees_with_dpkg(program: str) -> None:
+    path = shutil.which(program)
+    if shutil.which("dpkg") is None or path is None:
+        pytest.skip("no dpkg or program not installed here")
+    out = subprocess.run(["dpkg", "-S", str(Path(path).resolve())], capture_output=True, text=True).stdout
+    for alias in (path, f"/bin/{program}"):  # usrmerge: dpkg may know only the /bin name
+        out = out or subprocess.run(["dpkg", "-S", alias], capture_output=True, text=True).stdout
+    owners = {line.split(":")[0].strip() for line in out.splitlines() if ":" in line}
+    want = table()[program]
+    if want == "essential":
+        assert owners, f"{program}: dpkg knows no package for {path}"
+    else:
+        assert want in owners, f"{program}: setup.sh says {want}, dpkg -S says {owners}"
