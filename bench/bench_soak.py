@@ -1,6 +1,7 @@
-"""A short drive soak for ``./rtmu-dev bench``; the hour-long one is ``python -m bench.soak``.
+"""Short drive soaks for ``./rtmu-dev bench``: the client core, then the real window under Xvfb.
 
-``RTMU_SOAK_SECONDS`` sets the length (default 120 s, so the whole bench run stays a few minutes).
+The hour-long ones are ``python -m bench.soak --seconds 3600 [--window]``. ``RTMU_SOAK_SECONDS``
+sets each one's length here (default 90 s, so the whole bench run stays a few minutes).
 """
 
 from __future__ import annotations
@@ -9,10 +10,11 @@ import os
 
 from bench.common import Result
 from bench.soak import results, soak
+from bench.soak_window import soak_window
 
-DEFAULT_SECONDS = 120.0
+DEFAULT_SECONDS = 90.0
 
 
 def run() -> list[Result]:
     seconds = float(os.environ.get("RTMU_SOAK_SECONDS", DEFAULT_SECONDS))
-    return results(soak(seconds))
+    return results(soak(seconds)) + results(soak_window(seconds), "soak.window")

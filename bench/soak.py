@@ -71,6 +71,8 @@ class _Server:
         self.port = int(line[1])
         self.stops: list[float] = []
         """Server-side times (monotonic) of zero ratioDrive and stop packets."""
+        self.drives: list[float] = []
+        """Server-side times of ratioDrive packets that ask for motion."""
         self._cond = threading.Condition()
         threading.Thread(target=self._read, daemon=True).start()
 
@@ -82,18 +84,24 @@ class _Server:
                 continue
             t = float(parts[1])
             is_stop = parts[0] == "stop" or (float(parts[2]) == 0 and float(parts[3]) == 0)
-            if is_stop:
-                with self._cond:
-                    self.stops.append(t)
-                    self._cond.notify_all()
+            with self._cond:
+                (self.stops if is_stop else self.drives).append(t)
+                self._cond.notify_all()
 
     def first_stop_after(self, t0: float, timeout: float) -> float | None:
+        """The first stop the server decoded at or after ``t0``, waiting up to ``timeout``."""
+        return self._first_after("stops", t0, timeout)
+
+    def first_drive_after(self, t0: float, timeout: float) -> float | None:
+        return self._first_after("drives", t0, timeout)
+
+    def _first_after(self, kind: str, t0: float, timeout: float) -> float | None:
         deadline = time.monotonic() + timeout
         with self._cond:
             while True:
-                after = [t for t in self.stops if t >= t0]
+                after = [t for t in getattr(self, kind) if t >= t0]
                 if after:
-                    self.stops = []
+                    setattr(self, kind, [])
                     return min(after)
                 left = deadline - time.monotonic()
                 if left <= 0:
@@ -228,29 +236,38 @@ def soak(seconds: float, *, seed: int = 1, progress: Callable[[str], None] | Non
         server.close()
 
 
-def results(raw: dict[str, Any]) -> list[Result]:
+def results(raw: dict[str, Any], prefix: str = "soak") -> list[Result]:
     ms = raw["release_to_stop_ms"]
-    return [
-        Result("soak.release_to_stop_ms.p50", statistics.median(ms), "ms"),
-        Result("soak.release_to_stop_ms.p99", _pct(ms, 0.99), "ms"),
-        Result("soak.release_to_stop_ms.max", max(ms), "ms"),
-        Result("soak.rss_drift_mb", raw["rss_drift_mb"], "MB"),
-        Result("soak.rss_slope_mb_per_h", raw["rss_slope_mb_per_h"], "MB/h"),
-        Result("soak.max_handler_ms", raw["max_handler_ms"], "ms"),
-        Result("soak.slow_handlers", float(raw["slow_handlers"]), "count"),
-        Result("soak.max_loop_lag_ms", raw["max_loop_lag_ms"], "ms"),
-        Result("soak.cycles", float(raw["cycles"]), "count"),
-        Result("soak.seconds", raw["seconds"], "s"),
+    out = [
+        Result(f"{prefix}.release_to_stop_ms.p50", statistics.median(ms), "ms"),
+        Result(f"{prefix}.release_to_stop_ms.p99", _pct(ms, 0.99), "ms"),
+        Result(f"{prefix}.release_to_stop_ms.max", max(ms), "ms"),
+        Result(f"{prefix}.rss_drift_mb", raw["rss_drift_mb"], "MB"),
+        Result(f"{prefix}.rss_slope_mb_per_h", raw["rss_slope_mb_per_h"], "MB/h"),
     ]
+    if "max_handler_ms" in raw:
+        out.append(Result(f"{prefix}.max_handler_ms", raw["max_handler_ms"], "ms"))
+    out.append(Result(f"{prefix}.slow_handlers", float(raw["slow_handlers"]), "count"))
+    if "max_loop_lag_ms" in raw:
+        out.append(Result(f"{prefix}.max_loop_lag_ms", raw["max_loop_lag_ms"], "ms"))
+    out += [
+        Result(f"{prefix}.cycles", float(raw["cycles"]), "count"),
+        Result(f"{prefix}.seconds", raw["seconds"], "s"),
+    ]
+    return out
 
 
 def main(argv: list[str] | None = None) -> int:
     p = argparse.ArgumentParser(prog="python -m bench.soak", description=__doc__.split("\n")[0])
     p.add_argument("--seconds", type=float, default=3600.0, help="how long to drive (default 3600)")
+    p.add_argument("--window", action="store_true", help="drive the real window under Xvfb with xdotool")
     p.add_argument("--json", type=Path, help="also write the raw figures (every latency, RSS samples) here")
     args = p.parse_args(argv)
-    raw = soak(args.seconds, progress=lambda line: print(line, file=sys.stderr, flush=True))
-    for r in results(raw):
+    from bench.soak_window import soak_window
+
+    run = soak_window if args.window else soak
+    raw = run(args.seconds, progress=lambda line: print(line, file=sys.stderr, flush=True))
+    for r in results(raw, "soak.window" if args.window else "soak"):
         print(f"{r.name:<32} {r.value:12.4g} {r.unit}")
     if args.json is not None:
         args.json.write_text(json.dumps(raw, indent=1) + "\n")
