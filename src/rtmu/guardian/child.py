@@ -73,9 +73,20 @@ def read_hello(fd: int) -> m.Hello:
 
 
 def say(word: str, text: str = "") -> None:
-    with contextlib.suppress(OSError, ValueError):
+    try:
         sys.stdout.write(f"{word} {text}".rstrip().replace("\n", " ") + "\n")
         sys.stdout.flush()
+    except (OSError, ValueError):
+        _parent_stopped_listening()
+
+
+def _parent_stopped_listening() -> None:
+    """Point stdout at /dev/null: the unsent line would otherwise fail again at exit and print a
+    traceback into the stderr we share with the parent (a script's one-line error would grow)."""
+    with contextlib.suppress(OSError, ValueError):
+        devnull = os.open(os.devnull, os.O_WRONLY)
+        os.dup2(devnull, sys.stdout.fileno())
+        os.close(devnull)
 
 
 class Watch:
