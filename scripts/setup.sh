@@ -16,12 +16,13 @@ export DEBIAN_FRONTEND=noninteractive
 
 APT_PACKAGES=(
     gir1.2-gtk-4.0 gir1.2-adw-1 libgirepository1.0-dev libcairo2-dev pkg-config
-    build-essential xvfb xdotool openbox x11-utils
+    build-essential xvfb xdotool openbox x11-utils xxd bsdextrautils
 )
 # Every program the app, tests, bench and scripts start -> the package above that installs it
 # ("essential": in every Debian install). tests/test_setup_programs.py keeps this true.
 PROGRAM_PACKAGES=(
     Xvfb=xvfb xdotool=xdotool openbox=openbox xwininfo=x11-utils xprop=x11-utils bash=essential
+    xxd=xxd hexdump=bsdextrautils od=essential
 )
 VENV=.venv
 STAMP="$VENV/.rtmu-setup-stamp"

@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import ast
 import re
 import shutil
 import subprocess
@@ -25,7 +26,29 @@ def _array(name: str) -> list[str]:
 
 
 def programs_started(text: str) -> set[str]:
-    return {m.group(1) for m in STARTS.finditer(text)}
+    return {m.group(1) for m in STARTS.finditer(text)} | parametrized_tools(text)
+
+
+def parametrized_tools(text: str) -> set[str]:
+    """Programs a test runs through a parameter: ``@pytest.mark.parametrize("tool", [["xxd"], ...])``
+    then ``subprocess.run([*tool, ...])`` — the first word of each argument list."""
+    found: set[str] = set()
+    try:
+        tree = ast.parse(text)
+    except SyntaxError:
+        return found
+    for call in ast.walk(tree):
+        if not (isinstance(call, ast.Call) and getattr(call.func, "attr", "") == "parametrize"):
+            continue
+        if len(call.args) < 2 or not isinstance(call.args[0], ast.Constant) or call.args[0].value != "tool":
+            continue
+        if isinstance(call.args[1], ast.List | ast.Tuple):
+            for argv in call.args[1].elts:
+                if isinstance(argv, ast.List | ast.Tuple) and argv.elts:
+                    first = argv.elts[0]
+                    if isinstance(first, ast.Constant) and isinstance(first.value, str):
+                        found.add(first.value)
+    return found
 
 
 def all_programs() -> set[str]:
@@ -46,6 +69,8 @@ def test_the_scan_sees_a_new_program() -> None:
     assert programs_started('subprocess.Popen(["import", "-window", "root"])') == {"import"}
     assert programs_started('shutil.which("convert")') == {"convert"}
     assert programs_started('_x(env, "xprop", "-root")') == {"xprop"}
+    tools = '@pytest.mark.parametrize("tool", [["xxd", "-g1"], ["od", "-x"]])\ndef t(tool): ...'
+    assert programs_started(tools) == {"xxd", "od"}
 
 
 def test_every_program_started_is_installed_by_setup() -> None:
