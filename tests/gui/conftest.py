@@ -198,3 +198,38 @@ def every_window_test_saves_a_picture(request: pytest.FixtureRequest) -> Iterato
     passed = request.node.stash.get(_CALL_PASSED, False)
     if opened and passed and COUNTS["pictures"] == before["pictures"]:
         pytest.fail("this test opened the window but saved no screenshot (gui.shot or gui.render)")
+
+
+_OWNER_COUNT = [0]
+
+
+@pytest.fixture(autouse=True)
+def every_test_leaves_a_clean_x_server_and_no_processes(request: pytest.FixtureRequest) -> Iterator[None]:
+    """Reset what a test may leave behind, whether it passed, failed or timed out: the apps it left
+    open are closed, held keys and mouse buttons released, and every process it started (marked
+    through the environment, see ``isolation``) ends. A passing test that leaked a process fails:
+    each test owns and removes what it starts."""
+    from . import isolation
+    from .harness import OPEN
+
+    _OWNER_COUNT[0] += 1
+    mark = f"{os.getpid()}.{_OWNER_COUNT[0]}"
+    previous = os.environ.get(isolation.OWNER)
+    os.environ[isolation.OWNER] = mark
+    try:
+        yield
+    finally:
+        if previous is None:
+            os.environ.pop(isolation.OWNER, None)
+        else:
+            os.environ[isolation.OWNER] = previous
+        left_open = isolation.close_all(OPEN)
+        if not SKIP_REASON:
+            isolation.release_input()
+        killed = isolation.end_processes(mark)
+        isolation.reap_children()
+    if request.node.stash.get(_CALL_PASSED, False) and (killed or left_open):
+        pytest.fail(
+            f"this test left {left_open} app(s) open and {len(killed)} process(es) running: {killed}",
+            pytrace=False,
+        )

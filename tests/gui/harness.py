@@ -37,6 +37,8 @@ REPO = Path(__file__).resolve().parents[2]
 OFFICE_MAP = REPO / "data" / "maps" / "office.map"
 COUNTS = {"windows": 0, "pictures": 0}
 """Windows opened and pictures saved so far: every test that opens a window must leave a picture."""
+OPEN: dict[int, Callable[[], None]] = {}
+"""The teardown of every app still open, by id: the GUI conftest closes what a failed test left."""
 
 
 @contextlib.contextmanager
@@ -117,9 +119,10 @@ class Gui:
         """The app with these options, activated as ``rtmu`` would; waits for the connection if asked."""
         app = RtmuApplication(options)
         app.register(None)
+        gui = cls(app, shots, name)
+        OPEN[id(gui)] = gui.close  # before anything can fail: a half-opened app is closed too
         app.activate()
         COUNTS["windows"] += 1
-        gui = cls(app, shots, name)
         pump(lambda: app.window is not None and app.window.get_mapped(), 10, "the window to be mapped")
         gui.focus()
         if connect:
@@ -257,6 +260,7 @@ class Gui:
 
     # -- teardown ------------------------------------------------------------------------------
     def close(self) -> None:
+        OPEN.pop(id(self), None)
         app = self.app
         windows = list(app.get_windows())
         app.close_session()
