@@ -136,7 +136,9 @@ def test_reconnect_restores_status_and_map_but_never_motion() -> None:
                 ui.wait_for(lambda: model.connection.value.phase is Phase.RECONNECTING)
                 with SimThread(SimConfig(port=port, map_path=ARENA, seed=2)) as sim2:
                     ui.wait_for(lambda: model.connection.value.phase is Phase.CONNECTED, timeout=10)
-                    ui.wait_for(lambda: model.map.value.generation > generation, timeout=10)
+                    # The same map file (same getMapId): answered from the cache, not downloaded.
+                    ui.wait_for(lambda: runner.session.map_downloads_skipped >= 1, timeout=10)
+                    assert model.map.value.state == "ready" and model.map.value.generation == generation
                     ui.wait_for(lambda: model.health.value.level is LinkLevel.OK)
                     # The key is still "held" (renewed above): the heart has run since the
                     # reconnect, and anything it sent has reached the simulator by the reply.

@@ -46,6 +46,7 @@ from ..protocol.events import DataListReady, DataReceived, PeerShutdown, Rejecte
 from ..protocol.fields import FieldWriter
 from ..protocol.packet import MAX_LENGTH
 from ..protocol.payloads import Payload, Side, decode_payload
+from ..protocol.payloads.mapstream import MapTooLarge
 from .errors import (
     ClientError,
     ClientTimeout,
@@ -287,6 +288,9 @@ class _Pending:
             return True
         try:
             finished = self.rule.done(payload, self.count)
+        except MapTooLarge as exc:  # more than any map can be: an endless or hostile stream
+            self.fail(ProtocolFault(f"the server's map is too large, download stopped: {exc}"))
+            return True
         except ProtocolError as exc:  # the caller's end test found the reply malformed
             self.fail(ProtocolFault(f"malformed reply: {exc}"))
             return True
@@ -624,8 +628,11 @@ class AriaClient:
         try:
             while True:
                 try:
-                    async with asyncio.timeout(timeout):
-                        payload = await queue.get()
+                    if queue.empty():
+                        async with asyncio.timeout(timeout):
+                            payload = await queue.get()
+                    else:  # already here: no timer per packet (a big map is millions of packets)
+                        payload = queue.get_nowait()
                 except TimeoutError:
                     raise self._no_reply(
                         f"{name!r} from {self.host}:{self.port} stalled for {timeout:g} s "

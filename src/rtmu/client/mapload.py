@@ -103,4 +103,4 @@ def assembled_map(assembler: MapBinaryAssembler | MapTextAssembler) -> Any | Non
         return None
     if isinstance(assembler, MapBinaryAssembler):
         return maps.from_stream(result.header_lines, result.segments, result.points)  # type: ignore[union-attr]
-    return maps.parse_map_lines(result.lines)  # type: ignore[union-attr]
+    return maps.parse_map(result.text, source="<getMap>")  # type: ignore[union-attr]

@@ -41,10 +41,11 @@ from ..protocol.payloads.drive import RatioDrive, SafeDrive, SetSafeDrive
 from ..protocol.payloads.robot import BatteryInfo, ModeInfo, Update, UpdateNumbers, UpdateStrings
 from .connection import AriaClient, Packet
 from .diagnosis import explain
-from .errors import ClientError, ClientTimeout, MalformedReply, NotSupported, ServerClosed
+from .errors import ClientError, ClientTimeout, MalformedReply, NotSupported, ProtocolFault, ServerClosed
 from .health import HealthMonitor, ping_data
 from .ld_session import LdFeed
 from .lease import DriveGovernor, DriveLease, EndReason, SendRatios, SendStop
+from .mapcache import MapCache, map_key
 from .mapload import download_map, map_source
 from .reconnect import Backoff, worth_retrying
 
@@ -119,6 +120,9 @@ class Session:
         self._published: dict[str, Any] = {}
         self._robot = RobotState()
         self._map = MapModel()
+        self._map_cache = MapCache()
+        self.map_downloads_skipped = 0
+        """Map loads answered from the cache (same ``getMapId``): what a reconnect saved."""
         self._connection = ConnectionState()
         self._extra_subs: dict[str, tuple[int, Callable[[Packet], None]]] = {}
         self._tasks: set[asyncio.Task[Any]] = set()
@@ -758,6 +762,16 @@ class Session:
         if map_source(client) is None:
             self._set_map(MapModel(state="unsupported"))
             return self._map
+        target = self._target
+        key = None
+        if target is not None:
+            key = await map_key(client, target.host, target.port, self.config.reply_timeout)
+        cached = self._map_cache.get(key)
+        if cached is not None:  # the same map as last time (reconnect, spurious mapUpdated)
+            self.map_downloads_skipped += 1
+            if cached != self._map or cached.data is not self._map.data:
+                self._set_map(cached)
+            return self._map
         generation = self._map.generation
         self._set_map(MapModel(state="loading", name=self._map.name, generation=generation))
 
@@ -766,6 +780,10 @@ class Session:
 
         try:
             got = await download_map(client, timeout=self.config.reply_timeout, progress=progress)
+        except ProtocolFault as exc:  # the map itself is at fault: keep the verdict for this map
+            failed = self._map_failed(client, str(exc))
+            self._map_cache.put(key, failed)
+            return failed
         except ClientError as exc:
             return self._map_failed(client, str(exc))
         except Exception as exc:  # a bug must still end "loading": the window would wait for ever
@@ -779,6 +797,7 @@ class Session:
                 state="ready", data=got.data, name=got.name, generation=generation + 1, received=got.packets
             )
         )
+        self._map_cache.put(key, self._map)
         return self._map
 
     def _map_failed(self, client: AriaClient, reason: str) -> MapModel:

@@ -14,24 +14,30 @@ from __future__ import annotations
 
 import struct
 from collections.abc import Iterable, Sequence
-from dataclasses import dataclass, field
+from dataclasses import dataclass
 from enum import Enum, auto
 from typing import Final
 
 import numpy as np
 
 from ..errors import PayloadError
-from ..fields import FieldReader, FieldWriter
+from ..fields import TEXT_ENCODING, FieldReader, FieldWriter
 from ..packet import MAX_PAYLOAD
 from .map import COORD_DTYPE, POINT_BYTES, SEGMENT_BYTES, binary_block_kind, coords_bytes, read_block
 
 MAX_ITEMS_PER_PACKET: Final = 1000
 """ARIA puts at most 1000 points or segments in one binary packet."""
-DEFAULT_MAX_POINTS: Final = 20_000_000
-DEFAULT_MAX_SEGMENTS: Final = 5_000_000
-DEFAULT_MAX_HEADER_LINES: Final = 1_000_000
-DEFAULT_MAX_TEXT_LINES: Final = 5_000_000
-DEFAULT_MAX_TEXT_BYTES: Final = 256 * 1024 * 1024
+# Bounds from what a map can be, so that an endless or huge stream fails in seconds and costs at most
+# tens of MB (text maps above a million lines need getMapBinary, offered since ARIA 2.7).
+# ARIA's and ARAM's large site maps hold a few hundred thousand to ~2 million points, a
+# few thousand lines and tens of thousands of header lines (cairns, info). As int32 pairs the point
+# cap is 40 MB, the segment cap 16 MB; text is kept as bytes, one per character plus a separator.
+DEFAULT_MAX_POINTS: Final = 5_000_000
+DEFAULT_MAX_SEGMENTS: Final = 1_000_000
+DEFAULT_MAX_HEADER_LINES: Final = 200_000
+DEFAULT_MAX_HEADER_BYTES: Final = 32 * 1024 * 1024
+DEFAULT_MAX_TEXT_LINES: Final = 1_000_000
+DEFAULT_MAX_TEXT_BYTES: Final = 48 * 1024 * 1024
 
 _COUNT = struct.Struct("<i")
 _BLOCK_END: Final = _COUNT.pack(0)
@@ -46,6 +52,34 @@ class ReplyAlreadyComplete(PayloadError):
     """A packet arrived for a map reply that had already ended."""
 
 
+class _Claims:
+    """What the header says the map holds (``NumPoints:``, ``NumLines:``), as a bound on the stream.
+
+    A server that streams points for ever behind an honest header is stopped just past its own
+    count, in a fraction of a second, long before the absolute caps. ARIA writes these counts from
+    the real data; a slack of 10 % (at least 1000) forgives a hand-edited header.
+    """
+
+    def __init__(self) -> None:
+        self.points: int | None = None
+        self.lines: int | None = None
+
+    def note(self, line: bytes | str) -> None:
+        raw = line.encode(TEXT_ENCODING, "replace") if isinstance(line, str) else line
+        for key, attr in ((b"NumPoints:", "points"), (b"NumLines:", "lines")):
+            if raw.startswith(key):
+                try:
+                    value = int(raw[len(key) :].split()[0])
+                except (ValueError, IndexError):
+                    return
+                if value >= 0:
+                    setattr(self, attr, value)
+
+    @staticmethod
+    def over(claimed: int | None, count: int) -> bool:
+        return claimed is not None and count > claimed + max(1000, claimed // 10)
+
+
 def _text(payload: bytes) -> str:
     return FieldReader(payload).string("map line")
 
@@ -55,17 +89,25 @@ def _text(payload: bytes) -> str:
 
 @dataclass
 class TextMap:
-    """A ``getMap`` reply: the map file's lines in order (header, objects, LINES/DATA sections)."""
+    """A ``getMap`` reply: the map file's text (lines joined by ``\\n``, as ARIA's file has them)."""
 
-    lines: list[str] = field(default_factory=list)
+    text: bytes = b""
+    line_count: int = 0
     has_map: bool = True
+
+    @property
+    def lines(self) -> list[str]:
+        """The lines as text (for small maps and tests; the map parser reads :attr:`text`)."""
+        return self.text.decode(TEXT_ENCODING).split("\n") if self.line_count else []
 
 
 class MapTextAssembler:
     """Collects a ``getMap`` reply: line packets, ``""`` (end of map), then a zero-length packet.
 
     A lone ``""`` before any line means the server has no map; ARIA sends
-    nothing after it, so that ends the reply too.
+    nothing after it, so that ends the reply too. Lines are kept as bytes in one
+    buffer, not as a list of strings: a million-line map costs its size in bytes,
+    not ~60 bytes of object per line.
     """
 
     def __init__(
@@ -73,8 +115,11 @@ class MapTextAssembler:
     ) -> None:
         self.max_lines = max_lines
         self.max_bytes = max_bytes
-        self._lines: list[str] = []
-        self._bytes = 0
+        self._text = bytearray()
+        self._count = 0
+        self._claims = _Claims()
+        self._section = b""
+        self._in_section = 0
         self._end_of_map = False
         self.done = False
         self.has_map = True
@@ -85,33 +130,60 @@ class MapTextAssembler:
             raise ReplyAlreadyComplete("getMap reply already complete")
         if not payload:
             self.done = True
-            self.has_map = bool(self._lines)
+            self.has_map = self._count > 0
             return True
         if self._end_of_map:
             raise PayloadError("getMap: only the final empty packet may follow the end of the map")
-        line = _text(payload)
-        if line == "":
+        end = payload.find(b"\0")
+        line = payload if end < 0 else payload[:end]  # an unterminated string runs to the end
+        if not line:
             self._end_of_map = True
-            if not self._lines:  # no map: ARIA sends only this packet
+            if not self._count:  # no map: ARIA sends only this packet
                 self.has_map = False
                 self.done = True
             return self.done
-        if len(self._lines) >= self.max_lines:
+        if self._count >= self.max_lines:
             raise MapTooLarge(f"getMap: more than {self.max_lines} lines")
-        self._bytes += len(payload)
-        if self._bytes > self.max_bytes:
+        if len(self._text) + len(line) + 1 > self.max_bytes:
             raise MapTooLarge(f"getMap: more than {self.max_bytes} bytes of text")
-        self._lines.append(line)
+        if b"\n" in line or b"\r" in line:
+            raise PayloadError(f"getMap: line {self._count + 1} contains a line break")
+        self._check_claims(line)
+        if self._count:
+            self._text += b"\n"
+        self._text += line
+        self._count += 1
         return False
+
+    def _check_claims(self, line: bytes) -> None:
+        if line in (b"LINES", b"DATA"):
+            self._section, self._in_section = line, 0
+            return
+        if not self._section:
+            self._claims.note(line)
+            return
+        if line[:1].isalpha() and b":" not in line and b" " not in line:
+            self._section = b""  # another (scan-prefixed) section: only the absolute caps apply
+            return
+        self._in_section += 1
+        claimed, what = (
+            (self._claims.points, "points") if self._section == b"DATA" else (self._claims.lines, "lines")
+        )
+        if _Claims.over(claimed, self._in_section):
+            raise MapTooLarge(f"getMap: more {what} than the map's header says ({claimed})")
+
+    @property
+    def line_count(self) -> int:
+        return self._count
 
     @property
     def lines(self) -> list[str]:
-        return self._lines
+        return TextMap(bytes(self._text), self._count).lines
 
     def result(self) -> TextMap:
         if not self.done:
             raise PayloadError("getMap reply is not complete yet")
-        return TextMap(self._lines, self.has_map)
+        return TextMap(bytes(self._text), self._count, self.has_map)
 
 
 def map_text_payloads(lines: Iterable[str] | None) -> list[bytes]:
@@ -186,7 +258,7 @@ class MapBinaryAssembler:
         max_points: int = DEFAULT_MAX_POINTS,
         max_segments: int = DEFAULT_MAX_SEGMENTS,
         max_header_lines: int = DEFAULT_MAX_HEADER_LINES,
-        max_header_bytes: int = DEFAULT_MAX_TEXT_BYTES,
+        max_header_bytes: int = DEFAULT_MAX_HEADER_BYTES,
     ) -> None:
         self.max_points = max_points
         self.max_segments = max_segments
@@ -198,6 +270,9 @@ class MapBinaryAssembler:
         self._point_chunks: list[bytes] = []
         self.segment_count = 0
         self.point_count = 0
+        self._claims = _Claims()
+        self._claimed_section = False
+        self._section_count = 0
         self._state = _State.HEADER
         self.has_map = True
 
@@ -236,6 +311,8 @@ class MapBinaryAssembler:
         section = _section(text)
         if section is not None:
             self._state = section
+            self._claimed_section = text in ("LINES", "DATA")  # a scan's own section: no claim
+            self._section_count = 0
             return False
         if state is not _State.HEADER:
             raise PayloadError(f"getMapBinary: unexpected text after the geometry: {text[:40]!r}")
@@ -245,6 +322,7 @@ class MapBinaryAssembler:
         if self._header_bytes > self.max_header_bytes:
             raise MapTooLarge(f"getMapBinary: more than {self.max_header_bytes} bytes of header")
         self.header_lines.append(text)
+        self._claims.note(text)
         return False
 
     def _block(self, payload: bytes, state: _State) -> None:
@@ -262,6 +340,12 @@ class MapBinaryAssembler:
                 raise MapTooLarge(f"getMapBinary: more than {self.max_points} points")
             self.point_count += n
             chunks = self._point_chunks
+        self._section_count += n
+        if self._claimed_section:
+            claimed = self._claims.lines if state is _State.SEGMENTS else self._claims.points
+            if _Claims.over(claimed, self._section_count):
+                what = "line segments" if state is _State.SEGMENTS else "points"
+                raise MapTooLarge(f"getMapBinary: more {what} than the map's header says ({claimed})")
         if n == 0:
             self._state = _State.BETWEEN
         else:
