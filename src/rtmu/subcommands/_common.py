@@ -373,9 +373,12 @@ def _silence_stdout() -> None:
 
 
 def print_json(obj: Any) -> None:
+    """One JSON line: the exact strings, with characters that act on a terminal as ``\\uXXXX``."""
     import json
 
-    print(json.dumps(obj, separators=(",", ":"), ensure_ascii=False), flush=True)
+    from ..textsafe import json_safe
+
+    print(json_safe(json.dumps(obj, separators=(",", ":"), ensure_ascii=False)), flush=True)
 
 
 STATUS_KEYS = ("x", "y", "th", "vel", "rot_vel", "battery_v", "status", "mode")

@@ -30,6 +30,7 @@ from ..session_decoder import (
     Session,
     TrailingDrops,
 )
+from ..textsafe import json_safe, visible
 
 EXIT_OK = 0
 EXIT_UNREADABLE = 1
@@ -135,10 +136,10 @@ def run(args: argparse.Namespace) -> int:
     try:
         source = open_capture(args.file, args.format, args.direction)
     except UnreadableInput as exc:
-        print(f"rtmu decode: {exc}", file=sys.stderr)
+        print(f"rtmu decode: {visible(exc)}", file=sys.stderr)
         return EXIT_UNREADABLE
     except CaptureError as exc:
-        print(f"rtmu decode: {exc}", file=sys.stderr)
+        print(f"rtmu decode: {visible(exc)}", file=sys.stderr)
         return EXIT_UNRECOGNISED
     decoder = CaptureDecoder(report_trailing_drops=args.json)
     summary = args.summary if args.summary is not None else not args.json
@@ -156,17 +157,17 @@ def run(args: argparse.Namespace) -> int:
                 _write_text_summary(out, decoder, source, full=args.all)
         out.flush()
     except UnreadableInput as exc:
-        print(f"rtmu decode: {exc}", file=sys.stderr)
+        print(f"rtmu decode: {visible(exc)}", file=sys.stderr)
         return EXIT_UNREADABLE
     except CaptureError as exc:
-        print(f"rtmu decode: {exc}", file=sys.stderr)
+        print(f"rtmu decode: {visible(exc)}", file=sys.stderr)
         return EXIT_UNRECOGNISED
     except BrokenPipeError:  # `rtmu decode x | head`: the reader has seen enough
         devnull = os.open(os.devnull, os.O_WRONLY)
         os.dup2(devnull, sys.stdout.fileno())
         return EXIT_OK
     for warning in source.stats.warnings:
-        print(f"rtmu decode: warning: {warning}", file=sys.stderr)
+        print(f"rtmu decode: warning: {visible(warning)}", file=sys.stderr)
     return EXIT_OK
 
 
@@ -235,11 +236,15 @@ def trailing_drops_json(drops: TrailingDrops, source: CaptureSource) -> dict[str
 
 def _dumps(record: dict[str, Any]) -> str:
     try:
-        return json.dumps(
-            record, ensure_ascii=False, separators=(",", ":"), allow_nan=False, default=_json_default
+        return json_safe(
+            json.dumps(
+                record, ensure_ascii=False, separators=(",", ":"), allow_nan=False, default=_json_default
+            )
         )
     except ValueError:  # an infinity (ARIA's "INF" doubles): spell it as ARIA does
-        return json.dumps(_finite(record), ensure_ascii=False, separators=(",", ":"), default=_json_default)
+        return json_safe(
+            json.dumps(_finite(record), ensure_ascii=False, separators=(",", ":"), default=_json_default)
+        )
 
 
 def _json_default(value: Any) -> Any:
@@ -394,7 +399,7 @@ class _TextWriter:
         self.flush()
 
     def _emit(self, line: str) -> None:
-        self.lines.append(line)
+        self.lines.append(visible(line))  # packet strings come from the capture: untrusted text
         if len(self.lines) >= 2048:
             self.flush()
 
@@ -438,7 +443,7 @@ def _write_text(
 ) -> None:
     writer = _TextWriter(out, source, full, payload)
     kind = source.kind
-    out.write(f"# {source.path.name}: {kind}{_link(source)}\n")
+    out.write(f"# {visible(source.path.name)}: {kind}{_link(source)}\n")
     out.write(
         f"# {'time':>8} {'conn':>3} dir transport cmd name{' ' * 21}length  "
         "fields (checksum ok unless marked)\n"
@@ -535,7 +540,7 @@ def _write_text_summary(out: TextIO, decoder: CaptureDecoder, source: CaptureSou
         (decoder.ignored_datagrams, "UDP datagrams were not ArNetworking (ignored)"),
     ]
     lines.extend(f"note: {n} {text}" for n, text in notes if n)
-    out.write("\n".join(lines) + "\n")
+    out.write("\n".join(visible(line) for line in lines) + "\n")
 
 
 def _session_lines(session: Session, source: CaptureSource, full: bool) -> list[str]:

@@ -38,6 +38,7 @@ from ..protocol.fields import FieldReader, FieldWriter
 from ..protocol.packet import encode_packet
 from ..protocol.payloads import Side, decode_payload
 from ..protocol.payloads.robot import BatteryInfo, Update, UpdateNumbers, UpdateStrings
+from ..textsafe import visible
 from ._common import UsageError, add_connection_arguments, print_json, read_password
 
 READ_CHUNK = 65536
@@ -421,7 +422,7 @@ def handle(args: argparse.Namespace) -> int:
     try:
         password = read_password(args)
     except UsageError as exc:
-        print(f"rtmu doctor: {exc}", file=sys.stderr)
+        print(f"rtmu doctor: {visible(exc)}", file=sys.stderr)
         return EXIT_USAGE
     doctor = Doctor(host, port, args.user, password, args.protocol, args.timeout)
     try:
@@ -443,9 +444,9 @@ def handle(args: argparse.Namespace) -> int:
         return code
     print(f"rtmu doctor {host}:{port}" + (f" (user {args.user})" if args.user else ""))
     for s in doctor.steps:
-        print(f"  [{MARKS.get(s.result, s.result)}] {s.step.title}: {s.summary}")
+        print(f"  [{MARKS.get(s.result, s.result)}] {s.step.title}: {visible(s.summary)}")
         if s.advice:
-            print(f"         what to do: {s.advice}")
+            print(f"         what to do: {visible(s.advice)}")
     if failed is None:
         print("All steps passed: RTMU can connect to this robot.")
     else:

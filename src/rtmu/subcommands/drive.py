@@ -30,6 +30,7 @@ from ..client.errors import ClientError, NotSupported
 from ..guardian.handle import GuardianHandle, GuardianUnavailable, beat_network, start_ready
 from ..guardian.messages import Hello
 from ..protocol.payloads.drive import RatioDrive
+from ..textsafe import visible
 from ._common import (
     Interrupted,
     UsageError,
@@ -160,8 +161,8 @@ async def start_guardian(args: argparse.Namespace) -> GuardianHandle | None:
         return await start_ready(Hello(host, port, args.user, current_password(), args.timeout), args.timeout)
     except GuardianUnavailable as exc:
         print(
-            f"rtmu drive: warning: guardian not available ({exc}); if this process is killed or frozen, "
-            "only the server's 2 s watchdog stops the robot",
+            f"rtmu drive: warning: guardian not available ({visible(exc)}); if this process is killed "
+            "or frozen, only the server's 2 s watchdog stops the robot",
             file=sys.stderr,
             flush=True,
         )

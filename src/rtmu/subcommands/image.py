@@ -10,6 +10,7 @@ from typing import Any
 from ..cli import EXIT_CONNECTION, EXIT_OK
 from ..client.connection import AriaClient
 from ..client.errors import NotSupported
+from ..textsafe import visible
 from ._common import add_connection_arguments, fail, run_with_client
 
 MAX_SIDE = 8192
@@ -84,7 +85,7 @@ def handle(args: argparse.Namespace) -> int:
             return fail("image", f"{problem}; nothing saved", EXIT_CONNECTION)
         args.out.write_bytes(jpeg)
         size = f"{picture.width}x{picture.height}"  # type: ignore[attr-defined]
-        print(f"wrote {args.out}: {size}, {len(jpeg)} bytes from {source}", file=sys.stderr)
+        print(f"wrote {args.out}: {size}, {len(jpeg)} bytes from {visible(source)}", file=sys.stderr)
         return EXIT_OK
 
     return run_with_client("image", args, body)

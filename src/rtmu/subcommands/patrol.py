@@ -9,6 +9,7 @@ from typing import Any
 from ..cli import EXIT_OK, EXIT_USAGE
 from ..client import ld_data
 from ..client.connection import AriaClient
+from ..textsafe import visible
 from ._common import add_connection_arguments, run_with_client
 
 
@@ -27,7 +28,7 @@ def handle(args: argparse.Namespace) -> int:
     async def body(client: AriaClient) -> int:
         known = await ld_data.routes(client, args.timeout)
         if args.route not in known:
-            listed = ", ".join(known) or "none"
+            listed = visible(", ".join(known) or "none")
             print(f"rtmu patrol: no route {args.route!r} on this server (routes: {listed})", file=sys.stderr)
             return EXIT_USAGE
         ld_data.patrol(client, args.route)

@@ -8,6 +8,7 @@ from typing import Any
 from ..cli import EXIT_OK
 from ..client import ld_data
 from ..client.connection import AriaClient
+from ..textsafe import visible
 from ._common import add_connection_arguments, print_json, run_with_client
 
 
@@ -29,7 +30,7 @@ def handle(args: argparse.Namespace) -> int:
             print_json(list(names))
         else:
             for name in names:
-                print(name)
+                print(visible(name))
         return EXIT_OK
 
     return run_with_client("routes", args, body)
