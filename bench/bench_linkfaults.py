@@ -8,6 +8,9 @@ that instant minus the moment the proxy applied the fault (``safety.cli_drive_st
 same drive SIGSTOPped together with its guardian, stopped only by the simulator's 2 s ratioDrive
 watchdog, measured in this run.
 
+``safety.cli_drive_false_stops.fake_header`` counts trials in which one injected fake packet
+header stopped the drive within 6 s: the decoder resynchronises, so the right answer is 0.
+
 ``rtt_800ms`` includes the proxy's own 400 ms on the way to the server (the stop cannot arrive
 sooner); ``reset`` leaves nothing to carry a stop, so it measures the server's watchdog too.
 ``RTMU_LINKFAULT_TRIALS`` sets the trials per fault (default 5).
@@ -15,6 +18,7 @@ sooner); ``reset`` leaves nothing to carry a stop, so it measures the server's w
 
 from __future__ import annotations
 
+import contextlib
 import os
 import signal
 import statistics
@@ -37,9 +41,13 @@ GIVE_UP = 6.0
 
 FAULTS: dict[str, Callable[[FaultProxy], float]] = {
     "mute_to_client": lambda p: p.mute(TO_CLIENT),
-    "fake_header": lambda p: p.inject(FAKE_HEADER),
     "rtt_800ms": lambda p: p.delay(0.4),
     "reset": lambda p: p.reset(),
+}
+NOISE: dict[str, Callable[[FaultProxy], float]] = {
+    # Since the decoder drops a lying header once the stream visibly goes on without it, one fake
+    # header no longer stalls status: the drive must go on (a false stop resets the robot's mode).
+    "fake_header": lambda p: p.inject(FAKE_HEADER),
 }
 
 
@@ -75,7 +83,12 @@ def _trial(sim: SimThread, apply: Callable[[FaultProxy], float] | None) -> float
                 return None
             return (time.monotonic() - at) * 1000.0
         finally:
-            proc.kill()
+            # The guardian too, and SIGCONT first: a SIGSTOPped process never dies of a signal
+            # it cannot run, and an orphaned frozen guardian would linger after the bench.
+            for pid in (*_children(proc.pid), proc.pid):
+                for signum in (signal.SIGCONT, signal.SIGKILL):
+                    with contextlib.suppress(ProcessLookupError):
+                        os.kill(pid, signum)
             proc.wait()
             _wait(lambda: sim.snapshot().trans_ratio == 0, 3)
 
@@ -112,6 +125,9 @@ def run() -> list[Result]:
         for fault, apply in FAULTS.items():
             values = [v for v in (_trial(sim, apply) for _ in range(trials)) if v is not None]
             out += _stats(f"safety.cli_drive_stop_after_fault_ms.{fault}", values, baseline)
+        for noise, apply in NOISE.items():
+            stops = sum(1 for _ in range(trials) if _trial(sim, apply) is not None)
+            out.append(Result(f"safety.cli_drive_false_stops.{noise}", stops, "count"))
     return out
 
 
