@@ -16,7 +16,7 @@ from pathlib import Path
 
 import pytest
 
-from linkfaults import GARBAGE, TO_CLIENT, TO_SERVER, FaultProxy
+from linkfaults import FAKE_HEADER, GARBAGE, TO_CLIENT, TO_SERVER, FaultProxy
 from rtmu.model import LinkLevel, Phase
 from rtmu.sim import SimConfig, SimThread
 
@@ -163,5 +163,36 @@ def test_garbage_bytes_are_dropped_and_shown_without_a_false_stop(
     tip = gui.window.toolbar.cells["link"].get_tooltip_text() or ""
     gui.shot("garbage-still-driving")
     assert "bad packets dropped" in tip
+    gui.keyup("Up")
+    pump(lambda: sim.snapshot().trans_ratio == 0, 3, "the release to stop the robot")
+
+
+def test_one_fake_packet_header_costs_no_reconnect(rig: tuple[Gui, SimThread, FaultProxy]) -> None:
+    """A header announcing a 32 000-byte packet once held every real packet behind it until the
+    link was called lost (a reconnect every time). Now the stream is seen going on without it:
+    the window stays connected on its one connection, answers, and never reconnects."""
+    gui, sim, proxy = rig
+    _hold_up_until_driving(gui, sim)
+
+    def sessions() -> set[int]:
+        return {id(s) for s in sim.call(lambda: list(sim.server.sessions))}  # type: ignore[union-attr]
+
+    pump(lambda: len(sessions()) == 2, 10, "the window's and its guardian's logins")
+    before = sessions()
+    proxy.inject(FAKE_HEADER)
+    phases: set[Phase] = set()
+    levels: set[LinkLevel] = set()
+    end = time.monotonic() + 3.0  # longer than the 2 s after which a silent link is called lost
+
+    def watch() -> bool:
+        phases.add(gui.phase)
+        levels.add(gui.model.health.value.level)
+        return time.monotonic() > end
+
+    pump(watch, 6, "three seconds of watching the link")
+    gui.shot("fake-header-still-connected")
+    assert phases == {Phase.CONNECTED}, f"the window left CONNECTED: {phases}"
+    assert LinkLevel.LOST not in levels and LinkLevel.DOWN not in levels, levels
+    assert sessions() == before, "a connection was dropped or a new one made"
     gui.keyup("Up")
     pump(lambda: sim.snapshot().trans_ratio == 0, 3, "the release to stop the robot")
