@@ -147,6 +147,14 @@ class RobotState:
     """Route names (``getRoutes``, LD robots)."""
     data_store: tuple[tuple[str, str], ...] = ()
     """(data name, value) of every listed ``DataStore_*`` string, sorted by name."""
+    goals: tuple[str, ...] = ()
+    """The map's goal names (``getGoals``), asked for where ``gotoRouteGoal`` is listed (LD robots)."""
+    loc_score: int | None = None
+    """Localization score 0–100 from ``DataStore_Localization_Score``; None if not offered."""
+    goal_distance_mm: int | None = None
+    """Distance left to the goal from ``DataStore_Distance_To_Goal`` (0: no goal); None if not offered."""
+    closest_obstacle_mm: int | None = None
+    """``DataStore_Closest_Obstacle``; None if not offered or nothing in range."""
 
     @property
     def battery_pct(self) -> float | None:

@@ -60,6 +60,29 @@ def test_patrol_sends_the_route_and_refuses_an_unknown_one(
     assert _state(aram).patrols[before:] == [ROUTES[2]]
 
 
+def test_goto_sends_a_route_goal_and_refuses_an_unknown_one(
+    aram: SimThread, capsys: pytest.CaptureFixture[str]
+) -> None:
+    before = len(_state(aram).route_goals)
+    assert main(["goto", addr(aram), "Lab A", "--timeout", "5"]) == EXIT_OK
+    eventually(lambda: _state(aram).route_goals[before:] == ["Lab A"])
+    assert main(["goto", addr(aram), "Nowhere", "--timeout", "5"]) == EXIT_USAGE
+    err = capsys.readouterr().err
+    assert "no goal 'Nowhere'" in err and "Lab A" in err
+    assert _state(aram).route_goals[before:] == ["Lab A"]
+
+
+def test_data_store_values_become_toolbar_fields() -> None:
+    assert ld_data.store_fields("DataStore_Localization_Score", "87.4") == {"loc_score": 87}
+    assert ld_data.store_fields("DataStore_WiFi_Quality", "35", "Wi-Fi link quality (0–70)") == {
+        "wifi_quality": 50
+    }
+    assert ld_data.store_fields("DataStore_WiFi_Quality", "35") == {"wifi_quality": 35}
+    assert ld_data.store_fields("DataStore_Distance_To_Goal", "12400") == {"goal_distance_mm": 12400}
+    assert ld_data.store_fields("DataStore_Closest_Obstacle", "none") == {"closest_obstacle_mm": None}
+    assert ld_data.store_fields("DataStore_Dock_State", "Docked") == {}
+
+
 def test_say_sends_the_text(aram: SimThread) -> None:
     assert main(["say", addr(aram), "Mind the gap", "--timeout", "5"]) == EXIT_OK
     eventually(lambda: "Mind the gap" in _state(aram).said)
@@ -91,6 +114,7 @@ def test_default_profile_offers_none_of_it(plain: SimThread, capsys: pytest.Capt
     assert main(["routes", addr(plain), "--timeout", "5"]) == EXIT_UNSUPPORTED
     assert main(["patrol", addr(plain), "Loop", "--timeout", "5"]) == EXIT_UNSUPPORTED
     assert main(["say", addr(plain), "hello", "--timeout", "5"]) == EXIT_UNSUPPORTED
+    assert main(["goto", addr(plain), "Lab A", "--timeout", "5"]) == EXIT_UNSUPPORTED
     capsys.readouterr()
     assert main(["status", addr(plain), "--once", "--json", "--timeout", "5"]) == EXIT_OK
     assert "dock" not in json.loads(capsys.readouterr().out)

@@ -76,3 +76,45 @@ def test_default_profile_hides_the_ld_controls(screenshots: Path, request: pytes
             gui.shot("default-profile")
         finally:
             gui.close()
+
+
+def test_route_goals_and_data_store_values_in_the_window(
+    screenshots: Path, request: pytest.FixtureRequest
+) -> None:
+    """gotoRouteGoal from the routes popover's goal list; DataStore_* values in the toolbar: the
+    localization score and closest obstacle in the mode cell's tooltip, the Wi-Fi gauge fed too."""
+    with SimThread(SimConfig(port=0, profile="aram", map_path=OFFICE_MAP)) as sim:
+        gui = Gui.start(screenshots, request.node.name, "127.0.0.1", sim.port)
+        try:
+            window, robot = gui.window, gui.model.robot
+            panel = window.routes_panel
+            pump(lambda: len(panel.goal_rows) > 0, 5, "the map's goals in the routes panel")
+            goal = next(iter(panel.goal_rows))
+            panel.popup()
+            gui.shot("route-goals")
+            gui.click(panel.goal_rows[goal])
+            pump(lambda: _sim_state(sim).route_goals == [goal], 5, "gotoRouteGoal at the simulator")
+
+            pump(lambda: robot.value.loc_score == 100, 5, "the localization score from the data store")
+            assert robot.value.wifi_quality is not None
+            mode = window.toolbar.cells["mode"]
+            pump(lambda: "Localization score: 100 %" in (mode.get_tooltip_text() or ""), 5, "the tooltip")
+            assert "Closest obstacle:" in (mode.get_tooltip_text() or "")
+        finally:
+            gui.close()
+
+
+def test_without_data_store_values_the_toolbar_says_nothing_of_them(
+    screenshots: Path, request: pytest.FixtureRequest
+) -> None:
+    with SimThread(SimConfig(port=0, map_path=OFFICE_MAP)) as sim:
+        gui = Gui.start(screenshots, request.node.name, "127.0.0.1", sim.port)
+        try:
+            mode = gui.window.toolbar.cells["mode"]
+            pump(lambda: bool(mode.get_tooltip_text()), 5, "the mode cell's tooltip")
+            gui.shot("no-data-store")
+            assert "Localization score" not in (mode.get_tooltip_text() or "")
+            assert gui.model.robot.value.loc_score is None and gui.model.robot.value.goals == ()
+            assert not gui.window.routes_panel.get_visible()
+        finally:
+            gui.close()

@@ -7,7 +7,18 @@ does not list the data, so a serverDemo-like server is never asked for any of it
 
 from __future__ import annotations
 
-from ..protocol.payloads.ld import DATA_STORE_PREFIX, DataStoreValue, DockInfo, Patrol, Routes, Say
+import re
+
+from ..protocol.payloads.ld import (
+    DATA_STORE_PREFIX,
+    DataStoreValue,
+    DockInfo,
+    GotoRouteGoal,
+    Patrol,
+    Routes,
+    Say,
+)
+from ..protocol.payloads.map import Goals
 from .connection import AriaClient
 from .errors import MalformedReply, NotSupported
 
@@ -33,6 +44,23 @@ async def routes(client: AriaClient, timeout: float) -> tuple[str, ...]:
     if not isinstance(reply, Routes):
         raise MalformedReply("getRoutes did not decode as route names")
     return reply.routes
+
+
+async def goals(client: AriaClient, timeout: float) -> tuple[str, ...]:
+    """The map's goal names (``getGoals``); NotSupported when the server lists none."""
+    if not client.supports("getGoals"):
+        raise NotSupported("getGoals", "this server offers no goal list (getGoals)")
+    reply = (await client.request_once("getGoals", timeout=timeout)).decode()
+    if not isinstance(reply, Goals):
+        raise MalformedReply("getGoals did not decode as goal names")
+    return reply.goals
+
+
+def goto_route_goal(client: AriaClient, goal: str) -> None:
+    """Drive to ``goal`` (LD robots); NotSupported when the server has no ``gotoRouteGoal``."""
+    if not client.supports("gotoRouteGoal"):
+        raise NotSupported("gotoRouteGoal", "this server cannot drive to route goals (gotoRouteGoal)")
+    client.send("gotoRouteGoal", GotoRouteGoal(goal))
 
 
 def patrol(client: AriaClient, route: str) -> None:
@@ -65,3 +93,35 @@ async def data_store(client: AriaClient, timeout: float) -> dict[str, str]:
         if isinstance(value, DataStoreValue):
             out[name] = value.value
     return out
+
+
+_SCALE = re.compile(r"\(\s*0\s*[-–]\s*(\d+)\s*\)")
+"""A range in a data list description, e.g. "Wi-Fi link quality (0–70)"."""
+
+
+def store_fields(name: str, value: str, description: str = "") -> dict[str, int | None]:
+    """The :class:`~rtmu.model.RobotState` fields a ``DataStore_*`` value gives the toolbar.
+
+    Names as LD robots list them (``DataStore_Localization_Score``, ``DataStore_WiFi_Quality``,
+    ``DataStore_Distance_To_Goal``, ``DataStore_Closest_Obstacle``); anything else only goes to the
+    details table. Wi-Fi quality becomes % using the range in its description ("(0–70)": Linux's
+    link quality), else it is taken as % already. A value that is not a number clears the field.
+    """
+    key = name.lower()
+    try:
+        number: float | None = float(value.split()[0])
+    except (ValueError, IndexError):
+        number = None
+    if "localization_score" in key or "localisation_score" in key:
+        return {"loc_score": None if number is None else round(max(0.0, min(100.0, number)))}
+    if "wifi_quality" in key or "wi_fi_quality" in key:
+        if number is None:
+            return {"wifi_quality": None}
+        top = _SCALE.search(description)
+        scale = int(top.group(1)) if top and int(top.group(1)) > 0 else 100
+        return {"wifi_quality": round(max(0.0, min(100.0, number * 100 / scale)))}
+    if "distance_to_goal" in key:
+        return {"goal_distance_mm": None if number is None else max(0, round(number))}
+    if "closest_obstacle" in key:
+        return {"closest_obstacle_mm": None if number is None else max(0, round(number))}
+    return {}

@@ -14,10 +14,11 @@ from typing import Any
 
 from ..protocol.errors import ProtocolError
 from ..protocol.payloads.ld import DataStoreValue, DockInfo, Routes
+from ..protocol.payloads.map import Goals
 from ..protocol.payloads.sensors import RangeDeviceReadings
 from .connection import AriaClient, Packet
 from .errors import ClientError
-from .ld_data import LASER_NAMES, data_store_names
+from .ld_data import LASER_NAMES, data_store_names, store_fields
 
 LASER_INTERVAL_MS = 200
 DATA_STORE_INTERVAL_MS = 1000
@@ -39,6 +40,7 @@ class LdFeed:
         self._timeout = reply_timeout
         self._lasers: dict[str, tuple[tuple[int, int], ...]] = {}
         self._store: dict[str, str] = {}
+        self._descriptions: dict[str, str] = {}
 
     def subscribe(self, client: AriaClient) -> None:
         """Subscribe to what the server lists (called after every login)."""
@@ -53,18 +55,26 @@ class LdFeed:
             client.request("dockInfoChanged", -1, self._on_dock)
         if client.supports("routesUpdated") and client.supports("getRoutes"):
             client.request("routesUpdated", -1, lambda packet: self._refetch_routes(client))
+        if client.supports("goalsUpdated") and client.supports("gotoRouteGoal"):
+            client.request("goalsUpdated", -1, lambda packet: self._refetch_routes(client))
+        self._descriptions = {e.name: e.description for e in client.datalist}
         for name in data_store_names(client):
             client.request(name, DATA_STORE_INTERVAL_MS, self._on_store)
 
     async def fetch(self, client: AriaClient) -> None:
-        """One-off questions after login: the route list."""
-        if not client.supports("getRoutes"):
-            return
-        with contextlib.suppress(ClientError, ProtocolError):
-            reply = await client.request_once("getRoutes", timeout=self._timeout)
-            routes = self._decode("getRoutes", reply.payload)
-            if isinstance(routes, Routes):
-                self._update(routes=routes.routes)
+        """One-off questions after login: the route list, and the goals ``gotoRouteGoal`` can reach."""
+        if client.supports("getRoutes"):
+            with contextlib.suppress(ClientError, ProtocolError):
+                reply = await client.request_once("getRoutes", timeout=self._timeout)
+                routes = self._decode("getRoutes", reply.payload)
+                if isinstance(routes, Routes):
+                    self._update(routes=routes.routes)
+        if client.supports("gotoRouteGoal") and client.supports("getGoals"):
+            with contextlib.suppress(ClientError, ProtocolError):
+                reply = await client.request_once("getGoals", timeout=self._timeout)
+                goals = self._decode("getGoals", reply.payload)
+                if isinstance(goals, Goals):
+                    self._update(goals=goals.goals)
 
     def _refetch_routes(self, client: AriaClient) -> None:
         self._spawn(self.fetch(client), "ld-routes")
@@ -85,4 +95,5 @@ class LdFeed:
         value = self._decode(packet.name, packet.payload)
         if isinstance(value, DataStoreValue) and self._store.get(packet.name) != value.value:
             self._store[packet.name] = value.value
-            self._update(data_store=tuple(sorted(self._store.items())))
+            fields = store_fields(packet.name, value.value, self._descriptions.get(packet.name, ""))
+            self._update(data_store=tuple(sorted(self._store.items())), **fields)

@@ -24,6 +24,7 @@ from rtmu.protocol.payloads.ld import (
     DockInfo,
     DockInfoChanged,
     DockState,
+    GotoRouteGoal,
     Patrol,
     Routes,
     Say,
@@ -58,6 +59,8 @@ class LdState:
     since: float = 0.0
     """Simulated time the current dock transition started."""
     patrols: list[str] = field(default_factory=list)
+    route_goals: list[str] = field(default_factory=list)
+    """Goals asked for with ``gotoRouteGoal`` (recorded; the simulator does not navigate)."""
     said: list[str] = field(default_factory=list)
 
 
@@ -151,6 +154,15 @@ def _patrol(call: Call) -> Iterable[Reply]:
         return ()
     if route in ROUTES:
         ld_state(call.server).patrols.append(route)
+    return ()
+
+
+def _goto_route_goal(call: Call) -> Iterable[Reply]:
+    try:
+        goal = GotoRouteGoal.decode(call.args).goal
+    except (FieldUnderrun, PayloadError, ValueError):
+        return ()
+    ld_state(call.server).route_goals.append(goal)
     return ()
 
 
@@ -265,6 +277,7 @@ HANDLERS: dict[str, Handler] = {
     "dockInfo": _dock_info,
     "getRoutes": _routes,
     "patrol": _patrol,
+    "gotoRouteGoal": _goto_route_goal,
     "say": _say,
     **dict.fromkeys(DATA_STORE, _data_store),
 }

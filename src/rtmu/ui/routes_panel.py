@@ -1,9 +1,11 @@
-"""The routes button of LD robots: a header-bar button whose popover lists the server's routes.
+"""The routes button of LD robots: a header-bar button whose popover lists routes and goals.
 
-Shown only while the connected server lists ``getRoutes``; each route has a Patrol button that
-sends ``patrol`` (only when listed, too). The popover holds buttons only, no text fields, so the
-window's drive keys keep working as everywhere else. Route names come from the model
-(``RobotState.routes``), which the session fills from ``getRoutes`` / ``routesUpdated``.
+Shown only while the connected server lists ``getRoutes`` or ``gotoRouteGoal``. Each route has a
+Patrol button that sends ``patrol`` (only when listed, too); each of the map's goals (``getGoals``,
+asked for only where ``gotoRouteGoal`` is listed) has a Go button that sends ``gotoRouteGoal``.
+The popover holds buttons only, no text fields, so the window's drive keys keep working as
+everywhere else. Names come from the model (``RobotState.routes`` / ``goals``), which the session
+fills from ``getRoutes`` / ``routesUpdated`` and ``getGoals`` / ``goalsUpdated``.
 """
 
 from __future__ import annotations
@@ -16,7 +18,7 @@ gi.require_version("Gtk", "4.0")
 from gi.repository import Gtk  # noqa: E402
 
 from ..model import ConnectionState, Model, Phase, RobotState  # noqa: E402
-from ..protocol.payloads.ld import Patrol  # noqa: E402
+from ..protocol.payloads.ld import GotoRouteGoal, Patrol  # noqa: E402
 
 Send = Callable[[str, object], None]
 """``send(data name, payload)``: a fire-and-forget request through the controller's link."""
@@ -40,16 +42,18 @@ class RoutesPanel(Gtk.MenuButton):
         self.empty.add_css_class("dim-label")
         self.rows: dict[str, Gtk.Button] = {}
         """Route name → its Patrol button (what is shown now)."""
+        self.goal_rows: dict[str, Gtk.Button] = {}
+        """Goal name → its Go button (``gotoRouteGoal``)."""
         popover = Gtk.Popover()
         popover.set_child(self.list)
         self.set_popover(popover)
-        self._shown: tuple[str, ...] | None = None
+        self._shown: tuple[tuple[str, ...], tuple[str, ...]] | None = None
         self._unobserve = [
             model.robot.observe(self._on_robot),
             model.connection.observe(self._on_connection),
         ]
         self._on_connection(ConnectionState(), model.connection.value)
-        self._fill(model.robot.value.routes)
+        self._fill(model.robot.value.routes, model.robot.value.goals)
 
     def close(self) -> None:
         for remove in self._unobserve:
@@ -57,26 +61,29 @@ class RoutesPanel(Gtk.MenuButton):
         self._unobserve = []
 
     def _on_connection(self, _old: ConnectionState, new: ConnectionState) -> None:
-        offered = new.phase is Phase.CONNECTED and "getRoutes" in new.offers
-        self.set_visible(offered)
-        can_patrol = offered and "patrol" in new.offers
+        connected = new.phase is Phase.CONNECTED
+        self.set_visible(connected and ("getRoutes" in new.offers or "gotoRouteGoal" in new.offers))
         for button in self.rows.values():
-            button.set_sensitive(can_patrol)
+            button.set_sensitive(connected and "patrol" in new.offers)
+        for button in self.goal_rows.values():
+            button.set_sensitive(connected and "gotoRouteGoal" in new.offers)
 
     def _on_robot(self, old: RobotState, new: RobotState) -> None:
-        if new.routes != old.routes:
-            self._fill(new.routes)
+        if new.routes != old.routes or new.goals != old.goals:
+            self._fill(new.routes, new.goals)
 
-    def _fill(self, routes: tuple[str, ...]) -> None:
-        if routes == self._shown:
+    def _fill(self, routes: tuple[str, ...], goals: tuple[str, ...] = ()) -> None:
+        if (routes, goals) == self._shown:
             return
-        self._shown = routes
+        self._shown = (routes, goals)
         child = self.list.get_first_child()
         while child is not None:
             nxt = child.get_next_sibling()
             self.list.remove(child)
             child = nxt
         self.rows = {}
+        self.goal_rows = {}
+        self._fill_goals(goals)
         if not routes:
             self.list.append(self.empty)
             return
@@ -92,6 +99,34 @@ class RoutesPanel(Gtk.MenuButton):
             row.append(button)
             self.list.append(row)
             self.rows[name] = button
+
+    def _fill_goals(self, goals: tuple[str, ...]) -> None:
+        if not goals:
+            return
+        title = Gtk.Label(label="Goals", xalign=0.0)
+        title.add_css_class("heading")
+        self.list.append(title)
+        can_go = "gotoRouteGoal" in self.model.connection.value.offers
+        for name in goals:
+            row = Gtk.Box(spacing=8)
+            button = Gtk.Button.new_with_label("Go")
+            button.set_tooltip_text(f"Drive to the goal {name!r} (the robot drives by itself; STOP ends it)")
+            button.set_sensitive(can_go)
+            button.connect("clicked", lambda _b, n=name: self.go_to_goal(n))
+            row.append(Gtk.Label(label=name, xalign=0.0, hexpand=True))
+            row.append(button)
+            self.list.append(row)
+            self.goal_rows[name] = button
+        routes_title = Gtk.Label(label="Routes", xalign=0.0)
+        routes_title.add_css_class("heading")
+        self.list.append(routes_title)
+
+    def go_to_goal(self, goal: str) -> None:
+        if "gotoRouteGoal" in self.model.connection.value.offers:
+            self._send("gotoRouteGoal", GotoRouteGoal(goal))
+            popover = self.get_popover()
+            if popover is not None:
+                popover.popdown()
 
     def patrol(self, route: str) -> None:
         if "patrol" in self.model.connection.value.offers:

@@ -24,6 +24,7 @@ from gi.repository import GLib, Gtk  # noqa: E402
 
 from ..model import ConnectionState, LinkLevel, Model, Phase  # noqa: E402
 from .gauges import BatteryGauge, WifiGauge, battery_fraction, wifi_bars  # noqa: E402
+from .ld_status import details_lines, goal_suffix  # noqa: E402
 
 STALE_AFTER = 1.0
 """Seconds after which a pose/battery value is shown as stale (status arrives at 10 Hz)."""
@@ -194,7 +195,8 @@ class StatusToolbar(Gtk.ScrolledWindow):
         self._wifi(robot, have and link_ok, why)
         strings_known = robot.strings_at is not None and (robot.mode or robot.status)
         mode = robot.mode if robot.status in ("", robot.mode) else f"{robot.mode} · {robot.status}"
-        mode_tip = robot.extended_status or mode
+        mode_tip = "\n".join([robot.extended_status or mode, *details_lines(robot)])
+        mode += goal_suffix(robot)
         c["mode"].show_value(
             mode if strings_known else DASH,
             stale=not strings_known or not link_ok,
