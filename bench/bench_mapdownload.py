@@ -5,7 +5,7 @@ honest header (``NumPoints: 2``) the client stops just past the header's own cou
 (``NumPoints: 100000000``) only the absolute caps stop it (1 M text lines, 5 M binary points).
 
 - ``maps.endless_map_cap_s.<case>``: ``rtmu map`` from start to its exit (code 3), as a process.
-- ``maps.endless_map_peak_mb.<case>``: that process's peak resident memory (kernel ``ru_maxrss``);
+- ``maps.endless_map_peak_mb.<case>``: that process's peak resident memory (its own ``VmHWM``);
   baseline: the same command downloading a normal map in this run.
 - ``maps.window_endless_map_peak_mb``: the real window (own Xvfb) connected to the lying binary
   server for 15 s, peak resident memory (``VmHWM``); baseline: the window against a normal server.
@@ -24,7 +24,7 @@ from bench.common import Result
 
 REPO = Path(__file__).resolve().parents[1]
 sys.path.insert(0, str(REPO / "tests"))
-from client.endless_maps import endless_map_server  # noqa: E402
+from client.endless_maps import endless_map_server, run_watching_peak  # noqa: E402
 from client.servers import ServerThread, TestServer  # noqa: E402
 
 LYING = 100_000_000
@@ -40,13 +40,10 @@ def _rtmu_map(server: TestServer) -> tuple[float, float, int]:
     """Seconds, peak MB and exit code of one ``rtmu map`` against ``server``."""
     with ServerThread(server) as running, tempfile.TemporaryDirectory() as tmp:
         start = time.monotonic()
-        proc = subprocess.Popen(
-            [sys.executable, "-m", "rtmu", "map", f"127.0.0.1:{running.port}", "--out", f"{tmp}/m.map"],
-            stdout=subprocess.DEVNULL,
-            stderr=subprocess.DEVNULL,
+        code, peak, _err = run_watching_peak(
+            [sys.executable, "-m", "rtmu", "map", f"127.0.0.1:{running.port}", "--out", f"{tmp}/m.map"]
         )
-        _pid, status, usage = os.wait4(proc.pid, 0)
-        return time.monotonic() - start, usage.ru_maxrss / 1024, os.waitstatus_to_exitcode(status)
+        return time.monotonic() - start, peak, code
 
 
 def _window_peak_mb(server: TestServer) -> float:

@@ -9,6 +9,7 @@ from __future__ import annotations
 
 import asyncio
 import contextlib
+import time
 
 from rtmu.protocol.fields import FieldWriter
 from rtmu.protocol.payloads.map import MapId
@@ -77,3 +78,37 @@ async def _forever(side: ServerSide, name: str, kind: str, claim: int | None) ->
         while not writer.is_closing():
             writer.write(batch)
             await writer.drain()
+
+
+def run_watching_peak(argv: list[str], poll: float = 0.005) -> tuple[int, float, str]:
+    """Run ``argv``; its exit code, peak resident MB and stderr.
+
+    The peak is the kernel's ``VmHWM`` of the program itself, read until it exits. Why not
+    ``ru_maxrss`` from ``wait4``: for a child forked from a big process (pytest, the bench) Linux
+    keeps the high-water mark from before ``exec``, so every figure would read as the parent's size.
+    """
+    import subprocess
+    import threading
+
+    proc = subprocess.Popen(argv, stdout=subprocess.DEVNULL, stderr=subprocess.PIPE, text=True)
+    err: list[str] = []
+    reader = threading.Thread(target=lambda: err.append(proc.stderr.read()), daemon=True)  # type: ignore[union-attr]
+    reader.start()
+    peak_kb = 0
+    try:
+        while proc.poll() is None:
+            try:
+                with open(f"/proc/{proc.pid}/status") as f:
+                    for line in f:
+                        if line.startswith("VmHWM:"):
+                            peak_kb = max(peak_kb, int(line.split()[1]))
+            except (OSError, ValueError):
+                pass
+            time.sleep(poll)
+        proc.wait()
+    finally:
+        if proc.poll() is None:
+            proc.kill()
+            proc.wait()
+    reader.join(5)
+    return proc.returncode, peak_kb / 1024, "".join(err)

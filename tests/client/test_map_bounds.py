@@ -8,8 +8,6 @@ time to reach the caps is a figure of ``bench/bench_mapdownload.py``, not assert
 from __future__ import annotations
 
 import asyncio
-import os
-import subprocess
 import sys
 from pathlib import Path
 
@@ -20,7 +18,7 @@ from rtmu.client.session import Session, SessionConfig
 from rtmu.model import LinkHealth, LinkLevel
 from rtmu.protocol.payloads.mapstream import DEFAULT_MAX_POINTS, DEFAULT_MAX_TEXT_LINES
 
-from .endless_maps import endless_map_server
+from .endless_maps import endless_map_server, run_watching_peak
 from .servers import ServerThread, TestServer, run
 
 EXIT_PROTOCOL = 3
@@ -28,20 +26,9 @@ BOUND_MB = 150
 
 
 def _rtmu_map(port: int, out: Path) -> tuple[int, float, str]:
-    """Exit code, peak resident MB and stderr of one ``rtmu map`` run."""
-    proc = subprocess.Popen(
-        [sys.executable, "-m", "rtmu", "map", f"127.0.0.1:{port}", "--out", str(out), "--timeout", "5"],
-        stdout=subprocess.DEVNULL,
-        stderr=subprocess.PIPE,
-        text=True,
-    )
-    try:
-        _pid, status, usage = os.wait4(proc.pid, 0)
-    finally:
-        if proc.poll() is None:
-            proc.kill()
-    assert proc.stderr is not None
-    return os.waitstatus_to_exitcode(status), usage.ru_maxrss / 1024, proc.stderr.read()
+    """Exit code, peak resident MB (the program's own VmHWM) and stderr of one ``rtmu map`` run."""
+    argv = [sys.executable, "-m", "rtmu", "map", f"127.0.0.1:{port}", "--out", str(out), "--timeout", "5"]
+    return run_watching_peak(argv)
 
 
 def _normal_peak_mb(tmp_path: Path) -> float:
