@@ -20,7 +20,7 @@ import tempfile
 import time
 from pathlib import Path
 
-from bench.common import Result
+from bench.common import Result, end_process, start_xvfb
 
 REPO = Path(__file__).resolve().parents[1]
 sys.path.insert(0, str(REPO / "tests"))
@@ -47,9 +47,7 @@ def _rtmu_map(server: TestServer) -> tuple[float, float, int]:
 
 
 def _window_peak_mb(server: TestServer) -> float:
-    from bench.soak_window import _xvfb
-
-    xvfb, display = _xvfb()
+    xvfb, display = start_xvfb()
     env = dict(os.environ, DISPLAY=display, GDK_BACKEND="x11", GSK_RENDERER="cairo", NO_AT_BRIDGE="1")
     env.update(GSETTINGS_BACKEND="memory", XDG_CONFIG_HOME=tempfile.mkdtemp(prefix="rtmu-bench-"))
     try:
@@ -71,12 +69,7 @@ def _window_peak_mb(server: TestServer) -> float:
                                 peak = int(line.split()[1]) / 1024
                 return peak
             finally:
-                app.terminate()
-                try:
-                    app.wait(10)
-                except subprocess.TimeoutExpired:
-                    app.kill()
-                    app.wait(5)
+                end_process(app)
     finally:
         xvfb.terminate()
         xvfb.wait(5)

@@ -42,7 +42,7 @@ from pathlib import Path
 import cairo
 import numpy as np
 
-from bench.common import Result
+from bench.common import Result, start_xvfb
 from rtmu.maps import write_map
 from rtmu.sim.mapgen import generate_map
 from rtmu.ui import overlays
@@ -175,17 +175,10 @@ class _Display:
     def __enter__(self) -> str | None:
         if self.display or shutil.which("Xvfb") is None:
             return self.display
-        read_fd, write_fd = os.pipe()
-        self.proc = subprocess.Popen(
-            ["Xvfb", "-displayfd", str(write_fd), "-screen", "0", "1280x1024x24", "-nolisten", "tcp"],
-            pass_fds=(write_fd,),
-            stdout=subprocess.DEVNULL,
-            stderr=subprocess.DEVNULL,
-        )
-        os.close(write_fd)
-        with os.fdopen(read_fd) as pipe:
-            number = pipe.readline().strip()
-        self.display = f":{number}" if number else None
+        try:
+            self.proc, self.display = start_xvfb()
+        except RuntimeError:
+            self.display = None
         return self.display
 
     def __exit__(self, *exc: object) -> None:

@@ -156,6 +156,22 @@ def _rss_mb() -> float:
         return int(f.read().split()[1]) * os.sysconf("SC_PAGE_SIZE") / 2**20
 
 
+def drive_figures(
+    start: float, latencies: list[float], rss: list[tuple[float, float]], warmup: float
+) -> dict[str, Any]:
+    """The figures both soaks share: cycles, release→stop times, memory drift after warm-up."""
+    after_warmup = [(t, y) for t, y in rss if t >= warmup]
+    base = after_warmup[0][1] if after_warmup else rss[0][1]
+    return {
+        "seconds": time.monotonic() - start,
+        "cycles": len(latencies),
+        "release_to_stop_ms": [v * 1e3 for v in latencies],
+        "rss_drift_mb": rss[-1][1] - base,
+        "rss_slope_mb_per_h": _slope_per_hour(after_warmup),
+        "rss_mb": rss,
+    }
+
+
 def _pct(values: list[float], q: float) -> float:
     ordered = sorted(values)
     return ordered[min(len(ordered) - 1, round(q * (len(ordered) - 1)))]
@@ -217,15 +233,8 @@ def soak(seconds: float, *, seed: int = 1, progress: Callable[[str], None] | Non
                 )
         rss.append((time.monotonic() - start, _rss_mb()))
         client = runner.session.client if runner.session is not None else None
-        after_warmup = [(t, y) for t, y in rss if t >= warmup]
-        base = after_warmup[0][1] if after_warmup else rss[0][1]
         return {
-            "seconds": time.monotonic() - start,
-            "cycles": len(latencies),
-            "release_to_stop_ms": [v * 1e3 for v in latencies],
-            "rss_drift_mb": rss[-1][1] - base,
-            "rss_slope_mb_per_h": _slope_per_hour(after_warmup),
-            "rss_mb": rss,
+            **drive_figures(start, latencies, rss, warmup),
             "max_handler_ms": (client.max_handler_seconds * 1e3) if client is not None else float("nan"),
             "slow_handlers": client.slow_handlers if client is not None else -1,
             "max_loop_lag_ms": max_lag * 1e3,

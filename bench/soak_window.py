@@ -22,28 +22,12 @@ from collections.abc import Callable
 from pathlib import Path
 from typing import Any
 
-from bench.soak import HOLD, REST, RSS_EVERY, STOP_WAIT, _pct, _Server, _slope_per_hour
+from bench.common import end_process, start_xvfb
+from bench.soak import HOLD, REST, RSS_EVERY, STOP_WAIT, _pct, _Server, drive_figures
 
 KEY = "Left"
 """Turning in place: the robot never reaches a wall, so every stop is the release's."""
 SLOW = re.compile(r"the handler for (\S+) took (\d+) ms")
-
-
-def _xvfb() -> tuple[subprocess.Popen[bytes], str]:
-    read_fd, write_fd = os.pipe()
-    proc = subprocess.Popen(
-        ["Xvfb", "-displayfd", str(write_fd), "-screen", "0", "1280x1024x24", "-nolisten", "tcp"],
-        pass_fds=(write_fd,),
-        stdout=subprocess.DEVNULL,
-        stderr=subprocess.DEVNULL,
-    )
-    os.close(write_fd)
-    with os.fdopen(read_fd) as f:
-        display = f.readline().strip()
-    if not display:
-        proc.kill()
-        raise RuntimeError("Xvfb did not start")
-    return proc, f":{display}"
 
 
 def _xdotool(env: dict[str, str], *args: str) -> str:
@@ -63,7 +47,7 @@ def soak_window(
     """Run the window soak for ``seconds``; the same raw figures as :func:`bench.soak.soak`."""
     rng = random.Random(seed)
     server = _Server()
-    xvfb, display = _xvfb()
+    xvfb, display = start_xvfb()
     config = tempfile.mkdtemp(prefix="rtmu-soak-")
     env = dict(
         os.environ,
@@ -134,25 +118,13 @@ def soak_window(
                     f"rss {_rss_mb(app.pid):.1f} MB, slow handlers {len(slow)}"
                 )
         rss.append((time.monotonic() - start, _rss_mb(app.pid)))
-        after_warmup = [(t, y) for t, y in rss if t >= warmup]
-        base = after_warmup[0][1] if after_warmup else rss[0][1]
         return {
-            "seconds": time.monotonic() - start,
-            "cycles": len(latencies),
-            "release_to_stop_ms": [v * 1e3 for v in latencies],
-            "rss_drift_mb": rss[-1][1] - base,
-            "rss_slope_mb_per_h": _slope_per_hour(after_warmup),
-            "rss_mb": rss,
+            **drive_figures(start, latencies, rss, warmup),
             "slow_handlers": len(slow),
             "slow_handler_list": slow,
         }
     finally:
-        app.terminate()
-        try:
-            app.wait(10)
-        except subprocess.TimeoutExpired:
-            app.kill()
-            app.wait(5)
+        end_process(app)
         xvfb.terminate()
         xvfb.wait(5)
         server.close()

@@ -443,3 +443,17 @@ async def fetch_status(client: AriaClient, timeout: float) -> dict[str, Any]:
         soc = await battery_is_soc(client, timeout)
         return status_object(update.numbers, update.status, update.mode, soc=soc)
     raise NotSupported("updateNumbers", "this server offers no robot status (updateNumbers or update)")
+
+
+def unknown_name(command: str, kind: str, name: str, known: tuple[str, ...]) -> bool:
+    """True (with one line on stderr naming what the server does list) when ``name`` is not in
+    ``known``: a route or goal the server does not have is the user's mistake (exit 2)."""
+    if name in known:
+        return False
+    from ..textsafe import visible
+
+    listed = visible(", ".join(known) or "none")
+    print(
+        f"rtmu {command}: no {kind} {visible(repr(name))} on this server ({kind}s: {listed})", file=sys.stderr
+    )
+    return True

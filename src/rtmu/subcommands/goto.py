@@ -10,7 +10,7 @@ from ..cli import EXIT_OK, EXIT_USAGE
 from ..client import ld_data
 from ..client.connection import AriaClient
 from ..textsafe import visible
-from ._common import add_connection_arguments, run_with_client
+from ._common import add_connection_arguments, run_with_client, unknown_name
 
 
 def register(subparsers: Any) -> None:
@@ -30,9 +30,7 @@ def handle(args: argparse.Namespace) -> int:
         if not client.supports("gotoRouteGoal"):  # say so before asking for goals
             ld_data.goto_route_goal(client, args.goal)  # raises NotSupported (exit 4)
         known = await ld_data.goals(client, args.timeout)
-        if args.goal not in known:
-            listed = visible(", ".join(known) or "none")
-            print(f"rtmu goto: no goal {args.goal!r} on this map (goals: {listed})", file=sys.stderr)
+        if unknown_name("goto", "goal", args.goal, known):
             return EXIT_USAGE
         ld_data.goto_route_goal(client, args.goal)
         print(f"going to {visible(args.goal)}", file=sys.stderr)

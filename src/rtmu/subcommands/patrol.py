@@ -10,7 +10,7 @@ from ..cli import EXIT_OK, EXIT_USAGE
 from ..client import ld_data
 from ..client.connection import AriaClient
 from ..textsafe import visible
-from ._common import add_connection_arguments, run_with_client
+from ._common import add_connection_arguments, run_with_client, unknown_name
 
 
 def register(subparsers: Any) -> None:
@@ -27,12 +27,10 @@ def register(subparsers: Any) -> None:
 def handle(args: argparse.Namespace) -> int:
     async def body(client: AriaClient) -> int:
         known = await ld_data.routes(client, args.timeout)
-        if args.route not in known:
-            listed = visible(", ".join(known) or "none")
-            print(f"rtmu patrol: no route {args.route!r} on this server (routes: {listed})", file=sys.stderr)
+        if unknown_name("patrol", "route", args.route, known):
             return EXIT_USAGE
         ld_data.patrol(client, args.route)
-        print(f"patrolling {args.route}", file=sys.stderr)
+        print(f"patrolling {visible(args.route)}", file=sys.stderr)
         return EXIT_OK
 
     return run_with_client("patrol", args, body)
