@@ -30,6 +30,8 @@ OTHER_PACKAGES = [
     "xdotool",
     "openbox",
     "x11-utils",
+    "xxd",
+    "bsdextrautils",
 ]
 TOOLS = [
     "awk",
@@ -217,7 +219,7 @@ def test_a_ready_machine_asks_apt_nothing(tmp_path: Path) -> None:
     )
     result = machine.run()
     assert result.returncode == 0, result.stderr
-    assert "system packages present (13 checked)" in result.stdout
+    assert "system packages present (15 checked)" in result.stdout
     assert machine.apt_calls() == []
 
 
