@@ -34,7 +34,7 @@ from bench.common import Result
 from rtmu.client.lease import DriveRatios
 from rtmu.client.runner import ClientRunner
 from rtmu.client.session import SessionConfig
-from rtmu.model import Model, Phase
+from rtmu.model import Phase, RobotModel
 from rtmu.protocol.client_connection import ClientConnection, ClientState
 from rtmu.protocol.datalist import DataList
 from rtmu.protocol.events import RequestOnce, RequestReceived
@@ -42,6 +42,7 @@ from rtmu.protocol.packet import encode_packet
 from rtmu.protocol.payloads.drive import RatioDrive, SafeDrive
 from rtmu.protocol.payloads.robot import UpdateNumbers, UpdateStrings
 from rtmu.protocol.server_connection import ServerConnection
+from rtmu.state import RobotChanged, StateChange
 
 DRIVE_TRIALS = 400
 STATUS_SAMPLES = 600
@@ -158,7 +159,7 @@ def _ms(values: list[float]) -> tuple[float, float]:
 
 
 def _connected_runner(
-    port: int, model: Model, post: Callable[[Callable[[], None]], Any], **cfg: Any
+    port: int, model: RobotModel, post: Callable[[Callable[[], None]], Any], **cfg: Any
 ) -> ClientRunner:
     runner = ClientRunner(model, post=post, config=SessionConfig(fetch_map=False, **cfg)).start()
     runner.connect("127.0.0.1", port).result(10)
@@ -173,7 +174,7 @@ def _connected_runner(
 def drive_latency() -> list[Result]:
     server = _TimingServer().start()
     ui = _UiThread()
-    model = Model()
+    model = RobotModel()
     runner = _connected_runner(server.port, model, ui.post)
     got = threading.Event()
     stopped = threading.Event()
@@ -247,7 +248,7 @@ def _simple_send_latency(server: _TimingServer, got: threading.Event, arrival: d
 def status_latency() -> list[Result]:
     server = _TimingServer().start()
     ui = _UiThread()
-    model = Model()
+    model = RobotModel()
     to_model: list[float] = []
     to_tap: list[float] = []
     done = threading.Event()
@@ -260,9 +261,9 @@ def status_latency() -> list[Result]:
             if len(to_model) >= STATUS_SAMPLES:
                 done.set()
 
-    def tap(part: str, value: Any) -> None:
-        if part == "robot":
-            sent = server.sent_at.get(int(value.x))
+    def tap(change: StateChange) -> None:
+        if isinstance(change, RobotChanged):
+            sent = server.sent_at.get(int(change.value.x))
             if sent is not None:
                 to_tap.append(time.perf_counter() - sent)
 
@@ -305,7 +306,7 @@ def idle_cpu() -> list[Result]:
         if match is None:
             raise RuntimeError(f"the simulator did not say its port: {line!r}")
         ui = _UiThread()
-        model = Model()
+        model = RobotModel()
         runner = _connected_runner(int(match.group(1)), model, ui.post)
         try:
             time.sleep(1.0)  # map, infos, first pings

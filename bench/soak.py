@@ -39,7 +39,7 @@ from bench.common import Result
 from rtmu.client.lease import DriveRatios
 from rtmu.client.runner import LOOP_BEAT, ClientRunner
 from rtmu.client.session import SessionConfig
-from rtmu.model import Model, Phase
+from rtmu.model import Phase, RobotModel
 
 HOLD = (0.3, 1.5)
 REST = (0.2, 1.0)
@@ -192,7 +192,7 @@ def soak(seconds: float, *, seed: int = 1, progress: Callable[[str], None] | Non
     rng = random.Random(seed)
     server = _Server()
     ui = _UiThread()
-    model = Model()
+    model = RobotModel()
     runner = ClientRunner(model, post=ui.post, config=SessionConfig(fetch_map=True)).start()
     try:
         runner.connect("127.0.0.1", server.port).result(15)

@@ -17,7 +17,7 @@ from collections.abc import Iterator
 from dataclasses import dataclass
 from typing import TYPE_CHECKING, ClassVar, Protocol
 
-from .model import Phase
+from .state import Phase
 
 if TYPE_CHECKING:
     from .controller import Controller

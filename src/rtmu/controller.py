@@ -34,13 +34,14 @@ import contextlib
 import time
 from collections.abc import Callable, Mapping
 from dataclasses import replace
-from enum import Enum
 from typing import Protocol
 
 from .client.lease import DriveLease, DriveRatios, EndReason
 from .commands import COMMANDS, CommandRegistry, CommandState
-from .model import ZOOM_LEVELS, ConnectionState, LinkHealth, LinkLevel, Model, Phase, SpeedSetting
+from .model import ZOOM_LEVELS, OperatorState, RobotModel, SpeedSetting
+from .notices import Kind, Notice
 from .settings import Profile
+from .state import ConnectionState, LinkHealth, LinkLevel, Phase
 
 TICK = 0.1
 """Seconds between :meth:`Controller.tick` calls the UI timer should make (10 Hz renewal)."""
@@ -50,17 +51,11 @@ CURVE_ROT = 50.0
 DIRECTIONS = ("forward", "backward", "left", "right")
 
 
-class Notice(Enum):
-    INFO = "info"
-    WARNING = "warning"
-    ERROR = "error"
-
-
 class View(Protocol):
     """What the controller needs from a window (GTK, a test fake, or nothing at all)."""
 
-    def notify(self, level: Notice, text: str) -> None:
-        """Show a short message (banner/toast) to the operator."""
+    def notify(self, notice: Notice) -> None:
+        """Show a short message (banner/toast) to the operator; its kind says where."""
 
     def commands_changed(self, states: Mapping[str, CommandState]) -> None:
         """Enable/disable commands; ``states`` holds every command whose state changed."""
@@ -77,8 +72,8 @@ class ClientLink(Protocol):
     """
 
     lease: DriveLease
-    on_notice: Callable[[str, str], None] | None
-    """Set by the controller: ``on_notice(level, text)`` with level ``info``/``warning``/``error``."""
+    on_notice: Callable[[Notice], None] | None
+    """Set by the controller: the network side's messages for the operator."""
 
     def connect(
         self,
@@ -123,12 +118,30 @@ def ratios_for(held: set[str] | frozenset[str], throttle: float) -> DriveRatios:
     return DriveRatios(trans, rot, float(throttle))
 
 
+class NoView:
+    """The view of a controller no window shows (yet): notices and command states go nowhere."""
+
+    def notify(self, notice: Notice) -> None:
+        pass
+
+    def commands_changed(self, states: Mapping[str, CommandState]) -> None:
+        pass
+
+    def ask_password(self, profile: Profile, answer: Callable[[str | None], None]) -> None:
+        answer(None)
+
+
 class Controller:
-    """See the module notes. Construct once per window; call everything from the UI thread."""
+    """See the module notes. One per robot session; call everything from the UI thread.
+
+    ``robot`` is the robot's state, ``operator`` the speed and view choices of the window
+    (shared by every robot it shows); ``view`` may be replaced when another window shows it.
+    """
 
     def __init__(
         self,
-        model: Model,
+        robot: RobotModel,
+        operator: OperatorState,
         link: ClientLink,
         view: View,
         *,
@@ -137,7 +150,8 @@ class Controller:
         secrets: SecretStore | None = None,
         profile: Profile | None = None,
     ) -> None:
-        self.model = model
+        self.robot = robot
+        self.operator = operator
         self.link = link
         self.view = view
         self.clock = clock
@@ -154,24 +168,35 @@ class Controller:
         self._unfocused = False
         """Between focus loss and the next key press: releases seen then are not real key-ups."""
         link.on_notice = self._on_link_notice
-        model.connection.observe(self._on_connection)
-        model.health.observe(self._on_health)
+        self._unobserve = [
+            robot.connection.observe(self._on_connection),
+            robot.health.observe(self._on_health),
+        ]
         self.refresh_commands()
+
+    def close(self) -> None:
+        """Unhook from the model and the link (after the robot was stopped); idempotent."""
+        for remove in self._unobserve:
+            remove()
+        self._unobserve = []
+        if self.link.on_notice == self._on_link_notice:
+            self.link.on_notice = None
+        self.view = NoView()
 
     # -- CommandContext ----------------------------------------------------------------------
     @property
     def connected(self) -> bool:
-        return self.model.connection.value.connected
+        return self.robot.connection.value.connected
 
     def supports(self, name: str) -> bool:
-        return self.model.connection.value.supports(name)
+        return self.robot.connection.value.supports(name)
 
     def connection_phase(self) -> Phase:
-        return self.model.connection.value.phase
+        return self.robot.connection.value.phase
 
     def image_source(self) -> str | None:
         """The data a picture is requested with: the first getPicture…, else sendVideo, else None."""
-        offers = self.model.connection.value.offers
+        offers = self.robot.connection.value.offers
         pictures = sorted(n for n in offers if n.startswith("getPicture"))
         if pictures:
             return pictures[0]
@@ -183,7 +208,7 @@ class Controller:
         cmd = self.registry.get(name)
         reason = cmd.unavailable(self)
         if reason is not None:
-            self.view.notify(Notice.WARNING, f"{cmd.label}: {reason}")
+            self.view.notify(Notice.warning(Kind.COMMAND, f"{cmd.label}: {reason}"))
             return False
         cmd.activate(self)
         return True
@@ -239,7 +264,7 @@ class Controller:
             self._halt_held(reason)
 
     def _apply(self) -> None:
-        ratios = ratios_for(self._held, self.model.speed.value.percent)
+        ratios = ratios_for(self._held, self.operator.speed.value.percent)
         lease = self.link.lease
         if not ratios.moving:
             if self._generation is not None:
@@ -263,14 +288,16 @@ class Controller:
             self._generation = None
         if had and reason is EndReason.LAPSED:
             self.view.notify(
-                Notice.WARNING, "Stopped: the window did not respond in time. Press again to drive."
+                Notice.warning(
+                    Kind.SAFETY, "Stopped: the window did not respond in time. Press again to drive."
+                )
             )
 
     def stop(self) -> None:
         """Stop now. Always sent, whatever the link looks like; held keys must be pressed again."""
         self._halt_held(EndReason.STOPPED)
         self.link.lease.end(EndReason.STOPPED)
-        if self.model.connection.value.phase in (Phase.CONNECTED, Phase.RECONNECTING, Phase.CONNECTING):
+        if self.robot.connection.value.phase in (Phase.CONNECTED, Phase.RECONNECTING, Phase.CONNECTING):
             self.link.stop()
 
     def focus_lost(self) -> None:
@@ -291,16 +318,18 @@ class Controller:
 
     # -- speed -------------------------------------------------------------------------------
     def speed_up(self) -> None:
-        self._set_speed(self.model.speed.value.faster(), "maximum")
+        self._set_speed(self.operator.speed.value.faster(), "maximum")
 
     def speed_down(self) -> None:
-        self._set_speed(self.model.speed.value.slower(), "minimum")
+        self._set_speed(self.operator.speed.value.slower(), "minimum")
 
     def _set_speed(self, new: SpeedSetting, limit: str) -> None:
-        if not self.model.speed.set(new):
-            self.view.notify(Notice.INFO, f"Speed is already at its {limit} ({new.percent} %)")
+        if not self.operator.speed.set(new):
+            self.view.notify(
+                Notice.info(Kind.SPEED_LIMIT, f"Speed is already at its {limit} ({new.percent} %)")
+            )
             return
-        self.view.notify(Notice.INFO, f"Speed {new.percent} %")
+        self.view.notify(Notice.info(Kind.SPEED, f"Speed {new.percent} %"))
         if self._held and self._generation is not None:
             self._apply()
 
@@ -319,9 +348,9 @@ class Controller:
 
     def request_image(self) -> None:
         if not self.connected:
-            self.view.notify(Notice.WARNING, "Camera picture: not connected")
+            self.view.notify(Notice.warning(Kind.CAMERA, "Camera picture: not connected"))
         elif self.image_source() is None:
-            self.view.notify(Notice.WARNING, "This server offers no camera pictures")
+            self.view.notify(Notice.warning(Kind.CAMERA, "This server offers no camera pictures"))
         else:
             self.link.request_image()
 
@@ -331,10 +360,10 @@ class Controller:
 
     def _require(self, name: str) -> bool:
         if not self.connected:
-            self.view.notify(Notice.WARNING, "Not connected")
+            self.view.notify(Notice.warning(Kind.COMMAND, "Not connected"))
             return False
         if not self.supports(name):
-            self.view.notify(Notice.WARNING, f"This server does not offer {name}")
+            self.view.notify(Notice.warning(Kind.COMMAND, f"This server does not offer {name}"))
             return False
         return True
 
@@ -343,20 +372,20 @@ class Controller:
         """Use ``profile`` for the next connect and restore the view and speed it was left with."""
         self.profile = profile
         with contextlib.suppress(ValueError):
-            self.model.speed.set(SpeedSetting(profile.speed))
-        self.model.view.update(
+            self.operator.speed.set(SpeedSetting(profile.speed))
+        self.operator.view.update(
             zoom=profile.zoom, follow_robot=profile.follow_robot, show_sonar=profile.show_sonar
         )
 
     def current_profile(self) -> Profile:
         """The profile with the view options and speed as they are now (save it on exit)."""
-        v = self.model.view.value
+        v = self.operator.view.value
         return replace(
             self.profile,
             zoom=v.zoom,
             follow_robot=v.follow_robot,
             show_sonar=v.show_sonar,
-            speed=self.model.speed.value.percent,
+            speed=self.operator.speed.value.percent,
         )
 
     def connect(self, password: str | None = None) -> None:
@@ -378,7 +407,7 @@ class Controller:
         self._start_connect(password or "")
 
     def _busy_connecting(self) -> bool:
-        phase = self.model.connection.value.phase
+        phase = self.robot.connection.value.phase
         return self._lookup_pending or phase in (Phase.CONNECTING, Phase.CONNECTED, Phase.RECONNECTING)
 
     def _look_up_password(self, profile: Profile, secrets: SecretStore) -> None:
@@ -404,7 +433,7 @@ class Controller:
 
     def _password_answered(self, password: str | None) -> None:
         if password is None:
-            self.view.notify(Notice.INFO, "Connection cancelled")
+            self.view.notify(Notice.info(Kind.CONNECTION, "Connection cancelled"))
             return
         self._start_connect(password)
 
@@ -427,15 +456,15 @@ class Controller:
 
     # -- map view ----------------------------------------------------------------------------
     def set_zoom(self, zoom: float) -> None:
-        self.model.view.update(zoom=max(0.0, min(ZOOM_LEVELS[-1], float(zoom))))
+        self.operator.view.update(zoom=max(0.0, min(ZOOM_LEVELS[-1], float(zoom))))
 
     def zoom_in(self) -> None:
-        current = self.model.view.value.zoom
+        current = self.operator.view.value.zoom
         bigger = [z for z in ZOOM_LEVELS if z > current + 1e-9]
         self.set_zoom(bigger[0] if bigger else ZOOM_LEVELS[-1])
 
     def zoom_out(self) -> None:
-        current = self.model.view.value.zoom
+        current = self.operator.view.value.zoom
         if current == 0.0:
             return  # already "fit"
         smaller = [z for z in ZOOM_LEVELS if z < current - 1e-9]
@@ -446,12 +475,14 @@ class Controller:
         if new.phase is not Phase.CONNECTED and old.phase is Phase.CONNECTED:
             self._halt_held(EndReason.DISCONNECTED)
         if new.phase is Phase.CONNECTED and old.phase is not Phase.CONNECTED:
-            self.view.notify(Notice.INFO, f"Connected to {new.host}:{new.port}")
+            self.view.notify(Notice.info(Kind.CONNECTION, f"Connected to {new.host}:{new.port}"))
         elif new.phase is Phase.FAILED and new.error and new.error != old.error:
-            self.view.notify(Notice.ERROR, new.error)
+            self.view.notify(Notice.error(Kind.CONNECTION, new.error))
         elif new.phase is Phase.RECONNECTING and old.phase is Phase.CONNECTED:
             self.view.notify(
-                Notice.WARNING, f"Link lost: reconnecting ({new.error})" if new.error else "Reconnecting"
+                Notice.warning(
+                    Kind.CONNECTION, f"Link lost: reconnecting ({new.error})" if new.error else "Reconnecting"
+                )
             )
         self.refresh_commands()
 
@@ -461,11 +492,7 @@ class Controller:
             self._halt_held(EndReason.LINK)
             if moving:
                 self.link.stop()
-                self.view.notify(Notice.WARNING, f"Stopped: the link is {new.level.value}")
+                self.view.notify(Notice.warning(Kind.LINK, f"Stopped: the link is {new.level.value}"))
 
-    def _on_link_notice(self, level: str, text: str) -> None:
-        try:
-            notice = Notice(level)
-        except ValueError:
-            notice = Notice.INFO
-        self.view.notify(notice, text)
+    def _on_link_notice(self, notice: Notice) -> None:
+        self.view.notify(notice)

@@ -1,9 +1,8 @@
-"""What RTMU knows about the robot and the link: plain values that announce real changes.
+"""The UI thread's state: observables holding one robot's values, and the operator's own settings.
 
-The model is the single source of truth the window draws from. It never
-imports GTK or asyncio and is confined to ONE thread (the UI thread): the
-network side hands values over through the runner's "post to UI" function, and
-the controller and view read and write the model only from that thread.
+Confined to ONE thread (the UI thread): the network side hands typed changes
+(:data:`rtmu.state.StateChange`) over through the runner's "post to UI"
+function and :meth:`RobotModel.apply` stores them. Never imports GTK or asyncio.
 
 Every part is an observable holding one frozen value. ``set(new)`` replaces the
 value and calls the observers **only if the value really changed** — the
@@ -12,25 +11,59 @@ full redraw at every 200 ms update. Timestamps are kept on the values but are
 declared ``compare=False``, so a fresh-but-identical status refreshes the
 timestamps without waking anybody.
 
-Parts (all on :class:`Model`):
+Two owners, kept apart so that a window can show any robot of a fleet:
 
-* ``robot``      — :class:`RobotState`: pose, velocities, battery, temperature, status, mode,
-  safe drive, Wi-Fi, sonar, timestamps.
-* ``map``        — :class:`MapModel`: the downloaded map (``rtmu.maps.MapData``) or why there is none.
-* ``camera``     — :class:`CameraImage` (or None): the last picture.
-* ``connection`` — :class:`ConnectionState`: phase, server, the data names it offers, the last error.
-* ``health``     — :class:`LinkHealth`: RTT, status age, dropped packets, OK/STALE/LOST.
-* ``speed``      — :class:`SpeedSetting`: the drive throttle, 10 %…100 % in 10 % steps.
-* ``view``       — :class:`ViewOptions`: map zoom and other per-profile view choices.
+* :class:`RobotModel` — what one robot and its link are (one per
+  :class:`rtmu.fleet.RobotSession`): ``robot``, ``map``, ``camera``,
+  ``connection``, ``health`` and the ``trail`` it drove.
+* :class:`OperatorState` — what the operator chose (one per window): ``speed``
+  (the drive throttle step) and ``view`` (zoom, follow, layers).
+
+The value types live in :mod:`rtmu.state` and are re-exported here.
 """
 
 from __future__ import annotations
 
 import dataclasses
+import math
+from collections import deque
 from collections.abc import Callable
-from dataclasses import dataclass, field
-from enum import Enum
+from dataclasses import dataclass
 from typing import Any, Generic, TypeVar
+
+from .state import (
+    CameraChanged,
+    CameraImage,
+    ConnectionChanged,
+    ConnectionState,
+    HealthChanged,
+    LinkHealth,
+    LinkLevel,
+    MapChanged,
+    MapModel,
+    MapPhase,
+    Phase,
+    RobotChanged,
+    RobotState,
+    StateChange,
+)
+
+__all__ = [
+    "CameraImage",
+    "ConnectionState",
+    "LinkHealth",
+    "LinkLevel",
+    "MapModel",
+    "MapPhase",
+    "Observable",
+    "OperatorState",
+    "Phase",
+    "RobotModel",
+    "RobotState",
+    "SpeedSetting",
+    "Trail",
+    "ViewOptions",
+]
 
 T = TypeVar("T")
 
@@ -91,195 +124,84 @@ class Observable(Generic[T]):
         return self.set(dataclasses.replace(self._value, **changes))  # type: ignore[type-var]
 
 
-# -- robot ---------------------------------------------------------------------------------------
+# -- one robot ----------------------------------------------------------------------------------
+
+TRAIL_MAX = 1500
+"""Poses kept in the trail (the oldest go first)."""
+TRAIL_MIN_STEP_MM = 30.0
+"""A pose closer than this to the last kept one is not added."""
 
 
-@dataclass(frozen=True, slots=True)
-class RobotState:
-    """The robot as the server last described it. ``None`` = not reported (yet)."""
+class Trail:
+    """Where the robot has been on the current map: a bounded list of (x, y) mm, oldest first.
 
-    x: float = 0.0
-    """mm, map frame."""
-    y: float = 0.0
-    """mm."""
-    th: float = 0.0
-    """degrees, counter-clockwise positive, −179…180."""
-    vel: float = 0.0
-    """mm/s."""
-    rot_vel: float = 0.0
-    """deg/s."""
-    lat_vel: float = 0.0
-    """mm/s (0 on non-holonomic robots)."""
-    battery_v: float | None = None
-    """Volts, or state of charge in % when ``battery_is_soc``."""
-    battery_low: float | None = None
-    """Low-battery level in the same unit as ``battery_v`` (``batteryInfo``)."""
-    battery_shutdown: float | None = None
-    """Level at which the robot shuts down."""
-    battery_is_soc: bool = False
-    temperature: float | None = None
-    """°C; None when the server says unknown (−128)."""
-    status: str = ""
-    """e.g. ``Stopped``, ``Driving`` (``updateStrings``)."""
-    mode: str = ""
-    """Display mode string, e.g. ``Stop``, ``Drive``, ``UNSAFE Drive``."""
-    extended_status: str = ""
-    mode_name: str = ""
-    """Internal mode name from ``getModeInfo`` (``stop``, ``ratioDrive``…)."""
-    safe_drive: bool | None = None
-    wifi_quality: int | None = None
-    """Link quality as the server publishes it (a ``getStrings`` item); None if not offered."""
-    wifi_signal: int | None = None
-    """Signal level (dBm on Linux) from a ``getStrings`` item; None if not offered."""
-    sonar: tuple[tuple[int, int], ...] = ()
-    """Current sonar readings, global mm."""
-    numbers_at: float | None = field(default=None, compare=False)
-    """Monotonic time of the last pose/velocity/battery update (not compared: no redraw)."""
-    strings_at: float | None = field(default=None, compare=False)
-    """Monotonic time of the last status/mode update."""
-    sonar_at: float | None = field(default=None, compare=False)
-    laser: tuple[tuple[int, int], ...] = ()
-    """Current laser points of every listed ``Laser_*Current`` (LD robots), global mm."""
-    laser_at: float | None = field(default=None, compare=False)
-    dock_state: str | None = None
-    """``Undocked``, ``Docking``, ``Docked``, ``Undocking`` (``dockInfo``); None if not offered."""
-    routes: tuple[str, ...] = ()
-    """Route names (``getRoutes``, LD robots)."""
-    data_store: tuple[tuple[str, str], ...] = ()
-    """(data name, value) of every listed ``DataStore_*`` string, sorted by name."""
-    goals: tuple[str, ...] = ()
-    """The map's goal names (``getGoals``), asked for where ``gotoRouteGoal`` is listed (LD robots)."""
-    loc_score: int | None = None
-    """Localization score 0–100 from ``DataStore_Localization_Score``; None if not offered."""
-    goal_distance_mm: int | None = None
-    """Distance left to the goal from ``DataStore_Distance_To_Goal`` (0: no goal); None if not offered."""
-    closest_obstacle_mm: int | None = None
-    """``DataStore_Closest_Obstacle``; None if not offered or nothing in range."""
-
-    @property
-    def battery_pct(self) -> float | None:
-        """State of charge in %, when ``batteryInfo`` says the robot reports it; None when volts."""
-        return self.battery_v if self.battery_is_soc else None
-
-    @property
-    def battery_state(self) -> str:
-        """``ok``, ``low``, ``critical`` (at or under the shutdown level) or ``unknown``."""
-        if self.battery_v is None:
-            return "unknown"
-        if self.battery_shutdown is not None and self.battery_v <= self.battery_shutdown:
-            return "critical"
-        if self.battery_low is not None and self.battery_v <= self.battery_low:
-            return "low"
-        return "ok"
-
-    @property
-    def moving(self) -> bool:
-        return self.vel != 0 or self.rot_vel != 0 or self.lat_vel != 0
-
-
-# -- map -----------------------------------------------------------------------------------------
-
-
-@dataclass(frozen=True, slots=True)
-class MapModel:
-    """The server's map and the state of its download.
-
-    ``data`` is an ``rtmu.maps.MapData`` (typed ``object`` here so the model does
-    not import numpy-heavy code); ``None`` with ``state == "none"`` means the
-    server has no map, which the view shows as the robot alone (thesis §5.8.4).
+    Cleared when a new map arrives and when the pose is forgotten (a disconnect);
+    the view only draws it. ``observe`` hears every append and clear.
     """
 
-    state: str = "unknown"
-    """``unknown`` (not asked), ``loading``, ``ready``, ``none`` (server has no map), ``failed``,
-    ``unsupported`` (server offers no map data)."""
-    data: object | None = field(default=None, compare=False)
-    name: str = ""
-    """The server's map file name (``getMapName``), may be empty."""
-    generation: int = 0
-    """Bumped for every newly loaded map, so observers see a change even when the name is equal."""
-    received: int = 0
-    """Packets received so far while loading (progress)."""
-    error: str = ""
+    def __init__(self) -> None:
+        self.points: deque[tuple[float, float]] = deque(maxlen=TRAIL_MAX)
+        self._observers: list[Callable[[], None]] = []
+
+    def observe(self, observer: Callable[[], None]) -> Callable[[], None]:
+        self._observers.append(observer)
+
+        def remove() -> None:
+            if observer in self._observers:
+                self._observers.remove(observer)
+
+        return remove
+
+    def robot_moved(self, old: RobotState, new: RobotState) -> None:
+        if new.numbers_at is None:
+            self.clear()
+        elif (new.x, new.y) != (old.x, old.y) and (
+            not self.points or math.dist(self.points[-1], (new.x, new.y)) >= TRAIL_MIN_STEP_MM
+        ):
+            self.points.append((new.x, new.y))
+            self._changed()
+
+    def map_changed(self, old: MapModel, new: MapModel) -> None:
+        if new.generation != old.generation:
+            self.clear()
+
+    def clear(self) -> None:
+        if self.points:
+            self.points.clear()
+            self._changed()
+
+    def _changed(self) -> None:
+        for observer in list(self._observers):
+            observer()
 
 
-# -- camera --------------------------------------------------------------------------------------
+class RobotModel:
+    """One robot's observable state on the UI thread; a :class:`rtmu.state.StateSink` for its runner."""
 
+    def __init__(self) -> None:
+        self.robot: Observable[RobotState] = Observable(RobotState())
+        self.map: Observable[MapModel] = Observable(MapModel())
+        self.camera: Observable[CameraImage | None] = Observable(None)
+        self.connection: Observable[ConnectionState] = Observable(ConnectionState())
+        self.health: Observable[LinkHealth] = Observable(LinkHealth())
+        self.trail = Trail()
+        # The trail's observers run before any view's (added first), so a redraw sees the new point.
+        self.robot.observe(self.trail.robot_moved)
+        self.map.observe(self.trail.map_changed)
 
-@dataclass(frozen=True, slots=True)
-class CameraImage:
-    """One JPEG picture from the robot's camera. The view decodes it; the model only keeps bytes."""
-
-    jpeg: bytes = field(repr=False)
-    width: int
-    height: int
-    source: str
-    """Data name it came from (``getPictureCam1``, ``sendVideo``…)."""
-    received_at: float = field(compare=False)
-    sequence: int = 0
-    """Increases for every picture, so two identical frames still count as a new picture."""
-
-
-# -- connection and link -------------------------------------------------------------------------
-
-
-class Phase(Enum):
-    DISCONNECTED = "disconnected"
-    CONNECTING = "connecting"
-    CONNECTED = "connected"
-    RECONNECTING = "reconnecting"
-    FAILED = "failed"
-    """The last attempt failed and no retry is planned (``error`` says why)."""
-
-
-@dataclass(frozen=True, slots=True)
-class ConnectionState:
-    phase: Phase = Phase.DISCONNECTED
-    host: str = ""
-    port: int = 0
-    user: str = ""
-    profile: str = ""
-    offers: frozenset[str] = frozenset()
-    """Data names the server offers to this user (empty until connected)."""
-    error: str = ""
-    """An operator-readable sentence for the last failure, or ""."""
-    error_kind: str = ""
-    """The error's class: ``refused``, ``timeout``, ``login``, ``closed``, ``protocol``, ``unsupported``…"""
-    attempt: int = 0
-    """Reconnect attempt number while RECONNECTING."""
-    retry_in: float | None = None
-    """Seconds until the next reconnect attempt, if one is planned."""
-
-    @property
-    def connected(self) -> bool:
-        return self.phase is Phase.CONNECTED
-
-    def supports(self, name: str) -> bool:
-        return name in self.offers
-
-
-class LinkLevel(Enum):
-    DOWN = "down"
-    """Not connected."""
-    OK = "ok"
-    STALE = "stale"
-    """No status for 3 update intervals, or a ping went unanswered: driving is stopped."""
-    LOST = "lost"
-    """No status for 2 s, or 3 pings unanswered: the link is considered gone (reconnect if enabled)."""
-
-
-@dataclass(frozen=True, slots=True)
-class LinkHealth:
-    level: LinkLevel = LinkLevel.DOWN
-    rtt_ms: float | None = None
-    """Round-trip time of the last ping, rounded to 0.1 ms; None before the first."""
-    dropped: int = 0
-    """Packets the decoder threw away (bad length or checksum) on this connection."""
-    garbage_bytes: int = 0
-    """Bytes skipped while resynchronising."""
-    status_age: float | None = field(default=None, compare=False)
-    """Seconds since the last status packet (not compared: it changes all the time)."""
-    ping_failures: int = 0
-    """Pings in a row the server did not answer: it may no longer hear us (RTT is then None)."""
+    def apply(self, change: StateChange) -> None:
+        """Store a change from the network side (on the UI thread)."""
+        match change:
+            case RobotChanged(value):
+                self.robot.set(value)
+            case MapChanged(value):
+                self.map.set(value)
+            case CameraChanged(value):
+                self.camera.set(value)
+            case ConnectionChanged(value):
+                self.connection.set(value)
+            case HealthChanged(value):
+                self.health.set(value)
 
 
 # -- operator settings ---------------------------------------------------------------------------
@@ -326,24 +248,9 @@ class ViewOptions:
     show_sonar: bool = True
 
 
-# -- the whole model -----------------------------------------------------------------------------
-
-
-class Model:
-    """Every observable part of RTMU's state, on the UI thread."""
+class OperatorState:
+    """What the operator chose, shared by every robot the window shows: speed step and view options."""
 
     def __init__(self) -> None:
-        self.robot: Observable[RobotState] = Observable(RobotState())
-        self.map: Observable[MapModel] = Observable(MapModel())
-        self.camera: Observable[CameraImage | None] = Observable(None)
-        self.connection: Observable[ConnectionState] = Observable(ConnectionState())
-        self.health: Observable[LinkHealth] = Observable(LinkHealth())
         self.speed: Observable[SpeedSetting] = Observable(SpeedSetting())
         self.view: Observable[ViewOptions] = Observable(ViewOptions())
-
-    def reset_robot(self) -> None:
-        """Forget robot, map and picture (after a disconnect: stale values must not look live)."""
-        self.robot.set(RobotState())
-        self.map.set(MapModel())
-        self.camera.set(None)
-        self.health.set(LinkHealth())

@@ -11,19 +11,21 @@ from collections.abc import Callable, Mapping
 
 from rtmu.client.lease import DriveLease
 from rtmu.commands import CommandState
-from rtmu.controller import Notice
+from rtmu.notices import Kind, Level, Notice
 from rtmu.settings import Profile
 
 
 class FakeView:
     def __init__(self) -> None:
-        self.notices: list[tuple[Notice, str]] = []
+        self.notices: list[tuple[Level, str]] = []
+        self.kinds: list[Kind] = []
         self.states: dict[str, CommandState] = {}
         self.state_calls = 0
         self.password_asks: list[tuple[Profile, Callable[[str | None], None]]] = []
 
-    def notify(self, level: Notice, text: str) -> None:
-        self.notices.append((level, text))
+    def notify(self, notice: Notice) -> None:
+        self.notices.append((notice.level, notice.text))
+        self.kinds.append(notice.kind)
 
     def commands_changed(self, states: Mapping[str, CommandState]) -> None:
         self.state_calls += 1
@@ -39,7 +41,7 @@ class FakeView:
 class RecordingLink:
     def __init__(self, clock: Callable[[], float]) -> None:
         self.lease = DriveLease(clock=clock)
-        self.on_notice: Callable[[str, str], None] | None = None
+        self.on_notice: Callable[[Notice], None] | None = None
         self.calls: list[tuple[object, ...]] = []
         self.blocking: list[tuple[Callable[[], object], Callable[[object], None]]] = []
 

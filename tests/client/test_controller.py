@@ -8,8 +8,9 @@ import pytest
 
 from rtmu.client.lease import DriveRatios, EndReason
 from rtmu.commands import Command, CommandRegistry
-from rtmu.controller import Controller, Notice, ratios_for
-from rtmu.model import ConnectionState, LinkHealth, LinkLevel, Model, Phase, SpeedSetting
+from rtmu.controller import Controller, ratios_for
+from rtmu.model import ConnectionState, LinkHealth, LinkLevel, OperatorState, Phase, RobotModel, SpeedSetting
+from rtmu.notices import Kind, Level, Notice
 from rtmu.settings import Profile
 
 from .fakeclock import FakeClock
@@ -21,10 +22,11 @@ ALL = frozenset({"ratioDrive", "stop", "turnByAngle", "moveDist", "setSafeDrive"
 class Rig:
     def __init__(self, offers: frozenset[str] = ALL, connected: bool = True) -> None:
         self.clock = FakeClock()
-        self.model = Model()
+        self.model = RobotModel()
+        self.operator = OperatorState()
         self.view = FakeView()
         self.link = RecordingLink(self.clock)
-        self.ctl = Controller(self.model, self.link, self.view, clock=self.clock)
+        self.ctl = Controller(self.model, self.operator, self.link, self.view, clock=self.clock)
         if connected:
             self.connect(offers)
 
@@ -181,16 +183,16 @@ def test_press_while_disconnected_does_nothing_until_released() -> None:
 
 def test_speed_steps_and_limits_and_applies_to_a_drive_in_progress() -> None:
     rig = Rig()
-    rig.model.speed.set(SpeedSetting(90))
+    rig.operator.speed.set(SpeedSetting(90))
     rig.ctl.press("forward")
     rig.ctl.speed_up()
-    assert rig.model.speed.value.percent == 100 and rig.lease.ratios.throttle == 100
+    assert rig.operator.speed.value.percent == 100 and rig.lease.ratios.throttle == 100
     rig.ctl.speed_up()
-    assert rig.model.speed.value.percent == 100
+    assert rig.operator.speed.value.percent == 100
     assert "maximum" in rig.view.texts()[-1]
     for _ in range(12):
         rig.ctl.speed_down()
-    assert rig.model.speed.value.percent == 10 and rig.lease.ratios.throttle == 10
+    assert rig.operator.speed.value.percent == 10 and rig.lease.ratios.throttle == 10
     assert "minimum" in rig.view.texts()[-1]
     with pytest.raises(ValueError):
         SpeedSetting(55)
@@ -218,7 +220,7 @@ def test_image_and_safe_drive() -> None:
     assert rig.link.calls == [("request_image",), ("set_safe_drive", False)]
     rig.connect(frozenset({"ratioDrive"}))
     rig.ctl.request_image()
-    assert rig.view.notices[-1] == (Notice.WARNING, "This server offers no camera pictures")
+    assert rig.view.notices[-1] == (Level.WARNING, "This server offers no camera pictures")
 
 
 def test_command_states_follow_the_server_and_only_changes_are_sent() -> None:
@@ -243,7 +245,7 @@ def test_command_states_follow_the_server_and_only_changes_are_sent() -> None:
 def test_connect_asks_for_the_password_and_uses_the_keyring_when_remembered() -> None:
     rig = Rig(connected=False)
     rig.ctl.select_profile(Profile("lab", "10.0.0.5", 7272, user="alice", zoom=0.5))
-    assert rig.model.view.value.zoom == 0.5
+    assert rig.operator.view.value.zoom == 0.5
     rig.ctl.connect()
     assert rig.link.calls == [] and len(rig.view.password_asks) == 1
     rig.view.password_asks[0][1]("secret1")
@@ -307,22 +309,22 @@ def test_disconnect_stops_first() -> None:
 def test_zoom_steps() -> None:
     rig = Rig()
     rig.ctl.zoom_in()
-    assert rig.model.view.value.zoom == 0.1
+    assert rig.operator.view.value.zoom == 0.1
     for _ in range(20):
         rig.ctl.zoom_in()
-    assert rig.model.view.value.zoom == 1.0
+    assert rig.operator.view.value.zoom == 1.0
     rig.ctl.zoom_out()
-    assert rig.model.view.value.zoom == 0.9
+    assert rig.operator.view.value.zoom == 0.9
     rig.ctl.set_zoom(0)
     rig.ctl.zoom_out()
-    assert rig.model.view.value.zoom == 0.0
+    assert rig.operator.view.value.zoom == 0.0
 
 
 def test_link_notices_reach_the_view() -> None:
     rig = Rig()
     assert rig.link.on_notice is not None
-    rig.link.on_notice("error", "the map could not be loaded")
-    assert rig.view.notices[-1] == (Notice.ERROR, "the map could not be loaded")
+    rig.link.on_notice(Notice.error(Kind.MAP, "the map could not be loaded"))
+    assert rig.view.notices[-1] == (Level.ERROR, "the map could not be loaded")
 
 
 def test_adding_a_command_is_one_class() -> None:
@@ -339,7 +341,7 @@ def test_adding_a_command_is_one_class() -> None:
             controller.link.command("wander")
 
     rig = Rig()
-    ctl = Controller(rig.model, rig.link, rig.view, clock=rig.clock, registry=registry)
+    ctl = Controller(rig.model, rig.operator, rig.link, rig.view, clock=rig.clock, registry=registry)
     assert ctl.command_states()["wander"].reason == "this server does not offer wander"
     rig.connect(ALL | {"wander"})
     assert ctl.run("wander")
@@ -350,7 +352,7 @@ def test_adding_a_command_is_one_class() -> None:
 def test_profile_view_options_round_trip() -> None:
     rig = Rig()
     rig.ctl.select_profile(Profile("lab", zoom=0.3, speed=70, follow_robot=False))
-    assert rig.model.speed.value.percent == 70 and rig.model.view.value.follow_robot is False
+    assert rig.operator.speed.value.percent == 70 and rig.operator.view.value.follow_robot is False
     rig.ctl.zoom_in()
     rig.ctl.speed_down()
     saved = rig.ctl.current_profile()

@@ -203,7 +203,7 @@ def test_a_refused_second_login_is_said_plainly_and_driving_still_works() -> Non
     notices: list[tuple[str, str]] = []
     with SimThread(SimConfig(port=0, seed=1, max_clients=1)) as sim:
         runner = ClientRunner(config=SessionConfig(fetch_map=False, guardian=True))
-        runner.on_notice = lambda level, text: notices.append((level, text))
+        runner.on_notice = lambda notice: notices.append((notice.level.value, notice.text))
         with runner:
             runner.connect("127.0.0.1", sim.port).result(10)
 

@@ -7,7 +7,7 @@ from pathlib import Path
 
 from rtmu.client.runner import ClientRunner
 from rtmu.client.session import SessionConfig
-from rtmu.model import Model, Phase
+from rtmu.model import Phase, RobotModel
 from rtmu.sim import SimConfig, SimThread
 from rtmu.sim.ld_data import ROUTES
 
@@ -17,8 +17,8 @@ REPO = Path(__file__).resolve().parents[2]
 OFFICE = REPO / "data" / "maps" / "office.map"
 
 
-def connected(port: int) -> tuple[ClientRunner, Model, UiQueue]:
-    model, ui = Model(), UiQueue()
+def connected(port: int) -> tuple[ClientRunner, RobotModel, UiQueue]:
+    model, ui = RobotModel(), UiQueue()
     runner = ClientRunner(model, post=ui.post, clock=time.monotonic, config=SessionConfig(fetch_map=False))
     runner.start()
     runner.connect("127.0.0.1", port, profile="sim").result(10)

@@ -9,7 +9,7 @@ import pytest
 from rtmu.cli import EXIT_CONNECTION, main
 from rtmu.client.runner import ClientRunner
 from rtmu.client.session import SessionConfig
-from rtmu.model import Model, Phase
+from rtmu.model import Phase, RobotModel
 
 from .servers import MAP_LINES, ServerThread, TestServer
 from .uiqueue import UiQueue
@@ -17,14 +17,14 @@ from .uiqueue import UiQueue
 BAD_HEADER_MAP = ["2D-Map", "NumPoints: many", *MAP_LINES[4:]]
 
 
-Connected = tuple[ClientRunner, Model, UiQueue, list[tuple[str, str]]]
+Connected = tuple[ClientRunner, RobotModel, UiQueue, list[tuple[str, str]]]
 
 
 def _connected(server: TestServer, **config: object) -> Connected:
-    model, ui = Model(), UiQueue()
+    model, ui = RobotModel(), UiQueue()
     runner = ClientRunner(model, post=ui.post, config=SessionConfig(**config))  # type: ignore[arg-type]
     notices: list[tuple[str, str]] = []
-    runner.on_notice = lambda level, text: notices.append((level, text))
+    runner.on_notice = lambda notice: notices.append((notice.level.value, notice.text))
     runner.start()
     runner.connect("127.0.0.1", server.port).result(5)
     ui.wait_for(lambda: model.connection.value.phase is Phase.CONNECTED)
@@ -121,7 +121,7 @@ def test_a_bad_status_packet_is_counted_and_the_session_goes_on() -> None:
 
     server_obj.handlers["updateNumbers"] = every_other_bad
     with ServerThread(server_obj) as server:
-        model, ui = Model(), UiQueue()
+        model, ui = RobotModel(), UiQueue()
         runner = ClientRunner(
             model, post=ui.post, clock=FakeClock(), config=SessionConfig(status_interval_ms=20)
         )

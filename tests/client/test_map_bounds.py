@@ -17,6 +17,7 @@ from rtmu.client.lease import DriveLease
 from rtmu.client.session import Session, SessionConfig
 from rtmu.model import LinkHealth, LinkLevel
 from rtmu.protocol.payloads.mapstream import DEFAULT_MAX_POINTS, DEFAULT_MAX_TEXT_LINES
+from rtmu.state import HealthChanged, StateChange
 
 from .endless_maps import endless_map_server, run_watching_peak
 from .servers import ServerThread, TestServer, run
@@ -69,9 +70,9 @@ def test_a_session_fails_the_map_keeps_the_link_and_does_not_fetch_it_again(kind
         await server.start()
         health: list[LinkHealth] = []
 
-        def publish(part: str, value: object) -> None:
-            if part == "health":
-                health.append(value)  # type: ignore[arg-type]
+        def publish(change: StateChange) -> None:
+            if isinstance(change, HealthChanged):
+                health.append(change.value)
 
         session = Session(DriveLease(), publish, config=SessionConfig(lost_after=2.0))
         try:

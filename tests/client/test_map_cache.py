@@ -30,7 +30,7 @@ def test_reconnect_keeps_the_map_and_a_changed_map_is_loaded_again() -> None:
     async def go() -> None:
         server = map_id_server()
         await server.start()
-        session = Session(DriveLease(), lambda part, value: None, config=SessionConfig())
+        session = Session(DriveLease(), lambda change: None, config=SessionConfig())
         try:
             await session.connect("127.0.0.1", server.port, auto_reconnect=True)
             first = await asyncio.wait_for(session.load_map(), 10)
@@ -61,7 +61,7 @@ def test_without_a_map_id_every_connection_loads_the_map() -> None:
     async def go() -> None:
         server = TestServer()  # no getMapId
         await server.start()
-        session = Session(DriveLease(), lambda part, value: None, config=SessionConfig())
+        session = Session(DriveLease(), lambda change: None, config=SessionConfig())
         try:
             await session.connect("127.0.0.1", server.port, auto_reconnect=True)
             await asyncio.wait_for(session.load_map(), 10)

@@ -45,7 +45,7 @@ def test_a_long_map_without_status_does_not_reconnect() -> None:
     async def go() -> None:
         server = _slow_map_server()
         await server.start()
-        session = Session(DriveLease(), lambda part, value: None, config=SessionConfig(lost_after=1.0))
+        session = Session(DriveLease(), lambda change: None, config=SessionConfig(lost_after=1.0))
         try:
             await session.connect("127.0.0.1", server.port, auto_reconnect=True)
             got = await asyncio.wait_for(session.load_map(), 20)

@@ -11,7 +11,7 @@ from rtmu.client.lease import DriveRatios
 from rtmu.client.reconnect import Backoff
 from rtmu.client.runner import ClientRunner
 from rtmu.client.session import SessionConfig
-from rtmu.model import LinkLevel, Model, Phase
+from rtmu.model import LinkLevel, Phase, RobotModel
 from rtmu.protocol.payloads.drive import RatioDrive
 
 from .fakeclock import FakeClock
@@ -61,7 +61,7 @@ def count_statuses(server: TestServer) -> list[int]:
 
 
 def start(server: TestServer, clock=None, **config):  # type: ignore[no-untyped-def]
-    model, ui = Model(), UiQueue()
+    model, ui = RobotModel(), UiQueue()
     runner = ClientRunner(model, post=ui.post, clock=clock or time.monotonic, config=SessionConfig(**config))
     runner.start()
     runner.connect("127.0.0.1", server.port, profile="test").result(5)
@@ -188,7 +188,7 @@ def test_disconnect_clears_the_model(server: TestServer) -> None:
 
 
 def test_connect_failure_is_shown_in_the_model() -> None:
-    model, ui = Model(), UiQueue()
+    model, ui = RobotModel(), UiQueue()
     with ClientRunner(model, post=ui.post) as runner:
         with pytest.raises(Exception):  # noqa: B017 -- the model is what we check
             runner.connect("127.0.0.1", 1, profile="x").result(5)
@@ -221,7 +221,7 @@ def test_lost_link_reconnects_and_comes_back_without_motion(server: TestServer) 
 
 
 def test_disconnect_while_logging_in_cancels_the_attempt() -> None:
-    model, ui = Model(), UiQueue()
+    model, ui = RobotModel(), UiQueue()
     config = SessionConfig(connect_timeout=600)  # only a cancel can end this attempt during the test
     with (
         ServerThread(TestServer(silent=True)) as server,
@@ -338,7 +338,7 @@ def test_connecting_again_while_driving_stops_the_robot_on_the_old_link_first(se
 def test_run_blocking_runs_off_the_ui_and_network_threads_and_answers_on_the_ui_thread() -> None:
     import threading
 
-    model, ui = Model(), UiQueue()
+    model, ui = RobotModel(), UiQueue()
     with ClientRunner(model, post=ui.post) as runner:
         ran_on: list[int] = []
         answers: list[tuple[object, int]] = []

@@ -15,7 +15,7 @@ from rtmu.client.reconnect import Backoff
 from rtmu.client.runner import ClientRunner
 from rtmu.client.session import SessionConfig
 from rtmu.controller import Controller
-from rtmu.model import LinkLevel, Model, Phase
+from rtmu.model import LinkLevel, OperatorState, Phase, RobotModel
 from rtmu.sim import SimConfig, SimThread
 
 from .fakeclock import FakeClock
@@ -32,7 +32,7 @@ def sim_config(**kw: object) -> SimConfig:
 
 
 def connected_runner(port: int, clock=None, **config):  # type: ignore[no-untyped-def]
-    model, ui = Model(), UiQueue()
+    model, ui = RobotModel(), UiQueue()
     runner = ClientRunner(model, post=ui.post, clock=clock or time.monotonic, config=SessionConfig(**config))
     runner.start()
     runner.connect("127.0.0.1", port, profile="sim").result(10)
@@ -72,7 +72,7 @@ def test_controller_hold_release_and_frozen_ui_on_a_manual_clock() -> None:
         clock = FakeClock()
         runner, model, ui = connected_runner(sim.port, clock=clock, fetch_map=False)
         view = FakeView()
-        ctl = Controller(model, runner, view, clock=clock)
+        ctl = Controller(model, OperatorState(), runner, view, clock=clock)
         try:
 
             def step(seconds: float = 0.1, tick: bool = True) -> None:

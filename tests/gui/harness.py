@@ -26,7 +26,7 @@ gi.require_version("Graphene", "1.0")
 from gi.repository import Gdk, GdkX11, GLib, Graphene, Gtk  # noqa: E402
 from PIL import Image  # noqa: E402
 
-from rtmu.model import Phase  # noqa: E402
+from rtmu.model import OperatorState, Phase, RobotModel  # noqa: E402
 from rtmu.ui.app import GuiOptions  # noqa: E402
 from rtmu.ui.application import RtmuApplication  # noqa: E402
 from rtmu.ui.window import MainWindow  # noqa: E402
@@ -136,8 +136,14 @@ class Gui:
         return self.app.window
 
     @property
-    def model(self):  # type: ignore[no-untyped-def]
+    def model(self) -> RobotModel:
+        """The shown robot's state."""
         return self.window.model
+
+    @property
+    def operator(self) -> OperatorState:
+        """The operator's speed and view choices."""
+        return self.window.operator
 
     @property
     def stage(self):  # type: ignore[no-untyped-def]

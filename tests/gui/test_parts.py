@@ -8,7 +8,7 @@ import gi
 import pytest
 
 from rtmu.commands import COMMANDS
-from rtmu.model import ConnectionState, LinkHealth, LinkLevel, Model, Phase
+from rtmu.model import ConnectionState, LinkHealth, LinkLevel, OperatorState, Phase, RobotModel
 from rtmu.ui.gauges import battery_fraction, wifi_bars
 from rtmu.ui.keys import BINDINGS, KeyRouter
 from rtmu.ui.settings_dialog import validate
@@ -134,10 +134,10 @@ def test_the_first_run_hint_never_breaks_rtmu_demo_across_lines() -> None:
 
 
 def test_the_link_cell_says_when_the_server_does_not_answer_pings() -> None:
-    model = Model()
+    model = RobotModel()
     model.connection.set(ConnectionState(Phase.CONNECTED, "127.0.0.1", 7272))
     model.health.set(LinkHealth(LinkLevel.OK, rtt_ms=1.5))
-    toolbar = StatusToolbar(model, status_age=lambda: 0.1)
+    toolbar = StatusToolbar(model, OperatorState(), status_age=lambda: 0.1)
     cell = toolbar.cells["link"]
     assert "ping" not in cell.value.get_text() and not cell.stale
     model.health.set(LinkHealth(LinkLevel.STALE, rtt_ms=None, ping_failures=2))

@@ -87,7 +87,7 @@ def test_the_map_view_listens_to_a_real_zoom_gesture(gui: Gui) -> None:
     assert stage.viewport.zoom == pytest.approx(2.0)
     gesture.emit("end", None)
     assert stage.viewport.zoom == pytest.approx(2.0)
-    assert gui.model.view.value.zoom == pytest.approx(2.0), "the end of the pinch is remembered"
+    assert gui.operator.view.value.zoom == pytest.approx(2.0), "the end of the pinch is remembered"
     assert stays_at(stage, before, middle)
     gui.shot("pinched-200")
 
@@ -103,7 +103,7 @@ def test_a_pinch_zooms_by_its_factor_about_the_fingers(gui: Gui) -> None:
     stage._pinch_end(fingers, None)
     assert stage.viewport.zoom == pytest.approx(1.5)
     assert stays_at(stage, held, fingers.centre)
-    assert gui.model.view.value.zoom == pytest.approx(1.5)
+    assert gui.operator.view.value.zoom == pytest.approx(1.5)
     gui.shot("pinched-150")
 
     fingers = TwoFingers((stage.viewport.width - 80.0, stage.viewport.height - 60.0))

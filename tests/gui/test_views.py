@@ -10,9 +10,9 @@ import gi
 import numpy as np
 import pytest
 
-from rtmu.controller import Notice
 from rtmu.maps import MapObject, new_map, write_map
 from rtmu.model import Phase
+from rtmu.notices import Kind, Notice
 from rtmu.sim import SimConfig, SimThread
 
 from .harness import OFFICE_MAP, Gui, idle, pump
@@ -267,7 +267,7 @@ def test_server_strings_are_plain_text_never_markup(start: Start, tmp_path: Path
     assert not gui.window.subtitle_label.get_use_markup()
     layout = gui.stage.labels.layout(odd)
     assert layout.get_text() == odd
-    gui.window.show_notice(Notice.ERROR, odd)
+    gui.window.show_notice(Notice.error(Kind.GENERAL, odd))
     assert gui.window.banners.text(f"notice:{odd}") == odd
     idle(0.2)
     gui.shot("odd-strings")
@@ -301,7 +301,7 @@ def test_banners_tell_connecting_connected_and_a_failure_with_its_reason(screens
 def test_speed_at_its_limit_says_so(start: Start) -> None:
     gui, _sim = start()
     gui.key(*["plus"] * 6)
-    pump(lambda: gui.model.speed.value.percent == 100, 3, "full speed")
+    pump(lambda: gui.operator.speed.value.percent == 100, 3, "full speed")
     gui.key("plus")
     pump(lambda: gui.window.banners.text("speed") == "Speed at its maximum: 100 %", 3, "the limit banner")
     gui.shot("speed-limit")
@@ -377,10 +377,10 @@ def test_plain_rtmu_opens_the_last_profile_and_connects(screenshots: Path, tmp_p
         gui = Gui.open(GuiOptions(settings_path=path), screenshots, "test_last_profile")
         try:
             assert gui.window.controller.profile.name == "lab"
-            assert gui.model.speed.value.percent == 70
+            assert gui.operator.speed.value.percent == 70
             assert abs(gui.stage.viewport.zoom - 1.0) < 1e-9 and not gui.stage.fitted
             gui.key("minus")
-            pump(lambda: gui.model.speed.value.percent == 60, 3, "the speed to drop")
+            pump(lambda: gui.operator.speed.value.percent == 60, 3, "the speed to drop")
             gui.shot("last-profile-at-100pct-speed-60")
         finally:
             gui.close()

@@ -150,9 +150,9 @@ def test_space_stops_even_while_a_drive_key_is_still_held(gui: Gui, sim: SimThre
 
 
 def test_plus_and_minus_change_the_throttle_the_simulator_receives(gui: Gui, sim: SimThread) -> None:
-    assert gui.model.speed.value.percent == 50
+    assert gui.operator.speed.value.percent == 50
     gui.key("plus")
-    pump(lambda: gui.model.speed.value.percent == 60, 3, "the speed to rise to 60 %")
+    pump(lambda: gui.operator.speed.value.percent == 60, 3, "the speed to rise to 60 %")
     assert gui.window.banners.text("speed") == "Speed 60 %"
     gui.shot("speed-banner")
     gui.keydown("Up")
@@ -162,7 +162,7 @@ def test_plus_and_minus_change_the_throttle_the_simulator_receives(gui: Gui, sim
         gui.keyup("Up")
     pump(lambda: stopped(sim), 8, "the robot to stop")
     gui.key("minus", "minus", "minus")
-    pump(lambda: gui.model.speed.value.percent == 30, 3, "the speed to drop to 30 %")
+    pump(lambda: gui.operator.speed.value.percent == 30, 3, "the speed to drop to 30 %")
     gui.keydown("Up")
     try:
         pump(lambda: (received(sim) or (0, 0, 0, 0))[2] == 30, 5, "ratioDrive with throttle 30")

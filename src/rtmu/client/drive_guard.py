@@ -18,7 +18,7 @@ import contextlib
 import time
 
 from ..cli import EXIT_TIMEOUT
-from ..model import LinkLevel
+from ..state import LinkLevel
 from .connection import AriaClient, Packet
 from .errors import ClientError, ClientTimeout
 from .health import HealthMonitor, ping_data

@@ -20,8 +20,8 @@ injected clock.
 
 from __future__ import annotations
 
-from ..model import LinkHealth, LinkLevel
 from ..protocol.decoder import DropStats
+from ..state import LinkHealth, LinkLevel
 
 STALE_INTERVALS = 3
 LOST_AFTER = 2.0

@@ -16,9 +16,9 @@ from __future__ import annotations
 import contextlib
 from dataclasses import dataclass
 
-from ..model import MapModel
 from ..protocol.errors import ProtocolError
 from ..protocol.payloads.map import MapId
+from ..state import MapModel
 from .connection import AriaClient
 from .errors import ClientError
 

@@ -13,8 +13,10 @@ Concurrency design
 * Results travel back through ``post(fn)``, the injectable "run this on the UI
   thread" function: GTK passes ``GLib.idle_add``; tests and scripts pass a
   direct call or a queue. Posted functions return None, so ``idle_add`` runs
-  them once. With a :class:`~rtmu.model.Model`, every published value is set on
-  the matching model part on the UI thread; only real changes get posted.
+  them once. Every published change (:data:`rtmu.state.StateChange`) is handed
+  to the runner's ``sink`` (a :class:`~rtmu.model.RobotModel`, a recorder, a
+  test list) on the UI thread; only real changes get posted. The runner never
+  imports the UI thread's state: it knows the sink only by its ``apply``.
 * Calls that may block (keyring lookups) go to :meth:`ClientRunner.run_blocking`:
   a worker thread that is neither the UI thread nor the network loop.
 
@@ -63,7 +65,8 @@ import time
 from collections.abc import Awaitable, Callable
 from typing import Any, TypeVar
 
-from ..model import Model
+from ..notices import Kind, Notice
+from ..state import StateChange, StateSink
 from .connection import Packet
 from .errors import ClientError, ClientTimeout
 from .lease import LEASE_TTL, DriveLease, EndReason
@@ -79,34 +82,43 @@ SHUTDOWN_TIMEOUT = 0.5
 Post = Callable[[Callable[[], None]], Any]
 
 
+def settle(future: concurrent.futures.Future[bool], timeout: float) -> bool:
+    """The future's answer, or False when it fails or has none within ``timeout`` s (then cancelled)."""
+    try:
+        return bool(future.result(timeout))
+    except (concurrent.futures.TimeoutError, Exception):
+        future.cancel()
+        return False
+
+
 def call_directly(fn: Callable[[], None]) -> None:
     """The trivial ``post``: run on the calling (network) thread. For scripts and tests."""
     fn()
 
 
 class ClientRunner:
-    """Use as ``with ClientRunner(model, post=GLib.idle_add) as runner:`` (or ``start()``/``close()``).
+    """Use as ``with ClientRunner(robot_model, post=GLib.idle_add) as runner:`` (or ``start()``/``close()``).
 
     Implements ``rtmu.controller.ClientLink``. All public methods are thread-safe.
     """
 
     def __init__(
         self,
-        model: Model | None = None,
+        sink: StateSink | None = None,
         *,
         post: Post = call_directly,
         clock: Callable[[], float] = time.monotonic,
         config: SessionConfig | None = None,
         lease_ttl: float = LEASE_TTL,
     ) -> None:
-        self.model = model
+        self.sink = sink
         self.post = post
         self.clock = clock
         self.config = config or SessionConfig()
         self.lease = DriveLease(ttl=lease_ttl, clock=clock)
-        self.on_notice: Callable[[str, str], None] | None = None
-        """``on_notice(level, text)``, called on the UI thread (through ``post``)."""
-        self.on_publish: Callable[[str, Any], None] | None = None
+        self.on_notice: Callable[[Notice], None] | None = None
+        """``on_notice(notice)``, called on the UI thread (through ``post``)."""
+        self.on_publish: Callable[[StateChange], None] | None = None
         """Optional tap on every published value, called on the *network* thread (benchmarks, scripts)."""
         self.loop = asyncio.new_event_loop()
         self.session: Session | None = None
@@ -210,41 +222,38 @@ class ClientRunner:
             future.cancel()
             raise ClientTimeout(f"the network thread did not finish within {timeout:g} s") from None
 
-    def _fire(self, fn: Callable[..., Any], *args: Any) -> concurrent.futures.Future[Any]:
-        """Submit, and tell the operator (``on_notice``) if it fails."""
+    def _fire(
+        self, fn: Callable[..., Any], *args: Any, kind: Kind = Kind.COMMAND
+    ) -> concurrent.futures.Future[Any]:
+        """Submit, and tell the operator (``on_notice``, as a notice of ``kind``) if it fails."""
         future = self.submit(fn, *args)
-        future.add_done_callback(self._report)
+        future.add_done_callback(lambda done: self._report(done, kind))
         return future
 
-    def _report(self, future: concurrent.futures.Future[Any]) -> None:
+    def _report(self, future: concurrent.futures.Future[Any], kind: Kind) -> None:
         if future.cancelled():
             return
         exc = future.exception()
         if isinstance(exc, ClientError):
-            self._notice("error", str(exc))
+            self._notice(Notice.error(kind, str(exc)))
         elif exc is not None:
             log.error("network call failed", exc_info=exc)
-            self._notice("error", f"internal error: {exc}")
+            self._notice(Notice.error(kind, f"internal error: {exc}"))
 
-    def _publish(self, part: str, value: Any) -> None:
+    def _publish(self, change: StateChange) -> None:
         tap = self.on_publish
         if tap is not None:
-            tap(part, value)
-        model = self.model
-        if model is None:
+            tap(change)
+        sink = self.sink
+        if sink is None:
             return
-        observable = getattr(model, part)
+        self.post(lambda: sink.apply(change))
 
-        def apply() -> None:
-            observable.set(value)
-
-        self.post(apply)
-
-    def _notice(self, level: str, text: str) -> None:
+    def _notice(self, notice: Notice) -> None:
         def show() -> None:
             hook = self.on_notice
             if hook is not None:
-                hook(level, text)
+                hook(notice)
 
         self.post(show)
 
@@ -278,7 +287,7 @@ class ClientRunner:
         return future
 
     def disconnect(self) -> concurrent.futures.Future[None]:
-        return self._fire(self._session.disconnect)
+        return self._fire(self._session.disconnect, kind=Kind.CONNECTION)
 
     def stop(self) -> None:
         """Zero ratios and ``stop`` at once, whatever the link health says."""
@@ -292,27 +301,31 @@ class ClientRunner:
         then let the signal take its course. False after ``timeout`` s (the loop is blocked or the
         server does not read) or once the runner is closed. Not from the network thread.
         """
+        return settle(self.stop_flushing(timeout), timeout + 0.1)
+
+    def stop_flushing(self, timeout: float = 0.5) -> concurrent.futures.Future[bool]:
+        """:meth:`stop` now; the Future says (bounded by ``timeout``) whether it left this process.
+
+        Several runners can be stopped at once this way and their futures awaited together.
+        """
         self.lease.end(EndReason.STOPPED)
         if self._closed or self.session is None or not self._thread.is_alive():
-            return False
-        future = self._on_loop(self._session.stop_and_flush, timeout)
-        try:
-            return bool(future.result(timeout + 0.1))
-        except (concurrent.futures.TimeoutError, Exception):
-            future.cancel()
-            return False
+            done: concurrent.futures.Future[bool] = concurrent.futures.Future()
+            done.set_result(False)
+            return done
+        return self._on_loop(self._session.stop_and_flush, timeout)
 
     def command(self, name: str, *args: object) -> concurrent.futures.Future[None]:
         return self._fire(self._session.command, name, *args)
 
     def request_image(self) -> concurrent.futures.Future[Any]:
-        return self._fire(self._session.request_image)
+        return self._fire(self._session.request_image, kind=Kind.CAMERA)
 
     def set_safe_drive(self, on: bool) -> concurrent.futures.Future[None]:
         return self._fire(self._session.set_safe_drive, on)
 
     def load_map(self) -> concurrent.futures.Future[Any]:
-        return self._fire(self._session.load_map)
+        return self._fire(self._session.load_map, kind=Kind.MAP)
 
     def run_blocking(
         self, fn: Callable[[], T], done: Callable[[T | None], None], *, timeout: float = 30.0

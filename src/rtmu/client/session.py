@@ -2,9 +2,10 @@
 
 The :class:`Session` lives entirely on the network thread's asyncio loop (see
 ``runner`` for the thread and the UI-facing facade). It keeps a *shadow* of
-every model part (robot, map, camera, connection, health) and hands a new
-frozen value to ``publish(part, value)`` only when it really changed, so an
-unchanged 10 Hz status costs the UI thread nothing.
+every part of the robot's state (robot, map, camera, connection, health) and
+hands a typed change (:data:`rtmu.state.StateChange`) to ``publish`` only when
+the value really changed, so an unchanged 10 Hz status costs the UI thread
+nothing. Messages for the operator leave as typed :class:`rtmu.notices.Notice`.
 
 Its heart is one task that wakes at the exact moments something is due — a
 ``ratioDrive`` resend, the lease's expiry, the status going stale — or when the
@@ -26,19 +27,26 @@ from typing import Any
 
 from ..guardian.handle import BEAT_PERIOD, GuardianHandle
 from ..guardian.messages import Hello
-from ..model import (
-    CameraImage,
-    ConnectionState,
-    LinkHealth,
-    LinkLevel,
-    MapModel,
-    Phase,
-    RobotState,
-)
+from ..notices import Kind, Notice
 from ..protocol.errors import ProtocolError
 from ..protocol.payloads import Side, decode_payload, payload_type_for
 from ..protocol.payloads.drive import RatioDrive, SafeDrive, SetSafeDrive
 from ..protocol.payloads.robot import BatteryInfo, ModeInfo, Update, UpdateNumbers, UpdateStrings
+from ..state import (
+    CameraChanged,
+    CameraImage,
+    ConnectionChanged,
+    ConnectionState,
+    HealthChanged,
+    LinkHealth,
+    LinkLevel,
+    MapChanged,
+    MapModel,
+    Phase,
+    RobotChanged,
+    RobotState,
+    StateChange,
+)
 from .connection import AriaClient, Packet
 from .diagnosis import explain
 from .errors import ClientError, ClientTimeout, MalformedReply, NotSupported, ProtocolFault, ServerClosed
@@ -51,10 +59,10 @@ from .reconnect import Backoff, worth_retrying
 
 log = logging.getLogger(__name__)
 
-Publish = Callable[[str, Any], None]
-"""``publish(part, value)``: part is a :class:`~rtmu.model.Model` attribute name."""
-NoticeFn = Callable[[str, str], None]
-"""``notice(level, text)``, level ``info``/``warning``/``error``."""
+Publish = Callable[[StateChange], None]
+"""``publish(change)``: a new whole value for one part of the robot's state."""
+NoticeFn = Callable[[Notice], None]
+"""``notice(notice)``: a message for the operator, typed by what it is about."""
 
 HEART_MAX_SLEEP = 0.25
 STEP_TIMEOUT = 2.0
@@ -108,7 +116,7 @@ class Session:
     ) -> None:
         self.lease = lease
         self.publish_fn = publish
-        self.notice_fn = notice or (lambda level, text: None)
+        self.notice_fn: NoticeFn = notice or (lambda notice: None)
         self.clock = clock
         self.config = config or SessionConfig()
         self.health = HealthMonitor(
@@ -117,7 +125,7 @@ class Session:
         self.governor = DriveGovernor(lease)
         self.client: AriaClient | None = None
         self._target: _Target | None = None
-        self._published: dict[str, Any] = {}
+        self._published: dict[type, StateChange] = {}
         self._robot = RobotState()
         self._map = MapModel()
         self._map_cache = MapCache()
@@ -142,30 +150,31 @@ class Session:
         """LD (ARAM) data: lasers, docking state, routes, DataStore_* — only where listed."""
 
     # -- publishing --------------------------------------------------------------------------
-    def _publish(self, part: str, value: Any) -> None:
-        if part in self._published and self._published[part] == value:
+    def _publish(self, change: StateChange) -> None:
+        part = type(change)
+        if self._published.get(part) == change:
             return
-        self._published[part] = value
+        self._published[part] = change
         try:
-            self.publish_fn(part, value)
+            self.publish_fn(change)
         except Exception:
-            log.exception("publishing %s failed", part)
+            log.exception("publishing %s failed", part.__name__)
 
     def _robot_update(self, **changes: Any) -> None:
         self._robot = replace(self._robot, **changes)
-        self._publish("robot", self._robot)
+        self._publish(RobotChanged(self._robot))
 
     def _set_connection(self, **changes: Any) -> None:
         self._connection = replace(self._connection, **changes)
-        self._publish("connection", self._connection)
+        self._publish(ConnectionChanged(self._connection))
 
     def _set_map(self, value: MapModel) -> None:
         self._map = value
-        self._publish("map", value)
+        self._publish(MapChanged(value))
 
-    def _notice(self, level: str, text: str) -> None:
+    def _notice(self, notice: Notice) -> None:
         try:
-            self.notice_fn(level, text)
+            self.notice_fn(notice)
         except Exception:
             log.exception("notice callback failed")
 
@@ -198,9 +207,9 @@ class Session:
         self._cancel_reconnect()
         target = self._target = _Target(host, port, user, password, profile, auto_reconnect, protocol)
         self._robot = RobotState()
-        self._publish("robot", self._robot)
+        self._publish(RobotChanged(self._robot))
         self._set_map(MapModel())
-        self._publish("camera", None)
+        self._publish(CameraChanged(None))
         self._set_connection(
             phase=Phase.CONNECTING, host=host, port=port, user=user, profile=profile,
             offers=frozenset(), error="", error_kind="", attempt=0, retry_in=None,
@@ -261,9 +270,9 @@ class Session:
         self.lease.end(EndReason.DISCONNECTED)
         await self._drop_client()
         self._robot = RobotState()
-        self._publish("robot", self._robot)
+        self._publish(RobotChanged(self._robot))
         self._set_map(MapModel())
-        self._publish("camera", None)
+        self._publish(CameraChanged(None))
         self._set_connection(
             phase=Phase.DISCONNECTED, offers=frozenset(), error="", error_kind="", retry_in=None
         )
@@ -330,7 +339,11 @@ class Session:
                     return
                 self._set_connection(error=str(exc), error_kind=exc.kind)
                 continue
-            self._notice("info", f"Reconnected to {target.host}:{target.port}; press a key to drive again")
+            self._notice(
+                Notice.info(
+                    Kind.LINK, f"Reconnected to {target.host}:{target.port}; press a key to drive again"
+                )
+            )
             return
 
     def _cancel_reconnect(self) -> None:
@@ -577,9 +590,9 @@ class Session:
     def _publish_health(self, now: float | None = None) -> None:
         now = self.clock() if now is None else now
         if self.client is None or not self.health.running:
-            self._publish("health", LinkHealth(rtt_ms=None))
+            self._publish(HealthChanged(LinkHealth(rtt_ms=None)))
             return
-        self._publish("health", self.health.snapshot(now, self.client.drops))
+        self._publish(HealthChanged(self.health.snapshot(now, self.client.drops)))
 
     def _send(self, name: str, *args: Any) -> bool:
         client = self.client
@@ -631,7 +644,7 @@ class Session:
             if word == "stopped":
                 # It stopped the robot (we were frozen, or too slow): no drive resumes without a fresh press.
                 self.lease.end(EndReason.STOPPED)
-                self._notice("error", f"The guardian stopped the robot: {text}")
+                self._notice(Notice.error(Kind.SAFETY, f"The guardian stopped the robot: {text}"))
             elif word in ("unavailable", "lost", "ended"):
                 self.guardian = None
                 guardian.close(goodbye=True)
@@ -639,9 +652,11 @@ class Session:
 
     def _guardian_unavailable(self, reason: str) -> None:
         self._notice(
-            "warning",
-            f"Guardian not available ({reason}): if this window is killed or frozen while driving, "
-            "only the server's own 2 s watchdog stops the robot",
+            Notice.warning(
+                Kind.SAFETY,
+                f"Guardian not available ({reason}): if this window is killed or frozen while driving, "
+                "only the server's own 2 s watchdog stops the robot",
+            )
         )
 
     # -- operator commands -------------------------------------------------------------------
@@ -713,7 +728,7 @@ class Session:
             received_at=reply.received_at,
             sequence=self._image_sequence,
         )
-        self._publish("camera", image)
+        self._publish(CameraChanged(image))
         return image
 
     def _require(self, name: str) -> AriaClient:
@@ -803,7 +818,7 @@ class Session:
     def _map_failed(self, client: AriaClient, reason: str) -> MapModel:
         self._set_map(replace(self._map, state="failed", error=reason))
         if client.connected:
-            self._notice("warning", f"The map could not be loaded: {reason}")
+            self._notice(Notice.warning(Kind.MAP, f"The map could not be loaded: {reason}"))
         return self._map
 
 

@@ -1,9 +1,11 @@
-"""The ``Gtk.Application``: settings → profile, model, network thread, window; a safe shutdown.
+"""The ``Gtk.Application``: settings → profile, the fleet and its first robot session, the window.
 
-Wiring only. The network thread is :class:`rtmu.client.runner.ClientRunner` with
-``GLib.idle_add`` as its way back to the GTK thread. Shutting down stops the
-robot first, then closes the network thread with a bounded wait, then saves the
-profile's view choices (zoom, follow, sonar, speed).
+Wiring only. The application builds a :class:`rtmu.fleet.Fleet` (today a fleet
+of one: one :class:`~rtmu.fleet.RobotSession`, whose network thread posts back
+with ``GLib.idle_add``) and a window that shows the selected session. Every way
+out — closing, quitting, Ctrl+Z, a signal — goes through the fleet, so every
+robot is stopped first; then each session closes with a bounded wait, then the
+profile's view choices (zoom, follow, sonar, speed) are saved.
 """
 
 from __future__ import annotations
@@ -21,9 +23,9 @@ import gi
 gi.require_version("Gtk", "4.0")
 from gi.repository import Gio, GLib, Gtk  # noqa: E402
 
-from ..client.runner import ClientRunner  # noqa: E402
 from ..client.session import SessionConfig  # noqa: E402
-from ..model import Model, Phase  # noqa: E402
+from ..fleet import Fleet, RobotSession  # noqa: E402
+from ..model import Phase  # noqa: E402
 from ..settings import (  # noqa: E402
     DEFAULT_PORT,
     KeyringSecrets,
@@ -76,8 +78,7 @@ class RtmuApplication(Gtk.Application):
     def __init__(self, options: GuiOptions | None = None) -> None:
         super().__init__(application_id=APP_ID, flags=Gio.ApplicationFlags.NON_UNIQUE)
         self.options = options or GuiOptions()
-        self.model: Model | None = None
-        self.runner: ClientRunner | None = None
+        self.fleet = Fleet()
         self.window: MainWindow | None = None
         self.settings = Settings()
         self.secrets = SessionSecrets(KeyringSecrets())
@@ -123,15 +124,14 @@ class RtmuApplication(Gtk.Application):
         profile, auto_connect = self.choose_profile()
         if self.options.protocol is not None:  # --protocol: this run only, the saved profile keeps its own
             profile = replace(profile, protocol=self.options.protocol)
-        self.model = Model()
         # The guardian: a separate process that stops the robot if this one is killed or frozen.
         config = SessionConfig(guardian=self.options.guardian)
-        self.runner = ClientRunner(self.model, post=GLib.idle_add, config=config).start()
+        session = self.fleet.open(post=GLib.idle_add, config=config, profile=profile, secrets=self.secrets)
         try:
             window = MainWindow(
                 self,
-                self.model,
-                self.runner,
+                session,
+                self.fleet.operator,
                 profile=profile,
                 profiles=self.settings.profiles,
                 secrets=self.secrets,
@@ -160,16 +160,19 @@ class RtmuApplication(Gtk.Application):
         self.close_session()
         Gtk.Application.do_shutdown(self)
 
+    @property
+    def session(self) -> RobotSession | None:
+        """The robot session the window shows (the fleet's selection)."""
+        return self.fleet.selected.value
+
     def close_session(self) -> None:
-        """Stop the robot, close the network thread, save view choices. Idempotent (tests call it too)."""
+        """Stop every robot, close the sessions, save view choices. Idempotent (tests call it too)."""
+        self.fleet.stop_all()
         window, self.window = self.window, None
         if window is not None:
-            window.controller.stop()
             self._remember_view(window)
             window.shutdown()
-        runner, self.runner = self.runner, None
-        if runner is not None:
-            runner.close(RUNNER_CLOSE_TIMEOUT)
+        self.fleet.close(RUNNER_CLOSE_TIMEOUT)
         if self.options.persist and window is not None:
             self._save(background=False)
         for source in self._signal_sources:
@@ -184,9 +187,8 @@ class RtmuApplication(Gtk.Application):
             self._old_sigtstp = None
 
     def quit_safely(self) -> None:
-        """Stop the robot, then close every window (the shutdown handler does the rest)."""
-        if self.window is not None:
-            self.window.controller.stop()
+        """Stop every robot, then close every window (the shutdown handler does the rest)."""
+        self.fleet.stop_all()
         for w in list(self.get_windows()):
             w.close()
         self.quit()
@@ -206,11 +208,10 @@ class RtmuApplication(Gtk.Application):
         (the shell sees a normal job stop); once SIGCONT resumes us, ``raise_signal`` returns and
         this handler is put back. Held keys stay blocked until released: no drive resumes alone.
         """
-        window, runner = self.window, self.runner
+        window = self.window
         if window is not None:
             window.end_held_drive(keep_focus=True)
-        if runner is not None:
-            runner.stop_and_wait(SUSPEND_STOP_TIMEOUT)
+        self.fleet.stop_all(wait=SUSPEND_STOP_TIMEOUT)
         signal.signal(signal.SIGTSTP, signal.SIG_DFL)
         try:
             signal.raise_signal(signal.SIGTSTP)  # the process stops here until SIGCONT
@@ -263,7 +264,8 @@ class RtmuApplication(Gtk.Application):
 
         The runner's one worker also does the lookups, so a later lookup sees this password.
         """
-        secrets, runner = self.secrets, self.runner
+        secrets, session = self.secrets, self.session
+        runner = session.runner if session is not None else None
         if runner is None:
             secrets.set(profile, password)
             return
@@ -274,9 +276,10 @@ class RtmuApplication(Gtk.Application):
         runner.run_blocking(lambda: secrets.set(profile, password), stored)
 
     def _remember_view(self, window: MainWindow) -> None:
-        view = self.model.view.value if self.model is not None else None
+        operator = self.fleet.operator
+        view = operator.view.value
         name = window.controller.profile.name
-        if view is None or name not in self.settings.profiles:
+        if name not in self.settings.profiles:
             return
         zoom = max(0.0, min(100.0, view.zoom))
         self.settings.remember_view(
@@ -284,7 +287,7 @@ class RtmuApplication(Gtk.Application):
             zoom=zoom,
             follow_robot=view.follow_robot,
             show_sonar=view.show_sonar,
-            speed=self.model.speed.value.percent if self.model is not None else 50,
+            speed=operator.speed.value.percent,
         )
 
     def _save(self, *, background: bool) -> None:
@@ -308,4 +311,5 @@ class RtmuApplication(Gtk.Application):
 
     @property
     def connected(self) -> bool:
-        return self.model is not None and self.model.connection.value.phase is Phase.CONNECTED
+        session = self.session
+        return session is not None and session.state.connection.value.phase is Phase.CONNECTED

@@ -14,7 +14,7 @@ import gi
 gi.require_version("Gtk", "4.0")
 from gi.repository import Gdk, Gtk  # noqa: E402
 
-from ..model import ConnectionState, Model, RobotState  # noqa: E402
+from ..model import ConnectionState, RobotModel, RobotState  # noqa: E402
 from ..protocol.payloads.ld import Say, data_store_label  # noqa: E402
 
 Send = Callable[[str, object], None]
@@ -25,7 +25,7 @@ MAX_SAY = 1000
 class DetailsWindow(Gtk.Window):
     """The details table and the Say field; follows the model while open."""
 
-    def __init__(self, parent: Gtk.Window, model: Model, send: Send) -> None:
+    def __init__(self, parent: Gtk.Window, model: RobotModel, send: Send) -> None:
         super().__init__(title="Robot details", transient_for=parent, modal=False)
         self.set_default_size(420, 360)
         self.model = model

@@ -4,7 +4,8 @@ Per frame it paints the background, the visible tiles from :class:`TileCache`
 (or the stretched overview where a tile is still being rendered, or a metric
 grid when the server has no map), then cairns, trail, sonar and the robot —
 nothing that scales with the map's size. It reads the model and never writes
-the network; zoom and follow are view state, remembered in ``model.view``.
+the network; zoom and follow are view state, remembered in the operator's ``view``;
+the trail is the robot's (``RobotModel.trail``), so it survives the view.
 
 Input: drag to pan (turns Follow off), scroll or pinch to zoom about the
 pointer, and the zoom/fit/follow methods the window binds to keys and buttons.
@@ -25,14 +26,12 @@ import gi
 gi.require_version("Gtk", "4.0")
 from gi.repository import GLib, Gtk  # noqa: E402
 
-from ..model import LinkLevel, MapModel, Model, RobotState  # noqa: E402
+from ..model import LinkLevel, MapModel, OperatorState, RobotModel, RobotState  # noqa: E402
 from . import overlays  # noqa: E402
 from .frame import Scene, draw_frame  # noqa: E402
 from .tiles import TileCache  # noqa: E402
 from .viewport import ZOOM_MAX, ZOOM_MIN, Viewport, fit_view, nearest_step, step_zoom  # noqa: E402
 
-TRAIL_MAX = 1500
-TRAIL_MIN_STEP_MM = 30.0
 FOLLOW_BOX = 0.3
 """Follow pans when the robot leaves the middle (1 − 2 × 0.3 = 40 %) of the view."""
 FOLLOW_BOX_FITTED = 0.04
@@ -47,13 +46,15 @@ class MapStage(Gtk.DrawingArea):
 
     def __init__(
         self,
-        model: Model,
+        model: RobotModel,
+        operator: OperatorState,
         *,
         clock: Callable[[], float] = time.monotonic,
         status_age: Callable[[], float | None] | None = None,
     ) -> None:
         super().__init__()
         self.model = model
+        self.operator = operator
         self.clock = clock
         self.status_age = status_age
         self.add_css_class("map-stage")
@@ -61,8 +62,8 @@ class MapStage(Gtk.DrawingArea):
         self.set_vexpand(True)
         self.set_focusable(False)
         self.viewport = Viewport(800, 480, 1.0, 0.0, 0.0)
-        self.follow = model.view.value.follow_robot
-        self.fitted = model.view.value.zoom == 0.0
+        self.follow = operator.view.value.follow_robot
+        self.fitted = operator.view.value.zoom == 0.0
         """The zoom is "fit the map" (re-fitted when the widget is resized or a map arrives)."""
         self.on_view_changed: Callable[[], None] | None = None
         self.on_first_map_frame: Callable[[float], None] | None = None
@@ -72,7 +73,6 @@ class MapStage(Gtk.DrawingArea):
         self.frames = 0
         self.last_frame_complete = False
         """The last frame showed a map with every visible tile ready."""
-        self.trail: deque[tuple[float, float]] = deque(maxlen=TRAIL_MAX)
         self.labels = overlays.LabelCache()
         self.tiles = TileCache(self._tiles_ready_from_worker)
         self._tiles_pending = False
@@ -90,8 +90,9 @@ class MapStage(Gtk.DrawingArea):
         self._unobserve = [
             model.robot.observe(self._on_robot),
             model.map.observe(self._on_map),
-            model.view.observe(self._on_view_options),
+            operator.view.observe(self._on_view_options),
             model.health.observe(lambda old, new: self.queue_draw()),
+            model.trail.observe(self.queue_draw),
         ]
         self.connect("resize", self._on_resize)
         self._on_map(MapModel(), model.map.value)
@@ -115,7 +116,6 @@ class MapStage(Gtk.DrawingArea):
                 data = new.data
                 self.tiles.set_map(getattr(data, "points", None), getattr(data, "segments", None))
                 self._objects = list(getattr(data, "objects", []))
-                self.trail.clear()
                 if self.fitted:
                     self._fit_to_map(data)
                 self._keep_robot_visible(centre=not self.fitted)
@@ -129,13 +129,8 @@ class MapStage(Gtk.DrawingArea):
         self.queue_draw()
 
     def _on_robot(self, old: RobotState, new: RobotState) -> None:
-        if new.numbers_at is None:
-            self.trail.clear()
-        elif (new.x, new.y) != (old.x, old.y):
-            if not self.trail or math.dist(self.trail[-1], (new.x, new.y)) >= TRAIL_MIN_STEP_MM:
-                self.trail.append((new.x, new.y))
-            if self.follow:
-                self._keep_robot_visible()
+        if new.numbers_at is not None and (new.x, new.y) != (old.x, old.y) and self.follow:
+            self._keep_robot_visible()
         self.queue_draw()
 
     def _on_view_options(self, old, new) -> None:  # type: ignore[no-untyped-def]
@@ -159,7 +154,7 @@ class MapStage(Gtk.DrawingArea):
 
     # -- view state --------------------------------------------------------------------------
     def _publish_view(self) -> None:
-        self.model.view.update(zoom=0.0 if self.fitted else self.viewport.zoom, follow_robot=self.follow)
+        self.operator.view.update(zoom=0.0 if self.fitted else self.viewport.zoom, follow_robot=self.follow)
         if self.on_view_changed is not None:
             self.on_view_changed()
 
@@ -300,9 +295,9 @@ class MapStage(Gtk.DrawingArea):
             objects=self._objects,
             robot=(r.x, r.y, r.th) if r.numbers_at is not None else None,
             stale=stale,
-            trail=self.trail,
-            sonar=r.sonar if self.model.view.value.show_sonar else (),
-            laser=r.laser if self.model.view.value.show_sonar else (),
+            trail=self.model.trail.points,
+            sonar=r.sonar if self.operator.view.value.show_sonar else (),
+            laser=r.laser if self.operator.view.value.show_sonar else (),
         )
         return draw_frame(ctx, vp, scene)
 

@@ -17,7 +17,7 @@ import gi
 gi.require_version("Gtk", "4.0")
 from gi.repository import Gtk  # noqa: E402
 
-from ..model import ConnectionState, Model, Phase, RobotState  # noqa: E402
+from ..model import ConnectionState, Phase, RobotModel, RobotState  # noqa: E402
 from ..protocol.payloads.ld import GotoRouteGoal, Patrol  # noqa: E402
 
 Send = Callable[[str, object], None]
@@ -27,7 +27,7 @@ Send = Callable[[str, object], None]
 class RoutesPanel(Gtk.MenuButton):
     """Header-bar button + popover listing routes, each with Patrol."""
 
-    def __init__(self, model: Model, send: Send) -> None:
+    def __init__(self, model: RobotModel, send: Send) -> None:
         super().__init__(icon_name="mark-location-symbolic", tooltip_text="Routes (patrol)")
         self.set_focusable(False)
         inner = self.get_first_child()

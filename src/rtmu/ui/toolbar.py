@@ -22,7 +22,7 @@ import gi
 gi.require_version("Gtk", "4.0")
 from gi.repository import GLib, Gtk  # noqa: E402
 
-from ..model import ConnectionState, LinkLevel, Model, Phase  # noqa: E402
+from ..model import ConnectionState, LinkLevel, OperatorState, Phase, RobotModel  # noqa: E402
 from .gauges import BatteryGauge, WifiGauge, battery_fraction, wifi_bars  # noqa: E402
 from .ld_status import details_lines, goal_suffix  # noqa: E402
 
@@ -80,13 +80,15 @@ class StatusToolbar(Gtk.ScrolledWindow):
 
     def __init__(
         self,
-        model: Model,
+        model: RobotModel,
+        operator: OperatorState,
         *,
         clock: Callable[[], float] = time.monotonic,
         status_age: Callable[[], float | None] | None = None,
     ) -> None:
         super().__init__()
         self.model = model
+        self.operator = operator
         self.clock = clock
         self.status_age = status_age
         self.row = Gtk.Box(orientation=Gtk.Orientation.HORIZONTAL, spacing=0)
@@ -123,7 +125,7 @@ class StatusToolbar(Gtk.ScrolledWindow):
             model.robot.observe(lambda o, n: self.refresh()),
             model.health.observe(lambda o, n: self.refresh()),
             model.connection.observe(lambda o, n: self.refresh()),
-            model.speed.observe(lambda o, n: self.refresh()),
+            operator.speed.observe(lambda o, n: self.refresh()),
         ]
         self.refresh()
 
@@ -210,7 +212,9 @@ class StatusToolbar(Gtk.ScrolledWindow):
                 c["safe"].remove_css_class("alarm")
             else:
                 c["safe"].add_css_class("alarm")
-        c["speed"].show_value(f"{self.model.speed.value.percent} %", stale=False, tooltip="+ / − to change")
+        c["speed"].show_value(
+            f"{self.operator.speed.value.percent} %", stale=False, tooltip="+ / − to change"
+        )
         self._link(conn, health, age)
         self._dock(robot.dock_state, link_ok)
 

@@ -1,7 +1,9 @@
 """The main window: header bar, status toolbar, map ⇄ camera stack, banners, D-pad; the controller's View.
 
-The window wires widgets to the controller and the model and owns nothing
-else: no socket, no packet, no blocking call. A red STOP is always on screen:
+The window shows one :class:`rtmu.fleet.RobotSession` (its state, its
+controller) with the operator's choices (:class:`rtmu.model.OperatorState`); it
+wires widgets to them and owns nothing else: no socket, no packet, no blocking
+call, no network thread. A red STOP is always on screen:
 first in the header bar, and in the slim bar that replaces the header in full
 screen (``bars``). Its two timers are the UI's
 heartbeat: every :data:`rtmu.controller.TICK` it renews the drive lease
@@ -11,9 +13,10 @@ picture age).
 
 Banners have topics (see ``banners``): the connection's life (connecting,
 connected, failed, lost → reconnecting (n)) is drawn from the model into ONE
-``link`` banner updated in place; the controller's own sentences about the same
-events are folded into it instead of stacking; a deliberate disconnect shows
-nothing.
+``link`` banner updated in place; notices (:class:`rtmu.notices.Notice`) are
+routed by their kind — connection notices fold into that banner, speed into the
+speed banner, camera into the camera page — never by the words in their text; a
+deliberate disconnect shows nothing.
 """
 
 from __future__ import annotations
@@ -28,18 +31,20 @@ gi.require_version("Gdk", "4.0")
 from gi.repository import Gdk, Gio, GLib, Gtk  # noqa: E402
 
 from ..commands import COMMANDS, CommandState  # noqa: E402
-from ..controller import TICK, ClientLink, Controller, Notice, SecretStore  # noqa: E402
+from ..controller import TICK, SecretStore  # noqa: E402
+from ..fleet import RobotSession  # noqa: E402
 from ..guardian.handle import BEAT_PERIOD as GUARDIAN_BEAT  # noqa: E402
 from ..model import (  # noqa: E402
     SPEED_MAX,
     SPEED_MIN,
     ConnectionState,
     MapModel,
-    Model,
+    OperatorState,
     Phase,
     RobotState,
     SpeedSetting,
 )
+from ..notices import Kind, Level, Notice  # noqa: E402
 from ..settings import Profile  # noqa: E402
 from .banners import BannerStack  # noqa: E402
 from .bars import FullscreenBar, connect_button, menu_button, show_connection, stop_button  # noqa: E402
@@ -61,7 +66,6 @@ REFRESH_EVERY = 3
 LOOP_LAG_WARN = 0.5
 """Seconds without a network-loop heartbeat after which the window warns that drive commands (and
 stops) are not going out; the warning goes once the lag is under half of this again."""
-_LINK_WORDS = ("Connected to", "Link lost", "Reconnecting", "Connection cancelled")
 
 
 def touch_only(display: Gdk.Display | None = None) -> bool:
@@ -103,8 +107,8 @@ class _View:
     def __init__(self, window: MainWindow) -> None:
         self.window = window
 
-    def notify(self, level: Notice, text: str) -> None:
-        self.window.show_notice(level, text)
+    def notify(self, notice: Notice) -> None:
+        self.window.show_notice(notice)
 
     def commands_changed(self, states: Mapping[str, CommandState]) -> None:
         self.window.commands_changed(states)
@@ -119,8 +123,8 @@ class MainWindow(Gtk.ApplicationWindow):
     def __init__(
         self,
         app: Gtk.Application,
-        model: Model,
-        link: ClientLink,
+        session: RobotSession,
+        operator: OperatorState,
         *,
         profile: Profile,
         profiles: Mapping[str, Profile] | None = None,
@@ -132,7 +136,9 @@ class MainWindow(Gtk.ApplicationWindow):
         super().__init__(application=app, title="RTMU")
         self.set_default_size(800, 480)
         self.set_size_request(480, 320)
-        self.model = model
+        self.session = session
+        self.model = model = session.state
+        self.operator = operator
         self.clock = clock
         self.profiles = dict(profiles or {})
         self.keyring_available = keyring_available
@@ -143,11 +149,12 @@ class MainWindow(Gtk.ApplicationWindow):
         self._states: dict[str, CommandState] = {}
         self._dialog: Gtk.Window | None = None
 
-        status_age = getattr(link, "status_age", None)
+        link = session.runner
+        status_age = link.status_age
         self.banners = BannerStack()
-        self.stage = MapStage(model, clock=clock, status_age=status_age)
+        self.stage = MapStage(model, operator, clock=clock, status_age=status_age)
         self.stage.on_view_changed = self._view_changed
-        self.toolbar = StatusToolbar(model, clock=clock, status_age=status_age)
+        self.toolbar = StatusToolbar(model, operator, clock=clock, status_age=status_age)
         self.camera = CameraView(on_request=self._request_picture, on_back=self.show_map, clock=clock)
         self.inset = CameraInset(self.show_camera, clock=clock)
         self.decoder = PictureDecoder(self._picture_decoded)
@@ -158,7 +165,10 @@ class MainWindow(Gtk.ApplicationWindow):
         self.add_controller(self.keys.controller)
 
         self._build()
-        self.controller = Controller(model, link, _View(self), clock=clock, secrets=secrets, profile=profile)
+        self.controller = session.controller
+        if secrets is not None:
+            self.controller.secrets = secrets
+        session.attach_view(_View(self))
         self.controller.select_profile(profile)
         self._set_speed_from_profile(profile)
         self._install_actions()
@@ -166,7 +176,7 @@ class MainWindow(Gtk.ApplicationWindow):
 
         self._unobserve = [
             model.connection.observe(self._on_connection),
-            model.speed.observe(self._on_speed),
+            operator.speed.observe(self._on_speed),
             model.camera.observe(self._on_camera),
             model.map.observe(self._on_map),
             model.robot.observe(self._on_robot),
@@ -176,12 +186,7 @@ class MainWindow(Gtk.ApplicationWindow):
         self._tick_source = GLib.timeout_add(int(TICK * 1000), self._tick)
         # The UI thread's heartbeat to the guardian process (rtmu.guardian): it stops the robot
         # if these stop while driving because this process was killed or frozen.
-        ui_heartbeat = getattr(link, "ui_heartbeat", None)
-        self._beat_source = (
-            GLib.timeout_add(int(GUARDIAN_BEAT * 1000), lambda: ui_heartbeat() or True)
-            if callable(ui_heartbeat)
-            else 0
-        )
+        self._beat_source = GLib.timeout_add(int(GUARDIAN_BEAT * 1000), lambda: link.ui_heartbeat() or True)
         self.commands_changed(self.controller.command_states())
         self._on_connection(ConnectionState(), model.connection.value)
         self._on_map(MapModel(), model.map.value)
@@ -372,35 +377,36 @@ class MainWindow(Gtk.ApplicationWindow):
         self.fullscreen_action = toggle("fullscreen", False, self._set_fullscreen)
         self.dpad_action = toggle("dpad", self.dpad.get_visible(), self._set_dpad)
         self.inset_action = toggle("inset", True, self.inset.set_enabled)
-        self.sonar_action = toggle("sonar", self.model.view.value.show_sonar, self._set_sonar)
+        self.sonar_action = toggle("sonar", self.operator.view.value.show_sonar, self._set_sonar)
         self.safe_action = toggle("safe-drive", True, self._set_safe_drive)
         self.connect("notify::fullscreened", self._fullscreen_changed)
 
     # -- the controller's View -----------------------------------------------------------------
-    def show_notice(self, level: Notice, text: str) -> None:
-        """Show a controller/network message; connection and speed messages fold into their banners."""
+    def show_notice(self, notice: Notice) -> None:
+        """Show a controller/network message where its kind belongs (never routed by its words)."""
+        kind, level, text = notice.kind, notice.level, notice.text
         phase = self.model.connection.value.phase
-        if text.startswith(_LINK_WORDS) or (text and text == self.model.connection.value.error):
+        if kind is Kind.CONNECTION or (text and text == self.model.connection.value.error):
             return  # the link banner shows the connection's life from the model
-        if text.startswith("Reconnected to"):
-            self.banners.show("link", "info", text, timeout=4.0)
-        elif text.startswith("Stopped: the link"):
-            if phase is Phase.CONNECTED:
-                self.banners.show("link", "warning", text, timeout=None)
-        elif text.startswith("Speed is already"):
-            pct = self.model.speed.value.percent
+        if kind is Kind.LINK:
+            if level is Level.INFO:
+                self.banners.show("link", "info", text, timeout=4.0)
+            elif phase is Phase.CONNECTED:
+                self.banners.show("link", level.value, text, timeout=None)
+        elif kind is Kind.SPEED_LIMIT:
+            pct = self.operator.speed.value.percent
             limit = "maximum" if pct >= SPEED_MAX else "minimum"
             self.banners.show("speed", "warning", f"Speed at its {limit}: {pct} %", timeout=2.5,
                               fraction=pct / SPEED_MAX)  # fmt: skip
-        elif text.startswith("Speed "):
+        elif kind is Kind.SPEED:
             return  # the speed banner follows the model
-        elif "camera" in text.lower() or "picture" in text.lower():
+        elif kind is Kind.CAMERA:
             if self.camera.waiting:
                 self.camera.failed(text)
             self.banners.show("camera", level.value, text, timeout=5.0)
         else:
             self.banners.show(
-                f"notice:{text}", level.value, text, timeout=6.0 if level is Notice.ERROR else 4.0
+                f"notice:{text}", level.value, text, timeout=6.0 if level is Level.ERROR else 4.0
             )
 
     def commands_changed(self, states: Mapping[str, CommandState]) -> None:
@@ -663,7 +669,7 @@ class MainWindow(Gtk.ApplicationWindow):
         self.inset.place(corner_free=not on)  # the D-pad takes the bottom-left corner
 
     def _set_sonar(self, on: bool) -> None:
-        self.model.view.update(show_sonar=on)
+        self.operator.view.update(show_sonar=on)
 
     def _set_safe_drive(self, on: bool) -> None:
         self.controller.run("safe_drive_on" if on else "safe_drive_off")
@@ -674,7 +680,7 @@ class MainWindow(Gtk.ApplicationWindow):
 
     def _set_speed_from_profile(self, profile: Profile) -> None:
         pct = max(SPEED_MIN, min(SPEED_MAX, profile.speed // 10 * 10))
-        self.model.speed.set(SpeedSetting(pct))
+        self.operator.speed.set(SpeedSetting(pct))
 
     # -- dialogs -------------------------------------------------------------------------------
     def open_settings(self) -> None:

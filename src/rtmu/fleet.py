@@ -1,0 +1,156 @@
+"""One session per robot, and the fleet that owns them: what the application builds.
+
+A :class:`RobotSession` puts together everything that belongs to one robot —
+its state (:class:`~rtmu.model.RobotModel`: robot, map, camera, connection,
+health, trail), its network thread (:class:`~rtmu.client.runner.ClientRunner`,
+which holds the drive lease, the session and its guardian) and its
+:class:`~rtmu.controller.Controller` — and takes them apart again in one
+:meth:`RobotSession.close` that stops the robot first.
+
+The :class:`Fleet` owns the sessions, says which one is selected, and stops
+them all at once: the application's close, quit, suspend and signal paths go
+through :meth:`Fleet.stop_all` / :meth:`Fleet.close`, so no robot is left
+driving because a window only knew about another one. Today's window is a
+fleet of one. GTK-free: ``post`` is ``GLib.idle_add`` in the app and a direct
+call or a queue in tests; everything here runs on the UI thread.
+"""
+
+from __future__ import annotations
+
+import concurrent.futures
+import time
+from collections.abc import Callable
+from typing import Any
+
+from .client.runner import ClientRunner, Post, call_directly, settle
+from .client.session import SessionConfig
+from .commands import COMMANDS, CommandRegistry
+from .controller import Controller, NoView, SecretStore, View
+from .model import Observable, OperatorState, RobotModel
+from .settings import Profile
+
+CLOSE_TIMEOUT = 1.5
+"""How long closing one session may take (stop, disconnect, end the network thread)."""
+STOP_TIMEOUT = 0.5
+"""How long :meth:`Fleet.stop_all` waits for every stop to leave the process."""
+
+
+class RobotSession:
+    """One robot: its state, network runner and controller. Use from the UI thread."""
+
+    def __init__(
+        self,
+        operator: OperatorState,
+        *,
+        post: Post = call_directly,
+        config: SessionConfig | None = None,
+        profile: Profile | None = None,
+        secrets: SecretStore | None = None,
+        clock: Callable[[], float] = time.monotonic,
+        registry: CommandRegistry = COMMANDS,
+    ) -> None:
+        self.state = RobotModel()
+        self.runner = ClientRunner(self.state, post=post, clock=clock, config=config)
+        self.controller = Controller(
+            self.state,
+            operator,
+            self.runner,
+            NoView(),
+            clock=clock,
+            registry=registry,
+            secrets=secrets,
+            profile=profile,
+        )
+        self.closed = False
+
+    @property
+    def name(self) -> str:
+        """The profile's name, else ``host:port`` (what a robot list shows)."""
+        p = self.controller.profile
+        return p.name or f"{p.host}:{p.port}"
+
+    def start(self) -> RobotSession:
+        """Start the network thread."""
+        self.runner.start()
+        return self
+
+    def attach_view(self, view: View) -> None:
+        """Let ``view`` (a window) hear this robot's notices and command states."""
+        self.controller.view = view
+        view.commands_changed(self.controller.command_states())
+
+    def stop(self) -> concurrent.futures.Future[bool]:
+        """End any held drive and send zero ratios + ``stop`` now; the Future says if it left in time."""
+        self.controller.stop()
+        return self.runner.stop_flushing(STOP_TIMEOUT)
+
+    def close(self, timeout: float = CLOSE_TIMEOUT) -> None:
+        """Stop the robot, then unhook every observer and end the network thread. Idempotent."""
+        if self.closed:
+            return
+        self.closed = True
+        self.controller.stop()
+        self.controller.close()
+        self.runner.close(timeout)
+
+
+class Fleet:
+    """The robot sessions of one application, the selected one, and :meth:`stop_all`.
+
+    ``sessions`` and ``selected`` are observables, so a robot list binds to them.
+    """
+
+    def __init__(self, operator: OperatorState | None = None) -> None:
+        self.operator = operator or OperatorState()
+        self.sessions: Observable[tuple[RobotSession, ...]] = Observable(())
+        self.selected: Observable[RobotSession | None] = Observable(None)
+
+    def __iter__(self) -> Any:
+        return iter(self.sessions.value)
+
+    def __len__(self) -> int:
+        return len(self.sessions.value)
+
+    def open(self, *, select: bool = True, **options: Any) -> RobotSession:
+        """A new started session (``options`` as for :class:`RobotSession`), added to the fleet."""
+        session = RobotSession(self.operator, **options).start()
+        self.add(session, select=select)
+        return session
+
+    def add(self, session: RobotSession, *, select: bool = True) -> None:
+        self.sessions.set((*self.sessions.value, session))
+        if select or self.selected.value is None:
+            self.selected.set(session)
+
+    def select(self, session: RobotSession) -> None:
+        if session not in self.sessions.value:
+            raise ValueError("that session is not in this fleet")
+        self.selected.set(session)
+
+    def remove(self, session: RobotSession) -> None:
+        """Close ``session`` (its robot is stopped first) and forget it."""
+        session.close()
+        remaining = tuple(s for s in self.sessions.value if s is not session)
+        self.sessions.set(remaining)
+        if self.selected.value is session:
+            self.selected.set(remaining[0] if remaining else None)
+
+    def stop_all(self, wait: float | None = None) -> bool:
+        """Stop every robot now (all stops are sent before any is waited for).
+
+        With ``wait``: block up to that many seconds until every stop has left this process
+        (for Ctrl+Z, which freezes us next); True when all did.
+        """
+        futures = [session.stop() for session in self.sessions.value]
+        if wait is None:
+            return True
+        deadline = time.monotonic() + wait
+        return all([settle(f, max(0.0, deadline - time.monotonic())) for f in futures])
+
+    def close(self, timeout: float = CLOSE_TIMEOUT) -> None:
+        """Stop every robot at once, then close each session. Idempotent."""
+        self.stop_all()
+        for session in self.sessions.value:
+            session.close(timeout)
+        self.sessions.set(())
+        self.selected.set(None)

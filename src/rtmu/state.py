@@ -1,0 +1,253 @@
+"""The values RTMU knows about one robot and its link, and the typed changes that carry them.
+
+Plain frozen dataclasses: the network thread builds them, hands them over as a
+:data:`StateChange` (one class per part, so a change can never land on the
+wrong part), and the UI thread keeps them in :class:`rtmu.model.RobotModel`.
+Nothing here imports GTK or asyncio, and nothing here is tied to a thread, so
+the client layer uses this module and never the UI thread's observables.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+from enum import Enum, StrEnum
+from typing import TYPE_CHECKING, Protocol
+
+if TYPE_CHECKING:
+    from .mapfile.model import MapData
+
+
+# -- robot ---------------------------------------------------------------------------------------
+
+
+@dataclass(frozen=True, slots=True)
+class RobotState:
+    """The robot as the server last described it. ``None`` = not reported (yet)."""
+
+    x: float = 0.0
+    """mm, map frame."""
+    y: float = 0.0
+    """mm."""
+    th: float = 0.0
+    """degrees, counter-clockwise positive, −179…180."""
+    vel: float = 0.0
+    """mm/s."""
+    rot_vel: float = 0.0
+    """deg/s."""
+    lat_vel: float = 0.0
+    """mm/s (0 on non-holonomic robots)."""
+    battery_v: float | None = None
+    """Volts, or state of charge in % when ``battery_is_soc``."""
+    battery_low: float | None = None
+    """Low-battery level in the same unit as ``battery_v`` (``batteryInfo``)."""
+    battery_shutdown: float | None = None
+    """Level at which the robot shuts down."""
+    battery_is_soc: bool = False
+    temperature: float | None = None
+    """°C; None when the server says unknown (−128)."""
+    status: str = ""
+    """e.g. ``Stopped``, ``Driving`` (``updateStrings``)."""
+    mode: str = ""
+    """Display mode string, e.g. ``Stop``, ``Drive``, ``UNSAFE Drive``."""
+    extended_status: str = ""
+    mode_name: str = ""
+    """Internal mode name from ``getModeInfo`` (``stop``, ``ratioDrive``…)."""
+    safe_drive: bool | None = None
+    wifi_quality: int | None = None
+    """Link quality as the server publishes it (a ``getStrings`` item); None if not offered."""
+    wifi_signal: int | None = None
+    """Signal level (dBm on Linux) from a ``getStrings`` item; None if not offered."""
+    sonar: tuple[tuple[int, int], ...] = ()
+    """Current sonar readings, global mm."""
+    numbers_at: float | None = field(default=None, compare=False)
+    """Monotonic time of the last pose/velocity/battery update (not compared: no redraw)."""
+    strings_at: float | None = field(default=None, compare=False)
+    """Monotonic time of the last status/mode update."""
+    sonar_at: float | None = field(default=None, compare=False)
+    laser: tuple[tuple[int, int], ...] = ()
+    """Current laser points of every listed ``Laser_*Current`` (LD robots), global mm."""
+    laser_at: float | None = field(default=None, compare=False)
+    dock_state: str | None = None
+    """``Undocked``, ``Docking``, ``Docked``, ``Undocking`` (``dockInfo``); None if not offered."""
+    routes: tuple[str, ...] = ()
+    """Route names (``getRoutes``, LD robots)."""
+    data_store: tuple[tuple[str, str], ...] = ()
+    """(data name, value) of every listed ``DataStore_*`` string, sorted by name."""
+    goals: tuple[str, ...] = ()
+    """The map's goal names (``getGoals``), asked for where ``gotoRouteGoal`` is listed (LD robots)."""
+    loc_score: int | None = None
+    """Localization score 0–100 from ``DataStore_Localization_Score``; None if not offered."""
+    goal_distance_mm: int | None = None
+    """Distance left to the goal from ``DataStore_Distance_To_Goal`` (0: no goal); None if not offered."""
+    closest_obstacle_mm: int | None = None
+    """``DataStore_Closest_Obstacle``; None if not offered or nothing in range."""
+
+    @property
+    def battery_pct(self) -> float | None:
+        """State of charge in %, when ``batteryInfo`` says the robot reports it; None when volts."""
+        return self.battery_v if self.battery_is_soc else None
+
+    @property
+    def battery_state(self) -> str:
+        """``ok``, ``low``, ``critical`` (at or under the shutdown level) or ``unknown``."""
+        if self.battery_v is None:
+            return "unknown"
+        if self.battery_shutdown is not None and self.battery_v <= self.battery_shutdown:
+            return "critical"
+        if self.battery_low is not None and self.battery_v <= self.battery_low:
+            return "low"
+        return "ok"
+
+    @property
+    def moving(self) -> bool:
+        return self.vel != 0 or self.rot_vel != 0 or self.lat_vel != 0
+
+
+# -- map -----------------------------------------------------------------------------------------
+
+
+class MapPhase(StrEnum):
+    """Where the map download stands (a ``StrEnum``: it compares equal to its text)."""
+
+    UNKNOWN = "unknown"
+    """Not asked yet."""
+    LOADING = "loading"
+    READY = "ready"
+    NONE = "none"
+    """The server has no map: the view shows the robot alone (thesis §5.8.4)."""
+    FAILED = "failed"
+    UNSUPPORTED = "unsupported"
+    """The server offers no map data."""
+
+
+@dataclass(frozen=True, slots=True)
+class MapModel:
+    """The server's map and the state of its download (``data`` only when ``state`` is READY)."""
+
+    state: MapPhase = MapPhase.UNKNOWN
+    data: MapData | None = field(default=None, compare=False)
+    name: str = ""
+    """The server's map file name (``getMapName``), may be empty."""
+    generation: int = 0
+    """Bumped for every newly loaded map, so observers see a change even when the name is equal."""
+    received: int = 0
+    """Packets received so far while loading (progress)."""
+    error: str = ""
+
+
+# -- camera --------------------------------------------------------------------------------------
+
+
+@dataclass(frozen=True, slots=True)
+class CameraImage:
+    """One JPEG picture from the robot's camera. The view decodes it; the model only keeps bytes."""
+
+    jpeg: bytes = field(repr=False)
+    width: int
+    height: int
+    source: str
+    """Data name it came from (``getPictureCam1``, ``sendVideo``…)."""
+    received_at: float = field(compare=False)
+    sequence: int = 0
+    """Increases for every picture, so two identical frames still count as a new picture."""
+
+
+# -- connection and link -------------------------------------------------------------------------
+
+
+class Phase(Enum):
+    DISCONNECTED = "disconnected"
+    CONNECTING = "connecting"
+    CONNECTED = "connected"
+    RECONNECTING = "reconnecting"
+    FAILED = "failed"
+    """The last attempt failed and no retry is planned (``error`` says why)."""
+
+
+@dataclass(frozen=True, slots=True)
+class ConnectionState:
+    phase: Phase = Phase.DISCONNECTED
+    host: str = ""
+    port: int = 0
+    user: str = ""
+    profile: str = ""
+    offers: frozenset[str] = frozenset()
+    """Data names the server offers to this user (empty until connected)."""
+    error: str = ""
+    """An operator-readable sentence for the last failure, or ""."""
+    error_kind: str = ""
+    """The error's class: ``refused``, ``timeout``, ``login``, ``closed``, ``protocol``, ``unsupported``…"""
+    attempt: int = 0
+    """Reconnect attempt number while RECONNECTING."""
+    retry_in: float | None = None
+    """Seconds until the next reconnect attempt, if one is planned."""
+
+    @property
+    def connected(self) -> bool:
+        return self.phase is Phase.CONNECTED
+
+    def supports(self, name: str) -> bool:
+        return name in self.offers
+
+
+class LinkLevel(Enum):
+    DOWN = "down"
+    """Not connected."""
+    OK = "ok"
+    STALE = "stale"
+    """No status for 3 update intervals, or a ping went unanswered: driving is stopped."""
+    LOST = "lost"
+    """No status for 2 s, or 3 pings unanswered: the link is considered gone (reconnect if enabled)."""
+
+
+@dataclass(frozen=True, slots=True)
+class LinkHealth:
+    level: LinkLevel = LinkLevel.DOWN
+    rtt_ms: float | None = None
+    """Round-trip time of the last ping, rounded to 0.1 ms; None before the first."""
+    dropped: int = 0
+    """Packets the decoder threw away (bad length or checksum) on this connection."""
+    garbage_bytes: int = 0
+    """Bytes skipped while resynchronising."""
+    status_age: float | None = field(default=None, compare=False)
+    """Seconds since the last status packet (not compared: it changes all the time)."""
+    ping_failures: int = 0
+    """Pings in a row the server did not answer: it may no longer hear us (RTT is then None)."""
+
+
+# -- typed changes -------------------------------------------------------------------------------
+
+
+@dataclass(frozen=True, slots=True)
+class RobotChanged:
+    value: RobotState
+
+
+@dataclass(frozen=True, slots=True)
+class MapChanged:
+    value: MapModel
+
+
+@dataclass(frozen=True, slots=True)
+class CameraChanged:
+    value: CameraImage | None
+
+
+@dataclass(frozen=True, slots=True)
+class ConnectionChanged:
+    value: ConnectionState
+
+
+@dataclass(frozen=True, slots=True)
+class HealthChanged:
+    value: LinkHealth
+
+
+StateChange = RobotChanged | MapChanged | CameraChanged | ConnectionChanged | HealthChanged
+"""What the network side publishes: the class says which part changed, the value is the new whole."""
+
+
+class StateSink(Protocol):
+    """Where a runner's changes land, on the UI thread (``RobotModel``; a recorder or a test list)."""
+
+    def apply(self, change: StateChange) -> None: ...
