@@ -144,6 +144,8 @@ class RtmuApplication(Gtk.Application):
             self.quit()
             raise
         self.window = window
+        # Closing the window stops every robot of the fleet, not only the one it shows.
+        window.connect("close-request", lambda _w: self.fleet.stop_all() and False)
         if self.options.report_first_frame:
             window.stage.on_first_map_frame = self._report_first_frame
         if self.options.fullscreen:
