@@ -13,7 +13,8 @@ from pathlib import Path
 
 import pytest
 
-from rtmu.cli import EXIT_OK, main
+from rtmu.cli import main
+from rtmu.exit_codes import EXIT_OK
 from rtmu.maps import read_map, write_map
 from rtmu.sim import SimConfig, SimThread
 

@@ -15,12 +15,7 @@ import sys
 from collections.abc import Sequence
 
 from . import __version__, subcommands
-
-EXIT_OK = 0
-EXIT_USAGE = 2
-EXIT_CONNECTION = 3
-EXIT_UNSUPPORTED = 4
-EXIT_TIMEOUT = 5
+from .exit_codes import EXIT_USAGE
 
 
 def build_parser() -> argparse.ArgumentParser:

@@ -1,26 +1,26 @@
-"""The operator's commands: one small class each, in one registry.
+"""The operator's commands: one small class each, in one registry — the only definition of a command.
 
-A command says what it is called, what key runs it by default, which server
-data it needs and when it is enabled; running it calls the controller. The view
-builds its actions, menu entries and key bindings from :data:`COMMANDS`, and
-greys out a command with the reason :meth:`Command.unavailable` gives (e.g.
-"this server does not offer turnByAngle"). Adding a command = adding one class
-to this file.
+A command says what it is called (``name``, ``label``), which keys run it and
+under which heading the shortcuts window lists them (``keys``, ``group``),
+whether the robot menu offers it (``menu``), which server data it needs and when
+it is enabled, and what it does to its :class:`CommandTarget` (the controller).
+The window builds its actions (``win.<name>``, underscores as hyphens), its key
+table, the robot menu and the shortcuts window from :data:`COMMANDS`, and greys
+a command out with the reason :meth:`Command.unavailable` gives (e.g. "this
+server does not offer turnByAngle"). Adding a command = adding one class.
 
 Keys use GTK accelerator syntax (``"Up"``, ``"plus"``, ``"<Control>d"``) but
-nothing here imports GTK.
+nothing here imports GTK, nor the controller: a command knows its target only
+through the :class:`CommandTarget` protocol.
 """
 
 from __future__ import annotations
 
 from collections.abc import Iterator
 from dataclasses import dataclass
-from typing import TYPE_CHECKING, ClassVar, Protocol
+from typing import ClassVar, Protocol
 
 from .state import Phase
-
-if TYPE_CHECKING:
-    from .controller import Controller
 
 LINKING = (Phase.CONNECTING, Phase.RECONNECTING, Phase.CONNECTED)
 """Phases in which there is something to disconnect (an attempt in progress can be cancelled)."""
@@ -39,6 +39,35 @@ class CommandContext(Protocol):
     def connection_phase(self) -> Phase: ...
 
 
+class CommandTarget(Protocol):
+    """What commands act on (``rtmu.controller.Controller`` provides it)."""
+
+    def press(self, direction: str) -> None: ...
+
+    def release(self, direction: str) -> None: ...
+
+    def stop(self) -> None: ...
+
+    def speed_up(self) -> None: ...
+
+    def speed_down(self) -> None: ...
+
+    def turn_by(self, degrees: float) -> None: ...
+
+    def move_distance(self, mm: float) -> None: ...
+
+    def request_image(self) -> None: ...
+
+    def set_safe_drive(self, on: bool) -> None: ...
+
+    def connect(self, password: str | None = None) -> None: ...
+
+    def disconnect(self) -> None: ...
+
+    def open_dialog(self, name: str) -> None:
+        """Ask the window for the dialog ``name`` (``turn``, ``go``) that asks the operator for an amount."""
+
+
 @dataclass(frozen=True, slots=True)
 class CommandState:
     enabled: bool
@@ -53,8 +82,12 @@ class Command:
     """Stable identifier (action name), lower_snake_case."""
     label: ClassVar[str]
     """Short text for menus and tooltips."""
-    default_key: ClassVar[str | None] = None
-    """GTK accelerator string, or None."""
+    keys: ClassVar[tuple[str, ...]] = ()
+    """GTK accelerator strings that run it (the window's key table is built from these)."""
+    group: ClassVar[str] = "Robot"
+    """Heading in the shortcuts window."""
+    menu: ClassVar[bool] = False
+    """Offered in the window's robot menu (greyed with its reason when unavailable)."""
     needs: ClassVar[tuple[str | tuple[str, ...], ...]] = ()
     """Server data names it needs; a tuple inside means "any one of these"."""
     needs_connection: ClassVar[bool] = True
@@ -75,10 +108,10 @@ class Command:
         reason = self.unavailable(ctx)
         return CommandState(reason is None, reason or "")
 
-    def activate(self, controller: Controller) -> None:
+    def activate(self, target: CommandTarget) -> None:
         raise NotImplementedError
 
-    def deactivate(self, controller: Controller) -> None:
+    def deactivate(self, target: CommandTarget) -> None:
         """Key released (hold commands only)."""
 
 
@@ -91,8 +124,16 @@ class CommandRegistry:
     def register(self, cls: type[Command]) -> type[Command]:
         if cls.name in self._commands:
             raise ValueError(f"two commands named {cls.name!r}")
+        taken = self.keys()
+        for key in cls.keys:
+            if key in taken:
+                raise ValueError(f"{cls.name}: key {key!r} already runs {taken[key]!r}")
         self._commands[cls.name] = cls()
         return cls
+
+    def unregister(self, name: str) -> None:
+        """Remove a command (tests add their own and take them away again)."""
+        self._commands.pop(name, None)
 
     def get(self, name: str) -> Command:
         try:
@@ -112,9 +153,14 @@ class CommandRegistry:
     def states(self, ctx: CommandContext) -> dict[str, CommandState]:
         return {c.name: c.state(ctx) for c in self}
 
-    def default_keys(self) -> dict[str, str]:
-        """accelerator → command name, for the view's key bindings."""
-        return {c.default_key: c.name for c in self if c.default_key}
+    def keys(self) -> dict[str, str]:
+        """accelerator → command name, for the view's key table."""
+        return {key: c.name for c in self for key in c.keys}
+
+
+def action_name(command_name: str) -> str:
+    """The ``win.`` action of a command: GIO action names allow no underscores."""
+    return command_name.replace("_", "-")
 
 
 COMMANDS = CommandRegistry()
@@ -130,26 +176,28 @@ class _HeldDrive(Command):
     needs = ("ratioDrive",)
     hold = True
 
-    def activate(self, controller: Controller) -> None:
-        controller.press(self.direction)
+    def activate(self, target: CommandTarget) -> None:
+        target.press(self.direction)
 
-    def deactivate(self, controller: Controller) -> None:
-        controller.release(self.direction)
+    def deactivate(self, target: CommandTarget) -> None:
+        target.release(self.direction)
 
 
 @command
 class DriveForward(_HeldDrive):
     name = "drive_forward"
-    label = "Forward (hold)"
-    default_key = "Up"
+    label = "Drive forward (hold)"
+    keys = ("Up", "w")
+    group = "Driving"
     direction = "forward"
 
 
 @command
 class DriveBackward(_HeldDrive):
     name = "drive_backward"
-    label = "Backward (hold)"
-    default_key = "Down"
+    label = "Drive backward (hold)"
+    keys = ("Down", "s")
+    group = "Driving"
     direction = "backward"
 
 
@@ -157,7 +205,8 @@ class DriveBackward(_HeldDrive):
 class DriveLeft(_HeldDrive):
     name = "drive_left"
     label = "Turn left (hold)"
-    default_key = "Left"
+    keys = ("Left", "a")
+    group = "Driving"
     direction = "left"
 
 
@@ -165,7 +214,8 @@ class DriveLeft(_HeldDrive):
 class DriveRight(_HeldDrive):
     name = "drive_right"
     label = "Turn right (hold)"
-    default_key = "Right"
+    keys = ("Right", "d")
+    group = "Driving"
     direction = "right"
 
 
@@ -173,15 +223,16 @@ class DriveRight(_HeldDrive):
 class Stop(Command):
     name = "stop"
     label = "Stop"
-    default_key = "space"
+    keys = ("space", "KP_5")
+    group = "Driving"
     needs = (("stop", "ratioDrive"),)
 
     def unavailable(self, ctx: CommandContext) -> str | None:
         # Stop is never greyed out while connected: it is always worth sending.
         return None if ctx.connected else "not connected"
 
-    def activate(self, controller: Controller) -> None:
-        controller.stop()
+    def activate(self, target: CommandTarget) -> None:
+        target.stop()
 
 
 # -- speed --------------------------------------------------------------------------------------
@@ -191,22 +242,24 @@ class Stop(Command):
 class SpeedUp(Command):
     name = "speed_up"
     label = "Faster (+10 %)"
-    default_key = "plus"
+    keys = ("plus", "KP_Add", "equal")
+    group = "Speed"
     needs_connection = False
 
-    def activate(self, controller: Controller) -> None:
-        controller.speed_up()
+    def activate(self, target: CommandTarget) -> None:
+        target.speed_up()
 
 
 @command
 class SpeedDown(Command):
     name = "speed_down"
     label = "Slower (−10 %)"
-    default_key = "minus"
+    keys = ("minus", "KP_Subtract")
+    group = "Speed"
     needs_connection = False
 
-    def activate(self, controller: Controller) -> None:
-        controller.speed_down()
+    def activate(self, target: CommandTarget) -> None:
+        target.speed_down()
 
 
 # -- bounded moves (what the thesis's operators asked for) ---------------------------------------
@@ -216,15 +269,42 @@ class _TurnBy(Command):
     degrees: ClassVar[float]
     needs = ("turnByAngle",)
 
-    def activate(self, controller: Controller) -> None:
-        controller.turn_by(self.degrees)
+    def activate(self, target: CommandTarget) -> None:
+        target.turn_by(self.degrees)
+
+
+@command
+class TurnDialog(Command):
+    name = "turn"
+    label = "Turn by an angle…"
+    keys = ("t",)
+    group = "Moves"
+    menu = True
+    needs = ("turnByAngle",)
+
+    def activate(self, target: CommandTarget) -> None:
+        target.open_dialog("turn")
+
+
+@command
+class GoDialog(Command):
+    name = "go"
+    label = "Go a distance…"
+    keys = ("g",)
+    group = "Moves"
+    menu = True
+    needs = ("moveDist",)
+
+    def activate(self, target: CommandTarget) -> None:
+        target.open_dialog("go")
 
 
 @command
 class TurnLeft90(_TurnBy):
     name = "turn_left_90"
     label = "Turn 90° left"
-    default_key = "<Shift>Left"
+    keys = ("<Shift>Left",)
+    group = "Moves"
     degrees = 90.0
 
 
@@ -232,15 +312,17 @@ class TurnLeft90(_TurnBy):
 class TurnRight90(_TurnBy):
     name = "turn_right_90"
     label = "Turn 90° right"
-    default_key = "<Shift>Right"
+    keys = ("<Shift>Right",)
+    group = "Moves"
     degrees = -90.0
 
 
 @command
 class TurnAround(_TurnBy):
     name = "turn_around"
-    label = "Turn around (180°)"
-    default_key = "<Shift>Down"
+    label = "Turn around"
+    keys = ("<Shift>Down",)
+    group = "Moves"
     degrees = 180.0
 
 
@@ -248,11 +330,12 @@ class TurnAround(_TurnBy):
 class MoveForward1m(Command):
     name = "move_forward_1m"
     label = "Go 1 m forward"
-    default_key = "<Shift>Up"
+    keys = ("<Shift>Up",)
+    group = "Moves"
     needs = ("moveDist",)
 
-    def activate(self, controller: Controller) -> None:
-        controller.move_distance(1000.0)
+    def activate(self, target: CommandTarget) -> None:
+        target.move_distance(1000.0)
 
 
 # -- sensing ------------------------------------------------------------------------------------
@@ -262,7 +345,8 @@ class MoveForward1m(Command):
 class RequestImage(Command):
     name = "request_image"
     label = "Camera picture"
-    default_key = "i"
+    keys = ("i",)
+    group = "Window"
 
     def unavailable(self, ctx: CommandContext) -> str | None:
         if not ctx.connected:
@@ -271,8 +355,8 @@ class RequestImage(Command):
             return "this server offers no camera pictures (getPicture… or sendVideo)"
         return None
 
-    def activate(self, controller: Controller) -> None:
-        controller.request_image()
+    def activate(self, target: CommandTarget) -> None:
+        target.request_image()
 
 
 @command
@@ -281,8 +365,8 @@ class SafeDriveOn(Command):
     label = "Safe drive on"
     needs = ("setSafeDrive",)
 
-    def activate(self, controller: Controller) -> None:
-        controller.set_safe_drive(True)
+    def activate(self, target: CommandTarget) -> None:
+        target.set_safe_drive(True)
 
 
 @command
@@ -291,8 +375,8 @@ class SafeDriveOff(Command):
     label = "Safe drive off (no obstacle limits)"
     needs = ("setSafeDrive",)
 
-    def activate(self, controller: Controller) -> None:
-        controller.set_safe_drive(False)
+    def activate(self, target: CommandTarget) -> None:
+        target.set_safe_drive(False)
 
 
 # -- session ------------------------------------------------------------------------------------
@@ -302,61 +386,27 @@ class SafeDriveOff(Command):
 class Connect(Command):
     name = "connect"
     label = "Connect"
-    default_key = "<Control>o"
+    keys = ("<Control>o",)
+    group = "Connection"
     needs_connection = False
 
     def unavailable(self, ctx: CommandContext) -> str | None:
         return "already connected" if ctx.connected else None
 
-    def activate(self, controller: Controller) -> None:
-        controller.connect()
+    def activate(self, target: CommandTarget) -> None:
+        target.connect()
 
 
 @command
 class Disconnect(Command):
     name = "disconnect"
     label = "Disconnect"
-    default_key = "<Control>d"
+    keys = ("<Control>d",)
+    group = "Connection"
 
     def unavailable(self, ctx: CommandContext) -> str | None:
         # Also while connecting or reconnecting: the button says "Disconnect" then and cancels.
         return None if ctx.connection_phase() in LINKING else "not connected"
 
-    def activate(self, controller: Controller) -> None:
-        controller.disconnect()
-
-
-# -- map view -----------------------------------------------------------------------------------
-
-
-@command
-class ZoomIn(Command):
-    name = "zoom_in"
-    label = "Zoom in"
-    default_key = "<Control>plus"
-    needs_connection = False
-
-    def activate(self, controller: Controller) -> None:
-        controller.zoom_in()
-
-
-@command
-class ZoomOut(Command):
-    name = "zoom_out"
-    label = "Zoom out"
-    default_key = "<Control>minus"
-    needs_connection = False
-
-    def activate(self, controller: Controller) -> None:
-        controller.zoom_out()
-
-
-@command
-class ZoomFit(Command):
-    name = "zoom_fit"
-    label = "Fit map"
-    default_key = "<Control>0"
-    needs_connection = False
-
-    def activate(self, controller: Controller) -> None:
-        controller.set_zoom(0.0)
+    def activate(self, target: CommandTarget) -> None:
+        target.disconnect()

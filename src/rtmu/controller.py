@@ -38,7 +38,7 @@ from typing import Protocol
 
 from .client.lease import DriveLease, DriveRatios, EndReason
 from .commands import COMMANDS, CommandRegistry, CommandState
-from .model import ZOOM_LEVELS, OperatorState, RobotModel, SpeedSetting
+from .model import OperatorState, RobotModel, SpeedSetting
 from .notices import Kind, Notice
 from .settings import Profile
 from .state import ConnectionState, LinkHealth, LinkLevel, Phase
@@ -62,6 +62,9 @@ class View(Protocol):
 
     def ask_password(self, profile: Profile, answer: Callable[[str | None], None]) -> None:
         """Ask for the password of ``profile`` without blocking; call ``answer`` (None = cancelled)."""
+
+    def open_dialog(self, name: str) -> None:
+        """Open the dialog a command needs (``turn``: an angle, ``go``: a distance)."""
 
 
 class ClientLink(Protocol):
@@ -129,6 +132,9 @@ class NoView:
 
     def ask_password(self, profile: Profile, answer: Callable[[str | None], None]) -> None:
         answer(None)
+
+    def open_dialog(self, name: str) -> None:
+        pass
 
 
 class Controller:
@@ -454,21 +460,11 @@ class Controller:
         self.stop()
         self.link.disconnect()
 
-    # -- map view ----------------------------------------------------------------------------
-    def set_zoom(self, zoom: float) -> None:
-        self.operator.view.update(zoom=max(0.0, min(ZOOM_LEVELS[-1], float(zoom))))
-
-    def zoom_in(self) -> None:
-        current = self.operator.view.value.zoom
-        bigger = [z for z in ZOOM_LEVELS if z > current + 1e-9]
-        self.set_zoom(bigger[0] if bigger else ZOOM_LEVELS[-1])
-
-    def zoom_out(self) -> None:
-        current = self.operator.view.value.zoom
-        if current == 0.0:
-            return  # already "fit"
-        smaller = [z for z in ZOOM_LEVELS if z < current - 1e-9]
-        self.set_zoom(smaller[-1] if smaller else ZOOM_LEVELS[0])
+    # -- dialogs -----------------------------------------------------------------------------
+    def open_dialog(self, name: str) -> None:
+        """A command that needs an amount first (``turn``, ``go``): stop, then let the view ask for it."""
+        self.stop()
+        self.view.open_dialog(name)
 
     # -- reactions to the model --------------------------------------------------------------
     def _on_connection(self, old: ConnectionState, new: ConnectionState) -> None:

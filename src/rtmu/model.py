@@ -236,10 +236,6 @@ class SpeedSetting:
         return self.percent <= SPEED_MIN
 
 
-ZOOM_LEVELS: tuple[float, ...] = (0.1, 0.2, 0.3, 0.4, 0.5, 0.6, 0.7, 0.8, 0.9, 1.0)
-"""Map zoom steps. ``0`` in ``ViewOptions.zoom`` means "fit the whole map"."""
-
-
 @dataclass(frozen=True, slots=True)
 class ViewOptions:
     zoom: float = 0.0

@@ -12,7 +12,8 @@ import re
 import pytest
 from PIL import Image
 
-from rtmu.cli import EXIT_CONNECTION, EXIT_OK, main
+from rtmu.cli import main
+from rtmu.exit_codes import EXIT_CONNECTION, EXIT_OK
 
 from .servers import ServerSide, ServerThread, TestServer
 

@@ -6,9 +6,10 @@ from pathlib import Path
 
 import pytest
 
-from rtmu.cli import EXIT_CONNECTION, main
+from rtmu.cli import main
 from rtmu.client.runner import ClientRunner
 from rtmu.client.session import SessionConfig
+from rtmu.exit_codes import EXIT_CONNECTION
 from rtmu.model import Phase, RobotModel
 
 from .servers import MAP_LINES, ServerThread, TestServer

@@ -10,7 +10,7 @@ import pytest
 from rtmu.commands import COMMANDS
 from rtmu.model import ConnectionState, LinkHealth, LinkLevel, OperatorState, Phase, RobotModel
 from rtmu.ui.gauges import battery_fraction, wifi_bars
-from rtmu.ui.keys import BINDINGS, KeyRouter
+from rtmu.ui.keys import KeyRouter, bindings
 from rtmu.ui.settings_dialog import validate
 from rtmu.ui.shortcuts import shortcuts_xml
 from rtmu.ui.toolbar import StatusToolbar
@@ -63,7 +63,7 @@ def test_wifi_bars_from_quality_or_signal() -> None:
 def test_every_bound_command_exists_and_keys_do_not_clash() -> None:
     seen: dict[tuple[int, int], str] = {}
     router = KeyRouter(hold=print, release=print, command=print, view=print)
-    for b in BINDINGS:
+    for b in bindings():
         if b.kind in ("hold", "command"):
             assert b.target in COMMANDS, b.target
         for accel in b.accels:
@@ -84,7 +84,7 @@ def test_every_bound_command_exists_and_keys_do_not_clash() -> None:
 def test_shortcuts_xml_escapes_and_lists_every_binding() -> None:
     root = ET.fromstring(shortcuts_xml())
     titles = [p.text for p in root.iter("property") if p.get("name") == "title"]
-    for b in BINDINGS:
+    for b in bindings():
         assert b.title in titles
 
 

@@ -414,10 +414,10 @@ def test_unsupported_commands_are_disabled_with_the_reason(start: Start) -> None
     window.commands_changed({"drive_forward": CommandState(False, reason)})
     pad = window.dpad.pads["drive_forward"]
     assert not pad.get_sensitive() and reason in (pad.get_tooltip_text() or "")
-    window.commands_changed({"turn_left_90": CommandState(False, "this server does not offer turnByAngle")})
+    window.commands_changed({"turn": CommandState(False, "this server does not offer turnByAngle")})
     assert not window.lookup_action("turn").get_enabled()
     gui.key("t")
-    pump(lambda: "turnByAngle" in (window.banners.text("notice:turn_left_90") or ""), 3, "the reason banner")
+    pump(lambda: "turnByAngle" in (window.banners.text("notice:turn") or ""), 3, "the reason banner")
     gui.shot("turn-unsupported")
 
 

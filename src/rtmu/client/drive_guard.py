@@ -17,7 +17,7 @@ import asyncio
 import contextlib
 import time
 
-from ..cli import EXIT_TIMEOUT
+from ..exit_codes import EXIT_TIMEOUT
 from ..state import LinkLevel
 from .connection import AriaClient, Packet
 from .errors import ClientError, ClientTimeout

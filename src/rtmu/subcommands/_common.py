@@ -38,9 +38,9 @@ from collections.abc import Awaitable, Callable
 from pathlib import Path
 from typing import Any
 
-from ..cli import EXIT_CONNECTION, EXIT_OK, EXIT_USAGE
 from ..client.connection import CONNECT_TIMEOUT, DEFAULT_PORT, AriaClient
 from ..client.errors import ClientError
+from ..exit_codes import EXIT_CONNECTION, EXIT_OK, EXIT_USAGE
 from ..protocol.errors import ProtocolError
 
 MAX_PASSWORD_FILE = 4096

@@ -19,9 +19,9 @@ import time
 from dataclasses import dataclass, field
 from typing import Any
 
-from ..cli import EXIT_OK, EXIT_USAGE
 from ..client.connection import TEXT_BANNERS
 from ..client.diagnosis import ADVICE, Step, login_finding
+from ..exit_codes import EXIT_OK, EXIT_USAGE
 from ..protocol.client_connection import ClientConnection
 from ..protocol.commands import ClientCommand, ServerCommand
 from ..protocol.decoder import PacketDecoder

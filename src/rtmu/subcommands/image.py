@@ -7,9 +7,9 @@ import sys
 from pathlib import Path
 from typing import Any
 
-from ..cli import EXIT_CONNECTION, EXIT_OK
 from ..client.connection import AriaClient
 from ..client.errors import NotSupported
+from ..exit_codes import EXIT_CONNECTION, EXIT_OK
 from ..textsafe import visible
 from ._common import add_connection_arguments, fail, run_with_client
 

@@ -7,10 +7,10 @@ import sys
 from pathlib import Path
 from typing import Any
 
-from ..cli import EXIT_OK, EXIT_UNSUPPORTED
 from ..client.connection import AriaClient
 from ..client.errors import ProtocolFault
 from ..client.mapload import download_map
+from ..exit_codes import EXIT_OK, EXIT_UNSUPPORTED
 from ..mapfile.errors import MapFormatError
 from ..textsafe import visible
 from ._common import add_connection_arguments, fail, run_with_client

@@ -1,5 +1,9 @@
 """Every key RTMU answers to, in one table, and the capture-phase controller that routes them.
 
+The commands' keys come from the command registry (``rtmu.commands``: the only
+place a command is defined); this module adds only the window's own keys (zoom,
+follow, the camera page) and the application actions, listed for the help.
+
 Why capture phase: GtkWindow consumes Space and Return (button activation) and
 the arrow keys (focus moves) before a normal bubble-phase controller sees them;
 a teleoperation window must get them first. The router hands held keys to the
@@ -20,6 +24,8 @@ gi.require_version("Gtk", "4.0")
 gi.require_version("Gdk", "4.0")
 from gi.repository import Gdk, Gtk  # noqa: E402
 
+from ..commands import COMMANDS, CommandRegistry  # noqa: E402
+
 
 @dataclass(frozen=True, slots=True)
 class Binding:
@@ -34,20 +40,7 @@ class Binding:
     target: str
 
 
-BINDINGS: tuple[Binding, ...] = (
-    Binding(("Up", "w"), "Drive forward (hold)", "Driving", "hold", "drive_forward"),
-    Binding(("Down", "s"), "Drive backward (hold)", "Driving", "hold", "drive_backward"),
-    Binding(("Left", "a"), "Turn left (hold)", "Driving", "hold", "drive_left"),
-    Binding(("Right", "d"), "Turn right (hold)", "Driving", "hold", "drive_right"),
-    Binding(("space", "KP_5"), "Stop", "Driving", "command", "stop"),
-    Binding(("plus", "KP_Add", "equal"), "Faster (+10 %)", "Speed", "command", "speed_up"),
-    Binding(("minus", "KP_Subtract"), "Slower (−10 %)", "Speed", "command", "speed_down"),
-    Binding(("t",), "Turn by an angle…", "Moves", "view", "turn_dialog"),
-    Binding(("g",), "Go a distance…", "Moves", "view", "go_dialog"),
-    Binding(("<Shift>Left",), "Turn 90° left", "Moves", "command", "turn_left_90"),
-    Binding(("<Shift>Right",), "Turn 90° right", "Moves", "command", "turn_right_90"),
-    Binding(("<Shift>Down",), "Turn around", "Moves", "command", "turn_around"),
-    Binding(("<Shift>Up",), "Go 1 m forward", "Moves", "command", "move_forward_1m"),
+WINDOW_BINDINGS: tuple[Binding, ...] = (
     Binding(("<Control>plus", "<Control>equal", "<Control>KP_Add"), "Zoom in", "Map", "view", "zoom_in"),
     Binding(("<Control>minus", "<Control>KP_Subtract"), "Zoom out", "Map", "view", "zoom_out"),
     Binding(("<Control>0",), "Fit map", "Map", "view", "zoom_fit"),
@@ -55,15 +48,25 @@ BINDINGS: tuple[Binding, ...] = (
     Binding(("Escape",), "Camera picture ⇄ map", "Window", "view", "toggle_camera"),
     Binding(("F11",), "Full screen", "Window", "action", "win.fullscreen"),
     Binding(("<Control>t",), "Status toolbar", "Window", "action", "win.toolbar"),
-    Binding(("<Control>o",), "Connect", "Connection", "action", "win.connect"),
-    Binding(("<Control>d",), "Disconnect", "Connection", "action", "win.disconnect"),
     Binding(("<Control>comma",), "Connection settings", "Connection", "action", "win.settings"),
     Binding(
         ("<Control>question", "F1"), "Keyboard shortcuts", "Application", "action", "win.show-help-overlay"
     ),
     Binding(("<Control>q",), "Quit", "Application", "action", "app.quit"),
 )
-"""Groups are small (at most 6) so the shortcuts window fits an 800×480 screen in pages of columns."""
+"""The window's own keys: view intents and application actions (no robot command)."""
+
+
+def bindings(registry: CommandRegistry = COMMANDS) -> tuple[Binding, ...]:
+    """The whole key table: every command's keys from the registry, then the window's own.
+
+    Groups are small (at most 6) so the shortcuts window fits an 800×480 screen in pages of columns.
+    """
+    commands = tuple(
+        Binding(c.keys, c.label, c.group, "hold" if c.hold else "command", c.name) for c in registry if c.keys
+    )
+    return commands + WINDOW_BINDINGS
+
 
 MODS = Gdk.ModifierType.CONTROL_MASK | Gdk.ModifierType.SHIFT_MASK | Gdk.ModifierType.ALT_MASK
 
@@ -77,7 +80,7 @@ def _parse(accel: str) -> tuple[int, Gdk.ModifierType]:
 
 def accels_for(target: str) -> list[str]:
     """The accelerators of an ``action`` binding (for ``Gtk.Application.set_accels_for_action``)."""
-    return [a for b in BINDINGS if b.target == target for a in b.accels]
+    return [a for b in WINDOW_BINDINGS if b.target == target for a in b.accels]
 
 
 class KeyRouter:
@@ -95,6 +98,7 @@ class KeyRouter:
         release: Callable[[str], None],
         command: Callable[[str], None],
         view: Callable[[str], None],
+        registry: CommandRegistry = COMMANDS,
     ) -> None:
         self._hold = hold
         self._release = release
@@ -103,7 +107,7 @@ class KeyRouter:
         self._held: dict[int, str] = {}
         """keycode → hold command name, for the keys now down."""
         self._table: dict[tuple[int, int], Binding] = {}
-        for b in BINDINGS:
+        for b in bindings(registry):
             if b.kind == "action":
                 continue
             for accel in b.accels:

@@ -1,4 +1,6 @@
-"""The keyboard-shortcuts window, generated from the one key table in ``keys.BINDINGS``.
+"""The keyboard-shortcuts window, generated from the one key table, ``keys.bindings()``.
+
+The table is the command registry's keys followed by the window's own (zoom, follow, camera page).
 
 GTK 4.8 builds a ``GtkShortcutsWindow`` only from builder XML, so the table is
 written out as XML (escaped) and built; a key added to the table shows up here
@@ -16,7 +18,7 @@ import gi
 gi.require_version("Gtk", "4.0")
 from gi.repository import Gtk  # noqa: E402
 
-from .keys import BINDINGS, Binding  # noqa: E402
+from .keys import Binding, bindings  # noqa: E402
 
 COLUMN_LINES = 6
 """Lines per column of the shortcuts window: small enough for an 800×480 screen (pages of columns)."""
@@ -33,9 +35,9 @@ def shown_accels(b: Binding) -> list[str]:
     return keys[:2]
 
 
-def shortcuts_xml(bindings: tuple[Binding, ...] = BINDINGS, column_lines: int = COLUMN_LINES) -> str:
+def shortcuts_xml(table: tuple[Binding, ...] | None = None, column_lines: int = COLUMN_LINES) -> str:
     groups: dict[str, list[Binding]] = {}
-    for b in bindings:
+    for b in table if table is not None else bindings():
         groups.setdefault(b.group, []).append(b)
     out = [
         '<?xml version="1.0" encoding="UTF-8"?>',

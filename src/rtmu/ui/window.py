@@ -30,7 +30,7 @@ gi.require_version("Gtk", "4.0")
 gi.require_version("Gdk", "4.0")
 from gi.repository import Gdk, Gio, GLib, Gtk  # noqa: E402
 
-from ..commands import COMMANDS, CommandState  # noqa: E402
+from ..commands import COMMANDS, CommandState, action_name  # noqa: E402
 from ..controller import TICK, SecretStore  # noqa: E402
 from ..fleet import RobotSession  # noqa: E402
 from ..guardian.handle import BEAT_PERIOD as GUARDIAN_BEAT  # noqa: E402
@@ -85,13 +85,12 @@ def touch_only(display: Gdk.Display | None = None) -> bool:
     return not pointers
 
 
-ROBOT_MENU = (
-    ("Turn by an angle…", "win.turn", "turn_left_90"),
-    ("Go a distance…", "win.go", "move_forward_1m"),
+WINDOW_ROBOT_MENU = (
     ("Camera picture", "win.camera", "request_image"),
     ("Safe drive", "win.safe-drive", "safe_drive_on"),
 )
-"""The menu's robot section: label, action, the command whose state enables it."""
+"""The robot menu's window entries after the registry's menu commands: label, action, and the command
+whose state enables it (the camera page and the safe-drive switch are the window's, not commands)."""
 
 
 def short_reason(reason: str) -> str:
@@ -115,6 +114,9 @@ class _View:
 
     def ask_password(self, profile: Profile, answer: Callable[[str | None], None]) -> None:
         self.window.ask_password(profile, answer)
+
+    def open_dialog(self, name: str) -> None:
+        self.window.open_dialog(name)
 
 
 class MainWindow(Gtk.ApplicationWindow):
@@ -328,8 +330,9 @@ class MainWindow(Gtk.ApplicationWindow):
 
     def _fill_robot_menu(self) -> None:
         """The robot's commands; a greyed one says why (GTK menus have no tooltips): "… — not connected"."""
+        entries = [(c.label, f"win.{action_name(c.name)}", c.name) for c in COMMANDS if c.menu]
         items = []
-        for label, action, command in ROBOT_MENU:
+        for label, action, command in (*entries, *WINDOW_ROBOT_MENU):
             found = self.lookup_action(action.removeprefix("win."))
             state = self._states.get(command)
             if found is not None and not found.get_enabled() and state is not None:
@@ -364,12 +367,12 @@ class MainWindow(Gtk.ApplicationWindow):
             self.add_action(action)
             return action
 
-        plain("settings", self.open_settings)
-        plain("connect", self.connect_now)
+        # One action per command of the registry (held drive keys excepted: they have no "activate").
         # Disconnect also cancels an attempt in progress: its command is enabled while connecting.
-        plain("disconnect", self.controller.disconnect)
-        plain("turn", lambda: self.view_intent("turn_dialog"))
-        plain("go", lambda: self.view_intent("go_dialog"))
+        for cmd in COMMANDS:
+            if not cmd.hold:
+                plain(action_name(cmd.name), lambda name=cmd.name: self._command(name))
+        plain("settings", self.open_settings)
         plain("camera", lambda: self.view_intent("toggle_camera"))
         plain("about", self.show_about)
         plain("details", self.show_details)
@@ -414,6 +417,7 @@ class MainWindow(Gtk.ApplicationWindow):
         for name, state in states.items():
             label = COMMANDS.get(name).label if name in COMMANDS else name
             self.dpad.set_command_state(name, state.enabled, state.reason, label)
+            self._enable(action_name(name), state.enabled)
             if name == "request_image":
                 self.camera_button.set_sensitive(
                     state.enabled or self.stack.get_visible_child_name() == "camera"
@@ -423,15 +427,10 @@ class MainWindow(Gtk.ApplicationWindow):
                 )
                 self.camera.set_available(state.enabled, state.reason)
                 self._enable("camera", state.enabled or self.stack.get_visible_child_name() == "camera")
-            elif name == "turn_left_90":
-                self._enable("turn", state.enabled)
-            elif name == "move_forward_1m":
-                self._enable("go", state.enabled)
             elif name == "safe_drive_on":
                 self._enable("safe-drive", state.enabled)
-            elif name == "disconnect":
-                self._enable("disconnect", state.enabled)
-        if any(name in states for _label, _action, name in ROBOT_MENU):
+        shown = {c.name for c in COMMANDS if c.menu} | {name for _label, _action, name in WINDOW_ROBOT_MENU}
+        if shown & set(states):
             self._fill_robot_menu()
 
     def ask_password(self, profile: Profile, answer: Callable[[str | None], None]) -> None:
@@ -459,6 +458,12 @@ class MainWindow(Gtk.ApplicationWindow):
         self.controller.release_command(name)
 
     def _command(self, name: str) -> None:
+        """A command from a key, the menu or a button: refused with its reason while shown disabled."""
+        state = self._states.get(name)
+        if state is not None and not state.enabled:
+            label = COMMANDS.get(name).label.rstrip("…") if name in COMMANDS else name
+            self.banners.show(f"notice:{name}", "warning", f"{label}: {state.reason}", timeout=4.0)
+            return
         self.controller.run(name)
 
     def view_intent(self, name: str) -> None:
@@ -468,10 +473,6 @@ class MainWindow(Gtk.ApplicationWindow):
                 self.show_map()
             else:
                 self.show_camera(request=True)
-        elif name == "turn_dialog":
-            self._open_move_dialog("turn_left_90", lambda: turn_dialog(self, self.controller.turn_by))
-        elif name == "go_dialog":
-            self._open_move_dialog("move_forward_1m", lambda: go_dialog(self, self.controller.move_distance))
         elif name == "zoom_in":
             self.stage.zoom_in()
         elif name == "zoom_out":
@@ -481,14 +482,13 @@ class MainWindow(Gtk.ApplicationWindow):
         elif name == "follow":
             self.stage.set_follow(not self.stage.follow)
 
-    def _open_move_dialog(self, command: str, make: Callable[[], Gtk.Window]) -> None:
-        state = self.command_state(command)
-        if not state.enabled:
-            label = "Turn by an angle" if command.startswith("turn") else "Go a distance"
-            self.banners.show(f"notice:{command}", "warning", f"{label}: {state.reason}", timeout=4.0)
-            return
-        self.controller.stop()
-        dialog = make()
+    def open_dialog(self, name: str) -> None:
+        """The dialog a command asked for (the controller stopped the robot first)."""
+        makers = {
+            "turn": lambda: turn_dialog(self, self.controller.turn_by),
+            "go": lambda: go_dialog(self, self.controller.move_distance),
+        }
+        dialog = makers[name]()
         dialog.present()
 
     def stop_now(self) -> None:
