@@ -12,7 +12,7 @@ from pathlib import Path
 import numpy as np
 
 from bench.common import Result, best_time
-from rtmu.maps import read_map, write_map
+from rtmu.maps import map_header_lines, read_map, write_map
 from rtmu.sim.mapgen import generate_map
 
 POINTS = 1_000_000
@@ -50,7 +50,7 @@ def naive_parse(path: Path) -> tuple[np.ndarray, np.ndarray]:
 def naive_write(data, path: Path) -> None:  # type: ignore[no-untyped-def]
     """The obvious writer: the header lines, then one formatted string per point."""
     with open(path, "w", encoding="latin-1") as file:
-        for line in data.header_lines():
+        for line in map_header_lines(data):
             file.write(line + "\n")
         file.write("LINES\n")
         for x1, y1, x2, y2 in data.segments.tolist():

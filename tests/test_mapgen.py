@@ -5,7 +5,7 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
-from rtmu.maps import parse_map
+from rtmu.maps import map_bytes, parse_map
 from rtmu.sim.mapgen import box_segments, generate_map, points_along
 from test_maps_project import distance_to_points, distance_to_segments
 
@@ -17,14 +17,14 @@ def test_exact_counts(points: int, lines: int) -> None:
     data = generate_map(points, lines, seed=5)
     assert data.num_points == points and data.num_lines == lines
     assert data.points.dtype == np.int32 and data.segments.dtype == np.int32
-    assert parse_map(data.to_bytes()) == data
+    assert parse_map(map_bytes(data)) == data
 
 
 def test_same_seed_same_map_other_seed_other_map() -> None:
     a = generate_map(20_000, 400, seed=11)
     b = generate_map(20_000, 400, seed=11)
     c = generate_map(20_000, 400, seed=12)
-    assert a == b and a.to_bytes() == b.to_bytes()
+    assert a == b and map_bytes(a) == map_bytes(b)
     assert a != c
     assert not np.array_equal(a.points, c.points)
 

@@ -7,7 +7,17 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-from rtmu.maps import MapData, from_stream, parse_map, parse_map_lines, read_map, write_map
+from rtmu.maps import (
+    MapData,
+    from_stream,
+    map_bytes,
+    map_header_lines,
+    map_lines,
+    parse_map,
+    parse_map_lines,
+    read_map,
+    write_map,
+)
 
 ARIA_MAPS = ["ActivMediaLab.map", "columbia.map", "office.map", "triangle.map"]
 
@@ -107,14 +117,14 @@ def test_round_trip_through_a_file(aria_maps: dict[str, MapData], name: str, tmp
     assert np.array_equal(again.segments, original.segments)
     assert again.objects == original.objects
     assert again.unknown_lines == original.unknown_lines
-    assert again.to_bytes() == original.to_bytes()
+    assert map_bytes(again) == map_bytes(original)
 
 
 @pytest.mark.parametrize("name", ARIA_MAPS)
 def test_rewrite_keeps_every_line(aria_maps: dict[str, MapData], name: str, shared_dir: Path) -> None:
     """ARIA's own rewrite: same lines, headings with 6 decimals, LinesAreSorted added, unknown lines moved."""
     source = (shared_dir / "aria-maps" / name).read_text("latin-1").splitlines()
-    written = aria_maps[name].to_lines()
+    written = map_lines(aria_maps[name])
     expected = {
         line.replace(' 0 "" ICON', ' 0.000000 "" ICON').replace(' 54 "" ICON', ' 54.000000 "" ICON')
         for line in source
@@ -126,7 +136,7 @@ def test_rewrite_keeps_every_line(aria_maps: dict[str, MapData], name: str, shar
 @pytest.mark.parametrize("name", ARIA_MAPS)
 def test_getmap_lines_and_getmapbinary_give_the_same_map(aria_maps: dict[str, MapData], name: str) -> None:
     original = aria_maps[name]
-    assert parse_map_lines(original.to_lines()) == original
-    streamed = from_stream(original.header_lines(), original.segments, original.points)
+    assert parse_map_lines(map_lines(original)) == original
+    streamed = from_stream(map_header_lines(original), original.segments, original.points)
     assert streamed == original
     assert streamed.claimed.num_lines == original.num_lines

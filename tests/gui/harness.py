@@ -27,8 +27,8 @@ from gi.repository import Gdk, GdkX11, GLib, Graphene, Gtk  # noqa: E402
 from PIL import Image  # noqa: E402
 
 from rtmu.model import OperatorState, Phase, RobotModel  # noqa: E402
-from rtmu.ui.app import GuiOptions  # noqa: E402
 from rtmu.ui.application import RtmuApplication  # noqa: E402
+from rtmu.ui.options import GuiOptions  # noqa: E402
 from rtmu.ui.window import MainWindow  # noqa: E402
 
 from .process import screenshot  # noqa: E402

@@ -55,7 +55,7 @@ def test_connection_error_uses_the_doctors_words(screenshots: Path, request: pyt
 def test_window_protocol_option_overrides_and_a_refusal_names_the_wanted_string(
     screenshots: Path, request: pytest.FixtureRequest
 ) -> None:
-    from rtmu.ui.app import GuiOptions
+    from rtmu.ui.options import GuiOptions
 
     from .harness import scratch_dir
 

@@ -367,7 +367,7 @@ def test_a_user_is_asked_for_the_password_and_a_wrong_one_is_reported(
 
 def test_plain_rtmu_opens_the_last_profile_and_connects(screenshots: Path, tmp_path: Path) -> None:
     from rtmu.settings import Profile, Settings, save_settings
-    from rtmu.ui.app import GuiOptions
+    from rtmu.ui.options import GuiOptions
 
     with SimThread(SimConfig(port=0, map_path=OFFICE_MAP, seed=1)) as sim:
         settings = Settings()
@@ -459,7 +459,7 @@ def test_f11_full_screen_and_ctrl_q_quits_after_stopping_the_robot(start: Start)
 
 def test_full_screen_keeps_stop_connect_the_menu_and_a_way_out(screenshots: Path, tmp_path: Path) -> None:
     """``rtmu --fullscreen``: GTK hides the header bar, so a slim bar must offer the essentials."""
-    from rtmu.ui.app import GuiOptions
+    from rtmu.ui.options import GuiOptions
 
     with SimThread(SimConfig(port=0, map_path=OFFICE_MAP, seed=1)) as sim:
         options = GuiOptions(
@@ -513,8 +513,8 @@ def test_full_screen_keeps_stop_connect_the_menu_and_a_way_out(screenshots: Path
 def test_first_run_hint_in_full_screen_points_at_the_menu_on_screen(
     screenshots: Path, tmp_path: Path
 ) -> None:
-    from rtmu.ui.app import GuiOptions
     from rtmu.ui.application import FIRST_RUN_HINT
+    from rtmu.ui.options import GuiOptions
 
     options = GuiOptions(fullscreen=True, settings_path=tmp_path / "settings.toml", persist=False)
     gui = Gui.open(options, screenshots, "test_first_run_fullscreen", connect=False)

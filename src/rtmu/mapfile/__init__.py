@@ -30,7 +30,7 @@ from .reader import (
     read_map,
 )
 from .tokens import info_fields, split_keyword, split_tokens
-from .writer import object_text, to_bytes, to_lines, write_map
+from .writer import map_bytes, map_header_lines, map_lines, object_text, write_map
 
 __all__ = [
     "CATEGORIES",
@@ -49,6 +49,9 @@ __all__ = [
     "ScanClaims",
     "from_stream",
     "info_fields",
+    "map_bytes",
+    "map_header_lines",
+    "map_lines",
     "new_map",
     "object_text",
     "parse_map",
@@ -56,7 +59,5 @@ __all__ = [
     "read_map",
     "split_keyword",
     "split_tokens",
-    "to_bytes",
-    "to_lines",
     "write_map",
 ]

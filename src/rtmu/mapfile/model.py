@@ -349,26 +349,6 @@ class MapData:
     def goal_names(self) -> list[str]:
         return [obj.name for obj in self.goals()]
 
-    # -- text ---------------------------------------------------------------------------------------
-
-    def header_lines(self) -> list[str]:
-        """Everything before the data sections (what ``getMapBinary`` sends as text)."""
-        from .writer import header_lines
-
-        return header_lines(self)
-
-    def to_lines(self) -> list[str]:
-        """The whole file as lines without line ends (what ``getMap`` sends, one per packet)."""
-        from .writer import to_lines
-
-        return to_lines(self)
-
-    def to_bytes(self) -> bytes:
-        """The whole file, ``\\n`` line ends, latin-1."""
-        from .writer import to_bytes
-
-        return to_bytes(self)
-
     def __eq__(self, other: object) -> bool:
         """Same map content: provenance (source, warnings) and the header's stale claims do not count."""
         if not isinstance(other, MapData):

@@ -12,7 +12,7 @@ from .numeric import format_rows
 from .tokens import SPACE, format_heading, format_number, split_keyword, split_tokens
 
 
-def header_lines(data: MapData) -> list[str]:
+def map_header_lines(data: MapData) -> list[str]:
     """Every line before the data sections."""
     category = map_category(data.category)
     if category is None:
@@ -55,10 +55,10 @@ def object_text(obj: MapObject) -> str:
     return text
 
 
-def to_bytes(data: MapData) -> bytes:
+def map_bytes(data: MapData) -> bytes:
     """The whole file: latin-1, ``\\n`` after every line."""
     try:
-        head = ("\n".join(header_lines(data)) + "\n").encode("latin-1")
+        head = ("\n".join(map_header_lines(data)) + "\n").encode("latin-1")
     except UnicodeEncodeError as exc:
         raise ValueError(f"map text holds {exc.object[exc.start]!r}, which is not latin-1") from None
     parts = [head]
@@ -73,14 +73,14 @@ def to_bytes(data: MapData) -> bytes:
     return b"".join(parts)
 
 
-def to_lines(data: MapData) -> list[str]:
+def map_lines(data: MapData) -> list[str]:
     """The whole file as lines without line ends."""
-    return to_bytes(data).decode("latin-1").split("\n")[:-1]
+    return map_bytes(data).decode("latin-1").split("\n")[:-1]
 
 
 def write_map(data: MapData, path: str | os.PathLike[str]) -> None:
     """Write ``data`` to ``path``, replacing it atomically (a reader never sees half a map)."""
-    payload = to_bytes(data)
+    payload = map_bytes(data)
     target = Path(path)
     # A temporary file beside the target, created with open() so the usual umask applies.
     temp = target.with_name(f".{target.name}.{os.getpid()}.{secrets.token_hex(4)}.tmp")

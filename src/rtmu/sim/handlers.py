@@ -74,7 +74,7 @@ from .catalogue import STRING_COMMANDS
 from .robot import normalize_deg
 
 if TYPE_CHECKING:
-    from .server import Session, SimServer
+    from .context import SimClient, SimHost
     from .world import Popup, World
 
 TEMPERATURE_MOBILESIM = -127
@@ -106,8 +106,8 @@ Reply = bytes | Other | Stream
 
 @dataclass(slots=True)
 class Call:
-    server: SimServer
-    session: Session
+    server: SimHost
+    session: SimClient
     name: str
     number: int
     args: bytes
@@ -588,7 +588,7 @@ STRING_ITEMS = (
 )
 
 
-def string_values(server: SimServer) -> tuple[str, ...]:
+def string_values(server: SimHost) -> tuple[str, ...]:
     world = server.world
     link = world.wifi()
     return (

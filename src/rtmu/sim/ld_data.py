@@ -35,7 +35,7 @@ from .catalogue import Row
 from .handlers import SONAR_DRAWING, Call, Handler, Reply
 
 if TYPE_CHECKING:
-    from .server import SimServer
+    from .context import SimHost
 
 LASERS: dict[str, tuple[float, int, float]] = {
     "Laser_1Current": (250.0, 240, 15_000.0),
@@ -64,10 +64,10 @@ class LdState:
     said: list[str] = field(default_factory=list)
 
 
-_STATES: weakref.WeakKeyDictionary[SimServer, LdState] = weakref.WeakKeyDictionary()
+_STATES: weakref.WeakKeyDictionary[SimHost, LdState] = weakref.WeakKeyDictionary()
 
 
-def ld_state(server: SimServer) -> LdState:
+def ld_state(server: SimHost) -> LdState:
     """This server's LD state (created on first use)."""
     state = _STATES.get(server)
     if state is None:

@@ -22,6 +22,7 @@ from rtmu.protocol.packet import encode_packet
 from rtmu.protocol.payloads.map import Goals, MapId, MapName
 from rtmu.protocol.payloads.mapstream import map_binary_payloads, map_text_payloads
 
+from ..maps import map_header_lines
 from .geometry import Obstacles
 
 DEFAULT_POINT_CELL_MM = 40.0
@@ -129,7 +130,7 @@ def load_map(path: Path | None) -> ServedMap:
         path=path,
         name=str(path),
         lines=lines,
-        header=data.header_lines(),
+        header=map_header_lines(data),
         segments=np.asarray(data.segments, dtype=np.int32).reshape(-1, 4),
         points=np.asarray(data.points, dtype=np.int32).reshape(-1, 2),
         home=(float(home.x), float(home.y), float(home.th)) if home is not None else (0.0, 0.0, 0.0),

@@ -12,33 +12,13 @@ import argparse
 import os
 import sys
 import tempfile
-from dataclasses import dataclass, replace
+from dataclasses import replace
 from pathlib import Path
 
 from ..settings import DEFAULT_PORT
+from .options import GuiOptions
 
-APP_ID = "io.github.rtmu.Rtmu"
 EXIT_NO_DISPLAY = 6
-
-
-@dataclass
-class GuiOptions:
-    host: str | None = None
-    port: int | None = None
-    user: str | None = None
-    profile: str | None = None
-    fullscreen: bool = False
-    connect: bool | None = None
-    """None: connect when a profile was given or saved before; False: never at start."""
-    demo: bool = False
-    settings_path: Path | None = None
-    """None: the user's settings file; tests point it into a temporary directory."""
-    persist: bool = True
-    report_first_frame: bool = False
-    protocol: str | None = None
-    """Protocol string to log in with (None: the profile's; by default the server's own)."""
-    guardian: bool = True
-    """Start a guardian process per connection (``rtmu.guardian``); off only to measure without it."""
 
 
 def add_gui_arguments(parser: argparse.ArgumentParser) -> None:

@@ -34,8 +34,8 @@ from ..settings import (  # noqa: E402
     load_settings,
     save_settings,
 )
-from .app import APP_ID, GuiOptions  # noqa: E402
 from .keys import accels_for  # noqa: E402
+from .options import APP_ID, GuiOptions  # noqa: E402
 from .style import install_css  # noqa: E402
 from .window import MainWindow  # noqa: E402
 

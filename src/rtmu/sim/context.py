@@ -1,0 +1,56 @@
+"""What a data handler may use of the simulator and of the client it answers, as protocols.
+
+The handlers (``handlers``, ``profiles``, ``ld_data``) are called by the server and
+must not import it: these protocols name exactly what they reach for, so the
+server imports the handlers and never the other way round.
+"""
+
+from __future__ import annotations
+
+from collections import deque
+from collections.abc import Callable
+from typing import Protocol
+
+from .catalogue import Row
+from .mapserve import ServedMap
+from .video import VideoFeed
+from .world import World
+
+
+class Meter(Protocol):
+    percent: float
+    """The process's CPU use over the last second."""
+
+
+class SimClient(Protocol):
+    """One connected client, as a handler sees it."""
+
+    ident: int
+    self_identifier: str
+
+    def send(self, number: int, payload: bytes) -> None: ...
+
+    def may_use(self, group: str) -> bool: ...
+
+
+class SimHost(Protocol):
+    """The simulator, as a handler sees it."""
+
+    world: World
+    map: ServedMap
+    cpu: Meter
+    video: VideoFeed
+    video_size: tuple[int, int]
+    stop_log: deque[tuple[float, int, str]]
+
+    def cycle_cached(self, key: str, make: Callable[[], bytes]) -> bytes: ...
+
+    def broadcast(self, name: str, payload: bytes = b"") -> int: ...
+
+    def check_map(self) -> bool: ...
+
+    def reset_pose(self) -> None: ...
+
+    def custom_commands(self) -> tuple[Row, ...]: ...
+
+    def video_trailer(self) -> bytes: ...

@@ -1,0 +1,32 @@
+"""The window's start-up options and application id: plain data, shared by the entry point and the app.
+
+Kept apart from ``app`` (the entry point) and ``application`` (the GTK application) so
+that neither needs the other's module to know what the options are.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+from pathlib import Path
+
+APP_ID = "io.github.rtmu.Rtmu"
+
+
+@dataclass
+class GuiOptions:
+    host: str | None = None
+    port: int | None = None
+    user: str | None = None
+    profile: str | None = None
+    fullscreen: bool = False
+    connect: bool | None = None
+    """None: connect when a profile was given or saved before; False: never at start."""
+    demo: bool = False
+    settings_path: Path | None = None
+    """None: the user's settings file; tests point it into a temporary directory."""
+    persist: bool = True
+    report_first_frame: bool = False
+    protocol: str | None = None
+    """Protocol string to log in with (None: the profile's; by default the server's own)."""
+    guardian: bool = True
+    """Start a guardian process per connection (``rtmu.guardian``); off only to measure without it."""

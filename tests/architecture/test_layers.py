@@ -1,0 +1,121 @@
+"""The layer contract of ``src/rtmu``: who may import whom, no import cycles, a lazy client package.
+
+Read from the source (``import_graph``), every import counted — inside functions and
+under ``TYPE_CHECKING`` too. docs/architecture.md draws the same layers.
+"""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+import pytest
+
+from .import_graph import cycles, import_graph
+
+SRC = Path(__file__).resolve().parents[2] / "src"
+
+LAYERS: dict[str, tuple[str, ...]] = {
+    "base": ("rtmu", "rtmu.textsafe", "rtmu.exit_codes", "rtmu.notices"),
+    "codec": ("rtmu.protocol",),
+    "maps": ("rtmu.mapfile", "rtmu.maps"),
+    "values": ("rtmu.state",),
+    "capture": ("rtmu.capture", "rtmu.session_decoder"),
+    "client": ("rtmu.client", "rtmu.guardian"),
+    "simulator": ("rtmu.sim",),
+    "ui-state": ("rtmu.model",),
+    "settings": ("rtmu.settings",),
+    "control": ("rtmu.commands", "rtmu.controller"),
+    "fleet": ("rtmu.fleet",),
+    "view": ("rtmu.ui",),
+    "entry": ("rtmu.cli", "rtmu.__main__", "rtmu.subcommands"),
+}
+"""Layer → the modules (and packages) in it."""
+
+MAY_IMPORT: dict[str, frozenset[str]] = {
+    "base": frozenset(),
+    "codec": frozenset({"base"}),
+    "maps": frozenset({"base"}),
+    "values": frozenset({"maps", "base"}),
+    "capture": frozenset({"codec", "base"}),
+    # The network side knows the values it publishes, never the UI thread's state above it.
+    "client": frozenset({"values", "codec", "maps", "base"}),
+    "simulator": frozenset({"codec", "maps", "base"}),
+    "ui-state": frozenset({"values", "base"}),
+    "settings": frozenset({"base"}),
+    "control": frozenset({"client", "ui-state", "values", "settings", "base"}),
+    "fleet": frozenset({"control", "client", "ui-state", "values", "settings", "base"}),
+    # The window may start the bundled simulator (--demo); it never reaches the command line.
+    "view": frozenset(
+        {"fleet", "control", "client", "ui-state", "values", "settings", "simulator", "maps", "codec", "base"}
+    ),
+    "entry": frozenset(LAYERS),
+}
+"""Layer → the layers it may import (besides itself). Only the entry layer imports ``rtmu.cli``."""
+
+
+def layer_of(module: str) -> str:
+    best = ""
+    found = None
+    for layer, prefixes in LAYERS.items():
+        for prefix in prefixes:
+            inside = module == prefix or (prefix != "rtmu" and module.startswith(prefix + "."))
+            if inside and len(prefix) > len(best):
+                best, found = prefix, layer
+    if found is None:
+        raise AssertionError(f"{module} is in no layer: add it to LAYERS (and to docs/architecture.md)")
+    return found
+
+
+def violations(graph: dict[str, set[str]]) -> list[str]:
+    """Every import that crosses the contract, as 'a (layer) imports b (layer)'."""
+    out = []
+    for module, targets in sorted(graph.items()):
+        here = layer_of(module)
+        for target in sorted(targets):
+            there = layer_of(target)
+            if there != here and there not in MAY_IMPORT[here]:
+                out.append(f"{module} ({here}) imports {target} ({there})")
+    return out
+
+
+@pytest.fixture(scope="module")
+def graph() -> dict[str, set[str]]:
+    return import_graph(SRC, "rtmu")
+
+
+def test_every_import_keeps_the_layers(graph: dict[str, set[str]]) -> None:
+    assert violations(graph) == []
+
+
+def test_there_are_no_import_cycles(graph: dict[str, set[str]]) -> None:
+    assert cycles(graph) == []
+
+
+def test_the_client_package_imports_nothing_eagerly(graph: dict[str, set[str]]) -> None:
+    """Importing ``rtmu.client.lease`` (the controller does) must not load sockets and sessions."""
+    assert graph["rtmu.client"] == set()
+
+
+@pytest.mark.parametrize(
+    ("module", "forbidden"),
+    [
+        ("rtmu.client.session", "rtmu.model"),  # the client reaching for UI-thread state
+        ("rtmu.client.errors", "rtmu.cli"),  # exit codes taken from the command line
+        ("rtmu.protocol.decoder", "rtmu.client.connection"),  # the codec reaching up
+        ("rtmu.sim.server", "rtmu.ui.window"),
+    ],
+)
+def test_the_contract_catches_a_forbidden_import(
+    graph: dict[str, set[str]], module: str, forbidden: str
+) -> None:
+    broken = {m: set(t) for m, t in graph.items()}
+    broken[module].add(forbidden)
+    assert violations(broken) == [
+        f"{module} ({layer_of(module)}) imports {forbidden} ({layer_of(forbidden)})"
+    ]
+
+
+def test_the_cycle_check_catches_a_back_edge(graph: dict[str, set[str]]) -> None:
+    broken = {m: set(t) for m, t in graph.items()}
+    broken["rtmu.commands"].add("rtmu.controller")  # the controller imports the commands
+    assert ["rtmu.commands", "rtmu.controller"] in cycles(broken)
