@@ -4,7 +4,7 @@ Importing this package registers every type, so :func:`payload_type_for`
 finds a decoder by data name.
 """
 
-from . import camera, commands, drive, ld, map, mapstream, popup, robot, sensors, server, strings
+from . import camera, commands, control, drive, ld, map, mapstream, popup, robot, sensors, server, strings
 from .base import (
     NameMatch,
     Payload,
@@ -22,6 +22,7 @@ __all__ = [
     "Side",
     "camera",
     "commands",
+    "control",
     "decode_payload",
     "drive",
     "ld",
