@@ -11,6 +11,7 @@ every reply arrives on the one socket.
 
 from __future__ import annotations
 
+from dataclasses import asdict
 from enum import Enum, auto
 
 from .auth import password_digest
@@ -19,12 +20,11 @@ from .commands import (
     ClientType,
     RejectReason,
     ServerCommand,
-    describe_reject,
     is_control_command,
 )
 from .datalist import DataList
 from .decoder import PacketDecoder
-from .errors import FieldUnderrun, ProtocolError
+from .errors import ProtocolError
 from .events import (
     Connected,
     DataListReady,
@@ -35,8 +35,9 @@ from .events import (
     Rejected,
     ServerIntroduction,
 )
-from .fields import FieldReader, FieldWriter
+from .fields import FieldWriter
 from .packet import Packet, encode_packet
+from .payloads import control
 
 
 class ClientState(Enum):
@@ -157,43 +158,26 @@ class ClientConnection:
         return [DataReceived(cmd, self.datalist.name(cmd), packet.payload)]
 
     def _on_introduction(self, packet: Packet) -> ServerIntroduction:
-        r = FieldReader(packet.payload)
         try:
-            intro = ServerIntroduction(
-                version_tag=r.string("version tag"),
-                udp_port=r.ubyte2("server UDP port"),
-                auth_key=r.ubyte4("auth key"),
-                intro_key=r.ubyte4("intro key"),
-                password_key=r.string("password key"),
-                protocol_version=r.string("protocol version", default=""),
-            )
-        except FieldUnderrun as exc:
+            theirs = control.ServerIntroduction.decode(packet.payload)
+        except ProtocolError as exc:
             raise ProtocolError(f"malformed server introduction: {exc}") from exc
+        intro = ServerIntroduction(**asdict(theirs))
         self.introduction = intro
         digest = password_digest(self._password, intro.password_key, self.server_key)
         self._password = ""  # not kept longer than needed
         answer = intro.protocol_version if self.protocol_version is None else self.protocol_version
         self.sent_protocol_version = answer
-        payload = (
-            FieldWriter()
-            .ubyte2(0)
-            .string(self.user)
-            .raw(digest)
-            .string(answer)
-            .byte(int(self.client_type))
-            .bytes()
-        )
-        self._send(ClientCommand.INTRODUCTION, payload)
+        ours = control.ClientIntroduction(0, self.user, digest, answer, int(self.client_type))
+        self._send(ClientCommand.INTRODUCTION, ours.encode())
         self._send(ClientCommand.TCP_ONLY)
         self.state = ClientState.EXCHANGED_INTROS
         return intro
 
     def _on_rejected(self, packet: Packet) -> Rejected:
-        r = FieldReader(packet.payload)
-        reason = r.byte2("reason", default=0)
-        text = r.string("text", default="")
+        refusal = control.Rejected.decode(packet.payload)  # a missing field reads as 0 or "", never fails
         self.state = ClientState.REJECTED
-        return Rejected(reason, text, describe_reject(reason, text))
+        return Rejected(refusal.reason, refusal.text, refusal.explanation)
 
     def wanted_protocol(self) -> str | None:
         """The protocol string the server advertised (None before its introduction)."""
