@@ -202,8 +202,9 @@ class FaultProxy:
                     server.close()
                     return
                 self._links = [link for link in self._links if not all(p.done for p in link.pipes.values())]
-                self._links.append(_Link(self, client, server))
+                # Counted before the link starts forwarding: a client whose echo came back must see it.
                 self.connections += 1
+                self._links.append(_Link(self, client, server))
 
     def _applied(self) -> float:
         with self._lock:
