@@ -270,6 +270,7 @@ def test_short_client_introduction_is_rejected_not_crashed() -> None:
         LoginRefused(1, "")
     ]
     assert server.data_to_send() == REJECTED_REASON_1
+    assert server.malformed_packets == 1
 
 
 LONG_REASONS = {
@@ -469,6 +470,10 @@ def test_server_ignores_unknown_data_numbers_and_short_requests() -> None:
     events = server.receive_data(bad + short + once + encode_packet(ClientCommand.LIST))
     assert [type(e) for e in events] == [Ignored] * 4
     assert server.subscriptions == {}
+    assert server.malformed_packets == 1  # the short REQUEST; unknown numbers are well formed
+    stop = server.receive_data(encode_packet(ClientCommand.REQUESTSTOP, b"\x08"))
+    assert [type(e) for e in stop] == [Ignored] and "data number" in stop[0].why
+    assert server.malformed_packets == 2
 
 
 def test_bob_cannot_request_data_outside_his_groups() -> None:

@@ -15,7 +15,7 @@ from .auth import User, UserTable, make_password_key
 from .commands import ClientCommand, RejectReason, ServerCommand, is_control_command
 from .datalist import DataList
 from .decoder import PacketDecoder
-from .errors import FieldUnderrun
+from .errors import ProtocolError
 from .events import (
     ClientIntroduced,
     Event,
@@ -27,8 +27,8 @@ from .events import (
     RequestStopped,
     TcpOnlyRequested,
 )
-from .fields import FieldReader, FieldWriter
 from .packet import Packet, encode_packet
+from .payloads.control import ClientIntroduction, Rejected, Request, RequestStop, ServerIntroduction
 
 VERSION_TAG = "alpha"
 
@@ -58,6 +58,8 @@ class ServerConnection:
         self.user: User | None = None
         self.tcp_only = False
         self.subscriptions: dict[int, int] = {}
+        self.malformed_packets = 0
+        """Control packets that did not decode (a refused login, an ignored REQUEST): for logs and tests."""
         self.state = ServerState.SENT_INTRODUCTION
         self.decoder = PacketDecoder()
         rng = rng or random.SystemRandom()
@@ -65,17 +67,11 @@ class ServerConnection:
         self.intro_key = rng.randrange(1 << 31)
         self.password_key = make_password_key(rng)  # type: ignore[arg-type]
         self._out = bytearray()
-        intro = (
-            FieldWriter()
-            .string(VERSION_TAG)
-            .ubyte2(udp_port)
-            .ubyte4(self.auth_key)
-            .ubyte4(self.intro_key)
-            .string(self.password_key)
-            .string(protocol_version)  # ARIA advertises the string it enforces (§2.4 field 6)
-            .bytes()
+        # ARIA advertises the protocol string it enforces (§2.4 field 6).
+        intro = ServerIntroduction(
+            VERSION_TAG, udp_port, self.auth_key, self.intro_key, self.password_key, protocol_version
         )
-        self._send(ServerCommand.INTRODUCTION, intro)
+        self._send(ServerCommand.INTRODUCTION, intro.encode())
 
     # -- output ---------------------------------------------------------
     def data_to_send(self) -> bytes:
@@ -103,7 +99,7 @@ class ServerConnection:
         self.state = ServerState.CLOSED
 
     def reject(self, reason: RejectReason, text: str = "") -> LoginRefused:
-        self._send(ServerCommand.REJECTED, FieldWriter().byte2(int(reason)).string(text).bytes())
+        self._send(ServerCommand.REJECTED, Rejected(int(reason), text).encode())
         self.state = ServerState.CLOSING
         return LoginRefused(int(reason), text)
 
@@ -142,43 +138,56 @@ class ServerConnection:
         return [RequestOnce(cmd, entry.name, packet.payload)]
 
     def _on_introduction(self, packet: Packet) -> ClientIntroduced | LoginRefused:
-        r = FieldReader(packet.payload)
         try:
-            udp_port = r.ubyte2("client UDP port")
-            user = r.string("user name")
-            digest = r.raw(16, "password digest")
-            version = r.string("protocol version", default="")
-            client_type = r.byte("client type", default=0)
-        except FieldUnderrun:
-            return self.reject(RejectReason.BAD_USER_OR_PASSWORD)
-        if self.users is not None:
-            found = self.users.check(user, digest, self.password_key, self.server_key)
-            if found is None:
-                return self.reject(RejectReason.BAD_USER_OR_PASSWORD)
-            self.user = found
-            self.datalist = self._full_datalist.visible_to(found.groups)
+            intro: ClientIntroduction | None = ClientIntroduction.decode(packet.payload)
+        except ProtocolError:
+            self.malformed_packets += 1
+            intro = None
+        refused = self._refusal(intro)
+        if refused is not None:
+            return refused
+        assert intro is not None  # _refusal refuses a malformed introduction
         self.state = ServerState.CONNECTED
         self._send(ServerCommand.CONNECTED)
         for list_packet in self.datalist.list_packets():
             self._send(list_packet.command, list_packet.payload)
-        return ClientIntroduced(user, udp_port, version, client_type)
+        return ClientIntroduced(intro.user, intro.udp_port, intro.protocol_version, intro.client_type)
+
+    def _refusal(self, intro: ClientIntroduction | None) -> LoginRefused | None:
+        """Check a login (None: its INTRODUCTION did not decode); refuse it, or remember the user.
+
+        A subclass puts ARIA's other checks (central server, version, type) before these, in ARIA's order.
+        """
+        if intro is None:
+            return self.reject(RejectReason.BAD_USER_OR_PASSWORD)
+        if self.users is not None:
+            found = self.users.check(intro.user, intro.password_digest, self.password_key, self.server_key)
+            if found is None:
+                return self.reject(RejectReason.BAD_USER_OR_PASSWORD)
+            self.user = found
+            self.datalist = self._full_datalist.visible_to(found.groups)
+        return None
 
     def _on_request(self, packet: Packet) -> list[Event]:
-        r = FieldReader(packet.payload)
         try:
-            number = r.ubyte2("data number")
-            interval = r.byte4("interval")
-        except FieldUnderrun as exc:
+            request = Request.decode(packet.payload)
+        except ProtocolError as exc:
+            self.malformed_packets += 1
             return [Ignored(packet.command, str(exc))]
+        number = request.number
         entry = self.datalist.entry(number)
         if entry is None:
             return [Ignored(packet.command, f"REQUEST for unknown or forbidden data {number}")]
         new = number not in self.subscriptions
-        self.subscriptions[number] = interval
-        return [RequestReceived(number, entry.name, interval, r.rest(), new)]
+        self.subscriptions[number] = request.interval_ms
+        return [RequestReceived(number, entry.name, request.interval_ms, request.args, new)]
 
     def _on_request_stop(self, packet: Packet) -> list[Event]:
-        number = FieldReader(packet.payload).ubyte2("data number", default=-1)
+        try:
+            number = RequestStop.decode(packet.payload).number
+        except ProtocolError as exc:
+            self.malformed_packets += 1
+            return [Ignored(packet.command, str(exc))]
         if number not in self.subscriptions:
             return [Ignored(packet.command, f"REQUESTSTOP for data {number} that is not subscribed")]
         del self.subscriptions[number]

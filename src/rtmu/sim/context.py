@@ -38,10 +38,14 @@ class SimHost(Protocol):
 
     world: World
     map: ServedMap
-    cpu: Meter
     video: VideoFeed
     video_size: tuple[int, int]
     stop_log: deque[tuple[float, int, str]]
+
+    @property
+    def cpu(self) -> Meter:
+        """Read only, so the server's own meter type (which also samples) fits."""
+        ...
 
     def cycle_cached(self, key: str, make: Callable[[], bytes]) -> bytes: ...
 

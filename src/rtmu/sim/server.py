@@ -36,8 +36,8 @@ from rtmu.protocol.events import (
     RequestReceived,
     RequestStopped,
 )
-from rtmu.protocol.fields import FieldReader
-from rtmu.protocol.packet import Packet, encode_packet
+from rtmu.protocol.packet import encode_packet
+from rtmu.protocol.payloads.control import ClientIntroduction
 from rtmu.protocol.server_connection import ServerConnection, ServerState
 
 from .catalogue import Row, custom_commands
@@ -87,18 +87,12 @@ class SimServerConnection(ServerConnection):
         self._general_reject = general_reject
         self._config = config
 
-    def _on_introduction(self, packet: Packet):
+    def _refusal(self, intro: ClientIntroduction | None) -> LoginRefused | None:
         if self._general_reject is not None:
             reason, text = self._general_reject
             return self.reject(RejectReason(reason), text)
-        r = FieldReader(packet.payload)
-        version, client_type = "", 0
-        with contextlib.suppress(Exception):
-            r.ubyte2()
-            r.string()
-            r.raw(16)
-            version = r.string(default="")
-            client_type = r.byte(default=0)
+        # An introduction that does not decode carries no version and no type: ARIA reads "" and 0.
+        version, client_type = ("", 0) if intro is None else (intro.protocol_version, intro.client_type)
         enforced = self._config.protocol_version
         cfg = self._config
         if enforced is not None and version != enforced:
@@ -112,7 +106,7 @@ class SimServerConnection(ServerConnection):
                 "Server rejecting client connection since type (real or sim) does not match "
                 "(but is specified)",
             )
-        return super()._on_introduction(packet)
+        return super()._refusal(intro)
 
 
 @dataclass(slots=True)
@@ -296,7 +290,13 @@ class Session:
             self.abort()
 
     def receive(self, data: bytes) -> None:
-        for event in self.conn.receive_data(data):
+        malformed = self.conn.malformed_packets
+        events = self.conn.receive_data(data)
+        if self.conn.malformed_packets != malformed:
+            # Decoded as typed errors by the codec: a bad INTRODUCTION is refused, a bad REQUEST ignored.
+            self.server.malformed_packets += self.conn.malformed_packets - malformed
+            log.info("client %s: %d malformed control packet(s)", self.peer, self.conn.malformed_packets)
+        for event in events:
             if isinstance(event, RequestOnce):
                 self.server.invoke(self, event.number, event.name, event.args, once=True)
             elif isinstance(event, RequestReceived):
@@ -365,6 +365,8 @@ class SimServer:
         self._steps_done = 0
         self.port = 0
         self.cycles = 0
+        self.malformed_packets = 0
+        """Control packets from any client that did not decode (each refused or ignored, never raised)."""
         self.cpu = CpuMeter()
         self.video_size: tuple[int, int] = (320, 240)
         threaded = cfg.realtime if cfg.render_in_thread is None else cfg.render_in_thread
@@ -471,14 +473,14 @@ class SimServer:
         self.sessions.append(session)
         task = asyncio.current_task()
         if task is not None:
-            self._tasks.add(task)  # type: ignore[arg-type]
+            self._tasks.add(task)
         try:
             await session.run()
         except asyncio.CancelledError:
             pass  # the server is stopping; asyncio's stream callback would log a cancelled handler
         finally:
             if task is not None:
-                self._tasks.discard(task)  # type: ignore[arg-type]
+                self._tasks.discard(task)
 
     # -- serving ------------------------------------------------------------------------
     def cycle_cached(self, key: str, make: Callable[[], bytes]) -> bytes:
