@@ -171,6 +171,25 @@ def test_rejected_reads_as_a_sentence(tmp_path):
     assert decoder.sessions[0].rejected
 
 
+def test_malformed_control_packets_show_their_error_and_decoding_goes_on(tmp_path):
+    conv = Conversation().handshake()
+    conv.send(False, server_intro()).send(True, encode_packet(2, b"\x00\x00bob\x00\x01\x02"))  # digest cut
+    conv.send(True, encode_packet(129, b"\x08\x01\x00") + encode_packet(130, b"\x08\x01"))
+    conv.send(False, encode_packet(6, b"\x04\x00")).close()  # reason, then no text: ARIA reads ""
+    packets, _, decoder = _decode(_write(tmp_path, conv.frames()))
+    by_name = {(p.direction, p.name): p for p in packets}
+    intro = by_name[("c2s", "INTRODUCTION")]
+    assert intro.error is not None and "password digest" in intro.error and intro.fields == {}
+    assert by_name[("c2s", "REQUEST")].error is not None
+    assert by_name[("c2s", "REQUESTSTOP")].error is None  # bytes after the number are ignored
+    assert by_name[("c2s", "REQUESTSTOP")].fields == {"data": 0x0108, "data_name": None}
+    rejected = by_name[("s2c", "REJECTED")]
+    assert rejected.error is None and (rejected.fields["reason"], rejected.fields["text"]) == (4, "")
+    (session,) = decoder.sessions
+    assert session.user is None  # learnt only from an introduction that decodes
+    assert session.rejected is not None and "protocol version" in session.rejected
+
+
 def test_decode_error_is_shown_and_decoding_goes_on(tmp_path):
     extra = encode_packet(256, b"\x01\x02\x03") + encode_packet(256, update_numbers(x=7))
     packets, _, _ = _decode(_write(tmp_path, _session(NAMES_A, 50001, extra=extra).frames()))

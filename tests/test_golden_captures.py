@@ -3,7 +3,8 @@
 Facts are checked two ways where it matters: with an independent parse of the
 raw payload written here from the protocol document, and with the typed
 payloads of :mod:`rtmu.protocol.payloads`. Every registered payload type must
-re-encode every real packet of its data byte for byte.
+re-encode every real packet of its data byte for byte, every control packet must
+re-encode through its control type, and every data list must rebuild as sent.
 """
 
 from __future__ import annotations
@@ -21,6 +22,7 @@ import pytest
 
 from rtmu.capture import CaptureSource, open_capture
 from rtmu.protocol.fields import FieldReader
+from rtmu.protocol.payloads import control
 from rtmu.protocol.payloads.base import Side, payload_type_for
 from rtmu.session_decoder import CaptureDecoder, DecodedPacket, DropReport, side_of
 
@@ -439,3 +441,64 @@ def test_payload_types_cover_the_captured_services(name, side):
     # A missing type is a failure, not a skip: every service the captures carry must decode.
     assert payload_type_for(name, side) is not None, f"no payload type for {name} ({side.value}) registered"
     assert round_trips()[(name, side)] >= 1
+
+
+# -- every control packet re-encodes too --------------------------------------------------------
+MUST_ROUND_TRIP_CONTROL = [
+    ("s2c", "INTRODUCTION"),
+    ("c2s", "INTRODUCTION"),
+    ("c2s", "TCP_ONLY"),
+    ("s2c", "CONNECTED"),
+    ("c2s", "REQUEST"),
+    ("c2s", "REQUESTSTOP"),
+    ("c2s", "UDP_INTRODUCTION"),
+    ("s2c", "UDP_INTRODUCTION"),
+    ("c2s", "SHUTDOWN"),
+]
+
+
+@functools.cache
+def control_round_trips() -> Counter[tuple[str, str]]:
+    """Decode and re-encode every control packet of every capture (lists aside); how many per kind."""
+    checked: Counter[tuple[str, str]] = Counter()
+    failures = []
+    for name in CAPTURE_NAMES:
+        for p in decoded(name).packets:
+            if p.is_data or (p.name or "").startswith("LIST"):
+                continue
+            kind = control.control_type(p.command, side_of(p.direction))
+            if kind is None:
+                failures.append(f"{name}: no control type for {p.direction} {p.name or p.command}")
+                continue
+            again = kind.decode(p.payload).encode()
+            if again != p.payload:
+                failures.append(f"{name}: {p.direction} {p.name}: {p.payload.hex()} → {again.hex()}")
+            checked[(p.direction, p.name or str(p.command))] += 1
+    assert failures == []
+    return checked
+
+
+def test_every_control_packet_re_encodes_byte_for_byte():
+    checked = control_round_trips()
+    for kind in MUST_ROUND_TRIP_CONTROL:
+        assert checked[kind] >= 1, f"no {kind} in the captures"
+    assert checked[("s2c", "INTRODUCTION")] == checked[("c2s", "INTRODUCTION")] == 10
+    assert sum(checked.values()) >= 79
+
+
+def test_every_captured_data_list_is_rebuilt_byte_for_byte():
+    """The lists a server sends (LIST, LISTARGRET, LISTGROUPANDFLAGS) are what DataList builds from them."""
+    rebuilt = 0
+    for name in CAPTURE_NAMES:
+        d = decoded(name)
+        for session in d.decoder.sessions:
+            if session.transport != "tcp":
+                continue
+            sent = [
+                (p.command, p.payload)
+                for p in d.packets
+                if p.conn == session.id and p.direction == "s2c" and (p.name or "").startswith("LIST")
+            ]
+            assert sent == [(p.command, p.payload) for p in session.datalist.list_packets()], name
+            rebuilt += 1
+    assert rebuilt == 10

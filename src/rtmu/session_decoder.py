@@ -19,12 +19,13 @@ from typing import Any
 
 from .capture import CaptureEvent, Datagram, Endpoint, Flow, StreamData, StreamEnd, StreamGap
 from .protocol import payloads  # noqa: F401 -- importing the package registers every payload type
-from .protocol.commands import ClientCommand, ServerCommand, describe_reject, is_control_command
+from .protocol.commands import ClientCommand, ServerCommand, is_control_command
 from .protocol.datalist import DataList
 from .protocol.decoder import BadPacket, PacketDecoder
 from .protocol.fields import FieldReader
 from .protocol.packet import MIN_LENGTH, SYNC, Packet
 from .protocol.payloads import base as payload_base
+from .protocol.payloads import control
 from .protocol.payloads.base import Payload, Side
 
 C2S = "c2s"
@@ -521,68 +522,59 @@ class CaptureDecoder:
         return kind.decode(payload).to_fields(), None
 
     def _control(self, session: Session, direction: str, packet: Packet) -> dict[str, Any]:
+        """A control packet's fields, decoded by the same types the client and the server use."""
         command = packet.command
-        r = FieldReader(packet.payload)
-        if direction == S2C:
-            if command == ServerCommand.INTRODUCTION:
-                fields = {
-                    "version_tag": r.string("version tag"),
-                    "udp_port": r.ubyte2("server UDP port"),
-                    "auth_key": r.ubyte4("auth key"),
-                    "intro_key": r.ubyte4("intro key"),
-                    "password_key": r.string("password key"),
-                    "protocol_version": r.string("protocol version", default=""),
-                }
-                session.server_udp_port = fields["udp_port"]
-                session.auth_key = fields["auth_key"]
-                session.intro_key = fields["intro_key"]
-                return fields
-            if command == ServerCommand.REJECTED:
-                reason = r.byte2("reason", default=0)
-                text = r.string("text", default="")
-                session.rejected = describe_reject(reason, text)
-                return {"reason": reason, "text": text, "explanation": session.rejected}
-            if command in _LIST_COMMANDS:
-                session.datalist.absorb(packet)
-                return _list_fields(packet)
-            if command == ServerCommand.UDP_INTRODUCTION:
-                return {"intro_key": r.ubyte4("intro key")}
-        else:
-            if command == ClientCommand.INTRODUCTION:
-                fields = {
-                    "udp_port": r.ubyte2("client UDP port"),
-                    "user": r.string("user"),
-                    "password_digest": r.raw(16, "password digest").hex(),
-                    "protocol_version": r.string("protocol version", default=""),
-                    "client_type": r.byte("client type", default=0),
-                }
-                fields["client_type_name"] = _CLIENT_TYPES.get(fields["client_type"], "?")
-                session.client_udp_port = fields["udp_port"]
-                session.user = fields["user"]
-                return fields
-            if command == ClientCommand.REQUEST:
-                number = r.ubyte2("data number")
-                interval = r.byte4("interval")
-                args = r.rest()
-                data_name = session.datalist.name(number)
-                fields = {"data": number, "data_name": data_name, "interval_ms": interval}
-                if args:
-                    fields["args_length"] = len(args)
-                    fields["args"] = args.hex()
-                    if data_name:
-                        try:
-                            decoded, _ = self._typed(data_name, Side.ARGS, args)
-                        except Exception as exc:
-                            raise _PartialDecode(fields, f"arguments: {type(exc).__name__}: {exc}") from exc
-                        if decoded:
-                            fields["args"] = decoded
-                return fields
-            if command == ClientCommand.REQUESTSTOP:
-                number = r.ubyte2("data number")
-                return {"data": number, "data_name": session.datalist.name(number)}
-            if command == ClientCommand.UDP_INTRODUCTION:
-                return {"auth_key": r.ubyte4("auth key")}
-        return {}
+        if direction == S2C and command in _LIST_COMMANDS:
+            session.datalist.absorb(packet)
+            return _list_fields(packet)
+        kind = control.control_type(command, side_of(direction))
+        if kind is None:
+            return {}
+        decoded = kind.decode(packet.payload)
+        _learn_handshake(session, decoded)
+        if isinstance(decoded, control.Request):
+            return self._request_fields(session, decoded)
+        if isinstance(decoded, control.RequestStop):
+            return {"data": decoded.number, "data_name": session.datalist.name(decoded.number)}
+        fields = decoded.to_fields()
+        if isinstance(decoded, control.Rejected):
+            fields["explanation"] = decoded.explanation
+        elif isinstance(decoded, control.ClientIntroduction):
+            fields["client_type_name"] = _CLIENT_TYPES.get(decoded.client_type, "?")
+        return fields
+
+    def _request_fields(self, session: Session, request: control.Request) -> dict[str, Any]:
+        """A REQUEST with its data's name and, where a type is registered, its arguments decoded."""
+        data_name = session.datalist.name(request.number)
+        fields: dict[str, Any] = {
+            "data": request.number,
+            "data_name": data_name,
+            "interval_ms": request.interval_ms,
+        }
+        if request.args:
+            fields["args_length"] = len(request.args)
+            fields["args"] = request.args.hex()
+            if data_name:
+                try:
+                    decoded, _ = self._typed(data_name, Side.ARGS, request.args)
+                except Exception as exc:
+                    raise _PartialDecode(fields, f"arguments: {type(exc).__name__}: {exc}") from exc
+                if decoded:
+                    fields["args"] = decoded
+        return fields
+
+
+def _learn_handshake(session: Session, decoded: control.ControlPayload) -> None:
+    """Keep what attributes UDP datagrams to this session, and what the summary reports."""
+    if isinstance(decoded, control.ServerIntroduction):
+        session.server_udp_port = decoded.udp_port
+        session.auth_key = decoded.auth_key
+        session.intro_key = decoded.intro_key
+    elif isinstance(decoded, control.ClientIntroduction):
+        session.client_udp_port = decoded.udp_port
+        session.user = decoded.user
+    elif isinstance(decoded, control.Rejected):
+        session.rejected = decoded.explanation
 
 
 class _PartialDecode(Exception):
@@ -599,7 +591,7 @@ def _list_fields(packet: Packet) -> dict[str, Any]:
     first, second, counted = _LIST_COMMANDS[ServerCommand(packet.command)]
     r = FieldReader(packet.payload)
     count = r.ubyte2("count") if counted else 1
-    entries = []
+    entries: list[dict[str, Any]] = []
     while len(entries) < count and not r.at_end():
         entries.append({"number": r.ubyte2("data number"), first: r.string(first), second: r.string(second)})
     fields: dict[str, Any] = {"count": count, "entries": entries}
