@@ -517,7 +517,8 @@ def test_a_stream_holds_each_packet_once_and_bounds_what_is_unread() -> None:
         got = []
         async for payload in client.stream("getMap"):
             got.append(payload)
-            slot = client._pending[number][0] if client._pending[number] else None  # type: ignore[index]
+            waiting = client._conn.replies.waiting(number)  # type: ignore[union-attr,arg-type]
+            slot = waiting[0] if waiting else None
             assert slot is None or slot.payloads == []  # yielded packets are not kept a second time
         assert got == text_map_packets(MAP_LINES)
         with pytest.raises(ReplyTooLarge, match="3 packets of 'getMap' not read yet"):

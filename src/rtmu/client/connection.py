@@ -11,16 +11,11 @@ in the typed payloads) and adds what needs a clock and a socket:
   so nothing can hang on a server that accepts and never answers;
 * every failure is a typed :mod:`~rtmu.client.errors` error.
 
-Replies carry no request id in ArNetworking: a reply is matched to the oldest
-pending request of the same data number (ARIA answers in order). A request whose
-waiter gave up (timeout, cancel) is *abandoned*: its slot stays, so a late reply
-still lines up with it and cannot be taken for the next request's. But a reply that
-never comes must not shift every later reply by one for good, so an abandoned slot
-that has received nothing is dropped as soon as a newer request of the same data is
-sent (a reply later than its requester's whole timeout is treated as lost), and any
-abandoned slot is dropped after :data:`ABANDON_GRACE` s without a packet (a map that
-stalled half way). At most :data:`MAX_PENDING_PER_DATA` requests per data number
-wait at once.
+Which reply answers which request, and where a multi-packet reply ends, is the
+sans-I/O connection's business (:mod:`rtmu.protocol.replies`: matching in order,
+abandoned requests, the grace, the bounds); this class only waits on the events
+it reports. The bytes travel over a :class:`~rtmu.client.link.Link` — a TCP
+socket by default, or a recorded stream, or a test's feed (``opener=``).
 
 Everything here runs on one asyncio loop (the network thread's, see
 ``runner``); handlers are called on that loop and must be quick.
@@ -33,20 +28,36 @@ import contextlib
 import logging
 import socket
 import time
-from collections import deque
-from collections.abc import AsyncIterator, Callable
+from collections.abc import AsyncIterator, Callable, Iterable
 from dataclasses import dataclass, field
 
-from ..protocol.client_connection import ClientConnection, ClientState, protocol_advice
+from ..protocol.client_connection import ClientConnection, ClientState, named, protocol_advice
 from ..protocol.commands import RejectReason
 from ..protocol.datalist import DataList
 from ..protocol.decoder import DropStats
 from ..protocol.errors import ProtocolError
-from ..protocol.events import DataListReady, DataReceived, PeerShutdown, Rejected
+from ..protocol.events import (
+    DataListReady,
+    DataReceived,
+    Event,
+    PeerShutdown,
+    Rejected,
+    ReplyComplete,
+    ReplyError,
+    ReplyFailed,
+    ReplyId,
+    ReplyPacket,
+)
 from ..protocol.fields import FieldWriter
 from ..protocol.packet import MAX_LENGTH
 from ..protocol.payloads import Payload, Side, decode_payload
-from ..protocol.payloads.mapstream import MapTooLarge
+from ..protocol.replies import (
+    ABANDON_GRACE,
+    MAX_PENDING_PER_DATA,
+    MAX_REPLY_BYTES,
+    MAX_REPLY_PACKETS,
+    TooManyPending,
+)
 from .errors import (
     ClientError,
     ClientTimeout,
@@ -60,6 +71,7 @@ from .errors import (
     ReplyTooLarge,
     ServerClosed,
 )
+from .link import Link, Opener, open_tcp
 
 log = logging.getLogger(__name__)
 
@@ -81,15 +93,6 @@ NOT_ARIA_AFTER = 4096
 (a real server's introduction is one small packet, sent at once)."""
 TEXT_BANNERS = (b"HTTP/", b"SSH-", b"RFB ", b"220 ", b"220-", b"+OK", b"* OK")
 """How other common servers open a connection: such a peer is reported at once, not after --timeout."""
-MAX_REPLY_PACKETS = 1_000_000
-"""Default bound on the packets of one collected reply (``request_once``) or of a stream's unread ones."""
-MAX_REPLY_BYTES = 64 << 20
-"""Default bound on the payload bytes of one collected reply, or of a stream's unread packets."""
-ABANDON_GRACE = 0.5
-"""Seconds an abandoned request's slot waits quietly for a late reply before the reply counts as lost."""
-MAX_PENDING_PER_DATA = 64
-"""Requests of one data number that may wait for replies at once (abandoned slots included)."""
-
 Arg = Payload | bytes | bytearray | str | float | int | bool
 
 
@@ -160,195 +163,42 @@ def _decode_typed(name: str, payload: bytes, what: str) -> Payload:
 Handler = Callable[[Packet], None]
 
 
-# -- how a reply ends -----------------------------------------------------------------------------
-# ArNetworking has no end-of-reply framing; each data has its own pattern (protocol §3.7, §4.5).
+class _Waiter:
+    """The asyncio side of one tracked request: what ``request_once`` or ``stream`` waits on."""
 
+    __slots__ = ("count", "error", "finished", "payloads", "progress", "queue", "reply")
 
-class _EndRule:
-    """Decides, packet by packet, whether a reply is complete."""
-
-    def done(self, payload: bytes, count_before: int) -> bool:
-        raise NotImplementedError
-
-
-class _Single(_EndRule):
-    def __init__(self, n: int = 1) -> None:
-        self.n = n
-
-    def done(self, payload: bytes, count_before: int) -> bool:
-        return count_before + 1 >= self.n
-
-
-class _UntilEmpty(_EndRule):
-    """RETURN_UNTIL_EMPTY: a zero-length packet ends the series."""
-
-    def done(self, payload: bytes, count_before: int) -> bool:
-        return not payload
-
-
-class _Until(_EndRule):
-    """The caller's own end test (a map assembler's ``feed``)."""
-
-    def __init__(self, until: Callable[[bytes], bool]) -> None:
-        self.until = until
-
-    def done(self, payload: bytes, count_before: int) -> bool:
-        return self.until(payload)
-
-
-class _MapStream(_EndRule):
-    """``getMap``/``getMapBinary``: ends with a zero-length packet, or at once with one ``00`` (no map)."""
-
-    def done(self, payload: bytes, count_before: int) -> bool:
-        return not payload or (count_before == 0 and payload == b"\x00")
-
-
-_MAP_STREAMS = frozenset({"getMap", "getMapBinary", "getMapMultiScans", "getMapWithMaxCategory"})
-
-
-def _end_rule(
-    entry_flags: frozenset[str], name: str, expect: int | None, until: Callable[[bytes], bool] | None
-) -> _EndRule | None:
-    """None = the data has no reply (RETURN_NONE)."""
-    if until is not None:
-        return _Until(until)
-    if expect is not None:
-        return _Single(expect)
-    if name in _MAP_STREAMS:
-        return _MapStream()
-    if name == "popupList" or "RETURN_UNTIL_EMPTY" in entry_flags:
-        return _UntilEmpty()
-    if "RETURN_NONE" in entry_flags:
-        return None
-    return _Single()
-
-
-class _Pending:
-    """One request waiting for its reply packets (one slot in its data number's queue).
-
-    A waiter that gives up (timeout, cancel, a stream closed early) *abandons* the slot: it
-    stays so that a late reply still lines up with it, and swallows that reply's packets
-    (to the data's own end marker) without keeping them. See the module notes for when an
-    abandoned slot is dropped.
-
-    What the slot holds is bounded: a collected reply by ``max_packets``/``max_bytes`` in all,
-    a streamed one by the packets/bytes its reader has not taken yet (each payload is held
-    once: in the list, or in the stream's queue). Past a bound the waiter gets
-    :class:`ReplyTooLarge` and the slot swallows the rest of the reply.
-    """
-
-    __slots__ = (
-        "abandoned_at",
-        "count",
-        "error",
-        "fallback",
-        "finished",
-        "held_bytes",
-        "last_activity",
-        "max_bytes",
-        "max_packets",
-        "name",
-        "payloads",
-        "progress",
-        "queue",
-        "rule",
-    )
-
-    def __init__(
-        self,
-        name: str,
-        rule: _EndRule,
-        streaming: bool,
-        fallback: _EndRule | None = None,
-        *,
-        max_packets: int = MAX_REPLY_PACKETS,
-        max_bytes: int = MAX_REPLY_BYTES,
-    ) -> None:
-        self.name = name
-        self.rule = rule
-        self.fallback = fallback or rule
-        """Where the reply ends without the caller's own test (used once the caller is gone)."""
-        self.payloads: list[bytes] = []
-        self.count = 0
-        self.held_bytes = 0
-        """Bytes held for the waiter: all of them (collected), or those not read yet (streamed)."""
-        self.max_packets = max_packets
-        self.max_bytes = max_bytes
+    def __init__(self, reply: ReplyId, streaming: bool) -> None:
+        self.reply = reply
         self.queue: asyncio.Queue[bytes | None] | None = asyncio.Queue() if streaming else None
         self.progress = asyncio.Event()
+        self.payloads: tuple[bytes, ...] = ()
+        self.count = 0
         self.finished = False
         self.error: ClientError | None = None
-        self.abandoned_at: float | None = None
-        self.last_activity = 0.0
 
-    def feed(self, payload: bytes, now: float) -> bool:
-        """One packet of this reply; True when the slot is done (take it off the queue)."""
-        if self.abandoned_at is not None:
-            return self._swallow(payload, now)
-        if self.finished:
-            return True
-        try:
-            finished = self.rule.done(payload, self.count)
-        except MapTooLarge as exc:  # more than any map can be: an endless or hostile stream
-            self.fail(ProtocolFault(f"the server's map is too large, download stopped: {exc}"))
-            return True
-        except ProtocolError as exc:  # the caller's end test found the reply malformed
-            self.fail(ProtocolFault(f"malformed reply: {exc}"))
-            return True
+    def packet(self, payload: bytes) -> None:
         self.count += 1
-        self.finished = finished
-        self.held_bytes += len(payload)
         if self.queue is not None:
             self.queue.put_nowait(payload)
-            held_packets = self.queue.qsize()
-            if finished:
-                self.queue.put_nowait(None)
-        else:
-            self.payloads.append(payload)
-            held_packets = len(self.payloads)
-        if not finished and (held_packets > self.max_packets or self.held_bytes > self.max_bytes):
-            self._overflow(held_packets > self.max_packets, now)
-            return False
         self.progress.set()
-        return finished
 
-    def taken(self, payload: bytes) -> None:
-        """A stream's reader took ``payload``: it is no longer held here."""
-        self.held_bytes -= len(payload)
-
-    def _overflow(self, by_count: bool, now: float) -> None:
-        limit = f"{self.max_packets} packets" if by_count else f"{self.max_bytes} bytes"
-        waiting = "not read yet" if self.queue is not None else "in one reply"
+    def complete(self, payloads: tuple[bytes, ...]) -> None:
+        self.finished = True
+        self.payloads = payloads
         if self.queue is not None:
-            while not self.queue.empty():  # the reader gets the error next, not stale packets first
-                self.queue.get_nowait()
-        self.abandon(ReplyTooLarge(f"more than {limit} of {self.name!r} {waiting}; the rest is dropped"), now)
+            self.queue.put_nowait(None)
+        self.progress.set()
 
-    def _swallow(self, payload: bytes, now: float) -> bool:
-        self.last_activity = now
-        try:
-            done = self.fallback.done(payload, self.count)
-        except ProtocolError:
-            done = True
-        self.count += 1
-        return done
-
-    def abandon(self, error: ClientError, now: float) -> None:
-        """The waiter is gone (or must stop waiting): fail it, keep the slot for the rest of the reply."""
-        self.fail(error)
-        self.abandoned_at = self.last_activity = now
-        self.payloads = []
-        self.held_bytes = 0
-
-    def expired(self, now: float, grace: float) -> bool:
-        return self.abandoned_at is not None and now - self.last_activity >= grace
-
-    def fail(self, error: ClientError) -> None:
+    def fail(self, error: ClientError, *, drop_unread: bool = False) -> None:
+        """The reply will not come; ``drop_unread``: a stream's reader gets the error before stale packets."""
         if self.finished:
             return
         self.finished = True
         self.error = error
         if self.queue is not None:
+            while drop_unread and not self.queue.empty():
+                self.queue.get_nowait()
             self.queue.put_nowait(None)
         self.progress.set()
 
@@ -358,6 +208,7 @@ class AriaClient:
 
     ``on_close(error)`` is called once when the connection ends for any reason
     other than :meth:`disconnect` (``error`` says why, e.g. :class:`ServerClosed`).
+    ``opener(host, port)`` makes the :class:`~rtmu.client.link.Link` (default: TCP).
     """
 
     def __init__(
@@ -366,20 +217,21 @@ class AriaClient:
         on_close: Callable[[ClientError], None] | None = None,
         clock: Callable[[], float] = time.monotonic,
         abandon_grace: float = ABANDON_GRACE,
+        opener: Opener = open_tcp,
     ) -> None:
         self.on_close = on_close
         self.clock = clock
-        self.abandon_grace = abandon_grace
-        self.max_pending = MAX_PENDING_PER_DATA
+        self.opener = opener
+        self._abandon_grace = abandon_grace
+        self._max_pending = MAX_PENDING_PER_DATA
         self.host = ""
         self.port = 0
         self.user = ""
         self._conn: ClientConnection | None = None
-        self._reader: asyncio.StreamReader | None = None
-        self._writer: asyncio.StreamWriter | None = None
+        self._link: Link | None = None
         self._read_task: asyncio.Task[None] | None = None
         self._handlers: dict[int, Handler] = {}
-        self._pending: dict[int, deque[_Pending]] = {}
+        self._waiters: dict[ReplyId, _Waiter] = {}
         self._closed_error: ClientError | None = None
         self._closing = False
         self.handler_errors = 0
@@ -392,6 +244,28 @@ class AriaClient:
         self.packets_received = 0
 
     # -- state -----------------------------------------------------------------------------
+    @property
+    def abandon_grace(self) -> float:
+        """Seconds an abandoned request waits for a late reply (see :mod:`rtmu.protocol.replies`)."""
+        return self._abandon_grace
+
+    @abandon_grace.setter
+    def abandon_grace(self, seconds: float) -> None:
+        self._abandon_grace = seconds
+        if self._conn is not None:
+            self._conn.replies.abandon_grace = seconds
+
+    @property
+    def max_pending(self) -> int:
+        """Requests of one data number that may wait for replies at once."""
+        return self._max_pending
+
+    @max_pending.setter
+    def max_pending(self, count: int) -> None:
+        self._max_pending = count
+        if self._conn is not None:
+            self._conn.replies.max_pending = count
+
     @property
     def connected(self) -> bool:
         return (
@@ -442,17 +316,19 @@ class AriaClient:
         server_key: str = "",
         protocol: str | None = None,
     ) -> DataList:
-        """Open the socket, log in and wait for the complete data list, all within ``timeout`` s."""
+        """Open the link, log in and wait for the complete data list, all within ``timeout`` s."""
         if self._conn is not None:
             raise RuntimeError("AriaClient objects are single-use: make a new one to connect again")
         self.host, self.port, self.user = host, port, user or ""
         self._conn = ClientConnection(
             user or "", password or "", server_key=server_key, protocol_version=protocol
         )
+        self._conn.replies.abandon_grace = self._abandon_grace
+        self._conn.replies.max_pending = self._max_pending
         deadline = asyncio.get_running_loop().time() + timeout
         try:
             async with asyncio.timeout_at(deadline):
-                self._reader, self._writer = await asyncio.open_connection(host, port)
+                self._link = await self.opener(host, port)
         except TimeoutError:
             raise ClientTimeout(f"connecting to {host}:{port} timed out after {timeout:g} s") from None
         except ConnectionRefusedError:
@@ -463,10 +339,6 @@ class AriaClient:
             raise HostNotFound(f"cannot find host {host!r}: {exc.strerror or exc}") from None
         except OSError as exc:
             raise ConnectionFailed(f"cannot connect to {host}:{port}: {exc.strerror or exc}") from None
-        sock = self._writer.get_extra_info("socket")
-        if sock is not None:
-            with contextlib.suppress(OSError):
-                sock.setsockopt(socket.IPPROTO_TCP, socket.TCP_NODELAY, 1)
         try:
             async with asyncio.timeout_at(deadline):
                 await self._login()
@@ -482,11 +354,11 @@ class AriaClient:
         return self._conn.datalist
 
     async def _login(self) -> None:
-        assert self._reader is not None and self._conn is not None
+        assert self._link is not None and self._conn is not None
         received = 0
         while True:
             try:
-                data = await self._reader.read(READ_CHUNK)
+                data = await self._link.read(READ_CHUNK)
             except OSError as exc:
                 raise ServerClosed(f"the connection broke during login: {exc.strerror or exc}") from None
             if not data:
@@ -497,8 +369,9 @@ class AriaClient:
                     f"{self.host}:{self.port} is not an ArNetworking server (it said {banner!r})"
                 )
             received += len(data)
+            now = self.clock()
             try:
-                events = self._conn.receive_data(data)
+                events = self._conn.receive_data(data, now)
             except ProtocolError as exc:
                 raise ProtocolFault(f"{self.host}:{self.port} is not an ArNetworking server: {exc}") from None
             if received >= NOT_ARIA_AFTER and self._conn.decoder.stats.packets == 0:
@@ -516,7 +389,7 @@ class AriaClient:
                 if isinstance(event, DataListReady):
                     ready = True
                 elif isinstance(event, DataReceived):
-                    self._dispatch(event)
+                    self._deliver(event.command, event.name, event.payload, now)
             if ready:
                 return
 
@@ -555,15 +428,20 @@ class AriaClient:
         self._conn.request_stop(name)  # type: ignore[union-attr]
         self._flush()
 
-    def send(self, name: str, *args: Arg) -> None:
-        """Run ``name`` once without waiting for anything (``stop``, ``ratioDrive``, ``turnByAngle``…)."""
+    def send(self, what: str | Payload, *args: Arg) -> None:
+        """Run a command once without waiting for anything.
+
+        ``send(RatioDrive(…))``: the typed payload names its data; ``send("stop")``,
+        ``send("turnByAngle", 90)``: a name and arguments (see :func:`encode_args`).
+        """
+        name, payload = _request(what, args)
         self._number(name)
-        self._conn.request_once(name, encode_args(args))  # type: ignore[union-attr]
+        self._conn.request_once(name, payload)  # type: ignore[union-attr]
         self._flush()
 
     async def request_once(
         self,
-        name: str,
+        what: str | Payload,
         *args: Arg,
         timeout: float = REPLY_TIMEOUT,
         expect: int | None = None,
@@ -571,7 +449,7 @@ class AriaClient:
         max_packets: int = MAX_REPLY_PACKETS,
         max_bytes: int = MAX_REPLY_BYTES,
     ) -> Reply:
-        """Run ``name`` once and await its reply.
+        """Run ``what`` (a data name, or a typed payload naming its data) once and await its reply.
 
         Multi-packet replies (``getMap``, ``getMapBinary``, RETURN_UNTIL_EMPTY data) are
         collected to their end marker; ``timeout`` bounds the wait for *each* packet, so a big
@@ -583,32 +461,33 @@ class AriaClient:
         than ``max_packets`` packets or ``max_bytes`` payload bytes fails with
         :class:`ReplyTooLarge` (for big maps use ``rtmu.client.mapload`` or :meth:`stream`).
         """
-        pending = self._start(name, args, expect, until, False, max_packets, max_bytes)
-        if pending is None:
+        name, payload = _request(what, args)
+        waiter = self._start(name, payload, expect, until, False, max_packets, max_bytes)
+        if waiter is None:
             return Reply(name, (), self.clock())
         try:
-            while not pending.finished:
-                pending.progress.clear()
+            while not waiter.finished:
+                waiter.progress.clear()
                 try:
                     async with asyncio.timeout(timeout):
-                        await pending.progress.wait()
+                        await waiter.progress.wait()
                 except TimeoutError:
-                    got = pending.count
-                    self._abandon(name, pending)
+                    got = waiter.count
+                    self._abandon(waiter)
                     raise self._no_reply(
                         f"no reply to {name!r} from {self.host}:{self.port} within {timeout:g} s"
                         + (f" (after {got} packets)" if got else "")
                     ) from None
         finally:
-            if not pending.finished:  # cancelled: the slot must not wait for ever either
-                self._abandon(name, pending)
-        if pending.error is not None:
-            raise pending.error
-        return Reply(name, tuple(pending.payloads), self.clock())
+            if not waiter.finished:  # cancelled: the slot must not wait for ever either
+                self._abandon(waiter)
+        if waiter.error is not None:
+            raise waiter.error
+        return Reply(name, waiter.payloads, self.clock())
 
     async def stream(
         self,
-        name: str,
+        what: str | Payload,
         *args: Arg,
         timeout: float = REPLY_TIMEOUT,
         expect: int | None = None,
@@ -621,108 +500,95 @@ class AriaClient:
         Nothing is kept after it is yielded; the bounds apply to packets received but not
         read yet (a reader that falls that far behind gets :class:`ReplyTooLarge`).
         """
-        pending = self._start(name, args, expect, until, True, max_packets, max_bytes)
-        if pending is None:
+        name, payload = _request(what, args)
+        waiter = self._start(name, payload, expect, until, True, max_packets, max_bytes)
+        if waiter is None:
             return
-        queue = pending.queue
+        queue = waiter.queue
         assert queue is not None
         try:
             while True:
                 try:
                     if queue.empty():
                         async with asyncio.timeout(timeout):
-                            payload = await queue.get()
+                            item = await queue.get()
                     else:  # already here: no timer per packet (a big map is millions of packets)
-                        payload = queue.get_nowait()
+                        item = queue.get_nowait()
                 except TimeoutError:
                     raise self._no_reply(
                         f"{name!r} from {self.host}:{self.port} stalled for {timeout:g} s "
-                        f"after {pending.count} packets"
+                        f"after {waiter.count} packets"
                     ) from None
-                if payload is None:
-                    if pending.error is not None:
-                        raise pending.error
+                if item is None:
+                    if waiter.error is not None:
+                        raise waiter.error
                     return
-                pending.taken(payload)
-                yield payload
+                if self._conn is not None:
+                    self._conn.reply_taken(waiter.reply, item)
+                yield item
         finally:
-            if not pending.finished:
-                self._abandon(name, pending)
+            if not waiter.finished:
+                self._abandon(waiter)
 
     def _start(
         self,
         name: str,
-        args: tuple[Arg, ...],
+        payload: bytes,
         expect: int | None,
         until: Callable[[bytes], bool] | None,
         streaming: bool,
         max_packets: int = MAX_REPLY_PACKETS,
         max_bytes: int = MAX_REPLY_BYTES,
-    ) -> _Pending | None:
-        number = self._number(name)
-        entry = self._conn.datalist.entry(number)  # type: ignore[union-attr]
-        flags = entry.flag_set if entry else frozenset()
-        rule = _end_rule(flags, name, expect, until)
-        payload = encode_args(args)
-        if rule is None:
-            self._conn.request_once(name, payload)  # type: ignore[union-attr]
-            self._flush()
-            return None
-        queue = self._pending.setdefault(number, deque())
-        self._expire(queue, self.clock(), newer_request=True)
-        while len(queue) >= self.max_pending and queue[0].abandoned_at is not None:
-            queue.popleft()  # make room: the oldest abandoned slot goes first
-        if len(queue) >= self.max_pending:
+    ) -> _Waiter | None:
+        self._number(name)
+        conn = self._conn
+        assert conn is not None
+        try:
+            reply = conn.request_reply(
+                name, payload, now=self.clock(), expect=expect, until=until,
+                streaming=streaming, max_packets=max_packets, max_bytes=max_bytes,
+            )  # fmt: skip
+        except TooManyPending as exc:
             raise ClientError(
-                f"{len(queue)} requests for {name!r} are already waiting for {self.host}:{self.port} "
+                f"{exc.count} requests for {name!r} are already waiting for {self.host}:{self.port} "
                 "to answer; not sending more"
-            )
-        fallback = _end_rule(flags, name, expect, None)
-        pending = _Pending(name, rule, streaming, fallback, max_packets=max_packets, max_bytes=max_bytes)
-        queue.append(pending)
-        self._conn.request_once(name, payload)  # type: ignore[union-attr]
+            ) from None
         self._flush()
-        return pending
+        if reply is None:
+            return None
+        waiter = self._waiters[reply] = _Waiter(reply, streaming)
+        return waiter
 
-    def _abandon(self, name: str, pending: _Pending) -> None:
-        """A waiter gave up: keep its slot so late packets still line up, but stop caring."""
-        pending.abandon(ClientTimeout(f"{name!r} abandoned"), self.clock())
-
-    def _expire(self, queue: deque[_Pending], now: float, *, newer_request: bool = False) -> None:
-        """Drop abandoned slots at the head whose replies count as lost (see the module notes)."""
-        while queue:
-            head = queue[0]
-            if head.abandoned_at is None:
-                return
-            if not (head.expired(now, self.abandon_grace) or (newer_request and head.count == 0)):
-                return
-            queue.popleft()
+    def _abandon(self, waiter: _Waiter) -> None:
+        """A waiter gave up: its slot stays so late packets still line up, but nobody waits on it."""
+        self._waiters.pop(waiter.reply, None)
+        waiter.fail(ClientTimeout(f"{waiter.reply.name!r} abandoned"))
+        if self._conn is not None:
+            self._conn.abandon_reply(waiter.reply, self.clock())
 
     # -- I/O -------------------------------------------------------------------------------
     def _flush(self) -> None:
-        if self._conn is None or self._writer is None:
+        if self._conn is None or self._link is None:
             return
         data = self._conn.data_to_send()
-        if not data or self._writer.is_closing():
+        if not data or self._link.is_closing():
             return
-        self._writer.write(data)
-        if self._writer.transport.get_write_buffer_size() > MAX_WRITE_BUFFER:
+        self._link.write(data)
+        if self._link.backlog() > MAX_WRITE_BUFFER:
             self._fail(ServerClosed(f"{self.host}:{self.port} stopped reading; the connection was dropped"))
 
     async def _read_loop(self) -> None:
-        assert self._reader is not None and self._conn is not None
+        assert self._link is not None and self._conn is not None
         try:
             while True:
-                data = await self._reader.read(READ_CHUNK)
+                data = await self._link.read(READ_CHUNK)
                 if not data:
                     self._fail(ServerClosed(f"{self.host}:{self.port} closed the connection"))
                     return
-                for event in self._conn.receive_data(data):
-                    if isinstance(event, DataReceived):
-                        self._dispatch(event)
-                    elif isinstance(event, PeerShutdown):
-                        self._fail(ServerClosed(f"{self.host}:{self.port} shut down"))
-                        return
+                now = self.clock()
+                if not self._on_events(self._conn.receive_data(data, now), now):
+                    self._fail(ServerClosed(f"{self.host}:{self.port} shut down"))
+                    return
                 self._flush()
         except asyncio.CancelledError:
             raise
@@ -732,32 +598,50 @@ class AriaClient:
             reason = exc.strerror or exc
             self._fail(ServerClosed(f"the connection to {self.host}:{self.port} broke: {reason}"))
 
-    def _dispatch(self, event: DataReceived) -> None:
-        now = self.clock()
+    def _on_events(self, events: Iterable[Event], now: float) -> bool:
+        """Hand each event to its waiter and handler; False when the server shut down."""
+        for event in events:
+            if isinstance(event, DataReceived):
+                self._deliver(event.command, event.name, event.payload, now)
+            elif isinstance(event, ReplyPacket):
+                if not event.swallowed:
+                    waiter = self._waiters.get(event.reply)
+                    if waiter is not None:
+                        waiter.packet(event.payload)
+                self._deliver(event.command, event.name, event.payload, now)
+            elif isinstance(event, ReplyComplete):
+                waiter = self._waiters.pop(event.reply, None)
+                if waiter is not None:
+                    waiter.complete(event.payloads)
+            elif isinstance(event, ReplyFailed):
+                waiter = self._waiters.pop(event.reply, None)
+                if waiter is not None:
+                    too_large = event.reason is ReplyError.TOO_LARGE
+                    error = ReplyTooLarge(event.message) if too_large else ProtocolFault(event.message)
+                    waiter.fail(error, drop_unread=too_large)
+            elif isinstance(event, PeerShutdown):
+                return False
+        return True
+
+    def _deliver(self, number: int, name: str | None, payload: bytes, now: float) -> None:
+        """One data packet: count it, and call the subscription handler of its data."""
         self.last_packet_at = now
         self.packets_received += 1
-        number = event.command
-        queue = self._pending.get(number)
-        if queue:
-            self._expire(queue, now)
-            if queue and queue[0].feed(event.payload, now):
-                queue.popleft()
         handler = self._handlers.get(number)
-        if handler is not None:
-            started = time.perf_counter()
-            try:
-                handler(Packet(event.name or str(number), event.payload, now))
-            except Exception:
-                self.handler_errors += 1
-                log.exception("handler for %s failed", event.name)
-            spent = time.perf_counter() - started
-            self.max_handler_seconds = max(self.max_handler_seconds, spent)
-            if spent > SLOW_HANDLER:  # it held up the loop that sends the stops: say so
-                self.slow_handlers += 1
-                if self.slow_handlers <= 10 or self.slow_handlers % 1000 == 0:
-                    log.warning(
-                        "the handler for %s took %.0f ms on the network loop", event.name, spent * 1e3
-                    )
+        if handler is None:
+            return
+        started = time.perf_counter()
+        try:
+            handler(Packet(name or str(number), payload, now))
+        except Exception:
+            self.handler_errors += 1
+            log.exception("handler for %s failed", name)
+        spent = time.perf_counter() - started
+        self.max_handler_seconds = max(self.max_handler_seconds, spent)
+        if spent > SLOW_HANDLER:  # it held up the loop that sends the stops: say so
+            self.slow_handlers += 1
+            if self.slow_handlers <= 10 or self.slow_handlers % 1000 == 0:
+                log.warning("the handler for %s took %.0f ms on the network loop", name, spent * 1e3)
 
     def _fail(self, error: ClientError) -> None:
         """The connection is over (not by our choice): fail every waiter, tell ``on_close`` once."""
@@ -772,18 +656,17 @@ class AriaClient:
                 log.exception("on_close callback failed")
 
     def _teardown(self, error: ClientError) -> None:
-        for queue in self._pending.values():
-            for pending in queue:
-                pending.fail(error)
-        self._pending.clear()
+        waiters, self._waiters = self._waiters, {}
+        for waiter in waiters.values():
+            waiter.fail(error)
+        if self._conn is not None:
+            self._conn.replies.clear()
         self._handlers.clear()
         self._abort()
 
     def _abort(self) -> None:
-        if self._writer is not None:
-            transport = self._writer.transport
-            if not transport.is_closing():
-                transport.abort()
+        if self._link is not None:
+            self._link.abort()
 
     async def flush(self, timeout: float = CLOSE_TIMEOUT) -> bool:
         """Wait, at most ``timeout`` s, until everything sent has been handed to the kernel.
@@ -791,17 +674,17 @@ class AriaClient:
         True when nothing is left in our buffer (``rtmu drive`` checks that its stop has left
         before the process is suspended). Never raises.
         """
-        writer = self._writer
-        if writer is None or writer.is_closing():
+        link = self._link
+        if link is None or link.is_closing():
             return False
         loop = asyncio.get_running_loop()
         deadline = loop.time() + timeout
         with contextlib.suppress(TimeoutError, OSError):
             async with asyncio.timeout_at(deadline):
-                await writer.drain()
-                while writer.transport.get_write_buffer_size() > 0:
+                await link.drain()
+                while link.backlog() > 0:
                     await asyncio.sleep(0.005)
-        return not writer.is_closing() and writer.transport.get_write_buffer_size() == 0
+        return not link.is_closing() and link.backlog() == 0
 
     async def disconnect(self) -> None:
         """Say goodbye and close within :data:`CLOSE_TIMEOUT` s. Safe to call twice, or unconnected."""
@@ -811,20 +694,32 @@ class AriaClient:
         task = self._read_task
         if task is not None and task is not asyncio.current_task():
             task.cancel()
-        if self._conn is not None and self._writer is not None and self._closed_error is None:
+        if self._conn is not None and self._link is not None and self._closed_error is None:
             self._conn.shutdown()
             data = self._conn.data_to_send()
-            writer = self._writer
-            if not writer.is_closing():
+            link = self._link
+            if not link.is_closing():
                 with contextlib.suppress(OSError):
-                    writer.write(data)
-                writer.close()
+                    link.write(data)
+                link.close()
                 with contextlib.suppress(Exception):
-                    await asyncio.wait_for(writer.wait_closed(), CLOSE_TIMEOUT)
+                    await asyncio.wait_for(link.wait_closed(), CLOSE_TIMEOUT)
         self._teardown(ServerClosed("disconnected"))
         if task is not None and task is not asyncio.current_task() and not task.done():
             # Bounded: a reader that will not end must not keep the caller (a window closing) waiting.
             await asyncio.wait({task}, timeout=CLOSE_TIMEOUT)
+
+
+def _request(what: str | Payload, args: tuple[Arg, ...]) -> tuple[str, bytes]:
+    """(data name, argument bytes) from a call's arguments; a typed payload names its own data."""
+    if isinstance(what, Payload):
+        if args:
+            raise TypeError("a typed payload carries its own arguments")
+        try:
+            return named(what)
+        except ProtocolError as exc:
+            raise TypeError(str(exc)) from None
+    return what, encode_args(args)
 
 
 def login_rejected(conn: ClientConnection, event: Rejected) -> LoginRejected:

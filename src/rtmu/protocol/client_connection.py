@@ -7,10 +7,18 @@ them over for the caller's socket. No sockets, no asyncio, no clocks here.
 The client is TCP-only: it declares UDP port 0 and sends TCP_ONLY right after
 its INTRODUCTION (what ``ArClientBase`` does with a server without UDP), so
 every reply arrives on the one socket.
+
+Requests sent with :meth:`ClientConnection.request_reply` are *tracked*: the
+connection's :class:`~rtmu.protocol.replies.ReplyTracker` owns each one until
+its reply ends, and ``receive_data`` reports its packets as ``ReplyPacket`` and
+its end as ``ReplyComplete``/``ReplyFailed`` (see :mod:`.replies`). Packets no
+tracked request claims come out as ``DataReceived``. A typed
+:class:`~rtmu.protocol.payloads.Payload` names its own data: ``send(RatioDrive(…))``.
 """
 
 from __future__ import annotations
 
+from collections.abc import Callable
 from dataclasses import asdict
 from enum import Enum, auto
 
@@ -28,16 +36,18 @@ from .errors import ProtocolError
 from .events import (
     Connected,
     DataListReady,
-    DataReceived,
     Event,
     Ignored,
     PeerShutdown,
     Rejected,
+    ReplyId,
     ServerIntroduction,
 )
 from .fields import FieldWriter
 from .packet import Packet, encode_packet
 from .payloads import control
+from .payloads.base import NameMatch, Payload
+from .replies import MAX_REPLY_BYTES, MAX_REPLY_PACKETS, ReplyTracker, end_rule
 
 
 class ClientState(Enum):
@@ -74,6 +84,8 @@ class ClientConnection:
         self.datalist = DataList()
         self.decoder = PacketDecoder()
         self.introduction: ServerIntroduction | None = None
+        self.replies = ReplyTracker()
+        """The tracked requests waiting for replies (see :meth:`request_reply`)."""
         self._out = bytearray()
 
     # -- output -------------------------------------------------------------
@@ -101,10 +113,63 @@ class ClientConnection:
         self._require_connected()
         self._send(ClientCommand.REQUESTSTOP, FieldWriter().ubyte2(self.number_of(name)).bytes())
 
-    def request_once(self, name: str, args: bytes = b"") -> None:
-        """Run data ``name`` once: a packet whose command is the data number, payload the arguments."""
+    def request_once(self, what: str | Payload, args: bytes = b"") -> None:
+        """Run data ``what`` once: a packet whose command is the data number, payload the arguments.
+
+        ``what`` is a data name (``args`` its encoded arguments) or a typed payload that names its data.
+        The reply, if any, is not tracked: it arrives as ``DataReceived`` (see :meth:`request_reply`).
+        """
+        name, args = named(what, args)
         self._require_connected()
         self._send(self.number_of(name), args)
+
+    def send(self, payload: Payload, *, name: str | None = None) -> None:
+        """Send a typed command; its type picks the data (``name`` only for a family: ``setCameraRel…``)."""
+        self.request_once(name or payload_name(payload), payload.encode())
+
+    def request_reply(
+        self,
+        what: str | Payload,
+        args: bytes = b"",
+        *,
+        now: float,
+        expect: int | None = None,
+        until: Callable[[bytes], bool] | None = None,
+        streaming: bool = False,
+        max_packets: int = MAX_REPLY_PACKETS,
+        max_bytes: int = MAX_REPLY_BYTES,
+    ) -> ReplyId | None:
+        """Run ``what`` once and track its reply until it ends; None when the data has no reply.
+
+        ``expect=n``: the reply is n packets; ``until(payload) -> bool``: the caller's own end
+        test. ``streaming``: packets are handed out in ``ReplyPacket`` events and only those
+        not yet :meth:`reply_taken` count against the bounds. Raises ``TooManyPending``
+        (nothing sent) when too many requests of this data already wait.
+        """
+        name, args = named(what, args)
+        self._require_connected()
+        number = self.number_of(name)
+        entry = self.datalist.entry(number)
+        flags = entry.flag_set if entry else frozenset()
+        rule = end_rule(flags, name, expect, until)
+        if rule is None:
+            self._send(number, args)
+            return None
+        fallback = end_rule(flags, name, expect) or rule
+        pending = self.replies.expect(
+            number, name, rule, fallback, now=now, streaming=streaming,
+            max_packets=max_packets, max_bytes=max_bytes,
+        )  # fmt: skip
+        self._send(number, args)
+        return pending.id
+
+    def abandon_reply(self, reply: ReplyId, now: float) -> None:
+        """Its waiter gave up: the rest of the reply is swallowed, never taken for a later request's."""
+        self.replies.abandon(reply, now)
+
+    def reply_taken(self, reply: ReplyId, payload: bytes) -> None:
+        """A streamed reply's reader took ``payload``: it no longer counts against the bounds."""
+        self.replies.taken(reply, payload)
 
     def shutdown(self) -> None:
         """Say goodbye; the caller then closes the socket."""
@@ -117,7 +182,10 @@ class ClientConnection:
             raise ProtocolError(f"not connected (state {self.state.name})")
 
     # -- input --------------------------------------------------------------
-    def receive_data(self, data: bytes) -> list[Event]:
+    def receive_data(self, data: bytes, now: float | None = None) -> list[Event]:
+        """Bytes from the server → events; ``now`` dates the packets for the reply tracker's expiry."""
+        if now is not None:
+            self.replies.now = now
         events: list[Event] = []
         for packet in self.decoder.feed(data):
             events.extend(self._handle(packet))
@@ -155,7 +223,7 @@ class ClientConnection:
             return [Ignored(cmd, "unexpected control command")]
         if state is not ClientState.CONNECTED:
             return [Ignored(cmd, "data before the data list was complete")]
-        return [DataReceived(cmd, self.datalist.name(cmd), packet.payload)]
+        return [*self.replies.feed(cmd, self.datalist.name(cmd), packet.payload)]
 
     def _on_introduction(self, packet: Packet) -> ServerIntroduction:
         try:
@@ -182,6 +250,23 @@ class ClientConnection:
     def wanted_protocol(self) -> str | None:
         """The protocol string the server advertised (None before its introduction)."""
         return None if self.introduction is None else self.introduction.protocol_version
+
+
+def payload_name(payload: Payload) -> str:
+    """The data a typed payload is sent as; a family type (camera, range device) cannot say which."""
+    cls = type(payload)
+    if cls.NAME_MATCH is not NameMatch.EXACT:
+        raise ProtocolError(f"{cls.__name__} is sent under several data names: say which")
+    return cls.DATA_NAME
+
+
+def named(what: str | Payload, args: bytes = b"") -> tuple[str, bytes]:
+    """(data name, argument bytes) from a name and its bytes, or from a typed payload alone."""
+    if isinstance(what, Payload):
+        if args:
+            raise TypeError("a typed payload carries its own arguments")
+        return payload_name(what), what.encode()
+    return what, args
 
 
 def protocol_advice(wanted: str, sent: str) -> str:

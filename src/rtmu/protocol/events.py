@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 from dataclasses import dataclass
+from enum import Enum
 
 from .datalist import DataList
 
@@ -39,11 +40,65 @@ class DataListReady:
 
 @dataclass(frozen=True, slots=True)
 class DataReceived:
-    """A reply or broadcast for one data."""
+    """A data packet no tracked request claimed: a broadcast, a subscription update, an untracked reply."""
 
     command: int
     name: str | None
     payload: bytes
+
+
+@dataclass(frozen=True, slots=True)
+class ReplyId:
+    """Names one tracked request (``ClientConnection.request_reply``): the key its waiter is kept under."""
+
+    serial: int
+    """Unique per connection, in the order the requests were sent."""
+    number: int
+    name: str
+
+
+class ReplyError(Enum):
+    """Why a tracked reply failed; the message says it in words."""
+
+    TOO_LARGE = "too large"
+    """Past the request's packet or byte bound; the rest of the reply is swallowed."""
+    MALFORMED = "malformed"
+    """The reply's own end test refused a packet (a broken or endless map)."""
+
+
+@dataclass(frozen=True, slots=True)
+class ReplyPacket:
+    """A data packet that belongs to a tracked request (handlers see it like any packet)."""
+
+    reply: ReplyId
+    payload: bytes
+    swallowed: bool = False
+    """Not for the request's waiter: it gave up earlier, or the reply failed at this very packet."""
+
+    @property
+    def command(self) -> int:
+        return self.reply.number
+
+    @property
+    def name(self) -> str:
+        return self.reply.name
+
+
+@dataclass(frozen=True, slots=True)
+class ReplyComplete:
+    """The tracked reply ended; ``payloads`` is all of it (empty when streamed: already handed out)."""
+
+    reply: ReplyId
+    payloads: tuple[bytes, ...]
+
+
+@dataclass(frozen=True, slots=True)
+class ReplyFailed:
+    """The tracked reply cannot be delivered; its remaining packets are swallowed, not misattributed."""
+
+    reply: ReplyId
+    reason: ReplyError
+    message: str
 
 
 @dataclass(frozen=True, slots=True)
@@ -115,6 +170,9 @@ Event = (
     | Rejected
     | DataListReady
     | DataReceived
+    | ReplyPacket
+    | ReplyComplete
+    | ReplyFailed
     | PeerShutdown
     | ClientIntroduced
     | LoginRefused
