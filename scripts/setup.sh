@@ -202,7 +202,10 @@ ensure_project() {
         return
     fi
     say "installing rtmu and its dev tools into $VENV (PyGObject builds from source: a minute or two)"
-    "$VENV/bin/python" -m pip install -q --disable-pip-version-check -c "$CONSTRAINTS" -e '.[dev]' </dev/null ||
+    # pygobject-stubs builds its stubs for the GTK named here at install time; no pip cache, so a wheel
+    # once built for GTK 3 (its default) cannot come back from ~/.cache/pip.
+    export PYGOBJECT_STUB_CONFIG=Gtk4,Gdk4
+    "$VENV/bin/python" -m pip install -q --no-cache-dir --disable-pip-version-check -c "$CONSTRAINTS" -e '.[dev]' </dev/null ||
         die "pip install -c $CONSTRAINTS -e '.[dev]' failed (see above)"
     printf '%s\n' "$want" >"$STAMP"
     say "python packages installed"

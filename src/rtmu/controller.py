@@ -68,7 +68,8 @@ class View(Protocol):
 
 
 class ClientLink(Protocol):
-    """The network side as the controller sees it (``rtmu.client.ClientRunner``); every call returns at once.
+    """The network side as the controller sees it (``rtmu.client.ClientRunner``); every call returns at once
+    (what it returns — a Future in the runner — is not waited for).
 
     Results come back through the model (connection, robot, map, camera) on the
     UI thread; problems the operator should hear about go to ``on_notice``.
@@ -88,19 +89,19 @@ class ClientLink(Protocol):
         profile: str = "",
         auto_reconnect: bool = True,
         protocol: str | None = None,
-    ) -> None: ...
+    ) -> object: ...
 
-    def disconnect(self) -> None: ...
+    def disconnect(self) -> object: ...
 
-    def stop(self) -> None:
+    def stop(self) -> object:
         """Zero ratios and ``stop``, sent whatever the link health says."""
 
-    def command(self, name: str, *args: object) -> None:
+    def command(self, name: str, *args: object) -> object:
         """Fire-and-forget request-once (``turnByAngle``, ``moveDist``…)."""
 
-    def request_image(self) -> None: ...
+    def request_image(self) -> object: ...
 
-    def set_safe_drive(self, on: bool) -> None: ...
+    def set_safe_drive(self, on: bool) -> object: ...
 
     # Optional (the controller looks for it with getattr): ``run_blocking(fn, done)`` runs ``fn``
     # off the UI thread and posts ``done(result)`` back; keyring lookups go through it.

@@ -122,7 +122,7 @@ class Settings:
     def current(self) -> Profile:
         """The profile used last, else the first one, else a default local one."""
         if self.last_profile in self.profiles:
-            return self.profiles[self.last_profile]  # type: ignore[index]
+            return self.profiles[self.last_profile]
         return next(iter(self.profiles.values()), Profile())
 
     def put(self, profile: Profile) -> None:
@@ -350,7 +350,7 @@ class KeyringSecrets:
         if self._keyring is None or not profile.user:
             return None
         try:
-            return self._keyring.get_password(KEYRING_SERVICE, profile.keyring_user)  # type: ignore[no-any-return]
+            return self._keyring.get_password(KEYRING_SERVICE, profile.keyring_user)
         except Exception as exc:  # a locked or broken keyring must not stop a connection
             log.warning("keyring lookup failed: %s", exc)
             return None
@@ -405,7 +405,7 @@ def choose_backend(backend: Any) -> Any | None:
 
 def _load_keyring() -> Any | None:
     try:
-        import keyring  # type: ignore[import-not-found]
+        import keyring
     except ImportError:
         return None
     try:

@@ -8,6 +8,7 @@ that contains ArNetworking's ``0F 0C`` sync pair.
 
 from __future__ import annotations
 
+import io
 import struct
 from collections.abc import Iterator
 from pathlib import Path
@@ -52,11 +53,13 @@ class CaptureSource:
         tcp = TcpReassembler(stats)
         with _open(self.path) as f:
             head = f.read(24)
-            reader: FrameReader = PcapngReader(f) if head[:4] == PCAPNG_MAGIC else PcapReader(f, head)
-            if isinstance(reader, PcapngReader):
+            reader: FrameReader
+            if head[:4] == PCAPNG_MAGIC:
+                reader = PcapngReader(f)
                 f.seek(0)
             else:
-                stats.link_type = reader.link_type
+                reader = pcap = PcapReader(f, head)
+                stats.link_type = pcap.link_type
             last = None
             unsupported: set[int] = set()
             for frame in reader:
@@ -128,14 +131,14 @@ class CaptureSource:
             yield bytes(buf)
 
 
-def _open(path: Path):  # type: ignore[no-untyped-def]
+def _open(path: Path):
     try:
         return path.open("rb")
     except OSError as exc:
         raise UnreadableInput(f"cannot read {path}: {exc.strerror or exc}") from exc
 
 
-def _open_text(path: Path):  # type: ignore[no-untyped-def]
+def _open_text(path: Path):
     try:
         return path.open("r", encoding="latin-1", newline=None)
     except OSError as exc:
@@ -161,7 +164,7 @@ def open_capture(path: str | Path, fmt: str = "auto", direction: str = "auto") -
         if magic in PCAP_MAGICS:
             if len(sample) < 24:
                 raise CaptureError(f"{path} is cut short: a pcap header needs 24 bytes")
-            header = PcapReader(_BytesStream(sample), sample[:24])  # validates version and header
+            header = PcapReader(io.BytesIO(sample), sample[:24])  # validates version and header
             if header.link_type not in SUPPORTED_LINK_TYPES:
                 raise CaptureError(
                     f"{path}: link type {header.link_type} is not supported "
@@ -205,14 +208,3 @@ def _has_sync(path: Path) -> bool:
                 return True
             tail = chunk[-1:]
     return False
-
-
-class _BytesStream:
-    """Just enough of a file for the pcap header check."""
-
-    def __init__(self, data: bytes) -> None:
-        self._data = data
-
-    def read(self, size: int) -> bytes:
-        out, self._data = self._data[:size], self._data[size:]
-        return out

@@ -63,7 +63,7 @@ import logging
 import threading
 import time
 from collections.abc import Awaitable, Callable
-from typing import Any, TypeVar
+from typing import Any, TypeVar, overload
 
 from ..notices import Kind, Notice
 from ..state import StateChange, StateSink
@@ -196,24 +196,32 @@ class ClientRunner:
         return self.session
 
     # -- crossing threads --------------------------------------------------------------------
-    def submit(self, fn: Callable[..., Awaitable[T] | T], *args: Any) -> concurrent.futures.Future[T]:
+    @overload
+    def submit(self, fn: Callable[..., Awaitable[T]], *args: Any) -> concurrent.futures.Future[T]: ...
+    @overload
+    def submit(self, fn: Callable[..., T], *args: Any) -> concurrent.futures.Future[T]: ...
+    def submit(self, fn: Callable[..., Any], *args: Any) -> concurrent.futures.Future[Any]:
         """Run ``fn(*args)`` (plain or async) on the network loop; a Future for its result."""
         if self._closed:
-            failed: concurrent.futures.Future[T] = concurrent.futures.Future()
+            failed: concurrent.futures.Future[Any] = concurrent.futures.Future()
             failed.set_exception(ClientError("the client has been closed"))
             return failed
         return self._on_loop(fn, *args)
 
-    def _on_loop(self, fn: Callable[..., Awaitable[T] | T], *args: Any) -> concurrent.futures.Future[T]:
-        async def run() -> T:
+    def _on_loop(self, fn: Callable[..., Any], *args: Any) -> concurrent.futures.Future[Any]:
+        async def run() -> Any:
             result = fn(*args)
             if asyncio.iscoroutine(result) or isinstance(result, asyncio.Future):
-                return await result  # type: ignore[no-any-return]
-            return result  # type: ignore[return-value]
+                return await result
+            return result
 
         return asyncio.run_coroutine_threadsafe(run(), self.loop)
 
-    def call(self, fn: Callable[..., Awaitable[T] | T], *args: Any, timeout: float = 15.0) -> T:
+    @overload
+    def call(self, fn: Callable[..., Awaitable[T]], *args: Any, timeout: float = ...) -> T: ...
+    @overload
+    def call(self, fn: Callable[..., T], *args: Any, timeout: float = ...) -> T: ...
+    def call(self, fn: Callable[..., Any], *args: Any, timeout: float = 15.0) -> Any:
         """Blocking :meth:`submit` for scripts and tests (never from the GTK thread)."""
         future = self.submit(fn, *args)
         try:

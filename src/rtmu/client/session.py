@@ -23,13 +23,15 @@ import logging
 import time
 from collections.abc import Callable
 from dataclasses import dataclass, field, replace
+from functools import partial
 from typing import Any
 
 from ..guardian.handle import BEAT_PERIOD, GuardianHandle
 from ..guardian.messages import Hello
 from ..notices import Kind, Notice
+from ..protocol.client_connection import payload_name
 from ..protocol.errors import ProtocolError
-from ..protocol.payloads import Side, decode_payload, payload_type_for
+from ..protocol.payloads import Payload, Side, decode_payload, payload_type_for
 from ..protocol.payloads.drive import RatioDrive, SafeDrive, SetSafeDrive
 from ..protocol.payloads.robot import BatteryInfo, ModeInfo, Update, UpdateNumbers, UpdateStrings
 from ..state import (
@@ -42,6 +44,7 @@ from ..state import (
     LinkLevel,
     MapChanged,
     MapModel,
+    MapPhase,
     Phase,
     RobotChanged,
     RobotState,
@@ -56,6 +59,7 @@ from .lease import DriveGovernor, DriveLease, EndReason, SendRatios, SendStop
 from .mapcache import MapCache, map_key
 from .mapload import download_map, map_source
 from .reconnect import Backoff, worth_retrying
+from .subscriptions import Subscription, applicable
 
 log = logging.getLogger(__name__)
 
@@ -63,6 +67,8 @@ Publish = Callable[[StateChange], None]
 """``publish(change)``: a new whole value for one part of the robot's state."""
 NoticeFn = Callable[[Notice], None]
 """``notice(notice)``: a message for the operator, typed by what it is about."""
+ClientFactory = Callable[[Callable[[ClientError], None]], AriaClient]
+"""``factory(on_close)`` → a fresh, unconnected :class:`AriaClient` (its link is the factory's choice)."""
 
 HEART_MAX_SLEEP = 0.25
 STEP_TIMEOUT = 2.0
@@ -113,12 +119,20 @@ class Session:
         *,
         clock: Callable[[], float] = time.monotonic,
         config: SessionConfig | None = None,
+        client_factory: ClientFactory | None = None,
+        subscriptions: tuple[SessionSubscription, ...] | None = None,
     ) -> None:
         self.lease = lease
         self.publish_fn = publish
         self.notice_fn: NoticeFn = notice or (lambda notice: None)
         self.clock = clock
         self.config = config or SessionConfig()
+        self.client_factory: ClientFactory = client_factory or (
+            lambda on_close: AriaClient(on_close=on_close, clock=self.clock)
+        )
+        """Makes each connection's client: a replay or a test passes one over its own link."""
+        self.subscriptions = SUBSCRIPTIONS if subscriptions is None else subscriptions
+        """What every connection subscribes to (see :data:`SUBSCRIPTIONS`)."""
         self.health = HealthMonitor(
             self.config.status_interval_ms / 1000.0, lost_after=self.config.lost_after
         )
@@ -232,7 +246,7 @@ class Session:
             task.cancel()
 
     async def _open(self, target: _Target) -> None:
-        client = AriaClient(on_close=lambda error: self._on_client_closed(client, error), clock=self.clock)
+        client = self.client_factory(lambda error: self._on_client_closed(client, error))
         await client.connect(
             target.host,
             target.port,
@@ -369,19 +383,8 @@ class Session:
 
     # -- subscriptions -----------------------------------------------------------------------
     def _setup_subscriptions(self, client: AriaClient) -> None:
-        cfg = self.config
-        if client.supports("updateNumbers"):
-            client.request("updateNumbers", cfg.status_interval_ms, self._on_numbers)
-            if client.supports("updateStrings"):
-                client.request("updateStrings", -1, self._on_strings)
-        elif client.supports("update"):
-            client.request("update", cfg.status_interval_ms, self._on_update)
-        if client.supports("getModeInfo"):
-            client.request("getModeInfo", -1, self._on_mode_info)
-        if client.supports("mapUpdated"):
-            client.request("mapUpdated", -1, self._on_map_updated)
-        if client.supports("sonarCurrent"):
-            client.request("sonarCurrent", cfg.sonar_interval_ms, self._on_sonar)
+        for sub in applicable(self.subscriptions, client.supports):
+            client.request(sub.name, sub.interval(self.config), partial(sub.handler, self))
         self.ld.subscribe(client)
         for name, (interval, handler) in self._extra_subs.items():
             if client.supports(name):
@@ -573,7 +576,7 @@ class Session:
                 r = action.ratios
                 if self.guardian is not None:
                     self.guardian.arm()  # before the first ratioDrive of a drive
-                self._send("ratioDrive", RatioDrive(r.trans, r.rot, r.throttle, r.lat or None))
+                self._send(RatioDrive(r.trans, r.rot, r.throttle, r.lat or None))
             elif isinstance(action, SendStop):
                 self._send_stop()
         self._publish_health(now)
@@ -594,12 +597,14 @@ class Session:
             return
         self._publish(HealthChanged(self.health.snapshot(now, self.client.drops)))
 
-    def _send(self, name: str, *args: Any) -> bool:
+    def _send(self, what: str | Payload, *args: Any) -> bool:
+        """Send if connected and offered; a typed payload names its data (``_send(RatioDrive(…))``)."""
         client = self.client
+        name = what if isinstance(what, str) else payload_name(what)
         if client is None or not client.connected or not client.supports(name):
             return False
         try:
-            client.send(name, *args)
+            client.send(what, *args)
         except ClientError:
             return False
         self.packets_sent += 1
@@ -607,7 +612,7 @@ class Session:
 
     def _send_stop(self) -> None:
         """Zero ratios, then ``stop`` — whatever the link health looks like."""
-        self._send("ratioDrive", RatioDrive(0.0, 0.0, 0.0))
+        self._send(RatioDrive(0.0, 0.0, 0.0))
         self._send("stop")
         if self.guardian is not None:
             self.guardian.disarm()
@@ -686,7 +691,7 @@ class Session:
 
     def set_safe_drive(self, on: bool) -> None:
         client = self._require("setSafeDrive")
-        client.send("setSafeDrive", SetSafeDrive(on))
+        client.send(SetSafeDrive(on))
         if client.supports("getSafeDrive"):
             self._spawn(self._refresh_safe_drive(client), "safe-drive")
 
@@ -775,7 +780,7 @@ class Session:
         if client is None or not client.connected:
             raise ServerClosed("not connected")
         if map_source(client) is None:
-            self._set_map(MapModel(state="unsupported"))
+            self._set_map(MapModel(state=MapPhase.UNSUPPORTED))
             return self._map
         target = self._target
         key = None
@@ -788,7 +793,7 @@ class Session:
                 self._set_map(cached)
             return self._map
         generation = self._map.generation
-        self._set_map(MapModel(state="loading", name=self._map.name, generation=generation))
+        self._set_map(MapModel(state=MapPhase.LOADING, name=self._map.name, generation=generation))
 
         def progress(count: int) -> None:
             self._set_map(replace(self._map, received=count))
@@ -805,21 +810,40 @@ class Session:
             log.exception("loading the map failed")
             return self._map_failed(client, f"internal error: {exc}")
         if got.data is None:
-            self._set_map(MapModel(state="none", name=got.name, generation=generation, received=got.packets))
+            self._set_map(
+                MapModel(state=MapPhase.NONE, name=got.name, generation=generation, received=got.packets)
+            )
             return self._map
         self._set_map(
             MapModel(
-                state="ready", data=got.data, name=got.name, generation=generation + 1, received=got.packets
+                state=MapPhase.READY,
+                data=got.data,
+                name=got.name,
+                generation=generation + 1,
+                received=got.packets,
             )
         )
         self._map_cache.put(key, self._map)
         return self._map
 
     def _map_failed(self, client: AriaClient, reason: str) -> MapModel:
-        self._set_map(replace(self._map, state="failed", error=reason))
+        self._set_map(replace(self._map, state=MapPhase.FAILED, error=reason))
         if client.connected:
             self._notice(Notice.warning(Kind.MAP, f"The map could not be loaded: {reason}"))
         return self._map
+
+
+SessionSubscription = Subscription[Session, SessionConfig]
+
+SUBSCRIPTIONS: tuple[SessionSubscription, ...] = (
+    Subscription("updateNumbers", lambda c: c.status_interval_ms, Session._on_numbers),
+    Subscription("updateStrings", -1, Session._on_strings, needs="updateNumbers"),
+    Subscription("update", lambda c: c.status_interval_ms, Session._on_update, unless="updateNumbers"),
+    Subscription("getModeInfo", -1, Session._on_mode_info),
+    Subscription("mapUpdated", -1, Session._on_map_updated),
+    Subscription("sonarCurrent", lambda c: c.sonar_interval_ms, Session._on_sonar),
+)
+"""What a session subscribes to on every connection, in this order, where the server offers it."""
 
 
 _WIFI_WORDS = ("wireless", "wifi", "wi-fi", "wlan")

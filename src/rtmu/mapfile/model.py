@@ -376,7 +376,9 @@ def new_map(
     source: str = "<map>",
 ) -> MapData:
     """A single-scan map from arrays: the common way to build one in code."""
-    scan = MapScan(points=points, segments=segments, resolution=resolution)
+    scan = MapScan(
+        points=as_rows(points, 2, "points"), segments=as_rows(segments, 4, "segments"), resolution=resolution
+    )
     return MapData(
         category=category,
         scans=[scan],

@@ -120,7 +120,7 @@ def from_stream(
     log = WarningLog()
     reader = HeaderReader(source, log)
     for line_no, line in enumerate(header_lines, 1):
-        text = line.decode("latin-1") if isinstance(line, bytes) else line
+        text = line.decode("latin-1") if isinstance(line, bytes) else str(line)
         if len(text) > max_line:
             raise MapFormatError(f"line longer than {max_line} bytes", source, line_no)
         if line_no > max_header_lines:

@@ -70,7 +70,7 @@ class SpanChecksums:
         self._base = 0
         self.stop = 0
         self._sums = np.zeros(0, dtype=np.int64)
-        self._view = memoryview(self._sums)
+        self._view = self._sums.data
 
     @property
     def active(self) -> bool:
@@ -94,7 +94,7 @@ class SpanChecksums:
             grown[:kept] = self._sums[:kept]
             self._view.release()
             self._sums = grown
-            self._view = memoryview(grown)
+            self._view = grown.data
         sums = self._sums  # sums[0] and sums[1] are empty sums: zero from np.zeros, never written
         k = max(n0 + 1, 2)  # first new entry: sums[k] = sums[k - 2] + the word at base + k - 2
         if k <= n1:

@@ -104,7 +104,7 @@ class DataList:
         old = self._by_number.get(number)
         # ARIA's client stops at an unknown number; we keep what we know and skip it.
         if old is not None:
-            self.add(replace(old, **changes))
+            self.add(replace(old, **changes))  # type: ignore[arg-type]  # only the str fields are amended
 
     # -- server side: build list packets ----------------------------------
     def list_packets(self) -> list[Packet]:

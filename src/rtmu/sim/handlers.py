@@ -497,8 +497,8 @@ def _camera_info(call: Call) -> Iterable[Reply]:
 
 @handles("cameraInfo")
 def _legacy_camera_info(call: Call) -> Iterable[Reply]:
-    limits = (*PAN_RANGE, *TILT_RANGE)
-    return (LegacyCameraInfo(*(round(v) for v in limits), 0, 100, True).encode(),)
+    (pan0, pan1), (tilt0, tilt1) = PAN_RANGE, TILT_RANGE
+    return (LegacyCameraInfo(round(pan0), round(pan1), round(tilt0), round(tilt1), 0, 100, True).encode(),)
 
 
 @handles("setCameraAbsCam1")

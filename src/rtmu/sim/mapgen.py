@@ -163,10 +163,10 @@ def _layout(rng: np.random.Generator, structural_target: float) -> _Layout:
     walls.append(np.stack([xs[ii], spans[..., 0], xs[ii], spans[..., 1]], axis=-1).reshape(-1, 4))
 
     # Rooms: row 0 has its back wall at the band's bottom, row 1 at its top.
-    bb, rr, cc = np.meshgrid(np.arange(bands), np.arange(2), np.arange(columns), indexing="ij")
-    back = np.where(rr == 0, band_y[bb], band_y[bb] + BAND_HEIGHT)
-    front = np.where(rr == 0, c0[bb], c1[bb])
-    rooms = np.stack([x0[cc], x1[cc], back, front, bb.astype(np.float64)], axis=-1).reshape(-1, 5)
+    band, row, col = np.meshgrid(np.arange(bands), np.arange(2), np.arange(columns), indexing="ij")
+    back = np.where(row == 0, band_y[band], band_y[band] + BAND_HEIGHT)
+    front = np.where(row == 0, c0[band], c1[band])
+    rooms = np.stack([x0[col], x1[col], back, front, band.astype(np.float64)], axis=-1).reshape(-1, 5)
     return _Layout(np.concatenate(walls), rooms, width, height)
 
 

@@ -227,7 +227,7 @@ class World:
 
     # -- popups ---------------------------------------------------------------
     def create_popup(self, title: str, message: str, *, kind: int = 1, buttons=("OK", "", "")) -> Popup:
-        popup = Popup(self._next_popup_id, "", title, message, kind, tuple(buttons))  # type: ignore[arg-type]
+        popup = Popup(self._next_popup_id, "", title, message, kind, tuple(buttons))
         self._next_popup_id += 1
         self.popups[popup.id] = popup
         self.changes.popups_created.append(popup)

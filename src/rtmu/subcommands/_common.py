@@ -110,7 +110,7 @@ def _refuse_unknown_quietly(parser: argparse.ArgumentParser) -> None:
             parser.error(f"unrecognized arguments: {shown} (values not shown)")
         return namespace, extras
 
-    parser.parse_known_args = parse_known_args  # type: ignore[method-assign]
+    parser.parse_known_args = parse_known_args  # type: ignore[method-assign,assignment]
 
 
 def add_connection_arguments(parser: argparse.ArgumentParser) -> None:

@@ -95,7 +95,7 @@ examples:
   xxd bytes.bin > dump.txt && rtmu decode --direction c2s dump.txt"""
 
 
-def register(subparsers: argparse._SubParsersAction) -> None:  # type: ignore[type-arg]
+def register(subparsers: argparse._SubParsersAction) -> None:
     parser = subparsers.add_parser(
         "decode",
         help="decode ArNetworking traffic from a pcap/pcapng capture, a hex dump or raw bytes",

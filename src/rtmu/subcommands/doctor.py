@@ -155,7 +155,7 @@ class Doctor:
             raise fail(
                 Step.RESOLVE, f"cannot find host {self.host!r}: {exc.strerror or exc}", ADVICE["resolve"]
             ) from None
-        addresses = sorted({info[4][0] for info in infos})
+        addresses = sorted({str(info[4][0]) for info in infos})
         self.address = addresses[0]
         self.ok(Step.RESOLVE, f"{self.host} is {', '.join(addresses)}", addresses=addresses)
 

@@ -31,7 +31,7 @@ def default_map(name: str = "arena.map") -> Path | None:
     return None
 
 
-def register(subparsers: argparse._SubParsersAction) -> None:  # type: ignore[type-arg]
+def register(subparsers: argparse._SubParsersAction) -> None:
     p = subparsers.add_parser(
         "sim",
         help="run the bundled ARIA robot simulator (ArNetworking server, simulated Pioneer 3-DX)",

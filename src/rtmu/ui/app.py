@@ -118,7 +118,7 @@ def demo_map_path() -> Path:
     return target
 
 
-def start_demo_simulator():  # type: ignore[no-untyped-def]
+def start_demo_simulator():
     from ..sim import SimConfig, SimThread
 
     return SimThread(SimConfig(host="127.0.0.1", port=0, map_path=demo_map_path(), camera=True)).start()

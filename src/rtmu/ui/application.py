@@ -152,11 +152,11 @@ class RtmuApplication(Gtk.Application):
             window.fullscreen()
         window.present()
         if loaded.warning:
-            window.banners.show("notice:settings", "warning", loaded.warning, timeout=10.0)
+            window.banners.tell("notice:settings", "warning", loaded.warning, timeout=10.0)
         if auto_connect:
             window.connect_now()
         elif not self.settings.profiles and not self.options.host:
-            window.banners.show("notice:hint", "info", FIRST_RUN_HINT, timeout=12.0)
+            window.banners.tell("notice:hint", "info", FIRST_RUN_HINT, timeout=12.0)
 
     def do_shutdown(self) -> None:
         self.close_session()
@@ -222,7 +222,7 @@ class RtmuApplication(Gtk.Application):
                 signal.signal(signal.SIGTSTP, self._on_suspend)
         self.suspensions += 1
         if self.window is not None:
-            self.window.banners.show(
+            self.window.banners.tell(
                 "notice:suspended",
                 "warning",
                 f"The window was suspended (pid {os.getpid()}): the robot was stopped. Press a key to drive.",

@@ -54,7 +54,7 @@ class BannerStack(Gtk.Box):
         """The last (topic, level, text) shown, newest last: what the operator was told."""
 
     # -- public ------------------------------------------------------------------------------
-    def show(
+    def tell(
         self,
         topic: str,
         level: str,

@@ -16,7 +16,8 @@ from collections.abc import Callable
 import gi
 
 gi.require_version("Gtk", "4.0")
-from gi.repository import Gio, Gtk  # noqa: E402
+gi.require_version("Pango", "1.0")
+from gi.repository import Gio, Gtk, Pango  # noqa: E402
 
 
 def stop_button(on_stop: Callable[[], None]) -> Gtk.Button:
@@ -78,7 +79,7 @@ class FullscreenBar(Gtk.Revealer):
         self.connect_button = connect_button(on_connect)
         self.status_label = Gtk.Label(xalign=0.0, hexpand=True)
         self.status_label.add_css_class("subtitle")
-        self.status_label.set_ellipsize(3)  # Pango.EllipsizeMode.END
+        self.status_label.set_ellipsize(Pango.EllipsizeMode.END)
         self.status_label.set_use_markup(False)
         self.menu_button = menu_button(menu)
         self.leave_button = Gtk.Button(

@@ -17,8 +17,9 @@ from dataclasses import dataclass
 import gi
 
 gi.require_version("Gtk", "4.0")
+gi.require_version("Pango", "1.0")
 gi.require_version("Gdk", "4.0")
-from gi.repository import Gdk, GLib, Gtk  # noqa: E402
+from gi.repository import Gdk, GLib, Gtk, Pango  # noqa: E402
 
 from ..model import CameraImage  # noqa: E402
 
@@ -168,7 +169,7 @@ class CameraView(Gtk.Box):
         bar.add_css_class("camera-bar")
         self.info = Gtk.Label(xalign=0.0, hexpand=True)
         self.info.set_use_markup(False)
-        self.info.set_ellipsize(3)
+        self.info.set_ellipsize(Pango.EllipsizeMode.END)
         self.refresh_button = Gtk.Button.new_with_label("New picture")
         self.refresh_button.set_focusable(False)
         self.refresh_button.connect("clicked", lambda _b: on_request())
@@ -347,7 +348,9 @@ class _SizedPicture(Gtk.Picture):
             self._size = (width, height)
             self.queue_resize()
 
-    def do_measure(self, orientation: Gtk.Orientation, _for_size: int) -> tuple[int, int, int, int]:
+    def do_measure(  # GTK passes only the enum, never its nick strings
+        self, orientation: Gtk.Orientation, for_size: int
+    ) -> tuple[int, int, int, int]:
         n = self._size[0] if orientation == Gtk.Orientation.HORIZONTAL else self._size[1]
         return n, n, -1, -1
 

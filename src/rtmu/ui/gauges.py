@@ -60,7 +60,7 @@ class BatteryGauge(Gtk.DrawingArea):
             self.fraction, self.state = fraction, state
             self.queue_draw()
 
-    def _draw(self, _a: Gtk.DrawingArea, ctx, width: int, height: int) -> None:  # type: ignore[no-untyped-def]
+    def _draw(self, _a: Gtk.DrawingArea, ctx, width: int, height: int) -> None:
         colour = {"ok": GREEN, "low": AMBER, "critical": RED}.get(self.state, GREY)
         body_w = width - 4
         ctx.set_line_width(1.5)
@@ -89,7 +89,7 @@ class WifiGauge(Gtk.DrawingArea):
             self.bars, self.live = bars, live
             self.queue_draw()
 
-    def _draw(self, _a: Gtk.DrawingArea, ctx, width: int, height: int) -> None:  # type: ignore[no-untyped-def]
+    def _draw(self, _a: Gtk.DrawingArea, ctx, width: int, height: int) -> None:
         bar_w = (width - 3 * 2) / 4
         for i in range(4):
             h = height * (i + 1) / 4

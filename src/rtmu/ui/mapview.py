@@ -133,7 +133,7 @@ class MapStage(Gtk.DrawingArea):
             self._keep_robot_visible()
         self.queue_draw()
 
-    def _on_view_options(self, old, new) -> None:  # type: ignore[no-untyped-def]
+    def _on_view_options(self, old, new) -> None:
         """A profile switch (or the controller) changed zoom/follow: apply what differs from ours."""
         if new.follow_robot != self.follow:
             self.set_follow(new.follow_robot)

@@ -25,6 +25,7 @@ import threading
 from collections import OrderedDict
 from collections.abc import Callable
 from dataclasses import dataclass
+from typing import cast
 
 import cairo
 import numpy as np
@@ -412,7 +413,7 @@ class TileCache:
     def _run(self, gen: int, job: tuple[str, object]) -> None:
         kind, payload = job
         if kind == "index":
-            points, segments = payload  # type: ignore[misc]
+            points, segments = cast("tuple[np.ndarray, np.ndarray]", payload)
             index = MapIndex(points, segments)
             with self._lock:
                 if gen == self._generation:
@@ -428,7 +429,7 @@ class TileCache:
                     self._lock.notify_all()
             self._ready()
         else:
-            index, (scale, i, j) = payload  # type: ignore[misc]
+            index, (scale, i, j) = cast("tuple[MapIndex, tuple[float, int, int]]", payload)
             surface = render_region(index, scale, i * TILE, j * TILE, TILE, TILE)
             blank = _is_blank(surface)
             with self._lock:

@@ -20,7 +20,8 @@ from collections.abc import Callable
 import gi
 
 gi.require_version("Gtk", "4.0")
-from gi.repository import GLib, Gtk  # noqa: E402
+gi.require_version("Pango", "1.0")
+from gi.repository import GLib, Gtk, Pango  # noqa: E402
 
 from ..model import ConnectionState, LinkLevel, OperatorState, Phase, RobotModel  # noqa: E402
 from .gauges import BatteryGauge, WifiGauge, battery_fraction, wifi_bars  # noqa: E402
@@ -44,7 +45,7 @@ class Cell(Gtk.Box):
         self.value = Gtk.Label(label=DASH, xalign=0.0, width_chars=width_chars)
         self.value.add_css_class("value")
         self.value.set_use_markup(False)
-        self.value.set_ellipsize(3)  # Pango.EllipsizeMode.END
+        self.value.set_ellipsize(Pango.EllipsizeMode.END)
         self.value.set_max_width_chars(width_chars)  # = width_chars: a fixed column, whatever the text
         self.append(self.caption)
         row = Gtk.Box(orientation=Gtk.Orientation.HORIZONTAL, spacing=4)
@@ -234,7 +235,7 @@ class StatusToolbar(Gtk.ScrolledWindow):
         measured = self.status_age() if self.status_age is not None else None
         return max(0.0, measured if measured is not None else now - numbers_at)
 
-    def _battery(self, robot, stale: bool, why: str | None) -> None:  # type: ignore[no-untyped-def]
+    def _battery(self, robot, stale: bool, why: str | None) -> None:
         cell = self.cells["battery"]
         if robot.battery_v is None:
             cell.show_value(DASH, stale=True, tooltip=why or "No battery reading")
@@ -259,7 +260,7 @@ class StatusToolbar(Gtk.ScrolledWindow):
         fraction = battery_fraction(robot.battery_v, robot.battery_shutdown, is_soc=robot.battery_is_soc)
         self.battery_gauge.set_level(fraction, "stale" if stale else state)
 
-    def _wifi(self, robot, live: bool, why: str | None) -> None:  # type: ignore[no-untyped-def]
+    def _wifi(self, robot, live: bool, why: str | None) -> None:
         cell = self.cells["wifi"]
         q, s = robot.wifi_quality, robot.wifi_signal
         if q is None and s is None:
@@ -272,7 +273,7 @@ class StatusToolbar(Gtk.ScrolledWindow):
         cell.show_value(text, stale=not live, tooltip=(why + "\n" + tip) if why and not live else tip)
         self.wifi_gauge.set_bars(wifi_bars(q, s), live)
 
-    def _link(self, conn: ConnectionState, health, age: float | None) -> None:  # type: ignore[no-untyped-def]
+    def _link(self, conn: ConnectionState, health, age: float | None) -> None:
         cell = self.cells["link"]
         for level in LinkLevel:
             cell.remove_css_class(f"link-{level.value}")

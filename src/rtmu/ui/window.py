@@ -21,14 +21,16 @@ deliberate disconnect shows nothing.
 
 from __future__ import annotations
 
+import functools
 import time
 from collections.abc import Callable, Mapping
 
 import gi
 
 gi.require_version("Gtk", "4.0")
+gi.require_version("Pango", "1.0")
 gi.require_version("Gdk", "4.0")
-from gi.repository import Gdk, Gio, GLib, Gtk  # noqa: E402
+from gi.repository import Gdk, Gio, GLib, Gtk, Pango  # noqa: E402
 
 from ..commands import COMMANDS, CommandState, action_name  # noqa: E402
 from ..controller import TICK, SecretStore  # noqa: E402
@@ -100,6 +102,12 @@ def short_reason(reason: str) -> str:
     return reason or "unavailable"
 
 
+def _flag(action: Gio.SimpleAction) -> bool:
+    """A boolean action's state (False before it has one)."""
+    state = action.get_state()
+    return state is not None and state.get_boolean()
+
+
 class _View:
     """The controller's ``View`` (a separate object: ``notify`` is a GObject method on the window)."""
 
@@ -152,6 +160,7 @@ class MainWindow(Gtk.ApplicationWindow):
         self._dialog: Gtk.Window | None = None
 
         link = session.runner
+        self._link = link
         status_age = link.status_age
         self.banners = BannerStack()
         self.stage = MapStage(model, operator, clock=clock, status_age=status_age)
@@ -160,7 +169,7 @@ class MainWindow(Gtk.ApplicationWindow):
         self.camera = CameraView(on_request=self._request_picture, on_back=self.show_map, clock=clock)
         self.inset = CameraInset(self.show_camera, clock=clock)
         self.decoder = PictureDecoder(self._picture_decoded)
-        self.dpad = DPad(hold=self._hold, release=self._release, stop=lambda: self.controller.run("stop"))
+        self.dpad = DPad(hold=self._hold, release=self._release, stop=self._stop_from_dpad)
         self.keys = KeyRouter(
             hold=self._hold, release=self._release, command=self._command, view=self.view_intent
         )
@@ -188,7 +197,7 @@ class MainWindow(Gtk.ApplicationWindow):
         self._tick_source = GLib.timeout_add(int(TICK * 1000), self._tick)
         # The UI thread's heartbeat to the guardian process (rtmu.guardian): it stops the robot
         # if these stop while driving because this process was killed or frozen.
-        self._beat_source = GLib.timeout_add(int(GUARDIAN_BEAT * 1000), lambda: link.ui_heartbeat() or True)
+        self._beat_source = GLib.timeout_add(int(GUARDIAN_BEAT * 1000), self._beat)
         self.commands_changed(self.controller.command_states())
         self._on_connection(ConnectionState(), model.connection.value)
         self._on_map(MapModel(), model.map.value)
@@ -208,7 +217,7 @@ class MainWindow(Gtk.ApplicationWindow):
         self.title_label.add_css_class("title")
         self.subtitle_label = Gtk.Label(label="")
         self.subtitle_label.add_css_class("subtitle")
-        self.subtitle_label.set_ellipsize(3)
+        self.subtitle_label.set_ellipsize(Pango.EllipsizeMode.END)
         self.subtitle_label.set_max_width_chars(48)
         title_box.append(self.title_label)
         title_box.append(self.subtitle_label)
@@ -359,7 +368,7 @@ class MainWindow(Gtk.ApplicationWindow):
             action = Gio.SimpleAction.new_stateful(name, None, GLib.Variant.new_boolean(initial))
 
             def flip(a: Gio.SimpleAction, _p: object) -> None:
-                new = not a.get_state().get_boolean()
+                new = not _flag(a)
                 a.set_state(GLib.Variant.new_boolean(new))
                 fn(new)
 
@@ -371,7 +380,7 @@ class MainWindow(Gtk.ApplicationWindow):
         # Disconnect also cancels an attempt in progress: its command is enabled while connecting.
         for cmd in COMMANDS:
             if not cmd.hold:
-                plain(action_name(cmd.name), lambda name=cmd.name: self._command(name))
+                plain(action_name(cmd.name), functools.partial(self._command, cmd.name))
         plain("settings", self.open_settings)
         plain("camera", lambda: self.view_intent("toggle_camera"))
         plain("about", self.show_about)
@@ -393,22 +402,22 @@ class MainWindow(Gtk.ApplicationWindow):
             return  # the link banner shows the connection's life from the model
         if kind is Kind.LINK:
             if level is Level.INFO:
-                self.banners.show("link", "info", text, timeout=4.0)
+                self.banners.tell("link", "info", text, timeout=4.0)
             elif phase is Phase.CONNECTED:
-                self.banners.show("link", level.value, text, timeout=None)
+                self.banners.tell("link", level.value, text, timeout=None)
         elif kind is Kind.SPEED_LIMIT:
             pct = self.operator.speed.value.percent
             limit = "maximum" if pct >= SPEED_MAX else "minimum"
-            self.banners.show("speed", "warning", f"Speed at its {limit}: {pct} %", timeout=2.5,
+            self.banners.tell("speed", "warning", f"Speed at its {limit}: {pct} %", timeout=2.5,
                               fraction=pct / SPEED_MAX)  # fmt: skip
         elif kind is Kind.SPEED:
             return  # the speed banner follows the model
         elif kind is Kind.CAMERA:
             if self.camera.waiting:
                 self.camera.failed(text)
-            self.banners.show("camera", level.value, text, timeout=5.0)
+            self.banners.tell("camera", level.value, text, timeout=5.0)
         else:
-            self.banners.show(
+            self.banners.tell(
                 f"notice:{text}", level.value, text, timeout=6.0 if level is Level.ERROR else 4.0
             )
 
@@ -457,12 +466,20 @@ class MainWindow(Gtk.ApplicationWindow):
     def _release(self, name: str) -> None:
         self.controller.release_command(name)
 
+    def _stop_from_dpad(self) -> None:
+        self.controller.run("stop")
+
+    def _beat(self) -> bool:
+        """The GTK thread's heartbeat to the guardian; True keeps the timer."""
+        self._link.ui_heartbeat()
+        return True
+
     def _command(self, name: str) -> None:
         """A command from a key, the menu or a button: refused with its reason while shown disabled."""
         state = self._states.get(name)
         if state is not None and not state.enabled:
             label = COMMANDS.get(name).label.rstrip("…") if name in COMMANDS else name
-            self.banners.show(f"notice:{name}", "warning", f"{label}: {state.reason}", timeout=4.0)
+            self.banners.tell(f"notice:{name}", "warning", f"{label}: {state.reason}", timeout=4.0)
             return
         self.controller.run(name)
 
@@ -514,7 +531,7 @@ class MainWindow(Gtk.ApplicationWindow):
     def show_camera(self, request: bool = False) -> None:
         state = self.command_state("request_image")
         if request and not state.enabled:
-            self.banners.show("camera", "warning", f"Camera picture: {state.reason}", timeout=4.0)
+            self.banners.tell("camera", "warning", f"Camera picture: {state.reason}", timeout=4.0)
             self.camera_button.set_active(False)
             return
         self.controller.stop()
@@ -542,22 +559,22 @@ class MainWindow(Gtk.ApplicationWindow):
         where = f"{new.host}:{new.port}" if new.host else ""
         phase = new.phase
         if phase is Phase.CONNECTING and old.phase is not Phase.CONNECTING:
-            self.banners.show("link", "info", f"Connecting to {where}…", timeout=None)
+            self.banners.tell("link", "info", f"Connecting to {where}…", timeout=None)
         elif phase is Phase.CONNECTED and old.phase is not Phase.CONNECTED:
             if old.phase is Phase.RECONNECTING:
-                self.banners.show(
+                self.banners.tell(
                     "link", "info", f"Reconnected to {where}: press a key to drive again", timeout=4.0
                 )
             else:
-                self.banners.show("link", "info", f"Connected to {where}", timeout=3.0)
+                self.banners.tell("link", "info", f"Connected to {where}", timeout=3.0)
         elif phase is Phase.RECONNECTING:
             count = f" ({new.attempt})" if new.attempt else ""
-            self.banners.show("link", "warning", f"Link lost — reconnecting{count}…", timeout=None)
+            self.banners.tell("link", "warning", f"Link lost — reconnecting{count}…", timeout=None)
         elif phase is Phase.FAILED and (new.error != old.error or old.phase is not Phase.FAILED):
             lost = old.phase in (Phase.CONNECTED, Phase.RECONNECTING)
             reason = new.error or "no reason given"
             text = f"Link lost: {reason}" if lost else f"Could not connect to {where}: {reason}"
-            self.banners.show("link", "error", text, timeout=10.0)
+            self.banners.tell("link", "error", text, timeout=10.0)
         elif phase is Phase.DISCONNECTED and old.phase is not Phase.DISCONNECTED:
             self.banners.dismiss("link")  # deliberate: no banner at all
         if phase is Phase.DISCONNECTED or (phase is Phase.CONNECTING and old.phase is not Phase.RECONNECTING):
@@ -614,7 +631,7 @@ class MainWindow(Gtk.ApplicationWindow):
             self.safe_action.set_state(GLib.Variant.new_boolean(new.safe_drive))
 
     def _on_speed(self, _old: SpeedSetting, new: SpeedSetting) -> None:
-        self.banners.show(
+        self.banners.tell(
             "speed", "info", f"Speed {new.percent} %", timeout=2.5, fraction=new.percent / SPEED_MAX
         )
 
@@ -628,9 +645,9 @@ class MainWindow(Gtk.ApplicationWindow):
         current = self.model.camera.value
         if current is None or image is not current:
             return  # a newer picture (or a disconnect) overtook this one
-        self.camera.show_picture(image, None if textures is None else textures[0], error)  # type: ignore[arg-type]
+        self.camera.show_picture(image, None if textures is None else textures[0], error)
         if textures is not None:
-            self.inset.show_texture(textures[1], image.received_at)  # type: ignore[attr-defined]
+            self.inset.show_texture(textures[1], image.received_at)
 
     def _view_changed(self) -> None:
         label = "Fit" if self.stage.fitted else ""
@@ -661,7 +678,7 @@ class MainWindow(Gtk.ApplicationWindow):
     def _fullscreen_changed(self, *_a: object) -> None:
         state = self.is_fullscreen()
         self.fullscreen_bar.set_reveal_child(state)
-        if self.fullscreen_action.get_state().get_boolean() != state:
+        if _flag(self.fullscreen_action) != state:
             self.fullscreen_action.set_state(GLib.Variant.new_boolean(state))
 
     def _set_dpad(self, on: bool) -> None:
@@ -703,7 +720,7 @@ class MainWindow(Gtk.ApplicationWindow):
         self.controller.select_profile(profile)
         self._update_header(self.model.connection.value)
         if changed and self.model.connection.value.phase is not Phase.DISCONNECTED:
-            self.banners.show(
+            self.banners.tell(
                 "notice:saved", "info", f"Saved “{profile.name}”: reconnect to use it", timeout=4.0
             )
 
@@ -770,7 +787,7 @@ class MainWindow(Gtk.ApplicationWindow):
         lag = loop_lag() if callable(loop_lag) else None
         connected = self.model.connection.value.phase is Phase.CONNECTED
         if connected and lag is not None and lag > LOOP_LAG_WARN:
-            self.banners.show(
+            self.banners.tell(
                 "loop",
                 "error",
                 f"The network thread has not run for {lag:.1f} s: drive commands and stops are not going "

@@ -338,10 +338,10 @@ class CameraInfo(Payload):
     @classmethod
     def decode(cls, data: bytes) -> Self:
         r = FieldReader(data)
-        limits = [
+        pan0, pan1, tilt0, tilt1, zoom0, zoom1 = (
             r.byte2(f) / 100 for f in ("min pan", "max pan", "min tilt", "max tilt", "min zoom", "max zoom")
-        ]
-        return cls(*limits, r.byte("zoom available") != 0)
+        )
+        return cls(pan0, pan1, tilt0, tilt1, zoom0, zoom1, r.byte("zoom available") != 0)
 
 
 @register
@@ -524,5 +524,5 @@ class LegacyCameraInfo(Payload):
     @classmethod
     def decode(cls, data: bytes) -> Self:
         r = FieldReader(data)
-        limits = [r.byte2(f) for f in _LIMIT_FIELDS]
-        return cls(*limits, r.byte("zoom available") != 0)
+        pan0, pan1, tilt0, tilt1, zoom0, zoom1 = (r.byte2(f) for f in _LIMIT_FIELDS)
+        return cls(pan0, pan1, tilt0, tilt1, zoom0, zoom1, r.byte("zoom available") != 0)
