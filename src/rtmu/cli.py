@@ -10,7 +10,9 @@ from __future__ import annotations
 import argparse
 import importlib
 import importlib.util
+import os
 import pkgutil
+import signal
 import sys
 from collections.abc import Sequence
 
@@ -51,4 +53,11 @@ def main(argv: Sequence[str] | None = None) -> int:
         from .ui import app as gui_app
 
         return gui_app.run_gui(args)
-    return int(handler(args) or 0)
+    try:
+        return int(handler(args) or 0)
+    except BrokenPipeError:
+        # Whoever read our output went away (`rtmu mapinfo … | head`): no traceback for that. The
+        # handler's own finally blocks (a drive's stop) have run; nothing more will be printed.
+        devnull = os.open(os.devnull, os.O_WRONLY)
+        os.dup2(devnull, sys.stdout.fileno())
+        return 128 + signal.SIGPIPE
