@@ -19,6 +19,7 @@ from rtmu.protocol.payloads import (
     decode_payload,
     drive,
     ld,
+    navigation,
     payload_type_for,
     popup,
     registered,
@@ -116,6 +117,16 @@ SAMPLES: list[Payload] = [
     ld.GotoRouteGoal("Kitchen"),
     ld.Say("Hello"),
     ld.DataStoreValue("87"),
+    navigation.GotoGoal("Kitchen"),
+    navigation.GotoPose(1500, -2000, 90),
+    navigation.Home(),
+    navigation.TourGoals(),
+    navigation.Dock(),
+    navigation.LocalizeToPose(1000, 2000, -45, 200, 10),
+    navigation.LocState(0, 870),
+    navigation.PlannedPath(((0, 0), (1500, -200))),
+    navigation.PathPlannerStatus("Moving to goal"),
+    navigation.GoalName("Kitchen"),
 ]
 TYPES = sorted(registered().values(), key=lambda c: (c.DATA_NAME, c.SIDE.value))
 
@@ -175,6 +186,7 @@ def test_hostile_counts_are_refused_without_allocating() -> None:
         (strings.StringsInfo, b"\xff\xff"),
         (cam.CameraList, b"\xff\x7f"),
         (commands.CommandList, b"\xff\x7f"),
+        (navigation.PlannedPath, b"\xff\x7f"),
     ]:
         with pytest.raises(ProtocolError):
             cls.decode(raw)

@@ -4,7 +4,21 @@ Importing this package registers every type, so :func:`payload_type_for`
 finds a decoder by data name.
 """
 
-from . import camera, commands, control, drive, ld, map, mapstream, popup, robot, sensors, server, strings
+from . import (
+    camera,
+    commands,
+    control,
+    drive,
+    ld,
+    map,
+    mapstream,
+    navigation,
+    popup,
+    robot,
+    sensors,
+    server,
+    strings,
+)
 from .base import (
     NameMatch,
     Payload,
@@ -28,6 +42,7 @@ __all__ = [
     "ld",
     "map",
     "mapstream",
+    "navigation",
     "payload_type",
     "payload_type_for",
     "popup",
