@@ -22,6 +22,7 @@ from rtmu.client.errors import (
 from rtmu.protocol.auth import UserTable
 from rtmu.protocol.fields import FieldReader
 from rtmu.protocol.packet import encode_packet
+from rtmu.protocol.payloads.drive import TurnByAngle
 from rtmu.protocol.payloads.robot import UpdateNumbers
 
 from .servers import MAP_LINES, TestServer, run, text_map_packets
@@ -87,6 +88,25 @@ def test_request_once_without_reply_returns_at_once_and_arrives() -> None:
         await client.request_once("getSafeDrive")  # a round trip: the server has seen the turn by now
         turn = [r for r in server.received if r.name == "turnByAngle"]
         assert FieldReader(turn[0].args).double() == 90.0
+        await client.disconnect()
+        await server.stop()
+
+    run(go())
+
+
+def test_a_typed_payload_is_sent_under_its_own_data_name() -> None:
+    async def go() -> None:
+        server = TestServer()
+        await server.start()
+        client = await connected(server)
+        client.send(TurnByAngle(45.0))
+        reply = await client.request_once(TurnByAngle(-45.0))  # RETURN_NONE: empty at once
+        assert reply.payloads == ()
+        await client.request_once("getSafeDrive")  # a round trip: both turns have arrived
+        turns = [FieldReader(r.args).double() for r in server.received if r.name == "turnByAngle"]
+        assert turns == [45.0, -45.0]
+        with pytest.raises(TypeError, match="its own arguments"):
+            client.send(TurnByAngle(1.0), 2.0)
         await client.disconnect()
         await server.stop()
 

@@ -60,21 +60,21 @@ def goto_route_goal(client: AriaClient, goal: str) -> None:
     """Drive to ``goal`` (LD robots); NotSupported when the server has no ``gotoRouteGoal``."""
     if not client.supports("gotoRouteGoal"):
         raise NotSupported("gotoRouteGoal", "this server cannot drive to route goals (gotoRouteGoal)")
-    client.send("gotoRouteGoal", GotoRouteGoal(goal))
+    client.send(GotoRouteGoal(goal))
 
 
 def patrol(client: AriaClient, route: str) -> None:
     """Start patrolling ``route``; NotSupported when the server has no ``patrol``."""
     if not client.supports("patrol"):
         raise NotSupported("patrol", "this server cannot patrol routes (patrol)")
-    client.send("patrol", Patrol(route))
+    client.send(Patrol(route))
 
 
 def say(client: AriaClient, text: str) -> None:
     """Have the robot speak ``text``; NotSupported when the server has no ``say``."""
     if not client.supports("say"):
         raise NotSupported("say", "this server cannot speak (say)")
-    client.send("say", Say(text))
+    client.send(Say(text))
 
 
 def data_store_names(client: AriaClient) -> list[str]:

@@ -167,6 +167,7 @@ class ReplayLink:
                 if self.eof:
                     return b""
             elif len(self.written) >= self.chunks[self.position].written_before:
+                await asyncio.sleep(0)  # live, time passed between reads: let the client's tasks run first
                 chunk = self.chunks[self.position].data
                 self.position += 1
                 return chunk

@@ -684,10 +684,10 @@ class Session:
             return True
         return await client.flush(timeout)
 
-    def command(self, name: str, *args: Any) -> None:
-        """Fire-and-forget request-once (``turnByAngle``, ``moveDist``, custom commands)."""
-        client = self._require(name)
-        client.send(name, *args)
+    def command(self, what: str | Payload, *args: Any) -> None:
+        """Fire-and-forget request-once: ``command(TurnByAngle(90))``, or a name and arguments."""
+        client = self._require(what if isinstance(what, str) else payload_name(what))
+        client.send(what, *args)
 
     def set_safe_drive(self, on: bool) -> None:
         client = self._require("setSafeDrive")

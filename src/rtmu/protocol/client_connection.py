@@ -223,7 +223,7 @@ class ClientConnection:
             return [Ignored(cmd, "unexpected control command")]
         if state is not ClientState.CONNECTED:
             return [Ignored(cmd, "data before the data list was complete")]
-        return [*self.replies.feed(cmd, self.datalist.name(cmd), packet.payload)]
+        return self.replies.feed(cmd, self.datalist.name(cmd), packet.payload)
 
     def _on_introduction(self, packet: Packet) -> ServerIntroduction:
         try:

@@ -47,9 +47,12 @@ class DataReceived:
     payload: bytes
 
 
-@dataclass(frozen=True, slots=True)
+@dataclass(frozen=True, slots=True, eq=False)
 class ReplyId:
-    """Names one tracked request (``ClientConnection.request_reply``): the key its waiter is kept under."""
+    """Names one tracked request (``ClientConnection.request_reply``): the key its waiter is kept under.
+
+    Compared by identity (each request has its own): a cheap key on the per-packet path.
+    """
 
     serial: int
     """Unique per connection, in the order the requests were sent."""

@@ -27,7 +27,7 @@ from collections import deque
 from collections.abc import Callable, Iterator
 
 from .errors import ProtocolError
-from .events import DataReceived, ReplyComplete, ReplyError, ReplyFailed, ReplyId, ReplyPacket
+from .events import DataReceived, Event, ReplyComplete, ReplyError, ReplyFailed, ReplyId, ReplyPacket
 from .payloads.mapstream import MapTooLarge
 
 MAX_REPLY_PACKETS = 1_000_000
@@ -38,8 +38,6 @@ ABANDON_GRACE = 0.5
 """Seconds an abandoned request's slot waits quietly for a late reply before the reply counts as lost."""
 MAX_PENDING_PER_DATA = 64
 """Requests of one data number that may wait for replies at once (abandoned slots included)."""
-
-ReplyEvent = DataReceived | ReplyPacket | ReplyComplete | ReplyFailed
 
 
 # -- how a reply ends -----------------------------------------------------------------------------
@@ -274,9 +272,7 @@ class ReplyTracker:
         queue.append(pending)
         return pending
 
-    def feed(
-        self, number: int, name: str | None, payload: bytes, now: float | None = None
-    ) -> list[ReplyEvent]:
+    def feed(self, number: int, name: str | None, payload: bytes, now: float | None = None) -> list[Event]:
         """One data packet → ``[DataReceived]``, or ``[ReplyPacket]`` plus the reply's outcome if it ended."""
         if now is None:
             now = self.now
@@ -292,7 +288,7 @@ class ReplyTracker:
         if done:
             queue.popleft()
         refused = isinstance(outcome, ReplyFailed) and outcome.reason is ReplyError.MALFORMED
-        events: list[ReplyEvent] = [ReplyPacket(head.id, payload, swallowed=was_abandoned or refused)]
+        events: list[Event] = [ReplyPacket(head.id, payload, swallowed=was_abandoned or refused)]
         if outcome is not None:
             events.append(outcome)
         return events
@@ -312,7 +308,7 @@ class ReplyTracker:
     def get(self, reply: ReplyId) -> PendingReply | None:
         """The slot still waiting for ``reply``, or None once it ended or was dropped."""
         for pending in self._queues.get(reply.number, ()):
-            if pending.id == reply:
+            if pending.id is reply:
                 return pending
         return None
 
