@@ -203,7 +203,7 @@ def strings_payload(world: World) -> bytes:
 
 
 def mode_info_payload(world: World) -> bytes:
-    return ModeInfo(world.mode.NAME, False, False).encode()
+    return ModeInfo(*world.mode_info()).encode()
 
 
 @handles("updateStrings")

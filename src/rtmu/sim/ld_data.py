@@ -187,9 +187,15 @@ def _closest_obstacle_mm(call: Call) -> float:
 
 
 DATA_STORE: dict[str, tuple[str, object]] = {
-    "DataStore_Localization_Score": ("Localization score (0–100)", lambda call: "100"),
+    "DataStore_Localization_Score": (
+        "Localization score (0–100)",
+        lambda call: str(round(call.world.localization.score * 100)),
+    ),
     "DataStore_WiFi_Quality": ("Wi-Fi link quality (0–70)", lambda call: str(call.world.wifi().quality)),
-    "DataStore_Distance_To_Goal": ("Distance to the goal in mm (0: no goal)", lambda call: "0"),
+    "DataStore_Distance_To_Goal": (
+        "Distance to the goal in mm (0: no goal)",
+        lambda call: str(round(call.world.planner.distance_left())),
+    ),
     "DataStore_Closest_Obstacle": (
         "Distance to the closest obstacle in mm",
         lambda call: (lambda d: "none" if d == math.inf else str(round(d)))(_closest_obstacle_mm(call)),

@@ -22,7 +22,7 @@ from rtmu.protocol.packet import encode_packet
 from rtmu.protocol.payloads.map import Goals, MapId, MapName
 from rtmu.protocol.payloads.mapstream import map_binary_payloads, map_text_payloads
 
-from ..maps import map_header_lines
+from ..maps import MapObject, map_header_lines
 from .geometry import Obstacles
 
 DEFAULT_POINT_CELL_MM = 40.0
@@ -59,6 +59,8 @@ class ServedMap:
     home: tuple[float, float, float] = (0.0, 0.0, 0.0)
     has_home: bool = False
     goals: tuple[str, ...] = ()
+    objects: tuple[MapObject, ...] = ()
+    """Every cairn (goals, docks, forbidden lines and areas), for navigation."""
     md5: bytes = b""
     size: int = 0
     mtime: int = 0
@@ -136,6 +138,7 @@ def load_map(path: Path | None) -> ServedMap:
         home=(float(home.x), float(home.y), float(home.th)) if home is not None else (0.0, 0.0, 0.0),
         has_home=home is not None,
         goals=goals,
+        objects=tuple(data.objects),
         md5=hashlib.md5(raw).digest(),
         size=len(raw),
         mtime=int(st.st_mtime),

@@ -37,8 +37,24 @@ class Mode:
     def extended_status(self) -> str:
         return self.status
 
+    @property
+    def locked(self) -> bool:
+        """ARIA's mode lock: another mode cannot take over at once (the dock mode while docked)."""
+        return False
+
+    @property
+    def will_unlock(self) -> bool:
+        """Locked, but gives way when asked (:meth:`request_unlock`), the asking mode taking over after."""
+        return False
+
     def activate(self, body: Body, now: float) -> None:
         pass
+
+    def deactivate(self) -> None:
+        """Another mode took over."""
+
+    def request_unlock(self) -> None:
+        """Another mode wants to take over while this one is locked."""
 
     def command(self, body: Body, now: float, dt: float) -> Command:
         raise NotImplementedError

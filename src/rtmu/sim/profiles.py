@@ -67,7 +67,10 @@ class SimProfile:
         ]
         extra, _ = self.module_parts()
         known = {r[0] for r in rows}
-        rows += [r for r in extra if r[0] not in known]
+        for r in extra:  # the first module to list a name describes it
+            if r[0] not in known:
+                known.add(r[0])
+                rows.append(r)
         if self.catalogue_size > len(rows):
             rows += filler_rows(self.catalogue_size - len(rows), {r[0] for r in rows})
         return DataList.build(rows)
@@ -202,7 +205,11 @@ def filler_rows(count: int, taken: set[str]) -> list[Row]:
     return rows
 
 
-DEFAULT = SimProfile("default", "serverDemo with a simulated Pioneer 3-DX")
+DEFAULT = SimProfile(
+    "default",
+    "serverDemo with a simulated Pioneer 3-DX, navigating as ARNL does",
+    modules=("rtmu.sim.nav_data",),
+)
 ARAM = SimProfile(
     "aram",
     "an Omron LD robot running ARAM: protocol 6MTX, state of charge, Ex4 map, ~950 data",
@@ -210,7 +217,7 @@ ARAM = SimProfile(
     state_of_charge=True,
     map_header=EX4_HEADER,
     catalogue_size=LD_CATALOGUE_SIZE,
-    modules=("rtmu.sim.ld_data",),
+    modules=("rtmu.sim.nav_data", "rtmu.sim.ld_data"),  # the LD docking replaces ARNL's
     handlers={
         "updateNumbers": _soc_numbers,
         "batteryInfo": _soc_battery_info,

@@ -25,6 +25,8 @@ from collections.abc import Callable
 from dataclasses import dataclass
 from itertools import count
 
+import numpy as np
+
 from rtmu.protocol.auth import UserTable
 from rtmu.protocol.commands import RejectReason
 from rtmu.protocol.datalist import DataList
@@ -38,6 +40,7 @@ from rtmu.protocol.events import (
 )
 from rtmu.protocol.packet import encode_packet
 from rtmu.protocol.payloads.control import ClientIntroduction
+from rtmu.protocol.payloads.ld import DockInfoChanged
 from rtmu.protocol.server_connection import ServerConnection, ServerState
 
 from .catalogue import Row, custom_commands
@@ -53,6 +56,7 @@ from .handlers import (
     strings_payload,
 )
 from .mapserve import Chunks, ServedMap, load_map
+from .navmodes import NavMap
 from .profiles import get_profile
 from .video import VideoFeed
 from .world import PHYSICS_DT, World, free_spot_near
@@ -338,6 +342,7 @@ class SimServer:
         if cfg.protocol_version is None:
             cfg.protocol_version = self.profile.protocol_version
         self.handlers = self.profile.handler_table()
+        self._module_commands = tuple(r for r in self.profile.module_parts()[0] if r[4] == "CustomCommands")
         self.map: ServedMap = self._load_map(cfg.map_path)
         obstacles = self.map.obstacles()
         home = self.map.home
@@ -351,6 +356,7 @@ class SimServer:
             battery_v=cfg.battery_v,
         )
         self.home = (x, y, home[2])
+        self.world.nav_map = self._nav_map()
         self.datalist: DataList = self.profile.catalogue(camera=cfg.camera)
         self.users: UserTable | None = UserTable.load(cfg.users_path) if cfg.users_path else None
         self.sessions: list[Session] = []
@@ -544,6 +550,8 @@ class SimServer:
             self.broadcast("getModeInfo", mode_info_payload(self.world))
         if ch.strings:
             self.broadcast("updateStrings", strings_payload(self.world))
+        if ch.dock_info:
+            self.broadcast("dockInfoChanged", DockInfoChanged(self.world.dock_mode.state).encode())
         for popup in ch.popups_created:
             self.broadcast("popupCreate", popup_payload(popup))
         for popup_id, text in ch.popups_closed:
@@ -596,7 +604,8 @@ class SimServer:
         return time.monotonic() if self.config.realtime else self.world.time
 
     def custom_commands(self) -> tuple[Row, ...]:
-        return custom_commands(self.config.camera)
+        """serverDemo's simple commands, then the ones the profile's data modules add."""
+        return custom_commands(self.config.camera) + self._module_commands
 
     def video_trailer(self) -> bytes:
         """The 2 bytes ARIA's video forwarder leaves after a picture (the upstream packet's checksum)."""
@@ -616,6 +625,8 @@ class SimServer:
         x, y = free_spot_near(obstacles, home[0], home[1], 250.0)
         self.home = (x, y, home[2])
         self.world.replace_obstacles(obstacles)
+        self.world.nav_map = self._nav_map()
+        self.world.home = self.home
         self.reset_pose()
         self.broadcast("mapUpdated")
         self.broadcast("goalsUpdated")
@@ -631,7 +642,23 @@ class SimServer:
                 served.header[0] = header
         return served
 
+    def _nav_map(self) -> NavMap | None:
+        """What navigation plans on: the served map's walls and cairns (None without a map)."""
+        m = self.map
+        if not m.present:
+            return None
+        return NavMap(m.md5, m.segments, m.points, m.objects)
+
     # -- tools for tests and the demo -------------------------------------------------------
+    def lose_localization(self) -> None:
+        """The robot is lost (as ``SimulatorLoseLocalization``): navigation fails until ``localizeToPose``."""
+        self.world.lose_localization()
+        self.broadcast_changes()
+
+    def place_obstacle(self, x1: float, y1: float, x2: float, y2: float) -> None:
+        """A wall the map does not show (a trolley in the corridor): only the sonar will find it."""
+        self.world.add_obstacles(np.array([[x1, y1, x2, y2]], dtype=np.float64))
+
     def reset_pose(self) -> None:
         b = self.world.body
         b.x, b.y, b.th = self.home

@@ -17,7 +17,8 @@ from . import p3dx
 from .camera import Camera, View
 from .geometry import Obstacles
 from .modes import JogMode, Mode, RatioDriveMode, StopMode, WanderMode
-from .robot import Body
+from .navmodes import DockMode, GotoMode, Localization, NavMap, Planner, charge
+from .robot import Body, normalize_deg
 from .sonar import sonar_readings
 from .wifi import AccessPoint, Link
 
@@ -69,12 +70,14 @@ class Changes:
 
     mode_info: bool = False
     strings: bool = False
+    dock_info: bool = False
     popups_created: list[Popup] = field(default_factory=list)
     popups_closed: list[tuple[int, str]] = field(default_factory=list)
 
     def clear(self) -> None:
         self.mode_info = False
         self.strings = False
+        self.dock_info = False
         self.popups_created.clear()
         self.popups_closed.clear()
 
@@ -98,8 +101,25 @@ class World:
         self.ratio_mode = RatioDriveMode(drive_timeout)
         self.wander_mode = WanderMode(random.Random(self.rng.random()))
         self.jog_mode = JogMode()
-        self.modes: tuple[Mode, ...] = (self.stop_mode, self.ratio_mode, self.wander_mode, self.jog_mode)
+        self.nav_map: NavMap | None = None
+        self.localization = Localization()
+        self.planner = Planner(self)
+        self.goto_mode = GotoMode(self, self.planner)
+        self.dock_mode = DockMode(self, self.planner)
+        self.modes: tuple[Mode, ...] = (
+            self.stop_mode,
+            self.ratio_mode,
+            self.wander_mode,
+            self.jog_mode,
+            self.goto_mode,
+            self.dock_mode,
+        )
         self.mode: Mode = self.stop_mode
+        self.waiting_modes: list[Mode] = []
+        """Modes that asked to take over while the active one was locked, in the order they asked."""
+        self._mode_info = self.mode_info()
+        self.home = home
+        """Where ``home`` drives to (the map's home cairn, or where the robot started)."""
         self.camera = Camera(obstacles)
         if access_point is None:
             lo_x, lo_y, hi_x, hi_y = obstacles.bounds
@@ -125,6 +145,12 @@ class World:
         self.access_point = AccessPoint(obstacles, (lo_x + hi_x) / 2, (lo_y + hi_y) / 2)
         self._sonar_cache = None
 
+    def add_obstacles(self, segments: np.ndarray) -> None:
+        """Put walls into the world that the map does not have (a box left in a corridor): the body and
+        the sonar see them, the path planner only through the sonar."""
+        seg = np.concatenate([self.obstacles.segments, np.asarray(segments, dtype=np.float64).reshape(-1, 4)])
+        self.replace_obstacles(Obstacles(seg, self.obstacles.points, point_cell_mm=self.obstacles.cell))
+
     # -- modes ----------------------------------------------------------------
     def touch(self) -> None:
         """A client asked for something: the active mode is busy now."""
@@ -134,13 +160,33 @@ class World:
         return max(self.time - self.last_activity, 0.0)
 
     def activate(self, mode: Mode) -> None:
+        """Make ``mode`` the active one; a locked active mode is asked to give way and ``mode`` waits."""
         self.touch()
         if mode is self.mode:
             return
+        current = self.mode
+        if current.locked:
+            if current.will_unlock:
+                if mode not in self.waiting_modes:
+                    self.waiting_modes.append(mode)
+                current.request_unlock()
+                self.check_strings()
+            return
+        self.waiting_modes.clear()
+        current.deactivate()
         self.mode = mode
         mode.activate(self.body, self.time)
         self.changes.mode_info = True
-        self._check_strings()
+        self._mode_info = self.mode_info()
+        self.check_strings()
+
+    def mode_info(self) -> tuple[str, bool, bool]:
+        """(name, locked, will unlock if requested): what ``getModeInfo`` reports."""
+        m = self.mode
+        return (m.NAME, m.locked, m.locked and m.will_unlock)
+
+    def home_pose(self) -> tuple[float, float, float | None]:
+        return self.home
 
     def stop(self) -> None:
         self.activate(self.stop_mode)
@@ -161,7 +207,7 @@ class World:
             last = mode.last_command
             mode.set_ratios(0.0, 0.0, 0.0, 0.0, self.time)
             mode.last_command = last
-        self._check_strings()
+        self.check_strings()
 
     def wander(self) -> None:
         self.activate(self.wander_mode)
@@ -169,17 +215,32 @@ class World:
     def move_distance(self, distance: float) -> None:
         self.touch()
         self._jog().move(self.body, distance)
-        self._check_strings()
+        self.check_strings()
 
     def turn_by(self, angle: float) -> None:
         self.touch()
         self._jog().turn_by(self.body, angle)
-        self._check_strings()
+        self.check_strings()
 
     def turn_to(self, heading: float) -> None:
         self.touch()
         self._jog().turn_to(heading)
-        self._check_strings()
+        self.check_strings()
+
+    def lose_localization(self) -> None:
+        """The robot no longer knows where it is: navigation fails until :meth:`localize_to`."""
+        self.localization.lose(self.time)
+
+    def localize_to(self, x: float, y: float, th: float) -> None:
+        """``localizeToPose``: as ARNL with MobileSim, the simulated robot is put where the operator says
+        (the nearest spot it fits, when that is inside something), then localizes for a moment."""
+        fx, fy = free_spot_near(self.obstacles, x, y, p3dx.RADIUS_MM)
+        b = self.body
+        b.x, b.y, b.th = fx, fy, normalize_deg(th)
+        b.vel = b.rot_vel = 0.0
+        b.stalled = False
+        self._sonar_cache = None
+        self.localization.start(self.time)
 
     def _jog(self) -> JogMode:
         if self.mode is not self.jog_mode:
@@ -193,12 +254,21 @@ class World:
         self.body.step(dt, cmd)
         if not self.body.is_stopped():
             self.last_activity = self.time
+        if self.mode is self.dock_mode and self.dock_mode.docked:
+            charge(self, dt)
+        self.localization.tick(self.time)
+        if self.waiting_modes and not self.mode.locked:
+            self.activate(self.waiting_modes.pop(0))
+        info = self.mode_info()
+        if info != self._mode_info:
+            self._mode_info = info
+            self.changes.mode_info = True
         if self.body.battery_v <= p3dx.BATTERY_SHUTDOWN_V and self.mode is not self.stop_mode:
             self.stop()
         self._check_battery()
-        self._check_strings()
+        self.check_strings()
 
-    def _check_strings(self) -> None:
+    def check_strings(self) -> None:
         now = self.strings()
         if now != self._strings:
             self._strings = now
