@@ -11,9 +11,10 @@ session that depended on the socket, or on something other than the bytes, would
 from __future__ import annotations
 
 import asyncio
+from collections.abc import Callable
 from pathlib import Path
 
-from rtmu.client.connection import AriaClient
+from rtmu.client.connection import Arg, AriaClient, Handler
 from rtmu.client.errors import ClientError
 from rtmu.client.lease import DriveLease
 from rtmu.client.link import Chunk, Link, RecordingLink, ReplayLink, open_tcp
@@ -51,7 +52,7 @@ def session_over(link_for: asyncio.Future[Link] | Link, changes: list[StateChang
     async def opener(host: str, port: int) -> Link:
         return link_for if not isinstance(link_for, asyncio.Future) else await link_for
 
-    def factory(on_close):  # type: ignore[no-untyped-def]
+    def factory(on_close: Callable[[ClientError], None]) -> AriaClient:
         return AriaClient(on_close=on_close, opener=opener)
 
     return Session(DriveLease(), changes.append, config=CONFIG, client_factory=factory)
@@ -72,7 +73,7 @@ async def drive(port: int, seconds: float) -> None:
         await driver.disconnect()
 
 
-async def until(predicate, timeout: float = 10.0) -> None:  # type: ignore[no-untyped-def]
+async def until(predicate: Callable[[], bool], timeout: float = 10.0) -> None:
     async with asyncio.timeout(timeout):
         while not predicate():
             await asyncio.sleep(0.01)
@@ -161,7 +162,7 @@ def test_a_session_declares_its_subscriptions_as_data() -> None:
         requested: list[tuple[str, int]] = []
 
         class Watching(AriaClient):
-            def request(self, name, interval_ms, handler, *args):  # type: ignore[no-untyped-def]
+            def request(self, name: str, interval_ms: int, handler: Handler, *args: Arg) -> None:
                 requested.append((name, interval_ms))
                 super().request(name, interval_ms, handler, *args)
 

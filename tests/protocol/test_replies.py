@@ -54,7 +54,9 @@ def connect() -> tuple[ClientConnection, ServerConnection]:
     return client, server
 
 
-def answer(client: ClientConnection, server: ServerConnection, name: str, *payloads: bytes, now: float = 0.0):  # type: ignore[no-untyped-def]
+def answer(
+    client: ClientConnection, server: ServerConnection, name: str, *payloads: bytes, now: float = 0.0
+) -> list[Event]:
     """The server sends ``payloads`` as packets of ``name``; the client's events."""
     server.receive_data(client.data_to_send())
     for payload in payloads:
