@@ -119,7 +119,13 @@ hostile_piece = st.one_of(
 def test_decoder_matches_the_literal_rules_on_hostile_streams(
     pieces: list[bytes], data: st.DataObject
 ) -> None:
-    """Failed checksums switch the decoder to prefix sums; the packets and counts must not change."""
+    """Failed checksums switch the decoder to prefix sums; the packets and counts must not change.
+
+    One count may move by design: a header the decoder gave up as a liar (four checksummed packets
+    went on behind it while it waited) is one the literal rules count as cut off at the end, or as a
+    bad checksum once its span ends. So the dropped headers are compared in total, and the packets
+    exactly (found by hypothesis: ``0F 0C`` followed by four empty packets).
+    """
     stream = b"".join(pieces)
     cuts = data.draw(st.lists(st.integers(0, len(stream)), max_size=10))
     decoder = PacketDecoder()
@@ -127,11 +133,21 @@ def test_decoder_matches_the_literal_rules_on_hostile_streams(
     packets, bad_length, bad_checksum, truncated = reference_decode(stream)
     assert found == packets
     stats = decoder.stats
-    assert (stats.bad_length, stats.bad_checksum, stats.truncated_at_close) == (
-        bad_length,
-        bad_checksum,
-        truncated,
-    )
+    assert stats.bad_length == bad_length
+    assert stats.bad_checksum <= bad_checksum and stats.truncated_at_close <= truncated
+    assert stats.bad_checksum + stats.truncated_at_close + stats.lying_headers == bad_checksum + truncated
+
+
+def test_a_liar_before_four_packets_counts_as_a_liar_not_as_cut_off() -> None:
+    """The case hypothesis found: the same packets as the literal rules, the header named a liar."""
+    empty = b"\x0f\x0c\x08\x00\x00\x00\x00\x00"
+    stream = b"\x0f\x0c" + empty * 4
+    decoder = PacketDecoder()
+    found = decoder.feed(stream) + decoder.close()
+    packets, _, _, truncated = reference_decode(stream)
+    assert found == packets and len(found) == 4
+    assert truncated == 1
+    assert (decoder.stats.lying_headers, decoder.stats.truncated_at_close) == (1, 0)
 
 
 def test_planted_packets_survive_heavy_noise() -> None:
