@@ -14,7 +14,9 @@ Figures:
 * ``soak.rss_drift_mb`` — resident memory at the end minus at the end of warm-up (the first
   fifth, at most 120 s); ``soak.rss_slope_mb_per_h`` — least-squares slope after warm-up.
 * ``soak.max_handler_ms`` — the longest single subscription handler on the network loop;
-  ``soak.slow_handlers`` — how many took over ``SLOW_HANDLER``.
+  ``soak.slow_handlers`` — how many took over ``SLOW_HANDLER`` (wall clock: on a busy machine this
+  includes time the thread was not scheduled). ``soak.max_handler_cpu_ms`` /
+  ``soak.slow_handlers_cpu`` — the same by the handler's own CPU time: slow work of ours.
 * ``soak.max_loop_lag_ms`` — how late the network loop's heartbeat ran at worst, beyond its own
   period (any blocking work on the loop, or the process not being scheduled).
 * ``soak.cycles`` — hold/release cycles done; ``soak.seconds`` — how long it ran.
@@ -237,6 +239,10 @@ def soak(seconds: float, *, seed: int = 1, progress: Callable[[str], None] | Non
             **drive_figures(start, latencies, rss, warmup),
             "max_handler_ms": (client.max_handler_seconds * 1e3) if client is not None else float("nan"),
             "slow_handlers": client.slow_handlers if client is not None else -1,
+            "max_handler_cpu_ms": (client.max_handler_cpu_seconds * 1e3)
+            if client is not None
+            else float("nan"),
+            "slow_handlers_cpu": client.slow_handlers_cpu if client is not None else -1,
             "max_loop_lag_ms": max_lag * 1e3,
         }
     finally:
@@ -257,6 +263,9 @@ def results(raw: dict[str, Any], prefix: str = "soak") -> list[Result]:
     if "max_handler_ms" in raw:
         out.append(Result(f"{prefix}.max_handler_ms", raw["max_handler_ms"], "ms"))
     out.append(Result(f"{prefix}.slow_handlers", float(raw["slow_handlers"]), "count"))
+    if "max_handler_cpu_ms" in raw:
+        out.append(Result(f"{prefix}.max_handler_cpu_ms", raw["max_handler_cpu_ms"], "ms"))
+        out.append(Result(f"{prefix}.slow_handlers_cpu", float(raw["slow_handlers_cpu"]), "count"))
     if "max_loop_lag_ms" in raw:
         out.append(Result(f"{prefix}.max_loop_lag_ms", raw["max_loop_lag_ms"], "ms"))
     out += [
