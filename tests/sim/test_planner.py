@@ -135,9 +135,9 @@ def test_big_maps_plan_coarse_first_and_agree_with_a_whole_search() -> None:
     assert home is not None
     dock = next(o for o in data.objects if o.type == "Dock")
     plan = big.plan((home.x, home.y), (dock.x, dock.y))
-    whole = big._search(big.costs, big.to_cell(home.x, home.y), big.to_cell(dock.x, dock.y), shared=True)
-    assert plan.points[-1] == (dock.x, dock.y)
-    assert plan.length_mm <= 1.05 * len(whole) * big.cell + 2000
+    whole = big.plan((home.x, home.y), (dock.x, dock.y), coarse_first=False)
+    assert plan.points[-1] == whole.points[-1] == (dock.x, dock.y)
+    assert plan.length_mm <= 1.02 * whole.length_mm
     walls = Obstacles(data.segments, data.points)
     for x, y in _samples(plan, 50.0):
         assert walls.clearance(x, y, p3dx.RADIUS_MM) == math.inf

@@ -187,11 +187,13 @@ class PlanGrid:
         start: tuple[float, float],
         goal: tuple[float, float],
         extra: np.ndarray | None = None,
+        *,
+        coarse_first: bool = True,
     ) -> Plan:
         """The shortest safe path from ``start`` to ``goal`` (map mm), smoothed; raises :class:`NoPath`.
 
         ``extra`` are obstacle points (map mm) seen since the map was made — the robot's sonar — that
-        block the plan as walls do.
+        block the plan as walls do. ``coarse_first=False`` searches a big grid whole (for comparison).
         """
         costs, blocked = self.costs, self.blocked
         if extra is not None and len(extra):
@@ -206,7 +208,7 @@ class PlanGrid:
         si, sj = self._free_start(start, blocked)
         if (si, sj) == (gi, gj):
             return Plan((start, goal))
-        if costs is self.costs and self.costs.size > SINGLE_SEARCH_CELLS:
+        if coarse_first and costs is self.costs and self.costs.size > SINGLE_SEARCH_CELLS:
             cells = self._coarse_first((si, sj), (gi, gj))
         else:
             cells = self._search(costs, (si, sj), (gi, gj), shared=costs is self.costs)
