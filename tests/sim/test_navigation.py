@@ -196,6 +196,7 @@ def test_a_partly_blocked_corridor_is_driven_around():
         )
         assert server.robot.status == "Arrived at point"
         assert server.robot.collisions == 0
+        assert server.world.path_task.replans >= 1  # the map never showed the obstacle: the sonar did
         await _end(server, c)
 
     run(scenario())

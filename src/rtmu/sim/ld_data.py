@@ -194,7 +194,7 @@ DATA_STORE: dict[str, tuple[str, object]] = {
     "DataStore_WiFi_Quality": ("Wi-Fi link quality (0–70)", lambda call: str(call.world.wifi().quality)),
     "DataStore_Distance_To_Goal": (
         "Distance to the goal in mm (0: no goal)",
-        lambda call: str(round(call.world.planner.distance_left())),
+        lambda call: str(round(call.world.path_task.distance_left())),
     ),
     "DataStore_Closest_Obstacle": (
         "Distance to the closest obstacle in mm",

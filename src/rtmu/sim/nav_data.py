@@ -102,7 +102,7 @@ def _loc_state(call: Call) -> Iterable[Reply]:
 
 
 def _path(call: Call) -> Iterable[Reply]:
-    points = call.world.planner.path()
+    points = call.world.path_task.path()
     if len(points) > MAX_PATH_POINTS:  # never for a smoothed plan; thin rather than refuse
         step = math.ceil(len(points) / MAX_PATH_POINTS)
         points = points[::step][: MAX_PATH_POINTS - 1] + points[-1:]
@@ -110,7 +110,7 @@ def _path(call: Call) -> Iterable[Reply]:
 
 
 def _planner_status(call: Call) -> Iterable[Reply]:
-    return (PathPlannerStatus(call.world.planner.status).encode(),)
+    return (PathPlannerStatus(call.world.path_task.status).encode(),)
 
 
 def _goal_name(call: Call) -> Iterable[Reply]:

@@ -117,8 +117,8 @@ class World(Protocol):
     def home_pose(self) -> tuple[float, float, float | None]: ...
 
 
-class Planner:
-    """The path-planning task shared by both modes: one plan, its follower, and what to say about it."""
+class PathTask:
+    """ARNL's path-planning task, shared by both modes: one plan, its follower, and what to say about it."""
 
     def __init__(self, world: World) -> None:
         self.world = world
@@ -127,6 +127,8 @@ class Planner:
         self.failure = ""
         self._goal: tuple[float, float] = (0.0, 0.0)
         self._replans = 0
+        self.replans = 0
+        """Plans made again on the way (around what the sonar saw, or after straying), ever."""
 
     def start(self, goal: tuple[float, float], heading: float | None) -> bool:
         self.cancel()
@@ -172,6 +174,7 @@ class Planner:
         follower, nav = self.follower, self.world.nav_map
         assert follower is not None and nav is not None
         self._replans += 1
+        self.replans += 1
         seen = np.asarray(self.world.sonar(), dtype=np.float64).reshape(-1, 2)
         if why is Progress.BLOCKED and len(seen):
             near = np.hypot(seen[:, 0] - body.x, seen[:, 1] - body.y) < 2000.0
@@ -205,10 +208,10 @@ class GotoMode(Mode):
     NAME = "Goto"
     DATA = ("gotoGoal", "gotoPose", "home", "tourGoals")
 
-    def __init__(self, world: World, planner: Planner) -> None:
+    def __init__(self, world: World, path_task: PathTask) -> None:
         super().__init__()
         self.world = world
-        self.planner = planner
+        self.path_task = path_task
         self.goal_name = ""
         self._mode = "Goto goal"
         self._target: tuple[float, float, float | None] = (0.0, 0.0, None)
@@ -277,17 +280,17 @@ class GotoMode(Mode):
                 self.done = True
         else:
             x, y, th = self._target
-            if not self.planner.start((x, y), th):
+            if not self.path_task.start((x, y), th):
                 self.status = "Failed to plan to point"
                 self.done = True
 
     def deactivate(self) -> None:
-        self.planner.cancel()
+        self.path_task.cancel()
         self.done = True
 
     def _plan_to_goal(self, goal: MapObject) -> bool:
         heading = goal.th if goal.type.lower() == "goalwithheading" else None
-        return self.planner.start((goal.x, goal.y), heading)
+        return self.path_task.start((goal.x, goal.y), heading)
 
     def _plan_next_tour_goal(self) -> None:
         nav = self.world.nav_map
@@ -311,11 +314,11 @@ class GotoMode(Mode):
         if self.world.localization.lost:
             self._lost()
             return Command(0.0, 0.0)
-        cmd, progress = self.planner.step(body, now)
+        cmd, progress = self.path_task.step(body, now)
         if progress is Progress.ARRIVED:
             self._arrived()
         elif progress is Progress.BLOCKED:
-            self._failed(f" ({self.planner.failure.removeprefix('Failed to reach goal: ')})")
+            self._failed(f" ({self.path_task.failure.removeprefix('Failed to reach goal: ')})")
         return cmd
 
     def _arrived(self) -> None:
@@ -332,7 +335,7 @@ class GotoMode(Mode):
         if self._touring:
             self._plan_next_tour_goal()
             return
-        self.planner.cancel()
+        self.path_task.cancel()
         self.done = True
         if self._home:
             self.status = "Failed to get home" + why
@@ -342,8 +345,8 @@ class GotoMode(Mode):
             self.status = "Failed to get to point" + why
 
     def _lost(self) -> None:
-        self.planner.cancel()
-        self.planner.status = "Robot lost"
+        self.path_task.cancel()
+        self.path_task.status = "Robot lost"
         self.done = True
         if self._touring:
             self.status = "Failed touring because robot lost"
@@ -362,10 +365,10 @@ class DockMode(Mode):
     MODE_STRING = "Dock"
     DATA = ("dock", "undock")
 
-    def __init__(self, world: World, planner: Planner) -> None:
+    def __init__(self, world: World, path_task: PathTask) -> None:
         super().__init__()
         self.world = world
-        self.planner = planner
+        self.path_task = path_task
         self.state = DockState.UNDOCKED
         self.dock_name = ""
         self._dock: MapObject | None = None
@@ -403,7 +406,7 @@ class DockMode(Mode):
         dock = min(docks, key=lambda d: math.hypot(d.x - body.x, d.y - body.y))
         self._dock, self.dock_name = dock, dock.name
         ax, ay = self._approach(dock)
-        if self.world.localization.lost or not self.planner.start((ax, ay), dock.th):
+        if self.world.localization.lost or not self.path_task.start((ax, ay), dock.th):
             self.status = f"Cannot drive to dock at {dock.name}"
             self._switch(DockState.UNDOCKED)
             return
@@ -412,7 +415,7 @@ class DockMode(Mode):
         self._switch(DockState.DOCKING)
 
     def deactivate(self) -> None:
-        self.planner.cancel()
+        self.path_task.cancel()
 
     def request_unlock(self) -> None:
         """Someone else wants the robot: back out of the dock (or stop going there)."""
@@ -421,7 +424,7 @@ class DockMode(Mode):
             self._back_from = (self.world.body.x, self.world.body.y)
             self._switch(DockState.UNDOCKING)
         elif self.state is DockState.DOCKING:
-            self.planner.cancel()
+            self.path_task.cancel()
             self.status = "Stopped"
             self._switch(DockState.UNDOCKED)
 
@@ -440,7 +443,7 @@ class DockMode(Mode):
         if self.world.localization.lost:
             return self._fail()
         if self._phase == "approach":
-            cmd, progress = self.planner.step(body, now)
+            cmd, progress = self.path_task.step(body, now)
             if progress is Progress.BLOCKED:
                 return self._fail()
             if progress is Progress.ARRIVED:
@@ -465,7 +468,7 @@ class DockMode(Mode):
         return (body.x - dock.x) * math.cos(th) + (body.y - dock.y) * math.sin(th) > 0.0
 
     def _fail(self) -> Command:
-        self.planner.cancel()
+        self.path_task.cancel()
         self.status = "Failed dock"
         self._switch(DockState.UNDOCKED)
         return Command(0.0, 0.0)

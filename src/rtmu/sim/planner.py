@@ -13,6 +13,7 @@ fine grid is searched piece by piece along it, so a plan costs about the same on
 from __future__ import annotations
 
 import math
+import threading
 from collections.abc import Callable, Iterable, Sequence
 from dataclasses import dataclass
 
@@ -126,6 +127,11 @@ class PlanGrid:
         self.costs = np.where(self.blocked, np.inf, np.where(near, NEAR_WALL_COST, 1.0))
         self._mcp: MCP_Geometric | None = None
         self._coarse: _Coarse | None = None
+
+    def prepare(self) -> None:
+        """Build what the first plan would otherwise build (the coarse grid of a big map)."""
+        if self.costs.size > SINGLE_SEARCH_CELLS and self._coarse is None:
+            self._coarse = _Coarse(self)
 
     # -- coordinates ----------------------------------------------------------
     def _to_cell_float(self, x: np.ndarray, y: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
@@ -342,15 +348,22 @@ class _Coarse:
 
 
 class GridCache:
-    """The last map's grid: built on first use, and again only when the map's key (its MD5) changes."""
+    """The last map's grid: built on first use, and again only when the map's key (its MD5) changes.
+
+    Thread-safe, so a server can build a big map's grid on a worker thread before the first plan.
+    """
 
     def __init__(self) -> None:
         self._key: object = None
         self._grid: PlanGrid | None = None
+        self._lock = threading.Lock()
         self.builds = 0
 
     def get(self, key: object, build: Callable[[], PlanGrid]) -> PlanGrid:
-        if self._grid is None or key != self._key:
-            self._grid, self._key = build(), key
-            self.builds += 1
-        return self._grid
+        with self._lock:
+            if self._grid is None or key != self._key:
+                grid = build()
+                grid.prepare()
+                self._grid, self._key = grid, key
+                self.builds += 1
+            return self._grid

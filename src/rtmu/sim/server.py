@@ -391,6 +391,9 @@ class SimServer:
         self._real_start = time.monotonic()
         if cfg.realtime:
             self._cycle_task = asyncio.create_task(self._run_realtime(), name="rtmu-sim-cycle")
+            nav = self.world.nav_map
+            if nav is not None:  # a big map's planning grid takes a second: not in the first gotoGoal
+                asyncio.get_running_loop().run_in_executor(None, nav.grid)
             if len(self.map.lines) > WARM_STREAMS_ABOVE_LINES:
                 # Frame a big map's streams on a worker thread now, not in the first client's request.
                 loop = asyncio.get_running_loop()

@@ -17,7 +17,7 @@ from . import p3dx
 from .camera import Camera, View
 from .geometry import Obstacles
 from .modes import JogMode, Mode, RatioDriveMode, StopMode, WanderMode
-from .navmodes import DockMode, GotoMode, Localization, NavMap, Planner, charge
+from .navmodes import DockMode, GotoMode, Localization, NavMap, PathTask, charge
 from .robot import Body, normalize_deg
 from .sonar import sonar_readings
 from .wifi import AccessPoint, Link
@@ -103,9 +103,9 @@ class World:
         self.jog_mode = JogMode()
         self.nav_map: NavMap | None = None
         self.localization = Localization()
-        self.planner = Planner(self)
-        self.goto_mode = GotoMode(self, self.planner)
-        self.dock_mode = DockMode(self, self.planner)
+        self.path_task = PathTask(self)
+        self.goto_mode = GotoMode(self, self.path_task)
+        self.dock_mode = DockMode(self, self.path_task)
         self.modes: tuple[Mode, ...] = (
             self.stop_mode,
             self.ratio_mode,
@@ -254,7 +254,8 @@ class World:
         self.body.step(dt, cmd)
         if not self.body.is_stopped():
             self.last_activity = self.time
-        if self.mode is self.dock_mode and self.dock_mode.docked:
+        charging = self.mode is self.dock_mode and self.dock_mode.docked
+        if charging:
             charge(self, dt)
         self.localization.tick(self.time)
         if self.waiting_modes and not self.mode.locked:
@@ -263,7 +264,11 @@ class World:
         if info != self._mode_info:
             self._mode_info = info
             self.changes.mode_info = True
-        if self.body.battery_v <= p3dx.BATTERY_SHUTDOWN_V and self.mode is not self.stop_mode:
+        if (
+            self.body.battery_v <= p3dx.BATTERY_SHUTDOWN_V
+            and self.mode is not self.stop_mode
+            and not charging
+        ):
             self.stop()
         self._check_battery()
         self.check_strings()
