@@ -14,6 +14,7 @@ from pathlib import Path
 from rtmu.maps import MapObject, write_map
 from rtmu.protocol.payloads.commands import CommandList
 from rtmu.protocol.payloads.drive import RatioDrive
+from rtmu.protocol.payloads.ld import DataStoreValue
 from rtmu.protocol.payloads.map import Goals
 from rtmu.protocol.payloads.navigation import (
     GoalName,
@@ -343,6 +344,28 @@ def test_goto_pose_heading_may_come_as_two_bytes():
         c.once("gotoPose", struct.pack("<iih", 4000, 6000, -90))
         await _until(server, lambda: server.robot.status == "Arrived at point", 60)
         assert abs(server.robot.th + 90) <= 3
+        await _end(server, c)
+
+    run(scenario())
+
+
+def test_the_aram_profile_navigates_too_and_its_data_store_follows():
+    async def scenario() -> None:
+        server = SimServer(SimConfig(port=0, realtime=False, map_path=OFFICE, profile="aram"))
+        await server.start()
+        c = await WireClient().open(server.port)
+        assert {"gotoGoal", "gotoPose", "localizeToPose", "getLocState", "gotoRouteGoal"} <= {
+            e.name for e in c.conn.datalist
+        }
+        c.once("gotoGoal", GotoGoal("Room 102").encode())
+        await c.barrier()
+        await server.advance(3.0)
+        left = float(DataStoreValue.decode((await c.ask("DataStore_Distance_To_Goal"))[0]).value)
+        assert 1000 < left < 8000
+        await _until(server, lambda: server.robot.status == "Arrived at Room 102", 60)
+        assert DataStoreValue.decode((await c.ask("DataStore_Distance_To_Goal"))[0]).value == "0"
+        server.lose_localization()
+        assert int(DataStoreValue.decode((await c.ask("DataStore_Localization_Score"))[0]).value) < 20
         await _end(server, c)
 
     run(scenario())
