@@ -1,4 +1,4 @@
-"""A reader that goes away (``rtmu mapinfo MAP | head -1``) ends the command quietly, never with a traceback."""
+"""A reader that goes away (`rtmu mapinfo MAP | head -1`) ends the command quietly, without a traceback."""
 
 from __future__ import annotations
 
