@@ -60,6 +60,12 @@ class CommandTarget(Protocol):
 
     def set_safe_drive(self, on: bool) -> None: ...
 
+    def home(self) -> None: ...
+
+    def dock(self) -> None: ...
+
+    def tour_goals(self) -> None: ...
+
     def connect(self, password: str | None = None) -> None: ...
 
     def disconnect(self) -> None: ...
@@ -377,6 +383,45 @@ class SafeDriveOff(Command):
 
     def activate(self, target: CommandTarget) -> None:
         target.set_safe_drive(False)
+
+
+# -- navigation (the server drives; a STOP or a drive key cancels it) ----------------------------
+
+
+@command
+class Home(Command):
+    name = "home"
+    label = "Go home"
+    group = "Navigation"
+    menu = True
+    needs = ("home",)
+
+    def activate(self, target: CommandTarget) -> None:
+        target.home()
+
+
+@command
+class DockCommand(Command):
+    name = "dock"
+    label = "Dock and charge"
+    group = "Navigation"
+    menu = True
+    needs = ("dock",)
+
+    def activate(self, target: CommandTarget) -> None:
+        target.dock()
+
+
+@command
+class TourGoals(Command):
+    name = "tour_goals"
+    label = "Tour the goals"
+    group = "Navigation"
+    menu = True
+    needs = ("tourGoals",)
+
+    def activate(self, target: CommandTarget) -> None:
+        target.tour_goals()
 
 
 # -- session ------------------------------------------------------------------------------------

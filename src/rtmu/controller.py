@@ -26,6 +26,17 @@ Driving rules
   while unfocused therefore needs one press to clear it, then a fresh press).
 * Speed: 10…100 % in 10 % steps; it is the ``ratioDrive`` throttle and applies at
   once to a drive in progress.
+
+Navigation rules (the server drives: ARNL's goals, points, home, dock, tours)
+-----------------------------------------------------------------------------
+* The operator always wins. :meth:`stop` cancels a navigation (its ``stop`` goes
+  out at once, as always). A drive key pressed while the server navigates does
+  not steer: it sends the stop and nothing else, and stays blocked until released;
+  the next press drives as usual.
+* Sending the robot somewhere ends a held drive first (the network side sends the
+  stop before the goal), so the next ``ratioDrive`` cannot take it back.
+* Navigation is autonomy on the server: focus loss, a stale link or a lapsed lease
+  end *held drives* only, never a navigation (disconnecting still stops the robot).
 """
 
 from __future__ import annotations
@@ -41,7 +52,7 @@ from .commands import COMMANDS, CommandRegistry, CommandState
 from .model import OperatorState, RobotModel, SpeedSetting
 from .notices import Kind, Notice
 from .settings import Profile
-from .state import ConnectionState, LinkHealth, LinkLevel, Phase
+from .state import ConnectionState, LinkHealth, LinkLevel, NavState, Phase
 
 TICK = 0.1
 """Seconds between :meth:`Controller.tick` calls the UI timer should make (10 Hz renewal)."""
@@ -102,6 +113,20 @@ class ClientLink(Protocol):
     def request_image(self) -> object: ...
 
     def set_safe_drive(self, on: bool) -> object: ...
+
+    def goto_goal(self, name: str) -> object:
+        """The server drives to the map's goal ``name`` (``gotoGoal``)."""
+
+    def goto_pose(self, x: float, y: float, th: float | None = None) -> object: ...
+
+    def home(self) -> object: ...
+
+    def dock(self) -> object: ...
+
+    def tour_goals(self) -> object: ...
+
+    def localize(self, x: float, y: float, th: float) -> object:
+        """Tell the server where the robot is (``localizeToPose``)."""
 
     # Optional (the controller looks for it with getattr): ``run_blocking(fn, done)`` runs ``fn``
     # off the UI thread and posts ``done(result)`` back; keyring lookups go through it.
@@ -174,10 +199,13 @@ class Controller:
         """A keyring lookup runs off the UI thread; connect() waits for its answer."""
         self._unfocused = False
         """Between focus loss and the next key press: releases seen then are not real key-ups."""
+        self._nav_cancelled = False
+        """We sent the stop that ends the current navigation; the server has not said so yet."""
         link.on_notice = self._on_link_notice
         self._unobserve = [
             robot.connection.observe(self._on_connection),
             robot.health.observe(self._on_health),
+            robot.navigation.observe(self._on_navigation),
         ]
         self.refresh_commands()
 
@@ -251,6 +279,11 @@ class Controller:
         if not self.connected or not self.supports("ratioDrive"):
             self._blocked.add(direction)
             return
+        if self.navigating:  # the operator wins: this press only stops the navigation
+            self.stop()
+            self._blocked.add(direction)
+            self.view.notify(Notice.info(Kind.NAVIGATION, "Navigation cancelled. Press again to drive."))
+            return
         self._held.add(direction)
         self._apply()
 
@@ -301,14 +334,20 @@ class Controller:
             )
 
     def stop(self) -> None:
-        """Stop now. Always sent, whatever the link looks like; held keys must be pressed again."""
+        """Stop now. Always sent, whatever the link looks like; held keys must be pressed again.
+
+        Also ends a navigation: the server's ``stop`` mode takes over from its goal."""
+        if self.navigating:
+            self._nav_cancelled = True
         self._halt_held(EndReason.STOPPED)
         self.link.lease.end(EndReason.STOPPED)
         if self.robot.connection.value.phase in (Phase.CONNECTED, Phase.RECONNECTING, Phase.CONNECTING):
             self.link.stop()
 
     def focus_lost(self) -> None:
-        """The window lost keyboard focus: key releases may never arrive, so stop.
+        """The window lost keyboard focus: key releases may never arrive, so stop a held drive.
+
+        A navigation goes on: the server drives it, no key is held for it.
 
         Keys held now stay blocked until a real release is seen after focus returns (see the
         module notes): auto-repeat of a key held all along must not start the robot again.
@@ -364,6 +403,59 @@ class Controller:
     def set_safe_drive(self, on: bool) -> None:
         if self._require("setSafeDrive"):
             self.link.set_safe_drive(on)
+
+    # -- navigation (the server drives) --------------------------------------------------------
+    @property
+    def navigating(self) -> bool:
+        """The server navigates now, and we have not already sent the stop that ends it."""
+        return self.robot.navigation.value.navigating and not self._nav_cancelled
+
+    def goto_goal(self, name: str) -> None:
+        """Send the robot to the map's goal ``name``: ``gotoGoal``, else an LD robot's ``gotoRouteGoal``."""
+        goals = self.robot.navigation.value.goals
+        if goals and name not in goals:
+            self.view.notify(Notice.warning(Kind.NAVIGATION, f"This map has no goal called {name!r}"))
+            return
+        if not self.supports("gotoGoal") and self.supports("gotoRouteGoal"):
+            self._start_navigation()
+            self.link.command("gotoRouteGoal", name)
+        elif self._require("gotoGoal"):
+            self._start_navigation()
+            self.link.goto_goal(name)
+
+    def goto_pose(self, x: float, y: float, th: float | None = None) -> None:
+        """Send the robot to (x, y) mm on the map, facing ``th`` degrees when given (``gotoPose``)."""
+        if self._require("gotoPose"):
+            self._start_navigation()
+            self.link.goto_pose(float(x), float(y), None if th is None else float(th))
+
+    def home(self) -> None:
+        if self._require("home"):
+            self._start_navigation()
+            self.link.home()
+
+    def dock(self) -> None:
+        if self._require("dock"):
+            self._start_navigation()
+            self.link.dock()
+
+    def tour_goals(self) -> None:
+        if self._require("tourGoals"):
+            self._start_navigation()
+            self.link.tour_goals()
+
+    def localize(self, x: float, y: float, th: float) -> None:
+        """Tell the server the robot is at (x, y) mm facing ``th`` degrees (``localizeToPose``)."""
+        if self._require("localizeToPose"):
+            self.link.localize(float(x), float(y), float(th))
+
+    def _start_navigation(self) -> None:
+        self._halt_held(EndReason.STOPPED)  # the network side sends its stop before the goal
+        self._nav_cancelled = False
+
+    def _on_navigation(self, old: NavState, new: NavState) -> None:
+        if not new.navigating or (old.navigating and new.target != old.target):
+            self._nav_cancelled = False  # it ended (or someone sent it elsewhere): keys drive again
 
     def _require(self, name: str) -> bool:
         if not self.connected:

@@ -15,7 +15,7 @@ Two owners, kept apart so that a window can show any robot of a fleet:
 
 * :class:`RobotModel` — what one robot and its link are (one per
   :class:`rtmu.fleet.RobotSession`): ``robot``, ``map``, ``camera``,
-  ``connection``, ``health`` and the ``trail`` it drove.
+  ``connection``, ``health``, ``navigation`` and the ``trail`` it drove.
 * :class:`OperatorState` — what the operator chose (one per window): ``speed``
   (the drive throttle step) and ``view`` (zoom, follow, layers).
 
@@ -42,6 +42,9 @@ from .state import (
     MapChanged,
     MapModel,
     MapPhase,
+    NavChanged,
+    NavOutcome,
+    NavState,
     Phase,
     RobotChanged,
     RobotState,
@@ -55,6 +58,8 @@ __all__ = [
     "LinkLevel",
     "MapModel",
     "MapPhase",
+    "NavOutcome",
+    "NavState",
     "Observable",
     "OperatorState",
     "Phase",
@@ -184,6 +189,7 @@ class RobotModel:
         self.camera: Observable[CameraImage | None] = Observable(None)
         self.connection: Observable[ConnectionState] = Observable(ConnectionState())
         self.health: Observable[LinkHealth] = Observable(LinkHealth())
+        self.navigation: Observable[NavState] = Observable(NavState())
         self.trail = Trail()
         # The trail's observers run before any view's (added first), so a redraw sees the new point.
         self.robot.observe(self.trail.robot_moved)
@@ -202,6 +208,8 @@ class RobotModel:
                 self.connection.set(value)
             case HealthChanged(value):
                 self.health.set(value)
+            case NavChanged(value):
+                self.navigation.set(value)
 
 
 # -- operator settings ---------------------------------------------------------------------------

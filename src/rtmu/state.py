@@ -152,6 +152,58 @@ class CameraImage:
     """Increases for every picture, so two identical frames still count as a new picture."""
 
 
+# -- navigation ----------------------------------------------------------------------------------
+
+
+class NavOutcome(StrEnum):
+    """How the last navigation ended (a ``StrEnum``: it compares equal to its text)."""
+
+    NONE = ""
+    """Nothing has ended yet on this connection (or one is under way)."""
+    ARRIVED = "arrived"
+    DOCKED = "docked"
+    FAILED = "failed"
+    CANCELLED = "cancelled"
+    """It stopped before arriving: a stop, a drive command or another mode took over."""
+
+
+@dataclass(frozen=True, slots=True)
+class NavState:
+    """What an ARNL-class server is doing with the robot on its own: goals, path, localization.
+
+    Read from the mode name and status strings (ARNL's words: ``Going to …``, ``Arrived at …``,
+    ``Failed to get to …``, ``Docked``), ``getPath``, ``getLocState`` and ``getGoals`` — each only
+    where the server lists it. Defaults mean "not offered or not known".
+    """
+
+    offered: frozenset[str] = frozenset()
+    """The navigation data the server lists (``gotoGoal``, ``home``, ``dock``, ``getLocState`` …)."""
+    navigating: bool = False
+    """The server is driving the robot to a goal, a point, home or the dock right now."""
+    target: str = ""
+    """Where to, in the server's words: a goal name, ``point``, ``home``, ``dock at Charger``."""
+    target_pose: tuple[float, float, float | None] | None = None
+    """(x mm, y mm, heading ° or None) when known: what we sent, or the map's goal of that name."""
+    path: tuple[tuple[int, int], ...] = ()
+    """The planned path still ahead (``getPath``, map mm), while navigating."""
+    remaining_mm: float | None = None
+    """Distance along ``path`` from the robot's pose; None without a path."""
+    outcome: NavOutcome = NavOutcome.NONE
+    outcome_text: str = ""
+    """The server's own sentence for the outcome (``Arrived at Lab B``), bounded."""
+    reason: str = ""
+    """Why it failed, in plain words (``the robot is lost``, ``path blocked``); "" otherwise."""
+    loc_state: str | None = None
+    """``Good``, ``Idle``, ``Lost``, ``Initializing`` (``getLocState``); None if not offered."""
+    loc_score: float | None = None
+    """Localization score 0.0–1.0 (``getLocState``); None if not offered."""
+    goals: tuple[str, ...] = ()
+    """The map's goal names (``getGoals``), refreshed on ``goalsUpdated``."""
+
+    def offers(self, name: str) -> bool:
+        return name in self.offered
+
+
 # -- connection and link -------------------------------------------------------------------------
 
 
@@ -243,7 +295,12 @@ class HealthChanged:
     value: LinkHealth
 
 
-StateChange = RobotChanged | MapChanged | CameraChanged | ConnectionChanged | HealthChanged
+@dataclass(frozen=True, slots=True)
+class NavChanged:
+    value: NavState
+
+
+StateChange = RobotChanged | MapChanged | CameraChanged | ConnectionChanged | HealthChanged | NavChanged
 """What the network side publishes: the class says which part changed, the value is the new whole."""
 
 

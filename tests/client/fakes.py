@@ -63,6 +63,24 @@ class RecordingLink:
     def set_safe_drive(self, on: bool) -> None:
         self.calls.append(("set_safe_drive", on))
 
+    def goto_goal(self, name: str) -> None:
+        self.calls.append(("goto_goal", name))
+
+    def goto_pose(self, x: float, y: float, th: float | None = None) -> None:
+        self.calls.append(("goto_pose", x, y, th))
+
+    def home(self) -> None:
+        self.calls.append(("home",))
+
+    def dock(self) -> None:
+        self.calls.append(("dock",))
+
+    def tour_goals(self) -> None:
+        self.calls.append(("tour_goals",))
+
+    def localize(self, x: float, y: float, th: float) -> None:
+        self.calls.append(("localize", x, y, th))
+
     def run_blocking(self, fn: Callable[[], object], done: Callable[[object], None]) -> None:
         """Like the runner: ``fn`` must not run on the UI (test) thread; :meth:`finish_blocking` runs it."""
         self.calls.append(("run_blocking",))

@@ -55,8 +55,6 @@ class LdFeed:
             client.request("dockInfoChanged", -1, self._on_dock)
         if client.supports("routesUpdated") and client.supports("getRoutes"):
             client.request("routesUpdated", -1, lambda packet: self._refetch_routes(client))
-        if client.supports("goalsUpdated") and client.supports("gotoRouteGoal"):
-            client.request("goalsUpdated", -1, lambda packet: self._refetch_routes(client))
         self._descriptions = {e.name: e.description for e in client.datalist}
         for name in data_store_names(client):
             client.request(name, DATA_STORE_INTERVAL_MS, self._on_store)
@@ -78,6 +76,11 @@ class LdFeed:
 
     def _refetch_routes(self, client: AriaClient) -> None:
         self._spawn(self.fetch(client), "ld-routes")
+
+    def goals_updated(self, client: AriaClient) -> None:
+        """``goalsUpdated`` (the session holds that one subscription for navigation too): ask again."""
+        if client.supports("gotoRouteGoal"):
+            self._refetch_routes(client)
 
     def _on_laser(self, packet: Packet) -> None:
         readings = self._decode(packet.name, packet.payload)

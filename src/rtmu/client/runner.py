@@ -335,6 +335,25 @@ class ClientRunner:
     def load_map(self) -> concurrent.futures.Future[Any]:
         return self._fire(self._session.load_map, kind=Kind.MAP)
 
+    # -- navigation: the server drives; a refusal comes back as a Kind.NAVIGATION notice -------
+    def goto_goal(self, name: str) -> concurrent.futures.Future[None]:
+        return self._fire(self._session.goto_goal, name, kind=Kind.NAVIGATION)
+
+    def goto_pose(self, x: float, y: float, th: float | None = None) -> concurrent.futures.Future[None]:
+        return self._fire(self._session.goto_pose, x, y, th, kind=Kind.NAVIGATION)
+
+    def home(self) -> concurrent.futures.Future[None]:
+        return self._fire(self._session.home, kind=Kind.NAVIGATION)
+
+    def dock(self) -> concurrent.futures.Future[None]:
+        return self._fire(self._session.dock, kind=Kind.NAVIGATION)
+
+    def tour_goals(self) -> concurrent.futures.Future[None]:
+        return self._fire(self._session.tour_goals, kind=Kind.NAVIGATION)
+
+    def localize(self, x: float, y: float, th: float) -> concurrent.futures.Future[None]:
+        return self._fire(self._session.localize, x, y, th, kind=Kind.NAVIGATION)
+
     def run_blocking(
         self, fn: Callable[[], T], done: Callable[[T | None], None], *, timeout: float = 30.0
     ) -> concurrent.futures.Future[T]:

@@ -33,6 +33,7 @@ from ..protocol.client_connection import payload_name
 from ..protocol.errors import ProtocolError
 from ..protocol.payloads import Payload, Side, decode_payload, payload_type_for
 from ..protocol.payloads.drive import RatioDrive, SafeDrive, SetSafeDrive
+from ..protocol.payloads.navigation import Dock, GotoGoal, GotoPose, Home, LocalizeToPose, TourGoals
 from ..protocol.payloads.robot import BatteryInfo, ModeInfo, Update, UpdateNumbers, UpdateStrings
 from ..state import (
     CameraChanged,
@@ -58,6 +59,7 @@ from .ld_session import LdFeed
 from .lease import DriveGovernor, DriveLease, EndReason, SendRatios, SendStop
 from .mapcache import MapCache, map_key
 from .mapload import download_map, map_source
+from .nav_session import NavFeed
 from .reconnect import Backoff, worth_retrying
 from .subscriptions import Subscription, applicable
 
@@ -83,6 +85,10 @@ class SessionConfig:
     """``updateNumbers`` period: the status stream is also the link's heartbeat."""
     sonar_interval_ms: int = 200
     wifi_interval_ms: int = 1000
+    loc_state_interval_ms: int = 1000
+    """``getLocState`` period, where the server offers it."""
+    path_interval_ms: int = 500
+    """``getPath`` period, only while the server navigates."""
     ping_interval: float = 1.0
     connect_timeout: float = 10.0
     reply_timeout: float = 5.0
@@ -162,6 +168,13 @@ class Session:
         self.guardian: GuardianHandle | None = None
         self.ld = LdFeed(self._robot_update, self._decode, self._spawn, self.config.reply_timeout)
         """LD (ARAM) data: lasers, docking state, routes, DataStore_* — only where listed."""
+        self.nav = NavFeed(
+            self._publish, self._notice, self._decode, self._spawn, self.config.reply_timeout, self._goal_pose
+        )
+        """Navigation (ARNL): goals, path, outcome, localization — read from what the server lists."""
+        self.nav.changed = self._sync_subscriptions
+        self._held_subs: set[str] = set()
+        """Conditional subscriptions (``only_while``) held now on this connection."""
 
     # -- publishing --------------------------------------------------------------------------
     def _publish(self, change: StateChange) -> None:
@@ -177,6 +190,7 @@ class Session:
     def _robot_update(self, **changes: Any) -> None:
         self._robot = replace(self._robot, **changes)
         self._publish(RobotChanged(self._robot))
+        self.nav.robot(self._robot)
 
     def _set_connection(self, **changes: Any) -> None:
         self._connection = replace(self._connection, **changes)
@@ -222,6 +236,7 @@ class Session:
         target = self._target = _Target(host, port, user, password, profile, auto_reconnect, protocol)
         self._robot = RobotState()
         self._publish(RobotChanged(self._robot))
+        self.nav.disconnected()
         self._set_map(MapModel())
         self._publish(CameraChanged(None))
         self._set_connection(
@@ -266,6 +281,7 @@ class Session:
         self.governor.reset()
         self.health.start(self.clock())
         offers = frozenset(e.name for e in client.datalist)
+        self.nav.connected(client)
         self._setup_subscriptions(client)
         self._set_connection(phase=Phase.CONNECTED, offers=offers, error="", error_kind="", retry_in=None)
         self._spawn(self._ping_loop(client), "ping")
@@ -285,6 +301,7 @@ class Session:
         await self._drop_client()
         self._robot = RobotState()
         self._publish(RobotChanged(self._robot))
+        self.nav.disconnected()
         self._set_map(MapModel())
         self._publish(CameraChanged(None))
         self._set_connection(
@@ -383,12 +400,31 @@ class Session:
 
     # -- subscriptions -----------------------------------------------------------------------
     def _setup_subscriptions(self, client: AriaClient) -> None:
+        self._held_subs.clear()
         for sub in applicable(self.subscriptions, client.supports):
-            client.request(sub.name, sub.interval(self.config), partial(sub.handler, self))
+            if sub.only_while is None:
+                client.request(sub.name, sub.interval(self.config), partial(sub.handler, self))
+        self._sync_subscriptions()
         self.ld.subscribe(client)
         for name, (interval, handler) in self._extra_subs.items():
             if client.supports(name):
                 client.request(name, interval, handler)
+
+    def _sync_subscriptions(self) -> None:
+        """Start or end the conditional subscriptions (``only_while``) whose condition changed."""
+        client = self.client
+        if client is None or not client.connected:
+            return
+        for sub in applicable(self.subscriptions, client.supports):
+            if sub.only_while is None:
+                continue
+            wanted = sub.only_while(self)
+            if wanted and sub.name not in self._held_subs:
+                self._held_subs.add(sub.name)
+                client.request(sub.name, sub.interval(self.config), partial(sub.handler, self))
+            elif not wanted and sub.name in self._held_subs:
+                self._held_subs.discard(sub.name)
+                client.stop_request(sub.name)
 
     def subscribe(self, name: str, interval_ms: int, handler: Callable[[Packet], None]) -> None:
         """An extra subscription, restored after every reconnect."""
@@ -415,6 +451,7 @@ class Session:
             if client.supports("getSafeDrive"):
                 self._on_safe_drive((await client.request_once("getSafeDrive", timeout=timeout)).payload)
         await self.ld.fetch(client)
+        await self.nav.fetch_goals(client)
         await self._watch_wifi(client)
 
     def _decode(self, name: str, payload: bytes) -> Any:
@@ -475,6 +512,31 @@ class Session:
     def _on_map_updated(self, packet: Packet) -> None:
         if self.config.fetch_map:
             self._request_map()
+
+    def _on_goals_updated(self, packet: Packet) -> None:
+        client = self.client
+        if client is not None:
+            self.nav.on_goals_updated(client)
+            self.ld.goals_updated(client)
+
+    def _on_loc_state(self, packet: Packet) -> None:
+        self.nav.on_loc_state(packet)
+
+    def _on_path(self, packet: Packet) -> None:
+        self.nav.on_path(packet)
+
+    def _navigating(self) -> bool:
+        return self.nav.navigating
+
+    def _goal_pose(self, name: str) -> tuple[float, float, float | None] | None:
+        """The loaded map's goal called ``name``: (x, y, heading — only for a ``GoalWithHeading``)."""
+        data = self._map.data
+        if data is None or not name:
+            return None
+        for o in data.objects:
+            if o.is_goal and o.name == name:
+                return (o.x, o.y, o.th if o.type.lower() == "goalwithheading" else None)
+        return None
 
     # -- Wi-Fi (optional getStrings items, protocol §4.11) ------------------------------------
     async def _watch_wifi(self, client: AriaClient) -> None:
@@ -689,6 +751,52 @@ class Session:
         client = self._require(what if isinstance(what, str) else payload_name(what))
         client.send(what, *args)
 
+    # -- navigation: the server drives (ARNL) -------------------------------------------------
+    def navigate(self, payload: Payload) -> None:
+        """Send a navigation command (:class:`GotoGoal`, :class:`GotoPose`, :class:`Home`, :class:`Dock`,
+        :class:`TourGoals`, :class:`LocalizeToPose`); NotSupported where the server does not list it.
+
+        A drive in progress ends first (zero ratios + ``stop`` go out before the command): the
+        next ``ratioDrive`` would otherwise take the robot back from the server at once.
+        """
+        name = payload_name(payload)
+        client = self._require_nav(name)
+        if not isinstance(payload, LocalizeToPose):
+            driving = self.governor.driving
+            self.lease.end(EndReason.STOPPED)
+            if driving:
+                self._send_stop()
+                self.governor.reset()
+        client.send(payload)
+        self.packets_sent += 1
+        self.nav.sent(payload)
+
+    def goto_goal(self, name: str) -> None:
+        self.navigate(GotoGoal(name))
+
+    def goto_pose(self, x: float, y: float, th: float | None = None) -> None:
+        self.navigate(GotoPose(round(x), round(y), None if th is None else round(th)))
+
+    def home(self) -> None:
+        self.navigate(Home())
+
+    def dock(self) -> None:
+        self.navigate(Dock())
+
+    def tour_goals(self) -> None:
+        self.navigate(TourGoals())
+
+    def localize(self, x: float, y: float, th: float) -> None:
+        self.navigate(LocalizeToPose(round(x), round(y), round(th)))
+
+    def _require_nav(self, name: str) -> AriaClient:
+        client = self.client
+        if client is None or not client.connected:
+            raise ServerClosed("not connected")
+        if not client.supports(name):
+            raise NotSupported(name, f"this server does not navigate that way (it does not offer {name})")
+        return client
+
     def set_safe_drive(self, on: bool) -> None:
         client = self._require("setSafeDrive")
         client.send(SetSafeDrive(on))
@@ -842,6 +950,9 @@ SUBSCRIPTIONS: tuple[SessionSubscription, ...] = (
     Subscription("getModeInfo", -1, Session._on_mode_info),
     Subscription("mapUpdated", -1, Session._on_map_updated),
     Subscription("sonarCurrent", lambda c: c.sonar_interval_ms, Session._on_sonar),
+    Subscription("getLocState", lambda c: c.loc_state_interval_ms, Session._on_loc_state),
+    Subscription("goalsUpdated", -1, Session._on_goals_updated, needs="getGoals"),
+    Subscription("getPath", lambda c: c.path_interval_ms, Session._on_path, only_while=Session._navigating),
 )
 """What a session subscribes to on every connection, in this order, where the server offers it."""
 

@@ -2,7 +2,9 @@
 
 The session declares a tuple of :class:`Subscription` records instead of a
 chain of ``if client.supports(...)`` calls, so the set can be read, tested and
-replaced (a replay, a tool that wants less) without touching the session.
+replaced (a replay, a tool that wants less) without touching the session. A
+record may also say *when* it is wanted (``only_while``): the data is then asked
+for only while that holds, not for the whole connection.
 """
 
 from __future__ import annotations
@@ -32,6 +34,9 @@ class Subscription(Generic[S, C]):
     """Only when the server offers this data too (``updateStrings`` goes with ``updateNumbers``)."""
     unless: str | None = None
     """Not when the server offers this data (the old ``update`` gives way to ``updateNumbers``)."""
+    only_while: Callable[[S], bool] | None = None
+    """Held only while this holds for the session (``getPath`` while navigating): the session asks
+    again whenever the answer may have changed, and ends the subscription when it turns false."""
 
     def applies(self, offered: Callable[[str], bool]) -> bool:
         if not offered(self.name):

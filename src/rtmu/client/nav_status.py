@@ -1,0 +1,157 @@
+"""What an ARNL-class server's mode name and status string say about navigation (pure, no I/O).
+
+ARNL reports navigation only in words: its ``Goto`` mode says ``Going to Lab B``, then ``Arrived at
+Lab B`` or ``Failed to get to Lab B because robot lost``; its ``dock`` mode says ``Going to dock at
+Charger``, ``Driving into dock``, then ``Docked`` or ``Failed dock``. The window's session and the
+command line both read those words here, so they agree on what "arrived" and "failed" mean.
+
+Server text is untrusted: everything kept is cut to :data:`MAX_TEXT` characters (escaping for a
+terminal or a label is the printer's job).
+"""
+
+from __future__ import annotations
+
+import itertools
+import math
+from collections.abc import Sequence
+from dataclasses import dataclass
+from enum import Enum
+
+MAX_TEXT = 200
+"""Longest status, target or reason kept from the server."""
+
+NAV_MODES = frozenset({"Goto", "dock", "Dock"})
+"""``getModeInfo`` names of ARNL's navigation modes (``ArServerModeGoto``, ``ArServerModeDock``)."""
+
+NAV_DATA = (
+    "gotoGoal",
+    "gotoPose",
+    "home",
+    "tourGoals",
+    "dock",
+    "undock",
+    "localizeToPose",
+    "getLocState",
+    "getPath",
+    "pathPlannerStatus",
+    "goalName",
+    "getGoals",
+    "goalsUpdated",
+    "gotoRouteGoal",
+    "dockInfo",
+)
+"""The data navigation uses, where listed (the session's ``NavState.offered`` is these)."""
+
+_GOING = ("Going to ", "Returning home", "Touring to ", "Driving into dock", "Docking")
+_FAILED = ("Failed", "Unable to dock", "Cannot drive to dock")
+
+
+class NavPhase(Enum):
+    IDLE = "idle"
+    """Not navigating, and the status says nothing about an outcome (``Stopped``, ``Driving``)."""
+    GOING = "going"
+    ARRIVED = "arrived"
+    DOCKED = "docked"
+    FAILED = "failed"
+
+
+@dataclass(frozen=True, slots=True)
+class NavReading:
+    """One status string, read: the phase, where to, why it failed, and the text itself (bounded)."""
+
+    phase: NavPhase
+    target: str = ""
+    reason: str = ""
+    text: str = ""
+
+    @property
+    def finished(self) -> bool:
+        return self.phase in (NavPhase.ARRIVED, NavPhase.DOCKED, NavPhase.FAILED)
+
+    def sentence(self) -> str:
+        """The outcome for the operator: ``Arrived at Lab B``, ``Failed to get to Lab B because the
+        robot is lost``, ``Docked``; "" while not finished."""
+        if not self.finished:
+            return ""
+        if self.phase is NavPhase.FAILED:
+            head = _failure_head(self.text)
+            return f"{head} because {self.reason}" if self.reason and self.reason not in head else head
+        return self.text
+
+
+def _bounded(text: str) -> str:
+    return text[:MAX_TEXT]
+
+
+def read_status(status: str, mode_name: str = "") -> NavReading:
+    """Read one ``updateStrings`` status; ``mode_name`` (``getModeInfo``, "" if unknown) keeps a
+    ``Going to …`` of some other mode from counting as navigation."""
+    text = _bounded(status.strip())
+    if text == "Docked":
+        return NavReading(NavPhase.DOCKED, "dock", text=text)
+    if text.startswith("Arrived at "):
+        return NavReading(NavPhase.ARRIVED, text.removeprefix("Arrived at "), text=text)
+    if text == "Returned home":
+        return NavReading(NavPhase.ARRIVED, "home", text=text)
+    if text.startswith(_FAILED):
+        return NavReading(NavPhase.FAILED, _failure_target(text), _failure_reason(text), text)
+    if text.startswith(_GOING) and (not mode_name or mode_name in NAV_MODES):
+        return NavReading(NavPhase.GOING, _going_target(text), text=text)
+    return NavReading(NavPhase.IDLE, text=text)
+
+
+def _going_target(text: str) -> str:
+    if text.startswith("Returning home"):
+        return "home"
+    if text.startswith(("Driving into dock", "Docking")):
+        return "dock"
+    for prefix in ("Going to ", "Touring to "):
+        if text.startswith(prefix):
+            return text.removeprefix(prefix)
+    return ""
+
+
+def _failure_head(text: str) -> str:
+    """``Failed to get to Lab B`` out of ``… because robot lost`` or ``… (path blocked)``."""
+    head = text.split(" because ", 1)[0]
+    if head.endswith(")") and " (" in head:
+        head = head.rsplit(" (", 1)[0]
+    return head.strip()
+
+
+def _failure_target(text: str) -> str:
+    head = _failure_head(text)
+    for prefix in ("Failed to get to ", "Failed to plan to "):
+        if head.startswith(prefix):
+            return head.removeprefix(prefix)
+    if head.startswith("Failed to get home"):
+        return "home"
+    if "dock" in head.lower():
+        return "dock"
+    if head.startswith("Failed touring"):
+        return "tour"
+    return ""
+
+
+def _failure_reason(text: str) -> str:
+    """Why, in plain words: ARNL's ``because robot lost`` reads as ``the robot is lost``."""
+    if " because " in text:
+        why = text.split(" because ", 1)[1].strip().rstrip(".")
+        return "the robot is lost" if why == "robot lost" else why
+    if text.endswith(")") and " (" in text:
+        return text.rsplit(" (", 1)[1][:-1].strip()
+    if text.startswith("Failed to plan to "):
+        return "no path could be planned"
+    if text.startswith("Failed touring goals:"):
+        return text.split(":", 1)[1].strip().rstrip(".")
+    return ""
+
+
+def path_remaining(x: float, y: float, path: Sequence[tuple[int, int]]) -> float | None:
+    """mm left along ``path`` (corners still ahead, in order) from the robot at (x, y); None if empty."""
+    if not path:
+        return None
+    total = math.hypot(path[0][0] - x, path[0][1] - y)
+    for (ax, ay), (bx, by) in itertools.pairwise(path):
+        total += math.hypot(bx - ax, by - ay)
+    return total
