@@ -65,9 +65,10 @@ def test_goto_sends_a_route_goal_and_refuses_an_unknown_one(
     aram: SimThread, capsys: pytest.CaptureFixture[str]
 ) -> None:
     before = len(_state(aram).route_goals)
-    assert main(["goto", addr(aram), "Lab A", "--timeout", "5"]) == EXIT_OK
+    # The aram profile lists ARNL's gotoGoal too: --route asks for the LD command by name.
+    assert main(["goto", addr(aram), "Lab A", "--route", "--timeout", "5"]) == EXIT_OK
     eventually(lambda: _state(aram).route_goals[before:] == ["Lab A"])
-    assert main(["goto", addr(aram), "Nowhere", "--timeout", "5"]) == EXIT_USAGE
+    assert main(["goto", addr(aram), "Nowhere", "--route", "--timeout", "5"]) == EXIT_USAGE
     err = capsys.readouterr().err
     assert "no goal 'Nowhere'" in err and "Lab A" in err
     assert _state(aram).route_goals[before:] == ["Lab A"]
@@ -115,7 +116,7 @@ def test_default_profile_offers_none_of_it(plain: SimThread, capsys: pytest.Capt
     assert main(["routes", addr(plain), "--timeout", "5"]) == EXIT_UNSUPPORTED
     assert main(["patrol", addr(plain), "Loop", "--timeout", "5"]) == EXIT_UNSUPPORTED
     assert main(["say", addr(plain), "hello", "--timeout", "5"]) == EXIT_UNSUPPORTED
-    assert main(["goto", addr(plain), "Lab A", "--timeout", "5"]) == EXIT_UNSUPPORTED
+    assert main(["goto", addr(plain), "Lab A", "--route", "--timeout", "5"]) == EXIT_UNSUPPORTED
     capsys.readouterr()
     assert main(["status", addr(plain), "--once", "--json", "--timeout", "5"]) == EXIT_OK
     assert "dock" not in json.loads(capsys.readouterr().out)

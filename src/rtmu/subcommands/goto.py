@@ -1,4 +1,10 @@
-"""``rtmu goto HOST[:PORT] GOAL``: send the robot to one of the map's goals (``gotoRouteGoal``, LD robots)."""
+"""``rtmu goto HOST[:PORT] GOAL`` or ``--x MM --y MM [--th DEG]``: send the robot there and follow it.
+
+Which command goes out (see ``--help``): ARNL's ``gotoGoal`` / ``gotoPose`` wherever the server lists
+them — the server then reports ``Going to …`` / ``Arrived at …`` and we wait for the outcome. An LD
+robot that lists ``gotoRouteGoal`` but not ``gotoGoal`` (or ``--route``) gets ``gotoRouteGoal``, and
+the command ends once it is sent, as before: those robots report progress elsewhere.
+"""
 
 from __future__ import annotations
 
@@ -9,31 +15,70 @@ from typing import Any
 from ..client import ld_data
 from ..client.connection import AriaClient
 from ..exit_codes import EXIT_OK, EXIT_USAGE
+from ..protocol.payloads.navigation import GotoGoal, GotoPose
 from ..textsafe import visible
-from ._common import add_connection_arguments, run_with_client, unknown_name
+from ._common import UsageError, add_connection_arguments, run_with_client, unknown_name
+from ._navigate import EXIT_CODES_HELP, Expect, add_wait_arguments, navigate, require
+
+RULE = (
+    "GOAL goes as ARNL's gotoGoal wherever the server lists it, and the command follows the robot to "
+    "the end; a server with gotoRouteGoal but no gotoGoal (Omron LD robots), or --route, gets "
+    "gotoRouteGoal instead and the command ends once it is sent. --x/--y go as gotoPose. The goal "
+    "must be one getGoals lists (exit 2 otherwise; rtmu goals lists them)."
+)
 
 
 def register(subparsers: Any) -> None:
     p = subparsers.add_parser(
         "goto",
-        help="drive to one of the map's goals (LD robots: gotoRouteGoal)",
-        description="Send gotoRouteGoal GOAL; the goal must be one getGoals lists (exit 2 otherwise). "
-        "The robot then drives by itself: `rtmu drive … --seconds 0` or the window's STOP stops it.",
+        help="drive to a goal of the map or to a point (gotoGoal / gotoPose; LD robots: gotoRouteGoal)",
+        description=f"{RULE} Ctrl-C stops the robot. {EXIT_CODES_HELP}.",
     )
     add_connection_arguments(p)
-    p.add_argument("goal", metavar="GOAL", help="goal name, as the map names it")
+    p.add_argument("goal", metavar="GOAL", nargs="?", help="goal name, as the map names it")
+    p.add_argument("--x", type=float, metavar="MM", help="drive to this point instead (map mm)")
+    p.add_argument("--y", type=float, metavar="MM", help="the point's y (map mm)")
+    p.add_argument("--th", type=float, metavar="DEG", help="and end facing this heading (degrees)")
+    p.add_argument("--route", action="store_true", help="send gotoRouteGoal even where gotoGoal is listed")
+    add_wait_arguments(p)
     p.set_defaults(handler=handle)
 
 
+def check(args: argparse.Namespace) -> None:
+    point = args.x is not None or args.y is not None or args.th is not None
+    if args.goal is not None and point:
+        raise UsageError("give either GOAL or --x/--y, not both")
+    if args.goal is None and (args.x is None or args.y is None):
+        raise UsageError("give a GOAL, or a point with --x MM --y MM [--th DEG]")
+    if point and args.route:
+        raise UsageError("--route takes a GOAL, not a point")
+
+
 def handle(args: argparse.Namespace) -> int:
+    try:
+        check(args)
+    except UsageError as exc:
+        print(f"rtmu goto: {exc}", file=sys.stderr)
+        return EXIT_USAGE
+
     async def body(client: AriaClient) -> int:
-        if not client.supports("gotoRouteGoal"):  # say so before asking for goals
-            ld_data.goto_route_goal(client, args.goal)  # raises NotSupported (exit 4)
-        known = await ld_data.goals(client, args.timeout)
-        if unknown_name("goto", "goal", args.goal, known):
-            return EXIT_USAGE
-        ld_data.goto_route_goal(client, args.goal)
-        print(f"going to {visible(args.goal)}", file=sys.stderr)
-        return EXIT_OK
+        if args.goal is None:
+            require(client, "gotoPose", "drive to points")
+            th = None if args.th is None else round(args.th)
+            return await navigate(client, args, GotoPose(round(args.x), round(args.y), th), Expect("point"))
+        route = args.route or (not client.supports("gotoGoal") and client.supports("gotoRouteGoal"))
+        if route:
+            require(client, "gotoRouteGoal", "drive to route goals")  # exit 4 before asking for goals
+        else:
+            require(client, "gotoGoal", "drive to goals")
+        if client.supports("getGoals"):
+            known = await ld_data.goals(client, args.timeout)
+            if unknown_name("goto", "goal", args.goal, known):
+                return EXIT_USAGE
+        if route:
+            ld_data.goto_route_goal(client, args.goal)
+            print(f"going to {visible(args.goal)}", file=sys.stderr)
+            return EXIT_OK
+        return await navigate(client, args, GotoGoal(args.goal), Expect(args.goal))
 
     return run_with_client("goto", args, body)

@@ -1,0 +1,342 @@
+"""What ``rtmu goto / home / dock / localize`` share: send one navigation command, follow it to its end.
+
+The server drives (ARNL); we only read its words (``Going to Lab B`` → ``Arrived at Lab B`` or
+``Failed to get to Lab B because robot lost``, ``Docked``) through :mod:`rtmu.client.nav_status`,
+print each new one (escaped: server text), and exit with what they say. Ctrl-C, SIGTERM, SIGHUP
+(every ending signal) and giving up after ``--limit`` send ``stop`` before the command ends: the
+robot does not drive on for a command nobody is watching. ``--no-wait`` sends and leaves it driving.
+"""
+
+from __future__ import annotations
+
+import argparse
+import asyncio
+import contextlib
+import sys
+from collections.abc import Callable
+from dataclasses import dataclass
+from typing import Any
+
+from ..client.connection import AriaClient, Packet
+from ..client.errors import ClientError, NotSupported
+from ..client.nav_status import NavPhase, NavReading, path_remaining, read_status
+from ..exit_codes import EXIT_OK, EXIT_TIMEOUT
+from ..protocol.errors import ProtocolError
+from ..protocol.payloads import Payload, Side, decode_payload
+from ..protocol.payloads.drive import RatioDrive
+from ..protocol.payloads.ld import DockInfo
+from ..protocol.payloads.navigation import LocalizationState, LocState, PlannedPath
+from ..protocol.payloads.robot import ModeInfo, Update, UpdateNumbers, UpdateStrings
+from ..textsafe import visible
+from ._common import Interrupted, current_interrupts, positive_float, print_json
+
+EXIT_NAV_FAILED = 6
+"""The server could not get there (``Failed to get to …``, ``Failed to plan to …``, ``Failed dock``)."""
+EXIT_NAV_CANCELLED = 7
+"""It stopped before arriving: someone pressed STOP, drove, or sent the robot elsewhere."""
+EXIT_NAV_LOST = 8
+"""The robot is lost: navigation failed for that, or ``rtmu localize`` ended lost. Localize it first."""
+
+DEFAULT_LIMIT = 600.0
+SETTLE = 1.5
+"""After this many seconds an outcome the server already showed before our command counts as the
+answer (it repeated it: e.g. a second ``goto`` to an unreachable goal fails with the same words)."""
+STATUS_MS = 250
+PATH_MS = 1000
+DISTANCE_STEP_MM = 1000.0
+"""Print the distance left when it changed by this much (and no oftener than DISTANCE_EVERY s)."""
+DISTANCE_EVERY = 2.0
+
+EXIT_CODES_HELP = (
+    "exit codes: 0 arrived (docked, localized), 2 usage or unknown goal, 3 connection or login failure, "
+    f"4 the server does not navigate that way, 5 no outcome within --limit (the robot is stopped), "
+    f"{EXIT_NAV_FAILED} the server could not get there, {EXIT_NAV_CANCELLED} stopped before arriving "
+    f"(STOP, a drive, another goal), {EXIT_NAV_LOST} the robot is lost (localize it first), 128+N ended "
+    "by signal N (130 Ctrl-C, 143 SIGTERM, 129 SIGHUP) after sending stop"
+)
+
+
+def add_wait_arguments(parser: argparse.ArgumentParser) -> None:
+    parser.add_argument(
+        "--limit",
+        type=positive_float,
+        default=DEFAULT_LIMIT,
+        metavar="S",
+        help=f"give up after S seconds: stop the robot, exit 5 (default {DEFAULT_LIMIT:g})",
+    )
+    parser.add_argument(
+        "--no-wait", action="store_true", help="send the command and exit 0; the robot drives on by itself"
+    )
+    parser.add_argument(
+        "--json",
+        action="store_true",
+        help='one object per line: {"status", "phase"} as the server reports, then {"outcome", "text", '
+        '"reason", "x", "y", "th"}',
+    )
+
+
+def require(client: AriaClient, name: str, what: str) -> None:
+    """NotSupported (exit 4) with plain words when the server does not list ``name``."""
+    if not client.supports(name):
+        raise NotSupported(name, f"this server does not {what} (it does not offer {name})")
+
+
+def stop_robot(client: AriaClient) -> None:
+    """``stop`` (zero ``ratioDrive`` where there is no ``stop``); never raises: we are ending."""
+    with contextlib.suppress(ClientError):
+        if client.supports("stop"):
+            client.send("stop")
+        elif client.supports("ratioDrive"):
+            client.send(RatioDrive(0.0, 0.0, 0.0))
+
+
+@dataclass(frozen=True)
+class Expect:
+    """Which outcome answers our command: ``target`` as the server names it (a goal, ``point``,
+    ``home``) for an arrival, or ``docked`` for the dock."""
+
+    target: str = ""
+    docked: bool = False
+
+    def answers(self, r: NavReading) -> bool:
+        if r.phase is NavPhase.FAILED:
+            return True
+        if r.phase is NavPhase.DOCKED:
+            return self.docked
+        return r.phase is NavPhase.ARRIVED and not self.docked and r.target == self.target
+
+
+class _Watch:
+    """The server's words (and pose, path, dock state) as they come, on the command's loop."""
+
+    def __init__(self) -> None:
+        self.status = ""
+        self.mode_name = ""
+        self.dock_state: str | None = None
+        self.pose: tuple[float, float, float] | None = None
+        self.path: tuple[tuple[int, int], ...] = ()
+        self.loc: LocState | None = None
+        self.changed = asyncio.Event()
+
+    def reading(self) -> NavReading:
+        r = read_status(self.status, self.mode_name)
+        if r.phase is NavPhase.IDLE and self.dock_state in ("Docking", "Docked"):
+            phase = NavPhase.GOING if self.dock_state == "Docking" else NavPhase.DOCKED
+            return NavReading(phase, "dock", text=self.dock_state)
+        return r
+
+    def handler(self, apply: Callable[[Any], None]) -> Callable[[Packet], None]:
+        def on_packet(packet: Packet) -> None:
+            try:
+                value = decode_payload(packet.name, Side.REPLY, packet.payload)
+            except ProtocolError:
+                return  # one bad packet: the next one will do
+            apply(value)
+            self.changed.set()
+
+        return on_packet
+
+    def on_strings(self, s: Any) -> None:
+        if isinstance(s, UpdateStrings):
+            self.status = s.status
+        elif isinstance(s, Update):
+            self.status = s.status
+            self._numbers(s.numbers)
+
+    def on_numbers(self, n: Any) -> None:
+        if isinstance(n, UpdateNumbers):
+            self._numbers(n)
+
+    def _numbers(self, n: UpdateNumbers) -> None:
+        self.pose = (float(n.x), float(n.y), float(n.th))
+
+    def on_mode(self, m: Any) -> None:
+        if isinstance(m, ModeInfo):
+            self.mode_name = m.mode_name
+
+    def on_path(self, p: Any) -> None:
+        if isinstance(p, PlannedPath):
+            self.path = p.points
+
+    def on_dock(self, d: Any) -> None:
+        if isinstance(d, DockInfo):
+            self.dock_state = d.state_label
+
+    def on_loc(self, loc: Any) -> None:
+        if isinstance(loc, LocState):
+            self.loc = loc
+
+    def subscribe(self, client: AriaClient) -> None:
+        if client.supports("updateStrings"):
+            client.request("updateStrings", STATUS_MS, self.handler(self.on_strings))
+        elif client.supports("update"):
+            client.request("update", STATUS_MS, self.handler(self.on_strings))
+        if client.supports("updateNumbers"):
+            client.request("updateNumbers", STATUS_MS * 2, self.handler(self.on_numbers))
+        if client.supports("getModeInfo"):
+            client.request("getModeInfo", -1, self.handler(self.on_mode))
+        if client.supports("getPath"):
+            client.request("getPath", PATH_MS, self.handler(self.on_path))
+        if client.supports("dockInfo"):
+            client.request("dockInfo", STATUS_MS * 2, self.handler(self.on_dock))
+        if client.supports("getLocState"):
+            client.request("getLocState", STATUS_MS, self.handler(self.on_loc))
+
+    async def first(self, client: AriaClient, timeout: float) -> None:
+        """Wait (bounded) for the first status, so what the server said *before* our command is known."""
+        if not (client.supports("updateStrings") or client.supports("update")):
+            return
+        with contextlib.suppress(TimeoutError):
+            async with asyncio.timeout(timeout):
+                while not self.status:
+                    self.changed.clear()
+                    await self.changed.wait()
+
+
+def _say(args: argparse.Namespace, obj: dict[str, Any], line: str) -> None:
+    if args.json:
+        print_json(obj)
+    else:
+        print(line, flush=True)
+
+
+def _pose_fields(watch: _Watch) -> dict[str, Any]:
+    if watch.pose is None:
+        return {"x": None, "y": None, "th": None}
+    x, y, th = watch.pose
+    return {"x": x, "y": y, "th": th}
+
+
+async def navigate(client: AriaClient, args: argparse.Namespace, payload: Payload, expect: Expect) -> int:
+    """Send ``payload`` and follow the server's words until ``expect`` answers; the exit code."""
+    watch = _Watch()
+    watch.subscribe(client)
+    await watch.first(client, args.timeout)
+    before = watch.reading()
+    client.send(payload)
+    if args.no_wait:
+        _say(args, {"sent": type(payload).DATA_NAME}, f"sent {type(payload).DATA_NAME}")
+        await client.flush()
+        return EXIT_OK
+    return await _follow(client, args, watch, before, expect)
+
+
+async def _follow(
+    client: AriaClient, args: argparse.Namespace, watch: _Watch, before: NavReading, expect: Expect
+) -> int:
+    loop = asyncio.get_running_loop()
+    sent_at = loop.time()
+    shown = ""
+    seen_going = False
+    distance_at, distance_shown = 0.0, None
+    interrupts = current_interrupts()
+    try:
+        async with asyncio.timeout(args.limit):
+            while True:
+                r = watch.reading()
+                now = loop.time()
+                if r.text and r.text != shown and (r.text != before.text or now - sent_at >= SETTLE):
+                    shown = r.text
+                    _say(args, {"status": r.text, "phase": r.phase.value}, visible(r.text))
+                if r.phase is NavPhase.GOING:
+                    seen_going = True
+                    left = path_remaining(*watch.pose[:2], watch.path) if watch.pose and watch.path else None
+                    if (
+                        left is not None
+                        and now - distance_at >= DISTANCE_EVERY
+                        and (distance_shown is None or abs(left - distance_shown) >= DISTANCE_STEP_MM)
+                    ):
+                        distance_at, distance_shown = now, left
+                        _say(args, {"remaining_mm": round(left)}, f"  {left / 1000:.1f} m to go")
+                elif r.finished and expect.answers(r):
+                    fresh = seen_going or r.text != before.text or now - sent_at >= SETTLE
+                    if fresh:
+                        return _outcome(args, watch, r)
+                elif seen_going and (r.phase is NavPhase.IDLE or r.finished):
+                    # Stopped, driven, or finished somewhere else: someone took the robot over.
+                    return _ended(args, watch, r, "cancelled", EXIT_NAV_CANCELLED)
+                watch.changed.clear()
+                with contextlib.suppress(TimeoutError):
+                    async with asyncio.timeout(SETTLE / 3):
+                        await watch.changed.wait()
+    except TimeoutError:
+        stop_robot(client)
+        await client.flush()
+        _say(args, {"outcome": "timeout", **_pose_fields(watch)}, "no outcome in time: the robot was stopped")
+        print(f"rtmu {args.subcommand}: no outcome within {args.limit:g} s; stop sent", file=sys.stderr)
+        return EXIT_TIMEOUT
+    except asyncio.CancelledError:
+        signum = interrupts.take()
+        if signum is None:
+            raise
+        stop_robot(client)  # the stop first, before anything is printed
+        await client.flush()
+        raise Interrupted(signum, "the robot was stopped") from None
+
+
+def _outcome(args: argparse.Namespace, watch: _Watch, r: NavReading) -> int:
+    if r.phase is NavPhase.FAILED:
+        lost = r.reason == "the robot is lost"
+        code = EXIT_NAV_LOST if lost else EXIT_NAV_FAILED
+        return _ended(args, watch, r, "failed", code)
+    return _ended(args, watch, r, r.phase.value, EXIT_OK)
+
+
+def _ended(args: argparse.Namespace, watch: _Watch, r: NavReading, outcome: str, code: int) -> int:
+    obj = {"outcome": outcome, "text": r.text, "reason": r.reason, **_pose_fields(watch)}
+    if args.json:
+        print_json(obj)
+    elif code != EXIT_OK:
+        why = r.sentence() or r.text or "it stopped before arriving"
+        print(f"rtmu {args.subcommand}: {visible(why)}", file=sys.stderr)
+    return code
+
+
+# -- localization ------------------------------------------------------------------------------
+async def localize(client: AriaClient, args: argparse.Namespace, payload: Payload) -> int:
+    """Send ``localizeToPose``; where ``getLocState`` is listed, wait until it says localized or lost."""
+    watch = _Watch()
+    if client.supports("getLocState"):
+        client.request("getLocState", STATUS_MS, watch.handler(watch.on_loc))
+    client.send(payload)
+    if args.no_wait or not client.supports("getLocState"):
+        note = "" if args.no_wait else " (the server offers no getLocState to confirm it)"
+        _say(args, {"sent": "localizeToPose"}, f"sent localizeToPose{note}")
+        await client.flush()
+        return EXIT_OK
+    loop = asyncio.get_running_loop()
+    sent_at = loop.time()
+    seen_initializing = False
+    interrupts = current_interrupts()
+    try:
+        async with asyncio.timeout(args.limit):
+            while True:
+                loc = watch.loc
+                now = loop.time()
+                if loc is not None:
+                    state = loc.state
+                    if state == LocalizationState.INITIALIZING and not seen_initializing:
+                        seen_initializing = True
+                        _say(args, {"localization": loc.state_label}, "localizing")
+                    settled = seen_initializing or now - sent_at >= SETTLE
+                    if settled and state in (LocalizationState.GOOD, LocalizationState.LOST):
+                        good = state == LocalizationState.GOOD
+                        obj = {"outcome": "localized" if good else "lost", "score": loc.score_fraction}
+                        line = f"localized (score {loc.score_fraction:.2f})" if good else "the robot is lost"
+                        _say(args, obj, line)
+                        if not good:
+                            print(f"rtmu {args.subcommand}: the robot is still lost", file=sys.stderr)
+                        return EXIT_OK if good else EXIT_NAV_LOST
+                watch.changed.clear()
+                with contextlib.suppress(TimeoutError):
+                    async with asyncio.timeout(SETTLE / 3):
+                        await watch.changed.wait()
+    except TimeoutError:
+        _say(args, {"outcome": "timeout"}, "no answer in time")
+        print(f"rtmu {args.subcommand}: not localized within {args.limit:g} s", file=sys.stderr)
+        return EXIT_TIMEOUT
+    except asyncio.CancelledError:
+        signum = interrupts.take()
+        if signum is None:
+            raise
+        raise Interrupted(signum) from None

@@ -1,0 +1,31 @@
+"""``rtmu dock HOST[:PORT]``: send the robot to its charger (``dock``) and follow it until docked."""
+
+from __future__ import annotations
+
+import argparse
+from typing import Any
+
+from ..client.connection import AriaClient
+from ..protocol.payloads.navigation import Dock
+from ._common import add_connection_arguments, run_with_client
+from ._navigate import EXIT_CODES_HELP, Expect, add_wait_arguments, navigate, require
+
+
+def register(subparsers: Any) -> None:
+    p = subparsers.add_parser(
+        "dock",
+        help="drive to the charger and dock (dock), and wait until docked",
+        description="Send dock: the server drives to its dock and says 'Docked' (LD robots: dockInfo says "
+        f"Docked). A drive command undocks again. Ctrl-C stops the robot. {EXIT_CODES_HELP}.",
+    )
+    add_connection_arguments(p)
+    add_wait_arguments(p)
+    p.set_defaults(handler=handle)
+
+
+def handle(args: argparse.Namespace) -> int:
+    async def body(client: AriaClient) -> int:
+        require(client, "dock", "dock")
+        return await navigate(client, args, Dock(), Expect(docked=True))
+
+    return run_with_client("dock", args, body)

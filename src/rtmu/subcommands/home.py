@@ -1,0 +1,31 @@
+"""``rtmu home HOST[:PORT]``: send the robot home (ARNL's ``home``) and follow it until it is there."""
+
+from __future__ import annotations
+
+import argparse
+from typing import Any
+
+from ..client.connection import AriaClient
+from ..protocol.payloads.navigation import Home
+from ._common import add_connection_arguments, run_with_client
+from ._navigate import EXIT_CODES_HELP, Expect, add_wait_arguments, navigate, require
+
+
+def register(subparsers: Any) -> None:
+    p = subparsers.add_parser(
+        "home",
+        help="drive home (ARNL: home), and wait until the robot is there",
+        description="Send home: the server drives to the map's home (or where the robot started) and says "
+        f"'Returned home'. Ctrl-C stops the robot. {EXIT_CODES_HELP}.",
+    )
+    add_connection_arguments(p)
+    add_wait_arguments(p)
+    p.set_defaults(handler=handle)
+
+
+def handle(args: argparse.Namespace) -> int:
+    async def body(client: AriaClient) -> int:
+        require(client, "home", "drive home")
+        return await navigate(client, args, Home(), Expect("home"))
+
+    return run_with_client("home", args, body)
