@@ -10,19 +10,22 @@ import json
 import signal
 import subprocess
 import sys
+import threading
+import time
 from collections.abc import Iterator
 
 import pytest
 
 from rtmu.cli import main
 from rtmu.exit_codes import EXIT_OK, EXIT_TIMEOUT, EXIT_UNSUPPORTED, EXIT_USAGE
+from rtmu.protocol.payloads.robot import ModeInfo
 from rtmu.sim import SimConfig, SimThread
 from rtmu.sim.ld_data import ld_state
 from rtmu.sim.profiles import PROFILES, SimProfile
 from rtmu.subcommands._navigate import EXIT_NAV_CANCELLED, EXIT_NAV_FAILED, EXIT_NAV_LOST
 
 from .navsim import OFFICE, fast_sim, reset, robot
-from .servers import ServerThread, TestServer
+from .servers import SPECS, ServerThread, TestServer
 from .uiqueue import eventually
 
 
@@ -112,8 +115,6 @@ def test_dock_exits_0_when_docked(home: SimThread, capsys: pytest.CaptureFixture
 
 
 def test_another_client_stopping_the_robot_exits_7(home: SimThread) -> None:
-    import threading
-
     assert home.server is not None
     server = home.server
 
@@ -223,3 +224,35 @@ def test_ld_robots_without_goto_goal_get_goto_route_goal(
     assert capsys.readouterr().err == "going to Lab A\n"
     eventually(lambda: ld_only.call(lambda: ld_state(server).route_goals) == ["Lab A"])  # type: ignore[arg-type]
     assert main(["goto", addr(ld_only), "--x", "1", "--y", "2", "--timeout", "5"]) == EXIT_UNSUPPORTED
+
+
+def test_hostile_status_text_is_escaped_and_bounded(capsys: pytest.CaptureFixture[str]) -> None:
+    specs = [*SPECS, ("gotoPose", "point", "byte4 byte4 byte4", "none", "Navigation", "RETURN_NONE")]
+    server_obj = TestServer(specs)
+
+    def on_once(side: object, name: str, args: bytes) -> None:
+        if name == "gotoPose":
+            server_obj.strings = ("Going to point\x1b[2J", "Goto point", "")
+
+    server_obj.on_once = on_once  # type: ignore[assignment]
+    with ServerThread(server_obj) as server:
+        server.handlers["getModeInfo"] = lambda side, args: [ModeInfo("Goto").encode()]
+
+        def fail_later() -> None:
+            eventually(lambda: server.strings[0].startswith("Going"), timeout=5)
+            time.sleep(0.5)
+            failed = "Failed to get to point because \x1b]0;pwned\x07" + "x" * 5000
+            server.strings = (failed, "Goto point", "")
+
+        thread = threading.Thread(target=fail_later)
+        thread.start()
+        try:
+            code = main(["goto", addr(server), "--x", "1", "--y", "2", "--timeout", "5", "--limit", "20"])
+        finally:
+            thread.join(10)
+    assert code == EXIT_NAV_FAILED
+    out, err = capsys.readouterr()
+    assert "\x1b" not in out + err and "\x07" not in out + err
+    assert out.splitlines()[0] == "Going to point\\x1b[2J"
+    assert err.startswith("rtmu goto: Failed to get to point because \\x1b]0;pwned\\x07xxx")
+    assert len(err) < 400  # the server's words are cut, not copied whole

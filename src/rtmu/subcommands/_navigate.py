@@ -48,7 +48,7 @@ DISTANCE_STEP_MM = 1000.0
 DISTANCE_EVERY = 2.0
 
 EXIT_CODES_HELP = (
-    "exit codes: 0 arrived (docked, localized), 2 usage or unknown goal, 3 connection or login failure, "
+    "Exit codes: 0 arrived (docked, localized), 2 usage or unknown goal, 3 connection or login failure, "
     f"4 the server does not navigate that way, 5 no outcome within --limit (the robot is stopped), "
     f"{EXIT_NAV_FAILED} the server could not get there, {EXIT_NAV_CANCELLED} stopped before arriving "
     f"(STOP, a drive, another goal), {EXIT_NAV_LOST} the robot is lost (localize it first), 128+N ended "
