@@ -46,6 +46,8 @@ from .state import (
     NavOutcome,
     NavState,
     Phase,
+    PopupsChanged,
+    PopupsState,
     RobotChanged,
     RobotState,
     StateChange,
@@ -63,6 +65,7 @@ __all__ = [
     "Observable",
     "OperatorState",
     "Phase",
+    "PopupsState",
     "RobotModel",
     "RobotState",
     "SpeedSetting",
@@ -190,6 +193,7 @@ class RobotModel:
         self.connection: Observable[ConnectionState] = Observable(ConnectionState())
         self.health: Observable[LinkHealth] = Observable(LinkHealth())
         self.navigation: Observable[NavState] = Observable(NavState())
+        self.popups: Observable[PopupsState] = Observable(PopupsState())
         self.trail = Trail()
         # The trail's observers run before any view's (added first), so a redraw sees the new point.
         self.robot.observe(self.trail.robot_moved)
@@ -210,6 +214,8 @@ class RobotModel:
                 self.health.set(value)
             case NavChanged(value):
                 self.navigation.set(value)
+            case PopupsChanged(value):
+                self.popups.set(value)
 
 
 # -- operator settings ---------------------------------------------------------------------------

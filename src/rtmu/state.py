@@ -204,6 +204,37 @@ class NavState:
         return name in self.offered
 
 
+# -- server popups -------------------------------------------------------------------------------
+
+
+@dataclass(frozen=True, slots=True)
+class PopupInfo:
+    """One open server popup (``popupCreate``), its texts already cut to a bounded length."""
+
+    popup_id: int
+    title: str
+    message: str
+    icon: int
+    """The wire's popup type: 0 none, 1 information, 2 warning, 3 critical, 4 question."""
+    buttons: tuple[str, ...]
+    """Three labels; the index is the button number the server expects, "" means no such button."""
+    default_button: int = 0
+    escape_button: int = 0
+    opened_at: float = field(default=0.0, compare=False)
+    """Monotonic seconds when it arrived (the card counts from here: the wire carries no timeout)."""
+
+
+@dataclass(frozen=True, slots=True)
+class PopupsState:
+    """The server popups open now, oldest first: at most a bounded number, the rest only counted."""
+
+    open: tuple[PopupInfo, ...] = ()
+    dropped: int = 0
+    """Popups that arrived while the list was full (kept out, never shown): a flooding server."""
+    offered: bool = False
+    """The server offers popups (``popupCreate``) at all."""
+
+
 # -- connection and link -------------------------------------------------------------------------
 
 
@@ -300,7 +331,14 @@ class NavChanged:
     value: NavState
 
 
-StateChange = RobotChanged | MapChanged | CameraChanged | ConnectionChanged | HealthChanged | NavChanged
+@dataclass(frozen=True, slots=True)
+class PopupsChanged:
+    value: PopupsState
+
+
+StateChange = (
+    RobotChanged | MapChanged | CameraChanged | ConnectionChanged | HealthChanged | NavChanged | PopupsChanged
+)
 """What the network side publishes: the class says which part changed, the value is the new whole."""
 
 

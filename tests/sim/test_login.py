@@ -87,6 +87,8 @@ OWN_WORDS = {
     "SimulatorLowBattery",
     "SimulatorRecharge",
     "SimulatorSetBattery",
+    "SimulatorPopup",
+    "SimulatorPopupFlood",
     "SimulatorVideo320x240",
     "SimulatorVideo640x480",
     "popupCreate",

@@ -52,6 +52,7 @@ from ..state import (
     StateChange,
 )
 from .connection import AriaClient, Packet
+from .custom_commands import CommandCatalogue, ServerCommand, list_commands, run_command
 from .diagnosis import explain
 from .errors import ClientError, ClientTimeout, MalformedReply, NotSupported, ProtocolFault, ServerClosed
 from .health import HealthMonitor, ping_data
@@ -60,6 +61,7 @@ from .lease import DriveGovernor, DriveLease, EndReason, SendRatios, SendStop
 from .mapcache import MapCache, map_key
 from .mapload import download_map, map_source
 from .nav_session import NavFeed
+from .popups import PopupFeed
 from .reconnect import Backoff, worth_retrying
 from .subscriptions import Subscription, applicable
 
@@ -175,6 +177,10 @@ class Session:
         self.nav.changed = self._sync_subscriptions
         self._held_subs: set[str] = set()
         """Conditional subscriptions (``only_while``) held now on this connection."""
+        self.popups = PopupFeed(
+            self._publish, self._notice, self._decode, self._spawn, self.config.reply_timeout
+        )
+        """Server popups (§4.9): the open set as PopupsChanged, closing words as Kind.SERVER notices."""
 
     # -- publishing --------------------------------------------------------------------------
     def _publish(self, change: StateChange) -> None:
@@ -239,6 +245,7 @@ class Session:
         self.nav.disconnected()
         self._set_map(MapModel())
         self._publish(CameraChanged(None))
+        self.popups.disconnected()
         self._set_connection(
             phase=Phase.CONNECTING, host=host, port=port, user=user, profile=profile,
             offers=frozenset(), error="", error_kind="", attempt=0, retry_in=None,
@@ -285,6 +292,7 @@ class Session:
         self._setup_subscriptions(client)
         self._set_connection(phase=Phase.CONNECTED, offers=offers, error="", error_kind="", retry_in=None)
         self._spawn(self._ping_loop(client), "ping")
+        self.popups.connected(client)  # after the popupCreate subscription: popupList's answers go there
         self._spawn(self._fetch_once_infos(client), "infos")
         if self.config.fetch_map:
             self._request_map()
@@ -304,6 +312,7 @@ class Session:
         self.nav.disconnected()
         self._set_map(MapModel())
         self._publish(CameraChanged(None))
+        self.popups.disconnected()
         self._set_connection(
             phase=Phase.DISCONNECTED, offers=frozenset(), error="", error_kind="", retry_in=None
         )
@@ -527,6 +536,30 @@ class Session:
 
     def _navigating(self) -> bool:
         return self.nav.navigating
+    def _on_popup_create(self, packet: Packet) -> None:
+        self.popups.on_create(packet)
+
+    def _on_popup_close(self, packet: Packet) -> None:
+        self.popups.on_close(packet)
+
+    # -- the server's own commands (protocol §4.10) and popup answers ---------------------------
+    async def list_commands(self) -> CommandCatalogue:
+        """The simple and string commands this user may run (NotSupported where none are listed)."""
+        return await list_commands(self._require_connected(), self.config.reply_timeout)
+
+    async def run_command(self, command: ServerCommand, argument: str | None = None) -> bool:
+        """Send it; True once the server answered a request sent after it (it has taken it)."""
+        return await run_command(self._require_connected(), command, argument, self.config.reply_timeout)
+
+    def answer_popup(self, popup_id: int, button: int) -> None:
+        self.popups.click(popup_id, button)
+
+    def _require_connected(self) -> AriaClient:
+        client = self.client
+        if client is None or not client.connected:
+            raise ServerClosed("not connected")
+        return client
+
 
     def _goal_pose(self, name: str) -> tuple[float, float, float | None] | None:
         """The loaded map's goal called ``name``: (x, y, heading — only for a ``GoalWithHeading``)."""
@@ -959,6 +992,8 @@ SUBSCRIPTIONS: tuple[SessionSubscription, ...] = (
 
 _WIFI_WORDS = ("wireless", "wifi", "wi-fi", "wlan")
 
+    Subscription("popupCreate", -1, Session._on_popup_create),
+    Subscription("popupClose", -1, Session._on_popup_close),
 
 def _wifi_role(label: str) -> str | None:
     """Which RobotState field a ``getStrings`` item feeds, judged from its label."""

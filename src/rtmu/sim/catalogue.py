@@ -370,6 +370,22 @@ SIM_COMMANDS: tuple[Row, ...] = (
         "CustomCommands",
         "RETURN_NONE",
     ),
+    (
+        "SimulatorPopup",
+        "Raises a popup on every client: title|message|button labels, comma separated|timeout in seconds",
+        "string: argumentToCommand",
+        "none",
+        "CustomCommands",
+        "RETURN_NONE",
+    ),
+    (
+        "SimulatorPopupFlood",
+        "Raises popups as fast as a hostile server would: popups per second, then seconds (e.g. 1000 3)",
+        "string: argumentToCommand",
+        "none",
+        "CustomCommands",
+        "RETURN_NONE",
+    ),
 )
 
 VIDEO_COMMANDS: tuple[Row, ...] = (
@@ -647,7 +663,7 @@ DRAWINGS: tuple[Row, ...] = (
     ),
 )
 
-STRING_COMMANDS = frozenset({"SimulatorSetBattery"})
+STRING_COMMANDS = frozenset({"SimulatorSetBattery", "SimulatorPopup", "SimulatorPopupFlood"})
 """Simple commands that take one string argument (``listStringCommands``)."""
 
 

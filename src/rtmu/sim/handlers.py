@@ -70,7 +70,7 @@ from rtmu.protocol.payloads.strings import StringItem, Strings, StringsInfo
 
 from . import p3dx
 from .camera import PAN_RANGE, TILT_RANGE, ZOOM_RANGE
-from .catalogue import STRING_COMMANDS
+from .catalogue import STRING_COMMANDS, Row
 from .robot import normalize_deg
 
 if TYPE_CHECKING:
@@ -615,14 +615,49 @@ def _strings(call: Call) -> Iterable[Reply]:
 # -- simple commands ------------------------------------------------------------------------
 @handles("listCommands")
 def _list_commands(call: Call) -> Iterable[Reply]:
-    rows = [r for r in call.server.custom_commands() if r[0] not in STRING_COMMANDS]
+    rows = [r for r in _may_run(call) if r[0] not in STRING_COMMANDS]
     return (CommandList(tuple(CommandEntry(r[0], r[1]) for r in rows)).encode(),)
 
 
 @handles("listStringCommands")
 def _list_string_commands(call: Call) -> Iterable[Reply]:
-    rows = [r for r in call.server.custom_commands() if r[0] in STRING_COMMANDS]
+    rows = [r for r in _may_run(call) if r[0] in STRING_COMMANDS]
     return (StringCommandList(tuple(CommandEntry(r[0], r[1]) for r in rows)).encode(),)
+
+
+def _may_run(call: Call) -> list[Row]:
+    """The commands this client's user may run: ARIA's lists name them all, we list by group."""
+    return [r for r in call.server.custom_commands() if call.session.may_use(r[4])]
+
+
+@handles("SimulatorPopup")
+def _popup_command(call: Call) -> Iterable[Reply]:
+    text = decode_lenient(StringCommandArgs, call.args).argument
+    parts = text.split("|")
+    title = parts[0] if parts else ""
+    message = parts[1] if len(parts) > 1 else ""
+    labels = tuple(b.strip() for b in parts[2].split(",")) if len(parts) > 2 and parts[2].strip() else ("OK",)
+    try:
+        timeout = float(parts[3]) if len(parts) > 3 else 0.0
+    except ValueError:
+        timeout = 0.0
+    timeout = timeout if math.isfinite(timeout) and 0 <= timeout <= 3600 else 0.0
+    buttons = (*labels, "", "", "")[:3]
+    kind = 4 if len(labels) > 1 else 1
+    call.world.create_popup(title, message, kind=kind, buttons=buttons, timeout=timeout)
+    return ()
+
+
+@handles("SimulatorPopupFlood")
+def _popup_flood(call: Call) -> Iterable[Reply]:
+    words = decode_lenient(StringCommandArgs, call.args).argument.split()
+    try:
+        rate, seconds = float(words[0]), float(words[1])
+    except (ValueError, IndexError):
+        return ()
+    if math.isfinite(rate) and math.isfinite(seconds):
+        call.world.flood_popups(min(rate, 5000.0), min(seconds, 60.0))
+    return ()
 
 
 @handles("ResetTripOdometer")

@@ -62,6 +62,11 @@ class Popup:
     default_button: int = 0
     escape_button: int = 0
     timeout: float = 0.0
+    """Seconds until the server closes it with ``timeout_text`` (0: never), as ARIA's popup handler."""
+    timeout_text: str = "No answer"
+    pressed: tuple[str, str, str] = ("", "", "")
+    """What ``popupClose`` says after each button (ARIA's ``buttonNPressed``; "" = the button's label)."""
+    created_at: float = 0.0
 
 
 @dataclass
@@ -130,6 +135,12 @@ class World:
         self._sonar_cache: tuple[tuple[float, float, float], list[tuple[int, int]]] | None = None
         self.popups: dict[int, Popup] = {}
         self._next_popup_id = 1
+        self.popup_clicks: list[tuple[int, int]] = []
+        """Every ``popupClicked`` received, (id, button), for tests to check at the simulator."""
+        self.popup_flood: tuple[float, float] | None = None
+        """(popups per second, until world time): a hostile server raising popups as fast as it can."""
+        self._flood_due = 0.0
+        self._popup_check_at = 0.0
         self._low_battery_warned = False
         self.last_activity = 0.0
         self.received_ratios: tuple[float, float, float, float] | None = None
@@ -271,6 +282,7 @@ class World:
         ):
             self.stop()
         self._check_battery()
+        self._check_popups()
         self.check_strings()
 
     def check_strings(self) -> None:
@@ -301,19 +313,72 @@ class World:
         self.set_battery(p3dx.BATTERY_FULL_V)
 
     # -- popups ---------------------------------------------------------------
-    def create_popup(self, title: str, message: str, *, kind: int = 1, buttons=("OK", "", "")) -> Popup:
-        popup = Popup(self._next_popup_id, "", title, message, kind, tuple(buttons))
+    def create_popup(
+        self,
+        title: str,
+        message: str,
+        *,
+        kind: int = 1,
+        buttons=("OK", "", ""),
+        timeout: float = 0.0,
+        timeout_text: str = "No answer",
+        pressed: tuple[str, str, str] = ("", "", ""),
+        default_button: int = 0,
+        escape_button: int = 0,
+    ) -> Popup:
+        labels = (*buttons, "", "", "")[:3]
+        popup = Popup(
+            self._next_popup_id, "", title, message, kind, labels, default_button, escape_button,
+            timeout, timeout_text, pressed, self.time,
+        )  # fmt: skip
         self._next_popup_id += 1
         self.popups[popup.id] = popup
         self.changes.popups_created.append(popup)
         return popup
 
     def click_popup(self, popup_id: int, button: int) -> None:
+        self.popup_clicks.append((popup_id, button))
+        del self.popup_clicks[:-1000]
         popup = self.popups.pop(popup_id, None)
         if popup is None:
             return
-        label = popup.buttons[button] if 0 <= button < 3 else ""
-        self.changes.popups_closed.append((popup_id, label))
+        if 0 <= button < 3:
+            text = popup.pressed[button] or f"{popup.buttons[button]} pressed"
+        else:
+            text = "Closed: no such button"  # a button the popup never offered
+        self.changes.popups_closed.append((popup_id, text))
+
+    def close_popup(self, popup_id: int, text: str) -> bool:
+        """Close it from the server's side (its program decided): every client hears ``popupClose``."""
+        if self.popups.pop(popup_id, None) is None:
+            return False
+        self.changes.popups_closed.append((popup_id, text))
+        return True
+
+    def flood_popups(self, per_second: float, seconds: float) -> None:
+        """Raise ``per_second`` popups for ``seconds`` (each closes itself after 2 s): a hostile server."""
+        self.popup_flood = (per_second, self.time + seconds) if per_second > 0 and seconds > 0 else None
+        self._flood_due = self.time
+
+    def _check_popups(self) -> None:
+        flood = self.popup_flood
+        if flood is not None:
+            rate, until = flood
+            while self._flood_due <= min(self.time, until):
+                n = self._next_popup_id
+                self.create_popup(
+                    f"Flood <b>{n}</b> & co", f"Popup {n} of a flood: <i>plain</i> text & no markup",
+                    kind=2, buttons=("OK", "Cancel", ""), timeout=2.0,
+                )  # fmt: skip
+                self._flood_due += 1.0 / rate
+            if self.time >= until:
+                self.popup_flood = None
+        if self.time < self._popup_check_at:
+            return
+        self._popup_check_at = self.time + 0.1  # ARIA looks once a second; a tenth is close enough
+        for popup in list(self.popups.values()):
+            if popup.timeout > 0 and self.time - popup.created_at >= popup.timeout - 1e-9:
+                self.close_popup(popup.id, popup.timeout_text)
 
     # -- questions --------------------------------------------------------------
     def strings(self) -> tuple[str, str, str]:

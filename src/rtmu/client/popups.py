@@ -1,0 +1,157 @@
+"""Server popups for one session (protocol §4.9): what is open, answers, and the closing words.
+
+:class:`PopupFeed` is fed the session's ``popupCreate`` / ``popupClose`` packets (subscriptions
+in the session's table) and asks ``popupList`` once per login, so a reconnect shows again what the
+server still has open. It publishes the open set as one typed :class:`~rtmu.state.PopupsChanged`
+and the server's closing text as a ``Kind.SERVER`` notice. Server text is untrusted: titles,
+messages and labels are cut to a bounded length, and at most :data:`MAX_OPEN` popups are kept —
+a flood beyond that is only counted. Publishing is coalesced to once per loop turn, so a burst of
+a thousand popups costs the UI thread one update, not a thousand.
+"""
+
+from __future__ import annotations
+
+import asyncio
+import contextlib
+import time
+from collections.abc import Callable, Coroutine
+from typing import Any
+
+from ..notices import Kind, Notice
+from ..protocol.payloads.popup import PopupClicked, PopupClose, PopupCreate
+from ..state import PopupInfo, PopupsChanged, PopupsState
+from .connection import AriaClient, Packet
+from .errors import ClientError, NotSupported, ServerClosed
+
+MAX_OPEN = 64
+"""Open popups kept; more are counted in ``PopupsState.dropped`` (a window shows only a few anyway)."""
+MAX_TITLE = 200
+MAX_MESSAGE = 2000
+MAX_LABEL = 40
+MAX_CLOSE_TEXT = 300
+
+Publish = Callable[[PopupsChanged], None]
+NoticeFn = Callable[[Notice], None]
+Decode = Callable[[str, bytes], Any]
+Spawn = Callable[[Coroutine[Any, Any, None], str], None]
+
+
+def cut(text: str, limit: int) -> str:
+    """At most ``limit`` characters; a cut text ends in "…" so the operator sees it was cut."""
+    return text if len(text) <= limit else text[: limit - 1] + "…"
+
+
+def popup_info(p: PopupCreate, at: float) -> PopupInfo:
+    labels = tuple(cut(b, MAX_LABEL) for b in p.buttons[:3])
+    return PopupInfo(
+        p.popup_id,
+        cut(p.title, MAX_TITLE),
+        cut(p.message, MAX_MESSAGE),
+        p.popup_type if 0 <= p.popup_type <= 4 else 0,
+        labels + ("",) * (3 - len(labels)),
+        p.default_button,
+        p.escape_button,
+        at,
+    )
+
+
+class PopupFeed:
+    """The open popups of one session (network loop only)."""
+
+    def __init__(
+        self,
+        publish: Publish,
+        notice: NoticeFn,
+        decode: Decode,
+        spawn: Spawn,
+        reply_timeout: float,
+        clock: Callable[[], float] = time.monotonic,
+    ) -> None:
+        self._publish = publish
+        self._notice = notice
+        self._decode = decode
+        self._spawn = spawn
+        self._timeout = reply_timeout
+        self._clock = clock
+        self._open: dict[int, PopupInfo] = {}
+        self._dropped = 0
+        self._offered = False
+        self._client: AriaClient | None = None
+        self._dirty = False
+        self.state = PopupsState()
+
+    # -- connection --------------------------------------------------------------------------
+    def connected(self, client: AriaClient) -> None:
+        """A fresh login: forget the last link's popups and ask this server which are open."""
+        self._client = client
+        self._open.clear()
+        self._dropped = 0
+        self._offered = client.supports("popupCreate")
+        self._flush()
+        if self._offered and client.supports("popupList"):
+            self._spawn(self._list(client), "popup-list")
+
+    def disconnected(self) -> None:
+        self._client = None
+        self._open.clear()
+        self._dropped = 0
+        self._offered = False
+        self._flush()
+
+    async def _list(self, client: AriaClient) -> None:
+        # The open ones come as popupCreate packets (the subscription hears them), then an empty
+        # popupList packet ends the reply.
+        with contextlib.suppress(ClientError):
+            await client.request_once("popupList", timeout=self._timeout)
+
+    # -- packets -----------------------------------------------------------------------------
+    def on_create(self, packet: Packet) -> None:
+        p = self._decode(packet.name, packet.payload)
+        if not isinstance(p, PopupCreate):
+            return
+        if p.popup_id not in self._open and len(self._open) >= MAX_OPEN:
+            self._dropped += 1
+        else:
+            self._open[p.popup_id] = popup_info(p, self._clock())
+        self._changed()
+
+    def on_close(self, packet: Packet) -> None:
+        c = self._decode(packet.name, packet.payload)
+        if not isinstance(c, PopupClose):
+            return
+        gone = self._open.pop(c.popup_id, None)
+        if gone is None:
+            return  # not one we show (dropped in a flood, or closed twice): nothing to say
+        self._changed()
+        text = cut(c.message.strip(), MAX_CLOSE_TEXT)
+        if text:
+            self._notice(Notice.info(Kind.SERVER, f"{gone.title}: {text}" if gone.title else text))
+
+    # -- answers -----------------------------------------------------------------------------
+    def click(self, popup_id: int, button: int) -> None:
+        """The operator pressed ``button`` (0–2): tell the server; its ``popupClose`` removes the card."""
+        client = self._client
+        if client is None or not client.connected:
+            raise ServerClosed("not connected")
+        if not client.supports("popupClicked"):
+            raise NotSupported("popupClicked")
+        if not 0 <= button <= 2:
+            raise ValueError(f"a popup has buttons 0–2, not {button}")
+        client.send(PopupClicked(popup_id, button))
+
+    # -- publishing (coalesced) --------------------------------------------------------------
+    def _changed(self) -> None:
+        if self._dirty:
+            return
+        self._dirty = True
+        try:
+            asyncio.get_running_loop().call_soon(self._flush)
+        except RuntimeError:  # no loop (a test feeding packets by hand): publish now
+            self._flush()
+
+    def _flush(self) -> None:
+        self._dirty = False
+        state = PopupsState(tuple(self._open.values()), self._dropped, self._offered)
+        if state != self.state:
+            self.state = state
+            self._publish(PopupsChanged(state))
