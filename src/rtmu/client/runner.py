@@ -335,6 +335,18 @@ class ClientRunner:
     def load_map(self) -> concurrent.futures.Future[Any]:
         return self._fire(self._session.load_map, kind=Kind.MAP)
 
+    # -- the server's own commands and popups ---------------------------------------------------
+    def list_commands(self) -> concurrent.futures.Future[Any]:
+        """A :class:`~rtmu.client.custom_commands.CommandCatalogue` of what this user may run."""
+        return self._fire(self._session.list_commands)
+
+    def run_command(self, command: Any, argument: str | None = None) -> concurrent.futures.Future[bool]:
+        """Send a listed command; the Future says whether the server took it (False: it stayed silent)."""
+        return self._fire(self._session.run_command, command, argument)
+
+    def answer_popup(self, popup_id: int, button: int) -> concurrent.futures.Future[None]:
+        return self._fire(self._session.answer_popup, popup_id, button, kind=Kind.SERVER)
+
     # -- navigation: the server drives; a refusal comes back as a Kind.NAVIGATION notice -------
     def goto_goal(self, name: str) -> concurrent.futures.Future[None]:
         return self._fire(self._session.goto_goal, name, kind=Kind.NAVIGATION)
@@ -372,18 +384,6 @@ class ClientRunner:
                 self.post(lambda: done(result))
 
         def finished(f: concurrent.futures.Future[T]) -> None:
-    # -- the server's own commands and popups ---------------------------------------------------
-    def list_commands(self) -> concurrent.futures.Future[Any]:
-        """A :class:`~rtmu.client.custom_commands.CommandCatalogue` of what this user may run."""
-        return self._fire(self._session.list_commands)
-
-    def run_command(self, command: Any, argument: str | None = None) -> concurrent.futures.Future[bool]:
-        """Send a listed command; the Future says whether the server took it (False: it stayed silent)."""
-        return self._fire(self._session.run_command, command, argument)
-
-    def answer_popup(self, popup_id: int, button: int) -> concurrent.futures.Future[None]:
-        return self._fire(self._session.answer_popup, popup_id, button, kind=Kind.SERVER)
-
             if f.cancelled() or f.exception() is not None:
                 if f.exception() is not None:
                     log.warning("background call failed: %s", f.exception())

@@ -175,12 +175,12 @@ class Session:
         )
         """Navigation (ARNL): goals, path, outcome, localization — read from what the server lists."""
         self.nav.changed = self._sync_subscriptions
-        self._held_subs: set[str] = set()
-        """Conditional subscriptions (``only_while``) held now on this connection."""
         self.popups = PopupFeed(
             self._publish, self._notice, self._decode, self._spawn, self.config.reply_timeout
         )
         """Server popups (§4.9): the open set as PopupsChanged, closing words as Kind.SERVER notices."""
+        self._held_subs: set[str] = set()
+        """Conditional subscriptions (``only_while``) held now on this connection."""
 
     # -- publishing --------------------------------------------------------------------------
     def _publish(self, change: StateChange) -> None:
@@ -243,9 +243,9 @@ class Session:
         self._robot = RobotState()
         self._publish(RobotChanged(self._robot))
         self.nav.disconnected()
+        self.popups.disconnected()
         self._set_map(MapModel())
         self._publish(CameraChanged(None))
-        self.popups.disconnected()
         self._set_connection(
             phase=Phase.CONNECTING, host=host, port=port, user=user, profile=profile,
             offers=frozenset(), error="", error_kind="", attempt=0, retry_in=None,
@@ -290,9 +290,9 @@ class Session:
         offers = frozenset(e.name for e in client.datalist)
         self.nav.connected(client)
         self._setup_subscriptions(client)
+        self.popups.connected(client)  # after the popupCreate subscription: popupList's answers go there
         self._set_connection(phase=Phase.CONNECTED, offers=offers, error="", error_kind="", retry_in=None)
         self._spawn(self._ping_loop(client), "ping")
-        self.popups.connected(client)  # after the popupCreate subscription: popupList's answers go there
         self._spawn(self._fetch_once_infos(client), "infos")
         if self.config.fetch_map:
             self._request_map()
@@ -310,9 +310,9 @@ class Session:
         self._robot = RobotState()
         self._publish(RobotChanged(self._robot))
         self.nav.disconnected()
+        self.popups.disconnected()
         self._set_map(MapModel())
         self._publish(CameraChanged(None))
-        self.popups.disconnected()
         self._set_connection(
             phase=Phase.DISCONNECTED, offers=frozenset(), error="", error_kind="", retry_in=None
         )
@@ -534,8 +534,6 @@ class Session:
     def _on_path(self, packet: Packet) -> None:
         self.nav.on_path(packet)
 
-    def _navigating(self) -> bool:
-        return self.nav.navigating
     def _on_popup_create(self, packet: Packet) -> None:
         self.popups.on_create(packet)
 
@@ -560,6 +558,8 @@ class Session:
             raise ServerClosed("not connected")
         return client
 
+    def _navigating(self) -> bool:
+        return self.nav.navigating
 
     def _goal_pose(self, name: str) -> tuple[float, float, float | None] | None:
         """The loaded map's goal called ``name``: (x, y, heading — only for a ``GoalWithHeading``)."""
@@ -986,14 +986,14 @@ SUBSCRIPTIONS: tuple[SessionSubscription, ...] = (
     Subscription("getLocState", lambda c: c.loc_state_interval_ms, Session._on_loc_state),
     Subscription("goalsUpdated", -1, Session._on_goals_updated, needs="getGoals"),
     Subscription("getPath", lambda c: c.path_interval_ms, Session._on_path, only_while=Session._navigating),
+    Subscription("popupCreate", -1, Session._on_popup_create),
+    Subscription("popupClose", -1, Session._on_popup_close),
 )
 """What a session subscribes to on every connection, in this order, where the server offers it."""
 
 
 _WIFI_WORDS = ("wireless", "wifi", "wi-fi", "wlan")
 
-    Subscription("popupCreate", -1, Session._on_popup_create),
-    Subscription("popupClose", -1, Session._on_popup_close),
 
 def _wifi_role(label: str) -> str | None:
     """Which RobotState field a ``getStrings`` item feeds, judged from its label."""
