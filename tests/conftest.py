@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import os
+import tempfile
 from pathlib import Path
 
 import pytest
@@ -10,6 +11,10 @@ from hypothesis import settings
 
 REPO_ROOT = Path(__file__).resolve().parents[1]
 SHARED_DIR = REPO_ROOT.parent / "shared"
+
+# The window records every session (rtmu.recorder) under $XDG_DATA_HOME: never into the real home
+# from a test, nor from the windows and subprocesses tests start (they inherit this environment).
+os.environ["XDG_DATA_HOME"] = tempfile.mkdtemp(prefix="rtmu-test-data-")
 
 # Hypothesis's own "ci" profile (deterministic, no deadline) loads itself when CI is set. Locally we
 # only drop the 200 ms deadline: other work shares these two cores, and speed is bench/'s business.

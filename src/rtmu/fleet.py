@@ -20,14 +20,18 @@ from __future__ import annotations
 import concurrent.futures
 import time
 from collections.abc import Callable
-from typing import Any
+from pathlib import Path
+from typing import Any, cast
 
 from .client.runner import ClientRunner, Post, call_directly, settle
 from .client.session import SessionConfig
 from .commands import COMMANDS, CommandRegistry
-from .controller import Controller, NoView, SecretStore, View
+from .controller import ClientLink, Controller, NoView, SecretStore, View
 from .model import Observable, OperatorState, RobotModel
-from .settings import Profile
+from .recorder import Recorder, RecorderConfig
+from .recorder.files import recordings_dir
+from .recorder.intents import IntentTap
+from .settings import Profile, RecordingSettings
 
 CLOSE_TIMEOUT = 1.5
 """How long closing one session may take (stop, disconnect, end the network thread)."""
@@ -48,13 +52,20 @@ class RobotSession:
         secrets: SecretStore | None = None,
         clock: Callable[[], float] = time.monotonic,
         registry: CommandRegistry = COMMANDS,
+        recording: RecordingSettings | None = None,
     ) -> None:
         self.state = RobotModel()
-        self.runner = ClientRunner(self.state, post=post, clock=clock, config=config)
+        self.recorder = recorder_for(recording)
+        """This robot's flight recorder (None when recording is off: the default outside the window)."""
+        opener = self.recorder.opener() if self.recorder is not None else None
+        self.runner = ClientRunner(self.state, post=post, clock=clock, config=config, opener=opener)
+        link: ClientLink = self.runner
+        if self.recorder is not None:
+            link = cast(ClientLink, self._record_into(self.recorder))
         self.controller = Controller(
             self.state,
             operator,
-            self.runner,
+            link,
             NoView(),
             clock=clock,
             registry=registry,
@@ -62,6 +73,11 @@ class RobotSession:
             profile=profile,
         )
         self.closed = False
+
+    def _record_into(self, recorder: Recorder) -> IntentTap:
+        """Hook every source of the recording to ``recorder``; the controller's link, tapped for intents."""
+        recorder.attach(self.runner)
+        return IntentTap(self.runner, recorder.intent)
 
     @property
     def name(self) -> str:
@@ -92,6 +108,19 @@ class RobotSession:
         self.controller.stop()
         self.controller.close()
         self.runner.close(timeout)
+        if self.recorder is not None:
+            self.recorder.close(timeout)
+
+
+def recorder_for(settings: RecordingSettings | None) -> Recorder | None:
+    """A recorder as ``settings`` say (None: off). The window passes its settings; tests and scripts none."""
+    if settings is None or not settings.enabled:
+        return None
+    directory = Path(settings.directory) if settings.directory else recordings_dir()
+    config = RecorderConfig(
+        directory, max_bytes=settings.max_file_mb * 1_000_000, keep_days=settings.keep_days
+    )
+    return Recorder(config)
 
 
 class Fleet:

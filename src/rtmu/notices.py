@@ -39,6 +39,8 @@ class Kind(Enum):
     SERVER = "server"
     """Text the server raised for the operator (popups, messages): shown as it is, never routed by it."""
     NAVIGATION = "navigation"
+    RECORDING = "recording"
+    """The flight recorder: it stopped (full disk, size limit) or could not start."""
     GENERAL = "general"
 
 

@@ -100,6 +100,35 @@ class Profile:
         return f"{self.user}@{self.host}:{self.port}"
 
 
+@dataclass(frozen=True, slots=True)
+class RecordingSettings:
+    """The flight recorder (``rtmu.recorder``): every connection of the window is written to an MCAP file.
+
+    In the settings file as an optional table::
+
+        [recording]
+        enabled = true
+        directory = ""        # "" = $XDG_DATA_HOME/rtmu/recordings
+        max_file_mb = 1024    # one file stops growing here (the recording ends with a notice)
+        keep_days = 30        # older recordings are deleted when a new one starts; 0 keeps all
+    """
+
+    enabled: bool = True
+    directory: str = ""
+    max_file_mb: int = 1024
+    keep_days: int = 30
+
+    def validate(self) -> None:
+        if not 1 <= self.max_file_mb <= 1_000_000:
+            raise ValueError(f"recording: max_file_mb {self.max_file_mb} is not 1…1000000")
+        if not 0 <= self.keep_days <= 100_000:
+            raise ValueError(f"recording: keep_days {self.keep_days} is not 0…100000")
+        if len(self.directory) > 4096 or (self.directory and not os.path.isabs(self.directory)):
+            raise ValueError("recording: directory must be an absolute path (or empty for the default)")
+
+
+_RECORDING_TYPES: dict[str, type] = {"enabled": bool, "directory": str, "max_file_mb": int, "keep_days": int}
+
 _TYPES: dict[str, type] = {
     "host": str,
     "port": int,
@@ -118,6 +147,7 @@ _TYPES: dict[str, type] = {
 class Settings:
     profiles: dict[str, Profile] = field(default_factory=dict)
     last_profile: str | None = None
+    recording: RecordingSettings = field(default_factory=RecordingSettings)
 
     def current(self) -> Profile:
         """The profile used last, else the first one, else a default local one."""
@@ -174,7 +204,7 @@ def parse_settings(text: str) -> Settings:
     version = doc.get("version")
     if version != SCHEMA_VERSION:
         raise SettingsError(f"unknown settings version {version!r} (this RTMU writes {SCHEMA_VERSION})")
-    unknown = set(doc) - {"version", "last_profile", "profiles"}
+    unknown = set(doc) - {"version", "last_profile", "profiles", "recording"}
     if unknown:
         raise SettingsError(f"unknown settings: {', '.join(sorted(unknown))}")
     raw_profiles = doc.get("profiles", {})
@@ -189,7 +219,27 @@ def parse_settings(text: str) -> Settings:
     if last is not None and not isinstance(last, str):
         raise SettingsError("'last_profile' must be a string")
     settings.last_profile = last if last in settings.profiles else None
+    settings.recording = _recording(doc.get("recording", {}))
     return settings
+
+
+def _recording(raw: object) -> RecordingSettings:
+    if not isinstance(raw, dict):
+        raise SettingsError("'recording' must be a table")
+    values: dict[str, Any] = {}
+    for key, value in raw.items():
+        expected = _RECORDING_TYPES.get(key)
+        if expected is None:
+            raise SettingsError(f"recording: unknown key {key!r}")
+        if type(value) is not expected:
+            raise SettingsError(f"recording: {key} must be {expected.__name__}, not {value!r}")
+        values[key] = value
+    recording = RecordingSettings(**values)
+    try:
+        recording.validate()
+    except ValueError as exc:
+        raise SettingsError(str(exc)) from None
+    return recording
 
 
 def _profile(name: str, raw: dict[str, Any]) -> Profile:
@@ -277,6 +327,13 @@ def format_settings(settings: Settings) -> str:
             if f.name == "name":
                 continue
             lines.append(f"{f.name} = {_toml_value(getattr(profile, f.name))}")
+    if settings.recording != RecordingSettings():
+        settings.recording.validate()
+        lines += ["", "[recording]"]
+        lines += [
+            f"{f.name} = {_toml_value(getattr(settings.recording, f.name))}"
+            for f in fields(settings.recording)
+        ]
     return "\n".join(lines) + "\n"
 
 

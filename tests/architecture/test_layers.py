@@ -22,6 +22,7 @@ LAYERS: dict[str, tuple[str, ...]] = {
     "capture": ("rtmu.capture", "rtmu.session_decoder"),
     "client": ("rtmu.client", "rtmu.guardian"),
     "simulator": ("rtmu.sim",),
+    "recorder": ("rtmu.recorder",),
     "ui-state": ("rtmu.model",),
     "settings": ("rtmu.settings",),
     "control": ("rtmu.commands", "rtmu.controller"),
@@ -40,10 +41,12 @@ MAY_IMPORT: dict[str, frozenset[str]] = {
     # The network side knows the values it publishes, never the UI thread's state above it.
     "client": frozenset({"values", "codec", "maps", "base"}),
     "simulator": frozenset({"codec", "maps", "base"}),
+    # The flight recorder taps the client's links and values; the raw channel's layout is capture's.
+    "recorder": frozenset({"client", "values", "capture", "codec", "maps", "base"}),
     "ui-state": frozenset({"values", "base"}),
     "settings": frozenset({"base"}),
     "control": frozenset({"client", "ui-state", "values", "settings", "base"}),
-    "fleet": frozenset({"control", "client", "ui-state", "values", "settings", "base"}),
+    "fleet": frozenset({"control", "client", "recorder", "ui-state", "values", "settings", "base"}),
     # The window may start the bundled simulator (--demo); it never reaches the command line.
     "view": frozenset(
         {"fleet", "control", "client", "ui-state", "values", "settings", "simulator", "maps", "codec", "base"}

@@ -1,7 +1,8 @@
 """Open any supported input and turn it into capture events (see :mod:`rtmu.capture.base`).
 
 Formats: classic pcap and pcapng (TCP reassembled on any port, UDP datagrams
-passed through), a hex dump, or raw bytes (one stream each). ``auto`` picks by
+passed through), an RTMU recording (MCAP: its raw channel, see ``recorded``), a hex
+dump, or raw bytes (one stream each). ``auto`` picks by
 content: pcap magic numbers first, then text that parses as hex, then binary
 that contains ArNetworking's ``0F 0C`` sync pair.
 """
@@ -17,6 +18,7 @@ from .base import CaptureError, CaptureEvent, CaptureStats, Datagram, Endpoint, 
 from .hexdump import parse_hex
 from .net import SUPPORTED_LINK_TYPES, TCP, NotTcpUdp, ip_payload, parse_ip
 from .pcap import PCAP_MAGICS, PCAPNG_MAGIC, FrameReader, PcapngReader, PcapReader
+from .recorded import MCAP_MAGIC, recorded_events
 from .tcp import TcpReassembler
 
 FORMATS = ("auto", "pcap", "hex", "raw")
@@ -45,6 +47,8 @@ class CaptureSource:
     def events(self) -> Iterator[CaptureEvent]:
         if self.kind in ("pcap", "pcapng"):
             return self._pcap_events()
+        if self.kind == "mcap":
+            return recorded_events(self.path, self.stats)
         return self._stream_events()
 
     # -- pcap / pcapng ---------------------------------------------------------
@@ -175,6 +179,8 @@ def open_capture(path: str | Path, fmt: str = "auto", direction: str = "auto") -
             return source
         if magic == PCAPNG_MAGIC:
             return CaptureSource(path, "pcapng")
+        if sample.startswith(MCAP_MAGIC):  # an RTMU recording (rtmu.recorder): its raw channel
+            return CaptureSource(path, "mcap")
         if fmt == "pcap":
             raise CaptureError(f"{path} is not a pcap or pcapng file (unknown magic number {magic.hex()})")
     if not sample:

@@ -59,6 +59,16 @@ class EndReason(Enum):
 
 
 @dataclass(frozen=True, slots=True)
+class LeaseEvent:
+    """What happened to the lease, for a flight recorder: ``grant``, ``change`` or ``end`` (with why)."""
+
+    event: str
+    generation: int
+    ratios: DriveRatios
+    reason: EndReason | None = None
+
+
+@dataclass(frozen=True, slots=True)
 class LeaseView:
     """A consistent snapshot of the lease for the network side."""
 
@@ -81,6 +91,8 @@ class DriveLease:
         self.ttl = ttl
         self.clock = clock
         self.on_change: Callable[[], None] | None = None
+        self.on_event: Callable[[LeaseEvent], None] | None = None
+        """Optional tap (a recorder) on grants, changes and ends; called on the calling thread."""
         self._lock = threading.Lock()
         self._generation = 0
         self._ratios = STOPPED
@@ -96,6 +108,7 @@ class DriveLease:
             self._renewed_at = self.clock()
             self._ended = None
             generation = self._generation
+        self._event(LeaseEvent("grant", generation, ratios))
         self._changed()
         return generation
 
@@ -116,6 +129,8 @@ class DriveLease:
                 return False
             self._ratios = ratios
             self._renewed_at = now
+            generation = self._generation
+        self._event(LeaseEvent("change", generation, ratios))
         self._changed()
         return True
 
@@ -131,7 +146,9 @@ class DriveLease:
             was_live = self._ended is None
             if was_live:
                 self._ended = reason
+            ended, ratios = self._generation, self._ratios
         if was_live:
+            self._event(LeaseEvent("end", ended, ratios, reason))
             self._changed()
         return was_live
 
@@ -151,6 +168,11 @@ class DriveLease:
 
     def _live(self, now: float) -> bool:
         return self._ended is None and now - self._renewed_at <= self.ttl
+
+    def _event(self, event: LeaseEvent) -> None:
+        tap = self.on_event
+        if tap is not None:
+            tap(event)
 
     def _changed(self) -> None:
         hook = self.on_change

@@ -67,9 +67,10 @@ from typing import Any, TypeVar, overload
 
 from ..notices import Kind, Notice
 from ..state import StateChange, StateSink
-from .connection import Packet
+from .connection import AriaClient, Packet
 from .errors import ClientError, ClientTimeout
 from .lease import LEASE_TTL, DriveLease, EndReason
+from .link import Opener
 from .session import Session, SessionConfig
 
 log = logging.getLogger(__name__)
@@ -110,8 +111,11 @@ class ClientRunner:
         clock: Callable[[], float] = time.monotonic,
         config: SessionConfig | None = None,
         lease_ttl: float = LEASE_TTL,
+        opener: Opener | None = None,
     ) -> None:
         self.sink = sink
+        self.opener = opener
+        """Makes each connection's link (None: TCP); a flight recorder passes one that tees the bytes."""
         self.post = post
         self.clock = clock
         self.config = config or SessionConfig()
@@ -120,6 +124,10 @@ class ClientRunner:
         """``on_notice(notice)``, called on the UI thread (through ``post``)."""
         self.on_publish: Callable[[StateChange], None] | None = None
         """Optional tap on every published value, called on the *network* thread (benchmarks, scripts)."""
+        self.on_notice_sent: Callable[[Notice], None] | None = None
+        """Optional tap on every notice as it is raised (network thread mostly): a flight recorder."""
+        self.on_stop: Callable[[str, bool], None] | None = None
+        """Optional tap: ``on_stop(reason, sent)`` for every zero-ratios + ``stop`` (network thread)."""
         self.loop = asyncio.new_event_loop()
         self.session: Session | None = None
         self._thread = threading.Thread(target=self._run, name="rtmu-network", daemon=True)
@@ -144,7 +152,22 @@ class ClientRunner:
 
     def _run(self) -> None:
         asyncio.set_event_loop(self.loop)
-        self.session = Session(self.lease, self._publish, self._notice, clock=self.clock, config=self.config)
+        factory = None
+        opener = self.opener
+        if opener is not None:
+
+            def factory(on_close: Callable[[ClientError], None]) -> AriaClient:
+                return AriaClient(on_close=on_close, clock=self.clock, opener=opener)
+
+        self.session = Session(
+            self.lease,
+            self._publish,
+            self._notice,
+            clock=self.clock,
+            config=self.config,
+            client_factory=factory,
+        )
+        self.session.on_stop = self._stopped
         self.lease.on_change = self._lease_changed
         self._beat()
         self._ready.set()
@@ -257,7 +280,21 @@ class ClientRunner:
             return
         self.post(lambda: sink.apply(change))
 
+    def _stopped(self, reason: str, sent: bool) -> None:
+        tap = self.on_stop
+        if tap is not None:
+            tap(reason, sent)
+
+    def notify(self, notice: Notice) -> None:
+        """Tell the operator (``on_notice``, on the UI thread) from any thread: a recorder's problems."""
+        self._notice(notice)
+
     def _notice(self, notice: Notice) -> None:
+        tap = self.on_notice_sent
+        if tap is not None:
+            with contextlib.suppress(Exception):
+                tap(notice)
+
         def show() -> None:
             hook = self.on_notice
             if hook is not None:

@@ -167,6 +167,8 @@ class Session:
         self._image_sequence = 0
         self._wifi_labels: tuple[str, ...] = ()
         self.packets_sent = 0
+        self.on_stop: Callable[[str, bool], None] | None = None
+        """Optional tap (a flight recorder): ``on_stop(reason, sent)`` after every zero-ratios + ``stop``."""
         self.guardian: GuardianHandle | None = None
         self.ld = LdFeed(self._robot_update, self._decode, self._spawn, self.config.reply_timeout)
         """LD (ARAM) data: lasers, docking state, routes, DataStore_* — only where listed."""
@@ -235,7 +237,7 @@ class Session:
         self._cancel_connecting()
         self._connecting = asyncio.current_task()
         if self.connected:  # connecting again (another profile) while driving: stop on the old link first
-            self._send_stop()
+            self._send_stop("connecting elsewhere")
         self.lease.end(EndReason.DISCONNECTED)
         await self._drop_client()
         self._cancel_reconnect()
@@ -304,7 +306,7 @@ class Session:
         self._cancel_reconnect()
         self._target = None
         if self.connected:
-            self._send_stop()
+            self._send_stop("disconnect")
         self.lease.end(EndReason.DISCONNECTED)
         await self._drop_client()
         self._robot = RobotState()
@@ -673,7 +675,7 @@ class Session:
                     self.guardian.arm()  # before the first ratioDrive of a drive
                 self._send(RatioDrive(r.trans, r.rot, r.throttle, r.lat or None))
             elif isinstance(action, SendStop):
-                self._send_stop()
+                self._send_stop(f"lease {action.reason.value}")
         self._publish_health(now)
         if level is LinkLevel.LOST and self.client is not None:
             target = self._target
@@ -705,10 +707,14 @@ class Session:
         self.packets_sent += 1
         return True
 
-    def _send_stop(self) -> None:
-        """Zero ratios, then ``stop`` — whatever the link health looks like."""
-        self._send(RatioDrive(0.0, 0.0, 0.0))
-        self._send("stop")
+    def _send_stop(self, reason: str = "") -> None:
+        """Zero ratios, then ``stop`` — whatever the link health looks like. ``reason`` is for ``on_stop``."""
+        sent = self._send(RatioDrive(0.0, 0.0, 0.0))
+        sent = self._send("stop") or sent
+        tap = self.on_stop
+        if tap is not None:
+            with contextlib.suppress(Exception):
+                tap(reason or "stop", sent)
         if self.guardian is not None:
             self.guardian.disarm()
 
@@ -763,7 +769,7 @@ class Session:
     def stop_now(self) -> None:
         """The stop key: always sent at once, even when the link looks stale."""
         self.lease.end(EndReason.STOPPED)
-        self._send_stop()
+        self._send_stop("stop key")
         self.governor.reset()
         self.kick()
 
@@ -798,7 +804,7 @@ class Session:
             driving = self.governor.driving
             self.lease.end(EndReason.STOPPED)
             if driving:
-                self._send_stop()
+                self._send_stop("navigation takes over")
                 self.governor.reset()
         client.send(payload)
         self.packets_sent += 1

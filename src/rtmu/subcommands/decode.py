@@ -74,7 +74,8 @@ name (control commands by direction, data names from that connection's own
 LIST), length, checksum, decoded fields, and what a receiver would drop.
 
 Inputs: pcap or pcapng (TCP reassembled on any port, UDP datagrams attributed
-to their connection), a hex dump (xxd, hexdump, od, tshark, plain hex) or raw
+to their connection), an RTMU recording (FILE.mcap from the window or rtmu
+record: its raw channel, every connection in it), a hex dump (xxd, hexdump, od, tshark, plain hex) or raw
 bytes (one stream; --direction says who sent it when the packets do not)."""
 
 _EPILOG = """\
@@ -90,6 +91,7 @@ exit status: 0 the file was read (even with bad packets), 1 it cannot be read,
 
 examples:
   rtmu decode session.pcap
+  rtmu decode ~/.local/share/rtmu/recordings/20261125T041500Z_lab_7272.mcap
   rtmu decode --json session.pcap | jq 'select(.name == "ratioDrive") | .fields'
   rtmu decode --name getMapBinary --all session.pcap
   xxd bytes.bin > dump.txt && rtmu decode --direction c2s dump.txt"""
@@ -103,7 +105,9 @@ def register(subparsers: argparse._SubParsersAction) -> None:
         epilog=_EPILOG,
         formatter_class=argparse.RawDescriptionHelpFormatter,
     )
-    parser.add_argument("file", metavar="FILE", help="capture (pcap, pcapng), hex dump or raw bytes")
+    parser.add_argument(
+        "file", metavar="FILE", help="capture (pcap, pcapng), recording (.mcap), hex dump or raw bytes"
+    )
     parser.add_argument("--format", choices=FORMATS, default="auto", help="input format (default: detect)")
     parser.add_argument(
         "--direction",

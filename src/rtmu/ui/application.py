@@ -126,7 +126,13 @@ class RtmuApplication(Gtk.Application):
             profile = replace(profile, protocol=self.options.protocol)
         # The guardian: a separate process that stops the robot if this one is killed or frozen.
         config = SessionConfig(guardian=self.options.guardian)
-        session = self.fleet.open(post=GLib.idle_add, config=config, profile=profile, secrets=self.secrets)
+        session = self.fleet.open(
+            post=GLib.idle_add,
+            config=config,
+            profile=profile,
+            secrets=self.secrets,
+            recording=self.settings.recording,
+        )
         try:
             window = MainWindow(
                 self,

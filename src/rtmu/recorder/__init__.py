@@ -1,0 +1,14 @@
+"""The flight recorder: every robot session written to one MCAP file (issue 12).
+
+``recorder`` (one robot session: files per connection target, the hooks) →
+``recording`` (one file and its writer thread, bounded queue) → ``mcapfile``
+(foxglove-sdk's writer, channels) over ``sink`` (byte count, write errors);
+``tee`` the link that copies the raw bytes, ``convert`` values → Foxglove messages,
+``intents`` the operator's calls, ``files`` names, place and age, ``topics`` the
+channel names. The raw channel's layout is :mod:`rtmu.capture.recorded`.
+"""
+
+from .recorder import Recorder, RecorderConfig
+from .recording import Limits, Recording
+
+__all__ = ["Limits", "Recorder", "RecorderConfig", "Recording"]

@@ -1,0 +1,229 @@
+"""One recording: one MCAP file, filled by its own writer thread from a bounded queue.
+
+The threads that produce (the network loop that sends the stops, the UI thread) only
+``put_nowait`` a small item: they never encode, compress, write or wait. When the
+writer falls behind and the queue is full, the item is dropped and counted (the file
+says how many) — a slow disk can cost recorded data, never a late stop. A full disk,
+a failed write or the size cap ends the recording with one notice; the session goes on.
+"""
+
+from __future__ import annotations
+
+import contextlib
+import logging
+import queue
+import threading
+import time
+from collections.abc import Callable
+from dataclasses import dataclass
+from functools import partial
+from pathlib import Path
+
+from ..capture.recorded import CONNECTION_TOPIC, RAW_TOPICS, connection_record
+from ..notices import Kind, Notice
+from . import topics
+from .convert import Converter
+from .files import variant
+from .items import Event, Item, LinkOpened, Published, RawChunk
+from .mcapfile import McapFile
+
+log = logging.getLogger(__name__)
+
+QUEUE_ITEMS = 4096
+"""Items waiting for the writer; at 10 Hz status plus 10 camera frames/s that is minutes of slack."""
+FLUSH_SECONDS = 1.0
+"""A chunk is closed (and handed to the OS) at least this often: a crash loses at most this much."""
+SYNC_SECONDS = 5.0
+"""…and ``fsync``-ed this often: a power loss loses at most this much."""
+CLOSE_TIMEOUT = 5.0
+_CLOSE = object()
+
+
+@dataclass(frozen=True, slots=True)
+class Limits:
+    max_bytes: int = 1 << 30
+    """The file stops growing here (the recording ends with a notice)."""
+    flush_seconds: float = FLUSH_SECONDS
+    sync_seconds: float = SYNC_SECONDS
+    queue_items: int = QUEUE_ITEMS
+
+
+class Recording:
+    """``Recording(path, …).start()``; ``submit`` from any thread; ``close()`` once."""
+
+    def __init__(
+        self,
+        path: Path,
+        *,
+        metadata: dict[str, str] | None = None,
+        limits: Limits | None = None,
+        on_problem: Callable[[Notice], None] | None = None,
+    ) -> None:
+        self.path = path
+        self.metadata = metadata or {}
+        self.limits = limits or Limits()
+        self.on_problem = on_problem or (lambda notice: None)
+        self.dropped = 0
+        """Items not recorded because the queue was full."""
+        self.written_items = 0
+        self.stopped: str | None = None
+        """Why the recording ended early (full disk, size cap); None while it records."""
+        self.prune: Callable[[], object] | None = None
+        """Run on the writer thread before the file is made (forgetting old recordings)."""
+        self._queue: queue.Queue[object] = queue.Queue(self.limits.queue_items)
+        self._ending = threading.Event()
+        self._thread = threading.Thread(target=self._run, name="rtmu-recorder", daemon=True)
+        self._file: McapFile | None = None
+        self._opened = threading.Event()
+        self._conn: int | None = None
+        self._targets: dict[int, tuple[str, int]] = {}
+        self._closed = False
+        self._converter = Converter()
+
+    # -- any thread ----------------------------------------------------------------------------
+    def start(self) -> Recording:
+        """Start the writer thread; it makes the file (a failure becomes a notice, never an exception)."""
+        self._thread.start()
+        return self
+
+    def submit(self, item: Item) -> bool:
+        """Queue ``item`` without waiting; False (and counted) when the writer is behind or stopped."""
+        if self.stopped is not None or self._ending.is_set():
+            return False
+        try:
+            self._queue.put_nowait(item)
+        except queue.Full:
+            self.dropped += 1
+            return False
+        return True
+
+    def end(self) -> None:
+        """Finish soon, without waiting (the network loop's way): what is queued is still written."""
+        self._ending.set()
+        with contextlib.suppress(queue.Full):
+            self._queue.put_nowait(_CLOSE)
+
+    def close(self, timeout: float = CLOSE_TIMEOUT) -> None:
+        """:meth:`end`, then wait (bounded) until the file is finished (its summary written)."""
+        self.end()
+        if self._thread.is_alive():
+            self._thread.join(timeout)
+
+    # -- the writer thread ---------------------------------------------------------------------
+    def _run(self) -> None:
+        try:
+            if self.prune is not None:
+                self.prune()
+            file = self._file = self._create()
+        except Exception as exc:
+            why = exc.strerror if isinstance(exc, OSError) and exc.strerror else str(exc)
+            self._stop(f"{self.path} could not be created ({why})", started=False)
+            return
+        now = time.monotonic()
+        flush_at, sync_at = now + self.limits.flush_seconds, now + self.limits.sync_seconds
+        reported_drops = 0
+        while True:
+            try:
+                item = self._queue.get(timeout=max(0.0, flush_at - time.monotonic()))
+            except queue.Empty:
+                item = None
+            if item is _CLOSE or (item is None and self._ending.is_set()):
+                if self._queue.empty():
+                    break
+                continue
+            if self.stopped is None and item is not None:
+                self._write(file, item)  # type: ignore[arg-type]
+            if self.stopped is not None:
+                self._finish(file)  # keep what was written readable at once; drain the rest
+                continue
+            now = time.monotonic()
+            if self.stopped is None and now >= flush_at:
+                if self.dropped != reported_drops:
+                    reported_drops = self.dropped
+                    self._log(
+                        file, topics.RECORDER, {"event": "dropped", "items": self.dropped}, time.time_ns()
+                    )
+                sync = now >= sync_at
+                self._guard(file, partial(file.flush, sync=sync))
+                flush_at = now + self.limits.flush_seconds
+                if sync:
+                    sync_at = now + self.limits.sync_seconds
+        if self.stopped is None and self.dropped != reported_drops:
+            self._log(file, topics.RECORDER, {"event": "dropped", "items": self.dropped}, time.time_ns())
+        self._finish(file)
+
+    def _finish(self, file: McapFile) -> None:
+        if self._closed:
+            return
+        self._closed = True
+        try:
+            file.close()
+        except Exception as exc:  # a failed file: the part before the failure still reads
+            if self.stopped is None:
+                self._stop(f"the file could not be finished: {exc}")
+
+    def _create(self) -> McapFile:
+        """The file, in a private directory; a name taken already (same robot, same second) gets ``-N``."""
+        self.path.parent.mkdir(parents=True, exist_ok=True, mode=0o700)
+        first = self.path
+        for n in range(1, 100):
+            self.path = variant(first, n)
+            try:
+                return McapFile(self.path, self.metadata)
+            except FileExistsError:
+                continue
+        raise FileExistsError(f"{first} and 98 variants of it exist already")
+
+    def _write(self, file: McapFile, item: Item) -> None:
+        if isinstance(item, RawChunk):
+            if item.conn != self._conn and item.conn in self._targets:  # another connection's chunks
+                self._conn = item.conn
+                host, port = self._targets[item.conn]
+                self._log(file, CONNECTION_TOPIC, connection_record(item.conn, host, port), item.at_ns)
+            self._log(file, RAW_TOPICS[item.direction], item.data, item.at_ns)
+        elif isinstance(item, LinkOpened):
+            self._conn = item.conn
+            self._targets[item.conn] = (item.host, item.port)
+            self._log(file, CONNECTION_TOPIC, connection_record(item.conn, item.host, item.port), item.at_ns)
+        elif isinstance(item, Published):
+            try:
+                out = self._converter.change(item.change, item.at_ns)
+            except Exception:  # a value we cannot convert must not end the recording
+                log.exception("recording %s failed", type(item.change).__name__)
+                return
+            for topic, message in out:
+                self._log(file, topic, message, item.at_ns)
+        elif isinstance(item, Event):
+            self._log(file, item.topic, item.record, item.at_ns)
+        self.written_items += 1
+        if self.stopped is None and file.written > self.limits.max_bytes:
+            self._stop(f"the file reached its size limit ({self.limits.max_bytes / 1e6:g} MB)")
+
+    def _log(self, file: McapFile, topic: str, message: object, at_ns: int) -> None:
+        self._guard(file, lambda: file.log(topic, message, at_ns))
+
+    def _guard(self, file: McapFile, action: Callable[[], None]) -> None:
+        if self.stopped is not None:
+            return
+        try:
+            action()
+        except Exception as exc:
+            self._stop(_why(file, exc))
+            return
+        if file.file.error is not None:  # foxglove-sdk logs a failed write rather than raising it
+            self._stop(_why(file, file.file.error))
+
+    def _stop(self, why: str, *, started: bool = True) -> None:
+        self.stopped = why
+        log.warning("recording %s stopped: %s", self.path, why)
+        after = f"; {self.path} keeps what came before" if started else ""
+        self.on_problem(
+            Notice.warning(Kind.RECORDING, f"Recording stopped: {why}. The session goes on{after}.")
+        )
+
+
+def _why(file: McapFile, exc: BaseException) -> str:
+    error = file.file.error
+    if error is not None:
+        return f"writing {file.path.name} failed ({error.strerror or error})"
+    return f"writing {file.path.name} failed ({exc})"

@@ -1,0 +1,132 @@
+"""``rtmu record HOST[:PORT] --out FILE.mcap [--seconds S]``: a flight recording without the window.
+
+The same session and the same recorder as the window's: the raw bytes both ways, the
+robot's pose, status, sonar, map, camera pictures (``--camera-hz``), link health,
+notices and stops. Ends after ``--seconds``, or at Ctrl-C / SIGTERM, finishing the file.
+"""
+
+from __future__ import annotations
+
+import argparse
+import signal
+import sys
+import threading
+import time
+from pathlib import Path
+from typing import Any
+
+from ..client.errors import ClientError
+from ..client.runner import ClientRunner
+from ..client.session import SessionConfig
+from ..exit_codes import EXIT_CONNECTION, EXIT_OK, EXIT_USAGE
+from ..notices import Notice
+from ..recorder import Recorder, RecorderConfig
+from ..state import ConnectionChanged, Phase, StateChange
+from ..textsafe import visible
+from ._common import UsageError, add_connection_arguments, fail, positive_float, read_password
+
+
+def register(subparsers: Any) -> None:
+    p = subparsers.add_parser(
+        "record",
+        help="record a session to an MCAP file (raw bytes + decoded channels), headless",
+        description="Connect, follow the robot as the window does and write everything to FILE.mcap: "
+        "the exact bytes both ways (rtmu decode FILE.mcap explains them), pose, status, sonar, map, "
+        "camera, link health, notices and stops, readable in Foxglove.",
+    )
+    add_connection_arguments(p)
+    p.add_argument("--out", type=Path, required=True, metavar="FILE.mcap", help="the recording to write")
+    p.add_argument("--seconds", type=positive_float, default=None, metavar="S", help="stop after S seconds")
+    p.add_argument(
+        "--camera-hz",
+        type=float,
+        default=0.0,
+        metavar="HZ",
+        help="also ask for camera pictures this often (default 0: none)",
+    )
+    p.add_argument(
+        "--max-mb", type=positive_float, default=1024.0, metavar="MB", help="size limit of the file (1024)"
+    )
+    p.set_defaults(handler=handle)
+
+
+def handle(args: argparse.Namespace) -> int:
+    out: Path = args.out
+    if out.is_dir():
+        return fail("record", f"{out} is a directory", EXIT_USAGE)
+    try:
+        password = read_password(args)
+    except UsageError as exc:
+        return fail("record", str(exc), EXIT_USAGE)
+    except (KeyboardInterrupt, EOFError):
+        return fail("record", "cancelled", EXIT_USAGE)
+    out.unlink(missing_ok=True)  # the operator named it: a new recording replaces an old one
+    host, port = args.server
+
+    def tell(notice: Notice) -> None:
+        print(f"rtmu record: {visible(notice.text)}", file=sys.stderr)
+
+    config = RecorderConfig(out.parent, path=out, max_bytes=int(args.max_mb * 1e6), keep_days=0)
+    recorder = Recorder(config, tell)
+    runner = ClientRunner(config=SessionConfig(), opener=recorder.opener())
+    recorder.attach(runner)
+    runner.on_notice = tell
+    phases: list[Phase] = []
+    connected = threading.Event()
+
+    def published(change: StateChange) -> None:
+        recorder.published(change)
+        if isinstance(change, ConnectionChanged):
+            phases.append(change.value.phase)
+            if change.value.phase is Phase.CONNECTED:
+                connected.set()
+
+    runner.on_publish = published
+    ended = threading.Event()
+    previous = {s: signal.signal(s, lambda *_: ended.set()) for s in (signal.SIGINT, signal.SIGTERM)}
+    runner.start()
+    try:
+        future = runner.connect(host, port, args.user, password, protocol=args.protocol)
+        try:
+            future.result(args.timeout + 1.0)
+        except ClientError as exc:
+            return fail("record", str(exc), exc.exit_code)
+        except Exception as exc:
+            return fail("record", f"could not connect: {exc}", EXIT_CONNECTION)
+        print(f"rtmu record: recording {host}:{port} to {visible(str(out))}", file=sys.stderr)
+        _follow(runner, args, ended)
+    finally:
+        runner.close()
+        recorder.close()
+        for signum, handler in previous.items():
+            signal.signal(signum, handler)
+    for recording in recorder.recordings:
+        size = recording.path.stat().st_size if recording.path.exists() else 0
+        print(
+            f"rtmu record: {visible(str(recording.path))}: {size / 1e6:.2f} MB, "
+            f"{recording.written_items} items, {recording.dropped} dropped",
+            file=sys.stderr,
+        )
+    return EXIT_OK
+
+
+def _follow(runner: ClientRunner, args: argparse.Namespace, ended: threading.Event) -> None:
+    """Until ``--seconds`` or a signal: ask for camera pictures at ``--camera-hz`` where offered."""
+    deadline = None if args.seconds is None else time.monotonic() + args.seconds
+    period = 1.0 / args.camera_hz if args.camera_hz > 0 else None
+    next_picture = time.monotonic()
+    pending = None
+    while not ended.is_set():
+        now = time.monotonic()
+        if deadline is not None and now >= deadline:
+            return
+        if period is not None and now >= next_picture and (pending is None or pending.done()):
+            session = runner.session
+            if session is not None and session.image_source() is not None:
+                pending = runner.submit(session.request_image)
+                pending.add_done_callback(lambda f: f.cancelled() or f.exception())
+            next_picture = max(next_picture + period, now)
+        waits = [0.2] + ([deadline - now] if deadline is not None else [])
+        if period is not None:
+            waits.append(max(0.0, next_picture - now))
+        ended.wait(max(0.0, min(waits)))
