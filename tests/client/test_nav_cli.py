@@ -256,3 +256,9 @@ def test_hostile_status_text_is_escaped_and_bounded(capsys: pytest.CaptureFixtur
     assert out.splitlines()[0] == "Going to point\\x1b[2J"
     assert err.startswith("rtmu goto: Failed to get to point because \\x1b]0;pwned\\x07xxx")
     assert len(err) < 400  # the server's words are cut, not copied whole
+
+
+def test_an_ld_robots_dock_is_followed_through_dock_info(capsys: pytest.CaptureFixture[str]) -> None:
+    with fast_sim(profile="aram") as aram:
+        assert main(["dock", addr(aram), "--timeout", "5", "--limit", "30"]) == EXIT_OK
+        assert capsys.readouterr().out.splitlines() == ["Docking", "Docked"]
