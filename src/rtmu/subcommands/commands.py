@@ -1,0 +1,46 @@
+"""``rtmu commands HOST[:PORT] [--json]``: the server's own commands this user may run (§4.10)."""
+
+from __future__ import annotations
+
+import argparse
+from typing import Any
+
+from ..client.connection import AriaClient
+from ..client.custom_commands import list_commands
+from ..exit_codes import EXIT_OK
+from ..textsafe import visible
+from ._common import add_connection_arguments, print_json, run_with_client
+
+
+def register(subparsers: Any) -> None:
+    p = subparsers.add_parser(
+        "commands",
+        help="list the server's own commands (listCommands, listStringCommands) this user may run",
+        description="Print each command the server lists and this user may run, with its description; "
+        "ARG marks a command that takes one text argument (rtmu run NAME ARG). Exit 4 when the server "
+        "lists none.",
+    )
+    add_connection_arguments(p)
+    p.add_argument("--json", action="store_true", help="one JSON array of {name, description, argument}")
+    p.set_defaults(handler=handle)
+
+
+def handle(args: argparse.Namespace) -> int:
+    async def body(client: AriaClient) -> int:
+        catalogue = await list_commands(client, args.timeout)  # NotSupported (exit 4) without a list
+        if args.json:
+            print_json(
+                [
+                    {"name": c.name, "description": c.description, "argument": c.takes_argument}
+                    for c in catalogue.commands
+                ]
+            )
+            return EXIT_OK
+        width = max((len(visible(c.name)) for c in catalogue.commands), default=0)
+        for c in catalogue.commands:
+            arg = "ARG" if c.takes_argument else "   "
+            # A description may span lines (ARIA's MicroControllerCommand does): one line each here.
+            print(f"{visible(c.name):<{width}}  {arg}  {visible(c.description)}", flush=True)
+        return EXIT_OK
+
+    return run_with_client("commands", args, body)
