@@ -210,7 +210,8 @@ def test_a_held_drive_is_stopped_before_the_goal_goes_out() -> None:
         try:
             rig.ctl.press("forward")
             eventually(lambda: "ratioDrive" in server.names())
-            rig.ctl.goto_goal("Lab A")
+            # Straight to the runner, the lease still live: the session itself must stop first.
+            rig.runner.goto_goal("Lab A").result(5)
             eventually(lambda: "gotoGoal" in server.names())
             rig.hold(0.3)
             names = server.names()
