@@ -17,13 +17,13 @@ class CountingFile:
     def __init__(self, path: Path) -> None:
         self.path = path
         fd = os.open(path, os.O_WRONLY | os.O_CREAT | os.O_EXCL, 0o600)
-        self._file = os.fdopen(fd, "wb")
+        self._file = os.fdopen(fd, "wb", buffering=0)  # foxglove-sdk buffers; a failure shows at once
         self.written = 0
         self.error: OSError | None = None
 
     def write(self, data: bytes | bytearray) -> int:
         try:
-            n = self._file.write(data)
+            n = self._file.write(data) or 0  # may be short (a disk filling up): the writer writes the rest
         except OSError as exc:
             self.error = self.error or exc
             raise
@@ -31,7 +31,11 @@ class CountingFile:
         return n
 
     def seek(self, offset: int, whence: int = os.SEEK_SET) -> int:
-        return self._file.seek(offset, whence)
+        try:
+            return self._file.seek(offset, whence)
+        except OSError as exc:
+            self.error = self.error or exc
+            raise
 
     def tell(self) -> int:
         return self._file.tell()

@@ -1,0 +1,174 @@
+"""The recorder's parts one by one: names and age, settings, intents, the writer's queue, conversions."""
+
+from __future__ import annotations
+
+import os
+import threading
+import time
+from pathlib import Path
+
+import pytest
+
+from rtmu.client.lease import DriveLease, DriveRatios, EndReason, LeaseEvent
+from rtmu.notices import Kind
+from rtmu.recorder import Limits, Recording, topics
+from rtmu.recorder.convert import Converter, status_record
+from rtmu.recorder.files import file_name, prune, recordings_dir
+from rtmu.recorder.intents import IntentTap
+from rtmu.recorder.items import Event
+from rtmu.recorder.mcapfile import McapFile
+from rtmu.settings import RecordingSettings, SettingsError, format_settings, parse_settings
+from rtmu.state import RobotChanged, RobotState
+
+from .mcapread import read
+
+
+def test_recordings_live_under_xdg_data_home_named_by_utc_time_and_robot() -> None:
+    assert recordings_dir({"XDG_DATA_HOME": "/data"}) == Path("/data/rtmu/recordings")
+    assert recordings_dir({"XDG_DATA_HOME": "relative"}) == Path.home() / ".local/share/rtmu/recordings"
+    when = 1_764_044_100.0  # 2025-11-25 04:15:00 UTC
+    assert file_name("lab-robot:7272", when) == "20251125T041500Z_lab-robot-7272.mcap"
+    assert file_name("../../etc/passwd\x1b[2J", when) == "20251125T041500Z_etc-passwd-2J.mcap"
+
+
+def test_old_recordings_are_pruned_by_age_and_nothing_else(tmp_path: Path) -> None:
+    now = time.time()
+    old, new, other = tmp_path / "old.mcap", tmp_path / "new.mcap", tmp_path / "notes.txt"
+    for path in (old, new, other):
+        path.write_bytes(b"x")
+    os.utime(old, (now - 40 * 86400, now - 40 * 86400))
+    os.utime(other, (now - 40 * 86400, now - 40 * 86400))
+    assert prune(tmp_path, 0) == []
+    assert prune(tmp_path, 30, now) == [old]
+    assert not old.exists() and new.exists() and other.exists()
+
+
+def test_recording_settings_have_defaults_an_off_switch_and_bounds() -> None:
+    default = parse_settings("version = 1\n").recording
+    assert (
+        default == RecordingSettings()
+        and default.enabled
+        and default.max_file_mb > 0
+        and default.keep_days > 0
+    )
+    text = (
+        'version = 1\n[recording]\nenabled = false\nmax_file_mb = 50\nkeep_days = 7\ndirectory = "/srv/rec"\n'
+    )
+    parsed = parse_settings(text)
+    assert parsed.recording == RecordingSettings(
+        enabled=False, directory="/srv/rec", max_file_mb=50, keep_days=7
+    )
+    assert parse_settings(format_settings(parsed)).recording == parsed.recording
+    assert "[recording]" not in format_settings(parse_settings("version = 1\n"))
+    for bad in ("max_file_mb = 0", "keep_days = -1", 'directory = "rel"', "enabled = 1", "colour = 1"):
+        with pytest.raises(SettingsError):
+            parse_settings(f"version = 1\n[recording]\n{bad}\n")
+
+
+class Runner:
+    def __init__(self) -> None:
+        self.calls: list[tuple[object, ...]] = []
+        self.on_notice = None
+
+    def connect(self, host: str, port: int, user: str = "", password: str = "", *, profile: str = "") -> str:
+        self.calls.append(("connect", host, port, user, password, profile))
+        return "future"
+
+    def command(self, name: str, *args: object) -> None:
+        self.calls.append(("command", name, *args))
+
+    def ui_heartbeat(self) -> None:
+        self.calls.append(("beat",))
+
+
+def test_intents_pass_through_and_are_recorded_without_secrets() -> None:
+    inner = Runner()
+    seen: list[tuple[str, dict[str, object]]] = []
+    tap = IntentTap(inner, lambda name, args: seen.append((name, args)))
+    assert tap.connect("robot", 7272, "alice", "hunter2", profile="lab") == "future"
+    tap.command("turnByAngle", 90.0)
+    tap.ui_heartbeat()
+    tap.on_notice = print  # set on the real link
+    assert inner.on_notice is print
+    assert inner.calls == [
+        ("connect", "robot", 7272, "alice", "hunter2", "lab"),
+        ("command", "turnByAngle", 90.0),
+        ("beat",),
+    ]
+    assert seen == [
+        ("connect", {"host": "robot", "port": 7272, "user": "alice", "profile": "lab"}),
+        ("command", {"name": "turnByAngle", "args": [90.0]}),
+    ]
+    assert "hunter2" not in repr(seen)
+
+
+def test_the_lease_reports_grants_changes_and_ends_with_their_reason() -> None:
+    lease = DriveLease()
+    events: list[LeaseEvent] = []
+    lease.on_event = events.append
+    forward = DriveRatios(50.0, 0.0, 60.0)
+    generation = lease.grant(forward)
+    lease.change(DriveRatios(50.0, 20.0, 60.0))
+    lease.renew()
+    lease.end(EndReason.LAPSED)
+    lease.end(EndReason.STOPPED)  # already ended: nothing new happened
+    assert [(e.event, e.generation, e.reason) for e in events] == [
+        ("grant", generation, None),
+        ("change", generation, None),
+        ("end", generation, EndReason.LAPSED),
+    ]
+
+
+def test_status_names_the_battery_unit_the_robot_reports() -> None:
+    soc = status_record(RobotState(battery_v=41.0, battery_low=20.0, battery_is_soc=True, mode="Drive"))
+    assert soc["battery"] == {"state": "ok", "low": 20.0, "shutdown": None, "state_of_charge_pct": 41.0}
+    volts = status_record(RobotState(battery_v=11.0, battery_low=11.5))
+    assert volts["battery"]["volts"] == 11.0 and volts["battery"]["state"] == "low"
+
+
+def test_unchanged_parts_are_not_written_again() -> None:
+    convert = Converter()
+    still = RobotState(x=1000.0, y=2000.0, th=90.0, status="Stopped")
+    first = [t for t, _ in convert.change(RobotChanged(still), 1)]
+    assert first == [topics.POSE, topics.TF, topics.STATUS]
+    assert convert.change(RobotChanged(still), 2) == []
+    moved = [
+        t
+        for t, _ in convert.change(RobotChanged(RobotState(x=1001.0, y=2000.0, th=90.0, status="Stopped")), 3)
+    ]
+    assert moved == [topics.POSE, topics.TF]
+
+
+def test_producers_never_wait_for_a_stuck_writer(tmp_path: Path, monkeypatch: pytest.MonkeyPatch) -> None:
+    """A writer stuck on a dead disk: submit stays a non-blocking put, the surplus is dropped and counted."""
+    stuck = threading.Event()
+    real_log = McapFile.log
+
+    def slow_log(self: McapFile, topic: str, message: object, at_ns: int) -> None:
+        if topic == topics.NOTICES:
+            stuck.wait(10)
+        real_log(self, topic, message, at_ns)
+
+    monkeypatch.setattr(McapFile, "log", slow_log)
+    recording = Recording(tmp_path / "stuck.mcap", limits=Limits(queue_items=100)).start()
+    worst = 0.0
+    for n in range(1000):
+        started = time.perf_counter()
+        recording.submit(Event(topics.NOTICES, {"n": n}, time.time_ns()))
+        worst = max(worst, time.perf_counter() - started)
+    assert worst < 0.01, f"a submit waited {worst * 1000:.1f} ms"
+    assert recording.dropped >= 1000 - 100 - 1
+    stuck.set()
+    recording.close()
+    got = read(recording.path)
+    assert got.records(topics.RECORDER)[-1] == {"event": "dropped", "items": recording.dropped}
+
+
+def test_a_recording_that_cannot_make_its_file_says_so_once(tmp_path: Path) -> None:
+    (tmp_path / "file").write_text("not a directory")
+    problems = []
+    recording = Recording(tmp_path / "file" / "x.mcap", on_problem=problems.append).start()
+    recording.close()
+    assert [p.kind for p in problems] == [Kind.RECORDING]
+    assert "could not be created" in problems[0].text
+    assert not recording.submit(Event(topics.NOTICES, {}, 0))
