@@ -424,6 +424,23 @@ class TourGoals(Command):
         target.tour_goals()
 
 
+# -- the server's own commands ------------------------------------------------------------------
+
+
+@command
+class ServerCommands(Command):
+    """The palette of the server's own commands (listCommands, listStringCommands)."""
+
+    name = "server_commands"
+    label = "Server commands…"
+    keys = ("<Control>k",)
+    menu = True
+    needs = (("listCommands", "listStringCommands", "customListCommands", "customListStringCommands"),)
+
+    def activate(self, target: CommandTarget) -> None:
+        target.open_dialog("commands")
+
+
 # -- session ------------------------------------------------------------------------------------
 
 

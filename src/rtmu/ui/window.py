@@ -21,6 +21,7 @@ deliberate disconnect shows nothing.
 
 from __future__ import annotations
 
+import concurrent.futures
 import functools
 import time
 from collections.abc import Callable, Mapping
@@ -32,6 +33,7 @@ gi.require_version("Pango", "1.0")
 gi.require_version("Gdk", "4.0")
 from gi.repository import Gdk, Gio, GLib, Gtk, Pango  # noqa: E402
 
+from ..client.custom_commands import ServerCommand  # noqa: E402
 from ..commands import COMMANDS, CommandState, action_name  # noqa: E402
 from ..controller import TICK, SecretStore  # noqa: E402
 from ..fleet import RobotSession  # noqa: E402
@@ -57,6 +59,8 @@ from .keys import KeyRouter  # noqa: E402
 from .mapview import MapStage  # noqa: E402
 from .move_dialogs import go_dialog, turn_dialog  # noqa: E402
 from .notes import map_note  # noqa: E402
+from .palette import CommandPalette  # noqa: E402
+from .popups import PopupStack  # noqa: E402
 from .routes_panel import RoutesPanel  # noqa: E402
 from .settings_dialog import ConnectionDialog, PasswordPrompt  # noqa: E402
 from .shortcuts import build_shortcuts_window  # noqa: E402
@@ -244,6 +248,9 @@ class MainWindow(Gtk.ApplicationWindow):
         map_page.add_overlay(self._osd())
         map_page.add_overlay(self.dpad)
         map_page.add_overlay(self.inset)
+        # Server popups: cards over the map above the zoom buttons, never focusable (STOP is in the header).
+        self.popup_stack = PopupStack(self.model.popups, self._answer_popup, clock=self.clock)
+        map_page.add_overlay(self.popup_stack)
         self.map_note = Gtk.Label(halign=Gtk.Align.CENTER, valign=Gtk.Align.END, visible=False)
         self.map_note.add_css_class("map-note")
         self.map_note.set_margin_bottom(62)  # above the zoom buttons, which a narrow window puts under it
@@ -504,6 +511,7 @@ class MainWindow(Gtk.ApplicationWindow):
         makers = {
             "turn": lambda: turn_dialog(self, self.controller.turn_by),
             "go": lambda: go_dialog(self, self.controller.move_distance),
+            "commands": lambda: CommandPalette(self, self._link.list_commands, self._run_server_command),
         }
         dialog = makers[name]()
         dialog.present()
@@ -516,6 +524,24 @@ class MainWindow(Gtk.ApplicationWindow):
         """
         self.controller.stop()
         self.dpad.release_all()
+
+    def _answer_popup(self, popup_id: int, button: int) -> None:
+        self._link.answer_popup(popup_id, button)
+
+    def _run_server_command(self, command: ServerCommand, argument: str | None) -> None:
+        """From the palette: sent on the network thread; the outcome comes back as a banner."""
+
+        def done(future: concurrent.futures.Future[bool]) -> None:
+            if future.cancelled() or future.exception() is not None:
+                return  # the runner already raised a Kind.COMMAND notice with the reason
+            said = "taken by the server" if future.result() else "sent; the server did not answer"
+            GLib.idle_add(self._tell_once, "server-command", f"{command.name}: {said}")
+
+        self._link.run_command(command, argument).add_done_callback(done)
+
+    def _tell_once(self, topic: str, text: str) -> bool:
+        self.banners.tell(topic, "info", text, timeout=4.0)
+        return False  # an idle callback: once
 
     def toggle_connection(self) -> None:
         phase = self.model.connection.value.phase
