@@ -3,7 +3,8 @@
 Cost per frame does not grow with the map: the static map comes from the tile
 cache (a blit per visible tile, or the stretched overview while a tile is still
 being rendered), then the overlays — cairns, trail, sonar, robot — are drawn on
-top. Without a map: a metric grid and its legend.
+top, with navigation (``nav_draw``: planned path, goal ring, a picked pose) between the cairns and
+the robot. Without a map: a metric grid and its legend.
 """
 
 from __future__ import annotations
@@ -13,7 +14,7 @@ from dataclasses import dataclass, field
 
 import cairo
 
-from . import overlays
+from . import nav_draw, overlays
 from .tiles import BACKGROUND_RGB, EMPTY, TILE, Overview, TileCache
 from .viewport import Viewport
 
@@ -32,6 +33,12 @@ class Scene:
     sonar: Sequence[tuple[int, int]] = field(default_factory=tuple)
     laser: Sequence[tuple[int, int]] = field(default_factory=tuple)
     """Laser points (LD robots' ``Laser_*Current``), global mm; drawn under the sonar."""
+    path: Sequence[tuple[int, int]] = ()
+    """The planned path still ahead (``getPath``, mm) while the server navigates."""
+    goal: tuple[float, float] | None = None
+    """The cairn the robot is heading for, ringed."""
+    marker: nav_draw.Marker | None = None
+    """A pose the operator is picking (go to a point, set the robot's position)."""
 
 
 def draw_frame(ctx: cairo.Context, vp: Viewport, scene: Scene) -> bool:
@@ -49,6 +56,11 @@ def draw_frame(ctx: cairo.Context, vp: Viewport, scene: Scene) -> bool:
     if scene.objects:
         avoid = overlays.robot_box(vp, *scene.robot[:2]) if scene.robot is not None else None
         overlays.draw_cairns(ctx, vp, scene.objects, scene.labels, avoid)
+    if scene.goal is not None:
+        nav_draw.draw_goal_highlight(ctx, vp, *scene.goal)
+    nav_draw.draw_path(ctx, vp, scene.robot[:2] if scene.robot is not None else None, scene.path)
+    if scene.marker is not None:
+        nav_draw.draw_marker(ctx, vp, scene.marker)
     if scene.robot is not None:
         x, y, th = scene.robot
         overlays.draw_trail(ctx, vp, scene.trail)

@@ -29,6 +29,7 @@ from gi.repository import GLib, Gtk  # noqa: E402
 from ..model import LinkLevel, MapModel, OperatorState, RobotModel, RobotState  # noqa: E402
 from . import overlays  # noqa: E402
 from .frame import Scene, draw_frame  # noqa: E402
+from .nav_draw import Marker, MarkerKind  # noqa: E402
 from .tiles import TileCache  # noqa: E402
 from .viewport import ZOOM_MAX, ZOOM_MIN, Viewport, fit_view, nearest_step, step_zoom  # noqa: E402
 
@@ -85,6 +86,8 @@ class MapStage(Gtk.DrawingArea):
         self._pinch_anchor: tuple[float, float] | None = None
         self._pointer: tuple[float, float] | None = None
         self._scroll_accum = 0.0
+        self.marker: Marker | None = None
+        """A pose the operator is picking (``pose_pick`` sets it); drawn over the map."""
         self.set_draw_func(self._draw)
         self._install_input()
         self._unobserve = [
@@ -93,6 +96,7 @@ class MapStage(Gtk.DrawingArea):
             operator.view.observe(self._on_view_options),
             model.health.observe(lambda old, new: self.queue_draw()),
             model.trail.observe(self.queue_draw),
+            model.navigation.observe(lambda old, new: self.queue_draw()),
         ]
         self.connect("resize", self._on_resize)
         self._on_map(MapModel(), model.map.value)
@@ -299,7 +303,22 @@ class MapStage(Gtk.DrawingArea):
             sonar=r.sonar if self.operator.view.value.show_sonar else (),
             laser=r.laser if self.operator.view.value.show_sonar else (),
         )
+        self._add_navigation(scene)
         return draw_frame(ctx, vp, scene)
+
+    def _add_navigation(self, scene: Scene) -> None:
+        """While the server navigates: its path, and the goal ringed (or the point marked)."""
+        scene.marker = self.marker
+        nav = self.model.navigation.value
+        if not nav.navigating:
+            return
+        scene.path = nav.path
+        if nav.target_pose is not None:
+            x, y, th = nav.target_pose
+            if nav.target == "point":
+                scene.marker = scene.marker or Marker(MarkerKind.GOTO, x, y, th)
+            else:
+                scene.goal = (x, y)
 
     # -- input -------------------------------------------------------------------------------
     def _install_input(self) -> None:

@@ -23,6 +23,10 @@ CSS = """
 .status-cell.link-ok .value { color: #1e7a3f; }
 .status-cell.link-stale .value { color: #b56d00; opacity: 1; }
 .status-cell.link-lost .value { color: #c01c28; opacity: 1; }
+.status-cell.loc-good .value { color: #1e7a3f; }
+.status-cell.loc-poor .value { color: #b56d00; }
+.status-cell.loc-lost { background: alpha(#c01c28, 0.14); }
+.status-cell.loc-lost .value { color: #c01c28; }
 
 .fullscreen-bar { background: @theme_bg_color; padding: 4px 6px;
                   border-bottom: 1px solid alpha(black, 0.14); }
@@ -44,6 +48,17 @@ button.stop-button { min-width: 92px; font-weight: bold; letter-spacing: 1px; }
 .map-osd button, .map-osd label { color: white; }
 .map-osd label.zoom-label { min-width: 56px; font-feature-settings: "tnum"; font-weight: bold; }
 .map-osd togglebutton:checked { background: alpha(#3584e4, 0.85); }
+.motion { border-radius: 8px; padding: 3px 10px; box-shadow: 0 1px 4px alpha(black, 0.3); }
+.motion label { color: white; }
+.motion .motion-title { font-weight: bold; font-size: 10.5pt; }
+.motion .motion-detail { font-size: 9.5pt; }
+.motion .motion-hint { font-size: 8pt; opacity: 0.85; }
+.motion.motion-autonomous { background: alpha(#00797d, 0.92); }  /* teal: the path's colour */
+.motion.motion-held { background: alpha(#1c71d8, 0.92); }
+.pose-bar { background: alpha(#242424, 0.88); border-radius: 10px; padding: 4px 4px 4px 12px; }
+.pose-bar > label { color: white; font-weight: bold; }
+menubutton.goals-button > button { min-width: 20px; padding-left: 3px; padding-right: 3px; }
+.goal-list row.current-goal label { font-weight: bold; color: #00797d; }
 .map-note { background: alpha(white, 0.88); border-radius: 8px; padding: 6px 12px; color: #333; }
 
 .dpad-button { background: alpha(#242424, 0.45); color: white; border-radius: 16px; }

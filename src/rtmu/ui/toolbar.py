@@ -9,7 +9,8 @@ does not publish (Wi-Fi on most servers) is greyed with a tooltip saying so.
 Every column has a fixed width (its value label is exactly ``width_chars`` wide),
 so nothing shifts sideways when "—" becomes "12.8 V". A narrow window hides the
 least important columns first (:data:`HIDE_FIRST`) and shows them again when
-there is room; battery, mode and link always stay.
+there is room; battery, mode and link always stay. The localization column (servers with
+``getLocState``) gives way first while it says Good, and never while it says Lost or poor.
 """
 
 from __future__ import annotations
@@ -26,6 +27,7 @@ from gi.repository import GLib, Gtk, Pango  # noqa: E402
 from ..model import ConnectionState, LinkLevel, OperatorState, Phase, RobotModel  # noqa: E402
 from .gauges import BatteryGauge, WifiGauge, battery_fraction, wifi_bars  # noqa: E402
 from .ld_status import details_lines, goal_suffix  # noqa: E402
+from .nav_text import loc_level, loc_text, outcome_status  # noqa: E402
 
 STALE_AFTER = 1.0
 """Seconds after which a pose/battery value is shown as stale (status arrives at 10 Hz)."""
@@ -113,10 +115,15 @@ class StatusToolbar(Gtk.ScrolledWindow):
             "speed": Cell("Throttle", width_chars=5),
             "link": Cell("Link: rtt, age", width_chars=12),
             "dock": Cell("Dock", width_chars=9),
+            "loc": Cell("Localization", width_chars=8),
         }
         for cell in self.cells.values():
             self.row.append(cell)
         self.cells["dock"].set_visible(False)  # only for servers with dockInfo (LD robots)
+        self.cells["loc"].set_visible(False)  # only for servers with getLocState (ARNL)
+        self._loc_level: str | None = None
+        self._loc_given_up = False
+        """The Good localization column was hidden for width (it comes back with room, or news)."""
         mode = self.cells["mode"]
         mode.set_hexpand(True)
         mode.value.set_max_width_chars(40)  # the one column that takes the spare room
@@ -127,6 +134,7 @@ class StatusToolbar(Gtk.ScrolledWindow):
             model.health.observe(lambda o, n: self.refresh()),
             model.connection.observe(lambda o, n: self.refresh()),
             operator.speed.observe(lambda o, n: self.refresh()),
+            model.navigation.observe(lambda o, n: self.refresh()),
         ]
         self.refresh()
 
@@ -151,31 +159,38 @@ class StatusToolbar(Gtk.ScrolledWindow):
                 break
         return False
 
+    def _hideable(self) -> tuple[str, ...]:
+        """HIDE_FIRST, after a Good localization column (a Lost one must stay in view)."""
+        return ("loc", *HIDE_FIRST) if self._loc_level == "good" else HIDE_FIRST
+
     def fit(self) -> bool:
         """Hide or show one column so that the row fits; True if something changed (runs again)."""
         room = self.get_width()
         if room <= 0:
             return False
         need = self.row.measure(Gtk.Orientation.HORIZONTAL, -1)[0]
+        order = self._hideable()
         if need > room:
-            for name in HIDE_FIRST:
+            for name in order:
                 if self.cells[name].get_visible():
                     self.cells[name].set_visible(False)
+                    self._loc_given_up = self._loc_given_up or name == "loc"
                     return True
             return False
-        hidden = [n for n in HIDE_FIRST if not self.cells[n].get_visible()]
+        hidden = [n for n in order if not self.cells[n].get_visible()]
         if hidden:
             cell = self.cells[hidden[-1]]
             cell.set_visible(True)
             if self.row.measure(Gtk.Orientation.HORIZONTAL, -1)[0] > room:
                 cell.set_visible(False)  # still no room for it
                 return False
+            self._loc_given_up = self._loc_given_up and hidden[-1] != "loc"
             return True
         return False
 
     def hidden_columns(self) -> list[str]:
         """Columns given up for width (the dock column is absent, not given up, without dockInfo)."""
-        return [n for n, c in self.cells.items() if not c.get_visible() and n != "dock"]
+        return [n for n, c in self.cells.items() if not c.get_visible() and n not in ("dock", "loc")]
 
     def refresh(self) -> None:
         """Show the model's values and how old they are (called on changes and by the window's timer)."""
@@ -199,7 +214,13 @@ class StatusToolbar(Gtk.ScrolledWindow):
         strings_known = robot.strings_at is not None and (robot.mode or robot.status)
         mode = robot.mode if robot.status in ("", robot.mode) else f"{robot.mode} · {robot.status}"
         mode_tip = "\n".join([robot.extended_status or mode, *details_lines(robot)])
-        mode += goal_suffix(robot)
+        nav = self.model.navigation.value
+        if nav.navigating and nav.remaining_mm is not None:
+            mode += f" — {nav.remaining_mm / 1000:.1f} m left"
+        else:
+            mode += goal_suffix(robot)
+        if outcome_status(nav) and not nav.navigating:
+            mode_tip += "\nLast navigation: " + outcome_status(nav)
         c["mode"].show_value(
             mode if strings_known else DASH,
             stale=not strings_known or not link_ok,
@@ -218,6 +239,25 @@ class StatusToolbar(Gtk.ScrolledWindow):
         )
         self._link(conn, health, age)
         self._dock(robot.dock_state, link_ok)
+        self._loc(nav.loc_state, nav.loc_score, link_ok)
+
+    def _loc(self, state: str | None, score: float | None, live: bool) -> None:
+        """Localization (``getLocState``), shown only while the server offers it: good / poor / lost."""
+        cell = self.cells["loc"]
+        level = loc_level(state, score)
+        if level != self._loc_level:
+            self._loc_level = level
+            self._loc_given_up = self._loc_given_up and level == "good"
+            self._queue_fit()
+        cell.set_visible(level is not None and not self._loc_given_up)
+        for cls in ("good", "poor", "lost"):
+            (cell.add_css_class if cls == level else cell.remove_css_class)(f"loc-{cls}")
+        if level is not None:
+            text = loc_text(state, score)
+            tip = f"Localization: {text} (getLocState)"
+            if level == "lost":
+                tip += ": the robot does not know where it is — Go to › Set robot position"
+            cell.show_value(text, stale=not live, tooltip=tip)
 
     def _dock(self, state: str | None, live: bool) -> None:
         """The docking state, shown only while the server reports one (``dockInfo``)."""

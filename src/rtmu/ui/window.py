@@ -55,12 +55,18 @@ from .bars import FullscreenBar, connect_button, menu_button, show_connection, s
 from .camera import CameraInset, CameraView, PictureDecoder  # noqa: E402
 from .details import DetailsWindow  # noqa: E402
 from .dpad import DPad  # noqa: E402
+from .goals_panel import GoalsPanel  # noqa: E402
 from .keys import KeyRouter  # noqa: E402
 from .mapview import MapStage  # noqa: E402
+from .motion import MotionIndicator  # noqa: E402
 from .move_dialogs import go_dialog, turn_dialog  # noqa: E402
+from .nav_draw import Marker, MarkerKind  # noqa: E402
+from .nav_text import link_lost_note  # noqa: E402
 from .notes import map_note  # noqa: E402
 from .palette import CommandPalette  # noqa: E402
 from .popups import PopupStack  # noqa: E402
+from .pose_bar import PoseBar  # noqa: E402
+from .pose_pick import PosePicker  # noqa: E402
 from .routes_panel import RoutesPanel  # noqa: E402
 from .settings_dialog import ConnectionDialog, PasswordPrompt  # noqa: E402
 from .shortcuts import build_shortcuts_window  # noqa: E402
@@ -219,6 +225,7 @@ class MainWindow(Gtk.ApplicationWindow):
         title_box.add_css_class("title-box")
         self.title_label = Gtk.Label(label="RTMU")
         self.title_label.add_css_class("title")
+        self.title_label.set_ellipsize(Pango.EllipsizeMode.END)  # a 560 px window keeps its buttons
         self.subtitle_label = Gtk.Label(label="")
         self.subtitle_label.add_css_class("subtitle")
         self.subtitle_label.set_ellipsize(Pango.EllipsizeMode.END)
@@ -236,6 +243,9 @@ class MainWindow(Gtk.ApplicationWindow):
         header.pack_end(self.camera_button)
         self.routes_panel = RoutesPanel(self.model, self.send_data)  # only when the server lists getRoutes
         header.pack_end(self.routes_panel)
+        goto = self._goto_goal  # the panel shows only when the server navigates (goals, points, dock)
+        self.goals_panel = GoalsPanel(self.model, goto=goto, run=self._command, pick=self.start_pick)
+        header.pack_end(self.goals_panel)
         self.set_titlebar(header)
 
         self.toolbar_revealer = Gtk.Revealer(transition_type=Gtk.RevealerTransitionType.SLIDE_DOWN)
@@ -248,6 +258,11 @@ class MainWindow(Gtk.ApplicationWindow):
         map_page.add_overlay(self._osd())
         map_page.add_overlay(self.dpad)
         map_page.add_overlay(self.inset)
+        self.motion = MotionIndicator(self.model, held=self._drive_held)
+        map_page.add_overlay(self.motion)
+        self.picker = PosePicker(self.stage, changed=lambda: self.pose_bar.update())
+        self.pose_bar = PoseBar(self.picker, self._pose_confirmed)
+        map_page.add_overlay(self.pose_bar)
         # Server popups: cards over the map above the zoom buttons, never focusable (STOP is in the header).
         self.popup_stack = PopupStack(self.model.popups, self._answer_popup, clock=self.clock)
         map_page.add_overlay(self.popup_stack)
@@ -419,6 +434,8 @@ class MainWindow(Gtk.ApplicationWindow):
                               fraction=pct / SPEED_MAX)  # fmt: skip
         elif kind is Kind.SPEED:
             return  # the speed banner follows the model
+        elif kind is Kind.NAVIGATION:  # outcomes and cancellations: one banner, updated in place
+            self.banners.tell("navigation", level.value, text, timeout=8.0 if level is Level.INFO else 12.0)
         elif kind is Kind.CAMERA:
             if self.camera.waiting:
                 self.camera.failed(text)
@@ -430,6 +447,7 @@ class MainWindow(Gtk.ApplicationWindow):
 
     def commands_changed(self, states: Mapping[str, CommandState]) -> None:
         self._states.update(states)
+        self.goals_panel.commands_changed(states)
         for name, state in states.items():
             label = COMMANDS.get(name).label if name in COMMANDS else name
             self.dpad.set_command_state(name, state.enabled, state.reason, label)
@@ -492,7 +510,9 @@ class MainWindow(Gtk.ApplicationWindow):
 
     def view_intent(self, name: str) -> None:
         """Window-level intents from keys, menu and buttons."""
-        if name == "toggle_camera":
+        if name == "toggle_camera" and self.picker.active:
+            self.picker.cancel()  # Esc leaves a pick mode first
+        elif name == "toggle_camera":
             if self.stack.get_visible_child_name() == "camera":
                 self.show_map()
             else:
@@ -524,6 +544,12 @@ class MainWindow(Gtk.ApplicationWindow):
         """
         self.controller.stop()
         self.dpad.release_all()
+        self.picker.cancel()
+
+    def _drive_held(self) -> bool:
+        """A held drive is live (keys or D-pad); False while the window is still being built."""
+        controller = getattr(self, "controller", None)
+        return controller is not None and bool(controller.held)
 
     def _answer_popup(self, popup_id: int, button: int) -> None:
         self._link.answer_popup(popup_id, button)
@@ -542,6 +568,21 @@ class MainWindow(Gtk.ApplicationWindow):
     def _tell_once(self, topic: str, text: str) -> bool:
         self.banners.tell(topic, "info", text, timeout=4.0)
         return False  # an idle callback: once
+
+    def _goto_goal(self, goal: str) -> None:
+        self.controller.goto_goal(goal)
+
+    def start_pick(self, kind: MarkerKind) -> None:
+        """Go to a point / set robot position: a map mode; the pose bar confirms (``pose_bar``)."""
+        self.show_map()
+        self.picker.start(kind)
+
+    def _pose_confirmed(self, marker: Marker) -> None:
+        if marker.kind is MarkerKind.GOTO:
+            self.controller.goto_pose(marker.x, marker.y, marker.th)
+        else:
+            th = self.model.robot.value.th if marker.th is None else marker.th
+            self.controller.localize(marker.x, marker.y, th)
 
     def toggle_connection(self) -> None:
         phase = self.model.connection.value.phase
@@ -595,11 +636,13 @@ class MainWindow(Gtk.ApplicationWindow):
                 self.banners.tell("link", "info", f"Connected to {where}", timeout=3.0)
         elif phase is Phase.RECONNECTING:
             count = f" ({new.attempt})" if new.attempt else ""
-            self.banners.tell("link", "warning", f"Link lost — reconnecting{count}…", timeout=None)
+            note = link_lost_note(self.model.navigation.value)
+            self.banners.tell("link", "warning", f"Link lost — reconnecting{count}…{note}", timeout=None)
         elif phase is Phase.FAILED and (new.error != old.error or old.phase is not Phase.FAILED):
             lost = old.phase in (Phase.CONNECTED, Phase.RECONNECTING)
             reason = new.error or "no reason given"
-            text = f"Link lost: {reason}" if lost else f"Could not connect to {where}: {reason}"
+            note = link_lost_note(self.model.navigation.value)
+            text = f"Link lost: {reason}.{note}" if lost else f"Could not connect to {where}: {reason}"
             self.banners.tell("link", "error", text, timeout=10.0)
         elif phase is Phase.DISCONNECTED and old.phase is not Phase.DISCONNECTED:
             self.banners.dismiss("link")  # deliberate: no banner at all
@@ -798,6 +841,7 @@ class MainWindow(Gtk.ApplicationWindow):
     def _tick(self) -> bool:
         self.ticks += 1
         self.controller.tick()
+        self.motion.refresh()
         if self.ticks % REFRESH_EVERY == 0:
             self.toolbar.refresh()
             self.camera.tick()
@@ -843,4 +887,6 @@ class MainWindow(Gtk.ApplicationWindow):
         self.stage.close()
         self.toolbar.close()
         self.routes_panel.close()
+        self.goals_panel.close()
+        self.motion.close()
         self.decoder.close()

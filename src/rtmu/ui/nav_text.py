@@ -1,0 +1,82 @@
+"""The words the window uses for navigation: which motion is happening, where to, how localized.
+
+Pure text from :class:`rtmu.model.NavState` (no widgets), so the sentences are tested without a
+display and the toolbar, the motion indicator and the link banner all say the same thing. Names
+in them come from the server and are shown as plain text by the labels that use them.
+"""
+
+from __future__ import annotations
+
+from ..model import NavState
+
+POOR_SCORE = 0.6
+"""A localization score below this (0–1) is shown as poor (amber) even while the state is Good."""
+
+
+def loc_level(state: str | None, score: float | None) -> str | None:
+    """``good`` / ``poor`` / ``lost`` (the toolbar cell's CSS class), None when not offered."""
+    if state is None:
+        return None
+    if state == "Lost":
+        return "lost"
+    if state == "Good" and (score is None or score >= POOR_SCORE):
+        return "good"
+    return "poor"
+
+
+def loc_text(state: str | None, score: float | None) -> str:
+    """``Good 95 %``; the state alone when there is no score."""
+    if state is None:
+        return ""
+    return state if score is None else f"{state} {round(score * 100)} %"
+
+
+def where(target: str) -> str:
+    """A target in a sentence: ``Lab B``, ``the point``, ``home``, ``the dock``."""
+    return {"point": "the point", "dock": "the dock", "": "a goal"}.get(target, target)
+
+
+def going_text(nav: NavState) -> str:
+    """``Going to Lab B — 12.4 m left`` (``Going home``; no distance until a path is known)."""
+    head = _head(nav)
+    if nav.remaining_mm is not None:
+        head += f" — {nav.remaining_mm / 1000:.1f} m left"
+    return head
+
+
+def _head(nav: NavState) -> str:
+    return "Going home" if nav.target == "home" else f"Going to {where(nav.target)}"
+
+
+def motion_text(nav: NavState, *, held: bool, link_up: bool) -> tuple[str, tuple[str, ...]]:
+    """(kind, lines) for the motion indicator; kind ``autonomous``, ``held`` or "" (hidden).
+
+    Short lines (title, where to, how to end it) keep the pill narrow, clear of the banners.
+    Autonomy wins when both are true for a moment (a key press cancels navigation, and the
+    indicator follows once the server has said so). A lost link is said by the link banner alone
+    (see :func:`link_lost_note`): one place, not two.
+    """
+    if not link_up:
+        return "", ()
+    if nav.navigating:
+        return "autonomous", ("Navigating (autonomous)", going_text(nav), "Space or STOP cancels")
+    if held:
+        return "held", ("Driving (held keys)", "Let go to stop")
+    return "", ()
+
+
+def link_lost_note(nav: NavState) -> str:
+    """What the link banner adds while the robot navigates with no link: it is on its own."""
+    if not nav.navigating:
+        return ""
+    head = _head(nav)
+    return f" The robot is navigating on its own ({head[0].lower()}{head[1:]}); STOP stays available."
+
+
+def outcome_status(nav: NavState) -> str:
+    """The status column's words for how the last navigation ended ("" while none has)."""
+    if not nav.outcome_text:
+        return ""
+    if nav.reason and nav.reason not in nav.outcome_text:
+        return f"{nav.outcome_text} because {nav.reason}"
+    return nav.outcome_text
