@@ -140,8 +140,10 @@ def test_limit_stops_the_robot_and_exits_5(home: SimThread, capsys: pytest.Captu
 def test_no_wait_sends_and_leaves_it_driving(home: SimThread, capsys: pytest.CaptureFixture[str]) -> None:
     assert run(home, "goto", "Lab B", "--no-wait") == EXIT_OK
     assert capsys.readouterr().out == "sent gotoGoal\n"
-    eventually(lambda: robot(home).status == "Going to Lab B", timeout=5)
-    eventually(lambda: robot(home).vel > 100, timeout=10)
+    # Under load the fast clock runs slower and the long plan takes longer: generous waits.
+    eventually(lambda: robot(home).status == "Going to Lab B", timeout=15)
+    eventually(lambda: robot(home).vel > 100 or robot(home).status != "Going to Lab B", timeout=20)
+    assert robot(home).status == "Going to Lab B", robot(home).status
 
 
 def test_ctrl_c_sends_stop_before_exiting(home: SimThread) -> None:
