@@ -55,7 +55,15 @@ class StreamLink:
         self.writer = writer
 
     async def read(self, max_bytes: int) -> bytes:
-        return await self.reader.read(max_bytes)
+        try:
+            return await self.reader.read(max_bytes)
+        except OSError:
+            # The stream's own "closed" future holds the same error. Nobody else awaits it, so
+            # asyncio would print "Future exception was never retrieved" whenever the garbage
+            # collector happens to free it before the protocol (a reset link under rtmu drive did).
+            with contextlib.suppress(Exception):
+                await self.writer.wait_closed()
+            raise
 
     def write(self, data: bytes) -> None:
         self.writer.write(data)
