@@ -378,3 +378,43 @@ def test_goals_popover_pick_bar_and_indicator_fit_an_800x480_screen(
             pump(lambda: stopped(sim) and not window.motion.get_visible(), 5, "the stop")
         finally:
             gui.close()
+
+
+def test_what_the_server_does_not_list_stays_visible_greyed_with_its_reason() -> None:
+    """The panel alone, on a model whose server lists goals and points but neither dock nor localize."""
+    from rtmu.commands import CommandState
+    from rtmu.model import ConnectionState, NavState, RobotModel
+    from rtmu.ui.goals_panel import GoalsPanel
+
+    model = RobotModel()
+    chosen: list[str] = []
+    panel = GoalsPanel(
+        model, goto=chosen.append, run=chosen.append, pick=lambda kind: chosen.append(kind.value)
+    )
+    try:
+        assert not panel.get_visible(), "hidden while not connected"
+        offers = frozenset({"gotoGoal", "gotoPose", "home", "tourGoals", "getGoals"})
+        model.connection.set(ConnectionState(phase=Phase.CONNECTED, offers=offers))
+        model.navigation.set(NavState(offered=offers, goals=("Lab A", "Lab B", "Room <b>1</b>")))
+        panel.commands_changed(
+            {
+                "home": CommandState(True, ""),
+                "tour_goals": CommandState(True, ""),
+                "dock": CommandState(False, "this server does not offer dock"),
+            }
+        )
+        assert panel.get_visible()
+        assert panel.buttons["home"].get_sensitive() and panel.buttons["goto"].get_sensitive()
+        assert not panel.buttons["dock"].get_sensitive() and not panel.buttons["localize"].get_sensitive()
+        assert panel.buttons["dock"].get_visible() and panel.buttons["localize"].get_visible()
+        reasons = panel.reasons.get_text()
+        assert "Dock: not offered by the server" in reasons and "Set position: not offered" in reasons
+        label = panel.rows["Room <b>1</b>"].get_child()
+        assert isinstance(label, Gtk.Label) and label.get_text() == "Room <b>1</b>", "plain text, not markup"
+        panel.search.set_text("lab b")
+        panel._filter()
+        assert [n for n, row in panel.rows.items() if row.get_child_visible()] == ["Lab B"], "spaces ignored"
+        panel.choose_first()
+        assert chosen == ["Lab B"]
+    finally:
+        panel.close()
