@@ -9,16 +9,17 @@ from pathlib import Path
 
 import pytest
 
+from rtmu.capture import CaptureError, open_capture
 from rtmu.client.lease import DriveLease, DriveRatios, EndReason, LeaseEvent
 from rtmu.notices import Kind
-from rtmu.recorder import Limits, Recording, topics
+from rtmu.recorder import Limits, Recorder, RecorderConfig, Recording, topics
 from rtmu.recorder.convert import Converter, status_record
 from rtmu.recorder.files import file_name, prune, recordings_dir
 from rtmu.recorder.intents import IntentTap
 from rtmu.recorder.items import Event
 from rtmu.recorder.mcapfile import McapFile
 from rtmu.settings import RecordingSettings, SettingsError, format_settings, parse_settings
-from rtmu.state import RobotChanged, RobotState
+from rtmu.state import ConnectionChanged, ConnectionState, Phase, RobotChanged, RobotState
 
 from .mcapread import read
 
@@ -172,3 +173,38 @@ def test_a_recording_that_cannot_make_its_file_says_so_once(tmp_path: Path) -> N
     assert [p.kind for p in problems] == [Kind.RECORDING]
     assert "could not be created" in problems[0].text
     assert not recording.submit(Event(topics.NOTICES, {}, 0))
+
+
+def test_a_stopped_recording_is_not_restarted_by_every_reconnect(tmp_path: Path) -> None:
+    """A disk that refused once is not asked again on each reconnect; a new connect tries again."""
+    (tmp_path / "file").write_text("not a directory")
+    problems: list[object] = []
+    recorder = Recorder(RecorderConfig(tmp_path / "file"), problems.append)
+    assert recorder._link_opened("robot", 7272) is not None
+    first = recorder.recordings[0]
+    first.close()
+    assert first.stopped is not None and len(problems) == 1
+    assert recorder._link_opened("robot", 7272) is None, "a reconnect to the same robot"
+    assert len(recorder.recordings) == 1 and len(problems) == 1
+    recorder.published(ConnectionChanged(ConnectionState(phase=Phase.DISCONNECTED)))
+    assert recorder._link_opened("robot", 7272) is not None, "the operator connects again"
+    recorder.close()
+    assert len(recorder.recordings) == 2 and len(problems) == 2
+
+
+def test_decode_of_a_damaged_recording_names_the_damage(tmp_path: Path) -> None:
+    good = tmp_path / "good.mcap"
+    file = McapFile(good, {})
+    file.log(topics.NOTICES, {"n": 1}, 1)
+    file.close()
+    data = good.read_bytes()
+    for name, damaged in {
+        "cut.mcap": data[: len(data) // 2],
+        "noise.mcap": data[:8] + bytes(range(256)) * 8,
+        "lying.mcap": data[:8] + b"\x06" + (2**62).to_bytes(8, "little") + b"\x00" * 64,
+    }.items():
+        path = tmp_path / name
+        path.write_bytes(damaged)
+        source = open_capture(path)
+        with pytest.raises(CaptureError, match="not a readable MCAP recording"):
+            list(source.events())

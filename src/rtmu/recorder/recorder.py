@@ -85,7 +85,9 @@ class Recorder:
     def _link_opened(self, host: str, port: int) -> tuple[int, RawSink] | None:
         with self._lock:
             recording = self.recording
-            if recording is None or recording.stopped is not None or self._target != (host, port):
+            if recording is not None and recording.stopped is not None and self._target == (host, port):
+                return None  # stopped for a full disk or its limit: not again on every reconnect
+            if recording is None or self._target != (host, port):
                 recording = self._start(host, port)
             if recording is None:
                 return None
