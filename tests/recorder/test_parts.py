@@ -11,6 +11,7 @@ import pytest
 
 from rtmu.capture import CaptureError, open_capture
 from rtmu.client.lease import DriveLease, DriveRatios, EndReason, LeaseEvent
+from rtmu.fleet import recorder_for
 from rtmu.notices import Kind
 from rtmu.recorder import Limits, Recorder, RecorderConfig, Recording, topics
 from rtmu.recorder.convert import Converter, status_record
@@ -208,3 +209,13 @@ def test_decode_of_a_damaged_recording_names_the_damage(tmp_path: Path) -> None:
         source = open_capture(path)
         with pytest.raises(CaptureError, match="not a readable MCAP recording"):
             list(source.events())
+
+
+def test_the_window_records_by_default_and_the_off_switch_turns_it_off() -> None:
+    recorder = recorder_for(RecordingSettings())
+    assert recorder is not None and recorder.config.directory == recordings_dir()
+    assert recorder.config.max_bytes == RecordingSettings().max_file_mb * 1_000_000
+    assert recorder_for(RecordingSettings(enabled=False)) is None
+    assert recorder_for(None) is None, "tests and scripts that build a session record nothing"
+    custom = recorder_for(RecordingSettings(directory="/srv/rec", keep_days=3))
+    assert custom is not None and custom.config.directory == Path("/srv/rec") and custom.config.keep_days == 3
