@@ -14,7 +14,7 @@ from rtmu.client.lease import DriveLease, DriveRatios, EndReason, LeaseEvent
 from rtmu.fleet import recorder_for
 from rtmu.notices import Kind
 from rtmu.recorder import Limits, Recorder, RecorderConfig, Recording, topics
-from rtmu.recorder.convert import Converter, status_record
+from rtmu.recorder.convert import Converter, other_topic, status_record
 from rtmu.recorder.files import file_name, prune, recordings_dir
 from rtmu.recorder.intents import IntentTap
 from rtmu.recorder.items import Event
@@ -219,3 +219,24 @@ def test_the_window_records_by_default_and_the_off_switch_turns_it_off() -> None
     assert recorder_for(None) is None, "tests and scripts that build a session record nothing"
     custom = recorder_for(RecordingSettings(directory="/srv/rec", keep_days=3))
     assert custom is not None and custom.config.directory == Path("/srv/rec") and custom.config.keep_days == 3
+
+
+def test_every_part_the_session_publishes_has_a_topic_of_its_own() -> None:
+    """Parts without a Foxglove schema (navigation, popups, parts added later) each get a JSON topic."""
+    import typing
+
+    from rtmu import state
+
+    own = {
+        state.RobotChanged,
+        state.MapChanged,
+        state.CameraChanged,
+        state.ConnectionChanged,
+        state.HealthChanged,
+    }
+    others = [part for part in typing.get_args(state.StateChange) if part not in own]
+    assert state.NavChanged in others
+    named = {other_topic(part.__new__(part)) for part in others}
+    assert topics.NAVIGATION in named and len(named) == len(others)
+    fixed = {v for k, v in vars(topics).items() if k.isupper() and isinstance(v, str)}
+    assert named - {topics.NAVIGATION} <= {t for t in named if t.startswith(topics.STATE_PREFIX)} - fixed

@@ -8,6 +8,7 @@ on the writer thread only (a big map's lines take a while to build).
 from __future__ import annotations
 
 import math
+import re
 from dataclasses import asdict, is_dataclass
 from enum import Enum
 from typing import Any
@@ -101,6 +102,14 @@ def jsonable(value: Any) -> Any:
     return value
 
 
+def other_topic(change: object) -> str:
+    """``/rtmu/navigation`` for ``NavChanged``; ``/rtmu/state/<part>`` for other parts without a topic."""
+    name = type(change).__name__.removesuffix("Changed")
+    if name == "Nav":
+        return topics.NAVIGATION
+    return topics.STATE_PREFIX + re.sub(r"(?<!^)(?=[A-Z])", "_", name).lower()
+
+
 def notice_record(notice: Notice) -> dict[str, Any]:
     return {"kind": notice.kind.value, "level": notice.level.value, "text": notice.text}
 
@@ -163,8 +172,8 @@ class Converter:
             return [(topics.CONNECTION, jsonable(change.value))]
         if isinstance(change, HealthChanged):
             return [(topics.LINK_HEALTH, jsonable(change.value))]
-        # Any other part (navigation, and parts added later) as JSON: nothing published is lost.
-        return [(topics.NAVIGATION, jsonable(getattr(change, "value", change)))]
+        # Any other part (navigation, popups, parts added later) as JSON: nothing published is lost.
+        return [(other_topic(change), jsonable(getattr(change, "value", change)))]
 
     def robot(self, r: RobotState, at_ns: int) -> Out:
         out: Out = []
