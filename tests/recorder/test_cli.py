@@ -74,3 +74,29 @@ def test_decode_says_when_an_mcap_file_is_not_an_rtmu_recording(tmp_path: Path) 
     done = rtmu("decode", str(path))
     assert done.returncode == 0
     assert "no RTMU raw channel" in done.stderr and "no ArNetworking packets found" in done.stdout
+
+
+def test_record_ends_at_sigterm_with_a_finished_file(tmp_path: Path) -> None:
+    import signal
+    import time
+
+    out = tmp_path / "term.mcap"
+    with SimThread(SimConfig(port=0, seed=1)) as sim:
+        proc = subprocess.Popen(
+            [*RTMU, "record", f"127.0.0.1:{sim.port}", "--out", str(out)],
+            stderr=subprocess.PIPE,
+            text=True,
+        )
+        try:
+            deadline = time.monotonic() + 15
+            while not (out.exists() and out.stat().st_size > 2000):
+                assert time.monotonic() < deadline and proc.poll() is None
+                time.sleep(0.05)
+            proc.send_signal(signal.SIGTERM)
+            _, err = proc.communicate(timeout=15)
+        finally:
+            if proc.poll() is None:
+                proc.kill()
+    assert proc.returncode == 0, err
+    counts = summary_counts(out)
+    assert counts[topics.STATUS] >= 1 and counts["/aria/raw/s2c"] > 0

@@ -2,7 +2,8 @@
 
 The same session and the same recorder as the window's: the raw bytes both ways, the
 robot's pose, status, sonar, map, camera pictures (``--camera-hz``), link health,
-notices and stops. Ends after ``--seconds``, or at Ctrl-C / SIGTERM, finishing the file.
+notices and stops. Ends after ``--seconds``, or at Ctrl-C / SIGTERM / SIGHUP, finishing the file; a
+lost link is reconnected and recorded on in the same file.
 """
 
 from __future__ import annotations
@@ -68,7 +69,7 @@ def handle(args: argparse.Namespace) -> int:
 
     config = RecorderConfig(out.parent, path=out, max_bytes=int(args.max_mb * 1e6), keep_days=0)
     recorder = Recorder(config, tell)
-    runner = ClientRunner(config=SessionConfig(), opener=recorder.opener())
+    runner = ClientRunner(config=SessionConfig(connect_timeout=args.timeout), opener=recorder.opener())
     recorder.attach(runner)
     runner.on_notice = tell
     phases: list[Phase] = []
@@ -83,7 +84,8 @@ def handle(args: argparse.Namespace) -> int:
 
     runner.on_publish = published
     ended = threading.Event()
-    previous = {s: signal.signal(s, lambda *_: ended.set()) for s in (signal.SIGINT, signal.SIGTERM)}
+    ending = (signal.SIGINT, signal.SIGTERM, signal.SIGHUP)
+    previous = {s: signal.signal(s, lambda *_: ended.set()) for s in ending}
     runner.start()
     try:
         future = runner.connect(host, port, args.user, password, protocol=args.protocol)
