@@ -240,3 +240,27 @@ def test_every_part_the_session_publishes_has_a_topic_of_its_own() -> None:
     assert topics.NAVIGATION in named and len(named) == len(others)
     fixed = {v for k, v in vars(topics).items() if k.isupper() and isinstance(v, str)}
     assert named - {topics.NAVIGATION} <= {t for t in named if t.startswith(topics.STATE_PREFIX)} - fixed
+
+
+def test_a_stopped_recording_drains_quietly_until_closed(tmp_path: Path) -> None:
+    """After its limit the writer only drains its queue: no busy loop eating a core until it is closed."""
+    import resource
+
+    recording = Recording(tmp_path / "capped.mcap", limits=Limits(max_bytes=1)).start()
+    recording.submit(Event(topics.NOTICES, {"n": 1}, time.time_ns()))
+    deadline = time.monotonic() + 5
+    while recording.stopped is None:
+        assert time.monotonic() < deadline
+        time.sleep(0.01)
+
+    def cpu() -> float:
+        usage = resource.getrusage(resource.RUSAGE_SELF)
+        return usage.ru_utime + usage.ru_stime
+
+    before = cpu()
+    time.sleep(0.6)
+    assert cpu() - before < 0.2, "the stopped writer spins"
+    started = time.monotonic()
+    recording.close()
+    assert time.monotonic() - started < 2.0
+    assert "size limit" in (recording.stopped or "")

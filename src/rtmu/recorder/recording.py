@@ -36,6 +36,8 @@ FLUSH_SECONDS = 1.0
 SYNC_SECONDS = 5.0
 """…and ``fsync``-ed this often: a power loss loses at most this much."""
 CLOSE_TIMEOUT = 5.0
+IDLE_WAIT = 1.0
+"""A stopped recording only drains its queue until it is closed: it waits this long per look."""
 _CLOSE = object()
 
 
@@ -123,8 +125,9 @@ class Recording:
         flush_at, sync_at = now + self.limits.flush_seconds, now + self.limits.sync_seconds
         reported_drops = 0
         while True:
+            wait = IDLE_WAIT if self.stopped is not None else max(0.0, flush_at - time.monotonic())
             try:
-                item = self._queue.get(timeout=max(0.0, flush_at - time.monotonic()))
+                item = self._queue.get(timeout=wait)
             except queue.Empty:
                 item = None
             if item is _CLOSE or (item is None and self._ending.is_set()):
