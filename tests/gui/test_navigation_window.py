@@ -82,6 +82,11 @@ def teal_count(pixels: np.ndarray) -> int:
     return int(np.count_nonzero(np.abs(pixels.astype(int) - want).sum(axis=2) < 60))
 
 
+def typing(gui: Gui) -> bool:
+    """A text field (the goals' search) has the keyboard focus."""
+    return isinstance(gui.window.get_focus(), Gtk.Editable)
+
+
 def open_goals(gui: Gui) -> Gtk.Popover:
     panel = gui.window.goals_panel
     pump(panel.get_visible, 5, "the Go to button (the server navigates)")
@@ -120,7 +125,7 @@ def choose_goal(gui: Gui, query: str) -> None:
     """Open the popover, type in its search field, press Return: the first goal that matches."""
     popover = open_goals(gui)
     panel = gui.window.goals_panel
-    pump(gui.window.keys.typing, 3, "the search field to have the keys")
+    pump(lambda: typing(gui), 3, "the search field to have the keys")
     gui.xdotool("type", "--delay", "40", query)
     pump(lambda: panel.search.get_text() == query, 3, "the query in the search field")
     gui.screen_shot("goals-search")
@@ -389,7 +394,11 @@ def test_what_the_server_does_not_list_stays_visible_greyed_with_its_reason() ->
     model = RobotModel()
     chosen: list[str] = []
     panel = GoalsPanel(
-        model, goto=chosen.append, run=chosen.append, pick=lambda kind: chosen.append(kind.value)
+        model,
+        goto=chosen.append,
+        run=chosen.append,
+        pick=lambda kind: chosen.append(kind.value),
+        stop=lambda: chosen.append("stop"),
     )
     try:
         assert not panel.get_visible(), "hidden while not connected"
@@ -418,3 +427,22 @@ def test_what_the_server_does_not_list_stays_visible_greyed_with_its_reason() ->
         assert chosen == ["Lab B"]
     finally:
         panel.close()
+
+
+def test_space_cancels_navigation_even_while_typing_in_the_goal_search(gui: Gui, sim: SimThread) -> None:
+    window, nav = gui.window, gui.model.navigation
+    window.goals_panel.choose("Lab B")
+    pump(lambda: nav.value.navigating and sim.snapshot().vel > 200, 10, "the robot to navigate")
+    popover = open_goals(gui)
+    pump(lambda: typing(gui), 3, "the search field to have the keys")
+    gui.xdotool("type", "--delay", "40", "lab")
+    pump(lambda: window.goals_panel.search.get_text() == "lab", 3, "letters typed, not driven")
+    assert sim_mode(sim) == "Goto", "typing letters (a, s, d …) in the search does not touch the robot"
+    gui.key("space")
+    pump(lambda: sim_mode(sim) == "stop", 3, "Space to stop the robot")
+    pump(lambda: stopped(sim), 5, "the robot to stop")
+    assert window.goals_panel.search.get_text() == "lab", "Space stopped; it typed nothing"
+    assert popover.get_mapped()
+    gui.screen_shot("space-stopped-while-typing")
+    popover.popdown()  # an open popover holds the keyboard: leave none for the next test
+    pump(lambda: not popover.get_mapped(), 3, "the popover to close")

@@ -11,9 +11,6 @@ controller's press/release (tracked by hardware keycode, so a release whose
 keyval changed — Shift let go first, Caps Lock — still releases), swallows
 auto-repeat, and leaves everything it does not know to the application
 accelerators (F11, Ctrl+T, Ctrl+Q …, listed here too for the shortcuts window).
-
-A text field that has the focus (the goals' search) gets its keys: letters, arrows and Escape edit
-and close it rather than drive — only the stop keys keep stopping (:data:`WHILE_TYPING`).
 """
 
 from __future__ import annotations
@@ -70,9 +67,6 @@ def bindings(registry: CommandRegistry = COMMANDS) -> tuple[Binding, ...]:
     )
     return commands + WINDOW_BINDINGS
 
-
-WHILE_TYPING = frozenset({"stop"})
-"""Commands whose keys still act while a text field has the focus: the operator's stop always works."""
 
 MODS = Gdk.ModifierType.CONTROL_MASK | Gdk.ModifierType.SHIFT_MASK | Gdk.ModifierType.ALT_MASK
 
@@ -135,13 +129,6 @@ class KeyRouter:
                 found = None
         return found
 
-    def typing(self) -> bool:
-        """A text field of this window (or of one of its popovers) has the keyboard focus."""
-        widget = self.controller.get_widget()
-        root = widget.get_root() if widget is not None else None
-        focus = root.get_focus() if root is not None else None
-        return isinstance(focus, Gtk.Editable)
-
     @property
     def held(self) -> dict[int, str]:
         return dict(self._held)
@@ -158,7 +145,7 @@ class KeyRouter:
         if keycode in self._held:
             return True  # auto-repeat of a held key
         binding = self.lookup(keyval, state)
-        if binding is None or (self.typing() and binding.target not in WHILE_TYPING):
+        if binding is None:
             return False
         if binding.kind == "hold":
             self._held[keycode] = binding.target
