@@ -336,11 +336,9 @@ class MainWindow(Gtk.ApplicationWindow):
         return osd
 
     def _menu(self) -> Gio.Menu:
-        """Nine rows at the top level (view switches in a submenu): it fits an 800×480 screen."""
+        """The robot's commands, then one section for the rest (view switches in a submenu): two
+        sections and one separator, so it still fits an 800×480 screen as the robot's rows grow."""
         menu = Gio.Menu()
-        conn = Gio.Menu()
-        conn.append("Connection settings…", "win.settings")
-        menu.append_section(None, conn)
         self.robot_menu = Gio.Menu()
         self._fill_robot_menu()
         menu.append_section(None, self.robot_menu)
@@ -351,8 +349,9 @@ class MainWindow(Gtk.ApplicationWindow):
         view.append("Camera inset on the map", "win.inset")
         view.append("Sonar readings", "win.sonar")
         view.append("Robot details…", "win.details")
-        conn.append_submenu("View", view)  # beside the settings: one separator less, 800×480 still fits
         app = Gio.Menu()
+        app.append("Connection settings…", "win.settings")
+        app.append_submenu("View", view)
         app.append("Keyboard shortcuts", "win.show-help-overlay")
         app.append("About RTMU", "win.about")
         app.append("Quit", "app.quit")
