@@ -230,7 +230,8 @@ class PopupsState:
 
     open: tuple[PopupInfo, ...] = ()
     dropped: int = 0
-    """Popups that arrived while the list was full (kept out, never shown): a flooding server."""
+    """Popups that arrived while the list was full (never shown; a flooding server), less those
+    the server has closed since."""
     offered: bool = False
     """The server offers popups (``popupCreate``) at all."""
 

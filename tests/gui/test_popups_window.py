@@ -175,6 +175,7 @@ def test_a_flood_of_popups_stays_bounded_plain_and_the_window_keeps_answering(
     assert max(widgets) < 60, f"{max(widgets)} widgets under the popup stack"
     assert max(latencies) < 1.5, f"key presses took {latencies} s during the flood"
     pump(lambda: not window.model.popups.value.open, 15, "the flood's popups to time out")
+    pump(lambda: not stack.get_visible(), 5, "the cards and their '+K more' to go")
     growth = rss_mb() - rss_before
     assert growth < 60, f"the window grew by {growth:.0f} MB during the flood"
     print(f"flood: {made} popups, {rebuilds} rebuilds, key latency {max(latencies) * 1000:.0f} ms max, "

@@ -120,8 +120,11 @@ class PopupFeed:
         if not isinstance(c, PopupClose):
             return
         gone = self._open.pop(c.popup_id, None)
-        if gone is None:
-            return  # not one we show (dropped in a flood, or closed twice): nothing to say
+        if gone is None:  # not one we keep: most likely one a flood made us drop, now closed
+            if self._dropped > 0:
+                self._dropped -= 1
+                self._changed()
+            return
         self._changed()
         text = cut(c.message.strip(), MAX_CLOSE_TEXT)
         if text:
