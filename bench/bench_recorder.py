@@ -11,7 +11,8 @@ reports its own CPU time (all threads), so the simulator's work is not counted.
 * ``recorder.mb_per_hour``: what the measured part added to the file, extrapolated to one hour
   (the map, written once before, left out). The simulator's pictures are small (``picture_kb``);
 * ``recorder.mb_per_hour_40kb_camera``: the same with the pictures a real 640×480 camera sends
-  (~40 kB JPEGs at 10/s; JPEG does not compress further): measured rest + 40 kB × 10/s. A picture
+  (~40 kB JPEGs at 10/s; JPEG does not compress further): ``mb_per_hour_no_camera`` (the same
+  session recorded without pictures, measured) + 40 kB × 10/s. A picture
   is in the file twice (raw bytes and CompressedImage), but both land in one zstd chunk, which
   stores the second copy as a back-reference (100 random 40 kB pictures written twice: 4.0 MB).
 * ``recorder.submit_us``: what one item costs the thread that produces it (the network
@@ -41,8 +42,8 @@ SECONDS = float(os.environ.get("RTMU_RECORDER_BENCH_SECONDS", "20"))
 CAMERA_HZ = 10.0
 
 
-def client(port: int, out: str) -> dict[str, float]:
-    cmd = [sys.executable, "-m", "bench.recorder_client", str(port), str(SECONDS), str(CAMERA_HZ), out]
+def client(port: int, out: str, camera_hz: float = CAMERA_HZ) -> dict[str, float]:
+    cmd = [sys.executable, "-m", "bench.recorder_client", str(port), str(SECONDS), str(camera_hz), out]
     done = subprocess.run(cmd, capture_output=True, text=True, timeout=SECONDS + 120, cwd=REPO)
     if done.returncode != 0:
         raise RuntimeError(f"recorder client failed: {done.stderr[-2000:]}")
@@ -65,14 +66,15 @@ def run() -> list[Result]:
         sim.call(lambda: setattr(sim.server, "video_size", (640, 480)))
         off = client(sim.port, "-")
         on = client(sim.port, str(Path(tmp) / "bench.mcap"))
+        still = client(sim.port, str(Path(tmp) / "no-camera.mcap"), camera_hz=0.0)
     if on.get("stopped") or on.get("dropped"):
         raise RuntimeError(f"the recording did not keep up: {on}")
     pct_on = 100.0 * on["cpu_s"] / on["wall_s"]
     pct_off = 100.0 * off["cpu_s"] / off["wall_s"]
     per_hour = on["bytes"] / on["wall_s"] * 3600.0 / 1e6
     picture_kb = on["picture_bytes"] / max(1, on["pictures"]) / 1e3
-    rest = max(0.0, on["bytes"] - on["picture_bytes"]) / on["wall_s"]
-    real_camera = (rest + 40e3 * CAMERA_HZ) * 3600.0 / 1e6
+    no_camera = still["bytes"] / still["wall_s"] * 3600.0 / 1e6
+    real_camera = no_camera + 40e3 * CAMERA_HZ * 3600.0 / 1e6
     print(
         f"recorder: {on['pictures']} pictures ({picture_kb:.1f} kB each), {on['items']} items, "
         f"{on['bytes'] / 1e6:.2f} MB in "
@@ -84,6 +86,7 @@ def run() -> list[Result]:
         Result("recorder.cost_pct_of_core", pct_on - pct_off, "% of a core"),
         Result("recorder.mb_per_hour", per_hour, "MB"),
         Result("recorder.picture_kb", picture_kb, "kB"),
+        Result("recorder.mb_per_hour_no_camera", no_camera, "MB"),
         Result("recorder.mb_per_hour_40kb_camera", real_camera, "MB"),
         Result("recorder.submit_us", submit_cost() * 1e6, "us"),
         Result("recorder.max_loop_lag_ms", on["max_loop_lag_s"] * 1000, "ms", off["max_loop_lag_s"] * 1000),
