@@ -235,6 +235,10 @@ def test_click_to_go_with_a_dragged_heading(gui: Gui, sim: SimThread) -> None:
     pump(lambda: not popover.get_mapped(), 3, "the popover to close")
     assert window.picker.kind is MarkerKind.GOTO and window.pose_bar.get_visible()
     assert not window.pose_bar.go_button.get_sensitive(), "nothing to send before a click"
+    gui.key("Escape")  # Esc leaves the mode (it does not open the camera page)
+    pump(lambda: not window.picker.active and not window.pose_bar.get_visible(), 3, "Esc to end the mode")
+    assert window.stack.get_visible_child_name() == "map"
+    window.start_pick(MarkerKind.GOTO)
     target, heading = (6000.0, 6000.0), 90.0
     before = gui.stage.viewport
     drag_on_map(gui, *target, heading)
