@@ -33,7 +33,10 @@ def test_motion_says_autonomous_or_held_and_nothing_without_a_link() -> None:
     assert going_text(NavState(navigating=True, target="home")) == "Going home"
     assert going_text(NavState(navigating=True, target="point")) == "Going to the point"
     kind, lines = motion_text(GOING, held=True, link_up=True)
-    assert kind == "autonomous" and lines[0] == "Navigating (autonomous)" and "cancels" in lines[2]
+    assert (kind, lines) == (
+        "autonomous",
+        ("Navigating (autonomous)", "To Lab B", "12.4 m left · Space or STOP cancels"),
+    )
     assert motion_text(NavState(), held=True, link_up=True)[0] == "held"
     assert motion_text(NavState(), held=False, link_up=True) == ("", ())
     assert motion_text(GOING, held=False, link_up=False) == ("", ()), "the link banner says it then"

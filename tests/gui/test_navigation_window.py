@@ -143,7 +143,8 @@ def test_choosing_a_goal_drives_there_rings_its_cairn_and_says_arrived(gui: Gui,
     assert gui.model.robot.value.x == pytest.approx(start.x, abs=50), "typing in the search did not drive"
     pump(lambda: nav.value.navigating and nav.value.target == "Meeting Room", 5, "navigation to start")
     pump(lambda: window.motion.kind == "autonomous", 3, "the autonomous motion indicator")
-    assert window.motion.text.startswith("Navigating (autonomous) · Going to Meeting Room")
+    assert window.motion.text.startswith("Navigating (autonomous) · To Meeting Room · ")
+    assert "m left · Space or STOP cancels" in window.motion.text
     assert window.goals_panel.rows["Meeting Room"].has_css_class("current-goal")
     # The goal's cairn is ringed while the robot heads there.
     pixels = gui.stage_pixels()

@@ -3,7 +3,8 @@
 The server driving the robot by itself and the operator holding a key are different promises — one
 stops when a key is let go, the other does not — so the window names the one in force in a pill at
 the map's top left (teal for autonomy, blue for a held drive, nothing while the robot is left alone):
-a bold title, then where to and how far ("Going to Lab B — 12.4 m left"), then how to end it. Short
+a bold title, then where to ("To Lab B"), then how far and how to end it ("12.4 m left · Space or
+STOP cancels"). Short
 lines keep it narrow, clear of the banners centred at the top, even at 800 px. The words are
 ``nav_text.motion_text``; ``held()`` asks the controller whether a drive is held now (the window's
 timer calls :meth:`refresh`, so the pill follows key presses within a tick). While the link is lost
@@ -38,8 +39,8 @@ class MotionIndicator(Gtk.Box):
             getattr(self, f"set_margin_{side}")(8)
         self.set_can_target(False)
         self.lines: list[Gtk.Label] = []
-        for css in ("motion-title", "motion-detail", "motion-hint"):
-            label = Gtk.Label(xalign=0.0, max_width_chars=28)
+        for css, chars in (("motion-title", 28), ("motion-detail", 28), ("motion-hint", 36)):
+            label = Gtk.Label(xalign=0.0, max_width_chars=chars)
             label.add_css_class(css)
             label.set_ellipsize(Pango.EllipsizeMode.END)
             label.set_use_markup(False)  # goal names are the server's text

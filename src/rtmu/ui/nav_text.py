@@ -51,7 +51,8 @@ def _head(nav: NavState) -> str:
 def motion_text(nav: NavState, *, held: bool, link_up: bool) -> tuple[str, tuple[str, ...]]:
     """(kind, lines) for the motion indicator; kind ``autonomous``, ``held`` or "" (hidden).
 
-    Short lines (title, where to, how to end it) keep the pill narrow, clear of the banners.
+    Short lines (title, where to, how far and how to end it) keep the pill narrow, clear of the
+    banners; a long goal name is cut on its own line, never the distance.
     Autonomy wins when both are true for a moment (a key press cancels navigation, and the
     indicator follows once the server has said so). A lost link is said by the link banner alone
     (see :func:`link_lost_note`): one place, not two.
@@ -59,7 +60,9 @@ def motion_text(nav: NavState, *, held: bool, link_up: bool) -> tuple[str, tuple
     if not link_up:
         return "", ()
     if nav.navigating:
-        return "autonomous", ("Navigating (autonomous)", going_text(nav), "Space or STOP cancels")
+        dest = "Going home" if nav.target == "home" else f"To {where(nav.target)}"
+        left = "" if nav.remaining_mm is None else f"{nav.remaining_mm / 1000:.1f} m left · "
+        return "autonomous", ("Navigating (autonomous)", dest, f"{left}Space or STOP cancels")
     if held:
         return "held", ("Driving (held keys)", "Let go to stop")
     return "", ()

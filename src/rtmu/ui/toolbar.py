@@ -115,7 +115,7 @@ class StatusToolbar(Gtk.ScrolledWindow):
             "speed": Cell("Throttle", width_chars=5),
             "link": Cell("Link: rtt, age", width_chars=12),
             "dock": Cell("Dock", width_chars=9),
-            "loc": Cell("Localization", width_chars=8),
+            "loc": Cell("Localization", width_chars=9),
         }
         for cell in self.cells.values():
             self.row.append(cell)
