@@ -2,7 +2,9 @@
 
 from __future__ import annotations
 
+import atexit
 import os
+import shutil
 import tempfile
 from pathlib import Path
 
@@ -14,7 +16,9 @@ SHARED_DIR = REPO_ROOT.parent / "shared"
 
 # The window records every session (rtmu.recorder) under $XDG_DATA_HOME: never into the real home
 # from a test, nor from the windows and subprocesses tests start (they inherit this environment).
-os.environ["XDG_DATA_HOME"] = tempfile.mkdtemp(prefix="rtmu-test-data-")
+os.environ["XDG_DATA_HOME"] = _DATA_HOME = tempfile.mkdtemp(prefix="rtmu-test-data-")
+# Removed when the run ends (a GUI run must leave only its screenshots in /tmp: tests/gui/test_cleanup.py).
+atexit.register(shutil.rmtree, _DATA_HOME, ignore_errors=True)
 
 # Hypothesis's own "ci" profile (deterministic, no deadline) loads itself when CI is set. Locally we
 # only drop the 200 ms deadline: other work shares these two cores, and speed is bench/'s business.

@@ -54,7 +54,9 @@ def main(argv: Sequence[str] | None = None) -> int:
 
         return gui_app.run_gui(args)
     try:
-        return int(handler(args) or 0)
+        code = int(handler(args) or 0)
+        sys.stdout.flush()  # a block-buffered pipe fails here, not at exit (exit 120 and a warning)
+        return code
     except BrokenPipeError:
         # Whoever read our output went away (`rtmu mapinfo … | head`): no traceback for that. The
         # handler's own finally blocks (a drive's stop) have run; nothing more will be printed.
