@@ -82,11 +82,21 @@ def test_ctrl_z_stops_the_robot_then_the_process_and_nothing_drives_after_resume
             assert proc.poll() is None
             screenshot(screenshots / "test_suspend-01-resumed.png", window)
 
-            xdotool("keyup", "Up")  # a real release, then a fresh press drives again
-            held = False
-            xdotool("keydown", "Up")
-            held = True
-            wait(lambda: drives_received() > frozen_at, 5, "a fresh press to drive again")
+            # A real release, then a fresh press drives again. The operator is at the window: give it
+            # the focus back first (a resumed process on a busy X server may not have it yet), and
+            # press again if a press was lost — never without a release before it.
+            xdotool("windowfocus", "--sync", window)
+            for attempt in range(3):
+                xdotool("keyup", "Up")
+                held = False
+                xdotool("keydown", "Up")
+                held = True
+                try:
+                    wait(lambda: drives_received() > frozen_at, 5, "a fresh press to drive again")
+                    break
+                except AssertionError:
+                    if attempt == 2:
+                        raise
             # The handler is back after the resume: a second Ctrl+Z stops the robot again first.
             proc.send_signal(signal.SIGTSTP)
             wait(lambda: process_state(proc.pid) == "T", 5, "the process to stop a second time")
