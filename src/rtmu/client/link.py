@@ -110,22 +110,16 @@ class Chunk:
     written_before: int
 
 
-class RecordingLink:
-    """Wraps a link and keeps every chunk it reads, with the client's output count at that moment."""
+class LinkWrapper:
+    """A link around another one: everything goes to ``inner``; subclasses watch ``read``/``write``."""
 
     def __init__(self, inner: Link) -> None:
         self.inner = inner
-        self.chunks: list[Chunk] = []
-        self.written = 0
 
     async def read(self, max_bytes: int) -> bytes:
-        data = await self.inner.read(max_bytes)
-        if data:
-            self.chunks.append(Chunk(data, self.written))
-        return data
+        return await self.inner.read(max_bytes)
 
     def write(self, data: bytes) -> None:
-        self.written += len(data)
         self.inner.write(data)
 
     def backlog(self) -> int:
@@ -145,6 +139,25 @@ class RecordingLink:
 
     def abort(self) -> None:
         self.inner.abort()
+
+
+class RecordingLink(LinkWrapper):
+    """Wraps a link and keeps every chunk it reads, with the client's output count at that moment."""
+
+    def __init__(self, inner: Link) -> None:
+        super().__init__(inner)
+        self.chunks: list[Chunk] = []
+        self.written = 0
+
+    async def read(self, max_bytes: int) -> bytes:
+        data = await self.inner.read(max_bytes)
+        if data:
+            self.chunks.append(Chunk(data, self.written))
+        return data
+
+    def write(self, data: bytes) -> None:
+        self.written += len(data)
+        self.inner.write(data)
 
 
 class ReplayLink:

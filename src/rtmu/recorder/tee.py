@@ -10,17 +10,17 @@ from __future__ import annotations
 import time
 from collections.abc import Callable
 
-from ..client.link import Link, Opener
+from ..client.link import Link, LinkWrapper, Opener
 from .items import RawChunk
 
 RawSink = Callable[[RawChunk], object]
 
 
-class TeeLink:
+class TeeLink(LinkWrapper):
     """Wraps ``inner``; ``sink`` gets every chunk read (``s2c``) and written (``c2s``) on ``conn``."""
 
     def __init__(self, inner: Link, conn: int, sink: RawSink) -> None:
-        self.inner = inner
+        super().__init__(inner)
         self.conn = conn
         self.sink = sink
 
@@ -34,24 +34,6 @@ class TeeLink:
         self.inner.write(data)
         if data:
             self.sink(RawChunk(self.conn, "c2s", bytes(data), time.time_ns()))
-
-    def backlog(self) -> int:
-        return self.inner.backlog()
-
-    def is_closing(self) -> bool:
-        return self.inner.is_closing()
-
-    async def drain(self) -> None:
-        await self.inner.drain()
-
-    def close(self) -> None:
-        self.inner.close()
-
-    async def wait_closed(self) -> None:
-        await self.inner.wait_closed()
-
-    def abort(self) -> None:
-        self.inner.abort()
 
 
 def tee_opener(inner: Opener, opened: Callable[[str, int], tuple[int, RawSink] | None]) -> Opener:
