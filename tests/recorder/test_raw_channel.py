@@ -112,6 +112,12 @@ def test_the_raw_channel_decodes_to_exactly_the_live_packets(tmp_path: Path) -> 
     assert not source.stats.warnings
 
 
+def _subscribed_data_arrived(runner: ClientRunner) -> bool:
+    """The current connection has delivered a few subscribed packets (status among them)."""
+    client = runner.session.client if runner.session is not None else None
+    return client is not None and client.packets_received >= 5
+
+
 def test_raw_chunks_after_a_reconnect_belong_to_the_new_connection(tmp_path: Path) -> None:
     """A connection record before each connection's chunks: the decoder keeps their data lists apart."""
     out = tmp_path / "two.mcap"
@@ -122,7 +128,11 @@ def test_raw_chunks_after_a_reconnect_belong_to_the_new_connection(tmp_path: Pat
         with runner:
             runner.connect("127.0.0.1", sim.port).result(10)
             eventually(lambda: len(recorder.recordings) == 1)
+            # Status must have flowed on the first connection before it is replaced (a loaded
+            # machine once replaced it before its first updateNumbers).
+            eventually(lambda: _subscribed_data_arrived(runner))
             runner.connect("127.0.0.1", sim.port).result(10)
+            eventually(lambda: _subscribed_data_arrived(runner))
             time.sleep(0.3)
         recorder.close()
     source = open_capture(out)
