@@ -20,8 +20,14 @@ import tempfile
 import time
 from collections.abc import Iterator
 from pathlib import Path
+from typing import TYPE_CHECKING
 
 import pytest
+
+if TYPE_CHECKING:
+    from rtmu.sim import SimThread
+
+    from .harness import Gui
 
 REPO = Path(__file__).resolve().parents[2]
 _XVFB = shutil.which("Xvfb")
@@ -233,3 +239,15 @@ def every_test_leaves_a_clean_x_server_and_no_processes(request: pytest.FixtureR
             f"this test left {left_open} app(s) open and {len(killed)} process(es) running: {killed}",
             pytrace=False,
         )
+
+
+@pytest.fixture
+def gui(request: pytest.FixtureRequest, screenshots: Path, sim: SimThread) -> Iterator[Gui]:
+    """The real window connected to the module's ``sim`` fixture (each module picks its simulator)."""
+    from .harness import Gui  # imports GTK: only once the display is set up
+
+    g = Gui.start(screenshots, request.node.name, "127.0.0.1", sim.port)
+    try:
+        yield g
+    finally:
+        g.close()

@@ -39,15 +39,6 @@ def sim() -> Iterator[SimThread]:
         yield s
 
 
-@pytest.fixture
-def gui(request: pytest.FixtureRequest, screenshots: Path, sim: SimThread) -> Iterator[Gui]:
-    g = Gui.start(screenshots, request.node.name, "127.0.0.1", sim.port)
-    try:
-        yield g
-    finally:
-        g.close()
-
-
 # -- helpers --------------------------------------------------------------------------------------
 
 

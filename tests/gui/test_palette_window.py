@@ -8,7 +8,6 @@ server took the command, and that the palette closes and gives the keyboard back
 from __future__ import annotations
 
 from collections.abc import Iterator
-from pathlib import Path
 
 import pytest
 
@@ -23,15 +22,6 @@ from .harness import Gui, pump
 def sim() -> Iterator[SimThread]:
     with SimThread(SimConfig(port=0, map_path=None, camera=False, seed=1)) as s:
         yield s
-
-
-@pytest.fixture
-def gui(request: pytest.FixtureRequest, screenshots: Path, sim: SimThread) -> Iterator[Gui]:
-    g = Gui.start(screenshots, request.node.name, "127.0.0.1", sim.port)
-    try:
-        yield g
-    finally:
-        g.close()
 
 
 def palette() -> CommandPalette | None:

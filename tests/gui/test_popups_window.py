@@ -12,7 +12,6 @@ from __future__ import annotations
 import resource
 import time
 from collections.abc import Iterator
-from pathlib import Path
 from typing import Any
 
 import pytest
@@ -27,15 +26,6 @@ from .harness import OFFICE_MAP, Gui, idle, pump
 def sim() -> Iterator[SimThread]:
     with SimThread(SimConfig(port=0, map_path=OFFICE_MAP, camera=False, seed=1)) as s:
         yield s
-
-
-@pytest.fixture
-def gui(request: pytest.FixtureRequest, screenshots: Path, sim: SimThread) -> Iterator[Gui]:
-    g = Gui.start(screenshots, request.node.name, "127.0.0.1", sim.port)
-    try:
-        yield g
-    finally:
-        g.close()
 
 
 def raise_popup(sim: SimThread, title: str, message: str, **kw: Any) -> int:

@@ -11,7 +11,6 @@ from __future__ import annotations
 import math
 import re
 from collections.abc import Iterator
-from pathlib import Path
 
 import numpy as np
 import pytest
@@ -26,15 +25,6 @@ from .harness import OFFICE_MAP, Gui, idle, pump
 def sim() -> Iterator[SimThread]:
     with SimThread(SimConfig(port=0, map_path=OFFICE_MAP, camera=True, seed=1)) as s:
         yield s
-
-
-@pytest.fixture
-def gui(request: pytest.FixtureRequest, screenshots: Path, sim: SimThread) -> Iterator[Gui]:
-    g = Gui.start(screenshots, request.node.name, "127.0.0.1", sim.port)
-    try:
-        yield g
-    finally:
-        g.close()
 
 
 def received(sim: SimThread) -> tuple[float, float, float, float] | None:
