@@ -15,6 +15,7 @@ from rtmu.protocol.payloads import (
     NameMatch,
     Payload,
     Side,
+    central,
     commands,
     decode_payload,
     drive,
@@ -127,6 +128,13 @@ SAMPLES: list[Payload] = [
     navigation.PlannedPath(((0, 0), (1500, -200))),
     navigation.PathPlannerStatus("Moving to goal"),
     navigation.GoalName("Kitchen"),
+    central.ClientList((central.CentralEntry("", 7273, "robot1", "", "10.0.0.5"),)),
+    central.ClientAdded(central.CentralEntry("", 7274, "robot2", "", "10.0.0.6")),
+    central.ClientRemoved(central.CentralEntry("central.lan", 7274, "robot2", "", "10.0.0.6")),
+    central.SwitchRequest("robot1"),
+    central.SwitchAccepted(),
+    central.CentralServerHeartbeat(),
+    central.CentralHeartbeat(),
 ]
 TYPES = sorted(registered().values(), key=lambda c: (c.DATA_NAME, c.SIDE.value))
 

@@ -36,6 +36,13 @@ class SimConfig:
     """Enforce a client type (reason 6), as ``ArServerBase::enforceType`` does."""
     central_server: str | None = None
     """Pretend to be managed by a central server at this address: every login gets reason 2."""
+    switch_to: str | None = None
+    """``HOST[:PORT]`` of a central server's robot port (ARIA's ``-centralServer``): connect out and
+    switch (:mod:`rtmu.sim.switch`); direct logins are then refused with reason 2, as ARIA's are."""
+    switch_name: str = ""
+    """The name to switch with (ARIA's ``-identifier``); empty: the central server uses our address."""
+    switch_retry: float = 10.0
+    """Seconds before switching again after the central server's connection ended (ARIA: 10)."""
     video_trailer: bool = True
     """Append the 2 bytes ARIA's video forwarder leaves after each JPEG (serverDemo does this)."""
     render_in_thread: bool | None = None

@@ -43,6 +43,7 @@ from rtmu.protocol.payloads.control import ClientIntroduction
 from rtmu.protocol.payloads.ld import DockInfoChanged
 from rtmu.protocol.server_connection import ServerConnection, ServerState
 
+from . import switch
 from .catalogue import Row, custom_commands
 from .config import SimConfig
 from .handlers import (
@@ -377,6 +378,11 @@ class SimServer:
         self.video_size: tuple[int, int] = (320, 240)
         threaded = cfg.realtime if cfg.render_in_thread is None else cfg.render_in_thread
         self.video = VideoFeed(threaded=threaded)
+        self._switch_task: asyncio.Task[None] | None = None
+        if cfg.switch_to is not None:
+            switch.add_switch_data(self.datalist, self.handlers)
+            if cfg.central_server is None:  # as ARIA's robot servers do: direct logins get reason 2
+                cfg.central_server = switch.parse_address(cfg.switch_to)[0]
 
     @property
     def robot(self):
@@ -404,9 +410,14 @@ class SimServer:
                     number = self.datalist.number(name)
                     if number is not None:
                         loop.run_in_executor(None, make, number)
+        if cfg.switch_to is not None:
+            host, port = switch.parse_address(cfg.switch_to)
+            switching = switch.switch_loop(host, port, cfg.switch_name, cfg.switch_retry, self.serve_switched)
+            self._switch_task = asyncio.create_task(switching, name="rtmu-sim-switch")
 
     async def stop(self) -> None:
         """Say SHUTDOWN to every client, let the bytes go, close everything."""
+        self._stop_switching()
         if self._cycle_task is not None:
             self._cycle_task.cancel()
             with contextlib.suppress(asyncio.CancelledError):
@@ -438,6 +449,7 @@ class SimServer:
 
     def kill(self) -> None:
         """Die abruptly: no SHUTDOWN, sockets reset (for lost-link tests)."""
+        self._stop_switching()
         if self._cycle_task is not None:
             self._cycle_task.cancel()
             self._cycle_task = None
@@ -446,6 +458,15 @@ class SimServer:
         self.video.close()
         for s in list(self.sessions):
             s.abort()
+
+    def _stop_switching(self) -> None:
+        if self._switch_task is not None:
+            self._switch_task.cancel()
+            self._switch_task = None
+
+    async def serve_switched(self, reader: asyncio.StreamReader, writer: asyncio.StreamWriter) -> None:
+        """Serve the socket a central server accepted our switch on: its login is never refused as direct."""
+        await self._serve(reader, writer, None)
 
     def forget(self, session: Session) -> None:
         with contextlib.suppress(ValueError):
@@ -468,6 +489,12 @@ class SimServer:
                 "Server rejecting connection since it would exceed the maximum number of allowed "
                 f"connections (which is {cfg.max_clients})",
             )
+        await self._serve(reader, writer, general)
+
+    async def _serve(
+        self, reader: asyncio.StreamReader, writer: asyncio.StreamWriter, general: tuple[int, str] | None
+    ) -> None:
+        cfg = self.config
         conn = SimServerConnection(
             self.datalist,
             self.users,

@@ -117,6 +117,7 @@ def add_connection_arguments(parser: argparse.ArgumentParser) -> None:
     # No abbreviations: "--password secret" must not be taken for "--password-file secret".
     parser.allow_abbrev = False
     _refuse_unknown_quietly(parser)
+    _resolve_robot_first(parser)
     parser.add_argument(
         "server", type=host_port, metavar="HOST[:PORT]", help="robot server (port 7272 by default)"
     )
@@ -142,6 +143,78 @@ def add_connection_arguments(parser: argparse.ArgumentParser) -> None:
         metavar="S",
         help=f"seconds to wait for the server at each step (default {CONNECT_TIMEOUT:g})",
     )
+    parser.add_argument(
+        "--robot",
+        metavar="NAME",
+        default=None,
+        help="HOST[:PORT] is an ARIA central server: act on its robot NAME, through the port it "
+        "forwards that robot on ('rtmu fleet HOST' lists them)",
+    )
+
+
+def _resolve_robot_first(parser: argparse.ArgumentParser) -> None:
+    """With ``--robot NAME``, the subcommand's handler first resolves NAME through the central server.
+
+    The handler then sees ``args.server`` as the robot's forwarded address, so every subcommand (and a
+    drive's guardian, which logs in to ``args.server`` too) reaches that robot without knowing.
+    """
+    parse_known = parser.parse_known_args
+
+    def parse_known_args(args: Any = None, namespace: Any = None) -> tuple[argparse.Namespace, list[str]]:
+        namespace, extras = parse_known(args, namespace)
+        handler = getattr(namespace, "handler", None)
+        robot = getattr(namespace, "robot", None)
+        if robot is not None and handler is not None and not getattr(handler, "resolves_robot", False):
+            namespace.handler = _through_central(handler)
+        return namespace, extras
+
+    parser.parse_known_args = parse_known_args  # type: ignore[method-assign,assignment]
+
+
+def _through_central(handler: Callable[[argparse.Namespace], int]) -> Callable[[argparse.Namespace], int]:
+    def resolved(args: argparse.Namespace) -> int:
+        code = resolve_robot(args)
+        return code if code is not None else handler(args)
+
+    resolved.resolves_robot = True  # type: ignore[attr-defined]
+    return resolved
+
+
+def resolve_robot(args: argparse.Namespace) -> int | None:
+    """Point ``args.server`` at robot ``args.robot`` behind the central server ``args.server``.
+
+    None when done; else the exit code, after one line on stderr: 2 for a name the central server
+    does not list (naming the ones it does), 3/4/5 as for any login.
+    """
+    from ..client.central import list_robots
+    from ..textsafe import visible
+
+    name = str(getattr(args, "subcommand", None) or "rtmu")
+    try:
+        password = read_password(args)
+    except UsageError as exc:
+        return fail(name, str(exc), EXIT_USAGE)
+    except (KeyboardInterrupt, EOFError):
+        return fail(name, "cancelled", EXIT_USAGE)
+    host, port = args.server
+    try:
+        robots = asyncio.run(list_robots(host, port, args.user, password, timeout=args.timeout))
+    except ClientError as exc:
+        return fail(name, f"central server {host}:{port}: {exc}", exc.exit_code)
+    except ProtocolError as exc:
+        return fail(name, f"central server {host}:{port} sent a malformed robot list: {exc}", EXIT_CONNECTION)
+    except KeyboardInterrupt:
+        return fail(name, "interrupted by SIGINT", 128 + signal.SIGINT)
+    wanted = args.robot
+    found = [e for e, _ in robots if e.name == wanted] or [
+        e for e, _ in robots if e.name.lower() == wanted.lower()
+    ]
+    if not found:
+        listed = visible(", ".join(e.name for e, _ in robots) or "none")
+        where = f"behind the central server {host}:{port}"
+        return fail(name, f"no robot {wanted!r} {where} (robots: {listed})", EXIT_USAGE)
+    args.server = (found[0].host, found[0].port)
+    return None
 
 
 class UsageError(Exception):
@@ -150,6 +223,15 @@ class UsageError(Exception):
 
 def read_password(args: argparse.Namespace) -> str:
     """From ``--password-file``, else a prompt on the terminal (or one line of stdin when piped)."""
+    cached = getattr(args, "password_read", None)
+    if isinstance(cached, str):  # asked already (for the central server of --robot): never twice
+        return cached
+    password = _read_password(args)
+    args.password_read = password
+    return password
+
+
+def _read_password(args: argparse.Namespace) -> str:
     path: Path | None = getattr(args, "password_file", None)
     if path is not None:
         try:

@@ -81,6 +81,30 @@ def register(subparsers: argparse._SubParsersAction) -> None:
         "(default: the profile's — none, or 6MTX for aram)",
     )
     p.add_argument("-v", "--verbose", action="store_true", help="log connections and refusals")
+    central = p.add_argument_group("ARIA central server (switchServer)")
+    central.add_argument(
+        "--central",
+        action="store_true",
+        help="be a central server instead of a robot: operators on --port (7272) get the robot list, "
+        "robots switch to --robot-port (5000) and are each forwarded on a port of their own",
+    )
+    central.add_argument(
+        "--robot-port", type=int, default=5000, help="with --central: where robots switch to (default 5000)"
+    )
+    central.add_argument(
+        "--robots",
+        type=int,
+        default=0,
+        metavar="N",
+        help="with --central: also run N simulated robots (robot1…robotN) switched to it",
+    )
+    central.add_argument(
+        "--switch-to",
+        metavar="HOST[:PORT]",
+        help="as a robot: connect out to this central server's robot port (default port 5000) and be "
+        "forwarded by it (ARIA's -centralServer); direct logins are then refused with reason 2",
+    )
+    central.add_argument("--name", default="", help="with --switch-to: the robot's name (ARIA's -identifier)")
     gen = p.add_argument_group("map generator (writes a map and exits)")
     gen.add_argument("--make-map", type=Path, metavar="FILE", help="write a generated building map to FILE")
     gen.add_argument("--points", type=int, default=100_000, help="points in the generated map")
@@ -91,6 +115,12 @@ def register(subparsers: argparse._SubParsersAction) -> None:
 def run(args: argparse.Namespace) -> int:
     if args.make_map is not None:
         return make_map(args)
+    if args.robots < 0 or args.robots > 100:
+        print("rtmu sim: --robots takes 0…100", file=sys.stderr)
+        return EXIT_BAD_INPUT
+    if args.robots and not args.central:
+        print("rtmu sim: --robots N here runs robots behind --central", file=sys.stderr)
+        return EXIT_BAD_INPUT
     from ..sim import SimConfig
 
     map_path = (
@@ -120,11 +150,24 @@ def run(args: argparse.Namespace) -> int:
     )
     if args.battery is not None:
         cfg.battery_v = args.battery
+    if args.switch_to:
+        from ..sim.switch import parse_address
+
+        try:
+            parse_address(args.switch_to)
+        except ValueError as exc:
+            print(f"rtmu sim: {exc}", file=sys.stderr)
+            return EXIT_BAD_INPUT
+        cfg.switch_to, cfg.switch_name = args.switch_to, args.name
     if args.verbose:
         import logging
 
         logging.basicConfig(level=logging.INFO, format="%(asctime)s %(name)s: %(message)s")
     try:
+        if args.central:
+            from ._sim_central import serve_central
+
+            return asyncio.run(serve_central(cfg, args.robot_port, args.robots))
         return asyncio.run(serve(cfg))
     except KeyboardInterrupt:
         return EXIT_OK

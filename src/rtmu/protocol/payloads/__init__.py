@@ -6,6 +6,7 @@ finds a decoder by data name.
 
 from . import (
     camera,
+    central,
     commands,
     control,
     drive,
@@ -35,6 +36,7 @@ __all__ = [
     "Payload",
     "Side",
     "camera",
+    "central",
     "commands",
     "control",
     "decode_payload",

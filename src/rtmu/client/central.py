@@ -1,0 +1,224 @@
+"""The operator's side of ARIA's central server: which robots it forwards, and where.
+
+:func:`list_robots` asks once (``clientList``; used by ``rtmu fleet`` and ``--robot NAME``).
+:class:`CentralRoster` is a :class:`~rtmu.client.roster.Roster` that stays logged in on a thread of its
+own: the list first, then the ``clientAdded`` / ``clientRemoved`` broadcasts, each turned into a
+:class:`RobotAdded` / :class:`RobotRemoved`; when the central server's connection ends (or never came
+up), one :class:`RosterLost`. Every robot is reached on the central server's host (ARIA sends an empty
+hostname) at its forwarded port, unless the entry names another host.
+
+The central server is trusted no more than a robot: at most :data:`MAX_ROBOTS` robots are held, names
+longer than :data:`MAX_NAME` or entries without a port are dropped (and counted), and names are kept as
+plain text — whoever shows them escapes them.
+"""
+
+from __future__ import annotations
+
+import asyncio
+import contextlib
+import logging
+import threading
+from collections.abc import Callable
+from typing import Any
+
+from ..protocol.payloads.central import CentralEntry, ClientAdded, ClientList, ClientRemoved
+from .connection import CONNECT_TIMEOUT, DEFAULT_PORT, AriaClient, Packet
+from .errors import ClientError
+from .roster import Emit, RobotAdded, RobotEndpoint, RobotRemoved, RosterEvent, RosterLost
+
+log = logging.getLogger("rtmu.central")
+
+MAX_ROBOTS = 1000
+"""Robots one roster holds; more are dropped (a fleet this big is not one operator's)."""
+MAX_NAME = 512
+"""ARIA's central server keeps a robot's name in 512 bytes; a longer one is not a robot's."""
+CLOSE_JOIN_TIMEOUT = 2.0
+
+Post = Callable[..., Any]
+"""``post(fn, *args)``: run ``fn(*args)`` on the consumer's thread (``GLib.idle_add``, or a direct call)."""
+
+
+def _direct(fn: Callable[..., Any], *args: Any) -> None:
+    fn(*args)
+
+
+def endpoint_of(entry: CentralEntry, central_host: str, central_port: int) -> RobotEndpoint | None:
+    """The address an operator reaches ``entry`` at; None for an entry no robot could have sent."""
+    if not entry.name or len(entry.name) > MAX_NAME or not 0 < entry.port <= 0xFFFF:
+        return None
+    if len(entry.hostname) > MAX_NAME:
+        return None
+    host = entry.hostname or central_host
+    return RobotEndpoint(entry.name, host, entry.port, via=f"{central_host}:{central_port}")
+
+
+async def list_robots(
+    host: str,
+    port: int = DEFAULT_PORT,
+    user: str = "",
+    password: str = "",
+    *,
+    timeout: float = CONNECT_TIMEOUT,
+    protocol: str | None = None,
+) -> list[tuple[RobotEndpoint, CentralEntry]]:
+    """Log in to the central server, read ``clientList`` once, log out.
+
+    Raises :class:`~rtmu.client.errors.ClientError` (``NotSupported`` when the server is not a central
+    server) or a ``ProtocolError`` for a list that does not decode.
+    """
+    client = AriaClient()
+    try:
+        await client.connect(host, port, user, password, timeout=timeout, protocol=protocol)
+        reply = await client.request_once(ClientList.DATA_NAME, timeout=timeout)
+        listed = ClientList.decode(reply.payload)
+    finally:
+        await client.disconnect()
+    out: list[tuple[RobotEndpoint, CentralEntry]] = []
+    seen: set[str] = set()
+    for entry in listed.entries[:MAX_ROBOTS]:
+        endpoint = endpoint_of(entry, host, port)
+        if endpoint is not None and endpoint.name not in seen:
+            seen.add(endpoint.name)
+            out.append((endpoint, entry))
+    return out
+
+
+class CentralRoster:
+    """The robots behind one central server, kept up to date on a network thread of its own."""
+
+    def __init__(
+        self,
+        host: str,
+        port: int = DEFAULT_PORT,
+        *,
+        user: str = "",
+        password: str = "",
+        post: Post = _direct,
+        timeout: float = CONNECT_TIMEOUT,
+        max_robots: int = MAX_ROBOTS,
+    ) -> None:
+        self.host = host
+        self.port = port
+        self._user = user
+        self._password = password
+        self._post = post
+        self.timeout = timeout
+        self.max_robots = max_robots
+        self.robots: dict[str, RobotEndpoint] = {}
+        """Robots known now, by name (touched on the roster's thread only)."""
+        self.dropped = 0
+        """Entries refused: malformed, over :data:`MAX_ROBOTS`, or broadcasts that did not decode."""
+        self._emit: Emit | None = None
+        self._closed = threading.Event()
+        self._lost_sent = False
+        self._thread: threading.Thread | None = None
+        self._loop: asyncio.AbstractEventLoop | None = None
+        self._task: asyncio.Task[None] | None = None
+
+    # -- Roster ---------------------------------------------------------------------------
+    def start(self, emit: Emit) -> None:
+        if self._thread is not None:
+            raise RuntimeError("a CentralRoster starts once")
+        self._emit = emit
+        self._thread = threading.Thread(target=self._main, name="rtmu-central", daemon=True)
+        self._thread.start()
+
+    def close(self) -> None:
+        """Log out and end the thread; nothing is emitted after this returns."""
+        self._closed.set()
+        loop, task = self._loop, self._task
+        if loop is not None and task is not None:
+            with contextlib.suppress(RuntimeError):  # the loop already ended
+                loop.call_soon_threadsafe(task.cancel)
+        thread = self._thread
+        if thread is not None and thread is not threading.current_thread():
+            thread.join(CLOSE_JOIN_TIMEOUT)
+
+    # -- the thread -------------------------------------------------------------------------
+    def _main(self) -> None:
+        loop = asyncio.new_event_loop()
+        self._loop = loop
+        try:
+            self._task = loop.create_task(self._run())
+            if self._closed.is_set():
+                self._task.cancel()
+            with contextlib.suppress(asyncio.CancelledError):
+                loop.run_until_complete(self._task)
+        finally:
+            loop.close()
+
+    def _deliver(self, event: RosterEvent) -> None:
+        if self._closed.is_set() or self._emit is None:
+            return
+        self._post(self._emit_if_open, event)
+
+    def _emit_if_open(self, event: RosterEvent) -> None:
+        if not self._closed.is_set() and self._emit is not None:
+            self._emit(event)
+
+    def _lost(self, reason: str) -> None:
+        if self._lost_sent:
+            return
+        self._lost_sent = True
+        self.robots.clear()
+        self._deliver(RosterLost(reason))
+
+    async def _run(self) -> None:
+        ended = asyncio.Event()
+        why: list[str] = []
+
+        def on_close(error: ClientError) -> None:
+            why.append(str(error))
+            ended.set()
+
+        client = AriaClient(on_close=on_close)
+        try:
+            await client.connect(self.host, self.port, self._user, self._password, timeout=self.timeout)
+            self._password = ""
+            client.request(ClientAdded.DATA_NAME, -1, self._on_added)
+            client.request(ClientRemoved.DATA_NAME, -1, self._on_removed)
+            reply = await client.request_once(ClientList.DATA_NAME, timeout=self.timeout)
+            for entry in ClientList.decode(reply.payload).entries:
+                self._add(entry)
+            await ended.wait()
+            self._lost(why[0] if why else "the central server's connection ended")
+        except asyncio.CancelledError:
+            pass
+        except Exception as exc:  # ClientError, ProtocolError: the roster is gone, say why once
+            self._lost(str(exc) or type(exc).__name__)
+        finally:
+            with contextlib.suppress(Exception):
+                await client.disconnect()
+
+    def _on_added(self, packet: Packet) -> None:
+        try:
+            entry = ClientAdded.decode(packet.payload).entry
+        except Exception:
+            self.dropped += 1
+            return
+        self._add(entry)
+
+    def _on_removed(self, packet: Packet) -> None:
+        try:
+            entry = ClientRemoved.decode(packet.payload).entry
+        except Exception:
+            self.dropped += 1
+            return
+        if self.robots.pop(entry.name, None) is not None:
+            self._deliver(RobotRemoved(entry.name, "left the central server"))
+
+    def _add(self, entry: CentralEntry) -> None:
+        endpoint = endpoint_of(entry, self.host, self.port)
+        if endpoint is None:
+            self.dropped += 1
+            return
+        old = self.robots.get(endpoint.name)
+        if old == endpoint:
+            return  # heard in the list and in a broadcast
+        if old is None and len(self.robots) >= self.max_robots:
+            self.dropped += 1
+            return
+        if old is not None:
+            self._deliver(RobotRemoved(endpoint.name, "reconnected to the central server"))
+        self.robots[endpoint.name] = endpoint
+        self._deliver(RobotAdded(endpoint))

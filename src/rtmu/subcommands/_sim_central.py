@@ -1,0 +1,66 @@
+"""``rtmu sim --central [--robots N]``: a central server, and optionally N robots switched to it."""
+
+from __future__ import annotations
+
+import asyncio
+import contextlib
+import dataclasses
+import signal
+import sys
+
+from ..sim import SimConfig
+
+EXIT_OK = 0
+EXIT_BAD_INPUT = 2
+EXIT_CANNOT_LISTEN = 3
+
+
+async def serve_central(cfg: SimConfig, robot_port: int, robots: int) -> int:
+    """Serve until SIGINT/SIGTERM; ``cfg`` is the robots' template (map, camera, seed…)."""
+    from ..maps import MapFormatError
+    from ..sim import SimServer
+    from ..sim.central import CentralConfig, CentralServer
+
+    central = CentralServer(CentralConfig(host=cfg.host, port=cfg.port, robot_port=robot_port))
+    try:
+        await central.start()
+    except OSError as exc:
+        where = f"{cfg.host}:{cfg.port}/{robot_port}"
+        print(f"rtmu sim: cannot listen on {where}: {exc.strerror or exc}", file=sys.stderr)
+        return EXIT_CANNOT_LISTEN
+    print(
+        f"rtmu sim: ARIA central server: operators on {cfg.host}:{central.port}, robots switch to "
+        f"{cfg.host}:{central.robot_port}",
+        flush=True,
+    )
+    sims: list[SimServer] = []
+    try:
+        for i in range(1, robots + 1):
+            robot_cfg = dataclasses.replace(
+                cfg,
+                port=0,
+                seed=cfg.seed + i - 1,
+                switch_to=f"{cfg.host}:{central.robot_port}",
+                switch_name=f"robot{i}",
+                central_server=None,
+            )
+            sim = SimServer(robot_cfg)
+            await sim.start()
+            sims.append(sim)
+        if robots:
+            print(f"rtmu sim: {robots} simulated robot(s) switching to it: robot1…robot{robots}", flush=True)
+        stop = asyncio.Event()
+        loop = asyncio.get_running_loop()
+        for sig in (signal.SIGINT, signal.SIGTERM):
+            with contextlib.suppress(NotImplementedError, RuntimeError):
+                loop.add_signal_handler(sig, stop.set)
+        await stop.wait()
+        print("rtmu sim: stopping (telling operators and robots SHUTDOWN)", flush=True)
+        return EXIT_OK
+    except (OSError, MapFormatError, ValueError) as exc:
+        print(f"rtmu sim: cannot start the robots: {exc}", file=sys.stderr)
+        return EXIT_BAD_INPUT
+    finally:
+        await central.stop()
+        for sim in sims:
+            await sim.stop()

@@ -1,0 +1,117 @@
+"""``rtmu fleet HOST[:PORT]``: the robots behind an ARIA central server, with a status line each.
+
+The central server (ARIA's ``switchServer``, or ``rtmu sim --central``) lists its robots and the port
+it forwards each on; this asks for the list, then reads one status from every robot through its
+forwarded port (at the same time, each within ``--timeout``). ``--json`` prints one object:
+``{"central": "HOST:PORT", "robots": [{"name", "host", "port", "address", "status"}]}`` where
+``status`` is the object ``rtmu status --json`` prints, or ``{"error": "..."}`` for a robot that did
+not answer. Act on one of them with any subcommand's ``--robot NAME``.
+"""
+
+from __future__ import annotations
+
+import argparse
+import asyncio
+import signal
+from typing import Any
+
+from ..client.central import list_robots
+from ..client.connection import AriaClient
+from ..client.errors import ClientError
+from ..exit_codes import EXIT_CONNECTION, EXIT_OK, EXIT_USAGE
+from ..protocol.errors import ProtocolError
+from ..textsafe import visible
+from ._common import (
+    UsageError,
+    add_connection_arguments,
+    fail,
+    fetch_status,
+    print_json,
+    read_password,
+    status_line,
+)
+
+MAX_AT_ONCE = 16
+"""Robots asked for their status at the same time (a central server may forward hundreds)."""
+
+
+def register(subparsers: Any) -> None:
+    p = subparsers.add_parser(
+        "fleet",
+        help="list the robots behind an ARIA central server, with their status",
+        description=__doc__,
+        formatter_class=argparse.RawDescriptionHelpFormatter,
+    )
+    add_connection_arguments(p)
+    p.add_argument("--json", action="store_true", help="one JSON object (see above)")
+    p.add_argument("--no-status", action="store_true", help="list only; do not log in to each robot")
+    p.set_defaults(handler=handle)
+
+
+async def _status(
+    host: str, port: int, args: argparse.Namespace, password: str, gate: asyncio.Semaphore
+) -> dict[str, Any]:
+    async with gate:
+        client = AriaClient()
+        try:
+            login = (args.user, password)
+            await client.connect(host, port, *login, timeout=args.timeout, protocol=args.protocol)
+            return await fetch_status(client, args.timeout)
+        except (ClientError, ProtocolError) as exc:
+            return {"error": str(exc)}
+        finally:
+            await client.disconnect()
+
+
+def handle(args: argparse.Namespace) -> int:
+    if args.robot is not None:
+        return fail("fleet", "--robot does not apply to 'rtmu fleet': it lists every robot", EXIT_USAGE)
+    try:
+        password = read_password(args)
+    except UsageError as exc:
+        return fail("fleet", str(exc), EXIT_USAGE)
+    except (KeyboardInterrupt, EOFError):
+        return fail("fleet", "cancelled", EXIT_USAGE)
+    host, port = args.server
+
+    async def main() -> list[dict[str, Any]]:
+        robots = await list_robots(host, port, args.user, password, timeout=args.timeout)
+        gate = asyncio.Semaphore(MAX_AT_ONCE)
+        statuses: list[dict[str, Any] | None] = [None] * len(robots)
+        if not args.no_status:
+            statuses = list(
+                await asyncio.gather(*(_status(e.host, e.port, args, password, gate) for e, _ in robots))
+            )
+        rows = []
+        for (endpoint, entry), status in zip(robots, statuses, strict=True):
+            row: dict[str, Any] = {
+                "name": endpoint.name,
+                "host": endpoint.host,
+                "port": endpoint.port,
+                "address": entry.address,
+            }
+            if status is not None:
+                row["status"] = status
+            rows.append(row)
+        return rows
+
+    try:
+        rows = asyncio.run(main())
+    except ClientError as exc:
+        return fail("fleet", str(exc), exc.exit_code)
+    except ProtocolError as exc:
+        return fail("fleet", f"the central server sent a malformed robot list: {exc}", EXIT_CONNECTION)
+    except KeyboardInterrupt:
+        return fail("fleet", "interrupted by SIGINT", 128 + signal.SIGINT)
+    if args.json:
+        print_json({"central": f"{host}:{port}", "robots": rows})
+        return EXIT_OK
+    print(f"{host}:{port}: {len(rows)} robot{'' if len(rows) == 1 else 's'}")
+    for row in rows:
+        status = row.get("status")
+        shown = "" if status is None else status.get("error") or status_line(status)
+        print(f"  {visible(row['name'])}  port {row['port']}  {visible(shown)}", flush=True)
+    return EXIT_OK
+
+
+handle.resolves_robot = True  # type: ignore[attr-defined]  # --robot is refused here, not resolved
