@@ -1,0 +1,167 @@
+"""A central server and robots switched to it, on one thread and loop: for tests and ``bench``.
+
+``with CentralThread(robots=3) as fleet: fleet.port`` is the central server's operator port; the robots
+(``robot1``…) are real :class:`SimServer` s that switched to it over loopback, each forwarded on a port
+of its own. Robots can be added, stopped or killed, and the central server killed, while operators are
+connected.
+"""
+
+from __future__ import annotations
+
+import asyncio
+import concurrent.futures
+import dataclasses
+import threading
+import time
+from collections.abc import Callable, Coroutine
+from typing import Any, TypeVar
+
+from .central import CentralConfig, CentralServer
+from .config import SimConfig
+from .server import SimServer
+
+T = TypeVar("T")
+START_TIMEOUT = 30.0
+
+
+class CentralThread:
+    def __init__(
+        self, robots: int = 3, template: SimConfig | None = None, *, switch_retry: float = 0.2
+    ) -> None:
+        self.template = template or SimConfig(port=0, camera=False)
+        self.switch_retry = switch_retry
+        self.initial = robots
+        self.central: CentralServer | None = None
+        self.sims: dict[str, SimServer] = {}
+        self.loop: asyncio.AbstractEventLoop | None = None
+        self._thread: threading.Thread | None = None
+        self._ready = threading.Event()
+        self._error: BaseException | None = None
+
+    # -- lifetime -------------------------------------------------------------------------
+    def start(self) -> CentralThread:
+        self._thread = threading.Thread(target=self._main, name="rtmu-central-sim", daemon=True)
+        self._thread.start()
+        if not self._ready.wait(START_TIMEOUT):
+            raise TimeoutError("the central server did not start")
+        if self._error is not None:
+            raise RuntimeError("the central server failed to start") from self._error
+        for i in range(1, self.initial + 1):
+            self.add_robot(f"robot{i}")
+        self.wait_for_robots(self.initial)
+        return self
+
+    def _main(self) -> None:
+        loop = asyncio.new_event_loop()
+        self.loop = loop
+        asyncio.set_event_loop(loop)
+        try:
+            self.central = CentralServer(CentralConfig(host="127.0.0.1", port=0, robot_port=0))
+            loop.run_until_complete(self.central.start())
+        except BaseException as exc:
+            self._error = exc
+            self._ready.set()
+            loop.close()
+            return
+        self._ready.set()
+        try:
+            loop.run_forever()
+        finally:
+            pending = [t for t in asyncio.all_tasks(loop) if not t.done()]
+            for task in pending:
+                task.cancel()
+            if pending:
+                loop.run_until_complete(asyncio.gather(*pending, return_exceptions=True))
+            loop.close()
+
+    def stop(self) -> None:
+        if self.loop is None or not self.loop.is_running():
+            return
+
+        async def stop_all() -> None:
+            for sim in list(self.sims.values()):
+                await sim.stop()
+            if self.central is not None:
+                await self.central.stop()
+
+        self.run(stop_all())
+        self.loop.call_soon_threadsafe(self.loop.stop)
+        if self._thread is not None:
+            self._thread.join(10.0)
+
+    def __enter__(self) -> CentralThread:
+        return self.start()
+
+    def __exit__(self, *exc: object) -> None:
+        self.stop()
+
+    # -- access ---------------------------------------------------------------------------
+    @property
+    def port(self) -> int:
+        assert self.central is not None
+        return self.central.port
+
+    def call(self, fn: Callable[[], T], timeout: float = 10.0) -> T:
+        """Run ``fn`` on the loop and return its result."""
+        assert self.loop is not None
+        future: concurrent.futures.Future[T] = concurrent.futures.Future()
+
+        def run() -> None:
+            try:
+                future.set_result(fn())
+            except BaseException as exc:
+                future.set_exception(exc)
+
+        self.loop.call_soon_threadsafe(run)
+        return future.result(timeout)
+
+    def run(self, coro: Coroutine[Any, Any, T], timeout: float = 10.0) -> T:
+        assert self.loop is not None
+        return asyncio.run_coroutine_threadsafe(coro, self.loop).result(timeout)
+
+    def robots(self) -> dict[str, int]:
+        """Robot name → forwarded port, as the central server lists them now."""
+        assert self.central is not None
+        central = self.central
+        return self.call(lambda: {e.name: e.port for e in central.robots()})
+
+    def wait_for_robots(self, count: int, timeout: float = 20.0) -> dict[str, int]:
+        deadline = time.monotonic() + timeout
+        while True:
+            robots = self.robots()
+            if len(robots) == count:
+                return robots
+            if time.monotonic() > deadline:
+                raise TimeoutError(f"{len(robots)} robots switched, not {count}: {sorted(robots)}")
+            time.sleep(0.05)
+
+    def add_robot(self, name: str, **changes: Any) -> SimServer:
+        """Start a simulated robot that switches to the central server as ``name``."""
+        assert self.central is not None
+        cfg = dataclasses.replace(
+            self.template,
+            port=0,
+            switch_to=f"127.0.0.1:{self.central.robot_port}",
+            switch_name=name,
+            switch_retry=self.switch_retry,
+            central_server=None,
+            **changes,
+        )
+
+        async def start() -> SimServer:
+            sim = SimServer(cfg)
+            await sim.start()
+            return sim
+
+        sim = self.run(start())
+        self.sims[name] = sim
+        return sim
+
+    def stop_robot(self, name: str) -> None:
+        """The robot's server stops cleanly (its switched connection gets SHUTDOWN)."""
+        self.run(self.sims.pop(name).stop())
+
+    def kill_central(self) -> None:
+        """The central server dies: every operator and robot socket reset at once."""
+        assert self.central is not None
+        self.call(self.central.kill)
