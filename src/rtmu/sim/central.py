@@ -58,8 +58,6 @@ MAX_QUEUED = 4 * 1024 * 1024
 """Output waiting for one peer beyond this gets it dropped (a reader that stopped reading)."""
 MAX_OPERATORS = 64
 """Operators per port (the central port and each forwarder); one more is closed at once."""
-LOGIN_TIMEOUT = 10.0
-"""Seconds for a robot to introduce itself and list its data after the switch."""
 FORWARD_PORT_TRIES = 200
 
 OPERATOR_DATA = DataList.build(
@@ -128,6 +126,8 @@ class CentralConfig:
     max_robots: int = 100
     heartbeat_s: float = 1.0
     """How often ``centralServerHeartbeat`` goes to each robot that lists it."""
+    login_timeout: float = 10.0
+    """Seconds for a robot to ask ``switch``, and then to introduce itself and list its data."""
 
 
 class Peer:
@@ -243,7 +243,7 @@ class Forwarder:
     async def run(self) -> None:
         """Log in to the robot, open the forwarded port, then relay until the robot goes."""
         try:
-            async with asyncio.timeout(LOGIN_TIMEOUT):
+            async with asyncio.timeout(self.central.config.login_timeout):
                 await self._login()
             await self._listen()
         except (TimeoutError, ProtocolError, ConnectionError, OSError) as exc:
@@ -503,7 +503,7 @@ class CentralServer:
         peer.write(conn.data_to_send())
         name: str | None = None
         try:
-            async with asyncio.timeout(LOGIN_TIMEOUT):
+            async with asyncio.timeout(self.config.login_timeout):
                 while name is None:
                     data = await reader.read(READ_CHUNK)
                     if not data:

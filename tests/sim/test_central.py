@@ -1,0 +1,261 @@
+"""``rtmu sim --central``: the switch, the forwarder shared by operators, its bounds, and the CLI.
+
+The central server, the robots and the operators run in one event loop over real loopback sockets.
+"""
+
+from __future__ import annotations
+
+import asyncio
+import contextlib
+import signal
+import subprocess
+import sys
+import time
+from collections.abc import AsyncIterator
+from typing import Any
+
+from rtmu.client.central import list_robots
+from rtmu.client.connection import AriaClient, Packet
+from rtmu.client.errors import ClientError
+from rtmu.protocol.client_connection import ClientConnection
+from rtmu.protocol.events import DataListReady
+from rtmu.sim import SimConfig, SimServer
+from rtmu.sim.central import CentralConfig, CentralServer
+
+from .wire import run
+
+FAST = dict(port=0, camera=False, switch_retry=0.1)
+
+
+async def until(predicate: Any, timeout: float = 10.0) -> None:
+    deadline = time.monotonic() + timeout
+    while not predicate():
+        if time.monotonic() > deadline:
+            raise AssertionError("condition not reached in time")
+        await asyncio.sleep(0.01)
+
+
+@contextlib.asynccontextmanager
+async def central_with(
+    *names: str, **config: Any
+) -> AsyncIterator[tuple[CentralServer, dict[str, SimServer]]]:
+    central = CentralServer(CentralConfig(port=0, robot_port=0, **config))
+    await central.start()
+    sims: dict[str, SimServer] = {}
+    try:
+        for name in names:
+            sim = SimServer(SimConfig(switch_to=f"127.0.0.1:{central.robot_port}", switch_name=name, **FAST))
+            await sim.start()
+            sims[name] = sim
+        await until(lambda: len(central.robots()) == len(names))
+        yield central, sims
+    finally:
+        for sim in sims.values():
+            await sim.stop()
+        await central.stop()
+
+
+def port_of(central: CentralServer, name: str) -> int:
+    return next(e.port for e in central.robots() if e.name == name)
+
+
+def central_session_subscriptions(sim: SimServer) -> set[str]:
+    """What the central server (the robot's one client here) has subscribed to on the robot."""
+    (session,) = sim.sessions
+    return {sub.name for sub in session.subscriptions.values()}
+
+
+def test_two_operators_share_one_forwarded_robot_and_the_last_stop_stops_it() -> None:
+    async def main() -> None:
+        async with central_with("solo") as (central, sims):
+            port = port_of(central, "solo")
+            a, b, idle = AriaClient(), AriaClient(), AriaClient()
+            await a.connect("127.0.0.1", port, timeout=5)
+            await b.connect("127.0.0.1", port, timeout=5)
+            await idle.connect("127.0.0.1", port, timeout=5)  # asks for nothing, so hears nothing
+            idle_before = idle.packets_received
+            got: dict[str, int] = {"a": 0, "b": 0}
+
+            def counter(key: str) -> Any:
+                def on(packet: Packet) -> None:
+                    got[key] += 1
+
+                return on
+
+            a.request("updateNumbers", 50, counter("a"))
+            b.request("updateNumbers", 200, counter("b"))
+            await until(lambda: got["a"] > 3 and got["b"] > 1)
+            assert central_session_subscriptions(sims["solo"]) == {"updateNumbers"}
+
+            a.stop_request("updateNumbers")
+            await asyncio.sleep(0.1)
+            before = got["b"]
+            await until(lambda: got["b"] > before + 1)  # b still hears it
+            assert central_session_subscriptions(sims["solo"]) == {"updateNumbers"}
+
+            await b.disconnect()  # the last subscriber leaves: the robot is told to stop sending
+            await until(lambda: central_session_subscriptions(sims["solo"]) == set())
+            answered = await a.request_once("updateStrings", timeout=5)  # a still works once
+            assert answered.decode()
+            await a.disconnect()
+            assert idle.packets_received == idle_before
+            await idle.disconnect()
+
+    run(main())
+
+
+def test_an_operator_of_a_robot_that_leaves_is_told_shutdown_and_the_robot_is_unlisted() -> None:
+    async def main() -> None:
+        async with central_with("goner", "stayer") as (central, sims):
+            closed: list[ClientError] = []
+            op = AriaClient(on_close=closed.append)
+            await op.connect("127.0.0.1", port_of(central, "goner"), timeout=5)
+            await sims.pop("goner").stop()
+            await until(lambda: bool(closed))
+            assert "shut" in str(closed[0]) or "closed" in str(closed[0])
+            await until(lambda: [e.name for e in central.robots()] == ["stayer"])
+            await op.disconnect()
+
+    run(main())
+
+
+def test_the_robot_port_speaks_arias_switch_and_a_plain_client_can_list_it() -> None:
+    async def main() -> None:
+        async with central_with() as (central, _):
+            client = AriaClient()
+            datalist = await client.connect("127.0.0.1", central.robot_port, timeout=5)
+            assert "switch" in datalist and "centralServerHeartbeat" in datalist
+            await client.disconnect()
+            ops = AriaClient()
+            listed = await ops.connect("127.0.0.1", central.port, timeout=5)
+            assert [e.name for e in listed] == ["clientList", "clientAdded", "clientRemoved"]
+            await ops.disconnect()
+
+    run(main())
+
+
+def test_a_robot_that_switches_but_never_logs_in_costs_nothing_and_is_never_listed() -> None:
+    async def main() -> None:
+        async with central_with("real", login_timeout=0.5) as (central, _):
+            reader, writer = await asyncio.open_connection("127.0.0.1", central.robot_port)
+            conn = ClientConnection()
+            while True:  # log in and ask switch, then go silent instead of introducing a server
+                events = conn.receive_data(await reader.read(65536))
+                writer.write(conn.data_to_send())
+                if any(isinstance(e, DataListReady) for e in events):
+                    break
+            conn.request_once("switch", b"silent\x00")
+            writer.write(conn.data_to_send())
+            assert await asyncio.wait_for(reader.read(65536), 5)  # the acceptance
+            while await asyncio.wait_for(reader.read(65536), 5):  # given up on: a goodbye, then closed
+                pass
+            assert [e.name for e in central.robots()] == ["real"]
+            assert [f.name for f in central.forwarders] == ["real"]
+            writer.close()
+
+    run(main())
+
+
+def test_robots_beyond_the_bound_are_closed_at_once() -> None:
+    async def main() -> None:
+        async with central_with("one", "two", max_robots=2) as (central, _):
+            reader, writer = await asyncio.open_connection("127.0.0.1", central.robot_port)
+            assert await asyncio.wait_for(reader.read(65536), 5) == b""
+            writer.close()
+            assert len(central.forwarders) == 2
+
+    run(main())
+
+
+def test_garbage_on_the_robot_port_is_dropped_without_a_switch() -> None:
+    async def main() -> None:
+        async with central_with("one", login_timeout=0.5) as (central, _):
+            reader, writer = await asyncio.open_connection("127.0.0.1", central.robot_port)
+            writer.write(b"\x0f\x0c\xff\xff" + bytes(range(256)) * 64)
+            with contextlib.suppress(ConnectionError):
+                while await asyncio.wait_for(reader.read(65536), 5):
+                    pass
+            writer.close()
+            assert central.switches == 1 and [e.name for e in central.robots()] == ["one"]
+
+    run(main())
+
+
+def test_a_robot_switches_again_when_the_central_server_comes_back() -> None:
+    async def main() -> None:
+        central = CentralServer(CentralConfig(port=0, robot_port=0))
+        await central.start()
+        robot_port = central.robot_port
+        sim = SimServer(SimConfig(switch_to=f"127.0.0.1:{robot_port}", switch_name="back", **FAST))
+        await sim.start()
+        try:
+            await until(lambda: len(central.robots()) == 1)
+            central.kill()
+            again = CentralServer(CentralConfig(port=0, robot_port=robot_port))
+            await again.start()
+            await until(lambda: [e.name for e in again.robots()] == ["back"])
+            robots = await list_robots("127.0.0.1", again.port, timeout=5)
+            assert [e.name for e, _ in robots] == ["back"]
+            await again.stop()
+        finally:
+            await sim.stop()
+            await central.stop()
+
+    run(main())
+
+
+def test_rtmu_sim_central_with_robots_serves_a_fleet_and_stops_on_sigint() -> None:
+    proc = subprocess.Popen(
+        [
+            sys.executable,
+            "-m",
+            "rtmu",
+            "sim",
+            "--central",
+            "--port",
+            "0",
+            "--robot-port",
+            "0",
+            "--robots",
+            "2",
+        ],
+        stdout=subprocess.PIPE,
+        stderr=subprocess.PIPE,
+        text=True,
+    )
+    try:
+        assert proc.stdout is not None
+        first = proc.stdout.readline()
+        assert first.startswith("rtmu sim: ARIA central server: operators on 127.0.0.1:")
+        port = int(first.split("operators on 127.0.0.1:")[1].split(",")[0])
+        assert proc.stdout.readline().startswith("rtmu sim: 2 simulated robot(s)")
+
+        async def names() -> list[str]:
+            deadline = time.monotonic() + 20
+            while True:
+                robots = await list_robots("127.0.0.1", port, timeout=5)
+                if len(robots) == 2 or time.monotonic() > deadline:
+                    return [e.name for e, _ in robots]
+                await asyncio.sleep(0.1)
+
+        assert run(names()) == ["robot1", "robot2"]
+        proc.send_signal(signal.SIGINT)
+        assert proc.wait(15) == 0
+    finally:
+        if proc.poll() is None:
+            proc.kill()
+            proc.wait()
+
+
+def test_rtmu_sim_refuses_robots_without_central_and_a_bad_switch_address() -> None:
+    for argv, words in (
+        (["--robots", "2"], "behind --central"),
+        (["--switch-to", "host:99999"], "bad central server address"),
+    ):
+        done = subprocess.run(
+            [sys.executable, "-m", "rtmu", "sim", "--port", "0", *argv],
+            capture_output=True,
+            text=True,
+            timeout=30,
+        )
+        assert done.returncode == 2 and words in done.stderr
