@@ -16,6 +16,7 @@ from pathlib import Path
 
 import pytest
 
+from rtmu import maps
 from rtmu.cli import main
 from rtmu.client.central import CentralRoster
 from rtmu.client.roster import RobotAdded, RobotRemoved, RosterEvent, RosterLost
@@ -164,6 +165,16 @@ def test_drive_with_robot_moves_only_that_robot(
     assert obj["after"]["x"] == round(after["robot2"][0])
     robot = fleet.sims["robot2"].robot
     assert fleet.call(lambda: (robot.trans_ratio, robot.mode_name)) == (0, "stop")  # stopped by us
+
+
+def test_map_with_robot_downloads_through_the_forwarder(fleet: CentralThread, tmp_path: Path) -> None:
+    expected = maps.read_map(ARENA)  # a map is many packets: the forwarder relays them to the asker
+    for extra, name in (([], "bin.map"), (["--text"], "text.map")):
+        out = tmp_path / name
+        argv = ["map", addr(fleet), "--robot", "robot3", "--out", str(out), "--timeout", "10", *extra]
+        assert main(argv) == EXIT_OK
+        got = maps.read_map(out)
+        assert (got.num_points, got.num_lines) == (expected.num_points, expected.num_lines)
 
 
 def test_fleet_refuses_robot(fleet: CentralThread, capsys: pytest.CaptureFixture[str]) -> None:

@@ -60,9 +60,10 @@ def port_of(central: CentralServer, name: str) -> int:
 
 
 def central_session_subscriptions(sim: SimServer) -> set[str]:
-    """What the central server (the robot's one client here) has subscribed to on the robot."""
+    """What the central server (the robot's one client here) has subscribed to on the robot, for operators
+    (its own 1 s ``centralHeartbeat``, which ARIA's forwarder always asks for, is left out)."""
     (session,) = sim.sessions
-    return {sub.name for sub in session.subscriptions.values()}
+    return {sub.name for sub in session.subscriptions.values()} - {"centralHeartbeat"}
 
 
 def test_two_operators_share_one_forwarded_robot_and_the_last_stop_stops_it() -> None:
@@ -259,3 +260,62 @@ def test_rtmu_sim_refuses_robots_without_central_and_a_bad_switch_address() -> N
             timeout=30,
         )
         assert done.returncode == 2 and words in done.stderr
+
+
+def test_request_onces_from_two_operators_each_get_their_own_reply() -> None:
+    async def main() -> None:
+        async with central_with("shared") as (central, _):
+            port = port_of(central, "shared")
+            ops = [AriaClient() for _ in range(3)]
+            for op in ops:
+                await op.connect("127.0.0.1", port, timeout=5)
+            for _ in range(5):  # all at once: the forwarder's queue hands each reply to its asker
+                replies = await asyncio.gather(
+                    *(
+                        op.request_once(name, timeout=5)
+                        for op in ops
+                        for name in ("updateStrings", "getMapName")
+                    )
+                )
+                assert len(replies) == 6 and all(r.payloads for r in replies)
+            for op in ops:
+                await op.disconnect()
+
+    run(main())
+
+
+def test_arias_forwarding_rules_by_return_type() -> None:
+    from rtmu.protocol.datalist import DataEntry
+    from rtmu.sim.forwarder import Return, return_type
+
+    def kind(flags: str) -> Return | None:
+        return return_type(DataEntry(300, "x", flags=flags))
+
+    assert kind("RETURN_SINGLE") is Return.SINGLE
+    assert kind("RETURN_UNTIL_EMPTY") is Return.UNTIL_EMPTY
+    assert kind("RETURN_VIDEO") is Return.VIDEO
+    assert kind("RETURN_NONE|SLOW") is Return.NONE
+    assert kind("RETURN_COMPLEX") is None and kind("") is None
+    assert kind("RETURN_SINGLE|DO_NOT_FORWARD") is None
+
+
+def test_a_user_file_guards_the_central_port_and_every_forwarder(tmp_path) -> None:  # type: ignore[no-untyped-def]
+    users = tmp_path / "users.txt"
+    users.write_text("UserInfoVersion1\nuser alice secret1 all\n")
+
+    async def main() -> None:
+        async with central_with("guarded", users_path=users) as (central, _):
+            for port in (central.port, port_of(central, "guarded")):
+                stranger = AriaClient()
+                try:
+                    await stranger.connect("127.0.0.1", port, "mallory", "guess", timeout=5)
+                    raise AssertionError("a wrong password was let in")
+                except ClientError as exc:
+                    assert "password" in str(exc).lower() or "refused" in str(exc).lower()
+                alice = AriaClient()
+                await alice.connect("127.0.0.1", port, "alice", "secret1", timeout=5)
+                await alice.disconnect()
+            robots = await list_robots("127.0.0.1", central.port, "alice", "secret1", timeout=5)
+            assert [e.name for e, _ in robots] == ["guarded"]
+
+    run(main())

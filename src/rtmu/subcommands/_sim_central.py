@@ -21,7 +21,11 @@ async def serve_central(cfg: SimConfig, robot_port: int, robots: int) -> int:
     from ..sim import SimServer
     from ..sim.central import CentralConfig, CentralServer
 
-    central = CentralServer(CentralConfig(host=cfg.host, port=cfg.port, robot_port=robot_port))
+    # The user file guards the central port and the forwarders, as ARIA's switchServer's does; the
+    # robots behind it let the forwarder in (it logs in without a user).
+    central = CentralServer(
+        CentralConfig(host=cfg.host, port=cfg.port, robot_port=robot_port, users_path=cfg.users_path)
+    )
     try:
         await central.start()
     except OSError as exc:
@@ -43,6 +47,7 @@ async def serve_central(cfg: SimConfig, robot_port: int, robots: int) -> int:
                 switch_to=f"{cfg.host}:{central.robot_port}",
                 switch_name=f"robot{i}",
                 central_server=None,
+                users_path=None,
             )
             sim = SimServer(robot_cfg)
             await sim.start()
