@@ -319,3 +319,42 @@ def test_a_user_file_guards_the_central_port_and_every_forwarder(tmp_path) -> No
             assert [e.name for e, _ in robots] == ["guarded"]
 
     run(main())
+
+
+async def _mute_robot(robot_port: int, name: str) -> asyncio.StreamWriter:
+    """A robot that switches, lets the central server log in, then never sends another byte (its link
+    died without a reset): it answers none of the forwarder's heartbeats."""
+    from rtmu.protocol.datalist import DataList
+    from rtmu.protocol.server_connection import ServerConnection
+
+    reader, writer = await asyncio.open_connection("127.0.0.1", robot_port)
+    conn = ClientConnection()
+    while True:
+        events = conn.receive_data(await reader.read(65536))
+        writer.write(conn.data_to_send())
+        if any(isinstance(e, DataListReady) for e in events):
+            break
+    conn.request_once("switch", name.encode() + b"\x00")
+    writer.write(conn.data_to_send())
+    await reader.read(65536)  # the acceptance
+    served = ServerConnection(
+        DataList.build([("centralHeartbeat", "", "none", "none", "RobotInfo", "RETURN_SINGLE")])
+    )
+    writer.write(served.data_to_send())
+    while served.state.name != "CONNECTED":
+        served.receive_data(await reader.read(65536))
+        writer.write(served.data_to_send())
+    return writer
+
+
+def test_a_robot_gone_silent_is_dropped_and_unlisted() -> None:
+    async def main() -> None:
+        async with central_with("talker", robot_silence_s=1.5) as (central, _):
+            writer = await _mute_robot(central.robot_port, "mute")
+            await until(lambda: sorted(e.name for e in central.robots()) == ["mute", "talker"])
+            await until(lambda: [e.name for e in central.robots()] == ["talker"], timeout=10)
+            await asyncio.sleep(2.0)  # the talker answers its heartbeats: never dropped, never switched again
+            assert [e.name for e in central.robots()] == ["talker"] and central.switches == 2
+            writer.close()
+
+    run(main())

@@ -102,6 +102,9 @@ class CentralConfig:
     max_robots: int = 100
     heartbeat_s: float = 1.0
     """How often ``centralServerHeartbeat`` goes to each robot that lists it."""
+    robot_silence_s: float = 120.0
+    """A robot that sends nothing (not even its 1 s ``centralHeartbeat``) this long is dropped and
+    unlisted (ARIA's ``CentralServerFromRobotTimeoutInMins``, 2)."""
     login_timeout: float = 10.0
     """Seconds for a robot to ask ``switch``, and then to introduce itself and list its data."""
     users_path: Path | None = None
@@ -264,6 +267,7 @@ class CentralServer:
             users=self.users,
             login_timeout=cfg.login_timeout,
             heartbeat_s=cfg.heartbeat_s,
+            silence_timeout=cfg.robot_silence_s,
         )
         self.forwarders.append(forwarder)
         try:

@@ -201,6 +201,7 @@ class Forwarder:
         users: UserTable | None = None,
         login_timeout: float = 10.0,
         heartbeat_s: float = 1.0,
+        silence_timeout: float = 120.0,
     ) -> None:
         self.robot = robot
         self.name = name
@@ -210,6 +211,8 @@ class Forwarder:
         self.users = users
         self.login_timeout = login_timeout
         self.heartbeat_s = heartbeat_s
+        self.silence_timeout = silence_timeout
+        """Seconds without a packet from the robot before it is dropped (ARIA's 2 min heartbeat timeout)."""
         self.port = 0
         self.connected = False
         self.closed = False
@@ -315,7 +318,13 @@ class Forwarder:
         decoder = self.conn.decoder
         while not self.robot.closed:
             try:
-                data = await self.robot.reader.read(READ_CHUNK)
+                async with asyncio.timeout(self.silence_timeout):
+                    data = await self.robot.reader.read(READ_CHUNK)
+            except TimeoutError:
+                # It answers centralHeartbeat every second: a robot this quiet has lost its link.
+                log.info("robot %r: nothing for %g s; dropping it", self.name, self.silence_timeout)
+                self.robot.abort()
+                return
             except (ConnectionError, OSError):
                 return
             if not data:
