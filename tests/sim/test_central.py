@@ -358,3 +358,32 @@ def test_a_robot_gone_silent_is_dropped_and_unlisted() -> None:
             writer.close()
 
     run(main())
+
+
+def test_an_operator_flooding_requests_cannot_cost_the_robot_or_the_other_operators() -> None:
+    from rtmu.protocol.packet import encode_packet
+
+    async def main() -> None:
+        async with central_with("busy") as (central, sims):
+            port = port_of(central, "busy")
+            calm = AriaClient()
+            await calm.connect("127.0.0.1", port, timeout=5)
+            flooder = AriaClient()
+            await flooder.connect("127.0.0.1", port, timeout=5)
+            number = flooder.datalist.number("getMapName")
+            assert number is not None
+            _, writer = await asyncio.open_connection("127.0.0.1", port)  # and a raw one, never logging in
+            burst = encode_packet(number, b"") * 10_000
+            for _ in range(5):  # 80 kB of request-onces from each, far faster than the replies can be read
+                flooder._link.write(burst)  # type: ignore[union-attr]
+                writer.write(burst)
+                await asyncio.sleep(0)
+            for _ in range(3):
+                assert (await calm.request_once("updateNumbers", timeout=10)).payloads
+            assert [e.name for e in central.robots()] == ["busy"]
+            writer.close()
+            await flooder.disconnect()
+            await calm.disconnect()
+            assert sims["busy"].sessions  # the robot's switched connection is still up
+
+    run(main())

@@ -57,6 +57,8 @@ MAX_OPERATORS = 64
 """Operators per port (the central port and each forwarder); one more is closed at once."""
 MAX_WAITING = 256
 """Request-onces of one data waiting for the robot's replies; more are refused (not forwarded)."""
+MAX_UPSTREAM_BACKLOG = 1024 * 1024
+"""Requests queued for the robot beyond this: the operator sending more is dropped, not the robot."""
 HEARTBEAT_MS = 1000
 """How often a forwarder asks the robot's ``centralHeartbeat`` (ARIA's 1 s)."""
 
@@ -376,6 +378,17 @@ class Forwarder:
             self._operator_gone(op)
 
     def _on_operator(self, op: Operator, event: object) -> None:
+        if self._robot_backlog() > MAX_UPSTREAM_BACKLOG:
+            # The robot is not taking requests as fast as they come: whoever keeps sending more is
+            # dropped, before the robot's own link (which every operator shares) overflows.
+            log.info(
+                "robot %r: %d bytes of requests queued; dropping operator %s",
+                self.name,
+                MAX_UPSTREAM_BACKLOG,
+                op.address,
+            )
+            op.abort()
+            return
         if isinstance(event, RequestOnce):
             self._ask_once(op, event.number, event.args)
         elif isinstance(event, RequestReceived):
@@ -384,6 +397,10 @@ class Forwarder:
         elif isinstance(event, RequestStopped):
             op.subscriptions.pop(event.number, None)
             self._resubscribe(event.number, b"")
+
+    def _robot_backlog(self) -> int:
+        transport = self.robot.writer.transport
+        return 0 if transport is None or transport.is_closing() else transport.get_write_buffer_size()
 
     def _ask_once(self, op: Operator | None, number: int, args: bytes) -> None:
         if self.returns.get(number) in QUEUED:
