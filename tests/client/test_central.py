@@ -278,3 +278,51 @@ def test_robot_switching_again_under_its_name_replaces_the_old_connection() -> N
         eventually(lambda: fl.robots().get("ROBOT1", old_port) != old_port, timeout=10)
         assert list(fl.robots()) == ["ROBOT1"]
         assert twin.port
+
+
+def test_every_connecting_subcommand_takes_robot() -> None:
+    import argparse
+
+    from rtmu.cli import build_parser
+
+    parser = build_parser()
+    (sub,) = [a for a in parser._actions if isinstance(a, argparse._SubParsersAction)]
+    connecting = {name: p for name, p in sub.choices.items() if any(a.dest == "server" for a in p._actions)}
+    assert {"status", "drive", "map", "probe", "fleet", "goto", "record"} <= set(connecting)
+    for name, p in connecting.items():
+        assert any("--robot" in a.option_strings for a in p._actions), name
+
+
+def test_a_robot_started_with_switch_to_on_the_command_line_joins_the_fleet(
+    capsys: pytest.CaptureFixture[str],
+) -> None:
+    import subprocess
+    import sys
+
+    with CentralThread(robots=0) as fl:
+        robot_port = fl.central.robot_port  # type: ignore[union-attr]
+        proc = subprocess.Popen(
+            [
+                sys.executable,
+                "-m",
+                "rtmu",
+                "sim",
+                "--port",
+                "0",
+                "--no-camera",
+                "--switch-to",
+                f"127.0.0.1:{robot_port}",
+                "--name",
+                "cli-bot",
+            ],
+            stdout=subprocess.DEVNULL,
+            stderr=subprocess.DEVNULL,
+        )
+        try:
+            assert fl.wait_for_robots(1, timeout=30) == {"cli-bot": fl.robots()["cli-bot"]}
+            assert main(["status", addr(fl), "--robot", "cli-bot", "--once", "--timeout", "5"]) == EXIT_OK
+            assert "battery=" in capsys.readouterr().out
+        finally:
+            proc.terminate()
+            proc.wait(15)
+        fl.wait_for_robots(0, timeout=10)  # its SHUTDOWN on the way out unlists it
