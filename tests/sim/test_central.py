@@ -387,3 +387,38 @@ def test_an_operator_flooding_requests_cannot_cost_the_robot_or_the_other_operat
             assert sims["busy"].sessions  # the robot's switched connection is still up
 
     run(main())
+
+
+def test_a_client_list_larger_than_a_packet_is_cut_to_what_one_packet_holds() -> None:
+    async def main() -> None:
+        async with central_with() as (central, _):
+            names = [f"r{i:03d}" + "x" * 500 for i in range(70)]  # 70 × ~510 bytes > one packet
+            writers = [await _mute_robot(central.robot_port, name) for name in names]
+            await until(lambda: len(central.robots()) == 70)
+            robots = await list_robots("127.0.0.1", central.port, timeout=5)
+            assert 55 < len(robots) < 70
+            assert [e.name for e, _ in robots] == names[: len(robots)]
+            for writer in writers:
+                writer.close()
+
+    run(main())
+
+
+def test_connections_that_never_switch_count_against_the_robot_bound() -> None:
+    async def main() -> None:
+        async with central_with(max_robots=2, login_timeout=1.0) as (central, _):
+            idle = [await asyncio.open_connection("127.0.0.1", central.robot_port) for _ in range(2)]
+            await asyncio.sleep(0.1)
+            reader, writer = await asyncio.open_connection("127.0.0.1", central.robot_port)
+            assert await asyncio.wait_for(reader.read(65536), 5) == b""  # closed at once: no slot
+            writer.close()
+            for r, w in idle:  # the idle ones are dropped after the login timeout, freeing the slots
+                with contextlib.suppress(ConnectionError):
+                    while await asyncio.wait_for(r.read(65536), 5):
+                        pass
+                w.close()
+            writer = await _mute_robot(central.robot_port, "late")
+            await until(lambda: [e.name for e in central.robots()] == ["late"])
+            writer.close()
+
+    run(main())

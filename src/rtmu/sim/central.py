@@ -26,7 +26,7 @@ from rtmu.protocol.auth import UserTable
 from rtmu.protocol.datalist import DataList
 from rtmu.protocol.errors import ProtocolError
 from rtmu.protocol.events import LoginRefused, PeerShutdown, RequestOnce, RequestReceived, RequestStopped
-from rtmu.protocol.packet import encode_packet
+from rtmu.protocol.packet import MAX_PAYLOAD, encode_packet
 from rtmu.protocol.payloads.central import CentralEntry, ClientAdded, ClientList, ClientRemoved, SwitchRequest
 from rtmu.protocol.server_connection import ServerConnection
 
@@ -35,6 +35,8 @@ from .forwarder import KEY_RNG, MAX_OPERATORS, READ_CHUNK, Forwarder, Operator, 
 log = logging.getLogger("rtmu.sim.central")
 
 FORWARD_PORT_TRIES = 200
+MAX_NAME = 511
+"""ARIA reads a robot's name into 512 bytes: a longer one is cut there."""
 
 OPERATOR_DATA = DataList.build(
     [
@@ -125,6 +127,8 @@ class CentralServer:
         self.switches = 0
         """Switch requests accepted (tests and logs)."""
         self.users = UserTable.load(self.config.users_path) if self.config.users_path else None
+        self._switching = 0
+        """Robot-port connections not yet switched (they count against ``max_robots``)."""
 
     async def start(self) -> None:
         cfg = self.config
@@ -177,6 +181,15 @@ class CentralServer:
         """The robots operators can reach now, in the order they came."""
         return [f.entry for f in self.forwarders if f.connected]
 
+    def client_list(self) -> bytes:
+        """``clientList``: as many robots as one packet holds (ARIA's packet stops taking more there)."""
+        entries = self.robots()
+        while True:
+            payload = ClientList(tuple(entries)).encode()
+            if len(payload) <= MAX_PAYLOAD:
+                return payload
+            entries.pop()
+
     # -- operators on the central port ----------------------------------------------------
     async def _accept_operator(self, reader: asyncio.StreamReader, writer: asyncio.StreamWriter) -> None:
         op = Operator(reader, writer, OPERATOR_DATA, self.users)
@@ -197,11 +210,11 @@ class CentralServer:
         if isinstance(event, RequestReceived):
             op.subscriptions[event.number] = event.interval_ms
             if event.name == ClientList.DATA_NAME and event.new:
-                op.conn.send_data(event.name, ClientList(tuple(self.robots())).encode())
+                op.conn.send_data(event.name, self.client_list())
         elif isinstance(event, RequestStopped):
             op.subscriptions.pop(event.number, None)
         elif isinstance(event, RequestOnce) and event.name == ClientList.DATA_NAME:
-            op.conn.send_data(event.name, ClientList(tuple(self.robots())).encode())
+            op.conn.send_data(event.name, self.client_list())
 
     def _broadcast(self, name: str, payload: bytes) -> None:
         number = OPERATOR_DATA.number(name)
@@ -214,11 +227,22 @@ class CentralServer:
     # -- robots on the robot port ---------------------------------------------------------
     async def _accept_robot(self, reader: asyncio.StreamReader, writer: asyncio.StreamWriter) -> None:
         peer = Peer(reader, writer)
-        if len(self.forwarders) >= self.config.max_robots:
-            log.info("robot %s: already %d robots; closing it", peer.address, len(self.forwarders))
+        if len(self.forwarders) + self._switching >= self.config.max_robots:
+            log.info("robot %s: already %d robots; closing it", peer.address, self.config.max_robots)
             peer.abort()
             return
         self._track()
+        self._switching += 1
+        try:
+            name = await self._await_switch(peer)
+        finally:
+            self._switching -= 1
+        if name is not None:
+            await self._forward(peer, name[:MAX_NAME] or peer.address)
+
+    async def _await_switch(self, peer: Peer) -> str | None:
+        """Serve the robot port's login until ``switch`` is asked: the robot's name (None: it went)."""
+        reader = peer.reader
         conn = ServerConnection(ROBOT_DATA, rng=KEY_RNG)
         peer.write(conn.data_to_send())
         name: str | None = None
@@ -228,7 +252,7 @@ class CentralServer:
                     data = await reader.read(READ_CHUNK)
                     if not data:
                         peer.abort()
-                        return
+                        return None
                     for event in conn.receive_data(data):
                         if isinstance(event, RequestOnce) and event.name == SwitchRequest.DATA_NAME:
                             try:
@@ -239,17 +263,14 @@ class CentralServer:
                         if isinstance(event, (LoginRefused, PeerShutdown)):
                             peer.write(conn.data_to_send())
                             peer.close()
-                            return
+                            return None
                     peer.write(conn.data_to_send())
-        except (TimeoutError, ConnectionError, OSError):
+        except (TimeoutError, ConnectionError, OSError, asyncio.CancelledError):
             peer.abort()
-            return
-        except asyncio.CancelledError:
-            peer.abort()
-            return
+            return None
         conn.send_data(SwitchRequest.DATA_NAME)  # the empty acceptance; the socket turns round now
         peer.write(conn.data_to_send())
-        await self._forward(peer, name or peer.address)
+        return name
 
     async def _forward(self, peer: Peer, name: str) -> None:
         for old in [f for f in self.forwarders if f.name.lower() == name.lower()]:
