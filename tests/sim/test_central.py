@@ -422,3 +422,29 @@ def test_connections_that_never_switch_count_against_the_robot_bound() -> None:
             writer.close()
 
     run(main())
+
+
+def test_a_robot_that_switches_then_sends_a_malformed_introduction_is_not_forwarded() -> None:
+    from rtmu.protocol.commands import ServerCommand
+    from rtmu.protocol.packet import encode_packet
+
+    async def main() -> None:
+        async with central_with("good") as (central, _):
+            reader, writer = await asyncio.open_connection("127.0.0.1", central.robot_port)
+            conn = ClientConnection()
+            while True:
+                events = conn.receive_data(await reader.read(65536))
+                writer.write(conn.data_to_send())
+                if any(isinstance(e, DataListReady) for e in events):
+                    break
+            conn.request_once("switch", b"liar\x00")
+            writer.write(conn.data_to_send())
+            await reader.read(65536)  # the acceptance
+            writer.write(encode_packet(ServerCommand.INTRODUCTION, b"\xff"))  # an introduction cut short
+            with contextlib.suppress(ConnectionError):
+                while await asyncio.wait_for(reader.read(65536), 5):
+                    pass
+            assert [e.name for e in central.robots()] == ["good"] and len(central.forwarders) == 1
+            writer.close()
+
+    run(main())

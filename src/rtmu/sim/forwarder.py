@@ -31,6 +31,7 @@ from rtmu.protocol.auth import UserTable
 from rtmu.protocol.client_connection import ClientConnection
 from rtmu.protocol.commands import ServerCommand, is_control_command
 from rtmu.protocol.datalist import DataEntry, DataList
+from rtmu.protocol.errors import ProtocolError
 from rtmu.protocol.events import (
     ClientIntroduced,
     DataListReady,
@@ -244,7 +245,7 @@ class Forwarder:
             server = await self._listen(self._accept)
             self._servers.append(server)
             self.port = int(server.sockets[0].getsockname()[1])
-        except (TimeoutError, ConnectionError, OSError, ValueError) as exc:
+        except (TimeoutError, ConnectionError, OSError, ProtocolError) as exc:
             log.info("robot %r: cannot forward it: %s", self.name, exc or type(exc).__name__)
             self.close()
             return
@@ -280,7 +281,7 @@ class Forwarder:
             data = await self.robot.reader.read(READ_CHUNK)
             if not data:
                 raise ConnectionError("the robot closed the switched connection during login")
-            events = self.conn.receive_data(data)  # a ProtocolError here is a ValueError
+            events = self.conn.receive_data(data)  # a malformed introduction raises ProtocolError
             self.robot.write(self.conn.data_to_send())
             for event in events:
                 if isinstance(event, Rejected):
