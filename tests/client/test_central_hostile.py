@@ -163,3 +163,18 @@ def test_unknown_robot_list_names_are_escaped_too(
     assert code == 2
     err = capsys.readouterr().err
     assert "\x1b" not in err and err.count("\n") == 1
+
+
+def test_an_entry_naming_another_host_is_still_reached_at_the_central_servers_host(
+    central: tuple[TestServer, ServerThread],
+) -> None:
+    server, _ = central
+    listing(server, ClientList((CentralEntry("evil.example", 7301, "decoy"),)).encode())
+    heard = Heard()
+    roster = CentralRoster("127.0.0.1", server.port, timeout=5)
+    roster.start(heard)
+    try:
+        eventually(lambda: len(heard) == 1, timeout=10)
+        assert isinstance(heard[0], RobotAdded) and heard[0].endpoint.host == "127.0.0.1"
+    finally:
+        roster.close()

@@ -4,8 +4,9 @@
 :class:`CentralRoster` is a :class:`~rtmu.client.roster.Roster` that stays logged in on a thread of its
 own: the list first, then the ``clientAdded`` / ``clientRemoved`` broadcasts, each turned into a
 :class:`RobotAdded` / :class:`RobotRemoved`; when the central server's connection ends (or never came
-up), one :class:`RosterLost`. Every robot is reached on the central server's host (ARIA sends an empty
-hostname) at its forwarded port, unless the entry names another host.
+up), one :class:`RosterLost`. Every robot is reached on the central server's host at its forwarded
+port: ARIA's central server always sends an empty hostname, and one that named another host would
+be sending the operator's login (and drive commands) elsewhere, so such a name is not followed.
 
 The central server is trusted no more than a robot: at most :data:`MAX_ROBOTS` robots are held, names
 longer than :data:`MAX_NAME` or entries without a port are dropped (and counted), and names are kept as
@@ -46,10 +47,7 @@ def endpoint_of(entry: CentralEntry, central_host: str, central_port: int) -> Ro
     """The address an operator reaches ``entry`` at; None for an entry no robot could have sent."""
     if not entry.name or len(entry.name) > MAX_NAME or not 0 < entry.port <= 0xFFFF:
         return None
-    if len(entry.hostname) > MAX_NAME:
-        return None
-    host = entry.hostname or central_host
-    return RobotEndpoint(entry.name, host, entry.port, via=f"{central_host}:{central_port}")
+    return RobotEndpoint(entry.name, central_host, entry.port, via=f"{central_host}:{central_port}")
 
 
 async def list_robots(
