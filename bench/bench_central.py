@@ -3,26 +3,26 @@
 The same simulated robot configuration is reached two ways in one run: directly (the baseline) and
 through ``rtmu sim --central`` (the robot switched to the central server; the operator dials the
 port the central server forwards it on, and every request and reply makes one more hop through the
-forwarder; the central server and that one robot share a thread here). Each sample is one
-``updateNumbers`` request answered; servers run on threads of this process, so the figures include
-their share of the GIL on a loaded machine. Also timed: one ``list_robots`` (login to the central
+forwarder). Each server is an ``rtmu sim`` process of its own, as deployed. Each sample is one
+``updateNumbers`` request answered. Also timed: one ``list_robots`` (login to the central
 server, ``clientList``, logout) with three robots.
 """
 
 from __future__ import annotations
 
 import asyncio
+import re
 import statistics
+import subprocess
+import sys
 import time
 
 from rtmu.client.central import list_robots
 from rtmu.client.connection import AriaClient
-from rtmu.sim import SimConfig, SimThread
-from rtmu.sim.central_thread import CentralThread
 
-from .common import Result
+from .common import Result, end_process
 
-SAMPLES = 300
+SAMPLES = 1000
 WARMUP = 20
 
 
@@ -55,16 +55,56 @@ async def _list_ms(port: int, rounds: int = 20) -> float:
     return best
 
 
+def _start(*argv: str) -> tuple[subprocess.Popen[str], str]:
+    """``rtmu sim ARGV`` in its own process; returns it and its first line (which names its ports)."""
+    proc = subprocess.Popen(
+        [sys.executable, "-m", "rtmu", "sim", "--port", "0", "--no-camera", *argv],
+        stdout=subprocess.PIPE,
+        stderr=subprocess.DEVNULL,
+        text=True,
+    )
+    assert proc.stdout is not None
+    return proc, proc.stdout.readline()
+
+
+def _port_after(text: str, marker: str) -> int:
+    return int(re.search(re.escape(marker) + r"127\.0\.0\.1:(\d+)", text).group(1))  # type: ignore[union-attr]
+
+
+async def _wait_listed(port: int, count: int) -> list[int]:
+    deadline = time.monotonic() + 60
+    while True:
+        robots = await list_robots("127.0.0.1", port, timeout=10)
+        if len(robots) == count:
+            return [e.port for e, _ in robots]
+        if time.monotonic() > deadline:
+            raise TimeoutError(f"{len(robots)} robots switched, not {count}")
+        await asyncio.sleep(0.1)
+
+
 def run() -> list[Result]:
-    template = SimConfig(port=0, camera=False)
-    with SimThread(SimConfig(port=0, camera=False)) as direct:
-        base = asyncio.run(_latencies(direct.port))
-    with CentralThread(robots=1, template=template) as fleet:
-        # One robot, as direct: the central server and the robot share one loop, as the direct robot
-        # shares its loop with nobody else — the difference is the forwarder's hop alone.
-        forwarded = asyncio.run(_latencies(fleet.robots()["robot1"]))
-    with CentralThread(robots=3, template=template) as fleet:
-        listing = asyncio.run(_list_ms(fleet.port))
+    procs: list[subprocess.Popen[str]] = []
+    try:
+        # Every server in a process of its own, as deployed: the client here shares no GIL with them.
+        direct, line = _start()
+        procs.append(direct)
+        base = asyncio.run(_latencies(_port_after(line, "listening on ")))
+        central, line = _start("--central", "--robot-port", "0", "--robots", "0")
+        procs.append(central)
+        central_port = _port_after(line, "operators on ")
+        robot_port = _port_after(line, "robots switch to ")
+        robot, _ = _start("--switch-to", f"127.0.0.1:{robot_port}", "--name", "robot1")
+        procs.append(robot)
+        (forwarded_port,) = asyncio.run(_wait_listed(central_port, 1))
+        forwarded = asyncio.run(_latencies(forwarded_port))
+        for i in (2, 3):
+            more, _ = _start("--switch-to", f"127.0.0.1:{robot_port}", "--name", f"robot{i}")
+            procs.append(more)
+        asyncio.run(_wait_listed(central_port, 3))
+        listing = asyncio.run(_list_ms(central_port))
+    finally:
+        for proc in reversed(procs):
+            end_process(proc)
     return [
         Result("central.status_latency_p50_ms", statistics.median(forwarded), "ms", statistics.median(base)),
         Result("central.status_latency_p95_ms", _p95(forwarded), "ms", _p95(base)),
