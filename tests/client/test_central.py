@@ -326,3 +326,27 @@ def test_a_robot_started_with_switch_to_on_the_command_line_joins_the_fleet(
             proc.terminate()
             proc.wait(15)
         fl.wait_for_robots(0, timeout=10)  # its SHUTDOWN on the way out unlists it
+
+
+def test_a_drive_through_a_central_server_that_dies_ends_and_the_robot_stops() -> None:
+    import subprocess
+    import sys
+
+    with CentralThread(robots=2, template=SimConfig(port=0, camera=False)) as fl:
+        robot = fl.sims["robot1"].robot
+        other = fl.sims["robot2"].robot
+        argv = ["drive", addr(fl), "--robot", "robot1", "--trans", "60", "--seconds", "30", "--timeout", "5"]
+        proc = subprocess.Popen(
+            [sys.executable, "-m", "rtmu", *argv], stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True
+        )
+        try:
+            eventually(lambda: fl.call(lambda: robot.trans_ratio) == 60, timeout=30)
+            fl.kill_central()  # operator and robot links reset at once: nobody can send a stop now
+            assert proc.wait(15) != 0
+            # The robot's own ratio-drive watchdog (2 s) stops it: no link means no more ratioDrive.
+            eventually(lambda: fl.call(lambda: (robot.trans_ratio, robot.vel)) == (0, 0), timeout=10)
+            assert fl.call(lambda: other.ratio_drives_received) == 0  # the other robot never drove
+        finally:
+            if proc.poll() is None:
+                proc.kill()
+                proc.wait()
