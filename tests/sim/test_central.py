@@ -448,3 +448,43 @@ def test_a_robot_that_switches_then_sends_a_malformed_introduction_is_not_forwar
             writer.close()
 
     run(main())
+
+
+def test_a_robot_drops_a_central_server_whose_heartbeats_stop_and_switches_again() -> None:
+    async def main() -> None:
+        # This central server promises heartbeats (it lists centralServerHeartbeat) but sends one an hour.
+        async with central_with(heartbeat_s=3600) as (central, _):
+            sim = SimServer(
+                SimConfig(
+                    switch_to=f"127.0.0.1:{central.robot_port}",
+                    switch_name="wary",
+                    switch_silence=0.5,
+                    **FAST,
+                )
+            )
+            await sim.start()
+            try:
+                await until(lambda: central.switches >= 2, timeout=10)  # dropped, then switched again
+                assert sim.central_heartbeats is not None and sim.central_heartbeats.count <= central.switches
+            finally:
+                await sim.stop()
+
+        async with central_with() as (central, _):  # heartbeats every second: the link is kept
+            sim = SimServer(
+                SimConfig(
+                    switch_to=f"127.0.0.1:{central.robot_port}",
+                    switch_name="calm",
+                    switch_silence=1.5,
+                    **FAST,
+                )
+            )
+            await sim.start()
+            try:
+                await until(lambda: len(central.robots()) == 1)
+                await asyncio.sleep(3.0)
+                assert central.switches == 1
+                assert sim.central_heartbeats is not None and sim.central_heartbeats.count >= 2
+            finally:
+                await sim.stop()
+
+    run(main())

@@ -43,6 +43,9 @@ class SimConfig:
     """The name to switch with (ARIA's ``-identifier``); empty: the central server uses our address."""
     switch_retry: float = 10.0
     """Seconds before switching again after the central server's connection ended (ARIA: 10)."""
+    switch_silence: float = 120.0
+    """Seconds without the central server's heartbeat before that link counts as dead and is dropped
+    (ARIA's ``RobotFromCentralServerTimeoutInMins``, 2)."""
     video_trailer: bool = True
     """Append the 2 bytes ARIA's video forwarder leaves after each JPEG (serverDemo does this)."""
     render_in_thread: bool | None = None

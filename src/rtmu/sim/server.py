@@ -379,8 +379,10 @@ class SimServer:
         threaded = cfg.realtime if cfg.render_in_thread is None else cfg.render_in_thread
         self.video = VideoFeed(threaded=threaded)
         self._switch_task: asyncio.Task[None] | None = None
+        self.central_heartbeats: switch.Heartbeats | None = None
+        """The central server's heartbeats, heard while switched to one (``switch_to``)."""
         if cfg.switch_to is not None:
-            switch.add_switch_data(self.datalist, self.handlers)
+            self.central_heartbeats = switch.add_switch_data(self.datalist, self.handlers)
             if cfg.central_server is None:  # as ARIA's robot servers do: direct logins get reason 2
                 cfg.central_server = switch.parse_address(cfg.switch_to)[0]
 
@@ -412,7 +414,15 @@ class SimServer:
                         loop.run_in_executor(None, make, number)
         if cfg.switch_to is not None:
             host, port = switch.parse_address(cfg.switch_to)
-            switching = switch.switch_loop(host, port, cfg.switch_name, cfg.switch_retry, self.serve_switched)
+            switching = switch.switch_loop(
+                host,
+                port,
+                cfg.switch_name,
+                cfg.switch_retry,
+                self.serve_switched,
+                self.central_heartbeats,
+                cfg.switch_silence,
+            )
             self._switch_task = asyncio.create_task(switching, name="rtmu-sim-switch")
 
     async def stop(self) -> None:
