@@ -350,3 +350,33 @@ def test_a_drive_through_a_central_server_that_dies_ends_and_the_robot_stops() -
             if proc.poll() is None:
                 proc.kill()
                 proc.wait()
+
+
+def test_robot_behind_a_guarded_central_server_logs_in_to_both_with_one_password(
+    tmp_path: Path, capsys: pytest.CaptureFixture[str], monkeypatch: pytest.MonkeyPatch
+) -> None:
+    import io
+
+    users = tmp_path / "users.txt"
+    users.write_text("UserInfoVersion1\nuser alice secret1 all\n")
+    with CentralThread(robots=1, template=SimConfig(port=0, camera=False), users_path=users) as fl:
+        # The password comes from stdin once (as from a prompt): the central server and the forwarded
+        # robot both get it, and it is never asked for twice.
+        monkeypatch.setattr("sys.stdin", io.StringIO("secret1\n"))
+        argv = [
+            "status",
+            addr(fl),
+            "--robot",
+            "robot1",
+            "--user",
+            "alice",
+            "--once",
+            "--json",
+            "--timeout",
+            "5",
+        ]
+        assert main(argv) == EXIT_OK
+        assert "battery_v" in json.loads(capsys.readouterr().out)
+        monkeypatch.setattr("sys.stdin", io.StringIO("wrong\n"))
+        assert main(argv) == EXIT_CONNECTION
+        assert "central server" in capsys.readouterr().err

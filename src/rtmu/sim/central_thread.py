@@ -14,6 +14,7 @@ import dataclasses
 import threading
 import time
 from collections.abc import Callable, Coroutine
+from pathlib import Path
 from typing import Any, TypeVar
 
 from .central import CentralConfig, CentralServer
@@ -26,10 +27,17 @@ START_TIMEOUT = 30.0
 
 class CentralThread:
     def __init__(
-        self, robots: int = 3, template: SimConfig | None = None, *, switch_retry: float = 0.2
+        self,
+        robots: int = 3,
+        template: SimConfig | None = None,
+        *,
+        switch_retry: float = 0.2,
+        users_path: Path | None = None,
     ) -> None:
         self.template = template or SimConfig(port=0, camera=False)
         self.switch_retry = switch_retry
+        self.users_path = users_path
+        """The central server's user file (its port and the forwarders)."""
         self.initial = robots
         self.central: CentralServer | None = None
         self.sims: dict[str, SimServer] = {}
@@ -56,7 +64,8 @@ class CentralThread:
         self.loop = loop
         asyncio.set_event_loop(loop)
         try:
-            self.central = CentralServer(CentralConfig(host="127.0.0.1", port=0, robot_port=0))
+            config = CentralConfig(host="127.0.0.1", port=0, robot_port=0, users_path=self.users_path)
+            self.central = CentralServer(config)
             loop.run_until_complete(self.central.start())
         except BaseException as exc:
             self._error = exc

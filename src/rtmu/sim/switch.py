@@ -4,7 +4,8 @@ A robot started with ``SimConfig.switch_to`` logs in to the central server's rob
 client, checks that it lists ``switch`` (else it is not a central server), asks ``switch`` once with the
 robot's name, and on the empty reply serves that same socket as if a client had connected to it (the
 central server then logs in as a client; the robot's refusal of direct logins, reason 2, does not apply
-to it). When the switched connection ends it tries again after ``switch_retry`` seconds (ARIA: 10 s).
+to it). When the switched connection ends it tries again after ``switch_retry`` seconds (ARIA: 10 s);
+a central server that promised heartbeats and sends none for ``switch_silence`` seconds is dropped.
 The robot also lists ``centralHeartbeat`` (answered empty) and ``centralServerHeartbeat`` (noted).
 """
 
