@@ -380,3 +380,17 @@ def test_robot_behind_a_guarded_central_server_logs_in_to_both_with_one_password
         monkeypatch.setattr("sys.stdin", io.StringIO("wrong\n"))
         assert main(argv) == EXIT_CONNECTION
         assert "central server" in capsys.readouterr().err
+
+
+def test_image_with_robot_comes_through_the_forwarder_as_return_video(
+    fleet: CentralThread, tmp_path: Path
+) -> None:
+    fleet.add_robot("cam", camera=True)
+    try:
+        fleet.wait_for_robots(4)
+        out = tmp_path / "cam.jpg"
+        assert main(["image", addr(fleet), "--robot", "cam", "--out", str(out), "--timeout", "10"]) == EXIT_OK
+        assert out.read_bytes()[:2] == b"\xff\xd8"
+    finally:
+        fleet.stop_robot("cam")  # the module's fleet is three robots again for whoever comes next
+        fleet.wait_for_robots(3)
