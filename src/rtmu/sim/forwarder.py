@@ -9,7 +9,7 @@ no return type it knows — and relays by ARIA's rules:
 * a request-once of a ``RETURN_SINGLE`` / ``RETURN_UNTIL_EMPTY`` / video data queues the operator;
   the robot's next reply goes to the first in the queue (``RETURN_UNTIL_EMPTY``: until its empty
   packet), video replies to everyone queued; an operator gone meanwhile leaves a hole that eats its
-  reply, so the queue stays in step with the robot;
+  reply, so the queue stays in step with the robot; ``RETURN_VIDEO_OPTIM`` goes only to askers;
 * anything else the robot sends goes to the operators subscribed to that data;
 * one subscription upstream per data at the shortest interval any operator asked (−1 if all asked −1),
   each change also asked once so a newcomer gets data at once; REQUESTSTOP when the last one stops.
@@ -353,13 +353,13 @@ class Forwarder:
             if kind is Return.SINGLE or not packet.payload:
                 queue.popleft()
             return
-        if kind in (Return.VIDEO, Return.VIDEO_OPTIM) and queue:
+        if kind in (Return.VIDEO, Return.VIDEO_OPTIM):
             while queue:
                 op = queue.popleft()
                 if op is not None and (kind is Return.VIDEO_OPTIM or number not in op.subscriptions):
                     op.write(framed)
             if kind is Return.VIDEO_OPTIM:
-                return
+                return  # only ever to those who asked
         for op in self.operators:
             if number in op.subscriptions:
                 op.write(framed)
