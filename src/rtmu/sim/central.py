@@ -30,7 +30,8 @@ from rtmu.protocol.packet import MAX_PAYLOAD, encode_packet
 from rtmu.protocol.payloads.central import CentralEntry, ClientAdded, ClientList, ClientRemoved, SwitchRequest
 from rtmu.protocol.server_connection import ServerConnection
 
-from .forwarder import KEY_RNG, MAX_OPERATORS, READ_CHUNK, Forwarder, Operator, Peer, serve_operator
+from .forwarder import Forwarder
+from .peers import KEY_RNG, MAX_OPERATORS, READ_CHUNK, Operator, Peer, serve_operator
 
 log = logging.getLogger("rtmu.sim.central")
 
