@@ -4,7 +4,8 @@ The same simulated robot configuration is reached two ways in one run: directly 
 through ``rtmu sim --central`` (the robot switched to the central server; the operator dials the
 port the central server forwards it on, and every request and reply makes one more hop through the
 forwarder). Each server is an ``rtmu sim`` process of its own, as deployed. Each sample is one
-``updateNumbers`` request answered. Also timed: one ``list_robots`` (login to the central
+``updateNumbers`` request answered; the two connections take turns, so load on a shared machine falls
+on both alike. Also timed: one ``list_robots`` (login to the central
 server, ``clientList``, logout) with three robots.
 """
 
@@ -26,19 +27,24 @@ SAMPLES = 1000
 WARMUP = 20
 
 
-async def _latencies(port: int) -> list[float]:
-    client = AriaClient()
-    await client.connect("127.0.0.1", port, timeout=10)
+async def _latencies(*ports: int) -> list[list[float]]:
+    """Milliseconds per answered ``updateNumbers`` on each port, the ports taking turns sample by sample
+    (so a burst of load on the shared machine falls on both alike)."""
+    clients = [AriaClient() for _ in ports]
+    for client, port in zip(clients, ports, strict=True):
+        await client.connect("127.0.0.1", port, timeout=10)
     try:
-        out: list[float] = []
+        out: list[list[float]] = [[] for _ in ports]
         for i in range(WARMUP + SAMPLES):
-            t0 = time.perf_counter()
-            await client.request_once("updateNumbers", timeout=10)
-            if i >= WARMUP:
-                out.append((time.perf_counter() - t0) * 1000.0)
+            for client, times in zip(clients, out, strict=True):
+                t0 = time.perf_counter()
+                await client.request_once("updateNumbers", timeout=10)
+                if i >= WARMUP:
+                    times.append((time.perf_counter() - t0) * 1000.0)
         return out
     finally:
-        await client.disconnect()
+        for client in clients:
+            await client.disconnect()
 
 
 def _p95(values: list[float]) -> float:
@@ -88,7 +94,7 @@ def run() -> list[Result]:
         # Every server in a process of its own, as deployed: the client here shares no GIL with them.
         direct, line = _start()
         procs.append(direct)
-        base = asyncio.run(_latencies(_port_after(line, "listening on ")))
+        direct_port = _port_after(line, "listening on ")
         central, line = _start("--central", "--robot-port", "0", "--robots", "0")
         procs.append(central)
         central_port = _port_after(line, "operators on ")
@@ -96,7 +102,7 @@ def run() -> list[Result]:
         robot, _ = _start("--switch-to", f"127.0.0.1:{robot_port}", "--name", "robot1")
         procs.append(robot)
         (forwarded_port,) = asyncio.run(_wait_listed(central_port, 1))
-        forwarded = asyncio.run(_latencies(forwarded_port))
+        base, forwarded = asyncio.run(_latencies(direct_port, forwarded_port))
         for i in (2, 3):
             more, _ = _start("--switch-to", f"127.0.0.1:{robot_port}", "--name", f"robot{i}")
             procs.append(more)
