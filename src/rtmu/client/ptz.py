@@ -125,7 +125,8 @@ class PtzFeed:
 
     def disconnected(self) -> None:
         self._client, self._camera, self._polling = None, None, False
-        self._set(PtzState())
+        self._state = PtzState()
+        self._update(ptz=None)  # unknown until the next login reads the list
 
     def watch(self, on: bool) -> None:
         """Poll the position while ``on`` (the camera page is shown)."""
