@@ -15,7 +15,8 @@ from collections.abc import Callable
 import gi
 
 gi.require_version("Gtk", "4.0")
-from gi.repository import Gdk, Gtk  # noqa: E402
+gi.require_version("Pango", "1.0")
+from gi.repository import Gdk, Gtk, Pango  # noqa: E402
 
 from ..model import ConnectionState, RobotModel, RobotState  # noqa: E402
 from ..protocol.payloads.ld import Say, data_store_label  # noqa: E402
@@ -23,6 +24,9 @@ from ..protocol.payloads.ld import Say, data_store_label  # noqa: E402
 Send = Callable[[str, object], None]
 Watch = Callable[[bool], object]
 MAX_SAY = 1000
+NAME_CHARS = 28
+VALUE_CHARS = 40
+"""Widths (characters) past which a row's label and value are ellipsized."""
 """Characters; the entry refuses more."""
 
 
@@ -126,9 +130,13 @@ class DetailsWindow(Gtk.Window):
         self.values = {}
         self._shown = []
         for i, (label, value) in enumerate(rows):
-            name = Gtk.Label(label=label, xalign=0.0)
+            name = Gtk.Label(label=label, xalign=0.0, max_width_chars=NAME_CHARS)
+            name.set_ellipsize(Pango.EllipsizeMode.END)  # a long server label must not push its value away
             name.add_css_class("dim-label")
-            shown = Gtk.Label(label=value, xalign=0.0, hexpand=True)
+            if len(label) > NAME_CHARS:
+                name.set_tooltip_text(label)  # plain text, like the label itself
+            shown = Gtk.Label(label=value, xalign=0.0, hexpand=True, max_width_chars=VALUE_CHARS)
+            shown.set_ellipsize(Pango.EllipsizeMode.END)
             self.grid.attach(name, 0, i, 1, 1)
             self.grid.attach(shown, 1, i, 1, 1)
             self.values[label] = shown

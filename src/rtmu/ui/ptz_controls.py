@@ -87,6 +87,7 @@ class PtzControls(Gtk.Box):
 
     def __init__(self, model: RobotModel, link: PtzLink, on_moved: Callable[[], None] | None = None) -> None:
         super().__init__(orientation=Gtk.Orientation.HORIZONTAL, spacing=4)
+        self.add_css_class("camera-bar")  # the camera page's own bar style
         self.add_css_class("ptz-bar")
         for side in ("start", "end"):
             getattr(self, f"set_margin_{side}")(8)
