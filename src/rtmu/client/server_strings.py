@@ -45,6 +45,17 @@ def wifi_role(label: str) -> str | None:
     return None
 
 
+def _prefix_end(payload: bytes, count: int) -> int:
+    """Where the first ``count`` NUL-terminated strings of ``payload`` end (all of it if fewer)."""
+    end = 0
+    for _ in range(count):
+        found = payload.find(b"\0", end)
+        if found < 0:
+            return len(payload)
+        end = found + 1
+    return end
+
+
 def _int_or_none(text: str) -> int | None:
     try:
         return round(float(text.split()[0]))
@@ -62,6 +73,10 @@ class StringsFeed:
         self._timeout = reply_timeout
         self._client: AriaClient | None = None
         self._info: StringsInfo | None = None
+        self._labels: tuple[str, ...] = ()
+        """The first :data:`MAX_ITEMS` labels, clipped: what the table can show."""
+        self._roles: tuple[tuple[int, str], ...] = ()
+        """(index, RobotState field) of the Wi-Fi items among those labels."""
         self._held = False
         self._refetching = False
         self.watching = False
@@ -70,11 +85,11 @@ class StringsFeed:
 
     @property
     def _wifi(self) -> bool:
-        return self._info is not None and any(wifi_role(label) for label in self._info.labels)
+        return bool(self._roles)
 
     async def connected(self, client: AriaClient) -> None:
         """Read the labels once after login, then subscribe if anyone reads the values."""
-        self._client, self._info, self._held = client, None, False
+        self._client, self._info, self._held, self._labels, self._roles = client, None, False, (), ()
         if client.supports("getStringsInfo") and client.supports("getStrings"):
             await self._fetch_info(client)
         self._sync()
@@ -96,7 +111,15 @@ class StringsFeed:
             reply = await client.request_once("getStringsInfo", timeout=self._timeout)
             info = self._decode("getStringsInfo", reply.payload)
             if isinstance(info, StringsInfo) and client is self._client:
-                self._info = info
+                self._set_info(info)
+
+    def _set_info(self, info: StringsInfo) -> None:
+        # Worked out once per label list, not per packet: a hostile list may hold 10 000 labels.
+        self._info = info
+        shown = info.items[:MAX_ITEMS]
+        self._labels = tuple(clip(item.label) for item in shown)
+        roles = ((i, wifi_role(item.label)) for i, item in enumerate(shown))
+        self._roles = tuple((i, role) for i, role in roles if role is not None)
 
     def _sync(self) -> None:
         client = self._client
@@ -111,22 +134,34 @@ class StringsFeed:
             client.stop_request("getStrings")
 
     def _on_values(self, packet: Packet) -> None:
-        values = self._decode(packet.name, packet.payload)
+        """Values in label order. Only the first :data:`MAX_ITEMS` are decoded; the rest are counted.
+
+        This runs on the network loop: a 10 000-value packet must cost it no more than a few
+        hundred (``bench/bench_ptz.py``), so the tail is counted by its terminators, not parsed.
+        """
         info = self._info
-        if not isinstance(values, Strings) or info is None:
+        if info is None:
             return
-        if len(values.values) != len(info.items) and not self._refetching and self._client is not None:
+        payload = packet.payload
+        total = payload.count(b"\0")
+        cut = _prefix_end(payload, MAX_ITEMS)
+        try:
+            values = Strings.decode(payload[:cut]).values
+        except ProtocolError:
+            return
+        if total != len(info.items) and not self._refetching and self._client is not None:
             self._refetching = True  # an item was added since we read the labels: read them again
             self._spawn(self._refetch(self._client), "strings-info")
         changes: dict[str, Any] = {}
-        for label, text in info.pair(values):
-            role = wifi_role(label)
-            if role is not None:
-                changes[role] = _int_or_none(text)
+        for i, role in self._roles:
+            if i < len(values):
+                changes[role] = _int_or_none(values[i])
         if self.watching:
-            pairs = info.pair(values)
-            changes["server_strings"] = tuple((clip(k), clip(v)) for k, v in pairs[:MAX_ITEMS])
-            changes["server_strings_more"] = max(0, len(pairs) - MAX_ITEMS)
+            shown = min(len(values), len(self._labels))
+            changes["server_strings"] = tuple(
+                zip(self._labels[:shown], map(clip, values[:shown]), strict=True)
+            )
+            changes["server_strings_more"] = max(0, min(total, len(info.items)) - shown)
         if changes:
             self._update(**changes)
 
