@@ -96,6 +96,7 @@ class PtzControls(Gtk.Box):
         self._link = link
         self._on_moved = on_moved
         self._picture_timer = 0
+        self._closed = False
         self.watching = False
         self.buttons: dict[str, Gtk.Button] = {}
         self.label = Gtk.Label(xalign=0.0, hexpand=True)
@@ -134,6 +135,8 @@ class PtzControls(Gtk.Box):
         return disabled_reason(self.state, self.model.connection.value.connected)
 
     def close(self) -> None:
+        """The window is going: unhook, and ask the runner for nothing more (it may be closed)."""
+        self._closed = True
         for remove in self._unobserve:
             remove()
         self._unobserve = []
@@ -142,7 +145,7 @@ class PtzControls(Gtk.Box):
             self._picture_timer = 0
 
     def _set_watching(self, on: bool) -> None:
-        if on != self.watching:
+        if on != self.watching and not self._closed:
             self.watching = on
             self._link.watch_ptz(on)
 
