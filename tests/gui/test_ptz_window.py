@@ -20,6 +20,7 @@ from PIL import Image
 
 from rtmu.client.ptz import NO_LIST
 from rtmu.client.server_strings import MAX_ITEMS
+from rtmu.protocol.payloads.camera import Camera, CameraCommand, CameraData, CameraList
 from rtmu.protocol.payloads.strings import StringItem, Strings, StringsInfo
 from rtmu.sim import SimConfig, SimThread
 from rtmu.sim.handlers import STRING_ITEMS
@@ -195,5 +196,45 @@ def test_no_head_greys_the_controls_with_the_reason(
             pump(lambda: window.banners.text("ptz") == f"Camera head: {NO_LIST}", 5, "the reason as a banner")
             gui.shot("ptz-disabled")
             assert not any(r.name.startswith("setCamera") for r in server.received)
+        finally:
+            gui.close()
+
+
+def test_a_hostile_camera_name_is_literal_and_cannot_widen_the_window(
+    screenshots: Path, request: pytest.FixtureRequest
+) -> None:
+    specs = [
+        ("getCameraList", "cameras", "none", "list", "CameraInfo", "RETURN_SINGLE"),
+        ("getCameraDataX", "position", "none", "position", "CameraInfo", "RETURN_SINGLE"),
+        ("setCameraRelX", "rel", "pan tilt zoom", "none", "CameraControl", "RETURN_NONE"),
+    ]
+    name = "<b>Cam</b> &amp; " * 400
+    commands = (
+        CameraCommand("getCameraData", "getCameraDataX"),
+        CameraCommand("setCameraRel", "setCameraRelX"),
+    )
+    server = TestServer(SPECS + specs)
+    server.handlers["getCameraList"] = lambda s, a: [
+        CameraList((Camera("X", "T", name, "", commands),)).encode()
+    ]
+    server.handlers["getCameraDataX"] = lambda s, a: [CameraData(1, 2, 3).encode()]
+    with ServerThread(server) as running:
+        gui = Gui.start(screenshots, request.node.name, "127.0.0.1", running.port)
+        try:
+            window = gui.window
+            width = window.get_width()
+            gui.key("Escape")
+            pump(lambda: window.stack.get_visible_child_name() == "camera", 5, "the camera page")
+            ptz = window.ptz
+            pump(lambda: ptz.buttons["ptz_left"].get_sensitive(), 5, "the PTZ controls")
+            pump(lambda: "pan +1°" in ptz.label.get_text(), 5, "the position")
+            assert ptz.label.get_text().startswith("<b>Cam</b> &amp; ") and not ptz.label.get_use_markup()
+            assert not ptz.buttons["ptz_home"].get_sensitive()  # no setCameraAbs listed
+            assert not ptz.buttons["ptz_zoom_in"].get_sensitive()  # no limits read: no zoom
+            idle(0.3)
+            assert window.get_width() == width  # the name is ellipsized, the window keeps its size
+            gui.click(ptz.buttons["ptz_right"])
+            pump(lambda: any(r.name == "setCameraRelX" for r in server.received), 5, "the move at the server")
+            gui.shot("hostile-camera-name")
         finally:
             gui.close()

@@ -17,7 +17,8 @@ from typing import Protocol
 import gi
 
 gi.require_version("Gtk", "4.0")
-from gi.repository import GLib, Gtk  # noqa: E402
+gi.require_version("Pango", "1.0")
+from gi.repository import GLib, Gtk, Pango  # noqa: E402
 
 from ..model import RobotModel, RobotState  # noqa: E402
 from ..state import PtzState  # noqa: E402
@@ -101,6 +102,7 @@ class PtzControls(Gtk.Box):
         self.buttons: dict[str, Gtk.Button] = {}
         self.label = Gtk.Label(xalign=0.0, hexpand=True)
         self.label.set_use_markup(False)
+        self.label.set_ellipsize(Pango.EllipsizeMode.END)  # a long camera name must not widen the window
         self.append(self.label)
         for intent, icon, tip in (
             ("ptz_left", "go-previous-symbolic", "Pan left (Ctrl+Left)"),
