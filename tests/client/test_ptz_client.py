@@ -18,7 +18,7 @@ from typing import Any
 import pytest
 
 from rtmu.cli import main
-from rtmu.client.ptz import MAX_NAME, NO_HEAD, NO_LIST
+from rtmu.client.ptz import MAX_NAME, NO_HEAD, NO_LIST, POLL_MS
 from rtmu.client.runner import ClientRunner
 from rtmu.exit_codes import EXIT_OK, EXIT_UNSUPPORTED, EXIT_USAGE
 from rtmu.model import Phase, RobotModel
@@ -233,3 +233,28 @@ def test_cli_shows_and_points_the_head(sim: SimThread, capsys: pytest.CaptureFix
 def test_cli_without_a_camera_exits_4() -> None:
     with SimThread(SimConfig(port=0, map_path=OFFICE, camera=False)) as s:
         assert main(["ptz", f"127.0.0.1:{s.port}", "--timeout", "5"]) == EXIT_UNSUPPORTED
+
+
+def test_a_watched_position_is_polled_again_after_a_reconnect() -> None:
+    server = _server(CameraList((_camera(),)).encode())
+    thread = ServerThread(server)
+    with thread as srv:
+        r = Rig(srv.port)
+        try:
+            r.runner.watch_ptz(True).result(5)
+            r.wait(
+                lambda: any(
+                    x.name == "getCameraDataX" and x.kind == f"request {POLL_MS}" for x in srv.received
+                )
+            )
+            thread.call(lambda: srv.kill(srv.sides[0]))
+            r.wait(lambda: len(srv.sides) == 2 and r.model.connection.value.phase is Phase.CONNECTED, 15)
+            r.wait(lambda: any(x.side == 1 and x.kind == f"request {POLL_MS}" for x in srv.received), 10)
+            r.runner.watch_ptz(False).result(5)
+            r.wait(
+                lambda: any(
+                    x.side == 1 and x.name == "getCameraDataX" and x.kind == "stop" for x in srv.received
+                )
+            )
+        finally:
+            r.close()

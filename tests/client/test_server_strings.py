@@ -162,3 +162,19 @@ def test_an_added_item_is_picked_up_and_garbage_values_are_ignored(rig_on: Any) 
         rig.wait(lambda: _kinds(srv, "getStrings").count(f"request {INTERVAL_MS}") == 1)
         assert rig.model.connection.value.phase is Phase.CONNECTED
         assert rig.robot.server_strings == (("A", "1"), ("B", "2"))  # the last good values stay
+
+
+def test_an_open_table_asks_again_after_a_reconnect(rig_on: Any) -> None:
+    server = _server(("CPU Use",), ("12%",))
+    thread = ServerThread(server)
+    with thread as srv:
+        rig = rig_on(srv.port)
+        rig.runner.watch_strings(True).result(5)
+        rig.wait(lambda: rig.robot.server_strings == (("CPU Use", "12%"),))
+        thread.call(lambda: srv.kill(srv.sides[0]))  # the link drops; the session reconnects by itself
+        rig.wait(lambda: len(srv.sides) == 2 and rig.model.connection.value.phase is Phase.CONNECTED, 15)
+        rig.wait(lambda: any(r.side == 1 and r.name == "getStrings" for r in srv.received), 10)
+        rig.wait(lambda: rig.robot.server_strings == (("CPU Use", "12%"),))
+        assert [r.kind for r in srv.received if r.name == "getStrings" and r.side == 1] == [
+            f"request {INTERVAL_MS}"
+        ]
