@@ -129,7 +129,7 @@ class PtzState:
     zoom_range: tuple[float, float] = (0.0, 0.0)
     zoom_available: bool = False
     position: tuple[float, float, float] | None = None
-    """(pan, tilt, zoom) as last read."""
+    """(pan, tilt, zoom) as last read: pan positive to the right, tilt positive up (ARIA's convention)."""
 
     @property
     def movable(self) -> bool:

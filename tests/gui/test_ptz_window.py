@@ -144,18 +144,22 @@ def test_ptz_buttons_keys_and_drag_move_the_simulated_head(gui: Gui, sim: SimThr
 
     texture = window.camera.texture
     gui.click(ptz.buttons["ptz_left"])
-    pump(lambda: _head(sim) == (10.0, 0.0, 0.0), 5, "the head to pan left")
-    pump(lambda: ptz.label.get_text().startswith("Camera: pan +10°"), 5, "the position label")
+    pump(
+        lambda: _head(sim) == (-10.0, 0.0, 0.0),
+        5,
+        "the head to pan left (negative: ARIA pans right positive)",
+    )
+    pump(lambda: ptz.label.get_text().startswith("Camera: pan -10°"), 5, "the position label")
     _new_picture(gui, texture)
     left = _pixels(gui, window.camera.picture, "left")
     assert np.abs(left - ahead).mean() > 2  # the picture follows the head
     gui.shot("camera-panned-left")
 
     gui.key("ctrl+Right", "ctrl+Right", "ctrl+Up", "Page_Up")
-    pump(lambda: _head(sim) == (-10.0, 5.0, 10.0), 5, "the keys to move the head")
-    pump(lambda: gui.model.robot.value.ptz.position == (-10.0, 5.0, 10.0), 5, "the position read back")
+    pump(lambda: _head(sim) == (10.0, 5.0, 10.0), 5, "the keys to move the head")
+    pump(lambda: gui.model.robot.value.ptz.position == (10.0, 5.0, 10.0), 5, "the position read back")
 
-    # A drag to the left across a quarter of the picture turns the head left (positive pan).
+    # A drag to the left across a quarter of the picture turns the head left (negative pan).
     x, y = gui.centre_on_surface(window.camera.picture)
     dx = window.camera.picture.get_width() // 4
     xid = str(gui.xid())
@@ -164,7 +168,7 @@ def test_ptz_buttons_keys_and_drag_move_the_simulated_head(gui: Gui, sim: SimThr
         gui.xdotool("mousemove", "--window", xid, str(x - dx * step // 4), str(y))
         idle(0.03)
     gui.xdotool("mouseup", "1")
-    pump(lambda: _head(sim)[0] > 0.0, 5, "the drag to pan the head left")
+    pump(lambda: _head(sim)[0] < 0.0, 5, "the drag to pan the head left")
     gui.shot("camera-after-drag")
 
     after = sim.snapshot()

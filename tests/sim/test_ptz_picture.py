@@ -76,3 +76,32 @@ def test_pan_and_zoom_change_the_picture(tmp_path):
         await server.stop()
 
     run(scenario())
+
+
+WALL_ON_THE_RIGHT = """2D-Map
+Cairn: RobotHome 0 0 0.000000 "" ICON "Home"
+LINES
+-6000 -2500 6000 -2500
+DATA
+"""
+
+
+def test_a_positive_pan_turns_the_camera_right_as_arias_does(tmp_path):
+    """ARIA's camera handler looks at a goal with ``pan = -delta heading``: positive pan is clockwise."""
+    path = tmp_path / "right-wall.map"
+    path.write_text(WALL_ON_THE_RIGHT)
+
+    async def scenario() -> None:
+        server, c = await _start(path)
+        rows = {}
+        for pan in (90.0, -90.0):
+            c.once("setCameraAbsCam1", SetCameraAbs(pan, 0, 0).encode())
+            await c.barrier()
+            await server.advance(0.5)
+            rows[pan] = _wall_rows((await _picture(c)).astype(np.uint8))
+        assert rows[90.0] > 40  # the wall on the robot's right fills the middle of the view
+        assert rows[-90.0] < rows[90.0] / 4  # to the left there is nothing near
+        await c.close()
+        await server.stop()
+
+    run(scenario())

@@ -47,7 +47,7 @@ def register(subparsers: Any) -> None:
     )
     add_connection_arguments(p)
     p.add_argument("--json", action="store_true", help="one JSON object: cameras, limits, position")
-    p.add_argument("--pan", type=_angle, help="pan to this angle (degrees, counter-clockwise positive)")
+    p.add_argument("--pan", type=_angle, help="pan to this angle (degrees, right positive)")
     p.add_argument("--tilt", type=_angle, help="tilt to this angle (degrees, up positive)")
     p.add_argument("--zoom", type=_angle, help="zoom to this point of its range (%%)")
     p.set_defaults(handler=handle)

@@ -37,14 +37,15 @@ PICTURE_AFTER_MS = 400
 """After a move, ask for a new picture this much later (the head has turned by then)."""
 
 KEY_STEPS: dict[str, tuple[float, float, float | None]] = {
-    "ptz_left": (PAN_STEP, 0.0, None),
-    "ptz_right": (-PAN_STEP, 0.0, None),
+    "ptz_left": (-PAN_STEP, 0.0, None),
+    "ptz_right": (PAN_STEP, 0.0, None),
     "ptz_up": (0.0, TILT_STEP, None),
     "ptz_down": (0.0, -TILT_STEP, None),
     "ptz_zoom_in": (0.0, 0.0, ZOOM_STEP),
     "ptz_zoom_out": (0.0, 0.0, -ZOOM_STEP),
 }
-"""Key intent → relative (pan, tilt, zoom): pan is counter-clockwise positive, tilt up positive."""
+"""Key intent → relative (pan, tilt, zoom): pan is positive to the right (ARIA's camera handler turns
+a look-at heading into ``-delta``), tilt positive up."""
 
 
 class PtzLink(Protocol):
@@ -225,10 +226,10 @@ class PtzControls(Gtk.Box):
 def drag_to_move(dx: float, dy: float, width: int, height: int) -> tuple[float, float]:
     """A drag of (dx, dy) px on a (width × height) picture → (pan, tilt) degrees; (0, 0) for a click.
 
-    Right is a negative pan (ARIA's pan is counter-clockwise positive); up is a positive tilt.
+    Right is a positive pan (ARIA's pan is clockwise positive); up is a positive tilt.
     """
     if (dx * dx + dy * dy) ** 0.5 < DRAG_MIN_PX:
         return (0.0, 0.0)
-    pan = -dx / max(width, 1) * DRAG_PAN_DEG
+    pan = dx / max(width, 1) * DRAG_PAN_DEG
     tilt = -dy / max(height, 1) * DRAG_TILT_DEG
     return (round(pan, 1), round(tilt, 1))
