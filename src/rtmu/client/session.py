@@ -302,6 +302,7 @@ class Session:
         self.popups.connected(client)  # after the popupCreate subscription: popupList's answers go there
         self._set_connection(phase=Phase.CONNECTED, offers=offers, error="", error_kind="", retry_in=None)
         self._spawn(self._ping_loop(client), "ping")
+        self._spawn(self.ptz.connected(client), "ptz")  # first: a server without cameras is known at once
         self._spawn(self._fetch_once_infos(client), "infos")
         if self.config.fetch_map:
             self._request_map()
@@ -473,7 +474,6 @@ class Session:
         await self.ld.fetch(client)
         await self.nav.fetch_goals(client)
         await self.strings.connected(client)
-        await self.ptz.connected(client)
 
     def _decode(self, name: str, payload: bytes) -> Any:
         try:
