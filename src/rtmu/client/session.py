@@ -89,6 +89,7 @@ class SessionConfig:
     """``updateNumbers`` period: the status stream is also the link's heartbeat."""
     sonar_interval_ms: int = 200
     wifi_interval_ms: int = 1000
+    """``getStrings`` period (Wi-Fi gauges, and the details table while it is open)."""
     loc_state_interval_ms: int = 1000
     """``getLocState`` period, where the server offers it."""
     path_interval_ms: int = 500
@@ -184,6 +185,7 @@ class Session:
         """Server popups (§4.9): the open set as PopupsChanged, closing words as Kind.SERVER notices."""
         self.strings = StringsFeed(self._robot_update, self._decode, self._spawn, self.config.reply_timeout)
         """Server strings (§4.11): Wi-Fi gauges, and the details table while it is open."""
+        self.strings.interval_ms = self.config.wifi_interval_ms
         self.ptz = PtzFeed(self._robot_update, self._spawn, self.config.reply_timeout)
         """The pan-tilt-zoom camera head (§4.6): limits, position while watched, moves."""
         self._held_subs: set[str] = set()
