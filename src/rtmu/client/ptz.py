@@ -88,8 +88,11 @@ class PtzFeed:
             reply = await client.request_once("getCameraList", timeout=self._timeout)
             cameras = CameraList.decode(reply.payload).cameras
         except (ClientError, ProtocolError) as exc:
-            self._set(PtzState(reason=f"the camera list could not be read: {exc}"))
+            if client is self._client:
+                self._set(PtzState(reason=f"the camera list could not be read: {exc}"))
             return
+        if client is not self._client:
+            return  # a newer connection has started reading its own list
         self.cameras = cameras
         cam = pick_camera(cameras, client.supports)
         if cam is None:
@@ -119,6 +122,8 @@ class PtzFeed:
                         zoom_range=(info.min_zoom, info.max_zoom),
                         zoom_available=info.zoom_available,
                     )
+        if client is not self._client:
+            return
         self._set(state)
         await self.refresh()
         self._sync()
