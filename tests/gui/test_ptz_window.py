@@ -139,6 +139,7 @@ def test_ptz_buttons_keys_and_drag_move_the_simulated_head(gui: Gui, sim: SimThr
     ptz = window.ptz
     pump(lambda: gui.model.robot.value.ptz.position == (0.0, 0.0, 0.0), 5, "the head's position")
     assert ptz.label.get_text() == "Camera: pan +0°  tilt +0°  zoom 0 %"
+    assert ptz.buttons["ptz_left"].get_tooltip_text() == "Pan left (Ctrl+Left)"  # not a reason left over
     ahead = _pixels(gui, window.camera.picture, "ahead")
     gui.shot("camera-ahead")
 

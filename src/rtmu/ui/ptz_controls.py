@@ -101,6 +101,7 @@ class PtzControls(Gtk.Box):
         self._closed = False
         self.watching = False
         self.buttons: dict[str, Gtk.Button] = {}
+        self._tips: dict[str, str] = {}
         self.label = Gtk.Label(xalign=0.0, hexpand=True)
         self.label.set_use_markup(False)
         self.label.set_ellipsize(Pango.EllipsizeMode.END)  # a long camera name must not widen the window
@@ -116,7 +117,7 @@ class PtzControls(Gtk.Box):
         ):
             button = Gtk.Button.new_from_icon_name(icon)
             button.set_focusable(False)
-            button.set_tooltip_text(tip)
+            self._tips[intent] = tip
             button.connect("clicked", lambda _b, i=intent: self.key(i))
             self.buttons[intent] = button
             self.append(button)
@@ -162,8 +163,8 @@ class PtzControls(Gtk.Box):
         for intent, button in self.buttons.items():
             ok = not reason and self._can(intent)
             button.set_sensitive(ok)
-            if not ok:
-                button.set_tooltip_text(f"Camera head: {reason or 'not offered by this camera'}")
+            why = f"Camera head: {reason or 'not offered by this camera'}"
+            button.set_tooltip_text(self._tips[intent] if ok else why)
         self.label.set_tooltip_text(reason or None)
 
     def _can(self, intent: str) -> bool:
