@@ -81,6 +81,12 @@ class RobotState:
     """Distance left to the goal from ``DataStore_Distance_To_Goal`` (0: no goal); None if not offered."""
     closest_obstacle_mm: int | None = None
     """``DataStore_Closest_Obstacle``; None if not offered or nothing in range."""
+    server_strings: tuple[tuple[str, str], ...] = ()
+    """(label, value) of the server's ``getStrings`` items, only while the details table asks for them."""
+    server_strings_more: int = 0
+    """Items published beyond what ``server_strings`` keeps (bounded: ``client.server_strings``)."""
+    ptz: PtzState | None = None
+    """The pan-tilt-zoom camera as the server describes it; None before the camera list is read."""
 
     @property
     def battery_pct(self) -> float | None:
@@ -101,6 +107,33 @@ class RobotState:
     @property
     def moving(self) -> bool:
         return self.vel != 0 or self.rot_vel != 0 or self.lat_vel != 0
+
+
+@dataclass(frozen=True, slots=True)
+class PtzState:
+    """One pan-tilt-zoom camera (``getCameraList`` + ``getCameraInfo<N>`` + ``getCameraData<N>``).
+
+    ``reason`` says why the head cannot be moved (empty when it can); angles in degrees, zoom in %
+    of its range, as ArServerHandlerCamera sends them. ``position`` is None until it is first read.
+    """
+
+    camera: str = ""
+    """The camera's name (the data-name suffix, e.g. ``Cam1``)."""
+    display_name: str = ""
+    camera_type: str = ""
+    reason: str = ""
+    can_rel: bool = False
+    can_abs: bool = False
+    pan_range: tuple[float, float] = (0.0, 0.0)
+    tilt_range: tuple[float, float] = (0.0, 0.0)
+    zoom_range: tuple[float, float] = (0.0, 0.0)
+    zoom_available: bool = False
+    position: tuple[float, float, float] | None = None
+    """(pan, tilt, zoom) as last read: pan positive to the right, tilt positive up (ARIA's convention)."""
+
+    @property
+    def movable(self) -> bool:
+        return not self.reason and (self.can_rel or self.can_abs)
 
 
 # -- map -----------------------------------------------------------------------------------------

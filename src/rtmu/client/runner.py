@@ -384,6 +384,21 @@ class ClientRunner:
     def answer_popup(self, popup_id: int, button: int) -> concurrent.futures.Future[None]:
         return self._fire(self._session.answer_popup, popup_id, button, kind=Kind.SERVER)
 
+    # -- server strings and the camera head (no drive lease: neither moves the robot) -----------
+    def watch_strings(self, on: bool) -> concurrent.futures.Future[None]:
+        """Ask for ``getStrings`` while the details table is open (``on``), not otherwise."""
+        return self._fire(lambda: self._session.strings.watch(on))
+
+    def watch_ptz(self, on: bool) -> concurrent.futures.Future[None]:
+        """Poll the camera head's position while the camera page is shown (``on``)."""
+        return self._fire(lambda: self._session.ptz.watch(on))
+
+    def ptz_rel(self, pan: float, tilt: float, zoom: float | None = None) -> concurrent.futures.Future[None]:
+        return self._fire(lambda: self._session.ptz.move_rel(pan, tilt, zoom), kind=Kind.CAMERA)
+
+    def ptz_abs(self, pan: float, tilt: float, zoom: float | None = None) -> concurrent.futures.Future[None]:
+        return self._fire(lambda: self._session.ptz.move_abs(pan, tilt, zoom), kind=Kind.CAMERA)
+
     # -- navigation: the server drives; a refusal comes back as a Kind.NAVIGATION notice -------
     def goto_goal(self, name: str) -> concurrent.futures.Future[None]:
         return self._fire(self._session.goto_goal, name, kind=Kind.NAVIGATION)

@@ -62,7 +62,9 @@ from .mapcache import MapCache, map_key
 from .mapload import download_map, map_source
 from .nav_session import NavFeed
 from .popups import PopupFeed
+from .ptz import PtzFeed
 from .reconnect import Backoff, worth_retrying
+from .server_strings import StringsFeed
 from .subscriptions import Subscription, applicable
 
 log = logging.getLogger(__name__)
@@ -87,6 +89,7 @@ class SessionConfig:
     """``updateNumbers`` period: the status stream is also the link's heartbeat."""
     sonar_interval_ms: int = 200
     wifi_interval_ms: int = 1000
+    """``getStrings`` period (Wi-Fi gauges, and the details table while it is open)."""
     loc_state_interval_ms: int = 1000
     """``getLocState`` period, where the server offers it."""
     path_interval_ms: int = 500
@@ -165,7 +168,6 @@ class Session:
         self._kick = asyncio.Event()
         self._stepped: asyncio.Event = asyncio.Event()
         self._image_sequence = 0
-        self._wifi_labels: tuple[str, ...] = ()
         self.packets_sent = 0
         self.on_stop: Callable[[str, bool], None] | None = None
         """Optional tap (a flight recorder): ``on_stop(reason, sent)`` after every zero-ratios + ``stop``."""
@@ -181,6 +183,11 @@ class Session:
             self._publish, self._notice, self._decode, self._spawn, self.config.reply_timeout
         )
         """Server popups (§4.9): the open set as PopupsChanged, closing words as Kind.SERVER notices."""
+        self.strings = StringsFeed(self._robot_update, self._decode, self._spawn, self.config.reply_timeout)
+        """Server strings (§4.11): Wi-Fi gauges, and the details table while it is open."""
+        self.strings.interval_ms = self.config.wifi_interval_ms
+        self.ptz = PtzFeed(self._robot_update, self._spawn, self.config.reply_timeout)
+        """The pan-tilt-zoom camera head (§4.6): limits, position while watched, moves."""
         self._held_subs: set[str] = set()
         """Conditional subscriptions (``only_while``) held now on this connection."""
 
@@ -246,6 +253,8 @@ class Session:
         self._publish(RobotChanged(self._robot))
         self.nav.disconnected()
         self.popups.disconnected()
+        self.strings.disconnected()
+        self.ptz.disconnected()
         self._set_map(MapModel())
         self._publish(CameraChanged(None))
         self._set_connection(
@@ -295,6 +304,7 @@ class Session:
         self.popups.connected(client)  # after the popupCreate subscription: popupList's answers go there
         self._set_connection(phase=Phase.CONNECTED, offers=offers, error="", error_kind="", retry_in=None)
         self._spawn(self._ping_loop(client), "ping")
+        self._spawn(self.ptz.connected(client), "ptz")  # first: a server without cameras is known at once
         self._spawn(self._fetch_once_infos(client), "infos")
         if self.config.fetch_map:
             self._request_map()
@@ -313,6 +323,8 @@ class Session:
         self._publish(RobotChanged(self._robot))
         self.nav.disconnected()
         self.popups.disconnected()
+        self.strings.disconnected()
+        self.ptz.disconnected()
         self._set_map(MapModel())
         self._publish(CameraChanged(None))
         self._set_connection(
@@ -463,7 +475,7 @@ class Session:
                 self._on_safe_drive((await client.request_once("getSafeDrive", timeout=timeout)).payload)
         await self.ld.fetch(client)
         await self.nav.fetch_goals(client)
-        await self._watch_wifi(client)
+        await self.strings.connected(client)
 
     def _decode(self, name: str, payload: bytes) -> Any:
         try:
@@ -572,32 +584,6 @@ class Session:
             if o.is_goal and o.name == name:
                 return (o.x, o.y, o.th if o.type.lower() == "goalwithheading" else None)
         return None
-
-    # -- Wi-Fi (optional getStrings items, protocol §4.11) ------------------------------------
-    async def _watch_wifi(self, client: AriaClient) -> None:
-        if not (client.supports("getStringsInfo") and client.supports("getStrings")):
-            return
-        info = self._decode("getStringsInfo", (await client.request_once("getStringsInfo")).payload)
-        items = getattr(info, "items", None)
-        if not items:
-            return
-        self._wifi_labels = tuple(getattr(item, "label", getattr(item, "name", "")) for item in items)
-        if not any(_wifi_role(label) for label in self._wifi_labels):
-            return
-        client.request("getStrings", self.config.wifi_interval_ms, self._on_strings_values)
-
-    def _on_strings_values(self, packet: Packet) -> None:
-        values = self._decode(packet.name, packet.payload)
-        texts = getattr(values, "values", None)
-        if texts is None:
-            return
-        changes: dict[str, int | None] = {}
-        for label, text in zip(self._wifi_labels, texts, strict=False):
-            role = _wifi_role(label)
-            if role is not None:
-                changes[role] = _int_or_none(text)
-        if changes:
-            self._robot_update(**changes)
 
     # -- RTT ---------------------------------------------------------------------------------
     async def _ping_loop(self, client: AriaClient) -> None:
@@ -996,23 +982,3 @@ SUBSCRIPTIONS: tuple[SessionSubscription, ...] = (
     Subscription("popupClose", -1, Session._on_popup_close),
 )
 """What a session subscribes to on every connection, in this order, where the server offers it."""
-
-
-_WIFI_WORDS = ("wireless", "wifi", "wi-fi", "wlan")
-
-
-def _wifi_role(label: str) -> str | None:
-    """Which RobotState field a ``getStrings`` item feeds, judged from its label."""
-    low = label.lower()
-    if "quality" in low and (any(w in low for w in _WIFI_WORDS) or "link" in low):
-        return "wifi_quality"
-    if "signal" in low or ("dbm" in low and any(w in low for w in _WIFI_WORDS)):
-        return "wifi_signal"
-    return None
-
-
-def _int_or_none(text: str) -> int | None:
-    try:
-        return round(float(text.split()[0]))
-    except (ValueError, IndexError):
-        return None

@@ -106,7 +106,7 @@ def render_view(view: View) -> np.ndarray:
     w, h = view.size
     ptz = PanTiltZoom(view.pan, view.tilt, view.zoom)
     f = (w / 2) / math.tan(math.radians(ptz.fov_deg) / 2)
-    heading = math.radians(th + ptz.pan)
+    heading = math.radians(th - ptz.pan)  # ARIA's pan is positive to the right (clockwise)
     t = math.radians(th)
     cx = x + CAMERA_X_MM * math.cos(t)
     cy = y + CAMERA_X_MM * math.sin(t)

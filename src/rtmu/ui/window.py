@@ -67,6 +67,7 @@ from .palette import CommandPalette  # noqa: E402
 from .popups import PopupStack  # noqa: E402
 from .pose_bar import PoseBar  # noqa: E402
 from .pose_pick import PosePicker  # noqa: E402
+from .ptz_controls import PtzControls  # noqa: E402
 from .routes_panel import RoutesPanel  # noqa: E402
 from .settings_dialog import ConnectionDialog, PasswordPrompt  # noqa: E402
 from .shortcuts import build_shortcuts_window  # noqa: E402
@@ -178,6 +179,9 @@ class MainWindow(Gtk.ApplicationWindow):
         self.toolbar = StatusToolbar(model, operator, clock=clock, status_age=status_age)
         self.camera = CameraView(on_request=self._request_picture, on_back=self.show_map, clock=clock)
         self.inset = CameraInset(self.show_camera, clock=clock)
+        self.ptz = PtzControls(model, link, on_moved=self._request_picture)
+        self.ptz.attach_drag(self.camera.picture)
+        self.camera.append(self.ptz)
         self.decoder = PictureDecoder(self._picture_decoded)
         self.dpad = DPad(hold=self._hold, release=self._release, stop=self._stop_from_dpad)
         self.keys = KeyRouter(
@@ -524,6 +528,8 @@ class MainWindow(Gtk.ApplicationWindow):
             self.stage.fit()
         elif name == "follow":
             self.stage.set_follow(not self.stage.follow)
+        elif name.startswith("ptz_") and (reason := self.ptz.key(name)):
+            self.banners.tell("ptz", "warning", f"Camera head: {reason}", timeout=4.0)
 
     def open_dialog(self, name: str) -> None:
         """The dialog a command asked for (the controller stopped the robot first)."""
@@ -800,7 +806,7 @@ class MainWindow(Gtk.ApplicationWindow):
         """The details window (DataStore strings, docking, say): one at a time."""
         details = getattr(self, "details", None)
         if details is None or not details.get_visible():
-            self.details = DetailsWindow(self, self.model, self.send_data)
+            self.details = DetailsWindow(self, self.model, self.send_data, self._link.watch_strings)
         self.details.present()
 
     def show_about(self) -> None:
@@ -887,5 +893,6 @@ class MainWindow(Gtk.ApplicationWindow):
         self.toolbar.close()
         self.routes_panel.close()
         self.goals_panel.close()
+        self.ptz.close()
         self.motion.close()
         self.decoder.close()

@@ -1,0 +1,98 @@
+"""What the details strings and the camera head cost.
+
+* ``ptz.strings_update_us.hostile``: one ``getStrings`` packet of 10 000 values handled by the
+  session's strings feed while the details table is open — decoded, paired with 10 000 labels and
+  bounded to the 200 rows the table keeps. Baseline: the simulator's own 7-item packet.
+* ``ptz.strings_kept_items.hostile``: rows the model holds after that packet (the bound, not the flood).
+* ``ptz.move_to_position_ms``: from ``setCameraRel`` sent to the new position read back
+  (``getCameraData`` answered with the moved head) against the real-time simulator over loopback,
+  median of 30 moves. Baseline: a bare ``getCameraData`` round trip on the same connection.
+"""
+
+from __future__ import annotations
+
+import asyncio
+import statistics
+import time
+from pathlib import Path
+from typing import Any
+
+from bench.common import Result, best_time
+from rtmu.client.connection import AriaClient, Packet
+from rtmu.client.ptz import PtzFeed
+from rtmu.client.server_strings import StringsFeed
+from rtmu.protocol.payloads.strings import StringItem, Strings, StringsInfo
+from rtmu.sim import SimConfig, SimThread
+from rtmu.sim.handlers import STRING_ITEMS
+
+REPO = Path(__file__).resolve().parents[1]
+OFFICE = REPO / "data" / "maps" / "office.map"
+MOVES = 30
+
+
+def _feed(labels: tuple[str, ...]) -> tuple[StringsFeed, dict[str, Any]]:
+    kept: dict[str, Any] = {}
+
+    def decode(name: str, payload: bytes) -> Any:
+        return Strings.decode(payload) if name == "getStrings" else StringsInfo.decode(payload)
+
+    feed = StringsFeed(kept.update, decode, lambda coro, _name: coro.close(), 5.0)
+    feed._set_info(StringsInfo(tuple(StringItem(label, 10) for label in labels)))  # as read after login
+    feed.watching = True
+    return feed, kept
+
+
+def strings_update() -> list[Result]:
+    hostile_labels = tuple(f"x{i}" for i in range(10_000))
+    hostile, kept = _feed(hostile_labels)
+    flood = Packet("getStrings", Strings(tuple("v" for _ in hostile_labels)).encode(), 0.0)
+    sim_labels = tuple(label for label, _ in STRING_ITEMS)
+    plain, _ = _feed(sim_labels)
+    ordinary = Packet("getStrings", Strings(tuple("12" for _ in sim_labels)).encode(), 0.0)
+    hostile_s = best_time(lambda: hostile._on_values(flood))
+    plain_s = best_time(lambda: plain._on_values(ordinary))
+    return [
+        Result("ptz.strings_update_us.hostile", hostile_s * 1e6, "us", plain_s * 1e6),
+        Result("ptz.strings_kept_items.hostile", float(len(kept["server_strings"])), "items"),
+    ]
+
+
+async def _moves(port: int) -> tuple[float, float]:
+    client = AriaClient()
+    await client.connect("127.0.0.1", port, timeout=10)
+    try:
+        feed = PtzFeed(lambda **_c: None, lambda coro, _name: coro.close(), 5.0)
+        await feed.connected(client)
+        name = "getCameraDataCam1"
+        bare: list[float] = []
+        moved: list[float] = []
+        for i in range(MOVES):
+            t0 = time.perf_counter()
+            await client.request_once(name)
+            bare.append(time.perf_counter() - t0)
+            before = feed.state.position
+            t0 = time.perf_counter()
+            feed.move_rel(10.0 if i % 2 == 0 else -10.0, 0.0)
+            await feed.refresh()
+            while feed.state.position == before:  # ARIA may answer before the head has turned
+                await feed.refresh()
+            moved.append(time.perf_counter() - t0)
+        return statistics.median(moved), statistics.median(bare)
+    finally:
+        await client.disconnect()
+
+
+def move_to_position() -> list[Result]:
+    with SimThread(SimConfig(port=0, map_path=OFFICE)) as sim:
+        moved, bare = asyncio.run(_moves(sim.port))
+    return [Result("ptz.move_to_position_ms", moved * 1000, "ms", bare * 1000)]
+
+
+def run() -> list[Result]:
+    return [*strings_update(), *move_to_position()]
+
+
+if __name__ == "__main__":
+    for r in run():
+        base = f"  (baseline {r.baseline:.3f})" if r.baseline is not None else ""
+        print(f"{r.name:40s} {r.value:10.3f} {r.unit}{base}")

@@ -1,0 +1,214 @@
+"""The pan-tilt-zoom camera head of one session (``ArServerHandlerCamera``, protocol §4.6).
+
+After login :class:`PtzFeed` reads ``getCameraList``, picks the first camera whose list names a
+``setCameraRel`` or ``setCameraAbs`` data the server also lists, and reads its limits
+(``getCameraInfo<N>``) and position (``getCameraData<N>``) once. The position is then polled only
+while someone looks at it (the camera page is shown): a hidden page costs the robot nothing. Where
+there is no such camera the published :class:`~rtmu.state.PtzState` says why, so the window can
+grey its controls with the reason. Moving the head is camera work, never robot motion: it needs
+no drive lease. Every name and number comes from the server and is bounded before it is kept.
+"""
+
+from __future__ import annotations
+
+import contextlib
+import math
+from collections.abc import Callable, Coroutine
+from dataclasses import replace
+from typing import Any
+
+from ..protocol.errors import ProtocolError
+from ..protocol.payloads.camera import Camera, CameraData, CameraInfo, CameraList, SetCameraAbs, SetCameraRel
+from ..state import PtzState
+from .connection import AriaClient, Packet
+from .errors import ClientError, NotSupported
+
+POLL_MS = 250
+"""``getCameraData`` period while watched (ARIA suggests 100 ms; 4 Hz is plenty for a label)."""
+MAX_NAME = 64
+"""Characters kept of a camera's name, type or display name."""
+NO_LIST = "the server lists no cameras (getCameraList)"
+NO_HEAD = "the server's cameras have no pan/tilt/zoom head (no setCameraRel / setCameraAbs)"
+LIMIT = 327.67
+"""The largest angle a ``byte2`` hundredth can carry."""
+
+Update = Callable[..., None]
+Spawn = Callable[[Coroutine[Any, Any, None], str], None]
+
+
+def _clip(text: str) -> str:
+    return text if len(text) <= MAX_NAME else text[: MAX_NAME - 1] + "…"
+
+
+def _finite(*values: float | None) -> bool:
+    return all(v is None or (math.isfinite(v) and abs(v) <= LIMIT) for v in values)
+
+
+def pick_camera(cameras: tuple[Camera, ...], offered: Callable[[str], bool]) -> Camera | None:
+    """The first camera that can be moved: its list names a set command the server offers."""
+    for cam in cameras:
+        for command in ("setCameraRel", "setCameraAbs"):
+            name = cam.data_name(command)
+            if name and offered(name):
+                return cam
+    return None
+
+
+class PtzFeed:
+    """One session's PTZ head: ``update(ptz=PtzState)`` publishes it with the robot."""
+
+    def __init__(self, update: Update, spawn: Spawn, reply_timeout: float) -> None:
+        self._update = update
+        self._spawn = spawn
+        self._timeout = reply_timeout
+        self._client: AriaClient | None = None
+        self._camera: Camera | None = None
+        self._state = PtzState()
+        self._polling = False
+        self.cameras: tuple[Camera, ...] = ()
+        """Every camera the server listed (for ``rtmu ptz``), bounded by the packet."""
+        self.watching = False
+        """Someone shows the position (the camera page): poll ``getCameraData`` while True."""
+
+    @property
+    def state(self) -> PtzState:
+        return self._state
+
+    def _set(self, state: PtzState) -> None:
+        self._state = state
+        self._update(ptz=state)
+
+    async def connected(self, client: AriaClient) -> None:
+        """Read the camera list, limits and position once after login."""
+        self._client, self._camera, self._polling, self.cameras = client, None, False, ()
+        if not client.supports("getCameraList"):
+            self._set(PtzState(reason=NO_LIST))
+            return
+        try:
+            reply = await client.request_once("getCameraList", timeout=self._timeout)
+            cameras = CameraList.decode(reply.payload).cameras
+        except (ClientError, ProtocolError) as exc:
+            if client is self._client:
+                self._set(PtzState(reason=f"the camera list could not be read: {exc}"))
+            return
+        if client is not self._client:
+            return  # a newer connection has started reading its own list
+        self.cameras = cameras
+        cam = pick_camera(cameras, client.supports)
+        if cam is None:
+            self._set(PtzState(reason=NO_HEAD if cameras else NO_LIST))
+            return
+        self._camera = cam
+        state = PtzState(
+            camera=_clip(cam.name),
+            display_name=_clip(cam.display_name or cam.name),
+            camera_type=_clip(cam.camera_type),
+            can_rel=self._offers("setCameraRel"),
+            can_abs=self._offers("setCameraAbs"),
+        )
+        info_name = self._name("getCameraInfo")
+        if info_name:
+            with contextlib.suppress(ClientError, ProtocolError):
+                info = CameraInfo.decode(
+                    (await client.request_once(info_name, timeout=self._timeout)).payload
+                )
+                if _finite(
+                    info.min_pan, info.max_pan, info.min_tilt, info.max_tilt, info.min_zoom, info.max_zoom
+                ):
+                    state = replace(
+                        state,
+                        pan_range=(info.min_pan, info.max_pan),
+                        tilt_range=(info.min_tilt, info.max_tilt),
+                        zoom_range=(info.min_zoom, info.max_zoom),
+                        zoom_available=info.zoom_available,
+                    )
+        if client is not self._client:
+            return
+        self._set(state)
+        await self.refresh()
+        self._sync()
+
+    def disconnected(self) -> None:
+        self._client, self._camera, self._polling = None, None, False
+        self._state = PtzState()
+        self._update(ptz=None)  # unknown until the next login reads the list
+
+    def watch(self, on: bool) -> None:
+        """Poll the position while ``on`` (the camera page is shown)."""
+        self.watching = on
+        self._sync()
+
+    async def refresh(self) -> None:
+        """Read the position once (after login, and after each move when nobody polls)."""
+        client, name = self._client, self._name("getCameraData")
+        if client is None or not name:
+            return
+        with contextlib.suppress(ClientError, ProtocolError):
+            reply = await client.request_once(name, timeout=self._timeout)
+            self._on_data(Packet(name, reply.payload, reply.received_at))
+
+    def _sync(self) -> None:
+        client, name = self._client, self._name("getCameraData")
+        if client is None or not client.connected or not name:
+            return
+        if self.watching and not self._polling:
+            self._polling = True
+            client.request(name, POLL_MS, self._on_data)
+        elif not self.watching and self._polling:
+            self._polling = False
+            client.stop_request(name)
+
+    def _on_data(self, packet: Packet) -> None:
+        try:
+            data = CameraData.decode(packet.payload)
+        except ProtocolError:
+            return
+        if _finite(data.pan, data.tilt, data.zoom):
+            position = (data.pan, data.tilt, data.zoom)
+            if position != self._state.position:
+                self._set(replace(self._state, position=position))
+
+    # -- moving the head ---------------------------------------------------------------------
+    def move_rel(self, pan: float, tilt: float, zoom: float | None = None) -> None:
+        """Turn the head by (pan, tilt) degrees and zoom by ``zoom`` points of its range."""
+        client, name = self._require("setCameraRel")
+        client.send(name, SetCameraRel(_bound(pan), _bound(tilt), None if zoom is None else _bound(zoom)))
+        self._after_move()
+
+    def move_abs(self, pan: float, tilt: float, zoom: float | None = None) -> None:
+        """Point the head at (pan, tilt) degrees, zoom % (None: keep the zoom as it is)."""
+        client, name = self._require("setCameraAbs")
+        if zoom is None:
+            position = self._state.position
+            zoom = position[2] if position is not None else 0.0  # ARIA reads a missing zoom as 0
+        client.send(name, SetCameraAbs(_bound(pan), _bound(tilt), _bound(zoom)))
+        self._after_move()
+
+    def _after_move(self) -> None:
+        if not self._polling:
+            self._spawn(self.refresh(), "ptz-refresh")
+
+    def _require(self, command: str) -> tuple[AriaClient, str]:
+        client, name = self._client, self._name(command)
+        if client is None or not client.connected:
+            raise NotSupported("not connected")
+        if not name:
+            raise NotSupported(self._state.reason or f"this camera has no {command}")
+        return client, name
+
+    def _offers(self, command: str) -> bool:
+        return bool(self._name(command))
+
+    def _name(self, command: str) -> str | None:
+        cam, client = self._camera, self._client
+        if cam is None or client is None:
+            return None
+        name = cam.data_name(command)
+        return name if name and client.supports(name) else None
+
+
+def _bound(value: float) -> float:
+    """A finite angle that fits a ``byte2`` hundredth."""
+    if not math.isfinite(value):
+        return 0.0
+    return max(-LIMIT, min(LIMIT, value))

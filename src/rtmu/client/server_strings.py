@@ -1,0 +1,173 @@
+"""The server's information strings (``getStringsInfo`` / ``getStrings``, protocol §4.11) for one session.
+
+ARIA servers publish extra status (CPU, Wi-Fi, odometer, uptime …) as labelled, pre-formatted
+strings. One ``getStrings`` subscription serves two readers: the Wi-Fi gauges (held whenever a
+label names a wireless value) and the details table (held only while it is open, so a closed
+table costs the robot nothing). Everything is bounded before it reaches the model: at most
+:data:`MAX_ITEMS` rows of at most :data:`MAX_TEXT` characters each; the rest is only counted.
+"""
+
+from __future__ import annotations
+
+import contextlib
+from collections.abc import Callable, Coroutine
+from typing import Any
+
+from ..protocol.errors import ProtocolError
+from ..protocol.payloads.strings import Strings, StringsInfo
+from .connection import AriaClient, Packet
+from .errors import ClientError
+
+INTERVAL_MS = 1000
+MAX_ITEMS = 200
+"""Rows kept for the table; a hostile server may list thousands (a packet holds ~10 000)."""
+MAX_TEXT = 120
+"""Characters kept of a label or value (ARIA's own are under 40)."""
+_WIFI_WORDS = ("wireless", "wifi", "wi-fi", "wlan")
+
+Update = Callable[..., None]
+Decode = Callable[[str, bytes], Any]
+Spawn = Callable[[Coroutine[Any, Any, None], str], None]
+
+
+def clip(text: str) -> str:
+    """``text`` cut to :data:`MAX_TEXT` characters (an ellipsis says it was cut)."""
+    return text if len(text) <= MAX_TEXT else text[: MAX_TEXT - 1] + "…"
+
+
+def wifi_role(label: str) -> str | None:
+    """Which RobotState field a ``getStrings`` item feeds, judged from its label."""
+    low = label.lower()
+    if "quality" in low and (any(w in low for w in _WIFI_WORDS) or "link" in low):
+        return "wifi_quality"
+    if "signal" in low or ("dbm" in low and any(w in low for w in _WIFI_WORDS)):
+        return "wifi_signal"
+    return None
+
+
+def _prefix_end(payload: bytes, count: int) -> int:
+    """Where the first ``count`` NUL-terminated strings of ``payload`` end (all of it if fewer)."""
+    end = 0
+    for _ in range(count):
+        found = payload.find(b"\0", end)
+        if found < 0:
+            return len(payload)
+        end = found + 1
+    return end
+
+
+def _int_or_none(text: str) -> int | None:
+    try:
+        return round(float(text.split()[0]))
+    except (ValueError, IndexError, OverflowError):
+        return None
+
+
+class StringsFeed:
+    """Holds the ``getStrings`` subscription while someone reads it; ``update(**changes)`` feeds the robot."""
+
+    def __init__(self, update: Update, decode: Decode, spawn: Spawn, reply_timeout: float) -> None:
+        self._update = update
+        self._decode = decode
+        self._spawn = spawn
+        self._timeout = reply_timeout
+        self._client: AriaClient | None = None
+        self._info: StringsInfo | None = None
+        self._labels: tuple[str, ...] = ()
+        """The first :data:`MAX_ITEMS` labels, clipped: what the table can show."""
+        self._roles: tuple[tuple[int, str], ...] = ()
+        """(index, RobotState field) of the Wi-Fi items among those labels."""
+        self._held = False
+        self._refetching = False
+        self.watching = False
+        """The details table is open (set from the UI through the runner)."""
+        self.interval_ms = INTERVAL_MS
+
+    @property
+    def _wifi(self) -> bool:
+        return bool(self._roles)
+
+    async def connected(self, client: AriaClient) -> None:
+        """Read the labels once after login, then subscribe if anyone reads the values."""
+        self._client, self._info, self._held, self._labels, self._roles = client, None, False, (), ()
+        if client.supports("getStringsInfo") and client.supports("getStrings"):
+            await self._fetch_info(client)
+        self._sync()
+
+    def disconnected(self) -> None:
+        self._client, self._info, self._held = None, None, False
+        if self.watching:
+            self._update(server_strings=(), server_strings_more=0)
+
+    def watch(self, on: bool) -> None:
+        """The details table opened (True) or closed (False): ask for the values only while open."""
+        self.watching = on
+        self._sync()
+        if not on:
+            self._update(server_strings=(), server_strings_more=0)
+
+    async def _fetch_info(self, client: AriaClient) -> None:
+        with contextlib.suppress(ClientError, ProtocolError):
+            reply = await client.request_once("getStringsInfo", timeout=self._timeout)
+            info = self._decode("getStringsInfo", reply.payload)
+            if isinstance(info, StringsInfo) and client is self._client:
+                self._set_info(info)
+
+    def _set_info(self, info: StringsInfo) -> None:
+        # Worked out once per label list, not per packet: a hostile list may hold 10 000 labels.
+        self._info = info
+        shown = info.items[:MAX_ITEMS]
+        self._labels = tuple(clip(item.label) for item in shown)
+        roles = ((i, wifi_role(item.label)) for i, item in enumerate(shown))
+        self._roles = tuple((i, role) for i, role in roles if role is not None)
+
+    def _sync(self) -> None:
+        client = self._client
+        if client is None or not client.connected or self._info is None:
+            return
+        wanted = self.watching or self._wifi
+        if wanted and not self._held:
+            self._held = True
+            client.request("getStrings", self.interval_ms, self._on_values)
+        elif not wanted and self._held:
+            self._held = False
+            client.stop_request("getStrings")
+
+    def _on_values(self, packet: Packet) -> None:
+        """Values in label order. Only the first :data:`MAX_ITEMS` are decoded; the rest are counted.
+
+        This runs on the network loop: a 10 000-value packet must cost it no more than a few
+        hundred (``bench/bench_ptz.py``), so the tail is counted by its terminators, not parsed.
+        """
+        info = self._info
+        if info is None:
+            return
+        payload = packet.payload
+        total = payload.count(b"\0")
+        cut = _prefix_end(payload, MAX_ITEMS)
+        try:
+            values = Strings.decode(payload[:cut]).values
+        except ProtocolError:
+            return
+        if total != len(info.items) and not self._refetching and self._client is not None:
+            self._refetching = True  # an item was added since we read the labels: read them again
+            self._spawn(self._refetch(self._client), "strings-info")
+        changes: dict[str, Any] = {}
+        for i, role in self._roles:
+            if i < len(values):
+                changes[role] = _int_or_none(values[i])
+        if self.watching:
+            shown = min(len(values), len(self._labels))
+            changes["server_strings"] = tuple(
+                zip(self._labels[:shown], map(clip, values[:shown]), strict=True)
+            )
+            changes["server_strings_more"] = max(0, min(total, len(info.items)) - shown)
+        if changes:
+            self._update(**changes)
+
+    async def _refetch(self, client: AriaClient) -> None:
+        try:
+            await self._fetch_info(client)
+            self._sync()
+        finally:
+            self._refetching = False

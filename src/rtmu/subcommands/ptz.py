@@ -1,0 +1,130 @@
+"""``rtmu ptz HOST[:PORT]``: the server's cameras, the pan-tilt-zoom head's limits and position; set it.
+
+Reads ``getCameraList``, then ``getCameraInfo<N>`` and ``getCameraData<N>`` of the first camera
+that can be moved (see :mod:`rtmu.client.ptz`). ``--pan/--tilt/--zoom`` point it absolutely
+(``setCameraAbs<N>``; an axis left out keeps its current value) and print where it went.
+Exit 4 when the server has no movable camera head.
+"""
+
+from __future__ import annotations
+
+import argparse
+import asyncio
+import math
+from typing import Any
+
+from ..client.connection import AriaClient
+from ..client.ptz import PtzFeed
+from ..exit_codes import EXIT_OK, EXIT_UNSUPPORTED
+from ..state import PtzState
+from ..textsafe import visible
+from ._common import add_connection_arguments, fail, print_json, run_with_client
+
+SETTLE_S = 0.5
+"""How long a real head gets to turn before its position is read back."""
+PTZ_COMMANDS = ("setCameraRel", "setCameraAbs", "setCameraPct", "getCameraData", "getCameraInfo")
+
+
+def _angle(text: str) -> float:
+    try:
+        value = float(text)
+    except ValueError:
+        raise argparse.ArgumentTypeError(f"not a number: {text!r}") from None
+    if not math.isfinite(value) or abs(value) > 327.67:
+        raise argparse.ArgumentTypeError(f"{text} is out of range (±327.67)")
+    return value
+
+
+def register(subparsers: Any) -> None:
+    p = subparsers.add_parser(
+        "ptz",
+        help="the camera head: cameras, limits, position; --pan/--tilt/--zoom point it",
+        description=(
+            "List the server's cameras (getCameraList) and show the pan-tilt-zoom head's limits and "
+            "position; with --pan/--tilt/--zoom point it there (setCameraAbs) and show where it went. "
+            "Exit 4 when the server has no movable camera head."
+        ),
+    )
+    add_connection_arguments(p)
+    p.add_argument("--json", action="store_true", help="one JSON object: cameras, limits, position")
+    p.add_argument("--pan", type=_angle, help="pan to this angle (degrees, right positive)")
+    p.add_argument("--tilt", type=_angle, help="tilt to this angle (degrees, up positive)")
+    p.add_argument("--zoom", type=_angle, help="zoom to this point of its range (%%)")
+    p.set_defaults(handler=handle)
+
+
+def _ptz_object(state: PtzState) -> dict[str, Any]:
+    position = state.position
+    return {
+        "camera": state.camera,
+        "pan_range": list(state.pan_range),
+        "tilt_range": list(state.tilt_range),
+        "zoom_range": list(state.zoom_range),
+        "zoom_available": state.zoom_available,
+        "position": None
+        if position is None
+        else {"pan": position[0], "tilt": position[1], "zoom": position[2]},
+    }
+
+
+def handle(args: argparse.Namespace) -> int:
+    moving = any(v is not None for v in (args.pan, args.tilt, args.zoom))
+
+    async def body(client: AriaClient) -> int:
+        def discard(coro: Any, _name: str) -> None:
+            coro.close()  # the command reads the position back itself
+
+        feed = PtzFeed(lambda **_changes: None, discard, args.timeout)
+        await feed.connected(client)
+        state = feed.state
+        if moving and state.movable and state.can_abs:
+            pan, tilt, zoom = state.position or (0.0, 0.0, 0.0)
+            feed.move_abs(
+                pan if args.pan is None else args.pan,
+                tilt if args.tilt is None else args.tilt,
+                zoom if args.zoom is None else args.zoom,
+            )
+            await asyncio.sleep(SETTLE_S)
+            await feed.refresh()
+            state = feed.state
+        cameras = [
+            {
+                "name": c.name,
+                "type": c.camera_type,
+                "display_name": c.display_name,
+                "commands": [name for name in PTZ_COMMANDS if c.data_name(name)],
+            }
+            for c in feed.cameras
+        ]
+        if args.json:
+            print_json(
+                {
+                    "cameras": cameras,
+                    "ptz": None if state.reason else _ptz_object(state),
+                    "reason": state.reason,
+                }
+            )
+        else:
+            for c in cameras:
+                offered = ", ".join(c["commands"]) or "no pan/tilt/zoom commands"
+                print(visible(f"{c['name']} ({c['type'] or 'unknown type'}): {offered}"))
+            if not state.reason:
+                _print_head(state)
+        if state.reason:
+            return fail("ptz", state.reason, EXIT_UNSUPPORTED)
+        if moving and not state.can_abs:
+            return fail("ptz", "this camera cannot be pointed absolutely (no setCameraAbs)", EXIT_UNSUPPORTED)
+        return EXIT_OK
+
+    return run_with_client("ptz", args, body)
+
+
+def _print_head(state: PtzState) -> None:
+    (p0, p1), (t0, t1), (z0, z1) = state.pan_range, state.tilt_range, state.zoom_range
+    print(visible(f"head {state.camera}: pan {p0:g}…{p1:g}°, tilt {t0:g}…{t1:g}°"), end="")
+    print(f", zoom {z0:g}…{z1:g} %" if state.zoom_available else ", no zoom")
+    if state.position is None:
+        print("position: not read")
+    else:
+        pan, tilt, zoom = state.position
+        print(f"position: pan {pan:g}°, tilt {tilt:g}°, zoom {zoom:g} %")

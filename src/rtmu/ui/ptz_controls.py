@@ -1,0 +1,236 @@
+"""Pan-tilt-zoom controls for the camera page: buttons, a drag on the picture, and keys.
+
+The head's limits and position come from the model (``RobotState.ptz``, read by
+``client.ptz``); the controls only ask the server to move it and never guess where
+it went. The position is polled only while this bar is on screen (``map``/``unmap``
+call ``watch_ptz``). Where the server has no movable head every control is greyed and
+the bar says why. Buttons never take the keyboard focus, so drive keys keep driving;
+the keys (Ctrl+arrows, Page Up/Down) are routed here by the window's key table.
+Moving the camera head is not robot motion: it needs no drive lease.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Callable
+from typing import Protocol
+
+import gi
+
+gi.require_version("Gtk", "4.0")
+gi.require_version("Pango", "1.0")
+from gi.repository import GLib, Gtk, Pango  # noqa: E402
+
+from ..model import RobotModel, RobotState  # noqa: E402
+from ..state import PtzState  # noqa: E402
+
+PAN_STEP = 10.0
+"""Degrees per button press or key (ARIA scales relative moves down as the camera zooms in)."""
+TILT_STEP = 5.0
+ZOOM_STEP = 10.0
+"""Points of the zoom range per press."""
+DRAG_PAN_DEG = 48.0
+"""Degrees of pan for a drag across the whole picture (the simulated VC-C4's wide view)."""
+DRAG_TILT_DEG = 36.0
+DRAG_MIN_PX = 4.0
+"""A shorter drag is a click, not a move."""
+PICTURE_AFTER_MS = 400
+"""After a move, ask for a new picture this much later (the head has turned by then)."""
+
+KEY_STEPS: dict[str, tuple[float, float, float | None]] = {
+    "ptz_left": (-PAN_STEP, 0.0, None),
+    "ptz_right": (PAN_STEP, 0.0, None),
+    "ptz_up": (0.0, TILT_STEP, None),
+    "ptz_down": (0.0, -TILT_STEP, None),
+    "ptz_zoom_in": (0.0, 0.0, ZOOM_STEP),
+    "ptz_zoom_out": (0.0, 0.0, -ZOOM_STEP),
+}
+"""Key intent → relative (pan, tilt, zoom): pan is positive to the right (ARIA's camera handler turns
+a look-at heading into ``-delta``), tilt positive up."""
+
+
+class PtzLink(Protocol):
+    """What the controls need of the client runner."""
+
+    def ptz_rel(self, pan: float, tilt: float, zoom: float | None = None) -> object: ...
+
+    def ptz_abs(self, pan: float, tilt: float, zoom: float | None = None) -> object: ...
+
+    def watch_ptz(self, on: bool) -> object: ...
+
+
+def position_text(state: PtzState | None) -> str:
+    if state is None or not state.camera:
+        return "Camera head"
+    name = state.display_name or state.camera
+    if state.position is None:
+        return f"{name}: position not read yet"
+    pan, tilt, zoom = state.position
+    text = f"{name}: pan {pan:+.0f}°  tilt {tilt:+.0f}°"
+    if state.zoom_available:
+        text += f"  zoom {zoom:.0f} %"
+    return text
+
+
+def disabled_reason(state: PtzState | None, connected: bool) -> str:
+    """Why the head cannot be moved now ("" when it can)."""
+    if not connected:
+        return "not connected"
+    if state is None:
+        return "reading the camera list…"
+    if state.reason:
+        return state.reason
+    if not state.movable:
+        return "this camera cannot be moved"
+    return ""
+
+
+class PtzControls(Gtk.Box):
+    """A bar of pan/tilt/zoom buttons and the head's position; ``attach_drag`` adds the picture drag."""
+
+    def __init__(self, model: RobotModel, link: PtzLink, on_moved: Callable[[], None] | None = None) -> None:
+        super().__init__(orientation=Gtk.Orientation.HORIZONTAL, spacing=4)
+        self.add_css_class("camera-bar")  # the camera page's own bar style
+        self.add_css_class("ptz-bar")
+        for side in ("start", "end"):
+            getattr(self, f"set_margin_{side}")(8)
+        self.set_margin_bottom(4)
+        self.model = model
+        self._link = link
+        self._on_moved = on_moved
+        self._picture_timer = 0
+        self._closed = False
+        self.watching = False
+        self.buttons: dict[str, Gtk.Button] = {}
+        self._tips: dict[str, str] = {}
+        self.label = Gtk.Label(xalign=0.0, hexpand=True)
+        self.label.set_use_markup(False)
+        self.label.set_ellipsize(Pango.EllipsizeMode.END)  # a long camera name must not widen the window
+        self.append(self.label)
+        for intent, icon, tip in (
+            ("ptz_left", "go-previous-symbolic", "Pan left (Ctrl+Left)"),
+            ("ptz_up", "go-up-symbolic", "Tilt up (Ctrl+Up)"),
+            ("ptz_down", "go-down-symbolic", "Tilt down (Ctrl+Down)"),
+            ("ptz_right", "go-next-symbolic", "Pan right (Ctrl+Right)"),
+            ("ptz_zoom_out", "zoom-out-symbolic", "Zoom out (Page Down)"),
+            ("ptz_zoom_in", "zoom-in-symbolic", "Zoom in (Page Up)"),
+            ("ptz_home", "go-home-symbolic", "Point straight ahead"),
+        ):
+            button = Gtk.Button.new_from_icon_name(icon)
+            button.set_focusable(False)
+            self._tips[intent] = tip
+            button.connect("clicked", lambda _b, i=intent: self.key(i))
+            self.buttons[intent] = button
+            self.append(button)
+        self._unobserve = [
+            model.robot.observe(self._on_robot),
+            model.connection.observe(lambda _o, _n: self._show(self.model.robot.value)),
+        ]
+        self.connect("map", lambda _w: self._set_watching(True))
+        self.connect("unmap", lambda _w: self._set_watching(False))
+        self._show(model.robot.value)
+
+    # -- state ---------------------------------------------------------------------------------
+    @property
+    def state(self) -> PtzState | None:
+        return self.model.robot.value.ptz
+
+    @property
+    def reason(self) -> str:
+        return disabled_reason(self.state, self.model.connection.value.connected)
+
+    def close(self) -> None:
+        """The window is going: unhook, and ask the runner for nothing more (it may be closed)."""
+        self._closed = True
+        for remove in self._unobserve:
+            remove()
+        self._unobserve = []
+        if self._picture_timer:
+            GLib.source_remove(self._picture_timer)
+            self._picture_timer = 0
+
+    def _set_watching(self, on: bool) -> None:
+        if on != self.watching and not self._closed:
+            self.watching = on
+            self._link.watch_ptz(on)
+
+    def _on_robot(self, old: RobotState, new: RobotState) -> None:
+        if old.ptz != new.ptz:
+            self._show(new)
+
+    def _show(self, robot: RobotState) -> None:
+        state, reason = robot.ptz, self.reason
+        self.label.set_text(position_text(state) if not reason else f"Camera head: {reason}")
+        for intent, button in self.buttons.items():
+            ok = not reason and self._can(intent)
+            button.set_sensitive(ok)
+            why = f"Camera head: {reason or 'not offered by this camera'}"
+            button.set_tooltip_text(self._tips[intent] if ok else why)
+        self.label.set_tooltip_text(reason or None)
+
+    def _can(self, intent: str) -> bool:
+        state = self.state
+        if state is None:
+            return False
+        if intent == "ptz_home":
+            return state.can_abs
+        if intent.startswith("ptz_zoom"):
+            return state.can_rel and state.zoom_available
+        return state.can_rel
+
+    # -- moving --------------------------------------------------------------------------------
+    def key(self, intent: str) -> str:
+        """Run a PTZ intent (a button or a key); the reason it was refused, "" when sent."""
+        reason = self.reason
+        if reason:
+            return reason
+        if not self._can(intent):
+            return "this camera does not offer that move"
+        if intent == "ptz_home":
+            self._link.ptz_abs(0.0, 0.0, None)
+        else:
+            pan, tilt, zoom = KEY_STEPS[intent]
+            self._link.ptz_rel(pan, tilt, zoom)
+        self._moved()
+        return ""
+
+    def attach_drag(self, widget: Gtk.Widget) -> None:
+        """Dragging on ``widget`` (the picture) turns the head the way the drag goes."""
+        drag = Gtk.GestureDrag()
+        drag.connect("drag-end", self._drag_end)
+        widget.add_controller(drag)
+
+    def _drag_end(self, gesture: Gtk.GestureDrag, dx: float, dy: float) -> None:
+        widget = gesture.get_widget()
+        width = max(widget.get_width(), 1) if widget is not None else 1
+        height = max(widget.get_height(), 1) if widget is not None else 1
+        pan, tilt = drag_to_move(dx, dy, width, height)
+        if (pan, tilt) == (0.0, 0.0) or self.reason or not self._can("ptz_left"):
+            return
+        self._link.ptz_rel(pan, tilt, None)
+        self._moved()
+
+    def _moved(self) -> None:
+        if self._on_moved is None:
+            return
+        if self._picture_timer:
+            GLib.source_remove(self._picture_timer)
+
+        def later() -> bool:
+            self._picture_timer = 0
+            if self._on_moved is not None and self.get_mapped():
+                self._on_moved()
+            return False
+
+        self._picture_timer = GLib.timeout_add(PICTURE_AFTER_MS, later)
+
+
+def drag_to_move(dx: float, dy: float, width: int, height: int) -> tuple[float, float]:
+    """A drag of (dx, dy) px on a (width × height) picture → (pan, tilt) degrees; (0, 0) for a click.
+
+    Right is a positive pan (ARIA's pan is clockwise positive); up is a positive tilt.
+    """
+    if (dx * dx + dy * dy) ** 0.5 < DRAG_MIN_PX:
+        return (0.0, 0.0)
+    pan = dx / max(width, 1) * DRAG_PAN_DEG
+    tilt = -dy / max(height, 1) * DRAG_TILT_DEG
+    return (round(pan, 1), round(tilt, 1))
