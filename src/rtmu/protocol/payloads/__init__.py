@@ -7,6 +7,7 @@ finds a decoder by data name.
 from . import (
     camera,
     commands,
+    config,
     control,
     drive,
     ld,
@@ -36,6 +37,7 @@ __all__ = [
     "Side",
     "camera",
     "commands",
+    "config",
     "control",
     "decode_payload",
     "drive",
