@@ -8,8 +8,9 @@ display, taken from a recording of serverDemo's list
 (``shared/captures/clientCommandLister-serverDemoMap.pcap``; a test checks
 them against it). Every text that appears in no capture — the popup data and
 the simulator's own commands — is written in our own words. Data serverDemo
-has that the simulator does not serve (configuration editing,
-micro-controller pass-through, the laser) are left out.
+has that the simulator does not serve here (micro-controller pass-through,
+the laser) are left out; configuration editing is a data module of its own
+(:mod:`rtmu.sim.arconfig`).
 """
 
 from __future__ import annotations
