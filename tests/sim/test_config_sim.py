@@ -59,10 +59,10 @@ def values(packets: list[bytes], cls: type[ConfigSectionPacket] = ConfigSectionP
 
 
 def test_the_simulator_lists_the_config_data_as_serverdemo_does() -> None:
-    from rtmu.sim.arconfig import ROWS
+    from rtmu.sim.catalogue import CONFIG
 
     captured = {e.name: e for e in captured_datalist(CAPTURE)}
-    for row in ROWS:
+    for row in CONFIG:
         entry = captured[row[0]]
         assert row[1:] == (
             entry.description,

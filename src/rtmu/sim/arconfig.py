@@ -1,4 +1,3 @@
-# ruff: noqa: E501
 """The simulator's own configuration (ArConfig), served and changed through ARIA's config packets.
 
 Every parameter is bound to the live simulation: a ``setConfig`` that passes validation changes the
@@ -370,79 +369,7 @@ def parse_value(p: SimParam, text: str) -> tuple[Value, str]:
     return None, "this parameter has no value to set"
 
 
-# -- the data module: catalogue rows and handlers (see rtmu.sim.profiles) ---------------------------
-_GET_RETURN = "Use ArClientHandlerConfig if desired."
-_SET_RETURN = (
-    "string: if empty setConfig worked, if the string isn't empty then it is the first error that occured "
-    "(all non-error parameters are parsed, and only the first error is reported)"
-)
-ROWS = (
-    # ARIA's own texts, as serverDemo lists them (shared/captures/clientCommandLister-serverDemoMap.pcap).
-    (
-        "getConfigBySectionsV4",
-        "Gets the complete configuration information from the server",
-        "none",
-        "Advanced configuration retrieval, including handling of serializable.  " + _GET_RETURN,
-        "ConfigEditing",
-        "RETURN_UNTIL_EMPTY",
-    ),
-    (
-        "getConfigBySectionsV3",
-        "Gets the complete configuration information from the server",
-        "none",
-        "Advanced configuration retrieval, including handling of very big sections.  " + _GET_RETURN,
-        "ConfigEditing",
-        "RETURN_UNTIL_EMPTY",
-    ),
-    (
-        "getConfigBySectionsV2",
-        "Gets the complete configuration information from the server",
-        "none",
-        "Advanced configuration retrieval, including restart level and list objects.  " + _GET_RETURN,
-        "ConfigEditing",
-        "RETURN_UNTIL_EMPTY",
-    ),
-    (
-        "getConfigBySections",
-        "Gets the configuration information from the server",
-        "none",
-        "A single packet is sent for each config section.  Too complex to describe here.  " + _GET_RETURN,
-        "ConfigEditing",
-        "RETURN_UNTIL_EMPTY",
-    ),
-    (
-        "setConfig",
-        "takes a config back from the client to use",
-        "Repeating pairs of strings which are parameter name and value to parse",
-        _SET_RETURN,
-        "ConfigEditing",
-        "RETURN_SINGLE|IDLE_PACKET",
-    ),
-    (
-        "configUpdated",
-        "gets sent when the config is updated",
-        "none",
-        "none",
-        "ConfigEditing",
-        "RETURN_SINGLE",
-    ),
-    (
-        "getConfigSectionFlags",
-        "gets the flags for each section of the config",
-        "none",
-        "byte4: number of sections; repeating for number of sections (string: section; string: flags (separated by |))",
-        "ConfigEditing",
-        "RETURN_SINGLE",
-    ),
-    (
-        "getLastEditablePriority",
-        "Returns the last priority that may be edited by the user; e.g. EXPERT or FACTORY",
-        "none",
-        "byte: the last ArPriority::Priority value for which parameters may be edited",
-        "ConfigEditing",
-        "RETURN_SINGLE",
-    ),
-)
+# -- the data module: handlers (see rtmu.sim.profiles; the rows are ARIA's, in rtmu.sim.catalogue.CONFIG) --
 
 
 def _store(call: Call) -> ArConfigStore:
