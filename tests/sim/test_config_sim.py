@@ -165,6 +165,9 @@ def test_a_refused_value_names_the_parameter_and_changes_nothing() -> None:
             },
             "Battery/Drain: 'maybe' is not true or false": {"Battery": {"Drain": "maybe"}},
             "Teleop/Nothing: there is no such parameter": {"Teleop": {"Nothing": "1"}},
+            "Teleop/Timeout: 0.05 s is shorter than the 0.1 s between ratioDrive commands (0 disables it)": {
+                "Teleop": {"Timeout": "0.05"}
+            },
             "Robot config/SerialNumber: a factory parameter cannot be changed here": {
                 "Robot config": {"SerialNumber": "X"}
             },

@@ -22,6 +22,7 @@ from ..protocol.payloads.config import (
     ConfigRequest,
     ConfigSectionPacket,
     LastEditablePriority,
+    ParamType,
     Priority,
     SetConfig,
     SetConfigReply,
@@ -175,3 +176,51 @@ class ConfigFeed:
         listener = self.listener
         if listener is not None:
             listener()
+
+
+def check_value(param: ConfigParam, text: str) -> str:
+    """Why ``text`` cannot be this parameter's value ("" when it can), judged by its type and limits.
+
+    The server has the last word (it may refuse for reasons of its own); this only lets a page
+    say at once what is certainly wrong.
+    """
+    raw = text.strip()
+    if param.kind is ParamType.BOOL:
+        return (
+            ""
+            if raw.lower() in ("true", "false", "1", "0", "yes", "no", "on", "off")
+            else "not true or false"
+        )
+    if param.kind in (ParamType.INT, ParamType.DOUBLE):
+        try:
+            number = int(raw) if param.kind is ParamType.INT else float(raw)
+        except ValueError:
+            return "not a whole number" if param.kind is ParamType.INT else "not a number"
+        if number != number:
+            return "not a number"
+        if param.minimum is not None and number < param.minimum:
+            return f"below the minimum of {param.minimum:g}"
+        if param.maximum is not None and number > param.maximum:
+            return f"above the maximum of {param.maximum:g}"
+        return ""
+    if param.kind is ParamType.STRING:
+        if param.choices and raw not in param.choices:
+            return "not one of " + ", ".join(param.choices)
+        return "" if len(text) <= MAX_TEXT else f"longer than {MAX_TEXT} characters"
+    return "cannot be changed here"
+
+
+def changed_values(old: ServerConfig, new: ServerConfig) -> list[tuple[str, str, str]]:
+    """``(section, name, new value text)`` of every parameter whose value differs (or is new)."""
+    before = {(s.name, p.name): p.value for s in old.sections for p in s.params}
+    out: list[tuple[str, str, str]] = []
+    for s in new.sections:
+        for p in s.params:
+            if p.kind is not ParamType.SEPARATOR and before.get((s.name, p.name), object()) != p.value:
+                out.append((s.name, p.name, p.value_text()))
+    return out
+
+
+def names_param(error: str, section: str, name: str) -> bool:
+    """Whether a ``setConfig`` answer is about this parameter (ARIA-style ``Section/Name: why``)."""
+    return error.lower().startswith(f"{section}/{name}:".lower())

@@ -47,6 +47,8 @@ LAST_EDITABLE = Priority.EXPERT
 """As ARIA's handler without factory permission: FACTORY parameters are shown, never changed."""
 CAMERA_SIZES = {"320x240": (320, 240), "640x480": (640, 480)}
 FILLER_PER_SECTION = 1000
+MIN_TIMEOUT = 0.1
+"""A watchdog shorter than a client's resend period would stop every held drive: refused (0 is "off")."""
 
 
 @dataclass
@@ -104,7 +106,7 @@ class SimArConfig:
                 Priority.INTERMEDIATE,
                 0.0,
                 60.0,
-                1,
+                2,
             ),
             lambda: ratio.timeout,
             setter(ratio, "timeout"),
@@ -323,6 +325,15 @@ class SimArConfig:
                 where = f"{section}/{name}" if section else name
                 return f"{where}: there is no such parameter", False
             value, error = parse_value(p, text)
+            if (
+                not error
+                and p.template.name == "Timeout"
+                and isinstance(value, float)
+                and 0 < value < MIN_TIMEOUT
+            ):
+                error = (
+                    f"{text.strip()} s is shorter than the 0.1 s between ratioDrive commands (0 disables it)"
+                )
             if error:
                 return f"{p.section}/{p.template.name}: {error}", False
             planned.append((p, value))
