@@ -2,17 +2,22 @@
 
 from __future__ import annotations
 
+import asyncio
 import json
 from collections.abc import Iterator
 
 import pytest
 
 from rtmu.cli import main
+from rtmu.client.config_feed import MAX_TEXT, ServerConfig, check_value, fetch_config
+from rtmu.client.connection import AriaClient
+from rtmu.client.errors import MalformedReply
 from rtmu.exit_codes import EXIT_OK, EXIT_UNSUPPORTED, EXIT_USAGE
+from rtmu.protocol.payloads.config import ConfigParam, ConfigSectionPacket, ParamType
 from rtmu.sim import SimConfig, SimThread
 from rtmu.subcommands.config import EXIT_REFUSED
 
-from .servers import ServerThread, TestServer
+from .servers import SPECS, ServerThread, TestServer
 
 
 @pytest.fixture
@@ -122,3 +127,62 @@ def test_a_server_without_configuration_exits_4(capsys: pytest.CaptureFixture[st
         assert main(["config", addr(server.port), "--timeout", "5"]) == EXIT_UNSUPPORTED
         assert "offers no configuration" in capsys.readouterr().err
         assert main(["config", addr(server.port), "--timeout", "5", "--set", "A/b=1"]) == EXIT_UNSUPPORTED
+
+
+# -- the client module on its own: big, hostile and malformed configurations -----------------------
+CONFIG_SPECS = [
+    ("getConfigBySectionsV4", "config", "none", "sections", "ConfigEditing", "RETURN_UNTIL_EMPTY"),
+    ("setConfig", "set", "pairs", "string", "ConfigEditing", "RETURN_SINGLE|IDLE_PACKET"),
+]
+
+
+def _fetch(port: int) -> ServerConfig:
+    async def go() -> ServerConfig:
+        client = AriaClient()
+        await client.connect("127.0.0.1", port, timeout=5)
+        try:
+            return await fetch_config(client, 10)
+        finally:
+            await client.disconnect()
+
+    return asyncio.run(go())
+
+
+def test_ten_thousand_parameters_arrive_whole_and_bounded() -> None:
+    with SimThread(SimConfig(port=0, camera=False, config_filler=10_000)) as s:
+        config = _fetch(s.port)
+    assert config.param_count == 10_011 and config.cut == 0
+    extra = [sec for sec in config.sections if sec.name.startswith("<b>Extra")]
+    assert len(extra) == 10 and all(len(sec.params) == 1000 for sec in extra)  # parts joined per section
+    assert config.find("<b>extra</b> & 3", "P3500<I>&AMP;") is not None  # ARIA compares names case-blind
+
+
+def test_a_malformed_section_is_a_clear_error_and_a_huge_text_is_cut() -> None:
+    server = TestServer(SPECS + CONFIG_SPECS)
+    big = ConfigSectionPacket("S", "", (ConfigParam("Long", ParamType.STRING, "x" * 30_000),))
+    replies = {"ok": [big.encode(), b""], "bad": [b"Sname\x00comment\x00\x00\x01\x00Pbroken", b""]}
+    mode = ["ok"]
+    server.handlers["getConfigBySectionsV4"] = lambda side, args: replies[mode[0]]
+    with ServerThread(server) as running:
+        config = _fetch(running.port)
+        value = config.sections[0].params[0].value
+        assert isinstance(value, str) and len(value) == MAX_TEXT and value.endswith("…")
+        mode[0] = "bad"
+        with pytest.raises(MalformedReply, match="getConfigBySectionsV4 did not decode"):
+            _fetch(running.port)
+
+
+def test_check_value_knows_types_limits_and_choices() -> None:
+    timeout = ConfigParam("Timeout", ParamType.DOUBLE, 2.0, minimum=0.0, maximum=60.0)
+    assert check_value(timeout, "0.5") == "" and check_value(timeout, "61") == "above the maximum of 60"
+    assert (
+        check_value(timeout, "-1") == "below the minimum of 0"
+        and check_value(timeout, "soon") == "not a number"
+    )
+    assert check_value(timeout, "nan") == "not a number"
+    count = ConfigParam("N", ParamType.INT, 1, minimum=0, maximum=9)
+    assert check_value(count, "1.5") == "not a whole number"
+    size = ConfigParam("Size", ParamType.STRING, "a", display_hint="Choices:a;;b")
+    assert check_value(size, "c") == "not one of a, b" and check_value(size, "b") == ""
+    assert check_value(ConfigParam("On", ParamType.BOOL, True), "maybe") == "not true or false"
+    assert check_value(ConfigParam("L", ParamType.LIST), "x") == "cannot be changed here"

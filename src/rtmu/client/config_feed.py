@@ -12,6 +12,7 @@ tells a listener, so a page can fetch again without losing its own unsaved edits
 
 from __future__ import annotations
 
+import asyncio
 from collections.abc import Callable
 from dataclasses import dataclass, replace
 
@@ -81,6 +82,9 @@ def _cut(text: str) -> str:
 
 
 def _bounded(p: ConfigParam) -> ConfigParam:
+    fits = max(len(p.name), len(p.description), len(p.display_hint), len(p.extra)) <= MAX_TEXT
+    if fits and not p.children and not (isinstance(p.value, str) and len(p.value) > MAX_TEXT):
+        return p  # the common case: nothing to cut, no copy
     value = _cut(p.value) if isinstance(p.value, str) else p.value
     children = tuple(_bounded(c) for c in p.children[:1000])
     return replace(
@@ -140,10 +144,18 @@ async def fetch_config(client: AriaClient, timeout: float) -> ServerConfig:
     reply = await client.request_once(
         what, timeout=timeout, max_packets=MAX_REPLY_PACKETS, max_bytes=MAX_REPLY_BYTES
     )
+    # Thousands of parameters take a tenth of a second or more: not on the network loop.
+    return await asyncio.get_running_loop().run_in_executor(
+        None, decode_config, name, reply.payloads, last_editable
+    )
+
+
+def decode_config(name: str, payloads: tuple[bytes, ...], last_editable: int) -> ServerConfig:
+    """A ``getConfigBySections*`` reply's payloads as one bounded configuration (MalformedReply if bad)."""
     cls = payload_type_for(name, Side.REPLY)
     assert cls is not None and issubclass(cls, ConfigSectionPacket)
     try:
-        packets = [cls.decode(p) for p in reply.payloads]
+        packets = [cls.decode(p) for p in payloads]
     except ProtocolError as exc:
         raise MalformedReply(f"{name} did not decode: {exc}") from None
     return assemble(packets, last_editable, name)
