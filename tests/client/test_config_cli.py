@@ -12,12 +12,15 @@ from rtmu.cli import main
 from rtmu.client.config_feed import MAX_TEXT, ServerConfig, check_value, fetch_config
 from rtmu.client.connection import AriaClient
 from rtmu.client.errors import MalformedReply
+from rtmu.client.runner import ClientRunner
 from rtmu.exit_codes import EXIT_OK, EXIT_UNSUPPORTED, EXIT_USAGE
+from rtmu.model import RobotModel
 from rtmu.protocol.payloads.config import ConfigParam, ConfigSectionPacket, ParamType
 from rtmu.sim import SimConfig, SimThread
 from rtmu.subcommands.config import EXIT_REFUSED
 
 from .servers import SPECS, ServerThread, TestServer
+from .uiqueue import UiQueue, eventually
 
 
 @pytest.fixture
@@ -186,3 +189,27 @@ def test_check_value_knows_types_limits_and_choices() -> None:
     assert check_value(size, "c") == "not one of a, b" and check_value(size, "b") == ""
     assert check_value(ConfigParam("On", ParamType.BOOL, True), "maybe") == "not true or false"
     assert check_value(ConfigParam("L", ParamType.LIST), "x") == "cannot be changed here"
+
+
+def test_a_flood_of_config_updated_reaches_the_ui_as_a_few_posts() -> None:
+    specs = [
+        *SPECS,
+        *CONFIG_SPECS,
+        ("configUpdated", "changed", "none", "none", "ConfigEditing", "RETURN_SINGLE"),
+    ]
+    server = TestServer(specs)
+    thread = ServerThread(server)
+    model, ui = RobotModel(), UiQueue()
+    calls: list[int] = []
+    with thread, ClientRunner(model, post=ui.post) as runner:
+        runner.on_config_updated = lambda: calls.append(1)
+        runner.connect("127.0.0.1", server.port).result(10)
+        number = server.datalist.number("configUpdated")
+        eventually(
+            lambda: bool(thread.call(lambda: all(number in s.conn.subscriptions for s in server.sides)))
+        )
+        thread.call(lambda: [server.broadcast("configUpdated") for _ in range(5000)])
+        runner.call(lambda: runner.session.client.request_once("getSafeDrive"))  # type: ignore[union-attr]
+        eventually(lambda: runner.session.config_feed.updates == 5000)  # type: ignore[union-attr]
+        posted = ui.drain()
+    assert 1 <= len(calls) <= 50 and posted < 5000  # not one UI callback per broadcast

@@ -62,7 +62,7 @@ def open_page(gui: Gui) -> ConfigPage:
     pump(lambda: page(gui) is not None, 5, "the configuration page")
     p = page(gui)
     assert p is not None and p.get_transient_for() is gui.window
-    pump(lambda: p.config is not None and bool(p.rows), 10, "the configuration to load")
+    pump(lambda: p.config is not None and bool(p.rows), 15, "the configuration to load")
     return p
 
 

@@ -219,6 +219,7 @@ def test_ten_thousand_parameters_come_in_section_parts_that_fit_a_packet() -> No
         assert len(await fetch(c, "getConfigBySectionsV3")) > len(decoded) // 2
         assert ConfigSectionPacketV3.decode((await fetch(c, "getConfigBySectionsV3"))[0]).name == "Teleop"
         assert await set_config(c, {"<b>Extra</b> & 0": {"P0<i>&amp;": "7"}}) == ""
+        assert values(await fetch(c))["<b>Extra</b> & 0/P0<i>&amp;"] == 7  # the encoded sections follow a set
         await _end(server, c)
 
     run(scenario(), timeout=120)

@@ -130,6 +130,7 @@ class ClientRunner:
         """Optional tap: ``on_stop(reason, sent)`` for every zero-ratios + ``stop`` (network thread)."""
         self.on_config_updated: Callable[[], None] | None = None
         """Called on the UI thread when another client changed the server's configuration."""
+        self._config_post_pending = threading.Event()
         self.loop = asyncio.new_event_loop()
         self.session: Session | None = None
         self._thread = threading.Thread(target=self._run, name="rtmu-network", daemon=True)
@@ -397,9 +398,18 @@ class ClientRunner:
         return self.submit(self._session.set_config, changes)
 
     def _config_updated(self) -> None:
-        fn = self.on_config_updated
-        if fn is not None:
-            self.post(fn)
+        """Network loop: tell the UI once per burst (a flood of broadcasts is one post, not thousands)."""
+        if self.on_config_updated is None or self._config_post_pending.is_set():
+            return
+        self._config_post_pending.set()
+
+        def deliver() -> None:
+            self._config_post_pending.clear()
+            fn = self.on_config_updated
+            if fn is not None:
+                fn()
+
+        self.post(deliver)
 
     # -- navigation: the server drives; a refusal comes back as a Kind.NAVIGATION notice -------
     def goto_goal(self, name: str) -> concurrent.futures.Future[None]:

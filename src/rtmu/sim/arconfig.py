@@ -74,8 +74,13 @@ class SimArConfig:
         self._by_key: dict[tuple[str, str], SimParam] = {}
         self.sets = 0
         """Accepted ``setConfig``s (for tests)."""
+        self._filler_sections: set[str] = set()
+        self._filler_packets: dict[tuple[str, int, int, bool], list[bytes]] = {}
+        """Encoded filler sections (thousands of parameters take a while: not on every request)."""
         self._build()
         self._fill(filler)
+        if filler:
+            self.packets(4, ConfigRequest())  # encode them now, not in a client's first request
 
     # -- what there is ------------------------------------------------------------------------------
     def _add(
@@ -255,6 +260,7 @@ class SimArConfig:
         for i in range(count):
             section = f"<b>Extra</b> & {i // FILLER_PER_SECTION}"
             self.comments.setdefault(section, "<i>filler</i> & <span foreground='red'>markup</span>")
+            self._filler_sections.add(section)
             kind = kinds[i % len(kinds)]
             name = f"P{i}<i>&amp;"
             start: Value = {ParamType.INT: i, ParamType.DOUBLE: i / 10, ParamType.BOOL: i % 2 == 0}.get(
@@ -291,13 +297,22 @@ class SimArConfig:
         last = Priority.ADVANCED if request.last_priority is None else Priority.of(request.last_priority)
         read_only_too = request.last_editable is not None
         out: list[bytes] = []
-        for section in self.sections():
+        by_section: dict[str, list[SimParam]] = {}
+        for p in self.params:
+            by_section.setdefault(p.section, []).append(p)
+        for section, params in by_section.items():
+            key = (section, version, int(last), read_only_too)
+            cached = self._filler_packets.get(key)
+            if cached is not None:
+                out += cached
+                continue
+            first = len(out)
             head = cls(section, self.comments.get(section, ""), (), "")
             head_size = len(head.encode())
             part: list[ConfigParam] = []
             index, size = 1, head_size
-            for p in self.params:
-                if p.section != section or (not read_only_too and p.template.priority > LAST_EDITABLE):
+            for p in params:
+                if not read_only_too and p.template.priority > LAST_EDITABLE:
                     continue
                 param = p.current()
                 if param.priority > last:
@@ -313,6 +328,8 @@ class SimArConfig:
                 part.append(param)
                 size += one
             out.append(replace(head, params=tuple(part), index=index).encode())
+            if section in self._filler_sections:  # only the filler's values never change behind our back
+                self._filler_packets[key] = out[first:]
         out.append(b"")
         return out
 
@@ -342,6 +359,10 @@ class SimArConfig:
             if p.get() != value:
                 p.set(value)
                 changed = True
+                if p.section in self._filler_sections:
+                    self._filler_packets = {
+                        k: v for k, v in self._filler_packets.items() if k[0] != p.section
+                    }
         if planned:
             self.sets += 1
         return "", changed

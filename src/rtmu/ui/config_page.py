@@ -88,6 +88,8 @@ class ConfigPage(Gtk.Window):
         self.rows: dict[Key, tuple[ConfigParam, Gtk.Widget, Gtk.Label]] = {}
         """The parameters on screen now: their description, editor and answer label."""
         self.fetches = 0
+        self.fetching = False
+        self._again = ""
         self.saving = False
         self.closed = False
         install_css()
@@ -169,18 +171,32 @@ class ConfigPage(Gtk.Window):
 
     # -- fetching ---------------------------------------------------------------------------------
     def refresh(self, note: str = "") -> None:
-        """Ask the server for the whole configuration; unsaved edits are kept."""
+        """Ask the server for the whole configuration; unsaved edits are kept. One fetch at a time:
+        asked again meanwhile, it fetches once more when the answer is in."""
+        if self.fetching:
+            self._again = self._again or note or "again"
+            return
+        self.fetching = True
         self.status.set_text("Loading…")
         self.reload_button.set_sensitive(False)
         previous = self.config
         self._fetch().add_done_callback(lambda f: GLib.idle_add(self._fetched, f, previous, note))
 
+    def _refresh_later(self, note: str) -> bool:
+        if not self.closed:
+            self.refresh(note)
+        return False
+
     def _fetched(
         self, future: concurrent.futures.Future[Any], previous: ServerConfig | None, note: str
     ) -> bool:
+        self.fetching = False
         if self.closed:
             return False
         self.reload_button.set_sensitive(True)
+        if self._again:
+            again, self._again = self._again, ""
+            GLib.idle_add(self._refresh_later, "remote" if again == "remote" else "")
         error = None if future.cancelled() else future.exception()
         if future.cancelled() or error is not None:
             self.status.set_text(f"Could not load the configuration: {error or 'cancelled'}")
