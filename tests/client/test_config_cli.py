@@ -5,6 +5,7 @@ from __future__ import annotations
 import asyncio
 import json
 from collections.abc import Iterator
+from pathlib import Path
 
 import pytest
 
@@ -213,3 +214,32 @@ def test_a_flood_of_config_updated_reaches_the_ui_as_a_few_posts() -> None:
         eventually(lambda: runner.session.config_feed.updates == 5000)  # type: ignore[union-attr]
         posted = ui.drain()
     assert 1 <= len(calls) <= 50 and posted < 5000  # not one UI callback per broadcast
+
+
+def test_a_user_without_config_editing_is_offered_no_configuration(
+    tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    """ARIA lists data only to users of its command group: without ConfigEditing there is nothing to edit."""
+    users = tmp_path / "users.txt"
+    users.write_text("UserInfoVersion1\nuser alice secret1 all\nuser bob pw2 RobotInfo Movement Stop\n")
+    pw_bob, pw_alice = tmp_path / "bob.pw", tmp_path / "alice.pw"
+    pw_bob.write_text("pw2\n")
+    pw_alice.write_text("secret1\n")
+    with SimThread(SimConfig(port=0, camera=False, users_path=users)) as s:
+        bob = ["config", addr(s.port), "--user", "bob", "--password-file", str(pw_bob), "--timeout", "5"]
+        assert main(bob) == EXIT_UNSUPPORTED
+        assert main([*bob, "--set", "Teleop/Timeout=1"]) == EXIT_UNSUPPORTED
+        assert s.call(lambda: s.server.world.ratio_mode.timeout) == 2.0  # type: ignore[union-attr]
+        alice = [
+            "config",
+            addr(s.port),
+            "--user",
+            "alice",
+            "--password-file",
+            str(pw_alice),
+            "--timeout",
+            "5",
+        ]
+        assert main([*alice, "--set", "Teleop/Timeout=1"]) == EXIT_OK
+        assert s.call(lambda: s.server.world.ratio_mode.timeout) == 1.0  # type: ignore[union-attr]
+    assert "offers no configuration" in capsys.readouterr().err

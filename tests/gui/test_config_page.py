@@ -264,6 +264,7 @@ def test_ten_thousand_parameters_with_markup_open_bounded_and_responsive(
         pump(lambda: len(p.rows) == PAGE_SIZE, 5, "one page of rows")
         shown = labels(p.grid)
         assert ("P0<i>&amp;", False) in shown and ("<u>filler</u> 0 & <big>text</big>", False) in shown
+        assert ("<b>7</b>", False) in shown  # a choice list's item, as the drop-down shows it
         assert not any(markup for _text, markup in shown)
         assert p.sections.get_row_at_index(5).get_child().get_text() == "<b>Extra</b> & 0"
         assert p.comment.get_text() == "<i>filler</i> & <span foreground='red'>markup</span>"

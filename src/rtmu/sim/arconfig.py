@@ -280,6 +280,9 @@ class SimArConfig:
                 i % 5,
                 *limits,
                 2 if kind is ParamType.DOUBLE else -1,
+                display_hint=f"Choices:<b>{i}</b>;;<i>a</i> & b"
+                if kind is ParamType.STRING and i % 8 == 7
+                else "",
             )
             key = (section, name)
             self._add(section, template, lambda k=key: store[k], lambda v, k=key: store.__setitem__(k, v))  # type: ignore[misc]
