@@ -27,6 +27,7 @@ gi.require_version("Pango", "1.0")
 from gi.repository import Gdk, GLib, Gtk, Pango  # noqa: E402
 
 from ..client.config_feed import (  # noqa: E402
+    MAX_TEXT,
     ConfigSection,
     ServerConfig,
     changed_values,
@@ -368,6 +369,7 @@ class ConfigPage(Gtk.Window):
             widget = drop
         elif p.kind is ParamType.STRING:
             entry = Gtk.Entry(text=text, width_chars=16)
+            entry.set_max_length(MAX_TEXT)
             entry.connect("changed", lambda e: self._edited(key, e.get_text()))
             widget = entry
         else:
