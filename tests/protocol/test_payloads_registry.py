@@ -30,6 +30,7 @@ from rtmu.protocol.payloads import (
     strings,
 )
 from rtmu.protocol.payloads import camera as cam
+from rtmu.protocol.payloads import config as cfg
 from rtmu.protocol.payloads import map as mp
 
 SAMPLES: list[Payload] = [
@@ -135,6 +136,19 @@ SAMPLES: list[Payload] = [
     central.SwitchAccepted(),
     central.CentralServerHeartbeat(),
     central.CentralHeartbeat(),
+    cfg.ConfigSectionPacket(
+        "Teleop", "", (cfg.ConfigParam("Timeout", cfg.ParamType.DOUBLE, 2.0, "s", 1, 0.0, 60.0, 1),), "", 1
+    ),
+    cfg.ConfigSectionPacketV3("Teleop", "", (cfg.ConfigParam("On", cfg.ParamType.BOOL, True),)),
+    cfg.ConfigSectionPacketV2("Teleop", "", (cfg.ConfigParam("N", cfg.ParamType.INT, 1, "", 0, 0, 2),)),
+    cfg.ConfigSectionPacketV1("Teleop", "", (cfg.ConfigParam("S", cfg.ParamType.STRING, "x"),)),
+    cfg.ConfigRequest(4, 3),
+    cfg.SetConfig((("Section", "Teleop"), ("Timeout", "1"))),
+    cfg.SetConfigReply("Teleop/Timeout: 99 is above the maximum of 60"),
+    cfg.ConfigUpdated(),
+    cfg.ConfigSectionFlags((("Teleop", ""),)),
+    cfg.LastEditablePriority(3),
+    cfg.ConfigCausingRestart(1),
 ]
 TYPES = sorted(registered().values(), key=lambda c: (c.DATA_NAME, c.SIDE.value))
 

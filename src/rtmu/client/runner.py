@@ -128,6 +128,9 @@ class ClientRunner:
         """Optional tap on every notice as it is raised (network thread mostly): a flight recorder."""
         self.on_stop: Callable[[str, bool], None] | None = None
         """Optional tap: ``on_stop(reason, sent)`` for every zero-ratios + ``stop`` (network thread)."""
+        self.on_config_updated: Callable[[], None] | None = None
+        """Called on the UI thread when another client changed the server's configuration."""
+        self._config_post_pending = threading.Event()
         self.loop = asyncio.new_event_loop()
         self.session: Session | None = None
         self._thread = threading.Thread(target=self._run, name="rtmu-network", daemon=True)
@@ -168,6 +171,7 @@ class ClientRunner:
             client_factory=factory,
         )
         self.session.on_stop = self._stopped
+        self.session.config_feed.listener = self._config_updated
         self.lease.on_change = self._lease_changed
         self._beat()
         self._ready.set()
@@ -398,6 +402,29 @@ class ClientRunner:
 
     def ptz_abs(self, pan: float, tilt: float, zoom: float | None = None) -> concurrent.futures.Future[None]:
         return self._fire(lambda: self._session.ptz.move_abs(pan, tilt, zoom), kind=Kind.CAMERA)
+
+    # -- the server's configuration (client.config_feed) -----------------------------------------
+    def fetch_config(self) -> concurrent.futures.Future[Any]:
+        """A :class:`~rtmu.client.config_feed.ServerConfig` (NotSupported where none is offered)."""
+        return self.submit(self._session.fetch_config)
+
+    def set_config(self, changes: dict[str, dict[str, str]]) -> concurrent.futures.Future[Any]:
+        """``setConfig``; the Future's :class:`SetConfigReply` says whether the server took it."""
+        return self.submit(self._session.set_config, changes)
+
+    def _config_updated(self) -> None:
+        """Network loop: tell the UI once per burst (a flood of broadcasts is one post, not thousands)."""
+        if self.on_config_updated is None or self._config_post_pending.is_set():
+            return
+        self._config_post_pending.set()
+
+        def deliver() -> None:
+            self._config_post_pending.clear()
+            fn = self.on_config_updated
+            if fn is not None:
+                fn()
+
+        self.post(deliver)
 
     # -- navigation: the server drives; a refusal comes back as a Kind.NAVIGATION notice -------
     def goto_goal(self, name: str) -> concurrent.futures.Future[None]:

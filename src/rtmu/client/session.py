@@ -51,6 +51,7 @@ from ..state import (
     RobotState,
     StateChange,
 )
+from .config_feed import ConfigFeed, ServerConfig, fetch_config, set_config
 from .connection import AriaClient, Packet
 from .custom_commands import CommandCatalogue, ServerCommand, list_commands, run_command
 from .diagnosis import explain
@@ -188,6 +189,8 @@ class Session:
         self.strings.interval_ms = self.config.wifi_interval_ms
         self.ptz = PtzFeed(self._robot_update, self._spawn, self.config.reply_timeout)
         """The pan-tilt-zoom camera head (§4.6): limits, position while watched, moves."""
+        self.config_feed = ConfigFeed()
+        """``configUpdated`` broadcasts (the configuration page refreshes on them)."""
         self._held_subs: set[str] = set()
         """Conditional subscriptions (``only_while``) held now on this connection."""
 
@@ -565,6 +568,15 @@ class Session:
 
     def answer_popup(self, popup_id: int, button: int) -> None:
         self.popups.click(popup_id, button)
+
+    async def fetch_config(self) -> ServerConfig:
+        return await fetch_config(self._require_connected(), self.config.reply_timeout)
+
+    async def set_config(self, changes: dict[str, dict[str, str]]) -> Any:
+        return await set_config(self._require_connected(), changes, self.config.reply_timeout)
+
+    def _on_config_updated(self, packet: Packet) -> None:
+        self.config_feed.on_updated(packet)
 
     def _require_connected(self) -> AriaClient:
         client = self.client
@@ -980,5 +992,6 @@ SUBSCRIPTIONS: tuple[SessionSubscription, ...] = (
     Subscription("getPath", lambda c: c.path_interval_ms, Session._on_path, only_while=Session._navigating),
     Subscription("popupCreate", -1, Session._on_popup_create),
     Subscription("popupClose", -1, Session._on_popup_close),
+    Subscription("configUpdated", -1, Session._on_config_updated),
 )
 """What a session subscribes to on every connection, in this order, where the server offers it."""

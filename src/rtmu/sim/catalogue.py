@@ -8,8 +8,9 @@ display, taken from a recording of serverDemo's list
 (``shared/captures/clientCommandLister-serverDemoMap.pcap``; a test checks
 them against it). Every text that appears in no capture — the popup data and
 the simulator's own commands — is written in our own words. Data serverDemo
-has that the simulator does not serve (configuration editing,
-micro-controller pass-through, the laser) are left out.
+has that the simulator does not serve here (micro-controller pass-through,
+the laser) are left out. Configuration editing (``CONFIG``) is answered by
+:mod:`rtmu.sim.arconfig`.
 """
 
 from __future__ import annotations
@@ -616,6 +617,79 @@ STRINGS: tuple[Row, ...] = (
     ),
 )
 
+_GET_RETURN = "Use ArClientHandlerConfig if desired."
+_SET_RETURN = (
+    "string: if empty setConfig worked, if the string isn't empty then it is the first error that occured "
+    "(all non-error parameters are parsed, and only the first error is reported)"
+)
+CONFIG: tuple[Row, ...] = (
+    # ARIA's own texts, as serverDemo lists them (shared/captures/clientCommandLister-serverDemoMap.pcap).
+    (
+        "getConfigBySectionsV4",
+        "Gets the complete configuration information from the server",
+        "none",
+        "Advanced configuration retrieval, including handling of serializable.  " + _GET_RETURN,
+        "ConfigEditing",
+        "RETURN_UNTIL_EMPTY",
+    ),
+    (
+        "getConfigBySectionsV3",
+        "Gets the complete configuration information from the server",
+        "none",
+        "Advanced configuration retrieval, including handling of very big sections.  " + _GET_RETURN,
+        "ConfigEditing",
+        "RETURN_UNTIL_EMPTY",
+    ),
+    (
+        "getConfigBySectionsV2",
+        "Gets the complete configuration information from the server",
+        "none",
+        "Advanced configuration retrieval, including restart level and list objects.  " + _GET_RETURN,
+        "ConfigEditing",
+        "RETURN_UNTIL_EMPTY",
+    ),
+    (
+        "getConfigBySections",
+        "Gets the configuration information from the server",
+        "none",
+        "A single packet is sent for each config section.  Too complex to describe here.  " + _GET_RETURN,
+        "ConfigEditing",
+        "RETURN_UNTIL_EMPTY",
+    ),
+    (
+        "setConfig",
+        "takes a config back from the client to use",
+        "Repeating pairs of strings which are parameter name and value to parse",
+        _SET_RETURN,
+        "ConfigEditing",
+        "RETURN_SINGLE|IDLE_PACKET",
+    ),
+    (
+        "configUpdated",
+        "gets sent when the config is updated",
+        "none",
+        "none",
+        "ConfigEditing",
+        "RETURN_SINGLE",
+    ),
+    (
+        "getConfigSectionFlags",
+        "gets the flags for each section of the config",
+        "none",
+        "byte4: number of sections; repeating for number of sections (string: section; string: flags (separated by |))",
+        "ConfigEditing",
+        "RETURN_SINGLE",
+    ),
+    (
+        "getLastEditablePriority",
+        "Returns the last priority that may be edited by the user; e.g. EXPERT or FACTORY",
+        "none",
+        "byte: the last ArPriority::Priority value for which parameters may be edited",
+        "ConfigEditing",
+        "RETURN_SINGLE",
+    ),
+)
+
 POPUPS: tuple[Row, ...] = (
     # No capture has ARIA's popup handler, so these texts are our own (names, groups and flags are ARIA's).
     (
@@ -682,6 +756,7 @@ def build_catalogue(camera: bool = True) -> DataList:
     rows = [*CORE, *SIM_COMMANDS]
     if camera:
         rows += VIDEO_COMMANDS
+    rows += CONFIG
     rows += UNSAFE_COMMANDS
     if camera:
         rows += CAMERA

@@ -58,4 +58,6 @@ class SimConfig:
     client reads (a 1 M-point map is 8 MB binary, 21 MB as text), so they never count whole."""
     skip_periodic_above: int = 1024 * 1024
     """Skip periodic sends to a client with this much output still queued (it is not keeping up)."""
+    config_filler: int = 0
+    """Extra configuration parameters, markup in every text (:mod:`rtmu.sim.arconfig`): hostile tests."""
     verbose: bool = False

@@ -11,6 +11,8 @@ from collections import deque
 from collections.abc import Callable
 from typing import Protocol
 
+from rtmu.protocol.payloads.config import ConfigRequest, SetConfig
+
 from .catalogue import Row
 from .mapserve import ServedMap
 from .video import VideoFeed
@@ -20,6 +22,16 @@ from .world import World
 class Meter(Protocol):
     percent: float
     """The process's CPU use over the last second."""
+
+
+class ArConfigStore(Protocol):
+    """The server's configuration (:class:`rtmu.sim.arconfig.SimArConfig`), as its handlers use it."""
+
+    def packets(self, version: int, request: ConfigRequest) -> list[bytes]: ...
+
+    def apply(self, request: SetConfig) -> tuple[str, bool]: ...
+
+    def sections(self) -> list[str]: ...
 
 
 class SimClient(Protocol):
@@ -43,13 +55,18 @@ class SimHost(Protocol):
     stop_log: deque[tuple[float, int, str]]
 
     @property
+    def arconfig(self) -> ArConfigStore:
+        """Read only, so the server's own store type fits."""
+        ...
+
+    @property
     def cpu(self) -> Meter:
         """Read only, so the server's own meter type (which also samples) fits."""
         ...
 
     def cycle_cached(self, key: str, make: Callable[[], bytes]) -> bytes: ...
 
-    def broadcast(self, name: str, payload: bytes = b"") -> int: ...
+    def broadcast(self, name: str, payload: bytes = b"", exclude: SimClient | None = None) -> int: ...
 
     def check_map(self) -> bool: ...
 

@@ -130,6 +130,7 @@ BROADCAST_ONLY = frozenset(
         "popupClose",
         "cameraListUpdated",
         "cameraParamUpdated",
+        "configUpdated",
     }
 )
 """Data whose ARIA handler is empty: a subscription gets no immediate reply, only broadcasts."""

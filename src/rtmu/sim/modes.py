@@ -83,6 +83,10 @@ class RatioDriveMode(Mode):
     def __init__(self, timeout: float = 2.0) -> None:
         super().__init__()
         self.timeout = timeout
+        self.trans_vel_max = p3dx.TRANS_VEL_MAX
+        """Full stick forward (mm/s; backwards is a quarter): the server's configuration lowers it live."""
+        self.rot_vel_max = p3dx.ABSOLUTE_MAX_ROT_VEL
+        """No ratio turns faster than this (deg/s)."""
         self.safe = True
         self.trans_ratio = 0.0
         self.rot_ratio = 0.0
@@ -136,8 +140,8 @@ class RatioDriveMode(Mode):
 
     def _ratio_velocities(self, body: Body) -> Command:
         throttle = self.throttle_ratio / 100.0
-        full_fwd = p3dx.TRANS_VEL_MAX
-        full_back = p3dx.TRANS_VEL_MAX / 4.0
+        full_fwd = self.trans_vel_max
+        full_back = self.trans_vel_max / 4.0
         rot_stopped = p3dx.RATIO_ROT_AT_STOPPED
         rot_full = p3dx.RATIO_ROT_AT_FULL
         rot_ratio = self.rot_ratio / 100.0
@@ -154,6 +158,7 @@ class RatioDriveMode(Mode):
             rot = (
                 0.0 if abs(self.rot_ratio) < p3dx.RATIO_ROT_DEAD_ZONE else rot_ratio * rot_stopped * throttle
             )
+        rot = max(-self.rot_vel_max, min(self.rot_vel_max, rot))
         cmd = Command(vel, rot, safe=self.safe)
         # Stick pushed against the motion: brake three times harder.
         if (body.vel > 0 and self.trans_ratio < -50) or (body.vel < 0 and self.trans_ratio > 50):

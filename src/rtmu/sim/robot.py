@@ -60,6 +60,8 @@ class Body:
         self.vel = 0.0
         self.rot_vel = 0.0
         self.battery_v = float(battery_v)
+        self.drain_scale = 1.0
+        """How many times the P3-DX's own drain the pack loses (the server's configuration sets it)."""
         self.stalled = False
         """The last step pushed into an obstacle (ARIA: a motor stall)."""
         self.collisions = 0
@@ -153,7 +155,7 @@ class Body:
         drain = p3dx.BATTERY_IDLE_DRAIN_V_PER_S * dt
         drain += p3dx.BATTERY_MOTION_DRAIN_V_PER_M * abs(self.vel) * dt / 1000.0
         drain += p3dx.BATTERY_TURN_DRAIN_V_PER_REV * abs(self.rot_vel) * dt / 360.0
-        self.battery_v = max(self.battery_v - drain, 0.0)
+        self.battery_v = max(self.battery_v - drain * self.drain_scale, 0.0)
 
 
 def _approach(current: float, target: float, accel: float, decel: float, dt: float) -> float:

@@ -44,6 +44,7 @@ from rtmu.protocol.payloads.ld import DockInfoChanged
 from rtmu.protocol.server_connection import ServerConnection, ServerState
 
 from . import switch
+from .arconfig import SimArConfig
 from .catalogue import Row, custom_commands
 from .config import SimConfig
 from .handlers import (
@@ -376,6 +377,7 @@ class SimServer:
         """Control packets from any client that did not decode (each refused or ignored, never raised)."""
         self.cpu = CpuMeter()
         self.video_size: tuple[int, int] = (320, 240)
+        self.arconfig = SimArConfig(self, cfg.config_filler)
         threaded = cfg.realtime if cfg.render_in_thread is None else cfg.render_in_thread
         self.video = VideoFeed(threaded=threaded)
         self._switch_task: asyncio.Task[None] | None = None
@@ -552,15 +554,15 @@ class SimServer:
                 if other is not None:
                     session.send(other, reply.payload)
 
-    def broadcast(self, name: str, payload: bytes = b"") -> int:
-        """Send data ``name`` to every client subscribed to it; returns how many got it."""
+    def broadcast(self, name: str, payload: bytes = b"", exclude: object | None = None) -> int:
+        """Send data ``name`` to every client subscribed to it (but ``exclude``); returns how many got it."""
         number = self.datalist.number(name)
         if number is None:
             return 0
         packet = encode_packet(number, payload)
         sent = 0
         for s in list(self.sessions):
-            if number in s.subscriptions and not s.closed:
+            if number in s.subscriptions and not s.closed and s is not exclude:
                 s.write(packet)
                 sent += 1
         return sent

@@ -35,11 +35,16 @@ class AccessPoint:
         self.obstacles = obstacles
         self.x = x
         self.y = y
+        self.tx_at_1m_dbm = TX_AT_1M_DBM
+        self.path_loss_exponent = PATH_LOSS_EXPONENT
+        self.wall_loss_db = WALL_LOSS_DB
+        """The model's parameters, per access point: the server's configuration changes them live."""
 
     def link(self, rx: float, ry: float) -> Link:
         d_m = max(math.hypot(rx - self.x, ry - self.y) / 1000.0, 1.0)
         walls = min(self.obstacles.segment_crossings(self.x, self.y, rx, ry), MAX_WALLS_COUNTED)
-        signal = TX_AT_1M_DBM - 10.0 * PATH_LOSS_EXPONENT * math.log10(d_m) - WALL_LOSS_DB * walls
+        loss = 10.0 * self.path_loss_exponent * math.log10(d_m) + self.wall_loss_db * walls
+        signal = self.tx_at_1m_dbm - loss
         signal = max(signal, FLOOR_DBM)
         quality = int(max(0, min(70, round(signal + 110))))
         return Link(round(signal), NOISE_DBM, quality, walls)

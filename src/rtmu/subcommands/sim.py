@@ -80,6 +80,13 @@ def register(subparsers: argparse._SubParsersAction) -> None:
         help="enforce and advertise this protocol string, refusing others with reason 4 "
         "(default: the profile's — none, or 6MTX for aram)",
     )
+    p.add_argument(
+        "--config-filler",
+        type=int,
+        default=0,
+        metavar="N",
+        help="add N configuration parameters, markup in every text (try clients on a hostile ArConfig)",
+    )
     p.add_argument("-v", "--verbose", action="store_true", help="log connections and refusals")
     central = p.add_argument_group("ARIA central server (switchServer)")
     central.add_argument(
@@ -146,6 +153,7 @@ def run(args: argparse.Namespace) -> int:
         max_clients=args.max_clients if args.max_clients > 0 else None,
         protocol_version=args.protocol,
         profile=args.profile,
+        config_filler=max(0, min(args.config_filler, 200_000)),
         verbose=args.verbose,
     )
     if args.battery is not None:

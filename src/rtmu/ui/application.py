@@ -48,7 +48,7 @@ PYTHON_SIGNALS = (signal.SIGQUIT, signal.SIGALRM)
 """Signals that would kill the process by default and that GLib cannot watch: a Python handler."""
 _NO_BREAK = "\u2060"  # WORD JOINER: the line may not break here (not after the hyphens of "--demo")
 FIRST_RUN_HINT = (
-    "No robot set up yet: open the menu ☰ → Connection settings (Ctrl+,) — or try the simulator: "
+    "No robot set up yet: open the menu ☰ → Server → Connection settings (Ctrl+,) — or try the simulator: "
     f"rtmu{_NO_BREAK}\u00a0-{_NO_BREAK}-{_NO_BREAK}demo"
 )
 """Said on the first start; the menu button is on screen in a window and in full screen alike."""

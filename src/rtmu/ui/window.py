@@ -53,6 +53,7 @@ from ..settings import Profile  # noqa: E402
 from .banners import BannerStack  # noqa: E402
 from .bars import FullscreenBar, connect_button, menu_button, show_connection, stop_button  # noqa: E402
 from .camera import CameraInset, CameraView, PictureDecoder  # noqa: E402
+from .config_page import ConfigPage  # noqa: E402
 from .details import DetailsWindow  # noqa: E402
 from .dpad import DPad  # noqa: E402
 from .goals_panel import GoalsPanel  # noqa: E402
@@ -354,7 +355,10 @@ class MainWindow(Gtk.ApplicationWindow):
         view.append("Sonar readings", "win.sonar")
         view.append("Robot details…", "win.details")
         app = Gio.Menu()
-        app.append("Connection settings…", "win.settings")
+        server = Gio.Menu()  # the connection and the server's own settings: one row, so the menu still fits
+        server.append("Connection settings…", "win.settings")
+        server.append("Configuration…", "win.server-config")
+        app.append_submenu("Server", server)
         app.append_submenu("View", view)
         app.append("Keyboard shortcuts", "win.show-help-overlay")
         app.append("About RTMU", "win.about")
@@ -410,6 +414,7 @@ class MainWindow(Gtk.ApplicationWindow):
         plain("camera", lambda: self.view_intent("toggle_camera"))
         plain("about", self.show_about)
         plain("details", self.show_details)
+        plain("server-config", self.show_server_config)
         self.toolbar_action = toggle("toolbar", True, self.toolbar_revealer.set_reveal_child)
         self.fullscreen_action = toggle("fullscreen", False, self._set_fullscreen)
         self.dpad_action = toggle("dpad", self.dpad.get_visible(), self._set_dpad)
@@ -801,6 +806,16 @@ class MainWindow(Gtk.ApplicationWindow):
     def send_data(self, name: str, payload: object) -> None:
         """Fire-and-forget request of an LD panel (patrol, say) through the controller's link."""
         self.controller.link.command(name, payload)
+
+    def show_server_config(self) -> None:
+        """The server's configuration page (its own window, so typing there never drives): one at a time."""
+        page = getattr(self, "config_page", None)
+        if page is None or page.closed:
+            link = self._link
+            self.config_page = ConfigPage(
+                self, link.fetch_config, link.set_config, lambda fn: setattr(link, "on_config_updated", fn)
+            )
+        self.config_page.present()
 
     def show_details(self) -> None:
         """The details window (DataStore strings, docking, say): one at a time."""

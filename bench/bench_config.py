@@ -1,0 +1,69 @@
+"""What a big server configuration (ArConfig) costs a client: decoding, fetching over loopback, memory.
+
+The configuration is the simulator's own plus 10 000 filler parameters (``SimConfig.config_filler``,
+markup in every text), served as ``getConfigBySectionsV4`` packets split to fit 32 000 bytes.
+
+* ``config.decode_10k_ms``: the reply's payloads to a bounded ``ServerConfig`` (decode, cut, join the
+  parts of each section). Baseline: the payloads through the typed decoder alone, nothing joined.
+* ``config.fetch_10k_ms``: connect, ``getLastEditablePriority``, ``getConfigBySectionsV4`` and decode,
+  against ``rtmu sim`` on loopback. Baseline: the same for the simulator's plain 11 parameters.
+* ``config.decode_10k_peak_kib``: Python's peak allocation while decoding (``tracemalloc``). Baseline:
+  the size of the payloads on the wire.
+"""
+
+from __future__ import annotations
+
+import asyncio
+import time
+import tracemalloc
+
+from bench.common import Result, best_time
+from rtmu.client.config_feed import assemble, fetch_config
+from rtmu.client.connection import AriaClient
+from rtmu.protocol.payloads.config import ConfigRequest, ConfigSectionPacket, Priority
+from rtmu.sim import SimConfig, SimServer, SimThread
+
+FILLER = 10_000
+
+
+def _payloads() -> list[bytes]:
+    server = SimServer(SimConfig(port=0, config_filler=FILLER))
+    return server.arconfig.packets(4, ConfigRequest())
+
+
+def _decode(payloads: list[bytes]) -> int:
+    config = assemble([ConfigSectionPacket.decode(p) for p in payloads], Priority.EXPERT, "bench")
+    return config.param_count
+
+
+def _fetch_ms(filler: int, rounds: int = 5) -> float:
+    with SimThread(SimConfig(port=0, config_filler=filler, camera=False)) as sim:
+
+        async def once() -> float:
+            client = AriaClient()
+            started = time.perf_counter()
+            await client.connect("127.0.0.1", sim.port, timeout=10)
+            try:
+                config = await fetch_config(client, 30)
+                assert config.param_count == filler + 11
+                return (time.perf_counter() - started) * 1000
+            finally:
+                await client.disconnect()
+
+        return min(asyncio.run(once()) for _ in range(rounds))
+
+
+def run() -> list[Result]:
+    payloads = _payloads()
+    assert _decode(payloads) == FILLER + 11
+    decode = best_time(lambda: _decode(payloads), repeat=3)
+    plain = best_time(lambda: [ConfigSectionPacket.decode(p) for p in payloads], repeat=3)
+    tracemalloc.start()
+    _decode(payloads)
+    _current, peak = tracemalloc.get_traced_memory()
+    tracemalloc.stop()
+    return [
+        Result("config.decode_10k_ms", decode * 1000, "ms", baseline=plain * 1000),
+        Result("config.fetch_10k_ms", _fetch_ms(FILLER), "ms", baseline=_fetch_ms(0)),
+        Result("config.decode_10k_peak_kib", peak / 1024, "KiB", baseline=sum(map(len, payloads)) / 1024),
+    ]

@@ -1,0 +1,238 @@
+"""The server's configuration (ArConfig) for a client: fetch it, change values, follow others' changes.
+
+Shared by ``rtmu config`` and the window's configuration page (through the session). The newest
+``getConfigBySections*`` the server lists is asked for; its packets are joined into sections (a
+big section comes in parts). Everything is bounded: at most :data:`MAX_PARAMS` parameters and
+:data:`MAX_SECTIONS` sections are kept, texts are cut, and the reply itself is bounded in
+packets and bytes by the connection.
+
+:class:`ConfigFeed` counts ``configUpdated`` broadcasts (another client changed something) and
+tells a listener, so a page can fetch again without losing its own unsaved edits.
+"""
+
+from __future__ import annotations
+
+import asyncio
+from collections.abc import Callable
+from dataclasses import dataclass, replace
+
+from ..protocol.errors import ProtocolError
+from ..protocol.payloads.base import Side, payload_type_for
+from ..protocol.payloads.config import (
+    ConfigParam,
+    ConfigRequest,
+    ConfigSectionPacket,
+    LastEditablePriority,
+    ParamType,
+    Priority,
+    SetConfig,
+    SetConfigReply,
+)
+from .connection import AriaClient, Packet
+from .errors import MalformedReply, NotSupported
+
+VERSIONS = ("getConfigBySectionsV4", "getConfigBySectionsV3", "getConfigBySectionsV2", "getConfigBySections")
+"""Newest first: the first the server lists is used."""
+MAX_PARAMS = 100_000
+MAX_SECTIONS = 10_000
+MAX_TEXT = 2_000
+"""Names, descriptions and values longer than this are cut (ARIA's own buffers are 1–32 KB)."""
+MAX_REPLY_BYTES = 32 << 20
+MAX_REPLY_PACKETS = 20_000
+
+
+@dataclass(frozen=True, slots=True)
+class ConfigSection:
+    name: str
+    comment: str
+    params: tuple[ConfigParam, ...]
+    category: str = ""
+
+
+@dataclass(frozen=True, slots=True)
+class ServerConfig:
+    """A whole configuration as fetched, with the last priority the server lets a user edit."""
+
+    sections: tuple[ConfigSection, ...] = ()
+    last_editable: int = Priority.EXPERT
+    source: str = ""
+    """The data it came from (``getConfigBySectionsV4`` …)."""
+    cut: int = 0
+    """Parameters left out because the configuration was larger than :data:`MAX_PARAMS`."""
+
+    def find(self, section: str, name: str) -> ConfigParam | None:
+        """A parameter by section and name (case-insensitive, as ARIA compares them)."""
+        for s in self.sections:
+            if s.name.lower() == section.lower():
+                for p in s.params:
+                    if p.name.lower() == name.lower():
+                        return p
+        return None
+
+    @property
+    def param_count(self) -> int:
+        return sum(len(s.params) for s in self.sections)
+
+    def editable(self, param: ConfigParam) -> bool:
+        return param.priority <= self.last_editable
+
+
+def _cut(text: str) -> str:
+    return text if len(text) <= MAX_TEXT else text[: MAX_TEXT - 1] + "…"
+
+
+def _bounded(p: ConfigParam) -> ConfigParam:
+    fits = max(len(p.name), len(p.description), len(p.display_hint), len(p.extra)) <= MAX_TEXT
+    if fits and not p.children and not (isinstance(p.value, str) and len(p.value) > MAX_TEXT):
+        return p  # the common case: nothing to cut, no copy
+    value = _cut(p.value) if isinstance(p.value, str) else p.value
+    children = tuple(_bounded(c) for c in p.children[:1000])
+    return replace(
+        p,
+        name=_cut(p.name),
+        description=_cut(p.description),
+        value=value,
+        display_hint=_cut(p.display_hint),
+        extra=_cut(p.extra),
+        children=children,
+    )
+
+
+def offers_config(client: AriaClient) -> str | None:
+    """The config data this server lists (newest first), or None."""
+    return next((name for name in VERSIONS if client.supports(name)), None)
+
+
+def assemble(packets: list[ConfigSectionPacket], last_editable: int, source: str) -> ServerConfig:
+    """Join section packets (parts of one section follow each other) into bounded sections."""
+    sections: list[ConfigSection] = []
+    kept, dropped = 0, 0
+    for packet in packets:
+        if packet.end:
+            continue
+        room = max(0, MAX_PARAMS - kept)
+        params = tuple(_bounded(p) for p in packet.params[:room])
+        dropped += len(packet.params) - len(params)
+        kept += len(params)
+        if sections and packet.index > 1 and sections[-1].name == packet.name:
+            last = sections[-1]
+            sections[-1] = replace(last, params=last.params + params)
+        elif len(sections) < MAX_SECTIONS:
+            sections.append(
+                ConfigSection(_cut(packet.name), _cut(packet.comment), params, _cut(packet.category))
+            )
+        else:
+            dropped += len(params)
+    return ServerConfig(tuple(sections), last_editable, source, dropped)
+
+
+async def fetch_config(client: AriaClient, timeout: float) -> ServerConfig:
+    """The whole configuration; NotSupported when the server offers none."""
+    name = offers_config(client)
+    if name is None:
+        raise NotSupported(
+            "getConfigBySectionsV4", "this server offers no configuration (getConfigBySections)"
+        )
+    last_editable = int(Priority.EXPERT)
+    if client.supports(LastEditablePriority.DATA_NAME):
+        answer = (await client.request_once(LastEditablePriority.DATA_NAME, timeout=timeout)).decode()
+        if isinstance(answer, LastEditablePriority):
+            last_editable = int(Priority.of(answer.priority))
+    what: str | ConfigRequest = (
+        ConfigRequest(Priority.FACTORY, last_editable) if name == VERSIONS[0] else name
+    )
+    reply = await client.request_once(
+        what, timeout=timeout, max_packets=MAX_REPLY_PACKETS, max_bytes=MAX_REPLY_BYTES
+    )
+    # Thousands of parameters take a tenth of a second or more: not on the network loop.
+    return await asyncio.get_running_loop().run_in_executor(
+        None, decode_config, name, reply.payloads, last_editable
+    )
+
+
+def decode_config(name: str, payloads: tuple[bytes, ...], last_editable: int) -> ServerConfig:
+    """A ``getConfigBySections*`` reply's payloads as one bounded configuration (MalformedReply if bad)."""
+    cls = payload_type_for(name, Side.REPLY)
+    assert cls is not None and issubclass(cls, ConfigSectionPacket)
+    try:
+        packets = [cls.decode(p) for p in payloads]
+    except ProtocolError as exc:
+        raise MalformedReply(f"{name} did not decode: {exc}") from None
+    return assemble(packets, last_editable, name)
+
+
+async def set_config(
+    client: AriaClient, changes: dict[str, dict[str, str]], timeout: float
+) -> SetConfigReply:
+    """Send ``{section: {parameter: value text}}`` in one ``setConfig``; the server's answer."""
+    if not client.supports(SetConfig.DATA_NAME):
+        raise NotSupported(
+            SetConfig.DATA_NAME, "this server does not let its configuration be changed (setConfig)"
+        )
+    answer = (await client.request_once(SetConfig.of(changes), timeout=timeout)).decode()
+    if not isinstance(answer, SetConfigReply):
+        raise MalformedReply("setConfig did not answer with a string")
+    return replace(answer, error=_cut(answer.error))
+
+
+class ConfigFeed:
+    """``configUpdated`` broadcasts of one session: counted, and passed to a listener (network loop)."""
+
+    def __init__(self) -> None:
+        self.updates = 0
+        self.listener: Callable[[], None] | None = None
+        """Called on the network loop after each broadcast (the runner posts it to the UI thread)."""
+
+    def on_updated(self, packet: Packet) -> None:
+        self.updates += 1
+        listener = self.listener
+        if listener is not None:
+            listener()
+
+
+def check_value(param: ConfigParam, text: str) -> str:
+    """Why ``text`` cannot be this parameter's value ("" when it can), judged by its type and limits.
+
+    The server has the last word (it may refuse for reasons of its own); this only lets a page
+    say at once what is certainly wrong.
+    """
+    raw = text.strip()
+    if param.kind is ParamType.BOOL:
+        return (
+            ""
+            if raw.lower() in ("true", "false", "1", "0", "yes", "no", "on", "off")
+            else "not true or false"
+        )
+    if param.kind in (ParamType.INT, ParamType.DOUBLE):
+        try:
+            number = int(raw) if param.kind is ParamType.INT else float(raw)
+        except ValueError:
+            return "not a whole number" if param.kind is ParamType.INT else "not a number"
+        if number != number:
+            return "not a number"
+        if param.minimum is not None and number < param.minimum:
+            return f"below the minimum of {param.minimum:g}"
+        if param.maximum is not None and number > param.maximum:
+            return f"above the maximum of {param.maximum:g}"
+        return ""
+    if param.kind is ParamType.STRING:
+        if param.choices and raw not in param.choices:
+            return "not one of " + ", ".join(param.choices)
+        return "" if len(text) <= MAX_TEXT else f"longer than {MAX_TEXT} characters"
+    return "cannot be changed here"
+
+
+def changed_values(old: ServerConfig, new: ServerConfig) -> list[tuple[str, str, str]]:
+    """``(section, name, new value text)`` of every parameter whose value differs (or is new)."""
+    before = {(s.name, p.name): p.value for s in old.sections for p in s.params}
+    out: list[tuple[str, str, str]] = []
+    for s in new.sections:
+        for p in s.params:
+            if p.kind is not ParamType.SEPARATOR and before.get((s.name, p.name), object()) != p.value:
+                out.append((s.name, p.name, p.value_text()))
+    return out
+
+
+def names_param(error: str, section: str, name: str) -> bool:
+    """Whether a ``setConfig`` answer is about this parameter (ARIA-style ``Section/Name: why``)."""
+    return error.lower().startswith(f"{section}/{name}:".lower())

@@ -1,0 +1,499 @@
+"""The server's configuration page: sections, editors fit to each type, one Save, the server's answers.
+
+A window of its own (menu: Server ▸ Configuration…), so typing in it never reaches the main
+window's drive keys. Everything it shows comes from the server and is set as plain text, never as
+markup. A section shows :data:`PAGE_SIZE` parameters at a time, so a configuration of tens of
+thousands of parameters costs a page of widgets, not one per parameter.
+
+Edits are kept by ``(section, name)`` until they are saved, across sections, pages, the priority
+filter and refreshes. When another client changes the configuration (``configUpdated``) the page
+fetches it again, updates what the operator has not touched and says what changed — and which of
+the operator's own unsaved edits the other client changed under them.
+"""
+
+from __future__ import annotations
+
+import concurrent.futures
+import contextlib
+import math
+from collections.abc import Callable
+from typing import Any
+
+import gi
+
+gi.require_version("Gdk", "4.0")
+gi.require_version("Gtk", "4.0")
+gi.require_version("Pango", "1.0")
+from gi.repository import Gdk, GLib, Gtk, Pango  # noqa: E402
+
+from ..client.config_feed import (  # noqa: E402
+    MAX_TEXT,
+    ConfigSection,
+    ServerConfig,
+    changed_values,
+    check_value,
+    names_param,
+)
+from ..protocol.payloads.config import ConfigParam, ParamType, Priority, SetConfigReply  # noqa: E402
+
+Fetch = Callable[[], "concurrent.futures.Future[Any]"]
+Save = Callable[[dict[str, dict[str, str]]], "concurrent.futures.Future[Any]"]
+Follow = Callable[[Callable[[], None] | None], None]
+Key = tuple[str, str]
+
+PAGE_SIZE = 60
+"""Parameters shown at once (a section with more gets Previous / Next)."""
+MAX_SECTIONS_LISTED = 1000
+MAX_CHANGES_NAMED = 5
+SPIN_LIMIT = 1e12
+"""Unlimited numbers (ARIA's INT_MIN/INT_MAX, ±INF) are edited within ± this."""
+PRIORITY_LABELS = ("Basic", "Intermediate", "Advanced", "Expert", "Factory")
+CSS = """
+.config-ok { color: #26a269; font-weight: bold; }
+.config-error { color: #c01c28; }
+.config-edited { color: #1c71d8; }
+.config-banner { background: alpha(#e5a50a, 0.25); padding: 4px 8px; border-radius: 4px; }
+"""
+_css_done = False
+
+
+def install_css() -> None:
+    """The answer colours, once per display (the theme's own .success/.error differ between themes)."""
+    global _css_done
+    display = Gdk.Display.get_default()
+    if _css_done or display is None:
+        return
+    provider = Gtk.CssProvider()
+    provider.load_from_data(CSS.encode())
+    Gtk.StyleContext.add_provider_for_display(display, provider, Gtk.STYLE_PROVIDER_PRIORITY_APPLICATION)
+    _css_done = True
+
+
+class ConfigPage(Gtk.Window):
+    """See the module notes. ``fetch()``/``save(changes)`` return Futures completed on the network thread."""
+
+    def __init__(self, parent: Gtk.Window | None, fetch: Fetch, save: Save, follow: Follow) -> None:
+        super().__init__(
+            title="Server configuration", transient_for=parent, modal=False, destroy_with_parent=True
+        )
+        self.set_default_size(760, 440)
+        self._fetch, self._save, self._follow = fetch, save, follow
+        self.config: ServerConfig | None = None
+        self.edits: dict[Key, str] = {}
+        """Unsaved values (text, as ``setConfig`` sends them)."""
+        self.answers: dict[Key, tuple[bool, str]] = {}
+        """The server's last word on a parameter the operator saved: (accepted, text)."""
+        self.section = 0
+        self.page = 0
+        self.show_up_to = int(Priority.EXPERT)
+        self.rows: dict[Key, tuple[ConfigParam, Gtk.Widget, Gtk.Label]] = {}
+        """The parameters on screen now: their description, editor and answer label."""
+        self.fetches = 0
+        self.fetching = False
+        self._again = ""
+        self.saving = False
+        self.closed = False
+        install_css()
+        self._build()
+        self._follow(self.remote_changed)
+        self.connect("close-request", self._closing)
+        self.refresh()
+
+    # -- layout -----------------------------------------------------------------------------------
+    def _build(self) -> None:
+        box = Gtk.Box(orientation=Gtk.Orientation.VERTICAL, spacing=6)
+        for side in ("top", "bottom", "start", "end"):
+            getattr(box, f"set_margin_{side}")(8)
+        bar = Gtk.Box(spacing=8)
+        bar.append(Gtk.Label(label="Show up to"))
+        self.priority = Gtk.DropDown.new_from_strings(list(PRIORITY_LABELS))
+        self.priority.set_selected(self.show_up_to)
+        self.priority.connect("notify::selected", self._priority_chosen)
+        bar.append(self.priority)
+        self.status = Gtk.Label(label="Loading…", xalign=0.0, hexpand=True, ellipsize=Pango.EllipsizeMode.END)
+        bar.append(self.status)
+        self.reload_button = Gtk.Button(label="Reload")
+        self.reload_button.connect("clicked", lambda _b: self.refresh())
+        bar.append(self.reload_button)
+        self.save_button = Gtk.Button(label="Save")
+        self.save_button.add_css_class("suggested-action")
+        self.save_button.set_sensitive(False)
+        self.save_button.connect("clicked", lambda _b: self.save())
+        bar.append(self.save_button)
+        box.append(bar)
+        self.banner = Gtk.Label(xalign=0.0, wrap=True)
+        self.banner.add_css_class("config-banner")
+        self.banner.set_visible(False)
+        box.append(self.banner)
+        paned = Gtk.Paned(orientation=Gtk.Orientation.HORIZONTAL, vexpand=True)
+        self.sections = Gtk.ListBox()
+        self.sections.connect("row-selected", self._section_chosen)
+        left = Gtk.ScrolledWindow(hscrollbar_policy=Gtk.PolicyType.NEVER)
+        left.set_child(self.sections)
+        left.set_size_request(170, -1)
+        paned.set_start_child(left)
+        paned.set_shrink_start_child(False)
+        right = Gtk.Box(orientation=Gtk.Orientation.VERTICAL, spacing=4)
+        self.comment = Gtk.Label(xalign=0.0, wrap=True)
+        self.comment.add_css_class("dim-label")
+        right.append(self.comment)
+        self.grid = Gtk.Grid(column_spacing=12, row_spacing=6)
+        self.scroller = Gtk.ScrolledWindow(vexpand=True, hscrollbar_policy=Gtk.PolicyType.NEVER)
+        self.scroller.set_child(self.grid)
+        right.append(self.scroller)
+        pager = Gtk.Box(spacing=8)
+        self.prev_button = Gtk.Button(label="Previous")
+        self.prev_button.connect("clicked", lambda _b: self._turn(-1))
+        self.next_button = Gtk.Button(label="Next")
+        self.next_button.connect("clicked", lambda _b: self._turn(1))
+        self.page_label = Gtk.Label(hexpand=True)
+        pager.append(self.prev_button)
+        pager.append(self.page_label)
+        pager.append(self.next_button)
+        right.append(pager)
+        paned.set_end_child(right)
+        box.append(paned)
+        self.set_child(box)
+        keys = Gtk.EventControllerKey()
+        keys.set_propagation_phase(Gtk.PropagationPhase.CAPTURE)  # Escape closes, even from an editor
+        keys.connect("key-pressed", self._key)
+        self.add_controller(keys)
+
+    def _key(self, _c: Gtk.EventControllerKey, keyval: int, _code: int, _state: object) -> bool:
+        if keyval == Gdk.KEY_Escape:
+            self.close()
+            return True
+        return False  # every other key stays in this window: it never reaches the drive keys
+
+    def _closing(self, _w: Gtk.Window) -> bool:
+        self.closed = True
+        self._follow(None)
+        return False
+
+    # -- fetching ---------------------------------------------------------------------------------
+    def refresh(self, note: str = "") -> None:
+        """Ask the server for the whole configuration; unsaved edits are kept. One fetch at a time:
+        asked again meanwhile, it fetches once more when the answer is in."""
+        if self.fetching:
+            self._again = self._again or note or "again"
+            return
+        self.fetching = True
+        self.status.set_text("Loading…")
+        self.reload_button.set_sensitive(False)
+        previous = self.config
+        self._fetch().add_done_callback(lambda f: GLib.idle_add(self._fetched, f, previous, note))
+
+    def _refresh_later(self, note: str) -> bool:
+        if not self.closed:
+            self.refresh(note)
+        return False
+
+    def _fetched(
+        self, future: concurrent.futures.Future[Any], previous: ServerConfig | None, note: str
+    ) -> bool:
+        self.fetching = False
+        if self.closed:
+            return False
+        self.reload_button.set_sensitive(True)
+        if self._again:
+            again, self._again = self._again, ""
+            GLib.idle_add(self._refresh_later, "remote" if again == "remote" else "")
+        error = None if future.cancelled() else future.exception()
+        if future.cancelled() or error is not None:
+            self.status.set_text(f"Could not load the configuration: {error or 'cancelled'}")
+            return False
+        config: ServerConfig = future.result()
+        self.config = config
+        self.fetches += 1
+        for key, text in list(self.edits.items()):  # another client set what was being typed: nothing to save
+            param = config.find(*key)
+            if param is not None and (text == param.value_text() or _same_number(param, text)):
+                del self.edits[key]
+        if previous is not None and note:
+            self._tell_changes(previous, config)
+        if self.fetches == 1:
+            self.show_up_to = int(Priority.of(config.last_editable))
+            self.priority.set_selected(self.show_up_to)
+        self._fill_sections()
+        self._update_status()
+        return False
+
+    def _tell_changes(self, old: ServerConfig, new: ServerConfig) -> None:
+        changed = changed_values(old, new)
+        if not changed:
+            self.banner.set_text("Another client saved the configuration; no value changed.")
+            self.banner.set_visible(True)
+            return
+        names = [f"{s}/{n} (now {v})" for s, n, v in changed[:MAX_CHANGES_NAMED]]
+        more = f" and {len(changed) - MAX_CHANGES_NAMED} more" if len(changed) > MAX_CHANGES_NAMED else ""
+        text = "Another client changed " + ", ".join(names) + more + "."
+        clashes = [f"{s}/{n}" for s, n, _ in changed if (s, n) in self.edits]
+        if clashes:
+            text += (
+                " Your unsaved edit of "
+                + ", ".join(clashes[:MAX_CHANGES_NAMED])
+                + " is kept: Save would overwrite their value."
+            )
+        self.banner.set_text(text)
+        self.banner.set_visible(True)
+
+    def remote_changed(self) -> None:
+        """``configUpdated`` (UI thread): fetch again and say what changed."""
+        if not self.closed:
+            self.refresh(note="remote")
+
+    # -- sections and rows ------------------------------------------------------------------------
+    def _fill_sections(self) -> None:
+        config = self.config
+        assert config is not None
+        keep = self.section
+        while (row := self.sections.get_row_at_index(0)) is not None:
+            self.sections.remove(row)
+        for s in config.sections[:MAX_SECTIONS_LISTED]:
+            label = Gtk.Label(label=s.name, xalign=0.0, ellipsize=Pango.EllipsizeMode.END)
+            label.set_tooltip_text(s.comment or None)
+            self.sections.append(label)
+        count = min(len(config.sections), MAX_SECTIONS_LISTED)
+        if count:
+            self.section = min(keep, count - 1)
+            self.sections.select_row(self.sections.get_row_at_index(self.section))
+        self._show_section()
+
+    def _section_chosen(self, _box: Gtk.ListBox, row: Gtk.ListBoxRow | None) -> None:
+        if row is not None and row.get_index() != self.section:
+            self.section, self.page = row.get_index(), 0
+            self._show_section()
+
+    def _priority_chosen(self, *_a: object) -> None:
+        self.show_up_to = int(self.priority.get_selected())
+        self.page = 0
+        if self.config is not None:
+            self._show_section()
+
+    def _turn(self, step: int) -> None:
+        self.page = max(0, self.page + step)
+        self._show_section()
+
+    def current(self) -> ConfigSection | None:
+        config = self.config
+        if config is None or not config.sections:
+            return None
+        return config.sections[min(self.section, len(config.sections) - 1)]
+
+    def shown_params(self) -> list[ConfigParam]:
+        """The current section's parameters the priority filter lets through (separators included)."""
+        s = self.current()
+        return [] if s is None else [p for p in s.params if p.priority <= self.show_up_to]
+
+    def _show_section(self) -> None:
+        section = self.current()
+        while (child := self.grid.get_first_child()) is not None:
+            self.grid.remove(child)
+        self.rows = {}
+        if section is None:
+            self.comment.set_text("This server's configuration is empty.")
+            return
+        self.comment.set_text(section.comment)
+        params = self.shown_params()
+        pages = max(1, math.ceil(len(params) / PAGE_SIZE))
+        self.page = min(self.page, pages - 1)
+        first = self.page * PAGE_SIZE
+        for i, p in enumerate(params[first : first + PAGE_SIZE]):
+            self._add_row(section, p, i)
+        hidden = len(section.params) - len(params)
+        info = f"{first + 1}–{min(first + PAGE_SIZE, len(params))} of {len(params)}" if params else "nothing"
+        if hidden:
+            info += f" ({hidden} above {PRIORITY_LABELS[self.show_up_to].lower()} hidden)"
+        self.page_label.set_text(info)
+        self.prev_button.set_sensitive(self.page > 0)
+        self.next_button.set_sensitive(self.page < pages - 1)
+        self.scroller.get_vadjustment().set_value(0)
+
+    def _add_row(self, section: ConfigSection, p: ConfigParam, row: int) -> None:
+        if p.kind is ParamType.SEPARATOR:
+            self.grid.attach(Gtk.Separator(), 0, row, 3, 1)
+            return
+        config = self.config
+        assert config is not None
+        key = (section.name, p.name)
+        left = Gtk.Box(orientation=Gtk.Orientation.VERTICAL)
+        name = Gtk.Label(label=p.name, xalign=0.0, wrap=True, max_width_chars=28)
+        left.append(name)
+        if p.description:
+            about = Gtk.Label(label=p.description, xalign=0.0, wrap=True, max_width_chars=40)
+            about.add_css_class("dim-label")
+            about.add_css_class("caption")
+            left.append(about)
+        left.set_hexpand(True)
+        self.grid.attach(left, 0, row, 1, 1)
+        editor = self._editor(p, key, config.editable(p))
+        self.grid.attach(editor, 1, row, 1, 1)
+        answer = Gtk.Label(xalign=0.0, wrap=True, max_width_chars=30)
+        self.grid.attach(answer, 2, row, 1, 1)
+        self.rows[key] = (p, editor, answer)
+        self._show_answer(key)
+
+    def _editor(self, p: ConfigParam, key: Key, editable: bool) -> Gtk.Widget:
+        text = self.edits.get(key, p.value_text())
+        widget: Gtk.Widget
+        if p.kind is ParamType.BOOL:
+            switch = Gtk.Switch(active=text.lower() in ("true", "1", "yes", "on"), halign=Gtk.Align.START)
+            switch.connect(
+                "notify::active", lambda s, _p: self._edited(key, "true" if s.get_active() else "false")
+            )
+            widget = switch
+        elif p.kind in (ParamType.INT, ParamType.DOUBLE):
+            lo = (
+                -SPIN_LIMIT
+                if p.minimum is None or not math.isfinite(p.minimum)
+                else max(p.minimum, -SPIN_LIMIT)
+            )
+            hi = (
+                SPIN_LIMIT
+                if p.maximum is None or not math.isfinite(p.maximum)
+                else min(p.maximum, SPIN_LIMIT)
+            )
+            digits = 0 if p.kind is ParamType.INT else (p.precision if 0 <= p.precision <= 6 else 3)
+            step = 1.0 if p.kind is ParamType.INT else 10.0**-digits
+            spin = Gtk.SpinButton.new_with_range(lo, max(lo, hi), step)
+            spin.set_digits(digits)
+            with contextlib.suppress(ValueError):
+                spin.set_value(float(text))
+            spin.connect("changed", lambda s: self._edited(key, s.get_text()))
+            widget = spin
+        elif p.kind is ParamType.STRING and p.choices:
+            choices = list(p.choices) + ([text] if text not in p.choices else [])
+            drop = Gtk.DropDown.new_from_strings(choices)
+            drop.set_selected(choices.index(text))
+            drop.connect("notify::selected", lambda d, _p: self._edited(key, choices[d.get_selected()]))
+            widget = drop
+        elif p.kind is ParamType.STRING:
+            entry = Gtk.Entry(text=text, width_chars=16)
+            entry.set_max_length(MAX_TEXT)
+            entry.connect("changed", lambda e: self._edited(key, e.get_text()))
+            widget = entry
+        else:
+            widget = Gtk.Label(label=f"list of {len(p.children)} (read-only here)", xalign=0.0)
+        if not editable:
+            widget.set_sensitive(False)
+            widget.set_tooltip_text("Read-only: above the priority this server lets you edit")
+        widget.set_valign(Gtk.Align.CENTER)
+        return widget
+
+    # -- edits, validation, answers ---------------------------------------------------------------
+    def _edited(self, key: Key, text: str) -> None:
+        found = self.rows.get(key)
+        if found is None:
+            return
+        param = found[0]
+        unchanged = text == param.value_text() or _same_number(param, text)
+        if unchanged and key not in self.edits:
+            return  # an editor re-showing the value (a spin button formats it): not an edit
+        if unchanged:
+            self.edits.pop(key, None)
+        elif self.edits.get(key) == text:
+            return
+        else:
+            self.edits[key] = text
+        self.answers.pop(key, None)
+        self._show_answer(key)
+        self._update_status()
+
+    def invalid_edits(self) -> dict[Key, str]:
+        """Edits that are certainly wrong: key → why."""
+        config = self.config
+        out: dict[Key, str] = {}
+        if config is None:
+            return out
+        for (section, name), text in self.edits.items():
+            p = config.find(section, name)
+            why = "no longer offered by the server" if p is None else check_value(p, text)
+            if why:
+                out[(section, name)] = why
+        return out
+
+    def _show_answer(self, key: Key) -> None:
+        found = self.rows.get(key)
+        if found is None:
+            return
+        param, _editor, label = found
+        for css in ("config-error", "config-ok", "config-edited"):
+            label.remove_css_class(css)
+        if key in self.edits and key not in self.answers:
+            why = check_value(param, self.edits[key])
+            label.set_text(f"✗ {why}" if why else "edited")
+            label.add_css_class("config-error" if why else "config-edited")
+        elif key in self.answers:
+            ok, text = self.answers[key]
+            label.set_text(text)
+            label.add_css_class("config-ok" if ok else "config-error")
+        else:
+            label.set_text("")
+
+    def _update_status(self) -> None:
+        config = self.config
+        if config is None:
+            return
+        bad = self.invalid_edits()
+        self.save_button.set_sensitive(bool(self.edits) and not bad and not self.saving)
+        parts = [f"{config.param_count} parameters"]
+        if config.cut:
+            parts.append(f"{config.cut} not shown (too many)")
+        if self.edits:
+            parts.append(f"{len(self.edits)} unsaved")
+        if bad:
+            parts.append(f"{len(bad)} invalid")
+        self.status.set_text(", ".join(parts))
+
+    def save(self) -> None:
+        """Send every edit in one ``setConfig``; the answer is shown next to each parameter."""
+        if not self.edits or self.invalid_edits() or self.saving:
+            return
+        sent = dict(self.edits)
+        changes: dict[str, dict[str, str]] = {}
+        for (section, name), text in sent.items():
+            changes.setdefault(section, {})[name] = text
+        self.saving = True
+        self._update_status()
+        self.status.set_text("Saving…")
+        self._save(changes).add_done_callback(lambda f: GLib.idle_add(self._saved, f, sent))
+
+    def _saved(self, future: concurrent.futures.Future[Any], sent: dict[Key, str]) -> bool:
+        if self.closed:
+            return False
+        self.saving = False
+        error = None if future.cancelled() else future.exception()
+        if future.cancelled() or error is not None:
+            for key in sent:
+                self.answers[key] = (False, f"✗ not saved: {error or 'cancelled'}")
+                self._show_answer(key)
+            self._update_status()
+            return False
+        answer: SetConfigReply = future.result()
+        if answer.accepted:
+            for key, text in sent.items():
+                if self.edits.get(key) == text:
+                    del self.edits[key]
+                self.answers[key] = (True, "✓ accepted")
+        else:
+            blamed = [k for k in sent if names_param(answer.error, *k)]
+            for key in sent:
+                if key in blamed:
+                    self.answers[key] = (False, f"✗ {answer.error}")
+                else:
+                    self.answers[key] = (False, "not saved: the server refused the set")
+            if not blamed:
+                self.banner.set_text(f"The server refused: {answer.error}")
+                self.banner.set_visible(True)
+        self.refresh()
+        return False
+
+
+def _same_number(p: ConfigParam, text: str) -> bool:
+    """A spin button's text for the value it started with ("2.00" for 2): not an edit."""
+    if p.kind not in (ParamType.INT, ParamType.DOUBLE) or not isinstance(p.value, (int, float)):
+        return False
+    try:
+        return float(text) == float(p.value)
+    except ValueError:
+        return False

@@ -1,0 +1,280 @@
+"""The server configuration page in the real window: open, edit with real keys, save, see the server's answer.
+
+Real window, real simulator, real X keys and clicks. What is checked is the simulator's own state
+after a save (its watchdog timeout), the answer drawn next to each parameter (its words, and its
+colour in the page's pixels), a change made by another client while an edit is pending, the
+priority filter, keys typed in the page not driving the robot, and a hostile configuration of
+10 000 parameters with markup in every text.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Iterator
+from pathlib import Path
+
+import numpy as np
+import pytest
+from PIL import Image
+
+from rtmu.client.config_feed import set_config
+from rtmu.client.connection import AriaClient
+from rtmu.sim import SimConfig, SimThread
+from rtmu.ui.config_page import PAGE_SIZE, ConfigPage
+
+from .harness import Gui, idle, pump, scratch_dir
+
+
+@pytest.fixture
+def sim() -> Iterator[SimThread]:
+    with SimThread(SimConfig(port=0, map_path=None, camera=False, seed=1)) as s:
+        yield s
+
+
+def page(gui: Gui) -> ConfigPage | None:
+    """The mapped configuration page of this test's window."""
+    from gi.repository import Gtk
+
+    return next(
+        (
+            w
+            for w in Gtk.Window.list_toplevels()
+            if isinstance(w, ConfigPage) and w.get_mapped() and w.get_transient_for() is gui.window
+        ),
+        None,
+    )
+
+
+def open_page(gui: Gui) -> ConfigPage:
+    labels = []
+    menu = gui.window.menu_model
+    for i in range(menu.get_n_items()):
+        section = menu.get_item_link(i, "section")
+        for j in range(section.get_n_items()):
+            sub = section.get_item_link(j, "submenu")
+            label = section.get_item_attribute_value(j, "label", None)
+            if sub is not None and label is not None and label.get_string() == "Server":
+                labels += [
+                    sub.get_item_attribute_value(k, "label", None).get_string()
+                    for k in range(sub.get_n_items())
+                ]
+    assert labels == ["Connection settings…", "Configuration…"]
+    gui.window.activate_action("win.server-config", None)
+    pump(lambda: page(gui) is not None, 5, "the configuration page")
+    p = page(gui)
+    assert p is not None and p.get_transient_for() is gui.window
+    pump(lambda: p.config is not None and bool(p.rows), 15, "the configuration to load")
+    return p
+
+
+def choose_section(gui: Gui, p: ConfigPage, name: str) -> None:
+    assert p.config is not None
+    index = [s.name for s in p.config.sections].index(name)
+    click(gui, p.sections.get_row_at_index(index))
+    pump(lambda: p.current() is not None and p.current().name == name, 3, f"section {name}")  # type: ignore[union-attr]
+
+
+def click(gui: Gui, widget) -> None:  # type: ignore[no-untyped-def]
+    """A real click, the pointer first moved onto the widget's window (a page's first press after the pointer
+    entered it is otherwise taken as the enter, under a bare X server)."""
+    from gi.repository import GdkX11
+
+    x, y = gui.centre_on_surface(widget)
+    xid = str(GdkX11.X11Surface.get_xid(widget.get_native().get_surface()))
+    gui.xdotool("mousemove", "--window", xid, str(x), str(y))
+    idle(0.15)
+    gui.click(widget)
+
+
+def type_into(gui: Gui, widget, text: str, leave: bool = True) -> None:  # type: ignore[no-untyped-def]
+    """Real keys into ``widget``: its window gets the X focus, the widget GTK's, then ctrl+a and the text."""
+    from gi.repository import GdkX11
+
+    root = widget.get_root()
+    gui.xdotool("windowfocus", "--sync", str(GdkX11.X11Surface.get_xid(root.get_surface())))
+    pump(root.is_active, 5, "the page to have the keyboard")
+    widget.grab_focus()
+    pump(lambda: _focus_in(root, widget), 3, "the editor to have the keys")
+    gui.key("ctrl+a")
+    gui.xdotool("type", "--delay", "40", text)
+    if leave:
+        gui.key("Tab")  # leave the field, as an operator does: a spin button takes its text then
+
+
+def labels(widget) -> list[tuple[str, bool]]:  # type: ignore[no-untyped-def]
+    """Every label under ``widget``: (its text, whether it is read as markup)."""
+    from gi.repository import Gtk
+
+    out = [(widget.get_text(), widget.get_use_markup())] if isinstance(widget, Gtk.Label) else []
+    child = widget.get_first_child()
+    while child is not None:
+        out += labels(child)
+        child = child.get_next_sibling()
+    return out
+
+
+def _focus_in(root, widget) -> bool:  # type: ignore[no-untyped-def]
+    focus = root.get_focus()
+    return focus is not None and (focus is widget or focus.is_ancestor(widget))
+
+
+def answer(p: ConfigPage, section: str, name: str) -> str:
+    return p.rows[(section, name)][2].get_text()
+
+
+def red_and_green(gui: Gui, widget) -> tuple[int, int]:  # type: ignore[no-untyped-def]
+    """Pixels of ``widget`` that are clearly red, clearly green (the page's error and success colours)."""
+    path = gui.render(widget, scratch_dir("config-") / "answer.png")
+    with Image.open(path) as img:
+        rgb = np.asarray(img.convert("RGB")).astype(int)
+    r, g, b = rgb[..., 0], rgb[..., 1], rgb[..., 2]
+    return int(((r > 150) & (r > g + 60) & (r > b + 60)).sum()), int(
+        ((g > 100) & (g > r + 40) & (g > b + 20)).sum()
+    )
+
+
+def test_edit_save_accepted_then_a_refused_value_shows_the_servers_error(gui: Gui, sim: SimThread) -> None:
+    p = open_page(gui)
+    assert [s.name for s in p.config.sections] == ["Teleop", "Robot config", "Camera", "Battery", "Wi-Fi"]  # type: ignore[union-attr]
+    gui.render(p, gui.shots / f"{gui.name}-opened.png")
+    _param, spin, _label = p.rows[("Teleop", "Timeout")]
+    type_into(gui, spin, "0.5")
+    pump(lambda: p.edits.get(("Teleop", "Timeout")) == "0.50", 3, "the edit to be noted")
+    assert answer(p, "Teleop", "Timeout") == "edited" and p.save_button.get_sensitive()
+    click(gui, p.save_button)
+    pump(lambda: answer(p, "Teleop", "Timeout") == "✓ accepted", 5, "the server to accept")
+    assert sim.call(lambda: sim.server.world.ratio_mode.timeout) == 0.5  # type: ignore[union-attr]
+    assert not p.edits and not p.save_button.get_sensitive()
+    red, green = red_and_green(gui, p.rows[("Teleop", "Timeout")][2])
+    assert green > 20 and red == 0
+    gui.render(p, gui.shots / f"{gui.name}-accepted.png")
+
+    _param, spin, _label = p.rows[("Teleop", "Timeout")]
+    type_into(gui, spin, "0.05")  # within the limits, refused by the server for its own reason
+    pump(lambda: p.edits.get(("Teleop", "Timeout")) == "0.05", 3, "the second edit")
+    click(gui, p.save_button)
+    expected = (
+        "✗ Teleop/Timeout: 0.05 s is shorter than the 0.1 s between ratioDrive commands (0 disables it)"
+    )
+    pump(lambda: answer(p, "Teleop", "Timeout") == expected, 5, "the server's refusal")
+    assert p.edits == {("Teleop", "Timeout"): "0.05"}  # the refused edit is kept, not lost
+    assert sim.call(lambda: sim.server.world.ratio_mode.timeout) == 0.5  # type: ignore[union-attr]
+    red, _green = red_and_green(gui, p.rows[("Teleop", "Timeout")][2])
+    assert red > 20
+    gui.render(p, gui.shots / f"{gui.name}-refused.png")
+    gui.shot("main-window-behind")
+
+
+def test_inline_validation_blocks_save_and_typing_never_drives(gui: Gui, sim: SimThread) -> None:
+    p = open_page(gui)
+    choose_section(gui, p, "Robot config")
+    _param, spin, _label = p.rows[("Robot config", "TransVelMax")]
+    type_into(gui, spin, "99999", leave=False)
+    pump(lambda: answer(p, "Robot config", "TransVelMax") == "✗ above the maximum of 1500", 3, "inline error")
+    assert not p.save_button.get_sensitive()
+    red, _green = red_and_green(gui, p.rows[("Robot config", "TransVelMax")][2])
+    assert red > 20
+    gui.render(p, gui.shots / f"{gui.name}-inline.png")
+    gui.key("Tab")  # the spin button clamps to its limit: the server's own value, nothing left to save
+    pump(lambda: not p.edits and answer(p, "Robot config", "TransVelMax") == "", 3, "the edit to go")
+    gui.key("Up", "Up", "w", "space")  # drive keys in the main window; here they only edit
+    idle(0.5)
+    robot = sim.call(lambda: (sim.server.robot.vel, sim.server.world.ratio_mode.trans_ratio))  # type: ignore[union-attr]
+    assert robot == (0, 0)
+    assert sim.call(lambda: sim.server.world.mode.NAME) != "ratioDrive"  # type: ignore[union-attr]
+    gui.key("Escape")
+    pump(lambda: page(gui) is None, 3, "Escape to close the page")
+    gui.shot("closed")
+
+
+def test_another_clients_change_refreshes_without_losing_an_edit(gui: Gui, sim: SimThread) -> None:
+    p = open_page(gui)
+    choose_section(gui, p, "Camera")
+    drop = p.rows[("Camera", "FrameSize")][1]
+    drop.set_selected(1)  # 640x480, unsaved
+    pump(lambda: p.edits.get(("Camera", "FrameSize")) == "640x480", 3, "the pending edit")
+    fetches = p.fetches
+
+    async def other() -> str:
+        client = AriaClient()
+        await client.connect("127.0.0.1", sim.port, timeout=5)
+        try:
+            reply = await set_config(
+                client, {"Camera": {"FrameSize": "320x240"}, "Teleop": {"Timeout": "3"}}, 5
+            )
+            return reply.error
+        finally:
+            await client.disconnect()
+
+    import asyncio
+
+    assert asyncio.run(other()) == ""
+    pump(lambda: p.fetches > fetches, 5, "the page to fetch again on configUpdated")
+    text = p.banner.get_text()
+    assert p.banner.get_visible() and "Another client changed Teleop/Timeout (now 3)" in text
+    assert p.edits == {("Camera", "FrameSize"): "640x480"}  # kept
+    assert p.rows[("Camera", "FrameSize")][1].get_selected() == 1
+    gui.render(p, gui.shots / f"{gui.name}-remote-change.png")
+    # now a change to the very value being edited: the banner says so
+    fetches = p.fetches
+
+    async def clash() -> str:
+        client = AriaClient()
+        await client.connect("127.0.0.1", sim.port, timeout=5)
+        try:
+            return (await set_config(client, {"Camera": {"FrameSize": "640x480"}}, 5)).error
+        finally:
+            await client.disconnect()
+
+    assert asyncio.run(clash()) == ""
+    pump(lambda: p.fetches > fetches, 5, "the second refresh")
+    assert "Camera/FrameSize (now 640x480)" in p.banner.get_text()
+    assert not p.edits  # the other client set exactly this value: nothing left to save
+    gui.shot("after-remote")
+
+
+def test_the_priority_filter_hides_expert_parameters(gui: Gui, sim: SimThread) -> None:
+    p = open_page(gui)
+    choose_section(gui, p, "Wi-Fi")
+    assert len(p.rows) == 3
+    p.priority.set_selected(0)  # Basic
+    pump(lambda: not p.rows, 3, "the expert parameters to be hidden")
+    assert "3 above basic hidden" in p.page_label.get_text()
+    gui.render(p, gui.shots / f"{gui.name}-basic.png")
+    choose_section(gui, p, "Robot config")
+    p.priority.set_selected(4)  # Factory: the serial number is shown, read-only
+    pump(lambda: ("Robot config", "SerialNumber") in p.rows, 3, "the factory parameter")
+    assert not p.rows[("Robot config", "SerialNumber")][1].get_sensitive()
+    gui.shot("factory")
+
+
+@pytest.fixture
+def hostile() -> Iterator[SimThread]:
+    with SimThread(SimConfig(port=0, map_path=None, camera=False, config_filler=10_000)) as s:
+        yield s
+
+
+def test_ten_thousand_parameters_with_markup_open_bounded_and_responsive(
+    screenshots: Path, hostile: SimThread
+) -> None:
+    gui = Gui.start(screenshots, "config-hostile", "127.0.0.1", hostile.port)
+    try:
+        p = open_page(gui)
+        assert p.config is not None and p.config.param_count == 10_011
+        choose_section(gui, p, "<b>Extra</b> & 0")
+        pump(lambda: len(p.rows) == PAGE_SIZE, 5, "one page of rows")
+        shown = labels(p.grid)
+        assert ("P0<i>&amp;", False) in shown and ("<u>filler</u> 0 & <big>text</big>", False) in shown
+        assert ("<b>7</b>", False) in shown  # a choice list's item, as the drop-down shows it
+        assert not any(markup for _text, markup in shown)
+        assert p.sections.get_row_at_index(5).get_child().get_text() == "<b>Extra</b> & 0"
+        assert p.comment.get_text() == "<i>filler</i> & <span foreground='red'>markup</span>"
+        ticks = gui.window.ticks
+        click(gui, p.next_button)
+        pump(lambda: p.page_label.get_text() == "61–120 of 800 (200 above expert hidden)", 5, "the next page")
+        idle(0.5)
+        assert gui.window.ticks > ticks  # the main loop kept running
+        assert len(p.rows) == PAGE_SIZE  # a page of widgets, whatever the size of the section
+        gui.render(p, gui.shots / "config-hostile-page2.png")
+        gui.shot("main-window")
+    finally:
+        gui.close()
