@@ -1,0 +1,234 @@
+"""Replay: a recording fed back through a fresh session (the live client code) rebuilds what was recorded.
+
+A real session records the simulator (map, pictures, a drive); the file is then read with
+RTMU's replay reader and played through a ``ClientRunner`` whose opener is the replayer —
+no socket, no simulator. The robot it rebuilds is held against the recording's own
+``/robot/pose`` channel (read with the ``mcap`` package), at the end and after seeks.
+"""
+
+from __future__ import annotations
+
+import struct
+import time
+from collections.abc import Callable
+from pathlib import Path
+
+import pytest
+
+from rtmu.client.runner import ClientRunner
+from rtmu.client.session import SessionConfig
+from rtmu.recorder import topics
+from rtmu.recorder.replay import PacedLink, ReplayClock, Replayer
+from rtmu.recorder.replay_file import ReplayFileError, compressed_image_data, load
+from rtmu.state import CameraChanged, MapChanged, MapPhase, RobotChanged, StateChange
+
+from .mcapread import read
+from .simsession import hold, recorded_session
+
+REPLAY_CONFIG = SessionConfig(ping_interval=3600.0, lost_after=3600.0, connect_timeout=3600.0)
+
+
+@pytest.fixture(scope="module")
+def recording(tmp_path_factory: pytest.TempPathFactory) -> Path:
+    directory = tmp_path_factory.mktemp("replay")
+    with recorded_session(directory) as (session, ui, _view, _sim):
+        ui.wait_for(lambda: session.state.map.value.state is MapPhase.READY, timeout=15)
+        for _ in range(2):
+            before = session.state.camera.value
+            session.controller.request_image()
+            ui.wait_for(lambda b=before: session.state.camera.value is not b, timeout=5)
+        hold(ui, session, "forward", 1.2)
+        hold(ui, session, "left", 0.8)
+        time.sleep(0.4)
+        ui.drain()
+    (path,) = directory.glob("*.mcap")
+    return path
+
+
+def poses(path: Path) -> list[tuple[int, tuple[float, float]]]:
+    """(log time, (x, y) in mm) of every recorded pose, from the PoseInFrame protobuf's position doubles."""
+    out = []
+    for m in read(path).topic(topics.POSE):
+        out.append((m.log_time, _position(m.data)))
+    return out
+
+
+def _position(pose_in_frame: bytes) -> tuple[float, float]:
+    # PoseInFrame.pose (3) → Pose.position (1) → Vector3 x (1), y (2) as doubles: found by their tags.
+    pose = _field(pose_in_frame, 3)
+    position = _field(pose, 1)
+    x = y = 0.0
+    i = 0
+    while i < len(position):
+        tag = position[i]
+        if tag in (0x09, 0x11, 0x19):
+            value = struct.unpack("<d", position[i + 1 : i + 9])[0]
+            if tag == 0x09:
+                x = value
+            elif tag == 0x11:
+                y = value
+            i += 9
+        else:
+            raise AssertionError(f"unexpected tag {tag}")
+    return round(x * 1000), round(y * 1000)
+
+
+def _field(message: bytes, number: int) -> bytes:
+    i = 0
+    while i < len(message):
+        key = message[i]
+        i += 1
+        wire = key & 7
+        if wire == 2:
+            size, shift = 0, 0
+            while True:
+                b = message[i]
+                i += 1
+                size |= (b & 0x7F) << shift
+                shift += 7
+                if not b & 0x80:
+                    break
+            if key >> 3 == number:
+                return message[i : i + size]
+            i += size
+        elif wire == 0:
+            while message[i] & 0x80:
+                i += 1
+            i += 1
+        elif wire == 1:
+            i += 8
+        elif wire == 5:
+            i += 4
+    return b""
+
+
+def replaying(path: Path) -> tuple[ClientRunner, Replayer, list[StateChange]]:
+    seen: list[StateChange] = []
+    recorded = load(path)
+    replayer = Replayer(recorded, publish=seen.append)
+    runner = ClientRunner(opener=replayer.open, config=REPLAY_CONFIG)
+    runner.on_publish = seen.append
+    runner.start()
+    return runner, replayer, seen
+
+
+def until(predicate: Callable[[], bool], timeout: float = 30.0) -> None:
+    end = time.monotonic() + timeout
+    while not predicate():
+        assert time.monotonic() < end, "timed out"
+        time.sleep(0.02)
+
+
+def last_pose(seen: list[StateChange]) -> tuple[float, float]:
+    robot = [c.value for c in seen if isinstance(c, RobotChanged)][-1]
+    return (round(robot.x), round(robot.y))
+
+
+def recorded_pose_at(path: Path, at_ns: int) -> tuple[float, float]:
+    """The pose the recording had at ``at_ns`` (a pose is logged just after the bytes that carried it)."""
+    before = [p for t, p in poses(path) if t <= at_ns + 20_000_000]
+    return before[-1]
+
+
+def test_a_replay_at_x8_ends_with_the_robot_where_the_recording_left_it(recording: Path) -> None:
+    runner, replayer, seen = replaying(recording)
+    try:
+        replayer.clock.set_speed(8.0)
+        replayer.clock.play()
+        runner.connect("replay", 0, auto_reconnect=False)
+        until(lambda: replayer.link is not None and replayer.link.exhausted)
+        runner.sync()
+        time.sleep(0.3)
+        recorded = poses(recording)
+        assert len({p for _, p in recorded}) > 5, "the recording saw the robot move"
+        link = replayer.link
+        assert isinstance(link, PacedLink) and link.refused == 0
+        assert last_pose(seen) == recorded_pose_at(recording, link.delivered_ns)
+        assert last_pose(seen) != (0, 0)
+        assert any(isinstance(c, MapChanged) and c.value.state is MapPhase.READY for c in seen)
+        assert sum(isinstance(c, CameraChanged) for c in seen) >= 1
+    finally:
+        runner.close()
+
+
+def test_seeking_back_rebuilds_from_the_start_and_forward_only_moves_the_clock(recording: Path) -> None:
+    runner, replayer, seen = replaying(recording)
+    clock = replayer.clock
+    try:
+        recorded = poses(recording)
+        middle = recorded[len(recorded) // 2][0]
+        clock.seek(clock.end_ns)  # forward: everything is due at once, paused
+        runner.connect("replay", 0, auto_reconnect=False)
+        until(lambda: replayer.link is not None and replayer.link.exhausted)
+        runner.sync()
+        end = replayer.link
+        assert end is not None
+        at_end = last_pose(seen)
+        assert at_end == recorded_pose_at(recording, end.delivered_ns)
+        assert replayer.seek_needs_rebuild(middle)
+        clock.seek(middle)
+        seen.clear()
+        runner.connect("replay", 0, auto_reconnect=False)  # backward: a new connection from the start
+        link = replayer.link
+        assert link is not None
+        chunks = replayer.recorded.chunks
+        due = sum(1 for c in chunks if c.at_ns <= middle)
+        until(lambda: link.position >= due)
+        time.sleep(0.3)
+        runner.sync()
+        assert link.position == due, "nothing after the seek point while paused"
+        assert replayer.opened == 2
+        assert last_pose(seen) == recorded_pose_at(recording, link.delivered_ns)
+        assert last_pose(seen) != at_end
+    finally:
+        runner.close()
+
+
+def test_a_replay_link_refuses_drive_packets_and_sends_nothing(recording: Path) -> None:
+    runner, replayer, _seen = replaying(recording)
+    try:
+        replayer.clock.seek(replayer.clock.end_ns)
+        runner.connect("replay", 0, auto_reconnect=False)
+        until(lambda: replayer.link is not None and replayer.link.exhausted)
+        link = replayer.link
+        assert link is not None
+        before = link.refused
+        runner.stop_and_wait(2.0)  # the session's own stop: zero ratios + stop → both refused
+        until(lambda: link.refused >= before + 2, timeout=5)
+    finally:
+        runner.close()
+
+
+def test_the_clock_plays_pauses_and_keeps_its_speed_within_bounds() -> None:
+    now = [100.0]
+    clock = ReplayClock(0, 10_000_000_000, clock=lambda: now[0])
+    assert clock.now_ns() == 0 and clock.due_in(1) is None
+    clock.set_speed(4.0)
+    clock.play()
+    now[0] += 1.0
+    assert clock.now_ns() == 4_000_000_000
+    assert clock.due_in(6_000_000_000) == pytest.approx(0.5)
+    clock.pause()
+    now[0] += 5.0
+    assert clock.now_ns() == 4_000_000_000
+    clock.seek(99_000_000_000)
+    assert clock.now_ns() == 10_000_000_000 and clock.finished
+    for bad in (0.1, 16.0):
+        with pytest.raises(ValueError, match="between"):
+            clock.set_speed(bad)
+
+
+def test_bad_files_are_refused_with_the_reason(tmp_path: Path, recording: Path) -> None:
+    junk = tmp_path / "junk.mcap"
+    junk.write_bytes(b"not an mcap at all" * 100)
+    with pytest.raises(ReplayFileError):
+        load(junk)
+    with pytest.raises(ReplayFileError, match="no connection 7"):
+        load(recording, conn=7)
+    cut = tmp_path / "cut.mcap"
+    data = recording.read_bytes()
+    cut.write_bytes(data[: len(data) * 2 // 3])
+    partial = load(cut)  # a file cut short by a crash replays up to its last complete chunk
+    assert 0 < len(partial.chunks) < len(load(recording).chunks)
+    assert compressed_image_data(b"\x12\xff\xff\xff\xff\x0f") is None  # a size that lies
+    assert compressed_image_data(b"\x12\x03abc") == b"abc"
