@@ -126,7 +126,9 @@ def last_pose(seen: list[StateChange]) -> tuple[float, float]:
 
 def recorded_pose_at(path: Path, at_ns: int) -> tuple[float, float]:
     """The pose the recording had at ``at_ns`` (a pose is logged just after the bytes that carried it)."""
-    before = [p for t, p in poses(path) if t <= at_ns + 20_000_000]
+    ended = [m.log_time for m in read(path).topic(topics.STOPS) if m.json()["reason"] == "disconnect"]
+    cut = min([at_ns + 20_000_000, *ended])  # the session's own reset as it disconnects is not the robot
+    before = [p for t, p in poses(path) if t < cut]
     return before[-1]
 
 
@@ -169,6 +171,7 @@ def test_seeking_back_rebuilds_from_the_start_and_forward_only_moves_the_clock(r
         clock.seek(middle)
         seen.clear()
         runner.connect("replay", 0, auto_reconnect=False)  # backward: a new connection from the start
+        until(lambda: replayer.opened == 2)
         link = replayer.link
         assert link is not None
         chunks = replayer.recorded.chunks
