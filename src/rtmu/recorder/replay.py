@@ -58,6 +58,10 @@ class ReplayClock:
     def playing(self) -> bool:
         return self._playing
 
+    def seconds(self) -> float:
+        """The replay's clock for a session: time stands still while paused, so nothing goes stale."""
+        return self.now_ns() / 1e9
+
     def now_ns(self) -> int:
         with self._lock:
             return self._now()
@@ -253,6 +257,14 @@ class Replayer:
                 )  # fmt: skip
                 self.publish(CameraChanged(image))
             index += 1
+
+    def status_age(self) -> float | None:
+        """Seconds of *recording* time since the last server bytes shown: a paused replay is not stale,
+        a gap the live link had is (the window's staleness checks use this instead of the wall clock)."""
+        link = self.link
+        if link is None or link.position == 0:
+            return None
+        return max(0.0, (self.clock.now_ns() - link.delivered_ns) / 1e9)
 
     def seek_needs_rebuild(self, at_ns: int) -> bool:
         """A seek to before what the current link has delivered has to start again from the beginning."""

@@ -303,6 +303,8 @@ class MainWindow(Gtk.ApplicationWindow):
         box.append(self.toolbar_revealer)
         box.append(outer)
         outer.set_vexpand(True)
+        self.body = box
+        """The window's column (bars above, the map/camera stack); a replay appends its controls."""
         self.set_child(box)
 
     def _osd(self) -> Gtk.Widget:
