@@ -52,6 +52,7 @@ from ..notices import Kind, Level, Notice  # noqa: E402
 from ..settings import Profile  # noqa: E402
 from .banners import BannerStack  # noqa: E402
 from .bars import FullscreenBar, connect_button, menu_button, show_connection, stop_button  # noqa: E402
+from .bridge_toggle import BridgeToggle  # noqa: E402
 from .camera import CameraInset, CameraView, PictureDecoder  # noqa: E402
 from .details import DetailsWindow  # noqa: E402
 from .dpad import DPad  # noqa: E402
@@ -110,6 +111,10 @@ def short_reason(reason: str) -> str:
     if reason.startswith(("this server does not offer", "this server offers no")):
         return "not offered by the server"
     return reason or "unavailable"
+
+
+def _unset(action: Gio.SimpleAction) -> None:
+    action.set_state(GLib.Variant.new_boolean(False))
 
 
 def _flag(action: Gio.SimpleAction) -> bool:
@@ -351,6 +356,7 @@ class MainWindow(Gtk.ApplicationWindow):
         view.append("Camera inset on the map", "win.inset")
         view.append("Sonar readings", "win.sonar")
         view.append("Robot details…", "win.details")
+        view.append("Foxglove bridge (ws://127.0.0.1:8765)", "win.foxglove")
         app = Gio.Menu()
         app.append("Connection settings…", "win.settings")
         app.append_submenu("View", view)
@@ -414,6 +420,9 @@ class MainWindow(Gtk.ApplicationWindow):
         self.inset_action = toggle("inset", True, self.inset.set_enabled)
         self.sonar_action = toggle("sonar", self.operator.view.value.show_sonar, self._set_sonar)
         self.safe_action = toggle("safe-drive", True, self._set_safe_drive)
+        self.foxglove = BridgeToggle(self.session, self.show_notice)  # publishing only, never drives
+        self.foxglove_action = toggle("foxglove", False, self.foxglove.set)
+        self.foxglove.failed = functools.partial(_unset, self.foxglove_action)  # a busy port: unchecked again
         self.connect("notify::fullscreened", self._fullscreen_changed)
 
     # -- the controller's View -----------------------------------------------------------------
@@ -891,3 +900,4 @@ class MainWindow(Gtk.ApplicationWindow):
         self.goals_panel.close()
         self.motion.close()
         self.decoder.close()
+        self.foxglove.close()
