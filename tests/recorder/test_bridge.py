@@ -18,7 +18,7 @@ from contextlib import contextmanager
 from rtmu.client.runner import ClientRunner
 from rtmu.client.session import SessionConfig
 from rtmu.recorder import topics
-from rtmu.recorder.bridge import Bridge, DriveLimits, twist_ratios
+from rtmu.recorder.bridge import LEASE_TTL, Bridge, DriveLimits, twist_ratios
 from rtmu.sim import SimConfig, SimThread
 from rtmu.state import ConnectionChanged, MapChanged, MapPhase, Phase, StateChange
 
@@ -31,7 +31,7 @@ from .simsession import ARENA
 def bridged(*, drive: bool) -> Iterator[tuple[SimThread, ClientRunner, Bridge, list[float]]]:
     """Simulator + session + bridge on a free port; the list gets the time of every stop the session sent."""
     with SimThread(SimConfig(port=0, map_path=ARENA, seed=3)) as sim:
-        runner = ClientRunner(config=SessionConfig())
+        runner = ClientRunner(config=SessionConfig(), lease_ttl=LEASE_TTL)
         bridge = Bridge(port=0, lease=runner.lease if drive else None)
         stops: list[float] = []
         ready: list[StateChange] = []
@@ -122,7 +122,7 @@ def test_with_allow_drive_a_10_hz_twist_stream_drives_and_its_end_stops_the_robo
             assert time.monotonic() < end, "the robot was never stopped"
             time.sleep(0.01)
         stopped_after = time.monotonic() - last
-        # The lease lives 300 ms; generous for a loaded machine (bench/bench_bridge.py has the figure).
+        # The bridge's lease lives 250 ms; generous for a loaded machine (bench/bench_bridge.py: the figure).
         assert stopped_after < 1.0, stopped_after
         assert stops and stops[-1] > last
         assert bridge.drive is not None and bridge.drive.received >= 10

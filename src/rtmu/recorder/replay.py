@@ -126,6 +126,8 @@ class PacedLink:
         """Counted client packets written so far (compared with each chunk's gate)."""
         self.refused = 0
         """Drive packets the client tried to send (none ever leave)."""
+        self.fallbacks = 0
+        """Chunks that went on after :data:`GATE_GRACE` without the client packet they waited for."""
         self.written = 0
         self.delivered_ns = recorded.start_ns
         """Recording time of the last chunk handed out."""
@@ -150,6 +152,7 @@ class PacedLink:
                 continue
             if self.counted + self._slack < chunk.gate and not await self._gate(chunk.gate):
                 self._slack = chunk.gate - self.counted  # a packet we do not send: go on without it
+                self.fallbacks += 1
             self.position += 1
             self.delivered_ns = chunk.at_ns
             await asyncio.sleep(0)  # let the client's tasks run between reads, as time did live

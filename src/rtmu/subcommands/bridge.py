@@ -23,7 +23,7 @@ from ..client.runner import ClientRunner
 from ..client.session import SessionConfig
 from ..exit_codes import EXIT_CONNECTION, EXIT_OK, EXIT_USAGE
 from ..notices import Notice
-from ..recorder.bridge import DEFAULT_PORT, Bridge, DriveLimits
+from ..recorder.bridge import DEFAULT_PORT, LEASE_TTL, Bridge, DriveLimits
 from ..textsafe import visible
 from ._common import UsageError, add_connection_arguments, fail, positive_float, read_password
 
@@ -73,7 +73,7 @@ def handle(args: argparse.Namespace) -> int:
         print(f"rtmu bridge: {visible(notice.text)}", file=sys.stderr)
 
     config = SessionConfig(connect_timeout=args.timeout, guardian=args.allow_drive)
-    runner = ClientRunner(config=config)
+    runner = ClientRunner(config=config, lease_ttl=LEASE_TTL)
     runner.on_notice = tell
     bridge = Bridge(
         host=args.bind,
