@@ -1,0 +1,62 @@
+"""``rtmu replay`` and ``rtmu bridge`` as processes: their refusals, and a bridge serving until SIGTERM."""
+
+from __future__ import annotations
+
+import re
+import signal
+import subprocess
+import sys
+from pathlib import Path
+
+from rtmu.recorder import topics
+from rtmu.sim import SimConfig, SimThread
+
+from .foxglove_client import FoxgloveClient
+from .simsession import ARENA
+
+RTMU = [sys.executable, "-m", "rtmu"]
+
+
+def rtmu(*args: str, timeout: float = 60) -> subprocess.CompletedProcess[str]:
+    return subprocess.run([*RTMU, *args], capture_output=True, text=True, timeout=timeout)
+
+
+def test_replay_refuses_a_file_it_cannot_replay_before_any_window(tmp_path: Path) -> None:
+    junk = tmp_path / "junk.mcap"
+    junk.write_bytes(b"\x89MCAP0\r\n" + b"\xff" * 64)
+    done = rtmu("replay", str(junk))
+    assert done.returncode == 3, done.stderr
+    assert "rtmu replay:" in done.stderr and "junk.mcap" in done.stderr
+    missing = rtmu("replay", str(tmp_path / "none.mcap"))
+    assert missing.returncode == 2 and "is not a file" in missing.stderr
+
+
+def test_bridge_refuses_bad_options() -> None:
+    assert rtmu("bridge", "127.0.0.1:1", "--foxglove", "--port", "70000").returncode == 2
+    assert rtmu("bridge", "127.0.0.1:1").returncode == 2  # --foxglove is the only kind there is
+    failed = rtmu("bridge", "127.0.0.1:1", "--foxglove", "--port", "0", "--timeout", "2")
+    assert failed.returncode == 3, failed.stderr
+
+
+def test_bridge_serves_poses_until_sigterm() -> None:
+    with SimThread(SimConfig(port=0, map_path=ARENA, seed=1)) as sim:
+        proc = subprocess.Popen(
+            [*RTMU, "bridge", f"127.0.0.1:{sim.port}", "--foxglove", "--port", "0"],
+            stderr=subprocess.PIPE,
+            text=True,
+        )
+        try:
+            assert proc.stderr is not None
+            line = proc.stderr.readline()
+            found = re.search(r"ws://127\.0\.0\.1:(\d+) \(no drive\)", line)
+            assert found, line
+            with FoxgloveClient(f"ws://127.0.0.1:{found.group(1)}") as client:
+                client.until(lambda: bool(client.server_info))
+                client.subscribe(topics.POSE, topics.STATUS)
+                client.until(lambda: bool(client.of(topics.STATUS)), 10)
+            proc.send_signal(signal.SIGTERM)
+            assert proc.wait(10) == 0
+        finally:
+            if proc.poll() is None:
+                proc.kill()
+                proc.wait(5)
