@@ -1,4 +1,4 @@
-"""``rtmu replay FILE.mcap [--conn N] [--speed X] [--paused]``: the window, showing a recording.
+"""``rtmu replay FILE.mcap [--conn N]``: the window, showing a recording (its first connection by default).
 
 The file is read first, headless, so a file that is no replayable recording gets its
 reason on stderr and exit 3 without a window. The window then rebuilds every part of the
@@ -25,6 +25,9 @@ def register(subparsers: Any) -> None:
         "Drive keys, the D-pad and STOP send nothing. Exit 3 if the file cannot be replayed.",
     )
     p.add_argument("file", type=Path, metavar="FILE.mcap", help="the recording")
+    p.add_argument(
+        "--conn", type=int, default=1, metavar="N", help="which connection of the file (default 1: the first)"
+    )
     p.add_argument("--fullscreen", action="store_true", help="start full screen (F11 toggles)")
     p.set_defaults(handler=handle)
 
@@ -34,7 +37,7 @@ def handle(args: argparse.Namespace) -> int:
     if not path.is_file():
         return fail("replay", f"{path} is not a file", EXIT_USAGE)
     try:
-        recorded = load(path)
+        recorded = load(path, args.conn)
     except ReplayFileError as exc:
         return fail("replay", str(exc), EXIT_CONNECTION)
     for warning in recorded.warnings:
@@ -42,5 +45,6 @@ def handle(args: argparse.Namespace) -> int:
     from ..ui import app as gui_app
 
     args.replay = path
+    args.replay_conn = args.conn
     args.no_connect = True
     return gui_app.run_gui(args)

@@ -57,6 +57,7 @@ def options_from_args(args: argparse.Namespace) -> GuiOptions:
         protocol=getattr(args, "protocol", None),
         guardian=not getattr(args, "no_guardian", False),
         replay=getattr(args, "replay", None),
+        replay_conn=getattr(args, "replay_conn", 1),
     )
 
 

@@ -131,7 +131,11 @@ class RtmuApplication(Gtk.Application):
             profile = replace(profile, protocol=self.options.protocol)
         # The guardian: a separate process that stops the robot if this one is killed or frozen.
         config = SessionConfig(guardian=self.options.guardian)
-        replay = open_replay(self.options.replay) if self.options.replay is not None else None
+        replay = (
+            open_replay(self.options.replay, self.options.replay_conn)
+            if self.options.replay is not None
+            else None
+        )
         if replay is not None:  # a recording: its own profile and config, not recorded again
             profile, auto_connect, config = replay_profile(replay.recorded.path), False, REPLAY_CONFIG
             self.options = replace(self.options, persist=False)

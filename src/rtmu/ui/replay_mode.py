@@ -29,9 +29,9 @@ REPLAY_CONFIG = SessionConfig(ping_interval=3600.0, lost_after=3600.0, connect_t
 """A recording has no live link to watch: no pings, no staleness by wall clock, no guardian."""
 
 
-def open_replay(path: Path) -> Replayer:
-    """The recording's first connection, ready to play (``ReplayFileError`` says why it cannot)."""
-    return Replayer(load(path))
+def open_replay(path: Path, conn: int = 1) -> Replayer:
+    """Connection ``conn`` of the recording, ready to play (``ReplayFileError`` says why it cannot)."""
+    return Replayer(load(path, conn))
 
 
 def replay_profile(path: Path) -> Profile:
@@ -62,7 +62,7 @@ def show_replay(window: MainWindow, session: RobotSession, replayer: Replayer) -
     window.body.append(bar)
     window.title_label.set_text("RTMU — REPLAY")
     more = replayer.recorded.connections
-    extra = f" (connection 1 of {more})" if more > 1 else ""
+    extra = f" (connection {replayer.recorded.conn} of {more}; --conn N picks another)" if more > 1 else ""
     window.banners.tell(
         "replay", "info", f"Replay of {name}{extra}: nothing is sent to any robot", timeout=6.0
     )
