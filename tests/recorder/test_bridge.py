@@ -15,10 +15,11 @@ import time
 from collections.abc import Iterator
 from contextlib import contextmanager
 
+from rtmu.client.lease import DriveLease, EndReason
 from rtmu.client.runner import ClientRunner
 from rtmu.client.session import SessionConfig
 from rtmu.recorder import topics
-from rtmu.recorder.bridge import LEASE_TTL, Bridge, DriveLimits, twist_ratios
+from rtmu.recorder.bridge import LEASE_TTL, Bridge, DriveLimits, TwistDrive, twist_ratios
 from rtmu.sim import SimConfig, SimThread
 from rtmu.state import ConnectionChanged, MapChanged, MapPhase, Phase, StateChange
 
@@ -153,3 +154,40 @@ def test_twist_ratios_are_bounded_and_refuse_what_is_no_twist() -> None:
     assert twist_ratios(b'{"linear": {"x": Infinity}}', limits) is None
     assert twist_ratios(b"[" * 100_000, limits) is None
     assert twist_ratios(b'{"linear": 3}', limits) is None
+
+
+class Manual:
+    def __init__(self) -> None:
+        self.now = 100.0
+
+    def __call__(self) -> float:
+        return self.now
+
+
+def test_the_drive_rules_two_quick_messages_start_a_gap_ends_a_stop_needs_a_pause() -> None:
+    clock = Manual()
+    lease = DriveLease(ttl=LEASE_TTL, clock=clock)
+    drive = TwistDrive(lease, DriveLimits(), clock=clock)
+
+    def send(dt: float, linear: float = 0.5) -> bool:
+        clock.now += dt
+        drive.message(twist(linear))
+        return lease.view().live
+
+    assert not send(0.0), "one message alone never drives"
+    assert send(0.1), "the second within 200 ms does"
+    assert send(0.1) and send(0.19)
+    assert not send(0.25), "a gap over 200 ms ends the drive"
+    assert send(0.1), "a quick pair starts it again"
+    assert not send(0.1, 0.0), "a zero Twist stops at once"
+    assert send(0.1), "a live stream after a zero Twist is a fresh press"
+    lease.end(EndReason.STOPPED)  # STOP, a stale link…: not the stream's doing
+    assert not send(0.1) and not send(0.1), "the stream must pause before it drives again"
+    assert not send(0.3) and send(0.1)
+    generation = lease.view().generation
+    for _ in range(500):  # a flood: renewals only, no new grant, no ratio change faster than 50 Hz
+        send(0.001, 0.9)
+    view = lease.view()
+    assert view.live and view.generation == generation
+    drive.stop()
+    assert not lease.view().live

@@ -44,6 +44,9 @@ MAX_GAP = 0.2
 LEASE_TTL = 0.25
 """The drive lease of a bridge's session (``ClientRunner(lease_ttl=…)``): a stream that ends stops
 the robot this long after its last message — under 300 ms with the stop's way to the robot."""
+MIN_INTERVAL = 0.02
+"""Drive messages closer than this (over 50 Hz) only keep the drive alive: a flood cannot make the
+session send ``ratioDrive`` faster than that."""
 MAX_DRIVE_MESSAGE = 4096
 DRIVE_TOPICS = frozenset({"/cmd_vel"})
 TWIST_SCHEMAS = frozenset({"geometry_msgs/Twist", "geometry_msgs/msg/Twist"})
@@ -111,7 +114,10 @@ class TwistDrive:
                 self._end(EndReason.RELEASED)
                 return
             if self._generation is not None:
-                if gap <= MAX_GAP and self.lease.change(ratios):
+                same = ratios == self.lease.view(now).ratios
+                if gap <= MAX_GAP and (
+                    self.lease.renew() if same or gap < MIN_INTERVAL else self.lease.change(ratios)
+                ):
                     return
                 if self.lease.ended not in (None, EndReason.LAPSED):
                     self._blocked = True  # a stop or the link ended it, not the stream
