@@ -122,7 +122,24 @@ def test_replay_draws_the_recorded_robot_pauses_scrubs_and_never_drives(
         assert not gui.window.controller.held
         lease = gui.app.fleet.selected.value.runner.lease  # type: ignore[union-attr]
         assert lease.view(time.monotonic()).generation == 0, "no drive lease was ever granted"
+        window = gui.window
+        window.activate_action("win.dpad", None)
+        pump(lambda: window.dpad.get_visible() and window.dpad.get_mapped(), 3, "the D-pad")
+        banners.dismiss_all()
+        x, y = gui.centre_on_surface(window.dpad.pads["drive_forward"])  # pressed all the same
+        gui.xdotool(
+            "mousemove", "--window", xid, str(x), str(y), "mousedown", "1", "sleep", "0.4", "mouseup", "1"
+        )
+        pad = window.dpad.pads["drive_forward"]
+        assert not pad.get_sensitive() and "Replay" in (pad.get_tooltip_text() or "")  # greyed, saying why
+        assert lease.view(time.monotonic()).generation == 0
         assert (back.written, back.refused) == (written, refused), "the replay link saw no write at all"
         gui.shot("replay-drive-refused")
+
+        # One step on (a real click): only the clock moves, no rebuild; the next second is shown.
+        before = back.position
+        gui.click(bar.forward)
+        pump(lambda: back.position > before, 5, "the next second to be shown")
+        assert replayer.opened == 2 and not bar.clock.playing
     finally:
         gui.close()
