@@ -16,8 +16,10 @@ import pytest
 
 from rtmu.client.runner import ClientRunner
 from rtmu.client.session import SessionConfig
+from rtmu.recorder import Recorder, RecorderConfig
 from rtmu.recorder.replay import PacedLink, ReplayClock, Replayer
 from rtmu.recorder.replay_file import ReplayFileError, compressed_image_data, load
+from rtmu.sim import SimConfig, SimThread
 from rtmu.state import CameraChanged, MapChanged, MapPhase, RobotChanged, StateChange
 
 from .poses import poses, recorded_pose_at
@@ -168,3 +170,38 @@ def test_bad_files_are_refused_with_the_reason(tmp_path: Path, recording: Path) 
     assert 0 < len(partial.chunks) < len(load(recording).chunks)
     assert compressed_image_data(b"\x12\xff\xff\xff\xff\x0f") is None  # a size that lies
     assert compressed_image_data(b"\x12\x03abc") == b"abc"
+
+
+def test_a_recording_with_two_connections_replays_the_one_asked_for(tmp_path: Path) -> None:
+    out = tmp_path / "two.mcap"
+    recorder = Recorder(RecorderConfig(tmp_path, path=out))
+    with SimThread(SimConfig(port=0, seed=1)) as sim:
+        runner = ClientRunner(config=SessionConfig(fetch_map=False), opener=recorder.opener())
+        recorder.attach(runner)
+        with runner:
+            runner.connect("127.0.0.1", sim.port).result(10)
+            until(lambda: runner.session is not None and runner.session.client is not None
+                  and runner.session.client.packets_received >= 5)  # fmt: skip
+            sim.call(lambda: sim.server.world.ratio_drive(50.0, 0.0, 50.0))  # type: ignore[union-attr]
+            time.sleep(1.0)  # the second connection starts with the robot elsewhere
+            runner.connect("127.0.0.1", sim.port).result(10)
+            until(lambda: runner.session is not None and runner.session.client is not None
+                  and runner.session.client.packets_received >= 5)  # fmt: skip
+            time.sleep(0.3)
+        recorder.close()
+    first, second = load(out), load(out, 2)
+    assert first.connections == second.connections == 2
+    assert first.chunks[0].at_ns < first.end_ns <= second.chunks[0].at_ns
+    for recorded in (first, second):
+        replayer = Replayer(recorded)
+        seen: list[StateChange] = []
+        runner = ClientRunner(opener=replayer.open, config=REPLAY_CONFIG, clock=replayer.clock.seconds)
+        runner.on_publish = seen.append
+        with runner:
+            replayer.clock.seek(replayer.clock.end_ns)
+            runner.connect("replay", 0, auto_reconnect=False)
+            until(lambda r=replayer: r.link is not None and r.link.exhausted)
+            runner.sync()
+        assert any(isinstance(c, RobotChanged) for c in seen)
+    with pytest.raises(ReplayFileError, match="2 connection"):
+        load(out, 3)
