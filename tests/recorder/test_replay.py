@@ -205,3 +205,17 @@ def test_a_recording_with_two_connections_replays_the_one_asked_for(tmp_path: Pa
         assert any(isinstance(c, RobotChanged) for c in seen)
     with pytest.raises(ReplayFileError, match="2 connection"):
         load(out, 3)
+
+
+def test_what_a_replay_keeps_in_memory_is_bounded(recording: Path, monkeypatch: pytest.MonkeyPatch) -> None:
+    from rtmu.recorder import replay_file
+
+    full = load(recording)
+    assert len(full.images) >= 2
+    monkeypatch.setattr(replay_file, "MAX_IMAGE_BYTES", len(full.images[0][1]) + 1)
+    thinned = load(recording)
+    assert len(thinned.images) < len(full.images)
+    assert any("thinned" in w for w in thinned.warnings)
+    monkeypatch.setattr(replay_file, "MAX_REPLAY_BYTES", 10_000)
+    with pytest.raises(ReplayFileError, match="too long to replay"):
+        load(recording)

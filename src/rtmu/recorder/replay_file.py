@@ -39,6 +39,10 @@ NOT_REPLAYED = frozenset(
 MOTION = frozenset({"ratioDrive", "gotoGoal", "gotoPose", "gotoRouteGoal", "home", "dock", "tourGoals"})
 """What a replay link refuses outright (a replay never drives)."""
 MAX_IMAGE = 16 * 1024 * 1024
+MAX_REPLAY_BYTES = 512 * 1024 * 1024
+"""Server bytes of one connection a replay keeps in memory (hours of status and sonar)."""
+MAX_IMAGE_BYTES = 256 * 1024 * 1024
+"""Camera pictures a replay keeps in memory; beyond it every other one is left out (and it says so)."""
 
 
 class ReplayFileError(Exception):
@@ -90,18 +94,32 @@ class RecordedConnection:
 def load(path: Path, conn: int | None = None) -> RecordedConnection:
     """Connection ``conn`` (default: the first) of the recording at ``path``; ReplayFileError if none."""
     stats = CaptureStats()
+    index = 1 if conn is None else conn
+    flows: list[int] = []
+    mine: list[StreamData] = []
+    size = 0
     try:
-        events = list(recorded_events(path, stats))
+        for event in recorded_events(path, stats):
+            if not isinstance(event, StreamData):
+                continue
+            if event.flow.id not in flows:
+                flows.append(event.flow.id)
+            if len(flows) >= index and event.flow.id == flows[index - 1]:
+                size += len(event.data)
+                if size > MAX_REPLAY_BYTES:
+                    raise ReplayFileError(
+                        f"connection {index} of {path.name} holds over {MAX_REPLAY_BYTES >> 20} MB of "
+                        "ArNetworking bytes: too long to replay in one piece"
+                    )
+                mine.append(event)
+    except ReplayFileError:
+        raise
     except Exception as exc:
         raise ReplayFileError(str(exc)) from None
-    flows = sorted({e.flow.id for e in events if isinstance(e, StreamData)})
     if not flows:
         raise ReplayFileError(f"{path.name} holds no recorded ArNetworking bytes to replay")
-    index = 1 if conn is None else conn
-    if not 1 <= index <= len(flows):
+    if not mine:
         raise ReplayFileError(f"{path.name} holds {len(flows)} connection(s); there is no connection {index}")
-    flow_id = flows[index - 1]
-    mine = [e for e in events if isinstance(e, StreamData) and e.flow.id == flow_id]
     names: dict[int, str | None] = {}
     for item in CaptureDecoder(decode_payloads=False).run(iter(mine)):
         if isinstance(item, DecodedPacket) and item.direction == C2S:
@@ -128,8 +146,27 @@ def load(path: Path, conn: int | None = None) -> RecordedConnection:
             recorded.chunks.append(ServerChunk(_ns(event.time), event.data, count))
         else:
             count += recorded.counted(event.data, decoder)
-    recorded.images = list(_images(path, index, recorded.start_ns, recorded.end_ns))
+    recorded.images = _bounded(_images(path, index, recorded.start_ns, recorded.end_ns), recorded.warnings)
     return recorded
+
+
+def _bounded(pictures: Iterator[tuple[int, bytes]], warnings: list[str]) -> list[tuple[int, bytes]]:
+    """The pictures, thinned to one in 2, 4, 8 … whenever they outgrow :data:`MAX_IMAGE_BYTES`."""
+    kept: list[tuple[int, bytes]] = []
+    total = 0
+    stride = 1
+    for n, (at, jpeg) in enumerate(pictures):
+        if n % stride:
+            continue
+        kept.append((at, jpeg))
+        total += len(jpeg)
+        while total > MAX_IMAGE_BYTES and len(kept) > 1:
+            kept = kept[::2]
+            total = sum(len(j) for _, j in kept)
+            stride *= 2
+    if stride > 1:
+        warnings.append(f"camera pictures thinned to 1 in {stride} to fit in memory")
+    return kept
 
 
 def _ns(seconds: float | None) -> int:
