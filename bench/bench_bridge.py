@@ -10,7 +10,7 @@ channel the bridge advertises.
   with the bridge and a subscribed client — baseline: the same without the bridge.
 * ``bridge.stop_after_stream_ms_p50`` / ``_max``: ``--allow-drive``: a 10 Hz Twist stream
   drives, then stops; from its last message to the simulator's robot having zero ratios
-  (the bridge's lease lives 250 ms; 10 trials).
+  (the bridge's lease lives 220 ms; 10 trials).
 """
 
 from __future__ import annotations

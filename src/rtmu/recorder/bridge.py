@@ -10,7 +10,7 @@ Driving (``allow_drive``) is off unless asked for; without it the server does no
 advertise the client-publish capability. With it, ``geometry_msgs/Twist``-shaped JSON on
 a client channel (Foxglove's Teleop panel: ``/cmd_vel``) drives through the session's own
 :class:`~rtmu.client.lease.DriveLease` — :class:`TwistDrive` holds the rules: motion only
-while messages keep coming at 5 Hz or more, the lease (250 ms) lapses and the session stops
+while messages keep coming at 5 Hz or more, the lease (220 ms) lapses and the session stops
 the robot when they cease, and a lease ended by anything else (a stale link, a stop) needs
 a pause in the stream before the same stream can drive again.
 """
@@ -41,7 +41,7 @@ DEFAULT_PORT = 8765
 QUEUE_SIZE = 1024
 MAX_GAP = 0.2
 """Seconds between drive messages above which the stream no longer drives (5 Hz)."""
-LEASE_TTL = 0.25
+LEASE_TTL = 0.22
 """The drive lease of a bridge's session (``ClientRunner(lease_ttl=…)``): a stream that ends stops
 the robot this long after its last message — under 300 ms with the stop's way to the robot."""
 MIN_INTERVAL = 0.02
