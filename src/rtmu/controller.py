@@ -430,6 +430,9 @@ class Controller:
 
     def goto_goal(self, name: str) -> None:
         """Send the robot to the map's goal ``name``: ``gotoGoal``, else an LD robot's ``gotoRouteGoal``."""
+        if self.replay:
+            self._say_replay()
+            return
         goals = self.robot.navigation.value.goals
         if goals and name not in goals:
             self.view.notify(Notice.warning(Kind.NAVIGATION, f"This map has no goal called {name!r}"))
