@@ -19,9 +19,9 @@ from rtmu.client.lease import DriveLease, EndReason
 from rtmu.client.runner import ClientRunner
 from rtmu.client.session import SessionConfig
 from rtmu.recorder import topics
-from rtmu.recorder.bridge import LEASE_TTL, Bridge, DriveLimits, TwistDrive, twist_ratios
+from rtmu.recorder.bridge import LEASE_TTL, QUEUE_SIZE, Bridge, DriveLimits, TwistDrive, twist_ratios
 from rtmu.sim import SimConfig, SimThread
-from rtmu.state import ConnectionChanged, MapChanged, MapPhase, Phase, StateChange
+from rtmu.state import ConnectionChanged, MapChanged, MapPhase, Phase, RobotChanged, RobotState, StateChange
 
 from .foxglove_client import FoxgloveClient, twist
 from .poses import _position
@@ -191,3 +191,17 @@ def test_the_drive_rules_two_quick_messages_start_a_gap_ends_a_stop_needs_a_paus
     assert view.live and view.generation == generation
     drive.stop()
     assert not lease.view().live
+
+
+def test_a_flood_of_updates_is_dropped_and_counted_never_queued_without_bound() -> None:
+    bridge = Bridge(port=0).start()
+    try:
+        for i in range(20_000):  # far faster than any session publishes
+            bridge.published(RobotChanged(RobotState(x=float(i), y=0.0, th=0.0, numbers_at=1.0)))
+        assert bridge._queue.qsize() <= QUEUE_SIZE and bridge.dropped > 0
+        end = time.monotonic() + 20
+        while bridge._queue.qsize() and time.monotonic() < end:
+            time.sleep(0.05)
+        assert bridge.dropped + bridge.published_messages >= 20_000
+    finally:
+        bridge.close()

@@ -17,6 +17,7 @@ a pause in the stream before the same stream can drive again.
 
 from __future__ import annotations
 
+import contextlib
 import json
 import math
 import queue
@@ -247,8 +248,9 @@ class Bridge:
         try:
             self._queue.put_nowait(item)
         except queue.Full:
-            if force:
-                self._queue.put(item, timeout=1.0)
+            if force:  # the end: wait a little for room, then leave the worker to the daemon thread's fate
+                with contextlib.suppress(queue.Full):
+                    self._queue.put(item, timeout=1.0)
             else:
                 self.dropped += 1
 
