@@ -138,6 +138,9 @@ class SecretStore(Protocol):
     def get(self, profile: Profile) -> str | None: ...
 
 
+REPLAY_REASON = "Replay — nothing is sent to a robot"
+
+
 def ratios_for(held: set[str] | frozenset[str], throttle: float) -> DriveRatios:
     """The ``ratioDrive`` for a set of held directions (empty or cancelling → zero motion)."""
     trans = 100.0 * (("forward" in held) - ("backward" in held))
@@ -201,6 +204,9 @@ class Controller:
         """Between focus loss and the next key press: releases seen then are not real key-ups."""
         self._nav_cancelled = False
         """We sent the stop that ends the current navigation; the server has not said so yet."""
+        self.replay: str | None = None
+        """Set to the recording's name while the window shows a replay: then nothing is sent at all
+        (drive keys, D-pad, STOP and every server command say "replay"), and no lease is granted."""
         link.on_notice = self._on_link_notice
         self._unobserve = [
             robot.connection.observe(self._on_connection),
@@ -241,7 +247,7 @@ class Controller:
     def run(self, name: str) -> bool:
         """Run (or, for hold commands, press) command ``name``; False if it is disabled."""
         cmd = self.registry.get(name)
-        reason = cmd.unavailable(self)
+        reason = REPLAY_REASON if self.replay and cmd.needs_connection else cmd.unavailable(self)
         if reason is not None:
             self.view.notify(Notice.warning(Kind.COMMAND, f"{cmd.label}: {reason}"))
             return False
@@ -260,6 +266,9 @@ class Controller:
     def refresh_commands(self) -> None:
         """Recompute every command's state and tell the view about those that changed."""
         states = self.registry.states(self)
+        if self.replay:  # a replay sends nothing: every command that would is shown disabled, saying why
+            off = CommandState(False, REPLAY_REASON)
+            states = {k: off if self.registry.get(k).needs_connection else v for k, v in states.items()}
         changed = {k: v for k, v in states.items() if self._states.get(k) != v}
         self._states = states
         if changed:
@@ -276,6 +285,10 @@ class Controller:
         self._unfocused = False  # key presses reach a focused window only
         if direction in self._held or direction in self._blocked:
             return  # key auto-repeat, or a key held through a stop: wait for its release
+        if self.replay:
+            self._blocked.add(direction)
+            self._say_replay()
+            return
         if not self.connected or not self.supports("ratioDrive"):
             self._blocked.add(direction)
             return
@@ -336,7 +349,12 @@ class Controller:
     def stop(self) -> None:
         """Stop now. Always sent, whatever the link looks like; held keys must be pressed again.
 
-        Also ends a navigation: the server's ``stop`` mode takes over from its goal."""
+        Also ends a navigation: the server's ``stop`` mode takes over from its goal. A replay has no
+        robot to stop: it says so and sends nothing."""
+        if self.replay:
+            self._halt_held(EndReason.STOPPED)
+            self._say_replay()
+            return
         if self.navigating:
             self._nav_cancelled = True
         self._halt_held(EndReason.STOPPED)
@@ -412,6 +430,9 @@ class Controller:
 
     def goto_goal(self, name: str) -> None:
         """Send the robot to the map's goal ``name``: ``gotoGoal``, else an LD robot's ``gotoRouteGoal``."""
+        if self.replay:
+            self._say_replay()
+            return
         goals = self.robot.navigation.value.goals
         if goals and name not in goals:
             self.view.notify(Notice.warning(Kind.NAVIGATION, f"This map has no goal called {name!r}"))
@@ -457,7 +478,13 @@ class Controller:
         if not new.navigating or (old.navigating and new.target != old.target):
             self._nav_cancelled = False  # it ended (or someone sent it elsewhere): keys drive again
 
+    def _say_replay(self) -> None:
+        self.view.notify(Notice.warning(Kind.SAFETY, f"{REPLAY_REASON}: {self.replay}"))
+
     def _require(self, name: str) -> bool:
+        if self.replay:
+            self._say_replay()
+            return False
         if not self.connected:
             self.view.notify(Notice.warning(Kind.COMMAND, "Not connected"))
             return False

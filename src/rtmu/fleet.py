@@ -23,6 +23,7 @@ from collections.abc import Callable
 from pathlib import Path
 from typing import Any, cast
 
+from .client.link import Opener, open_tcp
 from .client.runner import ClientRunner, Post, call_directly, settle
 from .client.session import SessionConfig
 from .commands import COMMANDS, CommandRegistry
@@ -53,11 +54,13 @@ class RobotSession:
         clock: Callable[[], float] = time.monotonic,
         registry: CommandRegistry = COMMANDS,
         recording: RecordingSettings | None = None,
+        opener: Opener | None = None,
     ) -> None:
         self.state = RobotModel()
         self.recorder = recorder_for(recording)
         """This robot's flight recorder (None when recording is off: the default outside the window)."""
-        opener = self.recorder.opener() if self.recorder is not None else None
+        if self.recorder is not None:  # ``opener``: where the links come from (a replay's recording)
+            opener = self.recorder.opener(opener or open_tcp)
         self.runner = ClientRunner(self.state, post=post, clock=clock, config=config, opener=opener)
         link: ClientLink = self.runner
         if self.recorder is not None:

@@ -47,9 +47,22 @@ MAY_IMPORT: dict[str, frozenset[str]] = {
     "settings": frozenset({"base"}),
     "control": frozenset({"client", "ui-state", "values", "settings", "base"}),
     "fleet": frozenset({"control", "client", "recorder", "ui-state", "values", "settings", "base"}),
-    # The window may start the bundled simulator (--demo); it never reaches the command line.
+    # The window may start the bundled simulator (--demo) and play a recording back (rtmu replay: the
+    # recorder's clock and feeder); it never reaches the command line.
     "view": frozenset(
-        {"fleet", "control", "client", "ui-state", "values", "settings", "simulator", "maps", "codec", "base"}
+        {
+            "fleet",
+            "control",
+            "client",
+            "recorder",
+            "ui-state",
+            "values",
+            "settings",
+            "simulator",
+            "maps",
+            "codec",
+            "base",
+        }
     ),
     "entry": frozenset(LAYERS),
 }

@@ -362,3 +362,22 @@ def test_disconnect_is_enabled_whenever_there_is_something_to_cancel(phase: Phas
     assert rig.ctl.command_states()["disconnect"].enabled is enabled
     assert rig.ctl.run("disconnect") is enabled
     assert ("disconnect" in rig.link.names()) is enabled
+
+
+def test_in_replay_mode_nothing_is_sent_and_every_way_in_says_replay() -> None:
+    rig = Rig()
+    rig.ctl.replay = "lab.mcap"
+    rig.ctl.refresh_commands()
+    states = rig.view.states
+    assert not states["drive_forward"].enabled and "Replay" in states["drive_forward"].reason
+    assert not states["stop"].enabled and not states["request_image"].enabled
+    assert states["speed_up"].enabled  # what sends nothing still works
+    rig.ctl.press("forward")
+    assert rig.ctl.run("drive_forward") is False
+    rig.ctl.stop()
+    rig.ctl.turn_by(90)
+    rig.ctl.set_safe_drive(False)
+    rig.ctl.goto_goal("Lab")
+    rig.ctl.localize(0, 0, 0)
+    assert rig.link.calls == [] and rig.lease.generation == 0
+    assert sum("Replay" in t for t in rig.view.texts()) >= 6

@@ -56,6 +56,8 @@ def options_from_args(args: argparse.Namespace) -> GuiOptions:
         report_first_frame=bool(getattr(args, "report_first_frame", False)),
         protocol=getattr(args, "protocol", None),
         guardian=not getattr(args, "no_guardian", False),
+        replay=getattr(args, "replay", None),
+        replay_conn=getattr(args, "replay_conn", 1),
     )
 
 

@@ -14,6 +14,7 @@ import os
 import signal
 import sys
 import threading
+import time
 from collections.abc import Callable
 from dataclasses import replace
 from types import FrameType
@@ -36,6 +37,8 @@ from ..settings import (  # noqa: E402
 )
 from .keys import accels_for  # noqa: E402
 from .options import APP_ID, GuiOptions  # noqa: E402
+from .replay_bar import ReplayBar  # noqa: E402
+from .replay_mode import REPLAY_CONFIG, open_replay, replay_profile, show_replay  # noqa: E402
 from .style import install_css  # noqa: E402
 from .window import MainWindow  # noqa: E402
 
@@ -88,6 +91,8 @@ class RtmuApplication(Gtk.Application):
         self._signal_sources: list[int] = []
         self._old_handlers: dict[int, Callable[[int, FrameType | None], object] | int | None] = {}
         self._old_sigtstp: Callable[[int, FrameType | None], object] | int | None = None
+        self.replay_bar: ReplayBar | None = None
+        """The replay's controls (``rtmu replay``), None for a robot."""
         self.suspensions = 0
         """Times the process was suspended (Ctrl+Z) and resumed."""
 
@@ -126,12 +131,22 @@ class RtmuApplication(Gtk.Application):
             profile = replace(profile, protocol=self.options.protocol)
         # The guardian: a separate process that stops the robot if this one is killed or frozen.
         config = SessionConfig(guardian=self.options.guardian)
+        replay = (
+            open_replay(self.options.replay, self.options.replay_conn)
+            if self.options.replay is not None
+            else None
+        )
+        if replay is not None:  # a recording: its own profile and config, not recorded again
+            profile, auto_connect, config = replay_profile(replay.recorded.path), False, REPLAY_CONFIG
+            self.options = replace(self.options, persist=False)
         session = self.fleet.open(
             post=GLib.idle_add,
             config=config,
             profile=profile,
             secrets=self.secrets,
-            recording=self.settings.recording,
+            recording=None if replay is not None else self.settings.recording,
+            opener=None if replay is None else replay.open,
+            clock=time.monotonic if replay is None else replay.clock.seconds,  # a replay runs on its own time
         )
         try:
             window = MainWindow(
@@ -159,7 +174,9 @@ class RtmuApplication(Gtk.Application):
         window.present()
         if loaded.warning:
             window.banners.tell("notice:settings", "warning", loaded.warning, timeout=10.0)
-        if auto_connect:
+        if replay is not None:
+            self.replay_bar = show_replay(window, session, replay)
+        elif auto_connect:
             window.connect_now()
         elif not self.settings.profiles and not self.options.host:
             window.banners.tell("notice:hint", "info", FIRST_RUN_HINT, timeout=12.0)

@@ -28,5 +28,9 @@ class GuiOptions:
     report_first_frame: bool = False
     protocol: str | None = None
     """Protocol string to log in with (None: the profile's; by default the server's own)."""
+    replay: Path | None = None
+    """``rtmu replay FILE.mcap``: show this recording instead of connecting to a robot."""
+    replay_conn: int = 1
+    """Which of the recording's connections (``--conn``)."""
     guardian: bool = True
     """Start a guardian process per connection (``rtmu.guardian``); off only to measure without it."""

@@ -52,6 +52,7 @@ from ..notices import Kind, Level, Notice  # noqa: E402
 from ..settings import Profile  # noqa: E402
 from .banners import BannerStack  # noqa: E402
 from .bars import FullscreenBar, connect_button, menu_button, show_connection, stop_button  # noqa: E402
+from .bridge_toggle import BridgeToggle  # noqa: E402
 from .camera import CameraInset, CameraView, PictureDecoder  # noqa: E402
 from .config_page import ConfigPage  # noqa: E402
 from .details import DetailsWindow  # noqa: E402
@@ -112,6 +113,10 @@ def short_reason(reason: str) -> str:
     if reason.startswith(("this server does not offer", "this server offers no")):
         return "not offered by the server"
     return reason or "unavailable"
+
+
+def _unset(action: Gio.SimpleAction) -> None:
+    action.set_state(GLib.Variant.new_boolean(False))
 
 
 def _flag(action: Gio.SimpleAction) -> bool:
@@ -308,6 +313,8 @@ class MainWindow(Gtk.ApplicationWindow):
         box.append(self.toolbar_revealer)
         box.append(outer)
         outer.set_vexpand(True)
+        self.body = box
+        """The window's column (bars above, the map/camera stack); a replay appends its controls."""
         self.set_child(box)
 
     def _osd(self) -> Gtk.Widget:
@@ -354,6 +361,7 @@ class MainWindow(Gtk.ApplicationWindow):
         view.append("Camera inset on the map", "win.inset")
         view.append("Sonar readings", "win.sonar")
         view.append("Robot details…", "win.details")
+        view.append("Foxglove bridge (ws://127.0.0.1:8765)", "win.foxglove")
         app = Gio.Menu()
         server = Gio.Menu()  # the connection and the server's own settings: one row, so the menu still fits
         server.append("Connection settings…", "win.settings")
@@ -421,6 +429,9 @@ class MainWindow(Gtk.ApplicationWindow):
         self.inset_action = toggle("inset", True, self.inset.set_enabled)
         self.sonar_action = toggle("sonar", self.operator.view.value.show_sonar, self._set_sonar)
         self.safe_action = toggle("safe-drive", True, self._set_safe_drive)
+        self.foxglove = BridgeToggle(self.session, self.show_notice)  # publishing only, never drives
+        self.foxglove_action = toggle("foxglove", False, self.foxglove.set)
+        self.foxglove.failed = functools.partial(_unset, self.foxglove_action)  # a busy port: unchecked again
         self.connect("notify::fullscreened", self._fullscreen_changed)
 
     # -- the controller's View -----------------------------------------------------------------
@@ -911,3 +922,4 @@ class MainWindow(Gtk.ApplicationWindow):
         self.ptz.close()
         self.motion.close()
         self.decoder.close()
+        self.foxglove.close()

@@ -1,0 +1,101 @@
+"""``rtmu replay`` and ``rtmu bridge`` as processes: their refusals, and a bridge serving until SIGTERM."""
+
+from __future__ import annotations
+
+import re
+import signal
+import subprocess
+import sys
+import time
+from pathlib import Path
+
+from rtmu.recorder import topics
+from rtmu.sim import SimConfig, SimThread
+
+from .foxglove_client import FoxgloveClient, twist
+from .simsession import ARENA
+
+RTMU = [sys.executable, "-m", "rtmu"]
+
+
+def rtmu(*args: str, timeout: float = 60) -> subprocess.CompletedProcess[str]:
+    return subprocess.run([*RTMU, *args], capture_output=True, text=True, timeout=timeout)
+
+
+def test_replay_refuses_a_file_it_cannot_replay_before_any_window(tmp_path: Path) -> None:
+    junk = tmp_path / "junk.mcap"
+    junk.write_bytes(b"\x89MCAP0\r\n" + b"\xff" * 64)
+    done = rtmu("replay", str(junk))
+    assert done.returncode == 3, done.stderr
+    assert "rtmu replay:" in done.stderr and "junk.mcap" in done.stderr
+    missing = rtmu("replay", str(tmp_path / "none.mcap"))
+    assert missing.returncode == 2 and "is not a file" in missing.stderr
+
+
+def test_bridge_refuses_bad_options() -> None:
+    assert rtmu("bridge", "127.0.0.1:1", "--foxglove", "--port", "70000").returncode == 2
+    assert rtmu("bridge", "127.0.0.1:1").returncode == 2  # --foxglove is the only kind there is
+    failed = rtmu("bridge", "127.0.0.1:1", "--foxglove", "--port", "0", "--timeout", "2")
+    assert failed.returncode == 3, failed.stderr
+
+
+def test_bridge_serves_poses_until_sigterm() -> None:
+    with SimThread(SimConfig(port=0, map_path=ARENA, seed=1)) as sim:
+        proc = subprocess.Popen(
+            [*RTMU, "bridge", f"127.0.0.1:{sim.port}", "--foxglove", "--port", "0"],
+            stderr=subprocess.PIPE,
+            text=True,
+        )
+        try:
+            assert proc.stderr is not None
+            line = proc.stderr.readline()
+            found = re.search(r"ws://127\.0\.0\.1:(\d+) \(no drive\)", line)
+            assert found, line
+            with FoxgloveClient(f"ws://127.0.0.1:{found.group(1)}") as client:
+                client.until(lambda: bool(client.server_info))
+                client.subscribe(topics.POSE, topics.STATUS)
+                client.until(lambda: bool(client.of(topics.STATUS)), 10)
+            proc.send_signal(signal.SIGTERM)
+            assert proc.wait(10) == 0
+        finally:
+            if proc.poll() is None:
+                proc.kill()
+                proc.wait(5)
+
+
+def test_bridge_with_allow_drive_drives_with_its_guardian_and_stops_when_the_stream_ends() -> None:
+    """The whole command: its guardian (a second login) lets a healthy drive go on; the stream's end stops."""
+    with SimThread(SimConfig(port=0, seed=1)) as sim:
+        proc = subprocess.Popen(
+            [*RTMU, "bridge", f"127.0.0.1:{sim.port}", "--foxglove", "--port", "0", "--allow-drive"],
+            stderr=subprocess.PIPE,
+            text=True,
+        )
+        try:
+            assert proc.stderr is not None
+            line = proc.stderr.readline()
+            found = re.search(r"ws://127\.0\.0\.1:(\d+) \(drive allowed from /cmd_vel\)", line)
+            assert found, line
+            with FoxgloveClient(f"ws://127.0.0.1:{found.group(1)}") as client:
+                client.until(lambda: bool(client.server_info))
+                client.advertise(1, "/cmd_vel")
+                start = sim.snapshot().x
+                end = time.monotonic() + 2.0  # longer than the guardian's 0.4 s without a beat
+                while time.monotonic() < end:
+                    client.publish(1, twist(0.5))
+                    client.pump(0.1)
+                    assert time.monotonic() < end - 1.5 or sim.snapshot().trans_ratio > 0, (
+                        "a drive stopped early"
+                    )
+                assert sim.snapshot().x > start + 300
+                last = time.monotonic()
+                while sim.snapshot().trans_ratio != 0:
+                    assert time.monotonic() - last < 2.0, "the robot was never stopped"
+                    time.sleep(0.01)
+            proc.send_signal(signal.SIGTERM)
+            assert proc.wait(10) == 0
+            assert "guardian" not in proc.stderr.read().lower()  # it was there: no "not available"
+        finally:
+            if proc.poll() is None:
+                proc.kill()
+                proc.wait(5)
