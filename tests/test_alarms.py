@@ -104,3 +104,13 @@ def test_hostile_readings_are_no_readings(bad: float) -> None:
     robot = RobotState(battery_v=bad, battery_low=bad, battery_shutdown=bad, wifi_quality=bad)  # type: ignore[arg-type]
     assert m.update(robot, LinkHealth(LinkLevel.OK, rtt_ms=bad)) == []
     assert m.severity(Alarm.BATTERY) is Severity.WARNING
+
+
+def test_the_mute_is_remembered_in_settings_and_checked() -> None:
+    from rtmu.settings import Settings, SettingsError, format_settings, parse_settings
+
+    assert parse_settings(format_settings(Settings())).alarms_muted is False
+    text = format_settings(Settings(alarms_muted=True))
+    assert "alarms_muted = true" in text and parse_settings(text).alarms_muted is True
+    with pytest.raises(SettingsError, match="alarms_muted"):
+        parse_settings('version = 1\nalarms_muted = "yes"\n')

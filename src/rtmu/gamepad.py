@@ -42,6 +42,24 @@ AXIS_TRANS = "left_y"
 AXIS_ROT = "left_x"
 """Left is negative: rot (positive = left) = −value."""
 
+BUTTON_CODES = {
+    0x130: "south",  # BTN_SOUTH (A / Cross)
+    0x131: "east",  # BTN_EAST (B / Circle)
+    0x133: "north",  # BTN_NORTH
+    0x134: "west",  # BTN_WEST
+    0x136: "left_shoulder",  # BTN_TL (LB / L1)
+    0x137: "right_shoulder",  # BTN_TR
+    0x220: "dpad_up",  # BTN_DPAD_UP
+    0x221: "dpad_down",
+    0x222: "dpad_left",
+    0x223: "dpad_right",
+}
+"""Linux input button codes (what libmanette reports for a mapped pad) → the names used here."""
+AXIS_CODES = {0x00: "left_x", 0x01: "left_y", 0x03: "right_x", 0x04: "right_y"}
+"""ABS_X, ABS_Y, ABS_RX, ABS_RY."""
+HAT_Y = 0x11
+"""ABS_HAT0Y: an unmapped pad's D-pad, −1 up, +1 down."""
+
 DEAD_ZONE = 0.2
 """Stick deflection (of 1.0) read as centred: worn sticks rest up to ~0.15 off-centre."""
 STEP = 5.0
@@ -210,6 +228,19 @@ class Gamepad:
         elif self._pending and now - self._last_push >= MIN_PUSH_INTERVAL:
             self._push(now)
         self._publish()
+
+    def hat(self, device: object, axis: int, value: int) -> None:
+        """An unmapped pad's D-pad as a hat axis: up/down become the speed buttons."""
+        if axis != HAT_Y:
+            if device is self._device:
+                self._last_event = self.clock()
+            return
+        if value < 0:
+            self.button(device, FASTER, True)
+        elif value > 0:
+            self.button(device, SLOWER, True)
+        elif device is self._device:
+            self._last_event = self.clock()
 
     # -- inside ----------------------------------------------------------------------------------
     def _deadman_changed(self, down: bool) -> None:
