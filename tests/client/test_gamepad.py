@@ -17,10 +17,13 @@ from rtmu.client.lease import EndReason
 from rtmu.client.session import SessionConfig
 from rtmu.fleet import Fleet, RobotSession
 from rtmu.gamepad import (
+    AXIS_CODES,
     AXIS_ROT,
     AXIS_TRANS,
+    BUTTON_CODES,
     DEADMAN,
     FASTER,
+    HAT_Y,
     SILENCE,
     SLOWER,
     STOP,
@@ -329,3 +332,36 @@ def test_sim_flooding_pad_sends_a_bounded_stream() -> None:
         sent = sim.call(lambda: sim.server.robot.ratio_drives_received)
         assert events > 5000
         assert 0 < sent <= 45, f"{sent} ratioDrives for {events} pad events in 1 s"
+
+
+def test_an_unmapped_pads_hat_dpad_steps_the_speed_and_any_event_is_a_sign_of_life() -> None:
+    rig = PadRig()
+    rig.pad.axis(PAD, AXIS_TRANS, -1.0)
+    rig.pad.button(PAD, DEADMAN, True)
+    before = rig.lease.ratios.throttle
+    rig.pad.hat(PAD, HAT_Y, -1)
+    rig.pad.hat(PAD, HAT_Y, 0)
+    assert rig.lease.ratios.throttle == before + 10
+    for _ in range(round(2 * SILENCE / 0.5)):  # an unknown button now and then keeps the pad alive
+        rig.tick(0.5)
+        rig.pad.button(PAD, "code_999", True)
+    assert rig.lease.live
+
+
+def test_linux_codes_map_to_the_documented_buttons() -> None:
+    assert BUTTON_CODES[0x136] == DEADMAN and BUTTON_CODES[0x131] == STOP
+    assert BUTTON_CODES[0x220] == FASTER and BUTTON_CODES[0x221] == SLOWER
+    assert AXIS_CODES[0x01] == AXIS_TRANS and AXIS_CODES[0x00] == AXIS_ROT
+
+
+def test_the_libmanette_adapter_starts_on_this_machine_and_finds_no_pad() -> None:
+    from rtmu.ui.gamepad import ManettePads
+
+    rig = PadRig()
+    pad = Gamepad(rig.ctl, rig.clock)
+    pads = ManettePads(pad)
+    try:
+        assert pads.available, "libmanette (gir1.2-manette-0.2, from scripts/setup.sh) is missing"
+        assert pad.state.deadman is DeadMan.NO_PAD  # no /dev/input here: nothing plugged in
+    finally:
+        pads.close()
