@@ -94,6 +94,8 @@ class PhoneLayout:
         w = self.window
         w.toolbar_revealer.set_visible(not narrow)
         self.strip.set_visible(narrow)
+        if narrow:
+            self.strip.refresh()
         (w.add_css_class if narrow else w.remove_css_class)("phone")  # STOP a little narrower, still first
         header = w.get_titlebar()
         if isinstance(header, Gtk.HeaderBar):

@@ -39,12 +39,16 @@ class StatusStrip(Gtk.Box):
         mode.set_ellipsize(Pango.EllipsizeMode.END)
         mode.set_hexpand(True)
         self._unobserve = [
-            model.robot.observe(lambda _o, _n: self.refresh()),
-            model.health.observe(lambda _o, _n: self.refresh()),
-            model.connection.observe(lambda _o, _n: self.refresh()),
-            operator.speed.observe(lambda _o, _n: self.refresh()),
+            model.robot.observe(self._changed),
+            model.health.observe(self._changed),
+            model.connection.observe(self._changed),
+            operator.speed.observe(self._changed),
         ]
         self.refresh()
+
+    def _changed(self, _old: object, _new: object) -> None:
+        if self.get_visible():  # hidden in landscape: no work at 10 Hz; shown → refreshed by the layout
+            self.refresh()
 
     @property
     def text(self) -> str:
