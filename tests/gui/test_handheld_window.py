@@ -1,17 +1,16 @@
 """The handheld window: a 360×720 portrait phone and an 800×480 landscape screen, alarms, the gamepad pill.
 
-Each layout runs on an X server whose only screen has that size, so "fits" means
-fits the screen: the window, every widget drawn in it, the menu and the
-connection dialog (surfaces of their own, measured with xwininfo). The D-pad is
-driven by a real pointer press through the X server. Alarms are raised by the
-simulator itself: its battery told to fall (``SimulatorSetBattery``, its own
-string command) and its Wi-Fi access point moved out of reach.
+Each layout runs on an X server whose only screen has that size (no window manager:
+the window itself must pick the screen's size), so "fits" means fits the screen:
+the window, every widget drawn in it, the menu, the Go to list and the connection
+dialog (surfaces of their own, measured with xwininfo). The D-pad is driven by a
+real pointer press through the X server. Alarms are raised by the simulator itself:
+its battery told to fall by its own string command (``SimulatorSetBattery``, sent
+by the window's network side) and its Wi-Fi access point moved out of reach.
 """
 
 from __future__ import annotations
 
-import os
-import subprocess
 import time
 from collections.abc import Iterator
 from pathlib import Path
@@ -20,6 +19,7 @@ import gi
 import pytest
 
 from rtmu.alarms import Alarm
+from rtmu.client.custom_commands import ServerCommand
 from rtmu.gamepad import AXIS_TRANS, DEADMAN, DeadMan
 from rtmu.sim import SimConfig, SimThread
 from rtmu.sim.wifi import AccessPoint
@@ -35,38 +35,21 @@ from gi.repository import Graphene, Gtk  # noqa: E402
 
 @pytest.fixture(scope="module")
 def phone_screen() -> Iterator[str]:
-    """An X server whose only screen is a 360×720 portrait phone, with a window manager (openbox, standing
-    in for a phone's shell): ':N'."""
+    """An X server whose only screen is a 360×720 portrait phone: ':N'."""
     proc, display = _spawn_xvfb("360x720")
     if display is None:
         pytest.fail("an Xvfb of 360x720 did not start")
-    env = dict(os.environ, DISPLAY=display)
-    wm = subprocess.Popen(["openbox"], env=env, stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL)
     try:
-        deadline = time.monotonic() + 15
-        while (
-            "window id"
-            not in subprocess.run(
-                ["xprop", "-root", "_NET_SUPPORTING_WM_CHECK"],
-                env=env,
-                capture_output=True,
-                text=True,
-                timeout=10,
-            ).stdout
-        ):
-            assert wm.poll() is None and time.monotonic() < deadline, (
-                "openbox did not manage the phone screen"
-            )
-            time.sleep(0.1)
         yield display
     finally:
-        wm.terminate()
-        try:
-            wm.wait(5)
-        except subprocess.TimeoutExpired:
-            wm.kill()
-            wm.wait(5)
         _terminate(proc)
+
+
+@pytest.fixture
+def sim() -> Iterator[SimThread]:
+    """The simulator of the ``gui`` fixture (the session's big screen)."""
+    with SimThread(SimConfig(port=0, map_path=OFFICE_MAP, seed=1)) as s:
+        yield s
 
 
 def open_on(screen: str, shots: Path, name: str) -> Iterator[tuple[Gui, SimThread]]:
@@ -154,7 +137,6 @@ def test_portrait_phone_layout_fits_and_the_thumb_dpad_drives(phone: tuple[Gui, 
     window = gui.window
     layout = window.handheld.layout
     pump(lambda: layout.narrow and window.dpad.get_mapped(), 5, "the phone layout")
-    pump(lambda: window.is_maximized(), 5, "the window to be maximised")
     idle(0.3)
     assert gui.screen_rect(window) == (0, 0, 360, 720), "the window fills the phone's screen"
     assert layout.strip.get_mapped() and not window.toolbar_revealer.get_visible()
@@ -187,6 +169,17 @@ def test_portrait_phone_layout_fits_and_the_thumb_dpad_drives(phone: tuple[Gui, 
     gui.screen_shot("portrait-menu")
     popover.popdown()
     pump(lambda: not popover.get_mapped(), 3, "the menu to close")
+    # The header's Go to list (a popover of its own) too.
+    goals = window.goals_panel
+    pump(lambda: goals.get_mapped(), 5, "the Go to button (the simulator navigates)")
+    gui.click(goals)
+    goals_popover = goals.get_popover()
+    pump(lambda: goals_popover is not None and goals_popover.get_mapped(), 3, "the Go to list")
+    idle(0.3)
+    assert inside(drawn_rect(gui, goals_popover), 360, 720), drawn_rect(gui, goals_popover)
+    gui.screen_shot("portrait-goto")
+    goals_popover.popdown()
+    pump(lambda: not goals_popover.get_mapped(), 3, "the Go to list to close")
     window.activate_action("win.settings", None)
     pump(lambda: window._dialog is not None and window._dialog.get_mapped(), 5, "the connection dialog")
     dialog = window._dialog
@@ -219,7 +212,7 @@ def test_battery_and_wifi_alarms_from_the_simulator_with_mute(phone: tuple[Gui, 
     pump(lambda: gui.model.robot.value.battery_low is not None, 5, "batteryInfo")
     low = gui.model.robot.value.battery_low
     assert low is not None
-    sim.call(lambda: sim.server.world.set_battery(low - 0.3))
+    set_battery(gui, low - 0.3)
     pump(lambda: alarm_topic(Alarm.BATTERY) in banners.topics(), 5, "the battery banner")
     assert "Battery low" in (banners.text(alarm_topic(Alarm.BATTERY)) or "")
     assert alarms.sounded.count(Alarm.BATTERY) == 1
@@ -231,7 +224,7 @@ def test_battery_and_wifi_alarms_from_the_simulator_with_mute(phone: tuple[Gui, 
     assert alarms.muted and gui.app.settings.alarms_muted
     shutdown = gui.model.robot.value.battery_shutdown
     assert shutdown is not None
-    sim.call(lambda: sim.server.world.set_battery(shutdown - 0.2))
+    set_battery(gui, shutdown - 0.2)
     pump(lambda: "critical" in (banners.text(alarm_topic(Alarm.BATTERY)) or ""), 5, "the critical banner")
     beeps = alarms.beeps
     idle(0.3)
@@ -258,6 +251,12 @@ def test_battery_and_wifi_alarms_from_the_simulator_with_mute(phone: tuple[Gui, 
     )
 
 
+def set_battery(gui: Gui, volts: float) -> None:
+    """The simulator's own string command, sent by the window's network side: the server took it."""
+    command = ServerCommand("SimulatorSetBattery", "", True)
+    assert gui.window.session.runner.run_command(command, f"{volts:.2f}").result(10)
+
+
 def alarm_topic(alarm: Alarm) -> str:
     return AlarmView.topic(alarm)
 
@@ -268,18 +267,25 @@ def test_the_gamepad_pill_and_the_window_focus(phone: tuple[Gui, SimThread]) -> 
     handheld = window.handheld
     assert handheld.pads.available, "libmanette (gir1.2-manette-0.2) is not installed"
     assert not handheld.pad_status.get_visible(), "a pad shown with none connected"
+    pump(lambda: "link" not in window.banners.topics(), 6, "the Connected banner to go")
+    gui.focus()
+    pump(lambda: window.is_active(), 5, "the window to have the focus")  # a pad drives a focused window only
     device = object()
     handheld.pad.connected(device, "Test <b>pad</b>")
     handheld.pad.axis(device, AXIS_TRANS, -1.0)
     handheld.pad.button(device, DEADMAN, True)
     pump(lambda: handheld.pad_status.get_mapped(), 3, "the pad pill")
-    assert handheld.pad.state.deadman is DeadMan.HELD
+    assert handheld.pad.state.deadman is DeadMan.HELD, (window.is_active(), window.controller.analog_blocked)
     assert "<b>" in handheld.pad_status.text, "device text shown as plain text"
     end = time.monotonic() + 0.6
     while time.monotonic() < end:  # a real stick's noise keeps the pad talking
         handheld.pad.axis(device, AXIS_TRANS, -1.0)
         idle(0.05)
     pump(lambda: sim.call(lambda: sim.server.robot.mode_name) == "ratioDrive", 3, "the pad to drive")
+    ok, pill = handheld.pad_status.compute_bounds(window)
+    ok2, motion = window.motion.compute_bounds(window)
+    assert ok and ok2 and window.motion.get_mapped(), "the held drive's pill is not shown"
+    assert pill.get_y() >= motion.get_y() + motion.get_height(), "the pad pill overlaps the motion pill"
     gui.shot("gamepad-held")
     other = Gtk.Window(title="elsewhere")
     other.present()
@@ -291,3 +297,26 @@ def test_the_gamepad_pill_and_the_window_focus(phone: tuple[Gui, SimThread]) -> 
         other.destroy()
     handheld.pad.disconnected(device)
     assert not handheld.pad_status.get_visible()
+
+
+def test_narrowing_a_desktop_window_switches_and_widening_restores_it_exactly(gui: Gui) -> None:
+    """On the session's big screen: 800 wide → 400 (phone layout) → 800 (as it was, D-pad choice kept)."""
+    window = gui.window
+    layout = window.handheld.layout
+    pump(lambda: window.get_width() >= 600 and not layout.narrow, 5, "the landscape window")
+    assert not window.dpad.get_visible() and window.toolbar_revealer.get_visible()
+    window.set_default_size(400, 700)
+    pump(
+        lambda: layout.narrow and window.dpad.get_mapped() and layout.strip.get_mapped(),
+        5,
+        "the phone layout",
+    )
+    assert not window.toolbar_revealer.get_visible()
+    gui.shot("narrowed-400")
+    window.set_default_size(800, 480)
+    pump(lambda: not layout.narrow, 5, "the landscape layout again")
+    idle(0.3)
+    assert not window.dpad.get_visible(), "the D-pad the phone layout showed stayed"
+    assert window.toolbar_revealer.get_mapped() and not layout.strip.get_visible()
+    assert window.dpad.get_halign() is Gtk.Align.START and window.dpad.get_margin_bottom() == 12
+    gui.shot("widened-800")

@@ -33,6 +33,9 @@ from .layout import PhoneLayout  # noqa: E402
 MainWindow = Any
 """``ui.window.MainWindow``, which imports this module: named, not imported (no import cycle)."""
 
+PILL_BELOW_MOTION = 76
+"""The pad pill's top margin on a phone: under the three-line motion pill."""
+
 CSS = """
 .gamepad-status { background: alpha(#242424, 0.80); color: white; border-radius: 8px; padding: 3px 10px; }
 .gamepad-status.deadman-held { background: alpha(#1c71d8, 0.92); }
@@ -62,6 +65,8 @@ class Handheld:
         self.pads = ManettePads(self.pad)
         self.alarms = AlarmView(window.model, window.banners, window.get_display().beep, muted=muted)
         self.layout = PhoneLayout(window)
+        self.layout.on_change = self._layout_changed
+        self._layout_changed(self.layout.narrow)  # a phone's layout is chosen before the window shows
         self.sound_action = Gio.SimpleAction.new_stateful(
             "alarm-sound", None, GLib.Variant.new_boolean(not muted)
         )
@@ -80,6 +85,10 @@ class Handheld:
         self.set_muted(muted)
         if self.on_mute is not None:
             self.on_mute(muted)
+
+    def _layout_changed(self, narrow: bool) -> None:
+        """On a phone the motion pill (top left) and the pad pill cannot share a row: the pad's goes under."""
+        self.pad_status.set_margin_top(PILL_BELOW_MOTION if narrow else 8)
 
     def _on_active(self, *_a: object) -> None:
         self.pad.focus(self.window.is_active())

@@ -74,6 +74,7 @@ class PhoneLayout:
         if size is not None and size[0] < NARROW:
             window.set_default_size(*size)  # a phone: fill its screen (its shell maximises apps too)
             window.maximize()
+            self.apply(True)  # before the first size is computed: the landscape header would not fit
         self._resize_handler = window.stage.connect("resize", lambda _s, w, _h: self._queue(w))
 
     def _queue(self, width: int) -> None:

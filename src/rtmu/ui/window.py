@@ -549,9 +549,9 @@ class MainWindow(Gtk.ApplicationWindow):
         self.picker.cancel()
 
     def _drive_held(self) -> bool:
-        """A held drive is live (keys or D-pad); False while the window is still being built."""
+        """A held drive is live (keys, D-pad or the pad's dead-man); False while the window is being built."""
         controller = getattr(self, "controller", None)
-        return controller is not None and bool(controller.held)
+        return controller is not None and (bool(controller.held) or controller.analog_active)
 
     def _answer_popup(self, popup_id: int, button: int) -> None:
         self._link.answer_popup(popup_id, button)
