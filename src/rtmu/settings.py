@@ -5,6 +5,7 @@ when the variable is unset), a small flat TOML document::
 
     version = 1
     last_profile = "lab"
+    alarms_muted = true     # optional: the alarm beep is off (View > Alarm sound)
 
     [profiles."lab"]
     host = "10.0.0.5"
