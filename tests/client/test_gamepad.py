@@ -365,3 +365,22 @@ def test_the_libmanette_adapter_starts_on_this_machine_and_finds_no_pad() -> Non
         assert pad.state.deadman is DeadMan.NO_PAD  # no /dev/input here: nothing plugged in
     finally:
         pads.close()
+
+
+def test_the_stick_during_a_navigation_only_stops_it_and_the_next_deadman_press_drives() -> None:
+    from rtmu.model import NavState
+
+    rig = PadRig()
+    rig.model.navigation.set(NavState(navigating=True, target="Lab B", goals=("Lab A", "Lab B")))
+    rig.pad.button(PAD, DEADMAN, True)  # the dead-man alone, stick centred: the navigation goes on
+    assert "stop" not in rig.link.names()
+    rig.clock.advance(0.1)
+    rig.pad.axis(PAD, AXIS_TRANS, -1.0)  # the operator wins: this only stops
+    assert rig.link.names().count("stop") == 1 and not rig.lease.live
+    rig.model.navigation.set(NavState(navigating=False, goals=("Lab A", "Lab B")))
+    rig.clock.advance(0.1)
+    rig.pad.axis(PAD, AXIS_TRANS, -0.9)
+    assert not rig.lease.live, "the stick that stopped the navigation drove on without a fresh press"
+    rig.pad.button(PAD, DEADMAN, False)
+    rig.pad.button(PAD, DEADMAN, True)
+    assert rig.lease.live
