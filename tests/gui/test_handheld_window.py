@@ -277,11 +277,14 @@ def test_the_gamepad_pill_and_the_window_focus(phone: tuple[Gui, SimThread]) -> 
     pump(lambda: handheld.pad_status.get_mapped(), 3, "the pad pill")
     assert handheld.pad.state.deadman is DeadMan.HELD, (window.is_active(), window.controller.analog_blocked)
     assert "<b>" in handheld.pad_status.text, "device text shown as plain text"
-    end = time.monotonic() + 0.6
-    while time.monotonic() < end:  # a real stick's noise keeps the pad talking
-        handheld.pad.axis(device, AXIS_TRANS, -1.0)
+    end = time.monotonic() + 10.0
+    while sim.call(lambda: sim.server.robot.mode_name) != "ratioDrive" or not window.motion.get_mapped():
+        assert time.monotonic() < end, "the pad did not drive"
+        if handheld.pad.state.deadman is DeadMan.LATCHED:  # a loaded machine froze the UI: the lease
+            handheld.pad.button(device, DEADMAN, False)  # lapsed; as an operator would, press again
+            handheld.pad.button(device, DEADMAN, True)
+        handheld.pad.axis(device, AXIS_TRANS, -1.0)  # a real stick's noise keeps the pad talking
         idle(0.05)
-    pump(lambda: sim.call(lambda: sim.server.robot.mode_name) == "ratioDrive", 3, "the pad to drive")
     ok, pill = handheld.pad_status.compute_bounds(window)
     ok2, motion = window.motion.compute_bounds(window)
     assert ok and ok2 and window.motion.get_mapped(), "the held drive's pill is not shown"

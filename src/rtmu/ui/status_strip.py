@@ -15,9 +15,11 @@ gi.require_version("Gtk", "4.0")
 gi.require_version("Pango", "1.0")
 from gi.repository import Gtk, Pango  # noqa: E402
 
+from ..alarms import Thresholds  # noqa: E402
 from ..model import LinkLevel, OperatorState, Phase, RobotModel  # noqa: E402
 
 DASH = "—"
+SLOW_MS = Thresholds().rtt_high_ms
 
 
 class StatusStrip(Gtk.Box):
@@ -73,7 +75,8 @@ class StatusStrip(Gtk.Box):
             link, state = health.level.value, "lost" if health.level is LinkLevel.LOST else "stale"
         else:
             link = f"{health.rtt_ms:.0f} ms" if health.rtt_ms is not None else "ok"
-            state = "ok"
+            slow = health.rtt_ms is not None and health.rtt_ms > SLOW_MS
+            state = "stale" if slow else "ok"  # amber from where the round-trip alarm starts
         self._set("link", link, state)
         self._set("speed", f"{self.operator.speed.value.percent}%", "")
         self._set("mode", robot.mode or robot.status or DASH, "")
