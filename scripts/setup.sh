@@ -15,7 +15,7 @@ cd "$(dirname "${BASH_SOURCE[0]}")/.."
 export DEBIAN_FRONTEND=noninteractive
 
 APT_PACKAGES=(
-    gir1.2-gtk-4.0 gir1.2-adw-1 libgirepository1.0-dev libcairo2-dev pkg-config
+    gir1.2-gtk-4.0 gir1.2-adw-1 gir1.2-manette-0.2 libgirepository1.0-dev libcairo2-dev pkg-config
     build-essential xvfb xdotool openbox x11-utils xxd bsdextrautils
 )
 # Every program the app, tests, bench and scripts start -> the package above that installs it

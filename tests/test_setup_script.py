@@ -22,6 +22,7 @@ ROOT = Path(__file__).resolve().parents[1]
 OTHER_PACKAGES = [
     "gir1.2-gtk-4.0",
     "gir1.2-adw-1",
+    "gir1.2-manette-0.2",
     "libgirepository1.0-dev",
     "libcairo2-dev",
     "pkg-config",
@@ -219,7 +220,7 @@ def test_a_ready_machine_asks_apt_nothing(tmp_path: Path) -> None:
     )
     result = machine.run()
     assert result.returncode == 0, result.stderr
-    assert "system packages present (15 checked)" in result.stdout
+    assert "system packages present (16 checked)" in result.stdout
     assert machine.apt_calls() == []
 
 

@@ -24,6 +24,11 @@ Driving rules
   (a window "releasing everything" on focus loss) do not unblock; the first
   press after focus returns marks the window focused again (a key released
   while unfocused therefore needs one press to clear it, then a fresh press).
+* ``analog(trans, rot)`` / ``analog_release()``: a gamepad's stick while its
+  dead-man button is held (``rtmu.gamepad`` turns pad events into these). It rides
+  the SAME lease as the keys (held keys win over the stick while both are held);
+  every stop above blocks the stick too, until the dead-man is released and
+  pressed again.
 * Speed: 10…100 % in 10 % steps; it is the ``ratioDrive`` throttle and applies at
   once to a drive in progress.
 
@@ -196,6 +201,10 @@ class Controller:
         self._held: set[str] = set()
         self._blocked: set[str] = set()
         """Keys that were held when motion was stopped for them; ignored until released."""
+        self._analog: tuple[float, float] | None = None
+        """The gamepad stick (trans, rot in %) while its dead-man is held; None when let go."""
+        self._analog_blocked = False
+        """The stick drove (or was held) when motion was stopped: ignored until the dead-man is released."""
         self._generation: int | None = None
         self._states: dict[str, CommandState] = {}
         self._lookup_pending = False
@@ -308,16 +317,57 @@ class Controller:
         self._held.discard(direction)
         self._apply()
 
+    # -- analog motion (a gamepad's stick under its dead-man) ----------------------------------
+    @property
+    def analog_active(self) -> bool:
+        """The stick is being listened to (dead-man held, not blocked by a stop)."""
+        return self._analog is not None
+
+    @property
+    def analog_blocked(self) -> bool:
+        """A stop ended the stick's drive: the dead-man must be released before it drives again."""
+        return self._analog_blocked
+
+    def analog(self, trans: float, rot: float) -> None:
+        """The stick while the dead-man is held: trans/rot in −100…100 % (rot positive = left).
+
+        The first call grants the lease like a key press; later ones change its ratios. Ignored
+        while blocked (after any stop) until :meth:`analog_release`."""
+        if self._analog_blocked:
+            return
+        if not self.connected or not self.supports("ratioDrive"):
+            self._analog_blocked = True
+            return
+        if self.navigating and (trans or rot):  # the operator wins: this only stops the navigation
+            self.stop()
+            self._analog_blocked = True
+            self.view.notify(Notice.info(Kind.NAVIGATION, "Navigation cancelled. Press again to drive."))
+            return
+        self._analog = (max(-100.0, min(100.0, trans)), max(-100.0, min(100.0, rot)))
+        self._apply()
+
+    def analog_release(self) -> None:
+        """The dead-man was let go (or the pad is gone): stop the stick's drive; it may drive again."""
+        self._analog_blocked = False
+        if self._analog is None:
+            return
+        self._analog = None
+        self._apply()
+
     def tick(self) -> None:
         """Renew the lease while keys are held. Call every :data:`TICK` s from the UI thread's timer."""
-        if not self._held:
+        if not self._held and (self._analog is None or self._generation is None):
             return
         if not self.link.lease.renew():
             reason = self.link.lease.ended or EndReason.LAPSED
             self._halt_held(reason)
 
     def _apply(self) -> None:
-        ratios = ratios_for(self._held, self.operator.speed.value.percent)
+        speed = self.operator.speed.value.percent
+        if self._held or self._analog is None:
+            ratios = ratios_for(self._held, speed)
+        else:
+            ratios = DriveRatios(self._analog[0], self._analog[1], float(speed))
         lease = self.link.lease
         if not ratios.moving:
             if self._generation is not None:
@@ -333,9 +383,12 @@ class Controller:
 
     def _halt_held(self, reason: EndReason) -> None:
         """Motion was stopped for ``reason`` while keys were held: block them until released."""
-        had = bool(self._held)
+        had = bool(self._held) or (self._analog is not None and self._generation is not None)
         self._blocked |= self._held
         self._held.clear()
+        if self._analog is not None:
+            self._analog = None
+            self._analog_blocked = True
         if self._generation is not None:
             self.link.lease.end(reason, self._generation)
             self._generation = None
@@ -372,6 +425,9 @@ class Controller:
         """
         if self._held or self._generation is not None:
             self.stop()
+        if self._analog is not None:
+            self._analog = None
+            self._analog_blocked = True
         self._blocked |= self._held
         self._held.clear()
         self._unfocused = True
@@ -394,7 +450,7 @@ class Controller:
             )
             return
         self.view.notify(Notice.info(Kind.SPEED, f"Speed {new.percent} %"))
-        if self._held and self._generation is not None:
+        if (self._held or self._analog is not None) and self._generation is not None:
             self._apply()
 
     # -- bounded moves, sensing, modes -------------------------------------------------------

@@ -5,6 +5,7 @@ when the variable is unset), a small flat TOML document::
 
     version = 1
     last_profile = "lab"
+    alarms_muted = true     # optional: the alarm beep is off (View > Alarm sound)
 
     [profiles."lab"]
     host = "10.0.0.5"
@@ -148,6 +149,8 @@ class Settings:
     profiles: dict[str, Profile] = field(default_factory=dict)
     last_profile: str | None = None
     recording: RecordingSettings = field(default_factory=RecordingSettings)
+    alarms_muted: bool = False
+    """The alarm sound is off (``alarms_muted = true``; the banners still show): the View menu's switch."""
 
     def current(self) -> Profile:
         """The profile used last, else the first one, else a default local one."""
@@ -204,7 +207,7 @@ def parse_settings(text: str) -> Settings:
     version = doc.get("version")
     if version != SCHEMA_VERSION:
         raise SettingsError(f"unknown settings version {version!r} (this RTMU writes {SCHEMA_VERSION})")
-    unknown = set(doc) - {"version", "last_profile", "profiles", "recording"}
+    unknown = set(doc) - {"version", "last_profile", "profiles", "recording", "alarms_muted"}
     if unknown:
         raise SettingsError(f"unknown settings: {', '.join(sorted(unknown))}")
     raw_profiles = doc.get("profiles", {})
@@ -220,6 +223,10 @@ def parse_settings(text: str) -> Settings:
         raise SettingsError("'last_profile' must be a string")
     settings.last_profile = last if last in settings.profiles else None
     settings.recording = _recording(doc.get("recording", {}))
+    muted = doc.get("alarms_muted", False)
+    if type(muted) is not bool:
+        raise SettingsError(f"alarms_muted must be true or false, not {muted!r}")
+    settings.alarms_muted = muted
     return settings
 
 
@@ -320,6 +327,8 @@ def format_settings(settings: Settings) -> str:
     lines.append(f"version = {SCHEMA_VERSION}")
     if settings.last_profile is not None:
         lines.append(f"last_profile = {_toml_string(settings.last_profile)}")
+    if settings.alarms_muted:
+        lines.append("alarms_muted = true")
     for profile in settings.profiles.values():
         profile.validate()
         lines += ["", f"[profiles.{_toml_string(profile.name)}]"]

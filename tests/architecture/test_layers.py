@@ -25,7 +25,7 @@ LAYERS: dict[str, tuple[str, ...]] = {
     "recorder": ("rtmu.recorder",),
     "ui-state": ("rtmu.model",),
     "settings": ("rtmu.settings",),
-    "control": ("rtmu.commands", "rtmu.controller"),
+    "control": ("rtmu.commands", "rtmu.controller", "rtmu.gamepad", "rtmu.alarms"),
     "fleet": ("rtmu.fleet",),
     "view": ("rtmu.ui",),
     "entry": ("rtmu.cli", "rtmu.__main__", "rtmu.subcommands"),

@@ -165,6 +165,8 @@ class RtmuApplication(Gtk.Application):
             self.quit()
             raise
         self.window = window
+        window.handheld.set_muted(self.settings.alarms_muted)
+        window.handheld.on_mute = self._alarms_muted
         # Closing the window stops every robot of the fleet, not only the one it shows.
         window.connect("close-request", lambda _w: self.fleet.stop_all() and False)
         if self.options.report_first_frame:
@@ -315,8 +317,14 @@ class RtmuApplication(Gtk.Application):
             speed=operator.speed.value.percent,
         )
 
+    def _alarms_muted(self, muted: bool) -> None:
+        self.settings.alarms_muted = muted
+        if self.options.persist:
+            self._save(background=True)
+
     def _save(self, *, background: bool) -> None:
-        snapshot = Settings(dict(self.settings.profiles), self.settings.last_profile)
+        s = self.settings
+        snapshot = Settings(dict(s.profiles), s.last_profile, s.recording, alarms_muted=s.alarms_muted)
         path = self.options.settings_path
 
         def write() -> None:

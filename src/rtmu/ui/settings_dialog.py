@@ -19,6 +19,7 @@ gi.require_version("Gtk", "4.0")
 from gi.repository import Gtk  # noqa: E402
 
 from ..settings import DEFAULT_PORT, Profile  # noqa: E402
+from .layout import screen_size  # noqa: E402
 
 _HOST = re.compile(r"^[A-Za-z0-9]([A-Za-z0-9.\-]*[A-Za-z0-9])?$")
 _IPV6 = re.compile(r"^[0-9A-Fa-f:.]+$")
@@ -60,7 +61,8 @@ class ConnectionDialog(Gtk.Window):
         keyring_available: bool,
     ) -> None:
         super().__init__(title="Connection settings", modal=True, transient_for=parent)
-        self.set_default_size(440, -1)
+        screen = screen_size()  # a 360 px phone: the dialog takes its width, no more
+        self.set_default_size(440 if screen is None else min(440, screen[0] - 16), -1)
         self.set_resizable(False)
         self.add_css_class("connection-dialog")
         self._profiles = dict(profiles)
@@ -86,6 +88,11 @@ class ConnectionDialog(Gtk.Window):
         if not keyring_available:
             self.remember.set_label("Remember the password (this session only: no keyring)")
         self.reconnect = Gtk.CheckButton(label="Reconnect automatically when the link is lost")
+        for check in (self.remember, self.reconnect):  # long sentences wrap on a phone
+            label = check.get_last_child()
+            if isinstance(label, Gtk.Label):
+                label.set_wrap(True)
+                label.set_max_width_chars(30)
         self.protocol = Gtk.Entry(placeholder_text="(the one the server asks for)", max_length=200)
         self.protocol.set_tooltip_text(
             "Protocol string sent at login. Leave empty: RTMU answers with the string the server "

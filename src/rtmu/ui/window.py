@@ -58,6 +58,7 @@ from .config_page import ConfigPage  # noqa: E402
 from .details import DetailsWindow  # noqa: E402
 from .dpad import DPad  # noqa: E402
 from .goals_panel import GoalsPanel  # noqa: E402
+from .handheld import Handheld  # noqa: E402
 from .keys import KeyRouter  # noqa: E402
 from .mapview import MapStage  # noqa: E402
 from .motion import MotionIndicator  # noqa: E402
@@ -162,7 +163,7 @@ class MainWindow(Gtk.ApplicationWindow):
     ) -> None:
         super().__init__(application=app, title="RTMU")
         self.set_default_size(800, 480)
-        self.set_size_request(480, 320)
+        self.set_size_request(360, 320)  # 360: a portrait phone (ui.layout)
         self.session = session
         self.model = model = session.state
         self.operator = operator
@@ -215,6 +216,7 @@ class MainWindow(Gtk.ApplicationWindow):
         self.connect("notify::is-active", self._on_active)
         self.connect("close-request", self._on_close_request)
         self._tick_source = GLib.timeout_add(int(TICK * 1000), self._tick)
+        self.handheld = Handheld(self)  # gamepad, alarms, phone layout (after the focus handler above)
         # The UI thread's heartbeat to the guardian process (rtmu.guardian): it stops the robot
         # if these stop while driving because this process was killed or frozen.
         self._beat_source = GLib.timeout_add(int(GUARDIAN_BEAT * 1000), self._beat)
@@ -265,7 +267,7 @@ class MainWindow(Gtk.ApplicationWindow):
         self.toolbar_revealer.set_child(self.toolbar)
         self.toolbar_revealer.set_reveal_child(True)
 
-        map_page = Gtk.Overlay()
+        self.map_page = map_page = Gtk.Overlay()
         map_page.set_child(self.stage)
         map_page.add_overlay(self._osd())
         map_page.add_overlay(self.dpad)
@@ -358,6 +360,7 @@ class MainWindow(Gtk.ApplicationWindow):
         view.append("Status toolbar", "win.toolbar")
         view.append("Full screen", "win.fullscreen")
         view.append("Touch D-pad", "win.dpad")
+        view.append("Alarm sound", "win.alarm-sound")
         view.append("Camera inset on the map", "win.inset")
         view.append("Sonar readings", "win.sonar")
         view.append("Robot details…", "win.details")
@@ -568,9 +571,9 @@ class MainWindow(Gtk.ApplicationWindow):
         self.picker.cancel()
 
     def _drive_held(self) -> bool:
-        """A held drive is live (keys or D-pad); False while the window is still being built."""
+        """A held drive is live (keys, D-pad or the pad's dead-man); False while the window is being built."""
         controller = getattr(self, "controller", None)
-        return controller is not None and bool(controller.held)
+        return controller is not None and (bool(controller.held) or controller.analog_active)
 
     def _answer_popup(self, popup_id: int, button: int) -> None:
         self._link.answer_popup(popup_id, button)
@@ -915,6 +918,7 @@ class MainWindow(Gtk.ApplicationWindow):
         for remove in self._unobserve:
             remove()
         self._unobserve = []
+        self.handheld.close()
         self.stage.close()
         self.toolbar.close()
         self.routes_panel.close()

@@ -1,0 +1,142 @@
+"""Landscape ⇄ portrait phone layout, chosen by the window's width. The window keeps composing.
+
+libadwaita 1.2 (Debian 12) has no breakpoints, so the map stage's ``resize``
+(it spans the window's width) is the signal: under :data:`NARROW` px the window
+is a phone —
+
+* the status toolbar gives way to the one-line :class:`StatusStrip`;
+* the touch D-pad is shown, centred at the bottom above the zoom buttons, where a
+  thumb rests (the operator's own D-pad choice is restored when it widens again),
+  and the server's popup cards move up above it;
+* the header bar sheds what a phone does not need so that STOP, Connect, the menu,
+  the camera and Go to still fit 360 px: the title (the strip says the state), the
+  window's minimise/maximise/close buttons (a phone's shell closes apps; Quit is in
+  the menu), the Connect buttons' fixed minimum width and 20 px of STOP's (still
+  the first and the only red button);
+
+and at :data:`NARROW` or more everything is exactly as the landscape window
+always was. Switching happens in an idle callback, never inside a size
+allocation. A window opened on a screen narrower than :data:`NARROW` (a
+phone) starts maximised at that screen's size instead of 800×480.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Callable
+from typing import Any
+
+import gi
+
+gi.require_version("Gtk", "4.0")
+gi.require_version("Gdk", "4.0")
+from gi.repository import Gdk, GLib, Gtk  # noqa: E402
+
+from .status_strip import StatusStrip  # noqa: E402
+
+MainWindow = Any
+"""``ui.window.MainWindow``, which imports this module: named, not imported (no import cycle)."""
+
+NARROW = 600
+"""Widths under this (px) get the phone layout; 800×480 landscape is well above it."""
+DPAD_ABOVE_OSD = 64
+"""Bottom margin of the phone's D-pad: clear of the zoom row under it."""
+
+
+def screen_size() -> tuple[int, int] | None:
+    """The first monitor's size (logical px), or None when it cannot be known yet."""
+    display = Gdk.Display.get_default()
+    monitors = display.get_monitors() if display is not None else None
+    if monitors is None or monitors.get_n_items() == 0:
+        return None
+    monitor = monitors.get_item(0)
+    if not isinstance(monitor, Gdk.Monitor):
+        return None
+    geometry = monitor.get_geometry()
+    return geometry.width, geometry.height
+
+
+class PhoneLayout:
+    """Owns the strip and the switch; ``on_change(narrow)`` is told after each switch."""
+
+    def __init__(self, window: MainWindow) -> None:
+        self.window = window
+        self.narrow = False
+        self.on_change: Callable[[bool], None] | None = None
+        self.strip = StatusStrip(window.model, window.operator)
+        revealer = window.toolbar_revealer
+        parent = revealer.get_parent()
+        assert isinstance(parent, Gtk.Box)
+        parent.insert_child_after(self.strip, revealer)
+        self._dpad_before: bool | None = None
+        self._popups_margin = window.popup_stack.get_margin_bottom()
+        self._idle = 0
+        size = screen_size()
+        if size is not None and size[0] < NARROW:
+            window.set_default_size(*size)  # a phone: fill its screen (its shell maximises apps too)
+            window.maximize()
+            self.apply(True)  # before the first size is computed: the landscape header would not fit
+        self._resize_handler = window.stage.connect("resize", lambda _s, w, _h: self._queue(w))
+
+    def _queue(self, width: int) -> None:
+        if (width < NARROW) != self.narrow and not self._idle:
+            self._idle = GLib.idle_add(self._apply_idle)
+
+    def _apply_idle(self) -> bool:
+        self._idle = 0
+        width = self.window.stage.get_width()
+        if width > 0:
+            self.apply(width < NARROW)
+        return False
+
+    def apply(self, narrow: bool) -> None:
+        if narrow == self.narrow:
+            return
+        self.narrow = narrow
+        w = self.window
+        w.toolbar_revealer.set_visible(not narrow)
+        self.strip.set_visible(narrow)
+        if narrow:
+            self.strip.refresh()
+        (w.add_css_class if narrow else w.remove_css_class)("phone")  # STOP a little narrower, still first
+        header = w.get_titlebar()
+        if isinstance(header, Gtk.HeaderBar):
+            header.set_decoration_layout("" if narrow else None)
+        title_box = w.title_label.get_parent()
+        if title_box is not None:
+            title_box.set_visible(not narrow)
+        for button in (w.connect_button, w.fullscreen_bar.connect_button):
+            (button.remove_css_class if narrow else button.add_css_class)("connect-button")
+        dpad = w.dpad
+        if narrow:
+            self._dpad_before = dpad.get_visible()
+            self._popups_margin = w.popup_stack.get_margin_bottom()
+            self._show_dpad(True)
+            dpad.set_halign(Gtk.Align.CENTER)
+            dpad.set_margin_bottom(DPAD_ABOVE_OSD)
+            pad_height = dpad.measure(Gtk.Orientation.VERTICAL, -1)[1]
+            w.popup_stack.set_margin_bottom(DPAD_ABOVE_OSD + pad_height + 8)  # server popups above the pad
+        else:
+            dpad.set_halign(Gtk.Align.START)
+            dpad.set_margin_bottom(12)
+            w.popup_stack.set_margin_bottom(self._popups_margin)
+            self._show_dpad(bool(self._dpad_before))
+        if self.on_change is not None:
+            self.on_change(narrow)
+
+    def _show_dpad(self, on: bool) -> None:
+        action = self.window.lookup_action("dpad")
+        state = action.get_state() if action is not None else None
+        if action is not None and state is not None:
+            if state.get_boolean() != on:
+                action.activate(None)  # the window's own toggle: D-pad, camera inset corner, menu check
+        else:
+            self.window.dpad.set_visible(on)
+
+    def close(self) -> None:
+        if self._idle:
+            GLib.source_remove(self._idle)
+            self._idle = 0
+        if self._resize_handler:
+            self.window.stage.disconnect(self._resize_handler)
+            self._resize_handler = 0
+        self.strip.close()

@@ -1,0 +1,94 @@
+"""The phone layout's one-line status: battery, Wi-Fi, link, throttle and mode in 360 px.
+
+The full status toolbar needs ~800 px; on a portrait phone it would be a row of
+hidden columns. The strip keeps what decides whether to keep driving — battery
+(amber low, red critical), the robot's Wi-Fi, the link's round trip or state,
+the throttle — and the mode, ellipsized into what is left. Plain text labels
+(mode strings are the server's words).
+"""
+
+from __future__ import annotations
+
+import gi
+
+gi.require_version("Gtk", "4.0")
+gi.require_version("Pango", "1.0")
+from gi.repository import Gtk, Pango  # noqa: E402
+
+from ..alarms import Thresholds  # noqa: E402
+from ..model import LinkLevel, OperatorState, Phase, RobotModel  # noqa: E402
+
+DASH = "—"
+SLOW_MS = Thresholds().rtt_high_ms
+
+
+class StatusStrip(Gtk.Box):
+    """See the module notes. ``labels`` by name: battery, wifi, link, speed, mode."""
+
+    def __init__(self, model: RobotModel, operator: OperatorState) -> None:
+        super().__init__(orientation=Gtk.Orientation.HORIZONTAL, spacing=6, visible=False)
+        self.add_css_class("status-strip")
+        self.model = model
+        self.operator = operator
+        self.labels: dict[str, Gtk.Label] = {}
+        for name, chars in (("battery", 6), ("wifi", 5), ("link", 5), ("speed", 4), ("mode", 3)):
+            label = Gtk.Label(xalign=0.0, width_chars=chars)
+            label.set_use_markup(False)
+            label.add_css_class(f"strip-{name}")
+            self.labels[name] = label
+            self.append(label)
+        mode = self.labels["mode"]
+        mode.set_ellipsize(Pango.EllipsizeMode.END)
+        mode.set_hexpand(True)
+        self._unobserve = [
+            model.robot.observe(self._changed),
+            model.health.observe(self._changed),
+            model.connection.observe(self._changed),
+            operator.speed.observe(self._changed),
+        ]
+        self.refresh()
+
+    def _changed(self, _old: object, _new: object) -> None:
+        if self.get_visible():  # hidden in landscape: no work at 10 Hz; shown → refreshed by the layout
+            self.refresh()
+
+    @property
+    def text(self) -> str:
+        return " | ".join(label.get_text() for label in self.labels.values())
+
+    def refresh(self) -> None:
+        robot, health = self.model.robot.value, self.model.health.value
+        connected = self.model.connection.value.phase is Phase.CONNECTED
+        if robot.battery_v is None or not connected:
+            battery = f"Bat {DASH}"
+        elif robot.battery_is_soc:
+            battery = f"Bat {robot.battery_v:.0f}%"
+        else:
+            battery = f"Bat {robot.battery_v:.1f}V"
+        self._set("battery", battery, robot.battery_state if connected else "unknown")
+        quality = robot.wifi_quality
+        wifi = DASH if quality is None or not connected else f"{round(100 * max(0, min(70, quality)) / 70)}%"
+        self._set("wifi", f"Wi-Fi {wifi}", "")
+        if not connected:
+            link, state = self.model.connection.value.phase.value, "lost"
+        elif health.level is not LinkLevel.OK:
+            link, state = health.level.value, "lost" if health.level is LinkLevel.LOST else "stale"
+        else:
+            link = f"{health.rtt_ms:.0f} ms" if health.rtt_ms is not None else "ok"
+            slow = health.rtt_ms is not None and health.rtt_ms > SLOW_MS
+            state = "stale" if slow else "ok"  # amber from where the round-trip alarm starts
+        self._set("link", link, state)
+        self._set("speed", f"{self.operator.speed.value.percent}%", "")
+        self._set("mode", robot.mode or robot.status or DASH, "")
+
+    def _set(self, name: str, text: str, state: str) -> None:
+        label = self.labels[name]
+        if label.get_text() != text:
+            label.set_text(text)
+        for css in ("low", "critical", "ok", "stale", "lost"):
+            (label.add_css_class if css == state else label.remove_css_class)(css)
+
+    def close(self) -> None:
+        for remove in self._unobserve:
+            remove()
+        self._unobserve = []

@@ -1,0 +1,116 @@
+"""Alarm levels with hysteresis: one event (one beep) per crossing, never a stream; hostile values ignored."""
+
+from __future__ import annotations
+
+import math
+
+import pytest
+
+from rtmu.alarms import Alarm, AlarmMonitor, Severity
+from rtmu.state import LinkHealth, LinkLevel, RobotState
+
+OK = LinkHealth(LinkLevel.OK, rtt_ms=5.0)
+VOLTS = RobotState(battery_v=13.0, battery_low=11.5, battery_shutdown=11.0)
+
+
+def battery(monitor: AlarmMonitor, volts: float) -> list[tuple[Severity, bool]]:
+    robot = RobotState(battery_v=volts, battery_low=11.5, battery_shutdown=11.0)
+    return [(e.severity, e.sound) for e in monitor.update(robot, OK) if e.alarm is Alarm.BATTERY]
+
+
+def test_battery_low_then_critical_beeps_once_per_crossing() -> None:
+    m = AlarmMonitor()
+    assert battery(m, 13.0) == []
+    assert battery(m, 11.5) == [(Severity.WARNING, True)]
+    assert battery(m, 11.4) == [] and battery(m, 11.45) == []
+    assert battery(m, 11.0) == [(Severity.CRITICAL, True)]
+    assert battery(m, 11.1) == [], "inside the margin over shutdown: still critical"
+    assert battery(m, 11.3) == [(Severity.WARNING, False)], "better: no beep"
+    assert battery(m, 11.6) == [], "inside the margin over low: still low"
+    assert battery(m, 11.8) == [(Severity.CLEAR, False)]
+
+
+def test_a_voltage_hovering_at_the_threshold_raises_once() -> None:
+    m = AlarmMonitor()
+    sounds = 0
+    for i in range(200):
+        volts = 11.5 + (0.05 if i % 2 else -0.05)
+        sounds += sum(s for _sev, s in battery(m, volts))
+    assert sounds == 1
+    assert m.severity(Alarm.BATTERY) is Severity.WARNING
+
+
+def test_state_of_charge_uses_the_servers_levels_or_defaults() -> None:
+    m = AlarmMonitor()
+    robot = RobotState(battery_v=50.0, battery_is_soc=True)
+    assert m.update(robot, OK) == []
+    events = m.update(RobotState(battery_v=19.0, battery_is_soc=True), OK)
+    assert [(e.alarm, e.severity) for e in events] == [(Alarm.BATTERY, Severity.WARNING)]
+    assert "19 %" in events[0].text
+    events = m.update(RobotState(battery_v=30.0, battery_low=35.0, battery_is_soc=True), OK)
+    assert events == [], "the server's own low level (35 %) keeps it low"
+
+
+def test_volts_without_levels_raise_nothing() -> None:
+    m = AlarmMonitor()
+    assert m.update(RobotState(battery_v=1.0), OK) == []
+
+
+def test_wifi_quality_hysteresis() -> None:
+    m = AlarmMonitor()
+
+    def wifi(q: int) -> list[tuple[Severity, bool]]:
+        return [
+            (e.severity, e.sound) for e in m.update(RobotState(wifi_quality=q), OK) if e.alarm is Alarm.WIFI
+        ]
+
+    assert wifi(60) == []
+    assert wifi(19) == [(Severity.WARNING, True)]
+    assert wifi(22) == [] and wifi(27) == [] and wifi(10) == []
+    assert wifi(28) == [(Severity.CLEAR, False)]
+    assert wifi(21) == []
+
+
+def test_round_trip_and_unanswered_pings() -> None:
+    m = AlarmMonitor()
+
+    def rtt(ms: float | None, failures: int = 0) -> list[Severity]:
+        h = LinkHealth(LinkLevel.OK, rtt_ms=ms, ping_failures=failures)
+        return [e.severity for e in m.update(RobotState(), h) if e.alarm is Alarm.RTT]
+
+    assert rtt(50) == []
+    assert rtt(450) == [Severity.WARNING]
+    assert rtt(300) == [] and rtt(None) == []
+    assert rtt(150) == [Severity.CLEAR]
+    assert rtt(None, failures=2) == [Severity.WARNING]
+    assert rtt(30) == [Severity.CLEAR]
+
+
+def test_disconnecting_clears_every_alarm_silently() -> None:
+    m = AlarmMonitor()
+    m.update(RobotState(battery_v=11.0, battery_low=11.5, battery_shutdown=10.0, wifi_quality=5), OK)
+    assert set(m.active) == {Alarm.BATTERY, Alarm.WIFI}
+    events = m.update(RobotState(), LinkHealth(LinkLevel.DOWN))
+    assert {e.alarm for e in events} == {Alarm.BATTERY, Alarm.WIFI}
+    assert all(e.severity is Severity.CLEAR and not e.sound for e in events)
+    assert m.active == {}
+
+
+@pytest.mark.parametrize("bad", [math.nan, math.inf, -math.inf])
+def test_hostile_readings_are_no_readings(bad: float) -> None:
+    m = AlarmMonitor()
+    m.update(RobotState(battery_v=11.2, battery_low=11.5, battery_shutdown=11.0), OK)
+    assert m.severity(Alarm.BATTERY) is Severity.WARNING
+    robot = RobotState(battery_v=bad, battery_low=bad, battery_shutdown=bad, wifi_quality=bad)  # type: ignore[arg-type]
+    assert m.update(robot, LinkHealth(LinkLevel.OK, rtt_ms=bad)) == []
+    assert m.severity(Alarm.BATTERY) is Severity.WARNING
+
+
+def test_the_mute_is_remembered_in_settings_and_checked() -> None:
+    from rtmu.settings import Settings, SettingsError, format_settings, parse_settings
+
+    assert parse_settings(format_settings(Settings())).alarms_muted is False
+    text = format_settings(Settings(alarms_muted=True))
+    assert "alarms_muted = true" in text and parse_settings(text).alarms_muted is True
+    with pytest.raises(SettingsError, match="alarms_muted"):
+        parse_settings('version = 1\nalarms_muted = "yes"\n')
