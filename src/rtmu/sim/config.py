@@ -48,4 +48,7 @@ class SimConfig:
     client reads (a 1 M-point map is 8 MB binary, 21 MB as text), so they never count whole."""
     skip_periodic_above: int = 1024 * 1024
     """Skip periodic sends to a client with this much output still queued (it is not keeping up)."""
+    start_pose: tuple[float, float, float] | None = None
+    """Where the robot starts (x, y mm, th deg; moved to the nearest free spot); None: the map's home.
+    ``rtmu sim --robots N`` gives each robot its own (``sim.multi``)."""
     verbose: bool = False

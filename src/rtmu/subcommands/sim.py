@@ -80,6 +80,14 @@ def register(subparsers: argparse._SubParsersAction) -> None:
         help="enforce and advertise this protocol string, refusing others with reason 4 "
         "(default: the profile's — none, or 6MTX for aram)",
     )
+    p.add_argument(
+        "--robots",
+        type=int,
+        default=1,
+        metavar="N",
+        help="run N robots on the map, one server each on consecutive ports from --port, "
+        "named robot1…N (default 1)",
+    )
     p.add_argument("-v", "--verbose", action="store_true", help="log connections and refusals")
     gen = p.add_argument_group("map generator (writes a map and exits)")
     gen.add_argument("--make-map", type=Path, metavar="FILE", help="write a generated building map to FILE")
@@ -125,7 +133,7 @@ def run(args: argparse.Namespace) -> int:
 
         logging.basicConfig(level=logging.INFO, format="%(asctime)s %(name)s: %(message)s")
     try:
-        return asyncio.run(serve(cfg))
+        return asyncio.run(serve(cfg) if args.robots == 1 else serve_fleet(cfg, args.robots))
     except KeyboardInterrupt:
         return EXIT_OK
 
@@ -166,6 +174,36 @@ async def serve(cfg) -> int:
     await stop.wait()
     print("rtmu sim: stopping (telling clients SHUTDOWN)", flush=True)
     await server.stop()
+    return EXIT_OK
+
+
+async def serve_fleet(cfg, count: int) -> int:
+    """``--robots N``: N servers on one loop (``sim.multi``), one line per robot, Ctrl-C stops all."""
+    from ..maps import MapFormatError
+    from ..sim.multi import SimFleet, fleet_configs
+
+    try:
+        fleet = SimFleet(fleet_configs(cfg, count))
+    except (OSError, MapFormatError, ValueError) as exc:
+        print(f"rtmu sim: cannot load: {exc}", file=sys.stderr)
+        return EXIT_BAD_INPUT
+    try:
+        await fleet.start()
+    except OSError as exc:
+        print(f"rtmu sim: cannot listen: {exc.strerror or exc}", file=sys.stderr)
+        return EXIT_CANNOT_LISTEN
+    for robot, server in zip(fleet.robots, fleet.servers, strict=True):
+        x, y, th = server.home
+        print(f"rtmu sim: {robot.name} listening on {cfg.host}:{server.port}, "
+              f"at ({x:.0f}, {y:.0f}) mm, {th:.0f} deg", flush=True)  # fmt: skip
+    stop = asyncio.Event()
+    loop = asyncio.get_running_loop()
+    for sig in (signal.SIGINT, signal.SIGTERM):
+        with contextlib.suppress(NotImplementedError, RuntimeError):
+            loop.add_signal_handler(sig, stop.set)
+    await stop.wait()
+    print("rtmu sim: stopping every robot (telling clients SHUTDOWN)", flush=True)
+    await fleet.stop()
     return EXIT_OK
 
 
