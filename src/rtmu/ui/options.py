@@ -9,6 +9,8 @@ from __future__ import annotations
 from dataclasses import dataclass
 from pathlib import Path
 
+from ..settings import DirectRobot
+
 APP_ID = "io.github.rtmu.Rtmu"
 
 
@@ -28,5 +30,7 @@ class GuiOptions:
     report_first_frame: bool = False
     protocol: str | None = None
     """Protocol string to log in with (None: the profile's; by default the server's own)."""
+    fleet: tuple[DirectRobot, ...] = ()
+    """Robots to open the window on at once (``--demo --robots N``); empty: the profile's."""
     guardian: bool = True
     """Start a guardian process per connection (``rtmu.guardian``); off only to measure without it."""
