@@ -19,6 +19,7 @@ import time
 from collections.abc import Iterator
 from pathlib import Path
 
+import gi
 import numpy as np
 import pytest
 
@@ -32,6 +33,9 @@ from rtmu.ui.overlays import STALE_RGB
 from rtmu.ui.robot_list import row_text
 
 from .harness import OFFICE_MAP, Gui, idle, pump, scratch_dir
+
+gi.require_version("Gtk", "4.0")
+from gi.repository import Gtk  # noqa: E402
 
 
 @pytest.fixture
@@ -214,4 +218,47 @@ def test_one_killed_server_greys_its_robot_and_the_rest_carry_on(
         assert not row_text(second).stale and not row_text(session(gui, "robot1")).stale
     finally:
         gui.keyup("Up")
+        gui.close()
+
+
+def test_a_narrow_window_folds_the_list_under_the_map_and_names_stay_plain_text(
+    screenshots: Path, sims: list[SimThread]
+) -> None:
+    hostile = '<b>robot</b>\x1b[31m"2"'
+    robots = (
+        DirectRobot("robot1", "127.0.0.1", sims[0].port),
+        DirectRobot(hostile, "127.0.0.1", sims[1].port),
+    )
+    options = GuiOptions(
+        fleet=robots, settings_path=scratch_dir("settings-") / "settings.toml", persist=False
+    )
+    gui = Gui.open(options, screenshots, "fleet-narrow")
+    try:
+        b = binding(gui)
+        gui.window.set_default_size(520, 480)
+        pump(lambda: 0 < gui.window.get_width() < 560, 5, "the window to narrow")
+        pump(lambda: b.robot_list.fold.get_visible(), 3, "the list to become a strip")
+        assert gui.window.body.get_orientation() is Gtk.Orientation.VERTICAL
+        row = b.robot_list.row_of(session(gui, hostile))
+        assert row is not None
+        assert row.name.get_text() == '<b>robot</b> [31m"2"' and not row.name.get_use_markup()
+        gui.shot("narrow-strip")
+        strip = b.robot_list.get_height()
+        gui.click(b.robot_list.fold)
+        pump(lambda: not b.robot_list.revealer.get_child_revealed(), 3, "the strip to fold")
+        pump(lambda: b.robot_list.get_height() < strip, 3, "the map to take the room")
+        gui.shot("narrow-folded")
+        assert gui.stage.get_height() > 0
+    finally:
+        gui.close()
+
+
+def test_a_one_robot_profile_shows_no_robot_list(screenshots: Path, sims: list[SimThread]) -> None:
+    gui = Gui.start(screenshots, "fleet-of-one", "127.0.0.1", sims[0].port)
+    try:
+        assert gui.app.fleet_binding is None and len(gui.app.fleet) == 1
+        body = gui.window.body
+        assert body.get_first_child() is body.get_last_child(), "something beside the map of one robot"
+        gui.shot("one-robot")
+    finally:
         gui.close()

@@ -135,6 +135,11 @@ class RtmuApplication(Gtk.Application):
         # The guardian: a separate process that stops the robot if this one is killed or frozen.
         config = SessionConfig(guardian=self.options.guardian)
         roster = self.roster_for(profile)
+        if roster is None and profile.central:
+            # ARIA's central server: client/central.py's CentralRoster plugs in at roster_for.
+            self._fleet_notes.append(f"“{profile.name}” names a central server ({profile.central}), "
+                                     "which this RTMU cannot reach yet: nothing was connected")  # fmt: skip
+            auto_connect = False
         mirror: SelectedModel | None = None
         if roster is not None:
             session = self._follow(roster, profile, config)

@@ -16,6 +16,7 @@ Wiring only (the window composes it; it owns no socket and no robot). It
 from __future__ import annotations
 
 from collections.abc import Callable, Mapping, Sequence
+from itertools import islice
 
 import gi
 
@@ -33,6 +34,8 @@ from .overlays import ROBOT_RGB  # noqa: E402
 from .robot_list import NARROW_PX, RobotList  # noqa: E402
 from .window import MainWindow  # noqa: E402
 
+OTHER_TRAIL = 300
+"""Trail points drawn for a robot not selected (its latest; the selected robot's whole trail is drawn)."""
 REFRESH_MS = 300
 """How often rows re-read what changes without an event (a status growing old, the window's width)."""
 QUIET_KINDS = (Kind.CONNECTION, Kind.LINK, Kind.SPEED, Kind.SPEED_LIMIT)
@@ -140,12 +143,14 @@ class FleetBinding:
         self.window.stage.queue_draw()
 
     def _robot_changed(self, session: RobotSession) -> None:
-        self.robot_list.refresh(session)
+        # Rows are refreshed on the timer (``_refresh``): a status per robot every 100 ms must not
+        # cost a row update each; the map shows poses at once.
         if session is not self.fleet.selected.value:
             self.window.stage.queue_draw()  # the selected robot's own changes redraw through the window
 
     def _connection_changed(self, session: RobotSession, old: ConnectionState, new: ConnectionState) -> None:
         self._robot_changed(session)
+        self.robot_list.refresh(session)
         lost = old.phase is Phase.CONNECTED and new.phase in (Phase.RECONNECTING, Phase.FAILED)
         if lost and session is not self.fleet.selected.value and len(self.fleet) > 1:
             why = f" ({new.error})" if new.error else ""
@@ -186,8 +191,9 @@ class FleetBinding:
                 self.drawn_updates[session.name] = self.drawn_updates.get(session.name, 0) + 1
             if session is selected or r.numbers_at is None or session.state.map.value.name != shown_map:
                 continue
-            out.append(FleetMark(r.x, r.y, r.th, self.colour(session), self._stale(session),
-                                 session.state.trail.points))  # fmt: skip
+            trail = session.state.trail.points
+            tail = islice(trail, max(0, len(trail) - OTHER_TRAIL), None)
+            out.append(FleetMark(r.x, r.y, r.th, self.colour(session), self._stale(session), tuple(tail)))
         return out, rgb
 
     @staticmethod

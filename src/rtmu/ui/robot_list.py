@@ -71,7 +71,7 @@ def row_text(session: RobotSession) -> RowText:
             Phase.FAILED: "link lost" if conn.error else "failed",
         }[conn.phase]
     stale = conn.phase is not Phase.CONNECTED or health.level is not LinkLevel.OK
-    return RowText(session.name, " · ".join(words) or "—", battery, link, stale)
+    return RowText(_short(session.name), " · ".join(words) or "—", battery, link, stale)
 
 
 class _Row(Gtk.ListBoxRow):
