@@ -19,6 +19,7 @@ from collections.abc import Callable, Mapping, Sequence
 from itertools import islice
 
 import gi
+import numpy as np
 
 gi.require_version("Gtk", "4.0")
 from gi.repository import GLib, Gtk  # noqa: E402
@@ -74,6 +75,9 @@ class FleetBinding:
         self._colours: dict[int, RGB] = {}
         self._hooks: dict[int, list[Callable[[], None]]] = {}
         self._seen: dict[int, float | None] = {}
+        self._trails: dict[int, tuple[object, np.ndarray]] = {}
+        self._lost: dict[str, str] = {}
+        """Robots not shown whose link is lost (name → reason), in the order they were lost."""
         self.drawn_updates: dict[str, int] = {}
         """Per robot name: frames that showed a new status of it (the benchmark's on-screen rate)."""
         self.robot_list = RobotList(select=fleet.select, colour=self.colour)
@@ -105,6 +109,7 @@ class FleetBinding:
             for unhook in self._hooks.pop(key):
                 unhook()
             self._seen.pop(key, None)
+            self._trails.pop(key, None)
         selected = self.fleet.selected.value
         for session in sessions:
             if id(session) in self._hooks:
@@ -115,6 +120,10 @@ class FleetBinding:
                 session.attach_view(BackgroundView(self.window, session.name))
         self.robot_list.set_sessions(sessions, selected)
         self.robot_list.set_visible(len(sessions) > 1)
+        names = {s.name for s in sessions}
+        if any(name not in names for name in self._lost):
+            self._lost = {n: e for n, e in self._lost.items() if n in names}
+            self._tell_lost()
         self.window.stage.queue_draw()
 
     def _hook(self, session: RobotSession) -> list[Callable[[], None]]:
@@ -137,6 +146,8 @@ class FleetBinding:
         if new is None:
             return
         self.window.show_session(new)
+        if self._lost.pop(new.name, None) is not None:  # the window's own link banner speaks for it now
+            self._tell_lost()
         if old is not None and not old.closed:
             old.attach_view(BackgroundView(self.window, old.name))
         self.robot_list.show_selected(new)
@@ -153,9 +164,26 @@ class FleetBinding:
         self.robot_list.refresh(session)
         lost = old.phase is Phase.CONNECTED and new.phase in (Phase.RECONNECTING, Phase.FAILED)
         if lost and session is not self.fleet.selected.value and len(self.fleet) > 1:
-            why = f" ({new.error})" if new.error else ""
-            text = f"{session.name}: link lost{why} — the other robots carry on"
-            self.window.banners.tell(f"fleet:{session.name}", "warning", text, timeout=8.0)
+            self._lost[session.name] = new.error
+        elif new.phase is Phase.CONNECTED or session.closed:
+            self._lost.pop(session.name, None)
+        else:
+            return
+        self._tell_lost()
+
+    def _tell_lost(self) -> None:
+        """ONE banner, updated in place, names the robots (not shown) whose link is lost."""
+        if not self._lost:
+            self.window.banners.dismiss("fleet:links")
+            return
+        if len(self._lost) == 1:
+            name, error = next(iter(self._lost.items()))
+            text = f"{name}: link lost" + (f" ({error})" if error else "")
+        else:
+            text = f"{len(self._lost)} robots lost their link: {', '.join(self._lost)}"
+        self.window.banners.tell(
+            "fleet:links", "warning", text + " — the other robots carry on", timeout=None
+        )
 
     def _refresh(self) -> bool:
         """Rows and markers of robots that went quiet (no event says so), and the window's width."""
@@ -191,10 +219,21 @@ class FleetBinding:
                 self.drawn_updates[session.name] = self.drawn_updates.get(session.name, 0) + 1
             if session is selected or r.numbers_at is None or session.state.map.value.name != shown_map:
                 continue
-            trail = session.state.trail.points
-            tail = islice(trail, max(0, len(trail) - OTHER_TRAIL), None)
-            out.append(FleetMark(r.x, r.y, r.th, self.colour(session), self._stale(session), tuple(tail)))
+            trail = self._trail_array(session)
+            out.append(FleetMark(r.x, r.y, r.th, self.colour(session), self._stale(session), trail))
         return out, rgb
+
+    def _trail_array(self, session: RobotSession) -> np.ndarray:
+        """The robot's latest trail points as an (n, 2) array, rebuilt only when the trail changed."""
+        points = session.state.trail.points
+        key = (len(points), points[-1] if points else None)
+        cached = self._trails.get(id(session))
+        if cached is not None and cached[0] == key:
+            return cached[1]
+        tail = islice(points, max(0, len(points) - OTHER_TRAIL), None)
+        array = np.array(list(tail), dtype=float).reshape(-1, 2)
+        self._trails[id(session)] = (key, array)
+        return array
 
     @staticmethod
     def _stale(session: RobotSession) -> bool:

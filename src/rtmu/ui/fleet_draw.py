@@ -49,7 +49,8 @@ class FleetMark:
     th: float
     rgb: RGB
     stale: bool
-    trail: Sequence[tuple[float, float]] = ()
+    trail: Sequence[tuple[float, float]] | np.ndarray = ()
+    """The trail in mm: points, or an (n, 2) array (the window hands a cached array)."""
 
 
 def draw_fleet(ctx: cairo.Context, vp: Viewport, marks: Sequence[FleetMark], *, footprint: bool) -> None:
@@ -62,7 +63,7 @@ def draw_fleet(ctx: cairo.Context, vp: Viewport, marks: Sequence[FleetMark], *, 
         )
 
 
-def screen_polyline(vp: Viewport, trail: Sequence[tuple[float, float]]) -> np.ndarray:
+def screen_polyline(vp: Viewport, trail: Sequence[tuple[float, float]] | np.ndarray) -> np.ndarray:
     """``trail`` (mm) on screen, as an (n, 2) array without points that fall on the previous one."""
     if len(trail) < 2:
         return np.empty((0, 2))
@@ -76,7 +77,9 @@ def screen_polyline(vp: Viewport, trail: Sequence[tuple[float, float]]) -> np.nd
     return xy[keep]
 
 
-def _draw_trail(ctx: cairo.Context, vp: Viewport, trail: Sequence[tuple[float, float]], rgb: RGB) -> None:
+def _draw_trail(
+    ctx: cairo.Context, vp: Viewport, trail: Sequence[tuple[float, float]] | np.ndarray, rgb: RGB
+) -> None:
     xy = screen_polyline(vp, trail)
     if len(xy) < 2:
         return

@@ -61,8 +61,6 @@ def row_text(session: RobotSession) -> RowText:
         link = {LinkLevel.OK: "link ok", LinkLevel.STALE: "link stale", LinkLevel.LOST: "link lost"}.get(
             health.level, "connected"
         )
-        if health.level is LinkLevel.OK and health.rtt_ms is not None:
-            link = f"link ok · {health.rtt_ms:.0f} ms"
     else:
         link = {
             Phase.DISCONNECTED: "not connected",
