@@ -66,7 +66,7 @@ def measure(count: int, display: str) -> dict[str, float]:
     with _sims(count) as ports:
         out = subprocess.run(
             [sys.executable, "-m", "bench.fleet_window", str(SECONDS), *map(str, ports)],
-            cwd=REPO, env=env, capture_output=True, text=True, timeout=300,
+            cwd=REPO, env=env, capture_output=True, text=True, timeout=900,
         )  # fmt: skip
     found = re.search(r"^RESULT (.*)$", out.stdout, re.MULTILINE)
     if found is None:
