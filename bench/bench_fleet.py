@@ -13,6 +13,8 @@ every robot has its map and status, 10 s are measured:
   status is sent at 10 Hz).
 * ``fleet.cpu_cores.{1,5,20}_robots`` (cores): CPU seconds per second of the window process
   and its children (the guardian processes), simulators excluded (target < 1).
+* ``fleet.ready_s.{1,5,20}_robots`` (s): window start until every robot has its status and
+  its map (each robot downloads the map itself).
 
 Needs Xvfb (started here when ``DISPLAY`` is unset); without one the figures are skipped.
 """
@@ -91,5 +93,6 @@ def run() -> list[Result]:
             Result(f"fleet.frame_ms.{tag}.p95", f["frame_ms_p95"], "ms", base),
             Result(f"fleet.updates_per_s_min.{tag}", f["updates_per_s_min"], "1/s"),
             Result(f"fleet.cpu_cores.{tag}", f["cpu"], "cores"),
+            Result(f"fleet.ready_s.{tag}", f["ready_s"], "s"),
         ]
     return results

@@ -58,16 +58,30 @@ def cpu_seconds(pid: int) -> float:
     return total
 
 
+def describe() -> str:
+    """Each robot's connection phase, map state and whether it has a status (why it is not ready)."""
+    app = RtmuApplication.get_default()
+    fleet = getattr(app, "fleet", None)
+    if fleet is None:
+        return "no application"
+    return "; ".join(
+        f"{s.name}: {s.state.connection.value.phase.value}, map {s.state.map.value.state}, "
+        f"status {'yes' if s.state.robot.value.numbers_at is not None else 'no'}"
+        for s in fleet
+    )
+
+
 def pump_until(ready, timeout: float) -> None:  # type: ignore[no-untyped-def]
     ctx = GLib.MainContext.default()
     deadline = time.monotonic() + timeout
     while not ready():
         if time.monotonic() > deadline:
-            raise SystemExit("the fleet never became ready")
+            raise SystemExit(f"the fleet never became ready: {describe()}")
         ctx.iteration(True)
 
 
 def main(seconds: float, ports: list[int]) -> None:
+    started = time.monotonic()
     robots = tuple(DirectRobot(f"robot{i + 1}", "127.0.0.1", p) for i, p in enumerate(ports))
     config = Path(tempfile.mkdtemp(prefix="rtmu-bench-fleet-")) / "settings.toml"
     app = RtmuApplication(GuiOptions(fleet=robots, settings_path=config, persist=False))
@@ -80,7 +94,8 @@ def main(seconds: float, ports: list[int]) -> None:
             s.state.robot.value.numbers_at is not None and s.state.map.value.state == "ready" for s in fleet
         )
 
-    pump_until(ready, 300)
+    pump_until(ready, 600)
+    waited = time.monotonic()
     window, binding = app.window, app.fleet_binding
     assert window is not None and binding is not None
     pump_until(lambda: window.stage.last_frame_complete, 60)
@@ -104,6 +119,7 @@ def main(seconds: float, ports: list[int]) -> None:
         "updates_per_s_min": min(rates.values()),
         "updates_per_s_mean": statistics.fmean(rates.values()),
         "cpu": (cpu1 - cpu0) / (t1 - t0),
+        "ready_s": waited - started,
     }
     print("RESULT " + json.dumps(out), flush=True)
     app.close_session()
