@@ -80,6 +80,13 @@ def run_gui(args: argparse.Namespace) -> int:
     if options.port is not None and not 1 <= options.port <= 65535:
         print(f"rtmu: --port {options.port} is not 1…65535", file=sys.stderr)
         return 2
+    robots = getattr(args, "robots", 1)
+    if robots != 1 and not options.demo:
+        print("rtmu: --robots N goes with --demo (a fleet profile names real robots)", file=sys.stderr)
+        return 2
+    if not 1 <= robots <= 50:
+        print(f"rtmu: --robots {robots} is not 1…50", file=sys.stderr)
+        return 2
     if not display_available():
         print(
             "rtmu: cannot open a display (is DISPLAY or WAYLAND_DISPLAY set?); "
@@ -88,10 +95,6 @@ def run_gui(args: argparse.Namespace) -> int:
         )
         return EXIT_NO_DISPLAY
     sim = None
-    robots = int(getattr(args, "robots", 1) or 1)
-    if robots != 1 and not options.demo:
-        print("rtmu: --robots N goes with --demo (a fleet profile names real robots)", file=sys.stderr)
-        return 2
     if options.demo:
         try:
             sim = start_demo_simulator(robots)
