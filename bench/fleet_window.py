@@ -9,7 +9,7 @@ SECONDS, prints one JSON line and quits (stopping every robot). Measured:
 * ``updates_per_s``: per robot, frames that showed a status of it not shown before
   (``FleetBinding.drawn_updates``) per second;
 * ``cpu``: CPU seconds per second of this process and its children (the guardian processes)
-  over the same interval, from ``/proc``.
+  over the same interval, from ``/proc``; ``cpu_window``: this process alone.
 """
 
 from __future__ import annotations
@@ -35,8 +35,8 @@ from rtmu.ui.options import GuiOptions  # noqa: E402
 TICKS = os.sysconf("SC_CLK_TCK")
 
 
-def cpu_seconds(pid: int) -> float:
-    """utime + stime of ``pid`` and every live descendant."""
+def cpu_seconds(pid: int, *, descendants: bool = True) -> float:
+    """utime + stime of ``pid`` and (unless told not to) every live descendant."""
     children: dict[int, list[int]] = {}
     for entry in Path("/proc").iterdir():
         if not entry.name.isdigit():
@@ -54,7 +54,7 @@ def cpu_seconds(pid: int) -> float:
         except OSError:
             continue
         total += (int(fields[11]) + int(fields[12])) / TICKS
-        todo += children.get(p, [])
+        todo += children.get(p, []) if descendants else []
     return total
 
 
@@ -103,10 +103,12 @@ def main(seconds: float, ports: list[int]) -> None:
     pump_until(lambda: time.monotonic() > end, 10)
     window.stage.frame_times = deque(maxlen=1_000_000)  # every frame of the interval, not the last 240
     before = dict(binding.drawn_updates)
+    own0 = cpu_seconds(os.getpid(), descendants=False)
     cpu0, t0 = cpu_seconds(os.getpid()), time.monotonic()
     end = t0 + seconds
     pump_until(lambda: time.monotonic() > end, seconds + 10)
     cpu1, t1 = cpu_seconds(os.getpid()), time.monotonic()
+    own1 = cpu_seconds(os.getpid(), descendants=False)
     frames = sorted(window.stage.frame_times)
     rates = {name: (binding.drawn_updates.get(name, 0) - before.get(name, 0)) / (t1 - t0) for name in
              (s.name for s in fleet)}  # fmt: skip
@@ -120,6 +122,7 @@ def main(seconds: float, ports: list[int]) -> None:
         "updates_per_s_mean": statistics.fmean(rates.values()),
         "cpu": (cpu1 - cpu0) / (t1 - t0),
         "ready_s": waited - started,
+        "cpu_window": (own1 - own0) / (t1 - t0),
     }
     print("RESULT " + json.dumps(out), flush=True)
     app.close_session()

@@ -37,6 +37,8 @@ from .window import MainWindow  # noqa: E402
 
 OTHER_TRAIL = 300
 """Trail points drawn for a robot not selected (its latest; the selected robot's whole trail is drawn)."""
+OTHERS_REDRAW_MS = 66
+"""At most ~15 redraws a second for the robots not selected (their status comes at 10 Hz each)."""
 REFRESH_MS = 300
 """How often rows re-read what changes without an event (a status growing old, the window's width)."""
 QUIET_KINDS = (Kind.CONNECTION, Kind.LINK, Kind.SPEED, Kind.SPEED_LIMIT)
@@ -92,6 +94,7 @@ class FleetBinding:
         self._stale_seen: tuple[bool, ...] = ()
         self._sessions_changed()
         self._fit_width()
+        self._redraw_source = 0
         self._timer = GLib.timeout_add(REFRESH_MS, self._refresh)
 
     def colour(self, session: RobotSession) -> RGB:
@@ -156,8 +159,16 @@ class FleetBinding:
     def _robot_changed(self, session: RobotSession) -> None:
         # Rows are refreshed on the timer (``_refresh``): a status per robot every 100 ms must not
         # cost a row update each; the map shows poses at once.
-        if session is not self.fleet.selected.value:
-            self.window.stage.queue_draw()  # the selected robot's own changes redraw through the window
+        if session is not self.fleet.selected.value and not self._redraw_source:
+            # The selected robot's own changes redraw through the window at once; the others' are
+            # gathered into at most one redraw per OTHERS_REDRAW_MS (20 robots at 10 Hz would
+            # otherwise ask for a frame every 5 ms; each frame shows every robot's latest status).
+            self._redraw_source = GLib.timeout_add(OTHERS_REDRAW_MS, self._redraw_others)
+
+    def _redraw_others(self) -> bool:
+        self._redraw_source = 0
+        self.window.stage.queue_draw()
+        return False
 
     def _connection_changed(self, session: RobotSession, old: ConnectionState, new: ConnectionState) -> None:
         self._robot_changed(session)
@@ -247,6 +258,9 @@ class FleetBinding:
         return age is None or age > STALE_AFTER
 
     def close(self) -> None:
+        if self._redraw_source:
+            GLib.source_remove(self._redraw_source)
+            self._redraw_source = 0
         if self._timer:
             GLib.source_remove(self._timer)
             self._timer = 0
