@@ -23,19 +23,21 @@ import gi
 import numpy as np
 import pytest
 
+from rtmu.client.roster import Emit, RobotAdded, RobotEndpoint
 from rtmu.fleet import RobotSession
 from rtmu.settings import DirectRobot
 from rtmu.sim import SimConfig, SimThread
 from rtmu.sim.multi import SimFleetThreads, fleet_configs
+from rtmu.ui.application import RtmuApplication
 from rtmu.ui.fleet_bind import FleetBinding
 from rtmu.ui.options import GuiOptions
 from rtmu.ui.overlays import STALE_RGB
 from rtmu.ui.robot_list import row_text
 
-from .harness import OFFICE_MAP, Gui, idle, pump, scratch_dir
+from .harness import OFFICE_MAP, OPEN, Gui, idle, pump, scratch_dir
 
 gi.require_version("Gtk", "4.0")
-from gi.repository import Gtk  # noqa: E402
+from gi.repository import GLib, Gtk  # noqa: E402
 
 
 @pytest.fixture
@@ -260,5 +262,52 @@ def test_a_one_robot_profile_shows_no_robot_list(screenshots: Path, sims: list[S
         body = gui.window.body
         assert body.get_first_child() is body.get_last_child(), "something beside the map of one robot"
         gui.shot("one-robot")
+    finally:
+        gui.close()
+
+
+class LateRoster:
+    """A roster that names its robots a moment after it starts, as a central server does."""
+
+    def __init__(self, endpoints: list[RobotEndpoint]) -> None:
+        self.endpoints = endpoints
+        self.closed = False
+
+    def start(self, emit: Emit) -> None:
+        def later() -> bool:
+            for endpoint in self.endpoints:
+                if not self.closed:
+                    emit(RobotAdded(endpoint))
+            return False
+
+        GLib.timeout_add(700, later)
+
+    def close(self) -> None:
+        self.closed = True
+
+
+def test_robots_a_roster_names_later_appear_and_the_first_is_shown(
+    screenshots: Path, sims: list[SimThread]
+) -> None:
+    late = LateRoster([RobotEndpoint(f"robot{i + 1}", "127.0.0.1", sim.port) for i, sim in enumerate(sims)])
+    options = GuiOptions(
+        settings_path=scratch_dir("settings-") / "settings.toml", persist=False, connect=False
+    )
+    app = RtmuApplication(options)
+    app.roster_for = lambda _profile: late  # type: ignore[method-assign]
+    app.register(None)
+    gui = Gui(app, screenshots, "fleet-late-roster")
+    OPEN[id(gui)] = gui.close
+    app.activate()
+    try:
+        pump(lambda: app.window is not None and app.window.get_mapped(), 10, "the window")
+        assert len(app.fleet) == 0 and binding(gui).robot_list.get_visible() is False
+        pump(lambda: len(app.fleet) == 3, 10, "the roster's robots")
+        first = session(gui, "robot1")
+        pump(lambda: gui.window.session is first, 5, "the first robot to be shown")
+        pump(lambda: first.state.connection.value.connected, 10, "robot1 to connect")
+        pump(lambda: gui.model.robot.value.numbers_at is not None, 10, "robot1's status in the window")
+        assert binding(gui).robot_list.get_visible()
+        gui.shot("late-robots")
     finally:
         gui.close()

@@ -86,6 +86,8 @@ class RtmuApplication(Gtk.Application):
         self.fleet = Fleet()
         self.window: MainWindow | None = None
         self.fleet_binding: FleetBinding | None = None
+        self._stand_in: RobotSession | None = None
+        """What the window shows while a fleet has no robot yet (never connected, not in the fleet)."""
         self._fleet_notes: list[str] = []
         """Roster notices said before the window existed."""
         self.settings = Settings()
@@ -211,7 +213,11 @@ class RtmuApplication(Gtk.Application):
         self.fleet.follow(roster, make, self._announce)
         session = self.fleet.selected.value
         if session is None:
-            raise RuntimeError("the fleet profile names no robot")
+            # A roster that announces its robots later (a central server): the window shows this
+            # unconnected stand-in until the first robot arrives and is selected.
+            session = RobotSession(self.fleet.operator, post=GLib.idle_add, config=config, profile=profile,
+                                   secrets=self.secrets).start()  # fmt: skip
+            self._stand_in = session
         return session
 
     def _announce(self, text: str) -> None:
@@ -241,6 +247,9 @@ class RtmuApplication(Gtk.Application):
             self._remember_view(window)
             window.shutdown()
         self.fleet.close(RUNNER_CLOSE_TIMEOUT)
+        if self._stand_in is not None:
+            self._stand_in.close(RUNNER_CLOSE_TIMEOUT)
+            self._stand_in = None
         if self.options.persist and window is not None:
             self._save(background=False)
         for source in self._signal_sources:
