@@ -11,6 +11,7 @@ with driving.
 
 from __future__ import annotations
 
+import math
 from collections.abc import Callable
 from dataclasses import dataclass
 
@@ -104,8 +105,6 @@ class _Row(Gtk.ListBoxRow):
         return label
 
     def _draw_swatch(self, _area: Gtk.DrawingArea, ctx: object, width: int, height: int) -> None:
-        import math
-
         grey = self.shown is not None and self.shown.stale
         ctx.set_source_rgb(*((0.6, 0.61, 0.64) if grey else self.rgb))  # type: ignore[attr-defined]
         ctx.arc(width / 2, height / 2, min(width, height) / 2, 0, 2 * math.pi)  # type: ignore[attr-defined]
