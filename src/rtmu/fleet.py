@@ -10,9 +10,13 @@ which holds the drive lease, the session and its guardian) and its
 The :class:`Fleet` owns the sessions, says which one is selected, and stops
 them all at once: the application's close, quit, suspend and signal paths go
 through :meth:`Fleet.stop_all` / :meth:`Fleet.close`, so no robot is left
-driving because a window only knew about another one. Today's window is a
-fleet of one. GTK-free: ``post`` is ``GLib.idle_add`` in the app and a direct
-call or a queue in tests; everything here runs on the UI thread.
+driving because a window only knew about another one. A fleet follows a
+:class:`~rtmu.client.roster.Roster` (:meth:`Fleet.follow`): a robot added gets its
+own session, which connects; a robot removed has its session closed (stopped
+first); a lost roster stops every robot and says so once. Selecting a robot
+first stops the one selected before, so a held key never carries over.
+GTK-free: ``post`` is ``GLib.idle_add`` in the app and a direct call or a
+queue in tests; everything here runs on the UI thread.
 """
 
 from __future__ import annotations
@@ -20,10 +24,20 @@ from __future__ import annotations
 import concurrent.futures
 import time
 from collections.abc import Callable
+from dataclasses import replace
 from pathlib import Path
 from typing import Any, cast
 
 from .client.link import Opener, open_tcp
+from .client.roster import (
+    DirectRoster,
+    RobotAdded,
+    RobotEndpoint,
+    RobotRemoved,
+    Roster,
+    RosterEvent,
+    RosterLost,
+)
 from .client.runner import ClientRunner, Post, call_directly, settle
 from .client.session import SessionConfig
 from .commands import COMMANDS, CommandRegistry
@@ -126,6 +140,24 @@ def recorder_for(settings: RecordingSettings | None) -> Recorder | None:
     return Recorder(config)
 
 
+def robot_profile(base: Profile, endpoint: RobotEndpoint) -> Profile:
+    """The profile one robot of a fleet connects with: ``base``'s user and choices, its own address."""
+    return replace(base, name=endpoint.name, host=endpoint.host, port=endpoint.port, robots=(), central="")
+
+
+def direct_roster(profile: Profile) -> DirectRoster | None:
+    """The roster of a profile that lists its robots (None: one robot, or a central server's)."""
+    if not profile.robots:
+        return None
+    return DirectRoster([RobotEndpoint(r.name, r.host, r.port) for r in profile.robots])
+
+
+SessionMaker = Callable[[RobotEndpoint], RobotSession]
+"""Builds (not starts) the session of one robot a roster announced."""
+Announce = Callable[[str], None]
+"""Tells the operator one sentence (a window banner; a list in tests)."""
+
+
 class Fleet:
     """The robot sessions of one application, the selected one, and :meth:`stop_all`.
 
@@ -136,6 +168,67 @@ class Fleet:
         self.operator = operator or OperatorState()
         self.sessions: Observable[tuple[RobotSession, ...]] = Observable(())
         self.selected: Observable[RobotSession | None] = Observable(None)
+        self._roster: Roster | None = None
+        self._make: SessionMaker | None = None
+        self._announce: Announce = lambda _text: None
+        self.roster_lost: str | None = None
+        """Why the roster went away (None while it is there): said once, every robot stopped."""
+
+    # -- the roster ------------------------------------------------------------------------------
+    def follow(self, roster: Roster, make: SessionMaker, announce: Announce | None = None) -> None:
+        """Build a session per robot ``roster`` announces (``make``), start it and connect it.
+
+        Call once, on the UI thread; the roster must deliver its events on this thread too
+        (its ``post``). The first robot becomes the selection; later ones do not take it.
+        """
+        if self._roster is not None:
+            raise RuntimeError("this fleet already follows a roster")
+        self._roster, self._make = roster, make
+        if announce is not None:
+            self._announce = announce
+        roster.start(self.on_roster)
+
+    def on_roster(self, event: RosterEvent) -> None:
+        """One roster event (see :mod:`rtmu.client.roster`)."""
+        match event:
+            case RobotAdded(endpoint):
+                self._robot_added(endpoint)
+            case RobotRemoved(name, reason):
+                session = self.named(name)
+                if session is not None:
+                    self.remove(session)
+                    self._announce(f"{name} left the fleet" + (f": {reason}" if reason else ""))
+            case RosterLost(reason):
+                self._roster_lost(reason)
+
+    def _robot_added(self, endpoint: RobotEndpoint) -> None:
+        if self._make is None or self.roster_lost is not None:
+            return
+        old = self.named(endpoint.name)
+        if old is not None:  # announced again (a central server's robot came back): a fresh session
+            self.remove(old)
+        session = self._make(endpoint).start()
+        self.add(session, select=self.selected.value is None)
+        session.controller.connect()
+
+    def _roster_lost(self, reason: str) -> None:
+        """Every robot of the roster is gone: stop them all at once, say it ONCE, then close them."""
+        if self.roster_lost is not None:
+            return
+        self.roster_lost = reason
+        self.stop_all()
+        sessions = self.sessions.value
+        for session in sessions:
+            session.controller.view = NoView()  # their own link-lost notices would repeat this one
+        self._announce(f"Lost the robot list ({reason}): every robot was told to stop")
+        for session in sessions:
+            session.close()
+        self.sessions.set(())
+        self.selected.set(None)
+
+    def named(self, name: str) -> RobotSession | None:
+        """The session of the robot called ``name`` (its profile's name), if any."""
+        return next((s for s in self.sessions.value if s.name == name), None)
 
     def __iter__(self) -> Any:
         return iter(self.sessions.value)
@@ -155,8 +248,20 @@ class Fleet:
             self.selected.set(session)
 
     def select(self, session: RobotSession) -> None:
+        """Make ``session`` the one that takes the drive keys, D-pad and navigation commands.
+
+        The robot selected before is stopped first: its drive lease ends and it is sent a stop, and
+        its held keys stay blocked, so nothing held carries over — the new robot moves only on a
+        fresh press. A navigation the server runs on it goes on (the operator did not ask to stop
+        that; STOP on that robot still ends it).
+        """
         if session not in self.sessions.value:
             raise ValueError("that session is not in this fleet")
+        old = self.selected.value
+        if old is session:
+            return
+        if old is not None and not old.closed and (old.controller.held or not old.controller.navigating):
+            old.controller.stop()  # also blocks its held keys until they are released
         self.selected.set(session)
 
     def remove(self, session: RobotSession) -> None:
@@ -180,7 +285,9 @@ class Fleet:
         return all([settle(f, max(0.0, deadline - time.monotonic())) for f in futures])
 
     def close(self, timeout: float = CLOSE_TIMEOUT) -> None:
-        """Stop every robot at once, then close each session. Idempotent."""
+        """Stop every robot at once, then close each session (and the roster). Idempotent."""
+        if self._roster is not None:
+            self._roster.close()
         self.stop_all()
         for session in self.sessions.value:
             session.close(timeout)

@@ -18,6 +18,15 @@ when the variable is unset), a small flat TOML document::
     show_sonar = true
     speed = 50
 
+A profile may name a fleet instead of one robot: a list of robots reached
+directly, or ARIA's central server that forwards them (``central``; a profile
+with neither is the one robot of ``host``/``port``, as before)::
+
+    [profiles."floor 2"]
+    robots = [{ name = "robot1", host = "10.0.0.5", port = 7272 },
+              { name = "robot2", host = "10.0.0.6", port = 7272 }]
+    # or: central = "10.0.0.2:7272"
+
 It is read with ``tomllib`` and written by hand (the schema is flat, so no
 writer library is needed), atomically, readable by the user only.
 
@@ -58,6 +67,37 @@ MAX_SETTINGS_BYTES = 1 << 20
 """A settings file larger than this is not ours."""
 
 
+MAX_FLEET = 100
+"""Robots one profile may list."""
+
+
+@dataclass(frozen=True, slots=True)
+class DirectRobot:
+    """One robot of a fleet profile, reached directly."""
+
+    name: str
+    host: str
+    port: int = DEFAULT_PORT
+
+    def validate(self, profile: str) -> None:
+        if not self.name or len(self.name) > 200:
+            raise ValueError(f"profile {profile!r}: a robot name must be 1…200 characters")
+        if not self.host or len(self.host) > 255:
+            raise ValueError(f"profile {profile!r}: robot {self.name!r} has a bad host")
+        if not 1 <= self.port <= 65535:
+            raise ValueError(f"profile {profile!r}: robot {self.name!r}: port {self.port} is not 1…65535")
+
+
+def parse_central(text: str) -> tuple[str, int]:
+    """``"HOST:PORT"`` (or ``"HOST"``: ARIA's port) of a central server; ValueError when it is not one."""
+    host, sep, port_text = text.rpartition(":")
+    if not sep:
+        host, port_text = text, str(DEFAULT_PORT)
+    if not host or len(host) > 255 or not port_text.isdigit() or not 1 <= int(port_text) <= 65535:
+        raise ValueError(f"central server {text!r} is not HOST:PORT")
+    return host, int(port_text)
+
+
 @dataclass(frozen=True, slots=True)
 class Profile:
     """One robot server the operator connects to, and how they left the view last time."""
@@ -77,6 +117,15 @@ class Profile:
     """Drive throttle in %, 10…100 in steps of 10."""
     protocol: str = ""
     """Protocol string to log in with; "" answers with the one the server advertises (LD robots: 6MTX)."""
+    robots: tuple[DirectRobot, ...] = ()
+    """A fleet of robots reached directly (names unique); empty: the one robot at host/port."""
+    central: str = ""
+    """``"HOST:PORT"`` of ARIA's central server that lists and forwards the robots; empty: none."""
+
+    @property
+    def is_fleet(self) -> bool:
+        """The profile names several robots (a list or a central server), not one host."""
+        return bool(self.robots or self.central)
 
     def validate(self) -> None:
         """Raise ValueError if a field is out of range (used on everything read from disk)."""
@@ -94,6 +143,20 @@ class Profile:
             raise ValueError(f"profile {self.name!r}: zoom {self.zoom} out of range")
         if not 10 <= self.speed <= 100 or self.speed % 10:
             raise ValueError(f"profile {self.name!r}: speed {self.speed} is not 10…100 in steps of 10")
+        if len(self.robots) > MAX_FLEET:
+            raise ValueError(f"profile {self.name!r}: more than {MAX_FLEET} robots")
+        for robot in self.robots:
+            robot.validate(self.name)
+        names = [r.name for r in self.robots]
+        if len(set(names)) != len(names):
+            raise ValueError(f"profile {self.name!r}: two robots have the same name")
+        if self.central:
+            if self.robots:
+                raise ValueError(f"profile {self.name!r}: name robots or a central server, not both")
+            try:
+                parse_central(self.central)
+            except ValueError as exc:
+                raise ValueError(f"profile {self.name!r}: {exc}") from None
 
     @property
     def keyring_user(self) -> str:
@@ -141,7 +204,9 @@ _TYPES: dict[str, type] = {
     "show_sonar": bool,
     "speed": int,
     "protocol": str,
+    "central": str,
 }
+_ROBOT_KEYS = {"name": str, "host": str, "port": int}
 
 
 @dataclass
@@ -252,6 +317,9 @@ def _recording(raw: object) -> RecordingSettings:
 def _profile(name: str, raw: dict[str, Any]) -> Profile:
     values: dict[str, Any] = {"name": name}
     for key, value in raw.items():
+        if key == "robots":
+            values[key] = _robots(name, value)
+            continue
         expected = _TYPES.get(key)
         if expected is None:
             raise SettingsError(f"profile {name!r}: unknown key {key!r}")
@@ -266,6 +334,23 @@ def _profile(name: str, raw: dict[str, Any]) -> Profile:
     except ValueError as exc:
         raise SettingsError(str(exc)) from None
     return profile
+
+
+def _robots(profile: str, raw: object) -> tuple[DirectRobot, ...]:
+    """A profile's ``robots`` array of tables (each: name, host, port)."""
+    if not isinstance(raw, list):
+        raise SettingsError(f"profile {profile!r}: robots must be a list of tables")
+    if len(raw) > MAX_FLEET:
+        raise SettingsError(f"profile {profile!r}: more than {MAX_FLEET} robots")
+    robots = []
+    for item in raw:
+        if not isinstance(item, dict) or set(item) - set(_ROBOT_KEYS) or not {"name", "host"} <= set(item):
+            raise SettingsError(f"profile {profile!r}: each robot is a table of name, host and port")
+        for key, value in item.items():
+            if type(value) is not _ROBOT_KEYS[key]:
+                raise SettingsError(f"profile {profile!r}: robot {key} must be {_ROBOT_KEYS[key].__name__}")
+        robots.append(DirectRobot(**item))
+    return tuple(robots)
 
 
 @dataclass
@@ -333,8 +418,8 @@ def format_settings(settings: Settings) -> str:
         profile.validate()
         lines += ["", f"[profiles.{_toml_string(profile.name)}]"]
         for f in fields(profile):
-            if f.name == "name":
-                continue
+            if f.name == "name" or (f.name in ("robots", "central") and not getattr(profile, f.name)):
+                continue  # a one-robot profile is written as before the fleet existed
             lines.append(f"{f.name} = {_toml_value(getattr(profile, f.name))}")
     if settings.recording != RecordingSettings():
         settings.recording.validate()
@@ -374,6 +459,12 @@ def _toml_value(value: Any) -> str:
         return repr(float(value))
     if isinstance(value, str):
         return _toml_string(value)
+    if isinstance(value, tuple) and all(isinstance(r, DirectRobot) for r in value):
+        tables = [
+            f"{{ name = {_toml_string(r.name)}, host = {_toml_string(r.host)}, port = {r.port} }}"
+            for r in value
+        ]
+        return "[" + ", ".join(tables) + "]"
     raise TypeError(f"cannot write {value!r} to the settings file")
 
 

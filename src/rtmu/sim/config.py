@@ -60,4 +60,7 @@ class SimConfig:
     """Skip periodic sends to a client with this much output still queued (it is not keeping up)."""
     config_filler: int = 0
     """Extra configuration parameters, markup in every text (:mod:`rtmu.sim.arconfig`): hostile tests."""
+    start_pose: tuple[float, float, float] | None = None
+    """Where the robot starts (x, y mm, th deg; moved to the nearest free spot); None: the map's home.
+    ``rtmu sim --robots N`` gives each robot its own (``sim.multi``)."""
     verbose: bool = False

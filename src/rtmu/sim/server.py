@@ -347,7 +347,7 @@ class SimServer:
         self._module_commands = tuple(r for r in self.profile.module_parts()[0] if r[4] == "CustomCommands")
         self.map: ServedMap = self._load_map(cfg.map_path)
         obstacles = self.map.obstacles()
-        home = self.map.home
+        home = cfg.start_pose or self.map.home
         x, y = free_spot_near(obstacles, home[0], home[1], 250.0) if self.map.present else (home[0], home[1])
         self.world = World(
             obstacles,
@@ -663,7 +663,7 @@ class SimServer:
             return False
         self.map = self._load_map(path)
         obstacles = self.map.obstacles()
-        home = self.map.home
+        home = self.config.start_pose or self.map.home
         x, y = free_spot_near(obstacles, home[0], home[1], 250.0)
         self.home = (x, y, home[2])
         self.world.replace_obstacles(obstacles)

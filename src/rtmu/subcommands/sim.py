@@ -87,6 +87,14 @@ def register(subparsers: argparse._SubParsersAction) -> None:
         metavar="N",
         help="add N configuration parameters, markup in every text (try clients on a hostile ArConfig)",
     )
+    p.add_argument(
+        "--robots",
+        type=int,
+        default=None,
+        metavar="N",
+        help="run N robots on the map, one server each on consecutive ports from --port, "
+        "named robot1…N (default 1); with --central: N simulated robots switched to it (default 0)",
+    )
     p.add_argument("-v", "--verbose", action="store_true", help="log connections and refusals")
     central = p.add_argument_group("ARIA central server (switchServer)")
     central.add_argument(
@@ -97,13 +105,6 @@ def register(subparsers: argparse._SubParsersAction) -> None:
     )
     central.add_argument(
         "--robot-port", type=int, default=5000, help="with --central: where robots switch to (default 5000)"
-    )
-    central.add_argument(
-        "--robots",
-        type=int,
-        default=0,
-        metavar="N",
-        help="with --central: also run N simulated robots (robot1…robotN) switched to it",
     )
     central.add_argument(
         "--switch-to",
@@ -122,12 +123,18 @@ def register(subparsers: argparse._SubParsersAction) -> None:
 def run(args: argparse.Namespace) -> int:
     if args.make_map is not None:
         return make_map(args)
-    if args.robots < 0 or args.robots > 100:
-        print("rtmu sim: --robots takes 0…100", file=sys.stderr)
-        return EXIT_BAD_INPUT
-    if args.robots and not args.central:
-        print("rtmu sim: --robots N here runs robots behind --central", file=sys.stderr)
-        return EXIT_BAD_INPUT
+    if args.central:
+        args.robots = 0 if args.robots is None else args.robots
+        if not 0 <= args.robots <= 100:
+            print("rtmu sim: with --central, --robots takes 0…100", file=sys.stderr)
+            return EXIT_BAD_INPUT
+    else:
+        from ..sim.multi import MAX_ROBOTS
+
+        args.robots = 1 if args.robots is None else args.robots
+        if not 1 <= args.robots <= MAX_ROBOTS:
+            print(f"rtmu sim: --robots must be 1…{MAX_ROBOTS}", file=sys.stderr)
+            return EXIT_BAD_INPUT
     from ..sim import SimConfig
 
     map_path = (
@@ -176,7 +183,7 @@ def run(args: argparse.Namespace) -> int:
             from ._sim_central import serve_central
 
             return asyncio.run(serve_central(cfg, args.robot_port, args.robots))
-        return asyncio.run(serve(cfg))
+        return asyncio.run(serve(cfg) if args.robots == 1 else serve_fleet(cfg, args.robots))
     except KeyboardInterrupt:
         return EXIT_OK
 
@@ -217,6 +224,36 @@ async def serve(cfg) -> int:
     await stop.wait()
     print("rtmu sim: stopping (telling clients SHUTDOWN)", flush=True)
     await server.stop()
+    return EXIT_OK
+
+
+async def serve_fleet(cfg, count: int) -> int:
+    """``--robots N``: N servers on one loop (``sim.multi``), one line per robot, Ctrl-C stops all."""
+    from ..maps import MapFormatError
+    from ..sim.multi import SimFleet, fleet_configs
+
+    try:
+        fleet = SimFleet(fleet_configs(cfg, count))
+    except (OSError, MapFormatError, ValueError) as exc:
+        print(f"rtmu sim: cannot load: {exc}", file=sys.stderr)
+        return EXIT_BAD_INPUT
+    try:
+        await fleet.start()
+    except OSError as exc:
+        print(f"rtmu sim: cannot listen: {exc.strerror or exc}", file=sys.stderr)
+        return EXIT_CANNOT_LISTEN
+    for robot, server in zip(fleet.robots, fleet.servers, strict=True):
+        x, y, th = server.home
+        print(f"rtmu sim: {robot.name} listening on {cfg.host}:{server.port}, "
+              f"at ({x:.0f}, {y:.0f}) mm, {th:.0f} deg", flush=True)  # fmt: skip
+    stop = asyncio.Event()
+    loop = asyncio.get_running_loop()
+    for sig in (signal.SIGINT, signal.SIGTERM):
+        with contextlib.suppress(NotImplementedError, RuntimeError):
+            loop.add_signal_handler(sig, stop.set)
+    await stop.wait()
+    print("rtmu sim: stopping every robot (telling clients SHUTDOWN)", flush=True)
+    await fleet.stop()
     return EXIT_OK
 
 

@@ -29,6 +29,13 @@ def add_gui_arguments(parser: argparse.ArgumentParser) -> None:
         action="store_true",
         help="run the bundled robot simulator (office map) on a free loopback port and connect to it",
     )
+    g.add_argument(
+        "--robots",
+        type=int,
+        default=1,
+        metavar="N",
+        help="with --demo: N simulated robots on one map (as rtmu sim --robots N), all in the window",
+    )
     g.add_argument("--host", help="robot server to connect to (default: the last profile)")
     g.add_argument("--port", type=int, help=f"its port (default {DEFAULT_PORT})")
     g.add_argument("--user", help="user name for the server (asks for the password)")
@@ -61,11 +68,26 @@ def options_from_args(args: argparse.Namespace) -> GuiOptions:
     )
 
 
+def demo_fleet_options(options: GuiOptions, endpoints: list[tuple[str, int]]) -> GuiOptions:
+    """The window on every simulated robot of ``--demo --robots N``."""
+    from ..settings import DirectRobot
+
+    robots = tuple(DirectRobot(name, "127.0.0.1", port) for name, port in endpoints)
+    return replace(options, fleet=robots, host=None, port=None, user=None, persist=False, connect=True)
+
+
 def run_gui(args: argparse.Namespace) -> int:
     """Open the window; with ``--demo`` run the simulator beside it for as long as the window lives."""
     options = options_from_args(args)
     if options.port is not None and not 1 <= options.port <= 65535:
         print(f"rtmu: --port {options.port} is not 1…65535", file=sys.stderr)
+        return 2
+    robots = getattr(args, "robots", 1)
+    if robots != 1 and not options.demo:
+        print("rtmu: --robots N goes with --demo (a fleet profile names real robots)", file=sys.stderr)
+        return 2
+    if not 1 <= robots <= 50:
+        print(f"rtmu: --robots {robots} is not 1…50", file=sys.stderr)
         return 2
     if not display_available():
         print(
@@ -77,11 +99,16 @@ def run_gui(args: argparse.Namespace) -> int:
     sim = None
     if options.demo:
         try:
-            sim = start_demo_simulator()
+            sim = start_demo_simulator(robots)
         except Exception as exc:  # the window is useless without it: say why and stop
             print(f"rtmu: the demo simulator did not start: {exc}", file=sys.stderr)
             return 3
-        options = replace(options, host="127.0.0.1", port=sim.port, user=None, persist=False, connect=True)
+        if robots == 1:
+            options = replace(
+                options, host="127.0.0.1", port=sim.port, user=None, persist=False, connect=True
+            )
+        else:
+            options = demo_fleet_options(options, sim.endpoints())
     try:
         from .application import RtmuApplication
 
@@ -120,7 +147,12 @@ def demo_map_path() -> Path:
     return target
 
 
-def start_demo_simulator():
+def start_demo_simulator(robots: int = 1):
     from ..sim import SimConfig, SimThread
 
-    return SimThread(SimConfig(host="127.0.0.1", port=0, map_path=demo_map_path(), camera=True)).start()
+    config = SimConfig(host="127.0.0.1", port=0, map_path=demo_map_path(), camera=True)
+    if robots == 1:
+        return SimThread(config).start()
+    from ..sim.multi import SimFleetThreads, fleet_configs
+
+    return SimFleetThreads(fleet_configs(config, robots)).start()

@@ -1,8 +1,10 @@
 """The ``Gtk.Application``: settings → profile, the fleet and its first robot session, the window.
 
-Wiring only. The application builds a :class:`rtmu.fleet.Fleet` (today a fleet
-of one: one :class:`~rtmu.fleet.RobotSession`, whose network thread posts back
-with ``GLib.idle_add``) and a window that shows the selected session. Every way
+Wiring only. The application builds a :class:`rtmu.fleet.Fleet` — of one
+:class:`~rtmu.fleet.RobotSession` for a one-robot profile, or of every robot a
+fleet profile's roster names (``fleet.direct_roster``), each session's network
+thread posting back with ``GLib.idle_add`` — and a window that shows the selected
+session (``fleet_bind`` adds the robot list and the other robots on the map). Every way
 out — closing, quitting, Ctrl+Z, a signal — goes through the fleet, so every
 robot is stopped first; then each session closes with a bounded wait, then the
 profile's view choices (zoom, follow, sonar, speed) are saved.
@@ -14,7 +16,6 @@ import os
 import signal
 import sys
 import threading
-import time
 from collections.abc import Callable
 from dataclasses import replace
 from types import FrameType
@@ -24,8 +25,10 @@ import gi
 gi.require_version("Gtk", "4.0")
 from gi.repository import Gio, GLib, Gtk  # noqa: E402
 
+from ..client.central import CentralRoster  # noqa: E402
+from ..client.roster import RobotEndpoint, Roster  # noqa: E402
 from ..client.session import SessionConfig  # noqa: E402
-from ..fleet import Fleet, RobotSession  # noqa: E402
+from ..fleet import Fleet, RobotSession, direct_roster, robot_profile  # noqa: E402
 from ..model import Phase  # noqa: E402
 from ..settings import (  # noqa: E402
     DEFAULT_PORT,
@@ -33,12 +36,15 @@ from ..settings import (  # noqa: E402
     Profile,
     Settings,
     load_settings,
+    parse_central,
     save_settings,
 )
+from .fleet_bind import FleetBinding  # noqa: E402
 from .keys import accels_for  # noqa: E402
 from .options import APP_ID, GuiOptions  # noqa: E402
 from .replay_bar import ReplayBar  # noqa: E402
 from .replay_mode import REPLAY_CONFIG, open_replay, replay_profile, show_replay  # noqa: E402
+from .selected_model import SelectedModel  # noqa: E402
 from .style import install_css  # noqa: E402
 from .window import MainWindow  # noqa: E402
 
@@ -83,6 +89,11 @@ class RtmuApplication(Gtk.Application):
         self.options = options or GuiOptions()
         self.fleet = Fleet()
         self.window: MainWindow | None = None
+        self.fleet_binding: FleetBinding | None = None
+        self._stand_in: RobotSession | None = None
+        """What the window shows while a fleet has no robot yet (never connected, not in the fleet)."""
+        self._fleet_notes: list[str] = []
+        """Roster notices said before the window existed."""
         self.settings = Settings()
         self.secrets = SessionSecrets(KeyringSecrets())
         self.settings_warning: str | None = None
@@ -136,29 +147,48 @@ class RtmuApplication(Gtk.Application):
             if self.options.replay is not None
             else None
         )
+        roster: Roster | None = None
+        mirror: SelectedModel | None = None
         if replay is not None:  # a recording: its own profile and config, not recorded again
             profile, auto_connect, config = replay_profile(replay.recorded.path), False, REPLAY_CONFIG
             self.options = replace(self.options, persist=False)
-        session = self.fleet.open(
-            post=GLib.idle_add,
-            config=config,
-            profile=profile,
-            secrets=self.secrets,
-            recording=None if replay is not None else self.settings.recording,
-            opener=None if replay is None else replay.open,
-            clock=time.monotonic if replay is None else replay.clock.seconds,  # a replay runs on its own time
-        )
+            session = self.fleet.open(
+                post=GLib.idle_add,
+                config=config,
+                profile=profile,
+                secrets=self.secrets,
+                recording=None,
+                opener=replay.open,
+                clock=replay.clock.seconds,  # a replay runs on its own time
+            )
+        else:
+            roster = self.roster_for(profile)
+            if roster is not None:
+                session = self._follow(roster, profile, config)
+                mirror = SelectedModel(session.state)
+                auto_connect = False  # each robot connected as it was added
+            else:
+                session = self.fleet.open(
+                    post=GLib.idle_add,
+                    config=config,
+                    profile=profile,
+                    secrets=self.secrets,
+                    recording=self.settings.recording,
+                )
         try:
             window = MainWindow(
                 self,
                 session,
                 self.fleet.operator,
-                profile=profile,
+                profile=session.controller.profile,
                 profiles=self.settings.profiles,
                 secrets=self.secrets,
                 keyring_available=self.secrets.available,
                 profile_saved=self.profile_saved,
+                model=mirror,
             )
+            if roster is not None:
+                self.fleet_binding = FleetBinding(window, self.fleet)
         except Exception:
             self.failed = True
             self.close_session()
@@ -176,12 +206,54 @@ class RtmuApplication(Gtk.Application):
         window.present()
         if loaded.warning:
             window.banners.tell("notice:settings", "warning", loaded.warning, timeout=10.0)
+        for note in self._fleet_notes:
+            self._announce(note)
         if replay is not None:
             self.replay_bar = show_replay(window, session, replay)
         elif auto_connect:
             window.connect_now()
-        elif not self.settings.profiles and not self.options.host:
+        elif not self.settings.profiles and not self.options.host and roster is None:
             window.banners.tell("notice:hint", "info", FIRST_RUN_HINT, timeout=12.0)
+
+    def roster_for(self, profile: Profile) -> Roster | None:
+        """Where a fleet profile's robots come from (None: a one-robot profile)."""
+        if self.options.fleet:
+            return direct_roster(Profile("demo fleet", robots=self.options.fleet))
+        if profile.central:
+            host, port = parse_central(profile.central)
+            password = self.secrets.get(profile) or "" if profile.user else ""
+            return CentralRoster(host, port, user=profile.user, password=password, post=GLib.idle_add)
+        return direct_roster(profile)
+
+    def _follow(self, roster: Roster, profile: Profile, config: SessionConfig) -> RobotSession:
+        """Build the fleet from ``roster``; the first robot is the one the window shows first."""
+
+        def make(endpoint: RobotEndpoint) -> RobotSession:
+            return RobotSession(
+                self.fleet.operator,
+                post=GLib.idle_add,
+                config=config,
+                profile=robot_profile(profile, endpoint),
+                secrets=self.secrets,
+                recording=self.settings.recording,
+            )
+
+        self.fleet.follow(roster, make, self._announce)
+        session = self.fleet.selected.value
+        if session is None:
+            # A roster that announces its robots later (a central server): the window shows this
+            # unconnected stand-in until the first robot arrives and is selected.
+            session = RobotSession(self.fleet.operator, post=GLib.idle_add, config=config, profile=profile,
+                                   secrets=self.secrets).start()  # fmt: skip
+            self._stand_in = session
+        return session
+
+    def _announce(self, text: str) -> None:
+        """A roster notice (a robot left, the robot list was lost): a banner, or kept until there is one."""
+        if self.window is None:
+            self._fleet_notes.append(text)
+        else:
+            self.window.banners.tell(f"fleet:{text}", "warning", text, timeout=10.0)
 
     def do_shutdown(self) -> None:
         self.close_session()
@@ -196,10 +268,16 @@ class RtmuApplication(Gtk.Application):
         """Stop every robot, close the sessions, save view choices. Idempotent (tests call it too)."""
         self.fleet.stop_all()
         window, self.window = self.window, None
+        if self.fleet_binding is not None:
+            self.fleet_binding.close()
+            self.fleet_binding = None
         if window is not None:
             self._remember_view(window)
             window.shutdown()
         self.fleet.close(RUNNER_CLOSE_TIMEOUT)
+        if self._stand_in is not None:
+            self._stand_in.close(RUNNER_CLOSE_TIMEOUT)
+            self._stand_in = None
         if self.options.persist and window is not None:
             self._save(background=False)
         for source in self._signal_sources:
@@ -259,6 +337,8 @@ class RtmuApplication(Gtk.Application):
         """The profile to open with and whether to connect at once."""
         o = self.options
         s = self.settings
+        if o.fleet:
+            return Profile("demo fleet", robots=o.fleet), True
         if o.host:
             port = o.port or DEFAULT_PORT
             user = o.user or ""

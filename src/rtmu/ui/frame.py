@@ -3,8 +3,9 @@
 Cost per frame does not grow with the map: the static map comes from the tile
 cache (a blit per visible tile, or the stretched overview while a tile is still
 being rendered), then the overlays — cairns, trail, sonar, robot — are drawn on
-top, with navigation (``nav_draw``: planned path, goal ring, a picked pose) between the cairns and
-the robot. Without a map: a metric grid and its legend.
+top (the fleet's other robots, ``fleet_draw``, under the selected one), with navigation
+(``nav_draw``: planned path, goal ring, a picked pose) between the cairns and the robot.
+Without a map: a metric grid and its legend.
 """
 
 from __future__ import annotations
@@ -14,7 +15,7 @@ from dataclasses import dataclass, field
 
 import cairo
 
-from . import nav_draw, overlays
+from . import fleet_draw, nav_draw, overlays
 from .tiles import BACKGROUND_RGB, EMPTY, TILE, Overview, TileCache
 from .viewport import Viewport
 
@@ -39,6 +40,10 @@ class Scene:
     """The cairn the robot is heading for, ringed."""
     marker: nav_draw.Marker | None = None
     """A pose the operator is picking (go to a point, set the robot's position)."""
+    others: Sequence[fleet_draw.FleetMark] = ()
+    """The fleet's other robots on this map, each in its colour with its trail."""
+    robot_rgb: tuple[float, float, float] = overlays.ROBOT_RGB
+    """The selected robot's colour (its fleet colour; blue for a robot alone)."""
 
 
 def draw_frame(ctx: cairo.Context, vp: Viewport, scene: Scene) -> bool:
@@ -61,14 +66,16 @@ def draw_frame(ctx: cairo.Context, vp: Viewport, scene: Scene) -> bool:
     nav_draw.draw_path(ctx, vp, scene.robot[:2] if scene.robot is not None else None, scene.path)
     if scene.marker is not None:
         nav_draw.draw_marker(ctx, vp, scene.marker)
+    if scene.others:
+        fleet_draw.draw_fleet(ctx, vp, scene.others, footprint=has_map)
     if scene.robot is not None:
         x, y, th = scene.robot
-        overlays.draw_trail(ctx, vp, scene.trail)
+        overlays.draw_trail(ctx, vp, scene.trail, (*scene.robot_rgb, fleet_draw.TRAIL_ALPHA))
         if scene.laser and not scene.stale:
             overlays.draw_laser(ctx, vp, scene.laser)
         if scene.sonar and not scene.stale:
             overlays.draw_sonar(ctx, vp, (x, y), scene.sonar)
-        overlays.draw_robot(ctx, vp, x, y, th, stale=scene.stale, footprint=has_map)
+        overlays.draw_robot(ctx, vp, x, y, th, stale=scene.stale, footprint=has_map, rgb=scene.robot_rgb)
     return complete
 
 

@@ -18,7 +18,7 @@ from __future__ import annotations
 import math
 import time
 from collections import deque
-from collections.abc import Callable
+from collections.abc import Callable, Sequence
 
 import cairo
 import gi
@@ -28,6 +28,7 @@ from gi.repository import GLib, Gtk  # noqa: E402
 
 from ..model import LinkLevel, MapModel, OperatorState, RobotModel, RobotState  # noqa: E402
 from . import overlays  # noqa: E402
+from .fleet_draw import FleetMark  # noqa: E402
 from .frame import Scene, draw_frame  # noqa: E402
 from .nav_draw import Marker, MarkerKind  # noqa: E402
 from .tiles import TileCache  # noqa: E402
@@ -88,6 +89,8 @@ class MapStage(Gtk.DrawingArea):
         self._scroll_accum = 0.0
         self.marker: Marker | None = None
         """A pose the operator is picking (``pose_pick`` sets it); drawn over the map."""
+        self.fleet: Callable[[], tuple[Sequence[FleetMark], tuple[float, float, float]]] | None = None
+        """In a fleet (``fleet_bind``): the other robots to draw and the selected robot's colour."""
         self.set_draw_func(self._draw)
         self._install_input()
         self._unobserve = [
@@ -303,6 +306,8 @@ class MapStage(Gtk.DrawingArea):
             sonar=r.sonar if self.operator.view.value.show_sonar else (),
             laser=r.laser if self.operator.view.value.show_sonar else (),
         )
+        if self.fleet is not None:  # the fleet's other robots and the selected one's colour
+            scene.others, scene.robot_rgb = self.fleet()
         self._add_navigation(scene)
         return draw_frame(ctx, vp, scene)
 

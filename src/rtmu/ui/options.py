@@ -9,6 +9,8 @@ from __future__ import annotations
 from dataclasses import dataclass
 from pathlib import Path
 
+from ..settings import DirectRobot
+
 APP_ID = "io.github.rtmu.Rtmu"
 
 
@@ -32,5 +34,7 @@ class GuiOptions:
     """``rtmu replay FILE.mcap``: show this recording instead of connecting to a robot."""
     replay_conn: int = 1
     """Which of the recording's connections (``--conn``)."""
+    fleet: tuple[DirectRobot, ...] = ()
+    """Robots to open the window on at once (``--demo --robots N``); empty: the profile's."""
     guardian: bool = True
     """Start a guardian process per connection (``rtmu.guardian``); off only to measure without it."""

@@ -350,13 +350,18 @@ def _draw_labels(
 # -- trail, sonar, robot ------------------------------------------------------------------------------
 
 
-def draw_trail(ctx: cairo.Context, vp: Viewport, trail: Iterable[tuple[float, float]]) -> None:
+def draw_trail(
+    ctx: cairo.Context,
+    vp: Viewport,
+    trail: Iterable[tuple[float, float]],
+    rgba: tuple[float, float, float, float] = TRAIL_RGBA,
+) -> None:
     points = [vp.to_screen(x, y) for x, y in trail]
     if len(points) < 2:
         return
     ctx.save()
     ctx.new_path()
-    ctx.set_source_rgba(*TRAIL_RGBA)
+    ctx.set_source_rgba(*rgba)
     ctx.set_line_width(3.0)
     ctx.set_line_join(cairo.LINE_JOIN_ROUND)
     ctx.set_line_cap(cairo.LINE_CAP_ROUND)
@@ -413,6 +418,7 @@ def draw_robot(
     *,
     stale: bool,
     footprint: bool = True,
+    rgb: tuple[float, float, float] = ROBOT_RGB,
 ) -> None:
     """The robot to scale (footprint, or a circle when there is no map) with a heading mark.
 
@@ -423,7 +429,7 @@ def draw_robot(
     sx, sy = vp.to_screen(x, y)
     k = _robot_px_per_mm(vp)
     th = math.radians(th_deg)
-    rgb = STALE_RGB if stale else ROBOT_RGB
+    rgb = STALE_RGB if stale else rgb
     ctx.save()
     ctx.new_path()  # whatever an earlier helper left as the current point must not join the body
     ctx.translate(sx, sy)

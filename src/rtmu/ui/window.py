@@ -45,6 +45,7 @@ from ..model import (  # noqa: E402
     MapModel,
     OperatorState,
     Phase,
+    RobotModel,
     RobotState,
     SpeedSetting,
 )
@@ -72,6 +73,7 @@ from .pose_bar import PoseBar  # noqa: E402
 from .pose_pick import PosePicker  # noqa: E402
 from .ptz_controls import PtzControls  # noqa: E402
 from .routes_panel import RoutesPanel  # noqa: E402
+from .selected_model import SelectedModel  # noqa: E402
 from .settings_dialog import ConnectionDialog, PasswordPrompt  # noqa: E402
 from .shortcuts import build_shortcuts_window  # noqa: E402
 from .toolbar import StatusToolbar  # noqa: E402
@@ -160,12 +162,13 @@ class MainWindow(Gtk.ApplicationWindow):
         keyring_available: bool = False,
         profile_saved: Callable[[Profile, str | None], None] | None = None,
         clock: Callable[[], float] = time.monotonic,
+        model: RobotModel | None = None,
     ) -> None:
         super().__init__(application=app, title="RTMU")
         self.set_default_size(800, 480)
         self.set_size_request(360, 320)  # 360: a portrait phone (ui.layout)
         self.session = session
-        self.model = model = session.state
+        self.model = model = model or session.state  # a fleet's: the selected robot's (``selected_model``)
         self.operator = operator
         self.clock = clock
         self.profiles = dict(profiles or {})
@@ -179,7 +182,7 @@ class MainWindow(Gtk.ApplicationWindow):
 
         link = session.runner
         self._link = link
-        status_age = link.status_age
+        status_age = lambda: self._link.status_age()  # noqa: E731 - the shown robot's, also after a switch
         self.banners = BannerStack()
         self.stage = MapStage(model, operator, clock=clock, status_age=status_age)
         self.stage.on_view_changed = self._view_changed
@@ -200,7 +203,8 @@ class MainWindow(Gtk.ApplicationWindow):
         self.controller = session.controller
         if secrets is not None:
             self.controller.secrets = secrets
-        session.attach_view(_View(self))
+        self.robot_view = _View(self)
+        session.attach_view(self.robot_view)
         self.controller.select_profile(profile)
         self._set_speed_from_profile(profile)
         self._install_actions()
@@ -313,7 +317,11 @@ class MainWindow(Gtk.ApplicationWindow):
         box = Gtk.Box(orientation=Gtk.Orientation.VERTICAL)
         box.append(self.fullscreen_bar)
         box.append(self.toolbar_revealer)
-        box.append(outer)
+        self.body = Gtk.Box()  # the map and camera stack; a fleet's robot list goes beside or under it
+        self.body.append(outer)
+        outer.set_hexpand(True)
+        box.append(self.body)
+        self.body.set_vexpand(True)
         outer.set_vexpand(True)
         self.body = box
         """The window's column (bars above, the map/camera stack); a replay appends its controls."""
@@ -504,6 +512,23 @@ class MainWindow(Gtk.ApplicationWindow):
         a = self.lookup_action(action)
         if isinstance(a, Gio.SimpleAction):
             a.set_enabled(enabled)
+
+    def show_session(self, session: RobotSession) -> None:
+        """Show another robot of the fleet (which has already stopped the one shown before).
+
+        Keys held now stay held in the key router, so their auto-repeat is swallowed: the new
+        robot moves only on a fresh press. A finger on the D-pad is let go of.
+        """
+        self.dpad.release_all()
+        self.picker.cancel()
+        self.session, self.controller, self._link = session, session.controller, session.runner
+        session.attach_view(self.robot_view)
+        if isinstance(self.model, SelectedModel):
+            self.model.show(session.state)
+        self.camera.clear()
+        self.inset.show_texture(None)
+        self.commands_changed(self.controller.command_states())
+        self._update_header(self.model.connection.value)
 
     # -- intents -------------------------------------------------------------------------------
     def _hold(self, name: str) -> None:

@@ -1,0 +1,125 @@
+"""Several simulated robots on one map: ``rtmu sim --robots N``.
+
+Each robot is a whole ARIA server of its own (as real robots are: one ArNetworking
+server per robot), on its own port — consecutive from the first one given, or each a
+free port when that is 0 — with its own seed and its own start pose: the map's home
+for ``robot1``, then a row beside it (the nearest free spot, so none starts in a
+wall). Names are ``robot1`` … ``robotN``: what a fleet profile or the window's robot
+list calls them.
+"""
+
+from __future__ import annotations
+
+import dataclasses
+from collections.abc import Sequence
+from dataclasses import dataclass
+from pathlib import Path
+
+from .config import SimConfig
+from .server import SimServer
+from .thread import SimThread
+
+MAX_ROBOTS = 50
+"""More simulated robots than this in one process is a mistake, not a fleet."""
+SPACING_MM = 900.0
+"""Between the start poses of neighbouring robots (a P3-DX is ~500 mm long)."""
+
+
+@dataclass(frozen=True, slots=True)
+class SimRobot:
+    """One robot of a simulated fleet: its name and its server's configuration."""
+
+    name: str
+    config: SimConfig
+
+
+def robot_name(index: int) -> str:
+    """``robot1`` for index 0: the names ``--robots N`` gives."""
+    return f"robot{index + 1}"
+
+
+def map_home(path: Path | None) -> tuple[float, float, float]:
+    """The map's ``RobotHome`` (x, y mm, th deg), or the origin."""
+    if path is None:
+        return (0.0, 0.0, 0.0)
+    from ..maps import read_map
+
+    home = read_map(path).home()
+    return (float(home.x), float(home.y), float(home.th)) if home is not None else (0.0, 0.0, 0.0)
+
+
+def fleet_configs(base: SimConfig, count: int) -> list[SimRobot]:
+    """``count`` robots like ``base``: consecutive ports, seeds and start poses of their own."""
+    if not 1 <= count <= MAX_ROBOTS:
+        raise ValueError(f"--robots must be 1…{MAX_ROBOTS}, not {count}")
+    if base.port and base.port + count - 1 > 65535:
+        raise ValueError(f"ports {base.port}…{base.port + count - 1} do not all exist")
+    hx, hy, hth = base.start_pose or map_home(base.map_path)
+    robots = []
+    for i in range(count):
+        # 0, +1, -1, +2, -2 … rows of robots either side of home, all facing the same way.
+        step = (i + 1) // 2 * (1 if i % 2 else -1)
+        pose = (hx, hy + step * SPACING_MM, hth)
+        config = dataclasses.replace(
+            base,
+            port=base.port + i if base.port else 0,
+            seed=base.seed + i,
+            start_pose=pose,
+        )
+        robots.append(SimRobot(robot_name(i), config))
+    return robots
+
+
+class SimFleet:
+    """N simulated robots on one asyncio loop (``rtmu sim --robots N``): start and stop together."""
+
+    def __init__(self, robots: Sequence[SimRobot]) -> None:
+        self.robots = tuple(robots)
+        self.servers = [SimServer(r.config) for r in self.robots]
+
+    async def start(self) -> None:
+        """Start every server; on failure the ones started are stopped again before raising."""
+        started: list[SimServer] = []
+        try:
+            for server in self.servers:
+                await server.start()
+                started.append(server)
+        except BaseException:
+            for server in started:
+                await server.stop()
+            raise
+
+    async def stop(self) -> None:
+        for server in self.servers:
+            await server.stop()
+
+
+class SimFleetThreads:
+    """N simulators, each on its own thread (tests, benchmarks, ``rtmu --demo --robots N``)."""
+
+    def __init__(self, robots: Sequence[SimRobot]) -> None:
+        self.robots = tuple(robots)
+        self.sims = [SimThread(r.config) for r in self.robots]
+
+    def start(self) -> SimFleetThreads:
+        try:
+            for sim in self.sims:
+                sim.start()
+        except BaseException:
+            self.stop()
+            raise
+        return self
+
+    def stop(self) -> None:
+        for sim in self.sims:
+            sim.stop()
+
+    def __enter__(self) -> SimFleetThreads:
+        return self.start()
+
+    def __exit__(self, *exc: object) -> None:
+        self.stop()
+
+    def endpoints(self) -> list[tuple[str, int]]:
+        """(name, port) of each robot, in order."""
+        return [(r.name, sim.port) for r, sim in zip(self.robots, self.sims, strict=True)]
