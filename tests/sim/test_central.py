@@ -248,9 +248,10 @@ def test_rtmu_sim_central_with_robots_serves_a_fleet_and_stops_on_sigint() -> No
             proc.wait()
 
 
-def test_rtmu_sim_refuses_robots_without_central_and_a_bad_switch_address() -> None:
+def test_rtmu_sim_refuses_too_many_central_robots_and_a_bad_switch_address() -> None:
+    """``--robots`` alone means N direct robots (``sim.multi``); behind ``--central`` it is bounded too."""
     for argv, words in (
-        (["--robots", "2"], "behind --central"),
+        (["--central", "--robots", "101"], "with --central, --robots takes 0…100"),
         (["--switch-to", "host:99999"], "bad central server address"),
     ):
         done = subprocess.run(
