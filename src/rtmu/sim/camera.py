@@ -14,6 +14,7 @@ from __future__ import annotations
 
 import io
 import math
+import time
 from dataclasses import dataclass
 
 import numpy as np
@@ -23,8 +24,9 @@ from .geometry import Obstacles
 
 SIZES = ((320, 240), (640, 480))
 DEFAULT_SIZE = (320, 240)
-MAX_JPEG_BYTES = 31988 - 2
-"""A frame must fit one packet with its width, height and the forwarder's 2 trailing bytes."""
+MAX_JPEG_BYTES = 31988 - 2 - 32
+"""A frame must fit one packet with its width, height, stamp comment and the forwarder's 2 trailing bytes."""
+MAX_SIDE = 1920
 
 CAMERA_X_MM = 100.0
 """Mounted on the top plate, a little ahead of the centre of rotation."""
@@ -141,8 +143,22 @@ def render_view(view: View) -> np.ndarray:
 
 
 def render_jpeg(view: View, quality: int) -> bytes:
-    """``view`` rendered and JPEG-encoded: the whole cost of one frame, in one call for a worker thread."""
-    return encode_jpeg(render_view(view), quality)
+    """``view`` rendered, encoded and stamped: the whole cost of one frame, in one call for a worker."""
+    return stamp_jpeg(encode_jpeg(render_view(view), quality), time.time_ns())
+
+
+STAMP_PREFIX = b"RTMU-T="
+"""The render-time comment clients read to measure a frame's age end to end (wall-clock ns)."""
+
+
+def stamp_jpeg(jpeg: bytes, wall_ns: int) -> bytes:
+    """``jpeg`` with a COM segment ``RTMU-T=<wall_ns>`` after its JFIF header (decoders skip comments)."""
+    text = STAMP_PREFIX + str(wall_ns).encode()
+    comment = b"\xff\xfe" + (len(text) + 2).to_bytes(2, "big") + text
+    at = 2
+    if jpeg[2:4] == b"\xff\xe0":  # keep JFIF's APP0 first, where readers expect it
+        at = 4 + int.from_bytes(jpeg[4:6], "big")
+    return jpeg[:at] + comment + jpeg[at:]
 
 
 def encode_jpeg(pixels: np.ndarray, quality: int) -> bytes:
