@@ -64,6 +64,7 @@ from .nav_session import NavFeed
 from .popups import PopupFeed
 from .reconnect import Backoff, worth_retrying
 from .subscriptions import Subscription, applicable
+from .video_session import LiveVideo
 
 log = logging.getLogger(__name__)
 
@@ -181,6 +182,8 @@ class Session:
             self._publish, self._notice, self._decode, self._spawn, self.config.reply_timeout
         )
         """Server popups (§4.9): the open set as PopupsChanged, closing words as Kind.SERVER notices."""
+        self.video = LiveVideo(self._publish, self._spawn, self.clock)
+        """Live video (``client.video_session``): frames go out as the camera part; resumes on reconnect."""
         self._held_subs: set[str] = set()
         """Conditional subscriptions (``only_while``) held now on this connection."""
 
@@ -246,6 +249,8 @@ class Session:
         self._publish(RobotChanged(self._robot))
         self.nav.disconnected()
         self.popups.disconnected()
+        self.video.disconnected()
+        self.video.stop()  # a new connection (or none) starts without video: the operator asks again
         self._set_map(MapModel())
         self._publish(CameraChanged(None))
         self._set_connection(
@@ -293,6 +298,7 @@ class Session:
         self.nav.connected(client)
         self._setup_subscriptions(client)
         self.popups.connected(client)  # after the popupCreate subscription: popupList's answers go there
+        self.video.connected(client)
         self._set_connection(phase=Phase.CONNECTED, offers=offers, error="", error_kind="", retry_in=None)
         self._spawn(self._ping_loop(client), "ping")
         self._spawn(self._fetch_once_infos(client), "infos")
@@ -313,6 +319,8 @@ class Session:
         self._publish(RobotChanged(self._robot))
         self.nav.disconnected()
         self.popups.disconnected()
+        self.video.disconnected()
+        self.video.stop()  # a new connection (or none) starts without video: the operator asks again
         self._set_map(MapModel())
         self._publish(CameraChanged(None))
         self._set_connection(
@@ -346,6 +354,7 @@ class Session:
     def _connection_lost(self, error: ClientError) -> None:
         """Not our choice: the server died, closed, or the link was lost."""
         client, self.client = self.client, None
+        self.video.disconnected()
         # Our link died while driving: we cannot stop the robot, the guardian (its own link) can.
         self._close_guardian(goodbye=not self.governor.driving)
         for task in list(self._tasks):

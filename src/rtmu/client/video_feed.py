@@ -26,6 +26,7 @@ from dataclasses import dataclass, field
 
 from ..protocol.errors import ProtocolError
 from ..protocol.payloads.camera import VideoFrame
+from ..state import VideoStatus
 from .connection import AriaClient
 from .errors import ClientError, ClientTimeout, NotSupported, ServerClosed
 
@@ -135,34 +136,6 @@ class LiveFrame:
     stamp_ns: int | None
     """Wall-clock ns the server rendered it (None: the server does not stamp)."""
     round_trip_s: float
-
-
-@dataclass(frozen=True, slots=True)
-class VideoStatus:
-    """What the picture's caption shows: rate, traffic, age, and why the rate is lower than asked."""
-
-    fps: float
-    kbps: float
-    age_ms: float | None
-    target_fps: float
-    rate_fps: float
-    backoff: str
-    """Plain words when the governor slowed the rate ("" when at the asked rate)."""
-    paused: bool
-    dropped: int
-    note: str
-    """The last dropped frame's reason ("" when none)."""
-
-    def caption(self) -> str:
-        """One short line for the picture: "12.0 fps · 310 kB/s · 45 ms"."""
-        parts = [f"{self.fps:.1f} fps", f"{self.kbps:.0f} kB/s"]
-        if self.age_ms is not None:
-            parts.append(f"{self.age_ms:.0f} ms old")
-        if self.paused:
-            parts.append("paused")
-        if self.backoff:
-            parts.append(self.backoff)
-        return " · ".join(parts)
 
 
 class RateGovernor:

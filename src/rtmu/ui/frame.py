@@ -14,7 +14,7 @@ from dataclasses import dataclass, field
 
 import cairo
 
-from . import nav_draw, overlays
+from . import fov_draw, nav_draw, overlays
 from .tiles import BACKGROUND_RGB, EMPTY, TILE, Overview, TileCache
 from .viewport import Viewport
 
@@ -39,6 +39,8 @@ class Scene:
     """The cairn the robot is heading for, ringed."""
     marker: nav_draw.Marker | None = None
     """A pose the operator is picking (go to a point, set the robot's position)."""
+    fov: fov_draw.Wedge | None = None
+    """The camera's field of view, drawn as a wedge from the robot (None: not shown)."""
 
 
 def draw_frame(ctx: cairo.Context, vp: Viewport, scene: Scene) -> bool:
@@ -61,6 +63,8 @@ def draw_frame(ctx: cairo.Context, vp: Viewport, scene: Scene) -> bool:
     nav_draw.draw_path(ctx, vp, scene.robot[:2] if scene.robot is not None else None, scene.path)
     if scene.marker is not None:
         nav_draw.draw_marker(ctx, vp, scene.marker)
+    if scene.fov is not None and scene.robot is not None:
+        fov_draw.draw_fov(ctx, vp, scene.fov)
     if scene.robot is not None:
         x, y, th = scene.robot
         overlays.draw_trail(ctx, vp, scene.trail)
