@@ -375,6 +375,11 @@ class ClientRunner:
     def stop_video(self) -> concurrent.futures.Future[None]:
         return self._fire(self._session.video.stop, kind=Kind.CAMERA)
 
+    def video_shown(self, sequence: int) -> None:
+        """Backpressure: the window has shown live frame ``sequence`` (thread-safe, no future)."""
+        if not self._closed:
+            self.loop.call_soon_threadsafe(self._session.video.shown, sequence)
+
     def pause_video(self, paused: bool) -> concurrent.futures.Future[None]:
         return self._fire(self._session.video.pause, paused, kind=Kind.CAMERA)
 

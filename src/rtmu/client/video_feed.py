@@ -43,6 +43,8 @@ RTT_LIMIT_S = 0.5
 AGE_LIMIT_S = 1.0
 RECOVER_AFTER_S = 3.0
 REQUEST_TIMEOUT_S = 5.0
+CONSUMER_WAIT_S = 1.0
+"""Longest the loop waits for the consumer to show a frame before asking for the next anyway."""
 STATS_WINDOW_S = 2.0
 MAX_AGES = 1000
 MAX_SCAN_SEGMENTS = 64
@@ -271,6 +273,7 @@ class VideoFeed:
         fps: float = DEFAULT_FPS,
         quality: int | None = DEFAULT_QUALITY,
         timeout: float = REQUEST_TIMEOUT_S,
+        max_pending: int | None = None,
         clock: Callable[[], float] = time.monotonic,
         wall_ns: Callable[[], int] = time.time_ns,
     ) -> None:
@@ -286,6 +289,11 @@ class VideoFeed:
         self.stats = FrameStats()
         self.note = ""
         self._sequence = 0
+        self.max_pending = max_pending
+        """Frames handed on but not yet shown before the loop waits (None: never waits). A consumer
+        that reports :meth:`shown` gets backpressure: frames never queue up behind a busy UI."""
+        self._shown = 0
+        self._consumed = asyncio.Event()
         self._last: tuple[int | None, int, int] | None = None
         self._resume = asyncio.Event()
         self._resume.set()
@@ -310,6 +318,26 @@ class VideoFeed:
     def set_fps(self, fps: float) -> None:
         self.governor.set_fps(fps)
 
+    def shown(self, sequence: int) -> None:
+        """The consumer has shown (or given up on) frame ``sequence`` and every one before it."""
+        if sequence > self._shown:
+            self._shown = sequence
+            self._consumed.set()
+
+    async def _consumer_ready(self) -> None:
+        if self.max_pending is None:
+            return
+        deadline = self.clock() + CONSUMER_WAIT_S
+        while self._sequence - self._shown > self.max_pending and not self._stopped:
+            self._consumed.clear()
+            left = deadline - self.clock()
+            if left <= 0:
+                return  # a stalled consumer must not freeze the video for ever: go on, slowly
+            try:
+                await asyncio.wait_for(self._consumed.wait(), left)
+            except TimeoutError:
+                return
+
     def set_quality(self, quality: int | None) -> None:
         self.quality = None if quality is None else min(max(int(quality), 0), 100)
 
@@ -319,6 +347,7 @@ class VideoFeed:
         end = None if seconds is None else self.clock() + seconds
         while not self._stopped:
             await self._resume.wait()
+            await self._consumer_ready()
             if self._stopped or (end is not None and self.clock() >= end):
                 break
             started = self.clock()

@@ -76,6 +76,11 @@ class LiveVideo:
         if feed is not None:
             feed.stop()
 
+    def shown(self, sequence: int) -> None:
+        """The window has drawn (or dropped) live frame ``sequence``: the loop may ask for the next."""
+        if self.feed is not None:
+            self.feed.shown(sequence - self.sequence_base)
+
     def pause(self, paused: bool) -> None:
         self.paused = paused
         if self.feed is not None:
@@ -86,7 +91,7 @@ class LiveVideo:
         client = self.client
         assert client is not None
         source = video_source(client)
-        feed = VideoFeed(client, source, self._frame, fps=self.fps, quality=self.quality)
+        feed = VideoFeed(client, source, self._frame, fps=self.fps, quality=self.quality, max_pending=1)
         feed.pause(self.paused)
         self.feed = feed
         self._spawn(self._run(feed), "video")

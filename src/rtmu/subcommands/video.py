@@ -79,6 +79,7 @@ class _Player:
         self.first_ns: int | None = None
         self.last_ns: int | None = None
         self.notes: list[str] = []
+        self.feed: VideoFeed | None = None
 
     def on_frame(self, frame: LiveFrame) -> None:
         if len(self.pending) >= MAX_DECODES_QUEUED:
@@ -96,6 +97,8 @@ class _Player:
 
     def _done(self, frame: LiveFrame, future: asyncio.Future[str | None]) -> None:
         self.pending.discard(future)
+        if self.feed is not None:
+            self.feed.shown(frame.sequence)
         if future.cancelled():
             return
         ready = time.time_ns()
@@ -142,7 +145,10 @@ def handle(args: argparse.Namespace) -> int:
                 last_note[0] = status.note
                 player.note(status.note)
 
-        feed = VideoFeed(client, source, player.on_frame, on_status, fps=args.fps, quality=args.quality)
+        feed = VideoFeed(
+            client, source, player.on_frame, on_status, fps=args.fps, quality=args.quality, max_pending=1
+        )
+        player.feed = feed
         started = time.monotonic()
         await feed.run(args.seconds)
         elapsed = time.monotonic() - started

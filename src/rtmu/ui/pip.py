@@ -15,7 +15,8 @@ import gi
 
 gi.require_version("Gtk", "4.0")
 gi.require_version("Graphene", "1.0")
-from gi.repository import Graphene, Gtk  # noqa: E402
+gi.require_version("Gdk", "4.0")
+from gi.repository import Gdk, Graphene, Gtk  # noqa: E402
 
 from .camera import INSET_MIN_WIDTH, CameraInset  # noqa: E402
 
@@ -128,6 +129,10 @@ class PictureInPicture(CameraInset):
         width = min(max(INSET_MIN_WIDTH, width), MAX_WIDTH)
         self.user_width = width
         self.picture.set_size(width, width * 3 // 4)
+
+    def texture_for(self, picture: Gdk.Texture, thumbnail: Gdk.Texture) -> Gdk.Texture:
+        """The thumbnail while it is big enough (scaling a full frame every paint costs the GTK thread)."""
+        return thumbnail if self.picture._size[0] <= thumbnail.get_width() else picture
 
     def fit_to(self, map_width: int) -> None:
         if getattr(self, "user_width", None) is None:

@@ -738,12 +738,14 @@ class MainWindow(Gtk.ApplicationWindow):
     def _picture_decoded(
         self, image: object, textures: tuple[Gdk.Texture, Gdk.Texture] | None, error: str
     ) -> None:
+        if getattr(image, "video", None) is not None:
+            self._link.video_shown(image.sequence)  # type: ignore[attr-defined]  # the next frame only now
         current = self.model.camera.value
         if current is None or image is not current:
             return  # a newer picture (or a disconnect) overtook this one
         self.camera.show_picture(image, None if textures is None else textures[0], error)
         if textures is not None:
-            self.inset.show_texture(textures[0], image.received_at)  # full size: the inset can be resized
+            self.inset.show_texture(self.inset.texture_for(*textures), image.received_at)
             self.live.shown(image)
             self.split.show_picture(textures[0], image)
 
