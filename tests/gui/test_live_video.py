@@ -66,7 +66,7 @@ def test_live_video_plays_pauses_and_saves_a_frame(gui: Gui, sim: SimThread, tmp
     pump(lambda: frames_seen(gui) >= first + 10, 8, "more frames")
     b = picture_pixels(gui, "02-playing-later")
     changed = float((np.abs(a - b).sum(axis=2) > 24).mean())
-    assert changed > 0.005, f"consecutive screenshots of a turning robot's video differ ({changed:.4f} changed)"
+    assert changed > 0.005, f"consecutive screenshots of turning video differ ({changed:.4f} changed)"
     gui.shot("live")
 
     gui.click(live.pause_button)
