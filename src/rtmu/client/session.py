@@ -64,6 +64,7 @@ from .nav_session import NavFeed
 from .popups import PopupFeed
 from .reconnect import Backoff, worth_retrying
 from .subscriptions import Subscription, applicable
+from .video_feed import frame_stamp
 from .video_session import LiveVideo
 
 log = logging.getLogger(__name__)
@@ -888,6 +889,7 @@ class Session:
             source=source,
             received_at=reply.received_at,
             sequence=self._image_sequence,
+            stamp_ns=frame_stamp(bytes(picture.jpeg)),  # type: ignore[attr-defined]
         )
         self._publish(CameraChanged(image))
         return image

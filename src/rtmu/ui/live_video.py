@@ -118,7 +118,8 @@ class LiveVideoControls:
         self.image = image
         self.save_button.set_sensitive(True)
         status = image.video
-        if status is not None and self.live:
+        # Only while the page is on screen: a label changing on a hidden page still re-lays out the window.
+        if status is not None and self.live and self.camera.get_mapped():
             text = status.caption()
             if self.pause_button.get_active():
                 text += " · paused"

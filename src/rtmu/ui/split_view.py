@@ -61,8 +61,9 @@ class SplitView(Gtk.Box):
         self.picture.set_paintable(texture)
         self.placeholder.set_visible(texture is None)
         status = None if image is None else image.video
-        self.caption.set_text("" if status is None else status.caption())
-        self.caption.set_visible(status is not None)
+        if self.split or status is None:  # a hidden pane's label must not re-lay out the window per frame
+            self.caption.set_text("" if status is None else status.caption())
+            self.caption.set_visible(status is not None)
 
     def do_size_allocate(self, width: int, height: int, baseline: int) -> None:
         wanted = Gtk.Orientation.HORIZONTAL if width >= height else Gtk.Orientation.VERTICAL
