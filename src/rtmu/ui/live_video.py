@@ -11,6 +11,7 @@ from __future__ import annotations
 
 import time
 from collections.abc import Callable
+from dataclasses import replace
 from pathlib import Path
 
 import gi
@@ -60,18 +61,28 @@ class LiveVideoControls:
         self.caption.set_visible(False)
         camera.overlay.add_overlay(self.caption)
 
-        self.live_button = Gtk.ToggleButton(label="Live")
+        # Icons, and the rate and quality in a popover: the bar must still fit a 560 px window.
+        self.live_button = Gtk.ToggleButton(icon_name="camera-video-symbolic")
         self.live_button.set_tooltip_text("Live video: a new frame as soon as one arrives")
-        self.pause_button = Gtk.ToggleButton(label="Pause")
+        self.pause_button = Gtk.ToggleButton(icon_name="media-playback-pause-symbolic")
+        self.pause_button.set_tooltip_text("Pause the video")
         self.pause_button.set_sensitive(False)
-        self.save_button = Gtk.Button(label="Save frame")
+        self.save_button = Gtk.Button(icon_name="document-save-symbolic")
+        self.save_button.set_tooltip_text("Save the frame on screen (JPEG)")
         self.save_button.set_sensitive(False)
         self.fps = Gtk.DropDown.new_from_strings([f"{n} fps" for n in FPS_CHOICES])
         self.fps.set_selected(FPS_CHOICES.index(DEFAULT_FPS))
         self.fps.set_tooltip_text("Frames per second at most")
         self.quality = Gtk.DropDown.new_from_strings([f"Q {q}" for q in QUALITY_CHOICES])
         self.quality.set_tooltip_text("JPEG quality to ask the server for")
-        for w in (self.live_button, self.pause_button, self.save_button, self.fps, self.quality):
+        settings = Gtk.Box(orientation=Gtk.Orientation.VERTICAL, spacing=6)
+        settings.append(self.fps)
+        settings.append(self.quality)
+        popover = Gtk.Popover()
+        popover.set_child(settings)
+        self.settings_button = Gtk.MenuButton(icon_name="emblem-system-symbolic", popover=popover)
+        self.settings_button.set_tooltip_text("Video frame rate and JPEG quality")
+        for w in (self.live_button, self.pause_button, self.save_button, self.settings_button):
             w.set_focusable(False)  # the arrow keys keep driving
         self.live_button.connect("toggled", self._live_toggled)
         self.pause_button.connect("toggled", lambda b: self._pause(b.get_active()))
@@ -79,7 +90,7 @@ class LiveVideoControls:
         self.fps.connect("notify::selected", lambda *_a: self._settings_changed())
         self.quality.connect("notify::selected", lambda *_a: self._settings_changed())
         anchor: Gtk.Widget = camera.info
-        for w in (self.live_button, self.pause_button, self.save_button, self.fps, self.quality):
+        for w in (self.live_button, self.pause_button, self.save_button, self.settings_button):
             camera.bar.insert_child_after(w, anchor)
             anchor = w
 
@@ -120,6 +131,8 @@ class LiveVideoControls:
         status = image.video
         # Only while the page is on screen: a label changing on a hidden page still re-lays out the window.
         if status is not None and self.live and self.camera.get_mapped():
+            if image.stamp_ns is not None:  # its age now, on screen (the feed's is at arrival)
+                status = replace(status, age_ms=max(time.time_ns() - image.stamp_ns, 0) / 1e6)
             text = status.caption()
             if self.pause_button.get_active():
                 text += " · paused"
