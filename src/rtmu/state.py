@@ -181,6 +181,8 @@ class VideoStatus:
             parts.append("paused")
         if self.backoff:
             parts.append(self.backoff)
+        if self.dropped:
+            parts.append(f"{self.dropped} dropped" + (f" (last: {self.note})" if self.note else ""))
         return " · ".join(parts)
 
 

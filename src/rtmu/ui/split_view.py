@@ -12,7 +12,8 @@ import gi
 
 gi.require_version("Gtk", "4.0")
 gi.require_version("Gdk", "4.0")
-from gi.repository import Gdk, GLib, Gtk  # noqa: E402
+gi.require_version("Pango", "1.0")
+from gi.repository import Gdk, GLib, Gtk, Pango  # noqa: E402
 
 from ..model import CameraImage  # noqa: E402
 
@@ -37,6 +38,8 @@ class SplitView(Gtk.Box):
         self.caption = Gtk.Label(halign=Gtk.Align.START, valign=Gtk.Align.START)
         self.caption.add_css_class("video-caption")
         self.caption.set_use_markup(False)
+        self.caption.set_ellipsize(Pango.EllipsizeMode.END)  # a dropped frame's reason can be long
+        self.caption.set_max_width_chars(90)
         self.caption.set_can_target(False)
         self.caption.set_margin_start(8)
         self.caption.set_margin_top(8)
