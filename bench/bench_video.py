@@ -103,6 +103,7 @@ async def headless(port: int, serial: bool) -> tuple[Figures, float, float]:
 
             def on_frame(frame: LiveFrame) -> None:
                 if len(busy) >= 2:  # the window keeps only the newest too
+                    feed.shown(frame.sequence)
                     return
                 future = loop.run_in_executor(pool, decode_rgb, frame.jpeg)
                 busy.add(future)

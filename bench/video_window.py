@@ -76,6 +76,7 @@ def main(argv: list[str]) -> int:
     client_ms: list[float] = []
     frame_ms: list[float] = []
     drawn = [0]
+    last_stamp: list[int | None] = [None]
     waiting_paint: list[tuple[int | None, float]] = []
     original = window._picture_decoded
 
@@ -83,7 +84,7 @@ def main(argv: list[str]) -> int:
         original(image, textures, error)
         if textures is None or not measuring[0]:
             if mode == "serial" and textures is not None:
-                waiting_paint.append((None, image.received_at))
+                waiting_paint.append((image.stamp_ns, image.received_at))
             return
         now_ns = time.time_ns()
         if image.stamp_ns is not None:
@@ -103,7 +104,9 @@ def main(argv: list[str]) -> int:
             frame_ms.append((done - update_at[0]) * 1000)
         while waiting_paint:
             stamp, received = waiting_paint.pop(0)
-            if measuring[0]:
+            repeat = stamp is not None and stamp == last_stamp[0]
+            last_stamp[0] = stamp
+            if measuring[0] and not repeat:  # the same frame again is not a new frame
                 drawn[0] += 1
                 client_ms.append((time.monotonic() - received) * 1000)
                 if stamp is not None:

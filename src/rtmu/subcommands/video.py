@@ -84,6 +84,8 @@ class _Player:
     def on_frame(self, frame: LiveFrame) -> None:
         if len(self.pending) >= MAX_DECODES_QUEUED:
             self.skipped += 1
+            if self.feed is not None:
+                self.feed.shown(frame.sequence)  # given up on: the loop must not wait for it
             return
         future = asyncio.get_running_loop().run_in_executor(self.pool, self._decode, frame)
         self.pending.add(future)
