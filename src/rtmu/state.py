@@ -183,6 +183,40 @@ class CameraImage:
     received_at: float = field(compare=False)
     sequence: int = 0
     """Increases for every picture, so two identical frames still count as a new picture."""
+    stamp_ns: int | None = field(default=None, compare=False)
+    """Wall-clock ns the server rendered it (the simulator's ``RTMU-T`` comment); None: not stamped."""
+    video: VideoStatus | None = field(default=None, compare=False)
+    """Live video's figures when this frame came from the video loop (None: a single picture)."""
+
+
+@dataclass(frozen=True, slots=True)
+class VideoStatus:
+    """What live video's caption shows: rate, traffic, age, and why the rate is lower than asked."""
+
+    fps: float
+    kbps: float
+    age_ms: float | None
+    target_fps: float
+    rate_fps: float
+    backoff: str
+    """Plain words when the rate was lowered because the link is slow ("" at the asked rate)."""
+    paused: bool
+    dropped: int
+    note: str
+    """The last dropped frame's reason ("" when none)."""
+
+    def caption(self) -> str:
+        """One short line for the picture: "12.0 fps · 310 kB/s · 45 ms old"."""
+        parts = [f"{self.fps:.1f} fps", f"{self.kbps:.0f} kB/s"]
+        if self.age_ms is not None:
+            parts.append(f"{self.age_ms:.0f} ms old")
+        if self.paused:
+            parts.append("paused")
+        if self.backoff:
+            parts.append(self.backoff)
+        if self.dropped:
+            parts.append(f"{self.dropped} dropped" + (f" (last: {self.note})" if self.note else ""))
+        return " · ".join(parts)
 
 
 # -- navigation ----------------------------------------------------------------------------------

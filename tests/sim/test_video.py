@@ -2,9 +2,11 @@
 
 from __future__ import annotations
 
+import argparse
 import io
 import threading
 
+import pytest
 from PIL import Image
 
 from rtmu.protocol.payloads.camera import Picture
@@ -102,3 +104,38 @@ def test_realtime_pictures_are_rendered_on_the_worker(arena_map):
         await server.stop()
 
     run(scenario())
+
+
+def test_frames_carry_their_render_time_and_the_camera_size_and_rate_are_settable(arena_map):
+    import time
+
+    from rtmu.client.video_feed import frame_stamp
+    from rtmu.protocol.payloads.camera import VideoSize
+    from rtmu.subcommands.sim import _size
+
+    async def scenario() -> None:
+        cfg = SimConfig(port=0, realtime=False, map_path=arena_map, camera_size=(640, 480), camera_hz=20.0)
+        server = SimServer(cfg)
+        await server.start()
+        c = await WireClient().open(server.port)
+        size = VideoSize.decode((await c.ask("videoSize"))[0])
+        assert (size.width, size.height) == (640, 480)
+        before = time.time_ns()
+        first = Picture.decode((await c.ask("getPictureCam1"))[0])
+        stamp = frame_stamp(first.jpeg)
+        assert stamp is not None and before <= stamp <= time.time_ns()
+        assert Image.open(io.BytesIO(first.jpeg)).size == (640, 480)
+        server.world.ratio_drive(0, 60, 100)
+        renders = server.video.renders
+        await server.advance(1.0)
+        again = Picture.decode((await c.ask("getPictureCam1"))[0])
+        assert frame_stamp(again.jpeg) != stamp  # a new view, a new frame, a new stamp
+        assert server.video.period == 0.05 and server.video.renders > renders
+        await c.close()
+        await server.stop()
+
+    run(scenario(), timeout=60)
+    assert _size("640x480") == (640, 480) and _size("320X240") == (320, 240)
+    for bad in ("640", "0x480", "99999x2", "axb"):
+        with pytest.raises(argparse.ArgumentTypeError):
+            _size(bad)

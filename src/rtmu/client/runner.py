@@ -370,6 +370,23 @@ class ClientRunner:
     def request_image(self) -> concurrent.futures.Future[Any]:
         return self._fire(self._session.request_image, kind=Kind.CAMERA)
 
+    def start_video(
+        self, fps: float | None = None, quality: int | None = None
+    ) -> concurrent.futures.Future[None]:
+        """Live video (``client.video_session``): frames arrive as the model's camera part."""
+        return self._fire(self._session.video.start, fps, quality, kind=Kind.CAMERA)
+
+    def stop_video(self) -> concurrent.futures.Future[None]:
+        return self._fire(self._session.video.stop, kind=Kind.CAMERA)
+
+    def video_shown(self, sequence: int) -> None:
+        """Backpressure: the window has shown live frame ``sequence`` (thread-safe, no future)."""
+        if not self._closed:
+            self.loop.call_soon_threadsafe(self._session.video.shown, sequence)
+
+    def pause_video(self, paused: bool) -> concurrent.futures.Future[None]:
+        return self._fire(self._session.video.pause, paused, kind=Kind.CAMERA)
+
     def set_safe_drive(self, on: bool) -> concurrent.futures.Future[None]:
         return self._fire(self._session.set_safe_drive, on)
 

@@ -67,6 +67,8 @@ from .ptz import PtzFeed
 from .reconnect import Backoff, worth_retrying
 from .server_strings import StringsFeed
 from .subscriptions import Subscription, applicable
+from .video_feed import frame_stamp
+from .video_session import LiveVideo
 
 log = logging.getLogger(__name__)
 
@@ -191,6 +193,8 @@ class Session:
         """The pan-tilt-zoom camera head (§4.6): limits, position while watched, moves."""
         self.config_feed = ConfigFeed()
         """``configUpdated`` broadcasts (the configuration page refreshes on them)."""
+        self.video = LiveVideo(self._publish, self._spawn, self.clock)
+        """Live video (``client.video_session``): frames go out as the camera part; resumes on reconnect."""
         self._held_subs: set[str] = set()
         """Conditional subscriptions (``only_while``) held now on this connection."""
 
@@ -258,6 +262,8 @@ class Session:
         self.popups.disconnected()
         self.strings.disconnected()
         self.ptz.disconnected()
+        self.video.disconnected()
+        self.video.stop()  # a new connection (or none) starts without video: the operator asks again
         self._set_map(MapModel())
         self._publish(CameraChanged(None))
         self._set_connection(
@@ -305,6 +311,7 @@ class Session:
         self.nav.connected(client)
         self._setup_subscriptions(client)
         self.popups.connected(client)  # after the popupCreate subscription: popupList's answers go there
+        self.video.connected(client)
         self._set_connection(phase=Phase.CONNECTED, offers=offers, error="", error_kind="", retry_in=None)
         self._spawn(self._ping_loop(client), "ping")
         self._spawn(self.ptz.connected(client), "ptz")  # first: a server without cameras is known at once
@@ -328,6 +335,8 @@ class Session:
         self.popups.disconnected()
         self.strings.disconnected()
         self.ptz.disconnected()
+        self.video.disconnected()
+        self.video.stop()  # a new connection (or none) starts without video: the operator asks again
         self._set_map(MapModel())
         self._publish(CameraChanged(None))
         self._set_connection(
@@ -361,6 +370,7 @@ class Session:
     def _connection_lost(self, error: ClientError) -> None:
         """Not our choice: the server died, closed, or the link was lost."""
         client, self.client = self.client, None
+        self.video.disconnected()
         # Our link died while driving: we cannot stop the robot, the guardian (its own link) can.
         self._close_guardian(goodbye=not self.governor.driving)
         for task in list(self._tasks):
@@ -877,6 +887,7 @@ class Session:
             source=source,
             received_at=reply.received_at,
             sequence=self._image_sequence,
+            stamp_ns=frame_stamp(bytes(picture.jpeg)),  # type: ignore[attr-defined]
         )
         self._publish(CameraChanged(image))
         return image

@@ -48,6 +48,11 @@ class SimConfig:
     (ARIA's ``RobotFromCentralServerTimeoutInMins``, 2)."""
     video_trailer: bool = True
     """Append the 2 bytes ARIA's video forwarder leaves after each JPEG (serverDemo does this)."""
+    camera_size: tuple[int, int] = (320, 240)
+    """The picture size at start (``SimulatorVideo…`` commands still switch between 320x240 and 640x480)."""
+    camera_hz: float = 10.0
+    """New frames per second at most, shared by all clients (ARIA's forwarder polls its camera ~10 times a
+    second; raise it to serve live video faster)."""
     render_in_thread: bool | None = None
     """Render camera frames on a worker thread; None: in real-time mode only (inline on the manual clock)."""
     intro_timeout: float = 60.0

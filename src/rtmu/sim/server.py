@@ -376,10 +376,10 @@ class SimServer:
         self.malformed_packets = 0
         """Control packets from any client that did not decode (each refused or ignored, never raised)."""
         self.cpu = CpuMeter()
-        self.video_size: tuple[int, int] = (320, 240)
+        self.video_size: tuple[int, int] = cfg.camera_size
         self.arconfig = SimArConfig(self, cfg.config_filler)
         threaded = cfg.realtime if cfg.render_in_thread is None else cfg.render_in_thread
-        self.video = VideoFeed(threaded=threaded)
+        self.video = VideoFeed(threaded=threaded, period=1.0 / max(cfg.camera_hz, 0.1))
         self._switch_task: asyncio.Task[None] | None = None
         self.central_heartbeats: switch.Heartbeats | None = None
         """The central server's heartbeats, heard while switched to one (``switch_to``)."""

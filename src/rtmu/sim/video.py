@@ -35,7 +35,8 @@ from .camera import View, render_jpeg
 log = logging.getLogger("rtmu.sim")
 
 FRAME_PERIOD_S = 0.1
-"""The forwarder's polling period: at most one new frame per size per 100 ms of simulated time."""
+"""The forwarder's polling period: at most one new frame per size per 100 ms of simulated time
+(the default; ``SimConfig.camera_hz`` sets another)."""
 DEFAULT_QUALITY = 75
 MAX_OWED_PER_WAITER = 4
 """Replies owed to one requester (one client's data) while a frame renders; more are dropped, like UDP."""
@@ -61,7 +62,9 @@ class _Waiter:
 class VideoFeed:
     """The latest frame per picture size, renders at most every :data:`FRAME_PERIOD_S`, and who waits."""
 
-    def __init__(self, *, threaded: bool) -> None:
+    def __init__(self, *, threaded: bool, period: float = FRAME_PERIOD_S) -> None:
+        self.period = period
+        """Seconds of simulated time a frame is served before a new one is rendered."""
         self._executor = (
             concurrent.futures.ThreadPoolExecutor(max_workers=1, thread_name_prefix="rtmu-sim-video")
             if threaded
@@ -91,7 +94,7 @@ class VideoFeed:
             self.quality = min(max(int(quality), 1), 95)
         size = view.size
         latest = self._latest.get(size)
-        if latest is not None and (latest.view == view or now - latest.taken_at < FRAME_PERIOD_S - 1e-9):
+        if latest is not None and (latest.view == view or now - latest.taken_at < self.period - 1e-9):
             return latest.jpeg
         if self._executor is None:
             return self._store(view, now, render_jpeg(view, self.quality))

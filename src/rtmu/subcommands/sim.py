@@ -51,6 +51,20 @@ def register(subparsers: argparse._SubParsersAction) -> None:
     p.add_argument(
         "--no-camera", action="store_true", help="no camera: video and camera data are not offered"
     )
+    p.add_argument(
+        "--camera-size",
+        type=_size,
+        default=(320, 240),
+        metavar="WxH",
+        help="picture size at start (default 320x240; e.g. 640x480)",
+    )
+    p.add_argument(
+        "--camera-hz",
+        type=float,
+        default=10.0,
+        metavar="HZ",
+        help="new camera frames per second at most (default 10, like ARIA's video forwarder)",
+    )
     p.add_argument("--seed", type=int, default=1, help="seed for everything random (default 1)")
     p.add_argument(
         "--drive-timeout",
@@ -120,6 +134,17 @@ def register(subparsers: argparse._SubParsersAction) -> None:
     p.set_defaults(handler=run)
 
 
+def _size(text: str) -> tuple[int, int]:
+    """``WxH`` → (W, H), each 16…1920 (ArNetworking's packet limit caps a JPEG well before that)."""
+    try:
+        w, h = (int(v) for v in text.lower().split("x"))
+    except ValueError:
+        raise argparse.ArgumentTypeError(f"{text!r} is not WxH (e.g. 640x480)") from None
+    if not (16 <= w <= 1920 and 16 <= h <= 1920):
+        raise argparse.ArgumentTypeError(f"{text!r}: each side must be 16…1920 pixels")
+    return w, h
+
+
 def run(args: argparse.Namespace) -> int:
     if args.make_map is not None:
         return make_map(args)
@@ -154,6 +179,8 @@ def run(args: argparse.Namespace) -> int:
         map_path=map_path,
         users_path=args.users,
         camera=not args.no_camera,
+        camera_size=args.camera_size,
+        camera_hz=args.camera_hz,
         seed=args.seed,
         drive_timeout=args.drive_timeout,
         server_key=args.server_key,

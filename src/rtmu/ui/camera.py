@@ -144,7 +144,7 @@ class CameraView(Gtk.Box):
         self.requested_at: float | None = None
         self.error = ""
 
-        overlay = Gtk.Overlay()
+        overlay = self.overlay = Gtk.Overlay()
         overlay.set_vexpand(True)
         self.picture = Gtk.Picture()
         self.picture.set_can_shrink(True)
@@ -165,7 +165,7 @@ class CameraView(Gtk.Box):
         overlay.add_overlay(self.status_box)
         self.append(overlay)
 
-        bar = Gtk.Box(orientation=Gtk.Orientation.HORIZONTAL, spacing=8)
+        bar = self.bar = Gtk.Box(orientation=Gtk.Orientation.HORIZONTAL, spacing=8)
         bar.add_css_class("camera-bar")
         self.info = Gtk.Label(xalign=0.0, hexpand=True)
         self.info.set_use_markup(False)

@@ -15,7 +15,7 @@ from dataclasses import dataclass, field
 
 import cairo
 
-from . import fleet_draw, nav_draw, overlays
+from . import fleet_draw, fov_draw, nav_draw, overlays
 from .tiles import BACKGROUND_RGB, EMPTY, TILE, Overview, TileCache
 from .viewport import Viewport
 
@@ -44,6 +44,8 @@ class Scene:
     """The fleet's other robots on this map, each in its colour with its trail."""
     robot_rgb: tuple[float, float, float] = overlays.ROBOT_RGB
     """The selected robot's colour (its fleet colour; blue for a robot alone)."""
+    fov: fov_draw.Wedge | None = None
+    """The camera's field of view, drawn as a wedge from the robot (None: not shown)."""
 
 
 def draw_frame(ctx: cairo.Context, vp: Viewport, scene: Scene) -> bool:
@@ -68,6 +70,8 @@ def draw_frame(ctx: cairo.Context, vp: Viewport, scene: Scene) -> bool:
         nav_draw.draw_marker(ctx, vp, scene.marker)
     if scene.others:
         fleet_draw.draw_fleet(ctx, vp, scene.others, footprint=has_map)
+    if scene.fov is not None and scene.robot is not None:
+        fov_draw.draw_fov(ctx, vp, scene.fov)
     if scene.robot is not None:
         x, y, th = scene.robot
         overlays.draw_trail(ctx, vp, scene.trail, (*scene.robot_rgb, fleet_draw.TRAIL_ALPHA))

@@ -29,6 +29,7 @@ from gi.repository import GLib, Gtk  # noqa: E402
 from ..model import LinkLevel, MapModel, OperatorState, RobotModel, RobotState  # noqa: E402
 from . import overlays  # noqa: E402
 from .fleet_draw import FleetMark  # noqa: E402
+from .fov_draw import Wedge  # noqa: E402
 from .frame import Scene, draw_frame  # noqa: E402
 from .nav_draw import Marker, MarkerKind  # noqa: E402
 from .tiles import TileCache  # noqa: E402
@@ -59,6 +60,8 @@ class MapStage(Gtk.DrawingArea):
         self.operator = operator
         self.clock = clock
         self.status_age = status_age
+        self.show_fov = True
+        """Draw the camera's field of view (View ▸ Camera field of view) where the server has a camera."""
         self.add_css_class("map-stage")
         self.set_hexpand(True)
         self.set_vexpand(True)
@@ -309,7 +312,13 @@ class MapStage(Gtk.DrawingArea):
         if self.fleet is not None:  # the fleet's other robots and the selected one's colour
             scene.others, scene.robot_rgb = self.fleet()
         self._add_navigation(scene)
+        if self.show_fov and scene.robot is not None and self._has_camera():
+            scene.fov = Wedge(*scene.robot)
         return draw_frame(ctx, vp, scene)
+
+    def _has_camera(self) -> bool:
+        offers = self.model.connection.value.offers
+        return "sendVideo" in offers or any(name.startswith("getPicture") for name in offers)
 
     def _add_navigation(self, scene: Scene) -> None:
         """While the server navigates: its path, and the goal ringed (or the point marked)."""

@@ -59,7 +59,7 @@ def show_replay(window: MainWindow, session: RobotSession, replayer: Replayer) -
 
     window.stage.status_age = window.toolbar.status_age = replayer.status_age  # ages in recording time
     bar = ReplayBar(replayer.clock, seek, name)
-    window.body.append(bar)
+    window.column.append(bar)
     window.title_label.set_text("RTMU — REPLAY")
     more = replayer.recorded.connections
     extra = f" (connection {replayer.recorded.conn} of {more}; --conn N picks another)" if more > 1 else ""

@@ -82,6 +82,11 @@ menubutton.goals-button > button { min-width: 20px; padding-left: 3px; padding-r
 .camera-inset .inset-age { background: alpha(black, 0.62); color: white; font-size: 8.5pt;
                            padding: 0 4px; border-radius: 4px; margin: 3px; }
 .camera-inset.stale .inset-age { background: alpha(#9c5300, 0.92); }
+.pip .pip-close { min-height: 18px; min-width: 18px; padding: 0 5px; margin: 3px; border-radius: 9px;
+                  color: white; background: alpha(black, 0.55); border: none; box-shadow: none; }
+.pip .pip-grip { color: alpha(white, 0.9); font-size: 9pt; margin: 1px 2px; }
+.video-caption { background: alpha(black, 0.62); color: white; font-size: 9pt; padding: 1px 6px;
+                 border-radius: 4px; }
 
 /* GTK's own theme gives the shortcuts window's page buttons (1 2 3) negative label margins:
    "GtkLabel reported min width -4" warnings. Plain margins, same look. */

@@ -54,13 +54,14 @@ from ..settings import Profile  # noqa: E402
 from .banners import BannerStack  # noqa: E402
 from .bars import FullscreenBar, connect_button, menu_button, show_connection, stop_button  # noqa: E402
 from .bridge_toggle import BridgeToggle  # noqa: E402
-from .camera import CameraInset, CameraView, PictureDecoder  # noqa: E402
+from .camera import CameraView, PictureDecoder  # noqa: E402
 from .config_page import ConfigPage  # noqa: E402
 from .details import DetailsWindow  # noqa: E402
 from .dpad import DPad  # noqa: E402
 from .goals_panel import GoalsPanel  # noqa: E402
 from .handheld import Handheld  # noqa: E402
 from .keys import KeyRouter  # noqa: E402
+from .live_video import LiveVideoControls  # noqa: E402
 from .mapview import MapStage  # noqa: E402
 from .motion import MotionIndicator  # noqa: E402
 from .move_dialogs import go_dialog, turn_dialog  # noqa: E402
@@ -68,6 +69,7 @@ from .nav_draw import Marker, MarkerKind  # noqa: E402
 from .nav_text import link_lost_note  # noqa: E402
 from .notes import map_note  # noqa: E402
 from .palette import CommandPalette  # noqa: E402
+from .pip import PictureInPicture  # noqa: E402
 from .popups import PopupStack  # noqa: E402
 from .pose_bar import PoseBar  # noqa: E402
 from .pose_pick import PosePicker  # noqa: E402
@@ -76,6 +78,7 @@ from .routes_panel import RoutesPanel  # noqa: E402
 from .selected_model import SelectedModel  # noqa: E402
 from .settings_dialog import ConnectionDialog, PasswordPrompt  # noqa: E402
 from .shortcuts import build_shortcuts_window  # noqa: E402
+from .split_view import SplitView  # noqa: E402
 from .toolbar import StatusToolbar  # noqa: E402
 from .viewport import zoom_label  # noqa: E402
 
@@ -188,10 +191,14 @@ class MainWindow(Gtk.ApplicationWindow):
         self.stage.on_view_changed = self._view_changed
         self.toolbar = StatusToolbar(model, operator, clock=clock, status_age=status_age)
         self.camera = CameraView(on_request=self._request_picture, on_back=self.show_map, clock=clock)
-        self.inset = CameraInset(self.show_camera, clock=clock)
+        self.inset = PictureInPicture(self.show_camera, clock=clock, on_hide=lambda: self._hide_inset())
         self.ptz = PtzControls(model, link, on_moved=self._request_picture)
         self.ptz.attach_drag(self.camera.picture)
         self.camera.append(self.ptz)
+        self.live = LiveVideoControls(
+            self.camera, start=link.start_video, stop=link.stop_video, pause=link.pause_video,
+            tell=lambda level, text: self.banners.tell("camera", level, text, timeout=5.0),
+        )  # fmt: skip
         self.decoder = PictureDecoder(self._picture_decoded)
         self.dpad = DPad(hold=self._hold, release=self._release, stop=self._stop_from_dpad)
         self.keys = KeyRouter(
@@ -300,7 +307,8 @@ class MainWindow(Gtk.ApplicationWindow):
         self.stage.connect("resize", lambda _s, width, _h: self.inset.fit_to(width))
 
         self.stack = Gtk.Stack(transition_type=Gtk.StackTransitionType.NONE)
-        self.stack.add_named(map_page, "map")
+        self.split = SplitView(map_page)  # the map page, and the live picture beside it while split
+        self.stack.add_named(self.split, "map")
         self.stack.add_named(self.camera, "camera")
         self.stack.set_visible_child_name("map")
         outer = Gtk.Overlay()
@@ -323,8 +331,8 @@ class MainWindow(Gtk.ApplicationWindow):
         box.append(self.body)
         self.body.set_vexpand(True)
         outer.set_vexpand(True)
-        self.body = box
-        """The window's column (bars above, the map/camera stack); a replay appends its controls."""
+        self.column = box
+        """The window's column (bars above, the map/camera body); a replay appends its controls."""
         self.set_child(box)
 
     def _osd(self) -> Gtk.Widget:
@@ -370,6 +378,8 @@ class MainWindow(Gtk.ApplicationWindow):
         view.append("Touch D-pad", "win.dpad")
         view.append("Alarm sound", "win.alarm-sound")
         view.append("Camera inset on the map", "win.inset")
+        view.append("Split view: map and video", "win.split")
+        view.append("Camera field of view", "win.fov")
         view.append("Sonar readings", "win.sonar")
         view.append("Robot details…", "win.details")
         view.append("Foxglove bridge (ws://127.0.0.1:8765)", "win.foxglove")
@@ -438,6 +448,8 @@ class MainWindow(Gtk.ApplicationWindow):
         self.fullscreen_action = toggle("fullscreen", False, self._set_fullscreen)
         self.dpad_action = toggle("dpad", self.dpad.get_visible(), self._set_dpad)
         self.inset_action = toggle("inset", True, self.inset.set_enabled)
+        self.split_action = toggle("split", False, self._set_split)
+        self.fov_action = toggle("fov", True, self._set_fov)
         self.sonar_action = toggle("sonar", self.operator.view.value.show_sonar, self._set_sonar)
         self.safe_action = toggle("safe-drive", True, self._set_safe_drive)
         self.foxglove = BridgeToggle(self.session, self.show_notice)  # publishing only, never drives
@@ -697,6 +709,8 @@ class MainWindow(Gtk.ApplicationWindow):
             self.banners.dismiss("link")  # deliberate: no banner at all
         if phase is Phase.DISCONNECTED or (phase is Phase.CONNECTING and old.phase is not Phase.RECONNECTING):
             self.camera.clear()
+            self.live.connection_lost()
+            self.split.show_picture(None, None)
             if self.stack.get_visible_child_name() == "camera":
                 self.show_map()
         # The inset is a glance at the robot's view: a picture from an earlier connection is not
@@ -753,6 +767,20 @@ class MainWindow(Gtk.ApplicationWindow):
             "speed", "info", f"Speed {new.percent} %", timeout=2.5, fraction=new.percent / SPEED_MAX
         )
 
+    def _hide_inset(self) -> None:
+        if _flag(self.inset_action):
+            self.inset_action.activate(None)
+
+    def _set_split(self, on: bool) -> None:
+        """Map and video side by side: the split starts live video (the pane would show nothing else)."""
+        self.split.set_split(on)
+        if on and not self.live.live and self.command_state("request_image").enabled:
+            self.live.set_live(True)
+
+    def _set_fov(self, on: bool) -> None:
+        self.stage.show_fov = on
+        self.stage.queue_draw()
+
     def _on_camera(self, _old: object, new: object) -> None:
         if new is not None:
             self.decoder.decode(new)  # type: ignore[arg-type]
@@ -760,12 +788,16 @@ class MainWindow(Gtk.ApplicationWindow):
     def _picture_decoded(
         self, image: object, textures: tuple[Gdk.Texture, Gdk.Texture] | None, error: str
     ) -> None:
+        if getattr(image, "video", None) is not None:
+            self._link.video_shown(image.sequence)  # type: ignore[attr-defined]  # the next frame only now
         current = self.model.camera.value
         if current is None or image is not current:
             return  # a newer picture (or a disconnect) overtook this one
         self.camera.show_picture(image, None if textures is None else textures[0], error)
         if textures is not None:
-            self.inset.show_texture(textures[1], image.received_at)
+            self.inset.show_texture(self.inset.texture_for(*textures), image.received_at)
+            self.live.shown(image)
+            self.split.show_picture(textures[0], image)
 
     def _view_changed(self) -> None:
         label = "Fit" if self.stage.fitted else ""

@@ -1,0 +1,156 @@
+"""The real window playing video, measured from inside its own process (run under the bench's Xvfb).
+
+``python -m bench.video_window PORT MODE SECONDS`` opens RTMU's window on the simulator at PORT,
+shows the map with the picture-in-picture, and plays the camera for SECONDS after a 2 s warm-up:
+
+* ``live``: the live-video loop (``client.video_session``) at 20 frames/s;
+* ``serial``: the baseline — one ``request_image`` per frame, the next sent only once the previous
+  picture has been drawn.
+
+It prints one JSON object: frames drawn per second, each frame's age (render stamp → texture ready,
+and → first paint after it), the client's own share (received → drawn), the GTK thread's time per
+frame (frame clock ``update`` → ``after-paint``, for every frame GTK drew while playing) and the
+process's CPU share.
+"""
+
+from __future__ import annotations
+
+import json
+import statistics
+import sys
+import tempfile
+import time
+from pathlib import Path
+from typing import Any
+
+import gi
+
+gi.require_version("Gtk", "4.0")
+from gi.repository import GLib  # noqa: E402
+
+from rtmu.model import Phase  # noqa: E402
+from rtmu.ui.application import RtmuApplication  # noqa: E402
+from rtmu.ui.options import GuiOptions  # noqa: E402
+
+
+def pump(condition: Any, timeout: float) -> None:
+    ctx = GLib.MainContext.default()
+    deadline = time.monotonic() + timeout
+    while not condition():
+        if time.monotonic() > deadline:
+            raise TimeoutError("the window did not get there in time")
+        ctx.iteration(True)
+
+
+def run_for(seconds: float) -> None:
+    ctx = GLib.MainContext.default()
+    end = time.monotonic() + seconds
+    while time.monotonic() < end:
+        ctx.iteration(False) or time.sleep(0.001)
+
+
+def pct(values: list[float], p: int) -> float | None:
+    if len(values) < 2:
+        return values[0] if values else None
+    return statistics.quantiles(values, n=100, method="inclusive")[p - 1]
+
+
+def main(argv: list[str]) -> int:
+    port, mode, seconds = int(argv[0]), argv[1], float(argv[2])
+    settings = Path(tempfile.mkdtemp(prefix="rtmu-bench-video-")) / "settings.toml"
+    app = RtmuApplication(
+        GuiOptions(host="127.0.0.1", port=port, settings_path=settings, persist=False, connect=None)
+    )
+    app.register(None)
+    app.activate()
+    pump(lambda: app.window is not None and app.window.get_mapped(), 20)
+    window = app.window
+    assert window is not None
+    window.set_default_size(1024, 600)
+    pump(lambda: window.model.connection.value.phase is Phase.CONNECTED, 20)
+    pump(lambda: window.model.map.value.state in ("ready", "none"), 20)
+
+    measuring = [False]
+    ready_age: list[float] = []
+    drawn_age: list[float] = []
+    client_ms: list[float] = []
+    frame_ms: list[float] = []
+    drawn = [0]
+    last_stamp: list[int | None] = [None]
+    waiting_paint: list[tuple[int | None, float]] = []
+    original = window._picture_decoded
+
+    def decoded(image: Any, textures: Any, error: str) -> None:
+        original(image, textures, error)
+        if textures is None or not measuring[0]:
+            if mode == "serial" and textures is not None:
+                waiting_paint.append((image.stamp_ns, image.received_at))
+            return
+        now_ns = time.time_ns()
+        if image.stamp_ns is not None:
+            ready_age.append((now_ns - image.stamp_ns) / 1e6)
+        waiting_paint.append((image.stamp_ns, image.received_at))
+
+    window.decoder._deliver = decoded
+    clock = window.get_frame_clock()
+    update_at = [0.0]
+
+    def on_update(_clock: Any) -> None:
+        update_at[0] = time.perf_counter()
+
+    def after_paint(_clock: Any) -> None:
+        done = time.perf_counter()
+        if measuring[0] and update_at[0]:
+            frame_ms.append((done - update_at[0]) * 1000)
+        while waiting_paint:
+            stamp, received = waiting_paint.pop(0)
+            repeat = stamp is not None and stamp == last_stamp[0]
+            last_stamp[0] = stamp
+            if measuring[0] and not repeat:  # the same frame again is not a new frame
+                drawn[0] += 1
+                client_ms.append((time.monotonic() - received) * 1000)
+                if stamp is not None:
+                    drawn_age.append((time.time_ns() - stamp) / 1e6)
+            if mode == "serial":
+                window._link.request_image()  # the next only once this one is on screen
+
+    clock.connect("update", on_update)
+    clock.connect("after-paint", after_paint)
+
+    if mode == "live":
+        window.live.fps.set_selected(window.live.fps.get_model().get_n_items() - 2)  # 20 fps
+        window.live.set_live(True)
+    else:
+        window._link.request_image()
+    run_for(2.0)  # warm-up: first frames, texture upload paths
+    measuring[0] = True
+    cpu0, t0 = time.process_time(), time.monotonic()
+    run_for(seconds)
+    cpu, elapsed = time.process_time() - cpu0, time.monotonic() - t0
+    measuring[0] = False
+    window.live.set_live(False)
+    print(
+        json.dumps(
+            {
+                "fps": drawn[0] / elapsed,
+                "age_ready_p50": pct(ready_age, 50),
+                "age_ready_p95": pct(ready_age, 95),
+                "age_drawn_p95": pct(drawn_age, 95),
+                "client_ms_p50": pct(client_ms, 50),
+                "client_ms_p95": pct(client_ms, 95),
+                "frame_ms_p50": pct(frame_ms, 50),
+                "frame_ms_p95": pct(frame_ms, 95),
+                "cpu_pct": 100 * cpu / elapsed,
+            }
+        ),
+        flush=True,
+    )
+    app.close_session()
+    for w in list(app.get_windows()):
+        w.destroy()
+    pump(lambda: not app.get_windows(), 5)
+    return 0
+
+
+if __name__ == "__main__":
+    raise SystemExit(main(sys.argv[1:]))

@@ -1,0 +1,167 @@
+"""Live video controls on the camera page: Live, Pause, Save frame, the rate and quality, and the figures.
+
+The request loop runs on the network thread (``client.video_session``); frames
+arrive as the model's camera part and are decoded on the window's JPEG thread.
+This widget only adds buttons to the camera page's bar and a caption over its
+picture (frames/s, kB/s, age, and why the rate was lowered), and saves the
+frame on screen. Server text never reaches markup: every label is plain text.
+"""
+
+from __future__ import annotations
+
+import time
+from collections.abc import Callable
+from dataclasses import replace
+from pathlib import Path
+
+import gi
+
+gi.require_version("Gtk", "4.0")
+gi.require_version("Pango", "1.0")
+from gi.repository import GLib, Gtk, Pango  # noqa: E402
+
+from ..model import CameraImage  # noqa: E402
+from .camera import CameraView  # noqa: E402
+
+FPS_CHOICES = (2, 5, 10, 15, 20, 30)
+DEFAULT_FPS = 15
+QUALITY_CHOICES = ("Server's", "30", "50", "75", "90")
+
+
+def frames_dir() -> Path:
+    """Where saved frames go: ``~/Pictures/rtmu`` (the XDG pictures folder), else ``~/rtmu-frames``."""
+    pictures = GLib.get_user_special_dir(GLib.UserDirectory.DIRECTORY_PICTURES)
+    return Path(pictures) / "rtmu" if pictures else Path(GLib.get_home_dir()) / "rtmu-frames"
+
+
+class LiveVideoControls:
+    """Adds live video to a :class:`CameraView`; ``start``, ``stop`` and ``pause`` reach the link."""
+
+    def __init__(
+        self,
+        camera: CameraView,
+        *,
+        start: Callable[[float, int | None], object],
+        stop: Callable[[], object],
+        pause: Callable[[bool], object],
+        tell: Callable[[str, str], None],
+    ) -> None:
+        self.camera = camera
+        self._start, self._stop, self._pause, self._tell = start, stop, pause, tell
+        self.image: CameraImage | None = None
+        self.saved: list[Path] = []
+        self.folder: Path | None = None
+        """Where Save writes (None: :func:`frames_dir`)."""
+
+        self.caption = Gtk.Label(halign=Gtk.Align.START, valign=Gtk.Align.START)
+        self.caption.add_css_class("video-caption")
+        self.caption.set_use_markup(False)
+        self.caption.set_ellipsize(Pango.EllipsizeMode.END)  # a dropped frame's reason can be long
+        self.caption.set_max_width_chars(90)
+        self.caption.set_can_target(False)
+        self.caption.set_margin_start(8)
+        self.caption.set_margin_top(8)
+        self.caption.set_visible(False)
+        camera.overlay.add_overlay(self.caption)
+
+        # Icons, and the rate and quality in a popover: the bar must still fit a 560 px window.
+        self.live_button = Gtk.ToggleButton(icon_name="camera-video-symbolic")
+        self.live_button.set_tooltip_text("Live video: a new frame as soon as one arrives")
+        self.pause_button = Gtk.ToggleButton(icon_name="media-playback-pause-symbolic")
+        self.pause_button.set_tooltip_text("Pause the video")
+        self.pause_button.set_sensitive(False)
+        self.save_button = Gtk.Button(icon_name="document-save-symbolic")
+        self.save_button.set_tooltip_text("Save the frame on screen (JPEG)")
+        self.save_button.set_sensitive(False)
+        self.fps = Gtk.DropDown.new_from_strings([f"{n} fps" for n in FPS_CHOICES])
+        self.fps.set_selected(FPS_CHOICES.index(DEFAULT_FPS))
+        self.fps.set_tooltip_text("Frames per second at most")
+        self.quality = Gtk.DropDown.new_from_strings([f"Q {q}" for q in QUALITY_CHOICES])
+        self.quality.set_tooltip_text("JPEG quality to ask the server for")
+        settings = Gtk.Box(orientation=Gtk.Orientation.VERTICAL, spacing=6)
+        settings.append(self.fps)
+        settings.append(self.quality)
+        popover = Gtk.Popover()
+        popover.set_child(settings)
+        self.settings_button = Gtk.MenuButton(icon_name="emblem-system-symbolic", popover=popover)
+        self.settings_button.set_tooltip_text("Video frame rate and JPEG quality")
+        for w in (self.live_button, self.pause_button, self.save_button, self.settings_button):
+            w.set_focusable(False)  # the arrow keys keep driving
+        self.live_button.connect("toggled", self._live_toggled)
+        self.pause_button.connect("toggled", lambda b: self._pause(b.get_active()))
+        self.save_button.connect("clicked", lambda _b: self.save())
+        self.fps.connect("notify::selected", lambda *_a: self._settings_changed())
+        self.quality.connect("notify::selected", lambda *_a: self._settings_changed())
+        anchor: Gtk.Widget = camera.info
+        for w in (self.live_button, self.pause_button, self.save_button, self.settings_button):
+            camera.bar.insert_child_after(w, anchor)
+            anchor = w
+
+    # -- settings ---------------------------------------------------------------------------------
+    @property
+    def live(self) -> bool:
+        return self.live_button.get_active()
+
+    def target_fps(self) -> float:
+        return float(FPS_CHOICES[min(self.fps.get_selected(), len(FPS_CHOICES) - 1)])
+
+    def target_quality(self) -> int | None:
+        choice = QUALITY_CHOICES[min(self.quality.get_selected(), len(QUALITY_CHOICES) - 1)]
+        return int(choice) if choice.isdigit() else None
+
+    def set_live(self, on: bool) -> None:
+        self.live_button.set_active(on)
+
+    def _live_toggled(self, button: Gtk.ToggleButton) -> None:
+        on = button.get_active()
+        self.pause_button.set_sensitive(on)
+        if not on:
+            self.pause_button.set_active(False)
+            self.caption.set_visible(False)
+            self._stop()
+        else:
+            self._start(self.target_fps(), self.target_quality())
+
+    def _settings_changed(self) -> None:
+        if self.live:
+            self._start(self.target_fps(), self.target_quality())
+
+    # -- frames -----------------------------------------------------------------------------------
+    def shown(self, image: CameraImage) -> None:
+        """A frame is on screen: keep it for Save, show its figures."""
+        self.image = image
+        self.save_button.set_sensitive(True)
+        status = image.video
+        # Only while the page is on screen: a label changing on a hidden page still re-lays out the window.
+        if status is not None and self.live and self.camera.get_mapped():
+            if image.stamp_ns is not None:  # its age now, on screen (the feed's is at arrival)
+                status = replace(status, age_ms=max(time.time_ns() - image.stamp_ns, 0) / 1e6)
+            text = status.caption()
+            if self.pause_button.get_active():
+                text += " · paused"
+            self.caption.set_text(text)
+            self.caption.set_visible(True)
+
+    def connection_lost(self) -> None:
+        """No robot: no picture to save, and Live stays off until asked for again."""
+        self.image = None
+        self.save_button.set_sensitive(False)
+        self.live_button.set_active(False)
+
+    def save(self) -> Path | None:
+        """Write the frame on screen (its exact JPEG bytes) to :func:`frames_dir`; say where."""
+        image = self.image
+        if image is None:
+            return None
+        folder = self.folder or frames_dir()
+        stamp = time.strftime("%Y%m%dT%H%M%S", time.gmtime())
+        path = folder / f"rtmu-frame-{stamp}-{image.sequence % 1_000_000:06d}.jpg"
+        try:
+            folder.mkdir(parents=True, exist_ok=True)
+            path.write_bytes(image.jpeg)
+        except OSError as exc:
+            self._tell("error", f"Could not save the frame: {exc.strerror or exc}")
+            return None
+        self.saved.append(path)
+        self._tell("info", f"Frame saved: {path}")
+        return path

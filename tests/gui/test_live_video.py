@@ -1,0 +1,184 @@
+"""Live video in the real window: it plays (frames differ, figures shown), pauses, saves a frame; the
+picture-in-picture is moved, resized and hidden with real pointer drags; the split view; the wedge."""
+
+from __future__ import annotations
+
+import re
+from collections.abc import Iterator
+from pathlib import Path
+
+import numpy as np
+import pytest
+from PIL import Image
+
+from rtmu.sim import SimConfig, SimThread
+
+from .harness import OFFICE_MAP, Gui, idle, pump
+
+
+@pytest.fixture
+def sim() -> Iterator[SimThread]:
+    """A camera serving up to 20 new frames/s on a robot turning on the spot, so every frame is new."""
+    cfg = SimConfig(port=0, map_path=OFFICE_MAP, camera=True, seed=1, camera_hz=20.0, drive_timeout=0)
+    with SimThread(cfg) as s:
+        yield s
+
+
+def turn(sim: SimThread) -> None:
+    """Turn the robot on the spot (after the window connected: a new connection stops the robot)."""
+    assert sim.server is not None
+    world = sim.server.world
+    sim.call(lambda: world.ratio_drive(0, 30, 100))
+
+
+def picture_pixels(gui: Gui, label: str) -> np.ndarray:
+    path = gui.render(gui.window.camera.picture, gui.shots / f"{gui.name}-{label}.png")
+    with Image.open(path) as img:
+        return np.asarray(img.convert("RGB")).astype(int)
+
+
+def start_live(gui: Gui, sim: SimThread) -> None:
+    window = gui.window
+    gui.key("Escape")
+    pump(lambda: window.stack.get_visible_child_name() == "camera", 3, "the camera page")
+    gui.click(window.live.live_button)
+    pump(lambda: window.live.live, 3, "Live to be on")
+    idle(0.3)  # the window stops the robot around key presses; turn it once the keys are done
+    turn(sim)
+
+
+def frames_seen(gui: Gui) -> int:
+    image = gui.window.camera.image
+    return 0 if image is None else image.sequence
+
+
+def test_live_video_plays_pauses_and_saves_a_frame(gui: Gui, sim: SimThread, tmp_path: Path) -> None:
+    window, live = gui.window, gui.window.live
+    live.folder = tmp_path
+    start_live(gui, sim)
+    pump(lambda: window.camera.image is not None and window.camera.image.video is not None, 8, "a live frame")
+    first = frames_seen(gui)
+    pump(lambda: frames_seen(gui) >= first + 5, 8, "five more frames")
+    # The figures are on the picture: frames per second, kB/s and the frame's age (the simulator stamps it).
+    pump(lambda: re.search(r"\d+\.\d fps · \d+ kB/s · \d+ ms old", live.caption.get_text()), 3, "the figures")
+    assert live.caption.get_visible()
+    a = picture_pixels(gui, "01-playing")
+    pump(lambda: frames_seen(gui) >= first + 10, 8, "more frames")
+    b = picture_pixels(gui, "02-playing-later")
+    changed = float((np.abs(a - b).sum(axis=2) > 24).mean())
+    assert changed > 0.005, f"consecutive screenshots of turning video differ ({changed:.4f} changed)"
+    gui.shot("live")
+
+    gui.click(live.pause_button)
+    pump(lambda: live.pause_button.get_active(), 3, "Pause")
+    idle(0.5)  # a frame already asked for may still arrive
+    paused_at = frames_seen(gui)
+    idle(1.0)
+    assert frames_seen(gui) == paused_at, "no frames while paused"
+    gui.shot("paused")
+    gui.click(live.pause_button)
+    pump(lambda: frames_seen(gui) > paused_at, 5, "frames again after Pause is released")
+
+    gui.click(live.save_button)
+    pump(lambda: bool(live.saved), 3, "the frame to be saved")
+    saved = live.saved[-1]
+    assert saved.parent == tmp_path and saved.read_bytes()[:2] == b"\xff\xd8"
+    with Image.open(saved) as img:
+        assert img.size == (320, 240)
+    assert str(saved) in (window.banners.text("camera") or "")
+
+    gui.click(live.live_button)
+    pump(lambda: not live.live, 3, "Live off")
+    idle(0.5)
+    stopped_at = frames_seen(gui)
+    idle(1.0)
+    assert frames_seen(gui) == stopped_at, "Live off stops the requests"
+
+
+def inset_bounds(gui: Gui) -> tuple[float, float, float, float]:
+    inset = gui.window.inset
+    ok, rect = inset.compute_bounds(gui.stage)
+    assert ok
+    return rect.get_x(), rect.get_y(), rect.get_width(), rect.get_height()
+
+
+def drag(gui: Gui, widget, dx: int, dy: int) -> None:  # type: ignore[no-untyped-def]
+    """A real pointer drag through the X server from the middle of ``widget`` by (dx, dy), in steps."""
+    x, y = gui.centre_on_surface(widget)
+    xid = str(gui.xid())
+    args = ["mousemove", "--window", xid, str(x), str(y), "mousedown", "1"]
+    for i in range(1, 9):
+        args += ["sleep", "0.03", "mousemove", "--window", xid, str(x + dx * i // 8), str(y + dy * i // 8)]
+    args += ["sleep", "0.05", "mouseup", "1"]
+    gui.xdotool(*args)
+    idle(0.2)
+
+
+def test_the_picture_in_picture_moves_resizes_and_hides(gui: Gui, sim: SimThread) -> None:
+    window, inset = gui.window, gui.window.inset
+    start_live(gui, sim)
+    pump(lambda: window.camera.image is not None and window.camera.image.video is not None, 8, "a live frame")
+    gui.key("Escape")
+    pump(lambda: inset.get_visible() and inset.get_mapped(), 3, "the picture over the map")
+    x0, y0, w0, h0 = inset_bounds(gui)
+    first = frames_seen(gui)
+    pump(lambda: frames_seen(gui) >= first + 3, 8, "the picture to stay live on the map")
+    gui.shot("pip-start")
+
+    drag(gui, inset.picture, 220, -150)
+    pump(lambda: abs(inset_bounds(gui)[0] - (x0 + 220)) < 12, 3, "the picture to move right")
+    x1, y1, w1, h1 = inset_bounds(gui)
+    assert abs(y1 - (y0 - 150)) < 12 and abs(w1 - w0) < 1 and abs(h1 - h0) < 1
+    assert window.stack.get_visible_child_name() == "map", "a drag is not a click"
+    gui.shot("pip-moved")
+
+    drag(gui, inset.grip, 120, 90)
+    pump(lambda: inset_bounds(gui)[2] > w0 + 80, 3, "the picture to grow")
+    x2, y2, w2, h2 = inset_bounds(gui)
+    assert abs(x2 - x1) < 3 and abs(y2 - y1) < 3, "resizing keeps the corner where it was"
+    assert abs(w2 / h2 - w0 / h0) < 0.1
+    gui.shot("pip-resized")
+
+    gui.click(inset.close_button)
+    pump(lambda: not inset.get_visible(), 3, "the picture to hide")
+    assert window.inset_action.get_state().get_boolean() is False
+    gui.shot("pip-hidden")
+    window.activate_action("win.inset", None)
+    pump(lambda: inset.get_visible(), 3, "the picture back from the View menu")
+    assert abs(inset_bounds(gui)[0] - x2) < 3, "it comes back where it was put"
+
+
+def test_split_view_shows_map_and_live_video_side_by_side(gui: Gui, sim: SimThread) -> None:
+    window, split = gui.window, gui.window.split
+    turn(sim)
+    window.activate_action("win.split", None)  # View ▸ Split view: map and video
+    pump(lambda: split.pane.get_mapped(), 3, "the video pane")
+    pump(lambda: window.live.live, 3, "the split view to start live video")
+    pump(lambda: split.picture.get_paintable() is not None, 8, "a frame in the pane")
+    pump(lambda: "fps" in split.caption.get_text(), 5, "the figures in the pane")
+    assert window.stack.get_visible_child_name() == "map"
+    ok, pane = split.pane.compute_bounds(split)
+    ok2, stage = gui.stage.compute_bounds(split)
+    assert ok and ok2
+    assert pane.get_x() >= stage.get_x() + stage.get_width() - 2, "the video is beside the map"
+    assert abs(pane.get_width() - stage.get_width()) < 0.1 * split.get_width()
+    gui.shot("split")
+    window.activate_action("win.split", None)
+    pump(lambda: not split.pane.get_visible(), 3, "the pane to close")
+    gui.shot("split-off")
+
+
+def amber_pixels(pixels: np.ndarray) -> int:
+    r, g, b = pixels[..., 0].astype(int), pixels[..., 1].astype(int), pixels[..., 2].astype(int)
+    return int(np.count_nonzero((r - b > 60) & (r > 150) & (g > 90) & (g < r)))
+
+
+def test_the_field_of_view_wedge_is_drawn_and_can_be_switched_off(gui: Gui) -> None:
+    window = gui.window
+    with_wedge = gui.stage_pixels()
+    window.activate_action("win.fov", None)
+    pump(lambda: not gui.stage.show_fov, 3, "the wedge off")
+    idle(0.3)
+    without = gui.stage_pixels()
+    assert amber_pixels(with_wedge) > amber_pixels(without) + 200, "the amber wedge is on the map"
+    gui.shot("no-wedge")
