@@ -54,8 +54,10 @@ from ..state import (
 from .connection import AriaClient, Packet
 from .custom_commands import CommandCatalogue, ServerCommand, list_commands, run_command
 from .diagnosis import explain
+from .drawings_feed import DrawingsFeed
 from .errors import ClientError, ClientTimeout, MalformedReply, NotSupported, ProtocolFault, ServerClosed
 from .health import HealthMonitor, ping_data
+from .ld_data import LASER_NAMES
 from .ld_session import LdFeed
 from .lease import DriveGovernor, DriveLease, EndReason, SendRatios, SendStop
 from .mapcache import MapCache, map_key
@@ -183,6 +185,9 @@ class Session:
         """Server popups (§4.9): the open set as PopupsChanged, closing words as Kind.SERVER notices."""
         self._held_subs: set[str] = set()
         """Conditional subscriptions (``only_while``) held now on this connection."""
+        also = {"sonarCurrent": self._on_sonar, **dict.fromkeys(LASER_NAMES, self.ld.on_laser)}
+        self.drawings = DrawingsFeed(self._publish, self._spawn, self.config.reply_timeout, also)
+        """The server's drawings (getDrawingList): each shown one asked for at its own period."""
 
     # -- publishing --------------------------------------------------------------------------
     def _publish(self, change: StateChange) -> None:
@@ -246,6 +251,7 @@ class Session:
         self._publish(RobotChanged(self._robot))
         self.nav.disconnected()
         self.popups.disconnected()
+        self.drawings.disconnected()
         self._set_map(MapModel())
         self._publish(CameraChanged(None))
         self._set_connection(
@@ -293,6 +299,7 @@ class Session:
         self.nav.connected(client)
         self._setup_subscriptions(client)
         self.popups.connected(client)  # after the popupCreate subscription: popupList's answers go there
+        self.drawings.connected(client)  # after the sonar subscription, which a shown drawing replaces
         self._set_connection(phase=Phase.CONNECTED, offers=offers, error="", error_kind="", retry_in=None)
         self._spawn(self._ping_loop(client), "ping")
         self._spawn(self._fetch_once_infos(client), "infos")
@@ -313,6 +320,7 @@ class Session:
         self._publish(RobotChanged(self._robot))
         self.nav.disconnected()
         self.popups.disconnected()
+        self.drawings.disconnected()
         self._set_map(MapModel())
         self._publish(CameraChanged(None))
         self._set_connection(
