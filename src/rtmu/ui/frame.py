@@ -14,7 +14,8 @@ from dataclasses import dataclass, field
 
 import cairo
 
-from . import nav_draw, overlays
+from ..state import DrawingLayer
+from . import drawings_draw, nav_draw, overlays
 from .tiles import BACKGROUND_RGB, EMPTY, TILE, Overview, TileCache
 from .viewport import Viewport
 
@@ -39,6 +40,8 @@ class Scene:
     """The cairn the robot is heading for, ringed."""
     marker: nav_draw.Marker | None = None
     """A pose the operator is picking (go to a point, set the robot's position)."""
+    drawings: Sequence[DrawingLayer] = ()
+    """The server's drawings (``drawings_draw``) in their shapes and colours, under or over the robot."""
 
 
 def draw_frame(ctx: cairo.Context, vp: Viewport, scene: Scene) -> bool:
@@ -68,7 +71,11 @@ def draw_frame(ctx: cairo.Context, vp: Viewport, scene: Scene) -> bool:
             overlays.draw_laser(ctx, vp, scene.laser)
         if scene.sonar and not scene.stale:
             overlays.draw_sonar(ctx, vp, (x, y), scene.sonar)
+        if not scene.stale:
+            drawings_draw.draw_layers(ctx, vp, scene.drawings, (x, y), above_robot=False)
         overlays.draw_robot(ctx, vp, x, y, th, stale=scene.stale, footprint=has_map)
+        if not scene.stale:
+            drawings_draw.draw_layers(ctx, vp, scene.drawings, (x, y), above_robot=True)
     return complete
 
 
