@@ -150,6 +150,7 @@ class RtmuApplication(Gtk.Application):
             self.quit()
             raise
         self.window = window
+        window.layers.use_choices(self.settings.layers)  # the operator's drawings, remembered per server
         # Closing the window stops every robot of the fleet, not only the one it shows.
         window.connect("close-request", lambda _w: self.fleet.stop_all() and False)
         if self.options.report_first_frame:
@@ -299,7 +300,12 @@ class RtmuApplication(Gtk.Application):
         )
 
     def _save(self, *, background: bool) -> None:
-        snapshot = Settings(dict(self.settings.profiles), self.settings.last_profile)
+        snapshot = Settings(
+            dict(self.settings.profiles),
+            self.settings.last_profile,
+            self.settings.recording,
+            {server: dict(choices) for server, choices in self.settings.layers.items()},
+        )
         path = self.options.settings_path
 
         def write() -> None:
