@@ -127,3 +127,23 @@ def test_a_hostile_servers_drawings_are_bounded_and_named() -> None:
             assert rig.model.connection.value.phase is Phase.CONNECTED  # nothing of it ended the link
         finally:
             rig.close()
+
+
+def test_a_remembered_choice_given_before_connecting_keeps_the_drawing_hidden_and_unasked(
+    sim: SimThread,
+) -> None:
+    model, ui = RobotModel(), UiQueue()
+    runner = ClientRunner(model, post=ui.post)
+    runner.start()
+    try:
+        runner.set_drawing_choices({LASER: False}).result(5)
+        runner.connect("127.0.0.1", sim.port, profile="test").result(10)
+        ui.wait_for(lambda: any(d.name == LASER for d in model.drawings.value.layers), 10)
+        ui.wait_for(
+            lambda: any(d.name == "sonarCurrent" and d.points for d in model.drawings.value.layers), 10
+        )
+        laser = next(d for d in model.drawings.value.layers if d.name == LASER)
+        assert not laser.shown and laser.may_toggle and laser.points == ()
+        assert LASER not in requested_at(sim)
+    finally:
+        runner.close()
