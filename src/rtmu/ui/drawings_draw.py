@@ -67,7 +67,7 @@ def draw_layer(
     screen = [vp.to_screen(x, y) for x, y in layer.points]
     shape = layer.shape
     if shape == "polyDots":
-        _dots(ctx, vp, screen, _clamp(layer.size * vp.scale, DOT_PX) / 2)
+        _stamped_dots(ctx, vp, screen, _clamp(layer.size * vp.scale, DOT_PX) / 2, c)
     elif shape == "polyPoints":
         _pixels(ctx, vp, screen)
     elif shape == "polyArrows":
@@ -90,6 +90,39 @@ def _dots(ctx: cairo.Context, vp: Viewport, screen: list[tuple[float, float]], r
             ctx.arc(sx, sy, radius, 0, 2 * math.pi)
             ctx.close_path()
     ctx.fill()
+
+
+_STAMPS: dict[tuple[int, int], cairo.ImageSurface] = {}
+"""One small picture of a dot per (colour, radius in px): painting it is ~2× cheaper than an arc a point."""
+
+
+def _stamp(color: int, radius: float) -> cairo.ImageSurface:
+    key = (color, round(radius * 2))
+    stamp = _STAMPS.get(key)
+    if stamp is None:
+        if len(_STAMPS) > 64:  # colours and sizes come from the server: keep the cache small
+            _STAMPS.clear()
+        side = math.ceil(radius * 2) + 2
+        stamp = cairo.ImageSurface(cairo.FORMAT_ARGB32, side, side)
+        sc = cairo.Context(stamp)
+        sc.set_source_rgb(
+            ((color >> 16) & 0xFF) / 255.0, ((color >> 8) & 0xFF) / 255.0, (color & 0xFF) / 255.0
+        )
+        sc.arc(side / 2, side / 2, radius, 0, 2 * math.pi)
+        sc.fill()
+        _STAMPS[key] = stamp
+    return stamp
+
+
+def _stamped_dots(
+    ctx: cairo.Context, vp: Viewport, screen: list[tuple[float, float]], radius: float, color: int
+) -> None:
+    stamp = _stamp(color, radius)
+    half = stamp.get_width() / 2
+    for sx, sy in screen:
+        if _on_screen(vp, sx, sy):
+            ctx.set_source_surface(stamp, round(sx - half), round(sy - half))
+            ctx.paint()
 
 
 def _pixels(ctx: cairo.Context, vp: Viewport, screen: list[tuple[float, float]]) -> None:
