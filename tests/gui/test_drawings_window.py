@@ -19,8 +19,9 @@ import pytest
 from client.drawing_servers import MARKUP, hostile_drawing_server
 from client.servers import ServerThread
 from rtmu.sim import SimConfig, SimThread
+from rtmu.ui.options import GuiOptions
 
-from .harness import OFFICE_MAP, Gui, idle, pump
+from .harness import OFFICE_MAP, Gui, idle, pump, scratch_dir
 
 LASER, SONAR = "sim_lms2xx_1Current", "sonarCurrent"
 BLUE, SKY = (0, 0, 255), (0x33, 0xCC, 0xFF)
@@ -135,3 +136,31 @@ def test_a_hostile_servers_drawings_leave_the_window_answering(screenshots) -> N
             gui.shot("hostile-flood")
         finally:
             gui.close()
+
+
+def test_a_layer_switched_off_stays_off_for_that_server_after_a_restart(screenshots, sim: SimThread) -> None:  # type: ignore[no-untyped-def]
+    settings = scratch_dir("settings-") / "settings.toml"
+    options = GuiOptions(host="127.0.0.1", port=sim.port, settings_path=settings, persist=True)
+    gui = Gui.open(options, screenshots, "layers-remembered-1")
+    try:
+        pump(lambda: layer(gui, LASER) is not None and layer(gui, LASER).points, 10, "laser points")
+        gui.window.activate_action("win.layers", None)
+        panel = gui.window.layers
+        pump(lambda: panel.get_mapped() and LASER in panel.buttons, 5, "the Layers panel")
+        gui.click(panel.buttons[LASER])
+        pump(lambda: not layer(gui, LASER).shown, 5, "the laser hidden")
+        gui.shot("switched-off")
+    finally:
+        gui.close()
+    text = settings.read_text()
+    assert f'[layers."127.0.0.1:{sim.port}"]' in text and f'"{LASER}" = false' in text
+    gui = Gui.open(options, screenshots, "layers-remembered-2")
+    try:
+        pump(lambda: layer(gui, SONAR) is not None and layer(gui, SONAR).points, 10, "sonar points")
+        assert not layer(gui, LASER).shown and layer(gui, LASER).points == ()
+        assert LASER not in requested_at(sim) and SONAR in requested_at(sim)
+        idle(0.3)
+        assert count(gui.stage_pixels(), BLUE) == 0
+        gui.shot("still-off")
+    finally:
+        gui.close()
