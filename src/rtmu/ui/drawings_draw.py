@@ -102,7 +102,7 @@ def _stamp(color: int, radius: float) -> cairo.ImageSurface:
     if stamp is None:
         if len(_STAMPS) > 64:  # colours and sizes come from the server: keep the cache small
             _STAMPS.clear()
-        side = math.ceil(radius * 2) + 2
+        side = 2 * math.ceil(radius) + 1  # odd: the dot's centre is the middle of one pixel
         stamp = cairo.ImageSurface(cairo.FORMAT_ARGB32, side, side)
         sc = cairo.Context(stamp)
         sc.set_source_rgb(
@@ -118,10 +118,10 @@ def _stamped_dots(
     ctx: cairo.Context, vp: Viewport, screen: list[tuple[float, float]], radius: float, color: int
 ) -> None:
     stamp = _stamp(color, radius)
-    half = stamp.get_width() / 2
+    k = stamp.get_width() // 2
     for sx, sy in screen:
-        if _on_screen(vp, sx, sy):
-            ctx.set_source_surface(stamp, round(sx - half), round(sy - half))
+        if _on_screen(vp, sx, sy):  # centred on the pixel the point rounds to (at most ½ px off)
+            ctx.set_source_surface(stamp, round(sx) - k, round(sy) - k)
             ctx.paint()
 
 
