@@ -36,6 +36,8 @@ from .state import (
     CameraImage,
     ConnectionChanged,
     ConnectionState,
+    DrawingsChanged,
+    DrawingsState,
     HealthChanged,
     LinkHealth,
     LinkLevel,
@@ -56,6 +58,7 @@ from .state import (
 __all__ = [
     "CameraImage",
     "ConnectionState",
+    "DrawingsState",
     "LinkHealth",
     "LinkLevel",
     "MapModel",
@@ -194,6 +197,7 @@ class RobotModel:
         self.health: Observable[LinkHealth] = Observable(LinkHealth())
         self.navigation: Observable[NavState] = Observable(NavState())
         self.popups: Observable[PopupsState] = Observable(PopupsState())
+        self.drawings: Observable[DrawingsState] = Observable(DrawingsState())
         self.trail = Trail()
         # The trail's observers run before any view's (added first), so a redraw sees the new point.
         self.robot.observe(self.trail.robot_moved)
@@ -216,6 +220,8 @@ class RobotModel:
                 self.navigation.set(value)
             case PopupsChanged(value):
                 self.popups.set(value)
+            case DrawingsChanged(value):
+                self.drawings.set(value)
 
 
 # -- operator settings ---------------------------------------------------------------------------

@@ -216,6 +216,9 @@ class Settings:
     recording: RecordingSettings = field(default_factory=RecordingSettings)
     alarms_muted: bool = False
     """The alarm sound is off (``alarms_muted = true``; the banners still show): the View menu's switch."""
+    layers: dict[str, dict[str, bool]] = field(default_factory=dict)
+    """The operator's drawing choices per server (``"host:port"`` → drawing name → shown), as the
+    optional tables ``[layers."10.0.0.5:7272"]`` with ``"sonarCurrent" = false`` lines."""
 
     def current(self) -> Profile:
         """The profile used last, else the first one, else a default local one."""
@@ -272,7 +275,7 @@ def parse_settings(text: str) -> Settings:
     version = doc.get("version")
     if version != SCHEMA_VERSION:
         raise SettingsError(f"unknown settings version {version!r} (this RTMU writes {SCHEMA_VERSION})")
-    unknown = set(doc) - {"version", "last_profile", "profiles", "recording", "alarms_muted"}
+    unknown = set(doc) - {"version", "last_profile", "profiles", "recording", "alarms_muted", "layers"}
     if unknown:
         raise SettingsError(f"unknown settings: {', '.join(sorted(unknown))}")
     raw_profiles = doc.get("profiles", {})
@@ -292,7 +295,27 @@ def parse_settings(text: str) -> Settings:
     if type(muted) is not bool:
         raise SettingsError(f"alarms_muted must be true or false, not {muted!r}")
     settings.alarms_muted = muted
+    settings.layers = _layers(doc.get("layers", {}))
     return settings
+
+
+MAX_LAYER_SERVERS = 256
+MAX_LAYERS_PER_SERVER = 256
+
+
+def _layers(raw: object) -> dict[str, dict[str, bool]]:
+    if not isinstance(raw, dict) or len(raw) > MAX_LAYER_SERVERS:
+        raise SettingsError(f"'layers' must be a table of at most {MAX_LAYER_SERVERS} servers")
+    out: dict[str, dict[str, bool]] = {}
+    for server, table in raw.items():
+        if not isinstance(table, dict) or len(table) > MAX_LAYERS_PER_SERVER or len(server) > 300:
+            raise SettingsError(
+                f"layers: {server[:60]!r} must be a table of at most {MAX_LAYERS_PER_SERVER} names"
+            )
+        if not all(type(v) is bool and len(k) <= 255 for k, v in table.items()):
+            raise SettingsError(f"layers: {server[:60]!r}: every value must be true or false")
+        out[server] = dict(table)
+    return out
 
 
 def _recording(raw: object) -> RecordingSettings:
@@ -428,6 +451,10 @@ def format_settings(settings: Settings) -> str:
             f"{f.name} = {_toml_value(getattr(settings.recording, f.name))}"
             for f in fields(settings.recording)
         ]
+    for server, choices in settings.layers.items():
+        if choices:
+            lines += ["", f"[layers.{_toml_string(server)}]"]
+            lines += [f"{_toml_string(name)} = {_toml_value(bool(on))}" for name, on in choices.items()]
     return "\n".join(lines) + "\n"
 
 

@@ -303,6 +303,46 @@ class PopupsState:
     """The server offers popups (``popupCreate``) at all."""
 
 
+# -- the server's drawings -----------------------------------------------------------------------
+
+
+@dataclass(frozen=True, slots=True)
+class DrawingLayer:
+    """One drawing the server listed (``getDrawingList``), as this client shows it, and its last points."""
+
+    name: str
+    """The server's own name (its data name): untrusted text, shown literally."""
+    shape: str
+    """``polyDots``, ``polyArrows``, ``polyLine``, ``polyPoints``, ``polySegments`` or anything else."""
+    drawable: bool
+    """False for a shape RTMU does not know: listed with a note, never asked for, never drawn."""
+    color: int
+    """0xRRGGBB."""
+    size: int
+    layer: int
+    refresh_ms: int
+    """How often it is asked for while shown (the server's period, at least the client's minimum)."""
+    shown: bool
+    """On the map now (the server's visibility, or the operator's choice where they may choose)."""
+    may_toggle: bool
+    """The server lets the operator turn it on and off (``DefaultOn`` / ``DefaultOff``)."""
+    points: tuple[tuple[int, int], ...] = ()
+    """Global mm, as last received; empty while hidden."""
+    problem: str = ""
+    """Why its last sample was refused (malformed, too many points), or ""."""
+
+
+@dataclass(frozen=True, slots=True)
+class DrawingsState:
+    """The server's drawings, lowest layer first (drawn in this order)."""
+
+    layers: tuple[DrawingLayer, ...] = ()
+    offered: bool = False
+    """The server lists drawings: then its sonar and lasers are drawn from here, in its colours."""
+    note: str = ""
+    """Why the list could not be read, or ""."""
+
+
 # -- connection and link -------------------------------------------------------------------------
 
 
@@ -404,8 +444,20 @@ class PopupsChanged:
     value: PopupsState
 
 
+@dataclass(frozen=True, slots=True)
+class DrawingsChanged:
+    value: DrawingsState
+
+
 StateChange = (
-    RobotChanged | MapChanged | CameraChanged | ConnectionChanged | HealthChanged | NavChanged | PopupsChanged
+    RobotChanged
+    | MapChanged
+    | CameraChanged
+    | ConnectionChanged
+    | HealthChanged
+    | NavChanged
+    | PopupsChanged
+    | DrawingsChanged
 )
 """What the network side publishes: the class says which part changed, the value is the new whole."""
 

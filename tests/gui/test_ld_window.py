@@ -17,9 +17,15 @@ from .harness import OFFICE_MAP, Gui, pump
 
 
 def magenta(pixels: np.ndarray) -> int:
-    """How many stage pixels have the laser's colour (strong red and blue, little green)."""
+    """How many stage pixels have RTMU's own laser colour (strong red and blue, little green)."""
     r, g, b = (pixels[..., i].astype(int) for i in range(3))
     return int(np.count_nonzero((r > 170) & (b > 90) & (g < 80)))
+
+
+def laser_blue(pixels: np.ndarray) -> int:
+    """Stage pixels in the colours the LD server's drawings give its lasers (0x0000FF and 0x0000C0)."""
+    r, g, b = (pixels[..., i].astype(int) for i in range(3))
+    return int(np.count_nonzero((r == 0) & (g == 0) & ((b == 255) | (b == 192))))
 
 
 def _sim_state(sim: SimThread):  # type: ignore[no-untyped-def]
@@ -32,12 +38,25 @@ def test_laser_dock_routes_and_say_in_the_window(screenshots: Path, request: pyt
         try:
             window, robot = gui.window, gui.model.robot
             pump(lambda: len(robot.value.laser) > 50, 5, "laser points in the model")
-            pump(lambda: magenta(gui.stage_pixels()) > 30, 5, "laser points drawn on the stage")
+            # The server lists its lasers as drawings: they are drawn in its colours, not RTMU's magenta.
+            pump(lambda: laser_blue(gui.stage_pixels()) > 30, 5, "laser points drawn on the stage")
+            assert magenta(gui.stage_pixels()) == 0
             gui.shot("laser")
-            # The layer goes with the sonar toggle: off, and no laser pixel is left.
-            window.sonar_action.activate(None)
-            pump(lambda: magenta(gui.stage_pixels()) == 0, 5, "the laser layer to be hidden")
-            window.sonar_action.activate(None)
+            # Both lasers switched off in the Layers panel: no laser pixel is left.
+            window.activate_action("win.layers", None)
+            layers = window.layers
+            pump(
+                lambda: layers.get_mapped() and {"Laser_1Current", "Laser_2Current"} <= set(layers.buttons),
+                5,
+                "layers",
+            )
+            for name in ("Laser_1Current", "Laser_2Current"):
+                gui.click(layers.buttons[name])
+            pump(lambda: laser_blue(gui.stage_pixels()) == 0, 5, "the laser layers to be hidden")
+            for name in ("Laser_1Current", "Laser_2Current"):
+                gui.click(layers.buttons[name])
+            pump(lambda: laser_blue(gui.stage_pixels()) > 30, 5, "the lasers back")
+            layers.close()
 
             dock = window.toolbar.cells["dock"]
             pump(lambda: dock.get_visible() and dock.value.get_text() == "Undocked", 5, "the dock cell")

@@ -51,7 +51,7 @@ def test_sonar_reads_a_wall_ahead_and_nothing_in_open_space(tmp_path):
 
     async def scenario() -> None:
         server, c = await _start(path)
-        assert SensorList.decode((await c.ask("getSensorList"))[0]).names == ("sonar",)
+        assert SensorList.decode((await c.ask("getSensorList"))[0]).names == ("sim_lms2xx_1", "sonar")
         req = SensorCurrentRequest(("sonar", "nosuch")).encode()
         first, missing = (SensorReadings.decode(p) for p in await c.ask("getSensorCurrent", req, count=2))
         assert missing == SensorReadings("nosuch", (), exists=False)
@@ -66,8 +66,9 @@ def test_sonar_reads_a_wall_ahead_and_nothing_in_open_space(tmp_path):
         near = min(math.hypot(x - server.robot.x, y - server.robot.y) for x, y in after.readings)
         assert near < ahead - 900
         # The same echoes through ARIA's drawing for MobileEyes.
-        drawings = [DrawingListPacket.decode(p) for p in await c.ask("getDrawingList", count=2)]
-        assert drawings[0].drawing.name == "sonarCurrent" and drawings[1].end_of_reply
+        drawings = [DrawingListPacket.decode(p) for p in await c.ask("getDrawingList", count=3)]
+        assert [d.drawing.name for d in drawings[:2]] == ["sim_lms2xx_1Current", "sonarCurrent"]
+        assert drawings[2].end_of_reply
         sonar = RangeDeviceReadings.decode((await c.ask("sonarCurrent"))[0])
         assert sorted(sonar.readings) == sorted(after.readings)
         # Turned round, the wall is behind: the rear discs see it and the front ones see nothing.

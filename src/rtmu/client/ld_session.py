@@ -48,7 +48,7 @@ class LdFeed:
         self._store.clear()
         for name in LASER_NAMES:
             if client.supports(name):
-                client.request(name, LASER_INTERVAL_MS, self._on_laser)
+                client.request(name, LASER_INTERVAL_MS, self.on_laser)
         if client.supports("dockInfo"):
             client.request("dockInfo", DOCK_INTERVAL_MS, self._on_dock)
         if client.supports("dockInfoChanged"):
@@ -82,7 +82,8 @@ class LdFeed:
         if client.supports("gotoRouteGoal"):
             self._refetch_routes(client)
 
-    def _on_laser(self, packet: Packet) -> None:
+    def on_laser(self, packet: Packet) -> None:
+        """A ``Laser_*Current`` packet (also handed on by the drawings feed when it holds that request)."""
         readings = self._decode(packet.name, packet.payload)
         if isinstance(readings, RangeDeviceReadings):
             self._lasers[packet.name] = readings.readings

@@ -443,6 +443,15 @@ class ClientRunner:
 
         self.post(deliver)
 
+    # -- the server's drawings -----------------------------------------------------------------
+    def set_drawing_shown(self, name: str, shown: bool) -> concurrent.futures.Future[None]:
+        """Show or hide one drawing: a hidden one is no longer asked for (``rtmu.client.drawings_feed``)."""
+        return self._fire(self._session.drawings.set_shown, name, shown)
+
+    def set_drawing_choices(self, choices: dict[str, bool]) -> concurrent.futures.Future[None]:
+        """The operator's remembered choices for the server being connected to."""
+        return self._fire(self._session.drawings.set_choices, dict(choices))
+
     # -- navigation: the server drives; a refusal comes back as a Kind.NAVIGATION notice -------
     def goto_goal(self, name: str) -> concurrent.futures.Future[None]:
         return self._fire(self._session.goto_goal, name, kind=Kind.NAVIGATION)

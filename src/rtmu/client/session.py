@@ -55,8 +55,10 @@ from .config_feed import ConfigFeed, ServerConfig, fetch_config, set_config
 from .connection import AriaClient, Packet
 from .custom_commands import CommandCatalogue, ServerCommand, list_commands, run_command
 from .diagnosis import explain
+from .drawings_feed import DrawingsFeed
 from .errors import ClientError, ClientTimeout, MalformedReply, NotSupported, ProtocolFault, ServerClosed
 from .health import HealthMonitor, ping_data
+from .ld_data import LASER_NAMES
 from .ld_session import LdFeed
 from .lease import DriveGovernor, DriveLease, EndReason, SendRatios, SendStop
 from .mapcache import MapCache, map_key
@@ -197,6 +199,9 @@ class Session:
         """Live video (``client.video_session``): frames go out as the camera part; resumes on reconnect."""
         self._held_subs: set[str] = set()
         """Conditional subscriptions (``only_while``) held now on this connection."""
+        also = {"sonarCurrent": self._on_sonar, **dict.fromkeys(LASER_NAMES, self.ld.on_laser)}
+        self.drawings = DrawingsFeed(self._publish, self._spawn, self.config.reply_timeout, also)
+        """The server's drawings (getDrawingList): each shown one asked for at its own period."""
 
     # -- publishing --------------------------------------------------------------------------
     def _publish(self, change: StateChange) -> None:
@@ -264,6 +269,7 @@ class Session:
         self.ptz.disconnected()
         self.video.disconnected()
         self.video.stop()  # a new connection (or none) starts without video: the operator asks again
+        self.drawings.disconnected()
         self._set_map(MapModel())
         self._publish(CameraChanged(None))
         self._set_connection(
@@ -312,6 +318,7 @@ class Session:
         self._setup_subscriptions(client)
         self.popups.connected(client)  # after the popupCreate subscription: popupList's answers go there
         self.video.connected(client)
+        self.drawings.connected(client)  # after the sonar subscription, which a shown drawing replaces
         self._set_connection(phase=Phase.CONNECTED, offers=offers, error="", error_kind="", retry_in=None)
         self._spawn(self._ping_loop(client), "ping")
         self._spawn(self.ptz.connected(client), "ptz")  # first: a server without cameras is known at once
@@ -337,6 +344,7 @@ class Session:
         self.ptz.disconnected()
         self.video.disconnected()
         self.video.stop()  # a new connection (or none) starts without video: the operator asks again
+        self.drawings.disconnected()
         self._set_map(MapModel())
         self._publish(CameraChanged(None))
         self._set_connection(

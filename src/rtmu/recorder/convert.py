@@ -9,7 +9,7 @@ from __future__ import annotations
 
 import math
 import re
-from dataclasses import asdict, is_dataclass
+from dataclasses import asdict, is_dataclass, replace
 from enum import Enum
 from typing import Any
 
@@ -37,6 +37,7 @@ from ..notices import Notice
 from ..state import (
     CameraChanged,
     ConnectionChanged,
+    DrawingsChanged,
     HealthChanged,
     MapChanged,
     MapModel,
@@ -153,6 +154,7 @@ class Converter:
         self._map_state: tuple[Any, ...] | None = None
         self._map_written: int | None = None
         self._camera = -1
+        self._drawings: object = None
 
     def change(self, change: StateChange, at_ns: int) -> Out:
         if isinstance(change, RobotChanged):
@@ -172,6 +174,18 @@ class Converter:
             return [(topics.CONNECTION, jsonable(change.value))]
         if isinstance(change, HealthChanged):
             return [(topics.LINK_HEALTH, jsonable(change.value))]
+        if isinstance(change, DrawingsChanged):
+            # The list and what is shown, not every sample's points (those are in the raw bytes):
+            # a 5 Hz laser would otherwise cost tens of MB an hour of JSON.
+            layers: list[dict[str, Any]] = [
+                {**jsonable(replace(d, points=())), "points": len(d.points)} for d in change.value.layers
+            ]
+            shape = [(d.name, d.shown, d.problem, bool(d.points)) for d in change.value.layers]
+            if shape == self._drawings:
+                return []
+            self._drawings = shape
+            summary = {"offered": change.value.offered, "note": change.value.note, "layers": layers}
+            return [(other_topic(change), summary)]
         # Any other part (navigation, popups, parts added later) as JSON: nothing published is lost.
         return [(other_topic(change), jsonable(getattr(change, "value", change)))]
 

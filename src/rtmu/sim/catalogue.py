@@ -726,16 +726,13 @@ POPUPS: tuple[Row, ...] = (
     ),
 )
 
+_DRAWING_DATA = "See getDrawingList for the information on how this drawing should be drawn, and the documentation in ArDrawingData for that information means."
+
 DRAWINGS: tuple[Row, ...] = (
-    (
-        "sonarCurrent",
-        "",
-        "none",
-        "See getDrawingList for the information on how this drawing should be drawn, and the documentation in ArDrawingData for that information means.",
-        "SensorInfo",
-        "RETURN_SINGLE",
-    ),
+    ("sim_lms2xx_1Current", "", "none", _DRAWING_DATA, "SensorInfo", "RETURN_SINGLE"),
+    ("sonarCurrent", "", "none", _DRAWING_DATA, "SensorInfo", "RETURN_SINGLE"),
 )
+"""The range devices' drawing data (``getDrawingList`` says how to draw each): laser, then sonar."""
 
 STRING_COMMANDS = frozenset({"SimulatorSetBattery", "SimulatorPopup", "SimulatorPopupFlood"})
 """Simple commands that take one string argument (``listStringCommands``)."""

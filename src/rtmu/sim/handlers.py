@@ -68,7 +68,7 @@ from rtmu.protocol.payloads.sensors import (
 from rtmu.protocol.payloads.server import IdleProcessingPending, SelfIdentifier
 from rtmu.protocol.payloads.strings import StringItem, Strings, StringsInfo
 
-from . import p3dx
+from . import laser, p3dx
 from .camera import PAN_RANGE, TILT_RANGE, ZOOM_RANGE
 from .catalogue import STRING_COMMANDS, Row
 from .robot import normalize_deg
@@ -79,8 +79,14 @@ if TYPE_CHECKING:
 
 TEMPERATURE_MOBILESIM = -127
 """What MobileSim reports for the robot's temperature (captured)."""
-SENSORS = ("sonar",)
+SENSORS = (laser.NAME, "sonar")
+"""Range devices in ARIA's order (as serverDemo with MobileSim lists them: the laser first)."""
 SONAR_DRAWING = Drawing("sonarCurrent", "polyArrows", 0x0033CCFF, 200, 70, 200, 0x000000, "DefaultOn")
+"""ARIA's sonar drawing: light-blue arrows 200 mm long, layer 70, asked for every 200 ms."""
+LASER_DRAWING = Drawing(f"{laser.NAME}Current", "polyDots", 0x000000FF, 80, 75, 200, 0x000000, "DefaultOn")
+"""ARIA's laser drawing: blue dots 80 mm across, layer 75 (above the sonar)."""
+DRAWINGS = (LASER_DRAWING, SONAR_DRAWING)
+"""What getDrawingList lists, sorted by name as ARIA's case-insensitive map keeps them."""
 
 
 @dataclass(frozen=True, slots=True)
@@ -338,6 +344,8 @@ def _sensor_current(call: Call) -> Iterable[Reply]:
     for name in names[:64]:
         if name == "sonar":
             out.append(SensorReadings(name, tuple(call.world.sonar())).encode())
+        elif name == laser.NAME:
+            out.append(SensorReadings(name, tuple(call.world.laser())).encode())
         else:
             out.append(SensorReadings(name, (), exists=False).encode())
     return out
@@ -352,14 +360,23 @@ def _sonar_current(call: Call) -> Iterable[Reply]:
     )
 
 
+@handles(LASER_DRAWING.name)
+def _laser_current(call: Call) -> Iterable[Reply]:
+    return (
+        call.server.cycle_cached(
+            LASER_DRAWING.name, lambda: RangeDeviceReadings(tuple(call.world.laser())).encode()
+        ),
+    )
+
+
 @handles("getDrawingList")
 def _drawing_list(call: Call) -> Iterable[Reply]:
-    return (DrawingListPacket(SONAR_DRAWING).encode(), DrawingListPacket(None).encode())
+    return (*(DrawingListPacket(d).encode() for d in DRAWINGS), DrawingListPacket(None).encode())
 
 
 @handles("listDrawings")
 def _list_drawings(call: Call) -> Iterable[Reply]:
-    return (DrawingList((SONAR_DRAWING,)).encode(),)
+    return (DrawingList(DRAWINGS).encode(),)
 
 
 # -- map ----------------------------------------------------------------------------------

@@ -16,6 +16,7 @@ import numpy as np
 from . import p3dx
 from .camera import Camera, View
 from .geometry import Obstacles
+from .laser import laser_readings
 from .modes import JogMode, Mode, RatioDriveMode, StopMode, WanderMode
 from .navmodes import DockMode, GotoMode, Localization, NavMap, PathTask, charge
 from .robot import Body, normalize_deg
@@ -133,6 +134,7 @@ class World:
         self.changes = Changes()
         self._strings = self.strings()
         self._sonar_cache: tuple[tuple[float, float, float], list[tuple[int, int]]] | None = None
+        self._laser_cache: tuple[tuple[float, float, float], list[tuple[int, int]]] | None = None
         self.popups: dict[int, Popup] = {}
         self._next_popup_id = 1
         self.popup_clicks: list[tuple[int, int]] = []
@@ -154,7 +156,7 @@ class World:
         self.camera = Camera(obstacles)
         lo_x, lo_y, hi_x, hi_y = obstacles.bounds
         self.access_point = AccessPoint(obstacles, (lo_x + hi_x) / 2, (lo_y + hi_y) / 2)
-        self._sonar_cache = None
+        self._sonar_cache = self._laser_cache = None
 
     def add_obstacles(self, segments: np.ndarray) -> None:
         """Put walls into the world that the map does not have (a box left in a corridor): the body and
@@ -250,7 +252,7 @@ class World:
         b.x, b.y, b.th = fx, fy, normalize_deg(th)
         b.vel = b.rot_vel = 0.0
         b.stalled = False
-        self._sonar_cache = None
+        self._sonar_cache = self._laser_cache = None
         self.localization.start(self.time)
 
     def _jog(self) -> JogMode:
@@ -390,6 +392,13 @@ class World:
         if self._sonar_cache is None or self._sonar_cache[0] != pose:
             self._sonar_cache = (pose, sonar_readings(self.obstacles, *pose))
         return self._sonar_cache[1]
+
+    def laser(self) -> list[tuple[int, int]]:
+        """The simulated laser's current readings (:mod:`.laser`), cached per pose like the sonar."""
+        pose = (self.body.x, self.body.y, self.body.th)
+        if self._laser_cache is None or self._laser_cache[0] != pose:
+            self._laser_cache = (pose, laser_readings(self.obstacles, *pose))
+        return self._laser_cache[1]
 
     def wifi(self) -> Link:
         return self.access_point.link(self.body.x, self.body.y)

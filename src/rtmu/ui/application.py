@@ -197,6 +197,7 @@ class RtmuApplication(Gtk.Application):
         self.window = window
         window.handheld.set_muted(self.settings.alarms_muted)
         window.handheld.on_mute = self._alarms_muted
+        window.layers.use_choices(self.settings.layers)  # the operator's drawings, remembered per server
         # Closing the window stops every robot of the fleet, not only the one it shows.
         window.connect("close-request", lambda _w: self.fleet.stop_all() and False)
         if self.options.report_first_frame:
@@ -404,7 +405,13 @@ class RtmuApplication(Gtk.Application):
 
     def _save(self, *, background: bool) -> None:
         s = self.settings
-        snapshot = Settings(dict(s.profiles), s.last_profile, s.recording, alarms_muted=s.alarms_muted)
+        snapshot = Settings(
+            dict(s.profiles),
+            s.last_profile,
+            s.recording,
+            alarms_muted=s.alarms_muted,
+            layers={server: dict(choices) for server, choices in s.layers.items()},
+        )
         path = self.options.settings_path
 
         def write() -> None:

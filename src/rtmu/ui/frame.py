@@ -15,7 +15,8 @@ from dataclasses import dataclass, field
 
 import cairo
 
-from . import fleet_draw, fov_draw, nav_draw, overlays
+from ..state import DrawingLayer
+from . import drawings_draw, fleet_draw, fov_draw, nav_draw, overlays
 from .tiles import BACKGROUND_RGB, EMPTY, TILE, Overview, TileCache
 from .viewport import Viewport
 
@@ -46,6 +47,8 @@ class Scene:
     """The selected robot's colour (its fleet colour; blue for a robot alone)."""
     fov: fov_draw.Wedge | None = None
     """The camera's field of view, drawn as a wedge from the robot (None: not shown)."""
+    drawings: Sequence[DrawingLayer] = ()
+    """The server's drawings (``drawings_draw``) in their shapes and colours, under or over the robot."""
 
 
 def draw_frame(ctx: cairo.Context, vp: Viewport, scene: Scene) -> bool:
@@ -79,7 +82,11 @@ def draw_frame(ctx: cairo.Context, vp: Viewport, scene: Scene) -> bool:
             overlays.draw_laser(ctx, vp, scene.laser)
         if scene.sonar and not scene.stale:
             overlays.draw_sonar(ctx, vp, (x, y), scene.sonar)
+        if not scene.stale:
+            drawings_draw.draw_layers(ctx, vp, scene.drawings, (x, y), above_robot=False)
         overlays.draw_robot(ctx, vp, x, y, th, stale=scene.stale, footprint=has_map, rgb=scene.robot_rgb)
+        if not scene.stale:
+            drawings_draw.draw_layers(ctx, vp, scene.drawings, (x, y), above_robot=True)
     return complete
 
 

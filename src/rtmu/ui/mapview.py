@@ -103,6 +103,7 @@ class MapStage(Gtk.DrawingArea):
             model.health.observe(lambda old, new: self.queue_draw()),
             model.trail.observe(self.queue_draw),
             model.navigation.observe(lambda old, new: self.queue_draw()),
+            model.drawings.observe(lambda old, new: self.queue_draw()),
         ]
         self.connect("resize", self._on_resize)
         self._on_map(MapModel(), model.map.value)
@@ -299,6 +300,7 @@ class MapStage(Gtk.DrawingArea):
         r = self.model.robot.value
         has_map = self.model.map.value.state == "ready"
         stale = self.robot_is_stale()
+        drawings = self.model.drawings.value
         scene = Scene(
             labels=self.labels,
             tiles=self.tiles if has_map else None,
@@ -306,8 +308,9 @@ class MapStage(Gtk.DrawingArea):
             robot=(r.x, r.y, r.th) if r.numbers_at is not None else None,
             stale=stale,
             trail=self.model.trail.points,
-            sonar=r.sonar if self.operator.view.value.show_sonar else (),
-            laser=r.laser if self.operator.view.value.show_sonar else (),
+            sonar=r.sonar if self.operator.view.value.show_sonar and not drawings.offered else (),
+            laser=r.laser if self.operator.view.value.show_sonar and not drawings.offered else (),
+            drawings=drawings.layers,  # the server's own sonar/laser drawings replace RTMU's colours
         )
         if self.fleet is not None:  # the fleet's other robots and the selected one's colour
             scene.others, scene.robot_rgb = self.fleet()

@@ -61,6 +61,7 @@ from .dpad import DPad  # noqa: E402
 from .goals_panel import GoalsPanel  # noqa: E402
 from .handheld import Handheld  # noqa: E402
 from .keys import KeyRouter  # noqa: E402
+from .layers import LayersPanel  # noqa: E402
 from .live_video import LiveVideoControls  # noqa: E402
 from .mapview import MapStage  # noqa: E402
 from .motion import MotionIndicator  # noqa: E402
@@ -291,6 +292,8 @@ class MainWindow(Gtk.ApplicationWindow):
         # Server popups: cards over the map above the zoom buttons, never focusable (STOP is in the header).
         self.popup_stack = PopupStack(self.model.popups, self._answer_popup, clock=self.clock)
         map_page.add_overlay(self.popup_stack)
+        self.layers = LayersPanel(self.model.drawings, self.model.connection, self._link)  # View → Layers…
+        map_page.add_overlay(self.layers)
         self.map_note = Gtk.Label(halign=Gtk.Align.CENTER, valign=Gtk.Align.END, visible=False)
         self.map_note.add_css_class("map-note")
         self.map_note.set_margin_bottom(62)  # above the zoom buttons, which a narrow window puts under it
@@ -381,6 +384,7 @@ class MainWindow(Gtk.ApplicationWindow):
         view.append("Split view: map and video", "win.split")
         view.append("Camera field of view", "win.fov")
         view.append("Sonar readings", "win.sonar")
+        view.append("Layers…", "win.layers")
         view.append("Robot details…", "win.details")
         view.append("Foxglove bridge (ws://127.0.0.1:8765)", "win.foxglove")
         app = Gio.Menu()
@@ -444,6 +448,7 @@ class MainWindow(Gtk.ApplicationWindow):
         plain("about", self.show_about)
         plain("details", self.show_details)
         plain("server-config", self.show_server_config)
+        plain("layers", self.layers.open)
         self.toolbar_action = toggle("toolbar", True, self.toolbar_revealer.set_reveal_child)
         self.fullscreen_action = toggle("fullscreen", False, self._set_fullscreen)
         self.dpad_action = toggle("dpad", self.dpad.get_visible(), self._set_dpad)
@@ -981,6 +986,7 @@ class MainWindow(Gtk.ApplicationWindow):
         self.routes_panel.close()
         self.goals_panel.close()
         self.ptz.close()
+        self.layers.unobserve()
         self.motion.close()
         self.decoder.close()
         self.foxglove.close()

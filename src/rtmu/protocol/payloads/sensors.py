@@ -1,4 +1,4 @@
-"""Range sensors and their drawings (protocol §4.4).
+"""Range sensors (protocol §4.4); how a client draws them is in :mod:`.drawings`.
 
 Readings are ``(x, y)`` positions in mm in the global (odometric/map) frame,
 not ranges: the server has already placed them in the world.
@@ -163,91 +163,19 @@ class RangeDeviceCumulative(RangeDeviceReadings):
     DATA_NAME = "Cumulative"
 
 
-@dataclass(frozen=True, slots=True)
-class Drawing:
-    """How a client should draw one data (usually a range device's ``<device>Current``)."""
+# The drawing list moved to .drawings; these names stay importable from here.
+from .drawings import Drawing, DrawingList, DrawingListPacket  # noqa: E402
 
-    name: str
-    """The data to request, e.g. ``sonarCurrent``."""
-    shape: str
-    """``polyDots``, ``polyArrows``, ``polyLine``, ``polyPoints``, ``polySegments``…"""
-    primary_color: int
-    """0x00RRGGBB."""
-    size: int
-    """mm."""
-    layer: int
-    refresh_ms: int
-    """Suggested polling period; 0 = don't poll."""
-    secondary_color: int
-    visibility: str = ""
-    """e.g. ``DefaultOn`` (``getDrawingList`` only)."""
-
-    def _write(self, w: FieldWriter, with_visibility: bool) -> None:
-        w.string(self.name).string(self.shape).byte4(self.primary_color).byte4(self.size)
-        w.byte4(self.layer).ubyte4(self.refresh_ms).byte4(self.secondary_color)
-        if with_visibility:
-            w.string(self.visibility)
-
-    @classmethod
-    def _read(cls, r: FieldReader, with_visibility: bool) -> Drawing:
-        return cls(
-            r.string("drawing name"),
-            r.string("shape"),
-            r.byte4("primary color"),
-            r.byte4("size"),
-            r.byte4("layer"),
-            r.ubyte4("default refresh time"),
-            r.byte4("secondary color"),
-            r.string("visibility") if with_visibility else "",
-        )
-
-
-@register
-@dataclass(frozen=True, slots=True)
-class DrawingListPacket(Payload):
-    """One ``getDrawingList`` reply packet: a drawing, or None for the zero-length packet ending the list."""
-
-    DATA_NAME = "getDrawingList"
-    SIDE = Side.REPLY
-
-    drawing: Drawing | None
-
-    @property
-    def end_of_reply(self) -> bool:
-        return self.drawing is None
-
-    def encode(self) -> bytes:
-        if self.drawing is None:
-            return b""
-        w = FieldWriter()
-        self.drawing._write(w, True)
-        return w.bytes()
-
-    @classmethod
-    def decode(cls, data: bytes) -> Self:
-        if not data:
-            return cls(None)
-        return cls(Drawing._read(FieldReader(data), True))
-
-
-@register
-@dataclass(frozen=True, slots=True)
-class DrawingList(Payload):
-    """``listDrawings`` reply (deprecated): ``byte4`` count, then drawings without visibility."""
-
-    DATA_NAME = "listDrawings"
-    SIDE = Side.REPLY
-
-    drawings: tuple[Drawing, ...] = ()
-
-    def encode(self) -> bytes:
-        w = FieldWriter().byte4(len(self.drawings))
-        for d in self.drawings:
-            d._write(w, False)
-        return w.bytes()
-
-    @classmethod
-    def decode(cls, data: bytes) -> Self:
-        r = FieldReader(data)
-        count = checked_count(r.byte4("drawing count"), 22, r, "drawing count")
-        return cls(tuple(Drawing._read(r, False) for _ in range(count)))
+__all__ = [
+    "Drawing",
+    "DrawingList",
+    "DrawingListPacket",
+    "RangeDeviceCumulative",
+    "RangeDeviceReadings",
+    "Reading",
+    "SensorCumulativeReadings",
+    "SensorCumulativeRequest",
+    "SensorCurrentRequest",
+    "SensorList",
+    "SensorReadings",
+]

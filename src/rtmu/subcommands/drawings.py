@@ -1,0 +1,91 @@
+"""``rtmu drawings HOST[:PORT] [--json]``: what the server draws on its map, with one sample of each.
+
+One line per drawing of ``getDrawingList`` — name, shape, colour, size, layer, refresh period,
+visibility — and how many points one request of its data returned now. A shape RTMU cannot draw
+is listed with a note; a drawing whose sample is malformed or never comes says so, and the other
+drawings are still shown. Exit 0 with the list, 4 when the server lists no drawings.
+"""
+
+from __future__ import annotations
+
+import argparse
+from typing import Any
+
+from ..client.connection import AriaClient
+from ..client.drawing_list import drawing_list, drawing_sample
+from ..client.errors import ClientError
+from ..exit_codes import EXIT_OK
+from ..protocol.payloads.drawings import Drawing
+from ..textsafe import visible
+from ._common import add_connection_arguments, print_json, run_with_client
+
+
+def register(subparsers: Any) -> None:
+    p = subparsers.add_parser(
+        "drawings",
+        help="list the server's drawings (getDrawingList) with one current sample of each",
+        description=(
+            "Print each drawing the server lists (sonar, lasers, paths …): shape, colour, size, layer, "
+            "refresh period, visibility and the points one request returns now (exit 4 when it lists none)."
+        ),
+    )
+    add_connection_arguments(p)
+    p.add_argument("--json", action="store_true", help="one JSON array: every field and the sampled points")
+    p.set_defaults(handler=handle)
+
+
+def handle(args: argparse.Namespace) -> int:
+    async def body(client: AriaClient) -> int:
+        drawings = await drawing_list(client, args.timeout)  # NotSupported (exit 4) without a list
+        rows = [await _sample(client, d, args.timeout) for d in drawings]
+        if args.json:
+            print_json(rows)
+        elif not rows:
+            print("the server lists no drawings", flush=True)
+        else:
+            for row in rows:
+                print(_line(row), flush=True)
+        return EXIT_OK
+
+    return run_with_client("drawings", args, body)
+
+
+async def _sample(client: AriaClient, d: Drawing, timeout: float) -> dict[str, Any]:
+    row: dict[str, Any] = {
+        "name": d.name,
+        "shape": d.shape,
+        "drawn": d.known_shape is not None,
+        "primary_color": f"#{d.primary_color & 0xFFFFFF:06x}",
+        "secondary_color": f"#{d.secondary_color & 0xFFFFFF:06x}",
+        "size": d.size,
+        "layer": d.layer,
+        "refresh_ms": d.refresh_ms,
+        "visibility": d.visibility_kind.value,
+        "points": None,
+        "error": "",
+    }
+    try:
+        row["points"] = [list(p) for p in (await drawing_sample(client, d.name, timeout)).points]
+    except ClientError as exc:
+        row["error"] = str(exc)
+    return row
+
+
+def _line(row: dict[str, Any]) -> str:
+    refresh = f"every {row['refresh_ms']} ms" if row["refresh_ms"] else "when sent"
+    words = [
+        visible(row["name"]),
+        visible(row["shape"]),
+        row["primary_color"],
+        f"size {row['size']}",
+        f"layer {row['layer']}",
+        refresh,
+        visible(row["visibility"]),
+    ]
+    if row["error"]:
+        words.append(f"no sample: {visible(row['error'])}")
+    else:
+        words.append(f"{len(row['points'])} points")
+    if not row["drawn"]:
+        words.append("(shape not known to RTMU: not drawn)")
+    return "  ".join(words)
