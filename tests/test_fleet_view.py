@@ -72,3 +72,16 @@ def test_a_trail_is_stroked_without_points_on_the_same_pixels() -> None:
     xy = screen_polyline(vp, trail)
     assert len(xy) <= 160 and tuple(xy[-1]) == vp.to_screen(*trail[-1])
     assert all(math.dist(a, b) <= 4.0 for a, b in itertools.pairwise(xy))
+
+
+def test_the_selected_model_mirrors_every_part_of_a_robot_model() -> None:
+    """A part added to RobotModel (drawings, …) must reach the widgets of a fleet window too."""
+    from rtmu.model import Observable, RobotModel
+    from rtmu.ui.selected_model import PARTS, SelectedModel
+
+    source = RobotModel()
+    observables = {n for n, v in vars(source).items() if isinstance(v, Observable)}
+    assert observables <= set(PARTS) and {"robot", "drawings", "popups"} <= observables
+    mirror = SelectedModel(source)
+    for name in observables:
+        assert isinstance(getattr(mirror, name), Observable), name

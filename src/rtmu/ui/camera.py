@@ -176,6 +176,13 @@ class CameraView(Gtk.Box):
         back = Gtk.Button.new_with_label("Back to map (Esc)")
         back.set_focusable(False)
         back.connect("clicked", lambda _b: on_back())
+        for button in (self.refresh_button, back):
+            # Ellipsized labels: with the video and camera-head buttons beside them, the bar must
+            # still fit a 360 px phone (a hidden stack page's width is the window's minimum too).
+            label = button.get_child()
+            if isinstance(label, Gtk.Label):
+                label.set_ellipsize(Pango.EllipsizeMode.END)
+            button.set_tooltip_text(button.get_label())
         for w in (self.info, self.refresh_button, back):
             bar.append(w)
         self.append(bar)

@@ -15,7 +15,15 @@ from typing import Any
 
 from ..model import Observable, RobotModel, Trail
 
-PARTS = ("robot", "map", "camera", "connection", "health", "navigation", "popups")
+
+def _observable_parts() -> tuple[str, ...]:
+    """Every observable a :class:`RobotModel` has, read from one: a part added there is mirrored
+    here without a second list to forget (a fleet window once lacked the drawings)."""
+    probe = RobotModel()
+    return tuple(name for name, value in vars(probe).items() if isinstance(value, Observable))
+
+
+PARTS = _observable_parts()
 """The observables of a :class:`RobotModel` that are mirrored."""
 
 
