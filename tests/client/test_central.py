@@ -162,7 +162,8 @@ def test_drive_with_robot_moves_only_that_robot(
         name: abs(after[name][0] - before[name][0]) + abs(after[name][1] - before[name][1]) for name in NAMES
     }
     assert moved["robot2"] > 50 and moved["robot1"] == 0 and moved["robot3"] == 0
-    assert obj["after"]["x"] == round(after["robot2"][0])
+    # The last status the command read, give or take the few mm a stopping robot still rolls.
+    assert abs(obj["after"]["x"] - after["robot2"][0]) <= 20
     robot = fleet.sims["robot2"].robot
     assert fleet.call(lambda: (robot.trans_ratio, robot.mode_name)) == (0, "stop")  # stopped by us
 

@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import json
+import struct
 from collections import Counter
 from dataclasses import dataclass, field
 from pathlib import Path
@@ -56,7 +57,7 @@ def read(path: Path) -> Read:
                         channel.topic, name, channel.message_encoding, bytes(message.data), message.log_time
                     )
                 )
-        except (McapError, EOFError) as exc:
+        except (McapError, EOFError, struct.error) as exc:  # struct.error: cut inside a record's length
             out.cut_short = str(exc) or type(exc).__name__
     return out
 
