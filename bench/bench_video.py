@@ -18,6 +18,9 @@ frames/s, the robot turning so every frame is really rendered). Every frame carr
 * ``video.window.ui_frame_ms_p95``: the GTK thread's time per frame (frame clock update → after-paint)
   while video plays; baseline: the same with the one-at-a-time pictures.
 * ``video.window.cpu_pct``: the window process's CPU while playing.
+* ``video.window.stage_<stage>_ms_p95``: one stage of a frame's way to the screen, from the stage
+  before (``bench.video_window.STAGES``: posted to the GTK thread, queued for and decoded on the JPEG
+  thread, handed to and shown by the GTK thread, painted by the next frame-clock tick).
 * ``video.sim.render_ms_640x480``: the simulator's cost of one frame (ray cast, compose, JPEG, stamp);
   ``video.sim.cpu_pct``: the simulator process's CPU over the whole run.
 """
@@ -194,6 +197,15 @@ def run() -> list[Result]:
             Result("video.window.ui_frame_ms_p95", w_live["frame_ms_p95"], "ms", w_base["frame_ms_p95"]),
             Result("video.window.cpu_pct", w_live["cpu_pct"], "%"),
         ]
+        for stage in w_live["stages"]:  # where the window's latency goes (bench.video_window.STAGES)
+            results.append(
+                Result(
+                    f"video.window.stage_{stage}_ms_p95",
+                    w_live["stages"][stage]["p95"],
+                    "ms",
+                    w_base["stages"][stage]["p95"],
+                )
+            )
         server.stdin.close()
         out = server.stdout.read()
         server.wait(20)
