@@ -198,6 +198,14 @@ class CameraView(Gtk.Box):
         back = Gtk.Button.new_with_label("Back to map (Esc)")
         back.set_focusable(False)
         back.connect("clicked", lambda _b: on_back())
+        for button in (
+            self.refresh_button,
+            back,
+        ):  # a phone's 360 px: the bar shrinks, the window does not grow
+            label = button.get_child()
+            if isinstance(label, Gtk.Label):
+                label.set_ellipsize(Pango.EllipsizeMode.END)
+                button.set_tooltip_text(label.get_text())
         for w in (self.info, self.refresh_button, back):
             bar.append(w)
         self.append(bar)
@@ -246,7 +254,7 @@ class CameraView(Gtk.Box):
 
     def set_available(self, enabled: bool, reason: str) -> None:
         self.refresh_button.set_sensitive(enabled)
-        self.refresh_button.set_tooltip_text(None if enabled else f"Camera picture: {reason}")
+        self.refresh_button.set_tooltip_text("New picture" if enabled else f"Camera picture: {reason}")
 
     def tick(self) -> None:
         """Update the age line; give up on a request that took too long."""

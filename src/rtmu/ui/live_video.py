@@ -112,6 +112,13 @@ class LiveVideoControls:
     def set_live(self, on: bool) -> None:
         self.live_button.set_active(on)
 
+    def toggle(self, available: bool, reason: str) -> str:
+        """The Live key (V): on where the server has a camera, off always; why not, "" when done."""
+        if not self.live and not available:
+            return reason or "no camera"
+        self.set_live(not self.live)
+        return ""
+
     def _live_toggled(self, button: Gtk.ToggleButton) -> None:
         on = button.get_active()
         self.pause_button.set_sensitive(on)

@@ -584,6 +584,10 @@ class MainWindow(Gtk.ApplicationWindow):
             self.stage.fit()
         elif name == "follow":
             self.stage.set_follow(not self.stage.follow)
+        elif name == "live_video":
+            camera = self.command_state("request_image")
+            if reason := self.live.toggle(camera.enabled, camera.reason):
+                self.banners.tell("camera", "warning", f"Live video: {reason}", timeout=4.0)
         elif name.startswith("ptz_") and (reason := self.ptz.key(name)):
             self.banners.tell("ptz", "warning", f"Camera head: {reason}", timeout=4.0)
 
