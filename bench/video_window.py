@@ -9,8 +9,9 @@ shows the map with the picture-in-picture, and plays the camera for SECONDS afte
 
 It prints one JSON object: frames drawn per second, each frame's age (render stamp → texture ready,
 and → first paint after it), the client's own share (received → drawn), the GTK thread's time per
-frame (frame clock ``update`` → ``after-paint``, for every frame GTK drew while playing) and the
-process's CPU share.
+frame (frame clock ``update`` → ``after-paint``, for every frame GTK drew while playing), the
+process's CPU share, how often the map was drawn and the window painted, and each frame's
+time per stage (:data:`STAGES`).
 """
 
 from __future__ import annotations
@@ -176,8 +177,11 @@ def main(argv: list[str]) -> int:
     def on_update(_clock: Any) -> None:
         update_at[0] = time.perf_counter()
 
+    paints = [0]
+
     def after_paint(_clock: Any) -> None:
         done = time.perf_counter()
+        paints[0] += 1
         if measuring[0] and update_at[0]:
             frame_ms.append((done - update_at[0]) * 1000)
         stages.painted(measuring[0])
@@ -203,9 +207,10 @@ def main(argv: list[str]) -> int:
         window._link.request_image()
     run_for(2.0)  # warm-up: first frames, texture upload paths
     measuring[0] = True
-    cpu0, t0 = time.process_time(), time.monotonic()
+    cpu0, t0, draws0, paints0 = time.process_time(), time.monotonic(), window.stage.frames, paints[0]
     run_for(seconds)
     cpu, elapsed = time.process_time() - cpu0, time.monotonic() - t0
+    map_draws, window_paints = window.stage.frames - draws0, paints[0] - paints0
     measuring[0] = False
     window.live.set_live(False)
     print(
@@ -220,6 +225,8 @@ def main(argv: list[str]) -> int:
                 "frame_ms_p50": pct(frame_ms, 50),
                 "frame_ms_p95": pct(frame_ms, 95),
                 "cpu_pct": 100 * cpu / elapsed,
+                "map_draws_per_s": map_draws / elapsed,
+                "paints_per_s": window_paints / elapsed,
                 "stages": stages.summary(),
             }
         ),
