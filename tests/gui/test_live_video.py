@@ -17,7 +17,7 @@ from rtmu.sim import SimConfig, SimThread
 from .harness import OFFICE_MAP, Gui, idle, pump
 
 gi.require_version("Gdk", "4.0")
-from gi.repository import Gdk  # noqa: E402
+from gi.repository import Gdk, GLib  # noqa: E402
 
 
 @pytest.fixture
@@ -217,3 +217,38 @@ def test_the_v_key_plays_live_video_over_the_map_and_stops_it(gui: Gui, sim: Sim
     stopped_at = frames_seen(gui)
     idle(1.0)
     assert frames_seen(gui) == stopped_at, "V off stops the requests"
+
+
+def test_frames_keep_coming_whether_or_not_a_picture_is_on_screen(gui: Gui, sim: SimThread) -> None:
+    """The next frame is asked for after the paint that shows this one, and at once when no picture is
+    on screen (the map page with the picture-in-picture hidden): either way the video keeps its rate.
+    The robot stands still while the simulator's camera head sweeps, so every frame is new. (The
+    window's link figures repaint it several times a second anyway, so this cannot tell the at-once
+    path from a wait for the next paint; it holds the rate with and without a picture on screen.)"""
+    window, inset = gui.window, gui.window.inset
+    assert sim.server is not None
+    head = sim.server.world.camera.ptz
+
+    def sweep() -> bool:
+        sim.call(lambda: setattr(head, "pan", (head.pan + 3.0) % 90.0))
+        return True
+
+    gui.key("v")
+    pump(lambda: window.live.live, 3, "V to start live video")
+    source = GLib.timeout_add(40, sweep)
+    try:
+        pump(lambda: inset.get_mapped() and frames_seen(gui) > 0, 8, "the picture over the map")
+        first = frames_seen(gui)
+        idle(2.0)
+        shown = frames_seen(gui) - first
+        gui.click(inset.close_button)
+        pump(lambda: not inset.get_visible(), 3, "the picture to hide")
+        assert not window.camera.get_mapped() and not window.split.pane.get_mapped()
+        idle(0.5)
+        first = frames_seen(gui)
+        idle(2.0)
+        hidden = frames_seen(gui) - first
+    finally:
+        GLib.source_remove(source)
+    gui.shot("no-picture-on-screen")
+    assert shown >= 6 and hidden >= 6, f"{shown} frames in 2 s on screen, {hidden} with none on screen"
