@@ -198,10 +198,8 @@ class CameraView(Gtk.Box):
         back = Gtk.Button.new_with_label("Back to map (Esc)")
         back.set_focusable(False)
         back.connect("clicked", lambda _b: on_back())
-        for button in (
-            self.refresh_button,
-            back,
-        ):  # a phone's 360 px: the bar shrinks, the window does not grow
+        # On a phone's 360 px the two labels shrink (ellipsized) rather than make the window wider.
+        for button in (self.refresh_button, back):
             label = button.get_child()
             if isinstance(label, Gtk.Label):
                 label.set_ellipsize(Pango.EllipsizeMode.END)
