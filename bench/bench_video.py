@@ -12,12 +12,16 @@ frames/s, the robot turning so every frame is really rendered). Every frame carr
 * ``video.headless.cpu_pct``: this process's CPU while playing (% of one core).
 * ``video.window.fps_640x480``: frames drawn per second by the real window (map page with the
   picture-in-picture and the wedge) in its own process under Xvfb, 8 s at 20 frames/s. Baseline: the
-  window asking for one picture at a time, the next once the previous was painted.
+  window asking for one picture at a time, the next once the previous was painted. Both run twice,
+  interleaved; each keeps the run with the lower ``client_ms_p95``.
 * ``video.window.client_ms_p95``: received → first paint after the texture was ready;
   ``video.window.age_ms_p95``: render stamp → that paint.
 * ``video.window.ui_frame_ms_p95``: the GTK thread's time per frame (frame clock update → after-paint)
   while video plays; baseline: the same with the one-at-a-time pictures.
 * ``video.window.cpu_pct``: the window process's CPU while playing.
+* ``video.window.stage_<stage>_ms_p95``: one stage of a frame's way to the screen, from the stage
+  before (``bench.video_window.STAGES``: posted to the GTK thread, queued for and decoded on the JPEG
+  thread, handed to and shown by the GTK thread, painted by the next frame-clock tick).
 * ``video.sim.render_ms_640x480``: the simulator's cost of one frame (ray cast, compose, JPEG, stamp);
   ``video.sim.cpu_pct``: the simulator process's CPU over the whole run.
 """
@@ -45,6 +49,7 @@ SIZE = "640x480"
 SERVER_HZ = 25.0
 HEADLESS_S = 10.0
 WINDOW_S = 8.0
+WINDOW_RUNS = 2
 REPO = Path(__file__).resolve().parents[1]
 
 
@@ -185,8 +190,13 @@ def run() -> list[Result]:
             Result("video.headless.client_ms_p95", pct(live.client, 95), "ms", pct(base.client, 95)),
             Result("video.headless.cpu_pct", 100 * live_cpu / live_s, "%"),
         ]
-        w_live = window_run(port, "live", env)
-        w_base = window_run(port, "serial", env)
+        # Interleaved and twice each: on a shared machine a burst of load lands on one run, not on
+        # one side; each side keeps its run with the lower latency (as best_time keeps the fastest).
+        runs: dict[str, list[dict[str, Any]]] = {"live": [], "serial": []}
+        for _ in range(WINDOW_RUNS):
+            for mode in runs:
+                runs[mode].append(window_run(port, mode, env))
+        w_live, w_base = (min(runs[m], key=lambda r: r["client_ms_p95"]) for m in ("live", "serial"))
         results += [
             Result("video.window.fps_640x480", w_live["fps"], "frames/s", w_base["fps"]),
             Result("video.window.client_ms_p95", w_live["client_ms_p95"], "ms", w_base["client_ms_p95"]),
@@ -194,6 +204,15 @@ def run() -> list[Result]:
             Result("video.window.ui_frame_ms_p95", w_live["frame_ms_p95"], "ms", w_base["frame_ms_p95"]),
             Result("video.window.cpu_pct", w_live["cpu_pct"], "%"),
         ]
+        for stage in w_live["stages"]:  # where the window's latency goes (bench.video_window.STAGES)
+            results.append(
+                Result(
+                    f"video.window.stage_{stage}_ms_p95",
+                    w_live["stages"][stage]["p95"],
+                    "ms",
+                    w_base["stages"][stage]["p95"],
+                )
+            )
         server.stdin.close()
         out = server.stdout.read()
         server.wait(20)

@@ -3,12 +3,15 @@
 from __future__ import annotations
 
 import math
+from dataclasses import replace
 
 import cairo
 import numpy as np
 
+from rtmu.sim.camera import PanTiltZoom
+from rtmu.state import PtzState
 from rtmu.ui import overlays
-from rtmu.ui.fov_draw import Wedge, wedge_points
+from rtmu.ui.fov_draw import TELE_FOV_DEG, WIDE_FOV_DEG, Wedge, camera_aim, wedge_points, zoom_fov
 from rtmu.ui.frame import Scene, draw_frame
 from rtmu.ui.viewport import Viewport
 
@@ -39,11 +42,12 @@ def test_the_wedge_is_drawn_ahead_of_the_camera_and_nowhere_behind() -> None:
     for th, pan in ((0.0, 0.0), (90.0, 0.0), (30.0, 45.0)):
         with_wedge = frame(Wedge(0.0, 0.0, th, pan=pan), th)
         without = frame(None, th)
-        front = ahead(VP, th + pan, 1000.0)
-        back = ahead(VP, th + pan + 180.0, 1000.0)
+        heading = th - pan  # ARIA's pan turns to the right (clockwise), the map counter-clockwise
+        front = ahead(VP, heading, 1000.0)
+        back = ahead(VP, heading + 180.0, 1000.0)
         assert amber(with_wedge[front]) and not amber(without[front]), (th, pan, with_wedge[front])
         assert (with_wedge[back] == without[back]).all(), "nothing behind the camera"
-        outside = ahead(VP, th + pan + 40.0, 1000.0)  # the wedge is 48° wide: 40° off its axis is outside
+        outside = ahead(VP, heading + 40.0, 1000.0)  # the wedge is 48° wide: 40° off its axis is outside
         assert (with_wedge[outside] == without[outside]).all()
 
 
@@ -55,3 +59,26 @@ def test_zoom_narrows_the_wedge_and_it_stays_visible_zoomed_out() -> None:
     far_out = Viewport(400, 300, 0.01, 0.0, 0.0)
     pts = wedge_points(far_out, Wedge(0, 0, 0))
     assert max(p[0] for p in pts) - pts[0][0] >= 39, "a minimum on-screen reach"
+
+
+def test_the_head_pans_and_zooms_the_wedge_as_the_simulated_vc_c4_sees() -> None:
+    """The client's optics agree with the simulator's camera; pan turns the wedge clockwise."""
+    for zoom in (0.0, 25.0, 50.0, 100.0):
+        assert math.isclose(zoom_fov(zoom), PanTiltZoom(zoom=zoom).fov_deg, rel_tol=1e-9)
+    assert camera_aim(None) == (0.0, WIDE_FOV_DEG)
+    unread = PtzState(camera="Cam1", zoom_range=(0.0, 100.0), zoom_available=True)
+    assert camera_aim(unread) == (0.0, WIDE_FOV_DEG)
+    head = replace(unread, position=(60.0, 5.0, 100.0))
+    pan, fov = camera_aim(head)
+    assert pan == 60.0 and math.isclose(fov, TELE_FOV_DEG)
+    assert camera_aim(replace(head, zoom_available=False))[1] == WIDE_FOV_DEG
+    assert camera_aim(replace(head, position=(float("nan"), 0.0, float("inf")))) == (0.0, WIDE_FOV_DEG)
+
+    # Drawn: panned 60° right and fully zoomed, the wedge is a narrow beam at -60°, none at 0°.
+    with_head = frame(Wedge(0.0, 0.0, 0.0, pan, fov))
+    without = frame(None)
+    assert amber(with_head[ahead(VP, -60.0, 1500.0)])
+    assert not amber(with_head[ahead(VP, 0.0, 1500.0)]), "no longer straight ahead"
+    assert not amber(with_head[ahead(VP, 60.0, 1500.0)]), "right, not left"
+    off_axis = ahead(VP, -60.0 + 6.0, 1500.0)  # 6° off a 4° beam's axis
+    assert (with_head[off_axis] == without[off_axis]).all()

@@ -7,6 +7,7 @@ import re
 from collections.abc import Iterator
 from pathlib import Path
 
+import gi
 import numpy as np
 import pytest
 from PIL import Image
@@ -14,6 +15,9 @@ from PIL import Image
 from rtmu.sim import SimConfig, SimThread
 
 from .harness import OFFICE_MAP, Gui, idle, pump
+
+gi.require_version("Gdk", "4.0")
+from gi.repository import Gdk, GLib  # noqa: E402
 
 
 @pytest.fixture
@@ -182,3 +186,69 @@ def test_the_field_of_view_wedge_is_drawn_and_can_be_switched_off(gui: Gui) -> N
     without = gui.stage_pixels()
     assert amber_pixels(with_wedge) > amber_pixels(without) + 200, "the amber wedge is on the map"
     gui.shot("no-wedge")
+
+
+def test_the_v_key_plays_live_video_over_the_map_and_stops_it(gui: Gui, sim: SimThread) -> None:
+    """V (a letter no drive uses) toggles Live from the map page: the picture over the map plays."""
+    from rtmu.ui.keys import KeyRouter, bindings
+    from rtmu.ui.shortcuts import shortcuts_xml
+
+    window, live = gui.window, gui.window.live
+    assert [b.target for b in bindings() if "v" in b.accels] == ["live_video"], "V is for video only"
+    assert "Live video on/off" in shortcuts_xml()
+    router = KeyRouter(hold=print, release=print, command=print, view=print)
+    for key in ("v", "V"):
+        keyval = Gdk.keyval_from_name(key)
+        found = router.lookup(keyval, Gdk.ModifierType.SHIFT_MASK if key == "V" else Gdk.ModifierType(0))
+        assert found is not None and found.target == "live_video", key
+
+    gui.key("v")
+    pump(lambda: live.live, 3, "V to start live video")
+    assert window.stack.get_visible_child_name() == "map", "V plays where the operator is"
+    idle(0.3)
+    turn(sim)
+    pump(lambda: window.inset.get_visible() and frames_seen(gui) > 0, 8, "the live picture over the map")
+    first = frames_seen(gui)
+    pump(lambda: frames_seen(gui) >= first + 5, 8, "five more frames")
+    gui.shot("v-live-over-map")
+    gui.key("v")
+    pump(lambda: not live.live, 3, "V again to stop")
+    idle(0.5)
+    stopped_at = frames_seen(gui)
+    idle(1.0)
+    assert frames_seen(gui) == stopped_at, "V off stops the requests"
+
+
+def test_frames_keep_coming_whether_or_not_a_picture_is_on_screen(gui: Gui, sim: SimThread) -> None:
+    """The next frame is asked for after the paint that shows this one, and at once when no picture is
+    on screen (the map page with the picture-in-picture hidden): either way the video keeps its rate.
+    The robot stands still while the simulator's camera head sweeps, so every frame is new. (The
+    window's link figures repaint it several times a second anyway, so this cannot tell the at-once
+    path from a wait for the next paint; it holds the rate with and without a picture on screen.)"""
+    window, inset = gui.window, gui.window.inset
+    assert sim.server is not None
+    head = sim.server.world.camera.ptz
+
+    def sweep() -> bool:
+        sim.call(lambda: setattr(head, "pan", (head.pan + 3.0) % 90.0))
+        return True
+
+    gui.key("v")
+    pump(lambda: window.live.live, 3, "V to start live video")
+    source = GLib.timeout_add(40, sweep)
+    try:
+        pump(lambda: inset.get_mapped() and frames_seen(gui) > 0, 8, "the picture over the map")
+        first = frames_seen(gui)
+        idle(2.0)
+        shown = frames_seen(gui) - first
+        gui.click(inset.close_button)
+        pump(lambda: not inset.get_visible(), 3, "the picture to hide")
+        assert not window.camera.get_mapped() and not window.split.pane.get_mapped()
+        idle(0.5)
+        first = frames_seen(gui)
+        idle(2.0)
+        hidden = frames_seen(gui) - first
+    finally:
+        GLib.source_remove(source)
+    gui.shot("no-picture-on-screen")
+    assert shown >= 6 and hidden >= 6, f"{shown} frames in 2 s on screen, {hidden} with none on screen"

@@ -46,6 +46,7 @@ WINDOW_BINDINGS: tuple[Binding, ...] = (
     Binding(("<Control>0",), "Fit map", "Map", "view", "zoom_fit"),
     Binding(("f",), "Follow the robot on/off", "Map", "view", "follow"),
     Binding(("Escape",), "Camera picture ⇄ map", "Window", "view", "toggle_camera"),
+    Binding(("v",), "Live video on/off", "Window", "view", "live_video"),
     Binding(("<Control>Left",), "Pan the camera left", "Camera head", "view", "ptz_left"),
     Binding(("<Control>Right",), "Pan the camera right", "Camera head", "view", "ptz_right"),
     Binding(("<Control>Up",), "Tilt the camera up", "Camera head", "view", "ptz_up"),

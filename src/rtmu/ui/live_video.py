@@ -18,7 +18,8 @@ import gi
 
 gi.require_version("Gtk", "4.0")
 gi.require_version("Pango", "1.0")
-from gi.repository import GLib, Gtk, Pango  # noqa: E402
+gi.require_version("Gdk", "4.0")
+from gi.repository import Gdk, GLib, Gtk, Pango  # noqa: E402
 
 from ..model import CameraImage  # noqa: E402
 from .camera import CameraView  # noqa: E402
@@ -52,6 +53,8 @@ class LiveVideoControls:
         self.saved: list[Path] = []
         self.folder: Path | None = None
         """Where Save writes (None: :func:`frames_dir`)."""
+        self._after_paint: Callable[[], None] | None = None
+        self._paint_handler = 0
 
         self.caption = Gtk.Label(halign=Gtk.Align.START, valign=Gtk.Align.START)
         self.caption.add_css_class("video-caption")
@@ -112,6 +115,13 @@ class LiveVideoControls:
     def set_live(self, on: bool) -> None:
         self.live_button.set_active(on)
 
+    def toggle(self, available: bool, reason: str) -> str:
+        """The Live key (V): on where the server has a camera, off always; why not, "" when done."""
+        if not self.live and not available:
+            return reason or "no camera"
+        self.set_live(not self.live)
+        return ""
+
     def _live_toggled(self, button: Gtk.ToggleButton) -> None:
         on = button.get_active()
         self.pause_button.set_sensitive(on)
@@ -141,6 +151,31 @@ class LiveVideoControls:
                 text += " · paused"
             self.caption.set_text(text)
             self.caption.set_visible(True)
+
+    def when_painted(self, done: Callable[[], None], on_screen: bool) -> None:
+        """Call ``done`` once the window has painted the frame just set (its frame clock's after-paint),
+        or at once when no widget on screen shows it.
+
+        The video loop asks for the next frame on ``done``: asked at hand-over, the next frame would
+        arrive while this one is still waiting for its paint and queue behind it (the window's
+        latency); asked after the paint, it arrives while the GTK thread is free. A newer frame's
+        ``done`` replaces an older one's (it covers every frame before it).
+        """
+        root = self.camera.get_root()  # the window's clock (a hidden page may be unrealized)
+        clock = root.get_frame_clock() if isinstance(root, Gtk.Widget) else None
+        if not on_screen or clock is None:
+            done()
+            return
+        self._after_paint = done
+        if not self._paint_handler:
+            self._paint_handler = clock.connect("after-paint", self._painted)
+
+    def _painted(self, clock: Gdk.FrameClock) -> None:
+        done, self._after_paint = self._after_paint, None
+        clock.disconnect(self._paint_handler)
+        self._paint_handler = 0
+        if done is not None:
+            done()
 
     def connection_lost(self) -> None:
         """No robot: no picture to save, and Live stays off until asked for again."""

@@ -29,7 +29,7 @@ from gi.repository import GLib, Gtk  # noqa: E402
 from ..model import LinkLevel, MapModel, OperatorState, RobotModel, RobotState  # noqa: E402
 from . import overlays  # noqa: E402
 from .fleet_draw import FleetMark  # noqa: E402
-from .fov_draw import Wedge  # noqa: E402
+from .fov_draw import Wedge, camera_aim  # noqa: E402
 from .frame import Scene, draw_frame  # noqa: E402
 from .nav_draw import Marker, MarkerKind  # noqa: E402
 from .tiles import TileCache  # noqa: E402
@@ -316,7 +316,7 @@ class MapStage(Gtk.DrawingArea):
             scene.others, scene.robot_rgb = self.fleet()
         self._add_navigation(scene)
         if self.show_fov and scene.robot is not None and self._has_camera():
-            scene.fov = Wedge(*scene.robot)
+            scene.fov = Wedge(*scene.robot, *camera_aim(self.model.robot.value.ptz))
         return draw_frame(ctx, vp, scene)
 
     def _has_camera(self) -> bool:

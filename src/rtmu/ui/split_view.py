@@ -8,6 +8,8 @@ stacked layout when the window is taller than wide (a phone held upright).
 
 from __future__ import annotations
 
+from collections.abc import Callable
+
 import gi
 
 gi.require_version("Gtk", "4.0")
@@ -18,11 +20,28 @@ from gi.repository import Gdk, GLib, Gtk, Pango  # noqa: E402
 from ..model import CameraImage  # noqa: E402
 
 
+class _SizedBoxLayout(Gtk.BoxLayout):
+    """A box layout that tells its widget each size it allocates.
+
+    A ``Gtk.Box`` allocates through its layout manager, so a box's own ``do_size_allocate`` is never
+    called: the size has to be caught here.
+    """
+
+    def __init__(self, on_size: Callable[[int, int], None]) -> None:
+        super().__init__()
+        self._on_size = on_size
+
+    def do_allocate(self, widget: Gtk.Widget, width: int, height: int, baseline: int) -> None:
+        self._on_size(width, height)
+        Gtk.BoxLayout.do_allocate(self, widget, width, height, baseline)
+
+
 class SplitView(Gtk.Box):
     """``map_page`` and, while :attr:`split`, the live picture beside (or under) it."""
 
     def __init__(self, map_page: Gtk.Widget) -> None:
         super().__init__(orientation=Gtk.Orientation.HORIZONTAL, spacing=0)
+        self.set_layout_manager(_SizedBoxLayout(self._allocated))
         self.add_css_class("split-view")
         self.set_homogeneous(True)
         map_page.set_hexpand(True)
@@ -68,12 +87,11 @@ class SplitView(Gtk.Box):
             self.caption.set_text("" if status is None else status.caption())
             self.caption.set_visible(status is not None)
 
-    def do_size_allocate(self, width: int, height: int, baseline: int) -> None:
+    def _allocated(self, width: int, height: int) -> None:
         wanted = Gtk.Orientation.HORIZONTAL if width >= height else Gtk.Orientation.VERTICAL
         if wanted != self.get_orientation() and self._pending is None:
             self._pending = wanted  # never re-layout inside an allocation: on the next idle
             GLib.idle_add(self._turn)
-        Gtk.Box.do_size_allocate(self, width, height, baseline)
 
     def _turn(self) -> bool:
         if self._pending is not None:

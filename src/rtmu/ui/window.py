@@ -589,6 +589,10 @@ class MainWindow(Gtk.ApplicationWindow):
             self.stage.fit()
         elif name == "follow":
             self.stage.set_follow(not self.stage.follow)
+        elif name == "live_video":
+            camera = self.command_state("request_image")
+            if reason := self.live.toggle(camera.enabled, camera.reason):
+                self.banners.tell("camera", "warning", f"Live video: {reason}", timeout=4.0)
         elif name.startswith("ptz_") and (reason := self.ptz.key(name)):
             self.banners.tell("ptz", "warning", f"Camera head: {reason}", timeout=4.0)
 
@@ -793,9 +797,12 @@ class MainWindow(Gtk.ApplicationWindow):
     def _picture_decoded(
         self, image: object, textures: tuple[Gdk.Texture, Gdk.Texture] | None, error: str
     ) -> None:
-        if getattr(image, "video", None) is not None:
-            self._link.video_shown(image.sequence)  # type: ignore[attr-defined]  # the next frame only now
         current = self.model.camera.value
+        if getattr(image, "video", None) is not None:  # the next frame only once this one is painted
+            shows = (self.camera.picture, self.inset, self.split.pane)
+            seen = textures is not None and image is current and any(w.get_mapped() for w in shows)
+            sequence: int = image.sequence  # type: ignore[attr-defined]
+            self.live.when_painted(lambda: self._link.video_shown(sequence), seen)
         if current is None or image is not current:
             return  # a newer picture (or a disconnect) overtook this one
         self.camera.show_picture(image, None if textures is None else textures[0], error)
