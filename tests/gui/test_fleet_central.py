@@ -36,13 +36,19 @@ def central() -> Iterator[CentralThread]:
         yield fleet
 
 
-def open_central(screenshots: Path, name: str, central: CentralThread, robots: int = 3) -> Gui:
-    """The window on a saved profile that names ``central`` (as a user's settings file would)."""
+def open_central(
+    screenshots: Path, name: str, central: CentralThread, robots: int = 3, *, saved: bool = True
+) -> Gui:
+    """The window on a saved profile that names ``central`` (as a user's settings file would), or
+    on ``rtmu --central HOST:PORT`` (``saved=False``)."""
     settings_path = scratch_dir("settings-") / "settings.toml"
-    profile = Profile("hq", central=f"127.0.0.1:{central.port}")
-    save_settings(Settings({"hq": profile}, "hq"), settings_path)
-    gui = Gui.open(GuiOptions(profile="hq", settings_path=settings_path, persist=False), screenshots, name,
-                   connect=False)  # fmt: skip
+    where = f"127.0.0.1:{central.port}"
+    if saved:
+        save_settings(Settings({"hq": Profile("hq", central=where)}, "hq"), settings_path)
+        options = GuiOptions(profile="hq", settings_path=settings_path, persist=False)
+    else:
+        options = GuiOptions(central=where, settings_path=settings_path, persist=False)
+    gui = Gui.open(options, screenshots, name, connect=False)
     fleet = gui.app.fleet
     pump(lambda: len(fleet) == robots, 15, f"{robots} robot sessions from the central server")
     pump(lambda: all(s.state.connection.value.connected for s in fleet), 20, "every robot to connect")
@@ -126,7 +132,7 @@ def test_the_central_servers_robots_are_listed_live_and_one_drives_alone(
 def test_the_central_server_killed_stops_every_drive_and_is_said_once(
     screenshots: Path, central: CentralThread
 ) -> None:
-    gui = open_central(screenshots, "central-killed", central)
+    gui = open_central(screenshots, "central-killed", central, saved=False)  # as rtmu --central HOST:PORT
     try:
         gui.focus()
         gui.keydown("Up")

@@ -339,6 +339,8 @@ class RtmuApplication(Gtk.Application):
         s = self.settings
         if o.fleet:
             return Profile("demo fleet", robots=o.fleet), True
+        if o.central:
+            return Profile(f"central {o.central}", central=o.central, user=o.user or ""), True
         if o.host:
             port = o.port or DEFAULT_PORT
             user = o.user or ""
