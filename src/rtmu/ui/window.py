@@ -534,6 +534,7 @@ class MainWindow(Gtk.ApplicationWindow):
         self.dpad.release_all()
         self.picker.cancel()
         self.session, self.controller, self._link = session, session.controller, session.runner
+        self.handheld.show_controller(self.controller)  # the pad follows the selection, never carries over
         session.attach_view(self.robot_view)
         if isinstance(self.model, SelectedModel):
             self.model.show(session.state)
