@@ -129,4 +129,11 @@ def main(seconds: float, ports: list[int]) -> None:
 
 
 if __name__ == "__main__":
-    main(float(sys.argv[1]), [int(p) for p in sys.argv[2:]])
+    args = (float(sys.argv[1]), [int(p) for p in sys.argv[2:]])
+    profile = os.environ.get("RTMU_BENCH_PROFILE")  # a path: cProfile the window into it (finding costs)
+    if profile:
+        import cProfile
+
+        cProfile.run("main(*args)", profile)
+    else:
+        main(*args)
