@@ -15,7 +15,10 @@ every robot has its map and status, 10 s are measured:
   and its children (the guardian processes), simulators excluded (target < 1). Its
   ``baseline`` is the window process alone, without the guardians.
 * ``fleet.ready_s.{1,5,20}_robots`` (s): window start until every robot has its status and
-  its map (each robot downloads the map itself).
+  its map.
+* ``fleet.map_downloads.{1,5,20}_robots``: map downloads at start-up — the robots share one map
+  file, so one session downloads it and the others take it (``mapcache.SharedMaps``; without
+  it: one per robot).
 
 Needs Xvfb (started here when ``DISPLAY`` is unset); without one the figures are skipped.
 """
@@ -95,5 +98,6 @@ def run() -> list[Result]:
             Result(f"fleet.updates_per_s_min.{tag}", f["updates_per_s_min"], "1/s"),
             Result(f"fleet.cpu_cores.{tag}", f["cpu"], "cores", f.get("cpu_window")),
             Result(f"fleet.ready_s.{tag}", f["ready_s"], "s"),
+            Result(f"fleet.map_downloads.{tag}", f["map_downloads"], "downloads"),
         ]
     return results

@@ -9,7 +9,8 @@ SECONDS, prints one JSON line and quits (stopping every robot). Measured:
 * ``updates_per_s``: per robot, frames that showed a status of it not shown before
   (``FleetBinding.drawn_updates``) per second;
 * ``cpu``: CPU seconds per second of this process and its children (the guardian processes)
-  over the same interval, from ``/proc``; ``cpu_window``: this process alone.
+  over the same interval, from ``/proc``; ``cpu_window``: this process alone;
+* ``map_downloads``: sessions that downloaded the map themselves (the others took another's).
 """
 
 from __future__ import annotations
@@ -123,10 +124,20 @@ def main(seconds: float, ports: list[int]) -> None:
         "cpu": (cpu1 - cpu0) / (t1 - t0),
         "ready_s": waited - started,
         "cpu_window": (own1 - own0) / (t1 - t0),
+        "map_downloads": sum(
+            1 for s in fleet if s.runner.session is not None and s.runner.session.map_downloads_shared == 0
+        ),
     }
     print("RESULT " + json.dumps(out), flush=True)
     app.close_session()
 
 
 if __name__ == "__main__":
-    main(float(sys.argv[1]), [int(p) for p in sys.argv[2:]])
+    args = (float(sys.argv[1]), [int(p) for p in sys.argv[2:]])
+    profile = os.environ.get("RTMU_BENCH_PROFILE")  # a path: cProfile the window into it (finding costs)
+    if profile:
+        import cProfile
+
+        cProfile.run("main(*args)", profile)
+    else:
+        main(*args)

@@ -16,8 +16,9 @@ Mapping (a standard pad; Xbox / PlayStation names):
 Stops, each through the controller and so through the same drive lease as the keys:
 releasing the dead-man; the pad unplugged; the pad silent for :data:`SILENCE`
 seconds while the dead-man is held (a radio gone out of range sends no "removed");
-the window losing focus. After an unplug, a silence or a focus loss the stick
-is latched off until the dead-man is released and pressed again; after any other
+the window losing focus; another robot selected (:meth:`Gamepad.retarget`). After an
+unplug, a silence, a focus loss or a switch of robot the stick is latched off until the
+dead-man is released and pressed again; after any other
 stop (STOP, a lapsed lease, a stale link) the controller itself holds that rule.
 
 A pad that floods events cannot flood the robot: stick changes reach the lease at
@@ -213,6 +214,24 @@ class Gamepad:
         self._focused = active
         if not active and self._deadman:
             self._stop_stick()
+            self._latched = True
+        self._publish()
+
+    def retarget(self, drive: Drive) -> None:
+        """Drive another robot from now on (the window shows another robot of the fleet).
+
+        A stick that was driving is released on the robot before (the fleet has already
+        stopped it), and a dead-man still held is latched: the new robot moves only after
+        the dead-man is released and pressed again, as a held key does not carry over.
+        """
+        if drive is self.drive:
+            return
+        if self._driving():
+            self._stop_stick()
+        self.drive = drive
+        self._pushed = None
+        self._pending = False
+        if self._deadman:
             self._latched = True
         self._publish()
 

@@ -10,6 +10,7 @@ import asyncio
 from collections.abc import Callable
 
 from rtmu.client.lease import DriveLease
+from rtmu.client.mapcache import SharedMaps
 from rtmu.client.session import Session, SessionConfig
 
 from .endless_maps import map_id_server
@@ -71,5 +72,61 @@ def test_without_a_map_id_every_connection_loads_the_map() -> None:
         finally:
             await session.disconnect()
             await server.stop()
+
+    run(go(), timeout=40)
+
+
+def test_sessions_sharing_a_map_download_it_once_and_a_different_map_is_not_shared() -> None:
+    """A fleet's robots on one map file: one session downloads it, the others take that same map."""
+
+    async def go() -> None:
+        servers = [map_id_server() for _ in range(3)]
+        for server in servers:
+            await server.start()
+        servers[2].map_checksum = bytes(16)  # type: ignore[attr-defined]  # another map of the same name
+        shared = SharedMaps()
+        config = SessionConfig(shared_maps=shared)
+        sessions = [Session(DriveLease(), lambda change: None, config=config) for _ in servers]
+        try:
+            for session, server in zip(sessions, servers, strict=True):
+                await session.connect("127.0.0.1", server.port)
+            maps = await asyncio.wait_for(asyncio.gather(*(s.load_map() for s in sessions)), 20)
+            assert all(m.state == "ready" for m in maps)
+            loads = [_count(server, "getMapBinary") for server in servers]
+            assert sorted(loads[:2]) == [0, 1], f"the shared map was downloaded {sum(loads[:2])} times"
+            assert loads[2] == 1, "a different map (other MD5) was taken from the shared one"
+            assert maps[0].data is maps[1].data and maps[2].data is not maps[0].data
+            assert [s.map_downloads_shared for s in sessions] in ([1, 0, 0], [0, 1, 0])
+            assert shared.downloads == 2
+        finally:
+            for session in sessions:
+                await session.disconnect()
+            for server in servers:
+                await server.stop()
+
+    run(go(), timeout=40)
+
+
+def test_a_failed_shared_download_lets_the_waiting_session_fetch_its_own() -> None:
+    async def go() -> None:
+        servers = [map_id_server() for _ in range(2)]
+        for server in servers:
+            await server.start()
+        shared = SharedMaps()
+        key = ("test.map", bytes(range(16)).hex(), 1234, 1_700_000_000)
+        assert shared.claim(key) == (None, None)  # a session elsewhere is downloading it …
+        session = Session(DriveLease(), lambda change: None, config=SessionConfig(shared_maps=shared))
+        try:
+            await session.connect("127.0.0.1", servers[0].port)
+            loading = asyncio.ensure_future(session.load_map())
+            await asyncio.sleep(0.3)
+            assert not loading.done() and _count(servers[0], "getMapBinary") == 0, "it did not wait"
+            shared.finish(key, None)  # … and failed
+            got = await asyncio.wait_for(loading, 10)
+            assert got.state == "ready" and _count(servers[0], "getMapBinary") == 1
+        finally:
+            await session.disconnect()
+            for server in servers:
+                await server.stop()
 
     run(go(), timeout=40)

@@ -61,7 +61,7 @@ from .health import HealthMonitor, ping_data
 from .ld_data import LASER_NAMES
 from .ld_session import LdFeed
 from .lease import DriveGovernor, DriveLease, EndReason, SendRatios, SendStop
-from .mapcache import MapCache, map_key
+from .mapcache import MapCache, MapKey, SharedMaps, content_key, map_key
 from .mapload import download_map, map_source
 from .nav_session import NavFeed
 from .popups import PopupFeed
@@ -110,6 +110,8 @@ class SessionConfig:
     guardian: bool = False
     """Start a guardian process (:mod:`rtmu.guardian`) for each connection that may drive: it stops
     the robot if this process is killed or frozen while driving. The window and ``rtmu drive`` do."""
+    shared_maps: SharedMaps | None = field(default=None, compare=False)
+    """Maps shared with the process's other sessions (a fleet's window: one download per map file)."""
 
 
 @dataclass
@@ -161,6 +163,8 @@ class Session:
         self._map_cache = MapCache()
         self.map_downloads_skipped = 0
         """Map loads answered from the cache (same ``getMapId``): what a reconnect saved."""
+        self.map_downloads_shared = 0
+        """Map loads answered by another session's download of the same map (``config.shared_maps``)."""
         self._connection = ConnectionState()
         self._extra_subs: dict[str, tuple[int, Callable[[Packet], None]]] = {}
         self._tasks: set[asyncio.Task[Any]] = set()
@@ -956,6 +960,29 @@ class Session:
             if cached != self._map or cached.data is not self._map.data:
                 self._set_map(cached)
             return self._map
+        shared, content = self.config.shared_maps, content_key(key)
+        if shared is None or content is None:
+            return await self._download_map(client, key)
+        found, pending = shared.claim(content)
+        if pending is not None:
+            found = await shared.wait(pending)
+        if found is None:
+            if pending is not None:  # the other download failed: this session fetches its own
+                return await self._download_map(client, key)
+            model = None
+            try:
+                model = await self._download_map(client, key)
+            finally:
+                shared.finish(content, model if model is not None and model.state == MapPhase.READY else None)
+            return model
+        if not client.connected:
+            raise ServerClosed("not connected")
+        self.map_downloads_shared += 1
+        self._set_map(replace(found, generation=self._map.generation + 1))
+        self._map_cache.put(key, self._map)
+        return self._map
+
+    async def _download_map(self, client: AriaClient, key: MapKey | None) -> MapModel:
         generation = self._map.generation
         self._set_map(MapModel(state=MapPhase.LOADING, name=self._map.name, generation=generation))
 

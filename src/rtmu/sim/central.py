@@ -158,13 +158,13 @@ class CentralServer:
         for server in self._servers:
             server.close()
         self._servers.clear()
+        for op in list(self.operators):  # first: a dead process sends no clientRemoved as forwarders close
+            op.abort()
         for fwd in list(self.forwarders):
             for op in fwd.operators:
                 op.abort()
             fwd.robot.abort()
             fwd.close()
-        for op in list(self.operators):
-            op.abort()
 
     async def _settle(self) -> None:
         tasks = [t for t in self._tasks if not t.done() and t is not asyncio.current_task()]

@@ -15,7 +15,7 @@ import tempfile
 from dataclasses import replace
 from pathlib import Path
 
-from ..settings import DEFAULT_PORT
+from ..settings import DEFAULT_PORT, parse_central
 from .options import GuiOptions
 
 EXIT_NO_DISPLAY = 6
@@ -35,6 +35,11 @@ def add_gui_arguments(parser: argparse.ArgumentParser) -> None:
         default=1,
         metavar="N",
         help="with --demo: N simulated robots on one map (as rtmu sim --robots N), all in the window",
+    )
+    g.add_argument(
+        "--central",
+        metavar="HOST[:PORT]",
+        help="ARIA's central server: every robot it lists in the window (as a profile's central = …)",
     )
     g.add_argument("--host", help="robot server to connect to (default: the last profile)")
     g.add_argument("--port", type=int, help=f"its port (default {DEFAULT_PORT})")
@@ -57,6 +62,7 @@ def options_from_args(args: argparse.Namespace) -> GuiOptions:
         port=getattr(args, "port", None),
         user=getattr(args, "user", None),
         profile=getattr(args, "profile", None),
+        central=getattr(args, "central", None),
         fullscreen=bool(getattr(args, "fullscreen", False)),
         connect=False if getattr(args, "no_connect", False) else None,
         demo=bool(getattr(args, "demo", False)),
@@ -82,6 +88,15 @@ def run_gui(args: argparse.Namespace) -> int:
     if options.port is not None and not 1 <= options.port <= 65535:
         print(f"rtmu: --port {options.port} is not 1…65535", file=sys.stderr)
         return 2
+    if options.central is not None:
+        try:
+            parse_central(options.central)
+        except ValueError as exc:
+            print(f"rtmu: --central: {exc}", file=sys.stderr)
+            return 2
+        if options.host or options.demo:
+            print("rtmu: --central goes without --host and --demo", file=sys.stderr)
+            return 2
     robots = getattr(args, "robots", 1)
     if robots != 1 and not options.demo:
         print("rtmu: --robots N goes with --demo (a fleet profile names real robots)", file=sys.stderr)

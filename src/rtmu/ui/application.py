@@ -26,6 +26,7 @@ gi.require_version("Gtk", "4.0")
 from gi.repository import Gio, GLib, Gtk  # noqa: E402
 
 from ..client.central import CentralRoster  # noqa: E402
+from ..client.mapcache import SharedMaps  # noqa: E402
 from ..client.roster import RobotEndpoint, Roster  # noqa: E402
 from ..client.session import SessionConfig  # noqa: E402
 from ..fleet import Fleet, RobotSession, direct_roster, robot_profile  # noqa: E402
@@ -141,7 +142,8 @@ class RtmuApplication(Gtk.Application):
         if self.options.protocol is not None:  # --protocol: this run only, the saved profile keeps its own
             profile = replace(profile, protocol=self.options.protocol)
         # The guardian: a separate process that stops the robot if this one is killed or frozen.
-        config = SessionConfig(guardian=self.options.guardian)
+        # One download per map file for the whole fleet (robots of one site share their map).
+        config = SessionConfig(guardian=self.options.guardian, shared_maps=SharedMaps())
         replay = (
             open_replay(self.options.replay, self.options.replay_conn)
             if self.options.replay is not None
@@ -340,6 +342,8 @@ class RtmuApplication(Gtk.Application):
         s = self.settings
         if o.fleet:
             return Profile("demo fleet", robots=o.fleet), True
+        if o.central:
+            return Profile(f"central {o.central}", central=o.central, user=o.user or ""), True
         if o.host:
             port = o.port or DEFAULT_PORT
             user = o.user or ""

@@ -39,6 +39,8 @@ OTHER_TRAIL = 300
 """Trail points drawn for a robot not selected (its latest; the selected robot's whole trail is drawn)."""
 OTHERS_REDRAW_MS = 66
 """At most ~15 redraws a second for the robots not selected (their status comes at 10 Hz each)."""
+LINK_GRACE_MS = 1000
+"""A robot's lost link is said this long after it happens (unless the whole roster went meanwhile)."""
 REFRESH_MS = 300
 """How often rows re-read what changes without an event (a status growing old, the window's width)."""
 QUIET_KINDS = (Kind.CONNECTION, Kind.LINK, Kind.SPEED, Kind.SPEED_LIMIT)
@@ -80,6 +82,7 @@ class FleetBinding:
         self._trails: dict[int, tuple[object, np.ndarray]] = {}
         self._lost: dict[str, str] = {}
         """Robots not shown whose link is lost (name → reason), in the order they were lost."""
+        self._lost_source = 0
         self.drawn_updates: dict[str, int] = {}
         """Per robot name: frames that showed a new status of it (the benchmark's on-screen rate)."""
         self.robot_list = RobotList(select=fleet.select, colour=self.colour)
@@ -183,6 +186,22 @@ class FleetBinding:
         self._tell_lost()
 
     def _tell_lost(self) -> None:
+        """Say the lost links after ``LINK_GRACE_MS``, so a central server's end is said once, by the fleet.
+
+        When the central server dies, every forwarded link drops with it; the roster's loss,
+        arriving a moment later, closes those sessions and empties ``_lost`` before this speaks.
+        """
+        if not self._lost:
+            self._tell_lost_now()
+        elif not self._lost_source:
+            self._lost_source = GLib.timeout_add(LINK_GRACE_MS, self._tell_lost_later)
+
+    def _tell_lost_later(self) -> bool:
+        self._lost_source = 0
+        self._tell_lost_now()
+        return False
+
+    def _tell_lost_now(self) -> None:
         """ONE banner, updated in place, names the robots (not shown) whose link is lost."""
         if not self._lost:
             self.window.banners.dismiss("fleet:links")
@@ -258,6 +277,9 @@ class FleetBinding:
         return age is None or age > STALE_AFTER
 
     def close(self) -> None:
+        if self._lost_source:
+            GLib.source_remove(self._lost_source)
+            self._lost_source = 0
         if self._redraw_source:
             GLib.source_remove(self._redraw_source)
             self._redraw_source = 0

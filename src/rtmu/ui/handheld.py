@@ -23,7 +23,7 @@ import gi
 gi.require_version("Gtk", "4.0")
 from gi.repository import Gdk, Gio, GLib, Gtk  # noqa: E402
 
-from ..controller import TICK  # noqa: E402
+from ..controller import TICK, Controller  # noqa: E402
 from ..gamepad import Gamepad  # noqa: E402
 from .alarm_view import AlarmView  # noqa: E402
 from .gamepad import ManettePads  # noqa: E402
@@ -89,6 +89,10 @@ class Handheld:
     def _layout_changed(self, narrow: bool) -> None:
         """On a phone the motion pill (top left) and the pad pill cannot share a row: the pad's goes under."""
         self.pad_status.set_margin_top(PILL_BELOW_MOTION if narrow else 8)
+
+    def show_controller(self, controller: Controller) -> None:
+        """The window shows another robot: the pad drives its controller, after a fresh dead-man press."""
+        self.pad.retarget(controller)
 
     def _on_active(self, *_a: object) -> None:
         self.pad.focus(self.window.is_active())

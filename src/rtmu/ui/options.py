@@ -20,6 +20,8 @@ class GuiOptions:
     port: int | None = None
     user: str | None = None
     profile: str | None = None
+    central: str | None = None
+    """``--central HOST[:PORT]``: the window on every robot this central server lists (this run only)."""
     fullscreen: bool = False
     connect: bool | None = None
     """None: connect when a profile was given or saved before; False: never at start."""

@@ -539,6 +539,7 @@ class MainWindow(Gtk.ApplicationWindow):
         self.dpad.release_all()
         self.picker.cancel()
         self.session, self.controller, self._link = session, session.controller, session.runner
+        self.handheld.show_controller(self.controller)  # the pad follows the selection, never carries over
         session.attach_view(self.robot_view)
         if isinstance(self.model, SelectedModel):
             self.model.show(session.state)
@@ -695,7 +696,9 @@ class MainWindow(Gtk.ApplicationWindow):
     def _on_connection(self, old: ConnectionState, new: ConnectionState) -> None:
         where = f"{new.host}:{new.port}" if new.host else ""
         phase = new.phase
-        if phase is Phase.CONNECTING and old.phase is not Phase.CONNECTING:
+        if self.session.closed:  # a closed robot's late news (the fleet said why it went): no banner
+            pass
+        elif phase is Phase.CONNECTING and old.phase is not Phase.CONNECTING:
             self.banners.tell("link", "info", f"Connecting to {where}…", timeout=None)
         elif phase is Phase.CONNECTED and old.phase is not Phase.CONNECTED:
             if old.phase is Phase.RECONNECTING:
