@@ -326,7 +326,7 @@ def test_connecting_again_while_driving_stops_the_robot_on_the_old_link_first(se
                 model.connection.value.phase is Phase.CONNECTED and model.connection.value.profile == "other"
             )
         )
-        eventually(lambda: "SHUTDOWN" in [r.name for r in server.received if r.side == 0])
+        eventually(lambda: "SHUTDOWN" in [r.name for r in server.received if r.side == 0], timeout=10)
         old = [r for r in server.received if r.side == 0 and r.name in ("ratioDrive", "stop", "SHUTDOWN")]
         assert [r.name for r in old[-3:]] == ["ratioDrive", "stop", "SHUTDOWN"]
         assert RatioDrive.decode(old[-3].args) == RatioDrive(0, 0, 0)
