@@ -132,6 +132,7 @@ def test_a_hostile_servers_drawings_leave_the_window_answering(screenshots) -> N
             pump(lambda: gui.operator.speed.value.percent == before + 10, 5, "the speed key")
             idle(1.0)
             assert gui.window.ticks > ticks and gui.stage.frames > frames
+            assert gui.stage.drawings_redraws > 0  # drawings without status still get their frames
             assert gui.model.connection.value.connected
             gui.shot("hostile-flood")
         finally:
@@ -164,3 +165,30 @@ def test_a_layer_switched_off_stays_off_for_that_server_after_a_restart(screensh
         gui.shot("still-off")
     finally:
         gui.close()
+
+
+def test_drawings_ride_on_the_status_frames_instead_of_redrawing_the_map_each_update(
+    gui: Gui, sim: SimThread
+) -> None:
+    """Each drawings update once asked for a map frame of its own, on top of the robot's status
+    frames: with live video that doubled the map's repaints and tripled the window's frame time.
+    While status comes, new drawings are shown by the next status frame and ask for none."""
+    pump(lambda: layer(gui, LASER) is not None and len(layer(gui, LASER).points) > 20, 10, "laser points")
+    assert sim.server is not None
+    world = sim.server.world
+    updates = [0]
+    remove = gui.model.drawings.observe(lambda _old, _new: updates.__setitem__(0, updates[0] + 1))
+    try:
+        asked, frames = gui.stage.drawings_redraws, gui.stage.frames
+        for _ in range(5):  # the robot turns on the spot: every laser sample is new
+            sim.call(lambda: world.ratio_drive(0, 25, 100))
+            idle(0.4)
+    finally:
+        remove()
+    assert updates[0] >= 5, "the simulator's drawings did not keep coming"
+    assert gui.stage.frames - frames >= 5, "the map was not redrawn by the robot's status"
+    assert gui.stage.drawings_redraws - asked <= 1  # a status frame may come late once
+    sim.call(lambda: world.ratio_drive(0, 0, 100))
+    idle(0.5)
+    assert count(gui.stage_pixels(), BLUE) > 50  # and the laser is still drawn
+    gui.shot("drawings-with-status")
