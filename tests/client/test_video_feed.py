@@ -100,3 +100,28 @@ def test_stats_give_rates_over_the_window_and_age_percentiles() -> None:
     assert kbps == pytest.approx(100.0, rel=0.06)
     assert s.age_percentile(50) == pytest.approx(10.0)
     assert s.rates(30.0) == (0.0, 0.0)
+
+
+def test_a_repeated_old_frame_does_not_slow_the_video_down() -> None:
+    """A still robot's camera sends the same stamped picture again and again: its age grows, but
+    that is the scene standing still, not a late link (rtmu video once backed off to 0.5 fps)."""
+    from rtmu.client.video_feed import VideoFeed
+
+    now = [0.0]
+    stamp = 1_000_000_000_000
+    wall = [stamp + 5_000_000]  # the first copy arrives 5 ms after its render
+    feed = VideoFeed(
+        None, "getPictureCam1", lambda _f: None, fps=15, clock=lambda: now[0], wall_ns=lambda: wall[0]
+    )  # type: ignore[arg-type]
+    payload = VideoFrame(64, 48, stamp_jpeg(jpeg(), stamp)).encode()
+    assert feed.take(payload, 0.01) is not None
+    for _ in range(40):  # the same picture for 4 s more
+        now[0] += 0.1
+        wall[0] += 100_000_000
+        assert feed.take(payload, 0.01) is None
+    assert feed.stats.repeats == 40
+    assert feed.governor.reason == "" and feed.governor.rate_fps == 15
+    # …while a NEW frame that is really 3 s old still makes it back off.
+    late = VideoFrame(64, 48, stamp_jpeg(jpeg(), wall[0] - 3_000_000_000)).encode()
+    feed.take(late, 0.01)
+    assert "old" in feed.governor.reason

@@ -391,13 +391,16 @@ class VideoFeed:
             self.governor.observe(now, round_trip, None)
             return None
         age = None if stamp is None else max(received - stamp, 0) / 1e9
-        self.governor.observe(now, round_trip, age)
         jpeg = bytes(frame.jpeg)
         key = (stamp, len(jpeg), zlib.crc32(jpeg))
         if self._last == key:
+            # The same picture again (a still robot, a camera polled slower than we ask): its age says
+            # how long nothing changed, not how late the link is — only the round trip is judged.
+            self.governor.observe(now, round_trip, None)
             self.stats.repeats += 1
             self._report()
             return None
+        self.governor.observe(now, round_trip, age)
         self._last = key
         self._sequence += 1
         self.stats.add(now, len(jpeg), None if age is None else age * 1000.0)
