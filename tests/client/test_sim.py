@@ -198,7 +198,7 @@ def test_disconnect_and_close_while_driving_send_zero_ratios_and_stop(how: str) 
                 runner.disconnect().result(5)
             else:
                 runner.close()
-            eventually(lambda: sim.snapshot().mode_name == "stop")
+            eventually(lambda: sim.snapshot().mode_name == "stop", timeout=10)
             snap = sim.snapshot()
             assert snap.trans_ratio == 0 and snap.watchdog_stops == 0
             assert sim.call(lambda: sim.server.robot.received_ratios)[:3] == (0.0, 0.0, 0.0)  # type: ignore[union-attr]
