@@ -8,7 +8,7 @@ from pathlib import Path
 from typing import Any
 
 from ..client.connection import AriaClient
-from ..client.errors import NotSupported
+from ..client.video_feed import video_source
 from ..exit_codes import EXIT_CONNECTION, EXIT_OK
 from ..textsafe import visible
 from ._common import add_connection_arguments, fail, run_with_client
@@ -57,23 +57,9 @@ def register(subparsers: Any) -> None:
     p.set_defaults(handler=handle)
 
 
-def picture_source(client: AriaClient, camera: str | None) -> str:
-    if camera is not None:
-        name = f"getPicture{camera}"
-        if not client.supports(name):
-            raise NotSupported(name, f"this server has no camera named {camera!r} ({name})")
-        return name
-    pictures = sorted(e.name for e in client.datalist if e.name.startswith("getPicture"))
-    if pictures:
-        return pictures[0]
-    if client.supports("sendVideo"):
-        return "sendVideo"
-    raise NotSupported("getPicture", "this server offers no camera pictures (getPicture… or sendVideo)")
-
-
 def handle(args: argparse.Namespace) -> int:
     async def body(client: AriaClient) -> int:
-        source = picture_source(client, args.camera)
+        source = video_source(client, args.camera)
         extra: tuple[bytes, ...] = ()
         if args.quality is not None:
             extra = (bytes([max(0, min(100, args.quality))]),)
