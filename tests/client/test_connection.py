@@ -385,6 +385,54 @@ def test_disconnect_says_goodbye_and_ends_the_reader() -> None:
     run(go())
 
 
+def test_a_stop_sent_while_the_server_is_slow_to_read_still_arrives_after_disconnect(
+    monkeypatch: pytest.MonkeyPatch,
+) -> None:
+    """Closing with the server's status unread used to reset the socket: a server whose next
+    write met the reset dropped our last packets unread — the stop among them (a loaded
+    simulator lost it 1 time in 15). Now the client half-closes and reads on until the server
+    has read everything and closed. The linger is made long so only the order of events counts.
+    """
+    monkeypatch.setattr("rtmu.client.connection.LINGER_TIMEOUT", 30.0)
+
+    async def go() -> None:
+        server = TestServer()
+        await server.start()
+        client = await connected(server)
+        client.request("updateNumbers", 10, lambda p: None)  # the server keeps writing to us
+        await until(lambda: "updateNumbers" in server.names())
+        server.deafen()  # ...but reads nothing for a while, as a busy server does
+        await client.request_once("getSafeDrive")  # the read already waiting is the last one it does
+        client.send("stop")
+        closing = asyncio.create_task(client.disconnect())
+        await asyncio.sleep(0.3)  # the server writes on meanwhile: status for a client that has left
+        server.undeafen()
+        await until(lambda: "SHUTDOWN" in server.names() or server.sides[0].writer.is_closing())
+        await asyncio.wait_for(closing, 5)
+        assert server.names()[-2:] == ["stop", "SHUTDOWN"]
+        assert client.closed_error is None
+        await server.stop()
+
+    run(go())
+
+
+def test_disconnect_from_a_server_that_never_reads_or_closes_still_ends() -> None:
+    async def go() -> None:
+        server = TestServer()
+        await server.start()
+        client = await connected(server)
+        client.request("updateNumbers", 10, lambda p: None)
+        await until(lambda: "updateNumbers" in server.names())
+        server.deafen()
+        await client.request_once("getSafeDrive")  # the read already waiting is the last one it does
+        await client.disconnect()  # bounded by LINGER_TIMEOUT + CLOSE_TIMEOUT, not by the server
+        assert client._read_task is None or client._read_task.done()
+        assert not client.connected
+        await server.stop()
+
+    run(go(), timeout=10)
+
+
 def _numbered_map_names(server: TestServer, lose: set[int]) -> list[int]:
     """getMapName answers ``mapN`` for the N-th request (1-based), except the calls in ``lose``."""
     calls = [0]

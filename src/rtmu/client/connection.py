@@ -82,6 +82,8 @@ REPLY_TIMEOUT = 5.0
 """Default wait for a reply, and for each further packet of a multi-packet reply."""
 CLOSE_TIMEOUT = 0.2
 """How long ``disconnect`` lets the goodbye flush before cutting the socket."""
+LINGER_TIMEOUT = 0.5
+"""How long ``disconnect`` reads on after its goodbye, waiting for the server to close first."""
 MAX_WRITE_BUFFER = 1 << 20
 """A server that stops reading is dropped once this much output is queued (it would grow forever)."""
 READ_CHUNK = 1 << 16
@@ -716,6 +718,10 @@ class AriaClient:
             if not link.is_closing():
                 with contextlib.suppress(OSError):
                     link.write(data)
+                    link.finish_writing()
+                if task is not None and task is not asyncio.current_task():
+                    await asyncio.wait({task}, timeout=CLOSE_TIMEOUT)  # the link has one reader at a time
+                await _read_until_closed(link, LINGER_TIMEOUT)
                 link.close()
                 with contextlib.suppress(Exception):
                     await asyncio.wait_for(link.wait_closed(), CLOSE_TIMEOUT)
@@ -723,6 +729,18 @@ class AriaClient:
         if task is not None and task is not asyncio.current_task() and not task.done():
             # Bounded: a reader that will not end must not keep the caller (a window closing) waiting.
             await asyncio.wait({task}, timeout=CLOSE_TIMEOUT)
+
+
+async def _read_until_closed(link: Link, timeout: float) -> None:
+    """Read and drop the peer's bytes until it closes (bounded): our socket then closes clean.
+
+    Closing with the server's status still unread would reset the connection, and a server
+    whose next write meets the reset can lose our goodbye unread — the stop with it.
+    """
+    with contextlib.suppress(Exception):
+        async with asyncio.timeout(timeout):
+            while await link.read(READ_CHUNK):
+                pass
 
 
 def _request(what: str | Payload, args: tuple[Arg, ...]) -> tuple[str, bytes]:

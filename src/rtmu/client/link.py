@@ -32,6 +32,15 @@ class Link(Protocol):
 
     async def drain(self) -> None: ...
 
+    def finish_writing(self) -> None:
+        """Half-close: nothing more will be written, but the peer's bytes can still be read.
+
+        A socket closed while the peer's data sits unread in it is *reset*, and a server whose
+        next write meets that reset may drop our last packets (the stop) unread. Saying "no
+        more" first and reading until the peer closes lets it read everything we sent.
+        """
+        ...
+
     def close(self) -> None:
         """Close after what was written has left; :meth:`wait_closed` waits for it."""
         ...
@@ -76,6 +85,11 @@ class StreamLink:
 
     async def drain(self) -> None:
         await self.writer.drain()
+
+    def finish_writing(self) -> None:
+        if not self.writer.is_closing() and self.writer.can_write_eof():
+            with contextlib.suppress(OSError):
+                self.writer.write_eof()
 
     def close(self) -> None:
         self.writer.close()
@@ -130,6 +144,9 @@ class LinkWrapper:
 
     async def drain(self) -> None:
         await self.inner.drain()
+
+    def finish_writing(self) -> None:
+        self.inner.finish_writing()
 
     def close(self) -> None:
         self.inner.close()
@@ -208,6 +225,10 @@ class ReplayLink:
 
     async def drain(self) -> None:
         return None
+
+    def finish_writing(self) -> None:
+        """A recording has no peer to wait for: the same as closing."""
+        self.close()
 
     def close(self) -> None:
         self._closed = True

@@ -193,6 +193,10 @@ class PacedLink:
     async def drain(self) -> None:
         return None
 
+    def finish_writing(self) -> None:
+        """A replay has no peer to wait for: the same as closing."""
+        self.close()
+
     def close(self) -> None:
         self._closed = True
         self._changed.set()
