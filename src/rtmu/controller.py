@@ -381,8 +381,12 @@ class Controller:
                 return
             self._generation = lease.grant(ratios)
 
-    def _halt_held(self, reason: EndReason) -> None:
-        """Motion was stopped for ``reason`` while keys were held: block them until released."""
+    def _halt_held(self, reason: EndReason, *, quiet: bool = False) -> None:
+        """Motion was stopped for ``reason`` while keys were held: block them until released.
+
+        A lease the network side ended for the link (its drive loop sees a stale link before the
+        model's health reaches this thread) is said here, so the operator hears it whichever
+        side noticed first; ``quiet`` where the caller says it itself."""
         had = bool(self._held) or (self._analog is not None and self._generation is not None)
         self._blocked |= self._held
         self._held.clear()
@@ -398,6 +402,12 @@ class Controller:
                     Kind.SAFETY, "Stopped: the window did not respond in time. Press again to drive."
                 )
             )
+        elif had and reason is EndReason.LINK and not quiet:
+            level = self.robot.health.value.level
+            self._say_link_stop(level if level in (LinkLevel.STALE, LinkLevel.LOST) else LinkLevel.STALE)
+
+    def _say_link_stop(self, level: LinkLevel) -> None:
+        self.view.notify(Notice.warning(Kind.LINK, f"Stopped: the link is {level.value}"))
 
     def stop(self) -> None:
         """Stop now. Always sent, whatever the link looks like; held keys must be pressed again.
@@ -661,10 +671,10 @@ class Controller:
     def _on_health(self, old: LinkHealth, new: LinkHealth) -> None:
         if new.level in (LinkLevel.STALE, LinkLevel.LOST) and old.level is LinkLevel.OK:
             moving = bool(self._held) or self._generation is not None
-            self._halt_held(EndReason.LINK)
+            self._halt_held(EndReason.LINK, quiet=True)
             if moving:
                 self.link.stop()
-                self.view.notify(Notice.warning(Kind.LINK, f"Stopped: the link is {new.level.value}"))
+                self._say_link_stop(new.level)
 
     def _on_link_notice(self, notice: Notice) -> None:
         self.view.notify(notice)

@@ -156,6 +156,21 @@ def test_a_stale_link_stops_and_tells_the_operator() -> None:
     assert any("stale" in t for t in rig.view.texts())
 
 
+def test_a_stale_link_noticed_first_by_the_drive_loop_is_still_told_once() -> None:
+    """The network thread's drive loop ends the lease for the link before the model's health
+    reaches the UI thread; the next tick finds it ended. A fresh-PATH CI run once showed the
+    link cell but no banner this way."""
+    rig = Rig()
+    rig.ctl.press("forward")
+    rig.link.lease.end(EndReason.LINK)  # what the drive loop does when it sees the link go stale
+    rig.hold(0.1)
+    assert rig.view.texts().count("Stopped: the link is stale") == 1
+    rig.model.health.set(LinkHealth(LinkLevel.STALE))  # the health arrives afterwards
+    assert rig.view.texts().count("Stopped: the link is stale") == 1
+    rig.ctl.press("forward")  # still held: blocked until released
+    assert not rig.lease.live
+
+
 def test_after_a_reconnect_the_robot_stays_still_until_a_fresh_press() -> None:
     rig = Rig()
     rig.ctl.press("forward")

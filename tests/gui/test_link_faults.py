@@ -130,13 +130,11 @@ def test_a_link_fault_stops_the_robot_and_a_held_key_does_not_drive_again(
 
     # Where our stop cannot reach the server, its 2 s watchdog and our 2 s ping verdict race:
     # the banner may come a moment after the robot has stopped.
+    # (Said whichever thread noticed the stale link first: the drive loop or the health watch.)
     try:
         pump(lambda: any(t.startswith(("Stopped: the link", "Link lost")) for t in said()), 3, "the banner")
     except AssertionError:
-        # Where the fault cuts the way to the robot, the link cell naming it ("no ping ×N") is what the
-        # README promises; one fresh-PATH run saw the cell but no banner within 3 s (left for a later look).
-        if fault.stop_reaches_server or not _link_cell_says_fault(gui):
-            raise AssertionError((said(), cell)) from None
+        raise AssertionError((said(), cell)) from None
     if fault.stop_reaches_server:
         assert stopped_after <= OUR_STOP_WITHIN, f"stopped {stopped_after:.2f} s after the fault"
         assert _robot(sim, "watchdog_stops") == 0
