@@ -177,7 +177,41 @@ class RecordingLink(LinkWrapper):
         self.inner.write(data)
 
 
-class ReplayLink:
+class RecordedLink:
+    """What every link that plays a recording shares: no socket, no peer, nothing queued.
+
+    Subclasses read from their recording and count what the client writes; closing (or
+    half-closing: nobody is there to wait for) wakes a read that waits on :attr:`_changed`.
+    """
+
+    def __init__(self) -> None:
+        self._closed = False
+        self._changed = asyncio.Event()
+
+    def backlog(self) -> int:
+        return 0
+
+    def is_closing(self) -> bool:
+        return self._closed
+
+    async def drain(self) -> None:
+        return None
+
+    def finish_writing(self) -> None:
+        self.close()
+
+    def close(self) -> None:
+        self._closed = True
+        self._changed.set()
+
+    async def wait_closed(self) -> None:
+        return None
+
+    def abort(self) -> None:
+        self.close()
+
+
+class ReplayLink(RecordedLink):
     """Plays recorded chunks back, each only once the client has written as much as it had live.
 
     That gate keeps replies after the requests they answer, so a replayed session sends
@@ -186,14 +220,13 @@ class ReplayLink:
     """
 
     def __init__(self, chunks: Iterable[Chunk], *, eof: bool = False) -> None:
+        super().__init__()
         self.chunks = list(chunks)
         self.eof = eof
         self.position = 0
         """Chunks handed out so far."""
         self.written = bytearray()
         """Everything the client wrote (a test may decode it)."""
-        self._closed = False
-        self._changed = asyncio.Event()
 
     @property
     def exhausted(self) -> bool:
@@ -216,26 +249,3 @@ class ReplayLink:
     def write(self, data: bytes) -> None:
         self.written += data
         self._changed.set()
-
-    def backlog(self) -> int:
-        return 0
-
-    def is_closing(self) -> bool:
-        return self._closed
-
-    async def drain(self) -> None:
-        return None
-
-    def finish_writing(self) -> None:
-        """A recording has no peer to wait for: the same as closing."""
-        self.close()
-
-    def close(self) -> None:
-        self._closed = True
-        self._changed.set()
-
-    async def wait_closed(self) -> None:
-        return None
-
-    def abort(self) -> None:
-        self.close()

@@ -22,7 +22,7 @@ import threading
 import time
 from collections.abc import Callable
 
-from ..client.link import Link
+from ..client.link import Link, RecordedLink
 from ..protocol.decoder import PacketDecoder
 from ..state import CameraChanged, CameraImage, StateChange
 from .replay_file import RecordedConnection
@@ -114,10 +114,11 @@ class ReplayClock:
         return self.now_ns() >= self.end_ns
 
 
-class PacedLink:
+class PacedLink(RecordedLink):
     """A :class:`Link` over one recorded connection, paced by a :class:`ReplayClock`."""
 
     def __init__(self, recorded: RecordedConnection, clock: ReplayClock) -> None:
+        super().__init__()
         self.recorded = recorded
         self.clock = clock
         self.position = 0
@@ -133,8 +134,6 @@ class PacedLink:
         """Recording time of the last chunk handed out."""
         self._slack = 0
         self._decoder = PacketDecoder()
-        self._closed = False
-        self._changed = asyncio.Event()
 
     @property
     def exhausted(self) -> bool:
@@ -183,29 +182,6 @@ class PacedLink:
             elif packet.command not in self.recorded.uncounted:
                 self.counted += 1
         self._changed.set()
-
-    def backlog(self) -> int:
-        return 0
-
-    def is_closing(self) -> bool:
-        return self._closed
-
-    async def drain(self) -> None:
-        return None
-
-    def finish_writing(self) -> None:
-        """A replay has no peer to wait for: the same as closing."""
-        self.close()
-
-    def close(self) -> None:
-        self._closed = True
-        self._changed.set()
-
-    async def wait_closed(self) -> None:
-        return None
-
-    def abort(self) -> None:
-        self.close()
 
 
 class Replayer:
