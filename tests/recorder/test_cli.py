@@ -44,7 +44,8 @@ def test_record_then_decode_the_recording_like_a_capture(tmp_path: Path) -> None
     # Our goodbye is the last thing we say; the server's bytes read after it (while the client waits
     # for the server to close, so the stop is not lost to a reset) are on the wire but not delivered.
     said = [n for n in names if n[0] == "c2s"]
-    assert ("c2s", "stop") in said and said[-1] == ("c2s", "SHUTDOWN") and said.count(("c2s", "SHUTDOWN")) == 1
+    assert ("c2s", "stop") in said and said[-1] == ("c2s", "SHUTDOWN")
+    assert said.count(("c2s", "SHUTDOWN")) == 1
     delivered = packets[: names.index(("c2s", "SHUTDOWN"))]
     pictures = [p for p in delivered if p["dir"] == "s2c" and p["name"] == "getPictureCam1"]
     assert len(pictures) == counts[topics.CAMERA], "every picture the session got is in the raw channel"
