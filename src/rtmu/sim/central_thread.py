@@ -8,24 +8,21 @@ connected.
 
 from __future__ import annotations
 
-import asyncio
-import concurrent.futures
 import dataclasses
-import threading
 import time
-from collections.abc import Callable, Coroutine
 from pathlib import Path
-from typing import Any, TypeVar
+from typing import Any
 
 from .central import CentralConfig, CentralServer
 from .config import SimConfig
+from .loop_thread import LoopThread
 from .server import SimServer
 
-T = TypeVar("T")
-START_TIMEOUT = 30.0
 
+class CentralThread(LoopThread):
+    what = "the central server"
+    thread_name = "rtmu-central-sim"
 
-class CentralThread:
     def __init__(
         self,
         robots: int = 3,
@@ -34,6 +31,7 @@ class CentralThread:
         switch_retry: float = 0.2,
         users_path: Path | None = None,
     ) -> None:
+        super().__init__()
         self.template = template or SimConfig(port=0, camera=False)
         self.switch_retry = switch_retry
         self.users_path = users_path
@@ -41,50 +39,22 @@ class CentralThread:
         self.initial = robots
         self.central: CentralServer | None = None
         self.sims: dict[str, SimServer] = {}
-        self.loop: asyncio.AbstractEventLoop | None = None
-        self._thread: threading.Thread | None = None
-        self._ready = threading.Event()
-        self._error: BaseException | None = None
+
+    async def _open(self) -> None:
+        config = CentralConfig(host="127.0.0.1", port=0, robot_port=0, users_path=self.users_path)
+        self.central = CentralServer(config)
+        await self.central.start()
 
     # -- lifetime -------------------------------------------------------------------------
     def start(self) -> CentralThread:
-        self._thread = threading.Thread(target=self._main, name="rtmu-central-sim", daemon=True)
-        self._thread.start()
-        if not self._ready.wait(START_TIMEOUT):
-            raise TimeoutError("the central server did not start")
-        if self._error is not None:
-            raise RuntimeError("the central server failed to start") from self._error
+        self._start_loop()
         for i in range(1, self.initial + 1):
             self.add_robot(f"robot{i}")
         self.wait_for_robots(self.initial)
         return self
 
-    def _main(self) -> None:
-        loop = asyncio.new_event_loop()
-        self.loop = loop
-        asyncio.set_event_loop(loop)
-        try:
-            config = CentralConfig(host="127.0.0.1", port=0, robot_port=0, users_path=self.users_path)
-            self.central = CentralServer(config)
-            loop.run_until_complete(self.central.start())
-        except BaseException as exc:
-            self._error = exc
-            self._ready.set()
-            loop.close()
-            return
-        self._ready.set()
-        try:
-            loop.run_forever()
-        finally:
-            pending = [t for t in asyncio.all_tasks(loop) if not t.done()]
-            for task in pending:
-                task.cancel()
-            if pending:
-                loop.run_until_complete(asyncio.gather(*pending, return_exceptions=True))
-            loop.close()
-
     def stop(self) -> None:
-        if self.loop is None or not self.loop.is_running():
+        if not self.running:
             return
 
         async def stop_all() -> None:
@@ -94,9 +64,7 @@ class CentralThread:
                 await self.central.stop()
 
         self.run(stop_all())
-        self.loop.call_soon_threadsafe(self.loop.stop)
-        if self._thread is not None:
-            self._thread.join(10.0)
+        self._halt()
 
     def __enter__(self) -> CentralThread:
         return self.start()
@@ -109,24 +77,6 @@ class CentralThread:
     def port(self) -> int:
         assert self.central is not None
         return self.central.port
-
-    def call(self, fn: Callable[[], T], timeout: float = 10.0) -> T:
-        """Run ``fn`` on the loop and return its result."""
-        assert self.loop is not None
-        future: concurrent.futures.Future[T] = concurrent.futures.Future()
-
-        def run() -> None:
-            try:
-                future.set_result(fn())
-            except BaseException as exc:
-                future.set_exception(exc)
-
-        self.loop.call_soon_threadsafe(run)
-        return future.result(timeout)
-
-    def run(self, coro: Coroutine[Any, Any, T], timeout: float = 10.0) -> T:
-        assert self.loop is not None
-        return asyncio.run_coroutine_threadsafe(coro, self.loop).result(timeout)
 
     def robots(self) -> dict[str, int]:
         """Robot name → forwarded port, as the central server lists them now."""
