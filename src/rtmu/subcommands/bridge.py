@@ -15,7 +15,6 @@ import argparse
 import signal
 import sys
 import threading
-import time
 from typing import Any
 
 from ..client.errors import ClientError
@@ -26,6 +25,7 @@ from ..notices import Notice
 from ..recorder.bridge import DEFAULT_PORT, LEASE_TTL, Bridge, DriveLimits
 from ..textsafe import visible
 from ._common import UsageError, add_connection_arguments, fail, positive_float, read_password
+from ._follow import follow
 
 BEAT = 0.04
 """The main thread beats for the guardian as the window's UI thread does."""
@@ -104,7 +104,7 @@ def handle(args: argparse.Namespace) -> int:
             return fail("bridge", f"could not connect: {exc}", EXIT_CONNECTION)
         drive = "drive allowed from /cmd_vel" if args.allow_drive else "no drive"
         print(f"rtmu bridge: ws://{args.bind}:{bridge.port} ({drive})", file=sys.stderr, flush=True)
-        _follow(runner, args, ended)
+        follow(runner, ended, seconds=args.seconds, camera_hz=args.camera_hz, beat=BEAT)
     finally:
         bridge.close()  # ends any bridge drive first
         runner.stop_and_wait(0.5)
@@ -112,23 +112,3 @@ def handle(args: argparse.Namespace) -> int:
         for signum, handler in previous.items():
             signal.signal(signum, handler)
     return EXIT_OK
-
-
-def _follow(runner: ClientRunner, args: argparse.Namespace, ended: threading.Event) -> None:
-    """Until ``--seconds`` or a signal: beat for the guardian, ask for pictures at ``--camera-hz``."""
-    deadline = None if args.seconds is None else time.monotonic() + args.seconds
-    period = 1.0 / args.camera_hz if args.camera_hz > 0 else None
-    next_picture = time.monotonic()
-    pending = None
-    while not ended.is_set():
-        now = time.monotonic()
-        if deadline is not None and now >= deadline:
-            return
-        runner.ui_heartbeat()
-        if period is not None and now >= next_picture and (pending is None or pending.done()):
-            session = runner.session
-            if session is not None and session.image_source() is not None:
-                pending = runner.submit(session.request_image)
-                pending.add_done_callback(lambda f: f.cancelled() or f.exception())
-            next_picture = max(next_picture + period, now)
-        ended.wait(BEAT)

@@ -12,7 +12,6 @@ import argparse
 import signal
 import sys
 import threading
-import time
 from pathlib import Path
 from typing import Any
 
@@ -25,6 +24,7 @@ from ..recorder import Recorder, RecorderConfig
 from ..state import ConnectionChanged, Phase, StateChange
 from ..textsafe import visible
 from ._common import UsageError, add_connection_arguments, fail, positive_float, read_password
+from ._follow import follow
 
 
 def register(subparsers: Any) -> None:
@@ -96,7 +96,7 @@ def handle(args: argparse.Namespace) -> int:
         except Exception as exc:
             return fail("record", f"could not connect: {exc}", EXIT_CONNECTION)
         print(f"rtmu record: recording {host}:{port} to {visible(str(out))}", file=sys.stderr)
-        _follow(runner, args, ended)
+        follow(runner, ended, seconds=args.seconds, camera_hz=args.camera_hz)
     finally:
         runner.close()
         recorder.close()
@@ -110,25 +110,3 @@ def handle(args: argparse.Namespace) -> int:
             file=sys.stderr,
         )
     return EXIT_OK
-
-
-def _follow(runner: ClientRunner, args: argparse.Namespace, ended: threading.Event) -> None:
-    """Until ``--seconds`` or a signal: ask for camera pictures at ``--camera-hz`` where offered."""
-    deadline = None if args.seconds is None else time.monotonic() + args.seconds
-    period = 1.0 / args.camera_hz if args.camera_hz > 0 else None
-    next_picture = time.monotonic()
-    pending = None
-    while not ended.is_set():
-        now = time.monotonic()
-        if deadline is not None and now >= deadline:
-            return
-        if period is not None and now >= next_picture and (pending is None or pending.done()):
-            session = runner.session
-            if session is not None and session.image_source() is not None:
-                pending = runner.submit(session.request_image)
-                pending.add_done_callback(lambda f: f.cancelled() or f.exception())
-            next_picture = max(next_picture + period, now)
-        waits = [0.2] + ([deadline - now] if deadline is not None else [])
-        if period is not None:
-            waits.append(max(0.0, next_picture - now))
-        ended.wait(max(0.0, min(waits)))
