@@ -277,6 +277,16 @@ class Interrupted(Exception):
         super().__init__(f"interrupted by {signal_name(signum)}" + (f"; {detail}" if detail else ""))
 
 
+async def until_stop_signal() -> None:
+    """Wait for Ctrl-C or SIGTERM: how a long-running server (``rtmu sim``) is told to stop cleanly."""
+    stop = asyncio.Event()
+    loop = asyncio.get_running_loop()
+    for sig in (signal.SIGINT, signal.SIGTERM):
+        with contextlib.suppress(NotImplementedError, RuntimeError):
+            loop.add_signal_handler(sig, stop.set)
+    await stop.wait()
+
+
 def signal_name(signum: int) -> str:
     try:
         return signal.Signals(signum).name

@@ -2,13 +2,11 @@
 
 from __future__ import annotations
 
-import asyncio
-import contextlib
 import dataclasses
-import signal
 import sys
 
 from ..sim import SimConfig
+from ._common import until_stop_signal
 
 EXIT_OK = 0
 EXIT_BAD_INPUT = 2
@@ -54,12 +52,7 @@ async def serve_central(cfg: SimConfig, robot_port: int, robots: int) -> int:
             sims.append(sim)
         if robots:
             print(f"rtmu sim: {robots} simulated robot(s) switching to it: robot1…robot{robots}", flush=True)
-        stop = asyncio.Event()
-        loop = asyncio.get_running_loop()
-        for sig in (signal.SIGINT, signal.SIGTERM):
-            with contextlib.suppress(NotImplementedError, RuntimeError):
-                loop.add_signal_handler(sig, stop.set)
-        await stop.wait()
+        await until_stop_signal()
         print("rtmu sim: stopping (telling operators and robots SHUTDOWN)", flush=True)
         return EXIT_OK
     except (OSError, MapFormatError, ValueError) as exc:

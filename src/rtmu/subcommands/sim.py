@@ -11,10 +11,10 @@ from __future__ import annotations
 
 import argparse
 import asyncio
-import contextlib
-import signal
 import sys
 from pathlib import Path
+
+from ._common import until_stop_signal
 
 EXIT_OK = 0
 EXIT_BAD_INPUT = 2
@@ -243,12 +243,7 @@ async def serve(cfg) -> int:
         f"Pioneer 3-DX at ({home[0]:.0f}, {home[1]:.0f}) mm, {home[2]:.0f} deg{extras}",
         flush=True,
     )
-    stop = asyncio.Event()
-    loop = asyncio.get_running_loop()
-    for sig in (signal.SIGINT, signal.SIGTERM):
-        with contextlib.suppress(NotImplementedError, RuntimeError):
-            loop.add_signal_handler(sig, stop.set)
-    await stop.wait()
+    await until_stop_signal()
     print("rtmu sim: stopping (telling clients SHUTDOWN)", flush=True)
     await server.stop()
     return EXIT_OK
@@ -273,12 +268,7 @@ async def serve_fleet(cfg, count: int) -> int:
         x, y, th = server.home
         print(f"rtmu sim: {robot.name} listening on {cfg.host}:{server.port}, "
               f"at ({x:.0f}, {y:.0f}) mm, {th:.0f} deg", flush=True)  # fmt: skip
-    stop = asyncio.Event()
-    loop = asyncio.get_running_loop()
-    for sig in (signal.SIGINT, signal.SIGTERM):
-        with contextlib.suppress(NotImplementedError, RuntimeError):
-            loop.add_signal_handler(sig, stop.set)
-    await stop.wait()
+    await until_stop_signal()
     print("rtmu sim: stopping every robot (telling clients SHUTDOWN)", flush=True)
     await fleet.stop()
     return EXIT_OK
