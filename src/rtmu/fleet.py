@@ -37,6 +37,7 @@ from .client.roster import (
     Roster,
     RosterEvent,
     RosterLost,
+    RosterRestored,
 )
 from .client.runner import ClientRunner, Post, call_directly, settle
 from .client.session import SessionConfig
@@ -198,8 +199,10 @@ class Fleet:
                 if session is not None:
                     self.remove(session)
                     self._announce(f"{name} left the fleet" + (f": {reason}" if reason else ""))
-            case RosterLost(reason):
-                self._roster_lost(reason)
+            case RosterLost(reason, retrying):
+                self._roster_lost(reason, retrying)
+            case RosterRestored():
+                self._roster_restored()
 
     def _robot_added(self, endpoint: RobotEndpoint) -> None:
         if self._make is None or self.roster_lost is not None:
@@ -211,7 +214,7 @@ class Fleet:
         self.add(session, select=self.selected.value is None)
         session.controller.connect()
 
-    def _roster_lost(self, reason: str) -> None:
+    def _roster_lost(self, reason: str, retrying: bool = False) -> None:
         """Every robot of the roster is gone: stop them all at once, say it ONCE, then close them."""
         if self.roster_lost is not None:
             return
@@ -220,11 +223,19 @@ class Fleet:
         sessions = self.sessions.value
         for session in sessions:
             session.controller.view = NoView()  # their own link-lost notices would repeat this one
-        self._announce(f"Lost the robot list ({reason}): every robot was told to stop")
+        again = "; trying to reach it again" if retrying else ""
+        self._announce(f"Lost the robot list ({reason}): every robot was told to stop{again}")
         for session in sessions:
             session.close()
         self.sessions.set(())
         self.selected.set(None)
+
+    def _roster_restored(self) -> None:
+        """The roster's source is back: its robots come again as new sessions (none drives unpressed)."""
+        if self.roster_lost is None:
+            return
+        self.roster_lost = None
+        self._announce("The robot list is back: reconnecting to its robots (press again to drive)")
 
     def named(self, name: str) -> RobotSession | None:
         """The session of the robot called ``name`` (its profile's name), if any."""

@@ -19,7 +19,7 @@ import pytest
 from rtmu import maps
 from rtmu.cli import main
 from rtmu.client.central import CentralRoster
-from rtmu.client.roster import RobotAdded, RobotRemoved, RosterEvent, RosterLost
+from rtmu.client.roster import RobotAdded, RobotRemoved, RosterEvent, RosterLost, RosterRestored
 from rtmu.exit_codes import EXIT_CONNECTION, EXIT_OK, EXIT_USAGE
 from rtmu.sim import SimConfig, SimServer
 from rtmu.sim.central_thread import CentralThread
@@ -219,6 +219,48 @@ def test_roster_lost_once_when_the_central_server_dies() -> None:
             time.sleep(0.5)  # anything else it might still say
             assert len(heard.of(RosterLost)) == 1
             assert heard.events[-1] == heard.of(RosterLost)[0]
+        finally:
+            roster.close()
+
+
+def test_a_restarted_central_server_brings_the_roster_back_once() -> None:
+    with CentralThread(robots=2, template=SimConfig(port=0, camera=False)) as fl:
+        heard = Heard()
+        roster = CentralRoster("127.0.0.1", fl.port, timeout=5)
+        roster.start(heard)
+        try:
+            eventually(lambda: len(heard.of(RobotAdded)) == 2, timeout=10)
+            fl.kill_central()
+            eventually(lambda: heard.of(RosterLost) != [], timeout=10)
+            assert heard.of(RosterLost)[0].retrying  # type: ignore[attr-defined]
+            time.sleep(1.5)  # tries against nobody listening say nothing more
+            assert len(heard.of(RosterLost)) == 1 and heard.of(RosterRestored) == []
+            tries = roster.attempts
+            assert tries >= 2
+            fl.restart_central()
+            eventually(lambda: len(heard.of(RobotAdded)) == 4, timeout=30)  # the robots switched back
+            lost_at = heard.events.index(heard.of(RosterLost)[0])
+            after = heard.events[lost_at + 1 :]
+            assert isinstance(after[0], RosterRestored) and len(heard.of(RosterRestored)) == 1
+            again = {e.endpoint.name: e.endpoint for e in after if isinstance(e, RobotAdded)}
+            assert sorted(again) == NAMES[:2] and {n: e.port for n, e in again.items()} == fl.robots()
+            assert roster.robots == again
+        finally:
+            roster.close()
+
+
+def test_a_roster_refused_its_login_does_not_try_again(tmp_path: Path) -> None:
+    users = tmp_path / "users.txt"
+    users.write_text("UserInfoVersion1\nuser alice secret1 all\n")
+    with CentralThread(robots=0, users_path=users) as fl:
+        heard = Heard()
+        roster = CentralRoster("127.0.0.1", fl.port, user="alice", password="nope", timeout=5)
+        roster.start(heard)
+        try:
+            eventually(lambda: heard.events != [], timeout=10)
+            time.sleep(2.5)  # past the first retry's time
+            assert len(heard.events) == 1 and isinstance(heard.events[0], RosterLost)
+            assert not heard.events[0].retrying and roster.attempts == 1
         finally:
             roster.close()
 

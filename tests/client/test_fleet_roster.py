@@ -13,7 +13,16 @@ from collections.abc import Iterator
 from contextlib import contextmanager
 from pathlib import Path
 
-from rtmu.client.roster import DirectRoster, Emit, RobotEndpoint, RobotRemoved, RosterEvent, RosterLost
+from rtmu.client.roster import (
+    DirectRoster,
+    Emit,
+    RobotAdded,
+    RobotEndpoint,
+    RobotRemoved,
+    RosterEvent,
+    RosterLost,
+    RosterRestored,
+)
 from rtmu.client.session import SessionConfig
 from rtmu.fleet import Fleet, RobotSession, robot_profile
 from rtmu.model import Phase
@@ -153,6 +162,35 @@ def test_a_lost_roster_stops_every_robot_with_one_notice() -> None:
         assert len(heard) == 1 and "central server closed the connection" in heard[0]
         assert len(fleet) == 0 and fleet.selected.value is None
         assert all(s.closed for s in sessions)
+
+
+def test_a_restored_roster_brings_its_robots_back_still_until_pressed() -> None:
+    with three_robots() as (fleet, ui, roster, sims, heard):
+        first = fleet.named("robot1")
+        assert first is not None
+        hold(ui, first, 0.5)
+        roster.send(RosterLost("central server closed the connection", retrying=True))
+        wait_mode(sims[0], "stop")
+        assert "trying to reach it again" in heard[0]
+        roster.send(RobotAdded(RobotEndpoint("robot1", "127.0.0.1", sims[0].port)))  # before the restore
+        assert len(fleet) == 0, "a robot announced while the roster is lost is not taken"
+        roster.send(RosterRestored())
+        roster.send(RosterRestored())
+        assert heard[1:] == ["The robot list is back: reconnecting to its robots (press again to drive)"]
+        for sim in sims:
+            roster.send(RobotAdded(RobotEndpoint(f"robot{sims.index(sim) + 1}", "127.0.0.1", sim.port)))
+        ui.wait_for(lambda: len(fleet) == 3 and all(s.state.connection.value.connected for s in fleet), 15)
+        again = fleet.named("robot1")
+        assert again is not None and again is not first and fleet.selected.value is again
+        drives_before = drives(sims[0])
+        end = time.monotonic() + 0.5
+        while time.monotonic() < end:  # the new sessions run, the operator presses nothing
+            ui.drain()
+            time.sleep(0.02)
+        assert drives(sims[0]) == drives_before and mode(sims[0]) == "stop", "nothing drives unpressed"
+        hold(ui, again, 0.5)
+        assert mode(sims[0]) == "ratioDrive"
+        again.controller.release("forward")
 
 
 def test_one_robots_lost_link_leaves_the_others_connected_and_drivable() -> None:

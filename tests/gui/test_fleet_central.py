@@ -8,7 +8,8 @@ simulators did and what the window shows:
 * the robots appear in the list as the central server lists them; one that switches in later
   appears live, one that leaves disappears and its session is closed with its robot stopped;
 * a held key drives the selected robot through its forwarded port while the others stay still;
-* the central server killed: every drive stops (at the simulated robots) and the window says so once.
+* the central server killed: every drive stops (at the simulated robots) and the window says so once;
+  restarted: its robots come back, and a key held all along drives none of them until pressed again.
 """
 
 from __future__ import annotations
@@ -157,6 +158,41 @@ def test_the_central_server_killed_stops_every_drive_and_is_said_once(
         gui.keydown("Up")  # a fresh press reaches no robot
         idle(1.0)
         assert all(at(central, n)[3] == 0 for n in central.sims)
+    finally:
+        gui.keyup("Up")
+        gui.close()
+
+
+def test_a_restarted_central_server_brings_the_robots_back_and_a_held_key_drives_none(
+    screenshots: Path, central: CentralThread
+) -> None:
+    gui = open_central(screenshots, "central-restarted", central)
+    try:
+        gui.focus()
+        gui.keydown("Up")
+        first = gui.app.fleet.selected.value
+        assert first is not None
+        pump(lambda: at(central, first.name)[3] > 0, 10, f"{first.name} to drive")
+        central.kill_central()
+        pump(lambda: gui.app.fleet.roster_lost is not None, 15, "the window to notice the central server")
+        pump(lambda: all(at(central, n)[3] == 0 for n in central.sims), 10, "every robot to stop")
+        drives = {n: at(central, n)[4] for n in central.sims}
+        central.restart_central()  # the key is still held, all along
+        fleet = gui.app.fleet
+        pump(lambda: len(fleet) == 3 and gui.app.fleet.roster_lost is None, 30, "the robots to come back")
+        pump(lambda: all(s.state.connection.value.connected for s in fleet), 20, "every robot to connect")
+        assert sorted(names(gui)) == sorted(central.sims)
+        selected = fleet.selected.value
+        assert selected is not None and selected is not first
+        idle(1.5)  # the held key's auto-repeat, the new sessions' first ticks: nothing may drive
+        gui.shot("central-back")
+        assert {n: at(central, n)[4] for n in central.sims} == drives, "a robot drove without a fresh press"
+        told = [text for _t, _l, text in gui.window.banners.history]
+        assert sum("robot list is back" in text for text in told) == 1, told
+        gui.keyup("Up")
+        idle(0.3)
+        gui.keydown("Up")  # a fresh press drives the selected robot again
+        pump(lambda: at(central, selected.name)[3] > 0, 10, f"{selected.name} to drive after a fresh press")
     finally:
         gui.keyup("Up")
         gui.close()

@@ -4,9 +4,12 @@
 :class:`CentralRoster` is a :class:`~rtmu.client.roster.Roster` that stays logged in on a thread of its
 own: the list first, then the ``clientAdded`` / ``clientRemoved`` broadcasts, each turned into a
 :class:`RobotAdded` / :class:`RobotRemoved`; when the central server's connection ends (or never came
-up), one :class:`RosterLost`. Every robot is reached on the central server's host at its forwarded
-port: ARIA's central server always sends an empty hostname, and one that named another host would
-be sending the operator's login (and drive commands) elsewhere, so such a name is not followed.
+up), one :class:`RosterLost`. It then tries again (backing off to :data:`RETRY_MAX` s) unless
+the failure cannot heal by itself (a refused login, a server that breaks the protocol); once back,
+one :class:`RosterRestored` and the robots again, as new ones — none drives until pressed.
+Every robot is reached on the central server's host at its forwarded port: ARIA's central server
+always sends an empty hostname, and one that named another host would be sending the operator's
+login (and drive commands) elsewhere, so such a name is not followed.
 
 The central server is trusted no more than a robot: at most :data:`MAX_ROBOTS` robots are held, names
 longer than :data:`MAX_NAME` or entries without a port are dropped (and counted), and names are kept as
@@ -25,7 +28,8 @@ from typing import Any
 from ..protocol.payloads.central import CentralEntry, ClientAdded, ClientList, ClientRemoved
 from .connection import CONNECT_TIMEOUT, DEFAULT_PORT, AriaClient, Packet
 from .errors import ClientError
-from .roster import Emit, RobotAdded, RobotEndpoint, RobotRemoved, RosterEvent, RosterLost
+from .reconnect import Backoff, worth_retrying
+from .roster import Emit, RobotAdded, RobotEndpoint, RobotRemoved, RosterEvent, RosterLost, RosterRestored
 
 log = logging.getLogger("rtmu.central")
 
@@ -34,6 +38,10 @@ MAX_ROBOTS = 1000
 MAX_NAME = 512
 """ARIA's central server keeps a robot's name in 512 bytes; a longer one is not a robot's."""
 CLOSE_JOIN_TIMEOUT = 2.0
+RETRY_FIRST = 1.0
+"""Seconds before the first new try after the central server was lost."""
+RETRY_MAX = 30.0
+"""Longest wait between tries (an operator waiting for a restarted central server waits at most this)."""
 
 Post = Callable[..., Any]
 """``post(fn, *args)``: run ``fn(*args)`` on the consumer's thread (``GLib.idle_add``, or a direct call)."""
@@ -109,6 +117,9 @@ class CentralRoster:
         self._emit: Emit | None = None
         self._closed = threading.Event()
         self._lost_sent = False
+        self.backoff = Backoff(initial=RETRY_FIRST, maximum=RETRY_MAX)
+        self.attempts = 0
+        """Connections tried so far (the first included)."""
         self._thread: threading.Thread | None = None
         self._loop: asyncio.AbstractEventLoop | None = None
         self._task: asyncio.Task[None] | None = None
@@ -154,36 +165,56 @@ class CentralRoster:
         if not self._closed.is_set() and self._emit is not None:
             self._emit(event)
 
-    def _lost(self, reason: str) -> None:
+    def _lost(self, reason: str, retrying: bool) -> None:
         if self._lost_sent:
             return
         self._lost_sent = True
         self.robots.clear()
-        self._deliver(RosterLost(reason))
+        self._deliver(RosterLost(reason, retrying))
 
     async def _run(self) -> None:
+        """Stay logged in; after a loss, try again until closed or the failure cannot heal."""
+        with contextlib.suppress(asyncio.CancelledError):
+            while not self._closed.is_set():
+                reason, retry = await self._serve_once()
+                self._lost(reason, retry)
+                if not retry:
+                    return
+                await asyncio.sleep(self.backoff.next_delay())
+
+    async def _serve_once(self) -> tuple[str, bool]:
+        """One login: the list, then broadcasts until the link ends. (why it ended, worth retrying)."""
         ended = asyncio.Event()
-        why: list[str] = []
+        why: list[ClientError] = []
 
         def on_close(error: ClientError) -> None:
-            why.append(str(error))
+            why.append(error)
             ended.set()
 
+        self.attempts += 1
         client = AriaClient(on_close=on_close)
         try:
+            # The password stays while the roster lives: a lost central server is logged in to again.
             await client.connect(self.host, self.port, self._user, self._password, timeout=self.timeout)
-            self._password = ""
+            self.backoff.reset()
+            if self._lost_sent:  # before any robot: a broadcast may come ahead of the list
+                self._lost_sent = False
+                self._deliver(RosterRestored())
             client.request(ClientAdded.DATA_NAME, -1, self._on_added)
             client.request(ClientRemoved.DATA_NAME, -1, self._on_removed)
             reply = await client.request_once(ClientList.DATA_NAME, timeout=self.timeout)
             for entry in ClientList.decode(reply.payload).entries:
                 self._add(entry)
             await ended.wait()
-            self._lost(why[0] if why else "the central server's connection ended")
+            if not why:
+                return "the central server's connection ended", True
+            return str(why[0]), worth_retrying(why[0])
+        except ClientError as exc:
+            return str(exc) or type(exc).__name__, worth_retrying(exc)
         except asyncio.CancelledError:
-            pass
-        except Exception as exc:  # ClientError, ProtocolError: the roster is gone, say why once
-            self._lost(str(exc) or type(exc).__name__)
+            raise
+        except Exception as exc:  # a ProtocolError in the list: the same server will send it again
+            return str(exc) or type(exc).__name__, False
         finally:
             with contextlib.suppress(Exception):
                 await client.disconnect()

@@ -4,7 +4,8 @@ The fleet (``rtmu.fleet``) does not care how it learns of a robot: a :class:`Ros
 tells it, through :class:`RosterEvent` values, that a robot became reachable at an
 address (:class:`RobotAdded`), went away (:class:`RobotRemoved`), or that the whole
 roster was lost (:class:`RosterLost`: the central server's connection ended, so every
-robot reached through it is gone and every drive must stop). A direct profile is a
+robot reached through it is gone and every drive must stop) or is back
+(:class:`RosterRestored`: its robots are announced again, as new robots). A direct profile is a
 :class:`DirectRoster` (its robots are added at once and never leave); a central
 server is watched by a roster that lives in ``client/central.py``.
 
@@ -47,9 +48,16 @@ class RosterLost:
     """The source of the roster itself is gone (e.g. the central server): all its robots are gone."""
 
     reason: str
+    retrying: bool = False
+    """The roster keeps trying to reach its source; :class:`RosterRestored` says when it has."""
 
 
-RosterEvent = RobotAdded | RobotRemoved | RosterLost
+@dataclass(frozen=True, slots=True)
+class RosterRestored:
+    """The source is back after a :class:`RosterLost`; its robots follow as :class:`RobotAdded`."""
+
+
+RosterEvent = RobotAdded | RobotRemoved | RosterLost | RosterRestored
 Emit = Callable[[RosterEvent], None]
 
 

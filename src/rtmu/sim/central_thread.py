@@ -120,6 +120,22 @@ class CentralThread(LoopThread):
         """The robot's server stops cleanly (its switched connection gets SHUTDOWN)."""
         self.run(self.sims.pop(name).stop())
 
+    def restart_central(self) -> None:
+        """A new central server on the dead one's two ports (after :meth:`kill_central`), as a
+        restarted process would be; the robots' switch retries find it on their own."""
+        old = self.central
+        assert old is not None
+
+        async def start() -> None:
+            config = CentralConfig(
+                host="127.0.0.1", port=old.port, robot_port=old.robot_port, users_path=self.users_path
+            )
+            central = CentralServer(config)
+            await central.start()
+            self.central = central
+
+        self.run(start())
+
     def kill_central(self) -> None:
         """The central server dies: every operator and robot socket reset at once."""
         assert self.central is not None
