@@ -285,6 +285,7 @@ def test_the_gamepad_pill_and_the_window_focus(phone: tuple[Gui, SimThread]) -> 
             handheld.pad.button(device, DEADMAN, True)
         handheld.pad.axis(device, AXIS_TRANS, -1.0)  # a real stick's noise keeps the pad talking
         idle(0.05)
+
     def pills_apart() -> bool:
         ok, pill = handheld.pad_status.compute_bounds(window)
         ok2, motion = window.motion.compute_bounds(window)
