@@ -20,6 +20,7 @@ bytes after the last field are ignored, as ARIA does, unless a type keeps them
 from __future__ import annotations
 
 import dataclasses
+import struct
 from enum import Enum
 from typing import Any, ClassVar, Self, TypeVar
 
@@ -213,6 +214,24 @@ def checked_count(count: int, item_size: int, reader: FieldReader, field: str) -
             f"{field} claims {count} items of at least {item_size} bytes, only {reader.remaining} bytes left"
         )
     return count
+
+
+XY = struct.Struct("<ii")
+"""One ``byte4`` x, ``byte4`` y pair in mm: how range readings and drawings carry their points."""
+
+
+def read_xy(reader: FieldReader, count: int, field: str) -> tuple[tuple[int, int], ...]:
+    """``count`` x/y pairs, the count refused (named ``field``) before anything is allocated."""
+    checked_count(count, XY.size, reader, field)
+    return tuple(XY.iter_unpack(reader.raw(count * XY.size, field)))
+
+
+def write_xy(writer: FieldWriter, points: tuple[tuple[int, int], ...], what: str) -> None:
+    """The pairs after their count; ``what`` names one in the error when a value does not fit."""
+    try:
+        writer.raw(b"".join(XY.pack(x, y) for x, y in points))
+    except struct.error as exc:
+        raise ValueError(f"a {what} does not fit in byte4 x/y: {exc}") from exc
 
 
 def read_strings_to_end(reader: FieldReader, field: str) -> tuple[str, ...]:

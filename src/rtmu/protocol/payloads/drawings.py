@@ -14,13 +14,12 @@ caller can say so and leave it undrawn; nothing fails on it.
 
 from __future__ import annotations
 
-import struct
 from dataclasses import dataclass
 from enum import StrEnum
 from typing import Final, Self
 
 from ..fields import FieldReader, FieldWriter
-from .base import Payload, Side, checked_count, register
+from .base import Payload, Side, checked_count, read_xy, register, write_xy
 
 MAX_POINTS: Final = 3998
 """Points one drawing packet can carry: (32 000-byte packet − 8 bytes framing − 4 count) / 8 a point."""
@@ -29,7 +28,6 @@ MAX_DRAWINGS: Final = 256
 MAX_NAME: Final = 255
 """Characters of a name or shape kept (ARIA's own string fields are at most 255)."""
 
-_XY = struct.Struct("<ii")
 Point = tuple[int, int]
 
 
@@ -191,17 +189,13 @@ class DrawingPoints:
 
     def encode(self) -> bytes:
         w = FieldWriter().byte4(len(self.points))
-        try:
-            w.raw(b"".join(_XY.pack(x, y) for x, y in self.points))
-        except struct.error as exc:
-            raise ValueError(f"a point does not fit in byte4 x/y: {exc}") from exc
+        write_xy(w, self.points, "point")
         return w.bytes()
 
     @classmethod
     def decode(cls, data: bytes) -> Self:
         r = FieldReader(data)
-        count = checked_count(r.byte4("point count"), _XY.size, r, "point count")
-        return cls(tuple(_XY.iter_unpack(r.raw(count * _XY.size, "points"))))
+        return cls(read_xy(r, r.byte4("point count"), "point count"))
 
     def to_fields(self) -> dict[str, object]:
         return {"points": [list(p) for p in self.points]}

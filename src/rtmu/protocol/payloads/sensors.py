@@ -6,31 +6,16 @@ not ranges: the server has already placed them in the world.
 
 from __future__ import annotations
 
-import struct
 from dataclasses import dataclass
 from typing import Final, Self
 
 from ..errors import PayloadError
 from ..fields import FieldReader, FieldWriter
-from .base import NameMatch, Payload, Side, checked_count, read_strings_to_end, register
+from .base import NameMatch, Payload, Side, checked_count, read_strings_to_end, read_xy, register, write_xy
 
 NO_SUCH_SENSOR: Final = -1
-_XY = struct.Struct("<ii")
 
 Reading = tuple[int, int]
-
-
-def _read_xy(reader: FieldReader, count: int, field: str) -> tuple[Reading, ...]:
-    checked_count(count, _XY.size, reader, field)
-    raw = reader.raw(count * _XY.size, field)
-    return tuple(_XY.iter_unpack(raw))
-
-
-def _write_xy(writer: FieldWriter, readings: tuple[Reading, ...]) -> None:
-    try:
-        writer.raw(b"".join(_XY.pack(x, y) for x, y in readings))
-    except struct.error as exc:
-        raise ValueError(f"a reading does not fit in byte4 x/y: {exc}") from exc
 
 
 @register
@@ -110,7 +95,7 @@ class SensorReadings(Payload):
                 raise ValueError("a missing sensor has no readings")
             return FieldWriter().byte2(NO_SUCH_SENSOR).string(self.name).bytes()
         w = FieldWriter().byte2(len(self.readings)).string(self.name)
-        _write_xy(w, self.readings)
+        write_xy(w, self.readings, "reading")
         return w.bytes()
 
     @classmethod
@@ -122,7 +107,7 @@ class SensorReadings(Payload):
             return cls(name, (), exists=False)
         if count < 0:
             raise PayloadError(f"reading count is negative ({count})")
-        return cls(name, _read_xy(r, count, "readings"))
+        return cls(name, read_xy(r, count, "readings"))
 
 
 @register
@@ -146,13 +131,13 @@ class RangeDeviceReadings(Payload):
 
     def encode(self) -> bytes:
         w = FieldWriter().byte4(len(self.readings))
-        _write_xy(w, self.readings)
+        write_xy(w, self.readings, "reading")
         return w.bytes()
 
     @classmethod
     def decode(cls, data: bytes) -> Self:
         r = FieldReader(data)
-        return cls(_read_xy(r, r.byte4("reading count"), "readings"))
+        return cls(read_xy(r, r.byte4("reading count"), "readings"))
 
 
 @register
