@@ -36,6 +36,11 @@ POINT_PX = 2.0
 MARGIN_PX = 60.0
 
 
+def _rgb(color: int) -> tuple[float, float, float]:
+    """0xRRGGBB as cairo's 0…1 floats."""
+    return ((color >> 16) & 0xFF) / 255.0, ((color >> 8) & 0xFF) / 255.0, (color & 0xFF) / 255.0
+
+
 def _clamp(value: float, bounds: tuple[float, float]) -> float:
     return min(max(value, bounds[0]), bounds[1])
 
@@ -63,7 +68,7 @@ def draw_layer(
     c = layer.color
     ctx.save()
     ctx.new_path()
-    ctx.set_source_rgb(((c >> 16) & 0xFF) / 255.0, ((c >> 8) & 0xFF) / 255.0, (c & 0xFF) / 255.0)
+    ctx.set_source_rgb(*_rgb(c))
     screen = [vp.to_screen(x, y) for x, y in layer.points]
     shape = layer.shape
     if shape == "polyDots":
@@ -105,9 +110,7 @@ def _stamp(color: int, radius: float) -> cairo.ImageSurface:
         side = 2 * math.ceil(radius) + 1  # odd: the dot's centre is the middle of one pixel
         stamp = cairo.ImageSurface(cairo.FORMAT_ARGB32, side, side)
         sc = cairo.Context(stamp)
-        sc.set_source_rgb(
-            ((color >> 16) & 0xFF) / 255.0, ((color >> 8) & 0xFF) / 255.0, (color & 0xFF) / 255.0
-        )
+        sc.set_source_rgb(*_rgb(color))
         sc.arc(side / 2, side / 2, radius, 0, 2 * math.pi)
         sc.fill()
         _STAMPS[key] = stamp
