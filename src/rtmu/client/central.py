@@ -184,12 +184,11 @@ class CentralRoster:
 
     async def _serve_once(self) -> tuple[str, bool]:
         """One login: the list, then broadcasts until the link ends. (why it ended, worth retrying)."""
-        ended = asyncio.Event()
-        why: list[ClientError] = []
+        closed: asyncio.Future[ClientError] = asyncio.get_running_loop().create_future()
 
         def on_close(error: ClientError) -> None:
-            why.append(error)
-            ended.set()
+            if not closed.done():
+                closed.set_result(error)
 
         self.attempts += 1
         client = AriaClient(on_close=on_close)
@@ -205,14 +204,10 @@ class CentralRoster:
             reply = await client.request_once(ClientList.DATA_NAME, timeout=self.timeout)
             for entry in ClientList.decode(reply.payload).entries:
                 self._add(entry)
-            await ended.wait()
-            if not why:
-                return "the central server's connection ended", True
-            return str(why[0]), worth_retrying(why[0])
+            error = await closed
+            return str(error), worth_retrying(error)
         except ClientError as exc:
             return str(exc) or type(exc).__name__, worth_retrying(exc)
-        except asyncio.CancelledError:
-            raise
         except Exception as exc:  # a ProtocolError in the list: the same server will send it again
             return str(exc) or type(exc).__name__, False
         finally:
