@@ -18,7 +18,7 @@ from pathlib import Path
 
 from bench.common import Result, best_time
 from rtmu.capture import open_capture
-from rtmu.session_decoder import CaptureDecoder
+from rtmu.capture.session_decoder import CaptureDecoder
 
 CAPTURE = Path(__file__).resolve().parents[1].parent / "shared" / "captures" / "map-binary-columbia.pcap"
 

@@ -43,7 +43,7 @@ import cairo
 import numpy as np
 
 from bench.common import Result, start_xvfb
-from rtmu.maps import write_map
+from rtmu.mapfile import write_map
 from rtmu.sim.mapgen import generate_map
 from rtmu.ui import overlays
 from rtmu.ui.frame import Scene, draw_frame

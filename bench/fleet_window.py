@@ -29,7 +29,7 @@ import gi
 gi.require_version("Gtk", "4.0")
 from gi.repository import GLib  # noqa: E402
 
-from rtmu.settings import DirectRobot  # noqa: E402
+from rtmu.settings.store import DirectRobot  # noqa: E402
 from rtmu.ui.application import RtmuApplication  # noqa: E402
 from rtmu.ui.options import GuiOptions  # noqa: E402
 

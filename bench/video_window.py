@@ -29,7 +29,7 @@ import gi
 gi.require_version("Gtk", "4.0")
 from gi.repository import GLib  # noqa: E402
 
-from rtmu.model import Phase  # noqa: E402
+from rtmu.model.observables import Phase  # noqa: E402
 from rtmu.ui.application import RtmuApplication  # noqa: E402
 from rtmu.ui.options import GuiOptions  # noqa: E402
 

@@ -5,7 +5,7 @@ from __future__ import annotations
 
 import pytest
 
-from rtmu.commands import COMMANDS, Command, CommandRegistry, CommandTarget, action_name
+from rtmu.control.commands import COMMANDS, Command, CommandRegistry, CommandTarget, action_name
 
 
 def test_names_keys_and_actions_are_unique() -> None:

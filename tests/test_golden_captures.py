@@ -21,10 +21,10 @@ from pathlib import Path
 import pytest
 
 from rtmu.capture import CaptureSource, open_capture
+from rtmu.capture.session_decoder import CaptureDecoder, DecodedPacket, DropReport, side_of
 from rtmu.protocol.fields import FieldReader
 from rtmu.protocol.payloads import control
 from rtmu.protocol.payloads.base import Side, payload_type_for
-from rtmu.session_decoder import CaptureDecoder, DecodedPacket, DropReport, side_of
 
 SHARED = Path(__file__).resolve().parents[1].parent / "shared"
 CAPTURES = SHARED / "captures"

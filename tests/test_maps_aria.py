@@ -7,7 +7,7 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-from rtmu.maps import (
+from rtmu.mapfile import (
     MapData,
     from_stream,
     map_bytes,

@@ -13,9 +13,9 @@ from pathlib import Path
 
 import pytest
 
+from rtmu.base.exit_codes import EXIT_OK
 from rtmu.cli import main
-from rtmu.exit_codes import EXIT_OK
-from rtmu.maps import read_map, write_map
+from rtmu.mapfile import read_map, write_map
 from rtmu.sim import SimConfig, SimThread
 
 SHARED_MAPS = Path("/work/shared/aria-maps")

@@ -7,7 +7,7 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-from rtmu.maps import MapData, MapObject, map_bytes, parse_map, read_map
+from rtmu.mapfile import MapData, MapObject, map_bytes, parse_map, read_map
 from rtmu.sim.project_maps import PROJECT_MAPS
 
 MAPS_DIR = Path(__file__).resolve().parents[1] / "data" / "maps"

@@ -17,7 +17,7 @@ import sys
 from collections.abc import Sequence
 
 from . import __version__, subcommands
-from .exit_codes import EXIT_USAGE
+from .base.exit_codes import EXIT_USAGE
 
 
 def build_parser() -> argparse.ArgumentParser:

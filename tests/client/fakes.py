@@ -9,10 +9,10 @@ from __future__ import annotations
 
 from collections.abc import Callable, Mapping
 
+from rtmu.base.notices import Kind, Level, Notice
 from rtmu.client.lease import DriveLease
-from rtmu.commands import CommandState
-from rtmu.notices import Kind, Level, Notice
-from rtmu.settings import Profile
+from rtmu.control.commands import CommandState
+from rtmu.settings.store import Profile
 
 
 class FakeView:

@@ -14,11 +14,11 @@ from pathlib import Path
 
 import pytest
 
+from rtmu.base.exit_codes import EXIT_CONNECTION, EXIT_OK
 from rtmu.cli import main
 from rtmu.client.connection import AriaClient
 from rtmu.client.diagnosis import Step, explain
 from rtmu.client.errors import LoginRejected
-from rtmu.exit_codes import EXIT_CONNECTION, EXIT_OK
 from rtmu.protocol.payloads.robot import BatteryInfo
 from rtmu.sim import SimConfig, SimThread
 from rtmu.sim.profiles import ARAM_PROTOCOL, LD_CATALOGUE_SIZE

@@ -16,11 +16,11 @@ from pathlib import Path
 
 import pytest
 
-from rtmu import maps
+from rtmu import mapfile as maps
+from rtmu.base.exit_codes import EXIT_CONNECTION, EXIT_OK, EXIT_USAGE
 from rtmu.cli import main
 from rtmu.client.central import CentralRoster
 from rtmu.client.roster import RobotAdded, RobotRemoved, RosterEvent, RosterLost, RosterRestored
-from rtmu.exit_codes import EXIT_CONNECTION, EXIT_OK, EXIT_USAGE
 from rtmu.sim import SimConfig, SimServer
 from rtmu.sim.central_thread import CentralThread
 

@@ -12,10 +12,10 @@ from collections.abc import Iterator
 
 import pytest
 
+from rtmu.base.exit_codes import EXIT_CONNECTION, EXIT_OK
 from rtmu.cli import main
 from rtmu.client.central import MAX_NAME, CentralRoster
 from rtmu.client.roster import RobotAdded, RosterEvent, RosterLost
-from rtmu.exit_codes import EXIT_CONNECTION, EXIT_OK
 from rtmu.protocol.fields import FieldWriter
 from rtmu.protocol.payloads.central import CentralEntry, ClientAdded, ClientList
 from rtmu.sim.central import OPERATOR_DATA

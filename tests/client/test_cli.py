@@ -12,9 +12,9 @@ from pathlib import Path
 
 import pytest
 
-from rtmu import maps
+from rtmu import mapfile as maps
+from rtmu.base.exit_codes import EXIT_CONNECTION, EXIT_OK, EXIT_TIMEOUT, EXIT_UNSUPPORTED, EXIT_USAGE
 from rtmu.cli import main
-from rtmu.exit_codes import EXIT_CONNECTION, EXIT_OK, EXIT_TIMEOUT, EXIT_UNSUPPORTED, EXIT_USAGE
 from rtmu.sim import SimConfig, SimThread
 from rtmu.subcommands._common import host_port
 

@@ -9,13 +9,13 @@ from pathlib import Path
 
 import pytest
 
+from rtmu.base.exit_codes import EXIT_OK, EXIT_UNSUPPORTED, EXIT_USAGE
 from rtmu.cli import main
 from rtmu.client.config_feed import MAX_TEXT, ServerConfig, check_value, fetch_config
 from rtmu.client.connection import AriaClient
 from rtmu.client.errors import MalformedReply
 from rtmu.client.runner import ClientRunner
-from rtmu.exit_codes import EXIT_OK, EXIT_UNSUPPORTED, EXIT_USAGE
-from rtmu.model import RobotModel
+from rtmu.model.observables import RobotModel
 from rtmu.protocol.payloads.config import ConfigParam, ConfigSectionPacket, ParamType
 from rtmu.sim import SimConfig, SimThread
 from rtmu.subcommands.config import EXIT_REFUSED

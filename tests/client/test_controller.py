@@ -6,12 +6,20 @@ import threading
 
 import pytest
 
+from rtmu.base.notices import Kind, Level, Notice
 from rtmu.client.lease import DriveRatios, EndReason
-from rtmu.commands import Command, CommandRegistry, CommandTarget
-from rtmu.controller import Controller, ratios_for
-from rtmu.model import ConnectionState, LinkHealth, LinkLevel, OperatorState, Phase, RobotModel, SpeedSetting
-from rtmu.notices import Kind, Level, Notice
-from rtmu.settings import Profile
+from rtmu.control.commands import Command, CommandRegistry, CommandTarget
+from rtmu.control.controller import Controller, ratios_for
+from rtmu.model.observables import (
+    ConnectionState,
+    LinkHealth,
+    LinkLevel,
+    OperatorState,
+    Phase,
+    RobotModel,
+    SpeedSetting,
+)
+from rtmu.settings.store import Profile
 
 from .fakeclock import FakeClock
 from .fakes import FakeView, RecordingLink

@@ -8,8 +8,8 @@ from pathlib import Path
 
 import pytest
 
+from rtmu.base.exit_codes import EXIT_OK, EXIT_UNSUPPORTED
 from rtmu.cli import main
-from rtmu.exit_codes import EXIT_OK, EXIT_UNSUPPORTED
 from rtmu.sim import SimConfig, SimThread
 
 from .drawing_servers import MARKUP, MAX_POINTS_SENT, hostile_drawing_server

@@ -14,7 +14,7 @@ from pathlib import Path
 import pytest
 
 from rtmu.client.runner import ClientRunner
-from rtmu.model import Phase, RobotModel
+from rtmu.model.observables import Phase, RobotModel
 from rtmu.sim import SimConfig, SimThread
 
 from .drawing_servers import BOLD_POINTS, MARKUP, MAX_POINTS_SENT, SONAR_POINTS, hostile_drawing_server

@@ -16,7 +16,7 @@ from pathlib import Path
 import pytest
 
 from linkfaults import FAKE_HEADER, GARBAGE, TO_CLIENT, TO_SERVER, FaultProxy
-from rtmu.exit_codes import EXIT_TIMEOUT
+from rtmu.base.exit_codes import EXIT_TIMEOUT
 from rtmu.protocol.decoder import PacketDecoder
 from rtmu.protocol.packet import encode_packet
 from rtmu.sim import SimConfig, SimThread

@@ -12,9 +12,9 @@ from contextlib import ExitStack, contextmanager
 from pathlib import Path
 
 from rtmu.client.session import SessionConfig
-from rtmu.fleet import Fleet, RobotSession
-from rtmu.model import Phase
-from rtmu.settings import Profile
+from rtmu.fleet.sessions import Fleet, RobotSession
+from rtmu.model.observables import Phase
+from rtmu.settings.store import Profile
 from rtmu.sim import SimConfig, SimThread
 
 from .fakes import FakeView

@@ -24,9 +24,9 @@ from rtmu.client.roster import (
     RosterRestored,
 )
 from rtmu.client.session import SessionConfig
-from rtmu.fleet import Fleet, RobotSession, robot_profile
-from rtmu.model import Phase
-from rtmu.settings import Profile
+from rtmu.fleet.sessions import Fleet, RobotSession, robot_profile
+from rtmu.model.observables import Phase
+from rtmu.settings.store import Profile
 from rtmu.sim import SimConfig, SimThread
 from rtmu.sim.multi import SimFleetThreads, fleet_configs
 

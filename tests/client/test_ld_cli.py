@@ -9,10 +9,10 @@ from pathlib import Path
 
 import pytest
 
+from rtmu.base.exit_codes import EXIT_OK, EXIT_UNSUPPORTED, EXIT_USAGE
 from rtmu.cli import main
 from rtmu.client import ld_data
 from rtmu.client.connection import AriaClient
-from rtmu.exit_codes import EXIT_OK, EXIT_UNSUPPORTED, EXIT_USAGE
 from rtmu.sim import SimConfig, SimThread
 from rtmu.sim.ld_data import ROUTES, ld_state
 

@@ -7,7 +7,7 @@ from pathlib import Path
 
 from rtmu.client.runner import ClientRunner
 from rtmu.client.session import SessionConfig
-from rtmu.model import Phase, RobotModel
+from rtmu.model.observables import Phase, RobotModel
 from rtmu.sim import SimConfig, SimThread
 from rtmu.sim.ld_data import ROUTES
 

@@ -10,7 +10,7 @@ import pytest
 
 from rtmu.client.runner import ClientRunner
 from rtmu.client.session import SessionConfig
-from rtmu.model import CameraImage, Phase, RobotModel
+from rtmu.model.observables import CameraImage, Phase, RobotModel
 from rtmu.sim import SimConfig, SimThread
 
 from .uiqueue import UiQueue

@@ -6,11 +6,11 @@ from pathlib import Path
 
 import pytest
 
+from rtmu.base.exit_codes import EXIT_CONNECTION
 from rtmu.cli import main
 from rtmu.client.runner import ClientRunner
 from rtmu.client.session import SessionConfig
-from rtmu.exit_codes import EXIT_CONNECTION
-from rtmu.model import Phase, RobotModel
+from rtmu.model.observables import Phase, RobotModel
 
 from .servers import MAP_LINES, ServerThread, TestServer
 from .uiqueue import UiQueue

@@ -15,9 +15,9 @@ import pytest
 
 from rtmu.client.lease import DriveLease
 from rtmu.client.session import Session, SessionConfig
-from rtmu.model import LinkHealth, LinkLevel
+from rtmu.model.observables import LinkHealth, LinkLevel
 from rtmu.protocol.payloads.mapstream import DEFAULT_MAX_POINTS, DEFAULT_MAX_TEXT_LINES
-from rtmu.state import HealthChanged, StateChange
+from rtmu.values.state import HealthChanged, StateChange
 
 from .endless_maps import endless_map_server, run_watching_peak
 from .servers import ServerThread, TestServer, run

@@ -16,8 +16,8 @@ from collections.abc import Iterator
 
 import pytest
 
+from rtmu.base.exit_codes import EXIT_OK, EXIT_TIMEOUT, EXIT_UNSUPPORTED, EXIT_USAGE
 from rtmu.cli import main
-from rtmu.exit_codes import EXIT_OK, EXIT_TIMEOUT, EXIT_UNSUPPORTED, EXIT_USAGE
 from rtmu.protocol.payloads.robot import ModeInfo
 from rtmu.sim import SimConfig, SimThread
 from rtmu.sim.ld_data import ld_state

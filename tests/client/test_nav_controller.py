@@ -7,10 +7,10 @@ held drive first. End-to-end against the simulator: test_navigation_client.py.
 
 from __future__ import annotations
 
+from rtmu.base.notices import Kind
 from rtmu.client.lease import EndReason
-from rtmu.commands import COMMANDS
-from rtmu.model import NavState
-from rtmu.notices import Kind
+from rtmu.control.commands import COMMANDS
+from rtmu.model.observables import NavState
 
 from .test_controller import ALL, Rig
 
@@ -84,7 +84,7 @@ def test_focus_loss_does_not_stop_a_navigation_but_ends_a_held_drive() -> None:
 
 
 def test_a_stale_link_does_not_stop_a_navigation() -> None:
-    from rtmu.model import LinkHealth, LinkLevel
+    from rtmu.model.observables import LinkHealth, LinkLevel
 
     rig = Rig(NAV)
     navigating(rig)

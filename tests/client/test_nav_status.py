@@ -6,13 +6,13 @@ from dataclasses import replace
 
 import pytest
 
+from rtmu.base.notices import Kind, Level, Notice
 from rtmu.client.connection import Packet
 from rtmu.client.nav_session import NavFeed
 from rtmu.client.nav_status import MAX_TEXT, NavPhase, path_remaining, read_status
-from rtmu.notices import Kind, Level, Notice
 from rtmu.protocol.payloads import Side, decode_payload
 from rtmu.protocol.payloads.navigation import LocState, PlannedPath
-from rtmu.state import NavChanged, NavOutcome, RobotState
+from rtmu.values.state import NavChanged, NavOutcome, RobotState
 
 
 @pytest.mark.parametrize(

@@ -15,13 +15,13 @@ from pathlib import Path
 
 import pytest
 
+from rtmu.base.notices import Kind
 from rtmu.client.errors import NotSupported
 from rtmu.client.runner import ClientRunner
 from rtmu.client.session import SessionConfig
-from rtmu.controller import Controller
-from rtmu.maps import MapObject, write_map
-from rtmu.model import NavOutcome, OperatorState, Phase, RobotModel
-from rtmu.notices import Kind
+from rtmu.control.controller import Controller
+from rtmu.mapfile import MapObject, write_map
+from rtmu.model.observables import NavOutcome, OperatorState, Phase, RobotModel
 from rtmu.protocol.payloads.drive import RatioDrive
 from rtmu.protocol.payloads.robot import ModeInfo
 from rtmu.sim import SimThread

@@ -17,14 +17,14 @@ from typing import Any
 
 import pytest
 
+from rtmu.base.notices import Kind, Notice
 from rtmu.client.custom_commands import MAX_ARGUMENT, ServerCommand, list_commands
 from rtmu.client.popups import MAX_MESSAGE, MAX_OPEN
 from rtmu.client.runner import ClientRunner
-from rtmu.model import Phase, RobotModel
-from rtmu.notices import Kind, Notice
+from rtmu.model.observables import Phase, RobotModel
 from rtmu.protocol.payloads.commands import CommandEntry, CommandList
 from rtmu.sim import SimConfig, SimThread
-from rtmu.state import PopupsChanged, StateChange
+from rtmu.values.state import PopupsChanged, StateChange
 
 from .uiqueue import UiQueue, eventually
 

@@ -17,11 +17,11 @@ from typing import Any
 
 import pytest
 
+from rtmu.base.exit_codes import EXIT_OK, EXIT_UNSUPPORTED, EXIT_USAGE
 from rtmu.cli import main
 from rtmu.client.ptz import MAX_NAME, NO_HEAD, NO_LIST, POLL_MS
 from rtmu.client.runner import ClientRunner
-from rtmu.exit_codes import EXIT_OK, EXIT_UNSUPPORTED, EXIT_USAGE
-from rtmu.model import Phase, RobotModel
+from rtmu.model.observables import Phase, RobotModel
 from rtmu.protocol.fields import FieldWriter
 from rtmu.protocol.payloads.camera import Camera, CameraCommand, CameraData, CameraInfo, CameraList
 from rtmu.sim import SimConfig, SimThread

@@ -21,7 +21,7 @@ from rtmu.client.link import Chunk, Link, RecordingLink, ReplayLink, open_tcp
 from rtmu.client.session import Session, SessionConfig
 from rtmu.protocol.payloads.drive import RatioDrive
 from rtmu.sim import SimConfig, SimThread
-from rtmu.state import MapChanged, MapModel, MapPhase, RobotChanged, RobotState, StateChange
+from rtmu.values.state import MapChanged, MapModel, MapPhase, RobotChanged, RobotState, StateChange
 
 from .servers import run
 

@@ -11,7 +11,7 @@ from rtmu.client.lease import DriveRatios
 from rtmu.client.reconnect import Backoff
 from rtmu.client.runner import ClientRunner
 from rtmu.client.session import SessionConfig
-from rtmu.model import LinkLevel, Phase, RobotModel
+from rtmu.model.observables import LinkLevel, Phase, RobotModel
 from rtmu.protocol.payloads.drive import RatioDrive
 
 from .fakeclock import FakeClock

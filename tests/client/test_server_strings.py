@@ -17,7 +17,7 @@ import pytest
 
 from rtmu.client.runner import ClientRunner
 from rtmu.client.server_strings import INTERVAL_MS, MAX_ITEMS, MAX_TEXT
-from rtmu.model import Phase, RobotModel
+from rtmu.model.observables import Phase, RobotModel
 from rtmu.protocol.payloads.strings import StringItem, Strings, StringsInfo
 from rtmu.sim import SimConfig, SimThread
 from rtmu.sim.handlers import STRING_ITEMS

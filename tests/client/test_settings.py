@@ -8,7 +8,7 @@ from pathlib import Path
 
 import pytest
 
-from rtmu.settings import (
+from rtmu.settings.store import (
     KeyringSecrets,
     Profile,
     Settings,

@@ -14,8 +14,8 @@ from rtmu.client.lease import DriveRatios
 from rtmu.client.reconnect import Backoff
 from rtmu.client.runner import ClientRunner
 from rtmu.client.session import SessionConfig
-from rtmu.controller import Controller
-from rtmu.model import LinkLevel, OperatorState, Phase, RobotModel
+from rtmu.control.controller import Controller
+from rtmu.model.observables import LinkLevel, OperatorState, Phase, RobotModel
 from rtmu.sim import SimConfig, SimThread
 
 from .fakeclock import FakeClock

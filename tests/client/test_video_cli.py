@@ -11,8 +11,8 @@ from pathlib import Path
 import pytest
 from PIL import Image
 
+from rtmu.base.exit_codes import EXIT_CONNECTION, EXIT_OK
 from rtmu.cli import main
-from rtmu.exit_codes import EXIT_CONNECTION, EXIT_OK
 from rtmu.sim import SimConfig, SimThread
 
 from .servers import ServerSide, ServerThread, TestServer

@@ -9,9 +9,9 @@ import pytest
 from PIL import Image
 
 from rtmu.capture import open_capture
+from rtmu.capture.session_decoder import CaptureDecoder, DecodedPacket
 from rtmu.client.video_feed import BadFrame, FrameStats, RateGovernor, check_frame, frame_stamp, parse_frame
 from rtmu.protocol.payloads.camera import VideoFrame
-from rtmu.session_decoder import CaptureDecoder, DecodedPacket
 from rtmu.sim.camera import stamp_jpeg
 
 CAPTURE = Path(__file__).resolve().parents[3] / "shared" / "captures" / "getVideoExample-serverDemo.pcap"

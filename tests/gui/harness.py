@@ -26,7 +26,7 @@ gi.require_version("Graphene", "1.0")
 from gi.repository import Gdk, GdkX11, GLib, Graphene, Gtk  # noqa: E402
 from PIL import Image  # noqa: E402
 
-from rtmu.model import OperatorState, Phase, RobotModel  # noqa: E402
+from rtmu.model.observables import OperatorState, Phase, RobotModel  # noqa: E402
 from rtmu.ui.application import RtmuApplication  # noqa: E402
 from rtmu.ui.options import GuiOptions  # noqa: E402
 from rtmu.ui.window import MainWindow  # noqa: E402

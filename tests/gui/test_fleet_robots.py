@@ -24,8 +24,8 @@ import numpy as np
 import pytest
 
 from rtmu.client.roster import Emit, RobotAdded, RobotEndpoint
-from rtmu.fleet import RobotSession
-from rtmu.settings import DirectRobot
+from rtmu.fleet.sessions import RobotSession
+from rtmu.settings.store import DirectRobot
 from rtmu.sim import SimConfig, SimThread
 from rtmu.sim.multi import SimFleetThreads, fleet_configs
 from rtmu.ui.application import RtmuApplication

@@ -18,9 +18,9 @@ from pathlib import Path
 import gi
 import pytest
 
-from rtmu.alarms import Alarm
 from rtmu.client.custom_commands import ServerCommand
-from rtmu.gamepad import AXIS_TRANS, DEADMAN, DeadMan
+from rtmu.control.alarms import Alarm
+from rtmu.control.gamepad import AXIS_TRANS, DEADMAN, DeadMan
 from rtmu.sim import SimConfig, SimThread
 from rtmu.sim.wifi import AccessPoint
 from rtmu.ui.alarm_view import AlarmView

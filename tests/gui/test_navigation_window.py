@@ -16,7 +16,7 @@ import gi
 import numpy as np
 import pytest
 
-from rtmu.model import Phase
+from rtmu.model.observables import Phase
 from rtmu.sim import SimConfig, SimThread
 from rtmu.ui.nav_draw import PATH_RGB, MarkerKind
 
@@ -383,8 +383,8 @@ def test_goals_popover_pick_bar_and_indicator_fit_an_800x480_screen(
 
 def test_what_the_server_does_not_list_stays_visible_greyed_with_its_reason() -> None:
     """The panel alone, on a model whose server lists goals and points but neither dock nor localize."""
-    from rtmu.commands import CommandState
-    from rtmu.model import ConnectionState, NavState, RobotModel
+    from rtmu.control.commands import CommandState
+    from rtmu.model.observables import ConnectionState, NavState, RobotModel
     from rtmu.ui.goals_panel import GoalsPanel
 
     model = RobotModel()

@@ -11,7 +11,7 @@ from collections.abc import Iterator
 
 import pytest
 
-from rtmu.commands import COMMANDS
+from rtmu.control.commands import COMMANDS
 from rtmu.sim import SimConfig, SimThread
 from rtmu.ui.palette import CommandPalette
 

@@ -7,8 +7,8 @@ import xml.etree.ElementTree as ET
 import gi
 import pytest
 
-from rtmu.commands import COMMANDS
-from rtmu.model import ConnectionState, LinkHealth, LinkLevel, OperatorState, Phase, RobotModel
+from rtmu.control.commands import COMMANDS
+from rtmu.model.observables import ConnectionState, LinkHealth, LinkLevel, OperatorState, Phase, RobotModel
 from rtmu.ui.gauges import battery_fraction, wifi_bars
 from rtmu.ui.keys import KeyRouter, bindings
 from rtmu.ui.settings_dialog import validate
@@ -89,7 +89,7 @@ def test_shortcuts_xml_escapes_and_lists_every_binding() -> None:
 
 
 def test_the_map_note_follows_the_connection_phase_then_the_map() -> None:
-    from rtmu.model import ConnectionState, MapModel, Phase
+    from rtmu.model.observables import ConnectionState, MapModel, Phase
     from rtmu.ui.notes import map_note
 
     here = dict(host="127.0.0.1", port=7272)

@@ -15,6 +15,7 @@ from pathlib import Path
 import pytest
 
 from rtmu.capture import open_capture
+from rtmu.capture.session_decoder import CaptureDecoder, DecodedPacket
 from rtmu.protocol.errors import FieldUnderrun, PayloadError
 from rtmu.protocol.payloads import Side, payload_type_for
 from rtmu.protocol.payloads.drawings import (
@@ -28,7 +29,6 @@ from rtmu.protocol.payloads.drawings import (
     Visibility,
 )
 from rtmu.protocol.payloads.sensors import Drawing as SensorsDrawing
-from rtmu.session_decoder import CaptureDecoder, DecodedPacket
 
 CAPTURES = Path(__file__).resolve().parents[2].parent / "shared" / "captures"
 ARIA_DRAWING_REPLY = (

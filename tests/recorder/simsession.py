@@ -10,11 +10,11 @@ from pathlib import Path
 from client.fakes import FakeView
 from client.uiqueue import UiQueue
 from rtmu.client.session import SessionConfig
-from rtmu.fleet import Fleet, RobotSession
-from rtmu.model import Phase
-from rtmu.settings import Profile, RecordingSettings
+from rtmu.fleet.sessions import Fleet, RobotSession
+from rtmu.model.observables import Phase
+from rtmu.settings.store import Profile, RecordingSettings
 from rtmu.sim import SimConfig, SimThread
-from rtmu.state import StateChange
+from rtmu.values.state import StateChange
 
 REPO = Path(__file__).resolve().parents[2]
 ARENA = REPO / "data" / "maps" / "arena.map"

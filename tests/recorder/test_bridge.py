@@ -21,7 +21,15 @@ from rtmu.client.session import SessionConfig
 from rtmu.recorder import topics
 from rtmu.recorder.bridge import LEASE_TTL, QUEUE_SIZE, Bridge, DriveLimits, TwistDrive, twist_ratios
 from rtmu.sim import SimConfig, SimThread
-from rtmu.state import ConnectionChanged, MapChanged, MapPhase, Phase, RobotChanged, RobotState, StateChange
+from rtmu.values.state import (
+    ConnectionChanged,
+    MapChanged,
+    MapPhase,
+    Phase,
+    RobotChanged,
+    RobotState,
+    StateChange,
+)
 
 from .foxglove_client import FoxgloveClient, twist
 from .poses import _position

@@ -19,9 +19,9 @@ from pathlib import Path
 import pytest
 from mcap.exceptions import McapError
 
+from rtmu.base.notices import Kind
 from rtmu.capture.recorded import RAW_TOPICS
-from rtmu.model import Phase
-from rtmu.notices import Kind
+from rtmu.model.observables import Phase
 from rtmu.recorder import Limits, topics
 from rtmu.sim import SimConfig, SimThread
 

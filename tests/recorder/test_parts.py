@@ -9,18 +9,18 @@ from pathlib import Path
 
 import pytest
 
+from rtmu.base.notices import Kind
 from rtmu.capture import CaptureError, open_capture
 from rtmu.client.lease import DriveLease, DriveRatios, EndReason, LeaseEvent
-from rtmu.fleet import recorder_for
-from rtmu.notices import Kind
+from rtmu.fleet.sessions import recorder_for
 from rtmu.recorder import Limits, Recorder, RecorderConfig, Recording, topics
 from rtmu.recorder.convert import Converter, other_topic, status_record
 from rtmu.recorder.files import file_name, prune, recordings_dir
 from rtmu.recorder.intents import IntentTap
 from rtmu.recorder.items import Event
 from rtmu.recorder.mcapfile import McapFile
-from rtmu.settings import RecordingSettings, SettingsError, format_settings, parse_settings
-from rtmu.state import ConnectionChanged, ConnectionState, Phase, RobotChanged, RobotState
+from rtmu.settings.store import RecordingSettings, SettingsError, format_settings, parse_settings
+from rtmu.values.state import ConnectionChanged, ConnectionState, Phase, RobotChanged, RobotState
 
 from .mcapread import read
 
@@ -225,7 +225,7 @@ def test_every_part_the_session_publishes_has_a_topic_of_its_own() -> None:
     """Parts without a Foxglove schema (navigation, popups, parts added later) each get a JSON topic."""
     import typing
 
-    from rtmu import state
+    from rtmu.values import state
 
     own = {
         state.RobotChanged,

@@ -15,11 +15,11 @@ from typing import Any
 from client.uiqueue import eventually
 from rtmu.capture import Endpoint, Flow, StreamData, StreamEnd, open_capture
 from rtmu.capture.recorded import RAW_TOPICS
+from rtmu.capture.session_decoder import CaptureDecoder, DecodedPacket
 from rtmu.client.link import Link, open_tcp
 from rtmu.client.runner import ClientRunner
 from rtmu.client.session import SessionConfig
 from rtmu.recorder import Recorder, RecorderConfig
-from rtmu.session_decoder import CaptureDecoder, DecodedPacket
 from rtmu.sim import SimConfig, SimThread
 
 from .mcapread import read

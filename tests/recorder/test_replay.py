@@ -20,7 +20,7 @@ from rtmu.recorder import Recorder, RecorderConfig
 from rtmu.recorder.replay import PacedLink, ReplayClock, Replayer
 from rtmu.recorder.replay_file import ReplayFileError, compressed_image_data, load
 from rtmu.sim import SimConfig, SimThread
-from rtmu.state import CameraChanged, MapChanged, MapPhase, RobotChanged, StateChange
+from rtmu.values.state import CameraChanged, MapChanged, MapPhase, RobotChanged, StateChange
 
 from .poses import poses, recorded_pose_at
 from .simsession import hold, recorded_session

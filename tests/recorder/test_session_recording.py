@@ -12,7 +12,7 @@ from pathlib import Path
 
 from rtmu.capture.recorded import CONNECTION_TOPIC, RAW_TOPICS
 from rtmu.recorder import topics
-from rtmu.state import CameraChanged, MapPhase, RobotChanged, StateChange
+from rtmu.values.state import CameraChanged, MapPhase, RobotChanged, StateChange
 
 from .mcapread import read, summary_counts
 from .simsession import hold, recorded_session

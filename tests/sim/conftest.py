@@ -21,7 +21,7 @@ def arena_map() -> Path:
 @pytest.fixture(scope="session")
 def million_point_map(tmp_path_factory) -> Path:
     """A generated 1 M-point building map: its binary stream (8 MB) is larger than a client may queue."""
-    from rtmu.maps import write_map
+    from rtmu.mapfile import write_map
     from rtmu.sim.mapgen import generate_map
 
     path = tmp_path_factory.mktemp("maps") / "million.map"

@@ -10,7 +10,7 @@ import subprocess
 import sys
 from pathlib import Path
 
-from rtmu.maps import read_map
+from rtmu.mapfile import read_map
 from rtmu.protocol.payloads.commands import CommandList, StringCommandArgs, StringCommandList
 from rtmu.protocol.payloads.popup import PopupClicked, PopupClose, PopupCreate
 from rtmu.protocol.payloads.robot import UpdateNumbers

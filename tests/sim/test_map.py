@@ -7,7 +7,7 @@ import hashlib
 import numpy as np
 import pytest
 
-from rtmu.maps import read_map
+from rtmu.mapfile import read_map
 from rtmu.protocol.payloads.map import Goals, MapId, MapName, MapPacketKind, binary_block_kind
 from rtmu.protocol.payloads.mapstream import MapBinaryAssembler, MapTextAssembler
 from rtmu.sim import SimConfig, SimServer

@@ -11,7 +11,7 @@ import shutil
 import struct
 from pathlib import Path
 
-from rtmu.maps import MapObject, write_map
+from rtmu.mapfile import MapObject, write_map
 from rtmu.protocol.payloads.commands import CommandList
 from rtmu.protocol.payloads.drive import RatioDrive
 from rtmu.protocol.payloads.ld import DataStoreValue

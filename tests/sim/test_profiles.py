@@ -115,7 +115,7 @@ def test_deprecated_update_also_reports_state_of_charge(aram: SimThread) -> None
 
 
 def test_robot_state_battery_pct_follows_the_flag() -> None:
-    from rtmu.model import RobotState
+    from rtmu.model.observables import RobotState
 
     assert RobotState(battery_v=87.0, battery_is_soc=True).battery_pct == 87.0
     assert RobotState(battery_v=12.8).battery_pct is None

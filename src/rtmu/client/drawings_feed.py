@@ -9,7 +9,7 @@ is shown is the server's visibility (``AlwaysOn`` / ``AlwaysOff`` cannot be chan
 Everything from the server is bounded: at most ``MAX_DRAWINGS`` drawings, one packet of at most
 3 998 points per sample (a count that does not fit its bytes is refused and named on the layer),
 a refresh period no shorter than :data:`MIN_REFRESH_MS`, and at most one published
-:class:`~rtmu.state.DrawingsChanged` per :data:`PUBLISH_EVERY` s however fast samples come. A
+:class:`~rtmu.values.state.DrawingsChanged` per :data:`PUBLISH_EVERY` s however fast samples come. A
 shape RTMU cannot draw is listed (``drawable=False``) and never asked for.
 
 The session keeps its own sonar (and LD laser) handling: ``also`` maps those data names to the
@@ -26,7 +26,7 @@ from collections.abc import Callable, Coroutine, Mapping
 from typing import Any
 
 from ..protocol.payloads.drawings import Drawing, Visibility
-from ..state import DrawingLayer, DrawingsChanged, DrawingsState
+from ..values.state import DrawingLayer, DrawingsChanged, DrawingsState
 from .connection import AriaClient, Packet
 from .drawing_list import LIST, decode_points, drawing_list, drawing_sample
 from .errors import ClientError

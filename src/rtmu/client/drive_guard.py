@@ -17,8 +17,8 @@ import asyncio
 import contextlib
 import time
 
-from ..exit_codes import EXIT_TIMEOUT
-from ..state import LinkLevel
+from ..base.exit_codes import EXIT_TIMEOUT
+from ..values.state import LinkLevel
 from .connection import AriaClient, Packet
 from .errors import ClientError, ClientTimeout
 from .health import HealthMonitor, ping_data

@@ -7,7 +7,7 @@ and the command line prints it on one line and exits with ``error.exit_code``.
 
 from __future__ import annotations
 
-from ..exit_codes import EXIT_CONNECTION, EXIT_TIMEOUT, EXIT_UNSUPPORTED
+from ..base.exit_codes import EXIT_CONNECTION, EXIT_TIMEOUT, EXIT_UNSUPPORTED
 from ..protocol.commands import RejectReason, describe_reject
 from ..protocol.errors import ProtocolError
 

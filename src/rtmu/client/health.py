@@ -21,7 +21,7 @@ injected clock.
 from __future__ import annotations
 
 from ..protocol.decoder import DropStats
-from ..state import LinkHealth, LinkLevel
+from ..values.state import LinkHealth, LinkLevel
 
 STALE_INTERVALS = 3
 LOST_AFTER = 2.0

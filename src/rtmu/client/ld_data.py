@@ -100,7 +100,7 @@ _SCALE = re.compile(r"\(\s*0\s*[-–]\s*(\d+)\s*\)")
 
 
 def store_fields(name: str, value: str, description: str = "") -> dict[str, int | None]:
-    """The :class:`~rtmu.model.RobotState` fields a ``DataStore_*`` value gives the toolbar.
+    """The :class:`~rtmu.model.observables.RobotState` fields a ``DataStore_*`` value gives the toolbar.
 
     Names as LD robots list them (``DataStore_Localization_Score``, ``DataStore_WiFi_Quality``,
     ``DataStore_Distance_To_Goal``, ``DataStore_Closest_Obstacle``); anything else only goes to the

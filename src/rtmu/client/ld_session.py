@@ -1,7 +1,7 @@
 """The window session's share of LD (ARAM) data: lasers, docking state, routes, ``DataStore_*``.
 
 :class:`LdFeed` is what :class:`~rtmu.client.session.Session` calls after login: it subscribes only
-to the data the server lists and turns each packet into :class:`~rtmu.model.RobotState` changes
+to the data the server lists and turns each packet into :class:`~rtmu.model.observables.RobotState` changes
 through the session's ``update`` function. A serverDemo-like server lists none of it, so nothing
 is asked and the model keeps its defaults (no laser, ``dock_state`` None, no routes).
 """

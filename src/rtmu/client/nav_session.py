@@ -1,4 +1,4 @@
-"""The window session's share of navigation: the typed :class:`~rtmu.state.NavState` and its notices.
+"""The window session's share of navigation: the typed :class:`~rtmu.values.state.NavState` and its notices.
 
 :class:`NavFeed` is fed by :class:`~rtmu.client.session.Session`: every robot update (the status
 string and mode name say whether the server navigates, and how it ended — see
@@ -15,12 +15,12 @@ from collections.abc import Callable, Coroutine
 from dataclasses import replace
 from typing import Any
 
-from ..notices import Kind, Notice
+from ..base.notices import Kind, Notice
 from ..protocol.errors import ProtocolError
 from ..protocol.payloads import Payload
 from ..protocol.payloads.map import Goals
 from ..protocol.payloads.navigation import GotoPose, LocalizationState, LocState, PlannedPath
-from ..state import NavChanged, NavOutcome, NavState, RobotState
+from ..values.state import NavChanged, NavOutcome, NavState, RobotState
 from .connection import AriaClient, Packet
 from .errors import ClientError
 from .nav_status import MAX_TEXT, NAV_DATA, NavPhase, NavReading, path_remaining, read_status

@@ -2,7 +2,7 @@
 
 :class:`PopupFeed` is fed the session's ``popupCreate`` / ``popupClose`` packets (subscriptions
 in the session's table) and asks ``popupList`` once per login, so a reconnect shows again what the
-server still has open. It publishes the open set as one typed :class:`~rtmu.state.PopupsChanged`
+server still has open. It publishes the open set as one typed :class:`~rtmu.values.state.PopupsChanged`
 and the server's closing text as a ``Kind.SERVER`` notice. Server text is untrusted: titles,
 messages and labels are cut to a bounded length, and at most :data:`MAX_OPEN` popups are kept —
 a flood beyond that is only counted. Publishing is coalesced to once per loop turn, so a burst of
@@ -17,9 +17,9 @@ import time
 from collections.abc import Callable, Coroutine
 from typing import Any
 
-from ..notices import Kind, Notice
+from ..base.notices import Kind, Notice
 from ..protocol.payloads.popup import PopupClicked, PopupClose, PopupCreate
-from ..state import PopupInfo, PopupsChanged, PopupsState
+from ..values.state import PopupInfo, PopupsChanged, PopupsState
 from .connection import AriaClient, Packet
 from .errors import ClientError, NotSupported, ServerClosed
 

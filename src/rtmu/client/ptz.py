@@ -4,7 +4,7 @@ After login :class:`PtzFeed` reads ``getCameraList``, picks the first camera who
 ``setCameraRel`` or ``setCameraAbs`` data the server also lists, and reads its limits
 (``getCameraInfo<N>``) and position (``getCameraData<N>``) once. The position is then polled only
 while someone looks at it (the camera page is shown): a hidden page costs the robot nothing. Where
-there is no such camera the published :class:`~rtmu.state.PtzState` says why, so the window can
+there is no such camera the published :class:`~rtmu.values.state.PtzState` says why, so the window can
 grey its controls with the reason. Moving the head is camera work, never robot motion: it needs
 no drive lease. Every name and number comes from the server and is bounded before it is kept.
 """
@@ -19,7 +19,7 @@ from typing import Any
 
 from ..protocol.errors import ProtocolError
 from ..protocol.payloads.camera import Camera, CameraData, CameraInfo, CameraList, SetCameraAbs, SetCameraRel
-from ..state import PtzState
+from ..values.state import PtzState
 from .connection import AriaClient, Packet
 from .errors import ClientError, NotSupported
 

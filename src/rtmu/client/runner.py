@@ -13,8 +13,8 @@ Concurrency design
 * Results travel back through ``post(fn)``, the injectable "run this on the UI
   thread" function: GTK passes ``GLib.idle_add``; tests and scripts pass a
   direct call or a queue. Posted functions return None, so ``idle_add`` runs
-  them once. Every published change (:data:`rtmu.state.StateChange`) is handed
-  to the runner's ``sink`` (a :class:`~rtmu.model.RobotModel`, a recorder, a
+  them once. Every published change (:data:`rtmu.values.state.StateChange`) is handed
+  to the runner's ``sink`` (a :class:`~rtmu.model.observables.RobotModel`, a recorder, a
   test list) on the UI thread; only real changes get posted. The runner never
   imports the UI thread's state: it knows the sink only by its ``apply``.
 * Calls that may block (keyring lookups) go to :meth:`ClientRunner.run_blocking`:
@@ -65,8 +65,8 @@ import time
 from collections.abc import Awaitable, Callable
 from typing import Any, TypeVar, overload
 
-from ..notices import Kind, Notice
-from ..state import StateChange, StateSink
+from ..base.notices import Kind, Notice
+from ..values.state import StateChange, StateSink
 from .connection import AriaClient, Packet
 from .errors import ClientError, ClientTimeout
 from .lease import LEASE_TTL, DriveLease, EndReason
@@ -100,7 +100,7 @@ def call_directly(fn: Callable[[], None]) -> None:
 class ClientRunner:
     """Use as ``with ClientRunner(robot_model, post=GLib.idle_add) as runner:`` (or ``start()``/``close()``).
 
-    Implements ``rtmu.controller.ClientLink``. All public methods are thread-safe.
+    Implements ``rtmu.control.controller.ClientLink``. All public methods are thread-safe.
     """
 
     def __init__(

@@ -3,9 +3,9 @@
 The :class:`Session` lives entirely on the network thread's asyncio loop (see
 ``runner`` for the thread and the UI-facing facade). It keeps a *shadow* of
 every part of the robot's state (robot, map, camera, connection, health) and
-hands a typed change (:data:`rtmu.state.StateChange`) to ``publish`` only when
+hands a typed change (:data:`rtmu.values.state.StateChange`) to ``publish`` only when
 the value really changed, so an unchanged 10 Hz status costs the UI thread
-nothing. Messages for the operator leave as typed :class:`rtmu.notices.Notice`.
+nothing. Messages for the operator leave as typed :class:`rtmu.base.notices.Notice`.
 
 Its heart is one task that wakes at the exact moments something is due — a
 ``ratioDrive`` resend, the lease's expiry, the status going stale — or when the
@@ -26,16 +26,16 @@ from dataclasses import dataclass, field, replace
 from functools import partial
 from typing import Any
 
+from ..base.notices import Kind, Notice
 from ..guardian.handle import BEAT_PERIOD, GuardianHandle
 from ..guardian.messages import Hello
-from ..notices import Kind, Notice
 from ..protocol.client_connection import payload_name
 from ..protocol.errors import ProtocolError
 from ..protocol.payloads import Payload, Side, decode_payload, payload_type_for
 from ..protocol.payloads.drive import RatioDrive, SafeDrive, SetSafeDrive
 from ..protocol.payloads.navigation import Dock, GotoGoal, GotoPose, Home, LocalizeToPose, TourGoals
 from ..protocol.payloads.robot import BatteryInfo, ModeInfo, Update, UpdateNumbers, UpdateStrings
-from ..state import (
+from ..values.state import (
     CameraChanged,
     CameraImage,
     ConnectionChanged,

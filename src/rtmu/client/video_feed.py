@@ -26,7 +26,7 @@ from dataclasses import dataclass, field
 
 from ..protocol.errors import ProtocolError
 from ..protocol.payloads.camera import VideoFrame
-from ..state import VideoStatus
+from ..values.state import VideoStatus
 from .connection import AriaClient
 from .errors import ClientError, ClientTimeout, NotSupported, ServerClosed
 

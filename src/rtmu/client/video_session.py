@@ -2,7 +2,7 @@
 
 It hangs off :class:`~.session.Session` like ``nav_session`` does: the session
 tells it when a connection opens and ends, and it publishes every new frame as
-the model's ``camera`` part (a :class:`~rtmu.state.CameraImage` carrying its
+the model's ``camera`` part (a :class:`~rtmu.values.state.CameraImage` carrying its
 render stamp and the live figures), so the window's existing JPEG thread decodes
 it into textures. What the operator asked (live or not, paused, rate, quality)
 outlives the connection: after a reconnect the video resumes by itself.
@@ -14,7 +14,7 @@ import time
 from collections.abc import Callable, Coroutine
 from typing import Any
 
-from ..state import CameraChanged, CameraImage, StateChange
+from ..values.state import CameraChanged, CameraImage, StateChange
 from .connection import AriaClient
 from .errors import ServerClosed
 from .video_feed import DEFAULT_FPS, LiveFrame, VideoFeed, clamp_fps, video_source

@@ -31,9 +31,9 @@ import foxglove
 from foxglove import Channel, Context
 from foxglove.websocket import Capability, ChannelView, Client, ClientChannel, WebSocketServer
 
+from ..base.notices import Notice
 from ..client.lease import DriveLease, DriveRatios, EndReason
-from ..notices import Notice
-from ..state import StateChange
+from ..values.state import StateChange
 from . import topics
 from .convert import Converter, notice_record
 from .mcapfile import TYPED

@@ -33,8 +33,8 @@ from foxglove.messages import (
     Vector3,
 )
 
-from ..notices import Notice
-from ..state import (
+from ..base.notices import Notice
+from ..values.state import (
     CameraChanged,
     ConnectionChanged,
     DrawingsChanged,

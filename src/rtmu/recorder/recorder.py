@@ -1,6 +1,6 @@
 """The flight recorder of one robot session: a new file per connection target, fed from every side.
 
-A :class:`Recorder` belongs to one :class:`rtmu.fleet.RobotSession`. Its opener tees
+A :class:`Recorder` belongs to one :class:`rtmu.fleet.sessions.RobotSession`. Its opener tees
 every link the session's client opens; the first link to a robot starts a
 :class:`~rtmu.recorder.recording.Recording` (reconnects to the same robot keep
 writing the same file, as new connections in it) and a disconnect or a final
@@ -21,11 +21,11 @@ from functools import partial
 from pathlib import Path
 from typing import Any
 
+from ..base.notices import Kind, Level, Notice
 from ..client.lease import LeaseEvent
 from ..client.link import Opener, open_tcp
 from ..client.runner import ClientRunner
-from ..notices import Kind, Level, Notice
-from ..state import ConnectionChanged, Phase, StateChange
+from ..values.state import ConnectionChanged, Phase, StateChange
 from . import files, topics
 from .convert import jsonable, notice_record
 from .items import Event, Item, LinkOpened, Published, RawChunk
@@ -38,7 +38,7 @@ WAITING_EVENTS = 64
 
 @dataclass(frozen=True, slots=True)
 class RecorderConfig:
-    """Where and how much; :mod:`rtmu.settings` ``RecordingSettings`` fills it."""
+    """Where and how much; :mod:`rtmu.settings.store` ``RecordingSettings`` fills it."""
 
     directory: Path
     path: Path | None = None

@@ -19,8 +19,8 @@ from dataclasses import dataclass
 from functools import partial
 from pathlib import Path
 
+from ..base.notices import Kind, Notice
 from ..capture.recorded import CONNECTION_TOPIC, RAW_TOPICS, connection_record
-from ..notices import Kind, Notice
 from . import topics
 from .convert import Converter
 from .files import variant

@@ -24,7 +24,7 @@ from collections.abc import Callable
 
 from ..client.link import Link, RecordedLink
 from ..protocol.decoder import PacketDecoder
-from ..state import CameraChanged, CameraImage, StateChange
+from ..values.state import CameraChanged, CameraImage, StateChange
 from .replay_file import RecordedConnection
 
 SPEEDS = (0.25, 0.5, 1.0, 2.0, 4.0, 8.0)

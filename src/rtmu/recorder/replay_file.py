@@ -23,9 +23,9 @@ from pathlib import Path
 
 from ..capture.base import CaptureStats, StreamData
 from ..capture.recorded import CONNECTION_TOPIC, MAX_RECORD, recorded_events
+from ..capture.session_decoder import C2S, CaptureDecoder, DecodedPacket
 from ..client.health import PING_CANDIDATES
 from ..protocol.decoder import PacketDecoder
-from ..session_decoder import C2S, CaptureDecoder, DecodedPacket
 from . import topics
 
 NOT_REPLAYED = frozenset(

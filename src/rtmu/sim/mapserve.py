@@ -22,7 +22,7 @@ from rtmu.protocol.packet import encode_packet
 from rtmu.protocol.payloads.map import Goals, MapId, MapName
 from rtmu.protocol.payloads.mapstream import map_binary_payloads, map_text_payloads
 
-from ..maps import MapObject, map_header_lines
+from ..mapfile import MapObject, map_header_lines
 from .geometry import Obstacles
 
 DEFAULT_POINT_CELL_MM = 40.0
@@ -112,7 +112,7 @@ def load_map(path: Path | None) -> ServedMap:
     """Read ``path`` with the project's map reader; None = serve no map (an empty 10 m room to drive in)."""
     if path is None:
         return ServedMap(None, "")
-    from rtmu.maps import read_map
+    from rtmu.mapfile import read_map
 
     raw = path.read_bytes()
     data = read_map(path)

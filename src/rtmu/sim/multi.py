@@ -42,7 +42,7 @@ def map_home(path: Path | None) -> tuple[float, float, float]:
     """The map's ``RobotHome`` (x, y mm, th deg), or the origin."""
     if path is None:
         return (0.0, 0.0, 0.0)
-    from ..maps import read_map
+    from ..mapfile import read_map
 
     home = read_map(path).home()
     return (float(home.x), float(home.y), float(home.th)) if home is not None else (0.0, 0.0, 0.0)

@@ -19,7 +19,7 @@ from typing import Protocol
 
 import numpy as np
 
-from rtmu.maps import MapObject
+from rtmu.mapfile import MapObject
 from rtmu.protocol.payloads.ld import DockState
 from rtmu.protocol.payloads.navigation import LocalizationState
 

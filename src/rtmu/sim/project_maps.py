@@ -17,7 +17,7 @@ from pathlib import Path
 
 import numpy as np
 
-from rtmu.maps import InfoLine, MapData, MapObject, new_map, write_map
+from rtmu.mapfile import InfoLine, MapData, MapObject, new_map, write_map
 from rtmu.sim.mapgen import box_segments, points_along
 
 POINT_SPACING_MM = 20.0

@@ -38,9 +38,9 @@ from collections.abc import Awaitable, Callable
 from pathlib import Path
 from typing import Any
 
+from ..base.exit_codes import EXIT_CONNECTION, EXIT_OK, EXIT_USAGE
 from ..client.connection import CONNECT_TIMEOUT, DEFAULT_PORT, AriaClient
 from ..client.errors import ClientError
-from ..exit_codes import EXIT_CONNECTION, EXIT_OK, EXIT_USAGE
 from ..protocol.errors import ProtocolError
 
 MAX_PASSWORD_FILE = 4096
@@ -186,8 +186,8 @@ def resolve_robot(args: argparse.Namespace) -> int | None:
     None when done; else the exit code, after one line on stderr: 2 for a name the central server
     does not list (naming the ones it does), 3/4/5 as for any login.
     """
+    from ..base.textsafe import visible
     from ..client.central import list_robots
-    from ..textsafe import visible
 
     name = str(getattr(args, "subcommand", None) or "rtmu")
     try:
@@ -397,7 +397,7 @@ def current_password() -> str:
 
 
 def fail(name: str, message: str, code: int) -> int:
-    from ..textsafe import visible
+    from ..base.textsafe import visible
 
     print(f"rtmu {name}: {visible(message)}", file=sys.stderr)
     return code
@@ -468,7 +468,7 @@ def print_json(obj: Any) -> None:
     """One JSON line: the exact strings, with characters that act on a terminal as ``\\uXXXX``."""
     import json
 
-    from ..textsafe import json_safe
+    from ..base.textsafe import json_safe
 
     print(json_safe(json.dumps(obj, separators=(",", ":"), ensure_ascii=False)), flush=True)
 
@@ -496,7 +496,7 @@ def status_object(numbers: Any, status: str, mode: str, *, soc: bool = False) ->
 
 
 def status_line(obj: dict[str, Any]) -> str:
-    from ..textsafe import visible
+    from ..base.textsafe import visible
 
     battery = f"{obj['battery_pct']:.0f} %" if "battery_pct" in obj else f"{obj['battery_v']:.1f} V"
     return (
@@ -542,7 +542,7 @@ def unknown_name(command: str, kind: str, name: str, known: tuple[str, ...]) -> 
     ``known``: a route or goal the server does not have is the user's mistake (exit 2)."""
     if name in known:
         return False
-    from ..textsafe import visible
+    from ..base.textsafe import visible
 
     listed = visible(", ".join(known) or "none")
     print(

@@ -17,17 +17,17 @@ from collections.abc import Callable
 from dataclasses import dataclass
 from typing import Any
 
+from ..base.exit_codes import EXIT_OK, EXIT_TIMEOUT
+from ..base.textsafe import visible
 from ..client.connection import AriaClient, Packet
 from ..client.errors import ClientError, NotSupported
 from ..client.nav_status import NavPhase, NavReading, path_remaining, read_status
-from ..exit_codes import EXIT_OK, EXIT_TIMEOUT
 from ..protocol.errors import ProtocolError
 from ..protocol.payloads import Payload, Side, decode_payload
 from ..protocol.payloads.drive import RatioDrive
 from ..protocol.payloads.ld import DockInfo
 from ..protocol.payloads.navigation import LocalizationState, LocState, PlannedPath
 from ..protocol.payloads.robot import ModeInfo, Update, UpdateNumbers, UpdateStrings
-from ..textsafe import visible
 from ._common import Interrupted, current_interrupts, positive_float, print_json
 
 EXIT_NAV_FAILED = 6

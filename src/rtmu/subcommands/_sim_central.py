@@ -15,7 +15,7 @@ EXIT_CANNOT_LISTEN = 3
 
 async def serve_central(cfg: SimConfig, robot_port: int, robots: int) -> int:
     """Serve until SIGINT/SIGTERM; ``cfg`` is the robots' template (map, camera, seed…)."""
-    from ..maps import MapFormatError
+    from ..mapfile import MapFormatError
     from ..sim import SimServer
     from ..sim.central import CentralConfig, CentralServer
 

@@ -17,13 +17,13 @@ import sys
 import threading
 from typing import Any
 
+from ..base.exit_codes import EXIT_CONNECTION, EXIT_OK, EXIT_USAGE
+from ..base.notices import Notice
+from ..base.textsafe import visible
 from ..client.errors import ClientError
 from ..client.runner import ClientRunner
 from ..client.session import SessionConfig
-from ..exit_codes import EXIT_CONNECTION, EXIT_OK, EXIT_USAGE
-from ..notices import Notice
 from ..recorder.bridge import DEFAULT_PORT, LEASE_TTL, Bridge, DriveLimits
-from ..textsafe import visible
 from ._common import UsageError, add_connection_arguments, fail, positive_float, read_password
 from ._follow import follow
 

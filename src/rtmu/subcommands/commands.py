@@ -5,10 +5,10 @@ from __future__ import annotations
 import argparse
 from typing import Any
 
+from ..base.exit_codes import EXIT_OK
+from ..base.textsafe import visible
 from ..client.connection import AriaClient
 from ..client.custom_commands import list_commands
-from ..exit_codes import EXIT_OK
-from ..textsafe import visible
 from ._common import add_connection_arguments, print_json, run_with_client
 
 

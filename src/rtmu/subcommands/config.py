@@ -13,11 +13,11 @@ import math
 import sys
 from typing import Any
 
+from ..base.exit_codes import EXIT_OK, EXIT_USAGE
+from ..base.textsafe import visible
 from ..client.config_feed import ServerConfig, fetch_config, set_config
 from ..client.connection import AriaClient
-from ..exit_codes import EXIT_OK, EXIT_USAGE
 from ..protocol.payloads.config import ConfigParam, ParamType, Priority
-from ..textsafe import visible
 from ._common import add_connection_arguments, print_json, run_with_client
 
 EXIT_REFUSED = 6

@@ -18,9 +18,10 @@ from collections import deque
 from collections.abc import Iterable
 from typing import Any, TextIO
 
+from ..base.textsafe import json_safe, visible
 from ..capture import CaptureError, CaptureSource, UnreadableInput, open_capture
 from ..capture.reader import DIRECTIONS, FORMATS
-from ..session_decoder import (
+from ..capture.session_decoder import (
     C2S,
     S2C,
     CaptureDecoder,
@@ -30,7 +31,6 @@ from ..session_decoder import (
     Session,
     TrailingDrops,
 )
-from ..textsafe import json_safe, visible
 
 EXIT_OK = 0
 EXIT_UNREADABLE = 1

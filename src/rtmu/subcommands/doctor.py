@@ -19,9 +19,10 @@ import time
 from dataclasses import dataclass, field
 from typing import Any
 
+from ..base.exit_codes import EXIT_OK, EXIT_USAGE
+from ..base.textsafe import visible
 from ..client.connection import TEXT_BANNERS
 from ..client.diagnosis import ADVICE, Step, login_finding
-from ..exit_codes import EXIT_OK, EXIT_USAGE
 from ..protocol.client_connection import ClientConnection
 from ..protocol.commands import ClientCommand, ServerCommand
 from ..protocol.decoder import PacketDecoder
@@ -38,7 +39,6 @@ from ..protocol.fields import FieldReader, FieldWriter
 from ..protocol.packet import encode_packet
 from ..protocol.payloads import Side, decode_payload
 from ..protocol.payloads.robot import BatteryInfo, Update, UpdateNumbers, UpdateStrings
-from ..textsafe import visible
 from ._common import UsageError, add_connection_arguments, print_json, read_password
 
 READ_CHUNK = 65536

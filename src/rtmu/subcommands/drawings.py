@@ -11,12 +11,12 @@ from __future__ import annotations
 import argparse
 from typing import Any
 
+from ..base.exit_codes import EXIT_OK
+from ..base.textsafe import visible
 from ..client.connection import AriaClient
 from ..client.drawing_list import drawing_list, drawing_sample
 from ..client.errors import ClientError
-from ..exit_codes import EXIT_OK
 from ..protocol.payloads.drawings import Drawing
-from ..textsafe import visible
 from ._common import add_connection_arguments, print_json, run_with_client
 
 

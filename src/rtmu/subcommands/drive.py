@@ -23,14 +23,14 @@ import sys
 from collections.abc import Callable
 from typing import Any
 
+from ..base.exit_codes import EXIT_OK
+from ..base.textsafe import visible
 from ..client.connection import AriaClient
 from ..client.drive_guard import DriveGuard, LinkFault
 from ..client.errors import ClientError, NotSupported
-from ..exit_codes import EXIT_OK
 from ..guardian.handle import GuardianHandle, GuardianUnavailable, beat_network, start_ready
 from ..guardian.messages import Hello
 from ..protocol.payloads.drive import RatioDrive
-from ..textsafe import visible
 from ._common import (
     Interrupted,
     UsageError,

@@ -15,12 +15,12 @@ import asyncio
 import signal
 from typing import Any
 
+from ..base.exit_codes import EXIT_CONNECTION, EXIT_OK, EXIT_USAGE
+from ..base.textsafe import visible
 from ..client.central import list_robots
 from ..client.connection import AriaClient
 from ..client.errors import ClientError
-from ..exit_codes import EXIT_CONNECTION, EXIT_OK, EXIT_USAGE
 from ..protocol.errors import ProtocolError
-from ..textsafe import visible
 from ._common import (
     UsageError,
     add_connection_arguments,

@@ -12,11 +12,11 @@ import argparse
 import sys
 from typing import Any
 
+from ..base.exit_codes import EXIT_OK, EXIT_USAGE
+from ..base.textsafe import visible
 from ..client import ld_data
 from ..client.connection import AriaClient
-from ..exit_codes import EXIT_OK, EXIT_USAGE
 from ..protocol.payloads.navigation import GotoGoal, GotoPose
-from ..textsafe import visible
 from ._common import UsageError, add_connection_arguments, run_with_client, unknown_name
 from ._navigate import EXIT_CODES_HELP, Expect, add_wait_arguments, navigate, require
 

@@ -7,10 +7,10 @@ import sys
 from pathlib import Path
 from typing import Any
 
+from ..base.exit_codes import EXIT_CONNECTION, EXIT_OK
+from ..base.textsafe import visible
 from ..client.connection import AriaClient
 from ..client.video_feed import video_source
-from ..exit_codes import EXIT_CONNECTION, EXIT_OK
-from ..textsafe import visible
 from ._common import add_connection_arguments, fail, run_with_client
 
 MAX_SIDE = 8192

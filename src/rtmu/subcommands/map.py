@@ -7,12 +7,12 @@ import sys
 from pathlib import Path
 from typing import Any
 
+from ..base.exit_codes import EXIT_OK, EXIT_UNSUPPORTED
+from ..base.textsafe import visible
 from ..client.connection import AriaClient
 from ..client.errors import ProtocolFault
 from ..client.mapload import download_map
-from ..exit_codes import EXIT_OK, EXIT_UNSUPPORTED
 from ..mapfile.errors import MapFormatError
-from ..textsafe import visible
 from ._common import add_connection_arguments, fail, run_with_client
 
 
@@ -31,7 +31,7 @@ def register(subparsers: Any) -> None:
 
 def handle(args: argparse.Namespace) -> int:
     async def body(client: AriaClient) -> int:
-        from .. import maps
+        from .. import mapfile as maps
 
         got = await download_map(client, prefer_binary=not args.text, timeout=args.timeout)
         if got.data is None:

@@ -8,8 +8,8 @@ import sys
 from collections import Counter
 from typing import Any
 
-from rtmu.maps import Bounds, MapData, MapFormatError, read_map, split_keyword
-from rtmu.textsafe import visible
+from rtmu.base.textsafe import visible
+from rtmu.mapfile import Bounds, MapData, MapFormatError, read_map, split_keyword
 
 EXIT_OK = 0
 EXIT_BAD_MAP = 2

@@ -6,10 +6,10 @@ import argparse
 import sys
 from typing import Any
 
+from ..base.exit_codes import EXIT_OK, EXIT_USAGE
+from ..base.textsafe import visible
 from ..client import ld_data
 from ..client.connection import AriaClient
-from ..exit_codes import EXIT_OK, EXIT_USAGE
-from ..textsafe import visible
 from ._common import add_connection_arguments, run_with_client, unknown_name
 
 

@@ -13,11 +13,11 @@ import asyncio
 import math
 from typing import Any
 
+from ..base.exit_codes import EXIT_OK, EXIT_UNSUPPORTED
+from ..base.textsafe import visible
 from ..client.connection import AriaClient
 from ..client.ptz import PtzFeed
-from ..exit_codes import EXIT_OK, EXIT_UNSUPPORTED
-from ..state import PtzState
-from ..textsafe import visible
+from ..values.state import PtzState
 from ._common import add_connection_arguments, fail, print_json, run_with_client
 
 SETTLE_S = 0.5

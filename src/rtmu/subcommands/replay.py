@@ -11,7 +11,7 @@ import argparse
 from pathlib import Path
 from typing import Any
 
-from ..exit_codes import EXIT_CONNECTION, EXIT_USAGE
+from ..base.exit_codes import EXIT_CONNECTION, EXIT_USAGE
 from ..recorder.replay_file import ReplayFileError, load
 from ._common import fail
 

@@ -13,10 +13,10 @@ import argparse
 import sys
 from typing import Any
 
+from ..base.exit_codes import EXIT_OK, EXIT_TIMEOUT, EXIT_USAGE
+from ..base.textsafe import visible
 from ..client.connection import AriaClient
 from ..client.custom_commands import MAX_ARGUMENT, list_commands, run_command
-from ..exit_codes import EXIT_OK, EXIT_TIMEOUT, EXIT_USAGE
-from ..textsafe import visible
 from ._common import add_connection_arguments, print_json, run_with_client, unknown_name
 
 

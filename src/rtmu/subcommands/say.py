@@ -6,9 +6,9 @@ import argparse
 import sys
 from typing import Any
 
+from ..base.exit_codes import EXIT_OK, EXIT_USAGE
 from ..client import ld_data
 from ..client.connection import AriaClient
-from ..exit_codes import EXIT_OK, EXIT_USAGE
 from ._common import add_connection_arguments, run_with_client
 
 MAX_TEXT = 1000

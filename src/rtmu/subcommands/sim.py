@@ -216,7 +216,7 @@ def run(args: argparse.Namespace) -> int:
 
 
 async def serve(cfg) -> int:
-    from ..maps import MapFormatError
+    from ..mapfile import MapFormatError
     from ..sim import SimServer
 
     try:
@@ -251,7 +251,7 @@ async def serve(cfg) -> int:
 
 async def serve_fleet(cfg, count: int) -> int:
     """``--robots N``: N servers on one loop (``sim.multi``), one line per robot, Ctrl-C stops all."""
-    from ..maps import MapFormatError
+    from ..mapfile import MapFormatError
     from ..sim.multi import SimFleet, fleet_configs
 
     try:
@@ -275,7 +275,7 @@ async def serve_fleet(cfg, count: int) -> int:
 
 
 def make_map(args: argparse.Namespace) -> int:
-    from ..maps import write_map
+    from ..mapfile import write_map
     from ..sim.mapgen import generate_map
 
     if args.points < 0 or args.lines < 0:

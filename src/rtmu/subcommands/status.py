@@ -15,10 +15,10 @@ import contextlib
 import sys
 from typing import Any
 
+from ..base.exit_codes import EXIT_OK
 from ..client import ld_data
 from ..client.connection import AriaClient, Packet
 from ..client.errors import ClientTimeout, NotSupported, ProtocolFault
-from ..exit_codes import EXIT_OK
 from ..protocol.errors import ProtocolError
 from ..protocol.payloads.ld import DockInfo
 from ..protocol.payloads.robot import Update, UpdateNumbers, UpdateStrings

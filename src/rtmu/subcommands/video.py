@@ -18,10 +18,10 @@ import time
 from pathlib import Path
 from typing import Any
 
+from ..base.exit_codes import EXIT_CONNECTION, EXIT_OK
+from ..base.textsafe import visible
 from ..client.connection import AriaClient
 from ..client.video_feed import MAX_FPS, MIN_FPS, LiveFrame, VideoFeed, VideoStatus, video_source
-from ..exit_codes import EXIT_CONNECTION, EXIT_OK
-from ..textsafe import visible
 from ._common import add_connection_arguments, fail, run_with_client
 from .image import picture_problem
 

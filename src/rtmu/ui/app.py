@@ -15,7 +15,7 @@ import tempfile
 from dataclasses import replace
 from pathlib import Path
 
-from ..settings import DEFAULT_PORT, parse_central
+from ..settings.store import DEFAULT_PORT, parse_central
 from .options import GuiOptions
 
 EXIT_NO_DISPLAY = 6
@@ -76,7 +76,7 @@ def options_from_args(args: argparse.Namespace) -> GuiOptions:
 
 def demo_fleet_options(options: GuiOptions, endpoints: list[tuple[str, int]]) -> GuiOptions:
     """The window on every simulated robot of ``--demo --robots N``."""
-    from ..settings import DirectRobot
+    from ..settings.store import DirectRobot
 
     robots = tuple(DirectRobot(name, "127.0.0.1", port) for name, port in endpoints)
     return replace(options, fleet=robots, host=None, port=None, user=None, persist=False, connect=True)
@@ -153,7 +153,7 @@ def demo_map_path() -> Path:
         candidate = parent / "data" / "maps" / "office.map"
         if candidate.is_file():
             return candidate
-    from ..maps import write_map
+    from ..mapfile import write_map
     from ..sim.project_maps import office_map
 
     target = Path(tempfile.gettempdir()) / f"rtmu-demo-{os.getuid()}" / "office.map"

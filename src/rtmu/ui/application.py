@@ -1,7 +1,7 @@
 """The ``Gtk.Application``: settings → profile, the fleet and its first robot session, the window.
 
-Wiring only. The application builds a :class:`rtmu.fleet.Fleet` — of one
-:class:`~rtmu.fleet.RobotSession` for a one-robot profile, or of every robot a
+Wiring only. The application builds a :class:`rtmu.fleet.sessions.Fleet` — of one
+:class:`~rtmu.fleet.sessions.RobotSession` for a one-robot profile, or of every robot a
 fleet profile's roster names (``fleet.direct_roster``), each session's network
 thread posting back with ``GLib.idle_add`` — and a window that shows the selected
 session (``fleet_bind`` adds the robot list and the other robots on the map). Every way
@@ -29,9 +29,9 @@ from ..client.central import CentralRoster  # noqa: E402
 from ..client.mapcache import SharedMaps  # noqa: E402
 from ..client.roster import RobotEndpoint, Roster  # noqa: E402
 from ..client.session import SessionConfig  # noqa: E402
-from ..fleet import Fleet, RobotSession, direct_roster, robot_profile  # noqa: E402
-from ..model import Phase  # noqa: E402
-from ..settings import (  # noqa: E402
+from ..fleet.sessions import Fleet, RobotSession, direct_roster, robot_profile  # noqa: E402
+from ..model.observables import Phase  # noqa: E402
+from ..settings.store import (  # noqa: E402
     DEFAULT_PORT,
     KeyringSecrets,
     Profile,

@@ -11,10 +11,10 @@ from __future__ import annotations
 
 from collections.abc import Callable
 
-from ..fleet import RobotSession
-from ..notices import Kind, Notice
+from ..base.notices import Kind, Notice
+from ..fleet.sessions import RobotSession
 from ..recorder.bridge import DEFAULT_PORT, Bridge
-from ..state import ConnectionChanged, MapChanged, RobotChanged, StateChange
+from ..values.state import ConnectionChanged, MapChanged, RobotChanged, StateChange
 
 HOST = "127.0.0.1"
 

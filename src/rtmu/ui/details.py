@@ -18,7 +18,7 @@ gi.require_version("Gtk", "4.0")
 gi.require_version("Pango", "1.0")
 from gi.repository import Gdk, Gtk, Pango  # noqa: E402
 
-from ..model import ConnectionState, RobotModel, RobotState  # noqa: E402
+from ..model.observables import ConnectionState, RobotModel, RobotState  # noqa: E402
 from ..protocol.payloads.ld import Say, data_store_label  # noqa: E402
 
 Send = Callable[[str, object], None]

@@ -24,11 +24,11 @@ import numpy as np
 gi.require_version("Gtk", "4.0")
 from gi.repository import GLib, Gtk  # noqa: E402
 
-from ..commands import CommandState  # noqa: E402
-from ..fleet import Fleet, RobotSession  # noqa: E402
-from ..model import ConnectionState, LinkLevel, Phase  # noqa: E402
-from ..notices import Kind, Level, Notice  # noqa: E402
-from ..settings import Profile  # noqa: E402
+from ..base.notices import Kind, Level, Notice  # noqa: E402
+from ..control.commands import CommandState  # noqa: E402
+from ..fleet.sessions import Fleet, RobotSession  # noqa: E402
+from ..model.observables import ConnectionState, LinkLevel, Phase  # noqa: E402
+from ..settings.store import Profile  # noqa: E402
 from .fleet_draw import RGB, FleetMark, fleet_colour  # noqa: E402
 from .mapview import STALE_AFTER  # noqa: E402
 from .overlays import ROBOT_RGB  # noqa: E402

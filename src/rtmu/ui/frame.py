@@ -15,7 +15,7 @@ from dataclasses import dataclass, field
 
 import cairo
 
-from ..state import DrawingLayer
+from ..values.state import DrawingLayer
 from . import drawings_draw, fleet_draw, fov_draw, nav_draw, overlays
 from .tiles import BACKGROUND_RGB, EMPTY, TILE, Overview, TileCache
 from .viewport import Viewport

@@ -24,8 +24,8 @@ gi.require_version("Gdk", "4.0")
 gi.require_version("Pango", "1.0")
 from gi.repository import Gdk, Gtk, Pango  # noqa: E402
 
-from ..commands import COMMANDS, CommandState  # noqa: E402
-from ..model import ConnectionState, NavState, Phase, RobotModel  # noqa: E402
+from ..control.commands import COMMANDS, CommandState  # noqa: E402
+from ..model.observables import ConnectionState, NavState, Phase, RobotModel  # noqa: E402
 from .nav_draw import MarkerKind  # noqa: E402
 
 NAV_OFFERS = ("gotoGoal", "gotoRouteGoal", "gotoPose", "home", "dock", "tourGoals", "localizeToPose")

@@ -3,7 +3,7 @@
 The window creates one :class:`Handheld` after its own widgets and actions and
 calls :meth:`close` when it shuts down; everything else hooks itself on:
 
-* the gamepad mapping (``rtmu.gamepad``) on the window's controller, fed by
+* the gamepad mapping (``rtmu.control.gamepad``) on the window's controller, fed by
   libmanette (``ui.gamepad``), its status pill over the map, its own 10 Hz timer
   (silence, rate limit) and the window's focus (connected after the window's own
   focus handler, so the controller has already stopped when the pad hears of it);
@@ -23,8 +23,8 @@ import gi
 gi.require_version("Gtk", "4.0")
 from gi.repository import Gdk, Gio, GLib, Gtk  # noqa: E402
 
-from ..controller import TICK, Controller  # noqa: E402
-from ..gamepad import Gamepad  # noqa: E402
+from ..control.controller import TICK, Controller  # noqa: E402
+from ..control.gamepad import Gamepad  # noqa: E402
 from .alarm_view import AlarmView  # noqa: E402
 from .gamepad import ManettePads  # noqa: E402
 from .gamepad_status import GamepadStatus  # noqa: E402

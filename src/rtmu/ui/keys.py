@@ -1,6 +1,6 @@
 """Every key RTMU answers to, in one table, and the capture-phase controller that routes them.
 
-The commands' keys come from the command registry (``rtmu.commands``: the only
+The commands' keys come from the command registry (``rtmu.control.commands``: the only
 place a command is defined); this module adds only the window's own keys (zoom,
 follow, the camera page) and the application actions, listed for the help.
 
@@ -24,7 +24,7 @@ gi.require_version("Gtk", "4.0")
 gi.require_version("Gdk", "4.0")
 from gi.repository import Gdk, Gtk  # noqa: E402
 
-from ..commands import COMMANDS, CommandRegistry  # noqa: E402
+from ..control.commands import COMMANDS, CommandRegistry  # noqa: E402
 
 
 @dataclass(frozen=True, slots=True)

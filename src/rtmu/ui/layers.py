@@ -1,7 +1,7 @@
 """The Layers panel: one switch per drawing the server lists, remembered per server.
 
 A card over the map (View → Layers…), never focusable, so the arrow keys keep driving while it
-is open. Each drawing of :attr:`~rtmu.model.RobotModel.drawings` gets a check button labelled
+is open. Each drawing of :attr:`~rtmu.model.observables.RobotModel.drawings` gets a check button labelled
 with its name exactly as sent (plain text: no markup, no mnemonic underscores). A drawing the
 server keeps always on or off, or whose shape RTMU cannot draw, is listed greyed with the reason.
 Turning one off tells the network side to stop asking for it (``set_drawing_shown``) and
@@ -19,8 +19,8 @@ import gi
 gi.require_version("Gtk", "4.0")
 from gi.repository import Gtk, Pango  # noqa: E402
 
-from ..model import ConnectionState, DrawingsState, Observable, Phase  # noqa: E402
-from ..state import DrawingLayer  # noqa: E402
+from ..model.observables import ConnectionState, DrawingsState, Observable, Phase  # noqa: E402
+from ..values.state import DrawingLayer  # noqa: E402
 
 MAX_LABEL = 60
 """Characters of a name shown (the whole name is the button's tooltip)."""

@@ -26,7 +26,7 @@ import gi
 gi.require_version("Gtk", "4.0")
 from gi.repository import GLib, Gtk  # noqa: E402
 
-from ..model import LinkLevel, MapModel, OperatorState, RobotModel, RobotState  # noqa: E402
+from ..model.observables import LinkLevel, MapModel, OperatorState, RobotModel, RobotState  # noqa: E402
 from . import overlays  # noqa: E402
 from .fleet_draw import FleetMark  # noqa: E402
 from .fov_draw import Wedge, camera_aim  # noqa: E402

@@ -10,7 +10,7 @@ drawn on the map (``grid 2 m``) is its one source of truth.
 
 from __future__ import annotations
 
-from ..model import ConnectionState, MapModel, Phase
+from ..model.observables import ConnectionState, MapModel, Phase
 
 CONNECT_HINT = "press Connect (Ctrl+O)"
 

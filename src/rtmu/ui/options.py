@@ -9,7 +9,7 @@ from __future__ import annotations
 from dataclasses import dataclass
 from pathlib import Path
 
-from ..settings import DirectRobot
+from ..settings.store import DirectRobot
 
 APP_ID = "io.github.rtmu.Rtmu"
 

@@ -1,6 +1,6 @@
 """Server popups as non-modal cards over the map: plain text, the server's buttons, never the focus.
 
-The cards follow ``RobotModel.popups`` (:class:`rtmu.state.PopupsState`): the newest
+The cards follow ``RobotModel.popups`` (:class:`rtmu.values.state.PopupsState`): the newest
 :data:`MAX_CARDS` are shown over the map's right side, above the zoom buttons and clear of the
 banners at the top, the newest lowest, with "+K more" above them for the rest (and for those a
 flood made the client drop). STOP is in the header bar (or the full-screen bar), never under them.
@@ -25,8 +25,8 @@ gi.require_version("Gdk", "4.0")
 gi.require_version("Pango", "1.0")
 from gi.repository import Gdk, GLib, Gtk, Pango  # noqa: E402
 
-from ..model import Observable, PopupsState  # noqa: E402
-from ..state import PopupInfo  # noqa: E402
+from ..model.observables import Observable, PopupsState  # noqa: E402
+from ..values.state import PopupInfo  # noqa: E402
 
 MAX_CARDS = 3
 """Cards on screen at once; the rest are counted in the "+K more" line."""

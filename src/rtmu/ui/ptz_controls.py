@@ -20,8 +20,8 @@ gi.require_version("Gtk", "4.0")
 gi.require_version("Pango", "1.0")
 from gi.repository import GLib, Gtk, Pango  # noqa: E402
 
-from ..model import RobotModel, RobotState  # noqa: E402
-from ..state import PtzState  # noqa: E402
+from ..model.observables import RobotModel, RobotState  # noqa: E402
+from ..values.state import PtzState  # noqa: E402
 
 PAN_STEP = 10.0
 """Degrees per button press or key (ARIA scales relative moves down as the camera zooms in)."""

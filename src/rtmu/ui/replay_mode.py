@@ -15,11 +15,11 @@ from typing import TYPE_CHECKING
 from gi.repository import GLib
 
 from ..client.session import SessionConfig
-from ..fleet import RobotSession
+from ..fleet.sessions import RobotSession
 from ..recorder.replay import REPLAY_HOST, Replayer
 from ..recorder.replay_file import load
-from ..settings import Profile
-from ..state import StateChange
+from ..settings.store import Profile
+from ..values.state import StateChange
 from .replay_bar import ReplayBar
 
 if TYPE_CHECKING:

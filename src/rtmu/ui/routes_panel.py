@@ -17,7 +17,7 @@ import gi
 gi.require_version("Gtk", "4.0")
 from gi.repository import Gtk  # noqa: E402
 
-from ..model import ConnectionState, Phase, RobotModel, RobotState  # noqa: E402
+from ..model.observables import ConnectionState, Phase, RobotModel, RobotState  # noqa: E402
 from ..protocol.payloads.ld import GotoRouteGoal, Patrol  # noqa: E402
 
 Send = Callable[[str, object], None]

@@ -1,19 +1,19 @@
 """The main window: header bar, status toolbar, map ⇄ camera stack, banners, D-pad; the controller's View.
 
-The window shows one :class:`rtmu.fleet.RobotSession` (its state, its
-controller) with the operator's choices (:class:`rtmu.model.OperatorState`); it
+The window shows one :class:`rtmu.fleet.sessions.RobotSession` (its state, its
+controller) with the operator's choices (:class:`rtmu.model.observables.OperatorState`); it
 wires widgets to them and owns nothing else: no socket, no packet, no blocking
 call, no network thread. A red STOP is always on screen:
 first in the header bar, and in the slim bar that replaces the header in full
 screen (``bars``). Its two timers are the UI's
-heartbeat: every :data:`rtmu.controller.TICK` it renews the drive lease
+heartbeat: every :data:`rtmu.control.controller.TICK` it renews the drive lease
 (``controller.tick``) — if this loop ever stalls, the lease lapses and the
 network side stops the robot — and a slower one refreshes ages (stale values,
 picture age).
 
 Banners have topics (see ``banners``): the connection's life (connecting,
 connected, failed, lost → reconnecting (n)) is drawn from the model into ONE
-``link`` banner updated in place; notices (:class:`rtmu.notices.Notice`) are
+``link`` banner updated in place; notices (:class:`rtmu.base.notices.Notice`) are
 routed by their kind — connection notices fold into that banner, speed into the
 speed banner, camera into the camera page — never by the words in their text; a
 deliberate disconnect shows nothing.
@@ -33,12 +33,13 @@ gi.require_version("Pango", "1.0")
 gi.require_version("Gdk", "4.0")
 from gi.repository import Gdk, Gio, GLib, Gtk, Pango  # noqa: E402
 
+from ..base.notices import Kind, Level, Notice  # noqa: E402
 from ..client.custom_commands import ServerCommand  # noqa: E402
-from ..commands import COMMANDS, CommandState, action_name  # noqa: E402
-from ..controller import TICK, SecretStore  # noqa: E402
-from ..fleet import RobotSession  # noqa: E402
+from ..control.commands import COMMANDS, CommandState, action_name  # noqa: E402
+from ..control.controller import TICK, SecretStore  # noqa: E402
+from ..fleet.sessions import RobotSession  # noqa: E402
 from ..guardian.handle import BEAT_PERIOD as GUARDIAN_BEAT  # noqa: E402
-from ..model import (  # noqa: E402
+from ..model.observables import (  # noqa: E402
     SPEED_MAX,
     SPEED_MIN,
     ConnectionState,
@@ -49,8 +50,7 @@ from ..model import (  # noqa: E402
     RobotState,
     SpeedSetting,
 )
-from ..notices import Kind, Level, Notice  # noqa: E402
-from ..settings import Profile  # noqa: E402
+from ..settings.store import Profile  # noqa: E402
 from .banners import BannerStack  # noqa: E402
 from .bars import FullscreenBar, connect_button, menu_button, show_connection, stop_button  # noqa: E402
 from .bridge_toggle import BridgeToggle  # noqa: E402

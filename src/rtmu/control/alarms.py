@@ -30,7 +30,7 @@ import math
 from dataclasses import dataclass
 from enum import Enum, IntEnum
 
-from .state import LinkHealth, LinkLevel, RobotState
+from ..values.state import LinkHealth, LinkLevel, RobotState
 
 
 class Alarm(Enum):

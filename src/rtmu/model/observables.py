@@ -1,7 +1,7 @@
 """The UI thread's state: observables holding one robot's values, and the operator's own settings.
 
 Confined to ONE thread (the UI thread): the network side hands typed changes
-(:data:`rtmu.state.StateChange`) over through the runner's "post to UI"
+(:data:`rtmu.values.state.StateChange`) over through the runner's "post to UI"
 function and :meth:`RobotModel.apply` stores them. Never imports GTK or asyncio.
 
 Every part is an observable holding one frozen value. ``set(new)`` replaces the
@@ -14,12 +14,12 @@ timestamps without waking anybody.
 Two owners, kept apart so that a window can show any robot of a fleet:
 
 * :class:`RobotModel` — what one robot and its link are (one per
-  :class:`rtmu.fleet.RobotSession`): ``robot``, ``map``, ``camera``,
+  :class:`rtmu.fleet.sessions.RobotSession`): ``robot``, ``map``, ``camera``,
   ``connection``, ``health``, ``navigation`` and the ``trail`` it drove.
 * :class:`OperatorState` — what the operator chose (one per window): ``speed``
   (the drive throttle step) and ``view`` (zoom, follow, layers).
 
-The value types live in :mod:`rtmu.state` and are re-exported here.
+The value types live in :mod:`rtmu.values.state` and are re-exported here.
 """
 
 from __future__ import annotations
@@ -31,7 +31,7 @@ from collections.abc import Callable
 from dataclasses import dataclass
 from typing import Any, Generic, TypeVar
 
-from .state import (
+from ..values.state import (
     CameraChanged,
     CameraImage,
     ConnectionChanged,
@@ -187,7 +187,8 @@ class Trail:
 
 
 class RobotModel:
-    """One robot's observable state on the UI thread; a :class:`rtmu.state.StateSink` for its runner."""
+    """One robot's observable state on the UI thread; a :class:`~rtmu.values.state.StateSink` for its
+    runner."""
 
     def __init__(self) -> None:
         self.robot: Observable[RobotState] = Observable(RobotState())

@@ -25,7 +25,7 @@ Driving rules
   press after focus returns marks the window focused again (a key released
   while unfocused therefore needs one press to clear it, then a fresh press).
 * ``analog(trans, rot)`` / ``analog_release()``: a gamepad's stick while its
-  dead-man button is held (``rtmu.gamepad`` turns pad events into these). It rides
+  dead-man button is held (``rtmu.control.gamepad`` turns pad events into these). It rides
   the SAME lease as the keys (held keys win over the stick while both are held);
   every stop above blocks the stick too, until the dead-man is released and
   pressed again.
@@ -52,12 +52,12 @@ from collections.abc import Callable, Mapping
 from dataclasses import replace
 from typing import Protocol
 
-from .client.lease import DriveLease, DriveRatios, EndReason
+from ..base.notices import Kind, Notice
+from ..client.lease import DriveLease, DriveRatios, EndReason
+from ..model.observables import OperatorState, RobotModel, SpeedSetting
+from ..settings.store import Profile
+from ..values.state import ConnectionState, LinkHealth, LinkLevel, NavState, Phase
 from .commands import COMMANDS, CommandRegistry, CommandState
-from .model import OperatorState, RobotModel, SpeedSetting
-from .notices import Kind, Notice
-from .settings import Profile
-from .state import ConnectionState, LinkHealth, LinkLevel, NavState, Phase
 
 TICK = 0.1
 """Seconds between :meth:`Controller.tick` calls the UI timer should make (10 Hz renewal)."""
@@ -138,7 +138,7 @@ class ClientLink(Protocol):
 
 
 class SecretStore(Protocol):
-    """Where remembered passwords live (``rtmu.settings`` provides the keyring-backed one)."""
+    """Where remembered passwords live (``rtmu.settings.store`` provides the keyring-backed one)."""
 
     def get(self, profile: Profile) -> str | None: ...
 

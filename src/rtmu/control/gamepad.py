@@ -72,7 +72,7 @@ MIN_PUSH_INTERVAL = 0.05
 
 
 class Drive(Protocol):
-    """What the mapping needs of :class:`rtmu.controller.Controller`."""
+    """What the mapping needs of :class:`rtmu.control.controller.Controller`."""
 
     def analog(self, trans: float, rot: float) -> None: ...
 

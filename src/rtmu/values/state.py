@@ -2,7 +2,7 @@
 
 Plain frozen dataclasses: the network thread builds them, hands them over as a
 :data:`StateChange` (one class per part, so a change can never land on the
-wrong part), and the UI thread keeps them in :class:`rtmu.model.RobotModel`.
+wrong part), and the UI thread keeps them in :class:`rtmu.model.observables.RobotModel`.
 Nothing here imports GTK or asyncio, and nothing here is tied to a thread, so
 the client layer uses this module and never the UI thread's observables.
 """
@@ -14,7 +14,7 @@ from enum import Enum, StrEnum
 from typing import TYPE_CHECKING, Protocol
 
 if TYPE_CHECKING:
-    from .mapfile.model import MapData
+    from ..mapfile.model import MapData
 
 
 # -- robot ---------------------------------------------------------------------------------------

@@ -17,16 +17,16 @@ from collections.abc import Callable, Iterable, Iterator
 from dataclasses import dataclass, field
 from typing import Any
 
-from .capture import CaptureEvent, Datagram, Endpoint, Flow, StreamData, StreamEnd, StreamGap
-from .protocol import payloads  # noqa: F401 -- importing the package registers every payload type
-from .protocol.commands import ClientCommand, ServerCommand, is_control_command
-from .protocol.datalist import DataList
-from .protocol.decoder import BadPacket, PacketDecoder
-from .protocol.fields import FieldReader
-from .protocol.packet import MIN_LENGTH, SYNC, Packet
-from .protocol.payloads import base as payload_base
-from .protocol.payloads import control
-from .protocol.payloads.base import Payload, Side
+from ..protocol import payloads  # noqa: F401 -- importing the package registers every payload type
+from ..protocol.commands import ClientCommand, ServerCommand, is_control_command
+from ..protocol.datalist import DataList
+from ..protocol.decoder import BadPacket, PacketDecoder
+from ..protocol.fields import FieldReader
+from ..protocol.packet import MIN_LENGTH, SYNC, Packet
+from ..protocol.payloads import base as payload_base
+from ..protocol.payloads import control
+from ..protocol.payloads.base import Payload, Side
+from . import CaptureEvent, Datagram, Endpoint, Flow, StreamData, StreamEnd, StreamGap
 
 C2S = "c2s"
 S2C = "s2c"

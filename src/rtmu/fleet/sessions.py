@@ -1,10 +1,10 @@
 """One session per robot, and the fleet that owns them: what the application builds.
 
 A :class:`RobotSession` puts together everything that belongs to one robot —
-its state (:class:`~rtmu.model.RobotModel`: robot, map, camera, connection,
+its state (:class:`~rtmu.model.observables.RobotModel`: robot, map, camera, connection,
 health, trail), its network thread (:class:`~rtmu.client.runner.ClientRunner`,
 which holds the drive lease, the session and its guardian) and its
-:class:`~rtmu.controller.Controller` — and takes them apart again in one
+:class:`~rtmu.control.controller.Controller` — and takes them apart again in one
 :meth:`RobotSession.close` that stops the robot first.
 
 The :class:`Fleet` owns the sessions, says which one is selected, and stops
@@ -28,8 +28,8 @@ from dataclasses import replace
 from pathlib import Path
 from typing import Any, cast
 
-from .client.link import Opener, open_tcp
-from .client.roster import (
+from ..client.link import Opener, open_tcp
+from ..client.roster import (
     DirectRoster,
     RobotAdded,
     RobotEndpoint,
@@ -39,15 +39,15 @@ from .client.roster import (
     RosterLost,
     RosterRestored,
 )
-from .client.runner import ClientRunner, Post, call_directly, settle
-from .client.session import SessionConfig
-from .commands import COMMANDS, CommandRegistry
-from .controller import ClientLink, Controller, NoView, SecretStore, View
-from .model import Observable, OperatorState, RobotModel
-from .recorder import Recorder, RecorderConfig
-from .recorder.files import recordings_dir
-from .recorder.intents import IntentTap
-from .settings import Profile, RecordingSettings
+from ..client.runner import ClientRunner, Post, call_directly, settle
+from ..client.session import SessionConfig
+from ..control.commands import COMMANDS, CommandRegistry
+from ..control.controller import ClientLink, Controller, NoView, SecretStore, View
+from ..model.observables import Observable, OperatorState, RobotModel
+from ..recorder import Recorder, RecorderConfig
+from ..recorder.files import recordings_dir
+from ..recorder.intents import IntentTap
+from ..settings.store import Profile, RecordingSettings
 
 CLOSE_TIMEOUT = 1.5
 """How long closing one session may take (stop, disconnect, end the network thread)."""

@@ -20,7 +20,7 @@ from collections.abc import Iterator
 from dataclasses import dataclass
 from typing import ClassVar, Protocol
 
-from .state import Phase
+from ..values.state import Phase
 
 LINKING = (Phase.CONNECTING, Phase.RECONNECTING, Phase.CONNECTED)
 """Phases in which there is something to disconnect (an attempt in progress can be cancelled)."""
@@ -40,7 +40,7 @@ class CommandContext(Protocol):
 
 
 class CommandTarget(Protocol):
-    """What commands act on (``rtmu.controller.Controller`` provides it)."""
+    """What commands act on (``rtmu.control.controller.Controller`` provides it)."""
 
     def press(self, direction: str) -> None: ...
 
