@@ -35,7 +35,7 @@ from .process import screenshot  # noqa: E402
 
 REPO = Path(__file__).resolve().parents[2]
 OFFICE_MAP = REPO / "data" / "maps" / "office.map"
-COUNTS = {"windows": 0, "pictures": 0}
+COUNTS = {"windows": 0, "pictures": 0, "apps": 0}
 """Windows opened and pictures saved so far: every test that opens a window must leave a picture."""
 OPEN: dict[int, Callable[[], None]] = {}
 """The teardown of every app still open, by id: the GUI conftest closes what a failed test left."""
@@ -118,6 +118,10 @@ class Gui:
     def open(cls, options: GuiOptions, shots: Path, name: str, *, connect: bool = True) -> Gui:
         """The app with these options, activated as ``rtmu`` would; waits for the connection if asked."""
         app = RtmuApplication(options)
+        # Each window of this process exports its own object on the session bus (where there is one):
+        # a second app under the same id would collide with the first one's export.
+        COUNTS["apps"] += 1
+        app.set_application_id(f"{app.get_application_id()}.Test{COUNTS['apps']}")
         app.register(None)
         gui = cls(app, shots, name)
         OPEN[id(gui)] = gui.close  # before anything can fail: a half-opened app is closed too
