@@ -21,7 +21,7 @@ import statistics
 import time
 import zlib
 from collections import deque
-from collections.abc import Callable
+from collections.abc import Callable, Iterable
 from dataclasses import dataclass, field
 
 from ..protocol.errors import ProtocolError
@@ -236,6 +236,17 @@ class FrameStats:
         return cuts[min(max(int(p) - 1, 0), 98)]
 
 
+def picture_source(offers: Iterable[str]) -> str | None:
+    """The data a picture is asked with: the first ``getPicture…`` listed, else ``sendVideo``, else None.
+
+    The one rule, for the window's enabling (from the offered names) and the client alike."""
+    names = set(offers)
+    pictures = sorted(n for n in names if n.startswith("getPicture"))
+    if pictures:
+        return pictures[0]
+    return "sendVideo" if "sendVideo" in names else None
+
+
 def video_source(client: AriaClient, camera: str | None = None) -> str:
     """``getPicture<camera>`` (the first listed when no camera is named), else ``sendVideo``."""
     if camera is not None:
@@ -243,12 +254,10 @@ def video_source(client: AriaClient, camera: str | None = None) -> str:
         if not client.supports(name):
             raise NotSupported(name, f"this server has no camera named {camera!r} ({name})")
         return name
-    pictures = sorted(e.name for e in client.datalist if e.name.startswith("getPicture"))
-    if pictures:
-        return pictures[0]
-    if client.supports("sendVideo"):
-        return "sendVideo"
-    raise NotSupported("getPicture", "this server offers no camera pictures (getPicture… or sendVideo)")
+    source = picture_source(e.name for e in client.datalist)
+    if source is None:
+        raise NotSupported("getPicture", "this server offers no camera pictures (getPicture… or sendVideo)")
+    return source
 
 
 FrameSink = Callable[[LiveFrame], None]
