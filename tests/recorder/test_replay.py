@@ -20,6 +20,7 @@ from rtmu.recorder import Recorder, RecorderConfig
 from rtmu.recorder.replay import PacedLink, ReplayClock, Replayer
 from rtmu.recorder.replay_file import ReplayFileError, compressed_image_data, load
 from rtmu.sim import SimConfig, SimThread
+from rtmu.values.intents import RequestPicture
 from rtmu.values.state import CameraChanged, MapChanged, MapPhase, RobotChanged, StateChange
 
 from .poses import poses, recorded_pose_at
@@ -35,7 +36,7 @@ def recording(tmp_path_factory: pytest.TempPathFactory) -> Path:
         ui.wait_for(lambda: session.state.map.value.state is MapPhase.READY, timeout=15)
         for _ in range(2):
             before = session.state.camera.value
-            session.controller.request_image()
+            session.controller.ask(RequestPicture())
             ui.wait_for(lambda b=before: session.state.camera.value is not b, timeout=5)
         hold(ui, session, "forward", 1.2)
         hold(ui, session, "left", 0.8)

@@ -54,6 +54,8 @@ class DriveFeed(Feed):
         """Optional tap (a flight recorder): ``on_stop(reason, sent)`` after every zero-ratios + ``stop``."""
         self.on_lost: Callable[[ClientError], None] = lambda error: None
         """The session's reaction to a lost link (reconnect, or say it failed)."""
+        self.on_ping_reply: Callable[[str, bytes], None] = lambda name, payload: None
+        """Each ping's answer (the session hands a ``getSafeDrive`` answer to the status feed)."""
         self.busy: Callable[[], bool] = lambda: False
         """True while a long reply (the map) is arriving: its bytes keep the link alive."""
         self._kick = asyncio.Event()
@@ -174,10 +176,7 @@ class DriveFeed(Feed):
                 return
             else:
                 self.health.note_rtt(time.perf_counter() - started)
-                if name == "getSafeDrive":
-                    from .status_feed import StatusFeed
-
-                    self.ctx.feed(StatusFeed).on_safe_drive(reply.payload)
+                self.on_ping_reply(name, reply.payload)
                 self.publish_health()
             await asyncio.sleep(config.ping_interval)
 

@@ -170,15 +170,16 @@ class MapFeed(Feed):
             self.ctx.notice(Notice.warning(Kind.MAP, f"The map could not be loaded: {reason}"))
         return self.value
 
-    def goal_pose(self, name: str) -> tuple[float, float, float | None] | None:
-        """The loaded map's goal called ``name``: (x, y, heading — only for a ``GoalWithHeading``)."""
-        data = self.value.data
-        if data is None or not name:
-            return None
-        for o in data.objects:
-            if o.is_goal and o.name == name:
-                return (o.x, o.y, o.th if o.type.lower() == "goalwithheading" else None)
+
+def goal_pose(model: MapModel, name: str) -> tuple[float, float, float | None] | None:
+    """The map's goal called ``name``: (x, y, heading — only for a ``GoalWithHeading``); None without one."""
+    data = model.data
+    if data is None or not name:
         return None
+    for o in data.objects:
+        if o.is_goal and o.name == name:
+            return (o.x, o.y, o.th if o.type.lower() == "goalwithheading" else None)
+    return None
 
 
 async def _wait(task: asyncio.Task[MapModel]) -> None:

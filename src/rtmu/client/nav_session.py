@@ -29,7 +29,7 @@ from ..values.state import NavChanged, NavOutcome, NavState, RobotState
 from .connection import AriaClient, Packet
 from .errors import ClientError
 from .feed import Feed, FeedContext
-from .map_feed import MapFeed
+from .map_feed import goal_pose
 from .nav_status import MAX_TEXT, NAV_DATA, NavPhase, NavReading, path_remaining, read_status
 from .subscriptions import Subscription
 
@@ -139,7 +139,7 @@ class NavFeed(Feed):
             reading = NavReading(phase, "dock", text=dock_state)
         if reading.phase is NavPhase.GOING:
             target = reading.target
-            pose = self._sent_pose if target == "point" else self.ctx.feed(MapFeed).goal_pose(target)
+            pose = self._sent_pose if target == "point" else goal_pose(self.ctx.map, target)
             self._update(
                 navigating=True,
                 target=target,

@@ -273,7 +273,7 @@ class ClientRunner:
         if future.cancelled():
             return
         exc = future.exception()
-        if isinstance(exc, ClientError):
+        if isinstance(exc, (ClientError, ValueError)):  # the server's refusal, or an argument out of bounds
             self._notice(Notice.error(kind, str(exc)))
         elif exc is not None:
             log.error("network call failed", exc_info=exc)

@@ -45,6 +45,7 @@ from .lease import DriveLease, EndReason
 from .map_feed import MapFeed
 from .reconnect import worth_retrying
 from .session_config import SessionConfig, Target
+from .status_feed import StatusFeed
 from .subscriptions import Handler, Subscription, applicable, merged
 
 log = logging.getLogger(__name__)
@@ -107,6 +108,13 @@ class Session:
         self.drive.on_lost = self._connection_lost
         self.maps = self.feed(MapFeed)
         self.drive.busy = lambda: self.maps.downloading
+        status = self.feed(StatusFeed)
+        status.on_status = self.drive.note_status  # the status stream is the link's heartbeat
+        self.drive.on_ping_reply = self._on_ping_reply
+
+    def _on_ping_reply(self, name: str, payload: bytes) -> None:
+        if name == "getSafeDrive":  # the cheapest request may also be the one that says safe drive's state
+            self.feed(StatusFeed).on_safe_drive(payload)
 
     # -- the feeds' context ------------------------------------------------------------------
     @property

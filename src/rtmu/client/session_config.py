@@ -4,13 +4,10 @@ from __future__ import annotations
 
 from collections.abc import Callable
 from dataclasses import dataclass, field
-from typing import TYPE_CHECKING
+from typing import Any
 
 from .mapcache import SharedMaps
 from .reconnect import Backoff
-
-if TYPE_CHECKING:
-    from .feed import Feed
 
 
 @dataclass
@@ -37,8 +34,9 @@ class SessionConfig:
     the robot if this process is killed or frozen while driving. The window and ``rtmu drive`` do."""
     shared_maps: SharedMaps | None = field(default=None, compare=False)
     """Maps shared with the process's other sessions (a fleet's window: one download per map file)."""
-    extra_feeds: tuple[type[Feed], ...] = ()
-    """Feeds besides the standard set (:data:`rtmu.client.feeds.FEEDS`): a new capability plugs in here."""
+    extra_feeds: tuple[type[Any], ...] = ()
+    """:class:`~rtmu.client.feed.Feed` classes besides the standard set (:data:`rtmu.client.feeds.FEEDS`):
+    a new capability plugs in here."""
 
 
 @dataclass

@@ -8,7 +8,7 @@ whose health monitor declares the link stale when they stop.
 from __future__ import annotations
 
 import contextlib
-from collections.abc import Iterable
+from collections.abc import Callable, Iterable
 from typing import ClassVar
 
 from ..protocol.errors import ProtocolError
@@ -18,7 +18,7 @@ from ..protocol.payloads.robot import BatteryInfo, ModeInfo, Update, UpdateNumbe
 from ..values.intents import Intent, SetSafeDrive
 from .connection import AriaClient, Packet
 from .errors import ClientError
-from .feed import Feed
+from .feed import Feed, FeedContext
 from .subscriptions import Subscription
 
 
@@ -26,6 +26,11 @@ class StatusFeed(Feed):
     """Decodes the status stream into the published :class:`~rtmu.values.state.RobotState`."""
 
     handles: ClassVar[tuple[type[Intent], ...]] = (SetSafeDrive,)
+
+    def __init__(self, ctx: FeedContext) -> None:
+        super().__init__(ctx)
+        self.on_status: Callable[[float], None] = lambda at: None
+        """Every status packet's arrival time: the session gives it to the drive loop's health."""
 
     def subscriptions(self, client: AriaClient) -> Iterable[Subscription]:
         period = self.ctx.config.status_interval_ms
@@ -81,15 +86,12 @@ class StatusFeed(Feed):
             self._apply_numbers(numbers, packet.received_at)
 
     def _apply_numbers(self, n: UpdateNumbers, at: float) -> None:
-        from .drive_loop import DriveFeed  # the drive loop's health hears every status
-
-        drive = self.ctx.feed(DriveFeed)
         self.ctx.robot_update(
             x=float(n.x), y=float(n.y), th=float(n.th), vel=float(n.vel), rot_vel=float(n.rot_vel),
             lat_vel=float(n.lat_vel), battery_v=n.battery,
             temperature=float(n.temperature) if n.temperature_known else None, numbers_at=at,
         )  # fmt: skip
-        drive.note_status(at)
+        self.on_status(at)
 
     def _on_strings(self, packet: Packet) -> None:
         s = self.ctx.decode(packet.name, packet.payload)

@@ -21,11 +21,12 @@ import statistics
 import time
 import zlib
 from collections import deque
-from collections.abc import Callable, Iterable
+from collections.abc import Callable
 from dataclasses import dataclass, field
 
 from ..protocol.errors import ProtocolError
 from ..protocol.payloads.camera import VideoFrame
+from ..values.intents import picture_source
 from ..values.state import VideoStatus
 from .connection import AriaClient
 from .errors import ClientError, ClientTimeout, NotSupported, ServerClosed
@@ -234,17 +235,6 @@ class FrameStats:
             return self.ages_ms[0]
         cuts = statistics.quantiles(self.ages_ms, n=100, method="inclusive")
         return cuts[min(max(int(p) - 1, 0), 98)]
-
-
-def picture_source(offers: Iterable[str]) -> str | None:
-    """The data a picture is asked with: the first ``getPicture…`` listed, else ``sendVideo``, else None.
-
-    The one rule, for the window's enabling (from the offered names) and the client alike."""
-    names = set(offers)
-    pictures = sorted(n for n in names if n.startswith("getPicture"))
-    if pictures:
-        return pictures[0]
-    return "sendVideo" if "sendVideo" in names else None
 
 
 def video_source(client: AriaClient, camera: str | None = None) -> str:

@@ -54,10 +54,9 @@ from typing import Any, Protocol
 
 from ..base.notices import Kind, Notice
 from ..client.lease import DriveLease, DriveRatios, EndReason
-from ..client.video_feed import picture_source
 from ..model.observables import OperatorState, RobotModel, SpeedSetting
 from ..settings.store import Profile
-from ..values.intents import GotoGoal, Intent, Stop
+from ..values.intents import GotoGoal, Intent, RequestPicture, StartVideo, Stop, picture_source
 from ..values.state import ConnectionState, LinkHealth, LinkLevel, NavState, Phase
 from .commands import COMMANDS, CommandRegistry, CommandState
 
@@ -458,11 +457,15 @@ class Controller:
         if self.replay:
             self._say_replay()
             return None
-        if (intent.needs or intent.moves) and not self.connected:
+        offers = self.robot.connection.value.offers
+        if (intent.needs or intent.moves or not intent.offered(())) and not self.connected:
             self.view.notify(Notice.warning(intent.kind, f"{intent.label}: not connected"))
             return None
-        if intent.needs and not any(self.supports(name) for name in intent.needs):
-            self.view.notify(Notice.warning(intent.kind, f"This server does not offer {intent.needs[0]}"))
+        if not intent.offered(offers):
+            missing = f"offer {intent.needs[0]}" if intent.needs else f"offer {intent.label.lower()}"
+            if isinstance(intent, (RequestPicture, StartVideo)):
+                missing = "offer camera pictures"
+            self.view.notify(Notice.warning(intent.kind, f"This server does not {missing}"))
             return None
         goals = self.robot.navigation.value.goals
         if isinstance(intent, GotoGoal) and goals and intent.name not in goals:

@@ -22,7 +22,7 @@ the network side turns into ``ratioDrive`` (see :mod:`rtmu.client.lease`). :clas
 from __future__ import annotations
 
 import dataclasses
-from collections.abc import Mapping
+from collections.abc import Collection, Iterable, Mapping
 from dataclasses import dataclass, field
 from typing import Any, ClassVar
 
@@ -38,6 +38,11 @@ class Intent:
     label: ClassVar[str] = "Request"
     kind: ClassVar[Kind] = Kind.COMMAND
     """Where a failure is told to the operator (the navigation banner, the camera page…)."""
+
+    @classmethod
+    def offered(cls, offers: Collection[str]) -> bool:
+        """Whether a server listing ``offers`` can carry this intent out (``needs``: any one of them)."""
+        return not cls.needs or any(name in offers for name in cls.needs)
 
     def record(self) -> dict[str, Any]:
         """The intent's fields as plain JSON values, for the flight recorder (no secret is ever an intent)."""
@@ -178,9 +183,24 @@ class Say(Intent):
     text: str = ""
 
 
+def picture_source(offers: Iterable[str]) -> str | None:
+    """The data a picture is asked with: the first ``getPicture…`` listed, else ``sendVideo``, else None.
+
+    The one rule, for the window's enabling (from the offered names) and the client alike."""
+    names = set(offers)
+    pictures = sorted(n for n in names if n.startswith("getPicture"))
+    if pictures:
+        return pictures[0]
+    return "sendVideo" if "sendVideo" in names else None
+
+
 @dataclass(frozen=True)
 class RequestPicture(Intent):
     """One camera picture (the first ``getPicture…``, else ``sendVideo``)."""
+
+    @classmethod
+    def offered(cls, offers: Collection[str]) -> bool:
+        return picture_source(offers) is not None
 
     kind: ClassVar[Kind] = Kind.CAMERA
     label: ClassVar[str] = "Camera picture"
@@ -194,6 +214,10 @@ class StartVideo(Intent):
     label: ClassVar[str] = "Live video"
     fps: float | None = None
     quality: int | None = None
+
+    @classmethod
+    def offered(cls, offers: Collection[str]) -> bool:
+        return picture_source(offers) is not None
 
 
 @dataclass(frozen=True)
