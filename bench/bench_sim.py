@@ -50,7 +50,7 @@ from rtmu.sim.sonar import sonar_ranges
 
 REPO = Path(__file__).resolve().parents[1]
 OFFICE = REPO / "data" / "maps" / "office.map"
-COLUMBIA = REPO.parent / "shared" / "aria-maps" / "columbia.map"
+COLUMBIA = REPO / "tests" / "data" / "aria-maps" / "columbia.map"
 SIM_SECONDS = 10.0
 
 
