@@ -10,9 +10,10 @@ from pathlib import Path
 import pytest
 
 from rtmu.cli import main
+from rtmu.package_data import MAPS_DIR
 from testdata import ARIA_MAPS
 
-MAPS_DIR = Path(__file__).resolve().parents[1] / "data" / "maps"
+MAPS_DIR = MAPS_DIR
 
 
 def test_text_summary(capsys: pytest.CaptureFixture[str]) -> None:

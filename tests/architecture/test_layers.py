@@ -15,7 +15,7 @@ from .import_graph import cycles, import_graph
 SRC = Path(__file__).resolve().parents[2] / "src"
 
 LAYERS: dict[str, tuple[str, ...]] = {
-    "base": ("rtmu", "rtmu.textsafe", "rtmu.exit_codes", "rtmu.notices"),
+    "base": ("rtmu", "rtmu.textsafe", "rtmu.exit_codes", "rtmu.notices", "rtmu.package_data"),
     "codec": ("rtmu.protocol",),
     "maps": ("rtmu.mapfile", "rtmu.maps"),
     "values": ("rtmu.state",),

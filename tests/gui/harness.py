@@ -19,6 +19,8 @@ from pathlib import Path
 import gi
 import numpy as np
 
+from rtmu.package_data import project_map
+
 gi.require_version("Gtk", "4.0")
 gi.require_version("Gdk", "4.0")
 gi.require_version("GdkX11", "4.0")
@@ -33,8 +35,7 @@ from rtmu.ui.window import MainWindow  # noqa: E402
 
 from .process import screenshot  # noqa: E402
 
-REPO = Path(__file__).resolve().parents[2]
-OFFICE_MAP = REPO / "data" / "maps" / "office.map"
+OFFICE_MAP = project_map("office.map")
 COUNTS = {"windows": 0, "pictures": 0}
 """Windows opened and pictures saved so far: every test that opens a window must leave a picture."""
 OPEN: dict[int, Callable[[], None]] = {}

@@ -12,12 +12,12 @@ from client.uiqueue import UiQueue
 from rtmu.client.session import SessionConfig
 from rtmu.fleet import Fleet, RobotSession
 from rtmu.model import Phase
+from rtmu.package_data import project_map
 from rtmu.settings import Profile, RecordingSettings
 from rtmu.sim import SimConfig, SimThread
 from rtmu.state import StateChange
 
-REPO = Path(__file__).resolve().parents[2]
-ARENA = REPO / "data" / "maps" / "arena.map"
+ARENA = project_map("arena.map")
 
 
 @contextmanager
