@@ -16,8 +16,9 @@ import signal
 import sys
 from collections.abc import Sequence
 
-from . import __version__, subcommands
+from . import subcommands
 from .exit_codes import EXIT_USAGE
+from .versions import VersionAction
 
 
 def build_parser() -> argparse.ArgumentParser:
@@ -25,7 +26,9 @@ def build_parser() -> argparse.ArgumentParser:
         prog="rtmu",
         description="Teleoperate an ARIA (ArNetworking) robot; with no subcommand, open the window.",
     )
-    parser.add_argument("--version", action="version", version=f"rtmu {__version__}")
+    parser.add_argument(
+        "--version", action=VersionAction, help="show the versions of rtmu, its protocol and toolkit; exit"
+    )
     sub = parser.add_subparsers(dest="subcommand", metavar="SUBCOMMAND")
     for info in sorted(pkgutil.iter_modules(subcommands.__path__), key=lambda m: m.name):
         if info.name.startswith("_"):

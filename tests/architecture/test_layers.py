@@ -20,6 +20,7 @@ LAYERS: dict[str, tuple[str, ...]] = {
     "maps": ("rtmu.mapfile", "rtmu.maps"),
     "values": ("rtmu.state",),
     "capture": ("rtmu.capture", "rtmu.session_decoder"),
+    "about": ("rtmu.versions",),
     "client": ("rtmu.client", "rtmu.guardian"),
     "simulator": ("rtmu.sim",),
     "recorder": ("rtmu.recorder",),
@@ -38,6 +39,8 @@ MAY_IMPORT: dict[str, frozenset[str]] = {
     "maps": frozenset({"base"}),
     "values": frozenset({"maps", "base"}),
     "capture": frozenset({"codec", "base"}),
+    # What --version (and later the About window) says: the protocol's facts and the libraries' versions.
+    "about": frozenset({"codec", "base"}),
     # The network side knows the values it publishes, never the UI thread's state above it.
     "client": frozenset({"values", "codec", "maps", "base"}),
     "simulator": frozenset({"codec", "maps", "base"}),
@@ -61,6 +64,7 @@ MAY_IMPORT: dict[str, frozenset[str]] = {
             "simulator",
             "maps",
             "codec",
+            "about",
             "base",
         }
     ),
