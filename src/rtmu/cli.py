@@ -18,6 +18,7 @@ from collections.abc import Sequence
 
 from . import subcommands
 from .exit_codes import EXIT_USAGE
+from .subcommands import _integration
 from .versions import VersionAction
 
 
@@ -42,6 +43,7 @@ def build_parser() -> argparse.ArgumentParser:
         from .ui import app as gui_app
 
         gui_app.add_gui_arguments(parser)
+    _integration.add_arguments(parser)
     return parser
 
 
@@ -49,6 +51,9 @@ def main(argv: Sequence[str] | None = None) -> int:
     parser = build_parser()
     args = parser.parse_args(argv)
     handler = getattr(args, "handler", None)
+    installing = _integration.handle(args, parser) if handler is None else None
+    if installing is not None:
+        return installing
     if handler is None:
         if importlib.util.find_spec("rtmu.ui.app") is None:
             print("rtmu: the operator window is not built yet; try 'rtmu --help'", file=sys.stderr)
