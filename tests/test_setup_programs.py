@@ -95,7 +95,7 @@ def test_table_agrees_with_dpkg(program: str) -> None:
         assert owners, f"{program}: dpkg knows no package for {path}"
     else:
         # The package itself, or one it depends on directly (the same program moves between packages
-        # across releases: dbus-daemon is Debian 12's dbus-daemon package, Ubuntu 22.04's dbus).
+        # across releases: dbus-daemon is in Debian 12's dbus-daemon package, in Ubuntu 22.04's dbus).
         brings = {want} | direct_dependencies(want)
         assert owners & brings, f"{program}: setup.sh says {want} (brings {brings}), dpkg -S says {owners}"
 

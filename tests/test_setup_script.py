@@ -35,7 +35,7 @@ OTHER_PACKAGES = [
     "bsdextrautils",
     "appstream",
     "desktop-file-utils",
-    "dbus-x11",
+    "dbus",
 ]
 TOOLS = [
     "awk",
