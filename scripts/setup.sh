@@ -17,7 +17,7 @@ export DEBIAN_FRONTEND=noninteractive
 APT_PACKAGES=(
     gir1.2-gtk-4.0 gir1.2-adw-1 gir1.2-manette-0.2 libgirepository1.0-dev libcairo2-dev pkg-config
     build-essential xvfb xdotool openbox x11-utils xxd bsdextrautils
-    appstream desktop-file-utils dbus
+    appstream desktop-file-utils dbus git
 )
 # Every program the app, tests, bench and scripts start -> the package above that installs it
 # ("essential": in every Debian install). tests/test_setup_programs.py keeps this true.
@@ -28,7 +28,7 @@ PROGRAM_PACKAGES=(
     Xvfb=xvfb xdotool=xdotool openbox=openbox xwininfo=x11-utils xprop=x11-utils bash=essential
     xxd=xxd hexdump=bsdextrautils od=essential
     appstreamcli=appstream desktop-file-validate=desktop-file-utils
-    dbus-daemon=dbus dbus-run-session=dbus
+    dbus-daemon=dbus dbus-run-session=dbus git=git
 )
 VENV=.venv
 STAMP="$VENV/.rtmu-setup-stamp"

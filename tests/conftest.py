@@ -6,8 +6,12 @@ import atexit
 import os
 import shutil
 import tempfile
+from pathlib import Path
 
+import pytest
 from hypothesis import settings
+
+from checkout import build_dists
 
 # The window records every session (rtmu.recorder) under $XDG_DATA_HOME: never into the real home
 # from a test, nor from the windows and subprocesses tests start (they inherit this environment).
@@ -20,3 +24,9 @@ atexit.register(shutil.rmtree, _DATA_HOME, ignore_errors=True)
 if "CI" not in os.environ:
     settings.register_profile("rtmu-local", deadline=None)
     settings.load_profile("rtmu-local")
+
+
+@pytest.fixture(scope="session")
+def built_dists(tmp_path_factory: pytest.TempPathFactory) -> tuple[Path, Path]:
+    """The sdist and wheel ``python -m build`` makes of this checkout, built once per run."""
+    return build_dists(tmp_path_factory.mktemp("dists"))

@@ -36,6 +36,7 @@ OTHER_PACKAGES = [
     "appstream",
     "desktop-file-utils",
     "dbus",
+    "git",
 ]
 TOOLS = [
     "awk",
