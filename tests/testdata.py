@@ -2,7 +2,7 @@
 
 ``captures/`` holds sessions recorded from ARIA 2.9.1's own programs and ``aria-maps/`` ARIA's example
 maps (GPL-2, test data only: see each folder's README). Tests and benchmarks name these paths from
-here, so a clone runs with no ``../shared`` folder beside it (``tests/test_self_contained.py``).
+here, so a clone runs with nothing beside it (``tests/test_self_contained.py``).
 """
 
 from __future__ import annotations
