@@ -123,10 +123,10 @@ TMP_ROOT = tempfile.mkdtemp(prefix="rtmu-gui-")
 end of the session. The harness finds it through RTMU_GUI_TMP."""
 os.environ["RTMU_GUI_TMP"] = TMP_ROOT
 
-if _XVFB is None or _XDOTOOL is None or _DBUS_DAEMON is None:
-    SKIP_REASON = (
-        "Xvfb, xdotool and dbus-daemon are needed for the GUI tests (./rtmu-dev setup installs them)"
-    )
+if _XVFB is None or _XDOTOOL is None:
+    SKIP_REASON = "Xvfb and xdotool are needed for the GUI tests (apt-get install xvfb xdotool)"
+elif _DBUS_DAEMON is None:
+    SKIP_REASON = "dbus-daemon is needed for the GUI tests' session bus (apt-get install dbus)"
 else:
     display = _start_xvfb()
     bus = _spawn_session_bus()
