@@ -20,18 +20,17 @@ import statistics
 import struct
 import threading
 import time
-from pathlib import Path
 
 from websockets.sync.client import connect
 
 from bench.common import Result
 from rtmu.client.runner import ClientRunner
+from rtmu.package_data import project_map
 from rtmu.recorder import topics
 from rtmu.recorder.bridge import LEASE_TTL, Bridge
 from rtmu.sim import SimConfig, SimThread
 
-REPO = Path(__file__).resolve().parents[1]
-ARENA = REPO / "data" / "maps" / "arena.map"
+ARENA = project_map("arena.map")
 WINDOW = 10.0
 TWIST = json.dumps({"linear": {"x": 0.5}, "angular": {"z": 0.0}}).encode()
 

@@ -14,19 +14,18 @@ from __future__ import annotations
 import asyncio
 import statistics
 import time
-from pathlib import Path
 
 from bench.common import Result, best_time
 from rtmu.client.connection import AriaClient, Packet
 from rtmu.client.detached import DetachedContext
 from rtmu.client.ptz import PtzFeed
 from rtmu.client.server_strings import StringsFeed
+from rtmu.package_data import project_map
 from rtmu.protocol.payloads.strings import StringItem, Strings, StringsInfo
 from rtmu.sim import SimConfig, SimThread
 from rtmu.sim.handlers import STRING_ITEMS
 
-REPO = Path(__file__).resolve().parents[1]
-OFFICE = REPO / "data" / "maps" / "office.map"
+OFFICE = project_map("office.map")
 MOVES = 30
 
 

@@ -1,4 +1,4 @@
-"""Suite-wide settings and the path to the shared ARIA captures and maps (``../shared`` beside the repo)."""
+"""Suite-wide settings (the ARIA captures and maps the tests read are in ``tests/data``: ``testdata``)."""
 
 from __future__ import annotations
 
@@ -11,8 +11,7 @@ from pathlib import Path
 import pytest
 from hypothesis import settings
 
-REPO_ROOT = Path(__file__).resolve().parents[1]
-SHARED_DIR = REPO_ROOT.parent / "shared"
+from checkout import build_dists
 
 # The window records every session (rtmu.recorder) under $XDG_DATA_HOME: never into the real home
 # from a test, nor from the windows and subprocesses tests start (they inherit this environment).
@@ -28,8 +27,6 @@ if "CI" not in os.environ:
 
 
 @pytest.fixture(scope="session")
-def shared_dir() -> Path:
-    """``../shared`` (captures, ARIA maps, docs); CI checks it out beside the repository."""
-    if not SHARED_DIR.is_dir():
-        pytest.fail(f"{SHARED_DIR} is missing: clone or link the shared/ folder beside the repository")
-    return SHARED_DIR
+def built_dists(tmp_path_factory: pytest.TempPathFactory) -> tuple[Path, Path]:
+    """The sdist and wheel ``python -m build`` makes of this checkout, built once per run."""
+    return build_dists(tmp_path_factory.mktemp("dists"))

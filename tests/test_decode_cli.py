@@ -18,8 +18,8 @@ from capture_builders import (
     update_numbers,
 )
 from rtmu.protocol.packet import encode_packet
+from testdata import CAPTURES
 
-CAPTURES = Path(__file__).resolve().parents[1].parent / "shared" / "captures"
 PACKET_KEYS = {"conn", "dir", "command", "name", "length", "checksum_ok", "fields"}
 
 

@@ -10,12 +10,14 @@ from pathlib import Path
 import pytest
 
 from rtmu.cli import main
+from rtmu.package_data import MAPS_DIR
+from testdata import ARIA_MAPS
 
-MAPS_DIR = Path(__file__).resolve().parents[1] / "data" / "maps"
+MAPS_DIR = MAPS_DIR
 
 
-def test_text_summary(shared_dir: Path, capsys: pytest.CaptureFixture[str]) -> None:
-    assert main(["mapinfo", str(shared_dir / "aria-maps" / "columbia.map")]) == 0
+def test_text_summary(capsys: pytest.CaptureFixture[str]) -> None:
+    assert main(["mapinfo", str(ARIA_MAPS / "columbia.map")]) == 0
     out = capsys.readouterr().out
     assert "category:" in out and "2D-Map" in out
     assert "63311 (header: 63311)" in out

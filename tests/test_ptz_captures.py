@@ -1,4 +1,4 @@
-"""The camera head and the server strings against real ARIA sessions (``../shared/captures``).
+"""The camera head and the server strings against real ARIA sessions (``tests/data/captures``).
 
 serverDemo's data list (clientCommandLister) names a VC-C4 head ``Cam1``: ``client.ptz`` finds it
 movable from the names ARIA's camera handler registers, and the simulator registers the same

@@ -16,8 +16,10 @@ import signal
 import sys
 from collections.abc import Sequence
 
-from . import __version__, subcommands
+from . import subcommands
 from .base.exit_codes import EXIT_USAGE
+from .subcommands import _integration
+from .versions import VersionAction
 
 
 def build_parser() -> argparse.ArgumentParser:
@@ -25,7 +27,9 @@ def build_parser() -> argparse.ArgumentParser:
         prog="rtmu",
         description="Teleoperate an ARIA (ArNetworking) robot; with no subcommand, open the window.",
     )
-    parser.add_argument("--version", action="version", version=f"rtmu {__version__}")
+    parser.add_argument(
+        "--version", action=VersionAction, help="show the versions of rtmu, its protocol and toolkit; exit"
+    )
     sub = parser.add_subparsers(dest="subcommand", metavar="SUBCOMMAND")
     for info in sorted(pkgutil.iter_modules(subcommands.__path__), key=lambda m: m.name):
         if info.name.startswith("_"):
@@ -39,6 +43,7 @@ def build_parser() -> argparse.ArgumentParser:
         from .ui import app as gui_app
 
         gui_app.add_gui_arguments(parser)
+    _integration.add_arguments(parser)
     return parser
 
 
@@ -46,6 +51,9 @@ def main(argv: Sequence[str] | None = None) -> int:
     parser = build_parser()
     args = parser.parse_args(argv)
     handler = getattr(args, "handler", None)
+    installing = _integration.handle(args, parser) if handler is None else None
+    if installing is not None:
+        return installing
     if handler is None:
         if importlib.util.find_spec("rtmu.ui.app") is None:
             print("rtmu: the operator window is not built yet; try 'rtmu --help'", file=sys.stderr)

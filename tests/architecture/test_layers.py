@@ -15,18 +15,19 @@ from .import_graph import cycles, import_graph
 SRC = Path(__file__).resolve().parents[2] / "src"
 
 LAYERS: dict[str, tuple[str, ...]] = {
-    "base": ("rtmu", "rtmu.base"),
+    "base": ("rtmu", "rtmu.base", "rtmu.package_data"),
     "codec": ("rtmu.protocol",),
     "maps": ("rtmu.mapfile",),
     "values": ("rtmu.values",),
     "capture": ("rtmu.capture",),
+    "about": ("rtmu.versions",),
     "client": ("rtmu.client", "rtmu.guardian"),
     "simulator": ("rtmu.sim",),
     "recorder": ("rtmu.recorder",),
-    "ui-state": ("rtmu.model",),
-    "settings": ("rtmu.settings",),
+    "ui-state": ("rtmu.model.observables",),
+    "settings": ("rtmu.settings.store",),
     "control": ("rtmu.control",),
-    "fleet": ("rtmu.fleet",),
+    "fleet": ("rtmu.fleet.sessions",),
     "view": ("rtmu.ui",),
     "entry": ("rtmu.cli", "rtmu.__main__", "rtmu.subcommands"),
 }
@@ -38,6 +39,8 @@ MAY_IMPORT: dict[str, frozenset[str]] = {
     "maps": frozenset({"base"}),
     "values": frozenset({"maps", "base"}),
     "capture": frozenset({"codec", "base"}),
+    # What --version (and later the About window) says: the protocol's facts and the libraries' versions.
+    "about": frozenset({"codec", "base"}),
     # The network side knows the values it publishes, never the UI thread's state above it.
     "client": frozenset({"values", "codec", "maps", "base"}),
     "simulator": frozenset({"codec", "maps", "base"}),
@@ -61,6 +64,7 @@ MAY_IMPORT: dict[str, frozenset[str]] = {
             "simulator",
             "maps",
             "codec",
+            "about",
             "base",
         }
     ),

@@ -19,12 +19,12 @@ from rtmu.cli import main
 from rtmu.client.connection import AriaClient
 from rtmu.client.diagnosis import Step, explain
 from rtmu.client.errors import LoginRejected
+from rtmu.package_data import project_map
 from rtmu.protocol.payloads.robot import BatteryInfo
 from rtmu.sim import SimConfig, SimThread
 from rtmu.sim.profiles import ARAM_PROTOCOL, LD_CATALOGUE_SIZE
 
-REPO = Path(__file__).resolve().parents[2]
-OFFICE = REPO / "data" / "maps" / "office.map"
+OFFICE = project_map("office.map")
 
 
 @pytest.fixture(scope="module")

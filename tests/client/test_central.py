@@ -21,13 +21,13 @@ from rtmu.base.exit_codes import EXIT_CONNECTION, EXIT_OK, EXIT_USAGE
 from rtmu.cli import main
 from rtmu.client.central import CentralRoster
 from rtmu.client.roster import RobotAdded, RobotRemoved, RosterEvent, RosterLost, RosterRestored
+from rtmu.package_data import project_map
 from rtmu.sim import SimConfig, SimServer
 from rtmu.sim.central_thread import CentralThread
 
 from .uiqueue import eventually
 
-REPO = Path(__file__).resolve().parents[2]
-ARENA = REPO / "data" / "maps" / "arena.map"
+ARENA = project_map("arena.map")
 NAMES = ["robot1", "robot2", "robot3"]
 
 

@@ -15,6 +15,7 @@ import pytest
 from rtmu import mapfile as maps
 from rtmu.base.exit_codes import EXIT_CONNECTION, EXIT_OK, EXIT_TIMEOUT, EXIT_UNSUPPORTED, EXIT_USAGE
 from rtmu.cli import main
+from rtmu.package_data import project_map
 from rtmu.sim import SimConfig, SimThread
 from rtmu.subcommands._common import host_port
 
@@ -22,8 +23,7 @@ from .servers import SPECS, ServerThread, TestServer
 from .test_connection import free_port
 from .uiqueue import eventually
 
-REPO = Path(__file__).resolve().parents[2]
-ARENA = REPO / "data" / "maps" / "arena.map"
+ARENA = project_map("arena.map")
 STATUS_KEYS = {"x", "y", "th", "vel", "rot_vel", "battery_v", "status", "mode"}
 
 

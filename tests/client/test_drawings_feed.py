@@ -9,12 +9,12 @@ point count and a 3 998-point flood are each bounded and named, and the good dra
 from __future__ import annotations
 
 from collections.abc import Iterator
-from pathlib import Path
 
 import pytest
 
 from rtmu.client.runner import ClientRunner
 from rtmu.model.observables import Phase, RobotModel
+from rtmu.package_data import project_map
 from rtmu.sim import SimConfig, SimThread
 from rtmu.values.intents import DrawingChoices, ShowDrawing
 
@@ -22,8 +22,7 @@ from .drawing_servers import BOLD_POINTS, MARKUP, MAX_POINTS_SENT, SONAR_POINTS,
 from .servers import ServerThread
 from .uiqueue import UiQueue, eventually
 
-REPO = Path(__file__).resolve().parents[2]
-ARENA = REPO / "data" / "maps" / "arena.map"
+ARENA = project_map("arena.map")
 LASER = "sim_lms2xx_1Current"
 
 

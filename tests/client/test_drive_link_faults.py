@@ -11,20 +11,19 @@ import signal
 import subprocess
 import sys
 from collections.abc import Callable, Iterator
-from pathlib import Path
 
 import pytest
 
 from linkfaults import FAKE_HEADER, GARBAGE, TO_CLIENT, TO_SERVER, FaultProxy
 from rtmu.base.exit_codes import EXIT_TIMEOUT
+from rtmu.package_data import project_map
 from rtmu.protocol.decoder import PacketDecoder
 from rtmu.protocol.packet import encode_packet
 from rtmu.sim import SimConfig, SimThread
 
 from .uiqueue import eventually
 
-REPO = Path(__file__).resolve().parents[2]
-ARENA = REPO / "data" / "maps" / "arena.map"
+ARENA = project_map("arena.map")
 AFTER_FAULT_MAX = 8
 """ratioDrive packets the simulator may receive after the fault (already in flight + one resend
 before the fault is seen); a blind drive sends ~10 a second until --seconds ends."""

@@ -9,7 +9,6 @@ import math
 import time
 from collections.abc import Iterator
 from contextlib import contextmanager
-from pathlib import Path
 
 import pytest
 
@@ -32,13 +31,14 @@ from rtmu.control.gamepad import (
 )
 from rtmu.fleet.sessions import Fleet, RobotSession
 from rtmu.model.observables import LinkHealth, LinkLevel, Phase
+from rtmu.package_data import project_map
 from rtmu.settings.store import Profile
 from rtmu.sim import SimConfig, SimThread
 
 from .test_controller import Rig
 from .uiqueue import UiQueue
 
-ARENA = Path(__file__).resolve().parents[2] / "data" / "maps" / "arena.map"
+ARENA = project_map("arena.map")
 PAD = object()
 
 

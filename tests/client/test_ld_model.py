@@ -3,19 +3,18 @@
 from __future__ import annotations
 
 import time
-from pathlib import Path
 
 from rtmu.client.runner import ClientRunner
 from rtmu.client.session import SessionConfig
 from rtmu.model.observables import Phase, RobotModel
+from rtmu.package_data import project_map
 from rtmu.sim import SimConfig, SimThread
 from rtmu.sim.ld_data import ROUTES
 from rtmu.values.intents import Dock
 
 from .uiqueue import UiQueue
 
-REPO = Path(__file__).resolve().parents[2]
-OFFICE = REPO / "data" / "maps" / "office.map"
+OFFICE = project_map("office.map")
 
 
 def connected(port: int) -> tuple[ClientRunner, RobotModel, UiQueue]:

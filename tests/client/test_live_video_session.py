@@ -4,19 +4,19 @@ from __future__ import annotations
 
 import time
 from collections.abc import Iterator
-from pathlib import Path
 
 import pytest
 
 from rtmu.client.runner import ClientRunner
 from rtmu.client.session import SessionConfig
 from rtmu.model.observables import CameraImage, Phase, RobotModel
+from rtmu.package_data import project_map
 from rtmu.sim import SimConfig, SimThread
 from rtmu.values.intents import StartVideo, StopVideo, VideoShown
 
 from .uiqueue import UiQueue
 
-ARENA = Path(__file__).resolve().parents[2] / "data" / "maps" / "arena.map"
+ARENA = project_map("arena.map")
 
 
 def sim_config(port: int = 0) -> SimConfig:

@@ -12,7 +12,6 @@ from __future__ import annotations
 import json
 import time
 from collections.abc import Callable, Iterator
-from pathlib import Path
 from typing import Any
 
 import pytest
@@ -22,6 +21,7 @@ from rtmu.cli import main
 from rtmu.client.ptz import MAX_NAME, NO_HEAD, NO_LIST, POLL_MS
 from rtmu.client.runner import ClientRunner
 from rtmu.model.observables import Phase, RobotModel
+from rtmu.package_data import project_map
 from rtmu.protocol.fields import FieldWriter
 from rtmu.protocol.payloads.camera import Camera, CameraCommand, CameraData, CameraInfo, CameraList
 from rtmu.sim import SimConfig, SimThread
@@ -30,8 +30,7 @@ from rtmu.values.intents import PtzMove, WatchPtz
 from .servers import SPECS, ServerThread, TestServer
 from .uiqueue import UiQueue
 
-REPO = Path(__file__).resolve().parents[2]
-OFFICE = REPO / "data" / "maps" / "office.map"
+OFFICE = project_map("office.map")
 
 
 class Rig:

@@ -10,7 +10,6 @@ a label list that changes — stay bounded and never stop the session.
 from __future__ import annotations
 
 from collections.abc import Iterator
-from pathlib import Path
 from typing import Any
 
 import pytest
@@ -18,6 +17,7 @@ import pytest
 from rtmu.client.runner import ClientRunner
 from rtmu.client.server_strings import INTERVAL_MS, MAX_ITEMS, MAX_TEXT
 from rtmu.model.observables import Phase, RobotModel
+from rtmu.package_data import project_map
 from rtmu.protocol.payloads.strings import StringItem, Strings, StringsInfo
 from rtmu.sim import SimConfig, SimThread
 from rtmu.sim.handlers import STRING_ITEMS
@@ -26,8 +26,7 @@ from rtmu.values.intents import WatchStrings
 from .servers import SPECS, ServerThread, TestServer
 from .uiqueue import UiQueue
 
-REPO = Path(__file__).resolve().parents[2]
-OFFICE = REPO / "data" / "maps" / "office.map"
+OFFICE = project_map("office.map")
 STRING_SPECS = [
     ("getStringsInfo", "labels", "none", "labels", "NavigationInfo", "RETURN_SINGLE"),
     ("getStrings", "values", "none", "strings", "NavigationInfo", "RETURN_SINGLE"),

@@ -16,6 +16,7 @@ from rtmu.client.runner import ClientRunner
 from rtmu.client.session import SessionConfig
 from rtmu.control.controller import Controller
 from rtmu.model.observables import LinkLevel, OperatorState, Phase, RobotModel
+from rtmu.package_data import project_map
 from rtmu.sim import SimConfig, SimThread
 from rtmu.values.intents import RequestPicture, SetSafeDrive
 
@@ -24,8 +25,7 @@ from .fakes import FakeView
 from .servers import run
 from .uiqueue import UiQueue, eventually
 
-REPO = Path(__file__).resolve().parents[2]
-ARENA = REPO / "data" / "maps" / "arena.map"
+ARENA = project_map("arena.map")
 
 
 def sim_config(**kw: object) -> SimConfig:

@@ -6,19 +6,18 @@ import io
 import itertools
 import json
 from collections.abc import Iterator
-from pathlib import Path
 
 import pytest
 from PIL import Image
 
 from rtmu.base.exit_codes import EXIT_CONNECTION, EXIT_OK
 from rtmu.cli import main
+from rtmu.package_data import project_map
 from rtmu.sim import SimConfig, SimThread
 
 from .servers import ServerSide, ServerThread, TestServer
 
-REPO = Path(__file__).resolve().parents[2]
-ARENA = REPO / "data" / "maps" / "arena.map"
+ARENA = project_map("arena.map")
 SUMMARY_KEYS = {"frames", "fps", "kbps", "width", "height", "age_ms_p50", "age_ms_p95"}
 
 

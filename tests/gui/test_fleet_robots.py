@@ -34,7 +34,7 @@ from rtmu.ui.options import GuiOptions
 from rtmu.ui.overlays import STALE_RGB
 from rtmu.ui.robot_list import row_text
 
-from .harness import OFFICE_MAP, OPEN, Gui, idle, pump, scratch_dir
+from .harness import OFFICE_MAP, OPEN, Gui, idle, pump, register, scratch_dir
 
 gi.require_version("Gtk", "4.0")
 from gi.repository import GLib, Gtk  # noqa: E402
@@ -300,7 +300,7 @@ def test_robots_a_roster_names_later_appear_and_the_first_is_shown(
     )
     app = RtmuApplication(options)
     app.roster_for = lambda _profile: late  # type: ignore[method-assign]
-    app.register(None)
+    register(app)
     gui = Gui(app, screenshots, "fleet-late-roster")
     OPEN[id(gui)] = gui.close
     app.activate()

@@ -28,7 +28,7 @@ gi.require_version("Graphene", "1.0")
 from gi.repository import GdkX11, Graphene, Gtk  # noqa: E402
 
 GOALS = {"Meeting Room": (3000, 8300), "Lab B": (22500, 9000), "Room 101": (2000, 3200)}
-"""Cairns of data/maps/office.map used here (mm)."""
+"""Cairns of rtmu/data/maps/office.map used here (mm)."""
 ARRIVE_MM = 250.0
 TRIP_S = 60.0
 

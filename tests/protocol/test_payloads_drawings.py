@@ -10,7 +10,6 @@ from __future__ import annotations
 
 import struct
 import time
-from pathlib import Path
 
 import pytest
 
@@ -29,8 +28,8 @@ from rtmu.protocol.payloads.drawings import (
     Visibility,
 )
 from rtmu.protocol.payloads.sensors import Drawing as SensorsDrawing
+from testdata import CAPTURES
 
-CAPTURES = Path(__file__).resolve().parents[2].parent / "shared" / "captures"
 ARIA_DRAWING_REPLY = (
     "See getDrawingList for the information on how this drawing should be drawn, "
     "and the documentation in ArDrawingData for that information means."

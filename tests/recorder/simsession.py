@@ -13,12 +13,12 @@ from rtmu.client.link import Opener
 from rtmu.client.session_config import SessionConfig
 from rtmu.fleet.sessions import Fleet, RobotSession
 from rtmu.model.observables import Phase
+from rtmu.package_data import project_map
 from rtmu.settings.store import Profile, RecordingSettings
 from rtmu.sim import SimConfig, SimThread
 from rtmu.values.state import StateChange
 
-REPO = Path(__file__).resolve().parents[2]
-ARENA = REPO / "data" / "maps" / "arena.map"
+ARENA = project_map("arena.map")
 
 
 @contextmanager

@@ -1,6 +1,6 @@
 """Navigation as ARNL does it, over loopback on the manual clock: goals, poses, home, tours, dock, locating.
 
-Every scenario drives the office map (``data/maps/office.map``; home in the corridor's west end, a
+Every scenario drives the office map (``rtmu/data/maps/office.map``; home in the corridor's west end, a
 ``Dock`` called Charger just west of it, a forbidden server room, a forbidden line at the stairs).
 """
 
@@ -12,6 +12,7 @@ import struct
 from pathlib import Path
 
 from rtmu.mapfile import MapObject, write_map
+from rtmu.package_data import project_map
 from rtmu.protocol.payloads.commands import CommandList
 from rtmu.protocol.payloads.drive import RatioDrive
 from rtmu.protocol.payloads.ld import DataStoreValue
@@ -32,7 +33,7 @@ from rtmu.sim.project_maps import office_map
 
 from .wire import WireClient, run
 
-OFFICE = Path(__file__).resolve().parents[2] / "data" / "maps" / "office.map"
+OFFICE = project_map("office.map")
 GOALS = {o.name: o for o in office_map().objects}
 
 

@@ -9,12 +9,12 @@ from pathlib import Path
 import pytest
 
 from rtmu.client.connection import AriaClient
+from rtmu.package_data import project_map
 from rtmu.protocol.payloads.robot import BatteryInfo, UpdateNumbers
 from rtmu.sim import SimConfig, SimThread
 from rtmu.sim.profiles import ARAM, EX4_HEADER, LD_CATALOGUE_SIZE, filler_rows, get_profile
 
-REPO = Path(__file__).resolve().parents[2]
-OFFICE = REPO / "data" / "maps" / "office.map"
+OFFICE = project_map("office.map")
 
 
 @pytest.fixture(scope="module")

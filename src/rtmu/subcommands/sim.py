@@ -14,21 +14,12 @@ import asyncio
 import sys
 from pathlib import Path
 
+from ..package_data import project_map
 from ._common import until_stop_signal
 
 EXIT_OK = 0
 EXIT_BAD_INPUT = 2
 EXIT_CANNOT_LISTEN = 3
-
-
-def default_map(name: str = "arena.map") -> Path | None:
-    """One of the project's maps (the arena unless named), when the checkout has it."""
-    here = Path(__file__).resolve()
-    for parent in here.parents:
-        candidate = parent / "data" / "maps" / name
-        if candidate.is_file():
-            return candidate
-    return None
 
 
 def register(subparsers: argparse._SubParsersAction) -> None:
@@ -165,7 +156,7 @@ def run(args: argparse.Namespace) -> int:
     map_path = (
         None
         if args.no_map
-        else (args.map or default_map("office.map" if args.profile == "aram" else "arena.map"))
+        else (args.map or project_map("office.map" if args.profile == "aram" else "arena.map"))
     )
     if map_path is not None and not map_path.is_file():
         print(f"rtmu sim: no such map file: {map_path}", file=sys.stderr)

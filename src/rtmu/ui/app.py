@@ -9,11 +9,8 @@ for as long as it lives.
 from __future__ import annotations
 
 import argparse
-import os
 import sys
-import tempfile
 from dataclasses import replace
-from pathlib import Path
 
 from ..settings.store import DEFAULT_PORT, parse_central
 from .options import GuiOptions
@@ -146,26 +143,11 @@ def display_available() -> bool:
     return bool(Gtk.init_check()) and Gdk.Display.get_default() is not None
 
 
-def demo_map_path() -> Path:
-    """``data/maps/office.map`` of the checkout; an installed RTMU writes the same map to a temp file."""
-    here = Path(__file__).resolve()
-    for parent in here.parents:
-        candidate = parent / "data" / "maps" / "office.map"
-        if candidate.is_file():
-            return candidate
-    from ..mapfile import write_map
-    from ..sim.project_maps import office_map
-
-    target = Path(tempfile.gettempdir()) / f"rtmu-demo-{os.getuid()}" / "office.map"
-    target.parent.mkdir(parents=True, exist_ok=True)
-    write_map(office_map(), target)
-    return target
-
-
 def start_demo_simulator(robots: int = 1):
+    from ..package_data import project_map
     from ..sim import SimConfig, SimThread
 
-    config = SimConfig(host="127.0.0.1", port=0, map_path=demo_map_path(), camera=True)
+    config = SimConfig(host="127.0.0.1", port=0, map_path=project_map("office.map"), camera=True)
     if robots == 1:
         return SimThread(config).start()
     from ..sim.multi import SimFleetThreads, fleet_configs
