@@ -24,10 +24,10 @@ LAYERS: dict[str, tuple[str, ...]] = {
     "client": ("rtmu.client", "rtmu.guardian"),
     "simulator": ("rtmu.sim",),
     "recorder": ("rtmu.recorder",),
-    "ui-state": ("rtmu.model.observables",),
-    "settings": ("rtmu.settings.store",),
+    "ui-state": ("rtmu.model",),
+    "settings": ("rtmu.settings",),
     "control": ("rtmu.control",),
-    "fleet": ("rtmu.fleet.sessions",),
+    "fleet": ("rtmu.fleet",),
     "view": ("rtmu.ui",),
     "entry": ("rtmu.cli", "rtmu.__main__", "rtmu.subcommands"),
 }
