@@ -14,6 +14,7 @@ uploads are in :mod:`.download` and :mod:`.upload`.
 from __future__ import annotations
 
 import contextlib
+import os
 from collections.abc import AsyncGenerator, AsyncIterator
 from dataclasses import dataclass
 from typing import Final, cast
@@ -169,6 +170,16 @@ def remote_path(path: str, *, folder: bool = False) -> str:
     if len(joined) > MAX_NAME:
         raise ValueError(f"the path is longer than the {MAX_NAME} characters ARIA reads")
     return joined
+
+
+def local_name(name: str) -> str:
+    """A checked name from the robot as this computer's file system spells it (the same bytes)."""
+    return os.fsdecode(checked_name(name, "a file named").encode("latin-1"))
+
+
+def wire_name(name: str) -> str:
+    """A local file name as the robot will see it: its bytes, which ARIA strings carry as they are."""
+    return os.fsencode(name).decode("latin-1")
 
 
 def split_path(path: str) -> tuple[str, str]:
