@@ -125,7 +125,7 @@ def test_mapping_end_is_two_bytes_except_for_nothing_to_end() -> None:
         ("Office.2D", "office.2d"),
         ("x.2dd", "x.2dd"),
         ("ÄB", "Äb.2d"),
-    ],  # noqa: E501
+    ],
 )
 def test_scan_file_name_follows_aria(name: str, file: str) -> None:
     assert scan_file_name(name) == file

@@ -29,6 +29,8 @@ from ..exit_codes import EXIT_USAGE
 from ..protocol.errors import ProtocolError
 from ..protocol.payloads.files import (
     GET_FILE_WORDS,
+    DirEntry,
+    EntryKind,
     FileChunk,
     GetFileCode,
     GetFileRequest,
@@ -120,12 +122,15 @@ async def download_file(
     source = data_for(client, "download")
     check_destination(local, overwrite=overwrite)
     if size is None and offers(client, "list"):
-        entry = await find_entry(client, remote, timeout=timeout)
+        try:
+            entry = await find_entry(client, remote, timeout=timeout)
+        except Refused:  # ARIA lists folders by their exact name but finds files ignoring case
+            entry = DirEntry(EntryKind.FILE, remote, 0, 0, MAX_DOWNLOAD - GROWTH_SLACK)
         if entry is None:
             raise Refused(f"the robot lists no file {visible(repr(remote))}")
         if entry.is_folder:
             raise Refused(f"{visible(repr(remote))} is a folder on the robot, not a file")
-        size = entry.size
+        size = entry.size if entry.size < MAX_DOWNLOAD - GROWTH_SLACK else None
     limit = MAX_DOWNLOAD if size is None else size + GROWTH_SLACK
     started = time.monotonic()
     fd, temp_name = tempfile.mkstemp(dir=local.parent, prefix=f".{local.name}.", suffix=".part")

@@ -43,7 +43,7 @@ from .download import LocalFileError, Progress, Transfer
 from .errors import ClientTimeout, NotSupported
 from .remote_files import FEATURES, Refused, malformed, remote_path
 
-READ_BATCH: Final = 1 << 20
+READ_BATCH: Final = 35 * FILE_CHUNK
 """Bytes read from disk at once (off the network loop), then sent in ARIA's 30 000-byte packets."""
 MOVE_RATE: Final = 10 << 20
 """Bytes a second a robot is given to move a finished file into place (ARIA runs ``mv`` from /tmp)."""
