@@ -50,9 +50,9 @@ ROWS: tuple[Row, ...] = (
      "RobotInfo", "RETURN_SINGLE"),
     ("mappingStatusBroadcast", "Names the scan running now; also sent when one starts or ends", "none",
      "string: scan name (the file name when broadcast), empty when none", "RobotInfo", "RETURN_SINGLE"),
-    ("mappingLoopStart", "Marks in the scan log that a loop starts here", "string: loop tag", "none",
+    ("mappingLoopStart", "Marks in the scan log that a loop starts here", "string: argumentToCommand", "none",
      "CustomCommands", "RETURN_NONE"),
-    ("mappingLoopEnd", "Marks in the scan log that a loop ends here", "string: loop tag", "none",
+    ("mappingLoopEnd", "Marks in the scan log that a loop ends here", "string: argumentToCommand", "none",
      "CustomCommands", "RETURN_NONE"),
 )  # fmt: skip
 
