@@ -151,6 +151,9 @@ def test_download_both_variants_and_case_insensitive_names(
     assert stamped.mtime == 1_700_000_000 and int((out / "a.map").stat().st_mtime) == 1_700_000_000
     assert seen[-1] == (len(original), len(original))
     assert sorted(p.name for p in out.iterdir()) == ["a.map", "b.map"]  # no temporary file left
+    umask = os.umask(0)
+    os.umask(umask)
+    assert (out / "a.map").stat().st_mode & 0o777 == 0o666 & ~umask  # as any new file, not private
     chunks = [FileChunk.decode(p) for p in plain]
     assert chunks[-1].end and chunks[-2].end_of_file and b"".join(c.data for c in chunks) == original
     assert all(len(c.data) <= 30_000 for c in chunks)

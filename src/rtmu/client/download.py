@@ -18,7 +18,7 @@ from __future__ import annotations
 import asyncio
 import contextlib
 import os
-import tempfile
+import secrets
 import time
 from collections.abc import Callable
 from dataclasses import dataclass
@@ -133,8 +133,7 @@ async def download_file(
         size = entry.size if entry.size < MAX_DOWNLOAD - GROWTH_SLACK else None
     limit = MAX_DOWNLOAD if size is None else size + GROWTH_SLACK
     started = time.monotonic()
-    fd, temp_name = tempfile.mkstemp(dir=local.parent, prefix=f".{local.name}.", suffix=".part")
-    temp = Path(temp_name)
+    fd, temp = _temp_beside(local)
     try:
         with os.fdopen(fd, "wb") as out:
             got, mtime = await _receive(client, source, remote, out, limit, size, progress, timeout)
@@ -205,6 +204,17 @@ async def _receive(
     if batch:
         await loop.run_in_executor(None, out.write, b"".join(batch))
     return got, mtime
+
+
+def _temp_beside(local: Path) -> tuple[int, Path]:
+    """A new hidden file beside ``local``, created with the permissions any new file gets (the umask)."""
+    for _ in range(100):
+        temp = local.parent / f".{local.name}.{secrets.token_hex(4)}.part"
+        try:
+            return os.open(temp, os.O_WRONLY | os.O_CREAT | os.O_EXCL, 0o666), temp
+        except FileExistsError:
+            continue
+    raise LocalFileError(f"cannot make a temporary file beside {local}")
 
 
 def _sync(out: BinaryIO) -> None:
