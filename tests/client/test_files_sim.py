@@ -361,3 +361,36 @@ def test_the_default_files_folder_is_temporary_and_goes_with_the_simulator() -> 
         assert (root / "x.2d").is_file()
         folder.temporary.cleanup()
     assert not root.exists()
+
+
+def test_a_cancelled_transfer_leaves_nothing_behind(sim: SimThread, files: Path, tmp_path: Path) -> None:
+    (files / "big.bin").write_bytes(os.urandom(3_000_000))
+    local = tmp_path / "up.bin"
+    local.write_bytes(os.urandom(3_000_000))
+
+    async def cancelled(start: Callable[[Callable[[int, int | None], None]], Awaitable[Any]]) -> None:
+        first = asyncio.Event()
+        task = asyncio.ensure_future(start(lambda done, total: first.set()))
+        await first.wait()
+        task.cancel()
+        with pytest.raises(asyncio.CancelledError):
+            await task
+
+    async def body(c: AriaClient) -> None:
+        await cancelled(lambda p: download_file(c, "big.bin", tmp_path / "big.bin", progress=p))
+        await cancelled(lambda p: upload_file(c, local, "maps/up.bin", interleaved=True, progress=p))
+        await list_folder(c, "maps")  # the connection goes on
+
+    with_client(sim, body)
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["robot", "up.bin"]
+    assert sorted(p.name for p in (files / "maps").iterdir()) == ["Office.map"]  # temporary file dropped
+
+
+def test_scan_progress_reads_time_and_distance() -> None:
+    from rtmu.client.scan import ScanProgress
+
+    progress = ScanProgress(100.0)
+    for i in range(11):
+        progress.feed(i * 1420.0, 0.0, 100.0 + i * 10.2)
+    progress.feed(90_000.0, 0.0, 202.0)  # a jump (relocalised) is not driving
+    assert progress.text() == "1:42, 14.2 m driven"
