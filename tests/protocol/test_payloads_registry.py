@@ -31,7 +31,9 @@ from rtmu.protocol.payloads import (
 )
 from rtmu.protocol.payloads import camera as cam
 from rtmu.protocol.payloads import config as cfg
+from rtmu.protocol.payloads import files as fs
 from rtmu.protocol.payloads import map as mp
+from rtmu.protocol.payloads import mapping as scan
 
 SAMPLES: list[Payload] = [
     robot.UpdateNumbers(12.3, -1000, 2000, -45, 300, -20, 0, 31),
@@ -149,6 +151,32 @@ SAMPLES: list[Payload] = [
     cfg.ConfigSectionFlags((("Teleop", ""),)),
     cfg.LastEditablePriority(3),
     cfg.ConfigCausingRestart(1),
+    fs.DirListingRequest("maps"),
+    fs.DirListingMultipleRequest(""),
+    fs.DirListing(0, "", (fs.DirEntry(1, "maps", 1, 2, 4096), fs.DirEntry(2, "a.map", 3, 4, 120))),
+    fs.DirListingPacket(0, "maps", (fs.DirEntry(2, "office.map", 5, 6, 2291),)),
+    fs.GetFileRequest("maps/office.map"),
+    fs.GetFileWithTimestampRequest("office.map"),
+    fs.FileChunk(0, "office.map", b"2D-Map\n"),
+    fs.TimestampedFileChunk(0, "office.map", b"", 1795237141),
+    fs.PutFileRequest(1, "a.map", b"data"),
+    fs.PutFileInterleavedRequest(0, "a.map"),
+    fs.PutFileWithTimestampRequest(0, "a.map", mtime=1795237141),
+    fs.PutFileWithTimestampInterleavedRequest(2, "a.map"),
+    fs.PutFileReply(0, "a.map"),
+    fs.PutFileInterleavedReply(10, "a.map"),
+    fs.PutFileWithTimestampReply(7, "a.map"),
+    fs.PutFileWithTimestampInterleavedReply(11, "a.map"),
+    fs.DeleteFileRequest("a.map"),
+    fs.DeleteFileReply(2, "a.map"),
+    fs.DefaultUploadDownloadDir("maps"),
+    scan.MappingStart("office"),
+    scan.MappingStartReply(0),
+    scan.MappingEndReply(1),
+    scan.MappingStatus("office"),
+    scan.MappingStatusBroadcast("office.2d"),
+    scan.MappingLoopStart("1"),
+    scan.MappingLoopEnd("1"),
 ]
 TYPES = sorted(registered().values(), key=lambda c: (c.DATA_NAME, c.SIDE.value))
 

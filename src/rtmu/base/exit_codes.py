@@ -11,3 +11,6 @@ EXIT_USAGE = 2
 EXIT_CONNECTION = 3
 EXIT_UNSUPPORTED = 4
 EXIT_TIMEOUT = 5
+EXIT_REFUSED = 6
+"""The server answered and said no (a file it will not give or delete, a scan it cannot start): its words
+are printed. ``rtmu config --set`` uses the same number for a refused value."""

@@ -425,6 +425,39 @@ class AriaClient:
         self._conn.request(name, interval_ms, encode_args(args))  # type: ignore[union-attr]
         self._flush()
 
+    def listen(self, name: str, handler: Handler | None) -> None:
+        """Hear ``name``'s packets that no tracked request claims, sending nothing (ARIA's ``addHandler``).
+
+        For data whose answers do not pair one-to-one with requests (``putFile``: errors only, then one
+        result); ``None`` stops listening. NotSupported when the server does not list ``name``.
+        """
+        number = self._number(name)
+        if handler is None:
+            self._handlers.pop(number, None)
+        else:
+            self._handlers[number] = handler
+
+    async def drain(self, timeout: float = REPLY_TIMEOUT) -> None:
+        """Wait until our output is back under the link's high-water mark (a bulk sender's pacing).
+
+        ClientTimeout when the server reads nothing for ``timeout`` s; the connection's own error
+        once it has ended.
+        """
+        self._require_open()
+        link = self._link
+        assert link is not None
+        try:
+            async with asyncio.timeout(timeout):
+                await link.drain()
+        except TimeoutError:
+            raise ClientTimeout(
+                f"{self.host}:{self.port} read nothing of what we sent for {timeout:g} s"
+            ) from None
+        except OSError as exc:
+            reason = exc.strerror or exc
+            self._fail(ServerClosed(f"the connection to {self.host}:{self.port} broke: {reason}"))
+        self._require_open()
+
     def stop_request(self, name: str) -> None:
         """End a subscription (no reply). Unknown or unsubscribed names are ignored."""
         number = self._conn.datalist.number(name) if self._conn is not None else None

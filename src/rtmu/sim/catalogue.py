@@ -734,7 +734,9 @@ DRAWINGS: tuple[Row, ...] = (
 )
 """The range devices' drawing data (``getDrawingList`` says how to draw each): laser, then sonar."""
 
-STRING_COMMANDS = frozenset({"SimulatorSetBattery", "SimulatorPopup", "SimulatorPopupFlood"})
+STRING_COMMANDS = frozenset(
+    {"SimulatorSetBattery", "SimulatorPopup", "SimulatorPopupFlood", "mappingLoopStart", "mappingLoopEnd"}
+)
 """Simple commands that take one string argument (``listStringCommands``)."""
 
 

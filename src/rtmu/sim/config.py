@@ -68,4 +68,9 @@ class SimConfig:
     start_pose: tuple[float, float, float] | None = None
     """Where the robot starts (x, y mm, th deg; moved to the nearest free spot); None: the map's home.
     ``rtmu sim --robots N`` gives each robot its own (``sim.multi``)."""
+    files_dir: Path | None = None
+    """The folder ``getDirListing``/``getFile``/``putFile``/``deleteFile`` share and scans are written to;
+    None: a temporary folder of the simulator's own, removed when it goes (:mod:`rtmu.sim.files_folder`)."""
+    files_default_dir: str | None = None
+    """Offer ``getDefaultUploadDownloadDir`` naming this folder (ARIA lists it only when given one)."""
     verbose: bool = False

@@ -7,6 +7,7 @@ server imports the handlers and never the other way round.
 
 from __future__ import annotations
 
+import asyncio
 from collections import deque
 from collections.abc import Callable
 from typing import Protocol
@@ -14,6 +15,7 @@ from typing import Protocol
 from rtmu.protocol.payloads.config import ConfigRequest, SetConfig
 
 from .catalogue import Row
+from .config import SimConfig
 from .mapserve import ServedMap
 from .video import VideoFeed
 from .world import World
@@ -39,6 +41,9 @@ class SimClient(Protocol):
 
     ident: int
     self_identifier: str
+    closed: bool
+    writer: asyncio.StreamWriter
+    """A handler that sends a long series (a file) awaits ``writer.drain()`` between packets."""
 
     def send(self, number: int, payload: bytes) -> None: ...
 
@@ -50,6 +55,7 @@ class SimHost(Protocol):
 
     world: World
     map: ServedMap
+    config: SimConfig
     video: VideoFeed
     video_size: tuple[int, int]
     stop_log: deque[tuple[float, int, str]]

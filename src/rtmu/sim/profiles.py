@@ -205,10 +205,12 @@ def filler_rows(count: int, taken: set[str]) -> list[Row]:
     return rows
 
 
+COMMISSIONING = ("rtmu.sim.files_data", "rtmu.sim.mapping_data")
+"""ARIA's file services and scan-to-map handler: what commissioning a robot needs."""
 DEFAULT = SimProfile(
     "default",
     "serverDemo with a simulated Pioneer 3-DX, navigating as ARNL does",
-    modules=("rtmu.sim.nav_data", "rtmu.sim.arconfig"),
+    modules=("rtmu.sim.nav_data", "rtmu.sim.arconfig", *COMMISSIONING),
 )
 ARAM = SimProfile(
     "aram",
@@ -217,7 +219,12 @@ ARAM = SimProfile(
     state_of_charge=True,
     map_header=EX4_HEADER,
     catalogue_size=LD_CATALOGUE_SIZE,
-    modules=("rtmu.sim.nav_data", "rtmu.sim.ld_data", "rtmu.sim.arconfig"),  # the LD docking replaces ARNL's
+    modules=(
+        "rtmu.sim.nav_data",
+        "rtmu.sim.ld_data",
+        "rtmu.sim.arconfig",
+        *COMMISSIONING,
+    ),  # the LD docking replaces ARNL's
     handlers={
         "updateNumbers": _soc_numbers,
         "batteryInfo": _soc_battery_info,

@@ -47,6 +47,7 @@ from . import switch
 from .arconfig import SimArConfig
 from .catalogue import Row, custom_commands
 from .config import SimConfig
+from .files_data import add_default_folder
 from .handlers import (
     BROADCAST_ONLY,
     Call,
@@ -360,6 +361,8 @@ class SimServer:
         self.home = (x, y, home[2])
         self.world.nav_map = self._nav_map()
         self.datalist: DataList = self.profile.catalogue(camera=cfg.camera)
+        if cfg.files_default_dir is not None:
+            add_default_folder(self.datalist, self.handlers, cfg.files_default_dir)
         self.users: UserTable | None = UserTable.load(cfg.users_path) if cfg.users_path else None
         self.sessions: list[Session] = []
         self.stop_log: deque[tuple[float, int, str]] = deque(maxlen=1000)

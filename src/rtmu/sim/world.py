@@ -9,6 +9,7 @@ from __future__ import annotations
 
 import math
 import random
+from collections.abc import Callable
 from dataclasses import dataclass, field
 
 import numpy as np
@@ -145,6 +146,8 @@ class World:
         self._popup_check_at = 0.0
         self._low_battery_warned = False
         self.last_activity = 0.0
+        self.step_hooks: list[Callable[[], None]] = []
+        """Called after every step (a scan log looking at the robot, :mod:`.mapping_data`)."""
         self.received_ratios: tuple[float, float, float, float] | None = None
         """The last ratioDrive exactly as received (the watchdog zeroes the mode's ratios, not this)."""
         self.ratio_drives_received = 0
@@ -286,6 +289,8 @@ class World:
         self._check_battery()
         self._check_popups()
         self.check_strings()
+        for hook in self.step_hooks:
+            hook()
 
     def check_strings(self) -> None:
         now = self.strings()

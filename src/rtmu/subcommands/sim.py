@@ -100,6 +100,19 @@ def register(subparsers: argparse._SubParsersAction) -> None:
         help="run N robots on the map, one server each on consecutive ports from --port, "
         "named robot1…N (default 1); with --central: N simulated robots switched to it (default 0)",
     )
+    p.add_argument(
+        "--files",
+        type=Path,
+        metavar="DIR",
+        help="the folder served to getDirListing/getFile/putFile/deleteFile, where scans are written "
+        "(default: a temporary folder, removed when the simulator stops)",
+    )
+    p.add_argument(
+        "--files-default-dir",
+        metavar="NAME",
+        default=None,
+        help="offer getDefaultUploadDownloadDir naming this folder (ARIA offers it only when given one)",
+    )
     p.add_argument("-v", "--verbose", action="store_true", help="log connections and refusals")
     central = p.add_argument_group("ARIA central server (switchServer)")
     central.add_argument(
@@ -161,6 +174,9 @@ def run(args: argparse.Namespace) -> int:
     if map_path is not None and not map_path.is_file():
         print(f"rtmu sim: no such map file: {map_path}", file=sys.stderr)
         return EXIT_BAD_INPUT
+    if args.files is not None and not args.files.is_dir():
+        print(f"rtmu sim: no such folder: {args.files}", file=sys.stderr)
+        return EXIT_BAD_INPUT
     if args.users is not None and not args.users.is_file():
         print(f"rtmu sim: no such user file: {args.users}", file=sys.stderr)
         return EXIT_BAD_INPUT
@@ -179,6 +195,8 @@ def run(args: argparse.Namespace) -> int:
         protocol_version=args.protocol,
         profile=args.profile,
         config_filler=max(0, min(args.config_filler, 200_000)),
+        files_dir=args.files,
+        files_default_dir=args.files_default_dir,
         verbose=args.verbose,
     )
     if args.battery is not None:
@@ -229,6 +247,10 @@ async def serve(cfg) -> int:
         extras += f"; profile {cfg.profile}"
     if cfg.protocol_version:
         extras += f"; protocol {cfg.protocol_version!r} enforced"
+    from ..sim.files_folder import files_folder
+
+    files = files_folder(server)
+    extras += f"; files in {files.root}" + (" (temporary)" if files.temporary is not None else "")
     print(
         f"rtmu sim: ARIA robot server listening on {cfg.host}:{server.port}, serving {served}; "
         f"Pioneer 3-DX at ({home[0]:.0f}, {home[1]:.0f}) mm, {home[2]:.0f} deg{extras}",
@@ -237,6 +259,8 @@ async def serve(cfg) -> int:
     await until_stop_signal()
     print("rtmu sim: stopping (telling clients SHUTDOWN)", flush=True)
     await server.stop()
+    if files.temporary is not None:
+        files.temporary.cleanup()
     return EXIT_OK
 
 
