@@ -14,13 +14,14 @@ from pathlib import Path
 from rtmu.client.connection import AriaClient
 from rtmu.client.download import download_file
 from rtmu.client.scan import start_scan, stop_scan, tag_loop
+from rtmu.package_data import project_map
 from rtmu.protocol.payloads.drive import RatioDrive
 from rtmu.sim import SimConfig, SimThread
 
 from .scanlog_reader import Reading, Tag, read_scan_log
 from .servers import run
 
-OFFICE = Path(__file__).resolve().parents[2] / "data" / "maps" / "office.map"
+OFFICE = project_map("office.map")
 TRANS_PCT, TURN_PCT = 30.0, 40.0
 STEPS = 300
 """100 ms steps of driving: a little more than one full turn (about 20 °/s)."""
