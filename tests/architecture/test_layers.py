@@ -18,7 +18,7 @@ LAYERS: dict[str, tuple[str, ...]] = {
     "base": ("rtmu", "rtmu.textsafe", "rtmu.exit_codes", "rtmu.notices"),
     "codec": ("rtmu.protocol",),
     "maps": ("rtmu.mapfile", "rtmu.maps"),
-    "values": ("rtmu.state",),
+    "values": ("rtmu.state", "rtmu.mapedit"),
     "capture": ("rtmu.capture", "rtmu.session_decoder"),
     "client": ("rtmu.client", "rtmu.guardian"),
     "simulator": ("rtmu.sim",),

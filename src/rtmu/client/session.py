@@ -545,7 +545,9 @@ class Session:
     def _on_mode_info(self, packet: Packet) -> None:
         m = self._decode(packet.name, packet.payload)
         if isinstance(m, ModeInfo):
-            self._robot_update(mode_name=m.mode_name)
+            self._robot_update(
+                mode_name=m.mode_name, mode_locked=m.locked, mode_will_unlock=m.will_unlock_if_requested
+            )
 
     def _on_safe_drive(self, payload: bytes) -> None:
         s = self._decode("getSafeDrive", payload)

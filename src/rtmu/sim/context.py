@@ -14,6 +14,8 @@ from typing import Protocol
 from rtmu.protocol.payloads.config import ConfigRequest, SetConfig
 
 from .catalogue import Row
+from .config import SimConfig
+from .geometry import Obstacles
 from .mapserve import ServedMap
 from .video import VideoFeed
 from .world import World
@@ -33,6 +35,10 @@ class ArConfigStore(Protocol):
 
     def sections(self) -> list[str]: ...
 
+    def values(self) -> list[tuple[str, str, str]]: ...
+
+    defaults: list[tuple[str, str, str]]
+
 
 class SimClient(Protocol):
     """One connected client, as a handler sees it."""
@@ -50,6 +56,7 @@ class SimHost(Protocol):
 
     world: World
     map: ServedMap
+    config: SimConfig
     video: VideoFeed
     video_size: tuple[int, int]
     stop_log: deque[tuple[float, int, str]]
@@ -69,6 +76,12 @@ class SimHost(Protocol):
     def broadcast(self, name: str, payload: bytes = b"", exclude: SimClient | None = None) -> int: ...
 
     def check_map(self) -> bool: ...
+
+    def install_map(
+        self, served: ServedMap, *, move_home: bool = False, obstacles: Obstacles | None = None
+    ) -> None: ...
+
+    file_md5: bytes
 
     def reset_pose(self) -> None: ...
 

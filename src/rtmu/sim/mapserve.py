@@ -22,7 +22,7 @@ from rtmu.protocol.packet import encode_packet
 from rtmu.protocol.payloads.map import Goals, MapId, MapName
 from rtmu.protocol.payloads.mapstream import map_binary_payloads, map_text_payloads
 
-from ..maps import MapObject, map_header_lines
+from ..maps import MapData, MapObject, map_header_lines
 from .geometry import Obstacles
 
 DEFAULT_POINT_CELL_MM = 40.0
@@ -66,6 +66,8 @@ class ServedMap:
     mtime: int = 0
     resolution: int | None = None
     access_point: tuple[float, float] | None = None
+    data: MapData | None = field(default=None, repr=False)
+    """The map as read (kept so a map change can be applied to it)."""
     _framed: dict[tuple[str, int], Chunks] = field(default_factory=dict, repr=False)
 
     @property
@@ -115,7 +117,11 @@ def load_map(path: Path | None) -> ServedMap:
     from rtmu.maps import read_map
 
     raw = path.read_bytes()
-    data = read_map(path)
+    return served_map(path, str(path), raw, read_map(path), int(os.stat(path).st_mtime))
+
+
+def served_map(path: Path, name: str, raw: bytes, data: MapData, mtime: int) -> ServedMap:
+    """A map to serve: the file's bytes ``raw`` (sent line by line by ``getMap``) and what they read as."""
     text = raw.decode("latin-1")
     lines = [line.rstrip("\r") for line in text.split("\n")]
     lines = [line for line in lines if line.strip()]
@@ -127,10 +133,9 @@ def load_map(path: Path | None) -> ServedMap:
         if "access point" in label or "accesspoint" in label or "wifi" in label:
             ap = (float(obj.pose.x), float(obj.pose.y))
             break
-    st = os.stat(path)
     return ServedMap(
         path=path,
-        name=str(path),
+        name=name,
         lines=lines,
         header=map_header_lines(data),
         segments=np.asarray(data.segments, dtype=np.int32).reshape(-1, 4),
@@ -141,7 +146,8 @@ def load_map(path: Path | None) -> ServedMap:
         objects=tuple(data.objects),
         md5=hashlib.md5(raw).digest(),
         size=len(raw),
-        mtime=int(st.st_mtime),
+        mtime=mtime,
         resolution=data.resolution,
         access_point=ap,
+        data=data,
     )
