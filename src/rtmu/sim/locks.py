@@ -21,6 +21,7 @@ def _lock(will_unlock: bool):
         world.stop()
         if world.mode is world.stop_mode:
             world.stop_mode.lock = will_unlock
+        world.check_mode_info()
         return ()
 
     return handler
@@ -28,6 +29,7 @@ def _lock(will_unlock: bool):
 
 def _unlock(call: Call) -> Iterable[Reply]:
     call.world.stop_mode.lock = None
+    call.world.check_mode_info()
     return ()
 
 
