@@ -82,8 +82,8 @@ def _send(c: WireClient, packets: list[MapChangePacket]) -> None:
         c.once("processMapChanges", p.encode())
 
 
-async def _verdict(c: WireClient, count: int = 1) -> int:
-    got = await c.wait_for("processMapChanges", count)
+async def _verdict(c: WireClient, count: int = 1, timeout: float = 30.0) -> int:
+    got = await c.wait_for("processMapChanges", count, timeout)
     return MapChangeReply.decode(got[count - 1]).status
 
 
@@ -349,7 +349,7 @@ def test_a_hundred_thousand_objects_in_one_change_set_are_taken_within_bounds() 
         packets = change_packets(MapChangeSet((_objects(*lines),)))
         assert len(packets) > 100
         _send(a, packets)
-        assert await _verdict(a) == 10
+        assert await _verdict(a, timeout=100) == 10
         assert len(server.map.objects) == 3 + 100_000
         await a.close()
         await server.stop()

@@ -11,6 +11,7 @@ from collections import deque
 from collections.abc import Callable
 from typing import Protocol
 
+from rtmu.protocol.datalist import DataList
 from rtmu.protocol.payloads.config import ConfigRequest, SetConfig
 
 from .catalogue import Row
@@ -57,6 +58,7 @@ class SimHost(Protocol):
     world: World
     map: ServedMap
     config: SimConfig
+    datalist: DataList
     video: VideoFeed
     video_size: tuple[int, int]
     stop_log: deque[tuple[float, int, str]]

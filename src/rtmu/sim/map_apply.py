@@ -19,12 +19,22 @@ from __future__ import annotations
 
 import copy
 import hashlib
+import re
 from collections import defaultdict, deque
 from collections.abc import Sequence
 
 import numpy as np
 
-from rtmu.maps import InfoLine, MapData, MapFormatError, MapObject, map_bytes, parse_map_lines, split_keyword
+from rtmu.maps import (
+    InfoLine,
+    MapData,
+    MapFormatError,
+    MapObject,
+    map_bytes,
+    map_header_lines,
+    parse_map_lines,
+    split_keyword,
+)
 from rtmu.protocol.payloads.map import MapId
 from rtmu.protocol.payloads.mapchange import INFO_NAMES, ChangeData, LineChange, MapChangeSet
 
@@ -88,8 +98,42 @@ def same_file(this: MapId, other: MapId) -> bool:
     return not (this.checksum and other.checksum and this.checksum != other.checksum)
 
 
-def result_bytes(data: MapData) -> bytes:
-    return map_bytes(data)
+def result_bytes(
+    changed: MapData, before: MapData | None = None, before_raw: bytes = b""
+) -> tuple[bytes, list[str]]:
+    """The changed map's file and its header lines (as ARIA writes the file after a change).
+
+    When the change left every scan's points and segments as they were, the data sections of
+    ``before_raw`` are kept byte for byte after the new header: a 1 M-point map's points are not
+    formatted again for a goal added.
+    """
+    header = map_header_lines(changed)
+    try:
+        head = ("\n".join(header) + "\n").encode("latin-1")
+    except UnicodeEncodeError as exc:
+        raise ChangeRefused(
+            f"the changed map holds text that is not latin-1: {exc.object[exc.start]!r}"
+        ) from None
+    if before is not None and same_geometry(before, changed):
+        tail = _data_part(before_raw, changed)
+        if tail is not None:
+            return head + tail, header
+    return map_bytes(changed), header
+
+
+def same_geometry(a: MapData, b: MapData) -> bool:
+    """Whether ``b`` still holds ``a``'s very point and segment arrays (a change of objects only)."""
+    return len(a.scans) == len(b.scans) and all(
+        x.points is y.points and x.segments is y.segments for x, y in zip(a.scans, b.scans, strict=True)
+    )
+
+
+def _data_part(raw: bytes, data: MapData) -> bytes | None:
+    """``raw`` from its first data tag line (``LINES``, ``DATA``, ``<scan>_DATA`` …) on; None without one."""
+    tags = sorted({t for s in data.scans for t in (s.lines_tag, s.points_tag)})
+    pattern = rb"(?m)^(?:" + b"|".join(re.escape(t.encode("latin-1")) for t in tags) + rb")\r?$"
+    found = re.search(pattern, raw)
+    return None if found is None else raw[found.start() :]
 
 
 # -- objects ---------------------------------------------------------------------------------------

@@ -16,12 +16,14 @@ from __future__ import annotations
 import asyncio
 import logging
 import os
+import secrets
 import time
 from collections.abc import Iterable
 from dataclasses import dataclass, field
+from pathlib import Path
 from weakref import WeakKeyDictionary
 
-from rtmu.maps import new_map, write_map
+from rtmu.maps import new_map
 from rtmu.protocol.errors import ProtocolError
 from rtmu.protocol.fields import FieldReader
 from rtmu.protocol.payloads.map import MapId
@@ -38,8 +40,9 @@ from rtmu.protocol.payloads.mapchange import (
 
 from .catalogue import Row
 from .context import SimHost
+from .geometry import Obstacles
 from .handlers import Call, Handler, Other, Reply
-from .map_apply import ChangeRefused, apply_changes, check_ids, result_bytes, same_file
+from .map_apply import ChangeRefused, apply_changes, check_ids, result_bytes, same_file, same_geometry
 from .mapserve import ServedMap, served_map
 
 log = logging.getLogger("rtmu.sim")
@@ -166,20 +169,27 @@ def _apply_later(server: SimHost, call: Call, changes: MapChangeSet) -> None:
     path = before.path
     assert path is not None
     save = server.config.save_map_changes
+    binary = server.datalist.number("getMapBinary")
 
-    def work() -> tuple[ServedMap, object]:
+    walls = server.world.obstacles
+
+    def work() -> tuple[ServedMap, Obstacles]:
         data = before.data if before.data is not None else new_map()
         changed = apply_changes(data, changes)
-        raw = result_bytes(changed)
+        raw, header = result_bytes(changed, data, before.raw)
         mtime = int(time.time())
         check_ids(changes, raw, before.name, mtime)
         if save:
-            write_map(changed, path)
+            _write_file(path, raw)
             mtime = int(os.stat(path).st_mtime)
-        served = served_map(path, before.name, raw, changed, mtime)
+        served = served_map(path, before.name, raw, changed, mtime, header)
+        if binary is not None:  # framed here, not on the server's loop when the clients reload it
+            served.binary_stream(binary)
+        if same_geometry(data, changed):
+            return served, walls  # objects only: the world's walls are the same
         return served, served.obstacles()
 
-    def done(task: asyncio.Future[tuple[ServedMap, object]]) -> None:
+    def done(task: asyncio.Future[tuple[ServedMap, Obstacles]]) -> None:
         ok = False
         try:
             served, obstacles = task.result()
@@ -192,7 +202,7 @@ def _apply_later(server: SimHost, call: Call, changes: MapChangeSet) -> None:
             if server.map is before:
                 if save:
                     server.file_md5 = served.md5
-                server.install_map(served, obstacles=obstacles)  # type: ignore[arg-type]
+                server.install_map(served, obstacles=obstacles)
                 state.applied += 1
                 ok = True
             else:
@@ -201,6 +211,17 @@ def _apply_later(server: SimHost, call: Call, changes: MapChangeSet) -> None:
 
     future = asyncio.get_running_loop().run_in_executor(None, work)
     future.add_done_callback(done)
+
+
+def _write_file(path: Path, raw: bytes) -> None:
+    """The served file replaced atomically (a reader never sees half a map)."""
+    temp = path.with_name(f".{path.name}.{os.getpid()}.{secrets.token_hex(4)}.tmp")
+    try:
+        with open(temp, "xb") as f:
+            f.write(raw)
+        os.replace(temp, path)
+    finally:
+        temp.unlink(missing_ok=True)
 
 
 def _in_progress(call: Call) -> Iterable[Reply]:

@@ -52,7 +52,9 @@ class ServedMap:
     path: Path | None
     name: str
     """As configured (ARIA sends the path it was given)."""
-    lines: list[str] = field(default_factory=list)
+    raw: bytes = field(default=b"", repr=False)
+    """The file's bytes: ``getMap`` sends its lines (split only when first asked for: a 1 M-point map
+    is a million lines)."""
     header: list[str] = field(default_factory=list)
     segments: np.ndarray = field(default_factory=lambda: np.zeros((0, 4), np.int32))
     points: np.ndarray = field(default_factory=lambda: np.zeros((0, 2), np.int32))
@@ -68,11 +70,20 @@ class ServedMap:
     access_point: tuple[float, float] | None = None
     data: MapData | None = field(default=None, repr=False)
     """The map as read (kept so a map change can be applied to it)."""
+    _lines: list[str] | None = field(default=None, repr=False)
     _framed: dict[tuple[str, int], Chunks] = field(default_factory=dict, repr=False)
 
     @property
     def present(self) -> bool:
         return self.path is not None
+
+    @property
+    def lines(self) -> list[str]:
+        """The file's non-blank lines without line ends, as ``getMap`` sends them."""
+        if self._lines is None:
+            text = self.raw.decode("latin-1")
+            self._lines = [s for s in (line.rstrip("\r") for line in text.split("\n")) if s.strip()]
+        return self._lines
 
     def obstacles(self) -> Obstacles:
         cell = float(self.resolution) if self.resolution and self.resolution > 0 else DEFAULT_POINT_CELL_MM
@@ -120,11 +131,11 @@ def load_map(path: Path | None) -> ServedMap:
     return served_map(path, str(path), raw, read_map(path), int(os.stat(path).st_mtime))
 
 
-def served_map(path: Path, name: str, raw: bytes, data: MapData, mtime: int) -> ServedMap:
-    """A map to serve: the file's bytes ``raw`` (sent line by line by ``getMap``) and what they read as."""
-    text = raw.decode("latin-1")
-    lines = [line.rstrip("\r") for line in text.split("\n")]
-    lines = [line for line in lines if line.strip()]
+def served_map(
+    path: Path, name: str, raw: bytes, data: MapData, mtime: int, header: list[str] | None = None
+) -> ServedMap:
+    """A map to serve: the file's bytes ``raw`` (sent line by line by ``getMap``) and what they read as
+    (``header``: ``data``'s header lines, when already written)."""
     home = data.home()
     goals = tuple(obj.name for obj in data.goals())
     ap = None
@@ -136,8 +147,8 @@ def served_map(path: Path, name: str, raw: bytes, data: MapData, mtime: int) -> 
     return ServedMap(
         path=path,
         name=name,
-        lines=lines,
-        header=map_header_lines(data),
+        raw=raw,
+        header=header if header is not None else map_header_lines(data),
         segments=np.asarray(data.segments, dtype=np.int32).reshape(-1, 4),
         points=np.asarray(data.points, dtype=np.int32).reshape(-1, 2),
         home=(float(home.x), float(home.y), float(home.th)) if home is not None else (0.0, 0.0, 0.0),

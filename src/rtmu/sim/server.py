@@ -678,11 +678,14 @@ class SimServer:
         home = self.config.start_pose or self.map.home
         x, y = free_spot_near(obstacles, home[0], home[1], 250.0)
         self.home = (x, y, home[2])
-        self.world.replace_obstacles(obstacles)
-        self.world.nav_map = self._nav_map()
+        if obstacles is not self.world.obstacles:
+            self.world.replace_obstacles(obstacles)
+        self.world.nav_map = nav = self._nav_map()
         self.world.home = self.home
         if move_home:
             self.reset_pose()
+        if nav is not None and self.config.realtime:  # the new grid built aside, not in the next plan
+            asyncio.get_running_loop().run_in_executor(None, nav.grid)
         self.broadcast("mapUpdated")
         self.broadcast("goalsUpdated")
 
