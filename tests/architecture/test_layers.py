@@ -18,7 +18,7 @@ LAYERS: dict[str, tuple[str, ...]] = {
     "base": ("rtmu", "rtmu.base", "rtmu.package_data"),
     "codec": ("rtmu.protocol",),
     "maps": ("rtmu.mapfile",),
-    "values": ("rtmu.values",),
+    "values": ("rtmu.values", "rtmu.mapedit"),
     "capture": ("rtmu.capture",),
     "about": ("rtmu.versions",),
     "client": ("rtmu.client", "rtmu.guardian"),

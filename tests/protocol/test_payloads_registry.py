@@ -31,8 +31,10 @@ from rtmu.protocol.payloads import (
 )
 from rtmu.protocol.payloads import camera as cam
 from rtmu.protocol.payloads import config as cfg
+from rtmu.protocol.payloads import configcare as care
 from rtmu.protocol.payloads import files as fs
 from rtmu.protocol.payloads import map as mp
+from rtmu.protocol.payloads import mapchange as mc
 from rtmu.protocol.payloads import mapping as scan
 
 SAMPLES: list[Payload] = [
@@ -177,6 +179,26 @@ SAMPLES: list[Payload] = [
     scan.MappingStatusBroadcast("office.2d"),
     scan.MappingLoopStart("1"),
     scan.MappingLoopEnd("1"),
+    care.ConfigDefaultsRequest("Teleop"),
+    care.ConfigDefaults((("Section", "Teleop"), ("Timeout", "2"))),
+    care.ConfigDefaultsUpdated(),
+    care.SetConfigParam((("Section", "Teleop"), ("Timeout", "1"))),
+    care.SetConfigParamReply("Teleop", "Teleop/Timeout: 99 is above the maximum of 60"),
+    care.ReloadConfig(),
+    care.CheckMap(),
+    mc.MapChangePacket(
+        mc.ChangeCommand.CONTINUE,
+        mp.MapId("", "office.map", bytes(range(16)), 2291, 1795237141),
+        mp.MapId("", "office.map", b"", 0, -1),
+        mc.ChangeData.OBJECTS,
+        mc.LineChange.ADDITIONS,
+        "",
+        -1,
+        1,
+        (mc.FileLineGroup(mc.FileLine(12, 'Cairn: Goal 1000 2000 0.000000 "" ICON "Kitchen"')),),
+    ),
+    mc.MapChangeReply(10),
+    mc.MapChangesInProgress(True),
 ]
 TYPES = sorted(registered().values(), key=lambda c: (c.DATA_NAME, c.SIDE.value))
 

@@ -109,7 +109,9 @@ class StatusFeed(Feed):
     def _on_mode_info(self, packet: Packet) -> None:
         m = self.ctx.decode(packet.name, packet.payload)
         if isinstance(m, ModeInfo):
-            self.ctx.robot_update(mode_name=m.mode_name)
+            self.ctx.robot_update(
+                mode_name=m.mode_name, mode_locked=m.locked, mode_will_unlock=m.will_unlock_if_requested
+            )
 
     def _on_sonar(self, packet: Packet) -> None:
         readings = self.ctx.decode(packet.name, packet.payload)

@@ -32,6 +32,7 @@ from rtmu.protocol.payloads.config import (
     SetConfig,
     SetConfigReply,
     Value,
+    value_text,
 )
 from rtmu.protocol.payloads.config import ConfigSectionPacketV1 as V1
 from rtmu.protocol.payloads.config import ConfigSectionPacketV2 as V2
@@ -79,6 +80,8 @@ class SimArConfig:
         """Encoded filler sections (thousands of parameters take a while: not on every request)."""
         self._build()
         self._fill(filler)
+        self.defaults = self.values()
+        """The factory values (``getConfigDefaults``): every parameter as the simulator started with it."""
         if filler:
             self.packets(4, ConfigRequest())  # encode them now, not in a client's first request
 
@@ -286,6 +289,14 @@ class SimArConfig:
             )
             key = (section, name)
             self._add(section, template, lambda k=key: store[k], lambda v, k=key: store.__setitem__(k, v))  # type: ignore[misc]
+
+    def values(self) -> list[tuple[str, str, str]]:
+        """``(section, parameter, value text)`` of every parameter that has a value, in order."""
+        return [
+            (p.section, p.template.name, value_text(p.template.kind, p.get()))
+            for p in self.params
+            if p.template.kind not in (ParamType.SEPARATOR, ParamType.LIST)
+        ]
 
     def sections(self) -> list[str]:
         seen: dict[str, None] = {}

@@ -55,6 +55,9 @@ class SimConfig:
     second; raise it to serve live video faster)."""
     render_in_thread: bool | None = None
     """Render camera frames on a worker thread; None: in real-time mode only (inline on the manual clock)."""
+    save_map_changes: bool = False
+    """Write a map changed by ``processMapChanges`` into the served file, as ARIA does (False: the change
+    lives in the simulator only and the file is left as it was)."""
     intro_timeout: float = 60.0
     backup_timeout: float = 5.0
     """Drop a client whose queued output has not moved for this long (ARIA's backup timeout)."""

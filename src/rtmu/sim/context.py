@@ -12,10 +12,12 @@ from collections import deque
 from collections.abc import Callable
 from typing import Protocol
 
+from rtmu.protocol.datalist import DataList
 from rtmu.protocol.payloads.config import ConfigRequest, SetConfig
 
 from .catalogue import Row
 from .config import SimConfig
+from .geometry import Obstacles
 from .mapserve import ServedMap
 from .video import VideoFeed
 from .world import World
@@ -34,6 +36,10 @@ class ArConfigStore(Protocol):
     def apply(self, request: SetConfig) -> tuple[str, bool]: ...
 
     def sections(self) -> list[str]: ...
+
+    def values(self) -> list[tuple[str, str, str]]: ...
+
+    defaults: list[tuple[str, str, str]]
 
 
 class SimClient(Protocol):
@@ -56,6 +62,7 @@ class SimHost(Protocol):
     world: World
     map: ServedMap
     config: SimConfig
+    datalist: DataList
     video: VideoFeed
     video_size: tuple[int, int]
     stop_log: deque[tuple[float, int, str]]
@@ -75,6 +82,12 @@ class SimHost(Protocol):
     def broadcast(self, name: str, payload: bytes = b"", exclude: SimClient | None = None) -> int: ...
 
     def check_map(self) -> bool: ...
+
+    def install_map(
+        self, served: ServedMap, *, move_home: bool = False, obstacles: Obstacles | None = None
+    ) -> None: ...
+
+    file_md5: bytes
 
     def reset_pose(self) -> None: ...
 

@@ -68,6 +68,24 @@ class StopMode(Mode):
     def __init__(self) -> None:
         super().__init__()
         self.status = "Stopped"
+        self.lock: bool | None = None
+        """None: unlocked; else locked, and whether it gives way when another mode asks
+        (``SimulatorLockStopMode``: a stop that holds, as a safety or docking mode locks)."""
+
+    @property
+    def locked(self) -> bool:
+        return self.lock is not None
+
+    @property
+    def will_unlock(self) -> bool:
+        return bool(self.lock)
+
+    def request_unlock(self) -> None:
+        if self.lock:
+            self.lock = None
+
+    def deactivate(self) -> None:
+        self.lock = None
 
     def command(self, body: Body, now: float, dt: float) -> Command:
         self.status = "Stopped" if body.is_stopped() else "Stopping"

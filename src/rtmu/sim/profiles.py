@@ -9,7 +9,9 @@ Extension point: a profile names *data modules* (``SimProfile.modules``). Each i
 module with two attributes, ``ROWS`` (catalogue rows, :data:`rtmu.sim.catalogue.Row`) and
 ``HANDLERS`` (data name → handler, the same shape as :data:`rtmu.sim.handlers.HANDLERS`). A profile's
 catalogue is the default one, then the modules' rows, then the profile's filler rows; its handlers
-are the default ones overridden by the profile's own and then by the modules'.
+are the default ones overridden by the profile's own and then by the modules'. A module may also
+have ``PLACE_AFTER`` (data name → the name its row follows), so its rows keep ARIA's registration
+order among the default ones (``setConfigParam`` right after ``setConfig``, as serverDemo lists it).
 """
 
 from __future__ import annotations
@@ -66,11 +68,15 @@ class SimProfile:
             for e in base
         ]
         extra, _ = self.module_parts()
+        after: dict[str, str] = {}
+        for name in self.modules:
+            after.update(getattr(importlib.import_module(name), "PLACE_AFTER", {}))
         known = {r[0] for r in rows}
         for r in extra:  # the first module to list a name describes it
             if r[0] not in known:
                 known.add(r[0])
-                rows.append(r)
+                anchor = next((i for i, row in enumerate(rows) if row[0] == after.get(r[0])), None)
+                rows.insert(len(rows) if anchor is None else anchor + 1, r)
         if self.catalogue_size > len(rows):
             rows += filler_rows(self.catalogue_size - len(rows), {r[0] for r in rows})
         return DataList.build(rows)
@@ -205,8 +211,15 @@ def filler_rows(count: int, taken: set[str]) -> list[Row]:
     return rows
 
 
-COMMISSIONING = ("rtmu.sim.files_data", "rtmu.sim.mapping_data")
-"""ARIA's file services and scan-to-map handler: what commissioning a robot needs."""
+COMMISSIONING = (
+    "rtmu.sim.files_data",
+    "rtmu.sim.mapping_data",
+    "rtmu.sim.mapchanges",
+    "rtmu.sim.configcare",
+    "rtmu.sim.locks",
+)
+"""ARIA's file services, scan-to-map, live map changes, configuration care and mode locks: what
+commissioning a robot needs, served by every profile."""
 DEFAULT = SimProfile(
     "default",
     "serverDemo with a simulated Pioneer 3-DX, navigating as ARNL does",

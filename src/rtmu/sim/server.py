@@ -48,6 +48,7 @@ from .arconfig import SimArConfig
 from .catalogue import Row, custom_commands
 from .config import SimConfig
 from .files_data import add_default_folder
+from .geometry import Obstacles
 from .handlers import (
     BROADCAST_ONLY,
     Call,
@@ -347,6 +348,8 @@ class SimServer:
         self.handlers = self.profile.handler_table()
         self._module_commands = tuple(r for r in self.profile.module_parts()[0] if r[4] == "CustomCommands")
         self.map: ServedMap = self._load_map(cfg.map_path)
+        self.file_md5 = self.map.md5
+        """MD5 of the map file as last read (or written): ``checkMap`` reloads only when the file differs."""
         obstacles = self.map.obstacles()
         home = cfg.start_pose or self.map.home
         x, y = free_spot_near(obstacles, home[0], home[1], 250.0) if self.map.present else (home[0], home[1])
@@ -662,24 +665,38 @@ class SimServer:
         if path is None or not path.is_file():
             return False
         raw_md5 = hashlib.md5(path.read_bytes()).digest()
-        if raw_md5 == self.map.md5:
+        if raw_md5 == self.file_md5:
             return False
-        self.map = self._load_map(path)
-        obstacles = self.map.obstacles()
+        self.file_md5 = raw_md5
+        self.install_map(self._load_map(path), move_home=True)
+        return True
+
+    def install_map(
+        self, served: ServedMap, *, move_home: bool = False, obstacles: Obstacles | None = None
+    ) -> None:
+        """Serve ``served`` from now on (walls, navigation's grid, home); ``mapUpdated`` and ``goalsUpdated``
+        to every subscriber. ``move_home``: the robot starts again at the new map's home (``checkMap``)."""
+        self.map = self._profiled(served)
+        obstacles = obstacles or self.map.obstacles()
         home = self.config.start_pose or self.map.home
         x, y = free_spot_near(obstacles, home[0], home[1], 250.0)
         self.home = (x, y, home[2])
-        self.world.replace_obstacles(obstacles)
-        self.world.nav_map = self._nav_map()
+        if obstacles is not self.world.obstacles:
+            self.world.replace_obstacles(obstacles)
+        self.world.nav_map = nav = self._nav_map()
         self.world.home = self.home
-        self.reset_pose()
+        if move_home:
+            self.reset_pose()
+        if nav is not None and self.config.realtime:  # the new grid built aside, not in the next plan
+            asyncio.get_running_loop().run_in_executor(None, nav.grid)
         self.broadcast("mapUpdated")
         self.broadcast("goalsUpdated")
-        return True
 
     def _load_map(self, path):
         """The map file, served with the profile's first line (an LD robot's ``2D-Map-Ex4``)."""
-        served = load_map(path)
+        return self._profiled(load_map(path))
+
+    def _profiled(self, served: ServedMap) -> ServedMap:
         header = self.profile.map_header
         if header and served.present and served.lines:
             served.lines[0] = header

@@ -201,6 +201,13 @@ class World:
         m = self.mode
         return (m.NAME, m.locked, m.locked and m.will_unlock)
 
+    def check_mode_info(self) -> None:
+        """Flag ``getModeInfo`` for broadcast when the active mode's name or lock changed."""
+        info = self.mode_info()
+        if info != self._mode_info:
+            self._mode_info = info
+            self.changes.mode_info = True
+
     def home_pose(self) -> tuple[float, float, float | None]:
         return self.home
 
@@ -276,10 +283,7 @@ class World:
         self.localization.tick(self.time)
         if self.waiting_modes and not self.mode.locked:
             self.activate(self.waiting_modes.pop(0))
-        info = self.mode_info()
-        if info != self._mode_info:
-            self._mode_info = info
-            self.changes.mode_info = True
+        self.check_mode_info()
         if (
             self.body.battery_v <= p3dx.BATTERY_SHUTDOWN_V
             and self.mode is not self.stop_mode

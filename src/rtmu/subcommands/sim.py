@@ -93,6 +93,12 @@ def register(subparsers: argparse._SubParsersAction) -> None:
         help="add N configuration parameters, markup in every text (try clients on a hostile ArConfig)",
     )
     p.add_argument(
+        "--save-map-changes",
+        action="store_true",
+        help="write live map changes (processMapChanges) into the --map file, as ARIA does "
+        "(default: they live in the simulator only)",
+    )
+    p.add_argument(
         "--robots",
         type=int,
         default=None,
@@ -197,6 +203,7 @@ def run(args: argparse.Namespace) -> int:
         config_filler=max(0, min(args.config_filler, 200_000)),
         files_dir=args.files,
         files_default_dir=args.files_default_dir,
+        save_map_changes=args.save_map_changes,
         verbose=args.verbose,
     )
     if args.battery is not None:

@@ -52,6 +52,10 @@ class RobotState:
     extended_status: str = ""
     mode_name: str = ""
     """Internal mode name from ``getModeInfo`` (``stop``, ``ratioDrive``…)."""
+    mode_locked: bool = False
+    """``getModeInfo``: the active mode is locked (no other mode may take over: docking, safety)."""
+    mode_will_unlock: bool = False
+    """``getModeInfo``: the locked mode gives way when another mode asks (the dock backs out first)."""
     safe_drive: bool | None = None
     wifi_quality: int | None = None
     """Link quality as the server publishes it (a ``getStrings`` item); None if not offered."""
@@ -105,6 +109,16 @@ class RobotState:
     @property
     def moving(self) -> bool:
         return self.vel != 0 or self.rot_vel != 0 or self.lat_vel != 0
+
+    @property
+    def mode_lock(self) -> str:
+        """The mode lock in words ("" when unlocked), told to the operator instead of a silent refusal."""
+        if not self.mode_locked:
+            return ""
+        name = self.mode or self.mode_name or "its current"
+        if self.mode_will_unlock:
+            return f"locked in {name} mode; will unlock if asked"
+        return f"locked in {name} mode; will not unlock if asked"
 
 
 @dataclass(frozen=True, slots=True)
