@@ -208,7 +208,7 @@ def filler_rows(count: int, taken: set[str]) -> list[Row]:
 DEFAULT = SimProfile(
     "default",
     "serverDemo with a simulated Pioneer 3-DX, navigating as ARNL does",
-    modules=("rtmu.sim.nav_data", "rtmu.sim.arconfig"),
+    modules=("rtmu.sim.nav_data", "rtmu.sim.arconfig", "rtmu.sim.why_states"),
 )
 ARAM = SimProfile(
     "aram",
@@ -217,7 +217,13 @@ ARAM = SimProfile(
     state_of_charge=True,
     map_header=EX4_HEADER,
     catalogue_size=LD_CATALOGUE_SIZE,
-    modules=("rtmu.sim.nav_data", "rtmu.sim.ld_data", "rtmu.sim.arconfig"),  # the LD docking replaces ARNL's
+    modules=(
+        "rtmu.sim.nav_data",
+        "rtmu.sim.ld_data",
+        "rtmu.sim.arconfig",
+        "rtmu.sim.why_states",
+        "rtmu.sim.ld_safety",
+    ),  # the LD docking replaces ARNL's
     handlers={
         "updateNumbers": _soc_numbers,
         "batteryInfo": _soc_battery_info,
