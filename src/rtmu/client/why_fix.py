@@ -65,7 +65,7 @@ async def apply(
     except ClientError as exc:
         return FixResult(fix, True, False, f"sent, but the link failed: {exc}")
     if worked is None:
-        return FixResult(fix, True, False, f"sent {fix.sends}; RTMU cannot read back whether it worked")
+        return FixResult(fix, True, False, f"sent {fix.sends}; what the robot says now is below")
     if worked:
         return FixResult(fix, True, True, f"sent {fix.sends}: done")
     return FixResult(fix, True, False, f"sent {fix.sends}, but the robot did not change within {settle:g} s")

@@ -65,6 +65,8 @@ def _hold(what: str, on: bool) -> Handler:
             holds.add("motors")  # a released e-stop leaves the motors off until they are enabled
         elif not (what == "motors" and "estop" in holds):  # no motors while the e-stop is pressed
             holds.discard(what)
+            if what == "stall":
+                call.world.body.stalled = False
         call.world.check_strings()
         return ()
 
