@@ -207,7 +207,8 @@ def test_an_obstacle_inside_safe_drive_and_switching_it_off_needs_a_yes(sim: Sim
     code, answer = why_json(sim, capsys)
     assert code == codes.EXIT_WHY_SAFE_DRIVE == 31
     reason = answer["reasons"][0]
-    assert "ahead of the robot (straight on)" in reason["problem"] and "140 mm" in reason["problem"]
+    assert "290 mm ahead of its centre (straight on)" in reason["problem"]
+    assert "half the robot's length + 94 mm" in reason["problem"]
     assert "backwards: that way is clear" in reason["advice"] and reason["fix"]["confirm"] is True
     x0 = x_of(sim)
     assert drive(sim, "--trans", "50") == codes.EXIT_WHY_SAFE_DRIVE and abs(x_of(sim) - x0) < 1.0

@@ -100,10 +100,11 @@ def test_safe_drive_matters_only_the_way_the_robot_is_asked_to_go() -> None:
     assert causes(safe(ahead), Motion(-50, 0)) == []  # backing away
     assert causes(safe(ahead), Motion(0, 40)) == []  # turning on the spot is never held back
     assert causes(safe(ahead, on=False)) == []
-    assert causes(safe(Obstacle(210 + 160, 0, "laser"))) == []  # beyond the distance
+    assert causes(safe(Obstacle(255.5 + 150, 0, "laser"))) == []  # beyond the distance (from half its length)
+    assert causes(safe(Obstacle(255.5 + 149, 0, "laser"))) == [Cause.SAFE_DRIVE]
     assert causes(safe(Obstacle(290, 300, "sonar"))) == []  # beside the path, not in it
-    behind = diagnose(safe(Obstacle(-(301 + 20), -100, "sonar")), Motion(-50, 0)).reasons[0]
-    assert "20 mm behind the robot (100 mm to the right)" in behind.problem
+    behind = diagnose(safe(Obstacle(-(255.5 + 20), -100, "sonar")), Motion(-50, 0)).reasons[0]
+    assert "276 mm behind its centre (100 mm to the right)" in behind.problem and "= 406 mm" in behind.problem
     assert "forwards: that way is clear" in behind.advice
 
 
@@ -111,7 +112,7 @@ def test_the_reading_named_is_the_nearest_and_the_most_central() -> None:
     hit = nearest(
         (Obstacle(300, -200, "a"), Obstacle(300, 10, "b"), Obstacle(400, 0, "c")), P3DX, LIMITS, True
     )
-    assert hit is not None and hit[0].source == "b" and hit[1] == 90
+    assert hit is not None and hit[0].source == "b" and hit[1] == 300 - 255.5  # ARIA: from half the length
 
 
 def test_moved_reads_speed_or_a_pose_change_beyond_rounding() -> None:

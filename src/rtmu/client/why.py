@@ -373,7 +373,7 @@ def _safe_drive(facts: Facts, motion: Motion | None, navigate: bool) -> list[Rea
         hit = nearest(facts.obstacles, facts.footprint, facts.limits, forward)
         if hit is None:
             continue
-        obstacle, gap = hit
+        obstacle, _ = hit
         limit = facts.limits.front if forward else facts.limits.rear
         way, away = ("ahead of", "backwards") if forward else ("behind", "forwards")
         clear = nearest(facts.obstacles, facts.footprint, facts.limits, not forward) is None
@@ -384,8 +384,9 @@ def _safe_drive(facts: Facts, motion: Motion | None, navigate: bool) -> list[Rea
         out.append(
             Reason(
                 Cause.SAFE_DRIVE,
-                f"safe drive holds the robot back: an obstacle {max(gap, 0):.0f} mm {way} the robot "
-                f"{_side(obstacle)}, inside its safe-drive distance of {limit:.0f} mm",
+                f"safe drive holds the robot back: an obstacle {abs(obstacle.x):.0f} mm {way} its centre "
+                f"{_side(obstacle)}, closer than safe drive allows (half the robot's length + "
+                f"{limit:.0f} mm = {facts.footprint.reach + limit:.0f} mm)",
                 advice,
                 (
                     f"{obstacle.source}: reading at ({obstacle.x:.0f}, {obstacle.y:.0f}) mm in "
@@ -416,13 +417,14 @@ def nearest(
     obstacles: tuple[Obstacle, ...], footprint: Footprint, limits: SafeDriveLimits, forward: bool
 ) -> tuple[Obstacle, float] | None:
     """The closest reading in the robot's path (its width plus the side clearance) that is nearer
-    than the safe-drive distance to its front (or rear), with that distance; None when clear."""
+    than the safe-drive distance, with that distance; None when clear. Measured as ARIA's
+    ArActionDeceleratingLimiter measures: from half the robot's length ahead of (behind) its centre."""
     half = footprint.width / 2 + limits.side
     best: tuple[Obstacle, float] | None = None
     for o in obstacles:
         if abs(o.y) > half:
             continue
-        gap = (o.x - footprint.front) if forward else (-o.x - footprint.rear)
+        gap = (o.x if forward else -o.x) - footprint.reach
         if (o.x > 0) != forward or gap >= (limits.front if forward else limits.rear):
             continue
         if best is None or (round(gap), abs(o.y)) < (round(best[1]), abs(best[0].y)):

@@ -154,6 +154,12 @@ class Footprint:
     front: float
     rear: float
 
+    @property
+    def reach(self) -> float:
+        """How far ARIA's limiter takes the robot to reach ahead and behind its centre: half its length
+        (``ArRobot::getRobotLength() / 2``), whatever the split between front and rear."""
+        return (self.front + self.rear) / 2
+
 
 @dataclass(frozen=True, slots=True)
 class OurSide:

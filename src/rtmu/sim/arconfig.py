@@ -246,10 +246,10 @@ class SimArConfig:
         )
 
     def _margin(self, ahead: bool) -> tuple[Callable[[], Value], Callable[[Value], None]]:
-        """Safe drive's margin, told as ARIA's limiter tells it: from the footprint physicalInfo reports
-        (the simulated body is a circle, so its front and rear lie beyond that footprint)."""
+        """Safe drive's margin, told as ARIA's limiter measures it: from half the robot's length (as
+        physicalInfo gives it) ahead of and behind its centre; the simulated body is a circle."""
         margins = self.host.world.body.safe_margin
-        beyond = p3dx.RADIUS_MM - (p3dx.LENGTH_FRONT_MM if ahead else p3dx.LENGTH_REAR_MM)
+        beyond = p3dx.RADIUS_MM - p3dx.LENGTH_MM / 2
 
         def put(v: Value) -> None:
             margins[ahead] = max(float(v or 0) - beyond, 0.0)
@@ -437,7 +437,7 @@ def _clearance(word: str) -> ConfigParam:
         ParamType.INT,
         0,
         f"Safe drive stops this far short of anything {'ahead' if word == 'Forward' else 'behind'}, "
-        "in mm from the robot's front or rear as physicalInfo gives it",
+        "in mm from half the robot's length ahead of (behind) its centre",
         Priority.INTERMEDIATE,
         0,
         2000,
