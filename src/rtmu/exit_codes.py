@@ -46,7 +46,8 @@ EXIT_WHY_BATTERY = 30
 EXIT_WHY_SAFE_DRIVE = 31
 """Safe drive holds the robot back: an obstacle inside the safe-drive distance."""
 EXIT_WHY_WATCHDOG = 32
-"""The server's drive watchdog is shorter than RTMU's resend period: it stops every drive."""
+"""The server's drive watchdog is shorter than twice RTMU's resend period: it stops the robot
+between commands (jerky motion, none on a slow link)."""
 EXIT_WHY_LOST = 33
 """Localization is lost (only when asking about navigation)."""
 EXIT_WHY_LEASE = 34

@@ -355,7 +355,8 @@ def _watchdog(facts: Facts, motion: Motion | None, navigate: bool) -> list[Reaso
         Reason(
             Cause.WATCHDOG,
             f"the server's drive watchdog is {t:g} s: shorter than twice the "
-            f"{RESEND_PERIOD:g} s between RTMU's drive commands, so it stops the robot between them",
+            f"{RESEND_PERIOD:g} s between RTMU's drive commands, so it stops the robot between them "
+            "(jerky motion at best, none on a slow link)",
             "raise the Teleop Timeout in the server's configuration (ARIA's default is 2 s; 0 turns it off)",
             (f"configuration: Teleop Timeout = {t:g} s",),
         )
