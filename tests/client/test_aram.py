@@ -137,7 +137,7 @@ def test_doctor_good_aram_sim(aram: SimThread, capsys: pytest.CaptureFixture[str
     code, report = doctor_json(capsys, addr(aram))
     assert code == EXIT_OK and report["ok"] is True and report["failed_step"] is None
     steps = {s["step"]: s for s in report["steps"]}
-    assert list(steps) == ["resolve", "tcp", "introduction", "login", "data_list", "udp", "status"]
+    assert list(steps) == ["resolve", "tcp", "introduction", "login", "data_list", "udp", "status", "motion"]
     assert steps["introduction"]["protocol"] == "6MTX" and steps["introduction"]["sent_protocol"] == "6MTX"
     assert steps["data_list"]["count"] >= LD_CATALOGUE_SIZE
     assert report["features"]["teleop"] is True
@@ -236,6 +236,7 @@ def test_doctor_udp_handshake(answers: bool) -> None:
     rows = [
         ("updateNumbers", "status", "none", "numbers", "RobotInfo", "RETURN_SINGLE"),
         ("ratioDrive", "drive", "doubles", "none", "Movement", "RETURN_NONE"),
+        ("stop", "stop", "none", "none", "Stop", "RETURN_NONE"),  # else the motion step warns: no stop
     ]
     conns: list[ServerConnection] = []
 

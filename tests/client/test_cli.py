@@ -13,7 +13,14 @@ from pathlib import Path
 import pytest
 
 from rtmu import mapfile as maps
-from rtmu.base.exit_codes import EXIT_CONNECTION, EXIT_OK, EXIT_TIMEOUT, EXIT_UNSUPPORTED, EXIT_USAGE
+from rtmu.base.exit_codes import (
+    EXIT_CONNECTION,
+    EXIT_OK,
+    EXIT_TIMEOUT,
+    EXIT_UNSUPPORTED,
+    EXIT_USAGE,
+    EXIT_WHY_NO_DRIVE,
+)
 from rtmu.cli import main
 from rtmu.package_data import project_map
 from rtmu.sim import SimConfig, SimThread
@@ -143,7 +150,7 @@ def test_user_without_movement_rights_cannot_drive(sim: SimThread, tmp_path: Pat
         "--seconds",
         "1",
     ]
-    assert main(args) == EXIT_UNSUPPORTED
+    assert main(args) == EXIT_WHY_NO_DRIVE  # said as rtmu why says it (rtmu.client.why)
     assert "ratioDrive" in capsys.readouterr().err
 
 
@@ -232,9 +239,11 @@ def test_unsupported_exits_4(capsys: pytest.CaptureFixture[str], tmp_path: Path)
         target = f"127.0.0.1:{server.port}"
         assert main(["image", target, "--out", str(tmp_path / "x.jpg")]) == EXIT_UNSUPPORTED
         assert main(["map", target, "--out", str(tmp_path / "x.map")]) == EXIT_UNSUPPORTED
-        assert main(["drive", target, "--trans", "10", "--seconds", "1"]) == EXIT_UNSUPPORTED
-    lines = capsys.readouterr().err.splitlines()
-    assert len(lines) == 3 and all(line.startswith("rtmu ") for line in lines)
+        lines = capsys.readouterr().err.splitlines()
+        assert len(lines) == 2 and all(line.startswith("rtmu ") for line in lines)
+        # A server that offers no driving is told as rtmu why tells it, with its own exit code.
+        assert main(["drive", target, "--trans", "10", "--seconds", "1"]) == EXIT_WHY_NO_DRIVE
+    assert capsys.readouterr().err.startswith("rtmu drive: this login (no user name) may not drive")
 
 
 def test_server_killed_while_streaming_status_exits_3(capsys: pytest.CaptureFixture[str]) -> None:

@@ -132,8 +132,15 @@ def test_commands_popups_and_low_battery(arena_map):
         assert {"ResetTripOdometer", "SimulatorLowBattery", "safeRatioDrivingDisable"} <= set(names)
         assert all(n in c.conn.datalist for n in names)
         strings = StringCommandList.decode((await c.ask("listStringCommands"))[0]).commands
-        assert [e.name for e in strings][:3] == ["SimulatorSetBattery", "SimulatorPopup", "SimulatorPopupFlood"]
-        assert {e.name for e in strings[3:]} <= {"mappingLoopStart", "mappingLoopEnd"}  # ARIA lists them as string commands
+        assert [e.name for e in strings][:3] == [
+            "SimulatorSetBattery",
+            "SimulatorPopup",
+            "SimulatorPopupFlood",
+        ]
+        assert {e.name for e in strings[3:]} <= {
+            "mappingLoopStart",
+            "mappingLoopEnd",
+        }  # ARIA lists them as string commands
         c.request("popupCreate", -1)
         c.request("popupClose", -1)
         await c.barrier()

@@ -32,11 +32,12 @@ def test_factory_values_come_in_one_packet_of_pairs_whole_or_by_section() -> Non
             "SerialNumber",
             "SIM-P3DX-0001",
         ) in every
-        assert len(every) == 10  # no separator
+        assert len(every) == 12  # no separator
         one = ConfigDefaults.decode(
             (await c.ask("getConfigDefaults", ConfigDefaultsRequest("teleop").encode()))[0]
         )
-        assert one.pairs == (("Section", "Teleop"), ("Timeout", "2"))
+        assert one.pairs[:2] == (("Section", "Teleop"), ("Timeout", "2"))
+        assert {name for name, _value in one.pairs[2:]} == {"ForwardClearance", "BackwardClearance"}
         none = await c.ask("getConfigDefaults", ConfigDefaultsRequest("Nowhere").encode())
         assert none == [b""]
         await c.close()

@@ -30,7 +30,9 @@ def test_a_stop_that_will_not_unlock_holds_against_a_drive_and_is_said_so() -> N
     async def scenario() -> None:
         server, c = await _start()
         names = [e.name for e in CommandList.decode((await c.ask("listCommands"))[0]).commands]
-        assert {"SimulatorLockStopMode", "SimulatorLockStopModeYielding", "SimulatorUnlockMode"} <= set(names)
+        assert {"SimulatorLockStopMode", "SimulatorLockStopModeUnlockable", "SimulatorUnlockMode"} <= set(
+            names
+        )
         c.once("SimulatorLockStopMode")
         await c.until(lambda: _last_mode(c).locked)
         assert _last_mode(c) == ModeInfo("stop", True, False)
@@ -56,7 +58,7 @@ def test_a_stop_that_will_not_unlock_holds_against_a_drive_and_is_said_so() -> N
 def test_a_stop_that_yields_gives_way_to_the_mode_that_asks() -> None:
     async def scenario() -> None:
         server, c = await _start()
-        c.once("SimulatorLockStopModeYielding")
+        c.once("SimulatorLockStopModeUnlockable")
         await c.until(lambda: _last_mode(c).locked)
         assert _last_mode(c) == ModeInfo("stop", True, True)
         c.once("ratioDrive", RatioDrive(100, 0, 100).encode())

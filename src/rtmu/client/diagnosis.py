@@ -35,6 +35,9 @@ class Step(Enum):
     UDP = 16
     """Never fails ``rtmu doctor`` (RTMU uses TCP only)."""
     STATUS = 15
+    MOTION = 17
+    """Why won't it move (``rtmu why``'s answer): a failing motion step exits with the cause's own
+    code (20–39, :class:`rtmu.client.why_values.Cause`), not this value."""
 
     @property
     def key(self) -> str:
@@ -53,6 +56,7 @@ STEP_TITLES = {
     Step.DATA_LIST: "data list",
     Step.UDP: "UDP",
     Step.STATUS: "first status",
+    Step.MOTION: "why won't it move",
 }
 
 

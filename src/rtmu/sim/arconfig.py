@@ -119,6 +119,8 @@ class SimArConfig:
             lambda: ratio.timeout,
             setter(ratio, "timeout"),
         )
+        for ahead, word in ((True, "Forward"), (False, "Backward")):
+            self._add("Teleop", _clearance(word), *self._margin(ahead))
         self.comments["Robot config"] = "Limits of the simulated Pioneer 3-DX"
         self._add(
             "Robot config",
@@ -245,6 +247,17 @@ class SimArConfig:
             lambda: ap.wall_loss_db,
             setter(ap, "wall_loss_db"),
         )
+
+    def _margin(self, ahead: bool) -> tuple[Callable[[], Value], Callable[[Value], None]]:
+        """Safe drive's margin, told as ARIA's limiter measures it: from half the robot's length (as
+        physicalInfo gives it) ahead of and behind its centre; the simulated body is a circle."""
+        margins = self.host.world.body.safe_margin
+        beyond = p3dx.RADIUS_MM - p3dx.LENGTH_MM / 2
+
+        def put(v: Value) -> None:
+            margins[ahead] = max(float(v or 0) - beyond, 0.0)
+
+        return (lambda: round(margins[ahead] + beyond)), put
 
     def _set_frame_size(self, v: Value) -> None:
         self.host.video_size = CAMERA_SIZES[str(v)]
@@ -427,6 +440,19 @@ def _request(call: Call) -> ConfigRequest:
         return ConfigRequest.decode(call.args)
     except (FieldUnderrun, PayloadError):
         return ConfigRequest(None, None)
+
+
+def _clearance(word: str) -> ConfigParam:
+    return ConfigParam(
+        f"{word}Clearance",
+        ParamType.INT,
+        0,
+        f"Safe drive stops this far short of anything {'ahead' if word == 'Forward' else 'behind'}, "
+        "in mm from half the robot's length ahead of (behind) its centre",
+        Priority.INTERMEDIATE,
+        0,
+        2000,
+    )
 
 
 def _get_by_sections(version: int) -> Handler:

@@ -216,14 +216,13 @@ COMMISSIONING = (
     "rtmu.sim.mapping_data",
     "rtmu.sim.mapchanges",
     "rtmu.sim.configcare",
-    "rtmu.sim.locks",
 )
-"""ARIA's file services, scan-to-map, live map changes, configuration care and mode locks: what
+"""ARIA's file services, scan-to-map, live map changes and configuration care: what
 commissioning a robot needs, served by every profile."""
 DEFAULT = SimProfile(
     "default",
     "serverDemo with a simulated Pioneer 3-DX, navigating as ARNL does",
-    modules=("rtmu.sim.nav_data", "rtmu.sim.arconfig", *COMMISSIONING),
+    modules=("rtmu.sim.nav_data", "rtmu.sim.arconfig", *COMMISSIONING, "rtmu.sim.why_states"),
 )
 ARAM = SimProfile(
     "aram",
@@ -237,6 +236,8 @@ ARAM = SimProfile(
         "rtmu.sim.ld_data",
         "rtmu.sim.arconfig",
         *COMMISSIONING,
+        "rtmu.sim.why_states",
+        "rtmu.sim.ld_safety",
     ),  # the LD docking replaces ARNL's
     handlers={
         "updateNumbers": _soc_numbers,

@@ -394,6 +394,9 @@ class World:
     # -- questions --------------------------------------------------------------
     def strings(self) -> tuple[str, str, str]:
         m = self.mode
+        said = held_words(self.body.holds)
+        if said:  # the simulator's own words for a robot whose motors do not answer
+            return (said, m.mode_string, said)
         return (m.status, m.mode_string, m.extended_status)
 
     def sonar(self) -> list[tuple[int, int]]:
@@ -441,6 +444,15 @@ class World:
             b.collisions,
             r.timeouts,
         )
+
+
+def held_words(holds: set[str]) -> str:
+    """The status the simulator shows while its e-stop is pressed or its motors are off ("" otherwise)."""
+    if "estop" in holds:
+        return "EStop pressed"
+    if "motors" in holds:
+        return "Motors disabled"
+    return ""
 
 
 def free_spot_near(obstacles: Obstacles, x: float, y: float, radius: float) -> tuple[float, float]:

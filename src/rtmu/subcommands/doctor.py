@@ -6,6 +6,8 @@ tag and protocol string), the login, the data list (and which RTMU features the 
 UDP, the first status — and for the first step that fails says in plain words what went wrong
 and what to do next (the same words the window uses, :mod:`rtmu.client.diagnosis`). It stops
 there; the exit code names the step (10 name … 15 status; UDP never fails it, RTMU uses TCP).
+Connected, it asks the last question with a login of its own: why won't it move? — ``rtmu why``'s
+answer (:mod:`rtmu.client.why`); that step fails with the cause's own code (20–39).
 """
 
 from __future__ import annotations
@@ -21,8 +23,11 @@ from typing import Any
 
 from ..base.exit_codes import EXIT_OK, EXIT_USAGE
 from ..base.textsafe import visible
-from ..client.connection import TEXT_BANNERS
+from ..client.connection import TEXT_BANNERS, AriaClient
 from ..client.diagnosis import ADVICE, Step, login_finding
+from ..client.errors import ClientError
+from ..client.why import diagnose
+from ..client.why_gather import gather
 from ..protocol.client_connection import ClientConnection
 from ..protocol.commands import ClientCommand, ServerCommand
 from ..protocol.decoder import PacketDecoder
@@ -109,6 +114,8 @@ class Doctor:
     def __init__(self, host: str, port: int, user: str, password: str, protocol: str | None, timeout: float):
         self.host, self.port, self.user = host, port, user
         self._password = password
+        self._motion_password = password
+        """Kept for the motion step's own login, forgotten once it has logged in."""
         self.protocol = protocol
         self.timeout = timeout
         self.steps: list[StepResult] = []
@@ -130,14 +137,17 @@ class Doctor:
             await self._data_list()
             await self._udp(intro)
             await self._status()
+            await self._close()  # one login at a time: a robot may take few clients
+            await self._motion()
         except StepFailed as exc:
             self.steps.append(exc.result)
             done = {s.step for s in self.steps}
             for step in Step:
                 if step not in done:
                     self.steps.append(StepResult(step, "skipped", "not tried (an earlier step failed)"))
-            return exc.result.step.value
+            return int(exc.result.details.get("exit_code", exc.result.step.value))
         finally:
+            self._motion_password = ""
             await self._close()
         return EXIT_OK
 
@@ -368,6 +378,39 @@ class Doctor:
         details["battery_pct" if soc else "battery_v"] = numbers.battery
         self.ok(Step.STATUS, text, **details)
 
+    async def _motion(self) -> None:
+        """``rtmu why``'s answer, asked over a login of its own (the steps above use the bare codec)."""
+        client = AriaClient()
+        try:
+            await client.connect(
+                self.host,
+                self.port,
+                self.user,
+                self._motion_password,
+                timeout=self.timeout,
+                protocol=self.protocol,
+            )
+            answer = diagnose(await gather(client, self.timeout))
+        except ClientError as exc:
+            self.ok(Step.MOTION, f"could not ask: {exc}", "warn")
+            return
+        finally:
+            self._motion_password = ""
+            await client.disconnect()
+        reason = answer.primary
+        if reason is None:
+            self.ok(Step.MOTION, answer.sentence())
+            return
+        others = [r.sentence() for r in answer.reasons[1:]]
+        raise fail(
+            Step.MOTION,
+            reason.problem,
+            reason.advice,
+            cause=reason.cause.key,
+            exit_code=reason.cause.value,
+            also=others,
+        )
+
     async def _once(self, name: str) -> Any:
         conn = self.conn
         assert conn is not None
@@ -391,9 +434,11 @@ class Doctor:
             if self.conn is not None:
                 self.conn.shutdown()
                 self._flush()
-            self.writer.close()
+        writer, self.writer = self.writer, None  # closed once, whoever asks again
+        with contextlib.suppress(Exception):
+            writer.close()
             async with asyncio.timeout(1.0):
-                await self.writer.wait_closed()
+                await writer.wait_closed()
 
 
 # -- command line -------------------------------------------------------------------------------------
