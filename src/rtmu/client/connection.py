@@ -425,6 +425,11 @@ class AriaClient:
         self._conn.request(name, interval_ms, encode_args(args))  # type: ignore[union-attr]
         self._flush()
 
+    def subscribed(self, name: str) -> bool:
+        """True while a handler holds a subscription to ``name`` (another ``request`` would replace it)."""
+        number = self._conn.datalist.number(name) if self._conn is not None else None
+        return number is not None and number in self._handlers
+
     def stop_request(self, name: str) -> None:
         """End a subscription (no reply). Unknown or unsubscribed names are ignored."""
         number = self._conn.datalist.number(name) if self._conn is not None else None
