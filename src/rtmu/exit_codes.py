@@ -11,3 +11,7 @@ EXIT_USAGE = 2
 EXIT_CONNECTION = 3
 EXIT_UNSUPPORTED = 4
 EXIT_TIMEOUT = 5
+
+EXIT_FOREIGN_CONFIG = 9
+"""The robot has a configuration RTMU cannot show or edit yet (an Omron LD robot's ``getConfigValues``
+/ ``setConfigValues``, whose layouts are not public): ``rtmu config`` says which, and stops."""

@@ -343,6 +343,7 @@ class SimServer:
         self.profile = get_profile(cfg.profile)
         if cfg.protocol_version is None:
             cfg.protocol_version = self.profile.protocol_version
+        cfg.camera = cfg.camera and self.profile.camera
         self.handlers = self.profile.handler_table()
         self._module_commands = tuple(r for r in self.profile.module_parts()[0] if r[4] == "CustomCommands")
         self.map: ServedMap = self._load_map(cfg.map_path)
@@ -646,8 +647,9 @@ class SimServer:
         return time.monotonic() if self.config.realtime else self.world.time
 
     def custom_commands(self) -> tuple[Row, ...]:
-        """serverDemo's simple commands, then the ones the profile's data modules add."""
-        return custom_commands(self.config.camera) + self._module_commands
+        """serverDemo's simple commands, then the ones the profile's data modules add (those it lists)."""
+        rows = custom_commands(self.config.camera) + self._module_commands
+        return tuple(r for r in rows if r[0] in self.datalist)
 
     def video_trailer(self) -> bytes:
         """The 2 bytes ARIA's video forwarder leaves after a picture (the upstream packet's checksum)."""

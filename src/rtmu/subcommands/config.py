@@ -3,7 +3,8 @@
 Without ``--set``: every section and parameter with its value, type, limits and priority. With
 ``--set``: one ``setConfig`` of all the values given; the server checks them and either takes them
 all or answers with its first error, which is printed (exit 6). Exit 4 when the server offers no
-configuration.
+configuration; exit 9 when it offers one RTMU cannot show or edit yet — an Omron LD robot's
+``getConfigValues`` family (protocol 6MTX), named as such (``rtmu call`` reads it raw).
 """
 
 from __future__ import annotations
@@ -13,9 +14,9 @@ import math
 import sys
 from typing import Any
 
-from ..client.config_feed import ServerConfig, fetch_config, set_config
+from ..client.config_feed import ConfigApi, ForeignConfig, ServerConfig, fetch_config, set_config
 from ..client.connection import AriaClient
-from ..exit_codes import EXIT_OK, EXIT_USAGE
+from ..exit_codes import EXIT_FOREIGN_CONFIG, EXIT_OK, EXIT_USAGE
 from ..protocol.payloads.config import ConfigParam, ParamType, Priority
 from ..textsafe import visible
 from ._common import add_connection_arguments, print_json, run_with_client
@@ -50,12 +51,14 @@ def parse_assignment(text: str, parser: Any) -> tuple[str, str, str]:
 def register(subparsers: Any) -> None:
     p = subparsers.add_parser(
         "config",
-        help="show or change the server's configuration (getConfigBySections, setConfig)",
+        help="show or change the server's configuration (ArConfig: getConfigBySections, setConfig)",
         description=(
             "Print the server's configuration: sections, then parameters with value, type, limits "
             "and priority. --set SECTION/PARAM=VALUE (repeatable) changes values in one setConfig: "
             f"exit {EXIT_REFUSED} with the server's message when it refuses one (it then changes "
-            "none), 4 when the server offers no configuration."
+            f"none), 4 when the server offers no configuration, {EXIT_FOREIGN_CONFIG} when it offers "
+            "one RTMU cannot show or edit yet (an Omron LD robot's getConfigValues: named, and "
+            "readable raw with rtmu call)."
         ),
     )
     add_connection_arguments(p)
@@ -78,9 +81,14 @@ def handle(args: argparse.Namespace) -> int:
         return EXIT_USAGE
 
     async def body(client: AriaClient) -> int:
-        if assignments:
-            return await _set(client, assignments, args)
-        config = await fetch_config(client, args.timeout)
+        try:
+            if assignments:
+                return await _set(client, assignments, args)
+            config = await fetch_config(client, args.timeout)
+        except ForeignConfig as exc:
+            if args.json:
+                print_json({"api": api_key(exc.api), "data": list(exc.listed), "editable": False})
+            raise
         if args.json:
             print_json(config_json(config))
         else:
@@ -129,8 +137,13 @@ def param_json(p: ConfigParam, config: ServerConfig) -> dict[str, Any]:
     return out
 
 
+def api_key(api: ConfigApi) -> str:
+    return api.name.lower().replace("_", "-")
+
+
 def config_json(config: ServerConfig) -> dict[str, Any]:
     return {
+        "api": api_key(ConfigApi.ARCONFIG),
         "source": config.source,
         "last_editable": Priority.of(config.last_editable).name.lower(),
         "sections": [

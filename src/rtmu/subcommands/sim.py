@@ -85,7 +85,7 @@ def register(subparsers: argparse._SubParsersAction) -> None:
         choices=("default", "aram"),
         default="default",
         help="which server to be: default (serverDemo, Pioneer 3-DX) or aram (an Omron LD robot: "
-        "protocol 6MTX, state of charge, Ex4 map, ~950 data)",
+        "protocol 6MTX, state of charge, Ex4 map, lasers, only data 6MTX robots list)",
     )
     p.add_argument(
         "--protocol",
