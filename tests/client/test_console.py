@@ -123,6 +123,19 @@ def test_arguments_are_typed_from_the_description(sim: SimThread, capsys: pytest
     assert "not a whole number" in capsys.readouterr().err
 
 
+def test_name_and_arguments_may_follow_options(sim: SimThread, capsys: pytest.CaptureFixture[str]) -> None:
+    """Found against ARIA's own server: ``HOST --user U --password-file F NAME`` must call NAME."""
+    assert main(["call", addr(sim.port), "--timeout", "10", "getMapName"]) == EXIT_OK
+    assert "getMapName: replied" in capsys.readouterr().out
+    code = main(["call", addr(sim.port), "--timeout", "10", "gotoPose", "1500", "--yes", "-700"])
+    assert code == EXIT_OK
+    assert main(["call", addr(sim.port), "stop", "--yes", "--timeout", "10"]) == EXIT_OK
+    with pytest.raises(SystemExit) as info:
+        main(["call", addr(sim.port), "getMapName", "--bogus", "x"])
+    assert info.value.code == EXIT_USAGE
+    assert "unrecognized arguments: --bogus (values not shown)" in capsys.readouterr().err
+
+
 def test_refusals_and_unknown_names(sim: SimThread, capsys: pytest.CaptureFixture[str]) -> None:
     assert main(["call", addr(sim.port), "ratioDrive", "50", "0", "100", "--yes"]) == EXIT_USAGE
     assert "held drive" in capsys.readouterr().err

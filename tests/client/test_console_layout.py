@@ -189,6 +189,8 @@ def test_names_that_change_something(name: str) -> None:
         "update",
         "Laser_1Current",
         "getMapBinary",
+        "sendVideo",
+        "getPictureCam1",
     ],
 )
 def test_plain_reads(name: str) -> None:
@@ -202,3 +204,23 @@ def test_a_description_or_a_missing_reply_makes_an_unknown_name_a_change() -> No
     effect, why = classify(entry("frobnicate"))
     assert effect is Effect.READ and "nothing" in why
     assert name_words("safetyStatusEStop") == ["safety", "status", "estop"]
+
+
+def test_fields_run_together_without_separators_are_still_apart() -> None:
+    """serverDemo's getSensorCurrent: "byte2: numReadings string: sensorName, …: byte4: x byte4: y"."""
+    sensor = DEFAULT.catalogue(camera=True).entry("getSensorCurrent")
+    assert sensor is not None
+    layout = parse_layout(sensor.return_description)
+    assert [f.kind for f in layout.fields] == ["byte2", "string", "byte4", "byte4"]
+    assert layout.repeat_from == 2
+    payload = FieldWriter().byte2(2).string("sonar").byte4(-2098).byte4(2377).byte4(10).byte4(-20).bytes()
+    fields, more = split_fields(payload, layout)
+    assert [(f.kind, f.value) for f in fields] == [
+        ("byte2", 2),
+        ("string", "sonar"),
+        ("byte4", -2098),
+        ("byte4", 2377),
+        ("byte4", 10),
+        ("byte4", -20),
+    ]
+    assert more == 0 and fields[4].label == "x"

@@ -54,7 +54,7 @@ READ_LAST = frozenset(
     {
         "info", "list", "status", "state", "current", "cumulative", "count", "name", "names", "id", "size",
         "progress", "done", "resumable", "points", "lines", "path", "paths", "data", "shape", "sector",
-        "tree", "grid", "area", "trace", "stencils",
+        "tree", "grid", "area", "trace", "stencils", "video", "picture", "image",
     }
 )  # fmt: skip
 BROADCAST_LAST = frozenset({"updated", "changed", "update"})

@@ -43,9 +43,10 @@ NO_ARGUMENTS = frozenset({"", "none", "none.", "no arguments", "nothing"})
 
 # A typed field: an optional "optional", ARIA's type word (any case, "u" for unsigned, "int" and
 # "uint" as some servers write them), then a colon and the field's label up to ; , or a new field.
+_KIND = r"\b(?:u?byte[248]?|u?int(?:8|16|32)?|double|string)\s*:"
 _FIELD = re.compile(
     r"(?P<optional>\boptional\s+|\[\s*)?\b(?P<kind>u?byte[248]?|u?int(?:8|16|32)?|double|string)\s*:\s*"
-    r"(?P<label>(?:\([^()]*\)|[^;,:<(])*)",
+    rf"(?P<label>(?:(?!{_KIND})(?:\([^()]*\)|[^;,:<(]))*)",
     re.IGNORECASE,
 )
 _REPEAT = re.compile(r"repeat|for each|\btimes\b|\bper (?:point|reading|entry|item|sensor)", re.IGNORECASE)

@@ -20,6 +20,7 @@ from __future__ import annotations
 import argparse
 import difflib
 import json
+import re
 import sys
 import time
 from typing import Any
@@ -44,6 +45,7 @@ def register(subparsers: Any) -> None:
         "Exit 0 replied, 2 not listed / wrong arguments / needs --yes / refused, 3 connection, "
         "5 silent.",
     )
+    _positionals_anywhere(p)
     add_connection_arguments(p)
     p.add_argument("name", metavar="NAME", nargs="?", help="the data's name, as --list prints it")
     p.add_argument("arguments", metavar="ARG", nargs="*", help="its arguments, in order")
@@ -69,6 +71,34 @@ def register(subparsers: Any) -> None:
         help="list the server's data (those whose name, description or group contains FILTER)",
     )
     p.set_defaults(handler=handle)
+
+
+def _positionals_anywhere(parser: argparse.ArgumentParser) -> None:
+    """NAME and ARGs may come after options (``HOST --user U NAME 5``), as in every other subcommand.
+
+    argparse fills an optional NAME and ARG list with nothing at the first run of positionals (HOST
+    alone) and then calls the later words unrecognised; they are taken back here, in order, before the
+    connection arguments' own check refuses what is left (options it does not know).
+    """
+    parse_known = parser.parse_known_args
+
+    def parse_known_args(args: Any = None, namespace: Any = None) -> tuple[argparse.Namespace, list[str]]:
+        namespace, extras = parse_known(args, namespace)
+        words: list[str] = []
+        rest: list[str] = []
+        for arg in extras:
+            (words if not arg.startswith("-") or _NUMBER.fullmatch(arg) else rest).append(arg)
+        if words and getattr(namespace, "name", None) is None:
+            namespace.name = words.pop(0)
+        if words:
+            namespace.arguments = [*(getattr(namespace, "arguments", None) or []), *words]
+        return namespace, rest
+
+    parser.parse_known_args = parse_known_args  # type: ignore[method-assign,assignment]
+
+
+_NUMBER = re.compile(r"-\d+(\.\d*)?|-\.\d+")
+"""A negative number is an ARG, not an option."""
 
 
 def usage(message: str) -> int:
