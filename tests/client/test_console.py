@@ -10,6 +10,7 @@ promises bytes that never come — answered in bounded time with bounded views.
 from __future__ import annotations
 
 import json
+import threading
 from collections.abc import Iterator
 
 import pytest
@@ -25,7 +26,7 @@ from rtmu.client.console import (
     entry_of,
 )
 from rtmu.client.console_reply import MAX_FIELDS_SHOWN
-from rtmu.exit_codes import EXIT_OK, EXIT_TIMEOUT, EXIT_USAGE
+from rtmu.exit_codes import EXIT_CONNECTION, EXIT_OK, EXIT_TIMEOUT, EXIT_USAGE
 from rtmu.protocol.fields import FieldWriter
 from rtmu.protocol.packet import encode_packet
 from rtmu.sim import SimConfig, SimThread
@@ -171,6 +172,19 @@ def test_the_model_refuses_to_take_over_a_subscription_the_connection_holds(sim:
 
     assert run(go()) == "replied"
     assert console_entries(sim.server.datalist, "goal")  # type: ignore[union-attr]
+
+
+def test_following_ends_with_the_connection(capsys: pytest.CaptureFixture[str]) -> None:
+    thread = ServerThread(TestServer())
+    with thread as server:
+        end = threading.Timer(1.0, lambda: thread.call(lambda: [server.kill(s) for s in server.sides]))
+        end.start()
+        try:
+            code = main(["call", addr(server.port), "updateNumbers", "--every", "100", "--timeout", "5"])
+        finally:
+            end.join()
+    assert code == EXIT_CONNECTION
+    assert "rtmu call:" in capsys.readouterr().err
 
 
 # -- hostile servers ----------------------------------------------------------------------------------

@@ -11,7 +11,8 @@ A data that changes something is sent only with ``--yes``, never followed, and `
 Exit codes (:mod:`rtmu.exit_codes`): 0 replied (a command without reply: the server took it);
 2 usage — a data this user's list does not have, arguments that do not fit, a call that changes
 something without ``--yes`` or one the console refuses (the reason is printed; nothing was sent);
-3 connection; 5 silent — no reply within ``--timeout`` (no reply at all while following), a reply
+3 connection (also when it ends while following); 5 silent — no reply within ``--timeout`` (no reply
+at all while following), a reply
 that stalled part way, or a command the server did not confirm taking.
 """
 
@@ -33,6 +34,8 @@ from ..textsafe import visible
 from ._common import add_connection_arguments, positive_float, print_json, run_with_client
 
 SILENT_OUTCOMES = ("silent", "stalled", "sent")
+FOLLOW_CHECK = 0.5
+"""Seconds between looks at the connection while following a data."""
 
 
 def register(subparsers: Any) -> None:
@@ -144,7 +147,8 @@ async def follow(client: AriaClient, entry: ConsoleEntry, payload: bytes, args: 
     replies = 0
     try:
         while deadline is None or time.monotonic() < deadline:
-            wait = args.timeout if deadline is None else max(0.0, deadline - time.monotonic())
+            left = FOLLOW_CHECK if deadline is None else max(0.0, deadline - time.monotonic())
+            wait = min(FOLLOW_CHECK, left)  # and look at the connection between waits
             reply = await subscription.next(wait)
             if reply is None:
                 if not client.connected:
@@ -154,6 +158,8 @@ async def follow(client: AriaClient, entry: ConsoleEntry, payload: bytes, args: 
             show(reply, entry, args.json, args.timeout)
     finally:
         subscription.stop()
+    if client.closed_error is not None:  # the connection ended while following: exit 3, with why
+        raise client.closed_error
     if not replies:
         print(f"rtmu call: {visible(entry.name)}: no reply while following it", file=sys.stderr)
     return EXIT_OK if replies else EXIT_TIMEOUT
