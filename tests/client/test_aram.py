@@ -22,9 +22,11 @@ from rtmu.client.errors import LoginRejected
 from rtmu.package_data import project_map
 from rtmu.protocol.payloads.robot import BatteryInfo
 from rtmu.sim import SimConfig, SimThread
-from rtmu.sim.profiles import ARAM_PROTOCOL, LD_CATALOGUE_SIZE
+from rtmu.sim.profiles import ARAM, ARAM_PROTOCOL
 
 OFFICE = project_map("office.map")
+ARAM_COUNT = len(ARAM.catalogue(camera=True))
+"""The aram profile lists only what 6MTX robots list (and what the simulator serves of it)."""
 
 
 @pytest.fixture(scope="module")
@@ -59,7 +61,7 @@ def test_default_answer_is_the_advertised_string(aram: SimThread) -> None:
         finally:
             await client.disconnect()
 
-    assert asyncio.run(go()) >= LD_CATALOGUE_SIZE
+    assert asyncio.run(go()) == ARAM_COUNT
 
 
 def test_wrong_protocol_names_the_wanted_string(aram: SimThread) -> None:
@@ -83,7 +85,7 @@ def test_cli_wrong_protocol_exits_3_with_the_wanted_string(
 
 def test_cli_explicit_right_protocol_logs_in(aram: SimThread, capsys: pytest.CaptureFixture[str]) -> None:
     assert main(["probe", addr(aram), "--protocol", "6MTX", "--json", "--timeout", "5"]) == EXIT_OK
-    assert json.loads(capsys.readouterr().out)["count"] >= LD_CATALOGUE_SIZE
+    assert json.loads(capsys.readouterr().out)["count"] == ARAM_COUNT
 
 
 def test_sim_protocol_option_enforces_and_advertises() -> None:
@@ -139,7 +141,9 @@ def test_doctor_good_aram_sim(aram: SimThread, capsys: pytest.CaptureFixture[str
     steps = {s["step"]: s for s in report["steps"]}
     assert list(steps) == ["resolve", "tcp", "introduction", "login", "data_list", "udp", "status", "motion"]
     assert steps["introduction"]["protocol"] == "6MTX" and steps["introduction"]["sent_protocol"] == "6MTX"
-    assert steps["data_list"]["count"] >= LD_CATALOGUE_SIZE
+    assert steps["data_list"]["count"] == ARAM_COUNT
+    assert "its configuration is Omron LD's" in steps["data_list"]["summary"]
+    assert report["features"]["configuration"] is False  # getConfigValues is not ArConfig
     assert report["features"]["teleop"] is True
     assert steps["udp"]["result"] == "not_checked"  # the simulator announces UDP port 0
     assert 0 <= steps["status"]["battery_pct"] <= 100

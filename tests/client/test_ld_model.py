@@ -35,7 +35,7 @@ def test_model_gets_laser_dock_routes_and_data_store_from_aram() -> None:
             ui.wait_for(lambda: model.robot.value.routes == ROUTES, timeout=5)
             ui.wait_for(lambda: len(model.robot.value.data_store) >= 5, timeout=5)
             names = dict(model.robot.value.data_store)
-            assert 0 <= int(names["DataStore_WiFi_Quality"]) <= 70
+            assert 0 <= int(names["DataStore_WirelessQuality"]) <= 70
             runner.send(Dock()).result(5)
             ui.wait_for(lambda: model.robot.value.dock_state == "Docking", timeout=5)
             ui.wait_for(lambda: model.robot.value.dock_state == "Docked", timeout=10)

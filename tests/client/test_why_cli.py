@@ -255,7 +255,7 @@ def test_navigating_docked_and_lost_with_their_fixes(capsys) -> None:  # type: i
 
 # -- an Omron LD robot -------------------------------------------------------------------------------
 def test_ld_faults_are_read_raw_and_acknowledged_only_with_a_yes(capsys) -> None:  # type: ignore[no-untyped-def]
-    with SimThread(SimConfig(port=0, profile="aram")) as s:
+    with SimThread(SimConfig(port=0, profile="aram", test_hooks=True)) as s:
         assert s.server is not None
         state = safety_state(s.server)
         command(s, "SimulatorFault")
@@ -278,7 +278,7 @@ def test_ld_faults_are_read_raw_and_acknowledged_only_with_a_yes(capsys) -> None
 
 
 def test_ld_motors_are_enabled_only_with_a_yes(capsys) -> None:  # type: ignore[no-untyped-def]
-    with SimThread(SimConfig(port=0, profile="aram")) as s:
+    with SimThread(SimConfig(port=0, profile="aram", test_hooks=True)) as s:
         assert s.server is not None
         state = safety_state(s.server)
         command(s, "SimulatorMotorsOff")

@@ -18,6 +18,7 @@ from PIL import Image
 
 from rtmu.client.config_feed import set_config
 from rtmu.client.connection import AriaClient
+from rtmu.package_data import project_map
 from rtmu.sim import SimConfig, SimThread
 from rtmu.ui.config_page import PAGE_SIZE, ConfigPage
 
@@ -278,3 +279,24 @@ def test_ten_thousand_parameters_with_markup_open_bounded_and_responsive(
         gui.shot("main-window")
     finally:
         gui.close()
+
+
+def test_an_ld_robots_configuration_is_named_and_not_offered_for_editing(screenshots: Path) -> None:
+    """Protocol 6MTX lists Omron LD's getConfigValues family, not ArConfig's: the page says which API
+    the robot has and that RTMU cannot edit it yet, instead of an empty page or "none offered"."""
+    office = project_map("office.map")
+    with SimThread(SimConfig(port=0, profile="aram", map_path=office)) as aram:
+        gui = Gui.start(screenshots, "config-ld", "127.0.0.1", aram.port)
+        try:
+            gui.window.activate_action("win.server-config", None)
+            pump(lambda: page(gui) is not None, 5, "the configuration page")
+            p = page(gui)
+            assert p is not None
+            pump(lambda: p.banner.get_visible(), 10, "the page to name the robot's API")
+            text = p.banner.get_text()
+            assert "Omron LD's" in text and "getConfigValues" in text and "cannot show or edit it yet" in text
+            assert p.status.get_text() == "No configuration RTMU can edit"
+            assert p.config is None and not p.rows
+            gui.render(p, gui.shots / "config-ld.png")
+        finally:
+            gui.close()

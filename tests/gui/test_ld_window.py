@@ -69,7 +69,7 @@ def test_laser_dock_routes_and_say_in_the_window(screenshots: Path, request: pyt
 
             window.show_details()
             details = window.details
-            pump(lambda: "WiFi Quality" in details.values, 5, "the data-store table")
+            pump(lambda: "Wireless Quality" in details.values, 5, "the data-store table")
             assert details.values["Docking"].get_text() == "Undocked"
             assert details.say_row.get_visible()
             details.say_entry.set_text("Hello from the window")

@@ -45,8 +45,9 @@ def test_front_laser_sees_the_wall_at_one_ray_per_degree(tmp_path):
         # 4 m to each side); the low laser (126°, 4 m) only where it is within 4 m.
         assert 100 <= len(front) <= 140 and all(x == 2000 for x, _ in front)
         assert 0 < len(low) < len(front) and all(x == 2000 for x, _ in low)
-        names = [DrawingListPacket.decode(p).drawing for p in await c.ask("getDrawingList", count=4)]
-        assert [d.name for d in names if d] == ["sonarCurrent", "Laser_1Current", "Laser_2Current"]
+        names = [DrawingListPacket.decode(p).drawing for p in await c.ask("getDrawingList", count=3)]
+        assert [d.name for d in names if d] == ["Laser_1Current", "Laser_2Current"]  # no sonar on an LD
+        assert "sonarCurrent" not in c.conn.datalist
         await c.close()
         await server.stop()
 
@@ -83,9 +84,9 @@ def test_routes_patrol_say_and_data_store(arena_map):
         state = ld_state(server)
         assert state.patrols == [ROUTES[1]]
         assert state.said == ["Hello from RTMU"]
-        wifi = DataStoreValue.decode((await c.ask("DataStore_WiFi_Quality"))[0]).value
+        wifi = DataStoreValue.decode((await c.ask("DataStore_WirelessQuality"))[0]).value
         assert wifi == str(server.world.wifi().quality)
-        closest = DataStoreValue.decode((await c.ask("DataStore_Closest_Obstacle"))[0]).value
+        closest = DataStoreValue.decode((await c.ask("DataStore_Closest_Obstacle_Distance"))[0]).value
         assert closest == "none" or 0 < float(closest) < math.inf
         await c.close()
         await server.stop()
@@ -97,7 +98,7 @@ def test_default_profile_lists_none_of_it(arena_map):
     async def scenario() -> None:
         server, c = await _start(arena_map, profile="default")
         assert len(c.conn.datalist) > 50  # the list did arrive
-        for name in ("Laser_1Current", "dockInfo", "getRoutes", "patrol", "say", "DataStore_WiFi_Quality"):
+        for name in ("Laser_1Current", "dockInfo", "getRoutes", "patrol", "say", "DataStore_WirelessQuality"):
             assert name not in c.conn.datalist
         await c.close()
         await server.stop()

@@ -361,12 +361,12 @@ def test_the_aram_profile_navigates_too_and_its_data_store_follows():
         c.once("gotoGoal", GotoGoal("Room 102").encode())
         await c.barrier()
         await server.advance(3.0)
-        left = float(DataStoreValue.decode((await c.ask("DataStore_Distance_To_Goal"))[0]).value)
+        left = float(DataStoreValue.decode((await c.ask("DataStore_Distance_to_goal"))[0]).value)
         assert 1000 < left < 8000
         await _until(server, lambda: server.robot.status == "Arrived at Room 102", 60)
-        assert DataStoreValue.decode((await c.ask("DataStore_Distance_To_Goal"))[0]).value == "0"
+        assert DataStoreValue.decode((await c.ask("DataStore_Distance_to_goal"))[0]).value == "0"
         server.lose_localization()
-        assert int(DataStoreValue.decode((await c.ask("DataStore_Localization_Score"))[0]).value) < 20
+        assert int(DataStoreValue.decode((await c.ask("DataStore_LaserLocalizationScore"))[0]).value) < 20
         await _end(server, c)
 
     run(scenario())

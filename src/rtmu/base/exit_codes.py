@@ -57,3 +57,7 @@ EXIT_WHY_LEASE = 34
 """Our drive lease is not live (no key held, or a held key blocked until released; a replay)."""
 EXIT_WHY_UNEXPLAINED = 39
 """``rtmu drive``: asked to move, the robot did not, and nothing RTMU can read says why."""
+
+EXIT_FOREIGN_CONFIG = 9
+"""The robot has a configuration RTMU cannot show or edit yet (an Omron LD robot's ``getConfigValues``
+/ ``setConfigValues``, whose layouts are not public): ``rtmu config`` says which, and stops."""

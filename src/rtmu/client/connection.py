@@ -458,6 +458,11 @@ class AriaClient:
             self._fail(ServerClosed(f"the connection to {self.host}:{self.port} broke: {reason}"))
         self._require_open()
 
+    def subscribed(self, name: str) -> bool:
+        """True while a handler holds a subscription to ``name`` (another ``request`` would replace it)."""
+        number = self._conn.datalist.number(name) if self._conn is not None else None
+        return number is not None and number in self._handlers
+
     def stop_request(self, name: str) -> None:
         """End a subscription (no reply). Unknown or unsubscribed names are ignored."""
         number = self._conn.datalist.number(name) if self._conn is not None else None

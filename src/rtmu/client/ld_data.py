@@ -102,26 +102,28 @@ _SCALE = re.compile(r"\(\s*0\s*[-–]\s*(\d+)\s*\)")
 def store_fields(name: str, value: str, description: str = "") -> dict[str, int | None]:
     """The :class:`~rtmu.model.observables.RobotState` fields a ``DataStore_*`` value gives the toolbar.
 
-    Names as LD robots list them (``DataStore_Localization_Score``, ``DataStore_WiFi_Quality``,
-    ``DataStore_Distance_To_Goal``, ``DataStore_Closest_Obstacle``); anything else only goes to the
-    details table. Wi-Fi quality becomes % using the range in its description ("(0–70)": Linux's
-    link quality), else it is taken as % already. A value that is not a number clears the field.
+    Names as 6MTX robots list them (``DataStore_LaserLocalizationScore``,
+    ``DataStore_WirelessQuality``, ``DataStore_Distance_to_goal``,
+    ``DataStore_Closest_Obstacle_Distance``), read without case or underscores so that spellings such
+    as ``DataStore_Localization_Score`` or ``DataStore_WiFi_Quality`` count too; anything else only
+    goes to the details table. Wi-Fi quality becomes % using the range in its description ("(0–70)":
+    Linux's link quality), else it is taken as % already. A value that is not a number clears the field.
     """
-    key = name.lower()
+    key = name.lower().replace("_", "").replace("-", "")
     try:
         number: float | None = float(value.split()[0])
     except (ValueError, IndexError):
         number = None
-    if "localization_score" in key or "localisation_score" in key:
+    if "localizationscore" in key or "localisationscore" in key:
         return {"loc_score": None if number is None else round(max(0.0, min(100.0, number)))}
-    if "wifi_quality" in key or "wi_fi_quality" in key:
+    if "wifiquality" in key or "wirelessquality" in key:
         if number is None:
             return {"wifi_quality": None}
         top = _SCALE.search(description)
         scale = int(top.group(1)) if top and int(top.group(1)) > 0 else 100
         return {"wifi_quality": round(max(0.0, min(100.0, number * 100 / scale)))}
-    if "distance_to_goal" in key:
+    if "distancetogoal" in key:
         return {"goal_distance_mm": None if number is None else max(0, round(number))}
-    if "closest_obstacle" in key:
+    if "closestobstacle" in key:
         return {"closest_obstacle_mm": None if number is None else max(0, round(number))}
     return {}

@@ -32,6 +32,9 @@ class SimConfig:
     """Enforce a protocol version (reason 4 for a client that differs); None: the profile's."""
     profile: str = "default"
     """Which kind of server to be (:mod:`rtmu.sim.profiles`): ``default`` or ``aram``."""
+    test_hooks: bool | None = None
+    """List the simulator's own ``Simulator…`` commands (None: as the profile does — the default profile
+    lists them, ``aram`` only when asked, being true to a 6MTX robot's list)."""
     client_type: int | None = None
     """Enforce a client type (reason 6), as ``ArServerBase::enforceType`` does."""
     central_server: str | None = None

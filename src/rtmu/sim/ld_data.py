@@ -4,8 +4,11 @@ A data module of the profile extension point (:mod:`rtmu.sim.profiles`): ``ROWS`
 and ``HANDLERS`` for the server. Two lasers seen from the world's walls by the same ray caster as
 the sonar, one ray per degree, a docking state that ``dock``/``undock`` move through
 docking → docked (and back) in :data:`DOCK_SECONDS` of simulated time, a few routes that ``patrol``
-starts (recorded, no driving), ``DataStore_*`` strings from the simulator's real values and
-``say`` (recorded). What was asked is kept per server in :func:`ld_state` so tests can look.
+starts (recorded, no driving), ``DataStore_*`` strings from the simulator's real values (under names
+6MTX robots list; the value texts are ours) and ``say`` (recorded). LD's configuration data are
+listed but never answered (:data:`CONFIG_API`: their layouts are not public, and a made-up answer
+would teach RTMU a layout no robot has). What was asked is kept per server in :func:`ld_state` so
+tests can look.
 """
 
 from __future__ import annotations
@@ -32,7 +35,7 @@ from rtmu.protocol.payloads.ld import (
 from rtmu.protocol.payloads.sensors import Drawing, DrawingList, DrawingListPacket, RangeDeviceReadings
 
 from .catalogue import Row
-from .handlers import SONAR_DRAWING, Call, Handler, Reply
+from .handlers import Call, Handler, Reply
 
 if TYPE_CHECKING:
     from .context import SimHost
@@ -98,12 +101,12 @@ def _laser(call: Call) -> Iterable[Reply]:
 
 
 def _drawing_list(call: Call) -> Iterable[Reply]:
-    packets = [DrawingListPacket(d).encode() for d in (SONAR_DRAWING, *LASER_DRAWINGS)]
+    packets = [DrawingListPacket(d).encode() for d in LASER_DRAWINGS]  # LD robots list no sonar
     return (*packets, DrawingListPacket(None).encode())
 
 
 def _list_drawings(call: Call) -> Iterable[Reply]:
-    return (DrawingList((SONAR_DRAWING, *LASER_DRAWINGS)).encode(),)
+    return (DrawingList(LASER_DRAWINGS).encode(),)
 
 
 # -- docking ----------------------------------------------------------------------------------
@@ -187,21 +190,33 @@ def _closest_obstacle_mm(call: Call) -> float:
 
 
 DATA_STORE: dict[str, tuple[str, object]] = {
-    "DataStore_Localization_Score": (
+    "DataStore_LaserLocalizationScore": (
         "Localization score (0–100)",
         lambda call: str(round(call.world.localization.score * 100)),
     ),
-    "DataStore_WiFi_Quality": ("Wi-Fi link quality (0–70)", lambda call: str(call.world.wifi().quality)),
-    "DataStore_Distance_To_Goal": (
+    "DataStore_WirelessQuality": ("Wi-Fi link quality (0–70)", lambda call: str(call.world.wifi().quality)),
+    "DataStore_Distance_to_goal": (
         "Distance to the goal in mm (0: no goal)",
         lambda call: str(round(call.world.path_task.distance_left())),
     ),
-    "DataStore_Closest_Obstacle": (
+    "DataStore_Closest_Obstacle_Distance": (
         "Distance to the closest obstacle in mm",
         lambda call: (lambda d: "none" if d == math.inf else str(round(d)))(_closest_obstacle_mm(call)),
     ),
-    "DataStore_Dock_State": ("Docking state", lambda call: _dock_now(call).state_label),
+    "DataStore_DockingState": ("Docking state", lambda call: _dock_now(call).state_label),
 }
+"""Names as 6MTX robots list them; descriptions and value texts are the simulator's own (LD's are
+not public)."""
+CONFIG_API: tuple[Row, ...] = tuple(
+    (name, f"{what} (LD configuration; layout not public)", "not public", "not public", "ConfigEditing", "")
+    for name, what in (
+        ("getConfigValues", "The configuration's values"),
+        ("setConfigValues", "Sets configuration values"),
+        ("updateConfigValues", "Changes configuration values"),
+        ("configExpandedSectionList", "The configuration's sections"),
+    )
+)
+"""LD's configuration data, listed as a 6MTX robot lists them and never answered here."""
 
 
 def _data_store(call: Call) -> Iterable[Reply]:
@@ -271,6 +286,7 @@ ROWS: tuple[Row, ...] = (
         (name, desc, "none", "string: value", "DataStore", "RETURN_SINGLE")
         for name, (desc, _) in DATA_STORE.items()
     ),
+    *CONFIG_API,
 )
 
 HANDLERS: dict[str, Handler] = {

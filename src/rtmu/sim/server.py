@@ -345,6 +345,7 @@ class SimServer:
         self.profile = get_profile(cfg.profile)
         if cfg.protocol_version is None:
             cfg.protocol_version = self.profile.protocol_version
+        cfg.camera = cfg.camera and self.profile.camera
         self.handlers = self.profile.handler_table()
         self._module_commands = tuple(r for r in self.profile.module_parts()[0] if r[4] == "CustomCommands")
         self.map: ServedMap = self._load_map(cfg.map_path)
@@ -363,7 +364,7 @@ class SimServer:
         )
         self.home = (x, y, home[2])
         self.world.nav_map = self._nav_map()
-        self.datalist: DataList = self.profile.catalogue(camera=cfg.camera)
+        self.datalist: DataList = self.profile.catalogue(camera=cfg.camera, test_hooks=cfg.test_hooks)
         if cfg.files_default_dir is not None:
             add_default_folder(self.datalist, self.handlers, cfg.files_default_dir)
         self.users: UserTable | None = UserTable.load(cfg.users_path) if cfg.users_path else None
@@ -652,8 +653,9 @@ class SimServer:
         return time.monotonic() if self.config.realtime else self.world.time
 
     def custom_commands(self) -> tuple[Row, ...]:
-        """serverDemo's simple commands, then the ones the profile's data modules add."""
-        return custom_commands(self.config.camera) + self._module_commands
+        """serverDemo's simple commands, then the ones the profile's data modules add (those it lists)."""
+        rows = custom_commands(self.config.camera) + self._module_commands
+        return tuple(r for r in rows if r[0] in self.datalist)
 
     def video_trailer(self) -> bytes:
         """The 2 bytes ARIA's video forwarder leaves after a picture (the upstream packet's checksum)."""

@@ -3,8 +3,10 @@
 Without an action: every section and parameter with its value, type, limits and priority. With
 ``--set``: one ``setConfig`` of all the values given; the server checks them and either takes them
 all or answers with its first error, which is printed (exit 6). Exit 4 when the server offers no
-configuration. The care actions (``--defaults``, ``--reset``, ``--export``, ``--import``,
-``--reload``) are in :mod:`._config_care`.
+configuration; exit 9 when it offers one RTMU cannot show or edit yet — an Omron LD robot's
+``getConfigValues`` family (protocol 6MTX), named as such (``rtmu call`` reads it raw). The care
+actions (``--defaults``, ``--reset``, ``--export``, ``--import``, ``--reload``) are in
+:mod:`._config_care`.
 """
 
 from __future__ import annotations
@@ -15,9 +17,9 @@ import sys
 from pathlib import Path
 from typing import Any
 
-from ..base.exit_codes import EXIT_OK, EXIT_USAGE
+from ..base.exit_codes import EXIT_FOREIGN_CONFIG, EXIT_OK, EXIT_USAGE
 from ..base.textsafe import visible
-from ..client.config_feed import ServerConfig, fetch_config, set_config
+from ..client.config_feed import ConfigApi, ForeignConfig, ServerConfig, fetch_config, set_config
 from ..client.connection import AriaClient
 from ..protocol.payloads.config import ConfigParam, ParamType, Priority
 from . import _config_care
@@ -53,7 +55,7 @@ def parse_assignment(text: str, parser: Any) -> tuple[str, str, str]:
 def register(subparsers: Any) -> None:
     p = subparsers.add_parser(
         "config",
-        help="show or change the server's configuration (getConfigBySections, setConfig)",
+        help="show or change the server's configuration (ArConfig: getConfigBySections, setConfig)",
         description=(
             "Print the server's configuration: sections, then parameters with value, type, limits "
             "and priority. One action at most: --set SECTION/PARAM=VALUE (repeatable) changes values in "
@@ -65,7 +67,9 @@ def register(subparsers: Any) -> None:
             "arguments, a --reset target the server does not have, a file that exists or is not an "
             f"export; 3 connection failure; 4 not offered (no configuration, no factory values); "
             f"5 timeout; {EXIT_REFUSED} refused, by the server (its message is printed) or, for "
-            "--import, because the file does not fit the server (nothing is sent)."
+            "--import, because the file does not fit the server (nothing is sent); "
+            f"{EXIT_FOREIGN_CONFIG} the robot offers a configuration RTMU cannot show or edit yet (an "
+            "Omron LD robot's getConfigValues: named, and readable raw with rtmu call)."
         ),
     )
     add_connection_arguments(p)
@@ -108,12 +112,17 @@ def handle(args: argparse.Namespace) -> int:
         return EXIT_USAGE
 
     async def body(client: AriaClient) -> int:
-        if assignments:
-            return await _set(client, assignments, args)
-        done = await _config_care.run(client, args)
-        if done is not None:
-            return done
-        config = await fetch_config(client, args.timeout)
+        try:
+            if assignments:
+                return await _set(client, assignments, args)
+            done = await _config_care.run(client, args)
+            if done is not None:
+                return done
+            config = await fetch_config(client, args.timeout)
+        except ForeignConfig as exc:
+            if args.json:
+                print_json({"api": api_key(exc.api), "data": list(exc.listed), "editable": False})
+            raise
         if args.json:
             print_json(config_json(config))
         else:
@@ -162,8 +171,13 @@ def param_json(p: ConfigParam, config: ServerConfig) -> dict[str, Any]:
     return out
 
 
+def api_key(api: ConfigApi) -> str:
+    return api.name.lower().replace("_", "-")
+
+
 def config_json(config: ServerConfig) -> dict[str, Any]:
     return {
+        "api": api_key(ConfigApi.ARCONFIG),
         "source": config.source,
         "last_editable": Priority.of(config.last_editable).name.lower(),
         "sections": [

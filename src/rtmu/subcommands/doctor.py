@@ -23,6 +23,7 @@ from typing import Any
 
 from ..base.exit_codes import EXIT_OK, EXIT_USAGE
 from ..base.textsafe import visible
+from ..client.config_feed import ConfigApi, config_api
 from ..client.connection import TEXT_BANNERS, AriaClient
 from ..client.diagnosis import ADVICE, Step, login_finding
 from ..client.errors import ClientError
@@ -58,7 +59,7 @@ FEATURES: tuple[tuple[str, str, tuple[str, ...]], ...] = (
     ("map", "map download", ("getMapBinary", "getMap")),
     ("camera", "camera pictures", ("getPicture*", "sendVideo", "getVideo*")),
     ("sensors", "sonar and laser drawing", ("sonarCurrent", "Laser_*Current", "getSensorCurrent")),
-    ("configuration", "server configuration", ("getConfig*",)),
+    ("configuration", "server configuration (ArConfig)", ("getConfigBySections*", "setConfig")),
     ("popups", "the robot's message boxes", ("popupCreate",)),
     ("custom_commands", "the robot's custom commands", ("listCommands", "listStringCommands")),
     ("status", "pose, battery and status", ("updateNumbers", "update")),
@@ -296,6 +297,8 @@ class Doctor:
         summary = f"{len(entries)} data in {len(groups)} groups; RTMU can use: {', '.join(have) or 'nothing'}"
         if missing:
             summary += f"; not offered: {', '.join(missing)}"
+        if config_api(names) is ConfigApi.OMRON_LD:
+            summary += "; its configuration is Omron LD's (getConfigValues): RTMU cannot show or edit it yet"
         advice = ""
         if not self.features["teleop"] and self.user:
             advice = "driving is not offered to this user: log in as a user whose groups include Movement"

@@ -76,7 +76,14 @@ def register(subparsers: argparse._SubParsersAction) -> None:
         choices=("default", "aram"),
         default="default",
         help="which server to be: default (serverDemo, Pioneer 3-DX) or aram (an Omron LD robot: "
-        "protocol 6MTX, state of charge, Ex4 map, ~950 data)",
+        "protocol 6MTX, state of charge, Ex4 map, lasers, only data 6MTX robots list)",
+    )
+    p.add_argument(
+        "--test-hooks",
+        action="store_true",
+        default=None,
+        help="list the simulator's own Simulator… commands (put it in a state: a fault, a locked mode, "
+        "a stall …) also on a profile that leaves them out to stay true to a real robot's list (aram)",
     )
     p.add_argument(
         "--protocol",
@@ -200,6 +207,7 @@ def run(args: argparse.Namespace) -> int:
         max_clients=args.max_clients if args.max_clients > 0 else None,
         protocol_version=args.protocol,
         profile=args.profile,
+        test_hooks=args.test_hooks,
         config_filler=max(0, min(args.config_filler, 200_000)),
         files_dir=args.files,
         files_default_dir=args.files_default_dir,

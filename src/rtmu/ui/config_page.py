@@ -29,6 +29,7 @@ from gi.repository import Gdk, GLib, Gtk, Pango  # noqa: E402
 from ..client.config_feed import (  # noqa: E402
     MAX_TEXT,
     ConfigSection,
+    ForeignConfig,
     ServerConfig,
     changed_values,
     check_value,
@@ -199,6 +200,11 @@ class ConfigPage(Gtk.Window):
             again, self._again = self._again, ""
             GLib.idle_add(self._refresh_later, "remote" if again == "remote" else "")
         error = None if future.cancelled() else future.exception()
+        if isinstance(error, ForeignConfig):  # an answer, not a failure: its whole sentence, wrapped
+            self.status.set_text("No configuration RTMU can edit")
+            self.banner.set_text(str(error))
+            self.banner.set_visible(True)
+            return False
         if future.cancelled() or error is not None:
             self.status.set_text(f"Could not load the configuration: {error or 'cancelled'}")
             return False

@@ -333,8 +333,10 @@ class FetchConfig(Intent):
 
 @dataclass(frozen=True)
 class SetConfig(Intent):
-    """Change configuration values: section → parameter → text (``setConfig``, all or nothing)."""
+    """Change configuration values: section → parameter → text (``setConfig``, all or nothing).
 
-    needs: ClassVar[tuple[str, ...]] = ("setConfig",)
+    No ``needs``: the configuration feed says in plain words which configuration a robot has, also
+    one RTMU cannot edit (an LD robot's ``setConfigValues``)."""
+
     label: ClassVar[str] = "Configuration"
     changes: Mapping[str, Mapping[str, str]] = field(default_factory=dict)
