@@ -134,7 +134,7 @@ def test_three_robots_are_listed_and_drawn_each_in_its_colour(
         colours = {b.colour(s) for s in gui.app.fleet}
         assert len(colours) == 3
         # The three robots share one map file (same getMapId): it was downloaded once, not three times.
-        shared = [s.runner.session.map_downloads_shared for s in gui.app.fleet if s.runner.session]
+        shared = [s.runner.session.maps.downloads_shared for s in gui.app.fleet if s.runner.session]
         assert sum(shared) == 2, shared
         datas = {id(s.state.map.value.data) for s in gui.app.fleet}
         assert len(datas) == 1, "each robot holds its own copy of the same map"

@@ -24,6 +24,7 @@ from rtmu.control.gamepad import AXIS_TRANS, DEADMAN, DeadMan
 from rtmu.sim import SimConfig, SimThread
 from rtmu.sim.wifi import AccessPoint
 from rtmu.ui.alarm_view import AlarmView
+from rtmu.values.intents import RunServerCommand
 
 from .conftest import _spawn_xvfb, _terminate
 from .harness import OFFICE_MAP, Gui, idle, on_display, pump
@@ -254,7 +255,8 @@ def test_battery_and_wifi_alarms_from_the_simulator_with_mute(phone: tuple[Gui, 
 def set_battery(gui: Gui, volts: float) -> None:
     """The simulator's own string command, sent by the window's network side: the server took it."""
     command = ServerCommand("SimulatorSetBattery", "", True)
-    assert gui.window.session.runner.run_command(command, f"{volts:.2f}").result(10)
+    intent = RunServerCommand(command.name, f"{volts:.2f}", command.takes_argument)
+    assert gui.window.session.runner.send(intent).result(10)
 
 
 def alarm_topic(alarm: Alarm) -> str:

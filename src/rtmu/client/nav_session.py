@@ -18,6 +18,7 @@ from typing import Any, ClassVar
 from ..base.notices import Kind, Notice
 from ..protocol.errors import ProtocolError
 from ..protocol.payloads import Payload
+from ..protocol.payloads.ld import GotoRouteGoal
 from ..protocol.payloads.map import Goals
 from ..protocol.payloads.navigation import Dock as DockPayload
 from ..protocol.payloads.navigation import GotoGoal as GotoGoalPayload
@@ -86,8 +87,8 @@ class NavFeed(Feed):
         if isinstance(payload, GotoPosePayload):
             th = None if payload.th is None else float(payload.th)
             self._sent_pose = (float(payload.x), float(payload.y), th)
-        if name == "gotoRouteGoal":
-            client.send(name, payload)
+        if name == "gotoRouteGoal" and isinstance(intent, GotoGoal):
+            client.send(GotoRouteGoal(intent.name))
         else:
             client.send(payload)
 
