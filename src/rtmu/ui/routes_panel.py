@@ -124,7 +124,7 @@ class RoutesPanel(Gtk.MenuButton):
 
     def go_to_goal(self, goal: str) -> None:
         if "gotoRouteGoal" in self.model.connection.value.offers:
-            self._ask(GotoGoal(goal))
+            self._ask(GotoGoal(goal, route=True))
             popover = self.get_popover()
             if popover is not None:
                 popover.popdown()

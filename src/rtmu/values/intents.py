@@ -104,13 +104,17 @@ class SetSafeDrive(Intent):
 # -- navigation: the server drives ---------------------------------------------------------------
 @dataclass(frozen=True)
 class GotoGoal(Intent):
-    """Drive to the map's goal ``name`` (``gotoGoal``; an LD robot's ``gotoRouteGoal``)."""
+    """Drive to the map's goal ``name`` (``gotoGoal``; an LD robot's ``gotoRouteGoal``).
+
+    ``route``: as one of an LD robot's route goals (``gotoRouteGoal``, where listed), as its routes
+    panel sends it; otherwise ``gotoRouteGoal`` only where ``gotoGoal`` is not listed."""
 
     kind: ClassVar[Kind] = Kind.NAVIGATION
     moves: ClassVar[bool] = True
     needs: ClassVar[tuple[str, ...]] = ("gotoGoal", "gotoRouteGoal")
     label: ClassVar[str] = "Go to goal"
     name: str = ""
+    route: bool = False
 
 
 @dataclass(frozen=True)
