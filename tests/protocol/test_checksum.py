@@ -85,6 +85,21 @@ def test_numpy_threshold_neighbourhood() -> None:
         assert checksum(data) == checksum_naive(data), n
 
 
+def test_without_numpy_loaded_medium_packets_are_summed_with_struct(monkeypatch: pytest.MonkeyPatch) -> None:
+    """A command that never loaded numpy (``rtmu status``, the guardian) sums a data list with
+    ``struct``: the same checksum, around both switches (numpy's threshold and the struct limit)."""
+    from types import SimpleNamespace
+
+    from rtmu.protocol import checksum as module
+
+    monkeypatch.setattr(module, "sys", SimpleNamespace(modules={}))
+    rng = random.Random(7)
+    limit = 2 * module._STRUCT_LIMIT
+    for n in (*range(500, 530), 11_371, *range(limit - 12, limit + 12), MAX_LENGTH - 8):
+        data = rng.randbytes(6 + n)
+        assert checksum(data) == checksum_naive(data), n
+
+
 def test_coverage_rules() -> None:
     """Bytes 0–2 are not covered; for an odd payload the last byte is not either (§1.3)."""
     even = bytearray.fromhex("0F 0C 0E 00 81 00 08 01 C8 00 00 00")

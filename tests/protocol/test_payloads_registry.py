@@ -4,6 +4,10 @@ from __future__ import annotations
 
 import contextlib
 import json
+import os
+import subprocess
+import sys
+from pathlib import Path
 
 import numpy as np
 import pytest
@@ -262,3 +266,39 @@ def test_hostile_counts_are_refused_without_allocating() -> None:
     ]:
         with pytest.raises(ProtocolError):
             cls.decode(raw)
+
+
+def test_the_module_index_names_every_registered_type() -> None:
+    """``names.MODULE_NAMES`` is what lets the registry import one module per lookup: it must list
+    every registered data name under the module that defines it, and nothing else."""
+    from rtmu.protocol.payloads.names import MODULE_NAMES, PAYLOAD_MODULES
+
+    found: dict[str, set[str]] = {}
+    for (name, _side), cls in registered().items():
+        found.setdefault(cls.__module__.rsplit(".", 1)[1], set()).add(name)
+    missing = [
+        f"{m}: {n!r}" for m, names in found.items() for n in sorted(names - set(MODULE_NAMES.get(m, ())))
+    ]
+    stale = [
+        f"{m}: {n!r}" for m, names in MODULE_NAMES.items() for n in names if n not in found.get(m, set())
+    ]
+    assert missing == [], "add these to rtmu/protocol/payloads/names.py"
+    assert stale == [], "no type is registered under these: remove them from names.py"
+    package = Path(cam.__file__).parent
+    modules = {p.stem for p in package.glob("*.py")} - {"__init__", "base", "names"}
+    assert set(PAYLOAD_MODULES) == modules
+
+
+def test_a_lookup_imports_only_the_module_it_needs() -> None:
+    """In a fresh interpreter: decoding a status builds the robot types, not the camera's or the files'."""
+    code = (
+        "import sys\n"
+        "from rtmu.protocol.payloads import Side, payload_type_for\n"
+        "assert payload_type_for('update', Side.REPLY).__name__ == 'Update'\n"
+        "assert payload_type_for('getPictureCam1', Side.REPLY).__name__ == 'Picture'\n"
+        "assert payload_type_for('noSuchData', Side.REPLY) is None\n"
+        "print(sorted(m.rsplit('.', 1)[1] for m in sys.modules if m.startswith('rtmu.protocol.payloads.')))\n"
+    )
+    env = {**os.environ, "PYTHONPATH": str(Path(cam.__file__).parents[3])}  # the tree under test
+    out = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, check=True, env=env)
+    assert out.stdout.split() == ["['base',", "'camera',", "'names',", "'robot']"]

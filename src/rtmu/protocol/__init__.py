@@ -2,15 +2,53 @@
 
 Never imports asyncio, sockets or GTK. One codec serves both the client and the
 bundled simulator.
+
+The names below are imported from their modules when first used, so that importing one module
+of the codec (``rtmu.protocol.commands`` for a constant) does not load the rest of it. The
+checksum function is ``rtmu.protocol.checksum.checksum`` (the package's ``checksum`` is that module).
 """
 
-from .checksum import checksum
-from .commands import ClientCommand, ClientType, RejectReason, ServerCommand
-from .datalist import DataEntry, DataList
-from .decoder import DropStats, PacketDecoder
-from .errors import FieldUnderrun, PacketTooLong, PayloadError, ProtocolError
-from .fields import FieldReader, FieldWriter
-from .packet import MAX_LENGTH, MAX_PAYLOAD, Packet, encode_packet
+from __future__ import annotations
+
+import importlib
+from typing import TYPE_CHECKING, Any
+
+if TYPE_CHECKING:
+    from .commands import ClientCommand, ClientType, RejectReason, ServerCommand
+    from .datalist import DataEntry, DataList
+    from .decoder import DropStats, PacketDecoder
+    from .errors import FieldUnderrun, PacketTooLong, PayloadError, ProtocolError
+    from .fields import FieldReader, FieldWriter
+    from .packet import MAX_LENGTH, MAX_PAYLOAD, Packet, encode_packet
+
+_HOMES = {
+    "ClientCommand": "commands",
+    "ClientType": "commands",
+    "RejectReason": "commands",
+    "ServerCommand": "commands",
+    "DataEntry": "datalist",
+    "DataList": "datalist",
+    "DropStats": "decoder",
+    "PacketDecoder": "decoder",
+    "FieldUnderrun": "errors",
+    "PacketTooLong": "errors",
+    "PayloadError": "errors",
+    "ProtocolError": "errors",
+    "FieldReader": "fields",
+    "FieldWriter": "fields",
+    "MAX_LENGTH": "packet",
+    "MAX_PAYLOAD": "packet",
+    "Packet": "packet",
+    "encode_packet": "packet",
+}
+
+
+def __getattr__(name: str) -> Any:
+    home = _HOMES.get(name)
+    if home is None:
+        raise AttributeError(f"module {__name__!r} has no attribute {name!r}")
+    return getattr(importlib.import_module(f"{__name__}.{home}"), name)
+
 
 __all__ = [
     "MAX_LENGTH",
@@ -30,6 +68,5 @@ __all__ = [
     "ProtocolError",
     "RejectReason",
     "ServerCommand",
-    "checksum",
     "encode_packet",
 ]

@@ -4,16 +4,25 @@ The sum runs over big-endian 16-bit words starting at byte 3 (the high byte of
 the length field) and stops before the checksum; one odd byte left over is
 XORed in, and for an odd payload the very last payload byte is not covered at
 all. Small packets are summed with ``struct`` (C speed, no numpy call
-overhead); large ones with numpy, so a 32 KB map packet costs microseconds.
+overhead); large ones with numpy, so a 32 KB map packet costs microseconds. numpy is not imported
+for that alone: until something else has loaded it, packets up to :data:`_STRUCT_LIMIT` words (a
+server's data list, a small picture) are summed with ``struct`` too — ~0.2 ms each, against the
+50 ms numpy's import adds to a command that never needed it (``rtmu status --once``, the guardian).
 """
 
 from __future__ import annotations
 
 import struct
+import sys
+from typing import TYPE_CHECKING
 
-import numpy as np
+if TYPE_CHECKING:
+    import numpy as np
 
 _NUMPY_THRESHOLD = 256
+_STRUCT_LIMIT = 8192
+"""Words summed with ``struct`` while numpy is not loaded; a larger packet (a map block, a big
+picture) loads it: the command receiving it needs numpy anyway."""
 # One precompiled ">nH" per word count below the numpy threshold: a list index is the cheapest lookup.
 _WORD_STRUCTS: tuple[struct.Struct, ...] = tuple(struct.Struct(f">{n}H") for n in range(_NUMPY_THRESHOLD))
 
@@ -29,7 +38,11 @@ def checksum(data: bytes | bytearray | memoryview, end: int | None = None, start
     first = start + 3
     if words < _NUMPY_THRESHOLD:
         c = sum(_WORD_STRUCTS[words].unpack_from(data, first)) & 0xFFFF
+    elif words < _STRUCT_LIMIT and "numpy" not in sys.modules:
+        c = sum(struct.unpack_from(f">{words}H", data, first)) & 0xFFFF
     else:
+        import numpy as np
+
         c = int(np.frombuffer(data, dtype=">u2", count=words, offset=first).sum(dtype=np.uint64)) & 0xFFFF
     # n ends as 2 or 3, so one byte is always left to XOR in (the last payload byte is skipped when odd).
     return c ^ data[first + 2 * words]
@@ -63,14 +76,16 @@ class SpanChecksums:
     __slots__ = ("_base", "_sums", "_view", "stop")
 
     def __init__(self) -> None:
-        self.clear()
+        self._base = 0
+        self.stop = 0
+        self._sums: np.ndarray | None = None
+        """Allocated (and numpy imported) by the first :meth:`start`: few decoders ever need it."""
+        self._view: memoryview = memoryview(b"")
 
     def clear(self) -> None:
         """Forget the buffer (it was compacted or emptied); :meth:`start` begins again."""
         self._base = 0
         self.stop = 0
-        self._sums = np.zeros(0, dtype=np.int64)
-        self._view = self._sums.data
 
     @property
     def active(self) -> bool:
@@ -78,24 +93,28 @@ class SpanChecksums:
 
     def start(self, data: bytes | bytearray, base: int, stop: int) -> None:
         """Sum ``data[base:stop]``; later spans must start at ``base`` or after."""
-        self.clear()
         self._base = self.stop = base
         self.extend(data, stop)
 
     def extend(self, data: bytes | bytearray, stop: int) -> None:
         """Take ``data[..stop]`` into the sums (the buffer grew; bytes before the old stop unchanged)."""
+        import numpy as np
+
         n0 = self.stop - self._base
         n1 = stop - self._base
         if n1 <= n0:
             return
-        if n1 + 1 > len(self._sums):
-            grown = np.zeros(max(2 * len(self._sums), n1 + 1, 1024), dtype=np.int64)
-            kept = min(n0 + 1, len(self._sums))
-            grown[:kept] = self._sums[:kept]
+        sums = self._sums
+        if sums is None or n1 + 1 > len(sums):
+            grown = np.zeros(max(2 * len(sums) if sums is not None else 0, n1 + 1, 1024), dtype=np.int64)
+            if sums is not None:
+                kept = min(n0 + 1, len(sums))
+                grown[:kept] = sums[:kept]
             self._view.release()
-            self._sums = grown
+            self._sums = sums = grown
             self._view = grown.data
-        sums = self._sums  # sums[0] and sums[1] are empty sums: zero from np.zeros, never written
+        # sums[0] and sums[1] are empty sums: zero from np.zeros, never written (entries past a
+        # clear()'s stop are only read after being written again, k below starts at 2).
         k = max(n0 + 1, 2)  # first new entry: sums[k] = sums[k - 2] + the word at base + k - 2
         if k <= n1:
             raw = np.frombuffer(data, dtype=np.uint8, count=n1 - k + 2, offset=self._base + k - 2)

@@ -12,6 +12,9 @@ from enum import IntEnum
 
 FIRST_DATA_NUMBER = 256
 
+VERSION_TAG = "alpha"
+"""The version string a server puts in its introduction (ARIA 2.9.1's servers send this one)."""
+
 
 class ClientCommand(IntEnum):
     """Client → server control commands (``ArClientCommands.h``)."""

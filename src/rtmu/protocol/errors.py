@@ -28,3 +28,10 @@ class FieldUnderrun(ProtocolError):
 
 class PayloadError(ProtocolError):
     """A payload is well framed but its contents do not make sense (bad count, bad value)."""
+
+
+class MapTooLarge(PayloadError):
+    """A map reply went past one of the assembler's bounds (points, segments, lines, bytes).
+
+    Here rather than with the map assemblers (``payloads.mapstream``), so that the reply tracker
+    can catch it without importing them (and numpy) into every connection."""

@@ -26,9 +26,8 @@ import itertools
 from collections import deque
 from collections.abc import Callable, Iterator
 
-from .errors import ProtocolError
+from .errors import MapTooLarge, ProtocolError
 from .events import DataReceived, Event, ReplyComplete, ReplyError, ReplyFailed, ReplyId, ReplyPacket
-from .payloads.mapstream import MapTooLarge
 
 MAX_REPLY_PACKETS = 1_000_000
 """Default bound on the packets of one collected reply, or of a streamed one's unread packets."""

@@ -12,7 +12,7 @@ import random
 from enum import Enum, auto
 
 from .auth import User, UserTable, make_password_key
-from .commands import ClientCommand, RejectReason, ServerCommand, is_control_command
+from .commands import VERSION_TAG, ClientCommand, RejectReason, ServerCommand, is_control_command
 from .datalist import DataList
 from .decoder import PacketDecoder
 from .errors import ProtocolError
@@ -29,8 +29,6 @@ from .events import (
 )
 from .packet import Packet, encode_packet
 from .payloads.control import ClientIntroduction, Rejected, Request, RequestStop, ServerIntroduction
-
-VERSION_TAG = "alpha"
 
 
 class ServerState(Enum):

@@ -1,36 +1,17 @@
 """Typed payloads of the standard ArNetworking services (protocol §4).
 
-Importing this package registers every type, so :func:`payload_type_for`
-finds a decoder by data name.
+The payload modules (``robot``, ``camera``, ``map`` …) are imported when first needed: by name
+(``from rtmu.protocol.payloads import robot``) or by the registry, when
+:func:`payload_type_for` is asked for one of their data names (:mod:`.names` says which module
+holds which). :func:`registered` imports them all.
 """
 
-from . import (
-    camera,
-    central,
-    commands,
-    config,
-    configcare,
-    control,
-    drawings,
-    drive,
-    files,
-    ld,
-    map,
-    mapchange,
-    mapping,
-    mapstream,
-    navigation,
-    popup,
-    robot,
-    sensors,
-    server,
-    strings,
-)
 from .base import (
     NameMatch,
     Payload,
     Side,
     decode_payload,
+    load_all,
     payload_type,
     payload_type_for,
     register,
@@ -41,29 +22,10 @@ __all__ = [
     "NameMatch",
     "Payload",
     "Side",
-    "camera",
-    "central",
-    "commands",
-    "config",
-    "configcare",
-    "control",
     "decode_payload",
-    "drawings",
-    "drive",
-    "files",
-    "ld",
-    "map",
-    "mapchange",
-    "mapping",
-    "mapstream",
-    "navigation",
+    "load_all",
     "payload_type",
     "payload_type_for",
-    "popup",
     "register",
     "registered",
-    "robot",
-    "sensors",
-    "server",
-    "strings",
 ]

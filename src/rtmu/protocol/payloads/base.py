@@ -20,6 +20,7 @@ bytes after the last field are ignored, as ARIA does, unless a type keeps them
 from __future__ import annotations
 
 import dataclasses
+import importlib
 import struct
 from enum import Enum
 from typing import Any, ClassVar, Self, TypeVar
@@ -135,6 +136,8 @@ def _jsonable(value: Any) -> Any:
 
 _REGISTRY: dict[tuple[str, Side], type[Payload]] = {}
 _LOOKUP_CACHE: dict[tuple[str, Side], type[Payload] | None] = {}
+_MODULE_OF: dict[str, tuple[str, ...]] = {}
+"""Data name → the payload modules defining it (from :mod:`.names`), filled on first use."""
 P = TypeVar("P", bound=type[Payload])
 
 
@@ -148,9 +151,43 @@ def register(cls: P) -> P:
     return cls
 
 
+def _load_for(data_name: str) -> None:
+    """Import the payload modules that may hold a type for ``data_name``: the one that registers it
+    exactly and those of every family name it starts or ends with (each imported once)."""
+    if not _MODULE_OF:
+        from .names import MODULE_NAMES
+
+        index: dict[str, tuple[str, ...]] = {}
+        for module, names in MODULE_NAMES.items():
+            for name in names:
+                index[name] = (*index.get(name, ()), module)
+        _MODULE_OF.update(index)
+    wanted = {
+        module
+        for name, modules in _MODULE_OF.items()
+        if data_name.startswith(name) or data_name.endswith(name)
+        for module in modules
+    }
+    for module in sorted(wanted):
+        importlib.import_module(f"{__package__}.{module}")
+
+
+def load_all() -> None:
+    """Import every payload module (every type registered): for :func:`registered` and tools that
+    list or search all types."""
+    from .names import PAYLOAD_MODULES
+
+    for module in PAYLOAD_MODULES:
+        importlib.import_module(f"{__package__}.{module}")
+
+
 def payload_type(data_name: str, side: Side) -> type[Payload] | None:
     """The payload type registered under exactly this data name, or None."""
-    return _REGISTRY.get((data_name, side))
+    found = _REGISTRY.get((data_name, side))
+    if found is None:
+        _load_for(data_name)
+        found = _REGISTRY.get((data_name, side))
+    return found
 
 
 def payload_type_for(data_name: str, side: Side) -> type[Payload] | None:
@@ -165,7 +202,10 @@ def payload_type_for(data_name: str, side: Side) -> type[Payload] | None:
         return _LOOKUP_CACHE[key]
     except KeyError:
         pass
-    found = _lookup(data_name, side)
+    exact = _REGISTRY.get(key)
+    if exact is None:
+        _load_for(data_name)  # its modules, before the first answer is cached
+    found = exact or _lookup(data_name, side)
     if len(_LOOKUP_CACHE) < 4096:  # names come from the server: keep the cache bounded
         _LOOKUP_CACHE[key] = found
     return found
@@ -196,6 +236,8 @@ def decode_payload(data_name: str, side: Side, data: bytes) -> Payload | None:
 
 
 def registered() -> dict[tuple[str, Side], type[Payload]]:
+    """Every payload type, by (data name, side); imports every payload module first."""
+    load_all()
     return dict(_REGISTRY)
 
 

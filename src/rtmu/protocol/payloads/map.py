@@ -11,20 +11,22 @@ from __future__ import annotations
 import struct
 from dataclasses import dataclass
 from enum import Enum
-from typing import Final, Self
-
-import numpy as np
+from typing import TYPE_CHECKING, Final, Self
 
 from ..errors import FieldUnderrun, PayloadError
 from ..fields import FieldReader, FieldWriter
 from .base import EmptyPayload, Payload, Side, SingleField, checked_count, read_strings_to_end, register
+
+if TYPE_CHECKING:  # numpy comes with the first map block, not with the goal list's payloads
+    import numpy as np
 
 SEGMENT_BYTES: Final = 16
 """``byte4 x1, y1, x2, y2``."""
 POINT_BYTES: Final = 8
 """``byte4 x, y``."""
 _COUNT = struct.Struct("<i")
-COORD_DTYPE: Final = np.dtype("<i4")
+COORD_DTYPE: Final = "<i4"
+"""The coordinates' numpy dtype (little-endian int32), as numpy takes it anywhere a dtype goes."""
 
 
 @register
@@ -250,6 +252,8 @@ class MapBinaryPacket(Payload):
     @property
     def segments(self) -> np.ndarray:
         """``(n, 4)`` int32 array ``x1, y1, x2, y2`` (read-only view)."""
+        import numpy as np
+
         if self.kind is not MapPacketKind.SEGMENTS:
             return np.empty((0, 4), COORD_DTYPE)
         return np.frombuffer(self.coords, COORD_DTYPE).reshape(-1, 4)
@@ -257,6 +261,8 @@ class MapBinaryPacket(Payload):
     @property
     def points(self) -> np.ndarray:
         """``(n, 2)`` int32 array ``x, y`` (read-only view)."""
+        import numpy as np
+
         if self.kind is not MapPacketKind.POINTS:
             return np.empty((0, 2), COORD_DTYPE)
         return np.frombuffer(self.coords, COORD_DTYPE).reshape(-1, 2)
@@ -321,6 +327,8 @@ class MapWithMaxCategoryRequest(SingleField):
 
 def coords_bytes(array: object, columns: int) -> bytes:
     """Little-endian int32 bytes of an ``(n, columns)`` array; floats are rounded to whole mm."""
+    import numpy as np
+
     a = np.asarray(array)
     if a.size == 0:
         return b""

@@ -20,7 +20,7 @@ from typing import Final
 
 import numpy as np
 
-from ..errors import PayloadError
+from ..errors import MapTooLarge, PayloadError
 from ..fields import TEXT_ENCODING, FieldReader, FieldWriter
 from ..packet import MAX_PAYLOAD
 from .map import COORD_DTYPE, POINT_BYTES, SEGMENT_BYTES, binary_block_kind, coords_bytes, read_block
@@ -42,10 +42,6 @@ DEFAULT_MAX_TEXT_BYTES: Final = 48 * 1024 * 1024
 _COUNT = struct.Struct("<i")
 _BLOCK_END: Final = _COUNT.pack(0)
 _EMPTY_STRING: Final = b"\x00"
-
-
-class MapTooLarge(PayloadError):
-    """A map reply went past one of the assembler's bounds (points, segments, lines, bytes)."""
 
 
 class ReplyAlreadyComplete(PayloadError):
