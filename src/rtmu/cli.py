@@ -2,7 +2,11 @@
 
 A subcommand module defines ``register(subparsers)`` that adds its parser and
 sets ``handler=`` (a function taking the parsed namespace and returning the exit
-code). Adding a subcommand touches one new file.
+code). Adding a subcommand touches one new file, named as the command.
+
+A command imports only its own module: ``rtmu status …`` never loads the recorder, the simulator
+or GTK, and ``rtmu --version`` no subcommand at all (``LazySubcommands``). ``rtmu --help``, the man
+page and the completions load them all. ``tests/test_import_cost.py`` keeps it so.
 """
 
 from __future__ import annotations
@@ -15,6 +19,7 @@ import pkgutil
 import signal
 import sys
 from collections.abc import Sequence
+from typing import Any
 
 from . import subcommands
 from .base.exit_codes import EXIT_USAGE
@@ -22,22 +27,81 @@ from .subcommands import _integration
 from .versions import VersionAction
 
 
-def build_parser() -> argparse.ArgumentParser:
-    parser = argparse.ArgumentParser(
+def subcommand_names() -> list[str]:
+    """Every subcommand, sorted: one module of ``rtmu.subcommands`` each (``_``-modules are helpers)."""
+    return sorted(m.name for m in pkgutil.iter_modules(subcommands.__path__) if not m.name.startswith("_"))
+
+
+class LazySubcommands(argparse._SubParsersAction):
+    """The subcommands, each module imported when its command is chosen (or when help lists them).
+
+    Until then a command is a name in ``choices`` (so argparse accepts it and names it in errors)
+    with no parser; :meth:`load` imports the module and lets its ``register`` add the real one.
+    """
+
+    def __init__(self, *args: Any, **kwargs: Any) -> None:
+        super().__init__(*args, **kwargs)
+        self._modules: dict[str, str] = {}
+
+    def add_lazy(self, name: str, module: str) -> None:
+        self._modules[name] = module
+        self._name_parser_map[name] = None  # no parser until load()
+
+    def load(self, name: str) -> None:
+        module = self._modules.pop(name, None)
+        if module is None:
+            return
+        del self._name_parser_map[name]
+        register = getattr(importlib.import_module(module), "register", None)
+        if register is not None:
+            register(self)
+        if self._name_parser_map.get(name) is None:  # a module that registered nothing under its name
+            self._name_parser_map.pop(name, None)
+
+    def load_all(self) -> None:
+        for name in sorted(self._modules):
+            self.load(name)
+        self._choices_actions.sort(key=lambda action: action.dest)
+
+    def __call__(
+        self,
+        parser: argparse.ArgumentParser,
+        namespace: argparse.Namespace,
+        values: Any,
+        option_string: str | None = None,
+    ) -> None:
+        self.load(values[0])
+        super().__call__(parser, namespace, values, option_string)
+
+
+class _Parser(argparse.ArgumentParser):
+    """The top-level parser: its help lists every subcommand, so formatting it loads them all."""
+
+    lazy: LazySubcommands
+
+    def format_help(self) -> str:
+        self.lazy.load_all()
+        return super().format_help()
+
+
+def build_parser(*, lazy: bool = False) -> argparse.ArgumentParser:
+    """The whole ``rtmu`` parser; ``lazy``: subcommand modules imported only when chosen."""
+    parser = _Parser(
         prog="rtmu",
         description="Teleoperate an ARIA (ArNetworking) robot; with no subcommand, open the window.",
     )
     parser.add_argument(
         "--version", action=VersionAction, help="show the versions of rtmu, its protocol and toolkit; exit"
     )
-    sub = parser.add_subparsers(dest="subcommand", metavar="SUBCOMMAND")
-    for info in sorted(pkgutil.iter_modules(subcommands.__path__), key=lambda m: m.name):
-        if info.name.startswith("_"):
-            continue
-        module = importlib.import_module(f"{subcommands.__name__}.{info.name}")
-        register = getattr(module, "register", None)
-        if register is not None:
-            register(sub)
+    sub = parser.add_subparsers(
+        dest="subcommand", metavar="SUBCOMMAND", action=LazySubcommands, parser_class=argparse.ArgumentParser
+    )
+    assert isinstance(sub, LazySubcommands)
+    parser.lazy = sub
+    for name in subcommand_names():
+        sub.add_lazy(name, f"{subcommands.__name__}.{name}")
+    if not lazy:
+        sub.load_all()
     gui = importlib.util.find_spec("rtmu.ui.app")
     if gui is not None:
         from .ui import app as gui_app
@@ -48,10 +112,10 @@ def build_parser() -> argparse.ArgumentParser:
 
 
 def main(argv: Sequence[str] | None = None) -> int:
-    parser = build_parser()
+    parser = build_parser(lazy=True)
     args = parser.parse_args(argv)
     handler = getattr(args, "handler", None)
-    installing = _integration.handle(args, parser) if handler is None else None
+    installing = _integration.handle(args, build_parser) if handler is None else None
     if installing is not None:
         return installing
     if handler is None:

@@ -58,6 +58,7 @@ from ..protocol.replies import (
     MAX_REPLY_PACKETS,
     TooManyPending,
 )
+from .defaults import CONNECT_TIMEOUT, DEFAULT_PORT
 from .errors import (
     ClientError,
     ClientTimeout,
@@ -75,9 +76,6 @@ from .link import Link, Opener, open_tcp
 
 log = logging.getLogger(__name__)
 
-DEFAULT_PORT = 7272
-CONNECT_TIMEOUT = 10.0
-"""ARIA's own client gives up connecting after 10 s."""
 REPLY_TIMEOUT = 5.0
 """Default wait for a reply, and for each further packet of a multi-packet reply."""
 CLOSE_TIMEOUT = 0.2

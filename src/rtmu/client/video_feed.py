@@ -29,14 +29,13 @@ from ..protocol.payloads.camera import VideoFrame
 from ..values.intents import picture_source
 from ..values.state import VideoStatus
 from .connection import AriaClient
+from .defaults import MAX_FPS, MIN_FPS
 from .errors import ClientError, ClientTimeout, NotSupported, ServerClosed
 
 STAMP_PREFIX = b"RTMU-T="
 """JPEG comment (COM segment) text the simulator writes: render time in wall-clock nanoseconds."""
 MAX_SIDE = 8192
 """Largest width or height accepted from a server; no robot camera comes near it."""
-MAX_FPS = 30.0
-MIN_FPS = 0.5
 DEFAULT_FPS = 15.0
 DEFAULT_QUALITY: int | None = None
 """None: leave the quality argument out (the server's own choice), as ARIA's example client does."""

@@ -38,7 +38,7 @@ from . import topics
 from .convert import Converter, notice_record
 from .mcapfile import TYPED
 
-DEFAULT_PORT = 8765
+DEFAULT_PORT = topics.BRIDGE_PORT
 QUEUE_SIZE = 1024
 MAX_GAP = 0.2
 """Seconds between drive messages above which the stream no longer drives (5 Hz)."""

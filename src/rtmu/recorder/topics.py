@@ -5,6 +5,9 @@ The raw channel's topics live with its reader in :mod:`rtmu.capture.recorded`.
 
 from __future__ import annotations
 
+BRIDGE_PORT = 8765
+"""The live bridge's WebSocket port unless told otherwise: the one Foxglove's connection dialog offers."""
+
 POSE = "/robot/pose"
 """foxglove.PoseInFrame: the robot in the ``map`` frame (m, yaw)."""
 TF = "/tf"

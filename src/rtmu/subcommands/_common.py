@@ -26,22 +26,23 @@ SIGALRM end a command through its ``finally`` blocks — ``rtmu drive`` always s
 from __future__ import annotations
 
 import argparse
-import asyncio
 import contextlib
 import contextvars
 import getpass
-import inspect
 import os
 import signal
 import sys
 from collections.abc import Awaitable, Callable
 from pathlib import Path
-from typing import Any
+from typing import TYPE_CHECKING, Any
 
 from ..base.exit_codes import EXIT_CONNECTION, EXIT_OK, EXIT_USAGE
-from ..client.connection import CONNECT_TIMEOUT, DEFAULT_PORT, AriaClient
-from ..client.errors import ClientError
-from ..protocol.errors import ProtocolError
+from ..client.defaults import CONNECT_TIMEOUT, DEFAULT_PORT
+
+if TYPE_CHECKING:  # the network side is imported when a command runs, not for its --help
+    import asyncio
+
+    from ..client.connection import AriaClient
 
 MAX_PASSWORD_FILE = 4096
 
@@ -186,8 +187,12 @@ def resolve_robot(args: argparse.Namespace) -> int | None:
     None when done; else the exit code, after one line on stderr: 2 for a name the central server
     does not list (naming the ones it does), 3/4/5 as for any login.
     """
+    import asyncio
+
     from ..base.textsafe import visible
     from ..client.central import list_robots
+    from ..client.errors import ClientError
+    from ..protocol.errors import ProtocolError
 
     name = str(getattr(args, "subcommand", None) or "rtmu")
     try:
@@ -279,6 +284,8 @@ class Interrupted(Exception):
 
 async def until_stop_signal() -> None:
     """Wait for Ctrl-C or SIGTERM: how a long-running server (``rtmu sim``) is told to stop cleanly."""
+    import asyncio
+
     stop = asyncio.Event()
     loop = asyncio.get_running_loop()
     for sig in (signal.SIGINT, signal.SIGTERM):
@@ -316,6 +323,8 @@ class Interrupts:
 
     def install(self) -> None:
         """Handle the signals on the running loop, for the current task (call from that task)."""
+        import asyncio
+
         self._task = asyncio.current_task()
         self._loop = asyncio.get_running_loop()
         for signum in INTERRUPT_SIGNALS:
@@ -351,6 +360,9 @@ class Interrupts:
         self._suspender = self._loop.create_task(self._suspend())
 
     async def _suspend(self) -> None:
+        import asyncio
+        import inspect
+
         loop = self._loop
         assert loop is not None
         try:
@@ -405,6 +417,12 @@ def fail(name: str, message: str, code: int) -> int:
 
 def run_with_client(name: str, args: argparse.Namespace, body: Callable[[AriaClient], Awaitable[int]]) -> int:
     """Log in, run ``body(client)``, always disconnect; map every failure to an exit code and one line."""
+    import asyncio
+
+    from ..client.connection import AriaClient
+    from ..client.errors import ClientError
+    from ..protocol.errors import ProtocolError
+
     try:
         password = read_password(args)
     except UsageError as exc:

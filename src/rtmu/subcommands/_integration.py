@@ -14,8 +14,9 @@ from __future__ import annotations
 import argparse
 import os
 import sys
-from dataclasses import dataclass
+from collections.abc import Callable
 from pathlib import Path
+from typing import NamedTuple
 
 from .. import __version__
 from ..package_data import APP_ID, DESKTOP_DIR
@@ -45,8 +46,7 @@ MAN_SECTIONS = (
 )
 
 
-@dataclass(frozen=True)
-class Installed:
+class Installed(NamedTuple):
     """One file ``--install-desktop`` writes: where (under the data folder) and what."""
 
     relative: str
@@ -68,8 +68,14 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
     )
 
 
-def handle(args: argparse.Namespace, parser: argparse.ArgumentParser) -> int | None:
-    """Do what one of these options asks and return the exit code; None when none was given."""
+def handle(args: argparse.Namespace, full_parser: Callable[[], argparse.ArgumentParser]) -> int | None:
+    """Do what one of these options asks and return the exit code; None when none was given.
+
+    ``full_parser`` builds the parser with every subcommand (what the page and the completions
+    describe), only when one of these options asks for it."""
+    if not any(getattr(args, o, None) for o in ("man", "completion", "install_desktop", "uninstall_desktop")):
+        return None
+    parser = full_parser()
     if getattr(args, "man", False):
         sys.stdout.write(man_page(parser))
         return 0

@@ -10,16 +10,14 @@ robot does not drive on for a command nobody is watching. ``--no-wait`` sends an
 from __future__ import annotations
 
 import argparse
-import asyncio
 import contextlib
 import sys
 from collections.abc import Callable
 from dataclasses import dataclass
-from typing import Any
+from typing import TYPE_CHECKING, Any
 
 from ..base.exit_codes import EXIT_OK, EXIT_TIMEOUT
 from ..base.textsafe import visible
-from ..client.connection import AriaClient, Packet
 from ..client.errors import ClientError, NotSupported
 from ..client.nav_status import NavPhase, NavReading, path_remaining, read_status
 from ..protocol.errors import ProtocolError
@@ -29,6 +27,9 @@ from ..protocol.payloads.ld import DockInfo
 from ..protocol.payloads.navigation import LocalizationState, LocState, PlannedPath
 from ..protocol.payloads.robot import ModeInfo, Update, UpdateNumbers, UpdateStrings
 from ._common import Interrupted, current_interrupts, positive_float, print_json
+
+if TYPE_CHECKING:  # asyncio and the connection come with the command, not with its --help
+    from ..client.connection import AriaClient, Packet
 
 EXIT_NAV_FAILED = 6
 """The server could not get there (``Failed to get to …``, ``Failed to plan to …``, ``Failed dock``)."""
@@ -110,6 +111,8 @@ class _Watch:
     """The server's words (and pose, path, dock state) as they come, on the command's loop."""
 
     def __init__(self) -> None:
+        import asyncio
+
         self.status = ""
         self.mode_name = ""
         self.dock_state: str | None = None
@@ -184,6 +187,8 @@ class _Watch:
 
     async def first(self, client: AriaClient, timeout: float) -> None:
         """Wait (bounded) for the first status, so what the server said *before* our command is known."""
+        import asyncio
+
         if not (client.supports("updateStrings") or client.supports("update")):
             return
         with contextlib.suppress(TimeoutError):
@@ -224,6 +229,8 @@ async def navigate(client: AriaClient, args: argparse.Namespace, payload: Payloa
 async def _follow(
     client: AriaClient, args: argparse.Namespace, watch: _Watch, before: NavReading, expect: Expect
 ) -> int:
+    import asyncio
+
     loop = asyncio.get_running_loop()
     sent_at = loop.time()
     shown = ""
@@ -295,6 +302,8 @@ def _ended(args: argparse.Namespace, watch: _Watch, r: NavReading, outcome: str,
 # -- localization ------------------------------------------------------------------------------
 async def localize(client: AriaClient, args: argparse.Namespace, payload: Payload) -> int:
     """Send ``localizeToPose``; where ``getLocState`` is listed, wait until it says localized or lost."""
+    import asyncio
+
     watch = _Watch()
     if client.supports("getLocState"):
         client.request("getLocState", STATUS_MS, watch.handler(watch.on_loc))

@@ -15,17 +15,15 @@ import argparse
 import signal
 import sys
 import threading
-from typing import Any
+from typing import TYPE_CHECKING, Any
 
 from ..base.exit_codes import EXIT_CONNECTION, EXIT_OK, EXIT_USAGE
-from ..base.notices import Notice
 from ..base.textsafe import visible
-from ..client.errors import ClientError
-from ..client.runner import ClientRunner
-from ..client.session import SessionConfig
-from ..recorder.bridge import DEFAULT_PORT, LEASE_TTL, Bridge, DriveLimits
+from ..recorder.topics import BRIDGE_PORT as DEFAULT_PORT
 from ._common import UsageError, add_connection_arguments, fail, positive_float, read_password
-from ._follow import follow
+
+if TYPE_CHECKING:
+    from ..base.notices import Notice
 
 BEAT = 0.04
 """The main thread beats for the guardian as the window's UI thread does."""
@@ -57,6 +55,12 @@ def register(subparsers: Any) -> None:
 
 
 def handle(args: argparse.Namespace) -> int:
+    from ..client.errors import ClientError
+    from ..client.runner import ClientRunner
+    from ..client.session import SessionConfig
+    from ..recorder.bridge import LEASE_TTL, Bridge, DriveLimits
+    from ._follow import follow
+
     if not 0 <= args.ws_port <= 65535:
         return fail("bridge", f"--port {args.ws_port} is not 0…65535", EXIT_USAGE)
     if args.throttle > 100:

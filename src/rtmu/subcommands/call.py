@@ -24,14 +24,16 @@ import json
 import re
 import sys
 import time
-from typing import Any
+from typing import TYPE_CHECKING, Any
 
 from ..base.exit_codes import EXIT_OK, EXIT_TIMEOUT, EXIT_USAGE
 from ..base.textsafe import visible
-from ..client.connection import AriaClient
-from ..client.console import ConsoleEntry, ConsoleReply, Subscription, call, console_entries, entry_of
-from ..client.console_layout import KINDS, ArgumentError, describe, encode_arguments
+from ..client.console_layout import KINDS
 from ._common import add_connection_arguments, positive_float, print_json, run_with_client
+
+if TYPE_CHECKING:
+    from ..client.connection import AriaClient
+    from ..client.console import ConsoleEntry, ConsoleReply
 
 SILENT_OUTCOMES = ("silent", "stalled", "sent")
 FOLLOW_CHECK = 0.5
@@ -120,6 +122,8 @@ def handle(args: argparse.Namespace) -> int:
     if args.seconds is not None and args.every is None:
         return usage("--seconds goes with --every")
     types = [t.strip() for group in args.types or () for t in group.split(",") if t.strip()] or None
+    from ..client.console import call, console_entries, entry_of
+    from ..client.console_layout import ArgumentError, encode_arguments
 
     async def body(client: AriaClient) -> int:
         if listing:
@@ -142,6 +146,8 @@ def handle(args: argparse.Namespace) -> int:
 
 
 async def follow(client: AriaClient, entry: ConsoleEntry, payload: bytes, args: argparse.Namespace) -> int:
+    from ..client.console import Subscription
+
     subscription = Subscription(client, entry, args.every, payload).start()  # ConsoleRefusal: exit 2
     deadline = None if args.seconds is None else time.monotonic() + args.seconds
     replies = 0
@@ -174,6 +180,8 @@ def not_listed(name: str, names: list[str]) -> int:
 
 
 def print_list(entries: list[ConsoleEntry], as_json: bool) -> int:
+    from ..client.console_layout import describe
+
     if as_json:
         print_json([e.to_json() for e in entries])
         return EXIT_OK

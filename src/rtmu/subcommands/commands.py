@@ -3,13 +3,14 @@
 from __future__ import annotations
 
 import argparse
-from typing import Any
+from typing import TYPE_CHECKING, Any
 
 from ..base.exit_codes import EXIT_OK
 from ..base.textsafe import visible
-from ..client.connection import AriaClient
-from ..client.custom_commands import list_commands
 from ._common import add_connection_arguments, print_json, run_with_client
+
+if TYPE_CHECKING:
+    from ..client.connection import AriaClient
 
 
 def register(subparsers: Any) -> None:
@@ -26,6 +27,8 @@ def register(subparsers: Any) -> None:
 
 
 def handle(args: argparse.Namespace) -> int:
+    from ..client.custom_commands import list_commands
+
     async def body(client: AriaClient) -> int:
         catalogue = await list_commands(client, args.timeout)  # NotSupported (exit 4) without a list
         if args.json:

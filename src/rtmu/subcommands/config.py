@@ -15,15 +15,16 @@ import argparse
 import math
 import sys
 from pathlib import Path
-from typing import Any
+from typing import TYPE_CHECKING, Any
 
 from ..base.exit_codes import EXIT_FOREIGN_CONFIG, EXIT_OK, EXIT_USAGE
 from ..base.textsafe import visible
-from ..client.config_feed import ConfigApi, ForeignConfig, ServerConfig, fetch_config, set_config
-from ..client.connection import AriaClient
-from ..protocol.payloads.config import ConfigParam, ParamType, Priority
-from . import _config_care
 from ._common import add_connection_arguments, print_json, run_with_client
+
+if TYPE_CHECKING:
+    from ..client.config_feed import ConfigApi, ServerConfig
+    from ..client.connection import AriaClient
+    from ..protocol.payloads.config import ConfigParam
 
 EXIT_REFUSED = 6
 """The server refused a value (its message is printed)."""
@@ -101,6 +102,9 @@ def register(subparsers: Any) -> None:
 
 
 def handle(args: argparse.Namespace) -> int:
+    from ..client.config_feed import ForeignConfig, fetch_config
+    from . import _config_care
+
     assignments: list[tuple[str, str, str]] = args.assignments or []
     if len(assignments) > MAX_ASSIGNMENTS:
         print(f"rtmu config: at most {MAX_ASSIGNMENTS} values at once", file=sys.stderr)
@@ -133,6 +137,8 @@ def handle(args: argparse.Namespace) -> int:
 
 
 async def _set(client: AriaClient, assignments: list[tuple[str, str, str]], args: argparse.Namespace) -> int:
+    from ..client.config_feed import set_config
+
     changes: dict[str, dict[str, str]] = {}
     for section, name, value in assignments:
         changes.setdefault(section, {})[name] = value
@@ -152,6 +158,8 @@ def _finite(value: Any) -> Any:
 
 
 def param_json(p: ConfigParam, config: ServerConfig) -> dict[str, Any]:
+    from ..protocol.payloads.config import ParamType, Priority
+
     out: dict[str, Any] = {
         "name": p.name,
         "type": p.kind.name.lower(),
@@ -176,6 +184,9 @@ def api_key(api: ConfigApi) -> str:
 
 
 def config_json(config: ServerConfig) -> dict[str, Any]:
+    from ..client.config_feed import ConfigApi
+    from ..protocol.payloads.config import ParamType, Priority
+
     return {
         "api": api_key(ConfigApi.ARCONFIG),
         "source": config.source,
@@ -192,6 +203,8 @@ def config_json(config: ServerConfig) -> dict[str, Any]:
 
 
 def _limits(p: ConfigParam) -> str:
+    from ..protocol.payloads.config import ParamType
+
     if p.choices:
         return " one of " + ", ".join(visible(c) for c in p.choices)
     if p.kind not in (ParamType.INT, ParamType.DOUBLE):
@@ -206,6 +219,8 @@ def _limits(p: ConfigParam) -> str:
 
 
 def print_text(config: ServerConfig) -> None:
+    from ..protocol.payloads.config import ParamType, Priority
+
     for s in config.sections:
         comment = f"  ({visible(s.comment)})" if s.comment else ""
         print(f"[{visible(s.name)}]{comment}")

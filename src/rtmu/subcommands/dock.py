@@ -3,12 +3,13 @@
 from __future__ import annotations
 
 import argparse
-from typing import Any
+from typing import TYPE_CHECKING, Any
 
-from ..client.connection import AriaClient
-from ..protocol.payloads.navigation import Dock
 from ._common import add_connection_arguments, run_with_client
-from ._navigate import EXIT_CODES_HELP, Expect, add_wait_arguments, navigate, require
+from ._navigate import EXIT_CODES_HELP, Expect, add_wait_arguments
+
+if TYPE_CHECKING:
+    from ..client.connection import AriaClient
 
 
 def register(subparsers: Any) -> None:
@@ -24,6 +25,9 @@ def register(subparsers: Any) -> None:
 
 
 def handle(args: argparse.Namespace) -> int:
+    from ..protocol.payloads.navigation import Dock
+    from ._navigate import navigate, require
+
     async def body(client: AriaClient) -> int:
         require(client, "dock", "dock")
         return await navigate(client, args, Dock(), Expect(docked=True))

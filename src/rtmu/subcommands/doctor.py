@@ -13,23 +13,16 @@ answer (:mod:`rtmu.client.why`); that step fails with the cause's own code (20â€
 from __future__ import annotations
 
 import argparse
-import asyncio
 import contextlib
 import socket
 import sys
 import time
 from dataclasses import dataclass, field
-from typing import Any
+from typing import TYPE_CHECKING, Any
 
 from ..base.exit_codes import EXIT_OK, EXIT_USAGE
 from ..base.textsafe import visible
-from ..client.config_feed import ConfigApi, config_api
-from ..client.connection import TEXT_BANNERS, AriaClient
 from ..client.diagnosis import ADVICE, Step, login_finding
-from ..client.errors import ClientError
-from ..client.why import diagnose
-from ..client.why_gather import gather
-from ..protocol.client_connection import ClientConnection
 from ..protocol.commands import ClientCommand, ServerCommand
 from ..protocol.decoder import PacketDecoder
 from ..protocol.errors import ProtocolError
@@ -44,8 +37,12 @@ from ..protocol.events import (
 from ..protocol.fields import FieldReader, FieldWriter
 from ..protocol.packet import encode_packet
 from ..protocol.payloads import Side, decode_payload
-from ..protocol.payloads.robot import BatteryInfo, Update, UpdateNumbers, UpdateStrings
 from ._common import UsageError, add_connection_arguments, print_json, read_password
+
+if TYPE_CHECKING:  # the network side (asyncio, the client) comes with the walk, not with --help
+    import asyncio
+
+    from ..protocol.client_connection import ClientConnection
 
 READ_CHUNK = 65536
 NOT_ARIA_AFTER = 4096
@@ -154,6 +151,8 @@ class Doctor:
 
     # -- steps ------------------------------------------------------------------------------------
     async def _resolve(self) -> None:
+        import asyncio
+
         loop = asyncio.get_running_loop()
         try:
             async with asyncio.timeout(self.timeout):
@@ -171,6 +170,8 @@ class Doctor:
         self.ok(Step.RESOLVE, f"{self.host} is {', '.join(addresses)}", addresses=addresses)
 
     async def _connect(self) -> None:
+        import asyncio
+
         where = f"{self.host}:{self.port}"
         started = time.monotonic()
         try:
@@ -193,6 +194,10 @@ class Doctor:
 
     async def _read_events(self, step: Step, what: str) -> list[Any]:
         """The next events from the server, or the step fails (EOF, timeout, not ArNetworking)."""
+        import asyncio
+
+        from ..client.connection import TEXT_BANNERS
+
         assert self.reader is not None and self.conn is not None
         while True:
             try:
@@ -234,6 +239,8 @@ class Doctor:
             self.writer.write(out)
 
     async def _introduction(self) -> ServerIntroduction:
+        from ..protocol.client_connection import ClientConnection
+
         self.conn = ClientConnection(self.user, self._password, protocol_version=self.protocol)
         self._password = ""
         self._received = 0
@@ -285,6 +292,8 @@ class Doctor:
                     return
 
     async def _data_list(self) -> None:
+        from ..client.config_feed import ConfigApi, config_api
+
         assert self.conn is not None
         while not self.conn.datalist.complete:
             await self._read_events(Step.DATA_LIST, "data list")
@@ -313,6 +322,8 @@ class Doctor:
         )
 
     async def _udp(self, intro: ServerIntroduction) -> None:
+        import asyncio
+
         if intro.udp_port == 0:
             self.ok(Step.UDP, "not used: the server is TCP-only (UDP port 0)", "not_checked")
             return
@@ -354,6 +365,8 @@ class Doctor:
             transport.close()
 
     async def _status(self) -> None:
+        from ..protocol.payloads.robot import BatteryInfo, Update, UpdateNumbers, UpdateStrings
+
         conn = self.conn
         assert conn is not None
         name = "updateNumbers" if "updateNumbers" in conn.datalist else "update"
@@ -382,6 +395,11 @@ class Doctor:
         self.ok(Step.STATUS, text, **details)
 
     async def _motion(self) -> None:
+        from ..client.connection import AriaClient
+        from ..client.errors import ClientError
+        from ..client.why import diagnose
+        from ..client.why_gather import gather
+
         """``rtmu why``'s answer, asked over a login of its own (the steps above use the bare codec)."""
         client = AriaClient()
         try:
@@ -431,6 +449,8 @@ class Doctor:
                     raise fail(Step.STATUS, "the server shut the connection down", ADVICE["closed_early"])
 
     async def _close(self) -> None:
+        import asyncio
+
         if self.writer is None:
             return
         with contextlib.suppress(Exception):
@@ -466,6 +486,8 @@ MARKS = {"ok": "ok  ", "fail": "FAIL", "warn": "warn", "not_checked": "--  ", "s
 
 
 def handle(args: argparse.Namespace) -> int:
+    import asyncio
+
     host, port = args.server
     try:
         password = read_password(args)

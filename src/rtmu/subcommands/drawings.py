@@ -9,15 +9,15 @@ drawings are still shown. Exit 0 with the list, 4 when the server lists no drawi
 from __future__ import annotations
 
 import argparse
-from typing import Any
+from typing import TYPE_CHECKING, Any
 
 from ..base.exit_codes import EXIT_OK
 from ..base.textsafe import visible
-from ..client.connection import AriaClient
-from ..client.drawing_list import drawing_list, drawing_sample
-from ..client.errors import ClientError
-from ..protocol.payloads.drawings import Drawing
 from ._common import add_connection_arguments, print_json, run_with_client
+
+if TYPE_CHECKING:
+    from ..client.connection import AriaClient
+    from ..protocol.payloads.drawings import Drawing
 
 
 def register(subparsers: Any) -> None:
@@ -35,6 +35,8 @@ def register(subparsers: Any) -> None:
 
 
 def handle(args: argparse.Namespace) -> int:
+    from ..client.drawing_list import drawing_list
+
     async def body(client: AriaClient) -> int:
         drawings = await drawing_list(client, args.timeout)  # NotSupported (exit 4) without a list
         rows = [await _sample(client, d, args.timeout) for d in drawings]
@@ -51,6 +53,9 @@ def handle(args: argparse.Namespace) -> int:
 
 
 async def _sample(client: AriaClient, d: Drawing, timeout: float) -> dict[str, Any]:
+    from ..client.drawing_list import drawing_sample
+    from ..client.errors import ClientError
+
     row: dict[str, Any] = {
         "name": d.name,
         "shape": d.shape,

@@ -22,26 +22,14 @@ code is 128 + the signal's number as shells report it: 130 Ctrl-C, 143 SIGTERM,
 from __future__ import annotations
 
 import argparse
-import asyncio
 import contextlib
 import dataclasses
 import sys
 from collections.abc import Callable
-from typing import Any
+from typing import TYPE_CHECKING, Any
 
 from ..base.exit_codes import EXIT_OK
 from ..base.textsafe import visible
-from ..client.connection import AriaClient, Packet
-from ..client.drive_guard import DriveGuard, LinkFault
-from ..client.errors import ClientError
-from ..client.why import diagnose, moved, unexplained
-from ..client.why_gather import gather
-from ..client.why_values import Answer, Facts, Motion
-from ..guardian.handle import GuardianHandle, GuardianUnavailable, beat_network, start_ready
-from ..guardian.messages import Hello
-from ..protocol.errors import ProtocolError
-from ..protocol.payloads.drive import RatioDrive
-from ..protocol.payloads.robot import UpdateStrings
 from ._common import (
     Interrupted,
     UsageError,
@@ -54,7 +42,14 @@ from ._common import (
     signal_name,
     status_line,
 )
-from .why import print_answer
+
+if TYPE_CHECKING:  # the network side comes with the drive, not with --help
+    from ..client.connection import AriaClient, Packet
+    from ..client.drive_guard import DriveGuard
+    from ..client.why_values import Answer, Facts, Motion
+    from ..guardian.handle import GuardianHandle
+    from ..protocol.payloads.drive import RatioDrive
+    from ..protocol.payloads.robot import UpdateStrings
 
 RESEND = 0.1
 MAX_SECONDS = 600.0
@@ -95,6 +90,17 @@ def check(args: argparse.Namespace) -> None:
 
 
 def handle(args: argparse.Namespace) -> int:
+    import asyncio
+
+    from ..client.drive_guard import DriveGuard, LinkFault
+    from ..client.errors import ClientError
+    from ..client.why import diagnose, moved, unexplained
+    from ..client.why_gather import gather
+    from ..client.why_values import Facts, Motion
+    from ..guardian.handle import beat_network
+    from ..protocol.payloads.drive import RatioDrive
+    from .why import print_answer
+
     async def body(client: AriaClient) -> int:
         check(args)
         motion = Motion(args.trans, args.rot)
@@ -183,6 +189,9 @@ def handle(args: argparse.Namespace) -> int:
 
 async def start_guardian(args: argparse.Namespace) -> GuardianHandle | None:
     """The guardian for this drive (``rtmu.guardian``); None, with one line on stderr, if it cannot log in."""
+    from ..guardian.handle import GuardianUnavailable, start_ready
+    from ..guardian.messages import Hello
+
     host, port = args.server
     try:
         return await start_ready(Hello(host, port, args.user, current_password(), args.timeout), args.timeout)
@@ -198,6 +207,10 @@ async def start_guardian(args: argparse.Namespace) -> GuardianHandle | None:
 
 async def refuse(args: argparse.Namespace, client: AriaClient, motion: Motion) -> int:
     """This login may not drive: say why (``rtmu why``'s answer) and exit with its code."""
+    from ..client.why import diagnose
+    from ..client.why_gather import gather
+    from .why import print_answer
+
     answer = diagnose(await gather(client, args.timeout), motion)
     if args.json:
         print_json(
@@ -227,12 +240,18 @@ class StatusWords:
             client.request("updateStrings", -1, self._on_strings)
 
     def _on_strings(self, packet: Packet) -> None:
+        from ..client.errors import ClientError
+        from ..protocol.errors import ProtocolError
+        from ..protocol.payloads.robot import UpdateStrings
+
         with contextlib.suppress(ClientError, ProtocolError):
             value = packet.decode()
             if self.open and isinstance(value, UpdateStrings):
                 self.last = value
 
     def close(self) -> None:
+        from ..client.errors import ClientError
+
         if self.open:
             self.open = False
             with contextlib.suppress(ClientError):
@@ -281,6 +300,10 @@ async def drive(
     With a ``guard``, a link fault raises :class:`LinkFault` the moment it is seen (the guard
     wakes this loop when status arrives or a ping fails, and at the instant status would go stale).
     """
+    import asyncio
+
+    from ..client.drive_guard import LinkFault
+
     clock = client.clock
     end = clock() + seconds
     next_send = clock()
@@ -313,6 +336,9 @@ async def drive(
 
 def stop(client: AriaClient) -> None:
     """Zero ratios and ``stop``; never raises (we are often in a ``finally``)."""
+    from ..client.errors import ClientError
+    from ..protocol.payloads.drive import RatioDrive
+
     with contextlib.suppress(ClientError):
         client.send("ratioDrive", RatioDrive(0.0, 0.0, 0.0))
     if client.supports("stop"):
@@ -322,6 +348,8 @@ def stop(client: AriaClient) -> None:
 
 async def settle(client: AriaClient, timeout: float) -> dict[str, Any]:
     """The status once the robot stands still (or after :data:`SETTLE` s)."""
+    import asyncio
+
     loop = asyncio.get_running_loop()
     deadline = loop.time() + SETTLE
     while True:

@@ -14,25 +14,16 @@ import argparse
 import datetime
 import sys
 from pathlib import Path
-from typing import Any
+from typing import TYPE_CHECKING, Any
 
 from ..base.exit_codes import EXIT_OK, EXIT_REFUSED, EXIT_USAGE
 from ..base.textsafe import visible
-from ..client.connection import AriaClient
-from ..client.download import LocalFileError, check_destination, download_file
-from ..client.remote_files import (
-    default_folder,
-    delete_file,
-    find_entry,
-    list_folder,
-    offers,
-    remote_path,
-    wire_name,
-)
-from ..client.upload import check_source, upload_file
-from ..protocol.payloads.files import DirEntry
 from ._actions import action_parser, end_progress, progress_printer
 from ._common import add_connection_arguments, fail, print_json, run_with_client
+
+if TYPE_CHECKING:
+    from ..client.connection import AriaClient
+    from ..protocol.payloads.files import DirEntry
 
 EXIT_CODES = (
     "Exit codes: 0 done; 2 usage (a bad path, a local file that exists without --force, rm without --yes "
@@ -80,6 +71,8 @@ def register(subparsers: Any) -> None:
 
 
 def handle(args: argparse.Namespace) -> int:
+    from ..client.download import LocalFileError
+
     try:
         body = {"ls": _ls, "get": _get, "put": _put, "rm": _rm}[args.action](args)
     except (ValueError, LocalFileError) as exc:
@@ -99,6 +92,8 @@ def _when(seconds: int) -> str:
 
 
 def _ls(args: argparse.Namespace) -> Any:
+    from ..client.remote_files import list_folder, remote_path
+
     folder = remote_path(args.folder, folder=True)
 
     async def body(client: AriaClient) -> int:
@@ -119,6 +114,9 @@ def _ls(args: argparse.Namespace) -> Any:
 
 
 def _get(args: argparse.Namespace) -> Any:
+    from ..client.download import check_destination, download_file
+    from ..client.remote_files import remote_path
+
     remote = remote_path(args.remote)
     name = remote.rpartition("/")[2]
     local: Path = args.out if args.out is not None else Path(name)
@@ -149,6 +147,9 @@ def _get(args: argparse.Namespace) -> Any:
 
 
 def _put(args: argparse.Namespace) -> Any:
+    from ..client.remote_files import default_folder, find_entry, offers, remote_path, wire_name
+    from ..client.upload import check_source, upload_file
+
     local: Path = args.local
     check_source(local)
     given = args.remote
@@ -196,6 +197,8 @@ def _put(args: argparse.Namespace) -> Any:
 
 
 def _rm(args: argparse.Namespace) -> Any:
+    from ..client.remote_files import delete_file, remote_path
+
     remote = remote_path(args.remote)
     if not args.yes:
         host, port = args.server

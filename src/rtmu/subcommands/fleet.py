@@ -11,16 +11,11 @@ not answer. Act on one of them with any subcommand's ``--robot NAME``.
 from __future__ import annotations
 
 import argparse
-import asyncio
 import signal
-from typing import Any
+from typing import TYPE_CHECKING, Any
 
 from ..base.exit_codes import EXIT_CONNECTION, EXIT_OK, EXIT_USAGE
 from ..base.textsafe import visible
-from ..client.central import list_robots
-from ..client.connection import AriaClient
-from ..client.errors import ClientError
-from ..protocol.errors import ProtocolError
 from ._common import (
     UsageError,
     add_connection_arguments,
@@ -30,6 +25,9 @@ from ._common import (
     read_password,
     status_line,
 )
+
+if TYPE_CHECKING:
+    import asyncio
 
 MAX_AT_ONCE = 16
 """Robots asked for their status at the same time (a central server may forward hundreds)."""
@@ -51,6 +49,10 @@ def register(subparsers: Any) -> None:
 async def _status(
     host: str, port: int, args: argparse.Namespace, password: str, gate: asyncio.Semaphore
 ) -> dict[str, Any]:
+    from ..client.connection import AriaClient
+    from ..client.errors import ClientError
+    from ..protocol.errors import ProtocolError
+
     async with gate:
         client = AriaClient()
         try:
@@ -64,6 +66,12 @@ async def _status(
 
 
 def handle(args: argparse.Namespace) -> int:
+    import asyncio
+
+    from ..client.central import list_robots
+    from ..client.errors import ClientError
+    from ..protocol.errors import ProtocolError
+
     if args.robot is not None:
         return fail("fleet", "--robot does not apply to 'rtmu fleet': it lists every robot", EXIT_USAGE)
     try:

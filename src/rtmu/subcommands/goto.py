@@ -10,15 +10,15 @@ from __future__ import annotations
 
 import argparse
 import sys
-from typing import Any
+from typing import TYPE_CHECKING, Any
 
 from ..base.exit_codes import EXIT_OK, EXIT_USAGE
 from ..base.textsafe import visible
-from ..client import ld_data
-from ..client.connection import AriaClient
-from ..protocol.payloads.navigation import GotoGoal, GotoPose
 from ._common import UsageError, add_connection_arguments, run_with_client, unknown_name
-from ._navigate import EXIT_CODES_HELP, Expect, add_wait_arguments, navigate, require
+from ._navigate import EXIT_CODES_HELP, Expect, add_wait_arguments
+
+if TYPE_CHECKING:
+    from ..client.connection import AriaClient
 
 RULE = (
     "GOAL goes as ARNL's gotoGoal wherever the server lists it, and the command follows the robot to "
@@ -60,6 +60,9 @@ def handle(args: argparse.Namespace) -> int:
     except UsageError as exc:
         print(f"rtmu goto: {exc}", file=sys.stderr)
         return EXIT_USAGE
+    from ..client import ld_data
+    from ..protocol.payloads.navigation import GotoGoal, GotoPose
+    from ._navigate import navigate, require
 
     async def body(client: AriaClient) -> int:
         if args.goal is None:

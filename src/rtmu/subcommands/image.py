@@ -5,13 +5,14 @@ from __future__ import annotations
 import argparse
 import sys
 from pathlib import Path
-from typing import Any
+from typing import TYPE_CHECKING, Any
 
 from ..base.exit_codes import EXIT_CONNECTION, EXIT_OK
 from ..base.textsafe import visible
-from ..client.connection import AriaClient
-from ..client.video_feed import video_source
 from ._common import add_connection_arguments, fail, run_with_client
+
+if TYPE_CHECKING:
+    from ..client.connection import AriaClient
 
 MAX_SIDE = 8192
 """Largest width or height accepted from a server; no robot camera comes near it."""
@@ -58,6 +59,8 @@ def register(subparsers: Any) -> None:
 
 
 def handle(args: argparse.Namespace) -> int:
+    from ..client.video_feed import video_source
+
     async def body(client: AriaClient) -> int:
         source = video_source(client, args.camera)
         extra: tuple[bytes, ...] = ()

@@ -3,12 +3,13 @@
 from __future__ import annotations
 
 import argparse
-from typing import Any
+from typing import TYPE_CHECKING, Any
 
-from ..client.connection import AriaClient
-from ..protocol.payloads.navigation import LocalizeToPose
 from ._common import add_connection_arguments, run_with_client
-from ._navigate import EXIT_NAV_LOST, add_wait_arguments, localize, require
+from ._navigate import EXIT_NAV_LOST, add_wait_arguments
+
+if TYPE_CHECKING:
+    from ..client.connection import AriaClient
 
 
 def register(subparsers: Any) -> None:
@@ -29,6 +30,9 @@ def register(subparsers: Any) -> None:
 
 
 def handle(args: argparse.Namespace) -> int:
+    from ..protocol.payloads.navigation import LocalizeToPose
+    from ._navigate import localize, require
+
     async def body(client: AriaClient) -> int:
         require(client, "localizeToPose", "take a pose to localize at")
         return await localize(client, args, LocalizeToPose(round(args.x), round(args.y), round(args.th)))

@@ -5,15 +5,14 @@ from __future__ import annotations
 import argparse
 import sys
 from pathlib import Path
-from typing import Any
+from typing import TYPE_CHECKING, Any
 
 from ..base.exit_codes import EXIT_OK, EXIT_UNSUPPORTED
 from ..base.textsafe import visible
-from ..client.connection import AriaClient
-from ..client.errors import ProtocolFault
-from ..client.mapload import download_map
-from ..mapfile.errors import MapFormatError
 from ._common import add_connection_arguments, fail, run_with_client
+
+if TYPE_CHECKING:
+    from ..client.connection import AriaClient
 
 
 def register(subparsers: Any) -> None:
@@ -30,8 +29,12 @@ def register(subparsers: Any) -> None:
 
 
 def handle(args: argparse.Namespace) -> int:
+    from .. import mapfile as maps
+    from ..client.errors import ProtocolFault
+    from ..client.mapload import download_map
+    from ..mapfile.errors import MapFormatError
+
     async def body(client: AriaClient) -> int:
-        from .. import mapfile as maps
 
         got = await download_map(client, prefer_binary=not args.text, timeout=args.timeout)
         if got.data is None:

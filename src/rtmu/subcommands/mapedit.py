@@ -5,24 +5,15 @@ from __future__ import annotations
 import argparse
 import math
 import sys
-from typing import Any
+from typing import TYPE_CHECKING, Any
 
 from ..base.exit_codes import EXIT_OK, EXIT_USAGE
 from ..base.textsafe import visible
-from ..client.config_care import check_map
-from ..client.connection import AriaClient
-from ..client.errors import NotSupported
-from ..client.map_changes import (
-    ChangeWatch,
-    map_id,
-    not_holding,
-    object_change_set,
-    offers_map_changes,
-    send_changes,
-)
-from ..client.mapload import download_map
-from ..mapedit import DraftError, MapDraft, ObjectChanges, describe
 from ._common import add_connection_arguments, print_json, run_with_client
+
+if TYPE_CHECKING:
+    from ..client.connection import AriaClient
+    from ..mapedit import MapDraft, ObjectChanges
 
 DESCRIPTION = """Change the server's map live, in one change set (ARIA's ArMapChanger).
 
@@ -150,6 +141,8 @@ def register(subparsers: Any) -> None:
 
 def apply_edits(draft: MapDraft, edits: list[dict[str, Any]]) -> None:
     """Every edit into ``draft`` (DraftError names the first that does not fit)."""
+    from ..mapedit import DraftError
+
     for e in edits:
         kind = e["kind"]
         if kind in ("add_goal", "add_dock"):
@@ -184,6 +177,8 @@ def handle(args: argparse.Namespace) -> int:
         print(f"rtmu mapedit: at most {MAX_EDITS} edits at once", file=sys.stderr)
         return EXIT_USAGE
 
+    from ..client.config_care import check_map
+
     async def body(client: AriaClient) -> int:
         if args.check_map:
             changed = await check_map(client, args.timeout)
@@ -202,6 +197,18 @@ def handle(args: argparse.Namespace) -> int:
 
 
 async def _edit(client: AriaClient, edits: list[dict[str, Any]], args: argparse.Namespace) -> int:
+    from ..client.errors import NotSupported
+    from ..client.map_changes import (
+        ChangeWatch,
+        map_id,
+        not_holding,
+        object_change_set,
+        offers_map_changes,
+        send_changes,
+    )
+    from ..client.mapload import download_map
+    from ..mapedit import DraftError, MapDraft
+
     if not offers_map_changes(client):
         raise NotSupported("processMapChanges", "this server takes no live map changes (processMapChanges)")
     guard = await map_id(client, args.timeout)
@@ -243,6 +250,8 @@ async def _edit(client: AriaClient, edits: list[dict[str, Any]], args: argparse.
 def _report(
     args: argparse.Namespace, change: ObjectChanges, verdict: Any, missing: list[str], note: str
 ) -> None:
+    from ..mapedit import describe
+
     if args.json:
         print_json(
             {

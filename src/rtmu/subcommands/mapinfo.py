@@ -6,10 +6,12 @@ import argparse
 import json
 import sys
 from collections import Counter
-from typing import Any
+from typing import TYPE_CHECKING, Any
 
 from rtmu.base.textsafe import visible
-from rtmu.mapfile import Bounds, MapData, MapFormatError, read_map, split_keyword
+
+if TYPE_CHECKING:
+    from rtmu.mapfile import Bounds, MapData
 
 EXIT_OK = 0
 EXIT_BAD_MAP = 2
@@ -28,6 +30,8 @@ def register(subparsers: argparse._SubParsersAction) -> None:
 
 
 def run(args: argparse.Namespace) -> int:
+    from rtmu.mapfile import MapFormatError, read_map
+
     try:
         data = read_map(args.file)
     except MapFormatError as exc:
@@ -43,6 +47,8 @@ def run(args: argparse.Namespace) -> int:
 
 
 def summarise(data: MapData) -> dict[str, Any]:
+    from rtmu.mapfile import split_keyword
+
     """Everything ``mapinfo`` reports, as plain JSON-ready values."""
     scans = []
     for scan in data.scans:

@@ -4,13 +4,14 @@ from __future__ import annotations
 
 import argparse
 import sys
-from typing import Any
+from typing import TYPE_CHECKING, Any
 
 from ..base.exit_codes import EXIT_OK, EXIT_USAGE
 from ..base.textsafe import visible
-from ..client import ld_data
-from ..client.connection import AriaClient
 from ._common import add_connection_arguments, run_with_client, unknown_name
+
+if TYPE_CHECKING:
+    from ..client.connection import AriaClient
 
 
 def register(subparsers: Any) -> None:
@@ -25,6 +26,8 @@ def register(subparsers: Any) -> None:
 
 
 def handle(args: argparse.Namespace) -> int:
+    from ..client import ld_data
+
     async def body(client: AriaClient) -> int:
         known = await ld_data.routes(client, args.timeout)
         if unknown_name("patrol", "route", args.route, known):

@@ -9,18 +9,16 @@ Exit 4 when the server has no movable camera head.
 from __future__ import annotations
 
 import argparse
-import asyncio
 import math
-from typing import Any
+from typing import TYPE_CHECKING, Any
 
 from ..base.exit_codes import EXIT_OK, EXIT_UNSUPPORTED
 from ..base.textsafe import visible
-from ..client.connection import AriaClient
-from ..client.detached import DetachedContext
-from ..client.ptz import PtzFeed
-from ..client.session_config import SessionConfig
-from ..values.state import PtzState
 from ._common import add_connection_arguments, fail, print_json, run_with_client
+
+if TYPE_CHECKING:
+    from ..client.connection import AriaClient
+    from ..values.state import PtzState
 
 SETTLE_S = 0.5
 """How long a real head gets to turn before its position is read back."""
@@ -70,6 +68,12 @@ def _ptz_object(state: PtzState) -> dict[str, Any]:
 
 
 def handle(args: argparse.Namespace) -> int:
+    import asyncio
+
+    from ..client.detached import DetachedContext
+    from ..client.ptz import PtzFeed
+    from ..client.session_config import SessionConfig
+
     moving = any(v is not None for v in (args.pan, args.tilt, args.zoom))
 
     async def body(client: AriaClient) -> int:

@@ -13,18 +13,15 @@ import signal
 import sys
 import threading
 from pathlib import Path
-from typing import Any
+from typing import TYPE_CHECKING, Any
 
 from ..base.exit_codes import EXIT_CONNECTION, EXIT_OK, EXIT_USAGE
-from ..base.notices import Notice
 from ..base.textsafe import visible
-from ..client.errors import ClientError
-from ..client.runner import ClientRunner
-from ..client.session import SessionConfig
-from ..recorder import Recorder, RecorderConfig
-from ..values.state import ConnectionChanged, Phase, StateChange
 from ._common import UsageError, add_connection_arguments, fail, positive_float, read_password
-from ._follow import follow
+
+if TYPE_CHECKING:
+    from ..base.notices import Notice
+    from ..values.state import StateChange
 
 
 def register(subparsers: Any) -> None:
@@ -52,6 +49,13 @@ def register(subparsers: Any) -> None:
 
 
 def handle(args: argparse.Namespace) -> int:
+    from ..client.errors import ClientError
+    from ..client.runner import ClientRunner
+    from ..client.session import SessionConfig
+    from ..recorder.recorder import Recorder, RecorderConfig
+    from ..values.state import ConnectionChanged, Phase
+    from ._follow import follow
+
     out: Path = args.out
     if out.is_dir():
         return fail("record", f"{out} is a directory", EXIT_USAGE)

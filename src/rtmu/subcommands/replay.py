@@ -12,7 +12,6 @@ from pathlib import Path
 from typing import Any
 
 from ..base.exit_codes import EXIT_CONNECTION, EXIT_USAGE
-from ..recorder.replay_file import ReplayFileError, load
 from ._common import fail
 
 
@@ -33,6 +32,8 @@ def register(subparsers: Any) -> None:
 
 
 def handle(args: argparse.Namespace) -> int:
+    from ..recorder.replay_file import ReplayFileError, load
+
     path: Path = args.file
     if not path.is_file():
         return fail("replay", f"{path} is not a file", EXIT_USAGE)

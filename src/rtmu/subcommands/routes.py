@@ -3,13 +3,14 @@
 from __future__ import annotations
 
 import argparse
-from typing import Any
+from typing import TYPE_CHECKING, Any
 
 from ..base.exit_codes import EXIT_OK
 from ..base.textsafe import visible
-from ..client import ld_data
-from ..client.connection import AriaClient
 from ._common import add_connection_arguments, print_json, run_with_client
+
+if TYPE_CHECKING:
+    from ..client.connection import AriaClient
 
 
 def register(subparsers: Any) -> None:
@@ -24,6 +25,8 @@ def register(subparsers: Any) -> None:
 
 
 def handle(args: argparse.Namespace) -> int:
+    from ..client import ld_data
+
     async def body(client: AriaClient) -> int:
         names = await ld_data.routes(client, args.timeout)
         if args.json:

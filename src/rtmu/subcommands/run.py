@@ -11,13 +11,14 @@ from __future__ import annotations
 
 import argparse
 import sys
-from typing import Any
+from typing import TYPE_CHECKING, Any
 
 from ..base.exit_codes import EXIT_OK, EXIT_TIMEOUT, EXIT_USAGE
 from ..base.textsafe import visible
-from ..client.connection import AriaClient
-from ..client.custom_commands import MAX_ARGUMENT, list_commands, run_command
 from ._common import add_connection_arguments, print_json, run_with_client, unknown_name
+
+if TYPE_CHECKING:
+    from ..client.connection import AriaClient
 
 
 def register(subparsers: Any) -> None:
@@ -41,6 +42,8 @@ def usage(message: str) -> int:
 
 
 def handle(args: argparse.Namespace) -> int:
+    from ..client.custom_commands import MAX_ARGUMENT, list_commands, run_command
+
     if args.argument is not None and len(args.argument) > MAX_ARGUMENT:
         return usage(f"ARG is longer than {MAX_ARGUMENT} characters")
 

@@ -4,12 +4,13 @@ from __future__ import annotations
 
 import argparse
 import sys
-from typing import Any
+from typing import TYPE_CHECKING, Any
 
 from ..base.exit_codes import EXIT_OK, EXIT_USAGE
-from ..client import ld_data
-from ..client.connection import AriaClient
 from ._common import add_connection_arguments, run_with_client
+
+if TYPE_CHECKING:
+    from ..client.connection import AriaClient
 
 MAX_TEXT = 1000
 """Characters; a longer text is refused before connecting."""
@@ -27,6 +28,8 @@ def register(subparsers: Any) -> None:
 
 
 def handle(args: argparse.Namespace) -> int:
+    from ..client import ld_data
+
     text = args.text.strip()
     if not text or len(text) > MAX_TEXT:
         print(f"rtmu say: give a text of 1…{MAX_TEXT} characters", file=sys.stderr)

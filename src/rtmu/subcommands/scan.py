@@ -11,16 +11,15 @@ from __future__ import annotations
 import argparse
 import sys
 from pathlib import Path
-from typing import Any
+from typing import TYPE_CHECKING, Any
 
 from ..base.exit_codes import EXIT_OK, EXIT_REFUSED, EXIT_TIMEOUT, EXIT_USAGE
 from ..base.textsafe import visible
-from ..client.connection import AriaClient
-from ..client.download import LocalFileError, check_destination, download_file
-from ..client.remote_files import Refused, local_name
-from ..client.scan import scan_name, scan_status, scan_unavailable, start_scan, stop_scan, tag_loop
 from ._actions import action_parser, end_progress, progress_printer
 from ._common import add_connection_arguments, fail, print_json, run_with_client
+
+if TYPE_CHECKING:
+    from ..client.connection import AriaClient
 
 EXIT_CODES = (
     "Exit codes: 0 done; 2 usage (a bad name, a download folder that is missing or a file there that "
@@ -55,6 +54,8 @@ def register(subparsers: Any) -> None:
 
 
 def handle(args: argparse.Namespace) -> int:
+    from ..client.download import LocalFileError
+
     try:
         body = {"start": _start, "status": _status, "loop": _loop, "stop": _stop}[args.action](args)
     except (ValueError, LocalFileError) as exc:
@@ -63,6 +64,8 @@ def handle(args: argparse.Namespace) -> int:
 
 
 def _start(args: argparse.Namespace) -> Any:
+    from ..client.scan import scan_name, start_scan
+
     name = scan_name(args.name)
 
     async def body(client: AriaClient) -> int:
@@ -77,6 +80,8 @@ def _start(args: argparse.Namespace) -> Any:
 
 
 def _status(args: argparse.Namespace) -> Any:
+    from ..client.scan import scan_status
+
     async def body(client: AriaClient) -> int:
         status = await scan_status(client, timeout=args.timeout)
         if args.json:
@@ -91,6 +96,9 @@ def _status(args: argparse.Namespace) -> Any:
 
 
 def _loop(args: argparse.Namespace) -> Any:
+    from ..client.remote_files import Refused
+    from ..client.scan import scan_status, scan_unavailable, tag_loop
+
     async def body(client: AriaClient) -> int:
         knows = "scan_status" not in scan_unavailable(client)
         if knows and not (await scan_status(client, timeout=args.timeout)).scanning:
@@ -110,6 +118,10 @@ def _loop(args: argparse.Namespace) -> Any:
 
 
 def _stop(args: argparse.Namespace) -> Any:
+    from ..client.download import check_destination, download_file
+    from ..client.remote_files import Refused, local_name
+    from ..client.scan import scan_status, stop_scan
+
     folder: Path | None = args.download
     if folder is not None and not folder.is_dir():
         raise ValueError(f"no folder {folder} to download the scan into")

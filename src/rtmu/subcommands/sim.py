@@ -10,7 +10,6 @@ building map instead of serving.
 from __future__ import annotations
 
 import argparse
-import asyncio
 import sys
 from pathlib import Path
 
@@ -163,6 +162,8 @@ def _size(text: str) -> tuple[int, int]:
 
 
 def run(args: argparse.Namespace) -> int:
+    import asyncio
+
     if args.make_map is not None:
         return make_map(args)
     if args.central:

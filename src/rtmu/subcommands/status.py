@@ -10,18 +10,11 @@ Docking, Docked, Undocking) when the server offers ``dockInfo`` (LD robots).
 from __future__ import annotations
 
 import argparse
-import asyncio
 import contextlib
 import sys
-from typing import Any
+from typing import TYPE_CHECKING, Any
 
 from ..base.exit_codes import EXIT_OK
-from ..client import ld_data
-from ..client.connection import AriaClient, Packet
-from ..client.errors import ClientTimeout, NotSupported, ProtocolFault
-from ..protocol.errors import ProtocolError
-from ..protocol.payloads.ld import DockInfo
-from ..protocol.payloads.robot import Update, UpdateNumbers, UpdateStrings
 from ._common import (
     add_connection_arguments,
     battery_is_soc,
@@ -31,6 +24,9 @@ from ._common import (
     status_line,
     status_object,
 )
+
+if TYPE_CHECKING:
+    from ..client.connection import AriaClient, Packet
 
 
 def register(subparsers: Any) -> None:
@@ -52,6 +48,8 @@ def register(subparsers: Any) -> None:
 
 
 def handle(args: argparse.Namespace) -> int:
+    from ..client import ld_data
+
     if args.interval < 10:
         args.interval = 10
 
@@ -79,6 +77,14 @@ def say(message: str) -> None:
 
 
 async def stream(client: AriaClient, args: argparse.Namespace, show: Any) -> int:
+    import asyncio
+
+    from ..client import ld_data
+    from ..client.errors import ClientTimeout, NotSupported, ProtocolFault
+    from ..protocol.errors import ProtocolError
+    from ..protocol.payloads.ld import DockInfo
+    from ..protocol.payloads.robot import Update, UpdateNumbers, UpdateStrings
+
     strings = {"status": "", "mode": ""}
     soc = await battery_is_soc(client, args.timeout)
     dock: dict[str, str] = {}

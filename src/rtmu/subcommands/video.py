@@ -9,21 +9,24 @@ dropped with a note on stderr and the video goes on.
 from __future__ import annotations
 
 import argparse
-import asyncio
-import concurrent.futures
 import json
 import statistics
 import sys
 import time
 from pathlib import Path
-from typing import Any
+from typing import TYPE_CHECKING, Any
 
 from ..base.exit_codes import EXIT_CONNECTION, EXIT_OK
 from ..base.textsafe import visible
-from ..client.connection import AriaClient
-from ..client.video_feed import MAX_FPS, MIN_FPS, LiveFrame, VideoFeed, VideoStatus, video_source
+from ..client.defaults import MAX_FPS, MIN_FPS
 from ._common import add_connection_arguments, fail, run_with_client
 from .image import picture_problem
+
+if TYPE_CHECKING:
+    import asyncio
+
+    from ..client.connection import AriaClient
+    from ..client.video_feed import LiveFrame, VideoFeed, VideoStatus
 
 MAX_DECODES_QUEUED = 2
 """Frames waiting for the decoder; more are counted as skipped rather than queued without end."""
@@ -65,6 +68,8 @@ class _Player:
     """Decodes (and saves) the frames the feed hands on; keeps the figures for the summary."""
 
     def __init__(self, out: Path | None, quiet: bool) -> None:
+        import concurrent.futures
+
         self.out = out
         self.quiet = quiet
         self.pool = concurrent.futures.ThreadPoolExecutor(max_workers=1, thread_name_prefix="rtmu-video")
@@ -82,6 +87,8 @@ class _Player:
         self.feed: VideoFeed | None = None
 
     def on_frame(self, frame: LiveFrame) -> None:
+        import asyncio
+
         if len(self.pending) >= MAX_DECODES_QUEUED:
             self.skipped += 1
             if self.feed is not None:
@@ -126,12 +133,16 @@ class _Player:
             print(f"rtmu video: {visible(text)}", file=sys.stderr)
 
     async def settle(self) -> None:
+        import asyncio
+
         if self.pending:
             await asyncio.wait(list(self.pending), timeout=5.0)
         self.pool.shutdown(wait=False, cancel_futures=True)
 
 
 def handle(args: argparse.Namespace) -> int:
+    from ..client.video_feed import VideoFeed, video_source
+
     if args.seconds <= 0:
         return fail("video", "--seconds must be above 0", 2)
     if args.out is not None:

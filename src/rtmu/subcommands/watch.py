@@ -10,20 +10,17 @@ strings. Exit 0 after ``--seconds``; 3 when the connection ends; Ctrl-C ends it 
 from __future__ import annotations
 
 import argparse
-import asyncio
 import contextlib
 import time
 from collections.abc import Callable
-from typing import Any
+from typing import TYPE_CHECKING, Any
 
 from ..base.exit_codes import EXIT_OK
 from ..base.textsafe import visible
-from ..client.connection import AriaClient, Packet
-from ..client.errors import NotSupported
-from ..protocol.errors import ProtocolError
-from ..protocol.payloads.popup import PopupClose, PopupCreate, PopupType
-from ..protocol.payloads.robot import ModeInfo, UpdateStrings
 from ._common import add_connection_arguments, positive_float, print_json, run_with_client
+
+if TYPE_CHECKING:
+    from ..client.connection import AriaClient, Packet
 
 PLAIN_EVENTS = {
     "mapUpdated": ("map_updated", "map updated"),
@@ -49,6 +46,8 @@ def register(subparsers: Any) -> None:
 
 
 def popup_type(number: int) -> str:
+    from ..protocol.payloads.popup import PopupType
+
     with contextlib.suppress(ValueError):
         return PopupType(number).name.lower()
     return str(number)
@@ -56,6 +55,9 @@ def popup_type(number: int) -> str:
 
 def describe(name: str, payload: Any) -> tuple[dict[str, Any], str] | None:
     """(JSON object without ``t``, text line) for one broadcast; None for one not worth a line."""
+    from ..protocol.payloads.popup import PopupClose, PopupCreate
+    from ..protocol.payloads.robot import ModeInfo, UpdateStrings
+
     if isinstance(payload, PopupCreate):
         buttons = [b for b in payload.buttons if b]
         obj = {
@@ -81,6 +83,11 @@ def describe(name: str, payload: Any) -> tuple[dict[str, Any], str] | None:
 
 
 def handle(args: argparse.Namespace) -> int:
+    import asyncio
+
+    from ..client.errors import NotSupported
+    from ..protocol.errors import ProtocolError
+
     started = time.monotonic()
 
     def show(name: str, payload: Any) -> None:

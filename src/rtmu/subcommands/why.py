@@ -18,15 +18,15 @@ from __future__ import annotations
 
 import argparse
 import sys
-from typing import Any
+from typing import TYPE_CHECKING, Any
 
 from ..base.textsafe import visible
-from ..client.connection import AriaClient
-from ..client.why import diagnose
-from ..client.why_fix import FixResult, apply
-from ..client.why_gather import gather
-from ..client.why_values import Answer
 from ._common import add_connection_arguments, print_json, run_with_client
+
+if TYPE_CHECKING:
+    from ..client.connection import AriaClient
+    from ..client.why_fix import FixResult
+    from ..client.why_values import Answer
 
 MAX_FIXES = 3
 """Fixes tried one after another (each reveals what the next cause is)."""
@@ -50,6 +50,9 @@ def register(subparsers: Any) -> None:
 
 
 def handle(args: argparse.Namespace) -> int:
+    from ..client.why import diagnose
+    from ..client.why_gather import gather
+
     async def body(client: AriaClient) -> int:
         answer = diagnose(await gather(client, args.timeout), navigate=args.navigate)
         results: list[FixResult] = []
@@ -75,6 +78,10 @@ def handle(args: argparse.Namespace) -> int:
 async def fix_all(
     client: AriaClient, answer: Answer, args: argparse.Namespace
 ) -> tuple[Answer, list[FixResult]]:
+    from ..client.why import diagnose
+    from ..client.why_fix import apply
+    from ..client.why_gather import gather
+
     results: list[FixResult] = []
     tried: set[str] = set()
     for _ in range(MAX_FIXES):

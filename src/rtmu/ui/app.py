@@ -10,10 +10,12 @@ from __future__ import annotations
 
 import argparse
 import sys
-from dataclasses import replace
+from typing import TYPE_CHECKING
 
-from ..settings.store import DEFAULT_PORT, parse_central
-from .options import GuiOptions
+from ..client.defaults import DEFAULT_PORT
+
+if TYPE_CHECKING:
+    from .options import GuiOptions
 
 EXIT_NO_DISPLAY = 6
 
@@ -54,6 +56,8 @@ def add_gui_arguments(parser: argparse.ArgumentParser) -> None:
 
 
 def options_from_args(args: argparse.Namespace) -> GuiOptions:
+    from .options import GuiOptions
+
     return GuiOptions(
         host=getattr(args, "host", None),
         port=getattr(args, "port", None),
@@ -73,6 +77,8 @@ def options_from_args(args: argparse.Namespace) -> GuiOptions:
 
 def demo_fleet_options(options: GuiOptions, endpoints: list[tuple[str, int]]) -> GuiOptions:
     """The window on every simulated robot of ``--demo --robots N``."""
+    from dataclasses import replace
+
     from ..settings.store import DirectRobot
 
     robots = tuple(DirectRobot(name, "127.0.0.1", port) for name, port in endpoints)
@@ -81,6 +87,10 @@ def demo_fleet_options(options: GuiOptions, endpoints: list[tuple[str, int]]) ->
 
 def run_gui(args: argparse.Namespace) -> int:
     """Open the window; with ``--demo`` run the simulator beside it for as long as the window lives."""
+    from dataclasses import replace
+
+    from ..settings.store import parse_central
+
     options = options_from_args(args)
     if options.port is not None and not 1 <= options.port <= 65535:
         print(f"rtmu: --port {options.port} is not 1…65535", file=sys.stderr)

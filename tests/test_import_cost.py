@@ -1,0 +1,117 @@
+"""What starting a command loads: counted in fresh interpreters, never timed (issue 28).
+
+``rtmu --version``, every ``rtmu SUB --help``, a script's ``rtmu status --once`` and each guardian
+process pay their imports at every start. numpy, GTK, PIL, scikit-image, the recorder (foxglove-sdk,
+mcap) and — for the command line — asyncio and the connection are imported by the code that needs
+them, when it runs; these tests fail the day a module-level import pulls one of them in again, and
+name the chain that did.
+"""
+
+from __future__ import annotations
+
+import json
+import os
+import subprocess
+import sys
+from pathlib import Path
+
+import pytest
+
+import rtmu
+
+SRC = Path(rtmu.__file__).resolve().parents[1]
+
+HEAVY = ("numpy", "gi", "PIL", "skimage", "scipy", "foxglove", "mcap", "cairo")
+"""Never loaded by these entry points (GTK comes in through ``gi``)."""
+RECORDER_INSIDE = ("rtmu.recorder.",)
+"""The recorder's modules (its package and ``topics`` are names only; see ``rtmu/recorder/__init__``)."""
+NETWORK = ("asyncio", "rtmu.client.connection", "rtmu.client.runner", "rtmu.client.session", "rtmu.sim.")
+"""What a parser needs no part of: the command that runs loads it."""
+
+
+def loaded_by(code: str) -> list[str]:
+    """The modules in ``sys.modules`` after running ``code`` in a fresh interpreter (this tree first)."""
+    probe = f"{code}\nimport json, sys\nprint(json.dumps(sorted(sys.modules)))\n"
+    env = {**os.environ, "PYTHONPATH": str(SRC)}
+    out = subprocess.run([sys.executable, "-c", probe], capture_output=True, text=True, env=env, timeout=120)
+    assert out.returncode == 0, out.stderr[-2000:]
+    return list(json.loads(out.stdout.splitlines()[-1]))
+
+
+def offending(modules: list[str], *, network: bool) -> list[str]:
+    bad = [m for m in modules if m.split(".")[0] in HEAVY]
+    bad += [m for m in modules if m.startswith(RECORDER_INSIDE) and m != "rtmu.recorder.topics"]
+    if network:
+        bad += [m for m in modules if m == "asyncio" or m.startswith(NETWORK)]
+    return bad
+
+
+def why(module: str, code: str) -> str:
+    """Who imported ``module`` first, as ``-X importtime`` nests it (for the failure message)."""
+    env = {**os.environ, "PYTHONPATH": str(SRC)}
+    out = subprocess.run([sys.executable, "-X", "importtime", "-c", code], capture_output=True, text=True,
+                         env=env, timeout=120)  # fmt: skip
+    lines = [line.split("|")[-1].rstrip() for line in out.stderr.splitlines() if "|" in line]
+    for i, line in enumerate(lines):
+        if line.strip() == module:
+            depth = len(line) - len(line.lstrip())
+            chain = [line.strip()]
+            for later in lines[i + 1 :]:  # importtime prints a module after what it imported
+                d = len(later) - len(later.lstrip())
+                if d < depth:
+                    chain.append(later.strip())
+                    depth = d
+            return " ← ".join(chain)
+    return module
+
+
+def run_main(argv: list[str]) -> str:
+    """Code that runs ``rtmu ARGV`` (its output and exit swallowed)."""
+    return (
+        "import contextlib, io\nfrom rtmu.cli import main\n"
+        f"with contextlib.suppress(SystemExit), contextlib.redirect_stdout(io.StringIO()): main({argv!r})"
+    )
+
+
+def check(code: str, *, network: bool) -> list[str]:
+    modules = loaded_by(code)
+    bad = offending(modules, network=network)
+    return [why(m, code) for m in bad[:3]] + ([f"… {len(bad) - 3} more"] if len(bad) > 3 else [])
+
+
+def test_importing_rtmu_loads_nothing_else() -> None:
+    modules = loaded_by("import rtmu")
+    assert [m for m in modules if m.startswith("rtmu")] == ["rtmu"]
+
+
+def test_the_command_line_and_every_subcommand_parser_stay_light() -> None:
+    """``build_parser()`` imports every subcommand module (what ``rtmu --help`` does)."""
+    assert check("from rtmu.cli import build_parser; build_parser()", network=True) == []
+
+
+def test_version_imports_no_subcommand() -> None:
+    modules = loaded_by(run_main(["--version"]))
+    assert offending(modules, network=True) == []
+    assert [
+        m for m in modules if m.startswith("rtmu.subcommands.") and m != "rtmu.subcommands._integration"
+    ] == []
+
+
+@pytest.mark.parametrize("name", ["status", "drive", "bridge", "record", "video", "sim"])
+def test_a_subcommand_help_loads_that_subcommand_only(name: str) -> None:
+    modules = loaded_by(run_main([name, "--help"]))
+    assert offending(modules, network=True) == []
+    others = {m.split(".")[2] for m in modules if m.startswith("rtmu.subcommands.") and m.count(".") == 2}
+    others -= {name, *(m for m in others if m.startswith("_"))}
+    assert len(others) <= 1, f"rtmu {name} --help loads other subcommands: {sorted(others)}"  # video: image's
+
+
+def test_status_loads_no_numpy_gtk_or_recorder() -> None:
+    """What ``rtmu status --once`` needs: the connection and the status payloads, nothing heavy."""
+    modules = ("subcommands.status", "client.connection", "client.ld_data", "protocol.payloads.robot")
+    code = "import " + ", ".join(f"rtmu.{m}" for m in modules)
+    assert check(code, network=False) == []
+
+
+def test_the_guardian_child_loads_no_numpy_gtk_or_recorder() -> None:
+    assert check("import rtmu.guardian.child", network=False) == []
