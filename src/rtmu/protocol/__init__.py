@@ -10,8 +10,9 @@ checksum function is ``rtmu.protocol.checksum.checksum`` (the package's ``checks
 
 from __future__ import annotations
 
-import importlib
-from typing import TYPE_CHECKING, Any
+from typing import TYPE_CHECKING
+
+from ..base import lazy
 
 if TYPE_CHECKING:
     from .commands import ClientCommand, ClientType, RejectReason, ServerCommand
@@ -21,33 +22,29 @@ if TYPE_CHECKING:
     from .fields import FieldReader, FieldWriter
     from .packet import MAX_LENGTH, MAX_PAYLOAD, Packet, encode_packet
 
-_HOMES = {
-    "ClientCommand": "commands",
-    "ClientType": "commands",
-    "RejectReason": "commands",
-    "ServerCommand": "commands",
-    "DataEntry": "datalist",
-    "DataList": "datalist",
-    "DropStats": "decoder",
-    "PacketDecoder": "decoder",
-    "FieldUnderrun": "errors",
-    "PacketTooLong": "errors",
-    "PayloadError": "errors",
-    "ProtocolError": "errors",
-    "FieldReader": "fields",
-    "FieldWriter": "fields",
-    "MAX_LENGTH": "packet",
-    "MAX_PAYLOAD": "packet",
-    "Packet": "packet",
-    "encode_packet": "packet",
-}
-
-
-def __getattr__(name: str) -> Any:
-    home = _HOMES.get(name)
-    if home is None:
-        raise AttributeError(f"module {__name__!r} has no attribute {name!r}")
-    return getattr(importlib.import_module(f"{__name__}.{home}"), name)
+__getattr__ = lazy.exports(
+    __name__,
+    {
+        "ClientCommand": "commands",
+        "ClientType": "commands",
+        "RejectReason": "commands",
+        "ServerCommand": "commands",
+        "DataEntry": "datalist",
+        "DataList": "datalist",
+        "DropStats": "decoder",
+        "PacketDecoder": "decoder",
+        "FieldUnderrun": "errors",
+        "PacketTooLong": "errors",
+        "PayloadError": "errors",
+        "ProtocolError": "errors",
+        "FieldReader": "fields",
+        "FieldWriter": "fields",
+        "MAX_LENGTH": "packet",
+        "MAX_PAYLOAD": "packet",
+        "Packet": "packet",
+        "encode_packet": "packet",
+    },
+)
 
 
 __all__ = [

@@ -13,26 +13,17 @@ The package imports its modules when first asked for one of the names below (or 
 
 from __future__ import annotations
 
-import importlib
-from typing import TYPE_CHECKING, Any
+from typing import TYPE_CHECKING
+
+from ..base import lazy
 
 if TYPE_CHECKING:
     from .recorder import Recorder, RecorderConfig
     from .recording import Limits, Recording
 
-_HOMES = {
-    "Recorder": "recorder",
-    "RecorderConfig": "recorder",
-    "Limits": "recording",
-    "Recording": "recording",
-}
-
-
-def __getattr__(name: str) -> Any:
-    home = _HOMES.get(name)
-    if home is None:
-        raise AttributeError(f"module {__name__!r} has no attribute {name!r}")
-    return getattr(importlib.import_module(f"{__name__}.{home}"), name)
-
+__getattr__ = lazy.exports(
+    __name__,
+    {"Recorder": "recorder", "RecorderConfig": "recorder", "Limits": "recording", "Recording": "recording"},
+)
 
 __all__ = ["Limits", "Recorder", "RecorderConfig", "Recording"]
