@@ -9,10 +9,14 @@ from __future__ import annotations
 
 import os
 import subprocess
+import sys
 import time
 from collections.abc import Callable
 from dataclasses import dataclass
+from pathlib import Path
 from typing import Any
+
+TICKS = os.sysconf("SC_CLK_TCK")
 
 
 @dataclass
@@ -86,3 +90,45 @@ def start_xvfb() -> tuple[subprocess.Popen[bytes], str]:
         proc.kill()
         raise RuntimeError("Xvfb did not start")
     return proc, f":{display}"
+
+
+def cpu_seconds(pid: int, *, descendants: bool = True) -> float:
+    """utime + stime of ``pid`` and (unless told not to) every live descendant, from ``/proc``."""
+    children: dict[int, list[int]] = {}
+    for entry in Path("/proc").iterdir():
+        if not entry.name.isdigit():
+            continue
+        try:
+            fields = (entry / "stat").read_text().rsplit(")", 1)[1].split()
+        except OSError:
+            continue
+        children.setdefault(int(fields[1]), []).append(int(entry.name))
+    total, todo = 0.0, [pid]
+    while todo:
+        p = todo.pop()
+        try:
+            fields = Path(f"/proc/{p}/stat").read_text().rsplit(")", 1)[1].split()
+        except OSError:
+            continue
+        total += (int(fields[11]) + int(fields[12])) / TICKS
+        todo += children.get(p, []) if descendants else []
+    return total
+
+
+def as_installed(env: dict[str, str]) -> dict[str, str]:
+    """``env`` for a measured process that should start as an installed RTMU does: with its bytecode
+    cached. (A session that sets ``PYTHONDONTWRITEBYTECODE`` would otherwise make every start compile
+    every module again — a second of CPU in the window's launch.) Call :func:`cache_bytecode` first."""
+    out = dict(env)
+    out.pop("PYTHONDONTWRITEBYTECODE", None)
+    return out
+
+
+def cache_bytecode() -> None:
+    """Compile ``src/rtmu`` and ``bench`` to ``__pycache__`` (as installing a wheel does), quietly."""
+    repo = Path(__file__).resolve().parents[1]
+    subprocess.run(
+        [sys.executable, "-m", "compileall", "-q", str(repo / "src" / "rtmu"), str(repo / "bench")],
+        check=False,
+        stdout=subprocess.DEVNULL,
+    )

@@ -24,6 +24,8 @@ class FakeView:
         self.states: dict[str, CommandState] = {}
         self.state_calls = 0
         self.password_asks: list[tuple[Profile, Callable[[str | None], None]]] = []
+        self.drives = 0
+        """Drives begun (``driving`` calls): a window starts its lease-renewal timer on each."""
 
     def notify(self, notice: Notice) -> None:
         self.notices.append((notice.level, notice.text))
@@ -35,6 +37,9 @@ class FakeView:
 
     def ask_password(self, profile: Profile, answer: Callable[[str | None], None]) -> None:
         self.password_asks.append((profile, answer))
+
+    def driving(self) -> None:
+        self.drives += 1
 
     def texts(self) -> list[str]:
         return [t for _, t in self.notices]

@@ -106,6 +106,26 @@ def idle(seconds: float) -> None:
     pump(lambda: time.monotonic() >= end, seconds + 5, "time to pass")
 
 
+class LoopProbe:
+    """A 100 ms GLib timer of the test's own, counting: proof that nothing blocks the main loop.
+
+    (The window's own timers run only while something needs them — once a second at rest — so
+    they are no measure of the loop's liveness.) ``close()`` removes it."""
+
+    def __init__(self) -> None:
+        self.beats = 0
+        self._source = GLib.timeout_add(100, self._beat)
+
+    def _beat(self) -> bool:
+        self.beats += 1
+        return True
+
+    def close(self) -> None:
+        if self._source:
+            GLib.source_remove(self._source)
+            self._source = 0
+
+
 class Gui:
     """One RTMU application connected to a simulator, and what a test does with it."""
 

@@ -33,6 +33,10 @@ from .lease import DriveGovernor, EndReason, SendRatios, SendStop
 log = logging.getLogger(__name__)
 
 HEART_MAX_SLEEP = 0.25
+HEART_IDLE_SLEEP = 1.0
+"""Longest sleep while nothing is driven: a grant, a stop, a returning link and status wake the heart
+at once, and the link's next change of level is its own deadline — so at rest it wakes once a second
+(a guardian's reports, the health published) rather than ten times."""
 STEP_TIMEOUT = 2.0
 """``step()`` gives up (ClientTimeout) if the heart has not run within this many seconds."""
 
@@ -226,8 +230,10 @@ class DriveFeed(Feed):
             except Exception:
                 log.exception("session heart step failed")
             self._stepped.set()
-            wake = min(self.governor.next_wakeup(now), self.health.next_change(now))
-            delay = min(HEART_MAX_SLEEP, max(0.0, wake - self.ctx.clock()))
+            idle = not self.governor.driving and not self.lease.view(now).live
+            wake = min(now + HEART_IDLE_SLEEP if idle else self.governor.next_wakeup(now),
+                       self.health.next_change(now))  # fmt: skip
+            delay = min(HEART_IDLE_SLEEP if idle else HEART_MAX_SLEEP, max(0.0, wake - self.ctx.clock()))
             with contextlib.suppress(TimeoutError):
                 async with asyncio.timeout(delay):
                     await self._kick.wait()

@@ -2,8 +2,9 @@
 
 The guardian is a separate process with its own login that stops the robot when this process is
 killed, stopped by a signal, or silent past its lease while driving. The drive loop arms it before
-the first ``ratioDrive`` of a drive and disarms it after its own stop; the network loop beats for it
-here, the window's GTK timer through ``ClientRunner.ui_heartbeat``.
+the first ``ratioDrive`` of a drive and disarms it after its own stop; while it is armed the network
+loop beats for it here, the window's GTK timer through ``ClientRunner.ui_heartbeat``. Disarmed, no
+beat is wanted (its watch starts afresh at the next arm), so none is sent and no timer runs.
 """
 
 from __future__ import annotations
@@ -24,6 +25,8 @@ class GuardianLink:
         self._notice = notice
         self._timeout = connect_timeout
         self.handle: GuardianHandle | None = None
+        self._beating: GuardianHandle | None = None
+        """The guardian whose heartbeat chain runs (from its arming until it is disarmed)."""
 
     def start(self, target: Target) -> None:
         self.close(goodbye=True)
@@ -33,19 +36,23 @@ class GuardianLink:
             )
         except OSError as exc:
             self.unavailable(f"it could not be started: {exc.strerror or exc}")
-            return
-        self._beat(self.handle)
 
     def _beat(self, guardian: GuardianHandle) -> None:
-        """The network thread's heartbeat to the guardian, every BEAT_PERIOD while it lives."""
-        if self.handle is not guardian:
+        """The network thread's heartbeat to the guardian, every BEAT_PERIOD while it is armed."""
+        if self.handle is not guardian or not guardian.armed:
+            if self._beating is guardian:
+                self._beating = None
             return
         guardian.beat_net()
         asyncio.get_running_loop().call_later(BEAT_PERIOD, self._beat, guardian)
 
     def arm(self) -> None:
-        if self.handle is not None:
-            self.handle.arm()
+        guardian = self.handle
+        if guardian is not None:
+            guardian.arm()
+            if self._beating is not guardian:
+                self._beating = guardian
+                self._beat(guardian)
 
     def disarm(self) -> None:
         if self.handle is not None:

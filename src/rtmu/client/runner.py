@@ -428,16 +428,19 @@ class ClientRunner:
         """Wait until the network side has handled everything submitted so far and run one heart step."""
         self.call(self._session.step, timeout=timeout)
 
-    def ui_heartbeat(self) -> None:
-        """The UI thread is alive: call every ``rtmu.guardian.handle.BEAT_PERIOD`` s from its timer.
+    def ui_heartbeat(self) -> bool:
+        """The UI thread is alive: call every ``rtmu.guardian.handle.BEAT_PERIOD`` s from its timer
+        while the guardian is armed (the answer: whether it still is).
 
         The guardian process stops the robot when these (or the network thread's) stop while
         driving. A plain write to a pipe; never blocks.
         """
         session = self.session
         guardian = session.guardian if session is not None else None
-        if guardian is not None:
-            guardian.beat_ui()
+        if guardian is None:
+            return False
+        guardian.beat_ui()
+        return guardian.armed
 
     def status_age(self) -> float | None:
         """Seconds since the last status packet, read now; None when not connected.

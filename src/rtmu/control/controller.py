@@ -83,6 +83,10 @@ class View(Protocol):
     def open_dialog(self, name: str) -> None:
         """Open the dialog a command needs (``turn``: an angle, ``go``: a distance)."""
 
+    def driving(self) -> None:
+        """A held drive began (a lease was granted): from now until it ends, call :meth:`Controller.tick`
+        every :data:`TICK` s (a window runs that timer only while something is driven)."""
+
 
 class ClientLink(Protocol):
     """The network side as the controller sees it (``rtmu.client.ClientRunner``); every call returns at once
@@ -148,6 +152,9 @@ class NoView:
         answer(None)
 
     def open_dialog(self, name: str) -> None:
+        pass
+
+    def driving(self) -> None:
         pass
 
 
@@ -358,6 +365,7 @@ class Controller:
                 self._halt_held(lease.ended or EndReason.LAPSED)
                 return
             self._generation = lease.grant(ratios)
+            self.view.driving()
 
     def _halt_held(self, reason: EndReason, *, quiet: bool = False) -> None:
         """Motion was stopped for ``reason`` while keys were held: block them until released.

@@ -156,6 +156,11 @@ class Gamepad:
     def state(self) -> PadState:
         return self._state
 
+    @property
+    def present(self) -> bool:
+        """A pad is connected (only then does :meth:`tick` need calling)."""
+        return self._device is not None
+
     def connected(self, device: object, name: str) -> bool:
         """A pad appeared; True if it is now the one we listen to."""
         if self._device is not None:

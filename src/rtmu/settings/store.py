@@ -51,6 +51,7 @@ import contextlib
 import logging
 import math
 import os
+import threading
 import time
 import tomllib
 from collections.abc import Mapping
@@ -524,14 +525,26 @@ class KeyringSecrets:
     """
 
     def __init__(self, backend: Any | None = None) -> None:
-        self._keyring = backend if backend is not None else _load_keyring()
+        self._given = backend
+        self._loaded = backend is not None
+        self._lock = threading.Lock()
+
+    @property
+    def _keyring(self) -> Any | None:
+        """The backend, found the first time it is needed (finding it loads the keyring package and
+        its plug-ins: 30 MiB and a tenth of a second that a window without a password never needs)."""
+        with self._lock:
+            if not self._loaded:
+                self._given = _load_keyring()
+                self._loaded = True
+            return self._given
 
     @property
     def available(self) -> bool:
         return self._keyring is not None
 
     def get(self, profile: Profile) -> str | None:
-        if self._keyring is None or not profile.user:
+        if not profile.user or self._keyring is None:
             return None
         try:
             return self._keyring.get_password(KEYRING_SERVICE, profile.keyring_user)
@@ -541,7 +554,7 @@ class KeyringSecrets:
 
     def set(self, profile: Profile, password: str) -> bool:
         """Remember ``password``; False when no keyring is usable (the caller should then not promise it)."""
-        if self._keyring is None or not profile.user:
+        if not profile.user or self._keyring is None:
             return False
         try:
             self._keyring.set_password(KEYRING_SERVICE, profile.keyring_user, password)
@@ -551,7 +564,7 @@ class KeyringSecrets:
         return True
 
     def forget(self, profile: Profile) -> None:
-        if self._keyring is None or not profile.user:
+        if not profile.user or self._keyring is None:
             return
         with contextlib.suppress(Exception):  # nothing stored is fine
             self._keyring.delete_password(KEYRING_SERVICE, profile.keyring_user)

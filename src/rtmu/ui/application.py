@@ -44,7 +44,6 @@ from .fleet_bind import FleetBinding  # noqa: E402
 from .keys import accels_for  # noqa: E402
 from .options import APP_ID, GuiOptions  # noqa: E402
 from .replay_bar import ReplayBar  # noqa: E402
-from .replay_mode import REPLAY_CONFIG, open_replay, replay_profile, show_replay  # noqa: E402
 from .selected_model import SelectedModel  # noqa: E402
 from .style import install_css  # noqa: E402
 from .window import MainWindow  # noqa: E402
@@ -144,14 +143,16 @@ class RtmuApplication(Gtk.Application):
         # The guardian: a separate process that stops the robot if this one is killed or frozen.
         # One download per map file for the whole fleet (robots of one site share their map).
         config = SessionConfig(guardian=self.options.guardian, shared_maps=SharedMaps())
-        replay = (
-            open_replay(self.options.replay, self.options.replay_conn)
-            if self.options.replay is not None
-            else None
-        )
+        replay = None
+        if self.options.replay is not None:  # the recorder's replay is loaded for a replay only
+            from .replay_mode import open_replay
+
+            replay = open_replay(self.options.replay, self.options.replay_conn)
         roster: Roster | None = None
         mirror: SelectedModel | None = None
         if replay is not None:  # a recording: its own profile and config, not recorded again
+            from .replay_mode import REPLAY_CONFIG, replay_profile
+
             profile, auto_connect, config = replay_profile(replay.recorded.path), False, REPLAY_CONFIG
             self.options = replace(self.options, persist=False)
             session = self.fleet.open(
@@ -185,7 +186,7 @@ class RtmuApplication(Gtk.Application):
                 profile=session.controller.profile,
                 profiles=self.settings.profiles,
                 secrets=self.secrets,
-                keyring_available=self.secrets.available,
+                keyring_available=lambda: self.secrets.available,
                 profile_saved=self.profile_saved,
                 model=mirror,
             )
@@ -212,6 +213,8 @@ class RtmuApplication(Gtk.Application):
         for note in self._fleet_notes:
             self._announce(note)
         if replay is not None:
+            from .replay_mode import show_replay
+
             self.replay_bar = show_replay(window, session, replay)
         elif auto_connect:
             window.connect_now()

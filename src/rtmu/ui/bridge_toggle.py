@@ -10,11 +10,15 @@ from Foxglove is ``rtmu bridge --allow-drive``.
 from __future__ import annotations
 
 from collections.abc import Callable
+from typing import TYPE_CHECKING
 
 from ..base.notices import Kind, Notice
 from ..fleet.sessions import RobotSession
-from ..recorder.bridge import DEFAULT_PORT, Bridge
+from ..recorder.topics import BRIDGE_PORT
 from ..values.state import ConnectionChanged, MapChanged, RobotChanged, StateChange
+
+if TYPE_CHECKING:  # foxglove's WebSocket server is loaded when the bridge is switched on
+    from ..recorder.bridge import Bridge
 
 HOST = "127.0.0.1"
 
@@ -28,7 +32,7 @@ class BridgeToggle:
         tell: Callable[[Notice], None],
         *,
         failed: Callable[[], None] | None = None,
-        port: int = DEFAULT_PORT,
+        port: int = BRIDGE_PORT,
     ) -> None:
         self.session = session
         self.tell = tell
@@ -48,6 +52,8 @@ class BridgeToggle:
             self.failed()
 
     def _start(self) -> bool:
+        from ..recorder.bridge import Bridge
+
         bridge = Bridge(host=HOST, port=self.port)
         try:
             bridge.start()

@@ -22,6 +22,7 @@ gi.require_version("Gdk", "4.0")
 from gi.repository import Gdk, GLib, Gtk, Pango  # noqa: E402
 
 from ..model.observables import CameraImage  # noqa: E402
+from .toolbar import age_text  # noqa: E402
 
 MAX_SIDE = 4096
 INSET_SIZE = (176, 132)
@@ -264,10 +265,11 @@ class CameraView(Gtk.Box):
             self.info.set_text("Requesting…" if self.waiting else (self.error or "No picture"))
             return
         age = max(0.0, now - self.image.received_at)
-        text = f"{self.image.width}×{self.image.height} from {self.image.source} · {_age(age)} old"
+        text = f"{self.image.width}×{self.image.height} from {self.image.source} · {age_text(age)} old"
         if self.waiting:
             text += " · requesting a new one…"
-        self.info.set_text(text)
+        if text != self.info.get_text():
+            self.info.set_text(text)
 
     def _show_status(self, text: str, *, busy: bool) -> None:
         self.status_label.set_text(text)
@@ -336,16 +338,22 @@ class CameraInset(Gtk.Box):
     def tick(self) -> None:
         """Update the age (the window calls this on its slow timer)."""
         if self.received_at is None:
-            self.age_label.set_text("")
-            self.set_tooltip_text(None)
+            self._show_age("", None)
             return
-        age = _age(max(0.0, self.clock() - self.received_at))
-        self.age_label.set_text(age if self.live else f"{age} · link lost")
-        self.set_tooltip_text(
+        age = age_text(max(0.0, self.clock() - self.received_at))
+        self._show_age(
+            age if self.live else f"{age} · link lost",
             f"Camera picture taken {age} ago (click or Esc for the camera view)"
             if self.live
-            else f"Camera picture taken {age} ago, before the link was lost"
+            else f"Camera picture taken {age} ago, before the link was lost",
         )
+
+    def _show_age(self, text: str, tooltip: str | None) -> None:
+        """Labels and tooltips are set only when they change: each set costs GTK a relayout."""
+        if text != self.age_label.get_text():
+            self.age_label.set_text(text)
+        if tooltip != self.get_tooltip_text():
+            self.set_tooltip_text(tooltip)
 
     def place(self, *, corner_free: bool) -> None:
         """Bottom left (away from the banners, the zoom buttons and the note); top right if the D-pad
@@ -381,11 +389,3 @@ class _SizedPicture(Gtk.Picture):
     ) -> tuple[int, int, int, int]:
         n = self._size[0] if orientation == Gtk.Orientation.HORIZONTAL else self._size[1]
         return n, n, -1, -1
-
-
-def _age(seconds: float) -> str:
-    if seconds < 60:
-        return f"{seconds:.1f} s"
-    if seconds < 3600:
-        return f"{seconds / 60:.0f} min"
-    return f"{seconds / 3600:.1f} h"

@@ -69,6 +69,9 @@ class BackgroundView:
     def open_dialog(self, name: str) -> None:
         pass
 
+    def driving(self) -> None:
+        pass  # a robot in the background takes no keys
+
 
 class FleetBinding:
     """See the module notes. ``close`` unhooks everything (the window's shutdown)."""

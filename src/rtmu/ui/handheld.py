@@ -24,7 +24,7 @@ gi.require_version("Gtk", "4.0")
 from gi.repository import Gdk, Gio, GLib, Gtk  # noqa: E402
 
 from ..control.controller import TICK, Controller  # noqa: E402
-from ..control.gamepad import Gamepad  # noqa: E402
+from ..control.gamepad import Gamepad, PadState  # noqa: E402
 from .alarm_view import AlarmView  # noqa: E402
 from .gamepad import ManettePads  # noqa: E402
 from .gamepad_status import GamepadStatus  # noqa: E402
@@ -60,7 +60,7 @@ class Handheld:
         _install_css(window.get_display())
         self.pad = Gamepad(window.controller, window.clock)
         self.pad_status = GamepadStatus()
-        self.pad.on_change = self.pad_status.show_state
+        self.pad.on_change = self._pad_changed
         window.map_page.add_overlay(self.pad_status)
         self.pads = ManettePads(self.pad)
         self.alarms = AlarmView(window.model, window.banners, window.get_display().beep, muted=muted)
@@ -73,7 +73,8 @@ class Handheld:
         self.sound_action.connect("activate", self._toggle_sound)
         window.add_action(self.sound_action)
         self._focus_handler = window.connect("notify::is-active", self._on_active)
-        self._tick = GLib.timeout_add(int(TICK * 1000), self._on_tick)
+        self._tick = 0
+        """The pad's timer (stick pushes held back, a silent pad): runs only while a pad is connected."""
 
     def set_muted(self, muted: bool) -> None:
         self.alarms.muted = muted
@@ -97,9 +98,17 @@ class Handheld:
     def _on_active(self, *_a: object) -> None:
         self.pad.focus(self.window.is_active())
 
+    def _pad_changed(self, state: PadState) -> None:
+        self.pad_status.show_state(state)
+        if self.pad.present and not self._tick:
+            self._tick = GLib.timeout_add(int(TICK * 1000), self._on_tick)
+
     def _on_tick(self) -> bool:
         self.pad.tick()
-        return True
+        if self.pad.present:
+            return True
+        self._tick = 0
+        return False
 
     def close(self) -> None:
         """Release a pad that drove, stop timers and observers (idempotent)."""

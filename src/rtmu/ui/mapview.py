@@ -84,6 +84,9 @@ class MapStage(Gtk.DrawingArea):
         self.frames = 0
         self.last_frame_complete = False
         """The last frame showed a map with every visible tile ready."""
+        self.drawn_stale = True
+        """The last frame drew the robot greyed (or not at all): the window's timer redraws only when
+        :meth:`robot_is_stale` no longer says the same."""
         self.labels = overlays.LabelCache()
         self.tiles = TileCache(self._tiles_ready_from_worker)
         self._tiles_pending = False
@@ -326,7 +329,7 @@ class MapStage(Gtk.DrawingArea):
         """Draw one frame; True when a map is shown with every visible tile ready."""
         r = self.model.robot.value
         has_map = self.model.map.value.state == "ready"
-        stale = self.robot_is_stale()
+        stale = self.drawn_stale = self.robot_is_stale()
         drawings = self.model.drawings.value
         scene = Scene(
             labels=self.labels,

@@ -4,7 +4,10 @@ Values come from the model; :meth:`StatusToolbar.refresh` runs on the window's
 timer as well, because *age* changes without any new value: a value older than
 :data:`STALE_AFTER` (or any value while the link is not OK) is greyed and its
 tooltip says how old it is. Stale data never looks fresh. A value the server
-does not publish (Wi-Fi on most servers) is greyed with a tooltip saying so.
+does not publish (Wi-Fi on most servers) is greyed with a tooltip saying so. Ages are shown in
+whole seconds (:func:`age_text`), so a connected window's labels change once a second at most,
+not with every status packet, and a style class is touched only when it changes: each change
+costs GTK a restyle and a repaint of the header.
 
 Every column has a fixed width (its value label is exactly ``width_chars`` wide),
 so nothing shifts sideways when "—" becomes "12.8 V". A narrow window hides the
@@ -31,6 +34,17 @@ from .nav_text import loc_level, loc_text, outcome_status  # noqa: E402
 
 STALE_AFTER = 1.0
 """Seconds after which a pose/battery value is shown as stale (status arrives at 10 Hz)."""
+
+
+def age_text(seconds: float) -> str:
+    """An age as the window shows it: whole seconds, then minutes, then hours."""
+    if seconds < 60:
+        return f"{int(seconds)} s"
+    if seconds < 3600:
+        return f"{seconds / 60:.0f} min"
+    return f"{seconds / 3600:.1f} h"
+
+
 DASH = "—"
 HIDE_FIRST = ("rot", "vel", "wifi", "th", "safe", "y", "x", "speed")
 """Columns a narrow window gives up, in this order (the last one given up comes back first)."""
@@ -57,6 +71,16 @@ class Cell(Gtk.Box):
         self.append(row)
         self.stale = False
         self._tooltip: str | None = None
+        self._level: str | None = None
+
+    def show_level(self, css_class: str | None) -> None:
+        """One style class of a family (``link-ok``, ``link-stale`` …) in place of the one before."""
+        if css_class != self._level:
+            if self._level is not None:
+                self.remove_css_class(self._level)
+            if css_class is not None:
+                self.add_css_class(css_class)
+            self._level = css_class
 
     def show_value(self, text: str, *, stale: bool, tooltip: str | None = None) -> None:
         if self.value.get_text() != text:
@@ -318,14 +342,12 @@ class StatusToolbar(Gtk.ScrolledWindow):
 
     def _link(self, conn: ConnectionState, health, age: float | None) -> None:
         cell = self.cells["link"]
-        for level in LinkLevel:
-            cell.remove_css_class(f"link-{level.value}")
         if conn.phase is not Phase.CONNECTED:
             text = {Phase.CONNECTING: "connecting", Phase.RECONNECTING: "reconnecting"}.get(
                 conn.phase, "down"
             )
             cell.show_value(text, stale=True, tooltip=f"Not connected ({conn.phase.value})")
-            cell.add_css_class(f"link-{LinkLevel.DOWN.value}")
+            cell.show_level(f"link-{LinkLevel.DOWN.value}")
             return
         rtt = (
             DASH
@@ -334,12 +356,12 @@ class StatusToolbar(Gtk.ScrolledWindow):
             if health.rtt_ms < 10
             else f"{health.rtt_ms:.0f} ms"
         )
-        age_text = DASH if age is None else f"{age:.1f} s"
+        age_shown = DASH if age is None else age_text(age)
         tip = (
-            f"Link {health.level.value}: round trip {rtt}, last status {age_text} ago, "
+            f"Link {health.level.value}: round trip {rtt}, last status {age_shown} ago, "
             f"{health.dropped} bad packets dropped"
         )
-        text = f"{rtt} {age_text}"
+        text = f"{rtt} {age_shown}"
         if health.ping_failures > 0:
             # The link may look alive (status still arriving) while the server no longer hears us.
             text = f"no ping ×{health.ping_failures}"
@@ -348,7 +370,7 @@ class StatusToolbar(Gtk.ScrolledWindow):
                 f"commands; driving is stopped\n{tip}"
             )
         cell.show_value(text, stale=health.level is not LinkLevel.OK or health.ping_failures > 0, tooltip=tip)
-        cell.add_css_class(f"link-{health.level.value}")
+        cell.show_level(f"link-{health.level.value}")
 
 
 def _stale_reason(have: bool, age: float | None, conn: ConnectionState, level: LinkLevel) -> str | None:
@@ -358,10 +380,10 @@ def _stale_reason(have: bool, age: float | None, conn: ConnectionState, level: L
         return "No status from the robot yet"
     if level is not LinkLevel.OK:
         return (
-            f"Link {level.value}: no fresh status for {age:.1f} s"
+            f"Link {level.value}: no fresh status for {age_text(age)}"
             if age is not None
             else f"Link {level.value}"
         )
     if age is not None and age > STALE_AFTER:
-        return f"No update for {age:.1f} s"
+        return f"No update for {age_text(age)}"
     return None

@@ -5,11 +5,12 @@ controller) with the operator's choices (:class:`rtmu.model.observables.Operator
 wires widgets to them and owns nothing else: no socket, no packet, no blocking
 call, no network thread. A red STOP is always on screen:
 first in the header bar, and in the slim bar that replaces the header in full
-screen (``bars``). Its two timers are the UI's
-heartbeat: every :data:`rtmu.control.controller.TICK` it renews the drive lease
-(``controller.tick``) — if this loop ever stalls, the lease lapses and the
-network side stops the robot — and a slower one refreshes ages (stale values,
-picture age).
+screen (``bars``). Its timers are the UI's heartbeat: while a drive is held, every
+:data:`rtmu.control.controller.TICK` it renews the drive lease (``controller.tick``) — if this
+loop ever stalls, the lease lapses and the network side stops the robot — and beats for the
+guardian; they start when a drive begins (the controller's ``View.driving``) and end once it
+is over and the guardian disarmed. One slow timer (:data:`SLOW_TICK`) refreshes ages (stale
+values, picture age) once a second, so a window at rest wakes once a second, not 35 times.
 
 Banners have topics (see ``banners``): the connection's life (connecting,
 connected, failed, lost → reconnecting (n)) is drawn from the model into ONE
@@ -104,8 +105,8 @@ from .split_view import SplitView  # noqa: E402
 from .toolbar import StatusToolbar  # noqa: E402
 from .viewport import zoom_label  # noqa: E402
 
-REFRESH_EVERY = 3
-"""Ticks between refreshes of ages (toolbar, picture): 0.3 s."""
+SLOW_TICK = 1.0
+"""Seconds between the window's own ticks: ages (toolbar, picture), the stale look, the loop-lag watch."""
 LOOP_LAG_WARN = 0.5
 """Seconds without a network-loop heartbeat after which the window warns that drive commands (and
 stops) are not going out; the warning goes once the lag is under half of this again."""
@@ -171,6 +172,9 @@ class _View:
     def open_dialog(self, name: str) -> None:
         self.window.open_dialog(name)
 
+    def driving(self) -> None:
+        self.window.drive_started()
+
 
 class MainWindow(Gtk.ApplicationWindow):
     """See the module notes. ``profile_saved(profile, password)`` is the app's hook for settings."""
@@ -184,7 +188,7 @@ class MainWindow(Gtk.ApplicationWindow):
         profile: Profile,
         profiles: Mapping[str, Profile] | None = None,
         secrets: SecretStore | None = None,
-        keyring_available: bool = False,
+        keyring_available: bool | Callable[[], bool] = False,
         profile_saved: Callable[[Profile, str | None], None] | None = None,
         clock: Callable[[], float] = time.monotonic,
         model: RobotModel | None = None,
@@ -198,10 +202,12 @@ class MainWindow(Gtk.ApplicationWindow):
         self.clock = clock
         self.profiles = dict(profiles or {})
         self.keyring_available = keyring_available
+        """Whether passwords can be remembered: asked when the settings open (the keyring is loaded
+        only then, or when a password is needed — 30 MiB and 0.1 s a start otherwise)."""
         self._profile_saved = profile_saved
         self._passwords: dict[str, str] = {}
         self.ticks = 0
-        """Counts timer ticks: proof for tests that the main loop is alive."""
+        """Counts the slow timer's ticks (once a second)."""
         self._states: dict[str, CommandState] = {}
         self._dialog: Gtk.Window | None = None
 
@@ -251,11 +257,14 @@ class MainWindow(Gtk.ApplicationWindow):
         ]
         self.connect("notify::is-active", self._on_active)
         self.connect("close-request", self._on_close_request)
-        self._tick_source = GLib.timeout_add(int(TICK * 1000), self._tick)
-        self.handheld = Handheld(self)  # gamepad, alarms, phone layout (after the focus handler above)
+        self._tick_source = GLib.timeout_add(int(SLOW_TICK * 1000), self._tick)
+        self._drive_source = 0
+        """The lease renewal (TICK) while a drive is held; 0 at rest."""
         # The UI thread's heartbeat to the guardian process (rtmu.guardian): it stops the robot
-        # if these stop while driving because this process was killed or frozen.
-        self._beat_source = GLib.timeout_add(int(GUARDIAN_BEAT * 1000), self._beat)
+        # if these stop while driving because this process was killed or frozen. It runs from
+        # the start of a drive until the guardian is disarmed again.
+        self._beat_source = 0
+        self.handheld = Handheld(self)  # gamepad, alarms, phone layout (after the focus handler above)
         self.commands_changed(self.controller.command_states())
         self._on_connection(ConnectionState(), model.connection.value)
         self._on_map(MapModel(), model.map.value)
@@ -590,10 +599,36 @@ class MainWindow(Gtk.ApplicationWindow):
     def _stop_from_dpad(self) -> None:
         self.controller.run("stop")
 
+    def drive_started(self) -> None:
+        """A drive began (the controller granted a lease): renew it and beat for the guardian."""
+        if not self._drive_source:
+            self._drive_source = GLib.timeout_add(int(TICK * 1000), self._drive_tick)
+        if not self._beat_source:
+            self._beat_source = GLib.timeout_add(int(GUARDIAN_BEAT * 1000), self._beat)
+        self.motion.refresh()
+
+    def _driving(self) -> bool:
+        c = self.controller
+        return bool(c.held) or c.analog_active or c.link.lease.view().live
+
+    def _drive_tick(self) -> bool:
+        """While a drive is held: renew its lease; the pill follows the keys. Ends with the drive."""
+        self.controller.tick()
+        self.motion.refresh()
+        if self.stage.robot_is_stale() != self.stage.drawn_stale:
+            self.stage.queue_draw()
+        if self._driving():
+            return True
+        self._drive_source = 0
+        return False
+
     def _beat(self) -> bool:
-        """The GTK thread's heartbeat to the guardian; True keeps the timer."""
-        self._link.ui_heartbeat()
-        return True
+        """The GTK thread's heartbeat to the guardian, until it is disarmed after the drive."""
+        armed = self._link.ui_heartbeat()
+        if armed or self._driving():
+            return True
+        self._beat_source = 0
+        return False
 
     def _command(self, name: str) -> None:
         """A command from a key, the menu or a button: refused with its reason while shown disabled."""
@@ -912,9 +947,10 @@ class MainWindow(Gtk.ApplicationWindow):
         profiles = dict(self.profiles)
         current = self.controller.profile
         profiles.setdefault(current.name, current)
-        dialog = ConnectionDialog(
-            self, profiles, current, on_save=self._settings_saved, keyring_available=self.keyring_available
-        )
+        known = self.keyring_available
+        keyring = known() if callable(known) else known
+        save = self._settings_saved
+        dialog = ConnectionDialog(self, profiles, current, on_save=save, keyring_available=keyring)
         self._dialog = dialog
         dialog.present()
 
@@ -1007,16 +1043,15 @@ class MainWindow(Gtk.ApplicationWindow):
             self.controller.focus_gained()
 
     def _tick(self) -> bool:
+        """Once a second: ages and staleness (nothing else changes them), the network loop's lag."""
         self.ticks += 1
-        self.controller.tick()
         self.motion.refresh()
-        if self.ticks % REFRESH_EVERY == 0:
-            self.toolbar.refresh()
-            self.camera.tick()
-            self.inset.tick()
-            self._check_loop_lag()
-            if self.stage.robot_is_stale() and self.model.robot.value.numbers_at is not None:
-                self.stage.queue_draw()
+        self.toolbar.refresh()
+        self.camera.tick()
+        self.inset.tick()
+        self._check_loop_lag()
+        if self.stage.robot_is_stale() != self.stage.drawn_stale:
+            self.stage.queue_draw()  # the robot greys (or comes back) without a new status
         return True
 
     def _check_loop_lag(self) -> None:
@@ -1046,6 +1081,9 @@ class MainWindow(Gtk.ApplicationWindow):
         if self._tick_source:
             GLib.source_remove(self._tick_source)
             self._tick_source = 0
+        if self._drive_source:
+            GLib.source_remove(self._drive_source)
+            self._drive_source = 0
         if self._beat_source:
             GLib.source_remove(self._beat_source)
             self._beat_source = 0
