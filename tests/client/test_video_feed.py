@@ -125,3 +125,88 @@ def test_a_repeated_old_frame_does_not_slow_the_video_down() -> None:
     late = VideoFrame(64, 48, stamp_jpeg(jpeg(), wall[0] - 3_000_000_000)).encode()
     feed.take(late, 0.01)
     assert "old" in feed.governor.reason
+
+
+# -- pacing: the camera's period learned from its repeats (issue 28) ---------------------------------
+def play_camera(
+    pacer: object, *, fps: float, seconds: float, ready_at, warm_up: float = 3.0, start: float = 0.0
+):  # type: ignore[no-untyped-def]  # noqa: E501
+    """Drive ``pacer`` against a camera model on a simulated clock from ``start``: ``ready_at(t, last)``
+    is the id of the newest frame a request arriving at ``t`` gets, and when it was made (``last``: the
+    id the one before got). Returns (requests, new frames, ages in s of each new frame on arrival)
+    counted after ``warm_up``."""
+    t, last, requests, new, ages = start, -1, 0, 0, []
+    warm_up += start
+    while t < warm_up + seconds:
+        frame, made = ready_at(t + 0.001, last)
+        got = t + 0.002
+        outcome = "new" if frame != last else "repeat"
+        if t >= warm_up:
+            requests += 1
+            if outcome == "new":
+                new += 1
+                ages.append(got - made)
+        last = frame
+        t = max(got, pacer.after(t, outcome, 1.0 / fps))  # type: ignore[attr-defined]
+    return requests, new, ages
+
+
+def periodic(period: float, phase: float = 0.037):  # type: ignore[no-untyped-def]
+    """ARIA's video forwarder: a new picture every ``period`` on its own clock."""
+
+    def ready_at(t: float, _last: int) -> tuple[int, float]:
+        n = int((t - phase) // period)
+        return n, phase + n * period
+
+    return ready_at
+
+
+def on_request(period: float):  # type: ignore[no-untyped-def]
+    """The simulator: a request after ``period`` since the last new picture makes the next one."""
+    made = [-1.0]
+
+    def ready_at(t: float, last: int) -> tuple[int, float]:
+        if t - made[0] >= period:
+            made[0] = t
+            return last + 1, t
+        return last, made[0]
+
+    return ready_at
+
+
+@pytest.mark.parametrize("fps", [30.0, 15.0])
+@pytest.mark.parametrize("camera", ["periodic", "on_request"])
+def test_the_pacer_asks_about_once_per_new_frame_and_soon_after_it(fps: float, camera: str) -> None:
+    from rtmu.client.video_feed import FramePacer
+
+    ready = periodic(0.1) if camera == "periodic" else on_request(0.1)
+    pacer = FramePacer()
+    requests, new, ages = play_camera(pacer, fps=fps, seconds=20.0, ready_at=ready)
+    assert new >= 0.95 * 20 * 10 * (0.95 if camera == "on_request" else 1.0)  # no frame left out
+    assert requests <= 1.2 * new, (requests, new)
+    assert pacer.period == pytest.approx(0.1, rel=0.05)
+    assert sorted(ages)[int(0.95 * len(ages))] < 0.015  # each picture fetched soon after it was made
+
+
+def test_a_camera_faster_than_the_setting_is_paced_by_the_setting() -> None:
+    from rtmu.client.video_feed import FramePacer
+
+    requests, new, _ = play_camera(FramePacer(), fps=5.0, seconds=10.0, ready_at=periodic(0.02))
+    assert requests == new and 48 <= new <= 52
+
+
+def test_a_camera_that_makes_no_new_pictures_is_asked_about_once_a_second() -> None:
+    from rtmu.client.video_feed import FramePacer
+
+    requests, new, _ = play_camera(FramePacer(), fps=30.0, seconds=20.0, ready_at=lambda t, last: (0, 0.0))
+    assert new == 0 and requests <= 25
+
+
+def test_a_camera_that_slows_down_is_followed() -> None:
+    from rtmu.client.video_feed import FramePacer
+
+    pacer = FramePacer()
+    play_camera(pacer, fps=30.0, seconds=5.0, ready_at=periodic(0.1))
+    requests, new, _ = play_camera(pacer, fps=30.0, seconds=20.0, ready_at=periodic(0.2), start=8.0)
+    assert pacer.period == pytest.approx(0.2, rel=0.05)
+    assert requests <= 1.25 * new and new >= 0.9 * 20 * 5

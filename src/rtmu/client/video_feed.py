@@ -3,7 +3,11 @@
 ARIA offers no video stream, only a picture per request (``getPicture<Name>``,
 else ``sendVideo``), so "video" is a loop on the network thread: ask, wait for
 the frame, hand it on, ask again — never more than one request in flight, and
-no sooner than the frame-rate setting allows. The loop only checks a frame's
+no sooner than the frame-rate setting allows. A camera (ARIA's video forwarder polls its
+own about ten times a second) answers a request made before its next picture with the
+last one again; :class:`FramePacer` learns the camera's period from those repeats and asks
+when the next picture should be ready, so requests follow new frames (not the frame-rate
+setting) and their age stays low. The loop only checks a frame's
 structure (cheap, bounded) and reads its render stamp; decoding into pixels is
 the consumer's job on its own worker thread (the window's JPEG thread, the
 CLI's executor), so neither the network loop nor the GTK thread decodes.
@@ -45,6 +49,34 @@ RECOVER_AFTER_S = 3.0
 REQUEST_TIMEOUT_S = 5.0
 CONSUMER_WAIT_S = 1.0
 """Longest the loop waits for the consumer to show a frame before asking for the next anyway."""
+PERIOD_SAMPLES = 9
+"""Periods measured between repeats the pacer keeps; their median is the camera's period."""
+MARGIN_S = 0.003
+"""A request for a new frame goes this long after the moment the frame is expected, at least."""
+DRIFT_S = 0.0005
+"""Each new frame got as aimed moves the expected moment this much earlier: after about
+``margin / DRIFT_S`` frames a request comes too soon, and the repeat it gets pins the moment down
+again — about one repeat in eight frames, so a camera whose clock wanders is followed."""
+PATIENCE = 8
+"""New frames got as aimed in a row after which the drift doubles with each further one: a period
+learned a little long must not leave the requests later and later (no repeat would say so)."""
+AIMED_WINDOW = 20
+"""Aimed requests over which the share of repeats is watched: above :data:`REPEATS_HIGH` the margin
+widens by :data:`MARGIN_STEP_S` (a server whose clock ticks coarsely, a loaded machine), below
+:data:`REPEATS_LOW` it narrows by a quarter of that, down to :data:`MARGIN_S`."""
+REPEATS_HIGH = 0.2
+REPEATS_LOW = 0.1
+MARGIN_STEP_S = 0.001
+RETRY_MIN_S = 0.003
+"""After a repeat, ask again this soon — :data:`QUICK_RETRIES` times, then twice as long after each
+further repeat, up to :data:`RETRY_MAX_S`: a camera that makes no new pictures is asked about once
+a second."""
+QUICK_RETRIES = 8
+PRECISE_S = 0.004
+"""Two moments pinned down this closely together (their errors summed: half the time from each
+repeat to its new frame, so quick retries on both sides) measure the period; looser ones give a
+rough period that only says when to look next."""
+RETRY_MAX_S = 1.0
 STATS_WINDOW_S = 2.0
 MAX_AGES = 1000
 MAX_SCAN_SEGMENTS = 64
@@ -191,6 +223,123 @@ def clamp_fps(fps: float) -> float:
     return min(max(float(fps), MIN_FPS), MAX_FPS)
 
 
+class FramePacer:
+    """When to ask for the next picture: never sooner than the frame-rate setting allows, and never
+    sooner than the camera makes a new picture (its period learned from the repeats it answers).
+
+    ``after(sent, outcome, min_interval)`` takes the send time of the request just answered, what it
+    brought (``"new"``, ``"repeat"`` or ``"none"``: dropped, refused, timed out) and the shortest
+    interval the rate governor allows between frames; it returns when to send the next request.
+
+    A new frame was ready when its request went out; a repeat means the next one was not ready yet.
+    A repeat followed by a new frame brackets the moment it became ready (:attr:`ready_at`); from one
+    such moment to the next, over the frames between, comes the camera's :attr:`period` (median of
+    recent ones). The pacer then asks :attr:`margin` after each frame should be ready, drifting
+    earlier until a repeat pins the moment down again. Until it knows a period it asks at the
+    frame-rate setting; a camera faster than the setting fills every request and never repeats.
+    """
+
+    def __init__(self) -> None:
+        self.period: float | None = None
+        """The camera's period as learned (s); None until two repeats bracketed frames."""
+        self.ready_at: float | None = None
+        """When the newest frame is thought to have become ready (the clock of ``sent``)."""
+        self.margin = MARGIN_S
+        """How long after a frame's expected moment it is asked for (see :data:`AIMED_WINDOW`)."""
+        self._aimed: deque[bool] = deque(maxlen=AIMED_WINDOW)
+        self._rough: deque[tuple[float, float]] = deque(maxlen=3)
+        """Rough measures of the period (and give or take how much) since the last precise one."""
+        """Whether each recent aimed request got a repeat."""
+        self.requests = 0
+        self.new_frames = 0
+        self._periods: deque[float] = deque(maxlen=PERIOD_SAMPLES)
+        self._too_soon: float | None = None
+        """Send time of the last repeat since the newest frame: the next one came after it."""
+        self._bracketed: tuple[float, float] | None = None
+        """The last moment a repeat pinned down (and give or take how much), and the frames counted
+        since (:attr:`_since`)."""
+        self._slack = 0.0
+        """How far off :attr:`period` may be while only rough measures made it."""
+        self._quick = QUICK_RETRIES
+        """Repeats answered by a quick retry before the retries slow down."""
+        self._since = 0
+        self._misses = 0
+        self._expected: float | None = None
+        """When the request just answered was aimed at a frame being ready (None: not aimed)."""
+
+    def after(self, sent: float, outcome: str, min_interval: float) -> float:
+        self.requests += 1
+        if outcome == "new":
+            return self._new(sent, min_interval)
+        if outcome == "repeat":
+            return self._repeat(sent, min_interval)
+        return sent + min_interval
+
+    def _new(self, sent: float, min_interval: float) -> float:
+        self.new_frames += 1
+        self._since += 1
+        if self._too_soon is not None:
+            ready = (self._too_soon + sent) / 2  # became ready between the repeat and this request
+            self._learn(ready, (sent - self._too_soon) / 2)
+        elif self._expected is not None and sent <= self._expected + self.margin:
+            drift = DRIFT_S * 2 ** max(0, self._since - PATIENCE)
+            if self.period is not None:
+                drift = min(drift, self.period / 4)
+            ready = self._expected - self.margin - drift  # ready by then, maybe sooner: look earlier
+            self._aimed_outcome(False)
+        else:
+            ready = sent - self.margin  # asked late (paced by the setting, or held up): ready by now
+        self.ready_at, self._too_soon, self._misses = ready, None, 0
+        if self.period is None or self.period <= min_interval:
+            self._expected = None  # no period yet, or a camera faster than we ask: the setting paces
+            return sent + min_interval
+        expected = ready + self.period + self.margin - 2 * self._slack  # a rough period: look early
+        self._quick = QUICK_RETRIES + round(4 * self._slack / RETRY_MIN_S)  # …and through its doubt
+        self._expected = expected if expected >= sent + min_interval else None
+        return max(expected, sent + min_interval)
+
+    def _aimed_outcome(self, repeat: bool) -> None:
+        """Keep about one aimed request in eight a repeat, whatever the server's timing."""
+        self._aimed.append(repeat)
+        if len(self._aimed) < AIMED_WINDOW // 2:
+            return
+        share = sum(self._aimed) / len(self._aimed)
+        if share > REPEATS_HIGH and self.period is not None:
+            self.margin = min(self.margin + MARGIN_STEP_S, self.period / 4)
+            self._aimed.clear()
+        elif share < REPEATS_LOW:
+            self.margin = max(MARGIN_S, self.margin - MARGIN_STEP_S / 4)
+
+    def _learn(self, ready: float, error: float) -> None:
+        """A moment pinned down by a repeat (give or take ``error``): with the one before, a
+        measure of the period — kept when precise; rough ones serve until a precise one comes,
+        and three rough ones that disagree with the period say the camera changed its pace."""
+        before, frames = self._bracketed, self._since
+        self._bracketed, self._since = (ready, error), 0
+        if before is None or ready <= before[0]:
+            return
+        sample, slack = (ready - before[0]) / frames, (error + before[1]) / frames
+        if slack <= PRECISE_S:
+            self._periods.append(sample)
+            self._rough.clear()
+            self.period, self._slack = statistics.median(self._periods), 0.0
+            return
+        self._rough.append((sample, slack))
+        rough = statistics.median(r for r, _ in self._rough)
+        if self.period is None or (len(self._rough) >= 3 and abs(rough - self.period) > self.period / 4):
+            self._periods.clear()
+            self.period, self._slack = rough, max(sl for _, sl in self._rough)
+
+    def _repeat(self, sent: float, min_interval: float) -> float:
+        if self._expected is not None:  # aimed, yet too soon
+            self._aimed_outcome(True)
+        self._misses += 1
+        self._too_soon = sent
+        self._expected = None
+        retry = RETRY_MIN_S * 2 ** max(0, self._misses - self._quick)
+        return sent + min(retry, max(RETRY_MAX_S, min_interval))
+
+
 class FrameStats:
     """Frames, bytes and ages over a sliding window (rates) and overall (percentiles, bounded)."""
 
@@ -296,6 +445,7 @@ class VideoFeed:
         self._resume = asyncio.Event()
         self._resume.set()
         self._stopped = False
+        self.pacer = FramePacer()
 
     # -- controls (network loop) ----------------------------------------------------------------
     @property
@@ -355,6 +505,7 @@ class VideoFeed:
             except ClientTimeout as exc:
                 self._drop(f"no frame: {exc}")
                 self.governor.observe(self.clock(), self.clock() - started, None)
+                self.pacer.after(started, "none", self.governor.interval)
                 continue
             except ServerClosed:
                 raise
@@ -366,13 +517,9 @@ class VideoFeed:
                 continue
             now = self.clock()
             repeats = self.stats.repeats
-            self.take(reply.payload, now - started)
-            interval = self.governor.interval
-            if self.stats.repeats > repeats:
-                # The server's camera had nothing newer yet (a forwarder polls it ~10 times a second):
-                # ask again after a quarter of the interval, not a whole one, so frames are not late.
-                interval /= 4
-            wait = started + interval - self.clock()
+            live = self.take(reply.payload, now - started)
+            outcome = "new" if live is not None else "repeat" if self.stats.repeats > repeats else "none"
+            wait = self.pacer.after(started, outcome, self.governor.interval) - self.clock()
             if end is not None:
                 wait = min(wait, end - self.clock())
             if wait > 0:
