@@ -155,7 +155,21 @@ class MapStage(Gtk.DrawingArea):
     def _on_robot(self, old: RobotState, new: RobotState) -> None:
         if new.numbers_at is not None and (new.x, new.y) != (old.x, old.y) and self.follow:
             self._keep_robot_visible()
-        self.queue_draw()
+        if self._drawn_of(old) != self._drawn_of(new) or self.robot_is_stale() != self.drawn_stale:
+            self.queue_draw()
+
+    def _drawn_of(self, r: RobotState) -> tuple[object, ...]:
+        """What a frame shows of the robot's state: a change to anything else redraws nothing (the
+        sonar comes as the server's drawings where it draws them; a status only restates the pose)."""
+        own_sonar = self.operator.view.value.show_sonar and not self.model.drawings.value.offered
+        return (
+            r.numbers_at is None,
+            r.x,
+            r.y,
+            r.th,
+            (r.sonar, r.laser) if own_sonar else None,
+            r.ptz if self.show_fov else None,
+        )
 
     def _on_drawings(self, old: object, new: object) -> None:
         """Show new drawings with the next frame; ask for one only if none comes in time."""
