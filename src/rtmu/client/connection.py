@@ -27,6 +27,7 @@ import asyncio
 import contextlib
 import logging
 import socket
+import sys
 import time
 from collections.abc import AsyncIterator, Callable, Iterable
 from dataclasses import dataclass, field
@@ -168,9 +169,9 @@ class _Waiter:
 
     __slots__ = ("count", "error", "finished", "payloads", "progress", "queue", "reply")
 
-    def __init__(self, reply: ReplyId, streaming: bool) -> None:
+    def __init__(self, reply: ReplyId, streaming: bool, *, queued: bool = True) -> None:
         self.reply = reply
-        self.queue: asyncio.Queue[bytes | None] | None = asyncio.Queue() if streaming else None
+        self.queue: asyncio.Queue[bytes | None] | None = asyncio.Queue() if streaming and queued else None
         self.progress = asyncio.Event()
         self.payloads: tuple[bytes, ...] = ()
         self.count = 0
@@ -572,6 +573,45 @@ class AriaClient:
             if not waiter.finished:
                 self._abandon(waiter)
 
+    async def follow(
+        self,
+        what: str | Payload,
+        *args: Arg,
+        until: Callable[[bytes], bool],
+        timeout: float = REPLY_TIMEOUT,
+        progress: Callable[[int], None] | None = None,
+    ) -> int:
+        """A reply whose packets only ``until`` reads (a map assembler: it bounds and keeps what it
+        needs): nothing is queued or kept for the caller, so a million-packet map costs no queue
+        and no wake-up per packet. Returns the packet count; ``progress(count)`` after each burst;
+        ``timeout`` bounds the wait for each packet."""
+        name, payload = _request(what, args)
+        waiter = self._start(name, payload, None, until, True, sys.maxsize, sys.maxsize, queued=False)
+        if waiter is None:
+            return 0
+        try:
+            while not waiter.finished:
+                waiter.progress.clear()
+                got = waiter.count
+                try:
+                    async with asyncio.timeout(timeout):
+                        await waiter.progress.wait()
+                except TimeoutError:
+                    self._abandon(waiter)
+                    raise self._no_reply(
+                        f"{name!r} from {self.host}:{self.port} stalled for {timeout:g} s after {got} packets"
+                        if got
+                        else f"no reply to {name!r} from {self.host}:{self.port} within {timeout:g} s"
+                    ) from None
+                if progress is not None and waiter.count != got:
+                    progress(waiter.count)
+        finally:
+            if not waiter.finished:
+                self._abandon(waiter)
+        if waiter.error is not None:
+            raise waiter.error
+        return waiter.count
+
     def _start(
         self,
         name: str,
@@ -581,6 +621,8 @@ class AriaClient:
         streaming: bool,
         max_packets: int = MAX_REPLY_PACKETS,
         max_bytes: int = MAX_REPLY_BYTES,
+        *,
+        queued: bool = True,
     ) -> _Waiter | None:
         self._number(name)
         conn = self._conn
@@ -598,7 +640,7 @@ class AriaClient:
         self._flush()
         if reply is None:
             return None
-        waiter = self._waiters[reply] = _Waiter(reply, streaming)
+        waiter = self._waiters[reply] = _Waiter(reply, streaming, queued=queued)
         return waiter
 
     def _abandon(self, waiter: _Waiter) -> None:
@@ -642,14 +684,26 @@ class AriaClient:
 
     def _on_events(self, events: Iterable[Event], now: float) -> bool:
         """Hand each event to its waiter and handler; False when the server shut down."""
+        handlers, waiters = self._handlers, self._waiters
+        woken: _Waiter | None = None
         for event in events:
-            if isinstance(event, DataReceived):
-                self._deliver(event.command, event.name, event.payload, now)
-            elif isinstance(event, ReplyPacket):
-                if not event.swallowed:
-                    waiter = self._waiters.get(event.reply)
-                    if waiter is not None:
-                        waiter.packet(event.payload)
+            if isinstance(event, ReplyPacket):  # ahead of the rest: a map is a million of these
+                reply, payload, swallowed = event
+                if not swallowed:
+                    waiter = waiters.get(reply)
+                    if waiter is not None:  # _Waiter.packet, inlined: its wake-up once per read
+                        waiter.count += 1
+                        if waiter.queue is not None:
+                            waiter.queue.put_nowait(payload)
+                        if waiter is not woken:
+                            waiter.progress.set()
+                            woken = waiter
+                if reply.number in handlers:
+                    self._deliver(reply.number, reply.name, payload, now)
+                else:
+                    self.last_packet_at = now
+                    self.packets_received += 1
+            elif isinstance(event, DataReceived):
                 self._deliver(event.command, event.name, event.payload, now)
             elif isinstance(event, ReplyComplete):
                 waiter = self._waiters.pop(event.reply, None)

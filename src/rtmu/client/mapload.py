@@ -77,11 +77,7 @@ async def download_map(
     assembler: MapBinaryAssembler | MapTextAssembler = (
         MapBinaryAssembler() if source == "getMapBinary" else MapTextAssembler()
     )
-    count = 0
-    async for _ in client.stream(source, timeout=timeout, until=assembler.feed):
-        count += 1
-        if progress is not None and count % 200 == 0:
-            progress(count)
+    count = await client.follow(source, timeout=timeout, until=assembler.feed, progress=progress)
     try:
         async with asyncio.timeout(convert_timeout):
             data = await asyncio.get_running_loop().run_in_executor(None, assembled_map, assembler)

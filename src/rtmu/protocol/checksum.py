@@ -23,8 +23,9 @@ _NUMPY_THRESHOLD = 256
 _STRUCT_LIMIT = 8192
 """Words summed with ``struct`` while numpy is not loaded; a larger packet (a map block, a big
 picture) loads it: the command receiving it needs numpy anyway."""
-# One precompiled ">nH" per word count below the numpy threshold: a list index is the cheapest lookup.
-_WORD_STRUCTS: tuple[struct.Struct, ...] = tuple(struct.Struct(f">{n}H") for n in range(_NUMPY_THRESHOLD))
+WORD_STRUCTS: tuple[struct.Struct, ...] = tuple(struct.Struct(f">{n}H") for n in range(_NUMPY_THRESHOLD))
+"""One precompiled ``>nH`` per word count below the numpy threshold (a tuple index is the cheapest
+lookup); the decoder sums small packets with them in its own loop."""
 
 
 def checksum(data: bytes | bytearray | memoryview, end: int | None = None, start: int = 0) -> int:
@@ -37,7 +38,7 @@ def checksum(data: bytes | bytearray | memoryview, end: int | None = None, start
     words = (covered - 2) >> 1
     first = start + 3
     if words < _NUMPY_THRESHOLD:
-        c = sum(_WORD_STRUCTS[words].unpack_from(data, first)) & 0xFFFF
+        c = sum(WORD_STRUCTS[words].unpack_from(data, first)) & 0xFFFF
     elif words < _STRUCT_LIMIT and "numpy" not in sys.modules:
         c = sum(struct.unpack_from(f">{words}H", data, first)) & 0xFFFF
     else:

@@ -24,6 +24,7 @@ from enum import Enum, auto
 
 from .auth import password_digest
 from .commands import (
+    FIRST_DATA_NUMBER,
     ClientCommand,
     ClientType,
     RejectReason,
@@ -187,8 +188,15 @@ class ClientConnection:
         if now is not None:
             self.replies.now = now
         events: list[Event] = []
+        feed, name_of, extend = self.replies.feed, self.datalist.names.get, events.extend
+        connected = self.state is ClientState.CONNECTED
         for packet in self.decoder.feed(data):
-            events.extend(self._handle(packet))
+            cmd, payload = packet
+            if connected and cmd >= FIRST_DATA_NUMBER:  # the data: most packets
+                extend(feed(cmd, name_of(cmd), payload))
+            else:
+                extend(self._handle(packet))
+                connected = self.state is ClientState.CONNECTED
         return events
 
     def _handle(self, packet: Packet) -> list[Event]:

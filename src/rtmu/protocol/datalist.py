@@ -37,6 +37,8 @@ class DataList:
     def __init__(self, entries: Iterable[DataEntry] = ()) -> None:
         self._by_number: dict[int, DataEntry] = {}
         self._by_name: dict[str, DataEntry] = {}
+        self.names: dict[int, str] = {}
+        """Number → name (read only): ``names.get`` is the per-packet lookup, one C call."""
         self.have_list = False
         self.have_argret = False
         self.have_groups = False
@@ -50,6 +52,7 @@ class DataList:
             del self._by_name[old.name]
         self._by_number[entry.number] = entry
         self._by_name[entry.name] = entry
+        self.names[entry.number] = entry.name
 
     def __contains__(self, name: object) -> bool:
         return name in self._by_name

@@ -55,10 +55,15 @@ import re
 from dataclasses import dataclass, fields
 from typing import Final
 
-from .checksum import SpanChecksums, checksum
+from .checksum import WORD_STRUCTS, SpanChecksums, checksum
 from .packet import MAX_LENGTH, MIN_LENGTH, SYNC, Packet
 
 _COMPACT_AT = 64 * 1024
+_INLINE_SUM_BELOW: Final = 6 + 2 * len(WORD_STRUCTS)
+"""Packets shorter than this have their checksum summed inside the loop (one ``WORD_STRUCTS`` entry)."""
+_new_tuple = tuple.__new__
+"""``_new_tuple(Packet, (command, payload))``: a :class:`Packet` without the named tuple's Python
+``__new__`` frame (the decoder makes one per packet)."""
 
 STREAM_GOES_ON: Final = 4
 """Back-to-back valid packets behind a waiting header that prove the stream went on without it.
@@ -189,7 +194,7 @@ class PacketDecoder:
         self._chain = None
         self._proven = -1
 
-    def _stream_goes_on(self, buf: bytearray, pos: int, end: int) -> bool:
+    def _stream_goes_on(self, buf: bytes, pos: int, end: int) -> bool:
         """Whether STREAM_GOES_ON valid packets lie back to back behind the header waiting at ``pos``."""
         if self._proven > pos:
             return True
@@ -248,8 +253,11 @@ class PacketDecoder:
             chain = None
 
     def _drain(self) -> list[Packet]:
-        """Take every complete packet out of the buffer (one tight loop: this is the hot path)."""
-        buf = self._buf
+        """Take every complete packet out of the buffer (one tight loop: this is the hot path).
+
+        It reads a ``bytes`` snapshot of the buffer (a memcpy, ~1 µs for 64 KB): a payload sliced
+        from ``bytes`` is made in one step, from a ``bytearray`` in two (a third of a packet's cost)."""
+        buf = bytes(self._buf)
         find = buf.find
         pos = self._pos
         end = len(buf)
@@ -257,6 +265,8 @@ class PacketDecoder:
         sums = self._sums
         spans_summed = sums.active
         found: list[Packet] = []
+        new_packet = _new_tuple
+        word_structs = WORD_STRUCTS
         garbage = 0
         while True:
             start = find(SYNC, pos)
@@ -292,6 +302,12 @@ class PacketDecoder:
                 if sums.stop < end:
                     sums.extend(buf, end)
                 good = sums.checksum(buf, body_end, pos) == (buf[body_end] << 8 | buf[body_end + 1])
+            elif length < _INLINE_SUM_BELOW:  # checksum() inlined: most packets are small
+                words = (length - 6) >> 1
+                first = pos + 3
+                good = (sum(word_structs[words].unpack_from(buf, first)) & 0xFFFF) ^ buf[
+                    first + 2 * words
+                ] == (buf[body_end] << 8 | buf[body_end + 1])
             else:
                 good = checksum(buf, body_end, pos) == (buf[body_end] << 8 | buf[body_end + 1])
             if not good:
@@ -301,17 +317,17 @@ class PacketDecoder:
                     spans_summed = True
                 if self.keep_bad and pos >= self._bad_until:
                     command = buf[pos + 4] | buf[pos + 5] << 8
-                    self.bad_packets.append(BadPacket(command, length, bytes(buf[pos : pos + length])))
+                    self.bad_packets.append(BadPacket(command, length, buf[pos : pos + length]))
                     self._bad_until = pos + length
                 garbage += 2
                 pos += 2
                 continue
-            found.append(Packet(buf[pos + 4] | buf[pos + 5] << 8, bytes(buf[pos + 6 : body_end])))
+            found.append(new_packet(Packet, (buf[pos + 4] | buf[pos + 5] << 8, buf[pos + 6 : body_end])))
             pos += length
         stats.garbage_bytes += garbage
         stats.packets += len(found)
         if pos >= _COMPACT_AT or pos == end:
-            del buf[:pos]
+            del self._buf[:pos]
             self._bad_until = max(0, self._bad_until - pos)
             if spans_summed:
                 sums.clear()  # offsets moved; the next failure starts afresh from its own position

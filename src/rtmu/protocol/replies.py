@@ -29,6 +29,9 @@ from collections.abc import Callable, Iterator
 from .errors import MapTooLarge, ProtocolError
 from .events import DataReceived, Event, ReplyComplete, ReplyError, ReplyFailed, ReplyId, ReplyPacket
 
+_new_tuple = tuple.__new__
+"""Builds the per-packet named-tuple events without their Python ``__new__`` frame."""
+
 MAX_REPLY_PACKETS = 1_000_000
 """Default bound on the packets of one collected reply, or of a streamed one's unread packets."""
 MAX_REPLY_BYTES = 64 << 20
@@ -126,6 +129,7 @@ class PendingReply:
     """
 
     __slots__ = (
+        "_until",
         "abandoned_at",
         "count",
         "fallback",
@@ -152,6 +156,8 @@ class PendingReply:
     ) -> None:
         self.id = reply
         self.rule = rule
+        self._until = rule.until if isinstance(rule, Until) else None
+        """The caller's own end test, called directly (a map's million packets skip one frame each)."""
         self.fallback = fallback
         """Where the reply ends without the caller's own test (used once the caller is gone)."""
         self.streaming = streaming
@@ -173,7 +179,8 @@ class PendingReply:
         if self.abandoned_at is not None:
             return self._swallow(payload, now), None
         try:
-            finished = self.rule.done(payload, self.count)
+            test = self._until
+            finished = test(payload) if test is not None else self.rule.done(payload, self.count)
         except MapTooLarge as exc:  # more than any map can be: an endless or hostile stream
             return True, self._failed(
                 ReplyError.MALFORMED, f"the server's map is too large, download stopped: {exc}"
@@ -277,20 +284,19 @@ class ReplyTracker:
             now = self.now
         self.now = now
         queue = self._queues.get(number)
-        if queue:
+        if queue and queue[0].abandoned_at is not None:
             self._expire(queue, now)
         if not queue:
-            return [DataReceived(number, name, payload)]
+            return [_new_tuple(DataReceived, (number, name, payload))]
         head = queue[0]
-        was_abandoned = head.abandoned
+        was_abandoned = head.abandoned_at is not None
         done, outcome = head.feed(payload, now)
         if done:
             queue.popleft()
+        if outcome is None:  # one more packet of a reply that goes on: the hot path
+            return [_new_tuple(ReplyPacket, (head.id, payload, was_abandoned))]
         refused = isinstance(outcome, ReplyFailed) and outcome.reason is ReplyError.MALFORMED
-        events: list[Event] = [ReplyPacket(head.id, payload, swallowed=was_abandoned or refused)]
-        if outcome is not None:
-            events.append(outcome)
-        return events
+        return [ReplyPacket(head.id, payload, swallowed=was_abandoned or refused), outcome]
 
     def abandon(self, reply: ReplyId, now: float) -> None:
         """The waiter gave up (timeout, cancel, a stream closed early); no-op if the reply is over."""

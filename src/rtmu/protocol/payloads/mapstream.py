@@ -12,6 +12,7 @@ map (already parsed by :mod:`rtmu.mapfile`) into the payloads ARIA would send.
 
 from __future__ import annotations
 
+import math
 import struct
 from collections.abc import Iterable, Sequence
 from dataclasses import dataclass
@@ -39,6 +40,8 @@ DEFAULT_MAX_HEADER_BYTES: Final = 32 * 1024 * 1024
 DEFAULT_MAX_TEXT_LINES: Final = 1_000_000
 DEFAULT_MAX_TEXT_BYTES: Final = 48 * 1024 * 1024
 
+_NUMBER_START: Final = frozenset(b"-+.0123456789")
+"""First bytes of a point's or a line's numbers (a section's own lines start with a letter)."""
 _COUNT = struct.Struct("<i")
 _BLOCK_END: Final = _COUNT.pack(0)
 _EMPTY_STRING: Final = b"\x00"
@@ -116,12 +119,18 @@ class MapTextAssembler:
         self._claims = _Claims()
         self._section = b""
         self._in_section = 0
+        self._claimed: tuple[int | None, str] = (None, "")
+        self._limit: float = math.inf
+        """Points (or lines) of the section being read past which the header was a lie."""
         self._end_of_map = False
         self.done = False
         self.has_map = True
 
     def feed(self, payload: bytes) -> bool:
-        """Take one reply payload; True once the reply is complete."""
+        """Take one reply payload; True once the reply is complete.
+
+        Each line goes into the buffer with its NUL terminator as it came (no slice, one copy): the
+        NULs become line breaks once, in :meth:`result`."""
         if self.done:
             raise ReplyAlreadyComplete("getMap reply already complete")
         if not payload:
@@ -131,29 +140,45 @@ class MapTextAssembler:
         if self._end_of_map:
             raise PayloadError("getMap: only the final empty packet may follow the end of the map")
         end = payload.find(b"\0")
-        line = payload if end < 0 else payload[:end]  # an unterminated string runs to the end
-        if not line:
+        if end == 0:
             self._end_of_map = True
             if not self._count:  # no map: ARIA sends only this packet
                 self.has_map = False
                 self.done = True
             return self.done
-        if self._count >= self.max_lines:
+        count = self._count
+        if count >= self.max_lines:
             raise MapTooLarge(f"getMap: more than {self.max_lines} lines")
-        if len(self._text) + len(line) + 1 > self.max_bytes:
+        text = self._text
+        if end < 0:  # an unterminated string runs to the end
+            line = payload + b"\0"
+        elif end == len(payload) - 1:
+            line = payload
+        else:  # bytes after the terminator are not part of the line
+            line = payload[: end + 1]
+        if len(text) + len(line) > self.max_bytes + 1:  # the text: the lines and a break between each
             raise MapTooLarge(f"getMap: more than {self.max_bytes} bytes of text")
         if b"\n" in line or b"\r" in line:
-            raise PayloadError(f"getMap: line {self._count + 1} contains a line break")
-        self._check_claims(line)
-        if self._count:
-            self._text += b"\n"
-        self._text += line
-        self._count += 1
+            raise PayloadError(f"getMap: line {count + 1} contains a line break")
+        if self._section and line[0] in _NUMBER_START:  # one more point or line: the hot path
+            self._in_section += 1
+            if self._in_section > self._limit:
+                claimed, what = self._claimed
+                raise MapTooLarge(f"getMap: more {what} than the map's header says ({claimed})")
+        else:
+            self._check_claims(line[:-1])
+        text += line
+        self._count = count + 1
         return False
 
     def _check_claims(self, line: bytes) -> None:
         if line in (b"LINES", b"DATA"):
             self._section, self._in_section = line, 0
+            self._claimed = (
+                (self._claims.points, "points") if line == b"DATA" else (self._claims.lines, "lines")
+            )
+            claimed = self._claimed[0]
+            self._limit = math.inf if claimed is None else claimed + max(1000, claimed // 10)
             return
         if not self._section:
             self._claims.note(line)
@@ -162,10 +187,8 @@ class MapTextAssembler:
             self._section = b""  # another (scan-prefixed) section: only the absolute caps apply
             return
         self._in_section += 1
-        claimed, what = (
-            (self._claims.points, "points") if self._section == b"DATA" else (self._claims.lines, "lines")
-        )
-        if _Claims.over(claimed, self._in_section):
+        if self._in_section > self._limit:
+            claimed, what = self._claimed
             raise MapTooLarge(f"getMap: more {what} than the map's header says ({claimed})")
 
     @property
@@ -174,12 +197,16 @@ class MapTextAssembler:
 
     @property
     def lines(self) -> list[str]:
-        return TextMap(bytes(self._text), self._count).lines
+        return TextMap(self._joined(), self._count).lines
 
     def result(self) -> TextMap:
         if not self.done:
             raise PayloadError("getMap reply is not complete yet")
-        return TextMap(bytes(self._text), self._count, self.has_map)
+        return TextMap(self._joined(), self._count, self.has_map)
+
+    def _joined(self) -> bytes:
+        """The lines joined by line breaks (the buffer holds each with its NUL terminator)."""
+        return bytes(memoryview(self._text)[:-1]).replace(b"\0", b"\n")
 
 
 def map_text_payloads(lines: Iterable[str] | None) -> list[bytes]:
