@@ -26,7 +26,7 @@ import gi
 gi.require_version("Gtk", "4.0")
 from gi.repository import GLib, Gtk  # noqa: E402
 
-from ..model.observables import LinkLevel, MapModel, OperatorState, RobotModel, RobotState  # noqa: E402
+from ..model.observables import LinkHealth, LinkLevel, MapModel, OperatorState, RobotModel, RobotState  # noqa: E402
 from . import overlays  # noqa: E402
 from .fleet_draw import FleetMark  # noqa: E402
 from .fov_draw import Wedge, camera_aim  # noqa: E402
@@ -109,7 +109,7 @@ class MapStage(Gtk.DrawingArea):
             model.robot.observe(self._on_robot),
             model.map.observe(self._on_map),
             operator.view.observe(self._on_view_options),
-            model.health.observe(lambda old, new: self.queue_draw()),
+            model.health.observe(self._on_health),
             model.trail.observe(self.queue_draw),
             model.navigation.observe(lambda old, new: self.queue_draw()),
             model.drawings.observe(self._on_drawings),
@@ -196,6 +196,11 @@ class MapStage(Gtk.DrawingArea):
         elif new.zoom and abs(new.zoom - self.viewport.zoom) > 1e-6:
             self.set_zoom(new.zoom)
         self.queue_draw()
+
+    def _on_health(self, old: LinkHealth, new: LinkHealth) -> None:
+        """The map shows the link's level only (a stale robot): a new round-trip time is no redraw."""
+        if old.level is not new.level:
+            self.queue_draw()
 
     def robot_is_stale(self) -> bool:
         r = self.model.robot.value
