@@ -114,7 +114,10 @@ def test_image(sim: SimThread, pwfile: Path, tmp_path: Path) -> None:
     assert main(["image", *login(sim, pwfile), "--out", str(out)]) == EXIT_OK
     data = out.read_bytes()
     assert data[:2] == b"\xff\xd8" and data.rstrip(b"\x00")[-2:] == b"\xff\xd9"
-    assert main(["image", *login(sim, pwfile), "--out", str(out), "--camera", "Nope"]) == EXIT_UNSUPPORTED
+    again = ["image", *login(sim, pwfile), "--out", str(out), "--camera", "Nope"]
+    assert main(again) == EXIT_USAGE, "an existing picture is not replaced without --force"
+    assert main([*again, "--force"]) == EXIT_UNSUPPORTED
+    assert out.read_bytes() == data, "a failed picture leaves the old one as it was"
 
 
 def test_drive_moves_then_stops(sim: SimThread, pwfile: Path, capsys: pytest.CaptureFixture[str]) -> None:

@@ -1,13 +1,81 @@
-"""The exit codes every ``rtmu`` subcommand shares, apart from the CLI so that any layer may name them.
+"""The exit codes of the whole ``rtmu`` command line: one table, one meaning per code.
 
-A typed client error carries its code (``rtmu.client.errors``) without importing the
-command line; subcommands add their own codes above these in their modules.
+Every subcommand exits with one of these (``rtmu --help``, each subcommand's ``--help`` and
+the README print :func:`table_text`); ``tests/test_exit_codes.py`` runs each subcommand's
+failure paths and checks the code against :data:`EXIT_CODES`. A typed client error carries
+its code (``rtmu.client.errors``) without importing the command line.
 """
 
 from __future__ import annotations
 
+import signal
+
 EXIT_OK = 0
+EXIT_INTERNAL = 1
 EXIT_USAGE = 2
 EXIT_CONNECTION = 3
 EXIT_UNSUPPORTED = 4
 EXIT_TIMEOUT = 5
+EXIT_REFUSED = 6
+EXIT_CANCELLED = 7
+EXIT_LOST = 8
+EXIT_NO_DISPLAY = 9
+EXIT_DOCTOR_RESOLVE = 10
+EXIT_DOCTOR_TCP = 11
+EXIT_DOCTOR_INTRODUCTION = 12
+EXIT_DOCTOR_LOGIN = 13
+EXIT_DOCTOR_DATALIST = 14
+EXIT_DOCTOR_STATUS = 15
+EXIT_BAD_FILE = 16
+EXIT_SIZE_LIMIT = 17
+EXIT_SIGHUP = 128 + signal.SIGHUP
+EXIT_SIGINT = 128 + signal.SIGINT
+EXIT_SIGQUIT = 128 + signal.SIGQUIT
+EXIT_SIGPIPE = 128 + signal.SIGPIPE
+EXIT_SIGTERM = 128 + signal.SIGTERM
+EXIT_SIGTSTP = 128 + signal.SIGTSTP
+
+EXIT_CODES: dict[int, str] = {
+    EXIT_OK: "done",
+    EXIT_INTERNAL: "internal error in RTMU (a bug: please report it with the message)",
+    EXIT_USAGE: "usage: a bad or out-of-range argument, an unknown name (goal, route, robot, command), "
+    "a missing or unreadable password source, an input file that does not exist, or an output file "
+    "that exists (without --force) or cannot be written",
+    EXIT_CONNECTION: "connection, login or protocol failure: refused, unreachable, rejected, closed, "
+    "or the server sent something malformed",
+    EXIT_UNSUPPORTED: "the server (or this user) does not offer what is needed",
+    EXIT_TIMEOUT: "timeout: no answer, or no outcome within --limit (a navigation is stopped)",
+    EXIT_REFUSED: "the server refused or could not do it: a setting refused, a goal it could not reach, "
+    "a failed dock",
+    EXIT_CANCELLED: "stopped before arriving (STOP, a drive, another goal)",
+    EXIT_LOST: "the robot is lost (localize it first)",
+    EXIT_NO_DISPLAY: "no display: the window needs DISPLAY or WAYLAND_DISPLAY",
+    EXIT_DOCTOR_RESOLVE: "doctor: the name does not resolve",
+    EXIT_DOCTOR_TCP: "doctor: no TCP connection",
+    EXIT_DOCTOR_INTRODUCTION: "doctor: no ArNetworking introduction",
+    EXIT_DOCTOR_LOGIN: "doctor: login refused",
+    EXIT_DOCTOR_DATALIST: "doctor: no data list",
+    EXIT_DOCTOR_STATUS: "doctor: no first status",
+    EXIT_BAD_FILE: "a file's contents cannot be used: not a capture, recording or map RTMU reads, "
+    "cut short or malformed",
+    EXIT_SIZE_LIMIT: "record: the size limit (--max-mb) was reached or the disk filled; "
+    "the recording so far is kept",
+    EXIT_SIGHUP: "ended by SIGHUP (the terminal went away)",
+    EXIT_SIGINT: "ended by Ctrl-C (SIGINT)",
+    EXIT_SIGQUIT: "ended by SIGQUIT",
+    EXIT_SIGPIPE: "the reader of the output went away (e.g. piped into head)",
+    EXIT_SIGTERM: "ended by SIGTERM",
+    EXIT_SIGTSTP: "rtmu drive ended by Ctrl-Z (the robot was stopped first)",
+}
+"""Code → meaning. Other 128 + N: ended by signal N (any ending signal stops what the command drove)."""
+
+
+def signal_code(signum: int) -> int:
+    """The code of a command ended by signal ``signum``: 128 + N, as shells report it."""
+    return 128 + signum
+
+
+def table_text(codes: tuple[int, ...] | None = None, *, indent: str = "  ") -> str:
+    """The table as plain text for a ``--help`` epilog (``codes``: only those, in that order)."""
+    chosen = sorted(EXIT_CODES) if codes is None else codes
+    return "\n".join(f"{indent}{code:>3}  {EXIT_CODES[code]}" for code in chosen)

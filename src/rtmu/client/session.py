@@ -67,6 +67,7 @@ from .nav_session import NavFeed
 from .popups import PopupFeed
 from .ptz import PtzFeed
 from .reconnect import Backoff, worth_retrying
+from .roles import Role
 from .server_strings import StringsFeed
 from .subscriptions import Subscription, applicable
 from .video_feed import frame_stamp
@@ -111,6 +112,8 @@ class SessionConfig:
     """Start a guardian process (:mod:`rtmu.guardian`) for each connection that may drive: it stops
     the robot if this process is killed or frozen while driving. The window and ``rtmu drive`` do."""
     shared_maps: SharedMaps | None = field(default=None, compare=False)
+    role: Role = Role.OPERATOR
+    """OBSERVER (a recorder, a read-only bridge, a replay): no motion request ever leaves (client.roles)."""
     """Maps shared with the process's other sessions (a fleet's window: one download per map file)."""
 
 
@@ -259,7 +262,7 @@ class Session:
         """
         self._cancel_connecting()
         self._connecting = asyncio.current_task()
-        if self.connected:  # connecting again (another profile) while driving: stop on the old link first
+        if self.connected and self.client.drove:  # type: ignore[union-attr]  # our drive: stop it first
             self._send_stop("connecting elsewhere")
         self.lease.end(EndReason.DISCONNECTED)
         await self._drop_client()
@@ -306,6 +309,7 @@ class Session:
             target.password,
             timeout=self.config.connect_timeout,
             protocol=target.protocol,
+            role=self.config.role,
         )
         if self._target is not target:  # disconnected (or re-targeted) meanwhile
             await client.disconnect()
@@ -336,7 +340,7 @@ class Session:
         self._cancel_connecting()
         self._cancel_reconnect()
         self._target = None
-        if self.connected:
+        if self.connected and self.client.drove:  # type: ignore[union-attr]  # only our own drive
             self._send_stop("disconnect")
         self.lease.end(EndReason.DISCONNECTED)
         await self._drop_client()

@@ -31,6 +31,7 @@ from pathlib import Path
 
 from ..client.connection import AriaClient
 from ..client.errors import ClientError
+from ..client.roles import Role
 from . import messages as m
 from .halt import Halter
 
@@ -134,7 +135,9 @@ async def run(fd: int = 0) -> int:
         return 2
     client = AriaClient()
     try:
-        await client.connect(hello.host, hello.port, hello.user, hello.password, timeout=hello.timeout)
+        await client.connect(
+            hello.host, hello.port, hello.user, hello.password, timeout=hello.timeout, role=Role.OPERATOR
+        )
     except ClientError as exc:
         say(m.UNAVAILABLE, str(exc))
         return 3

@@ -36,14 +36,16 @@ import signal
 import sys
 from collections.abc import Awaitable, Callable
 from pathlib import Path
-from typing import Any
+from typing import Any, TypeVar
 
-from ..base.exit_codes import EXIT_CONNECTION, EXIT_OK, EXIT_USAGE
+from ..base.exit_codes import EXIT_CONNECTION, EXIT_SIGPIPE, EXIT_USAGE
 from ..client.connection import CONNECT_TIMEOUT, DEFAULT_PORT, AriaClient
 from ..client.errors import ClientError
+from ..client.roles import Role
 from ..protocol.errors import ProtocolError
 
 MAX_PASSWORD_FILE = 4096
+T = TypeVar("T")
 
 
 def host_port(text: str) -> tuple[str, int]:
@@ -198,13 +200,13 @@ def resolve_robot(args: argparse.Namespace) -> int | None:
         return fail(name, "cancelled", EXIT_USAGE)
     host, port = args.server
     try:
-        robots = asyncio.run(list_robots(host, port, args.user, password, timeout=args.timeout))
+        robots = run_interruptibly(lambda: list_robots(host, port, args.user, password, timeout=args.timeout))
     except ClientError as exc:
         return fail(name, f"central server {host}:{port}: {exc}", exc.exit_code)
     except ProtocolError as exc:
         return fail(name, f"central server {host}:{port} sent a malformed robot list: {exc}", EXIT_CONNECTION)
-    except KeyboardInterrupt:
-        return fail(name, "interrupted by SIGINT", 128 + signal.SIGINT)
+    except Interrupted as exc:
+        return fail(name, str(exc), exc.exit_code)
     wanted = args.robot
     found = [e for e, _ in robots if e.name == wanted] or [
         e for e, _ in robots if e.name.lower() == wanted.lower()
@@ -403,8 +405,36 @@ def fail(name: str, message: str, code: int) -> int:
     return code
 
 
-def run_with_client(name: str, args: argparse.Namespace, body: Callable[[AriaClient], Awaitable[int]]) -> int:
-    """Log in, run ``body(client)``, always disconnect; map every failure to an exit code and one line."""
+def run_interruptibly(main: Callable[[], Awaitable[T]]) -> T:
+    """``asyncio.run(main())`` with every ending signal (:data:`INTERRUPT_SIGNALS`) turned into
+    :class:`Interrupted` — exit 128 + N — after the command's ``finally`` blocks ran, whenever it comes
+    (before the handlers are in place, mid-command, or while the command is already ending)."""
+    interrupts = Interrupts()
+
+    async def guarded() -> T:
+        interrupts.install()
+        _INTERRUPTS.set(interrupts)
+        try:
+            return await main()
+        except asyncio.CancelledError:
+            signum = interrupts.take()
+            if signum is None:
+                raise
+            raise Interrupted(signum) from None
+
+    try:
+        return asyncio.run(guarded())
+    except (KeyboardInterrupt, asyncio.CancelledError):
+        raise Interrupted(interrupts.signum or signal.SIGINT) from None
+
+
+def run_with_client(
+    name: str, args: argparse.Namespace, body: Callable[[AriaClient], Awaitable[int]], *, role: Role
+) -> int:
+    """Log in as ``role``, run ``body(client)``, always disconnect; every failure → an exit code and one line.
+
+    Every command says its role: an OBSERVER's client cannot send a motion request on any path.
+    """
     try:
         password = read_password(args)
     except UsageError as exc:
@@ -417,17 +447,14 @@ def run_with_client(name: str, args: argparse.Namespace, body: Callable[[AriaCli
     async def main() -> int:
         host, port = args.server
         client = AriaClient()
-        interrupts = Interrupts()
-        interrupts.install()
-        _INTERRUPTS.set(interrupts)
         _PASSWORD.set(password)
         try:
             await client.connect(
-                host, port, args.user, password, timeout=args.timeout, protocol=args.protocol
+                host, port, args.user, password, timeout=args.timeout, protocol=args.protocol, role=role
             )
             return await body(client)
         except asyncio.CancelledError:
-            signum = interrupts.take()
+            signum = current_interrupts().take()
             if signum is None:
                 raise
             raise Interrupted(signum) from None
@@ -435,7 +462,7 @@ def run_with_client(name: str, args: argparse.Namespace, body: Callable[[AriaCli
             await client.disconnect()
 
     try:
-        return asyncio.run(main())
+        return run_interruptibly(main)
     except Interrupted as exc:
         return fail(name, str(exc), exc.exit_code)
     except ClientError as exc:
@@ -444,11 +471,9 @@ def run_with_client(name: str, args: argparse.Namespace, body: Callable[[AriaCli
         return fail(name, f"the server sent something malformed: {exc}", EXIT_CONNECTION)
     except UsageError as exc:
         return fail(name, str(exc), EXIT_USAGE)
-    except (KeyboardInterrupt, asyncio.CancelledError):  # Ctrl-C before the handlers were in place
-        return fail(name, "interrupted by SIGINT", 128 + signal.SIGINT)
     except BrokenPipeError:  # e.g. piped into ``head``: the reader has what it wanted
         _silence_stdout()
-        return EXIT_OK
+        return EXIT_SIGPIPE
     except OSError as exc:  # e.g. writing the output file
         return fail(name, str(exc), EXIT_CONNECTION if isinstance(exc, ConnectionError) else EXIT_USAGE)
 

@@ -17,6 +17,7 @@ from ..base.exit_codes import EXIT_OK, EXIT_USAGE
 from ..base.textsafe import visible
 from ..client.config_feed import ServerConfig, fetch_config, set_config
 from ..client.connection import AriaClient
+from ..client.roles import Role
 from ..protocol.payloads.config import ConfigParam, ParamType, Priority
 from ._common import add_connection_arguments, print_json, run_with_client
 
@@ -87,7 +88,7 @@ def handle(args: argparse.Namespace) -> int:
             print_text(config)
         return EXIT_OK
 
-    return run_with_client("config", args, body)
+    return run_with_client("config", args, body, role=Role.OBSERVER)
 
 
 async def _set(client: AriaClient, assignments: list[tuple[str, str, str]], args: argparse.Namespace) -> int:

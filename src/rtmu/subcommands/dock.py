@@ -6,6 +6,7 @@ import argparse
 from typing import Any
 
 from ..client.connection import AriaClient
+from ..client.roles import Role
 from ..protocol.payloads.navigation import Dock
 from ._common import add_connection_arguments, run_with_client
 from ._navigate import EXIT_CODES_HELP, Expect, add_wait_arguments, navigate, require
@@ -28,4 +29,4 @@ def handle(args: argparse.Namespace) -> int:
         require(client, "dock", "dock")
         return await navigate(client, args, Dock(), Expect(docked=True))
 
-    return run_with_client("dock", args, body)
+    return run_with_client("dock", args, body, role=Role.OPERATOR)

@@ -39,7 +39,14 @@ from ..protocol.fields import FieldReader, FieldWriter
 from ..protocol.packet import encode_packet
 from ..protocol.payloads import Side, decode_payload
 from ..protocol.payloads.robot import BatteryInfo, Update, UpdateNumbers, UpdateStrings
-from ._common import UsageError, add_connection_arguments, print_json, read_password
+from ._common import (
+    Interrupted,
+    UsageError,
+    add_connection_arguments,
+    print_json,
+    read_password,
+    run_interruptibly,
+)
 
 READ_CHUNK = 65536
 NOT_ARIA_AFTER = 4096
@@ -426,9 +433,10 @@ def handle(args: argparse.Namespace) -> int:
         return EXIT_USAGE
     doctor = Doctor(host, port, args.user, password, args.protocol, args.timeout)
     try:
-        code = asyncio.run(doctor.run())
-    except KeyboardInterrupt:
-        return 130
+        code = run_interruptibly(doctor.run)
+    except Interrupted as exc:
+        print(f"rtmu doctor: {exc}", file=sys.stderr)
+        return exc.exit_code
     failed = next((s for s in doctor.steps if s.result == "fail"), None)
     if args.json:
         print_json(

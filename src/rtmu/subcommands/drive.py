@@ -28,6 +28,7 @@ from ..base.textsafe import visible
 from ..client.connection import AriaClient
 from ..client.drive_guard import DriveGuard, LinkFault
 from ..client.errors import ClientError, NotSupported
+from ..client.roles import Role
 from ..guardian.handle import GuardianHandle, GuardianUnavailable, beat_network, start_ready
 from ..guardian.messages import Hello
 from ..protocol.payloads.drive import RatioDrive
@@ -151,7 +152,7 @@ def handle(args: argparse.Namespace) -> int:
     except UsageError as exc:
         print(f"rtmu drive: {exc}", file=sys.stderr)
         return 2
-    return run_with_client("drive", args, body)
+    return run_with_client("drive", args, body, role=Role.OPERATOR)
 
 
 async def start_guardian(args: argparse.Namespace) -> GuardianHandle | None:

@@ -12,7 +12,6 @@ from __future__ import annotations
 
 import argparse
 import asyncio
-import signal
 from typing import Any
 
 from ..base.exit_codes import EXIT_CONNECTION, EXIT_OK, EXIT_USAGE
@@ -20,14 +19,17 @@ from ..base.textsafe import visible
 from ..client.central import list_robots
 from ..client.connection import AriaClient
 from ..client.errors import ClientError
+from ..client.roles import Role
 from ..protocol.errors import ProtocolError
 from ._common import (
+    Interrupted,
     UsageError,
     add_connection_arguments,
     fail,
     fetch_status,
     print_json,
     read_password,
+    run_interruptibly,
     status_line,
 )
 
@@ -55,7 +57,9 @@ async def _status(
         client = AriaClient()
         try:
             login = (args.user, password)
-            await client.connect(host, port, *login, timeout=args.timeout, protocol=args.protocol)
+            await client.connect(
+                host, port, *login, timeout=args.timeout, protocol=args.protocol, role=Role.OBSERVER
+            )
             return await fetch_status(client, args.timeout)
         except (ClientError, ProtocolError) as exc:
             return {"error": str(exc)}
@@ -96,13 +100,13 @@ def handle(args: argparse.Namespace) -> int:
         return rows
 
     try:
-        rows = asyncio.run(main())
+        rows = run_interruptibly(main)
+    except Interrupted as exc:
+        return fail("fleet", str(exc), exc.exit_code)
     except ClientError as exc:
         return fail("fleet", str(exc), exc.exit_code)
     except ProtocolError as exc:
         return fail("fleet", f"the central server sent a malformed robot list: {exc}", EXIT_CONNECTION)
-    except KeyboardInterrupt:
-        return fail("fleet", "interrupted by SIGINT", 128 + signal.SIGINT)
     if args.json:
         print_json({"central": f"{host}:{port}", "robots": rows})
         return EXIT_OK

@@ -16,6 +16,7 @@ from ..base.exit_codes import EXIT_OK, EXIT_USAGE
 from ..base.textsafe import visible
 from ..client import ld_data
 from ..client.connection import AriaClient
+from ..client.roles import Role
 from ..protocol.payloads.navigation import GotoGoal, GotoPose
 from ._common import UsageError, add_connection_arguments, run_with_client, unknown_name
 from ._navigate import EXIT_CODES_HELP, Expect, add_wait_arguments, navigate, require
@@ -81,4 +82,4 @@ def handle(args: argparse.Namespace) -> int:
             return EXIT_OK
         return await navigate(client, args, GotoGoal(args.goal), Expect(args.goal))
 
-    return run_with_client("goto", args, body)
+    return run_with_client("goto", args, body, role=Role.OPERATOR)

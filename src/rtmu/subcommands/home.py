@@ -6,6 +6,7 @@ import argparse
 from typing import Any
 
 from ..client.connection import AriaClient
+from ..client.roles import Role
 from ..protocol.payloads.navigation import Home
 from ._common import add_connection_arguments, run_with_client
 from ._navigate import EXIT_CODES_HELP, Expect, add_wait_arguments, navigate, require
@@ -28,4 +29,4 @@ def handle(args: argparse.Namespace) -> int:
         require(client, "home", "drive home")
         return await navigate(client, args, Home(), Expect("home"))
 
-    return run_with_client("home", args, body)
+    return run_with_client("home", args, body, role=Role.OPERATOR)

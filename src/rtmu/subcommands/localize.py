@@ -6,6 +6,7 @@ import argparse
 from typing import Any
 
 from ..client.connection import AriaClient
+from ..client.roles import Role
 from ..protocol.payloads.navigation import LocalizeToPose
 from ._common import add_connection_arguments, run_with_client
 from ._navigate import EXIT_NAV_LOST, add_wait_arguments, localize, require
@@ -33,4 +34,4 @@ def handle(args: argparse.Namespace) -> int:
         require(client, "localizeToPose", "take a pose to localize at")
         return await localize(client, args, LocalizeToPose(round(args.x), round(args.y), round(args.th)))
 
-    return run_with_client("localize", args, body)
+    return run_with_client("localize", args, body, role=Role.OPERATOR)

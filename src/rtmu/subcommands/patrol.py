@@ -10,6 +10,7 @@ from ..base.exit_codes import EXIT_OK, EXIT_USAGE
 from ..base.textsafe import visible
 from ..client import ld_data
 from ..client.connection import AriaClient
+from ..client.roles import Role
 from ._common import add_connection_arguments, run_with_client, unknown_name
 
 
@@ -33,4 +34,4 @@ def handle(args: argparse.Namespace) -> int:
         print(f"patrolling {visible(args.route)}", file=sys.stderr)
         return EXIT_OK
 
-    return run_with_client("patrol", args, body)
+    return run_with_client("patrol", args, body, role=Role.OPERATOR)

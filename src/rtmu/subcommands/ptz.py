@@ -17,6 +17,7 @@ from ..base.exit_codes import EXIT_OK, EXIT_UNSUPPORTED
 from ..base.textsafe import visible
 from ..client.connection import AriaClient
 from ..client.ptz import PtzFeed
+from ..client.roles import Role
 from ..values.state import PtzState
 from ._common import add_connection_arguments, fail, print_json, run_with_client
 
@@ -116,7 +117,7 @@ def handle(args: argparse.Namespace) -> int:
             return fail("ptz", "this camera cannot be pointed absolutely (no setCameraAbs)", EXIT_UNSUPPORTED)
         return EXIT_OK
 
-    return run_with_client("ptz", args, body)
+    return run_with_client("ptz", args, body, role=Role.OBSERVER)
 
 
 def _print_head(state: PtzState) -> None:

@@ -17,6 +17,7 @@ from ..base.exit_codes import EXIT_OK, EXIT_TIMEOUT, EXIT_USAGE
 from ..base.textsafe import visible
 from ..client.connection import AriaClient
 from ..client.custom_commands import MAX_ARGUMENT, list_commands, run_command
+from ..client.roles import Role
 from ._common import add_connection_arguments, print_json, run_with_client, unknown_name
 
 
@@ -65,4 +66,4 @@ def handle(args: argparse.Namespace) -> int:
             print(f"rtmu run: {visible(command.name)} {silent}", file=sys.stderr)
         return EXIT_OK if taken else EXIT_TIMEOUT
 
-    return run_with_client("run", args, body)
+    return run_with_client("run", args, body, role=Role.OPERATOR)

@@ -19,6 +19,7 @@ from ..base.exit_codes import EXIT_OK
 from ..client import ld_data
 from ..client.connection import AriaClient, Packet
 from ..client.errors import ClientTimeout, NotSupported, ProtocolFault
+from ..client.roles import Role
 from ..protocol.errors import ProtocolError
 from ..protocol.payloads.ld import DockInfo
 from ..protocol.payloads.robot import Update, UpdateNumbers, UpdateStrings
@@ -70,7 +71,7 @@ def handle(args: argparse.Namespace) -> int:
             return EXIT_OK
         return await stream(client, args, show)
 
-    return run_with_client("status", args, body)
+    return run_with_client("status", args, body, role=Role.OBSERVER)
 
 
 def say(message: str) -> None:
