@@ -17,6 +17,7 @@ import sys
 from collections.abc import Sequence
 
 from . import __version__, subcommands
+from .base import logs
 from .base.exit_codes import EXIT_USAGE
 
 
@@ -43,6 +44,7 @@ def build_parser() -> argparse.ArgumentParser:
 
 
 def main(argv: Sequence[str] | None = None) -> int:
+    logs.configure()  # developer notices off the operator's terminal (RTMU_LOG=warning shows them)
     parser = build_parser()
     args = parser.parse_args(argv)
     handler = getattr(args, "handler", None)

@@ -204,7 +204,9 @@ def run(args: argparse.Namespace) -> int:
     if args.verbose:
         import logging
 
-        logging.basicConfig(level=logging.INFO, format="%(asctime)s %(name)s: %(message)s")
+        from ..base import logs
+
+        logs.configure(logging.INFO)
     try:
         if args.central:
             from ._sim_central import serve_central
