@@ -17,14 +17,34 @@ import sys
 from collections.abc import Sequence
 
 from . import __version__, subcommands
-from .base import logs
+from .base import exit_codes, logs
 from .base.exit_codes import EXIT_USAGE
+
+
+class HelpFormatter(argparse.HelpFormatter):
+    """argparse's own wrapping, except that indented lines (the exit-code table) are kept as written."""
+
+    def _fill_text(self, text: str, width: int, indent: str) -> str:
+        paragraphs = []
+        for paragraph in text.split("\n\n"):
+            if paragraph.startswith(" ") or "\n " in paragraph:
+                paragraphs.append("\n".join(indent + line for line in paragraph.splitlines()))
+            else:
+                paragraphs.append(super()._fill_text(paragraph, width, indent))
+        return "\n\n".join(paragraphs)
+
+
+def exits_epilog(codes: tuple[int, ...] | None) -> str:
+    """The help's closing part: these codes' lines of the one table (all of them for ``rtmu --help``)."""
+    return "Exit codes (one table for every rtmu command):\n" + exit_codes.table_text(codes)
 
 
 def build_parser() -> argparse.ArgumentParser:
     parser = argparse.ArgumentParser(
         prog="rtmu",
         description="Teleoperate an ARIA (ArNetworking) robot; with no subcommand, open the window.",
+        epilog=exits_epilog(None),
+        formatter_class=HelpFormatter,
     )
     parser.add_argument("--version", action="version", version=f"rtmu {__version__}")
     sub = parser.add_subparsers(dest="subcommand", metavar="SUBCOMMAND")
@@ -35,6 +55,9 @@ def build_parser() -> argparse.ArgumentParser:
         register = getattr(module, "register", None)
         if register is not None:
             register(sub)
+            command = sub.choices[info.name]
+            command.formatter_class = HelpFormatter
+            command.epilog = exits_epilog(getattr(module, "EXITS", exit_codes.NETWORK))
     gui = importlib.util.find_spec("rtmu.ui.app")
     if gui is not None:
         from .ui import app as gui_app

@@ -42,7 +42,7 @@ EXIT_CODES: dict[int, str] = {
     "a missing or unreadable password source, an input file that does not exist, or an output file "
     "that exists (without --force) or cannot be written",
     EXIT_CONNECTION: "connection, login or protocol failure: refused, unreachable, rejected, closed, "
-    "or the server sent something malformed",
+    "the server sent something malformed, or a port that cannot be listened on (sim, bridge)",
     EXIT_UNSUPPORTED: "the server (or this user) does not offer what is needed",
     EXIT_TIMEOUT: "timeout: no answer, or no outcome within --limit (a navigation is stopped)",
     EXIT_REFUSED: "the server refused or could not do it: a setting refused, a goal it could not reach, "
@@ -58,8 +58,8 @@ EXIT_CODES: dict[int, str] = {
     EXIT_DOCTOR_STATUS: "doctor: no first status",
     EXIT_BAD_FILE: "a file's contents cannot be used: not a capture, recording or map RTMU reads, "
     "cut short or malformed",
-    EXIT_SIZE_LIMIT: "record: the size limit (--max-mb) was reached or the disk filled; "
-    "the recording so far is kept",
+    EXIT_SIZE_LIMIT: "record: the recording could not go on (its --max-mb limit, a full or failing disk); "
+    "what it holds is kept",
     EXIT_SIGHUP: "ended by SIGHUP (the terminal went away)",
     EXIT_SIGINT: "ended by Ctrl-C (SIGINT)",
     EXIT_SIGQUIT: "ended by SIGQUIT",
@@ -70,12 +70,28 @@ EXIT_CODES: dict[int, str] = {
 """Code → meaning. Other 128 + N: ended by signal N (any ending signal stops what the command drove)."""
 
 
+ENDED = (EXIT_SIGHUP, EXIT_SIGINT, EXIT_SIGTERM)
+"""Every command that runs a while ends by these three through its own clean-up."""
+NETWORK = (
+    EXIT_OK, EXIT_USAGE, EXIT_CONNECTION, EXIT_UNSUPPORTED, EXIT_TIMEOUT, EXIT_INTERNAL, *ENDED, EXIT_SIGPIPE
+)  # fmt: skip
+"""The codes of a subcommand that talks to a robot server (its module's ``EXITS`` when it has more)."""
+
+
 def signal_code(signum: int) -> int:
     """The code of a command ended by signal ``signum``: 128 + N, as shells report it."""
     return 128 + signum
 
 
-def table_text(codes: tuple[int, ...] | None = None, *, indent: str = "  ") -> str:
-    """The table as plain text for a ``--help`` epilog (``codes``: only those, in that order)."""
-    chosen = sorted(EXIT_CODES) if codes is None else codes
-    return "\n".join(f"{indent}{code:>3}  {EXIT_CODES[code]}" for code in chosen)
+def table_text(codes: tuple[int, ...] | None = None, *, indent: str = "  ", width: int = 79) -> str:
+    """The table as plain text for a ``--help`` epilog (``codes``: only those), in order of code."""
+    import textwrap
+
+    chosen = sorted(set(EXIT_CODES if codes is None else codes))
+    lines = []
+    for code in chosen:
+        head = f"{indent}{code:>3}  "
+        lines.append(
+            textwrap.fill(EXIT_CODES[code], width, initial_indent=head, subsequent_indent=" " * len(head))
+        )
+    return "\n".join(lines)

@@ -1,21 +1,11 @@
 """What the network subcommands share: ``HOST[:PORT]``, login options, exit codes, one-line errors.
 
 Every network subcommand takes ``HOST[:PORT]`` (default port 7272; ``[::1]:7272``
-for IPv6), ``--user``, ``--password-file`` (or a prompt — a password is never
-accepted on the command line, where other users could read it in ``ps``) and
-``--timeout``. Failures print ONE line on stderr (``rtmu NAME: what went wrong``)
-and exit with a code scripts can rely on (constants in ``rtmu.cli``):
-
-=======  =========================================================
-0        ok
-2        usage error (bad arguments)
-3        connection or login failure (refused, unreachable, rejected, closed),
-         or the server sent something malformed
-4        the server does not offer what is needed
-5        timeout
-128 + N  ended by signal N, shell style: 129 SIGHUP, 130 SIGINT (Ctrl-C),
-         131 SIGQUIT, 143 SIGTERM, 148 SIGTSTP (``rtmu drive`` after Ctrl-Z)
-=======  =========================================================
+for IPv6), ``--user``, ``--password-file``, ``--password-stdin`` (or a prompt on a terminal —
+a password is never accepted on the command line, where other users could read it in ``ps``,
+nor read from a pipe unless ``--password-stdin`` says so) and ``--timeout``. Failures print
+ONE line on stderr (``rtmu NAME: what went wrong``) and exit with a code of the one table in
+:mod:`rtmu.base.exit_codes` (printed by every ``--help``).
 
 Signals: SIGINT, SIGTERM, SIGHUP (a closed terminal or SSH session), SIGQUIT, SIGUSR1/2 and
 SIGALRM end a command through its ``finally`` blocks — ``rtmu drive`` always sends zero ratios and
@@ -89,7 +79,7 @@ class _RefusePassword(argparse.Action):
     ) -> None:
         parser.error(
             "a password is never accepted on the command line (other users can read it with ps); "
-            "use --password-file FILE, or give --user alone to be asked for it"
+            "use --password-file FILE, --password-stdin, or give --user alone to be asked for it"
         )
 
 
@@ -115,7 +105,9 @@ def _refuse_unknown_quietly(parser: argparse.ArgumentParser) -> None:
     parser.parse_known_args = parse_known_args  # type: ignore[method-assign,assignment]
 
 
-def add_connection_arguments(parser: argparse.ArgumentParser) -> None:
+def add_connection_arguments(parser: argparse.ArgumentParser, *, robot: bool = True) -> None:
+    """``HOST[:PORT]``, the login options, ``--timeout``; ``robot``: also ``--robot NAME`` (through a
+    central server), which a command that lists the central server's robots itself does not take."""
     # No abbreviations: "--password secret" must not be taken for "--password-file secret".
     parser.allow_abbrev = False
     _refuse_unknown_quietly(parser)
@@ -123,13 +115,20 @@ def add_connection_arguments(parser: argparse.ArgumentParser) -> None:
     parser.add_argument(
         "server", type=host_port, metavar="HOST[:PORT]", help="robot server (port 7272 by default)"
     )
-    parser.add_argument("--user", default="", help="user name, if the server has a user file")
+    parser.add_argument("--user", default="", metavar="USER", help="user name, if the server has a user file")
     parser.add_argument("--password", nargs="?", action=_RefusePassword, help=argparse.SUPPRESS)
     parser.add_argument(
         "--password-file",
         type=Path,
         metavar="FILE",
-        help="read the password from the first line of FILE (else it is asked for when --user is given)",
+        help="read the password from the first line of FILE (else it is asked for on the terminal when "
+        "--user is given)",
+    )
+    parser.add_argument(
+        "--password-stdin",
+        action="store_true",
+        help="read the password from the first line of standard input (for scripts; nothing else reads "
+        "a password from a pipe)",
     )
     parser.add_argument(
         "--protocol",
@@ -145,13 +144,14 @@ def add_connection_arguments(parser: argparse.ArgumentParser) -> None:
         metavar="S",
         help=f"seconds to wait for the server at each step (default {CONNECT_TIMEOUT:g})",
     )
-    parser.add_argument(
-        "--robot",
-        metavar="NAME",
-        default=None,
-        help="HOST[:PORT] is an ARIA central server: act on its robot NAME, through the port it "
-        "forwards that robot on ('rtmu fleet HOST' lists them)",
-    )
+    if robot:
+        parser.add_argument(
+            "--robot",
+            metavar="NAME",
+            default=None,
+            help="HOST[:PORT] is an ARIA central server: act on its robot NAME, through the port it "
+            "forwards that robot on ('rtmu fleet HOST' lists them)",
+        )
 
 
 def _resolve_robot_first(parser: argparse.ArgumentParser) -> None:
@@ -224,7 +224,8 @@ class UsageError(Exception):
 
 
 def read_password(args: argparse.Namespace) -> str:
-    """From ``--password-file``, else a prompt on the terminal (or one line of stdin when piped)."""
+    """From ``--password-file``, ``--password-stdin`` or a prompt on the terminal; :class:`UsageError`
+    (exit 2, with the reason) when ``--user`` is given and none of them can supply it."""
     cached = getattr(args, "password_read", None)
     if isinstance(cached, str):  # asked already (for the central server of --robot): never twice
         return cached
@@ -248,12 +249,19 @@ def _read_password(args: argparse.Namespace) -> str:
         except OSError as exc:
             raise UsageError(f"cannot read the password file {path}: {exc.strerror or exc}") from None
         return data.decode("utf-8", "replace").splitlines()[0] if data else ""
+    if getattr(args, "password_stdin", False):
+        line = sys.stdin.readline() if sys.stdin is not None else ""
+        if not line:
+            raise UsageError("--password-stdin: standard input ended without a password line")
+        return line.rstrip("\r\n")
     if not args.user:
         return ""
     if sys.stdin is not None and sys.stdin.isatty():
         return getpass.getpass(f"Password for {args.user}@{args.server[0]}: ")
-    line = sys.stdin.readline() if sys.stdin is not None else ""
-    return line.rstrip("\r\n")
+    raise UsageError(
+        f"--user {args.user} needs a password and there is no terminal to ask on: give --password-file "
+        "FILE or --password-stdin (one line on standard input)"
+    )
 
 
 INTERRUPT_SIGNALS = (
@@ -279,14 +287,22 @@ class Interrupted(Exception):
         super().__init__(f"interrupted by {signal_name(signum)}" + (f"; {detail}" if detail else ""))
 
 
-async def until_stop_signal() -> None:
-    """Wait for Ctrl-C or SIGTERM: how a long-running server (``rtmu sim``) is told to stop cleanly."""
+async def until_stop_signal() -> int:
+    """Wait for Ctrl-C, SIGTERM or SIGHUP: how a long-running server (``rtmu sim``) is told to stop
+    cleanly. Returns the exit code that says which came (128 + its number, as every command)."""
     stop = asyncio.Event()
+    came: list[int] = []
     loop = asyncio.get_running_loop()
-    for sig in (signal.SIGINT, signal.SIGTERM):
+
+    def caught(signum: int) -> None:
+        came.append(signum)
+        stop.set()
+
+    for sig in (signal.SIGINT, signal.SIGTERM, signal.SIGHUP):
         with contextlib.suppress(NotImplementedError, RuntimeError):
-            loop.add_signal_handler(sig, stop.set)
+            loop.add_signal_handler(sig, caught, sig)
     await stop.wait()
+    return 128 + came[0]
 
 
 def signal_name(signum: int) -> str:

@@ -5,12 +5,12 @@ from __future__ import annotations
 import dataclasses
 import sys
 
+from ..base.exit_codes import EXIT_CONNECTION, EXIT_USAGE
 from ..sim import SimConfig
 from ._common import until_stop_signal
 
-EXIT_OK = 0
-EXIT_BAD_INPUT = 2
-EXIT_CANNOT_LISTEN = 3
+EXIT_BAD_INPUT = EXIT_USAGE
+EXIT_CANNOT_LISTEN = EXIT_CONNECTION
 
 
 async def serve_central(cfg: SimConfig, robot_port: int, robots: int) -> int:
@@ -52,9 +52,9 @@ async def serve_central(cfg: SimConfig, robot_port: int, robots: int) -> int:
             sims.append(sim)
         if robots:
             print(f"rtmu sim: {robots} simulated robot(s) switching to it: robot1…robot{robots}", flush=True)
-        await until_stop_signal()
+        code = await until_stop_signal()
         print("rtmu sim: stopping (telling operators and robots SHUTDOWN)", flush=True)
-        return EXIT_OK
+        return code
     except (OSError, MapFormatError, ValueError) as exc:
         print(f"rtmu sim: cannot start the robots: {exc}", file=sys.stderr)
         return EXIT_BAD_INPUT

@@ -89,7 +89,7 @@ def handle(args: argparse.Namespace) -> int:
         try:
             bridge.start()
         except Exception as exc:
-            return fail("bridge", f"cannot serve on {args.bind}:{args.ws_port}: {exc}", EXIT_USAGE)
+            return fail("bridge", f"cannot serve on {args.bind}:{args.ws_port}: {exc}", EXIT_CONNECTION)
         code = serve(args, runner, bridge, ending, password)
     if ending.exit_code is not None and code == EXIT_OK:
         return fail("bridge", f"ended by {signal_name(ending.signum or 0)}", ending.exit_code)

@@ -13,7 +13,7 @@ import math
 import sys
 from typing import Any
 
-from ..base.exit_codes import EXIT_OK, EXIT_USAGE
+from ..base.exit_codes import EXIT_OK, EXIT_REFUSED, EXIT_USAGE, NETWORK
 from ..base.textsafe import visible
 from ..client.config_feed import ServerConfig, fetch_config, set_config
 from ..client.connection import AriaClient
@@ -21,7 +21,6 @@ from ..client.roles import Role
 from ..protocol.payloads.config import ConfigParam, ParamType, Priority
 from ._common import add_connection_arguments, print_json, run_with_client
 
-EXIT_REFUSED = 6
 """The server refused a value (its message is printed)."""
 MAX_ASSIGNMENTS = 1000
 
@@ -46,6 +45,9 @@ def parse_assignment(text: str, parser: Any) -> tuple[str, str, str]:
     except UnicodeEncodeError:
         parser.error(f"--set {text!r}: ARIA strings carry latin-1 characters only")
     return section.strip(), name.strip(), value
+
+
+EXITS = (*NETWORK, EXIT_REFUSED)
 
 
 def register(subparsers: Any) -> None:

@@ -19,7 +19,18 @@ import time
 from dataclasses import dataclass, field
 from typing import Any
 
-from ..base.exit_codes import EXIT_OK, EXIT_USAGE
+from ..base.exit_codes import (
+    ENDED,
+    EXIT_DOCTOR_DATALIST,
+    EXIT_DOCTOR_INTRODUCTION,
+    EXIT_DOCTOR_LOGIN,
+    EXIT_DOCTOR_RESOLVE,
+    EXIT_DOCTOR_STATUS,
+    EXIT_DOCTOR_TCP,
+    EXIT_INTERNAL,
+    EXIT_OK,
+    EXIT_USAGE,
+)
 from ..base.textsafe import visible
 from ..client.connection import TEXT_BANNERS
 from ..client.diagnosis import ADVICE, Step, login_finding
@@ -48,6 +59,10 @@ from ._common import (
     run_interruptibly,
 )
 
+EXITS = (
+    EXIT_OK, EXIT_INTERNAL, EXIT_USAGE, EXIT_DOCTOR_RESOLVE, EXIT_DOCTOR_TCP, EXIT_DOCTOR_INTRODUCTION,
+    EXIT_DOCTOR_LOGIN, EXIT_DOCTOR_DATALIST, EXIT_DOCTOR_STATUS, *ENDED,
+)  # fmt: skip
 READ_CHUNK = 65536
 NOT_ARIA_AFTER = 4096
 """Bytes without a single valid packet after which the peer is taken for something else."""
@@ -408,8 +423,11 @@ def register(subparsers: Any) -> None:
     p = subparsers.add_parser(
         "doctor",
         help="find out why a robot does not connect, step by step",
-        description=__doc__,
-        formatter_class=argparse.RawDescriptionHelpFormatter,
+        description="Walk the whole way to a robot and say, step by step, what worked: name resolution, "
+        "TCP connect, the server's introduction (its version tag and protocol string), the login, the "
+        "data list (and which RTMU features the server offers), UDP, the first status. For the first "
+        "step that fails it says in plain words what went wrong and what to do next (the words the "
+        "window uses), and stops there; the exit code names the step. UDP never fails it: RTMU uses TCP.",
     )
     add_connection_arguments(p)
     p.add_argument(

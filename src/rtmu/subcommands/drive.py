@@ -23,7 +23,7 @@ import sys
 from collections.abc import Callable
 from typing import Any
 
-from ..base.exit_codes import EXIT_OK
+from ..base.exit_codes import EXIT_OK, EXIT_SIGQUIT, EXIT_SIGTSTP, EXIT_USAGE, NETWORK
 from ..base.textsafe import visible
 from ..client.connection import AriaClient
 from ..client.drive_guard import DriveGuard, LinkFault
@@ -51,6 +51,9 @@ SETTLE = 3.0
 """At most this long to wait for the robot to come to rest before printing the final pose."""
 AFTER_INTERRUPT = 1.0
 """After a signal, at most this long (stop already sent) for the pose printed as ``after``."""
+
+
+EXITS = (*NETWORK, EXIT_SIGQUIT, EXIT_SIGTSTP)
 
 
 def register(subparsers: Any) -> None:
@@ -151,7 +154,7 @@ def handle(args: argparse.Namespace) -> int:
         check(args)
     except UsageError as exc:
         print(f"rtmu drive: {exc}", file=sys.stderr)
-        return 2
+        return EXIT_USAGE
     return run_with_client("drive", args, body, role=Role.OPERATOR)
 
 

@@ -41,10 +41,14 @@ def register(subparsers: Any) -> None:
     p = subparsers.add_parser(
         "fleet",
         help="list the robots behind an ARIA central server, with their status",
-        description=__doc__,
-        formatter_class=argparse.RawDescriptionHelpFormatter,
+        description="Ask an ARIA central server (ARIA's switchServer, or rtmu sim --central) for its "
+        "robots and the port it forwards each on, then read one status from every robot through that "
+        "port (all at once, each within --timeout). --json prints one object (schema: fleet): "
+        '{"central": "HOST:PORT", "robots": [{"name", "host", "port", "address", "status"}]} where '
+        'status is what rtmu status --json prints, or {"error": "..."} for a robot that did not answer. '
+        "Act on one of them with any other subcommand's --robot NAME.",
     )
-    add_connection_arguments(p)
+    add_connection_arguments(p, robot=False)  # it lists every robot: no --robot NAME
     p.add_argument("--json", action="store_true", help="one JSON object (see above)")
     p.add_argument("--no-status", action="store_true", help="list only; do not log in to each robot")
     p.set_defaults(handler=handle)
@@ -68,8 +72,6 @@ async def _status(
 
 
 def handle(args: argparse.Namespace) -> int:
-    if args.robot is not None:
-        return fail("fleet", "--robot does not apply to 'rtmu fleet': it lists every robot", EXIT_USAGE)
     try:
         password = read_password(args)
     except UsageError as exc:

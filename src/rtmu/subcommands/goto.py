@@ -19,7 +19,7 @@ from ..client.connection import AriaClient
 from ..client.roles import Role
 from ..protocol.payloads.navigation import GotoGoal, GotoPose
 from ._common import UsageError, add_connection_arguments, run_with_client, unknown_name
-from ._navigate import EXIT_CODES_HELP, Expect, add_wait_arguments, navigate, require
+from ._navigate import NAVIGATION_EXITS, Expect, add_wait_arguments, navigate, require
 
 RULE = (
     "GOAL goes as ARNL's gotoGoal wherever the server lists it, and the command follows the robot to "
@@ -29,11 +29,14 @@ RULE = (
 )
 
 
+EXITS = NAVIGATION_EXITS
+
+
 def register(subparsers: Any) -> None:
     p = subparsers.add_parser(
         "goto",
         help="drive to a goal of the map or to a point (gotoGoal / gotoPose; LD robots: gotoRouteGoal)",
-        description=f"{RULE} Ctrl-C stops the robot. {EXIT_CODES_HELP}.",
+        description=f"{RULE} Ctrl-C, SIGTERM and SIGHUP stop the robot.",
     )
     add_connection_arguments(p)
     p.add_argument("goal", metavar="GOAL", nargs="?", help="goal name, as the map names it")

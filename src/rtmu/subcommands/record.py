@@ -19,7 +19,7 @@ import threading
 from pathlib import Path
 from typing import Any
 
-from ..base.exit_codes import EXIT_CONNECTION, EXIT_OK, EXIT_SIZE_LIMIT, EXIT_USAGE
+from ..base.exit_codes import EXIT_CONNECTION, EXIT_OK, EXIT_SIZE_LIMIT, EXIT_USAGE, NETWORK
 from ..base.notices import Kind, Notice
 from ..base.textsafe import visible
 from ..client.errors import ClientError
@@ -32,6 +32,8 @@ from ._common import UsageError, add_connection_arguments, fail, positive_float,
 from ._follow import EndingSignals, follow, until_connected
 from ._options import add_fps_option
 from ._output import add_force_option, check_file, partial_path, settle
+
+EXITS = (*NETWORK, EXIT_SIZE_LIMIT)
 
 
 def register(subparsers: Any) -> None:

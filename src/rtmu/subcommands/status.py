@@ -32,30 +32,43 @@ from ._common import (
     status_line,
     status_object,
 )
+from ._options import number_in
+
+HEARTBEAT = 1.0
+"""Seconds: an unchanged status is printed again this often, so a reader knows the link is alive."""
 
 
 def register(subparsers: Any) -> None:
     p = subparsers.add_parser(
         "status",
         help="print or stream the robot status",
-        description="Print the robot status once (--once) or stream it until interrupted. "
-        "JSON keys: x, y (mm), th (deg), vel (mm/s), rot_vel (deg/s), battery_v (volts) or "
-        "battery_pct (state of charge), status, mode.",
+        description="Print the robot status once (--once) or stream it until interrupted: a line whenever "
+        f"the status changes, and the same line again at most every {HEARTBEAT:g} s while it does not "
+        "(a heartbeat: the link is alive). JSON keys (schema: status): x, y (mm), th (deg), vel (mm/s), "
+        "rot_vel (deg/s), battery_v (volts) or battery_pct (state of charge), status, mode, and dock "
+        "where the server offers dockInfo.",
     )
     add_connection_arguments(p)
     p.add_argument("--once", action="store_true", help="print one status and exit")
     p.add_argument("--json", action="store_true", help="JSON: one object (one per line when streaming)")
     p.add_argument(
-        "--interval", type=int, default=100, metavar="MS", help="update interval when streaming (default 100)"
+        "--interval",
+        type=number_in(10, 60_000, integer=True),
+        default=100,
+        metavar="MS",
+        help="how often the server is asked for the status when streaming, 10…60000 ms (default 100)",
     )
-    p.add_argument("--count", type=int, default=0, metavar="N", help="stop after N updates (0 = never)")
+    p.add_argument(
+        "--count",
+        type=number_in(0, 1e9, integer=True),
+        default=0,
+        metavar="N",
+        help="stop after N lines (default 0: never)",
+    )
     p.set_defaults(handler=handle)
 
 
 def handle(args: argparse.Namespace) -> int:
-    if args.interval < 10:
-        args.interval = 10
-
     def show(obj: dict[str, Any]) -> None:
         if args.json:
             print_json(obj)
@@ -135,6 +148,8 @@ async def stream(client: AriaClient, args: argparse.Namespace, show: Any) -> int
     """Silence this long is worth a word on stderr before the timeout ends the stream."""
     last = loop.time()
     quiet = False
+    printed: dict[str, Any] | None = None
+    printed_at = 0.0
     while args.count <= 0 or shown < args.count:
         deadline = loop.time() + gap
         while queue.empty():
@@ -154,6 +169,9 @@ async def stream(client: AriaClient, args: argparse.Namespace, show: Any) -> int
             quiet = False
             say(f"status resumed after {loop.time() - last:.1f} s")
         last = loop.time()
-        show(queue.get_nowait())
-        shown += 1
+        current = queue.get_nowait()
+        if current != printed or last - printed_at >= HEARTBEAT:  # a change, or the heartbeat is due
+            show(current)
+            printed, printed_at = current, last
+            shown += 1
     return EXIT_OK
