@@ -93,9 +93,12 @@ def test_status_once_and_streamed_json(
 
 def test_password_from_a_pipe(sim: SimThread, monkeypatch: pytest.MonkeyPatch, capsys) -> None:  # type: ignore[no-untyped-def]
     monkeypatch.setattr("sys.stdin", io.StringIO("secret1\n"))
-    assert main(["status", addr(sim), "--user", "alice", "--once"]) == EXIT_OK
+    assert main(["status", addr(sim), "--user", "alice", "--once"]) == EXIT_USAGE  # only when asked to
+    assert "--password-stdin" in capsys.readouterr().err
+    monkeypatch.setattr("sys.stdin", io.StringIO("secret1\n"))
+    assert main(["status", addr(sim), "--user", "alice", "--password-stdin", "--once"]) == EXIT_OK
     monkeypatch.setattr("sys.stdin", io.StringIO("wrong\n"))
-    assert main(["status", addr(sim), "--user", "alice", "--once"]) == EXIT_CONNECTION
+    assert main(["status", addr(sim), "--user", "alice", "--password-stdin", "--once"]) == EXIT_CONNECTION
     err = capsys.readouterr().err
     assert err.count("\n") == 1 and err.startswith("rtmu status: login refused: wrong user name or password")
 
