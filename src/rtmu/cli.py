@@ -19,6 +19,7 @@ from collections.abc import Sequence
 from . import __version__, subcommands
 from .base import exit_codes, logs
 from .base.exit_codes import EXIT_USAGE
+from .subcommands.json_schemas import COMMAND_SCHEMA
 
 
 class HelpFormatter(argparse.HelpFormatter):
@@ -37,6 +38,13 @@ class HelpFormatter(argparse.HelpFormatter):
 def exits_epilog(codes: tuple[int, ...] | None) -> str:
     """The help's closing part: these codes' lines of the one table (all of them for ``rtmu --help``)."""
     return "Exit codes (one table for every rtmu command):\n" + exit_codes.table_text(codes)
+
+
+def name_schema(command: argparse.ArgumentParser, schema: str | None) -> None:
+    """Say in ``--json``'s help which published schema its lines follow (``subcommands.json_schemas``)."""
+    for action in command._actions:
+        if schema is not None and "--json" in action.option_strings and action.help:
+            action.help += f" (schema {schema!r}: python -m rtmu.subcommands.json_schemas {schema})"
 
 
 def build_parser() -> argparse.ArgumentParser:
@@ -58,6 +66,7 @@ def build_parser() -> argparse.ArgumentParser:
             command = sub.choices[info.name]
             command.formatter_class = HelpFormatter
             command.epilog = exits_epilog(getattr(module, "EXITS", exit_codes.NETWORK))
+            name_schema(command, COMMAND_SCHEMA.get(info.name))
     gui = importlib.util.find_spec("rtmu.ui.app")
     if gui is not None:
         from .ui import app as gui_app

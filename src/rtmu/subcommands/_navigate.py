@@ -55,14 +55,14 @@ def add_wait_arguments(parser: argparse.ArgumentParser, *, localizing: bool = Fa
         limit = f"give up waiting for the server's answer after S seconds, exit 5 (default {DEFAULT_LIMIT:g})"
         no_wait = "send localizeToPose and exit 0 without waiting for the server to confirm it"
         lines = (
-            'one object per line (schema: localize): {"localization": "initializing"} while it '
+            'one object per line: {"localization": "initializing"} while it '
             'localizes, then {"outcome": "localized" | "lost" | "timeout", "score"}; --no-wait: {"sent"}'
         )
     else:
         limit = f"give up after S seconds: stop the robot, exit 5 (default {DEFAULT_LIMIT:g})"
         no_wait = "send the command and exit 0; the robot drives on by itself"
         lines = (
-            'one object per line (schema: navigate): {"status", "phase"} as the server reports, '
+            'one object per line: {"status", "phase"} as the server reports, '
             '{"remaining_mm"} every metre or so, and a last {"outcome", "text", "reason", "x", "y", "th"} '
             '(also after Ctrl-C: outcome "interrupted", with "signal"); --no-wait: {"sent"}'
         )

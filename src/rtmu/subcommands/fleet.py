@@ -43,7 +43,7 @@ def register(subparsers: Any) -> None:
         help="list the robots behind an ARIA central server, with their status",
         description="Ask an ARIA central server (ARIA's switchServer, or rtmu sim --central) for its "
         "robots and the port it forwards each on, then read one status from every robot through that "
-        "port (all at once, each within --timeout). --json prints one object (schema: fleet): "
+        "port (all at once, each within --timeout). --json prints one object: "
         '{"central": "HOST:PORT", "robots": [{"name", "host", "port", "address", "status"}]} where '
         'status is what rtmu status --json prints, or {"error": "..."} for a robot that did not answer. '
         "Act on one of them with any other subcommand's --robot NAME.",

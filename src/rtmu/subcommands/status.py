@@ -44,7 +44,7 @@ def register(subparsers: Any) -> None:
         help="print or stream the robot status",
         description="Print the robot status once (--once) or stream it until interrupted: a line whenever "
         f"the status changes, and the same line again at most every {HEARTBEAT:g} s while it does not "
-        "(a heartbeat: the link is alive). JSON keys (schema: status): x, y (mm), th (deg), vel (mm/s), "
+        "(a heartbeat: the link is alive). JSON keys (schema status): x, y (mm), th (deg), vel (mm/s), "
         "rot_vel (deg/s), battery_v (volts) or battery_pct (state of charge), status, mode, and dock "
         "where the server offers dockInfo.",
     )
