@@ -192,3 +192,20 @@ def test_a_reader_that_goes_away_is_141(sim: SimThread) -> None:
     err.start()
     assert proc.wait(60) == EXIT_SIGPIPE
     check("status", EXIT_SIGPIPE, EXIT_SIGPIPE)
+
+
+def test_an_unreadable_recording_says_why_in_plain_words(
+    tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    """No empty reason for a cut-short file, no byte tuple for one that is no MCAP at all."""
+    junk = tmp_path / "notes.mcap"
+    junk.write_bytes(b"hello, these are notes")
+    cut = tmp_path / "cut.mcap"
+    cut.write_bytes(b"\x89MCAP0\r\n" + b"\x01" + b"\x00" * 20)  # MCAP's magic, then half a record
+    check("replay", run("replay", str(junk)), EXIT_BAD_FILE)  # (decode reads it as the text it is)
+    err = capsys.readouterr().err
+    assert "it does not start as an MCAP file does" in err and "(104," not in err, err
+    for name in ("replay", "decode"):
+        check(name, run(name, str(cut)), EXIT_BAD_FILE)
+        err = capsys.readouterr().err
+        assert err.rstrip().endswith("it is cut short: it ends in the middle of a record"), err

@@ -341,3 +341,15 @@ def test_drive_json_after_ctrl_c_says_it_was_interrupted(sim: SimThread, pwfile:
             proc.kill()
             proc.wait()
     assert obj["interrupted"] == "SIGINT" and set(obj["after"]) == STATUS_KEYS and obj["seconds"] == 20
+
+
+def test_drive_inside_arias_dead_zone_says_the_robot_will_not_move(
+    sim: SimThread, pwfile: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    before = sim.snapshot()
+    assert main(["drive", *login(sim, pwfile), "--trans", "10", "--seconds", "0.5"]) == EXIT_OK
+    assert "inside ARIA's dead zone" in capsys.readouterr().err
+    after = sim.snapshot()
+    assert (after.x, after.y) == (before.x, before.y), "ARIA's dead zone: it really did not move"
+    assert main(["drive", *login(sim, pwfile), "--trans", "11", "--seconds", "0.3"]) == EXIT_OK
+    assert "dead zone" not in capsys.readouterr().err

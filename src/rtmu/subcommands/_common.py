@@ -558,7 +558,6 @@ async def battery_is_soc(client: AriaClient, timeout: float) -> bool:
 
 async def fetch_status(client: AriaClient, timeout: float) -> dict[str, Any]:
     """One status from ``updateNumbers`` + ``updateStrings`` (or the old ``update``)."""
-    from ..client.errors import NotSupported
     from ..protocol.payloads.robot import Update, UpdateNumbers, UpdateStrings
 
     if client.supports("updateNumbers"):
@@ -575,18 +574,32 @@ async def fetch_status(client: AriaClient, timeout: float) -> dict[str, Any]:
         assert isinstance(update, Update)
         soc = await battery_is_soc(client, timeout)
         return status_object(update.numbers, update.status, update.mode, soc=soc)
-    raise NotSupported("updateNumbers", "this server offers no robot status (updateNumbers or update)")
+    raise no_status(client)
 
 
-def unknown_name(command: str, kind: str, name: str, known: tuple[str, ...]) -> bool:
-    """True (with one line on stderr naming what the server does list) when ``name`` is not in
-    ``known``: a route or goal the server does not have is the user's mistake (exit 2)."""
+def no_status(client: AriaClient) -> Exception:
+    """Why there is no robot status: ARIA's central server has robots, not a status of its own."""
+    from ..client.diagnosis import central_server_words
+    from ..client.errors import NotSupported
+
+    if client.supports("clientList"):
+        return NotSupported("updateNumbers", central_server_words(f"{client.host}:{client.port}"))
+    return NotSupported("updateNumbers", "this server offers no robot status (updateNumbers or update)")
+
+
+def known_name(command: str, kind: str, name: str, known: tuple[str, ...]) -> str | None:
+    """The server's own spelling of ``name`` among ``known``, compared case-insensitively as ARIA
+    compares goal names (an exact match first); None, with one line on stderr naming what the
+    server does list, when it has no such name — the user's mistake (exit 2)."""
     if name in known:
-        return False
+        return name
+    folded = [k for k in known if k.casefold() == name.casefold()]
+    if len(folded) == 1:
+        return folded[0]
     from ..base.textsafe import visible
 
     listed = visible(", ".join(known) or "none")
     print(
         f"rtmu {command}: no {kind} {visible(repr(name))} on this server ({kind}s: {listed})", file=sys.stderr
     )
-    return True
+    return None

@@ -18,6 +18,7 @@ async def serve_central(cfg: SimConfig, robot_port: int, robots: int) -> int:
     from ..mapfile import MapFormatError
     from ..sim import SimServer
     from ..sim.central import CentralConfig, CentralServer
+    from ..sim.multi import start_poses
 
     # The user file guards the central port and the forwarders, as ARIA's switchServer's does; the
     # robots behind it let the forwarder in (it logs in without a user).
@@ -37,9 +38,11 @@ async def serve_central(cfg: SimConfig, robot_port: int, robots: int) -> int:
     )
     sims: list[SimServer] = []
     try:
-        for i in range(1, robots + 1):
+        # Start poses apart, as `rtmu sim --robots N` gives them (not all on the map's home).
+        for i, pose in enumerate(start_poses(cfg, robots), start=1):
             robot_cfg = dataclasses.replace(
                 cfg,
+                start_pose=pose,
                 port=0,
                 seed=cfg.seed + i - 1,
                 switch_to=f"{cfg.host}:{central.robot_port}",

@@ -33,7 +33,7 @@ from ..base.exit_codes import (
 )
 from ..base.textsafe import visible
 from ..client.connection import TEXT_BANNERS
-from ..client.diagnosis import ADVICE, Step, login_finding
+from ..client.diagnosis import ADVICE, Step, central_server_words, login_finding
 from ..protocol.client_connection import ClientConnection
 from ..protocol.commands import ClientCommand, ServerCommand
 from ..protocol.decoder import PacketDecoder
@@ -367,6 +367,9 @@ class Doctor:
         assert conn is not None
         name = "updateNumbers" if "updateNumbers" in conn.datalist else "update"
         if name not in conn.datalist:
+            if "clientList" in conn.datalist:  # it lists robots instead of being one
+                where = f"{self.host}:{self.port}"
+                raise fail(Step.STATUS, central_server_words(where), ADVICE["central_server"])
             raise fail(Step.STATUS, "the server offers no robot status", ADVICE["status_missing"])
         soc = False
         if "batteryInfo" in conn.datalist:

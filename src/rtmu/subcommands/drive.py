@@ -31,7 +31,7 @@ from ..client.errors import ClientError, NotSupported
 from ..client.roles import Role
 from ..guardian.handle import GuardianHandle, GuardianUnavailable, beat_network, start_ready
 from ..guardian.messages import Hello
-from ..protocol.payloads.drive import RatioDrive
+from ..protocol.payloads.drive import RATIO_ROT_DEAD_ZONE, RATIO_TRANS_DEAD_ZONE, RatioDrive
 from ._common import (
     Interrupted,
     UsageError,
@@ -93,6 +93,15 @@ def handle(args: argparse.Namespace) -> int:
             raise NotSupported(
                 "ratioDrive", "this server (or this user) may not drive the robot (no ratioDrive)"
             )
+        ratios = RatioDrive(args.trans, args.rot, args.throttle)
+        if ratios.in_dead_zone:  # ARIA would take it and not move: say so rather than exit 0 silently
+            print(
+                f"rtmu drive: warning: --trans {args.trans:g} --rot {args.rot:g} is inside ARIA's dead "
+                f"zone (translation up to ±{RATIO_TRANS_DEAD_ZONE:g} %, rotation under "
+                f"±{RATIO_ROT_DEAD_ZONE:g} %): the robot will not move",
+                file=sys.stderr,
+                flush=True,
+            )
         guardian = await start_guardian(args)
         guard = DriveGuard(client)
         guard.start()  # before the first status fetch, so the link is watched from the start
@@ -114,7 +123,6 @@ def handle(args: argparse.Namespace) -> int:
         if guardian is not None:
             guardian.arm()  # it stops the robot if this process is killed or frozen from here on
         try:
-            ratios = RatioDrive(args.trans, args.rot, args.throttle)
             await drive(client, ratios, args.seconds, held=lambda: interrupts.suspending, guard=guard)
         except asyncio.CancelledError:
             signum = interrupts.take()

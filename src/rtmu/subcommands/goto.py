@@ -18,7 +18,7 @@ from ..client import ld_data
 from ..client.connection import AriaClient
 from ..client.roles import Role
 from ..protocol.payloads.navigation import GotoGoal, GotoPose
-from ._common import UsageError, add_connection_arguments, run_with_client, unknown_name
+from ._common import UsageError, add_connection_arguments, known_name, run_with_client
 from ._navigate import NAVIGATION_EXITS, Expect, add_wait_arguments, navigate, require
 
 RULE = (
@@ -77,8 +77,10 @@ def handle(args: argparse.Namespace) -> int:
             require(client, "gotoGoal", "drive to goals")
         if client.supports("getGoals"):
             known = await ld_data.goals(client, args.timeout)
-            if unknown_name("goto", "goal", args.goal, known):
+            goal = known_name("goto", "goal", args.goal, known)
+            if goal is None:
                 return EXIT_USAGE
+            args.goal = goal  # as the map spells it: what the server's words will name
         if route:
             ld_data.goto_route_goal(client, args.goal)
             print(f"going to {visible(args.goal)}", file=sys.stderr)

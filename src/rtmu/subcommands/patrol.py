@@ -11,7 +11,7 @@ from ..base.textsafe import visible
 from ..client import ld_data
 from ..client.connection import AriaClient
 from ..client.roles import Role
-from ._common import add_connection_arguments, run_with_client, unknown_name
+from ._common import add_connection_arguments, known_name, run_with_client
 
 
 def register(subparsers: Any) -> None:
@@ -28,8 +28,10 @@ def register(subparsers: Any) -> None:
 def handle(args: argparse.Namespace) -> int:
     async def body(client: AriaClient) -> int:
         known = await ld_data.routes(client, args.timeout)
-        if unknown_name("patrol", "route", args.route, known):
+        route = known_name("patrol", "route", args.route, known)
+        if route is None:
             return EXIT_USAGE
+        args.route = route
         ld_data.patrol(client, args.route)
         print(f"patrolling {visible(args.route)}", file=sys.stderr)
         return EXIT_OK

@@ -18,7 +18,7 @@ from typing import Any
 from ..base.exit_codes import EXIT_OK
 from ..client import ld_data
 from ..client.connection import AriaClient, Packet
-from ..client.errors import ClientTimeout, NotSupported, ProtocolFault
+from ..client.errors import ClientTimeout, ProtocolFault
 from ..client.roles import Role
 from ..protocol.errors import ProtocolError
 from ..protocol.payloads.ld import DockInfo
@@ -27,6 +27,7 @@ from ._common import (
     add_connection_arguments,
     battery_is_soc,
     fetch_status,
+    no_status,
     print_json,
     run_with_client,
     status_line,
@@ -139,7 +140,7 @@ async def stream(client: AriaClient, args: argparse.Namespace, show: Any) -> int
     elif client.supports("update"):
         client.request("update", args.interval, on_numbers)
     else:
-        raise NotSupported("updateNumbers", "this server offers no robot status (updateNumbers or update)")
+        raise no_status(client)
     shown = 0
     # A status must come within the interval plus the timeout, or the link is dead.
     gap = args.interval / 1000.0 + args.timeout
