@@ -200,6 +200,12 @@ def handle(args: argparse.Namespace) -> int:
                 f"from {visible(source)} in "
                 f"{elapsed:.1f} s: {summary['fps']} fps, {summary['kbps']} kB/s{age}"
                 + (f"; {summary['dropped']} dropped" if summary["dropped"] else "")
+                + (
+                    f"; {summary['repeats']} repeats (the camera had no newer picture: it is slower than "
+                    "asked, not the link)"
+                    if summary["repeats"]
+                    else ""
+                )
                 + (f"; {visible(status.backoff)}" if status.backoff else "")
             )
         if player.decoded == 0:
