@@ -12,7 +12,7 @@ from collections.abc import Iterator
 
 import pytest
 
-from rtmu.base.exit_codes import EXIT_DOCTOR_STATUS, EXIT_OK, EXIT_UNSUPPORTED, EXIT_USAGE
+from rtmu.base.exit_codes import EXIT_DOCTOR_STATUS, EXIT_LOST, EXIT_OK, EXIT_UNSUPPORTED, EXIT_USAGE
 from rtmu.cli import main
 from rtmu.sim import SimThread
 from rtmu.sim.central_thread import CentralThread
@@ -54,3 +54,55 @@ def test_status_and_doctor_name_a_central_server(capsys: pytest.CaptureFixture[s
         assert main(["doctor", where, "--timeout", "5"]) == EXIT_DOCTOR_STATUS
         out = capsys.readouterr().out
         assert "ARIA's central server" in out and "rtmu --central" in out
+
+
+def test_dock_after_a_goto_on_an_ld_robot_ends_docked_not_at_the_limit(aram: SimThread) -> None:
+    """The status still reads "Arrived at …" while dockInfo says Docked: the dock state answers."""
+    where = f"127.0.0.1:{aram.port}"
+    reset(aram)
+    assert main(["goto", where, "Room 101", "--timeout", "5", "--limit", "60"]) == EXIT_OK
+    assert main(["dock", where, "--timeout", "5", "--limit", "60"]) == EXIT_OK
+    snap = robot(aram)
+    assert aram.call(lambda: aram.server.world.dock_mode.state.name) == "DOCKED"  # type: ignore[union-attr]
+    assert abs(snap.x - 800) < 300 and abs(snap.y - 6000) < 300, "it drove to the charger"
+
+
+def test_an_ld_robots_patrol_and_route_goal_drive_it(aram: SimThread) -> None:
+    where = f"127.0.0.1:{aram.port}"
+    reset(aram)
+    before = robot(aram)
+    assert main(["patrol", where, "Loop", "--timeout", "5"]) == EXIT_OK
+    eventually(lambda: robot(aram).status.startswith("Touring to"), timeout=10)
+    eventually(lambda: abs(robot(aram).x - before.x) + abs(robot(aram).y - before.y) > 500, timeout=30)
+    assert main(["goto", where, "Lab A", "--route", "--timeout", "5"]) == EXIT_OK
+    eventually(lambda: robot(aram).status == "Arrived at Lab A", timeout=60)
+
+
+def test_localizing_off_the_map_leaves_the_robot_lost_where_it_was(aram: SimThread) -> None:
+    where = f"127.0.0.1:{aram.port}"
+    reset(aram)
+    before = robot(aram)
+    code = main(["localize", where, "999999", "999999", "0", "--timeout", "5", "--limit", "30"])
+    assert code == EXIT_LOST
+    after = robot(aram)
+    assert (after.x, after.y) == (before.x, before.y), "not teleported off the map"
+    reset(aram)
+
+
+def test_the_ld_simulator_says_what_it_is_when_it_starts() -> None:
+    import subprocess
+    import sys
+
+    proc = subprocess.Popen(
+        [sys.executable, "-m", "rtmu", "sim", "--kind", "aram", "--port", "0"],
+        stdout=subprocess.PIPE,
+        stderr=subprocess.PIPE,
+        text=True,
+    )
+    try:
+        assert proc.stdout is not None
+        line = proc.stdout.readline()
+        assert "Omron LD robot (ARAM) at" in line and "Pioneer" not in line, line
+    finally:
+        proc.terminate()
+        proc.wait(10)

@@ -38,7 +38,7 @@ def test_model_gets_laser_dock_routes_and_data_store_from_aram() -> None:
             assert 0 <= int(names["DataStore_WiFi_Quality"]) <= 70
             runner.command("dock").result(5)
             ui.wait_for(lambda: model.robot.value.dock_state == "Docking", timeout=5)
-            ui.wait_for(lambda: model.robot.value.dock_state == "Docked", timeout=10)
+            ui.wait_for(lambda: model.robot.value.dock_state == "Docked", timeout=90)  # it drives there
         finally:
             runner.close()
 

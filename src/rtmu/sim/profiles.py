@@ -49,6 +49,8 @@ class SimProfile:
     """Data modules (``ROWS`` + ``HANDLERS``) this profile serves — the extension point."""
     handlers: dict[str, Handler] = field(default_factory=dict)
     """Handlers of this profile that replace the default ones."""
+    robot: str = "Pioneer 3-DX"
+    """What the simulated robot is, in words (``rtmu sim`` says it when it starts)."""
 
     def module_parts(self) -> tuple[list[Row], dict[str, Handler]]:
         rows: list[Row] = []
@@ -217,13 +219,14 @@ ARAM = SimProfile(
     state_of_charge=True,
     map_header=EX4_HEADER,
     catalogue_size=LD_CATALOGUE_SIZE,
-    modules=("rtmu.sim.nav_data", "rtmu.sim.ld_data", "rtmu.sim.arconfig"),  # the LD docking replaces ARNL's
+    modules=("rtmu.sim.nav_data", "rtmu.sim.ld_data", "rtmu.sim.arconfig"),  # LD docking: dockInfo
     handlers={
         "updateNumbers": _soc_numbers,
         "batteryInfo": _soc_battery_info,
         "update": _soc_update,
         "getMapBinary": _ex4_map_binary,
     },
+    robot="Omron LD robot (ARAM)",
 )
 PROFILES: dict[str, SimProfile] = {p.name: p for p in (DEFAULT, ARAM)}
 

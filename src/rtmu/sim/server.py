@@ -712,6 +712,7 @@ class SimServer:
         b.x, b.y, b.th = self.home
         b.vel = b.rot_vel = 0.0
         b.stalled = False
+        self.world.dock_mode.leave()  # put back on its home cairn, it is on no dock
         self.world.stop()
 
 

@@ -116,7 +116,9 @@ class _Watch:
 
     def reading(self) -> NavReading:
         r = read_status(self.status, self.mode_name)
-        if r.phase is NavPhase.IDLE and self.dock_state in ("Docking", "Docked"):
+        # An LD robot says its docking in dockInfo; its status may still read "Arrived at …" from the goto
+        # before, so the dock state answers unless the status says it is on its way somewhere.
+        if r.phase is not NavPhase.GOING and self.dock_state in ("Docking", "Docked"):
             phase = NavPhase.GOING if self.dock_state == "Docking" else NavPhase.DOCKED
             return NavReading(phase, "dock", text=self.dock_state)
         return r

@@ -271,6 +271,7 @@ def run(args: argparse.Namespace) -> int:
 async def serve(cfg) -> int:
     from ..mapfile import MapFormatError
     from ..sim import SimServer
+    from ..sim.profiles import get_profile
 
     try:
         server = SimServer(cfg)
@@ -293,7 +294,7 @@ async def serve(cfg) -> int:
         extras += f"; protocol {cfg.protocol_version!r} enforced"
     print(
         f"rtmu sim: ARIA robot server listening on {cfg.host}:{server.port}, serving {served}; "
-        f"Pioneer 3-DX at ({home[0]:.0f}, {home[1]:.0f}) mm, {home[2]:.0f} deg{extras}",
+        f"{get_profile(cfg.profile).robot} at ({home[0]:.0f}, {home[1]:.0f}) mm, {home[2]:.0f} deg{extras}",
         flush=True,
     )
     code = await until_stop_signal()
