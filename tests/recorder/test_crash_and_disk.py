@@ -94,7 +94,7 @@ def test_a_full_disk_ends_the_recording_once_and_keeps_what_came_before(tmp_path
     partial = tmp_path / "full.mcap.partial"
     with SimThread(SimConfig(port=0, map_path=ARENA, seed=1)) as sim:
         proc = subprocess.Popen(
-            [*RECORD, f"127.0.0.1:{sim.port}", "--out", str(out), "--fps", "10", "--seconds", "60"],
+            [*RECORD, f"127.0.0.1:{sim.port}", "--out", str(out), "--fps", "2", "--seconds", "60"],
             stdout=subprocess.DEVNULL,
             stderr=subprocess.PIPE,
             text=True,

@@ -9,6 +9,7 @@ import sys
 import time
 from pathlib import Path
 
+from rtmu.base.exit_codes import EXIT_BAD_FILE
 from rtmu.recorder import topics
 from rtmu.sim import SimConfig, SimThread
 
@@ -26,10 +27,10 @@ def test_replay_refuses_a_file_it_cannot_replay_before_any_window(tmp_path: Path
     junk = tmp_path / "junk.mcap"
     junk.write_bytes(b"\x89MCAP0\r\n" + b"\xff" * 64)
     done = rtmu("replay", str(junk))
-    assert done.returncode == 3, done.stderr
+    assert done.returncode == EXIT_BAD_FILE, done.stderr  # one table: a file that cannot be used
     assert "rtmu replay:" in done.stderr and "junk.mcap" in done.stderr
     missing = rtmu("replay", str(tmp_path / "none.mcap"))
-    assert missing.returncode == 2 and "is not a file" in missing.stderr
+    assert missing.returncode == 2 and "does not exist" in missing.stderr
 
 
 def test_bridge_refuses_bad_options() -> None:
