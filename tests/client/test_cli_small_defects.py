@@ -106,3 +106,49 @@ def test_the_ld_simulator_says_what_it_is_when_it_starts() -> None:
     finally:
         proc.terminate()
         proc.wait(10)
+
+
+def test_streaming_status_prints_on_change_and_a_heartbeat_at_most_once_a_second() -> None:
+    """A parked robot's status was printed ten times a second, the same line every time."""
+    import signal
+    import subprocess
+    import sys
+    import time
+
+    from rtmu.sim import SimConfig
+
+    with SimThread(SimConfig(port=0)) as sim:
+        proc = subprocess.Popen(
+            [sys.executable, "-m", "rtmu", "status", f"127.0.0.1:{sim.port}", "--json"],
+            stdout=subprocess.PIPE,
+            stderr=subprocess.PIPE,
+            text=True,
+        )
+        assert proc.stdout is not None
+        first = proc.stdout.readline()  # connected and streaming: from here on, 2.5 s of a parked robot
+        started = time.monotonic()
+        time.sleep(2.5)
+        proc.send_signal(signal.SIGINT)
+        rest, _err = proc.communicate(timeout=30)
+        elapsed = time.monotonic() - started
+    lines = [first, *rest.splitlines()]
+    assert proc.returncode == 128 + signal.SIGINT
+    assert len({json.loads(line)["x"] for line in lines}) == 1, "parked: every line the same"
+    assert len(lines) <= 2 + elapsed, f"{len(lines)} lines in {elapsed:.1f} s: more than a heartbeat a second"
+
+
+def test_developer_log_lines_stay_off_the_terminal_unless_asked() -> None:
+    import os
+    import subprocess
+    import sys
+
+    code = (
+        "import logging; from rtmu.base import logs; logs.configure(); "
+        "logging.getLogger('rtmu.client.connection').warning('the handler for updateNumbers took 12 ms'); "
+        "logging.getLogger('rtmu.client.session').error('a real bug')"
+    )
+    quiet = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, timeout=60)
+    assert "took 12 ms" not in quiet.stderr and "a real bug" in quiet.stderr
+    env = {**os.environ, "RTMU_LOG": "warning"}
+    loud = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, timeout=60, env=env)
+    assert "took 12 ms" in loud.stderr
