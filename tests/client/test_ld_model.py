@@ -1,4 +1,4 @@
-"""The window's model hears LD data from ``rtmu sim --profile aram`` and none of it from the default."""
+"""The window's model hears LD data from ``rtmu sim --kind aram`` and none of it from the default."""
 
 from __future__ import annotations
 

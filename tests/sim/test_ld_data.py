@@ -1,4 +1,4 @@
-"""What ``rtmu sim --profile aram`` serves beyond serverDemo, as a client on loopback sees it."""
+"""What ``rtmu sim --kind aram`` serves beyond serverDemo, as a client on loopback sees it."""
 
 from __future__ import annotations
 

@@ -1,4 +1,4 @@
-"""``rtmu sim --profile aram``: an LD robot on the wire (protocol, state of charge, Ex4 map, LD-size list)."""
+"""``rtmu sim --kind aram``: an LD robot on the wire (protocol, state of charge, Ex4 map, LD-size list)."""
 
 from __future__ import annotations
 

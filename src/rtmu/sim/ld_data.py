@@ -1,4 +1,4 @@
-"""The data an Omron LD robot offers beyond serverDemo, for ``rtmu sim --profile aram``.
+"""The data an Omron LD robot offers beyond serverDemo, for ``rtmu sim --kind aram``.
 
 A data module of the profile extension point (:mod:`rtmu.sim.profiles`): ``ROWS`` for the catalogue
 and ``HANDLERS`` for the server. Two lasers seen from the world's walls by the same ray caster as
