@@ -112,9 +112,9 @@ class SessionConfig:
     """Start a guardian process (:mod:`rtmu.guardian`) for each connection that may drive: it stops
     the robot if this process is killed or frozen while driving. The window and ``rtmu drive`` do."""
     shared_maps: SharedMaps | None = field(default=None, compare=False)
+    """Maps shared with the process's other sessions (a fleet's window: one download per map file)."""
     role: Role = Role.OPERATOR
     """OBSERVER (a recorder, a read-only bridge, a replay): no motion request ever leaves (client.roles)."""
-    """Maps shared with the process's other sessions (a fleet's window: one download per map file)."""
 
 
 @dataclass
