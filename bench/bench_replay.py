@@ -29,6 +29,7 @@ from rtmu.recorder import Recorder, RecorderConfig
 from rtmu.recorder.replay import REPLAY_CONFIG, PacedLink, Replayer
 from rtmu.recorder.replay_file import load
 from rtmu.sim import SimConfig, SimThread
+from rtmu.values.intents import RequestPicture
 
 REPO = Path(__file__).resolve().parents[1]
 ARENA = REPO / "data" / "maps" / "arena.map"
@@ -48,7 +49,7 @@ def record(out: Path) -> None:
             while time.monotonic() < end:
                 sim.call(lambda: sim.server.world.ratio_drive(40.0, 25.0, 60.0))  # type: ignore[union-attr]
                 if time.monotonic() >= next_picture:
-                    runner.request_image()
+                    runner.send(RequestPicture())
                     next_picture = time.monotonic() + 0.5
                 time.sleep(0.1)
             sim.call(lambda: sim.server.world.stop())  # type: ignore[union-attr]

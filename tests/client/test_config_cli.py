@@ -11,7 +11,7 @@ import pytest
 
 from rtmu.base.exit_codes import EXIT_OK, EXIT_REFUSED, EXIT_UNSUPPORTED, EXIT_USAGE
 from rtmu.cli import main
-from rtmu.client.config_feed import MAX_TEXT, ServerConfig, check_value, fetch_config
+from rtmu.client.config_feed import MAX_TEXT, ConfigFeed, ServerConfig, check_value, fetch_config
 from rtmu.client.connection import AriaClient
 from rtmu.client.errors import MalformedReply
 from rtmu.client.runner import ClientRunner
@@ -210,7 +210,7 @@ def test_a_flood_of_config_updated_reaches_the_ui_as_a_few_posts() -> None:
         )
         thread.call(lambda: [server.broadcast("configUpdated") for _ in range(5000)])
         runner.call(lambda: runner.session.client.request_once("getSafeDrive"))  # type: ignore[union-attr]
-        eventually(lambda: runner.session.config_feed.updates == 5000)  # type: ignore[union-attr]
+        eventually(lambda: runner.session.feed(ConfigFeed).updates == 5000)  # type: ignore[union-attr]
         posted = ui.drain()
     assert 1 <= len(calls) <= 50 and posted < 5000  # not one UI callback per broadcast
 

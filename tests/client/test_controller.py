@@ -20,6 +20,15 @@ from rtmu.model.observables import (
     SpeedSetting,
 )
 from rtmu.settings.store import Profile
+from rtmu.values.intents import (
+    GotoGoal,
+    Localize,
+    MoveDistance,
+    RequestPicture,
+    RunServerCommand,
+    SetSafeDrive,
+    TurnBy,
+)
 
 from .fakeclock import FakeClock
 from .fakes import FakeView, RecordingLink
@@ -223,14 +232,14 @@ def test_speed_steps_and_limits_and_applies_to_a_drive_in_progress() -> None:
 
 def test_bounded_moves_need_server_support() -> None:
     rig = Rig(offers=frozenset({"ratioDrive", "stop"}))
-    rig.ctl.turn_by(90)
-    rig.ctl.move_distance(1000)
+    rig.ctl.ask(TurnBy(90))
+    rig.ctl.ask(MoveDistance(1000))
     assert rig.link.calls == []
     assert any("turnByAngle" in t for t in rig.view.texts())
     rig.connect(ALL)
     rig.ctl.press("forward")
-    rig.ctl.turn_by(-90)
-    rig.ctl.move_distance(500)
+    rig.ctl.ask(TurnBy(-90))
+    rig.ctl.ask(MoveDistance(500))
     assert rig.link.calls == [("command", "turnByAngle", -90.0), ("command", "moveDist", 500.0)]
     assert not rig.lease.live  # a bounded move replaces held driving
 
@@ -238,12 +247,12 @@ def test_bounded_moves_need_server_support() -> None:
 def test_image_and_safe_drive() -> None:
     rig = Rig()
     assert rig.ctl.image_source() == "getPictureCam1"
-    rig.ctl.request_image()
-    rig.ctl.set_safe_drive(False)
+    rig.ctl.ask(RequestPicture())
+    rig.ctl.ask(SetSafeDrive(False))
     assert rig.link.calls == [("request_image",), ("set_safe_drive", False)]
     rig.connect(frozenset({"ratioDrive"}))
-    rig.ctl.request_image()
-    assert rig.view.notices[-1] == (Level.WARNING, "This server offers no camera pictures")
+    rig.ctl.ask(RequestPicture())
+    assert rig.view.notices[-1] == (Level.WARNING, "This server does not offer camera pictures")
 
 
 def test_command_states_follow_the_server_and_only_changes_are_sent() -> None:
@@ -347,15 +356,14 @@ def test_adding_a_command_is_one_class() -> None:
         needs = ("wander",)
 
         def activate(self, target: CommandTarget) -> None:
-            assert isinstance(target, Controller)
-            target.link.command("wander")
+            target.ask(RunServerCommand("wander"))
 
     rig = Rig()
     ctl = Controller(rig.model, rig.operator, rig.link, rig.view, clock=rig.clock, registry=registry)
     assert ctl.command_states()["wander"].reason == "this server does not offer wander"
     rig.connect(ALL | {"wander"})
     assert ctl.run("wander")
-    assert rig.link.calls[-1] == ("command", "wander")
+    assert rig.link.calls[-1] == ("send", RunServerCommand("wander"))
     assert registry.keys() == {"w": "wander"}
 
 
@@ -398,9 +406,9 @@ def test_in_replay_mode_nothing_is_sent_and_every_way_in_says_replay() -> None:
     rig.ctl.press("forward")
     assert rig.ctl.run("drive_forward") is False
     rig.ctl.stop()
-    rig.ctl.turn_by(90)
-    rig.ctl.set_safe_drive(False)
-    rig.ctl.goto_goal("Lab")
-    rig.ctl.localize(0, 0, 0)
+    rig.ctl.ask(TurnBy(90))
+    rig.ctl.ask(SetSafeDrive(False))
+    rig.ctl.ask(GotoGoal("Lab"))
+    rig.ctl.ask(Localize(0, 0, 0))
     assert rig.link.calls == [] and rig.lease.generation == 0
     assert sum("Replay" in t for t in rig.view.texts()) >= 6

@@ -10,6 +10,7 @@ from rtmu.client.session import SessionConfig
 from rtmu.model.observables import Phase, RobotModel
 from rtmu.sim import SimConfig, SimThread
 from rtmu.sim.ld_data import ROUTES
+from rtmu.values.intents import Dock
 
 from .uiqueue import UiQueue
 
@@ -36,7 +37,7 @@ def test_model_gets_laser_dock_routes_and_data_store_from_aram() -> None:
             ui.wait_for(lambda: len(model.robot.value.data_store) >= 5, timeout=5)
             names = dict(model.robot.value.data_store)
             assert 0 <= int(names["DataStore_WiFi_Quality"]) <= 70
-            runner.command("dock").result(5)
+            runner.send(Dock()).result(5)
             ui.wait_for(lambda: model.robot.value.dock_state == "Docking", timeout=5)
             ui.wait_for(lambda: model.robot.value.dock_state == "Docked", timeout=90)  # it drives there
         finally:

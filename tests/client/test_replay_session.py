@@ -180,7 +180,8 @@ def test_a_session_declares_its_subscriptions_as_data() -> None:
             finally:
                 await session.close()
         names = [name for name, _ in requested]
-        assert names[:5] == ["updateNumbers", "updateStrings", "getModeInfo", "mapUpdated", "sonarCurrent"]
+        assert names[:4] == ["updateNumbers", "updateStrings", "getModeInfo", "sonarCurrent"]
+        assert "mapUpdated" in names
         assert ("updateNumbers", 250) in requested and ("sonarCurrent", 500) in requested
         assert "update" not in names  # gives way to updateNumbers
 

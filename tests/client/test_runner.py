@@ -406,19 +406,6 @@ def test_loop_lag_shows_a_blocked_network_loop() -> None:
     assert runner.loop_lag() is None
 
 
-def test_subscription_handlers_run_on_the_ui_thread(server: TestServer) -> None:
-    import threading
-
-    runner, _model, ui = start(server)
-    try:
-        threads: list[int] = []
-        runner.subscribe("batteryInfo", 20, lambda packet: threads.append(threading.get_ident()))
-        ui.wait_for(lambda: len(threads) >= 3)
-        assert set(threads) == {threading.get_ident()}  # posted, never run on the network loop
-    finally:
-        runner.close()
-
-
 def test_stop_and_wait_returns_once_the_stop_has_left(server: TestServer) -> None:
     runner, _model, _ui = start(server)
     try:

@@ -25,6 +25,7 @@ from rtmu.capture.recorded import RAW_TOPICS
 from rtmu.model.observables import Phase
 from rtmu.recorder import Limits, topics
 from rtmu.sim import SimConfig, SimThread
+from rtmu.values.intents import RequestPicture
 
 from .mcapread import read, summary_counts
 from .simsession import ARENA, recorded_session
@@ -125,7 +126,7 @@ def test_the_window_hears_that_its_recording_stopped_and_keeps_its_robot(tmp_pat
         assert "size limit" in view.texts()[view.kinds.index(Kind.RECORDING)]
         assert recording.stopped is not None
         before = session.state.camera.value
-        session.controller.request_image()  # the session goes on: a new picture arrives
+        session.controller.ask(RequestPicture())  # the session goes on: a new picture arrives
         ui.wait_for(lambda: session.state.camera.value is not before, timeout=5)
         age = session.runner.status_age()
         assert age is not None and age < 1.0, "status still streams in"

@@ -22,6 +22,7 @@ from rtmu.client.session import SessionConfig
 from rtmu.protocol.commands import ClientCommand
 from rtmu.recorder import Recorder, RecorderConfig
 from rtmu.sim import SimConfig, SimThread
+from rtmu.values.intents import RequestPicture
 
 from .mcapread import read
 from .simsession import ARENA
@@ -95,10 +96,10 @@ def test_the_raw_channel_decodes_to_exactly_the_live_packets(tmp_path: Path) -> 
         recorder.attach(runner)
         with runner:
             runner.connect("127.0.0.1", sim.port).result(10)
-            runner.call(runner._session.request_image)
+            runner.call(runner._session.dispatch, RequestPicture())
             time.sleep(0.5)
             runner.connect("127.0.0.1", sim.port).result(10)  # the same robot again: a second connection
-            runner.call(runner._session.request_image)
+            runner.call(runner._session.dispatch, RequestPicture())
             time.sleep(0.3)
         recorder.close()
     assert opened == [1, 2]

@@ -20,11 +20,12 @@ from rtmu.client.runner import ClientRunner
 from rtmu.client.session import SessionConfig
 from rtmu.protocol.packet import encode_packet
 from rtmu.protocol.payloads.drive import RatioDrive
-from rtmu.protocol.payloads.navigation import GotoGoal
 from rtmu.recorder import Recorder, RecorderConfig
 from rtmu.recorder.replay import REPLAY_CONFIG, PacedLink, ReplayClock, Replayer
 from rtmu.recorder.replay_file import ReplayFileError, compressed_image_data, load
 from rtmu.sim import SimConfig, SimThread
+from rtmu.values import intents
+from rtmu.values.intents import RequestPicture
 from rtmu.values.state import CameraChanged, MapChanged, MapPhase, RobotChanged, StateChange
 
 from .poses import poses, recorded_pose_at
@@ -38,7 +39,7 @@ def recording(tmp_path_factory: pytest.TempPathFactory) -> Path:
         ui.wait_for(lambda: session.state.map.value.state is MapPhase.READY, timeout=15)
         for _ in range(2):
             before = session.state.camera.value
-            session.controller.request_image()
+            session.controller.ask(RequestPicture())
             ui.wait_for(lambda b=before: session.state.camera.value is not b, timeout=5)
         hold(ui, session, "forward", 1.2)
         hold(ui, session, "left", 0.8)
@@ -137,7 +138,7 @@ def test_a_replay_is_an_observer_and_its_link_refuses_drive_packets(recording: P
         written = link.written
         runner.stop_and_wait(2.0)  # STOP, a navigation: the observer's client puts neither on the link
         with pytest.raises(MotionRefused):
-            runner.call(runner.session.navigate, GotoGoal("anywhere"))
+            runner.send(intents.GotoGoal(name="anywhere")).result(5)
         runner.sync()
         assert link.written == written and link.refused == 0
         # …and the link itself refuses a drive packet that reaches it some other way.

@@ -12,6 +12,7 @@ from pathlib import Path
 
 from rtmu.capture.recorded import CONNECTION_TOPIC, RAW_TOPICS
 from rtmu.recorder import topics
+from rtmu.values.intents import RequestPicture
 from rtmu.values.state import CameraChanged, MapPhase, RobotChanged, StateChange
 
 from .mcapread import read, summary_counts
@@ -44,7 +45,7 @@ def run_session(tmp_path: Path, spy: list[StateChange]) -> Path:
         ui.wait_for(lambda: session.state.map.value.state is MapPhase.READY, timeout=15)
         for _ in range(3):
             before = session.state.camera.value
-            session.controller.request_image()
+            session.controller.ask(RequestPicture())
             ui.wait_for(lambda b=before: session.state.camera.value is not b, timeout=5)
         hold(ui, session, "forward", 1.0)
         time.sleep(0.3)  # the release's stop goes out, the robot comes to rest
@@ -124,7 +125,7 @@ def test_operator_intents_are_recorded_without_the_password(tmp_path: Path) -> N
     got = read(path)
     intents = got.records(topics.INTENTS)
     names = [i["intent"] for i in intents]
-    assert names.count("request_image") == 3, names
-    assert "stop" in names
+    assert names.count("RequestPicture") == 3, names
+    assert "Stop" in names
     connect = intents[names.index("connect")]
     assert connect["host"] == "127.0.0.1" and "port" in connect and "password" not in connect

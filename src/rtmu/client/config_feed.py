@@ -13,8 +13,9 @@ tells a listener, so a page can fetch again without losing its own unsaved edits
 from __future__ import annotations
 
 import asyncio
-from collections.abc import Callable
+from collections.abc import Callable, Iterable
 from dataclasses import dataclass, replace
+from typing import Any, ClassVar
 
 from ..protocol.errors import ProtocolError
 from ..protocol.payloads.base import Side, payload_type_for
@@ -28,8 +29,12 @@ from ..protocol.payloads.config import (
     SetConfig,
     SetConfigReply,
 )
+from ..values.intents import FetchConfig, Intent
+from ..values.intents import SetConfig as SetConfigIntent
 from .connection import AriaClient, Packet
 from .errors import MalformedReply, NotSupported
+from .feed import Feed, FeedContext
+from .subscriptions import Subscription
 
 VERSIONS = ("getConfigBySectionsV4", "getConfigBySectionsV3", "getConfigBySectionsV2", "getConfigBySections")
 """Newest first: the first the server lists is used."""
@@ -175,13 +180,28 @@ async def set_config(
     return replace(answer, error=_cut(answer.error))
 
 
-class ConfigFeed:
-    """``configUpdated`` broadcasts of one session: counted, and passed to a listener (network loop)."""
+class ConfigFeed(Feed):
+    """Fetches and changes the configuration; ``configUpdated`` broadcasts are counted and passed to a
+    listener (network loop)."""
 
-    def __init__(self) -> None:
+    handles: ClassVar[tuple[type[Intent], ...]] = (FetchConfig, SetConfigIntent)
+
+    def __init__(self, ctx: FeedContext) -> None:
+        super().__init__(ctx)
         self.updates = 0
         self.listener: Callable[[], None] | None = None
         """Called on the network loop after each broadcast (the runner posts it to the UI thread)."""
+
+    def subscriptions(self, client: AriaClient) -> Iterable[Subscription]:
+        return (Subscription("configUpdated", -1, self.on_updated),)
+
+    def handle(self, intent: Intent) -> Any:
+        client = self.require()
+        timeout = self.ctx.config.reply_timeout
+        if isinstance(intent, SetConfigIntent):
+            changes = {section: dict(values) for section, values in intent.changes.items()}
+            return set_config(client, changes, timeout)
+        return fetch_config(client, timeout)
 
     def on_updated(self, packet: Packet) -> None:
         self.updates += 1

@@ -12,9 +12,9 @@ a refresh period no shorter than :data:`MIN_REFRESH_MS`, and at most one publish
 :class:`~rtmu.values.state.DrawingsChanged` per :data:`PUBLISH_EVERY` s however fast samples come. A
 shape RTMU cannot draw is listed (``drawable=False``) and never asked for.
 
-The session keeps its own sonar (and LD laser) handling: ``also`` maps those data names to the
-session's handlers, which this feed calls with every packet it receives for them, because its
-request replaces the session's subscription of the same name.
+The session keeps its own sonar (and LD laser) handling: where the session holds a subscription of
+a drawing's data name, this feed's request replaces it, so it hands every packet of that name on
+to the session's handler (``FeedContext.handler_for``).
 """
 
 from __future__ import annotations
@@ -22,14 +22,16 @@ from __future__ import annotations
 import asyncio
 import contextlib
 import logging
-from collections.abc import Callable, Coroutine, Mapping
-from typing import Any
+from collections.abc import Mapping
+from typing import ClassVar
 
 from ..protocol.payloads.drawings import Drawing, Visibility
+from ..values.intents import DrawingChoices, Intent, ShowDrawing
 from ..values.state import DrawingLayer, DrawingsChanged, DrawingsState
 from .connection import AriaClient, Packet
 from .drawing_list import LIST, decode_points, drawing_list, drawing_sample
 from .errors import ClientError
+from .feed import Feed, FeedContext
 
 log = logging.getLogger(__name__)
 
@@ -38,21 +40,15 @@ MIN_REFRESH_MS = 50
 PUBLISH_EVERY = 0.05
 """Seconds between two published states at most (samples arriving faster are coalesced)."""
 
-Publish = Callable[[DrawingsChanged], None]
-Spawn = Callable[[Coroutine[Any, Any, None], str], None]
-Handler = Callable[[Packet], None]
 
-
-class DrawingsFeed:
+class DrawingsFeed(Feed):
     """Drawings for one session (network loop only)."""
 
-    def __init__(
-        self, publish: Publish, spawn: Spawn, reply_timeout: float, also: Mapping[str, Handler] | None = None
-    ) -> None:
-        self._publish = publish
-        self._spawn = spawn
-        self._timeout = reply_timeout
-        self._also = dict(also or {})
+    handles: ClassVar[tuple[type[Intent], ...]] = (ShowDrawing, DrawingChoices)
+
+    def __init__(self, ctx: FeedContext) -> None:
+        super().__init__(ctx)
+        self._timeout = ctx.config.reply_timeout
         self._client: AriaClient | None = None
         self._drawings: tuple[Drawing, ...] = ()
         self._points: dict[str, tuple[tuple[int, int], ...]] = {}
@@ -71,7 +67,7 @@ class DrawingsFeed:
         self._reset(client)
         if client.supports(LIST):
             self._offered = True
-            self._spawn(self._fetch(client), "drawings")
+            self.ctx.spawn(self._fetch(client), "drawings")
         self._publish_now()
 
     def disconnected(self) -> None:
@@ -99,7 +95,7 @@ class DrawingsFeed:
             return
         self._drawings = tuple(sorted(drawings, key=lambda d: d.layer))
         for d in self._drawings:  # the session subscribed its sonar/lasers itself: a hidden one ends here
-            if d.name in self._also and not self.shown(d):
+            if self.ctx.handler_for(d.name) is not None and not self.shown(d):
                 client.stop_request(d.name)
         unknown = [d for d in self._drawings if d.known_shape is None]
         if unknown:
@@ -108,6 +104,12 @@ class DrawingsFeed:
         self._publish_now()
 
     # -- what the operator chose -------------------------------------------------------------
+    def handle(self, intent: Intent) -> None:
+        if isinstance(intent, ShowDrawing):
+            self.set_shown(intent.name, intent.shown)
+        elif isinstance(intent, DrawingChoices):
+            self.set_choices(intent.choices)
+
     def set_choices(self, choices: Mapping[str, bool]) -> None:
         """The operator's remembered choices for this server (settings), before or after connecting."""
         self._choices = {str(k): bool(v) for k, v in list(choices.items())[:1024]}
@@ -146,7 +148,7 @@ class DrawingsFeed:
                     client.request(d.name, max(d.refresh_ms, MIN_REFRESH_MS), self._on_packet)
                 else:  # "don't poll": the server sends it when it changes; one sample to start with
                     client.request(d.name, -1, self._on_packet)
-                    self._spawn(self._first_sample(client, d.name), f"drawing-{d.name[:40]}")
+                    self.ctx.spawn(self._first_sample(client, d.name), f"drawing-{d.name[:40]}")
             elif not wanted and d.name in self._requested:
                 self._requested.discard(d.name)
                 client.stop_request(d.name)
@@ -162,7 +164,7 @@ class DrawingsFeed:
 
     def _on_packet(self, packet: Packet) -> None:
         name = packet.name
-        also = self._also.get(name)
+        also = self.ctx.handler_for(name)
         if also is not None:
             try:
                 also(packet)
@@ -207,4 +209,4 @@ class DrawingsFeed:
             )
             for d in self._drawings
         )
-        self._publish(DrawingsChanged(DrawingsState(layers, self._offered, self._note)))
+        self.ctx.publish(DrawingsChanged(DrawingsState(layers, self._offered, self._note)))

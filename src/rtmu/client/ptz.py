@@ -13,15 +13,17 @@ from __future__ import annotations
 
 import contextlib
 import math
-from collections.abc import Callable, Coroutine
+from collections.abc import Callable
 from dataclasses import replace
-from typing import Any
+from typing import ClassVar
 
 from ..protocol.errors import ProtocolError
 from ..protocol.payloads.camera import Camera, CameraData, CameraInfo, CameraList, SetCameraAbs, SetCameraRel
+from ..values.intents import Intent, PtzMove, WatchPtz
 from ..values.state import PtzState
 from .connection import AriaClient, Packet
 from .errors import ClientError, NotSupported
+from .feed import Feed, FeedContext
 
 POLL_MS = 250
 """``getCameraData`` period while watched (ARIA suggests 100 ms; 4 Hz is plenty for a label)."""
@@ -31,9 +33,6 @@ NO_LIST = "the server lists no cameras (getCameraList)"
 NO_HEAD = "the server's cameras have no pan/tilt/zoom head (no setCameraRel / setCameraAbs)"
 LIMIT = 327.67
 """The largest angle a ``byte2`` hundredth can carry."""
-
-Update = Callable[..., None]
-Spawn = Callable[[Coroutine[Any, Any, None], str], None]
 
 
 def _clip(text: str) -> str:
@@ -54,13 +53,14 @@ def pick_camera(cameras: tuple[Camera, ...], offered: Callable[[str], bool]) -> 
     return None
 
 
-class PtzFeed:
-    """One session's PTZ head: ``update(ptz=PtzState)`` publishes it with the robot."""
+class PtzFeed(Feed):
+    """One session's PTZ head, published with the robot as ``RobotState.ptz``."""
 
-    def __init__(self, update: Update, spawn: Spawn, reply_timeout: float) -> None:
-        self._update = update
-        self._spawn = spawn
-        self._timeout = reply_timeout
+    handles: ClassVar[tuple[type[Intent], ...]] = (PtzMove, WatchPtz)
+
+    def __init__(self, ctx: FeedContext) -> None:
+        super().__init__(ctx)
+        self._timeout = ctx.config.reply_timeout
         self._client: AriaClient | None = None
         self._camera: Camera | None = None
         self._state = PtzState()
@@ -76,9 +76,12 @@ class PtzFeed:
 
     def _set(self, state: PtzState) -> None:
         self._state = state
-        self._update(ptz=state)
+        self.ctx.robot_update(ptz=state)
 
-    async def connected(self, client: AriaClient) -> None:
+    def connected(self, client: AriaClient) -> None:
+        self.ctx.spawn(self.read_head(client), "ptz")
+
+    async def read_head(self, client: AriaClient) -> None:
         """Read the camera list, limits and position once after login."""
         self._client, self._camera, self._polling, self.cameras = client, None, False, ()
         if not client.supports("getCameraList"):
@@ -131,7 +134,15 @@ class PtzFeed:
     def disconnected(self) -> None:
         self._client, self._camera, self._polling = None, None, False
         self._state = PtzState()
-        self._update(ptz=None)  # unknown until the next login reads the list
+        self.ctx.robot_update(ptz=None)  # unknown until the next login reads the list
+
+    def handle(self, intent: Intent) -> None:
+        if isinstance(intent, WatchPtz):
+            self.watch(intent.on)
+        elif isinstance(intent, PtzMove) and intent.relative:
+            self.move_rel(intent.pan, intent.tilt, intent.zoom)
+        elif isinstance(intent, PtzMove):
+            self.move_abs(intent.pan, intent.tilt, intent.zoom)
 
     def watch(self, on: bool) -> None:
         """Poll the position while ``on`` (the camera page is shown)."""
@@ -186,7 +197,7 @@ class PtzFeed:
 
     def _after_move(self) -> None:
         if not self._polling:
-            self._spawn(self.refresh(), "ptz-refresh")
+            self.ctx.spawn(self.refresh(), "ptz-refresh")
 
     def _require(self, command: str) -> tuple[AriaClient, str]:
         client, name = self._client, self._name(command)

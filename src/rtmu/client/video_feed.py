@@ -26,6 +26,7 @@ from dataclasses import dataclass, field
 
 from ..protocol.errors import ProtocolError
 from ..protocol.payloads.camera import VideoFrame
+from ..values.intents import picture_source
 from ..values.state import VideoStatus
 from .connection import AriaClient
 from .errors import ClientError, ClientTimeout, NotSupported, ServerClosed
@@ -243,12 +244,10 @@ def video_source(client: AriaClient, camera: str | None = None) -> str:
         if not client.supports(name):
             raise NotSupported(name, f"this server has no camera named {camera!r} ({name})")
         return name
-    pictures = sorted(e.name for e in client.datalist if e.name.startswith("getPicture"))
-    if pictures:
-        return pictures[0]
-    if client.supports("sendVideo"):
-        return "sendVideo"
-    raise NotSupported("getPicture", "this server offers no camera pictures (getPicture… or sendVideo)")
+    source = picture_source(e.name for e in client.datalist)
+    if source is None:
+        raise NotSupported("getPicture", "this server offers no camera pictures (getPicture… or sendVideo)")
+    return source
 
 
 FrameSink = Callable[[LiveFrame], None]

@@ -20,6 +20,8 @@ from collections.abc import Iterator
 from dataclasses import dataclass
 from typing import ClassVar, Protocol
 
+from ..values import intents
+from ..values.intents import Intent
 from ..values.state import Phase
 
 LINKING = (Phase.CONNECTING, Phase.RECONNECTING, Phase.CONNECTED)
@@ -52,19 +54,8 @@ class CommandTarget(Protocol):
 
     def speed_down(self) -> None: ...
 
-    def turn_by(self, degrees: float) -> None: ...
-
-    def move_distance(self, mm: float) -> None: ...
-
-    def request_image(self) -> None: ...
-
-    def set_safe_drive(self, on: bool) -> None: ...
-
-    def home(self) -> None: ...
-
-    def dock(self) -> None: ...
-
-    def tour_goals(self) -> None: ...
+    def ask(self, intent: Intent) -> object:
+        """Send an operator intent through the controller's guard."""
 
     def connect(self, password: str | None = None) -> None: ...
 
@@ -276,7 +267,7 @@ class _TurnBy(Command):
     needs = ("turnByAngle",)
 
     def activate(self, target: CommandTarget) -> None:
-        target.turn_by(self.degrees)
+        target.ask(intents.TurnBy(self.degrees))
 
 
 @command
@@ -341,7 +332,7 @@ class MoveForward1m(Command):
     needs = ("moveDist",)
 
     def activate(self, target: CommandTarget) -> None:
-        target.move_distance(1000.0)
+        target.ask(intents.MoveDistance(1000.0))
 
 
 # -- sensing ------------------------------------------------------------------------------------
@@ -362,7 +353,7 @@ class RequestImage(Command):
         return None
 
     def activate(self, target: CommandTarget) -> None:
-        target.request_image()
+        target.ask(intents.RequestPicture())
 
 
 @command
@@ -372,7 +363,7 @@ class SafeDriveOn(Command):
     needs = ("setSafeDrive",)
 
     def activate(self, target: CommandTarget) -> None:
-        target.set_safe_drive(True)
+        target.ask(intents.SetSafeDrive(True))
 
 
 @command
@@ -382,7 +373,7 @@ class SafeDriveOff(Command):
     needs = ("setSafeDrive",)
 
     def activate(self, target: CommandTarget) -> None:
-        target.set_safe_drive(False)
+        target.ask(intents.SetSafeDrive(False))
 
 
 # -- navigation (the server drives; a STOP or a drive key cancels it) ----------------------------
@@ -397,7 +388,7 @@ class Home(Command):
     needs = ("home",)
 
     def activate(self, target: CommandTarget) -> None:
-        target.home()
+        target.ask(intents.GoHome())
 
 
 @command
@@ -409,7 +400,7 @@ class DockCommand(Command):
     needs = ("dock",)
 
     def activate(self, target: CommandTarget) -> None:
-        target.dock()
+        target.ask(intents.Dock())
 
 
 @command
@@ -421,7 +412,7 @@ class TourGoals(Command):
     needs = ("tourGoals",)
 
     def activate(self, target: CommandTarget) -> None:
-        target.tour_goals()
+        target.ask(intents.TourGoals())
 
 
 # -- the server's own commands ------------------------------------------------------------------

@@ -50,12 +50,13 @@ import contextlib
 import time
 from collections.abc import Callable, Mapping
 from dataclasses import replace
-from typing import Protocol
+from typing import Any, Protocol
 
 from ..base.notices import Kind, Notice
 from ..client.lease import DriveLease, DriveRatios, EndReason
 from ..model.observables import OperatorState, RobotModel, SpeedSetting
 from ..settings.store import Profile
+from ..values.intents import GotoGoal, Intent, RequestPicture, StartVideo, Stop, picture_source
 from ..values.state import ConnectionState, LinkHealth, LinkLevel, NavState, Phase
 from .commands import COMMANDS, CommandRegistry, CommandState
 
@@ -85,7 +86,7 @@ class View(Protocol):
 
 class ClientLink(Protocol):
     """The network side as the controller sees it (``rtmu.client.ClientRunner``); every call returns at once
-    (what it returns — a Future in the runner — is not waited for).
+    (what it returns — a Future in the runner — is not waited for here).
 
     Results come back through the model (connection, robot, map, camera) on the
     UI thread; problems the operator should hear about go to ``on_notice``.
@@ -109,29 +110,8 @@ class ClientLink(Protocol):
 
     def disconnect(self) -> object: ...
 
-    def stop(self) -> object:
-        """Zero ratios and ``stop``, sent whatever the link health says."""
-
-    def command(self, name: str, *args: object) -> object:
-        """Fire-and-forget request-once (``turnByAngle``, ``moveDist``…)."""
-
-    def request_image(self) -> object: ...
-
-    def set_safe_drive(self, on: bool) -> object: ...
-
-    def goto_goal(self, name: str) -> object:
-        """The server drives to the map's goal ``name`` (``gotoGoal``)."""
-
-    def goto_pose(self, x: float, y: float, th: float | None = None) -> object: ...
-
-    def home(self) -> object: ...
-
-    def dock(self) -> object: ...
-
-    def tour_goals(self) -> object: ...
-
-    def localize(self, x: float, y: float, th: float) -> object:
-        """Tell the server where the robot is (``localizeToPose``)."""
+    def send(self, intent: Intent) -> Any:
+        """The one way an intent crosses to the network thread (a Future of the feed's answer)."""
 
     # Optional (the controller looks for it with getattr): ``run_blocking(fn, done)`` runs ``fn``
     # off the UI thread and posts ``done(result)`` back; keyring lookups go through it.
@@ -213,6 +193,8 @@ class Controller:
         """Between focus loss and the next key press: releases seen then are not real key-ups."""
         self._nav_cancelled = False
         """We sent the stop that ends the current navigation; the server has not said so yet."""
+        self.tap: Callable[[str, dict[str, Any]], None] | None = None
+        """The flight recorder's tap: every intent sent, and every connect (without its password)."""
         self.replay: str | None = None
         """Set to the recording's name while the window shows a replay: then nothing is sent at all
         (drive keys, D-pad, STOP and every server command say "replay"), and no lease is granted."""
@@ -245,12 +227,8 @@ class Controller:
         return self.robot.connection.value.phase
 
     def image_source(self) -> str | None:
-        """The data a picture is requested with: the first getPicture…, else sendVideo, else None."""
-        offers = self.robot.connection.value.offers
-        pictures = sorted(n for n in offers if n.startswith("getPicture"))
-        if pictures:
-            return pictures[0]
-        return "sendVideo" if "sendVideo" in offers else None
+        """The data a picture is requested with (:func:`~rtmu.client.video_feed.picture_source`)."""
+        return picture_source(self.robot.connection.value.offers)
 
     # -- commands ----------------------------------------------------------------------------
     def run(self, name: str) -> bool:
@@ -423,7 +401,8 @@ class Controller:
         self._halt_held(EndReason.STOPPED)
         self.link.lease.end(EndReason.STOPPED)
         if self.robot.connection.value.phase in (Phase.CONNECTED, Phase.RECONNECTING, Phase.CONNECTING):
-            self.link.stop()
+            self._record(Stop())
+            self.link.send(Stop())
 
     def focus_lost(self) -> None:
         """The window lost keyboard focus: key releases may never arrive, so stop a held drive.
@@ -463,30 +442,46 @@ class Controller:
         if (self._held or self._analog is not None) and self._generation is not None:
             self._apply()
 
-    # -- bounded moves, sensing, modes -------------------------------------------------------
-    def turn_by(self, degrees: float) -> None:
-        """Turn in place by ``degrees`` (positive = left), the server's ``turnByAngle``."""
-        if self._require("turnByAngle"):
-            self._halt_held(EndReason.STOPPED)
-            self.link.command("turnByAngle", float(degrees))
+    # -- every other intent: the guard ---------------------------------------------------------
+    def ask(self, intent: Intent) -> Any:
+        """Send one operator intent to this robot, after the rules that hold for every intent.
 
-    def move_distance(self, mm: float) -> None:
-        """Drive ``mm`` straight (negative = backwards), the server's ``moveDist``."""
-        if self._require("moveDist"):
-            self._halt_held(EndReason.STOPPED)
-            self.link.command("moveDist", float(mm))
+        Refused, with the reason shown, in a replay, while not connected (for an intent that needs
+        the server) and where the server does not offer it. An intent that moves the robot ends a
+        held drive first (the network side sends its stop before the intent), and a new goal makes
+        drive keys drive again once the server has taken it. Returns what ``link.send`` returns (a
+        Future of the answer), or None when refused. STOP has its own path: :meth:`stop`."""
+        if isinstance(intent, Stop):
+            self.stop()
+            return None
+        if self.replay:
+            self._say_replay()
+            return None
+        offers = self.robot.connection.value.offers
+        if (intent.needs or intent.moves or not intent.offered(())) and not self.connected:
+            self.view.notify(Notice.warning(intent.kind, f"{intent.label}: not connected"))
+            return None
+        if not intent.offered(offers):
+            missing = f"offer {intent.needs[0]}" if intent.needs else f"offer {intent.label.lower()}"
+            if isinstance(intent, (RequestPicture, StartVideo)):
+                missing = "offer camera pictures"
+            self.view.notify(Notice.warning(intent.kind, f"This server does not {missing}"))
+            return None
+        goals = self.robot.navigation.value.goals
+        if isinstance(intent, GotoGoal) and goals and intent.name not in goals:
+            self.view.notify(Notice.warning(Kind.NAVIGATION, f"This map has no goal called {intent.name!r}"))
+            return None
+        if intent.moves:
+            self._halt_held(EndReason.STOPPED)  # the network side sends its stop before the intent
+            self._nav_cancelled = False
+        self._record(intent)
+        return self.link.send(intent)
 
-    def request_image(self) -> None:
-        if not self.connected:
-            self.view.notify(Notice.warning(Kind.CAMERA, "Camera picture: not connected"))
-        elif self.image_source() is None:
-            self.view.notify(Notice.warning(Kind.CAMERA, "This server offers no camera pictures"))
-        else:
-            self.link.request_image()
-
-    def set_safe_drive(self, on: bool) -> None:
-        if self._require("setSafeDrive"):
-            self.link.set_safe_drive(on)
+    def _record(self, intent: Intent) -> None:
+        tap = self.tap
+        if tap is not None:
+            with contextlib.suppress(Exception):  # recording never stands between operator and robot
+                tap(type(intent).__name__, intent.record())
 
     # -- navigation (the server drives) --------------------------------------------------------
     @property
@@ -494,70 +489,12 @@ class Controller:
         """The server navigates now, and we have not already sent the stop that ends it."""
         return self.robot.navigation.value.navigating and not self._nav_cancelled
 
-    def goto_goal(self, name: str) -> None:
-        """Send the robot to the map's goal ``name``: ``gotoGoal``, else an LD robot's ``gotoRouteGoal``."""
-        if self.replay:
-            self._say_replay()
-            return
-        goals = self.robot.navigation.value.goals
-        if goals and name not in goals:
-            self.view.notify(Notice.warning(Kind.NAVIGATION, f"This map has no goal called {name!r}"))
-            return
-        if not self.supports("gotoGoal") and self.supports("gotoRouteGoal"):
-            self._start_navigation()
-            self.link.command("gotoRouteGoal", name)
-        elif self._require("gotoGoal"):
-            self._start_navigation()
-            self.link.goto_goal(name)
-
-    def goto_pose(self, x: float, y: float, th: float | None = None) -> None:
-        """Send the robot to (x, y) mm on the map, facing ``th`` degrees when given (``gotoPose``)."""
-        if self._require("gotoPose"):
-            self._start_navigation()
-            self.link.goto_pose(float(x), float(y), None if th is None else float(th))
-
-    def home(self) -> None:
-        if self._require("home"):
-            self._start_navigation()
-            self.link.home()
-
-    def dock(self) -> None:
-        if self._require("dock"):
-            self._start_navigation()
-            self.link.dock()
-
-    def tour_goals(self) -> None:
-        if self._require("tourGoals"):
-            self._start_navigation()
-            self.link.tour_goals()
-
-    def localize(self, x: float, y: float, th: float) -> None:
-        """Tell the server the robot is at (x, y) mm facing ``th`` degrees (``localizeToPose``)."""
-        if self._require("localizeToPose"):
-            self.link.localize(float(x), float(y), float(th))
-
-    def _start_navigation(self) -> None:
-        self._halt_held(EndReason.STOPPED)  # the network side sends its stop before the goal
-        self._nav_cancelled = False
-
     def _on_navigation(self, old: NavState, new: NavState) -> None:
         if not new.navigating or (old.navigating and new.target != old.target):
             self._nav_cancelled = False  # it ended (or someone sent it elsewhere): keys drive again
 
     def _say_replay(self) -> None:
         self.view.notify(Notice.warning(Kind.SAFETY, f"{REPLAY_REASON}: {self.replay}"))
-
-    def _require(self, name: str) -> bool:
-        if self.replay:
-            self._say_replay()
-            return False
-        if not self.connected:
-            self.view.notify(Notice.warning(Kind.COMMAND, "Not connected"))
-            return False
-        if not self.supports(name):
-            self.view.notify(Notice.warning(Kind.COMMAND, f"This server does not offer {name}"))
-            return False
-        return True
 
     # -- connection --------------------------------------------------------------------------
     def select_profile(self, profile: Profile) -> None:
@@ -632,6 +569,10 @@ class Controller:
     def _start_connect(self, password: str) -> None:
         p = self.profile
         self._halt_held(EndReason.DISCONNECTED)
+        tap = self.tap
+        if tap is not None:
+            with contextlib.suppress(Exception):
+                tap("connect", {"host": p.host, "port": p.port, "user": p.user, "profile": p.name})
         self.link.connect(
             p.host,
             p.port,
@@ -644,6 +585,10 @@ class Controller:
 
     def disconnect(self) -> None:
         self.stop()
+        tap = self.tap
+        if tap is not None:
+            with contextlib.suppress(Exception):
+                tap("disconnect", {})
         self.link.disconnect()
 
     # -- dialogs -----------------------------------------------------------------------------
@@ -673,7 +618,7 @@ class Controller:
             moving = bool(self._held) or self._generation is not None
             self._halt_held(EndReason.LINK, quiet=True)
             if moving:
-                self.link.stop()
+                self.link.send(Stop("link " + new.level.value))
                 self._say_link_stop(new.level)
 
     def _on_link_notice(self, notice: Notice) -> None:

@@ -26,7 +26,7 @@ import time
 from collections.abc import Callable
 from dataclasses import replace
 from pathlib import Path
-from typing import Any, cast
+from typing import Any
 
 from ..client.link import Opener, open_tcp
 from ..client.roster import (
@@ -42,11 +42,10 @@ from ..client.roster import (
 from ..client.runner import ClientRunner, Post, call_directly, settle
 from ..client.session import SessionConfig
 from ..control.commands import COMMANDS, CommandRegistry
-from ..control.controller import ClientLink, Controller, NoView, SecretStore, View
+from ..control.controller import Controller, NoView, SecretStore, View
 from ..model.observables import Observable, OperatorState, RobotModel
 from ..recorder import Recorder, RecorderConfig
 from ..recorder.files import recordings_dir
-from ..recorder.intents import IntentTap
 from ..settings.store import Profile, RecordingSettings
 
 CLOSE_TIMEOUT = 1.5
@@ -77,25 +76,20 @@ class RobotSession:
         if self.recorder is not None:  # ``opener``: where the links come from (a replay's recording)
             opener = self.recorder.opener(opener or open_tcp)
         self.runner = ClientRunner(self.state, post=post, clock=clock, config=config, opener=opener)
-        link: ClientLink = self.runner
-        if self.recorder is not None:
-            link = cast(ClientLink, self._record_into(self.recorder))
         self.controller = Controller(
             self.state,
             operator,
-            link,
+            self.runner,
             NoView(),
             clock=clock,
             registry=registry,
             secrets=secrets,
             profile=profile,
         )
+        if self.recorder is not None:  # every source of the recording; the controller's guard for intents
+            self.recorder.attach(self.runner)
+            self.controller.tap = self.recorder.intent
         self.closed = False
-
-    def _record_into(self, recorder: Recorder) -> IntentTap:
-        """Hook every source of the recording to ``recorder``; the controller's link, tapped for intents."""
-        recorder.attach(self.runner)
-        return IntentTap(self.runner, recorder.intent)
 
     @property
     def name(self) -> str:

@@ -15,6 +15,8 @@ from typing import Any
 
 from ..base.exit_codes import signal_code
 from ..client.runner import ClientRunner
+from ..client.video_feed import picture_source
+from ..values.intents import RequestPicture
 
 IDLE_WAIT = 0.2
 """Longest sleep between passes when nothing else is due (a signal sets ``ended`` anyway)."""
@@ -41,8 +43,9 @@ def follow(
             runner.ui_heartbeat()
         if period is not None and now >= next_picture and (pending is None or pending.done()):
             session = runner.session
-            if session is not None and session.image_source() is not None:
-                pending = runner.submit(session.request_image)
+            client = session.client if session is not None else None
+            if client is not None and picture_source(e.name for e in client.datalist) is not None:
+                pending = runner.submit(session.dispatch, RequestPicture())  # type: ignore[union-attr]
                 pending.add_done_callback(lambda f: f.cancelled() or f.exception())
             next_picture = max(next_picture + period, now)
         waits = [IDLE_WAIT if beat is None else beat]

@@ -16,8 +16,10 @@ from typing import Any
 from ..base.exit_codes import EXIT_OK, EXIT_UNSUPPORTED
 from ..base.textsafe import visible
 from ..client.connection import AriaClient
+from ..client.detached import DetachedContext
 from ..client.ptz import PtzFeed
 from ..client.roles import Role
+from ..client.session_config import SessionConfig
 from ..values.state import PtzState
 from ._common import UsageError, add_connection_arguments, fail, print_json, run_with_client
 
@@ -74,11 +76,8 @@ def handle(args: argparse.Namespace) -> int:
     moving = any(v is not None for v in (args.pan, args.tilt, args.zoom))
 
     async def body(client: AriaClient) -> int:
-        def discard(coro: Any, _name: str) -> None:
-            coro.close()  # the command reads the position back itself
-
-        feed = PtzFeed(lambda **_changes: None, discard, args.timeout)
-        await feed.connected(client)
+        feed = PtzFeed(DetachedContext(client, config=SessionConfig(reply_timeout=args.timeout)))
+        await feed.read_head(client)
         state = feed.state
         if moving and state.movable and state.can_abs:
             outside = _outside_limits(args, state)

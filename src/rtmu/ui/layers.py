@@ -12,7 +12,6 @@ handed to the network side again before the next connection to that server lists
 from __future__ import annotations
 
 from collections.abc import Callable, MutableMapping
-from typing import Protocol
 
 import gi
 
@@ -20,18 +19,11 @@ gi.require_version("Gtk", "4.0")
 from gi.repository import Gtk, Pango  # noqa: E402
 
 from ..model.observables import ConnectionState, DrawingsState, Observable, Phase  # noqa: E402
+from ..values.intents import DrawingChoices, Intent, ShowDrawing  # noqa: E402
 from ..values.state import DrawingLayer  # noqa: E402
 
 MAX_LABEL = 60
 """Characters of a name shown (the whole name is the button's tooltip)."""
-
-
-class DrawingLink(Protocol):
-    """What the panel needs of the network side (``ClientRunner``)."""
-
-    def set_drawing_shown(self, name: str, shown: bool) -> object: ...
-
-    def set_drawing_choices(self, choices: dict[str, bool]) -> object: ...
 
 
 def server_key(connection: ConnectionState) -> str:
@@ -57,7 +49,7 @@ class LayersPanel(Gtk.Box):
         self,
         drawings: Observable[DrawingsState],
         connection: Observable[ConnectionState],
-        link: DrawingLink,
+        ask: Callable[[Intent], object],
         choices: MutableMapping[str, dict[str, bool]] | None = None,
     ) -> None:
         super().__init__(orientation=Gtk.Orientation.VERTICAL, spacing=2)
@@ -71,7 +63,8 @@ class LayersPanel(Gtk.Box):
         self.set_visible(False)
         self._drawings = drawings
         self._connection = connection
-        self._link = link
+        self._ask = ask
+        """The selected robot's intents (``SelectedRobot.ask``)."""
         self.choices: MutableMapping[str, dict[str, bool]] = {} if choices is None else choices
         self.on_closed: Callable[[], None] = lambda: None
         self.buttons: dict[str, Gtk.CheckButton] = {}
@@ -125,7 +118,7 @@ class LayersPanel(Gtk.Box):
 
     def _send_choices(self) -> None:
         if self._server:
-            self._link.set_drawing_choices(dict(self.choices.get(self._server, {})))
+            self._ask(DrawingChoices(dict(self.choices.get(self._server, {}))))
 
     def _refresh(self) -> None:
         layers = self._drawings.value.layers
@@ -163,4 +156,4 @@ class LayersPanel(Gtk.Box):
             return
         if self._server:
             self.choices.setdefault(self._server, {})[name] = shown
-        self._link.set_drawing_shown(name, shown)
+        self._ask(ShowDrawing(name, shown))

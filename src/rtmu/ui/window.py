@@ -25,6 +25,7 @@ import concurrent.futures
 import functools
 import time
 from collections.abc import Callable, Mapping
+from typing import Any
 
 import gi
 
@@ -35,8 +36,10 @@ from gi.repository import Gdk, Gio, GLib, Gtk, Pango  # noqa: E402
 
 from ..base.notices import Kind, Level, Notice  # noqa: E402
 from ..client.custom_commands import ServerCommand  # noqa: E402
+from ..client.errors import ClientError  # noqa: E402
 from ..control.commands import COMMANDS, CommandState, action_name  # noqa: E402
 from ..control.controller import TICK, SecretStore  # noqa: E402
+from ..fleet.selected import SelectedRobot  # noqa: E402
 from ..fleet.sessions import RobotSession  # noqa: E402
 from ..guardian.handle import BEAT_PERIOD as GUARDIAN_BEAT  # noqa: E402
 from ..model.observables import (  # noqa: E402
@@ -51,6 +54,24 @@ from ..model.observables import (  # noqa: E402
     SpeedSetting,
 )
 from ..settings.store import Profile  # noqa: E402
+from ..values.intents import (  # noqa: E402
+    AnswerPopup,
+    FetchConfig,
+    GotoGoal,
+    GotoPose,
+    Intent,
+    ListServerCommands,
+    Localize,
+    MoveDistance,
+    PauseVideo,
+    RunServerCommand,
+    SetConfig,
+    StartVideo,
+    StopVideo,
+    TurnBy,
+    VideoShown,
+    WatchStrings,
+)
 from .banners import BannerStack  # noqa: E402
 from .bars import FullscreenBar, connect_button, menu_button, show_connection, stop_button  # noqa: E402
 from .bridge_toggle import BridgeToggle  # noqa: E402
@@ -186,6 +207,8 @@ class MainWindow(Gtk.ApplicationWindow):
 
         link = session.runner
         self._link = link
+        self.robot = SelectedRobot(session)
+        """The robot the operator commands: every widget's intents go to the selected one."""
         status_age = lambda: self._link.status_age()  # noqa: E731 - the shown robot's, also after a switch
         self.banners = BannerStack()
         self.stage = MapStage(model, operator, clock=clock, status_age=status_age)
@@ -193,11 +216,12 @@ class MainWindow(Gtk.ApplicationWindow):
         self.toolbar = StatusToolbar(model, operator, clock=clock, status_age=status_age)
         self.camera = CameraView(on_request=self._request_picture, on_back=self.show_map, clock=clock)
         self.inset = PictureInPicture(self.show_camera, clock=clock, on_hide=lambda: self._hide_inset())
-        self.ptz = PtzControls(model, link, on_moved=self._request_picture)
+        self.ptz = PtzControls(model, self.robot.ask, on_moved=self._request_picture)
         self.ptz.attach_drag(self.camera.picture)
         self.camera.append(self.ptz)
         self.live = LiveVideoControls(
-            self.camera, start=link.start_video, stop=link.stop_video, pause=link.pause_video,
+            self.camera, start=lambda fps, quality: self.robot.ask(StartVideo(fps, quality)),
+            stop=lambda: self.robot.ask(StopVideo()), pause=lambda on: self.robot.ask(PauseVideo(on)),
             tell=lambda level, text: self.banners.tell("camera", level, text, timeout=5.0),
         )  # fmt: skip
         self.decoder = PictureDecoder(self._picture_decoded)
@@ -265,7 +289,7 @@ class MainWindow(Gtk.ApplicationWindow):
         self.camera_button.set_tooltip_text("Camera picture (Esc)")
         self.camera_button.connect("clicked", self._camera_button_clicked)
         header.pack_end(self.camera_button)
-        self.routes_panel = RoutesPanel(self.model, self.send_data)  # only when the server lists getRoutes
+        self.routes_panel = RoutesPanel(self.model, self.robot.ask)  # only when the server lists getRoutes
         header.pack_end(self.routes_panel)
         goto = self._goto_goal  # the panel shows only when the server navigates (goals, points, dock)
         self.goals_panel = GoalsPanel(
@@ -292,7 +316,9 @@ class MainWindow(Gtk.ApplicationWindow):
         # Server popups: cards over the map above the zoom buttons, never focusable (STOP is in the header).
         self.popup_stack = PopupStack(self.model.popups, self._answer_popup, clock=self.clock)
         map_page.add_overlay(self.popup_stack)
-        self.layers = LayersPanel(self.model.drawings, self.model.connection, self._link)  # View → Layers…
+        self.layers = LayersPanel(
+            self.model.drawings, self.model.connection, self.robot.ask
+        )  # View → Layers…
         map_page.add_overlay(self.layers)
         self.map_note = Gtk.Label(halign=Gtk.Align.CENTER, valign=Gtk.Align.END, visible=False)
         self.map_note.add_css_class("map-note")
@@ -458,6 +484,10 @@ class MainWindow(Gtk.ApplicationWindow):
         self.sonar_action = toggle("sonar", self.operator.view.value.show_sonar, self._set_sonar)
         self.safe_action = toggle("safe-drive", True, self._set_safe_drive)
         self.foxglove = BridgeToggle(self.session, self.show_notice)  # publishing only, never drives
+        for follow in (self.ptz.follow_selection, self.live.follow_selection, self.foxglove.follow_selection):
+            self.robot.on_switch(follow)
+        self.robot.on_switch(self._details_follow)
+        self.robot.on_switch(self._config_follow)
         self.foxglove_action = toggle("foxglove", False, self.foxglove.set)
         self.foxglove.failed = functools.partial(_unset, self.foxglove_action)  # a busy port: unchecked again
         self.connect("notify::fullscreened", self._fullscreen_changed)
@@ -539,6 +569,7 @@ class MainWindow(Gtk.ApplicationWindow):
         self.dpad.release_all()
         self.picker.cancel()
         self.session, self.controller, self._link = session, session.controller, session.runner
+        self.robot.show(session)  # every widget's intents now go to this robot; what they hold moves
         self.handheld.show_controller(self.controller)  # the pad follows the selection, never carries over
         session.attach_view(self.robot_view)
         if isinstance(self.model, SelectedModel):
@@ -600,9 +631,11 @@ class MainWindow(Gtk.ApplicationWindow):
     def open_dialog(self, name: str) -> None:
         """The dialog a command asked for (the controller stopped the robot first)."""
         makers = {
-            "turn": lambda: turn_dialog(self, self.controller.turn_by),
-            "go": lambda: go_dialog(self, self.controller.move_distance),
-            "commands": lambda: CommandPalette(self, self._link.list_commands, self._run_server_command),
+            "turn": lambda: turn_dialog(self, lambda degrees: self.robot.ask(TurnBy(degrees))),
+            "go": lambda: go_dialog(self, lambda mm: self.robot.ask(MoveDistance(mm))),
+            "commands": lambda: CommandPalette(
+                self, lambda: self.request(ListServerCommands()), self._run_server_command
+            ),
         }
         dialog = makers[name]()
         dialog.present()
@@ -623,7 +656,17 @@ class MainWindow(Gtk.ApplicationWindow):
         return controller is not None and (bool(controller.held) or controller.analog_active)
 
     def _answer_popup(self, popup_id: int, button: int) -> None:
-        self._link.answer_popup(popup_id, button)
+        self.robot.ask(AnswerPopup(popup_id, button))
+
+    def request(self, intent: Intent) -> concurrent.futures.Future[Any]:
+        """:meth:`SelectedRobot.ask` for a widget that waits for the answer: a refusal (said already)
+        comes back as a failed Future, so the widget's own waiting ends too."""
+        future = self.robot.ask(intent)
+        if isinstance(future, concurrent.futures.Future):
+            return future
+        refused: concurrent.futures.Future[Any] = concurrent.futures.Future()
+        refused.set_exception(ClientError(f"{intent.label}: refused"))
+        return refused
 
     def _run_server_command(self, command: ServerCommand, argument: str | None) -> None:
         """From the palette: sent on the network thread; the outcome comes back as a banner."""
@@ -634,14 +677,14 @@ class MainWindow(Gtk.ApplicationWindow):
             said = "taken by the server" if future.result() else "sent; the server did not answer"
             GLib.idle_add(self._tell_once, "server-command", f"{command.name}: {said}")
 
-        self._link.run_command(command, argument).add_done_callback(done)
+        self.request(RunServerCommand(command.name, argument, command.takes_argument)).add_done_callback(done)
 
     def _tell_once(self, topic: str, text: str) -> bool:
         self.banners.tell(topic, "info", text, timeout=4.0)
         return False  # an idle callback: once
 
     def _goto_goal(self, goal: str) -> None:
-        self.controller.goto_goal(goal)
+        self.robot.ask(GotoGoal(goal))
 
     def start_pick(self, kind: MarkerKind) -> None:
         """Go to a point / set robot position: a map mode; the pose bar confirms (``pose_bar``)."""
@@ -650,10 +693,10 @@ class MainWindow(Gtk.ApplicationWindow):
 
     def _pose_confirmed(self, marker: Marker) -> None:
         if marker.kind is MarkerKind.GOTO:
-            self.controller.goto_pose(marker.x, marker.y, marker.th)
+            self.robot.ask(GotoPose(marker.x, marker.y, marker.th))
         else:
             th = self.model.robot.value.th if marker.th is None else marker.th
-            self.controller.localize(marker.x, marker.y, th)
+            self.robot.ask(Localize(marker.x, marker.y, th))
 
     def toggle_connection(self) -> None:
         phase = self.model.connection.value.phase
@@ -801,11 +844,11 @@ class MainWindow(Gtk.ApplicationWindow):
         self, image: object, textures: tuple[Gdk.Texture, Gdk.Texture] | None, error: str
     ) -> None:
         current = self.model.camera.value
-        if getattr(image, "video", None) is not None:  # the next frame only once this one is painted
+        frame = getattr(image, "frame", None)
+        if frame is not None:  # the next frame only once this one is painted
             shows = (self.camera.picture, self.inset, self.split.pane)
             seen = textures is not None and image is current and any(w.get_mapped() for w in shows)
-            sequence: int = image.sequence  # type: ignore[attr-defined]
-            self.live.when_painted(lambda: self._link.video_shown(sequence), seen)
+            self.live.when_painted(lambda: self.robot.ask(VideoShown(frame)), seen)
         if current is None or image is not current:
             return  # a newer picture (or a disconnect) overtook this one
         self.camera.show_picture(image, None if textures is None else textures[0], error)
@@ -889,25 +932,44 @@ class MainWindow(Gtk.ApplicationWindow):
                 "notice:saved", "info", f"Saved “{profile.name}”: reconnect to use it", timeout=4.0
             )
 
-    def send_data(self, name: str, payload: object) -> None:
-        """Fire-and-forget request of an LD panel (patrol, say) through the controller's link."""
-        self.controller.link.command(name, payload)
-
     def show_server_config(self) -> None:
         """The server's configuration page (its own window, so typing there never drives): one at a time."""
         page = getattr(self, "config_page", None)
         if page is None or page.closed:
-            link = self._link
             self.config_page = ConfigPage(
-                self, link.fetch_config, link.set_config, lambda fn: setattr(link, "on_config_updated", fn)
+                self,
+                lambda: self.request(FetchConfig()),
+                lambda changes: self.request(SetConfig(changes)),
+                self._follow_config_updates,
             )
         self.config_page.present()
+
+    def _follow_config_updates(self, listener: Callable[[], None] | None) -> None:
+        """The configuration page hears another client's changes on the robot shown (and only there)."""
+        self._config_listener = listener
+        self._link.on_config_updated = listener
+
+    def _config_follow(self, old: RobotSession, new: RobotSession) -> None:
+        listener = getattr(self, "_config_listener", None)
+        if listener is None:
+            return
+        old.runner.on_config_updated = None
+        new.runner.on_config_updated = listener
+        listener()  # the page reads the newly selected robot's configuration
+
+    def _details_follow(self, old: RobotSession, new: RobotSession) -> None:
+        details = getattr(self, "details", None)
+        if details is not None and details.get_visible():
+            old.controller.ask(WatchStrings(False))
+            new.controller.ask(WatchStrings(True))
 
     def show_details(self) -> None:
         """The details window (DataStore strings, docking, say): one at a time."""
         details = getattr(self, "details", None)
         if details is None or not details.get_visible():
-            self.details = DetailsWindow(self, self.model, self.send_data, self._link.watch_strings)
+            self.details = DetailsWindow(
+                self, self.model, self.robot.ask, lambda on: self.robot.ask(WatchStrings(on))
+            )
         self.details.present()
 
     def show_about(self) -> None:

@@ -73,8 +73,6 @@ class RobotState:
     """Route names (``getRoutes``, LD robots)."""
     data_store: tuple[tuple[str, str], ...] = ()
     """(data name, value) of every listed ``DataStore_*`` string, sorted by name."""
-    goals: tuple[str, ...] = ()
-    """The map's goal names (``getGoals``), asked for where ``gotoRouteGoal`` is listed (LD robots)."""
     loc_score: int | None = None
     """Localization score 0–100 from ``DataStore_Localization_Score``; None if not offered."""
     goal_distance_mm: int | None = None
@@ -187,6 +185,9 @@ class CameraImage:
     """Wall-clock ns the server rendered it (the simulator's ``RTMU-T`` comment); None: not stamped."""
     video: VideoStatus | None = field(default=None, compare=False)
     """Live video's figures when this frame came from the video loop (None: a single picture)."""
+    frame: int | None = field(default=None, compare=False)
+    """The video loop's own number for this frame (None: a single picture): what the window hands
+    back once it has painted it (``VideoShown``), so the loop asks for the next."""
 
 
 @dataclass(frozen=True, slots=True)
