@@ -32,10 +32,11 @@ from rtmu.base.exit_codes import (
     EXIT_USAGE,
 )
 from rtmu.cli import main
+from rtmu.package_data import project_map
 from rtmu.sim import SimConfig, SimThread
 
 REPO = Path(__file__).resolve().parents[1]
-ARENA = REPO / "data" / "maps" / "arena.map"
+ARENA = project_map("arena.map")
 RTMU = [sys.executable, "-m", "rtmu"]
 
 NETWORK_ARGS: dict[str, list[str]] = {

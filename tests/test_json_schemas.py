@@ -20,12 +20,13 @@ import jsonschema
 import pytest
 
 from rtmu.cli import build_parser
+from rtmu.package_data import project_map
 from rtmu.sim import SimConfig, SimThread
 from rtmu.sim.central_thread import CentralThread
 from rtmu.subcommands.json_schemas import COMMAND_SCHEMA, SCHEMAS
 
 REPO = Path(__file__).resolve().parents[1]
-OFFICE = REPO / "data" / "maps" / "office.map"
+OFFICE = project_map("office.map")
 RTMU = [sys.executable, "-m", "rtmu"]
 
 RUNS: list[tuple[str, list[str]]] = [

@@ -17,10 +17,11 @@ from PIL import Image
 
 from rtmu.base.exit_codes import EXIT_OK, EXIT_UNSUPPORTED, EXIT_USAGE
 from rtmu.cli import main
+from rtmu.package_data import project_map
 from rtmu.sim import SimConfig, SimThread
 
 REPO = Path(__file__).resolve().parents[2]
-ARENA = REPO / "data" / "maps" / "arena.map"
+ARENA = project_map("arena.map")
 
 
 @pytest.fixture(scope="module")

@@ -3,8 +3,8 @@
 from __future__ import annotations
 
 import math
-from pathlib import Path
 
+from rtmu.package_data import project_map
 from rtmu.protocol.payloads.drive import RatioDrive
 from rtmu.protocol.payloads.ld import (
     DataStoreValue,
@@ -56,7 +56,7 @@ def test_front_laser_sees_the_wall_at_one_ray_per_degree(tmp_path):
     run(scenario())
 
 
-OFFICE = Path(__file__).resolve().parents[2] / "data" / "maps" / "office.map"
+OFFICE = project_map("office.map")
 
 
 def test_dock_drives_to_the_dock_and_a_drive_backs_out_of_it():
