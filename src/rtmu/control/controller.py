@@ -42,6 +42,13 @@ Navigation rules (the server drives: ARNL's goals, points, home, dock, tours)
   stop before the goal), so the next ``ratioDrive`` cannot take it back.
 * Navigation is autonomy on the server: focus loss, a stale link or a lapsed lease
   end *held drives* only, never a navigation (disconnecting still stops the robot).
+* Looking never stops a mission: changing page (map ⇄ camera) or opening a dialog (Turn, Go, the
+  server's commands) ends a held drive — its keys go elsewhere — but never a navigation, and
+  is no stop key (:meth:`look`). Only STOP, Space and the drive keys cancel a navigation.
+* No drive starts or goes on while the stop key cannot reach the window (:meth:`focus_lost` until
+  :meth:`focus_gained` or a key press): a D-pad press then is refused, saying why
+  (:meth:`pointer_may_drive`).
+* Every stop the controller makes is said once, with what to do next.
 """
 
 from __future__ import annotations
@@ -59,6 +66,7 @@ from ..settings.store import Profile
 from ..values.intents import GotoGoal, Intent, RequestPicture, StartVideo, Stop, picture_source
 from ..values.state import ConnectionState, LinkHealth, LinkLevel, NavState, Phase
 from .commands import COMMANDS, CommandRegistry, CommandState
+from .key_rules import KEYS_INACTIVE
 
 TICK = 0.1
 """Seconds between :meth:`Controller.tick` calls the UI timer should make (10 Hz renewal)."""
@@ -195,6 +203,8 @@ class Controller:
         """We sent the stop that ends the current navigation; the server has not said so yet."""
         self.tap: Callable[[str, dict[str, Any]], None] | None = None
         """The flight recorder's tap: every intent sent, and every connect (without its password)."""
+        self.keys_reach = True
+        """The window has the keyboard, so the stop key reaches it (False from focus loss to focus gain)."""
         self.replay: str | None = None
         """Set to the recording's name while the window shows a replay: then nothing is sent at all
         (drive keys, D-pad, STOP and every server command say "replay"), and no lease is granted."""
@@ -270,6 +280,7 @@ class Controller:
         if direction not in DIRECTIONS:
             raise ValueError(f"unknown direction {direction!r}")
         self._unfocused = False  # key presses reach a focused window only
+        self.keys_reach = True
         if direction in self._held or direction in self._blocked:
             return  # key auto-repeat, or a key held through a stop: wait for its release
         if self.replay:
@@ -377,7 +388,8 @@ class Controller:
         if had and reason is EndReason.LAPSED:
             self.view.notify(
                 Notice.warning(
-                    Kind.SAFETY, "Stopped: the window did not respond in time. Press again to drive."
+                    Kind.SAFETY,
+                    "Stopped: the window did not respond in time (a busy computer?). Press again to drive.",
                 )
             )
         elif had and reason is EndReason.LINK and not quiet:
@@ -385,7 +397,9 @@ class Controller:
             self._say_link_stop(level if level in (LinkLevel.STALE, LinkLevel.LOST) else LinkLevel.STALE)
 
     def _say_link_stop(self, level: LinkLevel) -> None:
-        self.view.notify(Notice.warning(Kind.LINK, f"Stopped: the link is {level.value}"))
+        self.view.notify(
+            Notice.warning(Kind.LINK, f"Stopped: the link is {level.value}. Press again once it is back.")
+        )
 
     def stop(self) -> None:
         """Stop now. Always sent, whatever the link looks like; held keys must be pressed again.
@@ -412,18 +426,41 @@ class Controller:
         Keys held now stay blocked until a real release is seen after focus returns (see the
         module notes): auto-repeat of a key held all along must not start the robot again.
         """
-        if self._held or self._generation is not None:
+        driving = bool(self._held) or self._generation is not None
+        if driving:
             self.stop()
+            said = f"Stopped: the window lost the keyboard. {KEYS_INACTIVE}, then drive."
+            self.view.notify(Notice.warning(Kind.SAFETY, said))
         if self._analog is not None:
             self._analog = None
             self._analog_blocked = True
         self._blocked |= self._held
         self._held.clear()
         self._unfocused = True
+        self.keys_reach = False
 
     def focus_gained(self) -> None:
         """The window has the keyboard again: releases from now on are real (optional for a view)."""
         self._unfocused = False
+        self.keys_reach = True
+
+    def pointer_may_drive(self) -> bool:
+        """A D-pad (pointer, touch) hold may start only while the stop key reaches the window: else it
+        is refused, saying why (a key press proves the keyboard is here; a pointer press does not)."""
+        if not self.keys_reach:
+            self.view.notify(Notice.warning(Kind.SAFETY, f"{KEYS_INACTIVE}, then drive: Space must reach it"))
+        return self.keys_reach
+
+    def look(self, what: str, *, keys_leave: bool = False) -> None:
+        """The operator looks elsewhere (``what``: "the camera page", "a dialog", "the menu"): a held
+        drive ends, its keys blocked until released, and says so; a navigation goes on, and nothing is
+        sent for it. ``keys_leave``: the keyboard goes to another surface of the window (a menu), so
+        key-ups seen until the next press are not real ones (as after a focus loss)."""
+        if self._held or (self._analog is not None and self._generation is not None):
+            self._halt_held(EndReason.STOPPED)
+            self.view.notify(Notice.info(Kind.SAFETY, f"Stopped for {what}. Press again to drive."))
+        if keys_leave:
+            self._unfocused = True
 
     # -- speed -------------------------------------------------------------------------------
     def speed_up(self) -> None:
@@ -593,8 +630,12 @@ class Controller:
 
     # -- dialogs -----------------------------------------------------------------------------
     def open_dialog(self, name: str) -> None:
-        """A command that needs an amount first (``turn``, ``go``): stop, then let the view ask for it."""
-        self.stop()
+        """A dialog a command needs (``turn``, ``go``: an amount; ``commands``: the palette).
+
+        Opening one is looking (:meth:`look`): it takes the keyboard, so a held drive ends — a Turn or
+        Go jog would take over from it anyway — but a navigation goes on until the operator runs what
+        the dialog asks, or presses STOP (the dialog carries the stop keys)."""
+        self.look("a dialog")
         self.view.open_dialog(name)
 
     # -- reactions to the model --------------------------------------------------------------

@@ -56,11 +56,14 @@ def shortcuts_xml(table: tuple[Binding, ...] | None = None, column_lines: int = 
             f'<property name="title">{escape(title)}</property>',
         ]
         for b in items:
+            accels = " ".join(shown_accels(b)) if b.help is None else b.help
+            if not accels:
+                continue
             out += [
                 "<child>",
                 '<object class="GtkShortcutsShortcut">',
                 f'<property name="title">{escape(b.title)}</property>',
-                f'<property name="accelerator">{escape(" ".join(shown_accels(b)))}</property>',
+                f'<property name="accelerator">{escape(accels)}</property>',
                 "</object>",
                 "</child>",
             ]
