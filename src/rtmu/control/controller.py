@@ -448,7 +448,10 @@ class Controller:
         """A D-pad (pointer, touch) hold may start only while the stop key reaches the window: else it
         is refused, saying why (a key press proves the keyboard is here; a pointer press does not)."""
         if not self.keys_reach:
-            self.view.notify(Notice.warning(Kind.SAFETY, f"{KEYS_INACTIVE}, then drive: Space must reach it"))
+            said = (
+                "Not driving: Space could not stop it, the keyboard is elsewhere. Click the map, then drive."
+            )
+            self.view.notify(Notice.warning(Kind.SAFETY, said))
         return self.keys_reach
 
     def look(self, what: str, *, keys_leave: bool = False) -> None:

@@ -12,13 +12,12 @@ Two ways keys went missing:
   handled; a 100 ms check catches any other way a focus could be left behind (a page switched away).
 * **The keyboard is elsewhere** (another program, one of the window's dialogs): the drive keys
   cannot reach the window. The controller already ends held drives and refuses D-pad drives then;
-  here a note over the map says so ("Keys inactive — click the map", or which dialog has them and
-  that Space still stops there), from ``control.key_rules.keys_note``.
+  here a banner (topic ``keys``, kept while it lasts) says so ("Keys inactive — click the map", or
+  which dialog has them and that Space still stops there), from ``control.key_rules.keys_note``.
 """
 
 from __future__ import annotations
 
-from collections.abc import Callable
 from typing import Any
 
 import gi
@@ -33,11 +32,7 @@ MainWindow = Any
 """``ui.window.MainWindow`` (which imports this module): named, not imported."""
 
 CHECK_MS = 100
-
-CSS = """
-.keys-note { background: alpha(#9c5300, 0.92); color: white; border-radius: 8px; padding: 6px 14px;
-             font-weight: bold; }
-"""
+TOPIC = "keys"
 
 
 def stranded(window: Gtk.Window) -> Gtk.Widget | None:
@@ -57,22 +52,11 @@ def _popover_of(widget: Gtk.Widget | None) -> Gtk.Popover | None:
 class KeyReach:
     """See the module notes. ``repairs`` counts the stranded focuses put back (tests read it)."""
 
-    def __init__(self, window: MainWindow, on_change: Callable[[str], None] | None = None) -> None:
+    def __init__(self, window: MainWindow) -> None:
         self.window = window
         self.repairs = 0
-        self.on_change = on_change
-        self.note = Gtk.Label(halign=Gtk.Align.CENTER, valign=Gtk.Align.START, visible=False)
-        self.note.add_css_class("keys-note")
-        self.note.set_margin_top(56)  # under the banners' first row
-        self.note.set_can_target(False)  # clicks go to the map under it
-        self.note.set_wrap(True)
-        self.note.set_max_width_chars(40)
-        window.map_page.add_overlay(self.note)
-        provider = Gtk.CssProvider()
-        provider.load_from_data(CSS, -1)
-        Gtk.StyleContext.add_provider_for_display(
-            window.get_display(), provider, Gtk.STYLE_PROVIDER_PRIORITY_APPLICATION
-        )
+        self.text = ""
+        """What the window says about its keys now ("" while they reach it)."""
         self._handlers = [
             window.connect("notify::focus-widget", lambda *_a: self._focus_moved()),
             window.connect("notify::is-active", lambda *_a: self.refresh()),
@@ -124,11 +108,12 @@ class KeyReach:
         text = keys_note(window_active=active, connected=connected, dialog=dialog)
         if connected and not active:  # a dialog of this window carries the stop keys: Space reaches it
             window.controller.keys_reach = bool(dialog)
-        if text != self.note.get_text():
-            self.note.set_text(text)
-            if self.on_change is not None:
-                self.on_change(text)
-        self.note.set_visible(bool(text))
+        shown = window.banners.text(TOPIC)
+        if text and shown != text:
+            window.banners.tell(TOPIC, "warning", text, timeout=None)  # back if closed while it lasts
+        elif not text and shown is not None:
+            window.banners.dismiss(TOPIC)
+        self.text = text
 
     def _dialog_title(self) -> str:
         """The title of one of this window's own windows that has the keyboard now ("" if none)."""
