@@ -16,6 +16,7 @@ import gi
 
 from rtmu.sim import SimThread
 from rtmu.ui.stop_keys import descendants
+from rtmu.values.intents import GotoGoal
 
 from .harness import Gui, idle, pump
 
@@ -167,7 +168,7 @@ class StopCycle:
     def navigate(self) -> None:
         window = self.gui.window
         self._goal = (self._goal + 1) % len(GOALS)
-        window.controller.goto_goal(GOALS[self._goal])
+        window.controller.ask(GotoGoal(GOALS[self._goal]))
         pump(lambda: self.mode() == "Goto", 10, "the robot to navigate")
         pump(lambda: window.model.navigation.value.navigating, 5, "the window to see the navigation")
 

@@ -30,7 +30,11 @@ Driving rules
   every stop above blocks the stick too, until the dead-man is released and
   pressed again.
 * Speed: 10…100 % in 10 % steps; it is the ``ratioDrive`` throttle and applies at
-  once to a drive in progress.
+  once to a drive in progress. The operator's near-people cap (``OperatorState.near_people``)
+  lowers that throttle so a full drive stays under it, from the robot's top speed
+  (``motion_limits``: the server's own, else ARIA's P3-DX maximum, raised by any faster speed seen).
+* Every jog (Turn, Go) ends with its outcome said (``jog_watch``): arrived, stopped short and why,
+  or ended by a stop, a drive or a navigation.
 
 Navigation rules (the server drives: ARNL's goals, points, home, dock, tours)
 -----------------------------------------------------------------------------
@@ -64,9 +68,11 @@ from ..client.lease import DriveLease, DriveRatios, EndReason
 from ..model.observables import OperatorState, RobotModel, SpeedSetting
 from ..settings.store import Profile
 from ..values.intents import GotoGoal, Intent, RequestPicture, StartVideo, Stop, picture_source
-from ..values.state import ConnectionState, LinkHealth, LinkLevel, NavState, Phase
+from ..values.state import ConnectionState, LinkHealth, LinkLevel, NavState, Phase, RobotState
 from .commands import COMMANDS, CommandRegistry, CommandState
 from .key_rules import KEYS_INACTIVE
+from .motion_limits import RobotLimits, capped_throttle
+from .motion_watch import MotionWatch
 
 TICK = 0.1
 """Seconds between :meth:`Controller.tick` calls the UI timer should make (10 Hz renewal)."""
@@ -205,6 +211,8 @@ class Controller:
         """The flight recorder's tap: every intent sent, and every connect (without its password)."""
         self.keys_reach = True
         """The window has the keyboard, so the stop key reaches it (False from focus loss to focus gain)."""
+        self.motion = MotionWatch(link, lambda n: self.view.notify(n), self._reapply, clock)
+        """The robot's limits (the cap, the stopping distance) and how each jog ended."""
         self.replay: str | None = None
         """Set to the recording's name while the window shows a replay: then nothing is sent at all
         (drive keys, D-pad, STOP and every server command say "replay"), and no lease is granted."""
@@ -213,6 +221,8 @@ class Controller:
             robot.connection.observe(self._on_connection),
             robot.health.observe(self._on_health),
             robot.navigation.observe(self._on_navigation),
+            robot.robot.observe(self._on_robot),
+            operator.near_people.observe(lambda _old, _new: self._reapply()),
         ]
         self.refresh_commands()
 
@@ -345,6 +355,7 @@ class Controller:
 
     def tick(self) -> None:
         """Renew the lease while keys are held. Call every :data:`TICK` s from the UI thread's timer."""
+        self.motion.tick(self.robot.robot.value)
         if not self._held and (self._analog is None or self._generation is None):
             return
         if not self.link.lease.renew():
@@ -352,7 +363,9 @@ class Controller:
             self._halt_held(reason)
 
     def _apply(self) -> None:
-        speed = self.operator.speed.value.percent
+        speed = capped_throttle(
+            self.operator.speed.value.percent, self.operator.near_people.value.cap, self.limits
+        )
         if self._held or self._analog is None:
             ratios = ratios_for(self._held, speed)
         else:
@@ -368,7 +381,13 @@ class Controller:
                 # The lease died under us (lapsed/stale); the keys pressed before are stale too.
                 self._halt_held(lease.ended or EndReason.LAPSED)
                 return
+            self._end_jog("a drive")
             self._generation = lease.grant(ratios)
+
+    def _reapply(self) -> None:
+        """The cap or the robot's limits changed: a drive in progress takes the new throttle at once."""
+        if (self._held or self._analog is not None) and self._generation is not None:
+            self._apply()
 
     def _halt_held(self, reason: EndReason, *, quiet: bool = False) -> None:
         """Motion was stopped for ``reason`` while keys were held: block them until released.
@@ -412,6 +431,7 @@ class Controller:
             return
         if self.navigating:
             self._nav_cancelled = True
+        self._end_jog("STOP")
         self._halt_held(EndReason.STOPPED)
         self.link.lease.end(EndReason.STOPPED)
         if self.robot.connection.value.phase in (Phase.CONNECTED, Phase.RECONNECTING, Phase.CONNECTING):
@@ -479,8 +499,7 @@ class Controller:
             )
             return
         self.view.notify(Notice.info(Kind.SPEED, f"Speed {new.percent} %"))
-        if (self._held or self._analog is not None) and self._generation is not None:
-            self._apply()
+        self._reapply()
 
     # -- every other intent: the guard ---------------------------------------------------------
     def ask(self, intent: Intent) -> Any:
@@ -515,7 +534,10 @@ class Controller:
             self._halt_held(EndReason.STOPPED)  # the network side sends its stop before the intent
             self._nav_cancelled = False
         self._record(intent)
-        return self.link.send(intent)
+        sent = self.link.send(intent)
+        if intent.moves:
+            self.motion.intent_sent(intent, self.robot.robot.value)  # a jog is watched to its outcome
+        return sent
 
     def _record(self, intent: Intent) -> None:
         tap = self.tap
@@ -641,8 +663,25 @@ class Controller:
         self.look("a dialog")
         self.view.open_dialog(name)
 
+    @property
+    def limits(self) -> RobotLimits:
+        """The robot's top speed and braking (``motion_limits``): the cap and the stopping distance."""
+        return self.motion.limits
+
+    def _on_robot(self, _old: RobotState, new: RobotState) -> None:
+        self.motion.robot_changed(
+            new, self.link.lease.view().ratios if self._generation is not None else None
+        )
+
+    def _end_jog(self, why: str) -> None:
+        self.motion.end_jog(why, self.robot.robot.value)
+
     # -- reactions to the model --------------------------------------------------------------
     def _on_connection(self, old: ConnectionState, new: ConnectionState) -> None:
+        if new.phase is Phase.CONNECTED and old.phase is not Phase.CONNECTED:
+            self.motion.connected(self.supports)
+        elif new.phase is not Phase.CONNECTED and old.phase is Phase.CONNECTED:
+            self.motion.disconnected()
         if new.phase is not Phase.CONNECTED and old.phase is Phase.CONNECTED:
             self._halt_held(EndReason.DISCONNECTED)
         if new.phase is Phase.CONNECTED and old.phase is not Phase.CONNECTED:

@@ -91,6 +91,7 @@ from .motion import MotionIndicator  # noqa: E402
 from .move_dialogs import go_dialog, turn_dialog  # noqa: E402
 from .nav_draw import Marker, MarkerKind  # noqa: E402
 from .nav_text import link_lost_note  # noqa: E402
+from .near_people import NearPeopleSwitch  # noqa: E402
 from .notes import map_note  # noqa: E402
 from .palette import CommandPalette  # noqa: E402
 from .pip import PictureInPicture  # noqa: E402
@@ -267,6 +268,8 @@ class MainWindow(Gtk.ApplicationWindow):
         self.stop_keys = StopKeys(self, self.stop_now, on_popover=self._popover_took_keys)
         self.key_reach = KeyReach(self)
         self.keyboard = KeyboardNav(self)  # Tab, F10, Ctrl+G, Alt+1…9, a pick mode's keys
+        self.near_people = NearPeopleSwitch(self)  # View ▸ Near people: the speed cap
+        self.stage.limits = lambda: self.controller.limits  # the stopping distance drawn ahead
 
     # -- layout ------------------------------------------------------------------------------
     def _build(self) -> None:
@@ -406,7 +409,7 @@ class MainWindow(Gtk.ApplicationWindow):
         self.robot_menu = Gio.Menu()
         self._fill_robot_menu()
         menu.append_section(None, self.robot_menu)
-        view = Gio.Menu()
+        self.view_menu = view = Gio.Menu()
         view.append("Status toolbar", "win.toolbar")
         view.append("Full screen", "win.fullscreen")
         view.append("Touch D-pad", "win.dpad")
@@ -1074,6 +1077,7 @@ class MainWindow(Gtk.ApplicationWindow):
         self.handheld.close()
         self.stop_keys.close()
         self.key_reach.close()
+        self.near_people.close()
         self.stage.close()
         self.toolbar.close()
         self.routes_panel.close()
