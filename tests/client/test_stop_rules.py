@@ -120,7 +120,7 @@ def test_a_pointer_drive_waits_for_the_keys_and_every_focus_stop_says_what_to_do
     rig.ctl.press("left")
     rig.ctl.focus_lost()
     assert any(
-        t.startswith("Stopped: the window lost the keyboard") and "click the map" in t
+        t.startswith("Stopped: the window lost the keyboard") and "Click the map" in t
         for t in rig.view.texts()
     )
     assert not rig.ctl.pointer_may_drive()

@@ -70,7 +70,6 @@ from ..settings.store import Profile
 from ..values.intents import GotoGoal, Intent, RequestPicture, StartVideo, Stop, picture_source
 from ..values.state import ConnectionState, LinkHealth, LinkLevel, NavState, Phase, RobotState
 from .commands import COMMANDS, CommandRegistry, CommandState
-from .key_rules import KEYS_INACTIVE
 from .motion_limits import RobotLimits, capped_throttle
 from .motion_watch import MotionWatch
 
@@ -449,7 +448,7 @@ class Controller:
         driving = bool(self._held) or self._generation is not None
         if driving:
             self.stop()
-            said = f"Stopped: the window lost the keyboard. {KEYS_INACTIVE}, then drive."
+            said = "Stopped: the window lost the keyboard. Click the map, then press again to drive."
             self.view.notify(Notice.warning(Kind.SAFETY, said))
         if self._analog is not None:
             self._analog = None

@@ -222,7 +222,7 @@ class KeyboardNav:
             dx, dy = NUDGES[name]
             marker = Marker(marker.kind, marker.x + dx * step, marker.y + dy * step, marker.th)
         elif name in ("ptz_left", "ptz_right"):
-            th = 0.0 if marker.th is None else marker.th
+            th = stage.model.robot.value.th if marker.th is None else marker.th  # from the robot's heading
             th = math.remainder(th + (TURN_DEG if name == "ptz_left" else -TURN_DEG), 360.0)
             marker = Marker(marker.kind, marker.x, marker.y, th)
         else:
