@@ -36,6 +36,9 @@ def test_tab_shows_the_focus_and_space_on_a_focused_button_stops_without_clickin
 ) -> None:
     window, cycle = gui.window, StopCycle(gui, sim)
     assert window.get_focus() is None, "the window starts with no focused button: Return does nothing"
+    gui.key("Tab")
+    pump(lambda: window.get_focus() is not None, 3, "the first Tab")
+    assert window.get_focus().is_ancestor(window.stop_button) or window.get_focus() is window.stop_button
     seen: list[Gtk.Widget] = []
     for _ in range(12):
         gui.key("Tab")

@@ -74,7 +74,7 @@ def test_the_stopping_distance_is_drawn_ahead_while_the_robot_moves_and_goes_whe
 
 def test_near_people_caps_what_the_simulator_receives_and_says_so(gui: Gui, sim: SimThread) -> None:
     window = gui.window
-    pump(lambda: window.controller.limits.source.startswith("the server's"), 10, "the robot's own limits")
+    pump(lambda: window.controller.limits.source.startswith("its server's"), 10, "the robot's own limits")
     assert window.controller.limits.max_speed == 1500.0, "the simulator's Robot config/TransVelMax"
     for _ in range(5):
         gui.key("plus")  # 100 %: without the cap, 1.5 m/s

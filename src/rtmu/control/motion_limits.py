@@ -12,6 +12,8 @@ Where the numbers come from (facts from ARIA 2.9.1's sources and MobileSim 0.9.8
 * ``stop`` (ArServerModeStop → ``ArRobot::stop``: VEL 0, RVEL 0) and zero ``ratioDrive`` ratios
   brake alike, at that TransDecel; only the firmware's ESTOP command overrides it, and ARIA's network
   servers never send that for a client. So a release at 1.5 m/s rolls about 1500²/(2·300) = 3.75 m.
+* The reaction before braking (:data:`REACTION_S`) was measured against ARIA's serverDemoMap and
+  MobileSim, where zero ratios and ``stop`` both braked at 290–308 mm/s².
 * A robot seen going faster than the limits allow (a server that lists none, a robot faster than a
   P3-DX) raises the estimate (:meth:`RobotLimits.seen`): a cap computed from it stays a cap.
 """
@@ -26,8 +28,12 @@ ASSUMED_MAX_MM_S = 2200.0
 """ARIA's ``p3dx.p`` MaxVelocity: the fastest a P3-DX may be told to go."""
 ASSUMED_DECEL_MM_S2 = 300.0
 """ARCOS's default TransDecel (``p3dx.p`` keeps the firmware's; MobileSim's Pioneer uses 300 too)."""
-REACTION_S = 0.2
-"""From a release to the robot braking: the stop goes out at once, the robot's 100 ms cycle, the link."""
+REACTION_S = 0.8
+"""From the release, as the window shows the robot then, to its braking: measured on ARIA's own server
+(serverDemoMap on MobileSim 0.9.8's P3-DX) at about 0.75 s — a 635 mm/s robot rolled 1.16 m while
+its speed fell at 295 mm/s² (0.68 m of braking) — from ARIA's 100 ms robot and server cycles, the
+firmware's SIP cycle and the status reaching the window; the simulator answers faster (about 0.2 s),
+so the strip errs long there, on the safe side."""
 SECTION = "Robot config"
 MIN_SEEN_MM_S = 50.0
 """Speeds below this say nothing about the robot's maximum (noise, creeping)."""
@@ -39,7 +45,7 @@ class RobotLimits:
 
     max_speed: float = ASSUMED_MAX_MM_S
     decel: float = ASSUMED_DECEL_MM_S2
-    source: str = "assumed: ARIA's P3-DX"
+    source: str = "assumed from ARIA's P3-DX"
 
     def seen(self, speed: float, trans_pct: float, throttle_pct: float) -> RobotLimits:
         """The robot went ``speed`` mm/s at these ratios: a faster maximum than believed raises it."""
@@ -70,7 +76,7 @@ def limits_from_config(config: ServerConfig) -> RobotLimits:
         limits = replace(limits, decel=decel)
         found.append("TransDecel")
     if found:
-        limits = replace(limits, source=f"the server's configuration ({', '.join(found)})")
+        limits = replace(limits, source=f"its server's {' and '.join(found)}")
     return limits
 
 

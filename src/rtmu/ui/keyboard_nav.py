@@ -23,7 +23,8 @@ from typing import Any
 import gi
 
 gi.require_version("Gtk", "4.0")
-from gi.repository import Gio, GLib, Gtk  # noqa: E402
+gi.require_version("Gdk", "4.0")
+from gi.repository import Gdk, Gio, GLib, Gtk  # noqa: E402
 
 from ..control.commands import COMMANDS  # noqa: E402
 from ..fleet.sessions import Fleet  # noqa: E402
@@ -95,6 +96,10 @@ class KeyboardNav:
         # with none, so Return does nothing until the operator Tabs to a button.
         window.connect_after("map", lambda *_a: GLib.idle_add(self._no_first_focus))
         window.layers.connect("notify::visible", lambda *_a: self.refresh_focusable())
+        tab = Gtk.EventControllerKey()  # the first Tab (from no focus) lands on STOP, the first button
+        tab.set_propagation_phase(Gtk.PropagationPhase.CAPTURE)
+        tab.connect("key-pressed", self._first_tab)
+        window.add_controller(tab)
         select = Gio.SimpleAction.new("select-robot", GLib.VariantType.new("i"))
         select.connect("activate", lambda _a, p: self.select(p.get_int32()))
         window.add_action(select)
@@ -102,6 +107,17 @@ class KeyboardNav:
             action = Gio.SimpleAction.new(name, None)
             action.connect("activate", lambda _a, _p, s=step: self.step(s))
             window.add_action(action)
+
+    def _first_tab(
+        self, _c: Gtk.EventControllerKey, keyval: int, _code: int, state: Gdk.ModifierType
+    ) -> bool:
+        window = self.window
+        if keyval != Gdk.KEY_Tab or state & Gdk.ModifierType.SHIFT_MASK or window.get_focus() is not None:
+            return False
+        bar = window.fullscreen_bar
+        stop = bar.stop_button if bar.get_reveal_child() else window.stop_button
+        window.set_focus_visible(True)
+        return bool(stop.grab_focus())
 
     def _no_first_focus(self) -> bool:
         if not self.window.get_focus_visible():

@@ -68,8 +68,8 @@ class NearPeopleSwitch:
         if new.on:
             limits = self.window.controller.limits
             throttle = capped_throttle(100.0, new.mm_s, limits)
-            text = (f"{label(new)}: full drive is {throttle:.0f} % of this robot's "
-                    f"{limits.max_speed / 1000:.1f} m/s ({limits.source})")  # fmt: skip
+            text = (f"{label(new)}: a full drive is {throttle:.0f} % of this robot's "
+                    f"{limits.max_speed / 1000:.1f} m/s — {limits.source}")  # fmt: skip
         else:
             text = "Near-people cap off: the speed steps go up to the robot's full speed again"
         self.window.banners.tell("speed", "info", text, timeout=5.0)

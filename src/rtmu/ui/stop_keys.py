@@ -148,7 +148,7 @@ class StopKeys:
         if isinstance(widget, Gtk.TextView):
             return
         placeholder = widget.get_property("placeholder-text") or ""
-        short = FIELD_HINT.split(" · ")[0]
+        short = "Space stops"
         widget.set_property("placeholder-text", f"{placeholder} · {short}" if placeholder else FIELD_HINT)
 
     # -- keys ------------------------------------------------------------------------------
