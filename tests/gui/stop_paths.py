@@ -9,6 +9,7 @@ What is checked is what the simulator received, not what the window believes.
 
 from __future__ import annotations
 
+import time
 from collections.abc import Iterator
 from dataclasses import dataclass
 
@@ -148,6 +149,8 @@ class StopCycle:
         self.gui = gui
         self.sim = sim
         self.proved: list[str] = []
+        self.latencies: list[float] = []
+        """Seconds from each Space (xdotool started) to the simulator's stop log growing."""
         self._goal = 0
 
     def stops(self) -> int:
@@ -162,8 +165,10 @@ class StopCycle:
 
     def space_stops(self, what: str) -> None:
         before = self.stops()
+        pressed = time.monotonic()
         self.gui.key("space")
         pump(lambda: self.stops() > before, 5, f"Space to stop the robot {what}")
+        self.latencies.append(time.monotonic() - pressed)  # reported, never asserted (a loaded machine)
 
     def navigate(self) -> None:
         window = self.gui.window

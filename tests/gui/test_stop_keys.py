@@ -72,6 +72,9 @@ def pick_each(gui: Gui, sim: SimThread, how: str) -> list[str]:
         cycle.prove(f"{how} pick of {entry.name}")
         back_to_map(gui)
         set_back(window, initial)
+    lat = sorted(cycle.latencies)
+    median, worst = lat[len(lat) // 2] * 1000, lat[-1] * 1000
+    print(f"\n{how}: {len(lat)} stops, Space → simulator: median {median:.0f} ms, max {worst:.0f} ms")
     return cycle.proved
 
 
