@@ -678,7 +678,7 @@ class Controller:
     # -- reactions to the model --------------------------------------------------------------
     def _on_connection(self, old: ConnectionState, new: ConnectionState) -> None:
         if new.phase is Phase.CONNECTED and old.phase is not Phase.CONNECTED:
-            self.motion.connected(self.supports)
+            self.motion.connected(self.supports, ask=not self.replay)  # a replay asks a recording nothing
         elif new.phase is not Phase.CONNECTED and old.phase is Phase.CONNECTED:
             self.motion.disconnected()
         if new.phase is not Phase.CONNECTED and old.phase is Phase.CONNECTED:

@@ -43,10 +43,13 @@ class MotionWatch:
         self._connection = 0
         """Counts connections: limits fetched for an earlier one are not taken."""
 
-    def connected(self, supports: Callable[[str], bool]) -> None:
-        """A new connection: assumed limits until its server says its own (fetched off the UI thread)."""
+    def connected(self, supports: Callable[[str], bool], *, ask: bool = True) -> None:
+        """A new connection: assumed limits until its server says its own (fetched off the UI thread
+        when ``ask``)."""
         self._connection += 1
         self.limits = RobotLimits()
+        if not ask:
+            return
         send = getattr(self.link, "send", None)
         run_blocking = getattr(self.link, "run_blocking", None)
         if send is None or run_blocking is None or not any(supports(n) for n in CONFIG_DATA):
