@@ -260,7 +260,7 @@ def test_ten_thousand_parameters_with_markup_open_bounded_and_responsive(
     gui = Gui.start(screenshots, "config-hostile", "127.0.0.1", hostile.port)
     try:
         p = open_page(gui)
-        assert p.config is not None and p.config.param_count == 10_013
+        assert p.config is not None and p.config.param_count == 10_015  # with TransDecel, RotDecel
         choose_section(gui, p, "<b>Extra</b> & 0")
         pump(lambda: len(p.rows) == PAGE_SIZE, 5, "one page of rows")
         shown = labels(p.grid)

@@ -65,7 +65,8 @@ class GuardianLink:
         for word, text in guardian.poll():
             if word == "stopped":
                 stopped = True
-                self._notice(Notice.error(Kind.SAFETY, f"The guardian stopped the robot: {text}"))
+                said = f"The guardian stopped the robot: {text}. Press again to drive."
+                self._notice(Notice.error(Kind.SAFETY, said))
             elif word in ("unavailable", "lost", "ended"):
                 self.handle = None
                 guardian.close(goodbye=True)

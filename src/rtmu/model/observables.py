@@ -265,9 +265,23 @@ class ViewOptions:
     show_sonar: bool = True
 
 
+@dataclass(frozen=True, slots=True)
+class NearPeople:
+    """The operator's speed cap for work near people: on or off, and how fast at most (mm/s)."""
+
+    on: bool = False
+    mm_s: int = 250
+
+    @property
+    def cap(self) -> int | None:
+        """The cap in force (None: off)."""
+        return self.mm_s if self.on else None
+
+
 class OperatorState:
     """What the operator chose, shared by every robot the window shows: speed step and view options."""
 
     def __init__(self) -> None:
         self.speed: Observable[SpeedSetting] = Observable(SpeedSetting())
+        self.near_people: Observable[NearPeople] = Observable(NearPeople())
         self.view: Observable[ViewOptions] = Observable(ViewOptions())

@@ -6,6 +6,8 @@ when the variable is unset), a small flat TOML document::
     version = 1
     last_profile = "lab"
     alarms_muted = true     # optional: the alarm beep is off (View > Alarm sound)
+    near_people = true      # optional: View > Near people caps held driving …
+    near_people_mm_s = 250  # … at this speed (mm/s, 50…1000; 250 when not given)
 
     [profiles."lab"]
     host = "10.0.0.5"
@@ -62,6 +64,9 @@ log = logging.getLogger(__name__)
 
 DEFAULT_PORT = 7272
 SCHEMA_VERSION = 1
+NEAR_PEOPLE_KEYS = ("near_people", "near_people_mm_s")
+NEAR_PEOPLE_RANGE = (50, 1000)
+"""mm/s a near-people cap may be set to in the settings file."""
 KEYRING_SERVICE = "rtmu"
 MAX_SETTINGS_BYTES = 1 << 20
 """A settings file larger than this is not ours."""
@@ -216,6 +221,10 @@ class Settings:
     recording: RecordingSettings = field(default_factory=RecordingSettings)
     alarms_muted: bool = False
     """The alarm sound is off (``alarms_muted = true``; the banners still show): the View menu's switch."""
+    near_people: bool = False
+    """Held driving is capped at :attr:`near_people_mm_s` (View → Near people)."""
+    near_people_mm_s: int | None = None
+    """Its speed (mm/s) when the operator chose one; None: the window's default (250 mm/s)."""
     layers: dict[str, dict[str, bool]] = field(default_factory=dict)
     """The operator's drawing choices per server (``"host:port"`` → drawing name → shown), as the
     optional tables ``[layers."10.0.0.5:7272"]`` with ``"sonarCurrent" = false`` lines."""
@@ -275,7 +284,8 @@ def parse_settings(text: str) -> Settings:
     version = doc.get("version", SCHEMA_VERSION)  # a hand-written file without the line: version 1
     if version != SCHEMA_VERSION:
         raise SettingsError(f"unknown settings version {version!r} (this RTMU writes {SCHEMA_VERSION})")
-    unknown = set(doc) - {"version", "last_profile", "profiles", "recording", "alarms_muted", "layers"}
+    known = {"version", "last_profile", "profiles", "recording", "alarms_muted", "layers", *NEAR_PEOPLE_KEYS}
+    unknown = set(doc) - known
     if unknown:
         raise SettingsError(f"unknown settings: {', '.join(sorted(unknown))}")
     raw_profiles = doc.get("profiles", {})
@@ -295,6 +305,17 @@ def parse_settings(text: str) -> Settings:
     if type(muted) is not bool:
         raise SettingsError(f"alarms_muted must be true or false, not {muted!r}")
     settings.alarms_muted = muted
+    near = doc.get("near_people", False)
+    if type(near) is not bool:
+        raise SettingsError(f"near_people must be true or false, not {near!r}")
+    settings.near_people = near
+    cap = doc.get("near_people_mm_s")
+    if cap is not None and (type(cap) is not int or not NEAR_PEOPLE_RANGE[0] <= cap <= NEAR_PEOPLE_RANGE[1]):
+        low, high = NEAR_PEOPLE_RANGE
+        raise SettingsError(
+            f"near_people_mm_s must be a whole number of mm/s from {low} to {high}, not {cap!r}"
+        )
+    settings.near_people_mm_s = cap
     settings.layers = _layers(doc.get("layers", {}))
     return settings
 
@@ -448,6 +469,10 @@ def format_settings(settings: Settings) -> str:
         lines.append(f"last_profile = {_toml_string(settings.last_profile)}")
     if settings.alarms_muted:
         lines.append("alarms_muted = true")
+    if settings.near_people:
+        lines.append("near_people = true")
+    if settings.near_people_mm_s is not None:
+        lines.append(f"near_people_mm_s = {int(settings.near_people_mm_s)}")
     for profile in settings.profiles.values():
         profile.validate()
         lines += ["", f"[profiles.{_toml_string(profile.name)}]"]

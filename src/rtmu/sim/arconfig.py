@@ -150,6 +150,16 @@ class SimArConfig:
             lambda: round(ratio.rot_vel_max),
             setter(ratio, "rot_vel_max"),
         )
+        for name, attr, what, top in (
+            ("TransDecel", "trans_decel", "Braking on a stop or zero ratios, in mm/s²", 1000),
+            ("RotDecel", "rot_decel", "Slowing of a turn on a stop or zero ratios, in deg/s²", 500),
+        ):  # ARIA's ArRobotConfig lists these beside TransVelMax; its absolute maxima cap them
+            self._add(
+                "Robot config",
+                ConfigParam(name, ParamType.INT, 0, what, Priority.BASIC, 10, top),
+                lambda attr=attr: round(getattr(body, attr)),  # type: ignore[misc]
+                setter(body, attr),
+            )
         self._add("Robot config", ConfigParam("", ParamType.SEPARATOR), none, ignore)
         self._add(
             "Robot config",

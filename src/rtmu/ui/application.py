@@ -30,7 +30,10 @@ from ..client.mapcache import SharedMaps  # noqa: E402
 from ..client.roster import RobotEndpoint, Roster  # noqa: E402
 from ..client.session import SessionConfig  # noqa: E402
 from ..fleet.sessions import Fleet, RobotSession, direct_roster, robot_profile  # noqa: E402
-from ..model.observables import Phase  # noqa: E402
+from ..model.observables import (
+    NearPeople,
+    Phase,
+)
 from ..recorder.replay import REPLAY_CONFIG  # noqa: E402
 from ..settings.store import (  # noqa: E402
     DEFAULT_PORT,
@@ -200,6 +203,9 @@ class RtmuApplication(Gtk.Application):
         self.window = window
         window.handheld.set_muted(self.settings.alarms_muted)
         window.handheld.on_mute = self._alarms_muted
+        cap = self.settings.near_people_mm_s or NearPeople().mm_s
+        window.near_people.use(NearPeople(self.settings.near_people, cap))
+        window.near_people.on_change = self._near_people
         window.layers.use_choices(self.settings.layers)  # the operator's drawings, remembered per server
         # Closing the window stops every robot of the fleet, not only the one it shows.
         window.connect("close-request", lambda _w: self.fleet.stop_all() and False)
@@ -403,6 +409,17 @@ class RtmuApplication(Gtk.Application):
             speed=operator.speed.value.percent,
         )
 
+    def _near_people(self, setting: NearPeople) -> None:
+        if (self.settings.near_people, self.settings.near_people_mm_s or NearPeople().mm_s) == (
+            setting.on,
+            setting.mm_s,
+        ):
+            return
+        self.settings.near_people = setting.on
+        self.settings.near_people_mm_s = None if setting.mm_s == NearPeople().mm_s else setting.mm_s
+        if self.options.persist:
+            self._save(background=True)
+
     def _alarms_muted(self, muted: bool) -> None:
         self.settings.alarms_muted = muted
         if self.options.persist:
@@ -415,6 +432,8 @@ class RtmuApplication(Gtk.Application):
             s.last_profile,
             s.recording,
             alarms_muted=s.alarms_muted,
+            near_people=s.near_people,
+            near_people_mm_s=s.near_people_mm_s,
             layers={server: dict(choices) for server, choices in s.layers.items()},
         )
         path = self.options.settings_path

@@ -38,6 +38,8 @@ class Binding:
     """``hold`` (a hold command), ``command`` (run a registry command), ``view`` (a window intent),
     ``action`` (an application/window action, handled by accelerators, listed for the help only)."""
     target: str
+    help: str | None = None
+    """What the shortcuts window prints instead of the keys ("" leaves the line out)."""
 
 
 WINDOW_BINDINGS: tuple[Binding, ...] = (
@@ -46,6 +48,21 @@ WINDOW_BINDINGS: tuple[Binding, ...] = (
     Binding(("<Control>0",), "Fit map", "Map", "view", "zoom_fit"),
     Binding(("f",), "Follow the robot on/off", "Map", "view", "follow"),
     Binding(("Escape",), "Camera picture ⇄ map", "Window", "view", "toggle_camera"),
+    Binding(("F10", "Menu", "<Shift>F10"), "Open the menu", "Window", "view", "open_menu"),
+    Binding(("<Control>g",), "Go to: goals, a point, home, dock", "Navigation", "view", "goto_panel"),
+    *(
+        Binding(
+            (f"<Alt>{n}",),
+            "Select robot 1 … 9 of the list",
+            "Fleet",
+            "view",
+            f"robot_{n}",
+            "<Alt>1...<Alt>9" if n == 1 else "",
+        )
+        for n in range(1, 10)
+    ),
+    Binding(("<Alt>Page_Down",), "Next robot", "Fleet", "view", "next_robot"),
+    Binding(("<Alt>Page_Up",), "Previous robot", "Fleet", "view", "previous_robot"),
     Binding(("v",), "Live video on/off", "Window", "view", "live_video"),
     Binding(("<Control>Left",), "Pan the camera left", "Camera head", "view", "ptz_left"),
     Binding(("<Control>Right",), "Pan the camera right", "Camera head", "view", "ptz_right"),

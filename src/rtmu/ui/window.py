@@ -81,6 +81,8 @@ from .details import DetailsWindow  # noqa: E402
 from .dpad import DPad  # noqa: E402
 from .goals_panel import GoalsPanel  # noqa: E402
 from .handheld import Handheld  # noqa: E402
+from .key_reach import KeyReach  # noqa: E402
+from .keyboard_nav import KeyboardNav, menu_item  # noqa: E402
 from .keys import KeyRouter  # noqa: E402
 from .layers import LayersPanel  # noqa: E402
 from .live_video import LiveVideoControls  # noqa: E402
@@ -89,6 +91,7 @@ from .motion import MotionIndicator  # noqa: E402
 from .move_dialogs import go_dialog, turn_dialog  # noqa: E402
 from .nav_draw import Marker, MarkerKind  # noqa: E402
 from .nav_text import link_lost_note  # noqa: E402
+from .near_people import NearPeopleSwitch  # noqa: E402
 from .notes import map_note  # noqa: E402
 from .palette import CommandPalette  # noqa: E402
 from .pip import PictureInPicture  # noqa: E402
@@ -101,6 +104,7 @@ from .selected_model import SelectedModel  # noqa: E402
 from .settings_dialog import ConnectionDialog, PasswordPrompt  # noqa: E402
 from .shortcuts import build_shortcuts_window  # noqa: E402
 from .split_view import SplitView  # noqa: E402
+from .stop_keys import StopKeys  # noqa: E402
 from .toolbar import StatusToolbar  # noqa: E402
 from .viewport import zoom_label  # noqa: E402
 
@@ -225,7 +229,7 @@ class MainWindow(Gtk.ApplicationWindow):
             tell=lambda level, text: self.banners.tell("camera", level, text, timeout=5.0),
         )  # fmt: skip
         self.decoder = PictureDecoder(self._picture_decoded)
-        self.dpad = DPad(hold=self._hold, release=self._release, stop=self._stop_from_dpad)
+        self.dpad = DPad(hold=self._hold_pointer, release=self._release, stop=self._stop_from_dpad)
         self.keys = KeyRouter(
             hold=self._hold, release=self._release, command=self._command, view=self.view_intent
         )
@@ -260,6 +264,12 @@ class MainWindow(Gtk.ApplicationWindow):
         self._on_connection(ConnectionState(), model.connection.value)
         self._on_map(MapModel(), model.map.value)
         self._view_changed()
+        # Space stops from every surface (dialogs, menus, popovers); keys are never lost silently.
+        self.stop_keys = StopKeys(self, self.stop_now, on_popover=self._popover_took_keys)
+        self.key_reach = KeyReach(self)
+        self.keyboard = KeyboardNav(self)  # Tab, F10, Ctrl+G, Alt+1…9, a pick mode's keys
+        self.near_people = NearPeopleSwitch(self)  # View ▸ Near people: the speed cap
+        self.stage.limits = lambda: self.controller.limits  # the stopping distance drawn ahead
 
     # -- layout ------------------------------------------------------------------------------
     def _build(self) -> None:
@@ -292,9 +302,7 @@ class MainWindow(Gtk.ApplicationWindow):
         self.routes_panel = RoutesPanel(self.model, self.robot.ask)  # only when the server lists getRoutes
         header.pack_end(self.routes_panel)
         goto = self._goto_goal  # the panel shows only when the server navigates (goals, points, dock)
-        self.goals_panel = GoalsPanel(
-            self.model, goto=goto, run=self._command, pick=self.start_pick, stop=self.stop_now
-        )
+        self.goals_panel = GoalsPanel(self.model, goto=goto, run=self._command, pick=self.start_pick)
         header.pack_end(self.goals_panel)
         self.set_titlebar(header)
 
@@ -401,7 +409,7 @@ class MainWindow(Gtk.ApplicationWindow):
         self.robot_menu = Gio.Menu()
         self._fill_robot_menu()
         menu.append_section(None, self.robot_menu)
-        view = Gio.Menu()
+        self.view_menu = view = Gio.Menu()
         view.append("Status toolbar", "win.toolbar")
         view.append("Full screen", "win.fullscreen")
         view.append("Touch D-pad", "win.dpad")
@@ -413,7 +421,7 @@ class MainWindow(Gtk.ApplicationWindow):
         view.append("Layers…", "win.layers")
         view.append("Robot details…", "win.details")
         view.append("Foxglove bridge (ws://127.0.0.1:8765)", "win.foxglove")
-        app = Gio.Menu()
+        self.app_menu = app = Gio.Menu()
         server = Gio.Menu()  # the connection and the server's own settings: one row, so the menu still fits
         server.append("Connection settings…", "win.settings")
         server.append("Configuration…", "win.server-config")
@@ -443,7 +451,7 @@ class MainWindow(Gtk.ApplicationWindow):
             return
         self.robot_menu.remove_all()
         for label, action in items:
-            self.robot_menu.append(label, action)
+            self.robot_menu.append_item(menu_item(label, action))
 
     def _install_actions(self) -> None:
         def plain(name: str, fn: Callable[[], None]) -> Gio.SimpleAction:
@@ -582,7 +590,19 @@ class MainWindow(Gtk.ApplicationWindow):
     # -- intents -------------------------------------------------------------------------------
     def _hold(self, name: str) -> None:
         # On the camera page too: the picture shows its age, and a fresh press is the operator's intent.
-        self.controller.run(name)
+        if not self.keyboard.pick_key(name):  # a pick mode's arrows move its point instead
+            self.controller.run(name)
+
+    def _hold_pointer(self, name: str) -> None:
+        """A D-pad hold: only while Space can stop it (the controller says why not)."""
+        if self.controller.pointer_may_drive():
+            self.controller.run(name)
+
+    def _popover_took_keys(self) -> None:
+        """A menu or popover holds the keyboard now: held keys can no longer be seen let go."""
+        self.controller.look("the menu", keys_leave=True)
+        self.keys.release_all()
+        self.dpad.release_all()
 
     def _release(self, name: str) -> None:
         self.controller.release_command(name)
@@ -606,6 +626,8 @@ class MainWindow(Gtk.ApplicationWindow):
 
     def view_intent(self, name: str) -> None:
         """Window-level intents from keys, menu and buttons."""
+        if self.keyboard.view_intent(name):
+            return
         if name == "toggle_camera" and self.picker.active:
             self.picker.cancel()  # Esc leaves a pick mode first
         elif name == "toggle_camera":
@@ -715,7 +737,7 @@ class MainWindow(Gtk.ApplicationWindow):
             self.banners.tell("camera", "warning", f"Camera picture: {state.reason}", timeout=4.0)
             self.camera_button.set_active(False)
             return
-        self.controller.stop()
+        self.controller.look("the camera page")  # a held drive ends; a navigation goes on
         self.stack.set_visible_child_name("camera")
         self.camera_button.set_active(True)
         if request or self.camera.image is None:
@@ -1053,6 +1075,9 @@ class MainWindow(Gtk.ApplicationWindow):
             remove()
         self._unobserve = []
         self.handheld.close()
+        self.stop_keys.close()
+        self.key_reach.close()
+        self.near_people.close()
         self.stage.close()
         self.toolbar.close()
         self.routes_panel.close()
