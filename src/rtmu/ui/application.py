@@ -30,10 +30,7 @@ from ..client.mapcache import SharedMaps  # noqa: E402
 from ..client.roster import RobotEndpoint, Roster  # noqa: E402
 from ..client.session import SessionConfig  # noqa: E402
 from ..fleet.sessions import Fleet, RobotSession, direct_roster, robot_profile  # noqa: E402
-from ..model.observables import (
-    NearPeople,
-    Phase,
-)
+from ..model.observables import NearPeople, Phase  # noqa: E402
 from ..recorder.replay import REPLAY_CONFIG  # noqa: E402
 from ..settings.store import (  # noqa: E402
     DEFAULT_PORT,
