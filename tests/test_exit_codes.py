@@ -41,12 +41,14 @@ RTMU = [sys.executable, "-m", "rtmu"]
 
 NETWORK_ARGS: dict[str, list[str]] = {
     "bridge": ["--foxglove", "--ws-port", "0"],
+    "call": ["--list"],
     "commands": [],
     "config": [],
     "dock": [],
     "doctor": [],
     "drawings": [],
     "drive": ["--trans", "10", "--seconds", "1"],
+    "files": ["ls"],
     "fleet": [],
     "goals": [],
     "goto": ["Lab"],
@@ -54,6 +56,7 @@ NETWORK_ARGS: dict[str, list[str]] = {
     "image": ["--out", "{tmp}/x.jpg"],
     "localize": ["1", "2", "3"],
     "map": ["--out", "{tmp}/x.map"],
+    "mapedit": ["--check-map"],
     "patrol": ["Loop"],
     "probe": [],
     "ptz": [],
@@ -61,9 +64,11 @@ NETWORK_ARGS: dict[str, list[str]] = {
     "routes": [],
     "run": ["Anything"],
     "say": ["hello"],
+    "scan": ["status"],
     "status": ["--once"],
     "video": ["--seconds", "1"],
     "watch": ["--seconds", "1"],
+    "why": [],
 }
 """Every subcommand that dials a robot server, with what it needs besides HOST[:PORT]."""
 

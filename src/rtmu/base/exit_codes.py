@@ -113,6 +113,13 @@ EXIT_CODES: dict[int, str] = {
 """Code → meaning. Other 128 + N: ended by signal N (any ending signal stops what the command drove)."""
 
 
+WHY_ASKED = (
+    EXIT_WHY_NO_STOP, EXIT_WHY_NO_DRIVE, EXIT_WHY_ESTOP, EXIT_WHY_FAULTS, EXIT_WHY_MOTORS, EXIT_WHY_STALLED,
+    EXIT_WHY_LOCKED, EXIT_WHY_NAVIGATING, EXIT_WHY_DOCKED, EXIT_WHY_BATTERY, EXIT_WHY_SAFE_DRIVE,
+    EXIT_WHY_WATCHDOG, EXIT_WHY_LOST,
+)  # fmt: skip
+"""The causes a command's own login can find (``rtmu why``; without ``--navigate``, ``drive`` and the
+doctor's last step, all but the lost localization); our link (22) and drive lease (34) are the window's."""
 ENDED = (EXIT_SIGHUP, EXIT_SIGINT, EXIT_SIGTERM)
 """Every command that runs a while ends by these three through its own clean-up."""
 NETWORK = (

@@ -52,7 +52,7 @@ def parse_assignment(text: str, parser: Any) -> tuple[str, str, str]:
     return section.strip(), name.strip(), value
 
 
-EXITS = (*NETWORK, EXIT_REFUSED)
+EXITS = (*NETWORK, EXIT_REFUSED, EXIT_FOREIGN_CONFIG)
 
 
 def register(subparsers: Any) -> None:

@@ -32,12 +32,15 @@ from ..base.exit_codes import (
     EXIT_INTERNAL,
     EXIT_OK,
     EXIT_USAGE,
+    EXIT_WHY_LOST,
+    WHY_ASKED,
 )
 from ..base.textsafe import visible
 from ..client.config_feed import ConfigApi, config_api
 from ..client.connection import TEXT_BANNERS, AriaClient
 from ..client.diagnosis import ADVICE, Step, central_server_words, login_finding
 from ..client.errors import ClientError
+from ..client.roles import Role
 from ..client.why import diagnose
 from ..client.why_gather import gather
 from ..protocol.client_connection import ClientConnection
@@ -68,6 +71,7 @@ from ._common import (
 EXITS = (
     EXIT_OK, EXIT_INTERNAL, EXIT_USAGE, EXIT_DOCTOR_RESOLVE, EXIT_DOCTOR_TCP, EXIT_DOCTOR_INTRODUCTION,
     EXIT_DOCTOR_LOGIN, EXIT_DOCTOR_DATALIST, EXIT_DOCTOR_STATUS, *ENDED,
+    *(c for c in WHY_ASKED if c != EXIT_WHY_LOST),  # the last step: why won't it move
 )  # fmt: skip
 READ_CHUNK = 65536
 NOT_ARIA_AFTER = 4096
@@ -417,6 +421,7 @@ class Doctor:
                 self._motion_password,
                 timeout=self.timeout,
                 protocol=self.protocol,
+                role=Role.OBSERVER,
             )
             answer = diagnose(await gather(client, self.timeout))
         except ClientError as exc:

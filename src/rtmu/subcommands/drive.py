@@ -29,7 +29,16 @@ import sys
 from collections.abc import Callable
 from typing import Any
 
-from ..base.exit_codes import EXIT_OK, EXIT_SIGQUIT, EXIT_SIGTSTP, EXIT_USAGE, NETWORK
+from ..base.exit_codes import (
+    EXIT_OK,
+    EXIT_SIGQUIT,
+    EXIT_SIGTSTP,
+    EXIT_USAGE,
+    EXIT_WHY_LOST,
+    EXIT_WHY_UNEXPLAINED,
+    NETWORK,
+    WHY_ASKED,
+)
 from ..base.textsafe import visible
 from ..client.connection import AriaClient, Packet
 from ..client.drive_guard import DriveGuard, LinkFault
@@ -65,7 +74,10 @@ AFTER_INTERRUPT = 1.0
 """After a signal, at most this long (stop already sent) for the pose printed as ``after``."""
 
 
-EXITS = (*NETWORK, EXIT_SIGQUIT, EXIT_SIGTSTP)
+EXITS = (
+    *NETWORK, EXIT_SIGQUIT, EXIT_SIGTSTP, *(c for c in WHY_ASKED if c != EXIT_WHY_LOST), EXIT_WHY_UNEXPLAINED
+)  # fmt: skip
+"""A drive that did not move exits with the cause's code (never 0; 39 when nothing explains it)."""
 
 
 def register(subparsers: Any) -> None:

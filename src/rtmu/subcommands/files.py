@@ -16,7 +16,7 @@ import sys
 from pathlib import Path
 from typing import Any
 
-from ..base.exit_codes import EXIT_OK, EXIT_REFUSED, EXIT_USAGE
+from ..base.exit_codes import EXIT_OK, EXIT_REFUSED, EXIT_USAGE, NETWORK
 from ..base.textsafe import visible
 from ..client.connection import AriaClient
 from ..client.download import LocalFileError, check_destination, download_file
@@ -35,6 +35,7 @@ from ..protocol.payloads.files import DirEntry
 from ._actions import action_parser, end_progress, progress_printer
 from ._common import add_connection_arguments, fail, print_json, run_with_client
 
+EXITS = (*NETWORK, EXIT_REFUSED)
 EXIT_CODES = (
     "Exit codes: 0 done; 2 usage (a bad path, a local file that exists without --force, rm without --yes "
     "and no terminal); 3 connection, login or a reply that cannot be trusted (a listing with a hostile "

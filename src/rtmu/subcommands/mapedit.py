@@ -7,7 +7,7 @@ import math
 import sys
 from typing import Any
 
-from ..base.exit_codes import EXIT_NOT_HELD, EXIT_OK, EXIT_REFUSED, EXIT_USAGE
+from ..base.exit_codes import EXIT_NOT_HELD, EXIT_OK, EXIT_REFUSED, EXIT_USAGE, NETWORK
 from ..base.textsafe import visible
 from ..client.config_care import check_map
 from ..client.connection import AriaClient
@@ -47,6 +47,7 @@ verdict in time; 6 the server refused the change (its words are printed; the map
 """
 
 
+EXITS = (*NETWORK, EXIT_REFUSED, EXIT_NOT_HELD)
 MAX_EDITS = 10_000
 
 

@@ -13,7 +13,7 @@ import sys
 from pathlib import Path
 from typing import Any
 
-from ..base.exit_codes import EXIT_OK, EXIT_REFUSED, EXIT_TIMEOUT, EXIT_USAGE
+from ..base.exit_codes import EXIT_OK, EXIT_REFUSED, EXIT_TIMEOUT, EXIT_USAGE, NETWORK
 from ..base.textsafe import visible
 from ..client.connection import AriaClient
 from ..client.download import LocalFileError, check_destination, download_file
@@ -23,6 +23,7 @@ from ..client.scan import scan_name, scan_status, scan_unavailable, start_scan, 
 from ._actions import action_parser, end_progress, progress_printer
 from ._common import add_connection_arguments, fail, print_json, run_with_client
 
+EXITS = (*NETWORK, EXIT_REFUSED)
 EXIT_CODES = (
     "Exit codes: 0 done; 2 usage (a bad name, a download folder that is missing or a file there that "
     "exists without --force); 3 connection, login or a reply that cannot be trusted; 4 the robot cannot "

@@ -1,17 +1,7 @@
 """``rtmu why HOST[:PORT] [--json] [--fix] [--yes] [--navigate]``: why won't the robot move?
 
-Reads, never drives: the server's own data (its mode and lock, this login's rights, status words,
-safe drive and the obstacles its sonar and lasers see, battery, docking, localization, its drive
-watchdog, an LD robot's faults and safety data) told as one sentence with its fix
-(:mod:`rtmu.client.why`). Exit 0 when nothing RTMU can read keeps the robot from moving, else the
-cause's own code (``rtmu.base.exit_codes``, 20–39): 20 this login may not stop, 21 may not drive,
-23 e-stop, 24 faults, 25 motors disabled, 26 stalled, 27 mode locked, 28 navigating, 29 docked,
-30 battery, 31 safe drive, 32 drive watchdog, 33 lost (with --navigate).
-
-``--fix`` carries out the first cause's fix where there is one (unlock a mode that will unlock,
-undock, stop the server's own driving, switch safe drive off, acknowledge an LD robot's faults,
-enable its motors), then asks again. Switching safe drive off, acknowledging and enabling need a
-yes: typed at the prompt, or ``--yes``; without one nothing is sent.
+What it reads and what ``--fix`` may do is :data:`DESCRIPTION`, its ``--help`` (plain text); the
+answer itself is :mod:`rtmu.client.why`'s, its exit code the cause's (``rtmu.base.exit_codes``, 20–39).
 """
 
 from __future__ import annotations
@@ -20,6 +10,7 @@ import argparse
 import sys
 from typing import Any
 
+from ..base.exit_codes import NETWORK, WHY_ASKED
 from ..base.textsafe import visible
 from ..client.connection import AriaClient
 from ..client.roles import Role
@@ -31,13 +22,26 @@ from ._common import add_connection_arguments, print_json, run_with_client
 
 MAX_FIXES = 3
 """Fixes tried one after another (each reveals what the next cause is)."""
+EXITS = (*NETWORK, *WHY_ASKED)
+DESCRIPTION = """Why won't the robot move? Reads, never drives: the server's own data (its mode and lock,
+this login's rights, status words, safe drive and the obstacles its sonar and lasers see, battery,
+docking, localization, its drive watchdog, an LD robot's faults and safety data), told as one sentence
+with its fix. Exit 0 when nothing RTMU can read keeps the robot from moving, else the cause's own code
+(listed below): 20 this login may not stop, 21 may not drive, 23 e-stop, 24 faults, 25 motors disabled,
+26 stalled, 27 mode locked, 28 navigating, 29 docked, 30 battery, 31 safe drive, 32 drive watchdog,
+33 lost (with --navigate).
+
+--fix carries out the first cause's fix where there is one (unlock a mode that will unlock, undock, stop
+the server's own driving, switch safe drive off, acknowledge an LD robot's faults, enable its motors),
+then asks again. Switching safe drive off, acknowledging and enabling need a yes: typed at the prompt, or
+--yes; without one nothing is sent."""
 
 
 def register(subparsers: Any) -> None:
     p = subparsers.add_parser(
         "why",
         help="why won't the robot move? one sentence and its fix",
-        description=__doc__,
+        description=DESCRIPTION,
         formatter_class=argparse.RawDescriptionHelpFormatter,
     )
     add_connection_arguments(p)
