@@ -88,6 +88,11 @@ OBSERVERS = (
     Observer("config", ("config", "{addr}")),
     Observer("say", ("say", "{addr}", "hello")),
     Observer("doctor", ("doctor", "{addr}")),
+    Observer("why", ("why", "{addr}")),
+    Observer("call", ("call", "{addr}", "getGoals")),
+    Observer("files", ("files", "{addr}", "ls")),
+    Observer("scan", ("scan", "{addr}", "status")),
+    Observer("mapedit", ("mapedit", "{addr}", "--check-map")),
 )
 """Run against an LD (``aram``) simulator: it offers everything they look at (routes, say, dock…)."""
 OPERATORS = {"drive", "goto", "home", "dock", "localize", "patrol", "run"}
