@@ -48,6 +48,20 @@ STATUS = record(
 )
 STATUS["oneOf"] = [{"required": ["battery_v"]}, {"required": ["battery_pct"]}]
 
+WHY_ANSWER = record(
+    {
+        "can_move": FLAG,
+        "cause": {"type": ["string", "null"]},
+        "exit_code": INTEGER,
+        "sentence": TEXT,
+        "reasons": listing({"type": "object"}),
+        "notes": listing(TEXT),
+        "raw": listing({"type": "object"}),
+    }
+)
+"""``rtmu why``'s answer (``client.why_values.Answer.as_json``), as ``rtmu drive`` adds it when the robot
+did not move."""
+
 POSE = {"x": NUMBER_OR_NULL, "y": NUMBER_OR_NULL, "th": NUMBER_OR_NULL}
 SENT = record({"sent": TEXT})
 
@@ -71,8 +85,12 @@ SCHEMAS: dict[str, Schema] = {
         SENT,
     ),
     "drive": record(
-        {"before": STATUS, "after": {"oneOf": [STATUS, {"type": "null"}]}, "seconds": NUMBER},
-        {"interrupted": TEXT},
+        {
+            "before": {"oneOf": [STATUS, {"type": "null"}]},
+            "after": {"oneOf": [STATUS, {"type": "null"}]},
+            "seconds": NUMBER,
+        },
+        {"interrupted": TEXT, "moved": FLAG, "why": WHY_ANSWER},
     ),
     "goals": listing(TEXT),
     "routes": listing(TEXT),
