@@ -238,10 +238,15 @@ class VideoStatus:
 
 
 class NavOutcome(StrEnum):
-    """How the last navigation ended (a ``StrEnum``: it compares equal to its text)."""
+    """Where a navigation stands, read from the server's words: the one enum of the window, the CLI and
+    "why won't it move" (a ``StrEnum``: it compares equal to its text).
+
+    As a state's ``outcome``: how the last navigation ended (``NONE`` while none has, or one is under way)."""
 
     NONE = ""
-    """Nothing has ended yet on this connection (or one is under way)."""
+    """Nothing has ended yet on this connection (or one is under way); as one status read: no news."""
+    GOING = "going"
+    """One status read: the server is on its way (``Going to …``); never a state's ``outcome``."""
     ARRIVED = "arrived"
     DOCKED = "docked"
     FAILED = "failed"
