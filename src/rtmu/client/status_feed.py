@@ -31,6 +31,9 @@ class StatusFeed(Feed):
         super().__init__(ctx)
         self.on_status: Callable[[float], None] = lambda at: None
         """Every status packet's arrival time: the session gives it to the drive loop's health."""
+        self._battery_unit_known = True
+        """False while ``batteryInfo`` has not said whether the battery number is volts or a state of
+        charge: the number is not published until then (95.4 is no voltage)."""
 
     def subscriptions(self, client: AriaClient) -> Iterable[Subscription]:
         period = self.ctx.config.status_interval_ms
@@ -43,6 +46,7 @@ class StatusFeed(Feed):
         )
 
     def connected(self, client: AriaClient) -> None:
+        self._battery_unit_known = not client.supports("batteryInfo")
         self.ctx.spawn(self._fetch_infos(client), "status-infos")
 
     def handle(self, intent: Intent) -> None:
@@ -56,16 +60,20 @@ class StatusFeed(Feed):
     async def _fetch_infos(self, client: AriaClient) -> None:
         timeout = self.ctx.config.reply_timeout
         with contextlib.suppress(ClientError, ProtocolError):
-            if client.supports("batteryInfo"):
-                info = self.ctx.decode(
-                    "batteryInfo", (await client.request_once("batteryInfo", timeout=timeout)).payload
-                )
-                if isinstance(info, BatteryInfo):
-                    self.ctx.robot_update(
-                        battery_low=info.low_battery,
-                        battery_shutdown=info.shutdown,
-                        battery_is_soc=info.state_of_charge,
+            try:
+                if client.supports("batteryInfo"):
+                    info = self.ctx.decode(
+                        "batteryInfo", (await client.request_once("batteryInfo", timeout=timeout)).payload
                     )
+                    if isinstance(info, BatteryInfo):
+                        self.ctx.robot_update(
+                            battery_low=info.low_battery,
+                            battery_shutdown=info.shutdown,
+                            battery_is_soc=info.state_of_charge,
+                        )
+            finally:  # answered, refused or timed out: from the next status on the number is shown
+                if self.ctx.client is client:
+                    self._battery_unit_known = True
             if client.supports("getSafeDrive"):
                 await self._refresh_safe_drive(client)
 
@@ -88,7 +96,7 @@ class StatusFeed(Feed):
     def _apply_numbers(self, n: UpdateNumbers, at: float) -> None:
         self.ctx.robot_update(
             x=float(n.x), y=float(n.y), th=float(n.th), vel=float(n.vel), rot_vel=float(n.rot_vel),
-            lat_vel=float(n.lat_vel), battery_v=n.battery,
+            lat_vel=float(n.lat_vel), battery_v=n.battery if self._battery_unit_known else None,
             temperature=float(n.temperature) if n.temperature_known else None, numbers_at=at,
         )  # fmt: skip
         self.on_status(at)
