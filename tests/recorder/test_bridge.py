@@ -73,7 +73,7 @@ def bridged(*, drive: bool) -> Iterator[tuple[SimThread, ClientRunner, Bridge, l
 
 
 def url(bridge: Bridge) -> str:
-    return f"ws://127.0.0.1:{bridge.port}"
+    return bridge.url
 
 
 def stream(client: FoxgloveClient, payload: bytes, hz: float, seconds: float) -> None:
