@@ -50,6 +50,9 @@ def test_a_parked_robot_is_in_every_second_and_the_file_starts_with_the_real_rob
     assert statuses and statuses[0]["mode"] and statuses[0]["status"], "no empty status at the start"
     assert all(s["temperature_c"] is None for s in statuses), "MobileSim's -127 is no temperature"
     assert all("volts" in s["battery"] for s in statuses if s["battery"]["state"] != "unknown")
+    lasers = got.topic(topics.LASER)  # a Pioneer's laser: MobileSim's sim_lms2xx_1Current drawing
+    assert lasers and got.schemas()[topics.LASER] == ("foxglove.PointCloud", "protobuf")
+    assert max(m.data.count(b"map") for m in lasers) == 1 and max(len(m.data) for m in lasers) > 100 * 12
 
 
 def test_every_json_channel_has_a_named_schema(tmp_path: Path) -> None:
