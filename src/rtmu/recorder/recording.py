@@ -142,7 +142,9 @@ class Recording:
                 self._finish(file)  # keep what was written readable at once; drain the rest
                 continue
             now = time.monotonic()
-            if self.stopped is None and now >= repeat_at:  # a parked robot: its pose in every second
+            # A parked robot: its pose in every second — only once the writer has caught up, so a
+            # repeat never stamps "now" on a pose older than ones still waiting in the queue.
+            if self.stopped is None and now >= repeat_at and self._queue.empty():
                 repeat_at = now + REPEAT_EVERY
                 at_ns = time.time_ns()
                 for topic, message in self._converter.repeat(at_ns):
