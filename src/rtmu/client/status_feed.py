@@ -34,6 +34,8 @@ class StatusFeed(Feed):
         self._battery_unit_known = True
         """False while ``batteryInfo`` has not said whether the battery number is volts or a state of
         charge: the number is not published until then (95.4 is no voltage)."""
+        self._battery_held: float | None = None
+        """The last battery number while its unit was not known yet: published once it is."""
 
     def subscriptions(self, client: AriaClient) -> Iterable[Subscription]:
         period = self.ctx.config.status_interval_ms
@@ -71,9 +73,11 @@ class StatusFeed(Feed):
                             battery_shutdown=info.shutdown,
                             battery_is_soc=info.state_of_charge,
                         )
-            finally:  # answered, refused or timed out: from the next status on the number is shown
-                if self.ctx.client is client:
+            finally:  # answered, refused or timed out: the number is shown, now and from then on
+                if self.ctx.client is client and not self._battery_unit_known:
                     self._battery_unit_known = True
+                    if self._battery_held is not None:
+                        self.ctx.robot_update(battery_v=self._battery_held)
             if client.supports("getSafeDrive"):
                 await self._refresh_safe_drive(client)
 
@@ -94,6 +98,7 @@ class StatusFeed(Feed):
             self._apply_numbers(numbers, packet.received_at)
 
     def _apply_numbers(self, n: UpdateNumbers, at: float) -> None:
+        self._battery_held = n.battery
         self.ctx.robot_update(
             x=float(n.x), y=float(n.y), th=float(n.th), vel=float(n.vel), rot_vel=float(n.rot_vel),
             lat_vel=float(n.lat_vel), battery_v=n.battery if self._battery_unit_known else None,
