@@ -17,15 +17,44 @@ import sys
 from collections.abc import Sequence
 
 from . import subcommands
+from .base import exit_codes, logs
 from .base.exit_codes import EXIT_USAGE
 from .subcommands import _integration
+from .subcommands.json_schemas import COMMAND_SCHEMA
 from .versions import VersionAction
+
+
+class HelpFormatter(argparse.HelpFormatter):
+    """argparse's own wrapping, except that indented lines (the exit-code table) are kept as written."""
+
+    def _fill_text(self, text: str, width: int, indent: str) -> str:
+        paragraphs = []
+        for paragraph in text.split("\n\n"):
+            if paragraph.startswith(" ") or "\n " in paragraph:
+                paragraphs.append("\n".join(indent + line for line in paragraph.splitlines()))
+            else:
+                paragraphs.append(super()._fill_text(paragraph, width, indent))
+        return "\n\n".join(paragraphs)
+
+
+def exits_epilog(codes: tuple[int, ...] | None) -> str:
+    """The help's closing part: these codes' lines of the one table (all of them for ``rtmu --help``)."""
+    return "Exit codes (one table for every rtmu command):\n" + exit_codes.table_text(codes)
+
+
+def name_schema(command: argparse.ArgumentParser, schema: str | None) -> None:
+    """Say in ``--json``'s help which published schema its lines follow (``subcommands.json_schemas``)."""
+    for action in command._actions:
+        if schema is not None and "--json" in action.option_strings and action.help:
+            action.help += f" (schema {schema!r}: python -m rtmu.subcommands.json_schemas {schema})"
 
 
 def build_parser() -> argparse.ArgumentParser:
     parser = argparse.ArgumentParser(
         prog="rtmu",
         description="Teleoperate an ARIA (ArNetworking) robot; with no subcommand, open the window.",
+        epilog=exits_epilog(None),
+        formatter_class=HelpFormatter,
     )
     parser.add_argument(
         "--version", action=VersionAction, help="show the versions of rtmu, its protocol and toolkit; exit"
@@ -38,6 +67,10 @@ def build_parser() -> argparse.ArgumentParser:
         register = getattr(module, "register", None)
         if register is not None:
             register(sub)
+            command = sub.choices[info.name]
+            command.formatter_class = HelpFormatter
+            command.epilog = exits_epilog(getattr(module, "EXITS", exit_codes.NETWORK))
+            name_schema(command, COMMAND_SCHEMA.get(info.name))
     gui = importlib.util.find_spec("rtmu.ui.app")
     if gui is not None:
         from .ui import app as gui_app
@@ -48,6 +81,7 @@ def build_parser() -> argparse.ArgumentParser:
 
 
 def main(argv: Sequence[str] | None = None) -> int:
+    logs.configure()  # developer notices off the operator's terminal (RTMU_LOG=warning shows them)
     parser = build_parser()
     args = parser.parse_args(argv)
     handler = getattr(args, "handler", None)

@@ -100,9 +100,12 @@ def test_status_once_and_streamed_json(
 
 def test_password_from_a_pipe(sim: SimThread, monkeypatch: pytest.MonkeyPatch, capsys) -> None:  # type: ignore[no-untyped-def]
     monkeypatch.setattr("sys.stdin", io.StringIO("secret1\n"))
-    assert main(["status", addr(sim), "--user", "alice", "--once"]) == EXIT_OK
+    assert main(["status", addr(sim), "--user", "alice", "--once"]) == EXIT_USAGE  # only when asked to
+    assert "--password-stdin" in capsys.readouterr().err
+    monkeypatch.setattr("sys.stdin", io.StringIO("secret1\n"))
+    assert main(["status", addr(sim), "--user", "alice", "--password-stdin", "--once"]) == EXIT_OK
     monkeypatch.setattr("sys.stdin", io.StringIO("wrong\n"))
-    assert main(["status", addr(sim), "--user", "alice", "--once"]) == EXIT_CONNECTION
+    assert main(["status", addr(sim), "--user", "alice", "--password-stdin", "--once"]) == EXIT_CONNECTION
     err = capsys.readouterr().err
     assert err.count("\n") == 1 and err.startswith("rtmu status: login refused: wrong user name or password")
 
@@ -121,7 +124,10 @@ def test_image(sim: SimThread, pwfile: Path, tmp_path: Path) -> None:
     assert main(["image", *login(sim, pwfile), "--out", str(out)]) == EXIT_OK
     data = out.read_bytes()
     assert data[:2] == b"\xff\xd8" and data.rstrip(b"\x00")[-2:] == b"\xff\xd9"
-    assert main(["image", *login(sim, pwfile), "--out", str(out), "--camera", "Nope"]) == EXIT_UNSUPPORTED
+    again = ["image", *login(sim, pwfile), "--out", str(out), "--camera", "Nope"]
+    assert main(again) == EXIT_USAGE, "an existing picture is not replaced without --force"
+    assert main([*again, "--force"]) == EXIT_UNSUPPORTED
+    assert out.read_bytes() == data, "a failed picture leaves the old one as it was"
 
 
 def test_drive_moves_then_stops(sim: SimThread, pwfile: Path, capsys: pytest.CaptureFixture[str]) -> None:
@@ -344,3 +350,15 @@ def test_drive_json_after_ctrl_c_says_it_was_interrupted(sim: SimThread, pwfile:
             proc.kill()
             proc.wait()
     assert obj["interrupted"] == "SIGINT" and set(obj["after"]) == STATUS_KEYS and obj["seconds"] == 20
+
+
+def test_drive_inside_arias_dead_zone_says_the_robot_will_not_move(
+    sim: SimThread, pwfile: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    before = sim.snapshot()
+    assert main(["drive", *login(sim, pwfile), "--trans", "10", "--seconds", "0.5"]) == EXIT_OK
+    assert "inside ARIA's dead zone" in capsys.readouterr().err
+    after = sim.snapshot()
+    assert (after.x, after.y) == (before.x, before.y), "ARIA's dead zone: it really did not move"
+    assert main(["drive", *login(sim, pwfile), "--trans", "11", "--seconds", "0.3"]) == EXIT_OK
+    assert "dead zone" not in capsys.readouterr().err

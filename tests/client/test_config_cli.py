@@ -9,7 +9,7 @@ from pathlib import Path
 
 import pytest
 
-from rtmu.base.exit_codes import EXIT_OK, EXIT_UNSUPPORTED, EXIT_USAGE
+from rtmu.base.exit_codes import EXIT_OK, EXIT_REFUSED, EXIT_UNSUPPORTED, EXIT_USAGE
 from rtmu.cli import main
 from rtmu.client.config_feed import MAX_TEXT, ConfigFeed, ServerConfig, check_value, fetch_config
 from rtmu.client.connection import AriaClient
@@ -18,7 +18,6 @@ from rtmu.client.runner import ClientRunner
 from rtmu.model.observables import RobotModel
 from rtmu.protocol.payloads.config import ConfigParam, ConfigSectionPacket, ParamType
 from rtmu.sim import SimConfig, SimThread
-from rtmu.subcommands.config import EXIT_REFUSED
 
 from .servers import SPECS, ServerThread, TestServer
 from .uiqueue import UiQueue, eventually

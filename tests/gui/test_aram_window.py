@@ -1,4 +1,4 @@
-"""The real window against ``rtmu sim --profile aram``: state of charge in %, and first-contact words."""
+"""The real window against ``rtmu sim --kind aram``: state of charge in %, and first-contact words."""
 
 from __future__ import annotations
 

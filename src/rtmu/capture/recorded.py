@@ -105,9 +105,10 @@ def recorded_events(
             raise CaptureError(f"{path} is refused: {exc}") from None
         except Exception as exc:  # untrusted: cut off, a lying record or chunk size, a bad chunk…
             if stats.frames == 0 and not flows:
-                raise CaptureError(f"{path} is not a readable MCAP recording: {exc}") from None
+                raise CaptureError(f"{path} is not a readable MCAP recording: {unreadable(exc)}") from None
             stats.warnings.append(
-                f"the recording ends early (cut short by a crash or a full disk?): read up to there ({exc})"
+                "the recording ends early (cut short by a crash or a full disk?): read up to there "
+                f"({unreadable(exc)})"
             )
     stats.last_time = last
     if not flows:
@@ -115,3 +116,14 @@ def recorded_events(
     for flow in flows.values():
         yield StreamEnd(flow, CLIENT, last)
         yield StreamEnd(flow, flow.second, last)
+
+
+def unreadable(exc: BaseException) -> str:
+    """Why an MCAP file could not be read, in plain words (the reader's own errors may be empty)."""
+    from mcap.exceptions import EndOfFile, InvalidMagic
+
+    if isinstance(exc, InvalidMagic):
+        return "it does not start as an MCAP file does (it is not a recording)"
+    if isinstance(exc, (EndOfFile, EOFError)) or "unpack requires a buffer" in str(exc):
+        return "it is cut short: it ends in the middle of a record"
+    return str(exc) or type(exc).__name__

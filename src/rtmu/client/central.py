@@ -33,6 +33,7 @@ from ..protocol.payloads.central import CentralEntry, ClientAdded, ClientList, C
 from .connection import CONNECT_TIMEOUT, DEFAULT_PORT, AriaClient, Packet
 from .errors import ClientError
 from .reconnect import Backoff, worth_retrying
+from .roles import Role
 from .roster import Emit, RobotAdded, RobotEndpoint, RobotRemoved, RosterEvent, RosterLost, RosterRestored
 
 log = logging.getLogger("rtmu.central")
@@ -114,7 +115,8 @@ async def list_robots(
     """
     client = AriaClient()
     try:
-        await client.connect(host, port, user, password, timeout=timeout, protocol=protocol)
+        login = (user, password)
+        await client.connect(host, port, *login, timeout=timeout, protocol=protocol, role=Role.OBSERVER)
         reply = await client.request_once(ClientList.DATA_NAME, timeout=timeout)
         listed = ClientList.decode(reply.payload)
     finally:
@@ -234,7 +236,9 @@ class CentralRoster:
         client = AriaClient(on_close=on_close)
         try:
             # The password stays while the roster lives: a lost central server is logged in to again.
-            await client.connect(self.host, self.port, self._user, self._password, timeout=self.timeout)
+            await client.connect(
+                self.host, self.port, self._user, self._password, timeout=self.timeout, role=Role.OBSERVER
+            )
             self.backoff.reset()
             if self._lost_sent:  # before any robot: a broadcast may come ahead of the list
                 self._lost_sent = False

@@ -76,7 +76,7 @@ class GuardianLink:
         self._notice(
             Notice.warning(
                 Kind.SAFETY,
-                f"Guardian not available ({reason}): if this window is killed or frozen while driving, "
+                f"Guardian not available ({reason}): if this program is killed or frozen while driving, "
                 "only the server's own 2 s watchdog stops the robot",
             )
         )

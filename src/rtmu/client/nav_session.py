@@ -80,9 +80,12 @@ class NavFeed(Feed):
         """Send a navigation command; an LD robot without ``gotoGoal`` reaches a goal by ``gotoRouteGoal``."""
         name = SENDS[type(intent)]
         client = self.ctx.client
-        if isinstance(intent, GotoGoal) and client is not None:
-            if not client.supports(name) or (intent.route and client.supports("gotoRouteGoal")):
-                name = "gotoRouteGoal"
+        if (
+            isinstance(intent, GotoGoal)
+            and client is not None
+            and (not client.supports(name) or (intent.route and client.supports("gotoRouteGoal")))
+        ):
+            name = "gotoRouteGoal"
         client = self.require(name)
         payload = _payload(intent)
         if isinstance(payload, GotoPosePayload):

@@ -27,18 +27,13 @@ from ..capture.recorded import CONNECTION_TOPIC, recorded_events
 from ..capture.session_decoder import C2S, CaptureDecoder, DecodedPacket
 from ..client.health import PING_CANDIDATES
 from ..protocol.decoder import PacketDecoder
+from ..protocol.motion import MOTION_REQUESTS, is_motion
 from . import topics
 
-NOT_REPLAYED = frozenset(
-    {
-        "ratioDrive", "stop", "setSafeDrive", "gotoGoal", "gotoPose", "gotoRouteGoal", "home", "dock",
-        "tourGoals", "localizeToPose", "popupClicked", "patrolRoute", "say", "wander",
-        "sendVideo", "getSafeDrive", *PING_CANDIDATES,
-    }
-)  # fmt: skip
+NOT_REPLAYED = MOTION_REQUESTS | frozenset(
+    {"setSafeDrive", "localizeToPose", "popupClicked", "say", "sendVideo", "getSafeDrive", *PING_CANDIDATES}
+)
 """Client packets that come from the operator or a timer, never from the server's bytes alone."""
-MOTION = frozenset({"ratioDrive", "gotoGoal", "gotoPose", "gotoRouteGoal", "home", "dock", "tourGoals"})
-"""What a replay link refuses outright (a replay never drives)."""
 MAX_IMAGE = 16 * 1024 * 1024
 MAX_REPLAY_BYTES = 512 * 1024 * 1024
 """Server bytes of one connection a replay keeps in memory (hours of status and sonar), each recorded
@@ -133,7 +128,7 @@ def load(path: Path, conn: int | None = None) -> RecordedConnection:
         if isinstance(item, DecodedPacket) and item.direction == C2S:
             names.setdefault(item.command, item.name)
     uncounted = frozenset(c for c, n in names.items() if not_replayed(n))
-    motion = frozenset(c for c, n in names.items() if n in MOTION or n == "stop")
+    motion = frozenset(c for c, n in names.items() if n is not None and is_motion(n))  # refused outright
     recorded = RecordedConnection(
         path,
         index,

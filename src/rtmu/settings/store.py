@@ -272,7 +272,7 @@ def parse_settings(text: str) -> Settings:
         doc = tomllib.loads(text)
     except tomllib.TOMLDecodeError as exc:
         raise SettingsError(f"not valid TOML: {exc}") from None
-    version = doc.get("version")
+    version = doc.get("version", SCHEMA_VERSION)  # a hand-written file without the line: version 1
     if version != SCHEMA_VERSION:
         raise SettingsError(f"unknown settings version {version!r} (this RTMU writes {SCHEMA_VERSION})")
     unknown = set(doc) - {"version", "last_profile", "profiles", "recording", "alarms_muted", "layers"}
@@ -403,13 +403,24 @@ def load_settings(path: Path | None = None) -> Loaded:
             text = data.decode("utf-8")
         except UnicodeDecodeError:
             raise SettingsError("the file is not UTF-8 text") from None
-        return Loaded(parse_settings(text))
+        settings = parse_settings(text)
+        if not _says_its_version(text):
+            note = (
+                f"the settings file {path} has no 'version = {SCHEMA_VERSION}' line: it was read as version "
+                f"{SCHEMA_VERSION} (RTMU writes the line when it next saves)"
+            )
+            return Loaded(settings, note)
+        return Loaded(settings)
     except SettingsError as exc:
         moved = _set_aside(path)
         where = f"; it was kept as {moved.name}" if moved else ""
         warning = f"ignoring the settings file {path} ({exc}){where}; using default settings"
         log.warning(warning)
         return Loaded(Settings(), warning, moved)
+
+
+def _says_its_version(text: str) -> bool:
+    return "version" in tomllib.loads(text)
 
 
 def _set_aside(path: Path) -> Path | None:

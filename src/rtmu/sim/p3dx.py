@@ -21,6 +21,8 @@ from __future__ import annotations
 
 from dataclasses import dataclass
 
+from rtmu.protocol.payloads import drive as protocol_drive
+
 ROBOT_TYPE = "Pioneer"
 ROBOT_SUBTYPE = "p3dx"
 
@@ -47,8 +49,8 @@ STOP_DECEL = 1000.0
 # ArActionRatioInput defaults
 RATIO_ROT_AT_STOPPED = 50.0
 RATIO_ROT_AT_FULL = 25.0
-RATIO_TRANS_DEAD_ZONE = 10.0
-RATIO_ROT_DEAD_ZONE = 5.0
+RATIO_TRANS_DEAD_ZONE = protocol_drive.RATIO_TRANS_DEAD_ZONE
+RATIO_ROT_DEAD_ZONE = protocol_drive.RATIO_ROT_DEAD_ZONE
 
 # ArActionDriveDistance / jog defaults (used by moveDist)
 JOG_SPEED = 400.0

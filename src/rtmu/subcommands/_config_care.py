@@ -6,15 +6,13 @@ import argparse
 import sys
 from pathlib import Path
 
-from ..base.exit_codes import EXIT_OK, EXIT_USAGE
+from ..base.exit_codes import EXIT_OK, EXIT_REFUSED, EXIT_USAGE
 from ..base.textsafe import visible
 from ..client.config_care import differences, fetch_defaults, reload_config, reset, reset_targets
 from ..client.config_feed import fetch_config, set_config
 from ..client.config_file import ConfigFileError, export_text, plan_import, read_file, valued, write_export
 from ..client.connection import AriaClient
 from ._common import UsageError, print_json
-
-EXIT_REFUSED = 6
 
 
 def _refused(words: str) -> int:

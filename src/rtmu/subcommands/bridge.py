@@ -15,9 +15,7 @@ robot first.
 from __future__ import annotations
 
 import argparse
-import signal
 import sys
-import threading
 from typing import Any
 from urllib.parse import quote
 
@@ -25,12 +23,14 @@ from ..base.exit_codes import EXIT_CONNECTION, EXIT_OK, EXIT_USAGE
 from ..base.notices import Notice
 from ..base.textsafe import visible
 from ..client.errors import ClientError
+from ..client.roles import Role
 from ..client.runner import ClientRunner
 from ..client.session import SessionConfig
 from ..recorder.bridge import DEFAULT_PORT, LEASE_TTL, Bridge, DriveLimits
 from ..recorder.foxglove_gate import FOXGLOVE_ORIGINS, Gate, loopback_only
-from ._common import UsageError, add_connection_arguments, fail, positive_float, read_password
-from ._follow import follow
+from ._common import UsageError, add_connection_arguments, fail, positive_float, read_password, signal_name
+from ._follow import EndingSignals, follow, until_connected
+from ._options import add_fps_option
 
 BEAT = 0.04
 """The main thread beats for the guardian as the window's UI thread does."""
@@ -49,8 +49,9 @@ def register(subparsers: Any) -> None:
     )
     add_connection_arguments(p)
     p.add_argument("--foxglove", action="store_true", required=True, help="a Foxglove WebSocket server")
-    p.add_argument("--port", dest="ws_port", type=int, default=DEFAULT_PORT, metavar="PORT",
+    p.add_argument("--ws-port", dest="ws_port", type=int, default=DEFAULT_PORT, metavar="PORT",
                    help=f"its port (default {DEFAULT_PORT}; 0: any free one, printed)")  # fmt: skip
+    p.add_argument("--port", dest="ws_port", type=int, help=argparse.SUPPRESS)  # its old name
     p.add_argument(
         "--bind",
         default="127.0.0.1",
@@ -68,7 +69,7 @@ def register(subparsers: Any) -> None:
         action="append",
         default=[],
         metavar="ORIGIN",
-        help="also let browser pages from ORIGIN connect (repeatable; always allowed: "
+        help="also let browser pages from ORIGIN connect (repeatable; default: Foxglove's own only, "
         + ", ".join(sorted(FOXGLOVE_ORIGINS))
         + ")",
     )
@@ -77,20 +78,19 @@ def register(subparsers: Any) -> None:
         action="append",
         default=[],
         metavar="NAME",
-        help="also accept requests for host NAME (repeatable; always: IP addresses, localhost, this "
-        "machine's names)",
+        help="also accept requests for host NAME (repeatable; default: IP addresses, localhost and this "
+        "machine's names only)",
     )
     p.add_argument("--throttle", type=positive_float, default=50.0, metavar="PCT",
                    help="throttle of bridge drives, %% (default 50)")  # fmt: skip
-    p.add_argument("--camera-hz", type=float, default=0.0, metavar="HZ",
-                   help="camera pictures a second (default 0: no camera channel)")  # fmt: skip
+    add_fps_option(p, default=0.0, none_means="no pictures")
     p.add_argument("--seconds", type=positive_float, default=None, metavar="S", help="stop after S seconds")
     p.set_defaults(handler=handle)
 
 
 def handle(args: argparse.Namespace) -> int:
     if not 0 <= args.ws_port <= 65535:
-        return fail("bridge", f"--port {args.ws_port} is not 0…65535", EXIT_USAGE)
+        return fail("bridge", f"--ws-port {args.ws_port} is not 0…65535", EXIT_USAGE)
     if args.throttle > 100:
         return fail("bridge", "--throttle is at most 100", EXIT_USAGE)
     try:
@@ -99,12 +99,12 @@ def handle(args: argparse.Namespace) -> int:
         return fail("bridge", str(exc), EXIT_USAGE)
     except (KeyboardInterrupt, EOFError):
         return fail("bridge", "cancelled", EXIT_USAGE)
-    host, port = args.server
 
     def tell(notice: Notice) -> None:
         print(f"rtmu bridge: {visible(notice.text)}", file=sys.stderr)
 
-    config = SessionConfig(connect_timeout=args.timeout, guardian=args.allow_drive)
+    role = Role.OPERATOR if args.allow_drive else Role.OBSERVER  # read-only: it cannot command at all
+    config = SessionConfig(connect_timeout=args.timeout, guardian=args.allow_drive, role=role)
     runner = ClientRunner(config=config, lease_ttl=LEASE_TTL)
     runner.on_notice = tell
     bridge = Bridge(
@@ -119,32 +119,37 @@ def handle(args: argparse.Namespace) -> int:
     runner.on_publish = bridge.published
     runner.on_notice_sent = bridge.notice
     runner.on_stop = bridge.stopped
-    ended = threading.Event()
-    ending = (signal.SIGINT, signal.SIGTERM, signal.SIGHUP)
-    previous = {s: signal.signal(s, lambda *_: ended.set()) for s in ending}
-    try:
-        bridge.start()
-    except Exception as exc:
-        for signum, handler in previous.items():
-            signal.signal(signum, handler)
-        return fail("bridge", f"cannot serve on {args.bind}:{args.ws_port}: {exc}", EXIT_USAGE)
+    with EndingSignals() as ending:
+        try:
+            bridge.start()
+        except Exception as exc:
+            return fail("bridge", f"cannot serve on {args.bind}:{args.ws_port}: {exc}", EXIT_CONNECTION)
+        code = serve(args, runner, bridge, ending, password)
+    if ending.exit_code is not None and code == EXIT_OK:
+        return fail("bridge", f"ended by {signal_name(ending.signum or 0)}", ending.exit_code)
+    return code
+
+
+def serve(
+    args: argparse.Namespace, runner: ClientRunner, bridge: Bridge, ending: EndingSignals, password: str
+) -> int:
+    """Connect and follow until ``--seconds`` or a signal; the bridge and the runner end either way."""
+    host, port = args.server
     runner.start()
     try:
         future = runner.connect(host, port, args.user, password, protocol=args.protocol)
         try:
-            future.result(args.timeout + 1.0)
+            if not until_connected(future, ending.event, args.timeout + 1.0):
+                return EXIT_OK  # a signal came first: its code is the command's
         except ClientError as exc:
             return fail("bridge", str(exc), exc.exit_code)
         except Exception as exc:
             return fail("bridge", f"could not connect: {exc}", EXIT_CONNECTION)
         announce(bridge)
-        follow(runner, ended, seconds=args.seconds, camera_hz=args.camera_hz, beat=BEAT)
+        follow(runner, ending.event, seconds=args.seconds, camera_hz=args.fps, beat=BEAT)
     finally:
         bridge.close()  # ends any bridge drive first
-        runner.stop_and_wait(0.5)
-        runner.close()
-        for signum, handler in previous.items():
-            signal.signal(signum, handler)
+        runner.close()  # stops the robot only if a bridge drive moved it (client.roles)
     return EXIT_OK
 
 

@@ -31,6 +31,7 @@ from ..base.textsafe import visible
 from ..client.connection import AriaClient
 from ..client.console import ConsoleEntry, ConsoleReply, Subscription, call, console_entries, entry_of
 from ..client.console_layout import KINDS, ArgumentError, describe, encode_arguments
+from ..client.roles import Role
 from ._common import add_connection_arguments, positive_float, print_json, run_with_client
 
 SILENT_OUTCOMES = ("silent", "stalled", "sent")
@@ -138,7 +139,9 @@ def handle(args: argparse.Namespace) -> int:
         show(reply, entry, args.json, args.timeout)
         return EXIT_TIMEOUT if reply.outcome in SILENT_OUTCOMES else EXIT_OK
 
-    return run_with_client("call", args, body)
+    # Only a confirmed call (--yes) may be one that changes motion; without it this client cannot send one.
+    role = Role.OPERATOR if getattr(args, "yes", False) else Role.OBSERVER
+    return run_with_client("call", args, body, role=role)
 
 
 async def follow(client: AriaClient, entry: ConsoleEntry, payload: bytes, args: argparse.Namespace) -> int:

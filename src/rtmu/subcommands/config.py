@@ -17,15 +17,15 @@ import sys
 from pathlib import Path
 from typing import Any
 
-from ..base.exit_codes import EXIT_FOREIGN_CONFIG, EXIT_OK, EXIT_USAGE
+from ..base.exit_codes import EXIT_FOREIGN_CONFIG, EXIT_OK, EXIT_REFUSED, EXIT_USAGE, NETWORK
 from ..base.textsafe import visible
 from ..client.config_feed import ConfigApi, ForeignConfig, ServerConfig, fetch_config, set_config
 from ..client.connection import AriaClient
+from ..client.roles import Role
 from ..protocol.payloads.config import ConfigParam, ParamType, Priority
 from . import _config_care
 from ._common import add_connection_arguments, print_json, run_with_client
 
-EXIT_REFUSED = 6
 """The server refused a value (its message is printed)."""
 MAX_ASSIGNMENTS = 1000
 
@@ -50,6 +50,9 @@ def parse_assignment(text: str, parser: Any) -> tuple[str, str, str]:
     except UnicodeEncodeError:
         parser.error(f"--set {text!r}: ARIA strings carry latin-1 characters only")
     return section.strip(), name.strip(), value
+
+
+EXITS = (*NETWORK, EXIT_REFUSED)
 
 
 def register(subparsers: Any) -> None:
@@ -129,7 +132,7 @@ def handle(args: argparse.Namespace) -> int:
             print_text(config)
         return EXIT_OK
 
-    return run_with_client("config", args, body)
+    return run_with_client("config", args, body, role=Role.OBSERVER)
 
 
 async def _set(client: AriaClient, assignments: list[tuple[str, str, str]], args: argparse.Namespace) -> int:

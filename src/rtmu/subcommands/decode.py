@@ -18,6 +18,7 @@ from collections import deque
 from collections.abc import Iterable
 from typing import Any, TextIO
 
+from ..base.exit_codes import EXIT_BAD_FILE, EXIT_OK, EXIT_SIGPIPE, EXIT_USAGE
 from ..base.textsafe import json_safe, visible
 from ..capture import CaptureError, CaptureSource, UnreadableInput, open_capture
 from ..capture.reader import DIRECTIONS, FORMATS
@@ -32,9 +33,7 @@ from ..capture.session_decoder import (
     TrailingDrops,
 )
 
-EXIT_OK = 0
-EXIT_UNREADABLE = 1
-EXIT_UNRECOGNISED = 4
+EXITS = (EXIT_OK, EXIT_USAGE, EXIT_BAD_FILE, EXIT_SIGPIPE)
 RUN_HEAD = 3
 RUN_TAIL = 2
 SHORT_TEXT = 72
@@ -141,10 +140,10 @@ def run(args: argparse.Namespace) -> int:
         source = open_capture(args.file, args.format, args.direction)
     except UnreadableInput as exc:
         print(f"rtmu decode: {visible(exc)}", file=sys.stderr)
-        return EXIT_UNREADABLE
+        return EXIT_USAGE
     except CaptureError as exc:
         print(f"rtmu decode: {visible(exc)}", file=sys.stderr)
-        return EXIT_UNRECOGNISED
+        return EXIT_BAD_FILE
     decoder = CaptureDecoder(report_trailing_drops=args.json)
     summary = args.summary if args.summary is not None else not args.json
     out = sys.stdout
@@ -162,14 +161,14 @@ def run(args: argparse.Namespace) -> int:
         out.flush()
     except UnreadableInput as exc:
         print(f"rtmu decode: {visible(exc)}", file=sys.stderr)
-        return EXIT_UNREADABLE
+        return EXIT_USAGE
     except CaptureError as exc:
         print(f"rtmu decode: {visible(exc)}", file=sys.stderr)
-        return EXIT_UNRECOGNISED
-    except BrokenPipeError:  # `rtmu decode x | head`: the reader has seen enough
+        return EXIT_BAD_FILE
+    except BrokenPipeError:  # `rtmu decode x | head`: the reader has seen enough (141, as every command)
         devnull = os.open(os.devnull, os.O_WRONLY)
         os.dup2(devnull, sys.stdout.fileno())
-        return EXIT_OK
+        return EXIT_SIGPIPE
     for warning in source.stats.warnings:
         print(f"rtmu decode: warning: {visible(warning)}", file=sys.stderr)
     return EXIT_OK

@@ -21,11 +21,22 @@ import time
 from dataclasses import dataclass, field
 from typing import Any
 
-from ..base.exit_codes import EXIT_OK, EXIT_USAGE
+from ..base.exit_codes import (
+    ENDED,
+    EXIT_DOCTOR_DATALIST,
+    EXIT_DOCTOR_INTRODUCTION,
+    EXIT_DOCTOR_LOGIN,
+    EXIT_DOCTOR_RESOLVE,
+    EXIT_DOCTOR_STATUS,
+    EXIT_DOCTOR_TCP,
+    EXIT_INTERNAL,
+    EXIT_OK,
+    EXIT_USAGE,
+)
 from ..base.textsafe import visible
 from ..client.config_feed import ConfigApi, config_api
 from ..client.connection import TEXT_BANNERS, AriaClient
-from ..client.diagnosis import ADVICE, Step, login_finding
+from ..client.diagnosis import ADVICE, Step, central_server_words, login_finding
 from ..client.errors import ClientError
 from ..client.why import diagnose
 from ..client.why_gather import gather
@@ -45,8 +56,19 @@ from ..protocol.fields import FieldReader, FieldWriter
 from ..protocol.packet import encode_packet
 from ..protocol.payloads import Side, decode_payload
 from ..protocol.payloads.robot import BatteryInfo, Update, UpdateNumbers, UpdateStrings
-from ._common import UsageError, add_connection_arguments, print_json, read_password
+from ._common import (
+    Interrupted,
+    UsageError,
+    add_connection_arguments,
+    print_json,
+    read_password,
+    run_interruptibly,
+)
 
+EXITS = (
+    EXIT_OK, EXIT_INTERNAL, EXIT_USAGE, EXIT_DOCTOR_RESOLVE, EXIT_DOCTOR_TCP, EXIT_DOCTOR_INTRODUCTION,
+    EXIT_DOCTOR_LOGIN, EXIT_DOCTOR_DATALIST, EXIT_DOCTOR_STATUS, *ENDED,
+)  # fmt: skip
 READ_CHUNK = 65536
 NOT_ARIA_AFTER = 4096
 """Bytes without a single valid packet after which the peer is taken for something else."""
@@ -358,6 +380,9 @@ class Doctor:
         assert conn is not None
         name = "updateNumbers" if "updateNumbers" in conn.datalist else "update"
         if name not in conn.datalist:
+            if "clientList" in conn.datalist:  # it lists robots instead of being one
+                where = f"{self.host}:{self.port}"
+                raise fail(Step.STATUS, central_server_words(where), ADVICE["central_server"])
             raise fail(Step.STATUS, "the server offers no robot status", ADVICE["status_missing"])
         soc = False
         if "batteryInfo" in conn.datalist:
@@ -449,8 +474,11 @@ def register(subparsers: Any) -> None:
     p = subparsers.add_parser(
         "doctor",
         help="find out why a robot does not connect, step by step",
-        description=__doc__,
-        formatter_class=argparse.RawDescriptionHelpFormatter,
+        description="Walk the whole way to a robot and say, step by step, what worked: name resolution, "
+        "TCP connect, the server's introduction (its version tag and protocol string), the login, the "
+        "data list (and which RTMU features the server offers), UDP, the first status. For the first "
+        "step that fails it says in plain words what went wrong and what to do next (the words the "
+        "window uses), and stops there; the exit code names the step. UDP never fails it: RTMU uses TCP.",
     )
     add_connection_arguments(p)
     p.add_argument(
@@ -474,9 +502,10 @@ def handle(args: argparse.Namespace) -> int:
         return EXIT_USAGE
     doctor = Doctor(host, port, args.user, password, args.protocol, args.timeout)
     try:
-        code = asyncio.run(doctor.run())
-    except KeyboardInterrupt:
-        return 130
+        code = run_interruptibly(doctor.run)
+    except Interrupted as exc:
+        print(f"rtmu doctor: {exc}", file=sys.stderr)
+        return exc.exit_code
     failed = next((s for s in doctor.steps if s.result == "fail"), None)
     if args.json:
         print_json(

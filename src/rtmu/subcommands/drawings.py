@@ -19,6 +19,7 @@ from ..base.textsafe import visible
 from ..client.connection import AriaClient
 from ..client.drawing_list import drawing_list, drawing_sample
 from ..client.errors import ClientError
+from ..client.roles import Role
 from ..protocol.payloads.drawings import Drawing
 from ._common import add_connection_arguments, print_json, run_with_client
 
@@ -59,7 +60,7 @@ def handle(args: argparse.Namespace) -> int:
                 print(_line(row), flush=True)
         return EXIT_OK
 
-    return run_with_client("drawings", args, body)
+    return run_with_client("drawings", args, body, role=Role.OBSERVER)
 
 
 async def _sample(client: AriaClient, d: Drawing, timeout: float) -> dict[str, Any]:

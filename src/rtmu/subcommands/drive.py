@@ -29,18 +29,19 @@ import sys
 from collections.abc import Callable
 from typing import Any
 
-from ..base.exit_codes import EXIT_OK
+from ..base.exit_codes import EXIT_OK, EXIT_SIGQUIT, EXIT_SIGTSTP, EXIT_USAGE, NETWORK
 from ..base.textsafe import visible
 from ..client.connection import AriaClient, Packet
 from ..client.drive_guard import DriveGuard, LinkFault
 from ..client.errors import ClientError
+from ..client.roles import Role
 from ..client.why import diagnose, moved, unexplained
 from ..client.why_gather import gather
 from ..client.why_values import Answer, Facts, Motion
 from ..guardian.handle import GuardianHandle, GuardianUnavailable, beat_network, start_ready
 from ..guardian.messages import Hello
 from ..protocol.errors import ProtocolError
-from ..protocol.payloads.drive import RatioDrive
+from ..protocol.payloads.drive import RATIO_ROT_DEAD_ZONE, RATIO_TRANS_DEAD_ZONE, RatioDrive
 from ..protocol.payloads.robot import UpdateStrings
 from ._common import (
     Interrupted,
@@ -62,6 +63,9 @@ SETTLE = 3.0
 """At most this long to wait for the robot to come to rest before printing the final pose."""
 AFTER_INTERRUPT = 1.0
 """After a signal, at most this long (stop already sent) for the pose printed as ``after``."""
+
+
+EXITS = (*NETWORK, EXIT_SIGQUIT, EXIT_SIGTSTP)
 
 
 def register(subparsers: Any) -> None:
@@ -105,6 +109,15 @@ def handle(args: argparse.Namespace) -> int:
             for reason in warning.reasons:
                 if reason.loud:
                     print(f"rtmu drive: WARNING: {visible(reason.sentence())}", file=sys.stderr, flush=True)
+        ratios = RatioDrive(args.trans, args.rot, args.throttle)
+        if ratios.in_dead_zone:  # ARIA would take it and not move: say so rather than exit 0 silently
+            print(
+                f"rtmu drive: warning: --trans {args.trans:g} --rot {args.rot:g} is inside ARIA's dead "
+                f"zone (translation up to ±{RATIO_TRANS_DEAD_ZONE:g} %, rotation under "
+                f"±{RATIO_ROT_DEAD_ZONE:g} %): the robot will not move",
+                file=sys.stderr,
+                flush=True,
+            )
         guardian = await start_guardian(args)
         guard = DriveGuard(client)
         guard.start()  # before the first status fetch, so the link is watched from the start
@@ -128,7 +141,6 @@ def handle(args: argparse.Namespace) -> int:
         said = StatusWords(client)
         guard.seen_moving = False
         try:
-            ratios = RatioDrive(args.trans, args.rot, args.throttle)
             await drive(client, ratios, args.seconds, held=lambda: interrupts.suspending, guard=guard)
             said.close()  # what the server said while we drove, before our own stop changes it
         except asyncio.CancelledError:
@@ -177,8 +189,8 @@ def handle(args: argparse.Namespace) -> int:
         check(args)
     except UsageError as exc:
         print(f"rtmu drive: {exc}", file=sys.stderr)
-        return 2
-    return run_with_client("drive", args, body)
+        return EXIT_USAGE
+    return run_with_client("drive", args, body, role=Role.OPERATOR)
 
 
 async def start_guardian(args: argparse.Namespace) -> GuardianHandle | None:

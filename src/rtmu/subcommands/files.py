@@ -29,6 +29,7 @@ from ..client.remote_files import (
     remote_path,
     wire_name,
 )
+from ..client.roles import Role
 from ..client.upload import check_source, upload_file
 from ..protocol.payloads.files import DirEntry
 from ._actions import action_parser, end_progress, progress_printer
@@ -86,7 +87,7 @@ def handle(args: argparse.Namespace) -> int:
         return fail("files", str(exc), EXIT_USAGE)
     if isinstance(body, int):
         return body
-    return run_with_client("files", args, body)
+    return run_with_client("files", args, body, role=Role.OBSERVER)  # files, never motion
 
 
 def entry_json(e: DirEntry) -> dict[str, Any]:

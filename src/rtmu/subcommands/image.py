@@ -7,11 +7,14 @@ import sys
 from pathlib import Path
 from typing import Any
 
-from ..base.exit_codes import EXIT_CONNECTION, EXIT_OK
+from ..base.exit_codes import EXIT_CONNECTION, EXIT_OK, EXIT_USAGE
 from ..base.textsafe import visible
 from ..client.connection import AriaClient
+from ..client.roles import Role
 from ..client.video_feed import video_source
-from ._common import add_connection_arguments, fail, run_with_client
+from ._common import UsageError, add_connection_arguments, fail, run_with_client
+from ._options import add_quality_option
+from ._output import add_force_option, check_file, write_whole
 
 MAX_SIDE = 8192
 """Largest width or height accepted from a server; no robot camera comes near it."""
@@ -45,27 +48,78 @@ def register(subparsers: Any) -> None:
         description="Request one picture (getPicture<camera>, else sendVideo) and save the JPEG.",
     )
     add_connection_arguments(p)
-    p.add_argument("--out", type=Path, required=True, metavar="FILE.jpg", help="where to write the JPEG")
+    p.add_argument(
+        "--out",
+        type=Path,
+        required=True,
+        metavar="FILE",
+        help="where to write the picture: FILE.jpg as the camera sent it, or another format Pillow "
+        "writes (.png, .bmp, .tiff, .webp …), chosen by the name's ending",
+    )
     p.add_argument("--camera", default=None, metavar="NAME", help="camera name (getPicture<NAME>)")
-    p.add_argument("--quality", type=int, default=None, metavar="Q", help="JPEG quality 0…100 to ask for")
+    add_quality_option(p)
+    add_force_option(p)
     p.set_defaults(handler=handle)
 
 
+JPEG_ENDINGS = (".jpg", ".jpeg", ".jpe", ".jfif")
+
+
+def image_format(path: Path) -> str:
+    """The format the file name asks for ("JPEG", "PNG" …); :class:`UsageError` if none can be written."""
+    ending = path.suffix.lower()
+    if ending in JPEG_ENDINGS:
+        return "JPEG"
+    from PIL import Image
+
+    Image.init()
+    found = Image.registered_extensions().get(ending)
+    if found is None or found not in Image.SAVE:
+        named = f"ending {ending!r}" if ending else "no ending"
+        raise UsageError(
+            f"{path} has {named}: name the picture FILE.jpg (as sent), or .png, .bmp, .tiff or .webp"
+        )
+    return found
+
+
+def converted(jpeg: bytes, fmt: str) -> bytes:
+    """The picture in ``fmt`` (the JPEG bytes themselves for JPEG: nothing is re-compressed)."""
+    if fmt == "JPEG":
+        return jpeg
+    import io
+
+    from PIL import Image
+
+    out = io.BytesIO()
+    with Image.open(io.BytesIO(jpeg)) as img:
+        img.save(out, format=fmt)
+    return out.getvalue()
+
+
 def handle(args: argparse.Namespace) -> int:
+    try:  # before connecting: a picture is not taken for a file that cannot be written
+        fmt = image_format(args.out)
+        check_file(args.out, force=args.force)
+    except UsageError as exc:
+        return fail("image", str(exc), EXIT_USAGE)
+
     async def body(client: AriaClient) -> int:
         source = video_source(client, args.camera)
         extra: tuple[bytes, ...] = ()
         if args.quality is not None:
-            extra = (bytes([max(0, min(100, args.quality))]),)
+            extra = (bytes([args.quality]),)
         reply = await client.request_once(source, *extra, timeout=args.timeout)
         picture = reply.decode()  # MalformedReply (exit 3, one line) if it does not decode
         jpeg = bytes(picture.jpeg)  # type: ignore[attr-defined]
         problem = picture_problem(jpeg, picture.width, picture.height)  # type: ignore[attr-defined]
         if problem is not None:
             return fail("image", f"{problem}; nothing saved", EXIT_CONNECTION)
-        args.out.write_bytes(jpeg)
+        data = converted(jpeg, fmt)
+        written = write_whole(args.out, data, force=args.force)
+        if written != args.out:
+            print(f"rtmu image: {args.out} appeared meanwhile; kept it, wrote {written}", file=sys.stderr)
         size = f"{picture.width}x{picture.height}"  # type: ignore[attr-defined]
-        print(f"wrote {args.out}: {size}, {len(jpeg)} bytes from {visible(source)}", file=sys.stderr)
+        print(f"wrote {written}: {size} {fmt}, {len(data)} bytes from {visible(source)}", file=sys.stderr)
         return EXIT_OK
 
-    return run_with_client("image", args, body)
+    return run_with_client("image", args, body, role=Role.OBSERVER)

@@ -7,7 +7,7 @@ import math
 import sys
 from typing import Any
 
-from ..base.exit_codes import EXIT_OK, EXIT_USAGE
+from ..base.exit_codes import EXIT_NOT_HELD, EXIT_OK, EXIT_REFUSED, EXIT_USAGE
 from ..base.textsafe import visible
 from ..client.config_care import check_map
 from ..client.connection import AriaClient
@@ -21,6 +21,7 @@ from ..client.map_changes import (
     send_changes,
 )
 from ..client.mapload import download_map
+from ..client.roles import Role
 from ..mapedit import DraftError, MapDraft, ObjectChanges, describe
 from ._common import add_connection_arguments, print_json, run_with_client
 
@@ -42,13 +43,10 @@ guarded by the map's id, and the map is read again afterwards to check that it h
 Exit codes: 0 the server's map now holds the change; 2 an edit that does not fit the map, or bad
 arguments; 3 connection or login failure; 4 the server takes no map changes or has no map; 5 no
 verdict in time; 6 the server refused the change (its words are printed; the map is as it was);
-7 the server said it applied the change but its map, read again, does not hold it.
+19 the server said it applied the change but its map, read again, does not hold it.
 """
 
-EXIT_REFUSED = 6
-"""The server refused the change."""
-EXIT_NOT_HELD = 7
-"""The server said it applied the change, but its map read again does not hold it."""
+
 MAX_EDITS = 10_000
 
 
@@ -198,7 +196,7 @@ def handle(args: argparse.Namespace) -> int:
             return EXIT_OK
         return await _edit(client, edits, args)
 
-    return run_with_client("mapedit", args, body)
+    return run_with_client("mapedit", args, body, role=Role.OBSERVER)  # the map, never motion
 
 
 async def _edit(client: AriaClient, edits: list[dict[str, Any]], args: argparse.Namespace) -> int:

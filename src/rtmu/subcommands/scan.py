@@ -18,6 +18,7 @@ from ..base.textsafe import visible
 from ..client.connection import AriaClient
 from ..client.download import LocalFileError, check_destination, download_file
 from ..client.remote_files import Refused, local_name
+from ..client.roles import Role
 from ..client.scan import scan_name, scan_status, scan_unavailable, start_scan, stop_scan, tag_loop
 from ._actions import action_parser, end_progress, progress_printer
 from ._common import add_connection_arguments, fail, print_json, run_with_client
@@ -59,7 +60,7 @@ def handle(args: argparse.Namespace) -> int:
         body = {"start": _start, "status": _status, "loop": _loop, "stop": _stop}[args.action](args)
     except (ValueError, LocalFileError) as exc:
         return fail("scan", str(exc), EXIT_USAGE)
-    return run_with_client("scan", args, body)
+    return run_with_client("scan", args, body, role=Role.OBSERVER)  # a scan logs; the operator drives
 
 
 def _start(args: argparse.Namespace) -> Any:

@@ -20,6 +20,7 @@ from ..base.exit_codes import EXIT_OK
 from ..base.textsafe import visible
 from ..client.connection import AriaClient, Packet
 from ..client.errors import NotSupported
+from ..client.roles import Role
 from ..protocol.errors import ProtocolError
 from ..protocol.payloads.popup import PopupClose, PopupCreate, PopupType
 from ..protocol.payloads.robot import ModeInfo, UpdateStrings
@@ -123,4 +124,4 @@ def handle(args: argparse.Namespace) -> int:
             await asyncio.sleep(0.1 if end is None else min(0.1, max(0.0, end - loop.time())))
         return EXIT_OK
 
-    return run_with_client("watch", args, body)
+    return run_with_client("watch", args, body, role=Role.OBSERVER)

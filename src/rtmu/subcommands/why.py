@@ -22,6 +22,7 @@ from typing import Any
 
 from ..base.textsafe import visible
 from ..client.connection import AriaClient
+from ..client.roles import Role
 from ..client.why import diagnose
 from ..client.why_fix import FixResult, apply
 from ..client.why_gather import gather
@@ -69,7 +70,9 @@ def handle(args: argparse.Namespace) -> int:
             print_answer(answer)
         return answer.exit_code
 
-    return run_with_client("why", args, body)
+    # Asking never moves anything; --fix may send a stop (unlocking a mode) or switch safe drive.
+    role = Role.OPERATOR if getattr(args, "fix", False) else Role.OBSERVER
+    return run_with_client("why", args, body, role=role)
 
 
 async def fix_all(

@@ -12,10 +12,9 @@ import argparse
 import sys
 from dataclasses import replace
 
+from ..base.exit_codes import EXIT_CONNECTION, EXIT_INTERNAL, EXIT_NO_DISPLAY, EXIT_USAGE
 from ..settings.store import DEFAULT_PORT, parse_central
 from .options import GuiOptions
-
-EXIT_NO_DISPLAY = 6
 
 
 def add_gui_arguments(parser: argparse.ArgumentParser) -> None:
@@ -31,17 +30,18 @@ def add_gui_arguments(parser: argparse.ArgumentParser) -> None:
         type=int,
         default=1,
         metavar="N",
-        help="with --demo: N simulated robots on one map (as rtmu sim --robots N), all in the window",
+        help="with --demo: N simulated robots on one map (as rtmu sim --robots N), all in the window "
+        "(default 1)",
     )
     g.add_argument(
         "--central",
         metavar="HOST[:PORT]",
         help="ARIA's central server: every robot it lists in the window (as a profile's central = …)",
     )
-    g.add_argument("--host", help="robot server to connect to (default: the last profile)")
-    g.add_argument("--port", type=int, help=f"its port (default {DEFAULT_PORT})")
-    g.add_argument("--user", help="user name for the server (asks for the password)")
-    g.add_argument("--profile", help="use this saved connection profile")
+    g.add_argument("--host", metavar="HOST", help="robot server to connect to (default: the last profile)")
+    g.add_argument("--port", type=int, metavar="PORT", help=f"its port (default {DEFAULT_PORT})")
+    g.add_argument("--user", metavar="USER", help="user name for the server (asks for the password)")
+    g.add_argument("--profile", metavar="NAME", help="use this saved connection profile")
     g.add_argument(
         "--protocol",
         metavar="STRING",
@@ -84,23 +84,23 @@ def run_gui(args: argparse.Namespace) -> int:
     options = options_from_args(args)
     if options.port is not None and not 1 <= options.port <= 65535:
         print(f"rtmu: --port {options.port} is not 1…65535", file=sys.stderr)
-        return 2
+        return EXIT_USAGE
     if options.central is not None:
         try:
             parse_central(options.central)
         except ValueError as exc:
             print(f"rtmu: --central: {exc}", file=sys.stderr)
-            return 2
+            return EXIT_USAGE
         if options.host or options.demo:
             print("rtmu: --central goes without --host and --demo", file=sys.stderr)
-            return 2
+            return EXIT_USAGE
     robots = getattr(args, "robots", 1)
     if robots != 1 and not options.demo:
         print("rtmu: --robots N goes with --demo (a fleet profile names real robots)", file=sys.stderr)
-        return 2
+        return EXIT_USAGE
     if not 1 <= robots <= 50:
         print(f"rtmu: --robots {robots} is not 1…50", file=sys.stderr)
-        return 2
+        return EXIT_USAGE
     if not display_available():
         print(
             "rtmu: cannot open a display (is DISPLAY or WAYLAND_DISPLAY set?); "
@@ -114,7 +114,7 @@ def run_gui(args: argparse.Namespace) -> int:
             sim = start_demo_simulator(robots)
         except Exception as exc:  # the window is useless without it: say why and stop
             print(f"rtmu: the demo simulator did not start: {exc}", file=sys.stderr)
-            return 3
+            return EXIT_CONNECTION
         if robots == 1:
             options = replace(
                 options, host="127.0.0.1", port=sim.port, user=None, persist=False, connect=True
@@ -126,7 +126,7 @@ def run_gui(args: argparse.Namespace) -> int:
 
         app = RtmuApplication(options)
         status = int(app.run([sys.argv[0]]))
-        return 1 if app.failed and status == 0 else status
+        return EXIT_INTERNAL if app.failed and status == 0 else status
     finally:
         if sim is not None:
             sim.stop()

@@ -31,6 +31,7 @@ from ..client.roster import RobotEndpoint, Roster  # noqa: E402
 from ..client.session import SessionConfig  # noqa: E402
 from ..fleet.sessions import Fleet, RobotSession, direct_roster, robot_profile  # noqa: E402
 from ..model.observables import Phase  # noqa: E402
+from ..recorder.replay import REPLAY_CONFIG  # noqa: E402
 from ..settings.store import (  # noqa: E402
     DEFAULT_PORT,
     KeyringSecrets,
@@ -44,7 +45,7 @@ from .fleet_bind import FleetBinding  # noqa: E402
 from .keys import accels_for  # noqa: E402
 from .options import APP_ID, GuiOptions  # noqa: E402
 from .replay_bar import ReplayBar  # noqa: E402
-from .replay_mode import REPLAY_CONFIG, open_replay, replay_profile, show_replay  # noqa: E402
+from .replay_mode import open_replay, replay_profile, show_replay  # noqa: E402
 from .selected_model import SelectedModel  # noqa: E402
 from .style import install_css  # noqa: E402
 from .window import MainWindow  # noqa: E402
