@@ -69,7 +69,7 @@ class RobotState:
     """Monotonic time of the last status/mode update."""
     sonar_at: float | None = field(default=None, compare=False)
     laser: tuple[tuple[int, int], ...] = ()
-    """Current laser points of every listed ``Laser_*Current`` (LD robots), global mm."""
+    """Current points of every listed laser (``Laser_1Current``, ``sim_lms2xx_1Current`` …), global mm."""
     laser_at: float | None = field(default=None, compare=False)
     dock_state: str | None = None
     """``Undocked``, ``Docking``, ``Docked``, ``Undocking`` (``dockInfo``); None if not offered."""
