@@ -268,3 +268,19 @@ def test_closed_pipe_ends_quietly():
     err = proc.stderr.read()
     assert proc.wait(timeout=60) == EXIT_SIGPIPE  # the reader went away: 141, as every command
     assert b"Traceback" not in err
+
+
+def test_a_server_text_is_escaped_once_so_a_backslash_shows_as_one_escape(tmp_path):
+    r"""A password key ``a\b`` + CR is shown as ``'a\\b\r'``: one escape each, not ``a\\\\b``."""
+    from rtmu.protocol.commands import ServerCommand
+    from rtmu.protocol.payloads.control import ServerIntroduction
+
+    intro = ServerIntroduction("alpha", 0, 1, 2, "a\\b\r", "").encode()
+    path = tmp_path / "server.bin"
+    path.write_bytes(encode_packet(ServerCommand.INTRODUCTION, intro))
+    out = rtmu("--direction", "s2c", path).stdout
+    line = next(line for line in out.splitlines() if "password_key" in line)
+    assert r"password_key='a\\b\r'" in line, line
+    assert "\\\\\\" not in line and "\r" not in line  # never three backslashes in a row, never a raw CR
+    record = json_lines(rtmu("--json", "--direction", "s2c", path).stdout)[0]
+    assert record["fields"]["password_key"] == "a\\b\r"  # JSON carries the exact string

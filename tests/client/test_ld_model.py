@@ -43,14 +43,16 @@ def test_model_gets_laser_dock_routes_and_data_store_from_aram() -> None:
             runner.close()
 
 
-def test_default_profile_publishes_none_of_it() -> None:
+def test_default_profile_publishes_none_of_it_but_its_laser() -> None:
+    """A Pioneer server's laser (MobileSim's ``sim_lms2xx_1Current`` drawing) is every robot's laser."""
     with SimThread(SimConfig(port=0, map_path=OFFICE)) as sim:
         runner, model, ui = connected(sim.port)
         try:
             ui.wait_for(lambda: len(model.robot.value.sonar) > 0, timeout=5)
             ui.wait_for(lambda: model.robot.value.wifi_quality is not None, timeout=5)
+            ui.wait_for(lambda: len(model.robot.value.laser) > 50, timeout=5)
             robot = model.robot.value
-            assert robot.laser == () and robot.dock_state is None
+            assert robot.dock_state is None
             assert robot.routes == () and robot.data_store == ()
             offers = model.connection.value.offers
             assert "updateNumbers" in offers and "getRoutes" not in offers

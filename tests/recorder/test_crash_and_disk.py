@@ -31,8 +31,9 @@ from .mcapread import read, summary_counts
 from .simsession import ARENA, recorded_session
 
 RECORD = [sys.executable, "-m", "rtmu", "record"]
-DISK = 40_000
-"""Bytes the "disk" holds: the map and a second or two of pictures fill it."""
+DISK = 120_000
+"""Bytes the "disk" holds: the first chunks (the map, a Pioneer's laser at 5 Hz, two pictures a
+second) and a few seconds more fill it."""
 
 
 def sim_bytes_in(sim: SimThread) -> int:

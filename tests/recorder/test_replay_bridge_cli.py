@@ -40,6 +40,18 @@ def test_bridge_refuses_bad_options() -> None:
     assert failed.returncode == 3, failed.stderr
 
 
+def test_bridge_warns_when_driving_is_allowed_on_an_address_the_network_reaches() -> None:
+    """192.0.2.1 (TEST-NET-1) is no address of this machine: the warning comes, then the bind fails."""
+    args = ("bridge", "127.0.0.1:1", "--foxglove", "--timeout", "2")
+    done = rtmu(*args, "--bind", "192.0.2.1", "--allow-drive")
+    assert "WARNING: --allow-drive on 192.0.2.1" in done.stderr and "token" in done.stderr
+    assert done.returncode != 0 and "cannot serve on 192.0.2.1" in done.stderr
+    quiet = rtmu("bridge", "127.0.0.1:1", "--foxglove", "--port", "0", "--allow-drive", "--timeout", "2")
+    assert "WARNING" not in quiet.stderr  # loopback: no warning
+    watched = rtmu("bridge", "127.0.0.1:1", "--foxglove", "--bind", "192.0.2.1", "--timeout", "2")
+    assert "WARNING" not in watched.stderr and "can watch the robot" in watched.stderr
+
+
 def test_bridge_serves_poses_until_sigterm() -> None:
     with SimThread(SimConfig(port=0, map_path=ARENA, seed=1)) as sim:
         proc = subprocess.Popen(
@@ -75,9 +87,10 @@ def test_bridge_with_allow_drive_drives_with_its_guardian_and_stops_when_the_str
         try:
             assert proc.stderr is not None
             line = proc.stderr.readline()
-            found = re.search(r"ws://127\.0\.0\.1:(\d+) \(drive allowed from /cmd_vel\)", line)
+            found = re.search(r"(ws://127\.0\.0\.1:\d+/\?token=[\w-]+) \(drive allowed from /cmd_vel", line)
             assert found, line
-            with FoxgloveClient(f"ws://127.0.0.1:{found.group(1)}") as client:
+            assert "app.foxglove.dev" in proc.stderr.readline()
+            with FoxgloveClient(found.group(1)) as client:
                 client.until(lambda: bool(client.server_info))
                 client.advertise(1, "/cmd_vel")
                 start = sim.snapshot().x

@@ -24,9 +24,9 @@ import math
 import re
 
 from ..protocol.payloads.robot import ModeInfo
-from ..values.state import LinkLevel
+from ..values.state import LinkLevel, NavOutcome
 from .lease import RESEND_PERIOD
-from .nav_status import NavPhase, read_status
+from .nav_status import read_status
 from .why_values import (
     Answer,
     Cause,
@@ -249,7 +249,7 @@ def _modes(facts: Facts, motion: Motion | None, navigate: bool) -> list[Reason]:
     out: list[Reason] = []
     info = facts.mode_info
     docked = facts.dock_state == "Docked" or (
-        read_status(facts.status).phase is NavPhase.DOCKED
+        read_status(facts.status).phase is NavOutcome.DOCKED
         and info is not None
         and info.mode_name in DOCK_MODES
     )
@@ -301,7 +301,7 @@ def _modes(facts: Facts, motion: Motion | None, navigate: bool) -> list[Reason]:
                 )
             )
     reading = read_status(facts.status, info.mode_name if info else "")
-    if reading.phase is NavPhase.GOING and not docked:
+    if reading.phase is NavOutcome.GOING and not docked:
         fix = (
             Fix("stop", "send stop (the server's own driving ends)", "stop", False)
             if "stop" in facts.offers

@@ -48,6 +48,8 @@ LAST_EDITABLE = Priority.EXPERT
 """As ARIA's handler without factory permission: FACTORY parameters are shown, never changed."""
 CAMERA_SIZES = {"320x240": (320, 240), "640x480": (640, 480)}
 FILLER_PER_SECTION = 1000
+FILLER_CONTROL_SECTION = "Line\rbreak\nand \x1b[2Jescape"
+"""A hostile section name with filler: a CR, a newline and a terminal escape in it."""
 MIN_TIMEOUT = 0.1
 """A watchdog shorter than a client's resend period would stop every held drive: refused (0 is "off")."""
 
@@ -312,6 +314,16 @@ class SimArConfig:
             )
             key = (section, name)
             self._add(section, template, lambda k=key: store[k], lambda v, k=key: store.__setitem__(k, v))  # type: ignore[misc]
+        if count:  # control characters in names: a CR, a newline, an escape
+            section, name = FILLER_CONTROL_SECTION, "Line\rbreak"
+            store[(section, name)] = 1
+            template = ConfigParam(name, ParamType.INT, None, "a CR in its name", 0, 0, 10, -1)
+            self._add(
+                section,
+                template,
+                lambda: store[(FILLER_CONTROL_SECTION, "Line\rbreak")],
+                lambda v: store.__setitem__((FILLER_CONTROL_SECTION, "Line\rbreak"), v),
+            )
 
     def values(self) -> list[tuple[str, str, str]]:
         """``(section, parameter, value text)`` of every parameter that has a value, in order."""

@@ -189,7 +189,7 @@ def resolve_robot(args: argparse.Namespace) -> int | None:
     does not list (naming the ones it does), 3/4/5 as for any login.
     """
     from ..base.textsafe import visible
-    from ..client.central import list_robots
+    from ..client.central import AmbiguousRobot, find_robot, list_robots
 
     name = str(getattr(args, "subcommand", None) or "rtmu")
     try:
@@ -208,14 +208,15 @@ def resolve_robot(args: argparse.Namespace) -> int | None:
     except Interrupted as exc:
         return fail(name, str(exc), exc.exit_code)
     wanted = args.robot
-    found = [e for e, _ in robots if e.name == wanted] or [
-        e for e, _ in robots if e.name.lower() == wanted.lower()
-    ]
-    if not found:
+    try:
+        found = find_robot(robots, wanted)  # without case, as ARIA compares; several: refused
+    except AmbiguousRobot as exc:
+        return fail(name, str(exc), EXIT_USAGE)
+    if found is None:
         listed = visible(", ".join(e.name for e, _ in robots) or "none")
         where = f"behind the central server {host}:{port}"
         return fail(name, f"no robot {wanted!r} {where} (robots: {listed})", EXIT_USAGE)
-    args.server = (found[0].host, found[0].port)
+    args.server = (found.host, found.port)
     return None
 
 

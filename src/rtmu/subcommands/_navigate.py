@@ -21,13 +21,14 @@ from ..base.exit_codes import EXIT_CANCELLED, EXIT_LOST, EXIT_OK, EXIT_REFUSED, 
 from ..base.textsafe import visible
 from ..client.connection import AriaClient, Packet
 from ..client.errors import ClientError, NotSupported
-from ..client.nav_status import NavPhase, NavReading, path_remaining, read_status
+from ..client.nav_status import NavReading, path_remaining, read_status
 from ..protocol.errors import ProtocolError
 from ..protocol.payloads import Payload, Side, decode_payload
 from ..protocol.payloads.drive import RatioDrive
 from ..protocol.payloads.ld import DockInfo
 from ..protocol.payloads.navigation import LocalizationState, LocState, PlannedPath
 from ..protocol.payloads.robot import ModeInfo, Update, UpdateNumbers, UpdateStrings
+from ..values.state import NavOutcome
 from ._common import Interrupted, current_interrupts, positive_float, print_json, signal_name
 
 EXIT_NAV_FAILED = EXIT_REFUSED
@@ -95,11 +96,11 @@ class Expect:
     docked: bool = False
 
     def answers(self, r: NavReading) -> bool:
-        if r.phase is NavPhase.FAILED:
+        if r.phase is NavOutcome.FAILED:
             return True
-        if r.phase is NavPhase.DOCKED:
+        if r.phase is NavOutcome.DOCKED:
             return self.docked
-        return r.phase is NavPhase.ARRIVED and not self.docked and r.target == self.target
+        return r.phase is NavOutcome.ARRIVED and not self.docked and r.target == self.target
 
 
 class _Watch:
@@ -118,8 +119,8 @@ class _Watch:
         r = read_status(self.status, self.mode_name)
         # An LD robot says its docking in dockInfo; its status may still read "Arrived at …" from the goto
         # before, so the dock state answers unless the status says it is on its way somewhere.
-        if r.phase is not NavPhase.GOING and self.dock_state in ("Docking", "Docked"):
-            phase = NavPhase.GOING if self.dock_state == "Docking" else NavPhase.DOCKED
+        if r.phase is not NavOutcome.GOING and self.dock_state in ("Docking", "Docked"):
+            phase = NavOutcome.GOING if self.dock_state == "Docking" else NavOutcome.DOCKED
             return NavReading(phase, "dock", text=self.dock_state)
         return r
 
@@ -236,7 +237,7 @@ async def _follow(
                 if r.text and r.text != shown and (r.text != before.text or now - sent_at >= SETTLE):
                     shown = r.text
                     _say(args, {"status": r.text, "phase": r.phase.value}, visible(r.text))
-                if r.phase is NavPhase.GOING:
+                if r.phase is NavOutcome.GOING:
                     seen_going = True
                     left = path_remaining(*watch.pose[:2], watch.path) if watch.pose and watch.path else None
                     if (
@@ -250,7 +251,7 @@ async def _follow(
                     fresh = seen_going or r.text != before.text or now - sent_at >= SETTLE
                     if fresh:
                         return _outcome(args, watch, r)
-                elif seen_going and (r.phase is NavPhase.IDLE or r.finished):
+                elif seen_going and (r.phase is NavOutcome.NONE or r.finished):
                     # Stopped, driven, or finished somewhere else: someone took the robot over.
                     return _ended(args, watch, r, "cancelled", EXIT_NAV_CANCELLED)
                 watch.changed.clear()
@@ -275,7 +276,7 @@ async def _follow(
 
 
 def _outcome(args: argparse.Namespace, watch: _Watch, r: NavReading) -> int:
-    if r.phase is NavPhase.FAILED:
+    if r.phase is NavOutcome.FAILED:
         lost = r.reason == "the robot is lost"
         code = EXIT_NAV_LOST if lost else EXIT_NAV_FAILED
         return _ended(args, watch, r, "failed", code)

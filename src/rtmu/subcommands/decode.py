@@ -422,7 +422,7 @@ class _TextWriter:
         )
 
     def _packet_line(self, p: DecodedPacket) -> str:
-        name = _one_line(p.name) if p.name else ("?" if p.is_data else "(unknown control)")
+        name = p.name if p.name else ("?" if p.is_data else "(unknown control)")
         where = f"{self._time(p.time)} {p.conn:>3} {p.direction} {p.transport:<6}"
         head = f"{where} {p.command:>5} {name:<22} {p.length:>5}"
         parts: list[str] = []
@@ -485,7 +485,7 @@ def format_fields(fields: dict[str, Any], full: bool = False) -> str:
 
 def _entry(entry: dict[str, Any], full: bool) -> str:
     """One list entry: its number and texts (only the name, or the group and flags, when short)."""
-    values = [_one_line(str(v)) for k, v in entry.items() if k != "number" and v != ""]
+    values = [str(v) for k, v in entry.items() if k != "number" and v != ""]
     if not full and "name" in entry:
         values = [str(entry["name"])]
     text = "/".join(values)
@@ -494,19 +494,15 @@ def _entry(entry: dict[str, Any], full: bool) -> str:
     return f"{entry['number']} {text}" if text else str(entry["number"])
 
 
-_CONTROL = {c: f"\\x{c:02x}" for c in range(32)} | {10: "\\n", 13: "\\r", 9: "\\t"}
-
-
-def _one_line(text: str) -> str:
-    """Control characters escaped, so one packet stays one line (server texts do hold newlines)."""
-    return text.translate(_CONTROL)
-
-
 def _value(value: Any, full: bool) -> str:
+    """A field's value as text. A string is quoted and NOT escaped here: every text line is escaped
+    once, whole, when it is written (``visible``: control characters, so one packet stays one line,
+    and backslashes) — escaping here too showed a ``\\`` in a password key as four."""
     if isinstance(value, str):
         if not full and len(value) > SHORT_TEXT:
             value = value[:SHORT_TEXT] + "…"
-        return repr(value)
+        quote = '"' if "'" in value and '"' not in value else "'"
+        return f"{quote}{value}{quote}"
     if isinstance(value, float):
         return f"{value:g}"
     if isinstance(value, dict):
@@ -571,7 +567,7 @@ def _session_lines(session: Session, source: CaptureSource, full: bool) -> list[
             continue
         names = totals.by_name.most_common()
         shown = names if full else names[:10]
-        text = ", ".join(f"{_one_line(n)} ×{c}" for n, c in shown)
+        text = ", ".join(f"{n} ×{c}" for n, c in shown)
         if len(shown) < len(names):
             text += f", … +{len(names) - len(shown)} names"
         lines.append(f"  {direction} {totals.packets} packets, {totals.bytes} bytes: {text}")

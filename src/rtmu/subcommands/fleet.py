@@ -16,7 +16,7 @@ from typing import Any
 
 from ..base.exit_codes import EXIT_CONNECTION, EXIT_OK, EXIT_USAGE
 from ..base.textsafe import visible
-from ..client.central import list_robots
+from ..client.central import list_robots, one_per_name
 from ..client.connection import AriaClient
 from ..client.errors import ClientError
 from ..client.roles import Role
@@ -81,7 +81,7 @@ def handle(args: argparse.Namespace) -> int:
     host, port = args.server
 
     async def main() -> list[dict[str, Any]]:
-        robots = await list_robots(host, port, args.user, password, timeout=args.timeout)
+        robots = one_per_name(await list_robots(host, port, args.user, password, timeout=args.timeout))
         gate = asyncio.Semaphore(MAX_AT_ONCE)
         statuses: list[dict[str, Any] | None] = [None] * len(robots)
         if not args.no_status:

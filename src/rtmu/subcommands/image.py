@@ -23,28 +23,22 @@ MAX_SIDE = 8192
 def picture_problem(jpeg: bytes, width: int, height: int) -> str | None:
     """Why ``jpeg`` is not a sane picture of the claimed size, in plain words; None when it is.
 
-    Decoding (not just trusting the header) catches bytes that are not a JPEG, truncated
-    pictures and size fields that lie, before anything lands on disk as ``.jpg``.
+    Its header is read first and its data must be able to fill the size it declares
+    (:mod:`rtmu.client.jpeg_bounds`); then it is decoded at 1/8 scale, which reads all its data at
+    a fraction of its pixels' memory. Bytes that are not a JPEG, truncated pictures and size fields
+    that lie are caught before anything lands on disk.
     """
-    import io
-
-    from PIL import Image
+    from ..client.jpeg_bounds import decode_problem, fill_problem, read_header
 
     if width > MAX_SIDE or height > MAX_SIDE:
         return f"the server claims a {width}x{height} picture, over the {MAX_SIDE}x{MAX_SIDE} limit"
-    try:
-        with Image.open(io.BytesIO(jpeg)) as img:
-            if img.format != "JPEG":
-                return f"the server sent a {img.format or 'non-JPEG'} picture, not a JPEG"
-            w, h = img.size
-            if w > MAX_SIDE or h > MAX_SIDE:
-                return f"the picture is {w}x{h}, over the {MAX_SIDE}x{MAX_SIDE} limit"
-            if (width, height) != (0, 0) and (w, h) != (width, height):
-                return f"the server says {width}x{height} but the picture is {w}x{h}"
-            img.load()
-    except (OSError, SyntaxError, ValueError, Image.DecompressionBombError):
+    if not jpeg.startswith(b"\xff\xd8"):
         return f"the {len(jpeg)} bytes the server sent are not a complete JPEG picture"
-    return None
+    header = read_header(jpeg)
+    if header.size is not None and (width, height) not in ((0, 0), header.size):
+        w, h = header.size
+        return f"the server says {width}x{height} but the picture is {w}x{h}"
+    return fill_problem(jpeg, header) or decode_problem(jpeg)
 
 
 def register(subparsers: Any) -> None:

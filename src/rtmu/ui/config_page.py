@@ -2,8 +2,10 @@
 
 A window of its own (menu: Server ▸ Configuration…), so typing in it never reaches the main
 window's drive keys. Everything it shows comes from the server and is set as plain text, never as
-markup. A section shows :data:`PAGE_SIZE` parameters at a time, so a configuration of tens of
-thousands of parameters costs a page of widgets, not one per parameter.
+markup; a name (section, parameter) is one line, its control characters shown escaped (a CR in a
+section's name is ``\r``, not a line break). A section shows :data:`PAGE_SIZE` parameters at a
+time, so a configuration of tens of thousands of parameters costs a page of widgets, not one per
+parameter.
 
 Edits are kept by ``(section, name)`` until they are saved, across sections, pages, the priority
 filter and refreshes. When another client changes the configuration (``configUpdated``) the page
@@ -26,6 +28,7 @@ gi.require_version("Gtk", "4.0")
 gi.require_version("Pango", "1.0")
 from gi.repository import Gdk, GLib, Gtk, Pango  # noqa: E402
 
+from ..base.textsafe import visible  # noqa: E402
 from ..client.config_feed import (  # noqa: E402
     MAX_TEXT,
     ConfigSection,
@@ -256,7 +259,7 @@ class ConfigPage(Gtk.Window):
         while (row := self.sections.get_row_at_index(0)) is not None:
             self.sections.remove(row)
         for s in config.sections[:MAX_SECTIONS_LISTED]:
-            label = Gtk.Label(label=s.name, xalign=0.0, ellipsize=Pango.EllipsizeMode.END)
+            label = Gtk.Label(label=visible(s.name), xalign=0.0, ellipsize=Pango.EllipsizeMode.END)
             label.set_tooltip_text(s.comment or None)
             self.sections.append(label)
         count = min(len(config.sections), MAX_SECTIONS_LISTED)
@@ -323,7 +326,7 @@ class ConfigPage(Gtk.Window):
         assert config is not None
         key = (section.name, p.name)
         left = Gtk.Box(orientation=Gtk.Orientation.VERTICAL)
-        name = Gtk.Label(label=p.name, xalign=0.0, wrap=True, max_width_chars=28)
+        name = Gtk.Label(label=visible(p.name), xalign=0.0, wrap=True, max_width_chars=28)
         left.append(name)
         if p.description:
             about = Gtk.Label(label=p.description, xalign=0.0, wrap=True, max_width_chars=40)
