@@ -248,14 +248,6 @@ class SpeedSetting:
     def slower(self) -> SpeedSetting:
         return SpeedSetting(max(SPEED_MIN, self.percent - SPEED_STEP))
 
-    @property
-    def at_max(self) -> bool:
-        return self.percent >= SPEED_MAX
-
-    @property
-    def at_min(self) -> bool:
-        return self.percent <= SPEED_MIN
-
 
 @dataclass(frozen=True, slots=True)
 class ViewOptions:

@@ -118,8 +118,7 @@ class RtmuApplication(Gtk.Application):
         quit_action = Gio.SimpleAction.new("quit", None)
         quit_action.connect("activate", lambda _a, _p: self.quit_safely())
         self.add_action(quit_action)
-        for target in ("app.quit", "win.fullscreen", "win.toolbar", "win.connect", "win.disconnect",
-                       "win.settings", "win.show-help-overlay"):  # fmt: skip
+        for target in ("app.quit", "win.fullscreen", "win.toolbar", "win.settings", "win.show-help-overlay"):
             self.set_accels_for_action(target, accels_for(target))
         # Ctrl+C, kill, a closed terminal (SIGHUP), Ctrl+\ (SIGQUIT), SIGUSR1/2 and SIGALRM all end the
         # window the same way: stop the robot first, then quit. Left to their default, they would kill

@@ -921,10 +921,6 @@ class MainWindow(Gtk.ApplicationWindow):
     def _set_safe_drive(self, on: bool) -> None:
         self.controller.run("safe_drive_on" if on else "safe_drive_off")
 
-    def set_toolbar_visible(self, on: bool) -> None:
-        self.toolbar_revealer.set_reveal_child(on)
-        self.toolbar_action.set_state(GLib.Variant.new_boolean(on))
-
     def _set_speed_from_profile(self, profile: Profile) -> None:
         pct = max(SPEED_MIN, min(SPEED_MAX, profile.speed // 10 * 10))
         self.operator.speed.set(SpeedSetting(pct))
