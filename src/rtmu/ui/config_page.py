@@ -49,25 +49,6 @@ MAX_CHANGES_NAMED = 5
 SPIN_LIMIT = 1e12
 """Unlimited numbers (ARIA's INT_MIN/INT_MAX, ±INF) are edited within ± this."""
 PRIORITY_LABELS = ("Basic", "Intermediate", "Advanced", "Expert", "Factory")
-CSS = """
-.config-ok { color: #26a269; font-weight: bold; }
-.config-error { color: #c01c28; }
-.config-edited { color: #1c71d8; }
-.config-banner { background: alpha(#e5a50a, 0.25); padding: 4px 8px; border-radius: 4px; }
-"""
-_css_done = False
-
-
-def install_css() -> None:
-    """The answer colours, once per display (the theme's own .success/.error differ between themes)."""
-    global _css_done
-    display = Gdk.Display.get_default()
-    if _css_done or display is None:
-        return
-    provider = Gtk.CssProvider()
-    provider.load_from_data(CSS.encode())
-    Gtk.StyleContext.add_provider_for_display(display, provider, Gtk.STYLE_PROVIDER_PRIORITY_APPLICATION)
-    _css_done = True
 
 
 class ConfigPage(Gtk.Window):
@@ -94,7 +75,6 @@ class ConfigPage(Gtk.Window):
         self._again = ""
         self.saving = False
         self.closed = False
-        install_css()
         self._build()
         self._follow(self.remote_changed)
         self.connect("close-request", self._closing)
