@@ -34,7 +34,7 @@ gi.require_version("Pango", "1.0")
 gi.require_version("Gdk", "4.0")
 from gi.repository import Gdk, Gio, GLib, Gtk, Pango  # noqa: E402
 
-from ..base.notices import Kind, Level, Notice  # noqa: E402
+from ..base.notices import Notice  # noqa: E402
 from ..client.custom_commands import ServerCommand  # noqa: E402
 from ..client.errors import ClientError  # noqa: E402
 from ..control.commands import COMMANDS, CommandState, action_name  # noqa: E402
@@ -90,9 +90,9 @@ from .mapview import MapStage  # noqa: E402
 from .motion import MotionIndicator  # noqa: E402
 from .move_dialogs import go_dialog, turn_dialog  # noqa: E402
 from .nav_draw import Marker, MarkerKind  # noqa: E402
-from .nav_text import link_lost_note  # noqa: E402
 from .near_people import NearPeopleSwitch  # noqa: E402
 from .notes import map_note  # noqa: E402
+from .notice_router import NoticeRouter, speed_banner  # noqa: E402
 from .palette import CommandPalette  # noqa: E402
 from .pip import PictureInPicture  # noqa: E402
 from .popups import PopupStack  # noqa: E402
@@ -215,6 +215,12 @@ class MainWindow(Gtk.ApplicationWindow):
         """The robot the operator commands: every widget's intents go to the selected one."""
         status_age = lambda: self._link.status_age()  # noqa: E731 - the shown robot's, also after a switch
         self.banners = BannerStack()
+        self.notices = NoticeRouter(
+            self.banners,
+            connection=lambda: self.model.connection.value,
+            speed_percent=lambda: self.operator.speed.value.percent,
+            picture=lambda: self.camera,
+        )
         self.stage = MapStage(model, operator, clock=clock, status_age=status_age)
         self.stage.on_view_changed = self._view_changed
         self.toolbar = StatusToolbar(model, operator, clock=clock, status_age=status_age)
@@ -502,33 +508,8 @@ class MainWindow(Gtk.ApplicationWindow):
 
     # -- the controller's View -----------------------------------------------------------------
     def show_notice(self, notice: Notice) -> None:
-        """Show a controller/network message where its kind belongs (never routed by its words)."""
-        kind, level, text = notice.kind, notice.level, notice.text
-        phase = self.model.connection.value.phase
-        if kind is Kind.CONNECTION or (text and text == self.model.connection.value.error):
-            return  # the link banner shows the connection's life from the model
-        if kind is Kind.LINK:
-            if level is Level.INFO:
-                self.banners.tell("link", "info", text, timeout=4.0)
-            elif phase is Phase.CONNECTED:
-                self.banners.tell("link", level.value, text, timeout=None)
-        elif kind is Kind.SPEED_LIMIT:
-            pct = self.operator.speed.value.percent
-            limit = "maximum" if pct >= SPEED_MAX else "minimum"
-            self.banners.tell("speed", "warning", f"Speed at its {limit}: {pct} %", timeout=2.5,
-                              fraction=pct / SPEED_MAX)  # fmt: skip
-        elif kind is Kind.SPEED:
-            return  # the speed banner follows the model
-        elif kind is Kind.NAVIGATION:  # outcomes and cancellations: one banner, updated in place
-            self.banners.tell("navigation", level.value, text, timeout=8.0 if level is Level.INFO else 12.0)
-        elif kind is Kind.CAMERA:
-            if self.camera.waiting:
-                self.camera.failed(text)
-            self.banners.tell("camera", level.value, text, timeout=5.0)
-        else:
-            self.banners.tell(
-                f"notice:{text}", level.value, text, timeout=6.0 if level is Level.ERROR else 4.0
-            )
+        """Show a controller/network message where its kind belongs (``notice_router``)."""
+        self.notices.show(notice)
 
     def commands_changed(self, states: Mapping[str, CommandState]) -> None:
         self._states.update(states)
@@ -759,31 +740,9 @@ class MainWindow(Gtk.ApplicationWindow):
 
     # -- model reactions ---------------------------------------------------------------------
     def _on_connection(self, old: ConnectionState, new: ConnectionState) -> None:
-        where = f"{new.host}:{new.port}" if new.host else ""
         phase = new.phase
-        if self.session.closed:  # a closed robot's late news (the fleet said why it went): no banner
-            pass
-        elif phase is Phase.CONNECTING and old.phase is not Phase.CONNECTING:
-            self.banners.tell("link", "info", f"Connecting to {where}…", timeout=None)
-        elif phase is Phase.CONNECTED and old.phase is not Phase.CONNECTED:
-            if old.phase is Phase.RECONNECTING:
-                self.banners.tell(
-                    "link", "info", f"Reconnected to {where}: press a key to drive again", timeout=4.0
-                )
-            else:
-                self.banners.tell("link", "info", f"Connected to {where}", timeout=3.0)
-        elif phase is Phase.RECONNECTING:
-            count = f" ({new.attempt})" if new.attempt else ""
-            note = link_lost_note(self.model.navigation.value)
-            self.banners.tell("link", "warning", f"Link lost — reconnecting{count}…{note}", timeout=None)
-        elif phase is Phase.FAILED and (new.error != old.error or old.phase is not Phase.FAILED):
-            lost = old.phase in (Phase.CONNECTED, Phase.RECONNECTING)
-            reason = new.error or "no reason given"
-            note = link_lost_note(self.model.navigation.value)
-            text = f"Link lost: {reason}.{note}" if lost else f"Could not connect to {where}: {reason}"
-            self.banners.tell("link", "error", text, timeout=10.0)
-        elif phase is Phase.DISCONNECTED and old.phase is not Phase.DISCONNECTED:
-            self.banners.dismiss("link")  # deliberate: no banner at all
+        if not self.session.closed:  # a closed robot's late news (the fleet said why it went): no banner
+            self.notices.connection_changed(old, new, self.model.navigation.value)
         if phase is Phase.DISCONNECTED or (phase is Phase.CONNECTING and old.phase is not Phase.RECONNECTING):
             self.camera.clear()
             self.live.connection_lost()
@@ -840,9 +799,7 @@ class MainWindow(Gtk.ApplicationWindow):
             self.safe_action.set_state(GLib.Variant.new_boolean(new.safe_drive))
 
     def _on_speed(self, _old: SpeedSetting, new: SpeedSetting) -> None:
-        self.banners.tell(
-            "speed", "info", f"Speed {new.percent} %", timeout=2.5, fraction=new.percent / SPEED_MAX
-        )
+        self.notices.apply(speed_banner(new.percent))
 
     def _hide_inset(self) -> None:
         if _flag(self.inset_action):
