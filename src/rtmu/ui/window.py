@@ -56,7 +56,6 @@ from ..model.observables import (  # noqa: E402
 from ..settings.store import Profile  # noqa: E402
 from ..values.intents import (  # noqa: E402
     AnswerPopup,
-    FetchConfig,
     GotoGoal,
     GotoPose,
     Intent,
@@ -65,7 +64,6 @@ from ..values.intents import (  # noqa: E402
     MoveDistance,
     PauseVideo,
     RunServerCommand,
-    SetConfig,
     StartVideo,
     StopVideo,
     TurnBy,
@@ -911,12 +909,7 @@ class MainWindow(Gtk.ApplicationWindow):
         """The server's configuration page (its own window, so typing there never drives): one at a time."""
         page = getattr(self, "config_page", None)
         if page is None or page.closed:
-            self.config_page = ConfigPage(
-                self,
-                lambda: self.request(FetchConfig()),
-                lambda changes: self.request(SetConfig(changes)),
-                self._follow_config_updates,
-            )
+            self.config_page = ConfigPage(self, self.request, self._follow_config_updates)
         self.config_page.present()
 
     def _follow_config_updates(self, listener: Callable[[], None] | None) -> None:
