@@ -62,18 +62,14 @@ from ..values.intents import (  # noqa: E402
     ListServerCommands,
     Localize,
     MoveDistance,
-    PauseVideo,
     RunServerCommand,
-    StartVideo,
-    StopVideo,
     TurnBy,
-    VideoShown,
     WatchStrings,
 )
 from .banners import BannerStack  # noqa: E402
 from .bars import FullscreenBar, connect_button, menu_button, show_connection, stop_button  # noqa: E402
 from .bridge_toggle import BridgeToggle  # noqa: E402
-from .camera import CameraView, PictureDecoder  # noqa: E402
+from .camera_page import CameraPage  # noqa: E402
 from .config_page import ConfigPage  # noqa: E402
 from .details import DetailsWindow  # noqa: E402
 from .dpad import DPad  # noqa: E402
@@ -83,7 +79,6 @@ from .key_reach import KeyReach  # noqa: E402
 from .keyboard_nav import KeyboardNav, menu_item  # noqa: E402
 from .keys import KeyRouter  # noqa: E402
 from .layers import LayersPanel  # noqa: E402
-from .live_video import LiveVideoControls  # noqa: E402
 from .mapview import MapStage  # noqa: E402
 from .motion import MotionIndicator  # noqa: E402
 from .move_dialogs import go_dialog, turn_dialog  # noqa: E402
@@ -96,7 +91,6 @@ from .pip import PictureInPicture  # noqa: E402
 from .popups import PopupStack  # noqa: E402
 from .pose_bar import PoseBar  # noqa: E402
 from .pose_pick import PosePicker  # noqa: E402
-from .ptz_controls import PtzControls  # noqa: E402
 from .routes_panel import RoutesPanel  # noqa: E402
 from .selected_model import SelectedModel  # noqa: E402
 from .settings_dialog import ConnectionDialog, PasswordPrompt  # noqa: E402
@@ -222,17 +216,7 @@ class MainWindow(Gtk.ApplicationWindow):
         self.stage = MapStage(model, operator, clock=clock, status_age=status_age)
         self.stage.on_view_changed = self._view_changed
         self.toolbar = StatusToolbar(model, operator, clock=clock, status_age=status_age)
-        self.camera = CameraView(on_request=self._request_picture, on_back=self.show_map, clock=clock)
         self.inset = PictureInPicture(self.show_camera, clock=clock, on_hide=lambda: self._hide_inset())
-        self.ptz = PtzControls(model, self.robot.ask, on_moved=self._request_picture)
-        self.ptz.attach_drag(self.camera.picture)
-        self.camera.append(self.ptz)
-        self.live = LiveVideoControls(
-            self.camera, start=lambda fps, quality: self.robot.ask(StartVideo(fps, quality)),
-            stop=lambda: self.robot.ask(StopVideo()), pause=lambda on: self.robot.ask(PauseVideo(on)),
-            tell=lambda level, text: self.banners.tell("camera", level, text, timeout=5.0),
-        )  # fmt: skip
-        self.decoder = PictureDecoder(self._picture_decoded)
         self.dpad = DPad(hold=self._hold_pointer, release=self._release, stop=self._stop_from_dpad)
         self.keys = KeyRouter(
             hold=self._hold, release=self._release, command=self._command, view=self.view_intent
@@ -253,7 +237,6 @@ class MainWindow(Gtk.ApplicationWindow):
         self._unobserve = [
             model.connection.observe(self._on_connection),
             operator.speed.observe(self._on_speed),
-            model.camera.observe(self._on_camera),
             model.map.observe(self._on_map),
             model.robot.observe(self._on_robot),
         ]
@@ -277,6 +260,18 @@ class MainWindow(Gtk.ApplicationWindow):
 
     # -- layout ------------------------------------------------------------------------------
     def _build(self) -> None:
+        self.map_page = map_page = Gtk.Overlay()
+        self.stack = Gtk.Stack(transition_type=Gtk.StackTransitionType.NONE)
+        self.split = SplitView(map_page)  # the map page, and the live picture beside it while split
+        self.camera_page = CameraPage(
+            self.model, self.robot, self.banners, stack=self.stack, inset=self.inset, split=self.split,
+            command_state=self.command_state, toggle=lambda: self.view_intent("toggle_camera"),
+            page_changed=self._camera_page_changed,
+            clock=self.clock,
+        )  # fmt: skip
+        page = self.camera_page
+        self.camera, self.ptz, self.live = page.view, page.ptz, page.live
+        self.decoder, self.camera_button = page.decoder, page.button
         header = Gtk.HeaderBar()
         # Safety: STOP is always on screen, first in the bar and the only red button in it.
         self.stop_button = stop_button(self.stop_now)
@@ -298,10 +293,6 @@ class MainWindow(Gtk.ApplicationWindow):
         self.menu_model = self._menu()
         self.menu_button = menu_button(self.menu_model)
         header.pack_end(self.menu_button)
-        self.camera_button = Gtk.ToggleButton(icon_name="camera-photo-symbolic")
-        self.camera_button.set_focusable(False)
-        self.camera_button.set_tooltip_text("Camera picture (Esc)")
-        self.camera_button.connect("clicked", self._camera_button_clicked)
         header.pack_end(self.camera_button)
         self.routes_panel = RoutesPanel(self.model, self.robot.ask)  # only when the server lists getRoutes
         header.pack_end(self.routes_panel)
@@ -315,7 +306,6 @@ class MainWindow(Gtk.ApplicationWindow):
         self.toolbar_revealer.set_child(self.toolbar)
         self.toolbar_revealer.set_reveal_child(True)
 
-        self.map_page = map_page = Gtk.Overlay()
         map_page.set_child(self.stage)
         map_page.add_overlay(self._osd())
         map_page.add_overlay(self.dpad)
@@ -347,8 +337,6 @@ class MainWindow(Gtk.ApplicationWindow):
         self.inset.place(corner_free=not self.dpad.get_visible())
         self.stage.connect("resize", lambda _s, width, _h: self.inset.fit_to(width))
 
-        self.stack = Gtk.Stack(transition_type=Gtk.StackTransitionType.NONE)
-        self.split = SplitView(map_page)  # the map page, and the live picture beside it while split
         self.stack.add_named(self.split, "map")
         self.stack.add_named(self.camera, "camera")
         self.stack.set_visible_child_name("map")
@@ -491,13 +479,12 @@ class MainWindow(Gtk.ApplicationWindow):
         self.fullscreen_action = toggle("fullscreen", False, self._set_fullscreen)
         self.dpad_action = toggle("dpad", self.dpad.get_visible(), self._set_dpad)
         self.inset_action = toggle("inset", True, self.inset.set_enabled)
-        self.split_action = toggle("split", False, self._set_split)
+        self.split_action = toggle("split", False, self.camera_page.set_split)
         self.fov_action = toggle("fov", True, self._set_fov)
         self.sonar_action = toggle("sonar", self.operator.view.value.show_sonar, self._set_sonar)
         self.safe_action = toggle("safe-drive", True, self._set_safe_drive)
         self.foxglove = BridgeToggle(self.session, self.show_notice)  # publishing only, never drives
-        for follow in (self.ptz.follow_selection, self.live.follow_selection, self.foxglove.follow_selection):
-            self.robot.on_switch(follow)
+        self.robot.on_switch(self.foxglove.follow_selection)
         self.robot.on_switch(self._details_follow)
         self.robot.on_switch(self._config_follow)
         self.foxglove_action = toggle("foxglove", False, self.foxglove.set)
@@ -512,19 +499,13 @@ class MainWindow(Gtk.ApplicationWindow):
     def commands_changed(self, states: Mapping[str, CommandState]) -> None:
         self._states.update(states)
         self.goals_panel.commands_changed(states)
+        self.camera_page.commands_changed(dict(states))
         for name, state in states.items():
             label = COMMANDS.get(name).label if name in COMMANDS else name
             self.dpad.set_command_state(name, state.enabled, state.reason, label)
             self._enable(action_name(name), state.enabled)
             if name == "request_image":
-                self.camera_button.set_sensitive(
-                    state.enabled or self.stack.get_visible_child_name() == "camera"
-                )
-                self.camera_button.set_tooltip_text(
-                    "Camera picture (Esc)" if state.enabled else f"Camera picture: {state.reason}"
-                )
-                self.camera.set_available(state.enabled, state.reason)
-                self._enable("camera", state.enabled or self.stack.get_visible_child_name() == "camera")
+                self._enable("camera", state.enabled or self.camera_page.showing)
             elif name == "safe_drive_on":
                 self._enable("safe-drive", state.enabled)
         shown = {c.name for c in COMMANDS if c.menu} | {name for _label, _action, name in WINDOW_ROBOT_MENU}
@@ -561,8 +542,7 @@ class MainWindow(Gtk.ApplicationWindow):
         session.attach_view(self.robot_view)
         if isinstance(self.model, SelectedModel):
             self.model.show(session.state)
-        self.camera.clear()
-        self.inset.show_texture(None)
+        self.camera_page.robot_shown()
         self.commands_changed(self.controller.command_states())
         self._update_header(self.model.connection.value)
 
@@ -610,10 +590,7 @@ class MainWindow(Gtk.ApplicationWindow):
         if name == "toggle_camera" and self.picker.active:
             self.picker.cancel()  # Esc leaves a pick mode first
         elif name == "toggle_camera":
-            if self.stack.get_visible_child_name() == "camera":
-                self.show_map()
-            else:
-                self.show_camera(request=True)
+            self.camera_page.toggle()
         elif name == "zoom_in":
             self.stage.zoom_in()
         elif name == "zoom_out":
@@ -623,11 +600,9 @@ class MainWindow(Gtk.ApplicationWindow):
         elif name == "follow":
             self.stage.set_follow(not self.stage.follow)
         elif name == "live_video":
-            camera = self.command_state("request_image")
-            if reason := self.live.toggle(camera.enabled, camera.reason):
-                self.banners.tell("camera", "warning", f"Live video: {reason}", timeout=4.0)
-        elif name.startswith("ptz_") and (reason := self.ptz.key(name)):
-            self.banners.tell("ptz", "warning", f"Camera head: {reason}", timeout=4.0)
+            self.camera_page.live_key()
+        elif name.startswith("ptz_"):
+            self.camera_page.ptz_key(name)
 
     def open_dialog(self, name: str) -> None:
         """The dialog a command asked for (the controller stopped the robot first)."""
@@ -710,51 +685,20 @@ class MainWindow(Gtk.ApplicationWindow):
         profile = self.controller.profile
         self.controller.connect(password=self._passwords.get(profile.name))
 
-    def show_camera(self, request: bool = False) -> None:
-        state = self.command_state("request_image")
-        if request and not state.enabled:
-            self.banners.tell("camera", "warning", f"Camera picture: {state.reason}", timeout=4.0)
-            self.camera_button.set_active(False)
-            return
-        self.controller.look("the camera page")  # a held drive ends; a navigation goes on
-        self.stack.set_visible_child_name("camera")
-        self.camera_button.set_active(True)
-        if request or self.camera.image is None:
-            self._request_picture()
-
-    def show_map(self) -> None:
-        self.stack.set_visible_child_name("map")
-        self.camera_button.set_active(False)
+    def _camera_page_changed(self) -> None:
         self.commands_changed({"request_image": self.command_state("request_image")})
 
-    def _camera_button_clicked(self, button: Gtk.ToggleButton) -> None:
-        showing = self.stack.get_visible_child_name() == "camera"
-        if button.get_active() != showing:
-            self.view_intent("toggle_camera")
+    def show_camera(self, request: bool = False) -> None:
+        self.camera_page.show_camera(request)
 
-    def _request_picture(self) -> None:
-        if self.controller.run("request_image"):
-            self.camera.requesting()
+    def show_map(self) -> None:
+        self.camera_page.show_map()
 
     # -- model reactions ---------------------------------------------------------------------
     def _on_connection(self, old: ConnectionState, new: ConnectionState) -> None:
-        phase = new.phase
         if not self.session.closed:  # a closed robot's late news (the fleet said why it went): no banner
             self.notices.connection_changed(old, new, self.model.navigation.value)
-        if phase is Phase.DISCONNECTED or (phase is Phase.CONNECTING and old.phase is not Phase.RECONNECTING):
-            self.camera.clear()
-            self.live.connection_lost()
-            self.split.show_picture(None, None)
-            if self.stack.get_visible_child_name() == "camera":
-                self.show_map()
-        # The inset is a glance at the robot's view: a picture from an earlier connection is not
-        # one. Greyed (with its age) while the link is lost, gone once a new connection is made.
-        if phase in (Phase.DISCONNECTED, Phase.CONNECTING) or (
-            phase is Phase.CONNECTED and old.phase is not Phase.CONNECTED
-        ):
-            self.inset.show_texture(None)
-        elif phase in (Phase.RECONNECTING, Phase.FAILED):
-            self.inset.set_live(False)
+        self.camera_page.connection_changed(old, new)
         # Held keys stay held in the key router (their auto-repeat is swallowed); the controller
         # has blocked them, so only a fresh press drives after the link comes back.
         self._update_header(new)
@@ -803,36 +747,9 @@ class MainWindow(Gtk.ApplicationWindow):
         if _flag(self.inset_action):
             self.inset_action.activate(None)
 
-    def _set_split(self, on: bool) -> None:
-        """Map and video side by side: the split starts live video (the pane would show nothing else)."""
-        self.split.set_split(on)
-        if on and not self.live.live and self.command_state("request_image").enabled:
-            self.live.set_live(True)
-
     def _set_fov(self, on: bool) -> None:
         self.stage.show_fov = on
         self.stage.queue_draw()
-
-    def _on_camera(self, _old: object, new: object) -> None:
-        if new is not None:
-            self.decoder.decode(new)  # type: ignore[arg-type]
-
-    def _picture_decoded(
-        self, image: object, textures: tuple[Gdk.Texture, Gdk.Texture] | None, error: str
-    ) -> None:
-        current = self.model.camera.value
-        frame = getattr(image, "frame", None)
-        if frame is not None:  # the next frame only once this one is painted
-            shows = (self.camera.picture, self.inset, self.split.pane)
-            seen = textures is not None and image is current and any(w.get_mapped() for w in shows)
-            self.live.when_painted(lambda: self.robot.ask(VideoShown(frame)), seen)
-        if current is None or image is not current:
-            return  # a newer picture (or a disconnect) overtook this one
-        self.camera.show_picture(image, None if textures is None else textures[0], error)
-        if textures is not None:
-            self.inset.show_texture(self.inset.texture_for(*textures), image.received_at)
-            self.live.shown(image)
-            self.split.show_picture(textures[0], image)
 
     def _view_changed(self) -> None:
         label = "Fit" if self.stage.fitted else ""
@@ -980,8 +897,7 @@ class MainWindow(Gtk.ApplicationWindow):
         self.motion.refresh()
         if self.ticks % REFRESH_EVERY == 0:
             self.toolbar.refresh()
-            self.camera.tick()
-            self.inset.tick()
+            self.camera_page.tick()
             self._check_loop_lag()
             if self.stage.robot_is_stale() and self.model.robot.value.numbers_at is not None:
                 self.stage.queue_draw()
@@ -1028,8 +944,7 @@ class MainWindow(Gtk.ApplicationWindow):
         self.toolbar.close()
         self.routes_panel.close()
         self.goals_panel.close()
-        self.ptz.close()
         self.layers.unobserve()
         self.motion.close()
-        self.decoder.close()
+        self.camera_page.close()
         self.foxglove.close()
