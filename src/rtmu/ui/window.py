@@ -32,7 +32,7 @@ import gi
 gi.require_version("Gtk", "4.0")
 gi.require_version("Pango", "1.0")
 gi.require_version("Gdk", "4.0")
-from gi.repository import Gdk, Gio, GLib, Gtk, Pango  # noqa: E402
+from gi.repository import Gio, GLib, Gtk, Pango  # noqa: E402
 
 from ..base.notices import Notice  # noqa: E402
 from ..client.custom_commands import ServerCommand  # noqa: E402
@@ -55,12 +55,8 @@ from ..model.observables import (  # noqa: E402
 )
 from ..settings.store import Profile  # noqa: E402
 from ..values.intents import (  # noqa: E402
-    AnswerPopup,
-    GotoGoal,
-    GotoPose,
     Intent,
     ListServerCommands,
-    Localize,
     MoveDistance,
     RunServerCommand,
     TurnBy,
@@ -72,25 +68,17 @@ from .bridge_toggle import BridgeToggle  # noqa: E402
 from .camera_page import CameraPage  # noqa: E402
 from .config_page import ConfigPage  # noqa: E402
 from .details import DetailsWindow  # noqa: E402
-from .dpad import DPad  # noqa: E402
 from .goals_panel import GoalsPanel  # noqa: E402
 from .handheld import Handheld  # noqa: E402
 from .key_reach import KeyReach  # noqa: E402
 from .keyboard_nav import KeyboardNav, menu_item  # noqa: E402
 from .keys import KeyRouter  # noqa: E402
-from .layers import LayersPanel  # noqa: E402
-from .mapview import MapStage  # noqa: E402
-from .motion import MotionIndicator  # noqa: E402
+from .map_page import MapPage  # noqa: E402
 from .move_dialogs import go_dialog, turn_dialog  # noqa: E402
-from .nav_draw import Marker, MarkerKind  # noqa: E402
+from .nav_draw import MarkerKind  # noqa: E402
 from .near_people import NearPeopleSwitch  # noqa: E402
-from .notes import map_note  # noqa: E402
 from .notice_router import NoticeRouter, speed_banner  # noqa: E402
 from .palette import CommandPalette  # noqa: E402
-from .pip import PictureInPicture  # noqa: E402
-from .popups import PopupStack  # noqa: E402
-from .pose_bar import PoseBar  # noqa: E402
-from .pose_pick import PosePicker  # noqa: E402
 from .routes_panel import RoutesPanel  # noqa: E402
 from .selected_model import SelectedModel  # noqa: E402
 from .settings_dialog import ConnectionDialog, PasswordPrompt  # noqa: E402
@@ -98,30 +86,12 @@ from .shortcuts import build_shortcuts_window  # noqa: E402
 from .split_view import SplitView  # noqa: E402
 from .stop_keys import StopKeys  # noqa: E402
 from .toolbar import StatusToolbar  # noqa: E402
-from .viewport import zoom_label  # noqa: E402
 
 REFRESH_EVERY = 3
 """Ticks between refreshes of ages (toolbar, picture): 0.3 s."""
 LOOP_LAG_WARN = 0.5
 """Seconds without a network-loop heartbeat after which the window warns that drive commands (and
 stops) are not going out; the warning goes once the lag is under half of this again."""
-
-
-def touch_only(display: Gdk.Display | None = None) -> bool:
-    """True when the only pointing device is a touchscreen (a tablet): then the D-pad shows by default."""
-    display = display or Gdk.Display.get_default()
-    seat = display.get_default_seat() if display is not None else None
-    if seat is None:
-        return False
-    caps = seat.get_capabilities()
-    if not caps & Gdk.SeatCapabilities.TOUCH:
-        return False
-    pointers = [
-        d
-        for d in seat.get_devices(Gdk.SeatCapabilities.POINTER)
-        if d.get_source() in (Gdk.InputSource.MOUSE, Gdk.InputSource.TOUCHPAD, Gdk.InputSource.TRACKPOINT)
-    ]
-    return not pointers
 
 
 WINDOW_ROBOT_MENU = (
@@ -213,11 +183,15 @@ class MainWindow(Gtk.ApplicationWindow):
             speed_percent=lambda: self.operator.speed.value.percent,
             picture=lambda: self.camera,
         )
-        self.stage = MapStage(model, operator, clock=clock, status_age=status_age)
-        self.stage.on_view_changed = self._view_changed
         self.toolbar = StatusToolbar(model, operator, clock=clock, status_age=status_age)
-        self.inset = PictureInPicture(self.show_camera, clock=clock, on_hide=lambda: self._hide_inset())
-        self.dpad = DPad(hold=self._hold_pointer, release=self._release, stop=self._stop_from_dpad)
+        self.map_page = MapPage(
+            model, operator, self.robot, clock=clock, status_age=status_age,
+            show_camera=self.show_camera, show_map=self.show_map, hide_inset=self._hide_inset,
+        )  # fmt: skip
+        page = self.map_page
+        self.stage, self.dpad, self.inset, self.motion = page.stage, page.dpad, page.inset, page.motion
+        self.picker, self.pose_bar, self.popup_stack = page.picker, page.pose_bar, page.popup_stack
+        self.layers, self.map_note, self.follow_button = page.layers, page.note, page.follow_button
         self.keys = KeyRouter(
             hold=self._hold, release=self._release, command=self._command, view=self.view_intent
         )
@@ -250,19 +224,16 @@ class MainWindow(Gtk.ApplicationWindow):
         self.commands_changed(self.controller.command_states())
         self._on_connection(ConnectionState(), model.connection.value)
         self._on_map(MapModel(), model.map.value)
-        self._view_changed()
         # Space stops from every surface (dialogs, menus, popovers); keys are never lost silently.
         self.stop_keys = StopKeys(self, self.stop_now, on_popover=self._popover_took_keys)
         self.key_reach = KeyReach(self)
         self.keyboard = KeyboardNav(self)  # Tab, F10, Ctrl+G, Alt+1…9, a pick mode's keys
         self.near_people = NearPeopleSwitch(self)  # View ▸ Near people: the speed cap
-        self.stage.limits = lambda: self.controller.limits  # the stopping distance drawn ahead
 
     # -- layout ------------------------------------------------------------------------------
     def _build(self) -> None:
-        self.map_page = map_page = Gtk.Overlay()
         self.stack = Gtk.Stack(transition_type=Gtk.StackTransitionType.NONE)
-        self.split = SplitView(map_page)  # the map page, and the live picture beside it while split
+        self.split = SplitView(self.map_page)  # the map page, and the live picture beside it while split
         self.camera_page = CameraPage(
             self.model, self.robot, self.banners, stack=self.stack, inset=self.inset, split=self.split,
             command_state=self.command_state, toggle=lambda: self.view_intent("toggle_camera"),
@@ -296,8 +267,9 @@ class MainWindow(Gtk.ApplicationWindow):
         header.pack_end(self.camera_button)
         self.routes_panel = RoutesPanel(self.model, self.robot.ask)  # only when the server lists getRoutes
         header.pack_end(self.routes_panel)
-        goto = self._goto_goal  # the panel shows only when the server navigates (goals, points, dock)
-        self.goals_panel = GoalsPanel(self.model, goto=goto, run=self._command, pick=self.start_pick)
+        # The Go to panel shows only when the server navigates (goals, points, dock).
+        goto, pick = self.map_page.goto_goal, self.map_page.start_pick
+        self.goals_panel = GoalsPanel(self.model, goto=goto, run=self._command, pick=pick)
         header.pack_end(self.goals_panel)
         self.set_titlebar(header)
 
@@ -305,37 +277,6 @@ class MainWindow(Gtk.ApplicationWindow):
         self.toolbar_revealer.set_transition_duration(120)
         self.toolbar_revealer.set_child(self.toolbar)
         self.toolbar_revealer.set_reveal_child(True)
-
-        map_page.set_child(self.stage)
-        map_page.add_overlay(self._osd())
-        map_page.add_overlay(self.dpad)
-        map_page.add_overlay(self.inset)
-        self.motion = MotionIndicator(self.model, held=self._drive_held)
-        map_page.add_overlay(self.motion)
-        self.picker = PosePicker(self.stage, changed=lambda: self.pose_bar.update())
-        self.pose_bar = PoseBar(self.picker, self._pose_confirmed)
-        map_page.add_overlay(self.pose_bar)
-        # Server popups: cards over the map above the zoom buttons, never focusable (STOP is in the header).
-        self.popup_stack = PopupStack(self.model.popups, self._answer_popup, clock=self.clock)
-        map_page.add_overlay(self.popup_stack)
-        self.layers = LayersPanel(
-            self.model.drawings, self.model.connection, self.robot.ask
-        )  # View → Layers…
-        map_page.add_overlay(self.layers)
-        self.map_note = Gtk.Label(halign=Gtk.Align.CENTER, valign=Gtk.Align.END, visible=False)
-        self.map_note.add_css_class("map-note")
-        self.map_note.set_margin_bottom(62)  # above the zoom buttons, which a narrow window puts under it
-        self.map_note.set_margin_start(12)
-        self.map_note.set_margin_end(12)
-        self.map_note.set_wrap(True)
-        self.map_note.set_max_width_chars(60)
-        self.map_note.set_justify(Gtk.Justification.CENTER)
-        self.map_note.set_use_markup(False)
-        self.map_note.set_can_target(False)
-        map_page.add_overlay(self.map_note)
-        self.dpad.set_visible(touch_only())
-        self.inset.place(corner_free=not self.dpad.get_visible())
-        self.stage.connect("resize", lambda _s, width, _h: self.inset.fit_to(width))
 
         self.stack.add_named(self.split, "map")
         self.stack.add_named(self.camera, "camera")
@@ -363,36 +304,6 @@ class MainWindow(Gtk.ApplicationWindow):
         self.column = box
         """The window's column (bars above, the map/camera body); a replay appends its controls."""
         self.set_child(box)
-
-    def _osd(self) -> Gtk.Widget:
-        """Zoom −/label/+, Fit and Follow: big enough for a thumb, over the map's bottom right."""
-        osd = Gtk.Box(spacing=2, halign=Gtk.Align.END, valign=Gtk.Align.END)
-        osd.add_css_class("map-osd")
-        osd.set_margin_end(10)
-        osd.set_margin_bottom(10)
-
-        def button(icon: str, tip: str, fn: Callable[[], None]) -> Gtk.Button:
-            b = Gtk.Button(icon_name=icon, tooltip_text=tip)
-            b.add_css_class("flat")
-            b.set_focusable(False)
-            b.connect("clicked", lambda _b: fn())
-            return b
-
-        osd.append(button("zoom-out-symbolic", "Zoom out (Ctrl+minus)", self.stage.zoom_out))
-        self.zoom_label = Gtk.Label(label="100 %")
-        self.zoom_label.add_css_class("zoom-label")
-        osd.append(self.zoom_label)
-        osd.append(button("zoom-in-symbolic", "Zoom in (Ctrl+plus)", self.stage.zoom_in))
-        osd.append(button("zoom-fit-best-symbolic", "Fit map (Ctrl+0)", self.stage.fit))
-        self.follow_button = Gtk.ToggleButton(
-            icon_name="find-location-symbolic", tooltip_text="Follow the robot (F)"
-        )
-        self.follow_button.add_css_class("flat")
-        self.follow_button.set_focusable(False)
-        self.follow_button.set_active(self.stage.follow)
-        self.follow_button.connect("toggled", self._follow_toggled)
-        osd.append(self.follow_button)
-        return osd
 
     def _menu(self) -> Gio.Menu:
         """The robot's commands, then one section for the rest (view switches in a submenu): two
@@ -477,10 +388,10 @@ class MainWindow(Gtk.ApplicationWindow):
         plain("layers", self.layers.open)
         self.toolbar_action = toggle("toolbar", True, self.toolbar_revealer.set_reveal_child)
         self.fullscreen_action = toggle("fullscreen", False, self._set_fullscreen)
-        self.dpad_action = toggle("dpad", self.dpad.get_visible(), self._set_dpad)
+        self.dpad_action = toggle("dpad", self.dpad.get_visible(), self.map_page.set_dpad)
         self.inset_action = toggle("inset", True, self.inset.set_enabled)
         self.split_action = toggle("split", False, self.camera_page.set_split)
-        self.fov_action = toggle("fov", True, self._set_fov)
+        self.fov_action = toggle("fov", True, self.map_page.set_fov)
         self.sonar_action = toggle("sonar", self.operator.view.value.show_sonar, self._set_sonar)
         self.safe_action = toggle("safe-drive", True, self._set_safe_drive)
         self.foxglove = BridgeToggle(self.session, self.show_notice)  # publishing only, never drives
@@ -500,9 +411,8 @@ class MainWindow(Gtk.ApplicationWindow):
         self._states.update(states)
         self.goals_panel.commands_changed(states)
         self.camera_page.commands_changed(dict(states))
+        self.map_page.commands_changed(states)
         for name, state in states.items():
-            label = COMMANDS.get(name).label if name in COMMANDS else name
-            self.dpad.set_command_state(name, state.enabled, state.reason, label)
             self._enable(action_name(name), state.enabled)
             if name == "request_image":
                 self._enable("camera", state.enabled or self.camera_page.showing)
@@ -534,8 +444,7 @@ class MainWindow(Gtk.ApplicationWindow):
         Keys held now stay held in the key router, so their auto-repeat is swallowed: the new
         robot moves only on a fresh press. A finger on the D-pad is let go of.
         """
-        self.dpad.release_all()
-        self.picker.cancel()
+        self.map_page.let_go()
         self.session, self.controller, self._link = session, session.controller, session.runner
         self.robot.show(session)  # every widget's intents now go to this robot; what they hold moves
         self.handheld.show_controller(self.controller)  # the pad follows the selection, never carries over
@@ -552,11 +461,6 @@ class MainWindow(Gtk.ApplicationWindow):
         if not self.keyboard.pick_key(name):  # a pick mode's arrows move its point instead
             self.controller.run(name)
 
-    def _hold_pointer(self, name: str) -> None:
-        """A D-pad hold: only while Space can stop it (the controller says why not)."""
-        if self.controller.pointer_may_drive():
-            self.controller.run(name)
-
     def _popover_took_keys(self) -> None:
         """A menu or popover holds the keyboard now: held keys can no longer be seen let go."""
         self.controller.look("the menu", keys_leave=True)
@@ -565,9 +469,6 @@ class MainWindow(Gtk.ApplicationWindow):
 
     def _release(self, name: str) -> None:
         self.controller.release_command(name)
-
-    def _stop_from_dpad(self) -> None:
-        self.controller.run("stop")
 
     def _beat(self) -> bool:
         """The GTK thread's heartbeat to the guardian; True keeps the timer."""
@@ -623,16 +524,7 @@ class MainWindow(Gtk.ApplicationWindow):
         their auto-repeat cannot start the robot again; a finger on the D-pad is let go of here.
         """
         self.controller.stop()
-        self.dpad.release_all()
-        self.picker.cancel()
-
-    def _drive_held(self) -> bool:
-        """A held drive is live (keys, D-pad or the pad's dead-man); False while the window is being built."""
-        controller = getattr(self, "controller", None)
-        return controller is not None and (bool(controller.held) or controller.analog_active)
-
-    def _answer_popup(self, popup_id: int, button: int) -> None:
-        self.robot.ask(AnswerPopup(popup_id, button))
+        self.map_page.let_go()
 
     def request(self, intent: Intent) -> concurrent.futures.Future[Any]:
         """:meth:`SelectedRobot.ask` for a widget that waits for the answer: a refusal (said already)
@@ -659,20 +551,9 @@ class MainWindow(Gtk.ApplicationWindow):
         self.banners.tell(topic, "info", text, timeout=4.0)
         return False  # an idle callback: once
 
-    def _goto_goal(self, goal: str) -> None:
-        self.robot.ask(GotoGoal(goal))
-
     def start_pick(self, kind: MarkerKind) -> None:
-        """Go to a point / set robot position: a map mode; the pose bar confirms (``pose_bar``)."""
-        self.show_map()
-        self.picker.start(kind)
-
-    def _pose_confirmed(self, marker: Marker) -> None:
-        if marker.kind is MarkerKind.GOTO:
-            self.robot.ask(GotoPose(marker.x, marker.y, marker.th))
-        else:
-            th = self.model.robot.value.th if marker.th is None else marker.th
-            self.robot.ask(Localize(marker.x, marker.y, th))
+        """Go to a point / set robot position (``map_page``)."""
+        self.map_page.start_pick(kind)
 
     def toggle_connection(self) -> None:
         phase = self.model.connection.value.phase
@@ -702,7 +583,7 @@ class MainWindow(Gtk.ApplicationWindow):
         # Held keys stay held in the key router (their auto-repeat is swallowed); the controller
         # has blocked them, so only a fresh press drives after the link comes back.
         self._update_header(new)
-        self._update_map_note()
+        self.map_page.update_note(new, self.model.map.value)
 
     def _update_header(self, conn: ConnectionState) -> None:
         phase = conn.phase
@@ -726,15 +607,8 @@ class MainWindow(Gtk.ApplicationWindow):
         self.fullscreen_bar.status_label.set_text(" · ".join(parts))
 
     def _on_map(self, _old: MapModel, _new: MapModel) -> None:
-        self._update_map_note()
+        self.map_page.update_note(self.model.connection.value, self.model.map.value)
         self._update_header(self.model.connection.value)
-
-    def _update_map_note(self) -> None:
-        """The note under the map, from the connection phase and the map (``notes.map_note``)."""
-        text = map_note(self.model.connection.value, self.model.map.value)
-        if self.map_note.get_text() != text:
-            self.map_note.set_text(text)
-        self.map_note.set_visible(bool(text))
 
     def _on_robot(self, old: RobotState, new: RobotState) -> None:
         if new.safe_drive is not None and new.safe_drive != old.safe_drive:
@@ -746,24 +620,6 @@ class MainWindow(Gtk.ApplicationWindow):
     def _hide_inset(self) -> None:
         if _flag(self.inset_action):
             self.inset_action.activate(None)
-
-    def _set_fov(self, on: bool) -> None:
-        self.stage.show_fov = on
-        self.stage.queue_draw()
-
-    def _view_changed(self) -> None:
-        label = "Fit" if self.stage.fitted else ""
-        self.zoom_label.set_text(
-            zoom_label(self.stage.viewport.zoom)
-            if not label
-            else f"{label} {zoom_label(self.stage.viewport.zoom)}"
-        )
-        if self.follow_button.get_active() != self.stage.follow:
-            self.follow_button.set_active(self.stage.follow)
-
-    def _follow_toggled(self, button: Gtk.ToggleButton) -> None:
-        if button.get_active() != self.stage.follow:
-            self.stage.set_follow(button.get_active())
 
     # -- toggles -------------------------------------------------------------------------------
     def _set_fullscreen(self, on: bool) -> None:
@@ -782,10 +638,6 @@ class MainWindow(Gtk.ApplicationWindow):
         self.fullscreen_bar.set_reveal_child(state)
         if _flag(self.fullscreen_action) != state:
             self.fullscreen_action.set_state(GLib.Variant.new_boolean(state))
-
-    def _set_dpad(self, on: bool) -> None:
-        self.dpad.set_visible(on)
-        self.inset.place(corner_free=not on)  # the D-pad takes the bottom-left corner
 
     def _set_sonar(self, on: bool) -> None:
         self.operator.view.update(show_sonar=on)
@@ -894,13 +746,12 @@ class MainWindow(Gtk.ApplicationWindow):
     def _tick(self) -> bool:
         self.ticks += 1
         self.controller.tick()
-        self.motion.refresh()
-        if self.ticks % REFRESH_EVERY == 0:
+        slow = self.ticks % REFRESH_EVERY == 0
+        self.map_page.refresh(slow)
+        if slow:
             self.toolbar.refresh()
             self.camera_page.tick()
             self._check_loop_lag()
-            if self.stage.robot_is_stale() and self.model.robot.value.numbers_at is not None:
-                self.stage.queue_draw()
         return True
 
     def _check_loop_lag(self) -> None:
@@ -940,11 +791,9 @@ class MainWindow(Gtk.ApplicationWindow):
         self.stop_keys.close()
         self.key_reach.close()
         self.near_people.close()
-        self.stage.close()
+        self.map_page.close()
         self.toolbar.close()
         self.routes_panel.close()
         self.goals_panel.close()
-        self.layers.unobserve()
-        self.motion.close()
         self.camera_page.close()
         self.foxglove.close()
