@@ -35,7 +35,6 @@ gi.require_version("Gdk", "4.0")
 from gi.repository import Gio, GLib, Gtk, Pango  # noqa: E402
 
 from ..base.notices import Notice  # noqa: E402
-from ..client.custom_commands import ServerCommand  # noqa: E402
 from ..client.errors import ClientError  # noqa: E402
 from ..control.commands import COMMANDS, CommandState, action_name  # noqa: E402
 from ..control.controller import TICK, SecretStore  # noqa: E402
@@ -56,17 +55,11 @@ from ..model.observables import (  # noqa: E402
 from ..settings.store import Profile  # noqa: E402
 from ..values.intents import (  # noqa: E402
     Intent,
-    ListServerCommands,
-    MoveDistance,
-    RunServerCommand,
-    TurnBy,
-    WatchStrings,
 )
 from .banners import BannerStack  # noqa: E402
 from .bars import FullscreenBar, connect_button, menu_button, show_connection, stop_button  # noqa: E402
 from .bridge_toggle import BridgeToggle  # noqa: E402
 from .camera_page import CameraPage  # noqa: E402
-from .config_page import ConfigPage  # noqa: E402
 from .details import DetailsWindow  # noqa: E402
 from .goals_panel import GoalsPanel  # noqa: E402
 from .handheld import Handheld  # noqa: E402
@@ -74,18 +67,16 @@ from .key_reach import KeyReach  # noqa: E402
 from .keyboard_nav import KeyboardNav, menu_item  # noqa: E402
 from .keys import KeyRouter  # noqa: E402
 from .map_page import MapPage  # noqa: E402
-from .move_dialogs import go_dialog, turn_dialog  # noqa: E402
 from .nav_draw import MarkerKind  # noqa: E402
 from .near_people import NearPeopleSwitch  # noqa: E402
 from .notice_router import NoticeRouter, speed_banner  # noqa: E402
-from .palette import CommandPalette  # noqa: E402
 from .routes_panel import RoutesPanel  # noqa: E402
 from .selected_model import SelectedModel  # noqa: E402
-from .settings_dialog import ConnectionDialog, PasswordPrompt  # noqa: E402
 from .shortcuts import build_shortcuts_window  # noqa: E402
 from .split_view import SplitView  # noqa: E402
 from .stop_keys import StopKeys  # noqa: E402
 from .toolbar import StatusToolbar  # noqa: E402
+from .window_dialogs import WindowDialogs  # noqa: E402
 
 REFRESH_EVERY = 3
 """Ticks between refreshes of ages (toolbar, picture): 0.3 s."""
@@ -162,14 +153,9 @@ class MainWindow(Gtk.ApplicationWindow):
         self.model = model = model or session.state  # a fleet's: the selected robot's (``selected_model``)
         self.operator = operator
         self.clock = clock
-        self.profiles = dict(profiles or {})
-        self.keyring_available = keyring_available
-        self._profile_saved = profile_saved
-        self._passwords: dict[str, str] = {}
         self.ticks = 0
         """Counts timer ticks: proof for tests that the main loop is alive."""
         self._states: dict[str, CommandState] = {}
-        self._dialog: Gtk.Window | None = None
 
         link = session.runner
         self._link = link
@@ -198,6 +184,13 @@ class MainWindow(Gtk.ApplicationWindow):
         self.add_controller(self.keys.controller)
 
         self._build()
+        self.foxglove = BridgeToggle(session, self.show_notice)  # View ▸ Foxglove bridge: publishing only
+        self.robot.on_switch(self.foxglove.follow_selection)
+        self.dialogs = WindowDialogs(
+            self, self.robot, model, self.banners, request=self.request, profiles=profiles,
+            keyring_available=keyring_available, profile_saved=profile_saved,
+            profile_changed=lambda: self._update_header(self.model.connection.value),
+        )  # fmt: skip
         self.controller = session.controller
         if secrets is not None:
             self.controller.secrets = secrets
@@ -380,11 +373,11 @@ class MainWindow(Gtk.ApplicationWindow):
         for cmd in COMMANDS:
             if not cmd.hold:
                 plain(action_name(cmd.name), functools.partial(self._command, cmd.name))
-        plain("settings", self.open_settings)
+        plain("settings", self.dialogs.open_settings)
         plain("camera", lambda: self.view_intent("toggle_camera"))
-        plain("about", self.show_about)
-        plain("details", self.show_details)
-        plain("server-config", self.show_server_config)
+        plain("about", self.dialogs.show_about)
+        plain("details", self.dialogs.show_details)
+        plain("server-config", self.dialogs.show_server_config)
         plain("layers", self.layers.open)
         self.toolbar_action = toggle("toolbar", True, self.toolbar_revealer.set_reveal_child)
         self.fullscreen_action = toggle("fullscreen", False, self._set_fullscreen)
@@ -394,10 +387,6 @@ class MainWindow(Gtk.ApplicationWindow):
         self.fov_action = toggle("fov", True, self.map_page.set_fov)
         self.sonar_action = toggle("sonar", self.operator.view.value.show_sonar, self._set_sonar)
         self.safe_action = toggle("safe-drive", True, self._set_safe_drive)
-        self.foxglove = BridgeToggle(self.session, self.show_notice)  # publishing only, never drives
-        self.robot.on_switch(self.foxglove.follow_selection)
-        self.robot.on_switch(self._details_follow)
-        self.robot.on_switch(self._config_follow)
         self.foxglove_action = toggle("foxglove", False, self.foxglove.set)
         self.foxglove.failed = functools.partial(_unset, self.foxglove_action)  # a busy port: unchecked again
         self.connect("notify::fullscreened", self._fullscreen_changed)
@@ -423,12 +412,7 @@ class MainWindow(Gtk.ApplicationWindow):
             self._fill_robot_menu()
 
     def ask_password(self, profile: Profile, answer: Callable[[str | None], None]) -> None:
-        remembered = self._passwords.get(profile.name)
-        if remembered is not None:
-            answer(remembered)
-            return
-        prompt = PasswordPrompt(self, profile, answer)
-        prompt.present()
+        self.dialogs.ask_password(profile, answer)
 
     def command_state(self, name: str) -> CommandState:
         return self._states.get(name, CommandState(False, "unknown command"))
@@ -507,15 +491,7 @@ class MainWindow(Gtk.ApplicationWindow):
 
     def open_dialog(self, name: str) -> None:
         """The dialog a command asked for (the controller stopped the robot first)."""
-        makers = {
-            "turn": lambda: turn_dialog(self, lambda degrees: self.robot.ask(TurnBy(degrees))),
-            "go": lambda: go_dialog(self, lambda mm: self.robot.ask(MoveDistance(mm))),
-            "commands": lambda: CommandPalette(
-                self, lambda: self.request(ListServerCommands()), self._run_server_command
-            ),
-        }
-        dialog = makers[name]()
-        dialog.present()
+        self.dialogs.open_dialog(name)
 
     def stop_now(self) -> None:
         """The on-screen STOP: the same as Space, and sent whatever the link looks like.
@@ -536,21 +512,6 @@ class MainWindow(Gtk.ApplicationWindow):
         refused.set_exception(ClientError(f"{intent.label}: refused"))
         return refused
 
-    def _run_server_command(self, command: ServerCommand, argument: str | None) -> None:
-        """From the palette: sent on the network thread; the outcome comes back as a banner."""
-
-        def done(future: concurrent.futures.Future[bool]) -> None:
-            if future.cancelled() or future.exception() is not None:
-                return  # the runner already raised a Kind.COMMAND notice with the reason
-            said = "taken by the server" if future.result() else "sent; the server did not answer"
-            GLib.idle_add(self._tell_once, "server-command", f"{command.name}: {said}")
-
-        self.request(RunServerCommand(command.name, argument, command.takes_argument)).add_done_callback(done)
-
-    def _tell_once(self, topic: str, text: str) -> bool:
-        self.banners.tell(topic, "info", text, timeout=4.0)
-        return False  # an idle callback: once
-
     def start_pick(self, kind: MarkerKind) -> None:
         """Go to a point / set robot position (``map_page``)."""
         self.map_page.start_pick(kind)
@@ -564,7 +525,7 @@ class MainWindow(Gtk.ApplicationWindow):
 
     def connect_now(self) -> None:
         profile = self.controller.profile
-        self.controller.connect(password=self._passwords.get(profile.name))
+        self.controller.connect(password=self.dialogs.password_for(profile))
 
     def _camera_page_changed(self) -> None:
         self.commands_changed({"request_image": self.command_state("request_image")})
@@ -650,79 +611,13 @@ class MainWindow(Gtk.ApplicationWindow):
         self.operator.speed.set(SpeedSetting(pct))
 
     # -- dialogs -------------------------------------------------------------------------------
-    def open_settings(self) -> None:
-        profiles = dict(self.profiles)
-        current = self.controller.profile
-        profiles.setdefault(current.name, current)
-        dialog = ConnectionDialog(
-            self, profiles, current, on_save=self._settings_saved, keyring_available=self.keyring_available
-        )
-        self._dialog = dialog
-        dialog.present()
-
-    def _settings_saved(self, profile: Profile, password: str | None) -> None:
-        self.profiles[profile.name] = profile
-        if password is not None:
-            self._passwords[profile.name] = password
-        if self._profile_saved is not None:
-            self._profile_saved(profile, password)
-        changed = profile != self.controller.profile
-        self.controller.select_profile(profile)
-        self._update_header(self.model.connection.value)
-        if changed and self.model.connection.value.phase is not Phase.DISCONNECTED:
-            self.banners.tell(
-                "notice:saved", "info", f"Saved “{profile.name}”: reconnect to use it", timeout=4.0
-            )
-
-    def show_server_config(self) -> None:
-        """The server's configuration page (its own window, so typing there never drives): one at a time."""
-        page = getattr(self, "config_page", None)
-        if page is None or page.closed:
-            self.config_page = ConfigPage(self, self.request, self._follow_config_updates)
-        self.config_page.present()
-
-    def _follow_config_updates(self, listener: Callable[[], None] | None) -> None:
-        """The configuration page hears another client's changes on the robot shown (and only there)."""
-        self._config_listener = listener
-        self._link.on_config_updated = listener
-
-    def _config_follow(self, old: RobotSession, new: RobotSession) -> None:
-        listener = getattr(self, "_config_listener", None)
-        if listener is None:
-            return
-        old.runner.on_config_updated = None
-        new.runner.on_config_updated = listener
-        listener()  # the page reads the newly selected robot's configuration
-
-    def _details_follow(self, old: RobotSession, new: RobotSession) -> None:
-        details = getattr(self, "details", None)
-        if details is not None and details.get_visible():
-            old.controller.ask(WatchStrings(False))
-            new.controller.ask(WatchStrings(True))
-
     def show_details(self) -> None:
-        """The details window (DataStore strings, docking, say): one at a time."""
-        details = getattr(self, "details", None)
-        if details is None or not details.get_visible():
-            self.details = DetailsWindow(
-                self, self.model, self.robot.ask, lambda on: self.robot.ask(WatchStrings(on))
-            )
-        self.details.present()
+        self.dialogs.show_details()
 
-    def show_about(self) -> None:
-        from .. import __version__
-
-        about = Gtk.AboutDialog(
-            transient_for=self,
-            modal=True,
-            program_name="RTMU",
-            version=__version__,
-            comments="Robot Teleoperation, Mobile User interface: drive an ARIA (ArNetworking) robot "
-            "from a tablet or a laptop.",
-            logo_icon_name="io.github.rtmu.Rtmu",
-            license_type=Gtk.License.MIT_X11,
-        )
-        about.present()
+    @property
+    def details(self) -> DetailsWindow | None:
+        """The robot details window last opened (``window_dialogs``)."""
+        return self.dialogs.details
 
     # -- focus, timers, closing ----------------------------------------------------------------
     def _on_active(self, *_a: object) -> None:
