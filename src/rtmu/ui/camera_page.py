@@ -39,7 +39,7 @@ BUTTON_TIP = "Camera picture (Esc)"
 
 class CameraPage:
     """See the module notes. ``page_changed`` tells the window the page shown changed (its actions
-    follow); ``toggle`` is the window's camera ⇄ map (the header button's click)."""
+    follow). The header's camera button activates the window's ``win.camera`` (as Esc does)."""
 
     def __init__(
         self,
@@ -52,12 +52,11 @@ class CameraPage:
         split: SplitView,
         command_state: Callable[[str], CommandState],
         page_changed: Callable[[], None],
-        toggle: Callable[[], None],
         clock: Callable[[], float],
     ) -> None:
         self.model, self.robot, self.banners = model, robot, banners
         self.stack, self.inset, self.split = stack, inset, split
-        self._command_state, self._page_changed, self._toggle = command_state, page_changed, toggle
+        self._command_state, self._page_changed = command_state, page_changed
         self.view = CameraView(on_request=self.request_picture, on_back=self.show_map, clock=clock)
         self.ptz = PtzControls(model, robot.ask, on_moved=self.request_picture)
         self.ptz.attach_drag(self.view.picture)
@@ -111,7 +110,7 @@ class CameraPage:
 
     def _button_clicked(self, button: Gtk.ToggleButton) -> None:
         if button.get_active() != self.showing:
-            self._toggle()
+            button.activate_action("win.camera", None)
 
     def request_picture(self) -> None:
         if self.robot.session.controller.run("request_image"):

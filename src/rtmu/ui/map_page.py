@@ -7,7 +7,9 @@ the server's popup cards, the layers panel and the note under the map (not conne
 Other parts add their own overlays to it (the gamepad's pill). A pick mode (Go to point, Set
 position) is started here and confirmed by its bar; the intents go to the selected robot. The
 D-pad drives only while Space can stop it (``Controller.pointer_may_drive``); it lets go of a
-finger on STOP, on a switch of robot and when the window loses the keys.
+finger on STOP, on a switch of robot and when the window loses the keys. The zoom, fit and follow
+buttons activate the window's actions (``win.zoom-in`` …, ``win.follow``), as their keys do;
+``on_follow`` keeps the follow action's check in step with the map (a drag turns following off).
 """
 
 from __future__ import annotations
@@ -72,6 +74,8 @@ class MapPage(Gtk.Overlay):
     ) -> None:
         super().__init__()
         self.model, self.robot, self._show_map = model, robot, show_map
+        self.on_follow: Callable[[bool], None] = lambda _on: None
+        """Told whether the map follows the robot after every change of view (the window's action)."""
         self.stage = MapStage(model, operator, clock=clock, status_age=status_age)
         self.stage.on_view_changed = self._view_changed
         self.stage.limits = lambda: robot.session.controller.limits  # the stopping distance drawn ahead
@@ -104,26 +108,22 @@ class MapPage(Gtk.Overlay):
         osd.set_margin_end(10)
         osd.set_margin_bottom(10)
 
-        def button(icon: str, tip: str, fn: Callable[[], None]) -> Gtk.Button:
-            b = Gtk.Button(icon_name=icon, tooltip_text=tip)
+        def button(icon: str, tip: str, action: str, toggle: bool = False) -> Gtk.Button:
+            b = (Gtk.ToggleButton if toggle else Gtk.Button)(icon_name=icon, tooltip_text=tip)
             b.add_css_class("flat")
             b.set_focusable(False)
-            b.connect("clicked", lambda _b: fn())
+            b.set_action_name(action)  # the window's action, as the key's
             return b
 
-        osd.append(button("zoom-out-symbolic", "Zoom out (Ctrl+minus)", self.stage.zoom_out))
+        osd.append(button("zoom-out-symbolic", "Zoom out (Ctrl+minus)", "win.zoom-out"))
         self.zoom_label = Gtk.Label(label="100 %")
         self.zoom_label.add_css_class("zoom-label")
         osd.append(self.zoom_label)
-        osd.append(button("zoom-in-symbolic", "Zoom in (Ctrl+plus)", self.stage.zoom_in))
-        osd.append(button("zoom-fit-best-symbolic", "Fit map (Ctrl+0)", self.stage.fit))
-        self.follow_button = Gtk.ToggleButton(
-            icon_name="find-location-symbolic", tooltip_text="Follow the robot (F)"
+        osd.append(button("zoom-in-symbolic", "Zoom in (Ctrl+plus)", "win.zoom-in"))
+        osd.append(button("zoom-fit-best-symbolic", "Fit map (Ctrl+0)", "win.zoom-fit"))
+        self.follow_button = button(
+            "find-location-symbolic", "Follow the robot (F)", "win.follow", toggle=True
         )
-        self.follow_button.add_css_class("flat")
-        self.follow_button.set_focusable(False)
-        self.follow_button.set_active(self.stage.follow)
-        self.follow_button.connect("toggled", self._follow_toggled)
         osd.append(self.follow_button)
         return osd
 
@@ -146,14 +146,10 @@ class MapPage(Gtk.Overlay):
         label = "Fit" if self.stage.fitted else ""
         zoom = zoom_label(self.stage.viewport.zoom)
         self.zoom_label.set_text(f"{label} {zoom}" if label else zoom)
-        if self.follow_button.get_active() != self.stage.follow:
-            self.follow_button.set_active(self.stage.follow)
-
-    def _follow_toggled(self, button: Gtk.ToggleButton) -> None:
-        if button.get_active() != self.stage.follow:
-            self.stage.set_follow(button.get_active())
+        self.on_follow(self.stage.follow)  # the follow action's check (a drag turns following off)
 
     def toggle_follow(self) -> None:
+        """F and the follow button (``win.follow``)."""
         self.stage.set_follow(not self.stage.follow)
 
     def update_note(self, connection: ConnectionState, map_model: MapModel) -> None:

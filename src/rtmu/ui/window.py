@@ -22,7 +22,6 @@ deliberate disconnect shows nothing.
 from __future__ import annotations
 
 import concurrent.futures
-import functools
 import time
 from collections.abc import Callable, Mapping
 from typing import Any
@@ -32,11 +31,11 @@ import gi
 gi.require_version("Gtk", "4.0")
 gi.require_version("Pango", "1.0")
 gi.require_version("Gdk", "4.0")
-from gi.repository import Gio, GLib, Gtk, Pango  # noqa: E402
+from gi.repository import GLib, Gtk, Pango  # noqa: E402
 
 from ..base.notices import Notice  # noqa: E402
 from ..client.errors import ClientError  # noqa: E402
-from ..control.commands import COMMANDS, CommandState, action_name  # noqa: E402
+from ..control.commands import CommandState  # noqa: E402
 from ..control.controller import TICK, SecretStore  # noqa: E402
 from ..fleet.selected import SelectedRobot  # noqa: E402
 from ..fleet.sessions import RobotSession  # noqa: E402
@@ -49,13 +48,13 @@ from ..model.observables import (  # noqa: E402
     OperatorState,
     Phase,
     RobotModel,
-    RobotState,
     SpeedSetting,
 )
 from ..settings.store import Profile  # noqa: E402
 from ..values.intents import (  # noqa: E402
     Intent,
 )
+from .actions import WindowActions  # noqa: E402
 from .banners import BannerStack  # noqa: E402
 from .bars import FullscreenBar, connect_button, menu_button, show_connection, stop_button  # noqa: E402
 from .bridge_toggle import BridgeToggle  # noqa: E402
@@ -64,7 +63,7 @@ from .details import DetailsWindow  # noqa: E402
 from .goals_panel import GoalsPanel  # noqa: E402
 from .handheld import Handheld  # noqa: E402
 from .key_reach import KeyReach  # noqa: E402
-from .keyboard_nav import KeyboardNav, menu_item  # noqa: E402
+from .keyboard_nav import KeyboardNav  # noqa: E402
 from .keys import KeyRouter  # noqa: E402
 from .map_page import MapPage  # noqa: E402
 from .nav_draw import MarkerKind  # noqa: E402
@@ -83,31 +82,6 @@ REFRESH_EVERY = 3
 LOOP_LAG_WARN = 0.5
 """Seconds without a network-loop heartbeat after which the window warns that drive commands (and
 stops) are not going out; the warning goes once the lag is under half of this again."""
-
-
-WINDOW_ROBOT_MENU = (
-    ("Camera picture", "win.camera", "request_image"),
-    ("Safe drive", "win.safe-drive", "safe_drive_on"),
-)
-"""The robot menu's window entries after the registry's menu commands: label, action, and the command
-whose state enables it (the camera page and the safe-drive switch are the window's, not commands)."""
-
-
-def short_reason(reason: str) -> str:
-    """A reason short enough for a menu row ("this server does not offer X" → "not offered by the server")."""
-    if reason.startswith(("this server does not offer", "this server offers no")):
-        return "not offered by the server"
-    return reason or "unavailable"
-
-
-def _unset(action: Gio.SimpleAction) -> None:
-    action.set_state(GLib.Variant.new_boolean(False))
-
-
-def _flag(action: Gio.SimpleAction) -> bool:
-    """A boolean action's state (False before it has one)."""
-    state = action.get_state()
-    return state is not None and state.get_boolean()
 
 
 class _View:
@@ -155,7 +129,6 @@ class MainWindow(Gtk.ApplicationWindow):
         self.clock = clock
         self.ticks = 0
         """Counts timer ticks: proof for tests that the main loop is alive."""
-        self._states: dict[str, CommandState] = {}
 
         link = session.runner
         self._link = link
@@ -170,17 +143,19 @@ class MainWindow(Gtk.ApplicationWindow):
             picture=lambda: self.camera,
         )
         self.toolbar = StatusToolbar(model, operator, clock=clock, status_age=status_age)
+        self.actions = WindowActions(self)  # the menu now, the actions once the parts they run exist
+        self.menu_model = self.actions.menu_model
+        self.robot_menu, self.view_menu = self.actions.robot_menu, self.actions.view_menu
+        self.app_menu = self.actions.app_menu
         self.map_page = MapPage(
             model, operator, self.robot, clock=clock, status_age=status_age,
-            show_camera=self.show_camera, show_map=self.show_map, hide_inset=self._hide_inset,
+            show_camera=self.show_camera, show_map=self.show_map, hide_inset=self.actions.hide_inset,
         )  # fmt: skip
         page = self.map_page
         self.stage, self.dpad, self.inset, self.motion = page.stage, page.dpad, page.inset, page.motion
         self.picker, self.pose_bar, self.popup_stack = page.picker, page.pose_bar, page.popup_stack
         self.layers, self.map_note, self.follow_button = page.layers, page.note, page.follow_button
-        self.keys = KeyRouter(
-            hold=self._hold, release=self._release, command=self._command, view=self.view_intent
-        )
+        self.keys = KeyRouter(hold=self._hold, release=self._release, activate=self.actions.activate)
         self.add_controller(self.keys.controller)
 
         self._build()
@@ -198,14 +173,14 @@ class MainWindow(Gtk.ApplicationWindow):
         session.attach_view(self.robot_view)
         self.controller.select_profile(profile)
         self._set_speed_from_profile(profile)
-        self._install_actions()
+        self.actions.install()
+        self.inset_action = self.actions.inset_action
         self.set_help_overlay(build_shortcuts_window())
 
         self._unobserve = [
             model.connection.observe(self._on_connection),
             operator.speed.observe(self._on_speed),
             model.map.observe(self._on_map),
-            model.robot.observe(self._on_robot),
         ]
         self.connect("notify::is-active", self._on_active)
         self.connect("close-request", self._on_close_request)
@@ -229,9 +204,7 @@ class MainWindow(Gtk.ApplicationWindow):
         self.split = SplitView(self.map_page)  # the map page, and the live picture beside it while split
         self.camera_page = CameraPage(
             self.model, self.robot, self.banners, stack=self.stack, inset=self.inset, split=self.split,
-            command_state=self.command_state, toggle=lambda: self.view_intent("toggle_camera"),
-            page_changed=self._camera_page_changed,
-            clock=self.clock,
+            command_state=self.command_state, page_changed=self._camera_page_changed, clock=self.clock,
         )  # fmt: skip
         page = self.camera_page
         self.camera, self.ptz, self.live = page.view, page.ptz, page.live
@@ -254,7 +227,6 @@ class MainWindow(Gtk.ApplicationWindow):
         title_box.append(self.title_label)
         title_box.append(self.subtitle_label)
         header.set_title_widget(title_box)
-        self.menu_model = self._menu()
         self.menu_button = menu_button(self.menu_model)
         header.pack_end(self.menu_button)
         header.pack_end(self.camera_button)
@@ -262,7 +234,7 @@ class MainWindow(Gtk.ApplicationWindow):
         header.pack_end(self.routes_panel)
         # The Go to panel shows only when the server navigates (goals, points, dock).
         goto, pick = self.map_page.goto_goal, self.map_page.start_pick
-        self.goals_panel = GoalsPanel(self.model, goto=goto, run=self._command, pick=pick)
+        self.goals_panel = GoalsPanel(self.model, goto=goto, run=self.actions.run_command, pick=pick)
         header.pack_end(self.goals_panel)
         self.set_titlebar(header)
 
@@ -298,129 +270,23 @@ class MainWindow(Gtk.ApplicationWindow):
         """The window's column (bars above, the map/camera body); a replay appends its controls."""
         self.set_child(box)
 
-    def _menu(self) -> Gio.Menu:
-        """The robot's commands, then one section for the rest (view switches in a submenu): two
-        sections and one separator, so it still fits an 800×480 screen as the robot's rows grow."""
-        menu = Gio.Menu()
-        self.robot_menu = Gio.Menu()
-        self._fill_robot_menu()
-        menu.append_section(None, self.robot_menu)
-        self.view_menu = view = Gio.Menu()
-        view.append("Status toolbar", "win.toolbar")
-        view.append("Full screen", "win.fullscreen")
-        view.append("Touch D-pad", "win.dpad")
-        view.append("Alarm sound", "win.alarm-sound")
-        view.append("Camera inset on the map", "win.inset")
-        view.append("Split view: map and video", "win.split")
-        view.append("Camera field of view", "win.fov")
-        view.append("Sonar readings", "win.sonar")
-        view.append("Layers…", "win.layers")
-        view.append("Robot details…", "win.details")
-        view.append("Foxglove bridge (ws://127.0.0.1:8765)", "win.foxglove")
-        self.app_menu = app = Gio.Menu()
-        server = Gio.Menu()  # the connection and the server's own settings: one row, so the menu still fits
-        server.append("Connection settings…", "win.settings")
-        server.append("Configuration…", "win.server-config")
-        app.append_submenu("Server", server)
-        app.append_submenu("View", view)
-        app.append("Keyboard shortcuts", "win.show-help-overlay")
-        app.append("About RTMU", "win.about")
-        app.append("Quit", "app.quit")
-        menu.append_section(None, app)
-        return menu
-
-    def _fill_robot_menu(self) -> None:
-        """The robot's commands; a greyed one says why (GTK menus have no tooltips): "… — not connected"."""
-        entries = [(c.label, f"win.{action_name(c.name)}", c.name) for c in COMMANDS if c.menu]
-        items = []
-        for label, action, command in (*entries, *WINDOW_ROBOT_MENU):
-            found = self.lookup_action(action.removeprefix("win."))
-            state = self._states.get(command)
-            if found is not None and not found.get_enabled() and state is not None:
-                label = f"{label} — {short_reason(state.reason)}"
-            items.append((label, action))
-        shown = []
-        for i in range(self.robot_menu.get_n_items()):
-            value = self.robot_menu.get_item_attribute_value(i, "label", None)
-            shown.append(value.get_string() if value is not None else "")
-        if shown == [label for label, _ in items]:
-            return
-        self.robot_menu.remove_all()
-        for label, action in items:
-            self.robot_menu.append_item(menu_item(label, action))
-
-    def _install_actions(self) -> None:
-        def plain(name: str, fn: Callable[[], None]) -> Gio.SimpleAction:
-            action = Gio.SimpleAction.new(name, None)
-            action.connect("activate", lambda _a, _p: fn())
-            self.add_action(action)
-            return action
-
-        def toggle(name: str, initial: bool, fn: Callable[[bool], None]) -> Gio.SimpleAction:
-            action = Gio.SimpleAction.new_stateful(name, None, GLib.Variant.new_boolean(initial))
-
-            def flip(a: Gio.SimpleAction, _p: object) -> None:
-                new = not _flag(a)
-                a.set_state(GLib.Variant.new_boolean(new))
-                fn(new)
-
-            action.connect("activate", flip)
-            self.add_action(action)
-            return action
-
-        # One action per command of the registry (held drive keys excepted: they have no "activate").
-        # Disconnect also cancels an attempt in progress: its command is enabled while connecting.
-        for cmd in COMMANDS:
-            if not cmd.hold:
-                plain(action_name(cmd.name), functools.partial(self._command, cmd.name))
-        plain("settings", self.dialogs.open_settings)
-        plain("camera", lambda: self.view_intent("toggle_camera"))
-        plain("about", self.dialogs.show_about)
-        plain("details", self.dialogs.show_details)
-        plain("server-config", self.dialogs.show_server_config)
-        plain("layers", self.layers.open)
-        self.toolbar_action = toggle("toolbar", True, self.toolbar_revealer.set_reveal_child)
-        self.fullscreen_action = toggle("fullscreen", False, self._set_fullscreen)
-        self.dpad_action = toggle("dpad", self.dpad.get_visible(), self.map_page.set_dpad)
-        self.inset_action = toggle("inset", True, self.inset.set_enabled)
-        self.split_action = toggle("split", False, self.camera_page.set_split)
-        self.fov_action = toggle("fov", True, self.map_page.set_fov)
-        self.sonar_action = toggle("sonar", self.operator.view.value.show_sonar, self._set_sonar)
-        self.safe_action = toggle("safe-drive", True, self._set_safe_drive)
-        self.foxglove_action = toggle("foxglove", False, self.foxglove.set)
-        self.foxglove.failed = functools.partial(_unset, self.foxglove_action)  # a busy port: unchecked again
-        self.connect("notify::fullscreened", self._fullscreen_changed)
-
     # -- the controller's View -----------------------------------------------------------------
     def show_notice(self, notice: Notice) -> None:
         """Show a controller/network message where its kind belongs (``notice_router``)."""
         self.notices.show(notice)
 
     def commands_changed(self, states: Mapping[str, CommandState]) -> None:
-        self._states.update(states)
+        """Command states → the parts that show them, then the actions (and the menu's greyed rows)."""
         self.goals_panel.commands_changed(states)
         self.camera_page.commands_changed(dict(states))
         self.map_page.commands_changed(states)
-        for name, state in states.items():
-            self._enable(action_name(name), state.enabled)
-            if name == "request_image":
-                self._enable("camera", state.enabled or self.camera_page.showing)
-            elif name == "safe_drive_on":
-                self._enable("safe-drive", state.enabled)
-        shown = {c.name for c in COMMANDS if c.menu} | {name for _label, _action, name in WINDOW_ROBOT_MENU}
-        if shown & set(states):
-            self._fill_robot_menu()
+        self.actions.commands_changed(states)
 
     def ask_password(self, profile: Profile, answer: Callable[[str | None], None]) -> None:
         self.dialogs.ask_password(profile, answer)
 
     def command_state(self, name: str) -> CommandState:
-        return self._states.get(name, CommandState(False, "unknown command"))
-
-    def _enable(self, action: str, enabled: bool) -> None:
-        a = self.lookup_action(action)
-        if isinstance(a, Gio.SimpleAction):
-            a.set_enabled(enabled)
+        return self.actions.command_state(name)
 
     def show_session(self, session: RobotSession) -> None:
         """Show another robot of the fleet (which has already stopped the one shown before).
@@ -458,36 +324,6 @@ class MainWindow(Gtk.ApplicationWindow):
         """The GTK thread's heartbeat to the guardian; True keeps the timer."""
         self._link.ui_heartbeat()
         return True
-
-    def _command(self, name: str) -> None:
-        """A command from a key, the menu or a button: refused with its reason while shown disabled."""
-        state = self._states.get(name)
-        if state is not None and not state.enabled:
-            label = COMMANDS.get(name).label.rstrip("…") if name in COMMANDS else name
-            self.banners.tell(f"notice:{name}", "warning", f"{label}: {state.reason}", timeout=4.0)
-            return
-        self.controller.run(name)
-
-    def view_intent(self, name: str) -> None:
-        """Window-level intents from keys, menu and buttons."""
-        if self.keyboard.view_intent(name):
-            return
-        if name == "toggle_camera" and self.picker.active:
-            self.picker.cancel()  # Esc leaves a pick mode first
-        elif name == "toggle_camera":
-            self.camera_page.toggle()
-        elif name == "zoom_in":
-            self.stage.zoom_in()
-        elif name == "zoom_out":
-            self.stage.zoom_out()
-        elif name == "zoom_fit":
-            self.stage.fit()
-        elif name == "follow":
-            self.stage.set_follow(not self.stage.follow)
-        elif name == "live_video":
-            self.camera_page.live_key()
-        elif name.startswith("ptz_"):
-            self.camera_page.ptz_key(name)
 
     def open_dialog(self, name: str) -> None:
         """The dialog a command asked for (the controller stopped the robot first)."""
@@ -551,7 +387,7 @@ class MainWindow(Gtk.ApplicationWindow):
         connected_ish = phase in (Phase.CONNECTED, Phase.CONNECTING, Phase.RECONNECTING)
         for button in (self.connect_button, self.fullscreen_bar.connect_button):
             show_connection(button, connected_ish)
-        self._enable("connect", not connected_ish)
+        self.actions.enable("connect", not connected_ish)
         profile = self.controller.profile
         where = f"{conn.host}:{conn.port}" if conn.host else f"{profile.host}:{profile.port}"
         state = {
@@ -571,40 +407,13 @@ class MainWindow(Gtk.ApplicationWindow):
         self.map_page.update_note(self.model.connection.value, self.model.map.value)
         self._update_header(self.model.connection.value)
 
-    def _on_robot(self, old: RobotState, new: RobotState) -> None:
-        if new.safe_drive is not None and new.safe_drive != old.safe_drive:
-            self.safe_action.set_state(GLib.Variant.new_boolean(new.safe_drive))
-
     def _on_speed(self, _old: SpeedSetting, new: SpeedSetting) -> None:
         self.notices.apply(speed_banner(new.percent))
 
-    def _hide_inset(self) -> None:
-        if _flag(self.inset_action):
-            self.inset_action.activate(None)
-
     # -- toggles -------------------------------------------------------------------------------
-    def _set_fullscreen(self, on: bool) -> None:
-        if on:
-            self.fullscreen()
-        else:
-            self.unfullscreen()
-
     def leave_fullscreen(self) -> None:
-        """The bar's way out (as F11): the request is recorded in the action's state at once."""
-        self.fullscreen_action.set_state(GLib.Variant.new_boolean(False))
-        self.unfullscreen()
-
-    def _fullscreen_changed(self, *_a: object) -> None:
-        state = self.is_fullscreen()
-        self.fullscreen_bar.set_reveal_child(state)
-        if _flag(self.fullscreen_action) != state:
-            self.fullscreen_action.set_state(GLib.Variant.new_boolean(state))
-
-    def _set_sonar(self, on: bool) -> None:
-        self.operator.view.update(show_sonar=on)
-
-    def _set_safe_drive(self, on: bool) -> None:
-        self.controller.run("safe_drive_on" if on else "safe_drive_off")
+        """The full-screen bar's way out (as F11)."""
+        self.actions.leave_fullscreen()
 
     def _set_speed_from_profile(self, profile: Profile) -> None:
         pct = max(SPEED_MIN, min(SPEED_MAX, profile.speed // 10 * 10))
@@ -692,3 +501,4 @@ class MainWindow(Gtk.ApplicationWindow):
         self.goals_panel.close()
         self.camera_page.close()
         self.foxglove.close()
+        self.actions.close()
