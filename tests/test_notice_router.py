@@ -1,4 +1,6 @@
-"""Where the window shows a notice: by its kind, never by its words (``ui.notice_router``, no display)."""
+"""Where and how the window says things (``ui.notice_router``, ``ui.notes``), without a display.
+
+A notice goes where its kind says, never by its words; the connection's life is one link banner."""
 
 from __future__ import annotations
 
@@ -7,8 +9,19 @@ from dataclasses import dataclass, field
 import pytest
 
 from rtmu.base.notices import Kind, Notice
-from rtmu.model.observables import ConnectionState, NavState, Phase
-from rtmu.ui.notice_router import Banner, Dismiss, NoticeRouter, Route, link_banner, route, speed_banner
+from rtmu.model.observables import ConnectionState, NavState, Phase, SpeedSetting
+from rtmu.settings.store import Profile
+from rtmu.ui.notes import status_line
+from rtmu.ui.notice_router import (
+    Banner,
+    Dismiss,
+    NoticeRouter,
+    Route,
+    link_banner,
+    loop_lag_banner,
+    route,
+    speed_banner,
+)
 
 CONNECTED = ConnectionState(Phase.CONNECTED, host="127.0.0.1", port=7272)
 RECONNECTING = ConnectionState(Phase.RECONNECTING, host="127.0.0.1", port=7272, attempt=2)
@@ -92,6 +105,10 @@ class Told:
     def dismiss(self, topic: str) -> None:
         self.gone.append(topic)
 
+    def topics(self) -> list[str]:
+        topics = [topic for topic, *_ in self.shown]
+        return [t for t in dict.fromkeys(topics) if t not in self.gone]
+
 
 @dataclass
 class Picture:
@@ -114,3 +131,33 @@ def test_the_router_fails_a_waiting_picture_only_for_a_camera_notice() -> None:
     assert told.shown[-1] == ("camera", "error", "the camera is off", 5.0, None)
     router.connection_changed(CONNECTED, ConnectionState(), NavState())
     assert told.gone == ["link"]
+    router.loop_lag(1.5, connected=True)
+    assert told.shown[-1][0] == "loop"
+    router.loop_lag(0.1, connected=True)
+    assert told.gone == ["link", "loop"]
+
+
+def test_a_stalled_network_thread_is_said_until_it_runs_again() -> None:
+    assert loop_lag_banner(0.1, connected=True, shown=False) is None
+    stalled = loop_lag_banner(0.8, connected=True, shown=False)
+    assert isinstance(stalled, Banner) and stalled.topic == "loop" and stalled.timeout is None
+    assert "0.8 s" in stalled.text and "stops are not going out" in stalled.text
+    assert loop_lag_banner(0.4, connected=True, shown=True) is None, "kept until well under the limit"
+    assert loop_lag_banner(0.2, connected=True, shown=True) == Dismiss("loop")
+    assert loop_lag_banner(None, connected=False, shown=True) == Dismiss("loop")
+    assert loop_lag_banner(9.0, connected=False, shown=False) is None, "no link: nothing to warn about"
+
+
+def test_the_header_status_line() -> None:
+    profile = Profile("lab", host="10.0.0.5", port=7272)
+    off = ConnectionState()
+    assert status_line(off, profile, "") == "lab · 10.0.0.5:7272 · not connected"
+    on = ConnectionState(Phase.CONNECTED, host="10.0.0.5", port=7272)
+    assert status_line(on, profile, "C:\\maps\\office.map") == "lab · 10.0.0.5:7272 · connected · office.map"
+    named = Profile("lab 10.0.0.5:7272", host="10.0.0.5", port=7272)
+    lost = ConnectionState(Phase.RECONNECTING, host="10.0.0.5", port=7272, error="timed out")
+    assert status_line(lost, named, "office.map") == "lab 10.0.0.5:7272 · reconnecting (timed out)"
+
+
+def test_a_profiles_speed_is_the_step_at_or_below_within_range() -> None:
+    assert [SpeedSetting.nearest(p).percent for p in (0, 10, 55, 100, 140)] == [10, 10, 50, 100, 100]

@@ -242,6 +242,11 @@ class SpeedSetting:
         if not SPEED_MIN <= self.percent <= SPEED_MAX or self.percent % SPEED_STEP:
             raise ValueError(f"speed must be {SPEED_MIN}…{SPEED_MAX} in steps of {SPEED_STEP}")
 
+    @classmethod
+    def nearest(cls, percent: int) -> SpeedSetting:
+        """The step at or below ``percent``, within 10…100 (a profile's saved speed)."""
+        return cls(max(SPEED_MIN, min(SPEED_MAX, percent // SPEED_STEP * SPEED_STEP)))
+
     def faster(self) -> SpeedSetting:
         return SpeedSetting(min(SPEED_MAX, self.percent + SPEED_STEP))
 

@@ -6,7 +6,7 @@ connection notices fold into the ``link`` banner that the model drives, speed on
 banner, navigation outcomes into one ``navigation`` banner updated in place; anything else gets a
 banner of its own, keyed by its text. The connection's life (connecting, connected, lost →
 reconnecting (n), failed) is drawn from the model into that one ``link`` banner; a deliberate
-disconnect shows nothing.
+disconnect shows nothing. The speed step and a stalled network thread have a banner each.
 
 The rules are plain functions returning :class:`Banner` values, so they are tested without a
 display; :class:`NoticeRouter` applies them to the window's banners.
@@ -99,6 +99,25 @@ def link_banner(old: ConnectionState, new: ConnectionState, navigation: NavState
     return None
 
 
+LOOP_LAG_WARN = 0.5
+"""Seconds without a network-loop heartbeat after which the window warns that drive commands (and
+stops) are not going out; the warning goes once the lag is under half of this again."""
+
+
+def loop_lag_banner(lag: float | None, connected: bool, shown: bool) -> Banner | Dismiss | None:
+    """The ``loop`` banner while the network thread is stalled: then even a stop cannot leave the
+    process (``lag``: seconds since its last heartbeat; ``shown``: the banner is up now)."""
+    if connected and lag is not None and lag > LOOP_LAG_WARN:
+        text = (
+            f"The network thread has not run for {lag:.1f} s: drive commands and stops are not going "
+            "out; the robot may keep moving until the server's watchdog stops it"
+        )
+        return Banner("loop", "error", text, None)
+    if shown and (not connected or lag is None or lag < LOOP_LAG_WARN / 2):
+        return Dismiss("loop")
+    return None
+
+
 def speed_banner(percent: int) -> Banner:
     """The speed step the operator just chose, with its bar."""
     return Banner("speed", "info", f"Speed {percent} %", 2.5, percent / SPEED_MAX)
@@ -112,6 +131,8 @@ class Banners(Protocol):
     ) -> None: ...
 
     def dismiss(self, topic: str) -> None: ...
+
+    def topics(self) -> list[str]: ...
 
 
 class PictureRequest(Protocol):
@@ -147,6 +168,10 @@ class NoticeRouter:
 
     def connection_changed(self, old: ConnectionState, new: ConnectionState, navigation: NavState) -> None:
         self.apply(link_banner(old, new, navigation))
+
+    def loop_lag(self, lag: float | None, connected: bool) -> None:
+        """The network thread's lag now (None: unknown): the ``loop`` banner while it is stalled."""
+        self.apply(loop_lag_banner(lag, connected, "loop" in self.banners.topics()))
 
     def apply(self, banner: Banner | Dismiss | None) -> None:
         if isinstance(banner, Dismiss):
