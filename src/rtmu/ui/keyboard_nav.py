@@ -105,7 +105,7 @@ class KeyboardNav:
         w = self.window
         make_focusable(w, skip=(w.dpad, w.popup_stack))
 
-    # -- intents -------------------------------------------------------------------------------
+    # -- what the window's actions run ---------------------------------------------------------
     def open_menu(self) -> None:
         """The menu of the bar on screen (the full-screen bar's while full screen)."""
         w = self.window
