@@ -5,6 +5,7 @@ from __future__ import annotations
 import math
 
 from rtmu.package_data import project_map
+from rtmu.protocol.payloads.drawings import DrawingListPacket
 from rtmu.protocol.payloads.drive import RatioDrive
 from rtmu.protocol.payloads.ld import (
     DataStoreValue,
@@ -15,7 +16,7 @@ from rtmu.protocol.payloads.ld import (
     Routes,
     Say,
 )
-from rtmu.protocol.payloads.sensors import DrawingListPacket, RangeDeviceReadings
+from rtmu.protocol.payloads.sensors import RangeDeviceReadings
 from rtmu.sim import SimConfig, SimServer
 from rtmu.sim.ld_data import ROUTES, ld_state
 

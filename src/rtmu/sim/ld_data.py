@@ -22,6 +22,7 @@ from typing import TYPE_CHECKING
 import numpy as np
 
 from rtmu.protocol.errors import FieldUnderrun, PayloadError
+from rtmu.protocol.payloads.drawings import Drawing, DrawingList, DrawingListPacket
 from rtmu.protocol.payloads.ld import (
     DataStoreValue,
     DockInfo,
@@ -30,7 +31,7 @@ from rtmu.protocol.payloads.ld import (
     Routes,
     Say,
 )
-from rtmu.protocol.payloads.sensors import Drawing, DrawingList, DrawingListPacket, RangeDeviceReadings
+from rtmu.protocol.payloads.sensors import RangeDeviceReadings
 
 from .catalogue import Row
 from .handlers import Call, Handler, Reply

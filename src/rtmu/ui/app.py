@@ -2,19 +2,21 @@
 
 GTK is imported only when the window really opens (``application`` module), so
 ``rtmu --help`` and the headless subcommands never initialise a display. With
-``--demo`` the bundled simulator runs on a free loopback port beside the window
-for as long as it lives.
+``--demo`` the bundled simulator runs beside the window for as long as it lives (``ui.demo``).
 """
 
 from __future__ import annotations
 
 import argparse
 import sys
-from dataclasses import replace
+from typing import TYPE_CHECKING
 
 from ..base.exit_codes import EXIT_CONNECTION, EXIT_INTERNAL, EXIT_NO_DISPLAY, EXIT_USAGE
 from ..settings.store import DEFAULT_PORT, parse_central
 from .options import GuiOptions
+
+if TYPE_CHECKING:
+    from .demo import RunningDemo
 
 
 def add_gui_arguments(parser: argparse.ArgumentParser) -> None:
@@ -71,14 +73,6 @@ def options_from_args(args: argparse.Namespace) -> GuiOptions:
     )
 
 
-def demo_fleet_options(options: GuiOptions, endpoints: list[tuple[str, int]]) -> GuiOptions:
-    """The window on every simulated robot of ``--demo --robots N``."""
-    from ..settings.store import DirectRobot
-
-    robots = tuple(DirectRobot(name, "127.0.0.1", port) for name, port in endpoints)
-    return replace(options, fleet=robots, host=None, port=None, user=None, persist=False, connect=True)
-
-
 def run_gui(args: argparse.Namespace) -> int:
     """Open the window; with ``--demo`` run the simulator beside it for as long as the window lives."""
     options = options_from_args(args)
@@ -108,19 +102,15 @@ def run_gui(args: argparse.Namespace) -> int:
             file=sys.stderr,
         )
         return EXIT_NO_DISPLAY
-    sim = None
+    sim: RunningDemo | None = None
     if options.demo:
+        from .demo import start_demo
+
         try:
-            sim = start_demo_simulator(robots)
+            options, sim = start_demo(options, robots)
         except Exception as exc:  # the window is useless without it: say why and stop
             print(f"rtmu: the demo simulator did not start: {exc}", file=sys.stderr)
             return EXIT_CONNECTION
-        if robots == 1:
-            options = replace(
-                options, host="127.0.0.1", port=sim.port, user=None, persist=False, connect=True
-            )
-        else:
-            options = demo_fleet_options(options, sim.endpoints())
     try:
         from .application import RtmuApplication
 
@@ -141,15 +131,3 @@ def display_available() -> bool:
     from gi.repository import Gdk, Gtk
 
     return bool(Gtk.init_check()) and Gdk.Display.get_default() is not None
-
-
-def start_demo_simulator(robots: int = 1):
-    from ..package_data import project_map
-    from ..sim import SimConfig, SimThread
-
-    config = SimConfig(host="127.0.0.1", port=0, map_path=project_map("office.map"), camera=True)
-    if robots == 1:
-        return SimThread(config).start()
-    from ..sim.multi import SimFleetThreads, fleet_configs
-
-    return SimFleetThreads(fleet_configs(config, robots)).start()

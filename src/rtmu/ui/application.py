@@ -42,7 +42,7 @@ from ..settings.store import (  # noqa: E402
     save_settings,
 )
 from .fleet_bind import FleetBinding  # noqa: E402
-from .keys import accels_for  # noqa: E402
+from .keys import accelerated  # noqa: E402
 from .options import APP_ID, GuiOptions  # noqa: E402
 from .replay_bar import ReplayBar  # noqa: E402
 from .replay_mode import open_replay, replay_profile, show_replay  # noqa: E402
@@ -118,9 +118,8 @@ class RtmuApplication(Gtk.Application):
         quit_action = Gio.SimpleAction.new("quit", None)
         quit_action.connect("activate", lambda _a, _p: self.quit_safely())
         self.add_action(quit_action)
-        for target in ("app.quit", "win.fullscreen", "win.toolbar", "win.connect", "win.disconnect",
-                       "win.settings", "win.show-help-overlay"):  # fmt: skip
-            self.set_accels_for_action(target, accels_for(target))
+        for binding in accelerated():  # F11, Ctrl+T, Ctrl+comma, Ctrl+?, Ctrl+Q: from the one key table
+            self.set_accels_for_action(binding.action, list(binding.accels))
         # Ctrl+C, kill, a closed terminal (SIGHUP), Ctrl+\ (SIGQUIT), SIGUSR1/2 and SIGALRM all end the
         # window the same way: stop the robot first, then quit. Left to their default, they would kill
         # the process with the robot still driving until the server's watchdog noticed.

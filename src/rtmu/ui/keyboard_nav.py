@@ -26,8 +26,8 @@ gi.require_version("Gtk", "4.0")
 gi.require_version("Gdk", "4.0")
 from gi.repository import Gdk, Gio, GLib, Gtk  # noqa: E402
 
-from ..control.commands import COMMANDS  # noqa: E402
 from ..fleet.sessions import Fleet  # noqa: E402
+from .keys import menu_item  # noqa: E402
 from .nav_draw import Marker, MarkerKind  # noqa: E402
 from .stop_keys import descendants  # noqa: E402
 
@@ -40,27 +40,8 @@ NUDGE_PX = 20.0
 NUDGE_MIN_MM = 100.0
 TURN_DEG = 15.0
 ROBOT_KEYS = 9
-INTENTS = frozenset(
-    {
-        "open_menu",
-        "goto_panel",
-        "next_robot",
-        "previous_robot",
-        *(f"robot_{n}" for n in range(1, ROBOT_KEYS + 1)),
-    }
-)
-"""The view intents (``keys.WINDOW_BINDINGS``) this module answers."""
 NUDGES = {"drive_forward": (0, 1), "drive_backward": (0, -1), "drive_left": (-1, 0), "drive_right": (1, 0)}
 """Drive key → screen direction (x right, y up) of a pick mode's nudge."""
-
-
-def menu_item(label: str, action: str) -> Gio.MenuItem:
-    """A menu row that shows its key (a registry command's first key: T, G, Ctrl+K …)."""
-    item = Gio.MenuItem.new(label, action)
-    name = action.removeprefix("win.").replace("-", "_")
-    if name in COMMANDS and COMMANDS.get(name).keys:
-        item.set_attribute_value("accel", GLib.Variant.new_string(COMMANDS.get(name).keys[0]))
-    return item
 
 
 def make_focusable(root: Gtk.Widget, *, skip: Iterable[Gtk.Widget] = ()) -> int:
@@ -78,7 +59,9 @@ def make_focusable(root: Gtk.Widget, *, skip: Iterable[Gtk.Widget] = ()) -> int:
 
 
 class KeyboardNav:
-    """See the module notes; the window calls :meth:`intent` for the names in :data:`INTENTS`."""
+    """See the module notes; the window's actions (``ui.actions``: ``open-menu``, ``goto-panel``,
+    ``select-robot``, ``next-robot``, ``previous-robot``) run :meth:`open_menu`, :meth:`open_goto`,
+    :meth:`select` and :meth:`step`; the window's keys ask :meth:`pick_key` first in a pick mode."""
 
     def __init__(self, window: MainWindow) -> None:
         self.window = window
@@ -100,13 +83,6 @@ class KeyboardNav:
         tab.set_propagation_phase(Gtk.PropagationPhase.CAPTURE)
         tab.connect("key-pressed", self._first_tab)
         window.add_controller(tab)
-        select = Gio.SimpleAction.new("select-robot", GLib.VariantType.new("i"))
-        select.connect("activate", lambda _a, p: self.select(p.get_int32()))
-        window.add_action(select)
-        for name, step in (("next-robot", 1), ("previous-robot", -1)):
-            action = Gio.SimpleAction.new(name, None)
-            action.connect("activate", lambda _a, _p, s=step: self.step(s))
-            window.add_action(action)
 
     def _first_tab(
         self, _c: Gtk.EventControllerKey, keyval: int, _code: int, state: Gdk.ModifierType
@@ -129,26 +105,7 @@ class KeyboardNav:
         w = self.window
         make_focusable(w, skip=(w.dpad, w.popup_stack))
 
-    # -- intents -------------------------------------------------------------------------------
-    def view_intent(self, name: str) -> bool:
-        """A window intent this module answers (its own, or a pick mode's heading keys); True if used."""
-        if name in INTENTS:
-            self.intent(name)
-            return True
-        return name in ("ptz_left", "ptz_right") and self.pick_key(name)
-
-    def intent(self, name: str) -> None:
-        if name == "open_menu":
-            self.open_menu()
-        elif name == "goto_panel":
-            self.open_goto()
-        elif name == "next_robot":
-            self.step(1)
-        elif name == "previous_robot":
-            self.step(-1)
-        elif name.startswith("robot_"):
-            self.select(int(name.removeprefix("robot_")))
-
+    # -- what the window's actions run ---------------------------------------------------------
     def open_menu(self) -> None:
         """The menu of the bar on screen (the full-screen bar's while full screen)."""
         w = self.window
@@ -195,17 +152,9 @@ class KeyboardNav:
         sessions = fleet.sessions.value if fleet is not None else ()
         self.robots_menu.remove_all()
         for number, session in enumerate(sessions[:ROBOT_KEYS], start=1):
-            item = Gio.MenuItem.new(session.name, None)
-            item.set_action_and_target_value("win.select-robot", GLib.Variant.new_int32(number))
-            item.set_attribute_value("accel", GLib.Variant.new_string(f"<Alt>{number}"))
-            self.robots_menu.append_item(item)
-        for label, action, accel in (
-            ("Next robot", "win.next-robot", "<Alt>Page_Down"),
-            ("Previous robot", "win.previous-robot", "<Alt>Page_Up"),
-        ):
-            item = Gio.MenuItem.new(label, action)
-            item.set_attribute_value("accel", GLib.Variant.new_string(accel))
-            self.robots_menu.append_item(item)
+            self.robots_menu.append_item(menu_item(session.name, f"win.select-robot({number})"))
+        self.robots_menu.append_item(menu_item("Next robot", "win.next-robot"))
+        self.robots_menu.append_item(menu_item("Previous robot", "win.previous-robot"))
         many = len(sessions) > 1
         if many != self._robots_shown:
             self._robots_shown = many
