@@ -14,11 +14,13 @@ import shutil
 import subprocess
 import sys
 import xml.etree.ElementTree as ET
+from html import unescape
 from pathlib import Path
 
 import pytest
 
 from gui.doc_screenshots import DOC_SHOTS
+from rtmu.base.exit_codes import table_text
 from rtmu.package_data import APP_ID, DESKTOP_DIR
 
 ROOT = Path(__file__).resolve().parents[1]
@@ -47,6 +49,9 @@ def test_the_docs_build_without_a_warning(tmp_path: Path) -> None:
     assert "WARNING" not in done.stderr, done.stderr
     html = (tmp_path / "html" / "cli.html").read_text()
     assert "rtmu sim" in html and "--install-desktop" in html  # the reference read from the parser
+    shown = unescape(html)
+    for line in table_text(indent="").splitlines():  # the one table, as rtmu --help prints it
+        assert line.strip() in shown, f"docs/cli.md lacks the exit-code line {line.strip()!r}"
 
 
 def test_a_broken_link_fails_the_build(tmp_path: Path) -> None:

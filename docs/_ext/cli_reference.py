@@ -1,4 +1,5 @@
-"""``.. rtmu-cli-reference::`` — every ``rtmu`` command's ``--help``, read from the parser the command uses.
+"""``.. rtmu-cli-reference::`` — every ``rtmu`` command's ``--help``, read from the parser the command uses;
+``.. rtmu-exit-codes::`` — the one table of exit codes (``rtmu.base.exit_codes.table_text``).
 
 The reference cannot drift from the program: it is ``rtmu.cli.build_parser()`` formatted by argparse,
 exactly what ``rtmu --help`` and ``rtmu SUBCOMMAND --help`` print (at 100 columns).
@@ -34,6 +35,16 @@ class CliReference(SphinxDirective):
         return out
 
 
+class ExitCodes(SphinxDirective):
+    """``.. rtmu-exit-codes::`` — the one table of exit codes, as ``rtmu --help`` prints it."""
+
+    def run(self) -> list[nodes.Node]:
+        from rtmu.base.exit_codes import table_text
+
+        return [nodes.literal_block(text=table_text(indent=""))]
+
+
 def setup(app: Sphinx) -> dict[str, object]:
     app.add_directive("rtmu-cli-reference", CliReference)
+    app.add_directive("rtmu-exit-codes", ExitCodes)
     return {"parallel_read_safe": True, "parallel_write_safe": True}
