@@ -24,18 +24,16 @@ from pathlib import Path
 
 from bench.common import Result
 from rtmu.client.runner import ClientRunner
-from rtmu.client.session import SessionConfig
 from rtmu.package_data import project_map
 from rtmu.protocol.decoder import PacketDecoder
 from rtmu.recorder import Recorder, RecorderConfig
-from rtmu.recorder.replay import PacedLink, Replayer
+from rtmu.recorder.replay import REPLAY_CONFIG, PacedLink, Replayer
 from rtmu.recorder.replay_file import load
 from rtmu.sim import SimConfig, SimThread
 from rtmu.values.intents import RequestPicture
 
 ARENA = project_map("arena.map")
 SECONDS = float(os.environ.get("RTMU_REPLAY_BENCH_SECONDS", "30"))
-REPLAY_CONFIG = SessionConfig(ping_interval=3600.0, lost_after=3600.0, connect_timeout=3600.0)
 
 
 def record(out: Path) -> None:

@@ -1,6 +1,7 @@
 """Sphinx configuration of RTMU's documentation: ``./rtmu-dev docs`` builds it, the suite builds it with
 warnings as errors (tests/test_docs.py). Pages are Markdown (MyST); the CLI reference is read from the
-command's own argparse parser (``_ext/cli_reference.py``)."""
+command's own argparse parser (``_ext/cli_reference.py``), the exit codes from ``rtmu.base.exit_codes``
+(``_ext/exit_code_table.py``)."""
 
 from __future__ import annotations
 
@@ -17,7 +18,7 @@ author = "The RTMU developers"
 copyright = "2026, The RTMU developers"
 version = release = __version__
 
-extensions = ["myst_parser", "cli_reference"]
+extensions = ["myst_parser", "cli_reference", "exit_code_table"]
 source_suffix = {".md": "markdown", ".rst": "restructuredtext"}
 root_doc = "index"
 exclude_patterns = ["_build", "_ext"]

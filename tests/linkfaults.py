@@ -24,6 +24,7 @@ import socket
 import struct
 import threading
 import time
+from collections.abc import Callable
 from typing import Literal
 
 Direction = Literal["to_client", "to_server"]
@@ -59,6 +60,9 @@ class _Pipe:
             t.start()
 
     def put(self, data: bytes) -> None:
+        tap = self.proxy.tap
+        if tap is not None:  # before it is queued: a fault the tap sets applies to what follows
+            tap(self.direction, data)
         with self.cond:
             self.queue.append((time.monotonic() + self.proxy.delays[self.direction], data))
             self.queued += len(data)
@@ -131,6 +135,9 @@ class _Link:
             try:
                 if rst:
                     sock.setsockopt(socket.SOL_SOCKET, socket.SO_LINGER, struct.pack("ii", 1, 0))
+                    # Wake the reader thread blocked in recv() (shutting reads sends nothing): until that
+                    # call returns it holds the socket, and the close below would not reset anything.
+                    sock.shutdown(socket.SHUT_RD)
                 else:
                     sock.shutdown(socket.SHUT_RDWR)
             except OSError:
@@ -155,6 +162,10 @@ class FaultProxy:
         """``time.monotonic()`` when the last fault took effect (None: none yet)."""
         self.connections = 0
         """Connections accepted so far (a reconnect shows up here)."""
+        self.server_ports: list[int] = []
+        """Our local port of each connection to the target: the client's address as the server sees it."""
+        self.tap: Callable[[Direction, bytes], None] | None = None
+        """``tap(direction, data)`` for every chunk read, before it is forwarded (its reader's thread)."""
         self._links: list[_Link] = []
         self._lock = threading.Lock()
         self._listener = socket.socket(socket.AF_INET, socket.SOCK_STREAM)
@@ -204,6 +215,7 @@ class FaultProxy:
                 self._links = [link for link in self._links if not all(p.done for p in link.pipes.values())]
                 # Counted before the link starts forwarding: a client whose echo came back must see it.
                 self.connections += 1
+                self.server_ports.append(int(server.getsockname()[1]))
                 self._links.append(_Link(self, client, server))
 
     def _applied(self) -> float:

@@ -8,12 +8,14 @@ picture the docs, the README and the AppStream metainfo show must be one of them
 
 from __future__ import annotations
 
+import argparse
 import ast
 import re
 import shutil
 import subprocess
 import sys
 import xml.etree.ElementTree as ET
+from html import unescape
 from pathlib import Path
 
 import pytest
@@ -37,6 +39,20 @@ def sphinx(source: Path, out: Path) -> subprocess.CompletedProcess[str]:
     )
 
 
+def subcommands(parser: argparse.ArgumentParser) -> dict[str, argparse.ArgumentParser]:
+    for action in parser._actions:
+        if isinstance(action, argparse._SubParsersAction):
+            return dict(action.choices)
+    return {}
+
+
+def plain_text(html: str) -> str:
+    """What a reader sees of some HTML: no tags, entities and typographic quotes undone, spaces as one."""
+    inline = re.sub(r"</?(?:span|code|em|strong|a)\b[^>]*>", "", html)
+    text = unescape(re.sub(r"<[^>]+>", " ", inline)).translate(str.maketrans("‘’“”", "''\"\""))
+    return " ".join(text.split()) + " "
+
+
 def pages() -> list[Path]:
     return [ROOT / "README.md", *sorted(p for p in DOCS.rglob("*.md") if "_build" not in p.parts)]
 
@@ -47,6 +63,16 @@ def test_the_docs_build_without_a_warning(tmp_path: Path) -> None:
     assert "WARNING" not in done.stderr, done.stderr
     html = (tmp_path / "html" / "cli.html").read_text()
     assert "rtmu sim" in html and "--install-desktop" in html  # the reference read from the parser
+    from rtmu.base.exit_codes import EXIT_CODES
+    from rtmu.cli import build_parser
+
+    for name, sub in subcommands(build_parser()).items():  # every subcommand, and files' and scan's actions
+        assert f'id="cli-{name}"' in html, f"the CLI reference has no rtmu {name}"
+        for action in subcommands(sub):
+            assert f'id="cli-{name}-{action}"' in html, f"the CLI reference has no rtmu {name} {action}"
+    table = plain_text(html[html.index('id="exit-codes"') : html.index('id="reference"')])
+    for code, meaning in EXIT_CODES.items():  # the one table, generated from rtmu.base.exit_codes
+        assert f" {code} {meaning} " in table, f"the exit-code table does not say {code} {meaning}"
 
 
 def test_a_broken_link_fails_the_build(tmp_path: Path) -> None:
@@ -94,3 +120,53 @@ def test_relative_links_lead_to_files() -> None:
             if "://" in target or target.startswith("mailto:"):
                 continue
             assert (page.parent / target).exists(), f"{page.relative_to(ROOT)}: broken link {target}"
+
+
+FENCE = re.compile(r"^```[^\n]*\n(.*?)^```", re.MULTILINE | re.DOTALL)
+SPAN = re.compile(r"`([^`\n]+)`")
+OPTION = re.compile(r"(?<![\w-])(--?[a-zA-Z][\w-]*)")
+
+
+def shown_command_lines(text: str) -> list[str]:
+    """Every ``rtmu …`` the page shows: lines of its code blocks (comments cut) and inline code."""
+    lines = [line.split(" # ")[0] for block in FENCE.findall(text) for line in block.splitlines()]
+    lines += SPAN.findall(FENCE.sub("", text))
+    out = []
+    for line in lines:
+        for part in line.split(" | "):
+            words = part.strip().split()
+            if words and words[0] == "rtmu":
+                out.append(part.strip())
+    return out
+
+
+def options_of(parser: argparse.ArgumentParser) -> set[str]:
+    """The visible options of ``parser`` and of its own sub-actions (``files ls``, ``scan stop`` …)."""
+    found: set[str] = set()
+    for action in parser._actions:
+        if isinstance(action, argparse._SubParsersAction):
+            for nested in action.choices.values():
+                found |= options_of(nested)
+        elif action.help is not argparse.SUPPRESS:
+            found |= set(action.option_strings)
+    return found
+
+
+def test_no_page_shows_a_command_or_option_rtmu_help_does_not_have() -> None:
+    from rtmu.cli import build_parser
+
+    parser = build_parser()
+    commands = subcommands(parser)
+    wrong = []
+    for page in pages():
+        for line in shown_command_lines(page.read_text()):
+            words = line.split()
+            name = words[1] if len(words) > 1 else ""
+            if re.fullmatch(r"[a-z]+", name) and name not in commands:
+                wrong.append(f"{page.relative_to(ROOT)}: `{line}`: no subcommand {name!r}")
+                continue
+            known = options_of(commands[name]) if name in commands else options_of(parser)
+            for option in OPTION.findall(" ".join(words[1:])):
+                if option not in known:
+                    wrong.append(f"{page.relative_to(ROOT)}: `{line}`: {option} is not in its --help")
+    assert not wrong, "\n".join(wrong)

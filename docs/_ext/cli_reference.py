@@ -1,7 +1,8 @@
 """``.. rtmu-cli-reference::`` — every ``rtmu`` command's ``--help``, read from the parser the command uses.
 
 The reference cannot drift from the program: it is ``rtmu.cli.build_parser()`` formatted by argparse,
-exactly what ``rtmu --help`` and ``rtmu SUBCOMMAND --help`` print (at 100 columns).
+exactly what ``rtmu --help``, ``rtmu SUBCOMMAND --help`` and, for ``files`` and ``scan``,
+``rtmu SUBCOMMAND HOST ACTION --help`` print (at 100 columns).
 """
 
 from __future__ import annotations
@@ -31,6 +32,10 @@ class CliReference(SphinxDirective):
         for name, sub in subparsers(parser).items():
             target = nodes.target("", "", ids=[f"cli-{name}"])
             out += [target, nodes.rubric(text=f"rtmu {name}"), nodes.literal_block(text=sub.format_help())]
+            for action, nested in subparsers(sub).items():  # rtmu files ls, rtmu scan stop …
+                target = nodes.target("", "", ids=[f"cli-{name}-{action}"])
+                heading = nodes.rubric(text=f"rtmu {name} {action}")
+                out += [target, heading, nodes.literal_block(text=nested.format_help())]
         return out
 
 

@@ -22,14 +22,70 @@ from collections.abc import Sequence
 from typing import Any
 
 from . import subcommands
+from .base import exit_codes, logs
 from .base.exit_codes import EXIT_USAGE
 from .subcommands import _integration
 from .versions import VersionAction
 
 
+class HelpFormatter(argparse.HelpFormatter):
+    """argparse's own wrapping, except that indented lines (the exit-code table) are kept as written."""
+
+    def _fill_text(self, text: str, width: int, indent: str) -> str:
+        paragraphs = []
+        for paragraph in text.split("\n\n"):
+            if paragraph.startswith(" ") or "\n " in paragraph:
+                paragraphs.append("\n".join(indent + line for line in paragraph.splitlines()))
+            else:
+                paragraphs.append(super()._fill_text(paragraph, width, indent))
+        return "\n\n".join(paragraphs)
+
+
+def exits_epilog(codes: tuple[int, ...] | None) -> str:
+    """The help's closing part: these codes' lines of the one table (all of them for ``rtmu --help``)."""
+    return "Exit codes (one table for every rtmu command):\n" + exit_codes.table_text(codes)
+
+
+def actions_of(command: argparse.ArgumentParser) -> list[argparse.ArgumentParser]:
+    """The parsers of a subcommand's own action words (``rtmu files HOST ls``), if it has them."""
+    return [
+        parser
+        for action in command._actions
+        if isinstance(action, argparse._SubParsersAction)
+        for parser in action.choices.values()
+    ]
+
+
+def name_schema(command: argparse.ArgumentParser, schema: str | None) -> None:
+    """Say in ``--json``'s help which published schema its lines follow (``subcommands.json_schemas``)."""
+    for action in command._actions:
+        if schema is not None and "--json" in action.option_strings and action.help:
+            action.help += f" (schema {schema!r}: python -m rtmu.subcommands.json_schemas {schema})"
+
+
+def finish_help(command: argparse.ArgumentParser, codes: tuple[int, ...], schema: str | None) -> None:
+    """One style for a subcommand's help and its action words' helps: the exit codes, the schema named."""
+    for parser in (command, *actions_of(command)):
+        parser.formatter_class = HelpFormatter
+        parser.epilog = exits_epilog(codes)
+        name_schema(parser, schema)
+
+
+NOT_COMMANDS = frozenset({"json_schemas"})
+"""Modules of ``rtmu.subcommands`` that are data, not commands (they have no ``register``)."""
+
+
 def subcommand_names() -> list[str]:
     """Every subcommand, sorted: one module of ``rtmu.subcommands`` each (``_``-modules are helpers)."""
-    return sorted(m.name for m in pkgutil.iter_modules(subcommands.__path__) if not m.name.startswith("_"))
+    names = (m.name for m in pkgutil.iter_modules(subcommands.__path__) if not m.name.startswith("_"))
+    return sorted(set(names) - NOT_COMMANDS)
+
+
+def schema_of(name: str) -> str | None:
+    """The published schema a subcommand's ``--json`` lines follow (imported with the subcommand)."""
+    from .subcommands.json_schemas import COMMAND_SCHEMA
+
+    return COMMAND_SCHEMA.get(name)
 
 
 class LazySubcommands(argparse._SubParsersAction):
@@ -52,9 +108,13 @@ class LazySubcommands(argparse._SubParsersAction):
         if module is None:
             return
         del self._name_parser_map[name]
-        register = getattr(importlib.import_module(module), "register", None)
+        loaded = importlib.import_module(module)
+        register = getattr(loaded, "register", None)
         if register is not None:
             register(self)
+            command = self._name_parser_map.get(name)
+            if command is not None:
+                finish_help(command, getattr(loaded, "EXITS", exit_codes.NETWORK), schema_of(name))
         if self._name_parser_map.get(name) is None:  # a module that registered nothing under its name
             self._name_parser_map.pop(name, None)
 
@@ -89,6 +149,8 @@ def build_parser(*, lazy: bool = False) -> argparse.ArgumentParser:
     parser = _Parser(
         prog="rtmu",
         description="Teleoperate an ARIA (ArNetworking) robot; with no subcommand, open the window.",
+        epilog=exits_epilog(None),
+        formatter_class=HelpFormatter,
     )
     parser.add_argument(
         "--version", action=VersionAction, help="show the versions of rtmu, its protocol and toolkit; exit"
@@ -112,6 +174,7 @@ def build_parser(*, lazy: bool = False) -> argparse.ArgumentParser:
 
 
 def main(argv: Sequence[str] | None = None) -> int:
+    logs.configure()  # developer notices off the operator's terminal (RTMU_LOG=warning shows them)
     parser = build_parser(lazy=True)
     args = parser.parse_args(argv)
     handler = getattr(args, "handler", None)

@@ -1,4 +1,4 @@
-"""Omron LD robots (ARAM) on the wire, against ``rtmu sim --profile aram`` and the default profile.
+"""Omron LD robots (ARAM) on the wire, against ``rtmu sim --kind aram`` and the default profile.
 
 The protocol string (answered as advertised, ``--protocol`` overrides, reason 4 names the wanted
 string), the battery as state of charge, and ``rtmu doctor`` step by step — all over loopback.

@@ -19,6 +19,7 @@ from rtmu.base.exit_codes import (
     EXIT_TIMEOUT,
     EXIT_UNSUPPORTED,
     EXIT_USAGE,
+    EXIT_WHY_DEAD_ZONE,
     EXIT_WHY_NO_DRIVE,
 )
 from rtmu.cli import main
@@ -100,9 +101,12 @@ def test_status_once_and_streamed_json(
 
 def test_password_from_a_pipe(sim: SimThread, monkeypatch: pytest.MonkeyPatch, capsys) -> None:  # type: ignore[no-untyped-def]
     monkeypatch.setattr("sys.stdin", io.StringIO("secret1\n"))
-    assert main(["status", addr(sim), "--user", "alice", "--once"]) == EXIT_OK
+    assert main(["status", addr(sim), "--user", "alice", "--once"]) == EXIT_USAGE  # only when asked to
+    assert "--password-stdin" in capsys.readouterr().err
+    monkeypatch.setattr("sys.stdin", io.StringIO("secret1\n"))
+    assert main(["status", addr(sim), "--user", "alice", "--password-stdin", "--once"]) == EXIT_OK
     monkeypatch.setattr("sys.stdin", io.StringIO("wrong\n"))
-    assert main(["status", addr(sim), "--user", "alice", "--once"]) == EXIT_CONNECTION
+    assert main(["status", addr(sim), "--user", "alice", "--password-stdin", "--once"]) == EXIT_CONNECTION
     err = capsys.readouterr().err
     assert err.count("\n") == 1 and err.startswith("rtmu status: login refused: wrong user name or password")
 
@@ -121,7 +125,10 @@ def test_image(sim: SimThread, pwfile: Path, tmp_path: Path) -> None:
     assert main(["image", *login(sim, pwfile), "--out", str(out)]) == EXIT_OK
     data = out.read_bytes()
     assert data[:2] == b"\xff\xd8" and data.rstrip(b"\x00")[-2:] == b"\xff\xd9"
-    assert main(["image", *login(sim, pwfile), "--out", str(out), "--camera", "Nope"]) == EXIT_UNSUPPORTED
+    again = ["image", *login(sim, pwfile), "--out", str(out), "--camera", "Nope"]
+    assert main(again) == EXIT_USAGE, "an existing picture is not replaced without --force"
+    assert main([*again, "--force"]) == EXIT_UNSUPPORTED
+    assert out.read_bytes() == data, "a failed picture leaves the old one as it was"
 
 
 def test_drive_moves_then_stops(sim: SimThread, pwfile: Path, capsys: pytest.CaptureFixture[str]) -> None:
@@ -344,3 +351,21 @@ def test_drive_json_after_ctrl_c_says_it_was_interrupted(sim: SimThread, pwfile:
             proc.kill()
             proc.wait()
     assert obj["interrupted"] == "SIGINT" and set(obj["after"]) == STATUS_KEYS and obj["seconds"] == 20
+
+
+def test_drive_inside_arias_dead_zone_says_so_and_does_not_exit_0(
+    sim: SimThread, pwfile: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    """Issue 22 (say so) and issue 24 (asked to move and did not: never 0) both hold: a warning first,
+    then the answer names the dead zone, with its own code."""
+    before = sim.snapshot()
+    assert main(["drive", *login(sim, pwfile), "--trans", "10", "--seconds", "0.5"]) == EXIT_WHY_DEAD_ZONE
+    err = capsys.readouterr().err
+    warning, _, answer = err.partition("the robot did not move: ")
+    assert "inside ARIA's dead zone" in warning and "the robot will not move" in warning, err
+    assert "inside ARIA's dead zone" in answer and "ask for more than 10 % translation" in answer, err
+    assert "nothing RTMU can read says why" not in err
+    after = sim.snapshot()
+    assert (after.x, after.y) == (before.x, before.y), "ARIA's dead zone: it really did not move"
+    assert main(["drive", *login(sim, pwfile), "--trans", "11", "--seconds", "0.3"]) == EXIT_OK
+    assert "dead zone" not in capsys.readouterr().err

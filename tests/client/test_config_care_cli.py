@@ -56,7 +56,7 @@ def test_defaults_list_only_what_differs_from_the_factory_values(
         "default": "2",
         "editable": True,
     }
-    assert doc["factory_values"] == 10 and doc["cut"] == 0
+    assert doc["factory_values"] == 12 and doc["cut"] == 0
 
 
 def test_reset_one_parameter_then_a_whole_section(sim: SimThread, capsys: pytest.CaptureFixture[str]) -> None:
@@ -95,15 +95,15 @@ def test_export_then_import_restores_every_value_in_one_set(
 ) -> None:
     file = tmp_path / "robot.toml"
     assert config(sim.port, "--export", str(file)) == EXIT_OK
-    assert capsys.readouterr().out.strip() == f"wrote 10 parameters to {file}"
+    assert capsys.readouterr().out.strip() == f"wrote 12 parameters to {file}"
     values = read_file(file)
-    assert values["Teleop"] == {"Timeout": "2"} and values["Robot config"]["SerialNumber"] == "SIM-P3DX-0001"
+    assert values["Teleop"]["Timeout"] == "2" and values["Robot config"]["SerialNumber"] == "SIM-P3DX-0001"
     assert '"SerialNumber" = "SIM-P3DX-0001"  # factory, read-only' in file.read_text()
     assert config(sim.port, "--set", "Teleop/Timeout=0.5", "Camera/FrameSize=640x480") == EXIT_OK
     sets = sim.server.arconfig.sets  # type: ignore[union-attr]
     capsys.readouterr()
     assert config(sim.port, "--import", str(file)) == EXIT_OK
-    assert capsys.readouterr().out.strip() == "imported 2 values (8 already as the file says)"
+    assert capsys.readouterr().out.strip() == "imported 2 values (10 already as the file says)"
     assert sim.server.arconfig.sets == sets + 1  # type: ignore[union-attr]
     assert sim.server.world.ratio_mode.timeout == 2.0 and sim.server.video_size == (320, 240)  # type: ignore[union-attr]
 
@@ -115,7 +115,7 @@ def test_an_existing_file_is_kept_unless_forced(sim: SimThread, tmp_path: Path, 
     assert "already exists (give --force to replace it)" in capsys.readouterr().err
     assert file.read_text() == "precious"
     assert config(sim.port, "--export", str(file), "--force") == EXIT_OK
-    assert read_file(file)["Teleop"] == {"Timeout": "2"}
+    assert read_file(file)["Teleop"]["Timeout"] == "2"
     assert sorted(os.listdir(tmp_path)) == ["robot.toml"]  # no temporary file left beside it
     assert main(["config", "127.0.0.1:1", "--force"]) == EXIT_USAGE
 

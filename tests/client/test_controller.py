@@ -181,9 +181,9 @@ def test_a_stale_link_noticed_first_by_the_drive_loop_is_still_told_once() -> No
     rig.ctl.press("forward")
     rig.link.lease.end(EndReason.LINK)  # what the drive loop does when it sees the link go stale
     rig.hold(0.1)
-    assert rig.view.texts().count("Stopped: the link is stale") == 1
+    assert rig.view.texts().count("Stopped: the link is stale. Press again once it is back.") == 1
     rig.model.health.set(LinkHealth(LinkLevel.STALE))  # the health arrives afterwards
-    assert rig.view.texts().count("Stopped: the link is stale") == 1
+    assert rig.view.texts().count("Stopped: the link is stale. Press again once it is back.") == 1
     rig.ctl.press("forward")  # still held: blocked until released
     assert not rig.lease.live
 

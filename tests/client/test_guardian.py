@@ -280,3 +280,20 @@ def test_rtmu_drive_warns_in_one_line_when_the_guardian_is_refused_and_drives(tm
         warnings = [line for line in done.stderr.splitlines() if "guardian not available" in line]
         assert len(warnings) == 1 and warnings[0].startswith("rtmu drive: warning:"), done.stderr
         assert sim.call(lambda: sim.server.robot.ratio_drives_received) > 0
+
+
+def test_the_guardians_reasons_name_no_window_it_may_not_have() -> None:
+    """rtmu drive and rtmu bridge have guardians too: their stop reasons speak of the driving process."""
+    import os
+
+    from rtmu.guardian import messages as m
+    from rtmu.guardian.child import Watch
+
+    watch = Watch(os.getpid())
+    watch.take(m.BEAT_NET, 0.0)
+    watch.take(m.ARM, 0.0)
+    late = watch.why_stop(10.0)
+    watch.eof = True
+    gone = watch.why_stop(10.0)
+    for reason in (late, gone):
+        assert reason is not None and "window" not in reason and "process driving the robot" in reason

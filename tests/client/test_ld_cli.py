@@ -1,4 +1,4 @@
-"""``rtmu routes / patrol / say / status`` against ``rtmu sim --profile aram`` and the default profile."""
+"""``rtmu routes / patrol / say / status`` against ``rtmu sim --kind aram`` and the default profile."""
 
 from __future__ import annotations
 

@@ -10,7 +10,7 @@ from rtmu.base.notices import Kind, Level, Notice
 from rtmu.client.connection import Packet
 from rtmu.client.detached import DetachedContext
 from rtmu.client.nav_session import NavFeed
-from rtmu.client.nav_status import MAX_TEXT, NavPhase, path_remaining, read_status
+from rtmu.client.nav_status import MAX_TEXT, path_remaining, read_status
 from rtmu.protocol.payloads.navigation import LocState, PlannedPath
 from rtmu.values.state import NavOutcome, RobotState
 
@@ -18,36 +18,36 @@ from rtmu.values.state import NavOutcome, RobotState
 @pytest.mark.parametrize(
     ("status", "mode", "phase", "target", "sentence"),
     [
-        ("Going to Lab B", "Goto", NavPhase.GOING, "Lab B", ""),
-        ("Going to point", "Goto", NavPhase.GOING, "point", ""),
-        ("Going to dock at Charger", "dock", NavPhase.GOING, "dock at Charger", ""),
-        ("Driving into dock", "dock", NavPhase.GOING, "dock", ""),
-        ("Returning home", "Goto", NavPhase.GOING, "home", ""),
-        ("Touring to Room 101", "Goto", NavPhase.GOING, "Room 101", ""),
-        ("Arrived at Lab B", "Goto", NavPhase.ARRIVED, "Lab B", "Arrived at Lab B"),
-        ("Returned home", "Goto", NavPhase.ARRIVED, "home", "Returned home"),
-        ("Docked", "dock", NavPhase.DOCKED, "dock", "Docked"),
+        ("Going to Lab B", "Goto", NavOutcome.GOING, "Lab B", ""),
+        ("Going to point", "Goto", NavOutcome.GOING, "point", ""),
+        ("Going to dock at Charger", "dock", NavOutcome.GOING, "dock at Charger", ""),
+        ("Driving into dock", "dock", NavOutcome.GOING, "dock", ""),
+        ("Returning home", "Goto", NavOutcome.GOING, "home", ""),
+        ("Touring to Room 101", "Goto", NavOutcome.GOING, "Room 101", ""),
+        ("Arrived at Lab B", "Goto", NavOutcome.ARRIVED, "Lab B", "Arrived at Lab B"),
+        ("Returned home", "Goto", NavOutcome.ARRIVED, "home", "Returned home"),
+        ("Docked", "dock", NavOutcome.DOCKED, "dock", "Docked"),
         (
             "Failed to get to Lab B because robot lost",
             "Goto",
-            NavPhase.FAILED,
+            NavOutcome.FAILED,
             "Lab B",
             "Failed to get to Lab B because the robot is lost",
         ),
         (
             "Failed to get to Lab B (path blocked)",
             "Goto",
-            NavPhase.FAILED,
+            NavOutcome.FAILED,
             "Lab B",
             "Failed to get to Lab B because path blocked",
         ),
-        ("Failed to get home because robot lost", "Goto", NavPhase.FAILED, "home", None),
-        ("Failed dock", "dock", NavPhase.FAILED, "dock", "Failed dock"),
-        ("Stopped", "stop", NavPhase.IDLE, "", ""),
-        ("Going to the kitchen", "ratioDrive", NavPhase.IDLE, "", ""),  # not a navigation mode
+        ("Failed to get home because robot lost", "Goto", NavOutcome.FAILED, "home", None),
+        ("Failed dock", "dock", NavOutcome.FAILED, "dock", "Failed dock"),
+        ("Stopped", "stop", NavOutcome.NONE, "", ""),
+        ("Going to the kitchen", "ratioDrive", NavOutcome.NONE, "", ""),  # not a navigation mode
     ],
 )
-def test_arnl_words(status: str, mode: str, phase: NavPhase, target: str, sentence: str | None) -> None:
+def test_arnl_words(status: str, mode: str, phase: NavOutcome, target: str, sentence: str | None) -> None:
     r = read_status(status, mode)
     assert (r.phase, r.target) == (phase, target)
     if sentence is not None:

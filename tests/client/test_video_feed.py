@@ -130,7 +130,7 @@ def test_a_repeated_old_frame_does_not_slow_the_video_down() -> None:
 # -- pacing: the camera's period learned from its repeats (issue 28) ---------------------------------
 def play_camera(
     pacer: object, *, fps: float, seconds: float, ready_at, warm_up: float = 3.0, start: float = 0.0
-):  # type: ignore[no-untyped-def]  # noqa: E501
+):  # type: ignore[no-untyped-def]
     """Drive ``pacer`` against a camera model on a simulated clock from ``start``: ``ready_at(t, last)``
     is the id of the newest frame a request arriving at ``t`` gets, and when it was made (``last``: the
     id the one before got). Returns (requests, new frames, ages in s of each new frame on arrival)

@@ -13,6 +13,7 @@ import json
 from collections.abc import Iterator
 from pathlib import Path
 
+import jsonschema
 import pytest
 
 from rtmu.base import exit_codes as codes
@@ -21,6 +22,7 @@ from rtmu.client.connection import AriaClient
 from rtmu.protocol.payloads.drive import RatioDrive
 from rtmu.sim import SimConfig, SimThread
 from rtmu.sim.ld_safety import safety_state
+from rtmu.subcommands.json_schemas import SCHEMAS
 
 from .navsim import fast_sim, reset, robot
 from .servers import SPECS, ServerThread, TestServer
@@ -113,10 +115,13 @@ def test_a_mode_locked_for_good_is_named_and_a_drive_against_it_exits_27(sim: Si
     assert "RTMU cannot release it" in reason["advice"] and "fix" not in reason
     assert why(sim, "--fix") == codes.EXIT_WHY_LOCKED  # no fix to try: still locked
     x0 = x_of(sim)
-    assert drive(sim, "--trans", "50") == codes.EXIT_WHY_LOCKED
-    err = capsys.readouterr().err
+    assert drive(sim, "--trans", "50", "--json") == codes.EXIT_WHY_LOCKED
+    out, err = capsys.readouterr()
     assert "the robot did not move" in err and "will not unlock" in err
     assert abs(x_of(sim) - x0) < 1.0
+    line = json.loads(out.splitlines()[-1])  # after what why --fix printed
+    jsonschema.validate(line, SCHEMAS["drive"])  # the published shape, "moved" and "why" included
+    assert line["moved"] is False and line["why"]["exit_code"] == codes.EXIT_WHY_LOCKED
 
 
 def test_a_lock_that_gives_way_is_unlocked_by_the_fix_without_moving(sim: SimThread, capsys) -> None:  # type: ignore[no-untyped-def]

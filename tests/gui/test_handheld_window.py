@@ -182,8 +182,12 @@ def test_portrait_phone_layout_fits_and_the_thumb_dpad_drives(phone: tuple[Gui, 
     goals_popover.popdown()
     pump(lambda: not goals_popover.get_mapped(), 3, "the Go to list to close")
     window.activate_action("win.settings", None)
-    pump(lambda: window._dialog is not None and window._dialog.get_mapped(), 5, "the connection dialog")
-    dialog = window._dialog
+    pump(
+        lambda: window.dialogs.settings is not None and window.dialogs.settings.get_mapped(),
+        5,
+        "the connection dialog",
+    )
+    dialog = window.dialogs.settings
     assert dialog is not None
     idle(0.3)
     assert inside(gui.screen_rect(dialog), 360, 720), gui.screen_rect(dialog)

@@ -1,4 +1,4 @@
-"""The real window against ``rtmu sim --profile aram``: laser layer, dock cell, routes panel, details and say.
+"""The real window against ``rtmu sim --kind aram``: laser layer, dock cell, routes panel, details and say.
 
 And against the default profile: the LD controls stay hidden.
 """

@@ -394,7 +394,6 @@ def test_what_the_server_does_not_list_stays_visible_greyed_with_its_reason() ->
         goto=chosen.append,
         run=chosen.append,
         pick=lambda kind: chosen.append(kind.value),
-        stop=lambda: chosen.append("stop"),
     )
     try:
         assert not panel.get_visible(), "hidden while not connected"

@@ -219,8 +219,12 @@ def test_settings_dialog_validates_inline_and_saves_a_profile(start: Start) -> N
     gui, _sim = start()
     window = gui.window
     gui.key("ctrl+comma")
-    pump(lambda: window._dialog is not None and window._dialog.get_mapped(), 3, "the settings dialog")
-    dialog = window._dialog
+    pump(
+        lambda: window.dialogs.settings is not None and window.dialogs.settings.get_mapped(),
+        3,
+        "the settings dialog",
+    )
+    dialog = window.dialogs.settings
     dialog.port.set_text("99999")
     dialog.host.set_text("bad host!")
     assert not dialog.save.get_sensitive()

@@ -27,7 +27,6 @@ from rtmu.protocol.payloads.drawings import (
     Shape,
     Visibility,
 )
-from rtmu.protocol.payloads.sensors import Drawing as SensorsDrawing
 from testdata import CAPTURES
 
 ARIA_DRAWING_REPLY = (
@@ -87,7 +86,6 @@ def test_a_drawing_list_packet_is_arias_layout_field_by_field() -> None:
     assert back.rgb == pytest.approx((0x33 / 255, 0xCC / 255, 1.0))
     assert DrawingListPacket.decode(b"").end_of_reply
     assert payload_type_for("getDrawingList", Side.REPLY) is DrawingListPacket
-    assert SensorsDrawing is Drawing  # the old import path still works
 
 
 @pytest.mark.parametrize(

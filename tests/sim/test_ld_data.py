@@ -1,9 +1,12 @@
-"""What ``rtmu sim --profile aram`` serves beyond serverDemo, as a client on loopback sees it."""
+"""What ``rtmu sim --kind aram`` serves beyond serverDemo, as a client on loopback sees it."""
 
 from __future__ import annotations
 
 import math
 
+from rtmu.package_data import project_map
+from rtmu.protocol.payloads.drawings import DrawingListPacket
+from rtmu.protocol.payloads.drive import RatioDrive
 from rtmu.protocol.payloads.ld import (
     DataStoreValue,
     DockInfo,
@@ -13,9 +16,9 @@ from rtmu.protocol.payloads.ld import (
     Routes,
     Say,
 )
-from rtmu.protocol.payloads.sensors import DrawingListPacket, RangeDeviceReadings
+from rtmu.protocol.payloads.sensors import RangeDeviceReadings
 from rtmu.sim import SimConfig, SimServer
-from rtmu.sim.ld_data import DOCK_SECONDS, ROUTES, ld_state
+from rtmu.sim.ld_data import ROUTES, ld_state
 
 from .wire import WireClient, eventually, run
 
@@ -54,23 +57,41 @@ def test_front_laser_sees_the_wall_at_one_ray_per_degree(tmp_path):
     run(scenario())
 
 
-def test_dock_moves_through_docking_to_docked_and_broadcasts(arena_map):
+OFFICE = project_map("office.map")
+
+
+def test_dock_drives_to_the_dock_and_a_drive_backs_out_of_it():
+    """The LD dock is the simulator's dock mode: it drives there (Docking), is Docked only there, and a
+    drive undocks it (it no longer "docks" on the spot and stays Docked while driving away)."""
+
     async def scenario() -> None:
-        server, c = await _start(arena_map)
+        server, c = await _start(OFFICE)
         assert DockInfo.decode((await c.ask("dockInfo"))[0]).state == DockState.UNDOCKED
         c.request("dockInfoChanged", -1)
         await c.barrier()
+        start = (server.robot.x, server.robot.y)
         c.once("dock")
         (first,) = await c.wait_for("dockInfoChanged")
         assert DockInfoChanged.decode(first).state == DockState.DOCKING
-        await server.advance(DOCK_SECONDS + 0.5)
+        for _ in range(600):  # at most a minute of simulated time, a second at a time
+            if server.world.dock_mode.state is DockState.DOCKED:
+                break
+            await server.advance(1.0)
         assert DockInfo.decode((await c.ask("dockInfo"))[0]).state == DockState.DOCKED
+        dock = next(d for d in server.world.nav_map.docks())
+        assert math.hypot(server.robot.x - dock.x, server.robot.y - dock.y) < 100, "docked at the dock"
+        assert math.hypot(server.robot.x - start[0], server.robot.y - start[1]) > 500, "it drove there"
         await eventually(lambda: len(c.received["dockInfoChanged"]) >= 2, what="the docked broadcast")
-        assert DockInfoChanged.decode(c.received["dockInfoChanged"][1]).state == DockState.DOCKED
+        c.once("ratioDrive", RatioDrive(50.0, 0.0, 50.0).encode())
+        await c.barrier()
+        await server.advance(0.2)
+        assert DockInfo.decode((await c.ask("dockInfo"))[0]).state == DockState.UNDOCKING
+        await server.advance(5.0)
+        assert DockInfo.decode((await c.ask("dockInfo"))[0]).state == DockState.UNDOCKED
         await c.close()
         await server.stop()
 
-    run(scenario())
+    run(scenario(), timeout=120)
 
 
 def test_routes_patrol_say_and_data_store(arena_map):

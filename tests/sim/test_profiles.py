@@ -1,4 +1,4 @@
-"""``rtmu sim --profile aram``: an LD robot on the wire (protocol, state of charge, Ex4 map, 6MTX data)."""
+"""``rtmu sim --kind aram``: an LD robot on the wire (protocol, state of charge, Ex4 map, 6MTX data)."""
 
 from __future__ import annotations
 

@@ -74,6 +74,7 @@ from .errors import (
     ServerClosed,
 )
 from .link import Link, Opener, open_tcp
+from .roles import MotionGate, Role
 
 log = logging.getLogger(__name__)
 
@@ -247,6 +248,8 @@ class AriaClient:
         """Handler calls whose own CPU time went over :data:`SLOW_HANDLER`."""
         self.last_packet_at: float | None = None
         self.packets_received = 0
+        self._gate = MotionGate(Role.OBSERVER)
+        """Replaced at :meth:`connect` by the role asked for; never changed after."""
 
     # -- state -----------------------------------------------------------------------------
     @property
@@ -305,6 +308,17 @@ class AriaClient:
         """Why the connection ended (None while open or after a plain ``disconnect``)."""
         return self._closed_error
 
+    @property
+    def role(self) -> Role:
+        """OBSERVER (no motion request ever leaves) or OPERATOR, as given to :meth:`connect`."""
+        return self._gate.role
+
+    @property
+    def drove(self) -> bool:
+        """True once this connection sent a motion request that does more than stop: only then does
+        it stop the robot when it ends (its own drive, never somebody else's navigation)."""
+        return self._gate.drove
+
     def supports(self, name: str) -> bool:
         """True if the server offers ``name`` to this user (after ``connect``)."""
         return self._conn is not None and name in self._conn.datalist
@@ -320,10 +334,16 @@ class AriaClient:
         timeout: float = CONNECT_TIMEOUT,
         server_key: str = "",
         protocol: str | None = None,
+        role: Role = Role.OPERATOR,
     ) -> DataList:
-        """Open the link, log in and wait for the complete data list, all within ``timeout`` s."""
+        """Open the link, log in and wait for the complete data list, all within ``timeout`` s.
+
+        ``role`` is fixed for the connection's life: an OBSERVER's motion requests are refused
+        (:class:`~rtmu.client.errors.MotionRefused`) before anything is put on the wire.
+        """
         if self._conn is not None:
             raise RuntimeError("AriaClient objects are single-use: make a new one to connect again")
+        self._gate = MotionGate(role)
         self.host, self.port, self.user = host, port, user or ""
         self._conn = ClientConnection(
             user or "", password or "", server_key=server_key, protocol_version=protocol
@@ -420,8 +440,10 @@ class AriaClient:
         immediate reply).
         """
         number = self._number(name)
+        payload = encode_args(args)
+        self._gate.admit(name, payload)
         self._handlers[number] = handler
-        self._conn.request(name, interval_ms, encode_args(args))  # type: ignore[union-attr]
+        self._conn.request(name, interval_ms, payload)  # type: ignore[union-attr]
         self._flush()
 
     def listen(self, name: str, handler: Handler | None) -> None:
@@ -479,6 +501,7 @@ class AriaClient:
         """
         name, payload = _request(what, args)
         self._number(name)
+        self._gate.admit(name, payload)
         self._conn.request_once(name, payload)  # type: ignore[union-attr]
         self._flush()
 
@@ -625,6 +648,7 @@ class AriaClient:
         queued: bool = True,
     ) -> _Waiter | None:
         self._number(name)
+        self._gate.admit(name, payload)
         conn = self._conn
         assert conn is not None
         try:

@@ -74,6 +74,9 @@ class Finding:
 
 
 # -- the table ------------------------------------------------------------------------------------
+CENTRAL_ADVICE = (
+    "this is ARIA's central server: use 'rtmu fleet', --robot NAME, or open its robots with 'rtmu --central'"
+)
 ADVICE = {
     "resolve": "check the spelling, or use the robot's IP address instead of its name",
     "refused": "nothing listens on that port: check that the robot's server (ARAM / the ARIA server) "
@@ -91,9 +94,19 @@ ADVICE = {
     "login_timeout": "the server did not finish the login in time: it may be overloaded; try again",
     "status_missing": "this server offers no robot status (updateNumbers/update): RTMU can connect "
     "but will show no pose or battery",
+    "central_server": CENTRAL_ADVICE,
     "status_timeout": "the server did not send a status in time: the robot's base may be "
     "disconnected from its server; check the robot",
 }
+
+
+def central_server_words(where: str) -> str:
+    """What to do with ARIA's central server, which has no robot of its own (``where``: HOST:PORT)."""
+    return (
+        f"{where} is ARIA's central server, not a robot: list its robots with 'rtmu fleet {where}', act on "
+        f"one with --robot NAME, or open them all with 'rtmu --central {where}'"
+    )
+
 
 REJECT_ADVICE = {
     RejectReason.BAD_USER_OR_PASSWORD: (

@@ -25,6 +25,7 @@ import logging
 from collections.abc import Mapping
 from typing import ClassVar
 
+from ..protocol.errors import ProtocolError
 from ..protocol.payloads.drawings import Drawing, Visibility
 from ..values.intents import DrawingChoices, Intent, ShowDrawing
 from ..values.state import DrawingLayer, DrawingsChanged, DrawingsState
@@ -37,6 +38,9 @@ log = logging.getLogger(__name__)
 
 MIN_REFRESH_MS = 50
 """A drawing is never asked for more often than this, whatever period the server suggests."""
+MAX_REFRESH_MS = 2**31 - 1
+"""…nor less often than this: a request's period is a signed 32-bit count of ms on the wire (ARIA's
+``byte4``), and a drawing list may suggest up to 2³²−1 (24 days or 49 are the same thing: one sample)."""
 PUBLISH_EVERY = 0.05
 """Seconds between two published states at most (samples arriving faster are coalesced)."""
 
@@ -85,7 +89,7 @@ class DrawingsFeed(Feed):
 
     async def _fetch(self, client: AriaClient) -> None:
         try:
-            drawings = await drawing_list(client, self._timeout)
+            listed = await drawing_list(client, self._timeout)
         except ClientError as exc:
             if client is self._client:
                 self._note = f"the server's drawings could not be read: {exc}"
@@ -93,7 +97,8 @@ class DrawingsFeed(Feed):
             return
         if client is not self._client:
             return
-        self._drawings = tuple(sorted(drawings, key=lambda d: d.layer))
+        self._note = listed.dropped_text()
+        self._drawings = tuple(sorted(listed.drawings, key=lambda d: d.layer))
         for d in self._drawings:  # the session subscribed its sonar/lasers itself: a hidden one ends here
             if self.ctx.handler_for(d.name) is not None and not self.shown(d):
                 client.stop_request(d.name)
@@ -144,16 +149,23 @@ class DrawingsFeed(Feed):
             wanted = self.shown(d) and d.known_shape is not None
             if wanted and d.name not in self._requested:
                 self._requested.add(d.name)
-                if d.refresh_ms > 0:
-                    client.request(d.name, max(d.refresh_ms, MIN_REFRESH_MS), self._on_packet)
-                else:  # "don't poll": the server sends it when it changes; one sample to start with
-                    client.request(d.name, -1, self._on_packet)
-                    self.ctx.spawn(self._first_sample(client, d.name), f"drawing-{d.name[:40]}")
+                try:
+                    self._ask(client, d)
+                except (ClientError, ProtocolError, ValueError) as exc:  # this drawing only: the rest go on
+                    self._problems[d.name] = f"could not be asked for: {exc}"
+                    log.info("drawing %r could not be asked for: %s", d.name, exc)
             elif not wanted and d.name in self._requested:
                 self._requested.discard(d.name)
                 client.stop_request(d.name)
                 self._points.pop(d.name, None)
                 self._problems.pop(d.name, None)
+
+    def _ask(self, client: AriaClient, d: Drawing) -> None:
+        if d.refresh_ms > 0:
+            client.request(d.name, period_ms(d.refresh_ms), self._on_packet)
+        else:  # "don't poll": the server sends it when it changes; one sample to start with
+            client.request(d.name, -1, self._on_packet)
+            self.ctx.spawn(self._first_sample(client, d.name), f"drawing-{d.name[:40]}")
 
     async def _first_sample(self, client: AriaClient, name: str) -> None:
         with contextlib.suppress(ClientError):
@@ -201,7 +213,7 @@ class DrawingsFeed(Feed):
                 color=d.primary_color & 0xFFFFFF,
                 size=d.size,
                 layer=d.layer,
-                refresh_ms=max(d.refresh_ms, MIN_REFRESH_MS) if d.refresh_ms > 0 else 0,
+                refresh_ms=period_ms(d.refresh_ms) if d.refresh_ms > 0 else 0,
                 shown=self.shown(d) and d.known_shape is not None,
                 may_toggle=d.operator_may_toggle and d.known_shape is not None,
                 points=self._points.get(d.name, ()),
@@ -210,3 +222,8 @@ class DrawingsFeed(Feed):
             for d in self._drawings
         )
         self.ctx.publish(DrawingsChanged(DrawingsState(layers, self._offered, self._note)))
+
+
+def period_ms(suggested: int) -> int:
+    """The period a drawing is asked for at: the server's suggestion within what is sane and sendable."""
+    return min(max(suggested, MIN_REFRESH_MS), MAX_REFRESH_MS)

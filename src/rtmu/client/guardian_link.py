@@ -72,7 +72,8 @@ class GuardianLink:
         for word, text in guardian.poll():
             if word == "stopped":
                 stopped = True
-                self._notice(Notice.error(Kind.SAFETY, f"The guardian stopped the robot: {text}"))
+                said = f"The guardian stopped the robot: {text}. Press again to drive."
+                self._notice(Notice.error(Kind.SAFETY, said))
             elif word in ("unavailable", "lost", "ended"):
                 self.handle = None
                 guardian.close(goodbye=True)
@@ -83,7 +84,7 @@ class GuardianLink:
         self._notice(
             Notice.warning(
                 Kind.SAFETY,
-                f"Guardian not available ({reason}): if this window is killed or frozen while driving, "
+                f"Guardian not available ({reason}): if this program is killed or frozen while driving, "
                 "only the server's own 2 s watchdog stops the robot",
             )
         )

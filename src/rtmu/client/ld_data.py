@@ -24,6 +24,17 @@ from .errors import MalformedReply, NotSupported
 
 LASER_NAMES = ("Laser_1Current", "Laser_2Current")
 """The LD range devices RTMU draws, when listed."""
+MAX_LASERS = 8
+_LASER_DRAWING = re.compile(r"(?!sonar)\w+_\d+Current", re.IGNORECASE)
+"""ARIA names a laser ``<kind>_<n>`` (its laser connector: ``sim_lms2xx_1``, ``lms1xx_1``, ``urg_1``;
+ARAM: ``Laser_1``) and the drawing of its current readings ``<name>Current``; the sonar, bumpers and
+IRs have names of their own (``sonarCurrent``, ``bumpersCurrent``, ``irsCurrent``)."""
+
+
+def laser_names(client: AriaClient) -> tuple[str, ...]:
+    """The lasers' current-readings data the server lists (an LD robot's and an ARIA/Pioneer one's)."""
+    listed = [e.name for e in client.datalist if _LASER_DRAWING.fullmatch(e.name)]
+    return tuple(dict.fromkeys([*LASER_NAMES, *sorted(listed)]))[: len(LASER_NAMES) + MAX_LASERS]
 
 
 async def dock_info(client: AriaClient, timeout: float) -> DockInfo | None:

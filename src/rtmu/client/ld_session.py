@@ -1,5 +1,9 @@
 """The session's share of LD (ARAM) data: lasers, docking state, routes, ``DataStore_*``; patrol and say.
 
+The lasers are every robot's: an LD robot's ``Laser_*Current`` and an ARIA/Pioneer server's laser
+drawings (``sim_lms2xx_1Current`` …, :func:`~rtmu.client.ld_data.laser_names`), so the recorder and the
+Foxglove bridge have the laser of both.
+
 :class:`LdFeed` subscribes only to the data the server lists and turns each packet into
 :class:`~rtmu.values.state.RobotState` changes. A serverDemo-like server lists none of it, so nothing
 is asked and the model keeps its defaults (no laser, ``dock_state`` None, no routes). The goal list
@@ -21,7 +25,7 @@ from ..values.intents import Intent, Patrol, Say
 from .connection import AriaClient, Packet
 from .errors import ClientError
 from .feed import Feed, FeedContext
-from .ld_data import LASER_NAMES, data_store_names, store_fields
+from .ld_data import data_store_names, laser_names, store_fields
 from .subscriptions import Subscription
 
 LASER_INTERVAL_MS = 200
@@ -42,7 +46,7 @@ class LdFeed(Feed):
         self._descriptions: dict[str, str] = {}
 
     def subscriptions(self, client: AriaClient) -> Iterable[Subscription]:
-        subs = [Subscription(name, LASER_INTERVAL_MS, self.on_laser) for name in LASER_NAMES]
+        subs = [Subscription(name, LASER_INTERVAL_MS, self.on_laser) for name in laser_names(client)]
         subs += [
             Subscription("dockInfo", DOCK_INTERVAL_MS, self._on_dock),
             Subscription("dockInfoChanged", -1, self._on_dock),
@@ -80,7 +84,7 @@ class LdFeed(Feed):
             self.ctx.spawn(self._fetch_routes(client), "ld-routes")
 
     def on_laser(self, packet: Packet) -> None:
-        """A ``Laser_*Current`` packet (also handed on by the drawings feed when it holds that request)."""
+        """A laser's ``…Current`` packet (also handed on by the drawings feed when it holds that request)."""
         readings = self.ctx.decode(packet.name, packet.payload)
         if isinstance(readings, RangeDeviceReadings):
             self._lasers[packet.name] = readings.readings

@@ -31,7 +31,7 @@ from .connection import AriaClient, Packet
 from .errors import ClientError
 from .feed import Feed, FeedContext
 from .map_feed import goal_pose
-from .nav_status import MAX_TEXT, NAV_DATA, NavPhase, NavReading, path_remaining, read_status
+from .nav_status import MAX_TEXT, NAV_DATA, NavReading, path_remaining, read_status
 from .subscriptions import Subscription
 
 MAX_GOALS = 10_000
@@ -80,9 +80,12 @@ class NavFeed(Feed):
         """Send a navigation command; an LD robot without ``gotoGoal`` reaches a goal by ``gotoRouteGoal``."""
         name = SENDS[type(intent)]
         client = self.ctx.client
-        if isinstance(intent, GotoGoal) and client is not None:
-            if not client.supports(name) or (intent.route and client.supports("gotoRouteGoal")):
-                name = "gotoRouteGoal"
+        if (
+            isinstance(intent, GotoGoal)
+            and client is not None
+            and (not client.supports(name) or (intent.route and client.supports("gotoRouteGoal")))
+        ):
+            name = "gotoRouteGoal"
         client = self.require(name)
         payload = _payload(intent)
         if isinstance(payload, GotoPosePayload):
@@ -135,11 +138,11 @@ class NavFeed(Feed):
 
     def _read(self, reading: NavReading, dock_state: str | None) -> None:
         was = self.state.navigating
-        if reading.phase is NavPhase.IDLE and dock_state in ("Docking", "Docked"):
+        if reading.phase is NavOutcome.NONE and dock_state in ("Docking", "Docked"):
             # An LD robot's dock reports through dockInfo, not through ARNL's words.
-            phase = NavPhase.GOING if dock_state == "Docking" else NavPhase.DOCKED
+            phase = NavOutcome.GOING if dock_state == "Docking" else NavOutcome.DOCKED
             reading = NavReading(phase, "dock", text=dock_state)
-        if reading.phase is NavPhase.GOING:
+        if reading.phase is NavOutcome.GOING:
             target = reading.target
             pose = self._sent_pose if target == "point" else goal_pose(self.ctx.map, target)
             self._update(
@@ -152,9 +155,9 @@ class NavFeed(Feed):
             )
         elif reading.finished:
             outcome = {
-                NavPhase.ARRIVED: NavOutcome.ARRIVED,
-                NavPhase.DOCKED: NavOutcome.DOCKED,
-                NavPhase.FAILED: NavOutcome.FAILED,
+                NavOutcome.ARRIVED: NavOutcome.ARRIVED,
+                NavOutcome.DOCKED: NavOutcome.DOCKED,
+                NavOutcome.FAILED: NavOutcome.FAILED,
             }[reading.phase]
             news = was or self._last is None or reading.text != self._last.text
             self._update(

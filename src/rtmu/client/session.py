@@ -250,7 +250,7 @@ class Session:
         """
         self._cancel_connecting()
         self._connecting = asyncio.current_task()
-        if self.connected:  # connecting again (another profile) while driving: stop on the old link first
+        if self.connected and self.client.drove:  # type: ignore[union-attr]  # our drive: stop it first
             self.drive.send_stop("connecting elsewhere")
         target = Target(host, port, user, password, profile, auto_reconnect, protocol)
         await self._forget()
@@ -285,6 +285,7 @@ class Session:
             target.password,
             timeout=self.config.connect_timeout,
             protocol=target.protocol,
+            role=self.config.role,
         )
         if self._target is not target:  # disconnected (or re-targeted) meanwhile
             await client.disconnect()
@@ -313,7 +314,7 @@ class Session:
     async def disconnect(self) -> None:
         """Stop the robot, say goodbye, forget the robot's values. Returns within a fraction of a second."""
         self._cancel_connecting()
-        if self.connected:
+        if self.connected and self.client.drove:  # type: ignore[union-attr]  # only our own drive
             self.drive.send_stop("disconnect")
         await self._forget()
         self._set_connection(

@@ -8,6 +8,7 @@ from typing import Any
 
 from .mapcache import SharedMaps
 from .reconnect import Backoff
+from .roles import Role
 
 
 @dataclass
@@ -37,6 +38,8 @@ class SessionConfig:
     extra_feeds: tuple[type[Any], ...] = ()
     """:class:`~rtmu.client.feed.Feed` classes besides the standard set (:data:`rtmu.client.feeds.FEEDS`):
     a new capability plugs in here."""
+    role: Role = Role.OPERATOR
+    """OBSERVER (a recorder, a read-only bridge, a replay): no motion request ever leaves (client.roles)."""
 
 
 @dataclass

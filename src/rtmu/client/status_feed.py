@@ -31,6 +31,11 @@ class StatusFeed(Feed):
         super().__init__(ctx)
         self.on_status: Callable[[float], None] = lambda at: None
         """Every status packet's arrival time: the session gives it to the drive loop's health."""
+        self._battery_unit_known = True
+        """False while ``batteryInfo`` has not said whether the battery number is volts or a state of
+        charge: the number is not published until then (95.4 is no voltage)."""
+        self._battery_held: float | None = None
+        """The last battery number while its unit was not known yet: published once it is."""
 
     def subscriptions(self, client: AriaClient) -> Iterable[Subscription]:
         period = self.ctx.config.status_interval_ms
@@ -43,6 +48,7 @@ class StatusFeed(Feed):
         )
 
     def connected(self, client: AriaClient) -> None:
+        self._battery_unit_known = not client.supports("batteryInfo")
         self.ctx.spawn(self._fetch_infos(client), "status-infos")
 
     def handle(self, intent: Intent) -> None:
@@ -56,16 +62,22 @@ class StatusFeed(Feed):
     async def _fetch_infos(self, client: AriaClient) -> None:
         timeout = self.ctx.config.reply_timeout
         with contextlib.suppress(ClientError, ProtocolError):
-            if client.supports("batteryInfo"):
-                info = self.ctx.decode(
-                    "batteryInfo", (await client.request_once("batteryInfo", timeout=timeout)).payload
-                )
-                if isinstance(info, BatteryInfo):
-                    self.ctx.robot_update(
-                        battery_low=info.low_battery,
-                        battery_shutdown=info.shutdown,
-                        battery_is_soc=info.state_of_charge,
+            try:
+                if client.supports("batteryInfo"):
+                    info = self.ctx.decode(
+                        "batteryInfo", (await client.request_once("batteryInfo", timeout=timeout)).payload
                     )
+                    if isinstance(info, BatteryInfo):
+                        self.ctx.robot_update(
+                            battery_low=info.low_battery,
+                            battery_shutdown=info.shutdown,
+                            battery_is_soc=info.state_of_charge,
+                        )
+            finally:  # answered, refused or timed out: the number is shown, now and from then on
+                if self.ctx.client is client and not self._battery_unit_known:
+                    self._battery_unit_known = True
+                    if self._battery_held is not None:
+                        self.ctx.robot_update(battery_v=self._battery_held)
             if client.supports("getSafeDrive"):
                 await self._refresh_safe_drive(client)
 
@@ -86,9 +98,10 @@ class StatusFeed(Feed):
             self._apply_numbers(numbers, packet.received_at)
 
     def _apply_numbers(self, n: UpdateNumbers, at: float) -> None:
+        self._battery_held = n.battery
         self.ctx.robot_update(
             x=float(n.x), y=float(n.y), th=float(n.th), vel=float(n.vel), rot_vel=float(n.rot_vel),
-            lat_vel=float(n.lat_vel), battery_v=n.battery,
+            lat_vel=float(n.lat_vel), battery_v=n.battery if self._battery_unit_known else None,
             temperature=float(n.temperature) if n.temperature_known else None, numbers_at=at,
         )  # fmt: skip
         self.on_status(at)

@@ -35,11 +35,9 @@ from ..values.state import VideoStatus
 from .connection import AriaClient
 from .defaults import MAX_FPS, MIN_FPS
 from .errors import ClientError, ClientTimeout, NotSupported, ServerClosed
+from .jpeg_bounds import MAX_SIDE, STAMP_PREFIX, fill_problem, read_header
 
-STAMP_PREFIX = b"RTMU-T="
-"""JPEG comment (COM segment) text the simulator writes: render time in wall-clock nanoseconds."""
-MAX_SIDE = 8192
-"""Largest width or height accepted from a server; no robot camera comes near it."""
+__all__ = ["MAX_SIDE", "STAMP_PREFIX", "BadFrame", "VideoFeed", "check_frame", "frame_stamp", "parse_frame"]
 DEFAULT_FPS = 15.0
 DEFAULT_QUALITY: int | None = None
 """None: leave the quality argument out (the server's own choice), as ARIA's example client does."""
@@ -79,8 +77,6 @@ rough period that only says when to look next."""
 RETRY_MAX_S = 1.0
 STATS_WINDOW_S = 2.0
 MAX_AGES = 1000
-MAX_SCAN_SEGMENTS = 64
-"""Markers walked before the picture data when looking for the stamp and frame size."""
 
 
 class BadFrame(ValueError):
@@ -89,36 +85,7 @@ class BadFrame(ValueError):
 
 def frame_stamp(jpeg: bytes) -> int | None:
     """The render time (wall-clock ns) in the frame's ``RTMU-T=`` comment, or None when it has none."""
-    return _scan(jpeg)[0]
-
-
-def _scan(jpeg: bytes) -> tuple[int | None, tuple[int, int] | None]:
-    """Walk the JPEG's header segments (bounded): its stamp and the size its frame header declares."""
-    stamp: int | None = None
-    size: tuple[int, int] | None = None
-    i = 2
-    for _ in range(MAX_SCAN_SEGMENTS):
-        if i + 4 > len(jpeg) or jpeg[i] != 0xFF:
-            break
-        marker = jpeg[i + 1]
-        if marker == 0xFF:  # fill byte
-            i += 1
-            continue
-        if marker in (0xD8, 0x01) or 0xD0 <= marker <= 0xD7:
-            i += 2
-            continue
-        length = int.from_bytes(jpeg[i + 2 : i + 4], "big")
-        body = jpeg[i + 4 : i + 2 + length]
-        if marker == 0xFE and body.startswith(STAMP_PREFIX):
-            digits = body[len(STAMP_PREFIX) :].split(b"\x00", 1)[0].strip()
-            if digits.isdigit() and len(digits) <= 20:
-                stamp = int(digits)
-        elif marker in (0xC0, 0xC1, 0xC2, 0xC3) and len(body) >= 5:
-            size = (int.from_bytes(body[3:5], "big"), int.from_bytes(body[1:3], "big"))
-        if marker == 0xDA:  # start of scan: the header is over
-            break
-        i += 2 + length
-    return stamp, size
+    return read_header(jpeg).stamp
 
 
 def check_frame(jpeg: bytes, width: int, height: int) -> tuple[int | None, tuple[int, int]]:
@@ -132,15 +99,14 @@ def check_frame(jpeg: bytes, width: int, height: int) -> tuple[int | None, tuple
         raise BadFrame(f"the {len(jpeg)} bytes received are not a JPEG picture")
     if not jpeg.endswith(b"\xff\xd9"):
         raise BadFrame(f"the picture is cut short ({len(jpeg)} bytes, no end marker)")
-    stamp, size = _scan(jpeg)
-    if size is None:
-        raise BadFrame("the picture has no frame header")
-    w, h = size
-    if not (0 < w <= MAX_SIDE and 0 < h <= MAX_SIDE):
-        raise BadFrame(f"the picture declares {w}x{h} pixels, outside 1…{MAX_SIDE}")
-    if (width, height) != (0, 0) and (w, h) != (width, height):
-        raise BadFrame(f"the server says {width}x{height} but the picture is {w}x{h}")
-    return stamp, size
+    header = read_header(jpeg)
+    size = header.size
+    if size is not None and min(size) > 0 and max(size) <= MAX_SIDE and (width, height) not in ((0, 0), size):
+        raise BadFrame(f"the server says {width}x{height} but the picture is {size[0]}x{size[1]}")
+    problem = fill_problem(jpeg, header)  # its data can fill what it declares (jpeg_bounds)
+    if problem is not None or size is None:
+        raise BadFrame(problem or "the picture has no frame header")
+    return header.stamp, size
 
 
 def parse_frame(payload: bytes) -> tuple[VideoFrame, int | None]:

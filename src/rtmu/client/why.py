@@ -23,10 +23,11 @@ from __future__ import annotations
 import math
 import re
 
+from ..protocol.payloads.drive import RATIO_ROT_DEAD_ZONE, RATIO_TRANS_DEAD_ZONE, RatioDrive
 from ..protocol.payloads.robot import ModeInfo
-from ..values.state import LinkLevel
+from ..values.state import LinkLevel, NavOutcome
 from .lease import RESEND_PERIOD
-from .nav_status import NavPhase, read_status
+from .nav_status import read_status
 from .why_values import (
     Answer,
     Cause,
@@ -149,6 +150,27 @@ def _rights(facts: Facts, motion: Motion | None, navigate: bool) -> list[Reason]
     return out
 
 
+def _dead_zone(facts: Facts, motion: Motion | None, navigate: bool) -> list[Reason]:
+    """The drive asked for is one ARIA's ratio drive ignores: it is the request, not the robot."""
+    if (
+        motion is None
+        or "ratioDrive" not in facts.offers
+        or not RatioDrive(motion.trans, motion.rot).in_dead_zone
+    ):
+        return []
+    return [
+        Reason(
+            Cause.DEAD_ZONE,
+            f"the drive asked for (translation {motion.trans:g} %, rotation {motion.rot:g} %) is inside "
+            f"ARIA's dead zone (translation up to ±{RATIO_TRANS_DEAD_ZONE:g} %, rotation under "
+            f"±{RATIO_ROT_DEAD_ZONE:g} %): the server ignores it",
+            f"ask for more than {RATIO_TRANS_DEAD_ZONE:g} % translation or at least "
+            f"{RATIO_ROT_DEAD_ZONE:g} % rotation",
+            (f"our ratioDrive: {motion.trans:g} % translation, {motion.rot:g} % rotation",),
+        )
+    ]
+
+
 def _safety_words(facts: Facts, motion: Motion | None, navigate: bool) -> list[Reason]:
     out: list[Reason] = []
     lines = _words(facts)
@@ -249,7 +271,7 @@ def _modes(facts: Facts, motion: Motion | None, navigate: bool) -> list[Reason]:
     out: list[Reason] = []
     info = facts.mode_info
     docked = facts.dock_state == "Docked" or (
-        read_status(facts.status).phase is NavPhase.DOCKED
+        read_status(facts.status).phase is NavOutcome.DOCKED
         and info is not None
         and info.mode_name in DOCK_MODES
     )
@@ -301,7 +323,7 @@ def _modes(facts: Facts, motion: Motion | None, navigate: bool) -> list[Reason]:
                 )
             )
     reading = read_status(facts.status, info.mode_name if info else "")
-    if reading.phase is NavPhase.GOING and not docked:
+    if reading.phase is NavOutcome.GOING and not docked:
         fix = (
             Fix("stop", "send stop (the server's own driving ends)", "stop", False)
             if "stop" in facts.offers
@@ -439,7 +461,7 @@ def _side(o: Obstacle) -> str:
     return f"({abs(o.y):.0f} mm to the {'left' if o.y > 0 else 'right'})"
 
 
-_RULES = (_our_side, _rights, _safety_words, _battery, _stalled, _modes, _watchdog, _safe_drive)
+_RULES = (_our_side, _rights, _dead_zone, _safety_words, _battery, _stalled, _modes, _watchdog, _safe_drive)
 
 
 # -- did it move? ----------------------------------------------------------------------------------

@@ -20,9 +20,10 @@ from dataclasses import dataclass
 from ..protocol.payloads.drive import RatioDrive, SafeDrive, SetSafeDrive
 from ..protocol.payloads.ld import DockInfo
 from ..protocol.payloads.robot import ModeInfo, UpdateStrings
+from ..values.state import NavOutcome
 from .connection import AriaClient
 from .errors import ClientError
-from .nav_status import NavPhase, read_status
+from .nav_status import read_status
 from .why_values import Facts, Fix
 
 POLL = 0.1
@@ -135,7 +136,7 @@ async def _not_navigating(client: AriaClient, timeout: float) -> bool | None:
     strings = await _reply(client, "updateStrings", timeout)
     if not isinstance(strings, UpdateStrings):
         return None
-    return read_status(strings.status).phase is not NavPhase.GOING
+    return read_status(strings.status).phase is not NavOutcome.GOING
 
 
 async def _safe_drive_off(client: AriaClient, timeout: float) -> bool | None:

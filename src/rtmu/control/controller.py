@@ -30,7 +30,11 @@ Driving rules
   every stop above blocks the stick too, until the dead-man is released and
   pressed again.
 * Speed: 10…100 % in 10 % steps; it is the ``ratioDrive`` throttle and applies at
-  once to a drive in progress.
+  once to a drive in progress. The operator's near-people cap (``OperatorState.near_people``)
+  lowers that throttle so a full drive stays under it, from the robot's top speed
+  (``motion_limits``: the server's own, else ARIA's P3-DX maximum, raised by any faster speed seen).
+* Every jog (Turn, Go) ends with its outcome said (``jog_watch``): arrived, stopped short and why,
+  or ended by a stop, a drive or a navigation.
 
 Navigation rules (the server drives: ARNL's goals, points, home, dock, tours)
 -----------------------------------------------------------------------------
@@ -42,6 +46,13 @@ Navigation rules (the server drives: ARNL's goals, points, home, dock, tours)
   stop before the goal), so the next ``ratioDrive`` cannot take it back.
 * Navigation is autonomy on the server: focus loss, a stale link or a lapsed lease
   end *held drives* only, never a navigation (disconnecting still stops the robot).
+* Looking never stops a mission: changing page (map ⇄ camera) or opening a dialog (Turn, Go, the
+  server's commands) ends a held drive — its keys go elsewhere — but never a navigation, and
+  is no stop key (:meth:`look`). Only STOP, Space and the drive keys cancel a navigation.
+* No drive starts or goes on while the stop key cannot reach the window (:meth:`focus_lost` until
+  :meth:`focus_gained` or a key press): a D-pad press then is refused, saying why
+  (:meth:`pointer_may_drive`).
+* Every stop the controller makes is said once, with what to do next.
 """
 
 from __future__ import annotations
@@ -57,8 +68,10 @@ from ..client.lease import DriveLease, DriveRatios, EndReason
 from ..model.observables import OperatorState, RobotModel, SpeedSetting
 from ..settings.store import Profile
 from ..values.intents import GotoGoal, Intent, RequestPicture, StartVideo, Stop, picture_source
-from ..values.state import ConnectionState, LinkHealth, LinkLevel, NavState, Phase
+from ..values.state import ConnectionState, LinkHealth, LinkLevel, NavState, Phase, RobotState
 from .commands import COMMANDS, CommandRegistry, CommandState
+from .motion_limits import RobotLimits, capped_throttle
+from .motion_watch import MotionWatch
 
 TICK = 0.1
 """Seconds between :meth:`Controller.tick` calls the UI timer should make (10 Hz renewal)."""
@@ -202,6 +215,10 @@ class Controller:
         """We sent the stop that ends the current navigation; the server has not said so yet."""
         self.tap: Callable[[str, dict[str, Any]], None] | None = None
         """The flight recorder's tap: every intent sent, and every connect (without its password)."""
+        self.keys_reach = True
+        """The window has the keyboard, so the stop key reaches it (False from focus loss to focus gain)."""
+        self.motion = MotionWatch(link, lambda n: self.view.notify(n), self._reapply, clock)
+        """The robot's limits (the cap, the stopping distance) and how each jog ended."""
         self.replay: str | None = None
         """Set to the recording's name while the window shows a replay: then nothing is sent at all
         (drive keys, D-pad, STOP and every server command say "replay"), and no lease is granted."""
@@ -210,6 +227,8 @@ class Controller:
             robot.connection.observe(self._on_connection),
             robot.health.observe(self._on_health),
             robot.navigation.observe(self._on_navigation),
+            robot.robot.observe(self._on_robot),
+            operator.near_people.observe(lambda _old, _new: self._reapply()),
         ]
         self.refresh_commands()
 
@@ -277,6 +296,7 @@ class Controller:
         if direction not in DIRECTIONS:
             raise ValueError(f"unknown direction {direction!r}")
         self._unfocused = False  # key presses reach a focused window only
+        self.keys_reach = True
         if direction in self._held or direction in self._blocked:
             return  # key auto-repeat, or a key held through a stop: wait for its release
         if self.replay:
@@ -341,6 +361,7 @@ class Controller:
 
     def tick(self) -> None:
         """Renew the lease while keys are held. Call every :data:`TICK` s from the UI thread's timer."""
+        self.motion.tick(self.robot.robot.value)
         if not self._held and (self._analog is None or self._generation is None):
             return
         if not self.link.lease.renew():
@@ -348,7 +369,9 @@ class Controller:
             self._halt_held(reason)
 
     def _apply(self) -> None:
-        speed = self.operator.speed.value.percent
+        speed = capped_throttle(
+            self.operator.speed.value.percent, self.operator.near_people.value.cap, self.limits
+        )
         if self._held or self._analog is None:
             ratios = ratios_for(self._held, speed)
         else:
@@ -364,8 +387,14 @@ class Controller:
                 # The lease died under us (lapsed/stale); the keys pressed before are stale too.
                 self._halt_held(lease.ended or EndReason.LAPSED)
                 return
+            self._end_jog("a drive")
             self._generation = lease.grant(ratios)
             self.view.driving()
+
+    def _reapply(self) -> None:
+        """The cap or the robot's limits changed: a drive in progress takes the new throttle at once."""
+        if (self._held or self._analog is not None) and self._generation is not None:
+            self._apply()
 
     def _halt_held(self, reason: EndReason, *, quiet: bool = False) -> None:
         """Motion was stopped for ``reason`` while keys were held: block them until released.
@@ -385,7 +414,8 @@ class Controller:
         if had and reason is EndReason.LAPSED:
             self.view.notify(
                 Notice.warning(
-                    Kind.SAFETY, "Stopped: the window did not respond in time. Press again to drive."
+                    Kind.SAFETY,
+                    "Stopped: the window did not respond in time (a busy computer?). Press again to drive.",
                 )
             )
         elif had and reason is EndReason.LINK and not quiet:
@@ -393,7 +423,9 @@ class Controller:
             self._say_link_stop(level if level in (LinkLevel.STALE, LinkLevel.LOST) else LinkLevel.STALE)
 
     def _say_link_stop(self, level: LinkLevel) -> None:
-        self.view.notify(Notice.warning(Kind.LINK, f"Stopped: the link is {level.value}"))
+        self.view.notify(
+            Notice.warning(Kind.LINK, f"Stopped: the link is {level.value}. Press again once it is back.")
+        )
 
     def stop(self) -> None:
         """Stop now. Always sent, whatever the link looks like; held keys must be pressed again.
@@ -406,6 +438,7 @@ class Controller:
             return
         if self.navigating:
             self._nav_cancelled = True
+        self._end_jog("STOP")
         self._halt_held(EndReason.STOPPED)
         self.link.lease.end(EndReason.STOPPED)
         if self.robot.connection.value.phase in (Phase.CONNECTED, Phase.RECONNECTING, Phase.CONNECTING):
@@ -420,18 +453,44 @@ class Controller:
         Keys held now stay blocked until a real release is seen after focus returns (see the
         module notes): auto-repeat of a key held all along must not start the robot again.
         """
-        if self._held or self._generation is not None:
+        driving = bool(self._held) or self._generation is not None
+        if driving:
             self.stop()
+            said = "Stopped: the window lost the keyboard. Click the map, then press again to drive."
+            self.view.notify(Notice.warning(Kind.SAFETY, said))
         if self._analog is not None:
             self._analog = None
             self._analog_blocked = True
         self._blocked |= self._held
         self._held.clear()
         self._unfocused = True
+        self.keys_reach = False
 
     def focus_gained(self) -> None:
         """The window has the keyboard again: releases from now on are real (optional for a view)."""
         self._unfocused = False
+        self.keys_reach = True
+
+    def pointer_may_drive(self) -> bool:
+        """A D-pad (pointer, touch) hold may start only while the stop key reaches the window: else it
+        is refused, saying why (a key press proves the keyboard is here; a pointer press does not)."""
+        if not self.keys_reach:
+            said = (
+                "Not driving: Space could not stop it, the keyboard is elsewhere. Click the map, then drive."
+            )
+            self.view.notify(Notice.warning(Kind.SAFETY, said))
+        return self.keys_reach
+
+    def look(self, what: str, *, keys_leave: bool = False) -> None:
+        """The operator looks elsewhere (``what``: "the camera page", "a dialog", "the menu"): a held
+        drive ends, its keys blocked until released, and says so; a navigation goes on, and nothing is
+        sent for it. ``keys_leave``: the keyboard goes to another surface of the window (a menu), so
+        key-ups seen until the next press are not real ones (as after a focus loss)."""
+        if self._held or (self._analog is not None and self._generation is not None):
+            self._halt_held(EndReason.STOPPED)
+            self.view.notify(Notice.info(Kind.SAFETY, f"Stopped for {what}. Press again to drive."))
+        if keys_leave:
+            self._unfocused = True
 
     # -- speed -------------------------------------------------------------------------------
     def speed_up(self) -> None:
@@ -447,8 +506,7 @@ class Controller:
             )
             return
         self.view.notify(Notice.info(Kind.SPEED, f"Speed {new.percent} %"))
-        if (self._held or self._analog is not None) and self._generation is not None:
-            self._apply()
+        self._reapply()
 
     # -- every other intent: the guard ---------------------------------------------------------
     def ask(self, intent: Intent) -> Any:
@@ -483,7 +541,10 @@ class Controller:
             self._halt_held(EndReason.STOPPED)  # the network side sends its stop before the intent
             self._nav_cancelled = False
         self._record(intent)
-        return self.link.send(intent)
+        sent = self.link.send(intent)
+        if intent.moves:
+            self.motion.intent_sent(intent, self.robot.robot.value)  # a jog is watched to its outcome
+        return sent
 
     def _record(self, intent: Intent) -> None:
         tap = self.tap
@@ -601,12 +662,33 @@ class Controller:
 
     # -- dialogs -----------------------------------------------------------------------------
     def open_dialog(self, name: str) -> None:
-        """A command that needs an amount first (``turn``, ``go``): stop, then let the view ask for it."""
-        self.stop()
+        """A dialog a command needs (``turn``, ``go``: an amount; ``commands``: the palette).
+
+        Opening one is looking (:meth:`look`): it takes the keyboard, so a held drive ends — a Turn or
+        Go jog would take over from it anyway — but a navigation goes on until the operator runs what
+        the dialog asks, or presses STOP (the dialog carries the stop keys)."""
+        self.look("a dialog")
         self.view.open_dialog(name)
+
+    @property
+    def limits(self) -> RobotLimits:
+        """The robot's top speed and braking (``motion_limits``): the cap and the stopping distance."""
+        return self.motion.limits
+
+    def _on_robot(self, _old: RobotState, new: RobotState) -> None:
+        self.motion.robot_changed(
+            new, self.link.lease.view().ratios if self._generation is not None else None
+        )
+
+    def _end_jog(self, why: str) -> None:
+        self.motion.end_jog(why, self.robot.robot.value)
 
     # -- reactions to the model --------------------------------------------------------------
     def _on_connection(self, old: ConnectionState, new: ConnectionState) -> None:
+        if new.phase is Phase.CONNECTED and old.phase is not Phase.CONNECTED:
+            self.motion.connected(self.supports, ask=not self.replay)  # a replay asks a recording nothing
+        elif new.phase is not Phase.CONNECTED and old.phase is Phase.CONNECTED:
+            self.motion.disconnected()
         if new.phase is not Phase.CONNECTED and old.phase is Phase.CONNECTED:
             self._halt_held(EndReason.DISCONNECTED)
         if new.phase is Phase.CONNECTED and old.phase is not Phase.CONNECTED:

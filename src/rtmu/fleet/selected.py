@@ -9,11 +9,13 @@ strings watched) moves with the selection through :meth:`SelectedRobot.on_switch
 
 from __future__ import annotations
 
+import concurrent.futures
 import contextlib
 import logging
 from collections.abc import Callable
 from typing import Any
 
+from ..client.errors import ClientError
 from ..values.intents import Intent
 from .sessions import RobotSession
 
@@ -33,6 +35,16 @@ class SelectedRobot:
     def ask(self, intent: Intent) -> Any:
         """Send ``intent`` to the selected robot through its controller's guard (None when refused)."""
         return self.session.controller.ask(intent)
+
+    def request(self, intent: Intent) -> concurrent.futures.Future[Any]:
+        """:meth:`ask` for a widget that waits for the answer: a refusal (said already by the
+        controller) comes back as a failed Future, so the widget's own waiting ends too."""
+        future = self.ask(intent)
+        if isinstance(future, concurrent.futures.Future):
+            return future
+        refused: concurrent.futures.Future[Any] = concurrent.futures.Future()
+        refused.set_exception(ClientError(f"{intent.label}: refused"))
+        return refused
 
     def show(self, session: RobotSession) -> None:
         """The selection moved (the fleet already stopped the robot selected before)."""

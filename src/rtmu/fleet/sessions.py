@@ -28,6 +28,7 @@ from dataclasses import replace
 from pathlib import Path
 from typing import Any
 
+from ..base.notices import Kind, Notice
 from ..client.link import Opener, open_tcp
 from ..client.roster import (
     DirectRoster,
@@ -266,7 +267,11 @@ class Fleet:
         if old is session:
             return
         if old is not None and not old.closed and (old.controller.held or not old.controller.navigating):
+            driving = bool(old.controller.held) or old.controller.analog_active
             old.controller.stop()  # also blocks its held keys until they are released
+            if driving:  # a stop the operator did not press is said, with what to do
+                said = f"Stopped {old.name}: {session.name} is selected now. Press again to drive it."
+                old.controller.view.notify(Notice.info(Kind.SAFETY, said))
         self.selected.set(session)
 
     def remove(self, session: RobotSession) -> None:

@@ -242,19 +242,16 @@ class SpeedSetting:
         if not SPEED_MIN <= self.percent <= SPEED_MAX or self.percent % SPEED_STEP:
             raise ValueError(f"speed must be {SPEED_MIN}…{SPEED_MAX} in steps of {SPEED_STEP}")
 
+    @classmethod
+    def nearest(cls, percent: int) -> SpeedSetting:
+        """The step at or below ``percent``, within 10…100 (a profile's saved speed)."""
+        return cls(max(SPEED_MIN, min(SPEED_MAX, percent // SPEED_STEP * SPEED_STEP)))
+
     def faster(self) -> SpeedSetting:
         return SpeedSetting(min(SPEED_MAX, self.percent + SPEED_STEP))
 
     def slower(self) -> SpeedSetting:
         return SpeedSetting(max(SPEED_MIN, self.percent - SPEED_STEP))
-
-    @property
-    def at_max(self) -> bool:
-        return self.percent >= SPEED_MAX
-
-    @property
-    def at_min(self) -> bool:
-        return self.percent <= SPEED_MIN
 
 
 @dataclass(frozen=True, slots=True)
@@ -265,9 +262,23 @@ class ViewOptions:
     show_sonar: bool = True
 
 
+@dataclass(frozen=True, slots=True)
+class NearPeople:
+    """The operator's speed cap for work near people: on or off, and how fast at most (mm/s)."""
+
+    on: bool = False
+    mm_s: int = 250
+
+    @property
+    def cap(self) -> int | None:
+        """The cap in force (None: off)."""
+        return self.mm_s if self.on else None
+
+
 class OperatorState:
     """What the operator chose, shared by every robot the window shows: speed step and view options."""
 
     def __init__(self) -> None:
         self.speed: Observable[SpeedSetting] = Observable(SpeedSetting())
+        self.near_people: Observable[NearPeople] = Observable(NearPeople())
         self.view: Observable[ViewOptions] = Observable(ViewOptions())

@@ -28,7 +28,6 @@ if TYPE_CHECKING:
     import numpy as np
 
     from .decoder import PacketDecoder
-
     from .payloads.robot import Update, UpdateNumbers
 
 UPDATE_NUMBERS: Final = "updateNumbers"
@@ -266,7 +265,9 @@ class StatusStream:
         mode = np.empty(len(rows), dtype=object)
         status[:] = [r[2] for r in rows]
         mode[:] = [r[3] for r in rows]
-        return StatusBatch(np.array([r[0] for r in rows], dtype=np.int64), numbers, status, mode, len(packets))
+        return StatusBatch(
+            np.array([r[0] for r in rows], dtype=np.int64), numbers, status, mode, len(packets)
+        )
 
 
 BULK_BYTES: Final = 8192

@@ -26,10 +26,11 @@ from ..client.lease import LeaseEvent
 from ..client.link import Opener, open_tcp
 from ..client.runner import ClientRunner
 from ..values.state import ConnectionChanged, Phase, StateChange
-from . import files, topics
+from . import files, scrub, topics
 from .convert import jsonable, notice_record
 from .items import Event, Item, LinkOpened, Published, RawChunk
 from .recording import Limits, Recording
+from .scrub import LoginScrubber
 from .tee import RawSink, tee_opener
 
 ENDS_A_RECORDING = (Phase.DISCONNECTED, Phase.FAILED)
@@ -95,7 +96,7 @@ class Recorder:
             conn = self._conn
         now = time.time_ns()
         recording.submit(LinkOpened(conn, host, port, now))
-        return conn, partial(_raw_to, recording)
+        return conn, partial(_raw_to, recording, LoginScrubber())
 
     def _start(self, host: str, port: int) -> Recording | None:
         old = self.recording
@@ -106,6 +107,7 @@ class Recorder:
         metadata = {
             "robot": f"{host}:{port}",
             "started_utc": time.strftime("%Y-%m-%dT%H:%M:%SZ", time.gmtime()),
+            **scrub.METADATA,
         }
         recording = Recording(path, metadata=metadata, limits=limits, on_problem=self.notify)
         recording.prune = partial(files.prune, self.config.directory, self.config.keep_days)
@@ -173,5 +175,11 @@ class Recorder:
             recording.close(max(0.0, deadline - time.monotonic()))
 
 
-def _raw_to(recording: Recording, chunk: RawChunk) -> None:
+def _raw_to(recording: Recording, scrubber: LoginScrubber, chunk: RawChunk) -> None:
+    if chunk.direction == "c2s":
+        data = scrubber(chunk.data)  # the login's password digest is never recorded (recorder.scrub)
+        if not data:
+            return
+        if data is not chunk.data:
+            chunk = RawChunk(chunk.conn, chunk.direction, data, chunk.at_ns)
     recording.submit(chunk)

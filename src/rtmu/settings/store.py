@@ -6,6 +6,8 @@ when the variable is unset), a small flat TOML document::
     version = 1
     last_profile = "lab"
     alarms_muted = true     # optional: the alarm beep is off (View > Alarm sound)
+    near_people = true      # optional: View > Near people caps held driving …
+    near_people_mm_s = 250  # … at this speed (mm/s, 50…1000; 250 when not given)
 
     [profiles."lab"]
     host = "10.0.0.5"
@@ -63,6 +65,9 @@ log = logging.getLogger(__name__)
 
 DEFAULT_PORT = 7272
 SCHEMA_VERSION = 1
+NEAR_PEOPLE_KEYS = ("near_people", "near_people_mm_s")
+NEAR_PEOPLE_RANGE = (50, 1000)
+"""mm/s a near-people cap may be set to in the settings file."""
 KEYRING_SERVICE = "rtmu"
 MAX_SETTINGS_BYTES = 1 << 20
 """A settings file larger than this is not ours."""
@@ -217,6 +222,10 @@ class Settings:
     recording: RecordingSettings = field(default_factory=RecordingSettings)
     alarms_muted: bool = False
     """The alarm sound is off (``alarms_muted = true``; the banners still show): the View menu's switch."""
+    near_people: bool = False
+    """Held driving is capped at :attr:`near_people_mm_s` (View → Near people)."""
+    near_people_mm_s: int | None = None
+    """Its speed (mm/s) when the operator chose one; None: the window's default (250 mm/s)."""
     layers: dict[str, dict[str, bool]] = field(default_factory=dict)
     """The operator's drawing choices per server (``"host:port"`` → drawing name → shown), as the
     optional tables ``[layers."10.0.0.5:7272"]`` with ``"sonarCurrent" = false`` lines."""
@@ -273,10 +282,11 @@ def parse_settings(text: str) -> Settings:
         doc = tomllib.loads(text)
     except tomllib.TOMLDecodeError as exc:
         raise SettingsError(f"not valid TOML: {exc}") from None
-    version = doc.get("version")
+    version = doc.get("version", SCHEMA_VERSION)  # a hand-written file without the line: version 1
     if version != SCHEMA_VERSION:
         raise SettingsError(f"unknown settings version {version!r} (this RTMU writes {SCHEMA_VERSION})")
-    unknown = set(doc) - {"version", "last_profile", "profiles", "recording", "alarms_muted", "layers"}
+    known = {"version", "last_profile", "profiles", "recording", "alarms_muted", "layers", *NEAR_PEOPLE_KEYS}
+    unknown = set(doc) - known
     if unknown:
         raise SettingsError(f"unknown settings: {', '.join(sorted(unknown))}")
     raw_profiles = doc.get("profiles", {})
@@ -296,6 +306,17 @@ def parse_settings(text: str) -> Settings:
     if type(muted) is not bool:
         raise SettingsError(f"alarms_muted must be true or false, not {muted!r}")
     settings.alarms_muted = muted
+    near = doc.get("near_people", False)
+    if type(near) is not bool:
+        raise SettingsError(f"near_people must be true or false, not {near!r}")
+    settings.near_people = near
+    cap = doc.get("near_people_mm_s")
+    if cap is not None and (type(cap) is not int or not NEAR_PEOPLE_RANGE[0] <= cap <= NEAR_PEOPLE_RANGE[1]):
+        low, high = NEAR_PEOPLE_RANGE
+        raise SettingsError(
+            f"near_people_mm_s must be a whole number of mm/s from {low} to {high}, not {cap!r}"
+        )
+    settings.near_people_mm_s = cap
     settings.layers = _layers(doc.get("layers", {}))
     return settings
 
@@ -404,13 +425,24 @@ def load_settings(path: Path | None = None) -> Loaded:
             text = data.decode("utf-8")
         except UnicodeDecodeError:
             raise SettingsError("the file is not UTF-8 text") from None
-        return Loaded(parse_settings(text))
+        settings = parse_settings(text)
+        if not _says_its_version(text):
+            note = (
+                f"the settings file {path} has no 'version = {SCHEMA_VERSION}' line: it was read as version "
+                f"{SCHEMA_VERSION} (RTMU writes the line when it next saves)"
+            )
+            return Loaded(settings, note)
+        return Loaded(settings)
     except SettingsError as exc:
         moved = _set_aside(path)
         where = f"; it was kept as {moved.name}" if moved else ""
         warning = f"ignoring the settings file {path} ({exc}){where}; using default settings"
         log.warning(warning)
         return Loaded(Settings(), warning, moved)
+
+
+def _says_its_version(text: str) -> bool:
+    return "version" in tomllib.loads(text)
 
 
 def _set_aside(path: Path) -> Path | None:
@@ -438,6 +470,10 @@ def format_settings(settings: Settings) -> str:
         lines.append(f"last_profile = {_toml_string(settings.last_profile)}")
     if settings.alarms_muted:
         lines.append("alarms_muted = true")
+    if settings.near_people:
+        lines.append("near_people = true")
+    if settings.near_people_mm_s is not None:
+        lines.append(f"near_people_mm_s = {int(settings.near_people_mm_s)}")
     for profile in settings.profiles.values():
         profile.validate()
         lines += ["", f"[profiles.{_toml_string(profile.name)}]"]

@@ -48,6 +48,8 @@ LAST_EDITABLE = Priority.EXPERT
 """As ARIA's handler without factory permission: FACTORY parameters are shown, never changed."""
 CAMERA_SIZES = {"320x240": (320, 240), "640x480": (640, 480)}
 FILLER_PER_SECTION = 1000
+FILLER_CONTROL_SECTION = "Line\rbreak\nand \x1b[2Jescape"
+"""A hostile section name with filler: a CR, a newline and a terminal escape in it."""
 MIN_TIMEOUT = 0.1
 """A watchdog shorter than a client's resend period would stop every held drive: refused (0 is "off")."""
 
@@ -150,6 +152,16 @@ class SimArConfig:
             lambda: round(ratio.rot_vel_max),
             setter(ratio, "rot_vel_max"),
         )
+        for name, attr, what, top in (
+            ("TransDecel", "trans_decel", "Braking on a stop or zero ratios, in mm/s²", 1000),
+            ("RotDecel", "rot_decel", "Slowing of a turn on a stop or zero ratios, in deg/s²", 500),
+        ):  # ARIA's ArRobotConfig lists these beside TransVelMax; its absolute maxima cap them
+            self._add(
+                "Robot config",
+                ConfigParam(name, ParamType.INT, 0, what, Priority.BASIC, 10, top),
+                lambda attr=attr: round(getattr(body, attr)),  # type: ignore[misc]
+                setter(body, attr),
+            )
         self._add("Robot config", ConfigParam("", ParamType.SEPARATOR), none, ignore)
         self._add(
             "Robot config",
@@ -302,6 +314,16 @@ class SimArConfig:
             )
             key = (section, name)
             self._add(section, template, lambda k=key: store[k], lambda v, k=key: store.__setitem__(k, v))  # type: ignore[misc]
+        if count:  # control characters in names: a CR, a newline, an escape
+            section, name = FILLER_CONTROL_SECTION, "Line\rbreak"
+            store[(section, name)] = 1
+            template = ConfigParam(name, ParamType.INT, None, "a CR in its name", 0, 0, 10, -1)
+            self._add(
+                section,
+                template,
+                lambda: store[(FILLER_CONTROL_SECTION, "Line\rbreak")],
+                lambda v: store.__setitem__((FILLER_CONTROL_SECTION, "Line\rbreak"), v),
+            )
 
     def values(self) -> list[tuple[str, str, str]]:
         """``(section, parameter, value text)`` of every parameter that has a value, in order."""

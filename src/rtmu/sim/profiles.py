@@ -60,6 +60,8 @@ class SimProfile:
     """Data modules (``ROWS`` + ``HANDLERS``) this profile serves — the extension point."""
     handlers: dict[str, Handler] = field(default_factory=dict)
     """Handlers of this profile that replace the default ones."""
+    robot: str = "Pioneer 3-DX"
+    """What the simulated robot is, in words (``rtmu sim`` says it when it starts)."""
 
     def module_parts(self) -> tuple[list[Row], dict[str, Handler]]:
         rows: list[Row] = []
@@ -196,6 +198,7 @@ ARAM = SimProfile(
         "update": _soc_update,
         "getMapBinary": _ex4_map_binary,
     },
+    robot="Omron LD robot (ARAM)",
 )
 PROFILES: dict[str, SimProfile] = {p.name: p for p in (DEFAULT, ARAM)}
 

@@ -59,6 +59,7 @@ from .handlers import (
     popup_payload,
     strings_payload,
 )
+from .heard import RequestLog
 from .mapserve import Chunks, ServedMap, load_map
 from .navmodes import NavMap
 from .profiles import get_profile
@@ -305,6 +306,9 @@ class Session:
             self.server.malformed_packets += self.conn.malformed_packets - malformed
             log.info("client %s: %d malformed control packet(s)", self.peer, self.conn.malformed_packets)
         for event in events:
+            if isinstance(event, (RequestOnce, RequestReceived)):
+                once = isinstance(event, RequestOnce)
+                self.server.heard.note(self.server.world.time, self.ident, self.peer, event.name, once=once)
             if isinstance(event, RequestOnce):
                 self.server.invoke(self, event.number, event.name, event.args, once=True)
             elif isinstance(event, RequestReceived):
@@ -371,6 +375,8 @@ class SimServer:
         self.sessions: list[Session] = []
         self.stop_log: deque[tuple[float, int, str]] = deque(maxlen=1000)
         """Every ``stop`` received: (world time, session ident, the client's self identifier)."""
+        self.heard = RequestLog()
+        """Every request of every connection, by name (tests: no observer ever sent a motion request)."""
         self._ids = count(1)
         self._server: asyncio.base_events.Server | None = None
         self._cycle_task: asyncio.Task[None] | None = None
@@ -728,6 +734,7 @@ class SimServer:
         b.x, b.y, b.th = self.home
         b.vel = b.rot_vel = 0.0
         b.stalled = False
+        self.world.dock_mode.leave()  # put back on its home cairn, it is on no dock
         self.world.stop()
 
 

@@ -257,6 +257,10 @@ class World:
     def localize_to(self, x: float, y: float, th: float) -> None:
         """``localizeToPose``: as ARNL with MobileSim, the simulated robot is put where the operator says
         (the nearest spot it fits, when that is inside something), then localizes for a moment."""
+        if self.nav_map is not None and not self._on_map(x, y):
+            # ARNL finds nothing of the map around a pose off it: it stays lost, the robot where it was.
+            self.localization.lose(self.time)
+            return
         fx, fy = free_spot_near(self.obstacles, x, y, p3dx.RADIUS_MM)
         b = self.body
         b.x, b.y, b.th = fx, fy, normalize_deg(th)
@@ -264,6 +268,12 @@ class World:
         b.stalled = False
         self._sonar_cache = self._laser_cache = None
         self.localization.start(self.time)
+
+    def _on_map(self, x: float, y: float) -> bool:
+        """True when (x, y) lies within the map's extent (its lines and points, a robot's width around)."""
+        lo_x, lo_y, hi_x, hi_y = self.obstacles.bounds
+        margin = p3dx.RADIUS_MM
+        return lo_x - margin <= x <= hi_x + margin and lo_y - margin <= y <= hi_y + margin
 
     def _jog(self) -> JogMode:
         if self.mode is not self.jog_mode:

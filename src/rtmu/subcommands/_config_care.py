@@ -5,16 +5,14 @@ from __future__ import annotations
 import argparse
 import sys
 from pathlib import Path
+from typing import TYPE_CHECKING
 
-from ..base.exit_codes import EXIT_OK, EXIT_USAGE
+from ..base.exit_codes import EXIT_OK, EXIT_REFUSED, EXIT_USAGE
 from ..base.textsafe import visible
-from ..client.config_care import differences, fetch_defaults, reload_config, reset, reset_targets
-from ..client.config_feed import fetch_config, set_config
-from ..client.config_file import ConfigFileError, export_text, plan_import, read_file, valued, write_export
-from ..client.connection import AriaClient
 from ._common import UsageError, print_json
 
-EXIT_REFUSED = 6
+if TYPE_CHECKING:
+    from ..client.connection import AriaClient
 
 
 def _refused(words: str) -> int:
@@ -23,6 +21,9 @@ def _refused(words: str) -> int:
 
 
 async def show_defaults(client: AriaClient, args: argparse.Namespace) -> int:
+    from ..client.config_care import differences, fetch_defaults
+    from ..client.config_feed import fetch_config
+
     config = await fetch_config(client, args.timeout)
     factory = await fetch_defaults(client, args.timeout)
     diffs = differences(config, factory)
@@ -52,6 +53,9 @@ async def show_defaults(client: AriaClient, args: argparse.Namespace) -> int:
 
 
 async def do_reset(client: AriaClient, args: argparse.Namespace) -> int:
+    from ..client.config_care import fetch_defaults, reset, reset_targets
+    from ..client.config_feed import fetch_config
+
     config = await fetch_config(client, args.timeout)
     factory = await fetch_defaults(client, args.timeout)
     try:
@@ -76,6 +80,9 @@ async def do_reset(client: AriaClient, args: argparse.Namespace) -> int:
 
 
 async def do_export(client: AriaClient, args: argparse.Namespace) -> int:
+    from ..client.config_feed import fetch_config
+    from ..client.config_file import ConfigFileError, export_text, valued, write_export
+
     path: Path = args.export
     if path.exists() and not args.force:  # say so before asking the server for anything
         raise UsageError(f"{path} already exists (give --force to replace it)")
@@ -92,6 +99,9 @@ async def do_export(client: AriaClient, args: argparse.Namespace) -> int:
 
 
 async def do_import(client: AriaClient, args: argparse.Namespace) -> int:
+    from ..client.config_feed import fetch_config, set_config
+    from ..client.config_file import ConfigFileError, plan_import, read_file
+
     try:
         values = read_file(args.import_file)
     except ConfigFileError as exc:
@@ -126,6 +136,8 @@ async def do_import(client: AriaClient, args: argparse.Namespace) -> int:
 
 
 async def do_reload(client: AriaClient, args: argparse.Namespace) -> int:
+    from ..client.config_care import reload_config
+
     await reload_config(client, args.timeout)
     _say(args, {"reloaded": True}, "the server read its configuration again")
     return EXIT_OK

@@ -4,13 +4,16 @@ from __future__ import annotations
 
 import dataclasses
 import sys
+from typing import TYPE_CHECKING
 
-from ..sim import SimConfig
+from ..base.exit_codes import EXIT_CONNECTION, EXIT_USAGE
 from ._common import until_stop_signal
 
-EXIT_OK = 0
-EXIT_BAD_INPUT = 2
-EXIT_CANNOT_LISTEN = 3
+if TYPE_CHECKING:
+    from ..sim import SimConfig
+
+EXIT_BAD_INPUT = EXIT_USAGE
+EXIT_CANNOT_LISTEN = EXIT_CONNECTION
 
 
 async def serve_central(cfg: SimConfig, robot_port: int, robots: int) -> int:
@@ -18,6 +21,7 @@ async def serve_central(cfg: SimConfig, robot_port: int, robots: int) -> int:
     from ..mapfile import MapFormatError
     from ..sim import SimServer
     from ..sim.central import CentralConfig, CentralServer
+    from ..sim.multi import start_poses
 
     # The user file guards the central port and the forwarders, as ARIA's switchServer's does; the
     # robots behind it let the forwarder in (it logs in without a user).
@@ -37,9 +41,11 @@ async def serve_central(cfg: SimConfig, robot_port: int, robots: int) -> int:
     )
     sims: list[SimServer] = []
     try:
-        for i in range(1, robots + 1):
+        # Start poses apart, as `rtmu sim --robots N` gives them (not all on the map's home).
+        for i, pose in enumerate(start_poses(cfg, robots), start=1):
             robot_cfg = dataclasses.replace(
                 cfg,
+                start_pose=pose,
                 port=0,
                 seed=cfg.seed + i - 1,
                 switch_to=f"{cfg.host}:{central.robot_port}",
@@ -52,9 +58,9 @@ async def serve_central(cfg: SimConfig, robot_port: int, robots: int) -> int:
             sims.append(sim)
         if robots:
             print(f"rtmu sim: {robots} simulated robot(s) switching to it: robot1…robot{robots}", flush=True)
-        await until_stop_signal()
+        code = await until_stop_signal()
         print("rtmu sim: stopping (telling operators and robots SHUTDOWN)", flush=True)
-        return EXIT_OK
+        return code
     except (OSError, MapFormatError, ValueError) as exc:
         print(f"rtmu sim: cannot start the robots: {exc}", file=sys.stderr)
         return EXIT_BAD_INPUT

@@ -26,15 +26,17 @@ import sys
 import time
 from typing import TYPE_CHECKING, Any
 
-from ..base.exit_codes import EXIT_OK, EXIT_TIMEOUT, EXIT_USAGE
+from ..base.exit_codes import EXIT_OK, EXIT_TIMEOUT, EXIT_USAGE, NETWORK
 from ..base.textsafe import visible
-from ..client.console_layout import KINDS
+from ..client.console_layout import KINDS, ArgumentError, describe, encode_arguments
+from ..client.roles import Role
 from ._common import add_connection_arguments, positive_float, print_json, run_with_client
 
 if TYPE_CHECKING:
     from ..client.connection import AriaClient
     from ..client.console import ConsoleEntry, ConsoleReply
 
+EXITS = NETWORK
 SILENT_OUTCOMES = ("silent", "stalled", "sent")
 FOLLOW_CHECK = 0.5
 """Seconds between looks at the connection while following a data."""
@@ -46,9 +48,11 @@ def register(subparsers: Any) -> None:
         help="call any data the server lists (a console): once, or at an interval; --list shows them all",
         description="Send data NAME once with ARGs (typed as its argument description says, or as "
         "--type names) and print each reply as hex, fields and RTMU's own type where it has one. "
-        "--every MS follows it (-1: broadcasts only). A data that changes something needs --yes. "
-        "Exit 0 replied, 2 not listed / wrong arguments / needs --yes / refused, 3 connection, "
-        "5 silent.",
+        "--every MS follows it (-1: broadcasts only). A data that changes something needs --yes (without "
+        "it this command is an observer: it cannot send a motion request); ratioDrive is never sent. A data "
+        "this user's list does not have, arguments that do not fit, a call that needs --yes, or one the "
+        "console refuses are usage errors (nothing is sent); no reply within --timeout (none at all while "
+        "following), a reply that stalls, or a command the server does not confirm taking is a timeout.",
     )
     _positionals_anywhere(p)
     add_connection_arguments(p)
@@ -112,6 +116,8 @@ def usage(message: str) -> int:
 
 
 def handle(args: argparse.Namespace) -> int:
+    from ..client.console import call, console_entries, entry_of
+
     listing = args.list_filter is not None
     if not listing and not args.name:
         return usage("give NAME (the data to call) or --list")
@@ -122,8 +128,6 @@ def handle(args: argparse.Namespace) -> int:
     if args.seconds is not None and args.every is None:
         return usage("--seconds goes with --every")
     types = [t.strip() for group in args.types or () for t in group.split(",") if t.strip()] or None
-    from ..client.console import call, console_entries, entry_of
-    from ..client.console_layout import ArgumentError, encode_arguments
 
     async def body(client: AriaClient) -> int:
         if listing:
@@ -142,7 +146,9 @@ def handle(args: argparse.Namespace) -> int:
         show(reply, entry, args.json, args.timeout)
         return EXIT_TIMEOUT if reply.outcome in SILENT_OUTCOMES else EXIT_OK
 
-    return run_with_client("call", args, body)
+    # Only a confirmed call (--yes) may be one that changes motion; without it this client cannot send one.
+    role = Role.OPERATOR if getattr(args, "yes", False) else Role.OBSERVER
+    return run_with_client("call", args, body, role=role)
 
 
 async def follow(client: AriaClient, entry: ConsoleEntry, payload: bytes, args: argparse.Namespace) -> int:
@@ -180,8 +186,6 @@ def not_listed(name: str, names: list[str]) -> int:
 
 
 def print_list(entries: list[ConsoleEntry], as_json: bool) -> int:
-    from ..client.console_layout import describe
-
     if as_json:
         print_json([e.to_json() for e in entries])
         return EXIT_OK

@@ -7,6 +7,7 @@ from typing import TYPE_CHECKING, Any
 
 from ..base.exit_codes import EXIT_OK
 from ..base.textsafe import visible
+from ..client.roles import Role
 from ._common import add_connection_arguments, print_json, run_with_client
 
 if TYPE_CHECKING:
@@ -46,4 +47,4 @@ def handle(args: argparse.Namespace) -> int:
             print(f"{visible(c.name):<{width}}  {arg}  {visible(c.description)}", flush=True)
         return EXIT_OK
 
-    return run_with_client("commands", args, body)
+    return run_with_client("commands", args, body, role=Role.OBSERVER)

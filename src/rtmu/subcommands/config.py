@@ -3,7 +3,7 @@
 Without an action: every section and parameter with its value, type, limits and priority. With
 ``--set``: one ``setConfig`` of all the values given; the server checks them and either takes them
 all or answers with its first error, which is printed (exit 6). Exit 4 when the server offers no
-configuration; exit 9 when it offers one RTMU cannot show or edit yet — an Omron LD robot's
+configuration; exit 18 when it offers one RTMU cannot show or edit yet — an Omron LD robot's
 ``getConfigValues`` family (protocol 6MTX), named as such (``rtmu call`` reads it raw). The care
 actions (``--defaults``, ``--reset``, ``--export``, ``--import``, ``--reload``) are in
 :mod:`._config_care`.
@@ -17,17 +17,17 @@ import sys
 from pathlib import Path
 from typing import TYPE_CHECKING, Any
 
-from ..base.exit_codes import EXIT_FOREIGN_CONFIG, EXIT_OK, EXIT_USAGE
+from ..base.exit_codes import EXIT_FOREIGN_CONFIG, EXIT_OK, EXIT_REFUSED, EXIT_USAGE, NETWORK
 from ..base.textsafe import visible
+from ..client.roles import Role
+from ..protocol.payloads.config import ConfigParam, ParamType, Priority
+from . import _config_care
 from ._common import add_connection_arguments, print_json, run_with_client
 
 if TYPE_CHECKING:
     from ..client.config_feed import ConfigApi, ServerConfig
     from ..client.connection import AriaClient
-    from ..protocol.payloads.config import ConfigParam
 
-EXIT_REFUSED = 6
-"""The server refused a value (its message is printed)."""
 MAX_ASSIGNMENTS = 1000
 
 
@@ -53,6 +53,10 @@ def parse_assignment(text: str, parser: Any) -> tuple[str, str, str]:
     return section.strip(), name.strip(), value
 
 
+EXITS = (*NETWORK, EXIT_REFUSED, EXIT_FOREIGN_CONFIG)
+"""6: the server refused a value, in its own words (or an import does not fit it: nothing is sent)."""
+
+
 def register(subparsers: Any) -> None:
     p = subparsers.add_parser(
         "config",
@@ -64,13 +68,10 @@ def register(subparsers: Any) -> None:
             "--reset SECTION/PARAM or --reset SECTION puts factory values back; --export FILE writes "
             "every value to a TOML file (an existing file only with --force); --import FILE checks the "
             "whole file against the server's parameters and sends it in one setConfig, or nothing; "
-            "--reload makes the server read its configuration file again. Exit codes: 0 done; 2 bad "
-            "arguments, a --reset target the server does not have, a file that exists or is not an "
-            f"export; 3 connection failure; 4 not offered (no configuration, no factory values); "
-            f"5 timeout; {EXIT_REFUSED} refused, by the server (its message is printed) or, for "
-            "--import, because the file does not fit the server (nothing is sent); "
-            f"{EXIT_FOREIGN_CONFIG} the robot offers a configuration RTMU cannot show or edit yet (an "
-            "Omron LD robot's getConfigValues: named, and readable raw with rtmu call)."
+            "--reload makes the server read its configuration file again. A --reset target the server "
+            "does not have, or a file that exists or is not an export, is a usage error; an --import "
+            "that does not fit the server's parameters is refused and nothing is sent. An Omron LD "
+            "robot's configuration (getConfigValues) is named, not shown: rtmu call reads it raw."
         ),
     )
     add_connection_arguments(p)
@@ -103,7 +104,6 @@ def register(subparsers: Any) -> None:
 
 def handle(args: argparse.Namespace) -> int:
     from ..client.config_feed import ForeignConfig, fetch_config
-    from . import _config_care
 
     assignments: list[tuple[str, str, str]] = args.assignments or []
     if len(assignments) > MAX_ASSIGNMENTS:
@@ -133,7 +133,7 @@ def handle(args: argparse.Namespace) -> int:
             print_text(config)
         return EXIT_OK
 
-    return run_with_client("config", args, body)
+    return run_with_client("config", args, body, role=Role.OBSERVER)
 
 
 async def _set(client: AriaClient, assignments: list[tuple[str, str, str]], args: argparse.Namespace) -> int:
@@ -158,8 +158,6 @@ def _finite(value: Any) -> Any:
 
 
 def param_json(p: ConfigParam, config: ServerConfig) -> dict[str, Any]:
-    from ..protocol.payloads.config import ParamType, Priority
-
     out: dict[str, Any] = {
         "name": p.name,
         "type": p.kind.name.lower(),
@@ -185,7 +183,6 @@ def api_key(api: ConfigApi) -> str:
 
 def config_json(config: ServerConfig) -> dict[str, Any]:
     from ..client.config_feed import ConfigApi
-    from ..protocol.payloads.config import ParamType, Priority
 
     return {
         "api": api_key(ConfigApi.ARCONFIG),
@@ -203,8 +200,6 @@ def config_json(config: ServerConfig) -> dict[str, Any]:
 
 
 def _limits(p: ConfigParam) -> str:
-    from ..protocol.payloads.config import ParamType
-
     if p.choices:
         return " one of " + ", ".join(visible(c) for c in p.choices)
     if p.kind not in (ParamType.INT, ParamType.DOUBLE):
@@ -219,8 +214,6 @@ def _limits(p: ConfigParam) -> str:
 
 
 def print_text(config: ServerConfig) -> None:
-    from ..protocol.payloads.config import ParamType, Priority
-
     for s in config.sections:
         comment = f"  ({visible(s.comment)})" if s.comment else ""
         print(f"[{visible(s.name)}]{comment}")

@@ -20,9 +20,25 @@ import time
 from dataclasses import dataclass, field
 from typing import TYPE_CHECKING, Any
 
-from ..base.exit_codes import EXIT_OK, EXIT_USAGE
+from ..base.exit_codes import (
+    ENDED,
+    EXIT_DOCTOR_DATALIST,
+    EXIT_DOCTOR_INTRODUCTION,
+    EXIT_DOCTOR_LOGIN,
+    EXIT_DOCTOR_RESOLVE,
+    EXIT_DOCTOR_STATUS,
+    EXIT_DOCTOR_TCP,
+    EXIT_INTERNAL,
+    EXIT_OK,
+    EXIT_USAGE,
+    WHY_ASKED,
+)
 from ..base.textsafe import visible
-from ..client.diagnosis import ADVICE, Step, login_finding
+from ..client.diagnosis import ADVICE, Step, central_server_words, login_finding
+from ..client.errors import ClientError
+from ..client.roles import Role
+from ..client.why import diagnose
+from ..protocol.client_connection import ClientConnection
 from ..protocol.commands import ClientCommand, ServerCommand
 from ..protocol.decoder import PacketDecoder
 from ..protocol.errors import ProtocolError
@@ -37,13 +53,23 @@ from ..protocol.events import (
 from ..protocol.fields import FieldReader, FieldWriter
 from ..protocol.packet import encode_packet
 from ..protocol.payloads import Side, decode_payload
-from ._common import UsageError, add_connection_arguments, print_json, read_password
+from ..protocol.payloads.robot import BatteryInfo, Update, UpdateNumbers, UpdateStrings
+from ._common import (
+    Interrupted,
+    UsageError,
+    add_connection_arguments,
+    print_json,
+    read_password,
+    run_interruptibly,
+)
 
-if TYPE_CHECKING:  # the network side (asyncio, the client) comes with the walk, not with --help
+if TYPE_CHECKING:
     import asyncio
 
-    from ..protocol.client_connection import ClientConnection
-
+EXITS = (
+    EXIT_OK, EXIT_INTERNAL, EXIT_USAGE, EXIT_DOCTOR_RESOLVE, EXIT_DOCTOR_TCP, EXIT_DOCTOR_INTRODUCTION,
+    EXIT_DOCTOR_LOGIN, EXIT_DOCTOR_DATALIST, EXIT_DOCTOR_STATUS, *WHY_ASKED, *ENDED,
+)  # fmt: skip
 READ_CHUNK = 65536
 NOT_ARIA_AFTER = 4096
 """Bytes without a single valid packet after which the peer is taken for something else."""
@@ -239,8 +265,6 @@ class Doctor:
             self.writer.write(out)
 
     async def _introduction(self) -> ServerIntroduction:
-        from ..protocol.client_connection import ClientConnection
-
         self.conn = ClientConnection(self.user, self._password, protocol_version=self.protocol)
         self._password = ""
         self._received = 0
@@ -365,12 +389,13 @@ class Doctor:
             transport.close()
 
     async def _status(self) -> None:
-        from ..protocol.payloads.robot import BatteryInfo, Update, UpdateNumbers, UpdateStrings
-
         conn = self.conn
         assert conn is not None
         name = "updateNumbers" if "updateNumbers" in conn.datalist else "update"
         if name not in conn.datalist:
+            if "clientList" in conn.datalist:  # it lists robots instead of being one
+                where = f"{self.host}:{self.port}"
+                raise fail(Step.STATUS, central_server_words(where), ADVICE["central_server"])
             raise fail(Step.STATUS, "the server offers no robot status", ADVICE["status_missing"])
         soc = False
         if "batteryInfo" in conn.datalist:
@@ -395,12 +420,10 @@ class Doctor:
         self.ok(Step.STATUS, text, **details)
 
     async def _motion(self) -> None:
+        """``rtmu why``'s answer, asked over a login of its own (the steps above use the bare codec)."""
         from ..client.connection import AriaClient
-        from ..client.errors import ClientError
-        from ..client.why import diagnose
         from ..client.why_gather import gather
 
-        """``rtmu why``'s answer, asked over a login of its own (the steps above use the bare codec)."""
         client = AriaClient()
         try:
             await client.connect(
@@ -410,6 +433,7 @@ class Doctor:
                 self._motion_password,
                 timeout=self.timeout,
                 protocol=self.protocol,
+                role=Role.OBSERVER,
             )
             answer = diagnose(await gather(client, self.timeout))
         except ClientError as exc:
@@ -469,8 +493,13 @@ def register(subparsers: Any) -> None:
     p = subparsers.add_parser(
         "doctor",
         help="find out why a robot does not connect, step by step",
-        description=__doc__,
-        formatter_class=argparse.RawDescriptionHelpFormatter,
+        description="Walk the whole way to a robot and say, step by step, what worked: name resolution, "
+        "TCP connect, the server's introduction (its version tag and protocol string), the login, the "
+        "data list (and which RTMU features the server offers), UDP, the first status. For the first "
+        "step that fails it says in plain words what went wrong and what to do next (the words the "
+        "window uses), and stops there; the exit code names the step. UDP never fails it: RTMU uses TCP. "
+        "Connected, it asks last why the robot would not move (rtmu why's answer); that step fails with "
+        "the cause's own code.",
     )
     add_connection_arguments(p)
     p.add_argument(
@@ -486,8 +515,6 @@ MARKS = {"ok": "ok  ", "fail": "FAIL", "warn": "warn", "not_checked": "--  ", "s
 
 
 def handle(args: argparse.Namespace) -> int:
-    import asyncio
-
     host, port = args.server
     try:
         password = read_password(args)
@@ -496,9 +523,10 @@ def handle(args: argparse.Namespace) -> int:
         return EXIT_USAGE
     doctor = Doctor(host, port, args.user, password, args.protocol, args.timeout)
     try:
-        code = asyncio.run(doctor.run())
-    except KeyboardInterrupt:
-        return 130
+        code = run_interruptibly(doctor.run)
+    except Interrupted as exc:
+        print(f"rtmu doctor: {exc}", file=sys.stderr)
+        return exc.exit_code
     failed = next((s for s in doctor.steps if s.result == "fail"), None)
     if args.json:
         print_json(

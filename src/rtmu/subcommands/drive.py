@@ -9,7 +9,8 @@ before the process is suspended, and the drive is not resumed by ``fg``: it ends
 
 A drive asked to move that did not move the robot never exits 0: the same answer as ``rtmu why``
 (:mod:`rtmu.client.why`) goes to stderr, read with the status words the server said while we
-drove, and the exit code is the cause's (20–39; 39 when nothing RTMU can read explains it). A
+drove, and the exit code is the cause's (20–39; 35 when the ratios asked for are inside ARIA's
+dead zone, which is also said before driving; 39 when nothing RTMU can read explains it). A
 login that may not drive gets that answer at once (exit 21); one that may not stop is warned.
 
 After a signal the stop goes out first, then the pose is printed if a status comes
@@ -28,8 +29,17 @@ import sys
 from collections.abc import Callable
 from typing import TYPE_CHECKING, Any
 
-from ..base.exit_codes import EXIT_OK
+from ..base.exit_codes import EXIT_OK, EXIT_SIGQUIT, EXIT_SIGTSTP, EXIT_USAGE, NETWORK, WHY_DRIVE
 from ..base.textsafe import visible
+from ..client.errors import ClientError
+from ..client.roles import Role
+from ..client.why import diagnose, moved, unexplained
+from ..client.why_values import Answer, Facts, Motion
+from ..guardian.handle import GuardianHandle, GuardianUnavailable, beat_network, start_ready
+from ..guardian.messages import Hello
+from ..protocol.errors import ProtocolError
+from ..protocol.payloads.drive import RATIO_ROT_DEAD_ZONE, RATIO_TRANS_DEAD_ZONE, RatioDrive
+from ..protocol.payloads.robot import UpdateStrings
 from ._common import (
     Interrupted,
     UsageError,
@@ -43,13 +53,9 @@ from ._common import (
     status_line,
 )
 
-if TYPE_CHECKING:  # the network side comes with the drive, not with --help
+if TYPE_CHECKING:
     from ..client.connection import AriaClient, Packet
     from ..client.drive_guard import DriveGuard
-    from ..client.why_values import Answer, Facts, Motion
-    from ..guardian.handle import GuardianHandle
-    from ..protocol.payloads.drive import RatioDrive
-    from ..protocol.payloads.robot import UpdateStrings
 
 RESEND = 0.1
 MAX_SECONDS = 600.0
@@ -59,11 +65,15 @@ AFTER_INTERRUPT = 1.0
 """After a signal, at most this long (stop already sent) for the pose printed as ``after``."""
 
 
+EXITS = (*NETWORK, EXIT_SIGQUIT, EXIT_SIGTSTP, *WHY_DRIVE)
+
+
 def register(subparsers: Any) -> None:
     p = subparsers.add_parser(
         "drive",
         help="drive for some seconds, then stop",
-        description="Drive with ratioDrive for S seconds, then stop; print the pose before and after.",
+        description="Drive with ratioDrive for S seconds, then stop; print the pose before and after. "
+        "A drive that did not move the robot says why (as rtmu why does) and exits with the cause's code.",
     )
     add_connection_arguments(p)
     p.add_argument(
@@ -74,7 +84,11 @@ def register(subparsers: Any) -> None:
     )
     p.add_argument("--throttle", type=float, default=50.0, metavar="PCT", help="0…100 %% (default 50)")
     p.add_argument("--seconds", type=float, required=True, metavar="S", help=f"0…{MAX_SECONDS:g}")
-    p.add_argument("--json", action="store_true", help='one object {"before", "after", "seconds"}')
+    p.add_argument(
+        "--json",
+        action="store_true",
+        help='one object {"before", "after", "seconds"}; asked to move, also "moved" (and "why" if not)',
+    )
     p.set_defaults(handler=handle)
 
 
@@ -93,12 +107,7 @@ def handle(args: argparse.Namespace) -> int:
     import asyncio
 
     from ..client.drive_guard import DriveGuard, LinkFault
-    from ..client.errors import ClientError
-    from ..client.why import diagnose, moved, unexplained
     from ..client.why_gather import gather
-    from ..client.why_values import Facts, Motion
-    from ..guardian.handle import beat_network
-    from ..protocol.payloads.drive import RatioDrive
     from .why import print_answer
 
     async def body(client: AriaClient) -> int:
@@ -111,6 +120,15 @@ def handle(args: argparse.Namespace) -> int:
             for reason in warning.reasons:
                 if reason.loud:
                     print(f"rtmu drive: WARNING: {visible(reason.sentence())}", file=sys.stderr, flush=True)
+        ratios = RatioDrive(args.trans, args.rot, args.throttle)
+        if ratios.in_dead_zone:  # ARIA would take it and not move: say so rather than exit 0 silently
+            print(
+                f"rtmu drive: warning: --trans {args.trans:g} --rot {args.rot:g} is inside ARIA's dead "
+                f"zone (translation up to ±{RATIO_TRANS_DEAD_ZONE:g} %, rotation under "
+                f"±{RATIO_ROT_DEAD_ZONE:g} %): the robot will not move",
+                file=sys.stderr,
+                flush=True,
+            )
         guardian = await start_guardian(args)
         guard = DriveGuard(client)
         guard.start()  # before the first status fetch, so the link is watched from the start
@@ -134,7 +152,6 @@ def handle(args: argparse.Namespace) -> int:
         said = StatusWords(client)
         guard.seen_moving = False
         try:
-            ratios = RatioDrive(args.trans, args.rot, args.throttle)
             await drive(client, ratios, args.seconds, held=lambda: interrupts.suspending, guard=guard)
             said.close()  # what the server said while we drove, before our own stop changes it
         except asyncio.CancelledError:
@@ -183,15 +200,12 @@ def handle(args: argparse.Namespace) -> int:
         check(args)
     except UsageError as exc:
         print(f"rtmu drive: {exc}", file=sys.stderr)
-        return 2
-    return run_with_client("drive", args, body)
+        return EXIT_USAGE
+    return run_with_client("drive", args, body, role=Role.OPERATOR)
 
 
 async def start_guardian(args: argparse.Namespace) -> GuardianHandle | None:
     """The guardian for this drive (``rtmu.guardian``); None, with one line on stderr, if it cannot log in."""
-    from ..guardian.handle import GuardianUnavailable, start_ready
-    from ..guardian.messages import Hello
-
     host, port = args.server
     try:
         return await start_ready(Hello(host, port, args.user, current_password(), args.timeout), args.timeout)
@@ -207,7 +221,6 @@ async def start_guardian(args: argparse.Namespace) -> GuardianHandle | None:
 
 async def refuse(args: argparse.Namespace, client: AriaClient, motion: Motion) -> int:
     """This login may not drive: say why (``rtmu why``'s answer) and exit with its code."""
-    from ..client.why import diagnose
     from ..client.why_gather import gather
     from .why import print_answer
 
@@ -240,18 +253,12 @@ class StatusWords:
             client.request("updateStrings", -1, self._on_strings)
 
     def _on_strings(self, packet: Packet) -> None:
-        from ..client.errors import ClientError
-        from ..protocol.errors import ProtocolError
-        from ..protocol.payloads.robot import UpdateStrings
-
         with contextlib.suppress(ClientError, ProtocolError):
             value = packet.decode()
             if self.open and isinstance(value, UpdateStrings):
                 self.last = value
 
     def close(self) -> None:
-        from ..client.errors import ClientError
-
         if self.open:
             self.open = False
             with contextlib.suppress(ClientError):
@@ -336,9 +343,6 @@ async def drive(
 
 def stop(client: AriaClient) -> None:
     """Zero ratios and ``stop``; never raises (we are often in a ``finally``)."""
-    from ..client.errors import ClientError
-    from ..protocol.payloads.drive import RatioDrive
-
     with contextlib.suppress(ClientError):
         client.send("ratioDrive", RatioDrive(0.0, 0.0, 0.0))
     if client.supports("stop"):

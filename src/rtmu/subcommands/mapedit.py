@@ -7,8 +7,10 @@ import math
 import sys
 from typing import TYPE_CHECKING, Any
 
-from ..base.exit_codes import EXIT_OK, EXIT_USAGE
+from ..base.exit_codes import EXIT_NOT_HELD, EXIT_OK, EXIT_REFUSED, EXIT_USAGE, NETWORK
 from ..base.textsafe import visible
+from ..client.errors import NotSupported
+from ..client.roles import Role
 from ._common import add_connection_arguments, print_json, run_with_client
 
 if TYPE_CHECKING:
@@ -30,16 +32,12 @@ edits are checked against it: a name already taken, a name not on the map), the 
 guarded by the map's id, and the map is read again afterwards to check that it holds the change.
 --check-map instead asks the server to re-read its map file (checkMap).
 
-Exit codes: 0 the server's map now holds the change; 2 an edit that does not fit the map, or bad
-arguments; 3 connection or login failure; 4 the server takes no map changes or has no map; 5 no
-verdict in time; 6 the server refused the change (its words are printed; the map is as it was);
-7 the server said it applied the change but its map, read again, does not hold it.
+Exit 0 only when the server's map, read again, holds the change. An edit that does not fit the map
+is a usage error (nothing is sent); a refused change leaves the map as it was (the server's words
+are printed); a server that takes no map changes, or has no map, does not offer it.
 """
 
-EXIT_REFUSED = 6
-"""The server refused the change."""
-EXIT_NOT_HELD = 7
-"""The server said it applied the change, but its map read again does not hold it."""
+EXITS = (*NETWORK, EXIT_REFUSED, EXIT_NOT_HELD)
 MAX_EDITS = 10_000
 
 
@@ -93,7 +91,6 @@ def register(subparsers: Any) -> None:
         "mapedit",
         help="change the server's map live: add or remove goals, docks, forbidden lines and areas",
         description=DESCRIPTION,
-        formatter_class=argparse.RawDescriptionHelpFormatter,
     )
     add_connection_arguments(p)
     p.add_argument(
@@ -163,6 +160,8 @@ def apply_edits(draft: MapDraft, edits: list[dict[str, Any]]) -> None:
 
 
 def handle(args: argparse.Namespace) -> int:
+    from ..client.config_care import check_map
+
     edits: list[dict[str, Any]] = args.edits or []
     if args.check_map and edits:
         print("rtmu mapedit: --check-map goes alone, without edits", file=sys.stderr)
@@ -176,8 +175,6 @@ def handle(args: argparse.Namespace) -> int:
     if len(edits) > MAX_EDITS:
         print(f"rtmu mapedit: at most {MAX_EDITS} edits at once", file=sys.stderr)
         return EXIT_USAGE
-
-    from ..client.config_care import check_map
 
     async def body(client: AriaClient) -> int:
         if args.check_map:
@@ -193,11 +190,10 @@ def handle(args: argparse.Namespace) -> int:
             return EXIT_OK
         return await _edit(client, edits, args)
 
-    return run_with_client("mapedit", args, body)
+    return run_with_client("mapedit", args, body, role=Role.OBSERVER)  # the map, never motion
 
 
 async def _edit(client: AriaClient, edits: list[dict[str, Any]], args: argparse.Namespace) -> int:
-    from ..client.errors import NotSupported
     from ..client.map_changes import (
         ChangeWatch,
         map_id,

@@ -8,7 +8,8 @@ from typing import TYPE_CHECKING, Any
 
 from ..base.exit_codes import EXIT_OK, EXIT_USAGE
 from ..base.textsafe import visible
-from ._common import add_connection_arguments, run_with_client, unknown_name
+from ..client.roles import Role
+from ._common import add_connection_arguments, known_name, run_with_client
 
 if TYPE_CHECKING:
     from ..client.connection import AriaClient
@@ -30,10 +31,12 @@ def handle(args: argparse.Namespace) -> int:
 
     async def body(client: AriaClient) -> int:
         known = await ld_data.routes(client, args.timeout)
-        if unknown_name("patrol", "route", args.route, known):
+        route = known_name("patrol", "route", args.route, known)
+        if route is None:
             return EXIT_USAGE
+        args.route = route
         ld_data.patrol(client, args.route)
         print(f"patrolling {visible(args.route)}", file=sys.stderr)
         return EXIT_OK
 
-    return run_with_client("patrol", args, body)
+    return run_with_client("patrol", args, body, role=Role.OPERATOR)

@@ -7,6 +7,7 @@ from typing import TYPE_CHECKING, Any
 
 from ..base.exit_codes import EXIT_OK
 from ..base.textsafe import visible
+from ..client.roles import Role
 from ._common import add_connection_arguments, print_json, run_with_client
 
 if TYPE_CHECKING:
@@ -73,4 +74,4 @@ def handle(args: argparse.Namespace) -> int:
                     print(f"         returns: {visible(e.return_description)}")
         return EXIT_OK
 
-    return run_with_client("probe", args, body)
+    return run_with_client("probe", args, body, role=Role.OBSERVER)

@@ -7,6 +7,7 @@ from typing import TYPE_CHECKING, Any
 
 from ..base.exit_codes import EXIT_OK
 from ..base.textsafe import visible
+from ..client.roles import Role
 from ._common import add_connection_arguments, print_json, run_with_client
 
 if TYPE_CHECKING:
@@ -36,4 +37,4 @@ def handle(args: argparse.Namespace) -> int:
                 print(visible(name))
         return EXIT_OK
 
-    return run_with_client("routes", args, body)
+    return run_with_client("routes", args, body, role=Role.OBSERVER)

@@ -7,6 +7,7 @@ import sys
 from typing import TYPE_CHECKING, Any
 
 from ..base.exit_codes import EXIT_OK, EXIT_USAGE
+from ..client.roles import Role
 from ._common import add_connection_arguments, run_with_client
 
 if TYPE_CHECKING:
@@ -44,4 +45,4 @@ def handle(args: argparse.Namespace) -> int:
         ld_data.say(client, text)
         return EXIT_OK
 
-    return run_with_client("say", args, body)
+    return run_with_client("say", args, body, role=Role.OBSERVER)

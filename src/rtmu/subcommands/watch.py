@@ -17,6 +17,11 @@ from typing import TYPE_CHECKING, Any
 
 from ..base.exit_codes import EXIT_OK
 from ..base.textsafe import visible
+from ..client.errors import NotSupported
+from ..client.roles import Role
+from ..protocol.errors import ProtocolError
+from ..protocol.payloads.popup import PopupClose, PopupCreate, PopupType
+from ..protocol.payloads.robot import ModeInfo, UpdateStrings
 from ._common import add_connection_arguments, positive_float, print_json, run_with_client
 
 if TYPE_CHECKING:
@@ -46,8 +51,6 @@ def register(subparsers: Any) -> None:
 
 
 def popup_type(number: int) -> str:
-    from ..protocol.payloads.popup import PopupType
-
     with contextlib.suppress(ValueError):
         return PopupType(number).name.lower()
     return str(number)
@@ -55,9 +58,6 @@ def popup_type(number: int) -> str:
 
 def describe(name: str, payload: Any) -> tuple[dict[str, Any], str] | None:
     """(JSON object without ``t``, text line) for one broadcast; None for one not worth a line."""
-    from ..protocol.payloads.popup import PopupClose, PopupCreate
-    from ..protocol.payloads.robot import ModeInfo, UpdateStrings
-
     if isinstance(payload, PopupCreate):
         buttons = [b for b in payload.buttons if b]
         obj = {
@@ -84,9 +84,6 @@ def describe(name: str, payload: Any) -> tuple[dict[str, Any], str] | None:
 
 def handle(args: argparse.Namespace) -> int:
     import asyncio
-
-    from ..client.errors import NotSupported
-    from ..protocol.errors import ProtocolError
 
     started = time.monotonic()
 
@@ -130,4 +127,4 @@ def handle(args: argparse.Namespace) -> int:
             await asyncio.sleep(0.1 if end is None else min(0.1, max(0.0, end - loop.time())))
         return EXIT_OK
 
-    return run_with_client("watch", args, body)
+    return run_with_client("watch", args, body, role=Role.OBSERVER)

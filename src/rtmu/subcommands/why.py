@@ -1,17 +1,9 @@
 """``rtmu why HOST[:PORT] [--json] [--fix] [--yes] [--navigate]``: why won't the robot move?
 
-Reads, never drives: the server's own data (its mode and lock, this login's rights, status words,
-safe drive and the obstacles its sonar and lasers see, battery, docking, localization, its drive
-watchdog, an LD robot's faults and safety data) told as one sentence with its fix
-(:mod:`rtmu.client.why`). Exit 0 when nothing RTMU can read keeps the robot from moving, else the
-cause's own code (``rtmu.base.exit_codes``, 20–39): 20 this login may not stop, 21 may not drive,
-23 e-stop, 24 faults, 25 motors disabled, 26 stalled, 27 mode locked, 28 navigating, 29 docked,
-30 battery, 31 safe drive, 32 drive watchdog, 33 lost (with --navigate).
-
-``--fix`` carries out the first cause's fix where there is one (unlock a mode that will unlock,
-undock, stop the server's own driving, switch safe drive off, acknowledge an LD robot's faults,
-enable its motors), then asks again. Switching safe drive off, acknowledging and enabling need a
-yes: typed at the prompt, or ``--yes``; without one nothing is sent.
+Plain words for the help (:data:`DESCRIPTION`); the answer itself is :mod:`rtmu.client.why`'s, its
+exit code the cause's own (``rtmu.base.exit_codes``, :data:`rtmu.base.exit_codes.WHY_ASKED`).
+Without ``--fix`` this is an observer (its client cannot send a motion request); ``--fix`` logs in
+as an operator, because unlocking a mode or stopping the server's own driving sends ``stop``.
 """
 
 from __future__ import annotations
@@ -20,24 +12,50 @@ import argparse
 import sys
 from typing import TYPE_CHECKING, Any
 
+from ..base.exit_codes import EXIT_WHY_LOST, NETWORK, WHY_ASKED
 from ..base.textsafe import visible
+from ..client.roles import Role
+from ..client.why import diagnose
+from ..client.why_values import Answer
 from ._common import add_connection_arguments, print_json, run_with_client
 
 if TYPE_CHECKING:
     from ..client.connection import AriaClient
     from ..client.why_fix import FixResult
-    from ..client.why_values import Answer
 
+DESCRIPTION = """Why won't the robot move? Reads, never drives: the server's own data (its mode and
+lock, this login's rights, status words, safe drive and the obstacles its sonar and lasers see,
+battery, docking, localization, its drive watchdog, an LD robot's faults and safety data) told as
+one sentence with its fix. Exit 0 when nothing RTMU can read keeps the robot from moving, else the
+cause's own code (listed below).
+
+--fix carries out the first cause's fix where there is one (unlock a mode that will unlock, undock,
+stop the server's own driving, switch safe drive off, acknowledge an LD robot's faults, enable its
+motors), then asks again. Switching safe drive off, acknowledging and enabling need a yes: typed at
+the prompt, or --yes; without one nothing is sent."""
+
+EXITS = (*NETWORK, *WHY_ASKED, EXIT_WHY_LOST)
 MAX_FIXES = 3
 """Fixes tried one after another (each reveals what the next cause is)."""
+DESCRIPTION = """Why won't the robot move? Reads, never drives: the server's own data (its mode and lock,
+this login's rights, status words, safe drive and the obstacles its sonar and lasers see, battery,
+docking, localization, its drive watchdog, an LD robot's faults and safety data), told as one sentence
+with its fix. Exit 0 when nothing RTMU can read keeps the robot from moving, else the cause's own code
+(listed below): 20 this login may not stop, 21 may not drive, 23 e-stop, 24 faults, 25 motors disabled,
+26 stalled, 27 mode locked, 28 navigating, 29 docked, 30 battery, 31 safe drive, 32 drive watchdog,
+33 lost (with --navigate).
+
+--fix carries out the first cause's fix where there is one (unlock a mode that will unlock, undock, stop
+the server's own driving, switch safe drive off, acknowledge an LD robot's faults, enable its motors),
+then asks again. Switching safe drive off, acknowledging and enabling need a yes: typed at the prompt, or
+--yes; without one nothing is sent."""
 
 
 def register(subparsers: Any) -> None:
     p = subparsers.add_parser(
         "why",
         help="why won't the robot move? one sentence and its fix",
-        description=__doc__,
-        formatter_class=argparse.RawDescriptionHelpFormatter,
+        description=DESCRIPTION,
     )
     add_connection_arguments(p)
     p.add_argument("--json", action="store_true", help="one JSON object: the answer, its reasons and fixes")
@@ -50,7 +68,6 @@ def register(subparsers: Any) -> None:
 
 
 def handle(args: argparse.Namespace) -> int:
-    from ..client.why import diagnose
     from ..client.why_gather import gather
 
     async def body(client: AriaClient) -> int:
@@ -72,13 +89,14 @@ def handle(args: argparse.Namespace) -> int:
             print_answer(answer)
         return answer.exit_code
 
-    return run_with_client("why", args, body)
+    # Asking never moves anything; --fix may send a stop (unlocking a mode) or switch safe drive.
+    role = Role.OPERATOR if getattr(args, "fix", False) else Role.OBSERVER
+    return run_with_client("why", args, body, role=role)
 
 
 async def fix_all(
     client: AriaClient, answer: Answer, args: argparse.Namespace
 ) -> tuple[Answer, list[FixResult]]:
-    from ..client.why import diagnose
     from ..client.why_fix import apply
     from ..client.why_gather import gather
 

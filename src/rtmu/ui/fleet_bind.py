@@ -92,6 +92,7 @@ class FleetBinding:
         self.robot_list.set_visible(False)
         window.body.append(self.robot_list)
         window.stage.fleet = self.marks
+        window.keyboard.fleet = fleet  # Alt+1…9, Alt+Page Down / Up and the menu's Robots submenu
         self._unobserve = [
             fleet.sessions.observe(lambda _old, _new: self._sessions_changed()),
             fleet.selected.observe(self._selected_changed),
@@ -129,6 +130,7 @@ class FleetBinding:
                 session.attach_view(BackgroundView(self.window, session.name))
         self.robot_list.set_sessions(sessions, selected)
         self.robot_list.set_visible(len(sessions) > 1)
+        self.window.keyboard.fleet_changed()
         names = {s.name for s in sessions}
         if any(name not in names for name in self._lost):
             self._lost = {n: e for n, e in self._lost.items() if n in names}

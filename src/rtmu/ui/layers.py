@@ -1,7 +1,8 @@
 """The Layers panel: one switch per drawing the server lists, remembered per server.
 
-A card over the map (View → Layers…), never focusable, so the arrow keys keep driving while it
-is open. Each drawing of :attr:`~rtmu.model.observables.RobotModel.drawings` gets a check button labelled
+A card over the map (View → Layers…); its switches take the focus by Tab (``keyboard_nav``) while
+the arrow keys keep driving and Space keeps stopping (the window's key router and stop keys catch
+them first). Each drawing of :attr:`~rtmu.model.observables.RobotModel.drawings` gets a check button labelled
 with its name exactly as sent (plain text: no markup, no mnemonic underscores). A drawing the
 server keeps always on or off, or whose shape RTMU cannot draw, is listed greyed with the reason.
 Turning one off tells the network side to stop asking for it (``set_drawing_shown``) and

@@ -19,6 +19,7 @@ gi.require_version("Gtk", "4.0")
 gi.require_version("Pango", "1.0")
 from gi.repository import GLib, Gtk, Pango  # noqa: E402
 
+from ..control.commands import action_name  # noqa: E402
 from ..fleet.sessions import RobotSession  # noqa: E402
 from ..model.observables import RobotModel, RobotState  # noqa: E402
 from ..values.intents import Intent, PtzMove, WatchPtz  # noqa: E402
@@ -112,7 +113,8 @@ class PtzControls(Gtk.Box):
             button = Gtk.Button.new_from_icon_name(icon)
             button.set_focusable(False)
             self._tips[intent] = tip
-            button.connect("clicked", lambda _b, i=intent: self.key(i))
+            # The window's action (``win.ptz-left`` …), as the key's: a refusal is said the same way.
+            button.connect("clicked", lambda b, i=intent: b.activate_action(f"win.{action_name(i)}", None))
             self.buttons[intent] = button
             self.append(button)
         self._unobserve = [

@@ -69,7 +69,7 @@ class RobotState:
     """Monotonic time of the last status/mode update."""
     sonar_at: float | None = field(default=None, compare=False)
     laser: tuple[tuple[int, int], ...] = ()
-    """Current laser points of every listed ``Laser_*Current`` (LD robots), global mm."""
+    """Current points of every listed laser (``Laser_1Current``, ``sim_lms2xx_1Current`` …), global mm."""
     laser_at: float | None = field(default=None, compare=False)
     dock_state: str | None = None
     """``Undocked``, ``Docking``, ``Docked``, ``Undocking`` (``dockInfo``); None if not offered."""
@@ -238,10 +238,15 @@ class VideoStatus:
 
 
 class NavOutcome(StrEnum):
-    """How the last navigation ended (a ``StrEnum``: it compares equal to its text)."""
+    """Where a navigation stands, read from the server's words: the one enum of the window, the CLI and
+    "why won't it move" (a ``StrEnum``: it compares equal to its text).
+
+    As a state's ``outcome``: how the last navigation ended (``NONE`` while none has, or one is under way)."""
 
     NONE = ""
-    """Nothing has ended yet on this connection (or one is under way)."""
+    """Nothing has ended yet on this connection (or one is under way); as one status read: no news."""
+    GOING = "going"
+    """One status read: the server is on its way (``Going to …``); never a state's ``outcome``."""
     ARRIVED = "arrived"
     DOCKED = "docked"
     FAILED = "failed"

@@ -1,0 +1,97 @@
+"""The window's timers: a window at rest wakes once a second; a held drive adds the fast ones.
+
+The UI thread's heartbeat drives safety: while a drive is held, every
+:data:`rtmu.control.controller.TICK` the lease is renewed (``controller.tick``) — if this loop ever
+stalls, the lease lapses and the network side stops the robot — and every
+:data:`GUARDIAN_BEAT` the guardian process hears that the UI lives. Both start when the controller
+says a drive began (its ``View.driving``) and end once the drive is over and the guardian is
+disarmed again. The slow timer (:data:`SLOW_TICK`) refreshes what ages without a new value (the
+toolbar, the picture's age, a robot gone stale) and watches the network loop's lag; at rest the
+window therefore wakes once a second, not 35 times (issue 28).
+"""
+
+from __future__ import annotations
+
+from typing import TYPE_CHECKING
+
+import gi
+
+gi.require_version("Gtk", "4.0")
+from gi.repository import GLib  # noqa: E402
+
+from ..control.controller import TICK  # noqa: E402
+from ..guardian.handle import BEAT_PERIOD as GUARDIAN_BEAT  # noqa: E402
+from ..model.observables import Phase  # noqa: E402
+
+if TYPE_CHECKING:
+    from .window import MainWindow
+
+SLOW_TICK = 1.0
+"""Seconds between the window's own ticks: ages (toolbar, picture), the stale look, the loop-lag watch."""
+
+
+class WindowTimers:
+    """The slow tick always; the drive tick and the guardian beat from a drive's start to its end."""
+
+    def __init__(self, window: MainWindow) -> None:
+        self.window = window
+        self.ticks = 0
+        """Counts the slow timer's ticks (once a second)."""
+        self._slow = GLib.timeout_add(int(SLOW_TICK * 1000), self._slow_tick)
+        self._drive = 0
+        """The lease renewal (TICK) while a drive is held; 0 at rest."""
+        self._beat = 0
+        """The guardian's beat, from a drive's start until the guardian is disarmed; 0 at rest."""
+
+    @property
+    def fast_running(self) -> bool:
+        """Whether a drive's timers run (tests: none at rest)."""
+        return bool(self._drive or self._beat)
+
+    def drive_started(self) -> None:
+        """A drive began (the controller granted a lease): renew it and beat for the guardian."""
+        if not self._drive:
+            self._drive = GLib.timeout_add(int(TICK * 1000), self._drive_tick)
+        if not self._beat:
+            self._beat = GLib.timeout_add(int(GUARDIAN_BEAT * 1000), self._beat_tick)
+        self.window.map_page.refresh()
+
+    def _driving(self) -> bool:
+        c = self.window.controller
+        return bool(c.held) or c.analog_active or c.link.lease.view().live
+
+    def _drive_tick(self) -> bool:
+        """While a drive is held: renew its lease; the pill follows the keys. Ends with the drive."""
+        self.window.controller.tick()
+        self.window.map_page.refresh()
+        if self._driving():
+            return True
+        self._drive = 0
+        return False
+
+    def _beat_tick(self) -> bool:
+        """The GTK thread's heartbeat to the guardian, until it is disarmed after the drive."""
+        armed = self.window.session.runner.ui_heartbeat()
+        if armed or self._driving():
+            return True
+        self._beat = 0
+        return False
+
+    def _slow_tick(self) -> bool:
+        """Once a second: ages and staleness (nothing else changes them), the network loop's lag."""
+        self.ticks += 1
+        w = self.window
+        w.map_page.refresh()
+        w.toolbar.refresh()
+        w.camera_page.tick()
+        loop_lag = getattr(w.controller.link, "loop_lag", None)  # a stalled network thread: said
+        connected = w.model.connection.value.phase is Phase.CONNECTED
+        w.notices.loop_lag(loop_lag() if callable(loop_lag) else None, connected)
+        return True
+
+    def close(self) -> None:
+        """Stop every timer (idempotent)."""
+        for source in (self._slow, self._drive, self._beat):
+            if source:
+                GLib.source_remove(source)
+        self._slow = self._drive = self._beat = 0
