@@ -6,7 +6,8 @@ second — the robot turning so each new frame really differs). ``client.video_f
 ``rtmu video`` and the window's live video run) asks it for pictures at ``--fps`` 30 and 15 for
 :data:`SECONDS` each (after :data:`WARM_UP_S` in which the pacer learns the camera's period), with
 its :class:`~rtmu.client.video_feed.FramePacer`, then the same with the pacing of before (ask at the
-frame-rate setting, a quarter of that interval after a repeat), turn about. Frames carry the simulator's render stamp, so ages are end to end.
+frame-rate setting, a quarter of that interval after a repeat), turn about. Frames carry the
+simulator's render stamp, so ages are end to end.
 
 * ``video.pace.requests_per_new_frame.fps{30,15}``: requests sent ÷ new frames received (target
   ≤ 1.2; a repeat is a whole picture sent again over the robot's Wi-Fi). Baseline: the old pacing.

@@ -133,7 +133,8 @@ def _typed_status() -> list[Result]:
         raise RuntimeError("the bulk status decode differs from the per-packet one")
     bulk = _cpu(_bulk, chunks, commands)
     each = _cpu(_per_packet, chunks, commands)
-    out = [Result("wire.typed_status_packets_per_cpu_s", len(packets) / bulk, "packets/s", len(packets) / each)]
+    rate, baseline = len(packets) / bulk, len(packets) / each
+    out = [Result("wire.typed_status_packets_per_cpu_s", rate, "packets/s", baseline)]
     if CPPDECODE.exists():
         out.append(_aria_stream())
     return out
@@ -144,7 +145,9 @@ def _aria_stream() -> Result:
     with tempfile.TemporaryDirectory() as tmp:
         path = Path(tmp) / "status.bin"
         subprocess.run([str(CPPDECODE), "gen-status", str(path)], env=env, check=True, capture_output=True)
-        said = subprocess.run([str(CPPDECODE), "decode", str(path)], env=env, check=True, capture_output=True, text=True)
+        said = subprocess.run(
+            [str(CPPDECODE), "decode", str(path)], env=env, check=True, capture_output=True, text=True
+        )
         aria = float(re.search(r"([\d.]+) packets/s", said.stdout).group(1))  # type: ignore[union-attr]
         data = path.read_bytes()
     commands = {ARIA_UPDATE: "update"}
@@ -183,7 +186,8 @@ def _before_tree(into: Path) -> Path | None:
         return None
     with tarfile.open(fileobj=BytesIO(done.stdout)) as tar:
         tar.extractall(into, filter="data")
-    subprocess.run([sys.executable, "-m", "compileall", "-q", str(into / "src")], check=False, stdout=subprocess.DEVNULL)
+    compile_all = [sys.executable, "-m", "compileall", "-q", str(into / "src")]
+    subprocess.run(compile_all, check=False, stdout=subprocess.DEVNULL)
     return into / "src"
 
 
@@ -207,8 +211,10 @@ def _mapclient_us(port: int, lines: int) -> float | None:
     env = dict(os.environ, LD_LIBRARY_PATH=str(ARIA_LIB))
     for _ in range(RUNS):
         with tempfile.TemporaryDirectory() as tmp:
-            proc = subprocess.Popen([str(MAPCLIENT), "-host", "127.0.0.1", "-port", str(port)], cwd=tmp, env=env,
-                                    stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL)  # fmt: skip
+            command = [str(MAPCLIENT), "-host", "127.0.0.1", "-port", str(port)]
+            proc = subprocess.Popen(
+                command, cwd=tmp, env=env, stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL
+            )
             try:
                 written, deadline, size = Path(tmp) / "mapExample.map", time.monotonic() + 120, -1
                 while time.monotonic() < deadline:  # written, and no longer growing
@@ -228,8 +234,8 @@ def _mapclient_us(port: int, lines: int) -> float | None:
 def _text_map() -> list[Result]:
     with tempfile.TemporaryDirectory() as tmp:
         map_path = Path(tmp) / "big.map"
-        subprocess.run([sys.executable, "-m", "rtmu", "sim", "--make-map", str(map_path), "--points", str(MAP_POINTS),
-                        "--lines", str(MAP_LINES)], check=True, capture_output=True)  # fmt: skip
+        make = ["--make-map", str(map_path), "--points", str(MAP_POINTS), "--lines", str(MAP_LINES)]
+        subprocess.run([sys.executable, "-m", "rtmu", "sim", *make], check=True, capture_output=True)
         lines = sum(1 for _ in map_path.open("rb"))
         before = _before_tree(Path(tmp) / "before")
         with _simulator(map_path) as port:
