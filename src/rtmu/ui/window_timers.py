@@ -12,7 +12,7 @@ window therefore wakes once a second, not 35 times (issue 28).
 
 from __future__ import annotations
 
-from typing import TYPE_CHECKING
+from typing import TYPE_CHECKING, Protocol
 
 import gi
 
@@ -24,16 +24,38 @@ from ..guardian.handle import BEAT_PERIOD as GUARDIAN_BEAT  # noqa: E402
 from ..model.observables import Phase  # noqa: E402
 
 if TYPE_CHECKING:
-    from .window import MainWindow
+    from ..control.controller import Controller
+    from ..fleet.sessions import RobotSession
+    from ..model.observables import RobotModel
+    from .camera_page import CameraPage
+    from .map_page import MapPage
+    from .notice_router import NoticeRouter
+    from .toolbar import StatusToolbar
 
 SLOW_TICK = 1.0
 """Seconds between the window's own ticks: ages (toolbar, picture), the stale look, the loop-lag watch."""
 
 
+class TimedWindow(Protocol):
+    """What the timers use of the window (``ui.window.MainWindow``, which imports this module)."""
+
+    model: RobotModel
+    map_page: MapPage
+    toolbar: StatusToolbar
+    camera_page: CameraPage
+    notices: NoticeRouter
+
+    @property
+    def session(self) -> RobotSession: ...
+
+    @property
+    def controller(self) -> Controller: ...
+
+
 class WindowTimers:
     """The slow tick always; the drive tick and the guardian beat from a drive's start to its end."""
 
-    def __init__(self, window: MainWindow) -> None:
+    def __init__(self, window: TimedWindow) -> None:
         self.window = window
         self.ticks = 0
         """Counts the slow timer's ticks (once a second)."""
