@@ -97,8 +97,9 @@ class View(Protocol):
         """Open the dialog a command needs (``turn``: an angle, ``go``: a distance)."""
 
     def driving(self) -> None:
-        """A held drive began (a lease was granted): from now until it ends, call :meth:`Controller.tick`
-        every :data:`TICK` s (a window runs that timer only while something is driven)."""
+        """A held drive began (a lease was granted) or a jog is watched: from now while
+        :attr:`Controller.needs_tick`, call :meth:`Controller.tick` every :data:`TICK` s (a window runs
+        that timer only while something is driven)."""
 
 
 class ClientLink(Protocol):
@@ -359,6 +360,12 @@ class Controller:
         self._analog = None
         self._apply()
 
+    @property
+    def needs_tick(self) -> bool:
+        """Keys, the stick or a live lease drive, or a jog is watched: :meth:`tick` is needed."""
+        live = self._held or self._analog is not None or self.link.lease.view().live
+        return bool(live) or self.motion.jogs.jog is not None
+
     def tick(self) -> None:
         """Renew the lease while keys are held. Call every :data:`TICK` s from the UI thread's timer."""
         self.motion.tick(self.robot.robot.value)
@@ -544,6 +551,8 @@ class Controller:
         sent = self.link.send(intent)
         if intent.moves:
             self.motion.intent_sent(intent, self.robot.robot.value)  # a jog is watched to its outcome
+            if self.motion.jogs.jog is not None:
+                self.view.driving()  # a still robot's numbers change nothing: the tick finds its end
         return sent
 
     def _record(self, intent: Intent) -> None:

@@ -71,7 +71,8 @@ class WindowTimers:
         return bool(self._drive or self._beat)
 
     def drive_started(self) -> None:
-        """A drive began (the controller granted a lease): renew it and beat for the guardian."""
+        """A drive began (the controller granted a lease) or a jog is watched: tick the controller
+        (renew the lease, look for the jog's end) and beat for the guardian."""
         if not self._drive:
             self._drive = GLib.timeout_add(int(TICK * 1000), self._drive_tick)
         if not self._beat:
@@ -79,11 +80,11 @@ class WindowTimers:
         self.window.map_page.refresh()
 
     def _driving(self) -> bool:
-        c = self.window.controller
-        return bool(c.held) or c.analog_active or c.link.lease.view().live
+        return self.window.controller.needs_tick
 
     def _drive_tick(self) -> bool:
-        """While a drive is held: renew its lease; the pill follows the keys. Ends with the drive."""
+        """While a drive is held or a jog watched: renew the lease, look for the jog's end; the pill
+        follows the keys. Ends with them."""
         self.window.controller.tick()
         self.window.map_page.refresh()
         if self._driving():
