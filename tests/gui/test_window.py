@@ -93,16 +93,31 @@ def test_connects_and_draws_the_map_walls_and_the_robot_where_the_simulator_has_
 
 def test_holding_up_drives_forward_and_releasing_stops(gui: Gui, sim: SimThread) -> None:
     start = sim.snapshot()
+    timers = gui.window.timers
+    assert not timers.fast_running, "a window at rest runs no lease tick and no guardian beat"
     gui.keydown("Up")
     try:
         pump(lambda: sim.snapshot().x > start.x + 150, 8, "the robot to drive 150 mm forward")
         assert received(sim)[0] > 0  # type: ignore[index]
+        assert timers.fast_running, "a held drive renews its lease and beats for the guardian"
         gui.shot("driving")
     finally:
         gui.keyup("Up")
     pump(lambda: stopped(sim), 8, "the robot to stop after the key was released")
     assert gui.window.controller.held == frozenset()
+    pump(lambda: not timers.fast_running, 10, "the drive's timers to end once the guardian is disarmed")
     gui.shot("released")
+
+
+def test_a_still_robot_draws_no_new_frame(gui: Gui, sim: SimThread) -> None:
+    """Status keeps coming at 10 Hz while the robot stands: an unchanged frame is never drawn again."""
+    stage = gui.stage
+    pump(lambda: stopped(sim) and stage.last_frame_complete, 10, "a still robot on a drawn map")
+    idle(1.0)  # the first status of a still robot, the tiles: drawn by now
+    frames = stage.frames
+    idle(2.0)
+    assert stage.frames == frames, f"{stage.frames - frames} frames redrawn for a robot that did not move"
+    gui.shot("still")
 
 
 def test_the_red_stop_in_the_header_stops_the_robot_while_a_drive_key_is_held(
