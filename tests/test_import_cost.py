@@ -105,6 +105,7 @@ def test_version_imports_no_subcommand() -> None:
 def test_a_subcommand_help_loads_that_subcommand_only(name: str) -> None:
     modules = loaded_by(run_main([name, "--help"]))
     assert offending(modules, network=True) == []
+    assert "rtmu.subcommands.json_schemas" not in modules, "the help names its schema from _schema_names"
     commands = set(subcommand_names())  # not the helpers (``_common``) nor the schemas' data module
     others = {m.split(".")[2] for m in modules if m.startswith("rtmu.subcommands.") and m.count(".") == 2}
     others = (others & commands) - {name}

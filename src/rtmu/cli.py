@@ -82,8 +82,8 @@ def subcommand_names() -> list[str]:
 
 
 def schema_of(name: str) -> str | None:
-    """The published schema a subcommand's ``--json`` lines follow (imported with the subcommand)."""
-    from .subcommands.json_schemas import COMMAND_SCHEMA
+    """The published schema a subcommand's ``--json`` lines follow (by name: the schemas stay unloaded)."""
+    from .subcommands._schema_names import COMMAND_SCHEMA
 
     return COMMAND_SCHEMA.get(name)
 

@@ -34,26 +34,6 @@ from ..base.exit_codes import (
     WHY_ASKED,
 )
 from ..base.textsafe import visible
-from ..client.diagnosis import ADVICE, Step, central_server_words, login_finding
-from ..client.errors import ClientError
-from ..client.roles import Role
-from ..client.why import diagnose
-from ..protocol.client_connection import ClientConnection
-from ..protocol.commands import ClientCommand, ServerCommand
-from ..protocol.decoder import PacketDecoder
-from ..protocol.errors import ProtocolError
-from ..protocol.events import (
-    Connected,
-    DataListReady,
-    DataReceived,
-    PeerShutdown,
-    Rejected,
-    ServerIntroduction,
-)
-from ..protocol.fields import FieldReader, FieldWriter
-from ..protocol.packet import encode_packet
-from ..protocol.payloads import Side, decode_payload
-from ..protocol.payloads.robot import BatteryInfo, Update, UpdateNumbers, UpdateStrings
 from ._common import (
     Interrupted,
     UsageError,
@@ -65,6 +45,10 @@ from ._common import (
 
 if TYPE_CHECKING:
     import asyncio
+
+    from ..client.diagnosis import Step
+    from ..protocol.client_connection import ClientConnection
+    from ..protocol.events import ServerIntroduction
 
 EXITS = (
     EXIT_OK, EXIT_INTERNAL, EXIT_USAGE, EXIT_DOCTOR_RESOLVE, EXIT_DOCTOR_TCP, EXIT_DOCTOR_INTRODUCTION,
@@ -153,6 +137,8 @@ class Doctor:
         self.steps.append(StepResult(step, result, summary, advice, dict(details)))
 
     async def run(self) -> int:
+        from ..client.diagnosis import Step
+
         try:
             await self._resolve()
             await self._connect()
@@ -179,6 +165,8 @@ class Doctor:
     async def _resolve(self) -> None:
         import asyncio
 
+        from ..client.diagnosis import ADVICE, Step
+
         loop = asyncio.get_running_loop()
         try:
             async with asyncio.timeout(self.timeout):
@@ -197,6 +185,8 @@ class Doctor:
 
     async def _connect(self) -> None:
         import asyncio
+
+        from ..client.diagnosis import ADVICE, Step
 
         where = f"{self.host}:{self.port}"
         started = time.monotonic()
@@ -223,6 +213,8 @@ class Doctor:
         import asyncio
 
         from ..client.connection import TEXT_BANNERS
+        from ..client.diagnosis import ADVICE, Step
+        from ..protocol.errors import ProtocolError
 
         assert self.reader is not None and self.conn is not None
         while True:
@@ -265,6 +257,10 @@ class Doctor:
             self.writer.write(out)
 
     async def _introduction(self) -> ServerIntroduction:
+        from ..client.diagnosis import Step
+        from ..protocol.client_connection import ClientConnection
+        from ..protocol.events import ServerIntroduction
+
         self.conn = ClientConnection(self.user, self._password, protocol_version=self.protocol)
         self._password = ""
         self._received = 0
@@ -274,6 +270,8 @@ class Doctor:
                     return self._describe_intro(event)
 
     def _describe_intro(self, intro: ServerIntroduction) -> ServerIntroduction:
+        from ..client.diagnosis import Step
+
         wanted = intro.protocol_version
         assert self.conn is not None
         sent = self.conn.sent_protocol_version or ""
@@ -293,6 +291,9 @@ class Doctor:
         return intro
 
     async def _login(self, intro: ServerIntroduction) -> None:
+        from ..client.diagnosis import ADVICE, Step, login_finding
+        from ..protocol.events import Connected, DataListReady, PeerShutdown, Rejected
+
         assert self.conn is not None
         while True:
             for event in await self._read_events(Step.LOGIN, "answer to our login"):
@@ -317,6 +318,7 @@ class Doctor:
 
     async def _data_list(self) -> None:
         from ..client.config_feed import ConfigApi, config_api
+        from ..client.diagnosis import Step
 
         assert self.conn is not None
         while not self.conn.datalist.complete:
@@ -347,6 +349,12 @@ class Doctor:
 
     async def _udp(self, intro: ServerIntroduction) -> None:
         import asyncio
+
+        from ..client.diagnosis import Step
+        from ..protocol.commands import ClientCommand, ServerCommand
+        from ..protocol.decoder import PacketDecoder
+        from ..protocol.fields import FieldReader, FieldWriter
+        from ..protocol.packet import encode_packet
 
         if intro.udp_port == 0:
             self.ok(Step.UDP, "not used: the server is TCP-only (UDP port 0)", "not_checked")
@@ -389,6 +397,9 @@ class Doctor:
             transport.close()
 
     async def _status(self) -> None:
+        from ..client.diagnosis import ADVICE, Step, central_server_words
+        from ..protocol.payloads.robot import BatteryInfo, Update, UpdateNumbers, UpdateStrings
+
         conn = self.conn
         assert conn is not None
         name = "updateNumbers" if "updateNumbers" in conn.datalist else "update"
@@ -422,6 +433,10 @@ class Doctor:
     async def _motion(self) -> None:
         """``rtmu why``'s answer, asked over a login of its own (the steps above use the bare codec)."""
         from ..client.connection import AriaClient
+        from ..client.diagnosis import Step
+        from ..client.errors import ClientError
+        from ..client.roles import Role
+        from ..client.why import diagnose
         from ..client.why_gather import gather
 
         client = AriaClient()
@@ -457,6 +472,11 @@ class Doctor:
         )
 
     async def _once(self, name: str) -> Any:
+        from ..client.diagnosis import ADVICE, Step
+        from ..protocol.errors import ProtocolError
+        from ..protocol.events import DataReceived, PeerShutdown
+        from ..protocol.payloads import Side, decode_payload
+
         conn = self.conn
         assert conn is not None
         number = conn.number_of(name)

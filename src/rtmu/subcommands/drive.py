@@ -31,15 +31,6 @@ from typing import TYPE_CHECKING, Any
 
 from ..base.exit_codes import EXIT_OK, EXIT_SIGQUIT, EXIT_SIGTSTP, EXIT_USAGE, NETWORK, WHY_DRIVE
 from ..base.textsafe import visible
-from ..client.errors import ClientError
-from ..client.roles import Role
-from ..client.why import diagnose, moved, unexplained
-from ..client.why_values import Answer, Facts, Motion
-from ..guardian.handle import GuardianHandle, GuardianUnavailable, beat_network, start_ready
-from ..guardian.messages import Hello
-from ..protocol.errors import ProtocolError
-from ..protocol.payloads.drive import RATIO_ROT_DEAD_ZONE, RATIO_TRANS_DEAD_ZONE, RatioDrive
-from ..protocol.payloads.robot import UpdateStrings
 from ._common import (
     Interrupted,
     UsageError,
@@ -56,6 +47,10 @@ from ._common import (
 if TYPE_CHECKING:
     from ..client.connection import AriaClient, Packet
     from ..client.drive_guard import DriveGuard
+    from ..client.why_values import Answer, Facts, Motion
+    from ..guardian.handle import GuardianHandle
+    from ..protocol.payloads.drive import RatioDrive
+    from ..protocol.payloads.robot import UpdateStrings
 
 RESEND = 0.1
 MAX_SECONDS = 600.0
@@ -107,7 +102,13 @@ def handle(args: argparse.Namespace) -> int:
     import asyncio
 
     from ..client.drive_guard import DriveGuard, LinkFault
+    from ..client.errors import ClientError
+    from ..client.roles import Role
+    from ..client.why import diagnose, moved, unexplained
     from ..client.why_gather import gather
+    from ..client.why_values import Facts, Motion
+    from ..guardian.handle import beat_network
+    from ..protocol.payloads.drive import RATIO_ROT_DEAD_ZONE, RATIO_TRANS_DEAD_ZONE, RatioDrive
     from .why import print_answer
 
     async def body(client: AriaClient) -> int:
@@ -206,6 +207,9 @@ def handle(args: argparse.Namespace) -> int:
 
 async def start_guardian(args: argparse.Namespace) -> GuardianHandle | None:
     """The guardian for this drive (``rtmu.guardian``); None, with one line on stderr, if it cannot log in."""
+    from ..guardian.handle import GuardianUnavailable, start_ready
+    from ..guardian.messages import Hello
+
     host, port = args.server
     try:
         return await start_ready(Hello(host, port, args.user, current_password(), args.timeout), args.timeout)
@@ -221,6 +225,7 @@ async def start_guardian(args: argparse.Namespace) -> GuardianHandle | None:
 
 async def refuse(args: argparse.Namespace, client: AriaClient, motion: Motion) -> int:
     """This login may not drive: say why (``rtmu why``'s answer) and exit with its code."""
+    from ..client.why import diagnose
     from ..client.why_gather import gather
     from .why import print_answer
 
@@ -253,12 +258,18 @@ class StatusWords:
             client.request("updateStrings", -1, self._on_strings)
 
     def _on_strings(self, packet: Packet) -> None:
+        from ..client.errors import ClientError
+        from ..protocol.errors import ProtocolError
+        from ..protocol.payloads.robot import UpdateStrings
+
         with contextlib.suppress(ClientError, ProtocolError):
             value = packet.decode()
             if self.open and isinstance(value, UpdateStrings):
                 self.last = value
 
     def close(self) -> None:
+        from ..client.errors import ClientError
+
         if self.open:
             self.open = False
             with contextlib.suppress(ClientError):
@@ -343,6 +354,9 @@ async def drive(
 
 def stop(client: AriaClient) -> None:
     """Zero ratios and ``stop``; never raises (we are often in a ``finally``)."""
+    from ..client.errors import ClientError
+    from ..protocol.payloads.drive import RatioDrive
+
     with contextlib.suppress(ClientError):
         client.send("ratioDrive", RatioDrive(0.0, 0.0, 0.0))
     if client.supports("stop"):

@@ -15,6 +15,9 @@ from typing import Any
 from ..client.console_effect import Effect
 from ..client.why_values import Cause
 from ..protocol.payloads.config import ParamType, Priority
+from ._schema_names import COMMAND_SCHEMA, SCHEMA_NAMES
+
+__all__ = ["COMMAND_SCHEMA", "SCHEMAS", "main"]
 
 Schema = dict[str, Any]
 
@@ -356,13 +359,8 @@ SCHEMAS: dict[str, Schema] = {
 }
 """Schema name → the JSON Schema of one ``--json`` line (the navigation commands share ``navigate``)."""
 
-COMMAND_SCHEMA = {
-    "goto": "navigate",
-    "home": "navigate",
-    "dock": "navigate",
-    **{name: name for name in SCHEMAS if name != "navigate"},
-}
-"""Subcommand → the schema of its ``--json`` lines."""
+if tuple(SCHEMAS) != SCHEMA_NAMES:  # the command line's names (``_schema_names``) are these, in order
+    raise ImportError(f"_schema_names.SCHEMA_NAMES is not SCHEMAS' names: {tuple(SCHEMAS)}")
 
 
 def main(argv: list[str]) -> int:
