@@ -140,10 +140,9 @@ class Recording:
                 if self._queue.empty():
                     break
                 continue
-            if self.stopped is None and item is not None:
+            wrote = self.stopped is None and item is not None
+            if wrote:
                 self._write(file, item)  # type: ignore[arg-type]
-                if self._queue.empty():  # let the next items gather: one wake-up for many, not one each
-                    self._ending.wait(min(GATHER_SECONDS, max(0.0, flush_at - time.monotonic())))
             if self.stopped is not None:
                 self._finish(file)  # keep what was written readable at once; drain the rest
                 continue
@@ -166,6 +165,10 @@ class Recording:
                 flush_at = now + self.limits.flush_seconds
                 if sync:
                     sync_at = now + self.limits.sync_seconds
+            if wrote and self._queue.empty():  # let the next items gather: one wake-up for many, not one each
+                # (after the repeat above: a repeat is due only while the writer has caught up, and a
+                # still robot's raw packets keep the queue from being empty after a gathering wait)
+                self._ending.wait(min(GATHER_SECONDS, max(0.0, flush_at - time.monotonic())))
         if self.stopped is None and self.dropped != reported_drops:
             self._log(file, topics.RECORDER, {"event": "dropped", "items": self.dropped}, time.time_ns())
         self._finish(file)
