@@ -26,10 +26,10 @@ def main() -> int:
     runner = ClientRunner(config=SessionConfig(fetch_map=False, guardian=guardian)).start()
     runner.connect("127.0.0.1", port).result(10)
     deadline = time.monotonic() + 10
-    while guardian and time.monotonic() < deadline:  # drive once the guardian is up (or gave up)
+    while guardian and time.monotonic() < deadline:  # drive once the guardian is armed (or gave up)
         runner.sync()
-        g = runner.session.guardian if runner.session else None
-        if g is None or g.state != "starting":
+        seat = runner.session.guardian if runner.session else None
+        if seat is None or seat.waiting_reason() is None:
             break
         time.sleep(0.02)
 
