@@ -54,6 +54,7 @@ def open_central(
     pump(lambda: len(fleet) == robots, 15, f"{robots} robot sessions from the central server")
     pump(lambda: all(s.state.connection.value.connected for s in fleet), 20, "every robot to connect")
     pump(lambda: all(s.state.robot.value.numbers_at is not None for s in fleet), 15, "every robot's status")
+    gui.wait_armed()
     return gui
 
 
@@ -85,6 +86,7 @@ def click_row(gui: Gui, name: str) -> None:
     assert row is not None
     gui.click(row)
     pump(lambda: gui.app.fleet.selected.value is session(gui, name), 5, f"{name} to be selected")
+    gui.wait_armed(session(gui, name))  # it drives on a key pressed once its guardian can stop it
 
 
 def test_the_central_servers_robots_are_listed_live_and_one_drives_alone(

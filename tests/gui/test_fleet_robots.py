@@ -56,6 +56,7 @@ def open_fleet(screenshots: Path, name: str, sims: list[SimThread]) -> Gui:
     pump(lambda: len(fleet) == 3, 10, "three robot sessions")
     pump(lambda: all(s.state.robot.value.numbers_at is not None for s in fleet), 15, "every robot's status")
     pump(lambda: all(s.state.map.value.state == "ready" for s in fleet), 20, "every robot's map")
+    gui.wait_armed()
     gui.stage.fit()
     idle(0.3)
     return gui
@@ -110,6 +111,7 @@ def click_row(gui: Gui, name: str) -> None:
     assert row is not None
     gui.click(row)
     pump(lambda: gui.app.fleet.selected.value is session(gui, name), 5, f"{name} to be selected")
+    gui.wait_armed(session(gui, name))  # it drives on a key pressed once its guardian can stop it
 
 
 def test_three_robots_are_listed_and_drawn_each_in_its_colour(

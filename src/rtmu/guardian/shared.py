@@ -109,7 +109,7 @@ class GuardianSeat:
             return f"{self.name} is not the robot that may drive"
         if self.state in (SeatState.READY, SeatState.UNAVAILABLE):
             return None
-        return f"Arming the guardian for {self.name} …"
+        return f"arming the guardian for {self.name} …"
 
     @property
     def armed_for_it(self) -> bool:

@@ -94,6 +94,7 @@ stackswitcher.circular > button > label { margin: 0; padding: 0; }
 
 .field-error { color: #c01c28; font-size: 9pt; margin-bottom: 4px; }
 entry.error { border-color: #c01c28; }
+.robot-row.robot-selected { background-color: alpha(@theme_selected_bg_color, 0.3); border-radius: 6px; }
 """
 
 
