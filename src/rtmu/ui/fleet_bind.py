@@ -103,7 +103,9 @@ class FleetBinding:
         self._list_source = 0
         self._narrow: bool | None = None
         self._stale_seen: tuple[bool, ...] = ()
+        self._menu_names: tuple[str, ...] | None = None
         self._sessions_changed()
+        self._sync_list()
         self._fit_width()
         self._redraw_source = 0
         self._timer = GLib.timeout_add(REFRESH_MS, self._refresh)
@@ -132,8 +134,7 @@ class FleetBinding:
             self._hooks[id(session)] = self._hook(session)
             if session is not selected:
                 session.attach_view(BackgroundView(self.window, session.name))
-        self._sync_list()
-        self.window.keyboard.fleet_changed()
+        self._queue_list()  # the list and the menu's Robots submenu: once for a burst of robots
         names = {s.name for s in sessions}
         if any(name not in names for name in self._lost):
             self._lost = {n: e for n, e in self._lost.items() if n in names}
@@ -249,6 +250,10 @@ class FleetBinding:
         selected = self.fleet.selected.value
         self.robot_list.show_selected(selected.name if selected is not None else None)
         self.robot_list.set_visible(len(names) > 1)
+        connected = tuple(s.name for s in self.fleet.sessions.value)
+        if connected != self._menu_names:  # rebuilding the menu costs GTK a rebuild per item: not per robot
+            self._menu_names = connected
+            self.window.keyboard.fleet_changed()
 
     def _refresh(self) -> bool:
         """Rows and markers of robots that went quiet (no event says so), and the window's width."""

@@ -116,6 +116,7 @@ class _Row(Gtk.Box):
         self.link = self._label(text, "robot-link")
         self.append(text)
         self.shown: RowText | None = None
+        self.selected = False
         click = Gtk.GestureClick()
         click.connect("released", lambda _g, _n, _x, _y: self._clicked())
         self.add_controller(click)
@@ -157,7 +158,9 @@ class _Row(Gtk.Box):
             self.rgb = UNCONNECTED_RGB
             text = listed_row_text(item.name)
         selected = self.robots.selected_name == item.name
-        (self.add_css_class if selected else self.remove_css_class)("robot-selected")
+        if selected != self.selected:
+            self.selected = selected
+            (self.add_css_class if selected else self.remove_css_class)("robot-selected")
         if text == self.shown:
             return
         was_stale = self.shown.stale if self.shown is not None else None
