@@ -196,9 +196,9 @@ class DriveFeed(Feed):
             self._held_since = None
             return False
         view = self.lease.view(now)
-        if self.governor.driving:
-            self.lease.end(EndReason.STOPPED, view.generation)
-            self.ctx.notice(Notice.warning(Kind.SAFETY, f"Stopped: {why}. Press again once it is armed."))
+        if self.governor.driving:  # (a stop that ended it already — a new selection — said its own words)
+            if self.lease.end(EndReason.STOPPED, view.generation):
+                self.ctx.notice(Notice.warning(Kind.SAFETY, f"Stopped: {why}. Press again once it is armed."))
         elif view.live:
             if self._held_since is None:
                 self._held_since = now

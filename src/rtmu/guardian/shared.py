@@ -265,6 +265,7 @@ class SharedGuardian:
         if word == "ended":
             seat = self.chosen
             self._handle = None
+            self._broken = text  # said for a login asked before it may be started again
             if seat is not None and not self._closed and seat.state in (SeatState.ARMING, SeatState.READY):
                 self._unavailable(seat, text)
             return

@@ -127,8 +127,9 @@ class RtmuApplication(Gtk.Application):
         # Ctrl+C, kill, a closed terminal (SIGHUP), Ctrl+\ (SIGQUIT), SIGUSR1/2 and SIGALRM all end the
         # window the same way: stop the robot first, then quit. Left to their default, they would kill
         # the process with the robot still driving until the server's watchdog noticed.
+        # Above every other source (a central server's robots arrive as thousands of idle callbacks).
         for signum in GLIB_SIGNALS:
-            self._signal_sources.append(GLib.unix_signal_add(GLib.PRIORITY_DEFAULT, signum, self._on_signal))
+            self._signal_sources.append(GLib.unix_signal_add(GLib.PRIORITY_HIGH, signum, self._on_signal))
         # GLib does not watch these: a Python handler (PyGObject wakes the main loop for it).
         for signum in PYTHON_SIGNALS:
             self._old_handlers[signum] = signal.signal(signum, self._on_python_signal)
@@ -319,7 +320,10 @@ class RtmuApplication(Gtk.Application):
         return True
 
     def _on_python_signal(self, _signum: int, _frame: object) -> None:
-        GLib.idle_add(lambda: self._on_signal() and False)
+        source = GLib.idle_source_new()  # above every other source (the stubs' idle_add has no priority)
+        source.set_priority(GLib.PRIORITY_HIGH)
+        source.set_callback(lambda *_args: self._on_signal() and False)
+        source.attach(None)
 
     def _on_suspend(self, _signum: int, _frame: object) -> None:
         """SIGTSTP: end any held drive (as a focus loss), make sure the stop is out, then really stop.
