@@ -99,7 +99,7 @@ class Other:
 class Stream:
     """A download: packets already framed with this data's number, in chunks of whole packets.
 
-    The server sends it as the client reads, one download per client at a time (see ``Session.stream``).
+    The server sends it as the client reads, one download per client at a time (see ``SimClient.stream``).
     """
 
     chunks: tuple[bytes, ...]
