@@ -1,4 +1,4 @@
-""" "Why won't it move?" and the console on the one intent path: controller guard → runner → feed.
+"""Why won't it move? and the console on the one intent path: controller guard → runner → feed.
 
 Against the simulator over loopback, through a robot session built as the window builds it
 (recording on): the why answer names the cause the simulator was put in, a fix that needs a yes is

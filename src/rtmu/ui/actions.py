@@ -7,12 +7,12 @@ and which of them are enabled.
 * **The window's own**: the camera page (``camera``, Esc), ``zoom-in`` / ``zoom-out`` / ``zoom-fit``
   and ``follow``, ``open-menu``, ``goto-panel``, ``select-robot(n)`` / ``next-robot`` /
   ``previous-robot``, ``live-video``, the camera head's moves (``ptz-left`` … ``ptz-home``) and the
-  dialogs (``settings``, ``server-config``, ``details``, ``layers``, ``about``).
+  dialogs (``settings``, ``server-config``, ``details``, ``layers``, ``about``, ``why``).
 * **Switches** (stateful, so the menu shows their check marks): the View menu's ``toolbar``,
   ``fullscreen``, ``dpad``, ``inset``, ``split``, ``fov``, ``sonar``, ``foxglove``, and ``safe-drive``.
 * **The menu**: the robot's commands first (a greyed row says why: GTK menus have no tooltips),
-  then Server, View, the shortcuts, About and Quit; every row shows its key from the one key table
-  (``keys.menu_item``).
+  then "Why won't it move?", Server, View, the shortcuts, About and Quit; every row shows its key
+  from the one key table (``keys.menu_item``).
 
 Keys reach an action through :meth:`WindowActions.activate` (``keys.KeyRouter``), the menu and the
 buttons through GTK's own activation: one table says key → action (``keys``), the shortcuts window
@@ -95,6 +95,7 @@ class WindowActions:
         self._plain("server-config", w.dialogs.show_server_config)
         self._plain("details", w.dialogs.show_details)
         self._plain("about", w.dialogs.show_about)
+        self._plain("why", w.dialogs.show_why)
         self._plain("layers", w.layers.open)
         # The map.
         self._plain("zoom-in", w.stage.zoom_in)
@@ -269,6 +270,7 @@ class WindowActions:
         ):
             view.append_item(menu_item(label, action))
         self.app_menu = app = Gio.Menu()
+        app.append_item(menu_item("Why won't it move?…", "win.why"))
         server = Gio.Menu()  # the connection and the server's own settings: one row, so the menu still fits
         server.append_item(menu_item("Connection settings…", "win.settings"))
         server.append_item(menu_item("Configuration…", "win.server-config"))

@@ -26,13 +26,22 @@ from ..fleet.selected import SelectedRobot  # noqa: E402
 from ..fleet.sessions import RobotSession  # noqa: E402
 from ..model.observables import Phase, RobotModel  # noqa: E402
 from ..settings.store import Profile  # noqa: E402
-from ..values.intents import Intent, ListServerCommands, MoveDistance, RunServerCommand, TurnBy, WatchStrings  # noqa: E402
+from ..values.intents import (  # noqa: E402
+    AskWhy,
+    Intent,
+    ListServerCommands,
+    MoveDistance,
+    RunServerCommand,
+    TurnBy,
+    WatchStrings,
+)
 from .banners import BannerStack  # noqa: E402
 from .config_page import ConfigPage  # noqa: E402
 from .details import DetailsWindow  # noqa: E402
 from .move_dialogs import go_dialog, turn_dialog  # noqa: E402
 from .palette import CommandPalette  # noqa: E402
 from .settings_dialog import ConnectionDialog, PasswordPrompt  # noqa: E402
+from .why_window import WhyWindow  # noqa: E402
 
 Request = Callable[[Intent], "concurrent.futures.Future[Any]"]
 
@@ -53,6 +62,7 @@ class WindowDialogs:
         keyring_available: bool = False,
         profile_saved: Callable[[Profile, str | None], None] | None = None,
         profile_changed: Callable[[], None] = lambda: None,
+        why_question: Callable[[], AskWhy] = AskWhy,
     ) -> None:
         self.window, self.robot, self.model, self.banners = window, robot, model, banners
         self.request = request
@@ -64,6 +74,9 @@ class WindowDialogs:
         """The connection settings dialog last opened."""
         self.details: DetailsWindow | None = None
         self.config_page: ConfigPage | None = None
+        self.why: WhyWindow | None = None
+        """The "why won't it move?" window last opened."""
+        self._why_question = why_question
         self._config_listener: Callable[[], None] | None = None
         robot.on_switch(self._details_follow)
         robot.on_switch(self._config_follow)
@@ -129,6 +142,16 @@ class WindowDialogs:
         old.runner.on_config_updated = None
         new.runner.on_config_updated = listener
         listener()  # the page reads the newly selected robot's configuration
+
+    # -- why won't it move? ---------------------------------------------------------------------
+    def show_why(self) -> None:
+        """Why won't it move? (``why_window``): one at a time; opened again, it asks again."""
+        why = self.why
+        if why is None or why.closed:
+            why = self.why = WhyWindow(self.window, self.request, self._why_question)
+        else:
+            why.ask()
+        why.present()
 
     # -- robot details ---------------------------------------------------------------------------
     def show_details(self) -> None:
