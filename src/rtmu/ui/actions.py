@@ -7,7 +7,7 @@ and which of them are enabled.
 * **The window's own**: the camera page (``camera``, Esc), ``zoom-in`` / ``zoom-out`` / ``zoom-fit``
   and ``follow``, ``open-menu``, ``goto-panel``, ``select-robot(n)`` / ``next-robot`` /
   ``previous-robot``, ``live-video``, the camera head's moves (``ptz-left`` … ``ptz-home``) and the
-  dialogs (``settings``, ``server-config``, ``details``, ``layers``, ``about``, ``why``).
+  dialogs (``settings``, ``server-config``, ``details``, ``layers``, ``about``, ``why``, ``console``).
 * **Switches** (stateful, so the menu shows their check marks): the View menu's ``toolbar``,
   ``fullscreen``, ``dpad``, ``inset``, ``split``, ``fov``, ``sonar``, ``foxglove``, and ``safe-drive``.
 * **The menu**: the robot's commands first (a greyed row says why: GTK menus have no tooltips),
@@ -96,6 +96,7 @@ class WindowActions:
         self._plain("details", w.dialogs.show_details)
         self._plain("about", w.dialogs.show_about)
         self._plain("why", w.dialogs.show_why)
+        self._plain("console", w.dialogs.show_console)
         self._plain("layers", w.layers.open)
         # The map.
         self._plain("zoom-in", w.stage.zoom_in)
@@ -274,6 +275,7 @@ class WindowActions:
         server = Gio.Menu()  # the connection and the server's own settings: one row, so the menu still fits
         server.append_item(menu_item("Connection settings…", "win.settings"))
         server.append_item(menu_item("Configuration…", "win.server-config"))
+        server.append_item(menu_item("Console…", "win.console"))
         app.append_submenu("Server", server)
         app.append_submenu("View", view)
         app.append_item(menu_item("Keyboard shortcuts", "win.show-help-overlay"))

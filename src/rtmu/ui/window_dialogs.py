@@ -1,5 +1,5 @@
-"""The window's dialogs: connection settings and passwords, the server's configuration, robot details,
-About, the command palette and the Turn / Go amount dialogs.
+"""The window's dialogs: connection settings and passwords, the server's configuration, the console,
+"why won't it move?", robot details, About, the command palette and the Turn / Go amount dialogs.
 
 Each is a window of its own, transient for the main window (so typing in it never reaches the drive
 keys, and ``stop_keys`` gives it Space all the same), opened by a menu action or — for Turn, Go and
@@ -37,6 +37,7 @@ from ..values.intents import (  # noqa: E402
 )
 from .banners import BannerStack  # noqa: E402
 from .config_page import ConfigPage  # noqa: E402
+from .console_page import ConsolePage  # noqa: E402
 from .details import DetailsWindow  # noqa: E402
 from .move_dialogs import go_dialog, turn_dialog  # noqa: E402
 from .palette import CommandPalette  # noqa: E402
@@ -75,6 +76,8 @@ class WindowDialogs:
         self.details: DetailsWindow | None = None
         self.config_page: ConfigPage | None = None
         self.why: WhyWindow | None = None
+        self.console: ConsolePage | None = None
+        """The console page last opened."""
         """The "why won't it move?" window last opened."""
         self._why_question = why_question
         self._config_listener: Callable[[], None] | None = None
@@ -142,6 +145,14 @@ class WindowDialogs:
         old.runner.on_config_updated = None
         new.runner.on_config_updated = listener
         listener()  # the page reads the newly selected robot's configuration
+
+    # -- the console -----------------------------------------------------------------------------
+    def show_console(self) -> None:
+        """The console page (``console_page``): one at a time, its list read once it opens."""
+        console = self.console
+        if console is None or console.closed:
+            console = self.console = ConsolePage(self.window, self.request)
+        console.present()
 
     # -- why won't it move? ---------------------------------------------------------------------
     def show_why(self) -> None:
