@@ -31,8 +31,9 @@ import gi
 gi.require_version("Gtk", "4.0")
 from gi.repository import Gio, GLib  # noqa: E402
 
+from ..client.config_feed import ConfigApi, config_api  # noqa: E402
 from ..control.commands import COMMANDS, CommandState, action_name  # noqa: E402
-from ..model.observables import RobotState  # noqa: E402
+from ..model.observables import ConnectionState, RobotState  # noqa: E402
 from .keys import menu_item  # noqa: E402
 
 MainWindow = Any
@@ -81,7 +82,7 @@ class WindowActions:
         """The command states last heard from the controller."""
         self._run: dict[str, Run] = {}
         """action name → what it does (also for a key while the action is shown greyed)."""
-        self._unobserve: Callable[[], None] = lambda: None
+        self._unobserve: list[Callable[[], None]] = []
         self.menu_model = self._menu()
 
     # -- the actions -----------------------------------------------------------------------------
@@ -96,7 +97,7 @@ class WindowActions:
         self._plain("details", w.dialogs.show_details)
         self._plain("about", w.dialogs.show_about)
         self._plain("why", w.dialogs.show_why)
-        self._plain("console", w.dialogs.show_console)
+        self._plain("console", lambda: w.dialogs.show_console())
         self._plain("layers", w.layers.open)
         # The map.
         self._plain("zoom-in", w.stage.zoom_in)
@@ -127,10 +128,16 @@ class WindowActions:
         self.foxglove_action = self._toggle("foxglove", False, w.foxglove.set)
         w.foxglove.failed = functools.partial(set_flag, self.foxglove_action, False)  # a busy port: unchecked
         w.connect("notify::fullscreened", self._fullscreen_changed)
-        self._unobserve = w.model.robot.observe(self._on_robot)
+        self._unobserve = [
+            w.model.robot.observe(self._on_robot),
+            w.model.connection.observe(self._on_connection),
+        ]
+        self.fill_server_menu(config_api(w.model.connection.value.offers))
 
     def close(self) -> None:
-        self._unobserve()
+        for remove in self._unobserve:
+            remove()
+        self._unobserve = []
 
     def _add(
         self, name: str, run: Run, state: bool | None = None, *, param: str | None = None
@@ -272,10 +279,8 @@ class WindowActions:
             view.append_item(menu_item(label, action))
         self.app_menu = app = Gio.Menu()
         app.append_item(menu_item("Why won't it move?…", "win.why"))
-        server = Gio.Menu()  # the connection and the server's own settings: one row, so the menu still fits
-        server.append_item(menu_item("Connection settings…", "win.settings"))
-        server.append_item(menu_item("Configuration…", "win.server-config"))
-        server.append_item(menu_item("Console…", "win.console"))
+        self.server_menu = server = Gio.Menu()  # the connection and the server's own settings: one row
+        self.fill_server_menu(ConfigApi.ARCONFIG)
         app.append_submenu("Server", server)
         app.append_submenu("View", view)
         app.append_item(menu_item("Keyboard shortcuts", "win.show-help-overlay"))
@@ -283,6 +288,28 @@ class WindowActions:
         app.append_item(menu_item("Quit", "app.quit"))
         menu.append_section(None, app)
         return menu
+
+    def fill_server_menu(self, api: ConfigApi) -> None:
+        """Server ▸ …: its Configuration row says which configuration API the robot has where RTMU
+        cannot edit it yet (an Omron LD robot's), and that the console reads it."""
+        config = "Configuration…"
+        if api is ConfigApi.OMRON_LD:
+            config = f"Configuration… — {api.value}: not editable yet, see Console"
+        items = (
+            ("Connection settings…", "win.settings"),
+            (config, "win.server-config"),
+            ("Console…", "win.console"),
+        )
+        menu = self.server_menu
+        shown = [menu.get_item_attribute_value(i, "label", None) for i in range(menu.get_n_items())]
+        if [v.get_string() if v is not None else "" for v in shown] == [label for label, _ in items]:
+            return
+        menu.remove_all()
+        for label, action in items:
+            menu.append_item(menu_item(label, action))
+
+    def _on_connection(self, _old: ConnectionState, new: ConnectionState) -> None:
+        self.fill_server_menu(config_api(new.offers))
 
     def fill_robot_menu(self) -> None:
         """The robot's commands; a greyed one says why (GTK menus have no tooltips): "… — not connected"."""

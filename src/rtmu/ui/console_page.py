@@ -96,6 +96,9 @@ class ConsolePage(Gtk.Window):
         self.shown: list[ConsoleEntry] = []
         """The entries the list's rows show now (at most :data:`MAX_ROWS`)."""
         self.current: ConsoleEntry | None = None
+        self._built_for: tuple[str, int] | None = None
+        self._loads = 0
+        """Data lists read (the rows are rebuilt for a new one)."""
         self.loading = False
         self.calling = False
         self.closed = False
@@ -169,12 +172,17 @@ class ConsolePage(Gtk.Window):
             self.count.set_text(f"No data list: {visible(short(str(error or 'cancelled'), 200))}")
             return False
         self.entries = list(future.result())
+        self._loads += 1
         self.refilter()
         return False
 
     def refilter(self) -> None:
-        """Rebuild the rows for the filter (at most :data:`MAX_ROWS`)."""
+        """Rebuild the rows for the filter (at most :data:`MAX_ROWS`); not again for the same filter
+        and list (the search entry repeats its signal after a text set from code)."""
         text = self.search.get_text().strip()
+        if self._built_for == (text, self._loads):
+            return
+        self._built_for = (text, self._loads)
         found = [e for e in self.entries if matches(e, text)]
         self.shown = found[:MAX_ROWS]
         while (child := self.rows.get_first_child()) is not None:  # GTK 4.8 has no remove_all

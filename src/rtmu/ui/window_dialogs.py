@@ -130,7 +130,9 @@ class WindowDialogs:
         """The server's configuration page (its own window, so typing there never drives): one at a time."""
         page = self.config_page
         if page is None or page.closed:
-            page = self.config_page = ConfigPage(self.window, self.request, self._follow_config_updates)
+            page = self.config_page = ConfigPage(
+                self.window, self.request, self._follow_config_updates, open_console=self.show_console
+            )
         page.present()
 
     def _follow_config_updates(self, listener: Callable[[], None] | None) -> None:
@@ -147,11 +149,14 @@ class WindowDialogs:
         listener()  # the page reads the newly selected robot's configuration
 
     # -- the console -----------------------------------------------------------------------------
-    def show_console(self) -> None:
-        """The console page (``console_page``): one at a time, its list read once it opens."""
+    def show_console(self, filter_text: str = "") -> None:
+        """The console page (``console_page``): one at a time, its list read once it opens;
+        ``filter_text`` narrows it (the configuration page points at the robot's config data)."""
         console = self.console
         if console is None or console.closed:
             console = self.console = ConsolePage(self.window, self.request)
+        if filter_text:
+            console.search.set_text(filter_text)
         console.present()
 
     # -- why won't it move? ---------------------------------------------------------------------
