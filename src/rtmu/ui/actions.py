@@ -11,7 +11,7 @@ and which of them are enabled.
 * **Switches** (stateful, so the menu shows their check marks): the View menu's ``toolbar``,
   ``fullscreen``, ``dpad``, ``inset``, ``split``, ``fov``, ``sonar``, ``foxglove``, and ``safe-drive``.
 * **The menu**: the robot's commands first (a greyed row says why: GTK menus have no tooltips),
-  then "Why won't it move?", Server, View, the shortcuts, About and Quit; every row shows its key
+  then "Why won't it move?", Server, View, Help (the shortcuts, About) and Quit; every row shows its key
   from the one key table (``keys.menu_item``).
 
 Keys reach an action through :meth:`WindowActions.activate` (``keys.KeyRouter``), the menu and the
@@ -283,8 +283,12 @@ class WindowActions:
         self.fill_server_menu(ConfigApi.ARCONFIG)
         app.append_submenu("Server", server)
         app.append_submenu("View", view)
-        app.append_item(menu_item("Keyboard shortcuts", "win.show-help-overlay"))
-        app.append_item(menu_item("About RTMU", "win.about"))
+        helping = (
+            Gio.Menu()
+        )  # one row for both: "Why won't it move?" took a row, an 800×480 screen has no more
+        helping.append_item(menu_item("Keyboard shortcuts", "win.show-help-overlay"))
+        helping.append_item(menu_item("About RTMU", "win.about"))
+        app.append_submenu("Help", helping)
         app.append_item(menu_item("Quit", "app.quit"))
         menu.append_section(None, app)
         return menu
