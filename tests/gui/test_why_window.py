@@ -3,8 +3,10 @@
 Real window, real simulator, real X keys and clicks: a drive key held against a locked mode raises
 the hint within a few seconds and names the lock; ``?`` and the menu (by keyboard) open the why
 window; a fix (safe drive off) is offered behind a confirmation and nothing is sent before its yes;
-a user without Movement is told so by the hint. Space and the STOP button stop the robot (the
-simulator's stop log grows) with the why window and its confirmation open.
+a user without Movement is told so by the hint; a lock that gives way is unlocked by its fix, asked
+first in the window; an LD robot's fault is told at once and acknowledged only after the yes. Space
+and the STOP button stop the robot (the simulator's stop log grows) with the why window and its
+confirmation open.
 """
 
 from __future__ import annotations
@@ -17,6 +19,7 @@ import pytest
 from rtmu.base import exit_codes as codes
 from rtmu.cli import main
 from rtmu.sim import SimConfig, SimThread
+from rtmu.sim.ld_safety import safety_state
 from rtmu.ui.why_window import WhyWindow
 
 from .harness import Gui, idle, pump
@@ -152,3 +155,62 @@ def click_in(gui: Gui, widget: object) -> None:
     from .test_config_page import click
 
     click(gui, widget)
+
+
+def test_a_lock_that_gives_way_is_unlocked_by_its_fix_after_a_yes(gui: Gui, sim: SimThread) -> None:
+    command(sim, "SimulatorLockStopModeUnlockable")
+    gui.focus()
+    gui.key("question")
+    why = why_window(gui)
+    assert "will unlock" in why.sentence.get_text(), why.sentence.get_text()
+    assert why.fix_button.get_label() == "Ask the mode to unlock…"
+    gui.xdotool("windowfocus", "--sync", str(_xid(why)))
+    click_in(gui, why.fix_button)
+    pump(lambda: why.confirm.asking, 5, "the confirmation")  # a fix the CLI sends without a yes: asked here
+    idle(0.3)
+    assert _locked(sim)
+    click_in(gui, why.confirm.yes_button)
+    pump(lambda: not why.asking and why.answer is not None and why.answer.can_move, 15, "the new answer")
+    assert not _locked(sim) and "done" in why.status.get_text()
+    gui.render(why, gui.shots / f"{gui.name}-unlocked.png")
+
+
+def test_an_ld_fault_is_told_at_once_and_acknowledged_only_after_a_yes(screenshots: Path) -> None:
+    with SimThread(SimConfig(port=0, profile="aram", map_path=None, camera=False, test_hooks=True)) as sim:
+        assert sim.server is not None
+        state = safety_state(sim.server)
+        gui = Gui.start(screenshots, "test_ld_fault", "127.0.0.1", sim.port)
+        try:
+            command(sim, "SimulatorFault")
+            said = lambda: " ".join(text for _t, _l, text in gui.window.banners.history)  # noqa: E731
+            pump(lambda: "The robot reports 1 fault(s)" in said(), 10, "the fault notice")
+            gui.shot("fault-notice")
+            gui.focus()
+            gui.key("question")
+            why = why_window(gui)
+            assert (
+                "Drive fault 1" in why.sentence.get_text()
+                and "raw, layout not public" in why.details.get_text()
+            )
+            assert why.fix_button.get_label() == "Acknowledge the faults…"
+            gui.xdotool("windowfocus", "--sync", str(_xid(why)))
+            click_in(gui, why.fix_button)
+            pump(lambda: why.confirm.asking, 5, "the confirmation")
+            assert "acknowledgeFault" in why.confirm.question.get_text()
+            space_stops(gui, sim, "with the fault's confirmation open")
+            assert state.acknowledged == []  # nothing acknowledged without the yes
+            gui.xdotool("windowfocus", "--sync", str(_xid(why)))
+            if not why.confirm.asking:
+                click_in(gui, why.fix_button)
+            pump(lambda: why.confirm.asking, 5, "the confirmation again")
+            click_in(gui, why.confirm.yes_button)
+            pump(lambda: state.acknowledged != [], 10, "the acknowledgement")
+            assert state.acknowledged == ["Drive fault 1: simulated motor controller fault"]
+            pump(lambda: not why.asking and why.answer is not None and why.answer.can_move, 15, "the answer")
+            gui.render(why, gui.shots / f"{gui.name}-acknowledged.png")
+        finally:
+            gui.close()
+
+
+def _locked(sim: SimThread) -> bool:
+    return bool(sim.call(lambda: sim.server.world.mode.locked))  # type: ignore[union-attr]

@@ -85,7 +85,7 @@ class WhyWindow(Gtk.Window):
         box = Gtk.Box(orientation=Gtk.Orientation.VERTICAL, spacing=8)
         for side in ("start", "end", "top", "bottom"):
             getattr(box, f"set_margin_{side}")(12)
-        self.sentence = Gtk.Label(wrap=True, xalign=0.0, selectable=True)
+        self.sentence = Gtk.Label(wrap=True, xalign=0.0)
         self.sentence.add_css_class("title-3")
         self.sentence.set_max_width_chars(60)
         self.details = Gtk.Label(wrap=True, xalign=0.0, selectable=True)
@@ -107,6 +107,7 @@ class WhyWindow(Gtk.Window):
         for widget in (self.sentence, scroller, self.status, self.confirm, buttons):
             box.append(widget)
         self.set_child(box)
+        self.set_focus(self.again_button)  # not the selectable details: focused, their text is all selected
         self.connect("close-request", self._closing)
         self.ask()
 
@@ -135,7 +136,8 @@ class WhyWindow(Gtk.Window):
 
     def show_answer(self, answer: Answer) -> None:
         self.answer = answer
-        self.sentence.set_text(_short(answer.sentence()))
+        sentence = _short(answer.sentence())
+        self.sentence.set_text(sentence[:1].upper() + sentence[1:])
         self.details.set_text(answer_details(answer))
         first = answer.primary
         self.fix = first.fix if first is not None else None
