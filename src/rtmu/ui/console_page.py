@@ -98,6 +98,10 @@ class ConsolePage(Gtk.Window):
         self.current: ConsoleEntry | None = None
         self._built_for: tuple[str, int] | None = None
         self._loads = 0
+        self._robot = 0
+        """Counts switches of robot, so a reply from the robot selected before is not shown."""
+        self._stale = False
+        """The list being read belongs to the robot selected before (read again when it is in)."""
         """Data lists read (the rows are rebuilt for a new one)."""
         self.loading = False
         self.calling = False
@@ -154,6 +158,20 @@ class ConsolePage(Gtk.Window):
         self.set_child(paned)
 
     # -- the list ------------------------------------------------------------------------------------
+    def robot_switched(self) -> None:
+        """Another robot is selected: forget the list, the pick and any question, and read its list."""
+        self.confirm.cancel()
+        self.entries, self.shown, self.current = [], [], None
+        self._built_for = None
+        self.refilter()
+        self.details.set_text("Pick a data on the left.")
+        self.call_button.set_sensitive(False)
+        self.reply.get_buffer().set_text("")
+        self.status.set_text("Another robot is selected: its data list is read.")
+        self._stale = self.loading  # a list on its way is the robot's before: read again when it is in
+        self._robot += 1  # a reply on its way is the robot's before: not shown as this one's
+        self.reload()
+
     def reload(self) -> None:
         """Read the server's data list again (the selected robot's, this login's)."""
         if self.loading:
@@ -166,6 +184,10 @@ class ConsolePage(Gtk.Window):
     def _loaded(self, future: concurrent.futures.Future[Any]) -> bool:
         self.loading = False
         if self.closed:
+            return False
+        if self._stale:
+            self._stale = False
+            self.reload()
             return False
         error = None if future.cancelled() else future.exception()
         if future.cancelled() or error is not None:
@@ -255,11 +277,15 @@ class ConsolePage(Gtk.Window):
         self.calling = True
         self.status.set_text(f"Calling {intent.name}…")
         future = self._request(intent)
-        future.add_done_callback(lambda f: GLib.idle_add(self._replied, f))
+        robot = self._robot
+        future.add_done_callback(lambda f: GLib.idle_add(self._replied, f, robot))
 
-    def _replied(self, future: concurrent.futures.Future[Any]) -> bool:
+    def _replied(self, future: concurrent.futures.Future[Any], robot: int) -> bool:
         self.calling = False
         if self.closed:
+            return False
+        if robot != self._robot:
+            self.status.set_text("A reply came from the robot selected before: not shown here.")
             return False
         error = None if future.cancelled() else future.exception()
         if future.cancelled() or error is not None:

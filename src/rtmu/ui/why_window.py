@@ -82,6 +82,7 @@ class WhyWindow(Gtk.Window):
         self.asking = False
         self.closed = False
         self.fix: Fix | None = None
+        self._again = False
         box = Gtk.Box(orientation=Gtk.Orientation.VERTICAL, spacing=8)
         for side in ("start", "end", "top", "bottom"):
             getattr(box, f"set_margin_{side}")(12)
@@ -115,6 +116,7 @@ class WhyWindow(Gtk.Window):
     def ask(self) -> None:
         """Ask the selected robot again (the answer replaces the one shown)."""
         if self.asking:
+            self._again = True  # asked meanwhile (another robot selected): once more when this is in
             return
         self.asking = True
         self.confirm.cancel()
@@ -125,6 +127,10 @@ class WhyWindow(Gtk.Window):
     def _answered(self, future: concurrent.futures.Future[Any]) -> bool:
         self.asking = False
         if self.closed:
+            return False
+        if self._again:
+            self._again = False
+            self.ask()
             return False
         error = None if future.cancelled() else future.exception()
         if future.cancelled() or error is not None:
@@ -170,6 +176,9 @@ class WhyWindow(Gtk.Window):
         report = future.result()
         self.show_answer(report.answer)
         self.status.set_text(_short(report.message))
+        if self._again:  # another robot was selected meanwhile: ask it
+            self._again = False
+            self.ask()
         return False
 
     def _closing(self, *_a: object) -> bool:

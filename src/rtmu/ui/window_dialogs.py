@@ -83,6 +83,7 @@ class WindowDialogs:
         self._config_listener: Callable[[], None] | None = None
         robot.on_switch(self._details_follow)
         robot.on_switch(self._config_follow)
+        robot.on_switch(self._why_and_console_follow)
 
     # -- connection settings and passwords -----------------------------------------------------
     def password_for(self, profile: Profile) -> str | None:
@@ -158,6 +159,15 @@ class WindowDialogs:
         if filter_text:
             console.search.set_text(filter_text)
         console.present()
+
+    def _why_and_console_follow(self, _old: RobotSession, _new: RobotSession) -> None:
+        """A switch of robot: an open console reads the new robot's data list, an open why window asks
+        the new robot (neither keeps showing the robot before)."""
+        console, why = self.console, self.why
+        if console is not None and not console.closed:
+            console.robot_switched()
+        if why is not None and not why.closed:
+            why.ask()
 
     # -- why won't it move? ---------------------------------------------------------------------
     def show_why(self) -> None:
