@@ -91,6 +91,11 @@ def test_a_change_asks_first_ratio_drive_never_and_stop_works(gui: Gui, sim: Sim
     gui.render(page, gui.shots / f"{gui.name}-confirm.png")
     idle(0.5)
     assert not sim.snapshot().stalled and page.replies == 0  # nothing sent before the yes
+    gui.key("Escape")  # Esc in the confirmation cancels it
+    pump(lambda: not page.confirm.asking, 3, "Esc to cancel the confirmation")
+    page.arguments.grab_focus()
+    gui.key("Return")
+    pump(lambda: page.confirm.asking, 5, "the confirmation again")
     for how in ("Space", "the STOP button"):
         before = stops(sim)
         if how == "Space":

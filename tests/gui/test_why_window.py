@@ -84,6 +84,7 @@ def test_a_locked_mode_raises_the_hint_and_the_why_window_names_it(gui: Gui, sim
     assert "will not unlock" in hint(gui), hint(gui)
     assert gui.window.why_hint.asked == 1  # once per held drive
     assert abs(sim.snapshot().x - x0) < 1.0
+    space_stops(gui, sim, "with the hint shown")
     gui.focus()
     gui.key("question")
     why = why_window(gui)
