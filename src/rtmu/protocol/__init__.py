@@ -12,7 +12,7 @@ from __future__ import annotations
 
 from typing import TYPE_CHECKING
 
-from ..base import lazy
+from . import lazy
 
 if TYPE_CHECKING:
     from .commands import ClientCommand, ClientType, RejectReason, ServerCommand

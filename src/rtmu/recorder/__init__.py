@@ -15,7 +15,7 @@ from __future__ import annotations
 
 from typing import TYPE_CHECKING
 
-from ..base import lazy
+from ..protocol import lazy
 
 if TYPE_CHECKING:
     from .recorder import Recorder, RecorderConfig

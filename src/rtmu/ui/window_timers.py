@@ -31,6 +31,7 @@ if TYPE_CHECKING:
     from .map_page import MapPage
     from .notice_router import NoticeRouter
     from .toolbar import StatusToolbar
+    from .why_hint import WhyHint
 
 SLOW_TICK = 1.0
 """Seconds between the window's own ticks: ages (toolbar, picture), the stale look, the loop-lag watch."""
@@ -44,6 +45,7 @@ class TimedWindow(Protocol):
     toolbar: StatusToolbar
     camera_page: CameraPage
     notices: NoticeRouter
+    why_hint: WhyHint
 
     @property
     def session(self) -> RobotSession: ...
@@ -87,6 +89,7 @@ class WindowTimers:
         follows the keys. Ends with them."""
         self.window.controller.tick()
         self.window.map_page.refresh()
+        self.window.why_hint.tick()
         if self._driving():
             return True
         self._drive = 0
@@ -105,6 +108,7 @@ class WindowTimers:
         self.ticks += 1
         w = self.window
         w.map_page.refresh()
+        w.why_hint.tick()  # a key held that drives nothing (no lease, so no drive tick) is seen here
         w.toolbar.refresh()
         w.camera_page.tick()
         loop_lag = getattr(w.controller.link, "loop_lag", None)  # a stalled network thread: said

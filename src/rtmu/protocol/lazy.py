@@ -2,7 +2,8 @@
 
 ``from rtmu.protocol import PacketDecoder`` keeps working, but importing one module of the
 package (``rtmu.protocol.commands`` for a constant) no longer loads every other one with it:
-the package's ``__init__`` lists where each name lives and imports nothing itself.
+the package's ``__init__`` lists where each name lives and imports nothing itself. Here, at the
+bottom of the layers, so that ``protocol``, ``capture`` and ``recorder`` all may use it.
 """
 
 from __future__ import annotations
