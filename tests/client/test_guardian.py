@@ -277,11 +277,6 @@ def test_the_guardian_process_imports_no_client_gtk_recorder_or_asyncio() -> Non
     assert "rtmu.protocol.client_connection" in loaded  # it did load what it uses: the check can see
 
 
-@pytest.mark.xfail(
-    strict=True,
-    reason="the codec's checksum imports numpy at start-up until the codec loads it on first use "
-    "(being done on the 'lean' branch); then this passes and the marker must go",
-)
 def test_the_guardian_process_does_not_import_numpy() -> None:
     assert "numpy" not in _guardian_modules()
 
