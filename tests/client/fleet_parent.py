@@ -52,6 +52,9 @@ class Said:
     def open_dialog(self, name: str) -> None:
         pass
 
+    def driving(self) -> None:
+        pass  # no window timers here: the parent's loop ticks its controllers itself
+
 
 def main(argv: list[str]) -> int:
     ui: queue.Queue[Callable[[], object]] = queue.Queue()
