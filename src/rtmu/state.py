@@ -386,7 +386,8 @@ class LinkLevel(Enum):
     """Not connected."""
     OK = "ok"
     STALE = "stale"
-    """No status for 3 update intervals, or a ping went unanswered: driving is stopped."""
+    """No status for longer than the link's learned limit (``client.link_timing``: 0.2–0.45 s), or a
+    ping went unanswered: driving is stopped."""
     LOST = "lost"
     """No status for 2 s, or 3 pings unanswered: the link is considered gone (reconnect if enabled)."""
 
@@ -404,6 +405,12 @@ class LinkHealth:
     """Seconds since the last status packet (not compared: it changes all the time)."""
     ping_failures: int = 0
     """Pings in a row the server did not answer: it may no longer hear us (RTT is then None)."""
+    stale_limit: float | None = None
+    """Seconds without status after which the link counts as stale, as learned now (0.01 s steps)."""
+    jitter_ms: float | None = None
+    """How late status came lately above its normal pace (5 ms steps): what the limit was learned from."""
+    cause: str = field(default="", compare=False)
+    """While not OK: why, measured ("no status for 0.46 s, learned jitter 90 ms …"), with what to do."""
 
 
 # -- typed changes -------------------------------------------------------------------------------

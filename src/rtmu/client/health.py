@@ -4,13 +4,16 @@ ArNetworking has no keep-alive (protocol §2.12, §3.8): a dead Wi-Fi link looks
 exactly like a quiet robot unless we watch the status stream we subscribed to.
 So the status subscription *is* the heartbeat:
 
-* **stale** — no status for :data:`STALE_INTERVALS` update intervals (300 ms at
-  10 Hz): driving stops, the operator sees it;
+* **stale** — no status for longer than this link's learned limit
+  (:mod:`~rtmu.client.link_timing`: at least :data:`STALE_INTERVALS` update intervals — 300 ms at
+  10 Hz — and at most :data:`~rtmu.client.link_timing.STATUS_CEILING`): driving stops, the
+  operator sees it, with the measured cause (:meth:`HealthMonitor.cause`);
 * **lost**  — no status for :data:`LOST_AFTER` s: the connection is treated as
   gone (the session reconnects if the profile asks for it).
 
 Round-trip time comes from a cheap request-once every second (the first of
-:data:`PING_CANDIDATES` the server offers). A ping that gets no answer matters as
+:data:`PING_CANDIDATES` the server offers); how long one may take is learned the same way
+(:meth:`HealthMonitor.ping_deadline`). A ping that gets no answer matters as
 much as a missing status: a server that keeps *sending* status but has stopped
 *reading* (or answering) would never hear our ``stop``. So an unanswered ping makes
 the RTT unknown and the link at least **stale** (driving stops); after
@@ -20,12 +23,17 @@ injected clock.
 
 from __future__ import annotations
 
+from collections.abc import Callable
+
 from ..protocol.decoder import DropStats
 from ..state import LinkHealth, LinkLevel
+from .link_timing import STATUS_CEILING, Deadline, Timing
 
 STALE_INTERVALS = 3
 LOST_AFTER = 2.0
 PING_INTERVAL = 1.0
+PING_FLOOR = 0.5
+"""A ping is given at least this long, however steady the link (the window's pings are 1 s apart)."""
 PING_FAILURES_LOST = 3
 """Unanswered pings in a row after which the link counts as lost (a server that stopped reading)."""
 PING_CANDIDATES = ("ackCommTcp", "getSafeDrive", "getMapName", "batteryInfo", "physicalInfo", "getModeInfo")
@@ -40,10 +48,24 @@ class HealthMonitor:
         stale_intervals: int = STALE_INTERVALS,
         lost_after: float = LOST_AFTER,
         ping_failures_lost: int = PING_FAILURES_LOST,
+        stale_ceiling: float = STATUS_CEILING,
+        ping_floor: float = PING_FLOOR,
+        ping_ceiling: float | None = None,
     ) -> None:
         self.status_interval = status_interval
-        self.stale_after = stale_intervals * status_interval
-        self.lost_after = max(lost_after, self.stale_after)
+        floor = stale_intervals * status_interval
+        self.status_timing = Deadline(status_interval, floor, max(floor, stale_ceiling))
+        """Gaps between status packets → the stale limit (``client.link_timing``)."""
+        self.lost_after = max(lost_after, self.status_timing.ceiling)
+        ping_ceiling = lost_after if ping_ceiling is None else ping_ceiling
+        self.ping_timing = Deadline(0.0, min(ping_floor, ping_ceiling), ping_ceiling, fixed=ping_ceiling)
+        """Round trips → how long a ping may go unanswered."""
+        self.where = "the server"
+        self.undecided: Callable[[], bool] = _never
+        """True while the decoder holds a header with valid packets behind it (see :meth:`bind`):
+        the stream is alive and about to be delivered, so the stale limit is its ceiling meanwhile."""
+        self.last_packet_at: Callable[[], float | None] = _unknown
+        """When any packet last arrived (see :meth:`bind`): tells a quiet server from a dead link."""
         self.ping_failures_lost = ping_failures_lost
         self._started: float | None = None
         self._last_status: float | None = None
@@ -54,6 +76,14 @@ class HealthMonitor:
         """Packets that arrived intact but could not be decoded (counted with the decoder's drops)."""
         self._last_traffic: float | None = None
 
+    def bind(
+        self, where: str, last_packet_at: Callable[[], float | None], undecided: Callable[[], bool]
+    ) -> None:
+        """Watch one connection: its name for the words, its packet clock and its decoder."""
+        self.where = where
+        self.last_packet_at = last_packet_at
+        self.undecided = undecided
+
     @property
     def running(self) -> bool:
         return self._started is not None
@@ -62,6 +92,8 @@ class HealthMonitor:
         """A connection is up: the status age counts from now until the first status arrives."""
         self._started = now
         self._last_status = None
+        self.status_timing.reset(now)
+        self.ping_timing.reset(now)
         self.rtt = None
         self.ping_failures = 0
         self.bad_payloads = 0
@@ -72,7 +104,22 @@ class HealthMonitor:
         self._last_status = None
 
     def note_status(self, now: float) -> None:
+        last = self._last_status
+        if last is not None and now >= last:
+            self.status_timing.note(now - last, now)
         self._last_status = now
+
+    def stale_limit(self, now: float) -> float:
+        """Seconds without status after which the link is stale, now (learned; see ``link_timing``)."""
+        return self.status_timing.limit(now, undecided=self.undecided())
+
+    def ping_deadline(self, now: float) -> float:
+        """How long the next ping may go unanswered before it counts as a failure (learned)."""
+        return self.ping_timing.limit(now)
+
+    def timing(self, now: float) -> Timing:
+        """What the status stream's timing has learned (for a HUD, ``rtmu doctor``, a stop's words)."""
+        return self.status_timing.timing(now)
 
     def note_traffic(self, at: float | None) -> None:
         """Packets arrived at ``at`` (during a map download): the link is alive, if not fresh.
@@ -87,9 +134,11 @@ class HealthMonitor:
     def _traffic_alive(self, now: float) -> bool:
         return self._last_traffic is not None and now - self._last_traffic <= self.lost_after
 
-    def note_rtt(self, seconds: float) -> None:
+    def note_rtt(self, seconds: float, now: float | None = None) -> None:
         self.rtt = seconds
         self.ping_failures = 0
+        if now is not None:
+            self.ping_timing.note(seconds, now)
 
     def note_ping_timeout(self) -> None:
         """A ping got no answer in time: the RTT is unknown, and the link no better than stale."""
@@ -114,7 +163,7 @@ class HealthMonitor:
             return LinkLevel.LOST
         if age > self.lost_after and not self._traffic_alive(now):
             return LinkLevel.LOST
-        if age > self.stale_after or self.ping_failures:
+        if age > self.stale_limit(now) or self.ping_failures:
             return LinkLevel.STALE
         return LinkLevel.OK
 
@@ -124,7 +173,7 @@ class HealthMonitor:
         if age is None:
             return float("inf")
         since = now - age
-        for limit in (self.stale_after, self.lost_after):
+        for limit in (self.stale_limit(now), self.lost_after):
             if age <= limit:
                 return since + limit + 1e-4
         if self._last_traffic is not None and self._traffic_alive(now):
@@ -134,14 +183,53 @@ class HealthMonitor:
     def snapshot(self, now: float, drops: DropStats | None = None) -> LinkHealth:
         drops = drops or DropStats()
         rtt_ms = None if self.rtt is None else round(self.rtt * 1000.0, 1)
+        level = self.level(now)
+        timing = self.timing(now)
         return LinkHealth(
-            level=self.level(now),
+            level=level,
             rtt_ms=rtt_ms,
             dropped=drops.dropped + self.bad_payloads,
             garbage_bytes=drops.garbage_bytes,
             status_age=self.status_age(now),
             ping_failures=self.ping_failures,
+            stale_limit=round(self.stale_limit(now), 2),
+            jitter_ms=round(timing.jitter * 200.0) * 5.0,
+            cause="" if level in (LinkLevel.OK, LinkLevel.DOWN) else self.cause(now),
         )
+
+    def cause(self, now: float) -> str:
+        """Why the link is not OK now, measured, and what to do — one sentence for a notice or stderr.
+
+        Other data still arriving while status does not means the server, not the link, went quiet.
+        """
+        where = self.where
+        if self.ping_failures:
+            deadline = self.ping_deadline(now)
+            return (
+                f"{where} did not answer a ping within {deadline:.2f} s ({self.ping_failures} in a row): "
+                "it may not hear our commands — check the robot's Wi-Fi and that its server still runs"
+            )
+        age = self.status_age(now) or 0.0
+        timing = self.timing(now)
+        last_packet_at = self.last_packet_at()
+        quiet_server = last_packet_at is not None and now - last_packet_at < age / 2
+        what = (
+            "other data still arrives, so the server itself is slow or stopped sending status"
+            if quiet_server
+            else "nothing at all arrived (Wi-Fi, network or the server)"
+        )
+        return (
+            f"no status from {where} for {age:.2f} s — {what}; {timing.describe()}. "
+            "Check the robot's Wi-Fi (signal, roaming between access points)"
+        )
+
+
+def _never() -> bool:
+    return False
+
+
+def _unknown() -> float | None:
+    return None
 
 
 def ping_data(offers: object) -> str | None:

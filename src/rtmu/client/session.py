@@ -152,7 +152,9 @@ class Session:
         self.subscriptions = SUBSCRIPTIONS if subscriptions is None else subscriptions
         """What every connection subscribes to (see :data:`SUBSCRIPTIONS`)."""
         self.health = HealthMonitor(
-            self.config.status_interval_ms / 1000.0, lost_after=self.config.lost_after
+            self.config.status_interval_ms / 1000.0,
+            lost_after=self.config.lost_after,
+            ping_ceiling=self.config.ping_timeout or self.config.lost_after,
         )
         self.governor = DriveGovernor(lease)
         self.client: AriaClient | None = None
@@ -317,6 +319,7 @@ class Session:
         self.lease.end(EndReason.DISCONNECTED)
         self.governor.reset()
         self.health.start(self.clock())
+        self.health.bind(f"{target.host}:{target.port}", lambda: client.last_packet_at, client.undecided)
         offers = frozenset(e.name for e in client.datalist)
         self.nav.connected(client)
         self._setup_subscriptions(client)
@@ -624,11 +627,10 @@ class Session:
         name = ping_data(client.datalist)
         if name is None:
             return
-        timeout = self.config.ping_timeout or self.config.lost_after
         while client.connected:
             started = time.perf_counter()
             try:
-                reply = await client.request_once(name, timeout=timeout)
+                reply = await client.request_once(name, timeout=self.health.ping_deadline(self.clock()))
             except ClientTimeout:
                 # The server may have stopped reading: it would not hear a stop either.
                 self.health.note_ping_timeout()
@@ -637,7 +639,7 @@ class Session:
             except ClientError:
                 return
             else:
-                self.health.note_rtt(time.perf_counter() - started)
+                self.health.note_rtt(time.perf_counter() - started, self.clock())
                 if name == "getSafeDrive":
                     self._on_safe_drive(reply.payload)
                 self._publish_health()

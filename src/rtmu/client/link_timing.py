@@ -1,0 +1,142 @@
+"""How late may the next status (or a ping's answer) be before the link is declared stale? One rule.
+
+A fixed limit is wrong both ways: 200 ms stops a robot on healthy Wi-Fi, whose 802.11 retries,
+background scans and contention hold a stream for 50–300 ms now and then, or on a laptop whose
+other programs keep a core busy; 2 s would let a robot drive blind. So each link *learns* what it
+normally does, as TCP learns its retransmission timeout from the smoothed round trip and its
+variance (RFC 6298), and is declared stale at a margin above that — never below a floor (today's
+fixed limits, so a clean link stops as fast as ever) and never above a ceiling (what the safety
+promise allows: zero ratios and ``stop`` on the wire within 0.5 s of the last status).
+
+:class:`Deadline` learns from samples — the gap between two status packets, or a ping's round
+trip — three figures:
+
+* ``mean``: the smoothed sample (RFC 6298's SRTT, gain 1/8);
+* ``jitter``: how far samples came *above* the mean lately. Unlike RFC 6298's RTTVAR it rises at
+  once to a late sample and then decays slowly (half-life :data:`JITTER_MEMORY`), as Linux's
+  ``mdev_max`` does: Wi-Fi stalls are rare events, and a link that stalled 150 ms a minute ago
+  will do it again — an average over the last second would have forgotten it;
+* a ``prior``: until the link has shown what it does, the limit starts at the ceiling (TCP's
+  conservative initial RTO) and comes down with a half-life of :data:`PRIOR_MEMORY`.
+
+``limit = clamp(mean + MARGIN × max(jitter, prior) + PAD, floor, ceiling)``. ``MARGIN`` 2 lets the
+next stall be twice the longest one remembered; ``PAD`` covers timer noise on a clean link.
+
+While the link is *undecided* — the decoder holds a header whose body has not come but sees
+valid packets going on behind it (``PacketDecoder.undecided``) — the limit is the ceiling: the
+stream is alive, the decoder will deliver within a few packets, and a stale verdict must not race
+it. Pure logic over times passed in; one instance per stream.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+
+STATUS_CEILING = 0.45
+"""The status limit's ceiling: 50 ms under the 0.5 s promise (last status → stop on the wire)
+for the heart's wake-up and the send on a busy machine."""
+MARGIN = 2.0
+PAD = 0.05
+JITTER_MEMORY = 120.0
+"""Seconds for the remembered jitter to halve: longer than the gaps between a Wi-Fi's stalls."""
+PRIOR_MEMORY = 10.0
+"""Seconds for the starting assumption (limit at the ceiling) to halve once samples arrive."""
+GAIN = 1.0 / 8.0
+"""RFC 6298's alpha: the weight of a new sample in the smoothed mean."""
+
+LEARNING = True
+"""False: every :class:`Deadline` built from now on keeps its floor (status) or its ceiling (pings)
+— the fixed thresholds RTMU used before it learned. Only benchmarks set it, to measure the
+difference in the same run."""
+
+
+@dataclass(frozen=True, slots=True)
+class Timing:
+    """What a :class:`Deadline` has learned, for a HUD, ``rtmu doctor`` and the stop's explanation."""
+
+    limit: float
+    """Seconds after which the stream counts as stale (or the ping as unanswered) now."""
+    jitter: float
+    """Seconds: how late samples came above the mean lately (the remembered envelope)."""
+    mean: float
+    """The smoothed sample (gap or round trip), seconds."""
+    samples: int
+    learning: bool
+    """True while the starting assumption still sets the limit (too few samples to trust)."""
+
+    def describe(self) -> str:
+        """``learned jitter 90 ms, limit 0.33 s`` — the words a stop and the HUD use."""
+        word = "jitter so far" if self.learning else "learned jitter"
+        return f"{word} {self.jitter * 1000:.0f} ms, limit {self.limit:.2f} s"
+
+
+class Deadline:
+    """Learns one periodic stream (or round trip) and says how long to wait for the next sample."""
+
+    def __init__(
+        self,
+        expected: float,
+        floor: float,
+        ceiling: float,
+        *,
+        fixed: float | None = None,
+        learn: bool | None = None,
+    ) -> None:
+        if not 0.0 < floor <= ceiling:
+            raise ValueError(f"need 0 < floor <= ceiling, got {floor!r}, {ceiling!r}")
+        self.expected = expected
+        """The nominal sample: the subscription's interval, or a first guess at the round trip."""
+        self.floor = floor
+        self.ceiling = ceiling
+        self.fixed = floor if fixed is None else fixed
+        """The limit when not learning (:data:`LEARNING` off): the old fixed threshold."""
+        self.learn = LEARNING if learn is None else learn
+        self.reset(None)
+
+    def reset(self, now: float | None) -> None:
+        """A new connection: forget the samples; the limit starts at the ceiling again."""
+        self.mean = self.expected
+        self.samples = 0
+        self._jitter = 0.0
+        self._jitter_at = 0.0 if now is None else now
+        self._prior = max(0.0, (self.ceiling - self.expected - PAD) / MARGIN)
+        self._prior_since: float | None = None
+
+    def note(self, sample: float, now: float) -> None:
+        """One sample (a gap between two arrivals, or a round trip) seen at ``now``."""
+        if sample < 0.0 or math.isnan(sample):
+            return
+        if self._prior_since is None:
+            self._prior_since = now
+        sample = min(sample, self.ceiling)  # a fault's long gap teaches no more than the ceiling
+        late = sample - self.mean
+        remembered = self._decayed_jitter(now)
+        self._jitter = max(remembered, late)
+        self._jitter_at = now
+        self.mean += GAIN * (sample - self.mean)
+        self.samples += 1
+
+    def _decayed_jitter(self, now: float) -> float:
+        return self._jitter * 0.5 ** (max(0.0, now - self._jitter_at) / JITTER_MEMORY)
+
+    def _prior_now(self, now: float) -> float:
+        if self._prior_since is None:
+            return self._prior
+        return self._prior * 0.5 ** (max(0.0, now - self._prior_since) / PRIOR_MEMORY)
+
+    def limit(self, now: float, *, undecided: bool = False) -> float:
+        """Seconds the next sample may take before the stream counts as late (see the module notes)."""
+        if not self.learn:
+            return self.fixed
+        if undecided:
+            return self.ceiling
+        spread = max(self._decayed_jitter(now), self._prior_now(now))
+        return min(self.ceiling, max(self.floor, self.mean + MARGIN * spread + PAD))
+
+    def timing(self, now: float) -> Timing:
+        jitter = self._decayed_jitter(now)
+        limit = self.limit(now)
+        without_prior = min(self.ceiling, max(self.floor, self.mean + MARGIN * jitter + PAD))
+        learning = self.learn and limit - without_prior > 0.005
+        return Timing(limit, jitter, self.mean, self.samples, learning)
