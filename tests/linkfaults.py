@@ -32,6 +32,7 @@ import socket
 import struct
 import threading
 import time
+from collections.abc import Callable
 from dataclasses import dataclass
 from typing import Literal
 
@@ -88,7 +89,7 @@ class _Pipe:
         self.direction = direction
         self.src = src
         self.dst = dst
-        self.queue: collections.deque[tuple[float, bytes]] = collections.deque()
+        self.queue: collections.deque[tuple[float, bytes, bool]] = collections.deque()
         self.queued = 0
         self.cond = threading.Condition()
         self.done = False
@@ -99,12 +100,16 @@ class _Pipe:
         for t in self.threads:
             t.start()
 
-    def put(self, data: bytes) -> None:
+    def put(self, data: bytes, *, raw: bool = False) -> None:
+        clean = not raw
+        if not raw and self.direction in self.proxy.garbled:
+            data = self.proxy.noise(len(data))
+            clean = False
         with self.cond:
             due = time.monotonic() + self.proxy.delays[self.direction] + self.proxy.chunk_jitter()
             if self.queue:
                 due = max(due, self.queue[-1][0])  # jitter never reorders a stream
-            self.queue.append((due, data))
+            self.queue.append((due, data, clean))
             self.queued += len(data)
             self.cond.notify_all()
 
@@ -133,7 +138,7 @@ class _Pipe:
                             due = max(self.queue[0][0], self.proxy.held_until[self.direction])
                             wait = due - time.monotonic()
                             if wait <= 0:
-                                _, data = self.queue.popleft()
+                                _, data, clean = self.queue.popleft()
                                 self.queued -= len(data)
                                 self.cond.notify_all()
                                 break
@@ -143,6 +148,8 @@ class _Pipe:
                         else:
                             self.cond.wait(0.1)
                 self.dst.sendall(data)
+                if clean:
+                    self.proxy.delivered_at[self.direction] = self.proxy.clock()
         except OSError:
             pass
         finally:
@@ -191,10 +198,17 @@ class _Link:
 class FaultProxy:
     """Listens on 127.0.0.1 (ephemeral port), forwards each connection to ``target``; see the module notes."""
 
-    def __init__(self, host: str, port: int) -> None:
+    def __init__(self, host: str, port: int, *, clock: Callable[[], float] = time.monotonic) -> None:
         self.target = (host, port)
+        self.clock = clock
+        """Stamps :attr:`delivered_at` (a test passes the simulator's clock)."""
+        self.delivered_at: dict[Direction, float | None] = {TO_CLIENT: None, TO_SERVER: None}
+        """When the last of the server's own bytes (not injected, not garbled) went out each way."""
         self.muted: set[Direction] = set()
         self.delays: dict[Direction, float] = {TO_CLIENT: 0.0, TO_SERVER: 0.0}
+        self.garbled: set[Direction] = set()
+        """Directions whose bytes are replaced by line noise of the same length (:meth:`garble`)."""
+        self._noise = random.Random(16)
         self.held_until: dict[Direction, float] = {TO_CLIENT: 0.0, TO_SERVER: 0.0}
         """Bytes going each way wait until this ``time.monotonic()`` (a stall or a roam)."""
         self.stalls: list[tuple[float, float, tuple[Direction, ...]]] = []
@@ -280,9 +294,24 @@ class FaultProxy:
         with self._lock:
             links = list(self._links)
         for link in links:
-            link.pipes[direction].put(data)
+            link.pipes[direction].put(data, raw=True)
         self.fault_at = time.monotonic()
         return self.fault_at
+
+    def garble(self, *directions: Direction) -> float:
+        """From now on replace every byte going ``directions`` (default: server→client) by noise."""
+        self.garbled.update(directions or (TO_CLIENT,))
+        return self._applied()
+
+    def noise(self, n: int) -> bytes:
+        return self._noise.randbytes(n).replace(b"\x0f\x0c", b"\x0f\x0d")  # never a sync pair
+
+    def stalling_header(self) -> float:
+        """A fake header that holds the stream: nothing valid follows it (the rest is garbled)."""
+        at = self.inject(FAKE_HEADER)
+        self.garble(TO_CLIENT)
+        self.fault_at = at
+        return at
 
     def hold(self, seconds: float, *directions: Direction) -> float:
         """Hold every byte going ``directions`` (default: both) for ``seconds`` from now, in order."""
@@ -321,10 +350,16 @@ class FaultProxy:
             if not self._playing.is_set():
                 return
             if rng.random() * rate < profile.stall_rate:
-                self.hold(rng.uniform(profile.stall_min, profile.stall_max), *profile.stall_directions)
+                length = rng.uniform(profile.stall_min, profile.stall_max)
+                self.hold(length, *profile.stall_directions)
             else:
-                lost = rng.randint(1, max(1, profile.loss_burst))
-                self.hold(profile.loss_stall(lost), rng.choice(BOTH))
+                length = profile.loss_stall(rng.randint(1, max(1, profile.loss_burst)))
+                self.hold(length, rng.choice(BOTH))
+            # The next stall starts after this one ends: stalls never merge into a longer one
+            # than the profile says (the gaps between them are Poisson).
+            end = time.monotonic() + length
+            while self._playing.is_set() and time.monotonic() < end:
+                time.sleep(min(0.05, max(0.0, end - time.monotonic())))
 
     def stop_playing(self) -> None:
         """End a :meth:`play` (stalls under way run out; no new ones start)."""
@@ -359,6 +394,7 @@ class FaultProxy:
     def restore(self) -> None:
         """No mute, no delay, no profile, no stall: held bytes flow again in order."""
         self.stop_playing()
+        self.garbled.clear()
         self.muted.clear()
         self.delays = {TO_CLIENT: 0.0, TO_SERVER: 0.0}
         self.held_until = {TO_CLIENT: 0.0, TO_SERVER: 0.0}

@@ -176,3 +176,23 @@ def test_cpu_load_spins_at_its_niceness_and_always_ends() -> None:
         CpuLoad(nice=-5)
     with pytest.raises(ValueError):
         CpuLoad(seconds=0)
+
+
+def test_garble_turns_a_direction_into_noise_of_the_same_length(proxy: FaultProxy) -> None:
+    with _client(proxy) as sock:
+        proxy.garble(TO_CLIENT)
+        sent = b"\x0f\x0c" * 100
+        sock.sendall(sent)
+        got = _echoed(sock, sent)
+        assert len(got) == len(sent) and got != sent and b"\x0f\x0c" not in got
+        proxy.restore()
+        sock.sendall(b"ok")
+        assert _echoed(sock, b"ok") == b"ok"
+
+
+def test_a_stalling_header_is_a_real_header_then_noise(proxy: FaultProxy) -> None:
+    with _client(proxy) as sock:
+        proxy.stalling_header()
+        assert _echoed(sock, FAKE_HEADER) == FAKE_HEADER
+        sock.sendall(b"abcd")
+        assert _echoed(sock, b"abcd") != b"abcd"

@@ -28,14 +28,14 @@ def test_a_new_link_starts_at_the_ceiling_and_a_steady_one_comes_down_to_the_flo
     assert d.timing(0.0).learning
     t = steady(d, 0.0, 5.0)
     assert FLOOR < d.limit(t) < STATUS_CEILING  # coming down
-    t = steady(d, t, 60.0)
+    t = steady(d, t, 180.0)
     assert d.limit(t) == pytest.approx(FLOOR)
     assert not d.timing(t).learning and d.timing(t).jitter < 0.001
 
 
 def test_a_stall_is_remembered_long_enough_for_the_next_one() -> None:
     d = Deadline(0.05, FLOOR, STATUS_CEILING)
-    t = steady(d, 0.0, 60.0)
+    t = steady(d, 0.0, 180.0)
     t += 0.05 + 0.150  # a 150 ms Wi-Fi stall: the next status is that late
     d.note(0.2, t)
     assert d.timing(t).jitter == pytest.approx(0.15, abs=0.01)
@@ -43,7 +43,7 @@ def test_a_stall_is_remembered_long_enough_for_the_next_one() -> None:
         d.note(0.0, t)  # the held packets arrive in a burst
     assert d.limit(t) > 0.35  # the next stall, even twice as long, is not a fault
     t2 = steady(d, t, 30.0)  # a quiet half-minute later (good Wi-Fi stalls every ~10 s)
-    assert d.limit(t2) > 0.05 + 0.15 + 0.05  # a 150 ms stall still passes
+    assert d.limit(t2) > 0.05 + 0.3  # a stall twice as long still passes
     late = steady(d, t2, JITTER_MEMORY * 6)  # …and a link that has calmed down gets fast again
     assert d.limit(late) == pytest.approx(FLOOR, abs=0.01)
 
@@ -71,7 +71,7 @@ def test_a_faults_long_gap_teaches_no_more_than_the_ceiling() -> None:
 
 def test_an_undecided_decoder_gets_the_ceiling_never_more() -> None:
     d = Deadline(0.05, FLOOR, STATUS_CEILING)
-    t = steady(d, 0.0, 120.0)
+    t = steady(d, 0.0, 180.0)
     assert d.limit(t) == pytest.approx(FLOOR)
     assert d.limit(t, undecided=True) == STATUS_CEILING
 
@@ -80,7 +80,7 @@ def test_pings_learn_their_round_trip() -> None:
     d = Deadline(0.0, 0.25, 0.5, fixed=0.5)
     assert d.limit(0.0) == pytest.approx(0.5)
     t = 0.0
-    for _ in range(400):  # 100 s of 4 Hz pings answered in 2 ms
+    for _ in range(800):  # 200 s of 4 Hz pings answered in 2 ms
         t += 0.25
         d.note(0.002, t)
     assert d.limit(t) == pytest.approx(0.25)
@@ -103,10 +103,10 @@ def test_learning_off_keeps_the_old_fixed_thresholds(monkeypatch: pytest.MonkeyP
 def test_the_words_say_what_was_learned() -> None:
     d = Deadline(0.05, FLOOR, STATUS_CEILING)
     assert d.timing(0.0).describe().startswith("jitter so far 0 ms, limit 0.45 s")
-    t = steady(d, 0.0, 60.0)
+    t = steady(d, 0.0, 180.0)
     t += 0.14
     d.note(0.14, t)
-    assert d.timing(t).describe() == "learned jitter 90 ms, limit 0.29 s"  # 0.061 + 2 × 0.09 + 0.05
+    assert d.timing(t).describe() == "learned jitter 90 ms, limit 0.34 s"  # 0.061 + 2 × 0.09 + 0.1
 
 
 def test_floor_above_ceiling_is_refused() -> None:

@@ -108,6 +108,10 @@ class DriveGuard:
             return None
         return self.health.cause(now)
 
+    def advice(self) -> str:
+        """What to do about the last :meth:`fault`."""
+        return self.health.advice()
+
     async def close(self) -> None:
         """Stop pinging (the subscription ends with the connection)."""
         task, self._ping_task = self._ping_task, None

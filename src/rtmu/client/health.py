@@ -194,34 +194,33 @@ class HealthMonitor:
             ping_failures=self.ping_failures,
             stale_limit=round(self.stale_limit(now), 2),
             jitter_ms=round(timing.jitter * 200.0) * 5.0,
-            cause="" if level in (LinkLevel.OK, LinkLevel.DOWN) else self.cause(now),
+            cause="" if level in (LinkLevel.OK, LinkLevel.DOWN) else f"{self.cause(now)}. {self.advice()}",
         )
 
     def cause(self, now: float) -> str:
-        """Why the link is not OK now, measured, and what to do — one sentence for a notice or stderr.
+        """Why the link is not OK now, measured — one sentence for a notice or stderr.
 
         Other data still arriving while status does not means the server, not the link, went quiet.
         """
         where = self.where
         if self.ping_failures:
-            deadline = self.ping_deadline(now)
             return (
-                f"{where} did not answer a ping within {deadline:.2f} s ({self.ping_failures} in a row): "
-                "it may not hear our commands — check the robot's Wi-Fi and that its server still runs"
+                f"{where} did not answer a ping within {self.ping_deadline(now):.2f} s "
+                f"({self.ping_failures} in a row): it may not hear our commands"
             )
         age = self.status_age(now) or 0.0
-        timing = self.timing(now)
         last_packet_at = self.last_packet_at()
-        quiet_server = last_packet_at is not None and now - last_packet_at < age / 2
-        what = (
-            "other data still arrives, so the server itself is slow or stopped sending status"
-            if quiet_server
-            else "nothing at all arrived (Wi-Fi, network or the server)"
-        )
-        return (
-            f"no status from {where} for {age:.2f} s — {what}; {timing.describe()}. "
-            "Check the robot's Wi-Fi (signal, roaming between access points)"
-        )
+        if last_packet_at is not None and now - last_packet_at < age / 2:
+            what = "other data still arrives, so the server itself is slow or stopped sending status"
+        else:
+            what = "nothing at all arrived — Wi-Fi, network or the server"
+        return f"no status from {where} for {age:.2f} s ({self.timing(now).describe()}): {what}"
+
+    def advice(self) -> str:
+        """What the operator can do about :meth:`cause`."""
+        if self.ping_failures:
+            return "Check the robot's Wi-Fi and that its server still runs, then drive again."
+        return "Check the robot's Wi-Fi (signal, roaming between access points), then drive again."
 
 
 def _never() -> bool:

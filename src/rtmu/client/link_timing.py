@@ -20,7 +20,7 @@ trip — three figures:
   conservative initial RTO) and comes down with a half-life of :data:`PRIOR_MEMORY`.
 
 ``limit = clamp(mean + MARGIN × max(jitter, prior) + PAD, floor, ceiling)``. ``MARGIN`` 2 lets the
-next stall be twice the longest one remembered; ``PAD`` covers timer noise on a clean link.
+next stall be twice the longest one remembered; ``PAD`` covers where in the status period it falls.
 
 While the link is *undecided* — the decoder holds a header whose body has not come but sees
 valid packets going on behind it (``PacketDecoder.undecided``) — the limit is the ceiling: the
@@ -37,11 +37,15 @@ STATUS_CEILING = 0.45
 """The status limit's ceiling: 50 ms under the 0.5 s promise (last status → stop on the wire)
 for the heart's wake-up and the send on a busy machine."""
 MARGIN = 2.0
-PAD = 0.05
+PAD = 0.1
+"""Added to every learned limit: a stall's lateness is measured from the mean gap, but it may start
+just after a status or just before the next one (one status period apart); covers that phase."""
 JITTER_MEMORY = 120.0
 """Seconds for the remembered jitter to halve: longer than the gaps between a Wi-Fi's stalls."""
-PRIOR_MEMORY = 10.0
-"""Seconds for the starting assumption (limit at the ceiling) to halve once samples arrive."""
+PRIOR_MEMORY = 30.0
+"""Seconds for the starting assumption (limit at the ceiling) to halve once samples arrive: long
+enough that a link whose first stall comes late (good Wi-Fi stalls about every 10 s) is still
+covered when it does."""
 GAIN = 1.0 / 8.0
 """RFC 6298's alpha: the weight of a new sample in the smoothed mean."""
 
@@ -64,9 +68,13 @@ class Timing:
     samples: int
     learning: bool
     """True while the starting assumption still sets the limit (too few samples to trust)."""
+    fixed: bool = False
+    """True when learning is off (:data:`LEARNING`): the limit is the old fixed one."""
 
     def describe(self) -> str:
         """``learned jitter 90 ms, limit 0.33 s`` — the words a stop and the HUD use."""
+        if self.fixed:
+            return f"jitter {self.jitter * 1000:.0f} ms, fixed limit {self.limit:.2f} s"
         word = "jitter so far" if self.learning else "learned jitter"
         return f"{word} {self.jitter * 1000:.0f} ms, limit {self.limit:.2f} s"
 
@@ -139,4 +147,4 @@ class Deadline:
         limit = self.limit(now)
         without_prior = min(self.ceiling, max(self.floor, self.mean + MARGIN * jitter + PAD))
         learning = self.learn and limit - without_prior > 0.005
-        return Timing(limit, jitter, self.mean, self.samples, learning)
+        return Timing(limit, jitter, self.mean, self.samples, learning, fixed=not self.learn)

@@ -121,10 +121,11 @@ def handle(args: argparse.Namespace) -> int:
             await guard.close()
             if client.closed_error is not None:
                 raise LinkFault(
-                    f"{fault}; the stop could not be sent (the server's watchdog stops the robot)"
+                    f"{fault}; the stop could not be sent (the server's watchdog stops the robot within "
+                    "2 s). Check the robot's Wi-Fi and that its server still runs, then drive again."
                 ) from None
             await client.flush()
-            raise LinkFault(f"{fault}; zero ratioDrive and stop sent at once") from None
+            raise LinkFault(f"{fault}; zero ratioDrive and stop sent at once. {guard.advice()}") from None
         finally:
             stop(client)
             if beats is not None:
