@@ -2,7 +2,8 @@
 
 An operator's laptop runs other programs; "4 busy processes on 2 cores" is a load average near 6
 before RTMU does anything. :class:`CpuLoad` starts ``count`` processes that spin at ``nice``
-(0: as hungry as RTMU itself; 19: polite) and ends them on :meth:`stop` / leaving the ``with``.
+(0: as hungry as RTMU itself; 19: polite), optionally pinned to some CPUs, and ends them on
+:meth:`stop` / leaving the ``with``.
 Each one also ends by itself after ``seconds`` and when its parent goes away (it checks its parent
 pid while it spins), so a crashed test or bench never leaves a core burning::
 
@@ -21,6 +22,8 @@ import time
 SPIN = """
 import os, sys, time
 os.nice(int(sys.argv[2]))
+if sys.argv[3]:
+    os.sched_setaffinity(0, {int(c) for c in sys.argv[3].split(",")})
 end = time.monotonic() + float(sys.argv[1])
 parent = os.getppid()
 n = 0
@@ -35,7 +38,9 @@ MAX_SECONDS = 3600.0
 class CpuLoad:
     """``count`` spinning processes at ``nice``, each ending after ``seconds`` at the latest."""
 
-    def __init__(self, count: int = 4, nice: int = 0, seconds: float = 600.0) -> None:
+    def __init__(
+        self, count: int = 4, nice: int = 0, seconds: float = 600.0, cpus: tuple[int, ...] = ()
+    ) -> None:
         if not 0 <= nice <= 19:
             raise ValueError("nice must be 0…19 (raising priority needs privileges we do not ask for)")
         if not 0 < seconds <= MAX_SECONDS:
@@ -43,11 +48,14 @@ class CpuLoad:
         self.count = count
         self.nice = nice
         self.seconds = seconds
+        self.cpus = cpus
+        """Pin the spinners to these CPUs (empty: wherever the kernel puts them)."""
         self.procs: list[subprocess.Popen[bytes]] = []
 
     def start(self) -> CpuLoad:
         for _ in range(self.count):
-            argv = [sys.executable, "-c", SPIN, str(self.seconds), str(self.nice)]
+            cpus = ",".join(str(c) for c in self.cpus)
+            argv = [sys.executable, "-c", SPIN, str(self.seconds), str(self.nice), cpus]
             self.procs.append(subprocess.Popen(argv, stdin=subprocess.DEVNULL))
         return self
 

@@ -97,6 +97,8 @@ class DriveLease:
         self._generation = 0
         self._ratios = STOPPED
         self._renewed_at = float("-inf")
+        self._real_renewal: tuple[float, int] | None = None
+        """(time, thread id) of the last grant, renewal or change by the UI side (not an extension)."""
         self._ended: EndReason | None = EndReason.RELEASED
 
     # -- UI side -----------------------------------------------------------------------------
@@ -106,6 +108,7 @@ class DriveLease:
             self._generation += 1
             self._ratios = ratios
             self._renewed_at = self.clock()
+            self._real_renewal = (self._renewed_at, threading.get_native_id())
             self._ended = None
             generation = self._generation
         self._event(LeaseEvent("grant", generation, ratios))
@@ -118,8 +121,26 @@ class DriveLease:
             now = self.clock()
             if not self._live(now):
                 return False
-            self._renewed_at = now
+            self._renewed_at = max(self._renewed_at, now)
+            self._real_renewal = (now, threading.get_native_id())
             return True
+
+    def extend(self, at: float) -> bool:
+        """Move a live lease's renewal forward to ``at`` (never back, never past now): the
+        :class:`~rtmu.client.lease_keeper.LeaseKeeper`'s credit for a renewing thread that only waited
+        for a CPU. A lapsed or ended lease stays dead. True if it moved."""
+        with self._lock:
+            now = self.clock()
+            at = min(at, now)
+            if not self._live(now) or at <= self._renewed_at:
+                return False
+            self._renewed_at = at
+            return True
+
+    def last_renewal(self) -> tuple[float, int] | None:
+        """(time, native thread id) of the UI side's last grant, renewal or change while the lease lives."""
+        with self._lock:
+            return self._real_renewal if self._ended is None else None
 
     def change(self, ratios: DriveRatios) -> bool:
         """New ratios for the live lease (one of two held keys released, speed step); renews it."""
@@ -128,7 +149,8 @@ class DriveLease:
             if not self._live(now):
                 return False
             self._ratios = ratios
-            self._renewed_at = now
+            self._renewed_at = max(self._renewed_at, now)
+            self._real_renewal = (now, threading.get_native_id())
             generation = self._generation
         self._event(LeaseEvent("change", generation, ratios))
         self._changed()

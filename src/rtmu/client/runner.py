@@ -70,6 +70,7 @@ from ..state import StateChange, StateSink
 from .connection import AriaClient, Packet
 from .errors import ClientError, ClientTimeout
 from .lease import LEASE_TTL, DriveLease, EndReason
+from .lease_keeper import LeaseKeeper, raise_priority
 from .link import Opener
 from .session import Session, SessionConfig
 
@@ -120,6 +121,8 @@ class ClientRunner:
         self.clock = clock
         self.config = config or SessionConfig()
         self.lease = DriveLease(ttl=lease_ttl, clock=clock)
+        # Run-queue waits are real time: credited only to a lease on the real clock (not a test's).
+        self.keeper = LeaseKeeper(self.lease, beat=self._beat_ui_at) if clock is time.monotonic else None
         self.on_notice: Callable[[Notice], None] | None = None
         """``on_notice(notice)``, called on the UI thread (through ``post``)."""
         self.on_publish: Callable[[StateChange], None] | None = None
@@ -142,6 +145,8 @@ class ClientRunner:
 
     # -- lifecycle ---------------------------------------------------------------------------
     def start(self) -> ClientRunner:
+        if self.keeper is not None:
+            self.keeper.start()
         self._thread.start()
         if not self._ready.wait(5):
             raise RuntimeError("the network thread did not start")
@@ -154,6 +159,7 @@ class ClientRunner:
         self.close()
 
     def _run(self) -> None:
+        raise_priority()  # where allowed: the loop that sends drives and stops must run on time
         asyncio.set_event_loop(self.loop)
         factory = None
         opener = self.opener
@@ -188,6 +194,8 @@ class ClientRunner:
 
     def close(self, timeout: float = 2.0) -> None:
         """Stop the robot, disconnect, end the thread. Idempotent; returns within ``timeout``."""
+        if self.keeper is not None:
+            self.keeper.close()
         if self._closed or not self._thread.is_alive():
             self._closed = True
             self._blocking.shutdown(wait=False, cancel_futures=True)
@@ -529,6 +537,13 @@ class ClientRunner:
         guardian = session.guardian if session is not None else None
         if guardian is not None:
             guardian.beat_ui()
+
+    def _beat_ui_at(self, at: float) -> None:
+        """The lease keeper's beat for a UI thread that only waited for a CPU (keeper thread)."""
+        session = self.session
+        guardian = session.guardian if session is not None else None
+        if guardian is not None:
+            guardian.beat_ui(at)
 
     def status_age(self) -> float | None:
         """Seconds since the last status packet, read now; None when not connected.

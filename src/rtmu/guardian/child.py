@@ -8,10 +8,15 @@ Thresholds, and why they cannot cause a false stop:
   threads are stopped by a signal or traced (``T``/``t`` in ``/proc``), or it
   is gone: stop at once. A running process is never in that state, however
   busy, slow or starved it is, so GC pauses and CPU contention cannot trip it.
-* **a heartbeat :data:`SILENT_LATE` s late while armed** from a parent that
-  still runs: stop. The parent's own drive lease lapses 0.3 s after its UI last
-  renewed it, so by then the parent would stop the robot itself when it runs
-  again — the guardian never ends a drive the parent would have continued.
+* **a heartbeat late past what this parent normally does, while armed**, from a
+  parent that still runs: stop. How late is learned per heartbeat source by the
+  link's own rule (:mod:`rtmu.client.link_timing`): at least :data:`SILENT_LATE`
+  s — the parent's own drive lease lapses 0.3 s after its UI last renewed it, so
+  by then the parent would stop the robot itself — and at most
+  :data:`SILENT_CEILING` s on a parent whose threads a busy machine often keeps
+  waiting. The UI's beats carry the lease keeper's credited time
+  (:mod:`rtmu.client.lease_keeper`): a UI thread that only waits for a CPU is not
+  silent, one that is frozen is.
 
 Heartbeats carry the sender's monotonic time (one clock for all processes on
 Linux), and the pipe is drained before every decision, so a guardian that was
@@ -31,11 +36,14 @@ from pathlib import Path
 
 from ..client.connection import AriaClient
 from ..client.errors import ClientError
+from ..client.link_timing import Deadline
 from . import messages as m
 from .halt import Halter
+from .handle import BEAT_PERIOD
 
 QUICK_LATE = 0.1
 SILENT_LATE = 0.4
+SILENT_CEILING = 1.0
 CHECK_PERIOD = 0.02
 
 
@@ -96,6 +104,8 @@ class Watch:
         self.parent = parent
         self.armed = False
         self.last: dict[bytes, float] = {}
+        self.timing: dict[bytes, Deadline] = {}
+        """Per source: how late its beats normally come (learned; floor SILENT_LATE)."""
         self.bye = False
         self.eof = False
 
@@ -110,7 +120,15 @@ class Watch:
             self.armed = False
             self.bye = True
         else:  # a source is watched once it has beaten
-            self.last[kind] = max(at, self.last.get(kind, at))
+            last = self.last.get(kind)
+            timing = self.timing.setdefault(kind, Deadline(BEAT_PERIOD, SILENT_LATE, SILENT_CEILING))
+            if last is not None and at > last:
+                timing.note(at - last, at)
+            self.last[kind] = max(at, last if last is not None else at)
+
+    def limit(self, kind: bytes, now: float) -> float:
+        timing = self.timing.get(kind)
+        return timing.limit(now) if timing is not None else SILENT_LATE
 
     def why_stop(self, now: float) -> str | None:
         if not self.armed:
@@ -120,8 +138,14 @@ class Watch:
         late = now - min(self.last.values()) if self.last else 0.0
         if late > QUICK_LATE and parent_frozen(self.parent):
             return f"the window's process is stopped or gone (no heartbeat for {late * 1000:.0f} ms)"
-        if late > SILENT_LATE:
-            return f"no heartbeat from the window for {late * 1000:.0f} ms"
+        for kind, at in self.last.items():
+            limit = self.limit(kind, now)
+            if now - at > limit:
+                thread = "UI" if kind == m.BEAT_UI else "network"
+                return (
+                    f"no heartbeat from the window's {thread} thread for {(now - at) * 1000:.0f} ms "
+                    f"(its beats normally come within {limit * 1000:.0f} ms)"
+                )
         return None
 
 

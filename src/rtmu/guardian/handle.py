@@ -55,12 +55,12 @@ class GuardianHandle:
         return handle
 
     # -- records ---------------------------------------------------------------------------
-    def _send(self, kind: bytes) -> bool:
+    def _send(self, kind: bytes, at: float | None = None) -> bool:
         with self._lock:
             if self._fd < 0:
                 return False
             try:
-                os.write(self._fd, m.record(kind, self.clock()))
+                os.write(self._fd, m.record(kind, self.clock() if at is None else at))
                 return True
             except BlockingIOError:
                 stuck = True
@@ -81,9 +81,11 @@ class GuardianHandle:
             self.armed = False
             self._send(m.DISARM)
 
-    def beat_ui(self) -> None:
+    def beat_ui(self, at: float | None = None) -> None:
+        """The UI thread is alive (as of ``at``: the lease keeper's credited time for a UI thread that
+        only waited for a CPU; default now)."""
         if self.armed:
-            self._send(m.BEAT_UI)
+            self._send(m.BEAT_UI, at)
 
     def beat_net(self) -> None:
         if self.armed:
