@@ -397,17 +397,19 @@ class Controller:
             self.link.lease.end(reason, self._generation)
             self._generation = None
         if had and reason is EndReason.LAPSED:
-            self.view.notify(
-                Notice.warning(
-                    Kind.SAFETY, "Stopped: the window did not respond in time. Press again to drive."
-                )
-            )
+            why = self.link.lease.why
+            text = "Stopped: the window did not respond in time" + (f" ({why})" if why else "")
+            self.view.notify(Notice.warning(Kind.SAFETY, f"{text}. Press again to drive."))
         elif had and reason is EndReason.LINK and not quiet:
             level = self.robot.health.value.level
             self._say_link_stop(level if level in (LinkLevel.STALE, LinkLevel.LOST) else LinkLevel.STALE)
 
     def _say_link_stop(self, level: LinkLevel) -> None:
-        self.view.notify(Notice.warning(Kind.LINK, f"Stopped: the link is {level.value}"))
+        """Said once per stop, with the network side's measured cause where it gave one."""
+        why = self.link.lease.why or self.robot.health.value.cause
+        self.view.notify(
+            Notice.warning(Kind.LINK, f"Stopped: the link is {level.value}" + (f" — {why}" if why else ""))
+        )
 
     def stop(self) -> None:
         """Stop now. Always sent, whatever the link looks like; held keys must be pressed again.
@@ -425,7 +427,7 @@ class Controller:
         if self.robot.connection.value.phase in (Phase.CONNECTED, Phase.RECONNECTING, Phase.CONNECTING):
             self.link.stop()
 
-    def focus_lost(self) -> None:
+    def focus_lost(self, why: str = "the window lost the keyboard") -> None:
         """The window lost keyboard focus: key releases may never arrive, so stop a held drive.
 
         A navigation goes on: the server drives it, no key is held for it.
@@ -435,6 +437,7 @@ class Controller:
         """
         if self._held or self._generation is not None:
             self.stop()
+            self.view.notify(Notice.info(Kind.SAFETY, f"Stopped: {why}. Press again to drive."))
         if self._analog is not None:
             self._analog = None
             self._analog_blocked = True

@@ -20,7 +20,7 @@ from __future__ import annotations
 import threading
 import time
 from collections.abc import Callable
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 from enum import Enum
 
 LEASE_TTL = 0.3
@@ -100,6 +100,7 @@ class DriveLease:
         self._real_renewal: tuple[float, int] | None = None
         """(time, thread id) of the last grant, renewal or change by the UI side (not an extension)."""
         self._ended: EndReason | None = EndReason.RELEASED
+        self._why = ""
 
     # -- UI side -----------------------------------------------------------------------------
     def grant(self, ratios: DriveRatios) -> int:
@@ -110,6 +111,7 @@ class DriveLease:
             self._renewed_at = self.clock()
             self._real_renewal = (self._renewed_at, threading.get_native_id())
             self._ended = None
+            self._why = ""
             generation = self._generation
         self._event(LeaseEvent("grant", generation, ratios))
         self._changed()
@@ -160,14 +162,18 @@ class DriveLease:
         """The operator let go: the network side sends zero ratios and ``stop``."""
         self.end(EndReason.RELEASED)
 
-    def end(self, reason: EndReason, generation: int | None = None) -> bool:
-        """End the lease (if ``generation`` is given, only that one); True if a live lease ended."""
+    def end(self, reason: EndReason, generation: int | None = None, why: str = "") -> bool:
+        """End the lease (if ``generation`` is given, only that one); True if a live lease ended.
+
+        ``why``: the measured cause, in words, where the side that ended it knows one (the network
+        side's link health, the lapse's length) — the view says it (:attr:`why`)."""
         with self._lock:
             if generation is not None and generation != self._generation:
                 return False
             was_live = self._ended is None
             if was_live:
                 self._ended = reason
+                self._why = why
             ended, ratios = self._generation, self._ratios
         if was_live:
             self._event(LeaseEvent("end", ended, ratios, reason))
@@ -187,6 +193,12 @@ class DriveLease:
         """Why the current lease ended; None while it has not been ended explicitly."""
         with self._lock:
             return self._ended
+
+    @property
+    def why(self) -> str:
+        """The measured cause given when the current lease ended ("" if none was given)."""
+        with self._lock:
+            return self._why
 
     def _live(self, now: float) -> bool:
         return self._ended is None and now - self._renewed_at <= self.ttl
@@ -212,6 +224,8 @@ class SendStop:
     """Zero ratios then ``stop``: what every end of motion sends."""
 
     reason: EndReason
+    why: str = field(default="", compare=False)
+    """The measured cause where the governor ended the lease itself (a bad link, a lapse)."""
 
 
 DriveAction = SendRatios | SendStop
@@ -240,7 +254,9 @@ class DriveGovernor:
     def driving(self) -> bool:
         return self._driving_generation is not None
 
-    def step(self, now: float, link_ok: bool = True) -> list[DriveAction]:
+    def step(
+        self, now: float, link_ok: bool = True, link_why: Callable[[], str] | None = None
+    ) -> list[DriveAction]:
         view = self.lease.view(now)
         if view.live and link_ok:
             fresh = self._driving_generation != view.generation or self._sent_ratios != view.ratios
@@ -252,16 +268,21 @@ class DriveGovernor:
             return []
         if self._driving_generation is None:
             return []
+        why = ""
         if view.ended is not None:
             reason = view.ended
         elif not link_ok and view.live:
             reason = EndReason.LINK
+            why = link_why() if link_why is not None else ""
         else:
             reason = EndReason.LAPSED
-        self.lease.end(reason, self._driving_generation)
+            silent = now - (view.expires_at - self.lease.ttl)
+            why = f"the drive was not renewed for {silent:.2f} s"
+        if not self.lease.end(reason, self._driving_generation, why):
+            why = self.lease.why if view.ended is not None else why
         self._driving_generation = None
         self._sent_ratios = None
-        return [SendStop(reason)]
+        return [SendStop(reason, why)]
 
     def next_wakeup(self, now: float) -> float:
         """When ``step`` must run again at the latest (a resend or the lease's expiry)."""

@@ -690,14 +690,16 @@ class Session:
             self.health.note_traffic(self.client.last_packet_at)  # map bytes keep the link alive
         level = self.health.level(now)
         link_ok = level is LinkLevel.OK and self.connected
-        for action in self.governor.step(now, link_ok):
+        for action in self.governor.step(
+            now, link_ok, lambda: f"{self.health.cause(now)}. {self.health.advice()}"
+        ):
             if isinstance(action, SendRatios):
                 r = action.ratios
                 if self.guardian is not None:
                     self.guardian.arm()  # before the first ratioDrive of a drive
                 self._send(RatioDrive(r.trans, r.rot, r.throttle, r.lat or None))
             elif isinstance(action, SendStop):
-                self._send_stop(f"lease {action.reason.value}")
+                self._send_stop(f"lease {action.reason.value}" + (f": {action.why}" if action.why else ""))
         self._publish_health(now)
         if level is LinkLevel.LOST and self.client is not None:
             target = self._target

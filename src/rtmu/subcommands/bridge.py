@@ -83,7 +83,16 @@ def handle(args: argparse.Namespace) -> int:
     )
     runner.on_publish = bridge.published
     runner.on_notice_sent = bridge.notice
-    runner.on_stop = bridge.stopped
+
+    def stopped(reason: str, sent: bool) -> None:
+        bridge.stopped(reason, sent)
+        if reason.startswith("lease link"):  # a stream that paused is the operator's "release": not said
+            print(
+                f"rtmu bridge: stopped the robot: {visible(reason.removeprefix('lease link: '))}",
+                file=sys.stderr,
+            )
+
+    runner.on_stop = stopped
     ended = threading.Event()
     ending = (signal.SIGINT, signal.SIGTERM, signal.SIGHUP)
     previous = {s: signal.signal(s, lambda *_: ended.set()) for s in ending}

@@ -938,7 +938,9 @@ class MainWindow(Gtk.ApplicationWindow):
         ``keep_focus``: the window still has the keyboard (the process is being suspended), so a
         release seen afterwards is a real one and unblocks its key.
         """
-        self.controller.focus_lost()
+        self.controller.focus_lost(
+            "RTMU was suspended (Ctrl+Z)" if keep_focus else "the window lost the keyboard"
+        )
         self.keys.release_all()
         self.dpad.release_all()
         if keep_focus and self.is_active():
