@@ -10,6 +10,7 @@ Jitter within the ceiling (Wi-Fi stalls up to 300 ms) must not stop the drive at
 
 from __future__ import annotations
 
+import json
 import signal
 import subprocess
 import sys
@@ -20,6 +21,7 @@ from pathlib import Path
 import pytest
 
 from linkfaults import FAKE_HEADER, GARBAGE, TO_CLIENT, TO_SERVER, FaultProxy, WifiProfile
+from rtmu.client.link_timing import STATUS_CEILING
 from rtmu.exit_codes import EXIT_TIMEOUT
 from rtmu.guardian.halt import IDENTIFIER
 from rtmu.protocol.decoder import PacketDecoder
@@ -184,3 +186,26 @@ def test_a_roam_stops_the_drive_and_nothing_drives_after_the_link_returns(
     eventually(lambda: proxy.held_until[TO_SERVER] < time.monotonic(), timeout=5)
     time.sleep(0.5)
     assert _received(sim) == received and sim.snapshot().trans_ratio == 0  # nothing drove again
+
+
+def test_doctor_shows_what_the_link_taught_it(sim: SimThread, proxy: FaultProxy) -> None:
+    """``rtmu doctor`` watches the status stream and reports the learned figures: 0.5 s stalls in
+    its sample are named (longest gap, jitter), the limit is the ceiling, and it advises."""
+    proxy.play(WifiProfile("stalls", stall_rate=2.0, stall_min=0.5, stall_max=0.5), seed=1)
+    args = [
+        sys.executable,
+        "-m",
+        "rtmu",
+        "doctor",
+        f"127.0.0.1:{proxy.port}",
+        "--json",
+        "--link-seconds",
+        "2.5",
+    ]
+    done = subprocess.run(args, capture_output=True, text=True, timeout=60)
+    status = next(s for s in json.loads(done.stdout)["steps"] if s["step"] == "status")
+    link = status["link"]
+    assert done.returncode == 0 and link["status_every_ms"] == 50 and link["arrived"] > 10
+    assert link["longest_gap_ms"] >= 450 and link["jitter_ms"] >= 400
+    assert link["stale_after_s"] == STATUS_CEILING
+    assert "driving stops after 0.45 s without status" in status["summary"] and "Wi-Fi" in status["advice"]

@@ -70,6 +70,8 @@ class Timing:
     """True while the starting assumption still sets the limit (too few samples to trust)."""
     fixed: bool = False
     """True when learning is off (:data:`LEARNING`): the limit is the old fixed one."""
+    settled: float = 0.0
+    """The limit this link's own jitter gives, once the starting assumption has worn off."""
 
     def describe(self) -> str:
         """``learned jitter 90 ms, limit 0.33 s`` — the words a stop and the HUD use."""
@@ -147,4 +149,4 @@ class Deadline:
         limit = self.limit(now)
         without_prior = min(self.ceiling, max(self.floor, self.mean + MARGIN * jitter + PAD))
         learning = self.learn and limit - without_prior > 0.005
-        return Timing(limit, jitter, self.mean, self.samples, learning, fixed=not self.learn)
+        return Timing(limit, jitter, self.mean, self.samples, learning, not self.learn, without_prior)
