@@ -13,7 +13,7 @@ import pytest
 
 from cpuload import CpuLoad, wait_busy
 from rtmu.client.lease import DriveLease, DriveRatios, EndReason
-from rtmu.client.lease_keeper import STARVED_LIMIT, LeaseKeeper, runqueue_wait
+from rtmu.client.lease_keeper import STARVED_LIMIT, LeaseKeeper, RunQueueMeter
 
 from .fakeclock import FakeClock
 
@@ -33,7 +33,9 @@ class Waits:
 def rig() -> tuple[FakeClock, DriveLease, LeaseKeeper, Waits, list[float]]:
     clock, waits, beats = FakeClock(), Waits(), []
     lease = DriveLease(clock=clock)
-    return clock, lease, LeaseKeeper(lease, beat=beats.append, wait_of=waits), waits, beats
+    keeper = LeaseKeeper(lease, beat=beats.append, wait_of=waits)
+    lease.on_renew, lease.before_lapse = keeper.renewed, keeper.step  # as the runner wires it
+    return clock, lease, keeper, waits, beats
 
 
 def run(clock: FakeClock, keeper: LeaseKeeper, seconds: float, waiting: float, waits: Waits) -> None:
@@ -83,6 +85,23 @@ def test_a_renewal_restarts_the_account_and_ended_leases_stay_ended() -> None:
     assert lease.extend(clock()) is False
 
 
+def test_a_keeper_that_waited_too_catches_up_before_anyone_acts_on_the_lapse() -> None:
+    """Its own thread stood still as well (a starved renewer holding the GIL stalls every Python
+    thread): whoever finds the lease past its time asks the keeper first."""
+    clock, lease, _keeper, waits, _beats = rig()
+    lease.grant(FWD)
+    clock.advance(0.5)
+    waits.seconds += 0.45  # the renewer waited for a CPU nearly all along; no keeper look meanwhile
+    assert lease.view().live  # the network side's look: credited, lives
+    assert lease.renew()  # …and the renewer's own, once it runs
+    clock.advance(0.5)  # frozen now: no run-queue wait
+    view = lease.view()
+    assert not view.live and view.ended is None  # lapsed; the governor ends it, for good
+    lease.end(EndReason.LAPSED)
+    waits.seconds += 5.0
+    assert not lease.view().live and lease.renew() is False
+
+
 def test_unknown_waits_give_no_credit() -> None:
     clock = FakeClock()
     lease = DriveLease(clock=clock)
@@ -127,7 +146,7 @@ def test_the_kernel_account_tells_a_starved_thread_from_a_frozen_one() -> None:
     """Real threads on the real clock: a renewer sharing its CPU with six spinning processes waits
     ~6/7 of the time for it (50 ms of work take ~0.35 s or more) — without a keeper its lease
     lapses, with one it lives; a renewer that simply stops (blocked, not runnable) lapses either way."""
-    if len(os.sched_getaffinity(0)) < 2 or runqueue_wait(threading.get_native_id()) is None:
+    if len(os.sched_getaffinity(0)) < 2 or RunQueueMeter()(threading.get_native_id()) is None:
         pytest.skip("needs two CPUs and /proc/self/task/*/schedstat")
     cpu = sorted(os.sched_getaffinity(0))[0]
     with CpuLoad(count=6, nice=0, seconds=60, cpus=(cpu,)) as load:

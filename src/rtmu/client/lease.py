@@ -93,6 +93,12 @@ class DriveLease:
         self.on_change: Callable[[], None] | None = None
         self.on_event: Callable[[LeaseEvent], None] | None = None
         """Optional tap (a recorder) on grants, changes and ends; called on the calling thread."""
+        self.on_renew: Callable[[], None] | None = None
+        """Called on the renewing thread after each grant, renewal or change (the lease keeper's account)."""
+        self.before_lapse: Callable[[float], None] | None = None
+        """Called (outside the lock) when a lease not ended is found past its time, before anyone
+        acts on it: the :class:`~rtmu.client.lease_keeper.LeaseKeeper` catches up first — its own
+        thread may have waited behind a starved renewer too."""
         self._lock = threading.Lock()
         self._generation = 0
         self._ratios = STOPPED
@@ -113,28 +119,47 @@ class DriveLease:
             self._ended = None
             self._why = ""
             generation = self._generation
+        self._renewed()
         self._event(LeaseEvent("grant", generation, ratios))
         self._changed()
         return generation
 
+    def _catch_up(self) -> None:
+        hook = self.before_lapse
+        if hook is None:
+            return
+        with self._lock:
+            now = self.clock()
+            expired = self._ended is None and not self._live(now)
+        if expired:
+            hook(now)
+
     def renew(self) -> bool:
         """Keep a live lease alive; False when it has lapsed or was ended (it stays dead)."""
+        self._catch_up()
         with self._lock:
             now = self.clock()
             if not self._live(now):
                 return False
             self._renewed_at = max(self._renewed_at, now)
             self._real_renewal = (now, threading.get_native_id())
-            return True
+        self._renewed()
+        return True
+
+    def _renewed(self) -> None:
+        hook = self.on_renew
+        if hook is not None:
+            hook()
 
     def extend(self, at: float) -> bool:
-        """Move a live lease's renewal forward to ``at`` (never back, never past now): the
+        """Move the renewal forward to ``at`` (never back, never past now): the
         :class:`~rtmu.client.lease_keeper.LeaseKeeper`'s credit for a renewing thread that only waited
-        for a CPU. A lapsed or ended lease stays dead. True if it moved."""
+        for a CPU. Only a lease nobody has ended, and only so far that it is live at ``at``'s credit:
+        one already ended (released, stopped, or found lapsed and ended) stays dead. True if it moved."""
         with self._lock:
             now = self.clock()
             at = min(at, now)
-            if not self._live(now) or at <= self._renewed_at:
+            if self._ended is not None or at <= self._renewed_at or now - at > self.ttl:
                 return False
             self._renewed_at = at
             return True
@@ -146,6 +171,7 @@ class DriveLease:
 
     def change(self, ratios: DriveRatios) -> bool:
         """New ratios for the live lease (one of two held keys released, speed step); renews it."""
+        self._catch_up()
         with self._lock:
             now = self.clock()
             if not self._live(now):
@@ -154,6 +180,7 @@ class DriveLease:
             self._renewed_at = max(self._renewed_at, now)
             self._real_renewal = (now, threading.get_native_id())
             generation = self._generation
+        self._renewed()
         self._event(LeaseEvent("change", generation, ratios))
         self._changed()
         return True
@@ -182,6 +209,7 @@ class DriveLease:
 
     # -- both sides --------------------------------------------------------------------------
     def view(self, now: float | None = None) -> LeaseView:
+        self._catch_up()
         with self._lock:
             now = self.clock() if now is None else now
             return LeaseView(

@@ -31,6 +31,7 @@ it. Pure logic over times passed in; one instance per stream.
 from __future__ import annotations
 
 import math
+import os
 from dataclasses import dataclass
 
 STATUS_CEILING = 0.45
@@ -49,10 +50,12 @@ covered when it does."""
 GAIN = 1.0 / 8.0
 """RFC 6298's alpha: the weight of a new sample in the smoothed mean."""
 
-LEARNING = True
-"""False: every :class:`Deadline` built from now on keeps its floor (status) or its ceiling (pings)
-— the fixed thresholds RTMU used before it learned. Only benchmarks set it, to measure the
-difference in the same run."""
+FIXED_ENV = "RTMU_LINK_TIMING"
+"""``RTMU_LINK_TIMING=fixed`` in the environment: RTMU's limits before it learned them — fixed
+status and ping limits here, no run-queue credit for the lease (``lease_keeper``). Benchmarks set
+it on a child process (and its guardian inherits it) to measure the difference in the same run."""
+LEARNING = os.environ.get(FIXED_ENV, "") != "fixed"
+"""False: every :class:`Deadline` built from now on keeps its floor (status) or its ceiling (pings)."""
 
 
 @dataclass(frozen=True, slots=True)

@@ -67,6 +67,7 @@ from typing import Any, TypeVar, overload
 
 from ..notices import Kind, Notice
 from ..state import StateChange, StateSink
+from . import lease_keeper
 from .connection import AriaClient, Packet
 from .errors import ClientError, ClientTimeout
 from .lease import LEASE_TTL, DriveLease, EndReason
@@ -122,7 +123,11 @@ class ClientRunner:
         self.config = config or SessionConfig()
         self.lease = DriveLease(ttl=lease_ttl, clock=clock)
         # Run-queue waits are real time: credited only to a lease on the real clock (not a test's).
-        self.keeper = LeaseKeeper(self.lease, beat=self._beat_ui_at) if clock is time.monotonic else None
+        keep = clock is time.monotonic and lease_keeper.CREDITING
+        self.keeper = LeaseKeeper(self.lease, beat=self._beat_ui_at) if keep else None
+        if self.keeper is not None:
+            self.lease.on_renew = self.keeper.renewed
+            self.lease.before_lapse = self.keeper.step
         self.on_notice: Callable[[Notice], None] | None = None
         """``on_notice(notice)``, called on the UI thread (through ``post``)."""
         self.on_publish: Callable[[StateChange], None] | None = None

@@ -1,0 +1,157 @@
+"""The parts ``bench_links`` drives: a simulator behind the fault proxy, the driving processes.
+
+* :class:`Rig` — a :class:`~rtmu.sim.SimThread` with the tests' :class:`FaultProxy` in front, both
+  in this process; the simulator's ``stop`` log is watched from a thread so the moment a stop
+  arrives is known to a few ms (``time.monotonic()``, one clock for every process).
+* :class:`CoreParent` — ``bench.links_parent`` (the window's client core with a UI thread) and the
+  stops it reports.
+* :func:`drive` — ``rtmu drive`` through the rig, as a script would run it.
+
+``fixed=True`` runs a process with ``RTMU_LINK_TIMING=fixed``: the thresholds RTMU had before it
+learned them (and no lease keeper) — the baseline measured in the same run.
+"""
+
+from __future__ import annotations
+
+import contextlib
+import os
+import subprocess
+import sys
+import threading
+import time
+from pathlib import Path
+
+from rtmu.client.link_timing import FIXED_ENV
+from rtmu.sim import SimConfig, SimThread
+
+REPO = Path(__file__).resolve().parents[1]
+sys.path.insert(0, str(REPO / "tests"))
+from linkfaults import FaultProxy  # noqa: E402
+
+ARENA = REPO / "data" / "maps" / "arena.map"
+POLL = 0.002
+
+
+def env_for(fixed: bool) -> dict[str, str]:
+    env = dict(os.environ)
+    if fixed:
+        env[FIXED_ENV] = "fixed"
+    else:
+        env.pop(FIXED_ENV, None)
+    return env
+
+
+class Rig:
+    """Simulator + proxy; ``stops`` are the monotonic times stops reached the simulator."""
+
+    def __init__(self, seed: int = 1) -> None:
+        self.sim = SimThread(SimConfig(port=0, map_path=ARENA, seed=seed, max_clients=10)).start()
+        self.proxy = FaultProxy("127.0.0.1", self.sim.port).start()
+        self.stops: list[tuple[float, str]] = []
+        self._closed = threading.Event()
+        self._watch = threading.Thread(target=self._watch_stops, daemon=True)
+        self._watch.start()
+
+    def _watch_stops(self) -> None:
+        log = self.sim.server.stop_log
+        seen = len(log)
+        while not self._closed.is_set():
+            n = len(log)
+            if n > seen:
+                now = time.monotonic()
+                self.stops += [(now, who) for _t, _ident, who in list(log)[seen - n :]]
+                seen = n
+            time.sleep(POLL)
+
+    def stop_after(self, t0: float, timeout: float) -> float | None:
+        """The first stop that reached the simulator at or after ``t0`` (waiting up to ``timeout``)."""
+        deadline = time.monotonic() + timeout
+        while True:
+            for at, _who in list(self.stops):
+                if at >= t0:
+                    return at
+            if time.monotonic() > deadline:
+                return None
+            time.sleep(POLL)
+
+    def moving(self) -> bool:
+        return self.sim.snapshot().trans_ratio != 0
+
+    def wait(self, cond, timeout: float) -> bool:  # type: ignore[no-untyped-def]
+        deadline = time.monotonic() + timeout
+        while not cond():
+            if time.monotonic() > deadline:
+                return False
+            time.sleep(0.01)
+        return True
+
+    def close(self) -> None:
+        self._closed.set()
+        self.proxy.close()
+        self.sim.stop()
+
+
+class CoreParent:
+    """``bench.links_parent`` through ``port``; its reported stops and guardian stops, timestamped."""
+
+    def __init__(self, port: int, *, fixed: bool) -> None:
+        self.proc = subprocess.Popen(
+            [sys.executable, "-m", "bench.links_parent", str(port)],
+            cwd=REPO,
+            env=env_for(fixed),
+            stdin=subprocess.PIPE,
+            stdout=subprocess.PIPE,
+            text=True,
+        )
+        self.stops: list[tuple[float, str]] = []
+        self.guardian: list[tuple[float, str]] = []
+        self.ui_tid = 0
+        self._driving = threading.Event()
+        threading.Thread(target=self._read, daemon=True).start()
+        if not self._driving.wait(30):
+            self.close()
+            raise RuntimeError("the driving process did not start")
+
+    def _read(self) -> None:
+        assert self.proc.stdout is not None
+        for line in self.proc.stdout:
+            word, _, rest = line.strip().partition(" ")
+            if word == "ui":
+                self.ui_tid = int(rest)
+            elif word == "driving":
+                self._driving.set()
+            elif word in ("stop", "guardian"):
+                at, _, text = rest.partition(" ")
+                (self.stops if word == "stop" else self.guardian).append((float(at), text))
+
+    def send(self, *words: object) -> None:
+        assert self.proc.stdin is not None
+        with contextlib.suppress(OSError):
+            self.proc.stdin.write(" ".join(str(w) for w in words) + "\n")
+            self.proc.stdin.flush()
+
+    def stop_after(self, t0: float, timeout: float) -> tuple[float, str] | None:
+        deadline = time.monotonic() + timeout
+        while True:
+            for at, text in list(self.stops):
+                if at >= t0:
+                    return at, text
+            if time.monotonic() > deadline:
+                return None
+            time.sleep(POLL)
+
+    def close(self) -> None:
+        self.send("quit")
+        try:
+            self.proc.wait(10)
+        except subprocess.TimeoutExpired:
+            self.proc.kill()
+            self.proc.wait(5)
+
+
+def drive(port: int, seconds: float, *, fixed: bool) -> tuple[int, str]:
+    """``rtmu drive`` for ``seconds`` through ``port``: (exit code, stderr)."""
+    args = [sys.executable, "-m", "rtmu", "drive", f"127.0.0.1:{port}", "--trans", "30"]
+    args += ["--seconds", f"{seconds:.1f}", "--timeout", "10"]
+    done = subprocess.run(args, env=env_for(fixed), capture_output=True, text=True, timeout=seconds + 60)
+    return done.returncode, done.stderr
