@@ -27,7 +27,7 @@ from collections.abc import Callable
 
 from ..protocol.decoder import DropStats
 from ..state import LinkHealth, LinkLevel
-from .link_timing import STATUS_CEILING, Deadline, Timing
+from .link_timing import STATUS_CEILING, Deadline, Envelope, Timing, ceiling_for
 
 STALE_INTERVALS = 3
 LOST_AFTER = 2.0
@@ -56,6 +56,8 @@ class HealthMonitor:
         floor = stale_intervals * status_interval
         self.status_timing = Deadline(status_interval, floor, max(floor, stale_ceiling))
         """Gaps between status packets → the stale limit (``client.link_timing``)."""
+        self.wake_lateness = Envelope()
+        """How late the loop that stops the robot wakes (:meth:`note_wake`): lowers the ceiling."""
         self.lost_after = max(lost_after, self.status_timing.ceiling)
         ping_ceiling = lost_after if ping_ceiling is None else ping_ceiling
         self.ping_timing = Deadline(0.0, min(ping_floor, ping_ceiling), ping_ceiling, fixed=ping_ceiling)
@@ -109,9 +111,19 @@ class HealthMonitor:
             self.status_timing.note(now - last, now)
         self._last_status = now
 
+    def note_wake(self, late: float, now: float) -> None:
+        """The stopping loop woke ``late`` s after it meant to (a busy machine): keep room for that."""
+        if late > 0.0:
+            self.wake_lateness.note(late, now)
+
+    def ceiling(self, now: float) -> float:
+        """The stale limit's ceiling now: under the promise by twice the loop's recent lateness."""
+        timing = self.status_timing
+        return ceiling_for(self.wake_lateness.value(now), timing.floor, timing.ceiling)
+
     def stale_limit(self, now: float) -> float:
         """Seconds without status after which the link is stale, now (learned; see ``link_timing``)."""
-        return self.status_timing.limit(now, undecided=self.undecided())
+        return self.status_timing.limit(now, undecided=self.undecided(), ceiling=self.ceiling(now))
 
     def ping_deadline(self, now: float) -> float:
         """How long the next ping may go unanswered before it counts as a failure (learned)."""
@@ -119,7 +131,7 @@ class HealthMonitor:
 
     def timing(self, now: float) -> Timing:
         """What the status stream's timing has learned (for a HUD, ``rtmu doctor``, a stop's words)."""
-        return self.status_timing.timing(now)
+        return self.status_timing.timing(now, ceiling=self.ceiling(now))
 
     def note_traffic(self, at: float | None) -> None:
         """Packets arrived at ``at`` (during a map download): the link is alive, if not fresh.

@@ -22,6 +22,11 @@ trip — three figures:
 ``limit = clamp(mean + MARGIN × max(jitter, prior) + PAD, floor, ceiling)``. ``MARGIN`` 2 lets the
 next stall be twice the longest one remembered; ``PAD`` covers where in the status period it falls.
 
+The ceiling itself knows the machine: the loop that would send the stop measures how late it wakes
+(an :class:`Envelope` of its lateness), and :func:`ceiling_for` keeps twice the worst of it
+between the limit and the 0.5 s promise — a laptop that runs us 100 ms late stops a silent link
+at 0.3 s, so the stop is still on the wire within 0.5 s.
+
 While the link is *undecided* — the decoder holds a header whose body has not come but sees
 valid packets going on behind it (``PacketDecoder.undecided``) — the limit is the ceiling: the
 stream is alive, the decoder will deliver within a few packets, and a stale verdict must not race
@@ -34,9 +39,13 @@ import math
 import os
 from dataclasses import dataclass
 
+STATUS_PROMISE = 0.5
+"""The safety promise: zero ratios and ``stop`` on the wire within this many seconds of the last status."""
 STATUS_CEILING = 0.45
-"""The status limit's ceiling: 50 ms under the 0.5 s promise (last status → stop on the wire)
-for the heart's wake-up and the send on a busy machine."""
+"""The status limit's ceiling on a machine that runs us on time: 50 ms under the promise for the
+wake-up and the send. On a machine that wakes us late it is lower (:func:`ceiling_for`)."""
+WAKE_MARGIN = 2.0
+"""The ceiling keeps twice the worst recent wake-up lateness of the loop that stops the robot."""
 MARGIN = 2.0
 PAD = 0.1
 """Added to every learned limit: a stall's lateness is measured from the mean gap, but it may start
@@ -56,6 +65,27 @@ status and ping limits here, no run-queue credit for the lease (``lease_keeper``
 it on a child process (and its guardian inherits it) to measure the difference in the same run."""
 LEARNING = os.environ.get(FIXED_ENV, "") != "fixed"
 """False: every :class:`Deadline` built from now on keeps its floor (status) or its ceiling (pings)."""
+
+
+class Envelope:
+    """The worst recent value of something: rises at once, halves every ``memory`` seconds."""
+
+    def __init__(self, memory: float = JITTER_MEMORY) -> None:
+        self.memory = memory
+        self._value = 0.0
+        self._at = 0.0
+
+    def note(self, value: float, now: float) -> None:
+        self._value = max(self.value(now), value)
+        self._at = now
+
+    def value(self, now: float) -> float:
+        return self._value * 0.5 ** (max(0.0, now - self._at) / self.memory)
+
+
+def ceiling_for(wake_lateness: float, floor: float, ceiling: float = STATUS_CEILING) -> float:
+    """The status limit's ceiling on a machine whose stopping loop wakes ``wake_lateness`` s late."""
+    return max(floor, min(ceiling, STATUS_PROMISE - WAKE_MARGIN * wake_lateness))
 
 
 @dataclass(frozen=True, slots=True)
@@ -138,18 +168,21 @@ class Deadline:
             return self._prior
         return self._prior * 0.5 ** (max(0.0, now - self._prior_since) / PRIOR_MEMORY)
 
-    def limit(self, now: float, *, undecided: bool = False) -> float:
-        """Seconds the next sample may take before the stream counts as late (see the module notes)."""
+    def limit(self, now: float, *, undecided: bool = False, ceiling: float | None = None) -> float:
+        """Seconds the next sample may take before the stream counts as late (see the module notes);
+        ``ceiling``: a lower one for now (:func:`ceiling_for`)."""
         if not self.learn:
             return self.fixed
+        top = self.ceiling if ceiling is None else max(self.floor, min(self.ceiling, ceiling))
         if undecided:
-            return self.ceiling
+            return top
         spread = max(self._decayed_jitter(now), self._prior_now(now))
-        return min(self.ceiling, max(self.floor, self.mean + MARGIN * spread + PAD))
+        return min(top, max(self.floor, self.mean + MARGIN * spread + PAD))
 
-    def timing(self, now: float) -> Timing:
+    def timing(self, now: float, *, ceiling: float | None = None) -> Timing:
         jitter = self._decayed_jitter(now)
-        limit = self.limit(now)
-        without_prior = min(self.ceiling, max(self.floor, self.mean + MARGIN * jitter + PAD))
+        limit = self.limit(now, ceiling=ceiling)
+        top = self.ceiling if ceiling is None else max(self.floor, min(self.ceiling, ceiling))
+        without_prior = min(top, max(self.floor, self.mean + MARGIN * jitter + PAD))
         learning = self.learn and limit - without_prior > 0.005
         return Timing(limit, jitter, self.mean, self.samples, learning, not self.learn, without_prior)

@@ -679,9 +679,12 @@ class Session:
             self._stepped.set()
             wake = min(self.governor.next_wakeup(now), self.health.next_change(now))
             delay = min(HEART_MAX_SLEEP, max(0.0, wake - self.clock()))
+            due = self.clock() + delay
             with contextlib.suppress(TimeoutError):
                 async with asyncio.timeout(delay):
                     await self._kick.wait()
+            if not self._kick.is_set():  # woke by its timer: how late this machine ran it
+                self.health.note_wake(self.clock() - due, self.clock())
 
     def _beat(self, now: float) -> None:
         self._poll_guardian()

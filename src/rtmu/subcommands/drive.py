@@ -228,6 +228,8 @@ async def drive(
         with contextlib.suppress(TimeoutError):
             async with asyncio.timeout(max(0.0, wake - clock())):
                 await guard.changed.wait()
+        if not guard.changed.is_set():  # woke by its timer: how late this machine ran it
+            guard.health.note_wake(clock() - wake, clock())
 
 
 def stop(client: AriaClient) -> None:
