@@ -42,7 +42,8 @@ def env_for(fixed: bool) -> dict[str, str]:
 
 
 class Rig:
-    """Simulator + proxy; ``stops`` are the monotonic times stops reached the simulator."""
+    """Simulator + proxy; ``stops`` are the monotonic times stops reached the simulator (with who
+    sent them: a client's self identifier, ``rtmu-guardian``, or ``watchdog`` for the server's own)."""
 
     def __init__(self, seed: int = 1) -> None:
         self.sim = SimThread(SimConfig(port=0, map_path=ARENA, seed=seed, max_clients=10)).start()
@@ -54,13 +55,17 @@ class Rig:
 
     def _watch_stops(self) -> None:
         log = self.sim.server.stop_log
-        seen = len(log)
+        ratio_mode = self.sim.server.world.ratio_mode
+        seen, watchdog = len(log), ratio_mode.timeouts
         while not self._closed.is_set():
             n = len(log)
             if n > seen:
                 now = time.monotonic()
                 self.stops += [(now, who) for _t, _ident, who in list(log)[seen - n :]]
                 seen = n
+            if ratio_mode.timeouts > watchdog:  # the server's own 2 s watchdog stopped it
+                watchdog = ratio_mode.timeouts
+                self.stops.append((time.monotonic(), "watchdog"))
             time.sleep(POLL)
 
     def stop_after(self, t0: float, timeout: float) -> float | None:

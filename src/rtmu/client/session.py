@@ -183,6 +183,8 @@ class Session:
         self.on_stop: Callable[[str, bool], None] | None = None
         """Optional tap (a flight recorder): ``on_stop(reason, sent)`` after every zero-ratios + ``stop``."""
         self.guardian: GuardianHandle | None = None
+        self._stop_on_connect = False
+        """The link was lost while driving: reconnect at once and send a stop first."""
         self.ld = LdFeed(self._robot_update, self._decode, self._spawn, self.config.reply_timeout)
         """LD (ARAM) data: lasers, docking state, routes, DataStore_* — only where listed."""
         self.nav = NavFeed(
@@ -266,6 +268,7 @@ class Session:
         self.lease.end(EndReason.DISCONNECTED)
         await self._drop_client()
         self._cancel_reconnect()
+        self._stop_on_connect = False  # that was another connection's robot
         target = self._target = _Target(host, port, user, password, profile, auto_reconnect, protocol)
         self._robot = RobotState()
         self._publish(RobotChanged(self._robot))
@@ -313,6 +316,9 @@ class Session:
             await client.disconnect()
             raise ServerClosed("the connection attempt was cancelled")
         self.client = client
+        if self._stop_on_connect:  # the link was lost while driving: the robot may still be moving
+            self._stop_on_connect = False
+            self._send_stop("reconnected after the link was lost while driving")
         if self.config.guardian and client.supports("ratioDrive"):
             self._start_guardian(target)
         # Whatever happened before, the robot stays still until a fresh key press.
@@ -386,7 +392,9 @@ class Session:
         """Not our choice: the server died, closed, or the link was lost."""
         client, self.client = self.client, None
         self.video.disconnected()
-        # Our link died while driving: we cannot stop the robot, the guardian (its own link) can.
+        # Our link died while driving: we cannot stop the robot, the guardian (its own link) can —
+        # and our first reconnect, at once, begins with a stop (the guardian's link may be gone too).
+        self._stop_on_connect = self.governor.driving
         self._close_guardian(goodbye=not self.governor.driving)
         for task in list(self._tasks):
             task.cancel()
@@ -405,8 +413,10 @@ class Session:
 
     async def _reconnect(self, target: _Target) -> None:
         backoff = self.config.backoff()
+        at_once = self._stop_on_connect  # lost while driving: the first try carries a stop, no wait
         while self._target is target:
-            delay = backoff.next_delay()
+            delay = 0.0 if at_once else backoff.next_delay()
+            at_once = False
             self._set_connection(phase=Phase.RECONNECTING, attempt=backoff.attempt, retry_in=round(delay, 1))
             await asyncio.sleep(delay)
             if self._target is not target:
