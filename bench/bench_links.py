@@ -93,8 +93,10 @@ def core_false_stops(condition: str, seconds: float, fixed: bool, seed: int) -> 
                     parent.send("press")  # the operator presses again
                 time.sleep(0.05)
             held = time.monotonic() - start
-            stops = [t for t, _ in parent.stops + parent.guardian if start <= t <= start + held]
-            return _events(stops), held
+            said = [(t, why) for t, why in parent.stops + parent.guardian if start <= t <= start + held]
+            for t, why in said:
+                print(f"# links core/{condition} fixed={fixed}: stop at {t - start:.1f} s: {why}", flush=True)
+            return _events([t for t, _ in said]), held
         finally:
             parent.close()
     finally:
