@@ -29,10 +29,12 @@ fail has something behind it:
    own 10 Hz timer renews it while the key is held. Release, focus loss, a stop,
    a stale link or a lease not renewed for 300 ms (a frozen or busy UI) end it,
    and a dead lease never comes back without a fresh key press (also after a
-   reconnect).
+   reconnect). A UI that only waited for a CPU is credited that time by the
+   :class:`~rtmu.client.lease_keeper.LeaseKeeper` (up to 1 s).
 2. **The network loop sends ``ratioDrive`` only while the lease is fresh**, at
    10 Hz, and zero ratios + ``stop`` the moment it ends or lapses, or the link
-   health is not OK (no status for 300 ms, or a ping unanswered). It wakes at the
+   health is not OK (no status for the limit learned for this link, 0.3–0.45 s in
+   the window — ``client.link_timing`` —, or a ping unanswered). It wakes at the
    exact expiry, so a lapse costs at most the lease's 300 ms. ``disconnect``,
    ``close``, connecting elsewhere and ``stop()`` all send zero ratios + ``stop``.
 3. **If the network loop itself is blocked**, nothing can be sent — neither the
