@@ -159,3 +159,17 @@ def test_a_machine_that_wakes_us_late_gets_a_lower_ceiling_so_the_promise_holds(
     h.note_wake(0.3, 0.0)  # never below the floor
     assert h.stale_limit(0.0) == pytest.approx(0.2)
     assert h.stale_limit(2000.0) == pytest.approx(0.45)  # forgotten as the machine calms down
+
+
+def test_unanswered_pings_during_a_download_stop_driving_but_do_not_lose_the_link() -> None:
+    """A big map on a slow link holds our pings' answers behind its bytes: driving stops (STALE),
+    but the link is not called lost — that would reconnect and download the map again, for ever."""
+    h = HealthMonitor(0.1, lost_after=2.0)
+    h.start(0.0)
+    for _ in range(3):
+        h.note_ping_timeout()
+    h.note_status(1.0)
+    h.note_traffic(1.0)
+    assert h.level(1.1) is LinkLevel.STALE
+    h.traffic_done()
+    assert h.level(1.1) is LinkLevel.LOST and h.requests_unanswered

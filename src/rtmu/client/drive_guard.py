@@ -10,7 +10,7 @@ Status comes at 20 Hz and the ping is tighter than the window's (every :data:`PI
 a script has no operator watching the link cell, and a server that stopped reading would never
 hear its ``stop``. How late either may be is learned per link by the window's own rule
 (:mod:`~rtmu.client.link_timing`): status is stale after 0.2 s on a steady link and at most
-0.45 s on a jittery one; a ping must be answered within 0.25–:data:`MAX_RTT` s.
+0.45 s on a jittery one; a ping must be answered within 0.4–:data:`MAX_RTT` s.
 """
 
 from __future__ import annotations
@@ -30,7 +30,7 @@ STALE_INTERVALS = 4
 """The stale limit's floor, 200 ms without status: what a steady link gets (the limit learned for
 a jittery one is higher, up to ``link_timing.STATUS_CEILING``)."""
 PING_INTERVAL = 0.25
-PING_FLOOR = 0.25
+PING_FLOOR = 0.4
 MAX_RTT = 0.5
 """A ping not answered within this many seconds counts as a link fault (round trip too high); the
 deadline learned on a steady link is shorter, down to :data:`PING_FLOOR`."""

@@ -32,8 +32,12 @@ from .link_timing import STATUS_CEILING, Deadline, Envelope, Timing, ceiling_for
 STALE_INTERVALS = 3
 LOST_AFTER = 2.0
 PING_INTERVAL = 1.0
-PING_FLOOR = 0.5
-"""A ping is given at least this long, however steady the link (the window's pings are 1 s apart)."""
+PING_FLOOR = 0.4
+"""A ping is given at least this long, however steady the link: a Wi-Fi stall of 300 ms may hold its
+answer (the busy profile's longest)."""
+PING_CEILING = 0.5
+"""…and at most this long: a round trip over 0.5 s is no link to drive on — a stop sent now would
+reach the robot too late — so the ping fails and driving stops ("no ping")."""
 PING_FAILURES_LOST = 3
 """Unanswered pings in a row after which the link counts as lost (a server that stopped reading)."""
 PING_CANDIDATES = ("ackCommTcp", "getSafeDrive", "getMapName", "batteryInfo", "physicalInfo", "getModeInfo")
@@ -59,7 +63,7 @@ class HealthMonitor:
         self.wake_lateness = Envelope()
         """How late the loop that stops the robot wakes (:meth:`note_wake`): lowers the ceiling."""
         self.lost_after = max(lost_after, self.status_timing.ceiling)
-        ping_ceiling = lost_after if ping_ceiling is None else ping_ceiling
+        ping_ceiling = PING_CEILING if ping_ceiling is None else ping_ceiling
         self.ping_timing = Deadline(0.0, min(ping_floor, ping_ceiling), ping_ceiling, fixed=ping_ceiling)
         """Round trips → how long a ping may go unanswered."""
         self.where = "the server"
@@ -143,6 +147,10 @@ class HealthMonitor:
         if at is not None and (self._last_traffic is None or at > self._last_traffic):
             self._last_traffic = at
 
+    def traffic_done(self) -> None:
+        """The download is over: from now on only status (and answered pings) keep the link alive."""
+        self._last_traffic = None
+
     def _traffic_alive(self, now: float) -> bool:
         return self._last_traffic is not None and now - self._last_traffic <= self.lost_after
 
@@ -171,8 +179,8 @@ class HealthMonitor:
         age = self.status_age(now)
         if age is None:
             return LinkLevel.DOWN
-        if self.ping_failures >= self.ping_failures_lost:
-            return LinkLevel.LOST
+        if self.ping_failures >= self.ping_failures_lost and not self._traffic_alive(now):
+            return LinkLevel.LOST  # (a map download's bytes may hold our answers up: not lost then)
         if age > self.lost_after and not self._traffic_alive(now):
             return LinkLevel.LOST
         if age > self.stale_limit(now) or self.ping_failures:

@@ -104,7 +104,7 @@ class SessionConfig:
     reply_timeout: float = 5.0
     lost_after: float = 2.0
     ping_timeout: float | None = None
-    """How long a ping may go unanswered (None: ``lost_after``)."""
+    """The longest a ping may go unanswered (None: ``health.PING_CEILING``; learned below it)."""
     fetch_map: bool = True
     backoff: Callable[[], Backoff] = field(default=Backoff)
     guardian: bool = False
@@ -154,7 +154,7 @@ class Session:
         self.health = HealthMonitor(
             self.config.status_interval_ms / 1000.0,
             lost_after=self.config.lost_after,
-            ping_ceiling=self.config.ping_timeout or self.config.lost_after,
+            ping_ceiling=self.config.ping_timeout,
         )
         self.governor = DriveGovernor(lease)
         self.client: AriaClient | None = None
@@ -701,6 +701,8 @@ class Session:
         map_task = self._map_task
         if map_task is not None and not map_task.done() and self.client is not None:
             self.health.note_traffic(self.client.last_packet_at)  # map bytes keep the link alive
+        else:
+            self.health.traffic_done()
         level = self.health.level(now)
         link_ok = level is LinkLevel.OK and self.connected
         for action in self.governor.step(
