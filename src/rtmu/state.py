@@ -327,7 +327,10 @@ class DrawingLayer:
     may_toggle: bool
     """The server lets the operator turn it on and off (``DefaultOn`` / ``DefaultOff``)."""
     points: tuple[tuple[int, int], ...] = ()
-    """Global mm, as last received; empty while hidden."""
+    """Global mm, as last received — evenly thinned when the drawings together exceed the window's
+    budget (``client.drawing_budget``); empty while hidden."""
+    total_points: int = 0
+    """How many points the last sample had (more than ``points`` holds when thinned)."""
     problem: str = ""
     """Why its last sample was refused (malformed, too many points), or ""."""
 
