@@ -11,6 +11,11 @@ beside the ordinary robot data (status at the rate asked, ``ratioDrive`` and ``s
 * :func:`popup_storm_server` — 200 popups a second, each carrying 31.8 KB of text.
 
 Nothing here is malformed: a client must stay responsive by budgeting what it does with it.
+
+:func:`main` runs one in a process of its own (so its flood never competes with the client for
+one interpreter lock): ``KIND`` is ``drawings``, ``frames``, ``popups`` or ``plain``; it prints
+``port N``, then ``drive T TRANS ROT`` / ``stop T`` for every drive packet it hears (``T``:
+``time.monotonic()``, one clock for every process), until its stdin closes.
 """
 
 from __future__ import annotations
@@ -19,18 +24,22 @@ import asyncio
 import contextlib
 import io
 import itertools
+import sys
+import time
 
 from rtmu.protocol.events import RequestReceived
 from rtmu.protocol.fields import FieldWriter
 from rtmu.protocol.payloads.drawings import MAX_POINTS, Drawing, DrawingListPacket, DrawingPoints
+from rtmu.protocol.payloads.drive import RatioDrive
 from rtmu.protocol.payloads.popup import PopupCreate
 
-from .servers import SPECS, ServerSide, TestServer
+from .servers import SPECS, ServerSide, ServerThread, TestServer
 
 FLOOD_DRAWINGS = 256
 FLOOD_PERIOD = 0.001
 POPUPS_PER_S = 200
 POPUP_TEXT = 31_800
+FLOOD_TASK = "(flood)"
 
 
 def _row(name: str, returns: str = "RETURN_SINGLE") -> tuple[str, str, str, str, str, str]:
@@ -47,6 +56,7 @@ class _FloodServer(TestServer):
         self.flooded = flooded
         self.period = period
         self.sent = 0
+        self._asked: dict[int, dict[str, bytes]] = {}
 
     def _handle(self, side: ServerSide, event: object) -> None:
         super()._handle(side, event)
@@ -54,14 +64,17 @@ class _FloodServer(TestServer):
             old = side.subs.pop(event.name, None)
             if old is not None:
                 old.cancel()
-            loop = asyncio.get_running_loop()
-            side.subs[event.name] = loop.create_task(self._flood(side, event.name, event.args))
+            asked = self._asked.setdefault(id(side), {})
+            asked[event.name] = event.args
+            if len(asked) == 1:  # one sender per connection sends every flooded data asked for
+                side.subs[FLOOD_TASK] = asyncio.get_running_loop().create_task(self._flood(side, asked))
 
-    async def _flood(self, side: ServerSide, name: str, args: bytes) -> None:
+    async def _flood(self, side: ServerSide, asked: dict[str, bytes]) -> None:
         while True:
             await asyncio.sleep(self.period)
-            self.reply(side, name, args)
-            self.sent += 1
+            for name, args in list(asked.items()):
+                self.reply(side, name, args)
+                self.sent += 1
             with contextlib.suppress(ConnectionError):
                 await side.writer.drain()
 
@@ -122,3 +135,23 @@ def popup_storm_server(per_second: int = POPUPS_PER_S, text: int = POPUP_TEXT) -
 
     server.handlers["popupCreate"] = create
     return server
+
+
+def main(kind: str) -> int:
+    """Serve one kind of flood (see the module notes) until stdin closes."""
+    makers = {"drawings": drawing_flood_server, "frames": big_frame_server, "popups": popup_storm_server}
+    server = makers[kind]() if kind in makers else TestServer()
+
+    def tap(side: ServerSide, name: str, args: bytes) -> None:
+        now = time.monotonic()
+        if name == "ratioDrive":
+            r = RatioDrive.decode(args)
+            print(f"drive {now:.6f} {r.trans:g} {r.rot:g}", flush=True)
+        elif name == "stop":
+            print(f"stop {now:.6f}", flush=True)
+
+    server.on_once = tap
+    with ServerThread(server):
+        print(f"port {server.port}", flush=True)
+        sys.stdin.read()
+    return 0

@@ -157,7 +157,7 @@ def test_the_link_cell_shows_the_learned_stale_limit() -> None:
     model.robot.set(replace(model.robot.value, numbers_at=1.0))
     toolbar = StatusToolbar(model, OperatorState(), status_age=lambda: 0.1)
     cell = toolbar.cells["link"]
-    assert cell.value.get_text() == "1.5 ms 0.1/0.33 s"
+    assert cell.value.get_text() == "1.5 ms 0.1/0.33"
     assert "Stale after 0.33 s without status: learned from this link's jitter (90 ms)" in (
         cell.get_tooltip_text() or ""
     )

@@ -117,7 +117,7 @@ class StatusToolbar(Gtk.ScrolledWindow):
             "mode": Cell("Mode · status", width_chars=6),
             "safe": Cell("Safe", width_chars=3),
             "speed": Cell("Throttle", width_chars=5),
-            "link": Cell("Link: rtt, age", width_chars=12),
+            "link": Cell("Link: rtt, age/limit", width_chars=14),
             "dock": Cell("Dock", width_chars=9),
             "loc": Cell("Localization", width_chars=9),
         }
@@ -342,7 +342,7 @@ class StatusToolbar(Gtk.ScrolledWindow):
         )
         text = f"{rtt} {age_text}"
         if health.stale_limit is not None:  # the learned limit next to the age it is compared with
-            text = f"{rtt} {DASH if age is None else f'{age:.1f}'}/{health.stale_limit:.2f} s"
+            text = f"{rtt} {DASH if age is None else f'{age:.1f}'}/{health.stale_limit:.2f}"
             tip += (
                 f"\nStale after {health.stale_limit:.2f} s without status: learned from this link's "
                 f"jitter ({health.jitter_ms or 0:.0f} ms), at most {STATUS_CEILING:.2f} s"
