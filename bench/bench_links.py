@@ -5,12 +5,14 @@ Every figure is measured twice in the same run: with the limits RTMU learns per 
 before (``RTMU_LINK_TIMING=fixed``: stale after 3 status intervals in the window, 200 ms for
 ``rtmu drive``, pings 2 s / 0.5 s, the guardian's 0.4 s, no run-queue credit).
 
-* ``links.false_stops_per_10min.{core,drive}.{good,busy,load4}`` — a held drive for
+* ``links.false_stops_per_10min.{window,core,drive}.{good,busy,load4}`` — a held drive for
   ``RTMU_LINKS_SOAK_S`` s (baseline ``RTMU_LINKS_BASELINE_S``) through the fault proxy playing the
   issue's "good" / "busy" Wi-Fi, or on a clean link under 4 spinning processes (nice 0) on this
-  2-core machine; every stop is a false one, scaled to 10 minutes. ``core`` is the window's client
-  core (runner, lease, keeper, guardian) with its UI thread played by a thread that does 8 ms of
-  GIL-free work per 40 ms frame (``bench.links_parent``); ``drive`` is ``rtmu drive``.
+  2-core machine; every stop is a false one, scaled to 10 minutes. ``window`` is the real app under
+  Xvfb, a key held with xdotool (``bench.links_window``); ``core`` the window's client core (runner,
+  lease, keeper, guardian) with its UI thread played by a thread that does 8 ms of GIL-free work per
+  40 ms frame (``bench.links_parent``); ``drive`` is ``rtmu drive``. The three run at once in each
+  phase (Wi-Fi, then load), so each also carries the others' load.
 * ``links.stop_sent_ms.<fault>`` — from the last server bytes the client received to zero ratios +
   ``stop`` leaving the client (its own report, same monotonic clock); ``links.stop_at_sim_ms.<fault>``
   — to their arrival at the simulator, where the fault lets them through; ``reset`` is timed from
@@ -40,6 +42,7 @@ from typing import Any
 
 from bench.common import Result
 from bench.links_rig import REPO, CoreParent, Rig, drive
+from bench.links_window import window_false_stops as window_false_stops_in
 
 sys.path.insert(0, str(REPO / "tests"))
 from cpuload import CpuLoad, wait_busy
@@ -122,6 +125,20 @@ def drive_false_stops(condition: str, seconds: float, fixed: bool, seed: int) ->
         rig.close()
 
 
+def window_false_stops(condition: str, seconds: float, fixed: bool, seed: int) -> tuple[int, float]:
+    """(false stops, seconds held) for the real window (``bench.links_window``)."""
+    rig = Rig(seed)
+    try:
+        if condition in PROFILES:
+            rig.proxy.play(PROFILES[condition], seed=seed)
+        count, held, who = window_false_stops_in(rig, seconds, fixed)
+        if who:
+            print(f"# links window/{condition} fixed={fixed}: stops by {who}", flush=True)
+        return count, held
+    finally:
+        rig.close()
+
+
 def _per_10min(count: int, seconds: float) -> float:
     return count * 600.0 / max(seconds, 1.0)
 
@@ -133,7 +150,11 @@ def false_stop_rows() -> list[Result]:
     def phase(conditions: tuple[str, ...], seconds: float, fixed: bool) -> None:
         jobs: list[threading.Thread] = []
         for i, condition in enumerate(conditions):
-            for who, fn in (("core", core_false_stops), ("drive", drive_false_stops)):
+            for who, fn in (
+                ("core", core_false_stops),
+                ("drive", drive_false_stops),
+                ("window", window_false_stops),
+            ):
 
                 def job(who: str = who, fn: Any = fn, condition: str = condition, seed: int = i) -> None:
                     count, held = fn(condition, seconds, fixed, seed)
@@ -152,7 +173,7 @@ def false_stop_rows() -> list[Result]:
             wait_busy(load)
             phase(("load4",), seconds, fixed)
     out = []
-    for who in ("core", "drive"):
+    for who in ("window", "core", "drive"):
         for condition in ("good", "busy", "load4"):
             learned = figures.get((who, condition, False))
             if learned is not None:

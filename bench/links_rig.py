@@ -61,7 +61,7 @@ class Rig:
             n = len(log)
             if n > seen:
                 now = time.monotonic()
-                self.stops += [(now, who) for _t, _ident, who in list(log)[seen - n :]]
+                self.stops += [(now, who or "client") for _t, _ident, who in list(log)[seen - n :]]
                 seen = n
             if ratio_mode.timeouts > watchdog:  # the server's own 2 s watchdog stopped it
                 watchdog = ratio_mode.timeouts
