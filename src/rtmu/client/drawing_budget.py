@@ -17,8 +17,9 @@ import numpy as np
 from ..protocol.payloads.drawings import MAX_POINTS, Shape
 from .drawing_list import decode_points
 
-MAX_SHOWN_POINTS = 12_000
-"""Points handed to the window per update over all drawings (a frame of them draws in ~20 ms)."""
+MAX_SHOWN_POINTS = 6_000
+"""Points handed to the window per update over all drawings: a frame of them draws in ~12 ms (12 000
+took ~24 ms, and a key pressed during two such frames waited past 100 ms under a drawing flood)."""
 
 Points = tuple[tuple[int, int], ...]
 
