@@ -46,8 +46,9 @@ def hold_a_drive(server: TestServer) -> tuple[ClientRunner, RobotModel, UiQueue,
         ui.drain()
         time.sleep(0.04)
     drives = len([r for r in server.received if r.name == "ratioDrive"]) - before
+    stopped = list(stops)  # before our own release's stop
     runner.lease.release()
-    return runner, model, ui, list(stops), drives
+    return runner, model, ui, stopped, drives
 
 
 def test_a_drawing_flood_neither_stops_a_held_drive_nor_swamps_the_window() -> None:
