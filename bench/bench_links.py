@@ -11,8 +11,9 @@ before (``RTMU_LINK_TIMING=fixed``: stale after 3 status intervals in the window
   2-core machine; every stop is a false one, scaled to 10 minutes. ``window`` is the real app under
   Xvfb, a key held with xdotool (``bench.links_window``); ``core`` the window's client core (runner,
   lease, keeper, guardian) with its UI thread played by a thread that does 8 ms of GIL-free work per
-  40 ms frame (``bench.links_parent``); ``drive`` is ``rtmu drive``. The three run at once in each
-  phase (Wi-Fi, then load), so each also carries the others' load.
+  40 ms frame (``bench.links_parent``); ``drive`` is ``rtmu drive``. The three run at once, one
+  condition after the other, each with its simulator and proxy in a process of its own
+  (``bench.links_rig_proc``: shared, their interpreter lock would add its own delays to the link's).
 * ``links.stop_sent_ms.<fault>`` — from the last server bytes the client received to zero ratios +
   ``stop`` leaving the client (its own report, same monotonic clock); ``links.stop_at_sim_ms.<fault>``
   — to their arrival at the simulator, where the fault lets them through; ``reset`` is timed from
@@ -41,7 +42,7 @@ from collections.abc import Callable
 from typing import Any
 
 from bench.common import Result
-from bench.links_rig import REPO, CoreParent, Rig, drive
+from bench.links_rig import REPO, CoreParent, Rig, RigProcess, drive
 from bench.links_window import window_false_stops as window_false_stops_in
 
 sys.path.insert(0, str(REPO / "tests"))
@@ -78,11 +79,11 @@ def _events(times: list[float]) -> int:
 
 def core_false_stops(condition: str, seconds: float, fixed: bool, seed: int) -> tuple[int, float]:
     """(false stops, seconds held) for the core client under ``condition``."""
-    rig = Rig(seed)
+    rig = RigProcess(seed)
     try:
         if condition in PROFILES:
-            rig.proxy.play(PROFILES[condition], seed=seed)
-        parent = CoreParent(rig.proxy.port, fixed=fixed)
+            rig.play(condition, seed)
+        parent = CoreParent(rig.port, fixed=fixed)
         try:
             if not rig.wait(rig.moving, 20):
                 raise RuntimeError("the core client never drove")
@@ -108,18 +109,18 @@ def core_false_stops(condition: str, seconds: float, fixed: bool, seed: int) -> 
 
 def drive_false_stops(condition: str, seconds: float, fixed: bool, seed: int) -> tuple[int, float]:
     """(false stops, seconds driven) for ``rtmu drive``: a stopped drive starts again."""
-    rig = Rig(seed)
+    rig = RigProcess(seed)
     try:
         if condition in PROFILES:
-            rig.proxy.play(PROFILES[condition], seed=seed)
+            rig.play(condition, seed)
         stops, driven = 0, 0.0
-        world = rig.sim.server.world
         while driven < seconds - 1.0:
-            before = world.ratio_drives_received
-            code, _err = drive(rig.proxy.port, seconds - driven, fixed=fixed)
-            driven += (world.ratio_drives_received - before) * 0.1  # sent every 100 ms while driving
+            before = rig.drives()
+            code, err = drive(rig.port, seconds - driven, fixed=fixed)
+            driven += (rig.drives() - before) * 0.1  # sent every 100 ms while driving
             if code != 0:
                 stops += 1
+                print(f"# links drive/{condition} fixed={fixed}: {err.strip()[:300]}", flush=True)
         return stops, driven
     finally:
         rig.close()
@@ -127,10 +128,10 @@ def drive_false_stops(condition: str, seconds: float, fixed: bool, seed: int) ->
 
 def window_false_stops(condition: str, seconds: float, fixed: bool, seed: int) -> tuple[int, float]:
     """(false stops, seconds held) for the real window (``bench.links_window``)."""
-    rig = Rig(seed)
+    rig = RigProcess(seed)
     try:
         if condition in PROFILES:
-            rig.proxy.play(PROFILES[condition], seed=seed)
+            rig.play(condition, seed)
         count, held, who = window_false_stops_in(rig, seconds, fixed)
         if who:
             print(f"# links window/{condition} fixed={fixed}: stops by {who}", flush=True)
@@ -149,7 +150,7 @@ def false_stop_rows() -> list[Result]:
 
     def phase(conditions: tuple[str, ...], seconds: float, fixed: bool) -> None:
         jobs: list[threading.Thread] = []
-        for i, condition in enumerate(conditions):
+        for i, condition in enumerate(conditions, start=1):
             for who, fn in (
                 ("core", core_false_stops),
                 ("drive", drive_false_stops),
@@ -168,7 +169,8 @@ def false_stop_rows() -> list[Result]:
             j.join()
 
     for fixed, seconds in ((False, SOAK_S), (True, BASELINE_S)):
-        phase(("good", "busy"), seconds, fixed)
+        phase(("good",), seconds, fixed)
+        phase(("busy",), seconds, fixed)
         with CpuLoad(count=4, nice=0, seconds=seconds + 300) as load:
             wait_busy(load)
             phase(("load4",), seconds, fixed)
@@ -351,7 +353,10 @@ def freeze_rows() -> list[Result]:
 
 
 def run() -> list[Result]:
-    return freeze_rows() + latency_rows() + false_stop_rows()
+    """``RTMU_LINKS_PARTS`` (``freeze,latency,false`` by default) picks the parts to measure."""
+    parts = {"freeze": freeze_rows, "latency": latency_rows, "false": false_stop_rows}
+    chosen = os.environ.get("RTMU_LINKS_PARTS", ",".join(parts)).split(",")
+    return [r for name in chosen if name in parts for r in parts[name]()]
 
 
 if __name__ == "__main__":

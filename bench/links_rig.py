@@ -26,7 +26,7 @@ from rtmu.sim import SimConfig, SimThread
 
 REPO = Path(__file__).resolve().parents[1]
 sys.path.insert(0, str(REPO / "tests"))
-from linkfaults import FaultProxy  # noqa: E402
+from linkfaults import PROFILES, FaultProxy  # noqa: E402
 
 ARENA = REPO / "data" / "maps" / "arena.map"
 POLL = 0.002
@@ -68,6 +68,21 @@ class Rig:
                 self.stops.append((time.monotonic(), "watchdog"))
             time.sleep(POLL)
 
+    @property
+    def port(self) -> int:
+        """Where a client connects: the proxy."""
+        return self.proxy.port
+
+    def play(self, profile: str, seed: int) -> None:
+        self.proxy.play(PROFILES[profile], seed=seed)
+
+    def turning(self) -> bool:
+        return self.sim.snapshot().rot_ratio != 0
+
+    def drives(self) -> int:
+        """ratioDrive packets the simulator has received."""
+        return int(self.sim.server.world.ratio_drives_received)
+
     def stop_after(self, t0: float, timeout: float) -> float | None:
         """The first stop that reached the simulator at or after ``t0`` (waiting up to ``timeout``)."""
         deadline = time.monotonic() + timeout
@@ -94,6 +109,82 @@ class Rig:
         self._closed.set()
         self.proxy.close()
         self.sim.stop()
+
+
+class RigProcess:
+    """A :class:`Rig` in its own process (``bench.links_rig_proc``), with the same questions."""
+
+    def __init__(self, seed: int = 1) -> None:
+        self.proc = subprocess.Popen(
+            [sys.executable, "-m", "bench.links_rig_proc", str(seed)],
+            cwd=REPO,
+            stdin=subprocess.PIPE,
+            stdout=subprocess.PIPE,
+            text=True,
+        )
+        assert self.proc.stdout is not None
+        word, port = self.proc.stdout.readline().split()
+        if word != "port":
+            raise RuntimeError("the rig did not start")
+        self.port = int(port)
+        self.stops: list[tuple[float, str]] = []
+        self._states: list[tuple[float, float, int]] = []
+        self._cond = threading.Condition()
+        threading.Thread(target=self._read, daemon=True).start()
+
+    def _read(self) -> None:
+        assert self.proc.stdout is not None
+        for line in self.proc.stdout:
+            parts = line.split()
+            with self._cond:
+                if parts[:1] == ["stop"]:
+                    self.stops.append((float(parts[1]), parts[2]))
+                elif parts[:1] == ["state"]:
+                    self._states.append((float(parts[1]), float(parts[2]), int(parts[3])))
+                self._cond.notify_all()
+
+    def _send(self, line: str) -> None:
+        assert self.proc.stdin is not None
+        self.proc.stdin.write(line + "\n")
+        self.proc.stdin.flush()
+
+    def play(self, profile: str, seed: int) -> None:
+        self._send(f"play {profile} {seed}")
+
+    def state(self) -> tuple[float, float, int]:
+        """(commanded trans ratio, rot ratio, ratioDrive packets so far), asked now."""
+        with self._cond:
+            n = len(self._states)
+            self._send("state")
+            self._cond.wait_for(lambda: len(self._states) > n, 10)
+            return self._states[-1]
+
+    def moving(self) -> bool:
+        return self.state()[0] != 0
+
+    def turning(self) -> bool:
+        return self.state()[1] != 0
+
+    def drives(self) -> int:
+        return self.state()[2]
+
+    def wait(self, cond, timeout: float) -> bool:  # type: ignore[no-untyped-def]
+        deadline = time.monotonic() + timeout
+        while not cond():
+            if time.monotonic() > deadline:
+                return False
+            time.sleep(0.02)
+        return True
+
+    def close(self) -> None:
+        if self.proc.stdin is not None:
+            with contextlib.suppress(OSError):
+                self.proc.stdin.close()
+        try:
+            self.proc.wait(10)
+        except subprocess.TimeoutExpired:
+            self.proc.kill()
+            self.proc.wait(5)
 
 
 class CoreParent:

@@ -1,7 +1,7 @@
 """The real window held driving through the fault proxy, for ``bench_links``' false-stop rows.
 
 The app runs under its own Xvfb (as ``bench.soak_window``) with ``RTMU_LINK_TIMING`` as asked,
-connected through a :class:`~bench.links_rig.Rig`'s proxy to the simulator; ``xdotool keydown
+connected through a :class:`~bench.links_rig.RigProcess`'s proxy to the simulator; ``xdotool keydown
 Left`` turns the robot in place (it never reaches a wall, so every stop is one of ours). Every
 stop that reaches the simulator while the key is held is a false one: it is counted, the key is
 let go and pressed again, and the hold goes on until the time is up.
@@ -16,13 +16,13 @@ import time
 from pathlib import Path
 
 from bench.common import end_process, start_xvfb
-from bench.links_rig import Rig, env_for
+from bench.links_rig import RigProcess, env_for
 from bench.soak_window import _xdotool
 
 KEY = "Left"
 
 
-def window_false_stops(rig: Rig, seconds: float, fixed: bool) -> tuple[int, float, list[str]]:
+def window_false_stops(rig: RigProcess, seconds: float, fixed: bool) -> tuple[int, float, list[str]]:
     """(false stops, seconds held, who sent each) for the real window through ``rig``'s proxy."""
     xvfb, display = start_xvfb()
     config = tempfile.mkdtemp(prefix="rtmu-links-")
@@ -31,7 +31,7 @@ def window_false_stops(rig: Rig, seconds: float, fixed: bool) -> tuple[int, floa
     env.update(GSETTINGS_BACKEND="memory", XDG_CONFIG_HOME=config, XDG_DATA_HOME=config)
     env.pop("WAYLAND_DISPLAY", None)
     app = subprocess.Popen(
-        [sys.executable, "-m", "rtmu", "--host", "127.0.0.1", "--port", str(rig.proxy.port)],
+        [sys.executable, "-m", "rtmu", "--host", "127.0.0.1", "--port", str(rig.port)],
         env=env,
         stdout=subprocess.DEVNULL,
         stderr=subprocess.DEVNULL,
@@ -43,7 +43,7 @@ def window_false_stops(rig: Rig, seconds: float, fixed: bool) -> tuple[int, floa
         def press() -> bool:
             for _ in range(30):  # a press that beats "connected" is refused: press until one drives
                 _xdotool(env, "keydown", KEY)
-                if rig.wait(lambda: rig.sim.snapshot().rot_ratio != 0, 2.0):
+                if rig.wait(rig.turning, 2.0):
                     return True
                 _xdotool(env, "keyup", KEY)
                 time.sleep(0.5)

@@ -87,7 +87,7 @@ FAULTS: dict[str, tuple[Callable[[FaultProxy], float], str, bool]] = {
     "mute_to_server": (lambda p: p.mute(TO_SERVER), "did not answer a ping", False),
     "mute_both": (lambda p: p.mute(TO_CLIENT, TO_SERVER), "", False),
     "rtt_800ms": (lambda p: p.delay(0.4), "", True),
-    "reset": (lambda p: p.reset(), "lost the link", False),
+    "reset": (lambda p: p.reset(), "lost the link", True),  # the stop goes out on a new connection
     "garbage": (lambda p: p.garble(TO_CLIENT), "no status", True),
     "stalling_header": (lambda p: p.stalling_header(), "no status", True),
 }

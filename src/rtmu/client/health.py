@@ -27,7 +27,7 @@ from collections.abc import Callable
 
 from ..protocol.decoder import DropStats
 from ..state import LinkHealth, LinkLevel
-from .link_timing import STATUS_CEILING, Deadline, Envelope, Timing, ceiling_for
+from .link_timing import STATUS_CEILING, WAKE_MEMORY, Deadline, Envelope, Timing, ceiling_for
 
 STALE_INTERVALS = 3
 LOST_AFTER = 2.0
@@ -60,7 +60,7 @@ class HealthMonitor:
         floor = stale_intervals * status_interval
         self.status_timing = Deadline(status_interval, floor, max(floor, stale_ceiling))
         """Gaps between status packets → the stale limit (``client.link_timing``)."""
-        self.wake_lateness = Envelope()
+        self.wake_lateness = Envelope(WAKE_MEMORY)
         """How late the loop that stops the robot wakes (:meth:`note_wake`): lowers the ceiling."""
         self.lost_after = max(lost_after, self.status_timing.ceiling)
         ping_ceiling = PING_CEILING if ping_ceiling is None else ping_ceiling
@@ -121,7 +121,7 @@ class HealthMonitor:
             self.wake_lateness.note(late, now)
 
     def ceiling(self, now: float) -> float:
-        """The stale limit's ceiling now: under the promise by twice the loop's recent lateness."""
+        """The stale limit's ceiling now: under the promise by the loop's worst recent lateness."""
         timing = self.status_timing
         return ceiling_for(self.wake_lateness.value(now), timing.floor, timing.ceiling)
 

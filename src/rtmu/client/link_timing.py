@@ -23,9 +23,9 @@ trip — three figures:
 next stall be twice the longest one remembered; ``PAD`` covers where in the status period it falls.
 
 The ceiling itself knows the machine: the loop that would send the stop measures how late it wakes
-(an :class:`Envelope` of its lateness), and :func:`ceiling_for` keeps twice the worst of it
-between the limit and the 0.5 s promise — a laptop that runs us 100 ms late stops a silent link
-at 0.3 s, so the stop is still on the wire within 0.5 s.
+(an :class:`Envelope` of its lateness), and :func:`ceiling_for` keeps the worst of it between the
+limit and the 0.5 s promise — a laptop that lately ran us 150 ms late stops a silent link at
+0.35 s, so the stop is still on the wire within 0.5 s.
 
 While the link is *undecided* — the decoder holds a header whose body has not come but sees
 valid packets going on behind it (``PacketDecoder.undecided``) — the limit is the ceiling: the
@@ -44,8 +44,11 @@ STATUS_PROMISE = 0.5
 STATUS_CEILING = 0.45
 """The status limit's ceiling on a machine that runs us on time: 50 ms under the promise for the
 wake-up and the send. On a machine that wakes us late it is lower (:func:`ceiling_for`)."""
-WAKE_MARGIN = 2.0
-"""The ceiling keeps twice the worst recent wake-up lateness of the loop that stops the robot."""
+WAKE_MARGIN = 1.0
+"""The ceiling keeps the worst recent wake-up lateness of the loop that stops the robot under the
+promise (twice that collapsed the limit to its floor on a busy laptop for minutes after one hiccup)."""
+WAKE_MEMORY = 30.0
+"""Seconds for that remembered lateness to halve: a machine that calmed down gets its room back."""
 MARGIN = 2.0
 PAD = 0.1
 """Added to every learned limit: a stall's lateness is measured from the mean gap, but it may start
