@@ -13,7 +13,9 @@ before (``RTMU_LINK_TIMING=fixed``: stale after 3 status intervals in the window
   lease, keeper, guardian) with its UI thread played by a thread that does 8 ms of GIL-free work per
   40 ms frame (``bench.links_parent``); ``drive`` is ``rtmu drive``. The three run at once, one
   condition after the other, each with its simulator and proxy in a process of its own
-  (``bench.links_rig_proc``: shared, their interpreter lock would add its own delays to the link's).
+  (``bench.links_rig_proc``: shared, their interpreter lock would add its own delays to the link's)
+  and, where allowed, a few nice levels up: it stands for the robot, whose CPUs the laptop's load
+  does not take.
 * ``links.stop_sent_ms.<fault>`` — from the last server bytes the client received to zero ratios +
   ``stop`` leaving the client (its own report, same monotonic clock); ``links.stop_at_sim_ms.<fault>``
   — to their arrival at the simulator, where the fault lets them through; ``reset`` is timed from
