@@ -20,18 +20,17 @@ import statistics
 import struct
 import threading
 import time
-from pathlib import Path
 
 from websockets.sync.client import connect
 
 from bench.common import Result
 from rtmu.client.runner import ClientRunner
+from rtmu.package_data import project_map
 from rtmu.recorder import topics
 from rtmu.recorder.bridge import LEASE_TTL, Bridge
 from rtmu.sim import SimConfig, SimThread
 
-REPO = Path(__file__).resolve().parents[1]
-ARENA = REPO / "data" / "maps" / "arena.map"
+ARENA = project_map("arena.map")
 WINDOW = 10.0
 TWIST = json.dumps({"linear": {"x": 0.5}, "angular": {"z": 0.0}}).encode()
 
@@ -39,8 +38,8 @@ TWIST = json.dumps({"linear": {"x": 0.5}, "angular": {"z": 0.0}}).encode()
 class Client:
     """Subscribes to every channel; keeps the latency of each pose."""
 
-    def __init__(self, port: int) -> None:
-        opened = connect(f"ws://127.0.0.1:{port}", subprotocols=["foxglove.sdk.v1"])  # type: ignore[list-item]
+    def __init__(self, url: str) -> None:
+        opened = connect(url, subprotocols=["foxglove.sdk.v1"])  # type: ignore[list-item]
         self.ws = opened.__enter__()
         self.latencies: list[float] = []
         self.pose_sub: int | None = None
@@ -106,7 +105,7 @@ def session(with_bridge: bool, drive: bool = False) -> tuple[SimThread, ClientRu
 
 def cpu(with_bridge: bool) -> tuple[float, list[float]]:
     sim, runner, bridge = session(with_bridge)
-    client = Client(bridge.port) if bridge is not None else None
+    client = Client(bridge.url) if bridge is not None else None
     try:
         time.sleep(1.0)
         c0, t0 = time.process_time(), time.monotonic()
@@ -128,7 +127,7 @@ def cpu(with_bridge: bool) -> tuple[float, list[float]]:
 def stops(trials: int = 10) -> list[float]:
     sim, runner, bridge = session(True, drive=True)
     assert bridge is not None
-    client = Client(bridge.port)
+    client = Client(bridge.url)  # a drive bridge: its URL carries the token
     out: list[float] = []
     try:
         for _ in range(trials):

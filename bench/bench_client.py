@@ -34,7 +34,7 @@ from bench.common import Result
 from rtmu.client.lease import DriveRatios
 from rtmu.client.runner import ClientRunner
 from rtmu.client.session import SessionConfig
-from rtmu.model import Phase, RobotModel
+from rtmu.model.observables import Phase, RobotModel
 from rtmu.protocol.client_connection import ClientConnection, ClientState
 from rtmu.protocol.datalist import DataList
 from rtmu.protocol.events import RequestOnce, RequestReceived
@@ -42,7 +42,7 @@ from rtmu.protocol.packet import encode_packet
 from rtmu.protocol.payloads.drive import RatioDrive, SafeDrive
 from rtmu.protocol.payloads.robot import UpdateNumbers, UpdateStrings
 from rtmu.protocol.server_connection import ServerConnection
-from rtmu.state import RobotChanged, StateChange
+from rtmu.values.state import RobotChanged, StateChange
 
 DRIVE_TRIALS = 400
 STATUS_SAMPLES = 600

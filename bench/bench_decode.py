@@ -18,9 +18,9 @@ from pathlib import Path
 
 from bench.common import Result, best_time
 from rtmu.capture import open_capture
-from rtmu.session_decoder import CaptureDecoder
+from rtmu.capture.session_decoder import CaptureDecoder
 
-CAPTURE = Path(__file__).resolve().parents[1].parent / "shared" / "captures" / "map-binary-columbia.pcap"
+CAPTURE = Path(__file__).resolve().parents[1] / "tests" / "data" / "captures" / "map-binary-columbia.pcap"
 
 # The child's own high-water mark. Not getrusage's ru_maxrss: Linux carries that across fork and exec,
 # so every child reported the benchmark process's peak (all figures were equal). VmHWM belongs to the

@@ -19,10 +19,10 @@ import numpy as np
 
 from rtmu.protocol.errors import PayloadError
 from rtmu.protocol.payloads.drawings import MAX_POINTS, DrawingPoints
-from rtmu.state import DrawingLayer
 from rtmu.ui import overlays
 from rtmu.ui.frame import Scene, draw_frame
 from rtmu.ui.viewport import Viewport
+from rtmu.values.state import DrawingLayer
 
 from .common import Result, best_time
 

@@ -16,12 +16,12 @@ from __future__ import annotations
 from types import SimpleNamespace
 
 from bench.common import Result, best_time
-from rtmu.alarms import AlarmMonitor
 from rtmu.client.lease import DriveLease
-from rtmu.controller import Controller, NoView
-from rtmu.gamepad import AXIS_TRANS, DEADMAN, Gamepad
-from rtmu.model import ConnectionState, LinkHealth, LinkLevel, OperatorState, Phase, RobotModel
-from rtmu.state import RobotState
+from rtmu.control.alarms import AlarmMonitor
+from rtmu.control.controller import Controller, NoView
+from rtmu.control.gamepad import AXIS_TRANS, DEADMAN, Gamepad
+from rtmu.model.observables import ConnectionState, LinkHealth, LinkLevel, OperatorState, Phase, RobotModel
+from rtmu.values.state import RobotState
 
 
 class _Clock:

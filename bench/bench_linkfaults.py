@@ -29,13 +29,14 @@ from collections.abc import Callable
 from pathlib import Path
 
 from bench.common import Result
+from rtmu.package_data import project_map
 from rtmu.sim import SimConfig, SimThread
 
 REPO = Path(__file__).resolve().parents[1]
 sys.path.insert(0, str(REPO / "tests"))
 from linkfaults import FAKE_HEADER, TO_CLIENT, FaultProxy  # noqa: E402
 
-ARENA = REPO / "data" / "maps" / "arena.map"
+ARENA = project_map("arena.map")
 POLL = 0.005
 GIVE_UP = 6.0
 

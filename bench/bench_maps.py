@@ -12,7 +12,7 @@ from pathlib import Path
 import numpy as np
 
 from bench.common import Result, best_time
-from rtmu.maps import map_header_lines, read_map, write_map
+from rtmu.mapfile import map_header_lines, read_map, write_map
 from rtmu.sim.mapgen import generate_map
 
 POINTS = 1_000_000

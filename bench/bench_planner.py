@@ -22,7 +22,7 @@ import time
 from collections.abc import Callable
 
 from bench.common import Result
-from rtmu.maps import MapData
+from rtmu.mapfile import MapData
 from rtmu.sim.mapgen import generate_map
 from rtmu.sim.planner import NoPath, PlanGrid
 from rtmu.sim.project_maps import office_map

@@ -14,32 +14,27 @@ from __future__ import annotations
 import asyncio
 import statistics
 import time
-from pathlib import Path
-from typing import Any
 
 from bench.common import Result, best_time
 from rtmu.client.connection import AriaClient, Packet
+from rtmu.client.detached import DetachedContext
 from rtmu.client.ptz import PtzFeed
 from rtmu.client.server_strings import StringsFeed
+from rtmu.package_data import project_map
 from rtmu.protocol.payloads.strings import StringItem, Strings, StringsInfo
 from rtmu.sim import SimConfig, SimThread
 from rtmu.sim.handlers import STRING_ITEMS
 
-REPO = Path(__file__).resolve().parents[1]
-OFFICE = REPO / "data" / "maps" / "office.map"
+OFFICE = project_map("office.map")
 MOVES = 30
 
 
-def _feed(labels: tuple[str, ...]) -> tuple[StringsFeed, dict[str, Any]]:
-    kept: dict[str, Any] = {}
-
-    def decode(name: str, payload: bytes) -> Any:
-        return Strings.decode(payload) if name == "getStrings" else StringsInfo.decode(payload)
-
-    feed = StringsFeed(kept.update, decode, lambda coro, _name: coro.close(), 5.0)
+def _feed(labels: tuple[str, ...]) -> tuple[StringsFeed, DetachedContext]:
+    ctx = DetachedContext()
+    feed = StringsFeed(ctx)
     feed._set_info(StringsInfo(tuple(StringItem(label, 10) for label in labels)))  # as read after login
     feed.watching = True
-    return feed, kept
+    return feed, ctx
 
 
 def strings_update() -> list[Result]:
@@ -53,7 +48,7 @@ def strings_update() -> list[Result]:
     plain_s = best_time(lambda: plain._on_values(ordinary))
     return [
         Result("ptz.strings_update_us.hostile", hostile_s * 1e6, "us", plain_s * 1e6),
-        Result("ptz.strings_kept_items.hostile", float(len(kept["server_strings"])), "items"),
+        Result("ptz.strings_kept_items.hostile", float(len(kept.robot.server_strings)), "items"),
     ]
 
 
@@ -61,8 +56,8 @@ async def _moves(port: int) -> tuple[float, float]:
     client = AriaClient()
     await client.connect("127.0.0.1", port, timeout=10)
     try:
-        feed = PtzFeed(lambda **_c: None, lambda coro, _name: coro.close(), 5.0)
-        await feed.connected(client)
+        feed = PtzFeed(DetachedContext(client))
+        await feed.read_head(client)
         name = "getCameraDataCam1"
         bare: list[float] = []
         moved: list[float] = []

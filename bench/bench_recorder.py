@@ -32,12 +32,13 @@ import time
 from pathlib import Path
 
 from bench.common import Result, best_time
+from rtmu.package_data import project_map
 from rtmu.recorder import Limits, Recording, topics
 from rtmu.recorder.items import Event
 from rtmu.sim import SimConfig, SimThread
 
 REPO = Path(__file__).resolve().parents[1]
-ARENA = REPO / "data" / "maps" / "arena.map"
+ARENA = project_map("arena.map")
 SECONDS = float(os.environ.get("RTMU_RECORDER_BENCH_SECONDS", "20"))
 CAMERA_HZ = 10.0
 

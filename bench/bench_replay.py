@@ -24,17 +24,16 @@ from pathlib import Path
 
 from bench.common import Result
 from rtmu.client.runner import ClientRunner
-from rtmu.client.session import SessionConfig
+from rtmu.package_data import project_map
 from rtmu.protocol.decoder import PacketDecoder
 from rtmu.recorder import Recorder, RecorderConfig
-from rtmu.recorder.replay import PacedLink, Replayer
+from rtmu.recorder.replay import REPLAY_CONFIG, PacedLink, Replayer
 from rtmu.recorder.replay_file import load
 from rtmu.sim import SimConfig, SimThread
+from rtmu.values.intents import RequestPicture
 
-REPO = Path(__file__).resolve().parents[1]
-ARENA = REPO / "data" / "maps" / "arena.map"
+ARENA = project_map("arena.map")
 SECONDS = float(os.environ.get("RTMU_REPLAY_BENCH_SECONDS", "30"))
-REPLAY_CONFIG = SessionConfig(ping_interval=3600.0, lost_after=3600.0, connect_timeout=3600.0)
 
 
 def record(out: Path) -> None:
@@ -50,7 +49,7 @@ def record(out: Path) -> None:
             while time.monotonic() < end:
                 sim.call(lambda: sim.server.world.ratio_drive(40.0, 25.0, 60.0))  # type: ignore[union-attr]
                 if time.monotonic() >= next_picture:
-                    runner.request_image()
+                    runner.send(RequestPicture())
                     next_picture = time.monotonic() + 0.5
                 time.sleep(0.1)
             sim.call(lambda: sim.server.world.stop())  # type: ignore[union-attr]

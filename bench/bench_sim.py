@@ -31,6 +31,7 @@ from pathlib import Path
 import numpy as np
 
 from bench.common import Result, best_time
+from rtmu.package_data import project_map
 from rtmu.protocol.client_connection import ClientConnection, ClientState
 from rtmu.protocol.events import DataReceived
 from rtmu.protocol.payloads.drive import RatioDrive
@@ -49,8 +50,8 @@ from rtmu.sim.camera import (
 from rtmu.sim.sonar import sonar_ranges
 
 REPO = Path(__file__).resolve().parents[1]
-OFFICE = REPO / "data" / "maps" / "office.map"
-COLUMBIA = REPO.parent / "shared" / "aria-maps" / "columbia.map"
+OFFICE = project_map("office.map")
+COLUMBIA = REPO / "tests" / "data" / "aria-maps" / "columbia.map"
 SIM_SECONDS = 10.0
 
 

@@ -43,7 +43,8 @@ import cairo
 import numpy as np
 
 from bench.common import Result, start_xvfb
-from rtmu.maps import write_map
+from rtmu.mapfile import write_map
+from rtmu.package_data import project_map
 from rtmu.sim.mapgen import generate_map
 from rtmu.ui import overlays
 from rtmu.ui.frame import Scene, draw_frame
@@ -57,8 +58,7 @@ WIDTH, HEIGHT = 1024, 600
 FOLLOW_FRAMES = 400
 STEP_MM = 40.0
 NAIVE_FRAMES = 3
-REPO = Path(__file__).resolve().parents[1]
-OFFICE = REPO / "data" / "maps" / "office.map"
+OFFICE = project_map("office.map")
 
 
 def naive_frame(ctx: cairo.Context, vp: Viewport, points: np.ndarray, segments: np.ndarray) -> None:

@@ -44,6 +44,7 @@ from typing import Any
 from bench.common import Result, best_time, end_process, start_xvfb
 from rtmu.client.connection import AriaClient
 from rtmu.client.video_feed import LiveFrame, VideoFeed, frame_stamp, parse_frame, video_source
+from rtmu.package_data import project_map
 
 SIZE = "640x480"
 SERVER_HZ = 25.0
@@ -151,7 +152,7 @@ def render_cost() -> float:
     from rtmu.sim.config import SimConfig
     from rtmu.sim.server import SimServer
 
-    server = SimServer(SimConfig(port=0, realtime=False, map_path=REPO / "data" / "maps" / "office.map"))
+    server = SimServer(SimConfig(port=0, realtime=False, map_path=project_map("office.map")))
     world = server.world
     turn = [0.0]
 

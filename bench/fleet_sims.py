@@ -10,12 +10,12 @@ import asyncio
 import contextlib
 import signal
 import sys
-from pathlib import Path
 
+from rtmu.package_data import project_map
 from rtmu.sim import SimConfig
 from rtmu.sim.multi import SimFleet, fleet_configs
 
-OFFICE = Path(__file__).resolve().parents[1] / "data" / "maps" / "office.map"
+OFFICE = project_map("office.map")
 
 
 async def main(count: int) -> None:

@@ -29,7 +29,7 @@ import gi
 gi.require_version("Gtk", "4.0")
 from gi.repository import GLib  # noqa: E402
 
-from rtmu.settings import DirectRobot  # noqa: E402
+from rtmu.settings.store import DirectRobot  # noqa: E402
 from rtmu.ui.application import RtmuApplication  # noqa: E402
 from rtmu.ui.options import GuiOptions  # noqa: E402
 
@@ -125,7 +125,7 @@ def main(seconds: float, ports: list[int]) -> None:
         "ready_s": waited - started,
         "cpu_window": (own1 - own0) / (t1 - t0),
         "map_downloads": sum(
-            1 for s in fleet if s.runner.session is not None and s.runner.session.map_downloads_shared == 0
+            1 for s in fleet if s.runner.session is not None and s.runner.session.maps.downloads_shared == 0
         ),
     }
     print("RESULT " + json.dumps(out), flush=True)

@@ -23,11 +23,11 @@ import sys
 import threading
 import time
 
+from rtmu.base.notices import Kind, Notice
 from rtmu.client.lease import DriveRatios
 from rtmu.client.runner import ClientRunner
 from rtmu.client.session import SessionConfig
 from rtmu.guardian.handle import BEAT_PERIOD
-from rtmu.notices import Kind, Notice
 
 DRIVE = DriveRatios(40.0, 0.0, 40.0)
 FRAME_WORK = 0.008

@@ -41,7 +41,7 @@ from bench.common import Result
 from rtmu.client.lease import DriveRatios
 from rtmu.client.runner import LOOP_BEAT, ClientRunner
 from rtmu.client.session import SessionConfig
-from rtmu.model import Phase, RobotModel
+from rtmu.model.observables import Phase, RobotModel
 
 HOLD = (0.3, 1.5)
 REST = (0.2, 1.0)

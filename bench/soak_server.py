@@ -12,8 +12,8 @@ from __future__ import annotations
 
 import sys
 import time
-from pathlib import Path
 
+from rtmu.package_data import project_map
 from rtmu.protocol.payloads.drive import RatioDrive
 from rtmu.sim.config import SimConfig
 from rtmu.sim.server import SimServer
@@ -38,7 +38,7 @@ def _tap(server_cls: type[SimServer]) -> None:
 
 def main() -> int:
     _tap(SimServer)
-    office = Path(__file__).resolve().parents[1] / "data" / "maps" / "office.map"
+    office = project_map("office.map")
     sim = SimThread(SimConfig(port=0, map_path=office, camera=False)).start()
     assert sim.server is not None
     print(f"port {sim.server.port}", flush=True)

@@ -11,8 +11,8 @@ from __future__ import annotations
 import sys
 import threading
 import time
-from pathlib import Path
 
+from rtmu.package_data import project_map
 from rtmu.sim.config import SimConfig
 from rtmu.sim.thread import SimThread
 
@@ -20,7 +20,7 @@ from rtmu.sim.thread import SimThread
 def main(argv: list[str]) -> int:
     w, h = (int(v) for v in argv[0].split("x"))
     hz = float(argv[1])
-    office = Path(__file__).resolve().parents[1] / "data" / "maps" / "office.map"
+    office = project_map("office.map")
     cfg = SimConfig(port=0, map_path=office, camera_size=(w, h), camera_hz=hz, drive_timeout=0)
     sim = SimThread(cfg).start()
     assert sim.server is not None

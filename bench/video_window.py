@@ -26,10 +26,12 @@ from typing import Any
 
 import gi
 
+from rtmu.values.intents import RequestPicture
+
 gi.require_version("Gtk", "4.0")
 from gi.repository import GLib  # noqa: E402
 
-from rtmu.model import Phase  # noqa: E402
+from rtmu.model.observables import Phase  # noqa: E402
 from rtmu.ui.application import RtmuApplication  # noqa: E402
 from rtmu.ui.options import GuiOptions  # noqa: E402
 
@@ -155,7 +157,7 @@ def main(argv: list[str]) -> int:
     drawn = [0]
     last_stamp: list[int | None] = [None]
     waiting_paint: list[tuple[int | None, float]] = []
-    original = window._picture_decoded
+    original = window.camera_page.picture_decoded
     stages = Stages()
     stages.install(window)
 
@@ -195,7 +197,7 @@ def main(argv: list[str]) -> int:
                 if stamp is not None:
                     drawn_age.append((time.time_ns() - stamp) / 1e6)
             if mode == "serial":
-                window._link.request_image()  # the next only once this one is on screen
+                window.session.runner.send(RequestPicture())  # the next only once this one is on screen
 
     clock.connect("update", on_update)
     clock.connect("after-paint", after_paint)
@@ -204,7 +206,7 @@ def main(argv: list[str]) -> int:
         window.live.fps.set_selected(window.live.fps.get_model().get_n_items() - 2)  # 20 fps
         window.live.set_live(True)
     else:
-        window._link.request_image()
+        window.session.runner.send(RequestPicture())
     run_for(2.0)  # warm-up: first frames, texture upload paths
     measuring[0] = True
     cpu0, t0, draws0, paints0 = time.process_time(), time.monotonic(), window.stage.frames, paints[0]

@@ -17,12 +17,18 @@ export DEBIAN_FRONTEND=noninteractive
 APT_PACKAGES=(
     gir1.2-gtk-4.0 gir1.2-adw-1 gir1.2-manette-0.2 libgirepository1.0-dev libcairo2-dev pkg-config
     build-essential xvfb xdotool openbox x11-utils xxd bsdextrautils
+    appstream desktop-file-utils dbus git
 )
 # Every program the app, tests, bench and scripts start -> the package above that installs it
 # ("essential": in every Debian install). tests/test_setup_programs.py keeps this true.
+# A program may come from a direct dependency of the package named (dbus brings the session bus's
+# daemon: Debian 12 splits it into dbus-daemon, Ubuntu 22.04's dbus holds it). Not dbus-x11: its
+# dbus-launch makes GLib start a stray bus of its own wherever DBUS_SESSION_BUS_ADDRESS is unset.
 PROGRAM_PACKAGES=(
     Xvfb=xvfb xdotool=xdotool openbox=openbox xwininfo=x11-utils xprop=x11-utils bash=essential
     xxd=xxd hexdump=bsdextrautils od=essential
+    appstreamcli=appstream desktop-file-validate=desktop-file-utils
+    dbus-daemon=dbus dbus-run-session=dbus git=git
 )
 VENV=.venv
 STAMP="$VENV/.rtmu-setup-stamp"
@@ -215,7 +221,7 @@ main() {
     ensure_system_packages
     ensure_venv
     ensure_project
-    bash scripts/install-desktop.sh || say "the desktop entry was not installed (RTMU still runs as .venv/bin/rtmu)"
+    # Nothing is installed into the user's desktop from here: that is 'rtmu --install-desktop', on request.
 }
 
 # Sourcing this file (to try its functions) defines them without running anything.

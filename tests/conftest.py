@@ -1,18 +1,21 @@
-"""Suite-wide settings and the path to the shared ARIA captures and maps (``../shared`` beside the repo)."""
+"""Suite-wide settings (the ARIA captures and maps the tests read are in ``tests/data``: ``testdata``)."""
 
 from __future__ import annotations
 
 import atexit
+import functools
+import importlib
+import importlib.util
 import os
 import shutil
 import tempfile
+from collections.abc import Sequence
 from pathlib import Path
 
 import pytest
 from hypothesis import settings
 
-REPO_ROOT = Path(__file__).resolve().parents[1]
-SHARED_DIR = REPO_ROOT.parent / "shared"
+from checkout import build_dists
 
 # The window records every session (rtmu.recorder) under $XDG_DATA_HOME: never into the real home
 # from a test, nor from the windows and subprocesses tests start (they inherit this environment).
@@ -27,9 +30,34 @@ if "CI" not in os.environ:
     settings.load_profile("rtmu-local")
 
 
+def _every_exit_code_is_one_its_help_lists() -> None:
+    """Every subcommand a test runs in this process (``rtmu.cli.main``) ends with a code its ``--help``
+    lists (its module's ``EXITS``, from the one table): the contract checked by every CLI test, not
+    only by tests/test_exit_codes.py. Wrapped before any test module imports ``main``."""
+    import rtmu.cli
+    from rtmu.base import exit_codes
+
+    run = rtmu.cli.main
+
+    @functools.wraps(run)
+    def main(argv: Sequence[str] | None = None) -> int:
+        code = run(argv)
+        name = next(iter(argv or ()), "")
+        if name and not name.startswith(("-", "_")) and importlib.util.find_spec(f"rtmu.subcommands.{name}"):
+            module = importlib.import_module(f"rtmu.subcommands.{name}")
+            listed = getattr(module, "EXITS", exit_codes.NETWORK)
+            assert code in listed, (
+                f"rtmu {name} exited {code}, which its --help does not list: {sorted(listed)}"
+            )
+        return code
+
+    rtmu.cli.main = main
+
+
+_every_exit_code_is_one_its_help_lists()
+
+
 @pytest.fixture(scope="session")
-def shared_dir() -> Path:
-    """``../shared`` (captures, ARIA maps, docs); CI checks it out beside the repository."""
-    if not SHARED_DIR.is_dir():
-        pytest.fail(f"{SHARED_DIR} is missing: clone or link the shared/ folder beside the repository")
-    return SHARED_DIR
+def built_dists(tmp_path_factory: pytest.TempPathFactory) -> tuple[Path, Path]:
+    """The sdist and wheel ``python -m build`` makes of this checkout, built once per run."""
+    return build_dists(tmp_path_factory.mktemp("dists"))

@@ -101,6 +101,9 @@ class _Pipe:
             t.start()
 
     def put(self, data: bytes, *, raw: bool = False) -> None:
+        tap = self.proxy.tap
+        if tap is not None and not raw:  # before it is queued: a fault the tap sets applies to what follows
+            tap(self.direction, data)
         clean = not raw
         if not raw and self.direction in self.proxy.garbled:
             data = self.proxy.noise(len(data))
@@ -182,6 +185,9 @@ class _Link:
             try:
                 if rst:
                     sock.setsockopt(socket.SOL_SOCKET, socket.SO_LINGER, struct.pack("ii", 1, 0))
+                    # Wake the reader thread blocked in recv() (shutting reads sends nothing): until that
+                    # call returns it holds the socket, and the close below would not reset anything.
+                    sock.shutdown(socket.SHUT_RD)
                 else:
                     sock.shutdown(socket.SHUT_RDWR)
             except OSError:
@@ -221,6 +227,10 @@ class FaultProxy:
         """``time.monotonic()`` when the last fault took effect (None: none yet)."""
         self.connections = 0
         """Connections accepted so far (a reconnect shows up here)."""
+        self.server_ports: list[int] = []
+        """Our local port of each connection to the target: the client's address as the server sees it."""
+        self.tap: Callable[[Direction, bytes], None] | None = None
+        """``tap(direction, data)`` for every chunk read, before it is forwarded (its reader's thread)."""
         self._links: list[_Link] = []
         self._lock = threading.Lock()
         self._listener = socket.socket(socket.AF_INET, socket.SOCK_STREAM)
@@ -270,6 +280,7 @@ class FaultProxy:
                 self._links = [link for link in self._links if not all(p.done for p in link.pipes.values())]
                 # Counted before the link starts forwarding: a client whose echo came back must see it.
                 self.connections += 1
+                self.server_ports.append(int(server.getsockname()[1]))
                 self._links.append(_Link(self, client, server))
 
     def _applied(self) -> float:

@@ -6,8 +6,8 @@ import math
 
 import pytest
 
-from rtmu.alarms import Alarm, AlarmMonitor, Severity
-from rtmu.state import LinkHealth, LinkLevel, RobotState
+from rtmu.control.alarms import Alarm, AlarmMonitor, Severity
+from rtmu.values.state import LinkHealth, LinkLevel, RobotState
 
 OK = LinkHealth(LinkLevel.OK, rtt_ms=5.0)
 VOLTS = RobotState(battery_v=13.0, battery_low=11.5, battery_shutdown=11.0)
@@ -107,7 +107,7 @@ def test_hostile_readings_are_no_readings(bad: float) -> None:
 
 
 def test_the_mute_is_remembered_in_settings_and_checked() -> None:
-    from rtmu.settings import Settings, SettingsError, format_settings, parse_settings
+    from rtmu.settings.store import Settings, SettingsError, format_settings, parse_settings
 
     assert parse_settings(format_settings(Settings())).alarms_muted is False
     text = format_settings(Settings(alarms_muted=True))

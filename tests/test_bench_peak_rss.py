@@ -13,8 +13,10 @@ from pathlib import Path
 
 import pytest
 
+from testdata import CAPTURES
+
 ROOT = Path(__file__).resolve().parents[1]
-STRINGS = ROOT.parent / "shared" / "captures" / "strings.pcap"
+STRINGS = CAPTURES / "strings.pcap"
 BIG_PARENT = """
 import sys
 from bench.bench_decode import _peak_mb

@@ -9,10 +9,10 @@ from hypothesis import strategies as st
 
 from capture_builders import Conversation, catalogue, pcapng_file, server_greeting, update_numbers
 from rtmu.capture import CaptureError, open_capture
+from rtmu.capture.session_decoder import CaptureDecoder
 from rtmu.protocol.packet import encode_packet
-from rtmu.session_decoder import CaptureDecoder
+from testdata import CAPTURES
 
-CAPTURES = Path(__file__).resolve().parents[1].parent / "shared" / "captures"
 PCAP = (CAPTURES / "strings.pcap").read_bytes()
 
 

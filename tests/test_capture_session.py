@@ -20,9 +20,9 @@ from capture_builders import (
     update_numbers,
 )
 from rtmu.capture import open_capture
+from rtmu.capture.session_decoder import CaptureDecoder, DecodedPacket, DropReport
 from rtmu.protocol.fields import FieldWriter
 from rtmu.protocol.packet import encode_packet
-from rtmu.session_decoder import CaptureDecoder, DecodedPacket, DropReport
 
 NAMES_A = ["updateNumbers", "ratioDrive", "getSensorCurrent", "getMap"]
 NAMES_B = ["ratioDrive", "getMap", "updateNumbers", "getSensorCurrent"]  # numbered differently

@@ -6,9 +6,10 @@ import os
 import signal
 import subprocess
 import sys
-from pathlib import Path
 
-MAP = Path(__file__).resolve().parents[1] / "data" / "maps" / "office.map"
+from rtmu.package_data import project_map
+
+MAP = project_map("office.map")
 
 
 def test_a_closed_stdout_pipe_is_exit_141_without_a_traceback() -> None:

@@ -17,9 +17,10 @@ from capture_builders import (
     server_greeting,
     update_numbers,
 )
+from rtmu.base.exit_codes import EXIT_BAD_FILE, EXIT_SIGPIPE, EXIT_USAGE
 from rtmu.protocol.packet import encode_packet
+from testdata import CAPTURES
 
-CAPTURES = Path(__file__).resolve().parents[1].parent / "shared" / "captures"
 PACKET_KEYS = {"conn", "dir", "command", "name", "length", "checksum_ok", "fields"}
 
 
@@ -229,16 +230,16 @@ def test_hex_dump_of_damaged_bytes(tmp_path):
 @pytest.mark.parametrize(
     ("make", "code", "words"),
     [
-        (lambda p: p / "missing.pcap", 1, "cannot read"),
-        (lambda p: p, 1, "directory"),
-        (lambda p: _write(p / "notes.txt", b"just some notes, not hex\n"), 4, "not a hex dump"),
+        (lambda p: p / "missing.pcap", EXIT_USAGE, "cannot read"),
+        (lambda p: p, EXIT_USAGE, "directory"),
+        (lambda p: _write(p / "notes.txt", b"just some notes, not hex\n"), EXIT_BAD_FILE, "not a hex dump"),
         (
             lambda p: _write(p / "noise.bin", bytes(range(0x10, 0x0F, -1)) * 3 + b"\x00\x01"),
-            4,
+            EXIT_BAD_FILE,
             "not a recognised",
         ),
-        (lambda p: _write(p / "short.pcap", b"\xd4\xc3\xb2\xa1\x02\x00"), 4, "cut short"),
-        (lambda p: _write(p / "empty.pcap", b""), 4, "empty"),
+        (lambda p: _write(p / "short.pcap", b"\xd4\xc3\xb2\xa1\x02\x00"), EXIT_BAD_FILE, "cut short"),
+        (lambda p: _write(p / "empty.pcap", b""), EXIT_BAD_FILE, "empty"),
     ],
     ids=["missing", "directory", "text", "binary-noise", "short-pcap", "empty"],
 )
@@ -265,5 +266,21 @@ def test_closed_pipe_ends_quietly():
     proc.stdout.readline()
     proc.stdout.close()
     err = proc.stderr.read()
-    assert proc.wait(timeout=60) == 0
+    assert proc.wait(timeout=60) == EXIT_SIGPIPE  # the reader went away: 141, as every command
     assert b"Traceback" not in err
+
+
+def test_a_server_text_is_escaped_once_so_a_backslash_shows_as_one_escape(tmp_path):
+    r"""A password key ``a\b`` + CR is shown as ``'a\\b\r'``: one escape each, not ``a\\\\b``."""
+    from rtmu.protocol.commands import ServerCommand
+    from rtmu.protocol.payloads.control import ServerIntroduction
+
+    intro = ServerIntroduction("alpha", 0, 1, 2, "a\\b\r", "").encode()
+    path = tmp_path / "server.bin"
+    path.write_bytes(encode_packet(ServerCommand.INTRODUCTION, intro))
+    out = rtmu("--direction", "s2c", path).stdout
+    line = next(line for line in out.splitlines() if "password_key" in line)
+    assert r"password_key='a\\b\r'" in line, line
+    assert "\\\\\\" not in line and "\r" not in line  # never three backslashes in a row, never a raw CR
+    record = json_lines(rtmu("--json", "--direction", "s2c", path).stdout)[0]
+    assert record["fields"]["password_key"] == "a\\b\r"  # JSON carries the exact string

@@ -12,7 +12,7 @@ import math
 import cairo
 import numpy as np
 
-from rtmu.model import ConnectionState, Phase, RobotModel, RobotState
+from rtmu.model.observables import ConnectionState, Phase, RobotModel, RobotState
 from rtmu.ui.fleet_draw import FleetMark, fleet_colour, screen_polyline
 from rtmu.ui.frame import Scene, draw_frame
 from rtmu.ui.overlays import STALE_RGB, LabelCache
@@ -76,7 +76,7 @@ def test_a_trail_is_stroked_without_points_on_the_same_pixels() -> None:
 
 def test_the_selected_model_mirrors_every_part_of_a_robot_model() -> None:
     """A part added to RobotModel (drawings, …) must reach the widgets of a fleet window too."""
-    from rtmu.model import Observable, RobotModel
+    from rtmu.model.observables import Observable, RobotModel
     from rtmu.ui.selected_model import PARTS, SelectedModel
 
     source = RobotModel()

@@ -9,11 +9,11 @@ import cairo
 import numpy as np
 
 from rtmu.sim.camera import PanTiltZoom
-from rtmu.state import PtzState
 from rtmu.ui import overlays
 from rtmu.ui.fov_draw import TELE_FOV_DEG, WIDE_FOV_DEG, Wedge, camera_aim, wedge_points, zoom_fov
 from rtmu.ui.frame import Scene, draw_frame
 from rtmu.ui.viewport import Viewport
+from rtmu.values.state import PtzState
 
 VP = Viewport(400, 300, 1.0, 0.0, 0.0)
 

@@ -1,4 +1,4 @@
-"""Golden tests on real ARIA 2.9.1 sessions (``../shared/captures``): what ``rtmu decode`` reads from them.
+"""Golden tests on real ARIA 2.9.1 sessions (``tests/data/captures``): what ``rtmu decode`` reads from them.
 
 Facts are checked two ways where it matters: with an independent parse of the
 raw payload written here from the protocol document, and with the typed
@@ -16,19 +16,16 @@ import math
 import struct
 from collections import Counter
 from dataclasses import dataclass
-from pathlib import Path
 
 import pytest
 
 from rtmu.capture import CaptureSource, open_capture
+from rtmu.capture.session_decoder import CaptureDecoder, DecodedPacket, DropReport, side_of
 from rtmu.protocol.fields import FieldReader
 from rtmu.protocol.payloads import control
 from rtmu.protocol.payloads.base import Side, payload_type_for
-from rtmu.session_decoder import CaptureDecoder, DecodedPacket, DropReport, side_of
+from testdata import ARIA_MAPS, CAPTURES
 
-SHARED = Path(__file__).resolve().parents[1].parent / "shared"
-CAPTURES = SHARED / "captures"
-MAPS = SHARED / "aria-maps"
 CAPTURE_NAMES = sorted(p.name for p in CAPTURES.glob("*.pcap"))
 
 
@@ -63,7 +60,7 @@ def decoded(name: str) -> Decoded:
 
 
 def test_the_captures_are_there():
-    assert CAPTURES.is_dir(), f"{CAPTURES} missing: shared/ must sit beside the repository"
+    assert CAPTURES.is_dir(), f"{CAPTURES} missing: the captured ARIA sessions are part of the repository"
     assert len(CAPTURE_NAMES) >= 8
 
 
@@ -187,7 +184,7 @@ def test_drive_capture_statuses_match_the_decoded_poses_file():
 def _map_file(name: str) -> dict[str, list[str]]:
     sections: dict[str, list[str]] = {"header": [], "LINES": [], "DATA": []}
     current = "header"
-    for line in (MAPS / name).read_text(encoding="latin-1").splitlines():
+    for line in (ARIA_MAPS / name).read_text(encoding="latin-1").splitlines():
         if line in ("LINES", "DATA"):
             current = line
             continue
@@ -252,7 +249,7 @@ def test_columbia_binary_map_delivers_63311_points_in_64_blocks():
     (name,) = d.data("getMapName", conn=1)
     assert name.fields["file_name"].endswith("columbia.map")
     (ident,) = d.data("getMapId", conn=1)
-    assert ident.fields["size"] == (MAPS / "columbia.map").stat().st_size
+    assert ident.fields["size"] == (ARIA_MAPS / "columbia.map").stat().st_size
 
 
 def test_columbia_text_map_delivers_every_line():

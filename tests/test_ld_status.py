@@ -2,7 +2,7 @@
 
 from __future__ import annotations
 
-from rtmu.model import RobotState
+from rtmu.model.observables import RobotState
 from rtmu.ui.ld_status import details_lines, goal_suffix
 
 

@@ -5,7 +5,7 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
-from rtmu.maps import map_bytes, parse_map
+from rtmu.mapfile import map_bytes, parse_map
 from rtmu.sim.mapgen import box_segments, generate_map, points_along
 from test_maps_project import distance_to_points, distance_to_segments
 

@@ -1,4 +1,4 @@
-"""The bundled ARIA maps (../shared/aria-maps): counts and bounds equal their headers; exact round trips."""
+"""ARIA's example maps (tests/data/aria-maps): counts and bounds equal their headers; exact round trips."""
 
 from __future__ import annotations
 
@@ -7,7 +7,7 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-from rtmu.maps import (
+from rtmu.mapfile import (
     MapData,
     from_stream,
     map_bytes,
@@ -18,16 +18,17 @@ from rtmu.maps import (
     read_map,
     write_map,
 )
+from testdata import ARIA_MAPS
 
-ARIA_MAPS = ["ActivMediaLab.map", "columbia.map", "office.map", "triangle.map"]
+MAP_NAMES = ["ActivMediaLab.map", "columbia.map", "office.map", "triangle.map"]
 
 
 @pytest.fixture(scope="module")
-def aria_maps(shared_dir: Path) -> dict[str, MapData]:
-    return {name: read_map(shared_dir / "aria-maps" / name) for name in ARIA_MAPS}
+def aria_maps() -> dict[str, MapData]:
+    return {name: read_map(ARIA_MAPS / name) for name in MAP_NAMES}
 
 
-@pytest.mark.parametrize("name", ARIA_MAPS)
+@pytest.mark.parametrize("name", MAP_NAMES)
 def test_counts_and_bounds_equal_the_header(aria_maps: dict[str, MapData], name: str) -> None:
     data = aria_maps[name]
     assert data.category == "2D-Map"
@@ -43,7 +44,7 @@ def test_counts_and_bounds_equal_the_header(aria_maps: dict[str, MapData], name:
 
 
 def test_triangle_claim_and_truth(aria_maps: dict[str, MapData]) -> None:
-    # The protocol notes (pitfall 29) say this file claims 9 lines but holds 10. The copy in shared/ (and
+    # The protocol notes (pitfall 29) say this file claims 9 lines but holds 10. The copy in tests/data (and
     # ARIA 2.9's maps/triangle.map) holds exactly the 9 segments it claims; we expose both numbers.
     data = aria_maps["triangle.map"]
     assert data.claimed.num_lines == 9
@@ -107,7 +108,7 @@ def test_home_of_the_small_maps(aria_maps: dict[str, MapData]) -> None:
     assert all(not aria_maps[n].goals() for n in ("ActivMediaLab.map", "office.map", "triangle.map"))
 
 
-@pytest.mark.parametrize("name", ARIA_MAPS)
+@pytest.mark.parametrize("name", MAP_NAMES)
 def test_round_trip_through_a_file(aria_maps: dict[str, MapData], name: str, tmp_path: Path) -> None:
     original = aria_maps[name]
     write_map(original, tmp_path / name)
@@ -120,10 +121,10 @@ def test_round_trip_through_a_file(aria_maps: dict[str, MapData], name: str, tmp
     assert map_bytes(again) == map_bytes(original)
 
 
-@pytest.mark.parametrize("name", ARIA_MAPS)
-def test_rewrite_keeps_every_line(aria_maps: dict[str, MapData], name: str, shared_dir: Path) -> None:
+@pytest.mark.parametrize("name", MAP_NAMES)
+def test_rewrite_keeps_every_line(aria_maps: dict[str, MapData], name: str) -> None:
     """ARIA's own rewrite: same lines, headings with 6 decimals, LinesAreSorted added, unknown lines moved."""
-    source = (shared_dir / "aria-maps" / name).read_text("latin-1").splitlines()
+    source = (ARIA_MAPS / name).read_text("latin-1").splitlines()
     written = map_lines(aria_maps[name])
     expected = {
         line.replace(' 0 "" ICON', ' 0.000000 "" ICON').replace(' 54 "" ICON', ' 54.000000 "" ICON')
@@ -133,7 +134,7 @@ def test_rewrite_keeps_every_line(aria_maps: dict[str, MapData], name: str, shar
     assert expected - set(written) == set()
 
 
-@pytest.mark.parametrize("name", ARIA_MAPS)
+@pytest.mark.parametrize("name", MAP_NAMES)
 def test_getmap_lines_and_getmapbinary_give_the_same_map(aria_maps: dict[str, MapData], name: str) -> None:
     original = aria_maps[name]
     assert parse_map_lines(map_lines(original)) == original

@@ -13,12 +13,11 @@ from pathlib import Path
 
 import pytest
 
+from rtmu.base.exit_codes import EXIT_OK
 from rtmu.cli import main
-from rtmu.exit_codes import EXIT_OK
-from rtmu.maps import read_map, write_map
+from rtmu.mapfile import read_map, write_map
 from rtmu.sim import SimConfig, SimThread
-
-SHARED_MAPS = Path("/work/shared/aria-maps")
+from testdata import ARIA_MAPS
 
 UNKNOWN_LINES = (
     "MapScaleFactor: 1.000000",
@@ -125,7 +124,6 @@ def test_an_ex4_map_downloads_from_the_simulator(
         _check(replace(data, category="2D-Map-Ex4"))
 
 
-@pytest.mark.skipif(not SHARED_MAPS.is_dir(), reason="real ARIA maps not on this machine")
 def test_real_aria_maps_still_read() -> None:
-    for path in sorted(SHARED_MAPS.glob("*.map")):
+    for path in sorted(ARIA_MAPS.glob("*.map")):
         assert read_map(path).category.startswith("2D-Map"), path

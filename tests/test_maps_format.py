@@ -7,7 +7,7 @@ import pytest
 from hypothesis import given
 from hypothesis import strategies as st
 
-from rtmu.maps import (
+from rtmu.mapfile import (
     InfoLine,
     MapData,
     MapFormatError,

@@ -9,7 +9,7 @@ from pathlib import Path
 
 import pytest
 
-from rtmu.maps import MapFormatError, from_stream, parse_map, parse_map_lines, read_map
+from rtmu.mapfile import MapFormatError, from_stream, parse_map, parse_map_lines, read_map
 
 MB = 1 << 20
 

@@ -1,4 +1,4 @@
-"""``rtmu mapinfo``: the summary, the JSON form, and exit 2 with one clear line for a bad or missing file."""
+"""``rtmu mapinfo``: the summary, the JSON form, one clear line for a missing (exit 2) or bad (16) file."""
 
 from __future__ import annotations
 
@@ -9,13 +9,16 @@ from pathlib import Path
 
 import pytest
 
+from rtmu.base.exit_codes import EXIT_BAD_FILE, EXIT_USAGE
 from rtmu.cli import main
+from rtmu.package_data import MAPS_DIR
+from testdata import ARIA_MAPS
 
-MAPS_DIR = Path(__file__).resolve().parents[1] / "data" / "maps"
+MAPS_DIR = MAPS_DIR
 
 
-def test_text_summary(shared_dir: Path, capsys: pytest.CaptureFixture[str]) -> None:
-    assert main(["mapinfo", str(shared_dir / "aria-maps" / "columbia.map")]) == 0
+def test_text_summary(capsys: pytest.CaptureFixture[str]) -> None:
+    assert main(["mapinfo", str(ARIA_MAPS / "columbia.map")]) == 0
     out = capsys.readouterr().out
     assert "category:" in out and "2D-Map" in out
     assert "63311 (header: 63311)" in out
@@ -53,21 +56,21 @@ def test_json(capsys: pytest.CaptureFixture[str]) -> None:
 
 
 @pytest.mark.parametrize(
-    ("content", "message"),
+    ("content", "message", "code"),
     [
-        (None, "cannot read"),
-        (b"hello\nDATA\n", ":1: not an ARIA map"),
-        (b"2D-Map\nCairn: Goal 1 2\nDATA\n", ":2: Cairn: needs at least 7 fields"),
-        (b"2D-Map\nMinPos: 0 0\n", ":2: ends before any DATA or LINES section"),
+        (None, "cannot read", EXIT_USAGE),
+        (b"hello\nDATA\n", ":1: not an ARIA map", EXIT_BAD_FILE),
+        (b"2D-Map\nCairn: Goal 1 2\nDATA\n", ":2: Cairn: needs at least 7 fields", EXIT_BAD_FILE),
+        (b"2D-Map\nMinPos: 0 0\n", ":2: ends before any DATA or LINES section", EXIT_BAD_FILE),
     ],
 )
-def test_bad_file_exits_2_with_one_line(
-    tmp_path: Path, capsys: pytest.CaptureFixture[str], content: bytes | None, message: str
+def test_a_missing_or_bad_file_exits_with_one_line(
+    tmp_path: Path, capsys: pytest.CaptureFixture[str], content: bytes | None, message: str, code: int
 ) -> None:
     path = tmp_path / "bad.map"
     if content is not None:
         path.write_bytes(content)
-    assert main(["mapinfo", str(path), "--json"]) == 2
+    assert main(["mapinfo", str(path), "--json"]) == code
     captured = capsys.readouterr()
     assert captured.out == ""
     assert captured.err.count("\n") == 1

@@ -1,16 +1,15 @@
-"""Our own maps (data/maps): they parse, round-trip, match their generator, and a robot can start at home."""
+"""Our own maps (rtmu/data/maps): they parse, round-trip, match their generator, a robot can start at home."""
 
 from __future__ import annotations
-
-from pathlib import Path
 
 import numpy as np
 import pytest
 
-from rtmu.maps import MapData, MapObject, map_bytes, parse_map, read_map
+from rtmu.mapfile import MapData, MapObject, map_bytes, parse_map, read_map
+from rtmu.package_data import MAPS_DIR
 from rtmu.sim.project_maps import PROJECT_MAPS
 
-MAPS_DIR = Path(__file__).resolve().parents[1] / "data" / "maps"
+MAPS_DIR = MAPS_DIR
 HOME_CLEARANCE_MM = 500
 GOAL_CLEARANCE_MM = 400
 

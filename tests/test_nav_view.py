@@ -10,7 +10,7 @@ from __future__ import annotations
 import cairo
 import numpy as np
 
-from rtmu.model import NavOutcome, NavState
+from rtmu.model.observables import NavOutcome, NavState
 from rtmu.ui import overlays
 from rtmu.ui.frame import Scene, draw_frame
 from rtmu.ui.nav_draw import PATH_RGB, Marker, MarkerKind

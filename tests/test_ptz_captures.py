@@ -1,4 +1,4 @@
-"""The camera head and the server strings against real ARIA sessions (``../shared/captures``).
+"""The camera head and the server strings against real ARIA sessions (``tests/data/captures``).
 
 serverDemo's data list (clientCommandLister) names a VC-C4 head ``Cam1``: ``client.ptz`` finds it
 movable from the names ARIA's camera handler registers, and the simulator registers the same
@@ -8,13 +8,12 @@ details table would show it.
 
 from __future__ import annotations
 
-from typing import Any
-
 from rtmu.client.connection import Packet
+from rtmu.client.detached import DetachedContext
 from rtmu.client.ptz import pick_camera
 from rtmu.client.server_strings import StringsFeed
 from rtmu.protocol.payloads.camera import Camera, CameraCommand, CameraInfo
-from rtmu.protocol.payloads.strings import Strings, StringsInfo
+from rtmu.protocol.payloads.strings import StringsInfo
 from rtmu.sim.handlers import CAMERA_COMMANDS
 from test_golden_captures import decoded
 
@@ -79,17 +78,13 @@ def test_captured_strings_go_through_the_feed_as_the_table_shows_them():
     d = decoded("strings.pcap")
     (info_packet,) = d.data("getStringsInfo")
     values = d.data("getStrings")
-    kept: dict[str, Any] = {}
-
-    def decode(name: str, payload: bytes) -> Any:
-        return StringsInfo.decode(payload) if name == "getStringsInfo" else Strings.decode(payload)
-
-    feed = StringsFeed(kept.update, decode, lambda coro, _name: coro.close(), 5.0)
+    ctx = DetachedContext()
+    feed = StringsFeed(ctx)
     feed._set_info(StringsInfo.decode(info_packet.payload))
     feed.watch(True)
     for packet in values:
         feed._on_values(Packet("getStrings", packet.payload, 0.0))
-        ((label, value),) = kept["server_strings"]
+        ((label, value),) = ctx.robot.server_strings
         assert label == "Motor Packet Count" and value.isdigit()
-        assert kept["server_strings_more"] == 0
-    assert "wifi_quality" not in kept  # serverDemo publishes no wireless item
+        assert ctx.robot.server_strings_more == 0
+    assert ctx.robot.wifi_quality is None  # serverDemo publishes no wireless item

@@ -33,6 +33,10 @@ OTHER_PACKAGES = [
     "x11-utils",
     "xxd",
     "bsdextrautils",
+    "appstream",
+    "desktop-file-utils",
+    "dbus",
+    "git",
 ]
 TOOLS = [
     "awk",
@@ -220,7 +224,7 @@ def test_a_ready_machine_asks_apt_nothing(tmp_path: Path) -> None:
     )
     result = machine.run()
     assert result.returncode == 0, result.stderr
-    assert "system packages present (16 checked)" in result.stdout
+    assert f"system packages present ({3 + len(OTHER_PACKAGES)} checked)" in result.stdout
     assert machine.apt_calls() == []
 
 
@@ -290,3 +294,19 @@ def test_rtmu_dev_help_runs_without_the_set_up() -> None:
         ["bash", str(ROOT / "rtmu-dev"), "nonsense"], capture_output=True, text=True, timeout=30
     )
     assert bad.returncode == 2
+
+
+def test_set_up_installs_nothing_into_the_users_desktop(tmp_path: Path) -> None:
+    """The desktop entry is the operator's choice (``rtmu --install-desktop``), never a set-up side effect."""
+    home = tmp_path / "home"
+    home.mkdir()
+    command = (
+        "source scripts/setup.sh; ensure_system_packages() { :; }; ensure_venv() { :; }; "
+        "ensure_project() { :; }; main"
+    )
+    env = {"PATH": os.environ["PATH"], "HOME": str(home), "XDG_DATA_HOME": str(home / "data")}
+    result = subprocess.run(
+        ["bash", "-c", command], cwd=ROOT, env=env, capture_output=True, text=True, timeout=30
+    )
+    assert result.returncode == 0, result.stderr
+    assert list(home.iterdir()) == [], "scripts/setup.sh wrote into the user's home"

@@ -52,3 +52,31 @@ def hostile_drawing_server() -> TestServer:
         }
     )
     return server
+
+
+def drawings_server(
+    drawings: tuple[Drawing, ...], points: tuple[tuple[int, int], ...] = ((1, 2),)
+) -> TestServer:
+    """A server listing ``drawings`` in that order, each answering with ``points``."""
+    specs = [*SPECS, ("getDrawingList", "drawings", "none", "list", "SensorInfo", "RETURN_UNTIL_EMPTY")]
+    specs += [_row(d.name) for d in drawings]
+    server = TestServer(specs)
+    listing = [DrawingListPacket(d).encode() for d in drawings] + [DrawingListPacket(None).encode()]
+    sample = DrawingPoints(points).encode()
+    server.handlers["getDrawingList"] = lambda s, a: listing
+    for d in drawings:
+        server.handlers[d.name] = lambda s, a: [sample]
+    return server
+
+
+FOREVER = Drawing("forever", "polyDots", 0x0000FF, 100, 60, 0xFFFFFFFF, 0, "DefaultOn")
+"""Asks to be refreshed every 2³²−1 ms: more than a request's signed 32-bit period can say."""
+AFTER = Drawing("after", "polyDots", 0x00FF00, 100, 61, 200, 0, "DefaultOn")
+"""Comes after it in layer order: it must still be asked for."""
+
+
+def many(count: int) -> tuple[Drawing, ...]:
+    return tuple(
+        Drawing(f"d{n:03d}", "polyDots", 0x00FF00, 100, 60 + n % 20, 1000, 0, "DefaultOn")
+        for n in range(count)
+    )

@@ -9,10 +9,12 @@ from __future__ import annotations
 
 from collections.abc import Callable, Mapping
 
+from rtmu.base.notices import Kind, Level, Notice
 from rtmu.client.lease import DriveLease
-from rtmu.commands import CommandState
-from rtmu.notices import Kind, Level, Notice
-from rtmu.settings import Profile
+from rtmu.control.commands import CommandState
+from rtmu.settings.store import Profile
+from rtmu.values import intents
+from rtmu.values.intents import Intent
 
 
 class FakeView:
@@ -51,35 +53,9 @@ class RecordingLink:
     def disconnect(self) -> None:
         self.calls.append(("disconnect",))
 
-    def stop(self) -> None:
-        self.calls.append(("stop",))
-
-    def command(self, name: str, *args: object) -> None:
-        self.calls.append(("command", name, *args))
-
-    def request_image(self) -> None:
-        self.calls.append(("request_image",))
-
-    def set_safe_drive(self, on: bool) -> None:
-        self.calls.append(("set_safe_drive", on))
-
-    def goto_goal(self, name: str) -> None:
-        self.calls.append(("goto_goal", name))
-
-    def goto_pose(self, x: float, y: float, th: float | None = None) -> None:
-        self.calls.append(("goto_pose", x, y, th))
-
-    def home(self) -> None:
-        self.calls.append(("home",))
-
-    def dock(self) -> None:
-        self.calls.append(("dock",))
-
-    def tour_goals(self) -> None:
-        self.calls.append(("tour_goals",))
-
-    def localize(self, x: float, y: float, th: float) -> None:
-        self.calls.append(("localize", x, y, th))
+    def send(self, intent: Intent) -> None:
+        """Every intent the controller lets through, recorded in the shape the rules' tests read."""
+        self.calls.append(_call(intent))
 
     def run_blocking(self, fn: Callable[[], object], done: Callable[[object], None]) -> None:
         """Like the runner: ``fn`` must not run on the UI (test) thread; :meth:`finish_blocking` runs it."""
@@ -107,3 +83,30 @@ class RecordingLink:
 
     def names(self) -> list[object]:
         return [c[0] for c in self.calls]
+
+
+def _call(intent: Intent) -> tuple[object, ...]:
+    match intent:
+        case intents.Stop():
+            return ("stop",)
+        case intents.TurnBy(degrees=d):
+            return ("command", "turnByAngle", d)
+        case intents.MoveDistance(mm=mm):
+            return ("command", "moveDist", mm)
+        case intents.RequestPicture():
+            return ("request_image",)
+        case intents.SetSafeDrive(on=on):
+            return ("set_safe_drive", on)
+        case intents.GotoGoal(name=name):
+            return ("goto_goal", name)
+        case intents.GotoPose(x=x, y=y, th=th):
+            return ("goto_pose", x, y, th)
+        case intents.GoHome():
+            return ("home",)
+        case intents.Dock():
+            return ("dock",)
+        case intents.TourGoals():
+            return ("tour_goals",)
+        case intents.Localize(x=x, y=y, th=th):
+            return ("localize", x, y, th)
+    return ("send", intent)

@@ -13,10 +13,10 @@ from collections.abc import Iterator
 from contextlib import contextmanager
 from pathlib import Path
 
+from rtmu.package_data import project_map
 from rtmu.sim import SimConfig, SimThread
 
-REPO = Path(__file__).resolve().parents[2]
-OFFICE = REPO / "data" / "maps" / "office.map"
+OFFICE = project_map("office.map")
 STEP = 0.05
 PAUSE = 0.01
 

@@ -1,4 +1,4 @@
-"""Omron LD robots (ARAM) on the wire, against ``rtmu sim --profile aram`` and the default profile.
+"""Omron LD robots (ARAM) on the wire, against ``rtmu sim --kind aram`` and the default profile.
 
 The protocol string (answered as advertised, ``--protocol`` overrides, reason 4 names the wanted
 string), the battery as state of charge, and ``rtmu doctor`` step by step — all over loopback.
@@ -14,17 +14,19 @@ from pathlib import Path
 
 import pytest
 
+from rtmu.base.exit_codes import EXIT_CONNECTION, EXIT_OK
 from rtmu.cli import main
 from rtmu.client.connection import AriaClient
 from rtmu.client.diagnosis import Step, explain
 from rtmu.client.errors import LoginRejected
-from rtmu.exit_codes import EXIT_CONNECTION, EXIT_OK
+from rtmu.package_data import project_map
 from rtmu.protocol.payloads.robot import BatteryInfo
 from rtmu.sim import SimConfig, SimThread
-from rtmu.sim.profiles import ARAM_PROTOCOL, LD_CATALOGUE_SIZE
+from rtmu.sim.profiles import ARAM, ARAM_PROTOCOL
 
-REPO = Path(__file__).resolve().parents[2]
-OFFICE = REPO / "data" / "maps" / "office.map"
+OFFICE = project_map("office.map")
+ARAM_COUNT = len(ARAM.catalogue(camera=True))
+"""The aram profile lists only what 6MTX robots list (and what the simulator serves of it)."""
 
 
 @pytest.fixture(scope="module")
@@ -59,7 +61,7 @@ def test_default_answer_is_the_advertised_string(aram: SimThread) -> None:
         finally:
             await client.disconnect()
 
-    assert asyncio.run(go()) >= LD_CATALOGUE_SIZE
+    assert asyncio.run(go()) == ARAM_COUNT
 
 
 def test_wrong_protocol_names_the_wanted_string(aram: SimThread) -> None:
@@ -83,7 +85,7 @@ def test_cli_wrong_protocol_exits_3_with_the_wanted_string(
 
 def test_cli_explicit_right_protocol_logs_in(aram: SimThread, capsys: pytest.CaptureFixture[str]) -> None:
     assert main(["probe", addr(aram), "--protocol", "6MTX", "--json", "--timeout", "5"]) == EXIT_OK
-    assert json.loads(capsys.readouterr().out)["count"] >= LD_CATALOGUE_SIZE
+    assert json.loads(capsys.readouterr().out)["count"] == ARAM_COUNT
 
 
 def test_sim_protocol_option_enforces_and_advertises() -> None:
@@ -137,9 +139,11 @@ def test_doctor_good_aram_sim(aram: SimThread, capsys: pytest.CaptureFixture[str
     code, report = doctor_json(capsys, addr(aram))
     assert code == EXIT_OK and report["ok"] is True and report["failed_step"] is None
     steps = {s["step"]: s for s in report["steps"]}
-    assert list(steps) == ["resolve", "tcp", "introduction", "login", "data_list", "udp", "status"]
+    assert list(steps) == ["resolve", "tcp", "introduction", "login", "data_list", "udp", "status", "motion"]
     assert steps["introduction"]["protocol"] == "6MTX" and steps["introduction"]["sent_protocol"] == "6MTX"
-    assert steps["data_list"]["count"] >= LD_CATALOGUE_SIZE
+    assert steps["data_list"]["count"] == ARAM_COUNT
+    assert "its configuration is Omron LD's" in steps["data_list"]["summary"]
+    assert report["features"]["configuration"] is False  # getConfigValues is not ArConfig
     assert report["features"]["teleop"] is True
     assert steps["udp"]["result"] == "not_checked"  # the simulator announces UDP port 0
     assert 0 <= steps["status"]["battery_pct"] <= 100
@@ -236,6 +240,7 @@ def test_doctor_udp_handshake(answers: bool) -> None:
     rows = [
         ("updateNumbers", "status", "none", "numbers", "RobotInfo", "RETURN_SINGLE"),
         ("ratioDrive", "drive", "doubles", "none", "Movement", "RETURN_NONE"),
+        ("stop", "stop", "none", "none", "Stop", "RETURN_NONE"),  # else the motion step warns: no stop
     ]
     conns: list[ServerConnection] = []
 

@@ -31,7 +31,7 @@ async def _stubborn(release: threading.Event, started: threading.Event | None = 
 def test_step_gives_up_when_the_heart_does_not_run() -> None:
     async def go() -> None:
         session = Session(DriveLease(), lambda change: None)
-        session._ensure_heart = lambda: None  # type: ignore[method-assign]  # no heart at all
+        session.drive.ensure_heart = lambda: None  # type: ignore[method-assign]  # no heart at all
         with pytest.raises(ClientTimeout, match="heart"):
             await session.step(timeout=0.05)
 

@@ -16,18 +16,18 @@ from pathlib import Path
 
 import pytest
 
-from rtmu import maps
+from rtmu import mapfile as maps
+from rtmu.base.exit_codes import EXIT_CONNECTION, EXIT_OK, EXIT_USAGE
 from rtmu.cli import main
 from rtmu.client.central import CentralRoster
 from rtmu.client.roster import RobotAdded, RobotRemoved, RosterEvent, RosterLost, RosterRestored
-from rtmu.exit_codes import EXIT_CONNECTION, EXIT_OK, EXIT_USAGE
+from rtmu.package_data import project_map
 from rtmu.sim import SimConfig, SimServer
 from rtmu.sim.central_thread import CentralThread
 
 from .uiqueue import eventually
 
-REPO = Path(__file__).resolve().parents[2]
-ARENA = REPO / "data" / "maps" / "arena.map"
+ARENA = project_map("arena.map")
 NAMES = ["robot1", "robot2", "robot3"]
 
 
@@ -178,9 +178,16 @@ def test_map_with_robot_downloads_through_the_forwarder(fleet: CentralThread, tm
         assert (got.num_points, got.num_lines) == (expected.num_points, expected.num_lines)
 
 
-def test_fleet_refuses_robot(fleet: CentralThread, capsys: pytest.CaptureFixture[str]) -> None:
-    assert main(["fleet", addr(fleet), "--robot", "robot1"]) == EXIT_USAGE
-    assert "--robot does not apply" in capsys.readouterr().err
+def test_fleet_neither_offers_nor_takes_robot(
+    fleet: CentralThread, capsys: pytest.CaptureFixture[str]
+) -> None:
+    with pytest.raises(SystemExit) as exc:
+        main(["fleet", "--help"])
+    assert exc.value.code == 0 and "[--robot" not in capsys.readouterr().out
+    with pytest.raises(SystemExit) as exc:
+        main(["fleet", addr(fleet), "--robot", "robot1"])
+    assert exc.value.code == EXIT_USAGE
+    assert "unrecognized arguments: --robot" in capsys.readouterr().err
 
 
 # -- CentralRoster ------------------------------------------------------------------------------
@@ -331,8 +338,8 @@ def test_every_connecting_subcommand_takes_robot() -> None:
     (sub,) = [a for a in parser._actions if isinstance(a, argparse._SubParsersAction)]
     connecting = {name: p for name, p in sub.choices.items() if any(a.dest == "server" for a in p._actions)}
     assert {"status", "drive", "map", "probe", "fleet", "goto", "record"} <= set(connecting)
-    for name, p in connecting.items():
-        assert any("--robot" in a.option_strings for a in p._actions), name
+    for name, p in connecting.items():  # but fleet, which lists every robot of the central server
+        assert any("--robot" in a.option_strings for a in p._actions) == (name != "fleet"), name
 
 
 def test_a_robot_started_with_switch_to_on_the_command_line_joins_the_fleet(
@@ -402,7 +409,7 @@ def test_robot_behind_a_guarded_central_server_logs_in_to_both_with_one_password
     users = tmp_path / "users.txt"
     users.write_text("UserInfoVersion1\nuser alice secret1 all\n")
     with CentralThread(robots=1, template=SimConfig(port=0, camera=False), users_path=users) as fl:
-        # The password comes from stdin once (as from a prompt): the central server and the forwarded
+        # The password comes from stdin once (--password-stdin): the central server and the forwarded
         # robot both get it, and it is never asked for twice.
         monkeypatch.setattr("sys.stdin", io.StringIO("secret1\n"))
         argv = [
@@ -412,6 +419,7 @@ def test_robot_behind_a_guarded_central_server_logs_in_to_both_with_one_password
             "robot1",
             "--user",
             "alice",
+            "--password-stdin",
             "--once",
             "--json",
             "--timeout",

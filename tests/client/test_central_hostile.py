@@ -12,12 +12,12 @@ from collections.abc import Iterator
 
 import pytest
 
+from rtmu.base.exit_codes import EXIT_CONNECTION, EXIT_OK, EXIT_USAGE
 from rtmu.cli import main
 from rtmu.client.central import MAX_NAME, CentralRoster
-from rtmu.client.roster import RobotAdded, RosterEvent, RosterLost
-from rtmu.exit_codes import EXIT_CONNECTION, EXIT_OK
+from rtmu.client.roster import RobotAdded, RobotRemoved, RosterEvent, RosterLost
 from rtmu.protocol.fields import FieldWriter
-from rtmu.protocol.payloads.central import CentralEntry, ClientAdded, ClientList
+from rtmu.protocol.payloads.central import CentralEntry, ClientAdded, ClientList, ClientRemoved
 from rtmu.sim.central import OPERATOR_DATA
 
 from .servers import ServerThread, TestServer
@@ -178,3 +178,45 @@ def test_an_entry_naming_another_host_is_still_reached_at_the_central_servers_ho
         assert isinstance(heard[0], RobotAdded) and heard[0].endpoint.host == "127.0.0.1"
     finally:
         roster.close()
+
+
+CASES = (CentralEntry("", 7401, "ROBOT"), CentralEntry("", 7402, "robot"), CentralEntry("", 7403, "Robot"))
+
+
+def test_robot_names_differing_in_case_are_one_robot_the_last_one_listed(
+    central: tuple[TestServer, ServerThread], capsys: pytest.CaptureFixture[str]
+) -> None:
+    """ARIA's central server compares names case-blind: a namesake replaces the old connection."""
+    server, _ = central
+    listing(server, ClientList(CASES).encode())
+    heard = Heard()
+    roster = CentralRoster("127.0.0.1", server.port, timeout=5)
+    roster.start(heard)
+    try:
+        eventually(lambda: len(roster.robots) == 1 and len(heard) == 5, timeout=10)
+        assert [e.endpoint.port for e in heard if isinstance(e, RobotAdded)] == [7401, 7402, 7403]
+        assert [e.name for e in heard if isinstance(e, RobotRemoved)] == ["ROBOT", "robot"]
+        (kept,) = roster.robots.values()
+        assert (kept.name, kept.port) == ("Robot", 7403)
+        # The replaced one's own removal later must not take away the robot that replaced it.
+        server.broadcast("clientRemoved", ClientRemoved(CASES[0]).encode())
+        server.broadcast("clientAdded", ClientAdded(CentralEntry("", 7404, "other")).encode())
+        eventually(lambda: "other" in {e.name for e in roster.robots.values()}, timeout=5)
+        assert {e.name for e in roster.robots.values()} == {"Robot", "other"}
+    finally:
+        roster.close()
+    assert main(["fleet", f"127.0.0.1:{server.port}", "--no-status", "--json", "--timeout", "5"]) == EXIT_OK
+    rows = json.loads(capsys.readouterr().out)["robots"]
+    assert [(r["name"], r["port"]) for r in rows] == [("Robot", 7403)]
+
+
+def test_robot_that_fits_several_listed_names_is_refused_with_the_candidates(
+    central: tuple[TestServer, ServerThread], capsys: pytest.CaptureFixture[str]
+) -> None:
+    server, _ = central
+    listing(server, ClientList(CASES).encode())
+    code = main(["status", f"127.0.0.1:{server.port}", "--robot", "ROBOT", "--once", "--timeout", "5"])
+    assert code == EXIT_USAGE
+    err = capsys.readouterr().err
+    assert "'ROBOT' is ambiguous" in err and err.count("\n") == 1
+    assert "'ROBOT' (port 7401)" in err and "'robot' (port 7402)" in err and "'Robot' (port 7403)" in err

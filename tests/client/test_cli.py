@@ -12,9 +12,18 @@ from pathlib import Path
 
 import pytest
 
-from rtmu import maps
+from rtmu import mapfile as maps
+from rtmu.base.exit_codes import (
+    EXIT_CONNECTION,
+    EXIT_OK,
+    EXIT_TIMEOUT,
+    EXIT_UNSUPPORTED,
+    EXIT_USAGE,
+    EXIT_WHY_DEAD_ZONE,
+    EXIT_WHY_NO_DRIVE,
+)
 from rtmu.cli import main
-from rtmu.exit_codes import EXIT_CONNECTION, EXIT_OK, EXIT_TIMEOUT, EXIT_UNSUPPORTED, EXIT_USAGE
+from rtmu.package_data import project_map
 from rtmu.sim import SimConfig, SimThread
 from rtmu.subcommands._common import host_port
 
@@ -22,8 +31,7 @@ from .servers import SPECS, ServerThread, TestServer
 from .test_connection import free_port
 from .uiqueue import eventually
 
-REPO = Path(__file__).resolve().parents[2]
-ARENA = REPO / "data" / "maps" / "arena.map"
+ARENA = project_map("arena.map")
 STATUS_KEYS = {"x", "y", "th", "vel", "rot_vel", "battery_v", "status", "mode"}
 
 
@@ -93,9 +101,12 @@ def test_status_once_and_streamed_json(
 
 def test_password_from_a_pipe(sim: SimThread, monkeypatch: pytest.MonkeyPatch, capsys) -> None:  # type: ignore[no-untyped-def]
     monkeypatch.setattr("sys.stdin", io.StringIO("secret1\n"))
-    assert main(["status", addr(sim), "--user", "alice", "--once"]) == EXIT_OK
+    assert main(["status", addr(sim), "--user", "alice", "--once"]) == EXIT_USAGE  # only when asked to
+    assert "--password-stdin" in capsys.readouterr().err
+    monkeypatch.setattr("sys.stdin", io.StringIO("secret1\n"))
+    assert main(["status", addr(sim), "--user", "alice", "--password-stdin", "--once"]) == EXIT_OK
     monkeypatch.setattr("sys.stdin", io.StringIO("wrong\n"))
-    assert main(["status", addr(sim), "--user", "alice", "--once"]) == EXIT_CONNECTION
+    assert main(["status", addr(sim), "--user", "alice", "--password-stdin", "--once"]) == EXIT_CONNECTION
     err = capsys.readouterr().err
     assert err.count("\n") == 1 and err.startswith("rtmu status: login refused: wrong user name or password")
 
@@ -114,7 +125,10 @@ def test_image(sim: SimThread, pwfile: Path, tmp_path: Path) -> None:
     assert main(["image", *login(sim, pwfile), "--out", str(out)]) == EXIT_OK
     data = out.read_bytes()
     assert data[:2] == b"\xff\xd8" and data.rstrip(b"\x00")[-2:] == b"\xff\xd9"
-    assert main(["image", *login(sim, pwfile), "--out", str(out), "--camera", "Nope"]) == EXIT_UNSUPPORTED
+    again = ["image", *login(sim, pwfile), "--out", str(out), "--camera", "Nope"]
+    assert main(again) == EXIT_USAGE, "an existing picture is not replaced without --force"
+    assert main([*again, "--force"]) == EXIT_UNSUPPORTED
+    assert out.read_bytes() == data, "a failed picture leaves the old one as it was"
 
 
 def test_drive_moves_then_stops(sim: SimThread, pwfile: Path, capsys: pytest.CaptureFixture[str]) -> None:
@@ -143,7 +157,7 @@ def test_user_without_movement_rights_cannot_drive(sim: SimThread, tmp_path: Pat
         "--seconds",
         "1",
     ]
-    assert main(args) == EXIT_UNSUPPORTED
+    assert main(args) == EXIT_WHY_NO_DRIVE  # said as rtmu why says it (rtmu.client.why)
     assert "ratioDrive" in capsys.readouterr().err
 
 
@@ -232,9 +246,11 @@ def test_unsupported_exits_4(capsys: pytest.CaptureFixture[str], tmp_path: Path)
         target = f"127.0.0.1:{server.port}"
         assert main(["image", target, "--out", str(tmp_path / "x.jpg")]) == EXIT_UNSUPPORTED
         assert main(["map", target, "--out", str(tmp_path / "x.map")]) == EXIT_UNSUPPORTED
-        assert main(["drive", target, "--trans", "10", "--seconds", "1"]) == EXIT_UNSUPPORTED
-    lines = capsys.readouterr().err.splitlines()
-    assert len(lines) == 3 and all(line.startswith("rtmu ") for line in lines)
+        lines = capsys.readouterr().err.splitlines()
+        assert len(lines) == 2 and all(line.startswith("rtmu ") for line in lines)
+        # A server that offers no driving is told as rtmu why tells it, with its own exit code.
+        assert main(["drive", target, "--trans", "10", "--seconds", "1"]) == EXIT_WHY_NO_DRIVE
+    assert capsys.readouterr().err.startswith("rtmu drive: this login (no user name) may not drive")
 
 
 def test_server_killed_while_streaming_status_exits_3(capsys: pytest.CaptureFixture[str]) -> None:
@@ -335,3 +351,21 @@ def test_drive_json_after_ctrl_c_says_it_was_interrupted(sim: SimThread, pwfile:
             proc.kill()
             proc.wait()
     assert obj["interrupted"] == "SIGINT" and set(obj["after"]) == STATUS_KEYS and obj["seconds"] == 20
+
+
+def test_drive_inside_arias_dead_zone_says_so_and_does_not_exit_0(
+    sim: SimThread, pwfile: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    """Issue 22 (say so) and issue 24 (asked to move and did not: never 0) both hold: a warning first,
+    then the answer names the dead zone, with its own code."""
+    before = sim.snapshot()
+    assert main(["drive", *login(sim, pwfile), "--trans", "10", "--seconds", "0.5"]) == EXIT_WHY_DEAD_ZONE
+    err = capsys.readouterr().err
+    warning, _, answer = err.partition("the robot did not move: ")
+    assert "inside ARIA's dead zone" in warning and "the robot will not move" in warning, err
+    assert "inside ARIA's dead zone" in answer and "ask for more than 10 % translation" in answer, err
+    assert "nothing RTMU can read says why" not in err
+    after = sim.snapshot()
+    assert (after.x, after.y) == (before.x, before.y), "ARIA's dead zone: it really did not move"
+    assert main(["drive", *login(sim, pwfile), "--trans", "11", "--seconds", "0.3"]) == EXIT_OK
+    assert "dead zone" not in capsys.readouterr().err

@@ -9,16 +9,15 @@ from pathlib import Path
 
 import pytest
 
+from rtmu.base.exit_codes import EXIT_OK, EXIT_REFUSED, EXIT_UNSUPPORTED, EXIT_USAGE
 from rtmu.cli import main
-from rtmu.client.config_feed import MAX_TEXT, ServerConfig, check_value, fetch_config
+from rtmu.client.config_feed import MAX_TEXT, ConfigFeed, ServerConfig, check_value, fetch_config
 from rtmu.client.connection import AriaClient
 from rtmu.client.errors import MalformedReply
 from rtmu.client.runner import ClientRunner
-from rtmu.exit_codes import EXIT_OK, EXIT_UNSUPPORTED, EXIT_USAGE
-from rtmu.model import RobotModel
+from rtmu.model.observables import RobotModel
 from rtmu.protocol.payloads.config import ConfigParam, ConfigSectionPacket, ParamType
 from rtmu.sim import SimConfig, SimThread
-from rtmu.subcommands.config import EXIT_REFUSED
 
 from .servers import SPECS, ServerThread, TestServer
 from .uiqueue import UiQueue, eventually
@@ -155,7 +154,7 @@ def _fetch(port: int) -> ServerConfig:
 def test_ten_thousand_parameters_arrive_whole_and_bounded() -> None:
     with SimThread(SimConfig(port=0, camera=False, config_filler=10_000)) as s:
         config = _fetch(s.port)
-    assert config.param_count == 10_011 and config.cut == 0
+    assert config.param_count == 10_014 and config.cut == 0  # the filler, its control-character one + 13
     extra = [sec for sec in config.sections if sec.name.startswith("<b>Extra")]
     assert len(extra) == 10 and all(len(sec.params) == 1000 for sec in extra)  # parts joined per section
     assert config.find("<b>extra</b> & 3", "P3500<I>&AMP;") is not None  # ARIA compares names case-blind
@@ -211,7 +210,7 @@ def test_a_flood_of_config_updated_reaches_the_ui_as_a_few_posts() -> None:
         )
         thread.call(lambda: [server.broadcast("configUpdated") for _ in range(5000)])
         runner.call(lambda: runner.session.client.request_once("getSafeDrive"))  # type: ignore[union-attr]
-        eventually(lambda: runner.session.config_feed.updates == 5000)  # type: ignore[union-attr]
+        eventually(lambda: runner.session.feed(ConfigFeed).updates == 5000)  # type: ignore[union-attr]
         posted = ui.drain()
     assert 1 <= len(calls) <= 50 and posted < 5000  # not one UI callback per broadcast
 

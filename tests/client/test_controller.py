@@ -6,12 +6,29 @@ import threading
 
 import pytest
 
+from rtmu.base.notices import Kind, Level, Notice
 from rtmu.client.lease import DriveRatios, EndReason
-from rtmu.commands import Command, CommandRegistry, CommandTarget
-from rtmu.controller import Controller, ratios_for
-from rtmu.model import ConnectionState, LinkHealth, LinkLevel, OperatorState, Phase, RobotModel, SpeedSetting
-from rtmu.notices import Kind, Level, Notice
-from rtmu.settings import Profile
+from rtmu.control.commands import Command, CommandRegistry, CommandTarget
+from rtmu.control.controller import Controller, ratios_for
+from rtmu.model.observables import (
+    ConnectionState,
+    LinkHealth,
+    LinkLevel,
+    OperatorState,
+    Phase,
+    RobotModel,
+    SpeedSetting,
+)
+from rtmu.settings.store import Profile
+from rtmu.values.intents import (
+    GotoGoal,
+    Localize,
+    MoveDistance,
+    RequestPicture,
+    RunServerCommand,
+    SetSafeDrive,
+    TurnBy,
+)
 
 from .fakeclock import FakeClock
 from .fakes import FakeView, RecordingLink
@@ -164,9 +181,9 @@ def test_a_stale_link_noticed_first_by_the_drive_loop_is_still_told_once() -> No
     rig.ctl.press("forward")
     rig.link.lease.end(EndReason.LINK)  # what the drive loop does when it sees the link go stale
     rig.hold(0.1)
-    assert rig.view.texts().count("Stopped: the link is stale") == 1
+    assert rig.view.texts().count("Stopped: the link is stale. Press again once it is back.") == 1
     rig.model.health.set(LinkHealth(LinkLevel.STALE))  # the health arrives afterwards
-    assert rig.view.texts().count("Stopped: the link is stale") == 1
+    assert rig.view.texts().count("Stopped: the link is stale. Press again once it is back.") == 1
     rig.ctl.press("forward")  # still held: blocked until released
     assert not rig.lease.live
 
@@ -259,14 +276,14 @@ def test_speed_steps_and_limits_and_applies_to_a_drive_in_progress() -> None:
 
 def test_bounded_moves_need_server_support() -> None:
     rig = Rig(offers=frozenset({"ratioDrive", "stop"}))
-    rig.ctl.turn_by(90)
-    rig.ctl.move_distance(1000)
+    rig.ctl.ask(TurnBy(90))
+    rig.ctl.ask(MoveDistance(1000))
     assert rig.link.calls == []
     assert any("turnByAngle" in t for t in rig.view.texts())
     rig.connect(ALL)
     rig.ctl.press("forward")
-    rig.ctl.turn_by(-90)
-    rig.ctl.move_distance(500)
+    rig.ctl.ask(TurnBy(-90))
+    rig.ctl.ask(MoveDistance(500))
     assert rig.link.calls == [("command", "turnByAngle", -90.0), ("command", "moveDist", 500.0)]
     assert not rig.lease.live  # a bounded move replaces held driving
 
@@ -274,12 +291,12 @@ def test_bounded_moves_need_server_support() -> None:
 def test_image_and_safe_drive() -> None:
     rig = Rig()
     assert rig.ctl.image_source() == "getPictureCam1"
-    rig.ctl.request_image()
-    rig.ctl.set_safe_drive(False)
+    rig.ctl.ask(RequestPicture())
+    rig.ctl.ask(SetSafeDrive(False))
     assert rig.link.calls == [("request_image",), ("set_safe_drive", False)]
     rig.connect(frozenset({"ratioDrive"}))
-    rig.ctl.request_image()
-    assert rig.view.notices[-1] == (Level.WARNING, "This server offers no camera pictures")
+    rig.ctl.ask(RequestPicture())
+    assert rig.view.notices[-1] == (Level.WARNING, "This server does not offer camera pictures")
 
 
 def test_command_states_follow_the_server_and_only_changes_are_sent() -> None:
@@ -383,15 +400,14 @@ def test_adding_a_command_is_one_class() -> None:
         needs = ("wander",)
 
         def activate(self, target: CommandTarget) -> None:
-            assert isinstance(target, Controller)
-            target.link.command("wander")
+            target.ask(RunServerCommand("wander"))
 
     rig = Rig()
     ctl = Controller(rig.model, rig.operator, rig.link, rig.view, clock=rig.clock, registry=registry)
     assert ctl.command_states()["wander"].reason == "this server does not offer wander"
     rig.connect(ALL | {"wander"})
     assert ctl.run("wander")
-    assert rig.link.calls[-1] == ("command", "wander")
+    assert rig.link.calls[-1] == ("send", RunServerCommand("wander"))
     assert registry.keys() == {"w": "wander"}
 
 
@@ -434,9 +450,9 @@ def test_in_replay_mode_nothing_is_sent_and_every_way_in_says_replay() -> None:
     rig.ctl.press("forward")
     assert rig.ctl.run("drive_forward") is False
     rig.ctl.stop()
-    rig.ctl.turn_by(90)
-    rig.ctl.set_safe_drive(False)
-    rig.ctl.goto_goal("Lab")
-    rig.ctl.localize(0, 0, 0)
+    rig.ctl.ask(TurnBy(90))
+    rig.ctl.ask(SetSafeDrive(False))
+    rig.ctl.ask(GotoGoal("Lab"))
+    rig.ctl.ask(Localize(0, 0, 0))
     assert rig.link.calls == [] and rig.lease.generation == 0
     assert sum("Replay" in t for t in rig.view.texts()) >= 6

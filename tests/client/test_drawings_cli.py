@@ -4,19 +4,18 @@ from __future__ import annotations
 
 import json
 from collections.abc import Iterator
-from pathlib import Path
 
 import pytest
 
+from rtmu.base.exit_codes import EXIT_OK, EXIT_UNSUPPORTED
 from rtmu.cli import main
-from rtmu.exit_codes import EXIT_OK, EXIT_UNSUPPORTED
+from rtmu.package_data import project_map
 from rtmu.sim import SimConfig, SimThread
 
 from .drawing_servers import MARKUP, MAX_POINTS_SENT, hostile_drawing_server
 from .servers import SPECS, ServerThread, TestServer
 
-REPO = Path(__file__).resolve().parents[2]
-ARENA = REPO / "data" / "maps" / "arena.map"
+ARENA = project_map("arena.map")
 
 
 @pytest.fixture(scope="module")

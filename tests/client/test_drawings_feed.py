@@ -9,20 +9,20 @@ point count and a 3 998-point flood are each bounded and named, and the good dra
 from __future__ import annotations
 
 from collections.abc import Iterator
-from pathlib import Path
 
 import pytest
 
 from rtmu.client.runner import ClientRunner
-from rtmu.model import Phase, RobotModel
+from rtmu.model.observables import Phase, RobotModel
+from rtmu.package_data import project_map
 from rtmu.sim import SimConfig, SimThread
+from rtmu.values.intents import DrawingChoices, ShowDrawing
 
 from .drawing_servers import BOLD_POINTS, MARKUP, MAX_POINTS_SENT, SONAR_POINTS, hostile_drawing_server
 from .servers import ServerThread
 from .uiqueue import UiQueue, eventually
 
-REPO = Path(__file__).resolve().parents[2]
-ARENA = REPO / "data" / "maps" / "arena.map"
+ARENA = project_map("arena.map")
 LASER = "sim_lms2xx_1Current"
 
 
@@ -92,18 +92,18 @@ def test_both_drawings_are_listed_asked_for_at_their_period_and_land_in_the_mode
 
 def test_hiding_a_drawing_ends_its_request_and_showing_it_asks_again(rig: Rig, sim: SimThread) -> None:
     rig.wait(lambda: rig.layer(LASER) is not None and rig.layer(LASER).points)
-    rig.runner.set_drawing_shown(LASER, False).result(5)
+    rig.runner.send(ShowDrawing(LASER, False)).result(5)
     rig.wait(lambda: not rig.layer(LASER).shown and rig.layer(LASER).points == ())
     eventually(lambda: LASER not in requested_at(sim))
     assert "sonarCurrent" in requested_at(sim)
-    rig.runner.set_drawing_shown("sonarCurrent", False).result(5)
+    rig.runner.send(ShowDrawing("sonarCurrent", False)).result(5)
     eventually(lambda: "sonarCurrent" not in requested_at(sim))
     # A reconnect keeps the operator's choice: the session's own sonar subscription is ended again.
     rig.runner.disconnect().result(5)
     rig.runner.connect("127.0.0.1", sim.port, profile="test").result(10)
     rig.wait(lambda: rig.model.connection.value.phase is Phase.CONNECTED and rig.layer(LASER) is not None)
     eventually(lambda: not {LASER, "sonarCurrent"} & set(requested_at(sim)), timeout=5)
-    rig.runner.set_drawing_shown(LASER, True).result(5)
+    rig.runner.send(ShowDrawing(LASER, True)).result(5)
     rig.wait(lambda: rig.layer(LASER).shown and len(rig.layer(LASER).points) > 50)
     eventually(lambda: requested_at(sim).get(LASER) == 200)
 
@@ -136,7 +136,7 @@ def test_a_remembered_choice_given_before_connecting_keeps_the_drawing_hidden_an
     runner = ClientRunner(model, post=ui.post)
     runner.start()
     try:
-        runner.set_drawing_choices({LASER: False}).result(5)
+        runner.send(DrawingChoices({LASER: False})).result(5)
         runner.connect("127.0.0.1", sim.port, profile="test").result(10)
         ui.wait_for(lambda: any(d.name == LASER for d in model.drawings.value.layers), 10)
         ui.wait_for(

@@ -16,22 +16,21 @@ import subprocess
 import sys
 import time
 from collections.abc import Callable, Iterator
-from pathlib import Path
 
 import pytest
 
 from linkfaults import FAKE_HEADER, GARBAGE, TO_CLIENT, TO_SERVER, FaultProxy, WifiProfile
+from rtmu.base.exit_codes import EXIT_TIMEOUT
 from rtmu.client.link_timing import STATUS_CEILING
-from rtmu.exit_codes import EXIT_TIMEOUT
 from rtmu.guardian.halt import IDENTIFIER
+from rtmu.package_data import project_map
 from rtmu.protocol.decoder import PacketDecoder
 from rtmu.protocol.packet import encode_packet
 from rtmu.sim import SimConfig, SimThread
 
 from .uiqueue import eventually
 
-REPO = Path(__file__).resolve().parents[2]
-ARENA = REPO / "data" / "maps" / "arena.map"
+ARENA = project_map("arena.map")
 AFTER_FAULT_MAX = 10
 """ratioDrive packets the simulator may receive after the fault: those already in flight and the
 resends until the fault is seen — at most 0.45 s of stale status (a new link's limit is the ceiling,

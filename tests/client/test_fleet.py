@@ -9,19 +9,18 @@ from __future__ import annotations
 import time
 from collections.abc import Iterator
 from contextlib import ExitStack, contextmanager
-from pathlib import Path
 
 from rtmu.client.session import SessionConfig
-from rtmu.fleet import Fleet, RobotSession
-from rtmu.model import Phase
-from rtmu.settings import Profile
+from rtmu.fleet.sessions import Fleet, RobotSession
+from rtmu.model.observables import Phase
+from rtmu.package_data import project_map
+from rtmu.settings.store import Profile
 from rtmu.sim import SimConfig, SimThread
 
 from .fakes import FakeView
 from .uiqueue import UiQueue
 
-REPO = Path(__file__).resolve().parents[2]
-ARENA = REPO / "data" / "maps" / "arena.map"
+ARENA = project_map("arena.map")
 
 
 @contextmanager

@@ -7,8 +7,8 @@ from pathlib import Path
 import pytest
 
 from rtmu.client.roster import RobotAdded, RobotEndpoint, RosterEvent
-from rtmu.fleet import direct_roster, robot_profile
-from rtmu.settings import (
+from rtmu.fleet.sessions import direct_roster, robot_profile
+from rtmu.settings.store import (
     DirectRobot,
     Profile,
     Settings,

@@ -1,6 +1,6 @@
 """The gamepad's mapping and its stops: rules on a fake clock, then the same pad events against the simulator.
 
-No GTK here: ``rtmu.gamepad`` gets the events the libmanette adapter would give it.
+No GTK here: ``rtmu.control.gamepad`` gets the events the libmanette adapter would give it.
 """
 
 from __future__ import annotations
@@ -9,14 +9,12 @@ import math
 import time
 from collections.abc import Iterator
 from contextlib import contextmanager
-from pathlib import Path
 
 import pytest
 
 from rtmu.client.lease import EndReason
 from rtmu.client.session import SessionConfig
-from rtmu.fleet import Fleet, RobotSession
-from rtmu.gamepad import (
+from rtmu.control.gamepad import (
     AXIS_CODES,
     AXIS_ROT,
     AXIS_TRANS,
@@ -31,14 +29,16 @@ from rtmu.gamepad import (
     Gamepad,
     stick_ratios,
 )
-from rtmu.model import LinkHealth, LinkLevel, Phase
-from rtmu.settings import Profile
+from rtmu.fleet.sessions import Fleet, RobotSession
+from rtmu.model.observables import LinkHealth, LinkLevel, Phase
+from rtmu.package_data import project_map
+from rtmu.settings.store import Profile
 from rtmu.sim import SimConfig, SimThread
 
 from .test_controller import Rig
 from .uiqueue import UiQueue
 
-ARENA = Path(__file__).resolve().parents[2] / "data" / "maps" / "arena.map"
+ARENA = project_map("arena.map")
 PAD = object()
 
 
@@ -368,7 +368,7 @@ def test_the_libmanette_adapter_starts_on_this_machine_and_finds_no_pad() -> Non
 
 
 def test_the_stick_during_a_navigation_only_stops_it_and_the_next_deadman_press_drives() -> None:
-    from rtmu.model import NavState
+    from rtmu.model.observables import NavState
 
     rig = PadRig()
     rig.model.navigation.set(NavState(navigating=True, target="Lab B", goals=("Lab A", "Lab B")))

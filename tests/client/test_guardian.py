@@ -308,3 +308,20 @@ def test_the_guardian_learns_how_late_a_busy_parents_beats_come_within_its_bound
     assert watch.why_stop(t + SILENT_CEILING + 0.01) is not None  # but never beyond the ceiling
     watch.take(m.DISARM, t)
     assert watch.why_stop(t + 10.0) is None  # disarmed: nothing to watch
+
+
+def test_the_guardians_reasons_name_no_window_it_may_not_have() -> None:
+    """rtmu drive and rtmu bridge have guardians too: their stop reasons speak of the driving process."""
+    import os
+
+    from rtmu.guardian import messages as m
+    from rtmu.guardian.child import Watch
+
+    watch = Watch(os.getpid())
+    watch.take(m.BEAT_NET, 0.0)
+    watch.take(m.ARM, 0.0)
+    late = watch.why_stop(10.0)
+    watch.eof = True
+    gone = watch.why_stop(10.0)
+    for reason in (late, gone):
+        assert reason is not None and "window" not in reason and "process driving the robot" in reason

@@ -9,7 +9,7 @@ import pytest
 from rtmu.client.errors import ClientTimeout, LoginRejected, ServerClosed
 from rtmu.client.health import HealthMonitor, ping_data
 from rtmu.client.reconnect import Backoff, worth_retrying
-from rtmu.model import LinkLevel
+from rtmu.model.observables import LinkLevel
 from rtmu.protocol.decoder import DropStats
 
 

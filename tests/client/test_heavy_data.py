@@ -19,7 +19,7 @@ from rtmu.client.errors import MalformedReply
 from rtmu.client.lease import DriveRatios
 from rtmu.client.runner import ClientRunner
 from rtmu.client.session import SessionConfig
-from rtmu.model import RobotModel
+from rtmu.model.observables import RobotModel
 from rtmu.protocol.payloads.drawings import DrawingPoints
 
 from .heavy_servers import big_jpeg, drawing_flood_server, popup_storm_server

@@ -65,10 +65,12 @@ HUMAN = [
     ("patrol", ["Nowhere"]),
     ("doctor", []),
     ("drive", ["--trans", "0", "--rot", "0", "--seconds", "0.2"]),
+    ("why", []),
+    ("drive", ["--trans", "50", "--seconds", "0.3"]),  # it never moves: the answer is printed
 ]
 
 
-@pytest.mark.parametrize(("command", "extra"), HUMAN, ids=[c for c, _ in HUMAN])
+@pytest.mark.parametrize(("command", "extra"), HUMAN, ids=[f"{c}{i}" for i, (c, _) in enumerate(HUMAN)])
 def test_human_output_escapes_every_control_character(tmp_path: Path, command: str, extra: list[str]) -> None:
     with ServerThread(_hostile_server()) as server:
         argv = [a.format(tmp=tmp_path) for a in extra]

@@ -12,8 +12,8 @@ import re
 import pytest
 from PIL import Image
 
+from rtmu.base.exit_codes import EXIT_CONNECTION, EXIT_OK
 from rtmu.cli import main
-from rtmu.exit_codes import EXIT_CONNECTION, EXIT_OK
 
 from .servers import ServerSide, ServerThread, TestServer
 

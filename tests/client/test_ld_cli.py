@@ -1,25 +1,24 @@
-"""``rtmu routes / patrol / say / status`` against ``rtmu sim --profile aram`` and the default profile."""
+"""``rtmu routes / patrol / say / status`` against ``rtmu sim --kind aram`` and the default profile."""
 
 from __future__ import annotations
 
 import asyncio
 import json
 from collections.abc import Iterator
-from pathlib import Path
 
 import pytest
 
+from rtmu.base.exit_codes import EXIT_OK, EXIT_UNSUPPORTED, EXIT_USAGE
 from rtmu.cli import main
 from rtmu.client import ld_data
 from rtmu.client.connection import AriaClient
-from rtmu.exit_codes import EXIT_OK, EXIT_UNSUPPORTED, EXIT_USAGE
+from rtmu.package_data import project_map
 from rtmu.sim import SimConfig, SimThread
 from rtmu.sim.ld_data import ROUTES, ld_state
 
 from .uiqueue import eventually
 
-REPO = Path(__file__).resolve().parents[2]
-OFFICE = REPO / "data" / "maps" / "office.map"
+OFFICE = project_map("office.map")
 
 
 @pytest.fixture(scope="module")
@@ -75,6 +74,13 @@ def test_goto_sends_a_route_goal_and_refuses_an_unknown_one(
 
 
 def test_data_store_values_become_toolbar_fields() -> None:
+    # The names 6MTX robots list …
+    assert ld_data.store_fields("DataStore_LaserLocalizationScore", "87.4") == {"loc_score": 87}
+    assert ld_data.store_fields("DataStore_WirelessQuality", "35", "(0-70)") == {"wifi_quality": 50}
+    assert ld_data.store_fields("DataStore_Distance_to_goal", "12400") == {"goal_distance_mm": 12400}
+    assert ld_data.store_fields("DataStore_Closest_Obstacle_Distance", "800") == {"closest_obstacle_mm": 800}
+    assert ld_data.store_fields("DataStore_DockingState", "Docked") == {}
+    # … and other spellings of the same values.
     assert ld_data.store_fields("DataStore_Localization_Score", "87.4") == {"loc_score": 87}
     assert ld_data.store_fields("DataStore_WiFi_Quality", "35", "Wi-Fi link quality (0–70)") == {
         "wifi_quality": 50
@@ -108,8 +114,12 @@ def test_data_store_strings_are_read_by_name(aram: SimThread) -> None:
             await client.disconnect()
 
     values = asyncio.run(go())
-    assert set(values) >= {"DataStore_WiFi_Quality", "DataStore_Localization_Score", "DataStore_Dock_State"}
-    assert 0 <= int(values["DataStore_WiFi_Quality"]) <= 70
+    assert set(values) >= {
+        "DataStore_WirelessQuality",
+        "DataStore_LaserLocalizationScore",
+        "DataStore_DockingState",
+    }
+    assert 0 <= int(values["DataStore_WirelessQuality"]) <= 70
 
 
 def test_default_profile_offers_none_of_it(plain: SimThread, capsys: pytest.CaptureFixture[str]) -> None:

@@ -4,18 +4,19 @@ from __future__ import annotations
 
 import time
 from collections.abc import Iterator
-from pathlib import Path
 
 import pytest
 
 from rtmu.client.runner import ClientRunner
 from rtmu.client.session import SessionConfig
-from rtmu.model import CameraImage, Phase, RobotModel
+from rtmu.model.observables import CameraImage, Phase, RobotModel
+from rtmu.package_data import project_map
 from rtmu.sim import SimConfig, SimThread
+from rtmu.values.intents import StartVideo, StopVideo, VideoShown
 
 from .uiqueue import UiQueue
 
-ARENA = Path(__file__).resolve().parents[2] / "data" / "maps" / "arena.map"
+ARENA = project_map("arena.map")
 
 
 def sim_config(port: int = 0) -> SimConfig:
@@ -56,7 +57,7 @@ def test_live_frames_arrive_stamped_and_wait_for_the_window(sim: SimThread) -> N
     runner, model, ui, frames = start(sim.port)
     try:
         turn(sim)
-        runner.start_video(fps=20).result(5)
+        runner.send(StartVideo(fps=20)).result(5)
         ui.wait_for(lambda: len(frames) >= 1, timeout=10)
         first = frames[0]
         assert first.stamp_ns is not None and first.video is not None
@@ -66,14 +67,14 @@ def test_live_frames_arrive_stamped_and_wait_for_the_window(sim: SimThread) -> N
         unshown = len(frames)
         assert unshown <= 6, unshown
         # The window reports every frame it drew: now they flow at the asked rate.
-        model.camera.observe(lambda _o, new: new is not None and runner.video_shown(new.sequence))
-        runner.video_shown(frames[-1].sequence)
+        model.camera.observe(lambda _o, new: new is not None and runner.send(VideoShown(new.frame or 0)))
+        runner.send(VideoShown(frames[-1].frame or 0))
         count = len(frames)
         play_for(ui, 2.5)
         assert len(frames) - count > unshown, (len(frames) - count, unshown)
         assert len({f.sequence for f in frames}) == len(frames)
         assert len({f.stamp_ns for f in frames}) == len(frames), "every frame handed on is a new one"
-        runner.stop_video().result(5)
+        runner.send(StopVideo()).result(5)
         play_for(ui, 0.5)
         count = len(frames)
         play_for(ui, 1.0)
@@ -87,9 +88,9 @@ def test_live_video_resumes_by_itself_after_the_link_comes_back() -> None:
     port = sim.port
     runner, model, ui, frames = start(port)
     try:
-        model.camera.observe(lambda _o, new: new is not None and runner.video_shown(new.sequence))
+        model.camera.observe(lambda _o, new: new is not None and runner.send(VideoShown(new.frame or 0)))
         turn(sim)
-        runner.start_video(fps=10).result(5)
+        runner.send(StartVideo(fps=10)).result(5)
         ui.wait_for(lambda: len(frames) >= 2, timeout=10)
         sim.kill()
         ui.wait_for(lambda: model.connection.value.phase is not Phase.CONNECTED, timeout=10)

@@ -6,11 +6,11 @@ from pathlib import Path
 
 import pytest
 
+from rtmu.base.exit_codes import EXIT_CONNECTION
 from rtmu.cli import main
 from rtmu.client.runner import ClientRunner
 from rtmu.client.session import SessionConfig
-from rtmu.exit_codes import EXIT_CONNECTION
-from rtmu.model import Phase, RobotModel
+from rtmu.model.observables import Phase, RobotModel
 
 from .servers import MAP_LINES, ServerThread, TestServer
 from .uiqueue import UiQueue
@@ -91,7 +91,7 @@ def _bad_status_server() -> TestServer:
     [
         ["status", "--once"],
         ["status", "--count", "2", "--interval", "20"],
-        ["drive", "--trans", "10", "--seconds", "0.2"],
+        ["drive", "--trans", "30", "--seconds", "0.2"],  # outside ARIA's dead zone: no warning line
     ],
 )
 def test_a_malformed_status_exits_3_with_one_line(

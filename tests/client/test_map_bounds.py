@@ -15,9 +15,10 @@ import pytest
 
 from rtmu.client.lease import DriveLease
 from rtmu.client.session import Session, SessionConfig
-from rtmu.model import LinkHealth, LinkLevel
+from rtmu.model.observables import LinkHealth, LinkLevel
 from rtmu.protocol.payloads.mapstream import DEFAULT_MAX_POINTS, DEFAULT_MAX_TEXT_LINES
-from rtmu.state import HealthChanged, StateChange
+from rtmu.values.intents import LoadMap
+from rtmu.values.state import HealthChanged, StateChange
 
 from .endless_maps import endless_map_server, run_watching_peak
 from .servers import ServerThread, TestServer, run
@@ -81,7 +82,7 @@ def test_a_session_fails_the_map_keeps_the_link_and_does_not_fetch_it_again(kind
         session = Session(DriveLease(), publish, config=config)
         try:
             await session.connect("127.0.0.1", server.port, auto_reconnect=True)
-            got = await asyncio.wait_for(session.load_map(), 60)
+            got = await asyncio.wait_for(session.dispatch(LoadMap()), 60)
             assert got.state == "failed" and "too large" in got.error, got
             assert session.connected and len(server.sides) == 1  # the link was never called lost
             seen = len(health)
@@ -92,7 +93,7 @@ def test_a_session_fails_the_map_keeps_the_link_and_does_not_fetch_it_again(kind
             assert after and all(h.level in (LinkLevel.OK, LinkLevel.STALE) for h in after), after
             assert all(h.status_age is not None and h.status_age < 2.0 for h in after), after
             assert len(server.sides) == 1
-            again = await asyncio.wait_for(session.load_map(), 10)
+            again = await asyncio.wait_for(session.dispatch(LoadMap()), 10)
             assert again.state == "failed" and server.map_requests == 1  # type: ignore[attr-defined]
         finally:
             await session.disconnect()

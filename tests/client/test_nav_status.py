@@ -6,48 +6,48 @@ from dataclasses import replace
 
 import pytest
 
+from rtmu.base.notices import Kind, Level, Notice
 from rtmu.client.connection import Packet
+from rtmu.client.detached import DetachedContext
 from rtmu.client.nav_session import NavFeed
-from rtmu.client.nav_status import MAX_TEXT, NavPhase, path_remaining, read_status
-from rtmu.notices import Kind, Level, Notice
-from rtmu.protocol.payloads import Side, decode_payload
+from rtmu.client.nav_status import MAX_TEXT, path_remaining, read_status
 from rtmu.protocol.payloads.navigation import LocState, PlannedPath
-from rtmu.state import NavChanged, NavOutcome, RobotState
+from rtmu.values.state import NavOutcome, RobotState
 
 
 @pytest.mark.parametrize(
     ("status", "mode", "phase", "target", "sentence"),
     [
-        ("Going to Lab B", "Goto", NavPhase.GOING, "Lab B", ""),
-        ("Going to point", "Goto", NavPhase.GOING, "point", ""),
-        ("Going to dock at Charger", "dock", NavPhase.GOING, "dock at Charger", ""),
-        ("Driving into dock", "dock", NavPhase.GOING, "dock", ""),
-        ("Returning home", "Goto", NavPhase.GOING, "home", ""),
-        ("Touring to Room 101", "Goto", NavPhase.GOING, "Room 101", ""),
-        ("Arrived at Lab B", "Goto", NavPhase.ARRIVED, "Lab B", "Arrived at Lab B"),
-        ("Returned home", "Goto", NavPhase.ARRIVED, "home", "Returned home"),
-        ("Docked", "dock", NavPhase.DOCKED, "dock", "Docked"),
+        ("Going to Lab B", "Goto", NavOutcome.GOING, "Lab B", ""),
+        ("Going to point", "Goto", NavOutcome.GOING, "point", ""),
+        ("Going to dock at Charger", "dock", NavOutcome.GOING, "dock at Charger", ""),
+        ("Driving into dock", "dock", NavOutcome.GOING, "dock", ""),
+        ("Returning home", "Goto", NavOutcome.GOING, "home", ""),
+        ("Touring to Room 101", "Goto", NavOutcome.GOING, "Room 101", ""),
+        ("Arrived at Lab B", "Goto", NavOutcome.ARRIVED, "Lab B", "Arrived at Lab B"),
+        ("Returned home", "Goto", NavOutcome.ARRIVED, "home", "Returned home"),
+        ("Docked", "dock", NavOutcome.DOCKED, "dock", "Docked"),
         (
             "Failed to get to Lab B because robot lost",
             "Goto",
-            NavPhase.FAILED,
+            NavOutcome.FAILED,
             "Lab B",
             "Failed to get to Lab B because the robot is lost",
         ),
         (
             "Failed to get to Lab B (path blocked)",
             "Goto",
-            NavPhase.FAILED,
+            NavOutcome.FAILED,
             "Lab B",
             "Failed to get to Lab B because path blocked",
         ),
-        ("Failed to get home because robot lost", "Goto", NavPhase.FAILED, "home", None),
-        ("Failed dock", "dock", NavPhase.FAILED, "dock", "Failed dock"),
-        ("Stopped", "stop", NavPhase.IDLE, "", ""),
-        ("Going to the kitchen", "ratioDrive", NavPhase.IDLE, "", ""),  # not a navigation mode
+        ("Failed to get home because robot lost", "Goto", NavOutcome.FAILED, "home", None),
+        ("Failed dock", "dock", NavOutcome.FAILED, "dock", "Failed dock"),
+        ("Stopped", "stop", NavOutcome.NONE, "", ""),
+        ("Going to the kitchen", "ratioDrive", NavOutcome.NONE, "", ""),  # not a navigation mode
     ],
 )
-def test_arnl_words(status: str, mode: str, phase: NavPhase, target: str, sentence: str | None) -> None:
+def test_arnl_words(status: str, mode: str, phase: NavOutcome, target: str, sentence: str | None) -> None:
     r = read_status(status, mode)
     assert (r.phase, r.target) == (phase, target)
     if sentence is not None:
@@ -62,45 +62,43 @@ def test_server_text_is_bounded_and_the_distance_follows_the_path() -> None:
 
 class Rec:
     def __init__(self) -> None:
-        self.changes: list[NavChanged] = []
-        self.notices: list[Notice] = []
+        self.ctx = DetachedContext()
+        self.changes = self.ctx.changes
+        self.notices = self.ctx.notices
 
     def feed(self) -> NavFeed:
-        def decode(name: str, payload: bytes) -> object:
-            return decode_payload(name, Side.REPLY, payload)
-
-        return NavFeed(self.changes.append, self.notices.append, decode, lambda coro, name: coro.close(), 1.0)
+        return NavFeed(self.ctx)
 
 
 def test_outcomes_publish_and_notify_once_but_history_is_silent() -> None:
     rec = Rec()
     feed = rec.feed()
     robot = RobotState(status="Arrived at Lab A", mode_name="Goto")
-    feed.robot(robot)  # what happened before we connected: kept, not announced
+    feed.robot_changed(robot)  # what happened before we connected: kept, not announced
     assert feed.state.outcome is NavOutcome.ARRIVED and rec.notices == []
     flips: list[bool] = []
     feed.changed = lambda: flips.append(feed.navigating)
-    feed.robot(replace(robot, status="Going to Lab B"))
+    feed.robot_changed(replace(robot, status="Going to Lab B"))
     assert feed.state.navigating and feed.state.target == "Lab B" and flips == [True]
     assert feed.state.outcome is NavOutcome.NONE
     feed.on_path(Packet("getPath", PlannedPath(((0, 0), (3000, 4000))).encode(), 0.0))
-    feed.robot(replace(robot, status="Going to Lab B", x=0.0, y=0.0))
+    feed.robot_changed(replace(robot, status="Going to Lab B", x=0.0, y=0.0))
     assert feed.state.remaining_mm == pytest.approx(5000)
-    feed.robot(replace(robot, status="Failed to get to Lab B because robot lost"))
+    feed.robot_changed(replace(robot, status="Failed to get to Lab B because robot lost"))
     assert not feed.state.navigating and feed.state.path == () and flips == [True, False]
     assert (feed.state.outcome, feed.state.reason) == (NavOutcome.FAILED, "the robot is lost")
     assert rec.notices == [
         Notice(Kind.NAVIGATION, Level.WARNING, "Failed to get to Lab B because the robot is lost")
     ]
-    feed.robot(replace(robot, status="Failed to get to Lab B because robot lost", x=5.0))
+    feed.robot_changed(replace(robot, status="Failed to get to Lab B because robot lost", x=5.0))
     assert len(rec.notices) == 1  # the same words again are no news
 
 
 def test_a_stop_while_navigating_is_a_cancel_without_a_notice() -> None:
     rec = Rec()
     feed = rec.feed()
-    feed.robot(RobotState(status="Going to point", mode_name="Goto"))
-    feed.robot(RobotState(status="Stopped", mode_name="stop"))
+    feed.robot_changed(RobotState(status="Going to point", mode_name="Goto"))
+    feed.robot_changed(RobotState(status="Stopped", mode_name="stop"))
     assert feed.state.outcome is NavOutcome.CANCELLED and not feed.state.navigating
     assert rec.notices == []
 

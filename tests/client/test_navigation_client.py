@@ -15,17 +15,18 @@ from pathlib import Path
 
 import pytest
 
+from rtmu.base.notices import Kind
 from rtmu.client.errors import NotSupported
 from rtmu.client.runner import ClientRunner
 from rtmu.client.session import SessionConfig
-from rtmu.controller import Controller
-from rtmu.maps import MapObject, write_map
-from rtmu.model import NavOutcome, OperatorState, Phase, RobotModel
-from rtmu.notices import Kind
+from rtmu.control.controller import Controller
+from rtmu.mapfile import MapObject, write_map
+from rtmu.model.observables import NavOutcome, OperatorState, Phase, RobotModel
 from rtmu.protocol.payloads.drive import RatioDrive
 from rtmu.protocol.payloads.robot import ModeInfo
 from rtmu.sim import SimThread
 from rtmu.sim.project_maps import office_map
+from rtmu.values.intents import GotoGoal, GotoPose, Localize
 
 from .fakes import FakeView
 from .navsim import OFFICE, fast_sim, reset, robot
@@ -97,7 +98,7 @@ def test_goals_localization_and_what_the_server_offers(rig: Rig) -> None:
 def test_goto_goal_publishes_path_distance_and_arrival(rig: Rig, sim: SimThread) -> None:
     rig.wait(lambda: rig.model.map.value.data is not None and "Room 101" in rig.nav.goals)
     assert "getPath" not in server_subscriptions(sim)
-    rig.ctl.goto_goal("Room 101")
+    rig.ctl.ask(GotoGoal("Room 101"))
     rig.wait(lambda: rig.nav.navigating and rig.nav.target == "Room 101")
     assert rig.nav.target_pose == (2000.0, 3200.0, None)
     rig.wait(lambda: len(rig.nav.path) > 0 and (rig.nav.remaining_mm or 0) > 500)
@@ -117,7 +118,7 @@ def test_a_drive_key_cancels_navigation_with_a_stop_and_the_next_press_drives(
 ) -> None:
     assert sim.server is not None
     server = sim.server
-    rig.ctl.goto_goal("Corridor End")
+    rig.ctl.ask(GotoGoal("Corridor End"))
     rig.wait(lambda: rig.nav.navigating)
     eventually(lambda: robot(sim).vel > 100, timeout=10)
     drives = sim.call(lambda: server.robot.ratio_drives_received)
@@ -140,7 +141,7 @@ def test_a_drive_key_cancels_navigation_with_a_stop_and_the_next_press_drives(
 
 
 def test_stop_cancels_navigation_but_focus_loss_does_not(rig: Rig, sim: SimThread) -> None:
-    rig.ctl.goto_pose(12000, 6000)
+    rig.ctl.ask(GotoPose(12000, 6000))
     rig.wait(lambda: rig.nav.navigating and rig.nav.target == "point")
     assert rig.nav.target_pose == (12000.0, 6000.0, None)
     rig.ctl.focus_lost()
@@ -158,12 +159,12 @@ def test_a_lost_robot_fails_with_a_notice_until_localized(rig: Rig, sim: SimThre
     rig.wait(lambda: rig.nav.loc_state == "Good")
     sim.call(sim.server.lose_localization)
     rig.wait(lambda: rig.nav.loc_state == "Lost")
-    rig.ctl.goto_goal("Room 101")
+    rig.ctl.ask(GotoGoal("Room 101"))
     rig.wait(lambda: rig.nav.outcome is NavOutcome.FAILED)
     assert rig.nav.reason == "the robot is lost"
     assert "Failed to get to Room 101 because the robot is lost" in rig.view.texts()
     assert "The robot is lost: localize it before sending it anywhere" in rig.view.texts()
-    rig.ctl.localize(2500, 6000, 0)
+    rig.ctl.ask(Localize(2500, 6000, 0))
     rig.wait(lambda: rig.nav.loc_state == "Good")
     snap = robot(sim)
     assert (round(snap.x), round(snap.y)) == (2500, 6000)
@@ -191,7 +192,7 @@ def test_goals_are_asked_again_on_goals_updated(tmp_path: Path) -> None:
             data = office_map()
             data.objects.append(MapObject("Goal", 5000, 6000, 0.0, name="Printer"))
             write_map(data, path)
-            rig.runner.command("checkMap").result(5)
+            rig.runner.call(lambda: rig.runner.session.client.send("checkMap"))  # type: ignore[union-attr]
             rig.wait(lambda: "Printer" in rig.nav.goals)
         finally:
             rig.close()
@@ -211,7 +212,7 @@ def test_a_held_drive_is_stopped_before_the_goal_goes_out() -> None:
             rig.ctl.press("forward")
             eventually(lambda: "ratioDrive" in server.names())
             # Straight to the runner, the lease still live: the session itself must stop first.
-            rig.runner.goto_goal("Lab A").result(5)
+            rig.runner.send(GotoGoal("Lab A")).result(5)
             eventually(lambda: "gotoGoal" in server.names())
             rig.hold(0.3)
             names = server.names()
@@ -245,8 +246,8 @@ def test_a_server_without_navigation_asks_for_none_of_it_and_says_so() -> None:
         rig = Rig(server.port, fetch_map=False)
         try:
             assert rig.nav.offered == frozenset()
-            with pytest.raises(NotSupported, match="does not navigate that way"):
-                rig.runner.goto_goal("Lab A").result(5)
+            with pytest.raises(NotSupported, match="does not offer gotoGoal"):
+                rig.runner.send(GotoGoal("Lab A")).result(5)
             rig.wait(lambda: any(k is Kind.NAVIGATION for k in rig.view.kinds))
             for name in ("dock", "home", "tour_goals"):
                 assert not rig.ctl.command_states()[name].enabled

@@ -8,10 +8,10 @@ from __future__ import annotations
 
 import pytest
 
+from rtmu.base.exit_codes import EXIT_CONNECTION, EXIT_TIMEOUT
 from rtmu.cli import main
 from rtmu.client.connection import AriaClient
 from rtmu.client.errors import ClientTimeout, ProtocolFault
-from rtmu.exit_codes import EXIT_CONNECTION, EXIT_TIMEOUT
 from rtmu.protocol.checksum import checksum
 
 from .servers import ServerSide, ServerThread, TestServer, run

@@ -17,14 +17,15 @@ from typing import Any
 
 import pytest
 
+from rtmu.base.notices import Kind, Notice
 from rtmu.client.custom_commands import MAX_ARGUMENT, ServerCommand, list_commands
 from rtmu.client.popups import MAX_MESSAGE, MAX_OPEN
 from rtmu.client.runner import ClientRunner
-from rtmu.model import Phase, RobotModel
-from rtmu.notices import Kind, Notice
+from rtmu.model.observables import Phase, RobotModel
 from rtmu.protocol.payloads.commands import CommandEntry, CommandList
 from rtmu.sim import SimConfig, SimThread
-from rtmu.state import PopupsChanged, StateChange
+from rtmu.values.intents import AnswerPopup, ListServerCommands, RunServerCommand
+from rtmu.values.state import PopupsChanged, StateChange
 
 from .uiqueue import UiQueue, eventually
 
@@ -88,7 +89,7 @@ def test_popup_arrives_is_answered_and_closes_with_the_servers_words(sim: SimThr
     assert card.buttons == ("Yes", "No", "Later") and card.default_button == 1
     assert rig.popups.offered
 
-    rig.runner.answer_popup(pid, 2).result(5)
+    rig.runner.send(AnswerPopup(pid, 2)).result(5)
     eventually(lambda: (pid, 2) in sim.call(lambda: list(sim.server.world.popup_clicks)), timeout=5)
     rig.wait(lambda: all(p.popup_id != pid for p in rig.popups.open))
     rig.wait(lambda: any("Later pressed" in t for t in rig.server_texts()))
@@ -136,21 +137,35 @@ def test_long_server_text_is_cut() -> None:
 
 
 def test_commands_are_listed_with_descriptions_and_run(sim: SimThread, rig: Rig) -> None:
-    catalogue = rig.runner.list_commands().result(10)
+    catalogue = rig.runner.send(ListServerCommands()).result(10)
     by_name = {c.name: c for c in catalogue.commands}
     assert not by_name["ResetTripOdometer"].takes_argument
     assert by_name["SimulatorSetBattery"].takes_argument
     assert "battery" in by_name["SimulatorSetBattery"].description
-    assert rig.runner.run_command(by_name["SimulatorSetBattery"], "11.5").result(10) is True
+    assert (
+        rig.runner.send(
+            RunServerCommand(
+                by_name["SimulatorSetBattery"].name, "11.5", by_name["SimulatorSetBattery"].takes_argument
+            )
+        ).result(10)
+        is True
+    )
     assert sim.call(lambda: sim.server.world.body.battery_v) == pytest.approx(11.5)
     sim.call(lambda: setattr(sim.server.world.body, "odometer_mm", 5000.0))
-    assert rig.runner.run_command(by_name["ResetTripOdometer"]).result(10) is True
+    assert (
+        rig.runner.send(
+            RunServerCommand(
+                by_name["ResetTripOdometer"].name, None, by_name["ResetTripOdometer"].takes_argument
+            )
+        ).result(10)
+        is True
+    )
     assert sim.call(lambda: sim.server.world.body.odometer_mm) < 100
 
 
 def test_a_string_command_raises_a_popup(sim: SimThread, rig: Rig) -> None:
     cmd = ServerCommand("SimulatorPopup", "", True)
-    rig.runner.run_command(cmd, "Asked|by a command|Go,Stay|0").result(10)
+    rig.runner.send(RunServerCommand(cmd.name, "Asked|by a command|Go,Stay|0", cmd.takes_argument)).result(10)
     rig.wait(lambda: any(p.title == "Asked" for p in rig.popups.open))
     (card,) = [p for p in rig.popups.open if p.title == "Asked"]
     assert card.buttons == ("Go", "Stay", "")
@@ -159,7 +174,7 @@ def test_a_string_command_raises_a_popup(sim: SimThread, rig: Rig) -> None:
 def test_an_over_long_argument_is_refused_before_sending(rig: Rig) -> None:
     cmd = ServerCommand("SimulatorPopup", "", True)
     with pytest.raises(ValueError):
-        rig.runner.run_command(cmd, "x" * (MAX_ARGUMENT + 1)).result(10)
+        rig.runner.send(RunServerCommand(cmd.name, "x" * (MAX_ARGUMENT + 1), True)).result(10)
 
 
 def test_commands_a_user_may_not_run_are_not_listed(tmp_path: Path) -> None:
@@ -169,8 +184,8 @@ def test_commands_a_user_may_not_run_are_not_listed(tmp_path: Path) -> None:
         alice = Rig(sim.port, "alice", "secret1")
         bob = Rig(sim.port, "bob", "pw2")
         try:
-            everything = {c.name for c in alice.runner.list_commands().result(10).commands}
-            limited = {c.name for c in bob.runner.list_commands().result(10).commands}
+            everything = {c.name for c in alice.runner.send(ListServerCommands()).result(10).commands}
+            limited = {c.name for c in bob.runner.send(ListServerCommands()).result(10).commands}
         finally:
             alice.runner.close()
             bob.runner.close()

@@ -12,25 +12,25 @@ from __future__ import annotations
 import json
 import time
 from collections.abc import Callable, Iterator
-from pathlib import Path
 from typing import Any
 
 import pytest
 
+from rtmu.base.exit_codes import EXIT_CONNECTION, EXIT_OK, EXIT_TIMEOUT, EXIT_UNSUPPORTED, EXIT_USAGE
 from rtmu.cli import main
 from rtmu.client.ptz import MAX_NAME, NO_HEAD, NO_LIST, POLL_MS
 from rtmu.client.runner import ClientRunner
-from rtmu.exit_codes import EXIT_OK, EXIT_UNSUPPORTED, EXIT_USAGE
-from rtmu.model import Phase, RobotModel
+from rtmu.model.observables import Phase, RobotModel
+from rtmu.package_data import project_map
 from rtmu.protocol.fields import FieldWriter
 from rtmu.protocol.payloads.camera import Camera, CameraCommand, CameraData, CameraInfo, CameraList
 from rtmu.sim import SimConfig, SimThread
+from rtmu.values.intents import PtzMove, WatchPtz
 
 from .servers import SPECS, ServerThread, TestServer
 from .uiqueue import UiQueue
 
-REPO = Path(__file__).resolve().parents[2]
-OFFICE = REPO / "data" / "maps" / "office.map"
+OFFICE = project_map("office.map")
 
 
 class Rig:
@@ -93,16 +93,16 @@ def test_limits_and_position_come_from_the_server(rig: Rig) -> None:
 
 def test_moves_reach_the_simulated_head_and_come_back_as_position(rig: Rig, sim: SimThread) -> None:
     rig.wait(lambda: rig.ptz is not None and rig.ptz.position is not None)
-    rig.runner.ptz_rel(10, -5).result(5)
+    rig.runner.send(PtzMove(10, -5)).result(5)
     rig.wait(lambda: rig.ptz.position == (10.0, -5.0, 0.0))
     assert _head(sim) == (10.0, -5.0, 0.0)
-    rig.runner.ptz_abs(-40, 20, 50).result(5)
+    rig.runner.send(PtzMove(-40, 20, 50, relative=False)).result(5)
     rig.wait(lambda: rig.ptz.position == (-40.0, 20.0, 50.0))
     # ARIA scales relative turns by (1 - zoom) and rounds away from zero: 10 deg at 50 % → 5 deg.
-    rig.runner.ptz_rel(10, 0, 10).result(5)
+    rig.runner.send(PtzMove(10, 0, 10)).result(5)
     rig.wait(lambda: rig.ptz.position == (-35.0, 20.0, 60.0))
     # Beyond the limits the server clamps; a missing zoom in setCameraAbs keeps ours (we send it).
-    rig.runner.ptz_abs(200, 0).result(5)
+    rig.runner.send(PtzMove(200, 0, relative=False)).result(5)
     rig.wait(lambda: rig.ptz.position == (98.0, 0.0, 60.0))
 
 
@@ -118,11 +118,11 @@ def test_position_is_polled_only_while_watched(rig: Rig, sim: SimThread) -> None
     rig.runner.sync()
     rig.ui.drain()
     assert rig.ptz.position == (0.0, 0.0, 0.0)
-    rig.runner.watch_ptz(True).result(5)
+    rig.runner.send(WatchPtz(True)).result(5)
     rig.wait(lambda: rig.ptz.position == (30.0, 0.0, 0.0))
     turn(-12.5)
     rig.wait(lambda: rig.ptz.position == (-12.5, 0.0, 0.0))
-    rig.runner.watch_ptz(False).result(5)
+    rig.runner.send(WatchPtz(False)).result(5)
     rig.runner.sync()
     rig.ui.drain()
     turn(45.0)
@@ -137,7 +137,7 @@ def test_a_server_without_cameras_says_so() -> None:
         try:
             r.wait(lambda: r.ptz is not None)
             assert r.ptz.reason == NO_LIST and not r.ptz.movable
-            future = r.runner.ptz_rel(10, 0)
+            future = r.runner.send(PtzMove(10, 0))
             with pytest.raises(Exception, match="no cameras"):
                 future.result(5)
         finally:
@@ -238,13 +238,27 @@ def test_cli_without_a_camera_exits_4() -> None:
         assert main(["ptz", f"127.0.0.1:{s.port}", "--timeout", "5"]) == EXIT_UNSUPPORTED
 
 
+def test_cli_with_a_camera_list_that_never_comes_is_a_timeout_not_no_head(
+    capsys: pytest.CaptureFixture[str],
+) -> None:
+    """The window shows the reason; the command line says what happened: 5 silent, 3 malformed."""
+    server = TestServer([*SPECS, *CAMERA_SPECS])  # getCameraList listed, never answered
+    with ServerThread(server):
+        assert main(["ptz", f"127.0.0.1:{server.port}", "--timeout", "1"]) == EXIT_TIMEOUT
+    assert "getCameraList" in capsys.readouterr().err
+    server = TestServer([*SPECS, *CAMERA_SPECS])
+    server.handlers["getCameraList"] = lambda s, a: [b"\x05\x00"]  # five cameras, then nothing
+    with ServerThread(server):
+        assert main(["ptz", f"127.0.0.1:{server.port}", "--timeout", "5"]) == EXIT_CONNECTION
+
+
 def test_a_watched_position_is_polled_again_after_a_reconnect() -> None:
     server = _server(CameraList((_camera(),)).encode())
     thread = ServerThread(server)
     with thread as srv:
         r = Rig(srv.port)
         try:
-            r.runner.watch_ptz(True).result(5)
+            r.runner.send(WatchPtz(True)).result(5)
             r.wait(
                 lambda: any(
                     x.name == "getCameraDataX" and x.kind == f"request {POLL_MS}" for x in srv.received
@@ -253,7 +267,7 @@ def test_a_watched_position_is_polled_again_after_a_reconnect() -> None:
             thread.call(lambda: srv.kill(srv.sides[0]))
             r.wait(lambda: len(srv.sides) == 2 and r.model.connection.value.phase is Phase.CONNECTED, 15)
             r.wait(lambda: any(x.side == 1 and x.kind == f"request {POLL_MS}" for x in srv.received), 10)
-            r.runner.watch_ptz(False).result(5)
+            r.runner.send(WatchPtz(False)).result(5)
             r.wait(
                 lambda: any(
                     x.side == 1 and x.name == "getCameraDataX" and x.kind == "stop" for x in srv.received

@@ -11,7 +11,7 @@ from rtmu.client.lease import DriveRatios
 from rtmu.client.reconnect import Backoff
 from rtmu.client.runner import ClientRunner
 from rtmu.client.session import SessionConfig
-from rtmu.model import LinkLevel, Phase, RobotModel
+from rtmu.model.observables import LinkLevel, Phase, RobotModel
 from rtmu.protocol.payloads.drive import RatioDrive
 
 from .fakeclock import FakeClock
@@ -404,19 +404,6 @@ def test_loop_lag_shows_a_blocked_network_loop() -> None:
     finally:
         runner.close()
     assert runner.loop_lag() is None
-
-
-def test_subscription_handlers_run_on_the_ui_thread(server: TestServer) -> None:
-    import threading
-
-    runner, _model, ui = start(server)
-    try:
-        threads: list[int] = []
-        runner.subscribe("batteryInfo", 20, lambda packet: threads.append(threading.get_ident()))
-        ui.wait_for(lambda: len(threads) >= 3)
-        assert set(threads) == {threading.get_ident()}  # posted, never run on the network loop
-    finally:
-        runner.close()
 
 
 def test_stop_and_wait_returns_once_the_stop_has_left(server: TestServer) -> None:

@@ -10,23 +10,23 @@ a label list that changes — stay bounded and never stop the session.
 from __future__ import annotations
 
 from collections.abc import Iterator
-from pathlib import Path
 from typing import Any
 
 import pytest
 
 from rtmu.client.runner import ClientRunner
 from rtmu.client.server_strings import INTERVAL_MS, MAX_ITEMS, MAX_TEXT
-from rtmu.model import Phase, RobotModel
+from rtmu.model.observables import Phase, RobotModel
+from rtmu.package_data import project_map
 from rtmu.protocol.payloads.strings import StringItem, Strings, StringsInfo
 from rtmu.sim import SimConfig, SimThread
 from rtmu.sim.handlers import STRING_ITEMS
+from rtmu.values.intents import WatchStrings
 
 from .servers import SPECS, ServerThread, TestServer
 from .uiqueue import UiQueue
 
-REPO = Path(__file__).resolve().parents[2]
-OFFICE = REPO / "data" / "maps" / "office.map"
+OFFICE = project_map("office.map")
 STRING_SPECS = [
     ("getStringsInfo", "labels", "none", "labels", "NavigationInfo", "RETURN_SINGLE"),
     ("getStrings", "values", "none", "strings", "NavigationInfo", "RETURN_SINGLE"),
@@ -87,10 +87,10 @@ def test_getstrings_is_asked_only_while_the_table_is_open(rig_on: Any) -> None:
         rig.settle()
         assert _kinds(srv, "getStrings") == []  # nobody reads them: the robot is not asked
         assert rig.robot.server_strings == ()
-        rig.runner.watch_strings(True).result(5)
+        rig.runner.send(WatchStrings(True)).result(5)
         rig.wait(lambda: rig.robot.server_strings == (("CPU Use", "12%"), ("Mode", "Drive")))
         assert _kinds(srv, "getStrings") == [f"request {INTERVAL_MS}"]
-        rig.runner.watch_strings(False).result(5)
+        rig.runner.send(WatchStrings(False)).result(5)
         rig.wait(lambda: rig.robot.server_strings == ())
         rig.wait(lambda: _kinds(srv, "getStrings") == [f"request {INTERVAL_MS}", "stop"])
 
@@ -100,13 +100,13 @@ def test_simulator_strings_are_labelled_and_wifi_is_fed_without_the_table(rig_on
         rig = rig_on(sim.port)
         rig.wait(lambda: rig.robot.wifi_quality is not None)  # the gauge needs no open table
         assert rig.robot.server_strings == ()
-        rig.runner.watch_strings(True).result(5)
+        rig.runner.send(WatchStrings(True)).result(5)
         rig.wait(lambda: len(rig.robot.server_strings) == len(STRING_ITEMS))
         assert [label for label, _ in rig.robot.server_strings] == [label for label, _ in STRING_ITEMS]
         values = dict(rig.robot.server_strings)
         assert values["Motor Packet Count"] == "10" and values["CPU Use"].strip().endswith("%")
         assert int(values["Wireless Link Quality"]) == rig.robot.wifi_quality
-        rig.runner.watch_strings(False).result(5)
+        rig.runner.send(WatchStrings(False)).result(5)
         rig.wait(lambda: rig.robot.server_strings == ())
         quality = rig.robot.wifi_quality
         assert quality is not None  # the gauge keeps its subscription
@@ -117,7 +117,7 @@ def test_ten_thousand_strings_and_huge_labels_stay_bounded(rig_on: Any) -> None:
     server = _server(labels, tuple("v" for _ in labels))
     with ServerThread(server) as srv:
         rig = rig_on(srv.port)
-        rig.runner.watch_strings(True).result(5)
+        rig.runner.send(WatchStrings(True)).result(5)
         rig.wait(lambda: len(rig.robot.server_strings) == MAX_ITEMS)
         assert rig.robot.server_strings_more == len(labels) - MAX_ITEMS
         assert rig.robot.server_strings[0] == ("s0", "v")
@@ -126,7 +126,7 @@ def test_ten_thousand_strings_and_huge_labels_stay_bounded(rig_on: Any) -> None:
     server = _server(huge, ("V" * 9000, "<span>x</span>", "ok", "a value without a label"))
     with ServerThread(server) as srv:
         rig = rig_on(srv.port)
-        rig.runner.watch_strings(True).result(5)
+        rig.runner.send(WatchStrings(True)).result(5)
         rig.wait(lambda: len(rig.robot.server_strings) == 3)
         (l1, v1), (l2, v2), (l3, v3) = rig.robot.server_strings
         assert len(l1) == len(v1) == MAX_TEXT and l1.endswith("…")
@@ -138,7 +138,7 @@ def test_ten_thousand_empty_labels_fit_one_packet_and_stay_bounded(rig_on: Any) 
     server = _server(tuple("" for _ in range(10_000)), tuple("" for _ in range(10_000)))
     with ServerThread(server) as srv:
         rig = rig_on(srv.port)
-        rig.runner.watch_strings(True).result(5)
+        rig.runner.send(WatchStrings(True)).result(5)
         rig.wait(lambda: rig.robot.server_strings_more == 10_000 - MAX_ITEMS)
         assert len(rig.robot.server_strings) == MAX_ITEMS
         assert rig.model.connection.value.phase is Phase.CONNECTED
@@ -153,7 +153,7 @@ def test_an_added_item_is_picked_up_and_garbage_values_are_ignored(rig_on: Any) 
     server.handlers["getStrings"] = lambda s, a: [Strings(state["values"]).encode()]
     with ServerThread(server) as srv:
         rig = rig_on(srv.port)
-        rig.runner.watch_strings(True).result(5)
+        rig.runner.send(WatchStrings(True)).result(5)
         rig.wait(lambda: rig.robot.server_strings == (("A", "1"),))
         state["labels"], state["values"] = ("A", "B"), ("1", "2")  # ARIA broadcasts the new list; we re-read
         rig.wait(lambda: rig.robot.server_strings == (("A", "1"), ("B", "2")))
@@ -169,7 +169,7 @@ def test_an_open_table_asks_again_after_a_reconnect(rig_on: Any) -> None:
     thread = ServerThread(server)
     with thread as srv:
         rig = rig_on(srv.port)
-        rig.runner.watch_strings(True).result(5)
+        rig.runner.send(WatchStrings(True)).result(5)
         rig.wait(lambda: rig.robot.server_strings == (("CPU Use", "12%"),))
         thread.call(lambda: srv.kill(srv.sides[0]))  # the link drops; the session reconnects by itself
         rig.wait(lambda: len(srv.sides) == 2 and rig.model.connection.value.phase is Phase.CONNECTED, 15)

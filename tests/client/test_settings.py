@@ -8,7 +8,7 @@ from pathlib import Path
 
 import pytest
 
-from rtmu.settings import (
+from rtmu.settings.store import (
     KeyringSecrets,
     Profile,
     Settings,
@@ -171,3 +171,17 @@ def test_only_encrypted_keyring_backends_are_used(monkeypatch: pytest.MonkeyPatc
     assert plaintext.store == {}  # type: ignore[attr-defined]
     monkeypatch.setattr(keyring, "get_keyring", lambda: secret_service)
     assert KeyringSecrets().available
+
+
+def test_a_hand_written_file_without_its_version_line_is_read_as_version_1_and_said() -> None:
+    """The README's fleet example had no version line: the file was moved aside and defaults used."""
+    path = settings_path()
+    path.parent.mkdir(parents=True)
+    text = '[profiles.fleet]\nrobots = [{ name = "robot1", host = "10.0.0.5", port = 7272 }]\n'
+    path.write_text(text)
+    loaded = load_settings()
+    assert "fleet" in loaded.settings.profiles and loaded.moved_to is None
+    assert loaded.warning is not None and "read as version 1" in loaded.warning  # the window's banner
+    assert path.read_text() == text, "the operator's file is left as it is"
+    save_settings(loaded.settings)
+    assert "\nversion = 1\n" in path.read_text() and load_settings().warning is None

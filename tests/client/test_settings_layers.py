@@ -4,7 +4,13 @@ from __future__ import annotations
 
 import pytest
 
-from rtmu.settings import MAX_LAYERS_PER_SERVER, Settings, SettingsError, format_settings, parse_settings
+from rtmu.settings.store import (
+    MAX_LAYERS_PER_SERVER,
+    Settings,
+    SettingsError,
+    format_settings,
+    parse_settings,
+)
 
 
 def test_choices_round_trip_per_server_with_names_exactly_as_sent() -> None:

@@ -14,17 +14,18 @@ from rtmu.client.lease import DriveRatios
 from rtmu.client.reconnect import Backoff
 from rtmu.client.runner import ClientRunner
 from rtmu.client.session import SessionConfig
-from rtmu.controller import Controller
-from rtmu.model import LinkLevel, OperatorState, Phase, RobotModel
+from rtmu.control.controller import Controller
+from rtmu.model.observables import LinkLevel, OperatorState, Phase, RobotModel
+from rtmu.package_data import project_map
 from rtmu.sim import SimConfig, SimThread
+from rtmu.values.intents import RequestPicture, SetSafeDrive
 
 from .fakeclock import FakeClock
 from .fakes import FakeView
 from .servers import run
 from .uiqueue import UiQueue, eventually
 
-REPO = Path(__file__).resolve().parents[2]
-ARENA = REPO / "data" / "maps" / "arena.map"
+ARENA = project_map("arena.map")
 
 
 def sim_config(**kw: object) -> SimConfig:
@@ -54,10 +55,10 @@ def test_model_from_the_simulator_map_image_wifi_safe_drive() -> None:
             ui.wait_for(lambda: model.robot.value.wifi_quality is not None, timeout=5)
             ui.wait_for(lambda: len(model.robot.value.sonar) > 0, timeout=5)
             assert model.robot.value.wifi_signal is not None and model.robot.value.wifi_signal < 0
-            image = runner.request_image().result(5)
+            image = runner.send(RequestPicture()).result(5)
             assert image.jpeg[:2] == b"\xff\xd8" and image.width > 0
             ui.wait_for(lambda: model.camera.value is not None)
-            runner.set_safe_drive(False).result(5)
+            runner.send(SetSafeDrive(False)).result(5)
             ui.wait_for(lambda: model.robot.value.safe_drive is False)
             assert sim.snapshot().safe_drive is False
             ui.wait_for(lambda: model.health.value.rtt_ms is not None)
@@ -84,7 +85,7 @@ def test_controller_hold_release_and_frozen_ui_on_a_manual_clock() -> None:
                 session = runner.session
                 assert session is not None
                 # Wait until the status the simulator just sent has been read (its age is then 0).
-                eventually(lambda: runner.call(lambda: session.health.status_age(clock()) == 0.0))
+                eventually(lambda: runner.call(lambda: session.drive.health.status_age(clock()) == 0.0))
                 ui.drain()
 
             step()
@@ -137,7 +138,7 @@ def test_reconnect_restores_status_and_map_but_never_motion() -> None:
                 with SimThread(SimConfig(port=port, map_path=ARENA, seed=2)) as sim2:
                     ui.wait_for(lambda: model.connection.value.phase is Phase.CONNECTED, timeout=10)
                     # The same map file (same getMapId): answered from the cache, not downloaded.
-                    ui.wait_for(lambda: runner.session.map_downloads_skipped >= 1, timeout=10)
+                    ui.wait_for(lambda: runner.session.maps.downloads_skipped >= 1, timeout=10)
                     assert model.map.value.state == "ready" and model.map.value.generation == generation
                     ui.wait_for(lambda: model.health.value.level is LinkLevel.OK)
                     # The key is still "held" (renewed above): the heart has run since the

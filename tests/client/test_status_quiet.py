@@ -9,8 +9,8 @@ from __future__ import annotations
 import threading
 import time
 
+from rtmu.base.exit_codes import EXIT_OK
 from rtmu.cli import main
-from rtmu.exit_codes import EXIT_OK
 
 from .servers import ServerSide, ServerThread, TestServer, _numbers
 

@@ -6,19 +6,18 @@ import io
 import itertools
 import json
 from collections.abc import Iterator
-from pathlib import Path
 
 import pytest
 from PIL import Image
 
+from rtmu.base.exit_codes import EXIT_CONNECTION, EXIT_OK
 from rtmu.cli import main
-from rtmu.exit_codes import EXIT_CONNECTION, EXIT_OK
+from rtmu.package_data import project_map
 from rtmu.sim import SimConfig, SimThread
 
 from .servers import ServerSide, ServerThread, TestServer
 
-REPO = Path(__file__).resolve().parents[2]
-ARENA = REPO / "data" / "maps" / "arena.map"
+ARENA = project_map("arena.map")
 SUMMARY_KEYS = {"frames", "fps", "kbps", "width", "height", "age_ms_p50", "age_ms_p95"}
 
 
@@ -157,3 +156,17 @@ def test_a_camera_with_only_bad_frames_exits_3_with_the_reason(capsys) -> None: 
         code = main(["video", f"127.0.0.1:{running.port}", "--seconds", "1", "--json"])
     assert code == EXIT_CONNECTION
     assert "no frame could be shown" in capsys.readouterr().err
+
+
+def test_a_parked_robots_camera_plays_as_video_and_repeats_are_told_apart(capsys) -> None:  # type: ignore[no-untyped-def]
+    """Standing still, the simulated camera still sends fresh frames (it sent one in minutes before);
+    a repeated frame — the camera had nothing newer — is named as such, not taken for a slow link."""
+    with SimThread(SimConfig(port=0, map_path=ARENA, camera_hz=10.0)) as sim:
+        where = f"127.0.0.1:{sim.port}"
+        assert main(["video", where, "--seconds", "2", "--fps", "10", "--json", "--timeout", "5"]) == EXIT_OK
+        summary = json.loads(capsys.readouterr().out)
+        assert summary["frames"] >= 4, summary  # a camera that renews its picture: not one frame in 2 s
+        assert summary["backoff"] == "", "fresh frames are young: nothing to slow down for"
+        assert main(["video", where, "--seconds", "1", "--fps", "30", "--timeout", "5"]) == EXIT_OK
+        line = capsys.readouterr().out
+        assert "repeats (the camera had no newer picture" in line, line  # asked 30/s of a 10/s camera

@@ -3,18 +3,18 @@
 from __future__ import annotations
 
 import io
-from pathlib import Path
 
 import pytest
 from PIL import Image
 
 from rtmu.capture import open_capture
+from rtmu.capture.session_decoder import CaptureDecoder, DecodedPacket
 from rtmu.client.video_feed import BadFrame, FrameStats, RateGovernor, check_frame, frame_stamp, parse_frame
 from rtmu.protocol.payloads.camera import VideoFrame
-from rtmu.session_decoder import CaptureDecoder, DecodedPacket
 from rtmu.sim.camera import stamp_jpeg
+from testdata import CAPTURES
 
-CAPTURE = Path(__file__).resolve().parents[3] / "shared" / "captures" / "getVideoExample-serverDemo.pcap"
+CAPTURE = CAPTURES / "getVideoExample-serverDemo.pcap"
 
 
 def jpeg(width: int = 64, height: int = 48) -> bytes:

@@ -2,7 +2,9 @@
 
 The display is started when this file is loaded — before any test module
 imports GTK — and ``DISPLAY``/``GSK_RENDERER=cairo`` are exported (the cairo
-renderer gives the same pixels on every machine). Settings go to a temporary
+renderer gives the same pixels on every machine). A private D-Bus session bus
+is started beside it (``DBUS_SESSION_BUS_ADDRESS``): the application registers
+on it as on a desktop, and nothing reaches the developer's own session. Settings go to a temporary
 ``XDG_CONFIG_HOME``. Every test saves PNGs of the window into one folder,
 printed at the start and at the end of the run.
 
@@ -18,7 +20,7 @@ import shutil
 import subprocess
 import tempfile
 import time
-from collections.abc import Iterator
+from collections.abc import Callable, Iterator
 from pathlib import Path
 from typing import TYPE_CHECKING
 
@@ -32,28 +34,44 @@ if TYPE_CHECKING:
 REPO = Path(__file__).resolve().parents[2]
 _XVFB = shutil.which("Xvfb")
 _XDOTOOL = shutil.which("xdotool")
+_DBUS_DAEMON = shutil.which("dbus-daemon")
 _proc: subprocess.Popen[bytes] | None = None
 SKIP_REASON = ""
 
 
 def _spawn_xvfb(size: str) -> tuple[subprocess.Popen[bytes] | None, str | None]:
     """Start Xvfb with one screen of ``size`` (e.g. ``1280x1024``) on a free display: (process, ':N')."""
-    read_fd, write_fd = os.pipe()
-    proc = subprocess.Popen(
-        [
+    proc, number = _spawn_telling(
+        lambda fd: [
             _XVFB or "Xvfb",
             "-displayfd",
-            str(write_fd),
+            str(fd),
             "-screen",
             "0",
             f"{size}x24",
             "-nolisten",
             "tcp",
             "-noreset",
-        ],
-        pass_fds=(write_fd,),
-        stdout=subprocess.DEVNULL,
-        stderr=subprocess.DEVNULL,
+        ]
+    )
+    return proc, None if number is None else f":{number}"
+
+
+def _spawn_session_bus() -> str | None:
+    """A private D-Bus session bus for this run: its address (``DBUS_SESSION_BUS_ADDRESS``), or None."""
+    _, address = _spawn_telling(
+        lambda fd: [_DBUS_DAEMON or "dbus-daemon", "--session", "--nofork", f"--print-address={fd}"]
+    )
+    return address
+
+
+def _spawn_telling(argv: Callable[[int], list[str]]) -> tuple[subprocess.Popen[bytes] | None, str | None]:
+    """Start a server that writes one line (its display number, its address) to the descriptor it is
+    given when it is ready; (process, that line), or (None, None) when it said nothing within 15 s.
+    It is ended when the test run ends."""
+    read_fd, write_fd = os.pipe()
+    proc = subprocess.Popen(
+        argv(write_fd), pass_fds=(write_fd,), stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL
     )
     os.close(write_fd)
     deadline = time.monotonic() + 15
@@ -75,7 +93,7 @@ def _spawn_xvfb(size: str) -> tuple[subprocess.Popen[bytes] | None, str | None]:
         _terminate(proc)
         return None, None
     atexit.register(_terminate, proc)
-    return proc, f":{data.strip().decode()}"
+    return proc, data.strip().decode()
 
 
 def _start_xvfb() -> str | None:
@@ -107,16 +125,24 @@ os.environ["RTMU_GUI_TMP"] = TMP_ROOT
 
 if _XVFB is None or _XDOTOOL is None:
     SKIP_REASON = "Xvfb and xdotool are needed for the GUI tests (apt-get install xvfb xdotool)"
+elif _DBUS_DAEMON is None:
+    SKIP_REASON = "dbus-daemon is needed for the GUI tests' session bus (apt-get install dbus)"
 else:
     display = _start_xvfb()
-    if display is None:
-        SKIP_REASON = "Xvfb did not start"
+    bus = _spawn_session_bus()
+    if display is None or bus is None:
+        SKIP_REASON = "Xvfb did not start" if display is None else "the D-Bus session bus did not start"
     else:
+        os.environ["DBUS_SESSION_BUS_ADDRESS"] = bus
         os.environ["DISPLAY"] = display
         os.environ.pop("WAYLAND_DISPLAY", None)
         os.environ["GDK_BACKEND"] = "x11"
         os.environ["GSK_RENDERER"] = "cairo"
         os.environ["NO_AT_BRIDGE"] = "1"
+        # GTK 4 ignores NO_AT_BRIDGE; without this it asks the session bus for an accessibility bus and,
+        # when at-spi's launcher has gone (as on a busy CI machine), prints a Gtk-CRITICAL the tests would
+        # rightly count as a failure. Accessibility tests start their own bus and turn it back on.
+        os.environ["GTK_A11Y"] = "none"
         os.environ["GSETTINGS_BACKEND"] = "memory"
         os.environ["XDG_CONFIG_HOME"] = str(Path(TMP_ROOT) / "config")
 

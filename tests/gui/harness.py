@@ -19,6 +19,8 @@ from pathlib import Path
 import gi
 import numpy as np
 
+from rtmu.package_data import project_map
+
 gi.require_version("Gtk", "4.0")
 gi.require_version("Gdk", "4.0")
 gi.require_version("GdkX11", "4.0")
@@ -26,15 +28,15 @@ gi.require_version("Graphene", "1.0")
 from gi.repository import Gdk, GdkX11, GLib, Graphene, Gtk  # noqa: E402
 from PIL import Image  # noqa: E402
 
-from rtmu.model import OperatorState, Phase, RobotModel  # noqa: E402
+from rtmu.model.observables import OperatorState, Phase, RobotModel  # noqa: E402
+from rtmu.package_data import APP_ID  # noqa: E402
 from rtmu.ui.application import RtmuApplication  # noqa: E402
 from rtmu.ui.options import GuiOptions  # noqa: E402
 from rtmu.ui.window import MainWindow  # noqa: E402
 
 from .process import screenshot  # noqa: E402
 
-REPO = Path(__file__).resolve().parents[2]
-OFFICE_MAP = REPO / "data" / "maps" / "office.map"
+OFFICE_MAP = project_map("office.map")
 COUNTS = {"windows": 0, "pictures": 0}
 """Windows opened and pictures saved so far: every test that opens a window must leave a picture."""
 OPEN: dict[int, Callable[[], None]] = {}
@@ -60,6 +62,20 @@ def on_display(name: str) -> Iterator[Gdk.Display]:
         else:
             os.environ["DISPLAY"] = env_before
         display.close()
+
+
+def register(app: RtmuApplication) -> None:
+    """Register ``app`` on the run's session bus under an id of its own (``io.github.rtmu.Rtmu.TestN``).
+
+    This process opens many apps one after the other (``rtmu`` opens one): GLib keeps a closed app's
+    object exported on the bus until the app is finalized, so a second app with the same id could not
+    register here. Apps started as processes keep the real id."""
+    _REGISTERED[0] += 1
+    app.set_application_id(f"{APP_ID}.Test{_REGISTERED[0]}")
+    app.register(None)
+
+
+_REGISTERED = [0]
 
 
 def scratch_dir(prefix: str) -> Path:
@@ -118,7 +134,7 @@ class Gui:
     def open(cls, options: GuiOptions, shots: Path, name: str, *, connect: bool = True) -> Gui:
         """The app with these options, activated as ``rtmu`` would; waits for the connection if asked."""
         app = RtmuApplication(options)
-        app.register(None)
+        register(app)
         gui = cls(app, shots, name)
         OPEN[id(gui)] = gui.close  # before anything can fail: a half-opened app is closed too
         app.activate()

@@ -1,4 +1,4 @@
-"""The real window against ``rtmu sim --profile aram``: state of charge in %, and first-contact words."""
+"""The real window against ``rtmu sim --kind aram``: state of charge in %, and first-contact words."""
 
 from __future__ import annotations
 
@@ -86,8 +86,12 @@ def test_settings_dialog_keeps_a_protocol_string(screenshots: Path, request: pyt
         try:
             window = gui.window
             gui.key("ctrl+comma")
-            pump(lambda: window._dialog is not None and window._dialog.get_mapped(), 3, "the settings dialog")
-            dialog = window._dialog
+            pump(
+                lambda: window.dialogs.settings is not None and window.dialogs.settings.get_mapped(),
+                3,
+                "the settings dialog",
+            )
+            dialog = window.dialogs.settings
             assert dialog.protocol.get_text() == ""  # empty: answer as the server asks
             dialog.protocol.set_text(" 6MTX ")
             gui.render(dialog, gui.shots / f"{gui.name}-01-protocol.png")

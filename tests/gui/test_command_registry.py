@@ -9,7 +9,7 @@ from typing import ClassVar
 
 import pytest
 
-from rtmu.commands import COMMANDS, Command, CommandTarget
+from rtmu.control.commands import COMMANDS, Command, CommandTarget
 from rtmu.sim import SimConfig, SimThread
 from rtmu.ui.shortcuts import shortcuts_xml
 

@@ -18,7 +18,9 @@ from PIL import Image
 
 from rtmu.client.config_feed import set_config
 from rtmu.client.connection import AriaClient
+from rtmu.package_data import project_map
 from rtmu.sim import SimConfig, SimThread
+from rtmu.sim.arconfig import FILLER_CONTROL_SECTION
 from rtmu.ui.config_page import PAGE_SIZE, ConfigPage
 
 from .harness import Gui, idle, pump, scratch_dir
@@ -259,7 +261,7 @@ def test_ten_thousand_parameters_with_markup_open_bounded_and_responsive(
     gui = Gui.start(screenshots, "config-hostile", "127.0.0.1", hostile.port)
     try:
         p = open_page(gui)
-        assert p.config is not None and p.config.param_count == 10_011
+        assert p.config is not None and p.config.param_count == 10_016  # TransDecel, RotDecel, a hostile name
         choose_section(gui, p, "<b>Extra</b> & 0")
         pump(lambda: len(p.rows) == PAGE_SIZE, 5, "one page of rows")
         shown = labels(p.grid)
@@ -268,6 +270,13 @@ def test_ten_thousand_parameters_with_markup_open_bounded_and_responsive(
         assert not any(markup for _text, markup in shown)
         assert p.sections.get_row_at_index(5).get_child().get_text() == "<b>Extra</b> & 0"
         assert p.comment.get_text() == "<i>filler</i> & <span foreground='red'>markup</span>"
+        names = [p.sections.get_row_at_index(i).get_child().get_text() for i in range(len(p.config.sections))]
+        assert "Line\\rbreak\\nand \\x1b[2Jescape" in names, names  # one line, its controls shown
+        assert not any(c in name for name in names for c in "\r\n\x1b")
+        choose_section(gui, p, FILLER_CONTROL_SECTION)
+        pump(lambda: len(p.rows) == 1, 5, "the section with control characters")
+        assert ("Line\\rbreak", False) in labels(p.grid)
+        choose_section(gui, p, "<b>Extra</b> & 0")
         ticks = gui.window.ticks
         click(gui, p.next_button)
         pump(lambda: p.page_label.get_text() == "61–120 of 800 (200 above expert hidden)", 5, "the next page")
@@ -278,3 +287,24 @@ def test_ten_thousand_parameters_with_markup_open_bounded_and_responsive(
         gui.shot("main-window")
     finally:
         gui.close()
+
+
+def test_an_ld_robots_configuration_is_named_and_not_offered_for_editing(screenshots: Path) -> None:
+    """Protocol 6MTX lists Omron LD's getConfigValues family, not ArConfig's: the page says which API
+    the robot has and that RTMU cannot edit it yet, instead of an empty page or "none offered"."""
+    office = project_map("office.map")
+    with SimThread(SimConfig(port=0, profile="aram", map_path=office)) as aram:
+        gui = Gui.start(screenshots, "config-ld", "127.0.0.1", aram.port)
+        try:
+            gui.window.activate_action("win.server-config", None)
+            pump(lambda: page(gui) is not None, 5, "the configuration page")
+            p = page(gui)
+            assert p is not None
+            pump(lambda: p.banner.get_visible(), 10, "the page to name the robot's API")
+            text = p.banner.get_text()
+            assert "Omron LD's" in text and "getConfigValues" in text and "cannot show or edit it yet" in text
+            assert p.status.get_text() == "No configuration RTMU can edit"
+            assert p.config is None and not p.rows
+            gui.render(p, gui.shots / "config-ld.png")
+        finally:
+            gui.close()

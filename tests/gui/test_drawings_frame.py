@@ -11,10 +11,10 @@ from pathlib import Path
 
 import numpy as np
 
-from rtmu.state import DrawingLayer
 from rtmu.ui import overlays
 from rtmu.ui.frame import Scene
 from rtmu.ui.viewport import Viewport
+from rtmu.values.state import DrawingLayer
 
 from .test_frame_pixels import render
 

@@ -20,8 +20,8 @@ from pathlib import Path
 
 import pytest
 
-from rtmu.fleet import RobotSession
-from rtmu.settings import Profile, Settings, save_settings
+from rtmu.fleet.sessions import RobotSession
+from rtmu.settings.store import Profile, Settings, save_settings
 from rtmu.sim import SimConfig
 from rtmu.sim.central_thread import CentralThread
 from rtmu.sim.server import SimServer

@@ -13,8 +13,8 @@ from pathlib import Path
 
 import pytest
 
-from rtmu.gamepad import AXIS_TRANS, DEADMAN, DeadMan, Gamepad
-from rtmu.settings import DirectRobot
+from rtmu.control.gamepad import AXIS_TRANS, DEADMAN, DeadMan, Gamepad
+from rtmu.settings.store import DirectRobot
 from rtmu.sim import SimConfig, SimThread
 from rtmu.sim.multi import SimFleetThreads, fleet_configs
 from rtmu.ui.options import GuiOptions

@@ -24,8 +24,8 @@ import numpy as np
 import pytest
 
 from rtmu.client.roster import Emit, RobotAdded, RobotEndpoint
-from rtmu.fleet import RobotSession
-from rtmu.settings import DirectRobot
+from rtmu.fleet.sessions import RobotSession
+from rtmu.settings.store import DirectRobot
 from rtmu.sim import SimConfig, SimThread
 from rtmu.sim.multi import SimFleetThreads, fleet_configs
 from rtmu.ui.application import RtmuApplication
@@ -34,7 +34,7 @@ from rtmu.ui.options import GuiOptions
 from rtmu.ui.overlays import STALE_RGB
 from rtmu.ui.robot_list import row_text
 
-from .harness import OFFICE_MAP, OPEN, Gui, idle, pump, scratch_dir
+from .harness import OFFICE_MAP, OPEN, Gui, idle, pump, register, scratch_dir
 
 gi.require_version("Gtk", "4.0")
 from gi.repository import GLib, Gtk  # noqa: E402
@@ -134,7 +134,7 @@ def test_three_robots_are_listed_and_drawn_each_in_its_colour(
         colours = {b.colour(s) for s in gui.app.fleet}
         assert len(colours) == 3
         # The three robots share one map file (same getMapId): it was downloaded once, not three times.
-        shared = [s.runner.session.map_downloads_shared for s in gui.app.fleet if s.runner.session]
+        shared = [s.runner.session.maps.downloads_shared for s in gui.app.fleet if s.runner.session]
         assert sum(shared) == 2, shared
         datas = {id(s.state.map.value.data) for s in gui.app.fleet}
         assert len(datas) == 1, "each robot holds its own copy of the same map"
@@ -300,7 +300,7 @@ def test_robots_a_roster_names_later_appear_and_the_first_is_shown(
     )
     app = RtmuApplication(options)
     app.roster_for = lambda _profile: late  # type: ignore[method-assign]
-    app.register(None)
+    register(app)
     gui = Gui(app, screenshots, "fleet-late-roster")
     OPEN[id(gui)] = gui.close
     app.activate()

@@ -16,9 +16,9 @@ import pytest
 from gi.repository import GLib
 
 from rtmu.client.session import SessionConfig
-from rtmu.fleet import RobotSession
-from rtmu.model import Phase
-from rtmu.settings import Profile
+from rtmu.fleet.sessions import RobotSession
+from rtmu.model.observables import Phase
+from rtmu.settings.store import Profile
 from rtmu.sim import SimConfig, SimThread
 
 from .harness import OFFICE_MAP, Gui, pump

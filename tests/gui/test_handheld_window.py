@@ -18,12 +18,13 @@ from pathlib import Path
 import gi
 import pytest
 
-from rtmu.alarms import Alarm
 from rtmu.client.custom_commands import ServerCommand
-from rtmu.gamepad import AXIS_TRANS, DEADMAN, DeadMan
+from rtmu.control.alarms import Alarm
+from rtmu.control.gamepad import AXIS_TRANS, DEADMAN, DeadMan
 from rtmu.sim import SimConfig, SimThread
 from rtmu.sim.wifi import AccessPoint
 from rtmu.ui.alarm_view import AlarmView
+from rtmu.values.intents import RunServerCommand
 
 from .conftest import _spawn_xvfb, _terminate
 from .harness import OFFICE_MAP, Gui, idle, on_display, pump
@@ -181,8 +182,12 @@ def test_portrait_phone_layout_fits_and_the_thumb_dpad_drives(phone: tuple[Gui, 
     goals_popover.popdown()
     pump(lambda: not goals_popover.get_mapped(), 3, "the Go to list to close")
     window.activate_action("win.settings", None)
-    pump(lambda: window._dialog is not None and window._dialog.get_mapped(), 5, "the connection dialog")
-    dialog = window._dialog
+    pump(
+        lambda: window.dialogs.settings is not None and window.dialogs.settings.get_mapped(),
+        5,
+        "the connection dialog",
+    )
+    dialog = window.dialogs.settings
     assert dialog is not None
     idle(0.3)
     assert inside(gui.screen_rect(dialog), 360, 720), gui.screen_rect(dialog)
@@ -254,7 +259,8 @@ def test_battery_and_wifi_alarms_from_the_simulator_with_mute(phone: tuple[Gui, 
 def set_battery(gui: Gui, volts: float) -> None:
     """The simulator's own string command, sent by the window's network side: the server took it."""
     command = ServerCommand("SimulatorSetBattery", "", True)
-    assert gui.window.session.runner.run_command(command, f"{volts:.2f}").result(10)
+    intent = RunServerCommand(command.name, f"{volts:.2f}", command.takes_argument)
+    assert gui.window.session.runner.send(intent).result(10)
 
 
 def alarm_topic(alarm: Alarm) -> str:

@@ -17,7 +17,7 @@ from pathlib import Path
 import pytest
 
 from linkfaults import FAKE_HEADER, GARBAGE, TO_CLIENT, TO_SERVER, FaultProxy, WifiProfile
-from rtmu.model import LinkLevel, Phase
+from rtmu.model.observables import LinkLevel, Phase
 from rtmu.sim import SimConfig, SimThread
 
 from .harness import OFFICE_MAP, Gui, idle, pump

@@ -194,13 +194,13 @@ def test_the_v_key_plays_live_video_over_the_map_and_stops_it(gui: Gui, sim: Sim
     from rtmu.ui.shortcuts import shortcuts_xml
 
     window, live = gui.window, gui.window.live
-    assert [b.target for b in bindings() if "v" in b.accels] == ["live_video"], "V is for video only"
+    assert [b.action for b in bindings() if "v" in b.accels] == ["win.live-video"], "V is for video only"
     assert "Live video on/off" in shortcuts_xml()
-    router = KeyRouter(hold=print, release=print, command=print, view=print)
+    router = KeyRouter(hold=print, release=print, activate=print)
     for key in ("v", "V"):
         keyval = Gdk.keyval_from_name(key)
         found = router.lookup(keyval, Gdk.ModifierType.SHIFT_MASK if key == "V" else Gdk.ModifierType(0))
-        assert found is not None and found.target == "live_video", key
+        assert found is not None and found.action == "win.live-video", key
 
     gui.key("v")
     pump(lambda: live.live, 3, "V to start live video")

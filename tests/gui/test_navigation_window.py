@@ -16,7 +16,7 @@ import gi
 import numpy as np
 import pytest
 
-from rtmu.model import Phase
+from rtmu.model.observables import Phase
 from rtmu.sim import SimConfig, SimThread
 from rtmu.ui.nav_draw import PATH_RGB, MarkerKind
 
@@ -28,7 +28,7 @@ gi.require_version("Graphene", "1.0")
 from gi.repository import GdkX11, Graphene, Gtk  # noqa: E402
 
 GOALS = {"Meeting Room": (3000, 8300), "Lab B": (22500, 9000), "Room 101": (2000, 3200)}
-"""Cairns of data/maps/office.map used here (mm)."""
+"""Cairns of rtmu/data/maps/office.map used here (mm)."""
 ARRIVE_MM = 250.0
 TRIP_S = 60.0
 
@@ -383,8 +383,8 @@ def test_goals_popover_pick_bar_and_indicator_fit_an_800x480_screen(
 
 def test_what_the_server_does_not_list_stays_visible_greyed_with_its_reason() -> None:
     """The panel alone, on a model whose server lists goals and points but neither dock nor localize."""
-    from rtmu.commands import CommandState
-    from rtmu.model import ConnectionState, NavState, RobotModel
+    from rtmu.control.commands import CommandState
+    from rtmu.model.observables import ConnectionState, NavState, RobotModel
     from rtmu.ui.goals_panel import GoalsPanel
 
     model = RobotModel()
@@ -394,7 +394,6 @@ def test_what_the_server_does_not_list_stays_visible_greyed_with_its_reason() ->
         goto=chosen.append,
         run=chosen.append,
         pick=lambda kind: chosen.append(kind.value),
-        stop=lambda: chosen.append("stop"),
     )
     try:
         assert not panel.get_visible(), "hidden while not connected"

@@ -12,7 +12,7 @@ from pathlib import Path
 
 import pytest
 
-from rtmu.notices import Kind, Notice
+from rtmu.base.notices import Kind, Notice
 from rtmu.sim import SimConfig, SimThread
 
 from .harness import OFFICE_MAP, Gui, pump

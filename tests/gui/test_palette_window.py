@@ -11,7 +11,7 @@ from collections.abc import Iterator
 
 import pytest
 
-from rtmu.commands import COMMANDS
+from rtmu.control.commands import COMMANDS
 from rtmu.sim import SimConfig, SimThread
 from rtmu.ui.palette import CommandPalette
 
@@ -83,7 +83,9 @@ def test_search_and_run_a_simple_command(gui: Gui, sim: SimThread) -> None:
 def test_a_string_command_asks_for_its_argument_inline(gui: Gui, sim: SimThread) -> None:
     world = sim.server.world  # type: ignore[union-attr]
     p = open_palette(gui)
-    gui.xdotool("type", "--delay", "30", "battery voltage")
+    gui.xdotool("type", "--delay", "30", "battery")
+    gui.key("shift+space")  # in a text field Space stops the robot; Shift+Space types the space
+    gui.xdotool("type", "--delay", "30", "voltage")
     pump(lambda: p.visible_names() == ["SimulatorSetBattery"], 3, "the search to leave one command")
     gui.key("Return")  # a string command: its argument field takes the keys first
     pump(lambda: in_entry(p), 3, "the argument field to have the keys")

@@ -8,8 +8,8 @@ from dataclasses import replace
 import gi
 import pytest
 
-from rtmu.commands import COMMANDS
-from rtmu.model import ConnectionState, LinkHealth, LinkLevel, OperatorState, Phase, RobotModel
+from rtmu.control.commands import COMMANDS
+from rtmu.model.observables import ConnectionState, LinkHealth, LinkLevel, OperatorState, Phase, RobotModel
 from rtmu.ui.gauges import battery_fraction, wifi_bars
 from rtmu.ui.keys import KeyRouter, bindings
 from rtmu.ui.settings_dialog import validate
@@ -63,10 +63,10 @@ def test_wifi_bars_from_quality_or_signal() -> None:
 
 def test_every_bound_command_exists_and_keys_do_not_clash() -> None:
     seen: dict[tuple[int, int], str] = {}
-    router = KeyRouter(hold=print, release=print, command=print, view=print)
+    router = KeyRouter(hold=print, release=print, activate=print)
     for b in bindings():
-        if b.kind in ("hold", "command"):
-            assert b.target in COMMANDS, b.target
+        if b.held:
+            assert b.held in COMMANDS and COMMANDS.get(b.held).hold, b.held
         for accel in b.accels:
             ok, keyval, mods = Gtk.accelerator_parse(accel)
             assert ok, accel
@@ -75,10 +75,10 @@ def test_every_bound_command_exists_and_keys_do_not_clash() -> None:
             seen[key] = b.title
     # Shift typed the key: "+" is Shift+= on most layouts, a capital W is Shift+w.
     shift = Gdk.ModifierType.SHIFT_MASK
-    assert router.lookup(Gdk.KEY_plus, shift).target == "speed_up"  # type: ignore[union-attr]
-    assert router.lookup(Gdk.KEY_W, shift).target == "drive_forward"  # type: ignore[union-attr]
-    assert router.lookup(Gdk.KEY_Up, shift).target == "move_forward_1m"  # type: ignore[union-attr]
-    assert router.lookup(Gdk.KEY_space, Gdk.ModifierType(0)).target == "stop"  # type: ignore[union-attr]
+    assert router.lookup(Gdk.KEY_plus, shift).action == "win.speed-up"  # type: ignore[union-attr]
+    assert router.lookup(Gdk.KEY_W, shift).held == "drive_forward"  # type: ignore[union-attr]
+    assert router.lookup(Gdk.KEY_Up, shift).action == "win.move-forward-1m"  # type: ignore[union-attr]
+    assert router.lookup(Gdk.KEY_space, Gdk.ModifierType(0)).action == "win.stop"  # type: ignore[union-attr]
     assert router.lookup(Gdk.KEY_q, Gdk.ModifierType.CONTROL_MASK) is None  # left to the app accelerator
 
 
@@ -90,7 +90,7 @@ def test_shortcuts_xml_escapes_and_lists_every_binding() -> None:
 
 
 def test_the_map_note_follows_the_connection_phase_then_the_map() -> None:
-    from rtmu.model import ConnectionState, MapModel, Phase
+    from rtmu.model.observables import ConnectionState, MapModel, Phase
     from rtmu.ui.notes import map_note
 
     here = dict(host="127.0.0.1", port=7272)

@@ -17,11 +17,11 @@ import pytest
 
 from recorder.poses import recorded_pose_at
 from recorder.simsession import hold, recorded_session
-from rtmu.model import Phase
+from rtmu.model.observables import Phase
 from rtmu.recorder.replay import PacedLink
-from rtmu.state import MapPhase
 from rtmu.ui.options import GuiOptions
 from rtmu.ui.overlays import ROBOT_RGB
+from rtmu.values.state import MapPhase
 
 from .harness import Gui, idle, pump, scratch_dir
 

@@ -9,7 +9,7 @@ from pathlib import Path
 
 import pytest
 
-from rtmu.settings import Profile
+from rtmu.settings.store import Profile
 from rtmu.sim import SimConfig, SimThread
 
 from .harness import OFFICE_MAP, Gui, pump

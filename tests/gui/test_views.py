@@ -10,9 +10,9 @@ import gi
 import numpy as np
 import pytest
 
-from rtmu.maps import MapObject, new_map, write_map
-from rtmu.model import Phase
-from rtmu.notices import Kind, Notice
+from rtmu.base.notices import Kind, Notice
+from rtmu.mapfile import MapObject, new_map, write_map
+from rtmu.model.observables import Phase
 from rtmu.sim import SimConfig, SimThread
 
 from .harness import OFFICE_MAP, Gui, idle, pump
@@ -96,7 +96,7 @@ def test_the_map_note_says_connecting_connected_and_not_connected(start: Start, 
     """One note, from the connection phase: never "not connected" beside a Disconnect button."""
     import socket
 
-    from rtmu.model import MapModel
+    from rtmu.model.observables import MapModel
 
     with socket.socket() as deaf:  # accepts the TCP connection (backlog) and never says a word
         deaf.bind(("127.0.0.1", 0))
@@ -219,8 +219,12 @@ def test_settings_dialog_validates_inline_and_saves_a_profile(start: Start) -> N
     gui, _sim = start()
     window = gui.window
     gui.key("ctrl+comma")
-    pump(lambda: window._dialog is not None and window._dialog.get_mapped(), 3, "the settings dialog")
-    dialog = window._dialog
+    pump(
+        lambda: window.dialogs.settings is not None and window.dialogs.settings.get_mapped(),
+        3,
+        "the settings dialog",
+    )
+    dialog = window.dialogs.settings
     dialog.port.set_text("99999")
     dialog.host.set_text("bad host!")
     assert not dialog.save.get_sensitive()
@@ -366,7 +370,7 @@ def test_a_user_is_asked_for_the_password_and_a_wrong_one_is_reported(
 
 
 def test_plain_rtmu_opens_the_last_profile_and_connects(screenshots: Path, tmp_path: Path) -> None:
-    from rtmu.settings import Profile, Settings, save_settings
+    from rtmu.settings.store import Profile, Settings, save_settings
     from rtmu.ui.options import GuiOptions
 
     with SimThread(SimConfig(port=0, map_path=OFFICE_MAP, seed=1)) as sim:
@@ -384,7 +388,7 @@ def test_plain_rtmu_opens_the_last_profile_and_connects(screenshots: Path, tmp_p
             gui.shot("last-profile-at-100pct-speed-60")
         finally:
             gui.close()
-        from rtmu.settings import load_settings
+        from rtmu.settings.store import load_settings
 
         saved = load_settings(path).settings
         assert saved.last_profile == "lab" and saved.profiles["lab"].speed == 60, (
@@ -405,7 +409,7 @@ def test_battery_turns_amber_at_the_low_level_and_red_at_shutdown(
 
 
 def test_unsupported_commands_are_disabled_with_the_reason(start: Start) -> None:
-    from rtmu.commands import CommandState
+    from rtmu.control.commands import CommandState
 
     gui, _sim = start(map_path=None)
     window = gui.window
@@ -424,7 +428,7 @@ def test_unsupported_commands_are_disabled_with_the_reason(start: Start) -> None
 def test_wifi_not_published_is_greyed_with_a_reason(screenshots: Path) -> None:
     import time as _time
 
-    from rtmu.model import RobotState
+    from rtmu.model.observables import RobotState
 
     gui = Gui.start(screenshots, "test_wifi", "127.0.0.1", 1, connect=False)
     try:

@@ -15,7 +15,7 @@ from collections.abc import Iterator
 import numpy as np
 import pytest
 
-from rtmu.model import Phase
+from rtmu.model.observables import Phase
 from rtmu.sim import SimConfig, SimThread
 
 from .harness import OFFICE_MAP, Gui, idle, pump

@@ -3,7 +3,6 @@
 from __future__ import annotations
 
 import contextlib
-from pathlib import Path
 
 import pytest
 from hypothesis import given
@@ -11,6 +10,7 @@ from hypothesis import strategies as st
 
 from rtmu.protocol import DataEntry, DataList, FieldWriter, Packet, PacketDecoder, PayloadError, ServerCommand
 from rtmu.protocol.packet import MAX_LENGTH
+from testdata import CAPTURES
 
 from .test_packet import tcp_streams
 
@@ -178,9 +178,9 @@ def test_visible_to_filters_by_command_group() -> None:
     assert [e.name for e in dl.visible_to(set())] == ["identSetSelfIdentifier"]
 
 
-def test_the_captured_catalogue_of_a_real_server(shared_dir: Path) -> None:
+def test_the_captured_catalogue_of_a_real_server() -> None:
     """clientCommandLister against serverDemo: 114 data in LIST, LISTARGRET, LISTGROUPANDFLAGS."""
-    streams = tcp_streams(shared_dir / "captures" / "clientCommandLister-serverDemoMap.pcap")
+    streams = tcp_streams(CAPTURES / "clientCommandLister-serverDemoMap.pcap")
     from_server = next(s for (_, sport, _, _), s in streams.items() if sport == 7272)
     client = DataList()
     for packet in PacketDecoder().feed(from_server):

@@ -23,6 +23,7 @@ from rtmu.protocol import (
     encode_packet,
 )
 from rtmu.protocol.checksum import checksum_naive
+from testdata import CAPTURES
 
 
 def wire(hex_bytes: str) -> bytes:
@@ -160,16 +161,16 @@ def tcp_streams(path: Path) -> dict[Direction, bytes]:
     return {key: bytes(data) for key, data in streams.items()}
 
 
-def capture_files(shared: Path) -> list[Path]:
-    files = sorted((shared / "captures").glob("*.pcap"))
-    assert len(files) >= 8, "the shared captures are missing"
+def capture_files() -> list[Path]:
+    files = sorted(CAPTURES.glob("*.pcap"))
+    assert len(files) >= 8, f"the captured ARIA sessions are missing from {CAPTURES}"
     return files
 
 
-def test_every_captured_packet_decodes_and_re_encodes_to_the_same_bytes(shared_dir: Path) -> None:
+def test_every_captured_packet_decodes_and_re_encodes_to_the_same_bytes() -> None:
     """The captures hold ~65 000 packets from ARIA 2.9.1 itself: none may be dropped or altered."""
     total = 0
-    for path in capture_files(shared_dir):
+    for path in capture_files():
         streams = tcp_streams(path)
         assert streams, path
         for direction, stream in streams.items():

@@ -10,11 +10,11 @@ from __future__ import annotations
 
 import struct
 import time
-from pathlib import Path
 
 import pytest
 
 from rtmu.capture import open_capture
+from rtmu.capture.session_decoder import CaptureDecoder, DecodedPacket
 from rtmu.protocol.errors import FieldUnderrun, PayloadError
 from rtmu.protocol.payloads import Side, payload_type_for
 from rtmu.protocol.payloads.drawings import (
@@ -27,10 +27,8 @@ from rtmu.protocol.payloads.drawings import (
     Shape,
     Visibility,
 )
-from rtmu.protocol.payloads.sensors import Drawing as SensorsDrawing
-from rtmu.session_decoder import CaptureDecoder, DecodedPacket
+from testdata import CAPTURES
 
-CAPTURES = Path(__file__).resolve().parents[2].parent / "shared" / "captures"
 ARIA_DRAWING_REPLY = (
     "See getDrawingList for the information on how this drawing should be drawn, "
     "and the documentation in ArDrawingData for that information means."
@@ -88,7 +86,6 @@ def test_a_drawing_list_packet_is_arias_layout_field_by_field() -> None:
     assert back.rgb == pytest.approx((0x33 / 255, 0xCC / 255, 1.0))
     assert DrawingListPacket.decode(b"").end_of_reply
     assert payload_type_for("getDrawingList", Side.REPLY) is DrawingListPacket
-    assert SensorsDrawing is Drawing  # the old import path still works
 
 
 @pytest.mark.parametrize(

@@ -81,3 +81,4 @@ def test_registry_finds_every_ld_name():
     assert payload_type_for("say", Side.ARGS) is Say
     assert payload_type_for("DataStore_WiFi_Quality", Side.REPLY) is DataStoreValue
     assert data_store_label("DataStore_WiFi_Quality") == "WiFi Quality"
+    assert data_store_label("DataStore_LaserLocalizationScore") == "Laser Localization Score"

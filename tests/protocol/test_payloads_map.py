@@ -60,8 +60,8 @@ def captured_binary_stream() -> list[bytes]:
 
 
 def test_map_name() -> None:
-    raw = b"/work/shared/aria-maps/office.map\0"
-    assert MapName.decode(raw) == MapName("/work/shared/aria-maps/office.map")
+    raw = b"/usr/local/Aria/maps/office.map\0"
+    assert MapName.decode(raw) == MapName("/usr/local/Aria/maps/office.map")
     assert MapName.decode(raw).encode() == raw
     assert MapName("").encode() == b"\0"
 

@@ -18,6 +18,7 @@ from rtmu.protocol.payloads import (
     central,
     commands,
     decode_payload,
+    drawings,
     drive,
     ld,
     navigation,
@@ -31,7 +32,11 @@ from rtmu.protocol.payloads import (
 )
 from rtmu.protocol.payloads import camera as cam
 from rtmu.protocol.payloads import config as cfg
+from rtmu.protocol.payloads import configcare as care
+from rtmu.protocol.payloads import files as fs
 from rtmu.protocol.payloads import map as mp
+from rtmu.protocol.payloads import mapchange as mc
+from rtmu.protocol.payloads import mapping as scan
 
 SAMPLES: list[Payload] = [
     robot.UpdateNumbers(12.3, -1000, 2000, -45, 300, -20, 0, 31),
@@ -66,10 +71,10 @@ SAMPLES: list[Payload] = [
     sensors.SensorCumulativeReadings("sonar", ((1, 2),)),
     sensors.RangeDeviceReadings(((1, 2),)),
     sensors.RangeDeviceCumulative(((5, 6),)),
-    sensors.DrawingListPacket(
-        sensors.Drawing("sonarCurrent", "polyArrows", 0x33CCFF, 80, 75, 5000, 255, "On")
+    drawings.DrawingListPacket(
+        drawings.Drawing("sonarCurrent", "polyArrows", 0x33CCFF, 80, 75, 5000, 255, "On")
     ),
-    sensors.DrawingList((sensors.Drawing("sonarCurrent", "polyArrows", 1, 2, 3, 4, 5),)),
+    drawings.DrawingList((drawings.Drawing("sonarCurrent", "polyArrows", 1, 2, 3, 4, 5),)),
     cam.VideoFrame(320, 240, b"\xff\xd8jpeg\xff\xd9", b"\x05\xaa"),
     cam.Picture(2, 1, b"\xff\xd8\xff\xd9"),
     cam.VideoRequest(90),
@@ -149,6 +154,52 @@ SAMPLES: list[Payload] = [
     cfg.ConfigSectionFlags((("Teleop", ""),)),
     cfg.LastEditablePriority(3),
     cfg.ConfigCausingRestart(1),
+    fs.DirListingRequest("maps"),
+    fs.DirListingMultipleRequest(""),
+    fs.DirListing(0, "", (fs.DirEntry(1, "maps", 1, 2, 4096), fs.DirEntry(2, "a.map", 3, 4, 120))),
+    fs.DirListingPacket(0, "maps", (fs.DirEntry(2, "office.map", 5, 6, 2291),)),
+    fs.GetFileRequest("maps/office.map"),
+    fs.GetFileWithTimestampRequest("office.map"),
+    fs.FileChunk(0, "office.map", b"2D-Map\n"),
+    fs.TimestampedFileChunk(0, "office.map", b"", 1795237141),
+    fs.PutFileRequest(1, "a.map", b"data"),
+    fs.PutFileInterleavedRequest(0, "a.map"),
+    fs.PutFileWithTimestampRequest(0, "a.map", mtime=1795237141),
+    fs.PutFileWithTimestampInterleavedRequest(2, "a.map"),
+    fs.PutFileReply(0, "a.map"),
+    fs.PutFileInterleavedReply(10, "a.map"),
+    fs.PutFileWithTimestampReply(7, "a.map"),
+    fs.PutFileWithTimestampInterleavedReply(11, "a.map"),
+    fs.DeleteFileRequest("a.map"),
+    fs.DeleteFileReply(2, "a.map"),
+    fs.DefaultUploadDownloadDir("maps"),
+    scan.MappingStart("office"),
+    scan.MappingStartReply(0),
+    scan.MappingEndReply(1),
+    scan.MappingStatus("office"),
+    scan.MappingStatusBroadcast("office.2d"),
+    scan.MappingLoopStart("1"),
+    scan.MappingLoopEnd("1"),
+    care.ConfigDefaultsRequest("Teleop"),
+    care.ConfigDefaults((("Section", "Teleop"), ("Timeout", "2"))),
+    care.ConfigDefaultsUpdated(),
+    care.SetConfigParam((("Section", "Teleop"), ("Timeout", "1"))),
+    care.SetConfigParamReply("Teleop", "Teleop/Timeout: 99 is above the maximum of 60"),
+    care.ReloadConfig(),
+    care.CheckMap(),
+    mc.MapChangePacket(
+        mc.ChangeCommand.CONTINUE,
+        mp.MapId("", "office.map", bytes(range(16)), 2291, 1795237141),
+        mp.MapId("", "office.map", b"", 0, -1),
+        mc.ChangeData.OBJECTS,
+        mc.LineChange.ADDITIONS,
+        "",
+        -1,
+        1,
+        (mc.FileLineGroup(mc.FileLine(12, 'Cairn: Goal 1000 2000 0.000000 "" ICON "Kitchen"')),),
+    ),
+    mc.MapChangeReply(10),
+    mc.MapChangesInProgress(True),
 ]
 TYPES = sorted(registered().values(), key=lambda c: (c.DATA_NAME, c.SIDE.value))
 
@@ -202,7 +253,7 @@ def test_hostile_counts_are_refused_without_allocating() -> None:
     for cls, raw in [
         (robot.ModeDataList, big),
         (sensors.RangeDeviceReadings, big),
-        (sensors.DrawingList, big),
+        (drawings.DrawingList, big),
         (mp.MapId, b"\0\0" + big),
         (sensors.SensorReadings, b"\xff\x7fsonar\0"),
         (strings.StringsInfo, b"\xff\xff"),

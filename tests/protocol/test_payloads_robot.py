@@ -47,7 +47,9 @@ def test_update_numbers_captured() -> None:
     assert not n.temperature_known
     assert n.encode() == NUMBERS_CAPTURED
     m = UpdateNumbers.decode(NUMBERS_MOBILESIM)
-    assert m.th == -179 and m.temperature == -127 and m.temperature_known
+    assert m.th == -179 and m.temperature == -127
+    assert not m.temperature_known, "MobileSim's -127 means no sensor, not -127 degrees"
+    assert UpdateNumbers(13.0, 0, 0, 0, 0, 0, 0, -126).temperature_known
     assert m.encode() == NUMBERS_MOBILESIM
 
 

@@ -10,10 +10,8 @@ from hypothesis import strategies as st
 
 from rtmu.protocol.errors import FieldUnderrun, PayloadError
 from rtmu.protocol.payloads import Side, decode_payload, payload_type_for
+from rtmu.protocol.payloads.drawings import Drawing, DrawingList, DrawingListPacket
 from rtmu.protocol.payloads.sensors import (
-    Drawing,
-    DrawingList,
-    DrawingListPacket,
     RangeDeviceCumulative,
     RangeDeviceReadings,
     SensorCumulativeReadings,

@@ -19,6 +19,8 @@ from websockets.sync.client import ClientConnection, connect
 
 SUBPROTOCOL = "foxglove.sdk.v1"
 """What foxglove-sdk 0.30 asks for (the successor of ``foxglove.websocket.v1``, same messages)."""
+OLD_SUBPROTOCOL = "foxglove.websocket.v1"
+"""What the protocol's spec, older Foxglove and other ws-protocol clients ask for."""
 
 
 @dataclass
@@ -38,10 +40,20 @@ class FoxgloveClient:
     channels: dict[str, dict[str, Any]] = field(default_factory=dict)
     """Topic → the advertised channel."""
     messages: list[Received] = field(default_factory=list)
+    statuses: list[dict[str, Any]] = field(default_factory=list)
+    """Every ``status`` message the server sent this client."""
+    subprotocol: str = SUBPROTOCOL
+    origin: str | None = None
+    """The Origin header a browser page would send (None: none, as a non-browser client)."""
     _subs: dict[int, str] = field(default_factory=dict)
 
     def __enter__(self) -> FoxgloveClient:
-        opened = connect(self.url, subprotocols=[SUBPROTOCOL], open_timeout=5)  # type: ignore[list-item]
+        opened = connect(
+            self.url,
+            subprotocols=[self.subprotocol],  # type: ignore[list-item]
+            origin=self.origin,  # type: ignore[arg-type]
+            open_timeout=5,
+        )
         self.ws = opened.__enter__()
         return self
 
@@ -76,6 +88,8 @@ class FoxgloveClient:
             elif op == "advertise":
                 for channel in message["channels"]:
                     self.channels[channel["topic"]] = channel
+            elif op == "status":
+                self.statuses.append(message)
             return
         if frame[0] == 1:
             sub, log_time = struct.unpack_from("<IQ", frame, 1)

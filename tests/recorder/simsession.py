@@ -9,20 +9,26 @@ from pathlib import Path
 
 from client.fakes import FakeView
 from client.uiqueue import UiQueue
-from rtmu.client.session import SessionConfig
-from rtmu.fleet import Fleet, RobotSession
-from rtmu.model import Phase
-from rtmu.settings import Profile, RecordingSettings
+from rtmu.client.link import Opener
+from rtmu.client.session_config import SessionConfig
+from rtmu.fleet.sessions import Fleet, RobotSession
+from rtmu.model.observables import Phase
+from rtmu.package_data import project_map
+from rtmu.settings.store import Profile, RecordingSettings
 from rtmu.sim import SimConfig, SimThread
-from rtmu.state import StateChange
+from rtmu.values.state import StateChange
 
-REPO = Path(__file__).resolve().parents[2]
-ARENA = REPO / "data" / "maps" / "arena.map"
+ARENA = project_map("arena.map")
 
 
 @contextmanager
 def recorded_session(
-    directory: Path, *, sim: SimConfig | None = None, spy: list[StateChange] | None = None
+    directory: Path,
+    *,
+    sim: SimConfig | None = None,
+    spy: list[StateChange] | None = None,
+    config: SessionConfig | None = None,
+    opener: Opener | None = None,
 ) -> Iterator[tuple[RobotSession, UiQueue, FakeView, SimThread]]:
     """A connected session recording into ``directory``; ``spy`` gets every change the session published."""
     with SimThread(sim or SimConfig(port=0, map_path=ARENA, seed=1)) as server:
@@ -31,9 +37,10 @@ def recorded_session(
         profile = Profile("lab", host="127.0.0.1", port=server.port)
         session = fleet.open(
             post=ui.post,
-            config=SessionConfig(),
+            config=config or SessionConfig(),
             profile=profile,
             recording=RecordingSettings(directory=str(directory)),
+            opener=opener,
         )
         if spy is not None:
             tap = session.runner.on_publish

@@ -21,7 +21,15 @@ from rtmu.client.session import SessionConfig
 from rtmu.recorder import topics
 from rtmu.recorder.bridge import LEASE_TTL, QUEUE_SIZE, Bridge, DriveLimits, TwistDrive, twist_ratios
 from rtmu.sim import SimConfig, SimThread
-from rtmu.state import ConnectionChanged, MapChanged, MapPhase, Phase, RobotChanged, RobotState, StateChange
+from rtmu.values.state import (
+    ConnectionChanged,
+    MapChanged,
+    MapPhase,
+    Phase,
+    RobotChanged,
+    RobotState,
+    StateChange,
+)
 
 from .foxglove_client import FoxgloveClient, twist
 from .poses import _position
@@ -65,7 +73,7 @@ def bridged(*, drive: bool) -> Iterator[tuple[SimThread, ClientRunner, Bridge, l
 
 
 def url(bridge: Bridge) -> str:
-    return f"ws://127.0.0.1:{bridge.port}"
+    return bridge.url
 
 
 def stream(client: FoxgloveClient, payload: bytes, hz: float, seconds: float) -> None:
@@ -79,8 +87,10 @@ def test_a_client_gets_live_poses_and_the_map_it_subscribed_to_after_it_loaded()
     with bridged(drive=False) as (sim, _runner, bridge, _stops), FoxgloveClient(url(bridge)) as client:
         client.until(lambda: bool(client.server_info))
         assert "clientPublish" not in client.server_info.get("capabilities", [])
-        client.subscribe(topics.POSE, topics.MAP, topics.STATUS)
+        client.subscribe(topics.POSE, topics.MAP, topics.STATUS, topics.LASER)
         client.until(lambda: bool(client.of(topics.MAP)), 5)  # the map was published before we came
+        client.until(lambda: bool(client.of(topics.LASER)), 5)  # a Pioneer's laser (sim_lms2xx_1Current)
+        assert client.channels[topics.LASER]["schemaName"] == "foxglove.PointCloud"
         assert client.channels[topics.POSE]["schemaName"] == "foxglove.PoseInFrame"
         # Someone else drives the simulated robot: the poses follow it.
         sim.call(lambda: sim.server.world.ratio_drive(60.0, 0.0, 60.0))  # type: ignore[union-attr]

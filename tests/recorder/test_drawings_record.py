@@ -3,7 +3,7 @@
 from __future__ import annotations
 
 from rtmu.recorder.convert import Converter
-from rtmu.state import DrawingLayer, DrawingsChanged, DrawingsState
+from rtmu.values.state import DrawingLayer, DrawingsChanged, DrawingsState
 
 
 def _state(points: tuple[tuple[int, int], ...], shown: bool = True) -> DrawingsChanged:

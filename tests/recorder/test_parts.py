@@ -5,22 +5,22 @@ from __future__ import annotations
 import os
 import threading
 import time
+from dataclasses import replace
 from pathlib import Path
 
 import pytest
 
+from rtmu.base.notices import Kind
 from rtmu.capture import CaptureError, open_capture
 from rtmu.client.lease import DriveLease, DriveRatios, EndReason, LeaseEvent
-from rtmu.fleet import recorder_for
-from rtmu.notices import Kind
+from rtmu.fleet.sessions import recorder_for
 from rtmu.recorder import Limits, Recorder, RecorderConfig, Recording, topics
-from rtmu.recorder.convert import Converter, other_topic, status_record
+from rtmu.recorder.convert import REPEAT_EVERY, REPEAT_NS, Converter, other_topic, status_record
 from rtmu.recorder.files import file_name, prune, recordings_dir
-from rtmu.recorder.intents import IntentTap
 from rtmu.recorder.items import Event
 from rtmu.recorder.mcapfile import McapFile
-from rtmu.settings import RecordingSettings, SettingsError, format_settings, parse_settings
-from rtmu.state import ConnectionChanged, ConnectionState, Phase, RobotChanged, RobotState
+from rtmu.settings.store import RecordingSettings, SettingsError, format_settings, parse_settings
+from rtmu.values.state import ConnectionChanged, ConnectionState, Phase, RobotChanged, RobotState
 
 from .mcapread import read
 
@@ -83,27 +83,6 @@ class Runner:
         self.calls.append(("beat",))
 
 
-def test_intents_pass_through_and_are_recorded_without_secrets() -> None:
-    inner = Runner()
-    seen: list[tuple[str, dict[str, object]]] = []
-    tap = IntentTap(inner, lambda name, args: seen.append((name, args)))
-    assert tap.connect("robot", 7272, "alice", "hunter2", profile="lab") == "future"
-    tap.command("turnByAngle", 90.0)
-    tap.ui_heartbeat()
-    tap.on_notice = print  # set on the real link
-    assert inner.on_notice is print
-    assert inner.calls == [
-        ("connect", "robot", 7272, "alice", "hunter2", "lab"),
-        ("command", "turnByAngle", 90.0),
-        ("beat",),
-    ]
-    assert seen == [
-        ("connect", {"host": "robot", "port": 7272, "user": "alice", "profile": "lab"}),
-        ("command", {"name": "turnByAngle", "args": [90.0]}),
-    ]
-    assert "hunter2" not in repr(seen)
-
-
 def test_the_lease_reports_grants_changes_and_ends_with_their_reason() -> None:
     lease = DriveLease()
     events: list[LeaseEvent] = []
@@ -126,19 +105,45 @@ def test_status_names_the_battery_unit_the_robot_reports() -> None:
     assert soc["battery"] == {"state": "ok", "low": 20.0, "shutdown": None, "state_of_charge_pct": 41.0}
     volts = status_record(RobotState(battery_v=11.0, battery_low=11.5))
     assert volts["battery"]["volts"] == 11.0 and volts["battery"]["state"] == "low"
+    unknown = status_record(RobotState(battery_v=None, battery_is_soc=False))["battery"]
+    assert "volts" not in unknown and "state_of_charge_pct" not in unknown and unknown["state"] == "unknown"
 
 
 def test_unchanged_parts_are_not_written_again() -> None:
     convert = Converter()
-    still = RobotState(x=1000.0, y=2000.0, th=90.0, status="Stopped")
+    still = RobotState(x=1000.0, y=2000.0, th=90.0, status="Stopped", numbers_at=1.0, strings_at=1.0)
     first = [t for t, _ in convert.change(RobotChanged(still), 1)]
     assert first == [topics.POSE, topics.TF, topics.STATUS]
     assert convert.change(RobotChanged(still), 2) == []
-    moved = [
-        t
-        for t, _ in convert.change(RobotChanged(RobotState(x=1001.0, y=2000.0, th=90.0, status="Stopped")), 3)
-    ]
-    assert moved == [topics.POSE, topics.TF]
+    moved = replace(still, x=1001.0)
+    assert [t for t, _ in convert.change(RobotChanged(moved), 3)] == [topics.POSE, topics.TF]
+
+
+def test_nothing_of_the_robot_is_written_before_the_server_described_it() -> None:
+    """The session's starting RobotState is a placeholder: no pose at (0, 0), no empty status."""
+    convert = Converter()
+    assert convert.change(RobotChanged(RobotState()), 1) == []
+    assert convert.repeat(REPEAT_NS * 3) == []
+    numbers = RobotState(x=5.0, numbers_at=2.0)
+    assert [t for t, _ in convert.change(RobotChanged(numbers), 2)] == [topics.POSE, topics.TF]
+    words = replace(numbers, status="Stopped", mode="Stop", strings_at=2.1)  # its words, 100 ms later
+    status = convert.change(RobotChanged(words), 3)
+    assert [t for t, _ in status] == [topics.STATUS] and status[0][1]["status"] == "Stopped"
+    mute = Converter()  # a server that sends no status words: its numbers are recorded after a while
+    mute.change(RobotChanged(numbers), 10)
+    assert [t for t, _ in mute.repeat(10 + REPEAT_NS)] == [topics.POSE, topics.TF, topics.STATUS]
+
+
+def test_a_parked_robots_pose_and_status_are_repeated_so_every_second_holds_them() -> None:
+    convert = Converter()
+    parked = RobotState(x=1000.0, y=2000.0, th=90.0, status="Stopped", numbers_at=1.0, strings_at=1.0)
+    convert.change(RobotChanged(parked), 0)
+    assert convert.repeat(REPEAT_NS - 1) == [], "not yet"
+    again = convert.repeat(REPEAT_NS)
+    assert [t for t, _ in again] == [topics.POSE, topics.TF, topics.STATUS]
+    assert again[2][1]["status"] == "Stopped"
+    assert convert.repeat(REPEAT_NS + 1) == [], "just written"
+    assert REPEAT_NS / 1e9 + REPEAT_EVERY < 1.0, "called this often, no second of the file lacks them"
 
 
 def test_producers_never_wait_for_a_stuck_writer(tmp_path: Path, monkeypatch: pytest.MonkeyPatch) -> None:
@@ -225,7 +230,7 @@ def test_every_part_the_session_publishes_has_a_topic_of_its_own() -> None:
     """Parts without a Foxglove schema (navigation, popups, parts added later) each get a JSON topic."""
     import typing
 
-    from rtmu import state
+    from rtmu.values import state
 
     own = {
         state.RobotChanged,

@@ -14,18 +14,22 @@ from pathlib import Path
 
 import pytest
 
+from rtmu.client.errors import MotionRefused
+from rtmu.client.roles import Role
 from rtmu.client.runner import ClientRunner
 from rtmu.client.session import SessionConfig
+from rtmu.protocol.packet import encode_packet
+from rtmu.protocol.payloads.drive import RatioDrive
 from rtmu.recorder import Recorder, RecorderConfig
-from rtmu.recorder.replay import PacedLink, ReplayClock, Replayer
+from rtmu.recorder.replay import REPLAY_CONFIG, PacedLink, ReplayClock, Replayer
 from rtmu.recorder.replay_file import ReplayFileError, compressed_image_data, load
 from rtmu.sim import SimConfig, SimThread
-from rtmu.state import CameraChanged, MapChanged, MapPhase, RobotChanged, StateChange
+from rtmu.values import intents
+from rtmu.values.intents import RequestPicture
+from rtmu.values.state import CameraChanged, MapChanged, MapPhase, RobotChanged, StateChange
 
 from .poses import poses, recorded_pose_at
 from .simsession import hold, recorded_session
-
-REPLAY_CONFIG = SessionConfig(ping_interval=3600.0, lost_after=3600.0, connect_timeout=3600.0)
 
 
 @pytest.fixture(scope="module")
@@ -35,7 +39,7 @@ def recording(tmp_path_factory: pytest.TempPathFactory) -> Path:
         ui.wait_for(lambda: session.state.map.value.state is MapPhase.READY, timeout=15)
         for _ in range(2):
             before = session.state.camera.value
-            session.controller.request_image()
+            session.controller.ask(RequestPicture())
             ui.wait_for(lambda b=before: session.state.camera.value is not b, timeout=5)
         hold(ui, session, "forward", 1.2)
         hold(ui, session, "left", 0.8)
@@ -122,17 +126,24 @@ def test_seeking_back_rebuilds_from_the_start_and_forward_only_moves_the_clock(r
         runner.close()
 
 
-def test_a_replay_link_refuses_drive_packets_and_sends_nothing(recording: Path) -> None:
+def test_a_replay_is_an_observer_and_its_link_refuses_drive_packets(recording: Path) -> None:
     runner, replayer, _seen = replaying(recording)
     try:
         replayer.clock.seek(replayer.clock.end_ns)
         runner.connect("replay", 0, auto_reconnect=False)
         until(lambda: replayer.link is not None and replayer.link.exhausted)
         link = replayer.link
-        assert link is not None
-        before = link.refused
-        runner.stop_and_wait(2.0)  # the session's own stop: zero ratios + stop → both refused
-        until(lambda: link.refused >= before + 2, timeout=5)
+        assert link is not None and runner.session is not None and runner.session.client is not None
+        assert runner.session.client.role is Role.OBSERVER
+        written = link.written
+        runner.stop_and_wait(2.0)  # STOP, a navigation: the observer's client puts neither on the link
+        with pytest.raises(MotionRefused):
+            runner.send(intents.GotoGoal(name="anywhere")).result(5)
+        runner.sync()
+        assert link.written == written and link.refused == 0
+        # …and the link itself refuses a drive packet that reaches it some other way.
+        link.write(encode_packet(next(iter(link.recorded.motion)), RatioDrive(50.0, 0.0, 50.0).encode()))
+        assert link.refused == 1
     finally:
         runner.close()
 

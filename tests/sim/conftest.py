@@ -6,13 +6,14 @@ from pathlib import Path
 
 import pytest
 
-REPO = Path(__file__).resolve().parents[2]
-ARENA = REPO / "data" / "maps" / "arena.map"
+from rtmu.package_data import project_map
+
+ARENA = project_map("arena.map")
 
 
 @pytest.fixture
 def arena_map() -> Path:
-    """``data/maps/arena.map`` is committed: its absence is a broken checkout, not a reason to skip."""
+    """``rtmu/data/maps/arena.map`` is committed: its absence is a broken checkout, not a reason to skip."""
     if not ARENA.is_file():
         pytest.fail(f"{ARENA} is missing: it is part of the repository (restore it with git)")
     return ARENA
@@ -21,7 +22,7 @@ def arena_map() -> Path:
 @pytest.fixture(scope="session")
 def million_point_map(tmp_path_factory) -> Path:
     """A generated 1 M-point building map: its binary stream (8 MB) is larger than a client may queue."""
-    from rtmu.maps import write_map
+    from rtmu.mapfile import write_map
     from rtmu.sim.mapgen import generate_map
 
     path = tmp_path_factory.mktemp("maps") / "million.map"

@@ -19,6 +19,7 @@ from rtmu.client.connection import AriaClient, Packet
 from rtmu.client.errors import ClientError
 from rtmu.protocol.client_connection import ClientConnection
 from rtmu.protocol.events import DataListReady
+from rtmu.protocol.payloads.robot import UpdateNumbers
 from rtmu.sim import SimConfig, SimServer
 from rtmu.sim.central import CentralConfig, CentralServer
 
@@ -240,8 +241,22 @@ def test_rtmu_sim_central_with_robots_serves_a_fleet_and_stops_on_sigint() -> No
                 await asyncio.sleep(0.1)
 
         assert run(names()) == ["robot1", "robot2"]
+
+        async def poses() -> set[tuple[int, int]]:
+            seen = set()
+            for endpoint, _ in await list_robots("127.0.0.1", port, timeout=5):
+                client = AriaClient()
+                await client.connect(endpoint.host, endpoint.port, timeout=5)
+                try:
+                    numbers = UpdateNumbers.decode((await client.request_once("updateNumbers")).payload)
+                    seen.add((numbers.x, numbers.y))
+                finally:
+                    await client.disconnect()
+            return seen
+
+        assert len(run(poses())) == 2, "two robots start at the same place"
         proc.send_signal(signal.SIGINT)
-        assert proc.wait(15) == 0
+        assert proc.wait(15) == 128 + signal.SIGINT  # ended by Ctrl-C, as every command
     finally:
         if proc.poll() is None:
             proc.kill()

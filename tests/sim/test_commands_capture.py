@@ -15,10 +15,11 @@ from typing import Any
 from rtmu.client.custom_commands import list_commands, offers_commands
 from rtmu.protocol.payloads.commands import CommandEntry, CommandList, StringCommandList
 from rtmu.sim.catalogue import STRING_COMMANDS, custom_commands
+from testdata import CAPTURES
 
-from .wire import SHARED, captured_datalist
+from .wire import captured_datalist
 
-CAPTURE = SHARED / "captures" / "clientCommandLister-serverDemoMap.pcap"
+CAPTURE = CAPTURES / "clientCommandLister-serverDemoMap.pcap"
 STRING_ARG = "string: argumentToCommand"
 
 

@@ -16,10 +16,11 @@ from rtmu.protocol.payloads.config import (
 from rtmu.protocol.payloads.drive import RatioDrive
 from rtmu.sim import SimConfig, SimServer
 from rtmu.sim.arconfig import FILLER_PER_SECTION
+from testdata import CAPTURES
 
-from .wire import SHARED, WireClient, captured_datalist, run
+from .wire import WireClient, captured_datalist, run
 
-CAPTURE = SHARED / "captures" / "clientCommandLister-serverDemoMap.pcap"
+CAPTURE = CAPTURES / "clientCommandLister-serverDemoMap.pcap"
 
 
 async def _start(**kw) -> tuple[SimServer, WireClient]:

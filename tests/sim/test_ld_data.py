@@ -1,9 +1,12 @@
-"""What ``rtmu sim --profile aram`` serves beyond serverDemo, as a client on loopback sees it."""
+"""What ``rtmu sim --kind aram`` serves beyond serverDemo, as a client on loopback sees it."""
 
 from __future__ import annotations
 
 import math
 
+from rtmu.package_data import project_map
+from rtmu.protocol.payloads.drawings import DrawingListPacket
+from rtmu.protocol.payloads.drive import RatioDrive
 from rtmu.protocol.payloads.ld import (
     DataStoreValue,
     DockInfo,
@@ -13,9 +16,9 @@ from rtmu.protocol.payloads.ld import (
     Routes,
     Say,
 )
-from rtmu.protocol.payloads.sensors import DrawingListPacket, RangeDeviceReadings
+from rtmu.protocol.payloads.sensors import RangeDeviceReadings
 from rtmu.sim import SimConfig, SimServer
-from rtmu.sim.ld_data import DOCK_SECONDS, ROUTES, ld_state
+from rtmu.sim.ld_data import ROUTES, ld_state
 
 from .wire import WireClient, eventually, run
 
@@ -45,31 +48,50 @@ def test_front_laser_sees_the_wall_at_one_ray_per_degree(tmp_path):
         # 4 m to each side); the low laser (126°, 4 m) only where it is within 4 m.
         assert 100 <= len(front) <= 140 and all(x == 2000 for x, _ in front)
         assert 0 < len(low) < len(front) and all(x == 2000 for x, _ in low)
-        names = [DrawingListPacket.decode(p).drawing for p in await c.ask("getDrawingList", count=4)]
-        assert [d.name for d in names if d] == ["sonarCurrent", "Laser_1Current", "Laser_2Current"]
+        names = [DrawingListPacket.decode(p).drawing for p in await c.ask("getDrawingList", count=3)]
+        assert [d.name for d in names if d] == ["Laser_1Current", "Laser_2Current"]  # no sonar on an LD
+        assert "sonarCurrent" not in c.conn.datalist
         await c.close()
         await server.stop()
 
     run(scenario())
 
 
-def test_dock_moves_through_docking_to_docked_and_broadcasts(arena_map):
+OFFICE = project_map("office.map")
+
+
+def test_dock_drives_to_the_dock_and_a_drive_backs_out_of_it():
+    """The LD dock is the simulator's dock mode: it drives there (Docking), is Docked only there, and a
+    drive undocks it (it no longer "docks" on the spot and stays Docked while driving away)."""
+
     async def scenario() -> None:
-        server, c = await _start(arena_map)
+        server, c = await _start(OFFICE)
         assert DockInfo.decode((await c.ask("dockInfo"))[0]).state == DockState.UNDOCKED
         c.request("dockInfoChanged", -1)
         await c.barrier()
+        start = (server.robot.x, server.robot.y)
         c.once("dock")
         (first,) = await c.wait_for("dockInfoChanged")
         assert DockInfoChanged.decode(first).state == DockState.DOCKING
-        await server.advance(DOCK_SECONDS + 0.5)
+        for _ in range(600):  # at most a minute of simulated time, a second at a time
+            if server.world.dock_mode.state is DockState.DOCKED:
+                break
+            await server.advance(1.0)
         assert DockInfo.decode((await c.ask("dockInfo"))[0]).state == DockState.DOCKED
+        dock = next(d for d in server.world.nav_map.docks())
+        assert math.hypot(server.robot.x - dock.x, server.robot.y - dock.y) < 100, "docked at the dock"
+        assert math.hypot(server.robot.x - start[0], server.robot.y - start[1]) > 500, "it drove there"
         await eventually(lambda: len(c.received["dockInfoChanged"]) >= 2, what="the docked broadcast")
-        assert DockInfoChanged.decode(c.received["dockInfoChanged"][1]).state == DockState.DOCKED
+        c.once("ratioDrive", RatioDrive(50.0, 0.0, 50.0).encode())
+        await c.barrier()
+        await server.advance(0.2)
+        assert DockInfo.decode((await c.ask("dockInfo"))[0]).state == DockState.UNDOCKING
+        await server.advance(5.0)
+        assert DockInfo.decode((await c.ask("dockInfo"))[0]).state == DockState.UNDOCKED
         await c.close()
         await server.stop()
 
-    run(scenario())
+    run(scenario(), timeout=120)
 
 
 def test_routes_patrol_say_and_data_store(arena_map):
@@ -83,9 +105,9 @@ def test_routes_patrol_say_and_data_store(arena_map):
         state = ld_state(server)
         assert state.patrols == [ROUTES[1]]
         assert state.said == ["Hello from RTMU"]
-        wifi = DataStoreValue.decode((await c.ask("DataStore_WiFi_Quality"))[0]).value
+        wifi = DataStoreValue.decode((await c.ask("DataStore_WirelessQuality"))[0]).value
         assert wifi == str(server.world.wifi().quality)
-        closest = DataStoreValue.decode((await c.ask("DataStore_Closest_Obstacle"))[0]).value
+        closest = DataStoreValue.decode((await c.ask("DataStore_Closest_Obstacle_Distance"))[0]).value
         assert closest == "none" or 0 < float(closest) < math.inf
         await c.close()
         await server.stop()
@@ -97,7 +119,7 @@ def test_default_profile_lists_none_of_it(arena_map):
     async def scenario() -> None:
         server, c = await _start(arena_map, profile="default")
         assert len(c.conn.datalist) > 50  # the list did arrive
-        for name in ("Laser_1Current", "dockInfo", "getRoutes", "patrol", "say", "DataStore_WiFi_Quality"):
+        for name in ("Laser_1Current", "dockInfo", "getRoutes", "patrol", "say", "DataStore_WirelessQuality"):
             assert name not in c.conn.datalist
         await c.close()
         await server.stop()

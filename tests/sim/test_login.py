@@ -11,8 +11,9 @@ from rtmu.protocol.client_connection import ClientState
 from rtmu.protocol.commands import ClientType
 from rtmu.sim import SimConfig, SimServer
 from rtmu.sim.catalogue import build_catalogue
+from testdata import CAPTURES
 
-from .wire import SHARED, WireClient, captured_datalist, run
+from .wire import WireClient, captured_datalist, run
 
 USERS = "UserInfoVersion1\nuser alice secret1 all\nuser bob pw2 RobotInfo Movement Stop\n"
 
@@ -61,9 +62,9 @@ def test_open_server_accepts_anyone_and_lists_serverdemo_data():
     assert c.conn.datalist.entry("setSafeDrive").command_group == "UnsafeMovement"
 
 
-def test_data_list_matches_serverdemo_capture_for_shared_names(shared_dir):
+def test_data_list_matches_serverdemo_capture_for_shared_names():
     """Every name we share with the captured serverDemo carries its exact texts, group and flags."""
-    captured = captured_datalist(shared_dir / "captures" / "clientCommandLister-serverDemoMap.pcap")
+    captured = captured_datalist(CAPTURES / "clientCommandLister-serverDemoMap.pcap")
     assert len(captured) == 114
     c = run(_login(SimConfig(port=0, realtime=False)))
     ours = c.conn.datalist
@@ -111,9 +112,9 @@ ARIA_POPUP_SOURCE_TEXTS = {
 }
 
 
-def test_texts_not_in_a_capture_are_our_own(shared_dir):
+def test_texts_not_in_a_capture_are_our_own():
     """Captured wire texts may be served as recorded; anything else must not be ARIA's source text."""
-    captured = captured_datalist(shared_dir / "captures" / "clientCommandLister-serverDemoMap.pcap")
+    captured = captured_datalist(CAPTURES / "clientCommandLister-serverDemoMap.pcap")
     ours = build_catalogue(camera=True)
     assert {e.name for e in ours if e.name not in captured} == OWN_WORDS
     for e in ours:
@@ -228,6 +229,3 @@ def test_same_seed_does_not_repeat_login_keys():
     a, b = run(first_intro()), run(first_intro())
     assert a.password_key != b.password_key
     assert (a.auth_key, a.intro_key) != (b.auth_key, b.intro_key)
-
-
-_ = SHARED

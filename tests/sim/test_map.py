@@ -7,10 +7,11 @@ import hashlib
 import numpy as np
 import pytest
 
-from rtmu.maps import read_map
+from rtmu.mapfile import read_map
 from rtmu.protocol.payloads.map import Goals, MapId, MapName, MapPacketKind, binary_block_kind
 from rtmu.protocol.payloads.mapstream import MapBinaryAssembler, MapTextAssembler
 from rtmu.sim import SimConfig, SimServer
+from testdata import ARIA_MAPS
 
 from .wire import WireClient, run
 
@@ -61,11 +62,11 @@ def _binary_map(payloads: list[bytes]):
 
 
 @pytest.mark.parametrize("which", ["arena", "office", "columbia"])
-def test_get_map_streams_the_files_lines_and_binary_carries_its_geometry(which, arena_map, shared_dir):
+def test_get_map_streams_the_files_lines_and_binary_carries_its_geometry(which, arena_map):
     path = {
         "arena": arena_map,
         "office": arena_map.parent / "office.map",
-        "columbia": shared_dir / "aria-maps" / "columbia.map",
+        "columbia": ARIA_MAPS / "columbia.map",
     }[which]
     got = run(_fetch(path, "getMap", "getMapBinary", "getMapName", "getMapId", "getGoals"), timeout=120)
     # getMap: every line of the file, one per packet, then "" and the empty packet.
@@ -88,8 +89,8 @@ def test_get_map_streams_the_files_lines_and_binary_carries_its_geometry(which, 
     assert list(Goals.decode(got["getGoals"][0]).goals) == [g.name for g in data.goals()]
 
 
-def test_columbia_binary_blocks_are_at_most_1000_points(shared_dir):
-    path = shared_dir / "aria-maps" / "columbia.map"
+def test_columbia_binary_blocks_are_at_most_1000_points():
+    path = ARIA_MAPS / "columbia.map"
     got = run(_fetch(path, "getMapBinary"), timeout=120)
     blocks = [p for p in got["getMapBinary"] if binary_block_kind(p) is MapPacketKind.POINTS]
     counts = [int.from_bytes(p[:4], "little") for p in blocks]
@@ -170,8 +171,8 @@ def test_a_million_point_binary_map_reaches_a_reading_client_though_it_exceeds_t
     run(scenario(), timeout=120)
 
 
-def test_a_map_asked_for_again_while_it_is_being_sent_comes_once_more(shared_dir):
-    columbia = shared_dir / "aria-maps" / "columbia.map"
+def test_a_map_asked_for_again_while_it_is_being_sent_comes_once_more():
+    columbia = ARIA_MAPS / "columbia.map"
 
     async def scenario() -> None:
         server = SimServer(SimConfig(port=0, realtime=False, map_path=columbia))

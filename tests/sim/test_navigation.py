@@ -1,6 +1,6 @@
 """Navigation as ARNL does it, over loopback on the manual clock: goals, poses, home, tours, dock, locating.
 
-Every scenario drives the office map (``data/maps/office.map``; home in the corridor's west end, a
+Every scenario drives the office map (``rtmu/data/maps/office.map``; home in the corridor's west end, a
 ``Dock`` called Charger just west of it, a forbidden server room, a forbidden line at the stairs).
 """
 
@@ -11,7 +11,8 @@ import shutil
 import struct
 from pathlib import Path
 
-from rtmu.maps import MapObject, write_map
+from rtmu.mapfile import MapObject, write_map
+from rtmu.package_data import project_map
 from rtmu.protocol.payloads.commands import CommandList
 from rtmu.protocol.payloads.drive import RatioDrive
 from rtmu.protocol.payloads.ld import DataStoreValue
@@ -32,7 +33,7 @@ from rtmu.sim.project_maps import office_map
 
 from .wire import WireClient, run
 
-OFFICE = Path(__file__).resolve().parents[2] / "data" / "maps" / "office.map"
+OFFICE = project_map("office.map")
 GOALS = {o.name: o for o in office_map().objects}
 
 
@@ -360,12 +361,12 @@ def test_the_aram_profile_navigates_too_and_its_data_store_follows():
         c.once("gotoGoal", GotoGoal("Room 102").encode())
         await c.barrier()
         await server.advance(3.0)
-        left = float(DataStoreValue.decode((await c.ask("DataStore_Distance_To_Goal"))[0]).value)
+        left = float(DataStoreValue.decode((await c.ask("DataStore_Distance_to_goal"))[0]).value)
         assert 1000 < left < 8000
         await _until(server, lambda: server.robot.status == "Arrived at Room 102", 60)
-        assert DataStoreValue.decode((await c.ask("DataStore_Distance_To_Goal"))[0]).value == "0"
+        assert DataStoreValue.decode((await c.ask("DataStore_Distance_to_goal"))[0]).value == "0"
         server.lose_localization()
-        assert int(DataStoreValue.decode((await c.ask("DataStore_Localization_Score"))[0]).value) < 20
+        assert int(DataStoreValue.decode((await c.ask("DataStore_LaserLocalizationScore"))[0]).value) < 20
         await _end(server, c)
 
     run(scenario())

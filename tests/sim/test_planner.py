@@ -8,7 +8,7 @@ import math
 import numpy as np
 import pytest
 
-from rtmu.maps import MapObject
+from rtmu.mapfile import MapObject
 from rtmu.sim import p3dx
 from rtmu.sim.geometry import Obstacles
 from rtmu.sim.mapgen import generate_map

@@ -1,4 +1,4 @@
-"""``rtmu sim --profile aram``: an LD robot on the wire (protocol, state of charge, Ex4 map, LD-size list)."""
+"""``rtmu sim --kind aram``: an LD robot on the wire (protocol, state of charge, Ex4 map, 6MTX data)."""
 
 from __future__ import annotations
 
@@ -9,12 +9,14 @@ from pathlib import Path
 import pytest
 
 from rtmu.client.connection import AriaClient
+from rtmu.package_data import project_map
+from rtmu.protocol.payloads.commands import CommandList
 from rtmu.protocol.payloads.robot import BatteryInfo, UpdateNumbers
 from rtmu.sim import SimConfig, SimThread
-from rtmu.sim.profiles import ARAM, EX4_HEADER, LD_CATALOGUE_SIZE, filler_rows, get_profile
+from rtmu.sim.ld_data import CONFIG_API
+from rtmu.sim.profiles import ARAM, DEFAULT, EX4_HEADER, NOT_LISTED_BY_6MTX, get_profile
 
-REPO = Path(__file__).resolve().parents[2]
-OFFICE = REPO / "data" / "maps" / "office.map"
+OFFICE = project_map("office.map")
 
 
 @pytest.fixture(scope="module")
@@ -37,21 +39,24 @@ def test_unknown_profile_is_refused() -> None:
         get_profile("nope")
 
 
-def test_catalogue_is_ld_sized_with_long_descriptions(aram: SimThread) -> None:
+def test_catalogue_lists_only_what_6mtx_robots_list(aram: SimThread) -> None:
     async def body(client: AriaClient):  # type: ignore[no-untyped-def]
-        return list(client.datalist)
+        commands = CommandList.decode((await client.request_once("listCommands", timeout=5)).payload)
+        return list(client.datalist), [c.name for c in commands.commands]
 
-    entries = asyncio.run(_with_client(aram.port, body))
+    entries, commands = asyncio.run(_with_client(aram.port, body))
     names = [e.name for e in entries]
-    assert len(names) == LD_CATALOGUE_SIZE == len(set(names))
-    assert max(len(e.return_description) for e in entries) >= 16_000  # arrived whole, over many packets
-    assert {"ratioDrive", "updateNumbers", "getMapBinary"} <= set(names)
-
-
-def test_filler_rows_are_unique_and_stable() -> None:
-    a = filler_rows(2000, {"getArm"})
-    assert len(a) == 2000 and len({r[0] for r in a}) == 2000 and "getArm" not in {r[0] for r in a}
-    assert a == filler_rows(2000, {"getArm"})
+    assert len(names) == len(set(names))
+    assert not set(names) & NOT_LISTED_BY_6MTX
+    assert {"ratioDrive", "stop", "updateNumbers", "getMapBinary", "dockInfo", "configUpdated"} <= set(names)
+    # LD's configuration API instead of ArConfig's; no camera; none of the simulator's own commands.
+    assert {row[0] for row in CONFIG_API} <= set(names)
+    assert not any(n.startswith(("getConfigBySections", "getPicture", "Simulator")) for n in names)
+    assert "setConfig" not in names and "sendVideo" not in names
+    assert commands == ["ResetTripOdometer"]  # listCommands names only listed data
+    # What is left out is left out of the aram profile only: the default one still lists all of it.
+    default = {e.name for e in DEFAULT.catalogue(camera=True)}
+    assert default >= NOT_LISTED_BY_6MTX  # and every name left out is one the simulator has (no typo)
 
 
 def test_battery_is_state_of_charge(aram: SimThread) -> None:
@@ -115,7 +120,7 @@ def test_deprecated_update_also_reports_state_of_charge(aram: SimThread) -> None
 
 
 def test_robot_state_battery_pct_follows_the_flag() -> None:
-    from rtmu.model import RobotState
+    from rtmu.model.observables import RobotState
 
     assert RobotState(battery_v=87.0, battery_is_soc=True).battery_pct == 87.0
     assert RobotState(battery_v=12.8).battery_pct is None

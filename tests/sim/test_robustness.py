@@ -10,10 +10,11 @@ from rtmu.protocol.packet import encode_packet
 from rtmu.protocol.payloads.robot import UpdateNumbers
 from rtmu.sim import SimConfig, SimServer
 from rtmu.sim.server import REFUSING_SLOTS
+from testdata import ARIA_MAPS
 
-from .wire import SHARED, WireClient, eventually, run
+from .wire import WireClient, eventually, run
 
-COLUMBIA = SHARED / "aria-maps" / "columbia.map"
+COLUMBIA = ARIA_MAPS / "columbia.map"
 
 
 def test_fifty_clients_each_get_their_own_interval(arena_map):

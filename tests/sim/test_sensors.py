@@ -9,9 +9,9 @@ import numpy as np
 from PIL import Image
 
 from rtmu.protocol.payloads.camera import Picture, VideoFrame, VideoRequest, VideoSize
+from rtmu.protocol.payloads.drawings import DrawingListPacket
 from rtmu.protocol.payloads.drive import MoveDist, TurnToHeading
 from rtmu.protocol.payloads.sensors import (
-    DrawingListPacket,
     RangeDeviceReadings,
     SensorCurrentRequest,
     SensorList,

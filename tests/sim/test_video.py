@@ -6,6 +6,7 @@ import argparse
 import io
 import threading
 
+import numpy as np
 import pytest
 from PIL import Image
 
@@ -139,3 +140,28 @@ def test_frames_carry_their_render_time_and_the_camera_size_and_rate_are_settabl
     for bad in ("640", "0x480", "99999x2", "axb"):
         with pytest.raises(argparse.ArgumentTypeError):
             _size(bad)
+
+
+def test_a_parked_robots_camera_still_delivers_fresh_frames_at_its_rate(arena_map):
+    """A real camera sends new frames whatever the robot does: new noise, a new stamp, each period."""
+    from rtmu.client.video_feed import frame_stamp
+
+    async def scenario() -> None:
+        server = SimServer(SimConfig(port=0, realtime=False, map_path=arena_map, drive_timeout=0))
+        await server.start()
+        c = await WireClient().open(server.port)
+        frames = []
+        for _ in range(10):
+            frames.append(Picture.decode((await c.ask("getPictureCam1"))[0]).jpeg)
+            await server.advance(0.1)  # the robot stands still: the same view every time
+        assert server.video.renders == 1, "the scene was ray-cast once"
+        assert server.video.refreshes == 9, "and a fresh frame made every period after"
+        assert len(set(frames)) == 10 and len({frame_stamp(f) for f in frames}) == 10
+        first, last = (
+            np.asarray(Image.open(io.BytesIO(f)).convert("L"), dtype=float) for f in (frames[0], frames[-1])
+        )
+        assert 0 < np.abs(first - last).mean() < 4, "the same scene, only the sensor's noise differs"
+        await c.close()
+        await server.stop()
+
+    run(scenario())

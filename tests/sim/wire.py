@@ -14,7 +14,6 @@ from pathlib import Path
 from rtmu.protocol.client_connection import ClientConnection, ClientState
 from rtmu.protocol.events import DataListReady, DataReceived, PeerShutdown, Rejected
 
-SHARED = Path(__file__).resolve().parents[2] / ".." / "shared"
 TIMEOUT = 10.0
 
 

@@ -1,6 +1,6 @@
 """Reading captured traffic (pcap, pcapng, hex dumps, raw bytes) for ``rtmu decode`` and the tests.
 
-File parsing only: the ArNetworking side lives in :mod:`rtmu.session_decoder`.
+File parsing only: the ArNetworking side lives in :mod:`rtmu.capture.session_decoder`.
 """
 
 from .base import (

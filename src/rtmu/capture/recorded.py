@@ -10,7 +10,9 @@ it back yields the same :class:`~rtmu.capture.base.CaptureEvent`s a pcap does, s
 ``rtmu decode`` explains a recording with the same decoder.
 
 The file is untrusted like any capture. A file cut short by a crash or a power
-loss is read up to its last complete chunk and the shortfall becomes a warning.
+loss is read up to its last complete chunk and the shortfall becomes a warning. Chunks are
+weighed before they are decompressed (:mod:`.mcap_bounded`): a decompression bomb is refused
+with the reason (:class:`~rtmu.capture.mcap_bounded.McapBoundError`), never inflated.
 """
 
 from __future__ import annotations
@@ -21,6 +23,7 @@ from pathlib import Path
 from typing import Any
 
 from .base import CaptureError, CaptureEvent, CaptureStats, Endpoint, Flow, StreamData, StreamEnd
+from .mcap_bounded import DEFAULT_BUDGET, BoundedMcap, McapBoundError
 
 MCAP_MAGIC = b"\x89MCAP0\r\n"
 C2S = "c2s"
@@ -33,8 +36,6 @@ RAW_ENCODING = "arnetworking"
 RAW_SCHEMA = "rtmu.ArNetworkingBytes"
 CLIENT = Endpoint("rtmu", 0)
 """The recording side (the operator's client) of every recorded connection."""
-MAX_RECORD = 64 * 1024 * 1024
-"""A record (a compressed chunk) larger than this is not one RTMU wrote."""
 MAX_HOST = 255
 
 
@@ -59,10 +60,14 @@ def _server_of(data: bytes) -> tuple[int, Endpoint] | None:
     return conn, Endpoint(host, port)
 
 
-def recorded_events(path: Path, stats: CaptureStats) -> Iterator[CaptureEvent]:
-    """The raw channel of the recording at ``path`` as stream events, one flow per connection."""
-    from mcap.reader import NonSeekingReader
+def recorded_events(
+    path: Path, stats: CaptureStats, *, budget: int = DEFAULT_BUDGET
+) -> Iterator[CaptureEvent]:
+    """The raw channel of the recording at ``path`` as stream events, one flow per connection.
 
+    ``budget``: the uncompressed bytes the file's chunks may claim in all. A file that asks for more
+    than a recording may (a decompression bomb) raises :class:`CaptureError` saying so, before the
+    chunk is inflated."""
     flows: dict[int, Flow] = {}
     current: Flow | None = None
     last: float | None = None
@@ -71,9 +76,9 @@ def recorded_events(path: Path, stats: CaptureStats) -> Iterator[CaptureEvent]:
     except OSError as exc:
         raise CaptureError(f"cannot read {path}: {exc.strerror or exc}") from exc
     with f:
-        reader = NonSeekingReader(f, validate_crcs=True, record_size_limit=MAX_RECORD)
+        reader = BoundedMcap(f, budget=budget)
         try:
-            for _schema, channel, message in reader.iter_messages(log_time_order=False):
+            for _schema, channel, message in reader.messages():
                 at = message.log_time / 1e9
                 if channel.topic == CONNECTION_TOPIC:
                     known = _server_of(message.data)
@@ -96,11 +101,14 @@ def recorded_events(path: Path, stats: CaptureStats) -> Iterator[CaptureEvent]:
                 last = at
                 src = CLIENT if direction == C2S else current.second
                 yield StreamData(current, src, at, bytes(message.data))
+        except McapBoundError as exc:  # a bomb is no crash's cut: refused, whatever came before it
+            raise CaptureError(f"{path} is refused: {exc}") from None
         except Exception as exc:  # untrusted: cut off, a lying record or chunk size, a bad chunk…
             if stats.frames == 0 and not flows:
-                raise CaptureError(f"{path} is not a readable MCAP recording: {exc}") from None
+                raise CaptureError(f"{path} is not a readable MCAP recording: {unreadable(exc)}") from None
             stats.warnings.append(
-                f"the recording ends early (cut short by a crash or a full disk?): read up to there ({exc})"
+                "the recording ends early (cut short by a crash or a full disk?): read up to there "
+                f"({unreadable(exc)})"
             )
     stats.last_time = last
     if not flows:
@@ -108,3 +116,14 @@ def recorded_events(path: Path, stats: CaptureStats) -> Iterator[CaptureEvent]:
     for flow in flows.values():
         yield StreamEnd(flow, CLIENT, last)
         yield StreamEnd(flow, flow.second, last)
+
+
+def unreadable(exc: BaseException) -> str:
+    """Why an MCAP file could not be read, in plain words (the reader's own errors may be empty)."""
+    from mcap.exceptions import EndOfFile, InvalidMagic
+
+    if isinstance(exc, InvalidMagic):
+        return "it does not start as an MCAP file does (it is not a recording)"
+    if isinstance(exc, (EndOfFile, EOFError)) or "unpack requires a buffer" in str(exc):
+        return "it is cut short: it ends in the middle of a record"
+    return str(exc) or type(exc).__name__

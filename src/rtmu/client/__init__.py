@@ -12,12 +12,12 @@ One job per module:
 * ``session``    — everything that runs on the network loop for one operator session.
 * ``runner``     — :class:`ClientRunner`: the network thread and its thread-safe facade for a UI.
 
-Nothing here imports GTK or the UI thread's state (``rtmu.model``): the runner
-publishes typed changes (``rtmu.state``) and notices (``rtmu.notices``) to a
+Nothing here imports GTK or the UI thread's state (``rtmu.model.observables``): the runner
+publishes typed changes (``rtmu.values.state``) and notices (``rtmu.base.notices``) to a
 sink it is given. The package imports none of its modules eagerly, so a caller
 that needs the lease does not load the connection code.
 
-A window does not wire these itself: ``rtmu.fleet.RobotSession`` puts one robot's
+A window does not wire these itself: ``rtmu.fleet.sessions.RobotSession`` puts one robot's
 model, runner and controller together::
 
     session = RobotSession(operator, post=GLib.idle_add).start()   # network thread

@@ -13,7 +13,11 @@ login (and drive commands) elsewhere, so such a name is not followed.
 
 The central server is trusted no more than a robot: at most :data:`MAX_ROBOTS` robots are held, names
 longer than :data:`MAX_NAME` or entries without a port are dropped (and counted), and names are kept as
-plain text — whoever shows them escapes them.
+plain text — whoever shows them escapes them. Names are compared as ARIA's central server compares
+them, without case (:func:`robot_key`): ``ROBOT``, ``robot`` and ``Robot`` are one robot, and the one
+listed or announced last takes the place of the others, as a robot switching again under its name
+replaces its old connection there. ``--robot NAME`` that fits more than one listed entry is refused
+with the candidates (:func:`find_robot`), never settled by a guess.
 """
 
 from __future__ import annotations
@@ -29,6 +33,7 @@ from ..protocol.payloads.central import CentralEntry, ClientAdded, ClientList, C
 from .connection import CONNECT_TIMEOUT, DEFAULT_PORT, AriaClient, Packet
 from .errors import ClientError
 from .reconnect import Backoff, worth_retrying
+from .roles import Role
 from .roster import Emit, RobotAdded, RobotEndpoint, RobotRemoved, RosterEvent, RosterLost, RosterRestored
 
 log = logging.getLogger("rtmu.central")
@@ -43,12 +48,47 @@ RETRY_FIRST = 1.0
 RETRY_MAX = 30.0
 """Longest wait between tries (an operator waiting for a restarted central server waits at most this)."""
 
+Listed = list[tuple[RobotEndpoint, CentralEntry]]
+"""What :func:`list_robots` answers: each usable entry with the address it is reached at."""
 Post = Callable[..., Any]
 """``post(fn, *args)``: run ``fn(*args)`` on the consumer's thread (``GLib.idle_add``, or a direct call)."""
 
 
 def _direct(fn: Callable[..., Any], *args: Any) -> None:
     fn(*args)
+
+
+def robot_key(name: str) -> str:
+    """What makes two robot names the same robot: ARIA's central server compares them case-blind."""
+    return name.casefold()
+
+
+class AmbiguousRobot(ValueError):
+    """``--robot NAME`` fits more than one listed entry; the sentence names them."""
+
+
+def find_robot(robots: Listed, wanted: str) -> RobotEndpoint | None:
+    """The one listed robot named ``wanted`` (without case, as ARIA compares); None when none is;
+    :class:`AmbiguousRobot` when several entries are (a central server that broke its own rule)."""
+    found = [e for e, _ in robots if robot_key(e.name) == robot_key(wanted)]
+    if len(found) > 1:
+        listed = ", ".join(f"'{e.name}' (port {e.port})" for e in found)  # plain: shown through visible()
+        raise AmbiguousRobot(
+            f"'{wanted}' is ambiguous: the central server lists {len(found)} robots of that name, which "
+            f"ARIA counts as one ({listed}); it should list one"
+        )
+    return found[0] if found else None
+
+
+def one_per_name(
+    robots: list[tuple[RobotEndpoint, CentralEntry]],
+) -> list[tuple[RobotEndpoint, CentralEntry]]:
+    """One entry per robot as ARIA compares names: the one listed last, in the place of the first."""
+    out: dict[str, tuple[RobotEndpoint, CentralEntry]] = {}
+    for item in robots:
+        key = robot_key(item[0].name)
+        out[key] = item
+    return list(out.values())
 
 
 def endpoint_of(entry: CentralEntry, central_host: str, central_port: int) -> RobotEndpoint | None:
@@ -66,25 +106,27 @@ async def list_robots(
     *,
     timeout: float = CONNECT_TIMEOUT,
     protocol: str | None = None,
-) -> list[tuple[RobotEndpoint, CentralEntry]]:
-    """Log in to the central server, read ``clientList`` once, log out.
+) -> Listed:
+    """Log in to the central server, read ``clientList`` once, log out: every usable entry, in order
+    (:func:`one_per_name` makes it one per robot; :func:`find_robot` finds one).
 
     Raises :class:`~rtmu.client.errors.ClientError` (``NotSupported`` when the server is not a central
     server) or a ``ProtocolError`` for a list that does not decode.
     """
     client = AriaClient()
     try:
-        await client.connect(host, port, user, password, timeout=timeout, protocol=protocol)
+        login = (user, password)
+        await client.connect(host, port, *login, timeout=timeout, protocol=protocol, role=Role.OBSERVER)
         reply = await client.request_once(ClientList.DATA_NAME, timeout=timeout)
         listed = ClientList.decode(reply.payload)
     finally:
         await client.disconnect()
-    out: list[tuple[RobotEndpoint, CentralEntry]] = []
-    seen: set[str] = set()
+    out: Listed = []
+    seen: set[tuple[str, int]] = set()
     for entry in listed.entries[:MAX_ROBOTS]:
         endpoint = endpoint_of(entry, host, port)
-        if endpoint is not None and endpoint.name not in seen:
-            seen.add(endpoint.name)
+        if endpoint is not None and (endpoint.name, endpoint.port) not in seen:
+            seen.add((endpoint.name, endpoint.port))
             out.append((endpoint, entry))
     return out
 
@@ -111,7 +153,7 @@ class CentralRoster:
         self.timeout = timeout
         self.max_robots = max_robots
         self.robots: dict[str, RobotEndpoint] = {}
-        """Robots known now, by name (touched on the roster's thread only)."""
+        """Robots known now, by :func:`robot_key` of their name (touched on the roster's thread only)."""
         self.dropped = 0
         """Entries refused: malformed, over :data:`MAX_ROBOTS`, or broadcasts that did not decode."""
         self._emit: Emit | None = None
@@ -194,7 +236,9 @@ class CentralRoster:
         client = AriaClient(on_close=on_close)
         try:
             # The password stays while the roster lives: a lost central server is logged in to again.
-            await client.connect(self.host, self.port, self._user, self._password, timeout=self.timeout)
+            await client.connect(
+                self.host, self.port, self._user, self._password, timeout=self.timeout, role=Role.OBSERVER
+            )
             self.backoff.reset()
             if self._lost_sent:  # before any robot: a broadcast may come ahead of the list
                 self._lost_sent = False
@@ -228,21 +272,29 @@ class CentralRoster:
         except Exception:
             self.dropped += 1
             return
-        if self.robots.pop(entry.name, None) is not None:
-            self._deliver(RobotRemoved(entry.name, "left the central server"))
+        key = robot_key(entry.name)
+        known = self.robots.get(key)
+        # Only the robot of that name and port: one replaced by a namesake has gone already.
+        if known is not None and known.name == entry.name and known.port == entry.port:
+            del self.robots[key]
+            self._deliver(RobotRemoved(known.name, "left the central server"))
 
     def _add(self, entry: CentralEntry) -> None:
         endpoint = endpoint_of(entry, self.host, self.port)
         if endpoint is None:
             self.dropped += 1
             return
-        old = self.robots.get(endpoint.name)
+        key = robot_key(endpoint.name)
+        old = self.robots.get(key)
         if old == endpoint:
             return  # heard in the list and in a broadcast
         if old is None and len(self.robots) >= self.max_robots:
             self.dropped += 1
             return
-        if old is not None:
-            self._deliver(RobotRemoved(endpoint.name, "reconnected to the central server"))
-        self.robots[endpoint.name] = endpoint
+        if old is not None:  # ARIA's rule: a robot of the same name (any case) takes the old one's place
+            why = "reconnected to the central server"
+            if old.name != endpoint.name:
+                why = f"replaced by {endpoint.name!r}, the same robot as ARIA compares names"
+            self._deliver(RobotRemoved(old.name, why))
+        self.robots[key] = endpoint
         self._deliver(RobotAdded(endpoint))

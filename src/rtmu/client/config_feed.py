@@ -1,10 +1,13 @@
 """The server's configuration (ArConfig) for a client: fetch it, change values, follow others' changes.
 
-Shared by ``rtmu config`` and the window's configuration page (through the session). The newest
-``getConfigBySections*`` the server lists is asked for; its packets are joined into sections (a
-big section comes in parts). Everything is bounded: at most :data:`MAX_PARAMS` parameters and
-:data:`MAX_SECTIONS` sections are kept, texts are cut, and the reply itself is bounded in
-packets and bytes by the connection.
+Shared by ``rtmu config`` and the window's configuration page (through the session). Which
+configuration API a robot has is told plainly (:func:`config_api`): ARIA's ArConfig, Omron LD's
+``getConfigValues`` family (protocol 6MTX robots list it instead of ArConfig's; its layouts are not
+public, so RTMU cannot show or edit it yet — :class:`ForeignConfig` says so, and ``rtmu call`` reads
+it raw), or none. Of ArConfig, the newest ``getConfigBySections*`` the server lists is asked for; its
+packets are joined into sections (a big section comes in parts). Everything is bounded: at most
+:data:`MAX_PARAMS` parameters and :data:`MAX_SECTIONS` sections are kept, texts are cut, and the
+reply itself is bounded in packets and bytes by the connection.
 
 :class:`ConfigFeed` counts ``configUpdated`` broadcasts (another client changed something) and
 tells a listener, so a page can fetch again without losing its own unsaved edits.
@@ -13,9 +16,12 @@ tells a listener, so a page can fetch again without losing its own unsaved edits
 from __future__ import annotations
 
 import asyncio
-from collections.abc import Callable
+from collections.abc import Callable, Container, Iterable
 from dataclasses import dataclass, replace
+from enum import Enum
+from typing import Any, ClassVar
 
+from ..base.exit_codes import EXIT_FOREIGN_CONFIG
 from ..protocol.errors import ProtocolError
 from ..protocol.payloads.base import Side, payload_type_for
 from ..protocol.payloads.config import (
@@ -28,8 +34,12 @@ from ..protocol.payloads.config import (
     SetConfig,
     SetConfigReply,
 )
+from ..values.intents import FetchConfig, Intent
+from ..values.intents import SetConfig as SetConfigIntent
 from .connection import AriaClient, Packet
-from .errors import MalformedReply, NotSupported
+from .errors import ClientError, MalformedReply, NotSupported
+from .feed import Feed, FeedContext
+from .subscriptions import Subscription
 
 VERSIONS = ("getConfigBySectionsV4", "getConfigBySectionsV3", "getConfigBySectionsV2", "getConfigBySections")
 """Newest first: the first the server lists is used."""
@@ -103,6 +113,51 @@ def offers_config(client: AriaClient) -> str | None:
     return next((name for name in VERSIONS if client.supports(name)), None)
 
 
+class ConfigApi(Enum):
+    """Which configuration a robot offers, in the words an operator reads."""
+
+    ARCONFIG = "ARIA's ArConfig"
+    OMRON_LD = "Omron LD's"
+    NONE = "none"
+
+
+LD_CONFIG_DATA = ("getConfigValues", "setConfigValues", "updateConfigValues", "configExpandedSectionList")
+"""What LD robots with protocol 6MTX list for their configuration (and no ``getConfigBySections*``)."""
+
+
+def config_api(listed: Container[str]) -> ConfigApi:
+    """The configuration API of a server whose data list is ``listed`` (ArConfig wins where both are)."""
+    if any(name in listed for name in (*VERSIONS, SetConfig.DATA_NAME)):
+        return ConfigApi.ARCONFIG
+    if any(name in listed for name in LD_CONFIG_DATA):
+        return ConfigApi.OMRON_LD
+    return ConfigApi.NONE
+
+
+class ForeignConfig(ClientError):
+    """The robot's configuration is one RTMU cannot show or edit yet (an LD robot's); nothing was sent."""
+
+    exit_code = EXIT_FOREIGN_CONFIG
+    kind = "unsupported"
+
+    def __init__(self, api: ConfigApi, listed: tuple[str, ...]) -> None:
+        self.api = api
+        self.listed = listed
+        first = listed[0] if listed else "getConfigValues"
+        super().__init__(
+            f"this robot's configuration is {api.value} ({', '.join(listed)}), whose layouts are not "
+            f"public: RTMU cannot show or edit it yet (rtmu call HOST {first} shows the robot's raw reply)"
+        )
+
+
+def foreign_config(client: AriaClient) -> ForeignConfig | None:
+    """The :class:`ForeignConfig` to raise for this server, or None when its configuration is ArConfig
+    or it has none."""
+    if config_api(client.datalist) is not ConfigApi.OMRON_LD:
+        return None
+    return ForeignConfig(ConfigApi.OMRON_LD, tuple(n for n in LD_CONFIG_DATA if client.supports(n)))
+
+
 def assemble(packets: list[ConfigSectionPacket], last_editable: int, source: str) -> ServerConfig:
     """Join section packets (parts of one section follow each other) into bounded sections."""
     sections: list[ConfigSection] = []
@@ -127,9 +182,12 @@ def assemble(packets: list[ConfigSectionPacket], last_editable: int, source: str
 
 
 async def fetch_config(client: AriaClient, timeout: float) -> ServerConfig:
-    """The whole configuration; NotSupported when the server offers none."""
+    """The whole configuration; ForeignConfig for an LD robot's, NotSupported when the server offers none."""
     name = offers_config(client)
     if name is None:
+        foreign = foreign_config(client)
+        if foreign is not None:
+            raise foreign
         raise NotSupported(
             "getConfigBySectionsV4", "this server offers no configuration (getConfigBySections)"
         )
@@ -166,6 +224,9 @@ async def set_config(
 ) -> SetConfigReply:
     """Send ``{section: {parameter: value text}}`` in one ``setConfig``; the server's answer."""
     if not client.supports(SetConfig.DATA_NAME):
+        foreign = foreign_config(client)
+        if foreign is not None:
+            raise foreign
         raise NotSupported(
             SetConfig.DATA_NAME, "this server does not let its configuration be changed (setConfig)"
         )
@@ -175,13 +236,28 @@ async def set_config(
     return replace(answer, error=_cut(answer.error))
 
 
-class ConfigFeed:
-    """``configUpdated`` broadcasts of one session: counted, and passed to a listener (network loop)."""
+class ConfigFeed(Feed):
+    """Fetches and changes the configuration; ``configUpdated`` broadcasts are counted and passed to a
+    listener (network loop)."""
 
-    def __init__(self) -> None:
+    handles: ClassVar[tuple[type[Intent], ...]] = (FetchConfig, SetConfigIntent)
+
+    def __init__(self, ctx: FeedContext) -> None:
+        super().__init__(ctx)
         self.updates = 0
         self.listener: Callable[[], None] | None = None
         """Called on the network loop after each broadcast (the runner posts it to the UI thread)."""
+
+    def subscriptions(self, client: AriaClient) -> Iterable[Subscription]:
+        return (Subscription("configUpdated", -1, self.on_updated),)
+
+    def handle(self, intent: Intent) -> Any:
+        client = self.require()
+        timeout = self.ctx.config.reply_timeout
+        if isinstance(intent, SetConfigIntent):
+            changes = {section: dict(values) for section, values in intent.changes.items()}
+            return set_config(client, changes, timeout)
+        return fetch_config(client, timeout)
 
     def on_updated(self, packet: Packet) -> None:
         self.updates += 1

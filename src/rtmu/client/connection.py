@@ -72,6 +72,7 @@ from .errors import (
     ServerClosed,
 )
 from .link import Link, Opener, open_tcp
+from .roles import MotionGate, Role
 
 log = logging.getLogger(__name__)
 
@@ -248,6 +249,8 @@ class AriaClient:
         """Handler calls whose own CPU time went over :data:`SLOW_HANDLER`."""
         self.last_packet_at: float | None = None
         self.packets_received = 0
+        self._gate = MotionGate(Role.OBSERVER)
+        """Replaced at :meth:`connect` by the role asked for; never changed after."""
 
     # -- state -----------------------------------------------------------------------------
     @property
@@ -311,6 +314,17 @@ class AriaClient:
         """Why the connection ended (None while open or after a plain ``disconnect``)."""
         return self._closed_error
 
+    @property
+    def role(self) -> Role:
+        """OBSERVER (no motion request ever leaves) or OPERATOR, as given to :meth:`connect`."""
+        return self._gate.role
+
+    @property
+    def drove(self) -> bool:
+        """True once this connection sent a motion request that does more than stop: only then does
+        it stop the robot when it ends (its own drive, never somebody else's navigation)."""
+        return self._gate.drove
+
     def supports(self, name: str) -> bool:
         """True if the server offers ``name`` to this user (after ``connect``)."""
         return self._conn is not None and name in self._conn.datalist
@@ -326,10 +340,16 @@ class AriaClient:
         timeout: float = CONNECT_TIMEOUT,
         server_key: str = "",
         protocol: str | None = None,
+        role: Role = Role.OPERATOR,
     ) -> DataList:
-        """Open the link, log in and wait for the complete data list, all within ``timeout`` s."""
+        """Open the link, log in and wait for the complete data list, all within ``timeout`` s.
+
+        ``role`` is fixed for the connection's life: an OBSERVER's motion requests are refused
+        (:class:`~rtmu.client.errors.MotionRefused`) before anything is put on the wire.
+        """
         if self._conn is not None:
             raise RuntimeError("AriaClient objects are single-use: make a new one to connect again")
+        self._gate = MotionGate(role)
         self.host, self.port, self.user = host, port, user or ""
         self._conn = ClientConnection(
             user or "", password or "", server_key=server_key, protocol_version=protocol
@@ -426,9 +446,49 @@ class AriaClient:
         immediate reply).
         """
         number = self._number(name)
+        payload = encode_args(args)
+        self._gate.admit(name, payload)
         self._handlers[number] = handler
-        self._conn.request(name, interval_ms, encode_args(args))  # type: ignore[union-attr]
+        self._conn.request(name, interval_ms, payload)  # type: ignore[union-attr]
         self._flush()
+
+    def listen(self, name: str, handler: Handler | None) -> None:
+        """Hear ``name``'s packets that no tracked request claims, sending nothing (ARIA's ``addHandler``).
+
+        For data whose answers do not pair one-to-one with requests (``putFile``: errors only, then one
+        result); ``None`` stops listening. NotSupported when the server does not list ``name``.
+        """
+        number = self._number(name)
+        if handler is None:
+            self._handlers.pop(number, None)
+        else:
+            self._handlers[number] = handler
+
+    async def drain(self, timeout: float = REPLY_TIMEOUT) -> None:
+        """Wait until our output is back under the link's high-water mark (a bulk sender's pacing).
+
+        ClientTimeout when the server reads nothing for ``timeout`` s; the connection's own error
+        once it has ended.
+        """
+        self._require_open()
+        link = self._link
+        assert link is not None
+        try:
+            async with asyncio.timeout(timeout):
+                await link.drain()
+        except TimeoutError:
+            raise ClientTimeout(
+                f"{self.host}:{self.port} read nothing of what we sent for {timeout:g} s"
+            ) from None
+        except OSError as exc:
+            reason = exc.strerror or exc
+            self._fail(ServerClosed(f"the connection to {self.host}:{self.port} broke: {reason}"))
+        self._require_open()
+
+    def subscribed(self, name: str) -> bool:
+        """True while a handler holds a subscription to ``name`` (another ``request`` would replace it)."""
+        number = self._conn.datalist.number(name) if self._conn is not None else None
+        return number is not None and number in self._handlers
 
     def stop_request(self, name: str) -> None:
         """End a subscription (no reply). Unknown or unsubscribed names are ignored."""
@@ -447,6 +507,7 @@ class AriaClient:
         """
         name, payload = _request(what, args)
         self._number(name)
+        self._gate.admit(name, payload)
         self._conn.request_once(name, payload)  # type: ignore[union-attr]
         self._flush()
 
@@ -552,6 +613,7 @@ class AriaClient:
         max_bytes: int = MAX_REPLY_BYTES,
     ) -> _Waiter | None:
         self._number(name)
+        self._gate.admit(name, payload)
         conn = self._conn
         assert conn is not None
         try:

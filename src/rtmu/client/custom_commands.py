@@ -13,11 +13,14 @@ from __future__ import annotations
 
 import contextlib
 from dataclasses import dataclass
+from typing import Any, ClassVar
 
 from ..protocol.errors import ProtocolError
 from ..protocol.payloads.commands import CommandList, StringCommandArgs
+from ..values.intents import Intent, ListServerCommands, RunServerCommand
 from .connection import AriaClient
 from .errors import ClientTimeout, NotSupported, ProtocolFault
+from .feed import Feed
 from .health import ping_data
 
 LIST_SOURCES: tuple[tuple[str, bool], ...] = (
@@ -119,3 +122,18 @@ async def run_command(
     """:func:`send_command`, then :func:`taken`: did the server take it within ``timeout`` s?"""
     send_command(client, command, argument)
     return await taken(client, timeout)
+
+
+class CommandsFeed(Feed):
+    """The session's share: list the commands, run one (a command may drive: the guard ends a held
+    drive first, as for every intent that moves the robot)."""
+
+    handles: ClassVar[tuple[type[Intent], ...]] = (ListServerCommands, RunServerCommand)
+
+    def handle(self, intent: Intent) -> Any:
+        client = self.require()
+        timeout = self.ctx.config.reply_timeout
+        if isinstance(intent, RunServerCommand):
+            command = ServerCommand(intent.name, "", intent.string)
+            return run_command(client, command, intent.argument, timeout)
+        return list_commands(client, timeout)

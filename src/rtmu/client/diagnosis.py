@@ -35,6 +35,9 @@ class Step(Enum):
     UDP = 16
     """Never fails ``rtmu doctor`` (RTMU uses TCP only)."""
     STATUS = 15
+    MOTION = 17
+    """Why won't it move (``rtmu why``'s answer): a failing motion step exits with the cause's own
+    code (20–39, :class:`rtmu.client.why_values.Cause`), not this value."""
 
     @property
     def key(self) -> str:
@@ -53,6 +56,7 @@ STEP_TITLES = {
     Step.DATA_LIST: "data list",
     Step.UDP: "UDP",
     Step.STATUS: "first status",
+    Step.MOTION: "why won't it move",
 }
 
 
@@ -70,6 +74,9 @@ class Finding:
 
 
 # -- the table ------------------------------------------------------------------------------------
+CENTRAL_ADVICE = (
+    "this is ARIA's central server: use 'rtmu fleet', --robot NAME, or open its robots with 'rtmu --central'"
+)
 ADVICE = {
     "resolve": "check the spelling, or use the robot's IP address instead of its name",
     "refused": "nothing listens on that port: check that the robot's server (ARAM / the ARIA server) "
@@ -87,9 +94,19 @@ ADVICE = {
     "login_timeout": "the server did not finish the login in time: it may be overloaded; try again",
     "status_missing": "this server offers no robot status (updateNumbers/update): RTMU can connect "
     "but will show no pose or battery",
+    "central_server": CENTRAL_ADVICE,
     "status_timeout": "the server did not send a status in time: the robot's base may be "
     "disconnected from its server; check the robot",
 }
+
+
+def central_server_words(where: str) -> str:
+    """What to do with ARIA's central server, which has no robot of its own (``where``: HOST:PORT)."""
+    return (
+        f"{where} is ARIA's central server, not a robot: list its robots with 'rtmu fleet {where}', act on "
+        f"one with --robot NAME, or open them all with 'rtmu --central {where}'"
+    )
+
 
 REJECT_ADVICE = {
     RejectReason.BAD_USER_OR_PASSWORD: (

@@ -9,7 +9,7 @@ is shown is the server's visibility (``AlwaysOn`` / ``AlwaysOff`` cannot be chan
 Everything from the server is bounded: at most ``MAX_DRAWINGS`` drawings, one packet of at most
 3 998 points per sample (a count that does not fit its bytes is refused and named on the layer),
 a refresh period no shorter than :data:`MIN_REFRESH_MS`, and at most one published
-:class:`~rtmu.state.DrawingsChanged` per :data:`PUBLISH_EVERY` s however fast samples come. A
+:class:`~rtmu.values.state.DrawingsChanged` per :data:`PUBLISH_EVERY` s however fast samples come. A
 shape RTMU cannot draw is listed (``drawable=False``) and never asked for.
 
 The network loop pays almost nothing per sample however fast they come: a packet only replaces
@@ -17,9 +17,9 @@ its drawing's newest raw sample (the older one is dropped unread); samples are d
 state is published, and the window gets at most ``drawing_budget.MAX_SHOWN_POINTS`` points in
 all (each layer's ``total_points`` says how many its sample had).
 
-The session keeps its own sonar (and LD laser) handling: ``also`` maps those data names to the
-session's handlers, which this feed calls with every packet it receives for them, because its
-request replaces the session's subscription of the same name.
+The session keeps its own sonar (and LD laser) handling: where the session holds a subscription of
+a drawing's data name, this feed's request replaces it, so it hands every packet of that name on
+to the session's handler (``FeedContext.handler_for``).
 """
 
 from __future__ import annotations
@@ -28,22 +28,28 @@ import asyncio
 import contextlib
 import logging
 import time
-from collections.abc import Callable, Coroutine, Mapping
-from typing import Any
+from collections.abc import Mapping
+from typing import ClassVar
 
 import numpy as np
 
+from ..protocol.errors import ProtocolError
 from ..protocol.payloads.drawings import Drawing, Visibility
-from ..state import DrawingLayer, DrawingsChanged, DrawingsState
+from ..values.intents import DrawingChoices, Intent, ShowDrawing
+from ..values.state import DrawingLayer, DrawingsChanged, DrawingsState
 from .connection import AriaClient, Packet
 from .drawing_budget import sample_array, thin
 from .drawing_list import LIST, drawing_list, drawing_sample
 from .errors import ClientError
+from .feed import Feed, FeedContext
 
 log = logging.getLogger(__name__)
 
 MIN_REFRESH_MS = 50
 """A drawing is never asked for more often than this, whatever period the server suggests."""
+MAX_REFRESH_MS = 2**31 - 1
+"""…nor less often than this: a request's period is a signed 32-bit count of ms on the wire (ARIA's
+``byte4``), and a drawing list may suggest up to 2³²−1 (24 days or 49 are the same thing: one sample)."""
 PUBLISH_EVERY = 0.05
 """Seconds between two published states at most (samples arriving faster are coalesced)."""
 LOOP_SHARE = 0.1
@@ -51,21 +57,15 @@ LOOP_SHARE = 0.1
 took ``t`` s of CPU to make, the next waits at least ``t / LOOP_SHARE`` (a flood is shown less
 often rather than let it delay a ``ratioDrive``)."""
 
-Publish = Callable[[DrawingsChanged], None]
-Spawn = Callable[[Coroutine[Any, Any, None], str], None]
-Handler = Callable[[Packet], None]
 
-
-class DrawingsFeed:
+class DrawingsFeed(Feed):
     """Drawings for one session (network loop only)."""
 
-    def __init__(
-        self, publish: Publish, spawn: Spawn, reply_timeout: float, also: Mapping[str, Handler] | None = None
-    ) -> None:
-        self._publish = publish
-        self._spawn = spawn
-        self._timeout = reply_timeout
-        self._also = dict(also or {})
+    handles: ClassVar[tuple[type[Intent], ...]] = (ShowDrawing, DrawingChoices)
+
+    def __init__(self, ctx: FeedContext) -> None:
+        super().__init__(ctx)
+        self._timeout = ctx.config.reply_timeout
         self._client: AriaClient | None = None
         self._drawings: tuple[Drawing, ...] = ()
         self._points: dict[str, tuple[tuple[int, int], ...]] = {}
@@ -94,7 +94,7 @@ class DrawingsFeed:
         self._reset(client)
         if client.supports(LIST):
             self._offered = True
-            self._spawn(self._fetch(client), "drawings")
+            self.ctx.spawn(self._fetch(client), "drawings")
         self._publish_now()
 
     def disconnected(self) -> None:
@@ -115,7 +115,7 @@ class DrawingsFeed:
 
     async def _fetch(self, client: AriaClient) -> None:
         try:
-            drawings = await drawing_list(client, self._timeout)
+            listed = await drawing_list(client, self._timeout)
         except ClientError as exc:
             if client is self._client:
                 self._note = f"the server's drawings could not be read: {exc}"
@@ -123,9 +123,10 @@ class DrawingsFeed:
             return
         if client is not self._client:
             return
-        self._drawings = tuple(sorted(drawings, key=lambda d: d.layer))
+        self._note = listed.dropped_text()
+        self._drawings = tuple(sorted(listed.drawings, key=lambda d: d.layer))
         for d in self._drawings:  # the session subscribed its sonar/lasers itself: a hidden one ends here
-            if d.name in self._also and not self.shown(d):
+            if self.ctx.handler_for(d.name) is not None and not self.shown(d):
                 client.stop_request(d.name)
         unknown = [d for d in self._drawings if d.known_shape is None]
         if unknown:
@@ -134,6 +135,12 @@ class DrawingsFeed:
         self._publish_now()
 
     # -- what the operator chose -------------------------------------------------------------
+    def handle(self, intent: Intent) -> None:
+        if isinstance(intent, ShowDrawing):
+            self.set_shown(intent.name, intent.shown)
+        elif isinstance(intent, DrawingChoices):
+            self.set_choices(intent.choices)
+
     def set_choices(self, choices: Mapping[str, bool]) -> None:
         """The operator's remembered choices for this server (settings), before or after connecting."""
         self._choices = {str(k): bool(v) for k, v in list(choices.items())[:1024]}
@@ -168,16 +175,23 @@ class DrawingsFeed:
             wanted = self.shown(d) and d.known_shape is not None
             if wanted and d.name not in self._requested:
                 self._requested.add(d.name)
-                if d.refresh_ms > 0:
-                    client.request(d.name, max(d.refresh_ms, MIN_REFRESH_MS), self._on_packet)
-                else:  # "don't poll": the server sends it when it changes; one sample to start with
-                    client.request(d.name, -1, self._on_packet)
-                    self._spawn(self._first_sample(client, d.name), f"drawing-{d.name[:40]}")
+                try:
+                    self._ask(client, d)
+                except (ClientError, ProtocolError, ValueError) as exc:  # this drawing only: the rest go on
+                    self._problems[d.name] = f"could not be asked for: {exc}"
+                    log.info("drawing %r could not be asked for: %s", d.name, exc)
             elif not wanted and d.name in self._requested:
                 self._requested.discard(d.name)
                 client.stop_request(d.name)
                 self._forget(d.name)
                 self._problems.pop(d.name, None)
+
+    def _ask(self, client: AriaClient, d: Drawing) -> None:
+        if d.refresh_ms > 0:
+            client.request(d.name, period_ms(d.refresh_ms), self._on_packet)
+        else:  # "don't poll": the server sends it when it changes; one sample to start with
+            client.request(d.name, -1, self._on_packet)
+            self.ctx.spawn(self._first_sample(client, d.name), f"drawing-{d.name[:40]}")
 
     async def _first_sample(self, client: AriaClient, name: str) -> None:
         with contextlib.suppress(ClientError):
@@ -188,7 +202,7 @@ class DrawingsFeed:
 
     def _on_packet(self, packet: Packet) -> None:
         name = packet.name
-        also = self._also.get(name)
+        also = self.ctx.handler_for(name)
         if also is not None:
             try:
                 also(packet)
@@ -249,7 +263,7 @@ class DrawingsFeed:
                 color=d.primary_color & 0xFFFFFF,
                 size=d.size,
                 layer=d.layer,
-                refresh_ms=max(d.refresh_ms, MIN_REFRESH_MS) if d.refresh_ms > 0 else 0,
+                refresh_ms=period_ms(d.refresh_ms) if d.refresh_ms > 0 else 0,
                 shown=self.shown(d) and d.known_shape is not None,
                 may_toggle=d.operator_may_toggle and d.known_shape is not None,
                 points=self._points.get(d.name, ()),
@@ -258,4 +272,9 @@ class DrawingsFeed:
             )
             for d in self._drawings
         )
-        self._publish(DrawingsChanged(DrawingsState(layers, self._offered, self._note)))
+        self.ctx.publish(DrawingsChanged(DrawingsState(layers, self._offered, self._note)))
+
+
+def period_ms(suggested: int) -> int:
+    """The period a drawing is asked for at: the server's suggestion within what is sane and sendable."""
+    return min(max(suggested, MIN_REFRESH_MS), MAX_REFRESH_MS)

@@ -19,8 +19,10 @@ import asyncio
 import contextlib
 import time
 
-from ..exit_codes import EXIT_TIMEOUT
-from ..state import LinkLevel
+from ..base.exit_codes import EXIT_TIMEOUT
+from ..protocol.errors import ProtocolError
+from ..protocol.payloads.robot import Update, UpdateNumbers
+from ..values.state import LinkLevel
 from .connection import AriaClient, Packet
 from .errors import ClientError, ClientTimeout
 from .health import HealthMonitor, ping_data
@@ -62,6 +64,8 @@ class DriveGuard:
         """Set whenever something arrives or fails that may change :meth:`fault` (a wake-up)."""
         self._ping_task: asyncio.Task[None] | None = None
         self._status_name = "updateNumbers" if client.supports("updateNumbers") else "update"
+        self.seen_moving = False
+        """A status since this was last cleared showed the robot moving (``rtmu drive``: did it move?)."""
 
     def start(self) -> None:
         """Subscribe to status at 10 Hz and start pinging; the status age counts from now."""
@@ -76,6 +80,8 @@ class DriveGuard:
 
     def _on_status(self, packet: Packet) -> None:
         self.health.note_status(packet.received_at)
+        if not self.seen_moving:
+            self.seen_moving = _shows_motion(packet)
         self.changed.set()
 
     async def _ping_loop(self) -> None:
@@ -121,3 +127,13 @@ class DriveGuard:
                 await asyncio.wait({task}, timeout=0.5)
         with contextlib.suppress(ClientError):
             self.client.stop_request(self._status_name)
+
+
+def _shows_motion(packet: Packet) -> bool:
+    """The status packet shows a speed (one that does not decode shows nothing)."""
+    try:
+        value = packet.decode()
+    except (ClientError, ProtocolError):
+        return False
+    numbers = value.numbers if isinstance(value, Update) else value
+    return isinstance(numbers, UpdateNumbers) and (numbers.vel != 0 or numbers.rot_vel != 0)

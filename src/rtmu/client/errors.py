@@ -7,7 +7,7 @@ and the command line prints it on one line and exits with ``error.exit_code``.
 
 from __future__ import annotations
 
-from ..exit_codes import EXIT_CONNECTION, EXIT_TIMEOUT, EXIT_UNSUPPORTED
+from ..base.exit_codes import EXIT_CONNECTION, EXIT_INTERNAL, EXIT_TIMEOUT, EXIT_UNSUPPORTED
 from ..protocol.commands import RejectReason, describe_reject
 from ..protocol.errors import ProtocolError
 
@@ -96,3 +96,19 @@ class NotSupported(ClientError):
     def __init__(self, name: str, detail: str = "") -> None:
         self.name = name
         super().__init__(detail or f"this server does not offer {name!r} (or this user may not use it)")
+
+
+class MotionRefused(ClientError):
+    """An observer's client was asked to send a motion request; nothing was put on the wire.
+
+    Reaching this is a bug in the command that asked (an observer never commands motion).
+    """
+
+    exit_code = EXIT_INTERNAL
+    kind = "observer"
+
+    def __init__(self, name: str) -> None:
+        self.name = name
+        super().__init__(
+            f"an observer never sends {name!r} (it changes how the robot moves); nothing was sent"
+        )

@@ -26,7 +26,7 @@ from __future__ import annotations
 from collections.abc import Callable
 
 from ..protocol.decoder import DropStats
-from ..state import LinkHealth, LinkLevel
+from ..values.state import LinkHealth, LinkLevel
 from .link_timing import STATUS_CEILING, WAKE_MEMORY, Deadline, Envelope, Timing, ceiling_for
 
 STALE_INTERVALS = 3

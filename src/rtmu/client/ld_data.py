@@ -24,6 +24,17 @@ from .errors import MalformedReply, NotSupported
 
 LASER_NAMES = ("Laser_1Current", "Laser_2Current")
 """The LD range devices RTMU draws, when listed."""
+MAX_LASERS = 8
+_LASER_DRAWING = re.compile(r"(?!sonar)\w+_\d+Current", re.IGNORECASE)
+"""ARIA names a laser ``<kind>_<n>`` (its laser connector: ``sim_lms2xx_1``, ``lms1xx_1``, ``urg_1``;
+ARAM: ``Laser_1``) and the drawing of its current readings ``<name>Current``; the sonar, bumpers and
+IRs have names of their own (``sonarCurrent``, ``bumpersCurrent``, ``irsCurrent``)."""
+
+
+def laser_names(client: AriaClient) -> tuple[str, ...]:
+    """The lasers' current-readings data the server lists (an LD robot's and an ARIA/Pioneer one's)."""
+    listed = [e.name for e in client.datalist if _LASER_DRAWING.fullmatch(e.name)]
+    return tuple(dict.fromkeys([*LASER_NAMES, *sorted(listed)]))[: len(LASER_NAMES) + MAX_LASERS]
 
 
 async def dock_info(client: AriaClient, timeout: float) -> DockInfo | None:
@@ -100,28 +111,30 @@ _SCALE = re.compile(r"\(\s*0\s*[-–]\s*(\d+)\s*\)")
 
 
 def store_fields(name: str, value: str, description: str = "") -> dict[str, int | None]:
-    """The :class:`~rtmu.model.RobotState` fields a ``DataStore_*`` value gives the toolbar.
+    """The :class:`~rtmu.model.observables.RobotState` fields a ``DataStore_*`` value gives the toolbar.
 
-    Names as LD robots list them (``DataStore_Localization_Score``, ``DataStore_WiFi_Quality``,
-    ``DataStore_Distance_To_Goal``, ``DataStore_Closest_Obstacle``); anything else only goes to the
-    details table. Wi-Fi quality becomes % using the range in its description ("(0–70)": Linux's
-    link quality), else it is taken as % already. A value that is not a number clears the field.
+    Names as 6MTX robots list them (``DataStore_LaserLocalizationScore``,
+    ``DataStore_WirelessQuality``, ``DataStore_Distance_to_goal``,
+    ``DataStore_Closest_Obstacle_Distance``), read without case or underscores so that spellings such
+    as ``DataStore_Localization_Score`` or ``DataStore_WiFi_Quality`` count too; anything else only
+    goes to the details table. Wi-Fi quality becomes % using the range in its description ("(0–70)":
+    Linux's link quality), else it is taken as % already. A value that is not a number clears the field.
     """
-    key = name.lower()
+    key = name.lower().replace("_", "").replace("-", "")
     try:
         number: float | None = float(value.split()[0])
     except (ValueError, IndexError):
         number = None
-    if "localization_score" in key or "localisation_score" in key:
+    if "localizationscore" in key or "localisationscore" in key:
         return {"loc_score": None if number is None else round(max(0.0, min(100.0, number)))}
-    if "wifi_quality" in key or "wi_fi_quality" in key:
+    if "wifiquality" in key or "wirelessquality" in key:
         if number is None:
             return {"wifi_quality": None}
         top = _SCALE.search(description)
         scale = int(top.group(1)) if top and int(top.group(1)) > 0 else 100
         return {"wifi_quality": round(max(0.0, min(100.0, number * 100 / scale)))}
-    if "distance_to_goal" in key:
+    if "distancetogoal" in key:
         return {"goal_distance_mm": None if number is None else max(0, round(number))}
-    if "closest_obstacle" in key:
+    if "closestobstacle" in key:
         return {"closest_obstacle_mm": None if number is None else max(0, round(number))}
     return {}

@@ -1,103 +1,104 @@
-"""The window session's share of LD (ARAM) data: lasers, docking state, routes, ``DataStore_*``.
+"""The session's share of LD (ARAM) data: lasers, docking state, routes, ``DataStore_*``; patrol and say.
 
-:class:`LdFeed` is what :class:`~rtmu.client.session.Session` calls after login: it subscribes only
-to the data the server lists and turns each packet into :class:`~rtmu.model.RobotState` changes
-through the session's ``update`` function. A serverDemo-like server lists none of it, so nothing
-is asked and the model keeps its defaults (no laser, ``dock_state`` None, no routes).
+The lasers are every robot's: an LD robot's ``Laser_*Current`` and an ARIA/Pioneer server's laser
+drawings (``sim_lms2xx_1Current`` …, :func:`~rtmu.client.ld_data.laser_names`), so the recorder and the
+Foxglove bridge have the laser of both.
+
+:class:`LdFeed` subscribes only to the data the server lists and turns each packet into
+:class:`~rtmu.values.state.RobotState` changes. A serverDemo-like server lists none of it, so nothing
+is asked and the model keeps its defaults (no laser, ``dock_state`` None, no routes). The goal list
+is navigation's (:class:`~rtmu.client.nav_session.NavFeed`): one ``getGoals`` per update.
 """
 
 from __future__ import annotations
 
 import contextlib
-from collections.abc import Callable, Coroutine
-from typing import Any
+from collections.abc import Iterable
+from typing import ClassVar
 
 from ..protocol.errors import ProtocolError
 from ..protocol.payloads.ld import DataStoreValue, DockInfo, Routes
-from ..protocol.payloads.map import Goals
+from ..protocol.payloads.ld import Patrol as PatrolPayload
+from ..protocol.payloads.ld import Say as SayPayload
 from ..protocol.payloads.sensors import RangeDeviceReadings
+from ..values.intents import Intent, Patrol, Say
 from .connection import AriaClient, Packet
 from .errors import ClientError
-from .ld_data import LASER_NAMES, data_store_names, store_fields
+from .feed import Feed, FeedContext
+from .ld_data import data_store_names, laser_names, store_fields
+from .subscriptions import Subscription
 
 LASER_INTERVAL_MS = 200
 DATA_STORE_INTERVAL_MS = 1000
 DOCK_INTERVAL_MS = 1000
 """``dockInfo`` is polled as well as heard on ``dockInfoChanged``: a missed broadcast heals."""
 
-Update = Callable[..., None]
-Decode = Callable[[str, bytes], Any]
-Spawn = Callable[[Coroutine[Any, Any, None], str], None]
 
+class LdFeed(Feed):
+    """LD data subscriptions for one session, and the LD robot's own intents (patrol a route, speak)."""
 
-class LdFeed:
-    """LD data subscriptions for one session; ``update(**changes)`` changes the published robot."""
+    handles: ClassVar[tuple[type[Intent], ...]] = (Patrol, Say)
 
-    def __init__(self, update: Update, decode: Decode, spawn: Spawn, reply_timeout: float) -> None:
-        self._update = update
-        self._decode = decode
-        self._spawn = spawn
-        self._timeout = reply_timeout
+    def __init__(self, ctx: FeedContext) -> None:
+        super().__init__(ctx)
         self._lasers: dict[str, tuple[tuple[int, int], ...]] = {}
         self._store: dict[str, str] = {}
         self._descriptions: dict[str, str] = {}
 
-    def subscribe(self, client: AriaClient) -> None:
-        """Subscribe to what the server lists (called after every login)."""
+    def subscriptions(self, client: AriaClient) -> Iterable[Subscription]:
+        subs = [Subscription(name, LASER_INTERVAL_MS, self.on_laser) for name in laser_names(client)]
+        subs += [
+            Subscription("dockInfo", DOCK_INTERVAL_MS, self._on_dock),
+            Subscription("dockInfoChanged", -1, self._on_dock),
+            Subscription("routesUpdated", -1, self._on_routes_changed, needs="getRoutes"),
+            Subscription("goalsUpdated", -1, self._on_routes_changed, needs="gotoRouteGoal"),
+        ]
+        subs += [
+            Subscription(name, DATA_STORE_INTERVAL_MS, self._on_store) for name in data_store_names(client)
+        ]
+        return subs
+
+    def connected(self, client: AriaClient) -> None:
         self._lasers.clear()
         self._store.clear()
-        for name in LASER_NAMES:
-            if client.supports(name):
-                client.request(name, LASER_INTERVAL_MS, self.on_laser)
-        if client.supports("dockInfo"):
-            client.request("dockInfo", DOCK_INTERVAL_MS, self._on_dock)
-        if client.supports("dockInfoChanged"):
-            client.request("dockInfoChanged", -1, self._on_dock)
-        if client.supports("routesUpdated") and client.supports("getRoutes"):
-            client.request("routesUpdated", -1, lambda packet: self._refetch_routes(client))
         self._descriptions = {e.name: e.description for e in client.datalist}
-        for name in data_store_names(client):
-            client.request(name, DATA_STORE_INTERVAL_MS, self._on_store)
+        self.ctx.spawn(self._fetch_routes(client), "ld-routes")
 
-    async def fetch(self, client: AriaClient) -> None:
-        """One-off questions after login: the route list, and the goals ``gotoRouteGoal`` can reach."""
+    def handle(self, intent: Intent) -> None:
+        if isinstance(intent, Patrol):
+            self.require("patrol").send(PatrolPayload(intent.route))
+        elif isinstance(intent, Say):
+            self.require("say").send(SayPayload(intent.text))
+
+    async def _fetch_routes(self, client: AriaClient) -> None:
         if client.supports("getRoutes"):
             with contextlib.suppress(ClientError, ProtocolError):
-                reply = await client.request_once("getRoutes", timeout=self._timeout)
-                routes = self._decode("getRoutes", reply.payload)
+                reply = await client.request_once("getRoutes", timeout=self.ctx.config.reply_timeout)
+                routes = self.ctx.decode("getRoutes", reply.payload)
                 if isinstance(routes, Routes):
-                    self._update(routes=routes.routes)
-        if client.supports("gotoRouteGoal") and client.supports("getGoals"):
-            with contextlib.suppress(ClientError, ProtocolError):
-                reply = await client.request_once("getGoals", timeout=self._timeout)
-                goals = self._decode("getGoals", reply.payload)
-                if isinstance(goals, Goals):
-                    self._update(goals=goals.goals)
+                    self.ctx.robot_update(routes=routes.routes)
 
-    def _refetch_routes(self, client: AriaClient) -> None:
-        self._spawn(self.fetch(client), "ld-routes")
-
-    def goals_updated(self, client: AriaClient) -> None:
-        """``goalsUpdated`` (the session holds that one subscription for navigation too): ask again."""
-        if client.supports("gotoRouteGoal"):
-            self._refetch_routes(client)
+    def _on_routes_changed(self, packet: Packet) -> None:
+        client = self.ctx.client
+        if client is not None:
+            self.ctx.spawn(self._fetch_routes(client), "ld-routes")
 
     def on_laser(self, packet: Packet) -> None:
-        """A ``Laser_*Current`` packet (also handed on by the drawings feed when it holds that request)."""
-        readings = self._decode(packet.name, packet.payload)
+        """A laser's ``…Current`` packet (also handed on by the drawings feed when it holds that request)."""
+        readings = self.ctx.decode(packet.name, packet.payload)
         if isinstance(readings, RangeDeviceReadings):
             self._lasers[packet.name] = readings.readings
             points = tuple(p for name in sorted(self._lasers) for p in self._lasers[name])
-            self._update(laser=points, laser_at=packet.received_at)
+            self.ctx.robot_update(laser=points, laser_at=packet.received_at)
 
     def _on_dock(self, packet: Packet) -> None:
-        info = self._decode(packet.name, packet.payload)
+        info = self.ctx.decode(packet.name, packet.payload)
         if isinstance(info, DockInfo):
-            self._update(dock_state=info.state_label)
+            self.ctx.robot_update(dock_state=info.state_label)
 
     def _on_store(self, packet: Packet) -> None:
-        value = self._decode(packet.name, packet.payload)
+        value = self.ctx.decode(packet.name, packet.payload)
         if isinstance(value, DataStoreValue) and self._store.get(packet.name) != value.value:
             self._store[packet.name] = value.value
             fields = store_fields(packet.name, value.value, self._descriptions.get(packet.name, ""))
-            self._update(data_store=tuple(sorted(self._store.items())), **fields)
+            self.ctx.robot_update(data_store=tuple(sorted(self._store.items())), **fields)

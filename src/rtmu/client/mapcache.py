@@ -27,7 +27,7 @@ from dataclasses import dataclass
 
 from ..protocol.errors import ProtocolError
 from ..protocol.payloads.map import MapId
-from ..state import MapModel
+from ..values.state import MapModel
 from .connection import AriaClient
 from .errors import ClientError
 

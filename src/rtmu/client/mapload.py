@@ -1,4 +1,4 @@
-"""Download the server's map into ``rtmu.maps.MapData``: one function the session and ``rtmu map`` share.
+"""Download the server's map into ``rtmu.mapfile.MapData``: one function the session and ``rtmu map`` share.
 
 ``getMapBinary`` is preferred (geometry as int32 blocks: about 5× fewer bytes
 and packets than text); ``getMap`` is the fallback, or forced with
@@ -26,7 +26,7 @@ from .errors import ClientError, ClientTimeout, NotSupported, ProtocolFault
 @dataclass
 class Download:
     data: Any | None
-    """``rtmu.maps.MapData``, or None when the server has no map."""
+    """``rtmu.mapfile.MapData``, or None when the server has no map."""
     name: str
     """The server's map file name (``getMapName``), may be empty."""
     source: str
@@ -96,7 +96,7 @@ async def download_map(
 
 def assembled_map(assembler: MapBinaryAssembler | MapTextAssembler) -> Any | None:
     """A complete assembler → ``MapData`` (None: the server has no map)."""
-    from .. import maps
+    from .. import mapfile as maps
 
     result = assembler.result()
     if not result.has_map:

@@ -15,7 +15,8 @@ import itertools
 import math
 from collections.abc import Sequence
 from dataclasses import dataclass
-from enum import Enum
+
+from ..values.state import NavOutcome
 
 MAX_TEXT = 200
 """Longest status, target or reason kept from the server."""
@@ -46,34 +47,26 @@ _GOING = ("Going to ", "Returning home", "Touring to ", "Driving into dock", "Do
 _FAILED = ("Failed", "Unable to dock", "Cannot drive to dock")
 
 
-class NavPhase(Enum):
-    IDLE = "idle"
-    """Not navigating, and the status says nothing about an outcome (``Stopped``, ``Driving``)."""
-    GOING = "going"
-    ARRIVED = "arrived"
-    DOCKED = "docked"
-    FAILED = "failed"
-
-
 @dataclass(frozen=True, slots=True)
 class NavReading:
     """One status string, read: the phase, where to, why it failed, and the text itself (bounded)."""
 
-    phase: NavPhase
+    phase: NavOutcome
+    """``NONE`` (no news), ``GOING`` or how it ended (never ``CANCELLED``: only a change of words says so)."""
     target: str = ""
     reason: str = ""
     text: str = ""
 
     @property
     def finished(self) -> bool:
-        return self.phase in (NavPhase.ARRIVED, NavPhase.DOCKED, NavPhase.FAILED)
+        return self.phase in (NavOutcome.ARRIVED, NavOutcome.DOCKED, NavOutcome.FAILED)
 
     def sentence(self) -> str:
         """The outcome for the operator: ``Arrived at Lab B``, ``Failed to get to Lab B because the
         robot is lost``, ``Docked``; "" while not finished."""
         if not self.finished:
             return ""
-        if self.phase is NavPhase.FAILED:
+        if self.phase is NavOutcome.FAILED:
             head = _failure_head(self.text)
             return f"{head} because {self.reason}" if self.reason and self.reason not in head else head
         return self.text
@@ -88,16 +81,16 @@ def read_status(status: str, mode_name: str = "") -> NavReading:
     ``Going to …`` of some other mode from counting as navigation."""
     text = _bounded(status.strip())
     if text == "Docked":
-        return NavReading(NavPhase.DOCKED, "dock", text=text)
+        return NavReading(NavOutcome.DOCKED, "dock", text=text)
     if text.startswith("Arrived at "):
-        return NavReading(NavPhase.ARRIVED, text.removeprefix("Arrived at "), text=text)
+        return NavReading(NavOutcome.ARRIVED, text.removeprefix("Arrived at "), text=text)
     if text == "Returned home":
-        return NavReading(NavPhase.ARRIVED, "home", text=text)
+        return NavReading(NavOutcome.ARRIVED, "home", text=text)
     if text.startswith(_FAILED):
-        return NavReading(NavPhase.FAILED, _failure_target(text), _failure_reason(text), text)
+        return NavReading(NavOutcome.FAILED, _failure_target(text), _failure_reason(text), text)
     if text.startswith(_GOING) and (not mode_name or mode_name in NAV_MODES):
-        return NavReading(NavPhase.GOING, _going_target(text), text=text)
-    return NavReading(NavPhase.IDLE, text=text)
+        return NavReading(NavOutcome.GOING, _going_target(text), text=text)
+    return NavReading(NavOutcome.NONE, text=text)
 
 
 def _going_target(text: str) -> str:

@@ -1,8 +1,8 @@
 """Server popups for one session (protocol §4.9): what is open, answers, and the closing words.
 
-:class:`PopupFeed` is fed the session's ``popupCreate`` / ``popupClose`` packets (subscriptions
-in the session's table) and asks ``popupList`` once per login, so a reconnect shows again what the
-server still has open. It publishes the open set as one typed :class:`~rtmu.state.PopupsChanged`
+:class:`PopupFeed` is fed the session's ``popupCreate`` / ``popupClose`` packets (its
+subscriptions) and asks ``popupList`` once per login, so a reconnect shows again what the
+server still has open. It publishes the open set as one typed :class:`~rtmu.values.state.PopupsChanged`
 and the server's closing text as a ``Kind.SERVER`` notice. Server text is untrusted: titles,
 messages and labels are cut to a bounded length, and at most :data:`MAX_OPEN` popups are kept —
 a flood beyond that is only counted. Publishing is coalesced to at most one state per
@@ -14,15 +14,17 @@ from __future__ import annotations
 
 import asyncio
 import contextlib
-import time
-from collections.abc import Callable, Coroutine
-from typing import Any
+from collections.abc import Iterable
+from typing import ClassVar
 
-from ..notices import Kind, Notice
+from ..base.notices import Kind, Notice
 from ..protocol.payloads.popup import PopupClicked, PopupClose, PopupCreate
-from ..state import PopupInfo, PopupsChanged, PopupsState
+from ..values.intents import AnswerPopup, Intent
+from ..values.state import PopupInfo, PopupsChanged, PopupsState
 from .connection import AriaClient, Packet
-from .errors import ClientError, NotSupported, ServerClosed
+from .errors import ClientError
+from .feed import Feed, FeedContext
+from .subscriptions import Subscription
 
 MAX_OPEN = 64
 """Open popups kept; more are counted in ``PopupsState.dropped`` (a window shows only a few anyway)."""
@@ -32,11 +34,6 @@ MAX_LABEL = 40
 MAX_CLOSE_TEXT = 300
 PUBLISH_EVERY = 0.1
 """Seconds between two published popup states at least."""
-
-Publish = Callable[[PopupsChanged], None]
-NoticeFn = Callable[[Notice], None]
-Decode = Callable[[str, bytes], Any]
-Spawn = Callable[[Coroutine[Any, Any, None], str], None]
 
 
 def cut(text: str, limit: int) -> str:
@@ -58,24 +55,13 @@ def popup_info(p: PopupCreate, at: float) -> PopupInfo:
     )
 
 
-class PopupFeed:
+class PopupFeed(Feed):
     """The open popups of one session (network loop only)."""
 
-    def __init__(
-        self,
-        publish: Publish,
-        notice: NoticeFn,
-        decode: Decode,
-        spawn: Spawn,
-        reply_timeout: float,
-        clock: Callable[[], float] = time.monotonic,
-    ) -> None:
-        self._publish = publish
-        self._notice = notice
-        self._decode = decode
-        self._spawn = spawn
-        self._timeout = reply_timeout
-        self._clock = clock
+    handles: ClassVar[tuple[type[Intent], ...]] = (AnswerPopup,)
+
+    def __init__(self, ctx: FeedContext) -> None:
+        super().__init__(ctx)
         self._open: dict[int, PopupInfo] = {}
         self._dropped = 0
         self._offered = False
@@ -83,6 +69,12 @@ class PopupFeed:
         self._dirty = False
         self._published_at = float("-inf")
         self.state = PopupsState()
+
+    def subscriptions(self, client: AriaClient) -> Iterable[Subscription]:
+        return (
+            Subscription("popupCreate", -1, self.on_create),
+            Subscription("popupClose", -1, self.on_close),
+        )
 
     # -- connection --------------------------------------------------------------------------
     def connected(self, client: AriaClient) -> None:
@@ -93,7 +85,7 @@ class PopupFeed:
         self._offered = client.supports("popupCreate")
         self._flush()
         if self._offered and client.supports("popupList"):
-            self._spawn(self._list(client), "popup-list")
+            self.ctx.spawn(self._list(client), "popup-list")
 
     def disconnected(self) -> None:
         self._client = None
@@ -106,21 +98,21 @@ class PopupFeed:
         # The open ones come as popupCreate packets (the subscription hears them), then an empty
         # popupList packet ends the reply.
         with contextlib.suppress(ClientError):
-            await client.request_once("popupList", timeout=self._timeout)
+            await client.request_once("popupList", timeout=self.ctx.config.reply_timeout)
 
     # -- packets -----------------------------------------------------------------------------
     def on_create(self, packet: Packet) -> None:
-        p = self._decode(packet.name, packet.payload)
+        p = self.ctx.decode(packet.name, packet.payload)
         if not isinstance(p, PopupCreate):
             return
         if p.popup_id not in self._open and len(self._open) >= MAX_OPEN:
             self._dropped += 1
         else:
-            self._open[p.popup_id] = popup_info(p, self._clock())
+            self._open[p.popup_id] = popup_info(p, self.ctx.clock())
         self._changed()
 
     def on_close(self, packet: Packet) -> None:
-        c = self._decode(packet.name, packet.payload)
+        c = self.ctx.decode(packet.name, packet.payload)
         if not isinstance(c, PopupClose):
             return
         gone = self._open.pop(c.popup_id, None)
@@ -132,19 +124,15 @@ class PopupFeed:
         self._changed()
         text = cut(c.message.strip(), MAX_CLOSE_TEXT)
         if text:
-            self._notice(Notice.info(Kind.SERVER, f"{gone.title}: {text}" if gone.title else text))
+            self.ctx.notice(Notice.info(Kind.SERVER, f"{gone.title}: {text}" if gone.title else text))
 
     # -- answers -----------------------------------------------------------------------------
-    def click(self, popup_id: int, button: int) -> None:
-        """The operator pressed ``button`` (0–2): tell the server; its ``popupClose`` removes the card."""
-        client = self._client
-        if client is None or not client.connected:
-            raise ServerClosed("not connected")
-        if not client.supports("popupClicked"):
-            raise NotSupported("popupClicked")
-        if not 0 <= button <= 2:
-            raise ValueError(f"a popup has buttons 0–2, not {button}")
-        client.send(PopupClicked(popup_id, button))
+    def handle(self, intent: Intent) -> None:
+        """The operator pressed a button (0–2): tell the server; its ``popupClose`` removes the card."""
+        assert isinstance(intent, AnswerPopup)
+        if not 0 <= intent.button <= 2:
+            raise ValueError(f"a popup has buttons 0–2, not {intent.button}")
+        self.require("popupClicked").send(PopupClicked(intent.popup_id, intent.button))
 
     # -- publishing (coalesced) --------------------------------------------------------------
     def _changed(self) -> None:
@@ -156,12 +144,12 @@ class PopupFeed:
         except RuntimeError:  # no loop (a test feeding packets by hand): publish now
             self._flush()
             return
-        loop.call_later(max(0.0, self._published_at + PUBLISH_EVERY - self._clock()), self._flush)
+        loop.call_later(max(0.0, self._published_at + PUBLISH_EVERY - self.ctx.clock()), self._flush)
 
     def _flush(self) -> None:
         self._dirty = False
-        self._published_at = self._clock()
+        self._published_at = self.ctx.clock()
         state = PopupsState(tuple(self._open.values()), self._dropped, self._offered)
         if state != self.state:
             self.state = state
-            self._publish(PopupsChanged(state))
+            self.ctx.publish(PopupsChanged(state))

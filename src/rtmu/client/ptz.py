@@ -4,7 +4,7 @@ After login :class:`PtzFeed` reads ``getCameraList``, picks the first camera who
 ``setCameraRel`` or ``setCameraAbs`` data the server also lists, and reads its limits
 (``getCameraInfo<N>``) and position (``getCameraData<N>``) once. The position is then polled only
 while someone looks at it (the camera page is shown): a hidden page costs the robot nothing. Where
-there is no such camera the published :class:`~rtmu.state.PtzState` says why, so the window can
+there is no such camera the published :class:`~rtmu.values.state.PtzState` says why, so the window can
 grey its controls with the reason. Moving the head is camera work, never robot motion: it needs
 no drive lease. Every name and number comes from the server and is bounded before it is kept.
 """
@@ -13,15 +13,17 @@ from __future__ import annotations
 
 import contextlib
 import math
-from collections.abc import Callable, Coroutine
+from collections.abc import Callable
 from dataclasses import replace
-from typing import Any
+from typing import ClassVar
 
 from ..protocol.errors import ProtocolError
 from ..protocol.payloads.camera import Camera, CameraData, CameraInfo, CameraList, SetCameraAbs, SetCameraRel
-from ..state import PtzState
+from ..values.intents import Intent, PtzMove, WatchPtz
+from ..values.state import PtzState
 from .connection import AriaClient, Packet
 from .errors import ClientError, NotSupported
+from .feed import Feed, FeedContext
 
 POLL_MS = 250
 """``getCameraData`` period while watched (ARIA suggests 100 ms; 4 Hz is plenty for a label)."""
@@ -31,9 +33,6 @@ NO_LIST = "the server lists no cameras (getCameraList)"
 NO_HEAD = "the server's cameras have no pan/tilt/zoom head (no setCameraRel / setCameraAbs)"
 LIMIT = 327.67
 """The largest angle a ``byte2`` hundredth can carry."""
-
-Update = Callable[..., None]
-Spawn = Callable[[Coroutine[Any, Any, None], str], None]
 
 
 def _clip(text: str) -> str:
@@ -54,19 +53,23 @@ def pick_camera(cameras: tuple[Camera, ...], offered: Callable[[str], bool]) -> 
     return None
 
 
-class PtzFeed:
-    """One session's PTZ head: ``update(ptz=PtzState)`` publishes it with the robot."""
+class PtzFeed(Feed):
+    """One session's PTZ head, published with the robot as ``RobotState.ptz``."""
 
-    def __init__(self, update: Update, spawn: Spawn, reply_timeout: float) -> None:
-        self._update = update
-        self._spawn = spawn
-        self._timeout = reply_timeout
+    handles: ClassVar[tuple[type[Intent], ...]] = (PtzMove, WatchPtz)
+
+    def __init__(self, ctx: FeedContext) -> None:
+        super().__init__(ctx)
+        self._timeout = ctx.config.reply_timeout
         self._client: AriaClient | None = None
         self._camera: Camera | None = None
         self._state = PtzState()
         self._polling = False
         self.cameras: tuple[Camera, ...] = ()
         """Every camera the server listed (for ``rtmu ptz``), bounded by the packet."""
+        self.read_error: ClientError | ProtocolError | None = None
+        """Why the last camera list could not be read (the window shows it as the reason; ``rtmu ptz``
+        exits with its own code: a lost link is not "no camera head")."""
         self.watching = False
         """Someone shows the position (the camera page): poll ``getCameraData`` while True."""
 
@@ -76,11 +79,15 @@ class PtzFeed:
 
     def _set(self, state: PtzState) -> None:
         self._state = state
-        self._update(ptz=state)
+        self.ctx.robot_update(ptz=state)
 
-    async def connected(self, client: AriaClient) -> None:
+    def connected(self, client: AriaClient) -> None:
+        self.ctx.spawn(self.read_head(client), "ptz")
+
+    async def read_head(self, client: AriaClient) -> None:
         """Read the camera list, limits and position once after login."""
         self._client, self._camera, self._polling, self.cameras = client, None, False, ()
+        self.read_error = None
         if not client.supports("getCameraList"):
             self._set(PtzState(reason=NO_LIST))
             return
@@ -89,6 +96,7 @@ class PtzFeed:
             cameras = CameraList.decode(reply.payload).cameras
         except (ClientError, ProtocolError) as exc:
             if client is self._client:
+                self.read_error = exc
                 self._set(PtzState(reason=f"the camera list could not be read: {exc}"))
             return
         if client is not self._client:
@@ -131,7 +139,15 @@ class PtzFeed:
     def disconnected(self) -> None:
         self._client, self._camera, self._polling = None, None, False
         self._state = PtzState()
-        self._update(ptz=None)  # unknown until the next login reads the list
+        self.ctx.robot_update(ptz=None)  # unknown until the next login reads the list
+
+    def handle(self, intent: Intent) -> None:
+        if isinstance(intent, WatchPtz):
+            self.watch(intent.on)
+        elif isinstance(intent, PtzMove) and intent.relative:
+            self.move_rel(intent.pan, intent.tilt, intent.zoom)
+        elif isinstance(intent, PtzMove):
+            self.move_abs(intent.pan, intent.tilt, intent.zoom)
 
     def watch(self, on: bool) -> None:
         """Poll the position while ``on`` (the camera page is shown)."""
@@ -186,7 +202,7 @@ class PtzFeed:
 
     def _after_move(self) -> None:
         if not self._polling:
-            self._spawn(self.refresh(), "ptz-refresh")
+            self.ctx.spawn(self.refresh(), "ptz-refresh")
 
     def _require(self, command: str) -> tuple[AriaClient, str]:
         client, name = self._client, self._name(command)

@@ -1,6 +1,6 @@
 """Where a fleet's robots come from: a fixed list of direct robots, or ARIA's central server.
 
-The fleet (``rtmu.fleet``) does not care how it learns of a robot: a :class:`Roster`
+The fleet (``rtmu.fleet.sessions``) does not care how it learns of a robot: a :class:`Roster`
 tells it, through :class:`RosterEvent` values, that a robot became reachable at an
 address (:class:`RobotAdded`), went away (:class:`RobotRemoved`), or that the whole
 roster was lost (:class:`RosterLost`: the central server's connection ended, so every

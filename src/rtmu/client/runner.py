@@ -9,12 +9,14 @@ Concurrency design
   shared loop).
 * The **UI thread** calls the methods below; each returns at once (they hand
   work to the loop with ``call_soon_threadsafe`` and give back a
-  ``concurrent.futures.Future`` for those who care).
+  ``concurrent.futures.Future`` for those who care). Every operator intent crosses
+  in ONE way, :meth:`ClientRunner.send`: the session hands it to the feed that
+  handles its type.
 * Results travel back through ``post(fn)``, the injectable "run this on the UI
   thread" function: GTK passes ``GLib.idle_add``; tests and scripts pass a
   direct call or a queue. Posted functions return None, so ``idle_add`` runs
-  them once. Every published change (:data:`rtmu.state.StateChange`) is handed
-  to the runner's ``sink`` (a :class:`~rtmu.model.RobotModel`, a recorder, a
+  them once. Every published change (:data:`rtmu.values.state.StateChange`) is handed
+  to the runner's ``sink`` (a :class:`~rtmu.model.observables.RobotModel`, a recorder, a
   test list) on the UI thread; only real changes get posted. The runner never
   imports the UI thread's state: it knows the sink only by its ``apply``.
 * Calls that may block (keyring lookups) go to :meth:`ClientRunner.run_blocking`:
@@ -40,12 +42,11 @@ fail has something behind it:
 3. **If the network loop itself is blocked**, nothing can be sent — neither the
    resends nor the stop: a release or a stop waits until the loop runs again. So
    the loop must never run slow work: map packets → arrays runs in an executor
-   (:mod:`~rtmu.client.mapload`), payload decoding is a few microseconds, session
-   handlers only update a shadow and ``post`` to the UI, and
-   :meth:`ClientRunner.subscribe` handlers are posted to the UI thread too. The
-   loop beats every :data:`LOOP_BEAT` s; :meth:`ClientRunner.loop_lag` says how
-   long ago it last did, so a window can warn (e.g. above 0.5 s) that driving
-   commands may not be getting out.
+   (:mod:`~rtmu.client.mapload`), payload decoding is a few microseconds, and the
+   feeds' handlers only update a shadow and ``post`` to the UI. The loop beats
+   every :data:`LOOP_BEAT` s; :meth:`ClientRunner.loop_lag` says how long ago it
+   last did, so a window can warn (e.g. above 0.5 s) that driving commands may
+   not be getting out.
 4. **The guardian** (``SessionConfig(guardian=True)``, :mod:`rtmu.guardian`): a
    separate process with its own login that stops the robot when this process
    is killed, stopped by a signal, or silent past its lease while driving; the
@@ -67,15 +68,18 @@ import time
 from collections.abc import Awaitable, Callable
 from typing import Any, TypeVar, overload
 
-from ..notices import Kind, Notice
-from ..state import StateChange, StateSink
+from ..base.notices import Kind, Notice
+from ..values.intents import Intent, Stop
+from ..values.state import StateChange, StateSink
 from . import lease_keeper
-from .connection import AriaClient, Packet
+from .config_feed import ConfigFeed
+from .connection import AriaClient
 from .errors import ClientError, ClientTimeout
 from .lease import LEASE_TTL, DriveLease, EndReason
 from .lease_keeper import LeaseKeeper, raise_priority
 from .link import Opener
-from .session import Session, SessionConfig
+from .session import Session
+from .session_config import SessionConfig
 
 log = logging.getLogger(__name__)
 
@@ -104,7 +108,7 @@ def call_directly(fn: Callable[[], None]) -> None:
 class ClientRunner:
     """Use as ``with ClientRunner(robot_model, post=GLib.idle_add) as runner:`` (or ``start()``/``close()``).
 
-    Implements ``rtmu.controller.ClientLink``. All public methods are thread-safe.
+    Implements ``rtmu.control.controller.ClientLink``. All public methods are thread-safe.
     """
 
     def __init__(
@@ -183,8 +187,8 @@ class ClientRunner:
             config=self.config,
             client_factory=factory,
         )
-        self.session.on_stop = self._stopped
-        self.session.config_feed.listener = self._config_updated
+        self.session.drive.on_stop = self._stopped
+        self.session.feed(ConfigFeed).listener = self._config_updated
         self.lease.on_change = self._lease_changed
         self._beat()
         self._ready.set()
@@ -284,7 +288,7 @@ class ClientRunner:
         if future.cancelled():
             return
         exc = future.exception()
-        if isinstance(exc, ClientError):
+        if isinstance(exc, (ClientError, ValueError)):  # the server's refusal, or an argument out of bounds
             self._notice(Notice.error(kind, str(exc)))
         elif exc is not None:
             log.error("network call failed", exc_info=exc)
@@ -328,7 +332,7 @@ class ClientRunner:
         with contextlib.suppress(RuntimeError):  # loop already closed
             self.loop.call_soon_threadsafe(session.kick)
 
-    # -- ClientLink (controller.py) -----------------------------------------------------------
+    # -- the controller's link (rtmu.control.controller.ClientLink) -------------------------------
     def connect(
         self,
         host: str,
@@ -353,10 +357,20 @@ class ClientRunner:
     def disconnect(self) -> concurrent.futures.Future[None]:
         return self._fire(self._session.disconnect, kind=Kind.CONNECTION)
 
-    def stop(self) -> None:
+    def send(self, intent: Intent) -> concurrent.futures.Future[Any]:
+        """The one way an operator's intent crosses to the network thread (:meth:`Session.dispatch`).
+
+        Returns at once; the Future holds the feed's answer (a map, a configuration, whether the
+        server took a command). A failure is also told to the operator (``on_notice``, as a notice
+        of the intent's kind). A :class:`Stop` ends the lease here first, so a drive cannot be
+        renewed while the stop is on its way."""
+        if isinstance(intent, Stop):
+            self.lease.end(EndReason.STOPPED)
+        return self._fire(self._session.dispatch, intent, kind=intent.kind)
+
+    def stop(self) -> concurrent.futures.Future[Any]:
         """Zero ratios and ``stop`` at once, whatever the link health says."""
-        self.lease.end(EndReason.STOPPED)
-        self.submit(self._session.stop_now)
+        return self.send(Stop())
 
     def stop_and_wait(self, timeout: float = 0.5) -> bool:
         """Blocking :meth:`stop`: True once zero ratios + ``stop`` have left this process.
@@ -379,71 +393,6 @@ class ClientRunner:
             return done
         return self._on_loop(self._session.stop_and_flush, timeout)
 
-    def command(self, name: str, *args: object) -> concurrent.futures.Future[None]:
-        return self._fire(self._session.command, name, *args)
-
-    def request_image(self) -> concurrent.futures.Future[Any]:
-        return self._fire(self._session.request_image, kind=Kind.CAMERA)
-
-    def start_video(
-        self, fps: float | None = None, quality: int | None = None
-    ) -> concurrent.futures.Future[None]:
-        """Live video (``client.video_session``): frames arrive as the model's camera part."""
-        return self._fire(self._session.video.start, fps, quality, kind=Kind.CAMERA)
-
-    def stop_video(self) -> concurrent.futures.Future[None]:
-        return self._fire(self._session.video.stop, kind=Kind.CAMERA)
-
-    def video_shown(self, sequence: int) -> None:
-        """Backpressure: the window has shown live frame ``sequence`` (thread-safe, no future)."""
-        if not self._closed:
-            self.loop.call_soon_threadsafe(self._session.video.shown, sequence)
-
-    def pause_video(self, paused: bool) -> concurrent.futures.Future[None]:
-        return self._fire(self._session.video.pause, paused, kind=Kind.CAMERA)
-
-    def set_safe_drive(self, on: bool) -> concurrent.futures.Future[None]:
-        return self._fire(self._session.set_safe_drive, on)
-
-    def load_map(self) -> concurrent.futures.Future[Any]:
-        return self._fire(self._session.load_map, kind=Kind.MAP)
-
-    # -- the server's own commands and popups ---------------------------------------------------
-    def list_commands(self) -> concurrent.futures.Future[Any]:
-        """A :class:`~rtmu.client.custom_commands.CommandCatalogue` of what this user may run."""
-        return self._fire(self._session.list_commands)
-
-    def run_command(self, command: Any, argument: str | None = None) -> concurrent.futures.Future[bool]:
-        """Send a listed command; the Future says whether the server took it (False: it stayed silent)."""
-        return self._fire(self._session.run_command, command, argument)
-
-    def answer_popup(self, popup_id: int, button: int) -> concurrent.futures.Future[None]:
-        return self._fire(self._session.answer_popup, popup_id, button, kind=Kind.SERVER)
-
-    # -- server strings and the camera head (no drive lease: neither moves the robot) -----------
-    def watch_strings(self, on: bool) -> concurrent.futures.Future[None]:
-        """Ask for ``getStrings`` while the details table is open (``on``), not otherwise."""
-        return self._fire(lambda: self._session.strings.watch(on))
-
-    def watch_ptz(self, on: bool) -> concurrent.futures.Future[None]:
-        """Poll the camera head's position while the camera page is shown (``on``)."""
-        return self._fire(lambda: self._session.ptz.watch(on))
-
-    def ptz_rel(self, pan: float, tilt: float, zoom: float | None = None) -> concurrent.futures.Future[None]:
-        return self._fire(lambda: self._session.ptz.move_rel(pan, tilt, zoom), kind=Kind.CAMERA)
-
-    def ptz_abs(self, pan: float, tilt: float, zoom: float | None = None) -> concurrent.futures.Future[None]:
-        return self._fire(lambda: self._session.ptz.move_abs(pan, tilt, zoom), kind=Kind.CAMERA)
-
-    # -- the server's configuration (client.config_feed) -----------------------------------------
-    def fetch_config(self) -> concurrent.futures.Future[Any]:
-        """A :class:`~rtmu.client.config_feed.ServerConfig` (NotSupported where none is offered)."""
-        return self.submit(self._session.fetch_config)
-
-    def set_config(self, changes: dict[str, dict[str, str]]) -> concurrent.futures.Future[Any]:
-        """``setConfig``; the Future's :class:`SetConfigReply` says whether the server took it."""
-        return self.submit(self._session.set_config, changes)
-
     def _config_updated(self) -> None:
         """Network loop: tell the UI once per burst (a flood of broadcasts is one post, not thousands)."""
         if self.on_config_updated is None or self._config_post_pending.is_set():
@@ -457,34 +406,6 @@ class ClientRunner:
                 fn()
 
         self.post(deliver)
-
-    # -- the server's drawings -----------------------------------------------------------------
-    def set_drawing_shown(self, name: str, shown: bool) -> concurrent.futures.Future[None]:
-        """Show or hide one drawing: a hidden one is no longer asked for (``rtmu.client.drawings_feed``)."""
-        return self._fire(self._session.drawings.set_shown, name, shown)
-
-    def set_drawing_choices(self, choices: dict[str, bool]) -> concurrent.futures.Future[None]:
-        """The operator's remembered choices for the server being connected to."""
-        return self._fire(self._session.drawings.set_choices, dict(choices))
-
-    # -- navigation: the server drives; a refusal comes back as a Kind.NAVIGATION notice -------
-    def goto_goal(self, name: str) -> concurrent.futures.Future[None]:
-        return self._fire(self._session.goto_goal, name, kind=Kind.NAVIGATION)
-
-    def goto_pose(self, x: float, y: float, th: float | None = None) -> concurrent.futures.Future[None]:
-        return self._fire(self._session.goto_pose, x, y, th, kind=Kind.NAVIGATION)
-
-    def home(self) -> concurrent.futures.Future[None]:
-        return self._fire(self._session.home, kind=Kind.NAVIGATION)
-
-    def dock(self) -> concurrent.futures.Future[None]:
-        return self._fire(self._session.dock, kind=Kind.NAVIGATION)
-
-    def tour_goals(self) -> concurrent.futures.Future[None]:
-        return self._fire(self._session.tour_goals, kind=Kind.NAVIGATION)
-
-    def localize(self, x: float, y: float, th: float) -> concurrent.futures.Future[None]:
-        return self._fire(self._session.localize, x, y, th, kind=Kind.NAVIGATION)
 
     def run_blocking(
         self, fn: Callable[[], T], done: Callable[[T | None], None], *, timeout: float = 30.0
@@ -518,18 +439,6 @@ class ClientRunner:
         future.add_done_callback(lambda f: timer.cancel())
         return future
 
-    def subscribe(self, name: str, interval_ms: int, handler: Callable[[Packet], None]) -> None:
-        """An extra subscription (restored after reconnects); ``handler(packet)`` runs on the UI thread.
-
-        It is posted there (like every model update) so that no handler, however slow, can
-        hold up the network loop that sends the drive commands and the stops.
-        """
-
-        def deliver(packet: Packet) -> None:
-            self.post(lambda: handler(packet))
-
-        self._fire(self._session.subscribe, name, interval_ms, deliver)
-
     def sync(self, timeout: float = 2.0) -> None:
         """Wait until the network side has handled everything submitted so far and run one heart step."""
         self.call(self._session.step, timeout=timeout)
@@ -562,4 +471,4 @@ class ClientRunner:
         session = self.session
         if session is None or session.client is None:
             return None
-        return session.health.status_age(self.clock())
+        return session.drive.health.status_age(self.clock())

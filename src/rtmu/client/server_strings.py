@@ -10,13 +10,14 @@ table costs the robot nothing). Everything is bounded before it reaches the mode
 from __future__ import annotations
 
 import contextlib
-from collections.abc import Callable, Coroutine
-from typing import Any
+from typing import Any, ClassVar
 
 from ..protocol.errors import ProtocolError
 from ..protocol.payloads.strings import Strings, StringsInfo
+from ..values.intents import Intent, WatchStrings
 from .connection import AriaClient, Packet
 from .errors import ClientError
+from .feed import Feed, FeedContext
 
 INTERVAL_MS = 1000
 MAX_ITEMS = 200
@@ -24,10 +25,6 @@ MAX_ITEMS = 200
 MAX_TEXT = 120
 """Characters kept of a label or value (ARIA's own are under 40)."""
 _WIFI_WORDS = ("wireless", "wifi", "wi-fi", "wlan")
-
-Update = Callable[..., None]
-Decode = Callable[[str, bytes], Any]
-Spawn = Callable[[Coroutine[Any, Any, None], str], None]
 
 
 def clip(text: str) -> str:
@@ -63,14 +60,13 @@ def _int_or_none(text: str) -> int | None:
         return None
 
 
-class StringsFeed:
-    """Holds the ``getStrings`` subscription while someone reads it; ``update(**changes)`` feeds the robot."""
+class StringsFeed(Feed):
+    """Holds the ``getStrings`` subscription while someone reads it; the values feed the robot."""
 
-    def __init__(self, update: Update, decode: Decode, spawn: Spawn, reply_timeout: float) -> None:
-        self._update = update
-        self._decode = decode
-        self._spawn = spawn
-        self._timeout = reply_timeout
+    handles: ClassVar[tuple[type[Intent], ...]] = (WatchStrings,)
+
+    def __init__(self, ctx: FeedContext) -> None:
+        super().__init__(ctx)
         self._client: AriaClient | None = None
         self._info: StringsInfo | None = None
         self._labels: tuple[str, ...] = ()
@@ -80,16 +76,19 @@ class StringsFeed:
         self._held = False
         self._refetching = False
         self.watching = False
-        """The details table is open (set from the UI through the runner)."""
-        self.interval_ms = INTERVAL_MS
+        """The details table is open (an operator's :class:`WatchStrings`)."""
+        self.interval_ms = ctx.config.wifi_interval_ms
 
     @property
     def _wifi(self) -> bool:
         return bool(self._roles)
 
-    async def connected(self, client: AriaClient) -> None:
-        """Read the labels once after login, then subscribe if anyone reads the values."""
+    def connected(self, client: AriaClient) -> None:
         self._client, self._info, self._held, self._labels, self._roles = client, None, False, (), ()
+        self.ctx.spawn(self._start(client), "strings")
+
+    async def _start(self, client: AriaClient) -> None:
+        """Read the labels once after login, then subscribe if anyone reads the values."""
         if client.supports("getStringsInfo") and client.supports("getStrings"):
             await self._fetch_info(client)
         self._sync()
@@ -97,19 +96,23 @@ class StringsFeed:
     def disconnected(self) -> None:
         self._client, self._info, self._held = None, None, False
         if self.watching:
-            self._update(server_strings=(), server_strings_more=0)
+            self.ctx.robot_update(server_strings=(), server_strings_more=0)
+
+    def handle(self, intent: Intent) -> None:
+        assert isinstance(intent, WatchStrings)
+        self.watch(intent.on)
 
     def watch(self, on: bool) -> None:
         """The details table opened (True) or closed (False): ask for the values only while open."""
         self.watching = on
         self._sync()
         if not on:
-            self._update(server_strings=(), server_strings_more=0)
+            self.ctx.robot_update(server_strings=(), server_strings_more=0)
 
     async def _fetch_info(self, client: AriaClient) -> None:
         with contextlib.suppress(ClientError, ProtocolError):
-            reply = await client.request_once("getStringsInfo", timeout=self._timeout)
-            info = self._decode("getStringsInfo", reply.payload)
+            reply = await client.request_once("getStringsInfo", timeout=self.ctx.config.reply_timeout)
+            info = self.ctx.decode("getStringsInfo", reply.payload)
             if isinstance(info, StringsInfo) and client is self._client:
                 self._set_info(info)
 
@@ -151,7 +154,7 @@ class StringsFeed:
             return
         if total != len(info.items) and not self._refetching and self._client is not None:
             self._refetching = True  # an item was added since we read the labels: read them again
-            self._spawn(self._refetch(self._client), "strings-info")
+            self.ctx.spawn(self._refetch(self._client), "strings-info")
         changes: dict[str, Any] = {}
         for i, role in self._roles:
             if i < len(values):
@@ -163,7 +166,7 @@ class StringsFeed:
             )
             changes["server_strings_more"] = max(0, min(total, len(info.items)) - shown)
         if changes:
-            self._update(**changes)
+            self.ctx.robot_update(**changes)
 
     async def _refetch(self, client: AriaClient) -> None:
         try:

@@ -1,42 +1,36 @@
-"""A session's subscriptions as data: which data, how often, who handles it, and when it applies.
+"""A feed's subscriptions as data: which data, how often, who handles it, and when it applies.
 
-The session declares a tuple of :class:`Subscription` records instead of a
-chain of ``if client.supports(...)`` calls, so the set can be read, tested and
-replaced (a replay, a tool that wants less) without touching the session. A
-record may also say *when* it is wanted (``only_while``): the data is then asked
-for only while that holds, not for the whole connection.
+Each feed declares :class:`Subscription` records instead of a chain of ``if client.supports(...)``
+calls, so the set can be read and tested without a server. A record may also say *when* it is
+wanted (``only_while``): the data is then asked for only while that holds, not for the whole
+connection. Two feeds may want the same data (``goalsUpdated``): the session then asks once, at the
+shorter period, and hands each packet to both (:func:`merged`).
 """
 
 from __future__ import annotations
 
 from collections.abc import Callable, Iterable
 from dataclasses import dataclass
-from typing import Generic, TypeVar
 
 from .connection import Packet
 
-S = TypeVar("S")
-"""The session type the handlers belong to."""
-C = TypeVar("C")
-"""The config type the intervals are read from."""
+Handler = Callable[[Packet], None]
 
 
 @dataclass(frozen=True, slots=True)
-class Subscription(Generic[S, C]):
+class Subscription:
     """Subscribe to ``name`` every ``interval_ms`` (−1: broadcasts only) while the server offers it."""
 
     name: str
-    interval_ms: int | Callable[[C], int]
-    """A period in ms, or how to read it from the session's config."""
-    handler: Callable[[S, Packet], None]
-    """Called as ``handler(session, packet)`` (an unbound method of the session)."""
+    interval_ms: int
+    handler: Handler
     needs: str | None = None
     """Only when the server offers this data too (``updateStrings`` goes with ``updateNumbers``)."""
     unless: str | None = None
     """Not when the server offers this data (the old ``update`` gives way to ``updateNumbers``)."""
-    only_while: Callable[[S], bool] | None = None
-    """Held only while this holds for the session (``getPath`` while navigating): the session asks
-    again whenever the answer may have changed, and ends the subscription when it turns false."""
+    only_while: Callable[[], bool] | None = None
+    """Held only while this holds (``getPath`` while navigating): the session asks again whenever the
+    answer may have changed, and ends the subscription when it turns false."""
 
     def applies(self, offered: Callable[[str], bool]) -> bool:
         if not offered(self.name):
@@ -45,12 +39,51 @@ class Subscription(Generic[S, C]):
             return False
         return self.unless is None or not offered(self.unless)
 
-    def interval(self, config: C) -> int:
-        return self.interval_ms if isinstance(self.interval_ms, int) else self.interval_ms(config)
 
-
-def applicable(
-    subs: Iterable[Subscription[S, C]], offered: Callable[[str], bool]
-) -> list[Subscription[S, C]]:
+def applicable(subs: Iterable[Subscription], offered: Callable[[str], bool]) -> list[Subscription]:
     """The subscriptions to make on a server that offers what ``offered(name)`` says, in order."""
     return [sub for sub in subs if sub.applies(offered)]
+
+
+def merged(subs: Iterable[Subscription]) -> list[Subscription]:
+    """One record per data name, in first-seen order: the shortest period, every handler called.
+
+    Broadcasts (−1) give way to any period; ``only_while`` conditions combine with "or", and a record
+    without one makes the merged record unconditional."""
+    by_name: dict[str, list[Subscription]] = {}
+    for sub in subs:
+        by_name.setdefault(sub.name, []).append(sub)
+    out = []
+    for name, group in by_name.items():
+        if len(group) == 1:
+            out.append(group[0])
+            continue
+        periods = [s.interval_ms for s in group if s.interval_ms >= 0]
+        handlers = tuple(s.handler for s in group)
+        conditions = [s.only_while for s in group]
+        when: Callable[[], bool] | None = None
+        if all(c is not None for c in conditions):
+            when = _any_of(tuple(c for c in conditions if c is not None))
+        out.append(
+            Subscription(
+                name,
+                min(periods) if periods else -1,
+                _all_of(handlers),
+                needs=group[0].needs,
+                unless=group[0].unless,
+                only_while=when,
+            )
+        )
+    return out
+
+
+def _any_of(conditions: tuple[Callable[[], bool], ...]) -> Callable[[], bool]:
+    return lambda: any(c() for c in conditions)
+
+
+def _all_of(handlers: tuple[Handler, ...]) -> Handler:
+    def each(packet: Packet) -> None:
+        for handler in handlers:
+            handler(packet)
+
+    return each

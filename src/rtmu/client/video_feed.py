@@ -26,14 +26,13 @@ from dataclasses import dataclass, field
 
 from ..protocol.errors import ProtocolError
 from ..protocol.payloads.camera import VideoFrame
-from ..state import VideoStatus
+from ..values.intents import picture_source
+from ..values.state import VideoStatus
 from .connection import AriaClient
 from .errors import ClientError, ClientTimeout, NotSupported, ServerClosed
+from .jpeg_bounds import MAX_SIDE, STAMP_PREFIX, fill_problem, read_header
 
-STAMP_PREFIX = b"RTMU-T="
-"""JPEG comment (COM segment) text the simulator writes: render time in wall-clock nanoseconds."""
-MAX_SIDE = 8192
-"""Largest width or height accepted from a server; no robot camera comes near it."""
+__all__ = ["MAX_SIDE", "STAMP_PREFIX", "BadFrame", "VideoFeed", "check_frame", "frame_stamp", "parse_frame"]
 MAX_FPS = 30.0
 MIN_FPS = 0.5
 DEFAULT_FPS = 15.0
@@ -47,8 +46,6 @@ CONSUMER_WAIT_S = 1.0
 """Longest the loop waits for the consumer to show a frame before asking for the next anyway."""
 STATS_WINDOW_S = 2.0
 MAX_AGES = 1000
-MAX_SCAN_SEGMENTS = 64
-"""Markers walked before the picture data when looking for the stamp and frame size."""
 
 
 class BadFrame(ValueError):
@@ -57,36 +54,7 @@ class BadFrame(ValueError):
 
 def frame_stamp(jpeg: bytes) -> int | None:
     """The render time (wall-clock ns) in the frame's ``RTMU-T=`` comment, or None when it has none."""
-    return _scan(jpeg)[0]
-
-
-def _scan(jpeg: bytes) -> tuple[int | None, tuple[int, int] | None]:
-    """Walk the JPEG's header segments (bounded): its stamp and the size its frame header declares."""
-    stamp: int | None = None
-    size: tuple[int, int] | None = None
-    i = 2
-    for _ in range(MAX_SCAN_SEGMENTS):
-        if i + 4 > len(jpeg) or jpeg[i] != 0xFF:
-            break
-        marker = jpeg[i + 1]
-        if marker == 0xFF:  # fill byte
-            i += 1
-            continue
-        if marker in (0xD8, 0x01) or 0xD0 <= marker <= 0xD7:
-            i += 2
-            continue
-        length = int.from_bytes(jpeg[i + 2 : i + 4], "big")
-        body = jpeg[i + 4 : i + 2 + length]
-        if marker == 0xFE and body.startswith(STAMP_PREFIX):
-            digits = body[len(STAMP_PREFIX) :].split(b"\x00", 1)[0].strip()
-            if digits.isdigit() and len(digits) <= 20:
-                stamp = int(digits)
-        elif marker in (0xC0, 0xC1, 0xC2, 0xC3) and len(body) >= 5:
-            size = (int.from_bytes(body[3:5], "big"), int.from_bytes(body[1:3], "big"))
-        if marker == 0xDA:  # start of scan: the header is over
-            break
-        i += 2 + length
-    return stamp, size
+    return read_header(jpeg).stamp
 
 
 def check_frame(jpeg: bytes, width: int, height: int) -> tuple[int | None, tuple[int, int]]:
@@ -100,15 +68,14 @@ def check_frame(jpeg: bytes, width: int, height: int) -> tuple[int | None, tuple
         raise BadFrame(f"the {len(jpeg)} bytes received are not a JPEG picture")
     if not jpeg.endswith(b"\xff\xd9"):
         raise BadFrame(f"the picture is cut short ({len(jpeg)} bytes, no end marker)")
-    stamp, size = _scan(jpeg)
-    if size is None:
-        raise BadFrame("the picture has no frame header")
-    w, h = size
-    if not (0 < w <= MAX_SIDE and 0 < h <= MAX_SIDE):
-        raise BadFrame(f"the picture declares {w}x{h} pixels, outside 1…{MAX_SIDE}")
-    if (width, height) != (0, 0) and (w, h) != (width, height):
-        raise BadFrame(f"the server says {width}x{height} but the picture is {w}x{h}")
-    return stamp, size
+    header = read_header(jpeg)
+    size = header.size
+    if size is not None and min(size) > 0 and max(size) <= MAX_SIDE and (width, height) not in ((0, 0), size):
+        raise BadFrame(f"the server says {width}x{height} but the picture is {size[0]}x{size[1]}")
+    problem = fill_problem(jpeg, header)  # its data can fill what it declares (jpeg_bounds)
+    if problem is not None or size is None:
+        raise BadFrame(problem or "the picture has no frame header")
+    return header.stamp, size
 
 
 def parse_frame(payload: bytes) -> tuple[VideoFrame, int | None]:
@@ -243,12 +210,10 @@ def video_source(client: AriaClient, camera: str | None = None) -> str:
         if not client.supports(name):
             raise NotSupported(name, f"this server has no camera named {camera!r} ({name})")
         return name
-    pictures = sorted(e.name for e in client.datalist if e.name.startswith("getPicture"))
-    if pictures:
-        return pictures[0]
-    if client.supports("sendVideo"):
-        return "sendVideo"
-    raise NotSupported("getPicture", "this server offers no camera pictures (getPicture… or sendVideo)")
+    source = picture_source(e.name for e in client.datalist)
+    if source is None:
+        raise NotSupported("getPicture", "this server offers no camera pictures (getPicture… or sendVideo)")
+    return source
 
 
 FrameSink = Callable[[LiveFrame], None]

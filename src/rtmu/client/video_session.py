@@ -1,45 +1,47 @@
-"""Live video for the operator session: the :class:`~.video_feed.VideoFeed` loop, kept across reconnects.
+"""The session's camera: single pictures, and live video kept across reconnects.
 
-It hangs off :class:`~.session.Session` like ``nav_session`` does: the session
-tells it when a connection opens and ends, and it publishes every new frame as
-the model's ``camera`` part (a :class:`~rtmu.state.CameraImage` carrying its
-render stamp and the live figures), so the window's existing JPEG thread decodes
-it into textures. What the operator asked (live or not, paused, rate, quality)
-outlives the connection: after a reconnect the video resumes by itself.
+Every new picture — one asked for (:class:`RequestPicture`) or one of the live loop's frames
+(:class:`~.video_feed.VideoFeed`) — is published as the model's ``camera`` part (a
+:class:`~rtmu.values.state.CameraImage` carrying its render stamp and, for live frames, the loop's
+frame number and figures), so the window's JPEG thread decodes it into textures. What the operator
+asked (live or not, paused, rate, quality) outlives the connection: after a reconnect the video
+resumes by itself.
 """
 
 from __future__ import annotations
 
-import time
-from collections.abc import Callable, Coroutine
-from typing import Any
+from typing import ClassVar
 
-from ..state import CameraChanged, CameraImage, StateChange
+from ..protocol.payloads import Side, payload_type_for
+from ..values.intents import Intent, PauseVideo, RequestPicture, StartVideo, StopVideo, VideoShown
+from ..values.state import CameraChanged, CameraImage
 from .connection import AriaClient
-from .errors import ServerClosed
-from .video_feed import DEFAULT_FPS, LiveFrame, VideoFeed, clamp_fps, video_source
+from .errors import MalformedReply, NotSupported, ServerClosed
+from .feed import Feed, FeedContext
+from .video_feed import DEFAULT_FPS, LiveFrame, VideoFeed, clamp_fps, frame_stamp, video_source
 
 
-class LiveVideo:
-    """Starts, pauses and stops the request loop on the network thread; publishes frames."""
+class CameraFeed(Feed):
+    """Starts, pauses and stops the request loop on the network thread; publishes every picture."""
 
-    def __init__(
-        self,
-        publish: Callable[[StateChange], None],
-        spawn: Callable[[Coroutine[Any, Any, Any], str], None],
-        clock: Callable[[], float] = time.monotonic,
-    ) -> None:
-        self._publish = publish
-        self._spawn = spawn
-        self._clock = clock
+    handles: ClassVar[tuple[type[Intent], ...]] = (
+        RequestPicture,
+        StartVideo,
+        StopVideo,
+        PauseVideo,
+        VideoShown,
+    )
+
+    def __init__(self, ctx: FeedContext) -> None:
+        super().__init__(ctx)
         self.client: AriaClient | None = None
         self.feed: VideoFeed | None = None
         self.wanted = False
         self.paused = False
         self.fps = DEFAULT_FPS
         self.quality: int | None = None
-        self.sequence_base = 1_000_000_000
-        """Live frames number from here, so they never equal a single picture's sequence."""
+        self._sequence = 0
+        """One count for pictures and live frames alike: every new picture is a new value."""
 
     # -- the session's hooks ---------------------------------------------------------------------
     def connected(self, client: AriaClient) -> None:
@@ -48,13 +50,34 @@ class LiveVideo:
         if self.wanted:
             self._start()
 
-    def disconnected(self) -> None:
+    def lost(self) -> None:
         """The session cancels its tasks (the loop among them); forget the feed, keep the wish."""
         self.client = None
         self.feed = None
 
-    # -- the operator's controls (network loop) -------------------------------------------------
-    def start(self, fps: float | None = None, quality: int | None = None) -> None:
+    def disconnected(self) -> None:
+        """A new connection (or none) starts without video: the operator asks again."""
+        self.lost()
+        self._stop()
+        self.ctx.publish(CameraChanged(None))
+
+    # -- the operator's intents (network loop) -----------------------------------------------------
+    def handle(self, intent: Intent) -> object:
+        if isinstance(intent, RequestPicture):
+            return self._picture()
+        if isinstance(intent, StartVideo):
+            self._play(intent.fps, intent.quality)
+        elif isinstance(intent, StopVideo):
+            self._stop()
+        elif isinstance(intent, PauseVideo):
+            self.paused = intent.paused
+            if self.feed is not None:
+                self.feed.pause(intent.paused)
+        elif isinstance(intent, VideoShown) and self.feed is not None:
+            self.feed.shown(intent.sequence)
+        return None
+
+    def _play(self, fps: float | None, quality: int | None) -> None:
         """Play (NotSupported when the server has no camera); a second call only changes the settings."""
         if fps is not None:
             self.fps = clamp_fps(fps)
@@ -69,22 +92,36 @@ class LiveVideo:
             raise ServerClosed("not connected")
         self._start()
 
-    def stop(self) -> None:
+    def _stop(self) -> None:
         self.wanted = False
         self.paused = False
         feed, self.feed = self.feed, None
         if feed is not None:
             feed.stop()
 
-    def shown(self, sequence: int) -> None:
-        """The window has drawn (or dropped) live frame ``sequence``: the loop may ask for the next."""
-        if self.feed is not None:
-            self.feed.shown(sequence - self.sequence_base)
-
-    def pause(self, paused: bool) -> None:
-        self.paused = paused
-        if self.feed is not None:
-            self.feed.pause(paused)
+    async def _picture(self) -> CameraImage:
+        """One camera picture; also published as the model's ``camera`` part."""
+        client = self.require()
+        source = video_source(client)
+        reply = await client.request_once(source, timeout=self.ctx.config.reply_timeout)
+        if payload_type_for(source, Side.REPLY) is None:
+            raise NotSupported(source, f"RTMU cannot decode {source!r} pictures")
+        picture = self.ctx.decode(source, reply.payload)
+        if picture is None:
+            raise MalformedReply(f"the {source} picture is malformed")
+        self._sequence += 1
+        jpeg = bytes(picture.jpeg)
+        image = CameraImage(
+            jpeg=jpeg,
+            width=int(picture.width),
+            height=int(picture.height),
+            source=source,
+            received_at=reply.received_at,
+            sequence=self._sequence,
+            stamp_ns=frame_stamp(jpeg),
+        )
+        self.ctx.publish(CameraChanged(image))
+        return image
 
     # -- inside ---------------------------------------------------------------------------------
     def _start(self) -> None:
@@ -94,7 +131,7 @@ class LiveVideo:
         feed = VideoFeed(client, source, self._frame, fps=self.fps, quality=self.quality, max_pending=1)
         feed.pause(self.paused)
         self.feed = feed
-        self._spawn(self._run(feed), "video")
+        self.ctx.spawn(self._run(feed), "video")
 
     async def _run(self, feed: VideoFeed) -> None:
         try:
@@ -105,17 +142,19 @@ class LiveVideo:
 
     def _frame(self, frame: LiveFrame) -> None:
         feed = self.feed
-        self._publish(
+        self._sequence += 1
+        self.ctx.publish(
             CameraChanged(
                 CameraImage(
                     jpeg=frame.jpeg,
                     width=frame.width,
                     height=frame.height,
                     source=frame.source,
-                    received_at=self._clock(),
-                    sequence=self.sequence_base + frame.sequence,
+                    received_at=self.ctx.clock(),
+                    sequence=self._sequence,
                     stamp_ns=frame.stamp_ns,
                     video=None if feed is None else feed.status(),
+                    frame=frame.sequence,
                 )
             )
         )

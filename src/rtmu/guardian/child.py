@@ -37,6 +37,7 @@ from pathlib import Path
 from ..client.connection import AriaClient
 from ..client.errors import ClientError
 from ..client.link_timing import Deadline
+from ..client.roles import Role
 from . import messages as m
 from .halt import Halter
 from .handle import BEAT_PERIOD
@@ -134,16 +135,16 @@ class Watch:
         if not self.armed:
             return None
         if self.eof:
-            return "the window's process ended without saying goodbye"
+            return "the process driving the robot ended without saying goodbye"
         late = now - min(self.last.values()) if self.last else 0.0
         if late > QUICK_LATE and parent_frozen(self.parent):
-            return f"the window's process is stopped or gone (no heartbeat for {late * 1000:.0f} ms)"
+            return f"the process driving the robot is stopped or gone (no heartbeat for {late * 1000:.0f} ms)"
         for kind, at in self.last.items():
             limit = self.limit(kind, now)
             if now - at > limit:
                 thread = "UI" if kind == m.BEAT_UI else "network"
                 return (
-                    f"no heartbeat from the window's {thread} thread for {(now - at) * 1000:.0f} ms "
+                    f"no heartbeat from the driving process's {thread} thread for {(now - at) * 1000:.0f} ms "
                     f"(its beats normally come within {limit * 1000:.0f} ms)"
                 )
         return None
@@ -158,7 +159,9 @@ async def run(fd: int = 0) -> int:
         return 2
     client = AriaClient()
     try:
-        await client.connect(hello.host, hello.port, hello.user, hello.password, timeout=hello.timeout)
+        await client.connect(
+            hello.host, hello.port, hello.user, hello.password, timeout=hello.timeout, role=Role.OPERATOR
+        )
     except ClientError as exc:
         say(m.UNAVAILABLE, str(exc))
         return 3

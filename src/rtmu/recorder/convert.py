@@ -1,8 +1,11 @@
 """Typed session values → Foxglove messages and JSON records, for the writer thread.
 
-Pure apart from remembering what it last wrote: the robot's pose is written when it
-moves, the status when one of its fields changes, the map once per loaded map. Runs
-on the writer thread only (a big map's lines take a while to build).
+Pure apart from remembering what it last wrote: the robot's pose and status are written when
+they change and, for a recording, again while they do not (:meth:`Converter.repeat`: a parked
+robot is in every second of the file, so any window of it shows the robot), the map once per
+loaded map. Nothing is written
+of the robot before the server first described it (no placeholder pose at 0, 0; no empty status).
+Runs on the writer thread only (a big map's lines take a while to build).
 """
 
 from __future__ import annotations
@@ -33,8 +36,8 @@ from foxglove.messages import (
     Vector3,
 )
 
-from ..notices import Notice
-from ..state import (
+from ..base.notices import Notice
+from ..values.state import (
     CameraChanged,
     ConnectionChanged,
     DrawingsChanged,
@@ -51,6 +54,10 @@ from . import topics
 MAP_FRAME = "map"
 ROBOT_FRAME = "base_link"
 CAMERA_FRAME = "camera"
+REPEAT_NS = 500_000_000
+"""The pose (with its transform) and the status are written again after this long unchanged
+(:meth:`Converter.repeat`, called every :data:`REPEAT_EVERY` s): never a second of the file without them."""
+REPEAT_EVERY = 0.25
 MAX_SCENE_LINES = 200_000
 """Map lines beyond this are left out of the SceneUpdate (the raw channel still has them all)."""
 _XYZ = [
@@ -118,10 +125,8 @@ def notice_record(notice: Notice) -> dict[str, Any]:
 def status_record(r: RobotState) -> dict[str, Any]:
     """What "why did the robot stop" needs besides the stops: modes, status words, battery, motion."""
     battery: dict[str, Any] = {"state": r.battery_state, "low": r.battery_low, "shutdown": r.battery_shutdown}
-    if r.battery_is_soc:
-        battery["state_of_charge_pct"] = r.battery_v
-    else:
-        battery["volts"] = r.battery_v
+    if r.battery_v is not None:  # None until the robot said which it is (the session holds it back)
+        battery["state_of_charge_pct" if r.battery_is_soc else "volts"] = r.battery_v
     return {
         "mode": r.mode,
         "mode_name": r.mode_name,
@@ -148,7 +153,12 @@ class Converter:
 
     def __init__(self) -> None:
         self._pose: tuple[float, float, float] | None = None
+        self._pose_ns = 0
         self._status: dict[str, Any] | None = None
+        self._status_ns = 0
+        self._robot: RobotState | None = None
+        self._described_ns: int | None = None
+        """When the server first described the robot."""
         self._sonar: object = ()
         self._laser: object = ()
         self._map_state: tuple[Any, ...] | None = None
@@ -190,10 +200,32 @@ class Converter:
         return [(other_topic(change), jsonable(getattr(change, "value", change)))]
 
     def robot(self, r: RobotState, at_ns: int) -> Out:
+        if r.numbers_at is None and r.strings_at is None:
+            return []  # the session's starting value: the server has said nothing of the robot yet
+        self._robot = r
+        out = self._pose_and_status(r, at_ns, again=False)
+        if r.sonar != self._sonar:
+            self._sonar = r.sonar
+            out.append((topics.SONAR, cloud(r.sonar, at_ns)))
+        if r.laser != self._laser:
+            self._laser = r.laser
+            out.append((topics.LASER, cloud(r.laser, at_ns)))
+        return out
+
+    def repeat(self, at_ns: int) -> Out:
+        """The pose (with its TF) and the status again where they went unwritten for :data:`REPEAT_NS`.
+
+        The session publishes a robot only when it changes, so a parked robot's pose would be written
+        once; a recording calls this a few times a second so every second of the file holds it.
+        """
+        return [] if self._robot is None else self._pose_and_status(self._robot, at_ns, again=True)
+
+    def _pose_and_status(self, r: RobotState, at_ns: int, *, again: bool) -> Out:
         out: Out = []
         pose = (r.x, r.y, r.th)
-        if pose != self._pose:
-            self._pose = pose
+        stale = at_ns - self._pose_ns >= REPEAT_NS
+        if r.numbers_at is not None and (stale if again else pose != self._pose):
+            self._pose, self._pose_ns = pose, at_ns
             when = stamp(at_ns)
             position = Vector3(x=r.x / 1000.0, y=r.y / 1000.0, z=0.0)
             pose_msg = Pose(position=position, orientation=yaw(r.th))
@@ -206,16 +238,16 @@ class Converter:
                 rotation=yaw(r.th),
             )
             out.append((topics.TF, tf))
-        status = status_record(r)
-        if status != self._status:
-            self._status = status
+        if self._described_ns is None:
+            self._described_ns = at_ns
+        if r.strings_at is None and at_ns - self._described_ns < REPEAT_NS:
+            return (
+                out  # its status words come with the next packet: no status without them (unless none come)
+            )
+        status = status_record(r) if not again or self._status is None else self._status
+        if status != self._status or (again and at_ns - self._status_ns >= REPEAT_NS):
+            self._status, self._status_ns = status, at_ns
             out.append((topics.STATUS, status))
-        if r.sonar != self._sonar:
-            self._sonar = r.sonar
-            out.append((topics.SONAR, cloud(r.sonar, at_ns)))
-        if r.laser != self._laser:
-            self._laser = r.laser
-            out.append((topics.LASER, cloud(r.laser, at_ns)))
         return out
 
     def map(self, m: MapModel, at_ns: int) -> Out:

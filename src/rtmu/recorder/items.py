@@ -9,7 +9,7 @@ from __future__ import annotations
 from dataclasses import dataclass
 from typing import Any
 
-from ..state import StateChange
+from ..values.state import StateChange
 
 
 @dataclass(frozen=True, slots=True)

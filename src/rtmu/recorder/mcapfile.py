@@ -23,7 +23,7 @@ from foxglove.channels import (
 from foxglove.mcap import MCAPCompression, MCAPWriteOptions
 
 from ..capture.recorded import RAW_ENCODING, RAW_SCHEMA, RAW_TOPICS
-from . import topics
+from . import schemas, topics
 from .sink import CountingFile
 
 CHUNK_SIZE = 512 * 1024
@@ -39,6 +39,13 @@ TYPED: dict[str, Any] = {
     topics.MAP_POINTS: PointCloudChannel,
 }
 """Topic → the Foxglove channel class of its schema; every other decoded topic is JSON."""
+
+
+def json_channel(topic: str, context: Context) -> Channel:
+    """A JSON channel with its named schema (:mod:`.schemas`: ``rtmu.Status`` …)."""
+    name, data = schemas.schema_name(topic), schemas.schema_data(topic)
+    schema = Schema(name=name, encoding=schemas.ENCODING, data=data)
+    return Channel(topic, schema=schema, message_encoding="json", context=context)
 
 
 class McapFile:
@@ -72,7 +79,7 @@ class McapFile:
         channel = self._channels.get(topic)
         if channel is None:
             kind = TYPED.get(topic)
-            channel = kind(topic, context=self.context) if kind else Channel(topic, context=self.context)
+            channel = kind(topic, context=self.context) if kind else json_channel(topic, self.context)
             self._channels[topic] = channel
         channel.log(message, log_time=at_ns)
 

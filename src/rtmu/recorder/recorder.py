@@ -1,6 +1,6 @@
 """The flight recorder of one robot session: a new file per connection target, fed from every side.
 
-A :class:`Recorder` belongs to one :class:`rtmu.fleet.RobotSession`. Its opener tees
+A :class:`Recorder` belongs to one :class:`rtmu.fleet.sessions.RobotSession`. Its opener tees
 every link the session's client opens; the first link to a robot starts a
 :class:`~rtmu.recorder.recording.Recording` (reconnects to the same robot keep
 writing the same file, as new connections in it) and a disconnect or a final
@@ -21,15 +21,16 @@ from functools import partial
 from pathlib import Path
 from typing import Any
 
+from ..base.notices import Kind, Level, Notice
 from ..client.lease import LeaseEvent
 from ..client.link import Opener, open_tcp
 from ..client.runner import ClientRunner
-from ..notices import Kind, Level, Notice
-from ..state import ConnectionChanged, Phase, StateChange
-from . import files, topics
+from ..values.state import ConnectionChanged, Phase, StateChange
+from . import files, scrub, topics
 from .convert import jsonable, notice_record
 from .items import Event, Item, LinkOpened, Published, RawChunk
 from .recording import Limits, Recording
+from .scrub import LoginScrubber
 from .tee import RawSink, tee_opener
 
 ENDS_A_RECORDING = (Phase.DISCONNECTED, Phase.FAILED)
@@ -38,7 +39,7 @@ WAITING_EVENTS = 64
 
 @dataclass(frozen=True, slots=True)
 class RecorderConfig:
-    """Where and how much; :mod:`rtmu.settings` ``RecordingSettings`` fills it."""
+    """Where and how much; :mod:`rtmu.settings.store` ``RecordingSettings`` fills it."""
 
     directory: Path
     path: Path | None = None
@@ -95,7 +96,7 @@ class Recorder:
             conn = self._conn
         now = time.time_ns()
         recording.submit(LinkOpened(conn, host, port, now))
-        return conn, partial(_raw_to, recording)
+        return conn, partial(_raw_to, recording, LoginScrubber())
 
     def _start(self, host: str, port: int) -> Recording | None:
         old = self.recording
@@ -106,6 +107,7 @@ class Recorder:
         metadata = {
             "robot": f"{host}:{port}",
             "started_utc": time.strftime("%Y-%m-%dT%H:%M:%SZ", time.gmtime()),
+            **scrub.METADATA,
         }
         recording = Recording(path, metadata=metadata, limits=limits, on_problem=self.notify)
         recording.prune = partial(files.prune, self.config.directory, self.config.keep_days)
@@ -173,5 +175,11 @@ class Recorder:
             recording.close(max(0.0, deadline - time.monotonic()))
 
 
-def _raw_to(recording: Recording, chunk: RawChunk) -> None:
+def _raw_to(recording: Recording, scrubber: LoginScrubber, chunk: RawChunk) -> None:
+    if chunk.direction == "c2s":
+        data = scrubber(chunk.data)  # the login's password digest is never recorded (recorder.scrub)
+        if not data:
+            return
+        if data is not chunk.data:
+            chunk = RawChunk(chunk.conn, chunk.direction, data, chunk.at_ns)
     recording.submit(chunk)

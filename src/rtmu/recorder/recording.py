@@ -19,10 +19,10 @@ from dataclasses import dataclass
 from functools import partial
 from pathlib import Path
 
+from ..base.notices import Kind, Notice
 from ..capture.recorded import CONNECTION_TOPIC, RAW_TOPICS, connection_record
-from ..notices import Kind, Notice
 from . import topics
-from .convert import Converter
+from .convert import REPEAT_EVERY, Converter
 from .files import variant
 from .items import Event, Item, LinkOpened, Published, RawChunk
 from .mcapfile import McapFile
@@ -123,9 +123,11 @@ class Recording:
             return
         now = time.monotonic()
         flush_at, sync_at = now + self.limits.flush_seconds, now + self.limits.sync_seconds
+        repeat_at = now + REPEAT_EVERY
         reported_drops = 0
         while True:
-            wait = IDLE_WAIT if self.stopped is not None else max(0.0, flush_at - time.monotonic())
+            due = min(flush_at, repeat_at)
+            wait = IDLE_WAIT if self.stopped is not None else max(0.0, due - time.monotonic())
             try:
                 item = self._queue.get(timeout=wait)
             except queue.Empty:
@@ -140,6 +142,13 @@ class Recording:
                 self._finish(file)  # keep what was written readable at once; drain the rest
                 continue
             now = time.monotonic()
+            # A parked robot: its pose in every second — only once the writer has caught up, so a
+            # repeat never stamps "now" on a pose older than ones still waiting in the queue.
+            if self.stopped is None and now >= repeat_at and self._queue.empty():
+                repeat_at = now + REPEAT_EVERY
+                at_ns = time.time_ns()
+                for topic, message in self._converter.repeat(at_ns):
+                    self._log(file, topic, message, at_ns)
             if self.stopped is None and now >= flush_at:
                 if self.dropped != reported_drops:
                     reported_drops = self.dropped

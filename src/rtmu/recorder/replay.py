@@ -23,9 +23,17 @@ import time
 from collections.abc import Callable
 
 from ..client.link import Link, RecordedLink
+from ..client.roles import Role
+from ..client.session import SessionConfig
 from ..protocol.decoder import PacketDecoder
-from ..state import CameraChanged, CameraImage, StateChange
+from ..values.state import CameraChanged, CameraImage, StateChange
 from .replay_file import RecordedConnection
+
+REPLAY_CONFIG = SessionConfig(
+    ping_interval=3600.0, lost_after=3600.0, connect_timeout=3600.0, role=Role.OBSERVER
+)
+"""A replaying session: no live link to watch (no pings, no staleness by wall clock, no guardian), and
+an observer — its client cannot put a motion request on any link, the replay's included."""
 
 SPEEDS = (0.25, 0.5, 1.0, 2.0, 4.0, 8.0)
 POLL = 0.05

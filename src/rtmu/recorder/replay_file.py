@@ -21,26 +21,27 @@ from collections.abc import Iterator
 from dataclasses import dataclass, field
 from pathlib import Path
 
-from ..capture.base import CaptureStats, StreamData
-from ..capture.recorded import CONNECTION_TOPIC, MAX_RECORD, recorded_events
+from ..capture.base import CaptureError, CaptureStats, StreamData
+from ..capture.mcap_bounded import BoundedMcap
+from ..capture.recorded import CONNECTION_TOPIC, recorded_events
+from ..capture.session_decoder import C2S, CaptureDecoder, DecodedPacket
 from ..client.health import PING_CANDIDATES
 from ..protocol.decoder import PacketDecoder
-from ..session_decoder import C2S, CaptureDecoder, DecodedPacket
+from ..protocol.motion import MOTION_REQUESTS, is_motion
 from . import topics
 
-NOT_REPLAYED = frozenset(
-    {
-        "ratioDrive", "stop", "setSafeDrive", "gotoGoal", "gotoPose", "gotoRouteGoal", "home", "dock",
-        "tourGoals", "localizeToPose", "popupClicked", "patrolRoute", "say", "wander",
-        "sendVideo", "getSafeDrive", *PING_CANDIDATES,
-    }
-)  # fmt: skip
+NOT_REPLAYED = MOTION_REQUESTS | frozenset(
+    {"setSafeDrive", "localizeToPose", "popupClicked", "say", "sendVideo", "getSafeDrive", *PING_CANDIDATES}
+)
 """Client packets that come from the operator or a timer, never from the server's bytes alone."""
-MOTION = frozenset({"ratioDrive", "gotoGoal", "gotoPose", "gotoRouteGoal", "home", "dock", "tourGoals"})
-"""What a replay link refuses outright (a replay never drives)."""
 MAX_IMAGE = 16 * 1024 * 1024
 MAX_REPLAY_BYTES = 512 * 1024 * 1024
-"""Server bytes of one connection a replay keeps in memory (hours of status and sonar)."""
+"""Server bytes of one connection a replay keeps in memory (hours of status and sonar), each recorded
+chunk counted with :data:`CHUNK_OVERHEAD`: a file of millions of 8-byte chunks is refused as well."""
+CHUNK_OVERHEAD = 160
+"""What keeping one recorded chunk costs beside its bytes (its object, its bytes' header, its slot)."""
+REPLAY_BUDGET = 8 * 1024 * 1024 * 1024
+"""Uncompressed bytes a replayed file's chunks may claim in all (checked before any is decompressed)."""
 MAX_IMAGE_BYTES = 256 * 1024 * 1024
 """Camera pictures a replay keeps in memory; beyond it every other one is left out (and it says so)."""
 
@@ -99,21 +100,23 @@ def load(path: Path, conn: int | None = None) -> RecordedConnection:
     mine: list[StreamData] = []
     size = 0
     try:
-        for event in recorded_events(path, stats):
+        for event in recorded_events(path, stats, budget=REPLAY_BUDGET):
             if not isinstance(event, StreamData):
                 continue
             if event.flow.id not in flows:
                 flows.append(event.flow.id)
             if len(flows) >= index and event.flow.id == flows[index - 1]:
-                size += len(event.data)
+                size += len(event.data) + CHUNK_OVERHEAD
                 if size > MAX_REPLAY_BYTES:
                     raise ReplayFileError(
                         f"connection {index} of {path.name} holds over {MAX_REPLAY_BYTES >> 20} MB of "
-                        "ArNetworking bytes: too long to replay in one piece"
+                        "ArNetworking bytes (or millions of tiny chunks): too long to replay in one piece"
                     )
                 mine.append(event)
     except ReplayFileError:
         raise
+    except CaptureError as exc:  # a bomb, a file that is no recording: its reason as it stands
+        raise ReplayFileError(str(exc)) from None
     except Exception as exc:
         raise ReplayFileError(str(exc)) from None
     if not flows:
@@ -125,7 +128,7 @@ def load(path: Path, conn: int | None = None) -> RecordedConnection:
         if isinstance(item, DecodedPacket) and item.direction == C2S:
             names.setdefault(item.command, item.name)
     uncounted = frozenset(c for c, n in names.items() if not_replayed(n))
-    motion = frozenset(c for c, n in names.items() if n in MOTION or n == "stop")
+    motion = frozenset(c for c, n in names.items() if n is not None and is_motion(n))  # refused outright
     recorded = RecordedConnection(
         path,
         index,
@@ -175,13 +178,11 @@ def _ns(seconds: float | None) -> int:
 
 def _images(path: Path, conn: int, start_ns: int, end_ns: int) -> Iterator[tuple[int, bytes]]:
     """The camera pictures logged while connection ``conn`` was the current one."""
-    from mcap.reader import NonSeekingReader
-
     current = 0
     with path.open("rb") as f:
-        reader = NonSeekingReader(f, validate_crcs=True, record_size_limit=MAX_RECORD)
+        reader = BoundedMcap(f, budget=REPLAY_BUDGET)
         try:
-            for _schema, channel, message in reader.iter_messages(log_time_order=False):
+            for _schema, channel, message in reader.messages():
                 if channel.topic == CONNECTION_TOPIC:
                     try:
                         current = int(json.loads(message.data).get("conn", 0))

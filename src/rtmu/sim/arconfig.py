@@ -32,6 +32,7 @@ from rtmu.protocol.payloads.config import (
     SetConfig,
     SetConfigReply,
     Value,
+    value_text,
 )
 from rtmu.protocol.payloads.config import ConfigSectionPacketV1 as V1
 from rtmu.protocol.payloads.config import ConfigSectionPacketV2 as V2
@@ -47,6 +48,8 @@ LAST_EDITABLE = Priority.EXPERT
 """As ARIA's handler without factory permission: FACTORY parameters are shown, never changed."""
 CAMERA_SIZES = {"320x240": (320, 240), "640x480": (640, 480)}
 FILLER_PER_SECTION = 1000
+FILLER_CONTROL_SECTION = "Line\rbreak\nand \x1b[2Jescape"
+"""A hostile section name with filler: a CR, a newline and a terminal escape in it."""
 MIN_TIMEOUT = 0.1
 """A watchdog shorter than a client's resend period would stop every held drive: refused (0 is "off")."""
 
@@ -79,6 +82,8 @@ class SimArConfig:
         """Encoded filler sections (thousands of parameters take a while: not on every request)."""
         self._build()
         self._fill(filler)
+        self.defaults = self.values()
+        """The factory values (``getConfigDefaults``): every parameter as the simulator started with it."""
         if filler:
             self.packets(4, ConfigRequest())  # encode them now, not in a client's first request
 
@@ -116,6 +121,8 @@ class SimArConfig:
             lambda: ratio.timeout,
             setter(ratio, "timeout"),
         )
+        for ahead, word in ((True, "Forward"), (False, "Backward")):
+            self._add("Teleop", _clearance(word), *self._margin(ahead))
         self.comments["Robot config"] = "Limits of the simulated Pioneer 3-DX"
         self._add(
             "Robot config",
@@ -145,6 +152,16 @@ class SimArConfig:
             lambda: round(ratio.rot_vel_max),
             setter(ratio, "rot_vel_max"),
         )
+        for name, attr, what, top in (
+            ("TransDecel", "trans_decel", "Braking on a stop or zero ratios, in mm/s²", 1000),
+            ("RotDecel", "rot_decel", "Slowing of a turn on a stop or zero ratios, in deg/s²", 500),
+        ):  # ARIA's ArRobotConfig lists these beside TransVelMax; its absolute maxima cap them
+            self._add(
+                "Robot config",
+                ConfigParam(name, ParamType.INT, 0, what, Priority.BASIC, 10, top),
+                lambda attr=attr: round(getattr(body, attr)),  # type: ignore[misc]
+                setter(body, attr),
+            )
         self._add("Robot config", ConfigParam("", ParamType.SEPARATOR), none, ignore)
         self._add(
             "Robot config",
@@ -243,6 +260,17 @@ class SimArConfig:
             setter(ap, "wall_loss_db"),
         )
 
+    def _margin(self, ahead: bool) -> tuple[Callable[[], Value], Callable[[Value], None]]:
+        """Safe drive's margin, told as ARIA's limiter measures it: from half the robot's length (as
+        physicalInfo gives it) ahead of and behind its centre; the simulated body is a circle."""
+        margins = self.host.world.body.safe_margin
+        beyond = p3dx.RADIUS_MM - p3dx.LENGTH_MM / 2
+
+        def put(v: Value) -> None:
+            margins[ahead] = max(float(v or 0) - beyond, 0.0)
+
+        return (lambda: round(margins[ahead] + beyond)), put
+
     def _set_frame_size(self, v: Value) -> None:
         self.host.video_size = CAMERA_SIZES[str(v)]
 
@@ -286,6 +314,24 @@ class SimArConfig:
             )
             key = (section, name)
             self._add(section, template, lambda k=key: store[k], lambda v, k=key: store.__setitem__(k, v))  # type: ignore[misc]
+        if count:  # control characters in names: a CR, a newline, an escape
+            section, name = FILLER_CONTROL_SECTION, "Line\rbreak"
+            store[(section, name)] = 1
+            template = ConfigParam(name, ParamType.INT, None, "a CR in its name", 0, 0, 10, -1)
+            self._add(
+                section,
+                template,
+                lambda: store[(FILLER_CONTROL_SECTION, "Line\rbreak")],
+                lambda v: store.__setitem__((FILLER_CONTROL_SECTION, "Line\rbreak"), v),
+            )
+
+    def values(self) -> list[tuple[str, str, str]]:
+        """``(section, parameter, value text)`` of every parameter that has a value, in order."""
+        return [
+            (p.section, p.template.name, value_text(p.template.kind, p.get()))
+            for p in self.params
+            if p.template.kind not in (ParamType.SEPARATOR, ParamType.LIST)
+        ]
 
     def sections(self) -> list[str]:
         seen: dict[str, None] = {}
@@ -416,6 +462,19 @@ def _request(call: Call) -> ConfigRequest:
         return ConfigRequest.decode(call.args)
     except (FieldUnderrun, PayloadError):
         return ConfigRequest(None, None)
+
+
+def _clearance(word: str) -> ConfigParam:
+    return ConfigParam(
+        f"{word}Clearance",
+        ParamType.INT,
+        0,
+        f"Safe drive stops this far short of anything {'ahead' if word == 'Forward' else 'behind'}, "
+        "in mm from half the robot's length ahead of (behind) its centre",
+        Priority.INTERMEDIATE,
+        0,
+        2000,
+    )
 
 
 def _get_by_sections(version: int) -> Handler:

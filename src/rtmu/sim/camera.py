@@ -163,7 +163,25 @@ def _background(h: int, horizon: float) -> np.ndarray:
 
 def render_jpeg(view: View, quality: int) -> bytes:
     """``view`` rendered, encoded and stamped: the whole cost of one frame, in one call for a worker."""
-    return stamp_jpeg(encode_jpeg(render_rgbx(view), quality), time.time_ns())
+    return render_frame(view, quality)[1]
+
+
+def render_frame(view: View, quality: int) -> tuple[np.ndarray, bytes]:
+    """``view`` rendered (its RGBX pixels, kept for :func:`refresh_frame`) and as a stamped JPEG."""
+    pixels = render_rgbx(view)
+    return pixels, stamp_jpeg(encode_jpeg(pixels, quality), time.time_ns())
+
+
+SENSOR_NOISE = 3
+"""± levels of a camera sensor's noise: enough that two frames of one view are never equal."""
+
+
+def refresh_frame(pixels: np.ndarray, quality: int, seed: int) -> tuple[np.ndarray, bytes]:
+    """A new frame of a view that did not change, as a real camera delivers it: the same scene with
+    fresh sensor noise, encoded and stamped now (no ray casting: the scene's pixels are reused)."""
+    noise = np.random.default_rng(seed).integers(-SENSOR_NOISE, SENSOR_NOISE + 1, pixels.shape[:2])
+    noisy = np.clip(pixels[..., :3].astype(np.int16) + noise[..., None], 0, 255).astype(np.uint8)
+    return pixels, stamp_jpeg(encode_jpeg(noisy, quality), time.time_ns())
 
 
 STAMP_PREFIX = b"RTMU-T="

@@ -5,7 +5,7 @@ Names, command groups and flags follow serverDemo, in its registration order,
 numbered from 256. Where serverDemo offers the same data, the description,
 argument and return texts are the wire texts an ARIA server sends and clients
 display, taken from a recording of serverDemo's list
-(``shared/captures/clientCommandLister-serverDemoMap.pcap``; a test checks
+(``tests/data/captures/clientCommandLister-serverDemoMap.pcap``; a test checks
 them against it). Every text that appears in no capture — the popup data and
 the simulator's own commands — is written in our own words. Data serverDemo
 has that the simulator does not serve here (micro-controller pass-through,
@@ -623,7 +623,7 @@ _SET_RETURN = (
     "(all non-error parameters are parsed, and only the first error is reported)"
 )
 CONFIG: tuple[Row, ...] = (
-    # ARIA's own texts, as serverDemo lists them (shared/captures/clientCommandLister-serverDemoMap.pcap).
+    # ARIA's own texts, as serverDemo lists them (tests/data/captures/clientCommandLister-serverDemoMap.pcap).
     (
         "getConfigBySectionsV4",
         "Gets the complete configuration information from the server",
@@ -734,7 +734,9 @@ DRAWINGS: tuple[Row, ...] = (
 )
 """The range devices' drawing data (``getDrawingList`` says how to draw each): laser, then sonar."""
 
-STRING_COMMANDS = frozenset({"SimulatorSetBattery", "SimulatorPopup", "SimulatorPopupFlood"})
+STRING_COMMANDS = frozenset(
+    {"SimulatorSetBattery", "SimulatorPopup", "SimulatorPopupFlood", "mappingLoopStart", "mappingLoopEnd"}
+)
 """Simple commands that take one string argument (``listStringCommands``)."""
 
 

@@ -32,6 +32,9 @@ class SimConfig:
     """Enforce a protocol version (reason 4 for a client that differs); None: the profile's."""
     profile: str = "default"
     """Which kind of server to be (:mod:`rtmu.sim.profiles`): ``default`` or ``aram``."""
+    test_hooks: bool | None = None
+    """List the simulator's own ``Simulator…`` commands (None: as the profile does — the default profile
+    lists them, ``aram`` only when asked, being true to a 6MTX robot's list)."""
     client_type: int | None = None
     """Enforce a client type (reason 6), as ``ArServerBase::enforceType`` does."""
     central_server: str | None = None
@@ -55,6 +58,9 @@ class SimConfig:
     second; raise it to serve live video faster)."""
     render_in_thread: bool | None = None
     """Render camera frames on a worker thread; None: in real-time mode only (inline on the manual clock)."""
+    save_map_changes: bool = False
+    """Write a map changed by ``processMapChanges`` into the served file, as ARIA does (False: the change
+    lives in the simulator only and the file is left as it was)."""
     intro_timeout: float = 60.0
     backup_timeout: float = 5.0
     """Drop a client whose queued output has not moved for this long (ARIA's backup timeout)."""
@@ -68,4 +74,9 @@ class SimConfig:
     start_pose: tuple[float, float, float] | None = None
     """Where the robot starts (x, y mm, th deg; moved to the nearest free spot); None: the map's home.
     ``rtmu sim --robots N`` gives each robot its own (``sim.multi``)."""
+    files_dir: Path | None = None
+    """The folder ``getDirListing``/``getFile``/``putFile``/``deleteFile`` share and scans are written to;
+    None: a temporary folder of the simulator's own, removed when it goes (:mod:`rtmu.sim.files_folder`)."""
+    files_default_dir: str | None = None
+    """Offer ``getDefaultUploadDownloadDir`` naming this folder (ARIA lists it only when given one)."""
     verbose: bool = False

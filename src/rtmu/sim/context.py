@@ -7,13 +7,17 @@ server imports the handlers and never the other way round.
 
 from __future__ import annotations
 
+import asyncio
 from collections import deque
 from collections.abc import Callable
 from typing import Protocol
 
+from rtmu.protocol.datalist import DataList
 from rtmu.protocol.payloads.config import ConfigRequest, SetConfig
 
 from .catalogue import Row
+from .config import SimConfig
+from .geometry import Obstacles
 from .mapserve import ServedMap
 from .video import VideoFeed
 from .world import World
@@ -33,12 +37,19 @@ class ArConfigStore(Protocol):
 
     def sections(self) -> list[str]: ...
 
+    def values(self) -> list[tuple[str, str, str]]: ...
+
+    defaults: list[tuple[str, str, str]]
+
 
 class SimClient(Protocol):
     """One connected client, as a handler sees it."""
 
     ident: int
     self_identifier: str
+    closed: bool
+    writer: asyncio.StreamWriter
+    """A handler that sends a long series (a file) awaits ``writer.drain()`` between packets."""
 
     def send(self, number: int, payload: bytes) -> None: ...
 
@@ -50,6 +61,8 @@ class SimHost(Protocol):
 
     world: World
     map: ServedMap
+    config: SimConfig
+    datalist: DataList
     video: VideoFeed
     video_size: tuple[int, int]
     stop_log: deque[tuple[float, int, str]]
@@ -69,6 +82,12 @@ class SimHost(Protocol):
     def broadcast(self, name: str, payload: bytes = b"", exclude: SimClient | None = None) -> int: ...
 
     def check_map(self) -> bool: ...
+
+    def install_map(
+        self, served: ServedMap, *, move_home: bool = False, obstacles: Obstacles | None = None
+    ) -> None: ...
+
+    file_md5: bytes
 
     def reset_pose(self) -> None: ...
 

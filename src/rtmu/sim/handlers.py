@@ -34,6 +34,7 @@ from rtmu.protocol.payloads.camera import (
     VideoSize,
 )
 from rtmu.protocol.payloads.commands import CommandEntry, CommandList, StringCommandArgs, StringCommandList
+from rtmu.protocol.payloads.drawings import Drawing, DrawingList, DrawingListPacket
 from rtmu.protocol.payloads.drive import (
     MoveDist,
     RatioDrive,
@@ -57,9 +58,6 @@ from rtmu.protocol.payloads.robot import (
     UpdateStrings,
 )
 from rtmu.protocol.payloads.sensors import (
-    Drawing,
-    DrawingList,
-    DrawingListPacket,
     RangeDeviceReadings,
     SensorCurrentRequest,
     SensorList,

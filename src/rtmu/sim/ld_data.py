@@ -1,11 +1,14 @@
-"""The data an Omron LD robot offers beyond serverDemo, for ``rtmu sim --profile aram``.
+"""The data an Omron LD robot offers beyond serverDemo, for ``rtmu sim --kind aram``.
 
 A data module of the profile extension point (:mod:`rtmu.sim.profiles`): ``ROWS`` for the catalogue
 and ``HANDLERS`` for the server. Two lasers seen from the world's walls by the same ray caster as
-the sonar, one ray per degree, a docking state that ``dock``/``undock`` move through
-docking → docked (and back) in :data:`DOCK_SECONDS` of simulated time, a few routes that ``patrol``
-starts (recorded, no driving), ``DataStore_*`` strings from the simulator's real values and
-``say`` (recorded). What was asked is kept per server in :func:`ld_state` so tests can look.
+the sonar, one ray per degree; docking by the simulator's ``dock`` mode (it drives to the dock,
+``dockInfo`` reports its state, and a drive backs out of it first), a few routes that ``patrol``
+tours goal after goal (a route is goals of the map: :func:`route_goals`), ``gotoRouteGoal`` driving
+to a goal, ``DataStore_*`` strings from the simulator's real values (under names 6MTX robots list;
+the value texts are ours) and ``say`` (recorded). LD's configuration data are listed but never
+answered (:data:`CONFIG_API`: their layouts are not public, and a made-up answer would teach RTMU a
+layout no robot has). What was asked is kept per server in :func:`ld_state` so tests can look.
 """
 
 from __future__ import annotations
@@ -19,20 +22,19 @@ from typing import TYPE_CHECKING
 import numpy as np
 
 from rtmu.protocol.errors import FieldUnderrun, PayloadError
+from rtmu.protocol.payloads.drawings import Drawing, DrawingList, DrawingListPacket
 from rtmu.protocol.payloads.ld import (
     DataStoreValue,
     DockInfo,
-    DockInfoChanged,
-    DockState,
     GotoRouteGoal,
     Patrol,
     Routes,
     Say,
 )
-from rtmu.protocol.payloads.sensors import Drawing, DrawingList, DrawingListPacket, RangeDeviceReadings
+from rtmu.protocol.payloads.sensors import RangeDeviceReadings
 
 from .catalogue import Row
-from .handlers import SONAR_DRAWING, Call, Handler, Reply
+from .handlers import Call, Handler, Reply
 
 if TYPE_CHECKING:
     from .context import SimHost
@@ -47,7 +49,6 @@ LASER_DRAWINGS = (
     Drawing("Laser_1Current", "polyDots", 0x0000FF, 60, 75, 200, 0x000000, "DefaultOn"),
     Drawing("Laser_2Current", "polyDots", 0x0000C0, 60, 75, 200, 0x000000, "DefaultOn"),
 )
-DOCK_SECONDS = 2.0
 ROUTES = ("Loop", "Kitchen run", "Night patrol")
 SAY_LIMIT = 100
 """Texts kept in :attr:`LdState.said` (the oldest go first)."""
@@ -55,12 +56,9 @@ SAY_LIMIT = 100
 
 @dataclass
 class LdState:
-    dock: DockState = DockState.UNDOCKED
-    since: float = 0.0
-    """Simulated time the current dock transition started."""
     patrols: list[str] = field(default_factory=list)
     route_goals: list[str] = field(default_factory=list)
-    """Goals asked for with ``gotoRouteGoal`` (recorded; the simulator does not navigate)."""
+    """Goals asked for with ``gotoRouteGoal`` (each also driven to)."""
     said: list[str] = field(default_factory=list)
 
 
@@ -98,48 +96,17 @@ def _laser(call: Call) -> Iterable[Reply]:
 
 
 def _drawing_list(call: Call) -> Iterable[Reply]:
-    packets = [DrawingListPacket(d).encode() for d in (SONAR_DRAWING, *LASER_DRAWINGS)]
+    packets = [DrawingListPacket(d).encode() for d in LASER_DRAWINGS]  # LD robots list no sonar
     return (*packets, DrawingListPacket(None).encode())
 
 
 def _list_drawings(call: Call) -> Iterable[Reply]:
-    return (DrawingList((SONAR_DRAWING, *LASER_DRAWINGS)).encode(),)
+    return (DrawingList(LASER_DRAWINGS).encode(),)
 
 
-# -- docking ----------------------------------------------------------------------------------
-def _dock_now(call: Call) -> DockInfo:
-    """The dock state at the world's time: a transition that has run DOCK_SECONDS completes."""
-    state = ld_state(call.server)
-    done = call.world.time - state.since >= DOCK_SECONDS
-    if done and state.dock in (DockState.DOCKING, DockState.UNDOCKING):
-        state.dock = DockState.DOCKED if state.dock is DockState.DOCKING else DockState.UNDOCKED
-        state.since = call.world.time
-        call.server.broadcast("dockInfoChanged", DockInfoChanged(state.dock).encode())
-    return DockInfo(state.dock)
-
-
+# -- docking: the simulator's dock mode drives; LD robots report it as dockInfo -----------------------
 def _dock_info(call: Call) -> Iterable[Reply]:
-    return (_dock_now(call).encode(),)
-
-
-def _start(call: Call, target: DockState, unless: DockState) -> None:
-    state = ld_state(call.server)
-    _dock_now(call)
-    if state.dock in (target, unless):
-        return
-    state.dock = target
-    state.since = call.world.time
-    call.server.broadcast("dockInfoChanged", DockInfoChanged(target).encode())
-
-
-def _dock(call: Call) -> Iterable[Reply]:
-    _start(call, DockState.DOCKING, DockState.DOCKED)
-    return ()
-
-
-def _undock(call: Call) -> Iterable[Reply]:
-    _start(call, DockState.UNDOCKING, DockState.UNDOCKED)
-    return ()
+    return (DockInfo(call.world.dock_mode.state).encode(),)
 
 
 # -- routes and speech ---------------------------------------------------------------------------
@@ -154,7 +121,21 @@ def _patrol(call: Call) -> Iterable[Reply]:
         return ()
     if route in ROUTES:
         ld_state(call.server).patrols.append(route)
+        world = call.world
+        names = tuple(g.name for g in world.nav_map.goals()) if world.nav_map is not None else ()
+        world.touch()
+        world.goto_mode.tour(route_goals(route, names))
     return ()
+
+
+def route_goals(route: str, goals: tuple[str, ...]) -> tuple[str, ...]:
+    """The goals a route visits, in order: the loop every goal, the kitchen run every other one,
+    the night patrol every goal backwards (the simulator's routes are made from the map's goals)."""
+    if route == ROUTES[1]:
+        return goals[::2]
+    if route == ROUTES[2]:
+        return goals[::-1]
+    return goals
 
 
 def _goto_route_goal(call: Call) -> Iterable[Reply]:
@@ -163,6 +144,8 @@ def _goto_route_goal(call: Call) -> Iterable[Reply]:
     except (FieldUnderrun, PayloadError, ValueError):
         return ()
     ld_state(call.server).route_goals.append(goal)
+    call.world.touch()
+    call.world.goto_mode.goto_goal(goal)
     return ()
 
 
@@ -187,21 +170,36 @@ def _closest_obstacle_mm(call: Call) -> float:
 
 
 DATA_STORE: dict[str, tuple[str, object]] = {
-    "DataStore_Localization_Score": (
+    "DataStore_LaserLocalizationScore": (
         "Localization score (0–100)",
         lambda call: str(round(call.world.localization.score * 100)),
     ),
-    "DataStore_WiFi_Quality": ("Wi-Fi link quality (0–70)", lambda call: str(call.world.wifi().quality)),
-    "DataStore_Distance_To_Goal": (
+    "DataStore_WirelessQuality": ("Wi-Fi link quality (0–70)", lambda call: str(call.world.wifi().quality)),
+    "DataStore_Distance_to_goal": (
         "Distance to the goal in mm (0: no goal)",
         lambda call: str(round(call.world.path_task.distance_left())),
     ),
-    "DataStore_Closest_Obstacle": (
+    "DataStore_Closest_Obstacle_Distance": (
         "Distance to the closest obstacle in mm",
         lambda call: (lambda d: "none" if d == math.inf else str(round(d)))(_closest_obstacle_mm(call)),
     ),
-    "DataStore_Dock_State": ("Docking state", lambda call: _dock_now(call).state_label),
+    "DataStore_DockingState": (
+        "Docking state",
+        lambda call: DockInfo(call.world.dock_mode.state).state_label,
+    ),
 }
+"""Names as 6MTX robots list them; descriptions and value texts are the simulator's own (LD's are
+not public)."""
+CONFIG_API: tuple[Row, ...] = tuple(
+    (name, f"{what} (LD configuration; layout not public)", "not public", "not public", "ConfigEditing", "")
+    for name, what in (
+        ("getConfigValues", "The configuration's values"),
+        ("setConfigValues", "Sets configuration values"),
+        ("updateConfigValues", "Changes configuration values"),
+        ("configExpandedSectionList", "The configuration's sections"),
+    )
+)
+"""LD's configuration data, listed as a 6MTX robot lists them and never answered here."""
 
 
 def _data_store(call: Call) -> Iterable[Reply]:
@@ -271,6 +269,7 @@ ROWS: tuple[Row, ...] = (
         (name, desc, "none", "string: value", "DataStore", "RETURN_SINGLE")
         for name, (desc, _) in DATA_STORE.items()
     ),
+    *CONFIG_API,
 )
 
 HANDLERS: dict[str, Handler] = {
@@ -278,8 +277,6 @@ HANDLERS: dict[str, Handler] = {
     "Laser_2Current": _laser,
     "getDrawingList": _drawing_list,
     "listDrawings": _list_drawings,
-    "dock": _dock,
-    "undock": _undock,
     "dockInfo": _dock_info,
     "getRoutes": _routes,
     "patrol": _patrol,

@@ -15,7 +15,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from rtmu.maps import MapData, MapObject, new_map
+from rtmu.mapfile import MapData, MapObject, new_map
 
 ROOM_DEPTH = 5000
 CORRIDOR_WIDTH = 2000

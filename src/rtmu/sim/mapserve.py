@@ -22,7 +22,7 @@ from rtmu.protocol.packet import encode_packet
 from rtmu.protocol.payloads.map import Goals, MapId, MapName
 from rtmu.protocol.payloads.mapstream import map_binary_payloads, map_text_payloads
 
-from ..maps import MapObject, map_header_lines
+from ..mapfile import MapData, MapObject, map_header_lines
 from .geometry import Obstacles
 
 DEFAULT_POINT_CELL_MM = 40.0
@@ -52,7 +52,9 @@ class ServedMap:
     path: Path | None
     name: str
     """As configured (ARIA sends the path it was given)."""
-    lines: list[str] = field(default_factory=list)
+    raw: bytes = field(default=b"", repr=False)
+    """The file's bytes: ``getMap`` sends its lines (split only when first asked for: a 1 M-point map
+    is a million lines)."""
     header: list[str] = field(default_factory=list)
     segments: np.ndarray = field(default_factory=lambda: np.zeros((0, 4), np.int32))
     points: np.ndarray = field(default_factory=lambda: np.zeros((0, 2), np.int32))
@@ -66,11 +68,22 @@ class ServedMap:
     mtime: int = 0
     resolution: int | None = None
     access_point: tuple[float, float] | None = None
+    data: MapData | None = field(default=None, repr=False)
+    """The map as read (kept so a map change can be applied to it)."""
+    _lines: list[str] | None = field(default=None, repr=False)
     _framed: dict[tuple[str, int], Chunks] = field(default_factory=dict, repr=False)
 
     @property
     def present(self) -> bool:
         return self.path is not None
+
+    @property
+    def lines(self) -> list[str]:
+        """The file's non-blank lines without line ends, as ``getMap`` sends them."""
+        if self._lines is None:
+            text = self.raw.decode("latin-1")
+            self._lines = [s for s in (line.rstrip("\r") for line in text.split("\n")) if s.strip()]
+        return self._lines
 
     def obstacles(self) -> Obstacles:
         cell = float(self.resolution) if self.resolution and self.resolution > 0 else DEFAULT_POINT_CELL_MM
@@ -112,13 +125,17 @@ def load_map(path: Path | None) -> ServedMap:
     """Read ``path`` with the project's map reader; None = serve no map (an empty 10 m room to drive in)."""
     if path is None:
         return ServedMap(None, "")
-    from rtmu.maps import read_map
+    from rtmu.mapfile import read_map
 
     raw = path.read_bytes()
-    data = read_map(path)
-    text = raw.decode("latin-1")
-    lines = [line.rstrip("\r") for line in text.split("\n")]
-    lines = [line for line in lines if line.strip()]
+    return served_map(path, str(path), raw, read_map(path), int(os.stat(path).st_mtime))
+
+
+def served_map(
+    path: Path, name: str, raw: bytes, data: MapData, mtime: int, header: list[str] | None = None
+) -> ServedMap:
+    """A map to serve: the file's bytes ``raw`` (sent line by line by ``getMap``) and what they read as
+    (``header``: ``data``'s header lines, when already written)."""
     home = data.home()
     goals = tuple(obj.name for obj in data.goals())
     ap = None
@@ -127,12 +144,11 @@ def load_map(path: Path | None) -> ServedMap:
         if "access point" in label or "accesspoint" in label or "wifi" in label:
             ap = (float(obj.pose.x), float(obj.pose.y))
             break
-    st = os.stat(path)
     return ServedMap(
         path=path,
-        name=str(path),
-        lines=lines,
-        header=map_header_lines(data),
+        name=name,
+        raw=raw,
+        header=header if header is not None else map_header_lines(data),
         segments=np.asarray(data.segments, dtype=np.int32).reshape(-1, 4),
         points=np.asarray(data.points, dtype=np.int32).reshape(-1, 2),
         home=(float(home.x), float(home.y), float(home.th)) if home is not None else (0.0, 0.0, 0.0),
@@ -141,7 +157,8 @@ def load_map(path: Path | None) -> ServedMap:
         objects=tuple(data.objects),
         md5=hashlib.md5(raw).digest(),
         size=len(raw),
-        mtime=int(st.st_mtime),
+        mtime=mtime,
         resolution=data.resolution,
         access_point=ap,
+        data=data,
     )

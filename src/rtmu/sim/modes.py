@@ -68,6 +68,31 @@ class StopMode(Mode):
     def __init__(self) -> None:
         super().__init__()
         self.status = "Stopped"
+        self._lock: bool | None = None
+        """None: unlocked; else locked, and whether it gives way when asked (ARIA's ``lockMode``)."""
+
+    @property
+    def locked(self) -> bool:
+        return self._lock is not None
+
+    @property
+    def will_unlock(self) -> bool:
+        return self._lock is True
+
+    def lock(self, will_unlock: bool) -> None:
+        """ARIA's ``lockMode(willUnlockIfRequested)`` on the active stop mode (as a safety mode would)."""
+        self._lock = will_unlock
+
+    def unlock(self) -> None:
+        self._lock = None
+
+    def request_unlock(self) -> None:
+        """A stop mode has nothing to finish: one that will unlock does so at once."""
+        if self._lock is True:
+            self._lock = None
+
+    def deactivate(self) -> None:
+        self._lock = None
 
     def command(self, body: Body, now: float, dt: float) -> Command:
         self.status = "Stopped" if body.is_stopped() else "Stopping"

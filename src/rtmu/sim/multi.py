@@ -42,10 +42,16 @@ def map_home(path: Path | None) -> tuple[float, float, float]:
     """The map's ``RobotHome`` (x, y mm, th deg), or the origin."""
     if path is None:
         return (0.0, 0.0, 0.0)
-    from ..maps import read_map
+    from ..mapfile import read_map
 
     home = read_map(path).home()
     return (float(home.x), float(home.y), float(home.th)) if home is not None else (0.0, 0.0, 0.0)
+
+
+def start_poses(base: SimConfig, count: int) -> list[tuple[float, float, float]]:
+    """Where ``count`` robots start: 0, +1, -1, +2, -2 … rows either side of home, facing one way."""
+    hx, hy, hth = base.start_pose or map_home(base.map_path)
+    return [(hx, hy + (i + 1) // 2 * (1 if i % 2 else -1) * SPACING_MM, hth) for i in range(count)]
 
 
 def fleet_configs(base: SimConfig, count: int) -> list[SimRobot]:
@@ -54,12 +60,8 @@ def fleet_configs(base: SimConfig, count: int) -> list[SimRobot]:
         raise ValueError(f"--robots must be 1…{MAX_ROBOTS}, not {count}")
     if base.port and base.port + count - 1 > 65535:
         raise ValueError(f"ports {base.port}…{base.port + count - 1} do not all exist")
-    hx, hy, hth = base.start_pose or map_home(base.map_path)
     robots = []
-    for i in range(count):
-        # 0, +1, -1, +2, -2 … rows of robots either side of home, all facing the same way.
-        step = (i + 1) // 2 * (1 if i % 2 else -1)
-        pose = (hx, hy + step * SPACING_MM, hth)
+    for i, pose in enumerate(start_poses(base, count)):
         config = dataclasses.replace(
             base,
             port=base.port + i if base.port else 0,

@@ -19,7 +19,7 @@ from typing import Protocol
 
 import numpy as np
 
-from rtmu.maps import MapObject
+from rtmu.mapfile import MapObject
 from rtmu.protocol.payloads.ld import DockState
 from rtmu.protocol.payloads.navigation import LocalizationState
 
@@ -56,10 +56,11 @@ class NavMap:
         return [o for o in self.objects if o.is_goal]
 
     def goal(self, name: str) -> MapObject | None:
-        for o in self.goals():
-            if o.name == name:
-                return o
-        return None
+        """The goal called ``name``, compared case-insensitively as ARIA's map does (exact first)."""
+        goals = self.goals()
+        return next((o for o in goals if o.name == name), None) or next(
+            (o for o in goals if o.name.casefold() == name.casefold()), None
+        )
 
     def docks(self) -> list[MapObject]:
         return [o for o in self.objects if o.type.lower() == "dock" or o.type.lower() == "dockwithheading"]
@@ -217,6 +218,8 @@ class GotoMode(Mode):
         self._target: tuple[float, float, float | None] = (0.0, 0.0, None)
         self._home = False
         self._touring = False
+        self._tour_only: tuple[str, ...] | None = None
+        """A route's goals (an LD robot's patrol), or None: every goal of the map."""
         self.done = True
 
     @property
@@ -243,15 +246,18 @@ class GotoMode(Mode):
         self.status = "Returning home"
         self._begin()
 
-    def tour(self) -> None:
+    def tour(self, only: tuple[str, ...] | None = None) -> None:
+        """Goal after goal, for ever: every goal of the map, or only these (a route, in its order)."""
         current = self.goal_name
         self._reset("Touring goals")
         self.goal_name = current
         self._touring = True
+        self._tour_only = only
         self._begin()
 
     def _reset(self, mode: str) -> None:
         self._mode, self._home, self._touring, self.goal_name = mode, False, False, ""
+        self._tour_only = None
 
     def _begin(self) -> None:
         """(Re)start in this mode: activating again when already active re-plans, as ARNL's ``activate``."""
@@ -295,6 +301,9 @@ class GotoMode(Mode):
     def _plan_next_tour_goal(self) -> None:
         nav = self.world.nav_map
         goals = [] if nav is None else nav.goals()
+        if self._tour_only is not None:
+            by_name = {g.name: g for g in goals}
+            goals = [by_name[name] for name in self._tour_only if name in by_name]
         if self.world.localization.lost:
             self.status, self.done = "Failed touring because robot lost", True
             return
@@ -416,6 +425,12 @@ class DockMode(Mode):
 
     def deactivate(self) -> None:
         self.path_task.cancel()
+
+    def leave(self) -> None:
+        """The simulator took the robot away (its pose was reset): not docked, nothing under way."""
+        self.path_task.cancel()
+        self.status = "Stopped"
+        self._switch(DockState.UNDOCKED)
 
     def request_unlock(self) -> None:
         """Someone else wants the robot: back out of the dock (or stop going there)."""

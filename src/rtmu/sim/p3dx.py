@@ -15,11 +15,24 @@ Sources (facts, written down here by us):
 * ARIA's ``ArActionRatioInput`` defaults: full throttle forwards = the robot's
   TransVelMax, backwards = a quarter of it, rotation 50 deg/s when stopped and
   25 deg/s at full speed, dead zones 10 % (translation) and 5 % (rotation).
+* Braking — what ``stop`` and zero ratios do (checked against ARIA's sources and MobileSim 0.9.8):
+  ``p3dx.p`` leaves ``TransDecel`` and ``RotDecel`` at 0, which ``ArRobot`` reads as "keep the
+  firmware's own" (it applies a parameter only above 1); the Pioneer firmware's defaults, which
+  MobileSim's Pioneer emulation also starts from, are TransDecel 300 mm/s² and RotDecel 100 deg/s²
+  (ARIA caps them at 1000 mm/s² and 100 deg/s² when no config packet comes). ``stop`` activates
+  ArServerModeStop, whose ``ArRobot::stop()`` sends VEL 0 and RVEL 0 — the firmware slows at that
+  TransDecel exactly as it does for zero ``ratioDrive`` ratios (ArActionRatioInput asking for 0);
+  only the firmware's ESTOP command brakes harder, and no network client can send it. The capture
+  agrees: after ratioDrive(0, 20) and after ``stop`` the speed falls by 30 mm/s every 100 ms. So
+  a P3-DX let go at 1.5 m/s rolls 1500²/(2·300) = 3.75 m, plus what it covers before the stop
+  arrives: the simulator's StopMode and RatioDriveMode both brake at :data:`TRANS_DECEL`.
 """
 
 from __future__ import annotations
 
 from dataclasses import dataclass
+
+from rtmu.protocol.payloads import drive as protocol_drive
 
 ROBOT_TYPE = "Pioneer"
 ROBOT_SUBTYPE = "p3dx"
@@ -42,13 +55,14 @@ TRANS_DECEL = 300.0
 ROT_ACCEL = 100.0
 ROT_DECEL = 100.0
 STOP_DECEL = 1000.0
-"""mm/s² of an emergency stop (a collision, a watchdog stop): much harder than a normal slow-down."""
+"""mm/s² of an emergency stop (a collision, a watchdog stop): much harder than a normal slow-down;
+ARIA's AbsoluteMaxTransDecel without a config packet."""
 
 # ArActionRatioInput defaults
 RATIO_ROT_AT_STOPPED = 50.0
 RATIO_ROT_AT_FULL = 25.0
-RATIO_TRANS_DEAD_ZONE = 10.0
-RATIO_ROT_DEAD_ZONE = 5.0
+RATIO_TRANS_DEAD_ZONE = protocol_drive.RATIO_TRANS_DEAD_ZONE
+RATIO_ROT_DEAD_ZONE = protocol_drive.RATIO_ROT_DEAD_ZONE
 
 # ArActionDriveDistance / jog defaults (used by moveDist)
 JOG_SPEED = 400.0

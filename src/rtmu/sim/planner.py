@@ -22,7 +22,7 @@ from skimage.draw import polygon as fill_polygon
 from skimage.graph import MCP_Geometric
 from skimage.morphology import isotropic_dilation
 
-from rtmu.maps import MapObject
+from rtmu.mapfile import MapObject
 
 from . import p3dx
 

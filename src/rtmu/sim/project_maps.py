@@ -1,4 +1,4 @@
-"""The project's own maps, drawn in code so they can be checked and regenerated: ``data/maps/*.map``.
+"""The project's own maps, drawn in code so they can be checked and regenerated: ``rtmu/data/maps/*.map``.
 
 * ``arena.map`` — the thesis test arena: a closed 6 m × 5 m lab room, the robot's
   home near the west wall, a goal near the east wall and three boxes between.
@@ -7,7 +7,7 @@
   forbidden line at the top of the stairs.
 
 Regenerate with ``python -m rtmu.sim.project_maps [DIRECTORY]`` (default
-``data/maps`` of the checkout); the output is the same every time.
+the package's ``data/maps``, where ``rtmu.package_data`` finds them); the output is the same every time.
 """
 
 from __future__ import annotations
@@ -17,7 +17,8 @@ from pathlib import Path
 
 import numpy as np
 
-from rtmu.maps import InfoLine, MapData, MapObject, new_map, write_map
+from rtmu.mapfile import InfoLine, MapData, MapObject, new_map, write_map
+from rtmu.package_data import MAPS_DIR
 from rtmu.sim.mapgen import box_segments, points_along
 
 POINT_SPACING_MM = 20.0
@@ -120,7 +121,7 @@ PROJECT_MAPS = {"arena.map": arena_map, "office.map": office_map}
 
 
 def main(argv: list[str]) -> int:
-    target = Path(argv[1]) if len(argv) > 1 else Path(__file__).resolve().parents[3] / "data" / "maps"
+    target = Path(argv[1]) if len(argv) > 1 else MAPS_DIR
     target.mkdir(parents=True, exist_ok=True)
     for file_name, build in PROJECT_MAPS.items():
         write_map(build(), target / file_name)

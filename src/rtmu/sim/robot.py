@@ -17,7 +17,7 @@ from . import p3dx
 from .geometry import Obstacles
 
 SAFE_MARGIN_MM = 100.0
-"""Safe drive stops this far short of an obstacle (front or rear of the robot's circle)."""
+"""Safe drive stops this far short of an obstacle (front or rear of the robot's circle), by default."""
 
 
 def normalize_deg(angle: float) -> float:
@@ -69,6 +69,15 @@ class Body:
         """Set by a hard stop (collision, watchdog): decelerate at STOP_DECEL until at rest."""
         self.odometer_mm = 0.0
         self.limited_by_obstacle = False
+        self.safe_margin = {True: SAFE_MARGIN_MM, False: SAFE_MARGIN_MM}
+        """Safe drive's margin ahead (True) and behind (False), mm from the round body's edge."""
+        self.holds: set[str] = set()
+        """Why the motors do not answer now (``estop``, ``motors`` off, ``stall``, ``fault``): while any
+        is held every command is zero, and a ``stall`` keeps :attr:`stalled` set."""
+        self.trans_decel = p3dx.TRANS_DECEL
+        """mm/s² the body brakes at when a mode asks for a slower speed (``stop``, zero ratios):
+        the robot's TransDecel, which the server's configuration may change (``Robot config``)."""
+        self.rot_decel = p3dx.ROT_DECEL
 
     # -- queries -------------------------------------------------------------
     def is_stopped(self) -> bool:
@@ -93,16 +102,19 @@ class Body:
         self.emergency_stop = True
 
     def step(self, dt: float, cmd: Command) -> None:
+        if self.holds:  # the motors do not answer: brake hard to a standstill
+            cmd = Command(0.0, 0.0, safe=False)
+            self.emergency_stop = self.emergency_stop or not self.is_stopped()
         want_v, want_w = cmd.vel, cmd.rot_vel
         self.limited_by_obstacle = False
-        trans_decel = cmd.trans_decel or p3dx.TRANS_DECEL
+        trans_decel = cmd.trans_decel or self.trans_decel
         if cmd.safe and want_v != 0.0:
             # ARIA's decelerating limiter: keep a margin, and never go faster than what TransDecel can
             # stop in the space left; brake harder (up to an emergency stop) when already too fast.
             speed = max(abs(self.vel), abs(want_v))
-            look = speed * speed / (2.0 * p3dx.TRANS_DECEL) + 1500.0
-            room = max(self.free_distance(want_v > 0, look) - SAFE_MARGIN_MM, 0.0)
-            limit = math.sqrt(2.0 * p3dx.TRANS_DECEL * room)
+            look = speed * speed / (2.0 * self.trans_decel) + 1500.0
+            room = max(self.free_distance(want_v > 0, look) - self.safe_margin[want_v > 0], 0.0)
+            limit = math.sqrt(2.0 * self.trans_decel * room)
             if abs(want_v) > limit:
                 want_v = math.copysign(limit if limit > 10.0 else 0.0, want_v)
                 self.limited_by_obstacle = True
@@ -120,9 +132,11 @@ class Body:
             want_w = max(-p3dx.ABSOLUTE_MAX_ROT_VEL, min(p3dx.ABSOLUTE_MAX_ROT_VEL, want_w))
             self.vel = _approach(self.vel, want_v, p3dx.TRANS_ACCEL, trans_decel, dt)
             self.rot_vel = _approach(
-                self.rot_vel, want_w, p3dx.ROT_ACCEL, cmd.rot_decel or p3dx.ROT_DECEL, dt
+                self.rot_vel, want_w, p3dx.ROT_ACCEL, cmd.rot_decel or self.rot_decel, dt
             )
         self._integrate(dt)
+        if "stall" in self.holds:
+            self.stalled = True
         self._drain(dt)
 
     def _integrate(self, dt: float) -> None:

@@ -47,6 +47,8 @@ from . import switch
 from .arconfig import SimArConfig
 from .catalogue import Row, custom_commands
 from .config import SimConfig
+from .files_data import add_default_folder
+from .geometry import Obstacles
 from .handlers import (
     BROADCAST_ONLY,
     Call,
@@ -57,6 +59,7 @@ from .handlers import (
     popup_payload,
     strings_payload,
 )
+from .heard import RequestLog
 from .mapserve import Chunks, ServedMap, load_map
 from .navmodes import NavMap
 from .profiles import get_profile
@@ -303,6 +306,9 @@ class Session:
             self.server.malformed_packets += self.conn.malformed_packets - malformed
             log.info("client %s: %d malformed control packet(s)", self.peer, self.conn.malformed_packets)
         for event in events:
+            if isinstance(event, (RequestOnce, RequestReceived)):
+                once = isinstance(event, RequestOnce)
+                self.server.heard.note(self.server.world.time, self.ident, self.peer, event.name, once=once)
             if isinstance(event, RequestOnce):
                 self.server.invoke(self, event.number, event.name, event.args, once=True)
             elif isinstance(event, RequestReceived):
@@ -343,9 +349,12 @@ class SimServer:
         self.profile = get_profile(cfg.profile)
         if cfg.protocol_version is None:
             cfg.protocol_version = self.profile.protocol_version
+        cfg.camera = cfg.camera and self.profile.camera
         self.handlers = self.profile.handler_table()
         self._module_commands = tuple(r for r in self.profile.module_parts()[0] if r[4] == "CustomCommands")
         self.map: ServedMap = self._load_map(cfg.map_path)
+        self.file_md5 = self.map.md5
+        """MD5 of the map file as last read (or written): ``checkMap`` reloads only when the file differs."""
         obstacles = self.map.obstacles()
         home = cfg.start_pose or self.map.home
         x, y = free_spot_near(obstacles, home[0], home[1], 250.0) if self.map.present else (home[0], home[1])
@@ -359,11 +368,15 @@ class SimServer:
         )
         self.home = (x, y, home[2])
         self.world.nav_map = self._nav_map()
-        self.datalist: DataList = self.profile.catalogue(camera=cfg.camera)
+        self.datalist: DataList = self.profile.catalogue(camera=cfg.camera, test_hooks=cfg.test_hooks)
+        if cfg.files_default_dir is not None:
+            add_default_folder(self.datalist, self.handlers, cfg.files_default_dir)
         self.users: UserTable | None = UserTable.load(cfg.users_path) if cfg.users_path else None
         self.sessions: list[Session] = []
         self.stop_log: deque[tuple[float, int, str]] = deque(maxlen=1000)
         """Every ``stop`` received: (world time, session ident, the client's self identifier)."""
+        self.heard = RequestLog()
+        """Every request of every connection, by name (tests: no observer ever sent a motion request)."""
         self._ids = count(1)
         self._server: asyncio.base_events.Server | None = None
         self._cycle_task: asyncio.Task[None] | None = None
@@ -646,8 +659,9 @@ class SimServer:
         return time.monotonic() if self.config.realtime else self.world.time
 
     def custom_commands(self) -> tuple[Row, ...]:
-        """serverDemo's simple commands, then the ones the profile's data modules add."""
-        return custom_commands(self.config.camera) + self._module_commands
+        """serverDemo's simple commands, then the ones the profile's data modules add (those it lists)."""
+        rows = custom_commands(self.config.camera) + self._module_commands
+        return tuple(r for r in rows if r[0] in self.datalist)
 
     def video_trailer(self) -> bytes:
         """The 2 bytes ARIA's video forwarder leaves after a picture (the upstream packet's checksum)."""
@@ -659,24 +673,38 @@ class SimServer:
         if path is None or not path.is_file():
             return False
         raw_md5 = hashlib.md5(path.read_bytes()).digest()
-        if raw_md5 == self.map.md5:
+        if raw_md5 == self.file_md5:
             return False
-        self.map = self._load_map(path)
-        obstacles = self.map.obstacles()
+        self.file_md5 = raw_md5
+        self.install_map(self._load_map(path), move_home=True)
+        return True
+
+    def install_map(
+        self, served: ServedMap, *, move_home: bool = False, obstacles: Obstacles | None = None
+    ) -> None:
+        """Serve ``served`` from now on (walls, navigation's grid, home); ``mapUpdated`` and ``goalsUpdated``
+        to every subscriber. ``move_home``: the robot starts again at the new map's home (``checkMap``)."""
+        self.map = self._profiled(served)
+        obstacles = obstacles or self.map.obstacles()
         home = self.config.start_pose or self.map.home
         x, y = free_spot_near(obstacles, home[0], home[1], 250.0)
         self.home = (x, y, home[2])
-        self.world.replace_obstacles(obstacles)
-        self.world.nav_map = self._nav_map()
+        if obstacles is not self.world.obstacles:
+            self.world.replace_obstacles(obstacles)
+        self.world.nav_map = nav = self._nav_map()
         self.world.home = self.home
-        self.reset_pose()
+        if move_home:
+            self.reset_pose()
+        if nav is not None and self.config.realtime:  # the new grid built aside, not in the next plan
+            asyncio.get_running_loop().run_in_executor(None, nav.grid)
         self.broadcast("mapUpdated")
         self.broadcast("goalsUpdated")
-        return True
 
     def _load_map(self, path):
         """The map file, served with the profile's first line (an LD robot's ``2D-Map-Ex4``)."""
-        served = load_map(path)
+        return self._profiled(load_map(path))
+
+    def _profiled(self, served: ServedMap) -> ServedMap:
         header = self.profile.map_header
         if header and served.present and served.lines:
             served.lines[0] = header
@@ -706,6 +734,7 @@ class SimServer:
         b.x, b.y, b.th = self.home
         b.vel = b.rot_vel = 0.0
         b.stalled = False
+        self.world.dock_mode.leave()  # put back on its home cairn, it is on no dock
         self.world.stop()
 
 

@@ -6,9 +6,11 @@ holds, so a client that asks every cycle costs the robot nothing extra. The
 simulator does the same for each picture size, in simulated time:
 
 * a request is answered at once with the latest frame when that frame is
-  younger than :data:`FRAME_PERIOD_S`, or was taken from exactly the view the
-  camera has now (a robot standing still is never rendered twice);
-* otherwise a new frame is rendered from the current view, and every request
+  younger than :data:`FRAME_PERIOD_S`;
+* otherwise a new frame is made — as a real camera delivers a fresh frame at its rate
+  whatever the robot does: a view that did not change is not ray-cast again, its
+  picture gets fresh sensor noise and a new time stamp (:func:`camera.refresh_frame`);
+  a new view is rendered — and every request
   for that size that arrives before it is ready waits for it and gets it
   (rather than the stale one: a client that asks after the period has passed
   sees a picture from after its request). At most one render per size is in
@@ -29,8 +31,11 @@ import concurrent.futures
 import logging
 from collections.abc import Callable, Hashable
 from dataclasses import dataclass
+from functools import partial
 
-from .camera import View, render_jpeg
+import numpy as np
+
+from .camera import View, refresh_frame, render_frame
 
 log = logging.getLogger("rtmu.sim")
 
@@ -51,6 +56,8 @@ class Frame:
     jpeg: bytes
     taken_at: float
     """Simulated time of the view it shows."""
+    pixels: np.ndarray
+    """The view's rendered scene, reused (with fresh noise) while the view does not change."""
 
 
 @dataclass(slots=True)
@@ -71,11 +78,13 @@ class VideoFeed:
             else None
         )
         self._latest: dict[Size, Frame] = {}
-        self._in_flight: dict[Size, asyncio.Future[bytes]] = {}
+        self._in_flight: dict[Size, asyncio.Future[tuple[np.ndarray, bytes]]] = {}
         self._waiting: dict[Size, dict[Hashable, _Waiter]] = {}
         self.quality = DEFAULT_QUALITY
         self.renders = 0
-        """Frames rendered since the start (for tests and the benchmark)."""
+        """Frames rendered (ray-cast) since the start (for tests and the benchmark)."""
+        self.refreshes = 0
+        """Fresh frames of a view that did not change (noise and stamp only)."""
 
     @property
     def executor(self) -> concurrent.futures.ThreadPoolExecutor | None:
@@ -94,10 +103,14 @@ class VideoFeed:
             self.quality = min(max(int(quality), 1), 95)
         size = view.size
         latest = self._latest.get(size)
-        if latest is not None and (latest.view == view or now - latest.taken_at < self.period - 1e-9):
+        if latest is not None and now - latest.taken_at < self.period - 1e-9:
             return latest.jpeg
+        if latest is not None and latest.view == view:
+            job = partial(refresh_frame, latest.pixels, self.quality, self.renders + self.refreshes)
+        else:
+            job = partial(render_frame, view, self.quality)
         if self._executor is None:
-            return self._store(view, now, render_jpeg(view, self.quality))
+            return self._store(view, now, job())
         waiting = self._waiting.setdefault(size, {})
         waiter = waiting.get(requester)
         if waiter is None:
@@ -106,17 +119,22 @@ class VideoFeed:
             waiter.owed = min(waiter.owed + 1, MAX_OWED_PER_WAITER)
         if size not in self._in_flight:
             loop = asyncio.get_running_loop()
-            future = loop.run_in_executor(self._executor, render_jpeg, view, self.quality)
+            future = loop.run_in_executor(self._executor, job)
             self._in_flight[size] = future
             future.add_done_callback(lambda f: self._rendered(view, now, f))
         return None
 
-    def _store(self, view: View, now: float, jpeg: bytes) -> bytes:
-        self.renders += 1
-        self._latest[view.size] = Frame(view, jpeg, now)
+    def _store(self, view: View, now: float, made: tuple[np.ndarray, bytes]) -> bytes:
+        pixels, jpeg = made
+        latest = self._latest.get(view.size)
+        if latest is not None and latest.pixels is pixels:
+            self.refreshes += 1
+        else:
+            self.renders += 1
+        self._latest[view.size] = Frame(view, jpeg, now, pixels)
         return jpeg
 
-    def _rendered(self, view: View, now: float, future: asyncio.Future[bytes]) -> None:
+    def _rendered(self, view: View, now: float, future: asyncio.Future[tuple[np.ndarray, bytes]]) -> None:
         size = view.size
         self._in_flight.pop(size, None)
         waiting = self._waiting.pop(size, {})

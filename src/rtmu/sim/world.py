@@ -9,6 +9,7 @@ from __future__ import annotations
 
 import math
 import random
+from collections.abc import Callable
 from dataclasses import dataclass, field
 
 import numpy as np
@@ -145,6 +146,8 @@ class World:
         self._popup_check_at = 0.0
         self._low_battery_warned = False
         self.last_activity = 0.0
+        self.step_hooks: list[Callable[[], None]] = []
+        """Called after every step (a scan log looking at the robot, :mod:`.mapping_data`)."""
         self.received_ratios: tuple[float, float, float, float] | None = None
         """The last ratioDrive exactly as received (the watchdog zeroes the mode's ratios, not this)."""
         self.ratio_drives_received = 0
@@ -198,6 +201,13 @@ class World:
         m = self.mode
         return (m.NAME, m.locked, m.locked and m.will_unlock)
 
+    def check_mode_info(self) -> None:
+        """Flag ``getModeInfo`` for broadcast when the active mode's name or lock changed."""
+        info = self.mode_info()
+        if info != self._mode_info:
+            self._mode_info = info
+            self.changes.mode_info = True
+
     def home_pose(self) -> tuple[float, float, float | None]:
         return self.home
 
@@ -247,6 +257,10 @@ class World:
     def localize_to(self, x: float, y: float, th: float) -> None:
         """``localizeToPose``: as ARNL with MobileSim, the simulated robot is put where the operator says
         (the nearest spot it fits, when that is inside something), then localizes for a moment."""
+        if self.nav_map is not None and not self._on_map(x, y):
+            # ARNL finds nothing of the map around a pose off it: it stays lost, the robot where it was.
+            self.localization.lose(self.time)
+            return
         fx, fy = free_spot_near(self.obstacles, x, y, p3dx.RADIUS_MM)
         b = self.body
         b.x, b.y, b.th = fx, fy, normalize_deg(th)
@@ -254,6 +268,12 @@ class World:
         b.stalled = False
         self._sonar_cache = self._laser_cache = None
         self.localization.start(self.time)
+
+    def _on_map(self, x: float, y: float) -> bool:
+        """True when (x, y) lies within the map's extent (its lines and points, a robot's width around)."""
+        lo_x, lo_y, hi_x, hi_y = self.obstacles.bounds
+        margin = p3dx.RADIUS_MM
+        return lo_x - margin <= x <= hi_x + margin and lo_y - margin <= y <= hi_y + margin
 
     def _jog(self) -> JogMode:
         if self.mode is not self.jog_mode:
@@ -273,10 +293,7 @@ class World:
         self.localization.tick(self.time)
         if self.waiting_modes and not self.mode.locked:
             self.activate(self.waiting_modes.pop(0))
-        info = self.mode_info()
-        if info != self._mode_info:
-            self._mode_info = info
-            self.changes.mode_info = True
+        self.check_mode_info()
         if (
             self.body.battery_v <= p3dx.BATTERY_SHUTDOWN_V
             and self.mode is not self.stop_mode
@@ -286,6 +303,8 @@ class World:
         self._check_battery()
         self._check_popups()
         self.check_strings()
+        for hook in self.step_hooks:
+            hook()
 
     def check_strings(self) -> None:
         now = self.strings()
@@ -385,6 +404,9 @@ class World:
     # -- questions --------------------------------------------------------------
     def strings(self) -> tuple[str, str, str]:
         m = self.mode
+        said = held_words(self.body.holds)
+        if said:  # the simulator's own words for a robot whose motors do not answer
+            return (said, m.mode_string, said)
         return (m.status, m.mode_string, m.extended_status)
 
     def sonar(self) -> list[tuple[int, int]]:
@@ -432,6 +454,15 @@ class World:
             b.collisions,
             r.timeouts,
         )
+
+
+def held_words(holds: set[str]) -> str:
+    """The status the simulator shows while its e-stop is pressed or its motors are off ("" otherwise)."""
+    if "estop" in holds:
+        return "EStop pressed"
+    if "motors" in holds:
+        return "Motors disabled"
+    return ""
 
 
 def free_spot_near(obstacles: Obstacles, x: float, y: float, radius: float) -> tuple[float, float]:

@@ -1,21 +1,11 @@
 """What the network subcommands share: ``HOST[:PORT]``, login options, exit codes, one-line errors.
 
 Every network subcommand takes ``HOST[:PORT]`` (default port 7272; ``[::1]:7272``
-for IPv6), ``--user``, ``--password-file`` (or a prompt — a password is never
-accepted on the command line, where other users could read it in ``ps``) and
-``--timeout``. Failures print ONE line on stderr (``rtmu NAME: what went wrong``)
-and exit with a code scripts can rely on (constants in ``rtmu.cli``):
-
-=======  =========================================================
-0        ok
-2        usage error (bad arguments)
-3        connection or login failure (refused, unreachable, rejected, closed),
-         or the server sent something malformed
-4        the server does not offer what is needed
-5        timeout
-128 + N  ended by signal N, shell style: 129 SIGHUP, 130 SIGINT (Ctrl-C),
-         131 SIGQUIT, 143 SIGTERM, 148 SIGTSTP (``rtmu drive`` after Ctrl-Z)
-=======  =========================================================
+for IPv6), ``--user``, ``--password-file``, ``--password-stdin`` (or a prompt on a terminal —
+a password is never accepted on the command line, where other users could read it in ``ps``,
+nor read from a pipe unless ``--password-stdin`` says so) and ``--timeout``. Failures print
+ONE line on stderr (``rtmu NAME: what went wrong``) and exit with a code of the one table in
+:mod:`rtmu.base.exit_codes` (printed by every ``--help``).
 
 Signals: SIGINT, SIGTERM, SIGHUP (a closed terminal or SSH session), SIGQUIT, SIGUSR1/2 and
 SIGALRM end a command through its ``finally`` blocks — ``rtmu drive`` always sends zero ratios and
@@ -36,14 +26,16 @@ import signal
 import sys
 from collections.abc import Awaitable, Callable
 from pathlib import Path
-from typing import Any
+from typing import Any, TypeVar
 
+from ..base.exit_codes import EXIT_CONNECTION, EXIT_SIGPIPE, EXIT_USAGE
 from ..client.connection import CONNECT_TIMEOUT, DEFAULT_PORT, AriaClient
 from ..client.errors import ClientError
-from ..exit_codes import EXIT_CONNECTION, EXIT_OK, EXIT_USAGE
+from ..client.roles import Role
 from ..protocol.errors import ProtocolError
 
 MAX_PASSWORD_FILE = 4096
+T = TypeVar("T")
 
 
 def host_port(text: str) -> tuple[str, int]:
@@ -87,7 +79,7 @@ class _RefusePassword(argparse.Action):
     ) -> None:
         parser.error(
             "a password is never accepted on the command line (other users can read it with ps); "
-            "use --password-file FILE, or give --user alone to be asked for it"
+            "use --password-file FILE, --password-stdin, or give --user alone to be asked for it"
         )
 
 
@@ -113,7 +105,9 @@ def _refuse_unknown_quietly(parser: argparse.ArgumentParser) -> None:
     parser.parse_known_args = parse_known_args  # type: ignore[method-assign,assignment]
 
 
-def add_connection_arguments(parser: argparse.ArgumentParser) -> None:
+def add_connection_arguments(parser: argparse.ArgumentParser, *, robot: bool = True) -> None:
+    """``HOST[:PORT]``, the login options, ``--timeout``; ``robot``: also ``--robot NAME`` (through a
+    central server), which a command that lists the central server's robots itself does not take."""
     # No abbreviations: "--password secret" must not be taken for "--password-file secret".
     parser.allow_abbrev = False
     _refuse_unknown_quietly(parser)
@@ -121,13 +115,20 @@ def add_connection_arguments(parser: argparse.ArgumentParser) -> None:
     parser.add_argument(
         "server", type=host_port, metavar="HOST[:PORT]", help="robot server (port 7272 by default)"
     )
-    parser.add_argument("--user", default="", help="user name, if the server has a user file")
+    parser.add_argument("--user", default="", metavar="USER", help="user name, if the server has a user file")
     parser.add_argument("--password", nargs="?", action=_RefusePassword, help=argparse.SUPPRESS)
     parser.add_argument(
         "--password-file",
         type=Path,
         metavar="FILE",
-        help="read the password from the first line of FILE (else it is asked for when --user is given)",
+        help="read the password from the first line of FILE (else it is asked for on the terminal when "
+        "--user is given)",
+    )
+    parser.add_argument(
+        "--password-stdin",
+        action="store_true",
+        help="read the password from the first line of standard input (for scripts; nothing else reads "
+        "a password from a pipe)",
     )
     parser.add_argument(
         "--protocol",
@@ -143,13 +144,14 @@ def add_connection_arguments(parser: argparse.ArgumentParser) -> None:
         metavar="S",
         help=f"seconds to wait for the server at each step (default {CONNECT_TIMEOUT:g})",
     )
-    parser.add_argument(
-        "--robot",
-        metavar="NAME",
-        default=None,
-        help="HOST[:PORT] is an ARIA central server: act on its robot NAME, through the port it "
-        "forwards that robot on ('rtmu fleet HOST' lists them)",
-    )
+    if robot:
+        parser.add_argument(
+            "--robot",
+            metavar="NAME",
+            default=None,
+            help="HOST[:PORT] is an ARIA central server: act on its robot NAME, through the port it "
+            "forwards that robot on ('rtmu fleet HOST' lists them)",
+        )
 
 
 def _resolve_robot_first(parser: argparse.ArgumentParser) -> None:
@@ -186,8 +188,8 @@ def resolve_robot(args: argparse.Namespace) -> int | None:
     None when done; else the exit code, after one line on stderr: 2 for a name the central server
     does not list (naming the ones it does), 3/4/5 as for any login.
     """
-    from ..client.central import list_robots
-    from ..textsafe import visible
+    from ..base.textsafe import visible
+    from ..client.central import AmbiguousRobot, find_robot, list_robots
 
     name = str(getattr(args, "subcommand", None) or "rtmu")
     try:
@@ -198,22 +200,23 @@ def resolve_robot(args: argparse.Namespace) -> int | None:
         return fail(name, "cancelled", EXIT_USAGE)
     host, port = args.server
     try:
-        robots = asyncio.run(list_robots(host, port, args.user, password, timeout=args.timeout))
+        robots = run_interruptibly(lambda: list_robots(host, port, args.user, password, timeout=args.timeout))
     except ClientError as exc:
         return fail(name, f"central server {host}:{port}: {exc}", exc.exit_code)
     except ProtocolError as exc:
         return fail(name, f"central server {host}:{port} sent a malformed robot list: {exc}", EXIT_CONNECTION)
-    except KeyboardInterrupt:
-        return fail(name, "interrupted by SIGINT", 128 + signal.SIGINT)
+    except Interrupted as exc:
+        return fail(name, str(exc), exc.exit_code)
     wanted = args.robot
-    found = [e for e, _ in robots if e.name == wanted] or [
-        e for e, _ in robots if e.name.lower() == wanted.lower()
-    ]
-    if not found:
+    try:
+        found = find_robot(robots, wanted)  # without case, as ARIA compares; several: refused
+    except AmbiguousRobot as exc:
+        return fail(name, str(exc), EXIT_USAGE)
+    if found is None:
         listed = visible(", ".join(e.name for e, _ in robots) or "none")
         where = f"behind the central server {host}:{port}"
         return fail(name, f"no robot {wanted!r} {where} (robots: {listed})", EXIT_USAGE)
-    args.server = (found[0].host, found[0].port)
+    args.server = (found.host, found.port)
     return None
 
 
@@ -222,7 +225,8 @@ class UsageError(Exception):
 
 
 def read_password(args: argparse.Namespace) -> str:
-    """From ``--password-file``, else a prompt on the terminal (or one line of stdin when piped)."""
+    """From ``--password-file``, ``--password-stdin`` or a prompt on the terminal; :class:`UsageError`
+    (exit 2, with the reason) when ``--user`` is given and none of them can supply it."""
     cached = getattr(args, "password_read", None)
     if isinstance(cached, str):  # asked already (for the central server of --robot): never twice
         return cached
@@ -246,12 +250,19 @@ def _read_password(args: argparse.Namespace) -> str:
         except OSError as exc:
             raise UsageError(f"cannot read the password file {path}: {exc.strerror or exc}") from None
         return data.decode("utf-8", "replace").splitlines()[0] if data else ""
+    if getattr(args, "password_stdin", False):
+        line = sys.stdin.readline() if sys.stdin is not None else ""
+        if not line:
+            raise UsageError("--password-stdin: standard input ended without a password line")
+        return line.rstrip("\r\n")
     if not args.user:
         return ""
     if sys.stdin is not None and sys.stdin.isatty():
         return getpass.getpass(f"Password for {args.user}@{args.server[0]}: ")
-    line = sys.stdin.readline() if sys.stdin is not None else ""
-    return line.rstrip("\r\n")
+    raise UsageError(
+        f"--user {args.user} needs a password and there is no terminal to ask on: give --password-file "
+        "FILE or --password-stdin (one line on standard input)"
+    )
 
 
 INTERRUPT_SIGNALS = (
@@ -277,14 +288,22 @@ class Interrupted(Exception):
         super().__init__(f"interrupted by {signal_name(signum)}" + (f"; {detail}" if detail else ""))
 
 
-async def until_stop_signal() -> None:
-    """Wait for Ctrl-C or SIGTERM: how a long-running server (``rtmu sim``) is told to stop cleanly."""
+async def until_stop_signal() -> int:
+    """Wait for Ctrl-C, SIGTERM or SIGHUP: how a long-running server (``rtmu sim``) is told to stop
+    cleanly. Returns the exit code that says which came (128 + its number, as every command)."""
     stop = asyncio.Event()
+    came: list[int] = []
     loop = asyncio.get_running_loop()
-    for sig in (signal.SIGINT, signal.SIGTERM):
+
+    def caught(signum: int) -> None:
+        came.append(signum)
+        stop.set()
+
+    for sig in (signal.SIGINT, signal.SIGTERM, signal.SIGHUP):
         with contextlib.suppress(NotImplementedError, RuntimeError):
-            loop.add_signal_handler(sig, stop.set)
+            loop.add_signal_handler(sig, caught, sig)
     await stop.wait()
+    return 128 + came[0]
 
 
 def signal_name(signum: int) -> str:
@@ -397,14 +416,42 @@ def current_password() -> str:
 
 
 def fail(name: str, message: str, code: int) -> int:
-    from ..textsafe import visible
+    from ..base.textsafe import visible
 
     print(f"rtmu {name}: {visible(message)}", file=sys.stderr)
     return code
 
 
-def run_with_client(name: str, args: argparse.Namespace, body: Callable[[AriaClient], Awaitable[int]]) -> int:
-    """Log in, run ``body(client)``, always disconnect; map every failure to an exit code and one line."""
+def run_interruptibly(main: Callable[[], Awaitable[T]]) -> T:
+    """``asyncio.run(main())`` with every ending signal (:data:`INTERRUPT_SIGNALS`) turned into
+    :class:`Interrupted` — exit 128 + N — after the command's ``finally`` blocks ran, whenever it comes
+    (before the handlers are in place, mid-command, or while the command is already ending)."""
+    interrupts = Interrupts()
+
+    async def guarded() -> T:
+        interrupts.install()
+        _INTERRUPTS.set(interrupts)
+        try:
+            return await main()
+        except asyncio.CancelledError:
+            signum = interrupts.take()
+            if signum is None:
+                raise
+            raise Interrupted(signum) from None
+
+    try:
+        return asyncio.run(guarded())
+    except (KeyboardInterrupt, asyncio.CancelledError):
+        raise Interrupted(interrupts.signum or signal.SIGINT) from None
+
+
+def run_with_client(
+    name: str, args: argparse.Namespace, body: Callable[[AriaClient], Awaitable[int]], *, role: Role
+) -> int:
+    """Log in as ``role``, run ``body(client)``, always disconnect; every failure → an exit code and one line.
+
+    Every command says its role: an OBSERVER's client cannot send a motion request on any path.
+    """
     try:
         password = read_password(args)
     except UsageError as exc:
@@ -417,17 +464,14 @@ def run_with_client(name: str, args: argparse.Namespace, body: Callable[[AriaCli
     async def main() -> int:
         host, port = args.server
         client = AriaClient()
-        interrupts = Interrupts()
-        interrupts.install()
-        _INTERRUPTS.set(interrupts)
         _PASSWORD.set(password)
         try:
             await client.connect(
-                host, port, args.user, password, timeout=args.timeout, protocol=args.protocol
+                host, port, args.user, password, timeout=args.timeout, protocol=args.protocol, role=role
             )
             return await body(client)
         except asyncio.CancelledError:
-            signum = interrupts.take()
+            signum = current_interrupts().take()
             if signum is None:
                 raise
             raise Interrupted(signum) from None
@@ -435,7 +479,7 @@ def run_with_client(name: str, args: argparse.Namespace, body: Callable[[AriaCli
             await client.disconnect()
 
     try:
-        return asyncio.run(main())
+        return run_interruptibly(main)
     except Interrupted as exc:
         return fail(name, str(exc), exc.exit_code)
     except ClientError as exc:
@@ -444,11 +488,9 @@ def run_with_client(name: str, args: argparse.Namespace, body: Callable[[AriaCli
         return fail(name, f"the server sent something malformed: {exc}", EXIT_CONNECTION)
     except UsageError as exc:
         return fail(name, str(exc), EXIT_USAGE)
-    except (KeyboardInterrupt, asyncio.CancelledError):  # Ctrl-C before the handlers were in place
-        return fail(name, "interrupted by SIGINT", 128 + signal.SIGINT)
     except BrokenPipeError:  # e.g. piped into ``head``: the reader has what it wanted
         _silence_stdout()
-        return EXIT_OK
+        return EXIT_SIGPIPE
     except OSError as exc:  # e.g. writing the output file
         return fail(name, str(exc), EXIT_CONNECTION if isinstance(exc, ConnectionError) else EXIT_USAGE)
 
@@ -468,7 +510,7 @@ def print_json(obj: Any) -> None:
     """One JSON line: the exact strings, with characters that act on a terminal as ``\\uXXXX``."""
     import json
 
-    from ..textsafe import json_safe
+    from ..base.textsafe import json_safe
 
     print(json_safe(json.dumps(obj, separators=(",", ":"), ensure_ascii=False)), flush=True)
 
@@ -496,7 +538,7 @@ def status_object(numbers: Any, status: str, mode: str, *, soc: bool = False) ->
 
 
 def status_line(obj: dict[str, Any]) -> str:
-    from ..textsafe import visible
+    from ..base.textsafe import visible
 
     battery = f"{obj['battery_pct']:.0f} %" if "battery_pct" in obj else f"{obj['battery_v']:.1f} V"
     return (
@@ -517,7 +559,6 @@ async def battery_is_soc(client: AriaClient, timeout: float) -> bool:
 
 async def fetch_status(client: AriaClient, timeout: float) -> dict[str, Any]:
     """One status from ``updateNumbers`` + ``updateStrings`` (or the old ``update``)."""
-    from ..client.errors import NotSupported
     from ..protocol.payloads.robot import Update, UpdateNumbers, UpdateStrings
 
     if client.supports("updateNumbers"):
@@ -534,18 +575,32 @@ async def fetch_status(client: AriaClient, timeout: float) -> dict[str, Any]:
         assert isinstance(update, Update)
         soc = await battery_is_soc(client, timeout)
         return status_object(update.numbers, update.status, update.mode, soc=soc)
-    raise NotSupported("updateNumbers", "this server offers no robot status (updateNumbers or update)")
+    raise no_status(client)
 
 
-def unknown_name(command: str, kind: str, name: str, known: tuple[str, ...]) -> bool:
-    """True (with one line on stderr naming what the server does list) when ``name`` is not in
-    ``known``: a route or goal the server does not have is the user's mistake (exit 2)."""
+def no_status(client: AriaClient) -> Exception:
+    """Why there is no robot status: ARIA's central server has robots, not a status of its own."""
+    from ..client.diagnosis import central_server_words
+    from ..client.errors import NotSupported
+
+    if client.supports("clientList"):
+        return NotSupported("updateNumbers", central_server_words(f"{client.host}:{client.port}"))
+    return NotSupported("updateNumbers", "this server offers no robot status (updateNumbers or update)")
+
+
+def known_name(command: str, kind: str, name: str, known: tuple[str, ...]) -> str | None:
+    """The server's own spelling of ``name`` among ``known``, compared case-insensitively as ARIA
+    compares goal names (an exact match first); None, with one line on stderr naming what the
+    server does list, when it has no such name — the user's mistake (exit 2)."""
     if name in known:
-        return False
-    from ..textsafe import visible
+        return name
+    folded = [k for k in known if k.casefold() == name.casefold()]
+    if len(folded) == 1:
+        return folded[0]
+    from ..base.textsafe import visible
 
     listed = visible(", ".join(known) or "none")
     print(
         f"rtmu {command}: no {kind} {visible(repr(name))} on this server ({kind}s: {listed})", file=sys.stderr
     )
-    return True
+    return None

@@ -17,25 +17,27 @@ from collections.abc import Callable
 from dataclasses import dataclass
 from typing import Any
 
+from ..base.exit_codes import EXIT_CANCELLED, EXIT_LOST, EXIT_OK, EXIT_REFUSED, EXIT_TIMEOUT, NETWORK
+from ..base.textsafe import visible
 from ..client.connection import AriaClient, Packet
 from ..client.errors import ClientError, NotSupported
-from ..client.nav_status import NavPhase, NavReading, path_remaining, read_status
-from ..exit_codes import EXIT_OK, EXIT_TIMEOUT
+from ..client.nav_status import NavReading, path_remaining, read_status
 from ..protocol.errors import ProtocolError
 from ..protocol.payloads import Payload, Side, decode_payload
 from ..protocol.payloads.drive import RatioDrive
 from ..protocol.payloads.ld import DockInfo
 from ..protocol.payloads.navigation import LocalizationState, LocState, PlannedPath
 from ..protocol.payloads.robot import ModeInfo, Update, UpdateNumbers, UpdateStrings
-from ..textsafe import visible
-from ._common import Interrupted, current_interrupts, positive_float, print_json
+from ..values.state import NavOutcome
+from ._common import Interrupted, current_interrupts, positive_float, print_json, signal_name
 
-EXIT_NAV_FAILED = 6
+EXIT_NAV_FAILED = EXIT_REFUSED
 """The server could not get there (``Failed to get to …``, ``Failed to plan to …``, ``Failed dock``)."""
-EXIT_NAV_CANCELLED = 7
+EXIT_NAV_CANCELLED = EXIT_CANCELLED
 """It stopped before arriving: someone pressed STOP, drove, or sent the robot elsewhere."""
-EXIT_NAV_LOST = 8
+EXIT_NAV_LOST = EXIT_LOST
 """The robot is lost: navigation failed for that, or ``rtmu localize`` ended lost. Localize it first."""
+NAVIGATION_EXITS = (*NETWORK, EXIT_REFUSED, EXIT_CANCELLED, EXIT_LOST)
 
 DEFAULT_LIMIT = 600.0
 SETTLE = 1.5
@@ -47,32 +49,27 @@ DISTANCE_STEP_MM = 1000.0
 """Print the distance left when it changed by this much (and no oftener than DISTANCE_EVERY s)."""
 DISTANCE_EVERY = 2.0
 
-EXIT_CODES_HELP = (
-    "Exit codes: 0 arrived (docked, localized), 2 usage or unknown goal, 3 connection or login failure, "
-    f"4 the server does not navigate that way, 5 no outcome within --limit (the robot is stopped), "
-    f"{EXIT_NAV_FAILED} the server could not get there, {EXIT_NAV_CANCELLED} stopped before arriving "
-    f"(STOP, a drive, another goal), {EXIT_NAV_LOST} the robot is lost (localize it first), 128+N ended "
-    "by signal N (130 Ctrl-C, 143 SIGTERM, 129 SIGHUP) after sending stop"
-)
 
-
-def add_wait_arguments(parser: argparse.ArgumentParser) -> None:
-    parser.add_argument(
-        "--limit",
-        type=positive_float,
-        default=DEFAULT_LIMIT,
-        metavar="S",
-        help=f"give up after S seconds: stop the robot, exit 5 (default {DEFAULT_LIMIT:g})",
-    )
-    parser.add_argument(
-        "--no-wait", action="store_true", help="send the command and exit 0; the robot drives on by itself"
-    )
-    parser.add_argument(
-        "--json",
-        action="store_true",
-        help='one object per line: {"status", "phase"} as the server reports, then {"outcome", "text", '
-        '"reason", "x", "y", "th"}',
-    )
+def add_wait_arguments(parser: argparse.ArgumentParser, *, localizing: bool = False) -> None:
+    """``--limit``, ``--no-wait``, ``--json``: how long to follow the server's words, how to print them."""
+    if localizing:
+        limit = f"give up waiting for the server's answer after S seconds, exit 5 (default {DEFAULT_LIMIT:g})"
+        no_wait = "send localizeToPose and exit 0 without waiting for the server to confirm it"
+        lines = (
+            'one object per line: {"localization": "initializing"} while it '
+            'localizes, then {"outcome": "localized" | "lost" | "timeout", "score"}; --no-wait: {"sent"}'
+        )
+    else:
+        limit = f"give up after S seconds: stop the robot, exit 5 (default {DEFAULT_LIMIT:g})"
+        no_wait = "send the command and exit 0; the robot drives on by itself"
+        lines = (
+            'one object per line: {"status", "phase"} as the server reports, '
+            '{"remaining_mm"} every metre or so, and a last {"outcome", "text", "reason", "x", "y", "th"} '
+            '(also after Ctrl-C: outcome "interrupted", with "signal"); --no-wait: {"sent"}'
+        )
+    parser.add_argument("--limit", type=positive_float, default=DEFAULT_LIMIT, metavar="S", help=limit)
+    parser.add_argument("--no-wait", action="store_true", help=no_wait)
+    parser.add_argument("--json", action="store_true", help=lines)
 
 
 def require(client: AriaClient, name: str, what: str) -> None:
@@ -99,11 +96,11 @@ class Expect:
     docked: bool = False
 
     def answers(self, r: NavReading) -> bool:
-        if r.phase is NavPhase.FAILED:
+        if r.phase is NavOutcome.FAILED:
             return True
-        if r.phase is NavPhase.DOCKED:
+        if r.phase is NavOutcome.DOCKED:
             return self.docked
-        return r.phase is NavPhase.ARRIVED and not self.docked and r.target == self.target
+        return r.phase is NavOutcome.ARRIVED and not self.docked and r.target == self.target
 
 
 class _Watch:
@@ -120,8 +117,10 @@ class _Watch:
 
     def reading(self) -> NavReading:
         r = read_status(self.status, self.mode_name)
-        if r.phase is NavPhase.IDLE and self.dock_state in ("Docking", "Docked"):
-            phase = NavPhase.GOING if self.dock_state == "Docking" else NavPhase.DOCKED
+        # An LD robot says its docking in dockInfo; its status may still read "Arrived at …" from the goto
+        # before, so the dock state answers unless the status says it is on its way somewhere.
+        if r.phase is not NavOutcome.GOING and self.dock_state in ("Docking", "Docked"):
+            phase = NavOutcome.GOING if self.dock_state == "Docking" else NavOutcome.DOCKED
             return NavReading(phase, "dock", text=self.dock_state)
         return r
 
@@ -238,7 +237,7 @@ async def _follow(
                 if r.text and r.text != shown and (r.text != before.text or now - sent_at >= SETTLE):
                     shown = r.text
                     _say(args, {"status": r.text, "phase": r.phase.value}, visible(r.text))
-                if r.phase is NavPhase.GOING:
+                if r.phase is NavOutcome.GOING:
                     seen_going = True
                     left = path_remaining(*watch.pose[:2], watch.path) if watch.pose and watch.path else None
                     if (
@@ -252,7 +251,7 @@ async def _follow(
                     fresh = seen_going or r.text != before.text or now - sent_at >= SETTLE
                     if fresh:
                         return _outcome(args, watch, r)
-                elif seen_going and (r.phase is NavPhase.IDLE or r.finished):
+                elif seen_going and (r.phase is NavOutcome.NONE or r.finished):
                     # Stopped, driven, or finished somewhere else: someone took the robot over.
                     return _ended(args, watch, r, "cancelled", EXIT_NAV_CANCELLED)
                 watch.changed.clear()
@@ -271,11 +270,13 @@ async def _follow(
             raise
         stop_robot(client)  # the stop first, before anything is printed
         await client.flush()
+        if args.json:  # the promised last line: how it ended, and where the robot was
+            print_json({"outcome": "interrupted", "signal": signal_name(signum), **_pose_fields(watch)})
         raise Interrupted(signum, "the robot was stopped") from None
 
 
 def _outcome(args: argparse.Namespace, watch: _Watch, r: NavReading) -> int:
-    if r.phase is NavPhase.FAILED:
+    if r.phase is NavOutcome.FAILED:
         lost = r.reason == "the robot is lost"
         code = EXIT_NAV_LOST if lost else EXIT_NAV_FAILED
         return _ended(args, watch, r, "failed", code)

@@ -5,19 +5,20 @@ from __future__ import annotations
 import dataclasses
 import sys
 
+from ..base.exit_codes import EXIT_CONNECTION, EXIT_USAGE
 from ..sim import SimConfig
 from ._common import until_stop_signal
 
-EXIT_OK = 0
-EXIT_BAD_INPUT = 2
-EXIT_CANNOT_LISTEN = 3
+EXIT_BAD_INPUT = EXIT_USAGE
+EXIT_CANNOT_LISTEN = EXIT_CONNECTION
 
 
 async def serve_central(cfg: SimConfig, robot_port: int, robots: int) -> int:
     """Serve until SIGINT/SIGTERM; ``cfg`` is the robots' template (map, camera, seed…)."""
-    from ..maps import MapFormatError
+    from ..mapfile import MapFormatError
     from ..sim import SimServer
     from ..sim.central import CentralConfig, CentralServer
+    from ..sim.multi import start_poses
 
     # The user file guards the central port and the forwarders, as ARIA's switchServer's does; the
     # robots behind it let the forwarder in (it logs in without a user).
@@ -37,9 +38,11 @@ async def serve_central(cfg: SimConfig, robot_port: int, robots: int) -> int:
     )
     sims: list[SimServer] = []
     try:
-        for i in range(1, robots + 1):
+        # Start poses apart, as `rtmu sim --robots N` gives them (not all on the map's home).
+        for i, pose in enumerate(start_poses(cfg, robots), start=1):
             robot_cfg = dataclasses.replace(
                 cfg,
+                start_pose=pose,
                 port=0,
                 seed=cfg.seed + i - 1,
                 switch_to=f"{cfg.host}:{central.robot_port}",
@@ -52,9 +55,9 @@ async def serve_central(cfg: SimConfig, robot_port: int, robots: int) -> int:
             sims.append(sim)
         if robots:
             print(f"rtmu sim: {robots} simulated robot(s) switching to it: robot1…robot{robots}", flush=True)
-        await until_stop_signal()
+        code = await until_stop_signal()
         print("rtmu sim: stopping (telling operators and robots SHUTDOWN)", flush=True)
-        return EXIT_OK
+        return code
     except (OSError, MapFormatError, ValueError) as exc:
         print(f"rtmu sim: cannot start the robots: {exc}", file=sys.stderr)
         return EXIT_BAD_INPUT

@@ -1,34 +1,42 @@
 """``rtmu bridge HOST[:PORT] --foxglove [--port 8765] [--allow-drive]``: the robot, live, in Foxglove.
 
 Follows the robot as the window does and serves the recorder's decoded channels on a
-Foxglove WebSocket server (127.0.0.1 unless ``--bind`` says otherwise). Nothing drives
-unless ``--allow-drive``: then Twist-shaped JSON that a Foxglove client publishes
-(Teleop panel, ``/cmd_vel``, publish rate 5 Hz or more) drives through the session's
-drive lease with the window's stop rules, and a guardian process stops the robot if
-this process dies. Ends after ``--seconds`` or at Ctrl-C / SIGTERM / SIGHUP, stopping the
+Foxglove WebSocket server (127.0.0.1 unless ``--bind`` says otherwise). Only Foxglove's own
+app origins (and ``--allow-origin``) and this machine's names (and ``--allow-host``) may
+connect (:mod:`rtmu.recorder.foxglove_gate`). Nothing drives unless ``--allow-drive``: then
+every client must open the URL printed at the start (it carries a fresh token), one client
+drives at a time, and Twist-shaped JSON it publishes (Teleop panel, ``/cmd_vel``, publish
+rate 5 Hz or more) drives through the session's drive lease with the window's stop rules,
+and a guardian process stops the robot if this process dies; on an address other than
+loopback it warns. Ends after ``--seconds`` or at Ctrl-C / SIGTERM / SIGHUP, stopping the
 robot first.
 """
 
 from __future__ import annotations
 
 import argparse
-import signal
 import sys
-import threading
 from typing import Any
+from urllib.parse import quote
 
+from ..base.exit_codes import EXIT_CONNECTION, EXIT_OK, EXIT_USAGE
+from ..base.notices import Notice
+from ..base.textsafe import visible
 from ..client.errors import ClientError
+from ..client.roles import Role
 from ..client.runner import ClientRunner
 from ..client.session import SessionConfig
-from ..exit_codes import EXIT_CONNECTION, EXIT_OK, EXIT_USAGE
-from ..notices import Notice
 from ..recorder.bridge import DEFAULT_PORT, LEASE_TTL, Bridge, DriveLimits
-from ..textsafe import visible
-from ._common import UsageError, add_connection_arguments, fail, positive_float, read_password
-from ._follow import follow
+from ..recorder.foxglove_gate import FOXGLOVE_ORIGINS, Gate, loopback_only
+from ._common import UsageError, add_connection_arguments, fail, positive_float, read_password, signal_name
+from ._follow import EndingSignals, follow, until_connected
+from ._options import add_fps_option
 
 BEAT = 0.04
 """The main thread beats for the guardian as the window's UI thread does."""
+APP = "https://app.foxglove.dev/?ds=foxglove-websocket&ds.url="
+TOLD_REFUSALS = 20
+"""Refused handshakes said one by one; after that every 100th (a port scan must not flood the terminal)."""
 
 
 def register(subparsers: Any) -> None:
@@ -41,24 +49,48 @@ def register(subparsers: Any) -> None:
     )
     add_connection_arguments(p)
     p.add_argument("--foxglove", action="store_true", required=True, help="a Foxglove WebSocket server")
-    p.add_argument("--port", dest="ws_port", type=int, default=DEFAULT_PORT, metavar="PORT",
+    p.add_argument("--ws-port", dest="ws_port", type=int, default=DEFAULT_PORT, metavar="PORT",
                    help=f"its port (default {DEFAULT_PORT}; 0: any free one, printed)")  # fmt: skip
-    p.add_argument("--bind", default="127.0.0.1", metavar="ADDR", help="its address (default 127.0.0.1)")
+    p.add_argument("--port", dest="ws_port", type=int, help=argparse.SUPPRESS)  # its old name
+    p.add_argument(
+        "--bind",
+        default="127.0.0.1",
+        metavar="ADDR",
+        help="its address (default 127.0.0.1: this machine only; 0.0.0.0 lets the network in)",
+    )
     p.add_argument(
         "--allow-drive",
         action="store_true",
-        help="let Twist messages from Foxglove clients (/cmd_vel, at 5 Hz or more) drive the robot",
+        help="let Twist messages from Foxglove clients (/cmd_vel, at 5 Hz or more) drive the robot, one "
+        "client at a time; every client must then open the URL printed at the start (it holds a token)",
+    )
+    p.add_argument(
+        "--allow-origin",
+        action="append",
+        default=[],
+        metavar="ORIGIN",
+        help="also let browser pages from ORIGIN connect (repeatable; default: Foxglove's own only, "
+        + ", ".join(sorted(FOXGLOVE_ORIGINS))
+        + ")",
+    )
+    p.add_argument(
+        "--allow-host",
+        action="append",
+        default=[],
+        metavar="NAME",
+        help="also accept requests for host NAME (repeatable; default: IP addresses, localhost and this "
+        "machine's names only)",
     )
     p.add_argument("--throttle", type=positive_float, default=50.0, metavar="PCT",
                    help="throttle of bridge drives, %% (default 50)")  # fmt: skip
-    p.add_argument("--camera-hz", type=float, default=0.0, metavar="HZ", help="ask for camera pictures")
+    add_fps_option(p, default=0.0, none_means="no pictures")
     p.add_argument("--seconds", type=positive_float, default=None, metavar="S", help="stop after S seconds")
     p.set_defaults(handler=handle)
 
 
 def handle(args: argparse.Namespace) -> int:
     if not 0 <= args.ws_port <= 65535:
-        return fail("bridge", f"--port {args.ws_port} is not 0…65535", EXIT_USAGE)
+        return fail("bridge", f"--ws-port {args.ws_port} is not 0…65535", EXIT_USAGE)
     if args.throttle > 100:
         return fail("bridge", "--throttle is at most 100", EXIT_USAGE)
     try:
@@ -67,12 +99,12 @@ def handle(args: argparse.Namespace) -> int:
         return fail("bridge", str(exc), EXIT_USAGE)
     except (KeyboardInterrupt, EOFError):
         return fail("bridge", "cancelled", EXIT_USAGE)
-    host, port = args.server
 
     def tell(notice: Notice) -> None:
         print(f"rtmu bridge: {visible(notice.text)}", file=sys.stderr)
 
-    config = SessionConfig(connect_timeout=args.timeout, guardian=args.allow_drive)
+    role = Role.OPERATOR if args.allow_drive else Role.OBSERVER  # read-only: it cannot command at all
+    config = SessionConfig(connect_timeout=args.timeout, guardian=args.allow_drive, role=role)
     runner = ClientRunner(config=config, lease_ttl=LEASE_TTL)
     runner.on_notice = tell
     bridge = Bridge(
@@ -80,7 +112,10 @@ def handle(args: argparse.Namespace) -> int:
         port=args.ws_port,
         lease=runner.lease if args.allow_drive else None,
         limits=DriveLimits(throttle=args.throttle),
+        gate=Gate.make(allow_origins=args.allow_origin, allow_hosts=args.allow_host),
     )
+    bridge.server.on_refused = _refusals_told()
+    warn_exposure(args.bind, args.allow_drive)
     runner.on_publish = bridge.published
     runner.on_notice_sent = bridge.notice
 
@@ -93,31 +128,83 @@ def handle(args: argparse.Namespace) -> int:
             )
 
     runner.on_stop = stopped
-    ended = threading.Event()
-    ending = (signal.SIGINT, signal.SIGTERM, signal.SIGHUP)
-    previous = {s: signal.signal(s, lambda *_: ended.set()) for s in ending}
-    try:
-        bridge.start()
-    except Exception as exc:
-        for signum, handler in previous.items():
-            signal.signal(signum, handler)
-        return fail("bridge", f"cannot serve on {args.bind}:{args.ws_port}: {exc}", EXIT_USAGE)
+    with EndingSignals() as ending:
+        try:
+            bridge.start()
+        except Exception as exc:
+            return fail("bridge", f"cannot serve on {args.bind}:{args.ws_port}: {exc}", EXIT_CONNECTION)
+        code = serve(args, runner, bridge, ending, password)
+    if ending.exit_code is not None and code == EXIT_OK:
+        return fail("bridge", f"ended by {signal_name(ending.signum or 0)}", ending.exit_code)
+    return code
+
+
+def serve(
+    args: argparse.Namespace, runner: ClientRunner, bridge: Bridge, ending: EndingSignals, password: str
+) -> int:
+    """Connect and follow until ``--seconds`` or a signal; the bridge and the runner end either way."""
+    host, port = args.server
     runner.start()
     try:
         future = runner.connect(host, port, args.user, password, protocol=args.protocol)
         try:
-            future.result(args.timeout + 1.0)
+            if not until_connected(future, ending.event, args.timeout + 1.0):
+                return EXIT_OK  # a signal came first: its code is the command's
         except ClientError as exc:
             return fail("bridge", str(exc), exc.exit_code)
         except Exception as exc:
             return fail("bridge", f"could not connect: {exc}", EXIT_CONNECTION)
-        drive = "drive allowed from /cmd_vel" if args.allow_drive else "no drive"
-        print(f"rtmu bridge: ws://{args.bind}:{bridge.port} ({drive})", file=sys.stderr, flush=True)
-        follow(runner, ended, seconds=args.seconds, camera_hz=args.camera_hz, beat=BEAT)
+        announce(bridge)
+        follow(runner, ending.event, seconds=args.seconds, camera_hz=args.fps, beat=BEAT)
     finally:
         bridge.close()  # ends any bridge drive first
-        runner.stop_and_wait(0.5)
-        runner.close()
-        for signum, handler in previous.items():
-            signal.signal(signum, handler)
+        runner.close()  # stops the robot only if a bridge drive moved it (client.roles)
     return EXIT_OK
+
+
+def announce(bridge: Bridge) -> None:
+    """The URL to open, printed once (with a drive bridge's token: it is shown nowhere else)."""
+    if bridge.drive is None:
+        print(f"rtmu bridge: {bridge.url} (no drive)", file=sys.stderr, flush=True)
+        return
+    print(
+        f"rtmu bridge: {bridge.url} (drive allowed from /cmd_vel, one client at a time; the URL holds this "
+        "run's token: share it only with who may drive)",
+        file=sys.stderr,
+    )
+    app = APP + quote(bridge.url, safe="")
+    print(f"rtmu bridge: in Foxglove's web app: {app}", file=sys.stderr, flush=True)
+
+
+def warn_exposure(bind: str, allow_drive: bool) -> None:
+    """A bridge the network can reach says so; one that also drives warns."""
+    if loopback_only(bind):
+        return
+    if allow_drive:
+        print(
+            f"rtmu bridge: WARNING: --allow-drive on {visible(bind)}, an address other hosts can reach: "
+            "anyone with the printed URL (its token) on the network can drive the robot. Bind 127.0.0.1 and "
+            "tunnel (ssh -L) unless the network is yours alone.",
+            file=sys.stderr,
+            flush=True,
+        )
+    else:
+        print(
+            f"rtmu bridge: serving on {visible(bind)}: other hosts on the network can watch the robot "
+            "(they cannot drive it)",
+            file=sys.stderr,
+            flush=True,
+        )
+
+
+def _refusals_told() -> Any:
+    count = 0
+
+    def told(reason: str) -> None:
+        nonlocal count
+        count += 1
+        if count <= TOLD_REFUSALS or count % 100 == 0:
+            text = f"rtmu bridge: refused a connection ({count}): {visible(reason)}"
+            print(text, file=sys.stderr, flush=True)
+
+    return told

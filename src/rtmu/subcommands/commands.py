@@ -5,10 +5,11 @@ from __future__ import annotations
 import argparse
 from typing import Any
 
+from ..base.exit_codes import EXIT_OK
+from ..base.textsafe import visible
 from ..client.connection import AriaClient
 from ..client.custom_commands import list_commands
-from ..exit_codes import EXIT_OK
-from ..textsafe import visible
+from ..client.roles import Role
 from ._common import add_connection_arguments, print_json, run_with_client
 
 
@@ -43,4 +44,4 @@ def handle(args: argparse.Namespace) -> int:
             print(f"{visible(c.name):<{width}}  {arg}  {visible(c.description)}", flush=True)
         return EXIT_OK
 
-    return run_with_client("commands", args, body)
+    return run_with_client("commands", args, body, role=Role.OBSERVER)

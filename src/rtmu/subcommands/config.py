@@ -1,9 +1,12 @@
-"""``rtmu config HOST[:PORT] [--json] [--set SECTION/PARAM=VALUE …]``: the server's configuration (ArConfig).
+"""``rtmu config HOST[:PORT] [--json] [ACTION]``: the server's configuration (ArConfig), and its care.
 
-Without ``--set``: every section and parameter with its value, type, limits and priority. With
+Without an action: every section and parameter with its value, type, limits and priority. With
 ``--set``: one ``setConfig`` of all the values given; the server checks them and either takes them
 all or answers with its first error, which is printed (exit 6). Exit 4 when the server offers no
-configuration.
+configuration; exit 18 when it offers one RTMU cannot show or edit yet — an Omron LD robot's
+``getConfigValues`` family (protocol 6MTX), named as such (``rtmu call`` reads it raw). The care
+actions (``--defaults``, ``--reset``, ``--export``, ``--import``, ``--reload``) are in
+:mod:`._config_care`.
 """
 
 from __future__ import annotations
@@ -11,17 +14,18 @@ from __future__ import annotations
 import argparse
 import math
 import sys
+from pathlib import Path
 from typing import Any
 
-from ..client.config_feed import ServerConfig, fetch_config, set_config
+from ..base.exit_codes import EXIT_FOREIGN_CONFIG, EXIT_OK, EXIT_REFUSED, EXIT_USAGE, NETWORK
+from ..base.textsafe import visible
+from ..client.config_feed import ConfigApi, ForeignConfig, ServerConfig, fetch_config, set_config
 from ..client.connection import AriaClient
-from ..exit_codes import EXIT_OK, EXIT_USAGE
+from ..client.roles import Role
 from ..protocol.payloads.config import ConfigParam, ParamType, Priority
-from ..textsafe import visible
+from . import _config_care
 from ._common import add_connection_arguments, print_json, run_with_client
 
-EXIT_REFUSED = 6
-"""The server refused a value (its message is printed)."""
 MAX_ASSIGNMENTS = 1000
 
 
@@ -47,20 +51,31 @@ def parse_assignment(text: str, parser: Any) -> tuple[str, str, str]:
     return section.strip(), name.strip(), value
 
 
+EXITS = (*NETWORK, EXIT_REFUSED, EXIT_FOREIGN_CONFIG)
+"""6: the server refused a value, in its own words (or an import does not fit it: nothing is sent)."""
+
+
 def register(subparsers: Any) -> None:
     p = subparsers.add_parser(
         "config",
-        help="show or change the server's configuration (getConfigBySections, setConfig)",
+        help="show or change the server's configuration (ArConfig: getConfigBySections, setConfig)",
         description=(
             "Print the server's configuration: sections, then parameters with value, type, limits "
-            "and priority. --set SECTION/PARAM=VALUE (repeatable) changes values in one setConfig: "
-            f"exit {EXIT_REFUSED} with the server's message when it refuses one (it then changes "
-            "none), 4 when the server offers no configuration."
+            "and priority. One action at most: --set SECTION/PARAM=VALUE (repeatable) changes values in "
+            "one setConfig; --defaults lists what differs from the factory values (getConfigDefaults); "
+            "--reset SECTION/PARAM or --reset SECTION puts factory values back; --export FILE writes "
+            "every value to a TOML file (an existing file only with --force); --import FILE checks the "
+            "whole file against the server's parameters and sends it in one setConfig, or nothing; "
+            "--reload makes the server read its configuration file again. A --reset target the server "
+            "does not have, or a file that exists or is not an export, is a usage error; an --import "
+            "that does not fit the server's parameters is refused and nothing is sent. An Omron LD "
+            "robot's configuration (getConfigValues) is named, not shown: rtmu call reads it raw."
         ),
     )
     add_connection_arguments(p)
     p.add_argument("--json", action="store_true", help="one JSON object (the configuration, or the answer)")
-    p.add_argument(
+    actions = p.add_mutually_exclusive_group()
+    actions.add_argument(
         "--set",
         dest="assignments",
         nargs="+",
@@ -68,6 +83,20 @@ def register(subparsers: Any) -> None:
         metavar="SECTION/PARAM=VALUE",
         help="change these values (one setConfig)",
     )
+    actions.add_argument(
+        "--defaults", action="store_true", help="list the parameters that differ from their factory values"
+    )
+    actions.add_argument(
+        "--reset",
+        metavar="SECTION/PARAM",
+        help="put one parameter, or a whole SECTION, back to factory values",
+    )
+    actions.add_argument("--export", type=Path, metavar="FILE", help="write the whole configuration to FILE")
+    actions.add_argument(
+        "--import", dest="import_file", type=Path, metavar="FILE", help="set every value of an exported FILE"
+    )
+    actions.add_argument("--reload", action="store_true", help="make the server read its configuration again")
+    p.add_argument("--force", action="store_true", help="with --export: replace FILE if it exists")
     p.set_defaults(handler=handle)
 
 
@@ -77,17 +106,30 @@ def handle(args: argparse.Namespace) -> int:
         print(f"rtmu config: at most {MAX_ASSIGNMENTS} values at once", file=sys.stderr)
         return EXIT_USAGE
 
+    problem = _config_care.check_usage(args)
+    if problem:
+        print(f"rtmu config: {problem}", file=sys.stderr)
+        return EXIT_USAGE
+
     async def body(client: AriaClient) -> int:
-        if assignments:
-            return await _set(client, assignments, args)
-        config = await fetch_config(client, args.timeout)
+        try:
+            if assignments:
+                return await _set(client, assignments, args)
+            done = await _config_care.run(client, args)
+            if done is not None:
+                return done
+            config = await fetch_config(client, args.timeout)
+        except ForeignConfig as exc:
+            if args.json:
+                print_json({"api": api_key(exc.api), "data": list(exc.listed), "editable": False})
+            raise
         if args.json:
             print_json(config_json(config))
         else:
             print_text(config)
         return EXIT_OK
 
-    return run_with_client("config", args, body)
+    return run_with_client("config", args, body, role=Role.OBSERVER)
 
 
 async def _set(client: AriaClient, assignments: list[tuple[str, str, str]], args: argparse.Namespace) -> int:
@@ -129,8 +171,13 @@ def param_json(p: ConfigParam, config: ServerConfig) -> dict[str, Any]:
     return out
 
 
+def api_key(api: ConfigApi) -> str:
+    return api.name.lower().replace("_", "-")
+
+
 def config_json(config: ServerConfig) -> dict[str, Any]:
     return {
+        "api": api_key(ConfigApi.ARCONFIG),
         "source": config.source,
         "last_editable": Priority.of(config.last_editable).name.lower(),
         "sections": [

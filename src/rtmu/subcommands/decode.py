@@ -18,9 +18,11 @@ from collections import deque
 from collections.abc import Iterable
 from typing import Any, TextIO
 
+from ..base.exit_codes import EXIT_BAD_FILE, EXIT_OK, EXIT_SIGPIPE, EXIT_USAGE
+from ..base.textsafe import json_safe, visible
 from ..capture import CaptureError, CaptureSource, UnreadableInput, open_capture
 from ..capture.reader import DIRECTIONS, FORMATS
-from ..session_decoder import (
+from ..capture.session_decoder import (
     C2S,
     S2C,
     CaptureDecoder,
@@ -30,11 +32,8 @@ from ..session_decoder import (
     Session,
     TrailingDrops,
 )
-from ..textsafe import json_safe, visible
 
-EXIT_OK = 0
-EXIT_UNREADABLE = 1
-EXIT_UNRECOGNISED = 4
+EXITS = (EXIT_OK, EXIT_USAGE, EXIT_BAD_FILE, EXIT_SIGPIPE)
 RUN_HEAD = 3
 RUN_TAIL = 2
 SHORT_TEXT = 72
@@ -141,10 +140,10 @@ def run(args: argparse.Namespace) -> int:
         source = open_capture(args.file, args.format, args.direction)
     except UnreadableInput as exc:
         print(f"rtmu decode: {visible(exc)}", file=sys.stderr)
-        return EXIT_UNREADABLE
+        return EXIT_USAGE
     except CaptureError as exc:
         print(f"rtmu decode: {visible(exc)}", file=sys.stderr)
-        return EXIT_UNRECOGNISED
+        return EXIT_BAD_FILE
     decoder = CaptureDecoder(report_trailing_drops=args.json)
     summary = args.summary if args.summary is not None else not args.json
     out = sys.stdout
@@ -162,14 +161,14 @@ def run(args: argparse.Namespace) -> int:
         out.flush()
     except UnreadableInput as exc:
         print(f"rtmu decode: {visible(exc)}", file=sys.stderr)
-        return EXIT_UNREADABLE
+        return EXIT_USAGE
     except CaptureError as exc:
         print(f"rtmu decode: {visible(exc)}", file=sys.stderr)
-        return EXIT_UNRECOGNISED
-    except BrokenPipeError:  # `rtmu decode x | head`: the reader has seen enough
+        return EXIT_BAD_FILE
+    except BrokenPipeError:  # `rtmu decode x | head`: the reader has seen enough (141, as every command)
         devnull = os.open(os.devnull, os.O_WRONLY)
         os.dup2(devnull, sys.stdout.fileno())
-        return EXIT_OK
+        return EXIT_SIGPIPE
     for warning in source.stats.warnings:
         print(f"rtmu decode: warning: {visible(warning)}", file=sys.stderr)
     return EXIT_OK
@@ -423,7 +422,7 @@ class _TextWriter:
         )
 
     def _packet_line(self, p: DecodedPacket) -> str:
-        name = _one_line(p.name) if p.name else ("?" if p.is_data else "(unknown control)")
+        name = p.name if p.name else ("?" if p.is_data else "(unknown control)")
         where = f"{self._time(p.time)} {p.conn:>3} {p.direction} {p.transport:<6}"
         head = f"{where} {p.command:>5} {name:<22} {p.length:>5}"
         parts: list[str] = []
@@ -486,7 +485,7 @@ def format_fields(fields: dict[str, Any], full: bool = False) -> str:
 
 def _entry(entry: dict[str, Any], full: bool) -> str:
     """One list entry: its number and texts (only the name, or the group and flags, when short)."""
-    values = [_one_line(str(v)) for k, v in entry.items() if k != "number" and v != ""]
+    values = [str(v) for k, v in entry.items() if k != "number" and v != ""]
     if not full and "name" in entry:
         values = [str(entry["name"])]
     text = "/".join(values)
@@ -495,19 +494,15 @@ def _entry(entry: dict[str, Any], full: bool) -> str:
     return f"{entry['number']} {text}" if text else str(entry["number"])
 
 
-_CONTROL = {c: f"\\x{c:02x}" for c in range(32)} | {10: "\\n", 13: "\\r", 9: "\\t"}
-
-
-def _one_line(text: str) -> str:
-    """Control characters escaped, so one packet stays one line (server texts do hold newlines)."""
-    return text.translate(_CONTROL)
-
-
 def _value(value: Any, full: bool) -> str:
+    """A field's value as text. A string is quoted and NOT escaped here: every text line is escaped
+    once, whole, when it is written (``visible``: control characters, so one packet stays one line,
+    and backslashes) — escaping here too showed a ``\\`` in a password key as four."""
     if isinstance(value, str):
         if not full and len(value) > SHORT_TEXT:
             value = value[:SHORT_TEXT] + "…"
-        return repr(value)
+        quote = '"' if "'" in value and '"' not in value else "'"
+        return f"{quote}{value}{quote}"
     if isinstance(value, float):
         return f"{value:g}"
     if isinstance(value, dict):
@@ -572,7 +567,7 @@ def _session_lines(session: Session, source: CaptureSource, full: bool) -> list[
             continue
         names = totals.by_name.most_common()
         shown = names if full else names[:10]
-        text = ", ".join(f"{_one_line(n)} ×{c}" for n, c in shown)
+        text = ", ".join(f"{n} ×{c}" for n, c in shown)
         if len(shown) < len(names):
             text += f", … +{len(names) - len(shown)} names"
         lines.append(f"  {direction} {totals.packets} packets, {totals.bytes} bytes: {text}")

@@ -6,9 +6,12 @@ import argparse
 from typing import Any
 
 from ..client.connection import AriaClient
+from ..client.roles import Role
 from ..protocol.payloads.navigation import Dock
 from ._common import add_connection_arguments, run_with_client
-from ._navigate import EXIT_CODES_HELP, Expect, add_wait_arguments, navigate, require
+from ._navigate import NAVIGATION_EXITS, Expect, add_wait_arguments, navigate, require
+
+EXITS = NAVIGATION_EXITS
 
 
 def register(subparsers: Any) -> None:
@@ -16,7 +19,7 @@ def register(subparsers: Any) -> None:
         "dock",
         help="drive to the charger and dock (dock), and wait until docked",
         description="Send dock: the server drives to its dock and says 'Docked' (LD robots: dockInfo says "
-        f"Docked). A drive command undocks again. Ctrl-C stops the robot. {EXIT_CODES_HELP}.",
+        "Docked). A drive command undocks again. Ctrl-C, SIGTERM and SIGHUP stop the robot.",
     )
     add_connection_arguments(p)
     add_wait_arguments(p)
@@ -28,4 +31,4 @@ def handle(args: argparse.Namespace) -> int:
         require(client, "dock", "dock")
         return await navigate(client, args, Dock(), Expect(docked=True))
 
-    return run_with_client("dock", args, body)
+    return run_with_client("dock", args, body, role=Role.OPERATOR)

@@ -7,6 +7,8 @@ UDP, the first status and the status stream's timing (what RTMU learns from it: 
 waits for status before it stops) — and for the first step that fails says in plain words what went wrong
 and what to do next (the same words the window uses, :mod:`rtmu.client.diagnosis`). It stops
 there; the exit code names the step (10 name … 15 status; UDP never fails it, RTMU uses TCP).
+Connected, it asks the last question with a login of its own: why won't it move? — ``rtmu why``'s
+answer (:mod:`rtmu.client.why`); that step fails with the cause's own code (20–39).
 """
 
 from __future__ import annotations
@@ -20,12 +22,30 @@ import time
 from dataclasses import dataclass, field
 from typing import Any
 
-from ..client.connection import TEXT_BANNERS
-from ..client.diagnosis import ADVICE, Step, login_finding
+from ..base.exit_codes import (
+    ENDED,
+    EXIT_DOCTOR_DATALIST,
+    EXIT_DOCTOR_INTRODUCTION,
+    EXIT_DOCTOR_LOGIN,
+    EXIT_DOCTOR_RESOLVE,
+    EXIT_DOCTOR_STATUS,
+    EXIT_DOCTOR_TCP,
+    EXIT_INTERNAL,
+    EXIT_OK,
+    EXIT_USAGE,
+    WHY_ASKED,
+)
+from ..base.textsafe import visible
+from ..client.config_feed import ConfigApi, config_api
+from ..client.connection import TEXT_BANNERS, AriaClient
+from ..client.diagnosis import ADVICE, Step, central_server_words, login_finding
 from ..client.drive_guard import STALE_INTERVALS, STATUS_INTERVAL_MS
+from ..client.errors import ClientError
 from ..client.health import HealthMonitor
 from ..client.link_timing import STATUS_CEILING
-from ..exit_codes import EXIT_OK, EXIT_USAGE
+from ..client.roles import Role
+from ..client.why import diagnose
+from ..client.why_gather import gather
 from ..protocol.client_connection import ClientConnection
 from ..protocol.commands import ClientCommand, ServerCommand
 from ..protocol.decoder import PacketDecoder
@@ -42,9 +62,19 @@ from ..protocol.fields import FieldReader, FieldWriter
 from ..protocol.packet import encode_packet
 from ..protocol.payloads import Side, decode_payload
 from ..protocol.payloads.robot import BatteryInfo, Update, UpdateNumbers, UpdateStrings
-from ..textsafe import visible
-from ._common import UsageError, add_connection_arguments, print_json, read_password
+from ._common import (
+    Interrupted,
+    UsageError,
+    add_connection_arguments,
+    print_json,
+    read_password,
+    run_interruptibly,
+)
 
+EXITS = (
+    EXIT_OK, EXIT_INTERNAL, EXIT_USAGE, EXIT_DOCTOR_RESOLVE, EXIT_DOCTOR_TCP, EXIT_DOCTOR_INTRODUCTION,
+    EXIT_DOCTOR_LOGIN, EXIT_DOCTOR_DATALIST, EXIT_DOCTOR_STATUS, *WHY_ASKED, *ENDED,
+)  # fmt: skip
 READ_CHUNK = 65536
 NOT_ARIA_AFTER = 4096
 """Bytes without a single valid packet after which the peer is taken for something else."""
@@ -63,7 +93,7 @@ FEATURES: tuple[tuple[str, str, tuple[str, ...]], ...] = (
     ("map", "map download", ("getMapBinary", "getMap")),
     ("camera", "camera pictures", ("getPicture*", "sendVideo", "getVideo*")),
     ("sensors", "sonar and laser drawing", ("sonarCurrent", "Laser_*Current", "getSensorCurrent")),
-    ("configuration", "server configuration", ("getConfig*",)),
+    ("configuration", "server configuration (ArConfig)", ("getConfigBySections*", "setConfig")),
     ("popups", "the robot's message boxes", ("popupCreate",)),
     ("custom_commands", "the robot's custom commands", ("listCommands", "listStringCommands")),
     ("status", "pose, battery and status", ("updateNumbers", "update")),
@@ -129,6 +159,8 @@ class Doctor:
         self.host, self.port, self.user = host, port, user
         self.link_seconds = link_seconds
         self._password = password
+        self._motion_password = password
+        """Kept for the motion step's own login, forgotten once it has logged in."""
         self.protocol = protocol
         self.timeout = timeout
         self.steps: list[StepResult] = []
@@ -150,14 +182,17 @@ class Doctor:
             await self._data_list()
             await self._udp(intro)
             await self._status()
+            await self._close()  # one login at a time: a robot may take few clients
+            await self._motion()
         except StepFailed as exc:
             self.steps.append(exc.result)
             done = {s.step for s in self.steps}
             for step in Step:
                 if step not in done:
                     self.steps.append(StepResult(step, "skipped", "not tried (an earlier step failed)"))
-            return exc.result.step.value
+            return int(exc.result.details.get("exit_code", exc.result.step.value))
         finally:
+            self._motion_password = ""
             await self._close()
         return EXIT_OK
 
@@ -306,6 +341,8 @@ class Doctor:
         summary = f"{len(entries)} data in {len(groups)} groups; RTMU can use: {', '.join(have) or 'nothing'}"
         if missing:
             summary += f"; not offered: {', '.join(missing)}"
+        if config_api(names) is ConfigApi.OMRON_LD:
+            summary += "; its configuration is Omron LD's (getConfigValues): RTMU cannot show or edit it yet"
         advice = ""
         if not self.features["teleop"] and self.user:
             advice = "driving is not offered to this user: log in as a user whose groups include Movement"
@@ -365,6 +402,9 @@ class Doctor:
         assert conn is not None
         name = "updateNumbers" if "updateNumbers" in conn.datalist else "update"
         if name not in conn.datalist:
+            if "clientList" in conn.datalist:  # it lists robots instead of being one
+                where = f"{self.host}:{self.port}"
+                raise fail(Step.STATUS, central_server_words(where), ADVICE["central_server"])
             raise fail(Step.STATUS, "the server offers no robot status", ADVICE["status_missing"])
         soc = False
         if "batteryInfo" in conn.datalist:
@@ -434,6 +474,40 @@ class Doctor:
             "stale_after_s": round(timing.settled, 2),
         }
 
+    async def _motion(self) -> None:
+        """``rtmu why``'s answer, asked over a login of its own (the steps above use the bare codec)."""
+        client = AriaClient()
+        try:
+            await client.connect(
+                self.host,
+                self.port,
+                self.user,
+                self._motion_password,
+                timeout=self.timeout,
+                protocol=self.protocol,
+                role=Role.OBSERVER,
+            )
+            answer = diagnose(await gather(client, self.timeout))
+        except ClientError as exc:
+            self.ok(Step.MOTION, f"could not ask: {exc}", "warn")
+            return
+        finally:
+            self._motion_password = ""
+            await client.disconnect()
+        reason = answer.primary
+        if reason is None:
+            self.ok(Step.MOTION, answer.sentence())
+            return
+        others = [r.sentence() for r in answer.reasons[1:]]
+        raise fail(
+            Step.MOTION,
+            reason.problem,
+            reason.advice,
+            cause=reason.cause.key,
+            exit_code=reason.cause.value,
+            also=others,
+        )
+
     async def _once(self, name: str) -> Any:
         conn = self.conn
         assert conn is not None
@@ -457,9 +531,11 @@ class Doctor:
             if self.conn is not None:
                 self.conn.shutdown()
                 self._flush()
-            self.writer.close()
+        writer, self.writer = self.writer, None  # closed once, whoever asks again
+        with contextlib.suppress(Exception):
+            writer.close()
             async with asyncio.timeout(1.0):
-                await self.writer.wait_closed()
+                await writer.wait_closed()
 
 
 # -- command line -------------------------------------------------------------------------------------
@@ -467,8 +543,13 @@ def register(subparsers: Any) -> None:
     p = subparsers.add_parser(
         "doctor",
         help="find out why a robot does not connect, step by step",
-        description=__doc__,
-        formatter_class=argparse.RawDescriptionHelpFormatter,
+        description="Walk the whole way to a robot and say, step by step, what worked: name resolution, "
+        "TCP connect, the server's introduction (its version tag and protocol string), the login, the "
+        "data list (and which RTMU features the server offers), UDP, the first status. For the first "
+        "step that fails it says in plain words what went wrong and what to do next (the words the "
+        "window uses), and stops there; the exit code names the step. UDP never fails it: RTMU uses TCP. "
+        "Connected, it asks last why the robot would not move (rtmu why's answer); that step fails with "
+        "the cause's own code.",
     )
     add_connection_arguments(p)
     p.add_argument(
@@ -499,9 +580,10 @@ def handle(args: argparse.Namespace) -> int:
         return EXIT_USAGE
     doctor = Doctor(host, port, args.user, password, args.protocol, args.timeout, max(0.0, args.link_seconds))
     try:
-        code = asyncio.run(doctor.run())
-    except KeyboardInterrupt:
-        return 130
+        code = run_interruptibly(doctor.run)
+    except Interrupted as exc:
+        print(f"rtmu doctor: {exc}", file=sys.stderr)
+        return exc.exit_code
     failed = next((s for s in doctor.steps if s.result == "fail"), None)
     if args.json:
         print_json(

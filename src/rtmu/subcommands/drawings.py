@@ -3,21 +3,29 @@
 One line per drawing of ``getDrawingList`` — name, shape, colour, size, layer, refresh period,
 visibility — and how many points one request of its data returned now. A shape RTMU cannot draw
 is listed with a note; a drawing whose sample is malformed or never comes says so, and the other
-drawings are still shown. Exit 0 with the list, 4 when the server lists no drawings.
+drawings are still shown. A list longer than RTMU keeps (256) is printed as far as it is kept, and
+what was left out is said on stderr. Exit 0 with the list, 4 when the server lists no drawings.
 """
 
 from __future__ import annotations
 
 import argparse
+import asyncio
+import sys
 from typing import Any
 
+from ..base.exit_codes import EXIT_OK
+from ..base.textsafe import visible
 from ..client.connection import AriaClient
 from ..client.drawing_list import drawing_list, drawing_sample
 from ..client.errors import ClientError
-from ..exit_codes import EXIT_OK
+from ..client.roles import Role
 from ..protocol.payloads.drawings import Drawing
-from ..textsafe import visible
 from ._common import add_connection_arguments, print_json, run_with_client
+
+SAMPLES_AT_ONCE = 16
+"""Drawings sampled at the same time: a long list whose samples never come waits its timeout a few times,
+not once for each drawing."""
 
 
 def register(subparsers: Any) -> None:
@@ -36,8 +44,13 @@ def register(subparsers: Any) -> None:
 
 def handle(args: argparse.Namespace) -> int:
     async def body(client: AriaClient) -> int:
-        drawings = await drawing_list(client, args.timeout)  # NotSupported (exit 4) without a list
-        rows = [await _sample(client, d, args.timeout) for d in drawings]
+        listed = await drawing_list(client, args.timeout)  # NotSupported (exit 4) without a list
+        rows: list[dict[str, Any]] = []
+        for start in range(0, len(listed.drawings), SAMPLES_AT_ONCE):
+            batch = listed.drawings[start : start + SAMPLES_AT_ONCE]
+            rows += await asyncio.gather(*(_sample(client, d, args.timeout) for d in batch))
+        if listed.dropped:
+            print(f"rtmu drawings: {listed.dropped_text()} (not sampled, not shown)", file=sys.stderr)
         if args.json:
             print_json(rows)
         elif not rows:
@@ -47,7 +60,7 @@ def handle(args: argparse.Namespace) -> int:
                 print(_line(row), flush=True)
         return EXIT_OK
 
-    return run_with_client("drawings", args, body)
+    return run_with_client("drawings", args, body, role=Role.OBSERVER)
 
 
 async def _sample(client: AriaClient, d: Drawing, timeout: float) -> dict[str, Any]:

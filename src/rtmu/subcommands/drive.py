@@ -8,6 +8,12 @@ when ours was lost while driving — and prints the pose before and after (``--j
 Ctrl-Z (SIGTSTP) stops the robot before the process is suspended, and the drive is not resumed
 by ``fg``: it ends there.
 
+A drive asked to move that did not move the robot never exits 0: the same answer as ``rtmu why``
+(:mod:`rtmu.client.why`) goes to stderr, read with the status words the server said while we
+drove, and the exit code is the cause's (20–39; 35 when the ratios asked for are inside ARIA's
+dead zone, which is also said before driving; 39 when nothing RTMU can read explains it). A
+login that may not drive gets that answer at once (exit 21); one that may not stop is warned.
+
 After a signal the stop goes out first, then the pose is printed if a status comes
 within :data:`AFTER_INTERRUPT` s (``after: unknown`` / ``"after": null`` otherwise; the
 JSON object gains ``"interrupted": "SIGINT"``), one line on stderr says so, and the exit
@@ -20,18 +26,25 @@ from __future__ import annotations
 import argparse
 import asyncio
 import contextlib
+import dataclasses
 import sys
 from collections.abc import Callable
 from typing import Any
 
-from ..client.connection import AriaClient
+from ..base.exit_codes import EXIT_OK, EXIT_SIGQUIT, EXIT_SIGTSTP, EXIT_USAGE, NETWORK, WHY_DRIVE
+from ..base.textsafe import visible
+from ..client.connection import AriaClient, Packet
 from ..client.drive_guard import DriveGuard, LinkFault
-from ..client.errors import ClientError, NotSupported
-from ..exit_codes import EXIT_OK
+from ..client.errors import ClientError
+from ..client.roles import Role
+from ..client.why import diagnose, moved, unexplained
+from ..client.why_gather import gather
+from ..client.why_values import Answer, Facts, Motion
 from ..guardian.handle import GuardianHandle, GuardianUnavailable, beat_network, start_ready
 from ..guardian.messages import Hello
-from ..protocol.payloads.drive import RatioDrive
-from ..textsafe import visible
+from ..protocol.errors import ProtocolError
+from ..protocol.payloads.drive import RATIO_ROT_DEAD_ZONE, RATIO_TRANS_DEAD_ZONE, RatioDrive
+from ..protocol.payloads.robot import UpdateStrings
 from ._common import (
     Interrupted,
     UsageError,
@@ -44,6 +57,7 @@ from ._common import (
     signal_name,
     status_line,
 )
+from .why import print_answer
 
 RESEND = 0.1
 MAX_SECONDS = 600.0
@@ -53,11 +67,15 @@ AFTER_INTERRUPT = 1.0
 """After a signal, at most this long (stop already sent) for the pose printed as ``after``."""
 
 
+EXITS = (*NETWORK, EXIT_SIGQUIT, EXIT_SIGTSTP, *WHY_DRIVE)
+
+
 def register(subparsers: Any) -> None:
     p = subparsers.add_parser(
         "drive",
         help="drive for some seconds, then stop",
-        description="Drive with ratioDrive for S seconds, then stop; print the pose before and after.",
+        description="Drive with ratioDrive for S seconds, then stop; print the pose before and after. "
+        "A drive that did not move the robot says why (as rtmu why does) and exits with the cause's code.",
     )
     add_connection_arguments(p)
     p.add_argument(
@@ -68,7 +86,11 @@ def register(subparsers: Any) -> None:
     )
     p.add_argument("--throttle", type=float, default=50.0, metavar="PCT", help="0…100 %% (default 50)")
     p.add_argument("--seconds", type=float, required=True, metavar="S", help=f"0…{MAX_SECONDS:g}")
-    p.add_argument("--json", action="store_true", help='one object {"before", "after", "seconds"}')
+    p.add_argument(
+        "--json",
+        action="store_true",
+        help='one object {"before", "after", "seconds"}; asked to move, also "moved" (and "why" if not)',
+    )
     p.set_defaults(handler=handle)
 
 
@@ -86,9 +108,22 @@ def check(args: argparse.Namespace) -> None:
 def handle(args: argparse.Namespace) -> int:
     async def body(client: AriaClient) -> int:
         check(args)
+        motion = Motion(args.trans, args.rot)
         if not client.supports("ratioDrive"):
-            raise NotSupported(
-                "ratioDrive", "this server (or this user) may not drive the robot (no ratioDrive)"
+            return await refuse(args, client, motion)
+        if not client.supports("stop"):
+            warning = diagnose(Facts(offers=frozenset(e.name for e in client.datalist), user=client.user))
+            for reason in warning.reasons:
+                if reason.loud:
+                    print(f"rtmu drive: WARNING: {visible(reason.sentence())}", file=sys.stderr, flush=True)
+        ratios = RatioDrive(args.trans, args.rot, args.throttle)
+        if ratios.in_dead_zone:  # ARIA would take it and not move: say so rather than exit 0 silently
+            print(
+                f"rtmu drive: warning: --trans {args.trans:g} --rot {args.rot:g} is inside ARIA's dead "
+                f"zone (translation up to ±{RATIO_TRANS_DEAD_ZONE:g} %, rotation under "
+                f"±{RATIO_ROT_DEAD_ZONE:g} %): the robot will not move",
+                file=sys.stderr,
+                flush=True,
             )
         guardian = await start_guardian(args)
         guard = DriveGuard(client)
@@ -110,9 +145,11 @@ def handle(args: argparse.Namespace) -> int:
         beats = asyncio.create_task(beat_network(guardian)) if guardian is not None else None
         if guardian is not None:
             guardian.arm()  # it stops the robot if this process is killed or frozen from here on
+        said = StatusWords(client)
+        guard.seen_moving = False
         try:
-            ratios = RatioDrive(args.trans, args.rot, args.throttle)
             await drive(client, ratios, args.seconds, held=lambda: interrupts.suspending, guard=guard)
+            said.close()  # what the server said while we drove, before our own stop changes it
         except asyncio.CancelledError:
             signum = interrupts.take()
             if signum is None:
@@ -142,9 +179,17 @@ def handle(args: argparse.Namespace) -> int:
                     guardian.disarm()
                 guardian.close(goodbye=client.closed_error is None)
         await guard.close()
+        said.close()
         if signum is None:
-            report(args, before, await settle(client, args.timeout))
-            return EXIT_OK
+            final = await settle(client, args.timeout)
+            if not asked_to_move(args) or moved(pose(before), pose(final), guard.seen_moving):
+                report(args, before, final, moved=True if asked_to_move(args) else None)
+                return EXIT_OK
+            facts = said.into(await gather(client, args.timeout))
+            answer = unexplained(diagnose(facts, motion))
+            report(args, before, final, moved=False, why=answer)
+            print_answer(answer, sys.stderr, "rtmu drive: the robot did not move: ")
+            return answer.exit_code
         # Interrupted: the stop is out; the last pose is worth a short wait, not a long one.
         after: dict[str, Any] | None = None
         with contextlib.suppress(TimeoutError, ClientError):
@@ -157,8 +202,8 @@ def handle(args: argparse.Namespace) -> int:
         check(args)
     except UsageError as exc:
         print(f"rtmu drive: {exc}", file=sys.stderr)
-        return 2
-    return run_with_client("drive", args, body)
+        return EXIT_USAGE
+    return run_with_client("drive", args, body, role=Role.OPERATOR)
 
 
 async def start_guardian(args: argparse.Namespace) -> GuardianHandle | None:
@@ -176,17 +221,72 @@ async def start_guardian(args: argparse.Namespace) -> GuardianHandle | None:
         return None
 
 
+async def refuse(args: argparse.Namespace, client: AriaClient, motion: Motion) -> int:
+    """This login may not drive: say why (``rtmu why``'s answer) and exit with its code."""
+    answer = diagnose(await gather(client, args.timeout), motion)
+    if args.json:
+        print_json(
+            {"before": None, "after": None, "seconds": args.seconds, "moved": False, "why": answer.as_json()}
+        )
+    print_answer(answer, sys.stderr, "rtmu drive: ")
+    return answer.exit_code
+
+
+def asked_to_move(args: argparse.Namespace) -> bool:
+    return (args.trans != 0 or args.rot != 0) and args.throttle > 0
+
+
+def pose(status: dict[str, Any]) -> tuple[float, float, float]:
+    return (status["x"], status["y"], status["th"])
+
+
+class StatusWords:
+    """The server's status words while we drive (``updateStrings``, broadcast when they change), kept
+    until :meth:`close` — our own stop afterwards would replace them with "Stopped"."""
+
+    def __init__(self, client: AriaClient) -> None:
+        self.client = client
+        self.last: UpdateStrings | None = None
+        self.open = client.supports("updateStrings")
+        if self.open:
+            client.request("updateStrings", -1, self._on_strings)
+
+    def _on_strings(self, packet: Packet) -> None:
+        with contextlib.suppress(ClientError, ProtocolError):
+            value = packet.decode()
+            if self.open and isinstance(value, UpdateStrings):
+                self.last = value
+
+    def close(self) -> None:
+        if self.open:
+            self.open = False
+            with contextlib.suppress(ClientError):
+                self.client.stop_request("updateStrings")
+
+    def into(self, facts: Facts) -> Facts:
+        if self.last is None:
+            return facts
+        s = self.last
+        return dataclasses.replace(facts, status=s.status, mode=s.mode, extended_status=s.extended_status)
+
+
 def report(
     args: argparse.Namespace,
     before: dict[str, Any],
     after: dict[str, Any] | None,
     interrupted: str | None = None,
+    moved: bool | None = None,
+    why: Answer | None = None,
 ) -> None:
     """The poses on stdout; ``after`` None: the status did not come in time after an interrupt."""
     if args.json:
         obj: dict[str, Any] = {"before": before, "after": after, "seconds": args.seconds}
         if interrupted is not None:
             obj["interrupted"] = interrupted
+        if moved is not None:
+            obj["moved"] = moved
+        if why is not None:
+            obj["why"] = why.as_json()
         print_json(obj)
     elif after is not None:
         print(f"after:  {status_line(after)}", flush=True)
@@ -248,7 +348,13 @@ async def stop_on_a_new_connection(args: argparse.Namespace) -> bool:
     fresh = AriaClient()
     try:
         await fresh.connect(
-            host, port, args.user, current_password(), timeout=RECONNECT_FOR_STOP, protocol=args.protocol
+            host,
+            port,
+            args.user,
+            current_password(),
+            timeout=RECONNECT_FOR_STOP,
+            protocol=args.protocol,
+            role=Role.OPERATOR,  # it sends only zero ratios and stop
         )
         stop(fresh)
         return await fresh.flush(RECONNECT_FOR_STOP)

@@ -12,22 +12,24 @@ from __future__ import annotations
 
 import argparse
 import asyncio
-import signal
 from typing import Any
 
-from ..client.central import list_robots
+from ..base.exit_codes import EXIT_CONNECTION, EXIT_OK, EXIT_USAGE
+from ..base.textsafe import visible
+from ..client.central import list_robots, one_per_name
 from ..client.connection import AriaClient
 from ..client.errors import ClientError
-from ..exit_codes import EXIT_CONNECTION, EXIT_OK, EXIT_USAGE
+from ..client.roles import Role
 from ..protocol.errors import ProtocolError
-from ..textsafe import visible
 from ._common import (
+    Interrupted,
     UsageError,
     add_connection_arguments,
     fail,
     fetch_status,
     print_json,
     read_password,
+    run_interruptibly,
     status_line,
 )
 
@@ -39,10 +41,14 @@ def register(subparsers: Any) -> None:
     p = subparsers.add_parser(
         "fleet",
         help="list the robots behind an ARIA central server, with their status",
-        description=__doc__,
-        formatter_class=argparse.RawDescriptionHelpFormatter,
+        description="Ask an ARIA central server (ARIA's switchServer, or rtmu sim --central) for its "
+        "robots and the port it forwards each on, then read one status from every robot through that "
+        "port (all at once, each within --timeout). --json prints one object: "
+        '{"central": "HOST:PORT", "robots": [{"name", "host", "port", "address", "status"}]} where '
+        'status is what rtmu status --json prints, or {"error": "..."} for a robot that did not answer. '
+        "Act on one of them with any other subcommand's --robot NAME.",
     )
-    add_connection_arguments(p)
+    add_connection_arguments(p, robot=False)  # it lists every robot: no --robot NAME
     p.add_argument("--json", action="store_true", help="one JSON object (see above)")
     p.add_argument("--no-status", action="store_true", help="list only; do not log in to each robot")
     p.set_defaults(handler=handle)
@@ -55,7 +61,9 @@ async def _status(
         client = AriaClient()
         try:
             login = (args.user, password)
-            await client.connect(host, port, *login, timeout=args.timeout, protocol=args.protocol)
+            await client.connect(
+                host, port, *login, timeout=args.timeout, protocol=args.protocol, role=Role.OBSERVER
+            )
             return await fetch_status(client, args.timeout)
         except (ClientError, ProtocolError) as exc:
             return {"error": str(exc)}
@@ -64,8 +72,6 @@ async def _status(
 
 
 def handle(args: argparse.Namespace) -> int:
-    if args.robot is not None:
-        return fail("fleet", "--robot does not apply to 'rtmu fleet': it lists every robot", EXIT_USAGE)
     try:
         password = read_password(args)
     except UsageError as exc:
@@ -75,7 +81,7 @@ def handle(args: argparse.Namespace) -> int:
     host, port = args.server
 
     async def main() -> list[dict[str, Any]]:
-        robots = await list_robots(host, port, args.user, password, timeout=args.timeout)
+        robots = one_per_name(await list_robots(host, port, args.user, password, timeout=args.timeout))
         gate = asyncio.Semaphore(MAX_AT_ONCE)
         statuses: list[dict[str, Any] | None] = [None] * len(robots)
         if not args.no_status:
@@ -96,13 +102,13 @@ def handle(args: argparse.Namespace) -> int:
         return rows
 
     try:
-        rows = asyncio.run(main())
+        rows = run_interruptibly(main)
+    except Interrupted as exc:
+        return fail("fleet", str(exc), exc.exit_code)
     except ClientError as exc:
         return fail("fleet", str(exc), exc.exit_code)
     except ProtocolError as exc:
         return fail("fleet", f"the central server sent a malformed robot list: {exc}", EXIT_CONNECTION)
-    except KeyboardInterrupt:
-        return fail("fleet", "interrupted by SIGINT", 128 + signal.SIGINT)
     if args.json:
         print_json({"central": f"{host}:{port}", "robots": rows})
         return EXIT_OK

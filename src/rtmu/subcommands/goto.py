@@ -12,13 +12,14 @@ import argparse
 import sys
 from typing import Any
 
+from ..base.exit_codes import EXIT_OK, EXIT_USAGE
+from ..base.textsafe import visible
 from ..client import ld_data
 from ..client.connection import AriaClient
-from ..exit_codes import EXIT_OK, EXIT_USAGE
+from ..client.roles import Role
 from ..protocol.payloads.navigation import GotoGoal, GotoPose
-from ..textsafe import visible
-from ._common import UsageError, add_connection_arguments, run_with_client, unknown_name
-from ._navigate import EXIT_CODES_HELP, Expect, add_wait_arguments, navigate, require
+from ._common import UsageError, add_connection_arguments, known_name, run_with_client
+from ._navigate import NAVIGATION_EXITS, Expect, add_wait_arguments, navigate, require
 
 RULE = (
     "GOAL goes as ARNL's gotoGoal wherever the server lists it, and the command follows the robot to "
@@ -28,11 +29,14 @@ RULE = (
 )
 
 
+EXITS = NAVIGATION_EXITS
+
+
 def register(subparsers: Any) -> None:
     p = subparsers.add_parser(
         "goto",
         help="drive to a goal of the map or to a point (gotoGoal / gotoPose; LD robots: gotoRouteGoal)",
-        description=f"{RULE} Ctrl-C stops the robot. {EXIT_CODES_HELP}.",
+        description=f"{RULE} Ctrl-C, SIGTERM and SIGHUP stop the robot.",
     )
     add_connection_arguments(p)
     p.add_argument("goal", metavar="GOAL", nargs="?", help="goal name, as the map names it")
@@ -73,12 +77,14 @@ def handle(args: argparse.Namespace) -> int:
             require(client, "gotoGoal", "drive to goals")
         if client.supports("getGoals"):
             known = await ld_data.goals(client, args.timeout)
-            if unknown_name("goto", "goal", args.goal, known):
+            goal = known_name("goto", "goal", args.goal, known)
+            if goal is None:
                 return EXIT_USAGE
+            args.goal = goal  # as the map spells it: what the server's words will name
         if route:
             ld_data.goto_route_goal(client, args.goal)
             print(f"going to {visible(args.goal)}", file=sys.stderr)
             return EXIT_OK
         return await navigate(client, args, GotoGoal(args.goal), Expect(args.goal))
 
-    return run_with_client("goto", args, body)
+    return run_with_client("goto", args, body, role=Role.OPERATOR)

@@ -6,9 +6,12 @@ import argparse
 from typing import Any
 
 from ..client.connection import AriaClient
+from ..client.roles import Role
 from ..protocol.payloads.navigation import Home
 from ._common import add_connection_arguments, run_with_client
-from ._navigate import EXIT_CODES_HELP, Expect, add_wait_arguments, navigate, require
+from ._navigate import NAVIGATION_EXITS, Expect, add_wait_arguments, navigate, require
+
+EXITS = NAVIGATION_EXITS
 
 
 def register(subparsers: Any) -> None:
@@ -16,7 +19,7 @@ def register(subparsers: Any) -> None:
         "home",
         help="drive home (ARNL: home), and wait until the robot is there",
         description="Send home: the server drives to the map's home (or where the robot started) and says "
-        f"'Returned home'. Ctrl-C stops the robot. {EXIT_CODES_HELP}.",
+        "'Returned home'. Ctrl-C, SIGTERM and SIGHUP stop the robot.",
     )
     add_connection_arguments(p)
     add_wait_arguments(p)
@@ -28,4 +31,4 @@ def handle(args: argparse.Namespace) -> int:
         require(client, "home", "drive home")
         return await navigate(client, args, Home(), Expect("home"))
 
-    return run_with_client("home", args, body)
+    return run_with_client("home", args, body, role=Role.OPERATOR)

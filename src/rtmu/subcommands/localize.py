@@ -5,10 +5,14 @@ from __future__ import annotations
 import argparse
 from typing import Any
 
+from ..base.exit_codes import NETWORK
 from ..client.connection import AriaClient
+from ..client.roles import Role
 from ..protocol.payloads.navigation import LocalizeToPose
 from ._common import add_connection_arguments, run_with_client
 from ._navigate import EXIT_NAV_LOST, add_wait_arguments, localize, require
+
+EXITS = (*NETWORK, EXIT_NAV_LOST)
 
 
 def register(subparsers: Any) -> None:
@@ -16,15 +20,14 @@ def register(subparsers: Any) -> None:
         "localize",
         help="tell the robot where it is on the map (localizeToPose), and wait until it is localized",
         description="Send localizeToPose X Y TH; where the server offers getLocState, wait until it says "
-        "localized. Exit codes: 0 localized (or sent, where getLocState is not offered), 2 usage, "
-        "3 connection or login failure, 4 the server cannot be told (no localizeToPose), 5 no answer "
-        f"within --limit, {EXIT_NAV_LOST} still lost, 128+N ended by signal N.",
+        "localized (exit 0; also when it was only sent, where getLocState is not offered) or lost "
+        f"(exit {EXIT_NAV_LOST}). It never moves the robot.",
     )
     add_connection_arguments(p)
     p.add_argument("x", type=float, metavar="X", help="mm on the map")
     p.add_argument("y", type=float, metavar="Y", help="mm on the map")
     p.add_argument("th", type=float, metavar="TH", help="heading, degrees (counter-clockwise)")
-    add_wait_arguments(p)
+    add_wait_arguments(p, localizing=True)
     p.set_defaults(handler=handle)
 
 
@@ -33,4 +36,4 @@ def handle(args: argparse.Namespace) -> int:
         require(client, "localizeToPose", "take a pose to localize at")
         return await localize(client, args, LocalizeToPose(round(args.x), round(args.y), round(args.th)))
 
-    return run_with_client("localize", args, body)
+    return run_with_client("localize", args, body, role=Role.OPERATOR)

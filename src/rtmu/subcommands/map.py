@@ -7,13 +7,16 @@ import sys
 from pathlib import Path
 from typing import Any
 
+from ..base.exit_codes import EXIT_OK, EXIT_UNSUPPORTED, EXIT_USAGE
+from ..base.textsafe import visible
 from ..client.connection import AriaClient
 from ..client.errors import ProtocolFault
 from ..client.mapload import download_map
-from ..exit_codes import EXIT_OK, EXIT_UNSUPPORTED
+from ..client.roles import Role
 from ..mapfile.errors import MapFormatError
-from ..textsafe import visible
-from ._common import add_connection_arguments, fail, run_with_client
+from ..mapfile.writer import map_bytes
+from ._common import UsageError, add_connection_arguments, fail, run_with_client
+from ._output import add_force_option, check_file, write_whole
 
 
 def register(subparsers: Any) -> None:
@@ -26,27 +29,34 @@ def register(subparsers: Any) -> None:
     add_connection_arguments(p)
     p.add_argument("--out", type=Path, required=True, metavar="FILE", help="where to write the map")
     p.add_argument("--text", action="store_true", help="use getMap (one text line per packet)")
+    add_force_option(p)
     p.set_defaults(handler=handle)
 
 
 def handle(args: argparse.Namespace) -> int:
-    async def body(client: AriaClient) -> int:
-        from .. import maps
+    try:
+        check_file(args.out, force=args.force)  # before connecting: nothing downloaded for nothing
+    except UsageError as exc:
+        return fail("map", str(exc), EXIT_USAGE)
 
+    async def body(client: AriaClient) -> int:
         got = await download_map(client, prefer_binary=not args.text, timeout=args.timeout)
         if got.data is None:
             return fail("map", f"{args.server[0]}:{args.server[1]} has no map loaded", EXIT_UNSUPPORTED)
         try:
-            maps.write_map(got.data, args.out)
+            payload = map_bytes(got.data)
         except (MapFormatError, ValueError) as exc:  # parsed, yet not writable as a .map file
             reason = f"the map from {got.source!r} cannot be written as a .map file: {exc}"
             raise ProtocolFault(reason) from None
+        written = write_whole(args.out, payload, force=args.force)
         name = f" ({visible(got.name)})" if got.name else ""
+        if written != args.out:
+            print(f"rtmu map: {args.out} appeared meanwhile; kept it, wrote {written}", file=sys.stderr)
         print(
-            f"wrote {args.out}{name}: {got.data.num_points} points, {got.data.num_lines} lines "
+            f"wrote {written}{name}: {got.data.num_points} points, {got.data.num_lines} lines "
             f"via {got.source} in {got.packets} packets",
             file=sys.stderr,
         )
         return EXIT_OK
 
-    return run_with_client("map", args, body)
+    return run_with_client("map", args, body, role=Role.OBSERVER)

@@ -8,11 +8,11 @@ import sys
 from collections import Counter
 from typing import Any
 
-from rtmu.maps import Bounds, MapData, MapFormatError, read_map, split_keyword
-from rtmu.textsafe import visible
+from rtmu.base.exit_codes import EXIT_BAD_FILE, EXIT_OK, EXIT_SIGPIPE, EXIT_USAGE
+from rtmu.base.textsafe import visible
+from rtmu.mapfile import Bounds, MapData, MapFormatError, read_map, split_keyword
 
-EXIT_OK = 0
-EXIT_BAD_MAP = 2
+EXITS = (EXIT_OK, EXIT_USAGE, EXIT_BAD_FILE, EXIT_SIGPIPE)
 
 
 def register(subparsers: argparse._SubParsersAction) -> None:
@@ -20,7 +20,7 @@ def register(subparsers: argparse._SubParsersAction) -> None:
         "mapinfo",
         help="summarise an ARIA .map file (counts, bounds, objects)",
         description="Summarise an ARIA .map file: category, counts found and claimed by the header, bounds, "
-        "resolution, map objects by type, goal names and unknown header keywords. Exit 2 if unreadable.",
+        "resolution, map objects by type, goal names and unknown header keywords.",
     )
     parser.add_argument("file", metavar="FILE", help="the .map file")
     parser.add_argument("--json", action="store_true", help="print one JSON object instead of text")
@@ -32,7 +32,7 @@ def run(args: argparse.Namespace) -> int:
         data = read_map(args.file)
     except MapFormatError as exc:
         print(f"rtmu mapinfo: {visible(str(exc))}", file=sys.stderr)
-        return EXIT_BAD_MAP
+        return EXIT_USAGE if isinstance(exc.__cause__, OSError) else EXIT_BAD_FILE  # missing, or not a map
     summary = summarise(data)
     if args.json:
         print(json.dumps(summary))

@@ -6,11 +6,12 @@ import argparse
 import sys
 from typing import Any
 
+from ..base.exit_codes import EXIT_OK, EXIT_USAGE
+from ..base.textsafe import visible
 from ..client import ld_data
 from ..client.connection import AriaClient
-from ..exit_codes import EXIT_OK, EXIT_USAGE
-from ..textsafe import visible
-from ._common import add_connection_arguments, run_with_client, unknown_name
+from ..client.roles import Role
+from ._common import add_connection_arguments, known_name, run_with_client
 
 
 def register(subparsers: Any) -> None:
@@ -27,10 +28,12 @@ def register(subparsers: Any) -> None:
 def handle(args: argparse.Namespace) -> int:
     async def body(client: AriaClient) -> int:
         known = await ld_data.routes(client, args.timeout)
-        if unknown_name("patrol", "route", args.route, known):
+        route = known_name("patrol", "route", args.route, known)
+        if route is None:
             return EXIT_USAGE
+        args.route = route
         ld_data.patrol(client, args.route)
         print(f"patrolling {visible(args.route)}", file=sys.stderr)
         return EXIT_OK
 
-    return run_with_client("patrol", args, body)
+    return run_with_client("patrol", args, body, role=Role.OPERATOR)

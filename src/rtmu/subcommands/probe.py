@@ -5,9 +5,10 @@ from __future__ import annotations
 import argparse
 from typing import Any
 
+from ..base.exit_codes import EXIT_OK
+from ..base.textsafe import visible
 from ..client.connection import AriaClient
-from ..exit_codes import EXIT_OK
-from ..textsafe import visible
+from ..client.roles import Role
 from ._common import add_connection_arguments, print_json, run_with_client
 
 
@@ -71,4 +72,4 @@ def handle(args: argparse.Namespace) -> int:
                     print(f"         returns: {visible(e.return_description)}")
         return EXIT_OK
 
-    return run_with_client("probe", args, body)
+    return run_with_client("probe", args, body, role=Role.OBSERVER)

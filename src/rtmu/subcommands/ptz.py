@@ -13,12 +13,15 @@ import asyncio
 import math
 from typing import Any
 
+from ..base.exit_codes import EXIT_OK, EXIT_UNSUPPORTED
+from ..base.textsafe import visible
 from ..client.connection import AriaClient
+from ..client.detached import DetachedContext
 from ..client.ptz import PtzFeed
-from ..exit_codes import EXIT_OK, EXIT_UNSUPPORTED
-from ..state import PtzState
-from ..textsafe import visible
-from ._common import add_connection_arguments, fail, print_json, run_with_client
+from ..client.roles import Role
+from ..client.session_config import SessionConfig
+from ..values.state import PtzState
+from ._common import UsageError, add_connection_arguments, fail, print_json, run_with_client
 
 SETTLE_S = 0.5
 """How long a real head gets to turn before its position is read back."""
@@ -42,14 +45,16 @@ def register(subparsers: Any) -> None:
         description=(
             "List the server's cameras (getCameraList) and show the pan-tilt-zoom head's limits and "
             "position; with --pan/--tilt/--zoom point it there (setCameraAbs) and show where it went. "
-            "Exit 4 when the server has no movable camera head."
+            "A value outside the head's own limits (as the server reports them) is refused with those "
+            "limits (exit 2). Exit 4 when the server has no movable camera head. Moving the head never "
+            "moves the robot."
         ),
     )
     add_connection_arguments(p)
     p.add_argument("--json", action="store_true", help="one JSON object: cameras, limits, position")
-    p.add_argument("--pan", type=_angle, help="pan to this angle (degrees, right positive)")
-    p.add_argument("--tilt", type=_angle, help="tilt to this angle (degrees, up positive)")
-    p.add_argument("--zoom", type=_angle, help="zoom to this point of its range (%%)")
+    p.add_argument("--pan", type=_angle, metavar="DEG", help="pan to this angle (degrees, right positive)")
+    p.add_argument("--tilt", type=_angle, metavar="DEG", help="tilt to this angle (degrees, up positive)")
+    p.add_argument("--zoom", type=_angle, metavar="PCT", help="zoom to this point of its range (%%)")
     p.set_defaults(handler=handle)
 
 
@@ -71,13 +76,15 @@ def handle(args: argparse.Namespace) -> int:
     moving = any(v is not None for v in (args.pan, args.tilt, args.zoom))
 
     async def body(client: AriaClient) -> int:
-        def discard(coro: Any, _name: str) -> None:
-            coro.close()  # the command reads the position back itself
-
-        feed = PtzFeed(lambda **_changes: None, discard, args.timeout)
-        await feed.connected(client)
+        feed = PtzFeed(DetachedContext(client, config=SessionConfig(reply_timeout=args.timeout)))
+        await feed.read_head(client)
+        if feed.read_error is not None:  # a lost link, a silent or malformed reply: its own code, not 4
+            raise feed.read_error
         state = feed.state
         if moving and state.movable and state.can_abs:
+            outside = _outside_limits(args, state)
+            if outside:
+                raise UsageError(outside)
             pan, tilt, zoom = state.position or (0.0, 0.0, 0.0)
             feed.move_abs(
                 pan if args.pan is None else args.pan,
@@ -116,7 +123,21 @@ def handle(args: argparse.Namespace) -> int:
             return fail("ptz", "this camera cannot be pointed absolutely (no setCameraAbs)", EXIT_UNSUPPORTED)
         return EXIT_OK
 
-    return run_with_client("ptz", args, body)
+    return run_with_client("ptz", args, body, role=Role.OBSERVER)
+
+
+def _outside_limits(args: argparse.Namespace, state: PtzState) -> str:
+    """Why a wanted position is outside what the head reports it can do ("" when it is not)."""
+    wanted = [("--pan", args.pan, state.pan_range, "°"), ("--tilt", args.tilt, state.tilt_range, "°")]
+    if state.zoom_available:
+        wanted.append(("--zoom", args.zoom, state.zoom_range, " %"))
+    elif args.zoom is not None:
+        return "this camera head has no zoom (--zoom cannot be used)"
+    for option, value, (low, high), unit in wanted:
+        known = low < high  # a head that reports no limits (0…0) is left to clamp on its own
+        if value is not None and known and not low <= value <= high:
+            return f"{option} {value:g} is outside this head's limits: {low:g}…{high:g}{unit}"
+    return ""
 
 
 def _print_head(state: PtzState) -> None:

@@ -1,8 +1,8 @@
 """``rtmu replay FILE.mcap [--conn N]``: the window, showing a recording (its first connection by default).
 
 The file is read first, headless, so a file that is no replayable recording gets its
-reason on stderr and exit 3 without a window. The window then rebuilds every part of the
-state from the recorded bytes; nothing is ever sent to a robot.
+reason on stderr and exit 16 without a window (a missing file: exit 2). The window then
+rebuilds every part of the state from the recorded bytes; nothing is ever sent to a robot.
 """
 
 from __future__ import annotations
@@ -11,9 +11,12 @@ import argparse
 from pathlib import Path
 from typing import Any
 
-from ..exit_codes import EXIT_CONNECTION, EXIT_USAGE
+from ..base.exit_codes import EXIT_BAD_FILE, EXIT_NO_DISPLAY, EXIT_OK, EXIT_USAGE
 from ..recorder.replay_file import ReplayFileError, load
 from ._common import fail
+from ._options import number_in
+
+EXITS = (EXIT_OK, EXIT_USAGE, EXIT_NO_DISPLAY, EXIT_BAD_FILE)
 
 
 def register(subparsers: Any) -> None:
@@ -22,11 +25,15 @@ def register(subparsers: Any) -> None:
         help="open the window on a recording (play, pause, speed, timeline); nothing drives",
         description="Show a flight recording (rtmu record, or the window's own) in the operator window as "
         "it was live: map, robot, trail, sonar, camera, banners. Play, pause, x0.25-x8, scrub and step. "
-        "Drive keys, the D-pad and STOP send nothing. Exit 3 if the file cannot be replayed.",
+        "Drive keys, the D-pad and STOP send nothing.",
     )
     p.add_argument("file", type=Path, metavar="FILE.mcap", help="the recording")
     p.add_argument(
-        "--conn", type=int, default=1, metavar="N", help="which connection of the file (default 1: the first)"
+        "--conn",
+        type=number_in(1, 1_000_000, integer=True),
+        default=1,
+        metavar="N",
+        help="which connection of the file, counted from 1 (default 1: the first)",
     )
     p.add_argument("--fullscreen", action="store_true", help="start full screen (F11 toggles)")
     p.set_defaults(handler=handle)
@@ -34,12 +41,14 @@ def register(subparsers: Any) -> None:
 
 def handle(args: argparse.Namespace) -> int:
     path: Path = args.file
+    if not path.exists():
+        return fail("replay", f"{path} does not exist", EXIT_USAGE)
     if not path.is_file():
         return fail("replay", f"{path} is not a file", EXIT_USAGE)
     try:
         recorded = load(path, args.conn)
     except ReplayFileError as exc:
-        return fail("replay", str(exc), EXIT_CONNECTION)
+        return fail("replay", str(exc), EXIT_BAD_FILE)
     for warning in recorded.warnings:
         fail("replay", f"warning: {warning}", 0)
     from ..ui import app as gui_app

@@ -5,10 +5,11 @@ from __future__ import annotations
 import argparse
 from typing import Any
 
+from ..base.exit_codes import EXIT_OK
+from ..base.textsafe import visible
 from ..client import ld_data
 from ..client.connection import AriaClient
-from ..exit_codes import EXIT_OK
-from ..textsafe import visible
+from ..client.roles import Role
 from ._common import add_connection_arguments, print_json, run_with_client
 
 
@@ -33,4 +34,4 @@ def handle(args: argparse.Namespace) -> int:
                 print(visible(name))
         return EXIT_OK
 
-    return run_with_client("routes", args, body)
+    return run_with_client("routes", args, body, role=Role.OBSERVER)

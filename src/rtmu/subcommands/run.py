@@ -13,11 +13,12 @@ import argparse
 import sys
 from typing import Any
 
+from ..base.exit_codes import EXIT_OK, EXIT_TIMEOUT, EXIT_USAGE
+from ..base.textsafe import visible
 from ..client.connection import AriaClient
 from ..client.custom_commands import MAX_ARGUMENT, list_commands, run_command
-from ..exit_codes import EXIT_OK, EXIT_TIMEOUT, EXIT_USAGE
-from ..textsafe import visible
-from ._common import add_connection_arguments, print_json, run_with_client, unknown_name
+from ..client.roles import Role
+from ._common import add_connection_arguments, known_name, print_json, run_with_client
 
 
 def register(subparsers: Any) -> None:
@@ -47,8 +48,10 @@ def handle(args: argparse.Namespace) -> int:
     async def body(client: AriaClient) -> int:
         catalogue = await list_commands(client, args.timeout)  # NotSupported (exit 4) without a list
         names = tuple(c.name for c in catalogue.commands)
-        if unknown_name("run", "command", args.name, names):
+        name = known_name("run", "command", args.name, names)
+        if name is None:
             return EXIT_USAGE
+        args.name = name
         command = catalogue.find(args.name)
         assert command is not None
         if command.takes_argument and args.argument is None:
@@ -65,4 +68,4 @@ def handle(args: argparse.Namespace) -> int:
             print(f"rtmu run: {visible(command.name)} {silent}", file=sys.stderr)
         return EXIT_OK if taken else EXIT_TIMEOUT
 
-    return run_with_client("run", args, body)
+    return run_with_client("run", args, body, role=Role.OPERATOR)

@@ -6,9 +6,10 @@ import argparse
 import sys
 from typing import Any
 
+from ..base.exit_codes import EXIT_OK, EXIT_USAGE
 from ..client import ld_data
 from ..client.connection import AriaClient
-from ..exit_codes import EXIT_OK, EXIT_USAGE
+from ..client.roles import Role
 from ._common import add_connection_arguments, run_with_client
 
 MAX_TEXT = 1000
@@ -41,4 +42,4 @@ def handle(args: argparse.Namespace) -> int:
         ld_data.say(client, text)
         return EXIT_OK
 
-    return run_with_client("say", args, body)
+    return run_with_client("say", args, body, role=Role.OBSERVER)

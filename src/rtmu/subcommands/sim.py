@@ -14,39 +14,49 @@ import asyncio
 import sys
 from pathlib import Path
 
+from ..base.exit_codes import ENDED, EXIT_CONNECTION, EXIT_OK, EXIT_SIGINT, EXIT_USAGE
+from ..package_data import project_map
 from ._common import until_stop_signal
+from ._options import number_in
 
-EXIT_OK = 0
-EXIT_BAD_INPUT = 2
-EXIT_CANNOT_LISTEN = 3
-
-
-def default_map(name: str = "arena.map") -> Path | None:
-    """One of the project's maps (the arena unless named), when the checkout has it."""
-    here = Path(__file__).resolve()
-    for parent in here.parents:
-        candidate = parent / "data" / "maps" / name
-        if candidate.is_file():
-            return candidate
-    return None
+EXIT_BAD_INPUT = EXIT_USAGE
+EXIT_CANNOT_LISTEN = EXIT_CONNECTION
+EXITS = (EXIT_OK, EXIT_USAGE, EXIT_CONNECTION, *ENDED)
+SIM_DESCRIPTION = (
+    "Run the bundled ARIA robot simulator: an ArNetworking server that behaves on the wire like ARIA's "
+    "serverDemo driving MobileSim (--kind aram: an Omron LD robot), so the RTMU window, ARIA's own example "
+    "clients and MobileEyes-style tools can connect to it. It listens on 127.0.0.1 unless told otherwise; "
+    "Ctrl-C stops it cleanly (every client is told SHUTDOWN). --make-map FILE writes a generated "
+    "building map instead of serving."
+)
 
 
 def register(subparsers: argparse._SubParsersAction) -> None:
     p = subparsers.add_parser(
         "sim",
         help="run the bundled ARIA robot simulator (ArNetworking server, simulated Pioneer 3-DX)",
-        description=__doc__,
-        formatter_class=argparse.RawDescriptionHelpFormatter,
+        description=SIM_DESCRIPTION,
     )
-    p.add_argument("--host", default="127.0.0.1", help="address to listen on (default 127.0.0.1)")
     p.add_argument(
-        "--port", type=int, default=7272, help="TCP port (default 7272, ARIA's; 0 = any free port)"
+        "--host", default="127.0.0.1", metavar="ADDR", help="address to listen on (default 127.0.0.1)"
+    )
+    p.add_argument(
+        "--port",
+        type=number_in(0, 65535, integer=True),
+        default=7272,
+        metavar="PORT",
+        help="the robot server's TCP port (default 7272, ARIA's; 0 = any free port)",
     )
     maps = p.add_mutually_exclusive_group()
-    maps.add_argument("--map", type=Path, help="ARIA .map file to serve (default: the project's arena)")
+    maps.add_argument(
+        "--map", type=Path, metavar="FILE", help="ARIA .map file to serve (default: the project's arena)"
+    )
     maps.add_argument("--no-map", action="store_true", help="serve no map (an empty world)")
     p.add_argument(
-        "--users", type=Path, help="ARIA user-info file (UserInfoVersion1); default: open to anyone"
+        "--users",
+        type=Path,
+        metavar="FILE",
+        help="ARIA user-info file (UserInfoVersion1); default: open to anyone",
     )
     p.add_argument(
         "--no-camera", action="store_true", help="no camera: video and camera data are not offered"
@@ -60,33 +70,51 @@ def register(subparsers: argparse._SubParsersAction) -> None:
     )
     p.add_argument(
         "--camera-hz",
-        type=float,
+        type=number_in(0.1, 60),
         default=10.0,
         metavar="HZ",
-        help="new camera frames per second at most (default 10, like ARIA's video forwarder)",
+        help="the simulated camera's own frame rate, 0.1…60 new frames/s (default 10, like ARIA's video "
+        "forwarder)",
     )
-    p.add_argument("--seed", type=int, default=1, help="seed for everything random (default 1)")
+    p.add_argument("--seed", type=int, default=1, metavar="N", help="seed for everything random (default 1)")
     p.add_argument(
         "--drive-timeout",
-        type=float,
+        type=number_in(0, 3600),
         default=2.0,
-        help="seconds without ratioDrive before a moving robot is stopped (ARIA's 2 s; 0 disables)",
+        metavar="S",
+        help="seconds without ratioDrive before a moving robot is stopped (default 2, ARIA's; 0 disables)",
     )
-    p.add_argument("--battery", type=float, default=None, help="starting battery voltage (default 12.8)")
-    p.add_argument("--server-key", default="", help="ARIA server key mixed into password digests")
+    p.add_argument(
+        "--battery", type=float, default=None, metavar="VOLTS", help="starting battery voltage (default 12.8)"
+    )
+    p.add_argument(
+        "--server-key",
+        default="",
+        metavar="KEY",
+        help="ARIA server key mixed into password digests (default: none)",
+    )
     p.add_argument(
         "--max-clients",
-        type=int,
+        type=number_in(0, 100_000, integer=True),
         default=100,
+        metavar="N",
         help="refuse more clients than this, ARIA's reason 5 (default 100; 0 = no limit)",
     )
     p.add_argument(
-        "--profile",
+        "--kind",
         choices=("default", "aram"),
         default="default",
         help="which server to be: default (serverDemo, Pioneer 3-DX) or aram (an Omron LD robot: "
-        "protocol 6MTX, state of charge, Ex4 map, ~950 data)",
+        "protocol 6MTX, state of charge, Ex4 map, only data 6MTX robots list); default: default",
     )
+    p.add_argument(
+        "--test-hooks",
+        action="store_true",
+        default=None,
+        help="list the simulator's own Simulator… commands (put it in a state: a fault, a locked mode, "
+        "a stall …) also on a kind that leaves them out to stay true to a real robot's list (aram)",
+    )
+    p.add_argument("--profile", dest="kind", choices=("default", "aram"), help=argparse.SUPPRESS)  # old name
     p.add_argument(
         "--protocol",
         metavar="STRING",
@@ -102,12 +130,31 @@ def register(subparsers: argparse._SubParsersAction) -> None:
         help="add N configuration parameters, markup in every text (try clients on a hostile ArConfig)",
     )
     p.add_argument(
+        "--save-map-changes",
+        action="store_true",
+        help="write live map changes (processMapChanges) into the --map file, as ARIA does "
+        "(default: they live in the simulator only)",
+    )
+    p.add_argument(
         "--robots",
         type=int,
         default=None,
         metavar="N",
         help="run N robots on the map, one server each on consecutive ports from --port, "
         "named robot1…N (default 1); with --central: N simulated robots switched to it (default 0)",
+    )
+    p.add_argument(
+        "--files",
+        type=Path,
+        metavar="DIR",
+        help="the folder served to getDirListing/getFile/putFile/deleteFile, where scans are written "
+        "(default: a temporary folder, removed when the simulator stops)",
+    )
+    p.add_argument(
+        "--files-default-dir",
+        metavar="NAME",
+        default=None,
+        help="offer getDefaultUploadDownloadDir naming this folder (ARIA offers it only when given one)",
     )
     p.add_argument("-v", "--verbose", action="store_true", help="log connections and refusals")
     central = p.add_argument_group("ARIA central server (switchServer)")
@@ -118,7 +165,11 @@ def register(subparsers: argparse._SubParsersAction) -> None:
         "robots switch to --robot-port (5000) and are each forwarded on a port of their own",
     )
     central.add_argument(
-        "--robot-port", type=int, default=5000, help="with --central: where robots switch to (default 5000)"
+        "--robot-port",
+        type=number_in(0, 65535, integer=True),
+        default=5000,
+        metavar="PORT",
+        help="with --central: where robots switch to (default 5000)",
     )
     central.add_argument(
         "--switch-to",
@@ -126,11 +177,28 @@ def register(subparsers: argparse._SubParsersAction) -> None:
         help="as a robot: connect out to this central server's robot port (default port 5000) and be "
         "forwarded by it (ARIA's -centralServer); direct logins are then refused with reason 2",
     )
-    central.add_argument("--name", default="", help="with --switch-to: the robot's name (ARIA's -identifier)")
+    central.add_argument(
+        "--name",
+        default="",
+        metavar="NAME",
+        help="with --switch-to: the robot's name (ARIA's -identifier; default: its address)",
+    )
     gen = p.add_argument_group("map generator (writes a map and exits)")
     gen.add_argument("--make-map", type=Path, metavar="FILE", help="write a generated building map to FILE")
-    gen.add_argument("--points", type=int, default=100_000, help="points in the generated map")
-    gen.add_argument("--lines", type=int, default=5_000, help="line segments in the generated map")
+    gen.add_argument(
+        "--points",
+        type=int,
+        default=100_000,
+        metavar="N",
+        help="points in the generated map (default 100000)",
+    )
+    gen.add_argument(
+        "--lines",
+        type=int,
+        default=5_000,
+        metavar="N",
+        help="line segments in the generated map (default 5000)",
+    )
     p.set_defaults(handler=run)
 
 
@@ -165,10 +233,13 @@ def run(args: argparse.Namespace) -> int:
     map_path = (
         None
         if args.no_map
-        else (args.map or default_map("office.map" if args.profile == "aram" else "arena.map"))
+        else (args.map or project_map("office.map" if args.kind == "aram" else "arena.map"))
     )
     if map_path is not None and not map_path.is_file():
         print(f"rtmu sim: no such map file: {map_path}", file=sys.stderr)
+        return EXIT_BAD_INPUT
+    if args.files is not None and not args.files.is_dir():
+        print(f"rtmu sim: no such folder: {args.files}", file=sys.stderr)
         return EXIT_BAD_INPUT
     if args.users is not None and not args.users.is_file():
         print(f"rtmu sim: no such user file: {args.users}", file=sys.stderr)
@@ -186,8 +257,12 @@ def run(args: argparse.Namespace) -> int:
         server_key=args.server_key,
         max_clients=args.max_clients if args.max_clients > 0 else None,
         protocol_version=args.protocol,
-        profile=args.profile,
+        profile=args.kind,
+        test_hooks=args.test_hooks,
         config_filler=max(0, min(args.config_filler, 200_000)),
+        files_dir=args.files,
+        files_default_dir=args.files_default_dir,
+        save_map_changes=args.save_map_changes,
         verbose=args.verbose,
     )
     if args.battery is not None:
@@ -204,20 +279,23 @@ def run(args: argparse.Namespace) -> int:
     if args.verbose:
         import logging
 
-        logging.basicConfig(level=logging.INFO, format="%(asctime)s %(name)s: %(message)s")
+        from ..base import logs
+
+        logs.configure(logging.INFO)
     try:
         if args.central:
             from ._sim_central import serve_central
 
             return asyncio.run(serve_central(cfg, args.robot_port, args.robots))
         return asyncio.run(serve(cfg) if args.robots == 1 else serve_fleet(cfg, args.robots))
-    except KeyboardInterrupt:
-        return EXIT_OK
+    except KeyboardInterrupt:  # before the handlers were in place
+        return EXIT_SIGINT
 
 
 async def serve(cfg) -> int:
-    from ..maps import MapFormatError
+    from ..mapfile import MapFormatError
     from ..sim import SimServer
+    from ..sim.profiles import get_profile
 
     try:
         server = SimServer(cfg)
@@ -238,20 +316,26 @@ async def serve(cfg) -> int:
         extras += f"; profile {cfg.profile}"
     if cfg.protocol_version:
         extras += f"; protocol {cfg.protocol_version!r} enforced"
+    from ..sim.files_folder import files_folder
+
+    files = files_folder(server)
+    extras += f"; files in {files.root}" + (" (temporary)" if files.temporary is not None else "")
     print(
         f"rtmu sim: ARIA robot server listening on {cfg.host}:{server.port}, serving {served}; "
-        f"Pioneer 3-DX at ({home[0]:.0f}, {home[1]:.0f}) mm, {home[2]:.0f} deg{extras}",
+        f"{get_profile(cfg.profile).robot} at ({home[0]:.0f}, {home[1]:.0f}) mm, {home[2]:.0f} deg{extras}",
         flush=True,
     )
-    await until_stop_signal()
+    code = await until_stop_signal()
     print("rtmu sim: stopping (telling clients SHUTDOWN)", flush=True)
     await server.stop()
-    return EXIT_OK
+    if files.temporary is not None:
+        files.temporary.cleanup()
+    return code
 
 
 async def serve_fleet(cfg, count: int) -> int:
     """``--robots N``: N servers on one loop (``sim.multi``), one line per robot, Ctrl-C stops all."""
-    from ..maps import MapFormatError
+    from ..mapfile import MapFormatError
     from ..sim.multi import SimFleet, fleet_configs
 
     try:
@@ -268,14 +352,14 @@ async def serve_fleet(cfg, count: int) -> int:
         x, y, th = server.home
         print(f"rtmu sim: {robot.name} listening on {cfg.host}:{server.port}, "
               f"at ({x:.0f}, {y:.0f}) mm, {th:.0f} deg", flush=True)  # fmt: skip
-    await until_stop_signal()
+    code = await until_stop_signal()
     print("rtmu sim: stopping every robot (telling clients SHUTDOWN)", flush=True)
     await fleet.stop()
-    return EXIT_OK
+    return code
 
 
 def make_map(args: argparse.Namespace) -> int:
-    from ..maps import write_map
+    from ..mapfile import write_map
     from ..sim.mapgen import generate_map
 
     if args.points < 0 or args.lines < 0:

@@ -15,10 +15,11 @@ import contextlib
 import sys
 from typing import Any
 
+from ..base.exit_codes import EXIT_OK
 from ..client import ld_data
 from ..client.connection import AriaClient, Packet
-from ..client.errors import ClientTimeout, NotSupported, ProtocolFault
-from ..exit_codes import EXIT_OK
+from ..client.errors import ClientTimeout, ProtocolFault
+from ..client.roles import Role
 from ..protocol.errors import ProtocolError
 from ..protocol.payloads.ld import DockInfo
 from ..protocol.payloads.robot import Update, UpdateNumbers, UpdateStrings
@@ -26,35 +27,49 @@ from ._common import (
     add_connection_arguments,
     battery_is_soc,
     fetch_status,
+    no_status,
     print_json,
     run_with_client,
     status_line,
     status_object,
 )
+from ._options import number_in
+
+HEARTBEAT = 1.0
+"""Seconds: an unchanged status is printed again this often, so a reader knows the link is alive."""
 
 
 def register(subparsers: Any) -> None:
     p = subparsers.add_parser(
         "status",
         help="print or stream the robot status",
-        description="Print the robot status once (--once) or stream it until interrupted. "
-        "JSON keys: x, y (mm), th (deg), vel (mm/s), rot_vel (deg/s), battery_v (volts) or "
-        "battery_pct (state of charge), status, mode.",
+        description="Print the robot status once (--once) or stream it until interrupted: a line whenever "
+        f"the status changes, and the same line again at most every {HEARTBEAT:g} s while it does not "
+        "(a heartbeat: the link is alive). JSON keys (schema status): x, y (mm), th (deg), vel (mm/s), "
+        "rot_vel (deg/s), battery_v (volts) or battery_pct (state of charge), status, mode, and dock "
+        "where the server offers dockInfo.",
     )
     add_connection_arguments(p)
     p.add_argument("--once", action="store_true", help="print one status and exit")
     p.add_argument("--json", action="store_true", help="JSON: one object (one per line when streaming)")
     p.add_argument(
-        "--interval", type=int, default=100, metavar="MS", help="update interval when streaming (default 100)"
+        "--interval",
+        type=number_in(10, 60_000, integer=True),
+        default=100,
+        metavar="MS",
+        help="how often the server is asked for the status when streaming, 10…60000 ms (default 100)",
     )
-    p.add_argument("--count", type=int, default=0, metavar="N", help="stop after N updates (0 = never)")
+    p.add_argument(
+        "--count",
+        type=number_in(0, 1e9, integer=True),
+        default=0,
+        metavar="N",
+        help="stop after N lines (default 0: never)",
+    )
     p.set_defaults(handler=handle)
 
 
 def handle(args: argparse.Namespace) -> int:
-    if args.interval < 10:
-        args.interval = 10
-
     def show(obj: dict[str, Any]) -> None:
         if args.json:
             print_json(obj)
@@ -70,7 +85,7 @@ def handle(args: argparse.Namespace) -> int:
             return EXIT_OK
         return await stream(client, args, show)
 
-    return run_with_client("status", args, body)
+    return run_with_client("status", args, body, role=Role.OBSERVER)
 
 
 def say(message: str) -> None:
@@ -125,7 +140,7 @@ async def stream(client: AriaClient, args: argparse.Namespace, show: Any) -> int
     elif client.supports("update"):
         client.request("update", args.interval, on_numbers)
     else:
-        raise NotSupported("updateNumbers", "this server offers no robot status (updateNumbers or update)")
+        raise no_status(client)
     shown = 0
     # A status must come within the interval plus the timeout, or the link is dead.
     gap = args.interval / 1000.0 + args.timeout
@@ -134,6 +149,8 @@ async def stream(client: AriaClient, args: argparse.Namespace, show: Any) -> int
     """Silence this long is worth a word on stderr before the timeout ends the stream."""
     last = loop.time()
     quiet = False
+    printed: dict[str, Any] | None = None
+    printed_at = 0.0
     while args.count <= 0 or shown < args.count:
         deadline = loop.time() + gap
         while queue.empty():
@@ -153,6 +170,9 @@ async def stream(client: AriaClient, args: argparse.Namespace, show: Any) -> int
             quiet = False
             say(f"status resumed after {loop.time() - last:.1f} s")
         last = loop.time()
-        show(queue.get_nowait())
-        shown += 1
+        current = queue.get_nowait()
+        if current != printed or last - printed_at >= HEARTBEAT:  # a change, or the heartbeat is due
+            show(current)
+            printed, printed_at = current, last
+            shown += 1
     return EXIT_OK

@@ -18,16 +18,21 @@ import time
 from pathlib import Path
 from typing import Any
 
+from ..base.exit_codes import EXIT_CONNECTION, EXIT_OK, EXIT_USAGE
+from ..base.textsafe import visible
 from ..client.connection import AriaClient
-from ..client.video_feed import MAX_FPS, MIN_FPS, LiveFrame, VideoFeed, VideoStatus, video_source
-from ..exit_codes import EXIT_CONNECTION, EXIT_OK
-from ..textsafe import visible
-from ._common import add_connection_arguments, fail, run_with_client
+from ..client.roles import Role
+from ..client.video_feed import LiveFrame, VideoFeed, VideoStatus, video_source
+from ._common import UsageError, add_connection_arguments, fail, run_with_client
+from ._options import add_fps_option, add_quality_option
+from ._output import add_force_option, check_folder
 from .image import picture_problem
 
 MAX_DECODES_QUEUED = 2
 """Frames waiting for the decoder; more are counted as skipped rather than queued without end."""
 MAX_NOTES = 5
+FRAME_NAME = "frame_{:06d}.jpg"
+FRAME_GLOB = "frame_*.jpg"
 
 
 def register(subparsers: Any) -> None:
@@ -40,15 +45,16 @@ def register(subparsers: Any) -> None:
     add_connection_arguments(p)
     p.add_argument("--seconds", type=float, default=5.0, metavar="S", help="how long to play (default 5)")
     p.add_argument("--json", action="store_true", help="print one summary object (JSON) at the end")
-    p.add_argument("--out", type=Path, default=None, metavar="DIR", help="save every decoded frame here")
     p.add_argument(
-        "--fps",
-        type=float,
-        default=15.0,
-        metavar="N",
-        help=f"frames per second at most ({MIN_FPS:g}…{MAX_FPS:g})",
+        "--out",
+        type=Path,
+        default=None,
+        metavar="DIR",
+        help="save every decoded frame here as frame_NNNNNN.jpg (the folder is made if missing)",
     )
-    p.add_argument("--quality", type=int, default=None, metavar="Q", help="JPEG quality 0…100 to ask for")
+    add_fps_option(p, default=15.0)
+    add_quality_option(p)
+    add_force_option(p, "frames saved in DIR by an earlier run")
     p.add_argument("--camera", default=None, metavar="NAME", help="camera name (getPicture<NAME>)")
     p.set_defaults(handler=handle)
 
@@ -94,7 +100,7 @@ class _Player:
     def _decode(self, frame: LiveFrame) -> str | None:
         problem = picture_problem(frame.jpeg, frame.width, frame.height)
         if problem is None and self.out is not None:
-            (self.out / f"frame_{frame.sequence:06d}.jpg").write_bytes(frame.jpeg)
+            (self.out / FRAME_NAME.format(frame.sequence)).write_bytes(frame.jpeg)
         return problem
 
     def _done(self, frame: LiveFrame, future: asyncio.Future[str | None]) -> None:
@@ -133,9 +139,15 @@ class _Player:
 
 def handle(args: argparse.Namespace) -> int:
     if args.seconds <= 0:
-        return fail("video", "--seconds must be above 0", 2)
+        return fail("video", "--seconds must be above 0", EXIT_USAGE)
     if args.out is not None:
-        args.out.mkdir(parents=True, exist_ok=True)
+        try:  # before connecting: frames are not fetched for a folder that cannot hold them
+            check_folder(args.out)
+            if not args.force and args.out.is_dir() and any(args.out.glob(FRAME_GLOB)):
+                raise UsageError(f"{args.out} holds frames of an earlier run; give --force to replace them")
+            args.out.mkdir(exist_ok=True)
+        except (UsageError, OSError) as exc:
+            return fail("video", str(exc), EXIT_USAGE)
 
     async def body(client: AriaClient) -> int:
         source = video_source(client, args.camera)
@@ -188,6 +200,12 @@ def handle(args: argparse.Namespace) -> int:
                 f"from {visible(source)} in "
                 f"{elapsed:.1f} s: {summary['fps']} fps, {summary['kbps']} kB/s{age}"
                 + (f"; {summary['dropped']} dropped" if summary["dropped"] else "")
+                + (
+                    f"; {summary['repeats']} repeats (the camera had no newer picture: it is slower than "
+                    "asked, not the link)"
+                    if summary["repeats"]
+                    else ""
+                )
                 + (f"; {visible(status.backoff)}" if status.backoff else "")
             )
         if player.decoded == 0:
@@ -195,7 +213,7 @@ def handle(args: argparse.Namespace) -> int:
             return fail("video", f"no frame could be shown: {why}", EXIT_CONNECTION)
         return EXIT_OK
 
-    return run_with_client("video", args, body)
+    return run_with_client("video", args, body, role=Role.OBSERVER)
 
 
 def _round(value: float | None) -> float | None:

@@ -3,7 +3,7 @@
 Subscribes to the server's broadcasts only (interval −1) — popups opened and closed, the active
 mode, the status strings, map, goals and configuration updated — so a script can follow a robot
 without polling. The popups already open are listed first (``popupList``). Lines show server text
-escaped (:func:`rtmu.textsafe.visible`); ``--json`` gives one object per line with the exact
+escaped (:func:`rtmu.base.textsafe.visible`); ``--json`` gives one object per line with the exact
 strings. Exit 0 after ``--seconds``; 3 when the connection ends; Ctrl-C ends it as every command.
 """
 
@@ -16,13 +16,14 @@ import time
 from collections.abc import Callable
 from typing import Any
 
+from ..base.exit_codes import EXIT_OK
+from ..base.textsafe import visible
 from ..client.connection import AriaClient, Packet
 from ..client.errors import NotSupported
-from ..exit_codes import EXIT_OK
+from ..client.roles import Role
 from ..protocol.errors import ProtocolError
 from ..protocol.payloads.popup import PopupClose, PopupCreate, PopupType
 from ..protocol.payloads.robot import ModeInfo, UpdateStrings
-from ..textsafe import visible
 from ._common import add_connection_arguments, positive_float, print_json, run_with_client
 
 PLAIN_EVENTS = {
@@ -123,4 +124,4 @@ def handle(args: argparse.Namespace) -> int:
             await asyncio.sleep(0.1 if end is None else min(0.1, max(0.0, end - loop.time())))
         return EXIT_OK
 
-    return run_with_client("watch", args, body)
+    return run_with_client("watch", args, body, role=Role.OBSERVER)

@@ -1,4 +1,4 @@
-"""RTMU's GTK4 window: the view layer over ``rtmu.controller`` and ``rtmu.model``.
+"""RTMU's GTK4 window: the view layer over ``rtmu.control.controller`` and ``rtmu.model.observables``.
 
 One module per job: ``app`` (entry points and options, no GTK import),
 ``application`` (Gtk.Application: settings, network thread, window, shutdown),

@@ -1,6 +1,6 @@
 """The alarms on screen: a banner per active alarm and one short beep per crossing, with a mute.
 
-``rtmu.alarms`` decides (levels, hysteresis); this shows. Never a modal dialog:
+``rtmu.control.alarms`` decides (levels, hysteresis); this shows. Never a modal dialog:
 each alarm is a banner of its own topic (``alarm:battery`` …) that stays while
 the alarm is active and goes when it clears (a clear says so for a few
 seconds). The sound is the display's bell (:meth:`Gdk.Display.beep`): it
@@ -13,8 +13,8 @@ from __future__ import annotations
 
 from collections.abc import Callable
 
-from ..alarms import Alarm, AlarmEvent, AlarmMonitor, Severity
-from ..model import RobotModel
+from ..control.alarms import Alarm, AlarmEvent, AlarmMonitor, Severity
+from ..model.observables import RobotModel
 from .banners import BannerStack
 
 LEVEL = {Severity.WARNING: "warning", Severity.CRITICAL: "error"}

@@ -2,23 +2,21 @@
 
 GTK is imported only when the window really opens (``application`` module), so
 ``rtmu --help`` and the headless subcommands never initialise a display. With
-``--demo`` the bundled simulator runs on a free loopback port beside the window
-for as long as it lives.
+``--demo`` the bundled simulator runs beside the window for as long as it lives (``ui.demo``).
 """
 
 from __future__ import annotations
 
 import argparse
-import os
 import sys
-import tempfile
-from dataclasses import replace
-from pathlib import Path
+from typing import TYPE_CHECKING
 
-from ..settings import DEFAULT_PORT, parse_central
+from ..base.exit_codes import EXIT_CONNECTION, EXIT_INTERNAL, EXIT_NO_DISPLAY, EXIT_USAGE
+from ..settings.store import DEFAULT_PORT, parse_central
 from .options import GuiOptions
 
-EXIT_NO_DISPLAY = 6
+if TYPE_CHECKING:
+    from .demo import RunningDemo
 
 
 def add_gui_arguments(parser: argparse.ArgumentParser) -> None:
@@ -34,17 +32,18 @@ def add_gui_arguments(parser: argparse.ArgumentParser) -> None:
         type=int,
         default=1,
         metavar="N",
-        help="with --demo: N simulated robots on one map (as rtmu sim --robots N), all in the window",
+        help="with --demo: N simulated robots on one map (as rtmu sim --robots N), all in the window "
+        "(default 1)",
     )
     g.add_argument(
         "--central",
         metavar="HOST[:PORT]",
         help="ARIA's central server: every robot it lists in the window (as a profile's central = …)",
     )
-    g.add_argument("--host", help="robot server to connect to (default: the last profile)")
-    g.add_argument("--port", type=int, help=f"its port (default {DEFAULT_PORT})")
-    g.add_argument("--user", help="user name for the server (asks for the password)")
-    g.add_argument("--profile", help="use this saved connection profile")
+    g.add_argument("--host", metavar="HOST", help="robot server to connect to (default: the last profile)")
+    g.add_argument("--port", type=int, metavar="PORT", help=f"its port (default {DEFAULT_PORT})")
+    g.add_argument("--user", metavar="USER", help="user name for the server (asks for the password)")
+    g.add_argument("--profile", metavar="NAME", help="use this saved connection profile")
     g.add_argument(
         "--protocol",
         metavar="STRING",
@@ -74,36 +73,28 @@ def options_from_args(args: argparse.Namespace) -> GuiOptions:
     )
 
 
-def demo_fleet_options(options: GuiOptions, endpoints: list[tuple[str, int]]) -> GuiOptions:
-    """The window on every simulated robot of ``--demo --robots N``."""
-    from ..settings import DirectRobot
-
-    robots = tuple(DirectRobot(name, "127.0.0.1", port) for name, port in endpoints)
-    return replace(options, fleet=robots, host=None, port=None, user=None, persist=False, connect=True)
-
-
 def run_gui(args: argparse.Namespace) -> int:
     """Open the window; with ``--demo`` run the simulator beside it for as long as the window lives."""
     options = options_from_args(args)
     if options.port is not None and not 1 <= options.port <= 65535:
         print(f"rtmu: --port {options.port} is not 1…65535", file=sys.stderr)
-        return 2
+        return EXIT_USAGE
     if options.central is not None:
         try:
             parse_central(options.central)
         except ValueError as exc:
             print(f"rtmu: --central: {exc}", file=sys.stderr)
-            return 2
+            return EXIT_USAGE
         if options.host or options.demo:
             print("rtmu: --central goes without --host and --demo", file=sys.stderr)
-            return 2
+            return EXIT_USAGE
     robots = getattr(args, "robots", 1)
     if robots != 1 and not options.demo:
         print("rtmu: --robots N goes with --demo (a fleet profile names real robots)", file=sys.stderr)
-        return 2
+        return EXIT_USAGE
     if not 1 <= robots <= 50:
         print(f"rtmu: --robots {robots} is not 1…50", file=sys.stderr)
-        return 2
+        return EXIT_USAGE
     if not display_available():
         print(
             "rtmu: cannot open a display (is DISPLAY or WAYLAND_DISPLAY set?); "
@@ -111,25 +102,21 @@ def run_gui(args: argparse.Namespace) -> int:
             file=sys.stderr,
         )
         return EXIT_NO_DISPLAY
-    sim = None
+    sim: RunningDemo | None = None
     if options.demo:
+        from .demo import start_demo
+
         try:
-            sim = start_demo_simulator(robots)
+            options, sim = start_demo(options, robots)
         except Exception as exc:  # the window is useless without it: say why and stop
             print(f"rtmu: the demo simulator did not start: {exc}", file=sys.stderr)
-            return 3
-        if robots == 1:
-            options = replace(
-                options, host="127.0.0.1", port=sim.port, user=None, persist=False, connect=True
-            )
-        else:
-            options = demo_fleet_options(options, sim.endpoints())
+            return EXIT_CONNECTION
     try:
         from .application import RtmuApplication
 
         app = RtmuApplication(options)
         status = int(app.run([sys.argv[0]]))
-        return 1 if app.failed and status == 0 else status
+        return EXIT_INTERNAL if app.failed and status == 0 else status
     finally:
         if sim is not None:
             sim.stop()
@@ -144,30 +131,3 @@ def display_available() -> bool:
     from gi.repository import Gdk, Gtk
 
     return bool(Gtk.init_check()) and Gdk.Display.get_default() is not None
-
-
-def demo_map_path() -> Path:
-    """``data/maps/office.map`` of the checkout; an installed RTMU writes the same map to a temp file."""
-    here = Path(__file__).resolve()
-    for parent in here.parents:
-        candidate = parent / "data" / "maps" / "office.map"
-        if candidate.is_file():
-            return candidate
-    from ..maps import write_map
-    from ..sim.project_maps import office_map
-
-    target = Path(tempfile.gettempdir()) / f"rtmu-demo-{os.getuid()}" / "office.map"
-    target.parent.mkdir(parents=True, exist_ok=True)
-    write_map(office_map(), target)
-    return target
-
-
-def start_demo_simulator(robots: int = 1):
-    from ..sim import SimConfig, SimThread
-
-    config = SimConfig(host="127.0.0.1", port=0, map_path=demo_map_path(), camera=True)
-    if robots == 1:
-        return SimThread(config).start()
-    from ..sim.multi import SimFleetThreads, fleet_configs
-
-    return SimFleetThreads(fleet_configs(config, robots)).start()

@@ -1,7 +1,7 @@
 """The ``Gtk.Application``: settings → profile, the fleet and its first robot session, the window.
 
-Wiring only. The application builds a :class:`rtmu.fleet.Fleet` — of one
-:class:`~rtmu.fleet.RobotSession` for a one-robot profile, or of every robot a
+Wiring only. The application builds a :class:`rtmu.fleet.sessions.Fleet` — of one
+:class:`~rtmu.fleet.sessions.RobotSession` for a one-robot profile, or of every robot a
 fleet profile's roster names (``fleet.direct_roster``), each session's network
 thread posting back with ``GLib.idle_add`` — and a window that shows the selected
 session (``fleet_bind`` adds the robot list and the other robots on the map). Every way
@@ -29,9 +29,10 @@ from ..client.central import CentralRoster  # noqa: E402
 from ..client.mapcache import SharedMaps  # noqa: E402
 from ..client.roster import RobotEndpoint, Roster  # noqa: E402
 from ..client.session import SessionConfig  # noqa: E402
-from ..fleet import Fleet, RobotSession, direct_roster, robot_profile  # noqa: E402
-from ..model import Phase  # noqa: E402
-from ..settings import (  # noqa: E402
+from ..fleet.sessions import Fleet, RobotSession, direct_roster, robot_profile  # noqa: E402
+from ..model.observables import NearPeople, Phase  # noqa: E402
+from ..recorder.replay import REPLAY_CONFIG  # noqa: E402
+from ..settings.store import (  # noqa: E402
     DEFAULT_PORT,
     KeyringSecrets,
     Profile,
@@ -41,10 +42,10 @@ from ..settings import (  # noqa: E402
     save_settings,
 )
 from .fleet_bind import FleetBinding  # noqa: E402
-from .keys import accels_for  # noqa: E402
+from .keys import accelerated  # noqa: E402
 from .options import APP_ID, GuiOptions  # noqa: E402
 from .replay_bar import ReplayBar  # noqa: E402
-from .replay_mode import REPLAY_CONFIG, open_replay, replay_profile, show_replay  # noqa: E402
+from .replay_mode import open_replay, replay_profile, show_replay  # noqa: E402
 from .selected_model import SelectedModel  # noqa: E402
 from .style import install_css  # noqa: E402
 from .window import MainWindow  # noqa: E402
@@ -117,9 +118,8 @@ class RtmuApplication(Gtk.Application):
         quit_action = Gio.SimpleAction.new("quit", None)
         quit_action.connect("activate", lambda _a, _p: self.quit_safely())
         self.add_action(quit_action)
-        for target in ("app.quit", "win.fullscreen", "win.toolbar", "win.connect", "win.disconnect",
-                       "win.settings", "win.show-help-overlay"):  # fmt: skip
-            self.set_accels_for_action(target, accels_for(target))
+        for binding in accelerated():  # F11, Ctrl+T, Ctrl+comma, Ctrl+?, Ctrl+Q: from the one key table
+            self.set_accels_for_action(binding.action, list(binding.accels))
         # Ctrl+C, kill, a closed terminal (SIGHUP), Ctrl+\ (SIGQUIT), SIGUSR1/2 and SIGALRM all end the
         # window the same way: stop the robot first, then quit. Left to their default, they would kill
         # the process with the robot still driving until the server's watchdog noticed.
@@ -199,6 +199,9 @@ class RtmuApplication(Gtk.Application):
         self.window = window
         window.handheld.set_muted(self.settings.alarms_muted)
         window.handheld.on_mute = self._alarms_muted
+        cap = self.settings.near_people_mm_s or NearPeople().mm_s
+        window.near_people.use(NearPeople(self.settings.near_people, cap))
+        window.near_people.on_change = self._near_people
         window.layers.use_choices(self.settings.layers)  # the operator's drawings, remembered per server
         # Closing the window stops every robot of the fleet, not only the one it shows.
         window.connect("close-request", lambda _w: self.fleet.stop_all() and False)
@@ -402,6 +405,17 @@ class RtmuApplication(Gtk.Application):
             speed=operator.speed.value.percent,
         )
 
+    def _near_people(self, setting: NearPeople) -> None:
+        if (self.settings.near_people, self.settings.near_people_mm_s or NearPeople().mm_s) == (
+            setting.on,
+            setting.mm_s,
+        ):
+            return
+        self.settings.near_people = setting.on
+        self.settings.near_people_mm_s = None if setting.mm_s == NearPeople().mm_s else setting.mm_s
+        if self.options.persist:
+            self._save(background=True)
+
     def _alarms_muted(self, muted: bool) -> None:
         self.settings.alarms_muted = muted
         if self.options.persist:
@@ -414,6 +428,8 @@ class RtmuApplication(Gtk.Application):
             s.last_profile,
             s.recording,
             alarms_muted=s.alarms_muted,
+            near_people=s.near_people,
+            near_people_mm_s=s.near_people_mm_s,
             layers={server: dict(choices) for server, choices in s.layers.items()},
         )
         path = self.options.settings_path

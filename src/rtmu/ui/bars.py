@@ -11,7 +11,7 @@ stops the robot without a keyboard, so it never hides.
 
 from __future__ import annotations
 
-from collections.abc import Callable
+from collections.abc import Callable, Sequence
 
 import gi
 
@@ -61,6 +61,47 @@ def show_connection(button: Gtk.Button, connected_ish: bool) -> None:
     )
 
 
+class HeaderBar(Gtk.HeaderBar):
+    """STOP, Connect/Disconnect, the title over the status line; at the end the menu, then ``end``
+    (the window's camera, Routes and Go to buttons)."""
+
+    def __init__(
+        self,
+        *,
+        on_stop: Callable[[], None],
+        on_connect: Callable[[], None],
+        menu: Gio.MenuModel,
+        end: Sequence[Gtk.Widget] = (),
+    ) -> None:
+        super().__init__()
+        # Safety: STOP is always on screen, first in the bar and the only red button in it.
+        self.stop_button = stop_button(on_stop)
+        self.pack_start(self.stop_button)
+        self.connect_button = connect_button(on_connect)
+        self.pack_start(self.connect_button)
+        title_box = Gtk.Box(orientation=Gtk.Orientation.VERTICAL, valign=Gtk.Align.CENTER)
+        title_box.add_css_class("title-box")
+        self.title_label = Gtk.Label(label="RTMU")
+        self.title_label.add_css_class("title")
+        self.title_label.set_ellipsize(Pango.EllipsizeMode.END)  # a 560 px window keeps its buttons
+        self.subtitle_label = Gtk.Label(label="")
+        self.subtitle_label.add_css_class("subtitle")
+        self.subtitle_label.set_ellipsize(Pango.EllipsizeMode.END)
+        self.subtitle_label.set_max_width_chars(48)
+        title_box.append(self.title_label)
+        title_box.append(self.subtitle_label)
+        self.set_title_widget(title_box)
+        self.menu_button = menu_button(menu)
+        self.pack_end(self.menu_button)
+        for widget in end:
+            self.pack_end(widget)
+
+    def show_status(self, connected_ish: bool, status: str) -> None:
+        """Connect ⇄ Disconnect and the status line (``notes.status_line``)."""
+        show_connection(self.connect_button, connected_ish)
+        self.subtitle_label.set_text(status)
+
+
 class FullscreenBar(Gtk.Revealer):
     """STOP, Connect/Disconnect, the status line, the menu and "leave full screen", at the top edge."""
 
@@ -92,3 +133,8 @@ class FullscreenBar(Gtk.Revealer):
         box.append(self.leave_button)
         self.set_child(box)
         self.set_reveal_child(False)
+
+    def show_status(self, connected_ish: bool, status: str) -> None:
+        """As the header bar's, which it stands in for."""
+        show_connection(self.connect_button, connected_ish)
+        self.status_label.set_text(status)

@@ -11,10 +11,10 @@ from __future__ import annotations
 
 from collections.abc import Callable
 
-from ..fleet import RobotSession
-from ..notices import Kind, Notice
+from ..base.notices import Kind, Notice
+from ..fleet.sessions import RobotSession
 from ..recorder.bridge import DEFAULT_PORT, Bridge
-from ..state import ConnectionChanged, MapChanged, RobotChanged, StateChange
+from ..values.state import ConnectionChanged, MapChanged, RobotChanged, StateChange
 
 HOST = "127.0.0.1"
 
@@ -54,6 +54,13 @@ class BridgeToggle:
         except Exception as exc:
             self.tell(Notice.error(Kind.RECORDING, f"Foxglove bridge not started: {exc}"))
             return False
+        self._attach(bridge)
+        self.bridge = bridge
+        self.tell(Notice.info(Kind.RECORDING, f"Foxglove bridge on ws://{HOST}:{bridge.port} (no drive)"))
+        return True
+
+    def _attach(self, bridge: Bridge) -> None:
+        """Publish this session's changes on ``bridge``, seeded with what the window shows now."""
         runner = self.session.runner
         before = self._before = runner.on_publish
 
@@ -70,9 +77,6 @@ class BridgeToggle:
         ):
             bridge.published(change)
         runner.on_publish = both
-        self.bridge = bridge
-        self.tell(Notice.info(Kind.RECORDING, f"Foxglove bridge on ws://{HOST}:{bridge.port} (no drive)"))
-        return True
 
     def _stop(self) -> None:
         bridge, self.bridge = self.bridge, None
@@ -80,6 +84,16 @@ class BridgeToggle:
         if bridge is not None:
             bridge.close()
         self.tell(Notice.info(Kind.RECORDING, "Foxglove bridge stopped"))
+
+    def follow_selection(self, old: RobotSession, new: RobotSession) -> None:
+        """The window shows another robot: the bridge publishes that one (it runs on, same port)."""
+        bridge = self.bridge
+        self.session = new
+        if bridge is None:
+            return
+        old.runner.on_publish = self._before
+        self._attach(bridge)
+        self.tell(Notice.info(Kind.RECORDING, f"Foxglove bridge now shows {new.name}"))
 
     def close(self) -> None:
         if self.bridge is not None:

@@ -21,7 +21,7 @@ gi.require_version("Pango", "1.0")
 gi.require_version("Gdk", "4.0")
 from gi.repository import Gdk, GLib, Gtk, Pango  # noqa: E402
 
-from ..model import CameraImage  # noqa: E402
+from ..model.observables import CameraImage  # noqa: E402
 
 MAX_SIDE = 4096
 DECODE_SIDE = 1024

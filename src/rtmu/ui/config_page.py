@@ -2,13 +2,17 @@
 
 A window of its own (menu: Server ▸ Configuration…), so typing in it never reaches the main
 window's drive keys. Everything it shows comes from the server and is set as plain text, never as
-markup. A section shows :data:`PAGE_SIZE` parameters at a time, so a configuration of tens of
-thousands of parameters costs a page of widgets, not one per parameter.
+markup; a name (section, parameter) is one line, its control characters shown escaped (a CR in a
+section's name is ``\r``, not a line break). A section shows :data:`PAGE_SIZE` parameters at a
+time, so a configuration of tens of thousands of parameters costs a page of widgets, not one per
+parameter.
 
-Edits are kept by ``(section, name)`` until they are saved, across sections, pages, the priority
-filter and refreshes. When another client changes the configuration (``configUpdated``) the page
-fetches it again, updates what the operator has not touched and says what changed — and which of
-the operator's own unsaved edits the other client changed under them.
+What the operator typed and what the server answered live in a GTK-free
+:class:`~rtmu.ui.config_edits.ConfigEdits` (kept across sections, pages, the priority filter and
+refreshes); this window shows it. When another client changes the configuration (``configUpdated``)
+the page fetches it again, updates what the operator has not touched and says what changed — and
+which of the operator's own unsaved edits the other client changed under them. Requests go as
+intents (``FetchConfig``, ``SetConfig``) through the window's ``request``: the selected robot's.
 """
 
 from __future__ import annotations
@@ -26,78 +30,61 @@ gi.require_version("Gtk", "4.0")
 gi.require_version("Pango", "1.0")
 from gi.repository import Gdk, GLib, Gtk, Pango  # noqa: E402
 
-from ..client.config_feed import (  # noqa: E402
-    MAX_TEXT,
-    ConfigSection,
-    ServerConfig,
-    changed_values,
-    check_value,
-    names_param,
-)
+from ..base.textsafe import visible  # noqa: E402
+from ..client.config_feed import MAX_TEXT, ConfigSection, ForeignConfig, ServerConfig  # noqa: E402
 from ..protocol.payloads.config import ConfigParam, ParamType, Priority, SetConfigReply  # noqa: E402
+from ..values.intents import FetchConfig, Intent  # noqa: E402
+from .config_edits import ConfigEdits, Key  # noqa: E402
 
-Fetch = Callable[[], "concurrent.futures.Future[Any]"]
-Save = Callable[[dict[str, dict[str, str]]], "concurrent.futures.Future[Any]"]
+Request = Callable[[Intent], "concurrent.futures.Future[Any]"]
+"""The window's ``request``: an intent to the selected robot, its answer as a Future."""
 Follow = Callable[[Callable[[], None] | None], None]
-Key = tuple[str, str]
 
 PAGE_SIZE = 60
 """Parameters shown at once (a section with more gets Previous / Next)."""
 MAX_SECTIONS_LISTED = 1000
-MAX_CHANGES_NAMED = 5
 SPIN_LIMIT = 1e12
 """Unlimited numbers (ARIA's INT_MIN/INT_MAX, ±INF) are edited within ± this."""
 PRIORITY_LABELS = ("Basic", "Intermediate", "Advanced", "Expert", "Factory")
-CSS = """
-.config-ok { color: #26a269; font-weight: bold; }
-.config-error { color: #c01c28; }
-.config-edited { color: #1c71d8; }
-.config-banner { background: alpha(#e5a50a, 0.25); padding: 4px 8px; border-radius: 4px; }
-"""
-_css_done = False
-
-
-def install_css() -> None:
-    """The answer colours, once per display (the theme's own .success/.error differ between themes)."""
-    global _css_done
-    display = Gdk.Display.get_default()
-    if _css_done or display is None:
-        return
-    provider = Gtk.CssProvider()
-    provider.load_from_data(CSS.encode())
-    Gtk.StyleContext.add_provider_for_display(display, provider, Gtk.STYLE_PROVIDER_PRIORITY_APPLICATION)
-    _css_done = True
 
 
 class ConfigPage(Gtk.Window):
-    """See the module notes. ``fetch()``/``save(changes)`` return Futures completed on the network thread."""
+    """See the module notes. ``request(intent)`` returns a Future completed on the network thread;
+    ``follow(listener)`` has the page hear another client's changes (None: no longer)."""
 
-    def __init__(self, parent: Gtk.Window | None, fetch: Fetch, save: Save, follow: Follow) -> None:
+    def __init__(self, parent: Gtk.Window | None, request: Request, follow: Follow) -> None:
         super().__init__(
             title="Server configuration", transient_for=parent, modal=False, destroy_with_parent=True
         )
         self.set_default_size(760, 440)
-        self._fetch, self._save, self._follow = fetch, save, follow
-        self.config: ServerConfig | None = None
-        self.edits: dict[Key, str] = {}
-        """Unsaved values (text, as ``setConfig`` sends them)."""
-        self.answers: dict[Key, tuple[bool, str]] = {}
-        """The server's last word on a parameter the operator saved: (accepted, text)."""
+        self._request, self._follow = request, follow
+        self.state = ConfigEdits()
+        """What the operator typed and what the server said (GTK-free)."""
         self.section = 0
         self.page = 0
         self.show_up_to = int(Priority.EXPERT)
         self.rows: dict[Key, tuple[ConfigParam, Gtk.Widget, Gtk.Label]] = {}
         """The parameters on screen now: their description, editor and answer label."""
-        self.fetches = 0
         self.fetching = False
         self._again = ""
         self.saving = False
         self.closed = False
-        install_css()
         self._build()
         self._follow(self.remote_changed)
         self.connect("close-request", self._closing)
         self.refresh()
+
+    @property
+    def config(self) -> ServerConfig | None:
+        return self.state.config
+
+    @property
+    def edits(self) -> dict[Key, str]:
+        return self.state.edits
+
+    @property
+    def fetches(self) -> int:
+        return self.state.fetches
 
     # -- layout -----------------------------------------------------------------------------------
     def _build(self) -> None:
@@ -181,7 +168,9 @@ class ConfigPage(Gtk.Window):
         self.status.set_text("Loading…")
         self.reload_button.set_sensitive(False)
         previous = self.config
-        self._fetch().add_done_callback(lambda f: GLib.idle_add(self._fetched, f, previous, note))
+        self._request(FetchConfig()).add_done_callback(
+            lambda f: GLib.idle_add(self._fetched, f, previous, note)
+        )
 
     def _refresh_later(self, note: str) -> bool:
         if not self.closed:
@@ -199,43 +188,25 @@ class ConfigPage(Gtk.Window):
             again, self._again = self._again, ""
             GLib.idle_add(self._refresh_later, "remote" if again == "remote" else "")
         error = None if future.cancelled() else future.exception()
+        if isinstance(error, ForeignConfig):  # an answer, not a failure: its whole sentence, wrapped
+            self.status.set_text("No configuration RTMU can edit")
+            self.banner.set_text(str(error))
+            self.banner.set_visible(True)
+            return False
         if future.cancelled() or error is not None:
             self.status.set_text(f"Could not load the configuration: {error or 'cancelled'}")
             return False
         config: ServerConfig = future.result()
-        self.config = config
-        self.fetches += 1
-        for key, text in list(self.edits.items()):  # another client set what was being typed: nothing to save
-            param = config.find(*key)
-            if param is not None and (text == param.value_text() or _same_number(param, text)):
-                del self.edits[key]
+        self.state.fetched(config)  # another client set what was being typed: nothing to save
         if previous is not None and note:
-            self._tell_changes(previous, config)
+            self.banner.set_text(self.state.changes_note(previous, config))
+            self.banner.set_visible(True)
         if self.fetches == 1:
             self.show_up_to = int(Priority.of(config.last_editable))
             self.priority.set_selected(self.show_up_to)
         self._fill_sections()
         self._update_status()
         return False
-
-    def _tell_changes(self, old: ServerConfig, new: ServerConfig) -> None:
-        changed = changed_values(old, new)
-        if not changed:
-            self.banner.set_text("Another client saved the configuration; no value changed.")
-            self.banner.set_visible(True)
-            return
-        names = [f"{s}/{n} (now {v})" for s, n, v in changed[:MAX_CHANGES_NAMED]]
-        more = f" and {len(changed) - MAX_CHANGES_NAMED} more" if len(changed) > MAX_CHANGES_NAMED else ""
-        text = "Another client changed " + ", ".join(names) + more + "."
-        clashes = [f"{s}/{n}" for s, n, _ in changed if (s, n) in self.edits]
-        if clashes:
-            text += (
-                " Your unsaved edit of "
-                + ", ".join(clashes[:MAX_CHANGES_NAMED])
-                + " is kept: Save would overwrite their value."
-            )
-        self.banner.set_text(text)
-        self.banner.set_visible(True)
 
     def remote_changed(self) -> None:
         """``configUpdated`` (UI thread): fetch again and say what changed."""
@@ -250,7 +221,7 @@ class ConfigPage(Gtk.Window):
         while (row := self.sections.get_row_at_index(0)) is not None:
             self.sections.remove(row)
         for s in config.sections[:MAX_SECTIONS_LISTED]:
-            label = Gtk.Label(label=s.name, xalign=0.0, ellipsize=Pango.EllipsizeMode.END)
+            label = Gtk.Label(label=visible(s.name), xalign=0.0, ellipsize=Pango.EllipsizeMode.END)
             label.set_tooltip_text(s.comment or None)
             self.sections.append(label)
         count = min(len(config.sections), MAX_SECTIONS_LISTED)
@@ -317,7 +288,7 @@ class ConfigPage(Gtk.Window):
         assert config is not None
         key = (section.name, p.name)
         left = Gtk.Box(orientation=Gtk.Orientation.VERTICAL)
-        name = Gtk.Label(label=p.name, xalign=0.0, wrap=True, max_width_chars=28)
+        name = Gtk.Label(label=visible(p.name), xalign=0.0, wrap=True, max_width_chars=28)
         left.append(name)
         if p.description:
             about = Gtk.Label(label=p.description, xalign=0.0, wrap=True, max_width_chars=40)
@@ -334,7 +305,7 @@ class ConfigPage(Gtk.Window):
         self._show_answer(key)
 
     def _editor(self, p: ConfigParam, key: Key, editable: bool) -> Gtk.Widget:
-        text = self.edits.get(key, p.value_text())
+        text = self.state.edits.get(key, p.value_text())
         widget: Gtk.Widget
         if p.kind is ParamType.BOOL:
             switch = Gtk.Switch(active=text.lower() in ("true", "1", "yes", "on"), halign=Gtk.Align.START)
@@ -383,34 +354,13 @@ class ConfigPage(Gtk.Window):
     # -- edits, validation, answers ---------------------------------------------------------------
     def _edited(self, key: Key, text: str) -> None:
         found = self.rows.get(key)
-        if found is None:
-            return
-        param = found[0]
-        unchanged = text == param.value_text() or _same_number(param, text)
-        if unchanged and key not in self.edits:
-            return  # an editor re-showing the value (a spin button formats it): not an edit
-        if unchanged:
-            self.edits.pop(key, None)
-        elif self.edits.get(key) == text:
-            return
-        else:
-            self.edits[key] = text
-        self.answers.pop(key, None)
-        self._show_answer(key)
-        self._update_status()
+        if found is not None and self.state.edit(key, found[0], text):
+            self._show_answer(key)
+            self._update_status()
 
     def invalid_edits(self) -> dict[Key, str]:
         """Edits that are certainly wrong: key → why."""
-        config = self.config
-        out: dict[Key, str] = {}
-        if config is None:
-            return out
-        for (section, name), text in self.edits.items():
-            p = config.find(section, name)
-            why = "no longer offered by the server" if p is None else check_value(p, text)
-            if why:
-                out[(section, name)] = why
-        return out
+        return self.state.invalid()
 
     def _show_answer(self, key: Key) -> None:
         found = self.rows.get(key)
@@ -419,44 +369,27 @@ class ConfigPage(Gtk.Window):
         param, _editor, label = found
         for css in ("config-error", "config-ok", "config-edited"):
             label.remove_css_class(css)
-        if key in self.edits and key not in self.answers:
-            why = check_value(param, self.edits[key])
-            label.set_text(f"✗ {why}" if why else "edited")
-            label.add_css_class("config-error" if why else "config-edited")
-        elif key in self.answers:
-            ok, text = self.answers[key]
-            label.set_text(text)
-            label.add_css_class("config-ok" if ok else "config-error")
-        else:
-            label.set_text("")
+        note = self.state.note(key, param)
+        label.set_text(note.text)
+        if note.style:
+            label.add_css_class(f"config-{note.style}")
 
     def _update_status(self) -> None:
-        config = self.config
-        if config is None:
+        if self.state.config is None:
             return
-        bad = self.invalid_edits()
-        self.save_button.set_sensitive(bool(self.edits) and not bad and not self.saving)
-        parts = [f"{config.param_count} parameters"]
-        if config.cut:
-            parts.append(f"{config.cut} not shown (too many)")
-        if self.edits:
-            parts.append(f"{len(self.edits)} unsaved")
-        if bad:
-            parts.append(f"{len(bad)} invalid")
-        self.status.set_text(", ".join(parts))
+        self.save_button.set_sensitive(self.state.can_save(self.saving))
+        self.status.set_text(self.state.status())
 
     def save(self) -> None:
         """Send every edit in one ``setConfig``; the answer is shown next to each parameter."""
-        if not self.edits or self.invalid_edits() or self.saving:
+        found = None if self.saving else self.state.save_intent()
+        if found is None:
             return
-        sent = dict(self.edits)
-        changes: dict[str, dict[str, str]] = {}
-        for (section, name), text in sent.items():
-            changes.setdefault(section, {})[name] = text
+        sent, intent = found
         self.saving = True
         self._update_status()
         self.status.set_text("Saving…")
-        self._save(changes).add_done_callback(lambda f: GLib.idle_add(self._saved, f, sent))
+        self._request(intent).add_done_callback(lambda f: GLib.idle_add(self._saved, f, sent))
 
     def _saved(self, future: concurrent.futures.Future[Any], sent: dict[Key, str]) -> bool:
         if self.closed:
@@ -464,36 +397,15 @@ class ConfigPage(Gtk.Window):
         self.saving = False
         error = None if future.cancelled() else future.exception()
         if future.cancelled() or error is not None:
+            self.state.save_failed(sent, str(error or "cancelled"))
             for key in sent:
-                self.answers[key] = (False, f"✗ not saved: {error or 'cancelled'}")
                 self._show_answer(key)
             self._update_status()
             return False
         answer: SetConfigReply = future.result()
-        if answer.accepted:
-            for key, text in sent.items():
-                if self.edits.get(key) == text:
-                    del self.edits[key]
-                self.answers[key] = (True, "✓ accepted")
-        else:
-            blamed = [k for k in sent if names_param(answer.error, *k)]
-            for key in sent:
-                if key in blamed:
-                    self.answers[key] = (False, f"✗ {answer.error}")
-                else:
-                    self.answers[key] = (False, "not saved: the server refused the set")
-            if not blamed:
-                self.banner.set_text(f"The server refused: {answer.error}")
-                self.banner.set_visible(True)
+        whole = self.state.saved(sent, answer)
+        if whole:
+            self.banner.set_text(whole)
+            self.banner.set_visible(True)
         self.refresh()
-        return False
-
-
-def _same_number(p: ConfigParam, text: str) -> bool:
-    """A spin button's text for the value it started with ("2.00" for 2): not an edit."""
-    if p.kind not in (ParamType.INT, ParamType.DOUBLE) or not isinstance(p.value, (int, float)):
-        return False
-    try:
-        return float(text) == float(p.value)
-    except ValueError:
         return False

@@ -18,10 +18,11 @@ gi.require_version("Gtk", "4.0")
 gi.require_version("Pango", "1.0")
 from gi.repository import Gdk, Gtk, Pango  # noqa: E402
 
-from ..model import ConnectionState, RobotModel, RobotState  # noqa: E402
-from ..protocol.payloads.ld import Say, data_store_label  # noqa: E402
+from ..model.observables import ConnectionState, RobotModel, RobotState  # noqa: E402
+from ..protocol.payloads.ld import data_store_label  # noqa: E402
+from ..values.intents import Intent, Say  # noqa: E402
 
-Send = Callable[[str, object], None]
+Ask = Callable[[Intent], object]
 Watch = Callable[[bool], object]
 MAX_SAY = 1000
 NAME_CHARS = 28
@@ -33,11 +34,11 @@ VALUE_CHARS = 40
 class DetailsWindow(Gtk.Window):
     """The details table and the Say field; follows the model while open."""
 
-    def __init__(self, parent: Gtk.Window, model: RobotModel, send: Send, watch: Watch | None = None) -> None:
+    def __init__(self, parent: Gtk.Window, model: RobotModel, ask: Ask, watch: Watch | None = None) -> None:
         super().__init__(title="Robot details", transient_for=parent, modal=False)
         self.set_default_size(420, 360)
         self.model = model
-        self._send = send
+        self._ask = ask
         self._watch = watch
         box = Gtk.Box(orientation=Gtk.Orientation.VERTICAL, spacing=10)
         for side in ("top", "bottom", "start", "end"):
@@ -156,5 +157,5 @@ class DetailsWindow(Gtk.Window):
             return
         self.say_entry.remove_css_class("error")
         self.say_entry.set_tooltip_text(None)
-        self._send("say", Say(text))
+        self._ask(Say(text))
         self.say_entry.set_text("")

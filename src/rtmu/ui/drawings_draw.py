@@ -1,7 +1,7 @@
 """The server's drawings on the map, GTK-free: ARIA's shapes in the server's colours and sizes.
 
 Drawn by :func:`rtmu.ui.frame.draw_frame`, so a frame rendered without a window (tests, the
-benchmark) shows exactly what the window shows. Each :class:`~rtmu.state.DrawingLayer` is drawn
+benchmark) shows exactly what the window shows. Each :class:`~rtmu.values.state.DrawingLayer` is drawn
 opaque in its primary colour, lowest layer first; layers below the robot's (50) go under it, the
 rest (range devices start at 70) over it. Shapes, as ARIA's ``ArDrawingData`` defines them:
 
@@ -23,7 +23,7 @@ from collections.abc import Sequence
 
 import cairo
 
-from ..state import DrawingLayer
+from ..values.state import DrawingLayer
 from .viewport import Viewport
 
 ROBOT_LAYER = 50

@@ -24,11 +24,11 @@ import numpy as np
 gi.require_version("Gtk", "4.0")
 from gi.repository import GLib, Gtk  # noqa: E402
 
-from ..commands import CommandState  # noqa: E402
-from ..fleet import Fleet, RobotSession  # noqa: E402
-from ..model import ConnectionState, LinkLevel, Phase  # noqa: E402
-from ..notices import Kind, Level, Notice  # noqa: E402
-from ..settings import Profile  # noqa: E402
+from ..base.notices import Kind, Level, Notice  # noqa: E402
+from ..control.commands import CommandState  # noqa: E402
+from ..fleet.sessions import Fleet, RobotSession  # noqa: E402
+from ..model.observables import ConnectionState, LinkLevel, Phase  # noqa: E402
+from ..settings.store import Profile  # noqa: E402
 from .fleet_draw import RGB, FleetMark, fleet_colour  # noqa: E402
 from .mapview import STALE_AFTER  # noqa: E402
 from .overlays import ROBOT_RGB  # noqa: E402
@@ -89,6 +89,7 @@ class FleetBinding:
         self.robot_list.set_visible(False)
         window.body.append(self.robot_list)
         window.stage.fleet = self.marks
+        window.keyboard.fleet = fleet  # Alt+1…9, Alt+Page Down / Up and the menu's Robots submenu
         self._unobserve = [
             fleet.sessions.observe(lambda _old, _new: self._sessions_changed()),
             fleet.selected.observe(self._selected_changed),
@@ -126,6 +127,7 @@ class FleetBinding:
                 session.attach_view(BackgroundView(self.window, session.name))
         self.robot_list.set_sessions(sessions, selected)
         self.robot_list.set_visible(len(sessions) > 1)
+        self.window.keyboard.fleet_changed()
         names = {s.name for s in sessions}
         if any(name not in names for name in self._lost):
             self._lost = {n: e for n, e in self._lost.items() if n in names}

@@ -18,7 +18,7 @@ from dataclasses import dataclass
 
 import cairo
 
-from ..state import PtzState
+from ..values.state import PtzState
 from .viewport import Viewport
 
 WIDE_FOV_DEG = 48.0

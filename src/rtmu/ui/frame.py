@@ -15,8 +15,8 @@ from dataclasses import dataclass, field
 
 import cairo
 
-from ..state import DrawingLayer
-from . import drawings_draw, fleet_draw, fov_draw, nav_draw, overlays
+from ..values.state import DrawingLayer
+from . import drawings_draw, fleet_draw, fov_draw, nav_draw, overlays, stop_draw
 from .tiles import BACKGROUND_RGB, EMPTY, TILE, Overview, TileCache
 from .viewport import Viewport
 
@@ -49,6 +49,8 @@ class Scene:
     """The camera's field of view, drawn as a wedge from the robot (None: not shown)."""
     drawings: Sequence[DrawingLayer] = ()
     """The server's drawings (``drawings_draw``) in their shapes and colours, under or over the robot."""
+    stop_reach: stop_draw.StopReach | None = None
+    """While the robot moves: the strip it sweeps before it can stand still (``stop_draw``)."""
 
 
 def draw_frame(ctx: cairo.Context, vp: Viewport, scene: Scene) -> bool:
@@ -75,6 +77,8 @@ def draw_frame(ctx: cairo.Context, vp: Viewport, scene: Scene) -> bool:
         fleet_draw.draw_fleet(ctx, vp, scene.others, footprint=has_map)
     if scene.fov is not None and scene.robot is not None:
         fov_draw.draw_fov(ctx, vp, scene.fov)
+    if scene.stop_reach is not None and scene.robot is not None and not scene.stale:
+        stop_draw.draw_stop_reach(ctx, vp, scene.stop_reach)
     if scene.robot is not None:
         x, y, th = scene.robot
         overlays.draw_trail(ctx, vp, scene.trail, (*scene.robot_rgb, fleet_draw.TRAIL_ALPHA))

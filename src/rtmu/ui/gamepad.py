@@ -1,10 +1,10 @@
-"""libmanette → :class:`rtmu.gamepad.Gamepad`: the thin adapter, no decisions of its own.
+"""libmanette → :class:`rtmu.control.gamepad.Gamepad`: the thin adapter, no decisions of its own.
 
 libmanette (Debian's ``gir1.2-manette-0.2``) finds pads through udev and reads
 them with evdev on the GTK main loop, so its signals arrive on the UI thread —
 the thread the controller lives on. This module only translates its devices and
 events into the mapping's calls; every rule (dead-man, silence, focus, rate
-limit) is in ``rtmu.gamepad``. Without libmanette (another distribution, no
+limit) is in ``rtmu.control.gamepad``. Without libmanette (another distribution, no
 typelib) the window simply has no gamepad.
 """
 
@@ -13,7 +13,7 @@ from __future__ import annotations
 import logging
 from typing import Any
 
-from ..gamepad import AXIS_CODES, BUTTON_CODES, Gamepad
+from ..control.gamepad import AXIS_CODES, BUTTON_CODES, Gamepad
 
 log = logging.getLogger(__name__)
 

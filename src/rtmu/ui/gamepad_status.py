@@ -3,7 +3,7 @@
 A small pill at the map's top right, shown only while a pad is connected: its
 name (plain text: a device name is untrusted), then "LB: hold to drive",
 "LB held: driving" (blue, like a held key) or "Release LB to drive again"
-(amber: a stop happened while it was held, see ``rtmu.gamepad``).
+(amber: a stop happened while it was held, see ``rtmu.control.gamepad``).
 """
 
 from __future__ import annotations
@@ -14,7 +14,7 @@ gi.require_version("Gtk", "4.0")
 gi.require_version("Pango", "1.0")
 from gi.repository import Gtk, Pango  # noqa: E402
 
-from ..gamepad import DeadMan, PadState  # noqa: E402
+from ..control.gamepad import DeadMan, PadState  # noqa: E402
 
 TEXT = {
     DeadMan.NO_PAD: "",

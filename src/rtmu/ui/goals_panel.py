@@ -9,8 +9,9 @@ this robot cannot do instead of looking for it.
 
 Shown only while the connected server navigates in some way. The popover is a surface of its own:
 its keys do not reach the window's key router, so typing in the search field types and arrows move
-in the list, while the stop keys (Space, from the registry) are caught here and stop the robot —
-also mid-navigation, also mid-word. Goal names are plain text; the goal being driven to is marked.
+in the list, while the stop keys (Space) stop the robot there as on every surface of the window
+(``stop_keys``) — also mid-navigation, also mid-word. Goal names are plain text; the goal being
+driven to is marked. Ctrl+G opens it from the keyboard (``keyboard_nav``).
 """
 
 from __future__ import annotations
@@ -20,12 +21,11 @@ from collections.abc import Callable, Mapping
 import gi
 
 gi.require_version("Gtk", "4.0")
-gi.require_version("Gdk", "4.0")
 gi.require_version("Pango", "1.0")
-from gi.repository import Gdk, Gtk, Pango  # noqa: E402
+from gi.repository import Gtk, Pango  # noqa: E402
 
-from ..commands import COMMANDS, CommandState  # noqa: E402
-from ..model import ConnectionState, NavState, Phase, RobotModel  # noqa: E402
+from ..control.commands import COMMANDS, CommandState  # noqa: E402
+from ..model.observables import ConnectionState, NavState, Phase, RobotModel  # noqa: E402
 from .nav_draw import MarkerKind  # noqa: E402
 
 NAV_OFFERS = ("gotoGoal", "gotoRouteGoal", "gotoPose", "home", "dock", "tourGoals", "localizeToPose")
@@ -54,20 +54,12 @@ class GoalsPanel(Gtk.MenuButton):
         goto: Callable[[str], None],
         run: Callable[[str], None],
         pick: Callable[[MarkerKind], None],
-        stop: Callable[[], None],
     ) -> None:
         super().__init__(tooltip_text="Send the robot somewhere: goals, a point, home, the dock")
-        self.set_focusable(False)
-        inner = self.get_first_child()
-        if inner is not None:
-            inner.set_focusable(False)  # keys go to the window's router, as for the menu button
         self.set_icon_name("go-jump-symbolic")  # an icon: the header must still fit a 560 px window
         self.add_css_class("goals-button")
         self.model = model
-        self._goto, self._run, self._pick, self._stop = goto, run, pick, stop
-        self._stop_keys = {
-            Gdk.keyval_to_lower(Gtk.accelerator_parse(a)[1]) for a in COMMANDS.get("stop").keys
-        }
+        self._goto, self._run, self._pick = goto, run, pick
         self._states: dict[str, CommandState] = {}
 
         box = Gtk.Box(orientation=Gtk.Orientation.VERTICAL, spacing=6)
@@ -124,10 +116,6 @@ class GoalsPanel(Gtk.MenuButton):
         popover = Gtk.Popover()
         popover.set_child(box)
         popover.connect("show", lambda _p: self._opened())
-        keys = Gtk.EventControllerKey()
-        keys.set_propagation_phase(Gtk.PropagationPhase.CAPTURE)
-        keys.connect("key-pressed", self._key_pressed)
-        popover.add_controller(keys)
         self.set_popover(popover)
 
         self._goals: tuple[str, ...] | None = None
@@ -156,16 +144,6 @@ class GoalsPanel(Gtk.MenuButton):
             if row.get_child_visible():
                 self.choose(name)
                 return
-
-    def _key_pressed(
-        self, _c: Gtk.EventControllerKey, keyval: int, _code: int, state: Gdk.ModifierType
-    ) -> bool:
-        """A stop key stops, whatever has the focus in the popover (it types nothing)."""
-        mods = Gdk.ModifierType.CONTROL_MASK | Gdk.ModifierType.ALT_MASK
-        if Gdk.keyval_to_lower(keyval) in self._stop_keys and not state & mods:
-            self._stop()
-            return True
-        return False
 
     def _command(self, name: str) -> None:
         self.popdown()

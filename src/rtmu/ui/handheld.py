@@ -3,7 +3,7 @@
 The window creates one :class:`Handheld` after its own widgets and actions and
 calls :meth:`close` when it shuts down; everything else hooks itself on:
 
-* the gamepad mapping (``rtmu.gamepad``) on the window's controller, fed by
+* the gamepad mapping (``rtmu.control.gamepad``) on the window's controller, fed by
   libmanette (``ui.gamepad``), its status pill over the map, its own 10 Hz timer
   (silence, rate limit) and the window's focus (connected after the window's own
   focus handler, so the controller has already stopped when the pad hears of it);
@@ -21,10 +21,10 @@ from typing import Any
 import gi
 
 gi.require_version("Gtk", "4.0")
-from gi.repository import Gdk, Gio, GLib, Gtk  # noqa: E402
+from gi.repository import Gio, GLib  # noqa: E402
 
-from ..controller import TICK, Controller  # noqa: E402
-from ..gamepad import Gamepad  # noqa: E402
+from ..control.controller import TICK, Controller  # noqa: E402
+from ..control.gamepad import Gamepad  # noqa: E402
 from .alarm_view import AlarmView  # noqa: E402
 from .gamepad import ManettePads  # noqa: E402
 from .gamepad_status import GamepadStatus  # noqa: E402
@@ -36,19 +36,6 @@ MainWindow = Any
 PILL_BELOW_MOTION = 76
 """The pad pill's top margin on a phone: under the three-line motion pill."""
 
-CSS = """
-.gamepad-status { background: alpha(#242424, 0.80); color: white; border-radius: 8px; padding: 3px 10px; }
-.gamepad-status.deadman-held { background: alpha(#1c71d8, 0.92); }
-.gamepad-status.deadman-latched { background: alpha(#9c5300, 0.94); }
-.status-strip { background: @theme_bg_color; border-bottom: 1px solid alpha(black, 0.14); padding: 2px 6px; }
-.status-strip label { font-size: 10pt; font-weight: bold; font-feature-settings: "tnum"; }
-.status-strip label.low { color: #b56d00; }
-.status-strip label.critical, .status-strip label.lost { color: #c01c28; }
-.status-strip label.stale { color: #b56d00; }
-.status-strip label.ok { color: #1e7a3f; }
-window.phone button.stop-button { min-width: 72px; }
-"""
-
 
 class Handheld:
     """See the module notes."""
@@ -57,7 +44,6 @@ class Handheld:
         self.window = window
         self.on_mute: Callable[[bool], None] | None = None
         """Told when the operator switches the alarm sound (the app saves it)."""
-        _install_css(window.get_display())
         self.pad = Gamepad(window.controller, window.clock)
         self.pad_status = GamepadStatus()
         self.pad.on_change = self.pad_status.show_state
@@ -112,9 +98,3 @@ class Handheld:
         self.pads.close()
         self.alarms.close()
         self.layout.close()
-
-
-def _install_css(display: Gdk.Display) -> None:
-    provider = Gtk.CssProvider()
-    provider.load_from_data(CSS, -1)
-    Gtk.StyleContext.add_provider_for_display(display, provider, Gtk.STYLE_PROVIDER_PRIORITY_APPLICATION)

@@ -1,8 +1,11 @@
-"""Every key RTMU answers to, in one table, and the capture-phase controller that routes them.
+"""Every key RTMU answers to, in one table — key → action — and the capture-phase router.
 
-The commands' keys come from the command registry (``rtmu.commands``: the only
-place a command is defined); this module adds only the window's own keys (zoom,
-follow, the camera page) and the application actions, listed for the help.
+The commands' keys come from the command registry (``rtmu.control.commands``: the only
+place a command is defined): a command's keys activate its ``win.<name>`` action, a held
+command's keys drive while held. This module adds only the window's own keys, each naming
+the ``win.*`` action it activates (zoom, follow, the camera page, live video, the camera
+head, the fleet …; ``ui.actions`` defines them). The shortcuts window (``ui.shortcuts``) and
+the menu's key labels (:func:`menu_item`) read the same table.
 
 Why capture phase: GtkWindow consumes Space and Return (button activation) and
 the arrow keys (focus moves) before a normal bubble-phase controller sees them;
@@ -10,7 +13,7 @@ a teleoperation window must get them first. The router hands held keys to the
 controller's press/release (tracked by hardware keycode, so a release whose
 keyval changed — Shift let go first, Caps Lock — still releases), swallows
 auto-repeat, and leaves everything it does not know to the application
-accelerators (F11, Ctrl+T, Ctrl+Q …, listed here too for the shortcuts window).
+accelerators (F11, Ctrl+T, Ctrl+Q …: bindings marked ``accelerator``).
 """
 
 from __future__ import annotations
@@ -22,57 +25,112 @@ import gi
 
 gi.require_version("Gtk", "4.0")
 gi.require_version("Gdk", "4.0")
-from gi.repository import Gdk, Gtk  # noqa: E402
+from gi.repository import Gdk, Gio, GLib, Gtk  # noqa: E402
 
-from ..commands import COMMANDS, CommandRegistry  # noqa: E402
+from ..control.commands import COMMANDS, CommandRegistry, action_name  # noqa: E402
 
 
 @dataclass(frozen=True, slots=True)
 class Binding:
-    """Keys (GTK accelerator strings) that trigger one intent; ``intent`` is (kind, argument)."""
+    """Keys (GTK accelerator strings) and what they do: activate a window action, or drive while held."""
 
     accels: tuple[str, ...]
     title: str
     group: str
-    kind: str
-    """``hold`` (a hold command), ``command`` (run a registry command), ``view`` (a window intent),
-    ``action`` (an application/window action, handled by accelerators, listed for the help only)."""
-    target: str
+    action: str = ""
+    """The action the keys activate, with its target where it takes one: ``win.zoom-in``,
+    ``win.select-robot(3)``, ``app.quit`` ("" for a held drive key)."""
+    held: str = ""
+    """A held drive command (``drive_forward`` …): it drives while the key is down, stops on release."""
+    help: str | None = None
+    """What the shortcuts window prints instead of the keys ("" leaves the line out)."""
+    accelerator: bool = False
+    """GTK's application accelerators carry these keys (``set_accels_for_action``); the router leaves
+    them alone."""
+
+
+def _ptz(keys: str, title: str, move: str) -> Binding:
+    return Binding((keys,), title, "Camera head", f"win.{move}")
 
 
 WINDOW_BINDINGS: tuple[Binding, ...] = (
-    Binding(("<Control>plus", "<Control>equal", "<Control>KP_Add"), "Zoom in", "Map", "view", "zoom_in"),
-    Binding(("<Control>minus", "<Control>KP_Subtract"), "Zoom out", "Map", "view", "zoom_out"),
-    Binding(("<Control>0",), "Fit map", "Map", "view", "zoom_fit"),
-    Binding(("f",), "Follow the robot on/off", "Map", "view", "follow"),
-    Binding(("Escape",), "Camera picture ⇄ map", "Window", "view", "toggle_camera"),
-    Binding(("v",), "Live video on/off", "Window", "view", "live_video"),
-    Binding(("<Control>Left",), "Pan the camera left", "Camera head", "view", "ptz_left"),
-    Binding(("<Control>Right",), "Pan the camera right", "Camera head", "view", "ptz_right"),
-    Binding(("<Control>Up",), "Tilt the camera up", "Camera head", "view", "ptz_up"),
-    Binding(("<Control>Down",), "Tilt the camera down", "Camera head", "view", "ptz_down"),
-    Binding(("Page_Up",), "Zoom the camera in", "Camera head", "view", "ptz_zoom_in"),
-    Binding(("Page_Down",), "Zoom the camera out", "Camera head", "view", "ptz_zoom_out"),
-    Binding(("F11",), "Full screen", "Window", "action", "win.fullscreen"),
-    Binding(("<Control>t",), "Status toolbar", "Window", "action", "win.toolbar"),
-    Binding(("<Control>comma",), "Connection settings", "Connection", "action", "win.settings"),
-    Binding(
-        ("<Control>question", "F1"), "Keyboard shortcuts", "Application", "action", "win.show-help-overlay"
+    Binding(("<Control>plus", "<Control>equal", "<Control>KP_Add"), "Zoom in", "Map", "win.zoom-in"),
+    Binding(("<Control>minus", "<Control>KP_Subtract"), "Zoom out", "Map", "win.zoom-out"),
+    Binding(("<Control>0",), "Fit map", "Map", "win.zoom-fit"),
+    Binding(("f",), "Follow the robot on/off", "Map", "win.follow"),
+    Binding(("Escape",), "Camera picture ⇄ map", "Window", "win.camera"),
+    Binding(("F10", "Menu", "<Shift>F10"), "Open the menu", "Window", "win.open-menu"),
+    Binding(("<Control>g",), "Go to: goals, a point, home, dock", "Navigation", "win.goto-panel"),
+    *(
+        Binding(
+            (f"<Alt>{n}",),
+            "Select robot 1 … 9 of the list",
+            "Fleet",
+            f"win.select-robot({n})",
+            help="<Alt>1...<Alt>9" if n == 1 else "",
+        )
+        for n in range(1, 10)
     ),
-    Binding(("<Control>q",), "Quit", "Application", "action", "app.quit"),
+    Binding(("<Alt>Page_Down",), "Next robot", "Fleet", "win.next-robot"),
+    Binding(("<Alt>Page_Up",), "Previous robot", "Fleet", "win.previous-robot"),
+    Binding(("v",), "Live video on/off", "Window", "win.live-video"),
+    _ptz("<Control>Left", "Pan the camera left", "ptz-left"),
+    _ptz("<Control>Right", "Pan the camera right", "ptz-right"),
+    _ptz("<Control>Up", "Tilt the camera up", "ptz-up"),
+    _ptz("<Control>Down", "Tilt the camera down", "ptz-down"),
+    _ptz("Page_Up", "Zoom the camera in", "ptz-zoom-in"),
+    _ptz("Page_Down", "Zoom the camera out", "ptz-zoom-out"),
+    Binding(("F11",), "Full screen", "Window", "win.fullscreen", accelerator=True),
+    Binding(("<Control>t",), "Status toolbar", "Window", "win.toolbar", accelerator=True),
+    Binding(("<Control>comma",), "Connection settings", "Connection", "win.settings", accelerator=True),
+    Binding(
+        ("<Control>question", "F1"),
+        "Keyboard shortcuts",
+        "Application",
+        "win.show-help-overlay",
+        accelerator=True,
+    ),
+    Binding(("<Control>q",), "Quit", "Application", "app.quit", accelerator=True),
 )
-"""The window's own keys: view intents and application actions (no robot command)."""
+"""The window's own keys, each naming the action it activates (no robot command: those are the
+registry's)."""
 
 
 def bindings(registry: CommandRegistry = COMMANDS) -> tuple[Binding, ...]:
     """The whole key table: every command's keys from the registry, then the window's own.
 
+    A command's keys activate its action (``win.<name>``); a held command's keys drive while held.
     Groups are small (at most 6) so the shortcuts window fits an 800×480 screen in pages of columns.
     """
     commands = tuple(
-        Binding(c.keys, c.label, c.group, "hold" if c.hold else "command", c.name) for c in registry if c.keys
+        Binding(c.keys, c.label, c.group, held=c.name)
+        if c.hold
+        else Binding(c.keys, c.label, c.group, f"win.{action_name(c.name)}")
+        for c in registry
+        if c.keys
     )
     return commands + WINDOW_BINDINGS
+
+
+def accelerated() -> tuple[Binding, ...]:
+    """The bindings GTK's application accelerators carry (the app sets them at start-up)."""
+    return tuple(b for b in WINDOW_BINDINGS if b.accelerator)
+
+
+def menu_accel(action: str, registry: CommandRegistry = COMMANDS) -> str | None:
+    """The key a menu row shows for ``action`` (detailed, as in the table): its binding's first key."""
+    return next((b.accels[0] for b in bindings(registry) if b.action == action), None)
+
+
+def menu_item(label: str, action: str) -> Gio.MenuItem:
+    """A menu row for ``action`` (detailed: ``win.select-robot(3)``) showing its key from the table."""
+    _ok, name, target = Gio.Action.parse_detailed_name(action)
+    item = Gio.MenuItem.new(label, None)
+    item.set_action_and_target_value(name, target)
+    accel = menu_accel(action)
+    if accel is not None:
+        item.set_attribute_value("accel", GLib.Variant.new_string(accel))
+    return item
 
 
 MODS = Gdk.ModifierType.CONTROL_MASK | Gdk.ModifierType.SHIFT_MASK | Gdk.ModifierType.ALT_MASK
@@ -85,13 +143,9 @@ def _parse(accel: str) -> tuple[int, Gdk.ModifierType]:
     return keyval, mods
 
 
-def accels_for(target: str) -> list[str]:
-    """The accelerators of an ``action`` binding (for ``Gtk.Application.set_accels_for_action``)."""
-    return [a for b in WINDOW_BINDINGS if b.target == target for a in b.accels]
-
-
 class KeyRouter:
-    """Capture-phase key handling ; ``hold``/``release``/``command``/``view`` are callbacks.
+    """Capture-phase key handling: a held key calls ``hold``/``release`` with its command, any other
+    key of the table ``activate`` with its action (``win.zoom-in``).
 
     Shift matters only where the table says so (``<Shift>Up`` is a move, plain
     ``Up`` drives); for ``plus``/``equal`` Shift is part of typing the key and is
@@ -103,19 +157,17 @@ class KeyRouter:
         *,
         hold: Callable[[str], None],
         release: Callable[[str], None],
-        command: Callable[[str], None],
-        view: Callable[[str], None],
+        activate: Callable[[str], object],
         registry: CommandRegistry = COMMANDS,
     ) -> None:
         self._hold = hold
         self._release = release
-        self._command = command
-        self._view = view
+        self._activate = activate
         self._held: dict[int, str] = {}
         """keycode → hold command name, for the keys now down."""
         self._table: dict[tuple[int, int], Binding] = {}
         for b in bindings(registry):
-            if b.kind == "action":
+            if b.accelerator:
                 continue
             for accel in b.accels:
                 keyval, mods = _parse(accel)
@@ -132,8 +184,8 @@ class KeyRouter:
         if found is None and mods & int(Gdk.ModifierType.SHIFT_MASK):
             # Shift typed the key itself (plus on most layouts, a capital W): try without it.
             found = self._table.get((key, mods & ~int(Gdk.ModifierType.SHIFT_MASK)))
-            if found is not None and found.kind == "command" and found.target.startswith(("turn", "move")):
-                found = None
+            if found is not None and found.action.startswith(("win.turn", "win.move")):
+                found = None  # Shift+arrow is a move of its own; not a turn or move without Shift
         return found
 
     @property
@@ -154,13 +206,11 @@ class KeyRouter:
         binding = self.lookup(keyval, state)
         if binding is None:
             return False
-        if binding.kind == "hold":
-            self._held[keycode] = binding.target
-            self._hold(binding.target)
-        elif binding.kind == "command":
-            self._command(binding.target)
+        if binding.held:
+            self._held[keycode] = binding.held
+            self._hold(binding.held)
         else:
-            self._view(binding.target)
+            self._activate(binding.action)
         return True
 
     def _released(

@@ -1,7 +1,8 @@
 """The Layers panel: one switch per drawing the server lists, remembered per server.
 
-A card over the map (View → Layers…), never focusable, so the arrow keys keep driving while it
-is open. Each drawing of :attr:`~rtmu.model.RobotModel.drawings` gets a check button labelled
+A card over the map (View → Layers…); its switches take the focus by Tab (``keyboard_nav``) while
+the arrow keys keep driving and Space keeps stopping (the window's key router and stop keys catch
+them first). Each drawing of :attr:`~rtmu.model.observables.RobotModel.drawings` gets a check button labelled
 with its name exactly as sent (plain text: no markup, no mnemonic underscores). A drawing the
 server keeps always on or off, or whose shape RTMU cannot draw, is listed greyed with the reason.
 Turning one off tells the network side to stop asking for it (``set_drawing_shown``) and
@@ -12,26 +13,18 @@ handed to the network side again before the next connection to that server lists
 from __future__ import annotations
 
 from collections.abc import Callable, MutableMapping
-from typing import Protocol
 
 import gi
 
 gi.require_version("Gtk", "4.0")
 from gi.repository import Gtk, Pango  # noqa: E402
 
-from ..model import ConnectionState, DrawingsState, Observable, Phase  # noqa: E402
-from ..state import DrawingLayer  # noqa: E402
+from ..model.observables import ConnectionState, DrawingsState, Observable, Phase  # noqa: E402
+from ..values.intents import DrawingChoices, Intent, ShowDrawing  # noqa: E402
+from ..values.state import DrawingLayer  # noqa: E402
 
 MAX_LABEL = 60
 """Characters of a name shown (the whole name is the button's tooltip)."""
-
-
-class DrawingLink(Protocol):
-    """What the panel needs of the network side (``ClientRunner``)."""
-
-    def set_drawing_shown(self, name: str, shown: bool) -> object: ...
-
-    def set_drawing_choices(self, choices: dict[str, bool]) -> object: ...
 
 
 def server_key(connection: ConnectionState) -> str:
@@ -57,7 +50,7 @@ class LayersPanel(Gtk.Box):
         self,
         drawings: Observable[DrawingsState],
         connection: Observable[ConnectionState],
-        link: DrawingLink,
+        ask: Callable[[Intent], object],
         choices: MutableMapping[str, dict[str, bool]] | None = None,
     ) -> None:
         super().__init__(orientation=Gtk.Orientation.VERTICAL, spacing=2)
@@ -71,7 +64,8 @@ class LayersPanel(Gtk.Box):
         self.set_visible(False)
         self._drawings = drawings
         self._connection = connection
-        self._link = link
+        self._ask = ask
+        """The selected robot's intents (``SelectedRobot.ask``)."""
         self.choices: MutableMapping[str, dict[str, bool]] = {} if choices is None else choices
         self.on_closed: Callable[[], None] = lambda: None
         self.buttons: dict[str, Gtk.CheckButton] = {}
@@ -125,7 +119,7 @@ class LayersPanel(Gtk.Box):
 
     def _send_choices(self) -> None:
         if self._server:
-            self._link.set_drawing_choices(dict(self.choices.get(self._server, {})))
+            self._ask(DrawingChoices(dict(self.choices.get(self._server, {}))))
 
     def _refresh(self) -> None:
         layers = self._drawings.value.layers
@@ -163,4 +157,4 @@ class LayersPanel(Gtk.Box):
             return
         if self._server:
             self.choices.setdefault(self._server, {})[name] = shown
-        self._link.set_drawing_shown(name, shown)
+        self._ask(ShowDrawing(name, shown))

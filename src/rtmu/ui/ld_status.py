@@ -6,7 +6,7 @@ appears only when the server lists the value (the model field is None otherwise)
 
 from __future__ import annotations
 
-from ..model import RobotState
+from ..model.observables import RobotState
 
 
 def goal_suffix(robot: RobotState) -> str:

@@ -21,7 +21,9 @@ gi.require_version("Pango", "1.0")
 gi.require_version("Gdk", "4.0")
 from gi.repository import Gdk, GLib, Gtk, Pango  # noqa: E402
 
-from ..model import CameraImage  # noqa: E402
+from ..fleet.sessions import RobotSession  # noqa: E402
+from ..model.observables import CameraImage  # noqa: E402
+from ..values.intents import StopVideo  # noqa: E402
 from .camera import CameraView  # noqa: E402
 
 FPS_CHOICES = (2, 5, 10, 15, 20, 30)
@@ -130,6 +132,12 @@ class LiveVideoControls:
             self.caption.set_visible(False)
             self._stop()
         else:
+            self._start(self.target_fps(), self.target_quality())
+
+    def follow_selection(self, old: RobotSession, new: RobotSession) -> None:
+        """Another robot is shown: its camera plays (the old one's video stops), at the same settings."""
+        if self.live:
+            old.controller.ask(StopVideo())
             self._start(self.target_fps(), self.target_quality())
 
     def _settings_changed(self) -> None:

@@ -26,12 +26,14 @@ import gi
 gi.require_version("Gtk", "4.0")
 from gi.repository import GLib, Gtk  # noqa: E402
 
-from ..model import LinkLevel, MapModel, OperatorState, RobotModel, RobotState  # noqa: E402
+from ..control.motion_limits import RobotLimits  # noqa: E402
+from ..model.observables import LinkLevel, MapModel, OperatorState, RobotModel, RobotState  # noqa: E402
 from . import overlays  # noqa: E402
 from .fleet_draw import FleetMark  # noqa: E402
 from .fov_draw import Wedge, camera_aim  # noqa: E402
 from .frame import Scene, draw_frame  # noqa: E402
 from .nav_draw import Marker, MarkerKind  # noqa: E402
+from .stop_draw import stop_reach  # noqa: E402
 from .tiles import TileCache  # noqa: E402
 from .viewport import ZOOM_MAX, ZOOM_MIN, Viewport, fit_view, nearest_step, step_zoom  # noqa: E402
 
@@ -99,6 +101,8 @@ class MapStage(Gtk.DrawingArea):
         self.marker: Marker | None = None
         """A pose the operator is picking (``pose_pick`` sets it); drawn over the map."""
         self.fleet: Callable[[], tuple[Sequence[FleetMark], tuple[float, float, float]]] | None = None
+        self.limits: Callable[[], RobotLimits] = RobotLimits
+        """The shown robot's speed and braking (the window hands over its controller's)."""
         """In a fleet (``fleet_bind``): the other robots to draw and the selected robot's colour."""
         self.set_draw_func(self._draw)
         self._install_input()
@@ -344,6 +348,8 @@ class MapStage(Gtk.DrawingArea):
         self._add_navigation(scene)
         if self.show_fov and scene.robot is not None and self._has_camera():
             scene.fov = Wedge(*scene.robot, *camera_aim(self.model.robot.value.ptz))
+        if scene.robot is not None:
+            scene.stop_reach = stop_reach(r.x, r.y, r.th, r.vel, self.limits())
         return draw_frame(ctx, vp, scene)
 
     def _has_camera(self) -> bool:

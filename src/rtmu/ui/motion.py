@@ -21,7 +21,7 @@ gi.require_version("Gtk", "4.0")
 gi.require_version("Pango", "1.0")
 from gi.repository import Gtk, Pango  # noqa: E402
 
-from ..model import Phase, RobotModel  # noqa: E402
+from ..model.observables import Phase, RobotModel  # noqa: E402
 from .nav_text import motion_text  # noqa: E402
 
 KINDS = ("autonomous", "held")

@@ -13,7 +13,7 @@ from collections.abc import Callable, Sequence
 import gi
 
 gi.require_version("Gtk", "4.0")
-from gi.repository import Gdk, Gtk  # noqa: E402
+from gi.repository import Gdk, GLib, Gtk  # noqa: E402
 
 
 class AmountDialog(Gtk.Window):
@@ -69,6 +69,18 @@ class AmountDialog(Gtk.Window):
         keys.set_propagation_phase(Gtk.PropagationPhase.CAPTURE)  # Enter in the number field = Go
         keys.connect("key-pressed", self._key)
         self.add_controller(keys)
+        self.connect("close-request", lambda _w: self._give_back(parent))
+
+    @staticmethod
+    def _give_back(parent: Gtk.Window) -> bool:
+        """The keyboard goes back to the window (driving, Space) as the dialog closes; False: close."""
+
+        def present() -> bool:
+            parent.present()
+            return False
+
+        GLib.idle_add(present)
+        return False
 
     def _key(self, _c: Gtk.EventControllerKey, keyval: int, _code: int, _state: object) -> bool:
         if keyval == Gdk.KEY_Escape:

@@ -1,13 +1,13 @@
 """The words the window uses for navigation: which motion is happening, where to, how localized.
 
-Pure text from :class:`rtmu.model.NavState` (no widgets), so the sentences are tested without a
+Pure text from :class:`rtmu.model.observables.NavState` (no widgets), so the sentences are tested without a
 display and the toolbar, the motion indicator and the link banner all say the same thing. Names
 in them come from the server and are shown as plain text by the labels that use them.
 """
 
 from __future__ import annotations
 
-from ..model import NavState
+from ..model.observables import NavState
 
 POOR_SCORE = 0.6
 """A localization score below this (0–1) is shown as poor (amber) even while the state is Good."""

@@ -1,6 +1,6 @@
-"""The note at the bottom of the map: one sentence from the connection phase and the map's state.
+"""What the window says about its connection: the note at the bottom of the map and the header's status.
 
-One function decides it, from the model alone, and the window calls it on
+One function each decides them, from the model alone, and the window calls them on
 every connection change and every map change — so the note can never say "not
 connected" next to a Disconnect button, or vanish after a disconnect. GTK-free.
 
@@ -10,7 +10,8 @@ drawn on the map (``grid 2 m``) is its one source of truth.
 
 from __future__ import annotations
 
-from ..model import ConnectionState, MapModel, Phase
+from ..model.observables import ConnectionState, MapModel, Phase
+from ..settings.store import Profile
 
 CONNECT_HINT = "press Connect (Ctrl+O)"
 
@@ -37,3 +38,20 @@ def map_note(conn: ConnectionState, m: MapModel) -> str:
     if m.state == "unknown":
         return "Connected; asking for the map…"
     return ""
+
+
+def status_line(conn: ConnectionState, profile: Profile, map_name: str) -> str:
+    """The header's status line (and the full-screen bar's): profile · where · phase · map file."""
+    phase = conn.phase
+    where = f"{conn.host}:{conn.port}" if conn.host else f"{profile.host}:{profile.port}"
+    state = {
+        Phase.DISCONNECTED: "not connected",
+        Phase.CONNECTING: "connecting…",
+        Phase.CONNECTED: "connected",
+        Phase.RECONNECTING: f"reconnecting ({conn.error})" if conn.error else "reconnecting",
+        Phase.FAILED: f"failed: {conn.error}" if conn.error else "failed",
+    }[phase]
+    name = map_name.replace("\\", "/").rsplit("/", 1)[-1]
+    parts = [profile.name, state] if where in profile.name else [profile.name, where, state]
+    parts += [name] if name and phase is Phase.CONNECTED else []
+    return " · ".join(parts)

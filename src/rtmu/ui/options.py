@@ -9,9 +9,10 @@ from __future__ import annotations
 from dataclasses import dataclass
 from pathlib import Path
 
-from ..settings import DirectRobot
+from ..package_data import APP_ID
+from ..settings.store import DirectRobot
 
-APP_ID = "io.github.rtmu.Rtmu"
+__all__ = ["APP_ID", "GuiOptions"]
 
 
 @dataclass

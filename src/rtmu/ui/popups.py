@@ -1,6 +1,6 @@
 """Server popups as non-modal cards over the map: plain text, the server's buttons, never the focus.
 
-The cards follow ``RobotModel.popups`` (:class:`rtmu.state.PopupsState`): the newest
+The cards follow ``RobotModel.popups`` (:class:`rtmu.values.state.PopupsState`): the newest
 :data:`MAX_CARDS` are shown over the map's right side, above the zoom buttons and clear of the
 banners at the top, the newest lowest, with "+K more" above them for the rest (and for those a
 flood made the client drop). STOP is in the header bar (or the full-screen bar), never under them.
@@ -23,10 +23,10 @@ import gi
 gi.require_version("Gtk", "4.0")
 gi.require_version("Gdk", "4.0")
 gi.require_version("Pango", "1.0")
-from gi.repository import Gdk, GLib, Gtk, Pango  # noqa: E402
+from gi.repository import GLib, Gtk, Pango  # noqa: E402
 
-from ..model import Observable, PopupsState  # noqa: E402
-from ..state import PopupInfo  # noqa: E402
+from ..model.observables import Observable, PopupsState  # noqa: E402
+from ..values.state import PopupInfo  # noqa: E402
 
 MAX_CARDS = 3
 """Cards on screen at once; the rest are counted in the "+K more" line."""
@@ -38,27 +38,6 @@ ICONS = {
     3: "dialog-error-symbolic",
     4: "dialog-question-symbolic",
 }
-CSS = """
-.popup-card { background: alpha(@theme_bg_color, 0.96); border-radius: 10px; padding: 8px 10px;
-              border: 1px solid alpha(black, 0.18); box-shadow: 0 2px 6px alpha(black, 0.25); }
-.popup-card.warning { border-left: 5px solid #e5a50a; }
-.popup-card.critical { border-left: 5px solid #c01c28; }
-.popup-card .popup-title { font-weight: bold; }
-.popup-card .popup-age { font-size: 8pt; opacity: 0.6; font-feature-settings: "tnum"; }
-.popup-more { background: alpha(#242424, 0.62); color: white; border-radius: 8px; padding: 2px 8px; }
-"""
-_css_done = False
-
-
-def install_css() -> None:
-    global _css_done
-    display = Gdk.Display.get_default()
-    if _css_done or display is None:
-        return
-    provider = Gtk.CssProvider()
-    provider.load_from_data(CSS.encode())
-    Gtk.StyleContext.add_provider_for_display(display, provider, Gtk.STYLE_PROVIDER_PRIORITY_APPLICATION)
-    _css_done = True
 
 
 def plain_label(text: str, css: str, *, wrap: bool = False) -> Gtk.Label:
@@ -104,7 +83,6 @@ class PopupStack(Gtk.Box):
         clock: Callable[[], float] = time.monotonic,
     ) -> None:
         super().__init__(orientation=Gtk.Orientation.VERTICAL, spacing=6)
-        install_css()
         self.set_halign(Gtk.Align.END)
         self.set_valign(Gtk.Align.END)
         self.set_margin_bottom(62)  # above the zoom buttons

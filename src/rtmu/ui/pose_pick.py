@@ -65,6 +65,12 @@ class PosePicker:
         self.stage.set_cursor(None)
         self._show()
 
+    def set_marker(self, marker: Marker) -> None:
+        """A pose chosen by keyboard (``keyboard_nav``): shown, and confirmed, like a click's."""
+        if self.kind is not None:
+            self.marker = marker
+            self._show()
+
     def _show(self) -> None:
         self.stage.marker = self.marker
         self.stage.queue_draw()

@@ -12,7 +12,6 @@ Moving the camera head is not robot motion: it needs no drive lease.
 from __future__ import annotations
 
 from collections.abc import Callable
-from typing import Protocol
 
 import gi
 
@@ -20,8 +19,11 @@ gi.require_version("Gtk", "4.0")
 gi.require_version("Pango", "1.0")
 from gi.repository import GLib, Gtk, Pango  # noqa: E402
 
-from ..model import RobotModel, RobotState  # noqa: E402
-from ..state import PtzState  # noqa: E402
+from ..control.commands import action_name  # noqa: E402
+from ..fleet.sessions import RobotSession  # noqa: E402
+from ..model.observables import RobotModel, RobotState  # noqa: E402
+from ..values.intents import Intent, PtzMove, WatchPtz  # noqa: E402
+from ..values.state import PtzState  # noqa: E402
 
 PAN_STEP = 10.0
 """Degrees per button press or key (ARIA scales relative moves down as the camera zooms in)."""
@@ -46,16 +48,6 @@ KEY_STEPS: dict[str, tuple[float, float, float | None]] = {
 }
 """Key intent → relative (pan, tilt, zoom): pan is positive to the right (ARIA's camera handler turns
 a look-at heading into ``-delta``), tilt positive up."""
-
-
-class PtzLink(Protocol):
-    """What the controls need of the client runner."""
-
-    def ptz_rel(self, pan: float, tilt: float, zoom: float | None = None) -> object: ...
-
-    def ptz_abs(self, pan: float, tilt: float, zoom: float | None = None) -> object: ...
-
-    def watch_ptz(self, on: bool) -> object: ...
 
 
 def position_text(state: PtzState | None) -> str:
@@ -87,7 +79,9 @@ def disabled_reason(state: PtzState | None, connected: bool) -> str:
 class PtzControls(Gtk.Box):
     """A bar of pan/tilt/zoom buttons and the head's position; ``attach_drag`` adds the picture drag."""
 
-    def __init__(self, model: RobotModel, link: PtzLink, on_moved: Callable[[], None] | None = None) -> None:
+    def __init__(
+        self, model: RobotModel, ask: Callable[[Intent], object], on_moved: Callable[[], None] | None = None
+    ) -> None:
         super().__init__(orientation=Gtk.Orientation.HORIZONTAL, spacing=4)
         self.add_css_class("camera-bar")  # the camera page's own bar style
         self.add_css_class("ptz-bar")
@@ -95,7 +89,8 @@ class PtzControls(Gtk.Box):
             getattr(self, f"set_margin_{side}")(8)
         self.set_margin_bottom(4)
         self.model = model
-        self._link = link
+        self._ask = ask
+        """The selected robot's intents (``SelectedRobot.ask``): the head of the robot being shown."""
         self._on_moved = on_moved
         self._picture_timer = 0
         self._closed = False
@@ -118,7 +113,8 @@ class PtzControls(Gtk.Box):
             button = Gtk.Button.new_from_icon_name(icon)
             button.set_focusable(False)
             self._tips[intent] = tip
-            button.connect("clicked", lambda _b, i=intent: self.key(i))
+            # The window's action (``win.ptz-left`` …), as the key's: a refusal is said the same way.
+            button.connect("clicked", lambda b, i=intent: b.activate_action(f"win.{action_name(i)}", None))
             self.buttons[intent] = button
             self.append(button)
         self._unobserve = [
@@ -151,7 +147,13 @@ class PtzControls(Gtk.Box):
     def _set_watching(self, on: bool) -> None:
         if on != self.watching and not self._closed:
             self.watching = on
-            self._link.watch_ptz(on)
+            self._ask(WatchPtz(on))
+
+    def follow_selection(self, old: RobotSession, new: RobotSession) -> None:
+        """Another robot is shown: its head is polled while the page is, the old one's no longer."""
+        if self.watching and not self._closed:
+            old.controller.ask(WatchPtz(False))
+            new.controller.ask(WatchPtz(True))
 
     def _on_robot(self, old: RobotState, new: RobotState) -> None:
         if old.ptz != new.ptz:
@@ -186,10 +188,10 @@ class PtzControls(Gtk.Box):
         if not self._can(intent):
             return "this camera does not offer that move"
         if intent == "ptz_home":
-            self._link.ptz_abs(0.0, 0.0, None)
+            self._ask(PtzMove(0.0, 0.0, None, relative=False))
         else:
             pan, tilt, zoom = KEY_STEPS[intent]
-            self._link.ptz_rel(pan, tilt, zoom)
+            self._ask(PtzMove(pan, tilt, zoom))
         self._moved()
         return ""
 
@@ -206,7 +208,7 @@ class PtzControls(Gtk.Box):
         pan, tilt = drag_to_move(dx, dy, width, height)
         if (pan, tilt) == (0.0, 0.0) or self.reason or not self._can("ptz_left"):
             return
-        self._link.ptz_rel(pan, tilt, None)
+        self._ask(PtzMove(pan, tilt, None))
         self._moved()
 
     def _moved(self) -> None:

@@ -14,19 +14,15 @@ from typing import TYPE_CHECKING
 
 from gi.repository import GLib
 
-from ..client.session import SessionConfig
-from ..fleet import RobotSession
+from ..fleet.sessions import RobotSession
 from ..recorder.replay import REPLAY_HOST, Replayer
 from ..recorder.replay_file import load
-from ..settings import Profile
-from ..state import StateChange
+from ..settings.store import Profile
+from ..values.state import StateChange
 from .replay_bar import ReplayBar
 
 if TYPE_CHECKING:
     from .window import MainWindow
-
-REPLAY_CONFIG = SessionConfig(ping_interval=3600.0, lost_after=3600.0, connect_timeout=3600.0)
-"""A recording has no live link to watch: no pings, no staleness by wall clock, no guardian."""
 
 
 def open_replay(path: Path, conn: int = 1) -> Replayer:

@@ -20,8 +20,8 @@ import gi
 gi.require_version("Gtk", "4.0")
 from gi.repository import Gtk, Pango  # noqa: E402
 
-from ..fleet import RobotSession  # noqa: E402
-from ..model import LinkLevel, Phase, RobotState  # noqa: E402
+from ..fleet.sessions import RobotSession  # noqa: E402
+from ..model.observables import LinkLevel, Phase, RobotState  # noqa: E402
 from .fleet_draw import RGB  # noqa: E402
 
 NARROW_PX = 640

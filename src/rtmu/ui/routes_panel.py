@@ -17,24 +17,24 @@ import gi
 gi.require_version("Gtk", "4.0")
 from gi.repository import Gtk  # noqa: E402
 
-from ..model import ConnectionState, Phase, RobotModel, RobotState  # noqa: E402
-from ..protocol.payloads.ld import GotoRouteGoal, Patrol  # noqa: E402
+from ..model.observables import ConnectionState, Phase, RobotModel  # noqa: E402
+from ..values.intents import GotoGoal, Intent, Patrol  # noqa: E402
 
-Send = Callable[[str, object], None]
-"""``send(data name, payload)``: a fire-and-forget request through the controller's link."""
+Ask = Callable[[Intent], object]
+"""The selected robot's intents (``SelectedRobot.ask``): through its controller's guard."""
 
 
 class RoutesPanel(Gtk.MenuButton):
     """Header-bar button + popover listing routes, each with Patrol."""
 
-    def __init__(self, model: RobotModel, send: Send) -> None:
+    def __init__(self, model: RobotModel, ask: Ask) -> None:
         super().__init__(icon_name="mark-location-symbolic", tooltip_text="Routes (patrol)")
         self.set_focusable(False)
         inner = self.get_first_child()
         if inner is not None:
             inner.set_focusable(False)  # keys go to the window's router, as for the menu button
         self.model = model
-        self._send = send
+        self._ask = ask
         self.list = Gtk.Box(orientation=Gtk.Orientation.VERTICAL, spacing=4)
         for side in ("top", "bottom", "start", "end"):
             getattr(self.list, f"set_margin_{side}")(8)
@@ -49,11 +49,12 @@ class RoutesPanel(Gtk.MenuButton):
         self.set_popover(popover)
         self._shown: tuple[tuple[str, ...], tuple[str, ...]] | None = None
         self._unobserve = [
-            model.robot.observe(self._on_robot),
+            model.robot.observe(lambda _o, _n: self._refill()),
+            model.navigation.observe(lambda _o, _n: self._refill()),
             model.connection.observe(self._on_connection),
         ]
         self._on_connection(ConnectionState(), model.connection.value)
-        self._fill(model.robot.value.routes, model.robot.value.goals)
+        self._refill()
 
     def close(self) -> None:
         for remove in self._unobserve:
@@ -68,9 +69,9 @@ class RoutesPanel(Gtk.MenuButton):
         for button in self.goal_rows.values():
             button.set_sensitive(connected and "gotoRouteGoal" in new.offers)
 
-    def _on_robot(self, old: RobotState, new: RobotState) -> None:
-        if new.routes != old.routes or new.goals != old.goals:
-            self._fill(new.routes, new.goals)
+    def _refill(self) -> None:
+        """Routes are the robot's; goals the map's one list (``NavState.goals``)."""
+        self._fill(self.model.robot.value.routes, self.model.navigation.value.goals)
 
     def _fill(self, routes: tuple[str, ...], goals: tuple[str, ...] = ()) -> None:
         if (routes, goals) == self._shown:
@@ -123,14 +124,14 @@ class RoutesPanel(Gtk.MenuButton):
 
     def go_to_goal(self, goal: str) -> None:
         if "gotoRouteGoal" in self.model.connection.value.offers:
-            self._send("gotoRouteGoal", GotoRouteGoal(goal))
+            self._ask(GotoGoal(goal, route=True))
             popover = self.get_popover()
             if popover is not None:
                 popover.popdown()
 
     def patrol(self, route: str) -> None:
         if "patrol" in self.model.connection.value.offers:
-            self._send("patrol", Patrol(route))
+            self._ask(Patrol(route))
             popover = self.get_popover()
             if popover is not None:
                 popover.popdown()

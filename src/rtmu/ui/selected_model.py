@@ -1,7 +1,7 @@
 """The selected robot's state as one stable model, so the window's widgets never rebind.
 
 The window's toolbar, map stage, camera, navigation panels and popups each observe a
-:class:`~rtmu.model.RobotModel` they were given once. In a fleet that model is a
+:class:`~rtmu.model.observables.RobotModel` they were given once. In a fleet that model is a
 :class:`SelectedModel`: it mirrors whichever robot is selected — its observables take
 the selected robot's values and follow its changes, its trail *is* that robot's
 trail — and :meth:`SelectedModel.show` moves it to another robot, every widget
@@ -13,7 +13,7 @@ from __future__ import annotations
 from collections.abc import Callable
 from typing import Any
 
-from ..model import Observable, RobotModel, Trail
+from ..model.observables import Observable, RobotModel, Trail
 
 
 def _observable_parts() -> tuple[str, ...]:

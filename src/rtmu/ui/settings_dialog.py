@@ -18,7 +18,7 @@ import gi
 gi.require_version("Gtk", "4.0")
 from gi.repository import Gtk  # noqa: E402
 
-from ..settings import DEFAULT_PORT, Profile  # noqa: E402
+from ..settings.store import DEFAULT_PORT, Profile  # noqa: E402
 from .layout import screen_size  # noqa: E402
 
 _HOST = re.compile(r"^[A-Za-z0-9]([A-Za-z0-9.\-]*[A-Za-z0-9])?$")

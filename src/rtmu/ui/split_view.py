@@ -17,7 +17,7 @@ gi.require_version("Gdk", "4.0")
 gi.require_version("Pango", "1.0")
 from gi.repository import Gdk, GLib, Gtk, Pango  # noqa: E402
 
-from ..model import CameraImage  # noqa: E402
+from ..model.observables import CameraImage  # noqa: E402
 
 
 class _SizedBoxLayout(Gtk.BoxLayout):

@@ -15,8 +15,8 @@ gi.require_version("Gtk", "4.0")
 gi.require_version("Pango", "1.0")
 from gi.repository import Gtk, Pango  # noqa: E402
 
-from ..alarms import Thresholds  # noqa: E402
-from ..model import LinkLevel, OperatorState, Phase, RobotModel  # noqa: E402
+from ..control.alarms import Thresholds  # noqa: E402
+from ..model.observables import LinkLevel, OperatorState, Phase, RobotModel  # noqa: E402
 
 DASH = "—"
 SLOW_MS = Thresholds().rtt_high_ms

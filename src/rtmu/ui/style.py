@@ -1,6 +1,13 @@
-"""RTMU's stylesheet: legible at 800×480 and at arm's length, greyed means stale."""
+"""RTMU's one stylesheet: legible at 800×480 and at arm's length, greyed means stale.
+
+Every widget's style is here, in sections named for the modules that use the classes, and it is
+installed once per display by :func:`install_css` (the application's start-up): no widget module
+loads CSS of its own, so a colour is defined once and a new widget adds its rules here.
+"""
 
 from __future__ import annotations
+
+import weakref
 
 import gi
 
@@ -94,13 +101,47 @@ stackswitcher.circular > button > label { margin: 0; padding: 0; }
 
 .field-error { color: #c01c28; font-size: 9pt; margin-bottom: 4px; }
 entry.error { border-color: #c01c28; }
+
+/* Server popups over the map (popups) */
+.popup-card { background: alpha(@theme_bg_color, 0.96); border-radius: 10px; padding: 8px 10px;
+              border: 1px solid alpha(black, 0.18); box-shadow: 0 2px 6px alpha(black, 0.25); }
+.popup-card.warning { border-left: 5px solid #e5a50a; }
+.popup-card.critical { border-left: 5px solid #c01c28; }
+.popup-card .popup-title { font-weight: bold; }
+.popup-card .popup-age { font-size: 8pt; opacity: 0.6; font-feature-settings: "tnum"; }
+.popup-more { background: alpha(#242424, 0.62); color: white; border-radius: 8px; padding: 2px 8px; }
+
+/* The server's configuration page (config_page): the answer colours — the theme's own
+   .success/.error differ between themes */
+.config-ok { color: #26a269; font-weight: bold; }
+.config-error { color: #c01c28; }
+.config-edited { color: #1c71d8; }
+.config-banner { background: alpha(#e5a50a, 0.25); padding: 4px 8px; border-radius: 4px; }
+
+/* Handheld (handheld): the gamepad pill, the phone's status strip and narrower STOP */
+.gamepad-status { background: alpha(#242424, 0.80); color: white; border-radius: 8px; padding: 3px 10px; }
+.gamepad-status.deadman-held { background: alpha(#1c71d8, 0.92); }
+.gamepad-status.deadman-latched { background: alpha(#9c5300, 0.94); }
+.status-strip { background: @theme_bg_color; border-bottom: 1px solid alpha(black, 0.14); padding: 2px 6px; }
+.status-strip label { font-size: 10pt; font-weight: bold; font-feature-settings: "tnum"; }
+.status-strip label.low { color: #b56d00; }
+.status-strip label.critical, .status-strip label.lost { color: #c01c28; }
+.status-strip label.stale { color: #b56d00; }
+.status-strip label.ok { color: #1e7a3f; }
+window.phone button.stop-button { min-width: 72px; }
 """
 
 
-def install_css() -> None:
-    display = Gdk.Display.get_default()
-    if display is None:
+_INSTALLED: weakref.WeakSet[Gdk.Display] = weakref.WeakSet()
+"""Displays that have the stylesheet (a process can open several apps, and tests several displays)."""
+
+
+def install_css(display: Gdk.Display | None = None) -> None:
+    """:data:`CSS` on ``display`` (the default display), once."""
+    display = display or Gdk.Display.get_default()
+    if display is None or display in _INSTALLED:
         return
     provider = Gtk.CssProvider()
     provider.load_from_data(CSS, -1)
     Gtk.StyleContext.add_provider_for_display(display, provider, Gtk.STYLE_PROVIDER_PRIORITY_APPLICATION)
+    _INSTALLED.add(display)

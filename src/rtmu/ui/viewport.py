@@ -1,7 +1,7 @@
 """Where the map is on the screen: zoom, centre and the world ⇄ pixel transform (pure, no GTK).
 
 World coordinates are the map's millimetres, x to the right and y **up**;
-screen pixels have y down. At 100 % one pixel is 10 mm (what ``rtmu.model``
+screen pixels have y down. At 100 % one pixel is 10 mm (what ``rtmu.model.observables``
 calls zoom 1.0), so 400 % shows a 455 mm robot 182 px long and 10 % shows a
 30 m office in 300 px.
 

@@ -12,6 +12,11 @@ from typing import Self
 from ..fields import FieldReader, FieldWriter
 from .base import Payload, Side, SingleField, SingleFlag, register
 
+RATIO_TRANS_DEAD_ZONE = 10.0
+"""ARIA's ratio drive (ArActionRatioInput) ignores a translation ratio within ±10 %…"""
+RATIO_ROT_DEAD_ZONE = 5.0
+"""…and a rotation ratio under ±5 %: such a ratioDrive moves nothing."""
+
 
 @register
 @dataclass(frozen=True, slots=True)
@@ -37,6 +42,12 @@ class RatioDrive(Payload):
     def lat_ratio(self) -> float:
         """The lateral ratio the server uses: 0 when the field was left out."""
         return 0.0 if self.lat is None else self.lat
+
+    @property
+    def in_dead_zone(self) -> bool:
+        """True when ARIA's dead zones swallow every ratio asked for (and some was asked for)."""
+        asked = self.trans != 0 or self.rot != 0
+        return asked and abs(self.trans) <= RATIO_TRANS_DEAD_ZONE and abs(self.rot) < RATIO_ROT_DEAD_ZONE
 
     @property
     def moving(self) -> bool:

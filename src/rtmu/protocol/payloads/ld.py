@@ -19,6 +19,7 @@ Confirmation of each layout:
 
 from __future__ import annotations
 
+import re
 from dataclasses import dataclass
 from enum import IntEnum
 from typing import Self
@@ -160,5 +161,13 @@ class DataStoreValue(SingleField):
 
 
 def data_store_label(data_name: str) -> str:
-    """``DataStore_WiFi_Quality`` → ``WiFi Quality``: the name a person reads in the details table."""
-    return data_name.removeprefix(DATA_STORE_PREFIX).replace("_", " ")
+    """``DataStore_WiFi_Quality`` → ``WiFi Quality``, ``DataStore_WirelessQuality`` → ``Wireless
+    Quality``: the name a person reads in the details table (a name without underscores is split
+    where its words start)."""
+    name = data_name.removeprefix(DATA_STORE_PREFIX)
+    if "_" in name:
+        return name.replace("_", " ")
+    return _WORD_START.sub(" ", name)
+
+
+_WORD_START = re.compile(r"(?<=[a-z0-9])(?=[A-Z])")

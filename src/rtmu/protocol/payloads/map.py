@@ -59,25 +59,29 @@ class MapId(Payload):
     """Modification time, Unix seconds."""
 
     def encode(self) -> bytes:
-        return (
-            FieldWriter()
-            .string(self.source_name)
-            .string(self.file_name)
-            .ubyte4(len(self.checksum))
-            .raw(self.checksum)
-            .ubyte4(self.size)
-            .byte4(self.mtime)
-            .bytes()
-        )
+        return self.write(FieldWriter()).bytes()
 
     @classmethod
     def decode(cls, data: bytes) -> Self:
-        r = FieldReader(data)
+        return cls.read(FieldReader(data))
+
+    def write(self, w: FieldWriter) -> FieldWriter:
+        """The id's fields into ``w`` (``processMapChanges`` carries two ids inside its own packet)."""
+        w.string(self.source_name).string(self.file_name).ubyte4(len(self.checksum)).raw(self.checksum)
+        return w.ubyte4(self.size).byte4(self.mtime)
+
+    @classmethod
+    def read(cls, r: FieldReader) -> Self:
         source = r.string("source name")
         name = r.string("file name")
         length = checked_count(r.ubyte4("checksum length"), 1, r, "checksum length")
         checksum = r.raw(length, "checksum")
         return cls(source, name, checksum, r.ubyte4("file size"), r.byte4("modification time"))
+
+    @property
+    def is_null(self) -> bool:
+        """No source and no file name: ARIA's "null" id (a change set that names no map)."""
+        return not self.source_name and not self.file_name
 
     def to_fields(self) -> dict[str, object]:
         out = Payload.to_fields(self)

@@ -7,7 +7,7 @@ bounds what it will hold (lines, bytes, points) and raises :class:`MapTooLarge`
 or :class:`~rtmu.protocol.errors.PayloadError` instead of growing without end.
 
 Server side: :func:`map_text_payloads` and :func:`map_binary_payloads` turn a
-map (already parsed by :mod:`rtmu.maps`) into the payloads ARIA would send.
+map (already parsed by :mod:`rtmu.mapfile`) into the payloads ARIA would send.
 """
 
 from __future__ import annotations

@@ -17,7 +17,10 @@ from ..fields import FieldReader, FieldWriter
 from .base import Payload, Side, SingleField, SingleFlag, checked_count, register
 
 TEMPERATURE_UNKNOWN: Final = -128
-"""ARIA's temperature byte when the robot does not report one (MobileSim sends -127)."""
+"""ARIA's temperature byte when the robot does not report one."""
+TEMPERATURE_NOT_REPORTED: Final = frozenset({TEMPERATURE_UNKNOWN, -127})
+"""Bytes that mean "no temperature": ARIA's −128, and the −127 that MobileSim (a robot without the
+sensor) sends. No robot runs at −127 °C, so reading it as a temperature would only mislead."""
 
 _NUMBERS = struct.Struct("<hiihhhhb")
 _NUMBER_FIELDS: Final = (
@@ -68,13 +71,13 @@ class UpdateNumbers(Payload):
     lat_vel: int
     """mm/s (0 on non-holonomic robots)."""
     temperature: int = TEMPERATURE_UNKNOWN
-    """°C; −128 = unknown."""
+    """°C; −128 (or MobileSim's −127) = unknown."""
 
     SIZE = _NUMBERS.size
 
     @property
     def temperature_known(self) -> bool:
-        return self.temperature != TEMPERATURE_UNKNOWN
+        return self.temperature not in TEMPERATURE_NOT_REPORTED
 
     def encode(self) -> bytes:
         return self._pack()

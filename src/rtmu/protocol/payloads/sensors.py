@@ -146,21 +146,3 @@ class RangeDeviceCumulative(RangeDeviceReadings):
     """``<device>Cumulative`` reply: as ``<device>Current``."""
 
     DATA_NAME = "Cumulative"
-
-
-# The drawing list moved to .drawings; these names stay importable from here.
-from .drawings import Drawing, DrawingList, DrawingListPacket  # noqa: E402
-
-__all__ = [
-    "Drawing",
-    "DrawingList",
-    "DrawingListPacket",
-    "RangeDeviceCumulative",
-    "RangeDeviceReadings",
-    "Reading",
-    "SensorCumulativeReadings",
-    "SensorCumulativeRequest",
-    "SensorCurrentRequest",
-    "SensorList",
-    "SensorReadings",
-]

@@ -1,0 +1,1 @@
+"""The base layer (see docs/architecture.md)."""

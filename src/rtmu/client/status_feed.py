@@ -1,0 +1,132 @@
+"""The robot's own status: pose, speeds, battery, status and mode words, safe drive and sonar.
+
+The status stream (``updateNumbers`` + ``updateStrings``, or the old ``update``) is also the
+link's heartbeat: every status packet is told to the drive loop (:mod:`rtmu.client.drive_loop`),
+whose health monitor declares the link stale when they stop.
+"""
+
+from __future__ import annotations
+
+import contextlib
+from collections.abc import Callable, Iterable
+from typing import ClassVar
+
+from ..protocol.errors import ProtocolError
+from ..protocol.payloads.drive import SafeDrive
+from ..protocol.payloads.drive import SetSafeDrive as SetSafeDrivePayload
+from ..protocol.payloads.robot import BatteryInfo, ModeInfo, Update, UpdateNumbers, UpdateStrings
+from ..values.intents import Intent, SetSafeDrive
+from .connection import AriaClient, Packet
+from .errors import ClientError
+from .feed import Feed, FeedContext
+from .subscriptions import Subscription
+
+
+class StatusFeed(Feed):
+    """Decodes the status stream into the published :class:`~rtmu.values.state.RobotState`."""
+
+    handles: ClassVar[tuple[type[Intent], ...]] = (SetSafeDrive,)
+
+    def __init__(self, ctx: FeedContext) -> None:
+        super().__init__(ctx)
+        self.on_status: Callable[[float], None] = lambda at: None
+        """Every status packet's arrival time: the session gives it to the drive loop's health."""
+        self._battery_unit_known = True
+        """False while ``batteryInfo`` has not said whether the battery number is volts or a state of
+        charge: the number is not published until then (95.4 is no voltage)."""
+        self._battery_held: float | None = None
+        """The last battery number while its unit was not known yet: published once it is."""
+
+    def subscriptions(self, client: AriaClient) -> Iterable[Subscription]:
+        period = self.ctx.config.status_interval_ms
+        return (
+            Subscription("updateNumbers", period, self._on_numbers),
+            Subscription("updateStrings", -1, self._on_strings, needs="updateNumbers"),
+            Subscription("update", period, self._on_update, unless="updateNumbers"),
+            Subscription("getModeInfo", -1, self._on_mode_info),
+            Subscription("sonarCurrent", self.ctx.config.sonar_interval_ms, self._on_sonar),
+        )
+
+    def connected(self, client: AriaClient) -> None:
+        self._battery_unit_known = not client.supports("batteryInfo")
+        self.ctx.spawn(self._fetch_infos(client), "status-infos")
+
+    def handle(self, intent: Intent) -> None:
+        assert isinstance(intent, SetSafeDrive)
+        client = self.require("setSafeDrive")
+        client.send(SetSafeDrivePayload(intent.on))
+        if client.supports("getSafeDrive"):
+            self.ctx.spawn(self._refresh_safe_drive(client), "safe-drive")
+
+    # -- one-off questions after login -------------------------------------------------------
+    async def _fetch_infos(self, client: AriaClient) -> None:
+        timeout = self.ctx.config.reply_timeout
+        with contextlib.suppress(ClientError, ProtocolError):
+            try:
+                if client.supports("batteryInfo"):
+                    info = self.ctx.decode(
+                        "batteryInfo", (await client.request_once("batteryInfo", timeout=timeout)).payload
+                    )
+                    if isinstance(info, BatteryInfo):
+                        self.ctx.robot_update(
+                            battery_low=info.low_battery,
+                            battery_shutdown=info.shutdown,
+                            battery_is_soc=info.state_of_charge,
+                        )
+            finally:  # answered, refused or timed out: the number is shown, now and from then on
+                if self.ctx.client is client and not self._battery_unit_known:
+                    self._battery_unit_known = True
+                    if self._battery_held is not None:
+                        self.ctx.robot_update(battery_v=self._battery_held)
+            if client.supports("getSafeDrive"):
+                await self._refresh_safe_drive(client)
+
+    async def _refresh_safe_drive(self, client: AriaClient) -> None:
+        reply = await client.request_once("getSafeDrive", timeout=self.ctx.config.reply_timeout)
+        self.on_safe_drive(reply.payload)
+
+    def on_safe_drive(self, payload: bytes) -> None:
+        """A ``getSafeDrive`` answer (also the drive loop's ping where it is the cheapest request)."""
+        s = self.ctx.decode("getSafeDrive", payload)
+        if isinstance(s, SafeDrive):
+            self.ctx.robot_update(safe_drive=s.safe)
+
+    # -- the stream --------------------------------------------------------------------------
+    def _on_numbers(self, packet: Packet) -> None:
+        numbers = self.ctx.decode(packet.name, packet.payload)
+        if isinstance(numbers, UpdateNumbers):
+            self._apply_numbers(numbers, packet.received_at)
+
+    def _apply_numbers(self, n: UpdateNumbers, at: float) -> None:
+        self._battery_held = n.battery
+        self.ctx.robot_update(
+            x=float(n.x), y=float(n.y), th=float(n.th), vel=float(n.vel), rot_vel=float(n.rot_vel),
+            lat_vel=float(n.lat_vel), battery_v=n.battery if self._battery_unit_known else None,
+            temperature=float(n.temperature) if n.temperature_known else None, numbers_at=at,
+        )  # fmt: skip
+        self.on_status(at)
+
+    def _on_strings(self, packet: Packet) -> None:
+        s = self.ctx.decode(packet.name, packet.payload)
+        if isinstance(s, UpdateStrings):
+            self.ctx.robot_update(
+                status=s.status, mode=s.mode, extended_status=s.extended_status, strings_at=packet.received_at
+            )
+
+    def _on_update(self, packet: Packet) -> None:
+        u = self.ctx.decode(packet.name, packet.payload)
+        if isinstance(u, Update):
+            self.ctx.robot_update(status=u.status, mode=u.mode, strings_at=packet.received_at)
+            self._apply_numbers(u.numbers, packet.received_at)
+
+    def _on_mode_info(self, packet: Packet) -> None:
+        m = self.ctx.decode(packet.name, packet.payload)
+        if isinstance(m, ModeInfo):
+            self.ctx.robot_update(
+                mode_name=m.mode_name, mode_locked=m.locked, mode_will_unlock=m.will_unlock_if_requested
+            )
+
+    def _on_sonar(self, packet: Packet) -> None:
+        readings = self.ctx.decode(packet.name, packet.payload)
+        if readings is not None and hasattr(readings, "readings"):
+            self.ctx.robot_update(sonar=tuple(readings.readings), sonar_at=packet.received_at)

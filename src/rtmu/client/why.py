@@ -1,0 +1,515 @@
+"""Why won't it move? — what RTMU knows or can ask, told as one plain sentence with its fix (no I/O).
+
+"It won't move" is the call robot support gets most. :func:`diagnose` reads :class:`Facts` — the
+server's own data, gathered by :mod:`rtmu.client.why_gather` (the command line) or filled in by the
+window from what its session already holds, plus our own side (link, lease, guardian) — and answers
+with the causes it finds, the most fundamental first, each a sentence, its fix and what ``--fix``
+may do about it. A cause is named only when the server's data says so; nothing is guessed. Values
+RTMU cannot interpret (an Omron LD robot's safety data, whose layouts are not public) come back
+raw, labelled as such, and are never acted on without the operator's confirmation.
+
+What ARIA 2.9.1 itself puts on the wire (learnt from its sources): the active mode's lock
+(``getModeInfo``: locked, will / will not unlock if asked — a locked mode gives way only when
+another mode asks to take over and it agrees), ``ratioDrive`` in group Movement and ``stop`` in
+Stop (a login's data list holds only what its groups allow), safe drive (``getSafeDrive``; its
+limiter's ``Clearance``/``PaddingAtSlowSpeed`` parameters in the Teleop section), the teleop
+watchdog (``Timeout``), and the status words ``Stalled`` / ``Bumped``. ArRobot's e-stop and
+motor-enable flags are not sent by ArServerInfoRobot: RTMU names those only where a server's own
+status words say so.
+"""
+
+from __future__ import annotations
+
+import math
+import re
+
+from ..protocol.payloads.drive import RATIO_ROT_DEAD_ZONE, RATIO_TRANS_DEAD_ZONE, RatioDrive
+from ..protocol.payloads.robot import ModeInfo
+from ..values.state import LinkLevel, NavOutcome
+from .lease import RESEND_PERIOD
+from .nav_status import read_status
+from .why_values import (
+    Answer,
+    Cause,
+    Facts,
+    Fix,
+    Footprint,
+    Motion,
+    Obstacle,
+    Reason,
+    SafeDriveLimits,
+)
+
+# -- the rules -----------------------------------------------------------------------------------
+WATCHDOG_MARGIN = 2.0
+"""A server watchdog shorter than this many of RTMU's resend periods stops drives between commands."""
+_ESTOP = re.compile(r"\be-?stop\b|\bemergency[ -]stop\b", re.IGNORECASE)
+_ESTOP_CLEAR = re.compile(r"\b(relieved|released|not pressed|clear(ed)?|ok)\b", re.IGNORECASE)
+_MOTORS_OFF = re.compile(r"\bmotors?\b[^.\n]{0,20}\b(disabled|off)\b", re.IGNORECASE)
+_STALL_WORDS = ("Stalled", "Bumped")
+"""ArServerModeRatioDrive's / ArServerModeDrive's status when a motor stalls or the stall value
+(bumpers) is set."""
+DOCK_MODES = frozenset({"dock", "Dock"})
+
+
+def diagnose(facts: Facts, motion: Motion | None = None, *, navigate: bool = False) -> Answer:
+    """Every cause the facts show, in :class:`Cause` order. ``motion``: the drive asked for (an
+    obstacle then matters only in its direction); ``navigate``: the question is about navigation
+    (a lost localization counts)."""
+    found: list[Reason] = []
+    for rule in _RULES:
+        found.extend(rule(facts, motion, navigate))
+    order = list(Cause)
+    found.sort(key=lambda r: order.index(r.cause))
+    notes = list(facts.notes)
+    if facts.ours.guardian:
+        notes.append(f"the guardian is not watching this drive ({facts.ours.guardian})")
+    return Answer(tuple(found), tuple(notes), facts.raw)
+
+
+def _words(facts: Facts) -> list[str]:
+    """The server's own status lines (status, then each line of the extended status)."""
+    lines = [facts.status, *facts.extended_status.splitlines()]
+    return [line.strip() for line in lines if line.strip()]
+
+
+def _quote(text: str) -> str:
+    return '"' + text[:120] + '"'
+
+
+def _our_side(facts: Facts, motion: Motion | None, navigate: bool) -> list[Reason]:
+    ours = facts.ours
+    out: list[Reason] = []
+    if ours.link in (LinkLevel.STALE, LinkLevel.LOST, LinkLevel.DOWN):
+        said = {
+            LinkLevel.STALE: "stale (no status in time)",
+            LinkLevel.LOST: "lost",
+            LinkLevel.DOWN: "down (not connected)",
+        }[ours.link]
+        out.append(
+            Reason(
+                Cause.LINK,
+                f"our link to the robot is {said}: RTMU sends no drive over it",
+                "check the network (Wi-Fi, cable); once the link is back, press the drive key again",
+                (f"link: {ours.link.value}",),
+            )
+        )
+    if ours.replay:
+        out.append(
+            Reason(
+                Cause.LEASE,
+                "this is a replay: nothing is sent to a robot",
+                "connect to the robot to drive it",
+            )
+        )
+    elif ours.keys_blocked:
+        out.append(
+            Reason(
+                Cause.LEASE,
+                "a drive key held through a stop is ignored until it is released",
+                "let go of the key and press it again",
+            )
+        )
+    elif ours.lease_ended == "lapsed":
+        out.append(
+            Reason(
+                Cause.LEASE,
+                "the window did not renew the drive in time (it was busy or frozen), "
+                "so RTMU stopped the robot",
+                "press the drive key again",
+            )
+        )
+    return out
+
+
+def _rights(facts: Facts, motion: Motion | None, navigate: bool) -> list[Reason]:
+    who = f"user {facts.user!r}" if facts.user else "this login (no user name)"
+    drive, stop = "ratioDrive" in facts.offers, "stop" in facts.offers
+    out: list[Reason] = []
+    if not drive:
+        problem = f"{who} may not drive the robot (no ratioDrive in its data list)"
+        if not stop:
+            problem = f"{who} may neither drive nor stop the robot (no ratioDrive, no stop in its data list)"
+        advice = (
+            "log in as a user whose groups include Movement (and Stop)"
+            if facts.user
+            else "this server offers no driving without a login: log in as a user with Movement"
+        )
+        out.append(Reason(Cause.NO_DRIVE, problem, advice, ("data list: no ratioDrive",)))
+    if not stop:
+        out.append(
+            Reason(
+                Cause.NO_STOP,
+                f"SAFETY: {who} may not send stop (no stop in its data list): RTMU's STOP cannot stop the "
+                "robot from this login" + (" except by zero drive ratios" if drive else ""),
+                "do not drive from this login; use one whose groups include Stop",
+                ("data list: no stop",),
+                loud=True,
+            )
+        )
+    return out
+
+
+def _dead_zone(facts: Facts, motion: Motion | None, navigate: bool) -> list[Reason]:
+    """The drive asked for is one ARIA's ratio drive ignores: it is the request, not the robot."""
+    if (
+        motion is None
+        or "ratioDrive" not in facts.offers
+        or not RatioDrive(motion.trans, motion.rot).in_dead_zone
+    ):
+        return []
+    return [
+        Reason(
+            Cause.DEAD_ZONE,
+            f"the drive asked for (translation {motion.trans:g} %, rotation {motion.rot:g} %) is inside "
+            f"ARIA's dead zone (translation up to ±{RATIO_TRANS_DEAD_ZONE:g} %, rotation under "
+            f"±{RATIO_ROT_DEAD_ZONE:g} %): the server ignores it",
+            f"ask for more than {RATIO_TRANS_DEAD_ZONE:g} % translation or at least "
+            f"{RATIO_ROT_DEAD_ZONE:g} % rotation",
+            (f"our ratioDrive: {motion.trans:g} % translation, {motion.rot:g} % rotation",),
+        )
+    ]
+
+
+def _safety_words(facts: Facts, motion: Motion | None, navigate: bool) -> list[Reason]:
+    out: list[Reason] = []
+    lines = _words(facts)
+    estop = next((w for w in lines if _ESTOP.search(w) and not _ESTOP_CLEAR.search(w)), None)
+    if estop is not None:
+        out.append(
+            Reason(
+                Cause.ESTOP,
+                f"the robot's e-stop is pressed (the server says {_quote(estop)})",
+                "make it safe, release the e-stop button on the robot, then reset it as the robot requires",
+                (f"status: {_quote(estop)}",),
+            )
+        )
+    motors = next((w for w in lines if _MOTORS_OFF.search(w)), None)
+    if motors is not None:
+        out.append(
+            Reason(
+                Cause.MOTORS,
+                f"the robot's motors are disabled (the server says {_quote(motors)})",
+                _motors_advice(facts),
+                (f"status: {_quote(motors)}",),
+                _enable_fix(facts),
+            )
+        )
+    if facts.faults:
+        shown = "; ".join(f[:120] for f in facts.faults[:5]) + (" …" if len(facts.faults) > 5 else "")
+        fix = None
+        if "acknowledgeFault" in facts.offers:
+            fix = Fix(
+                "acknowledge_faults",
+                "acknowledge the listed faults on the robot (acknowledgeFault; "
+                "its layout is not public: RTMU builds it from the server's own description)",
+                "acknowledgeFault",
+                confirm=True,
+            )
+        out.append(
+            Reason(
+                Cause.FAULTS,
+                f"the robot reports {len(facts.faults)} fault(s): {shown}",
+                "clear what caused them, then acknowledge them (with care: the robot may move on)",
+                ("getFaults",),
+                fix,
+            )
+        )
+    return out
+
+
+def _motors_advice(facts: Facts) -> str:
+    if "enableMotors" in facts.offers:
+        return "find out why they were disabled (e-stop, a fault), then enable them again (enableMotors)"
+    return "find out why they were disabled (e-stop, a fault) and enable them on the robot"
+
+
+def _enable_fix(facts: Facts) -> Fix | None:
+    if "enableMotors" not in facts.offers:
+        return None
+    return Fix(
+        "enable_motors", "enable the motors (enableMotors; its layout is not public)", "enableMotors", True
+    )
+
+
+def _battery(facts: Facts, motion: Motion | None, navigate: bool) -> list[Reason]:
+    level, shutdown = facts.battery, facts.battery_shutdown
+    if level is None or shutdown is None or level > shutdown:
+        return []
+    unit = "%" if facts.battery_soc else "V"
+    return [
+        Reason(
+            Cause.BATTERY,
+            f"the battery ({level:g} {unit}) is at or below the robot's shutdown level ({shutdown:g} {unit})",
+            "charge the robot (dock it or plug it in) before driving",
+            (f"updateNumbers: battery {level:g} {unit}", f"batteryInfo: shutdown {shutdown:g} {unit}"),
+        )
+    ]
+
+
+def _stalled(facts: Facts, motion: Motion | None, navigate: bool) -> list[Reason]:
+    word = next((w for w in _words(facts) if w in _STALL_WORDS), None)
+    if word is None:
+        return []
+    what = (
+        "a motor is stalled"
+        if word == "Stalled"
+        else "the robot is bumped (its stall or bumper flags are set)"
+    )
+    return [
+        Reason(
+            Cause.STALLED,
+            f"{what} (the server says {_quote(word)})",
+            "the robot pushed against something or a wheel is blocked: drive away from it, "
+            "check the wheels and bumpers",
+            (f"status: {_quote(word)}",),
+        )
+    ]
+
+
+def _modes(facts: Facts, motion: Motion | None, navigate: bool) -> list[Reason]:
+    out: list[Reason] = []
+    info = facts.mode_info
+    docked = facts.dock_state == "Docked" or (
+        read_status(facts.status).phase is NavOutcome.DOCKED
+        and info is not None
+        and info.mode_name in DOCK_MODES
+    )
+    if docked:
+        evidence = (
+            [f"dockInfo: {facts.dock_state}"] if facts.dock_state else [f"status: {_quote(facts.status)}"]
+        )
+        fix = (
+            Fix("undock", "undock (the robot backs out of its dock)", "undock", False)
+            if "undock" in facts.offers
+            else None
+        )
+        out.append(
+            Reason(
+                Cause.DOCKED,
+                "the robot is docked (charging)",
+                "undock it first" + (" (undock)" if fix else "") + "; a drive asks the dock to let go "
+                "and the robot backs out before it drives",
+                tuple(evidence),
+                fix,
+            )
+        )
+    if info is not None and info.locked and not (docked and info.mode_name in DOCK_MODES):
+        name = info.mode_name or "(unnamed)"
+        said = (
+            f"getModeInfo: mode {name!r}, locked, "
+            f"{'will' if info.will_unlock_if_requested else 'will not'} unlock if asked",
+        )
+        if info.will_unlock_if_requested:
+            fix = _unlock_fix(facts, info)
+            out.append(
+                Reason(
+                    Cause.LOCKED,
+                    f"the {name!r} mode holds the robot locked (it will unlock if asked)",
+                    "ask it to unlock"
+                    + (f": {fix.label}" if fix else " (this login can send nothing that asks)"),
+                    said,
+                    fix,
+                )
+            )
+        else:
+            out.append(
+                Reason(
+                    Cause.LOCKED,
+                    f"the {name!r} mode holds the robot locked and will not unlock if asked",
+                    f"RTMU cannot release it: whatever locked the {name!r} mode (docking, a safety "
+                    "mode, a program on the server) must unlock it",
+                    said,
+                )
+            )
+    reading = read_status(facts.status, info.mode_name if info else "")
+    if reading.phase is NavOutcome.GOING and not docked:
+        fix = (
+            Fix("stop", "send stop (the server's own driving ends)", "stop", False)
+            if "stop" in facts.offers
+            else None
+        )
+        target = f" ({reading.target})" if reading.target else ""
+        out.append(
+            Reason(
+                Cause.NAVIGATING,
+                f"the server is driving the robot itself{target}: {_quote(reading.text)}",
+                "press STOP first; the next drive is then yours",
+                (f"status: {_quote(reading.text)}",),
+                fix,
+            )
+        )
+    if navigate and facts.loc_state == "Lost":
+        out.append(
+            Reason(
+                Cause.LOST,
+                "the robot is lost (its localization says Lost): it cannot navigate",
+                "tell it where it is (rtmu localize, or Set position in the window)",
+                ("getLocState: Lost",),
+            )
+        )
+    return out
+
+
+def _unlock_fix(facts: Facts, info: ModeInfo) -> Fix | None:
+    """Asking means trying to switch modes: ARIA's mode then calls the locked one's requestUnlock.
+    A stop switches to the stop mode; when ``stop`` is the locked mode itself, a zero ratioDrive asks."""
+    if info.mode_name != "stop" and "stop" in facts.offers:
+        return Fix(
+            "unlock", "send stop: switching to the stop mode asks the locked mode to give way", "stop", False
+        )
+    if "ratioDrive" in facts.offers:
+        return Fix(
+            "unlock",
+            "send a zero ratioDrive: switching to the drive mode asks the locked mode to "
+            "give way (zero ratios never move the robot)",
+            "ratioDrive",
+            False,
+        )
+    return None
+
+
+def _watchdog(facts: Facts, motion: Motion | None, navigate: bool) -> list[Reason]:
+    t = facts.teleop_timeout
+    if t is None or not 0.0 < t < WATCHDOG_MARGIN * RESEND_PERIOD:
+        return []
+    return [
+        Reason(
+            Cause.WATCHDOG,
+            f"the server's drive watchdog is {t:g} s: shorter than twice the "
+            f"{RESEND_PERIOD:g} s between RTMU's drive commands, so it stops the robot between them "
+            "(jerky motion at best, none on a slow link)",
+            "raise the Teleop Timeout in the server's configuration (ARIA's default is 2 s; 0 turns it off)",
+            (f"configuration: Teleop Timeout = {t:g} s",),
+        )
+    ]
+
+
+def _safe_drive(facts: Facts, motion: Motion | None, navigate: bool) -> list[Reason]:
+    if facts.safe_drive is not True or facts.footprint is None or facts.limits is None:
+        return []
+    if motion is not None and motion.trans == 0:
+        return []  # safe drive limits translation only: turning on the spot is not held back
+    ways = (True, False) if motion is None else ((motion.trans > 0),)
+    out: list[Reason] = []
+    for forward in ways:
+        hit = nearest(facts.obstacles, facts.footprint, facts.limits, forward)
+        if hit is None:
+            continue
+        obstacle, _ = hit
+        limit = facts.limits.front if forward else facts.limits.rear
+        way, away = ("ahead of", "backwards") if forward else ("behind", "forwards")
+        clear = nearest(facts.obstacles, facts.footprint, facts.limits, not forward) is None
+        fix = _safe_off_fix(facts)
+        advice = f"drive away from it ({away}{': that way is clear' if clear else ''})" + (
+            ", or switch safe drive off (with care: the robot then drives into things)" if fix else ""
+        )
+        out.append(
+            Reason(
+                Cause.SAFE_DRIVE,
+                f"safe drive holds the robot back: an obstacle {abs(obstacle.x):.0f} mm {way} its centre "
+                f"{_side(obstacle)}, closer than safe drive allows (half the robot's length + "
+                f"{limit:.0f} mm = {facts.footprint.reach + limit:.0f} mm)",
+                advice,
+                (
+                    f"{obstacle.source}: reading at ({obstacle.x:.0f}, {obstacle.y:.0f}) mm in "
+                    f"the robot's frame",
+                    f"limits: {facts.limits.source}",
+                    "getSafeDrive: on",
+                ),
+                fix,
+            )
+        )
+        break  # one sentence is enough; the first direction asked about decides
+    return out
+
+
+def _safe_off_fix(facts: Facts) -> Fix | None:
+    for name in ("setSafeDrive", "safeRatioDrivingDisable"):
+        if name in facts.offers:
+            return Fix(
+                "safe_drive_off",
+                f"switch safe drive off ({name}); the robot then drives into things",
+                name,
+                True,
+            )
+    return None
+
+
+def nearest(
+    obstacles: tuple[Obstacle, ...], footprint: Footprint, limits: SafeDriveLimits, forward: bool
+) -> tuple[Obstacle, float] | None:
+    """The closest reading in the robot's path (its width plus the side clearance) that is nearer
+    than the safe-drive distance, with that distance; None when clear. Measured as ARIA's
+    ArActionDeceleratingLimiter measures: from half the robot's length ahead of (behind) its centre."""
+    half = footprint.width / 2 + limits.side
+    best: tuple[Obstacle, float] | None = None
+    for o in obstacles:
+        if abs(o.y) > half:
+            continue
+        gap = (o.x if forward else -o.x) - footprint.reach
+        if (o.x > 0) != forward or gap >= (limits.front if forward else limits.rear):
+            continue
+        if best is None or (round(gap), abs(o.y)) < (round(best[1]), abs(best[0].y)):
+            best = (o, gap)
+    return best
+
+
+def _side(o: Obstacle) -> str:
+    if abs(o.y) < 50:
+        return "(straight on)"
+    return f"({abs(o.y):.0f} mm to the {'left' if o.y > 0 else 'right'})"
+
+
+_RULES = (_our_side, _rights, _dead_zone, _safety_words, _battery, _stalled, _modes, _watchdog, _safe_drive)
+
+
+# -- did it move? ----------------------------------------------------------------------------------
+MOVED_MM = 10.0
+MOVED_DEG = 2.0
+
+
+def moved(before: tuple[float, float, float], after: tuple[float, float, float], seen_moving: bool) -> bool:
+    """A drive moved the robot: a status during it showed speed, or the pose changed more than the
+    odometry's rounding (:data:`MOVED_MM`, :data:`MOVED_DEG`)."""
+    (x0, y0, th0), (x1, y1, th1) = before, after
+    turned = abs((th1 - th0 + 180.0) % 360.0 - 180.0)
+    return seen_moving or math.hypot(x1 - x0, y1 - y0) > MOVED_MM or turned > MOVED_DEG
+
+
+def unexplained(answer: Answer) -> Answer:
+    """A drive that did not move and no cause that explains it: say so rather than exit 0."""
+    if any(r.cause is not Cause.NO_STOP for r in answer.reasons):
+        return answer
+    reason = Reason(
+        Cause.UNEXPLAINED,
+        "the robot did not move, and nothing RTMU can read says why",
+        "look at the robot itself (e-stop, motors, faults on its own display) and at the server's log",
+    )
+    return Answer((reason, *answer.reasons), answer.notes, answer.raw)
+
+
+HINT_AFTER = 1.0
+"""Seconds a held drive may produce no motion before the window offers its answer."""
+
+
+class StillWhileHeld:
+    """When to offer "why won't it move?" on its own: a drive held :data:`HINT_AFTER` s without the
+    robot moving. Fed by the window on its own clock; says True once per held drive."""
+
+    def __init__(self, after: float = HINT_AFTER) -> None:
+        self.after = after
+        self._since: float | None = None
+        self._said = False
+
+    def update(self, now: float, driving: bool, moving: bool) -> bool:
+        """``driving``: a drive is held now; ``moving``: the last status shows the robot moving."""
+        if not driving or moving:
+            self._since, self._said = None, False
+            return False
+        if self._since is None:
+            self._since = now
+        if self._said or now - self._since < self.after:
+            return False
+        self._said = True
+        return True

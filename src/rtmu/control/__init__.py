@@ -1,0 +1,1 @@
+"""The control layer (see docs/architecture.md)."""

@@ -1,0 +1,707 @@
+"""Operator intents → client calls, with the robot's safety rules in one place.
+
+The controller runs on the UI thread. It is GTK-free: it talks to the window
+through the small :class:`View` protocol and to the network through
+:class:`ClientLink` (implemented by ``rtmu.client.ClientRunner``), and reads
+time from an injected clock, so every rule below is tested without a display.
+
+Driving rules
+-------------
+* ``press(direction)`` / ``release(direction)``: move only **while held**. The
+  first press grants a drive lease (``rtmu.client.lease``); :meth:`tick`, called
+  by the UI's own timer every :data:`TICK` seconds, renews it while keys are
+  held; the network side resends ``ratioDrive`` at 10 Hz while the lease is
+  fresh. Two held directions combine into a curve (forward+left = forward with
+  half rotation); opposite directions cancel. Releasing the last key sends zero
+  ratios and ``stop``.
+* :meth:`stop` always wins and is always sent, even when the link looks stale.
+* Focus loss, disconnect, a stale or lost link, and a lapsed lease (the UI froze
+  for more than 300 ms) stop the robot. Keys still held at that moment are
+  *blocked* until released: the robot stays still until a fresh key press —
+  also after a reconnect, and also after focus comes back: a key held through
+  the focus loss auto-repeats as presses, which must not restart motion. While
+  the window is unfocused no real key release can arrive, so releases then
+  (a window "releasing everything" on focus loss) do not unblock; the first
+  press after focus returns marks the window focused again (a key released
+  while unfocused therefore needs one press to clear it, then a fresh press).
+* ``analog(trans, rot)`` / ``analog_release()``: a gamepad's stick while its
+  dead-man button is held (``rtmu.control.gamepad`` turns pad events into these). It rides
+  the SAME lease as the keys (held keys win over the stick while both are held);
+  every stop above blocks the stick too, until the dead-man is released and
+  pressed again.
+* Speed: 10…100 % in 10 % steps; it is the ``ratioDrive`` throttle and applies at
+  once to a drive in progress. The operator's near-people cap (``OperatorState.near_people``)
+  lowers that throttle so a full drive stays under it, from the robot's top speed
+  (``motion_limits``: the server's own, else ARIA's P3-DX maximum, raised by any faster speed seen).
+* Every jog (Turn, Go) ends with its outcome said (``jog_watch``): arrived, stopped short and why,
+  or ended by a stop, a drive or a navigation.
+
+Navigation rules (the server drives: ARNL's goals, points, home, dock, tours)
+-----------------------------------------------------------------------------
+* The operator always wins. :meth:`stop` cancels a navigation (its ``stop`` goes
+  out at once, as always). A drive key pressed while the server navigates does
+  not steer: it sends the stop and nothing else, and stays blocked until released;
+  the next press drives as usual.
+* Sending the robot somewhere ends a held drive first (the network side sends the
+  stop before the goal), so the next ``ratioDrive`` cannot take it back.
+* Navigation is autonomy on the server: focus loss, a stale link or a lapsed lease
+  end *held drives* only, never a navigation (disconnecting still stops the robot).
+* Looking never stops a mission: changing page (map ⇄ camera) or opening a dialog (Turn, Go, the
+  server's commands) ends a held drive — its keys go elsewhere — but never a navigation, and
+  is no stop key (:meth:`look`). Only STOP, Space and the drive keys cancel a navigation.
+* No drive starts or goes on while the stop key cannot reach the window (:meth:`focus_lost` until
+  :meth:`focus_gained` or a key press): a D-pad press then is refused, saying why
+  (:meth:`pointer_may_drive`).
+* Every stop the controller makes is said once, with what to do next.
+"""
+
+from __future__ import annotations
+
+import contextlib
+import time
+from collections.abc import Callable, Mapping
+from dataclasses import replace
+from typing import Any, Protocol
+
+from ..base.notices import Kind, Notice
+from ..client.lease import DriveLease, DriveRatios, EndReason
+from ..model.observables import OperatorState, RobotModel, SpeedSetting
+from ..settings.store import Profile
+from ..values.intents import GotoGoal, Intent, RequestPicture, StartVideo, Stop, picture_source
+from ..values.state import ConnectionState, LinkHealth, LinkLevel, NavState, Phase, RobotState
+from .commands import COMMANDS, CommandRegistry, CommandState
+from .motion_limits import RobotLimits, capped_throttle
+from .motion_watch import MotionWatch
+
+TICK = 0.1
+"""Seconds between :meth:`Controller.tick` calls the UI timer should make (10 Hz renewal)."""
+CURVE_ROT = 50.0
+"""Rotation ratio (%) used when a turn key is held together with forward or backward."""
+
+DIRECTIONS = ("forward", "backward", "left", "right")
+
+
+class View(Protocol):
+    """What the controller needs from a window (GTK, a test fake, or nothing at all)."""
+
+    def notify(self, notice: Notice) -> None:
+        """Show a short message (banner/toast) to the operator; its kind says where."""
+
+    def commands_changed(self, states: Mapping[str, CommandState]) -> None:
+        """Enable/disable commands; ``states`` holds every command whose state changed."""
+
+    def ask_password(self, profile: Profile, answer: Callable[[str | None], None]) -> None:
+        """Ask for the password of ``profile`` without blocking; call ``answer`` (None = cancelled)."""
+
+    def open_dialog(self, name: str) -> None:
+        """Open the dialog a command needs (``turn``: an angle, ``go``: a distance)."""
+
+
+class ClientLink(Protocol):
+    """The network side as the controller sees it (``rtmu.client.ClientRunner``); every call returns at once
+    (what it returns — a Future in the runner — is not waited for here).
+
+    Results come back through the model (connection, robot, map, camera) on the
+    UI thread; problems the operator should hear about go to ``on_notice``.
+    """
+
+    lease: DriveLease
+    on_notice: Callable[[Notice], None] | None
+    """Set by the controller: the network side's messages for the operator."""
+
+    def connect(
+        self,
+        host: str,
+        port: int,
+        user: str = "",
+        password: str = "",
+        *,
+        profile: str = "",
+        auto_reconnect: bool = True,
+        protocol: str | None = None,
+    ) -> object: ...
+
+    def disconnect(self) -> object: ...
+
+    def send(self, intent: Intent) -> Any:
+        """The one way an intent crosses to the network thread (a Future of the feed's answer)."""
+
+    # Optional (the controller looks for it with getattr): ``run_blocking(fn, done)`` runs ``fn``
+    # off the UI thread and posts ``done(result)`` back; keyring lookups go through it.
+
+
+class SecretStore(Protocol):
+    """Where remembered passwords live (``rtmu.settings.store`` provides the keyring-backed one)."""
+
+    def get(self, profile: Profile) -> str | None: ...
+
+
+REPLAY_REASON = "Replay — nothing is sent to a robot"
+KEYBOARD_LOST = "the window lost the keyboard"
+"""Why a held drive stops on a focus loss (a suspend names its own reason)."""
+
+
+def ratios_for(held: set[str] | frozenset[str], throttle: float) -> DriveRatios:
+    """The ``ratioDrive`` for a set of held directions (empty or cancelling → zero motion)."""
+    trans = 100.0 * (("forward" in held) - ("backward" in held))
+    rot = 100.0 * (("left" in held) - ("right" in held))
+    if trans and rot:
+        rot = CURVE_ROT if rot > 0 else -CURVE_ROT
+    return DriveRatios(trans, rot, float(throttle))
+
+
+class NoView:
+    """The view of a controller no window shows (yet): notices and command states go nowhere."""
+
+    def notify(self, notice: Notice) -> None:
+        pass
+
+    def commands_changed(self, states: Mapping[str, CommandState]) -> None:
+        pass
+
+    def ask_password(self, profile: Profile, answer: Callable[[str | None], None]) -> None:
+        answer(None)
+
+    def open_dialog(self, name: str) -> None:
+        pass
+
+
+class Controller:
+    """See the module notes. One per robot session; call everything from the UI thread.
+
+    ``robot`` is the robot's state, ``operator`` the speed and view choices of the window
+    (shared by every robot it shows); ``view`` may be replaced when another window shows it.
+    """
+
+    def __init__(
+        self,
+        robot: RobotModel,
+        operator: OperatorState,
+        link: ClientLink,
+        view: View,
+        *,
+        clock: Callable[[], float] = time.monotonic,
+        registry: CommandRegistry = COMMANDS,
+        secrets: SecretStore | None = None,
+        profile: Profile | None = None,
+    ) -> None:
+        self.robot = robot
+        self.operator = operator
+        self.link = link
+        self.view = view
+        self.clock = clock
+        self.registry = registry
+        self.secrets = secrets
+        self.profile = profile or Profile()
+        self._held: set[str] = set()
+        self._blocked: set[str] = set()
+        """Keys that were held when motion was stopped for them; ignored until released."""
+        self._analog: tuple[float, float] | None = None
+        """The gamepad stick (trans, rot in %) while its dead-man is held; None when let go."""
+        self._analog_blocked = False
+        """The stick drove (or was held) when motion was stopped: ignored until the dead-man is released."""
+        self._generation: int | None = None
+        self._states: dict[str, CommandState] = {}
+        self._lookup_pending = False
+        """A keyring lookup runs off the UI thread; connect() waits for its answer."""
+        self._unfocused = False
+        """Between focus loss and the next key press: releases seen then are not real key-ups."""
+        self._nav_cancelled = False
+        """We sent the stop that ends the current navigation; the server has not said so yet."""
+        self.tap: Callable[[str, dict[str, Any]], None] | None = None
+        """The flight recorder's tap: every intent sent, and every connect (without its password)."""
+        self.keys_reach = True
+        """The window has the keyboard, so the stop key reaches it (False from focus loss to focus gain)."""
+        self.motion = MotionWatch(link, lambda n: self.view.notify(n), self._reapply, clock)
+        """The robot's limits (the cap, the stopping distance) and how each jog ended."""
+        self.replay: str | None = None
+        """Set to the recording's name while the window shows a replay: then nothing is sent at all
+        (drive keys, D-pad, STOP and every server command say "replay"), and no lease is granted."""
+        link.on_notice = self._on_link_notice
+        self._unobserve = [
+            robot.connection.observe(self._on_connection),
+            robot.health.observe(self._on_health),
+            robot.navigation.observe(self._on_navigation),
+            robot.robot.observe(self._on_robot),
+            operator.near_people.observe(lambda _old, _new: self._reapply()),
+        ]
+        self.refresh_commands()
+
+    def close(self) -> None:
+        """Unhook from the model and the link (after the robot was stopped); idempotent."""
+        for remove in self._unobserve:
+            remove()
+        self._unobserve = []
+        if self.link.on_notice == self._on_link_notice:
+            self.link.on_notice = None
+        self.view = NoView()
+
+    # -- CommandContext ----------------------------------------------------------------------
+    @property
+    def connected(self) -> bool:
+        return self.robot.connection.value.connected
+
+    def supports(self, name: str) -> bool:
+        return self.robot.connection.value.supports(name)
+
+    def connection_phase(self) -> Phase:
+        return self.robot.connection.value.phase
+
+    def image_source(self) -> str | None:
+        """The data a picture is requested with (:func:`~rtmu.client.video_feed.picture_source`)."""
+        return picture_source(self.robot.connection.value.offers)
+
+    # -- commands ----------------------------------------------------------------------------
+    def run(self, name: str) -> bool:
+        """Run (or, for hold commands, press) command ``name``; False if it is disabled."""
+        cmd = self.registry.get(name)
+        reason = REPLAY_REASON if self.replay and cmd.needs_connection else cmd.unavailable(self)
+        if reason is not None:
+            self.view.notify(Notice.warning(Kind.COMMAND, f"{cmd.label}: {reason}"))
+            return False
+        cmd.activate(self)
+        return True
+
+    def release_command(self, name: str) -> None:
+        """Key of a hold command released (always honoured, even if the command became disabled)."""
+        cmd = self.registry.get(name)
+        if cmd.hold:
+            cmd.deactivate(self)
+
+    def command_states(self) -> dict[str, CommandState]:
+        return dict(self._states)
+
+    def refresh_commands(self) -> None:
+        """Recompute every command's state and tell the view about those that changed."""
+        states = self.registry.states(self)
+        if self.replay:  # a replay sends nothing: every command that would is shown disabled, saying why
+            off = CommandState(False, REPLAY_REASON)
+            states = {k: off if self.registry.get(k).needs_connection else v for k, v in states.items()}
+        changed = {k: v for k, v in states.items() if self._states.get(k) != v}
+        self._states = states
+        if changed:
+            self.view.commands_changed(changed)
+
+    # -- held motion -------------------------------------------------------------------------
+    @property
+    def held(self) -> frozenset[str]:
+        return frozenset(self._held)
+
+    def press(self, direction: str) -> None:
+        if direction not in DIRECTIONS:
+            raise ValueError(f"unknown direction {direction!r}")
+        self._unfocused = False  # key presses reach a focused window only
+        self.keys_reach = True
+        if direction in self._held or direction in self._blocked:
+            return  # key auto-repeat, or a key held through a stop: wait for its release
+        if self.replay:
+            self._blocked.add(direction)
+            self._say_replay()
+            return
+        if not self.connected or not self.supports("ratioDrive"):
+            self._blocked.add(direction)
+            return
+        if self.navigating:  # the operator wins: this press only stops the navigation
+            self.stop()
+            self._blocked.add(direction)
+            self.view.notify(Notice.info(Kind.NAVIGATION, "Navigation cancelled. Press again to drive."))
+            return
+        self._held.add(direction)
+        self._apply()
+
+    def release(self, direction: str) -> None:
+        if not self._unfocused:  # a real key-up: the key may drive again on its next press
+            self._blocked.discard(direction)
+        if direction not in self._held:
+            return
+        self._held.discard(direction)
+        self._apply()
+
+    # -- analog motion (a gamepad's stick under its dead-man) ----------------------------------
+    @property
+    def analog_active(self) -> bool:
+        """The stick is being listened to (dead-man held, not blocked by a stop)."""
+        return self._analog is not None
+
+    @property
+    def analog_blocked(self) -> bool:
+        """A stop ended the stick's drive: the dead-man must be released before it drives again."""
+        return self._analog_blocked
+
+    def analog(self, trans: float, rot: float) -> None:
+        """The stick while the dead-man is held: trans/rot in −100…100 % (rot positive = left).
+
+        The first call grants the lease like a key press; later ones change its ratios. Ignored
+        while blocked (after any stop) until :meth:`analog_release`."""
+        if self._analog_blocked:
+            return
+        if not self.connected or not self.supports("ratioDrive"):
+            self._analog_blocked = True
+            return
+        if self.navigating and (trans or rot):  # the operator wins: this only stops the navigation
+            self.stop()
+            self._analog_blocked = True
+            self.view.notify(Notice.info(Kind.NAVIGATION, "Navigation cancelled. Press again to drive."))
+            return
+        self._analog = (max(-100.0, min(100.0, trans)), max(-100.0, min(100.0, rot)))
+        self._apply()
+
+    def analog_release(self) -> None:
+        """The dead-man was let go (or the pad is gone): stop the stick's drive; it may drive again."""
+        self._analog_blocked = False
+        if self._analog is None:
+            return
+        self._analog = None
+        self._apply()
+
+    def tick(self) -> None:
+        """Renew the lease while keys are held. Call every :data:`TICK` s from the UI thread's timer."""
+        self.motion.tick(self.robot.robot.value)
+        if not self._held and (self._analog is None or self._generation is None):
+            return
+        if not self.link.lease.renew():
+            reason = self.link.lease.ended or EndReason.LAPSED
+            self._halt_held(reason)
+
+    def _apply(self) -> None:
+        speed = capped_throttle(
+            self.operator.speed.value.percent, self.operator.near_people.value.cap, self.limits
+        )
+        if self._held or self._analog is None:
+            ratios = ratios_for(self._held, speed)
+        else:
+            ratios = DriveRatios(self._analog[0], self._analog[1], float(speed))
+        lease = self.link.lease
+        if not ratios.moving:
+            if self._generation is not None:
+                lease.release()
+                self._generation = None
+            return
+        if self._generation is None or not lease.change(ratios):
+            if self._generation is not None:
+                # The lease died under us (lapsed/stale); the keys pressed before are stale too.
+                self._halt_held(lease.ended or EndReason.LAPSED)
+                return
+            self._end_jog("a drive")
+            self._generation = lease.grant(ratios)
+
+    def _reapply(self) -> None:
+        """The cap or the robot's limits changed: a drive in progress takes the new throttle at once."""
+        if (self._held or self._analog is not None) and self._generation is not None:
+            self._apply()
+
+    def _halt_held(self, reason: EndReason, *, quiet: bool = False) -> None:
+        """Motion was stopped for ``reason`` while keys were held: block them until released.
+
+        A lease the network side ended for the link (its drive loop sees a stale link before the
+        model's health reaches this thread) is said here, so the operator hears it whichever
+        side noticed first; ``quiet`` where the caller says it itself."""
+        had = bool(self._held) or (self._analog is not None and self._generation is not None)
+        self._blocked |= self._held
+        self._held.clear()
+        if self._analog is not None:
+            self._analog = None
+            self._analog_blocked = True
+        if self._generation is not None:
+            self.link.lease.end(reason, self._generation)
+            self._generation = None
+        if had and reason is EndReason.LAPSED:
+            why = self.link.lease.why or "a busy computer?"
+            text = f"Stopped: the window did not respond in time ({why})"
+            self.view.notify(Notice.warning(Kind.SAFETY, f"{text}. Press again to drive."))
+        elif had and reason is EndReason.LINK and not quiet:
+            level = self.robot.health.value.level
+            self._say_link_stop(level if level in (LinkLevel.STALE, LinkLevel.LOST) else LinkLevel.STALE)
+
+    def _say_link_stop(self, level: LinkLevel) -> None:
+        """Said once per stop, with the network side's measured cause where it gave one."""
+        why = self.link.lease.why or self.robot.health.value.cause
+        said = f" — {why}" if why else ". Press again once it is back."
+        self.view.notify(Notice.warning(Kind.LINK, f"Stopped: the link is {level.value}{said}"))
+
+    def stop(self) -> None:
+        """Stop now. Always sent, whatever the link looks like; held keys must be pressed again.
+
+        Also ends a navigation: the server's ``stop`` mode takes over from its goal. A replay has no
+        robot to stop: it says so and sends nothing."""
+        if self.replay:
+            self._halt_held(EndReason.STOPPED)
+            self._say_replay()
+            return
+        if self.navigating:
+            self._nav_cancelled = True
+        self._end_jog("STOP")
+        self._halt_held(EndReason.STOPPED)
+        self.link.lease.end(EndReason.STOPPED)
+        if self.robot.connection.value.phase in (Phase.CONNECTED, Phase.RECONNECTING, Phase.CONNECTING):
+            self._record(Stop())
+            self.link.send(Stop())
+
+    def focus_lost(self, why: str = KEYBOARD_LOST) -> None:
+        """The window lost keyboard focus: key releases may never arrive, so stop a held drive.
+
+        A navigation goes on: the server drives it, no key is held for it.
+
+        Keys held now stay blocked until a real release is seen after focus returns (see the
+        module notes): auto-repeat of a key held all along must not start the robot again.
+        """
+        driving = bool(self._held) or self._generation is not None
+        if driving:
+            self.stop()
+            then = "Click the map, then press again" if why == KEYBOARD_LOST else "Press again"
+            self.view.notify(Notice.warning(Kind.SAFETY, f"Stopped: {why}. {then} to drive."))
+        if self._analog is not None:
+            self._analog = None
+            self._analog_blocked = True
+        self._blocked |= self._held
+        self._held.clear()
+        self._unfocused = True
+        self.keys_reach = False
+
+    def focus_gained(self) -> None:
+        """The window has the keyboard again: releases from now on are real (optional for a view)."""
+        self._unfocused = False
+        self.keys_reach = True
+
+    def pointer_may_drive(self) -> bool:
+        """A D-pad (pointer, touch) hold may start only while the stop key reaches the window: else it
+        is refused, saying why (a key press proves the keyboard is here; a pointer press does not)."""
+        if not self.keys_reach:
+            said = (
+                "Not driving: Space could not stop it, the keyboard is elsewhere. Click the map, then drive."
+            )
+            self.view.notify(Notice.warning(Kind.SAFETY, said))
+        return self.keys_reach
+
+    def look(self, what: str, *, keys_leave: bool = False) -> None:
+        """The operator looks elsewhere (``what``: "the camera page", "a dialog", "the menu"): a held
+        drive ends, its keys blocked until released, and says so; a navigation goes on, and nothing is
+        sent for it. ``keys_leave``: the keyboard goes to another surface of the window (a menu), so
+        key-ups seen until the next press are not real ones (as after a focus loss)."""
+        if self._held or (self._analog is not None and self._generation is not None):
+            self._halt_held(EndReason.STOPPED)
+            self.view.notify(Notice.info(Kind.SAFETY, f"Stopped for {what}. Press again to drive."))
+        if keys_leave:
+            self._unfocused = True
+
+    # -- speed -------------------------------------------------------------------------------
+    def speed_up(self) -> None:
+        self._set_speed(self.operator.speed.value.faster(), "maximum")
+
+    def speed_down(self) -> None:
+        self._set_speed(self.operator.speed.value.slower(), "minimum")
+
+    def _set_speed(self, new: SpeedSetting, limit: str) -> None:
+        if not self.operator.speed.set(new):
+            self.view.notify(
+                Notice.info(Kind.SPEED_LIMIT, f"Speed is already at its {limit} ({new.percent} %)")
+            )
+            return
+        self.view.notify(Notice.info(Kind.SPEED, f"Speed {new.percent} %"))
+        self._reapply()
+
+    # -- every other intent: the guard ---------------------------------------------------------
+    def ask(self, intent: Intent) -> Any:
+        """Send one operator intent to this robot, after the rules that hold for every intent.
+
+        Refused, with the reason shown, in a replay, while not connected (for an intent that needs
+        the server) and where the server does not offer it. An intent that moves the robot ends a
+        held drive first (the network side sends its stop before the intent), and a new goal makes
+        drive keys drive again once the server has taken it. Returns what ``link.send`` returns (a
+        Future of the answer), or None when refused. STOP has its own path: :meth:`stop`."""
+        if isinstance(intent, Stop):
+            self.stop()
+            return None
+        if self.replay:
+            self._say_replay()
+            return None
+        offers = self.robot.connection.value.offers
+        if (intent.needs or intent.moves or not intent.offered(())) and not self.connected:
+            self.view.notify(Notice.warning(intent.kind, f"{intent.label}: not connected"))
+            return None
+        if not intent.offered(offers):
+            missing = f"offer {intent.needs[0]}" if intent.needs else f"offer {intent.label.lower()}"
+            if isinstance(intent, (RequestPicture, StartVideo)):
+                missing = "offer camera pictures"
+            self.view.notify(Notice.warning(intent.kind, f"This server does not {missing}"))
+            return None
+        goals = self.robot.navigation.value.goals
+        if isinstance(intent, GotoGoal) and goals and intent.name not in goals:
+            self.view.notify(Notice.warning(Kind.NAVIGATION, f"This map has no goal called {intent.name!r}"))
+            return None
+        if intent.moves:
+            self._halt_held(EndReason.STOPPED)  # the network side sends its stop before the intent
+            self._nav_cancelled = False
+        self._record(intent)
+        sent = self.link.send(intent)
+        if intent.moves:
+            self.motion.intent_sent(intent, self.robot.robot.value)  # a jog is watched to its outcome
+        return sent
+
+    def _record(self, intent: Intent) -> None:
+        tap = self.tap
+        if tap is not None:
+            with contextlib.suppress(Exception):  # recording never stands between operator and robot
+                tap(type(intent).__name__, intent.record())
+
+    # -- navigation (the server drives) --------------------------------------------------------
+    @property
+    def navigating(self) -> bool:
+        """The server navigates now, and we have not already sent the stop that ends it."""
+        return self.robot.navigation.value.navigating and not self._nav_cancelled
+
+    def _on_navigation(self, old: NavState, new: NavState) -> None:
+        if not new.navigating or (old.navigating and new.target != old.target):
+            self._nav_cancelled = False  # it ended (or someone sent it elsewhere): keys drive again
+
+    def _say_replay(self) -> None:
+        self.view.notify(Notice.warning(Kind.SAFETY, f"{REPLAY_REASON}: {self.replay}"))
+
+    # -- connection --------------------------------------------------------------------------
+    def select_profile(self, profile: Profile) -> None:
+        """Use ``profile`` for the next connect and restore the view and speed it was left with."""
+        self.profile = profile
+        with contextlib.suppress(ValueError):
+            self.operator.speed.set(SpeedSetting(profile.speed))
+        self.operator.view.update(
+            zoom=profile.zoom, follow_robot=profile.follow_robot, show_sonar=profile.show_sonar
+        )
+
+    def current_profile(self) -> Profile:
+        """The profile with the view options and speed as they are now (save it on exit)."""
+        v = self.operator.view.value
+        return replace(
+            self.profile,
+            zoom=v.zoom,
+            follow_robot=v.follow_robot,
+            show_sonar=v.show_sonar,
+            speed=self.operator.speed.value.percent,
+        )
+
+    def connect(self, password: str | None = None) -> None:
+        """Connect with the current profile; asks the view for the password when none is known.
+
+        A remembered password is looked up off the UI thread (a keyring may block on D-Bus or
+        an unlock prompt) when the link offers ``run_blocking``; the connection starts when
+        the answer comes back, unless the profile changed meanwhile.
+        """
+        profile = self.profile
+        if self._busy_connecting():
+            return
+        if password is None and profile.user:
+            if profile.remember_password and self.secrets is not None:
+                self._look_up_password(profile, self.secrets)
+                return
+            self.view.ask_password(profile, self._password_answered)
+            return
+        self._start_connect(password or "")
+
+    def _busy_connecting(self) -> bool:
+        phase = self.robot.connection.value.phase
+        return self._lookup_pending or phase in (Phase.CONNECTING, Phase.CONNECTED, Phase.RECONNECTING)
+
+    def _look_up_password(self, profile: Profile, secrets: SecretStore) -> None:
+        run_blocking = getattr(self.link, "run_blocking", None)
+        if run_blocking is None:  # a link without a worker: look it up here
+            self._password_found(profile, secrets.get(profile))
+            return
+        self._lookup_pending = True
+
+        def found(password: str | None) -> None:
+            self._lookup_pending = False
+            self._password_found(profile, password)
+
+        run_blocking(lambda: secrets.get(profile), found)
+
+    def _password_found(self, profile: Profile, password: str | None) -> None:
+        if profile != self.profile or self._busy_connecting():
+            return  # another profile was chosen, or a connection started, while we looked
+        if password is None:
+            self.view.ask_password(profile, self._password_answered)
+            return
+        self._start_connect(password)
+
+    def _password_answered(self, password: str | None) -> None:
+        if password is None:
+            self.view.notify(Notice.info(Kind.CONNECTION, "Connection cancelled"))
+            return
+        self._start_connect(password)
+
+    def _start_connect(self, password: str) -> None:
+        p = self.profile
+        self._halt_held(EndReason.DISCONNECTED)
+        tap = self.tap
+        if tap is not None:
+            with contextlib.suppress(Exception):
+                tap("connect", {"host": p.host, "port": p.port, "user": p.user, "profile": p.name})
+        self.link.connect(
+            p.host,
+            p.port,
+            p.user,
+            password,
+            profile=p.name,
+            auto_reconnect=p.auto_reconnect,
+            protocol=p.protocol or None,
+        )
+
+    def disconnect(self) -> None:
+        self.stop()
+        tap = self.tap
+        if tap is not None:
+            with contextlib.suppress(Exception):
+                tap("disconnect", {})
+        self.link.disconnect()
+
+    # -- dialogs -----------------------------------------------------------------------------
+    def open_dialog(self, name: str) -> None:
+        """A dialog a command needs (``turn``, ``go``: an amount; ``commands``: the palette).
+
+        Opening one is looking (:meth:`look`): it takes the keyboard, so a held drive ends — a Turn or
+        Go jog would take over from it anyway — but a navigation goes on until the operator runs what
+        the dialog asks, or presses STOP (the dialog carries the stop keys)."""
+        self.look("a dialog")
+        self.view.open_dialog(name)
+
+    @property
+    def limits(self) -> RobotLimits:
+        """The robot's top speed and braking (``motion_limits``): the cap and the stopping distance."""
+        return self.motion.limits
+
+    def _on_robot(self, _old: RobotState, new: RobotState) -> None:
+        self.motion.robot_changed(
+            new, self.link.lease.view().ratios if self._generation is not None else None
+        )
+
+    def _end_jog(self, why: str) -> None:
+        self.motion.end_jog(why, self.robot.robot.value)
+
+    # -- reactions to the model --------------------------------------------------------------
+    def _on_connection(self, old: ConnectionState, new: ConnectionState) -> None:
+        if new.phase is Phase.CONNECTED and old.phase is not Phase.CONNECTED:
+            self.motion.connected(self.supports, ask=not self.replay)  # a replay asks a recording nothing
+        elif new.phase is not Phase.CONNECTED and old.phase is Phase.CONNECTED:
+            self.motion.disconnected()
+        if new.phase is not Phase.CONNECTED and old.phase is Phase.CONNECTED:
+            self._halt_held(EndReason.DISCONNECTED)
+        if new.phase is Phase.CONNECTED and old.phase is not Phase.CONNECTED:
+            self.view.notify(Notice.info(Kind.CONNECTION, f"Connected to {new.host}:{new.port}"))
+        elif new.phase is Phase.FAILED and new.error and new.error != old.error:
+            self.view.notify(Notice.error(Kind.CONNECTION, new.error))
+        elif new.phase is Phase.RECONNECTING and old.phase is Phase.CONNECTED:
+            self.view.notify(
+                Notice.warning(
+                    Kind.CONNECTION, f"Link lost: reconnecting ({new.error})" if new.error else "Reconnecting"
+                )
+            )
+        self.refresh_commands()
+
+    def _on_health(self, old: LinkHealth, new: LinkHealth) -> None:
+        if new.level in (LinkLevel.STALE, LinkLevel.LOST) and old.level is LinkLevel.OK:
+            moving = bool(self._held) or self._generation is not None
+            self._halt_held(EndReason.LINK, quiet=True)
+            if moving:
+                self.link.send(Stop("link " + new.level.value))
+                self._say_link_stop(new.level)
+
+    def _on_link_notice(self, notice: Notice) -> None:
+        self.view.notify(notice)

@@ -1,0 +1,1 @@
+"""The fleet layer (see docs/architecture.md)."""

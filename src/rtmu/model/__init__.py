@@ -1,0 +1,1 @@
+"""The model layer (see docs/architecture.md)."""

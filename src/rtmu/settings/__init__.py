@@ -1,0 +1,1 @@
+"""The settings layer (see docs/architecture.md)."""

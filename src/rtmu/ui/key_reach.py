@@ -1,0 +1,128 @@
+"""The window never loses its keys silently: stranded focus is put back, and lost keys are said.
+
+Two ways keys went missing:
+
+* **Focus stranded in a closed popover.** GTK 4.8's ``GtkPopoverMenu``, closed by a pick in one of
+  its submenus (View, Server), switches back to its main page *after* it has hidden and gives that
+  page's scrolled window the window's focus. The window then keeps a focus widget that is not mapped,
+  and GTK delivers every key to it: no controller — not even the window's capture-phase key router —
+  sees Space, Up or Escape until the menu is opened and closed again. :class:`KeyReach` watches the
+  window's focus and, as soon as it lands on a widget that is not on screen, moves it back (to the
+  popover's button when it can take it, else to the window itself) before the next event is
+  handled; a 100 ms check catches any other way a focus could be left behind (a page switched away).
+* **The keyboard is elsewhere** (another program, one of the window's dialogs): the drive keys
+  cannot reach the window. The controller already ends held drives and refuses D-pad drives then;
+  here a banner (topic ``keys``, kept while it lasts) says so ("Keys inactive — click the map", or
+  which dialog has them and that Space still stops there), from ``control.key_rules.keys_note``.
+"""
+
+from __future__ import annotations
+
+from typing import Any
+
+import gi
+
+gi.require_version("Gtk", "4.0")
+from gi.repository import GLib, Gtk  # noqa: E402
+
+from ..control.key_rules import keys_note  # noqa: E402
+from ..model.observables import Phase  # noqa: E402
+
+MainWindow = Any
+"""``ui.window.MainWindow`` (which imports this module): named, not imported."""
+
+CHECK_MS = 100
+TOPIC = "keys"
+
+
+def stranded(window: Gtk.Window) -> Gtk.Widget | None:
+    """The window's focus widget when it is not on screen (keys sent to it are lost), else None."""
+    focus = window.get_focus()
+    if focus is None or focus.get_mapped():
+        return None
+    return focus
+
+
+def _popover_of(widget: Gtk.Widget | None) -> Gtk.Popover | None:
+    while widget is not None and not isinstance(widget, Gtk.Popover):
+        widget = widget.get_parent()
+    return widget
+
+
+class KeyReach:
+    """See the module notes. ``repairs`` counts the stranded focuses put back (tests read it)."""
+
+    def __init__(self, window: MainWindow) -> None:
+        self.window = window
+        self.repairs = 0
+        self.text = ""
+        """What the window says about its keys now ("" while they reach it)."""
+        self._handlers = [
+            window.connect("notify::focus-widget", lambda *_a: self._focus_moved()),
+            window.connect("notify::is-active", lambda *_a: self.refresh()),
+        ]
+        self._timer = GLib.timeout_add(CHECK_MS, self._check)
+        self.refresh()
+
+    def close(self) -> None:
+        if self._timer:
+            GLib.source_remove(self._timer)
+            self._timer = 0
+        for handler in self._handlers:
+            self.window.disconnect(handler)
+        self._handlers = []
+
+    # -- stranded focus ----------------------------------------------------------------------
+    def _focus_moved(self) -> None:
+        if stranded(self.window) is not None:
+            GLib.idle_add(self._repair_once, priority=GLib.PRIORITY_HIGH)  # type: ignore[call-arg]
+
+    def _repair_once(self) -> bool:
+        self.repair()
+        return False
+
+    def repair(self) -> bool:
+        """Put a stranded focus back where keys reach the window; True when there was one."""
+        focus = stranded(self.window)
+        if focus is None:
+            return False
+        popover = _popover_of(focus)
+        button = popover.get_parent() if popover is not None else None
+        self.window.set_focus(None)
+        if button is not None and button.get_mapped() and button.get_focusable():
+            button.grab_focus()
+        self.repairs += 1
+        return True
+
+    def _check(self) -> bool:
+        self.repair()
+        self.refresh()
+        return True
+
+    # -- the note ------------------------------------------------------------------------------
+    def refresh(self) -> None:
+        window = self.window
+        connected = window.model.connection.value.phase is Phase.CONNECTED
+        active = window.is_active()
+        dialog = self._dialog_title() if connected and not active else ""
+        text = keys_note(window_active=active, connected=connected, dialog=dialog)
+        if connected and not active:  # a dialog of this window carries the stop keys: Space reaches it
+            window.controller.keys_reach = bool(dialog)
+        shown = window.banners.text(TOPIC)
+        if text and shown != text:
+            window.banners.tell(TOPIC, "warning", text, timeout=None)  # back if closed while it lasts
+        elif not text and shown is not None:
+            window.banners.dismiss(TOPIC)
+        self.text = text
+
+    def _dialog_title(self) -> str:
+        """The title of one of this window's own windows that has the keyboard now ("" if none)."""
+        for other in Gtk.Window.list_toplevels():
+            if not isinstance(other, Gtk.Window) or other is self.window or not other.is_active():
+                continue
+            parent = other.get_transient_for()
+            while parent is not None and parent is not self.window:
+                parent = parent.get_transient_for()
+            if parent is self.window:
+                return other.get_title() or "a dialog"
+        return ""

@@ -1,0 +1,182 @@
+"""Where the window says things: each notice by its ``Kind``, and the connection's life as ONE banner.
+
+A :class:`~rtmu.base.notices.Notice` is routed by its kind, never by the words in its text:
+connection notices fold into the ``link`` banner that the model drives, speed ones into the
+``speed`` banner, camera ones into the camera page (failing a picture request under way) and its
+banner, navigation outcomes into one ``navigation`` banner updated in place; anything else gets a
+banner of its own, keyed by its text. The connection's life (connecting, connected, lost →
+reconnecting (n), failed) is drawn from the model into that one ``link`` banner; a deliberate
+disconnect shows nothing. The speed step and a stalled network thread have a banner each.
+
+The rules are plain functions returning :class:`Banner` values, so they are tested without a
+display; :class:`NoticeRouter` applies them to the window's banners.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Callable
+from dataclasses import dataclass
+from typing import NamedTuple, Protocol
+
+from ..base.notices import Kind, Level, Notice
+from ..model.observables import SPEED_MAX, ConnectionState, NavState, Phase
+from .nav_text import link_lost_note
+
+
+@dataclass(frozen=True, slots=True)
+class Banner:
+    """One banner to show: its topic (one banner per topic, updated in place), level and words."""
+
+    topic: str
+    level: str
+    text: str
+    timeout: float | None
+    """Seconds on screen; None: until dismissed or replaced."""
+    fraction: float | None = None
+    """A level bar under the text (0…1: the speed step)."""
+
+
+class Dismiss(NamedTuple):
+    """Take the banner of ``topic`` away."""
+
+    topic: str
+
+
+@dataclass(frozen=True, slots=True)
+class Route:
+    """Where one notice goes: a banner (or none), and whether it fails a picture request under way."""
+
+    banner: Banner | None = None
+    fails_picture: bool = False
+
+
+def route(notice: Notice, connection: ConnectionState, speed_percent: int) -> Route:
+    """Where ``notice`` is shown, from its kind and level (the connection and speed step the window shows)."""
+    kind, level, text = notice.kind, notice.level, notice.text
+    if kind is Kind.CONNECTION or (text and text == connection.error):
+        return Route()  # the link banner shows the connection's life from the model
+    if kind is Kind.LINK:
+        if level is Level.INFO:
+            return Route(Banner("link", "info", text, 4.0))
+        if connection.phase is Phase.CONNECTED:
+            return Route(Banner("link", level.value, text, None))
+        return Route()
+    if kind is Kind.SPEED_LIMIT:
+        limit = "maximum" if speed_percent >= SPEED_MAX else "minimum"
+        words = f"Speed at its {limit}: {speed_percent} %"
+        return Route(Banner("speed", "warning", words, 2.5, speed_percent / SPEED_MAX))
+    if kind is Kind.SPEED:
+        return Route()  # the speed banner follows the model
+    if kind is Kind.NAVIGATION:  # outcomes and cancellations: one banner, updated in place
+        return Route(Banner("navigation", level.value, text, 8.0 if level is Level.INFO else 12.0))
+    if kind is Kind.CAMERA:
+        return Route(Banner("camera", level.value, text, 5.0), fails_picture=True)
+    return Route(Banner(f"notice:{text}", level.value, text, 6.0 if level is Level.ERROR else 4.0))
+
+
+def link_banner(old: ConnectionState, new: ConnectionState, navigation: NavState) -> Banner | Dismiss | None:
+    """The ``link`` banner for a change of connection (None: the banner stays as it is)."""
+    where = f"{new.host}:{new.port}" if new.host else ""
+    phase = new.phase
+    if phase is Phase.CONNECTING and old.phase is not Phase.CONNECTING:
+        return Banner("link", "info", f"Connecting to {where}…", None)
+    if phase is Phase.CONNECTED and old.phase is not Phase.CONNECTED:
+        if old.phase is Phase.RECONNECTING:
+            return Banner("link", "info", f"Reconnected to {where}: press a key to drive again", 4.0)
+        return Banner("link", "info", f"Connected to {where}", 3.0)
+    if phase is Phase.RECONNECTING:
+        count = f" ({new.attempt})" if new.attempt else ""
+        note = link_lost_note(navigation)
+        return Banner("link", "warning", f"Link lost — reconnecting{count}…{note}", None)
+    if phase is Phase.FAILED and (new.error != old.error or old.phase is not Phase.FAILED):
+        lost = old.phase in (Phase.CONNECTED, Phase.RECONNECTING)
+        reason = new.error or "no reason given"
+        note = link_lost_note(navigation)
+        text = f"Link lost: {reason}.{note}" if lost else f"Could not connect to {where}: {reason}"
+        return Banner("link", "error", text, 10.0)
+    if phase is Phase.DISCONNECTED and old.phase is not Phase.DISCONNECTED:
+        return Dismiss("link")  # deliberate: no banner at all
+    return None
+
+
+LOOP_LAG_WARN = 0.5
+"""Seconds without a network-loop heartbeat after which the window warns that drive commands (and
+stops) are not going out; the warning goes once the lag is under half of this again."""
+
+
+def loop_lag_banner(lag: float | None, connected: bool, shown: bool) -> Banner | Dismiss | None:
+    """The ``loop`` banner while the network thread is stalled: then even a stop cannot leave the
+    process (``lag``: seconds since its last heartbeat; ``shown``: the banner is up now)."""
+    if connected and lag is not None and lag > LOOP_LAG_WARN:
+        text = (
+            f"The network thread has not run for {lag:.1f} s: drive commands and stops are not going "
+            "out; the robot may keep moving until the server's watchdog stops it"
+        )
+        return Banner("loop", "error", text, None)
+    if shown and (not connected or lag is None or lag < LOOP_LAG_WARN / 2):
+        return Dismiss("loop")
+    return None
+
+
+def speed_banner(percent: int) -> Banner:
+    """The speed step the operator just chose, with its bar."""
+    return Banner("speed", "info", f"Speed {percent} %", 2.5, percent / SPEED_MAX)
+
+
+class Banners(Protocol):
+    """The window's banner column (``ui.banners.BannerStack``)."""
+
+    def tell(
+        self, topic: str, level: str, text: str, *, timeout: float | None = 4.0, fraction: float | None = None
+    ) -> None: ...
+
+    def dismiss(self, topic: str) -> None: ...
+
+    def topics(self) -> list[str]: ...
+
+
+class PictureRequest(Protocol):
+    """The camera page's picture request (``ui.camera.CameraView``)."""
+
+    @property
+    def waiting(self) -> bool: ...
+
+    def failed(self, reason: str) -> None: ...
+
+
+class NoticeRouter:
+    """Applies :func:`route` and :func:`link_banner` to the window's banners and camera page."""
+
+    def __init__(
+        self,
+        banners: Banners,
+        *,
+        connection: Callable[[], ConnectionState],
+        speed_percent: Callable[[], int],
+        picture: Callable[[], PictureRequest],
+    ) -> None:
+        self.banners = banners
+        self._connection, self._speed, self._picture = connection, speed_percent, picture
+
+    def show(self, notice: Notice) -> None:
+        """Show a controller or network notice where its kind belongs."""
+        found = route(notice, self._connection(), self._speed())
+        picture = self._picture()
+        if found.fails_picture and picture.waiting:
+            picture.failed(notice.text)
+        self.apply(found.banner)
+
+    def connection_changed(self, old: ConnectionState, new: ConnectionState, navigation: NavState) -> None:
+        self.apply(link_banner(old, new, navigation))
+
+    def loop_lag(self, lag: float | None, connected: bool) -> None:
+        """The network thread's lag now (None: unknown): the ``loop`` banner while it is stalled."""
+        self.apply(loop_lag_banner(lag, connected, "loop" in self.banners.topics()))
+
+    def apply(self, banner: Banner | Dismiss | None) -> None:
+        if isinstance(banner, Dismiss):
+            self.banners.dismiss(banner.topic)
+        elif banner is not None:
+            self.banners.tell(
+                banner.topic, banner.level, banner.text, timeout=banner.timeout, fraction=banner.fraction
+            )

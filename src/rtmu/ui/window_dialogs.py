@@ -1,0 +1,192 @@
+"""The window's dialogs: connection settings and passwords, the server's configuration, robot details,
+About, the command palette and the Turn / Go amount dialogs.
+
+Each is a window of its own, transient for the main window (so typing in it never reaches the drive
+keys, and ``stop_keys`` gives it Space all the same), opened by a menu action or — for Turn, Go and
+the palette — by the controller after it stopped the robot. What a dialog asks of a robot goes as an
+intent to the *selected* robot (``request``); a dialog that watches something on the robot (the
+details' status strings, the configuration's ``configUpdated``) moves that watch along on a switch of
+robot (:meth:`SelectedRobot.on_switch <rtmu.fleet.selected.SelectedRobot.on_switch>`).
+Passwords typed in the settings or at a prompt are remembered here for this run.
+"""
+
+from __future__ import annotations
+
+import concurrent.futures
+from collections.abc import Callable, Mapping
+from typing import Any
+
+import gi
+
+gi.require_version("Gtk", "4.0")
+from gi.repository import GLib, Gtk  # noqa: E402
+
+from ..client.custom_commands import ServerCommand  # noqa: E402
+from ..fleet.selected import SelectedRobot  # noqa: E402
+from ..fleet.sessions import RobotSession  # noqa: E402
+from ..model.observables import Phase, RobotModel  # noqa: E402
+from ..settings.store import Profile  # noqa: E402
+from ..values.intents import Intent, ListServerCommands, MoveDistance, RunServerCommand, TurnBy, WatchStrings  # noqa: E402
+from .banners import BannerStack  # noqa: E402
+from .config_page import ConfigPage  # noqa: E402
+from .details import DetailsWindow  # noqa: E402
+from .move_dialogs import go_dialog, turn_dialog  # noqa: E402
+from .palette import CommandPalette  # noqa: E402
+from .settings_dialog import ConnectionDialog, PasswordPrompt  # noqa: E402
+
+Request = Callable[[Intent], "concurrent.futures.Future[Any]"]
+
+
+class WindowDialogs:
+    """See the module notes. ``profile_saved(profile, password)`` is the app's hook for settings;
+    ``profile_changed`` tells the window the profile shown changed (its header follows)."""
+
+    def __init__(
+        self,
+        window: Gtk.Window,
+        robot: SelectedRobot,
+        model: RobotModel,
+        banners: BannerStack,
+        *,
+        request: Request,
+        profiles: Mapping[str, Profile] | None = None,
+        keyring_available: bool = False,
+        profile_saved: Callable[[Profile, str | None], None] | None = None,
+        profile_changed: Callable[[], None] = lambda: None,
+    ) -> None:
+        self.window, self.robot, self.model, self.banners = window, robot, model, banners
+        self.request = request
+        self.profiles = dict(profiles or {})
+        self.keyring_available = keyring_available
+        self._profile_saved, self._profile_changed = profile_saved, profile_changed
+        self._passwords: dict[str, str] = {}
+        self.settings: ConnectionDialog | None = None
+        """The connection settings dialog last opened."""
+        self.details: DetailsWindow | None = None
+        self.config_page: ConfigPage | None = None
+        self._config_listener: Callable[[], None] | None = None
+        robot.on_switch(self._details_follow)
+        robot.on_switch(self._config_follow)
+
+    # -- connection settings and passwords -----------------------------------------------------
+    def password_for(self, profile: Profile) -> str | None:
+        """The password typed for ``profile`` in this run (None: the keyring's, or ask)."""
+        return self._passwords.get(profile.name)
+
+    def open_settings(self) -> None:
+        profiles = dict(self.profiles)
+        current = self.robot.session.controller.profile
+        profiles.setdefault(current.name, current)
+        self.settings = ConnectionDialog(
+            self.window,
+            profiles,
+            current,
+            on_save=self._settings_saved,
+            keyring_available=self.keyring_available,
+        )
+        self.settings.present()
+
+    def _settings_saved(self, profile: Profile, password: str | None) -> None:
+        self.profiles[profile.name] = profile
+        if password is not None:
+            self._passwords[profile.name] = password
+        if self._profile_saved is not None:
+            self._profile_saved(profile, password)
+        controller = self.robot.session.controller
+        changed = profile != controller.profile
+        controller.select_profile(profile)
+        self._profile_changed()
+        if changed and self.model.connection.value.phase is not Phase.DISCONNECTED:
+            self.banners.tell(
+                "notice:saved", "info", f"Saved “{profile.name}”: reconnect to use it", timeout=4.0
+            )
+
+    def ask_password(self, profile: Profile, answer: Callable[[str | None], None]) -> None:
+        """The controller needs a password to connect: the one typed in this run, else a prompt."""
+        remembered = self._passwords.get(profile.name)
+        if remembered is not None:
+            answer(remembered)
+            return
+        PasswordPrompt(self.window, profile, answer).present()
+
+    # -- the server's configuration ------------------------------------------------------------
+    def show_server_config(self) -> None:
+        """The server's configuration page (its own window, so typing there never drives): one at a time."""
+        page = self.config_page
+        if page is None or page.closed:
+            page = self.config_page = ConfigPage(self.window, self.request, self._follow_config_updates)
+        page.present()
+
+    def _follow_config_updates(self, listener: Callable[[], None] | None) -> None:
+        """The configuration page hears another client's changes on the robot shown (and only there)."""
+        self._config_listener = listener
+        self.robot.session.runner.on_config_updated = listener
+
+    def _config_follow(self, old: RobotSession, new: RobotSession) -> None:
+        listener = self._config_listener
+        if listener is None:
+            return
+        old.runner.on_config_updated = None
+        new.runner.on_config_updated = listener
+        listener()  # the page reads the newly selected robot's configuration
+
+    # -- robot details ---------------------------------------------------------------------------
+    def show_details(self) -> None:
+        """The details window (DataStore strings, docking, say): one at a time."""
+        details = self.details
+        if details is None or not details.get_visible():
+            robot = self.robot
+            details = self.details = DetailsWindow(
+                self.window, self.model, robot.ask, lambda on: robot.ask(WatchStrings(on))
+            )
+        details.present()
+
+    def _details_follow(self, old: RobotSession, new: RobotSession) -> None:
+        details = self.details
+        if details is not None and details.get_visible():
+            old.controller.ask(WatchStrings(False))
+            new.controller.ask(WatchStrings(True))
+
+    # -- About -----------------------------------------------------------------------------------
+    def show_about(self) -> None:
+        from .. import __version__
+
+        about = Gtk.AboutDialog(
+            transient_for=self.window,
+            modal=True,
+            program_name="RTMU",
+            version=__version__,
+            comments="Robot Teleoperation, Mobile User interface: drive an ARIA (ArNetworking) robot "
+            "from a tablet or a laptop.",
+            logo_icon_name="io.github.rtmu.Rtmu",
+            license_type=Gtk.License.MIT_X11,
+        )
+        about.present()
+
+    # -- the controller's dialogs: Turn, Go, the palette -----------------------------------------
+    def open_dialog(self, name: str) -> None:
+        """The dialog a command asked for (the controller stopped the robot first)."""
+        ask = self.robot.ask
+        makers: dict[str, Callable[[], Gtk.Window]] = {
+            "turn": lambda: turn_dialog(self.window, lambda degrees: ask(TurnBy(degrees))),
+            "go": lambda: go_dialog(self.window, lambda mm: ask(MoveDistance(mm))),
+            "commands": lambda: CommandPalette(
+                self.window, lambda: self.request(ListServerCommands()), self._run_server_command
+            ),
+        }
+        makers[name]().present()
+
+    def _run_server_command(self, command: ServerCommand, argument: str | None) -> None:
+        """From the palette: sent on the network thread; the outcome comes back as a banner."""
+
+        def done(future: concurrent.futures.Future[bool]) -> None:
+            if future.cancelled() or future.exception() is not None:
+                return  # the runner already raised a Kind.COMMAND notice with the reason
+            said = "taken by the server" if future.result() else "sent; the server did not answer"
+            GLib.idle_add(self._tell_once, "server-command", f"{command.name}: {said}")
+
+        self.request(RunServerCommand(command.name, argument, command.takes_argument)).add_done_callback(done)
+
+    def _tell_once(self, topic: str, text: str) -> bool:
+        self.banners.tell(topic, "info", text, timeout=4.0)
+        return False  # an idle callback: once

@@ -1,0 +1,144 @@
+"""Everything by keyboard, with real key events (issue 21): Tab moves a visible focus through the bars,
+Space on a focused button stops the robot and never clicks the button, F10 / Menu / Shift+F10 open the
+menu, Ctrl+G the Go-to panel, a pick mode takes arrows and Return, and the shortcuts window opens with
+driving and STOP on its first page. (Every menu item by keyboard: test_stop_keys; every Go-to item by
+keyboard: test_stop_keys_states; Alt+1…9 in a fleet: test_stop_keys_states.)"""
+
+from __future__ import annotations
+
+import math
+from collections.abc import Iterator
+
+import gi
+import pytest
+
+from rtmu.model.observables import Phase
+from rtmu.sim import SimConfig, SimThread
+from rtmu.ui.shortcuts import shortcuts_xml
+from rtmu.ui.stop_keys import descendants
+
+from .harness import OFFICE_MAP, Gui, idle, pump
+from .stop_paths import StopCycle, back_to_map, owned_windows
+from .test_stop_keys_states import focus_until
+
+gi.require_version("Gtk", "4.0")
+from gi.repository import Gtk  # noqa: E402
+
+
+@pytest.fixture
+def sim() -> Iterator[SimThread]:
+    with SimThread(SimConfig(port=0, map_path=OFFICE_MAP, seed=1)) as s:
+        yield s
+
+
+def test_tab_shows_the_focus_and_space_on_a_focused_button_stops_without_clicking_it(
+    gui: Gui, sim: SimThread
+) -> None:
+    window, cycle = gui.window, StopCycle(gui, sim)
+    assert window.get_focus() is None, "the window starts with no focused button: Return does nothing"
+    gui.key("Tab")
+    pump(lambda: window.get_focus() is not None, 3, "the first Tab")
+    assert window.get_focus().is_ancestor(window.stop_button) or window.get_focus() is window.stop_button
+    seen: list[Gtk.Widget] = []
+    for _ in range(12):
+        gui.key("Tab")
+        idle(0.05)
+        focus = window.get_focus()
+        assert focus is not None and window.get_focus_visible(), "Tab shows where the focus is"
+        seen.append(focus)
+    for button in (window.stop_button, window.connect_button, window.menu_button, window.camera_button):
+        assert any(f is button or f.is_ancestor(button) for f in seen), f"Tab never reached {button!r}"
+    focus_until(gui, window.connect_button)  # "Disconnect": the button Space must never click
+    gui.shot("disconnect-focused")
+    cycle.navigate()
+    cycle.space_stops("with the Disconnect button focused")
+    idle(0.5)
+    assert gui.phase is Phase.CONNECTED, "Space clicked the focused Disconnect button"
+    focus_until(gui, window.stop_button)
+    cycle.navigate()
+    gui.key("Return")  # Return activates the focused button: here STOP
+    pump(lambda: cycle.mode() == "stop", 3, "Return on the focused STOP to stop")
+
+
+@pytest.mark.parametrize("key", ["F10", "Menu", "shift+F10"])
+def test_f10_menu_and_shift_f10_open_the_menu(gui: Gui, key: str) -> None:
+    popover = gui.window.menu_button.get_popover()
+    assert popover is not None
+    gui.key(key)
+    pump(popover.get_mapped, 3, f"{key} to open the menu")
+    gui.screen_shot(f"menu-by-{key}")
+    gui.key("Escape")
+    pump(lambda: not popover.get_mapped(), 3, "Escape to close it")
+
+
+def test_the_menu_shows_the_keys_of_t_g_and_ctrl_k(gui: Gui) -> None:
+    menu = gui.window.robot_menu
+    accels = {}
+    for i in range(menu.get_n_items()):
+        action = menu.get_item_attribute_value(i, "action", None).get_string()
+        accel = menu.get_item_attribute_value(i, "accel", None)
+        accels[action] = accel.get_string() if accel is not None else ""
+    assert (
+        accels["win.turn"] == "t"
+        and accels["win.go"] == "g"
+        and accels["win.server-commands"] == "<Control>k"
+    )
+    gui.key("F10")
+    popover = gui.window.menu_button.get_popover()
+    pump(popover.get_mapped, 3, "the menu")
+    gui.screen_shot("menu-with-keys")
+    gui.key("Escape")
+
+
+def test_go_to_point_and_set_position_by_keyboard_alone(gui: Gui, sim: SimThread) -> None:
+    window, cycle = gui.window, StopCycle(gui, sim)
+    panel = window.goals_panel
+    for label, kind in (("Set position…", "localize"), ("Go to point…", "goto")):
+        gui.key("ctrl+g")
+        pump(lambda: panel.get_popover().get_mapped(), 3, "Ctrl+G to open the Go-to panel")
+        focus_until(gui, panel.buttons[kind])
+        gui.key("Return")
+        pump(lambda: window.picker.active, 3, f"{label} to start its map mode")
+        start = gui.model.robot.value
+        for key in ("Right", "Right", "Right", "Up", "Down"):  # along the corridor
+            gui.key(key)
+        gui.key("ctrl+Left")  # its heading: 15° to the left
+        pump(lambda: window.picker.marker is not None, 3, "the point to move")
+        marker = window.picker.marker
+        assert marker is not None and marker.x > start.x + 200 and abs(marker.y - start.y) < 1, marker
+        assert marker.th is not None and abs(marker.th - (start.th + 15.0)) < 1
+        assert cycle.mode() != "ratioDrive", "the arrows moved the point: they did not drive"
+        gui.shot(f"{kind}-picked-by-keyboard")
+        gui.key("Return")
+        pump(lambda: not window.picker.active, 3, "Return to confirm")
+        if kind == "localize":
+            x, y = marker.x, marker.y
+            pump(
+                lambda x=x, y=y: math.hypot(sim.snapshot().x - x, sim.snapshot().y - y) < 50,
+                5,
+                "the robot placed there",
+            )
+        else:
+            pump(lambda: cycle.mode() == "Goto", 5, "the robot to go to the point")
+            cycle.space_stops("going to a point chosen by keyboard")
+    back_to_map(gui)
+
+
+def test_configuration_and_about_open_from_the_keyboard_and_the_shortcuts_start_with_driving(
+    gui: Gui,
+) -> None:
+    window = gui.window
+    xml = shortcuts_xml()
+    for words in ("Open the menu", "Go to: goals", "Select robot 1", "Next robot", "Stop"):
+        assert words in xml, words
+    gui.key("ctrl+question")
+    pump(lambda: owned_windows(window), 5, "the shortcuts window")
+    shortcuts = owned_windows(window)[0]
+    assert isinstance(shortcuts, Gtk.ShortcutsWindow)
+    stack = next(w for w in descendants(shortcuts) if isinstance(w, Gtk.Stack) and w.get_mapped())
+    page = stack.get_visible_child()
+    assert page is not None
+    shown = [g.get_property("title") for g in descendants(page) if isinstance(g, Gtk.ShortcutsGroup)]
+    assert shown[0] == "Driving", f"the first page shows {shown}"  # drive keys and STOP, first
+    gui.screen_shot("shortcuts-first-page")
+    back_to_map(gui)
