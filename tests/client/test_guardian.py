@@ -300,7 +300,7 @@ def test_the_guardian_learns_how_late_a_busy_parents_beats_come_within_its_bound
     t = _beats(watch, m.BEAT_NET, 0.0, 300.0, 0.04)
     assert watch.limit(m.BEAT_NET, t) == pytest.approx(SILENT_LATE)
     assert watch.why_stop(t + 0.39) is None
-    assert "network thread for 410 ms" in (watch.why_stop(t + 0.41) or "")
+    assert "network thread of the process driving the robot for 410 ms" in (watch.why_stop(t + 0.41) or "")
     watch.take(m.BEAT_NET, t + 0.35)  # a busy machine delayed one beat 350 ms…
     t = _beats(watch, m.BEAT_NET, t + 0.35, 5.0, 0.04)
     assert watch.why_stop(t + 0.6) is None  # …so a 600 ms silence is no alarm now

@@ -15,6 +15,7 @@ import numpy as np
 import pytest
 
 from rtmu.client.drawing_budget import MAX_SHOWN_POINTS, sample_array, thin
+from rtmu.client.drawings_feed import DrawingsFeed
 from rtmu.client.errors import MalformedReply
 from rtmu.client.lease import DriveRatios
 from rtmu.client.runner import ClientRunner
@@ -56,7 +57,8 @@ def test_a_drawing_flood_neither_stops_a_held_drive_nor_swamps_the_window() -> N
     with ServerThread(server):
         runner, model, _ui, stops, drives = hold_a_drive(server)
         try:
-            feed = runner.session.drawings  # type: ignore[union-attr]
+            assert runner.session is not None
+            feed = runner.session.feed(DrawingsFeed)
             shown = model.drawings.value.layers
             assert stops == [], stops
             assert drives >= HOLD * 10 / 2, f"{drives} ratioDrive in {HOLD} s"  # 10 Hz, generously

@@ -144,8 +144,8 @@ class Watch:
             if now - at > limit:
                 thread = "UI" if kind == m.BEAT_UI else "network"
                 return (
-                    f"no heartbeat from the driving process's {thread} thread for {(now - at) * 1000:.0f} ms "
-                    f"(its beats normally come within {limit * 1000:.0f} ms)"
+                    f"no heartbeat from the {thread} thread of the process driving the robot for "
+                    f"{(now - at) * 1000:.0f} ms (its beats normally come within {limit * 1000:.0f} ms)"
                 )
         return None
 
