@@ -1,7 +1,7 @@
 """Real Wi-Fi and a busy laptop: false stops, stop latencies under real faults, what the keeper costs.
 
 Every figure is measured twice in the same run: with the limits RTMU learns per link
-(``client.link_timing``, the lease keeper) and, as the baseline, with the fixed thresholds it had
+(``base.link_timing``, the lease keeper) and, as the baseline, with the fixed thresholds it had
 before (``RTMU_LINK_TIMING=fixed``: stale after 3 status intervals in the window, 200 ms for
 ``rtmu drive``, pings 2 s / 0.5 s, the guardian's 0.4 s, no run-queue credit).
 

@@ -21,7 +21,7 @@ import threading
 import time
 from pathlib import Path
 
-from rtmu.client.link_timing import FIXED_ENV
+from rtmu.base.link_timing import FIXED_ENV
 from rtmu.sim import SimConfig, SimThread
 
 REPO = Path(__file__).resolve().parents[1]

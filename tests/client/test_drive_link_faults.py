@@ -21,7 +21,7 @@ import pytest
 
 from linkfaults import FAKE_HEADER, GARBAGE, TO_CLIENT, TO_SERVER, FaultProxy, WifiProfile
 from rtmu.base.exit_codes import EXIT_TIMEOUT
-from rtmu.client.link_timing import STATUS_CEILING
+from rtmu.base.link_timing import STATUS_CEILING
 from rtmu.guardian.halt import IDENTIFIER
 from rtmu.package_data import project_map
 from rtmu.protocol.decoder import PacketDecoder
@@ -34,7 +34,7 @@ ARENA = project_map("arena.map")
 AFTER_FAULT_MAX = 10
 """ratioDrive packets the simulator may receive after the fault: those already in flight and the
 resends until the fault is seen — at most 0.45 s of stale status (a new link's limit is the ceiling,
-``client.link_timing``) or a ping's 0.5 s deadline plus up to 0.25 s since it was sent (an 800 ms
+``base.link_timing``) or a ping's 0.5 s deadline plus up to 0.25 s since it was sent (an 800 ms
 round trip); a blind drive sends ~10 a second until --seconds ends."""
 
 

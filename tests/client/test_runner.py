@@ -149,7 +149,7 @@ def test_stale_status_stops_the_robot_even_while_the_lease_is_renewed(server: Te
         runner.lease.grant(DriveRatios(100, 0, 50))
         runner.sync()
         dry_up_status(runner, server)
-        for _ in range(5):  # a new link's limit is the ceiling, 0.45 s (client.link_timing)
+        for _ in range(5):  # a new link's limit is the ceiling, 0.45 s (base.link_timing)
             clock.advance(0.1)
             runner.lease.renew()
             runner.sync()

@@ -5,7 +5,6 @@ One job per module:
 * ``errors``     — typed errors an operator understands, each with its CLI exit code.
 * ``connection`` — :class:`AriaClient`, one logged-in connection on asyncio streams.
 * ``health``     — RTT, status age, dropped packets → OK / STALE / LOST, and why.
-* ``link_timing`` — the stale limit and ping deadline each link learns (one rule for all).
 * ``lease``      — the drive lease the UI renews and the governor that turns it into packets.
 * ``lease_keeper`` — credits a renewing UI thread with the time it only waited for a CPU.
 * ``reconnect``  — backoff policy.

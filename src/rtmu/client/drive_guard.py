@@ -9,7 +9,7 @@ an unanswered or too slow ping, or a lost connection — or None while the link 
 Status comes at 20 Hz and the ping is tighter than the window's (every :data:`PING_INTERVAL` s):
 a script has no operator watching the link cell, and a server that stopped reading would never
 hear its ``stop``. How late either may be is learned per link by the window's own rule
-(:mod:`~rtmu.client.link_timing`): status is stale after 0.2 s on a steady link and at most
+(:mod:`~rtmu.base.link_timing`): status is stale after 0.2 s on a steady link and at most
 0.45 s on a jittery one; a ping must be answered within 0.4–:data:`MAX_RTT` s.
 """
 

@@ -5,8 +5,8 @@ exactly like a quiet robot unless we watch the status stream we subscribed to.
 So the status subscription *is* the heartbeat:
 
 * **stale** — no status for longer than this link's learned limit
-  (:mod:`~rtmu.client.link_timing`: at least :data:`STALE_INTERVALS` update intervals — 300 ms at
-  10 Hz — and at most :data:`~rtmu.client.link_timing.STATUS_CEILING`): driving stops, the
+  (:mod:`~rtmu.base.link_timing`: at least :data:`STALE_INTERVALS` update intervals — 300 ms at
+  10 Hz — and at most :data:`~rtmu.base.link_timing.STATUS_CEILING`): driving stops, the
   operator sees it, with the measured cause (:meth:`HealthMonitor.cause`);
 * **lost**  — no status for :data:`LOST_AFTER` s: the connection is treated as
   gone (the session reconnects if the profile asks for it).
@@ -25,9 +25,9 @@ from __future__ import annotations
 
 from collections.abc import Callable
 
+from ..base.link_timing import STATUS_CEILING, WAKE_MEMORY, Deadline, Envelope, Timing, ceiling_for
 from ..protocol.decoder import DropStats
 from ..values.state import LinkHealth, LinkLevel
-from .link_timing import STATUS_CEILING, WAKE_MEMORY, Deadline, Envelope, Timing, ceiling_for
 
 STALE_INTERVALS = 3
 LOST_AFTER = 2.0
@@ -59,7 +59,7 @@ class HealthMonitor:
         self.status_interval = status_interval
         floor = stale_intervals * status_interval
         self.status_timing = Deadline(status_interval, floor, max(floor, stale_ceiling))
-        """Gaps between status packets → the stale limit (``client.link_timing``)."""
+        """Gaps between status packets → the stale limit (``base.link_timing``)."""
         self.wake_lateness = Envelope(WAKE_MEMORY)
         """How late the loop that stops the robot wakes (:meth:`note_wake`): lowers the ceiling."""
         self.lost_after = max(lost_after, self.status_timing.ceiling)
@@ -126,7 +126,7 @@ class HealthMonitor:
         return ceiling_for(self.wake_lateness.value(now), timing.floor, timing.ceiling)
 
     def stale_limit(self, now: float) -> float:
-        """Seconds without status after which the link is stale, now (learned; see ``link_timing``)."""
+        """Seconds without status after which the link is stale, now (learned; see ``base.link_timing``)."""
         return self.status_timing.limit(now, undecided=self.undecided(), ceiling=self.ceiling(now))
 
     def ping_deadline(self, now: float) -> float:

@@ -38,7 +38,7 @@ import time
 from collections.abc import Callable
 from dataclasses import dataclass
 
-from . import link_timing
+from ..base import link_timing
 from .lease import DriveLease
 
 PERIOD = 0.05

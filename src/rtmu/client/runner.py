@@ -36,7 +36,7 @@ fail has something behind it:
 2. **The network loop sends ``ratioDrive`` only while the lease is fresh**, at
    10 Hz, and zero ratios + ``stop`` the moment it ends or lapses, or the link
    health is not OK (no status for the limit learned for this link, 0.3–0.45 s in
-   the window — ``client.link_timing`` —, or a ping unanswered). It wakes at the
+   the window — ``base.link_timing`` —, or a ping unanswered). It wakes at the
    exact expiry, so a lapse costs at most the lease's 300 ms. ``disconnect``,
    ``close``, connecting elsewhere and ``stop()`` all send zero ratios + ``stop``.
 3. **If the network loop itself is blocked**, nothing can be sent — neither the

@@ -163,7 +163,7 @@ class PacketDecoder:
 
         A client's link watch reads it: the stream is demonstrably alive and will be delivered
         once :data:`STREAM_GOES_ON` of them prove the header a liar, so a stale verdict must not
-        race that proof (``rtmu.client.link_timing``)."""
+        race that proof (``rtmu.base.link_timing``)."""
         chain = self._chain
         if chain is None or chain[0] <= self._pos or self.buffered < 4:
             return 0

@@ -35,6 +35,7 @@ from ..base.exit_codes import (
     EXIT_USAGE,
     WHY_ASKED,
 )
+from ..base.link_timing import STATUS_CEILING
 from ..base.textsafe import visible
 from ..client.config_feed import ConfigApi, config_api
 from ..client.connection import TEXT_BANNERS, AriaClient
@@ -42,7 +43,6 @@ from ..client.diagnosis import ADVICE, Step, central_server_words, login_finding
 from ..client.drive_guard import STALE_INTERVALS, STATUS_INTERVAL_MS
 from ..client.errors import ClientError
 from ..client.health import HealthMonitor
-from ..client.link_timing import STATUS_CEILING
 from ..client.roles import Role
 from ..client.why import diagnose
 from ..client.why_gather import gather
@@ -441,7 +441,7 @@ class Doctor:
 
     async def _link_timing(self, name: str) -> dict[str, Any]:
         """Subscribe to status at ``rtmu drive``'s rate for :attr:`link_seconds` and learn its timing
-        by the rule the window and ``rtmu drive`` use (``client.link_timing``)."""
+        by the rule the window and ``rtmu drive`` use (``base.link_timing``)."""
         conn, reader = self.conn, self.reader
         assert conn is not None and reader is not None
         number = conn.number_of(name)

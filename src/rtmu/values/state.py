@@ -409,7 +409,7 @@ class LinkLevel(Enum):
     """Not connected."""
     OK = "ok"
     STALE = "stale"
-    """No status for longer than the link's learned limit (``client.link_timing``: 0.2–0.45 s), or a
+    """No status for longer than the link's learned limit (``base.link_timing``: 0.2–0.45 s), or a
     ping went unanswered: driving is stopped."""
     LOST = "lost"
     """No status for 2 s, or 3 pings unanswered: the link is considered gone (reconnect if enabled)."""

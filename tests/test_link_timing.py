@@ -1,4 +1,4 @@
-"""The learned stale limit (``client.link_timing``): floor on a steady link, above a jittery link's
+"""The learned stale limit (``base.link_timing``): floor on a steady link, above a jittery link's
 stalls, never above the ceiling the safety promise allows — on made-up arrival times, no clock."""
 
 from __future__ import annotations
@@ -7,8 +7,8 @@ import random
 
 import pytest
 
-from rtmu.client import link_timing
-from rtmu.client.link_timing import JITTER_MEMORY, STATUS_CEILING, Deadline
+from rtmu.base import link_timing
+from rtmu.base.link_timing import JITTER_MEMORY, STATUS_CEILING, Deadline
 
 FLOOR = 0.2  # rtmu drive: 4 × 50 ms
 
