@@ -205,6 +205,8 @@ def test_doctor_shows_what_the_link_taught_it(sim: SimThread, proxy: FaultProxy)
     status = next(s for s in json.loads(done.stdout)["steps"] if s["step"] == "status")
     link = status["link"]
     assert done.returncode == 0 and link["status_every_ms"] == 50 and link["arrived"] > 10
-    assert link["longest_gap_ms"] >= 450 and link["jitter_ms"] >= 400
+    # A 0.5 s stall teaches at most the ceiling: ~0.4 s above the mean, remembered (halving every
+    # 2 min) until the doctor reads it up to 2.5 s later — a little under 400 ms by then.
+    assert link["longest_gap_ms"] >= 450 and link["jitter_ms"] >= 350
     assert link["stale_after_s"] == STATUS_CEILING
     assert "driving stops after 0.45 s without status" in status["summary"] and "Wi-Fi" in status["advice"]
