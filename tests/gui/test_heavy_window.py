@@ -3,8 +3,9 @@
 The server is one of ``tests/client/heavy_servers.py`` in a process of its own (so its flood never
 shares this process's interpreter lock with the window), reporting every drive packet it hears.
 For each flood: Up held through real X input keeps ``ratioDrive`` coming with no stop, a release
-stops the robot, and what reached the window is bounded (points drawn, popup rebuilds, the size a
-4096×4096 picture was decoded at). Rates and latencies are measured in ``bench/bench_heavy.py``.
+stops the robot, and what reached the window is bounded (points drawn, popup rebuilds; a frame
+declaring 4096×4096 with 632 bytes of data is refused unread). Rates and latencies are measured
+in ``bench/bench_heavy.py``.
 """
 
 from __future__ import annotations
@@ -19,7 +20,7 @@ from pathlib import Path
 import pytest
 
 from rtmu.client.drawing_budget import MAX_SHOWN_POINTS
-from rtmu.ui.camera import DECODE_SIDE
+from rtmu.client.video_session import CameraFeed
 
 from .harness import Gui, idle, pump
 
@@ -127,12 +128,19 @@ def test_a_popup_storm_leaves_the_window_driving(flood: tuple[Gui, FloodServer])
 @pytest.mark.parametrize("flood", ["frames"], indirect=True)
 def test_4096_squared_frames_leave_the_window_driving(flood: tuple[Gui, FloodServer]) -> None:
     gui, server = flood
-    gui.key("v")  # live video: one 4096×4096 picture after another
-    camera = gui.window.camera
-    pump(lambda: camera.texture is not None, 10, "a picture on the camera page")
+    gui.key("v")  # live video: one 632-byte frame declaring 4096×4096 after another
+    session = gui.window.session.runner.session
+    assert session is not None
+    camera_feed = session.feed(CameraFeed)
+
+    def refused() -> int:
+        feed = camera_feed.feed
+        return 0 if feed is None else feed.stats.dropped
+
+    # Its data cannot fill what it declares (client.jpeg_bounds): refused on arrival, never decoded.
+    pump(lambda: refused() >= 5, 10, "the frames to be asked for and refused")
     drives, stops = _hold_up(gui, server)
     gui.shot("big-frames-driving")
     assert stops == 0 and drives >= HOLD * 10 / 2, (drives, stops)
-    texture = camera.texture
-    assert texture is not None and texture.get_width() == texture.get_height() == DECODE_SIDE
+    assert gui.window.camera.texture is None and refused() >= 20  # still asked for, still refused
     _release_stops(gui, server)
