@@ -106,7 +106,7 @@ def main() -> int:
     while time.monotonic() < deadline:  # drive once the guardian is up (or gave up)
         runner.sync()
         g = runner.session.guardian if runner.session else None
-        if g is None or g.state != "starting":
+        if g is None or g.waiting_reason() is None:  # armed, or unavailable (then it drives unguarded)
             break
         time.sleep(0.02)
     ui = Ui(runner)
