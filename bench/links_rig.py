@@ -22,13 +22,14 @@ import time
 from pathlib import Path
 
 from rtmu.base.link_timing import FIXED_ENV
+from rtmu.package_data import project_map
 from rtmu.sim import SimConfig, SimThread
 
 REPO = Path(__file__).resolve().parents[1]
 sys.path.insert(0, str(REPO / "tests"))
 from linkfaults import PROFILES, FaultProxy  # noqa: E402
 
-ARENA = REPO / "data" / "maps" / "arena.map"
+ARENA = project_map("arena.map")
 POLL = 0.002
 
 
