@@ -279,7 +279,8 @@ def test_simulator_killed_while_driving(gui: Gui, sim: SimThread) -> None:
             gui.wait_connected(timeout=20)
             idle(0.8)
             assert stopped(again), "a key held through a reconnect must not drive"
-            assert received(again) is None
+            # Lost while driving: the reconnect's first packets are a stop (zero ratios), never a drive.
+            assert received(again) in (None, (0.0, 0.0, 0.0, 0.0)), received(again)
             gui.shot("reconnected-key-still-held")
             gui.keyup("Up")
             gui.keydown("Up")

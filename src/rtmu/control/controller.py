@@ -138,6 +138,8 @@ class SecretStore(Protocol):
 
 
 REPLAY_REASON = "Replay — nothing is sent to a robot"
+KEYBOARD_LOST = "the window lost the keyboard"
+"""Why a held drive stops on a focus loss (a suspend names its own reason)."""
 
 
 def ratios_for(held: set[str] | frozenset[str], throttle: float) -> DriveRatios:
@@ -422,20 +424,18 @@ class Controller:
             self.link.lease.end(reason, self._generation)
             self._generation = None
         if had and reason is EndReason.LAPSED:
-            self.view.notify(
-                Notice.warning(
-                    Kind.SAFETY,
-                    "Stopped: the window did not respond in time (a busy computer?). Press again to drive.",
-                )
-            )
+            why = self.link.lease.why or "a busy computer?"
+            text = f"Stopped: the window did not respond in time ({why})"
+            self.view.notify(Notice.warning(Kind.SAFETY, f"{text}. Press again to drive."))
         elif had and reason is EndReason.LINK and not quiet:
             level = self.robot.health.value.level
             self._say_link_stop(level if level in (LinkLevel.STALE, LinkLevel.LOST) else LinkLevel.STALE)
 
     def _say_link_stop(self, level: LinkLevel) -> None:
-        self.view.notify(
-            Notice.warning(Kind.LINK, f"Stopped: the link is {level.value}. Press again once it is back.")
-        )
+        """Said once per stop, with the network side's measured cause where it gave one."""
+        why = self.link.lease.why or self.robot.health.value.cause
+        said = f" — {why}" if why else ". Press again once it is back."
+        self.view.notify(Notice.warning(Kind.LINK, f"Stopped: the link is {level.value}{said}"))
 
     def stop(self) -> None:
         """Stop now. Always sent, whatever the link looks like; held keys must be pressed again.
@@ -455,7 +455,7 @@ class Controller:
             self._record(Stop())
             self.link.send(Stop())
 
-    def focus_lost(self) -> None:
+    def focus_lost(self, why: str = KEYBOARD_LOST) -> None:
         """The window lost keyboard focus: key releases may never arrive, so stop a held drive.
 
         A navigation goes on: the server drives it, no key is held for it.
@@ -466,8 +466,8 @@ class Controller:
         driving = bool(self._held) or self._generation is not None
         if driving:
             self.stop()
-            said = "Stopped: the window lost the keyboard. Click the map, then press again to drive."
-            self.view.notify(Notice.warning(Kind.SAFETY, said))
+            then = "Click the map, then press again" if why == KEYBOARD_LOST else "Press again"
+            self.view.notify(Notice.warning(Kind.SAFETY, f"Stopped: {why}. {then} to drive."))
         if self._analog is not None:
             self._analog = None
             self._analog_blocked = True

@@ -24,6 +24,7 @@ gi.require_version("Gtk", "4.0")
 gi.require_version("Pango", "1.0")
 from gi.repository import GLib, Gtk, Pango  # noqa: E402
 
+from ..base.link_timing import STATUS_CEILING  # noqa: E402
 from ..model.observables import ConnectionState, LinkLevel, OperatorState, Phase, RobotModel  # noqa: E402
 from .gauges import BatteryGauge, WifiGauge, battery_fraction, wifi_bars  # noqa: E402
 from .ld_status import details_lines, goal_suffix  # noqa: E402
@@ -116,7 +117,7 @@ class StatusToolbar(Gtk.ScrolledWindow):
             "mode": Cell("Mode · status", width_chars=6),
             "safe": Cell("Safe", width_chars=3),
             "speed": Cell("Throttle", width_chars=5),
-            "link": Cell("Link: rtt, age", width_chars=12),
+            "link": Cell("Link: rtt, age/limit", width_chars=14),
             "dock": Cell("Dock", width_chars=9),
             "loc": Cell("Localization", width_chars=9),
         }
@@ -337,6 +338,12 @@ class StatusToolbar(Gtk.ScrolledWindow):
             f"{health.dropped} bad packets dropped"
         )
         text = f"{rtt} {age_text}"
+        if health.stale_limit is not None:  # the learned limit next to the age it is compared with
+            text = f"{rtt} {DASH if age is None else f'{age:.1f}'}/{health.stale_limit:.2f}"
+            tip += (
+                f"\nStale after {health.stale_limit:.2f} s without status: learned from this link's "
+                f"jitter ({health.jitter_ms or 0:.0f} ms), at most {STATUS_CEILING:.2f} s"
+            )
         if health.ping_failures > 0:
             # The link may look alive (status still arriving) while the server no longer hears us.
             text = f"no ping ×{health.ping_failures}"

@@ -345,7 +345,10 @@ class DrawingLayer:
     may_toggle: bool
     """The server lets the operator turn it on and off (``DefaultOn`` / ``DefaultOff``)."""
     points: tuple[tuple[int, int], ...] = ()
-    """Global mm, as last received; empty while hidden."""
+    """Global mm, as last received — evenly thinned when the drawings together exceed the window's
+    budget (``client.drawing_budget``); empty while hidden."""
+    total_points: int = 0
+    """How many points the last sample had (more than ``points`` holds when thinned)."""
     problem: str = ""
     """Why its last sample was refused (malformed, too many points), or ""."""
 
@@ -404,7 +407,8 @@ class LinkLevel(Enum):
     """Not connected."""
     OK = "ok"
     STALE = "stale"
-    """No status for 3 update intervals, or a ping went unanswered: driving is stopped."""
+    """No status for longer than the link's learned limit (``base.link_timing``: 0.2–0.45 s), or a
+    ping went unanswered: driving is stopped."""
     LOST = "lost"
     """No status for 2 s, or 3 pings unanswered: the link is considered gone (reconnect if enabled)."""
 
@@ -422,6 +426,12 @@ class LinkHealth:
     """Seconds since the last status packet (not compared: it changes all the time)."""
     ping_failures: int = 0
     """Pings in a row the server did not answer: it may no longer hear us (RTT is then None)."""
+    stale_limit: float | None = None
+    """Seconds without status after which the link counts as stale, as learned now (0.01 s steps)."""
+    jitter_ms: float | None = None
+    """How late status came lately above its normal pace (5 ms steps): what the limit was learned from."""
+    cause: str = field(default="", compare=False)
+    """While not OK: why, measured ("no status for 0.46 s, learned jitter 90 ms …"), with what to do."""
 
 
 # -- typed changes -------------------------------------------------------------------------------
