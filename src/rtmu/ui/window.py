@@ -353,6 +353,7 @@ class MainWindow(Gtk.ApplicationWindow):
             loop_lag = getattr(self.controller.link, "loop_lag", None)  # a stalled network thread: said
             connected = self.model.connection.value.phase is Phase.CONNECTED
             self.notices.loop_lag(loop_lag() if callable(loop_lag) else None, connected)
+            self.notices.link_health(self.model.health.value.level)
         return True
 
     def _beat(self) -> bool:
