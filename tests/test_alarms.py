@@ -114,3 +114,27 @@ def test_the_mute_is_remembered_in_settings_and_checked() -> None:
     assert "alarms_muted = true" in text and parse_settings(text).alarms_muted is True
     with pytest.raises(SettingsError, match="alarms_muted"):
         parse_settings('version = 1\nalarms_muted = "yes"\n')
+
+
+@pytest.mark.parametrize(
+    "docked",
+    [{"dock_state": "Docked"}, {"status": "Docked"}],
+    ids=["dockInfo", "status"],
+)
+def test_a_low_battery_on_its_dock_is_charging_not_an_alarm(docked: dict[str, str]) -> None:
+    """ "Bring the robot to its charger" is a lie once it is there: docked, the low banner gives way to a
+    charging note; undocked while still low, it is raised (and beeps) again (issue 21)."""
+    m = AlarmMonitor()
+    low = RobotState(battery_v=11.4, battery_low=11.5, battery_shutdown=11.0)
+    assert [(e.severity, e.sound) for e in m.update(low, OK)] == [(Severity.WARNING, True)]
+    on_dock = RobotState(battery_v=11.4, battery_low=11.5, battery_shutdown=11.0, **docked)  # type: ignore[arg-type]
+    events = m.update(on_dock, OK)
+    assert [(e.severity, e.text) for e in events] == [
+        (Severity.CLEAR, "Battery low (11.4 V), charging on its dock")
+    ]
+    assert m.update(on_dock, OK) == [], "said once"
+    assert [(e.severity, e.sound) for e in m.update(low, OK)] == [(Severity.WARNING, True)], "undocked"
+    critical = RobotState(battery_v=10.9, battery_low=11.5, battery_shutdown=11.0, **docked)  # type: ignore[arg-type]
+    assert [e.severity for e in m.update(critical, OK)] == [Severity.CRITICAL], "critical even docked"
+    undocking = RobotState(battery_v=11.4, battery_low=11.5, battery_shutdown=11.0, dock_state="Undocking")
+    assert [e.severity for e in m.update(undocking, OK)] == [Severity.WARNING]

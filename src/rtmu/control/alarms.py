@@ -14,6 +14,9 @@ Levels (the server's own words where it publishes them):
   (:attr:`RobotState.battery_low` / ``battery_shutdown``); low is a warning, at or
   under shutdown it is critical. A robot that gives no levels gets none in volts
   (a pack's voltage says nothing without them) and 20 % / 5 % in state of charge.
+  A docked robot is where the low warning sends the operator: docked (``dockInfo``,
+  or ARNL's "Docked" status), low is no alarm but a short "charging" note; undocked
+  while still low, it is raised again. Critical stays critical on the dock.
 * **Wi-Fi**: the link quality the server publishes (``getStrings``' "Wireless Link
   Quality", the kernel's 0–70 scale): under :attr:`Thresholds.wifi_low` is a warning.
 * **Round trip**: the client's ping time (``LinkHealth.rtt_ms``) over
@@ -30,7 +33,8 @@ import math
 from dataclasses import dataclass
 from enum import Enum, IntEnum
 
-from ..values.state import LinkHealth, LinkLevel, RobotState
+from ..client.nav_status import read_status
+from ..values.state import LinkHealth, LinkLevel, NavOutcome, RobotState
 
 
 class Alarm(Enum):
@@ -128,6 +132,8 @@ class AlarmMonitor:
             Severity.WARNING: f"Battery low: {shown} — bring the robot to its charger",
             Severity.CLEAR: f"Battery back to {shown}",
         }[now]
+        if now is Severity.WARNING and _docked(robot):
+            now, text = Severity.CLEAR, f"Battery low ({shown}), charging on its dock"
         self._change(Alarm.BATTERY, now, text, events)
 
     def _wifi(self, robot: RobotState, events: list[AlarmEvent]) -> None:
@@ -170,6 +176,13 @@ class AlarmMonitor:
         worse = now > self._severity[alarm]
         self._severity[alarm] = now
         events.append(AlarmEvent(alarm, now, text, sound=worse))
+
+
+def _docked(robot: RobotState) -> bool:
+    """On its charger: ``dockInfo`` says Docked, or (a server without it) ARNL's status does."""
+    if robot.dock_state is not None:
+        return robot.dock_state == "Docked"
+    return read_status(robot.status).phase is NavOutcome.DOCKED
 
 
 def _reading(value: float | None) -> float | None:
