@@ -18,6 +18,8 @@ gi.require_version("Gtk", "4.0")
 from gi.repository import GLib, Gtk  # noqa: E402
 
 MAX_BANNERS = 4
+MARGIN_TOP = 8
+"""Pixels between the top of the pages and the first banner (more under the navigation pill)."""
 HISTORY = 50
 MAX_CHARS = 300
 ICONS = {
@@ -46,7 +48,7 @@ class BannerStack(Gtk.Box):
         self.add_css_class("banner-stack")
         self.set_halign(Gtk.Align.CENTER)
         self.set_valign(Gtk.Align.START)
-        self.set_margin_top(8)
+        self.set_margin_top(MARGIN_TOP)
         self.set_can_target(True)
         self._banners: dict[str, _Banner] = {}
         self._order: list[str] = []
@@ -111,6 +113,22 @@ class BannerStack(Gtk.Box):
 
     def topics(self) -> list[str]:
         return list(self._order)
+
+    def keep_clear_of(self, widget: Gtk.Widget) -> None:
+        """Start the column under ``widget`` (the navigation pill) while it is shown where the column
+        would cover it: a banner never hides what the robot is doing. Called by the window's timer;
+        the margin only changes when it must (no relayout otherwise)."""
+        top = MARGIN_TOP
+        parent = self.get_parent()
+        if parent is not None and widget.get_mapped() and self._order:
+            ok_pill, pill = widget.compute_bounds(parent)
+            ok_own, own = self.compute_bounds(parent)
+            if ok_pill and ok_own:
+                left, right = own.get_x(), own.get_x() + own.get_width()
+                if left < pill.get_x() + pill.get_width() and pill.get_x() < right:
+                    top = max(top, round(pill.get_y() + pill.get_height()) + MARGIN_TOP // 2)
+        if self.get_margin_top() != top:
+            self.set_margin_top(top)
 
     # -- internals ---------------------------------------------------------------------------
     def _make(self, topic: str) -> _Banner:
