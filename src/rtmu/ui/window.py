@@ -352,7 +352,8 @@ class MainWindow(Gtk.ApplicationWindow):
             self.toolbar.refresh()
             self.camera_page.tick()
             loop_lag = getattr(self.controller.link, "loop_lag", None)  # a stalled network thread: said
-            connected = self.model.connection.value.phase is Phase.CONNECTED
+            # A replay sends nothing (and its clock is the recording's): no "stops are not going out".
+            connected = self.model.connection.value.phase is Phase.CONNECTED and not self.controller.replay
             self.notices.loop_lag(loop_lag() if callable(loop_lag) else None, connected)
             self.notices.link_health(self.model.health.value.level)
         return True
