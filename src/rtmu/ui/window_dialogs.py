@@ -75,8 +75,8 @@ class WindowDialogs:
 
     def open_settings(self) -> None:
         profiles = dict(self.profiles)
-        current = self.robot.session.controller.profile
-        profiles.setdefault(current.name, current)
+        current = self.robot.session.controller.current_profile()  # the speed and view as they are now:
+        profiles[current.name] = current  # Save keeps them (never the speed the profile was opened with)
         self.settings = ConnectionDialog(
             self.window,
             profiles,
@@ -93,7 +93,7 @@ class WindowDialogs:
         if self._profile_saved is not None:
             self._profile_saved(profile, password)
         controller = self.robot.session.controller
-        changed = profile != controller.profile
+        changed = profile != controller.current_profile()
         controller.select_profile(profile)
         self._profile_changed()
         if changed and self.model.connection.value.phase is not Phase.DISCONNECTED:
