@@ -64,11 +64,22 @@ def test_wifi_quality_hysteresis() -> None:
             (e.severity, e.sound) for e in m.update(RobotState(wifi_quality=q), OK) if e.alarm is Alarm.WIFI
         ]
 
-    assert wifi(60) == []
-    assert wifi(19) == [(Severity.WARNING, True)]
-    assert wifi(22) == [] and wifi(27) == [] and wifi(10) == []
-    assert wifi(28) == [(Severity.CLEAR, False)]
-    assert wifi(21) == []
+    assert wifi(86) == []
+    assert wifi(27) == [(Severity.WARNING, True)]
+    assert wifi(31) == [] and wifi(39) == [] and wifi(14) == []
+    assert wifi(40) == [(Severity.CLEAR, False)]
+    assert wifi(30) == []
+
+
+def test_the_wifi_alarm_says_the_percent_the_toolbar_shows() -> None:
+    """One unit: the banner said "10/70" where the toolbar said "14 %" (issue 21)."""
+    m = AlarmMonitor()
+    (event,) = m.update(RobotState(wifi_quality=14), OK)
+    assert event.text == "Weak Wi-Fi on the robot: link quality 14 %"
+    assert m.update(RobotState(wifi_quality=20), OK) == [], "no new event, no beep"
+    assert m.words[Alarm.WIFI] == "Weak Wi-Fi on the robot: link quality 20 %", "the words follow the value"
+    m.update(RobotState(wifi_quality=50), OK)
+    assert Alarm.WIFI not in m.words
 
 
 def test_round_trip_and_unanswered_pings() -> None:

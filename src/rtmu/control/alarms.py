@@ -18,7 +18,8 @@ Levels (the server's own words where it publishes them):
   or ARNL's "Docked" status), low is no alarm but a short "charging" note; undocked
   while still low, it is raised again. Critical stays critical on the dock.
 * **Wi-Fi**: the link quality the server publishes (``getStrings``' "Wireless Link
-  Quality", the kernel's 0–70 scale): under :attr:`Thresholds.wifi_low` is a warning.
+  Quality", the kernel's 0–70 scale), in % as the toolbar shows it: under
+  :attr:`Thresholds.wifi_low` is a warning.
 * **Round trip**: the client's ping time (``LinkHealth.rtt_ms``) over
   :attr:`Thresholds.rtt_high_ms`, or unanswered pings, is a warning. A stale or lost
   link has its own banner already; without a connection every alarm clears silently.
@@ -51,9 +52,10 @@ class Severity(IntEnum):
 
 @dataclass(frozen=True, slots=True)
 class Thresholds:
-    wifi_low: float = 20.0
-    """Quality (of 70) under which the Wi-Fi alarm is raised (≈ −90 dBm)."""
-    wifi_clear: float = 28.0
+    wifi_low: float = 29.0
+    """Quality (%) under which the Wi-Fi alarm is raised (20 of Linux's 70: ≈ −90 dBm)."""
+    wifi_clear: float = 40.0
+    """Quality (%) at which it clears (28 of 70)."""
     rtt_high_ms: float = 400.0
     rtt_clear_ms: float = 200.0
     ping_failures: int = 2
@@ -83,6 +85,9 @@ class AlarmMonitor:
     def __init__(self, thresholds: Thresholds | None = None) -> None:
         self.t = thresholds or Thresholds()
         self._severity: dict[Alarm, Severity] = dict.fromkeys(Alarm, Severity.CLEAR)
+        self.words: dict[Alarm, str] = {}
+        """What each active alarm says with the latest value ("… link quality 20 %"): a banner
+        raised at 14 % shows the number the toolbar shows now, without a new event or beep."""
 
     def severity(self, alarm: Alarm) -> Severity:
         return self._severity[alarm]
@@ -105,6 +110,7 @@ class AlarmMonitor:
         """No connection: the connection banner speaks now; every alarm clears, silently."""
         events = [AlarmEvent(a, Severity.CLEAR, "") for a, s in self._severity.items() if s]
         self._severity = dict.fromkeys(Alarm, Severity.CLEAR)
+        self.words = {}
         return events
 
     # -- each alarm ------------------------------------------------------------------------------
@@ -148,9 +154,9 @@ class AlarmMonitor:
         else:
             now = was
         text = (
-            f"Weak Wi-Fi on the robot: link quality {quality:.0f}/70"
+            f"Weak Wi-Fi on the robot: link quality {quality:.0f} %"
             if now
-            else f"Wi-Fi back: link quality {quality:.0f}/70"
+            else f"Wi-Fi back: link quality {quality:.0f} %"
         )
         self._change(Alarm.WIFI, now, text, events)
 
@@ -171,6 +177,10 @@ class AlarmMonitor:
         self._change(Alarm.RTT, now, text, events)
 
     def _change(self, alarm: Alarm, now: Severity, text: str, events: list[AlarmEvent]) -> None:
+        if now is Severity.CLEAR:
+            self.words.pop(alarm, None)
+        else:
+            self.words[alarm] = text
         if now is self._severity[alarm]:
             return
         worse = now > self._severity[alarm]
