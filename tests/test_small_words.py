@@ -2,6 +2,8 @@
 
 from __future__ import annotations
 
+from pathlib import Path
+
 from rtmu.ui.notes import heading_text
 
 
@@ -29,3 +31,20 @@ def test_about_says_its_licence_once_and_has_its_own_logo() -> None:
     assert "MIT License" in LICENSE_TEXT and "The The" not in LICENSE_TEXT and "the The" not in LICENSE_TEXT
     logo = app_logo()
     assert logo is not None and logo.get_width() > 0, "the package's own icon could not be read"
+
+
+def test_saved_frames_go_to_the_pictures_folder_the_readme_names(tmp_path: Path) -> None:
+    """``~/Pictures/rtmu`` where the desktop set no pictures folder; its own folder where it did."""
+    import subprocess
+    import sys
+
+    probe = "from rtmu.ui.live_video import frames_dir; print(frames_dir())"
+    home = tmp_path / "home"
+    (home / ".config").mkdir(parents=True)
+    env = {"HOME": str(home), "XDG_CONFIG_HOME": str(home / ".config"), "PATH": "/usr/bin:/bin"}
+    env["PYTHONPATH"] = ":".join(sys.path)
+    said = subprocess.run([sys.executable, "-c", probe], env=env, capture_output=True, text=True, check=True)
+    assert said.stdout.strip() == str(home / "Pictures" / "rtmu")
+    (home / ".config" / "user-dirs.dirs").write_text('XDG_PICTURES_DIR="$HOME/Bilder"\n', encoding="utf-8")
+    said = subprocess.run([sys.executable, "-c", probe], env=env, capture_output=True, text=True, check=True)
+    assert said.stdout.strip() == str(home / "Bilder" / "rtmu")

@@ -32,9 +32,10 @@ QUALITY_CHOICES = ("Server's", "30", "50", "75", "90")
 
 
 def frames_dir() -> Path:
-    """Where saved frames go: ``~/Pictures/rtmu`` (the XDG pictures folder), else ``~/rtmu-frames``."""
+    """Where saved frames go: ``rtmu`` in the XDG pictures folder (``user-dirs.dirs``), which is
+    ``~/Pictures`` where the desktop never set one (as the README says; GLib gives no folder then)."""
     pictures = GLib.get_user_special_dir(GLib.UserDirectory.DIRECTORY_PICTURES)
-    return Path(pictures) / "rtmu" if pictures else Path(GLib.get_home_dir()) / "rtmu-frames"
+    return Path(pictures or Path(GLib.get_home_dir()) / "Pictures") / "rtmu"
 
 
 class LiveVideoControls:
