@@ -158,6 +158,7 @@ def test_portrait_phone_layout_fits_and_the_thumb_dpad_drives(phone: tuple[Gui, 
             8,
             "the D-pad to drive",
         )
+        pump(lambda: window.motion.text.startswith("Driving (D-pad held)"), 3, "the pill naming the D-pad")
         gui.shot("portrait-dpad-held")
     finally:
         gui.xdotool("mouseup", "1")

@@ -191,10 +191,12 @@ class MapPage(Gtk.Overlay):
     def _stop(self) -> None:
         self.robot.session.controller.run("stop")
 
-    def _drive_held(self) -> bool:
-        """A held drive is live (keys, D-pad or the pad's dead-man)."""
+    def _drive_held(self) -> str:
+        """What holds a live drive: ``dpad``, ``keys``, ``pad`` (the gamepad's dead-man); "" none."""
         controller = self.robot.session.controller
-        return bool(controller.held) or controller.analog_active
+        if controller.held:
+            return "dpad" if self.dpad.held else "keys"
+        return "pad" if controller.analog_active else ""
 
     def let_go(self) -> None:
         """STOP, a switch of robot: a finger on the D-pad is let go of and a pick mode ends."""
