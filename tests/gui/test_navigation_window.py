@@ -306,6 +306,11 @@ def test_a_lost_robot_is_localized_with_the_map_mode_and_navigates_again(gui: Gu
     assert window.pose_bar.go_button.get_label() == "Set here"
     gui.shot("placing-the-robot")
     gui.click(window.pose_bar.go_button)
+    pump(
+        lambda: (window.banners.text("navigation") or "").startswith("Position set: robot at 2."),
+        3,
+        "the confirmation of Set position",
+    )
     pump(lambda: distance(sim, *place) < 60, 3, "the simulator to take the pose")
     pump(lambda: loc.has_css_class("loc-good"), 5, "localization good again")
     assert abs(sim.snapshot().th) < 5
