@@ -27,6 +27,9 @@ MAX_SIDE = 4096
 INSET_SIZE = (176, 132)
 """The inset's largest size (and its thumbnail's)."""
 INSET_MIN_WIDTH = 96
+INSET_OLD_AFTER = 3.0
+"""Seconds after which the inset's picture is greyed and called old: live video is 15 pictures a
+second and one request answers in well under a second, so an older one is no view of now."""
 MAX_JPEG_BYTES = 16 * 1024 * 1024
 REQUEST_TIMEOUT = 7.0
 """Seconds the page waits for a requested picture before saying none came."""
@@ -283,8 +286,9 @@ class CameraInset(Gtk.Box):
     """The last picture as a small inset on the map, with its age; a click opens the camera page.
 
     An old picture must never pass for the robot's view: the inset shows how old it is, turns
-    grey while the link is lost (:meth:`set_live`), and the window clears it on a new
-    connection. It sits in the bottom-left corner (top right while the touch D-pad is there)
+    grey and says "old picture" once it is older than :data:`INSET_OLD_AFTER` or while the link is
+    lost (:meth:`set_live`), and the window clears it on a new connection. It sits in the
+    bottom-left corner (top right while the touch D-pad is there)
     and takes about a sixth of the map's width, between :data:`INSET_MIN_WIDTH` and
     :data:`INSET_SIZE`.
     """
@@ -327,20 +331,27 @@ class CameraInset(Gtk.Box):
     def set_live(self, live: bool) -> None:
         """False while the link is lost: the picture is greyed, and says so."""
         self.live = live
-        if live:
+        self.tick()
+
+    @property
+    def old(self) -> bool:
+        """The picture is older than :data:`INSET_OLD_AFTER`: shown greyed and called old."""
+        return self.received_at is not None and self.clock() - self.received_at > INSET_OLD_AFTER
+
+    def tick(self) -> None:
+        """Update the age, and the grey of an old picture (the window calls this on its slow timer)."""
+        old = self.old
+        if self.live and not old:
             self.remove_css_class("stale")
         else:
             self.add_css_class("stale")
-        self.tick()
-
-    def tick(self) -> None:
-        """Update the age (the window calls this on its slow timer)."""
         if self.received_at is None:
             self.age_label.set_text("")
             self.set_tooltip_text(None)
             return
         age = _age(max(0.0, self.clock() - self.received_at))
-        self.age_label.set_text(age if self.live else f"{age} · link lost")
+        fresh = f"old picture · {age}" if old else age
+        self.age_label.set_text(fresh if self.live else f"{age} · link lost")
         self.set_tooltip_text(
             f"Camera picture taken {age} ago (click or Esc for the camera view)"
             if self.live
