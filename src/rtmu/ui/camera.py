@@ -167,6 +167,7 @@ class CameraView(Gtk.Box):
         self.image: CameraImage | None = None
         self.texture: Gdk.Texture | None = None
         self.requested_at: float | None = None
+        self._age_elsewhere = False
         self.error = ""
 
         overlay = self.overlay = Gtk.Overlay()
@@ -216,6 +217,16 @@ class CameraView(Gtk.Box):
     @property
     def waiting(self) -> bool:
         return self.requested_at is not None
+
+    @property
+    def age_shown_elsewhere(self) -> bool:
+        """Live video's caption over the picture says the frame's age (``ui.live_video``)."""
+        return self._age_elsewhere
+
+    @age_shown_elsewhere.setter
+    def age_shown_elsewhere(self, value: bool) -> None:
+        self._age_elsewhere = value
+        self.tick()
 
     def requesting(self) -> None:
         """A picture was asked for: show that it is coming (the old one stays, dimmed)."""
@@ -267,7 +278,9 @@ class CameraView(Gtk.Box):
             self.info.set_text("Requesting…" if self.waiting else (self.error or "No picture"))
             return
         age = max(0.0, now - self.image.received_at)
-        text = f"{self.image.width}×{self.image.height} from {self.image.source} · {_age(age)} old"
+        text = f"{self.image.width}×{self.image.height} from {self.image.source}"
+        if not self.age_shown_elsewhere:  # live video's caption says the frame's age: one age, not two
+            text += f" · {_age(age)} old"
         if self.waiting:
             text += " · requesting a new one…"
         self.info.set_text(text)

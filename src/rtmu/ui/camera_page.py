@@ -93,8 +93,8 @@ class CameraPage:
         self.robot.session.controller.look("the camera page")  # a held drive ends; a navigation goes on
         self.stack.set_visible_child_name(PAGE)
         self.button.set_active(True)
-        if request or self.view.image is None:
-            self.request_picture()
+        if (request or self.view.image is None) and not self.live.live:
+            self.request_picture()  # (live video is the picture: no "Requesting…" over it)
 
     def show_map(self) -> None:
         self.stack.set_visible_child_name("map")
