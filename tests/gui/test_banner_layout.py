@@ -1,5 +1,6 @@
 """Banners never cover the navigation pill (issue 21): at a phone's 360x720, at 800x480 and at 1280x800,
-with two banners up while the robot navigates, the banner column and the pill do not overlap."""
+with two banners up while the robot navigates, the banner column and the pill do not overlap; on the
+camera page (its own pill) neither."""
 
 from __future__ import annotations
 
@@ -19,7 +20,7 @@ LONG = "The server says something long enough to wrap onto a second line of the 
 
 @pytest.fixture
 def gui(screenshots: Path) -> Iterator[Gui]:
-    with SimThread(SimConfig(port=0, map_path=OFFICE_MAP, camera=False, seed=1)) as sim:
+    with SimThread(SimConfig(port=0, map_path=OFFICE_MAP, camera=True, seed=1)) as sim:
         gui = Gui.start(screenshots, "banner-layout", "127.0.0.1", sim.port)
         try:
             yield gui
@@ -72,5 +73,18 @@ def test_banners_leave_the_navigation_pill_visible(gui: Gui) -> None:
         gui.shot(f"{width}x{height}")
         covering = [b for b in _drawn_banners(gui) if _overlap(b, pill)]
         assert not covering, f"at {width}x{height} banners {covering} cover the pill {pill}"
+    # The camera page's pill, on a phone: the banners start under it too.
+    window.set_default_size(360, 720)
+    pump(lambda: window.handheld.layout.narrow, 5, "the phone layout")
+    gui.key("Escape")
+    pill = window.camera_page.motion
+    pump(lambda: pill.get_mapped() and pill.kind == "autonomous", 5, "the camera page's pill")
+    for text in (LONG, "A second message from the server"):
+        window.banners.tell(f"notice:{text}", "warning", text, timeout=None)
+    idle(0.5)
+    box = _bounds(gui, pill)
+    gui.shot("camera-page-360x720")
+    covering = [b for b in _drawn_banners(gui) if _overlap(b, box)]
+    assert not covering, f"on the camera page banners {covering} cover the pill {box}"
     gui.key("space")
     pump(lambda: window.motion.kind == "", 5, "Space to end the navigation")

@@ -48,3 +48,19 @@ def test_the_gear_popover_is_dark_with_light_words(gui: Gui) -> None:
     popover.popdown()
     gui.key("space")  # Space still stops from the camera page
     pump(lambda: window.stack.get_visible_child_name() == "camera", 3, "the page kept")
+
+
+def test_the_camera_page_shows_the_navigation_pill(gui: Gui) -> None:
+    """Looking at the camera never hides that the robot navigates (and Space still ends it)."""
+    window = gui.window
+    window.goals_panel.choose("Corridor End")
+    pump(lambda: window.motion.kind == "autonomous", 10, "the navigation")
+    gui.key("Escape")  # looking: the navigation goes on
+    pump(lambda: window.camera_page.showing, 5, "the camera page")
+    pill = window.camera_page.motion
+    pump(lambda: pill.get_mapped() and pill.kind == "autonomous", 3, "the pill on the camera page")
+    assert pill.text.startswith("Navigating (autonomous) · To Corridor End"), pill.text
+    gui.shot("camera-page-navigating")
+    gui.key("space")
+    pump(lambda: not gui.model.navigation.value.navigating, 5, "Space to end the navigation")
+    pump(lambda: not pill.get_visible(), 3, "the pill to go")

@@ -114,19 +114,20 @@ class BannerStack(Gtk.Box):
     def topics(self) -> list[str]:
         return list(self._order)
 
-    def keep_clear_of(self, widget: Gtk.Widget) -> None:
-        """Start the column under ``widget`` (the navigation pill) while it is shown where the column
-        would cover it: a banner never hides what the robot is doing. Called by the window's timer;
-        the margin only changes when it must (no relayout otherwise)."""
+    def keep_clear_of(self, *pills: Gtk.Widget) -> None:
+        """Start the column under the motion pills (the map's, the camera page's) while one is shown
+        where the column would cover it: a banner never hides what the robot is doing. Called by the
+        window's timer; the margin only changes when it must (no relayout otherwise)."""
         top = MARGIN_TOP
         parent = self.get_parent()
-        if parent is not None and widget.get_mapped() and self._order:
-            ok_pill, pill = widget.compute_bounds(parent)
-            ok_own, own = self.compute_bounds(parent)
-            if ok_pill and ok_own:
-                left, right = own.get_x(), own.get_x() + own.get_width()
-                if left < pill.get_x() + pill.get_width() and pill.get_x() < right:
-                    top = max(top, round(pill.get_y() + pill.get_height()) + MARGIN_TOP // 2)
+        ok_own, own = self.compute_bounds(parent) if parent is not None else (False, None)
+        for pill in pills:
+            if parent is None or not ok_own or own is None or not pill.get_mapped() or not self._order:
+                continue
+            ok_pill, box = pill.compute_bounds(parent)
+            left, right = own.get_x(), own.get_x() + own.get_width()
+            if ok_pill and left < box.get_x() + box.get_width() and box.get_x() < right:
+                top = max(top, round(box.get_y() + box.get_height()) + MARGIN_TOP // 2)
         if self.get_margin_top() != top:
             self.set_margin_top(top)
 

@@ -31,7 +31,7 @@ from ..values.intents import AnswerPopup, GotoGoal, GotoPose, Localize  # noqa: 
 from .dpad import DPad  # noqa: E402
 from .layers import LayersPanel  # noqa: E402
 from .mapview import MapStage  # noqa: E402
-from .motion import MotionIndicator  # noqa: E402
+from .motion import MotionIndicator, held_by  # noqa: E402
 from .nav_draw import Marker, MarkerKind  # noqa: E402
 from .notes import map_note  # noqa: E402
 from .pip import PictureInPicture  # noqa: E402
@@ -194,11 +194,8 @@ class MapPage(Gtk.Overlay):
         self.robot.session.controller.run("stop")
 
     def _drive_held(self) -> str:
-        """What holds a live drive: ``dpad``, ``keys``, ``pad`` (the gamepad's dead-man); "" none."""
-        controller = self.robot.session.controller
-        if controller.held:
-            return "dpad" if self.dpad.held else "keys"
-        return "pad" if controller.analog_active else ""
+        """What holds a live drive (``motion.held_by``)."""
+        return held_by(self.robot.session.controller, bool(self.dpad.held))
 
     def let_go(self) -> None:
         """STOP, a switch of robot: a finger on the D-pad is let go of and a pick mode ends."""

@@ -14,6 +14,7 @@ the pill gives way to the link banner, which then says the robot is on its own.
 from __future__ import annotations
 
 from collections.abc import Callable
+from typing import Protocol
 
 import gi
 
@@ -25,6 +26,23 @@ from ..model.observables import Phase, RobotModel  # noqa: E402
 from .nav_text import motion_text  # noqa: E402
 
 KINDS = ("autonomous", "held")
+
+
+class _Held(Protocol):
+    """The controller's view of a held drive (``control.controller.Controller``)."""
+
+    @property
+    def held(self) -> frozenset[str]: ...
+
+    @property
+    def analog_active(self) -> bool: ...
+
+
+def held_by(controller: _Held, dpad_held: bool) -> str:
+    """What holds a live drive: ``dpad``, ``keys``, ``pad`` (the gamepad's dead-man); "" none."""
+    if controller.held:
+        return "dpad" if dpad_held else "keys"
+    return "pad" if controller.analog_active else ""
 
 
 class MotionIndicator(Gtk.Box):

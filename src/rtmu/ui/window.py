@@ -347,7 +347,7 @@ class MainWindow(Gtk.ApplicationWindow):
         self.controller.tick()
         slow = self.ticks % REFRESH_EVERY == 0
         self.map_page.refresh(slow)
-        self.banners.keep_clear_of(self.motion)
+        self.banners.keep_clear_of(self.motion, self.camera_page.motion)
         if slow:
             self.toolbar.refresh()
             self.camera_page.tick()
