@@ -153,7 +153,17 @@ def test_replay_draws_the_recorded_robot_pauses_scrubs_and_never_drives(
         assert runner is not None
         runner.submit(lambda: time.sleep(1.2))
         end_at = time.monotonic() + 2.0
-        pump(lambda: topics.update(gui.window.banners.topics()) or time.monotonic() > end_at, 5, "2 s")
+        stale: list[object] = []
+
+        def watch() -> bool:
+            topics.update(gui.window.banners.topics())
+            cell = gui.window.toolbar.cells["x"]
+            if cell.stale:
+                stale.append((gui.model.health.value.level, gui.phase, cell.get_tooltip_text()))
+            return time.monotonic() > end_at
+
+        pump(watch, 5, "2 s")
+        assert not stale, f"stale markers while the recording plays on: {stale[:3]}"
         assert "loop" not in topics, "a replay raised the network-thread alarm"
     finally:
         gui.close()
