@@ -86,5 +86,13 @@ def test_banners_leave_the_navigation_pill_visible(gui: Gui) -> None:
     gui.shot("camera-page-360x720")
     covering = [b for b in _drawn_banners(gui) if _overlap(b, box)]
     assert not covering, f"on the camera page banners {covering} cover the pill {box}"
+    # The bar's word buttons are icons on a phone (their words were cut to a letter), words in the tip.
+    view = window.camera
+    pump(lambda: view.compact, 3, "the compact camera bar")
+    assert view.back_button.get_icon_name() == "go-previous-symbolic"
+    assert view.back_button.get_tooltip_text() == "Back to map (Esc)"
+    window.set_default_size(1280, 800)
+    pump(lambda: not view.compact, 5, "the words back on a wide window")
+    assert view.back_button.get_label() == "Back to map (Esc)"
     gui.key("space")
     pump(lambda: window.motion.kind == "", 5, "Space to end the navigation")

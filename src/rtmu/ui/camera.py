@@ -30,6 +30,8 @@ INSET_MIN_WIDTH = 96
 INSET_OLD_AFTER = 3.0
 """Seconds after which the inset's picture is greyed and called old: live video is 15 pictures a
 second and one request answers in well under a second, so an older one is no view of now."""
+COMPACT_BAR_BELOW = 620
+"""Page width (px) under which the bar's "New picture" and "Back to map" become icons."""
 MAX_JPEG_BYTES = 16 * 1024 * 1024
 REQUEST_TIMEOUT = 7.0
 """Seconds the page waits for a requested picture before saying none came."""
@@ -202,12 +204,10 @@ class CameraView(Gtk.Box):
         back = Gtk.Button.new_with_label("Back to map (Esc)")
         back.set_focusable(False)
         back.connect("clicked", lambda _b: on_back())
-        # On a phone's 360 px the two labels shrink (ellipsized) rather than make the window wider.
-        for button in (self.refresh_button, back):
-            label = button.get_child()
-            if isinstance(label, Gtk.Label):
-                label.set_ellipsize(Pango.EllipsizeMode.END)
-                button.set_tooltip_text(label.get_text())
+        self.back_button = back
+        self.compact = False
+        self._refresh_tip = "New picture"
+        self._words_on_buttons()
         for w in (self.info, self.refresh_button, back):
             bar.append(w)
         self.append(bar)
@@ -266,10 +266,41 @@ class CameraView(Gtk.Box):
 
     def set_available(self, enabled: bool, reason: str) -> None:
         self.refresh_button.set_sensitive(enabled)
-        self.refresh_button.set_tooltip_text("New picture" if enabled else f"Camera picture: {reason}")
+        self._refresh_tip = "New picture" if enabled else f"Camera picture: {reason}"
+        self.refresh_button.set_tooltip_text(self._refresh_tip)
+
+    def _buttons(self) -> tuple[tuple[Gtk.Button, str, str, str], ...]:
+        """(button, its words, its icon, its tooltip)."""
+        return (
+            (self.refresh_button, "New picture", "camera-photo-symbolic", self._refresh_tip),
+            (self.back_button, "Back to map (Esc)", "go-previous-symbolic", "Back to map (Esc)"),
+        )
+
+    def _words_on_buttons(self) -> None:
+        for button, words, _icon, tip in self._buttons():
+            button.set_label(words)
+            label = button.get_child()
+            if isinstance(label, Gtk.Label):  # shrinks (ellipsized) rather than widen the window
+                label.set_ellipsize(Pango.EllipsizeMode.END)
+            button.set_tooltip_text(tip)
+
+    def fit_bar(self, width: int) -> None:
+        """Under :data:`COMPACT_BAR_BELOW` px the two word buttons become icons (their words in the
+        tooltip): on a phone the words were cut to a letter."""
+        compact = 0 < width < COMPACT_BAR_BELOW
+        if compact == self.compact:
+            return
+        self.compact = compact
+        if compact:
+            for button, _words, icon, tip in self._buttons():
+                button.set_icon_name(icon)
+                button.set_tooltip_text(tip)
+        else:
+            self._words_on_buttons()
 
     def tick(self) -> None:
-        """Update the age line; give up on a request that took too long."""
+        """Update the age line; give up on a request that took too long; fit the bar to the width."""
+        self.fit_bar(self.get_width())
         now = self.clock()
         if self.requested_at is not None and now - self.requested_at > REQUEST_TIMEOUT:
             self.failed(f"No picture arrived within {REQUEST_TIMEOUT:.0f} s.")
