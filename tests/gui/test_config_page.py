@@ -224,6 +224,10 @@ def test_escape_with_an_unsaved_edit_asks_before_discarding_it(gui: Gui, sim: Si
     assert page(gui) is p and p.edits == {("Teleop", "Timeout"): "0.70"}, "closed or lost the edit"
     assert "1 unsaved edit" in p.discard.label.get_text()
     gui.render(p, gui.shots / f"{gui.name}-asks.png")
+    stops = sim.call(lambda: len(sim.server.stop_log))  # type: ignore[union-attr]
+    gui.key("space")  # the stop key still stops while the page asks (and answers nothing)
+    pump(lambda: sim.call(lambda: len(sim.server.stop_log)) > stops, 3, "Space to send a stop")  # type: ignore[union-attr]
+    assert p.discard.asking and page(gui) is p, "Space answered the question"
     gui.key("Escape")  # answers "keep editing"
     pump(lambda: not p.discard.asking, 3, "the question to go")
     assert page(gui) is p and p.edits
