@@ -149,6 +149,11 @@ def test_edit_save_accepted_then_a_refused_value_shows_the_servers_error(gui: Gu
     red, green = red_and_green(gui, p.rows[("Teleop", "Timeout")][2])
     assert green > 20 and red == 0
     gui.render(p, gui.shots / f"{gui.name}-accepted.png")
+    _change_from_another_client(sim, {"Teleop": {"Timeout": "4"}})
+    pump(lambda: answer(p, "Teleop", "Timeout") == "", 5, "the tick to go once another value is held")
+    fetches = p.fetches
+    _change_from_another_client(sim, {"Teleop": {"Timeout": "0.5"}})  # back, for what follows
+    pump(lambda: p.fetches > fetches and not p.fetching, 5, "the page to fetch again")
 
     _param, spin, _label = p.rows[("Teleop", "Timeout")]
     type_into(gui, spin, "0.05")  # within the limits, refused by the server for its own reason
@@ -166,6 +171,20 @@ def test_edit_save_accepted_then_a_refused_value_shows_the_servers_error(gui: Gu
     gui.shot("main-window-behind")
 
 
+def _change_from_another_client(sim: SimThread, changes: dict[str, dict[str, str]]) -> None:
+    import asyncio
+
+    async def other() -> str:
+        client = AriaClient()
+        await client.connect("127.0.0.1", sim.port, timeout=5)
+        try:
+            return (await set_config(client, changes, 5)).error
+        finally:
+            await client.disconnect()
+
+    assert asyncio.run(other()) == ""
+
+
 def test_inline_validation_blocks_save_and_typing_never_drives(gui: Gui, sim: SimThread) -> None:
     p = open_page(gui)
     choose_section(gui, p, "Robot config")
@@ -176,16 +195,48 @@ def test_inline_validation_blocks_save_and_typing_never_drives(gui: Gui, sim: Si
     red, _green = red_and_green(gui, p.rows[("Robot config", "TransVelMax")][2])
     assert red > 20
     gui.render(p, gui.shots / f"{gui.name}-inline.png")
-    gui.key("Tab")  # the spin button clamps to its limit: the server's own value, nothing left to save
-    pump(lambda: not p.edits and answer(p, "Robot config", "TransVelMax") == "", 3, "the edit to go")
+    gui.key("Tab")  # never clamped to 1500 without a word: the held value stays, the row says why
+    pump(lambda: not p.edits, 3, "the wrong edit to go")
+    said = answer(p, "Robot config", "TransVelMax")
+    assert said.startswith("✗ 99999 not taken: above the maximum of 1500 (still "), said
+    assert spin.get_value() != 1500 or said.endswith("(still 1500)"), "clamped to the limit"
+    gui.render(p, gui.shots / f"{gui.name}-refused-in-words.png")
     gui.key("Up", "Up", "w", "space")  # drive keys in the main window; here they only edit
     idle(0.5)
     robot = sim.call(lambda: (sim.server.robot.vel, sim.server.world.ratio_mode.trans_ratio))  # type: ignore[union-attr]
     assert robot == (0, 0)
     assert sim.call(lambda: sim.server.world.mode.NAME) != "ratioDrive"  # type: ignore[union-attr]
     gui.key("Escape")
+    if p.edits:  # Up in a spin button edits it: Escape asks before the edit is lost
+        pump(lambda: p.discard.asking, 3, "the discard question")
+        click(gui, p.discard.discard_button)
     pump(lambda: page(gui) is None, 3, "Escape to close the page")
     gui.shot("closed")
+
+
+def test_escape_with_an_unsaved_edit_asks_before_discarding_it(gui: Gui, sim: SimThread) -> None:
+    p = open_page(gui)
+    _param, spin, _label = p.rows[("Teleop", "Timeout")]
+    type_into(gui, spin, "0.7")
+    pump(lambda: p.edits.get(("Teleop", "Timeout")) == "0.70", 3, "the edit")
+    gui.key("Escape")
+    pump(lambda: p.discard.asking, 3, "the question")
+    assert page(gui) is p and p.edits == {("Teleop", "Timeout"): "0.70"}, "closed or lost the edit"
+    assert "1 unsaved edit" in p.discard.label.get_text()
+    gui.render(p, gui.shots / f"{gui.name}-asks.png")
+    stops = sim.call(lambda: len(sim.server.stop_log))  # type: ignore[union-attr]
+    gui.key("space")  # the stop key still stops while the page asks (and answers nothing)
+    pump(lambda: sim.call(lambda: len(sim.server.stop_log)) > stops, 3, "Space to send a stop")  # type: ignore[union-attr]
+    assert p.discard.asking and page(gui) is p, "Space answered the question"
+    gui.key("Escape")  # answers "keep editing"
+    pump(lambda: not p.discard.asking, 3, "the question to go")
+    assert page(gui) is p and p.edits
+    p.close()  # the title bar's close asks too
+    pump(lambda: p.discard.asking, 3, "the question on close")
+    assert page(gui) is p
+    click(gui, p.discard.discard_button)
+    pump(lambda: page(gui) is None, 3, "Discard and close to close the page")
+    assert sim.call(lambda: sim.server.world.ratio_mode.timeout) != 0.7  # type: ignore[union-attr]
 
 
 def test_another_clients_change_refreshes_without_losing_an_edit(gui: Gui, sim: SimThread) -> None:
@@ -261,7 +312,9 @@ def test_ten_thousand_parameters_with_markup_open_bounded_and_responsive(
     gui = Gui.start(screenshots, "config-hostile", "127.0.0.1", hostile.port)
     try:
         p = open_page(gui)
-        assert p.config is not None and p.config.param_count == 10_016  # TransDecel, RotDecel, a hostile name
+        assert (
+            p.config is not None and p.config.param_count == 10_015
+        )  # TransDecel, RotDecel, a hostile name (the separator is none)
         choose_section(gui, p, "<b>Extra</b> & 0")
         pump(lambda: len(p.rows) == PAGE_SIZE, 5, "one page of rows")
         shown = labels(p.grid)

@@ -189,10 +189,13 @@ class WindowActions:
         return self.states.get(name, UNKNOWN)
 
     def _camera(self) -> None:
-        """Esc and the camera button: a pick mode ends first; else camera ⇄ map."""
+        """Esc and the camera button: a pick mode ends first, then the Layers panel closes; else
+        camera ⇄ map."""
         w = self.window
         if w.picker.active:
             w.picker.cancel()
+        elif w.layers.get_visible():
+            w.layers.close()
         else:
             w.camera_page.toggle()
 

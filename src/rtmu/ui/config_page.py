@@ -11,7 +11,8 @@ What the operator typed and what the server answered live in a GTK-free
 :class:`~rtmu.ui.config_edits.ConfigEdits` (kept across sections, pages, the priority filter and
 refreshes); this window shows it. When another client changes the configuration (``configUpdated``)
 the page fetches it again, updates what the operator has not touched and says what changed — and
-which of the operator's own unsaved edits the other client changed under them. Requests go as
+which of the operator's own unsaved edits the other client changed under them. Closing it (Escape,
+the title bar) with unsaved edits asks first (``ui.discard_question``). Requests go as
 intents (``FetchConfig``, ``SetConfig``) through the window's ``request``: the selected robot's.
 A robot whose configuration RTMU cannot edit yet (an Omron LD robot's ``getConfigValues``) gets the
 plain sentence of which API it has, and a button to read it raw in the console (``console_page``).
@@ -37,6 +38,7 @@ from ..client.config_feed import MAX_TEXT, ConfigSection, ForeignConfig, ServerC
 from ..protocol.payloads.config import ConfigParam, ParamType, Priority, SetConfigReply  # noqa: E402
 from ..values.intents import FetchConfig, Intent  # noqa: E402
 from .config_edits import ConfigEdits, Key  # noqa: E402
+from .discard_question import DiscardQuestion  # noqa: E402
 
 Request = Callable[[Intent], "concurrent.futures.Future[Any]"]
 """The window's ``request``: an intent to the selected robot, its answer as a Future."""
@@ -79,6 +81,7 @@ class ConfigPage(Gtk.Window):
         self._again = ""
         self.saving = False
         self.closed = False
+        self._discarding = False
         self._build()
         self._follow(self.remote_changed)
         self.connect("close-request", self._closing)
@@ -122,6 +125,8 @@ class ConfigPage(Gtk.Window):
         self.banner.add_css_class("config-banner")
         self.banner.set_visible(False)
         box.append(self.banner)
+        self.discard = DiscardQuestion(self._discard_and_close)
+        box.append(self.discard)
         self.console_button = Gtk.Button(
             label="Read it in the console…", halign=Gtk.Align.START, visible=False
         )
@@ -163,14 +168,28 @@ class ConfigPage(Gtk.Window):
 
     def _key(self, _c: Gtk.EventControllerKey, keyval: int, _code: int, _state: object) -> bool:
         if keyval == Gdk.KEY_Escape:
-            self.close()
+            if self.discard.asking:  # Escape answers the question the safe way: keep editing
+                self.discard.dismiss()
+            else:
+                self.close()
             return True
         return False  # every other key stays in this window: it never reaches the drive keys
 
     def _closing(self, _w: Gtk.Window) -> bool:
+        focus = self.get_focus()
+        spin = focus.get_ancestor(Gtk.SpinButton) if focus is not None else None
+        if isinstance(spin, Gtk.SpinButton):
+            spin.update()  # what it holds now decides whether there is an edit to lose
+        if self.state.edits and not self._discarding:  # never lose an edit without asking
+            self.discard.ask(len(self.state.edits))
+            return True
         self.closed = True
         self._follow(None)
         return False
+
+    def _discard_and_close(self) -> None:
+        self._discarding = True
+        self.close()
 
     def _console(self) -> None:
         """The console, filtered to the robot's configuration data (read raw: the layouts are not public)."""
@@ -350,6 +369,9 @@ class ConfigPage(Gtk.Window):
             step = 1.0 if p.kind is ParamType.INT else 10.0**-digits
             spin = Gtk.SpinButton.new_with_range(lo, max(lo, hi), step)
             spin.set_digits(digits)
+            # Out of its limits, the held value comes back (and the row says what was not taken),
+            # never the limit in its place without a word.
+            spin.set_update_policy(Gtk.SpinButtonUpdatePolicy.IF_VALID)
             with contextlib.suppress(ValueError):
                 spin.set_value(float(text))
             spin.connect("changed", lambda s: self._edited(key, s.get_text()))
@@ -401,6 +423,8 @@ class ConfigPage(Gtk.Window):
             return
         self.save_button.set_sensitive(self.state.can_save(self.saving))
         self.status.set_text(self.state.status())
+        if not self.state.edits:
+            self.discard.dismiss()  # saved (or typed back) meanwhile: nothing left to lose
 
     def save(self) -> None:
         """Send every edit in one ``setConfig``; the answer is shown next to each parameter."""

@@ -29,6 +29,7 @@ from ..model.observables import ConnectionState, LinkLevel, OperatorState, Phase
 from .gauges import BatteryGauge, WifiGauge, battery_fraction, wifi_bars  # noqa: E402
 from .ld_status import details_lines, goal_suffix  # noqa: E402
 from .nav_text import loc_level, loc_text, outcome_status  # noqa: E402
+from .notes import heading_text  # noqa: E402
 
 STALE_AFTER = 1.0
 """Seconds after which a pose/battery value is shown as stale (status arrives at 10 Hz)."""
@@ -210,7 +211,7 @@ class StatusToolbar(Gtk.ScrolledWindow):
         c = self.cells
         c["x"].show_value(f"{robot.x / 1000:.2f}" if have else DASH, stale=stale, tooltip=why)
         c["y"].show_value(f"{robot.y / 1000:.2f}" if have else DASH, stale=stale, tooltip=why)
-        c["th"].show_value(f"{robot.th:.0f}°" if have else DASH, stale=stale, tooltip=why)
+        c["th"].show_value(heading_text(robot.th) if have else DASH, stale=stale, tooltip=why)
         c["vel"].show_value(f"{robot.vel:.0f}" if have else DASH, stale=stale, tooltip=why)
         c["rot"].show_value(f"{robot.rot_vel:.0f}" if have else DASH, stale=stale, tooltip=why)
         self._battery(robot, stale, why)

@@ -353,12 +353,15 @@ class MainWindow(Gtk.ApplicationWindow):
         self.why_hint.tick()
         slow = self.ticks % REFRESH_EVERY == 0
         self.map_page.refresh(slow)
+        self.banners.keep_clear_of(self.motion, self.camera_page.motion)
         if slow:
             self.toolbar.refresh()
             self.camera_page.tick()
             loop_lag = getattr(self.controller.link, "loop_lag", None)  # a stalled network thread: said
-            connected = self.model.connection.value.phase is Phase.CONNECTED
+            # A replay sends nothing (and its clock is the recording's): no "stops are not going out".
+            connected = self.model.connection.value.phase is Phase.CONNECTED and not self.controller.replay
             self.notices.loop_lag(loop_lag() if callable(loop_lag) else None, connected)
+            self.notices.link_health(self.model.health.value.level)
         return True
 
     def _beat(self) -> bool:

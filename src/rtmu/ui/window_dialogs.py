@@ -35,6 +35,7 @@ from ..values.intents import (  # noqa: E402
     TurnBy,
     WatchStrings,
 )
+from .about import about_dialog  # noqa: E402
 from .banners import BannerStack  # noqa: E402
 from .config_page import ConfigPage  # noqa: E402
 from .console_page import ConsolePage  # noqa: E402
@@ -92,8 +93,8 @@ class WindowDialogs:
 
     def open_settings(self) -> None:
         profiles = dict(self.profiles)
-        current = self.robot.session.controller.profile
-        profiles.setdefault(current.name, current)
+        current = self.robot.session.controller.current_profile()  # the speed and view as they are now:
+        profiles[current.name] = current  # Save keeps them (never the speed the profile was opened with)
         self.settings = ConnectionDialog(
             self.window,
             profiles,
@@ -110,7 +111,7 @@ class WindowDialogs:
         if self._profile_saved is not None:
             self._profile_saved(profile, password)
         controller = self.robot.session.controller
-        changed = profile != controller.profile
+        changed = profile != controller.current_profile()
         controller.select_profile(profile)
         self._profile_changed()
         if changed and self.model.connection.value.phase is not Phase.DISCONNECTED:
@@ -200,16 +201,7 @@ class WindowDialogs:
     def show_about(self) -> None:
         from .. import __version__
 
-        about = Gtk.AboutDialog(
-            transient_for=self.window,
-            modal=True,
-            program_name="RTMU",
-            version=__version__,
-            comments="Robot Teleoperation, Mobile User interface: drive an ARIA (ArNetworking) robot "
-            "from a tablet or a laptop.",
-            logo_icon_name="io.github.rtmu.Rtmu",
-            license_type=Gtk.License.MIT_X11,
-        )
+        about = about_dialog(self.window, __version__)
         about.present()
 
     # -- the controller's dialogs: Turn, Go, the palette -----------------------------------------

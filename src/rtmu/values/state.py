@@ -58,7 +58,8 @@ class RobotState:
     """``getModeInfo``: the locked mode gives way when another mode asks (the dock backs out first)."""
     safe_drive: bool | None = None
     wifi_quality: int | None = None
-    """Link quality as the server publishes it (a ``getStrings`` item); None if not offered."""
+    """Link quality in % (a ``getStrings`` item's 0–70, an LD robot's DataStore item, turned into %);
+    None if not offered."""
     wifi_signal: int | None = None
     """Signal level (dBm on Linux) from a ``getStrings`` item; None if not offered."""
     sonar: tuple[tuple[int, int], ...] = ()
