@@ -136,7 +136,8 @@ def red_and_green(gui: Gui, widget) -> tuple[int, int]:  # type: ignore[no-untyp
 
 def test_edit_save_accepted_then_a_refused_value_shows_the_servers_error(gui: Gui, sim: SimThread) -> None:
     p = open_page(gui)
-    assert [s.name for s in p.config.sections] == ["Teleop", "Robot config", "Camera", "Battery", "Wi-Fi"]  # type: ignore[union-attr]
+    names = [s.name for s in p.config.sections]  # type: ignore[union-attr]
+    assert names == ["Teleop", "Robot config", "Camera", "Battery", "Wi-Fi", "Files"]
     gui.render(p, gui.shots / f"{gui.name}-opened.png")
     _param, spin, _label = p.rows[("Teleop", "Timeout")]
     type_into(gui, spin, "0.5")
@@ -261,14 +262,15 @@ def test_ten_thousand_parameters_with_markup_open_bounded_and_responsive(
     gui = Gui.start(screenshots, "config-hostile", "127.0.0.1", hostile.port)
     try:
         p = open_page(gui)
-        assert p.config is not None and p.config.param_count == 10_016  # TransDecel, RotDecel, a hostile name
+        # the simulator's own, TransDecel, RotDecel, Files/Map and a hostile name
+        assert p.config is not None and p.config.param_count == 10_017
         choose_section(gui, p, "<b>Extra</b> & 0")
         pump(lambda: len(p.rows) == PAGE_SIZE, 5, "one page of rows")
         shown = labels(p.grid)
         assert ("P0<i>&amp;", False) in shown and ("<u>filler</u> 0 & <big>text</big>", False) in shown
         assert ("<b>7</b>", False) in shown  # a choice list's item, as the drop-down shows it
         assert not any(markup for _text, markup in shown)
-        assert p.sections.get_row_at_index(5).get_child().get_text() == "<b>Extra</b> & 0"
+        assert p.sections.get_row_at_index(6).get_child().get_text() == "<b>Extra</b> & 0"
         assert p.comment.get_text() == "<i>filler</i> & <span foreground='red'>markup</span>"
         names = [p.sections.get_row_at_index(i).get_child().get_text() for i in range(len(p.config.sections))]
         assert "Line\\rbreak\\nand \\x1b[2Jescape" in names, names  # one line, its controls shown
