@@ -93,6 +93,7 @@ class WindowActions:
         self._plain("camera", self._camera)
         self._plain("settings", w.dialogs.open_settings)
         self._plain("server-config", w.dialogs.show_server_config)
+        self._plain("files", w.commissioning.show_files)
         self._plain("details", w.dialogs.show_details)
         self._plain("about", w.dialogs.show_about)
         self._plain("layers", w.layers.open)
@@ -272,6 +273,7 @@ class WindowActions:
         server = Gio.Menu()  # the connection and the server's own settings: one row, so the menu still fits
         server.append_item(menu_item("Connection settings…", "win.settings"))
         server.append_item(menu_item("Configuration…", "win.server-config"))
+        server.append_item(menu_item("Files on the robot…", "win.files"))
         app.append_submenu("Server", server)
         app.append_submenu("View", view)
         app.append_item(menu_item("Keyboard shortcuts", "win.show-help-overlay"))

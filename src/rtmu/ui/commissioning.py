@@ -1,0 +1,47 @@
+"""Commissioning a robot from the window: its files page, and (``scan_mode``) scanning for a map.
+
+The window builds one :class:`Commissioning` and its actions open what it holds (Server ▸ Files on
+the robot…). Each part asks the *selected* robot through intents (``SelectedRobot``) and follows the
+selection; this class only keeps one of each open.
+"""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+import gi
+
+gi.require_version("Gtk", "4.0")
+from gi.repository import Gtk  # noqa: E402
+
+from ..fleet.selected import SelectedRobot  # noqa: E402
+from ..model.observables import RobotModel  # noqa: E402
+from .files_page import FilesPage  # noqa: E402
+
+
+def default_downloads() -> Path:
+    """Where downloads go until the operator picks a folder: ~/Downloads where it exists, else ~."""
+    home = Path.home()
+    downloads = home / "Downloads"
+    return downloads if downloads.is_dir() else home
+
+
+class Commissioning:
+    """See the module notes."""
+
+    def __init__(self, window: Gtk.Window, robot: SelectedRobot, model: RobotModel) -> None:
+        self.window, self.robot, self.model = window, robot, model
+        self.files_page: FilesPage | None = None
+        """The files page last opened."""
+
+    def show_files(self) -> None:
+        """The robot's files (a window of its own): one at a time."""
+        page = self.files_page
+        if page is None or page.closed:
+            downloads = default_downloads()
+            page = self.files_page = FilesPage(self.window, self.robot, self.model, downloads=downloads)
+        page.present()
+
+    def close(self) -> None:
+        if self.files_page is not None and not self.files_page.closed:
+            self.files_page.close()
