@@ -1,12 +1,14 @@
 """Commissioning a robot from the window: its files page, and (``scan_mode``) scanning for a map.
 
 The window builds one :class:`Commissioning` and its actions open what it holds (Server ▸ Files on
-the robot…). Each part asks the *selected* robot through intents (``SelectedRobot``) and follows the
-selection; this class only keeps one of each open.
+the robot…, Server ▸ Scan a map…); the scanning banner sits under the toolbar. Each part asks the
+*selected* robot through intents (``SelectedRobot``) and follows the selection; this class only
+keeps one of each open.
 """
 
 from __future__ import annotations
 
+from collections.abc import Callable
 from pathlib import Path
 
 import gi
@@ -17,6 +19,7 @@ from gi.repository import Gtk  # noqa: E402
 from ..fleet.selected import SelectedRobot  # noqa: E402
 from ..model.observables import RobotModel  # noqa: E402
 from .files_page import FilesPage  # noqa: E402
+from .scan_mode import ScanBar  # noqa: E402
 
 
 def default_downloads() -> Path:
@@ -29,10 +32,26 @@ def default_downloads() -> Path:
 class Commissioning:
     """See the module notes."""
 
-    def __init__(self, window: Gtk.Window, robot: SelectedRobot, model: RobotModel) -> None:
+    def __init__(
+        self,
+        window: Gtk.Window,
+        robot: SelectedRobot,
+        model: RobotModel,
+        *,
+        column: Gtk.Box,
+        after: Gtk.Widget,
+        clock: Callable[[], float],
+    ) -> None:
         self.window, self.robot, self.model = window, robot, model
         self.files_page: FilesPage | None = None
         """The files page last opened."""
+        self.scan_bar = ScanBar(window, robot, model, clock)
+        """The scanning banner, in the window's ``column`` right under ``after`` (the toolbar)."""
+        column.insert_child_after(self.scan_bar, after)
+
+    def scan(self) -> None:
+        """Server ▸ Scan a map…"""
+        self.scan_bar.open_dialog()
 
     def show_files(self) -> None:
         """The robot's files (a window of its own): one at a time."""
@@ -43,5 +62,6 @@ class Commissioning:
         page.present()
 
     def close(self) -> None:
+        self.scan_bar.close()
         if self.files_page is not None and not self.files_page.closed:
             self.files_page.close()

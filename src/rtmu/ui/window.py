@@ -153,7 +153,11 @@ class MainWindow(Gtk.ApplicationWindow):
             keyring_available=keyring_available, profile_saved=profile_saved,
             profile_changed=lambda: self._update_header(self.model.connection.value),
         )  # fmt: skip
-        self.commissioning = Commissioning(self, self.robot, model)  # files, scanning for a map
+        self.commissioning = (
+            Commissioning(  # the robot's files, scanning for a map (its bar: under the toolbar)
+                self, self.robot, model, column=self.column, after=self.toolbar_revealer, clock=clock
+            )
+        )
         if secrets is not None:
             self.controller.secrets = secrets
         self.robot_view = _View(self)
