@@ -220,3 +220,45 @@ def test_a_user_without_file_access_sees_every_feature_greyed_with_the_reason(
             gui.render(page, gui.shots / f"{gui.name}-greyed.png")
         finally:
             gui.close()
+
+
+def test_a_map_on_the_robot_made_its_map_with_real_clicks(
+    gui: Gui, sim: SimThread, robot_files: Path
+) -> None:
+    page = open_page(gui)
+    double_click(gui, row_named(page, "maps"))
+    pump(lambda: [e.name for e in page.shown] == ["Office.map"], 10, "maps/")
+    (robot_files / "maps" / "Other.map").write_bytes((robot_files / "maps" / "Office.map").read_bytes())
+    (robot_files / "maps" / "Broken.map").write_text("not a map\n")
+    (robot_files / "maps" / "readme.txt").write_text("maps of the site\n")
+    click(gui, page.refresh_button)
+    pump(lambda: len(page.shown) == 4, 10, "the new files listed")
+    click(gui, row_named(page, "readme.txt"))
+    assert not page.use_map_button.get_sensitive()  # only a .map can be the map
+    assert "select a .map file" in (page.use_map_button.get_tooltip_text() or "")
+    generation = gui.model.map.value.generation
+
+    # a file that is not a map: the robot refuses, its map stays
+    click(gui, row_named(page, "Broken.map"))
+    click(gui, page.use_map_button)
+    click(gui, confirmation(page).yes_button)
+    pump(lambda: "Switch map failed" in page.status.get_text(), 10, "the refusal")
+    assert (
+        "cannot be read as a map" in page.status.get_text() and gui.model.map.value.generation == generation
+    )
+    gui.render(page, gui.shots / f"{gui.name}-refused-map.png")
+
+    click(gui, row_named(page, "Other.map"))
+    click(gui, page.use_map_button)
+    ask = confirmation(page)
+    assert "“maps/Other.map” the robot's map" in ask.question.get_text()
+    click(gui, ask.yes_button)
+    pump(lambda: "now uses maps/Other.map" in page.status.get_text(), 15, "the switch")
+    pump(
+        lambda: gui.model.map.value.generation > generation and gui.model.map.value.state == "ready",
+        15,
+        "map",
+    )
+    assert "Other" in gui.model.map.value.name
+    gui.render(page, gui.shots / f"{gui.name}-switched.png")
+    gui.shot("window-after-switch")

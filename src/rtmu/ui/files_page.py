@@ -6,6 +6,9 @@ robot (``ListFiles``, ``DownloadFile``, ``UploadFile``, ``DeleteFile``) and foll
 Every name shown comes from the robot and is set as plain text; the client already refused a
 listing holding a name that is not one plain file name, and the page says so.
 
+A ``.map`` file can be made the robot's map (``SwitchMap``: ARNL's ``Files/Map``, then ``checkMap``),
+after a question; the window's map reloads on the server's ``mapUpdated``.
+
 Nothing is lost by a click: a delete asks first, naming the file; a download into a folder that
 already holds the name asks before replacing it (the client writes to a hidden file beside it and
 renames it only when complete); an upload over a file the robot lists asks too. Transfers show a
@@ -33,7 +36,7 @@ from ..fleet.sessions import RobotSession  # noqa: E402
 from ..model.observables import ConnectionState, Phase, RobotModel  # noqa: E402
 from ..protocol.payloads.files import DirEntry  # noqa: E402
 from ..values.commission import TransfersState  # noqa: E402
-from ..values.intents import DeleteFile, DownloadFile, Intent, ListFiles, UploadFile  # noqa: E402
+from ..values.intents import DeleteFile, DownloadFile, Intent, ListFiles, SwitchMap, UploadFile  # noqa: E402
 from .confirm import Confirm  # noqa: E402
 from .files_text import greyed, human_size, parent_of, remote_join, transfer_text, when  # noqa: E402
 
@@ -112,7 +115,9 @@ class FilesPage(Gtk.Window):
         self.delete_button = Gtk.Button(label="Delete…")
         self.delete_button.add_css_class("destructive-action")
         self.delete_button.connect("clicked", lambda _b: self.delete_selected())
-        for button in (self.download_button, self.upload_button, self.delete_button):
+        self.use_map_button = Gtk.Button(label="Use as the robot's map…")
+        self.use_map_button.connect("clicked", lambda _b: self.use_selected_map())
+        for button in (self.download_button, self.upload_button, self.delete_button, self.use_map_button):
             actions.append(button)
         box.append(actions)
         self.progress = Gtk.Box(orientation=Gtk.Orientation.VERTICAL, spacing=4)
@@ -144,6 +149,9 @@ class FilesPage(Gtk.Window):
         self.download_button.set_sensitive("download" not in missing and is_file)
         self.upload_button.set_sensitive("upload" not in missing)
         self.delete_button.set_sensitive("delete" not in missing and entry is not None)
+        switching = self._switch_problem(entry)
+        self.use_map_button.set_sensitive(not switching)
+        self.use_map_button.set_tooltip_text(switching or "Make this map the robot's (ARNL's Files/Map)")
         self.refresh_button.set_sensitive("list" not in missing)
         self.up_button.set_sensitive("list" not in missing and bool(self.folder))
         for button, feature in (
@@ -159,6 +167,17 @@ class FilesPage(Gtk.Window):
         said = list(dict.fromkeys(missing.values()))  # once each, in the page's order
         self.reason.set_text("\n".join(said))
         self.reason.set_visible(bool(said))
+
+    def _switch_problem(self, entry: DirEntry | None) -> str:
+        """Why the selection cannot become the robot's map ("" when it can)."""
+        conn = self.model.connection.value
+        if conn.phase is not Phase.CONNECTED:
+            return "not connected to a robot"
+        if not SwitchMap.offered(conn.offers):
+            return "this robot's configuration cannot be set (it offers no setConfig)"
+        if entry is None or not entry.is_file or not entry.name.lower().endswith(".map"):
+            return "select a .map file"
+        return ""
 
     def selected(self) -> DirEntry | None:
         row = self.rows.get_selected_row()
@@ -319,6 +338,33 @@ class FilesPage(Gtk.Window):
             self.refresh()
 
         self._ask(DeleteFile(remote), done, "Delete")
+
+    # -- switch map -------------------------------------------------------------------------------
+    def use_selected_map(self) -> None:
+        """Make the selected ``.map`` the robot's map (asked first: the robot loads it at once)."""
+        entry = self.selected()
+        if entry is None or self._switch_problem(entry):
+            return
+        remote = remote_join(self.folder, entry.name)
+        self._confirm(
+            f"Make “{visible(remote)}” the robot's map?",
+            "Use this map",
+            lambda: self._switch(remote),
+            detail="The robot loads it at once (ARNL's Files/Map parameter).",
+        )
+
+    def _switch(self, remote: str) -> None:
+        self._say(f"Switching the robot to {visible(remote)}…", error=False)
+
+        def done(updated: Any) -> None:
+            if updated:
+                self._say(f"The robot now uses {visible(remote)}", error=False)
+            else:
+                self._say(
+                    f"The robot took {visible(remote)} but has not said its map changed yet", error=False
+                )
+
+        self._ask(SwitchMap(remote), done, "Switch map")
 
     # -- plumbing ---------------------------------------------------------------------------------
     def _confirm(self, question: str, action: str, on_yes: Any, *, detail: str = "") -> None:
