@@ -71,6 +71,8 @@ def pick_each(gui: Gui, sim: SimThread, how: str) -> list[str]:
             "win.settings",
             "win.server-config",
             "win.files",
+            "win.scan",
+            "win.map-edit",
         ):
             pump(lambda: owned_windows(window), 5, f"{entry.name} to open its window")
         if len(cycle.proved) in (3, 12):

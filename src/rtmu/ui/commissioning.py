@@ -1,9 +1,9 @@
 """Commissioning a robot from the window: its files page, and (``scan_mode``) scanning for a map.
 
 The window builds one :class:`Commissioning` and its actions open what it holds (Server ▸ Files on
-the robot…, Server ▸ Scan a map…); the scanning banner sits under the toolbar. Each part asks the
-*selected* robot through intents (``SelectedRobot``) and follows the selection; this class only
-keeps one of each open.
+the robot…, Server ▸ Scan a map…, Server ▸ Edit the map…); the scanning banner sits under the
+toolbar. Each part asks the *selected* robot through intents (``SelectedRobot``) and follows the
+selection; this class only keeps one of each open.
 """
 
 from __future__ import annotations
@@ -19,6 +19,7 @@ from gi.repository import Gtk  # noqa: E402
 from ..fleet.selected import SelectedRobot  # noqa: E402
 from ..model.observables import RobotModel  # noqa: E402
 from .files_page import FilesPage  # noqa: E402
+from .map_edit_window import MapEditWindow  # noqa: E402
 from .scan_mode import ScanBar  # noqa: E402
 
 
@@ -45,9 +46,17 @@ class Commissioning:
         self.window, self.robot, self.model = window, robot, model
         self.files_page: FilesPage | None = None
         """The files page last opened."""
+        self.map_edit: MapEditWindow | None = None
+        """The map editing window last opened."""
         self.scan_bar = ScanBar(window, robot, model, clock)
         """The scanning banner, in the window's ``column`` right under ``after`` (the toolbar)."""
         column.insert_child_after(self.scan_bar, after)
+
+    def edit_map(self) -> None:
+        """Server ▸ Edit the map…: one draft window at a time."""
+        if self.map_edit is None or self.map_edit.closed:
+            self.map_edit = MapEditWindow(self.window, self.robot, self.model)
+        self.map_edit.present()
 
     def scan(self) -> None:
         """Server ▸ Scan a map…"""
@@ -63,5 +72,6 @@ class Commissioning:
 
     def close(self) -> None:
         self.scan_bar.close()
-        if self.files_page is not None and not self.files_page.closed:
-            self.files_page.close()
+        for page in (self.files_page, self.map_edit):
+            if page is not None and not page.closed:
+                page.close()
