@@ -30,13 +30,14 @@ gi.require_version("Pango", "1.0")
 from gi.repository import GLib, Gtk, Pango  # noqa: E402
 
 from ..base.textsafe import visible  # noqa: E402
+from ..client.config_care import map_param_problem  # noqa: E402
 from ..client.remote_files import Listing, local_name, wire_name  # noqa: E402
 from ..fleet.selected import SelectedRobot  # noqa: E402
 from ..fleet.sessions import RobotSession  # noqa: E402
 from ..model.observables import ConnectionState, Phase, RobotModel  # noqa: E402
 from ..protocol.payloads.files import DirEntry  # noqa: E402
 from ..values.commission import TransfersState  # noqa: E402
-from ..values.intents import DeleteFile, DownloadFile, Intent, ListFiles, SwitchMap, UploadFile  # noqa: E402
+from ..values.intents import DeleteFile, DownloadFile, FetchConfig, Intent, ListFiles, SwitchMap, UploadFile  # noqa: E402
 from .confirm import Confirm  # noqa: E402
 from .files_text import greyed, human_size, parent_of, remote_join, transfer_text, when  # noqa: E402
 
@@ -65,6 +66,8 @@ class FilesPage(Gtk.Window):
         self.closed = False
         self.confirm: Confirm | None = None
         """The confirmation open now (delete, replace), if any."""
+        self.map_param: str | None = None
+        """Why this robot's configuration cannot switch maps ("" when it can; None until read)."""
         self._build(downloads)
         self._unobserve = [
             model.transfers.observe(lambda _o, new: self._show_transfers(new)),
@@ -73,6 +76,7 @@ class FilesPage(Gtk.Window):
         self._unswitch = robot.on_switch(self._robot_switched)
         self.connect("close-request", self._closing)
         self._update_greyed()
+        self._check_map_param()
         self.refresh()
 
     # -- layout -----------------------------------------------------------------------------------
@@ -113,7 +117,6 @@ class FilesPage(Gtk.Window):
         self.upload_button = Gtk.Button(label="Upload…")
         self.upload_button.connect("clicked", lambda _b: self._choose_upload())
         self.delete_button = Gtk.Button(label="Delete…")
-        self.delete_button.add_css_class("destructive-action")
         self.delete_button.connect("clicked", lambda _b: self.delete_selected())
         self.use_map_button = Gtk.Button(label="Use as the robot's map…")
         self.use_map_button.connect("clicked", lambda _b: self.use_selected_map())
@@ -175,9 +178,29 @@ class FilesPage(Gtk.Window):
             return "not connected to a robot"
         if not SwitchMap.offered(conn.offers):
             return "this robot's configuration cannot be set (it offers no setConfig)"
+        if self.map_param:
+            return self.map_param
         if entry is None or not entry.is_file or not entry.name.lower().endswith(".map"):
             return "select a .map file"
         return ""
+
+    def _check_map_param(self) -> None:
+        """Read the configuration once per connection: can it name the robot's map (``Files/Map``)?"""
+        if self.map_param is not None or not SwitchMap.offered(self.model.connection.value.offers):
+            return
+        self.map_param = ""
+
+        def read(future: concurrent.futures.Future[Any]) -> bool:
+            error = None if future.cancelled() else future.exception()
+            if future.cancelled() or error is not None:
+                self.map_param = f"this robot's configuration could not be read ({error or 'cancelled'})"
+            else:
+                self.map_param = map_param_problem(future.result())
+            if not self.closed:
+                self._update_greyed()
+            return False
+
+        self.robot.request(FetchConfig()).add_done_callback(lambda f: GLib.idle_add(read, f))
 
     def selected(self) -> DirEntry | None:
         row = self.rows.get_selected_row()
@@ -411,12 +434,17 @@ class FilesPage(Gtk.Window):
             self.progress.append(bar)
 
     def _connection_changed(self, old: ConnectionState, new: ConnectionState) -> None:
+        if new.phase is not Phase.CONNECTED:
+            self.map_param = None
         self._update_greyed()
         if new.phase is Phase.CONNECTED and old.phase is not Phase.CONNECTED:
+            self._check_map_param()
             self.refresh()
 
     def _robot_switched(self, _old: RobotSession, _new: RobotSession) -> None:
         self.folder = ""
+        self.map_param = None
+        self._check_map_param()
         self._update_greyed()
         self.refresh()
 

@@ -153,8 +153,8 @@ class ScanBar(Gtk.Revealer):
         self.loop_start.connect("clicked", lambda _b: self._tag(True))
         self.loop_end = Gtk.Button(label="Loop end", tooltip_text="Back where the loop began")
         self.loop_end.connect("clicked", lambda _b: self._tag(False))
-        self.stop_scan = Gtk.Button(label="Stop scan")
-        self.stop_scan.add_css_class("destructive-action")
+        # Not red: STOP is the only red button near the header (ui.bars); this one ends the log, not motion.
+        self.stop_scan = Gtk.Button(label="Stop scan", tooltip_text="End the scan (the robot is not stopped)")
         self.stop_scan.connect("clicked", lambda _b: self._stop())
         self.download = Gtk.Button(label="Download the scan…")
         self.download.add_css_class("suggested-action")
