@@ -202,3 +202,19 @@ def test_the_controller_refuses_autonomous_motion_while_scanning_but_stop_and_he
     model.scan.set(ScanState(offered=True, last_file="hall.2d"))
     ctl.ask(GotoGoal("Goal1"))
     assert ("goto_goal", "Goal1") in link.calls
+
+
+def test_a_scan_running_before_login_is_told_as_such(sim: SimThread) -> None:
+    first = Rig(sim.port)
+    try:
+        first.ask(StartScan("early"))
+    finally:
+        first.runner.close()
+    late = Rig(sim.port)  # the subscription's first answer and the status answer both say it runs
+    try:
+        late.wait(lambda: late.model.scan.value.scanning)
+        assert late.model.scan.value.file_name == "early.2d" and late.model.scan.value.since is None
+        late.ask(StopScan())
+        late.wait(lambda: late.model.scan.value.last_file == "early.2d")
+    finally:
+        late.runner.close()

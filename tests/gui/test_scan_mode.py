@@ -179,3 +179,47 @@ def test_scan_drive_tag_stop_and_download_with_stop_working_throughout(
 
     click(gui, bar.dismiss)
     pump(lambda: not bar.get_reveal_child(), 5, "the banner to go")
+
+
+def test_a_scan_started_elsewhere_shows_its_bar_and_guards_motion(
+    screenshots: Path, sim: SimThread, robot_files: Path
+) -> None:
+    from client.servers import run
+    from rtmu.client.connection import AriaClient
+    from rtmu.client.scan import start_scan, stop_scan
+
+    async def begin() -> None:
+        c = AriaClient()
+        await c.connect("127.0.0.1", sim.port, timeout=10)
+        try:
+            await start_scan(c, "early")
+        finally:
+            await c.disconnect()
+
+    run(begin(), 20)  # a scan already running before the window connects
+    gui = Gui.start(screenshots, "test_scan_started_elsewhere", "127.0.0.1", sim.port)
+    try:
+        bar = bar_of(gui)
+        pump(bar.get_reveal_child, 10, "the bar for a scan running at login")
+        assert "Scanning early" in bar.label.get_text()
+        assert "running before this connection" in bar.label.get_text(), gui.model.scan.value
+        gui.shot("scan-running-at-login")
+        dialog = open_dialog(gui)  # a second scan cannot be started: said, Start greyed
+        assert not dialog.start_button.get_sensitive()
+        assert "a scan is already running" in dialog.reason.get_text()
+        dialog.close()
+
+        async def end() -> None:
+            c = AriaClient()
+            await c.connect("127.0.0.1", sim.port, timeout=10)
+            try:
+                await stop_scan(c)
+            finally:
+                await c.disconnect()
+
+        run(end(), 20)  # another client ends it: the bar offers its download
+        pump(lambda: bar.download.get_visible(), 10, "the ended scan offered")
+        assert gui.model.scan.value.last_file.startswith("early")
+        gui.shot("scan-ended-elsewhere")
+    finally:
+        gui.close()

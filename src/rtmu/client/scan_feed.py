@@ -37,11 +37,13 @@ class ScanFeed(Feed):
         super().__init__(ctx)
         self.value = ScanState()
         self.bad_names = 0
+        self._login = False
 
     def subscriptions(self, client: AriaClient) -> Iterable[Subscription]:
         return (Subscription(MappingStatusBroadcast.DATA_NAME, -1, self._heard),)
 
     def connected(self, client: AriaClient) -> None:
+        self._login = True  # the first status heard tells what ran before this connection
         missing = scan_unavailable(client)
         self._set(ScanState(offered="scan" not in missing))
         if "scan_status" not in missing:
@@ -65,6 +67,7 @@ class ScanFeed(Feed):
 
     def _status(self, status: ScanStatus, *, at_login: bool = False) -> None:
         """The robot said which scan runs (a status answer names the scan, a broadcast its file)."""
+        at_login, self._login = at_login or self._login, False  # (a subscription's first answer too)
         old = self.value
         if status.file_name == old.file_name:
             return
@@ -89,6 +92,7 @@ class ScanFeed(Feed):
 
     async def _start(self, client: AriaClient, name: str) -> str:
         file_name = await start_scan(client, name, timeout=self.ctx.config.reply_timeout)
+        self._login = False  # started here and now, whatever was heard before
         self._status(ScanStatus(file_name))  # the broadcast says the same, later
         return file_name
 
