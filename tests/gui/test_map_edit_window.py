@@ -86,6 +86,12 @@ def test_a_draft_applied_as_one_change_is_seen_by_a_second_client(gui: Gui, sim:
             r.get_child().get_text() for r in _rows(w)
         ]
         gui.render(w, gui.shots / f"{gui.name}-draft.png")
+        # the map draws the draft, and a banner says it is one
+        drawn = gui.stage.draft_objects
+        assert drawn is not None and any(getattr(o, "name", "") == "Charger-side" for o in drawn)
+        assert any(getattr(o, "type", "") == "RobotHome" for o in drawn)  # the rest of the map stays drawn
+        assert "draft (2 edits), not applied" in (gui.window.banners.text("map-draft") or "")
+        gui.shot("draft-on-the-map")
         # undo and redo with their keys
         gui.xdotool("windowfocus", "--sync", str(GdkX11.X11Surface.get_xid(w.get_surface())))
         w.rows.grab_focus()
@@ -102,6 +108,7 @@ def test_a_draft_applied_as_one_change_is_seen_by_a_second_client(gui: Gui, sim:
         assert any(o.from_xy == (1000, 1000) and o.to_xy == (1000, 2500) for o in lines)
         pump(lambda: "Charger-side" in gui.model.navigation.value.goals, 10, "the window's goals")
         pump(lambda: w.state_label.get_text().startswith("No changes"), 10, "a fresh draft")
+        assert gui.stage.draft_objects is None and gui.window.banners.text("map-draft") is None
         gui.render(w, gui.shots / f"{gui.name}-applied.png")
 
         # another client's change under an open draft: said, the draft kept

@@ -17,10 +17,15 @@ gi.require_version("Gtk", "4.0")
 from gi.repository import Gtk  # noqa: E402
 
 from ..fleet.selected import SelectedRobot  # noqa: E402
+from ..mapfile import MapObject  # noqa: E402
 from ..model.observables import RobotModel  # noqa: E402
+from .banners import BannerStack  # noqa: E402
 from .files_page import FilesPage  # noqa: E402
 from .map_edit_window import MapEditWindow  # noqa: E402
+from .mapview import MapStage  # noqa: E402
 from .scan_mode import ScanBar  # noqa: E402
+
+DRAFT_TOPIC = "map-draft"
 
 
 def default_downloads() -> Path:
@@ -42,8 +47,11 @@ class Commissioning:
         column: Gtk.Box,
         after: Gtk.Widget,
         clock: Callable[[], float],
+        stage: MapStage | None = None,
+        banners: BannerStack | None = None,
     ) -> None:
         self.window, self.robot, self.model = window, robot, model
+        self.stage, self.banners = stage, banners
         self.files_page: FilesPage | None = None
         """The files page last opened."""
         self.map_edit: MapEditWindow | None = None
@@ -55,8 +63,24 @@ class Commissioning:
     def edit_map(self) -> None:
         """Server ▸ Edit the map…: one draft window at a time."""
         if self.map_edit is None or self.map_edit.closed:
-            self.map_edit = MapEditWindow(self.window, self.robot, self.model)
+            self.map_edit = MapEditWindow(self.window, self.robot, self.model, self._show_draft)
         self.map_edit.present()
+
+    def _show_draft(self, objects: tuple[MapObject, ...] | None, edits: int) -> None:
+        """The map draws a draft (or the robot's map again), and a banner says a draft is shown."""
+        if self.stage is not None:
+            self.stage.draft_objects = list(objects) if objects is not None else None
+            self.stage.queue_draw()
+        if self.banners is None:
+            return
+        if objects is None:
+            self.banners.dismiss(DRAFT_TOPIC)
+        else:
+            plural = "s" if edits != 1 else ""
+            text = (
+                f"The map shows a draft ({edits} edit{plural}), not applied: Apply or Discard in Edit the map"
+            )
+            self.banners.tell(DRAFT_TOPIC, "info", text, timeout=None)
 
     def scan(self) -> None:
         """Server ▸ Scan a map…"""

@@ -8,13 +8,16 @@ starts afresh on it. When the map changes under an open draft (another client's 
 kept, rebased on the new map, and what changed — and which edits now conflict — is said plainly. A
 change the server refuses leaves its map as it was and the draft as it is.
 
-What is typed is in mm and degrees; "Robot's pose" fills the fields from where the robot is. The
-draft is not drawn on the map yet: the list here is the draft.
+What is typed is in mm and degrees; "Robot's pose" fills the fields from where the robot is. While
+the draft holds edits, the map draws the draft's goals, docks and forbidden lines and areas instead
+of the robot's, and a banner says a draft is shown, not applied (``show_draft``); closing the window
+shows the robot's map again.
 """
 
 from __future__ import annotations
 
 import concurrent.futures
+from collections.abc import Callable
 from typing import Any
 
 import gi
@@ -55,10 +58,18 @@ def editable(objects: tuple[MapObject, ...] | list[MapObject]) -> list[MapObject
 class MapEditWindow(Gtk.Window):
     """See the module notes."""
 
-    def __init__(self, parent: Gtk.Window, robot: SelectedRobot, model: RobotModel) -> None:
+    def __init__(
+        self,
+        parent: Gtk.Window,
+        robot: SelectedRobot,
+        model: RobotModel,
+        show_draft: Callable[[tuple[MapObject, ...] | None, int], None] = lambda _o, _n: None,
+    ) -> None:
         super().__init__(title="Edit the map (draft)", transient_for=parent, destroy_with_parent=True)
         self.set_default_size(620, 520)
         self.robot, self.model = robot, model
+        self._show_draft = show_draft
+        """Told the draft's objects to draw on the map (None: the map's own again) and its edit count."""
         self.draft: MapDraft | None = None
         self.generation = -1
         """The map the draft is made on (``MapModel.generation``)."""
@@ -344,9 +355,16 @@ class MapEditWindow(Gtk.Window):
         self.redo_button.set_sensitive(draft is not None and draft.can_redo)
         self.discard_button.set_sensitive(dirty)
         self.apply_button.set_sensitive(dirty and connected and not self.applying)
+        if dirty and draft is not None:
+            data = self.model.map.value.data
+            kept = [o for o in (data.objects if data is not None else ()) if o.type.lower() not in EDITABLE]
+            self._show_draft((*kept, *draft.objects), len(edits))  # home and the like stay as they are
+        else:
+            self._show_draft(None, 0)
 
     def _closing(self, _w: Gtk.Window) -> bool:
         self.closed = True
+        self._show_draft(None, 0)  # the map shows the robot's map again
         for remove in self._unobserve:
             remove()
         self._unobserve = []

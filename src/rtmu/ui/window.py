@@ -6,7 +6,7 @@ header, STOP first and always on screen, and the full-screen bar), ``map_page``,
 (and where pictures go), ``toolbar``, ``banners``, ``actions`` (every ``win.*`` action and the
 menu), ``keys`` (the one key table), ``stop_keys`` (Space stops from every surface),
 ``keyboard_nav``, ``key_reach``, ``notice_router`` (where things are said), ``window_dialogs``,
-``handheld``, ``near_people``, ``bridge_toggle``, ``commissioning`` (the robot's files, scanning).
+``handheld``, ``near_people``, ``bridge_toggle``, ``commissioning`` (files, scanning, map edits).
 A new page goes into :attr:`MainWindow.stack`, a new action into ``actions``, a new dialog into
 ``window_dialogs``.
 
@@ -153,11 +153,10 @@ class MainWindow(Gtk.ApplicationWindow):
             keyring_available=keyring_available, profile_saved=profile_saved,
             profile_changed=lambda: self._update_header(self.model.connection.value),
         )  # fmt: skip
-        self.commissioning = (
-            Commissioning(  # the robot's files, scanning for a map (its bar: under the toolbar)
-                self, self.robot, model, column=self.column, after=self.toolbar_revealer, clock=clock
-            )
-        )
+        self.commissioning = Commissioning(  # the robot's files, scanning, map edits (bar under the toolbar)
+            self, self.robot, model, column=self.column, after=self.toolbar_revealer, clock=clock,
+            stage=self.stage, banners=self.banners,
+        )  # fmt: skip
         if secrets is not None:
             self.controller.secrets = secrets
         self.robot_view = _View(self)
