@@ -22,7 +22,7 @@ from rtmu.sim import SimConfig, SimThread
 from rtmu.ui.map_edit_window import MapEditWindow
 from rtmu.values.intents import ApplyMapChanges
 
-from .harness import Gui, pump
+from .harness import Gui, idle, pump
 from .stop_paths import StopCycle
 from .test_config_page import click, type_into
 
@@ -142,3 +142,39 @@ def _rows(w: MapEditWindow) -> list:  # type: ignore[type-arg]
         out.append(row)
         i += 1
     return out
+
+
+def test_a_goal_placed_by_a_click_and_a_drag_on_the_map(gui: Gui, sim: SimThread) -> None:
+    from gi.repository import GdkX11, Graphene
+
+    w = open_window(gui)
+    stage = gui.stage
+    sx, sy = stage.viewport.to_screen(6500, 6000)  # the corridor, in the stage's own pixels
+    ok, point = stage.compute_point(stage.get_native(), Graphene.Point().init(sx, sy))
+    assert ok
+    dx, dy = stage.get_native().get_surface_transform()
+    x, y = round(point.x + dx), round(point.y + dy)
+    edit_xid = str(GdkX11.X11Surface.get_xid(w.get_surface()))
+    gui.xdotool("windowmove", "--sync", edit_xid, "640", "0")  # off the map's left half (no window manager)
+    idle(0.3)
+    click(gui, w.pick_button)
+    pump(lambda: gui.window.commissioning.point_pick.active, 3, "the pick mode")  # type: ignore[union-attr]
+    xid = str(GdkX11.X11Surface.get_xid(gui.window.get_surface()))
+    gui.xdotool("mousemove", "--window", xid, str(x), str(y))
+    idle(0.2)  # the pointer enters the window first (under a bare X server the first press is the enter)
+    gui.xdotool("mousedown", "1")
+    gui.xdotool("mousemove", "--window", xid, str(x), str(y - 20))
+    gui.xdotool("mousemove", "--window", xid, str(x), str(y - 60), "mouseup", "1")  # dragged up: 90°
+    pump(lambda: w.fields["x"].get_text() != "", 5, "the picked point in the fields")
+    px, py, th = (float(w.fields[n].get_text()) for n in ("x", "y", "th"))
+    scale_mm = 1.0 / stage.viewport.scale  # one pixel, in mm
+    assert abs(px - 6500) <= 2 * scale_mm and abs(py - 6000) <= 2 * scale_mm, (px, py)
+    assert abs(th - 90) <= 2, th
+    assert not gui.window.commissioning.point_pick.active  # type: ignore[union-attr]  # one pick per start
+    type_into(gui, w.name_entry, "Picked")
+    click(gui, w.add_button)
+    pump(
+        lambda: w.draft is not None and w.draft.find("Picked") is not None, 5, "the picked goal in the draft"
+    )
+    gui.shot("picked-goal-drawn")
+    assert "Picked" not in gui.model.navigation.value.goals

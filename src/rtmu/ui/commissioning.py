@@ -22,6 +22,7 @@ from ..model.observables import RobotModel  # noqa: E402
 from .banners import BannerStack  # noqa: E402
 from .files_page import FilesPage  # noqa: E402
 from .map_edit_window import MapEditWindow  # noqa: E402
+from .map_point_pick import MapPointPick  # noqa: E402
 from .mapview import MapStage  # noqa: E402
 from .scan_mode import ScanBar  # noqa: E402
 
@@ -52,6 +53,8 @@ class Commissioning:
     ) -> None:
         self.window, self.robot, self.model = window, robot, model
         self.stage, self.banners = stage, banners
+        self.point_pick = MapPointPick(stage) if stage is not None else None
+        """The map editor's one-point pick on the map (None without a map stage)."""
         self.files_page: FilesPage | None = None
         """The files page last opened."""
         self.map_edit: MapEditWindow | None = None
@@ -63,7 +66,8 @@ class Commissioning:
     def edit_map(self) -> None:
         """Server ▸ Edit the map…: one draft window at a time."""
         if self.map_edit is None or self.map_edit.closed:
-            self.map_edit = MapEditWindow(self.window, self.robot, self.model, self._show_draft)
+            pick = self.point_pick.start if self.point_pick is not None else None
+            self.map_edit = MapEditWindow(self.window, self.robot, self.model, self._show_draft, pick)
         self.map_edit.present()
 
     def _show_draft(self, objects: tuple[MapObject, ...] | None, edits: int) -> None:
@@ -96,6 +100,8 @@ class Commissioning:
 
     def close(self) -> None:
         self.scan_bar.close()
+        if self.point_pick is not None:
+            self.point_pick.cancel()
         for page in (self.files_page, self.map_edit):
             if page is not None and not page.closed:
                 page.close()

@@ -8,7 +8,8 @@ starts afresh on it. When the map changes under an open draft (another client's 
 kept, rebased on the new map, and what changed — and which edits now conflict — is said plainly. A
 change the server refuses leaves its map as it was and the draft as it is.
 
-What is typed is in mm and degrees; "Robot's pose" fills the fields from where the robot is. While
+What is typed is in mm and degrees; "Robot's pose" fills the fields from where the robot is, "Pick on
+the map" from the next click on the map (a drag from the point sets the heading: ``map_point_pick``). While
 the draft holds edits, the map draws the draft's goals, docks and forbidden lines and areas instead
 of the robot's, and a banner says a draft is shown, not applied (``show_draft``); closing the window
 shows the robot's map again.
@@ -45,6 +46,7 @@ from ..mapedit.draft import (  # noqa: E402
 from ..mapfile import MapObject  # noqa: E402
 from ..model.observables import MapModel, MapPhase, Phase, RobotModel  # noqa: E402
 from ..values.intents import ApplyMapChanges  # noqa: E402
+from .map_point_pick import Picked  # noqa: E402
 
 EDITABLE = {t.lower() for t in (GOAL, GOAL_WITH_HEADING, DOCK, FORBIDDEN_LINE, FORBIDDEN_AREA)}
 KINDS = ("Goal", "Dock", "Forbidden line", "Forbidden area")
@@ -64,11 +66,12 @@ class MapEditWindow(Gtk.Window):
         robot: SelectedRobot,
         model: RobotModel,
         show_draft: Callable[[tuple[MapObject, ...] | None, int], None] = lambda _o, _n: None,
+        pick: Callable[[Picked], None] | None = None,
     ) -> None:
         super().__init__(title="Edit the map (draft)", transient_for=parent, destroy_with_parent=True)
         self.set_default_size(620, 520)
         self.robot, self.model = robot, model
-        self._show_draft = show_draft
+        self._show_draft, self._pick = show_draft, pick
         """Told the draft's objects to draw on the map (None: the map's own again) and its edit count."""
         self.draft: MapDraft | None = None
         self.generation = -1
@@ -126,6 +129,18 @@ class MapEditWindow(Gtk.Window):
         here = Gtk.Button(label="Robot's pose")
         here.connect("clicked", lambda _b: self._fill_from_robot())
         form.attach(here, 3, 0, 1, 1)
+        self.pick_button = Gtk.Button(
+            label="Pick on the map", tooltip_text="Click a point; drag for a heading"
+        )
+        self.pick_button.connect("clicked", lambda _b: self.pick_point(end=False))
+        self.pick_end_button = Gtk.Button(
+            label="Pick the end", tooltip_text="The other end of a line or area"
+        )
+        self.pick_end_button.connect("clicked", lambda _b: self.pick_point(end=True))
+        self.pick_button.set_sensitive(self._pick is not None)
+        self.pick_end_button.set_sensitive(self._pick is not None)
+        form.attach(self.pick_button, 4, 0, 1, 1)
+        form.attach(self.pick_end_button, 4, 1, 1, 1)
         fields = Gtk.Grid(column_spacing=6, column_homogeneous=True)
         titles = {
             "x": "x (mm)",
@@ -280,6 +295,23 @@ class MapEditWindow(Gtk.Window):
         pose = self.model.robot.value
         for name, value in (("x", pose.x), ("y", pose.y), ("th", pose.th)):
             self.fields[name].set_text(f"{value:.0f}")
+
+    def pick_point(self, *, end: bool) -> None:
+        """The next click on the map fills x, y (and a dragged heading) — or x2, y2 with ``end``."""
+        if self._pick is None:
+            return
+        self._say("Click the map" + ("" if end else " (drag from the point for a heading)"), error=False)
+
+        def picked(x: float, y: float, th: float | None) -> None:
+            self.fields["x2" if end else "x"].set_text(f"{x:.0f}")
+            self.fields["y2" if end else "y"].set_text(f"{y:.0f}")
+            if th is not None and not end:
+                self.fields["th"].set_text(f"{th:.0f}")
+            self._say(
+                f"Picked ({x:.0f}, {y:.0f})" + (f", heading {th:.0f}°" if th is not None else ""), error=False
+            )
+
+        self._pick(picked)
 
     def _row_selected(self, _box: Gtk.ListBox, _row: Gtk.ListBoxRow | None) -> None:
         obj = self.selected()
