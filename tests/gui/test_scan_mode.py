@@ -54,7 +54,7 @@ def drive_up_then_space(gui: Gui, cycle: StopCycle, what: str, seconds: float = 
     gui.focus()
     gui.keydown("Up")
     try:
-        pump(cycle.driven, 8, f"a held Up to drive ({what})")
+        pump(cycle.driven, 20, f"a held Up to drive ({what})")  # generous: a loaded machine
         idle(seconds)
         cycle.space_stops(what)
     finally:
@@ -99,6 +99,10 @@ def test_scan_drive_tag_stop_and_download_with_stop_working_throughout(
     text = bar.label.get_text()
     assert re.fullmatch(r"Scanning hall-2\.2d… \d+:\d\d, \d+\.\d m driven", text), text
     gui.shot("scanning")
+    from gi.repository import Gtk
+
+    minimum = bar.measure(Gtk.Orientation.HORIZONTAL, -1)[0]
+    assert minimum <= 360, minimum  # the bar fits a portrait phone (ui.layout's narrowest window)
 
     # the loop tags, with real clicks
     assert not bar.loop_end.get_sensitive()

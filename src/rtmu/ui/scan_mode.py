@@ -141,12 +141,16 @@ class ScanBar(Gtk.Revealer):
         self.chooser: Gtk.FileChooserDialog | None = None
         self.loop_open = False
         self.downloads = 0
-        box = Gtk.Box(spacing=8)
+        # The words and the buttons side by side, the buttons under the words on a narrow (phone) window.
+        box = Gtk.FlowBox(
+            selection_mode=Gtk.SelectionMode.NONE, min_children_per_line=1, max_children_per_line=2,
+            column_spacing=8, row_spacing=4, homogeneous=False,
+        )  # fmt: skip
         box.add_css_class("scan-bar")
         for side in ("top", "bottom", "start", "end"):
             getattr(box, f"set_margin_{side}")(4)
         self.label = Gtk.Label(xalign=0.0, hexpand=True, wrap=True)
-        box.append(self.label)
+        buttons = Gtk.Box(spacing=8, halign=Gtk.Align.END, hexpand=True)
         self.loop_start = Gtk.Button(
             label="Loop start", tooltip_text="Here a loop begins (the log is tagged)"
         )
@@ -162,7 +166,12 @@ class ScanBar(Gtk.Revealer):
         self.dismiss = Gtk.Button(icon_name="window-close-symbolic", tooltip_text="Hide")
         self.dismiss.connect("clicked", lambda _b: self._dismiss())
         for button in (self.loop_start, self.loop_end, self.stop_scan, self.download, self.dismiss):
-            box.append(button)
+            buttons.append(button)
+        for part in (self.label, buttons):
+            box.append(part)
+            cell = part.get_parent()
+            assert isinstance(cell, Gtk.FlowBoxChild)
+            cell.set_focusable(False)  # Tab goes to the buttons, not to their cells
         self.set_child(box)
         self.note = ""
         self.message = ""
