@@ -262,3 +262,29 @@ def test_a_map_on_the_robot_made_its_map_with_real_clicks(
     assert "Other" in gui.model.map.value.name
     gui.render(page, gui.shots / f"{gui.name}-switched.png")
     gui.shot("window-after-switch")
+
+
+def test_a_huge_folder_shows_a_bounded_page_and_a_hostile_name_is_refused_in_words(
+    gui: Gui, sim: SimThread, robot_files: Path
+) -> None:
+    crowd = robot_files / "crowd"
+    crowd.mkdir()
+    for i in range(3000):
+        (crowd / f"f{i:05d}.txt").touch()
+    page = open_page(gui)
+    seen = page.listings
+    double_click(gui, row_named(page, "crowd"))
+    pump(lambda: page.listings > seen, 30, "the crowd's listing")
+    assert len(page.shown) == 1000 and "Showing the first 1000 of 3000 entries" in page.status.get_text()
+    ticks = gui.window.ticks
+    idle(0.5)
+    assert gui.window.ticks > ticks  # the main loop kept running
+    gui.render(page, gui.shots / f"{gui.name}-crowd.png")
+
+    (crowd / "bad\x1bname.txt").touch()  # a control character: the whole listing is refused, said in words
+    seen = page.listings
+    click(gui, page.refresh_button)
+    pump(lambda: "List failed" in page.status.get_text(), 15, "the refusal of the listing")
+    assert "not a plain file name" in page.status.get_text() and "\x1b" not in page.status.get_text()
+    assert page.status.has_css_class("error") and not page.shown and page.listings == seen
+    gui.render(page, gui.shots / f"{gui.name}-hostile-name.png")
