@@ -171,3 +171,29 @@ def test_export_refuse_overwrite_then_import_an_edited_file(gui: Gui, sim: SimTh
     assert timeout(sim) == 0.7
     assert [w for w in owned_windows(gui.window) if w is not p] == []
     gui.render(p, gui.shots / f"{gui.name}-import-refused.png")
+
+
+def test_a_changed_parameter_has_its_own_reset_button_on_the_page(gui: Gui, sim: SimThread) -> None:
+    p = open_page(gui)
+    factory = timeout(sim)
+    pump(lambda: p.care.factory is not None, 10, "the factory values")
+    assert ("Teleop", "Timeout") not in p.care.resets or p.care.resets[
+        ("Teleop", "Timeout")
+    ].get_parent() is None
+    _param, spin, _label = p.rows[("Teleop", "Timeout")]
+    type_into(gui, spin, "0.5")
+    pump(lambda: p.edits.get(("Teleop", "Timeout")) == "0.50", 3, "the edit")
+    click(gui, p.save_button)
+    pump(lambda: answer(p, "Teleop", "Timeout") == "✓ accepted", 5, "the save")
+    pump(
+        lambda: ("Teleop", "Timeout") in p.care.resets and p.care.resets[("Teleop", "Timeout")].get_mapped(),
+        10,
+        "the row's reset button",
+    )
+    button = p.care.resets[("Teleop", "Timeout")]
+    assert "Reset to default (2)" in (button.get_tooltip_text() or "")
+    gui.render(p, gui.shots / f"{gui.name}-row-reset.png")
+    click(gui, button)
+    pump(lambda: timeout(sim) == factory, 10, "the factory value on the simulator")
+    pump(lambda: "back to its factory value" in p.banner.get_text(), 5, "the reset said")
+    pump(lambda: not button.get_mapped(), 10, "the button gone with the difference")

@@ -30,9 +30,10 @@ gi.require_version("Pango", "1.0")
 from gi.repository import Gdk, GLib, Gtk, Pango  # noqa: E402
 
 from ..base.textsafe import visible  # noqa: E402
-from ..client.config_care import DEFAULTS, Difference, FactoryValues, differences  # noqa: E402
+from ..client.config_care import DEFAULTS, Difference, FactoryValues, differences, same_value  # noqa: E402
 from ..client.config_feed import ServerConfig  # noqa: E402
 from ..client.config_file import ConfigFileError, export_text, plan_import, read_file, write_export  # noqa: E402
+from ..protocol.payloads.config import ConfigParam  # noqa: E402
 from ..values.intents import FetchConfig, FetchConfigDefaults, Intent, ResetConfig, SetConfig  # noqa: E402
 from .confirm import Confirm  # noqa: E402
 
@@ -210,18 +211,59 @@ class ConfigCare:
         for b in (self.defaults_button, self.export_button, self.import_button):
             self.buttons.append(b)
         self.defaults: DefaultsWindow | None = None
+        self.factory: FactoryValues | None = None
+        """The factory values, read once the page has the configuration (where the server keeps them)."""
+        self.resets: dict[tuple[str, str], Gtk.Button] = {}
+        """The page's per-row reset buttons made last, by (section, parameter)."""
+        self._reading = False
         self.chooser: Gtk.FileChooserDialog | None = None
         self.confirm: Confirm | None = None
         self.update()
 
     def update(self) -> None:
-        """Grey what the server does not offer (called when the configuration is read)."""
+        """Grey what the server does not offer (called when the configuration is read); the factory
+        values are read once, so each changed parameter on the page gets its own reset button."""
         offered = DEFAULTS in self._offers()
         self.defaults_button.set_sensitive(offered)
         if offered:
             self.defaults_button.set_has_tooltip(False)
         else:
             self.defaults_button.set_tooltip_text(NO_DEFAULTS)
+        if offered and self.factory is None and not self._reading:
+            self._reading = True
+
+            def read(values: Any, error: BaseException | None) -> None:
+                self._reading = False
+                if error is None:
+                    self.factory = values
+                    show_rows = getattr(self.page, "show_rows", None)
+                    if callable(show_rows):
+                        show_rows()  # the rows gain their reset buttons (no second fetch)
+
+            _when_done(self._request(FetchConfigDefaults()), read)
+
+    def reset_button(self, section: str, param: ConfigParam, editable: bool) -> Gtk.Widget | None:
+        """ "Reset to default" for one row of the page, when its value is not the factory value."""
+        default = self.factory.get(section, param.name) if self.factory is not None else None
+        if default is None or same_value(param, default):
+            return None
+        button = Gtk.Button(icon_name="edit-undo-symbolic", valign=Gtk.Align.CENTER)
+        button.set_tooltip_text(f"Reset to default ({visible(default)})")
+        button.set_sensitive(editable)
+
+        def answered(reply: Any, error: BaseException | None) -> None:
+            if error is None and reply is not None and not reply.accepted:
+                error = RuntimeError(reply.error)
+            if error is not None:
+                self._say(f"{section}/{param.name} was not reset: {error}", True)
+            else:
+                self._say(f"{section}/{param.name} is back to its factory value {default}", False)
+            self._refresh_page()
+
+        changes = {section: {param.name: default}}
+        button.connect("clicked", lambda _b: _when_done(self._request(ResetConfig(changes)), answered))
+        self.resets[(section, param.name)] = button
+        return button
 
     def _config(self) -> ServerConfig | None:
         return getattr(self.page, "config", None)

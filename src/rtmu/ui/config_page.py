@@ -275,6 +275,11 @@ class ConfigPage(Gtk.Window):
         s = self.current()
         return [] if s is None else [p for p in s.params if p.priority <= self.show_up_to]
 
+    def show_rows(self) -> None:
+        """Draw the current section's rows again (the factory values arrived: reset buttons)."""
+        if self.config is not None and not self.closed:
+            self._show_section()
+
     def _show_section(self) -> None:
         section = self.current()
         while (child := self.grid.get_first_child()) is not None:
@@ -320,6 +325,9 @@ class ConfigPage(Gtk.Window):
         self.grid.attach(editor, 1, row, 1, 1)
         answer = Gtk.Label(xalign=0.0, wrap=True, max_width_chars=30)
         self.grid.attach(answer, 2, row, 1, 1)
+        reset = self.care.reset_button(section.name, p, config.editable(p))
+        if reset is not None:
+            self.grid.attach(reset, 3, row, 1, 1)
         self.rows[key] = (p, editor, answer)
         self._show_answer(key)
 
