@@ -10,7 +10,9 @@ returns nothing (ARIA's commands) all mean "changes something". Each answer carr
 decided it, so the operator can see why a confirmation is asked.
 
 ``ratioDrive`` is never the console's: held motion happens only while the operator holds a key,
-through the drive lease (:data:`HELD_MOTION`).
+through the drive lease (:data:`HELD_MOTION`). Every request of the one motion list
+(:data:`rtmu.protocol.motion.MOTION_REQUESTS`) changes something whatever its description says: a
+server that describes ``tourGoalsInList`` as a list of names does not make it a read.
 """
 
 from __future__ import annotations
@@ -19,6 +21,7 @@ import re
 from enum import Enum
 
 from ..protocol.datalist import DataEntry
+from ..protocol.motion import is_motion
 
 
 class Effect(Enum):
@@ -89,6 +92,8 @@ def classify(entry: DataEntry) -> tuple[Effect, str]:
     words = name_words(entry.name)
     if entry.name in HELD_MOTION:
         return Effect.CHANGES, "it drives the robot while held (RTMU sends it only from a held drive)"
+    if is_motion(entry.name):
+        return Effect.CHANGES, "it changes how the robot moves (a motion request)"
     strong = next((w for w in words if w in STRONG and not (w == "estop" and _reads(words))), None)
     if strong is not None:
         return Effect.CHANGES, f"its name says {strong!r}"

@@ -219,6 +219,9 @@ class Controller:
         self.replay: str | None = None
         """Set to the recording's name while the window shows a replay: then nothing is sent at all
         (drive keys, D-pad, STOP and every server command say "replay"), and no lease is granted."""
+        self.drive_gate: Callable[[], str | None] | None = None
+        """Why a held drive may not start now (None: it may), asked on each first press: the window's
+        guardian not yet armed for this robot (``rtmu.guardian.shared.GuardianSeat.waiting_reason``)."""
         link.on_notice = self._on_link_notice
         self._unobserve = [
             robot.connection.observe(self._on_connection),
@@ -308,8 +311,19 @@ class Controller:
             self._blocked.add(direction)
             self.view.notify(Notice.info(Kind.NAVIGATION, "Navigation cancelled. Press again to drive."))
             return
+        if self._gate_refuses():
+            self._blocked.add(direction)
+            return
         self._held.add(direction)
         self._apply()
+
+    def _gate_refuses(self) -> bool:
+        """The drive gate says no: tell the operator why (the key must be pressed again)."""
+        gate = self.drive_gate
+        why = gate() if gate is not None else None
+        if why is not None:
+            self.view.notify(Notice.warning(Kind.SAFETY, f"Not driving: {why} Press again once it is armed."))
+        return why is not None
 
     def release(self, direction: str) -> None:
         if not self._unfocused:  # a real key-up: the key may drive again on its next press
@@ -344,6 +358,9 @@ class Controller:
             self.stop()
             self._analog_blocked = True
             self.view.notify(Notice.info(Kind.NAVIGATION, "Navigation cancelled. Press again to drive."))
+            return
+        if self._analog is None and (trans or rot) and self._gate_refuses():
+            self._analog_blocked = True
             return
         self._analog = (max(-100.0, min(100.0, trans)), max(-100.0, min(100.0, rot)))
         self._apply()

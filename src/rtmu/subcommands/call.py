@@ -26,7 +26,7 @@ import sys
 import time
 from typing import Any
 
-from ..base.exit_codes import EXIT_OK, EXIT_TIMEOUT, EXIT_USAGE
+from ..base.exit_codes import EXIT_OK, EXIT_TIMEOUT, EXIT_USAGE, NETWORK
 from ..base.textsafe import visible
 from ..client.connection import AriaClient
 from ..client.console import ConsoleEntry, ConsoleReply, Subscription, call, console_entries, entry_of
@@ -34,6 +34,7 @@ from ..client.console_layout import KINDS, ArgumentError, describe, encode_argum
 from ..client.roles import Role
 from ._common import add_connection_arguments, positive_float, print_json, run_with_client
 
+EXITS = NETWORK
 SILENT_OUTCOMES = ("silent", "stalled", "sent")
 FOLLOW_CHECK = 0.5
 """Seconds between looks at the connection while following a data."""
@@ -45,9 +46,11 @@ def register(subparsers: Any) -> None:
         help="call any data the server lists (a console): once, or at an interval; --list shows them all",
         description="Send data NAME once with ARGs (typed as its argument description says, or as "
         "--type names) and print each reply as hex, fields and RTMU's own type where it has one. "
-        "--every MS follows it (-1: broadcasts only). A data that changes something needs --yes. "
-        "Exit 0 replied, 2 not listed / wrong arguments / needs --yes / refused, 3 connection, "
-        "5 silent.",
+        "--every MS follows it (-1: broadcasts only). A data that changes something needs --yes (without "
+        "it this command is an observer: it cannot send a motion request); ratioDrive is never sent. A data "
+        "this user's list does not have, arguments that do not fit, a call that needs --yes, or one the "
+        "console refuses are usage errors (nothing is sent); no reply within --timeout (none at all while "
+        "following), a reply that stalls, or a command the server does not confirm taking is a timeout.",
     )
     _positionals_anywhere(p)
     add_connection_arguments(p)

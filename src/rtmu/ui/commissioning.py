@@ -17,7 +17,7 @@ gi.require_version("Gtk", "4.0")
 from gi.repository import Gtk  # noqa: E402
 
 from ..fleet.selected import SelectedRobot  # noqa: E402
-from ..mapfile import MapObject  # noqa: E402
+from ..mapedit import MapObject  # noqa: E402
 from ..model.observables import RobotModel  # noqa: E402
 from .banners import BannerStack  # noqa: E402
 from .files_page import FilesPage  # noqa: E402

@@ -32,7 +32,7 @@ from ..base.textsafe import visible  # noqa: E402
 from ..client.map_changes import ChangeVerdict  # noqa: E402
 from ..fleet.selected import SelectedRobot  # noqa: E402
 from ..fleet.sessions import RobotSession  # noqa: E402
-from ..mapedit import MapDraft  # noqa: E402
+from ..mapedit import MapDraft, MapObject  # noqa: E402
 from ..mapedit.draft import (  # noqa: E402
     DOCK,
     FORBIDDEN_AREA,
@@ -43,7 +43,6 @@ from ..mapedit.draft import (  # noqa: E402
     describe,
     object_key,
 )
-from ..mapfile import MapObject  # noqa: E402
 from ..model.observables import MapModel, MapPhase, Phase, RobotModel  # noqa: E402
 from ..values.intents import ApplyMapChanges  # noqa: E402
 from .map_point_pick import Picked  # noqa: E402

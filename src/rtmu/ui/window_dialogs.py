@@ -21,7 +21,7 @@ import gi
 gi.require_version("Gtk", "4.0")
 from gi.repository import GLib, Gtk  # noqa: E402
 
-from ..client.custom_commands import ServerCommand  # noqa: E402
+from ..client.custom_commands import CustomCommand  # noqa: E402
 from ..fleet.selected import SelectedRobot  # noqa: E402
 from ..fleet.sessions import RobotSession  # noqa: E402
 from ..model.observables import Phase, RobotModel  # noqa: E402
@@ -179,7 +179,7 @@ class WindowDialogs:
         }
         makers[name]().present()
 
-    def _run_server_command(self, command: ServerCommand, argument: str | None) -> None:
+    def _run_server_command(self, command: CustomCommand, argument: str | None) -> None:
         """From the palette: sent on the network thread; the outcome comes back as a banner."""
 
         def done(future: concurrent.futures.Future[bool]) -> None:
