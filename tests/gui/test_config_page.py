@@ -62,6 +62,7 @@ def open_page(gui: Gui) -> ConfigPage:
     assert labels == [
         "Connection settings…",
         "Configuration…",
+        "Console…",
         "Files on the robot…",
         "Scan a map…",
         "Edit the map…",

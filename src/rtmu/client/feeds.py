@@ -8,6 +8,7 @@ from __future__ import annotations
 
 from .config_care_feed import ConfigCareFeed
 from .config_feed import ConfigFeed
+from .console_feed import ConsoleFeed
 from .custom_commands import CommandsFeed
 from .drawings_feed import DrawingsFeed
 from .drive_loop import DriveFeed
@@ -23,6 +24,7 @@ from .scan_feed import ScanFeed
 from .server_strings import StringsFeed
 from .status_feed import StatusFeed
 from .video_session import CameraFeed
+from .why_feed import WhyFeed
 
 FEEDS: tuple[type[Feed], ...] = (
     DriveFeed,
@@ -40,5 +42,7 @@ FEEDS: tuple[type[Feed], ...] = (
     ScanFeed,
     ConfigCareFeed,
     MapEditFeed,
+    WhyFeed,
+    ConsoleFeed,
     MapFeed,
 )

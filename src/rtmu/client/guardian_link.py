@@ -42,6 +42,8 @@ class GuardianLink:
             self.seat = self._own.seat(OWN_NAME)
             self._own.choose(self.seat)
         self._armed = False
+        self.unavailable_reason: str | None = None
+        """Why the guardian cannot stop this robot, once it said so (``rtmu why`` names it); else None."""
 
     def start(self, target: Target) -> None:
         """Connected to ``target`` (which offers ``ratioDrive``): the guardian may log in to it."""
@@ -116,6 +118,7 @@ class GuardianLink:
         return stopped
 
     def unavailable(self, reason: str) -> None:
+        self.unavailable_reason = reason
         self._notice(
             Notice.warning(
                 Kind.SAFETY,

@@ -72,6 +72,7 @@ from ..model.observables import OperatorState, RobotModel, SpeedSetting
 from ..settings.store import Profile
 from ..values.intents import GotoGoal, Intent, RequestPicture, StartVideo, Stop, picture_source
 from ..values.state import ConnectionState, LinkHealth, LinkLevel, NavState, Phase, RobotState
+from . import intent_rules
 from .commands import COMMANDS, CommandRegistry, CommandState
 from .motion_limits import RobotLimits, capped_throttle
 from .motion_watch import MotionWatch
@@ -526,11 +527,12 @@ class Controller:
         """Send one operator intent to this robot, after the rules that hold for every intent.
 
         Refused, with the reason shown, in a replay, while not connected (for an intent that needs
-        the server), where the server does not offer it, and — for one that moves the robot — while
-        it scans for a map (``scan_rule``). An intent that moves the robot ends a
-        held drive first (the network side sends its stop before the intent), and a new goal makes
-        drive keys drive again once the server has taken it. Returns what ``link.send`` returns (a
-        Future of the answer), or None when refused. STOP has its own path: :meth:`stop`."""
+        the server), where the server does not offer it, where ``intent_rules`` refuses it (a
+        console motion request or a fix the operator has not confirmed), and — for one that moves the
+        robot — while it scans for a map (``scan_rule``). An intent that moves the robot ends a held
+        drive first (the network side sends its stop before the intent), and a new goal makes drive
+        keys drive again once the server has taken it. Returns what ``link.send`` returns (a Future
+        of the answer), or None when refused. STOP has its own path: :meth:`stop`."""
         if isinstance(intent, Stop):
             self.stop()
             return None
@@ -555,12 +557,17 @@ class Controller:
         if isinstance(intent, GotoGoal) and goals and intent.name not in goals:
             self.view.notify(Notice.warning(Kind.NAVIGATION, f"This map has no goal called {intent.name!r}"))
             return None
-        if intent.moves:
+        refused = intent_rules.refusal(intent)  # a console call of a motion request, a fix, unconfirmed
+        if refused is not None:
+            self.view.notify(Notice.warning(intent.kind, f"{intent.label}: {refused}"))
+            return None
+        moving = intent_rules.moves(intent)
+        if moving:
             self._halt_held(EndReason.STOPPED)  # the network side sends its stop before the intent
             self._nav_cancelled = False
         self._record(intent)
         sent = self.link.send(intent)
-        if intent.moves:
+        if moving:
             self.motion.intent_sent(intent, self.robot.robot.value)  # a jog is watched to its outcome
         return sent
 

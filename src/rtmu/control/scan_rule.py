@@ -11,11 +11,12 @@ from __future__ import annotations
 
 from ..values.commission import ScanState
 from ..values.intents import Intent
+from . import intent_rules
 
 
 def scan_refusal(intent: Intent, scan: ScanState) -> str | None:
     """Why ``intent`` is refused while ``scan`` runs (None: it may go)."""
-    if not intent.moves or not scan.scanning:
+    if not scan.scanning or not intent_rules.moves(intent):  # a console call of a motion request too
         return None
     return (
         f"{intent.label}: not while scanning for a map ({scan.file_name or scan.name}) — "

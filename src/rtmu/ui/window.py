@@ -6,8 +6,9 @@ header, STOP first and always on screen, and the full-screen bar), ``map_page``,
 (and where pictures go), ``toolbar``, ``banners``, ``actions`` (every ``win.*`` action and the
 menu), ``keys`` (the one key table), ``stop_keys`` (Space stops from every surface),
 ``keyboard_nav``, ``key_reach``, ``notice_router`` (where things are said), ``window_dialogs``,
-``handheld``, ``near_people``, ``bridge_toggle``, ``commissioning`` (files, scanning, map edits).
-A new page goes into :attr:`MainWindow.stack`, a new action into ``actions``, a new dialog into
+``handheld``, ``near_people``, ``bridge_toggle``, ``why_hint`` (a still held drive asks why),
+``commissioning`` (files, scanning, map edits). A new page goes into :attr:`MainWindow.stack`, a
+new action into ``actions``, a new dialog into
 ``window_dialogs``.
 
 Its two timers are the UI's heartbeat: every :data:`rtmu.control.controller.TICK` it renews the
@@ -58,6 +59,7 @@ from .shortcuts import build_shortcuts_window  # noqa: E402
 from .split_view import SplitView  # noqa: E402
 from .stop_keys import StopKeys  # noqa: E402
 from .toolbar import StatusToolbar  # noqa: E402
+from .why_hint import WhyContext, WhyHint  # noqa: E402
 from .window_dialogs import WindowDialogs  # noqa: E402
 
 REFRESH_EVERY = 3
@@ -133,6 +135,8 @@ class MainWindow(Gtk.ApplicationWindow):
         self.drive = DriveInput(self.robot, m, activate=self.actions.activate, pick_key=self._pick_key)
         self.keys = self.drive.router  # before the stop keys' controller, which GTK runs first
         self.add_controller(self.keys.controller)
+        why = WhyContext(self.robot, model, self.keys)  # what the window knows of a drive, for "why?"
+        self.why_hint = WhyHint(why, self.banners, clock)  # a held drive and no motion for 1 s: ask why
         self.stack = Gtk.Stack(transition_type=Gtk.StackTransitionType.NONE)
         """The window's pages by name: ``map`` (the map page, split with the live picture), ``camera``."""
         self.split = SplitView(m)  # the map page, and the live picture beside it while split
@@ -152,6 +156,7 @@ class MainWindow(Gtk.ApplicationWindow):
             self, self.robot, model, self.banners, request=self.request, profiles=profiles,
             keyring_available=keyring_available, profile_saved=profile_saved,
             profile_changed=lambda: self._update_header(self.model.connection.value),
+            why_question=why.question,
         )  # fmt: skip
         self.commissioning = Commissioning(  # the robot's files, scanning, map edits (bar under the toolbar)
             self, self.robot, model, column=self.column, after=self.toolbar_revealer, clock=clock,
@@ -351,6 +356,7 @@ class MainWindow(Gtk.ApplicationWindow):
     def _tick(self) -> bool:
         self.ticks += 1
         self.controller.tick()
+        self.why_hint.tick()
         slow = self.ticks % REFRESH_EVERY == 0
         self.map_page.refresh(slow)
         if slow:
