@@ -19,6 +19,7 @@ from PIL import Image
 from rtmu.client.config_feed import set_config
 from rtmu.client.connection import AriaClient
 from rtmu.package_data import project_map
+from rtmu.protocol.payloads.config import ParamType
 from rtmu.sim import SimConfig, SimThread
 from rtmu.sim.arconfig import FILLER_CONTROL_SECTION
 from rtmu.ui.config_page import PAGE_SIZE, ConfigPage
@@ -59,7 +60,14 @@ def open_page(gui: Gui) -> ConfigPage:
                     sub.get_item_attribute_value(k, "label", None).get_string()
                     for k in range(sub.get_n_items())
                 ]
-    assert labels == ["Connection settings…", "Configuration…", "Console…"]
+    assert labels == [
+        "Connection settings…",
+        "Configuration…",
+        "Console…",
+        "Files on the robot…",
+        "Scan a map…",
+        "Edit the map…",
+    ]
     gui.window.activate_action("win.server-config", None)
     pump(lambda: page(gui) is not None, 5, "the configuration page")
     p = page(gui)
@@ -136,7 +144,8 @@ def red_and_green(gui: Gui, widget) -> tuple[int, int]:  # type: ignore[no-untyp
 
 def test_edit_save_accepted_then_a_refused_value_shows_the_servers_error(gui: Gui, sim: SimThread) -> None:
     p = open_page(gui)
-    assert [s.name for s in p.config.sections] == ["Teleop", "Robot config", "Camera", "Battery", "Wi-Fi"]  # type: ignore[union-attr]
+    names = [s.name for s in p.config.sections]  # type: ignore[union-attr]
+    assert names == ["Teleop", "Robot config", "Camera", "Battery", "Wi-Fi", "Files"]
     gui.render(p, gui.shots / f"{gui.name}-opened.png")
     _param, spin, _label = p.rows[("Teleop", "Timeout")]
     type_into(gui, spin, "0.5")
@@ -312,16 +321,17 @@ def test_ten_thousand_parameters_with_markup_open_bounded_and_responsive(
     gui = Gui.start(screenshots, "config-hostile", "127.0.0.1", hostile.port)
     try:
         p = open_page(gui)
-        assert (
-            p.config is not None and p.config.param_count == 10_015
-        )  # TransDecel, RotDecel, a hostile name (the separator is none)
+        served = hostile.call(  # every parameter the simulator serves but its separators (only a line)
+            lambda: sum(q.template.kind is not ParamType.SEPARATOR for q in hostile.server.arconfig.params)  # type: ignore[union-attr]
+        )
+        assert served > 10_000 and p.config is not None and p.config.param_count == served
         choose_section(gui, p, "<b>Extra</b> & 0")
         pump(lambda: len(p.rows) == PAGE_SIZE, 5, "one page of rows")
         shown = labels(p.grid)
         assert ("P0<i>&amp;", False) in shown and ("<u>filler</u> 0 & <big>text</big>", False) in shown
         assert ("<b>7</b>", False) in shown  # a choice list's item, as the drop-down shows it
         assert not any(markup for _text, markup in shown)
-        assert p.sections.get_row_at_index(5).get_child().get_text() == "<b>Extra</b> & 0"
+        assert p.sections.get_row_at_index(6).get_child().get_text() == "<b>Extra</b> & 0"
         assert p.comment.get_text() == "<i>filler</i> & <span foreground='red'>markup</span>"
         names = [p.sections.get_row_at_index(i).get_child().get_text() for i in range(len(p.config.sections))]
         assert "Line\\rbreak\\nand \\x1b[2Jescape" in names, names  # one line, its controls shown

@@ -23,7 +23,7 @@ from __future__ import annotations
 import concurrent.futures
 import contextlib
 import math
-from collections.abc import Callable
+from collections.abc import Callable, Collection
 from typing import Any
 
 import gi
@@ -37,6 +37,7 @@ from ..base.textsafe import visible  # noqa: E402
 from ..client.config_feed import MAX_TEXT, ConfigSection, ForeignConfig, ServerConfig  # noqa: E402
 from ..protocol.payloads.config import ConfigParam, ParamType, Priority, SetConfigReply  # noqa: E402
 from ..values.intents import FetchConfig, Intent  # noqa: E402
+from .config_care_view import ConfigCare  # noqa: E402
 from .config_edits import ConfigEdits, Key  # noqa: E402
 from .discard_question import DiscardQuestion  # noqa: E402
 
@@ -61,13 +62,14 @@ class ConfigPage(Gtk.Window):
         parent: Gtk.Window | None,
         request: Request,
         follow: Follow,
+        offers: Callable[[], Collection[str]] = frozenset,
         open_console: Callable[[str], None] | None = None,
     ) -> None:
         super().__init__(
             title="Server configuration", transient_for=parent, modal=False, destroy_with_parent=True
         )
         self.set_default_size(760, 440)
-        self._request, self._follow = request, follow
+        self._request, self._follow, self._offers = request, follow, offers
         self._open_console = open_console
         """Opens the console filtered to a text (a configuration RTMU cannot edit is read there)."""
         self.state = ConfigEdits()
@@ -121,6 +123,11 @@ class ConfigPage(Gtk.Window):
         self.save_button.connect("clicked", lambda _b: self.save())
         bar.append(self.save_button)
         box.append(bar)
+        self.care = ConfigCare(self, self._request, self._offers, self._tell)
+        """Factory values, reset to default, export and import (``config_care_view``)."""
+        care_bar = Gtk.Box(spacing=8, halign=Gtk.Align.END)
+        care_bar.append(self.care.buttons)
+        box.append(care_bar)
         self.banner = Gtk.Label(xalign=0.0, wrap=True)
         self.banner.add_css_class("config-banner")
         self.banner.set_visible(False)
@@ -165,6 +172,12 @@ class ConfigPage(Gtk.Window):
         keys.set_propagation_phase(Gtk.PropagationPhase.CAPTURE)  # Escape closes, even from an editor
         keys.connect("key-pressed", self._key)
         self.add_controller(keys)
+
+    def _tell(self, text: str, error: bool) -> None:
+        """A line under the bar: an export or import done, or why not (red)."""
+        self.banner.set_text(text)
+        (self.banner.add_css_class if error else self.banner.remove_css_class)("error")
+        self.banner.set_visible(True)
 
     def _key(self, _c: Gtk.EventControllerKey, keyval: int, _code: int, _state: object) -> bool:
         if keyval == Gdk.KEY_Escape:
@@ -238,6 +251,7 @@ class ConfigPage(Gtk.Window):
             self.status.set_text(f"Could not load the configuration: {error or 'cancelled'}")
             return False
         config: ServerConfig = future.result()
+        self.care.update()
         self.state.fetched(config)  # another client set what was being typed: nothing to save
         if previous is not None and note:
             self.banner.set_text(self.state.changes_note(previous, config))
@@ -297,6 +311,11 @@ class ConfigPage(Gtk.Window):
         s = self.current()
         return [] if s is None else [p for p in s.params if p.priority <= self.show_up_to]
 
+    def show_rows(self) -> None:
+        """Draw the current section's rows again (the factory values arrived: reset buttons)."""
+        if self.config is not None and not self.closed:
+            self._show_section()
+
     def _show_section(self) -> None:
         section = self.current()
         while (child := self.grid.get_first_child()) is not None:
@@ -342,6 +361,9 @@ class ConfigPage(Gtk.Window):
         self.grid.attach(editor, 1, row, 1, 1)
         answer = Gtk.Label(xalign=0.0, wrap=True, max_width_chars=30)
         self.grid.attach(answer, 2, row, 1, 1)
+        reset = self.care.reset_button(section.name, p, config.editable(p))
+        if reset is not None:
+            self.grid.attach(reset, 3, row, 1, 1)
         self.rows[key] = (p, editor, answer)
         self._show_answer(key)
 

@@ -6,8 +6,9 @@ header, STOP first and always on screen, and the full-screen bar), ``map_page``,
 (and where pictures go), ``toolbar``, ``banners``, ``actions`` (every ``win.*`` action and the
 menu), ``keys`` (the one key table), ``stop_keys`` (Space stops from every surface),
 ``keyboard_nav``, ``key_reach``, ``notice_router`` (where things are said), ``window_dialogs``,
-``handheld``, ``near_people``, ``bridge_toggle``, ``why_hint`` (a still held drive asks why). A new
-page goes into :attr:`MainWindow.stack`, a new action into ``actions``, a new dialog into
+``handheld``, ``near_people``, ``bridge_toggle``, ``why_hint`` (a still held drive asks why),
+``commissioning`` (files, scanning, map edits). A new page goes into :attr:`MainWindow.stack`, a
+new action into ``actions``, a new dialog into
 ``window_dialogs``.
 
 Its two timers are the UI's heartbeat: every :data:`rtmu.control.controller.TICK` it renews the
@@ -40,6 +41,7 @@ from .banners import BannerStack  # noqa: E402
 from .bars import FullscreenBar, HeaderBar  # noqa: E402
 from .bridge_toggle import BridgeToggle  # noqa: E402
 from .camera_page import CameraPage  # noqa: E402
+from .commissioning import Commissioning  # noqa: E402
 from .details import DetailsWindow  # noqa: E402
 from .drive_input import DriveInput  # noqa: E402
 from .goals_panel import GoalsPanel  # noqa: E402
@@ -155,6 +157,10 @@ class MainWindow(Gtk.ApplicationWindow):
             keyring_available=keyring_available, profile_saved=profile_saved,
             profile_changed=lambda: self._update_header(self.model.connection.value),
             why_question=why.question,
+        )  # fmt: skip
+        self.commissioning = Commissioning(  # the robot's files, scanning, map edits (bar under the toolbar)
+            self, self.robot, model, column=self.column, after=self.toolbar_revealer, clock=clock,
+            stage=self.stage, banners=self.banners,
         )  # fmt: skip
         if secrets is not None:
             self.controller.secrets = secrets
@@ -387,5 +393,5 @@ class MainWindow(Gtk.ApplicationWindow):
         parts: tuple[_Part, ...] = (self.handheld, self.stop_keys, self.key_reach, self.near_people)
         for part in (*parts, self.map_page, self.toolbar, self.routes_panel, self.goals_panel):
             part.close()
-        for part in (self.camera_page, self.foxglove, self.actions):
+        for part in (self.camera_page, self.foxglove, self.actions, self.commissioning):
             part.close()

@@ -132,8 +132,13 @@ class WindowDialogs:
         """The server's configuration page (its own window, so typing there never drives): one at a time."""
         page = self.config_page
         if page is None or page.closed:
+            offers = lambda: self.model.connection.value.offers  # noqa: E731 - the shown robot's, always
             page = self.config_page = ConfigPage(
-                self.window, self.request, self._follow_config_updates, open_console=self.show_console
+                self.window,
+                self.request,
+                self._follow_config_updates,
+                offers,
+                open_console=self.show_console,
             )
         page.present()
 

@@ -13,6 +13,8 @@ from dataclasses import dataclass, field
 from enum import Enum, StrEnum
 from typing import TYPE_CHECKING, Protocol
 
+from .commission import ScanState, TransfersState
+
 if TYPE_CHECKING:
     from ..mapfile.model import MapData
 
@@ -478,6 +480,16 @@ class DrawingsChanged:
     value: DrawingsState
 
 
+@dataclass(frozen=True, slots=True)
+class ScanChanged:
+    value: ScanState
+
+
+@dataclass(frozen=True, slots=True)
+class TransfersChanged:
+    value: TransfersState
+
+
 StateChange = (
     RobotChanged
     | MapChanged
@@ -487,6 +499,8 @@ StateChange = (
     | NavChanged
     | PopupsChanged
     | DrawingsChanged
+    | ScanChanged
+    | TransfersChanged
 )
 """What the network side publishes: the class says which part changed, the value is the new whole."""
 
