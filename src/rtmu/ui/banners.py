@@ -17,6 +17,8 @@ import gi
 gi.require_version("Gtk", "4.0")
 from gi.repository import GLib, Gtk  # noqa: E402
 
+from . import accessible  # noqa: E402
+
 MAX_BANNERS = 4
 HISTORY = 50
 MAX_CHARS = 300
@@ -131,6 +133,7 @@ class BannerStack(Gtk.Box):
         close.add_css_class("circular")
         close.set_focusable(False)
         close.set_tooltip_text("Dismiss")
+        accessible.name(close, "Dismiss")
         close.connect("clicked", lambda _b: self.dismiss(topic))
         for child in (icon, label, bar, close):
             box.append(child)

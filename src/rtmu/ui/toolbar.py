@@ -25,6 +25,7 @@ gi.require_version("Pango", "1.0")
 from gi.repository import GLib, Gtk, Pango  # noqa: E402
 
 from ..model.observables import ConnectionState, LinkLevel, OperatorState, Phase, RobotModel  # noqa: E402
+from . import accessible  # noqa: E402
 from .gauges import BatteryGauge, WifiGauge, battery_fraction, wifi_bars  # noqa: E402
 from .ld_status import details_lines, goal_suffix  # noqa: E402
 from .nav_text import loc_level, loc_text, outcome_status  # noqa: E402
@@ -56,11 +57,17 @@ class Cell(Gtk.Box):
         row.append(self.value)
         self.append(row)
         self.stale = False
+        self._said = ""
         self._tooltip: str | None = None
 
-    def show_value(self, text: str, *, stale: bool, tooltip: str | None = None) -> None:
+    def show_value(self, text: str, *, stale: bool, tooltip: str | None = None, words: str = "") -> None:
+        """``words``: the state the value's colour shows (``low``, ``link stale``), for screen readers."""
         if self.value.get_text() != text:
             self.value.set_text(text)
+        said = ", ".join(w for w in (words, "not current" if stale else "") if w)
+        if said != self._said:
+            self._said = said
+            accessible.describe(self.value, f"{self.caption.get_text()}: {said}" if said else "")
         if stale != self.stale:
             self.stale = stale
             if stale:
@@ -260,7 +267,7 @@ class StatusToolbar(Gtk.ScrolledWindow):
             tip = f"Localization: {text} (getLocState)"
             if level == "lost":
                 tip += ": the robot does not know where it is — Go to › Set robot position"
-            cell.show_value(text, stale=not live, tooltip=tip)
+            cell.show_value(text, stale=not live, tooltip=tip, words=level)
 
     def _dock(self, state: str | None, live: bool) -> None:
         """The docking state, shown only while the server reports one (``dockInfo``)."""
@@ -294,7 +301,8 @@ class StatusToolbar(Gtk.ScrolledWindow):
             levels.append(f"shutdown at {robot.battery_shutdown:g} {unit}")
         tip = {"low": "Battery LOW", "critical": "Battery at SHUTDOWN level"}.get(state, "Battery")
         tip += f" ({', '.join(levels)})" if levels else ""
-        cell.show_value(text, stale=stale, tooltip=(why + "\n" + tip) if why else tip)
+        words = {"low": "low", "critical": "at shutdown level"}.get(state, "")
+        cell.show_value(text, stale=stale, tooltip=(why + "\n" + tip) if why else tip, words=words)
         for cls in ("low", "critical"):
             if cls == state and not stale:
                 cell.add_css_class(cls)
@@ -324,7 +332,9 @@ class StatusToolbar(Gtk.ScrolledWindow):
             text = {Phase.CONNECTING: "connecting", Phase.RECONNECTING: "reconnecting"}.get(
                 conn.phase, "down"
             )
-            cell.show_value(text, stale=True, tooltip=f"Not connected ({conn.phase.value})")
+            cell.show_value(
+                text, stale=True, tooltip=f"Not connected ({conn.phase.value})", words="not connected"
+            )
             cell.add_css_class(f"link-{LinkLevel.DOWN.value}")
             return
         rtt = (
@@ -347,7 +357,12 @@ class StatusToolbar(Gtk.ScrolledWindow):
                 f"Server not answering pings ({health.ping_failures} in a row): it may not hear our "
                 f"commands; driving is stopped\n{tip}"
             )
-        cell.show_value(text, stale=health.level is not LinkLevel.OK or health.ping_failures > 0, tooltip=tip)
+        cell.show_value(
+            text,
+            stale=health.level is not LinkLevel.OK or health.ping_failures > 0,
+            tooltip=tip,
+            words=f"link {health.level.value}",
+        )
         cell.add_css_class(f"link-{health.level.value}")
 
 
