@@ -27,6 +27,7 @@ from ..fleet.sessions import RobotSession  # noqa: E402
 from ..model.observables import Phase, RobotModel  # noqa: E402
 from ..settings.store import Profile  # noqa: E402
 from ..values.intents import Intent, ListServerCommands, MoveDistance, RunServerCommand, TurnBy, WatchStrings  # noqa: E402
+from .about import about_dialog  # noqa: E402
 from .banners import BannerStack  # noqa: E402
 from .config_page import ConfigPage  # noqa: E402
 from .details import DetailsWindow  # noqa: E402
@@ -149,19 +150,9 @@ class WindowDialogs:
 
     # -- About -----------------------------------------------------------------------------------
     def show_about(self) -> None:
-        from .. import __version__
-
-        about = Gtk.AboutDialog(
-            transient_for=self.window,
-            modal=True,
-            program_name="RTMU",
-            version=__version__,
-            comments="Robot Teleoperation, Mobile User interface: drive an ARIA (ArNetworking) robot "
-            "from a tablet or a laptop.",
-            logo_icon_name="io.github.rtmu.Rtmu",
-            license_type=Gtk.License.MIT_X11,
-        )
-        about.present()
+        """Help ▸ About, with the debug information of the robot shown (``about``)."""
+        conn = self.model.connection.value
+        about_dialog(self.window, conn, self.robot.session.controller.profile.name).present()
 
     # -- the controller's dialogs: Turn, Go, the palette -----------------------------------------
     def open_dialog(self, name: str) -> None:
