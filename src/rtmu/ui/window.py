@@ -6,8 +6,8 @@ header, STOP first and always on screen, and the full-screen bar), ``map_page``,
 (and where pictures go), ``toolbar``, ``banners``, ``actions`` (every ``win.*`` action and the
 menu), ``keys`` (the one key table), ``stop_keys`` (Space stops from every surface),
 ``keyboard_nav``, ``key_reach``, ``notice_router`` (where things are said), ``window_dialogs``,
-``handheld``, ``near_people``, ``bridge_toggle``. A new page goes into :attr:`MainWindow.stack`,
-a new action into ``actions``, a new dialog into ``window_dialogs``.
+``handheld``, ``near_people``, ``bridge_toggle``, ``idle_inhibit``, ``desktop_notify``. A new page
+goes into :attr:`MainWindow.stack`, a new action into ``actions``, a new dialog into ``window_dialogs``.
 
 Its two timers are the UI's heartbeat: every :data:`rtmu.control.controller.TICK` it renews the
 drive lease (``controller.tick``) — if this loop ever stalls, the lease lapses and the network
@@ -39,10 +39,12 @@ from .banners import BannerStack  # noqa: E402
 from .bars import FullscreenBar, HeaderBar  # noqa: E402
 from .bridge_toggle import BridgeToggle  # noqa: E402
 from .camera_page import CameraPage  # noqa: E402
+from .desktop_notify import DesktopNotifier  # noqa: E402
 from .details import DetailsWindow  # noqa: E402
 from .drive_input import DriveInput  # noqa: E402
 from .goals_panel import GoalsPanel  # noqa: E402
 from .handheld import Handheld  # noqa: E402
+from .idle_inhibit import IdleInhibit  # noqa: E402
 from .key_reach import KeyReach  # noqa: E402
 from .keyboard_nav import KeyboardNav  # noqa: E402
 from .map_page import MapPage  # noqa: E402
@@ -180,6 +182,8 @@ class MainWindow(Gtk.ApplicationWindow):
         self.key_reach = KeyReach(self)
         self.keyboard = KeyboardNav(self)  # Tab, F10, Ctrl+G, Alt+1…9, a pick mode's keys
         self.near_people = NearPeopleSwitch(self)  # View ▸ Near people: the speed cap
+        self.idle_inhibit = IdleInhibit(self, model, held=self.motion.held, say=self.motion.set_note)
+        self.notifier = DesktopNotifier(self, model, self.view_menu)  # while the window is not focused
 
     @property
     def session(self) -> RobotSession:
@@ -349,6 +353,7 @@ class MainWindow(Gtk.ApplicationWindow):
         self.map_page.refresh(slow)
         if slow:
             self.toolbar.refresh()
+            self.idle_inhibit.refresh()  # no screen lock or suspend while the robot moves
             self.camera_page.tick()
             loop_lag = getattr(self.controller.link, "loop_lag", None)  # a stalled network thread: said
             connected = self.model.connection.value.phase is Phase.CONNECTED
@@ -375,7 +380,14 @@ class MainWindow(Gtk.ApplicationWindow):
         for remove in self._unobserve:
             remove()
         self._unobserve = []
-        parts: tuple[_Part, ...] = (self.handheld, self.stop_keys, self.key_reach, self.near_people)
+        parts: tuple[_Part, ...] = (
+            self.handheld,
+            self.stop_keys,
+            self.key_reach,
+            self.near_people,
+            self.idle_inhibit,
+            self.notifier,
+        )
         for part in (*parts, self.map_page, self.toolbar, self.routes_panel, self.goals_panel):
             part.close()
         for part in (self.camera_page, self.foxglove, self.actions):
