@@ -135,7 +135,15 @@ def main(argv: list[str] | None = None) -> int:
     app = find_application(args.pid, args.timeout)
     for action in args.activate:
         activate(app, action)
-    out: dict[str, Any] = {"nodes": walk(app)}
+    nodes = walk(app)
+    deadline = time.monotonic() + args.timeout
+    while nodes[0]["role"] != "application" or len(nodes) < 2:  # registered, its tree not served yet
+        if time.monotonic() > deadline:
+            raise SystemExit(f"the application's tree could not be read: {nodes[:2]}")
+        time.sleep(0.5)
+        app = find_application(args.pid, args.timeout)
+        nodes = walk(app)
+    out: dict[str, Any] = {"nodes": nodes}
     if args.events > 0:
         out["events"] = listen(args.pid, args.events)
     print(json.dumps(out), flush=True)

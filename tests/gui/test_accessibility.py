@@ -16,6 +16,7 @@ import os
 import re
 import subprocess
 import sys
+import time
 from pathlib import Path
 from typing import Any
 
@@ -105,6 +106,13 @@ def test_every_control_has_a_name_and_the_map_says_where_the_robot_is(tmp_path: 
                 lambda: sim.call(lambda: any(s.subscriptions for s in sim.server.sessions)), 30, "subscribed"
             )
             nodes = read_tree(proc.pid, env, "win.dpad", "win.settings")
+            for _attempt in range(20):  # a busy machine: the D-pad and the dialog may come a little later
+                shown = {n["name"] for n in nodes}
+                if {"Forward", "Host"} <= shown:
+                    break
+                time.sleep(1.0)
+                nodes = read_tree(proc.pid, env)
+            assert len(nodes) > 100, f"a tree this small is not the window's: {nodes[:3]}"
             assert not unnamed_controls(nodes), "\n".join(unnamed_controls(nodes))
             names = {(n["role"], n["name"]) for n in nodes}
             for pad in ("Forward", "Turn left", "Turn right", "Backward", "Stop"):
