@@ -58,12 +58,21 @@ class Cell(Gtk.Box):
         self.append(row)
         self.stale = False
         self._said = ""
+        self._heading = caption
+        self.mark = ""
+        """A word the caption carries for a state its colour shows (``LOW``): not by colour alone."""
         self._tooltip: str | None = None
 
-    def show_value(self, text: str, *, stale: bool, tooltip: str | None = None, words: str = "") -> None:
-        """``words``: the state the value's colour shows (``low``, ``link stale``), for screen readers."""
+    def show_value(
+        self, text: str, *, stale: bool, tooltip: str | None = None, words: str = "", mark: str = ""
+    ) -> None:
+        """``words``: the state the value's colour shows (``low``, ``link stale``), for screen readers;
+        ``mark``: the same in one visible word after the caption (``Battery · LOW``)."""
         if self.value.get_text() != text:
             self.value.set_text(text)
+        if mark != self.mark:
+            self.mark = mark
+            self.caption.set_text(f"{self._heading} · {mark}" if mark else self._heading)
         said = ", ".join(w for w in (words, "not current" if stale else "") if w)
         if said != self._said:
             self._said = said
@@ -302,7 +311,8 @@ class StatusToolbar(Gtk.ScrolledWindow):
         tip = {"low": "Battery LOW", "critical": "Battery at SHUTDOWN level"}.get(state, "Battery")
         tip += f" ({', '.join(levels)})" if levels else ""
         words = {"low": "low", "critical": "at shutdown level"}.get(state, "")
-        cell.show_value(text, stale=stale, tooltip=(why + "\n" + tip) if why else tip, words=words)
+        mark = "" if stale else {"low": "LOW", "critical": "SHUTDOWN"}.get(state, "")
+        cell.show_value(text, stale=stale, tooltip=(why + "\n" + tip) if why else tip, words=words, mark=mark)
         for cls in ("low", "critical"):
             if cls == state and not stale:
                 cell.add_css_class(cls)
@@ -362,6 +372,7 @@ class StatusToolbar(Gtk.ScrolledWindow):
             stale=health.level is not LinkLevel.OK or health.ping_failures > 0,
             tooltip=tip,
             words=f"link {health.level.value}",
+            mark="" if health.level is LinkLevel.OK else health.level.value.upper(),
         )
         cell.add_css_class(f"link-{health.level.value}")
 
