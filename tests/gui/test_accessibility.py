@@ -105,10 +105,12 @@ def test_every_control_has_a_name_and_the_map_says_where_the_robot_is(tmp_path: 
             wait(
                 lambda: sim.call(lambda: any(s.subscriptions for s in sim.server.sessions)), 30, "subscribed"
             )
-            nodes = read_tree(proc.pid, env, "win.dpad", "win.settings")
+            nodes = read_tree(proc.pid, env, "win.dpad", "win.settings", "win.server-config")
             for _attempt in range(20):  # a busy machine: the D-pad and the dialog may come a little later
                 shown = {n["name"] for n in nodes}
-                if {"Forward", "Host"} <= shown:
+                if {"Forward", "Host", "Show up to"} <= shown and any(
+                    n["role"] == "spin button" for n in nodes
+                ):
                     break
                 time.sleep(1.0)
                 nodes = read_tree(proc.pid, env)

@@ -30,6 +30,8 @@ def name(widget: Gtk.Widget, label: str, description: str | None = None) -> None
         widget.update_property([Prop.LABEL], [label])
     else:
         widget.update_property([Prop.LABEL, Prop.DESCRIPTION], [label, description])
+    if isinstance(widget, Gtk.DropDown):  # its button, which takes the clicks, is unnamed in GTK 4.8
+        name_inner_toggle(widget, label)
 
 
 def name_menu_button(button: Gtk.MenuButton, label: str) -> None:
@@ -63,7 +65,7 @@ def mnemonic_button(text: str) -> Gtk.Button:
 
 
 def name_inner_toggle(widget: Gtk.Widget, label: str) -> None:
-    """The arrow button GTK builds inside a combo box with an entry (unnamed in GTK 4.8)."""
+    """The button GTK builds inside a drop-down or a combo box with an entry (unnamed in GTK 4.8)."""
     stack = [widget.get_first_child()]
     while stack:
         child = stack.pop()
