@@ -1,11 +1,13 @@
 """How fast the robot stops when the driving process is frozen (SIGSTOP) or killed (SIGKILL).
 
 Each trial starts a driving process (``bench.safety_parent``: the window's client
-core — runner, lease, guardian — without GTK), waits until the simulator drives,
-sends the signal, and times until the simulator stops commanding motion: a
-``stop`` arrives (the guardian's) or its own 2 s ratio-drive watchdog fires. The
-baseline is the same with the guardian disabled (the watchdog alone), measured in
-the same run. A soak drives with a healthy process and counts the guardian's
+core — fleet, runner, lease, its one shared guardian — without GTK), waits until the
+simulator drives, sends the signal, and times until the simulator stops commanding
+motion: a ``stop`` arrives (the guardian's) or its own 2 s ratio-drive watchdog fires.
+``safety.stop_after_window_*`` are the window's shared guardian; ``safety.own_guardian_*``
+the guardian of its own that ``rtmu bridge --allow-drive`` starts (``rtmu drive``'s works
+the same way). The baseline is the same with the guardian disabled (the watchdog alone),
+measured in the same run. A soak drives with a healthy process and counts the guardian's
 stops (each one would be a false alarm: a ``stop`` resets an ARIA server's mode).
 
 ``RTMU_BENCH_SAFETY_TRIALS`` (default 20) and ``RTMU_BENCH_SAFETY_SOAK_S`` (default
@@ -33,8 +35,8 @@ TRIALS = int(os.environ.get("RTMU_BENCH_SAFETY_TRIALS", "20"))
 SOAK_S = float(os.environ.get("RTMU_BENCH_SAFETY_SOAK_S", "60"))
 
 
-def _parent(sim: SimThread, guardian: bool, soak: float | None = None) -> subprocess.Popen[str]:
-    argv = [sys.executable, "-m", "bench.safety_parent", str(sim.port), "1" if guardian else "0"]
+def _parent(sim: SimThread, guardian: str, soak: float | None = None) -> subprocess.Popen[str]:
+    argv = [sys.executable, "-m", "bench.safety_parent", str(sim.port), guardian]
     if soak is not None:
         argv.append(str(soak))
     proc = subprocess.Popen(argv, stdout=subprocess.PIPE, text=True, cwd=REPO)
@@ -54,7 +56,7 @@ def _wait(condition, timeout: float) -> bool:  # type: ignore[no-untyped-def]
     return True
 
 
-def trial(sim: SimThread, signum: int, guardian: bool) -> float:
+def trial(sim: SimThread, signum: int, guardian: str) -> float:
     """Milliseconds from the signal until the simulator stopped commanding motion."""
     server = sim.server
     proc = _parent(sim, guardian)
@@ -82,7 +84,7 @@ def soak(sim: SimThread, seconds: float) -> tuple[int, int]:
     """(stops sent by the guardian, mode changes) while a healthy process drives for ``seconds``."""
     server = sim.server
     before = len(server.stop_log)
-    proc = _parent(sim, True, seconds)
+    proc = _parent(sim, "shared", seconds)
     changes = 0
     try:
         _wait(lambda: server.world.mode.NAME == "ratioDrive", 10)
@@ -121,13 +123,14 @@ def _stats(name: str, values: list[float], baseline: list[float]) -> list[Result
 def run() -> list[Result]:
     results: list[Result] = []
     with SimThread(SimConfig(port=0, seed=1, max_clients=10)) as sim:
-        for name, signum in (
-            ("safety.stop_after_window_freeze_ms", signal.SIGSTOP),
-            ("safety.stop_after_window_kill_ms", signal.SIGKILL),
-        ):
-            guarded = [trial(sim, signum, True) for _ in range(TRIALS)]
-            watchdog_only = [trial(sim, signum, False) for _ in range(max(3, TRIALS))]
-            results += _stats(name, guarded, watchdog_only)
+        for signum, what in ((signal.SIGSTOP, "freeze"), (signal.SIGKILL, "kill")):
+            watchdog_only = [trial(sim, signum, "none") for _ in range(max(3, TRIALS))]
+            for name, mode in (
+                (f"safety.stop_after_window_{what}_ms", "shared"),
+                (f"safety.own_guardian_stop_after_{what}_ms", "own"),
+            ):
+                guarded = [trial(sim, signum, mode) for _ in range(TRIALS)]
+                results += _stats(name, guarded, watchdog_only)
         spurious, changes = soak(sim, SOAK_S)
         results.append(Result("safety.guardian_spurious_stops", float(spurious), "count"))
         results.append(Result("safety.soak_mode_changes", float(changes), "count"))

@@ -3,9 +3,13 @@
 from __future__ import annotations
 
 import atexit
+import functools
+import importlib
+import importlib.util
 import os
 import shutil
 import tempfile
+from collections.abc import Sequence
 from pathlib import Path
 
 import pytest
@@ -24,6 +28,33 @@ atexit.register(shutil.rmtree, _DATA_HOME, ignore_errors=True)
 if "CI" not in os.environ:
     settings.register_profile("rtmu-local", deadline=None)
     settings.load_profile("rtmu-local")
+
+
+def _every_exit_code_is_one_its_help_lists() -> None:
+    """Every subcommand a test runs in this process (``rtmu.cli.main``) ends with a code its ``--help``
+    lists (its module's ``EXITS``, from the one table): the contract checked by every CLI test, not
+    only by tests/test_exit_codes.py. Wrapped before any test module imports ``main``."""
+    import rtmu.cli
+    from rtmu.base import exit_codes
+
+    run = rtmu.cli.main
+
+    @functools.wraps(run)
+    def main(argv: Sequence[str] | None = None) -> int:
+        code = run(argv)
+        name = next(iter(argv or ()), "")
+        if name and not name.startswith(("-", "_")) and importlib.util.find_spec(f"rtmu.subcommands.{name}"):
+            module = importlib.import_module(f"rtmu.subcommands.{name}")
+            listed = getattr(module, "EXITS", exit_codes.NETWORK)
+            assert code in listed, (
+                f"rtmu {name} exited {code}, which its --help does not list: {sorted(listed)}"
+            )
+        return code
+
+    rtmu.cli.main = main
+
+
+_every_exit_code_is_one_its_help_lists()
 
 
 @pytest.fixture(scope="session")

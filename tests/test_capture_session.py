@@ -20,7 +20,8 @@ from capture_builders import (
     update_numbers,
 )
 from rtmu.capture import open_capture
-from rtmu.capture.session_decoder import CaptureDecoder, DecodedPacket, DropReport
+from rtmu.capture.conversation import DecodedPacket, DropReport
+from rtmu.capture.session_decoder import CaptureDecoder
 from rtmu.protocol.fields import FieldWriter
 from rtmu.protocol.packet import encode_packet
 

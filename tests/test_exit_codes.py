@@ -24,12 +24,17 @@ from rtmu.base import exit_codes
 from rtmu.base.exit_codes import (
     EXIT_BAD_FILE,
     EXIT_CONNECTION,
+    EXIT_FOREIGN_CONFIG,
     EXIT_NO_DISPLAY,
+    EXIT_OK,
     EXIT_REFUSED,
     EXIT_SIGPIPE,
     EXIT_TIMEOUT,
     EXIT_UNSUPPORTED,
     EXIT_USAGE,
+    EXIT_WHY_DEAD_ZONE,
+    EXIT_WHY_ESTOP,
+    EXIT_WHY_STALLED,
 )
 from rtmu.cli import main
 from rtmu.package_data import project_map
@@ -41,13 +46,13 @@ RTMU = [sys.executable, "-m", "rtmu"]
 
 NETWORK_ARGS: dict[str, list[str]] = {
     "bridge": ["--foxglove", "--ws-port", "0"],
-    "call": ["--list"],
+    "call": ["updateNumbers"],
     "commands": [],
     "config": [],
     "dock": [],
     "doctor": [],
     "drawings": [],
-    "drive": ["--trans", "10", "--seconds", "1"],
+    "drive": ["--trans", "30", "--seconds", "1"],
     "files": ["ls"],
     "fleet": [],
     "goals": [],
@@ -118,7 +123,9 @@ def test_nothing_listening_is_a_connection_failure(name: str, tmp_path: Path) ->
     check(name, code, expected)
 
 
-@pytest.mark.parametrize("name", ["status", "probe", "goals", "record"])
+@pytest.mark.parametrize(
+    "name", ["status", "probe", "goals", "record", "config", "files", "scan", "mapedit", "why", "call"]
+)
 def test_a_server_that_never_answers_is_a_timeout(name: str, tmp_path: Path) -> None:
     with socket.socket() as listener:
         listener.bind(("127.0.0.1", 0))
@@ -137,6 +144,56 @@ def test_server_side_failures_have_their_codes(sim: SimThread, tmp_path: Path) -
     check("ptz", run("ptz", where, "--pan", "200", "--timeout", "5"), EXIT_USAGE)  # the head's own limits
     check("status", run("status", where, "--interval", "5"), EXIT_USAGE)
     check("image", run("image", where, "--out", str(tmp_path / "x.jpg"), "--quality", "0"), EXIT_USAGE)
+
+
+def test_the_commissioning_and_console_commands_failures(sim: SimThread, tmp_path: Path) -> None:
+    """files, scan, mapedit, config's care and call: each failure has the code its help lists."""
+    where = f"127.0.0.1:{sim.port}"
+    missing = ["get", "no/such.txt", "--out", str(tmp_path / "x.bin")]
+    check("files", run("files", where, *missing, "--timeout", "5"), EXIT_REFUSED)  # the robot's words
+    assert not (tmp_path / "x.bin").exists()
+    check("files", run("files", where, "ls", "../etc", "--timeout", "5"), EXIT_USAGE)  # before connecting
+    check("files", run("files", where, "rm", "x.txt", "--timeout", "5"), EXIT_USAGE)  # no --yes, no terminal
+    check("scan", run("scan", where, "stop", "--timeout", "5"), EXIT_REFUSED)  # no scan is running
+    check("scan", run("scan", where, "loop", "start", "--timeout", "5"), EXIT_REFUSED)
+    check("mapedit", run("mapedit", where, "--remove", "No Such Goal", "--timeout", "5"), EXIT_USAGE)
+    check("mapedit", run("mapedit", where, "--add-goal", "X", "--timeout", "5"), EXIT_USAGE)  # no --x --y
+    check("config", run("config", where, "--reset", "No/Such", "--timeout", "5"), EXIT_USAGE)
+    check("call", run("call", where, "noSuchData", "--timeout", "5"), EXIT_USAGE)
+    check("call", run("call", where, "gotoGoal", "Goal", "--timeout", "5"), EXIT_USAGE)  # needs --yes
+    check("call", run("call", where, "updateNumbers", "--timeout", "5"), EXIT_OK)
+
+
+def test_why_and_a_drive_that_did_not_move_exit_with_the_causes_code(tmp_path: Path) -> None:
+    """Asked to move and not moved is never 0: the cause's code, each one its help lists."""
+    with SimThread(SimConfig(port=0, map_path=ARENA)) as sim:
+        where = f"127.0.0.1:{sim.port}"
+        check("why", run("why", where, "--timeout", "5"), EXIT_OK)
+        check(
+            "drive",
+            run("drive", where, "--trans", "5", "--seconds", "0.3", "--timeout", "5"),
+            EXIT_WHY_DEAD_ZONE,
+        )
+        check("run", run("run", where, "SimulatorStallMotors", "--timeout", "5"), EXIT_OK)
+        check(
+            "drive",
+            run("drive", where, "--trans", "50", "--seconds", "0.3", "--timeout", "5"),
+            EXIT_WHY_STALLED,
+        )
+        check("run", run("run", where, "SimulatorClearStall", "--timeout", "5"), EXIT_OK)
+        check("run", run("run", where, "SimulatorEStop", "--timeout", "5"), EXIT_OK)
+        check("why", run("why", where, "--timeout", "5"), EXIT_WHY_ESTOP)
+        check("doctor", run("doctor", where, "--timeout", "5"), EXIT_WHY_ESTOP)  # its last step asks why
+
+
+def test_an_ld_robots_configuration_and_camera(tmp_path: Path) -> None:
+    """An Omron LD robot (aram): a configuration RTMU cannot edit yet is 18, no camera is 4."""
+    with SimThread(SimConfig(port=0, map_path=ARENA, profile="aram")) as aram:
+        where = f"127.0.0.1:{aram.port}"
+        check("config", run("config", where, "--timeout", "5"), EXIT_FOREIGN_CONFIG)
+        check("config", run("config", where, "--defaults", "--timeout", "5"), EXIT_FOREIGN_CONFIG)
+        check("video", run("video", where, "--seconds", "1", "--timeout", "5"), EXIT_UNSUPPORTED)
+        check("scan", run("scan", where, "loop", "start", "--timeout", "5"), EXIT_UNSUPPORTED)  # not on 6MTX
 
 
 def test_files_named_on_the_command_line(tmp_path: Path) -> None:

@@ -20,7 +20,8 @@ from dataclasses import dataclass
 import pytest
 
 from rtmu.capture import CaptureSource, open_capture
-from rtmu.capture.session_decoder import CaptureDecoder, DecodedPacket, DropReport, side_of
+from rtmu.capture.conversation import DecodedPacket, DropReport
+from rtmu.capture.session_decoder import CaptureDecoder, side_of
 from rtmu.protocol.fields import FieldReader
 from rtmu.protocol.payloads import control
 from rtmu.protocol.payloads.base import Side, payload_type_for

@@ -42,11 +42,29 @@ def exits_epilog(codes: tuple[int, ...] | None) -> str:
     return "Exit codes (one table for every rtmu command):\n" + exit_codes.table_text(codes)
 
 
+def actions_of(command: argparse.ArgumentParser) -> list[argparse.ArgumentParser]:
+    """The parsers of a subcommand's own action words (``rtmu files HOST ls``), if it has them."""
+    return [
+        parser
+        for action in command._actions
+        if isinstance(action, argparse._SubParsersAction)
+        for parser in action.choices.values()
+    ]
+
+
 def name_schema(command: argparse.ArgumentParser, schema: str | None) -> None:
     """Say in ``--json``'s help which published schema its lines follow (``subcommands.json_schemas``)."""
     for action in command._actions:
         if schema is not None and "--json" in action.option_strings and action.help:
             action.help += f" (schema {schema!r}: python -m rtmu.subcommands.json_schemas {schema})"
+
+
+def finish_help(command: argparse.ArgumentParser, codes: tuple[int, ...], schema: str | None) -> None:
+    """One style for a subcommand's help and its action words' helps: the exit codes, the schema named."""
+    for parser in (command, *actions_of(command)):
+        parser.formatter_class = HelpFormatter
+        parser.epilog = exits_epilog(codes)
+        name_schema(parser, schema)
 
 
 def build_parser() -> argparse.ArgumentParser:
@@ -67,10 +85,8 @@ def build_parser() -> argparse.ArgumentParser:
         register = getattr(module, "register", None)
         if register is not None:
             register(sub)
-            command = sub.choices[info.name]
-            command.formatter_class = HelpFormatter
-            command.epilog = exits_epilog(getattr(module, "EXITS", exit_codes.NETWORK))
-            name_schema(command, COMMAND_SCHEMA.get(info.name))
+            codes = getattr(module, "EXITS", exit_codes.NETWORK)
+            finish_help(sub.choices[info.name], codes, COMMAND_SCHEMA.get(info.name))
     gui = importlib.util.find_spec("rtmu.ui.app")
     if gui is not None:
         from .ui import app as gui_app

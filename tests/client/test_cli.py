@@ -19,6 +19,7 @@ from rtmu.base.exit_codes import (
     EXIT_TIMEOUT,
     EXIT_UNSUPPORTED,
     EXIT_USAGE,
+    EXIT_WHY_DEAD_ZONE,
     EXIT_WHY_NO_DRIVE,
 )
 from rtmu.cli import main
@@ -352,12 +353,18 @@ def test_drive_json_after_ctrl_c_says_it_was_interrupted(sim: SimThread, pwfile:
     assert obj["interrupted"] == "SIGINT" and set(obj["after"]) == STATUS_KEYS and obj["seconds"] == 20
 
 
-def test_drive_inside_arias_dead_zone_says_the_robot_will_not_move(
+def test_drive_inside_arias_dead_zone_says_so_and_does_not_exit_0(
     sim: SimThread, pwfile: Path, capsys: pytest.CaptureFixture[str]
 ) -> None:
+    """Issue 22 (say so) and issue 24 (asked to move and did not: never 0) both hold: a warning first,
+    then the answer names the dead zone, with its own code."""
     before = sim.snapshot()
-    assert main(["drive", *login(sim, pwfile), "--trans", "10", "--seconds", "0.5"]) == EXIT_OK
-    assert "inside ARIA's dead zone" in capsys.readouterr().err
+    assert main(["drive", *login(sim, pwfile), "--trans", "10", "--seconds", "0.5"]) == EXIT_WHY_DEAD_ZONE
+    err = capsys.readouterr().err
+    warning, _, answer = err.partition("the robot did not move: ")
+    assert "inside ARIA's dead zone" in warning and "the robot will not move" in warning, err
+    assert "inside ARIA's dead zone" in answer and "ask for more than 10 % translation" in answer, err
+    assert "nothing RTMU can read says why" not in err
     after = sim.snapshot()
     assert (after.x, after.y) == (before.x, before.y), "ARIA's dead zone: it really did not move"
     assert main(["drive", *login(sim, pwfile), "--trans", "11", "--seconds", "0.3"]) == EXIT_OK

@@ -74,21 +74,24 @@ def test_goto_sends_a_route_goal_and_refuses_an_unknown_one(
 
 
 def test_data_store_values_become_toolbar_fields() -> None:
+    # The localization score and the distance left are navigation's, on ARNL's scale (0–1)
     # The names 6MTX robots list …
-    assert ld_data.store_fields("DataStore_LaserLocalizationScore", "87.4") == {"loc_score": 87}
+    assert ld_data.store_fields("DataStore_LaserLocalizationScore", "87.4") == {"loc_score": 0.874}
     assert ld_data.store_fields("DataStore_WirelessQuality", "35", "(0-70)") == {"wifi_quality": 50}
-    assert ld_data.store_fields("DataStore_Distance_to_goal", "12400") == {"goal_distance_mm": 12400}
+    assert ld_data.store_fields("DataStore_Distance_to_goal", "12400") == {"remaining_mm": 12400}
     assert ld_data.store_fields("DataStore_Closest_Obstacle_Distance", "800") == {"closest_obstacle_mm": 800}
     assert ld_data.store_fields("DataStore_DockingState", "Docked") == {}
     # … and other spellings of the same values.
-    assert ld_data.store_fields("DataStore_Localization_Score", "87.4") == {"loc_score": 87}
+    assert ld_data.store_fields("DataStore_Localization_Score", "87.4") == {"loc_score": 0.874}
     assert ld_data.store_fields("DataStore_WiFi_Quality", "35", "Wi-Fi link quality (0–70)") == {
         "wifi_quality": 50
     }
     assert ld_data.store_fields("DataStore_WiFi_Quality", "35") == {"wifi_quality": 35}
-    assert ld_data.store_fields("DataStore_Distance_To_Goal", "12400") == {"goal_distance_mm": 12400}
+    assert ld_data.store_fields("DataStore_Distance_To_Goal", "12400") == {"remaining_mm": 12400}
     assert ld_data.store_fields("DataStore_Closest_Obstacle", "none") == {"closest_obstacle_mm": None}
     assert ld_data.store_fields("DataStore_Dock_State", "Docked") == {}
+    assert ld_data.store_fields("DataStore_Distance_to_goal", "0") == {"remaining_mm": None}  # 0: no goal
+    assert ld_data.store_fields("DataStore_LaserLocalizationScore", "130") == {"loc_score": 1.0}
 
 
 def test_say_sends_the_text(aram: SimThread) -> None:

@@ -91,7 +91,7 @@ def _bad_status_server() -> TestServer:
     [
         ["status", "--once"],
         ["status", "--count", "2", "--interval", "20"],
-        ["drive", "--trans", "10", "--seconds", "0.2"],
+        ["drive", "--trans", "30", "--seconds", "0.2"],  # outside ARIA's dead zone: no warning line
     ],
 )
 def test_a_malformed_status_exits_3_with_one_line(

@@ -1,17 +1,21 @@
 """Observers never command: every looking subcommand, during a navigation, on every exit path.
 
-A real simulator navigates the robot between two far goals, driven by an operator connection of
-this test. Each observer subcommand runs as its own process through its own fault proxy (so the
-simulator's per-connection request log, ``SimServer.heard``, tells whose requests are whose) and
-ends by itself, by SIGINT, SIGTERM or SIGHUP, or by a lost link. Afterwards the simulator must have
-heard no motion request (``rtmu.protocol.motion``) from any of them: only the operator commanded.
-Commands that would finish at once are held mid-command by the proxy (the server's answers are held
-after their first request) so that a signal or a lost link finds them connected.
+Two real simulators — an LD ``aram`` one (routes, say, LD docking) and an ARIA one (a camera, a
+camera head, ArConfig, which 6MTX robots do not list) — each navigate their robot between two far
+goals, driven by an operator connection of this test. Each observer subcommand runs as its own
+process through its own fault proxy (so the simulator's per-connection request log,
+``SimServer.heard``, tells whose requests are whose) against the one that offers what it looks at,
+and ends by itself (with the code that says it did its work), by SIGINT, SIGTERM or SIGHUP, or by a
+lost link (never with 0). Afterwards the simulators must have heard no motion request
+(``rtmu.protocol.motion``) from any of them: only the operator commanded. Commands that would finish
+at once are held mid-command by the proxy (the server's answers are held after their first request)
+so that a signal or a lost link finds them connected. Every code is one the command's help lists.
 """
 
 from __future__ import annotations
 
 import asyncio
+import importlib
 import os
 import signal
 import subprocess
@@ -25,7 +29,9 @@ from pathlib import Path
 import pytest
 
 from linkfaults import TO_CLIENT, TO_SERVER, Direction, FaultProxy
-from rtmu.cli import build_parser
+from rtmu.base import exit_codes
+from rtmu.base.exit_codes import EXIT_CONNECTION, EXIT_OK, EXIT_USAGE, EXIT_WHY_NAVIGATING
+from rtmu.cli import build_parser, main
 from rtmu.client.connection import AriaClient
 from rtmu.client.errors import MotionRefused
 from rtmu.client.roles import Role
@@ -37,11 +43,19 @@ from rtmu.protocol.payloads.navigation import GotoGoal
 from rtmu.sim import SimConfig, SimThread
 
 from .navsim import OFFICE
+from .servers import SPECS, ServerThread, TestServer
 from .uiqueue import eventually
 
 GOALS = ("Corridor End", "Room 101")
 """Far apart on the office map: the robot is always on its way to one of them."""
 ENDING = {"sigint": signal.SIGINT, "sigterm": signal.SIGTERM, "sighup": signal.SIGHUP}
+
+
+DONE = frozenset({EXIT_OK})
+DURING_NAVIGATION = frozenset({EXIT_OK, EXIT_WHY_NAVIGATING})
+"""``why`` (and doctor's last step) during a navigation: 28, or 0 at a goal between two legs."""
+DOCTOR_STEPS = frozenset(range(exit_codes.EXIT_DOCTOR_RESOLVE, exit_codes.EXIT_DOCTOR_STATUS + 1))
+"""A doctor names the step at which the link went."""
 
 
 @dataclass(frozen=True)
@@ -53,6 +67,15 @@ class Observer:
     """One that runs until ended (None: ``ends``, held by the proxy after its first request)."""
     holds_at_login: bool = False
     """It sends no request at all (``probe`` reads the data list): held after its INTRODUCTION."""
+    sim: str = "aram"
+    """The simulator that offers what it looks at: ``aram`` or ``aria`` (a camera, ArConfig)."""
+    ended: frozenset[int] = DONE
+    """The codes it ends with by itself during a navigation: it did its work (not 4, not offered)."""
+    waits: bool = True
+    """It waits for the server's answers (False: ``say`` sends its one command and is done), so a link
+    lost while it runs is never reported as done…"""
+    lost: frozenset[int] = frozenset({EXIT_CONNECTION})
+    """…but with these codes."""
 
     @property
     def held(self) -> bool:
@@ -64,8 +87,9 @@ OBSERVERS = (
     Observer("watch", ("watch", "{addr}", "--seconds", "1"), ("watch", "{addr}")),
     Observer(
         "video",
-        ("video", "{addr}", "--seconds", "1", "--out", "{tmp}/frames"),
+        ("video", "{addr}", "--seconds", "3", "--out", "{tmp}/frames"),
         ("video", "{addr}", "--seconds", "300"),
+        sim="aria",
     ),
     Observer(
         "record",
@@ -78,25 +102,34 @@ OBSERVERS = (
         ("bridge", "{addr}", "--foxglove", "--ws-port", "0"),
     ),
     Observer("probe", ("probe", "{addr}"), holds_at_login=True),
-    Observer("image", ("image", "{addr}", "--out", "{tmp}/p.jpg")),
+    Observer("image", ("image", "{addr}", "--out", "{tmp}/p.jpg"), sim="aria"),
     Observer("drawings", ("drawings", "{addr}")),
     Observer("map", ("map", "{addr}", "--out", "{tmp}/m.map")),
-    Observer("ptz", ("ptz", "{addr}", "--json")),
+    Observer("ptz", ("ptz", "{addr}", "--json"), sim="aria"),
     Observer("goals", ("goals", "{addr}")),
     Observer("routes", ("routes", "{addr}")),
     Observer("commands", ("commands", "{addr}")),
-    Observer("config", ("config", "{addr}")),
-    Observer("say", ("say", "{addr}", "hello")),
-    Observer("doctor", ("doctor", "{addr}")),
-    Observer("why", ("why", "{addr}")),
-    Observer("call", ("call", "{addr}", "getGoals")),
+    Observer("config", ("config", "{addr}"), sim="aria"),
+    Observer("say", ("say", "{addr}", "hello"), waits=False),
+    Observer("doctor", ("doctor", "{addr}"), ended=DURING_NAVIGATION, lost=DOCTOR_STEPS),
     Observer("files", ("files", "{addr}", "ls")),
     Observer("scan", ("scan", "{addr}", "status")),
-    Observer("mapedit", ("mapedit", "{addr}", "--check-map")),
+    Observer(  # re-reading an unchanged map file changes nothing; no mapUpdated comes, so it waits
+        "mapedit",
+        ("mapedit", "{addr}", "--check-map", "--timeout", "3"),
+        ("mapedit", "{addr}", "--check-map"),
+    ),
+    Observer("why", ("why", "{addr}"), ended=DURING_NAVIGATION),
+    Observer(
+        "call", ("call", "{addr}", "updateNumbers"), ("call", "{addr}", "updateNumbers", "--every", "100")
+    ),
 )
-"""Run against an LD (``aram``) simulator: it offers everything they look at (routes, say, dock…)."""
+"""Each against the simulator that offers everything it looks at (routes, say, dock … or a camera)."""
 OPERATORS = {"drive", "goto", "home", "dock", "localize", "patrol", "run"}
 """Subcommands that may command motion (a test of their own stops lives in test_nav_cli / test_cli)."""
+OPERATOR_WITH = {"why": "--fix", "call": "--yes"}
+"""Observers that become operators only with this option (a fix may send stop; a confirmed call may
+be a motion request): the option is the operator's explicit yes."""
 OFFLINE = {"decode", "mapinfo", "sim", "replay"}
 """Subcommands that reach no robot server (replay's own rule: tests/client/test_replay_session.py)."""
 
@@ -108,6 +141,9 @@ def test_every_subcommand_is_an_observer_an_operator_or_offline() -> None:
     observers = {o.name for o in OBSERVERS} | {"fleet"}
     assert names == observers | OPERATORS | OFFLINE, "say whether a new subcommand commands motion"
     assert not observers & OPERATORS
+    assert set(OPERATOR_WITH) <= observers, "observers unless the option is given"
+    for name, option in OPERATOR_WITH.items():
+        assert any(option in a.option_strings for a in sub.choices[name]._actions), (name, option)  # type: ignore[attr-defined]
 
 
 class Navigation:
@@ -147,13 +183,20 @@ class Navigation:
 
 
 @pytest.fixture(scope="module")
-def navigating() -> Iterator[SimThread]:
-    config = SimConfig(port=0, map_path=OFFICE, seed=3, profile="aram")
-    with SimThread(config) as sim, Navigation(sim.port) as nav:
-        eventually(lambda: sim.snapshot().status.startswith("Going to"), timeout=30)
-        yield sim
-        assert nav.sent >= 1
-        assert sim.snapshot().status.startswith(("Going to", "Arrived at")), "something stopped it"
+def navigating() -> Iterator[dict[str, SimThread]]:
+    with (
+        SimThread(SimConfig(port=0, map_path=OFFICE, seed=3, profile="aram")) as aram,
+        SimThread(SimConfig(port=0, map_path=OFFICE, seed=3)) as aria,
+        Navigation(aram.port) as nav_aram,
+        Navigation(aria.port) as nav_aria,
+    ):
+        sims = {"aram": aram, "aria": aria}
+        for sim in sims.values():
+            eventually(lambda sim=sim: sim.snapshot().status.startswith("Going to"), timeout=30)  # type: ignore[misc]
+        yield sims
+        assert nav_aram.sent >= 1 and nav_aria.sent >= 1
+        for kind, sim in sims.items():
+            assert sim.snapshot().status.startswith(("Going to", "Arrived at")), f"something stopped {kind}"
 
 
 def hold_after_first_request(proxy: FaultProxy, *, at_login: bool) -> None:
@@ -176,6 +219,8 @@ class Run:
     proxy: FaultProxy
     process: subprocess.Popen[str]
     signalled: bool = False
+    cut: bool = False
+    """Its link was cut while it ran."""
 
     def peers(self) -> set[str]:
         return {f"127.0.0.1:{port}" for port in self.proxy.server_ports}
@@ -190,8 +235,9 @@ def start(observer: Observer, port: int, tmp: Path, *, running: bool) -> Run:
     where = tmp / observer.name
     where.mkdir(exist_ok=True)
     args = [a.format(addr=f"127.0.0.1:{proxy.port}", tmp=where) for a in argv]
+    timeout = [] if "--timeout" in args else ["--timeout", "30"]
     process = subprocess.Popen(
-        [sys.executable, "-m", "rtmu", *args, "--timeout", "30"],
+        [sys.executable, "-m", "rtmu", *args, *timeout],
         stdin=subprocess.DEVNULL,
         stdout=subprocess.DEVNULL,
         stderr=subprocess.PIPE,
@@ -240,19 +286,28 @@ def assert_no_motion(sim: SimThread, runs: list[Run]) -> None:
         assert not motion, f"rtmu {run.observer.name} (an observer) sent {motion}"
 
 
+def declared(name: str) -> tuple[int, ...]:
+    """The codes ``rtmu NAME --help`` lists (its module's ``EXITS``)."""
+    module = importlib.import_module(f"rtmu.subcommands.{name}")
+    return tuple(getattr(module, "EXITS", exit_codes.NETWORK))
+
+
 @pytest.mark.parametrize("path", ["end", "sigint", "sigterm", "sighup", "lost link"])
 def test_no_observer_sends_a_motion_request_during_a_navigation(
-    navigating: SimThread, tmp_path: Path, path: str
+    navigating: dict[str, SimThread], tmp_path: Path, path: str
 ) -> None:
     running = path != "end"
-    runs = [start(o, navigating.port, tmp_path, running=running) for o in OBSERVERS]
+    runs = [start(o, navigating[o.sim].port, tmp_path, running=running) for o in OBSERVERS]
+    sim_of = {run.observer.name: navigating[run.observer.sim] for run in runs}
     try:
-        wait_connected(navigating, runs)
+        for kind, sim in navigating.items():
+            wait_connected(sim, [run for run in runs if run.observer.sim == kind])
         for run in runs:
             if path in ENDING and run.process.poll() is None:
                 run.process.send_signal(ENDING[path])
                 run.signalled = True
             elif path == "lost link":
+                run.cut = run.process.poll() is None
                 run.proxy.reset()
         if path == "lost link":  # a recorder or bridge reconnects and records on: end it once it has
             for run in runs:
@@ -267,15 +322,55 @@ def test_no_observer_sends_a_motion_request_during_a_navigation(
             if run.process.poll() is None:
                 run.process.kill()
             run.proxy.close()
-    assert_no_motion(navigating, runs)
     for run in runs:
-        code, err = ended[run.observer.name]
-        assert code >= 0, f"rtmu {run.observer.name} was killed by a signal instead of ending: {err}"
+        assert_no_motion(sim_of[run.observer.name], [run])
+    for run in runs:
+        name = run.observer.name
+        code, err = ended[name]
+        assert code >= 0, f"rtmu {name} was killed by a signal instead of ending: {err}"
+        assert code in declared(name), f"rtmu {name} exited {code}, which its --help does not list: {err}"
+        if path == "end":
+            assert code in run.observer.ended, f"rtmu {name} did not do its work: {code} {err}"
         if path in ENDING and run.signalled:
-            assert code == 128 + ENDING[path], (run.observer.name, code, err)
+            assert code == 128 + ENDING[path], (name, code, err)
         if path == "lost link" and run.signalled:
-            assert code == 128 + signal.SIGINT, (run.observer.name, code, err)
-    assert navigating.snapshot().status.startswith(("Going to", "Arrived at"))
+            assert code == 128 + signal.SIGINT, (name, code, err)
+        elif path == "lost link" and run.cut and run.observer.waits:
+            assert code in run.observer.lost, f"rtmu {name} lost its link and exited {code}: {err}"
+    for sim in navigating.values():
+        assert sim.snapshot().status.startswith(("Going to", "Arrived at"))
+
+
+def test_the_console_never_sends_a_motion_request_without_yes_whatever_its_description() -> None:
+    """A server may describe ``tourGoalsInList`` as a list of names: it is still a motion request."""
+    specs = [
+        *SPECS,
+        ("tourGoalsInList", "the names it knows", "none", "string", "Navigation", "RETURN_SINGLE"),
+    ]
+    with ServerThread(TestServer(specs)) as server:
+        where = f"127.0.0.1:{server.port}"
+        assert main(["call", where, "tourGoalsInList", "--timeout", "5"]) == EXIT_USAGE
+        assert main(["call", where, "stop", "--timeout", "5"]) == EXIT_USAGE
+        assert main(["call", where, "updateNumbers", "--timeout", "5"]) == EXIT_OK  # a read needs no yes
+        assert not [n for n in server.names() if n in MOTION_REQUESTS]
+        assert main(["call", where, "stop", "--yes", "--timeout", "5"]) == EXIT_OK  # an operator now
+        assert "stop" in server.names()
+
+
+def test_a_lost_link_while_waiting_for_a_broadcast_is_a_connection_failure() -> None:
+    """mapedit --check-map waits for mapUpdated: a lost link is 3, not "the file had not changed"."""
+    specs = [*SPECS, ("checkMap", "re-read the map file", "none", "none", "Map", "RETURN_NONE")]
+    server = TestServer(specs)
+
+    def crash_on_check_map(side, args):  # type: ignore[no-untyped-def]
+        server.kill(side)  # a server that goes away instead of re-reading its map
+        return None
+
+    server.handlers["checkMap"] = crash_on_check_map
+    with ServerThread(server):
+        code = main(["mapedit", f"127.0.0.1:{server.port}", "--check-map", "--timeout", "20"])
+    assert code == EXIT_CONNECTION
+    assert "checkMap" in server.names()
 
 
 def test_an_observers_client_refuses_motion_before_the_wire() -> None:

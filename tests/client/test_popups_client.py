@@ -18,7 +18,7 @@ from typing import Any
 import pytest
 
 from rtmu.base.notices import Kind, Notice
-from rtmu.client.custom_commands import MAX_ARGUMENT, ServerCommand, list_commands
+from rtmu.client.custom_commands import MAX_ARGUMENT, CustomCommand, list_commands
 from rtmu.client.popups import MAX_MESSAGE, MAX_OPEN
 from rtmu.client.runner import ClientRunner
 from rtmu.model.observables import Phase, RobotModel
@@ -164,7 +164,7 @@ def test_commands_are_listed_with_descriptions_and_run(sim: SimThread, rig: Rig)
 
 
 def test_a_string_command_raises_a_popup(sim: SimThread, rig: Rig) -> None:
-    cmd = ServerCommand("SimulatorPopup", "", True)
+    cmd = CustomCommand("SimulatorPopup", "", True)
     rig.runner.send(RunServerCommand(cmd.name, "Asked|by a command|Go,Stay|0", cmd.takes_argument)).result(10)
     rig.wait(lambda: any(p.title == "Asked" for p in rig.popups.open))
     (card,) = [p for p in rig.popups.open if p.title == "Asked"]
@@ -172,7 +172,7 @@ def test_a_string_command_raises_a_popup(sim: SimThread, rig: Rig) -> None:
 
 
 def test_an_over_long_argument_is_refused_before_sending(rig: Rig) -> None:
-    cmd = ServerCommand("SimulatorPopup", "", True)
+    cmd = CustomCommand("SimulatorPopup", "", True)
     with pytest.raises(ValueError):
         rig.runner.send(RunServerCommand(cmd.name, "x" * (MAX_ARGUMENT + 1), True)).result(10)
 

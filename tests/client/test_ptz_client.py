@@ -16,7 +16,7 @@ from typing import Any
 
 import pytest
 
-from rtmu.base.exit_codes import EXIT_OK, EXIT_UNSUPPORTED, EXIT_USAGE
+from rtmu.base.exit_codes import EXIT_CONNECTION, EXIT_OK, EXIT_TIMEOUT, EXIT_UNSUPPORTED, EXIT_USAGE
 from rtmu.cli import main
 from rtmu.client.ptz import MAX_NAME, NO_HEAD, NO_LIST, POLL_MS
 from rtmu.client.runner import ClientRunner
@@ -236,6 +236,20 @@ def test_cli_shows_and_points_the_head(sim: SimThread, capsys: pytest.CaptureFix
 def test_cli_without_a_camera_exits_4() -> None:
     with SimThread(SimConfig(port=0, map_path=OFFICE, camera=False)) as s:
         assert main(["ptz", f"127.0.0.1:{s.port}", "--timeout", "5"]) == EXIT_UNSUPPORTED
+
+
+def test_cli_with_a_camera_list_that_never_comes_is_a_timeout_not_no_head(
+    capsys: pytest.CaptureFixture[str],
+) -> None:
+    """The window shows the reason; the command line says what happened: 5 silent, 3 malformed."""
+    server = TestServer([*SPECS, *CAMERA_SPECS])  # getCameraList listed, never answered
+    with ServerThread(server):
+        assert main(["ptz", f"127.0.0.1:{server.port}", "--timeout", "1"]) == EXIT_TIMEOUT
+    assert "getCameraList" in capsys.readouterr().err
+    server = TestServer([*SPECS, *CAMERA_SPECS])
+    server.handlers["getCameraList"] = lambda s, a: [b"\x05\x00"]  # five cameras, then nothing
+    with ServerThread(server):
+        assert main(["ptz", f"127.0.0.1:{server.port}", "--timeout", "5"]) == EXIT_CONNECTION
 
 
 def test_a_watched_position_is_polled_again_after_a_reconnect() -> None:

@@ -8,7 +8,8 @@ import pytest
 from PIL import Image
 
 from rtmu.capture import open_capture
-from rtmu.capture.session_decoder import CaptureDecoder, DecodedPacket
+from rtmu.capture.conversation import DecodedPacket
+from rtmu.capture.session_decoder import CaptureDecoder
 from rtmu.client.video_feed import BadFrame, FrameStats, RateGovernor, check_frame, frame_stamp, parse_frame
 from rtmu.protocol.payloads.camera import VideoFrame
 from rtmu.sim.camera import stamp_jpeg

@@ -130,6 +130,19 @@ def test_a_drive_nothing_explains_is_unexplained_even_with_a_no_stop_warning() -
     assert explained.exit_code == 26
 
 
+def test_a_drive_inside_arias_dead_zone_is_its_own_cause_not_unexplained() -> None:
+    """ArActionRatioInput ignores up to ±10 % translation and under ±5 % rotation: the request is why."""
+    answer = unexplained(diagnose(Facts(offers=ALL), Motion(10, 4.9)))
+    assert [r.cause for r in answer.reasons] == [Cause.DEAD_ZONE] and answer.exit_code == 35
+    assert "dead zone" in answer.sentence() and "more than 10 %" in answer.sentence()
+    assert causes(Facts(offers=ALL), Motion(-10, 0)) == [Cause.DEAD_ZONE]
+    assert causes(Facts(offers=ALL), Motion(11, 0)) == []
+    assert causes(Facts(offers=ALL), Motion(0, 5)) == []
+    assert causes(Facts(offers=ALL), Motion(0, 0)) == [], "nothing asked for: no dead zone"
+    assert causes(Facts(offers=ALL)) == [], "rtmu why asks about no drive in particular"
+    assert causes(Facts(offers=frozenset({"stop"})), Motion(5, 0)) == [Cause.NO_DRIVE], "may not drive at all"
+
+
 def test_replies_of_unknown_layout_are_read_only_where_safe() -> None:
     assert split_fields(b"") == ()
     assert split_fields(b"Fault A\x00Fault B\x00") == ("Fault A", "Fault B")

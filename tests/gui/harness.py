@@ -28,6 +28,7 @@ gi.require_version("Graphene", "1.0")
 from gi.repository import Gdk, GdkX11, GLib, Graphene, Gtk  # noqa: E402
 from PIL import Image  # noqa: E402
 
+from rtmu.fleet.sessions import RobotSession  # noqa: E402
 from rtmu.model.observables import OperatorState, Phase, RobotModel  # noqa: E402
 from rtmu.package_data import APP_ID  # noqa: E402
 from rtmu.ui.application import RtmuApplication  # noqa: E402
@@ -175,6 +176,15 @@ class Gui:
         pump(lambda: self.model.robot.value.numbers_at is not None, timeout, "the first robot status")
         if self.model.map.value.state == "ready":
             pump(lambda: self.stage.last_frame_complete, timeout, "a frame with the whole map drawn")
+        self.wait_armed(timeout=timeout)
+
+    def wait_armed(self, session: RobotSession | None = None, timeout: float = 10.0) -> None:
+        """Until the window's guardian is armed for ``session`` (default: the one shown): before that
+        a drive key is refused (a robot may drive only once its guardian can stop it)."""
+        shown = session or self.window.session
+        seat = shown.seat
+        if seat is not None and shown.controller.supports("ratioDrive"):
+            pump(lambda: seat.waiting_reason() is None, timeout, f"the guardian to be armed for {shown.name}")
 
     # -- keys ----------------------------------------------------------------------------------
     def xid(self) -> int:

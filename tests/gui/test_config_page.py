@@ -59,7 +59,7 @@ def open_page(gui: Gui) -> ConfigPage:
                     sub.get_item_attribute_value(k, "label", None).get_string()
                     for k in range(sub.get_n_items())
                 ]
-    assert labels == ["Connection settings…", "Configuration…"]
+    assert labels == ["Connection settings…", "Configuration…", "Console…"]
     gui.window.activate_action("win.server-config", None)
     pump(lambda: page(gui) is not None, 5, "the configuration page")
     p = page(gui)

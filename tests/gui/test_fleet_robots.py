@@ -56,6 +56,7 @@ def open_fleet(screenshots: Path, name: str, sims: list[SimThread]) -> Gui:
     pump(lambda: len(fleet) == 3, 10, "three robot sessions")
     pump(lambda: all(s.state.robot.value.numbers_at is not None for s in fleet), 15, "every robot's status")
     pump(lambda: all(s.state.map.value.state == "ready" for s in fleet), 20, "every robot's map")
+    gui.wait_armed()
     gui.stage.fit()
     idle(0.3)
     return gui
@@ -110,6 +111,7 @@ def click_row(gui: Gui, name: str) -> None:
     assert row is not None
     gui.click(row)
     pump(lambda: gui.app.fleet.selected.value is session(gui, name), 5, f"{name} to be selected")
+    gui.wait_armed(session(gui, name))  # it drives on a key pressed once its guardian can stop it
 
 
 def test_three_robots_are_listed_and_drawn_each_in_its_colour(
@@ -204,8 +206,13 @@ def test_one_killed_server_greys_its_robot_and_the_rest_carry_on(
         second = session(gui, "robot2")
         where3 = on_screen(gui, third)
         sims[2].kill()
+        # the row's link words follow the connection's state at the list's own pace (~150 ms)
         pump(lambda: row_text(third).stale, 10, "robot3's row to go stale")
-        assert "lost" in row_text(third).link or "reconnect" in row_text(third).link
+        pump(
+            lambda: "lost" in row_text(third).link or "reconnect" in row_text(third).link,
+            5,
+            "robot3 said lost",
+        )
         sims[1].call(lambda: sims[1].server.world.wander())  # robot2 goes on moving by itself
         start2 = second.state.robot.value
         updates2 = b.drawn_updates.get("robot2", 0)

@@ -18,10 +18,11 @@ from pathlib import Path
 import pytest
 
 from rtmu.guardian.halt import IDENTIFIER
+from rtmu.settings.store import DirectRobot, Profile, Settings, save_settings
 from rtmu.sim import SimConfig, SimThread
 
 from .harness import OFFICE_MAP
-from .process import connect_and_hold_up, wait, xdotool
+from .process import connect_and_hold_up, subscribed, wait, xdotool
 
 
 def guardian_stops(sim: SimThread) -> int:
@@ -60,3 +61,82 @@ def test_a_killed_or_frozen_window_is_stopped_by_its_guardian(signum: int, tmp_p
             proc.wait(5)
         # With the window gone its guardian leaves too (EOF on its pipe).
         wait(lambda: not sim.call(lambda: list(sim.server.sessions)), 10, "the guardian to log out")
+
+
+def logins(sim: SimThread) -> int:
+    return len(sim.call(lambda: list(sim.server.sessions)))
+
+
+def _guardians_of(pid: int) -> list[int]:
+    found = []
+    for entry in Path("/proc").iterdir():
+        if not entry.name.isdigit():
+            continue
+        try:
+            ppid = int((entry / "stat").read_text().rsplit(")", 1)[1].split()[1])
+            cmdline = (entry / "cmdline").read_bytes()
+        except (OSError, ValueError, IndexError):
+            continue
+        if ppid == pid and b"rtmu.guardian" in cmdline:
+            found.append(int(entry.name))
+    return found
+
+
+@pytest.mark.parametrize("signum", [signal.SIGKILL, signal.SIGSTOP], ids=["SIGKILL", "SIGSTOP"])
+def test_a_fleet_window_killed_or_frozen_is_stopped_by_its_one_guardian_at_the_selected_robot(
+    signum: int, tmp_path: Path
+) -> None:
+    """Two robots, robot2 selected by keyboard and driven: ONE guardian, armed for robot2, stops it."""
+    with (
+        SimThread(SimConfig(port=0, map_path=OFFICE_MAP, seed=1)) as one,
+        SimThread(SimConfig(port=0, map_path=OFFICE_MAP, seed=2)) as two,
+    ):
+        robots = (DirectRobot("robot1", "127.0.0.1", one.port), DirectRobot("robot2", "127.0.0.1", two.port))
+        save_settings(
+            Settings({"two": Profile("two", robots=robots)}, "two"), tmp_path / "rtmu" / "settings.toml"
+        )
+        env = dict(os.environ, XDG_CONFIG_HOME=str(tmp_path), XDG_DATA_HOME=str(tmp_path))
+        proc = subprocess.Popen(
+            [sys.executable, "-m", "rtmu", "--profile", "two"],
+            stdout=subprocess.DEVNULL,
+            stderr=subprocess.PIPE,
+            text=True,
+            env=env,
+        )
+        held = False
+        try:
+            window = xdotool("search", "--sync", "--onlyvisible", "--pid", str(proc.pid), "--name", "RTMU")
+            window = window.split()[0]
+            wait(lambda: subscribed(one) and subscribed(two), 20, "both robots connected")
+            xdotool("windowfocus", "--sync", window)
+            xdotool("key", "alt+2")  # robot2: the guardian leaves robot1 for it
+            wait(lambda: len(two.call(lambda: list(two.server.sessions))) == 2, 15, "the guardian at robot2")
+            wait(
+                lambda: len(one.call(lambda: list(one.server.sessions))) == 1,
+                15,
+                "the guardian to leave robot1",
+            )
+            for _attempt in range(5):  # a press before it is armed is refused: press again
+                xdotool("keydown", "Up")
+                held = True
+                try:
+                    wait(lambda: abs(two.snapshot().vel) > 1.0, 2, "robot2 to drive")
+                    break
+                except AssertionError:
+                    xdotool("keyup", "Up")
+                    held = False
+            assert held, "robot2 never drove"
+            assert _guardians_of(proc.pid) != [] and len(_guardians_of(proc.pid)) == 1, "not ONE guardian"
+            watchdog = two.call(lambda: two.server.robot.watchdog_stops)
+            proc.send_signal(signum)
+            wait(lambda: guardian_stops(two) == 1, 5, "a stop from the guardian at robot2")
+            assert two.call(lambda: two.server.robot.watchdog_stops) == watchdog, "the watchdog fired"
+            assert guardian_stops(one) == 0 and abs(one.snapshot().vel) < 1.0
+        finally:
+            if held:
+                xdotool("keyup", "Up")
+            if proc.poll() is None:
+                proc.send_signal(signal.SIGCONT)
+                proc.kill()
+            proc.wait(5)
+        wait(lambda: not two.call(lambda: list(two.server.sessions)), 10, "the guardian to log out")

@@ -18,7 +18,7 @@ from pathlib import Path
 import gi
 import pytest
 
-from rtmu.client.custom_commands import ServerCommand
+from rtmu.client.custom_commands import CustomCommand
 from rtmu.control.alarms import Alarm
 from rtmu.control.gamepad import AXIS_TRANS, DEADMAN, DeadMan
 from rtmu.sim import SimConfig, SimThread
@@ -258,7 +258,7 @@ def test_battery_and_wifi_alarms_from_the_simulator_with_mute(phone: tuple[Gui, 
 
 def set_battery(gui: Gui, volts: float) -> None:
     """The simulator's own string command, sent by the window's network side: the server took it."""
-    command = ServerCommand("SimulatorSetBattery", "", True)
+    command = CustomCommand("SimulatorSetBattery", "", True)
     intent = RunServerCommand(command.name, f"{volts:.2f}", command.takes_argument)
     assert gui.window.session.runner.send(intent).result(10)
 

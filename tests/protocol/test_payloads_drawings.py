@@ -14,7 +14,8 @@ import time
 import pytest
 
 from rtmu.capture import open_capture
-from rtmu.capture.session_decoder import CaptureDecoder, DecodedPacket
+from rtmu.capture.conversation import DecodedPacket
+from rtmu.capture.session_decoder import CaptureDecoder
 from rtmu.protocol.errors import FieldUnderrun, PayloadError
 from rtmu.protocol.payloads import Side, payload_type_for
 from rtmu.protocol.payloads.drawings import (

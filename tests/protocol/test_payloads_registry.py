@@ -18,6 +18,7 @@ from rtmu.protocol.payloads import (
     central,
     commands,
     decode_payload,
+    drawings,
     drive,
     ld,
     navigation,
@@ -70,10 +71,10 @@ SAMPLES: list[Payload] = [
     sensors.SensorCumulativeReadings("sonar", ((1, 2),)),
     sensors.RangeDeviceReadings(((1, 2),)),
     sensors.RangeDeviceCumulative(((5, 6),)),
-    sensors.DrawingListPacket(
-        sensors.Drawing("sonarCurrent", "polyArrows", 0x33CCFF, 80, 75, 5000, 255, "On")
+    drawings.DrawingListPacket(
+        drawings.Drawing("sonarCurrent", "polyArrows", 0x33CCFF, 80, 75, 5000, 255, "On")
     ),
-    sensors.DrawingList((sensors.Drawing("sonarCurrent", "polyArrows", 1, 2, 3, 4, 5),)),
+    drawings.DrawingList((drawings.Drawing("sonarCurrent", "polyArrows", 1, 2, 3, 4, 5),)),
     cam.VideoFrame(320, 240, b"\xff\xd8jpeg\xff\xd9", b"\x05\xaa"),
     cam.Picture(2, 1, b"\xff\xd8\xff\xd9"),
     cam.VideoRequest(90),
@@ -252,7 +253,7 @@ def test_hostile_counts_are_refused_without_allocating() -> None:
     for cls, raw in [
         (robot.ModeDataList, big),
         (sensors.RangeDeviceReadings, big),
-        (sensors.DrawingList, big),
+        (drawings.DrawingList, big),
         (mp.MapId, b"\0\0" + big),
         (sensors.SensorReadings, b"\xff\x7fsonar\0"),
         (strings.StringsInfo, b"\xff\xff"),

@@ -9,7 +9,8 @@ from pathlib import Path
 
 from client.uiqueue import eventually
 from rtmu.capture import open_capture
-from rtmu.capture.session_decoder import CaptureDecoder, DecodedPacket
+from rtmu.capture.conversation import DecodedPacket
+from rtmu.capture.session_decoder import CaptureDecoder
 from rtmu.client import console
 from rtmu.client.runner import ClientRunner
 from rtmu.client.session import SessionConfig

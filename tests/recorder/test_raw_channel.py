@@ -14,8 +14,9 @@ from typing import Any
 
 from client.uiqueue import eventually
 from rtmu.capture import Endpoint, Flow, StreamData, StreamEnd, open_capture
+from rtmu.capture.conversation import DecodedPacket
 from rtmu.capture.recorded import RAW_TOPICS
-from rtmu.capture.session_decoder import CaptureDecoder, DecodedPacket
+from rtmu.capture.session_decoder import CaptureDecoder
 from rtmu.client.link import Link, open_tcp
 from rtmu.client.runner import ClientRunner
 from rtmu.client.session import SessionConfig

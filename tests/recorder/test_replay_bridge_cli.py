@@ -94,13 +94,18 @@ def test_bridge_with_allow_drive_drives_with_its_guardian_and_stops_when_the_str
                 client.until(lambda: bool(client.server_info))
                 client.advertise(1, "/cmd_vel")
                 start = sim.snapshot().x
+                # The first drive waits until its guardian has logged in (a fresh process, cold on a
+                # loaded machine): a stream held meanwhile then drives without a pause.
+                armed = time.monotonic() + 20.0
+                while sim.snapshot().trans_ratio == 0:
+                    assert time.monotonic() < armed, "the stream never drove"
+                    client.publish(1, twist(0.5))
+                    client.pump(0.1)
                 end = time.monotonic() + 2.0  # longer than the guardian's 0.4 s without a beat
                 while time.monotonic() < end:
                     client.publish(1, twist(0.5))
                     client.pump(0.1)
-                    assert time.monotonic() < end - 1.5 or sim.snapshot().trans_ratio > 0, (
-                        "a drive stopped early"
-                    )
+                    assert sim.snapshot().trans_ratio > 0, "a drive stopped early"
                 assert sim.snapshot().x > start + 300
                 last = time.monotonic()
                 while sim.snapshot().trans_ratio != 0:

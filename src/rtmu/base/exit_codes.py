@@ -50,6 +50,7 @@ EXIT_WHY_SAFE_DRIVE = 31
 EXIT_WHY_WATCHDOG = 32
 EXIT_WHY_LOST = 33
 EXIT_WHY_LEASE = 34
+EXIT_WHY_DEAD_ZONE = 35
 EXIT_WHY_UNEXPLAINED = 39
 EXIT_SIGHUP = 128 + signal.SIGHUP
 EXIT_SIGINT = 128 + signal.SIGINT
@@ -102,6 +103,8 @@ EXIT_CODES: dict[int, str] = {
     EXIT_WHY_WATCHDOG: "why: the server's drive watchdog is shorter than RTMU's resend period allows",
     EXIT_WHY_LOST: "why: localization is lost (asked about navigation)",
     EXIT_WHY_LEASE: "why: our drive lease is not live (no key held, a blocked key, a replay)",
+    EXIT_WHY_DEAD_ZONE: "drive: the ratios asked for are inside ARIA's dead zone (translation up to ±10 %, "
+    "rotation under ±5 %): the robot ignores them",
     EXIT_WHY_UNEXPLAINED: "drive: asked to move, the robot did not, and nothing RTMU can read says why",
     EXIT_SIGHUP: "ended by SIGHUP (the terminal went away)",
     EXIT_SIGINT: "ended by Ctrl-C (SIGINT)",
@@ -113,19 +116,21 @@ EXIT_CODES: dict[int, str] = {
 """Code → meaning. Other 128 + N: ended by signal N (any ending signal stops what the command drove)."""
 
 
-WHY_ASKED = (
-    EXIT_WHY_NO_STOP, EXIT_WHY_NO_DRIVE, EXIT_WHY_ESTOP, EXIT_WHY_FAULTS, EXIT_WHY_MOTORS, EXIT_WHY_STALLED,
-    EXIT_WHY_LOCKED, EXIT_WHY_NAVIGATING, EXIT_WHY_DOCKED, EXIT_WHY_BATTERY, EXIT_WHY_SAFE_DRIVE,
-    EXIT_WHY_WATCHDOG, EXIT_WHY_LOST,
-)  # fmt: skip
-"""The causes a command's own login can find (``rtmu why``; without ``--navigate``, ``drive`` and the
-doctor's last step, all but the lost localization); our link (22) and drive lease (34) are the window's."""
 ENDED = (EXIT_SIGHUP, EXIT_SIGINT, EXIT_SIGTERM)
 """Every command that runs a while ends by these three through its own clean-up."""
 NETWORK = (
     EXIT_OK, EXIT_USAGE, EXIT_CONNECTION, EXIT_UNSUPPORTED, EXIT_TIMEOUT, EXIT_INTERNAL, *ENDED, EXIT_SIGPIPE
 )  # fmt: skip
 """The codes of a subcommand that talks to a robot server (its module's ``EXITS`` when it has more)."""
+WHY_ASKED = (
+    EXIT_WHY_NO_STOP, EXIT_WHY_NO_DRIVE, EXIT_WHY_ESTOP, EXIT_WHY_FAULTS, EXIT_WHY_MOTORS, EXIT_WHY_STALLED,
+    EXIT_WHY_LOCKED, EXIT_WHY_NAVIGATING, EXIT_WHY_DOCKED, EXIT_WHY_BATTERY, EXIT_WHY_SAFE_DRIVE,
+    EXIT_WHY_WATCHDOG,
+)  # fmt: skip
+"""The causes a login of the command line can find by asking (``rtmu why``, doctor's last step); the
+link and the lease (22, 34) are the window's own side, a lost robot (33) counts only for navigation."""
+WHY_DRIVE = (*(c for c in WHY_ASKED if c != EXIT_WHY_NO_STOP), EXIT_WHY_DEAD_ZONE, EXIT_WHY_UNEXPLAINED)
+"""What ``rtmu drive`` exits with when the robot did not move (a login that may not stop is warned)."""
 
 
 def signal_code(signum: int) -> int:

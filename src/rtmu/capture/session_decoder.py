@@ -14,12 +14,10 @@ from __future__ import annotations
 
 from collections import Counter
 from collections.abc import Callable, Iterable, Iterator
-from dataclasses import dataclass, field
 from typing import Any
 
 from ..protocol import payloads  # noqa: F401 -- importing the package registers every payload type
 from ..protocol.commands import ClientCommand, ServerCommand, is_control_command
-from ..protocol.datalist import DataList
 from ..protocol.decoder import BadPacket, PacketDecoder
 from ..protocol.fields import FieldReader
 from ..protocol.packet import MIN_LENGTH, SYNC, Packet
@@ -27,9 +25,16 @@ from ..protocol.payloads import base as payload_base
 from ..protocol.payloads import control
 from ..protocol.payloads.base import Payload, Side
 from . import CaptureEvent, Datagram, Endpoint, Flow, StreamData, StreamEnd, StreamGap
+from .conversation import (
+    C2S,
+    S2C,
+    Conversation,
+    DecodedPacket,
+    DecodeItem,
+    DropReport,
+    TrailingDrops,
+)
 
-C2S = "c2s"
-S2C = "s2c"
 HELD_BEFORE_ID = 64
 """Bad packets kept for a TCP flow that has not yet shown a good one (it may not be ArNetworking)."""
 DROP_KEYS = ("garbage_bytes", "bad_length", "bad_checksum", "truncated_at_close", "capture_gap_bytes")
@@ -70,117 +75,6 @@ def side_of(direction: str) -> Side:
     return Side.REPLY if direction == S2C else Side.ARGS
 
 
-# -- what comes out ---------------------------------------------------------------
-@dataclass(slots=True)
-class DecodedPacket:
-    conn: int
-    direction: str
-    transport: str
-    time: float | None
-    command: int
-    name: str | None
-    length: int
-    checksum_ok: bool
-    payload: bytes
-    fields: dict[str, Any]
-    error: str | None = None
-    note: str | None = None
-    """A short remark: ``end of reply``, ``empty``, ``not decoded``…"""
-    dropped_before: dict[str, int] | None = None
-    """What the framing decoder threw away in this direction just before this packet."""
-
-    @property
-    def is_data(self) -> bool:
-        return not is_control_command(self.command)
-
-
-@dataclass(slots=True)
-class DropReport:
-    conn: int
-    direction: str
-    transport: str
-    time: float | None
-    counts: dict[str, int]
-
-
-@dataclass(slots=True)
-class TrailingDrops:
-    """Drops that no later packet carries as ``dropped_before``: what ended a stream or a datagram.
-
-    Only yielded by ``CaptureDecoder(report_trailing_drops=True)``: ``rtmu decode --json`` shows
-    drops through the next packet's ``dropped_before``, so without these the garbage or cut-off
-    packet at the very end of a stream would vanish from its output.
-    """
-
-    conn: int
-    direction: str
-    transport: str
-    time: float | None
-    counts: dict[str, int]
-
-
-DecodeItem = DecodedPacket | DropReport | TrailingDrops
-
-
-@dataclass(slots=True)
-class DirectionTotals:
-    packets: int = 0
-    bytes: int = 0
-    by_name: Counter[str] = field(default_factory=Counter)
-    drops: Counter[str] = field(default_factory=Counter)
-
-
-class Session:
-    """One ArNetworking conversation: a TCP connection, a bare stream, or an orphan UDP flow."""
-
-    def __init__(self, transport: str, flow: Flow | None, a: Endpoint, b: Endpoint) -> None:
-        self.id: int | None = None
-        self.transport = transport
-        self.flow = flow
-        self.ends = (a, b)
-        self.server: Endpoint | None = flow.server if flow else None
-        self.server_guessed = False
-        self.datalist = DataList()
-        self.decoders = {C2S: PacketDecoder(keep_bad=True), S2C: PacketDecoder(keep_bad=True)}
-        self.totals = {C2S: DirectionTotals(), S2C: DirectionTotals()}
-        self.pending_drops: dict[tuple[str, str], Counter[str]] = {}
-        """Drops not yet attached to a packet, by (direction, transport)."""
-        self.held: list[DecodeItem] = []
-        self.held_overflow = 0
-        self.ended: set[str] = set()
-        self.first_time: float | None = None
-        self.last_time: float | None = None
-        self.udp_datagrams = 0
-        self.udp_flows: set[tuple[Endpoint, Endpoint]] = set()
-        # handshake facts (for UDP attribution and the summary)
-        self.server_udp_port: int | None = None
-        self.client_udp_port: int | None = None
-        self.auth_key: int | None = None
-        self.intro_key: int | None = None
-        self.user: str | None = None
-        self.rejected: str | None = None
-
-    @property
-    def client(self) -> Endpoint | None:
-        if self.server is None:
-            return None
-        return self.ends[1] if self.server == self.ends[0] else self.ends[0]
-
-    def direction_from(self, src: Endpoint) -> str:
-        return S2C if src == self.server else C2S
-
-    def touch(self, time: float | None) -> None:
-        if time is None:
-            return
-        if self.first_time is None:
-            self.first_time = time
-        self.last_time = time
-
-    @property
-    def drops(self) -> Counter[str]:
-        return self.totals[C2S].drops + self.totals[S2C].drops
-
-
 # -- the decoder ---------------------------------------------------------------
 class CaptureDecoder:
     """Run capture events through per-connection sessions; iterate :meth:`run` for the packets."""
@@ -188,11 +82,11 @@ class CaptureDecoder:
     def __init__(self, *, decode_payloads: bool = True, report_trailing_drops: bool = False) -> None:
         self.decode_payloads = decode_payloads
         self.report_trailing_drops = report_trailing_drops
-        self.sessions: list[Session] = []
+        self.sessions: list[Conversation] = []
         """Sessions with a connection id, in id order."""
-        self._by_flow: dict[int, Session] = {}
-        self._udp_routes: dict[tuple[Endpoint, Endpoint], tuple[Session, str]] = {}
-        self._udp_orphans: dict[tuple[Endpoint, Endpoint], Session] = {}
+        self._by_flow: dict[int, Conversation] = {}
+        self._udp_routes: dict[tuple[Endpoint, Endpoint], tuple[Conversation, str]] = {}
+        self._udp_orphans: dict[tuple[Endpoint, Endpoint], Conversation] = {}
         self._next_id = 1
         self.ignored_tcp_flows = 0
         """TCP connections in which no valid ArNetworking packet was found (HTTP, SSH…)."""
@@ -215,21 +109,21 @@ class CaptureDecoder:
         self._by_flow.clear()
 
     # -- sessions ---------------------------------------------------------
-    def _session_for(self, flow: Flow) -> Session:
+    def _session_for(self, flow: Flow) -> Conversation:
         session = self._by_flow.get(flow.id)
         if session is None:
-            session = Session(flow.transport, flow, flow.first, flow.second)
+            session = Conversation(flow.transport, flow, flow.first, flow.second)
             self._by_flow[flow.id] = session
             if flow.transport == "stream":
                 self._number(session)
         return session
 
-    def _number(self, session: Session) -> None:
+    def _number(self, session: Conversation) -> None:
         session.id = self._next_id
         self._next_id += 1
         self.sessions.append(session)
 
-    def _release(self, session: Session) -> Iterator[DecodeItem]:
+    def _release(self, session: Conversation) -> Iterator[DecodeItem]:
         """Give the session its id (first good packet) and let out what it held meanwhile."""
         if session.id is None:
             self._number(session)
@@ -238,7 +132,7 @@ class CaptureDecoder:
                 yield item
             session.held.clear()
 
-    def _emit(self, session: Session, items: list[DecodeItem]) -> Iterator[DecodeItem]:
+    def _emit(self, session: Conversation, items: list[DecodeItem]) -> Iterator[DecodeItem]:
         if session.id is not None:
             yield from items
             return
@@ -305,7 +199,7 @@ class CaptureDecoder:
 
     def _framed(
         self,
-        session: Session,
+        session: Conversation,
         direction: str,
         transport: str,
         time: float | None,
@@ -343,7 +237,7 @@ class CaptureDecoder:
 
     def _trailing(
         self,
-        session: Session,
+        session: Conversation,
         direction: str,
         transport: str,
         time: float | None,
@@ -376,17 +270,17 @@ class CaptureDecoder:
         self._trailing(session, direction, "udp", event.time, leftover, items)
         yield from self._emit(session, items)
 
-    def _orphan(self, event: Datagram) -> Session:
+    def _orphan(self, event: Datagram) -> Conversation:
         key = (event.src, event.dst) if event.src <= event.dst else (event.dst, event.src)
         session = self._udp_orphans.get(key)
         if session is None:
-            session = Session("udp", None, event.src, event.dst)
+            session = Conversation("udp", None, event.src, event.dst)
             session.server = _port_guess(event.src, event.dst)
             session.server_guessed = True
             self._udp_orphans[key] = session
         return session
 
-    def _route(self, event: Datagram) -> tuple[Session, str] | None:
+    def _route(self, event: Datagram) -> tuple[Conversation, str] | None:
         """Which TCP session a datagram belongs to: learnt routes, UDP keys, then announced ports."""
         src, dst = event.src, event.dst
         route = self._udp_routes.get((src, dst))
@@ -399,7 +293,7 @@ class CaptureDecoder:
             self._udp_routes[(dst, src)] = (session, S2C if direction == C2S else C2S)
         return found
 
-    def _by_key(self, event: Datagram) -> tuple[Session, str] | None:
+    def _by_key(self, event: Datagram) -> tuple[Conversation, str] | None:
         data = event.data
         if len(data) != MIN_LENGTH + 4 or data[4] != 3 or data[5] != 0:
             return None
@@ -412,8 +306,8 @@ class CaptureDecoder:
                 return session, S2C
         return None
 
-    def _by_ports(self, src: Endpoint, dst: Endpoint) -> tuple[Session, str] | None:
-        loose: list[tuple[Session, str]] = []
+    def _by_ports(self, src: Endpoint, dst: Endpoint) -> tuple[Conversation, str] | None:
+        loose: list[tuple[Conversation, str]] = []
         for session in reversed(self.sessions):
             client, server = session.client, session.server
             if client is None or server is None or not session.server_udp_port:
@@ -427,7 +321,7 @@ class CaptureDecoder:
         return loose[0] if len(loose) == 1 else None
 
     # -- one packet --------------------------------------------------------------
-    def _name(self, session: Session, direction: str, command: int) -> str | None:
+    def _name(self, session: Conversation, direction: str, command: int) -> str | None:
         if not is_control_command(command):
             return session.datalist.name(command)
         enum = ServerCommand if direction == S2C else ClientCommand
@@ -437,7 +331,7 @@ class CaptureDecoder:
             return None
 
     def _bad(
-        self, session: Session, direction: str, transport: str, time: float | None, raw: BadPacket
+        self, session: Conversation, direction: str, transport: str, time: float | None, raw: BadPacket
     ) -> DecodedPacket:
         totals = session.totals[direction]
         totals.packets += 1
@@ -459,7 +353,7 @@ class CaptureDecoder:
         )
 
     def _annotate(
-        self, session: Session, direction: str, transport: str, time: float | None, packet: Packet
+        self, session: Conversation, direction: str, transport: str, time: float | None, packet: Packet
     ) -> DecodedPacket:
         command = packet.command
         payload = packet.payload
@@ -495,7 +389,7 @@ class CaptureDecoder:
         )
 
     def _data(
-        self, session: Session, direction: str, command: int, payload: bytes
+        self, session: Conversation, direction: str, command: int, payload: bytes
     ) -> tuple[dict[str, Any], str | None]:
         entry = session.datalist.entry(command)
         if not payload:
@@ -521,7 +415,7 @@ class CaptureDecoder:
             return {}, None
         return kind.decode(payload).to_fields(), None
 
-    def _control(self, session: Session, direction: str, packet: Packet) -> dict[str, Any]:
+    def _control(self, session: Conversation, direction: str, packet: Packet) -> dict[str, Any]:
         """A control packet's fields, decoded by the same types the client and the server use."""
         command = packet.command
         if direction == S2C and command in _LIST_COMMANDS:
@@ -543,7 +437,7 @@ class CaptureDecoder:
             fields["client_type_name"] = _CLIENT_TYPES.get(decoded.client_type, "?")
         return fields
 
-    def _request_fields(self, session: Session, request: control.Request) -> dict[str, Any]:
+    def _request_fields(self, session: Conversation, request: control.Request) -> dict[str, Any]:
         """A REQUEST with its data's name and, where a type is registered, its arguments decoded."""
         data_name = session.datalist.name(request.number)
         fields: dict[str, Any] = {
@@ -564,7 +458,7 @@ class CaptureDecoder:
         return fields
 
 
-def _learn_handshake(session: Session, decoded: control.ControlPayload) -> None:
+def _learn_handshake(session: Conversation, decoded: control.ControlPayload) -> None:
     """Keep what attributes UDP datagrams to this session, and what the summary reports."""
     if isinstance(decoded, control.ServerIntroduction):
         session.server_udp_port = decoded.udp_port

@@ -11,6 +11,7 @@ ARIA prints doubles with six significant digits, so ``0.333333`` is the factory 
 from __future__ import annotations
 
 import asyncio
+import contextlib
 import math
 from dataclasses import dataclass
 
@@ -159,12 +160,17 @@ async def reset(
     return await set_config(client, changes, timeout)
 
 
+CLOSED_CHECK = 0.25
+"""Seconds between looks at the connection while waiting for a broadcast."""
+
+
 class Broadcasts:
     """Counts one broadcast (``configUpdated``, ``mapUpdated``) on a command's own connection."""
 
     def __init__(self, client: AriaClient, name: str) -> None:
         self.count = 0
         self._event = asyncio.Event()
+        self._client = client
         self.name = name
         if client.supports(name):
             client.request(name, -1, self._on)
@@ -174,15 +180,21 @@ class Broadcasts:
         self._event.set()
 
     async def next(self, timeout: float) -> bool:
-        """True once another one came within ``timeout`` s."""
+        """True once another one came within ``timeout`` s; False when none did. A connection that
+        ends meanwhile raises its error: "none came" must not be said of a link that was lost."""
         start = self.count
-        try:
-            async with asyncio.timeout(timeout):
-                while self.count == start:
-                    self._event.clear()
+        loop = asyncio.get_running_loop()
+        deadline = loop.time() + timeout
+        while self.count == start:
+            if self._client.closed_error is not None:
+                raise self._client.closed_error
+            left = deadline - loop.time()
+            if left <= 0:
+                return False
+            self._event.clear()
+            with contextlib.suppress(TimeoutError):
+                async with asyncio.timeout(min(left, CLOSED_CHECK)):
                     await self._event.wait()
-        except TimeoutError:
-            return False
         return True
 
 

@@ -6,11 +6,14 @@ data a read only when nothing in its name or description suggests an effect: a v
 set / delete / enable / acknowledge / reset / stop anywhere in the name, a motion or mission verb
 (go, move, drive, dock, patrol, say …) that the name does not turn into a noun (``dockInfo`` is a
 read), a description that opens with such a verb ("Sends the robot to its dock"), or a data that
-returns nothing (ARIA's commands) all mean "changes something". Each answer carries the words that
-decided it, so the operator can see why a confirmation is asked.
+returns nothing (ARIA's commands) all mean "changes something"; a motion request
+(:func:`moves_robot`) always does, whatever its words. Each answer carries the words that decided
+it, so the operator can see why a confirmation is asked.
 
 ``ratioDrive`` is never the console's: held motion happens only while the operator holds a key,
-through the drive lease (:data:`HELD_MOTION`).
+through the drive lease (:data:`HELD_MOTION`). Every request of the one motion list
+(:data:`rtmu.protocol.motion.MOTION_REQUESTS`) changes something whatever its description says: a
+server that describes ``tourGoalsInList`` as a list of names does not make it a read.
 """
 
 from __future__ import annotations
@@ -19,6 +22,7 @@ import re
 from enum import Enum
 
 from ..protocol.datalist import DataEntry
+from ..protocol.motion import is_motion
 
 
 class Effect(Enum):
@@ -28,6 +32,13 @@ class Effect(Enum):
 
 HELD_MOTION = frozenset({"ratioDrive"})
 """Data RTMU sends only from a held drive (its lease and guardian): the console refuses them."""
+
+
+def moves_robot(name: str) -> bool:
+    """Calling ``name`` starts, changes or ends the robot's motion (the one list an observer may never
+    send, :data:`rtmu.protocol.motion.MOTION_REQUESTS`): always a change, confirmed in the window."""
+    return is_motion(name)
+
 
 STRONG = frozenset(
     {
@@ -89,6 +100,8 @@ def classify(entry: DataEntry) -> tuple[Effect, str]:
     words = name_words(entry.name)
     if entry.name in HELD_MOTION:
         return Effect.CHANGES, "it drives the robot while held (RTMU sends it only from a held drive)"
+    if moves_robot(entry.name):  # whatever its words say (``tourGoalsInList`` ends in a reading noun)
+        return Effect.CHANGES, "it starts, changes or ends the robot's motion"
     strong = next((w for w in words if w in STRONG and not (w == "estop" and _reads(words))), None)
     if strong is not None:
         return Effect.CHANGES, f"its name says {strong!r}"

@@ -39,7 +39,7 @@ MAX_ARGUMENT = 1000
 
 
 @dataclass(frozen=True, slots=True)
-class ServerCommand:
+class CustomCommand:
     name: str
     """Its data name: what is sent to run it."""
     description: str
@@ -48,13 +48,13 @@ class ServerCommand:
 
 @dataclass(frozen=True, slots=True)
 class CommandCatalogue:
-    commands: tuple[ServerCommand, ...] = ()
+    commands: tuple[CustomCommand, ...] = ()
     hidden: int = 0
     """Listed by the server but not offered to this user (its groups), so not shown."""
     cut: int = 0
     """Beyond :data:`MAX_COMMANDS`: not shown."""
 
-    def find(self, name: str) -> ServerCommand | None:
+    def find(self, name: str) -> CustomCommand | None:
         return next((c for c in self.commands if c.name == name), None)
 
 
@@ -67,7 +67,7 @@ async def list_commands(client: AriaClient, timeout: float = 5.0) -> CommandCata
     sources = [(name, arg) for name, arg in LIST_SOURCES if client.supports(name)]
     if not sources:
         raise NotSupported("listCommands", "this server offers no command list (listCommands)")
-    found: dict[str, ServerCommand] = {}
+    found: dict[str, CustomCommand] = {}
     hidden = cut = 0
     for name, takes_argument in sources:
         reply = await client.request_once(name, timeout=timeout)
@@ -86,11 +86,11 @@ async def list_commands(client: AriaClient, timeout: float = 5.0) -> CommandCata
                 description = entry.description
                 if len(description) > MAX_DESCRIPTION:
                     description = description[: MAX_DESCRIPTION - 1] + "…"
-                found[entry.name] = ServerCommand(entry.name, description, takes_argument)
+                found[entry.name] = CustomCommand(entry.name, description, takes_argument)
     return CommandCatalogue(tuple(found.values()), hidden, cut)
 
 
-def send_command(client: AriaClient, command: ServerCommand, argument: str | None = None) -> None:
+def send_command(client: AriaClient, command: CustomCommand, argument: str | None = None) -> None:
     """Send it once (no reply comes); NotSupported when this user's data list lacks it."""
     if not client.supports(command.name):
         raise NotSupported(command.name)
@@ -117,7 +117,7 @@ async def taken(client: AriaClient, timeout: float = 5.0) -> bool:
 
 
 async def run_command(
-    client: AriaClient, command: ServerCommand, argument: str | None = None, timeout: float = 5.0
+    client: AriaClient, command: CustomCommand, argument: str | None = None, timeout: float = 5.0
 ) -> bool:
     """:func:`send_command`, then :func:`taken`: did the server take it within ``timeout`` s?"""
     send_command(client, command, argument)
@@ -134,6 +134,6 @@ class CommandsFeed(Feed):
         client = self.require()
         timeout = self.ctx.config.reply_timeout
         if isinstance(intent, RunServerCommand):
-            command = ServerCommand(intent.name, "", intent.string)
+            command = CustomCommand(intent.name, "", intent.string)
             return run_command(client, command, intent.argument, timeout)
         return list_commands(client, timeout)

@@ -18,6 +18,7 @@ import time
 from collections.abc import Callable
 from typing import Any, ClassVar
 
+from ..base.notices import Kind, Notice
 from ..protocol.client_connection import payload_name
 from ..protocol.payloads import Payload
 from ..protocol.payloads.drive import RatioDrive
@@ -33,6 +34,8 @@ from .lease import DriveGovernor, EndReason, SendRatios, SendStop
 log = logging.getLogger(__name__)
 
 HEART_MAX_SLEEP = 0.25
+HOLD_SAID_AFTER = 1.0
+"""A drive held back this long for the guardian (its login is slow) is said, once."""
 STEP_TIMEOUT = 2.0
 """``step()`` gives up (ClientTimeout) if the heart has not run within this many seconds."""
 
@@ -48,7 +51,10 @@ class DriveFeed(Feed):
         self.lease = ctx.lease
         self.governor = DriveGovernor(self.lease)
         self.health = HealthMonitor(config.status_interval_ms / 1000.0, lost_after=config.lost_after)
-        self.guardian = GuardianLink(ctx.notice, config.connect_timeout)
+        self.guardian = GuardianLink(ctx.notice, config)
+        self._held_since: float | None = None
+        """Since when a live lease has waited for the guardian to be armed (see :meth:`_unguarded`)."""
+        self._held_said: int | None = None
         self.packets_sent = 0
         self.on_stop: Callable[[str, bool], None] | None = None
         """Optional tap (a flight recorder): ``on_stop(reason, sent)`` after every zero-ratios + ``stop``."""
@@ -65,8 +71,8 @@ class DriveFeed(Feed):
     # -- the connection --------------------------------------------------------------------------
     def connected(self, client: AriaClient) -> None:
         target = self.ctx.target
-        if self.ctx.config.guardian and target is not None and client.supports("ratioDrive"):
-            self.guardian.start(target)
+        if target is not None and client.supports("ratioDrive"):
+            self.guardian.start(target)  # (a session without a guardian has no seat: nothing happens)
         # Whatever happened before, the robot stays still until a fresh key press.
         self.lease.end(EndReason.DISCONNECTED)
         self.governor.reset()
@@ -75,13 +81,13 @@ class DriveFeed(Feed):
         self.kick()
 
     def disconnected(self) -> None:
-        self.guardian.close(goodbye=True)
+        self.guardian.close()
         self.health.stop()
         self.governor.reset()
 
     def lost(self) -> None:
         """Our link died, not by our choice: while driving, only the guardian (its own link) can stop."""
-        self.guardian.close(goodbye=not self.governor.driving)
+        self.guardian.lost(driving=self.governor.driving)
         self.lease.end(EndReason.DISCONNECTED)
         self.governor.reset()
         self.health.stop()
@@ -180,6 +186,27 @@ class DriveFeed(Feed):
                 self.publish_health()
             await asyncio.sleep(config.ping_interval)
 
+    def _unguarded(self, now: float) -> bool:
+        """True while no drive may start: the guardian is still being armed for this robot (or it is
+        not the robot that may drive). A held drive then waits — its lease stays the operator's, and
+        the first ``ratioDrive`` goes once the guardian is armed; the window's controller refuses the
+        key before it gets here, saying why. A drive already going when that happens is ended."""
+        why = self.guardian.waiting_reason()
+        if why is None:
+            self._held_since = None
+            return False
+        view = self.lease.view(now)
+        if self.governor.driving:  # (a stop that ended it already — a new selection — said its own words)
+            if self.lease.end(EndReason.STOPPED, view.generation):
+                self.ctx.notice(Notice.warning(Kind.SAFETY, f"Stopped: {why}. Press again once it is armed."))
+        elif view.live:
+            if self._held_since is None:
+                self._held_since = now
+            elif now - self._held_since >= HOLD_SAID_AFTER and self._held_said != view.generation:
+                self._held_said = view.generation
+                self.ctx.notice(Notice.warning(Kind.SAFETY, f"Not driving yet: {why}"))
+        return True
+
     def publish_health(self, now: float | None = None) -> None:
         now = self.ctx.clock() if now is None else now
         client = self.ctx.client
@@ -241,6 +268,8 @@ class DriveFeed(Feed):
             self.health.note_traffic(client.last_packet_at)  # map bytes keep the link alive
         level = self.health.level(now)
         link_ok = level is LinkLevel.OK and client is not None and client.connected
+        if self._unguarded(now):
+            link_ok = False  # nothing is sent until the guardian is armed (a drive going was ended above)
         for action in self.governor.step(now, link_ok):
             if isinstance(action, SendRatios):
                 r = action.ratios

@@ -6,6 +6,7 @@ before drawings (a shown sonar drawing takes over the status feed's sonar reques
 from __future__ import annotations
 
 from .config_feed import ConfigFeed
+from .console_feed import ConsoleFeed
 from .custom_commands import CommandsFeed
 from .drawings_feed import DrawingsFeed
 from .drive_loop import DriveFeed
@@ -18,6 +19,7 @@ from .ptz import PtzFeed
 from .server_strings import StringsFeed
 from .status_feed import StatusFeed
 from .video_session import CameraFeed
+from .why_feed import WhyFeed
 
 FEEDS: tuple[type[Feed], ...] = (
     DriveFeed,
@@ -31,5 +33,7 @@ FEEDS: tuple[type[Feed], ...] = (
     CameraFeed,
     DrawingsFeed,
     CommandsFeed,
+    WhyFeed,
+    ConsoleFeed,
     MapFeed,
 )

@@ -1,9 +1,14 @@
-"""The session's side of the guardian process (:mod:`rtmu.guardian`): start it, beat for it, hear it.
+"""The session's side of the guardian process (:mod:`rtmu.guardian`): offer it the robot, beat, hear it.
 
 The guardian is a separate process with its own login that stops the robot when this process is
-killed, stopped by a signal, or silent past its lease while driving. The drive loop arms it before
-the first ``ratioDrive`` of a drive and disarms it after its own stop; the network loop beats for it
-here, the window's GTK timer through ``ClientRunner.ui_heartbeat``.
+killed, stopped by a signal, or silent past its lease while driving. A window's sessions share ONE
+(``SessionConfig.guardian_seat``: a seat at the window's
+:class:`~rtmu.guardian.shared.SharedGuardian`, armed for the selected robot only); a script that
+drives (``SessionConfig(guardian=True)``: ``rtmu bridge --allow-drive``) has its own for each
+connection. The drive loop asks :meth:`GuardianLink.waiting_reason` before a drive (none starts
+while the guardian is still logging in to this robot), arms it before the first ``ratioDrive`` of
+a drive and disarms it after its own stop; the network loop beats for it here while armed, the
+window's GTK timer through ``ClientRunner.ui_heartbeat``.
 """
 
 from __future__ import annotations
@@ -12,68 +17,108 @@ import asyncio
 from collections.abc import Callable
 
 from ..base.notices import Kind, Notice
-from ..guardian.handle import BEAT_PERIOD, GuardianHandle
+from ..guardian.handle import BEAT_PERIOD
 from ..guardian.messages import Hello
-from .session_config import Target
+from ..guardian.shared import GuardianSeat, SharedGuardian
+from .session_config import SessionConfig, Target
+
+OWN_NAME = "this robot"
+"""How a script's own guardian names its one robot ("Arming the guardian for this robot …")."""
 
 
 class GuardianLink:
-    """At most one guardian for the current connection; every method runs on the network loop."""
+    """This session's guardian seat; every method runs on the network loop."""
 
-    def __init__(self, notice: Callable[[Notice], None], connect_timeout: float) -> None:
+    def __init__(self, notice: Callable[[Notice], None], config: SessionConfig) -> None:
         self._notice = notice
-        self._timeout = connect_timeout
-        self.handle: GuardianHandle | None = None
+        self._timeout = config.connect_timeout
+        self._own: SharedGuardian | None = None
+        self.seat: GuardianSeat | None = config.guardian_seat
+        """Where this session's records go (None: no guardian at all)."""
+        if self.seat is None and config.guardian:
+            # Its own process, started now: warm (imports done) by the time the connection is up, so
+            # arming it is one login. Ended with the session (:meth:`end`).
+            self._own = SharedGuardian()
+            self.seat = self._own.seat(OWN_NAME)
+            self._own.choose(self.seat)
+        self._armed = False
+        self.unavailable_reason: str | None = None
+        """Why the guardian cannot stop this robot, once it said so (``rtmu why`` names it); else None."""
 
     def start(self, target: Target) -> None:
-        self.close(goodbye=True)
-        try:
-            self.handle = GuardianHandle.start(
-                Hello(target.host, target.port, target.user, target.password, self._timeout)
-            )
-        except OSError as exc:
-            self.unavailable(f"it could not be started: {exc.strerror or exc}")
-            return
-        self._beat(self.handle)
+        """Connected to ``target`` (which offers ``ratioDrive``): the guardian may log in to it."""
+        if self.seat is not None:
+            self.seat.offer(
+                Hello(target.host, target.port, target.user, target.password, self._timeout,
+                      protocol=target.protocol)
+            )  # fmt: skip
 
-    def _beat(self, guardian: GuardianHandle) -> None:
-        """The network thread's heartbeat to the guardian, every BEAT_PERIOD while it lives."""
-        if self.handle is not guardian:
-            return
-        guardian.beat_net()
-        asyncio.get_running_loop().call_later(BEAT_PERIOD, self._beat, guardian)
+    def waiting_reason(self) -> str | None:
+        """Why a drive may not start now (the guardian is still logging in to this robot), or None."""
+        seat = self.seat
+        return None if seat is None else seat.waiting_reason()
 
     def arm(self) -> None:
-        if self.handle is not None:
-            self.handle.arm()
+        seat = self.seat
+        if seat is None:
+            return
+        seat.arm()
+        if not self._armed:
+            self._armed = True
+            self._beat(seat)
+
+    def _beat(self, seat: GuardianSeat) -> None:
+        """The network thread's heartbeat to the guardian, every BEAT_PERIOD while armed."""
+        if not self._armed or self.seat is not seat:
+            return
+        seat.beat_net()
+        asyncio.get_running_loop().call_later(BEAT_PERIOD, self._beat, seat)
 
     def disarm(self) -> None:
-        if self.handle is not None:
-            self.handle.disarm()
+        self._armed = False
+        if self.seat is not None:
+            self.seat.disarm()
 
-    def close(self, *, goodbye: bool) -> None:
-        guardian, self.handle = self.handle, None
-        if guardian is not None:
-            guardian.close(goodbye=goodbye)
+    def close(self) -> None:
+        """Our connection ended by our choice: the guardian leaves this robot."""
+        self._armed = False
+        if self.seat is not None:
+            self.seat.withdraw(leave=True)
+
+    def lost(self, *, driving: bool) -> None:
+        """Our link died, not by our choice: while driving, only the guardian (its own link) can stop."""
+        self._armed = False
+        seat = self.seat
+        if seat is None:
+            return
+        if driving:
+            seat.halt()
+        seat.withdraw(leave=False)  # its own login may well be alive: the reconnect finds it ready
+
+    def end(self) -> None:
+        """The session is closed: a guardian of its own ends (a shared one is the window's to end)."""
+        self.close()
+        own, self._own = self._own, None
+        if own is not None:
+            own.close()
 
     def poll(self) -> bool:
         """Hear what the guardian said; True when it stopped the robot (a drive must not resume)."""
-        guardian = self.handle
-        if guardian is None:
+        seat = self.seat
+        if seat is None:
             return False
         stopped = False
-        for word, text in guardian.poll():
+        for word, text in seat.take_reports():
             if word == "stopped":
                 stopped = True
                 said = f"The guardian stopped the robot: {text}. Press again to drive."
                 self._notice(Notice.error(Kind.SAFETY, said))
-            elif word in ("unavailable", "lost", "ended"):
-                self.handle = None
-                guardian.close(goodbye=True)
+            elif word == "unavailable":
                 self.unavailable(text)
         return stopped
 
     def unavailable(self, reason: str) -> None:
+        self.unavailable_reason = reason
         self._notice(
             Notice.warning(
                 Kind.SAFETY,

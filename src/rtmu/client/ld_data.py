@@ -110,8 +110,13 @@ _SCALE = re.compile(r"\(\s*0\s*[-–]\s*(\d+)\s*\)")
 """A range in a data list description, e.g. "Wi-Fi link quality (0–70)"."""
 
 
-def store_fields(name: str, value: str, description: str = "") -> dict[str, int | None]:
-    """The :class:`~rtmu.model.observables.RobotState` fields a ``DataStore_*`` value gives the toolbar.
+NAV_FIELDS = frozenset({"loc_score", "remaining_mm"})
+"""Of :func:`store_fields`' keys, those that are :class:`~rtmu.values.state.NavState`'s (the one
+localization score and the one distance to the goal, whichever server reports them)."""
+
+
+def store_fields(name: str, value: str, description: str = "") -> dict[str, float | None]:
+    """The state fields a ``DataStore_*`` value gives the toolbar (:data:`NAV_FIELDS` are navigation's).
 
     Names as 6MTX robots list them (``DataStore_LaserLocalizationScore``,
     ``DataStore_WirelessQuality``, ``DataStore_Distance_to_goal``,
@@ -126,7 +131,7 @@ def store_fields(name: str, value: str, description: str = "") -> dict[str, int 
     except (ValueError, IndexError):
         number = None
     if "localizationscore" in key or "localisationscore" in key:
-        return {"loc_score": None if number is None else round(max(0.0, min(100.0, number)))}
+        return {"loc_score": None if number is None else round(max(0.0, min(100.0, number)) / 100, 3)}
     if "wifiquality" in key or "wirelessquality" in key:
         if number is None:
             return {"wifi_quality": None}
@@ -134,7 +139,7 @@ def store_fields(name: str, value: str, description: str = "") -> dict[str, int 
         scale = int(top.group(1)) if top and int(top.group(1)) > 0 else 100
         return {"wifi_quality": round(max(0.0, min(100.0, number * 100 / scale)))}
     if "distancetogoal" in key:
-        return {"goal_distance_mm": None if number is None else max(0, round(number))}
+        return {"remaining_mm": None if number is None or number <= 0 else round(number)}  # 0: no goal
     if "closestobstacle" in key:
         return {"closest_obstacle_mm": None if number is None else max(0, round(number))}
     return {}

@@ -25,7 +25,8 @@ from ..values.intents import Intent, Patrol, Say
 from .connection import AriaClient, Packet
 from .errors import ClientError
 from .feed import Feed, FeedContext
-from .ld_data import data_store_names, laser_names, store_fields
+from .ld_data import NAV_FIELDS, data_store_names, laser_names, store_fields
+from .nav_session import NavFeed
 from .subscriptions import Subscription
 
 LASER_INTERVAL_MS = 200
@@ -101,4 +102,8 @@ class LdFeed(Feed):
         if isinstance(value, DataStoreValue) and self._store.get(packet.name) != value.value:
             self._store[packet.name] = value.value
             fields = store_fields(packet.name, value.value, self._descriptions.get(packet.name, ""))
-            self.ctx.robot_update(data_store=tuple(sorted(self._store.items())), **fields)
+            nav = {k: v for k, v in fields.items() if k in NAV_FIELDS}
+            robot = {k: v for k, v in fields.items() if k not in NAV_FIELDS}
+            self.ctx.robot_update(data_store=tuple(sorted(self._store.items())), **robot)
+            if nav:
+                self.ctx.feed(NavFeed).robot_reports(**nav)

@@ -124,6 +124,11 @@ class NavFeed(Feed):
     def _update(self, **changes: Any) -> None:
         self._set(replace(self.state, **changes))
 
+    def robot_reports(self, **changes: float | None) -> None:
+        """What an LD robot reports of itself (``DataStore_*``): its localization score and distance to
+        the goal, into the same fields ARNL's requests fill."""
+        self._update(**changes)
+
     # -- robot updates (status, mode, pose) ----------------------------------------------------
     def robot_changed(self, robot: RobotState) -> None:
         """Called with every new robot value: the words decide the phase, the pose the distance left."""

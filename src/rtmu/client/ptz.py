@@ -67,6 +67,9 @@ class PtzFeed(Feed):
         self._polling = False
         self.cameras: tuple[Camera, ...] = ()
         """Every camera the server listed (for ``rtmu ptz``), bounded by the packet."""
+        self.read_error: ClientError | ProtocolError | None = None
+        """Why the last camera list could not be read (the window shows it as the reason; ``rtmu ptz``
+        exits with its own code: a lost link is not "no camera head")."""
         self.watching = False
         """Someone shows the position (the camera page): poll ``getCameraData`` while True."""
 
@@ -84,6 +87,7 @@ class PtzFeed(Feed):
     async def read_head(self, client: AriaClient) -> None:
         """Read the camera list, limits and position once after login."""
         self._client, self._camera, self._polling, self.cameras = client, None, False, ()
+        self.read_error = None
         if not client.supports("getCameraList"):
             self._set(PtzState(reason=NO_LIST))
             return
@@ -92,6 +96,7 @@ class PtzFeed(Feed):
             cameras = CameraList.decode(reply.payload).cameras
         except (ClientError, ProtocolError) as exc:
             if client is self._client:
+                self.read_error = exc
                 self._set(PtzState(reason=f"the camera list could not be read: {exc}"))
             return
         if client is not self._client:

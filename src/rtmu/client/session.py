@@ -22,7 +22,7 @@ from dataclasses import replace
 from typing import Any, TypeVar
 
 from ..base.notices import Kind, Notice
-from ..guardian.handle import GuardianHandle
+from ..guardian.shared import GuardianSeat
 from ..protocol.errors import ProtocolError
 from ..protocol.payloads import Side, decode_payload
 from ..values.intents import Intent, Stop
@@ -230,8 +230,9 @@ class Session:
         return self.client is not None and self.client.connected
 
     @property
-    def guardian(self) -> GuardianHandle | None:
-        return self.drive.guardian.handle
+    def guardian(self) -> GuardianSeat | None:
+        """This session's place at its guardian (None without one): ``state`` says if it is armed."""
+        return self.drive.guardian.seat
 
     async def connect(
         self,
@@ -340,11 +341,12 @@ class Session:
     async def close(self) -> None:
         """Disconnect and end every task (runner shutdown); each wait is bounded."""
         await self.disconnect()
+        self.drive.guardian.end()
         await self.drive.end_heart(TASK_END_TIMEOUT)
 
     async def _drop_client(self) -> None:
         client, self.client = self.client, None
-        self.drive.guardian.close(goodbye=True)
+        self.drive.guardian.close()
         self._cancel_tasks()
         self.drive.health.stop()
         self.drive.governor.reset()

@@ -4,11 +4,14 @@ from __future__ import annotations
 
 from collections.abc import Callable
 from dataclasses import dataclass, field
-from typing import Any
+from typing import TYPE_CHECKING, Any
 
 from .mapcache import SharedMaps
 from .reconnect import Backoff
 from .roles import Role
+
+if TYPE_CHECKING:
+    from ..guardian.shared import GuardianSeat
 
 
 @dataclass
@@ -31,8 +34,12 @@ class SessionConfig:
     fetch_map: bool = True
     backoff: Callable[[], Backoff] = field(default=Backoff)
     guardian: bool = False
-    """Start a guardian process (:mod:`rtmu.guardian`) for each connection that may drive: it stops
-    the robot if this process is killed or frozen while driving. The window and ``rtmu drive`` do."""
+    """Start a guardian process (:mod:`rtmu.guardian`) of this session's own for each connection that
+    may drive: it stops the robot if this process is killed or frozen while driving (``rtmu bridge
+    --allow-drive``). A window's sessions share one instead (:attr:`guardian_seat`)."""
+    guardian_seat: GuardianSeat | None = field(default=None, compare=False)
+    """This session's seat at the window's ONE guardian (``rtmu.guardian.shared``): armed for the
+    robot the window lets drive, and no drive starts before it is (or could not be)."""
     shared_maps: SharedMaps | None = field(default=None, compare=False)
     """Maps shared with the process's other sessions (a fleet's window: one download per map file)."""
     extra_feeds: tuple[type[Any], ...] = ()

@@ -23,6 +23,7 @@ from __future__ import annotations
 import math
 import re
 
+from ..protocol.payloads.drive import RATIO_ROT_DEAD_ZONE, RATIO_TRANS_DEAD_ZONE, RatioDrive
 from ..protocol.payloads.robot import ModeInfo
 from ..values.state import LinkLevel, NavOutcome
 from .lease import RESEND_PERIOD
@@ -147,6 +148,27 @@ def _rights(facts: Facts, motion: Motion | None, navigate: bool) -> list[Reason]
             )
         )
     return out
+
+
+def _dead_zone(facts: Facts, motion: Motion | None, navigate: bool) -> list[Reason]:
+    """The drive asked for is one ARIA's ratio drive ignores: it is the request, not the robot."""
+    if (
+        motion is None
+        or "ratioDrive" not in facts.offers
+        or not RatioDrive(motion.trans, motion.rot).in_dead_zone
+    ):
+        return []
+    return [
+        Reason(
+            Cause.DEAD_ZONE,
+            f"the drive asked for (translation {motion.trans:g} %, rotation {motion.rot:g} %) is inside "
+            f"ARIA's dead zone (translation up to ±{RATIO_TRANS_DEAD_ZONE:g} %, rotation under "
+            f"±{RATIO_ROT_DEAD_ZONE:g} %): the server ignores it",
+            f"ask for more than {RATIO_TRANS_DEAD_ZONE:g} % translation or at least "
+            f"{RATIO_ROT_DEAD_ZONE:g} % rotation",
+            (f"our ratioDrive: {motion.trans:g} % translation, {motion.rot:g} % rotation",),
+        )
+    ]
 
 
 def _safety_words(facts: Facts, motion: Motion | None, navigate: bool) -> list[Reason]:
@@ -439,7 +461,7 @@ def _side(o: Obstacle) -> str:
     return f"({abs(o.y):.0f} mm to the {'left' if o.y > 0 else 'right'})"
 
 
-_RULES = (_our_side, _rights, _safety_words, _battery, _stalled, _modes, _watchdog, _safe_drive)
+_RULES = (_our_side, _rights, _dead_zone, _safety_words, _battery, _stalled, _modes, _watchdog, _safe_drive)
 
 
 # -- did it move? ----------------------------------------------------------------------------------

@@ -24,6 +24,7 @@ class Cause(Enum):
     LINK = codes.EXIT_WHY_LINK
     LEASE = codes.EXIT_WHY_LEASE
     NO_DRIVE = codes.EXIT_WHY_NO_DRIVE
+    DEAD_ZONE = codes.EXIT_WHY_DEAD_ZONE
     ESTOP = codes.EXIT_WHY_ESTOP
     FAULTS = codes.EXIT_WHY_FAULTS
     MOTORS = codes.EXIT_WHY_MOTORS

@@ -69,6 +69,7 @@ from ..model.observables import OperatorState, RobotModel, SpeedSetting
 from ..settings.store import Profile
 from ..values.intents import GotoGoal, Intent, RequestPicture, StartVideo, Stop, picture_source
 from ..values.state import ConnectionState, LinkHealth, LinkLevel, NavState, Phase, RobotState
+from . import intent_rules
 from .commands import COMMANDS, CommandRegistry, CommandState
 from .motion_limits import RobotLimits, capped_throttle
 from .motion_watch import MotionWatch
@@ -215,6 +216,9 @@ class Controller:
         self.replay: str | None = None
         """Set to the recording's name while the window shows a replay: then nothing is sent at all
         (drive keys, D-pad, STOP and every server command say "replay"), and no lease is granted."""
+        self.drive_gate: Callable[[], str | None] | None = None
+        """Why a held drive may not start now (None: it may), asked on each first press: the window's
+        guardian not yet armed for this robot (``rtmu.guardian.shared.GuardianSeat.waiting_reason``)."""
         link.on_notice = self._on_link_notice
         self._unobserve = [
             robot.connection.observe(self._on_connection),
@@ -304,8 +308,19 @@ class Controller:
             self._blocked.add(direction)
             self.view.notify(Notice.info(Kind.NAVIGATION, "Navigation cancelled. Press again to drive."))
             return
+        if self._gate_refuses():
+            self._blocked.add(direction)
+            return
         self._held.add(direction)
         self._apply()
+
+    def _gate_refuses(self) -> bool:
+        """The drive gate says no: tell the operator why (the key must be pressed again)."""
+        gate = self.drive_gate
+        why = gate() if gate is not None else None
+        if why is not None:
+            self.view.notify(Notice.warning(Kind.SAFETY, f"Not driving: {why} Press again once it is armed."))
+        return why is not None
 
     def release(self, direction: str) -> None:
         if not self._unfocused:  # a real key-up: the key may drive again on its next press
@@ -340,6 +355,9 @@ class Controller:
             self.stop()
             self._analog_blocked = True
             self.view.notify(Notice.info(Kind.NAVIGATION, "Navigation cancelled. Press again to drive."))
+            return
+        if self._analog is None and (trans or rot) and self._gate_refuses():
+            self._analog_blocked = True
             return
         self._analog = (max(-100.0, min(100.0, trans)), max(-100.0, min(100.0, rot)))
         self._apply()
@@ -505,10 +523,11 @@ class Controller:
         """Send one operator intent to this robot, after the rules that hold for every intent.
 
         Refused, with the reason shown, in a replay, while not connected (for an intent that needs
-        the server) and where the server does not offer it. An intent that moves the robot ends a
-        held drive first (the network side sends its stop before the intent), and a new goal makes
-        drive keys drive again once the server has taken it. Returns what ``link.send`` returns (a
-        Future of the answer), or None when refused. STOP has its own path: :meth:`stop`."""
+        the server), where the server does not offer it, and where ``intent_rules`` refuses it (a
+        console motion request or a fix the operator has not confirmed). An intent that moves the
+        robot ends a held drive first (the network side sends its stop before the intent), and a new
+        goal makes drive keys drive again once the server has taken it. Returns what ``link.send``
+        returns (a Future of the answer), or None when refused. STOP has its own path: :meth:`stop`."""
         if isinstance(intent, Stop):
             self.stop()
             return None
@@ -529,12 +548,17 @@ class Controller:
         if isinstance(intent, GotoGoal) and goals and intent.name not in goals:
             self.view.notify(Notice.warning(Kind.NAVIGATION, f"This map has no goal called {intent.name!r}"))
             return None
-        if intent.moves:
+        refused = intent_rules.refusal(intent)  # a console call of a motion request, a fix, unconfirmed
+        if refused is not None:
+            self.view.notify(Notice.warning(intent.kind, f"{intent.label}: {refused}"))
+            return None
+        moving = intent_rules.moves(intent)
+        if moving:
             self._halt_held(EndReason.STOPPED)  # the network side sends its stop before the intent
             self._nav_cancelled = False
         self._record(intent)
         sent = self.link.send(intent)
-        if intent.moves:
+        if moving:
             self.motion.intent_sent(intent, self.robot.robot.value)  # a jog is watched to its outcome
         return sent
 

@@ -11,10 +11,15 @@ The :class:`Fleet` owns the sessions, says which one is selected, and stops
 them all at once: the application's close, quit, suspend and signal paths go
 through :meth:`Fleet.stop_all` / :meth:`Fleet.close`, so no robot is left
 driving because a window only knew about another one. A fleet follows a
-:class:`~rtmu.client.roster.Roster` (:meth:`Fleet.follow`): a robot added gets its
-own session, which connects; a robot removed has its session closed (stopped
-first); a lost roster stops every robot and says so once. Selecting a robot
-first stops the one selected before, so a held key never carries over.
+:class:`~rtmu.client.roster.Roster` (:meth:`Fleet.follow`): every robot it names is
+*listed*; the first ``connect_at_most`` get a session each, which connects (the
+others are connected on demand when selected: :mod:`.budget`); a robot removed has its
+session closed (stopped first); a lost roster stops every robot and says so once.
+Selecting a robot first stops the one selected before, so a held key never carries
+over, and arms the window's ONE guardian (:class:`~rtmu.guardian.shared.SharedGuardian`)
+for the new one: its controller refuses drive keys until it is armed. Closing a session
+never blocks the UI thread (its network thread ends on a thread of its own); closing the
+fleet closes them all at once, within one bounded wait.
 GTK-free: ``post`` is ``GLib.idle_add`` in the app and a direct call or a
 queue in tests; everything here runs on the UI thread.
 """
@@ -22,6 +27,7 @@ queue in tests; everything here runs on the UI thread.
 from __future__ import annotations
 
 import concurrent.futures
+import threading
 import time
 from collections.abc import Callable
 from dataclasses import replace
@@ -44,10 +50,12 @@ from ..client.runner import ClientRunner, Post, call_directly, settle
 from ..client.session import SessionConfig
 from ..control.commands import COMMANDS, CommandRegistry
 from ..control.controller import Controller, NoView, SecretStore, View
+from ..guardian.shared import GuardianSeat, SharedGuardian
 from ..model.observables import Observable, OperatorState, RobotModel
 from ..recorder import Recorder, RecorderConfig
 from ..recorder.files import recordings_dir
 from ..settings.store import Profile, RecordingSettings
+from .budget import CONNECT_AT_MOST, to_connect, to_let_go
 
 CLOSE_TIMEOUT = 1.5
 """How long closing one session may take (stop, disconnect, end the network thread)."""
@@ -70,8 +78,15 @@ class RobotSession:
         registry: CommandRegistry = COMMANDS,
         recording: RecordingSettings | None = None,
         opener: Opener | None = None,
+        guardian: SharedGuardian | None = None,
     ) -> None:
         self.state = RobotModel()
+        self.seat: GuardianSeat | None = None
+        """This robot's seat at the window's one guardian (None: none, or its own per connection)."""
+        if guardian is not None:
+            p = profile or Profile()
+            self.seat = guardian.seat(p.name or f"{p.host}:{p.port}")
+            config = replace(config or SessionConfig(), guardian=False, guardian_seat=self.seat)
         self.recorder = recorder_for(recording)
         """This robot's flight recorder (None when recording is off: the default outside the window)."""
         if self.recorder is not None:  # ``opener``: where the links come from (a replay's recording)
@@ -90,6 +105,8 @@ class RobotSession:
         if self.recorder is not None:  # every source of the recording; the controller's guard for intents
             self.recorder.attach(self.runner)
             self.controller.tap = self.recorder.intent
+        if self.seat is not None:  # no drive key before the guardian is armed for this robot
+            self.controller.drive_gate = self.seat.waiting_reason
         self.closed = False
 
     @property
@@ -113,13 +130,24 @@ class RobotSession:
         self.controller.stop()
         return self.runner.stop_flushing(STOP_TIMEOUT)
 
-    def close(self, timeout: float = CLOSE_TIMEOUT) -> None:
+    def close(self, timeout: float = CLOSE_TIMEOUT, *, stop: bool = True) -> None:
         """Stop the robot, then unhook every observer and end the network thread. Idempotent."""
+        if self.begin_close(stop=stop):
+            self.finish_close(timeout)
+
+    def begin_close(self, *, stop: bool = True) -> bool:
+        """The UI thread's part of :meth:`close`: stop the robot (unless ``stop`` is False: an idle
+        robot let go of), unhook the controller. False if it was closed already."""
         if self.closed:
-            return
+            return False
         self.closed = True
-        self.controller.stop()
+        if stop:
+            self.controller.stop()
         self.controller.close()
+        return True
+
+    def finish_close(self, timeout: float = CLOSE_TIMEOUT) -> None:
+        """The rest of :meth:`close` — end the network thread, finish the recording — from any thread."""
         self.runner.close(timeout)
         if self.recorder is not None:
             self.recorder.close(timeout)
@@ -157,22 +185,40 @@ Announce = Callable[[str], None]
 class Fleet:
     """The robot sessions of one application, the selected one, and :meth:`stop_all`.
 
-    ``sessions`` and ``selected`` are observables, so a robot list binds to them.
+    ``listed`` (every robot the roster names), ``sessions`` (those connected) and ``selected`` are
+    observables, so a robot list binds to them. ``guardian``: the window's one guardian, armed for
+    the selected robot (None: none, or each session its own). The fleet ends it in :meth:`close`.
     """
 
-    def __init__(self, operator: OperatorState | None = None) -> None:
+    def __init__(
+        self,
+        operator: OperatorState | None = None,
+        *,
+        connect_at_most: int = CONNECT_AT_MOST,
+        guardian: SharedGuardian | None = None,
+    ) -> None:
         self.operator = operator or OperatorState()
+        self.listed: Observable[tuple[RobotEndpoint, ...]] = Observable(())
+        """Every robot the roster names now, in its order (connected or not)."""
         self.sessions: Observable[tuple[RobotSession, ...]] = Observable(())
         self.selected: Observable[RobotSession | None] = Observable(None)
+        self.connect_at_most = max(1, connect_at_most)
+        """How many robots are connected at once (the others are connected when selected)."""
+        self.guardian = guardian
         self._roster: Roster | None = None
         self._make: SessionMaker | None = None
         self._announce: Announce = lambda _text: None
+        self._used: dict[int, float] = {}
+        """When each session was last selected (the least recently used one is let go first)."""
+        self._closing: list[threading.Thread] = []
         self.roster_lost: str | None = None
         """Why the roster went away (None while it is there): said once, every robot stopped."""
+        self.selected.observe(self._selection_moved)
 
     # -- the roster ------------------------------------------------------------------------------
     def follow(self, roster: Roster, make: SessionMaker, announce: Announce | None = None) -> None:
-        """Build a session per robot ``roster`` announces (``make``), start it and connect it.
+        """List every robot ``roster`` announces; build (``make``), start and connect a session for the
+        first ``connect_at_most`` of them.
 
         Call once, on the UI thread; the roster must deliver its events on this thread too
         (its ``post``). The first robot becomes the selection; later ones do not take it.
@@ -190,10 +236,7 @@ class Fleet:
             case RobotAdded(endpoint):
                 self._robot_added(endpoint)
             case RobotRemoved(name, reason):
-                session = self.named(name)
-                if session is not None:
-                    self.remove(session)
-                    self._announce(f"{name} left the fleet" + (f": {reason}" if reason else ""))
+                self._robot_removed(name, reason)
             case RosterLost(reason, retrying):
                 self._roster_lost(reason, retrying)
             case RosterRestored():
@@ -202,12 +245,24 @@ class Fleet:
     def _robot_added(self, endpoint: RobotEndpoint) -> None:
         if self._make is None or self.roster_lost is not None:
             return
+        listed = self.listed.value
+        if any(e.name == endpoint.name for e in listed):  # announced again: in its place, as new
+            self.listed.set(tuple(endpoint if e.name == endpoint.name else e for e in listed))
+        else:
+            self.listed.set((*listed, endpoint))
         old = self.named(endpoint.name)
-        if old is not None:  # announced again (a central server's robot came back): a fresh session
+        if old is not None:  # a central server's robot came back: a fresh session
             self.remove(old)
-        session = self._make(endpoint).start()
-        self.add(session, select=self.selected.value is None)
-        session.controller.connect()
+        if old is not None or len(self.sessions.value) < self.connect_at_most:
+            self._connect(endpoint)
+
+    def _robot_removed(self, name: str, reason: str) -> None:
+        self.listed.set(tuple(e for e in self.listed.value if e.name != name))
+        session = self.named(name)
+        if session is not None:
+            self.remove(session)
+            self._announce(f"{name} left the fleet" + (f": {reason}" if reason else ""))
+            self._fill()
 
     def _roster_lost(self, reason: str, retrying: bool = False) -> None:
         """Every robot of the roster is gone: stop them all at once, say it ONCE, then close them."""
@@ -221,9 +276,10 @@ class Fleet:
         again = "; trying to reach it again" if retrying else ""
         self._announce(f"Lost the robot list ({reason}): every robot was told to stop{again}")
         for session in sessions:
-            session.close()
+            self._close_soon(session)
         self.sessions.set(())
         self.selected.set(None)
+        self.listed.set(())
 
     def _roster_restored(self) -> None:
         """The roster's source is back: its robots come again as new sessions (none drives unpressed)."""
@@ -242,6 +298,48 @@ class Fleet:
     def __len__(self) -> int:
         return len(self.sessions.value)
 
+    # -- connected on demand, within the budget -------------------------------------------------
+    def _connect(self, endpoint: RobotEndpoint) -> RobotSession:
+        assert self._make is not None
+        session = self._make(endpoint).start()
+        self.add(session, select=self.selected.value is None)
+        session.controller.connect()
+        return session
+
+    def select_named(self, name: str) -> RobotSession:
+        """Select the robot called ``name``: connected now if it is only listed (and the connected
+        robot used least recently let go, beyond :attr:`connect_at_most`). ValueError if not listed."""
+        session = self.named(name)
+        if session is None:
+            endpoint = next((e for e in self.listed.value if e.name == name), None)
+            if endpoint is None or self._make is None:
+                raise ValueError(f"no robot called {name!r} is listed")
+            session = self._connect(endpoint)
+        self.select(session)
+        self._trim()
+        return session
+
+    def _fill(self) -> None:
+        """Connect listed robots until :attr:`connect_at_most` are (after one left)."""
+        if self._make is None or self.roster_lost is not None:
+            return
+        connected = [s.name for s in self.sessions.value]
+        for name in to_connect([e.name for e in self.listed.value], connected, self.connect_at_most):
+            endpoint = next(e for e in self.listed.value if e.name == name)
+            self._connect(endpoint)
+
+    def _trim(self) -> None:
+        """Let go of the least recently used idle robots beyond :attr:`connect_at_most`."""
+        for session in to_let_go(self.sessions.value, self.connect_at_most, keep=self._keeps,
+                                 last_used=lambda s: self._used.get(id(s), 0.0)):  # fmt: skip
+            self._close_soon(session, stop=False)
+            self._forget(session)
+
+    def _keeps(self, session: RobotSession) -> bool:
+        c = session.controller
+        return session is self.selected.value or c.navigating or bool(c.held) or c.analog_active
+
+    # -- sessions ------------------------------------------------------------------------------
     def open(self, *, select: bool = True, **options: Any) -> RobotSession:
         """A new started session (``options`` as for :class:`RobotSession`), added to the fleet."""
         session = RobotSession(self.operator, **options).start()
@@ -258,8 +356,8 @@ class Fleet:
 
         The robot selected before is stopped first: its drive lease ends and it is sent a stop, and
         its held keys stay blocked, so nothing held carries over — the new robot moves only on a
-        fresh press. A navigation the server runs on it goes on (the operator did not ask to stop
-        that; STOP on that robot still ends it).
+        fresh press, once the guardian is armed for it. A navigation the server runs on it goes on
+        (the operator did not ask to stop that; STOP on that robot still ends it).
         """
         if session not in self.sessions.value:
             raise ValueError("that session is not in this fleet")
@@ -274,13 +372,32 @@ class Fleet:
                 old.controller.view.notify(Notice.info(Kind.SAFETY, said))
         self.selected.set(session)
 
+    def _selection_moved(self, _old: RobotSession | None, new: RobotSession | None) -> None:
+        if new is not None:
+            self._used[id(new)] = time.monotonic()
+        if self.guardian is not None:
+            self.guardian.choose(new.seat if new is not None else None)
+
     def remove(self, session: RobotSession) -> None:
         """Close ``session`` (its robot is stopped first) and forget it."""
-        session.close()
+        self._close_soon(session)
+        self._forget(session)
+
+    def _forget(self, session: RobotSession) -> None:
+        self._used.pop(id(session), None)
         remaining = tuple(s for s in self.sessions.value if s is not session)
         self.sessions.set(remaining)
         if self.selected.value is session:
             self.selected.set(remaining[0] if remaining else None)
+
+    def _close_soon(self, session: RobotSession, *, stop: bool = True) -> None:
+        """Stop (unless ``stop`` is False) and unhook now; end its thread off the UI thread."""
+        if not session.begin_close(stop=stop):
+            return
+        self._closing = [t for t in self._closing if t.is_alive()]
+        thread = threading.Thread(target=session.finish_close, name="rtmu-session-close", daemon=True)
+        thread.start()
+        self._closing.append(thread)
 
     def stop_all(self, wait: float | None = None) -> bool:
         """Stop every robot now (all stops are sent before any is waited for).
@@ -295,11 +412,18 @@ class Fleet:
         return all([settle(f, max(0.0, deadline - time.monotonic())) for f in futures])
 
     def close(self, timeout: float = CLOSE_TIMEOUT) -> None:
-        """Stop every robot at once, then close each session (and the roster). Idempotent."""
+        """Stop every robot at once, then close every session together — one bounded wait of about
+        ``timeout`` s for them all — and end the guardian. Idempotent."""
         if self._roster is not None:
             self._roster.close()
         self.stop_all()
         for session in self.sessions.value:
-            session.close(timeout)
+            self._close_soon(session)
+        deadline = time.monotonic() + timeout + 0.5
+        for thread in self._closing:
+            thread.join(max(0.0, deadline - time.monotonic()))
+        self._closing = [t for t in self._closing if t.is_alive()]
         self.sessions.set(())
         self.selected.set(None)
+        if self.guardian is not None:
+            self.guardian.close()

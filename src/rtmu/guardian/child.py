@@ -1,5 +1,11 @@
 """The guardian process's main loop (``python -m rtmu.guardian``).
 
+It starts idle and logs in to the robot each :data:`~.messages.LOGIN` record names (the window's
+one guardian follows the robot that may drive; ``rtmu drive`` and ``rtmu bridge`` log in once),
+on its own connection (:mod:`.login`). It says ``ready`` once logged in; from then on, while the
+parent says motion may be commanded ("armed"), heartbeats must keep coming from the parent's UI
+and network threads.
+
 Thresholds, and why they cannot cause a false stop:
 
 * **EOF on the pipe while armed** (the parent was killed, crashed, OOM-killed):
@@ -8,36 +14,44 @@ Thresholds, and why they cannot cause a false stop:
   threads are stopped by a signal or traced (``T``/``t`` in ``/proc``), or it
   is gone: stop at once. A running process is never in that state, however
   busy, slow or starved it is, so GC pauses and CPU contention cannot trip it.
-* **a heartbeat :data:`SILENT_LATE` s late while armed** from a parent that
-  still runs: stop. The parent's own drive lease lapses 0.3 s after its UI last
-  renewed it, so by then the parent would stop the robot itself when it runs
-  again — the guardian never ends a drive the parent would have continued.
+* **a heartbeat late past its source's limit while armed** from a parent that
+  still runs: stop. The limit is :data:`SILENT_LATE` s by default: the parent's own drive
+  lease lapses 0.3 s after its UI last renewed it, so by then the parent would stop the robot
+  itself when it runs again — the guardian never ends a drive the parent would have continued.
+  How late each source may be is asked of a :class:`BeatLimit` per source (the ``limits`` of
+  :class:`Watch`): a learned limit plugs in there.
 
 Heartbeats carry the sender's monotonic time (one clock for all processes on
 Linux), and the pipe is drained before every decision, so a guardian that was
 itself starved of CPU judges by when beats were sent, not when it read them.
-After a stop it is disarmed until the parent arms it again (a new drive).
+After a stop it is disarmed until the parent arms it again (a new drive). A new login while
+armed first stops the robot watched so far (the parent switched robots in the middle of a drive,
+and its own stop for that robot may not have left yet). Disarmed, it sleeps on its pipe and its
+socket instead of waking 50 times a second.
 """
 
 from __future__ import annotations
 
-import asyncio
 import contextlib
 import os
-import struct
+import select
 import sys
 import time
+from collections.abc import Callable
 from pathlib import Path
+from typing import Protocol
 
-from ..client.connection import AriaClient
-from ..client.errors import ClientError
-from ..client.roles import Role
 from . import messages as m
 from .halt import Halter
+from .login import LoginState, RobotLogin
 
 QUICK_LATE = 0.1
 SILENT_LATE = 0.4
 CHECK_PERIOD = 0.02
+"""Seconds between looks while armed."""
+IDLE_PERIOD = 1.0
+"""Seconds between looks while disarmed: nothing can call for a stop then, and a record on the pipe
+(ARM first of all) or a byte on the socket wakes the loop at once."""
 
 
 def parent_frozen(pid: int) -> bool:
@@ -57,25 +71,9 @@ def parent_frozen(pid: int) -> bool:
     return False
 
 
-def read_hello(fd: int) -> m.Hello:
-    def exactly(n: int) -> bytes:
-        data = b""
-        while len(data) < n:
-            chunk = os.read(fd, n - len(data))
-            if not chunk:
-                raise EOFError("the parent closed the pipe before its hello")
-            data += chunk
-        return data
-
-    (size,) = struct.unpack(">I", exactly(4))
-    if size > m.MAX_HELLO:
-        raise ValueError("hello too large")
-    return m.Hello.decode(exactly(size))
-
-
-def say(word: str, text: str = "") -> None:
+def say(word: str, serial: int, text: str = "") -> None:
     try:
-        sys.stdout.write(f"{word} {text}".rstrip().replace("\n", " ") + "\n")
+        sys.stdout.write(m.report(word, serial, text) + "\n")
         sys.stdout.flush()
     except (OSError, ValueError):
         _parent_stopped_listening()
@@ -90,13 +88,41 @@ def _parent_stopped_listening() -> None:
         os.close(devnull)
 
 
+class BeatLimit(Protocol):
+    """How late one heartbeat source may be: learns from the gaps between its beats."""
+
+    def note(self, sample: float, now: float) -> None: ...
+
+    def limit(self, now: float) -> float: ...
+
+
+class FixedLimit:
+    """A source may be :data:`SILENT_LATE` s late, whatever it did before (the default)."""
+
+    def __init__(self, seconds: float = SILENT_LATE) -> None:
+        self.seconds = seconds
+
+    def note(self, sample: float, now: float) -> None:
+        pass
+
+    def limit(self, now: float) -> float:
+        return self.seconds
+
+
+LimitFor = Callable[[bytes], BeatLimit]
+"""``limits(source)``: the limit of one heartbeat source (``BEAT_UI`` or ``BEAT_NET``), made once."""
+
+
 class Watch:
     """Armed/disarmed state and the heartbeats' last send times; decides when to stop."""
 
-    def __init__(self, parent: int) -> None:
+    def __init__(self, parent: int, limits: LimitFor | None = None) -> None:
         self.parent = parent
         self.armed = False
         self.last: dict[bytes, float] = {}
+        self.limits: LimitFor = limits or (lambda _source: FixedLimit())
+        self.timing: dict[bytes, BeatLimit] = {}
+        """Per source: how late its beats may come (``limits``)."""
         self.bye = False
         self.eof = False
 
@@ -110,8 +136,18 @@ class Watch:
         elif kind == m.BYE:
             self.armed = False
             self.bye = True
-        else:  # a source is watched once it has beaten
-            self.last[kind] = max(at, self.last.get(kind, at))
+        elif kind in (m.BEAT_UI, m.BEAT_NET):  # a source is watched once it has beaten
+            last = self.last.get(kind)
+            timing = self.timing.get(kind)
+            if timing is None:
+                timing = self.timing[kind] = self.limits(kind)
+            if last is not None and at > last:
+                timing.note(at - last, at)
+            self.last[kind] = max(at, last if last is not None else at)
+
+    def limit(self, kind: bytes, now: float) -> float:
+        timing = self.timing.get(kind)
+        return timing.limit(now) if timing is not None else SILENT_LATE
 
     def why_stop(self, now: float) -> str | None:
         if not self.armed:
@@ -121,64 +157,142 @@ class Watch:
         late = now - min(self.last.values()) if self.last else 0.0
         if late > QUICK_LATE and parent_frozen(self.parent):
             return f"the process driving the robot is stopped or gone (no heartbeat for {late * 1000:.0f} ms)"
-        if late > SILENT_LATE:
-            return f"no heartbeat from the process driving the robot for {late * 1000:.0f} ms"
+        for kind, at in self.last.items():
+            if now - at > self.limit(kind, now):
+                return f"no heartbeat from the process driving the robot for {(now - at) * 1000:.0f} ms"
         return None
 
 
-async def run(fd: int = 0) -> int:
-    parent = os.getppid()
-    try:
-        hello = read_hello(fd)
-    except (EOFError, ValueError, KeyError, OSError) as exc:
-        say(m.UNAVAILABLE, f"bad hello: {exc}")
-        return 2
-    client = AriaClient()
-    try:
-        await client.connect(
-            hello.host, hello.port, hello.user, hello.password, timeout=hello.timeout, role=Role.OPERATOR
-        )
-    except ClientError as exc:
-        say(m.UNAVAILABLE, str(exc))
-        return 3
-    del hello  # the password is not needed any more
-    halter = Halter(client)
-    say(m.READY)
-    watch = Watch(parent)
-    reader = m.RecordReader()
-    os.set_blocking(fd, False)
+class Guardian:
+    """The loop's state: the pipe, the watch, and the login to the robot watched now."""
 
-    def drain() -> None:
-        while not watch.eof:
+    def __init__(self, fd: int, watch: Watch) -> None:
+        self.fd = fd
+        self.watch = watch
+        self.reader = m.RecordReader()
+        self.login: RobotLogin | None = None
+        self.halter: Halter | None = None
+        self.serial = -1
+        """The serial of the login asked for last (every word about it carries this number)."""
+
+    # -- the pipe ------------------------------------------------------------------------------
+    def drain(self) -> None:
+        while not self.watch.eof:
             try:
-                data = os.read(fd, 4096)
+                data = os.read(self.fd, 65536)
             except BlockingIOError:
                 return
             except OSError:
                 data = b""
             if not data:
-                watch.eof = True
+                self.watch.eof = True
                 return
-            for kind, at in reader.feed(data):
-                watch.take(kind, at)
+            try:
+                records = self.reader.feed(data)
+            except ValueError:  # out of step with the parent: as good as gone
+                self.watch.eof = True
+                return
+            for kind, at, hello in records:
+                if kind == m.LOGIN and hello is not None:
+                    self.log_in(hello)
+                elif kind == m.HALT:
+                    self.stop("the program driving it lost its own link to the robot while driving")
+                else:
+                    self.watch.take(kind, at)
 
-    try:
-        while True:
-            drain()
-            why = watch.why_stop(time.monotonic())
-            if why is not None:
-                halter.halt()
-                await halter.flush()
-                watch.armed = False
-                say(m.STOPPED, why)
-            if watch.eof or watch.bye:
-                return 0
-            if not halter.connected:
-                say(m.LOST, str(client.closed_error or "the guardian's connection closed"))
-                return 3
-            await asyncio.sleep(CHECK_PERIOD)
-    finally:
-        await client.disconnect()
+    # -- the robot -----------------------------------------------------------------------------
+    def log_in(self, hello: m.Hello) -> None:
+        """Watch the robot ``hello`` names from now on; the one watched before is left."""
+        if self.watch.armed:  # a switch in the middle of a drive: that robot is stopped first, quietly
+            self.halt()
+        self.watch.armed = False
+        self.serial = hello.serial
+        if not hello.host:  # log out: the parent's robot is gone and no other is to be watched yet
+            self.leave()
+            return
+        login = self.login
+        if login is not None and login.state is LoginState.READY and hello.same_robot(login.hello):
+            say(m.READY, self.serial)  # logged in to that robot already
+            return
+        self.leave()
+        self.login = RobotLogin(hello)
+
+    def leave(self) -> None:
+        login, self.login, self.halter = self.login, None, None
+        if login is not None:
+            login.close()
+
+    def halt(self) -> bool:
+        halter = self.halter
+        if halter is None:
+            return False
+        halter.halt()
+        return halter.flush()
+
+    def stop(self, why: str) -> None:
+        """Stop the robot watched now (if logged in) and say so; disarmed afterwards."""
+        if self.halt():
+            say(m.STOPPED, self.serial, why)
+        self.watch.armed = False
+
+    def progress(self, now: float) -> None:
+        """Say what the login did: ready, refused, or its connection ended."""
+        login = self.login
+        if login is None:
+            return
+        login.check_deadline(now)
+        if login.state is LoginState.READY and self.halter is None:
+            self.halter = Halter(login)
+            say(m.READY, self.serial)
+        elif login.state is LoginState.FAILED:
+            say(m.UNAVAILABLE, self.serial, login.error)
+            self.login = None
+        elif login.state is LoginState.CLOSED:
+            say(m.LOST, self.serial, login.error or "the guardian's connection closed")
+            self.login, self.halter = None, None
+
+    # -- the loop ------------------------------------------------------------------------------
+    def wait(self) -> None:
+        """Sleep until the pipe or the socket has something, or it is time to look again."""
+        login = self.login
+        readers: list[int] = [self.fd]
+        writers: list[int] = []
+        period = CHECK_PERIOD if self.watch.armed else IDLE_PERIOD
+        if login is not None and login.active:
+            readers.append(login.fileno())
+            if login.wants_write():
+                writers.append(login.fileno())
+            if login.state is not LoginState.READY:
+                period = min(period, max(0.0, login.deadline - time.monotonic()) + 0.01)
+        try:
+            readable, writable, _ = select.select(readers, writers, [], period)
+        except (OSError, ValueError):
+            return
+        if login is not None and login is self.login:
+            if login.fileno() in writable:
+                login.on_writable()
+            if login.fileno() in readable:
+                login.on_readable(time.monotonic())
+
+    def run(self) -> int:
+        try:
+            while True:
+                self.drain()
+                now = time.monotonic()
+                self.progress(now)
+                why = self.watch.why_stop(now)
+                if why is not None:
+                    self.stop(why)
+                if self.watch.eof or self.watch.bye:
+                    return 0
+                self.wait()
+        finally:
+            self.leave()
+
+
+def run(fd: int = 0, limits: LimitFor | None = None) -> int:
+    os.set_blocking(fd, False)
+    return Guardian(fd, Watch(os.getppid(), limits)).run()
 
 
 def main() -> int:
@@ -188,4 +302,4 @@ def main() -> int:
     for signum in (signal.SIGINT, signal.SIGTSTP, signal.SIGHUP):
         with contextlib.suppress(OSError, ValueError):
             signal.signal(signum, signal.SIG_IGN)
-    return asyncio.run(run())
+    return run()

@@ -1,9 +1,9 @@
-"""The parent's side of a guardian: start it, hand it the credentials, arm, beat, disarm, say goodbye.
+"""The parent's side of a guardian process: start it, send it logins, arm, beat, disarm, say goodbye.
 
-Every method is thread-safe and never blocks: records go to a non-blocking pipe
-with one ``os.write`` each (the UI thread and the network thread both beat). A
-full pipe means the guardian has stopped reading: it is then ended and reported
-unavailable rather than let a lost disarm become a false stop later.
+Every method that writes is thread-safe and never blocks: records go to a non-blocking pipe under
+one lock (the UI thread and the network thread both beat). A full pipe means the guardian has
+stopped reading: it is then ended and reported unavailable rather than let a lost disarm become a
+false stop later.
 """
 
 from __future__ import annotations
@@ -23,7 +23,7 @@ BEAT_PERIOD = 0.04
 
 
 class GuardianHandle:
-    """One guardian process. :meth:`start` it, then :meth:`poll` its reports from time to time."""
+    """One guardian process. :meth:`start` it, :meth:`login` it, then :meth:`poll` its reports."""
 
     def __init__(self, proc: subprocess.Popen[bytes], clock: Callable[[], float] = time.monotonic) -> None:
         self.proc = proc
@@ -33,14 +33,18 @@ class GuardianHandle:
         self._fd = proc.stdin.fileno()
         self._out = proc.stdout.fileno()
         os.set_blocking(self._out, False)
+        os.set_blocking(self._fd, False)
         self._partial = b""
         self.armed = False
+        self.serial = -1
+        """The serial of the last login sent (:meth:`login`)."""
         self.state = "starting"
-        """starting → ready, or unavailable/lost/ended (with :attr:`reason`)."""
+        """Of the last login: starting → ready, or unavailable/lost (with :attr:`reason`);
+        ended when the process is gone."""
         self.reason = ""
 
     @classmethod
-    def start(cls, hello: m.Hello) -> GuardianHandle:
+    def start(cls, hello: m.Hello | None = None) -> GuardianHandle:
         """Spawn ``python -m rtmu.guardian`` in its own session; credentials go down the pipe only."""
         proc = subprocess.Popen(
             [sys.executable, "-m", "rtmu.guardian"],
@@ -49,18 +53,23 @@ class GuardianHandle:
             start_new_session=True,
         )
         handle = cls(proc)
-        assert proc.stdin is not None
-        os.write(handle._fd, hello.encode())  # far below the pipe's 64 KiB: never blocks
-        os.set_blocking(handle._fd, False)
+        if hello is not None:
+            handle.login(hello)
         return handle
 
+    @property
+    def alive(self) -> bool:
+        return self._fd >= 0 and self.state != "ended"
+
     # -- records ---------------------------------------------------------------------------
-    def _send(self, kind: bytes) -> bool:
+    def _write(self, data: bytes) -> bool:
         with self._lock:
             if self._fd < 0:
                 return False
             try:
-                os.write(self._fd, m.record(kind, self.clock()))
+                view = memoryview(data)
+                while view:  # a login is longer than one record; the pipe has room for it (64 KiB)
+                    view = view[os.write(self._fd, view) :]
                 return True
             except BlockingIOError:
                 stuck = True
@@ -68,6 +77,18 @@ class GuardianHandle:
                 stuck = False
         self._gone("ended", "the guardian stopped reading its pipe" if stuck else "the guardian ended")
         return False
+
+    def _send(self, kind: bytes, at: float | None = None) -> bool:
+        return self._write(m.record(kind, self.clock() if at is None else at))
+
+    def login(self, hello: m.Hello) -> bool:
+        """Watch the robot ``hello`` names from now on (its serial names the answers about it)."""
+        with self._lock:
+            self.armed = False
+            self.serial = hello.serial
+            if self.state != "ended":
+                self.state, self.reason = "starting", ""
+        return self._write(m.login_record(hello, self.clock()))
 
     def arm(self) -> None:
         """Before the first nonzero ``ratioDrive`` of a drive."""
@@ -81,18 +102,31 @@ class GuardianHandle:
             self.armed = False
             self._send(m.DISARM)
 
-    def beat_ui(self) -> None:
+    def halt(self) -> None:
+        """Our own link to the robot died while driving: the guardian stops it on its connection."""
+        self.armed = False
+        self._send(m.HALT)
+
+    def beat_ui(self, at: float | None = None) -> None:
+        """The UI thread is alive (as of ``at``; default now)."""
         if self.armed:
-            self._send(m.BEAT_UI)
+            self._send(m.BEAT_UI, at)
 
     def beat_net(self) -> None:
         if self.armed:
             self._send(m.BEAT_NET)
 
     # -- reports ---------------------------------------------------------------------------
-    def poll(self) -> list[tuple[str, str]]:
-        """The guardian's reports since the last call, as (word, text); never blocks."""
-        out: list[tuple[str, str]] = []
+    def fileno(self) -> int:
+        """Where its reports come from (for a ``select``); -1 once closed."""
+        return self._out
+
+    def poll(self) -> list[tuple[str, int, str]]:
+        """The guardian's reports since the last call, as (word, serial, text); never blocks.
+
+        Call from one thread only. EOF while the process was wanted is reported as ``ended``
+        (serial -1)."""
+        out: list[tuple[str, int, str]] = []
         while self._out >= 0:
             try:
                 data = os.read(self._out, 4096)
@@ -102,18 +136,20 @@ class GuardianHandle:
                 data = b""
             if not data:
                 self._out = -1
-                if self.state in ("starting", "ready"):
+                if self.state != "ended":
                     code = self.proc.poll()
                     self._gone("ended", f"the guardian ended unexpectedly (exit code {code})")
-                    out.append(("ended", self.reason))
+                    out.append(("ended", -1, self.reason))
                 break
             self._partial += data
             *lines, self._partial = self._partial.split(b"\n")
             for line in lines:
-                word, _, text = line.decode("utf-8", "replace").partition(" ")
-                out.append((word, text))
-                if word == m.READY and self.state == "starting":
-                    self.state = "ready"
+                word, serial, text = m.parse_report(line.decode("utf-8", "replace"))
+                out.append((word, serial, text))
+                if serial != self.serial:
+                    continue  # about a robot it has left
+                if word == m.READY:
+                    self.state, self.reason = "ready", ""
                 elif word in (m.UNAVAILABLE, m.LOST):
                     self.state, self.reason = word, text
         return out
@@ -126,12 +162,11 @@ class GuardianHandle:
             self.armed = False
             self._send(m.BYE)
         self._close_pipe()
-        out, self._out = self._out, -1  # poll() runs on the same (network) thread as close()
+        out, self._out = self._out, -1  # poll() runs on the same thread as close() (or has ended)
         if out >= 0 and self.proc.stdout is not None:
             with contextlib.suppress(OSError, ValueError):
                 self.proc.stdout.close()
-        if self.state in ("starting", "ready"):
-            self.state = "ended"
+        self.state = "ended"
         threading.Thread(target=self._reap, name="rtmu-guardian-reap", daemon=True).start()
 
     def _reap(self) -> None:

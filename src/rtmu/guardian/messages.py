@@ -1,12 +1,14 @@
-"""The pipe between the parent and its guardian: one hello, then fixed-size records.
+"""The pipe between the parent and its guardian: records, some carrying a login.
 
-Parent → guardian (the guardian's stdin): a 4-byte big-endian length and a JSON
-hello (host, port, user, password — never in argv or the environment), then
-records of :data:`RECORD` (a kind byte, the sender's ``time.monotonic()``).
-Every record is written with one ``os.write`` of fewer than ``PIPE_BUF`` bytes,
-so records from the UI and the network threads never interleave.
+Parent → guardian (the guardian's stdin): records of :data:`RECORD` (a kind byte, the sender's
+``time.monotonic()``). A :data:`LOGIN` record is followed by a 4-byte big-endian length and a JSON
+:class:`Hello` (host, port, user, password — never in argv or the environment — and the login's
+serial number): log out of the robot watched so far and log in to this one. The parent writes
+every record under one lock, so records from the UI and the network threads never interleave.
 
-Guardian → parent (its stdout): one line per event, ``<word> <text>``.
+Guardian → parent (its stdout): one line per event, ``<word> <serial> <text>``; the serial names
+the login the event is about, so a late word about a robot the guardian left is never taken for
+the robot it watches now.
 """
 
 from __future__ import annotations
@@ -16,6 +18,7 @@ import struct
 from dataclasses import dataclass
 
 RECORD = struct.Struct(">cd")
+LENGTH = struct.Struct(">I")
 BEAT_UI = b"u"
 """The parent's UI thread is alive."""
 BEAT_NET = b"n"
@@ -24,16 +27,24 @@ ARM = b"a"
 """Motion may be commanded from now on: watch the heartbeats."""
 DISARM = b"d"
 """The parent has sent its own stop: nothing to watch."""
+HALT = b"h"
+"""Stop the robot now through the guardian's own connection (the parent's link to it died while driving)."""
+LOGIN = b"l"
+"""A :class:`Hello` follows: watch this robot from now on (the one watched before is left, stopped
+first if a drive was armed on it). A hello with an empty host only leaves: nothing is watched."""
 BYE = b"b"
 """A clean exit: end without a stop."""
-KINDS = frozenset({BEAT_UI, BEAT_NET, ARM, DISARM, BYE})
+KINDS = frozenset({BEAT_UI, BEAT_NET, ARM, DISARM, HALT, LOGIN, BYE})
 MAX_HELLO = 64 * 1024
 
 # guardian → parent words
 READY = "ready"
+"""Logged in to the robot of that serial: it can stop it."""
 UNAVAILABLE = "unavailable"
+"""Could not log in (the text says why): that robot is not watched."""
 STOPPED = "stopped"
 LOST = "lost"
+"""Its connection to that robot closed."""
 
 
 @dataclass(frozen=True)
@@ -43,6 +54,10 @@ class Hello:
     user: str = ""
     password: str = ""
     timeout: float = 10.0
+    serial: int = 0
+    """Which login this is (the parent counts them); every word about it carries this number."""
+    protocol: str | None = None
+    """The protocol string to answer with (None: the one the server advertises), as the parent's."""
 
     def encode(self) -> bytes:
         body = json.dumps(
@@ -52,29 +67,96 @@ class Hello:
                 "user": self.user,
                 "password": self.password,
                 "timeout": self.timeout,
+                "serial": self.serial,
+                "protocol": self.protocol,
             }
         ).encode()
-        return struct.pack(">I", len(body)) + body
+        return LENGTH.pack(len(body)) + body
 
     @classmethod
     def decode(cls, body: bytes) -> Hello:
         d = json.loads(body.decode())
-        return cls(str(d["host"]), int(d["port"]), str(d["user"]), str(d["password"]), float(d["timeout"]))
+        protocol = d.get("protocol")
+        return cls(
+            str(d["host"]),
+            int(d["port"]),
+            str(d["user"]),
+            str(d["password"]),
+            float(d["timeout"]),
+            int(d.get("serial", 0)),
+            None if protocol is None else str(protocol),
+        )
+
+    def same_robot(self, other: Hello | None) -> bool:
+        """The same login (address, user, password, protocol): logged in to one is logged in to both."""
+        if other is None:
+            return False
+        mine = (self.host, self.port, self.user, self.password, self.protocol)
+        return mine == (other.host, other.port, other.user, other.password, other.protocol)
 
 
 def record(kind: bytes, at: float) -> bytes:
     return RECORD.pack(kind, at)
 
 
+def login_record(hello: Hello, at: float) -> bytes:
+    return RECORD.pack(LOGIN, at) + hello.encode()
+
+
+Record = tuple[bytes, float, Hello | None]
+"""(kind, the sender's time, the hello of a LOGIN record)."""
+
+
 class RecordReader:
-    """Splits bytes from the pipe into (kind, time) records; keeps a partial record for later."""
+    """Splits bytes from the pipe into records; keeps a partial record for later.
+
+    A login whose hello is too long or does not decode raises ``ValueError``: the pipe is then out
+    of step, and the guardian ends rather than guess where the next record starts."""
 
     def __init__(self) -> None:
         self._buf = b""
 
-    def feed(self, data: bytes) -> list[tuple[bytes, float]]:
+    def feed(self, data: bytes) -> list[Record]:
         self._buf += data
-        n = len(self._buf) // RECORD.size * RECORD.size
-        out = [RECORD.unpack_from(self._buf, i) for i in range(0, n, RECORD.size)]
-        self._buf = self._buf[n:]
-        return [(k, t) for k, t in out if k in KINDS]
+        out: list[Record] = []
+        at = 0
+        buf = self._buf
+        while len(buf) - at >= RECORD.size:
+            kind, when = RECORD.unpack_from(buf, at)
+            if kind != LOGIN:
+                at += RECORD.size
+                if kind in KINDS:
+                    out.append((kind, when, None))
+                continue
+            head = at + RECORD.size
+            if len(buf) - head < LENGTH.size:
+                break
+            (size,) = LENGTH.unpack_from(buf, head)
+            if size > MAX_HELLO:
+                raise ValueError("hello too large")
+            if len(buf) - head - LENGTH.size < size:
+                break
+            body = buf[head + LENGTH.size : head + LENGTH.size + size]
+            try:
+                hello = Hello.decode(body)
+            except (ValueError, KeyError, TypeError) as exc:
+                raise ValueError(f"bad hello: {exc}") from None
+            out.append((LOGIN, when, hello))
+            at = head + LENGTH.size + size
+        self._buf = buf[at:]
+        return out
+
+
+def report(word: str, serial: int, text: str = "") -> str:
+    """One line to the parent: ``<word> <serial> <text>``, on one line whatever the text holds."""
+    return f"{word} {serial} {text}".rstrip().replace("\n", " ").replace("\r", " ")
+
+
+def parse_report(line: str) -> tuple[str, int, str]:
+    """(word, serial, text) of one line the guardian said; serial -1 when the line has none."""
+    word, _, rest = line.partition(" ")
+    number, _, text = rest.partition(" ")
+    try:
+        return word, int(number), text
+    except ValueError:
+        return word, -1, rest

@@ -142,8 +142,6 @@ def status_record(r: RobotState) -> dict[str, Any]:
         "dock_state": r.dock_state,
         "wifi_quality": r.wifi_quality,
         "wifi_signal": r.wifi_signal,
-        "loc_score": r.loc_score,
-        "goal_distance_mm": r.goal_distance_mm,
         "closest_obstacle_mm": r.closest_obstacle_mm,
     }
 

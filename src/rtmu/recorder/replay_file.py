@@ -22,9 +22,10 @@ from dataclasses import dataclass, field
 from pathlib import Path
 
 from ..capture.base import CaptureError, CaptureStats, StreamData
+from ..capture.conversation import C2S, DecodedPacket
 from ..capture.mcap_bounded import BoundedMcap
 from ..capture.recorded import CONNECTION_TOPIC, recorded_events
-from ..capture.session_decoder import C2S, CaptureDecoder, DecodedPacket
+from ..capture.session_decoder import CaptureDecoder
 from ..client.health import PING_CANDIDATES
 from ..protocol.decoder import PacketDecoder
 from ..protocol.motion import MOTION_REQUESTS, is_motion

@@ -61,8 +61,6 @@ _SCHEMAS: dict[str, dict[str, Any]] = {
         dock_state={"type": ["string", "null"]},
         wifi_quality=_INT,
         wifi_signal=_INT,
-        loc_score=_INT,
-        goal_distance_mm=_INT,
         closest_obstacle_mm=_INT,
     ),
     topics.CONNECTION: _object(
@@ -103,6 +101,8 @@ _SCHEMAS: dict[str, dict[str, Any]] = {
         outcome_text=_TEXT,
         reason=_TEXT,
         remaining_mm=_NUMBER,
+        loc_state={"type": ["string", "null"]},
+        loc_score={**_NUMBER, "description": "0–1 (an LD robot's 0–100 scaled); null when not offered"},
     ),
     topics.NOTICES: _object(
         "rtmu.Notice", "A message shown to the operator.", kind=_TEXT, level=_TEXT, text=_TEXT

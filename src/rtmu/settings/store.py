@@ -29,6 +29,7 @@ with neither is the one robot of ``host``/``port``, as before)::
     robots = [{ name = "robot1", host = "10.0.0.5", port = 7272 },
               { name = "robot2", host = "10.0.0.6", port = 7272 }]
     # or: central = "10.0.0.2:7272"
+    connect_at_most = 20  # robots connected at once; the others are listed, connected when selected
 
 It is read with ``tomllib`` and written by hand (the schema is flat, so no
 writer library is needed), atomically, readable by the user only.
@@ -76,6 +77,9 @@ MAX_SETTINGS_BYTES = 1 << 20
 
 
 MAX_FLEET = 100
+CONNECT_AT_MOST = 20
+"""A fleet's robots connected at once by default (``fleet.budget`` says why there is a bound)."""
+MAX_CONNECT_AT_MOST = 1000
 """Robots one profile may list."""
 
 
@@ -129,6 +133,8 @@ class Profile:
     """A fleet of robots reached directly (names unique); empty: the one robot at host/port."""
     central: str = ""
     """``"HOST:PORT"`` of ARIA's central server that lists and forwards the robots; empty: none."""
+    connect_at_most: int = CONNECT_AT_MOST
+    """A fleet's robots connected at once (the others listed, connected when selected): 1…1000."""
 
     @property
     def is_fleet(self) -> bool:
@@ -153,6 +159,9 @@ class Profile:
             raise ValueError(f"profile {self.name!r}: speed {self.speed} is not 10…100 in steps of 10")
         if len(self.robots) > MAX_FLEET:
             raise ValueError(f"profile {self.name!r}: more than {MAX_FLEET} robots")
+        if not 1 <= self.connect_at_most <= MAX_CONNECT_AT_MOST:
+            most = self.connect_at_most
+            raise ValueError(f"profile {self.name!r}: connect_at_most {most} is not 1…{MAX_CONNECT_AT_MOST}")
         for robot in self.robots:
             robot.validate(self.name)
         names = [r.name for r in self.robots]
@@ -213,6 +222,7 @@ _TYPES: dict[str, type] = {
     "speed": int,
     "protocol": str,
     "central": str,
+    "connect_at_most": int,
 }
 _ROBOT_KEYS = {"name": str, "host": str, "port": int}
 
@@ -491,6 +501,8 @@ def format_settings(settings: Settings) -> str:
         for f in fields(profile):
             if f.name == "name" or (f.name in ("robots", "central") and not getattr(profile, f.name)):
                 continue  # a one-robot profile is written as before the fleet existed
+            if f.name == "connect_at_most" and profile.connect_at_most == CONNECT_AT_MOST:
+                continue
             lines.append(f"{f.name} = {_toml_value(getattr(profile, f.name))}")
     if settings.recording != RecordingSettings():
         settings.recording.validate()

@@ -28,6 +28,7 @@ from rtmu.protocol.datalist import DataList
 from rtmu.protocol.payloads.robot import BatteryInfo, Update
 
 from . import p3dx
+from .camera_data import HANDLERS as CAMERA_HANDLERS
 from .catalogue import Row, build_catalogue
 from .handlers import HANDLERS, Call, Handler, Reply, numbers
 
@@ -95,7 +96,7 @@ class SimProfile:
 
     def handler_table(self) -> dict[str, Handler]:
         _, extra = self.module_parts()
-        return {**HANDLERS, **self.handlers, **extra}
+        return {**HANDLERS, **CAMERA_HANDLERS, **self.handlers, **extra}
 
 
 # -- state of charge -----------------------------------------------------------------------------

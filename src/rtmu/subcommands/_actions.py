@@ -26,6 +26,12 @@ def add_late_connection_options(parser: argparse.ArgumentParser) -> None:
     parser.add_argument(
         "--password-file", type=Path, metavar="FILE", default=quiet, help="read the password from FILE"
     )
+    parser.add_argument(
+        "--password-stdin",
+        action="store_true",
+        default=quiet,
+        help="read the password from the first line of standard input",
+    )
     parser.add_argument("--protocol", metavar="STRING", default=quiet, help="protocol string to log in with")
     parser.add_argument(
         "--timeout", type=positive_float, metavar="S", default=quiet, help="seconds to wait at each step"

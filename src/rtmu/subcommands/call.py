@@ -20,21 +20,21 @@ from __future__ import annotations
 
 import argparse
 import difflib
-import json
 import re
 import sys
 import time
 from typing import Any
 
-from ..base.exit_codes import EXIT_OK, EXIT_TIMEOUT, EXIT_USAGE
+from ..base.exit_codes import EXIT_OK, EXIT_TIMEOUT, EXIT_USAGE, NETWORK
 from ..base.textsafe import visible
 from ..client.connection import AriaClient
 from ..client.console import ConsoleEntry, ConsoleReply, Subscription, call, console_entries, entry_of
-from ..client.console_layout import KINDS, ArgumentError, describe, encode_arguments
+from ..client.console_layout import KINDS, ArgumentError, encode_arguments
+from ..client.console_text import SILENT_OUTCOMES, entry_lines, outcome_line, packet_lines
 from ..client.roles import Role
 from ._common import add_connection_arguments, positive_float, print_json, run_with_client
 
-SILENT_OUTCOMES = ("silent", "stalled", "sent")
+EXITS = NETWORK
 FOLLOW_CHECK = 0.5
 """Seconds between looks at the connection while following a data."""
 
@@ -45,9 +45,11 @@ def register(subparsers: Any) -> None:
         help="call any data the server lists (a console): once, or at an interval; --list shows them all",
         description="Send data NAME once with ARGs (typed as its argument description says, or as "
         "--type names) and print each reply as hex, fields and RTMU's own type where it has one. "
-        "--every MS follows it (-1: broadcasts only). A data that changes something needs --yes. "
-        "Exit 0 replied, 2 not listed / wrong arguments / needs --yes / refused, 3 connection, "
-        "5 silent.",
+        "--every MS follows it (-1: broadcasts only). A data that changes something needs --yes (without "
+        "it this command is an observer: it cannot send a motion request); ratioDrive is never sent. A data "
+        "this user's list does not have, arguments that do not fit, a call that needs --yes, or one the "
+        "console refuses are usage errors (nothing is sent); no reply within --timeout (none at all while "
+        "following), a reply that stalls, or a command the server does not confirm taking is a timeout.",
     )
     _positionals_anywhere(p)
     add_connection_arguments(p)
@@ -181,13 +183,8 @@ def print_list(entries: list[ConsoleEntry], as_json: bool) -> int:
         print_json([e.to_json() for e in entries])
         return EXIT_OK
     for e in entries:
-        d = e.data
-        effect = f"changes something ({e.why})" if e.changes else "read"
-        print(f"{d.number:5d}  {visible(d.name)}  [{visible(d.command_group)}] {visible(d.flags)}  {effect}")
-        if d.description:
-            print(f"       {visible(d.description)}")
-        returns = visible(_short(d.return_description))
-        print(f"       arguments: {visible(describe(e.arguments))}   returns: {returns}")
+        for line in entry_lines(e):
+            print(line)
     print(f"{len(entries)} data", flush=True)
     return EXIT_OK
 
@@ -196,34 +193,8 @@ def show(reply: ConsoleReply, entry: ConsoleEntry, as_json: bool, timeout: float
     if as_json:
         print_json(reply.to_json())
         return
-    packets = f"{reply.packet_count} packet{'s' if reply.packet_count != 1 else ''}"
-    what = {
-        "replied": f"{packets}, {reply.byte_count} bytes",
-        "cut": f"{reply.packet_count} packets, {reply.byte_count} bytes (stopped reading there)",
-        "taken": "no reply by design; the server took it",
-        "sent": f"no reply by design; the server did not confirm taking it within {timeout:g} s",
-        "silent": f"no reply within {timeout:g} s",
-        "stalled": f"{reply.packet_count} packets, then nothing for {timeout:g} s",
-    }[reply.outcome]
-    dropped = f" ({reply.dropped} older replies dropped)" if reply.dropped else ""
     stream = sys.stderr if reply.outcome in SILENT_OUTCOMES else sys.stdout
-    print(f"{visible(entry.name)}: {reply.outcome}: {what}{dropped}", file=stream)
-    for index, packet in enumerate(reply.packets, 1):
-        print(f"  packet {index} ({packet.size} bytes): {packet.hex}")
-        for f in packet.fields:
-            label = f"  ({visible(f.label)})" if f.label else ""
-            value = visible(json.dumps(f.value, ensure_ascii=False)) if isinstance(f.value, str) else f.value
-            print(f"    {f.kind} {value}{label}")
-        if packet.more_fields:
-            print(f"    … and {packet.more_fields} more fields")
-        if packet.typed_name:
-            typed = packet.typed_error or json.dumps(packet.typed, ensure_ascii=False, separators=(",", ":"))
-            print(f"    as {packet.typed_name}: {visible(typed)}")
-    if reply.packet_count > len(reply.packets):
-        print(f"  (+{reply.packet_count - len(reply.packets)} more packets not shown)")
+    print(outcome_line(reply, timeout), file=stream)
+    for line in packet_lines(reply):
+        print(line)
     sys.stdout.flush()
-
-
-def _short(text: str, limit: int = 160) -> str:
-    one = " ".join(text.split())
-    return one if len(one) <= limit else one[: limit - 1] + "…"

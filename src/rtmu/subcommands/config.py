@@ -3,7 +3,7 @@
 Without an action: every section and parameter with its value, type, limits and priority. With
 ``--set``: one ``setConfig`` of all the values given; the server checks them and either takes them
 all or answers with its first error, which is printed (exit 6). Exit 4 when the server offers no
-configuration; exit 9 when it offers one RTMU cannot show or edit yet — an Omron LD robot's
+configuration; exit 18 when it offers one RTMU cannot show or edit yet — an Omron LD robot's
 ``getConfigValues`` family (protocol 6MTX), named as such (``rtmu call`` reads it raw). The care
 actions (``--defaults``, ``--reset``, ``--export``, ``--import``, ``--reload``) are in
 :mod:`._config_care`.
@@ -26,7 +26,6 @@ from ..protocol.payloads.config import ConfigParam, ParamType, Priority
 from . import _config_care
 from ._common import add_connection_arguments, print_json, run_with_client
 
-"""The server refused a value (its message is printed)."""
 MAX_ASSIGNMENTS = 1000
 
 
@@ -53,6 +52,7 @@ def parse_assignment(text: str, parser: Any) -> tuple[str, str, str]:
 
 
 EXITS = (*NETWORK, EXIT_REFUSED, EXIT_FOREIGN_CONFIG)
+"""6: the server refused a value, in its own words (or an import does not fit it: nothing is sent)."""
 
 
 def register(subparsers: Any) -> None:
@@ -66,13 +66,10 @@ def register(subparsers: Any) -> None:
             "--reset SECTION/PARAM or --reset SECTION puts factory values back; --export FILE writes "
             "every value to a TOML file (an existing file only with --force); --import FILE checks the "
             "whole file against the server's parameters and sends it in one setConfig, or nothing; "
-            "--reload makes the server read its configuration file again. Exit codes: 0 done; 2 bad "
-            "arguments, a --reset target the server does not have, a file that exists or is not an "
-            f"export; 3 connection failure; 4 not offered (no configuration, no factory values); "
-            f"5 timeout; {EXIT_REFUSED} refused, by the server (its message is printed) or, for "
-            "--import, because the file does not fit the server (nothing is sent); "
-            f"{EXIT_FOREIGN_CONFIG} the robot offers a configuration RTMU cannot show or edit yet (an "
-            "Omron LD robot's getConfigValues: named, and readable raw with rtmu call)."
+            "--reload makes the server read its configuration file again. A --reset target the server "
+            "does not have, or a file that exists or is not an export, is a usage error; an --import "
+            "that does not fit the server's parameters is refused and nothing is sent. An Omron LD "
+            "robot's configuration (getConfigValues) is named, not shown: rtmu call reads it raw."
         ),
     )
     add_connection_arguments(p)

@@ -21,17 +21,17 @@ from typing import Any, TextIO
 from ..base.exit_codes import EXIT_BAD_FILE, EXIT_OK, EXIT_SIGPIPE, EXIT_USAGE
 from ..base.textsafe import json_safe, visible
 from ..capture import CaptureError, CaptureSource, UnreadableInput, open_capture
-from ..capture.reader import DIRECTIONS, FORMATS
-from ..capture.session_decoder import (
+from ..capture.conversation import (
     C2S,
     S2C,
-    CaptureDecoder,
+    Conversation,
     DecodedPacket,
     DecodeItem,
     DropReport,
-    Session,
     TrailingDrops,
 )
+from ..capture.reader import DIRECTIONS, FORMATS
+from ..capture.session_decoder import CaptureDecoder
 
 EXITS = (EXIT_OK, EXIT_USAGE, EXIT_BAD_FILE, EXIT_SIGPIPE)
 RUN_HEAD = 3
@@ -309,7 +309,7 @@ def _write_json_summary(out: TextIO, decoder: CaptureDecoder, source: CaptureSou
     out.write(_dumps(capture) + "\n")
 
 
-def _session_facts(session: Session, source: CaptureSource) -> dict[str, Any]:
+def _session_facts(session: Conversation, source: CaptureSource) -> dict[str, Any]:
     return {
         "transport": session.transport,
         "client": str(session.client) if session.client else None,
@@ -542,7 +542,7 @@ def _write_text_summary(out: TextIO, decoder: CaptureDecoder, source: CaptureSou
     out.write("\n".join(visible(line) for line in lines) + "\n")
 
 
-def _session_lines(session: Session, source: CaptureSource, full: bool) -> list[str]:
+def _session_lines(session: Conversation, source: CaptureSource, full: bool) -> list[str]:
     start = _relative(session.first_time, source)
     end = _relative(session.last_time, source)
     when = f"  {start:.3f}–{end:.3f} s" if start is not None and end is not None else ""

@@ -32,7 +32,6 @@ from ..base.exit_codes import (
     EXIT_INTERNAL,
     EXIT_OK,
     EXIT_USAGE,
-    EXIT_WHY_LOST,
     WHY_ASKED,
 )
 from ..base.textsafe import visible
@@ -71,8 +70,7 @@ from ._common import (
 
 EXITS = (
     EXIT_OK, EXIT_INTERNAL, EXIT_USAGE, EXIT_DOCTOR_RESOLVE, EXIT_DOCTOR_TCP, EXIT_DOCTOR_INTRODUCTION,
-    EXIT_DOCTOR_LOGIN, EXIT_DOCTOR_DATALIST, EXIT_DOCTOR_STATUS, *ENDED,
-    *(c for c in WHY_ASKED if c != EXIT_WHY_LOST),  # the last step: why won't it move
+    EXIT_DOCTOR_LOGIN, EXIT_DOCTOR_DATALIST, EXIT_DOCTOR_STATUS, *WHY_ASKED, *ENDED,
 )  # fmt: skip
 READ_CHUNK = 65536
 NOT_ARIA_AFTER = 4096
@@ -484,7 +482,9 @@ def register(subparsers: Any) -> None:
         "TCP connect, the server's introduction (its version tag and protocol string), the login, the "
         "data list (and which RTMU features the server offers), UDP, the first status. For the first "
         "step that fails it says in plain words what went wrong and what to do next (the words the "
-        "window uses), and stops there; the exit code names the step. UDP never fails it: RTMU uses TCP.",
+        "window uses), and stops there; the exit code names the step. UDP never fails it: RTMU uses TCP. "
+        "Connected, it asks last why the robot would not move (rtmu why's answer); that step fails with "
+        "the cause's own code.",
     )
     add_connection_arguments(p)
     p.add_argument(

@@ -9,7 +9,8 @@ before the process is suspended, and the drive is not resumed by ``fg``: it ends
 
 A drive asked to move that did not move the robot never exits 0: the same answer as ``rtmu why``
 (:mod:`rtmu.client.why`) goes to stderr, read with the status words the server said while we
-drove, and the exit code is the cause's (20–39; 39 when nothing RTMU can read explains it). A
+drove, and the exit code is the cause's (20–39; 35 when the ratios asked for are inside ARIA's
+dead zone, which is also said before driving; 39 when nothing RTMU can read explains it). A
 login that may not drive gets that answer at once (exit 21); one that may not stop is warned.
 
 After a signal the stop goes out first, then the pose is printed if a status comes
@@ -29,16 +30,7 @@ import sys
 from collections.abc import Callable
 from typing import Any
 
-from ..base.exit_codes import (
-    EXIT_OK,
-    EXIT_SIGQUIT,
-    EXIT_SIGTSTP,
-    EXIT_USAGE,
-    EXIT_WHY_LOST,
-    EXIT_WHY_UNEXPLAINED,
-    NETWORK,
-    WHY_ASKED,
-)
+from ..base.exit_codes import EXIT_OK, EXIT_SIGQUIT, EXIT_SIGTSTP, EXIT_USAGE, NETWORK, WHY_DRIVE
 from ..base.textsafe import visible
 from ..client.connection import AriaClient, Packet
 from ..client.drive_guard import DriveGuard, LinkFault
@@ -74,17 +66,15 @@ AFTER_INTERRUPT = 1.0
 """After a signal, at most this long (stop already sent) for the pose printed as ``after``."""
 
 
-EXITS = (
-    *NETWORK, EXIT_SIGQUIT, EXIT_SIGTSTP, *(c for c in WHY_ASKED if c != EXIT_WHY_LOST), EXIT_WHY_UNEXPLAINED
-)  # fmt: skip
-"""A drive that did not move exits with the cause's code (never 0; 39 when nothing explains it)."""
+EXITS = (*NETWORK, EXIT_SIGQUIT, EXIT_SIGTSTP, *WHY_DRIVE)
 
 
 def register(subparsers: Any) -> None:
     p = subparsers.add_parser(
         "drive",
         help="drive for some seconds, then stop",
-        description="Drive with ratioDrive for S seconds, then stop; print the pose before and after.",
+        description="Drive with ratioDrive for S seconds, then stop; print the pose before and after. "
+        "A drive that did not move the robot says why (as rtmu why does) and exits with the cause's code.",
     )
     add_connection_arguments(p)
     p.add_argument(
@@ -95,7 +85,11 @@ def register(subparsers: Any) -> None:
     )
     p.add_argument("--throttle", type=float, default=50.0, metavar="PCT", help="0…100 %% (default 50)")
     p.add_argument("--seconds", type=float, required=True, metavar="S", help=f"0…{MAX_SECONDS:g}")
-    p.add_argument("--json", action="store_true", help='one object {"before", "after", "seconds"}')
+    p.add_argument(
+        "--json",
+        action="store_true",
+        help='one object {"before", "after", "seconds"}; asked to move, also "moved" (and "why" if not)',
+    )
     p.set_defaults(handler=handle)
 
 

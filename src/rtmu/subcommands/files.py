@@ -36,11 +36,12 @@ from ._actions import action_parser, end_progress, progress_printer
 from ._common import add_connection_arguments, fail, print_json, run_with_client
 
 EXITS = (*NETWORK, EXIT_REFUSED)
-EXIT_CODES = (
-    "Exit codes: 0 done; 2 usage (a bad path, a local file that exists without --force, rm without --yes "
-    "and no terminal); 3 connection, login or a reply that cannot be trusted (a listing with a hostile "
-    f"name, a file longer than listed); 4 the robot does not offer it; 5 timeout; {EXIT_REFUSED} the robot "
-    "refused (no such file or folder, outside its folder, another client uploading the same file …)."
+DESCRIPTION = (
+    "Files in the folder the robot shares (paths relative to it). A bad path, a local file that exists "
+    "without --force, or rm without --yes and no terminal to ask on are usage errors, found before "
+    "connecting; a reply that cannot be trusted (a listing entry with a hostile name, a file longer than "
+    "listed) is a protocol failure; what the robot refuses (no such file or folder, outside its folder, "
+    "another client uploading the same file) is a refusal in its own words."
 )
 
 
@@ -48,7 +49,7 @@ def register(subparsers: Any) -> None:
     p = subparsers.add_parser(
         "files",
         help="list, download, upload and delete files on the robot (getDirListing, getFile, putFile …)",
-        description="Files in the folder the robot shares. " + EXIT_CODES,
+        description=DESCRIPTION,
     )
     add_connection_arguments(p)
     actions = p.add_subparsers(dest="action", metavar="ls|get|put|rm", required=True)

@@ -12,6 +12,10 @@ import json
 import sys
 from typing import Any
 
+from ..client.console_effect import Effect
+from ..client.why_values import Cause
+from ..protocol.payloads.config import ParamType, Priority
+
 Schema = dict[str, Any]
 
 NUMBER = {"type": "number"}
@@ -19,6 +23,9 @@ INTEGER = {"type": "integer"}
 TEXT = {"type": "string"}
 FLAG = {"type": "boolean"}
 NUMBER_OR_NULL = {"type": ["number", "null"]}
+INTEGER_OR_NULL = {"type": ["integer", "null"]}
+TEXT_OR_NULL = {"type": ["string", "null"]}
+ANY: Schema = {}
 
 
 def record(
@@ -40,6 +47,18 @@ def one_of(*schemas: Schema) -> Schema:
 
 def listing(item: Schema) -> Schema:
     return {"type": "array", "items": item}
+
+
+def constant(value: Any) -> Schema:
+    return {"const": value}
+
+
+def either(*values: Any) -> Schema:
+    return {"enum": list(values)}
+
+
+def or_null(schema: Schema) -> Schema:
+    return {"oneOf": [schema, {"type": "null"}]}
 
 
 STATUS = record(
@@ -65,6 +84,85 @@ did not move."""
 POSE = {"x": NUMBER_OR_NULL, "y": NUMBER_OR_NULL, "th": NUMBER_OR_NULL}
 SENT = record({"sent": TEXT})
 
+# -- why won't it move? (rtmu why, and a drive that did not move) ----------------------------------
+WHY_REASON = record(
+    {
+        "cause": either(*(c.key for c in Cause)),
+        "exit_code": either(*(c.value for c in Cause)),
+        "problem": TEXT,
+        "advice": TEXT,
+        "evidence": listing(TEXT),
+        "loud": FLAG,
+    },
+    {"fix": record({"key": TEXT, "label": TEXT, "sends": TEXT, "confirm": FLAG})},
+)
+WHY_RAW = record({"name": TEXT, "description": TEXT, "hex": TEXT, "fields": listing(TEXT), "note": TEXT})
+"""A reply RTMU shows as it came (an LD robot's safety data, whose layouts are not public)."""
+WHY_ANSWER_KEYS: dict[str, Schema] = {
+    "can_move": FLAG,
+    "cause": {"enum": [None, *(c.key for c in Cause)]},
+    "exit_code": either(0, *(c.value for c in Cause)),
+    "sentence": TEXT,
+    "reasons": listing(WHY_REASON),
+    "notes": listing(TEXT),
+    "raw": listing(WHY_RAW),
+}
+WHY_FIX_RESULT = record({"key": TEXT, "sent": FLAG, "worked": FLAG, "message": TEXT})
+
+# -- the server's configuration (rtmu config and its care actions) -----------------------------------
+CONFIG_PARAM = record(
+    {
+        "name": TEXT,
+        "type": either(*(t.name.lower() for t in ParamType if t is not ParamType.SEPARATOR)),
+        "value": {"type": ["boolean", "integer", "number", "string", "null"]},
+        "description": TEXT,
+        "priority": either(*(p.name.lower() for p in Priority)),
+        "editable": FLAG,
+    },
+    {
+        "min": NUMBER_OR_NULL,
+        "max": NUMBER_OR_NULL,
+        "choices": listing(TEXT),
+        "restart": INTEGER,
+        "members": listing({"$ref": "#/$defs/param"}),
+    },
+)
+"""One parameter (``members``: a list parameter's own, each a parameter again)."""
+
+# -- the console (rtmu call) ----------------------------------------------------------------------
+CONSOLE_ENTRY = record(
+    {
+        "number": INTEGER,
+        "name": TEXT,
+        "description": TEXT,
+        "arguments": TEXT,
+        "returns": TEXT,
+        "group": TEXT,
+        "flags": TEXT,
+        "effect": either(*(e.value for e in Effect)),
+        "why": TEXT,
+        "argument_layout": TEXT,
+    }
+)
+CONSOLE_FIELD = record(
+    {"kind": TEXT, "value": {"type": ["integer", "number", "string"]}, "offset": INTEGER}, {"label": TEXT}
+)
+CONSOLE_PACKET = record(
+    {"size": INTEGER, "hex": TEXT, "fields": listing(CONSOLE_FIELD), "more_fields": INTEGER},
+    {"typed": record({"type": TEXT, "fields": ANY, "error": TEXT_OR_NULL})},
+)
+CONSOLE_REPLY = record(
+    {
+        "name": TEXT,
+        "outcome": either("replied", "taken", "sent", "silent", "stalled", "cut"),
+        "packet_count": INTEGER,
+        "bytes": INTEGER,
+        "seconds": NUMBER,
+        "packets": listing(CONSOLE_PACKET),
+    },
+    {"dropped": INTEGER},
+)
+
 SCHEMAS: dict[str, Schema] = {
     "status": STATUS,
     "navigate": one_of(
@@ -85,13 +183,10 @@ SCHEMAS: dict[str, Schema] = {
         SENT,
     ),
     "drive": record(
-        {
-            "before": {"oneOf": [STATUS, {"type": "null"}]},
-            "after": {"oneOf": [STATUS, {"type": "null"}]},
-            "seconds": NUMBER,
-        },
-        {"interrupted": TEXT, "moved": FLAG, "why": WHY_ANSWER},
+        {"before": or_null(STATUS), "after": or_null(STATUS), "seconds": NUMBER},
+        {"interrupted": TEXT, "moved": FLAG, "why": record(WHY_ANSWER_KEYS)},
     ),
+    "why": record({"server": TEXT, **WHY_ANSWER_KEYS, "fixes": listing(WHY_FIX_RESULT)}),
     "goals": listing(TEXT),
     "routes": listing(TEXT),
     "probe": record(
@@ -108,18 +203,94 @@ SCHEMAS: dict[str, Schema] = {
         }
     ),
     "commands": listing(record({"name": TEXT, "description": TEXT, "argument": FLAG}, closed=False)),
-    "config": one_of(
+    "config": {
+        **one_of(
+            record(
+                {
+                    "api": constant("arconfig"),
+                    "source": TEXT,
+                    "last_editable": either(*(p.name.lower() for p in Priority)),
+                    "sections": listing(
+                        record({"name": TEXT, "comment": TEXT, "params": listing({"$ref": "#/$defs/param"})})
+                    ),
+                }
+            ),
+            record({"api": TEXT, "data": listing(TEXT), "editable": constant(False)}),  # one RTMU cannot edit
+            record({"accepted": FLAG, "error": TEXT}),  # --set
+            record(  # --defaults
+                {
+                    "differences": listing(
+                        record(
+                            {"section": TEXT, "name": TEXT, "value": TEXT, "default": TEXT, "editable": FLAG}
+                        )
+                    ),
+                    "factory_values": INTEGER,
+                    "cut": INTEGER,
+                }
+            ),
+            record({"reset": listing(TEXT), "accepted": FLAG, "error": TEXT}),  # --reset
+            record({"exported": TEXT, "parameters": INTEGER}),  # --export
+            record(  # --import: sent, or the problems that kept it from being sent
+                {"accepted": FLAG, "sent": INTEGER},
+                {"unchanged": INTEGER, "error": TEXT, "problems": listing(TEXT)},
+            ),
+            record({"reloaded": constant(True)}),  # --reload
+        ),
+        "$defs": {"param": CONFIG_PARAM},
+    },
+    "files": one_of(
+        record(  # ls
+            {
+                "folder": TEXT,
+                "source": TEXT,
+                "entries": listing(
+                    record(
+                        {
+                            "name": TEXT,
+                            "type": either("folder", "file"),
+                            "size": INTEGER,
+                            "mtime": INTEGER,
+                            "atime": INTEGER,
+                        }
+                    )
+                ),
+            }
+        ),
+        record(  # get
+            {
+                "remote": TEXT,
+                "local": TEXT,
+                "bytes": INTEGER,
+                "seconds": NUMBER,
+                "mtime": INTEGER_OR_NULL,
+                "listed_size": INTEGER_OR_NULL,
+            }
+        ),
+        record({"local": TEXT, "remote": TEXT, "bytes": INTEGER, "seconds": NUMBER}),  # put
+        record({"deleted": TEXT}),  # rm
+    ),
+    "scan": one_of(
+        record({"scanning": constant(True), "file": TEXT}),  # start
+        record({"scanning": FLAG, "name": TEXT, "file": TEXT}),  # status
+        record({"loop": either("start", "end"), "tag": TEXT, "taken": FLAG}),  # loop
+        record({"stopped": constant(True), "file": TEXT}, {"downloaded": TEXT, "bytes": INTEGER}),  # stop
+    ),
+    "mapedit": one_of(
+        record({"map_updated": FLAG}),  # --check-map
         record(
             {
-                "source": TEXT,
-                "sections": listing(
-                    record({"name": TEXT, "params": listing({"type": "object"})}, closed=False)
-                ),
-            },
-            closed=False,
+                "removed": listing(TEXT),
+                "added": listing(TEXT),
+                "applied": {"type": ["boolean", "null"]},
+                "status": INTEGER_OR_NULL,
+                "words": TEXT,
+                "map_updated": FLAG,
+                "holds": FLAG,
+                "missing": listing(TEXT),
+            }
         ),
-        record({"accepted": FLAG}, {"error": TEXT}, closed=False),
     ),
+    "call": one_of(listing(CONSOLE_ENTRY), CONSOLE_REPLY),  # --list (one array), or one object per reply
     "drawings": listing(
         record({"name": TEXT, "shape": TEXT, "drawn": FLAG, "points": listing(listing(NUMBER))}, closed=False)
     ),

@@ -40,12 +40,10 @@ edits are checked against it: a name already taken, a name not on the map), the 
 guarded by the map's id, and the map is read again afterwards to check that it holds the change.
 --check-map instead asks the server to re-read its map file (checkMap).
 
-Exit codes: 0 the server's map now holds the change; 2 an edit that does not fit the map, or bad
-arguments; 3 connection or login failure; 4 the server takes no map changes or has no map; 5 no
-verdict in time; 6 the server refused the change (its words are printed; the map is as it was);
-19 the server said it applied the change but its map, read again, does not hold it.
+Exit 0 only when the server's map, read again, holds the change. An edit that does not fit the map
+is a usage error (nothing is sent); a refused change leaves the map as it was (the server's words
+are printed); a server that takes no map changes, or has no map, does not offer it.
 """
-
 
 EXITS = (*NETWORK, EXIT_REFUSED, EXIT_NOT_HELD)
 MAX_EDITS = 10_000
@@ -101,7 +99,6 @@ def register(subparsers: Any) -> None:
         "mapedit",
         help="change the server's map live: add or remove goals, docks, forbidden lines and areas",
         description=DESCRIPTION,
-        formatter_class=argparse.RawDescriptionHelpFormatter,
     )
     add_connection_arguments(p)
     p.add_argument(

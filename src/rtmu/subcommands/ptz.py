@@ -78,6 +78,8 @@ def handle(args: argparse.Namespace) -> int:
     async def body(client: AriaClient) -> int:
         feed = PtzFeed(DetachedContext(client, config=SessionConfig(reply_timeout=args.timeout)))
         await feed.read_head(client)
+        if feed.read_error is not None:  # a lost link, a silent or malformed reply: its own code, not 4
+            raise feed.read_error
         state = feed.state
         if moving and state.movable and state.can_abs:
             outside = _outside_limits(args, state)

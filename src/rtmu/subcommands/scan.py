@@ -1,9 +1,7 @@
 """``rtmu scan HOST[:PORT] start NAME | status | loop start|end [TAG] | stop [--download DIR]``: map scans.
 
-The robot logs its laser and its path into ``NAME.2d`` (lower case) in its files folder while it is
-driven round the site (``rtmu drive``, the window); Mapper3 or MobilePlanner turn the log into a map.
-Loop tags mark where a loop starts and ends. ``stop --download DIR`` ends the scan and fetches the log
-into DIR (an existing file there is refused without ``--force``, before the scan is ended).
+What it does, in the help's plain words: :data:`DESCRIPTION`. A scan logs; the operator drives, so
+this is an observer (its client cannot send a motion request).
 """
 
 from __future__ import annotations
@@ -17,6 +15,7 @@ from ..base.exit_codes import EXIT_OK, EXIT_REFUSED, EXIT_TIMEOUT, EXIT_USAGE, N
 from ..base.textsafe import visible
 from ..client.connection import AriaClient
 from ..client.download import LocalFileError, check_destination, download_file
+from ..client.errors import NotSupported
 from ..client.remote_files import Refused, local_name
 from ..client.roles import Role
 from ..client.scan import scan_name, scan_status, scan_unavailable, start_scan, stop_scan, tag_loop
@@ -24,11 +23,13 @@ from ._actions import action_parser, end_progress, progress_printer
 from ._common import add_connection_arguments, fail, print_json, run_with_client
 
 EXITS = (*NETWORK, EXIT_REFUSED)
-EXIT_CODES = (
-    "Exit codes: 0 done; 2 usage (a bad name, a download folder that is missing or a file there that "
-    "exists without --force); 3 connection, login or a reply that cannot be trusted; 4 the robot cannot "
-    f"scan (no mappingStart); 5 timeout (a loop tag the robot did not take); {EXIT_REFUSED} the robot "
-    "refused (a scan already runs, none runs, its file could not be opened)."
+DESCRIPTION = (
+    "Scan for a map. The robot logs its laser and its path into NAME.2d (lower case) in its files folder "
+    "while it is driven round the site (rtmu drive, the window); Mapper3 or MobilePlanner turn the log "
+    "into a map. Loop tags mark where a loop starts and ends. stop --download DIR ends the scan and "
+    "fetches the log into DIR (an existing file there is refused without --force, before the scan is "
+    "ended). A loop tag the robot does not confirm in time is a timeout; what the robot refuses (a scan "
+    "already runs, none runs, its file could not be opened) is a refusal in its own words."
 )
 
 
@@ -36,7 +37,7 @@ def register(subparsers: Any) -> None:
     p = subparsers.add_parser(
         "scan",
         help="scan for a map: start, status, loop tags, stop and download the .2d (mappingStart …)",
-        description=(__doc__ or "").split("\n\n", 1)[1].replace("``", "") + " " + EXIT_CODES,
+        description=DESCRIPTION,
     )
     add_connection_arguments(p)
     actions = p.add_subparsers(dest="action", metavar="start|status|loop|stop", required=True)
@@ -94,8 +95,13 @@ def _status(args: argparse.Namespace) -> Any:
 
 def _loop(args: argparse.Namespace) -> Any:
     async def body(client: AriaClient) -> int:
-        knows = "scan_status" not in scan_unavailable(client)
-        if knows and not (await scan_status(client, timeout=args.timeout)).scanning:
+        unavailable = scan_unavailable(client)
+        if "scan_loops" in unavailable:  # say what the robot lacks before asking whether it scans
+            raise NotSupported("mappingLoopStart", unavailable["scan_loops"])
+        if (
+            "scan_status" not in unavailable
+            and not (await scan_status(client, timeout=args.timeout)).scanning
+        ):
             raise Refused("no scan is running on the robot; it ignores loop tags then")
         taken = await tag_loop(client, start=args.edge == "start", tag=args.tag, timeout=args.timeout)
         if args.json:

@@ -1,7 +1,9 @@
 """``rtmu why HOST[:PORT] [--json] [--fix] [--yes] [--navigate]``: why won't the robot move?
 
-What it reads and what ``--fix`` may do is :data:`DESCRIPTION`, its ``--help`` (plain text); the
-answer itself is :mod:`rtmu.client.why`'s, its exit code the cause's (``rtmu.base.exit_codes``, 20–39).
+Plain words for the help (:data:`DESCRIPTION`); the answer itself is :mod:`rtmu.client.why`'s, its
+exit code the cause's own (``rtmu.base.exit_codes``, :data:`rtmu.base.exit_codes.WHY_ASKED`).
+Without ``--fix`` this is an observer (its client cannot send a motion request); ``--fix`` logs in
+as an operator, because unlocking a mode or stopping the server's own driving sends ``stop``.
 """
 
 from __future__ import annotations
@@ -10,7 +12,7 @@ import argparse
 import sys
 from typing import Any
 
-from ..base.exit_codes import NETWORK, WHY_ASKED
+from ..base.exit_codes import EXIT_WHY_LOST, NETWORK, WHY_ASKED
 from ..base.textsafe import visible
 from ..client.connection import AriaClient
 from ..client.roles import Role
@@ -20,9 +22,20 @@ from ..client.why_gather import gather
 from ..client.why_values import Answer
 from ._common import add_connection_arguments, print_json, run_with_client
 
+DESCRIPTION = """Why won't the robot move? Reads, never drives: the server's own data (its mode and
+lock, this login's rights, status words, safe drive and the obstacles its sonar and lasers see,
+battery, docking, localization, its drive watchdog, an LD robot's faults and safety data) told as
+one sentence with its fix. Exit 0 when nothing RTMU can read keeps the robot from moving, else the
+cause's own code (listed below).
+
+--fix carries out the first cause's fix where there is one (unlock a mode that will unlock, undock,
+stop the server's own driving, switch safe drive off, acknowledge an LD robot's faults, enable its
+motors), then asks again. Switching safe drive off, acknowledging and enabling need a yes: typed at
+the prompt, or --yes; without one nothing is sent."""
+
+EXITS = (*NETWORK, *WHY_ASKED, EXIT_WHY_LOST)
 MAX_FIXES = 3
 """Fixes tried one after another (each reveals what the next cause is)."""
-EXITS = (*NETWORK, *WHY_ASKED)
 DESCRIPTION = """Why won't the robot move? Reads, never drives: the server's own data (its mode and lock,
 this login's rights, status words, safe drive and the obstacles its sonar and lasers see, battery,
 docking, localization, its drive watchdog, an LD robot's faults and safety data), told as one sentence
@@ -42,7 +55,6 @@ def register(subparsers: Any) -> None:
         "why",
         help="why won't the robot move? one sentence and its fix",
         description=DESCRIPTION,
-        formatter_class=argparse.RawDescriptionHelpFormatter,
     )
     add_connection_arguments(p)
     p.add_argument("--json", action="store_true", help="one JSON object: the answer, its reasons and fixes")

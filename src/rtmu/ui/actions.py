@@ -7,12 +7,12 @@ and which of them are enabled.
 * **The window's own**: the camera page (``camera``, Esc), ``zoom-in`` / ``zoom-out`` / ``zoom-fit``
   and ``follow``, ``open-menu``, ``goto-panel``, ``select-robot(n)`` / ``next-robot`` /
   ``previous-robot``, ``live-video``, the camera head's moves (``ptz-left`` … ``ptz-home``) and the
-  dialogs (``settings``, ``server-config``, ``details``, ``layers``, ``about``).
+  dialogs (``settings``, ``server-config``, ``details``, ``layers``, ``about``, ``why``, ``console``).
 * **Switches** (stateful, so the menu shows their check marks): the View menu's ``toolbar``,
   ``fullscreen``, ``dpad``, ``inset``, ``split``, ``fov``, ``sonar``, ``foxglove``, and ``safe-drive``.
 * **The menu**: the robot's commands first (a greyed row says why: GTK menus have no tooltips),
-  then Server, View, the shortcuts, About and Quit; every row shows its key from the one key table
-  (``keys.menu_item``).
+  then "Why won't it move?", Server, View, Help (the shortcuts, About) and Quit; every row shows its key
+  from the one key table (``keys.menu_item``).
 
 Keys reach an action through :meth:`WindowActions.activate` (``keys.KeyRouter``), the menu and the
 buttons through GTK's own activation: one table says key → action (``keys``), the shortcuts window
@@ -31,8 +31,9 @@ import gi
 gi.require_version("Gtk", "4.0")
 from gi.repository import Gio, GLib  # noqa: E402
 
+from ..client.config_feed import ConfigApi, config_api  # noqa: E402
 from ..control.commands import COMMANDS, CommandState, action_name  # noqa: E402
-from ..model.observables import RobotState  # noqa: E402
+from ..model.observables import ConnectionState, RobotState  # noqa: E402
 from .keys import menu_item  # noqa: E402
 
 MainWindow = Any
@@ -81,7 +82,7 @@ class WindowActions:
         """The command states last heard from the controller."""
         self._run: dict[str, Run] = {}
         """action name → what it does (also for a key while the action is shown greyed)."""
-        self._unobserve: Callable[[], None] = lambda: None
+        self._unobserve: list[Callable[[], None]] = []
         self.menu_model = self._menu()
 
     # -- the actions -----------------------------------------------------------------------------
@@ -95,6 +96,8 @@ class WindowActions:
         self._plain("server-config", w.dialogs.show_server_config)
         self._plain("details", w.dialogs.show_details)
         self._plain("about", w.dialogs.show_about)
+        self._plain("why", w.dialogs.show_why)
+        self._plain("console", lambda: w.dialogs.show_console())
         self._plain("layers", w.layers.open)
         # The map.
         self._plain("zoom-in", w.stage.zoom_in)
@@ -125,10 +128,16 @@ class WindowActions:
         self.foxglove_action = self._toggle("foxglove", False, w.foxglove.set)
         w.foxglove.failed = functools.partial(set_flag, self.foxglove_action, False)  # a busy port: unchecked
         w.connect("notify::fullscreened", self._fullscreen_changed)
-        self._unobserve = w.model.robot.observe(self._on_robot)
+        self._unobserve = [
+            w.model.robot.observe(self._on_robot),
+            w.model.connection.observe(self._on_connection),
+        ]
+        self.fill_server_menu(config_api(w.model.connection.value.offers))
 
     def close(self) -> None:
-        self._unobserve()
+        for remove in self._unobserve:
+            remove()
+        self._unobserve = []
 
     def _add(
         self, name: str, run: Run, state: bool | None = None, *, param: str | None = None
@@ -269,16 +278,42 @@ class WindowActions:
         ):
             view.append_item(menu_item(label, action))
         self.app_menu = app = Gio.Menu()
-        server = Gio.Menu()  # the connection and the server's own settings: one row, so the menu still fits
-        server.append_item(menu_item("Connection settings…", "win.settings"))
-        server.append_item(menu_item("Configuration…", "win.server-config"))
+        app.append_item(menu_item("Why won't it move?…", "win.why"))
+        self.server_menu = server = Gio.Menu()  # the connection and the server's own settings: one row
+        self.fill_server_menu(ConfigApi.ARCONFIG)
         app.append_submenu("Server", server)
         app.append_submenu("View", view)
-        app.append_item(menu_item("Keyboard shortcuts", "win.show-help-overlay"))
-        app.append_item(menu_item("About RTMU", "win.about"))
+        helping = (
+            Gio.Menu()
+        )  # one row for both: "Why won't it move?" took a row, an 800×480 screen has no more
+        helping.append_item(menu_item("Keyboard shortcuts", "win.show-help-overlay"))
+        helping.append_item(menu_item("About RTMU", "win.about"))
+        app.append_submenu("Help", helping)
         app.append_item(menu_item("Quit", "app.quit"))
         menu.append_section(None, app)
         return menu
+
+    def fill_server_menu(self, api: ConfigApi) -> None:
+        """Server ▸ …: its Configuration row says which configuration API the robot has where RTMU
+        cannot edit it yet (an Omron LD robot's), and that the console reads it."""
+        config = "Configuration…"
+        if api is ConfigApi.OMRON_LD:
+            config = f"Configuration… — {api.value}: not editable yet, see Console"
+        items = (
+            ("Connection settings…", "win.settings"),
+            (config, "win.server-config"),
+            ("Console…", "win.console"),
+        )
+        menu = self.server_menu
+        shown = [menu.get_item_attribute_value(i, "label", None) for i in range(menu.get_n_items())]
+        if [v.get_string() if v is not None else "" for v in shown] == [label for label, _ in items]:
+            return
+        menu.remove_all()
+        for label, action in items:
+            menu.append_item(menu_item(label, action))
+
+    def _on_connection(self, _old: ConnectionState, new: ConnectionState) -> None:
+        self.fill_server_menu(config_api(new.offers))
 
     def fill_robot_menu(self) -> None:
         """The robot's commands; a greyed one says why (GTK menus have no tooltips): "… — not connected"."""

@@ -1,13 +1,15 @@
 """The ``Gtk.Application``: settings → profile, the fleet and its first robot session, the window.
 
 Wiring only. The application builds a :class:`rtmu.fleet.sessions.Fleet` — of one
-:class:`~rtmu.fleet.sessions.RobotSession` for a one-robot profile, or of every robot a
-fleet profile's roster names (``fleet.direct_roster``), each session's network
-thread posting back with ``GLib.idle_add`` — and a window that shows the selected
-session (``fleet_bind`` adds the robot list and the other robots on the map). Every way
+:class:`~rtmu.fleet.sessions.RobotSession` for a one-robot profile, or of the robots a
+fleet profile's roster names (``fleet.direct_roster``; at most the profile's
+``connect_at_most`` connected at once), each session's network thread posting back with
+``GLib.idle_add`` — ONE guardian process for the window (``rtmu.guardian.shared``,
+armed for the selected robot), and a window that shows the selected session
+(``fleet_bind`` adds the robot list and the other robots on the map). Every way
 out — closing, quitting, Ctrl+Z, a signal — goes through the fleet, so every
-robot is stopped first; then each session closes with a bounded wait, then the
-profile's view choices (zoom, follow, sonar, speed) are saved.
+robot is stopped first; then the sessions close together within one bounded wait, then
+the profile's view choices (zoom, follow, sonar, speed) are saved.
 """
 
 from __future__ import annotations
@@ -30,6 +32,7 @@ from ..client.mapcache import SharedMaps  # noqa: E402
 from ..client.roster import RobotEndpoint, Roster  # noqa: E402
 from ..client.session import SessionConfig  # noqa: E402
 from ..fleet.sessions import Fleet, RobotSession, direct_roster, robot_profile  # noqa: E402
+from ..guardian.shared import SharedGuardian  # noqa: E402
 from ..model.observables import NearPeople, Phase  # noqa: E402
 from ..recorder.replay import REPLAY_CONFIG  # noqa: E402
 from ..settings.store import (  # noqa: E402
@@ -123,8 +126,9 @@ class RtmuApplication(Gtk.Application):
         # Ctrl+C, kill, a closed terminal (SIGHUP), Ctrl+\ (SIGQUIT), SIGUSR1/2 and SIGALRM all end the
         # window the same way: stop the robot first, then quit. Left to their default, they would kill
         # the process with the robot still driving until the server's watchdog noticed.
+        # Above every other source (a central server's robots arrive as thousands of idle callbacks).
         for signum in GLIB_SIGNALS:
-            self._signal_sources.append(GLib.unix_signal_add(GLib.PRIORITY_DEFAULT, signum, self._on_signal))
+            self._signal_sources.append(GLib.unix_signal_add(GLib.PRIORITY_HIGH, signum, self._on_signal))
         # GLib does not watch these: a Python handler (PyGObject wakes the main loop for it).
         for signum in PYTHON_SIGNALS:
             self._old_handlers[signum] = signal.signal(signum, self._on_python_signal)
@@ -141,9 +145,8 @@ class RtmuApplication(Gtk.Application):
         profile, auto_connect = self.choose_profile()
         if self.options.protocol is not None:  # --protocol: this run only, the saved profile keeps its own
             profile = replace(profile, protocol=self.options.protocol)
-        # The guardian: a separate process that stops the robot if this one is killed or frozen.
         # One download per map file for the whole fleet (robots of one site share their map).
-        config = SessionConfig(guardian=self.options.guardian, shared_maps=SharedMaps())
+        config = SessionConfig(guardian=self.options.guardian_per_robot, shared_maps=SharedMaps())
         replay = (
             open_replay(self.options.replay, self.options.replay_conn)
             if self.options.replay is not None
@@ -164,6 +167,11 @@ class RtmuApplication(Gtk.Application):
                 clock=replay.clock.seconds,  # a replay runs on its own time
             )
         else:
+            # The guardian: ONE separate process that stops the selected robot if this one is killed
+            # or frozen, started now so that it is warm when the first robot is selected.
+            if self.options.guardian and not self.options.guardian_per_robot:
+                self.fleet.guardian = SharedGuardian()
+            self.fleet.connect_at_most = self.options.connect_at_most or profile.connect_at_most
             roster = self.roster_for(profile)
             if roster is not None:
                 session = self._follow(roster, profile, config)
@@ -176,6 +184,7 @@ class RtmuApplication(Gtk.Application):
                     profile=profile,
                     secrets=self.secrets,
                     recording=self.settings.recording,
+                    guardian=self.fleet.guardian,
                 )
         try:
             window = MainWindow(
@@ -243,6 +252,7 @@ class RtmuApplication(Gtk.Application):
                 profile=robot_profile(profile, endpoint),
                 secrets=self.secrets,
                 recording=self.settings.recording,
+                guardian=self.fleet.guardian,
             )
 
         self.fleet.follow(roster, make, self._announce)
@@ -310,7 +320,10 @@ class RtmuApplication(Gtk.Application):
         return True
 
     def _on_python_signal(self, _signum: int, _frame: object) -> None:
-        GLib.idle_add(lambda: self._on_signal() and False)
+        source = GLib.idle_source_new()  # above every other source (the stubs' idle_add has no priority)
+        source.set_priority(GLib.PRIORITY_HIGH)
+        source.set_callback(lambda *_args: self._on_signal() and False)
+        source.attach(None)
 
     def _on_suspend(self, _signum: int, _frame: object) -> None:
         """SIGTSTP: end any held drive (as a focus loss), make sure the stop is out, then really stop.

@@ -13,6 +13,8 @@ refreshes); this window shows it. When another client changes the configuration 
 the page fetches it again, updates what the operator has not touched and says what changed — and
 which of the operator's own unsaved edits the other client changed under them. Requests go as
 intents (``FetchConfig``, ``SetConfig``) through the window's ``request``: the selected robot's.
+A robot whose configuration RTMU cannot edit yet (an Omron LD robot's ``getConfigValues``) gets the
+plain sentence of which API it has, and a button to read it raw in the console (``console_page``).
 """
 
 from __future__ import annotations
@@ -53,12 +55,20 @@ class ConfigPage(Gtk.Window):
     """See the module notes. ``request(intent)`` returns a Future completed on the network thread;
     ``follow(listener)`` has the page hear another client's changes (None: no longer)."""
 
-    def __init__(self, parent: Gtk.Window | None, request: Request, follow: Follow) -> None:
+    def __init__(
+        self,
+        parent: Gtk.Window | None,
+        request: Request,
+        follow: Follow,
+        open_console: Callable[[str], None] | None = None,
+    ) -> None:
         super().__init__(
             title="Server configuration", transient_for=parent, modal=False, destroy_with_parent=True
         )
         self.set_default_size(760, 440)
         self._request, self._follow = request, follow
+        self._open_console = open_console
+        """Opens the console filtered to a text (a configuration RTMU cannot edit is read there)."""
         self.state = ConfigEdits()
         """What the operator typed and what the server said (GTK-free)."""
         self.section = 0
@@ -114,6 +124,11 @@ class ConfigPage(Gtk.Window):
         self.banner.add_css_class("config-banner")
         self.banner.set_visible(False)
         box.append(self.banner)
+        self.console_button = Gtk.Button(
+            label="Read it in the console…", halign=Gtk.Align.START, visible=False
+        )
+        self.console_button.connect("clicked", lambda _b: self._console())
+        box.append(self.console_button)
         paned = Gtk.Paned(orientation=Gtk.Orientation.HORIZONTAL, vexpand=True)
         self.sections = Gtk.ListBox()
         self.sections.connect("row-selected", self._section_chosen)
@@ -159,6 +174,11 @@ class ConfigPage(Gtk.Window):
         self._follow(None)
         return False
 
+    def _console(self) -> None:
+        """The console, filtered to the robot's configuration data (read raw: the layouts are not public)."""
+        if self._open_console is not None:
+            self._open_console("config")
+
     # -- fetching ---------------------------------------------------------------------------------
     def refresh(self, note: str = "") -> None:
         """Ask the server for the whole configuration; unsaved edits are kept. One fetch at a time:
@@ -192,8 +212,10 @@ class ConfigPage(Gtk.Window):
         error = None if future.cancelled() else future.exception()
         if isinstance(error, ForeignConfig):  # an answer, not a failure: its whole sentence, wrapped
             self.status.set_text("No configuration RTMU can edit")
-            self.banner.set_text(str(error))
+            where = ". In this window, Server ▸ Console… reads it raw." if self._open_console else ""
+            self.banner.set_text(f"{str(error).rstrip('.')}{where}")
             self.banner.set_visible(True)
+            self.console_button.set_visible(self._open_console is not None)
             return False
         if future.cancelled() or error is not None:
             self.status.set_text(f"Could not load the configuration: {error or 'cancelled'}")

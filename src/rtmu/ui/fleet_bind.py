@@ -3,8 +3,10 @@
 Wiring only (the window composes it; it owns no socket and no robot). It
 
 * puts the :class:`~rtmu.ui.robot_list.RobotList` beside the map (under it on a narrow
-  window) — shown only while the fleet has more than one robot, so a one-robot profile
-  looks exactly as before;
+  window) — shown only while the fleet lists more than one robot, so a one-robot profile
+  looks exactly as before. It lists every robot the roster names (those not connected
+  say so; a click connects one: ``Fleet.select_named``), and follows a roster that names
+  hundreds of robots at most every :data:`LIST_SYNC_MS`, so the window keeps answering keys;
 * gives each robot a colour for its life in the fleet and hands the map stage the other
   robots that share the selected one's map (``fleet_draw``), redrawing when one moves;
 * follows ``Fleet.selected``: the window shows the new robot (``MainWindow.show_session``);
@@ -41,6 +43,9 @@ OTHERS_REDRAW_MS = 66
 """At most ~15 redraws a second for the robots not selected (their status comes at 10 Hz each)."""
 LINK_GRACE_MS = 1000
 """A robot's lost link is said this long after it happens (unless the whole roster went meanwhile)."""
+LIST_SYNC_MS = 150
+"""The robot list follows the roster's names at most this often (a central server may announce
+thousands one by one: each is one cheap event, the list's rows are updated in one go)."""
 REFRESH_MS = 300
 """How often rows re-read what changes without an event (a status growing old, the window's width)."""
 QUIET_KINDS = (Kind.CONNECTION, Kind.LINK, Kind.SPEED, Kind.SPEED_LIMIT)
@@ -85,7 +90,7 @@ class FleetBinding:
         self._lost_source = 0
         self.drawn_updates: dict[str, int] = {}
         """Per robot name: frames that showed a new status of it (the benchmark's on-screen rate)."""
-        self.robot_list = RobotList(select=fleet.select, colour=self.colour)
+        self.robot_list = RobotList(select=self._select_named, colour=self.colour, session_of=fleet.named)
         self.robot_list.set_visible(False)
         window.body.append(self.robot_list)
         window.stage.fleet = self.marks
@@ -93,10 +98,14 @@ class FleetBinding:
         self._unobserve = [
             fleet.sessions.observe(lambda _old, _new: self._sessions_changed()),
             fleet.selected.observe(self._selected_changed),
+            fleet.listed.observe(lambda _old, _new: self._queue_list()),
         ]
+        self._list_source = 0
         self._narrow: bool | None = None
         self._stale_seen: tuple[bool, ...] = ()
+        self._menu_names: tuple[str, ...] | None = None
         self._sessions_changed()
+        self._sync_list()
         self._fit_width()
         self._redraw_source = 0
         self._timer = GLib.timeout_add(REFRESH_MS, self._refresh)
@@ -125,9 +134,7 @@ class FleetBinding:
             self._hooks[id(session)] = self._hook(session)
             if session is not selected:
                 session.attach_view(BackgroundView(self.window, session.name))
-        self.robot_list.set_sessions(sessions, selected)
-        self.robot_list.set_visible(len(sessions) > 1)
-        self.window.keyboard.fleet_changed()
+        self._queue_list()  # the list and the menu's Robots submenu: once for a burst of robots
         names = {s.name for s in sessions}
         if any(name not in names for name in self._lost):
             self._lost = {n: e for n, e in self._lost.items() if n in names}
@@ -158,7 +165,7 @@ class FleetBinding:
             self._tell_lost()
         if old is not None and not old.closed:
             old.attach_view(BackgroundView(self.window, old.name))
-        self.robot_list.show_selected(new)
+        self.robot_list.show_selected(new.name)
         self.window.stage.queue_draw()
 
     def _robot_changed(self, session: RobotSession) -> None:
@@ -177,7 +184,7 @@ class FleetBinding:
 
     def _connection_changed(self, session: RobotSession, old: ConnectionState, new: ConnectionState) -> None:
         self._robot_changed(session)
-        self.robot_list.refresh(session)
+        self.robot_list.refresh()
         lost = old.phase is Phase.CONNECTED and new.phase in (Phase.RECONNECTING, Phase.FAILED)
         if lost and session is not self.fleet.selected.value and len(self.fleet) > 1:
             self._lost[session.name] = new.error
@@ -216,6 +223,37 @@ class FleetBinding:
         self.window.banners.tell(
             "fleet:links", "warning", text + " — the other robots carry on", timeout=None
         )
+
+    # -- the robot list --------------------------------------------------------------------------
+    def _select_named(self, name: str) -> None:
+        """A row was clicked: select that robot, connecting it if it is only listed."""
+        try:
+            self.fleet.select_named(name)
+        except ValueError:  # it left the list meanwhile
+            self._queue_list()
+
+    def _queue_list(self) -> None:
+        if not self._list_source:
+            self._list_source = GLib.timeout_add(LIST_SYNC_MS, self._sync_list_later)
+
+    def _sync_list_later(self) -> bool:
+        self._list_source = 0
+        self._sync_list()
+        return False
+
+    def _sync_list(self) -> None:
+        """The list's rows: every listed robot, then any connected one the roster does not list."""
+        listed = [e.name for e in self.fleet.listed.value]
+        known = set(listed)
+        names = listed + [s.name for s in self.fleet.sessions.value if s.name not in known]
+        self.robot_list.set_names(names)
+        selected = self.fleet.selected.value
+        self.robot_list.show_selected(selected.name if selected is not None else None)
+        self.robot_list.set_visible(len(names) > 1)
+        connected = tuple(s.name for s in self.fleet.sessions.value)
+        if connected != self._menu_names:  # rebuilding the menu costs GTK a rebuild per item: not per robot
+            self._menu_names = connected
+            self.window.keyboard.fleet_changed()
 
     def _refresh(self) -> bool:
         """Rows and markers of robots that went quiet (no event says so), and the window's width."""
@@ -285,6 +323,9 @@ class FleetBinding:
         if self._redraw_source:
             GLib.source_remove(self._redraw_source)
             self._redraw_source = 0
+        if self._list_source:
+            GLib.source_remove(self._list_source)
+            self._list_source = 0
         if self._timer:
             GLib.source_remove(self._timer)
             self._timer = 0

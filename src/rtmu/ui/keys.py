@@ -74,6 +74,7 @@ WINDOW_BINDINGS: tuple[Binding, ...] = (
     Binding(("<Alt>Page_Down",), "Next robot", "Fleet", "win.next-robot"),
     Binding(("<Alt>Page_Up",), "Previous robot", "Fleet", "win.previous-robot"),
     Binding(("v",), "Live video on/off", "Window", "win.live-video"),
+    Binding(("question",), "Why won't it move?", "Window", "win.why"),
     _ptz("<Control>Left", "Pan the camera left", "ptz-left"),
     _ptz("<Control>Right", "Pan the camera right", "ptz-right"),
     _ptz("<Control>Up", "Tilt the camera up", "ptz-up"),

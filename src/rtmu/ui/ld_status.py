@@ -6,22 +6,22 @@ appears only when the server lists the value (the model field is None otherwise)
 
 from __future__ import annotations
 
-from ..model.observables import RobotState
+from ..values.state import NavState, RobotState
 
 
-def goal_suffix(robot: RobotState) -> str:
-    """ " — 12.4 m left" while the robot has a goal (``DataStore_Distance_To_Goal`` > 0)."""
-    mm = robot.goal_distance_mm
+def goal_suffix(nav: NavState) -> str:
+    """ " — 12.4 m left" while the robot has a goal (a path ahead, or an LD robot's own distance)."""
+    mm = nav.remaining_mm
     return f" — {mm / 1000:.1f} m left" if mm else ""
 
 
-def details_lines(robot: RobotState) -> list[str]:
+def details_lines(robot: RobotState, nav: NavState) -> list[str]:
     """Tooltip lines for the mode cell: localization score, closest obstacle, distance to goal."""
     lines = []
-    if robot.loc_score is not None:
-        lines.append(f"Localization score: {robot.loc_score} %")
+    if nav.loc_score is not None:
+        lines.append(f"Localization score: {nav.loc_score * 100:.0f} %")
     if robot.closest_obstacle_mm is not None:
         lines.append(f"Closest obstacle: {robot.closest_obstacle_mm / 1000:.2f} m")
-    if robot.goal_distance_mm:
-        lines.append(f"Distance to the goal: {robot.goal_distance_mm / 1000:.1f} m")
+    if nav.remaining_mm:
+        lines.append(f"Distance to the goal: {nav.remaining_mm / 1000:.1f} m")
     return lines

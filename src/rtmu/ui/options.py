@@ -40,4 +40,9 @@ class GuiOptions:
     fleet: tuple[DirectRobot, ...] = ()
     """Robots to open the window on at once (``--demo --robots N``); empty: the profile's."""
     guardian: bool = True
-    """Start a guardian process per connection (``rtmu.guardian``); off only to measure without it."""
+    """Start the window's guardian process (``rtmu.guardian``); off only to measure without it."""
+    guardian_per_robot: bool = False
+    """One guardian process per robot connection, as before the window shared one: a benchmark's
+    baseline only (``bench/bench_fleet_scale.py``)."""
+    connect_at_most: int | None = None
+    """How many robots of a fleet to keep connected at once (None: the profile's ``connect_at_most``)."""

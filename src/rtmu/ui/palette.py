@@ -20,17 +20,17 @@ gi.require_version("Pango", "1.0")
 gi.require_version("Gdk", "4.0")
 from gi.repository import Gdk, GLib, Gtk, Pango  # noqa: E402
 
-from ..client.custom_commands import MAX_ARGUMENT, CommandCatalogue, ServerCommand  # noqa: E402
+from ..client.custom_commands import MAX_ARGUMENT, CommandCatalogue, CustomCommand  # noqa: E402
 from . import accessible  # noqa: E402
 
 ListFn = Callable[[], "concurrent.futures.Future[Any]"]
 """Asks the network thread for the :class:`CommandCatalogue` (``ClientRunner.list_commands``)."""
-RunFn = Callable[[ServerCommand, "str | None"], None]
+RunFn = Callable[[CustomCommand, "str | None"], None]
 """Runs one command (the window reports the outcome)."""
 
 
 class _Row(Gtk.ListBoxRow):
-    def __init__(self, command: ServerCommand, run: Callable[[_Row], None]) -> None:
+    def __init__(self, command: CustomCommand, run: Callable[[_Row], None]) -> None:
         super().__init__()
         self.command = command
         self.haystack = f"{command.name}\n{command.description}".lower()

@@ -129,6 +129,9 @@ entry.error { border-color: #c01c28; }
 .status-strip label.stale { color: #b56d00; }
 .status-strip label.ok { color: #1e7a3f; }
 window.phone button.stop-button { min-width: 72px; }
+
+/* The fleet's robot list (robot_list): the selected row */
+.robot-row.robot-selected { background-color: alpha(@theme_selected_bg_color, 0.3); border-radius: 6px; }
 """
 
 

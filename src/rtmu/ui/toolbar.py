@@ -232,12 +232,9 @@ class StatusToolbar(Gtk.ScrolledWindow):
         self._wifi(robot, have and link_ok, why)
         strings_known = robot.strings_at is not None and (robot.mode or robot.status)
         mode = robot.mode if robot.status in ("", robot.mode) else f"{robot.mode} · {robot.status}"
-        mode_tip = "\n".join([robot.extended_status or mode, *details_lines(robot)])
         nav = self.model.navigation.value
-        if nav.navigating and nav.remaining_mm is not None:
-            mode += f" — {nav.remaining_mm / 1000:.1f} m left"
-        else:
-            mode += goal_suffix(robot)
+        mode_tip = "\n".join([robot.extended_status or mode, *details_lines(robot, nav)])
+        mode += goal_suffix(nav)
         if outcome_status(nav) and not nav.navigating:
             mode_tip += "\nLast navigation: " + outcome_status(nav)
         c["mode"].show_value(

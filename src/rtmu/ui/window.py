@@ -6,8 +6,9 @@ header, STOP first and always on screen, and the full-screen bar), ``map_page``,
 (and where pictures go), ``toolbar``, ``banners``, ``actions`` (every ``win.*`` action and the
 menu), ``keys`` (the one key table), ``stop_keys`` (Space stops from every surface),
 ``keyboard_nav``, ``key_reach``, ``notice_router`` (where things are said), ``window_dialogs``,
-``handheld``, ``near_people``, ``bridge_toggle``, ``idle_inhibit``, ``desktop_notify``. A new page
-goes into :attr:`MainWindow.stack`, a new action into ``actions``, a new dialog into ``window_dialogs``.
+``handheld``, ``near_people``, ``bridge_toggle``, ``why_hint`` (a still held drive asks why),
+``idle_inhibit``, ``desktop_notify``. A new page goes into :attr:`MainWindow.stack`, a new action into
+``actions``, a new dialog into ``window_dialogs``.
 
 Its two timers are the UI's heartbeat: every :data:`rtmu.control.controller.TICK` it renews the
 drive lease (``controller.tick``) — if this loop ever stalls, the lease lapses and the network
@@ -58,6 +59,7 @@ from .shortcuts import build_shortcuts_window  # noqa: E402
 from .split_view import SplitView  # noqa: E402
 from .stop_keys import StopKeys  # noqa: E402
 from .toolbar import StatusToolbar  # noqa: E402
+from .why_hint import WhyContext, WhyHint  # noqa: E402
 from .window_dialogs import WindowDialogs  # noqa: E402
 
 REFRESH_EVERY = 3
@@ -133,6 +135,8 @@ class MainWindow(Gtk.ApplicationWindow):
         self.drive = DriveInput(self.robot, m, activate=self.actions.activate, pick_key=self._pick_key)
         self.keys = self.drive.router  # before the stop keys' controller, which GTK runs first
         self.add_controller(self.keys.controller)
+        why = WhyContext(self.robot, model, self.keys)  # what the window knows of a drive, for "why?"
+        self.why_hint = WhyHint(why, self.banners, clock)  # a held drive and no motion for 1 s: ask why
         self.stack = Gtk.Stack(transition_type=Gtk.StackTransitionType.NONE)
         """The window's pages by name: ``map`` (the map page, split with the live picture), ``camera``."""
         self.split = SplitView(m)  # the map page, and the live picture beside it while split
@@ -152,6 +156,7 @@ class MainWindow(Gtk.ApplicationWindow):
             self, self.robot, model, self.banners, request=self.request, profiles=profiles,
             keyring_available=keyring_available, profile_saved=profile_saved,
             profile_changed=lambda: self._update_header(self.model.connection.value),
+            why_question=why.question,
         )  # fmt: skip
         if secrets is not None:
             self.controller.secrets = secrets
@@ -349,6 +354,7 @@ class MainWindow(Gtk.ApplicationWindow):
     def _tick(self) -> bool:
         self.ticks += 1
         self.controller.tick()
+        self.why_hint.tick()
         slow = self.ticks % REFRESH_EVERY == 0
         self.map_page.refresh(slow)
         if slow:
@@ -380,15 +386,8 @@ class MainWindow(Gtk.ApplicationWindow):
         for remove in self._unobserve:
             remove()
         self._unobserve = []
-        parts: tuple[_Part, ...] = (
-            self.handheld,
-            self.stop_keys,
-            self.key_reach,
-            self.near_people,
-            self.idle_inhibit,
-            self.notifier,
-        )
-        for part in (*parts, self.map_page, self.toolbar, self.routes_panel, self.goals_panel):
+        parts: tuple[_Part, ...] = (self.handheld, self.stop_keys, self.key_reach, self.near_people)
+        for part in (*parts, self.idle_inhibit, self.notifier, self.map_page, self.toolbar):
             part.close()
-        for part in (self.camera_page, self.foxglove, self.actions):
+        for part in (self.routes_panel, self.goals_panel, self.camera_page, self.foxglove, self.actions):
             part.close()

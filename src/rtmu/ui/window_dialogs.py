@@ -1,5 +1,5 @@
-"""The window's dialogs: connection settings and passwords, the server's configuration, robot details,
-About, the command palette and the Turn / Go amount dialogs.
+"""The window's dialogs: connection settings and passwords, the server's configuration, the console,
+"why won't it move?", robot details, About, the command palette and the Turn / Go amount dialogs.
 
 Each is a window of its own, transient for the main window (so typing in it never reaches the drive
 keys, and ``stop_keys`` gives it Space all the same), opened by a menu action or — for Turn, Go and
@@ -21,19 +21,29 @@ import gi
 gi.require_version("Gtk", "4.0")
 from gi.repository import GLib, Gtk  # noqa: E402
 
-from ..client.custom_commands import ServerCommand  # noqa: E402
+from ..client.custom_commands import CustomCommand  # noqa: E402
 from ..fleet.selected import SelectedRobot  # noqa: E402
 from ..fleet.sessions import RobotSession  # noqa: E402
 from ..model.observables import Phase, RobotModel  # noqa: E402
 from ..settings.store import Profile  # noqa: E402
-from ..values.intents import Intent, ListServerCommands, MoveDistance, RunServerCommand, TurnBy, WatchStrings  # noqa: E402
+from ..values.intents import (  # noqa: E402
+    AskWhy,
+    Intent,
+    ListServerCommands,
+    MoveDistance,
+    RunServerCommand,
+    TurnBy,
+    WatchStrings,
+)
 from .about import about_dialog  # noqa: E402
 from .banners import BannerStack  # noqa: E402
 from .config_page import ConfigPage  # noqa: E402
+from .console_page import ConsolePage  # noqa: E402
 from .details import DetailsWindow  # noqa: E402
 from .move_dialogs import go_dialog, turn_dialog  # noqa: E402
 from .palette import CommandPalette  # noqa: E402
 from .settings_dialog import ConnectionDialog, PasswordPrompt  # noqa: E402
+from .why_window import WhyWindow  # noqa: E402
 
 Request = Callable[[Intent], "concurrent.futures.Future[Any]"]
 
@@ -54,6 +64,7 @@ class WindowDialogs:
         keyring_available: bool = False,
         profile_saved: Callable[[Profile, str | None], None] | None = None,
         profile_changed: Callable[[], None] = lambda: None,
+        why_question: Callable[[], AskWhy] = AskWhy,
     ) -> None:
         self.window, self.robot, self.model, self.banners = window, robot, model, banners
         self.request = request
@@ -65,9 +76,15 @@ class WindowDialogs:
         """The connection settings dialog last opened."""
         self.details: DetailsWindow | None = None
         self.config_page: ConfigPage | None = None
+        self.why: WhyWindow | None = None
+        self.console: ConsolePage | None = None
+        """The console page last opened."""
+        """The "why won't it move?" window last opened."""
+        self._why_question = why_question
         self._config_listener: Callable[[], None] | None = None
         robot.on_switch(self._details_follow)
         robot.on_switch(self._config_follow)
+        robot.on_switch(self._why_and_console_follow)
 
     # -- connection settings and passwords -----------------------------------------------------
     def password_for(self, profile: Profile) -> str | None:
@@ -115,7 +132,9 @@ class WindowDialogs:
         """The server's configuration page (its own window, so typing there never drives): one at a time."""
         page = self.config_page
         if page is None or page.closed:
-            page = self.config_page = ConfigPage(self.window, self.request, self._follow_config_updates)
+            page = self.config_page = ConfigPage(
+                self.window, self.request, self._follow_config_updates, open_console=self.show_console
+            )
         page.present()
 
     def _follow_config_updates(self, listener: Callable[[], None] | None) -> None:
@@ -130,6 +149,36 @@ class WindowDialogs:
         old.runner.on_config_updated = None
         new.runner.on_config_updated = listener
         listener()  # the page reads the newly selected robot's configuration
+
+    # -- the console -----------------------------------------------------------------------------
+    def show_console(self, filter_text: str = "") -> None:
+        """The console page (``console_page``): one at a time, its list read once it opens;
+        ``filter_text`` narrows it (the configuration page points at the robot's config data)."""
+        console = self.console
+        if console is None or console.closed:
+            console = self.console = ConsolePage(self.window, self.request)
+        if filter_text:
+            console.search.set_text(filter_text)
+        console.present()
+
+    def _why_and_console_follow(self, _old: RobotSession, _new: RobotSession) -> None:
+        """A switch of robot: an open console reads the new robot's data list, an open why window asks
+        the new robot (neither keeps showing the robot before)."""
+        console, why = self.console, self.why
+        if console is not None and not console.closed:
+            console.robot_switched()
+        if why is not None and not why.closed:
+            why.ask()
+
+    # -- why won't it move? ---------------------------------------------------------------------
+    def show_why(self) -> None:
+        """Why won't it move? (``why_window``): one at a time; opened again, it asks again."""
+        why = self.why
+        if why is None or why.closed:
+            why = self.why = WhyWindow(self.window, self.request, self._why_question)
+        else:
+            why.ask()
+        why.present()
 
     # -- robot details ---------------------------------------------------------------------------
     def show_details(self) -> None:
@@ -167,7 +216,7 @@ class WindowDialogs:
         }
         makers[name]().present()
 
-    def _run_server_command(self, command: ServerCommand, argument: str | None) -> None:
+    def _run_server_command(self, command: CustomCommand, argument: str | None) -> None:
         """From the palette: sent on the network thread; the outcome comes back as a banner."""
 
         def done(future: concurrent.futures.Future[bool]) -> None:

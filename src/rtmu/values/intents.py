@@ -344,3 +344,86 @@ class SetConfig(Intent):
 
     label: ClassVar[str] = "Configuration"
     changes: Mapping[str, Mapping[str, str]] = field(default_factory=dict)
+
+
+# -- why won't it move? and the console -------------------------------------------------------------
+FIXES_NEEDING_YES = frozenset({"safe_drive_off", "acknowledge_faults", "enable_motors"})
+"""Fixes (``client.why_values.Fix.key``) that change how the robot protects itself or act on a robot
+whose layouts are not public: the guard refuses :class:`ApplyFix` for them without ``confirmed``."""
+
+
+@dataclass(frozen=True)
+class AskWhy(Intent):
+    """Why won't it move? Everything the server's own data says, plus our side, as one answer (reads only).
+
+    The window says what only it knows: the drive asked for (``trans``/``rot`` in %: an obstacle then
+    matters only that way), the link as it shows it, and whether a held key is ignored after a stop."""
+
+    label: ClassVar[str] = "Why won't it move?"
+    navigate: bool = False
+    """The question is about navigation (a lost localization counts)."""
+    trans: float = 0.0
+    rot: float = 0.0
+    link: str = ""
+    """The link level the window shows (``LinkLevel`` value); "" when not known."""
+    keys_blocked: bool = False
+
+
+@dataclass(frozen=True)
+class ApplyFix(Intent):
+    """Carry out the fix of a cause "why won't it move?" found (``Fix.key``), then ask again.
+
+    The network side finds the cause again from the server's data before it sends anything, so only a
+    fix the robot still needs is made. Counted as moving: undocking backs the robot out, unlocking or
+    acknowledging gives the drive back. ``confirmed``: the operator said yes to what it will do."""
+
+    moves: ClassVar[bool] = True
+    label: ClassVar[str] = "Fix"
+    key: str = ""
+    confirmed: bool = False
+    navigate: bool = False
+
+
+@dataclass(frozen=True)
+class ConsoleList(Intent):
+    """The server's whole data list with its descriptions, as the console reads it (``text``: a filter)."""
+
+    label: ClassVar[str] = "Console"
+    text: str = ""
+
+
+@dataclass(frozen=True)
+class ConsoleCall(Intent):
+    """Call any data the server lists once, with the operator's words as its arguments.
+
+    ``types`` names the arguments' types where the data's description does not; ``confirmed``: the
+    operator said yes to a call that changes something (a motion request never goes without it)."""
+
+    label: ClassVar[str] = "Console"
+    name: str = ""
+    arguments: tuple[str, ...] = ()
+    types: tuple[str, ...] = ()
+    confirmed: bool = False
+
+
+@dataclass(frozen=True)
+class ConsoleFollow(Intent):
+    """Follow a data at ``interval_ms`` (−1: only what the server broadcasts), or stop following it (``on``).
+
+    A data that changes something is never followed (it would be repeated at every interval)."""
+
+    label: ClassVar[str] = "Console"
+    name: str = ""
+    interval_ms: int = 1000
+    arguments: tuple[str, ...] = ()
+    types: tuple[str, ...] = ()
+    on: bool = True
+
+
+@dataclass(frozen=True)
+class ConsoleNext(Intent):
+    """The replies that arrived for the followed data ``name``, waiting up to ``wait`` s for the first."""
+
+    label: ClassVar[str] = "Console"
+    name: str = ""
+    wait: float = 0.5

@@ -77,10 +77,6 @@ class RobotState:
     """Route names (``getRoutes``, LD robots)."""
     data_store: tuple[tuple[str, str], ...] = ()
     """(data name, value) of every listed ``DataStore_*`` string, sorted by name."""
-    loc_score: int | None = None
-    """Localization score 0–100 from ``DataStore_Localization_Score``; None if not offered."""
-    goal_distance_mm: int | None = None
-    """Distance left to the goal from ``DataStore_Distance_To_Goal`` (0: no goal); None if not offered."""
     closest_obstacle_mm: int | None = None
     """``DataStore_Closest_Obstacle``; None if not offered or nothing in range."""
     server_strings: tuple[tuple[str, str], ...] = ()
@@ -274,7 +270,8 @@ class NavState:
     path: tuple[tuple[int, int], ...] = ()
     """The planned path still ahead (``getPath``, map mm), while navigating."""
     remaining_mm: float | None = None
-    """Distance along ``path`` from the robot's pose; None without a path."""
+    """Distance left to the goal: along ``path`` from the robot's pose (ARNL), or an LD robot's own
+    ``DataStore_Distance_to_goal``; None without a path or a goal."""
     outcome: NavOutcome = NavOutcome.NONE
     outcome_text: str = ""
     """The server's own sentence for the outcome (``Arrived at Lab B``), bounded."""
@@ -283,7 +280,8 @@ class NavState:
     loc_state: str | None = None
     """``Good``, ``Idle``, ``Lost``, ``Initializing`` (``getLocState``); None if not offered."""
     loc_score: float | None = None
-    """Localization score 0.0–1.0 (``getLocState``); None if not offered."""
+    """Localization score 0.0–1.0: ARNL's ``getLocState``, or an LD robot's ``DataStore_…Localization
+    Score`` (0–100 on the wire, one scale here); None if not offered."""
     goals: tuple[str, ...] = ()
     """The map's goal names (``getGoals``), refreshed on ``goalsUpdated``."""
 

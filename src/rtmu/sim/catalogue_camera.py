@@ -1,0 +1,182 @@
+# ruff: noqa: E501
+"""The camera's rows of the simulator's catalogue: what serverDemo with a VC-C4 head lists.
+
+The texts are the wire texts serverDemo sends for its camera data (from the same recording that
+:mod:`.catalogue` quotes; a test checks them against it); answered by :mod:`.camera_data`. Kept apart
+from :mod:`.catalogue` so that each table fits in a module.
+"""
+
+from __future__ import annotations
+
+from .catalogue_row import Row
+
+CAMERA: tuple[Row, ...] = (
+    (
+        "videoSize",
+        "gets the width and height of the video data",
+        "none",
+        "uByte2: width, uByte2: height",
+        "Video",
+        "RETURN_SINGLE",
+    ),
+    (
+        "sendVideo",
+        "gets video from the robot's camera (you should requestOnce this, you shouldn't request it, since you could easily fill the bandwidth that way)",
+        "uByte: quality (0 - 100)",
+        "out: uByte2: width, uByte2: height, (len - readLen)*uByte: jpegData",
+        "Video",
+        "RETURN_VIDEO",
+    ),
+    (
+        "getCameraDataCam1",
+        'Get "double" information about camera position. (factor == 100)',
+        "None",
+        "byte2: pan * factor, byte2: tilt * factor, byte2: zoomPercent * factor (optional)",
+        "CameraInfo",
+        "RETURN_SINGLE",
+    ),
+    (
+        "getCameraInfoCam1",
+        'Get ("double") information about the camera\'s pan, tilt, and (optional) zoom ranges. (factor == 100)',
+        "None",
+        "byte2: minPan * factor, byte2: maxPan * factor byte2: minTilt * factor, byte2: maxTilt * factor, byte2: minZoom * factor, byte2: maxZoom * factor, byte: isZoomAvailable",
+        "CameraInfo",
+        "RETURN_SINGLE",
+    ),
+    (
+        "setCameraAbsCam1",
+        'Sends absolute ("double") pan, tilt, and zoom (optional) commands to the camera. (factor == 100)',
+        "None",
+        "byte2: pan * factor, byte2: tilt * factor, byte2: zoom * factor (optional)",
+        "CameraControl",
+        "RETURN_SINGLE",
+    ),
+    (
+        "setCameraPctCam1",
+        'Sends ("double") pan, tilt, and zoom (optional) commands to point camera, as percent of visible frame. (factor == 100)',
+        "None",
+        "byte2: panOffset * factor, byte2: tiltOffset * factor, byte2: zoom * factor (optional)",
+        "CameraControl",
+        "RETURN_SINGLE",
+    ),
+    (
+        "setCameraRelCam1",
+        'Sends ("double") pan, tilt, and zoom (optional) commands to the camera, relative to its current position. (factor == 100)',
+        "None",
+        "byte2: relPan * factor, byte2: relTilt * factor, byte2: relZoom * factor (optional)",
+        "CameraControl",
+        "RETURN_SINGLE",
+    ),
+    (
+        "getCameraModeListCam1",
+        "Gets the list of modes this camera supports",
+        "None",
+        "ubyte2: numModes; <repeating numModes times> string: modeName",
+        "CameraInfo",
+        "RETURN_SINGLE",
+    ),
+    (
+        "cameraModeUpdatedCam1",
+        "Sent whenever the camera mode is updated",
+        "None",
+        "string: modeName; <other data depends on mode>",
+        "CameraInfo",
+        "RETURN_SINGLE",
+    ),
+    (
+        "setCameraModeCam1",
+        "Sets the mode of the camera",
+        "string: modeName; <other data depends on mode>",
+        "None",
+        "CameraControl",
+        "RETURN_SINGLE",
+    ),
+    (
+        "resetCameraCam1",
+        "Resets the camera to 0 0 0 and may reinitialize it (depending on camera)",
+        "None",
+        "None",
+        "CameraControl",
+        "RETURN_SINGLE",
+    ),
+    (
+        "cameraUpdate",
+        "Get (integer) information about camera position",
+        "None",
+        "byte2: pan, byte2: tilt, byte2: zoom (optional)",
+        "CameraInfo",
+        "RETURN_SINGLE",
+    ),
+    (
+        "cameraInfo",
+        "Get (integer) information about the camera's pan, tilt, and (optional) zoom ranges",
+        "None",
+        "byte2: minPan, byte2: maxPan byte2: minTilt, byte2: maxTilt, byte2: minZoom, byte2: maxZoom, byte: isZoomAvailable",
+        "CameraInfo",
+        "RETURN_SINGLE",
+    ),
+    (
+        "camera",
+        "Sends (integer) pan, tilt, and zoom (optional) commands to the camera, relative to its current position",
+        "None",
+        "byte: relPan, byte: relTilt, byte: relZoom (optional)",
+        "CameraControl",
+        "RETURN_SINGLE",
+    ),
+    (
+        "cameraAbs",
+        "Sends absolute (integer) pan, tilt, and zoom (optional) commands to the camera",
+        "None",
+        "byte: pan, byte: tilt, byte: zoom (optional)",
+        "CameraControl",
+        "RETURN_SINGLE",
+    ),
+    (
+        "cameraPct",
+        "Sends (integer) pan, tilt commands to the camera, as percent of visible frame",
+        "None",
+        "byte: pan, byte: tilt, byte: zoom (optional)",
+        "CameraControl",
+        "RETURN_SINGLE",
+    ),
+    (
+        "getPictureCam1",
+        "Gets video from the robot's camera",
+        "uByte: quality (0 - 100)",
+        "out: uByte2: width, uByte2: height, (len - readLen)*uByte: jpegData",
+        "Video",
+        "",
+    ),
+    (
+        "getCameraList",
+        "Gets information about the robot's cameras.",
+        "none",
+        "byte2: numCameras, repeating for numCameras: { string: cameraName, string: cameraType, string: displayName, string: displayType, byte2: numCommands, repeating for numCommands: {string: command, string: cameraCommandName byte4: requestInterval } byte2: numParams, repeating for numParams: {see ArConfigArg format}}",
+        "CameraInfo",
+        "RETURN_SINGLE",
+    ),
+    (
+        "setCameraParams",
+        "Sets the specified camera parameters.",
+        "string: cameraName, repeating for each param: { string: paramName, <param value - see ArConfigArg format> }, empty paramName terminates list",
+        "string: cameraName, repeating for each modified param: { string: paramName, <param value - see ArConfigArg format> }, empty paramName terminates list",
+        "CameraInfo",
+        "RETURN_SINGLE",
+    ),
+    (
+        "cameraListUpdated",
+        "Single packet is sent when the camera collection has been modified.",
+        "none",
+        "none",
+        "CameraInfo",
+        "RETURN_SINGLE",
+    ),
+    (
+        "cameraParamUpdated",
+        "Packet is sent when the camera parameters have been modified.",
+        "none",
+        "string: cameraName, repeating for each modified param: { string: paramName, <param value - see ArConfigArg format> }, empty paramName terminates list",
+        "CameraInfo",
+        "RETURN_SINGLE",
+    ),
+)
