@@ -40,6 +40,9 @@ leaves them unnamed; they move the pane the reader already reads), nor icons, wh
 control; the map, a drawing, is checked on its own."""
 FALLBACK = re.compile(r"^(Gtk|Adw)[A-Z]\w*$|\+")
 """GTK 4.8 names an unnamed widget by its type (``GtkButton``, ``rtmu+ui+goals_panel+GoalsPanel``)."""
+OPENED = ("win.dpad", "win.settings", "win.server-config", "win.console", "win.why")
+"""What the reader opens through the window's own actions before it reads: the D-pad, connection
+settings, the server's configuration, the console and "why won't it move?"."""
 MNEMONIC_TWICE = re.compile(r"^(\S*_\S*) (\S+)$")
 """GTK 4.8's name for a mnemonic button, ``_Cancel Cancel``: the raw label read out, then the label."""
 
@@ -105,10 +108,10 @@ def test_every_control_has_a_name_and_the_map_says_where_the_robot_is(tmp_path: 
             wait(
                 lambda: sim.call(lambda: any(s.subscriptions for s in sim.server.sessions)), 30, "subscribed"
             )
-            nodes = read_tree(proc.pid, env, "win.dpad", "win.settings", "win.server-config")
+            nodes = read_tree(proc.pid, env, *OPENED)
             for _attempt in range(20):  # a busy machine: the D-pad and the dialog may come a little later
                 shown = {n["name"] for n in nodes}
-                if {"Forward", "Host", "Show up to"} <= shown and any(
+                if {"Forward", "Host", "Show up to", "Call once"} <= shown and any(
                     n["role"] == "spin button" for n in nodes
                 ):
                     break
