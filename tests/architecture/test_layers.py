@@ -43,8 +43,9 @@ MAY_IMPORT: dict[str, frozenset[str]] = {
     # What --version (and later the About window) says: the protocol's facts and the libraries' versions.
     "about": frozenset({"codec", "base"}),
     # The stop process: its halt and its login go through the codec on a plain socket. It never imports
-    # the client it guards against (nor asyncio, numpy or GTK: it starts light).
-    "guardian": frozenset({"codec"}),
+    # the client it guards against (nor asyncio, numpy or GTK: it starts light). From base it takes the
+    # one rule for how late a stream may be (base.link_timing), shared with the client's link health.
+    "guardian": frozenset({"codec", "base"}),
     # The network side knows the values it publishes, never the UI thread's state above it.
     "client": frozenset({"guardian", "values", "codec", "maps", "base"}),
     "simulator": frozenset({"codec", "maps", "base"}),

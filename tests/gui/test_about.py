@@ -37,7 +37,7 @@ def test_about_shows_the_logo_reads_right_and_copies_the_debug_information(gui: 
     pump(lambda: any(isinstance(w, Gtk.AboutDialog) for w in owned_windows(gui.window)), 5, "About")
     about = next(w for w in owned_windows(gui.window) if isinstance(w, Gtk.AboutDialog))
     assert about.get_logo() is not None, "no logo: GTK shows a broken image"
-    assert "The The" not in about.get_license() and "MIT licence" in about.get_license()
+    assert "The The" not in about.get_license() and "MIT License" in about.get_license()
     info = about.get_system_information()
     assert info.splitlines()[0] == f"rtmu {__version__}"
     assert f"robot: 127.0.0.1:{sim.port}" in info and "connected" in info

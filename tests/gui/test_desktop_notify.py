@@ -52,7 +52,7 @@ def test_popups_and_a_low_battery_reach_the_desktop_only_while_the_window_is_awa
     other.present()
     pump(lambda: not gui.window.is_active(), 10, "the window to lose the focus")
     gui.window.activate_action("win.notify-popup", None)  # View ▸ Desktop notifications ▸ off
-    assert gui.window.notifier.choices["popup"] is False
+    assert gui.window.desktop.notifier.choices["popup"] is False
     popup(sim, "Switched off")
     pump(lambda: len(gui.window.model.popups.value.open) == 2, 10, "the second popup card")
     idle(0.5)

@@ -302,6 +302,11 @@ class AriaClient:
         """What the decoder threw away on this connection (bad checksums, garbage bytes…)."""
         return self._conn.decoder.stats if self._conn is not None else DropStats()
 
+    def undecided(self) -> bool:
+        """True while the decoder holds a header whose body has not come but sees valid packets
+        going on behind it: the stream is alive and will be delivered within a few packets."""
+        return self._conn is not None and self._conn.decoder.undecided > 0
+
     def _no_reply(self, message: str) -> ClientError:
         """A timeout, unless the server sent a packet over ARIA's limit: that is then why (dropped)."""
         size = self.drops.largest_over_limit

@@ -292,6 +292,7 @@ class Session:
             await client.disconnect()
             raise ServerClosed("the connection attempt was cancelled")
         self.client = client
+        self.drive.stop_first()  # lost while driving: the robot may still move, a stop goes out first
         self._subs = merged(
             applicable((s for f in self.feeds for s in f.subscriptions(client)), client.supports)
         )
@@ -379,8 +380,10 @@ class Session:
 
     async def _reconnect(self, target: Target) -> None:
         backoff = self.config.backoff()
+        at_once = self.drive.stop_on_connect  # lost while driving: the first try carries a stop, no wait
         while self._target is target:
-            delay = backoff.next_delay()
+            delay = 0.0 if at_once else backoff.next_delay()
+            at_once = False
             self._set_connection(phase=Phase.RECONNECTING, attempt=backoff.attempt, retry_in=round(delay, 1))
             await asyncio.sleep(delay)
             if self._target is not target:

@@ -110,6 +110,12 @@ def parse_central(text: str) -> tuple[str, int]:
     return host, int(port_text)
 
 
+def address_name(host: str, port: int | str, user: str = "") -> str:
+    """The name RTMU gives a profile made from an address: ``host:port``, ``user@host:port``."""
+    user = user.strip()
+    return f"{user + '@' if user else ''}{host.strip()}:{str(port).strip()}"
+
+
 @dataclass(frozen=True, slots=True)
 class Profile:
     """One robot server the operator connects to, and how they left the view last time."""

@@ -26,9 +26,13 @@ from ..settings.last_doctor import load_last_doctor  # noqa: E402
 from ..versions import version_lines  # noqa: E402
 from . import accessible  # noqa: E402
 
-LICENCE = (
-    "RTMU is free software under the MIT licence: you may use, copy, change and share it.\n"
-    "It comes with absolutely no warranty. The licence's full text is the LICENSE file of its source."
+LICENSE_TEXT = (
+    "RTMU is free software under the MIT License: use, copy, change and share it, keeping the "
+    "copyright notice. It comes with absolutely no warranty; the LICENSE file has the full text."
+)
+COMMENTS = (
+    "Robot Teleoperation, Mobile User interface: drive an ARIA (ArNetworking) robot "
+    "from a tablet or a laptop."
 )
 WEBSITE = "https://github.com/rtmu/rtmu"
 
@@ -58,7 +62,8 @@ def debug_information(
     )
 
 
-def logo() -> Gdk.Paintable | None:
+def app_logo() -> Gdk.Texture | None:
+    """RTMU's icon from the package (None when this system cannot read SVG: the dialog shows none)."""
     try:
         return Gdk.Texture.new_from_filename(str(DESKTOP_DIR / f"{APP_ID}.svg"))
     except GLib.Error:
@@ -73,14 +78,14 @@ def about_dialog(parent: Gtk.Window, conn: ConnectionState, profile: str) -> Gtk
         modal=True,
         program_name="RTMU",
         version=__version__,
-        comments="Robot Teleoperation, Mobile User interface: drive an ARIA (ArNetworking) robot "
-        "from a tablet or a laptop.",
+        comments=COMMENTS,
         website=WEBSITE,
-        license=LICENCE,
+        license_type=Gtk.License.CUSTOM,
+        license=LICENSE_TEXT,
         wrap_license=True,
         system_information=info,
     )
-    paintable = logo()
+    paintable = app_logo()
     if paintable is not None:
         about.set_logo(paintable)
     copy = Gtk.Button(

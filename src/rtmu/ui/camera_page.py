@@ -29,6 +29,7 @@ from . import accessible  # noqa: E402
 from .banners import BannerStack  # noqa: E402
 from .camera import CameraView, PictureDecoder  # noqa: E402
 from .live_video import LiveVideoControls  # noqa: E402
+from .motion import MotionIndicator, held_by  # noqa: E402
 from .pip import PictureInPicture  # noqa: E402
 from .ptz_controls import PtzControls  # noqa: E402
 from .split_view import SplitView  # noqa: E402
@@ -67,6 +68,11 @@ class CameraPage:
             stop=lambda: robot.ask(StopVideo()), pause=lambda on: robot.ask(PauseVideo(on)),
             tell=lambda level, text: banners.tell("camera", level, text, timeout=5.0),
         )  # fmt: skip
+        # The motion pill here too (top right: the video's caption has the top left): looking at the
+        # camera never hides that the robot is navigating or driven.
+        self.motion = MotionIndicator(model, held=lambda: held_by(robot.session.controller, False))
+        self.motion.set_halign(Gtk.Align.END)
+        self.view.overlay.add_overlay(self.motion)
         self.decoder = PictureDecoder(self.picture_decoded)
         self.button = Gtk.ToggleButton(icon_name="camera-photo-symbolic")
         """The header's camera button: pressed while the page shows."""
@@ -95,8 +101,8 @@ class CameraPage:
         self.robot.session.controller.look("the camera page")  # a held drive ends; a navigation goes on
         self.stack.set_visible_child_name(PAGE)
         self.button.set_active(True)
-        if request or self.view.image is None:
-            self.request_picture()
+        if (request or self.view.image is None) and not self.live.live:
+            self.request_picture()  # (live video is the picture: no "Requesting…" over it)
 
     def show_map(self) -> None:
         self.stack.set_visible_child_name("map")
@@ -192,11 +198,14 @@ class CameraPage:
         self.inset.show_texture(None)
 
     def tick(self) -> None:
-        """Ages on the page and the inset (the window's slow timer)."""
+        """Ages on the page and the inset, the page's motion pill (the window's slow timer)."""
         self.view.tick()
         self.inset.tick()
+        if self.showing:
+            self.motion.refresh()
 
     def close(self) -> None:
         self._unobserve()
+        self.motion.close()
         self.ptz.close()
         self.decoder.close()

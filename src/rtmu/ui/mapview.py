@@ -104,6 +104,8 @@ class MapStage(Gtk.DrawingArea):
         self._scroll_accum = 0.0
         self.marker: Marker | None = None
         """A pose the operator is picking (``pose_pick`` sets it); drawn over the map."""
+        self.draft_objects: list[object] | None = None
+        """A map draft's objects, drawn instead of the map's own while it has edits (``map_edit_window``)."""
         self.fleet: Callable[[], tuple[Sequence[FleetMark], tuple[float, float, float]]] | None = None
         self.limits: Callable[[], RobotLimits] = RobotLimits
         """The shown robot's speed and braking (the window hands over its controller's)."""
@@ -340,7 +342,7 @@ class MapStage(Gtk.DrawingArea):
         scene = Scene(
             labels=self.labels,
             tiles=self.tiles if has_map else None,
-            objects=self._objects,
+            objects=self._objects if self.draft_objects is None else self.draft_objects,
             robot=(r.x, r.y, r.th) if r.numbers_at is not None else None,
             stale=stale,
             trail=self.model.trail.points,

@@ -3,7 +3,8 @@
 Every field is checked as it is typed (:func:`validate`, pure) and a problem is
 shown in an inline message under the field; Save stays insensitive until the
 form is valid. Picking another profile in the list loads its fields; typing a
-new name saves a new profile. The dialog never connects and never writes files
+new name saves a new profile. A profile named after its address follows a changed host or port.
+The dialog never connects and never writes files
 itself: ``on_save(profile, password)`` hands the result to the window.
 """
 
@@ -18,7 +19,7 @@ import gi
 gi.require_version("Gtk", "4.0")
 from gi.repository import Gtk  # noqa: E402
 
-from ..settings.store import DEFAULT_PORT, Profile  # noqa: E402
+from ..settings.store import DEFAULT_PORT, Profile, address_name  # noqa: E402
 from . import accessible  # noqa: E402
 from .layout import screen_size  # noqa: E402
 
@@ -145,6 +146,8 @@ class ConnectionDialog(Gtk.Window):
 
         self._load(current)
         self.profile.connect("changed", self._profile_changed)
+        for entry in (self.host, self.port, self.user):
+            entry.connect("changed", lambda _e: self._address_changed())
         for entry in (self.profile_entry, self.host, self.port, self.user):
             entry.connect("changed", lambda _e: self.check())
             entry.set_activates_default(True)
@@ -166,6 +169,7 @@ class ConnectionDialog(Gtk.Window):
     def _load(self, profile: Profile) -> None:
         self._loading = True
         self._base = profile
+        self._address_name = address_name(profile.host, str(profile.port), profile.user)
         self.profile_entry.set_text(profile.name)
         self.host.set_text(profile.host)
         self.port.set_text(str(profile.port))
@@ -175,6 +179,16 @@ class ConnectionDialog(Gtk.Window):
         self.reconnect.set_active(profile.auto_reconnect)
         self.protocol.set_text(profile.protocol)
         self._loading = False
+
+    def _address_changed(self) -> None:
+        """A profile named after its address ("127.0.0.1:7391", as RTMU names one) follows the user, host
+        and port typed; a name the operator chose stays."""
+        now = address_name(self.host.get_text(), self.port.get_text(), self.user.get_text())
+        if not self._loading and self.profile_entry.get_text() == self._address_name:
+            self._loading = True  # the new name is no pick of another profile
+            self.profile_entry.set_text(now)
+            self._loading = False
+        self._address_name = now
 
     def _profile_changed(self, combo: Gtk.ComboBoxText) -> None:
         name = combo.get_active_id()

@@ -71,7 +71,7 @@ class StatusStrip(Gtk.Box):
             battery = f"Bat {robot.battery_v:.1f}V"
         self._set("battery", battery, robot.battery_state if connected else "unknown")
         quality = robot.wifi_quality
-        wifi = DASH if quality is None or not connected else f"{round(100 * max(0, min(70, quality)) / 70)}%"
+        wifi = DASH if quality is None or not connected else f"{max(0, min(100, quality))}%"  # (in %)
         self._set("wifi", f"Wi-Fi {wifi}", "")
         if not connected:
             link, state = self.model.connection.value.phase.value, "lost"

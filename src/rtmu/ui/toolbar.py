@@ -24,11 +24,13 @@ gi.require_version("Gtk", "4.0")
 gi.require_version("Pango", "1.0")
 from gi.repository import GLib, Gtk, Pango  # noqa: E402
 
+from ..base.link_timing import STATUS_CEILING  # noqa: E402
 from ..model.observables import ConnectionState, LinkLevel, OperatorState, Phase, RobotModel  # noqa: E402
 from . import accessible  # noqa: E402
 from .gauges import BatteryGauge, WifiGauge, battery_fraction, wifi_bars  # noqa: E402
 from .ld_status import details_lines, goal_suffix  # noqa: E402
 from .nav_text import loc_level, loc_text, outcome_status  # noqa: E402
+from .notes import heading_text  # noqa: E402
 
 STALE_AFTER = 1.0
 """Seconds after which a pose/battery value is shown as stale (status arrives at 10 Hz)."""
@@ -132,7 +134,7 @@ class StatusToolbar(Gtk.ScrolledWindow):
             "mode": Cell("Mode · status", width_chars=6),
             "safe": Cell("Safe", width_chars=3),
             "speed": Cell("Throttle", width_chars=5),
-            "link": Cell("Link: rtt, age", width_chars=12),
+            "link": Cell("Link: rtt, age/limit", width_chars=14),
             "dock": Cell("Dock", width_chars=9),
             "loc": Cell("Localization", width_chars=9),
         }
@@ -225,7 +227,7 @@ class StatusToolbar(Gtk.ScrolledWindow):
         c = self.cells
         c["x"].show_value(f"{robot.x / 1000:.2f}" if have else DASH, stale=stale, tooltip=why)
         c["y"].show_value(f"{robot.y / 1000:.2f}" if have else DASH, stale=stale, tooltip=why)
-        c["th"].show_value(f"{robot.th:.0f}°" if have else DASH, stale=stale, tooltip=why)
+        c["th"].show_value(heading_text(robot.th) if have else DASH, stale=stale, tooltip=why)
         c["vel"].show_value(f"{robot.vel:.0f}" if have else DASH, stale=stale, tooltip=why)
         c["rot"].show_value(f"{robot.rot_vel:.0f}" if have else DASH, stale=stale, tooltip=why)
         self._battery(robot, stale, why)
@@ -357,6 +359,12 @@ class StatusToolbar(Gtk.ScrolledWindow):
             f"{health.dropped} bad packets dropped"
         )
         text = f"{rtt} {age_text}"
+        if health.stale_limit is not None:  # the learned limit next to the age it is compared with
+            text = f"{rtt} {DASH if age is None else f'{age:.1f}'}/{health.stale_limit:.2f}"
+            tip += (
+                f"\nStale after {health.stale_limit:.2f} s without status: learned from this link's "
+                f"jitter ({health.jitter_ms or 0:.0f} ms), at most {STATUS_CEILING:.2f} s"
+            )
         if health.ping_failures > 0:
             # The link may look alive (status still arriving) while the server no longer hears us.
             text = f"no ping ×{health.ping_failures}"

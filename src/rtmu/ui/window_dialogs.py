@@ -93,8 +93,8 @@ class WindowDialogs:
 
     def open_settings(self) -> None:
         profiles = dict(self.profiles)
-        current = self.robot.session.controller.profile
-        profiles.setdefault(current.name, current)
+        current = self.robot.session.controller.current_profile()  # the speed and view as they are now:
+        profiles[current.name] = current  # Save keeps them (never the speed the profile was opened with)
         self.settings = ConnectionDialog(
             self.window,
             profiles,
@@ -111,7 +111,7 @@ class WindowDialogs:
         if self._profile_saved is not None:
             self._profile_saved(profile, password)
         controller = self.robot.session.controller
-        changed = profile != controller.profile
+        changed = profile != controller.current_profile()
         controller.select_profile(profile)
         self._profile_changed()
         if changed and self.model.connection.value.phase is not Phase.DISCONNECTED:
@@ -132,8 +132,13 @@ class WindowDialogs:
         """The server's configuration page (its own window, so typing there never drives): one at a time."""
         page = self.config_page
         if page is None or page.closed:
+            offers = lambda: self.model.connection.value.offers  # noqa: E731 - the shown robot's, always
             page = self.config_page = ConfigPage(
-                self.window, self.request, self._follow_config_updates, open_console=self.show_console
+                self.window,
+                self.request,
+                self._follow_config_updates,
+                offers,
+                open_console=self.show_console,
             )
         page.present()
 
