@@ -58,7 +58,8 @@ MAY_IMPORT: dict[str, frozenset[str]] = {
         {"control", "client", "guardian", "recorder", "ui-state", "values", "settings", "base"}
     ),
     # The window may start the bundled simulator (--demo) and play a recording back (rtmu replay: the
-    # recorder's clock and feeder); it never reaches the command line.
+    # recorder's clock and feeder); its About window says what --version says; it never reaches the
+    # command line.
     "view": frozenset(
         {
             "fleet",
@@ -71,6 +72,7 @@ MAY_IMPORT: dict[str, frozenset[str]] = {
             "settings",
             "simulator",
             "codec",
+            "about",
             "base",
         }
     ),

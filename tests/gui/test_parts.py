@@ -162,3 +162,31 @@ def test_the_link_cell_shows_the_learned_stale_limit() -> None:
         cell.get_tooltip_text() or ""
     )
     toolbar.close()
+
+
+def test_colour_states_are_also_words_in_the_toolbar() -> None:
+    """Battery and link say in a visible word (and to a screen reader) what their colour says."""
+    from rtmu.values.state import RobotState
+
+    model = RobotModel()
+    model.connection.set(ConnectionState(Phase.CONNECTED, "127.0.0.1", 7272))
+    model.health.set(LinkHealth(LinkLevel.OK, rtt_ms=1.5))
+    robot = RobotState(battery_v=12.5, battery_low=11.5, battery_shutdown=11.0, numbers_at=1.0)
+    model.robot.set(robot)
+    toolbar = StatusToolbar(model, OperatorState(), status_age=lambda: 0.1)
+    battery, link = toolbar.cells["battery"], toolbar.cells["link"]
+    heading = link.caption.get_text()
+    assert battery.caption.get_text() == "Battery" and heading.startswith("Link")
+    model.robot.set(RobotState(battery_v=11.3, battery_low=11.5, battery_shutdown=11.0, numbers_at=2.0))
+    toolbar.refresh()
+    assert battery.caption.get_text() == "Battery · LOW" and battery.has_css_class("low")
+    model.robot.set(RobotState(battery_v=10.9, battery_low=11.5, battery_shutdown=11.0, numbers_at=3.0))
+    toolbar.refresh()
+    assert battery.caption.get_text() == "Battery · SHUTDOWN"
+    model.health.set(LinkHealth(LinkLevel.LOST, rtt_ms=None))
+    toolbar.refresh()
+    assert link.caption.get_text() == f"{heading} · LOST"
+    model.health.set(LinkHealth(LinkLevel.OK, rtt_ms=1.5))
+    toolbar.refresh()
+    assert link.caption.get_text() == heading
+    toolbar.close()

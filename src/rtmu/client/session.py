@@ -303,7 +303,11 @@ class Session:
             feed.connected(client)
         self.sync_subscriptions()
         offers = frozenset(e.name for e in client.datalist)
-        self._set_connection(phase=Phase.CONNECTED, offers=offers, error="", error_kind="", retry_in=None)
+        tag, wanted, sent = client.server_words
+        self._set_connection(
+            phase=Phase.CONNECTED, offers=offers, error="", error_kind="", retry_in=None,
+            server_tag=tag, server_protocol=wanted, sent_protocol=sent,
+        )  # fmt: skip
         self.kick()
 
     def _subs_of(self, feed: Feed, client: AriaClient) -> list[Subscription]:

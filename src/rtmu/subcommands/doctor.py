@@ -62,6 +62,7 @@ from ..protocol.fields import FieldReader, FieldWriter
 from ..protocol.packet import encode_packet
 from ..protocol.payloads import Side, decode_payload
 from ..protocol.payloads.robot import BatteryInfo, Update, UpdateNumbers, UpdateStrings
+from ..settings.last_doctor import save_last_doctor
 from ._common import (
     Interrupted,
     UsageError,
@@ -585,6 +586,8 @@ def handle(args: argparse.Namespace) -> int:
         print(f"rtmu doctor: {exc}", file=sys.stderr)
         return exc.exit_code
     failed = next((s for s in doctor.steps if s.result == "fail"), None)
+    lines = report_lines(doctor, host, port, args.user, failed, code)
+    save_last_doctor(lines)  # for the window's About ▸ debug information
     if args.json:
         print_json(
             {
@@ -597,13 +600,22 @@ def handle(args: argparse.Namespace) -> int:
             }
         )
         return code
-    print(f"rtmu doctor {host}:{port}" + (f" (user {args.user})" if args.user else ""))
-    for s in doctor.steps:
-        print(f"  [{MARKS.get(s.result, s.result)}] {s.step.title}: {visible(s.summary)}")
-        if s.advice:
-            print(f"         what to do: {visible(s.advice)}")
-    if failed is None:
-        print("All steps passed: RTMU can connect to this robot.")
-    else:
-        print(f"Stopped at the {failed.step.title} step (exit {code}).")
+    for line in lines:
+        print(line)
     return code
+
+
+def report_lines(
+    doctor: Doctor, host: str, port: int, user: str, failed: StepResult | None, code: int
+) -> list[str]:
+    """The human report, step by step (printed, and kept as the last one)."""
+    lines = [f"rtmu doctor {host}:{port}" + (f" (user {user})" if user else "")]
+    for s in doctor.steps:
+        lines.append(f"  [{MARKS.get(s.result, s.result)}] {s.step.title}: {visible(s.summary)}")
+        if s.advice:
+            lines.append(f"         what to do: {visible(s.advice)}")
+    if failed is None:
+        lines.append("All steps passed: RTMU can connect to this robot.")
+    else:
+        lines.append(f"Stopped at the {failed.step.title} step (exit {code}).")
+    return lines

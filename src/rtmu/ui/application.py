@@ -213,6 +213,7 @@ class RtmuApplication(Gtk.Application):
         window.near_people.use(NearPeople(self.settings.near_people, cap))
         window.near_people.on_change = self._near_people
         window.layers.use_choices(self.settings.layers)  # the operator's drawings, remembered per server
+        window.desktop.notifier.use(self.settings.notifications, on_change=self._notifications)
         # Closing the window stops every robot of the fleet, not only the one it shows.
         window.connect("close-request", lambda _w: self.fleet.stop_all() and False)
         if self.options.report_first_frame:
@@ -437,6 +438,11 @@ class RtmuApplication(Gtk.Application):
         if self._saves_asked:
             self._save(background=True)
 
+    def _notifications(self, choices: dict[str, bool]) -> None:
+        self.settings.notifications = dict(choices)
+        if self.options.persist:
+            self._save(background=True)
+
     def _alarms_muted(self, muted: bool) -> None:
         self.settings.alarms_muted = muted
         if self._saves_asked:
@@ -452,6 +458,7 @@ class RtmuApplication(Gtk.Application):
             near_people=s.near_people,
             near_people_mm_s=s.near_people_mm_s,
             layers={server: dict(choices) for server, choices in s.layers.items()},
+            notifications=dict(s.notifications),
         )
         path = self.options.settings_path
 

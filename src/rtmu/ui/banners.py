@@ -17,6 +17,8 @@ import gi
 gi.require_version("Gtk", "4.0")
 from gi.repository import GLib, Gtk  # noqa: E402
 
+from . import accessible  # noqa: E402
+
 MAX_BANNERS = 4
 MARGIN_TOP = 8
 """Pixels between the top of the pages and the first banner (more under the navigation pill)."""
@@ -150,6 +152,7 @@ class BannerStack(Gtk.Box):
         close.add_css_class("circular")
         close.set_focusable(False)
         close.set_tooltip_text("Dismiss")
+        accessible.name(close, "Dismiss")
         close.connect("clicked", lambda _b: self.dismiss(topic))
         for child in (icon, label, bar, close):
             box.append(child)

@@ -25,6 +25,7 @@ from ..control.commands import CommandState  # noqa: E402
 from ..fleet.selected import SelectedRobot  # noqa: E402
 from ..model.observables import CameraImage, ConnectionState, Phase, RobotModel  # noqa: E402
 from ..values.intents import PauseVideo, StartVideo, StopVideo, VideoShown  # noqa: E402
+from . import accessible  # noqa: E402
 from .banners import BannerStack  # noqa: E402
 from .camera import CameraView, PictureDecoder  # noqa: E402
 from .live_video import LiveVideoControls  # noqa: E402
@@ -77,6 +78,7 @@ class CameraPage:
         """The header's camera button: pressed while the page shows."""
         self.button.set_focusable(False)
         self.button.set_tooltip_text(BUTTON_TIP)
+        accessible.name(self.button, "Camera picture")
         self.button.connect("clicked", self._button_clicked)
         # What the page holds on a robot (the head polled, the video playing) moves with the selection.
         robot.on_switch(self.ptz.follow_selection)

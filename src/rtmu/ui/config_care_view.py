@@ -35,6 +35,7 @@ from ..client.config_feed import ServerConfig  # noqa: E402
 from ..client.config_file import ConfigFileError, export_text, plan_import, read_file, write_export  # noqa: E402
 from ..protocol.payloads.config import ConfigParam  # noqa: E402
 from ..values.intents import FetchConfig, FetchConfigDefaults, Intent, ResetConfig, SetConfig  # noqa: E402
+from . import accessible  # noqa: E402
 from .confirm import Confirm  # noqa: E402
 
 Request = Callable[[Intent], "concurrent.futures.Future[Any]"]
@@ -248,6 +249,7 @@ class ConfigCare:
         if default is None or same_value(param, default):
             return None
         button = Gtk.Button(icon_name="edit-undo-symbolic", valign=Gtk.Align.CENTER)
+        accessible.name(button, "Reset to default")
         button.set_tooltip_text(f"Reset to default ({visible(default)})")
         button.set_sensitive(editable)
 

@@ -37,6 +37,7 @@ from ..base.textsafe import visible  # noqa: E402
 from ..client.config_feed import MAX_TEXT, ConfigSection, ForeignConfig, ServerConfig  # noqa: E402
 from ..protocol.payloads.config import ConfigParam, ParamType, Priority, SetConfigReply  # noqa: E402
 from ..values.intents import FetchConfig, Intent  # noqa: E402
+from . import accessible  # noqa: E402
 from .config_care_view import ConfigCare  # noqa: E402
 from .config_edits import ConfigEdits, Key  # noqa: E402
 from .discard_question import DiscardQuestion  # noqa: E402
@@ -109,6 +110,7 @@ class ConfigPage(Gtk.Window):
         bar = Gtk.Box(spacing=8)
         bar.append(Gtk.Label(label="Show up to"))
         self.priority = Gtk.DropDown.new_from_strings(list(PRIORITY_LABELS))
+        accessible.name(self.priority, "Show up to")
         self.priority.set_selected(self.show_up_to)
         self.priority.connect("notify::selected", self._priority_chosen)
         bar.append(self.priority)
@@ -358,6 +360,7 @@ class ConfigPage(Gtk.Window):
         left.set_hexpand(True)
         self.grid.attach(left, 0, row, 1, 1)
         editor = self._editor(p, key, config.editable(p))
+        accessible.name(editor, visible(p.name))  # the parameter's name from the server, as shown
         self.grid.attach(editor, 1, row, 1, 1)
         answer = Gtk.Label(xalign=0.0, wrap=True, max_width_chars=30)
         self.grid.attach(answer, 2, row, 1, 1)

@@ -38,6 +38,7 @@ from ..model.observables import ConnectionState, Phase, RobotModel  # noqa: E402
 from ..protocol.payloads.files import DirEntry  # noqa: E402
 from ..values.commission import TransfersState  # noqa: E402
 from ..values.intents import DeleteFile, DownloadFile, FetchConfig, Intent, ListFiles, SwitchMap, UploadFile  # noqa: E402
+from . import accessible  # noqa: E402
 from .confirm import Confirm  # noqa: E402
 from .files_text import greyed, human_size, parent_of, remote_join, transfer_text, when  # noqa: E402
 
@@ -86,6 +87,7 @@ class FilesPage(Gtk.Window):
             getattr(box, f"set_margin_{side}")(8)
         bar = Gtk.Box(spacing=8)
         self.up_button = Gtk.Button(icon_name="go-up-symbolic", tooltip_text="The folder above")
+        accessible.name(self.up_button, "The folder above")
         self.up_button.connect("clicked", lambda _b: self.open_folder(parent_of(self.folder)))
         bar.append(self.up_button)
         self.path_label = Gtk.Label(xalign=0.0, hexpand=True, ellipsize=Pango.EllipsizeMode.START)

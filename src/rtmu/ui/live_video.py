@@ -24,6 +24,7 @@ from gi.repository import Gdk, GLib, Gtk, Pango  # noqa: E402
 from ..fleet.sessions import RobotSession  # noqa: E402
 from ..model.observables import CameraImage  # noqa: E402
 from ..values.intents import StopVideo  # noqa: E402
+from . import accessible  # noqa: E402
 from .camera import CameraView  # noqa: E402
 
 FPS_CHOICES = (2, 5, 10, 15, 20, 30)
@@ -93,6 +94,12 @@ class LiveVideoControls:
         self.settings_button.set_tooltip_text("Video frame rate and JPEG quality")
         for w in (self.live_button, self.pause_button, self.save_button, self.settings_button):
             w.set_focusable(False)  # the arrow keys keep driving
+        accessible.name(self.live_button, "Live video")
+        accessible.name(self.pause_button, "Pause video")
+        accessible.name(self.save_button, "Save frame")
+        accessible.name(self.fps, "Frame rate")
+        accessible.name(self.quality, "JPEG quality")
+        accessible.name_menu_button(self.settings_button, "Video settings")
         self.live_button.connect("toggled", self._live_toggled)
         self.pause_button.connect("toggled", lambda b: self._paused(b.get_active()))
         self.save_button.connect("clicked", lambda _b: self.save())

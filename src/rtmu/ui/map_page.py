@@ -28,6 +28,7 @@ from ..control.commands import COMMANDS, CommandState  # noqa: E402
 from ..fleet.selected import SelectedRobot  # noqa: E402
 from ..model.observables import ConnectionState, MapModel, OperatorState, RobotModel  # noqa: E402
 from ..values.intents import AnswerPopup, GotoGoal, GotoPose, Localize  # noqa: E402
+from . import accessible  # noqa: E402
 from .dpad import DPad  # noqa: E402
 from .layers import LayersPanel  # noqa: E402
 from .mapview import MapStage  # noqa: E402
@@ -115,6 +116,7 @@ class MapPage(Gtk.Overlay):
             b.add_css_class("flat")
             b.set_focusable(False)
             b.set_action_name(action)  # the window's action, as the key's
+            accessible.name(b, accessible.spoken(tip))
             return b
 
         osd.append(button("zoom-out-symbolic", "Zoom out (Ctrl+minus)", "win.zoom-out"))

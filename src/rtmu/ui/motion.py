@@ -57,7 +57,12 @@ class MotionIndicator(Gtk.Box):
             getattr(self, f"set_margin_{side}")(8)
         self.set_can_target(False)
         self.lines: list[Gtk.Label] = []
-        for css, chars in (("motion-title", 28), ("motion-detail", 28), ("motion-hint", 36)):
+        for css, chars in (
+            ("motion-title", 28),
+            ("motion-detail", 28),
+            ("motion-hint", 36),
+            ("motion-note", 28),
+        ):
             label = Gtk.Label(xalign=0.0, max_width_chars=chars)
             label.add_css_class(css)
             label.set_ellipsize(Pango.EllipsizeMode.END)
@@ -67,6 +72,8 @@ class MotionIndicator(Gtk.Box):
         self.model = model
         self.held = held
         self.kind = ""
+        self.note = ""
+        """A fact about the motion from outside it (``idle_inhibit``: the screen is kept on)."""
         self._unobserve = [
             model.navigation.observe(lambda _o, _n: self.refresh()),
             model.connection.observe(lambda _o, _n: self.refresh()),
@@ -83,10 +90,17 @@ class MotionIndicator(Gtk.Box):
             remove()
         self._unobserve = []
 
+    def set_note(self, note: str) -> None:
+        """The last line while the pill shows (empty: none)."""
+        if note != self.note:
+            self.note = note
+            self.refresh()
+
     def refresh(self) -> None:
         link_up = self.model.connection.value.phase is Phase.CONNECTED
         by = self.held()
         kind, lines = motion_text(self.model.navigation.value, held=bool(by), link_up=link_up, by=by)
+        lines = (*lines[:3], *([""] * (3 - len(lines[:3]))), self.note) if kind else lines
         for i, label in enumerate(self.lines):
             text = lines[i] if i < len(lines) else ""
             if text != label.get_text():

@@ -21,6 +21,7 @@ gi.require_version("Gdk", "4.0")
 from gi.repository import Gdk, GLib, Gtk, Pango  # noqa: E402
 
 from ..client.custom_commands import MAX_ARGUMENT, CommandCatalogue, CustomCommand  # noqa: E402
+from . import accessible  # noqa: E402
 
 ListFn = Callable[[], "concurrent.futures.Future[Any]"]
 """Asks the network thread for the :class:`CommandCatalogue` (``ClientRunner.list_commands``)."""
@@ -57,6 +58,7 @@ class _Row(Gtk.ListBoxRow):
         if command.takes_argument:
             self.entry = Gtk.Entry(placeholder_text="argument, then Enter")
             self.entry.set_max_length(MAX_ARGUMENT)
+            accessible.name(self.entry, "Argument")
             self.entry.connect("activate", lambda _e: run(self))
             box.append(self.entry)
         self.set_child(box)

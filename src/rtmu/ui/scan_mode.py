@@ -34,6 +34,7 @@ from ..fleet.sessions import RobotSession  # noqa: E402
 from ..model.observables import Phase, RobotModel, RobotState  # noqa: E402
 from ..values.commission import ScanState, TransfersState  # noqa: E402
 from ..values.intents import DownloadFile, Intent, StartScan, StopScan, TagScanLoop  # noqa: E402
+from . import accessible  # noqa: E402
 from .confirm import Confirm  # noqa: E402
 from .files_text import human_size, transfer_text  # noqa: E402
 
@@ -164,6 +165,7 @@ class ScanBar(Gtk.Revealer):
         self.download.add_css_class("suggested-action")
         self.download.connect("clicked", lambda _b: self._choose_folder())
         self.dismiss = Gtk.Button(icon_name="window-close-symbolic", tooltip_text="Hide")
+        accessible.name(self.dismiss, "Hide the scan's panel")
         self.dismiss.connect("clicked", lambda _b: self._dismiss())
         for button in (self.loop_start, self.loop_end, self.stop_scan, self.download, self.dismiss):
             buttons.append(button)

@@ -20,6 +20,7 @@ gi.require_version("Gtk", "4.0")
 from gi.repository import Gtk  # noqa: E402
 
 from ..settings.store import DEFAULT_PORT, Profile, address_name  # noqa: E402
+from . import accessible  # noqa: E402
 from .layout import screen_size  # noqa: E402
 
 _HOST = re.compile(r"^[A-Za-z0-9]([A-Za-z0-9.\-]*[A-Za-z0-9])?$")
@@ -80,6 +81,8 @@ class ConnectionDialog(Gtk.Window):
         for name in self._profiles:
             self.profile.append(name, name)
         self.profile_entry: Gtk.Entry = self.profile.get_child()  # type: ignore[assignment]
+        accessible.name(self.profile_entry, "Profile name")
+        accessible.name_inner_toggle(self.profile, "Profiles")
         self.host = Gtk.Entry(placeholder_text="robot.local or 192.168.1.10", hexpand=True)
         self.port = Gtk.Entry(placeholder_text=str(DEFAULT_PORT), input_purpose=Gtk.InputPurpose.DIGITS)
         self.user = Gtk.Entry(placeholder_text="(none)")
@@ -116,6 +119,8 @@ class ConnectionDialog(Gtk.Window):
                 label.add_css_class("dim-label")
                 grid.attach(label, 0, 2 * i, 1, 1)
             grid.attach(widget, 1, 2 * i, 1, 1)
+            if caption:  # the caption beside it is not tied to it: the entry says its own name
+                accessible.name(widget, caption)
             message = Gtk.Label(xalign=0.0, wrap=True, max_width_chars=40, visible=False)
             message.add_css_class("field-error")
             message.set_use_markup(False)
@@ -126,9 +131,9 @@ class ConnectionDialog(Gtk.Window):
         buttons.set_margin_top(8)
         buttons.set_margin_bottom(16)
         buttons.set_margin_end(16)
-        cancel = Gtk.Button.new_with_mnemonic("_Cancel")
+        cancel = accessible.mnemonic_button("_Cancel")
         cancel.connect("clicked", lambda _b: self.close())
-        self.save = Gtk.Button.new_with_mnemonic("_Save")
+        self.save = accessible.mnemonic_button("_Save")
         self.save.add_css_class("suggested-action")
         self.save.connect("clicked", self._save)
         buttons.append(cancel)
@@ -253,9 +258,9 @@ class PasswordPrompt(Gtk.Window):
         self.entry.set_property("activates-default", True)
         box.append(self.entry)
         buttons = Gtk.Box(spacing=8, halign=Gtk.Align.END)
-        cancel = Gtk.Button.new_with_mnemonic("_Cancel")
+        cancel = accessible.mnemonic_button("_Cancel")
         cancel.connect("clicked", lambda _b: self.close())
-        ok = Gtk.Button.new_with_mnemonic("C_onnect")
+        ok = accessible.mnemonic_button("C_onnect")
         ok.add_css_class("suggested-action")
         ok.connect("clicked", self._ok)
         buttons.append(cancel)

@@ -26,6 +26,7 @@ from gi.repository import GLib, Gtk, Pango  # noqa: E402
 
 from ..base.link_timing import STATUS_CEILING  # noqa: E402
 from ..model.observables import ConnectionState, LinkLevel, OperatorState, Phase, RobotModel  # noqa: E402
+from . import accessible  # noqa: E402
 from .gauges import BatteryGauge, WifiGauge, battery_fraction, wifi_bars  # noqa: E402
 from .ld_status import details_lines, goal_suffix  # noqa: E402
 from .nav_text import loc_level, loc_text, outcome_status  # noqa: E402
@@ -58,11 +59,26 @@ class Cell(Gtk.Box):
         row.append(self.value)
         self.append(row)
         self.stale = False
+        self._said = ""
+        self._heading = caption
+        self.mark = ""
+        """A word the caption carries for a state its colour shows (``LOW``): not by colour alone."""
         self._tooltip: str | None = None
 
-    def show_value(self, text: str, *, stale: bool, tooltip: str | None = None) -> None:
+    def show_value(
+        self, text: str, *, stale: bool, tooltip: str | None = None, words: str = "", mark: str = ""
+    ) -> None:
+        """``words``: the state the value's colour shows (``low``, ``link stale``), for screen readers;
+        ``mark``: the same in one visible word after the caption (``Battery · LOW``)."""
         if self.value.get_text() != text:
             self.value.set_text(text)
+        if mark != self.mark:
+            self.mark = mark
+            self.caption.set_text(f"{self._heading} · {mark}" if mark else self._heading)
+        said = ", ".join(w for w in (words, "not current" if stale else "") if w)
+        if said != self._said:
+            self._said = said
+            accessible.describe(self.value, f"{self.caption.get_text()}: {said}" if said else "")
         if stale != self.stale:
             self.stale = stale
             if stale:
@@ -259,7 +275,7 @@ class StatusToolbar(Gtk.ScrolledWindow):
             tip = f"Localization: {text} (getLocState)"
             if level == "lost":
                 tip += ": the robot does not know where it is — Go to › Set robot position"
-            cell.show_value(text, stale=not live, tooltip=tip)
+            cell.show_value(text, stale=not live, tooltip=tip, words=level)
 
     def _dock(self, state: str | None, live: bool) -> None:
         """The docking state, shown only while the server reports one (``dockInfo``)."""
@@ -293,7 +309,9 @@ class StatusToolbar(Gtk.ScrolledWindow):
             levels.append(f"shutdown at {robot.battery_shutdown:g} {unit}")
         tip = {"low": "Battery LOW", "critical": "Battery at SHUTDOWN level"}.get(state, "Battery")
         tip += f" ({', '.join(levels)})" if levels else ""
-        cell.show_value(text, stale=stale, tooltip=(why + "\n" + tip) if why else tip)
+        words = {"low": "low", "critical": "at shutdown level"}.get(state, "")
+        mark = "" if stale else {"low": "LOW", "critical": "SHUTDOWN"}.get(state, "")
+        cell.show_value(text, stale=stale, tooltip=(why + "\n" + tip) if why else tip, words=words, mark=mark)
         for cls in ("low", "critical"):
             if cls == state and not stale:
                 cell.add_css_class(cls)
@@ -323,7 +341,9 @@ class StatusToolbar(Gtk.ScrolledWindow):
             text = {Phase.CONNECTING: "connecting", Phase.RECONNECTING: "reconnecting"}.get(
                 conn.phase, "down"
             )
-            cell.show_value(text, stale=True, tooltip=f"Not connected ({conn.phase.value})")
+            cell.show_value(
+                text, stale=True, tooltip=f"Not connected ({conn.phase.value})", words="not connected"
+            )
             cell.add_css_class(f"link-{LinkLevel.DOWN.value}")
             return
         rtt = (
@@ -352,7 +372,13 @@ class StatusToolbar(Gtk.ScrolledWindow):
                 f"Server not answering pings ({health.ping_failures} in a row): it may not hear our "
                 f"commands; driving is stopped\n{tip}"
             )
-        cell.show_value(text, stale=health.level is not LinkLevel.OK or health.ping_failures > 0, tooltip=tip)
+        cell.show_value(
+            text,
+            stale=health.level is not LinkLevel.OK or health.ping_failures > 0,
+            tooltip=tip,
+            words=f"link {health.level.value}",
+            mark="" if health.level is LinkLevel.OK else health.level.value.upper(),
+        )
         cell.add_css_class(f"link-{health.level.value}")
 
 

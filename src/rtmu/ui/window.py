@@ -1,20 +1,17 @@
 """The main window: it composes the parts, holds them, and is the controller's View. Nothing more.
 
-It shows the selected :class:`~rtmu.fleet.sessions.RobotSession` with the operator's choices and
-owns no socket, no blocking call and no feature of its own; each lives in a part: ``bars`` (the
-header, STOP first and always on screen, and the full-screen bar), ``map_page``, ``camera_page``
-(and where pictures go), ``toolbar``, ``banners``, ``actions`` (every ``win.*`` action and the
-menu), ``keys`` (the one key table), ``stop_keys`` (Space stops from every surface),
-``keyboard_nav``, ``key_reach``, ``notice_router`` (where things are said), ``window_dialogs``,
-``handheld``, ``near_people``, ``bridge_toggle``, ``why_hint`` (a still held drive asks why),
-``commissioning`` (files, scanning, map edits). A new page goes into :attr:`MainWindow.stack`, a
-new action into ``actions``, a new dialog into
-``window_dialogs``.
+It shows the selected :class:`~rtmu.fleet.sessions.RobotSession` with the operator's choices and owns no
+socket, no blocking call and no feature of its own; each lives in a part: ``bars`` (the header, STOP first
+and always on screen, and the full-screen bar), ``map_page``, ``camera_page`` (and where pictures go),
+``toolbar``, ``banners``, ``actions`` (every ``win.*`` action and the menu), ``keys`` (the one key table),
+``stop_keys`` (Space stops from every surface), ``keyboard_nav``, ``key_reach``, ``notice_router`` (where
+things are said), ``window_dialogs``, ``handheld``, ``near_people``, ``bridge_toggle``, ``why_hint`` (a
+still held drive asks why), ``commissioning`` (files, scanning, map edits), ``desktop_citizen``. A new page
+goes into :attr:`MainWindow.stack`, a new action into ``actions``, a new dialog into ``window_dialogs``.
 
-Its two timers are the UI's heartbeat: every :data:`rtmu.control.controller.TICK` it renews the
-drive lease (``controller.tick``) — if this loop ever stalls, the lease lapses and the network
-side stops the robot — and it beats for the guardian process; every :data:`REFRESH_EVERY` ticks
-it refreshes ages (stale values, picture age).
+Its two timers are the UI's heartbeat: every :data:`rtmu.control.controller.TICK` it renews the drive lease
+(``controller.tick``) — if this loop stalls, the lease lapses and the network side stops the robot — and
+beats for the guardian process; every :data:`REFRESH_EVERY` ticks it refreshes ages (stale values, pictures).
 """
 
 from __future__ import annotations
@@ -42,6 +39,7 @@ from .bars import FullscreenBar, HeaderBar  # noqa: E402
 from .bridge_toggle import BridgeToggle  # noqa: E402
 from .camera_page import CameraPage  # noqa: E402
 from .commissioning import Commissioning  # noqa: E402
+from .desktop_citizen import DesktopCitizen  # noqa: E402
 from .details import DetailsWindow  # noqa: E402
 from .drive_input import DriveInput  # noqa: E402
 from .goals_panel import GoalsPanel  # noqa: E402
@@ -191,6 +189,9 @@ class MainWindow(Gtk.ApplicationWindow):
         self.key_reach = KeyReach(self)
         self.keyboard = KeyboardNav(self)  # Tab, F10, Ctrl+G, Alt+1…9, a pick mode's keys
         self.near_people = NearPeopleSwitch(self)  # View ▸ Near people: the speed cap
+        self.desktop = DesktopCitizen(
+            self, model, self.motion, self.view_menu
+        )  # screen kept on, notifications
 
     @property
     def session(self) -> RobotSession:
@@ -362,6 +363,7 @@ class MainWindow(Gtk.ApplicationWindow):
         self.banners.keep_clear_of(self.motion, self.camera_page.motion)
         if slow:
             self.toolbar.refresh()
+            self.desktop.refresh()  # no screen lock or suspend while the robot moves
             self.camera_page.tick()
             loop_lag = getattr(self.controller.link, "loop_lag", None)  # a stalled network thread: said
             # A replay sends nothing (and its clock is the recording's): no "stops are not going out".
@@ -391,7 +393,7 @@ class MainWindow(Gtk.ApplicationWindow):
             remove()
         self._unobserve = []
         parts: tuple[_Part, ...] = (self.handheld, self.stop_keys, self.key_reach, self.near_people)
-        for part in (*parts, self.map_page, self.toolbar, self.routes_panel, self.goals_panel):
+        for part in (*parts, self.desktop, self.map_page, self.toolbar, self.routes_panel, self.goals_panel):
             part.close()
         for part in (self.camera_page, self.foxglove, self.actions, self.commissioning):
             part.close()

@@ -204,10 +204,9 @@ class WindowDialogs:
 
     # -- About -----------------------------------------------------------------------------------
     def show_about(self) -> None:
-        from .. import __version__
-
-        about = about_dialog(self.window, __version__)
-        about.present()
+        """Help ▸ About, with the debug information of the robot shown (``about``)."""
+        conn = self.model.connection.value
+        about_dialog(self.window, conn, self.robot.session.controller.profile.name).present()
 
     # -- the controller's dialogs: Turn, Go, the palette -----------------------------------------
     def open_dialog(self, name: str) -> None:

@@ -396,6 +396,12 @@ class ConnectionState:
     """Reconnect attempt number while RECONNECTING."""
     retry_in: float | None = None
     """Seconds until the next reconnect attempt, if one is planned."""
+    server_tag: str = ""
+    """The version tag of the server's introduction (what About's debug information quotes)."""
+    server_protocol: str = ""
+    """The protocol string the server's introduction asked for, as sent (untrusted text)."""
+    sent_protocol: str = ""
+    """The protocol string this client answered with."""
 
     @property
     def connected(self) -> bool:
