@@ -57,10 +57,10 @@ STOP_WAIT = 2.0
 class _Server:
     """``bench.soak_server`` in a child process, and the drive packets it reports."""
 
-    def __init__(self) -> None:
+    def __init__(self, *argv: str) -> None:
         repo = Path(__file__).resolve().parents[1]
         self.proc = subprocess.Popen(
-            [sys.executable, "-m", "bench.soak_server"],
+            [sys.executable, "-m", *(argv or ("bench.soak_server",))],
             cwd=repo,
             stdin=subprocess.PIPE,
             stdout=subprocess.PIPE,

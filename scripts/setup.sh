@@ -18,14 +18,19 @@ APT_PACKAGES=(
     gir1.2-gtk-4.0 gir1.2-adw-1 gir1.2-manette-0.2 libgirepository1.0-dev libcairo2-dev pkg-config
     build-essential xvfb xdotool openbox x11-utils xxd bsdextrautils
     appstream desktop-file-utils dbus git
+    at-spi2-core python3-pyatspi
 )
 # Every program the app, tests, bench and scripts start -> the package above that installs it
 # ("essential": in every Debian install). tests/test_setup_programs.py keeps this true.
 # A program may come from a direct dependency of the package named (dbus brings the session bus's
 # daemon: Debian 12 splits it into dbus-daemon, Ubuntu 22.04's dbus holds it). Not dbus-x11: its
 # dbus-launch makes GLib start a stray bus of its own wherever DBUS_SESSION_BUS_ADDRESS is unset.
+# at-spi2-core's at-spi-bus-launcher starts an accessibility bus (the AT-SPI test starts its own on a
+# private session bus); python3-pyatspi is what that test reads the window with, as a screen reader does
+# (linked into the venv below: it is a system package only).
 PROGRAM_PACKAGES=(
     Xvfb=xvfb xdotool=xdotool openbox=openbox xwininfo=x11-utils xprop=x11-utils bash=essential
+    at-spi-bus-launcher=at-spi2-core
     xxd=xxd hexdump=bsdextrautils od=essential
     appstreamcli=appstream desktop-file-validate=desktop-file-utils
     dbus-daemon=dbus dbus-run-session=dbus git=git
@@ -217,10 +222,29 @@ ensure_project() {
     say "python packages installed"
 }
 
+# -- 4. the system's pyatspi in the venv ----------------------------------------------------------
+# pyatspi is pure Python over GObject introspection and exists only as a distribution package, not on
+# PyPI. The venv (without --system-site-packages, so the system's other Python packages never shadow the
+# pinned ones) gets a link to that one package; the venv's own PyGObject loads the Atspi typelib.
+ensure_pyatspi() {
+    have dpkg-query || return 0
+    local init src site
+    init=$(dpkg-query -L python3-pyatspi 2>/dev/null | grep -m1 '/pyatspi/__init__.py$' || true)
+    [ -n "$init" ] || return 0 # not a Debian-like system, or not installed: the AT-SPI test says so
+    src=${init%/__init__.py}
+    for site in "$VENV"/lib/python3*/site-packages; do
+        [ -d "$site" ] || continue # no venv yet (or another layout): nothing to link into
+        [ "$(readlink "$site/pyatspi" 2>/dev/null)" = "$src" ] && continue
+        ln -sfn "$src" "$site/pyatspi"
+        say "linked the system's pyatspi into $site"
+    done
+}
+
 main() {
     ensure_system_packages
     ensure_venv
     ensure_project
+    ensure_pyatspi
     # Nothing is installed into the user's desktop from here: that is 'rtmu --install-desktop', on request.
 }
 

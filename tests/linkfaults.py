@@ -14,6 +14,14 @@ Every fault method returns the ``time.monotonic()`` at which it took effect (``f
 test or bench can measure how long the client took to react as seen by the server. Threads only
 (two per direction per connection, plus the acceptor); buffers are bounded (a full buffer stops
 reading, which is back-pressure as over TCP); :meth:`close` ends every thread within a second.
+
+Real Wi-Fi loses nothing a TCP stream can see, but holds it: 802.11 retries, background scans and
+contention stall a direction for tens to hundreds of ms now and then, and a lost segment costs a
+retransmission timeout (Linux: at least 200 ms, doubled per loss in a row). :meth:`play` plays a
+:class:`WifiProfile` — stalls at a Poisson rate with lengths drawn from a range, per-chunk jitter,
+loss bursts as retransmission stalls — until :meth:`restore`; :meth:`roam` is a 1–2 s gap in both
+directions, as when a robot moves between access points. Stalls hold bytes, in order, never drop
+them; :attr:`stalls` lists what was played (start, seconds, directions), seeded, so a run repeats.
 """
 
 from __future__ import annotations
@@ -25,6 +33,7 @@ import struct
 import threading
 import time
 from collections.abc import Callable
+from dataclasses import dataclass
 from typing import Literal
 
 Direction = Literal["to_client", "to_server"]
@@ -38,6 +47,38 @@ GARBAGE = random.Random(15).randbytes(1024)
 """1 KiB of line noise (fixed seed): no valid packet in it."""
 MAX_BUFFER = 4 * 1024 * 1024
 READ_CHUNK = 65536
+RTO_MIN = 0.2
+"""Linux's minimum TCP retransmission timeout: what one lost segment costs a stream."""
+
+
+@dataclass(frozen=True)
+class WifiProfile:
+    """How a Wi-Fi link holds a stream (see the module notes); rates are per second, lengths in s."""
+
+    name: str
+    stall_rate: float = 0.0
+    """Stalls per second (Poisson)."""
+    stall_min: float = 0.0
+    stall_max: float = 0.0
+    stall_directions: tuple[Direction, ...] = (TO_CLIENT,)
+    jitter: float = 0.0
+    """Each chunk is delayed by 0…``jitter`` s more (order kept)."""
+    loss_rate: float = 0.0
+    """Loss bursts per second (Poisson), either direction: 1…``loss_burst`` segments lost in a row."""
+    loss_burst: int = 1
+
+    def loss_stall(self, lost: int) -> float:
+        """The retransmission stall ``lost`` segments in a row cost (the timeout doubles each time)."""
+        return RTO_MIN * (2**lost - 1)
+
+
+GOOD_WIFI = WifiProfile("good", stall_rate=0.1, stall_min=0.05, stall_max=0.15, jitter=0.005)
+"""The issue's "good Wi-Fi": the server→client direction held 50–150 ms about every 10 s."""
+BUSY_WIFI = WifiProfile("busy", stall_rate=1 / 3, stall_min=0.1, stall_max=0.3, jitter=0.02)
+"""The issue's "busy Wi-Fi": held 100–300 ms about every 3 s, and 0–20 ms jitter on every chunk."""
+LOSSY_WIFI = WifiProfile("lossy", jitter=0.01, loss_rate=0.2, loss_burst=1)
+"""One lost segment about every 5 s in either direction: a 200 ms retransmission stall each."""
+PROFILES = {p.name: p for p in (GOOD_WIFI, BUSY_WIFI, LOSSY_WIFI)}
 
 
 class _Pipe:
@@ -48,7 +89,7 @@ class _Pipe:
         self.direction = direction
         self.src = src
         self.dst = dst
-        self.queue: collections.deque[tuple[float, bytes]] = collections.deque()
+        self.queue: collections.deque[tuple[float, bytes, bool]] = collections.deque()
         self.queued = 0
         self.cond = threading.Condition()
         self.done = False
@@ -59,12 +100,19 @@ class _Pipe:
         for t in self.threads:
             t.start()
 
-    def put(self, data: bytes) -> None:
+    def put(self, data: bytes, *, raw: bool = False) -> None:
         tap = self.proxy.tap
-        if tap is not None:  # before it is queued: a fault the tap sets applies to what follows
+        if tap is not None and not raw:  # before it is queued: a fault the tap sets applies to what follows
             tap(self.direction, data)
+        clean = not raw
+        if not raw and self.direction in self.proxy.garbled:
+            data = self.proxy.noise(len(data))
+            clean = False
         with self.cond:
-            self.queue.append((time.monotonic() + self.proxy.delays[self.direction], data))
+            due = time.monotonic() + self.proxy.delays[self.direction] + self.proxy.chunk_jitter()
+            if self.queue:
+                due = max(due, self.queue[-1][0])  # jitter never reorders a stream
+            self.queue.append((due, data, clean))
             self.queued += len(data)
             self.cond.notify_all()
 
@@ -90,10 +138,10 @@ class _Pipe:
                         if self.done and not self.queue:
                             return
                         if self.queue and self.direction not in self.proxy.muted:
-                            due = self.queue[0][0]
+                            due = max(self.queue[0][0], self.proxy.held_until[self.direction])
                             wait = due - time.monotonic()
                             if wait <= 0:
-                                _, data = self.queue.popleft()
+                                _, data, clean = self.queue.popleft()
                                 self.queued -= len(data)
                                 self.cond.notify_all()
                                 break
@@ -103,6 +151,8 @@ class _Pipe:
                         else:
                             self.cond.wait(0.1)
                 self.dst.sendall(data)
+                if clean:
+                    self.proxy.delivered_at[self.direction] = self.proxy.clock()
         except OSError:
             pass
         finally:
@@ -154,10 +204,25 @@ class _Link:
 class FaultProxy:
     """Listens on 127.0.0.1 (ephemeral port), forwards each connection to ``target``; see the module notes."""
 
-    def __init__(self, host: str, port: int) -> None:
+    def __init__(self, host: str, port: int, *, clock: Callable[[], float] = time.monotonic) -> None:
         self.target = (host, port)
+        self.clock = clock
+        """Stamps :attr:`delivered_at` (a test passes the simulator's clock)."""
+        self.delivered_at: dict[Direction, float | None] = {TO_CLIENT: None, TO_SERVER: None}
+        """When the last of the server's own bytes (not injected, not garbled) went out each way."""
         self.muted: set[Direction] = set()
         self.delays: dict[Direction, float] = {TO_CLIENT: 0.0, TO_SERVER: 0.0}
+        self.garbled: set[Direction] = set()
+        """Directions whose bytes are replaced by line noise of the same length (:meth:`garble`)."""
+        self._noise = random.Random(16)
+        self.held_until: dict[Direction, float] = {TO_CLIENT: 0.0, TO_SERVER: 0.0}
+        """Bytes going each way wait until this ``time.monotonic()`` (a stall or a roam)."""
+        self.stalls: list[tuple[float, float, tuple[Direction, ...]]] = []
+        """What :meth:`play` and :meth:`roam` held: (start, seconds, directions)."""
+        self._profile: WifiProfile | None = None
+        self._jitter_rng = random.Random(0)
+        self._player: threading.Thread | None = None
+        self._playing = threading.Event()
         self.fault_at: float | None = None
         """``time.monotonic()`` when the last fault took effect (None: none yet)."""
         self.connections = 0
@@ -219,10 +284,7 @@ class FaultProxy:
                 self._links.append(_Link(self, client, server))
 
     def _applied(self) -> float:
-        with self._lock:
-            for link in self._links:
-                for pipe in link.pipes.values():
-                    pipe.wake()
+        self._wake()
         self.fault_at = time.monotonic()
         return self.fault_at
 
@@ -243,9 +305,93 @@ class FaultProxy:
         with self._lock:
             links = list(self._links)
         for link in links:
-            link.pipes[direction].put(data)
+            link.pipes[direction].put(data, raw=True)
         self.fault_at = time.monotonic()
         return self.fault_at
+
+    def garble(self, *directions: Direction) -> float:
+        """From now on replace every byte going ``directions`` (default: server→client) by noise."""
+        self.garbled.update(directions or (TO_CLIENT,))
+        return self._applied()
+
+    def noise(self, n: int) -> bytes:
+        return self._noise.randbytes(n).replace(b"\x0f\x0c", b"\x0f\x0d")  # never a sync pair
+
+    def stalling_header(self) -> float:
+        """A fake header that holds the stream: nothing valid follows it (the rest is garbled)."""
+        at = self.inject(FAKE_HEADER)
+        self.garble(TO_CLIENT)
+        self.fault_at = at
+        return at
+
+    def hold(self, seconds: float, *directions: Direction) -> float:
+        """Hold every byte going ``directions`` (default: both) for ``seconds`` from now, in order."""
+        now = time.monotonic()
+        directions = directions or BOTH
+        for d in directions:
+            self.held_until[d] = max(self.held_until[d], now + seconds)
+        self.stalls.append((now, seconds, tuple(directions)))
+        self._wake()
+        return now
+
+    def roam(self, seconds: float = 1.5) -> float:
+        """A robot moving between access points: nothing in either direction for ``seconds``."""
+        self.fault_at = self.hold(seconds, *BOTH)
+        return self.fault_at
+
+    def play(self, profile: WifiProfile, seed: int = 0) -> None:
+        """Play ``profile`` (stalls, jitter, loss stalls) from now until :meth:`restore` or :meth:`close`."""
+        self.stop_playing()
+        self._profile = profile
+        self._jitter_rng = random.Random(seed + 1)
+        self._playing.set()
+        rng = random.Random(seed)
+        self._player = threading.Thread(
+            target=self._play, args=(profile, rng), name=f"linkfaults-{profile.name}", daemon=True
+        )
+        self._player.start()
+
+    def _play(self, profile: WifiProfile, rng: random.Random) -> None:
+        rate = profile.stall_rate + profile.loss_rate
+        while rate > 0 and self._playing.is_set() and not self._closed.is_set():
+            wait = rng.expovariate(rate)
+            end = time.monotonic() + wait
+            while self._playing.is_set() and time.monotonic() < end:
+                time.sleep(min(0.05, max(0.0, end - time.monotonic())))
+            if not self._playing.is_set():
+                return
+            if rng.random() * rate < profile.stall_rate:
+                length = rng.uniform(profile.stall_min, profile.stall_max)
+                self.hold(length, *profile.stall_directions)
+            else:
+                length = profile.loss_stall(rng.randint(1, max(1, profile.loss_burst)))
+                self.hold(length, rng.choice(BOTH))
+            # The next stall starts after this one ends: stalls never merge into a longer one
+            # than the profile says (the gaps between them are Poisson).
+            end = time.monotonic() + length
+            while self._playing.is_set() and time.monotonic() < end:
+                time.sleep(min(0.05, max(0.0, end - time.monotonic())))
+
+    def stop_playing(self) -> None:
+        """End a :meth:`play` (stalls under way run out; no new ones start)."""
+        self._playing.clear()
+        self._profile = None
+        player, self._player = self._player, None
+        if player is not None and player is not threading.current_thread():
+            player.join(1.0)
+
+    def chunk_jitter(self) -> float:
+        profile = self._profile
+        if profile is None or profile.jitter <= 0:
+            return 0.0
+        return self._jitter_rng.uniform(0.0, profile.jitter)
+
+    def _wake(self) -> None:
+        with self._lock:
+            links = list(self._links)
+        for link in links:
+            for pipe in link.pipes.values():
+                pipe.wake()
 
     def reset(self) -> float:
         """Abort every open connection with an RST to both ends (new connections still work)."""
@@ -257,9 +403,12 @@ class FaultProxy:
         return self.fault_at
 
     def restore(self) -> None:
-        """No mute, no delay: held bytes flow again in order."""
+        """No mute, no delay, no profile, no stall: held bytes flow again in order."""
+        self.stop_playing()
+        self.garbled.clear()
         self.muted.clear()
         self.delays = {TO_CLIENT: 0.0, TO_SERVER: 0.0}
+        self.held_until = {TO_CLIENT: 0.0, TO_SERVER: 0.0}
         at = self.fault_at
         self._applied()
         self.fault_at = at
@@ -267,6 +416,7 @@ class FaultProxy:
     def close(self) -> None:
         """Stop accepting, close every connection, join the threads (bounded)."""
         self._closed.set()
+        self.stop_playing()
         self._listener.close()
         with self._lock:
             links, self._links = self._links, []

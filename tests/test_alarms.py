@@ -64,11 +64,22 @@ def test_wifi_quality_hysteresis() -> None:
             (e.severity, e.sound) for e in m.update(RobotState(wifi_quality=q), OK) if e.alarm is Alarm.WIFI
         ]
 
-    assert wifi(60) == []
-    assert wifi(19) == [(Severity.WARNING, True)]
-    assert wifi(22) == [] and wifi(27) == [] and wifi(10) == []
-    assert wifi(28) == [(Severity.CLEAR, False)]
-    assert wifi(21) == []
+    assert wifi(86) == []
+    assert wifi(27) == [(Severity.WARNING, True)]
+    assert wifi(31) == [] and wifi(39) == [] and wifi(14) == []
+    assert wifi(40) == [(Severity.CLEAR, False)]
+    assert wifi(30) == []
+
+
+def test_the_wifi_alarm_says_the_percent_the_toolbar_shows() -> None:
+    """One unit: the banner said "10/70" where the toolbar said "14 %" (issue 21)."""
+    m = AlarmMonitor()
+    (event,) = m.update(RobotState(wifi_quality=14), OK)
+    assert event.text == "Weak Wi-Fi on the robot: link quality 14 %"
+    assert m.update(RobotState(wifi_quality=20), OK) == [], "no new event, no beep"
+    assert m.words[Alarm.WIFI] == "Weak Wi-Fi on the robot: link quality 20 %", "the words follow the value"
+    m.update(RobotState(wifi_quality=50), OK)
+    assert Alarm.WIFI not in m.words
 
 
 def test_round_trip_and_unanswered_pings() -> None:
@@ -114,3 +125,27 @@ def test_the_mute_is_remembered_in_settings_and_checked() -> None:
     assert "alarms_muted = true" in text and parse_settings(text).alarms_muted is True
     with pytest.raises(SettingsError, match="alarms_muted"):
         parse_settings('version = 1\nalarms_muted = "yes"\n')
+
+
+@pytest.mark.parametrize(
+    "docked",
+    [{"dock_state": "Docked"}, {"status": "Docked"}],
+    ids=["dockInfo", "status"],
+)
+def test_a_low_battery_on_its_dock_is_charging_not_an_alarm(docked: dict[str, str]) -> None:
+    """ "Bring the robot to its charger" is a lie once it is there: docked, the low banner gives way to a
+    charging note; undocked while still low, it is raised (and beeps) again (issue 21)."""
+    m = AlarmMonitor()
+    low = RobotState(battery_v=11.4, battery_low=11.5, battery_shutdown=11.0)
+    assert [(e.severity, e.sound) for e in m.update(low, OK)] == [(Severity.WARNING, True)]
+    on_dock = RobotState(battery_v=11.4, battery_low=11.5, battery_shutdown=11.0, **docked)  # type: ignore[arg-type]
+    events = m.update(on_dock, OK)
+    assert [(e.severity, e.text) for e in events] == [
+        (Severity.CLEAR, "Battery low (11.4 V), charging on its dock")
+    ]
+    assert m.update(on_dock, OK) == [], "said once"
+    assert [(e.severity, e.sound) for e in m.update(low, OK)] == [(Severity.WARNING, True)], "undocked"
+    critical = RobotState(battery_v=10.9, battery_low=11.5, battery_shutdown=11.0, **docked)  # type: ignore[arg-type]
+    assert [e.severity for e in m.update(critical, OK)] == [Severity.CRITICAL], "critical even docked"
+    undocking = RobotState(battery_v=11.4, battery_low=11.5, battery_shutdown=11.0, dock_state="Undocking")
+    assert [e.severity for e in m.update(undocking, OK)] == [Severity.WARNING]

@@ -108,3 +108,37 @@ def test_an_edit_of_a_parameter_the_server_dropped_is_invalid() -> None:
     edits.fetched(ServerConfig((ConfigSection("Teleop", "", (TIMEOUT,)),)))
     assert edits.invalid() == {("Robot", "Name"): "no longer offered by the server"}
     assert ConfigEdits().status() == "" and ConfigEdits().invalid() == {}
+
+
+def test_a_value_out_of_its_limits_is_refused_in_words_not_clamped() -> None:
+    """The spin button puts the held value back rather than clamp 99 to 10: the row says so (issue 21)."""
+    edits, key = loaded(), ("Teleop", "Timeout")
+    assert edits.edit(key, TIMEOUT, "99")
+    assert edits.note(key, TIMEOUT) == RowNote("✗ above the maximum of 10", "error")
+    assert edits.edit(key, TIMEOUT, ""), "a spin button empties itself before it shows a value"
+    assert edits.edit(key, TIMEOUT, "2.00"), "the editor put the held value back"
+    assert edits.edits == {}
+    assert edits.note(key, TIMEOUT) == RowNote("✗ 99 not taken: above the maximum of 10 (still 2)", "error")
+    assert edits.edit(key, TIMEOUT, "3.00")
+    assert edits.note(key, TIMEOUT) == RowNote("edited", "edited"), "the next edit ends the refusal"
+
+
+def test_an_accepted_answer_goes_when_another_client_changes_the_value() -> None:
+    edits, key = loaded(), ("Teleop", "Timeout")
+    edits.edit(key, TIMEOUT, "0.50")
+    found = edits.save_intent()
+    assert found is not None
+    edits.saved(found[0], SetConfigReply(""))
+    edits.fetched(config(0.5))
+    assert edits.note(key, TIMEOUT) == RowNote("✓ accepted", "ok"), "the value it was for is held"
+    edits.fetched(config(3.0))  # another client set 3
+    assert edits.note(key, TIMEOUT) == RowNote(), "no tick beside a value nobody here set"
+
+
+def test_a_separator_is_no_parameter() -> None:
+    line = ConfigParam("", ParamType.SEPARATOR)
+    both = ServerConfig((ConfigSection("Teleop", "", (TIMEOUT, line, SAFE)),))
+    assert both.param_count == 2
+    edits = ConfigEdits()
+    edits.fetched(both)
+    assert edits.status() == "2 parameters"

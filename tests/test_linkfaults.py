@@ -1,4 +1,5 @@
-"""The fault proxy (tests/linkfaults.py) against a loopback echo server: each fault does what it says."""
+"""The lab: the fault proxy (tests/linkfaults.py) against a loopback echo server — each fault and Wi-Fi
+profile does what it says — and the CPU-load generator (tests/cpuload.py)."""
 
 from __future__ import annotations
 
@@ -9,7 +10,19 @@ from collections.abc import Iterator
 
 import pytest
 
-from linkfaults import FAKE_HEADER, TO_CLIENT, TO_SERVER, FaultProxy
+from cpuload import CpuLoad, niceness, wait_busy
+from linkfaults import (
+    BUSY_WIFI,
+    FAKE_HEADER,
+    GOOD_WIFI,
+    LOSSY_WIFI,
+    PROFILES,
+    RTO_MIN,
+    TO_CLIENT,
+    TO_SERVER,
+    FaultProxy,
+    WifiProfile,
+)
 
 
 @pytest.fixture
@@ -104,3 +117,82 @@ def test_close_ends_every_thread() -> None:
         assert p.port
     time.sleep(0.05)
     assert not [t for t in threading.enumerate() if t.name.startswith("linkfaults") and t.name not in before]
+
+
+def _echoed(sock: socket.socket, sent: bytes, timeout: float = 5.0) -> bytes:
+    got = b""
+    sock.settimeout(timeout)
+    while len(got) < len(sent):
+        got += sock.recv(65536)
+    return got
+
+
+def test_a_hold_delays_one_direction_then_delivers_everything_in_order(proxy: FaultProxy) -> None:
+    with _client(proxy) as sock:
+        proxy.hold(0.4, TO_CLIENT)
+        sock.sendall(b"abc")
+        assert _quiet(sock, 0.2)  # held…
+        assert _echoed(sock, b"abc") == b"abc"  # …then delivered
+        assert proxy.stalls[-1][1:] == (0.4, (TO_CLIENT,))
+
+
+def test_a_roam_holds_both_directions(proxy: FaultProxy) -> None:
+    with _client(proxy) as sock:
+        at = proxy.roam(0.5)
+        assert proxy.fault_at == at
+        sock.sendall(b"r")
+        assert _quiet(sock, 0.3)
+        assert _echoed(sock, b"r") == b"r"
+        assert proxy.held_until[TO_SERVER] == proxy.held_until[TO_CLIENT] == pytest.approx(at + 0.5)
+
+
+def test_a_wifi_profile_stalls_and_jitters_but_loses_and_reorders_nothing(proxy: FaultProxy) -> None:
+    storm = WifiProfile("storm", stall_rate=20, stall_min=0.01, stall_max=0.03, jitter=0.01, loss_rate=5)
+    with _client(proxy) as sock:
+        proxy.play(storm, seed=3)
+        sent = b"".join(i.to_bytes(2, "big") for i in range(400))
+        for i in range(0, len(sent), 8):
+            sock.sendall(sent[i : i + 8])
+            time.sleep(0.002)
+        assert _echoed(sock, sent, timeout=10) == sent
+        proxy.restore()
+    assert len(proxy.stalls) >= 3  # ~25 a second for the ~1 s the bytes took
+    assert any(seconds == pytest.approx(RTO_MIN) for _at, seconds, _d in proxy.stalls)  # a loss
+    assert {p.name for p in (GOOD_WIFI, BUSY_WIFI, LOSSY_WIFI)} == set(PROFILES)
+
+
+def test_cpu_load_spins_at_its_niceness_and_always_ends() -> None:
+    with CpuLoad(count=2, nice=19, seconds=30) as load:
+        assert wait_busy(load)
+        assert [niceness(p.pid) for p in load.procs] == [19, 19]
+        pids = [p.pid for p in load.procs]
+    assert all(niceness(pid) is None for pid in pids)  # ended with the block
+    short = CpuLoad(count=1, nice=19, seconds=0.3).start()  # …and by itself, however it is left
+    try:
+        short.procs[0].wait(10)
+    finally:
+        short.stop()
+    with pytest.raises(ValueError):
+        CpuLoad(nice=-5)
+    with pytest.raises(ValueError):
+        CpuLoad(seconds=0)
+
+
+def test_garble_turns_a_direction_into_noise_of_the_same_length(proxy: FaultProxy) -> None:
+    with _client(proxy) as sock:
+        proxy.garble(TO_CLIENT)
+        sent = b"\x0f\x0c" * 100
+        sock.sendall(sent)
+        got = _echoed(sock, sent)
+        assert len(got) == len(sent) and got != sent and b"\x0f\x0c" not in got
+        proxy.restore()
+        sock.sendall(b"ok")
+        assert _echoed(sock, b"ok") == b"ok"
+
+
+def test_a_stalling_header_is_a_real_header_then_noise(proxy: FaultProxy) -> None:
+    with _client(proxy) as sock:
+        proxy.stalling_header()
+        assert _echoed(sock, FAKE_HEADER) == FAKE_HEADER
+        sock.sendall(b"abcd")
+        assert _echoed(sock, b"abcd") != b"abcd"

@@ -38,6 +38,9 @@ def test_motion_says_autonomous_or_held_and_nothing_without_a_link() -> None:
         ("Navigating (autonomous)", "To Lab B", "12.4 m left · Space or STOP cancels"),
     )
     assert motion_text(NavState(), held=True, link_up=True)[0] == "held"
+    assert motion_text(NavState(), held=True, link_up=True)[1][0] == "Driving (held keys)"
+    dpad = motion_text(NavState(), held=True, link_up=True, by="dpad")
+    assert dpad == ("held", ("Driving (D-pad held)", "Let go to stop")), "a D-pad drive is no held key"
     assert motion_text(NavState(), held=False, link_up=True) == ("", ())
     assert motion_text(GOING, held=False, link_up=False) == ("", ()), "the link banner says it then"
     assert (

@@ -9,7 +9,7 @@ from dataclasses import dataclass, field
 import pytest
 
 from rtmu.base.notices import Kind, Notice
-from rtmu.model.observables import ConnectionState, NavState, Phase, SpeedSetting
+from rtmu.model.observables import ConnectionState, LinkLevel, NavState, Phase, SpeedSetting
 from rtmu.settings.store import Profile
 from rtmu.ui.notes import status_line
 from rtmu.ui.notice_router import (
@@ -17,6 +17,7 @@ from rtmu.ui.notice_router import (
     Dismiss,
     NoticeRouter,
     Route,
+    link_back_banner,
     link_banner,
     loop_lag_banner,
     route,
@@ -109,6 +110,10 @@ class Told:
         topics = [topic for topic, *_ in self.shown]
         return [t for t in dict.fromkeys(topics) if t not in self.gone]
 
+    def text(self, topic: str) -> str | None:
+        said = [text for t, _level, text, *_ in self.shown if t == topic]
+        return said[-1] if said and topic in self.topics() else None
+
 
 @dataclass
 class Picture:
@@ -135,6 +140,31 @@ def test_the_router_fails_a_waiting_picture_only_for_a_camera_notice() -> None:
     assert told.shown[-1][0] == "loop"
     router.loop_lag(0.1, connected=True)
     assert told.gone == ["link", "loop"]
+
+
+def test_a_link_stop_banner_goes_once_the_link_is_healthy_again() -> None:
+    """ "Stopped: the link is stale" is true while it is up; a healthy link for a second ends it, and
+    a later healthy drive never runs under it (issue 21)."""
+    assert link_back_banner("Stopped: the link is stale. Press again once it is back.", 0.5) is None
+    back = link_back_banner("Stopped: the link is stale. Press again once it is back.", 1.2)
+    assert back == Banner("link", "info", "The link is back: press a key to drive again", 4.0)
+    assert link_back_banner("Stopped: the link is lost.", None) is None, "still unhealthy"
+    assert link_back_banner("Link lost — reconnecting (2)…", 5.0) is None, "the connection's own banner"
+    assert link_back_banner(None, 5.0) is None
+
+    told, now = Told(), [0.0]
+    router = NoticeRouter(
+        told, connection=lambda: CONNECTED, speed_percent=lambda: 50, picture=Picture, clock=lambda: now[0]
+    )
+    router.show(Notice.warning(Kind.LINK, "Stopped: the link is stale. Press again once it is back."))
+    stale, ok = LinkLevel.STALE, LinkLevel.OK
+    for t, level in ((0.1, stale), (0.5, ok), (1.2, stale), (1.4, ok)):
+        now[0] = t
+        router.link_health(level)
+    assert told.text("link").startswith("Stopped"), "never healthy for a whole second yet"  # type: ignore[union-attr]
+    now[0] = 2.5
+    router.link_health(LinkLevel.OK)
+    assert told.text("link") == "The link is back: press a key to drive again"
 
 
 def test_a_stalled_network_thread_is_said_until_it_runs_again() -> None:

@@ -14,7 +14,7 @@ from rtmu.client.ptz import pick_camera
 from rtmu.client.server_strings import StringsFeed
 from rtmu.protocol.payloads.camera import Camera, CameraCommand, CameraInfo
 from rtmu.protocol.payloads.strings import StringsInfo
-from rtmu.sim.handlers import CAMERA_COMMANDS
+from rtmu.sim.camera_data import CAMERA_COMMANDS
 from test_golden_captures import decoded
 
 # getCameraList's command table for Cam1 as serverDemo sends it (protocol §4.6), without video.

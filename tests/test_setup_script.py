@@ -37,6 +37,8 @@ OTHER_PACKAGES = [
     "desktop-file-utils",
     "dbus",
     "git",
+    "at-spi2-core",
+    "python3-pyatspi",
 ]
 TOOLS = [
     "awk",

@@ -43,8 +43,9 @@ MAY_IMPORT: dict[str, frozenset[str]] = {
     # What --version (and later the About window) says: the protocol's facts and the libraries' versions.
     "about": frozenset({"codec", "base"}),
     # The stop process: its halt and its login go through the codec on a plain socket. It never imports
-    # the client it guards against (nor asyncio, numpy or GTK: it starts light).
-    "guardian": frozenset({"codec"}),
+    # the client it guards against (nor asyncio, numpy or GTK: it starts light). From base it takes the
+    # one rule for how late a stream may be (base.link_timing), shared with the client's link health.
+    "guardian": frozenset({"codec", "base"}),
     # The network side knows the values it publishes, never the UI thread's state above it.
     "client": frozenset({"guardian", "values", "codec", "maps", "base"}),
     "simulator": frozenset({"codec", "maps", "base"}),
@@ -57,7 +58,8 @@ MAY_IMPORT: dict[str, frozenset[str]] = {
         {"control", "client", "guardian", "recorder", "ui-state", "values", "settings", "base"}
     ),
     # The window may start the bundled simulator (--demo) and play a recording back (rtmu replay: the
-    # recorder's clock and feeder); it never reaches the command line.
+    # recorder's clock and feeder); its About window says what --version says; it never reaches the
+    # command line.
     "view": frozenset(
         {
             "fleet",
@@ -70,6 +72,7 @@ MAY_IMPORT: dict[str, frozenset[str]] = {
             "settings",
             "simulator",
             "codec",
+            "about",
             "base",
         }
     ),

@@ -188,6 +188,50 @@ def test_a_stale_link_noticed_first_by_the_drive_loop_is_still_told_once() -> No
     assert not rig.lease.live
 
 
+def stops(rig: Rig) -> list[str]:
+    return [t for t in rig.view.texts() if t.startswith("Stopped")]
+
+
+def test_a_stop_for_the_link_says_the_network_sides_measured_cause_once() -> None:
+    rig = Rig()
+    rig.ctl.press("forward")
+    cause = (
+        "no status from robot:7272 for 0.46 s (learned jitter 90 ms, limit 0.45 s): nothing at all arrived"
+    )
+    rig.link.lease.end(EndReason.LINK, why=cause)  # the drive loop saw it first and measured it
+    rig.hold(0.1)
+    rig.model.health.set(LinkHealth(LinkLevel.STALE, cause="(the health's own words, later)"))
+    assert stops(rig) == [f"Stopped: the link is stale — {cause}"]
+    assert rig.view.kinds[-1] is Kind.LINK
+
+
+def test_a_stale_health_seen_first_by_the_window_says_the_healths_cause() -> None:
+    rig = Rig()
+    rig.ctl.press("forward")
+    rig.model.health.set(LinkHealth(LinkLevel.STALE, cause="no status for 0.31 s"))
+    assert stops(rig) == ["Stopped: the link is stale — no status for 0.31 s"]
+
+
+def test_a_lapse_says_how_long_the_window_was_silent() -> None:
+    rig = Rig()
+    rig.ctl.press("forward")
+    rig.link.lease.end(EndReason.LAPSED, why="the drive was not renewed for 0.41 s")
+    rig.hold(0.1)
+    said = "Stopped: the window did not respond in time (the drive was not renewed for 0.41 s)."
+    assert stops(rig) == [f"{said} Press again to drive."]
+    assert rig.view.kinds[-1] is Kind.SAFETY
+
+
+def test_focus_loss_while_driving_is_said_with_its_reason_and_only_then() -> None:
+    rig = Rig()
+    rig.ctl.focus_lost()  # nothing driving: nothing to say
+    assert stops(rig) == []
+    rig.ctl.focus_gained()
+    rig.ctl.press("forward")
+    rig.ctl.focus_lost("RTMU was suspended (Ctrl+Z)")
+    assert stops(rig) == ["Stopped: RTMU was suspended (Ctrl+Z). Press again to drive."]
+
+
 def test_after_a_reconnect_the_robot_stays_still_until_a_fresh_press() -> None:
     rig = Rig()
     rig.ctl.press("forward")

@@ -25,6 +25,8 @@ from rtmu.client.lease import DriveRatios
 from rtmu.client.runner import ClientRunner
 from rtmu.client.session import SessionConfig
 from rtmu.guardian import halt
+from rtmu.guardian import messages as m
+from rtmu.guardian.child import SILENT_CEILING, SILENT_LATE, Watch, learned_limit
 from rtmu.guardian.halt import IDENTIFIER, IDENTIFIER_ARGS, ZERO_RATIO_DRIVE
 from rtmu.guardian.shared import SeatState
 from rtmu.protocol.payloads.drive import RatioDrive
@@ -311,6 +313,32 @@ def test_rtmu_drive_warns_in_one_line_when_the_guardian_is_refused_and_drives(tm
         warnings = [line for line in done.stderr.splitlines() if "guardian not available" in line]
         assert len(warnings) == 1 and warnings[0].startswith("rtmu drive: warning:"), done.stderr
         assert sim.call(lambda: sim.server.robot.ratio_drives_received) > 0
+
+
+def _beats(watch: Watch, kind: bytes, start: float, seconds: float, every: float) -> float:
+    t = start
+    for _ in range(round(seconds / every)):
+        t += every
+        watch.take(kind, t)
+    return t
+
+
+def test_the_guardian_learns_how_late_a_busy_parents_beats_come_within_its_bounds() -> None:
+    """Its silent limit follows the link rule (base.link_timing): 0.4 s for a calm parent, more
+    for one whose beats a busy machine delays now and then — never more than SILENT_CEILING."""
+    watch = Watch(os.getpid(), learned_limit)  # this process: running, never "stopped"
+    watch.take(m.ARM, 0.0)
+    t = _beats(watch, m.BEAT_NET, 0.0, 300.0, 0.04)
+    assert watch.limit(m.BEAT_NET, t) == pytest.approx(SILENT_LATE)
+    assert watch.why_stop(t + 0.39) is None
+    assert "network thread of the process driving the robot for 410 ms" in (watch.why_stop(t + 0.41) or "")
+    watch.take(m.BEAT_NET, t + 0.35)  # a busy machine delayed one beat 350 ms…
+    t = _beats(watch, m.BEAT_NET, t + 0.35, 5.0, 0.04)
+    assert watch.why_stop(t + 0.6) is None  # …so a 600 ms silence is no alarm now
+    assert SILENT_LATE < watch.limit(m.BEAT_NET, t) <= SILENT_CEILING
+    assert watch.why_stop(t + SILENT_CEILING + 0.01) is not None  # but never beyond the ceiling
+    watch.take(m.DISARM, t)
+    assert watch.why_stop(t + 10.0) is None  # disarmed: nothing to watch
 
 
 def test_the_guardians_reasons_name_no_window_it_may_not_have() -> None:

@@ -4,6 +4,8 @@ from __future__ import annotations
 
 import random
 
+import pytest
+
 from rtmu.client.errors import ClientTimeout, LoginRejected, ServerClosed
 from rtmu.client.health import HealthMonitor, ping_data
 from rtmu.client.reconnect import Backoff, worth_retrying
@@ -11,19 +13,66 @@ from rtmu.model.observables import LinkLevel
 from rtmu.protocol.decoder import DropStats
 
 
+def steady_status(h: HealthMonitor, start: float, seconds: float, interval: float = 0.1) -> float:
+    t = start
+    for _ in range(round(seconds / interval)):
+        t += interval
+        h.note_status(t)
+    return t
+
+
 def test_levels_follow_the_status_age() -> None:
     h = HealthMonitor(0.1, lost_after=2.0)
     assert h.level(0.0) is LinkLevel.DOWN
     h.start(10.0)
     assert h.level(10.2) is LinkLevel.OK
-    assert h.level(10.31) is LinkLevel.STALE  # 3 intervals without status
-    h.note_status(10.31)
-    assert h.level(10.5) is LinkLevel.OK
-    assert h.level(12.32) is LinkLevel.LOST
-    assert abs(h.next_change(10.5) - 10.61) < 1e-3
-    assert abs(h.next_change(10.7) - 12.31) < 1e-3
+    assert h.level(10.44) is LinkLevel.OK  # a new link starts at the ceiling…
+    assert h.level(10.46) is LinkLevel.STALE
+    t = steady_status(h, 10.0, 180.0)  # …and a steady one comes down to 3 intervals
+    assert h.stale_limit(t) == pytest.approx(0.3)
+    assert h.level(t + 0.29) is LinkLevel.OK
+    assert h.level(t + 0.31) is LinkLevel.STALE
+    h.note_status(t + 0.31)
+    t += 0.31
+    assert h.level(t + 0.2) is LinkLevel.OK
+    assert h.level(t + 2.02) is LinkLevel.LOST
+    assert h.next_change(t + 0.1) == pytest.approx(t + h.stale_limit(t + 0.1), abs=1e-3)
+    assert h.next_change(t + 0.7) == pytest.approx(t + 2.0, abs=1e-3)
     h.stop()
-    assert h.level(20.0) is LinkLevel.DOWN
+    assert h.level(t + 20.0) is LinkLevel.DOWN
+
+
+def test_a_stale_verdict_says_its_measured_cause() -> None:
+    h = HealthMonitor(0.1, lost_after=2.0)
+    h.start(0.0)
+    last_packet: list[float | None] = [None]
+    h.bind("robot:7272", lambda: last_packet[0], lambda: False)
+    t = steady_status(h, 0.0, 180.0)
+    last_packet[0] = t
+    snap = h.snapshot(t + 0.35)
+    assert snap.level is LinkLevel.STALE and snap.stale_limit == 0.3
+    assert snap.cause == (
+        "no status from robot:7272 for 0.35 s (learned jitter 0 ms, limit 0.30 s): nothing at all "
+        "arrived — Wi-Fi, network or the server. Check the robot's Wi-Fi (signal, roaming between "
+        "access points), then drive again."
+    )
+    last_packet[0] = t + 0.3  # sonar still comes: the server, not the link, went quiet
+    assert "the server itself is slow" in h.cause(t + 0.35)
+    assert h.snapshot(t + 0.1).cause == ""  # nothing to explain while OK
+
+
+def test_an_undecided_decoder_holds_the_verdict_until_the_ceiling() -> None:
+    h = HealthMonitor(0.1, lost_after=2.0)
+    h.start(0.0)
+    undecided = [False]
+    h.bind("robot:7272", lambda: None, lambda: undecided[0])
+    t = steady_status(h, 0.0, 180.0)
+    undecided[0] = True  # a fake header waits, valid packets pile up behind it
+    assert h.level(t + 0.35) is LinkLevel.OK
+    assert h.next_change(t + 0.35) == pytest.approx(t + 0.45, abs=1e-3)
+    assert h.level(t + 0.46) is LinkLevel.STALE  # never beyond the ceiling
+    undecided[0] = False
+    assert h.level(t + 0.35) is LinkLevel.STALE
 
 
 def test_snapshot_counts_drops_and_rounds_rtt() -> None:
@@ -97,3 +146,30 @@ def test_traffic_during_a_download_keeps_the_link_from_lost_but_not_from_stale()
     assert h.level(13.95) is LinkLevel.LOST
     h.start(20.0)  # a new connection forgets the old traffic
     assert h.level(22.1) is LinkLevel.LOST
+
+
+def test_a_machine_that_wakes_us_late_gets_a_lower_ceiling_so_the_promise_holds() -> None:
+    """The stop must be on the wire within 0.5 s of the last status: when the loop that sends it
+    has lately woken 150 ms late, the limit keeps that from the promise (0.35 s)."""
+    h = HealthMonitor(0.05, stale_intervals=4)
+    h.start(0.0)
+    assert h.stale_limit(0.0) == pytest.approx(0.45)
+    h.note_wake(0.15, 0.0)
+    assert h.stale_limit(0.0) == pytest.approx(0.35)
+    h.note_wake(0.4, 0.0)  # never below the floor
+    assert h.stale_limit(0.0) == pytest.approx(0.2)
+    assert h.stale_limit(300.0) == pytest.approx(0.45)  # forgotten as the machine calms down
+
+
+def test_unanswered_pings_during_a_download_stop_driving_but_do_not_lose_the_link() -> None:
+    """A big map on a slow link holds our pings' answers behind its bytes: driving stops (STALE),
+    but the link is not called lost — that would reconnect and download the map again, for ever."""
+    h = HealthMonitor(0.1, lost_after=2.0)
+    h.start(0.0)
+    for _ in range(3):
+        h.note_ping_timeout()
+    h.note_status(1.0)
+    h.note_traffic(1.0)
+    assert h.level(1.1) is LinkLevel.STALE
+    h.traffic_done()
+    assert h.level(1.1) is LinkLevel.LOST and h.requests_unanswered

@@ -143,3 +143,24 @@ def test_renewals_from_another_thread_are_safe() -> None:
     finally:
         stop.set()
         t.join()
+
+
+def test_every_stop_the_governor_decides_carries_its_measured_cause() -> None:
+    clock, lease, gov = make()
+    lease.grant(FWD)
+    gov.step(clock())
+    clock.advance(0.34)  # not renewed: the UI froze
+    [stop] = gov.step(clock())
+    assert stop == SendStop(EndReason.LAPSED)
+    assert stop.why == "the drive was not renewed for 0.34 s"
+    assert lease.why == stop.why  # the view says the same words
+    lease.grant(FWD)
+    gov.step(clock())
+    assert lease.why == ""  # a new lease forgets the old cause
+    [stop] = gov.step(clock(), link_ok=False, link_why=lambda: "no status for 0.46 s")
+    assert stop.reason is EndReason.LINK and stop.why == lease.why == "no status for 0.46 s"
+    lease.grant(FWD)
+    gov.step(clock())
+    lease.release()
+    [stop] = gov.step(clock(), link_ok=False, link_why=lambda: "not asked")
+    assert stop.reason is EndReason.RELEASED and stop.why == ""  # the operator's own act: no cause

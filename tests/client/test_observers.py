@@ -110,7 +110,10 @@ OBSERVERS = (
     Observer("routes", ("routes", "{addr}")),
     Observer("commands", ("commands", "{addr}")),
     Observer("config", ("config", "{addr}"), sim="aria"),
-    Observer("say", ("say", "{addr}", "hello"), waits=False),
+    # say sends its one command and ends without waiting for an answer, so a signal sent "while it
+    # runs" could land as it exits (a loaded machine: killed by SIGINT during interpreter shutdown,
+    # -2). Held at its login instead, it is surely mid-command when the signal or the cut comes.
+    Observer("say", ("say", "{addr}", "hello"), holds_at_login=True, waits=False),
     Observer("doctor", ("doctor", "{addr}"), ended=DURING_NAVIGATION, lost=DOCTOR_STEPS),
     Observer("files", ("files", "{addr}", "ls")),
     Observer("scan", ("scan", "{addr}", "status")),

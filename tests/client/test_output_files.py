@@ -132,3 +132,22 @@ def test_a_quality_in_range_reaches_the_camera(sim: SimThread, tmp_path: Path) -
     assert code == EXIT_OK
     code = main(["image", f"127.0.0.1:{sim.port}", "--out", str(out), "--camera", "Nope", "--force"])
     assert code == EXIT_UNSUPPORTED
+
+
+@pytest.mark.parametrize(
+    ("argv", "limits"),
+    [
+        (["replay", "x.mcap", "--conn", "0"], "use 1…1000000"),
+        (["status", "127.0.0.1:9", "--count", "-1"], "use 0…1000000000"),
+        (["video", "127.0.0.1:9", "--fps", "100"], "use 0.5…30"),
+    ],
+)
+def test_a_refusal_writes_its_limits_as_the_operator_types_them(
+    capsys: pytest.CaptureFixture[str], argv: list[str], limits: str
+) -> None:
+    """A limit reads as a plain number: "use 1…1000000", never "use 1…1e+06"."""
+    with pytest.raises(SystemExit) as exc:
+        main(argv)
+    assert exc.value.code == EXIT_USAGE
+    err = capsys.readouterr().err
+    assert limits in err and "e+" not in err, err

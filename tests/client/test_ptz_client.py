@@ -122,13 +122,22 @@ def test_position_is_polled_only_while_watched(rig: Rig, sim: SimThread) -> None
     rig.wait(lambda: rig.ptz.position == (30.0, 0.0, 0.0))
     turn(-12.5)
     rig.wait(lambda: rig.ptz.position == (-12.5, 0.0, 0.0))
+    # A move while polled is read back at once (a request-once right after it), not at the next poll.
+    reads = sum(1 for h in sim.server.heard.all() if h.name.startswith("getCameraData") and h.once)
+    rig.runner.send(PtzMove(0, 0, 10)).result(5)
+    rig.wait(lambda: rig.ptz.position is not None and rig.ptz.position[2] == 10.0)
+    rig.wait(
+        lambda: (
+            sum(1 for h in sim.server.heard.all() if h.name.startswith("getCameraData") and h.once) > reads
+        )
+    )
     rig.runner.send(WatchPtz(False)).result(5)
     rig.runner.sync()
     rig.ui.drain()
     turn(45.0)
     time.sleep(0.6)  # more than two poll periods: a poll still running would have been heard
     rig.ui.drain()
-    assert rig.ptz.position == (-12.5, 0.0, 0.0)
+    assert rig.ptz.position == (-12.5, 0.0, 10.0)
 
 
 def test_a_server_without_cameras_says_so() -> None:

@@ -149,7 +149,7 @@ def test_stale_status_stops_the_robot_even_while_the_lease_is_renewed(server: Te
         runner.lease.grant(DriveRatios(100, 0, 50))
         runner.sync()
         dry_up_status(runner, server)
-        for _ in range(4):
+        for _ in range(5):  # a new link's limit is the ceiling, 0.45 s (base.link_timing)
             clock.advance(0.1)
             runner.lease.renew()
             runner.sync()
@@ -419,3 +419,27 @@ def test_stop_and_wait_returns_once_the_stop_has_left(server: TestServer) -> Non
     finally:
         runner.close()
     assert runner.stop_and_wait(0.1) is False  # closed: nothing to send it with
+
+
+def test_a_link_lost_while_driving_is_reconnected_at_once_and_the_first_thing_sent_is_a_stop() -> None:
+    """Our connection dropped under a driving robot (the guardian's link may have gone with it):
+    the session does not wait out its backoff, and zero ratios and a stop go out before anything."""
+    server = TestServer()
+    thread = ServerThread(server)
+    with thread:
+        runner, model, ui = start(server, backoff=lambda: Backoff(initial=30.0, jitter=0.0))
+        try:
+            runner.lease.grant(DriveRatios(60, 0, 50))
+            runner.sync()
+            eventually(lambda: ratio_drives(server)[-1:] == [RatioDrive(60, 0, 50)])
+            thread.call(lambda: server.kill(server.sides[0]))
+            eventually(lambda: len(server.sides) == 2, timeout=5.0)  # at once, not after 30 s
+            eventually(lambda: any(r.side == 1 and r.name == "stop" for r in server.received))
+            on_new = [r.name for r in server.received if r.side == 1 and r.name in ("ratioDrive", "stop")]
+            assert on_new[:2] == ["ratioDrive", "stop"]
+            first = next(r for r in server.received if r.side == 1 and r.name == "ratioDrive")
+            assert RatioDrive.decode(first.args) == RatioDrive(0, 0, 0)
+            ui.wait_for(lambda: model.connection.value.phase is Phase.CONNECTED)
+            assert not runner.lease.view().live  # and nothing drives until a fresh press
+        finally:
+            runner.close()

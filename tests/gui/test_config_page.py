@@ -19,6 +19,7 @@ from PIL import Image
 from rtmu.client.config_feed import set_config
 from rtmu.client.connection import AriaClient
 from rtmu.package_data import project_map
+from rtmu.protocol.payloads.config import ParamType
 from rtmu.sim import SimConfig, SimThread
 from rtmu.sim.arconfig import FILLER_CONTROL_SECTION
 from rtmu.ui.config_page import PAGE_SIZE, ConfigPage
@@ -59,7 +60,14 @@ def open_page(gui: Gui) -> ConfigPage:
                     sub.get_item_attribute_value(k, "label", None).get_string()
                     for k in range(sub.get_n_items())
                 ]
-    assert labels == ["Connection settings…", "Configuration…", "Console…"]
+    assert labels == [
+        "Connection settings…",
+        "Configuration…",
+        "Console…",
+        "Files on the robot…",
+        "Scan a map…",
+        "Edit the map…",
+    ]
     gui.window.activate_action("win.server-config", None)
     pump(lambda: page(gui) is not None, 5, "the configuration page")
     p = page(gui)
@@ -136,7 +144,8 @@ def red_and_green(gui: Gui, widget) -> tuple[int, int]:  # type: ignore[no-untyp
 
 def test_edit_save_accepted_then_a_refused_value_shows_the_servers_error(gui: Gui, sim: SimThread) -> None:
     p = open_page(gui)
-    assert [s.name for s in p.config.sections] == ["Teleop", "Robot config", "Camera", "Battery", "Wi-Fi"]  # type: ignore[union-attr]
+    names = [s.name for s in p.config.sections]  # type: ignore[union-attr]
+    assert names == ["Teleop", "Robot config", "Camera", "Battery", "Wi-Fi", "Files"]
     gui.render(p, gui.shots / f"{gui.name}-opened.png")
     _param, spin, _label = p.rows[("Teleop", "Timeout")]
     type_into(gui, spin, "0.5")
@@ -149,6 +158,11 @@ def test_edit_save_accepted_then_a_refused_value_shows_the_servers_error(gui: Gu
     red, green = red_and_green(gui, p.rows[("Teleop", "Timeout")][2])
     assert green > 20 and red == 0
     gui.render(p, gui.shots / f"{gui.name}-accepted.png")
+    _change_from_another_client(sim, {"Teleop": {"Timeout": "4"}})
+    pump(lambda: answer(p, "Teleop", "Timeout") == "", 5, "the tick to go once another value is held")
+    fetches = p.fetches
+    _change_from_another_client(sim, {"Teleop": {"Timeout": "0.5"}})  # back, for what follows
+    pump(lambda: p.fetches > fetches and not p.fetching, 5, "the page to fetch again")
 
     _param, spin, _label = p.rows[("Teleop", "Timeout")]
     type_into(gui, spin, "0.05")  # within the limits, refused by the server for its own reason
@@ -166,6 +180,20 @@ def test_edit_save_accepted_then_a_refused_value_shows_the_servers_error(gui: Gu
     gui.shot("main-window-behind")
 
 
+def _change_from_another_client(sim: SimThread, changes: dict[str, dict[str, str]]) -> None:
+    import asyncio
+
+    async def other() -> str:
+        client = AriaClient()
+        await client.connect("127.0.0.1", sim.port, timeout=5)
+        try:
+            return (await set_config(client, changes, 5)).error
+        finally:
+            await client.disconnect()
+
+    assert asyncio.run(other()) == ""
+
+
 def test_inline_validation_blocks_save_and_typing_never_drives(gui: Gui, sim: SimThread) -> None:
     p = open_page(gui)
     choose_section(gui, p, "Robot config")
@@ -176,16 +204,48 @@ def test_inline_validation_blocks_save_and_typing_never_drives(gui: Gui, sim: Si
     red, _green = red_and_green(gui, p.rows[("Robot config", "TransVelMax")][2])
     assert red > 20
     gui.render(p, gui.shots / f"{gui.name}-inline.png")
-    gui.key("Tab")  # the spin button clamps to its limit: the server's own value, nothing left to save
-    pump(lambda: not p.edits and answer(p, "Robot config", "TransVelMax") == "", 3, "the edit to go")
+    gui.key("Tab")  # never clamped to 1500 without a word: the held value stays, the row says why
+    pump(lambda: not p.edits, 3, "the wrong edit to go")
+    said = answer(p, "Robot config", "TransVelMax")
+    assert said.startswith("✗ 99999 not taken: above the maximum of 1500 (still "), said
+    assert spin.get_value() != 1500 or said.endswith("(still 1500)"), "clamped to the limit"
+    gui.render(p, gui.shots / f"{gui.name}-refused-in-words.png")
     gui.key("Up", "Up", "w", "space")  # drive keys in the main window; here they only edit
     idle(0.5)
     robot = sim.call(lambda: (sim.server.robot.vel, sim.server.world.ratio_mode.trans_ratio))  # type: ignore[union-attr]
     assert robot == (0, 0)
     assert sim.call(lambda: sim.server.world.mode.NAME) != "ratioDrive"  # type: ignore[union-attr]
     gui.key("Escape")
+    if p.edits:  # Up in a spin button edits it: Escape asks before the edit is lost
+        pump(lambda: p.discard.asking, 3, "the discard question")
+        click(gui, p.discard.discard_button)
     pump(lambda: page(gui) is None, 3, "Escape to close the page")
     gui.shot("closed")
+
+
+def test_escape_with_an_unsaved_edit_asks_before_discarding_it(gui: Gui, sim: SimThread) -> None:
+    p = open_page(gui)
+    _param, spin, _label = p.rows[("Teleop", "Timeout")]
+    type_into(gui, spin, "0.7")
+    pump(lambda: p.edits.get(("Teleop", "Timeout")) == "0.70", 3, "the edit")
+    gui.key("Escape")
+    pump(lambda: p.discard.asking, 3, "the question")
+    assert page(gui) is p and p.edits == {("Teleop", "Timeout"): "0.70"}, "closed or lost the edit"
+    assert "1 unsaved edit" in p.discard.label.get_text()
+    gui.render(p, gui.shots / f"{gui.name}-asks.png")
+    stops = sim.call(lambda: len(sim.server.stop_log))  # type: ignore[union-attr]
+    gui.key("space")  # the stop key still stops while the page asks (and answers nothing)
+    pump(lambda: sim.call(lambda: len(sim.server.stop_log)) > stops, 3, "Space to send a stop")  # type: ignore[union-attr]
+    assert p.discard.asking and page(gui) is p, "Space answered the question"
+    gui.key("Escape")  # answers "keep editing"
+    pump(lambda: not p.discard.asking, 3, "the question to go")
+    assert page(gui) is p and p.edits
+    p.close()  # the title bar's close asks too
+    pump(lambda: p.discard.asking, 3, "the question on close")
+    assert page(gui) is p
+    click(gui, p.discard.discard_button)
+    pump(lambda: page(gui) is None, 3, "Discard and close to close the page")
+    assert sim.call(lambda: sim.server.world.ratio_mode.timeout) != 0.7  # type: ignore[union-attr]
 
 
 def test_another_clients_change_refreshes_without_losing_an_edit(gui: Gui, sim: SimThread) -> None:
@@ -261,14 +321,17 @@ def test_ten_thousand_parameters_with_markup_open_bounded_and_responsive(
     gui = Gui.start(screenshots, "config-hostile", "127.0.0.1", hostile.port)
     try:
         p = open_page(gui)
-        assert p.config is not None and p.config.param_count == 10_016  # TransDecel, RotDecel, a hostile name
+        served = hostile.call(  # every parameter the simulator serves but its separators (only a line)
+            lambda: sum(q.template.kind is not ParamType.SEPARATOR for q in hostile.server.arconfig.params)  # type: ignore[union-attr]
+        )
+        assert served > 10_000 and p.config is not None and p.config.param_count == served
         choose_section(gui, p, "<b>Extra</b> & 0")
         pump(lambda: len(p.rows) == PAGE_SIZE, 5, "one page of rows")
         shown = labels(p.grid)
         assert ("P0<i>&amp;", False) in shown and ("<u>filler</u> 0 & <big>text</big>", False) in shown
         assert ("<b>7</b>", False) in shown  # a choice list's item, as the drop-down shows it
         assert not any(markup for _text, markup in shown)
-        assert p.sections.get_row_at_index(5).get_child().get_text() == "<b>Extra</b> & 0"
+        assert p.sections.get_row_at_index(6).get_child().get_text() == "<b>Extra</b> & 0"
         assert p.comment.get_text() == "<i>filler</i> & <span foreground='red'>markup</span>"
         names = [p.sections.get_row_at_index(i).get_child().get_text() for i in range(len(p.config.sections))]
         assert "Line\\rbreak\\nand \\x1b[2Jescape" in names, names  # one line, its controls shown

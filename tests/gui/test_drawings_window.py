@@ -98,6 +98,10 @@ def test_sonar_and_laser_in_their_colours_and_a_layer_switched_off_is_gone_and_n
     idle(0.3)
     assert count(gui.stage_pixels(), BLUE) > 50
     gui.shot("laser-on")
+    gui.focus()
+    gui.key("Escape")  # closes the panel, and only the panel: the map stays (issue 21)
+    pump(lambda: not panel.get_visible(), 3, "Escape to close the Layers panel")
+    assert not gui.window.camera_page.showing, "Escape went to the camera page instead"
 
 
 def test_a_hostile_servers_drawings_leave_the_window_answering(screenshots) -> None:  # type: ignore[no-untyped-def]

@@ -158,6 +158,7 @@ def test_portrait_phone_layout_fits_and_the_thumb_dpad_drives(phone: tuple[Gui, 
             8,
             "the D-pad to drive",
         )
+        pump(lambda: window.motion.text.startswith("Driving (D-pad held)"), 3, "the pill naming the D-pad")
         gui.shot("portrait-dpad-held")
     finally:
         gui.xdotool("mouseup", "1")
@@ -242,6 +243,17 @@ def test_battery_and_wifi_alarms_from_the_simulator_with_mute(phone: tuple[Gui, 
     pump(lambda: alarm_topic(Alarm.WIFI) in banners.topics(), 8, "the Wi-Fi banner")
     assert alarms.sounded.count(Alarm.WIFI) == 1, alarms.events  # (a loaded machine may add the round trip's)
     pump(lambda: gui.model.robot.value.wifi_quality is not None, 3, "a Wi-Fi value")
+    # The banner and the status strip say the same number, in the same unit (issue 21: "10/70" vs "25 %").
+    quality = gui.model.robot.value.wifi_quality
+    pump(
+        lambda: (
+            banners.text(alarm_topic(Alarm.WIFI)) == f"Weak Wi-Fi on the robot: link quality {quality} %"
+            or quality != gui.model.robot.value.wifi_quality
+        ),
+        3,
+        "the banner to say the Wi-Fi value the strip shows",
+    )
+    assert f"Wi-Fi {gui.model.robot.value.wifi_quality}%" in window.handheld.layout.strip.text, "strip"
     gui.shot("alarm-wifi")
     assert clipped_widgets(window) == []
     # The simulator's own "Low battery" popup card sits above the thumb's D-pad, not under it.

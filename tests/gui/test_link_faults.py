@@ -16,14 +16,15 @@ from pathlib import Path
 
 import pytest
 
-from linkfaults import FAKE_HEADER, GARBAGE, TO_CLIENT, TO_SERVER, FaultProxy
+from linkfaults import FAKE_HEADER, GARBAGE, TO_CLIENT, TO_SERVER, FaultProxy, WifiProfile
 from rtmu.model.observables import LinkLevel, Phase
 from rtmu.sim import SimConfig, SimThread
 
 from .harness import OFFICE_MAP, Gui, idle, pump
 
 OUR_STOP_WITHIN = 1.0
-"""Simulator seconds from the fault to our stop, where the link carries it (documented: 0.3 s)."""
+"""Simulator seconds from the fault to our stop, where the link carries it (documented: 0.5 s from the
+last status; bounded generously: a loaded machine slows the simulator, the proxy and the window)."""
 WATCHDOG_WITHIN = 3.0
 """Simulator seconds from the fault to a stop where nothing of ours can arrive (watchdog: 2 s)."""
 
@@ -40,7 +41,7 @@ FAULTS = {
     "mute_to_server": Fault(lambda p: p.mute(TO_SERVER), False),
     "mute_both": Fault(lambda p: p.mute(TO_CLIENT, TO_SERVER), False),
     "delay_400ms_each_way": Fault(lambda p: p.delay(0.4), True),
-    "reset": Fault(lambda p: p.reset(), False),
+    "reset": Fault(lambda p: p.reset(), True),  # reconnected at once, and a stop sent first
 }
 
 
@@ -115,11 +116,15 @@ def test_a_link_fault_stops_the_robot_and_a_held_key_does_not_drive_again(
     _hold_up_until_driving(gui, sim)
     stop_seen = _StopWatch(sim)
     sim_at_fault = sim.snapshot().time
+    bad: list[bool] = []  # every state the window went through (a reconnect may be over at once)
+    gui.model.connection.observe(lambda _old, new: bad.append(new.phase is not Phase.CONNECTED))
+    gui.model.health.observe(lambda _old, new: bad.append(new.level is not LinkLevel.OK))
     fault.apply(proxy)
 
     # The operator is told at once: the link cell leaves its OK state and the link banner speaks.
-    pump(lambda: not _link_ok(gui), 5, "the window to see the fault")
-    pump(lambda: _link_cell_says_fault(gui), 3, "the link cell to show the fault")
+    pump(lambda: any(bad) or not _link_ok(gui), 5, "the window to see the fault")
+    if name != "reset":  # a reset is reconnected at once, with a stop: the cell may never show it
+        pump(lambda: _link_cell_says_fault(gui), 3, "the link cell to show the fault")
     cell = _link_cell(gui)
     gui.shot(f"{name}-fault")
     pump(lambda: stop_seen.at is not None, WATCHDOG_WITHIN + 2, "the robot to stop")
@@ -135,6 +140,9 @@ def test_a_link_fault_stops_the_robot_and_a_held_key_does_not_drive_again(
         pump(lambda: any(t.startswith(("Stopped: the link", "Link lost")) for t in said()), 3, "the banner")
     except AssertionError:
         raise AssertionError((said(), cell)) from None
+    if name == "mute_to_client":  # explained with its measured cause and what to do
+        stop_words = next(t for t in said() if t.startswith("Stopped: the link"))
+        assert "— no status from " in stop_words and "limit 0." in stop_words and "Wi-Fi" in stop_words
     if fault.stop_reaches_server:
         assert stopped_after <= OUR_STOP_WITHIN, f"stopped {stopped_after:.2f} s after the fault"
         assert _robot(sim, "watchdog_stops") == 0
@@ -198,10 +206,73 @@ def test_one_fake_packet_header_costs_no_reconnect(rig: tuple[Gui, SimThread, Fa
         levels.add(gui.model.health.value.level)
         return time.monotonic() > end
 
+    stops = len(sim.server.stop_log)  # type: ignore[union-attr]
     pump(watch, 6, "three seconds of watching the link")
     gui.shot("fake-header-still-connected")
     assert phases == {Phase.CONNECTED}, f"the window left CONNECTED: {phases}"
-    assert LinkLevel.LOST not in levels and LinkLevel.DOWN not in levels, levels
+    # …and the stale limit does not race the decoder's proof: the held drive was never stopped.
+    assert levels == {LinkLevel.OK}, levels
+    assert len(sim.server.stop_log) == stops and abs(sim.snapshot().vel) > 1.0  # type: ignore[union-attr]
     assert sessions() == before, "a connection was dropped or a new one made"
+    gui.keyup("Up")
+    pump(lambda: sim.snapshot().trans_ratio == 0, 3, "the release to stop the robot")
+
+
+JITTERY = WifiProfile("jittery", stall_rate=1.0, stall_min=0.1, stall_max=0.3, jitter=0.02)
+"""The busy Wi-Fi profile's stalls (server→client held 100–300 ms), three times as often."""
+
+
+def test_wifi_jitter_within_the_ceiling_never_stops_a_held_drive(
+    rig: tuple[Gui, SimThread, FaultProxy],
+) -> None:
+    """Eight seconds of stalls up to 300 ms (a status gap up to 0.4 s at 10 Hz): the learned limit
+    rides them out — the same window with a fixed 300 ms limit stopped on the first long one."""
+    gui, sim, proxy = rig
+    _hold_up_until_driving(gui, sim)
+    stops = len(sim.server.stop_log)  # type: ignore[union-attr]
+    levels: set[LinkLevel] = set()
+    proxy.play(JITTERY, seed=5)
+    end = time.monotonic() + 8.0
+
+    def watch() -> bool:
+        levels.add(gui.model.health.value.level)
+        return time.monotonic() > end
+
+    pump(watch, 20, "eight seconds of jittery Wi-Fi")
+    proxy.restore()
+    stalls = [seconds for _at, seconds, _d in proxy.stalls]
+    gui.shot("jitter-still-driving")
+    assert len(stalls) >= 4 and max(stalls) > 0.2, stalls  # the seed played real stalls
+    said = [t for _topic, _level, t in list(gui.window.banners.history) if t.startswith("Stopped")]
+    assert levels == {LinkLevel.OK} and said == [], (levels, said, stalls)
+    assert len(sim.server.stop_log) == stops and abs(sim.snapshot().vel) > 1.0  # type: ignore[union-attr]
+    assert "/0." in _link_cell(gui)  # the HUD shows the learned limit beside the status age
+    gui.keyup("Up")
+    pump(lambda: sim.snapshot().trans_ratio == 0, 3, "the release to stop the robot")
+
+
+def test_a_roam_stops_the_robot_and_the_held_key_does_not_restart_it(
+    rig: tuple[Gui, SimThread, FaultProxy],
+) -> None:
+    """1.5 s with nothing in either direction (a robot moving between access points): our stop leaves
+    within the limit and reaches the robot as the link returns — before the server's 2 s watchdog —
+    the window says why, and Up, still held, does not drive again."""
+    gui, sim, proxy = rig
+    _hold_up_until_driving(gui, sim)
+    stop_seen = _StopWatch(sim)
+    sim_at_fault = sim.snapshot().time
+    proxy.roam(1.5)
+    pump(lambda: not _link_ok(gui), 5, "the window to see the roam")
+    pump(lambda: stop_seen.at is not None, WATCHDOG_WITHIN + 2, "the robot to stop")
+    assert float(stop_seen.at) - sim_at_fault <= 1.5 + OUR_STOP_WITHIN  # type: ignore[arg-type]
+    assert _robot(sim, "watchdog_stops") == 0, "the server's watchdog had to stop it"
+    said = [t for topic, _level, t in list(gui.window.banners.history) if topic == "link"]
+    assert any(t.startswith("Stopped: the link is stale — no status") for t in said), said
+    pump(lambda: _link_ok(gui), 15, "the link to be OK again")
+    idle(1.5)
+    gui.shot("roam-over-key-still-held")
+    assert sim.snapshot().trans_ratio == 0 and abs(sim.snapshot().vel) < 1.0, "drove without a fresh press"
+    gui.keyup("Up")
+    _hold_up_until_driving(gui, sim)
     gui.keyup("Up")
     pump(lambda: sim.snapshot().trans_ratio == 0, 3, "the release to stop the robot")

@@ -4,6 +4,7 @@ picture-in-picture is moved, resized and hidden with real pointer drags; the spl
 from __future__ import annotations
 
 import re
+import time
 from collections.abc import Iterator
 from pathlib import Path
 
@@ -66,6 +67,19 @@ def test_live_video_plays_pauses_and_saves_a_frame(gui: Gui, sim: SimThread, tmp
     # The figures are on the picture: frames per second, kB/s and the frame's age (the simulator stamps it).
     pump(lambda: re.search(r"\d+\.\d fps · \d+ kB/s · \d+ ms old", live.caption.get_text()), 3, "the figures")
     assert live.caption.get_visible()
+    # One age on screen, the caption's: the bar's line says none while it plays (issue 21).
+    pump(lambda: " old" not in window.camera.info.get_text(), 3, "the bar's age to give way")
+    # Back to the map and to the camera again: live video is the picture, nothing is "requested" over it.
+    requests: list[float] = []
+    asked = window.camera.requesting
+    window.camera.requesting = lambda: (requests.append(time.monotonic()), asked())[1]  # type: ignore[method-assign]
+    gui.key("Escape")
+    pump(lambda: not window.camera_page.showing, 3, "the map")
+    gui.key("Escape")
+    pump(lambda: window.camera_page.showing, 3, "the camera page")
+    assert requests == [], "a single picture (and its spinner) was asked for over live video"
+    assert not window.camera.status_box.get_visible(), "a spinner over video"
+    del window.camera.requesting
     a = picture_pixels(gui, "01-playing")
     pump(lambda: frames_seen(gui) >= first + 10, 8, "more frames")
     b = picture_pixels(gui, "02-playing-later")
@@ -79,6 +93,7 @@ def test_live_video_plays_pauses_and_saves_a_frame(gui: Gui, sim: SimThread, tmp
     paused_at = frames_seen(gui)
     idle(1.0)
     assert frames_seen(gui) == paused_at, "no frames while paused"
+    pump(lambda: " old" in window.camera.info.get_text(), 3, "the bar's age back while paused")
     gui.shot("paused")
     gui.click(live.pause_button)
     pump(lambda: frames_seen(gui) > paused_at, 5, "frames again after Pause is released")

@@ -257,6 +257,9 @@ def test_click_to_go_with_a_dragged_heading(gui: Gui, sim: SimThread) -> None:
 
 def test_dock_and_charge(gui: Gui, sim: SimThread) -> None:
     window = gui.window
+    sim.call(lambda: sim.server.world.set_battery(11.4))  # under ARIA's 11.5 V low level
+    pump(lambda: (window.banners.text("alarm:battery") or "").startswith("Battery low"), 5, "the low alarm")
+    assert "bring the robot to its charger" in (window.banners.text("alarm:battery") or "")
     popover = open_goals(gui)
     dock = window.goals_panel.buttons["dock"]
     assert dock.get_sensitive() and "dock" in gui.model.connection.value.offers
@@ -265,6 +268,11 @@ def test_dock_and_charge(gui: Gui, sim: SimThread) -> None:
     pump(lambda: window.motion.kind == "autonomous", 5, "navigating to the dock")
     pump(lambda: status(sim) == "Docked", TRIP_S, "the robot to dock")
     pump(lambda: window.banners.text("navigation") == "Docked", 3, "the Docked banner")
+    # On its charger, "bring the robot to its charger" would be a lie: a charging note takes its place.
+    pump(
+        lambda: "charging on its dock" in (window.banners.text("alarm:battery") or ""), 3, "the charging note"
+    )
+    gui.shot("docked-low-battery-charging")
     # Just under a tenth: a second or two of charging shows as a rise in the window too.
     sim.call(lambda: sim.server.world.set_battery(11.8497))
     pump(lambda: gui.model.robot.value.battery_v == pytest.approx(11.8), 3, "the lower battery")
@@ -298,6 +306,11 @@ def test_a_lost_robot_is_localized_with_the_map_mode_and_navigates_again(gui: Gu
     assert window.pose_bar.go_button.get_label() == "Set here"
     gui.shot("placing-the-robot")
     gui.click(window.pose_bar.go_button)
+    pump(
+        lambda: (window.banners.text("navigation") or "").startswith("Position set: robot at 2."),
+        3,
+        "the confirmation of Set position",
+    )
     pump(lambda: distance(sim, *place) < 60, 3, "the simulator to take the pose")
     pump(lambda: loc.has_css_class("loc-good"), 5, "localization good again")
     assert abs(sim.snapshot().th) < 5

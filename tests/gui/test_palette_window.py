@@ -71,6 +71,8 @@ def test_search_and_run_a_simple_command(gui: Gui, sim: SimThread) -> None:
     assert "ResetTripOdometer" in names and "SimulatorSetBattery" in names
     gui.xdotool("type", "--delay", "30", "trip odo")
     pump(lambda: p.visible_names() == ["ResetTripOdometer"], 3, "the search to leave one command")
+    total = len(p.catalogue.commands)  # type: ignore[union-attr]
+    assert p.note.get_text().startswith(f"1 of {total} commands"), p.note.get_text()
     gui.screen_shot("palette-search")
     gui.key("Return")
     pump(lambda: palette() is None, 3, "the palette to close")

@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import xml.etree.ElementTree as ET
+from dataclasses import replace
 
 import gi
 import pytest
@@ -146,4 +147,46 @@ def test_the_link_cell_says_when_the_server_does_not_answer_pings() -> None:
     assert "not answering pings (2 in a row)" in (cell.get_tooltip_text() or "")
     model.health.set(LinkHealth(LinkLevel.OK, rtt_ms=1.5))
     assert "ping" not in cell.value.get_text() and "pings" not in (cell.get_tooltip_text() or "")
+    toolbar.close()
+
+
+def test_the_link_cell_shows_the_learned_stale_limit() -> None:
+    model = RobotModel()
+    model.connection.set(ConnectionState(Phase.CONNECTED, "127.0.0.1", 7272))
+    model.health.set(LinkHealth(LinkLevel.OK, rtt_ms=1.5, stale_limit=0.33, jitter_ms=90.0))
+    model.robot.set(replace(model.robot.value, numbers_at=1.0))
+    toolbar = StatusToolbar(model, OperatorState(), status_age=lambda: 0.1)
+    cell = toolbar.cells["link"]
+    assert cell.value.get_text() == "1.5 ms 0.1/0.33"
+    assert "Stale after 0.33 s without status: learned from this link's jitter (90 ms)" in (
+        cell.get_tooltip_text() or ""
+    )
+    toolbar.close()
+
+
+def test_colour_states_are_also_words_in_the_toolbar() -> None:
+    """Battery and link say in a visible word (and to a screen reader) what their colour says."""
+    from rtmu.values.state import RobotState
+
+    model = RobotModel()
+    model.connection.set(ConnectionState(Phase.CONNECTED, "127.0.0.1", 7272))
+    model.health.set(LinkHealth(LinkLevel.OK, rtt_ms=1.5))
+    robot = RobotState(battery_v=12.5, battery_low=11.5, battery_shutdown=11.0, numbers_at=1.0)
+    model.robot.set(robot)
+    toolbar = StatusToolbar(model, OperatorState(), status_age=lambda: 0.1)
+    battery, link = toolbar.cells["battery"], toolbar.cells["link"]
+    heading = link.caption.get_text()
+    assert battery.caption.get_text() == "Battery" and heading.startswith("Link")
+    model.robot.set(RobotState(battery_v=11.3, battery_low=11.5, battery_shutdown=11.0, numbers_at=2.0))
+    toolbar.refresh()
+    assert battery.caption.get_text() == "Battery · LOW" and battery.has_css_class("low")
+    model.robot.set(RobotState(battery_v=10.9, battery_low=11.5, battery_shutdown=11.0, numbers_at=3.0))
+    toolbar.refresh()
+    assert battery.caption.get_text() == "Battery · SHUTDOWN"
+    model.health.set(LinkHealth(LinkLevel.LOST, rtt_ms=None))
+    toolbar.refresh()
+    assert link.caption.get_text() == f"{heading} · LOST"
+    model.health.set(LinkHealth(LinkLevel.OK, rtt_ms=1.5))
+    toolbar.refresh()
+    assert link.caption.get_text() == heading
     toolbar.close()

@@ -105,6 +105,7 @@ def test_replay_draws_the_recorded_robot_pauses_scrubs_and_never_drives(
         gui.shot("replay-scrubbed-back")
         assert robot_blue_near(gui, *there) > 10, "the robot is drawn where the recording had it then"
         assert robot_blue_near(gui, *end) == 0, "and no longer where it ended"
+        assert not gui.window.connect_button.get_visible(), "the header offers Disconnect in a replay"
 
         # Nothing drives: a held arrow key and the STOP button send nothing and say "replay".
         written, refused = back.written, back.refused
@@ -141,5 +142,28 @@ def test_replay_draws_the_recorded_robot_pauses_scrubs_and_never_drives(
         gui.click(bar.forward)
         pump(lambda: back.position > before, 5, "the next second to be shown")
         assert replayer.opened == 2 and not bar.clock.playing
+
+        # Played on after the seek back, with the network thread busy for a second (as a rebuild from
+        # the first byte keeps it): a replay sends nothing, so no "stops are not going out" alarm.
+        topics: set[str] = set()
+        bar.set_speed(1.0)
+        gui.click(bar.play_button)
+        pump(lambda: bar.clock.playing, 3, "the replay to play")
+        runner = gui.app.fleet.selected.value.runner
+        assert runner is not None
+        runner.submit(lambda: time.sleep(1.2))
+        end_at = time.monotonic() + 2.0
+        stale: list[object] = []
+
+        def watch() -> bool:
+            topics.update(gui.window.banners.topics())
+            cell = gui.window.toolbar.cells["x"]
+            if cell.stale:
+                stale.append((gui.model.health.value.level, gui.phase, cell.get_tooltip_text()))
+            return time.monotonic() > end_at
+
+        pump(watch, 5, "2 s")
+        assert not stale, f"stale markers while the recording plays on: {stale[:3]}"
+        assert "loop" not in topics, "a replay raised the network-thread alarm"
     finally:
         gui.close()

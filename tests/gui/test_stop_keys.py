@@ -65,7 +65,15 @@ def pick_each(gui: Gui, sim: SimThread, how: str) -> list[str]:
         (picker.by_mouse if how == "mouse" else picker.by_keyboard)(entry)
         pump(lambda: not picker.popover.get_mapped(), 3, f"the menu to close after {entry.name}")
         idle(0.3)  # what the pick opens (a dialog, a page) comes up
-        if entry.action in ("win.about", "win.show-help-overlay", "win.settings", "win.server-config"):
+        if entry.action in (
+            "win.about",
+            "win.show-help-overlay",
+            "win.settings",
+            "win.server-config",
+            "win.files",
+            "win.scan",
+            "win.map-edit",
+        ):
             pump(lambda: owned_windows(window), 5, f"{entry.name} to open its window")
         if len(cycle.proved) in (3, 12):
             gui.screen_shot(f"after-{how}-pick-{len(cycle.proved)}")

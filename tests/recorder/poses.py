@@ -5,6 +5,7 @@ from __future__ import annotations
 import struct
 from pathlib import Path
 
+from rtmu.capture.recorded import RAW_TOPICS
 from rtmu.recorder import topics
 
 from .mcapread import read
@@ -68,8 +69,15 @@ def _field(message: bytes, number: int) -> bytes:
 
 
 def recorded_pose_at(path: Path, at_ns: int) -> tuple[float, float]:
-    """The pose the recording had at ``at_ns`` (a pose is logged just after the bytes that carried it)."""
-    ended = [m.log_time for m in read(path).topic(topics.STOPS) if m.json()["reason"] == "disconnect"]
-    cut = min([at_ns + 20_000_000, *ended])  # the session's own reset as it disconnects is not the robot
+    """The pose the recording had at ``at_ns`` (a pose is logged just after the bytes that carried it).
+
+    Once the server's last bytes are delivered, that is the last pose before the session disconnected,
+    however late a loaded machine logged it; before then, the pose logged within 20 ms of the bytes.
+    """
+    recording = read(path)
+    ended = [m.log_time for m in recording.topic(topics.STOPS) if m.json()["reason"] == "disconnect"]
+    more = any(m.log_time > at_ns for m in recording.topic(RAW_TOPICS["s2c"]))
+    allowance = [at_ns + 20_000_000] if more or not ended else []
+    cut = min([*allowance, *ended])  # the session's own reset as it disconnects is not the robot
     before = [p for t, p in poses(path) if t < cut]
     return before[-1]

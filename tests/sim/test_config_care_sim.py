@@ -36,6 +36,7 @@ def test_factory_values_come_in_one_packet_of_pairs_whole_or_by_section() -> Non
         assert [(sec, name) for sec, name, _ in every] == [
             (sec, name) for sec, name, _ in server.arconfig.values()
         ]
+        assert [(s, n) for s, n, _v in every if s == "Files"] == [("Files", "Map")]  # ARNL's map file
         one = ConfigDefaults.decode(
             (await c.ask("getConfigDefaults", ConfigDefaultsRequest("teleop").encode()))[0]
         )

@@ -80,7 +80,7 @@ def test_sections_and_values_reflect_the_live_simulation() -> None:
         packets = await fetch(c)
         assert packets[-1] == b"" and all(len(p) <= MAX_PAYLOAD for p in packets)
         names = [ConfigSectionPacket.decode(p).name for p in packets[:-1]]
-        assert names == ["Teleop", "Robot config", "Camera", "Battery", "Wi-Fi"]
+        assert names == ["Teleop", "Robot config", "Camera", "Battery", "Wi-Fi", "Files"]
         got = values(packets)
         assert got["Teleop/Timeout"] == 2.0 and got["Camera/FrameSize"] == "320x240"
         assert got["Robot config/SerialNumber"] == "SIM-P3DX-0001"  # factory: shown because asked for

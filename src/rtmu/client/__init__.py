@@ -4,8 +4,9 @@ One job per module:
 
 * ``errors``     — typed errors an operator understands, each with its CLI exit code.
 * ``connection`` — :class:`AriaClient`, one logged-in connection on asyncio streams.
-* ``health``     — RTT, status age, dropped packets → OK / STALE / LOST.
+* ``health``     — RTT, status age, dropped packets → OK / STALE / LOST, and why.
 * ``lease``      — the drive lease the UI renews and the governor that turns it into packets.
+* ``lease_keeper`` — credits a renewing UI thread with the time it only waited for a CPU.
 * ``reconnect``  — backoff policy.
 * ``session``    — everything that runs on the network loop for one operator session.
 * ``runner``     — :class:`ClientRunner`: the network thread and its thread-safe facade for a UI.

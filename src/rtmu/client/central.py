@@ -166,6 +166,14 @@ class CentralRoster:
         self._loop: asyncio.AbstractEventLoop | None = None
         self._task: asyncio.Task[None] | None = None
 
+    @property
+    def given_up(self) -> bool:
+        """True once the roster has stopped for good by itself (a loss that cannot heal, e.g. a refused
+        login): its thread has ended without :meth:`close`. Tests wait for this instead of sleeping past
+        a retry that must not come."""
+        thread = self._thread
+        return thread is not None and not thread.is_alive() and not self._closed.is_set()
+
     # -- Roster ---------------------------------------------------------------------------
     def start(self, emit: Emit) -> None:
         if self._thread is not None:

@@ -215,3 +215,20 @@ async def check_map(client: AriaClient, timeout: float) -> bool:
     updates = Broadcasts(client, "mapUpdated")
     client.send(CheckMap())
     return await updates.next(timeout)
+
+
+MAP_SECTION, MAP_PARAM = "Files", "Map"
+"""Where ARIA's map handler (ARNL, ``ArServerHandlerMap``) keeps the map file it loads."""
+
+
+def map_param_problem(config: ServerConfig) -> str:
+    """Why this configuration cannot switch the robot's map ("" when its ``Files/Map`` can be set)."""
+    param = config.find(MAP_SECTION, MAP_PARAM)
+    if param is None:
+        return (
+            "this server's configuration has no Files/Map parameter (ARNL's map file), so it cannot be "
+            "told to load another map"
+        )
+    if not config.editable(param):
+        return "this server's Files/Map parameter is above the priority this user may edit"
+    return ""

@@ -81,7 +81,8 @@ class ServerConfig:
 
     @property
     def param_count(self) -> int:
-        return sum(len(s.params) for s in self.sections)
+        """The parameters (a separator between them is none)."""
+        return sum(1 for s in self.sections for p in s.params if p.kind is not ParamType.SEPARATOR)
 
     def editable(self, param: ConfigParam) -> bool:
         return param.priority <= self.last_editable

@@ -288,9 +288,23 @@ class AriaClient:
         return self._conn.datalist if self._conn is not None else DataList()
 
     @property
+    def server_words(self) -> tuple[str, str, str]:
+        """(the server's version tag, the protocol string it asked for, the one we answered): for support."""
+        conn = self._conn
+        intro = None if conn is None else conn.introduction
+        if conn is None or intro is None:
+            return "", "", ""
+        return intro.version_tag, intro.protocol_version, conn.sent_protocol_version or ""
+
+    @property
     def drops(self) -> DropStats:
         """What the decoder threw away on this connection (bad checksums, garbage bytes…)."""
         return self._conn.decoder.stats if self._conn is not None else DropStats()
+
+    def undecided(self) -> bool:
+        """True while the decoder holds a header whose body has not come but sees valid packets
+        going on behind it: the stream is alive and will be delivered within a few packets."""
+        return self._conn is not None and self._conn.decoder.undecided > 0
 
     def _no_reply(self, message: str) -> ClientError:
         """A timeout, unless the server sent a packet over ARIA's limit: that is then why (dropped)."""

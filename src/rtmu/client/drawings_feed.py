@@ -12,6 +12,11 @@ a refresh period no shorter than :data:`MIN_REFRESH_MS`, and at most one publish
 :class:`~rtmu.values.state.DrawingsChanged` per :data:`PUBLISH_EVERY` s however fast samples come. A
 shape RTMU cannot draw is listed (``drawable=False``) and never asked for.
 
+The network loop pays almost nothing per sample however fast they come: a packet only replaces
+its drawing's newest raw sample (the older one is dropped unread); samples are decoded when a
+state is published, and the window gets at most ``drawing_budget.MAX_SHOWN_POINTS`` points in
+all (each layer's ``total_points`` says how many its sample had).
+
 The session keeps its own sonar (and LD laser) handling: where the session holds a subscription of
 a drawing's data name, this feed's request replaces it, so it hands every packet of that name on
 to the session's handler (``FeedContext.handler_for``).
@@ -22,15 +27,19 @@ from __future__ import annotations
 import asyncio
 import contextlib
 import logging
+import time
 from collections.abc import Mapping
 from typing import ClassVar
+
+import numpy as np
 
 from ..protocol.errors import ProtocolError
 from ..protocol.payloads.drawings import Drawing, Visibility
 from ..values.intents import DrawingChoices, Intent, ShowDrawing
 from ..values.state import DrawingLayer, DrawingsChanged, DrawingsState
 from .connection import AriaClient, Packet
-from .drawing_list import LIST, decode_points, drawing_list, drawing_sample
+from .drawing_budget import sample_array, thin
+from .drawing_list import LIST, drawing_list, drawing_sample
 from .errors import ClientError
 from .feed import Feed, FeedContext
 
@@ -43,6 +52,10 @@ MAX_REFRESH_MS = 2**31 - 1
 ``byte4``), and a drawing list may suggest up to 2³²−1 (24 days or 49 are the same thing: one sample)."""
 PUBLISH_EVERY = 0.05
 """Seconds between two published states at most (samples arriving faster are coalesced)."""
+LOOP_SHARE = 0.1
+"""At most this share of the network loop's time goes to publishing drawings: after a state that
+took ``t`` s of CPU to make, the next waits at least ``t / LOOP_SHARE`` (a flood is shown less
+often rather than let it delay a ``ratioDrive``)."""
 
 
 class DrawingsFeed(Feed):
@@ -56,14 +69,24 @@ class DrawingsFeed(Feed):
         self._client: AriaClient | None = None
         self._drawings: tuple[Drawing, ...] = ()
         self._points: dict[str, tuple[tuple[int, int], ...]] = {}
+        """What the window was last given of each drawing (thinned to the budget)."""
+        self._raw: dict[str, bytes] = {}
+        """Each drawing's newest sample not yet decoded (an older one is dropped unread)."""
+        self._arrays: dict[str, np.ndarray] = {}
+        """Each drawing's last good sample, decoded (numpy views, no Python objects per point)."""
+        self._last_raw: dict[str, bytes] = {}
         self._problems: dict[str, str] = {}
         self._requested: set[str] = set()
         self._choices: dict[str, bool] = {}
         self._offered = False
         self._note = ""
         self._flush_pending = False
+        self._cost = 0.0
+        """CPU seconds the last published state took to make (paces the next: :data:`LOOP_SHARE`)."""
         self.bad_samples = 0
         """Samples refused on this session (malformed or too many points)."""
+        self.samples = 0
+        """Samples received on this session (most of a flood is dropped unread)."""
 
     # -- connection --------------------------------------------------------------------------
     def connected(self, client: AriaClient) -> None:
@@ -82,6 +105,9 @@ class DrawingsFeed(Feed):
         self._client = client
         self._drawings = ()
         self._points.clear()
+        self._raw.clear()
+        self._arrays.clear()
+        self._last_raw.clear()
         self._problems.clear()
         self._requested.clear()
         self._offered = False
@@ -157,7 +183,7 @@ class DrawingsFeed(Feed):
             elif not wanted and d.name in self._requested:
                 self._requested.discard(d.name)
                 client.stop_request(d.name)
-                self._points.pop(d.name, None)
+                self._forget(d.name)
                 self._problems.pop(d.name, None)
 
     def _ask(self, client: AriaClient, d: Drawing) -> None:
@@ -170,8 +196,8 @@ class DrawingsFeed(Feed):
     async def _first_sample(self, client: AriaClient, name: str) -> None:
         with contextlib.suppress(ClientError):
             sample = await drawing_sample(client, name, self._timeout)
-            if client is self._client and name in self._requested:
-                self._points[name] = sample.points
+            if client is self._client and name in self._requested and name not in self._arrays:
+                self._arrays[name] = np.array(sample.points, dtype=np.int32).reshape(-1, 2)
                 self._schedule_publish()
 
     def _on_packet(self, packet: Packet) -> None:
@@ -184,27 +210,51 @@ class DrawingsFeed(Feed):
                 log.exception("the session's handler for %s failed", name)
         if name not in self._requested:
             return
-        try:
-            self._points[name] = decode_points(name, packet.payload).points
-            self._problems.pop(name, None)
-        except ClientError as exc:
-            self.bad_samples += 1
-            self._points.pop(name, None)
-            self._problems[name] = str(exc)
+        self.samples += 1
+        self._raw[name] = packet.payload  # the newest only: decoded when published
         self._schedule_publish()
+
+    def _forget(self, name: str) -> None:
+        self._points.pop(name, None)
+        self._raw.pop(name, None)
+        self._arrays.pop(name, None)
+        self._last_raw.pop(name, None)
+
+    def _decode_fresh(self) -> None:
+        """Decode the newest raw sample of each drawing that sent one since the last state."""
+        raw, self._raw = self._raw, {}
+        for name, payload in list(raw.items()):
+            if payload == self._last_raw.get(name):
+                del raw[name]  # the same sample again (a laser at rest): nothing to decode or thin
+                continue
+            self._last_raw[name] = payload
+            try:
+                self._arrays[name] = sample_array(name, payload)
+                self._problems.pop(name, None)
+            except ClientError as exc:
+                self.bad_samples += 1
+                self._arrays.pop(name, None)
+                self._problems[name] = str(exc)
+        if raw:
+            shapes = {d.name: d.shape for d in self._drawings}
+            kept = {n: (shapes.get(n, ""), a) for n, a in self._arrays.items() if n in self._requested}
+            self._points = thin(kept)
 
     # -- publishing --------------------------------------------------------------------------
     def _schedule_publish(self) -> None:
         if self._flush_pending:
             return
         self._flush_pending = True
-        asyncio.get_running_loop().call_later(PUBLISH_EVERY, self._flush)
+        asyncio.get_running_loop().call_later(max(PUBLISH_EVERY, self._cost / LOOP_SHARE), self._flush)
 
     def _flush(self) -> None:
         self._flush_pending = False
+        started = time.thread_time()
         self._publish_now()
+        self._cost = time.thread_time() - started
 
     def _publish_now(self) -> None:
+        self._decode_fresh()
         layers = tuple(
             DrawingLayer(
                 name=d.name,
@@ -217,6 +267,7 @@ class DrawingsFeed(Feed):
                 shown=self.shown(d) and d.known_shape is not None,
                 may_toggle=d.operator_may_toggle and d.known_shape is not None,
                 points=self._points.get(d.name, ()),
+                total_points=len(self._arrays[d.name]) if d.name in self._arrays else 0,
                 problem=self._problems.get(d.name, ""),
             )
             for d in self._drawings

@@ -6,9 +6,11 @@ server, feeding both into the same :class:`~rtmu.client.health.HealthMonitor` th
 uses. :meth:`DriveGuard.fault` says, in words, why driving must stop now — stale status,
 an unanswered or too slow ping, or a lost connection — or None while the link is OK.
 
-Status comes at 20 Hz (stale after 200 ms), and the ping is tighter than the window's
-(every :data:`PING_INTERVAL` s, answered within :data:`MAX_RTT` s): a script has no operator
-watching the link cell, and a server that stopped reading would never hear its ``stop``.
+Status comes at 20 Hz and the ping is tighter than the window's (every :data:`PING_INTERVAL` s):
+a script has no operator watching the link cell, and a server that stopped reading would never
+hear its ``stop``. How late either may be is learned per link by the window's own rule
+(:mod:`~rtmu.base.link_timing`): status is stale after 0.2 s on a steady link and at most
+0.45 s on a jittery one; a ping must be answered within 0.4–:data:`MAX_RTT` s.
 """
 
 from __future__ import annotations
@@ -27,11 +29,13 @@ from .health import HealthMonitor, ping_data
 
 STATUS_INTERVAL_MS = 50
 STALE_INTERVALS = 4
-"""Stale after 200 ms without status: with the fault falling anywhere between two status packets,
-the stop leaves 150–200 ms after it, inside the window's 300 ms promise with room for a busy machine."""
+"""The stale limit's floor, 200 ms without status: what a steady link gets (the limit learned for
+a jittery one is higher, up to ``link_timing.STATUS_CEILING``)."""
 PING_INTERVAL = 0.25
+PING_FLOOR = 0.4
 MAX_RTT = 0.5
-"""A ping not answered within this many seconds counts as a link fault (round trip too high)."""
+"""A ping not answered within this many seconds counts as a link fault (round trip too high); the
+deadline learned on a steady link is shorter, down to :data:`PING_FLOOR`."""
 
 
 class LinkFault(ClientError):
@@ -50,7 +54,12 @@ class DriveGuard:
         self.client = client
         self.max_rtt = max_rtt
         self.ping_interval = ping_interval
-        self.health = HealthMonitor(STATUS_INTERVAL_MS / 1000.0, stale_intervals=STALE_INTERVALS)
+        self.health = HealthMonitor(
+            STATUS_INTERVAL_MS / 1000.0,
+            stale_intervals=STALE_INTERVALS,
+            ping_floor=PING_FLOOR,
+            ping_ceiling=max_rtt,
+        )
         self.changed = asyncio.Event()
         """Set whenever something arrives or fails that may change :meth:`fault` (a wake-up)."""
         self._ping_task: asyncio.Task[None] | None = None
@@ -61,6 +70,8 @@ class DriveGuard:
     def start(self) -> None:
         """Subscribe to status at 10 Hz and start pinging; the status age counts from now."""
         self.health.start(self.client.clock())
+        client = self.client
+        self.health.bind(f"{client.host}:{client.port}", lambda: client.last_packet_at, client.undecided)
         if self.client.on_close is None:  # a lost connection wakes the drive loop at once
             self.client.on_close = lambda error: self.changed.set()
         self.client.request(self._status_name, STATUS_INTERVAL_MS, self._on_status)
@@ -79,7 +90,7 @@ class DriveGuard:
         while self.client.connected:
             started = time.perf_counter()
             try:
-                await self.client.request_once(name, timeout=self.max_rtt)
+                await self.client.request_once(name, timeout=self.health.ping_deadline(self.client.clock()))
             except ClientTimeout:
                 self.health.note_ping_timeout()
                 self.changed.set()
@@ -87,7 +98,7 @@ class DriveGuard:
                 self.changed.set()
                 return
             else:
-                self.health.note_rtt(time.perf_counter() - started)
+                self.health.note_rtt(time.perf_counter() - started, self.client.clock())
             await asyncio.sleep(self.ping_interval)
 
     def next_check(self, now: float) -> float:
@@ -96,16 +107,16 @@ class DriveGuard:
 
     def fault(self, now: float) -> str | None:
         """Why driving must stop now (one sentence naming the fault), or None while the link is OK."""
-        where = f"{self.client.host}:{self.client.port}"
         error = self.client.closed_error
         if error is not None:
             return f"lost the link: {error}"
         if self.health.level(now) is LinkLevel.OK:
             return None
-        if self.health.ping_failures:
-            return f"{where} did not answer a ping within {self.max_rtt * 1000:.0f} ms (round trip too high)"
-        age = self.health.status_age(now) or 0.0
-        return f"no status from {where} for {age * 1000:.0f} ms (the link is stale)"
+        return self.health.cause(now)
+
+    def advice(self) -> str:
+        """What to do about the last :meth:`fault`."""
+        return self.health.advice()
 
     async def close(self) -> None:
         """Stop pinging (the subscription ends with the connection)."""

@@ -54,7 +54,9 @@ class DriveFeed(Feed):
         config = ctx.config
         self.lease = ctx.lease
         self.governor = DriveGovernor(self.lease)
-        self.health = HealthMonitor(config.status_interval_ms / 1000.0, lost_after=config.lost_after)
+        self.health = HealthMonitor(
+            config.status_interval_ms / 1000.0, lost_after=config.lost_after, ping_ceiling=config.ping_timeout
+        )
         self.guardian = GuardianLink(ctx.notice, config)
         self._held_since: float | None = None
         """Since when a live lease has waited for the guardian to be armed (see :meth:`_unguarded`)."""
@@ -71,8 +73,17 @@ class DriveFeed(Feed):
         self._kick = asyncio.Event()
         self._stepped = asyncio.Event()
         self._heart_task: asyncio.Task[None] | None = None
+        self.stop_on_connect = False
+        """The link was lost while driving: the next connection (made at once) begins with a stop."""
 
     # -- the connection --------------------------------------------------------------------------
+    def stop_first(self) -> None:
+        """A new connection is up: if ours was lost while driving, the robot may still be moving —
+        a stop is the first thing sent on it (the guardian's own link may have gone with ours)."""
+        if self.stop_on_connect:
+            self.stop_on_connect = False
+            self.send_stop("reconnected after the link was lost while driving")
+
     def connected(self, client: AriaClient) -> None:
         target = self.ctx.target
         if target is not None and client.supports("ratioDrive"):
@@ -81,16 +92,21 @@ class DriveFeed(Feed):
         self.lease.end(EndReason.DISCONNECTED)
         self.governor.reset()
         self.health.start(self.ctx.clock())
+        where = f"{target.host}:{target.port}" if target is not None else "the server"
+        self.health.bind(where, lambda: client.last_packet_at, client.undecided)
         self.ctx.spawn(self._ping_loop(client), "ping")
         self.kick()
 
     def disconnected(self) -> None:
+        self.stop_on_connect = False  # forgotten on purpose: the next connection may be another robot
         self.guardian.close()
         self.health.stop()
         self.governor.reset()
 
     def lost(self) -> None:
-        """Our link died, not by our choice: while driving, only the guardian (its own link) can stop."""
+        """Our link died, not by our choice: while driving, only the guardian (its own link) can stop —
+        and the first reconnect, made at once, begins with a stop (:meth:`stop_first`)."""
+        self.stop_on_connect = self.governor.driving
         self.guardian.lost(driving=self.governor.driving)
         self.lease.end(EndReason.DISCONNECTED)
         self.governor.reset()
@@ -172,11 +188,10 @@ class DriveFeed(Feed):
         if name is None:
             return
         config = self.ctx.config
-        timeout = config.ping_timeout or config.lost_after
         while client.connected:
             started = time.perf_counter()
             try:
-                reply = await client.request_once(name, timeout=timeout)
+                reply = await client.request_once(name, timeout=self.health.ping_deadline(self.ctx.clock()))
             except ClientTimeout:
                 # The server may have stopped reading: it would not hear a stop either.
                 self.health.note_ping_timeout()
@@ -185,7 +200,7 @@ class DriveFeed(Feed):
             except ClientError:
                 return
             else:
-                self.health.note_rtt(time.perf_counter() - started)
+                self.health.note_rtt(time.perf_counter() - started, self.ctx.clock())
                 self.on_ping_reply(name, reply.payload)
                 self.publish_health()
             await asyncio.sleep(config.ping_interval)
@@ -261,9 +276,12 @@ class DriveFeed(Feed):
             wake = min(now + HEART_IDLE_SLEEP if idle else self.governor.next_wakeup(now),
                        self.health.next_change(now))  # fmt: skip
             delay = min(HEART_IDLE_SLEEP if idle else HEART_MAX_SLEEP, max(0.0, wake - self.ctx.clock()))
+            due = self.ctx.clock() + delay
             with contextlib.suppress(TimeoutError):
                 async with asyncio.timeout(delay):
                     await self._kick.wait()
+            if not self._kick.is_set():  # woke by its timer: how late this machine ran it
+                self.health.note_wake(self.ctx.clock() - due, self.ctx.clock())
 
     def _beat(self, now: float) -> None:
         if self.guardian.poll():
@@ -272,17 +290,21 @@ class DriveFeed(Feed):
         client = self.ctx.client
         if self.busy() and client is not None:
             self.health.note_traffic(client.last_packet_at)  # map bytes keep the link alive
+        else:
+            self.health.traffic_done()
         level = self.health.level(now)
         link_ok = level is LinkLevel.OK and client is not None and client.connected
         if self._unguarded(now):
             link_ok = False  # nothing is sent until the guardian is armed (a drive going was ended above)
-        for action in self.governor.step(now, link_ok):
+        for action in self.governor.step(
+            now, link_ok, lambda: f"{self.health.cause(now)}. {self.health.advice()}"
+        ):
             if isinstance(action, SendRatios):
                 r = action.ratios
                 self.guardian.arm()  # before the first ratioDrive of a drive
                 self.send(RatioDrive(r.trans, r.rot, r.throttle, r.lat or None))
             elif isinstance(action, SendStop):
-                self.send_stop(f"lease {action.reason.value}")
+                self.send_stop(f"lease {action.reason.value}" + (f": {action.why}" if action.why else ""))
         self.publish_health(now)
         target = self.ctx.target
         if level is LinkLevel.LOST and client is not None and target is not None and target.auto_reconnect:

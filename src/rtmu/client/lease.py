@@ -20,7 +20,7 @@ from __future__ import annotations
 import threading
 import time
 from collections.abc import Callable
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 from enum import Enum
 
 LEASE_TTL = 0.3
@@ -93,11 +93,20 @@ class DriveLease:
         self.on_change: Callable[[], None] | None = None
         self.on_event: Callable[[LeaseEvent], None] | None = None
         """Optional tap (a recorder) on grants, changes and ends; called on the calling thread."""
+        self.on_renew: Callable[[], None] | None = None
+        """Called on the renewing thread after each grant, renewal or change (the lease keeper's account)."""
+        self.before_lapse: Callable[[float], None] | None = None
+        """Called (outside the lock) when a lease not ended is found past its time, before anyone
+        acts on it: the :class:`~rtmu.client.lease_keeper.LeaseKeeper` catches up first — its own
+        thread may have waited behind a starved renewer too."""
         self._lock = threading.Lock()
         self._generation = 0
         self._ratios = STOPPED
         self._renewed_at = float("-inf")
+        self._real_renewal: tuple[float, int] | None = None
+        """(time, thread id) of the last grant, renewal or change by the UI side (not an extension)."""
         self._ended: EndReason | None = EndReason.RELEASED
+        self._why = ""
 
     # -- UI side -----------------------------------------------------------------------------
     def grant(self, ratios: DriveRatios) -> int:
@@ -106,30 +115,72 @@ class DriveLease:
             self._generation += 1
             self._ratios = ratios
             self._renewed_at = self.clock()
+            self._real_renewal = (self._renewed_at, threading.get_native_id())
             self._ended = None
+            self._why = ""
             generation = self._generation
+        self._renewed()
         self._event(LeaseEvent("grant", generation, ratios))
         self._changed()
         return generation
 
+    def _catch_up(self) -> None:
+        hook = self.before_lapse
+        if hook is None:
+            return
+        with self._lock:
+            now = self.clock()
+            expired = self._ended is None and not self._live(now)
+        if expired:
+            hook(now)
+
     def renew(self) -> bool:
         """Keep a live lease alive; False when it has lapsed or was ended (it stays dead)."""
+        self._catch_up()
         with self._lock:
             now = self.clock()
             if not self._live(now):
                 return False
-            self._renewed_at = now
+            self._renewed_at = max(self._renewed_at, now)
+            self._real_renewal = (now, threading.get_native_id())
+        self._renewed()
+        return True
+
+    def _renewed(self) -> None:
+        hook = self.on_renew
+        if hook is not None:
+            hook()
+
+    def extend(self, at: float) -> bool:
+        """Move the renewal forward to ``at`` (never back, never past now): the
+        :class:`~rtmu.client.lease_keeper.LeaseKeeper`'s credit for a renewing thread that only waited
+        for a CPU. Only a lease nobody has ended, and only so far that it is live at ``at``'s credit:
+        one already ended (released, stopped, or found lapsed and ended) stays dead. True if it moved."""
+        with self._lock:
+            now = self.clock()
+            at = min(at, now)
+            if self._ended is not None or at <= self._renewed_at or now - at > self.ttl:
+                return False
+            self._renewed_at = at
             return True
+
+    def last_renewal(self) -> tuple[float, int] | None:
+        """(time, native thread id) of the UI side's last grant, renewal or change while the lease lives."""
+        with self._lock:
+            return self._real_renewal if self._ended is None else None
 
     def change(self, ratios: DriveRatios) -> bool:
         """New ratios for the live lease (one of two held keys released, speed step); renews it."""
+        self._catch_up()
         with self._lock:
             now = self.clock()
             if not self._live(now):
                 return False
             self._ratios = ratios
-            self._renewed_at = now
+            self._renewed_at = max(self._renewed_at, now)
+            self._real_renewal = (now, threading.get_native_id())
             generation = self._generation
+        self._renewed()
         self._event(LeaseEvent("change", generation, ratios))
         self._changed()
         return True
@@ -138,14 +189,18 @@ class DriveLease:
         """The operator let go: the network side sends zero ratios and ``stop``."""
         self.end(EndReason.RELEASED)
 
-    def end(self, reason: EndReason, generation: int | None = None) -> bool:
-        """End the lease (if ``generation`` is given, only that one); True if a live lease ended."""
+    def end(self, reason: EndReason, generation: int | None = None, why: str = "") -> bool:
+        """End the lease (if ``generation`` is given, only that one); True if a live lease ended.
+
+        ``why``: the measured cause, in words, where the side that ended it knows one (the network
+        side's link health, the lapse's length) — the view says it (:attr:`why`)."""
         with self._lock:
             if generation is not None and generation != self._generation:
                 return False
             was_live = self._ended is None
             if was_live:
                 self._ended = reason
+                self._why = why
             ended, ratios = self._generation, self._ratios
         if was_live:
             self._event(LeaseEvent("end", ended, ratios, reason))
@@ -154,6 +209,7 @@ class DriveLease:
 
     # -- both sides --------------------------------------------------------------------------
     def view(self, now: float | None = None) -> LeaseView:
+        self._catch_up()
         with self._lock:
             now = self.clock() if now is None else now
             return LeaseView(
@@ -165,6 +221,12 @@ class DriveLease:
         """Why the current lease ended; None while it has not been ended explicitly."""
         with self._lock:
             return self._ended
+
+    @property
+    def why(self) -> str:
+        """The measured cause given when the current lease ended ("" if none was given)."""
+        with self._lock:
+            return self._why
 
     def _live(self, now: float) -> bool:
         return self._ended is None and now - self._renewed_at <= self.ttl
@@ -190,6 +252,8 @@ class SendStop:
     """Zero ratios then ``stop``: what every end of motion sends."""
 
     reason: EndReason
+    why: str = field(default="", compare=False)
+    """The measured cause where the governor ended the lease itself (a bad link, a lapse)."""
 
 
 DriveAction = SendRatios | SendStop
@@ -218,7 +282,9 @@ class DriveGovernor:
     def driving(self) -> bool:
         return self._driving_generation is not None
 
-    def step(self, now: float, link_ok: bool = True) -> list[DriveAction]:
+    def step(
+        self, now: float, link_ok: bool = True, link_why: Callable[[], str] | None = None
+    ) -> list[DriveAction]:
         view = self.lease.view(now)
         if view.live and link_ok:
             fresh = self._driving_generation != view.generation or self._sent_ratios != view.ratios
@@ -230,16 +296,21 @@ class DriveGovernor:
             return []
         if self._driving_generation is None:
             return []
+        why = ""
         if view.ended is not None:
             reason = view.ended
         elif not link_ok and view.live:
             reason = EndReason.LINK
+            why = link_why() if link_why is not None else ""
         else:
             reason = EndReason.LAPSED
-        self.lease.end(reason, self._driving_generation)
+            silent = now - (view.expires_at - self.lease.ttl)
+            why = f"the drive was not renewed for {silent:.2f} s"
+        if not self.lease.end(reason, self._driving_generation, why):
+            why = self.lease.why if view.ended is not None else why
         self._driving_generation = None
         self._sent_ratios = None
-        return [SendStop(reason)]
+        return [SendStop(reason, why)]
 
     def next_wakeup(self, now: float) -> float:
         """When ``step`` must run again at the latest (a resend or the lease's expiry)."""

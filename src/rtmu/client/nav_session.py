@@ -31,7 +31,7 @@ from .connection import AriaClient, Packet
 from .errors import ClientError
 from .feed import Feed, FeedContext
 from .map_feed import goal_pose
-from .nav_status import MAX_TEXT, NAV_DATA, NavReading, path_remaining, read_status
+from .nav_status import MAX_TEXT, NAV_DATA, NavReading, path_remaining, read_motion
 from .subscriptions import Subscription
 
 MAX_GOALS = 10_000
@@ -57,7 +57,6 @@ class NavFeed(Feed):
         self._history = True
         """No status seen yet on this connection: an outcome read now happened before we came."""
         self._last: NavReading | None = None
-        self._last_dock: str | None = None
         self._sent_pose: tuple[float, float, float | None] | None = None
         self._pose = (0.0, 0.0)
 
@@ -111,7 +110,7 @@ class NavFeed(Feed):
 
     def _reset(self, state: NavState) -> None:
         was = self.state.navigating
-        self._history, self._last, self._last_dock, self._sent_pose = True, None, None, None
+        self._history, self._last, self._sent_pose = True, None, None
         self._set(state)
         if was:
             self.changed()
@@ -133,20 +132,16 @@ class NavFeed(Feed):
     def robot_changed(self, robot: RobotState) -> None:
         """Called with every new robot value: the words decide the phase, the pose the distance left."""
         self._pose = (robot.x, robot.y)
-        reading = read_status(robot.status, robot.mode_name)
-        if robot.status and (reading != self._last or robot.dock_state != self._last_dock):
-            self._read(reading, robot.dock_state)
-            self._last, self._last_dock = reading, robot.dock_state
+        reading = read_motion(robot.status, robot.mode_name, robot.dock_state)
+        if robot.status and reading != self._last:
+            self._read(reading)
+            self._last = reading
             self._history = False
         elif self.state.navigating and self.state.path:
             self._update(remaining_mm=path_remaining(robot.x, robot.y, self.state.path))
 
-    def _read(self, reading: NavReading, dock_state: str | None) -> None:
+    def _read(self, reading: NavReading) -> None:
         was = self.state.navigating
-        if reading.phase is NavOutcome.NONE and dock_state in ("Docking", "Docked"):
-            # An LD robot's dock reports through dockInfo, not through ARNL's words.
-            phase = NavOutcome.GOING if dock_state == "Docking" else NavOutcome.DOCKED
-            reading = NavReading(phase, "dock", text=dock_state)
         if reading.phase is NavOutcome.GOING:
             target = reading.target
             pose = self._sent_pose if target == "point" else goal_pose(self.ctx.map, target)

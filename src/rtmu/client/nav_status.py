@@ -76,6 +76,18 @@ def _bounded(text: str) -> str:
     return text[:MAX_TEXT]
 
 
+def read_motion(status: str, mode_name: str = "", dock_state: str | None = None) -> NavReading:
+    """What the robot is doing on its own, for the window and the command line alike: the status read
+    by :func:`read_status`, with an LD robot's ``dockInfo`` state (``dock_state``) answering unless the
+    status says it is on its way somewhere — its status may still read "Arrived at …" from the goto
+    before the dock."""
+    reading = read_status(status, mode_name)
+    if reading.phase is not NavOutcome.GOING and dock_state in ("Docking", "Docked"):
+        phase = NavOutcome.GOING if dock_state == "Docking" else NavOutcome.DOCKED
+        return NavReading(phase, "dock", text=dock_state)
+    return reading
+
+
 def read_status(status: str, mode_name: str = "") -> NavReading:
     """Read one ``updateStrings`` status; ``mode_name`` (``getModeInfo``, "" if unknown) keeps a
     ``Going to …`` of some other mode from counting as navigation."""

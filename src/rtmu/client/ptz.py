@@ -155,7 +155,7 @@ class PtzFeed(Feed):
         self._sync()
 
     async def refresh(self) -> None:
-        """Read the position once (after login, and after each move when nobody polls)."""
+        """Read the position once (after login, and after each move)."""
         client, name = self._client, self._name("getCameraData")
         if client is None or not name:
             return
@@ -201,8 +201,9 @@ class PtzFeed(Feed):
         self._after_move()
 
     def _after_move(self) -> None:
-        if not self._polling:
-            self.ctx.spawn(self.refresh(), "ptz-refresh")
+        """Read where the head went at once, polled or not: the camera page's label follows the key
+        press, not the next poll (a head still moving is read again by the poll)."""
+        self.ctx.spawn(self.refresh(), "ptz-refresh")
 
     def _require(self, command: str) -> tuple[AriaClient, str]:
         client, name = self._client, self._name(command)

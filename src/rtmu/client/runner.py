@@ -31,10 +31,12 @@ fail has something behind it:
    own 10 Hz timer renews it while the key is held. Release, focus loss, a stop,
    a stale link or a lease not renewed for 300 ms (a frozen or busy UI) end it,
    and a dead lease never comes back without a fresh key press (also after a
-   reconnect).
+   reconnect). A UI that only waited for a CPU is credited that time by the
+   :class:`~rtmu.client.lease_keeper.LeaseKeeper` (up to 1 s).
 2. **The network loop sends ``ratioDrive`` only while the lease is fresh**, at
    10 Hz, and zero ratios + ``stop`` the moment it ends or lapses, or the link
-   health is not OK (no status for 300 ms, or a ping unanswered). It wakes at the
+   health is not OK (no status for the limit learned for this link, 0.3–0.45 s in
+   the window — ``base.link_timing`` —, or a ping unanswered). It wakes at the
    exact expiry, so a lapse costs at most the lease's 300 ms. ``disconnect``,
    ``close``, connecting elsewhere and ``stop()`` all send zero ratios + ``stop``.
 3. **If the network loop itself is blocked**, nothing can be sent — neither the
@@ -69,10 +71,12 @@ from typing import Any, TypeVar, overload
 from ..base.notices import Kind, Notice
 from ..values.intents import Intent, Stop
 from ..values.state import StateChange, StateSink
+from . import lease_keeper
 from .config_feed import ConfigFeed
 from .connection import AriaClient
 from .errors import ClientError, ClientTimeout
 from .lease import LEASE_TTL, DriveLease, EndReason
+from .lease_keeper import LeaseKeeper, raise_priority
 from .link import Opener
 from .session import Session
 from .session_config import SessionConfig
@@ -124,6 +128,12 @@ class ClientRunner:
         self.clock = clock
         self.config = config or SessionConfig()
         self.lease = DriveLease(ttl=lease_ttl, clock=clock)
+        # Run-queue waits are real time: credited only to a lease on the real clock (not a test's).
+        keep = clock is time.monotonic and lease_keeper.CREDITING
+        self.keeper = LeaseKeeper(self.lease, beat=self._beat_ui_at) if keep else None
+        if self.keeper is not None:
+            self.lease.on_renew = self.keeper.renewed
+            self.lease.before_lapse = self.keeper.step
         self.on_notice: Callable[[Notice], None] | None = None
         """``on_notice(notice)``, called on the UI thread (through ``post``)."""
         self.on_publish: Callable[[StateChange], None] | None = None
@@ -146,6 +156,8 @@ class ClientRunner:
 
     # -- lifecycle ---------------------------------------------------------------------------
     def start(self) -> ClientRunner:
+        if self.keeper is not None:
+            self.keeper.start()
         self._thread.start()
         if not self._ready.wait(5):
             raise RuntimeError("the network thread did not start")
@@ -158,6 +170,7 @@ class ClientRunner:
         self.close()
 
     def _run(self) -> None:
+        raise_priority()  # where allowed: the loop that sends drives and stops must run on time
         asyncio.set_event_loop(self.loop)
         factory = None
         opener = self.opener
@@ -192,6 +205,8 @@ class ClientRunner:
 
     def close(self, timeout: float = 2.0) -> None:
         """Stop the robot, disconnect, end the thread. Idempotent; returns within ``timeout``."""
+        if self.keeper is not None:
+            self.keeper.close()
         if self._closed or not self._thread.is_alive():
             self._closed = True
             self._blocking.shutdown(wait=False, cancel_futures=True)
@@ -441,6 +456,13 @@ class ClientRunner:
             return False
         guardian.beat_ui()
         return guardian.armed
+
+    def _beat_ui_at(self, at: float) -> None:
+        """The lease keeper's beat for a UI thread that only waited for a CPU (keeper thread)."""
+        session = self.session
+        guardian = session.guardian if session is not None else None
+        if guardian is not None:
+            guardian.beat_ui(at)
 
     def status_age(self) -> float | None:
         """Seconds since the last status packet, read now; None when not connected.

@@ -42,6 +42,17 @@ def wifi_role(label: str) -> str | None:
     return None
 
 
+WIFI_QUALITY_SCALE = 70
+"""ARIA publishes the wireless link quality as Linux reads it (``/proc/net/wireless``: 0–70)."""
+
+
+def quality_percent(raw: int | None) -> int | None:
+    """A published link quality (0–70) in %: the one unit the window, the alarm and an LD robot use."""
+    if raw is None:
+        return None
+    return round(max(0.0, min(100.0, raw * 100 / WIFI_QUALITY_SCALE)))
+
+
 def _prefix_end(payload: bytes, count: int) -> int:
     """Where the first ``count`` NUL-terminated strings of ``payload`` end (all of it if fewer)."""
     end = 0
@@ -158,7 +169,8 @@ class StringsFeed(Feed):
         changes: dict[str, Any] = {}
         for i, role in self._roles:
             if i < len(values):
-                changes[role] = _int_or_none(values[i])
+                number = _int_or_none(values[i])
+                changes[role] = quality_percent(number) if role == "wifi_quality" else number
         if self.watching:
             shown = min(len(values), len(self._labels))
             changes["server_strings"] = tuple(

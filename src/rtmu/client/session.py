@@ -292,6 +292,7 @@ class Session:
             await client.disconnect()
             raise ServerClosed("the connection attempt was cancelled")
         self.client = client
+        self.drive.stop_first()  # lost while driving: the robot may still move, a stop goes out first
         self._subs = merged(
             applicable((s for f in self.feeds for s in f.subscriptions(client)), client.supports)
         )
@@ -302,7 +303,11 @@ class Session:
             feed.connected(client)
         self.sync_subscriptions()
         offers = frozenset(e.name for e in client.datalist)
-        self._set_connection(phase=Phase.CONNECTED, offers=offers, error="", error_kind="", retry_in=None)
+        tag, wanted, sent = client.server_words
+        self._set_connection(
+            phase=Phase.CONNECTED, offers=offers, error="", error_kind="", retry_in=None,
+            server_tag=tag, server_protocol=wanted, sent_protocol=sent,
+        )  # fmt: skip
         self.kick()
 
     def _subs_of(self, feed: Feed, client: AriaClient) -> list[Subscription]:
@@ -375,8 +380,10 @@ class Session:
 
     async def _reconnect(self, target: Target) -> None:
         backoff = self.config.backoff()
+        at_once = self.drive.stop_on_connect  # lost while driving: the first try carries a stop, no wait
         while self._target is target:
-            delay = backoff.next_delay()
+            delay = 0.0 if at_once else backoff.next_delay()
+            at_once = False
             self._set_connection(phase=Phase.RECONNECTING, attempt=backoff.attempt, retry_in=round(delay, 1))
             await asyncio.sleep(delay)
             if self._target is not target:

@@ -30,7 +30,7 @@ class SessionConfig:
     reply_timeout: float = 5.0
     lost_after: float = 2.0
     ping_timeout: float | None = None
-    """How long a ping may go unanswered (None: ``lost_after``)."""
+    """The longest a ping may go unanswered (None: ``health.PING_CEILING``; learned below it)."""
     fetch_map: bool = True
     backoff: Callable[[], Backoff] = field(default=Backoff)
     guardian: bool = False

@@ -14,8 +14,12 @@ Levels (the server's own words where it publishes them):
   (:attr:`RobotState.battery_low` / ``battery_shutdown``); low is a warning, at or
   under shutdown it is critical. A robot that gives no levels gets none in volts
   (a pack's voltage says nothing without them) and 20 % / 5 % in state of charge.
+  A docked robot is where the low warning sends the operator: docked (``dockInfo``,
+  or ARNL's "Docked" status), low is no alarm but a short "charging" note; undocked
+  while still low, it is raised again. Critical stays critical on the dock.
 * **Wi-Fi**: the link quality the server publishes (``getStrings``' "Wireless Link
-  Quality", the kernel's 0–70 scale): under :attr:`Thresholds.wifi_low` is a warning.
+  Quality", the kernel's 0–70 scale), in % as the toolbar shows it: under
+  :attr:`Thresholds.wifi_low` is a warning.
 * **Round trip**: the client's ping time (``LinkHealth.rtt_ms``) over
   :attr:`Thresholds.rtt_high_ms`, or unanswered pings, is a warning. A stale or lost
   link has its own banner already; without a connection every alarm clears silently.
@@ -30,7 +34,8 @@ import math
 from dataclasses import dataclass
 from enum import Enum, IntEnum
 
-from ..values.state import LinkHealth, LinkLevel, RobotState
+from ..client.nav_status import read_status
+from ..values.state import LinkHealth, LinkLevel, NavOutcome, RobotState
 
 
 class Alarm(Enum):
@@ -47,9 +52,10 @@ class Severity(IntEnum):
 
 @dataclass(frozen=True, slots=True)
 class Thresholds:
-    wifi_low: float = 20.0
-    """Quality (of 70) under which the Wi-Fi alarm is raised (≈ −90 dBm)."""
-    wifi_clear: float = 28.0
+    wifi_low: float = 29.0
+    """Quality (%) under which the Wi-Fi alarm is raised (20 of Linux's 70: ≈ −90 dBm)."""
+    wifi_clear: float = 40.0
+    """Quality (%) at which it clears (28 of 70)."""
     rtt_high_ms: float = 400.0
     rtt_clear_ms: float = 200.0
     ping_failures: int = 2
@@ -79,6 +85,9 @@ class AlarmMonitor:
     def __init__(self, thresholds: Thresholds | None = None) -> None:
         self.t = thresholds or Thresholds()
         self._severity: dict[Alarm, Severity] = dict.fromkeys(Alarm, Severity.CLEAR)
+        self.words: dict[Alarm, str] = {}
+        """What each active alarm says with the latest value ("… link quality 20 %"): a banner
+        raised at 14 % shows the number the toolbar shows now, without a new event or beep."""
 
     def severity(self, alarm: Alarm) -> Severity:
         return self._severity[alarm]
@@ -101,6 +110,7 @@ class AlarmMonitor:
         """No connection: the connection banner speaks now; every alarm clears, silently."""
         events = [AlarmEvent(a, Severity.CLEAR, "") for a, s in self._severity.items() if s]
         self._severity = dict.fromkeys(Alarm, Severity.CLEAR)
+        self.words = {}
         return events
 
     # -- each alarm ------------------------------------------------------------------------------
@@ -128,6 +138,8 @@ class AlarmMonitor:
             Severity.WARNING: f"Battery low: {shown} — bring the robot to its charger",
             Severity.CLEAR: f"Battery back to {shown}",
         }[now]
+        if now is Severity.WARNING and _docked(robot):
+            now, text = Severity.CLEAR, f"Battery low ({shown}), charging on its dock"
         self._change(Alarm.BATTERY, now, text, events)
 
     def _wifi(self, robot: RobotState, events: list[AlarmEvent]) -> None:
@@ -142,9 +154,9 @@ class AlarmMonitor:
         else:
             now = was
         text = (
-            f"Weak Wi-Fi on the robot: link quality {quality:.0f}/70"
+            f"Weak Wi-Fi on the robot: link quality {quality:.0f} %"
             if now
-            else f"Wi-Fi back: link quality {quality:.0f}/70"
+            else f"Wi-Fi back: link quality {quality:.0f} %"
         )
         self._change(Alarm.WIFI, now, text, events)
 
@@ -165,11 +177,22 @@ class AlarmMonitor:
         self._change(Alarm.RTT, now, text, events)
 
     def _change(self, alarm: Alarm, now: Severity, text: str, events: list[AlarmEvent]) -> None:
+        if now is Severity.CLEAR:
+            self.words.pop(alarm, None)
+        else:
+            self.words[alarm] = text
         if now is self._severity[alarm]:
             return
         worse = now > self._severity[alarm]
         self._severity[alarm] = now
         events.append(AlarmEvent(alarm, now, text, sound=worse))
+
+
+def _docked(robot: RobotState) -> bool:
+    """On its charger: ``dockInfo`` says Docked, or (a server without it) ARNL's status does."""
+    if robot.dock_state is not None:
+        return robot.dock_state == "Docked"
+    return read_status(robot.status).phase is NavOutcome.DOCKED
 
 
 def _reading(value: float | None) -> float | None:

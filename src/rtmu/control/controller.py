@@ -52,6 +52,9 @@ Navigation rules (the server drives: ARNL's goals, points, home, dock, tours)
 * No drive starts or goes on while the stop key cannot reach the window (:meth:`focus_lost` until
   :meth:`focus_gained` or a key press): a D-pad press then is refused, saying why
   (:meth:`pointer_may_drive`).
+* While the robot scans for a map, every intent that would move it on its own (a goal, a jog, a
+  patrol, a server command that may drive) is refused with the reason (``scan_rule``); held drives
+  and STOP go on as always.
 * Every stop the controller makes is said once, with what to do next.
 """
 
@@ -73,6 +76,7 @@ from . import intent_rules
 from .commands import COMMANDS, CommandRegistry, CommandState
 from .motion_limits import RobotLimits, capped_throttle
 from .motion_watch import MotionWatch
+from .scan_rule import scan_refusal
 
 TICK = 0.1
 """Seconds between :meth:`Controller.tick` calls the UI timer should make (10 Hz renewal)."""
@@ -143,6 +147,8 @@ class SecretStore(Protocol):
 
 
 REPLAY_REASON = "Replay — nothing is sent to a robot"
+KEYBOARD_LOST = "the window lost the keyboard"
+"""Why a held drive stops on a focus loss (a suspend names its own reason)."""
 
 
 def ratios_for(held: set[str] | frozenset[str], throttle: float) -> DriveRatios:
@@ -437,20 +443,18 @@ class Controller:
             self.link.lease.end(reason, self._generation)
             self._generation = None
         if had and reason is EndReason.LAPSED:
-            self.view.notify(
-                Notice.warning(
-                    Kind.SAFETY,
-                    "Stopped: the window did not respond in time (a busy computer?). Press again to drive.",
-                )
-            )
+            why = self.link.lease.why or "a busy computer?"
+            text = f"Stopped: the window did not respond in time ({why})"
+            self.view.notify(Notice.warning(Kind.SAFETY, f"{text}. Press again to drive."))
         elif had and reason is EndReason.LINK and not quiet:
             level = self.robot.health.value.level
             self._say_link_stop(level if level in (LinkLevel.STALE, LinkLevel.LOST) else LinkLevel.STALE)
 
     def _say_link_stop(self, level: LinkLevel) -> None:
-        self.view.notify(
-            Notice.warning(Kind.LINK, f"Stopped: the link is {level.value}. Press again once it is back.")
-        )
+        """Said once per stop, with the network side's measured cause where it gave one."""
+        why = self.link.lease.why or self.robot.health.value.cause
+        said = f" — {why}" if why else ". Press again once it is back."
+        self.view.notify(Notice.warning(Kind.LINK, f"Stopped: the link is {level.value}{said}"))
 
     def stop(self) -> None:
         """Stop now. Always sent, whatever the link looks like; held keys must be pressed again.
@@ -470,7 +474,7 @@ class Controller:
             self._record(Stop())
             self.link.send(Stop())
 
-    def focus_lost(self) -> None:
+    def focus_lost(self, why: str = KEYBOARD_LOST) -> None:
         """The window lost keyboard focus: key releases may never arrive, so stop a held drive.
 
         A navigation goes on: the server drives it, no key is held for it.
@@ -481,8 +485,8 @@ class Controller:
         driving = bool(self._held) or self._generation is not None
         if driving:
             self.stop()
-            said = "Stopped: the window lost the keyboard. Click the map, then press again to drive."
-            self.view.notify(Notice.warning(Kind.SAFETY, said))
+            then = "Click the map, then press again" if why == KEYBOARD_LOST else "Press again"
+            self.view.notify(Notice.warning(Kind.SAFETY, f"Stopped: {why}. {then} to drive."))
         if self._analog is not None:
             self._analog = None
             self._analog_blocked = True
@@ -538,11 +542,12 @@ class Controller:
         """Send one operator intent to this robot, after the rules that hold for every intent.
 
         Refused, with the reason shown, in a replay, while not connected (for an intent that needs
-        the server), where the server does not offer it, and where ``intent_rules`` refuses it (a
-        console motion request or a fix the operator has not confirmed). An intent that moves the
-        robot ends a held drive first (the network side sends its stop before the intent), and a new
-        goal makes drive keys drive again once the server has taken it. Returns what ``link.send``
-        returns (a Future of the answer), or None when refused. STOP has its own path: :meth:`stop`."""
+        the server), where the server does not offer it, where ``intent_rules`` refuses it (a
+        console motion request or a fix the operator has not confirmed), and — for one that moves the
+        robot — while it scans for a map (``scan_rule``). An intent that moves the robot ends a held
+        drive first (the network side sends its stop before the intent), and a new goal makes drive
+        keys drive again once the server has taken it. Returns what ``link.send`` returns (a Future
+        of the answer), or None when refused. STOP has its own path: :meth:`stop`."""
         if isinstance(intent, Stop):
             self.stop()
             return None
@@ -558,6 +563,10 @@ class Controller:
             if isinstance(intent, (RequestPicture, StartVideo)):
                 missing = "offer camera pictures"
             self.view.notify(Notice.warning(intent.kind, f"This server does not {missing}"))
+            return None
+        refusal = scan_refusal(intent, self.robot.scan.value)  # while scanning: only held drives move it
+        if refusal is not None:
+            self.view.notify(Notice.warning(intent.kind, refusal))
             return None
         goals = self.robot.navigation.value.goals
         if isinstance(intent, GotoGoal) and goals and intent.name not in goals:

@@ -15,11 +15,15 @@ Thresholds, and why they cannot cause a false stop:
   is gone: stop at once. A running process is never in that state, however
   busy, slow or starved it is, so GC pauses and CPU contention cannot trip it.
 * **a heartbeat late past its source's limit while armed** from a parent that
-  still runs: stop. The limit is :data:`SILENT_LATE` s by default: the parent's own drive
+  still runs: stop. The limit is at least :data:`SILENT_LATE` s: the parent's own drive
   lease lapses 0.3 s after its UI last renewed it, so by then the parent would stop the robot
   itself when it runs again — the guardian never ends a drive the parent would have continued.
   How late each source may be is asked of a :class:`BeatLimit` per source (the ``limits`` of
-  :class:`Watch`): a learned limit plugs in there.
+  :class:`Watch`). The process learns it (:func:`learned_limit`) by the link's own rule
+  (:mod:`rtmu.base.link_timing`): at most :data:`SILENT_CEILING` s on a parent whose threads a busy
+  machine often keeps waiting. The UI's beats carry the lease keeper's credited time
+  (``rtmu.client.lease_keeper``): a UI thread that only waits for a CPU is not silent, one that is
+  frozen is.
 
 Heartbeats carry the sender's monotonic time (one clock for all processes on
 Linux), and the pipe is drained before every decision, so a guardian that was
@@ -41,12 +45,16 @@ from collections.abc import Callable
 from pathlib import Path
 from typing import Protocol
 
+from ..base.link_timing import Deadline
 from . import messages as m
 from .halt import Halter
+from .handle import BEAT_PERIOD
 from .login import LoginState, RobotLogin
 
 QUICK_LATE = 0.1
 SILENT_LATE = 0.4
+SILENT_CEILING = 1.0
+"""The learned silent limit's ceiling (:func:`learned_limit`): a busy machine may delay a beat this much."""
 CHECK_PERIOD = 0.02
 """Seconds between looks while armed."""
 IDLE_PERIOD = 1.0
@@ -109,6 +117,12 @@ class FixedLimit:
         return self.seconds
 
 
+def learned_limit(_source: bytes) -> BeatLimit:
+    """How late one source's beats come, learned as a link's status is (``base.link_timing``):
+    :data:`SILENT_LATE` for a calm parent, up to :data:`SILENT_CEILING` for one a busy machine delays."""
+    return Deadline(BEAT_PERIOD, SILENT_LATE, SILENT_CEILING)
+
+
 LimitFor = Callable[[bytes], BeatLimit]
 """``limits(source)``: the limit of one heartbeat source (``BEAT_UI`` or ``BEAT_NET``), made once."""
 
@@ -158,8 +172,13 @@ class Watch:
         if late > QUICK_LATE and parent_frozen(self.parent):
             return f"the process driving the robot is stopped or gone (no heartbeat for {late * 1000:.0f} ms)"
         for kind, at in self.last.items():
-            if now - at > self.limit(kind, now):
-                return f"no heartbeat from the process driving the robot for {(now - at) * 1000:.0f} ms"
+            limit = self.limit(kind, now)
+            if now - at > limit:
+                thread = "UI" if kind == m.BEAT_UI else "network"
+                return (
+                    f"no heartbeat from the {thread} thread of the process driving the robot for "
+                    f"{(now - at) * 1000:.0f} ms (its beats normally come within {limit * 1000:.0f} ms)"
+                )
         return None
 
 
@@ -290,7 +309,7 @@ class Guardian:
             self.leave()
 
 
-def run(fd: int = 0, limits: LimitFor | None = None) -> int:
+def run(fd: int = 0, limits: LimitFor | None = learned_limit) -> int:
     os.set_blocking(fd, False)
     return Guardian(fd, Watch(os.getppid(), limits)).run()
 

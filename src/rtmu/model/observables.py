@@ -31,6 +31,7 @@ from collections.abc import Callable
 from dataclasses import dataclass
 from typing import Any, Generic, TypeVar
 
+from ..values.commission import ScanState, TransfersState
 from ..values.state import (
     CameraChanged,
     CameraImage,
@@ -52,7 +53,9 @@ from ..values.state import (
     PopupsState,
     RobotChanged,
     RobotState,
+    ScanChanged,
     StateChange,
+    TransfersChanged,
 )
 
 __all__ = [
@@ -71,8 +74,10 @@ __all__ = [
     "PopupsState",
     "RobotModel",
     "RobotState",
+    "ScanState",
     "SpeedSetting",
     "Trail",
+    "TransfersState",
     "ViewOptions",
 ]
 
@@ -199,6 +204,8 @@ class RobotModel:
         self.navigation: Observable[NavState] = Observable(NavState())
         self.popups: Observable[PopupsState] = Observable(PopupsState())
         self.drawings: Observable[DrawingsState] = Observable(DrawingsState())
+        self.scan: Observable[ScanState] = Observable(ScanState())
+        self.transfers: Observable[TransfersState] = Observable(TransfersState())
         self.trail = Trail()
         # The trail's observers run before any view's (added first), so a redraw sees the new point.
         self.robot.observe(self.trail.robot_moved)
@@ -223,6 +230,10 @@ class RobotModel:
                 self.popups.set(value)
             case DrawingsChanged(value):
                 self.drawings.set(value)
+            case ScanChanged(value):
+                self.scan.set(value)
+            case TransfersChanged(value):
+                self.transfers.set(value)
 
 
 # -- operator settings ---------------------------------------------------------------------------

@@ -162,6 +162,18 @@ class PacketDecoder:
         """Bytes held while waiting for the rest of a packet."""
         return len(self._buf) - self._pos
 
+    @property
+    def undecided(self) -> int:
+        """Valid packets seen so far behind a header that still waits for its body (0: none waits).
+
+        A client's link watch reads it: the stream is demonstrably alive and will be delivered
+        once :data:`STREAM_GOES_ON` of them prove the header a liar, so a stale verdict must not
+        race that proof (``rtmu.base.link_timing``)."""
+        chain = self._chain
+        if chain is None or chain[0] <= self._pos or self.buffered < 4:
+            return 0
+        return chain[2]
+
     def feed(self, data: bytes | bytearray | memoryview) -> list[Packet]:
         if data:
             self._buf += data

@@ -251,11 +251,17 @@ class Replayer:
 
     def status_age(self) -> float | None:
         """Seconds of *recording* time since the last server bytes shown: a paused replay is not stale,
-        a gap the live link had is (the window's staleness checks use this instead of the wall clock)."""
+        a gap the live link had is, a replay catching up with its clock after a seek is not (the
+        window's staleness checks use this instead of the wall clock)."""
         link = self.link
         if link is None or link.position == 0:
             return None
-        return max(0.0, (self.clock.now_ns() - link.delivered_ns) / 1e9)
+        now = self.clock.now_ns()
+        if not link.exhausted and link.recorded.chunks[link.position].at_ns <= now:
+            # Behind the clock (the rebuild after a seek back, a busy thread): the recorded bytes are
+            # being handed over as fast as they are read; the recording had no gap here.
+            return 0.0
+        return max(0.0, (now - link.delivered_ns) / 1e9)
 
     def seek_needs_rebuild(self, at_ns: int) -> bool:
         """A seek to before what the current link has delivered has to start again from the beginning."""

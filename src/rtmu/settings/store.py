@@ -8,6 +8,7 @@ when the variable is unset), a small flat TOML document::
     alarms_muted = true     # optional: the alarm beep is off (View > Alarm sound)
     near_people = true      # optional: View > Near people caps held driving …
     near_people_mm_s = 250  # … at this speed (mm/s, 50…1000; 250 when not given)
+    # optional: [notifications] battery_low = false … switches a desktop notification off
 
     [profiles."lab"]
     host = "10.0.0.5"
@@ -62,6 +63,8 @@ from dataclasses import dataclass, field, fields, replace
 from pathlib import Path
 from typing import Any
 
+from .notifications import notification_lines, parse_notifications
+
 log = logging.getLogger(__name__)
 
 DEFAULT_PORT = 7272
@@ -106,6 +109,12 @@ def parse_central(text: str) -> tuple[str, int]:
     if not host or len(host) > 255 or not port_text.isdigit() or not 1 <= int(port_text) <= 65535:
         raise ValueError(f"central server {text!r} is not HOST:PORT")
     return host, int(port_text)
+
+
+def address_name(host: str, port: int | str, user: str = "") -> str:
+    """The name RTMU gives a profile made from an address: ``host:port``, ``user@host:port``."""
+    user = user.strip()
+    return f"{user + '@' if user else ''}{host.strip()}:{str(port).strip()}"
 
 
 @dataclass(frozen=True, slots=True)
@@ -236,6 +245,8 @@ class Settings:
     """Held driving is capped at :attr:`near_people_mm_s` (View → Near people)."""
     near_people_mm_s: int | None = None
     """Its speed (mm/s) when the operator chose one; None: the window's default (250 mm/s)."""
+    notifications: dict[str, bool] = field(default_factory=dict)
+    """Desktop notifications switched on or off by kind (``settings.notifications``); unnamed: on."""
     layers: dict[str, dict[str, bool]] = field(default_factory=dict)
     """The operator's drawing choices per server (``"host:port"`` → drawing name → shown), as the
     optional tables ``[layers."10.0.0.5:7272"]`` with ``"sonarCurrent" = false`` lines."""
@@ -295,7 +306,10 @@ def parse_settings(text: str) -> Settings:
     version = doc.get("version", SCHEMA_VERSION)  # a hand-written file without the line: version 1
     if version != SCHEMA_VERSION:
         raise SettingsError(f"unknown settings version {version!r} (this RTMU writes {SCHEMA_VERSION})")
-    known = {"version", "last_profile", "profiles", "recording", "alarms_muted", "layers", *NEAR_PEOPLE_KEYS}
+    known = {
+        "version", "last_profile", "profiles", "recording", "alarms_muted", "layers", "notifications",
+        *NEAR_PEOPLE_KEYS,
+    }  # fmt: skip
     unknown = set(doc) - known
     if unknown:
         raise SettingsError(f"unknown settings: {', '.join(sorted(unknown))}")
@@ -328,6 +342,10 @@ def parse_settings(text: str) -> Settings:
         )
     settings.near_people_mm_s = cap
     settings.layers = _layers(doc.get("layers", {}))
+    try:
+        settings.notifications = parse_notifications(doc.get("notifications", {}))
+    except ValueError as exc:
+        raise SettingsError(str(exc)) from None
     return settings
 
 
@@ -500,6 +518,7 @@ def format_settings(settings: Settings) -> str:
             f"{f.name} = {_toml_value(getattr(settings.recording, f.name))}"
             for f in fields(settings.recording)
         ]
+    lines += notification_lines(settings.notifications)
     for server, choices in settings.layers.items():
         if choices:
             lines += ["", f"[layers.{_toml_string(server)}]"]

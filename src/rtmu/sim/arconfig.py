@@ -38,7 +38,7 @@ from rtmu.protocol.payloads.config import ConfigSectionPacketV1 as V1
 from rtmu.protocol.payloads.config import ConfigSectionPacketV2 as V2
 from rtmu.protocol.payloads.config import ConfigSectionPacketV3 as V3
 
-from . import p3dx
+from . import map_switch, p3dx
 
 if TYPE_CHECKING:
     from .context import ArConfigStore, SimHost
@@ -62,6 +62,8 @@ class SimParam:
     template: ConfigParam
     get: Callable[[], Value]
     set: Callable[[Value], None]
+    check: Callable[[Value], str] | None = None
+    """Why a value that fits the type cannot be taken ("" when it can): ``Files/Map`` names a missing file."""
 
     def current(self) -> ConfigParam:
         return replace(self.template, value=self.get())
@@ -89,9 +91,14 @@ class SimArConfig:
 
     # -- what there is ------------------------------------------------------------------------------
     def _add(
-        self, section: str, template: ConfigParam, get: Callable[[], Value], put: Callable[[Value], None]
+        self,
+        section: str,
+        template: ConfigParam,
+        get: Callable[[], Value],
+        put: Callable[[Value], None],
+        check: Callable[[Value], str] | None = None,
     ) -> None:
-        p = SimParam(section, template, get, put)
+        p = SimParam(section, template, get, put, check)
         self.params.append(p)
         if template.kind is not ParamType.SEPARATOR:
             self._by_key[(section.lower(), template.name.lower())] = p
@@ -259,6 +266,14 @@ class SimArConfig:
             lambda: ap.wall_loss_db,
             setter(ap, "wall_loss_db"),
         )
+        self.comments[map_switch.SECTION] = map_switch.COMMENT  # ARNL's map file (rtmu.sim.map_switch)
+        self._add(
+            map_switch.SECTION,
+            map_switch.TEMPLATE,
+            lambda: map_switch.current(self.host),
+            lambda v: map_switch.switch(self.host, str(v or "")),
+            lambda v: map_switch.problem(self.host, str(v or "")),
+        )
 
     def _margin(self, ahead: bool) -> tuple[Callable[[], Value], Callable[[Value], None]]:
         """Safe drive's margin, told as ARIA's limiter measures it: from half the robot's length (as
@@ -400,6 +415,8 @@ class SimArConfig:
                 error = (
                     f"{text.strip()} s is shorter than the 0.1 s between ratioDrive commands (0 disables it)"
                 )
+            if not error and p.check is not None:
+                error = p.check(value)
             if error:
                 return f"{p.section}/{p.template.name}: {error}", False
             planned.append((p, value))

@@ -14,7 +14,6 @@ from types import TracebackType
 from typing import TYPE_CHECKING, Any
 
 from ..base.exit_codes import signal_code
-from ..values.intents import RequestPicture
 
 if TYPE_CHECKING:
     from ..client.runner import ClientRunner
@@ -33,6 +32,7 @@ def follow(
 ) -> None:
     """Return after ``seconds`` (None: never) or once ``ended`` is set; ``beat``: heartbeat period."""
     from ..client.video_feed import picture_source
+    from ..values.intents import RequestPicture
 
     deadline = None if seconds is None else time.monotonic() + seconds
     period = 1.0 / camera_hz if camera_hz > 0 else None

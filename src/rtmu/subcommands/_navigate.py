@@ -19,7 +19,7 @@ from typing import TYPE_CHECKING, Any
 from ..base.exit_codes import EXIT_CANCELLED, EXIT_LOST, EXIT_OK, EXIT_REFUSED, EXIT_TIMEOUT, NETWORK
 from ..base.textsafe import visible
 from ..client.errors import ClientError, NotSupported
-from ..client.nav_status import NavReading, path_remaining, read_status
+from ..client.nav_status import NavReading, path_remaining, read_motion
 from ..protocol.errors import ProtocolError
 from ..protocol.payloads import Payload, Side, decode_payload
 from ..protocol.payloads.drive import RatioDrive
@@ -119,13 +119,7 @@ class _Watch:
         self.changed = asyncio.Event()
 
     def reading(self) -> NavReading:
-        r = read_status(self.status, self.mode_name)
-        # An LD robot says its docking in dockInfo; its status may still read "Arrived at …" from the goto
-        # before, so the dock state answers unless the status says it is on its way somewhere.
-        if r.phase is not NavOutcome.GOING and self.dock_state in ("Docking", "Docked"):
-            phase = NavOutcome.GOING if self.dock_state == "Docking" else NavOutcome.DOCKED
-            return NavReading(phase, "dock", text=self.dock_state)
-        return r
+        return read_motion(self.status, self.mode_name, self.dock_state)
 
     def handler(self, apply: Callable[[Any], None]) -> Callable[[Packet], None]:
         def on_packet(packet: Packet) -> None:

@@ -19,6 +19,11 @@ QUALITY_MAX = 100
 """ARIA's JPEG quality, as ``sendVideo`` takes it (0 would ask the camera for nothing usable)."""
 
 
+def plain(value: float) -> str:
+    """A limit as the operator would type it: ``1000000``, ``0.5`` — never ``1e+06``."""
+    return str(int(value)) if float(value).is_integer() else f"{value:g}"
+
+
 def number_in(
     low: float, high: float, *, integer: bool = False, zero: bool = False
 ) -> Callable[[str], float]:
@@ -34,7 +39,7 @@ def number_in(
             return value
         if not (math.isfinite(value) and low <= value <= high):
             extra = " (or 0)" if zero else ""
-            raise argparse.ArgumentTypeError(f"{text} is out of range: use {low:g}…{high:g}{extra}")
+            raise argparse.ArgumentTypeError(f"{text} is out of range: use {plain(low)}…{plain(high)}{extra}")
         return value
 
     parse.__name__ = "number"  # argparse names the type in its messages

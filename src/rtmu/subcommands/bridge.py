@@ -126,7 +126,16 @@ def handle(args: argparse.Namespace) -> int:
     warn_exposure(args.bind, args.allow_drive)
     runner.on_publish = bridge.published
     runner.on_notice_sent = bridge.notice
-    runner.on_stop = bridge.stopped
+
+    def stopped(reason: str, sent: bool) -> None:
+        bridge.stopped(reason, sent)
+        if reason.startswith("lease link"):  # a stream that paused is the operator's "release": not said
+            print(
+                f"rtmu bridge: stopped the robot: {visible(reason.removeprefix('lease link: '))}",
+                file=sys.stderr,
+            )
+
+    runner.on_stop = stopped
     with EndingSignals() as ending:
         try:
             bridge.start()

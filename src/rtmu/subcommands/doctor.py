@@ -3,7 +3,8 @@
 "It doesn't connect and I can't tell why" is what owners of ARIA robots ask most. The doctor
 tries each step on its own — name resolution, TCP connect, the server's introduction (its version
 tag and protocol string), the login, the data list (and which RTMU features the server offers),
-UDP, the first status — and for the first step that fails says in plain words what went wrong
+UDP, the first status and the status stream's timing (what RTMU learns from it: how long a drive
+waits for status before it stops) — and for the first step that fails says in plain words what went wrong
 and what to do next (the same words the window uses, :mod:`rtmu.client.diagnosis`). It stops
 there; the exit code names the step (10 name … 15 status; UDP never fails it, RTMU uses TCP).
 Connected, it asks the last question with a login of its own: why won't it move? — ``rtmu why``'s
@@ -33,6 +34,7 @@ from ..base.exit_codes import (
     EXIT_USAGE,
     WHY_ASKED,
 )
+from ..base.link_timing import STATUS_CEILING
 from ..base.textsafe import visible
 from ._common import (
     Interrupted,
@@ -58,6 +60,12 @@ READ_CHUNK = 65536
 NOT_ARIA_AFTER = 4096
 """Bytes without a single valid packet after which the peer is taken for something else."""
 UDP_WAIT_S = 2.0
+LINK_SECONDS = 3.0
+"""How long the status step watches the status stream to learn the link's timing (``--link-seconds``)."""
+ADVICE_LINK_STALLS = (
+    "the link held status back longer than RTMU waits before stopping a drive: check the robot's "
+    "Wi-Fi (signal, roaming, a crowded channel) before driving far"
+)
 
 FEATURES: tuple[tuple[str, str, tuple[str, ...]], ...] = (
     ("teleop", "drive with the keys", ("ratioDrive",)),
@@ -119,8 +127,18 @@ def features_of(names: set[str]) -> dict[str, bool]:
 class Doctor:
     """One walk to one server; :meth:`run` fills :attr:`steps` and returns the exit code."""
 
-    def __init__(self, host: str, port: int, user: str, password: str, protocol: str | None, timeout: float):
+    def __init__(
+        self,
+        host: str,
+        port: int,
+        user: str,
+        password: str,
+        protocol: str | None,
+        timeout: float,
+        link_seconds: float = LINK_SECONDS,
+    ):
         self.host, self.port, self.user = host, port, user
+        self.link_seconds = link_seconds
         self._password = password
         self._motion_password = password
         """Kept for the motion step's own login, forgotten once it has logged in."""
@@ -428,7 +446,60 @@ class Doctor:
             text += f", {status} ({mode})"
         details: dict[str, Any] = {"x": numbers.x, "y": numbers.y, "th": numbers.th, "status": status}
         details["battery_pct" if soc else "battery_v"] = numbers.battery
-        self.ok(Step.STATUS, text, **details)
+        advice = ""
+        if self.link_seconds > 0:
+            link = await self._link_timing(name)
+            details["link"] = link
+            text += (
+                f"; status every {link['status_every_ms']} ms for {self.link_seconds:g} s: longest gap "
+                f"{link['longest_gap_ms']} ms, learned jitter {link['jitter_ms']} ms, so driving stops "
+                f"after {link['stale_after_s']:.2f} s without status"
+            )
+            if link["longest_gap_ms"] > STATUS_CEILING * 1000:
+                advice = ADVICE_LINK_STALLS
+        self.ok(Step.STATUS, text, advice=advice, **details)
+
+    async def _link_timing(self, name: str) -> dict[str, Any]:
+        """Subscribe to status at ``rtmu drive``'s rate for :attr:`link_seconds` and learn its timing
+        by the rule the window and ``rtmu drive`` use (``base.link_timing``)."""
+        import asyncio
+
+        from ..client.drive_guard import STALE_INTERVALS, STATUS_INTERVAL_MS
+        from ..client.health import HealthMonitor
+        from ..protocol.errors import ProtocolError
+        from ..protocol.events import DataReceived
+
+        conn, reader = self.conn, self.reader
+        assert conn is not None and reader is not None
+        number = conn.number_of(name)
+        health = HealthMonitor(STATUS_INTERVAL_MS / 1000.0, stale_intervals=STALE_INTERVALS)
+        loop = asyncio.get_running_loop()
+        start = loop.time()
+        health.start(start)
+        conn.request(name, STATUS_INTERVAL_MS)
+        self._flush()
+        last, longest = None, 0.0
+        with contextlib.suppress(TimeoutError, OSError):
+            async with asyncio.timeout(self.link_seconds):
+                while data := await reader.read(READ_CHUNK):
+                    now = loop.time()
+                    for event in conn.receive_data(data):
+                        if isinstance(event, DataReceived) and event.command == number:
+                            longest = max(longest, now - last) if last is not None else 0.0
+                            last = now
+                            health.note_status(now)
+                    self._flush()
+        with contextlib.suppress(ProtocolError, KeyError):
+            conn.request_stop(name)
+            self._flush()
+        timing = health.timing(loop.time())
+        return {
+            "status_every_ms": STATUS_INTERVAL_MS,
+            "arrived": timing.samples + (1 if last is not None else 0),
+            "longest_gap_ms": round(longest * 1000),
+            "jitter_ms": round(timing.jitter * 1000),
+            "stale_after_s": round(timing.settled, 2),
+        }
 
     async def _motion(self) -> None:
         """``rtmu why``'s answer, asked over a login of its own (the steps above use the bare codec)."""
@@ -528,6 +599,13 @@ def register(subparsers: Any) -> None:
         help='one JSON object: {"server", "ok", "failed_step", "exit_code", "features", "steps": '
         '[{"step", "title", "result", "summary", "advice", ...}]}',
     )
+    p.add_argument(
+        "--link-seconds",
+        type=float,
+        default=LINK_SECONDS,
+        metavar="S",
+        help=f"watch the status stream this long to learn its timing (default {LINK_SECONDS:g}; 0: skip)",
+    )
     p.set_defaults(handler=handle)
 
 
@@ -535,19 +613,23 @@ MARKS = {"ok": "ok  ", "fail": "FAIL", "warn": "warn", "not_checked": "--  ", "s
 
 
 def handle(args: argparse.Namespace) -> int:
+    from ..settings.last_doctor import save_last_doctor
+
     host, port = args.server
     try:
         password = read_password(args)
     except UsageError as exc:
         print(f"rtmu doctor: {visible(exc)}", file=sys.stderr)
         return EXIT_USAGE
-    doctor = Doctor(host, port, args.user, password, args.protocol, args.timeout)
+    doctor = Doctor(host, port, args.user, password, args.protocol, args.timeout, max(0.0, args.link_seconds))
     try:
         code = run_interruptibly(doctor.run)
     except Interrupted as exc:
         print(f"rtmu doctor: {exc}", file=sys.stderr)
         return exc.exit_code
     failed = next((s for s in doctor.steps if s.result == "fail"), None)
+    lines = report_lines(doctor, host, port, args.user, failed, code)
+    save_last_doctor(lines)  # for the window's About ▸ debug information
     if args.json:
         print_json(
             {
@@ -560,13 +642,22 @@ def handle(args: argparse.Namespace) -> int:
             }
         )
         return code
-    print(f"rtmu doctor {host}:{port}" + (f" (user {args.user})" if args.user else ""))
-    for s in doctor.steps:
-        print(f"  [{MARKS.get(s.result, s.result)}] {s.step.title}: {visible(s.summary)}")
-        if s.advice:
-            print(f"         what to do: {visible(s.advice)}")
-    if failed is None:
-        print("All steps passed: RTMU can connect to this robot.")
-    else:
-        print(f"Stopped at the {failed.step.title} step (exit {code}).")
+    for line in lines:
+        print(line)
     return code
+
+
+def report_lines(
+    doctor: Doctor, host: str, port: int, user: str, failed: StepResult | None, code: int
+) -> list[str]:
+    """The human report, step by step (printed, and kept as the last one)."""
+    lines = [f"rtmu doctor {host}:{port}" + (f" (user {user})" if user else "")]
+    for s in doctor.steps:
+        lines.append(f"  [{MARKS.get(s.result, s.result)}] {s.step.title}: {visible(s.summary)}")
+        if s.advice:
+            lines.append(f"         what to do: {visible(s.advice)}")
+    if failed is None:
+        lines.append("All steps passed: RTMU can connect to this robot.")
+    else:
+        lines.append(f"Stopped at the {failed.step.title} step (exit {code}).")
+    return lines

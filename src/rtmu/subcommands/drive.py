@@ -2,10 +2,11 @@
 
 Sends ``ratioDrive`` every 100 ms for S seconds (ARIA's watchdog stops a robot
 that hears nothing for 2 s), then zero ratios and ``stop`` — also on Ctrl-C, SIGTERM,
-SIGHUP (the terminal or SSH session went away), SIGQUIT or any error — and prints the
-pose before and after (``--json``: one object ``{"before": STATUS, "after": STATUS,
-"seconds": S}`` with the keys of ``rtmu status``). Ctrl-Z (SIGTSTP) stops the robot
-before the process is suspended, and the drive is not resumed by ``fg``: it ends there.
+SIGHUP (the terminal or SSH session went away), SIGQUIT or any error, and on a new connection
+when ours was lost while driving — and prints the pose before and after (``--json``: one object
+``{"before": STATUS, "after": STATUS, "seconds": S}`` with the keys of ``rtmu status``).
+Ctrl-Z (SIGTSTP) stops the robot before the process is suspended, and the drive is not resumed
+by ``fg``: it ends there.
 
 A drive asked to move that did not move the robot never exits 0: the same answer as ``rtmu why``
 (:mod:`rtmu.client.why`) goes to stderr, read with the status words the server said while we
@@ -162,12 +163,18 @@ def handle(args: argparse.Namespace) -> int:
         except LinkFault as fault:
             stop(client)
             await guard.close()
-            if client.closed_error is not None:
+            if client.closed_error is not None:  # our connection is gone: a new one carries the stop
+                if await stop_on_a_new_connection(args):
+                    raise LinkFault(
+                        f"{fault}; zero ratioDrive and stop sent at once on a new connection. Check the "
+                        "robot's Wi-Fi and that its server still runs, then drive again."
+                    ) from None
                 raise LinkFault(
-                    f"{fault}; the stop could not be sent (the server's watchdog stops the robot)"
+                    f"{fault}; the stop could not be sent (the server's watchdog stops the robot within "
+                    "2 s). Check the robot's Wi-Fi and that its server still runs, then drive again."
                 ) from None
             await client.flush()
-            raise LinkFault(f"{fault}; zero ratioDrive and stop sent at once") from None
+            raise LinkFault(f"{fault}; zero ratioDrive and stop sent at once. {guard.advice()}") from None
         finally:
             stop(client)
             if beats is not None:
@@ -350,6 +357,39 @@ async def drive(
         with contextlib.suppress(TimeoutError):
             async with asyncio.timeout(max(0.0, wake - clock())):
                 await guard.changed.wait()
+        if not guard.changed.is_set():  # woke by its timer: how late this machine ran it
+            guard.health.note_wake(clock() - wake, clock())
+
+
+RECONNECT_FOR_STOP = 1.0
+"""Seconds a new connection may take to log in and carry the stop after ours was lost."""
+
+
+async def stop_on_a_new_connection(args: argparse.Namespace) -> bool:
+    """Log in again at once and send zero ratios + ``stop``; True once they have left this process."""
+    from ..client.connection import AriaClient
+    from ..client.errors import ClientError
+    from ..client.roles import Role
+
+    host, port = args.server
+    fresh = AriaClient()
+    try:
+        await fresh.connect(
+            host,
+            port,
+            args.user,
+            current_password(),
+            timeout=RECONNECT_FOR_STOP,
+            protocol=args.protocol,
+            role=Role.OPERATOR,  # it sends only zero ratios and stop
+        )
+        stop(fresh)
+        return await fresh.flush(RECONNECT_FOR_STOP)
+    except ClientError:
+        return False
+    finally:
+        with contextlib.suppress(ClientError):
+            await fresh.disconnect()
 
 
 def stop(client: AriaClient) -> None:

@@ -94,6 +94,9 @@ class WindowActions:
         self._plain("camera", self._camera)
         self._plain("settings", w.dialogs.open_settings)
         self._plain("server-config", w.dialogs.show_server_config)
+        self._plain("files", w.commissioning.show_files)
+        self._plain("scan", w.commissioning.scan)
+        self._plain("map-edit", w.commissioning.edit_map)
         self._plain("details", w.dialogs.show_details)
         self._plain("about", w.dialogs.show_about)
         self._plain("why", w.dialogs.show_why)
@@ -189,10 +192,13 @@ class WindowActions:
         return self.states.get(name, UNKNOWN)
 
     def _camera(self) -> None:
-        """Esc and the camera button: a pick mode ends first; else camera ⇄ map."""
+        """Esc and the camera button: a pick mode ends first, then the Layers panel closes; else
+        camera ⇄ map."""
         w = self.window
         if w.picker.active:
             w.picker.cancel()
+        elif w.layers.get_visible():
+            w.layers.close()
         else:
             w.camera_page.toggle()
 
@@ -303,6 +309,9 @@ class WindowActions:
             ("Connection settings…", "win.settings"),
             (config, "win.server-config"),
             ("Console…", "win.console"),
+            ("Files on the robot…", "win.files"),  # commissioning (``ui.commissioning``)
+            ("Scan a map…", "win.scan"),
+            ("Edit the map…", "win.map-edit"),
         )
         menu = self.server_menu
         shown = [menu.get_item_attribute_value(i, "label", None) for i in range(menu.get_n_items())]

@@ -63,6 +63,12 @@ class AlarmView:
                 self.beeps += 1
                 self.sounded.append(event.alarm)
                 self.beep()
+        for alarm, words in self.monitor.words.items():  # the latest value, as the toolbar shows it
+            topic = self.topic(alarm)
+            shown = self.banners.text(topic)
+            if shown is not None and shown != words:
+                level = LEVEL[self.monitor.severity(alarm)]
+                self.banners.tell(topic, level, words, timeout=None)
 
     def close(self) -> None:
         for remove in self._unobserve:

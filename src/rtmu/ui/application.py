@@ -39,6 +39,7 @@ from ..settings.store import (  # noqa: E402
     KeyringSecrets,
     Profile,
     Settings,
+    address_name,
     load_settings,
     parse_central,
     save_settings,
@@ -213,6 +214,7 @@ class RtmuApplication(Gtk.Application):
         window.near_people.use(NearPeople(self.settings.near_people, cap))
         window.near_people.on_change = self._near_people
         window.layers.use_choices(self.settings.layers)  # the operator's drawings, remembered per server
+        window.desktop.notifier.use(self.settings.notifications, on_change=self._notifications)
         # Closing the window stops every robot of the fleet, not only the one it shows.
         window.connect("close-request", lambda _w: self.fleet.stop_all() and False)
         if self.options.report_first_frame:
@@ -369,7 +371,7 @@ class RtmuApplication(Gtk.Application):
             match = next(
                 (p for p in s.profiles.values() if (p.host, p.port, p.user) == (o.host, port, user)), None
             )
-            name = o.profile or (match.name if match else f"{user + '@' if user else ''}{o.host}:{port}")
+            name = o.profile or (match.name if match else address_name(o.host, port, user))
             base = match or s.profiles.get(name) or Profile(name=name)
             profile = replace(base, name=name, host=o.host, port=port, user=user)
             if o.persist:
@@ -387,8 +389,15 @@ class RtmuApplication(Gtk.Application):
         self.settings.put(profile)
         if password is not None and profile.remember_password:
             self._store_password(profile, password)
-        if self.options.persist:
+        if self._saves_asked:
             self._save(background=True)
+
+    @property
+    def _saves_asked(self) -> bool:
+        """Whether what the operator saves on purpose (a profile, near people, muted alarms) is written.
+        ``--demo`` writes nothing by itself (its simulator's port changes every run) but keeps what the
+        operator saved; a replay writes nothing."""
+        return self.options.persist or (self.options.demo and self.options.replay is None)
 
     def _store_password(self, profile: Profile, password: str) -> None:
         """Into the keyring off the GTK thread: D-Bus or an unlock prompt may block for seconds.
@@ -429,12 +438,17 @@ class RtmuApplication(Gtk.Application):
             return
         self.settings.near_people = setting.on
         self.settings.near_people_mm_s = None if setting.mm_s == NearPeople().mm_s else setting.mm_s
+        if self._saves_asked:
+            self._save(background=True)
+
+    def _notifications(self, choices: dict[str, bool]) -> None:
+        self.settings.notifications = dict(choices)
         if self.options.persist:
             self._save(background=True)
 
     def _alarms_muted(self, muted: bool) -> None:
         self.settings.alarms_muted = muted
-        if self.options.persist:
+        if self._saves_asked:
             self._save(background=True)
 
     def _save(self, *, background: bool) -> None:
@@ -447,6 +461,7 @@ class RtmuApplication(Gtk.Application):
             near_people=s.near_people,
             near_people_mm_s=s.near_people_mm_s,
             layers={server: dict(choices) for server, choices in s.layers.items()},
+            notifications=dict(s.notifications),
         )
         path = self.options.settings_path
 

@@ -17,7 +17,11 @@ import gi
 gi.require_version("Gtk", "4.0")
 from gi.repository import GLib, Gtk  # noqa: E402
 
+from . import accessible  # noqa: E402
+
 MAX_BANNERS = 4
+MARGIN_TOP = 8
+"""Pixels between the top of the pages and the first banner (more under the navigation pill)."""
 HISTORY = 50
 MAX_CHARS = 300
 ICONS = {
@@ -46,7 +50,7 @@ class BannerStack(Gtk.Box):
         self.add_css_class("banner-stack")
         self.set_halign(Gtk.Align.CENTER)
         self.set_valign(Gtk.Align.START)
-        self.set_margin_top(8)
+        self.set_margin_top(MARGIN_TOP)
         self.set_can_target(True)
         self._banners: dict[str, _Banner] = {}
         self._order: list[str] = []
@@ -112,6 +116,23 @@ class BannerStack(Gtk.Box):
     def topics(self) -> list[str]:
         return list(self._order)
 
+    def keep_clear_of(self, *pills: Gtk.Widget) -> None:
+        """Start the column under the motion pills (the map's, the camera page's) while one is shown
+        where the column would cover it: a banner never hides what the robot is doing. Called by the
+        window's timer; the margin only changes when it must (no relayout otherwise)."""
+        top = MARGIN_TOP
+        parent = self.get_parent()
+        ok_own, own = self.compute_bounds(parent) if parent is not None else (False, None)
+        for pill in pills:
+            if parent is None or not ok_own or own is None or not pill.get_mapped() or not self._order:
+                continue
+            ok_pill, box = pill.compute_bounds(parent)
+            left, right = own.get_x(), own.get_x() + own.get_width()
+            if ok_pill and left < box.get_x() + box.get_width() and box.get_x() < right:
+                top = max(top, round(box.get_y() + box.get_height()) + MARGIN_TOP // 2)
+        if self.get_margin_top() != top:
+            self.set_margin_top(top)
+
     # -- internals ---------------------------------------------------------------------------
     def _make(self, topic: str) -> _Banner:
         while len(self._order) >= MAX_BANNERS:
@@ -131,6 +152,7 @@ class BannerStack(Gtk.Box):
         close.add_css_class("circular")
         close.set_focusable(False)
         close.set_tooltip_text("Dismiss")
+        accessible.name(close, "Dismiss")
         close.connect("clicked", lambda _b: self.dismiss(topic))
         for child in (icon, label, bar, close):
             box.append(child)

@@ -19,6 +19,8 @@ gi.require_version("Gtk", "4.0")
 gi.require_version("Pango", "1.0")
 from gi.repository import Gio, Gtk, Pango  # noqa: E402
 
+from . import accessible  # noqa: E402
+
 
 def stop_button(on_stop: Callable[[], None]) -> Gtk.Button:
     """A red STOP button (icon and word: readable at arm's length, not only by colour)."""
@@ -30,6 +32,7 @@ def stop_button(on_stop: Callable[[], None]) -> Gtk.Button:
     button.add_css_class("stop-button")
     button.set_focusable(False)
     button.connect("clicked", lambda _b: on_stop())
+    accessible.name(button, "STOP")  # GTK 4.8 does not name a button from a label inside a box
     return button
 
 
@@ -51,6 +54,7 @@ def menu_button(menu: Gio.MenuModel) -> Gtk.MenuButton:
     if inner is not None:
         inner.set_focusable(False)
     button.set_menu_model(menu)
+    accessible.name_menu_button(button, "Main menu")
     return button
 
 
@@ -127,6 +131,7 @@ class FullscreenBar(Gtk.Revealer):
             icon_name="view-restore-symbolic", tooltip_text="Leave full screen (F11)"
         )
         self.leave_button.set_focusable(False)
+        accessible.name(self.leave_button, "Leave full screen")
         self.leave_button.connect("clicked", lambda _b: on_leave())
         for child in (self.stop_button, self.connect_button, self.status_label, self.menu_button):
             box.append(child)

@@ -25,9 +25,18 @@ from ..model.observables import CameraImage  # noqa: E402
 from .toolbar import age_text  # noqa: E402
 
 MAX_SIDE = 4096
+DECODE_SIDE = 1024
+"""A bigger picture is decoded at 1/2, 1/4 or 1/8 scale (JPEG's own DCT scaling, no resampling)
+down to about this size: a window shows it no larger, and a 4096×4096 frame then costs 3 MB and
+~20 ms instead of 50 MB and ~140 ms a frame (a 632-byte JPEG may declare that much)."""
 INSET_SIZE = (176, 132)
 """The inset's largest size (and its thumbnail's)."""
 INSET_MIN_WIDTH = 96
+INSET_OLD_AFTER = 3.0
+"""Seconds after which the inset's picture is greyed and called old: live video is 15 pictures a
+second and one request answers in well under a second, so an older one is no view of now."""
+COMPACT_BAR_BELOW = 620
+"""Page width (px) under which the bar's "New picture" and "Back to map" become icons."""
 MAX_JPEG_BYTES = 16 * 1024 * 1024
 REQUEST_TIMEOUT = 7.0
 """Seconds the page waits for a requested picture before saying none came."""
@@ -56,7 +65,9 @@ def decode_jpeg(data: bytes) -> Decoded:
             w, h = img.size
             if not (0 < w <= MAX_SIDE and 0 < h <= MAX_SIDE):
                 raise ValueError(f"a {w}×{h} picture is out of range")
+            img.draft("RGB", (DECODE_SIDE, DECODE_SIDE))  # a no-op for all but big JPEGs
             rgb = img.convert("RGB")
+            w, h = rgb.size
             # A box reduce by a whole factor, never below the inset's size: ten times cheaper than
             # thumbnail()'s resampling (2.3 ms of a 640x480 frame's 3 ms), and GTK scales the rest.
             factor = max(1, min(w // INSET_SIZE[0], h // INSET_SIZE[1]))
@@ -165,6 +176,7 @@ class CameraView(Gtk.Box):
         self.image: CameraImage | None = None
         self.texture: Gdk.Texture | None = None
         self.requested_at: float | None = None
+        self._age_elsewhere = False
         self.error = ""
 
         overlay = self.overlay = Gtk.Overlay()
@@ -199,12 +211,10 @@ class CameraView(Gtk.Box):
         back = Gtk.Button.new_with_label("Back to map (Esc)")
         back.set_focusable(False)
         back.connect("clicked", lambda _b: on_back())
-        # On a phone's 360 px the two labels shrink (ellipsized) rather than make the window wider.
-        for button in (self.refresh_button, back):
-            label = button.get_child()
-            if isinstance(label, Gtk.Label):
-                label.set_ellipsize(Pango.EllipsizeMode.END)
-                button.set_tooltip_text(label.get_text())
+        self.back_button = back
+        self.compact = False
+        self._refresh_tip = "New picture"
+        self._words_on_buttons()
         for w in (self.info, self.refresh_button, back):
             bar.append(w)
         self.append(bar)
@@ -214,6 +224,16 @@ class CameraView(Gtk.Box):
     @property
     def waiting(self) -> bool:
         return self.requested_at is not None
+
+    @property
+    def age_shown_elsewhere(self) -> bool:
+        """Live video's caption over the picture says the frame's age (``ui.live_video``)."""
+        return self._age_elsewhere
+
+    @age_shown_elsewhere.setter
+    def age_shown_elsewhere(self, value: bool) -> None:
+        self._age_elsewhere = value
+        self.tick()
 
     def requesting(self) -> None:
         """A picture was asked for: show that it is coming (the old one stays, dimmed)."""
@@ -253,10 +273,41 @@ class CameraView(Gtk.Box):
 
     def set_available(self, enabled: bool, reason: str) -> None:
         self.refresh_button.set_sensitive(enabled)
-        self.refresh_button.set_tooltip_text("New picture" if enabled else f"Camera picture: {reason}")
+        self._refresh_tip = "New picture" if enabled else f"Camera picture: {reason}"
+        self.refresh_button.set_tooltip_text(self._refresh_tip)
+
+    def _buttons(self) -> tuple[tuple[Gtk.Button, str, str, str], ...]:
+        """(button, its words, its icon, its tooltip)."""
+        return (
+            (self.refresh_button, "New picture", "camera-photo-symbolic", self._refresh_tip),
+            (self.back_button, "Back to map (Esc)", "go-previous-symbolic", "Back to map (Esc)"),
+        )
+
+    def _words_on_buttons(self) -> None:
+        for button, words, _icon, tip in self._buttons():
+            button.set_label(words)
+            label = button.get_child()
+            if isinstance(label, Gtk.Label):  # shrinks (ellipsized) rather than widen the window
+                label.set_ellipsize(Pango.EllipsizeMode.END)
+            button.set_tooltip_text(tip)
+
+    def fit_bar(self, width: int) -> None:
+        """Under :data:`COMPACT_BAR_BELOW` px the two word buttons become icons (their words in the
+        tooltip): on a phone the words were cut to a letter."""
+        compact = 0 < width < COMPACT_BAR_BELOW
+        if compact == self.compact:
+            return
+        self.compact = compact
+        if compact:
+            for button, _words, icon, tip in self._buttons():
+                button.set_icon_name(icon)
+                button.set_tooltip_text(tip)
+        else:
+            self._words_on_buttons()
 
     def tick(self) -> None:
-        """Update the age line; give up on a request that took too long."""
+        """Update the age line; give up on a request that took too long; fit the bar to the width."""
+        self.fit_bar(self.get_width())
         now = self.clock()
         if self.requested_at is not None and now - self.requested_at > REQUEST_TIMEOUT:
             self.failed(f"No picture arrived within {REQUEST_TIMEOUT:.0f} s.")
@@ -265,7 +316,9 @@ class CameraView(Gtk.Box):
             self.info.set_text("Requesting…" if self.waiting else (self.error or "No picture"))
             return
         age = max(0.0, now - self.image.received_at)
-        text = f"{self.image.width}×{self.image.height} from {self.image.source} · {age_text(age)} old"
+        text = f"{self.image.width}×{self.image.height} from {self.image.source}"
+        if not self.age_shown_elsewhere:  # live video's caption says the frame's age: one age, not two
+            text += f" · {age_text(age)} old"
         if self.waiting:
             text += " · requesting a new one…"
         if text != self.info.get_text():
@@ -285,8 +338,9 @@ class CameraInset(Gtk.Box):
     """The last picture as a small inset on the map, with its age; a click opens the camera page.
 
     An old picture must never pass for the robot's view: the inset shows how old it is, turns
-    grey while the link is lost (:meth:`set_live`), and the window clears it on a new
-    connection. It sits in the bottom-left corner (top right while the touch D-pad is there)
+    grey and says "old picture" once it is older than :data:`INSET_OLD_AFTER` or while the link is
+    lost (:meth:`set_live`), and the window clears it on a new connection. It sits in the
+    bottom-left corner (top right while the touch D-pad is there)
     and takes about a sixth of the map's width, between :data:`INSET_MIN_WIDTH` and
     :data:`INSET_SIZE`.
     """
@@ -329,20 +383,27 @@ class CameraInset(Gtk.Box):
     def set_live(self, live: bool) -> None:
         """False while the link is lost: the picture is greyed, and says so."""
         self.live = live
-        if live:
+        self.tick()
+
+    @property
+    def old(self) -> bool:
+        """The picture is older than :data:`INSET_OLD_AFTER`: shown greyed and called old."""
+        return self.received_at is not None and self.clock() - self.received_at > INSET_OLD_AFTER
+
+    def tick(self) -> None:
+        """Update the age, and the grey of an old picture (the window calls this on its slow timer)."""
+        old = self.old
+        if self.live and not old:
             self.remove_css_class("stale")
         else:
             self.add_css_class("stale")
-        self.tick()
-
-    def tick(self) -> None:
-        """Update the age (the window calls this on its slow timer)."""
         if self.received_at is None:
             self._show_age("", None)
             return
         age = age_text(max(0.0, self.clock() - self.received_at))
+        fresh = f"old picture · {age}" if old else age
         self._show_age(
-            age if self.live else f"{age} · link lost",
+            fresh if self.live else f"{age} · link lost",
             f"Camera picture taken {age} ago (click or Esc for the camera view)"
             if self.live
             else f"Camera picture taken {age} ago, before the link was lost",

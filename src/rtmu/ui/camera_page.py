@@ -25,9 +25,11 @@ from ..control.commands import CommandState  # noqa: E402
 from ..fleet.selected import SelectedRobot  # noqa: E402
 from ..model.observables import CameraImage, ConnectionState, Phase, RobotModel  # noqa: E402
 from ..values.intents import PauseVideo, StartVideo, StopVideo, VideoShown  # noqa: E402
+from . import accessible  # noqa: E402
 from .banners import BannerStack  # noqa: E402
 from .camera import CameraView, PictureDecoder  # noqa: E402
 from .live_video import LiveVideoControls  # noqa: E402
+from .motion import MotionIndicator, held_by  # noqa: E402
 from .pip import PictureInPicture  # noqa: E402
 from .ptz_controls import PtzControls  # noqa: E402
 from .split_view import SplitView  # noqa: E402
@@ -66,11 +68,17 @@ class CameraPage:
             stop=lambda: robot.ask(StopVideo()), pause=lambda on: robot.ask(PauseVideo(on)),
             tell=lambda level, text: banners.tell("camera", level, text, timeout=5.0),
         )  # fmt: skip
+        # The motion pill here too (top right: the video's caption has the top left): looking at the
+        # camera never hides that the robot is navigating or driven.
+        self.motion = MotionIndicator(model, held=lambda: held_by(robot.session.controller, False))
+        self.motion.set_halign(Gtk.Align.END)
+        self.view.overlay.add_overlay(self.motion)
         self.decoder = PictureDecoder(self.picture_decoded)
         self.button = Gtk.ToggleButton(icon_name="camera-photo-symbolic")
         """The header's camera button: pressed while the page shows."""
         self.button.set_focusable(False)
         self.button.set_tooltip_text(BUTTON_TIP)
+        accessible.name(self.button, "Camera picture")
         self.button.connect("clicked", self._button_clicked)
         # What the page holds on a robot (the head polled, the video playing) moves with the selection.
         robot.on_switch(self.ptz.follow_selection)
@@ -93,8 +101,8 @@ class CameraPage:
         self.robot.session.controller.look("the camera page")  # a held drive ends; a navigation goes on
         self.stack.set_visible_child_name(PAGE)
         self.button.set_active(True)
-        if request or self.view.image is None:
-            self.request_picture()
+        if (request or self.view.image is None) and not self.live.live:
+            self.request_picture()  # (live video is the picture: no "Requesting…" over it)
 
     def show_map(self) -> None:
         self.stack.set_visible_child_name("map")
@@ -190,11 +198,14 @@ class CameraPage:
         self.inset.show_texture(None)
 
     def tick(self) -> None:
-        """Ages on the page and the inset (the window's slow timer)."""
+        """Ages on the page and the inset, the page's motion pill (the window's slow timer)."""
         self.view.tick()
         self.inset.tick()
+        if self.showing:
+            self.motion.refresh()
 
     def close(self) -> None:
         self._unobserve()
+        self.motion.close()
         self.ptz.close()
         self.decoder.close()

@@ -3,7 +3,9 @@
 Edits are kept by ``(section, name)`` until they are saved — across sections, pages, the
 priority filter and refreshes — as the text ``setConfig`` sends. A fetched configuration that
 already holds an edit's value (another client set exactly that) drops the edit; one that changed
-under an open page is said in words, naming the operator's own unsaved edits it changed. Saving
+under an open page is said in words, naming the operator's own unsaved edits it changed, and ends a
+"✓ accepted" that is no longer the value held. A value out of its limits is never clamped silently:
+the editor keeps the held value and the row says what was not taken and why. Saving
 builds the :class:`~rtmu.values.intents.SetConfig` intent from the edits; the server's answer is
 kept per parameter. The page (``ui.config_page``) only shows this state; keeping it GTK-free lets
 the rules be tested without a display.
@@ -56,6 +58,12 @@ class ConfigEdits:
         """Unsaved values (text, as ``setConfig`` sends them)."""
         self.answers: dict[Key, tuple[bool, str]] = {}
         """The server's last word on a parameter the operator saved: (accepted, text)."""
+        self.accepted: dict[Key, str] = {}
+        """The value each "✓ accepted" was for: another value fetched later ends that answer."""
+        self.refused: dict[Key, str] = {}
+        """A value the editor would not take (out of its limits), in words, until the next edit."""
+        self._wrong: dict[Key, tuple[str, str]] = {}
+        """The last wrong value typed in each editor, and why: said if the editor puts its value back."""
         self.fetches = 0
 
     # -- fetching ------------------------------------------------------------------------------
@@ -67,6 +75,11 @@ class ConfigEdits:
             param = config.find(*key)
             if param is not None and unchanged(param, text):
                 del self.edits[key]
+        for key, text in list(self.accepted.items()):  # another client set something else since
+            param = config.find(*key)
+            if param is None or not unchanged(param, text):
+                del self.accepted[key]
+                self.answers.pop(key, None)
 
     def changes_note(self, old: ServerConfig, new: ServerConfig) -> str:
         """What another client changed between ``old`` and ``new``, and which unsaved edits it touched."""
@@ -89,15 +102,27 @@ class ConfigEdits:
     def edit(self, key: Key, param: ConfigParam, text: str) -> bool:
         """The operator set ``param`` to ``text``; False when that changes nothing (an editor re-showing
         the value it holds, or the same edit again)."""
+        was = self.edits.get(key)
         if unchanged(param, text):
-            if key not in self.edits:
+            if was is None:
                 return False
             del self.edits[key]
-        elif self.edits.get(key) == text:
+            wrong = self._wrong.pop(key, None)
+            if wrong:  # the editor put its value back rather than take a wrong one: said, not silent
+                self.refused[key] = f"✗ {wrong[0]} not taken: {wrong[1]} (still {param.value_text()})"
+        elif was == text:
             return False
         else:
             self.edits[key] = text
+            self.refused.pop(key, None)
+            typed = text.strip()
+            why = check_value(param, text)
+            if typed and why:  # (an editor empties itself before it shows a value: that is no typing)
+                self._wrong[key] = (typed, why)
+            elif typed:
+                self._wrong.pop(key, None)
         self.answers.pop(key, None)
+        self.accepted.pop(key, None)
         return True
 
     def invalid(self) -> dict[Key, str]:
@@ -121,6 +146,8 @@ class ConfigEdits:
         if key in self.answers:
             ok, text = self.answers[key]
             return RowNote(text, "ok" if ok else "error")
+        if key in self.refused:
+            return RowNote(self.refused[key], "error")
         return RowNote()
 
     def can_save(self, saving: bool) -> bool:
@@ -131,7 +158,7 @@ class ConfigEdits:
         config = self.config
         if config is None:
             return ""
-        parts = [f"{config.param_count} parameters"]
+        parts = [f"{config.param_count} parameters"]  # separators are no parameters (param_count)
         if config.cut:
             parts.append(f"{config.cut} not shown (too many)")
         if self.edits:
@@ -165,6 +192,7 @@ class ConfigEdits:
                 if self.edits.get(key) == text:  # typed again meanwhile: that edit is still to save
                     del self.edits[key]
                 self.answers[key] = (True, "✓ accepted")
+                self.accepted[key] = text
             return ""
         blamed = [k for k in sent if names_param(reply.error, *k)]
         for key in sent:

@@ -11,7 +11,8 @@ What the operator typed and what the server answered live in a GTK-free
 :class:`~rtmu.ui.config_edits.ConfigEdits` (kept across sections, pages, the priority filter and
 refreshes); this window shows it. When another client changes the configuration (``configUpdated``)
 the page fetches it again, updates what the operator has not touched and says what changed — and
-which of the operator's own unsaved edits the other client changed under them. Requests go as
+which of the operator's own unsaved edits the other client changed under them. Closing it (Escape,
+the title bar) with unsaved edits asks first (``ui.discard_question``). Requests go as
 intents (``FetchConfig``, ``SetConfig``) through the window's ``request``: the selected robot's.
 A robot whose configuration RTMU cannot edit yet (an Omron LD robot's ``getConfigValues``) gets the
 plain sentence of which API it has, and a button to read it raw in the console (``console_page``).
@@ -22,7 +23,7 @@ from __future__ import annotations
 import concurrent.futures
 import contextlib
 import math
-from collections.abc import Callable
+from collections.abc import Callable, Collection
 from typing import Any
 
 import gi
@@ -36,7 +37,10 @@ from ..base.textsafe import visible  # noqa: E402
 from ..client.config_feed import MAX_TEXT, ConfigSection, ForeignConfig, ServerConfig  # noqa: E402
 from ..protocol.payloads.config import ConfigParam, ParamType, Priority, SetConfigReply  # noqa: E402
 from ..values.intents import FetchConfig, Intent  # noqa: E402
+from . import accessible  # noqa: E402
+from .config_care_view import ConfigCare  # noqa: E402
 from .config_edits import ConfigEdits, Key  # noqa: E402
+from .discard_question import DiscardQuestion  # noqa: E402
 
 Request = Callable[[Intent], "concurrent.futures.Future[Any]"]
 """The window's ``request``: an intent to the selected robot, its answer as a Future."""
@@ -59,13 +63,14 @@ class ConfigPage(Gtk.Window):
         parent: Gtk.Window | None,
         request: Request,
         follow: Follow,
+        offers: Callable[[], Collection[str]] = frozenset,
         open_console: Callable[[str], None] | None = None,
     ) -> None:
         super().__init__(
             title="Server configuration", transient_for=parent, modal=False, destroy_with_parent=True
         )
         self.set_default_size(760, 440)
-        self._request, self._follow = request, follow
+        self._request, self._follow, self._offers = request, follow, offers
         self._open_console = open_console
         """Opens the console filtered to a text (a configuration RTMU cannot edit is read there)."""
         self.state = ConfigEdits()
@@ -79,6 +84,7 @@ class ConfigPage(Gtk.Window):
         self._again = ""
         self.saving = False
         self.closed = False
+        self._discarding = False
         self._build()
         self._follow(self.remote_changed)
         self.connect("close-request", self._closing)
@@ -104,6 +110,7 @@ class ConfigPage(Gtk.Window):
         bar = Gtk.Box(spacing=8)
         bar.append(Gtk.Label(label="Show up to"))
         self.priority = Gtk.DropDown.new_from_strings(list(PRIORITY_LABELS))
+        accessible.name(self.priority, "Show up to")
         self.priority.set_selected(self.show_up_to)
         self.priority.connect("notify::selected", self._priority_chosen)
         bar.append(self.priority)
@@ -118,10 +125,17 @@ class ConfigPage(Gtk.Window):
         self.save_button.connect("clicked", lambda _b: self.save())
         bar.append(self.save_button)
         box.append(bar)
+        self.care = ConfigCare(self, self._request, self._offers, self._tell)
+        """Factory values, reset to default, export and import (``config_care_view``)."""
+        care_bar = Gtk.Box(spacing=8, halign=Gtk.Align.END)
+        care_bar.append(self.care.buttons)
+        box.append(care_bar)
         self.banner = Gtk.Label(xalign=0.0, wrap=True)
         self.banner.add_css_class("config-banner")
         self.banner.set_visible(False)
         box.append(self.banner)
+        self.discard = DiscardQuestion(self._discard_and_close)
+        box.append(self.discard)
         self.console_button = Gtk.Button(
             label="Read it in the console…", halign=Gtk.Align.START, visible=False
         )
@@ -161,16 +175,36 @@ class ConfigPage(Gtk.Window):
         keys.connect("key-pressed", self._key)
         self.add_controller(keys)
 
+    def _tell(self, text: str, error: bool) -> None:
+        """A line under the bar: an export or import done, or why not (red)."""
+        self.banner.set_text(text)
+        (self.banner.add_css_class if error else self.banner.remove_css_class)("error")
+        self.banner.set_visible(True)
+
     def _key(self, _c: Gtk.EventControllerKey, keyval: int, _code: int, _state: object) -> bool:
         if keyval == Gdk.KEY_Escape:
-            self.close()
+            if self.discard.asking:  # Escape answers the question the safe way: keep editing
+                self.discard.dismiss()
+            else:
+                self.close()
             return True
         return False  # every other key stays in this window: it never reaches the drive keys
 
     def _closing(self, _w: Gtk.Window) -> bool:
+        focus = self.get_focus()
+        spin = focus.get_ancestor(Gtk.SpinButton) if focus is not None else None
+        if isinstance(spin, Gtk.SpinButton):
+            spin.update()  # what it holds now decides whether there is an edit to lose
+        if self.state.edits and not self._discarding:  # never lose an edit without asking
+            self.discard.ask(len(self.state.edits))
+            return True
         self.closed = True
         self._follow(None)
         return False
+
+    def _discard_and_close(self) -> None:
+        self._discarding = True
+        self.close()
 
     def _console(self) -> None:
         """The console, filtered to the robot's configuration data (read raw: the layouts are not public)."""
@@ -219,6 +253,7 @@ class ConfigPage(Gtk.Window):
             self.status.set_text(f"Could not load the configuration: {error or 'cancelled'}")
             return False
         config: ServerConfig = future.result()
+        self.care.update()
         self.state.fetched(config)  # another client set what was being typed: nothing to save
         if previous is not None and note:
             self.banner.set_text(self.state.changes_note(previous, config))
@@ -278,6 +313,11 @@ class ConfigPage(Gtk.Window):
         s = self.current()
         return [] if s is None else [p for p in s.params if p.priority <= self.show_up_to]
 
+    def show_rows(self) -> None:
+        """Draw the current section's rows again (the factory values arrived: reset buttons)."""
+        if self.config is not None and not self.closed:
+            self._show_section()
+
     def _show_section(self) -> None:
         section = self.current()
         while (child := self.grid.get_first_child()) is not None:
@@ -320,9 +360,13 @@ class ConfigPage(Gtk.Window):
         left.set_hexpand(True)
         self.grid.attach(left, 0, row, 1, 1)
         editor = self._editor(p, key, config.editable(p))
+        accessible.name(editor, visible(p.name))  # the parameter's name from the server, as shown
         self.grid.attach(editor, 1, row, 1, 1)
         answer = Gtk.Label(xalign=0.0, wrap=True, max_width_chars=30)
         self.grid.attach(answer, 2, row, 1, 1)
+        reset = self.care.reset_button(section.name, p, config.editable(p))
+        if reset is not None:
+            self.grid.attach(reset, 3, row, 1, 1)
         self.rows[key] = (p, editor, answer)
         self._show_answer(key)
 
@@ -350,6 +394,9 @@ class ConfigPage(Gtk.Window):
             step = 1.0 if p.kind is ParamType.INT else 10.0**-digits
             spin = Gtk.SpinButton.new_with_range(lo, max(lo, hi), step)
             spin.set_digits(digits)
+            # Out of its limits, the held value comes back (and the row says what was not taken),
+            # never the limit in its place without a word.
+            spin.set_update_policy(Gtk.SpinButtonUpdatePolicy.IF_VALID)
             with contextlib.suppress(ValueError):
                 spin.set_value(float(text))
             spin.connect("changed", lambda s: self._edited(key, s.get_text()))
@@ -401,6 +448,8 @@ class ConfigPage(Gtk.Window):
             return
         self.save_button.set_sensitive(self.state.can_save(self.saving))
         self.status.set_text(self.state.status())
+        if not self.state.edits:
+            self.discard.dismiss()  # saved (or typed back) meanwhile: nothing left to lose
 
     def save(self) -> None:
         """Send every edit in one ``setConfig``; the answer is shown next to each parameter."""

@@ -36,6 +36,7 @@ from ..client.console_effect import HELD_MOTION  # noqa: E402
 from ..client.console_layout import describe  # noqa: E402
 from ..client.console_text import effect_words, outcome_line, packet_lines, short  # noqa: E402
 from ..values.intents import ConsoleCall, ConsoleList, Intent  # noqa: E402
+from . import accessible  # noqa: E402
 from .confirm_bar import ConfirmBar  # noqa: E402
 
 Request = Callable[[Intent], "concurrent.futures.Future[Any]"]
@@ -117,6 +118,7 @@ class ConsolePage(Gtk.Window):
         left = Gtk.Box(orientation=Gtk.Orientation.VERTICAL, spacing=6)
         self.search = Gtk.SearchEntry(placeholder_text="Filter: name, description or group")
         self.search.connect("search-changed", lambda _e: self.refilter())
+        accessible.name(self.search, "Filter the data")
         self.count = Gtk.Label(xalign=0.0)
         self.count.add_css_class("dim-label")
         self.rows = Gtk.ListBox(selection_mode=Gtk.SelectionMode.SINGLE)
@@ -132,7 +134,9 @@ class ConsolePage(Gtk.Window):
         args = Gtk.Box(spacing=6)
         self.arguments = Gtk.Entry(hexpand=True, placeholder_text="Arguments, separated by spaces")
         self.arguments.connect("activate", lambda _e: self.call())
+        accessible.name(self.arguments, "Arguments")
         self.types = Gtk.Entry(width_chars=14, placeholder_text="Types (byte4,…)")
+        accessible.name(self.types, "Argument types")
         self.types.set_tooltip_text(
             "Only where the description names no types: byte, byte2, byte4, double, string"
         )
@@ -145,6 +149,7 @@ class ConsolePage(Gtk.Window):
         self.status = Gtk.Label(xalign=0.0, wrap=True)
         self.confirm = ConfirmBar()
         self.reply = Gtk.TextView(editable=False, monospace=True, wrap_mode=Gtk.WrapMode.CHAR, vexpand=True)
+        accessible.name(self.reply, "Reply")
         reply_scroller = Gtk.ScrolledWindow(vexpand=True)
         reply_scroller.set_child(self.reply)
         right_parts: tuple[Gtk.Widget, ...] = (self.details, args, self.status, self.confirm, reply_scroller)

@@ -21,6 +21,7 @@ from gi.repository import Gdk, Gtk, Pango  # noqa: E402
 from ..model.observables import ConnectionState, RobotModel, RobotState  # noqa: E402
 from ..protocol.payloads.ld import data_store_label  # noqa: E402
 from ..values.intents import Intent, Say  # noqa: E402
+from . import accessible  # noqa: E402
 
 Ask = Callable[[Intent], object]
 Watch = Callable[[bool], object]
@@ -53,8 +54,9 @@ class DetailsWindow(Gtk.Window):
         self.say_row = Gtk.Box(spacing=8)
         self.say_entry = Gtk.Entry(hexpand=True, placeholder_text="Text for the robot to say")
         self.say_entry.set_max_length(MAX_SAY)
+        accessible.name(self.say_entry, "Text for the robot to say")
         self.say_entry.connect("activate", lambda _e: self.say())
-        self.say_button = Gtk.Button.new_with_mnemonic("_Say")
+        self.say_button = accessible.mnemonic_button("_Say")
         self.say_button.connect("clicked", lambda _b: self.say())
         self.say_row.append(self.say_entry)
         self.say_row.append(self.say_button)

@@ -16,6 +16,8 @@ import gi
 gi.require_version("Gtk", "4.0")
 from gi.repository import Gtk  # noqa: E402
 
+from . import accessible  # noqa: E402
+
 PADS = (
     ("drive_forward", "go-up-symbolic", 1, 0, "Forward (hold)"),
     ("drive_left", "go-previous-symbolic", 0, 1, "Turn left (hold)"),
@@ -61,7 +63,7 @@ class DPad(Gtk.Grid):
 
     @staticmethod
     def _pad(child: Gtk.Widget, tooltip: str) -> Gtk.Widget:
-        box = Gtk.Box()
+        box = Gtk.Box(accessible_role=Gtk.AccessibleRole.BUTTON)  # a pad is a button to a screen reader
         box.add_css_class("dpad-button")
         box.set_size_request(PAD_PX, PAD_PX)
         child.set_hexpand(True)
@@ -72,6 +74,7 @@ class DPad(Gtk.Grid):
         box.append(child)
         box.set_tooltip_text(tooltip)
         box.set_can_target(True)
+        accessible.name(box, accessible.spoken(tooltip))
         return box
 
     def _begin(self, gesture: Gtk.GestureDrag, _seq: object, name: str) -> None:

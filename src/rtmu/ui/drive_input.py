@@ -13,6 +13,7 @@ from __future__ import annotations
 
 from collections.abc import Callable
 
+from ..control.controller import KEYBOARD_LOST
 from ..fleet.selected import SelectedRobot
 from .keys import KeyRouter
 from .map_page import MapPage
@@ -70,7 +71,7 @@ class DriveInput:
         release seen afterwards is a real one and unblocks its key.
         """
         controller = self.robot.session.controller
-        controller.focus_lost()
+        controller.focus_lost("RTMU was suspended (Ctrl+Z)" if still_active else KEYBOARD_LOST)
         self.router.release_all()
         self.map_page.dpad.release_all()
         if still_active:

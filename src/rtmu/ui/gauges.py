@@ -12,6 +12,8 @@ import gi
 gi.require_version("Gtk", "4.0")
 from gi.repository import Gtk  # noqa: E402
 
+from . import accessible  # noqa: E402
+
 GREEN = (0.18, 0.62, 0.27)
 AMBER = (0.90, 0.60, 0.0)
 RED = (0.85, 0.11, 0.14)
@@ -46,7 +48,7 @@ def wifi_bars(quality: int | None, signal: int | None) -> int:
 
 class BatteryGauge(Gtk.DrawingArea):
     def __init__(self) -> None:
-        super().__init__()
+        super().__init__(accessible_role=Gtk.AccessibleRole.METER)
         self.set_content_width(30)
         self.set_content_height(14)
         self.set_valign(Gtk.Align.CENTER)
@@ -54,11 +56,13 @@ class BatteryGauge(Gtk.DrawingArea):
         self.state = "unknown"
         """``ok``, ``low`` (amber), ``critical`` (red), ``unknown`` or ``stale`` (grey)."""
         self.set_draw_func(self._draw)
+        accessible.name(self, "Battery level")
 
     def set_level(self, fraction: float, state: str) -> None:
         if (fraction, state) != (self.fraction, self.state):
             self.fraction, self.state = fraction, state
             self.queue_draw()
+            accessible.value(self, round(fraction * 100), 0, 100, f"{fraction:.0%}, {state}")
 
     def _draw(self, _a: Gtk.DrawingArea, ctx, width: int, height: int) -> None:
         colour = {"ok": GREEN, "low": AMBER, "critical": RED}.get(self.state, GREY)
@@ -76,18 +80,20 @@ class BatteryGauge(Gtk.DrawingArea):
 
 class WifiGauge(Gtk.DrawingArea):
     def __init__(self) -> None:
-        super().__init__()
+        super().__init__(accessible_role=Gtk.AccessibleRole.METER)
         self.set_content_width(22)
         self.set_content_height(16)
         self.set_valign(Gtk.Align.CENTER)
         self.bars = 0
         self.live = False
         self.set_draw_func(self._draw)
+        accessible.name(self, "Wi-Fi signal")
 
     def set_bars(self, bars: int, live: bool) -> None:
         if (bars, live) != (self.bars, self.live):
             self.bars, self.live = bars, live
             self.queue_draw()
+            accessible.value(self, bars, 0, 4, f"{bars} of 4 bars" if live else "no signal reading")
 
     def _draw(self, _a: Gtk.DrawingArea, ctx, width: int, height: int) -> None:
         bar_w = (width - 3 * 2) / 4

@@ -26,6 +26,7 @@ from gi.repository import Gtk, Pango  # noqa: E402
 
 from ..control.commands import COMMANDS, CommandState  # noqa: E402
 from ..model.observables import ConnectionState, NavState, Phase, RobotModel  # noqa: E402
+from . import accessible  # noqa: E402
 from .nav_draw import MarkerKind  # noqa: E402
 
 NAV_OFFERS = ("gotoGoal", "gotoRouteGoal", "gotoPose", "home", "dock", "tourGoals", "localizeToPose")
@@ -57,6 +58,7 @@ class GoalsPanel(Gtk.MenuButton):
     ) -> None:
         super().__init__(tooltip_text="Send the robot somewhere: goals, a point, home, the dock")
         self.set_icon_name("go-jump-symbolic")  # an icon: the header must still fit a 560 px window
+        accessible.name_menu_button(self, "Go to")
         self.add_css_class("goals-button")
         self.model = model
         self._goto, self._run, self._pick = goto, run, pick

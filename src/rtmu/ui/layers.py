@@ -22,6 +22,7 @@ from gi.repository import Gtk, Pango  # noqa: E402
 from ..model.observables import ConnectionState, DrawingsState, Observable, Phase  # noqa: E402
 from ..values.intents import DrawingChoices, Intent, ShowDrawing  # noqa: E402
 from ..values.state import DrawingLayer  # noqa: E402
+from . import accessible  # noqa: E402
 
 MAX_LABEL = 60
 """Characters of a name shown (the whole name is the button's tooltip)."""
@@ -79,6 +80,7 @@ class LayersPanel(Gtk.Box):
         close = Gtk.Button(icon_name="window-close-symbolic", tooltip_text="Close")
         close.add_css_class("flat")
         close.set_focusable(False)
+        accessible.name(close, "Close layers")
         close.connect("clicked", lambda _b: self.close())
         head.append(close)
         self.append(head)

@@ -24,6 +24,7 @@ from gi.repository import Gdk, GLib, Gtk, Pango  # noqa: E402
 from ..fleet.sessions import RobotSession  # noqa: E402
 from ..model.observables import CameraImage  # noqa: E402
 from ..values.intents import StopVideo  # noqa: E402
+from . import accessible  # noqa: E402
 from .camera import CameraView  # noqa: E402
 
 FPS_CHOICES = (2, 5, 10, 15, 20, 30)
@@ -32,9 +33,10 @@ QUALITY_CHOICES = ("Server's", "30", "50", "75", "90")
 
 
 def frames_dir() -> Path:
-    """Where saved frames go: ``~/Pictures/rtmu`` (the XDG pictures folder), else ``~/rtmu-frames``."""
+    """Where saved frames go: ``rtmu`` in the XDG pictures folder (``user-dirs.dirs``), which is
+    ``~/Pictures`` where the desktop never set one (as the README says; GLib gives no folder then)."""
     pictures = GLib.get_user_special_dir(GLib.UserDirectory.DIRECTORY_PICTURES)
-    return Path(pictures) / "rtmu" if pictures else Path(GLib.get_home_dir()) / "rtmu-frames"
+    return Path(pictures or Path(GLib.get_home_dir()) / "Pictures") / "rtmu"
 
 
 class LiveVideoControls:
@@ -92,8 +94,14 @@ class LiveVideoControls:
         self.settings_button.set_tooltip_text("Video frame rate and JPEG quality")
         for w in (self.live_button, self.pause_button, self.save_button, self.settings_button):
             w.set_focusable(False)  # the arrow keys keep driving
+        accessible.name(self.live_button, "Live video")
+        accessible.name(self.pause_button, "Pause video")
+        accessible.name(self.save_button, "Save frame")
+        accessible.name(self.fps, "Frame rate")
+        accessible.name(self.quality, "JPEG quality")
+        accessible.name_menu_button(self.settings_button, "Video settings")
         self.live_button.connect("toggled", self._live_toggled)
-        self.pause_button.connect("toggled", lambda b: self._pause(b.get_active()))
+        self.pause_button.connect("toggled", lambda b: self._paused(b.get_active()))
         self.save_button.connect("clicked", lambda _b: self.save())
         self.fps.connect("notify::selected", lambda *_a: self._settings_changed())
         self.quality.connect("notify::selected", lambda *_a: self._settings_changed())
@@ -124,8 +132,14 @@ class LiveVideoControls:
         self.set_live(not self.live)
         return ""
 
+    def _paused(self, paused: bool) -> None:
+        """A paused frame's caption no longer counts its age: the bar's line does again."""
+        self.camera.age_shown_elsewhere = self.live and not paused
+        self._pause(paused)
+
     def _live_toggled(self, button: Gtk.ToggleButton) -> None:
         on = button.get_active()
+        self.camera.age_shown_elsewhere = on  # the caption gives the frame's age: the bar gives none
         self.pause_button.set_sensitive(on)
         if not on:
             self.pause_button.set_active(False)

@@ -15,6 +15,7 @@ buttons activate the window's actions (``win.zoom-in`` …, ``win.follow``), as 
 from __future__ import annotations
 
 from collections.abc import Callable, Mapping
+from dataclasses import replace
 
 import gi
 
@@ -22,19 +23,21 @@ gi.require_version("Gtk", "4.0")
 gi.require_version("Gdk", "4.0")
 from gi.repository import Gdk, Gtk  # noqa: E402
 
+from ..base.notices import Kind, Notice  # noqa: E402
 from ..control.commands import COMMANDS, CommandState  # noqa: E402
 from ..fleet.selected import SelectedRobot  # noqa: E402
 from ..model.observables import ConnectionState, MapModel, OperatorState, RobotModel  # noqa: E402
 from ..values.intents import AnswerPopup, GotoGoal, GotoPose, Localize  # noqa: E402
+from . import accessible  # noqa: E402
 from .dpad import DPad  # noqa: E402
 from .layers import LayersPanel  # noqa: E402
 from .mapview import MapStage  # noqa: E402
-from .motion import MotionIndicator  # noqa: E402
+from .motion import MotionIndicator, held_by  # noqa: E402
 from .nav_draw import Marker, MarkerKind  # noqa: E402
 from .notes import map_note  # noqa: E402
 from .pip import PictureInPicture  # noqa: E402
 from .popups import PopupStack  # noqa: E402
-from .pose_bar import PoseBar  # noqa: E402
+from .pose_bar import PoseBar, pose_words  # noqa: E402
 from .pose_pick import PosePicker  # noqa: E402
 from .viewport import zoom_label  # noqa: E402
 
@@ -113,6 +116,7 @@ class MapPage(Gtk.Overlay):
             b.add_css_class("flat")
             b.set_focusable(False)
             b.set_action_name(action)  # the window's action, as the key's
+            accessible.name(b, accessible.spoken(tip))
             return b
 
         osd.append(button("zoom-out-symbolic", "Zoom out (Ctrl+minus)", "win.zoom-out"))
@@ -192,10 +196,9 @@ class MapPage(Gtk.Overlay):
     def _stop(self) -> None:
         self.robot.session.controller.run("stop")
 
-    def _drive_held(self) -> bool:
-        """A held drive is live (keys, D-pad or the pad's dead-man)."""
-        controller = self.robot.session.controller
-        return bool(controller.held) or controller.analog_active
+    def _drive_held(self) -> str:
+        """What holds a live drive (``motion.held_by``)."""
+        return held_by(self.robot.session.controller, bool(self.dpad.held))
 
     def let_go(self) -> None:
         """STOP, a switch of robot: a finger on the D-pad is let go of and a pick mode ends."""
@@ -216,7 +219,11 @@ class MapPage(Gtk.Overlay):
             self.robot.ask(GotoPose(marker.x, marker.y, marker.th))
         else:
             th = self.model.robot.value.th if marker.th is None else marker.th
-            self.robot.ask(Localize(marker.x, marker.y, th))
+            if self.robot.ask(Localize(marker.x, marker.y, th)) is not None:  # (a refusal is said)
+                placed = replace(marker, th=th)
+                self.robot.session.controller.view.notify(  # the operator sees the pick was taken
+                    Notice.info(Kind.NAVIGATION, f"Position set: {pose_words(placed).lower()}")
+                )
 
     def _answer_popup(self, popup_id: int, button: int) -> None:
         self.robot.ask(AnswerPopup(popup_id, button))

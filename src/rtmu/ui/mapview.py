@@ -28,10 +28,11 @@ from gi.repository import GLib, Gtk  # noqa: E402
 
 from ..control.motion_limits import RobotLimits  # noqa: E402
 from ..model.observables import LinkHealth, LinkLevel, MapModel, OperatorState, RobotModel, RobotState  # noqa: E402
-from . import overlays  # noqa: E402
+from . import accessible, overlays  # noqa: E402
 from .fleet_draw import FleetMark  # noqa: E402
 from .fov_draw import Wedge, camera_aim  # noqa: E402
 from .frame import Scene, draw_frame  # noqa: E402
+from .map_words import MapDescription  # noqa: E402
 from .nav_draw import Marker, MarkerKind  # noqa: E402
 from .stop_draw import stop_reach  # noqa: E402
 from .tiles import TileCache  # noqa: E402
@@ -63,9 +64,12 @@ class MapStage(Gtk.DrawingArea):
         clock: Callable[[], float] = time.monotonic,
         status_age: Callable[[], float | None] | None = None,
     ) -> None:
-        super().__init__()
+        super().__init__(accessible_role=Gtk.AccessibleRole.IMG)  # a drawing: "image" to a screen reader
         self.model = model
         self.operator = operator
+        accessible.name(self, "Map")
+        self.words = MapDescription(model, lambda text: accessible.describe(self, text))
+        """The map in words (``map_words``): its description, said again when it changes materially."""
         self.clock = clock
         self.status_age = status_age
         self.show_fov = True
@@ -103,6 +107,8 @@ class MapStage(Gtk.DrawingArea):
         self._scroll_accum = 0.0
         self.marker: Marker | None = None
         """A pose the operator is picking (``pose_pick`` sets it); drawn over the map."""
+        self.draft_objects: list[object] | None = None
+        """A map draft's objects, drawn instead of the map's own while it has edits (``map_edit_window``)."""
         self.fleet: Callable[[], tuple[Sequence[FleetMark], tuple[float, float, float]]] | None = None
         self.limits: Callable[[], RobotLimits] = RobotLimits
         """The shown robot's speed and braking (the window hands over its controller's)."""
@@ -128,6 +134,7 @@ class MapStage(Gtk.DrawingArea):
         for remove in self._unobserve:
             remove()
         self._unobserve = []
+        self.words.close()
         self._cancel_drawings_redraw()
         self.tiles.close()
 
@@ -359,7 +366,7 @@ class MapStage(Gtk.DrawingArea):
         scene = Scene(
             labels=self.labels,
             tiles=self.tiles if has_map else None,
-            objects=self._objects,
+            objects=self._objects if self.draft_objects is None else self.draft_objects,
             robot=(r.x, r.y, r.th) if r.numbers_at is not None else None,
             stale=stale,
             trail=self.model.trail.points,

@@ -6,7 +6,7 @@ the map's top left (teal for autonomy, blue for a held drive, nothing while the 
 a bold title, then where to ("To Lab B"), then how far and how to end it ("12.4 m left · Space or
 STOP cancels"). Short
 lines keep it narrow, clear of the banners centred at the top, even at 800 px. The words are
-``nav_text.motion_text``; ``held()`` asks the controller whether a drive is held now (the window's
+``nav_text.motion_text``; ``held()`` asks what holds a drive now ("" none; the window's
 timer calls :meth:`refresh`, so the pill follows key presses within a tick). While the link is lost
 the pill gives way to the link banner, which then says the robot is on its own.
 """
@@ -14,6 +14,7 @@ the pill gives way to the link banner, which then says the robot is on its own.
 from __future__ import annotations
 
 from collections.abc import Callable
+from typing import Protocol
 
 import gi
 
@@ -27,10 +28,27 @@ from .nav_text import motion_text  # noqa: E402
 KINDS = ("autonomous", "held")
 
 
+class _Held(Protocol):
+    """The controller's view of a held drive (``control.controller.Controller``)."""
+
+    @property
+    def held(self) -> frozenset[str]: ...
+
+    @property
+    def analog_active(self) -> bool: ...
+
+
+def held_by(controller: _Held, dpad_held: bool) -> str:
+    """What holds a live drive: ``dpad``, ``keys``, ``pad`` (the gamepad's dead-man); "" none."""
+    if controller.held:
+        return "dpad" if dpad_held else "keys"
+    return "pad" if controller.analog_active else ""
+
+
 class MotionIndicator(Gtk.Box):
     """See the module notes; ``kind`` is what is shown now (``autonomous``, ``held`` or "")."""
 
-    def __init__(self, model: RobotModel, held: Callable[[], bool]) -> None:
+    def __init__(self, model: RobotModel, held: Callable[[], str]) -> None:
         super().__init__(orientation=Gtk.Orientation.VERTICAL, visible=False)
         self.set_halign(Gtk.Align.START)
         self.set_valign(Gtk.Align.START)
@@ -39,7 +57,12 @@ class MotionIndicator(Gtk.Box):
             getattr(self, f"set_margin_{side}")(8)
         self.set_can_target(False)
         self.lines: list[Gtk.Label] = []
-        for css, chars in (("motion-title", 28), ("motion-detail", 28), ("motion-hint", 36)):
+        for css, chars in (
+            ("motion-title", 28),
+            ("motion-detail", 28),
+            ("motion-hint", 36),
+            ("motion-note", 28),
+        ):
             label = Gtk.Label(xalign=0.0, max_width_chars=chars)
             label.add_css_class(css)
             label.set_ellipsize(Pango.EllipsizeMode.END)
@@ -49,6 +72,8 @@ class MotionIndicator(Gtk.Box):
         self.model = model
         self.held = held
         self.kind = ""
+        self.note = ""
+        """A fact about the motion from outside it (``idle_inhibit``: the screen is kept on)."""
         self._unobserve = [
             model.navigation.observe(lambda _o, _n: self.refresh()),
             model.connection.observe(lambda _o, _n: self.refresh()),
@@ -65,9 +90,17 @@ class MotionIndicator(Gtk.Box):
             remove()
         self._unobserve = []
 
+    def set_note(self, note: str) -> None:
+        """The last line while the pill shows (empty: none)."""
+        if note != self.note:
+            self.note = note
+            self.refresh()
+
     def refresh(self) -> None:
         link_up = self.model.connection.value.phase is Phase.CONNECTED
-        kind, lines = motion_text(self.model.navigation.value, held=self.held(), link_up=link_up)
+        by = self.held()
+        kind, lines = motion_text(self.model.navigation.value, held=bool(by), link_up=link_up, by=by)
+        lines = (*lines[:3], *([""] * (3 - len(lines[:3]))), self.note) if kind else lines
         for i, label in enumerate(self.lines):
             text = lines[i] if i < len(lines) else ""
             if text != label.get_text():

@@ -15,6 +15,8 @@ import gi
 gi.require_version("Gtk", "4.0")
 from gi.repository import Gdk, GLib, Gtk  # noqa: E402
 
+from . import accessible  # noqa: E402
+
 
 class AmountDialog(Gtk.Window):
     """One number with a unit and quick buttons; ``on_go(value)`` when confirmed."""
@@ -45,6 +47,7 @@ class AmountDialog(Gtk.Window):
         adjustment = Gtk.Adjustment(value=initial, lower=lower, upper=upper, step_increment=step,
                                     page_increment=step * 10)  # fmt: skip
         self.spin = Gtk.SpinButton(adjustment=adjustment, digits=digits, numeric=True, hexpand=True)
+        accessible.name(self.spin, prompt)
         row.append(self.spin)
         row.append(Gtk.Label(label=unit))
         box.append(row)
@@ -55,9 +58,9 @@ class AmountDialog(Gtk.Window):
             quick_row.append(b)
         box.append(quick_row)
         buttons = Gtk.Box(spacing=8, halign=Gtk.Align.END)
-        cancel = Gtk.Button.new_with_mnemonic("_Cancel")
+        cancel = accessible.mnemonic_button("_Cancel")
         cancel.connect("clicked", lambda _b: self.close())
-        go = Gtk.Button.new_with_mnemonic("_Go")
+        go = accessible.mnemonic_button("_Go")
         go.add_css_class("suggested-action")
         go.connect("clicked", lambda _b: self._go(self.spin.get_value()))
         buttons.append(cancel)

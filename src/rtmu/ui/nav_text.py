@@ -48,8 +48,13 @@ def _head(nav: NavState) -> str:
     return "Going home" if nav.target == "home" else f"Going to {where(nav.target)}"
 
 
-def motion_text(nav: NavState, *, held: bool, link_up: bool) -> tuple[str, tuple[str, ...]]:
-    """(kind, lines) for the motion indicator; kind ``autonomous``, ``held`` or "" (hidden).
+HELD_BY = {"keys": "Driving (held keys)", "dpad": "Driving (D-pad held)", "pad": "Driving (gamepad)"}
+"""The held drive's title by what holds it: the operator lets go of the thing named."""
+
+
+def motion_text(nav: NavState, *, held: bool, link_up: bool, by: str = "keys") -> tuple[str, tuple[str, ...]]:
+    """(kind, lines) for the motion indicator; kind ``autonomous``, ``held`` or "" (hidden);
+    ``by`` is what holds a drive (a :data:`HELD_BY` key).
 
     Short lines (title, where to, how far and how to end it) keep the pill narrow, clear of the
     banners; a long goal name is cut on its own line, never the distance.
@@ -64,7 +69,7 @@ def motion_text(nav: NavState, *, held: bool, link_up: bool) -> tuple[str, tuple
         left = "" if nav.remaining_mm is None else f"{nav.remaining_mm / 1000:.1f} m left · "
         return "autonomous", ("Navigating (autonomous)", dest, f"{left}Space or STOP cancels")
     if held:
-        return "held", ("Driving (held keys)", "Let go to stop")
+        return "held", (HELD_BY.get(by, HELD_BY["keys"]), "Let go to stop")
     return "", ()
 
 

@@ -16,6 +16,11 @@ from ..settings.store import Profile
 CONNECT_HINT = "press Connect (Ctrl+O)"
 
 
+def heading_text(degrees: float) -> str:
+    """A heading in whole degrees, never "-0°" (a robot facing -0.3° faces 0°)."""
+    return f"{round(degrees) + 0}°"
+
+
 def map_note(conn: ConnectionState, m: MapModel) -> str:
     """What the map area should say now; "" when the map speaks for itself."""
     where = f" to {conn.host}:{conn.port}" if conn.host else ""

@@ -14,12 +14,13 @@ display; :class:`NoticeRouter` applies them to the window's banners.
 
 from __future__ import annotations
 
+import time
 from collections.abc import Callable
 from dataclasses import dataclass
 from typing import NamedTuple, Protocol
 
 from ..base.notices import Kind, Level, Notice
-from ..model.observables import SPEED_MAX, ConnectionState, NavState, Phase
+from ..model.observables import SPEED_MAX, ConnectionState, LinkLevel, NavState, Phase
 from .nav_text import link_lost_note
 
 
@@ -118,6 +119,21 @@ def loop_lag_banner(lag: float | None, connected: bool, shown: bool) -> Banner |
     return None
 
 
+LINK_STOP_WORDS = "Stopped: the link"
+"""How the controller's stop for a stale or lost link begins (``Controller._say_link_stop``)."""
+LINK_BACK_AFTER = 1.0
+"""Seconds of a healthy link after which a "Stopped: the link is stale" banner gives way: it stays
+only while it is true (a later healthy drive never runs under it)."""
+
+
+def link_back_banner(shown: str | None, ok_for: float | None) -> Banner | None:
+    """The ``link`` banner once the link has been healthy for ``ok_for`` seconds (None: not healthy now)
+    while it still says a link stop (``shown``): the stop is over, and the banner says how to go on."""
+    if shown is None or not shown.startswith(LINK_STOP_WORDS) or ok_for is None or ok_for < LINK_BACK_AFTER:
+        return None
+    return Banner("link", "info", "The link is back: press a key to drive again", 4.0)
+
+
 def speed_banner(percent: int) -> Banner:
     """The speed step the operator just chose, with its bar."""
     return Banner("speed", "info", f"Speed {percent} %", 2.5, percent / SPEED_MAX)
@@ -133,6 +149,8 @@ class Banners(Protocol):
     def dismiss(self, topic: str) -> None: ...
 
     def topics(self) -> list[str]: ...
+
+    def text(self, topic: str) -> str | None: ...
 
 
 class PictureRequest(Protocol):
@@ -154,9 +172,12 @@ class NoticeRouter:
         connection: Callable[[], ConnectionState],
         speed_percent: Callable[[], int],
         picture: Callable[[], PictureRequest],
+        clock: Callable[[], float] = time.monotonic,
     ) -> None:
         self.banners = banners
         self._connection, self._speed, self._picture = connection, speed_percent, picture
+        self._clock = clock
+        self._ok_since: float | None = None
 
     def show(self, notice: Notice) -> None:
         """Show a controller or network notice where its kind belongs."""
@@ -172,6 +193,18 @@ class NoticeRouter:
     def loop_lag(self, lag: float | None, connected: bool) -> None:
         """The network thread's lag now (None: unknown): the ``loop`` banner while it is stalled."""
         self.apply(loop_lag_banner(lag, connected, "loop" in self.banners.topics()))
+
+    def link_health(self, level: LinkLevel) -> None:
+        """The link's health now (polled by the window's timer): a link stop's banner goes once it is
+        healthy again for :data:`LINK_BACK_AFTER`."""
+        now = self._clock()
+        healthy = level is LinkLevel.OK and self._connection().phase is Phase.CONNECTED
+        if not healthy:
+            self._ok_since = None
+            return
+        if self._ok_since is None:
+            self._ok_since = now
+        self.apply(link_back_banner(self.banners.text("link"), now - self._ok_since))
 
     def apply(self, banner: Banner | Dismiss | None) -> None:
         if isinstance(banner, Dismiss):

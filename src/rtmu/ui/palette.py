@@ -21,6 +21,7 @@ gi.require_version("Gdk", "4.0")
 from gi.repository import Gdk, GLib, Gtk, Pango  # noqa: E402
 
 from ..client.custom_commands import MAX_ARGUMENT, CommandCatalogue, CustomCommand  # noqa: E402
+from . import accessible  # noqa: E402
 
 ListFn = Callable[[], "concurrent.futures.Future[Any]"]
 """Asks the network thread for the :class:`CommandCatalogue` (``ClientRunner.list_commands``)."""
@@ -57,9 +58,26 @@ class _Row(Gtk.ListBoxRow):
         if command.takes_argument:
             self.entry = Gtk.Entry(placeholder_text="argument, then Enter")
             self.entry.set_max_length(MAX_ARGUMENT)
+            accessible.name(self.entry, "Argument")
             self.entry.connect("activate", lambda _e: run(self))
             box.append(self.entry)
         self.set_child(box)
+
+
+def count_note(shown: int, total: int, hidden: int, search: str) -> str:
+    """ "12 commands", "1 of 12 commands" while a search filters them, or why there are none."""
+    if not total:
+        return "The server offers this user no commands."
+    plural = "s" if total != 1 else ""
+    if not search.strip():
+        note = f"{total} command{plural}"
+    elif shown:
+        note = f"{shown} of {total} command{plural}"
+    else:
+        note = f"No command matches “{search.strip()}” ({total} in all)"
+    if hidden:
+        note += f" ({hidden} more the server has are not open to this user)"
+    return note
 
 
 class CommandPalette(Gtk.Window):
@@ -77,7 +95,7 @@ class CommandPalette(Gtk.Window):
         box.set_margin_start(8)
         box.set_margin_end(8)
         self.search = Gtk.SearchEntry(placeholder_text="Search the server's commands")
-        self.search.connect("search-changed", lambda _s: self.rows.invalidate_filter())
+        self.search.connect("search-changed", lambda _s: self._filter_changed())
         self.search.connect("activate", lambda _s: self._activate_first())
         self.search.connect("stop-search", lambda _s: self.close())
         box.append(self.search)
@@ -123,13 +141,22 @@ class CommandPalette(Gtk.Window):
         self.catalogue = catalogue
         for command in catalogue.commands:
             self.rows.append(_Row(command, self._run_row))
-        count = len(catalogue.commands)
-        note = f"{count} command{'s' if count != 1 else ''}"
-        if catalogue.hidden:
-            note += f" ({catalogue.hidden} more the server has are not open to this user)"
-        self.note.set_text(note if count else "The server offers this user no commands.")
+        self._say_count()
+
+    def _say_count(self) -> None:
+        """The note under the search: how many commands the list shows now, of how many."""
+        catalogue = self.catalogue
+        if catalogue is None:
+            return
+        shown = sum(1 for row in self._rows() if self._matches(row))
+        total, search = len(catalogue.commands), self.search.get_text()
+        self.note.set_text(count_note(shown, total, catalogue.hidden, search))
 
     # -- filtering and running -----------------------------------------------------------------
+    def _filter_changed(self) -> None:
+        self.rows.invalidate_filter()
+        self._say_count()
+
     def _matches(self, row: Gtk.ListBoxRow) -> bool:
         words = self.search.get_text().lower().split()
         return isinstance(row, _Row) and all(w in row.haystack for w in words)

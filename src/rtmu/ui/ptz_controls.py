@@ -24,6 +24,7 @@ from ..fleet.sessions import RobotSession  # noqa: E402
 from ..model.observables import RobotModel, RobotState  # noqa: E402
 from ..values.intents import Intent, PtzMove, WatchPtz  # noqa: E402
 from ..values.state import PtzState  # noqa: E402
+from . import accessible  # noqa: E402
 
 PAN_STEP = 10.0
 """Degrees per button press or key (ARIA scales relative moves down as the camera zooms in)."""
@@ -113,6 +114,7 @@ class PtzControls(Gtk.Box):
             button = Gtk.Button.new_from_icon_name(icon)
             button.set_focusable(False)
             self._tips[intent] = tip
+            accessible.name(button, accessible.spoken(tip))
             # The window's action (``win.ptz-left`` …), as the key's: a refusal is said the same way.
             button.connect("clicked", lambda b, i=intent: b.activate_action(f"win.{action_name(i)}", None))
             self.buttons[intent] = button

@@ -16,6 +16,7 @@ gi.require_version("Gtk", "4.0")
 from gi.repository import GLib, Gtk  # noqa: E402
 
 from ..recorder.replay import SPEEDS, ReplayClock  # noqa: E402
+from . import accessible  # noqa: E402
 
 STEP_NS = 1_000_000_000
 REFRESH_MS = 100
@@ -53,6 +54,7 @@ class ReplayBar(Gtk.Box):
         self.speed.set_focusable(False)
         self.speed.set_selected(SPEEDS.index(1.0))
         self.speed.set_tooltip_text("Replay speed")
+        accessible.name(self.speed, "Replay speed")
         self.speed.connect("notify::selected", self._speed_chosen)
         self.append(self.speed)
         seconds = max(0.1, (clock.end_ns - clock.start_ns) / 1e9)
@@ -61,6 +63,7 @@ class ReplayBar(Gtk.Box):
         self.timeline.set_hexpand(True)
         self.timeline.set_focusable(False)
         self.timeline.set_tooltip_text("Scrub through the recording")
+        accessible.name(self.timeline, "Recording position")
         self.timeline.connect("change-value", self._scrubbed)
         self.append(self.timeline)
         self.time_label = Gtk.Label(label="")
@@ -74,6 +77,7 @@ class ReplayBar(Gtk.Box):
         button = Gtk.Button(icon_name=icon)
         button.set_focusable(False)
         button.set_tooltip_text(tip)
+        accessible.name(button, accessible.spoken(tip))
         button.connect("clicked", lambda _b: fn())
         self.append(button)
         return button

@@ -57,6 +57,8 @@ def show_replay(window: MainWindow, session: RobotSession, replayer: Replayer) -
     bar = ReplayBar(replayer.clock, seek, name)
     window.column.append(bar)
     window.title_label.set_text("RTMU — REPLAY")
+    for button in (window.connect_button, window.fullscreen_bar.connect_button):
+        button.set_visible(False)  # there is no robot to disconnect from; closing the window ends it
     more = replayer.recorded.connections
     extra = f" (connection {replayer.recorded.conn} of {more}; --conn N picks another)" if more > 1 else ""
     window.banners.tell(

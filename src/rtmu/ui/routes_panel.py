@@ -19,6 +19,7 @@ from gi.repository import Gtk  # noqa: E402
 
 from ..model.observables import ConnectionState, Phase, RobotModel  # noqa: E402
 from ..values.intents import GotoGoal, Intent, Patrol  # noqa: E402
+from . import accessible  # noqa: E402
 
 Ask = Callable[[Intent], object]
 """The selected robot's intents (``SelectedRobot.ask``): through its controller's guard."""
@@ -29,6 +30,7 @@ class RoutesPanel(Gtk.MenuButton):
 
     def __init__(self, model: RobotModel, ask: Ask) -> None:
         super().__init__(icon_name="mark-location-symbolic", tooltip_text="Routes (patrol)")
+        accessible.name_menu_button(self, "Routes")
         self.set_focusable(False)
         inner = self.get_first_child()
         if inner is not None:

@@ -3,7 +3,8 @@
 Every field is checked as it is typed (:func:`validate`, pure) and a problem is
 shown in an inline message under the field; Save stays insensitive until the
 form is valid. Picking another profile in the list loads its fields; typing a
-new name saves a new profile. The dialog never connects and never writes files
+new name saves a new profile. A profile named after its address follows a changed host or port.
+The dialog never connects and never writes files
 itself: ``on_save(profile, password)`` hands the result to the window.
 """
 
@@ -18,7 +19,8 @@ import gi
 gi.require_version("Gtk", "4.0")
 from gi.repository import Gtk  # noqa: E402
 
-from ..settings.store import DEFAULT_PORT, Profile  # noqa: E402
+from ..settings.store import DEFAULT_PORT, Profile, address_name  # noqa: E402
+from . import accessible  # noqa: E402
 from .layout import screen_size  # noqa: E402
 
 _HOST = re.compile(r"^[A-Za-z0-9]([A-Za-z0-9.\-]*[A-Za-z0-9])?$")
@@ -79,6 +81,8 @@ class ConnectionDialog(Gtk.Window):
         for name in self._profiles:
             self.profile.append(name, name)
         self.profile_entry: Gtk.Entry = self.profile.get_child()  # type: ignore[assignment]
+        accessible.name(self.profile_entry, "Profile name")
+        accessible.name_inner_toggle(self.profile, "Profiles")
         self.host = Gtk.Entry(placeholder_text="robot.local or 192.168.1.10", hexpand=True)
         self.port = Gtk.Entry(placeholder_text=str(DEFAULT_PORT), input_purpose=Gtk.InputPurpose.DIGITS)
         self.user = Gtk.Entry(placeholder_text="(none)")
@@ -115,6 +119,8 @@ class ConnectionDialog(Gtk.Window):
                 label.add_css_class("dim-label")
                 grid.attach(label, 0, 2 * i, 1, 1)
             grid.attach(widget, 1, 2 * i, 1, 1)
+            if caption:  # the caption beside it is not tied to it: the entry says its own name
+                accessible.name(widget, caption)
             message = Gtk.Label(xalign=0.0, wrap=True, max_width_chars=40, visible=False)
             message.add_css_class("field-error")
             message.set_use_markup(False)
@@ -125,9 +131,9 @@ class ConnectionDialog(Gtk.Window):
         buttons.set_margin_top(8)
         buttons.set_margin_bottom(16)
         buttons.set_margin_end(16)
-        cancel = Gtk.Button.new_with_mnemonic("_Cancel")
+        cancel = accessible.mnemonic_button("_Cancel")
         cancel.connect("clicked", lambda _b: self.close())
-        self.save = Gtk.Button.new_with_mnemonic("_Save")
+        self.save = accessible.mnemonic_button("_Save")
         self.save.add_css_class("suggested-action")
         self.save.connect("clicked", self._save)
         buttons.append(cancel)
@@ -140,6 +146,8 @@ class ConnectionDialog(Gtk.Window):
 
         self._load(current)
         self.profile.connect("changed", self._profile_changed)
+        for entry in (self.host, self.port, self.user):
+            entry.connect("changed", lambda _e: self._address_changed())
         for entry in (self.profile_entry, self.host, self.port, self.user):
             entry.connect("changed", lambda _e: self.check())
             entry.set_activates_default(True)
@@ -161,6 +169,7 @@ class ConnectionDialog(Gtk.Window):
     def _load(self, profile: Profile) -> None:
         self._loading = True
         self._base = profile
+        self._address_name = address_name(profile.host, str(profile.port), profile.user)
         self.profile_entry.set_text(profile.name)
         self.host.set_text(profile.host)
         self.port.set_text(str(profile.port))
@@ -170,6 +179,16 @@ class ConnectionDialog(Gtk.Window):
         self.reconnect.set_active(profile.auto_reconnect)
         self.protocol.set_text(profile.protocol)
         self._loading = False
+
+    def _address_changed(self) -> None:
+        """A profile named after its address ("127.0.0.1:7391", as RTMU names one) follows the user, host
+        and port typed; a name the operator chose stays."""
+        now = address_name(self.host.get_text(), self.port.get_text(), self.user.get_text())
+        if not self._loading and self.profile_entry.get_text() == self._address_name:
+            self._loading = True  # the new name is no pick of another profile
+            self.profile_entry.set_text(now)
+            self._loading = False
+        self._address_name = now
 
     def _profile_changed(self, combo: Gtk.ComboBoxText) -> None:
         name = combo.get_active_id()
@@ -239,9 +258,9 @@ class PasswordPrompt(Gtk.Window):
         self.entry.set_property("activates-default", True)
         box.append(self.entry)
         buttons = Gtk.Box(spacing=8, halign=Gtk.Align.END)
-        cancel = Gtk.Button.new_with_mnemonic("_Cancel")
+        cancel = accessible.mnemonic_button("_Cancel")
         cancel.connect("clicked", lambda _b: self.close())
-        ok = Gtk.Button.new_with_mnemonic("C_onnect")
+        ok = accessible.mnemonic_button("C_onnect")
         ok.add_css_class("suggested-action")
         ok.connect("clicked", self._ok)
         buttons.append(cancel)

@@ -17,9 +17,12 @@ from gi.repository import Gtk, Pango  # noqa: E402
 
 from ..control.alarms import Thresholds  # noqa: E402
 from ..model.observables import LinkLevel, OperatorState, Phase, RobotModel  # noqa: E402
+from . import accessible  # noqa: E402
 
 DASH = "—"
 SLOW_MS = Thresholds().rtt_high_ms
+STATE_WORDS = {"low": "low", "critical": "at shutdown level", "stale": "slow or stale", "lost": "lost"}
+"""The words for each colour of the strip (amber, red): a screen reader hears the state, too."""
 
 
 class StatusStrip(Gtk.Box):
@@ -31,6 +34,7 @@ class StatusStrip(Gtk.Box):
         self.model = model
         self.operator = operator
         self.labels: dict[str, Gtk.Label] = {}
+        self._said: dict[str, str] = {}
         for name, chars in (("battery", 6), ("wifi", 5), ("link", 5), ("speed", 4), ("mode", 3)):
             label = Gtk.Label(xalign=0.0, width_chars=chars)
             label.set_use_markup(False)
@@ -67,7 +71,7 @@ class StatusStrip(Gtk.Box):
             battery = f"Bat {robot.battery_v:.1f}V"
         self._set("battery", battery, robot.battery_state if connected else "unknown")
         quality = robot.wifi_quality
-        wifi = DASH if quality is None or not connected else f"{round(100 * max(0, min(70, quality)) / 70)}%"
+        wifi = DASH if quality is None or not connected else f"{max(0, min(100, quality))}%"  # (in %)
         self._set("wifi", f"Wi-Fi {wifi}", "")
         if not connected:
             link, state = self.model.connection.value.phase.value, "lost"
@@ -87,6 +91,10 @@ class StatusStrip(Gtk.Box):
             label.set_text(text)
         for css in ("low", "critical", "ok", "stale", "lost"):
             (label.add_css_class if css == state else label.remove_css_class)(css)
+        words = STATE_WORDS.get(state, "")  # what the colour says, for a screen reader
+        if self._said.get(name, "") != words:  # said once per change, not at 10 Hz
+            self._said[name] = words
+            accessible.describe(label, f"{name} {words}" if words else "")
 
     def close(self) -> None:
         for remove in self._unobserve:

@@ -82,6 +82,11 @@ menubutton.goals-button > button { min-width: 20px; padding-left: 3px; padding-r
 .camera-bar button:hover { background: alpha(white, 0.2); }
 .camera-bar button:disabled { color: alpha(white, 0.4); }
 .camera-bar label { color: alpha(white, 0.85); }
+/* Its popovers (the gear's frame rate and quality, their drop-down lists) are inside the dark bar:
+   dark too, or its white words land on the theme's white popover. */
+.camera-bar popover > contents, .camera-bar popover > arrow { background: #2a2a2a; color: white;
+                                                             border-color: alpha(white, 0.25); }
+.camera-bar popover listview, .camera-bar popover list { background: transparent; color: white; }
 .camera-inset { border: 2px solid alpha(white, 0.85); border-radius: 6px;
                 box-shadow: 0 2px 8px alpha(black, 0.4); background: black; }
 .camera-inset.stale { opacity: 0.8; border-color: alpha(#9c5300, 0.9); }

@@ -27,10 +27,13 @@ gi.require_version("Gtk", "4.0")
 gi.require_version("Pango", "1.0")
 from gi.repository import GLib, Gtk, Pango  # noqa: E402
 
+from ..base.link_timing import STATUS_CEILING  # noqa: E402
 from ..model.observables import ConnectionState, LinkLevel, OperatorState, Phase, RobotModel  # noqa: E402
+from . import accessible  # noqa: E402
 from .gauges import BatteryGauge, WifiGauge, battery_fraction, wifi_bars  # noqa: E402
 from .ld_status import details_lines, goal_suffix  # noqa: E402
 from .nav_text import loc_level, loc_text, outcome_status  # noqa: E402
+from .notes import heading_text  # noqa: E402
 
 STALE_AFTER = 1.0
 """Seconds after which a pose/battery value is shown as stale (status arrives at 10 Hz)."""
@@ -70,6 +73,10 @@ class Cell(Gtk.Box):
         row.append(self.value)
         self.append(row)
         self.stale = False
+        self._said = ""
+        self._heading = caption
+        self.mark = ""
+        """A word the caption carries for a state its colour shows (``LOW``): not by colour alone."""
         self._tooltip: str | None = None
         self._level: str | None = None
 
@@ -82,9 +89,20 @@ class Cell(Gtk.Box):
                 self.add_css_class(css_class)
             self._level = css_class
 
-    def show_value(self, text: str, *, stale: bool, tooltip: str | None = None) -> None:
+    def show_value(
+        self, text: str, *, stale: bool, tooltip: str | None = None, words: str = "", mark: str = ""
+    ) -> None:
+        """``words``: the state the value's colour shows (``low``, ``link stale``), for screen readers;
+        ``mark``: the same in one visible word after the caption (``Battery · LOW``)."""
         if self.value.get_text() != text:
             self.value.set_text(text)
+        if mark != self.mark:
+            self.mark = mark
+            self.caption.set_text(f"{self._heading} · {mark}" if mark else self._heading)
+        said = ", ".join(w for w in (words, "not current" if stale else "") if w)
+        if said != self._said:
+            self._said = said
+            accessible.describe(self.value, f"{self.caption.get_text()}: {said}" if said else "")
         if stale != self.stale:
             self.stale = stale
             if stale:
@@ -140,7 +158,7 @@ class StatusToolbar(Gtk.ScrolledWindow):
             "mode": Cell("Mode · status", width_chars=6),
             "safe": Cell("Safe", width_chars=3),
             "speed": Cell("Throttle", width_chars=5),
-            "link": Cell("Link: rtt, age", width_chars=12),
+            "link": Cell("Link: rtt, age/limit", width_chars=14),
             "dock": Cell("Dock", width_chars=9),
             "loc": Cell("Localization", width_chars=9),
         }
@@ -233,7 +251,7 @@ class StatusToolbar(Gtk.ScrolledWindow):
         c = self.cells
         c["x"].show_value(f"{robot.x / 1000:.2f}" if have else DASH, stale=stale, tooltip=why)
         c["y"].show_value(f"{robot.y / 1000:.2f}" if have else DASH, stale=stale, tooltip=why)
-        c["th"].show_value(f"{robot.th:.0f}°" if have else DASH, stale=stale, tooltip=why)
+        c["th"].show_value(heading_text(robot.th) if have else DASH, stale=stale, tooltip=why)
         c["vel"].show_value(f"{robot.vel:.0f}" if have else DASH, stale=stale, tooltip=why)
         c["rot"].show_value(f"{robot.rot_vel:.0f}" if have else DASH, stale=stale, tooltip=why)
         self._battery(robot, stale, why)
@@ -281,7 +299,7 @@ class StatusToolbar(Gtk.ScrolledWindow):
             tip = f"Localization: {text} (getLocState)"
             if level == "lost":
                 tip += ": the robot does not know where it is — Go to › Set robot position"
-            cell.show_value(text, stale=not live, tooltip=tip)
+            cell.show_value(text, stale=not live, tooltip=tip, words=level)
 
     def _dock(self, state: str | None, live: bool) -> None:
         """The docking state, shown only while the server reports one (``dockInfo``)."""
@@ -315,7 +333,9 @@ class StatusToolbar(Gtk.ScrolledWindow):
             levels.append(f"shutdown at {robot.battery_shutdown:g} {unit}")
         tip = {"low": "Battery LOW", "critical": "Battery at SHUTDOWN level"}.get(state, "Battery")
         tip += f" ({', '.join(levels)})" if levels else ""
-        cell.show_value(text, stale=stale, tooltip=(why + "\n" + tip) if why else tip)
+        words = {"low": "low", "critical": "at shutdown level"}.get(state, "")
+        mark = "" if stale else {"low": "LOW", "critical": "SHUTDOWN"}.get(state, "")
+        cell.show_value(text, stale=stale, tooltip=(why + "\n" + tip) if why else tip, words=words, mark=mark)
         for cls in ("low", "critical"):
             if cls == state and not stale:
                 cell.add_css_class(cls)
@@ -343,7 +363,9 @@ class StatusToolbar(Gtk.ScrolledWindow):
             text = {Phase.CONNECTING: "connecting", Phase.RECONNECTING: "reconnecting"}.get(
                 conn.phase, "down"
             )
-            cell.show_value(text, stale=True, tooltip=f"Not connected ({conn.phase.value})")
+            cell.show_value(
+                text, stale=True, tooltip=f"Not connected ({conn.phase.value})", words="not connected"
+            )
             cell.show_level(f"link-{LinkLevel.DOWN.value}")
             return
         rtt = (
@@ -359,6 +381,12 @@ class StatusToolbar(Gtk.ScrolledWindow):
             f"{health.dropped} bad packets dropped"
         )
         text = f"{rtt} {age_shown}"
+        if health.stale_limit is not None:  # the learned limit next to the age it is compared with
+            text = f"{rtt} {DASH if age is None else f'{age:.1f}'}/{health.stale_limit:.2f}"
+            tip += (
+                f"\nStale after {health.stale_limit:.2f} s without status: learned from this link's "
+                f"jitter ({health.jitter_ms or 0:.0f} ms), at most {STATUS_CEILING:.2f} s"
+            )
         if health.ping_failures > 0:
             # The link may look alive (status still arriving) while the server no longer hears us.
             text = f"no ping ×{health.ping_failures}"
@@ -366,7 +394,13 @@ class StatusToolbar(Gtk.ScrolledWindow):
                 f"Server not answering pings ({health.ping_failures} in a row): it may not hear our "
                 f"commands; driving is stopped\n{tip}"
             )
-        cell.show_value(text, stale=health.level is not LinkLevel.OK or health.ping_failures > 0, tooltip=tip)
+        cell.show_value(
+            text,
+            stale=health.level is not LinkLevel.OK or health.ping_failures > 0,
+            tooltip=tip,
+            words=f"link {health.level.value}",
+            mark="" if health.level is LinkLevel.OK else health.level.value.upper(),
+        )
         cell.show_level(f"link-{health.level.value}")
 
 

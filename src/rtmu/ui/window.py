@@ -1,14 +1,13 @@
 """The main window: it composes the parts, holds them, and is the controller's View. Nothing more.
 
-It shows the selected :class:`~rtmu.fleet.sessions.RobotSession` with the operator's choices and
-owns no socket, no blocking call and no feature of its own; each lives in a part: ``bars`` (the
-header, STOP first and always on screen, and the full-screen bar), ``map_page``, ``camera_page``
-(and where pictures go), ``toolbar``, ``banners``, ``actions`` (every ``win.*`` action and the
-menu), ``keys`` (the one key table), ``stop_keys`` (Space stops from every surface),
-``keyboard_nav``, ``key_reach``, ``notice_router`` (where things are said), ``window_dialogs``,
-``handheld``, ``near_people``, ``bridge_toggle``, ``why_hint`` (a still held drive asks why). A new
-page goes into :attr:`MainWindow.stack`, a new action into ``actions``, a new dialog into
-``window_dialogs``.
+It shows the selected :class:`~rtmu.fleet.sessions.RobotSession` with the operator's choices and owns no
+socket, no blocking call and no feature of its own; each lives in a part: ``bars`` (the header, STOP first
+and always on screen, and the full-screen bar), ``map_page``, ``camera_page`` (and where pictures go),
+``toolbar``, ``banners``, ``actions`` (every ``win.*`` action and the menu), ``keys`` (the one key table),
+``stop_keys`` (Space stops from every surface), ``keyboard_nav``, ``key_reach``, ``notice_router`` (where
+things are said), ``window_dialogs``, ``handheld``, ``near_people``, ``bridge_toggle``, ``why_hint`` (a
+still held drive asks why), ``commissioning`` (files, scanning, map edits), ``desktop_citizen``. A new page
+goes into :attr:`MainWindow.stack`, a new action into ``actions``, a new dialog into ``window_dialogs``.
 
 Its timers (``window_timers``) are the UI's heartbeat: while a drive is held they renew the drive
 lease every :data:`rtmu.control.controller.TICK` — if this loop ever stalls, the lease lapses and
@@ -39,6 +38,8 @@ from .banners import BannerStack  # noqa: E402
 from .bars import FullscreenBar, HeaderBar  # noqa: E402
 from .bridge_toggle import BridgeToggle  # noqa: E402
 from .camera_page import CameraPage  # noqa: E402
+from .commissioning import Commissioning  # noqa: E402
+from .desktop_citizen import DesktopCitizen  # noqa: E402
 from .details import DetailsWindow  # noqa: E402
 from .drive_input import DriveInput  # noqa: E402
 from .goals_panel import GoalsPanel  # noqa: E402
@@ -154,6 +155,10 @@ class MainWindow(Gtk.ApplicationWindow):
             profile_changed=lambda: self._update_header(self.model.connection.value),
             why_question=why.question,
         )  # fmt: skip
+        self.commissioning = Commissioning(  # the robot's files, scanning, map edits (bar under the toolbar)
+            self, self.robot, model, column=self.column, after=self.toolbar_revealer, clock=clock,
+            stage=self.stage, banners=self.banners,
+        )  # fmt: skip
         if secrets is not None:
             self.controller.secrets = secrets
         # The slow tick now; the lease renewal and the guardian's beat once the controller says a
@@ -182,6 +187,9 @@ class MainWindow(Gtk.ApplicationWindow):
         self.key_reach = KeyReach(self)
         self.keyboard = KeyboardNav(self)  # Tab, F10, Ctrl+G, Alt+1…9, a pick mode's keys
         self.near_people = NearPeopleSwitch(self)  # View ▸ Near people: the speed cap
+        self.desktop = DesktopCitizen(
+            self, model, self.motion, self.view_menu
+        )  # screen kept on, notifications
 
     @property
     def session(self) -> RobotSession:
@@ -357,7 +365,7 @@ class MainWindow(Gtk.ApplicationWindow):
             remove()
         self._unobserve = []
         parts: tuple[_Part, ...] = (self.handheld, self.stop_keys, self.key_reach, self.near_people)
-        for part in (*parts, self.map_page, self.toolbar, self.routes_panel, self.goals_panel):
+        for part in (*parts, self.desktop, self.map_page, self.toolbar, self.routes_panel, self.goals_panel):
             part.close()
-        for part in (self.camera_page, self.foxglove, self.actions):
+        for part in (self.camera_page, self.foxglove, self.actions, self.commissioning):
             part.close()

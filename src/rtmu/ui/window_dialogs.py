@@ -35,6 +35,7 @@ from ..values.intents import (  # noqa: E402
     TurnBy,
     WatchStrings,
 )
+from .about import about_dialog  # noqa: E402
 from .banners import BannerStack  # noqa: E402
 from .config_page import ConfigPage  # noqa: E402
 from .console_page import ConsolePage  # noqa: E402
@@ -94,8 +95,8 @@ class WindowDialogs:
 
     def open_settings(self) -> None:
         profiles = dict(self.profiles)
-        current = self.robot.session.controller.profile
-        profiles.setdefault(current.name, current)
+        current = self.robot.session.controller.current_profile()  # the speed and view as they are now:
+        profiles[current.name] = current  # Save keeps them (never the speed the profile was opened with)
         known = self.keyring_available
         self.settings = ConnectionDialog(
             self.window,
@@ -113,7 +114,7 @@ class WindowDialogs:
         if self._profile_saved is not None:
             self._profile_saved(profile, password)
         controller = self.robot.session.controller
-        changed = profile != controller.profile
+        changed = profile != controller.current_profile()
         controller.select_profile(profile)
         self._profile_changed()
         if changed and self.model.connection.value.phase is not Phase.DISCONNECTED:
@@ -134,8 +135,13 @@ class WindowDialogs:
         """The server's configuration page (its own window, so typing there never drives): one at a time."""
         page = self.config_page
         if page is None or page.closed:
+            offers = lambda: self.model.connection.value.offers  # noqa: E731 - the shown robot's, always
             page = self.config_page = ConfigPage(
-                self.window, self.request, self._follow_config_updates, open_console=self.show_console
+                self.window,
+                self.request,
+                self._follow_config_updates,
+                offers,
+                open_console=self.show_console,
             )
         page.present()
 
@@ -201,19 +207,9 @@ class WindowDialogs:
 
     # -- About -----------------------------------------------------------------------------------
     def show_about(self) -> None:
-        from .. import __version__
-
-        about = Gtk.AboutDialog(
-            transient_for=self.window,
-            modal=True,
-            program_name="RTMU",
-            version=__version__,
-            comments="Robot Teleoperation, Mobile User interface: drive an ARIA (ArNetworking) robot "
-            "from a tablet or a laptop.",
-            logo_icon_name="io.github.rtmu.Rtmu",
-            license_type=Gtk.License.MIT_X11,
-        )
-        about.present()
+        """Help ▸ About, with the debug information of the robot shown (``about``)."""
+        conn = self.model.connection.value
+        about_dialog(self.window, conn, self.robot.session.controller.profile.name).present()
 
     # -- the controller's dialogs: Turn, Go, the palette -----------------------------------------
     def open_dialog(self, name: str) -> None:

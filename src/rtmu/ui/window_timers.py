@@ -27,8 +27,11 @@ if TYPE_CHECKING:
     from ..control.controller import Controller
     from ..fleet.sessions import RobotSession
     from ..model.observables import RobotModel
+    from .banners import BannerStack
     from .camera_page import CameraPage
+    from .desktop_citizen import DesktopCitizen
     from .map_page import MapPage
+    from .motion import MotionIndicator
     from .notice_router import NoticeRouter
     from .toolbar import StatusToolbar
     from .why_hint import WhyHint
@@ -46,6 +49,9 @@ class TimedWindow(Protocol):
     camera_page: CameraPage
     notices: NoticeRouter
     why_hint: WhyHint
+    banners: BannerStack
+    motion: MotionIndicator
+    desktop: DesktopCitizen
 
     @property
     def session(self) -> RobotSession: ...
@@ -90,6 +96,7 @@ class WindowTimers:
         self.window.controller.tick()
         self.window.map_page.refresh()
         self.window.why_hint.tick()
+        self.window.banners.keep_clear_of(self.window.motion, self.window.camera_page.motion)
         if self._driving():
             return True
         self._drive = 0
@@ -109,11 +116,15 @@ class WindowTimers:
         w = self.window
         w.map_page.refresh()
         w.why_hint.tick()  # a key held that drives nothing (no lease, so no drive tick) is seen here
+        w.banners.keep_clear_of(w.motion, w.camera_page.motion)
         w.toolbar.refresh()
+        w.desktop.refresh()  # no screen lock or suspend while the robot moves
         w.camera_page.tick()
         loop_lag = getattr(w.controller.link, "loop_lag", None)  # a stalled network thread: said
-        connected = w.model.connection.value.phase is Phase.CONNECTED
+        # A replay sends nothing (and its clock is the recording's): no "stops are not going out".
+        connected = w.model.connection.value.phase is Phase.CONNECTED and not w.controller.replay
         w.notices.loop_lag(loop_lag() if callable(loop_lag) else None, connected)
+        w.notices.link_health(w.model.health.value.level)
         return True
 
     def close(self) -> None:

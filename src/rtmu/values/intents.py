@@ -27,6 +27,7 @@ from dataclasses import dataclass, field
 from typing import Any, ClassVar
 
 from ..base.notices import Kind
+from ..mapfile.model import MapObject
 
 
 @dataclass(frozen=True)
@@ -60,6 +61,8 @@ def _plain(value: Any) -> Any:
         return [_plain(v) for v in value]
     if isinstance(value, Mapping):
         return {str(k): _plain(v) for k, v in value.items()}
+    if dataclasses.is_dataclass(value) and not isinstance(value, type):  # a map object of a change set
+        return {f.name: _plain(getattr(value, f.name)) for f in dataclasses.fields(value)}
     return repr(value)[:200]
 
 
@@ -343,6 +346,124 @@ class SetConfig(Intent):
     one RTMU cannot edit (an LD robot's ``setConfigValues``)."""
 
     label: ClassVar[str] = "Configuration"
+    changes: Mapping[str, Mapping[str, str]] = field(default_factory=dict)
+
+
+# -- commissioning: files, scans, map changes, configuration care ----------------------------------
+FILE_LISTING = ("getDirListingMultiplePackets", "getDirListing")
+FILE_DOWNLOAD = ("getFileWithTimestamp", "getFile")
+FILE_UPLOAD = ("putFileWithTimestamp", "putFile", "putFileWithTimestampInterleaved", "putFileInterleaved")
+
+
+@dataclass(frozen=True)
+class ListFiles(Intent):
+    """One folder on the robot (relative to the folder its ``ArServerFileUtils`` shares; "" is that one)."""
+
+    needs: ClassVar[tuple[str, ...]] = FILE_LISTING
+    label: ClassVar[str] = "Files on the robot"
+    folder: str = ""
+
+
+@dataclass(frozen=True)
+class DownloadFile(Intent):
+    """Fetch ``remote`` into the local file ``local`` (streamed to disk; the name taken only at the end).
+
+    ``size``: the listed size, when the asker has it (the progress's total and the download's bound)."""
+
+    needs: ClassVar[tuple[str, ...]] = FILE_DOWNLOAD
+    label: ClassVar[str] = "Download"
+    remote: str = ""
+    local: str = ""
+    size: int | None = None
+    overwrite: bool = False
+
+
+@dataclass(frozen=True)
+class UploadFile(Intent):
+    """Send the local file ``local`` to ``remote`` on the robot (the robot keeps its old file on refusal)."""
+
+    needs: ClassVar[tuple[str, ...]] = FILE_UPLOAD
+    label: ClassVar[str] = "Upload"
+    local: str = ""
+    remote: str = ""
+
+
+@dataclass(frozen=True)
+class DeleteFile(Intent):
+    needs: ClassVar[tuple[str, ...]] = ("deleteFile",)
+    label: ClassVar[str] = "Delete"
+    remote: str = ""
+
+
+@dataclass(frozen=True)
+class StartScan(Intent):
+    """Start logging a scan for a map into ``<name>.2d`` (``mappingStart``); the operator then drives."""
+
+    kind: ClassVar[Kind] = Kind.MAP
+    needs: ClassVar[tuple[str, ...]] = ("mappingStart",)
+    label: ClassVar[str] = "Scan a map"
+    name: str = ""
+
+
+@dataclass(frozen=True)
+class StopScan(Intent):
+    """End the scan (``mappingEnd``); the answer is the scan's file name ("" when the robot does not say)."""
+
+    kind: ClassVar[Kind] = Kind.MAP
+    needs: ClassVar[tuple[str, ...]] = ("mappingEnd",)
+    label: ClassVar[str] = "Stop the scan"
+
+
+@dataclass(frozen=True)
+class TagScanLoop(Intent):
+    """Mark where a loop starts (``start``) or ends while scanning (``mappingLoopStart`` / ``…End``)."""
+
+    kind: ClassVar[Kind] = Kind.MAP
+    needs: ClassVar[tuple[str, ...]] = ("mappingLoopStart",)
+    label: ClassVar[str] = "Loop tag"
+    start: bool = True
+
+
+@dataclass(frozen=True)
+class ApplyMapChanges(Intent):
+    """One change set to the map (``processMapChanges``): these objects deleted, these added.
+
+    ``generation``: the published map the draft was made on; the feed refuses the change, sending
+    nothing, when the map shown has changed since (the server would refuse it anyway)."""
+
+    kind: ClassVar[Kind] = Kind.MAP
+    needs: ClassVar[tuple[str, ...]] = ("processMapChanges",)
+    label: ClassVar[str] = "Apply map changes"
+    removed: tuple[MapObject, ...] = ()
+    added: tuple[MapObject, ...] = ()
+    generation: int = 0
+
+
+@dataclass(frozen=True)
+class SwitchMap(Intent):
+    """Make the robot's file ``path`` its active map: ARNL's ``Files/Map`` parameter, then ``checkMap``."""
+
+    kind: ClassVar[Kind] = Kind.MAP
+    needs: ClassVar[tuple[str, ...]] = ("setConfig",)
+    label: ClassVar[str] = "Switch map"
+    path: str = ""
+
+
+@dataclass(frozen=True)
+class FetchConfigDefaults(Intent):
+    """The factory value of every parameter (``getConfigDefaults``: only where the server keeps them)."""
+
+    needs: ClassVar[tuple[str, ...]] = ("getConfigDefaults",)
+    label: ClassVar[str] = "Factory values"
+
+
+@dataclass(frozen=True)
+class ResetConfig(Intent):
+    """Put factory values back: section → parameter → factory text (one ``setConfigParam`` for a single
+    parameter where offered, else one ``setConfig``)."""
+
+    needs: ClassVar[tuple[str, ...]] = ("setConfig", "setConfigParam")
+    label: ClassVar[str] = "Reset to default"
     changes: Mapping[str, Mapping[str, str]] = field(default_factory=dict)
 
 

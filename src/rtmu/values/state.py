@@ -13,6 +13,8 @@ from dataclasses import dataclass, field
 from enum import Enum, StrEnum
 from typing import TYPE_CHECKING, Protocol
 
+from .commission import ScanState, TransfersState
+
 if TYPE_CHECKING:
     from ..mapfile.model import MapData
 
@@ -58,7 +60,8 @@ class RobotState:
     """``getModeInfo``: the locked mode gives way when another mode asks (the dock backs out first)."""
     safe_drive: bool | None = None
     wifi_quality: int | None = None
-    """Link quality as the server publishes it (a ``getStrings`` item); None if not offered."""
+    """Link quality in % (a ``getStrings`` item's 0–70, an LD robot's DataStore item, turned into %);
+    None if not offered."""
     wifi_signal: int | None = None
     """Signal level (dBm on Linux) from a ``getStrings`` item; None if not offered."""
     sonar: tuple[tuple[int, int], ...] = ()
@@ -345,7 +348,10 @@ class DrawingLayer:
     may_toggle: bool
     """The server lets the operator turn it on and off (``DefaultOn`` / ``DefaultOff``)."""
     points: tuple[tuple[int, int], ...] = ()
-    """Global mm, as last received; empty while hidden."""
+    """Global mm, as last received — evenly thinned when the drawings together exceed the window's
+    budget (``client.drawing_budget``); empty while hidden."""
+    total_points: int = 0
+    """How many points the last sample had (more than ``points`` holds when thinned)."""
     problem: str = ""
     """Why its last sample was refused (malformed, too many points), or ""."""
 
@@ -390,6 +396,12 @@ class ConnectionState:
     """Reconnect attempt number while RECONNECTING."""
     retry_in: float | None = None
     """Seconds until the next reconnect attempt, if one is planned."""
+    server_tag: str = ""
+    """The version tag of the server's introduction (what About's debug information quotes)."""
+    server_protocol: str = ""
+    """The protocol string the server's introduction asked for, as sent (untrusted text)."""
+    sent_protocol: str = ""
+    """The protocol string this client answered with."""
 
     @property
     def connected(self) -> bool:
@@ -404,7 +416,8 @@ class LinkLevel(Enum):
     """Not connected."""
     OK = "ok"
     STALE = "stale"
-    """No status for 3 update intervals, or a ping went unanswered: driving is stopped."""
+    """No status for longer than the link's learned limit (``base.link_timing``: 0.2–0.45 s), or a
+    ping went unanswered: driving is stopped."""
     LOST = "lost"
     """No status for 2 s, or 3 pings unanswered: the link is considered gone (reconnect if enabled)."""
 
@@ -422,6 +435,12 @@ class LinkHealth:
     """Seconds since the last status packet (not compared: it changes all the time)."""
     ping_failures: int = 0
     """Pings in a row the server did not answer: it may no longer hear us (RTT is then None)."""
+    stale_limit: float | None = None
+    """Seconds without status after which the link counts as stale, as learned now (0.01 s steps)."""
+    jitter_ms: float | None = None
+    """How late status came lately above its normal pace (5 ms steps): what the limit was learned from."""
+    cause: str = field(default="", compare=False)
+    """While not OK: why, measured ("no status for 0.46 s, learned jitter 90 ms …"), with what to do."""
 
 
 # -- typed changes -------------------------------------------------------------------------------
@@ -467,6 +486,16 @@ class DrawingsChanged:
     value: DrawingsState
 
 
+@dataclass(frozen=True, slots=True)
+class ScanChanged:
+    value: ScanState
+
+
+@dataclass(frozen=True, slots=True)
+class TransfersChanged:
+    value: TransfersState
+
+
 StateChange = (
     RobotChanged
     | MapChanged
@@ -476,6 +505,8 @@ StateChange = (
     | NavChanged
     | PopupsChanged
     | DrawingsChanged
+    | ScanChanged
+    | TransfersChanged
 )
 """What the network side publishes: the class says which part changed, the value is the new whole."""
 

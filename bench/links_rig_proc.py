@@ -1,0 +1,68 @@
+"""A simulator behind the fault proxy in a process of its own, for ``bench_links``' long soaks.
+
+Several soaks run at once; with their simulators and proxies in one process they would share one
+interpreter lock, and the harness's own delays would pass for the link's. So each soak gets this:
+``python -m bench.links_rig_proc SEED`` prints ``port P`` (the proxy's), then ``stop T WHO`` for
+every stop that reaches the simulator (``T``: ``time.monotonic()``, one clock for every process;
+``WHO``: the sender's identifier, ``client`` without one, ``watchdog`` for the server's own).
+Commands on stdin: ``play PROFILE SEED`` (a Wi-Fi profile of ``tests/linkfaults.py``), ``state``
+(answers ``state TRANS ROT DRIVES``: the commanded ratios and ratioDrive packets so far).
+"""
+
+from __future__ import annotations
+
+import contextlib
+import os
+import sys
+import threading
+
+from bench.links_rig import Rig
+from linkfaults import PROFILES
+
+ROBOT_PRIORITY = -10
+"""The simulator stands for the robot, which does not share the laptop's CPUs: where allowed (root,
+``RLIMIT_NICE``), its process runs this many nice levels up, so the laptop's load (other engineers'
+work, the bench's spinners) delays the client, not the status the client is waiting for."""
+
+
+def main() -> int:
+    with contextlib.suppress(OSError):
+        os.setpriority(os.PRIO_PROCESS, 0, ROBOT_PRIORITY)
+    rig = Rig(int(sys.argv[1]))
+    lock = threading.Lock()
+
+    def say(line: str) -> None:
+        with lock:
+            sys.stdout.write(line + "\n")
+            sys.stdout.flush()
+
+    def report() -> None:
+        seen = 0
+        while not done.wait(0.002):
+            stops = rig.stops
+            for at, who in stops[seen:]:
+                say(f"stop {at:.6f} {who or 'client'}")
+            seen = len(stops)
+
+    done = threading.Event()
+    threading.Thread(target=report, daemon=True).start()
+    say(f"port {rig.proxy.port}")
+    try:
+        for line in sys.stdin:
+            words = line.split()
+            if not words:
+                continue
+            if words[0] == "play":
+                rig.proxy.play(PROFILES[words[1]], seed=int(words[2]))
+            elif words[0] == "state":
+                snap = rig.sim.snapshot()
+                drives = rig.sim.server.world.ratio_drives_received
+                say(f"state {snap.trans_ratio:g} {snap.rot_ratio:g} {drives}")
+    finally:
+        done.set()
+        rig.close()
+    return 0
+
+
+if __name__ == "__main__":
+    raise SystemExit(main())

@@ -1,0 +1,403 @@
+"""Editing the robot's map as a draft (ARIA's ``ArMapChanger``): goals, docks, forbidden lines and areas.
+
+Server ▸ Edit the map… opens a window of its own over the map. Edits are kept in a
+:class:`~rtmu.mapedit.MapDraft` — shown as a draft, with undo and redo — and change nothing until
+Apply sends them as ONE ``processMapChanges`` series (``ApplyMapChanges`` to the selected robot,
+guarded by the map's id). The server's ``mapUpdated`` then reloads the window's map; a draft Applied
+starts afresh on it. When the map changes under an open draft (another client's change), the draft is
+kept, rebased on the new map, and what changed — and which edits now conflict — is said plainly. A
+change the server refuses leaves its map as it was and the draft as it is.
+
+What is typed is in mm and degrees; "Robot's pose" fills the fields from where the robot is, "Pick on
+the map" from the next click on the map (a drag from the point sets the heading: ``map_point_pick``). While
+the draft holds edits, the map draws the draft's goals, docks and forbidden lines and areas instead
+of the robot's, and a banner says a draft is shown, not applied (``show_draft``); closing the window
+shows the robot's map again.
+"""
+
+from __future__ import annotations
+
+import concurrent.futures
+from collections.abc import Callable
+from typing import Any
+
+import gi
+
+gi.require_version("Gdk", "4.0")
+gi.require_version("Gtk", "4.0")
+gi.require_version("Pango", "1.0")
+from gi.repository import Gdk, GLib, Gtk, Pango  # noqa: E402
+
+from ..base.textsafe import visible  # noqa: E402
+from ..client.map_changes import ChangeVerdict  # noqa: E402
+from ..fleet.selected import SelectedRobot  # noqa: E402
+from ..fleet.sessions import RobotSession  # noqa: E402
+from ..mapedit import MapDraft, MapObject  # noqa: E402
+from ..mapedit.draft import (  # noqa: E402
+    DOCK,
+    FORBIDDEN_AREA,
+    FORBIDDEN_LINE,
+    GOAL,
+    GOAL_WITH_HEADING,
+    DraftError,
+    describe,
+    object_key,
+)
+from ..model.observables import MapModel, MapPhase, Phase, RobotModel  # noqa: E402
+from ..values.intents import ApplyMapChanges  # noqa: E402
+from .map_point_pick import Picked  # noqa: E402
+
+EDITABLE = {t.lower() for t in (GOAL, GOAL_WITH_HEADING, DOCK, FORBIDDEN_LINE, FORBIDDEN_AREA)}
+KINDS = ("Goal", "Dock", "Forbidden line", "Forbidden area")
+
+
+def editable(objects: tuple[MapObject, ...] | list[MapObject]) -> list[MapObject]:
+    """The objects this window edits, in map order."""
+    return [o for o in objects if o.type.lower() in EDITABLE]
+
+
+class MapEditWindow(Gtk.Window):
+    """See the module notes."""
+
+    def __init__(
+        self,
+        parent: Gtk.Window,
+        robot: SelectedRobot,
+        model: RobotModel,
+        show_draft: Callable[[tuple[MapObject, ...] | None, int], None] = lambda _o, _n: None,
+        pick: Callable[[Picked], None] | None = None,
+    ) -> None:
+        super().__init__(title="Edit the map (draft)", transient_for=parent, destroy_with_parent=True)
+        self.set_default_size(620, 520)
+        self.robot, self.model = robot, model
+        self._show_draft, self._pick = show_draft, pick
+        """Told the draft's objects to draw on the map (None: the map's own again) and its edit count."""
+        self.draft: MapDraft | None = None
+        self.generation = -1
+        """The map the draft is made on (``MapModel.generation``)."""
+        self.applying = False
+        self.applied = 0
+        """Change sets the server took (tests wait for the next one)."""
+        self.closed = False
+        self.shown: list[MapObject] = []
+        self._build()
+        self._unobserve = [
+            model.map.observe(self._map_changed),
+            model.connection.observe(lambda *_a: self._show()),
+        ]
+        self._unswitch = robot.on_switch(self._switched)
+        self.connect("close-request", self._closing)
+        self._map_changed(MapModel(), model.map.value)
+
+    # -- layout -----------------------------------------------------------------------------------
+    def _build(self) -> None:
+        box = Gtk.Box(orientation=Gtk.Orientation.VERTICAL, spacing=6)
+        for side in ("top", "bottom", "start", "end"):
+            getattr(box, f"set_margin_{side}")(8)
+        bar = Gtk.Box(spacing=6)
+        self.state_label = Gtk.Label(xalign=0.0, hexpand=True, wrap=True)
+        bar.append(self.state_label)
+        self.undo_button = Gtk.Button(label="Undo")
+        self.undo_button.connect("clicked", lambda _b: self._step(undo=True))
+        self.redo_button = Gtk.Button(label="Redo")
+        self.redo_button.connect("clicked", lambda _b: self._step(undo=False))
+        self.discard_button = Gtk.Button(label="Discard")
+        self.discard_button.connect("clicked", lambda _b: self._discard())
+        self.apply_button = Gtk.Button(label="Apply")
+        self.apply_button.add_css_class("suggested-action")
+        self.apply_button.connect("clicked", lambda _b: self.apply())
+        for b in (self.undo_button, self.redo_button, self.discard_button, self.apply_button):
+            bar.append(b)
+        box.append(bar)
+        self.news = Gtk.Label(xalign=0.0, wrap=True, selectable=True)
+        box.append(self.news)
+        self.rows = Gtk.ListBox()
+        self.rows.connect("row-selected", self._row_selected)
+        scroller = Gtk.ScrolledWindow(vexpand=True, hscrollbar_policy=Gtk.PolicyType.NEVER)
+        scroller.set_child(self.rows)
+        box.append(scroller)
+        self.edits_label = Gtk.Label(xalign=0.0, wrap=True)
+        self.edits_label.add_css_class("dim-label")
+        box.append(self.edits_label)
+        form = Gtk.Grid(column_spacing=6, row_spacing=6)
+        self.kind = Gtk.DropDown.new_from_strings(list(KINDS))
+        self.name_entry = Gtk.Entry(placeholder_text="name (goals, docks)")
+        self.fields: dict[str, Gtk.Entry] = {}
+        form.attach(self.kind, 0, 0, 1, 1)
+        form.attach(self.name_entry, 1, 0, 2, 1)
+        here = Gtk.Button(label="Robot's pose")
+        here.connect("clicked", lambda _b: self._fill_from_robot())
+        form.attach(here, 3, 0, 1, 1)
+        self.pick_button = Gtk.Button(
+            label="Pick on the map", tooltip_text="Click a point; drag for a heading"
+        )
+        self.pick_button.connect("clicked", lambda _b: self.pick_point(end=False))
+        self.pick_end_button = Gtk.Button(
+            label="Pick the end", tooltip_text="The other end of a line or area"
+        )
+        self.pick_end_button.connect("clicked", lambda _b: self.pick_point(end=True))
+        self.pick_button.set_sensitive(self._pick is not None)
+        self.pick_end_button.set_sensitive(self._pick is not None)
+        form.attach(self.pick_button, 4, 0, 1, 1)
+        form.attach(self.pick_end_button, 4, 1, 1, 1)
+        fields = Gtk.Grid(column_spacing=6, column_homogeneous=True)
+        titles = {
+            "x": "x (mm)",
+            "y": "y (mm)",
+            "th": "heading (°)",
+            "x2": "x2 (mm, line / area)",
+            "y2": "y2 (mm)",
+        }
+        for i, (name, title) in enumerate(titles.items()):
+            fields.attach(Gtk.Label(label=title, xalign=0.0, ellipsize=Pango.EllipsizeMode.END), i, 0, 1, 1)
+            entry = Gtk.Entry(width_chars=6)
+            self.fields[name] = entry
+            fields.attach(entry, i, 1, 1, 1)
+        form.attach(fields, 0, 1, 4, 2)
+        actions = Gtk.Box(spacing=6)
+        self.add_button = Gtk.Button(label="Add")
+        self.add_button.connect("clicked", lambda _b: self.add())
+        self.move_button = Gtk.Button(label="Move selected here")
+        self.move_button.connect("clicked", lambda _b: self.move_selected())
+        self.rename_button = Gtk.Button(label="Rename selected")
+        self.rename_button.connect("clicked", lambda _b: self.rename_selected())
+        self.delete_button = Gtk.Button(label="Delete selected")
+        self.delete_button.connect("clicked", lambda _b: self.delete_selected())
+        for b in (self.add_button, self.move_button, self.rename_button, self.delete_button):
+            actions.append(b)
+        form.attach(actions, 0, 3, 4, 1)
+        box.append(form)
+        self.set_child(box)
+        keys = Gtk.EventControllerKey()
+        keys.connect("key-pressed", self._key)
+        self.add_controller(keys)
+
+    def _key(self, _c: Gtk.EventControllerKey, keyval: int, _code: int, state: Gdk.ModifierType) -> bool:
+        if keyval == Gdk.KEY_Escape:
+            self.close()
+            return True
+        if state & Gdk.ModifierType.CONTROL_MASK and keyval in (Gdk.KEY_z, Gdk.KEY_y):
+            self._step(undo=keyval == Gdk.KEY_z)
+            return True
+        return False
+
+    # -- the map underneath -------------------------------------------------------------------------
+    def _map_changed(self, _old: MapModel, new: MapModel) -> None:
+        if new.state != MapPhase.READY or new.data is None or new.generation == self.generation:
+            self._show()
+            return
+        objects = editable(new.data.objects)
+        draft, self.generation = self.draft, new.generation
+        if draft is None or not draft.dirty:
+            self.draft = MapDraft(objects)  # nothing of the operator's to keep: the list follows the map
+        else:
+            underneath = draft.rebase(objects)
+            if not underneath.nothing:
+                self._say(underneath.summary(), error=bool(underneath.conflicts))
+        self._show()
+
+    def _switched(self, _old: RobotSession, _new: RobotSession) -> None:
+        """Another robot selected: a draft belongs to one map, so it is dropped, and said."""
+        dropped = self.draft is not None and self.draft.dirty
+        self.draft, self.generation = None, -1
+        self._map_changed(MapModel(), self.model.map.value)
+        if dropped:
+            self._say("Another robot was selected: the draft made on the other map was dropped.", error=True)
+
+    # -- editing ----------------------------------------------------------------------------------
+    def _number(self, name: str, *, required: bool = True) -> float | None:
+        text = self.fields[name].get_text().strip()
+        if not text and not required:
+            return None
+        try:
+            return float(text)
+        except ValueError:
+            raise DraftError(f"{name}: {text!r} is not a number") from None
+
+    def _edit(self, what: Any) -> None:
+        """Run one draft edit; a DraftError is said, and the draft stays as it was."""
+        if self.draft is None:
+            self._say("There is no map to edit yet.", error=True)
+            return
+        try:
+            what(self.draft)
+        except DraftError as exc:
+            self._say(str(exc), error=True)
+            return
+        self._say("", error=False)
+        self._show()
+
+    def add(self) -> None:
+        kind = KINDS[self.kind.get_selected()]
+        name = self.name_entry.get_text().strip()
+
+        def run(d: MapDraft) -> None:
+            x, y = self._number("x"), self._number("y")
+            assert x is not None and y is not None
+            if kind == "Goal":
+                d.add_goal(name, x, y, self._number("th", required=False))
+            elif kind == "Dock":
+                d.add_dock(name, x, y, self._number("th") or 0.0)
+            else:
+                x2, y2 = self._number("x2"), self._number("y2")
+                assert x2 is not None and y2 is not None
+                (d.add_forbidden_line if kind == "Forbidden line" else d.add_forbidden_area)(x, y, x2, y2)
+
+        self._edit(run)
+
+    def selected(self) -> MapObject | None:
+        row = self.rows.get_selected_row()
+        return self.shown[row.get_index()] if row is not None and row.get_index() < len(self.shown) else None
+
+    def move_selected(self) -> None:
+        obj = self.selected()
+        if obj is None or not obj.name:
+            self._say(
+                "Select a goal or dock to move (a line or area is deleted and drawn again).", error=True
+            )
+            return
+
+        def run(d: MapDraft) -> None:
+            x, y = self._number("x"), self._number("y")
+            assert x is not None and y is not None
+            d.move(obj.name, x, y)
+            th = self._number("th", required=False)
+            if th is not None:
+                d.turn(obj.name, th)
+
+        self._edit(run)
+
+    def rename_selected(self) -> None:
+        obj = self.selected()
+        if obj is None or not obj.name:
+            self._say("Select a goal or dock to rename.", error=True)
+            return
+        self._edit(lambda d: d.rename(obj.name, self.name_entry.get_text().strip()))
+
+    def delete_selected(self) -> None:
+        obj = self.selected()
+        if obj is not None:
+            self._edit(lambda d: d.delete_object(obj))
+
+    def _step(self, *, undo: bool) -> None:
+        if self.draft is not None:
+            (self.draft.undo if undo else self.draft.redo)()
+            self._show()
+
+    def _discard(self) -> None:
+        if self.draft is not None:
+            self.draft.clear()
+            self._say("The draft was discarded; the robot's map is unchanged.", error=False)
+            self._show()
+
+    def _fill_from_robot(self) -> None:
+        pose = self.model.robot.value
+        for name, value in (("x", pose.x), ("y", pose.y), ("th", pose.th)):
+            self.fields[name].set_text(f"{value:.0f}")
+
+    def pick_point(self, *, end: bool) -> None:
+        """The next click on the map fills x, y (and a dragged heading) — or x2, y2 with ``end``."""
+        if self._pick is None:
+            return
+        self._say("Click the map" + ("" if end else " (drag from the point for a heading)"), error=False)
+
+        def picked(x: float, y: float, th: float | None) -> None:
+            self.fields["x2" if end else "x"].set_text(f"{x:.0f}")
+            self.fields["y2" if end else "y"].set_text(f"{y:.0f}")
+            if th is not None and not end:
+                self.fields["th"].set_text(f"{th:.0f}")
+            self._say(
+                f"Picked ({x:.0f}, {y:.0f})" + (f", heading {th:.0f}°" if th is not None else ""), error=False
+            )
+
+        self._pick(picked)
+
+    def _row_selected(self, _box: Gtk.ListBox, _row: Gtk.ListBoxRow | None) -> None:
+        obj = self.selected()
+        if obj is None:
+            return
+        self.name_entry.set_text(obj.name)
+        self.fields["x"].set_text(f"{obj.x:.0f}")
+        self.fields["y"].set_text(f"{obj.y:.0f}")
+        self.fields["th"].set_text(f"{obj.th:.0f}")
+
+    # -- applying ---------------------------------------------------------------------------------
+    def apply(self) -> None:
+        """Send the draft as one change set; the server's verdict is said here."""
+        draft = self.draft
+        if draft is None or not draft.dirty or self.applying:
+            return
+        change = draft.change()
+        self.applying = True
+        self._say(f"Applying {len(draft.edits)} edits…", error=False)
+        self._show()
+        intent = ApplyMapChanges(change.removed, change.added, self.generation)
+        self.robot.request(intent).add_done_callback(lambda f: GLib.idle_add(self._verdict, f))
+
+    def _verdict(self, future: concurrent.futures.Future[Any]) -> bool:
+        self.applying = False
+        if self.closed:
+            return False
+        error = None if future.cancelled() else future.exception()
+        if future.cancelled() or error is not None:
+            self._say(f"Not applied: {error or 'cancelled'}. The draft is kept.", error=True)
+        else:
+            verdict: ChangeVerdict = future.result()
+            if verdict.applied:
+                self.applied += 1
+                if self.draft is not None:
+                    self.draft = MapDraft(self.draft.objects)  # the map now holds it: a fresh draft
+                self._say(f"Applied: {verdict.words}", error=False)
+            else:
+                self._say(f"The robot refused the change; its map is as it was. {verdict.words}", error=True)
+        self._show()
+        return False
+
+    # -- showing ----------------------------------------------------------------------------------
+    def _say(self, text: str, *, error: bool) -> None:
+        self.news.set_text(text)
+        (self.news.add_css_class if error else self.news.remove_css_class)("error")
+
+    def _show(self) -> None:
+        draft = self.draft
+        connected = self.model.connection.value.phase is Phase.CONNECTED
+        while (row := self.rows.get_first_child()) is not None:
+            self.rows.remove(row)
+        self.shown = list(draft.objects) if draft is not None else []
+        added = {object_key(o) for o in (draft.change().added if draft is not None else ())}
+        for obj in self.shown:
+            text = describe(obj) + ("" if obj.from_xy else f" at ({obj.x:.0f}, {obj.y:.0f}) {obj.th:.0f}°")
+            if object_key(obj) in added:
+                text += "  — draft"
+            label = Gtk.Label(label=visible(text), xalign=0.0, ellipsize=Pango.EllipsizeMode.END)
+            self.rows.append(label)
+        edits = draft.edits if draft is not None else ()
+        dirty = draft is not None and draft.dirty
+        if draft is None:
+            self.state_label.set_text("No map to edit" if connected else "Not connected")
+        elif dirty:
+            self.state_label.set_text(
+                f"Draft: {len(edits)} edit{'s' if len(edits) != 1 else ''}, not applied"
+            )
+        else:
+            self.state_label.set_text("No changes: the list is the robot's map")
+        self.edits_label.set_text("; ".join(e.label for e in edits))
+        self.undo_button.set_sensitive(draft is not None and draft.can_undo)
+        self.redo_button.set_sensitive(draft is not None and draft.can_redo)
+        self.discard_button.set_sensitive(dirty)
+        self.apply_button.set_sensitive(dirty and connected and not self.applying)
+        if dirty and draft is not None:
+            data = self.model.map.value.data
+            kept = [o for o in (data.objects if data is not None else ()) if o.type.lower() not in EDITABLE]
+            self._show_draft((*kept, *draft.objects), len(edits))  # home and the like stay as they are
+        else:
+            self._show_draft(None, 0)
+
+    def _closing(self, _w: Gtk.Window) -> bool:
+        self.closed = True
+        self._show_draft(None, 0)  # the map shows the robot's map again
+        for remove in self._unobserve:
+            remove()
+        self._unobserve = []
+        self._unswitch()
+        return False

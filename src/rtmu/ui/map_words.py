@@ -1,0 +1,87 @@
+"""The map in words: what a screen reader says for the drawn map, and when it says it again.
+
+The map is a drawing; a screen reader user hears its accessible description instead: where the robot
+is, its mode, its battery and what it is doing. The words are rounded (half a metre, 15 degrees, a
+tenth of a volt, whole metres left) so the description — and the announcement a screen reader makes
+when it changes — follows material changes, not every 10 Hz status packet.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Callable
+
+from ..model.observables import ConnectionState, NavState, Phase, RobotModel, RobotState
+from .nav_text import loc_level, where
+
+POSE_STEP_M = 0.5
+HEADING_STEP_DEG = 15
+
+
+def _step(value: float, step: float) -> float:
+    return round(value / step) * step
+
+
+def battery_words(robot: RobotState) -> str:
+    """``battery 12.8 volts, low``: the number and the state its colour shows."""
+    if robot.battery_v is None:
+        return "battery unknown"
+    number = f"{robot.battery_v:.0f} percent" if robot.battery_is_soc else f"{robot.battery_v:.1f} volts"
+    state = {"low": ", low", "critical": ", at shutdown level"}.get(robot.battery_state, "")
+    return f"battery {number}{state}"
+
+
+def activity_words(robot: RobotState, nav: NavState) -> str:
+    """What the robot is doing, in words: going somewhere, driving, or standing."""
+    if nav.navigating:
+        left = "" if nav.remaining_mm is None else f", {nav.remaining_mm / 1000:.0f} metres left"
+        return ("going home" if nav.target == "home" else f"going to {where(nav.target)}") + left
+    if abs(robot.vel) > 20 or abs(robot.rot_vel) > 3:
+        return "moving"
+    return "standing still"
+
+
+def map_description(robot: RobotState, nav: NavState, connection: ConnectionState) -> str:
+    """The map's accessible description (see the module notes)."""
+    if connection.phase is not Phase.CONNECTED:
+        return f"Not connected ({connection.phase.value})"
+    if robot.numbers_at is None:
+        return "Connected, no position from the robot yet"
+    x, y = _step(robot.x / 1000, POSE_STEP_M), _step(robot.y / 1000, POSE_STEP_M)
+    heading = int(_step(robot.th, HEADING_STEP_DEG)) % 360
+    parts = [f"Robot at x {x:.1f}, y {y:.1f} metres, heading {heading} degrees"]
+    mode = robot.mode or robot.status
+    if mode:
+        parts.append(f"mode {mode}")  # the server's own word
+    parts.append(battery_words(robot))
+    parts.append(activity_words(robot, nav))
+    level = loc_level(nav.loc_state, nav.loc_score)
+    if level is not None:
+        parts.append(f"localization {level}")
+    return "; ".join(parts)
+
+
+class MapDescription:
+    """Keeps ``describe(text)`` (the map widget's description) in step with the model, only on change."""
+
+    def __init__(self, model: RobotModel, describe: Callable[[str], None]) -> None:
+        self.model = model
+        self._describe = describe
+        self.text = ""
+        self._unobserve = [
+            model.robot.observe(self._changed),
+            model.navigation.observe(self._changed),
+            model.connection.observe(self._changed),
+        ]
+        self._changed(None, None)
+
+    def _changed(self, _old: object, _new: object) -> None:
+        m = self.model
+        text = map_description(m.robot.value, m.navigation.value, m.connection.value)
+        if text != self.text:
+            self.text = text
+            self._describe(text)
+
+    def close(self) -> None:
+        for remove in self._unobserve:
+            remove()
+        self._unobserve = []

@@ -1,0 +1,170 @@
+"""The lease keeper: a renewing thread that only waited for a CPU keeps its lease; a busy, blocked
+or frozen one does not, and nothing dead comes back. First on a fake clock with made-up run-queue
+waits, then with the kernel's real account of a thread starved behind spinning processes."""
+
+from __future__ import annotations
+
+import hashlib
+import os
+import threading
+import time
+
+import pytest
+
+from cpuload import CpuLoad, wait_busy
+from rtmu.client.lease import DriveLease, DriveRatios, EndReason
+from rtmu.client.lease_keeper import STARVED_LIMIT, LeaseKeeper, RunQueueMeter
+
+from .fakeclock import FakeClock
+
+FWD = DriveRatios(50, 0, 50)
+
+
+class Waits:
+    """A made-up run-queue account for every thread: what ``wait_of`` returns."""
+
+    def __init__(self) -> None:
+        self.seconds = 0.0
+
+    def __call__(self, tid: int) -> float | None:
+        return self.seconds
+
+
+def rig() -> tuple[FakeClock, DriveLease, LeaseKeeper, Waits, list[float]]:
+    clock, waits, beats = FakeClock(), Waits(), []
+    lease = DriveLease(clock=clock)
+    keeper = LeaseKeeper(lease, beat=beats.append, wait_of=waits)
+    lease.on_renew, lease.before_lapse = keeper.renewed, keeper.step  # as the runner wires it
+    return clock, lease, keeper, waits, beats
+
+
+def run(clock: FakeClock, keeper: LeaseKeeper, seconds: float, waiting: float, waits: Waits) -> None:
+    """``seconds`` of keeper looks while the renewing thread waits ``waiting`` s per s for a CPU."""
+    for _ in range(round(seconds / 0.05)):
+        clock.advance(0.05)
+        waits.seconds += 0.05 * waiting
+        keeper.step(clock())
+
+
+def test_a_thread_waiting_for_a_core_keeps_its_lease_up_to_the_limit() -> None:
+    clock, lease, keeper, waits, beats = rig()
+    lease.grant(FWD)
+    keeper.step(clock())  # sees the grant
+    run(clock, keeper, 0.8, 0.95, waits)  # starved: runnable, not running, for 0.8 s
+    assert lease.view().live and keeper.credited > 0.6
+    assert beats and beats[-1] <= clock() and clock() - beats[-1] < 0.3  # the guardian hears it too
+    run(clock, keeper, STARVED_LIMIT, 0.95, waits)  # a machine that cannot run us for a second
+    assert not lease.view().live  # …stops the robot anyway
+    assert lease.renew() is False  # and a lapsed lease stays dead
+
+
+def test_a_busy_or_blocked_thread_gets_no_credit() -> None:
+    clock, lease, keeper, waits, beats = rig()
+    lease.grant(FWD)
+    keeper.step(clock())
+    run(clock, keeper, 0.25, 0.0, waits)  # running its own work (or blocked): no run-queue wait
+    assert lease.view().live
+    run(clock, keeper, 0.1, 0.0, waits)
+    assert not lease.view().live and beats == []  # lapsed at 0.3 s, as without a keeper
+
+
+def test_a_renewal_restarts_the_account_and_ended_leases_stay_ended() -> None:
+    clock, lease, keeper, waits, _beats = rig()
+    lease.grant(FWD)
+    keeper.step(clock())
+    run(clock, keeper, 0.2, 1.0, waits)
+    assert lease.renew()  # a real renewal
+    run(clock, keeper, 0.05, 1.0, waits)  # first look after it: the new baseline, no credit yet
+    before = lease.view().expires_at
+    run(clock, keeper, 0.2, 1.0, waits)
+    assert lease.view().expires_at > before
+    lease.release()
+    run(clock, keeper, 0.5, 1.0, waits)
+    view = lease.view()
+    assert view.ended is EndReason.RELEASED and not view.live
+    assert lease.extend(clock()) is False
+
+
+def test_a_keeper_that_waited_too_catches_up_before_anyone_acts_on_the_lapse() -> None:
+    """Its own thread stood still as well (a starved renewer holding the GIL stalls every Python
+    thread): whoever finds the lease past its time asks the keeper first."""
+    clock, lease, _keeper, waits, _beats = rig()
+    lease.grant(FWD)
+    clock.advance(0.5)
+    waits.seconds += 0.45  # the renewer waited for a CPU nearly all along; no keeper look meanwhile
+    assert lease.view().live  # the network side's look: credited, lives
+    assert lease.renew()  # …and the renewer's own, once it runs
+    clock.advance(0.5)  # frozen now: no run-queue wait
+    view = lease.view()
+    assert not view.live and view.ended is None  # lapsed; the governor ends it, for good
+    lease.end(EndReason.LAPSED)
+    waits.seconds += 5.0
+    assert not lease.view().live and lease.renew() is False
+
+
+def test_unknown_waits_give_no_credit() -> None:
+    clock = FakeClock()
+    lease = DriveLease(clock=clock)
+    keeper = LeaseKeeper(lease, wait_of=lambda tid: None)
+    lease.grant(FWD)
+    for _ in range(8):
+        clock.advance(0.05)
+        keeper.step(clock())
+    assert not lease.view().live
+
+
+def _gil_free_work(cpu_seconds: float) -> None:
+    """CPU work that does not hold the GIL (hashing releases it), as GTK's rendering in C does."""
+    start = time.thread_time()
+    block = bytes(1 << 20)
+    while time.thread_time() - start < cpu_seconds:
+        hashlib.sha256(block).digest()
+
+
+def _starved_renewer(lease: DriveLease, cpu: int, seconds: float) -> list[float]:
+    """A "UI" thread pinned to ``cpu`` that renews after every 50 ms of its own work; returns when
+    its lease lapsed (empty: never)."""
+    lapsed: list[float] = []
+
+    def ui() -> None:
+        os.sched_setaffinity(0, {cpu})  # this thread only (Linux: 0 is the caller)
+        lease.grant(FWD)
+        end = time.monotonic() + seconds
+        while time.monotonic() < end:
+            _gil_free_work(0.05)
+            if not lease.renew():
+                lapsed.append(time.monotonic())
+                return
+
+    thread = threading.Thread(target=ui, daemon=True)
+    thread.start()
+    thread.join(seconds + 30)
+    return lapsed
+
+
+def test_the_kernel_account_tells_a_starved_thread_from_a_frozen_one() -> None:
+    """Real threads on the real clock: a renewer sharing its CPU with six spinning processes waits
+    ~6/7 of the time for it (50 ms of work take ~0.35 s or more) — without a keeper its lease
+    lapses, with one it lives; a renewer that simply stops (blocked, not runnable) lapses either way."""
+    if len(os.sched_getaffinity(0)) < 2 or RunQueueMeter()(threading.get_native_id()) is None:
+        pytest.skip("needs two CPUs and /proc/self/task/*/schedstat")
+    cpu = sorted(os.sched_getaffinity(0))[0]
+    with CpuLoad(count=6, nice=0, seconds=60, cpus=(cpu,)) as load:
+        assert wait_busy(load)
+        without = _starved_renewer(DriveLease(), cpu, 3.0)
+        assert without, "the renewer was never starved past the lease: the setup proves nothing"
+        lease = DriveLease()
+        keeper = LeaseKeeper(lease).start()
+        try:
+            lapsed = _starved_renewer(lease, cpu, 3.0)
+        finally:
+            keeper.close()
+    assert lapsed == [], f"a starved renewer lost its lease (longest credit {keeper.credited:.2f} s)"
+    assert keeper.credited > 0.25
+    keeper = LeaseKeeper(lease).start()
+    try:
+        lease.grant(FWD)  # frozen: granted, then never renewed again (sleeping, not runnable)
+        time.sleep(0.6)
+        assert not lease.view().live
+    finally:
+        keeper.close()

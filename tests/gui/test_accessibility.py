@@ -1,0 +1,152 @@
+"""The window as a screen reader reads it: its AT-SPI tree, from another process, on a bus of its own.
+
+``rtmu`` runs as a process against the simulator with GTK's accessibility bridge on (the other GUI
+tests turn it off), on the accessibility bus ``a11y_bus`` starts for this test alone; the reader
+(``atspi_reader``, pyatspi as Orca uses it) walks the application's tree after turning the D-pad on
+and opening Connection settings through the window's own actions. Every control must have a name
+that is words, not GTK's fallback (a type name such as ``GtkButton``); the map must say where the
+robot is, its mode, battery and what it is doing, and say it again when the robot has moved.
+The probe window (``a11y_probe``, one unnamed icon button) proves the same check fails.
+"""
+
+from __future__ import annotations
+
+import json
+import os
+import re
+import subprocess
+import sys
+import time
+from pathlib import Path
+from typing import Any
+
+import pytest
+
+from rtmu.sim import SimConfig, SimThread
+
+from .a11y_bus import accessibility_bus, missing
+from .harness import OFFICE_MAP
+from .process import wait, xdotool
+
+HERE = Path(__file__).parent
+READER = HERE / "atspi_reader.py"
+CONTROL_ROLES = {
+    "push button", "toggle button", "check box", "radio button", "combo box", "text", "password text",
+    "spin button", "slider", "switch", "menu item", "check menu item", "radio menu item", "entry",
+    "level bar",
+}  # fmt: skip
+"""Roles a user operates or reads a value from. Not GTK's own scroll bars of a scrolled pane (GTK 4.8
+leaves them unnamed; they move the pane the reader already reads), nor icons, which decorate a named
+control; the map, a drawing, is checked on its own."""
+FALLBACK = re.compile(r"^(Gtk|Adw)[A-Z]\w*$|\+")
+"""GTK 4.8 names an unnamed widget by its type (``GtkButton``, ``rtmu+ui+goals_panel+GoalsPanel``)."""
+OPENED = ("win.dpad", "win.settings", "win.server-config", "win.console", "win.why")
+"""What the reader opens through the window's own actions before it reads: the D-pad, connection
+settings, the server's configuration, the console and "why won't it move?"."""
+MNEMONIC_TWICE = re.compile(r"^(\S*_\S*) (\S+)$")
+"""GTK 4.8's name for a mnemonic button, ``_Cancel Cancel``: the raw label read out, then the label."""
+
+
+def _skip_or_fail() -> None:
+    why = missing()
+    if why:
+        if os.environ.get("CI", "").lower() in ("true", "1"):
+            pytest.fail(f"CI=true but the accessibility test cannot run: {why}", pytrace=False)
+        pytest.skip(why)
+
+
+def read_tree(pid: int, env: dict[str, str], *activate: str) -> list[dict[str, Any]]:
+    argv = [sys.executable, str(READER), str(pid), *(a for act in activate for a in ("--activate", act))]
+    out = subprocess.run(argv, env=env, capture_output=True, text=True, timeout=120)
+    assert out.returncode == 0, out.stderr
+    nodes: list[dict[str, Any]] = json.loads(out.stdout.splitlines()[-1])["nodes"]
+    return nodes
+
+
+def unnamed_controls(nodes: list[dict[str, Any]]) -> list[str]:
+    """Each control without words for a name: ``role 'name' at path``."""
+    bad = []
+    for n in nodes:
+        if n["role"] not in CONTROL_ROLES:
+            continue
+        twice = MNEMONIC_TWICE.match(n["name"])
+        if not n["name"].strip() or FALLBACK.search(n["name"]) or (twice and "_" in twice[1]):
+            bad.append(f"{n['role']} {n['name']!r} at {n['path']} ({n['description'][:60]!r})")
+    return bad
+
+
+def test_a_control_without_a_name_is_found(tmp_path: Path) -> None:
+    """The check can fail: the probe's unnamed icon button is reported, its named one is not."""
+    _skip_or_fail()
+    with accessibility_bus(tmp_path / "runtime") as env:
+        proc = subprocess.Popen(
+            [sys.executable, str(HERE / "a11y_probe.py")], env=env, stderr=subprocess.PIPE
+        )
+        try:
+            nodes = read_tree(proc.pid, env)
+        finally:
+            proc.terminate()
+            proc.wait(10)
+    bad = unnamed_controls(nodes)
+    assert len(bad) == 1 and bad[0].startswith("push button"), bad
+    assert any(n["role"] == "push button" and n["name"] == "Up" for n in nodes)
+
+
+def test_every_control_has_a_name_and_the_map_says_where_the_robot_is(tmp_path: Path) -> None:
+    _skip_or_fail()
+    with (
+        SimThread(SimConfig(port=0, map_path=OFFICE_MAP, seed=1)) as sim,
+        accessibility_bus(tmp_path / "runtime") as env,
+    ):
+        env["XDG_CONFIG_HOME"] = str(tmp_path / "config")
+        proc = subprocess.Popen(
+            [sys.executable, "-m", "rtmu", "--host", "127.0.0.1", "--port", str(sim.port)],
+            env=env, stdout=subprocess.DEVNULL, stderr=subprocess.PIPE, text=True,
+        )  # fmt: skip
+        try:
+            xdotool("search", "--sync", "--onlyvisible", "--pid", str(proc.pid), "--name", "RTMU")
+            wait(
+                lambda: sim.call(lambda: any(s.subscriptions for s in sim.server.sessions)), 30, "subscribed"
+            )
+            nodes = read_tree(proc.pid, env, *OPENED)
+            for _attempt in range(20):  # a busy machine: the D-pad and the dialog may come a little later
+                shown = {n["name"] for n in nodes}
+                if {"Forward", "Host", "Show up to", "Call once"} <= shown and any(
+                    n["role"] == "spin button" for n in nodes
+                ):
+                    break
+                time.sleep(1.0)
+                nodes = read_tree(proc.pid, env)
+            assert len(nodes) > 100, f"a tree this small is not the window's: {nodes[:3]}"
+            assert not unnamed_controls(nodes), "\n".join(unnamed_controls(nodes))
+            names = {(n["role"], n["name"]) for n in nodes}
+            for pad in ("Forward", "Turn left", "Turn right", "Backward", "Stop"):
+                assert ("push button", pad) in names, f"the D-pad's {pad} is not a named button"
+            assert ("push button", "STOP") in names
+            assert ("level bar", "Battery level") in names
+            assert ("text", "Host") in names  # the settings dialog's fields say what they are
+            (stage,) = [n for n in nodes if n["role"] == "image" and n["name"] == "Map"]
+            before = stage["description"]
+            for words in ("Robot at x", "heading", "mode", "battery", "volts", "standing still"):
+                assert words in before, before
+
+            # The robot moves 2 m (put there in the simulator): a screen reader hears the map's new words.
+            listener = subprocess.Popen(
+                [sys.executable, str(READER), str(proc.pid), "--events", "8"],
+                env=env, stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True,
+            )  # fmt: skip
+            assert listener.stdout is not None
+            first = listener.stdout.readline()  # after the walk: {"listening": true}
+            assert json.loads(first or "{}").get("listening"), (
+                listener.stderr.read() if listener.stderr else ""
+            )
+            sim.call(lambda: setattr(sim.server.world.body, "x", sim.server.world.body.x + 2000.0))
+            out, err = listener.communicate(timeout=120)
+            assert listener.returncode == 0, err
+            heard = json.loads(out.splitlines()[-1])["events"]
+            said = [e["value"] for e in heard if e["name"] == "Map" and "description" in e["type"]]
+            assert any("Robot at x" in s and s != before for s in said), heard
+            assert len(said) <= 3, f"the map repeated itself: {said}"  # one material change, said once
+        finally:
+            proc.terminate()
+            proc.wait(15)
