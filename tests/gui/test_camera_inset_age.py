@@ -25,7 +25,7 @@ def test_an_old_picture_is_greyed_and_called_old() -> None:
     inset.show_texture(_texture(), received_at=100.0)
     now[0] = 101.0
     inset.tick()
-    assert not inset.has_css_class("stale") and inset.age_label.get_text() == "1.0 s"
+    assert not inset.has_css_class("stale") and inset.age_label.get_text() == "1 s"  # whole seconds
     now[0] = 100.0 + INSET_OLD_AFTER + 240.0  # minutes later, the robot driving on
     inset.tick()
     assert inset.has_css_class("stale"), "an old picture looks fresh"
