@@ -145,6 +145,7 @@ class MainWindow(Gtk.ApplicationWindow):
             command_state=self.command_state, page_changed=self._page_changed, clock=clock,
         )  # fmt: skip
         self.camera, self.ptz, self.live = c.view, c.ptz, c.live
+        m.dpad_place.follow_pages(self.stack, c.view.overlay, "camera")  # the D-pad on the camera page too
         self.decoder, self.camera_button = c.decoder, c.button
         self.set_titlebar(self._header())
         self.set_child(self._body())
