@@ -127,6 +127,11 @@ def test_the_dpad_keeps_to_its_corner_clear_of_the_robot_and_the_rest(small: tup
         pump(lambda: not cycle.driven(), 5, "the held drive to end on Space")
     finally:
         gui.xdotool("mouseup", "1")
+    cycle.navigate()  # the header's STOP, clicked on the camera page
+    before = cycle.stops()
+    gui.click(window.stop_button)
+    pump(lambda: cycle.stops() > before, 5, "STOP on the camera page to stop the robot")
+    gui.focus()
     gui.key("Escape")
     pump(lambda: window.stack.get_visible_child_name() == "map", 5, "the map page")
     settled(gui)

@@ -3,7 +3,7 @@
 GTK hides the title bar in full screen, and with it the Go to, Routes and camera buttons; the
 full-screen bar now carries them while it shows and gives them back after. In-process on a display
 of its own with openbox (full screen needs a window manager): F11, then each button is clicked with
-the mouse and does its job, Space stops a navigation in that state, and F11 puts them back.
+the mouse and does its job, Space and the bar's STOP stop a navigation in that state, and F11 puts them back.
 """
 
 from __future__ import annotations
@@ -66,6 +66,10 @@ def test_full_screen_keeps_go_to_and_the_camera_reachable(wm_gui: tuple[Gui, Sim
     cycle.navigate()
     cycle.space_stops("navigating in full screen on the camera page")
     pump(lambda: cycle.mode() == "stop", 5, "the simulator's stop mode")
+    cycle.navigate()  # and the full-screen bar's STOP, clicked
+    before = cycle.stops()
+    gui.click(bar.stop_button)
+    pump(lambda: cycle.stops() > before, 5, "the full-screen bar's STOP to stop the robot")
     window.show_map()
     gui.focus()
     gui.key("F11")

@@ -26,6 +26,15 @@ gi.require_version("Gtk", "4.0")
 from gi.repository import Gtk  # noqa: E402
 
 
+def stop_button_stops(gui: Gui, sim: SimThread) -> None:
+    """The header's STOP, clicked during a navigation, stops the robot (the simulator's stop log)."""
+    cycle = StopCycle(gui, sim)
+    cycle.navigate()
+    before = cycle.stops()
+    gui.click(gui.window.stop_button)
+    pump(lambda: cycle.stops() > before, 5, "STOP to stop the robot")
+
+
 def assert_landscape(gui: Gui) -> None:
     """The window is laid out as at 800×480 always was: toolbar, title and window buttons."""
     window = gui.window
@@ -54,6 +63,7 @@ def test_split_view_at_800x480_keeps_the_landscape_window(screenshots: Path, sma
             gui.screen_shot("split-view")
             assert_landscape(gui)
             StopCycle(gui, sim).prove("split view at 800x480", dpad_here=False)
+            stop_button_stops(gui, sim)
         finally:
             gui.close()
 
@@ -80,5 +90,6 @@ def test_the_fleet_at_800x480_keeps_the_landscape_window(
             gui.screen_shot("fleet")
             assert_landscape(gui)
             StopCycle(gui, fleet_sims[0]).prove("the fleet view at 800x480", dpad_here=False)
+            stop_button_stops(gui, fleet_sims[0])
         finally:
             gui.close()
