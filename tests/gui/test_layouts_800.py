@@ -21,6 +21,7 @@ from rtmu.ui.options import GuiOptions
 
 from .harness import OFFICE_MAP, Gui, idle, on_display, pump, scratch_dir
 from .stop_paths import MenuPicker, StopCycle, menu_entries
+from .test_dpad_place import assert_in_corner_clear_of_the_zoom_row
 
 gi.require_version("Gtk", "4.0")
 from gi.repository import Gtk  # noqa: E402
@@ -89,7 +90,14 @@ def test_the_fleet_at_800x480_keeps_the_landscape_window(
             idle(0.5)
             gui.screen_shot("fleet")
             assert_landscape(gui)
-            StopCycle(gui, fleet_sims[0]).prove("the fleet view at 800x480", dpad_here=False)
+            # The D-pad (View ▸ Touch D-pad, clicked) in its corner of the narrower map, off the zoom row.
+            entry = next(e for e in menu_entries(gui.window.menu_model) if e.action == "win.dpad")
+            MenuPicker(gui).by_mouse(entry)
+            pump(lambda: gui.window.dpad.get_mapped(), 5, "the D-pad")
+            idle(0.5)
+            gui.screen_shot("fleet-dpad")
+            assert_in_corner_clear_of_the_zoom_row(gui)
+            StopCycle(gui, fleet_sims[0]).prove("the fleet view at 800x480")
             stop_button_stops(gui, fleet_sims[0])
         finally:
             gui.close()
