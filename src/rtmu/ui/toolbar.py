@@ -9,7 +9,7 @@ does not publish (Wi-Fi on most servers) is greyed with a tooltip saying so.
 Every column has a fixed width (its value label is exactly ``width_chars`` wide),
 so nothing shifts sideways when "—" becomes "12.8 V". A narrow window hides the
 least important columns first (:data:`HIDE_FIRST`) and shows them again when
-there is room; battery, mode and link always stay. The localization column (servers with
+there is room; speed, battery, mode and link always stay. The localization column (servers with
 ``getLocState``) gives way first while it says Good, and never while it says Lost or poor.
 """
 
@@ -35,8 +35,10 @@ from .notes import heading_text  # noqa: E402
 STALE_AFTER = 1.0
 """Seconds after which a pose/battery value is shown as stale (status arrives at 10 Hz)."""
 DASH = "—"
-HIDE_FIRST = ("rot", "vel", "wifi", "th", "safe", "y", "x", "speed")
-"""Columns a narrow window gives up, in this order (the last one given up comes back first)."""
+HIDE_FIRST = ("rot", "th", "y", "x", "wifi", "safe", "speed")
+"""Columns a narrow window gives up, in this order (the last one given up comes back first). The
+speed (mm/s) is never given up: the operator must always see how fast the robot goes (a
+1280×800 screen at ``GDK_SCALE=2`` is a 640 px window); the pose is on the map as well."""
 
 
 class Cell(Gtk.Box):
