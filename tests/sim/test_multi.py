@@ -15,6 +15,7 @@ import pytest
 from rtmu.protocol.payloads.robot import UpdateNumbers
 from rtmu.sim import SimConfig
 from rtmu.sim.multi import fleet_configs
+from rtmu.sim.start_spots import SPACING_MM
 
 from .wire import WireClient, run
 
@@ -91,7 +92,9 @@ def test_fleet_configs_give_consecutive_ports_own_seeds_and_poses() -> None:
     assert [r.config.port for r in robots] == [7300, 7301, 7302, 7303]
     assert [r.config.seed for r in robots] == [5, 6, 7, 8]
     assert len({r.config.start_pose for r in robots}) == 4
-    assert robots[0].config.start_pose == (1000.0, 0.0, 90.0)
+    # In a row ahead of home (90°: +y), robot1 in front, none on home itself.
+    wanted = [(1000.0, SPACING_MM * k, 90.0) for k in (4, 3, 2, 1)]
+    assert [r.config.start_pose for r in robots] == [pytest.approx(p) for p in wanted]
     assert {r.config.port for r in fleet_configs(SimConfig(port=0), 3)} == {0}
 
 

@@ -2,9 +2,8 @@
 
 Each robot is a whole ARIA server of its own (as real robots are: one ArNetworking
 server per robot), on its own port — consecutive from the first one given, or each a
-free port when that is 0 — with its own seed and its own start pose: the map's home
-for ``robot1``, then a row beside it (the nearest free spot, so none starts in a
-wall). Names are ``robot1`` … ``robotN``: what a fleet profile or the window's robot
+free port when that is 0 — with its own seed and its own start pose, clear of the walls and off the map's home
+(``sim.start_spots``). Names are ``robot1`` … ``robotN``: what a fleet profile or the window's robot
 list calls them.
 """
 
@@ -16,13 +15,13 @@ from dataclasses import dataclass
 from pathlib import Path
 
 from .config import SimConfig
+from .mapserve import load_map
 from .server import SimServer
+from .start_spots import fleet_start_poses
 from .thread import SimThread
 
 MAX_ROBOTS = 50
 """More simulated robots than this in one process is a mistake, not a fleet."""
-SPACING_MM = 900.0
-"""Between the start poses of neighbouring robots (a P3-DX is ~500 mm long)."""
 
 
 @dataclass(frozen=True, slots=True)
@@ -49,9 +48,18 @@ def map_home(path: Path | None) -> tuple[float, float, float]:
 
 
 def start_poses(base: SimConfig, count: int) -> list[tuple[float, float, float]]:
-    """Where ``count`` robots start: 0, +1, -1, +2, -2 … rows either side of home, facing one way."""
-    hx, hy, hth = base.start_pose or map_home(base.map_path)
-    return [(hx, hy + (i + 1) // 2 * (1 if i % 2 else -1) * SPACING_MM, hth) for i in range(count)]
+    """Where ``count`` robots start: along home's heading, apart and clear of walls (``start_spots``)."""
+    home = base.start_pose or map_home(base.map_path)
+    if base.map_path is None:
+        return fleet_start_poses(home, count, None)
+    served = load_map(base.map_path)
+    segments = served.segments
+    bounds = None
+    if len(segments):
+        xs, ys = segments[:, [0, 2]], segments[:, [1, 3]]
+        bounds = (float(xs.min()), float(ys.min()), float(xs.max()), float(ys.max()))
+    markers = tuple((float(o.pose.x), float(o.pose.y)) for o in served.objects if not o.has_from_to)
+    return fleet_start_poses(home, count, served.obstacles(), bounds=bounds, markers=markers)
 
 
 def fleet_configs(base: SimConfig, count: int) -> list[SimRobot]:

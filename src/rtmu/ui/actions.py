@@ -257,7 +257,7 @@ class WindowActions:
 
     def _fullscreen_changed(self, *_a: object) -> None:
         state = self.window.is_fullscreen()
-        self.window.fullscreen_bar.set_reveal_child(state)
+        self.window.fullscreen_bar.show_for(state, self.window.header)  # Go to and the camera go along
         self._show_flag(self.fullscreen_action, state)
 
     # -- the menu --------------------------------------------------------------------------------

@@ -3,7 +3,10 @@
 GTK hides a window's title bar in full screen, and with it Connect/Disconnect,
 the menu and every way out — a trap on a touch tablet without a keyboard. So in
 full screen a slim bar with the same essentials (STOP, Connect/Disconnect, the
-status line, the menu and "leave full screen") is revealed at the top edge.
+status line, the menu and "leave full screen") is revealed at the top edge, and the
+header's own end buttons (Go to, Routes, the camera) move into it while it shows
+(:meth:`FullscreenBar.show_for`): a widget has one parent, and one button of each is one
+state to keep.
 
 STOP comes first in both and is the only red button: it is how the operator
 stops the robot without a keyboard, so it never hides.
@@ -97,7 +100,9 @@ class HeaderBar(Gtk.HeaderBar):
         self.set_title_widget(title_box)
         self.menu_button = menu_button(menu)
         self.pack_end(self.menu_button)
-        for widget in end:
+        self.end = tuple(end)
+        """Go to, Routes and the camera: lent to the full-screen bar while it shows."""
+        for widget in self.end:
             self.pack_end(widget)
 
     def show_status(self, connected_ish: bool, status: str) -> None:
@@ -136,8 +141,25 @@ class FullscreenBar(Gtk.Revealer):
         for child in (self.stop_button, self.connect_button, self.status_label, self.menu_button):
             box.append(child)
         box.append(self.leave_button)
+        self.box = box
+        self.borrowed: tuple[Gtk.Widget, ...] = ()
+        """The header's end buttons while full screen shows this bar (module notes)."""
         self.set_child(box)
         self.set_reveal_child(False)
+
+    def show_for(self, on: bool, header: HeaderBar) -> None:
+        """Full screen on or off: reveal the bar, and move the header's end buttons here or back."""
+        self.set_reveal_child(on)
+        if on and not self.borrowed:
+            self.borrowed = header.end
+            for widget in self.borrowed:  # packed from the end: Go to ends up first, as in the header
+                header.remove(widget)
+                self.box.insert_child_after(widget, self.status_label)
+        elif not on and self.borrowed:
+            for widget in self.borrowed:
+                self.box.remove(widget)
+                header.pack_end(widget)
+            self.borrowed = ()
 
     def show_status(self, connected_ish: bool, status: str) -> None:
         """As the header bar's, which it stands in for."""

@@ -1,8 +1,8 @@
 """Landscape ⇄ portrait phone layout, chosen by the window's width. The window keeps composing.
 
-libadwaita 1.2 (Debian 12) has no breakpoints, so the map stage's ``resize``
-(it spans the window's width) is the signal: under :data:`NARROW` px the window
-is a phone —
+libadwaita 1.2 (Debian 12) has no breakpoints, so the map stage's ``resize`` is the
+signal, and the window's own width decides (split view and the fleet's robot list make
+the map narrower, not the window): under :data:`NARROW` px the window is a phone —
 
 * the status toolbar gives way to the one-line :class:`StatusStrip`;
 * the touch D-pad is shown, centred at the bottom above the zoom buttons, where a
@@ -75,15 +75,19 @@ class PhoneLayout:
             window.set_default_size(*size)  # a phone: fill its screen (its shell maximises apps too)
             window.maximize()
             self.apply(True)  # before the first size is computed: the landscape header would not fit
-        self._resize_handler = window.stage.connect("resize", lambda _s, w, _h: self._queue(w))
+        # The stage resizes whenever the window does (and when split view or the fleet list takes a
+        # side of it): the trigger. The choice is by the *window's* width: a map made narrower by the
+        # video or the robot list beside it is not a phone, and must keep the title bar's buttons.
+        self._resize_handler = window.stage.connect("resize", lambda _s, _w, _h: self._queue())
 
-    def _queue(self, width: int) -> None:
-        if (width < NARROW) != self.narrow and not self._idle:
+    def _queue(self) -> None:
+        width = self.window.get_width()
+        if width > 0 and (width < NARROW) != self.narrow and not self._idle:
             self._idle = GLib.idle_add(self._apply_idle)
 
     def _apply_idle(self) -> bool:
         self._idle = 0
-        width = self.window.stage.get_width()
+        width = self.window.get_width()
         if width > 0:
             self.apply(width < NARROW)
         return False

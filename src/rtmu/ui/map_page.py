@@ -3,7 +3,8 @@
 One part of the window (``ui.window`` composes it), a ``Gtk.Overlay`` whose child is the map
 stage (:class:`~rtmu.ui.mapview.MapStage`) and whose overlays are, bottom to top: the zoom / fit /
 follow buttons, the touch D-pad, the camera inset, the motion pill, the pose bar of a pick mode,
-the server's popup cards, the layers panel and the note under the map (not connected, no map …).
+the server's popup cards, the layers panel and the note under the map (not connected, no map …);
+``dpad_place`` keeps the D-pad in its corner, on the page shown and clear of the rest.
 Other parts add their own overlays to it (the gamepad's pill). A pick mode (Go to point, Set
 position) is started here and confirmed by its bar; the intents go to the selected robot. The
 D-pad drives only while Space can stop it (``Controller.pointer_may_drive``); it lets go of a
@@ -30,6 +31,7 @@ from ..model.observables import ConnectionState, MapModel, OperatorState, RobotM
 from ..values.intents import AnswerPopup, GotoGoal, GotoPose, Localize  # noqa: E402
 from . import accessible  # noqa: E402
 from .dpad import DPad  # noqa: E402
+from .dpad_place import DPadPlacement  # noqa: E402
 from .layers import LayersPanel  # noqa: E402
 from .mapview import MapStage  # noqa: E402
 from .motion import MotionIndicator, held_by  # noqa: E402
@@ -85,7 +87,8 @@ class MapPage(Gtk.Overlay):
         self.dpad = DPad(hold=self._hold, release=self._release, stop=self._stop)
         self.inset = PictureInPicture(show_camera, clock=clock, on_hide=hide_inset)
         self.set_child(self.stage)
-        self.add_overlay(self._osd())
+        self.osd = self._osd()
+        self.add_overlay(self.osd)
         self.add_overlay(self.dpad)
         self.add_overlay(self.inset)
         self.motion = MotionIndicator(model, held=self._drive_held)
@@ -102,6 +105,12 @@ class MapPage(Gtk.Overlay):
         self.add_overlay(self.note)
         self.dpad.set_visible(touch_only())
         self.inset.place(corner_free=not self.dpad.get_visible())
+        # The D-pad in a corner, on the page shown, clear of the zoom row, the pick bar and (Fit) the robot.
+        self.dpad_place = DPadPlacement(
+            self.dpad, self, osd=self.osd, pose_bar=self.pose_bar, refit=self.stage.refit
+        )
+        self.stage.fit_room = self.dpad_place.fit_room
+        self.stage.connect("resize", lambda *_a: self.dpad_place.queue())
         self.stage.connect("resize", lambda _s, width, _h: self.inset.fit_to(width))
 
     def _osd(self) -> Gtk.Widget:
@@ -229,6 +238,7 @@ class MapPage(Gtk.Overlay):
         self.robot.ask(AnswerPopup(popup_id, button))
 
     def close(self) -> None:
+        self.dpad_place.close()
         self.stage.close()
         self.layers.unobserve()
         self.motion.close()

@@ -36,7 +36,7 @@ from .map_words import MapDescription  # noqa: E402
 from .nav_draw import Marker, MarkerKind  # noqa: E402
 from .stop_draw import stop_reach  # noqa: E402
 from .tiles import TileCache  # noqa: E402
-from .viewport import ZOOM_MAX, ZOOM_MIN, Viewport, fit_view, nearest_step, step_zoom  # noqa: E402
+from .viewport import ZOOM_MAX, ZOOM_MIN, Insets, Viewport, best_fit, nearest_step, step_zoom  # noqa: E402
 
 FOLLOW_BOX = 0.3
 """Follow pans when the robot leaves the middle (1 − 2 × 0.3 = 40 %) of the view."""
@@ -82,6 +82,8 @@ class MapStage(Gtk.DrawingArea):
         self.follow = operator.view.value.follow_robot
         self.fitted = operator.view.value.zoom == 0.0
         """The zoom is "fit the map" (re-fitted when the widget is resized or a map arrives)."""
+        self.fit_room: Callable[[int, int], tuple[Insets, ...]] = lambda _w, _h: ()
+        """Ways for Fit to keep clear of an overlay at this size (``dpad_place``): none by default."""
         self.on_view_changed: Callable[[], None] | None = None
         self.on_first_map_frame: Callable[[float], None] | None = None
         """Called once per map with the time of the first frame that showed it completely."""
@@ -258,6 +260,11 @@ class MapStage(Gtk.DrawingArea):
         self._publish_view()
         self.queue_draw()
 
+    def refit(self) -> None:
+        """Fit again if fitted (an overlay that asks for room came or went)."""
+        if self.fitted:
+            self.fit()
+
     def set_follow(self, on: bool) -> None:
         self.follow = on
         if on:
@@ -271,13 +278,18 @@ class MapStage(Gtk.DrawingArea):
         if bounds is None:
             return  # the index is being built; _tiles_ready fits again when it is
 
-        self.viewport = fit_view(bounds, self.viewport.width, self.viewport.height)
+        self.viewport = self._fit_view(bounds)
         self._view_moved()
 
     def _fit_no_map(self) -> None:
         r = self.model.robot.value
-        self.viewport = fit_view((r.x - 5000, r.y - 5000, r.x + 5000, r.y + 5000), *self._size())
+        self.viewport = self._fit_view((r.x - 5000, r.y - 5000, r.x + 5000, r.y + 5000))
         self._view_moved()
+
+    def _fit_view(self, bounds: tuple[float, float, float, float]) -> Viewport:
+        """Fit ``bounds`` clear of the overlays that ask for room (``fit_room``: the D-pad)."""
+        width, height = self._size()
+        return best_fit(bounds, width, height, self.fit_room(width, height))
 
     def _view_moved(self) -> None:
         """Zoom or centre changed without the operator: let the window's zoom label follow."""
@@ -330,7 +342,7 @@ class MapStage(Gtk.DrawingArea):
     def _tiles_ready(self) -> bool:
         if self.map_data is not None and self.fitted and self.tiles.bounds is not None:
             # The index knows the true bounds now (the header's may lie): fit again once.
-            vp = fit_view(self.tiles.bounds, *self._size())
+            vp = self._fit_view(self.tiles.bounds)
             if abs(vp.zoom - self.viewport.zoom) > 1e-9 or (vp.cx, vp.cy) != (
                 self.viewport.cx,
                 self.viewport.cy,

@@ -12,7 +12,7 @@ costs GTK a restyle and a repaint of the header.
 Every column has a fixed width (its value label is exactly ``width_chars`` wide),
 so nothing shifts sideways when "—" becomes "12.8 V". A narrow window hides the
 least important columns first (:data:`HIDE_FIRST`) and shows them again when
-there is room; battery, mode and link always stay. The localization column (servers with
+there is room; speed, battery, mode and link always stay. The localization column (servers with
 ``getLocState``) gives way first while it says Good, and never while it says Lost or poor.
 """
 
@@ -49,8 +49,10 @@ def age_text(seconds: float) -> str:
 
 
 DASH = "—"
-HIDE_FIRST = ("rot", "vel", "wifi", "th", "safe", "y", "x", "speed")
-"""Columns a narrow window gives up, in this order (the last one given up comes back first)."""
+HIDE_FIRST = ("rot", "th", "y", "x", "wifi", "safe", "speed")
+"""Columns a narrow window gives up, in this order (the last one given up comes back first). The
+speed (mm/s) is never given up: the operator must always see how fast the robot goes (a
+1280×800 screen at ``GDK_SCALE=2`` is a 640 px window); the pose is on the map as well."""
 
 
 class Cell(Gtk.Box):

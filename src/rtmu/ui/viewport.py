@@ -113,18 +113,45 @@ def nearest_step(zoom: float) -> float:
     return min(ZOOM_STEPS, key=lambda z: abs(math.log(z / zoom)))
 
 
+FIT_ROOM_SHARE = 0.5
+"""Fit keeps clear of an overlay only while the map stays at least this share of its plain fit."""
+Insets = tuple[int, int, int, int]
+"""Pixels kept clear at the (left, top, right, bottom) edges: an overlay's corner (the D-pad)."""
+
+
 def fit_view(
-    bounds: tuple[float, float, float, float], width: int, height: int, *, margin: int = FIT_MARGIN_PX
+    bounds: tuple[float, float, float, float],
+    width: int,
+    height: int,
+    *,
+    margin: int = FIT_MARGIN_PX,
+    insets: Insets = (0, 0, 0, 0),
 ) -> Viewport:
-    """The viewport showing all of ``bounds`` (min_x, min_y, max_x, max_y in mm), centred, ≤ 400 %."""
+    """The viewport showing all of ``bounds`` (min_x, min_y, max_x, max_y in mm), centred in what
+    ``insets`` leave of the widget, ≤ 400 %."""
     x0, y0, x1, y1 = bounds
-    w = max(1.0, width - 2 * margin)
-    h = max(1.0, height - 2 * margin)
+    left, top, right, bottom = insets
+    w = max(1.0, width - left - right - 2 * margin)
+    h = max(1.0, height - top - bottom - 2 * margin)
     span_x = max(x1 - x0, 1000.0)
     span_y = max(y1 - y0, 1000.0)
     zoom = min(w / span_x, h / span_y) / PX_PER_MM_AT_100
     zoom = clamp_zoom(zoom, allow_fit=True)
-    return Viewport(width, height, zoom, (x0 + x1) / 2, (y0 + y1) / 2)
+    view = Viewport(width, height, zoom, (x0 + x1) / 2, (y0 + y1) / 2)
+    # The bounds' centre at the centre of the free rectangle, not of the widget.
+    return view.panned((left - right) / 2, (top - bottom) / 2)
+
+
+def best_fit(
+    bounds: tuple[float, float, float, float], width: int, height: int, choices: tuple[Insets, ...]
+) -> Viewport:
+    """Of the ways to keep clear of an overlay (``choices``: beside it, above it …), the fit that
+    shows the map largest — unless even that shows it at less than :data:`FIT_ROOM_SHARE` of the
+    plain fit (a split phone's small map under a big D-pad): then the plain fit, legible."""
+    plain = fit_view(bounds, width, height)
+    views = [fit_view(bounds, width, height, insets=i) for i in choices]
+    best = max(views, key=lambda v: v.zoom, default=plain)
+    return best if best.zoom >= FIT_ROOM_SHARE * plain.zoom else plain
 
 
 def zoom_label(zoom: float) -> str:

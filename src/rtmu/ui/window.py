@@ -6,8 +6,8 @@ and always on screen, and the full-screen bar), ``map_page``, ``camera_page`` (a
 ``toolbar``, ``banners``, ``actions`` (every ``win.*`` action and the menu), ``keys`` (the one key table),
 ``stop_keys`` (Space stops from every surface), ``keyboard_nav``, ``key_reach``, ``notice_router`` (where
 things are said), ``window_dialogs``, ``handheld``, ``near_people``, ``bridge_toggle``, ``why_hint`` (a
-still held drive asks why), ``commissioning`` (files, scanning, map edits), ``desktop_citizen``. A new page
-goes into :attr:`MainWindow.stack`, a new action into ``actions``, a new dialog into ``window_dialogs``.
+still held drive asks why), ``commissioning`` (files, scanning, map edits), ``desktop_citizen``; a new page
+goes into ``stack``, a new action into ``actions``, a new dialog into ``window_dialogs``.
 
 Its timers (``window_timers``) are the UI's heartbeat: while a drive is held they renew the drive
 lease every :data:`rtmu.control.controller.TICK` — if this loop ever stalls, the lease lapses and
@@ -142,6 +142,7 @@ class MainWindow(Gtk.ApplicationWindow):
             command_state=self.command_state, page_changed=self._page_changed, clock=clock,
         )  # fmt: skip
         self.camera, self.ptz, self.live = c.view, c.ptz, c.live
+        m.dpad_place.follow_pages(self.stack, c.view.overlay, "camera")  # the D-pad on the camera page too
         self.decoder, self.camera_button = c.decoder, c.button
         self.set_titlebar(self._header())
         self.set_child(self._body())
