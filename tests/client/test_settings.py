@@ -8,14 +8,12 @@ from pathlib import Path
 
 import pytest
 
+from rtmu.settings.secrets import KeyringSecrets, choose_backend, is_secure_backend
 from rtmu.settings.store import (
-    KeyringSecrets,
     Profile,
     Settings,
-    choose_backend,
     config_dir,
     format_settings,
-    is_secure_backend,
     load_settings,
     parse_settings,
     save_settings,

@@ -34,9 +34,9 @@ from ..client.session import SessionConfig  # noqa: E402
 from ..fleet.sessions import Fleet, RobotSession, direct_roster, robot_profile  # noqa: E402
 from ..guardian.shared import SharedGuardian  # noqa: E402
 from ..model.observables import NearPeople, Phase  # noqa: E402
+from ..settings.secrets import KeyringSecrets  # noqa: E402
 from ..settings.store import (  # noqa: E402
     DEFAULT_PORT,
-    KeyringSecrets,
     Profile,
     Settings,
     address_name,
