@@ -5,7 +5,7 @@ from __future__ import annotations
 import json
 
 from rtmu.base.textsafe import visible
-from rtmu.subcommands._common import status_line
+from rtmu.subcommands._status import status_line
 
 HOSTILE = "ok\x1b[2J\r\x07\x08\x7f\x9b31m\u202eevil\u200b\u2028end"
 

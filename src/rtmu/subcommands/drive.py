@@ -38,12 +38,11 @@ from ._common import (
     add_connection_arguments,
     current_interrupts,
     current_password,
-    fetch_status,
     print_json,
     run_with_client,
     signal_name,
-    status_line,
 )
+from ._status import fetch_status, status_line
 
 if TYPE_CHECKING:
     from ..client.connection import AriaClient, Packet

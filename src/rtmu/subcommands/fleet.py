@@ -23,12 +23,11 @@ from ._common import (
     UsageError,
     add_connection_arguments,
     fail,
-    fetch_status,
     print_json,
     read_password,
     run_interruptibly,
-    status_line,
 )
+from ._status import fetch_status, status_line
 
 if TYPE_CHECKING:
     import asyncio

@@ -22,15 +22,11 @@ from ..protocol.payloads.ld import DockInfo
 from ..protocol.payloads.robot import Update, UpdateNumbers, UpdateStrings
 from ._common import (
     add_connection_arguments,
-    battery_is_soc,
-    fetch_status,
-    no_status,
     print_json,
     run_with_client,
-    status_line,
-    status_object,
 )
 from ._options import number_in
+from ._status import battery_is_soc, fetch_status, no_status, status_line, status_object
 
 if TYPE_CHECKING:
     import asyncio
