@@ -112,8 +112,9 @@ def test_rtmu_image_refuses_a_cut_short_8192_picture_at_no_cost_and_saves_nothin
 
 
 CHECK = (
-    "import sys\n"
+    "import io, sys\n"
     "from pathlib import Path\n"
+    "from PIL import Image, ImageFile  # imported first: the figures are the work, not the libraries\n"
     "from rtmu.client.jpeg_bounds import decode_problem\n"
     "data = Path(sys.argv[1]).read_bytes()\n"
     "def hwm():\n"
@@ -123,8 +124,6 @@ CHECK = (
     "if sys.argv[2] == 'check':\n"
     "    assert decode_problem(data) is None\n"
     "else:\n"
-    "    import io\n"
-    "    from PIL import Image\n"
     "    Image.open(io.BytesIO(data)).load()\n"
     "print(hwm() - before)\n"
 )

@@ -177,6 +177,8 @@ def test_stalled_motors_are_named_and_the_drive_exits_26(sim: SimThread, capsys)
     zero_drive(sim)  # in the drive mode the status says Stalled, as ARIA's does
     assert why(sim) == codes.EXIT_WHY_STALLED
     command(sim, "SimulatorClearStall")
+    # The server says so on its next cycle (as ARIA's does on its next robot task cycle): ask then.
+    eventually(lambda: sim.call(lambda: sim.server.world.mode.status) != "Stalled", timeout=10)  # type: ignore[union-attr]
     assert why(sim) == codes.EXIT_OK
 
 

@@ -47,6 +47,11 @@ def logins(sim: SimThread) -> int:
     return len(sim.call(lambda: list(sim.server.sessions)))
 
 
+def subscribed(sim: SimThread) -> int:
+    """Logins whose session is set up: they asked for their status (the guardian's never does)."""
+    return sum(sim.call(lambda: [bool(c.subscriptions) for c in sim.server.sessions]))  # type: ignore[union-attr]
+
+
 def stop_requests(*sims: SimThread) -> int:
     return sum(len(sim.call(lambda sim=sim: list(sim.server.stop_log))) for sim in sims)
 
@@ -139,10 +144,20 @@ def test_a_central_server_listing_1000_robots_gets_20_connections_stop_still_wor
             window = found.split()[0]
             # 20 robots (at the two simulators, whichever were named first) and the one guardian.
             wait(lambda: connections() == BUDGET + 1, 90, "20 robot connections and the guardian's")
+            # A login is not yet a robot the window shows: Space stops a robot once its session is up.
+            wait(lambda: subscribed(one) + subscribed(two) >= BUDGET, 60, "the 20 sessions set up")
             xdotool("windowfocus", "--sync", window)
             stops = stop_requests(one, two)
-            xdotool("key", "space")  # STOP, to the robot shown (at one of the two simulators)
-            wait(lambda: stop_requests(one, two) > stops, 15, "STOP to reach the robot shown")
+            # STOP, to the robot shown (at one of the two simulators). While the list pours in, the robot
+            # shown may still be one that is listed but not yet connected (nothing to stop there), so Space
+            # is pressed every 0.5 s until a stop arrives: the window must keep answering keys meanwhile.
+            deadline = time.monotonic() + 15
+            while stop_requests(one, two) == stops:
+                assert time.monotonic() < deadline, "no STOP reached the robot shown within 15 s"
+                xdotool("key", "space")
+                wait_until = time.monotonic() + 0.5
+                while stop_requests(one, two) == stops and time.monotonic() < wait_until:
+                    time.sleep(0.02)
             end = time.monotonic() + 2.0
             while time.monotonic() < end:  # the rest of the list keeps arriving: no more connections
                 connections()
