@@ -1,6 +1,6 @@
 """A window with one icon-only button and no name for it: the accessibility check must find it.
 
-Run by ``test_accessibility`` as a process of its own (with its accessibility bus): the proof that
+Run by ``test_a11y_tree`` as a process of its own (with its accessibility bus): the proof that
 the check the window passes can fail.
 """
 

@@ -7,6 +7,10 @@ and opening Connection settings through the window's own actions. Every control 
 that is words, not GTK's fallback (a type name such as ``GtkButton``); the map must say where the
 robot is, its mode, battery and what it is doing, and say it again when the robot has moved.
 The probe window (``a11y_probe``, one unnamed icon button) proves the same check fails.
+
+Known and not yet explained: run after ``test_about.py`` in the same pytest process, the reader is told the
+window's application "no longer exists" after an action, though the window process is alive; this file's
+name sorts it first meanwhile (see the closing note of the session that found it).
 """
 
 from __future__ import annotations
