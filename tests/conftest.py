@@ -3,13 +3,15 @@
 from __future__ import annotations
 
 import atexit
+import faulthandler
 import functools
 import importlib
 import importlib.util
 import os
 import shutil
+import sys
 import tempfile
-from collections.abc import Sequence
+from collections.abc import Iterator, Sequence
 from pathlib import Path
 
 import pytest
@@ -55,6 +57,24 @@ def _every_exit_code_is_one_its_help_lists() -> None:
 
 
 _every_exit_code_is_one_its_help_lists()
+
+
+HANG_EXIT_AFTER = 120.0
+"""Seconds past pytest-timeout's own limit after which a test still running is taken as stuck where no
+Python signal handler can run (inside a C call: an X or D-Bus round trip): every thread's traceback is
+written and the run ends, so a hung call costs CI minutes and says where, not the whole budget."""
+
+
+@pytest.hookimpl(hookwrapper=True)
+def pytest_runtest_protocol(item: pytest.Item) -> Iterator[None]:
+    limit = float(item.config.getini("timeout") or 0)
+    if limit > 0:
+        faulthandler.dump_traceback_later(limit + HANG_EXIT_AFTER, exit=True, file=sys.__stderr__)
+    try:
+        yield
+    finally:
+        if limit > 0:
+            faulthandler.cancel_dump_traceback_later()
 
 
 @pytest.fixture(scope="session")
