@@ -35,7 +35,7 @@ from rtmu.ui.application import RtmuApplication  # noqa: E402
 from rtmu.ui.options import GuiOptions  # noqa: E402
 from rtmu.ui.window import MainWindow  # noqa: E402
 
-from .process import screenshot  # noqa: E402
+from .process import PATIENCE, screenshot  # noqa: E402
 
 OFFICE_MAP = project_map("office.map")
 COUNTS = {"windows": 0, "pictures": 0}
@@ -88,16 +88,16 @@ def scratch_dir(prefix: str) -> Path:
 
 
 def pump(condition: Callable[[], bool], timeout: float = 5.0, what: str = "condition") -> None:
-    """Run the GTK main loop until ``condition()`` is true; fail after ``timeout`` seconds."""
+    """Run the GTK main loop until ``condition()`` is true; fail after ``timeout`` seconds (× PATIENCE)."""
     ctx = GLib.MainContext.default()
-    deadline = time.monotonic() + timeout
+    deadline = time.monotonic() + timeout * PATIENCE
     while True:
         while ctx.pending():
             ctx.iteration(False)
         if condition():
             return
         if time.monotonic() > deadline:
-            raise AssertionError(f"timed out after {timeout:g} s waiting for {what}")
+            raise AssertionError(f"timed out after {timeout * PATIENCE:g} s waiting for {what}")
         ctx.iteration(False) or time.sleep(0.004)
 
 

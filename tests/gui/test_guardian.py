@@ -49,7 +49,7 @@ def test_a_killed_or_frozen_window_is_stopped_by_its_guardian(signum: int, tmp_p
             assert guardian_stops(sim) == 0
             watchdog = sim.call(lambda: sim.server.robot.watchdog_stops)
             proc.send_signal(signum)
-            wait(lambda: guardian_stops(sim) == 1, 5, "a stop from the guardian")
+            wait(lambda: guardian_stops(sim) == 1, 20, "a stop from the guardian")
             assert sim.call(lambda: sim.server.robot.mode_name) == "stop"
             assert sim.call(lambda: sim.server.robot.watchdog_stops) == watchdog, "the watchdog fired"
         finally:
@@ -128,8 +128,11 @@ def test_a_fleet_window_killed_or_frozen_is_stopped_by_its_one_guardian_at_the_s
             assert held, "robot2 never drove"
             assert _guardians_of(proc.pid) != [] and len(_guardians_of(proc.pid)) == 1, "not ONE guardian"
             watchdog = two.call(lambda: two.server.robot.watchdog_stops)
+            # Counted from here: on a busy machine the guardian may already have stopped a drive whose
+            # heartbeats came late (then the test pressed again); checked is the stop after the signal.
+            before = guardian_stops(two)
             proc.send_signal(signum)
-            wait(lambda: guardian_stops(two) == 1, 5, "a stop from the guardian at robot2")
+            wait(lambda: guardian_stops(two) > before, 20, "a stop from the guardian at robot2")
             assert two.call(lambda: two.server.robot.watchdog_stops) == watchdog, "the watchdog fired"
             assert guardian_stops(one) == 0 and abs(one.snapshot().vel) < 1.0
         finally:
