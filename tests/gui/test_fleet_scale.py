@@ -153,7 +153,7 @@ def test_a_central_server_listing_1000_robots_gets_20_connections_stop_still_wor
             # is pressed every 0.5 s until a stop arrives: the window must keep answering keys meanwhile.
             deadline = time.monotonic() + 15 * PATIENCE
             while stop_requests(one, two) == stops:
-                assert time.monotonic() < deadline, f"no STOP reached the robot shown within {15 * PATIENCE:g} s"
+                assert time.monotonic() < deadline, "no STOP reached the robot shown in time"
                 xdotool("key", "space")
                 wait_until = time.monotonic() + 0.5
                 while stop_requests(one, two) == stops and time.monotonic() < wait_until:
