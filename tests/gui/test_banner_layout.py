@@ -4,7 +4,7 @@ camera page (its own pill) neither."""
 
 from __future__ import annotations
 
-from collections.abc import Iterator
+from collections.abc import Callable, Iterator
 from pathlib import Path
 
 import pytest
@@ -50,6 +50,20 @@ def _drawn_banners(gui: Gui) -> list[tuple[float, float, float, float]]:
     return out
 
 
+def _covering(gui: Gui, pill: object) -> list[tuple[float, float, float, float]]:
+    """The drawn banners that overlap ``pill`` now (and the pill's box last)."""
+    box = _bounds(gui, pill)
+    return [b for b in _drawn_banners(gui) if _overlap(b, box)]
+
+
+def _settle(covering: Callable[[], list[tuple[float, float, float, float]]], where: str) -> None:
+    """Wait until no banner covers the pill; fail saying which ones still do."""
+    try:
+        pump(lambda: not covering(), 5, "the banners to leave the pill")
+    except AssertionError:
+        raise AssertionError(f"{where} banners {covering()} cover the pill") from None
+
+
 def test_banners_leave_the_navigation_pill_visible(gui: Gui) -> None:
     window = gui.window
     window.goals_panel.choose("Corridor End")
@@ -69,10 +83,9 @@ def test_banners_leave_the_navigation_pill_visible(gui: Gui) -> None:
         for text in (LONG, "A second message from the server"):  # keep them up (4 s timeout)
             window.banners.tell(f"notice:{text}", "warning", text, timeout=None)
         assert window.motion.get_mapped(), f"the pill is hidden at {width}x{height}"
-        pill = _bounds(gui, window.motion)
+        # Waited for, not slept on: on a busy machine the relayout after a resize can take a while.
+        _settle(lambda: _covering(gui, window.motion), f"at {width}x{height}")
         gui.shot(f"{width}x{height}")
-        covering = [b for b in _drawn_banners(gui) if _overlap(b, pill)]
-        assert not covering, f"at {width}x{height} banners {covering} cover the pill {pill}"
     # The camera page's pill, on a phone: the banners start under it too.
     window.set_default_size(360, 720)
     pump(lambda: window.handheld.layout.narrow, 5, "the phone layout")
@@ -81,11 +94,8 @@ def test_banners_leave_the_navigation_pill_visible(gui: Gui) -> None:
     pump(lambda: pill.get_mapped() and pill.kind == "autonomous", 5, "the camera page's pill")
     for text in (LONG, "A second message from the server"):
         window.banners.tell(f"notice:{text}", "warning", text, timeout=None)
-    idle(0.5)
-    box = _bounds(gui, pill)
+    _settle(lambda: _covering(gui, pill), "on the camera page at 360x720")
     gui.shot("camera-page-360x720")
-    covering = [b for b in _drawn_banners(gui) if _overlap(b, box)]
-    assert not covering, f"on the camera page banners {covering} cover the pill {box}"
     # The bar's word buttons are icons on a phone (their words were cut to a letter), words in the tip.
     view = window.camera
     pump(lambda: view.compact, 3, "the compact camera bar")

@@ -37,7 +37,7 @@ from rtmu.ui.robot_list import row_text
 from .harness import OFFICE_MAP, OPEN, Gui, idle, pump, register, scratch_dir
 
 gi.require_version("Gtk", "4.0")
-from gi.repository import GLib, Gtk  # noqa: E402
+from gi.repository import Gtk  # noqa: E402
 
 
 @pytest.fixture
@@ -279,20 +279,22 @@ def test_a_one_robot_profile_shows_no_robot_list(screenshots: Path, sims: list[S
 
 
 class LateRoster:
-    """A roster that names its robots a moment after it starts, as a central server does."""
+    """A roster that names its robots later than it starts, as a central server does: when the test
+    says (:meth:`name_them`), not after a fixed delay a busy machine could outrun."""
 
     def __init__(self, endpoints: list[RobotEndpoint]) -> None:
         self.endpoints = endpoints
         self.closed = False
+        self.emit: Emit | None = None
 
     def start(self, emit: Emit) -> None:
-        def later() -> bool:
-            for endpoint in self.endpoints:
-                if not self.closed:
-                    emit(RobotAdded(endpoint))
-            return False
+        self.emit = emit
 
-        GLib.timeout_add(700, later)
+    def name_them(self) -> None:
+        assert self.emit is not None, "the window never started its roster"
+        for endpoint in self.endpoints:
+            if not self.closed:
+                self.emit(RobotAdded(endpoint))
 
     def close(self) -> None:
         self.closed = True
@@ -313,7 +315,11 @@ def test_robots_a_roster_names_later_appear_and_the_first_is_shown(
     app.activate()
     try:
         pump(lambda: app.window is not None and app.window.get_mapped(), 10, "the window")
+        pump(lambda: late.emit is not None, 10, "the window to start its roster")
+        idle(0.3)  # nothing named yet: the window shows no robot and no list meanwhile
         assert len(app.fleet) == 0 and binding(gui).robot_list.get_visible() is False
+        gui.shot("late-robots-none-yet")
+        late.name_them()
         pump(lambda: len(app.fleet) == 3, 10, "the roster's robots")
         first = session(gui, "robot1")
         pump(lambda: gui.window.session is first, 5, "the first robot to be shown")
