@@ -597,24 +597,3 @@ def test_a_stream_holds_each_packet_once_and_bounds_what_is_unread() -> None:
         await server.stop()
 
     run(go())
-
-
-def test_a_stream_closed_early_gives_up_its_request_then_and_there() -> None:
-    """A reader that stops after one packet of a reply still coming closes the stream: its request is
-    abandoned at that close (nobody waits on it any more), not whenever the garbage collector runs."""
-
-    async def go() -> None:
-        server = TestServer()
-        server.handlers["getMap"] = lambda s, a: text_map_packets(MAP_LINES)[:2]  # no end: still coming
-        await server.start()
-        client = await connected(server)
-        stream = client.stream("getMap")
-        assert await anext(stream) == text_map_packets(MAP_LINES)[0]
-        assert len(client._waiters) == 1
-        await stream.aclose()  # type: ignore[attr-defined]
-        assert client._waiters == {}
-        assert (await client.request_once("getSafeDrive")).payloads  # the connection goes on
-        await client.disconnect()
-        await server.stop()
-
-    run(go())
