@@ -17,9 +17,9 @@ def test_a_stream_closed_early_gives_up_its_request_then_and_there() -> None:
         client = await connected(server)
         stream = client.stream("getMap")
         assert await anext(stream) == text_map_packets(MAP_LINES)[0]
-        assert len(client._waiters) == 1
+        assert len(client._inbox.waiters) == 1
         await stream.aclose()  # type: ignore[attr-defined]
-        assert client._waiters == {}
+        assert client._inbox.waiters == {}
         assert (await client.request_once("getSafeDrive")).payloads  # the connection goes on
         await client.disconnect()
         await server.stop()

@@ -29,22 +29,12 @@ import functools
 import logging
 import sys
 import time
-from collections.abc import AsyncIterator, Callable, Iterable
+from collections.abc import AsyncIterator, Callable
 
 from ..protocol.client_connection import ClientConnection, ClientState
 from ..protocol.datalist import DataList
 from ..protocol.decoder import DropStats
 from ..protocol.errors import ProtocolError
-from ..protocol.events import (
-    DataReceived,
-    Event,
-    PeerShutdown,
-    ReplyComplete,
-    ReplyError,
-    ReplyFailed,
-    ReplyId,
-    ReplyPacket,
-)
 from ..protocol.payloads import Payload
 from ..protocol.replies import (
     ABANDON_GRACE,
@@ -53,18 +43,17 @@ from ..protocol.replies import (
     MAX_REPLY_PACKETS,
     TooManyPending,
 )
-from .call_values import Arg, Handler, Packet, Reply, encode_args, request_parts
+from .call_values import Arg, Handler, Reply, encode_args, request_parts
 from .defaults import CONNECT_TIMEOUT, DEFAULT_PORT
 from .errors import (
     ClientError,
     ClientTimeout,
     NotSupported,
     ProtocolFault,
-    ReplyTooLarge,
     ServerClosed,
 )
 from .goodbye import CLOSE_TIMEOUT, flushed, say_goodbye
-from .handler_stats import HandlerStats
+from .inbox import Inbox
 from .link import READ_CHUNK, Link, Opener, open_tcp
 from .login import log_in, open_link
 from .reply_waiter import ReplyWaiter
@@ -105,14 +94,12 @@ class AriaClient:
         self._conn: ClientConnection | None = None
         self._link: Link | None = None
         self._read_task: asyncio.Task[None] | None = None
-        self._handlers: dict[int, Handler] = {}
-        self._waiters: dict[ReplyId, ReplyWaiter] = {}
+        self._inbox = Inbox()
+        """Subscriptions and waiting requests, where each incoming event goes (``inbox``)."""
         self._closed_error: ClientError | None = None
         self._closing = False
-        self.handler_stats = HandlerStats()
+        self.handler_stats = self._inbox.stats
         """How the subscription handlers' calls went: errors, slow calls, the longest (``handler_stats``)."""
-        self.last_packet_at: float | None = None
-        self.packets_received = 0
         self._gate = MotionGate(Role.OBSERVER)
         """Replaced at :meth:`connect` by the role asked for; never changed after."""
 
@@ -172,6 +159,15 @@ class AriaClient:
         return self._conn is not None and self._conn.decoder.undecided > 0
 
     @property
+    def last_packet_at(self) -> float | None:
+        """When the last packet came (None before the first): the link's health reads it."""
+        return self._inbox.last_packet_at
+
+    @property
+    def packets_received(self) -> int:
+        return self._inbox.packets_received
+
+    @property
     def closed_error(self) -> ClientError | None:
         """Why the connection ended (None while open or after a plain ``disconnect``)."""
         return self._closed_error
@@ -223,7 +219,7 @@ class AriaClient:
         try:
             async with asyncio.timeout_at(deadline):
                 peer = f"{host}:{port}"
-                await log_in(self._link, self._conn, peer, self.clock, self._flush, self._deliver)
+                await log_in(self._link, self._conn, peer, self.clock, self._flush, self._inbox.deliver)
         except TimeoutError:
             self._abort()
             raise ClientTimeout(
@@ -259,7 +255,7 @@ class AriaClient:
         number = self._number(name)
         payload = encode_args(args)
         self._gate.admit(name, payload)
-        self._handlers[number] = handler
+        self._inbox.handlers[number] = handler
         self._conn.request(name, interval_ms, payload)  # type: ignore[union-attr]
         self._flush()
 
@@ -271,9 +267,9 @@ class AriaClient:
         """
         number = self._number(name)
         if handler is None:
-            self._handlers.pop(number, None)
+            self._inbox.handlers.pop(number, None)
         else:
-            self._handlers[number] = handler
+            self._inbox.handlers[number] = handler
 
     async def drain(self, timeout: float = REPLY_TIMEOUT) -> None:
         """Wait until our output is back under the link's high-water mark (a bulk sender's pacing).
@@ -299,14 +295,14 @@ class AriaClient:
     def subscribed(self, name: str) -> bool:
         """True while a handler holds a subscription to ``name`` (another ``request`` would replace it)."""
         number = self._conn.datalist.number(name) if self._conn is not None else None
-        return number is not None and number in self._handlers
+        return number is not None and number in self._inbox.handlers
 
     def stop_request(self, name: str) -> None:
         """End a subscription (no reply). Unknown or unsubscribed names are ignored."""
         number = self._conn.datalist.number(name) if self._conn is not None else None
         if number is None or not self.connected:
             return
-        self._handlers.pop(number, None)
+        self._inbox.handlers.pop(number, None)
         self._conn.request_stop(name)  # type: ignore[union-attr]
         self._flush()
 
@@ -424,7 +420,7 @@ class AriaClient:
         self._flush()
         if reply is None:
             return None
-        waiter = self._waiters[reply] = ReplyWaiter(
+        waiter = self._inbox.waiters[reply] = ReplyWaiter(
             reply,
             streaming,
             abandon=self._abandon,
@@ -436,7 +432,7 @@ class AriaClient:
 
     def _abandon(self, waiter: ReplyWaiter) -> None:
         """A waiter gave up: its slot stays so late packets still line up, but nobody waits on it."""
-        self._waiters.pop(waiter.reply, None)
+        self._inbox.waiters.pop(waiter.reply, None)
         waiter.fail(ClientTimeout(f"{waiter.reply.name!r} abandoned"))
         if self._conn is not None:
             self._conn.abandon_reply(waiter.reply, self.clock())
@@ -461,7 +457,7 @@ class AriaClient:
                     self._fail(ServerClosed(f"{self.host}:{self.port} closed the connection"))
                     return
                 now = self.clock()
-                if not self._on_events(self._conn.receive_data(data, now), now):
+                if not self._inbox.route(self._conn.receive_data(data, now), now):
                     self._fail(ServerClosed(f"{self.host}:{self.port} shut down"))
                     return
                 self._flush()
@@ -472,52 +468,6 @@ class AriaClient:
         except OSError as exc:
             reason = exc.strerror or exc
             self._fail(ServerClosed(f"the connection to {self.host}:{self.port} broke: {reason}"))
-
-    def _on_events(self, events: Iterable[Event], now: float) -> bool:
-        """Hand each event to its waiter and handler; False when the server shut down."""
-        handlers, waiters = self._handlers, self._waiters
-        woken: ReplyWaiter | None = None
-        for event in events:
-            if isinstance(event, ReplyPacket):  # ahead of the rest: a map is a million of these
-                reply, payload, swallowed = event
-                if not swallowed:
-                    waiter = waiters.get(reply)
-                    if waiter is not None:  # ReplyWaiter.packet, inlined: its wake-up once per read
-                        waiter.count += 1
-                        if waiter.queue is not None:
-                            waiter.queue.put_nowait(payload)
-                        if waiter is not woken:
-                            waiter.progress.set()
-                            woken = waiter
-                if reply.number in handlers:
-                    self._deliver(reply.number, reply.name, payload, now)
-                else:
-                    self.last_packet_at = now
-                    self.packets_received += 1
-            elif isinstance(event, DataReceived):
-                self._deliver(event.command, event.name, event.payload, now)
-            elif isinstance(event, ReplyComplete):
-                waiter = self._waiters.pop(event.reply, None)
-                if waiter is not None:
-                    waiter.complete(event.payloads)
-            elif isinstance(event, ReplyFailed):
-                waiter = self._waiters.pop(event.reply, None)
-                if waiter is not None:
-                    too_large = event.reason is ReplyError.TOO_LARGE
-                    error = ReplyTooLarge(event.message) if too_large else ProtocolFault(event.message)
-                    waiter.fail(error, drop_unread=too_large)
-            elif isinstance(event, PeerShutdown):
-                return False
-        return True
-
-    def _deliver(self, number: int, name: str | None, payload: bytes, now: float) -> None:
-        """One data packet: count it, and call the subscription handler of its data."""
-        self.last_packet_at = now
-        self.packets_received += 1
-        handler = self._handlers.get(number)
-        if handler is None:
-            return
-        self.handler_stats.call(handler, Packet(name or str(number), payload, now))
 
     def _fail(self, error: ClientError) -> None:
         """The connection is over (not by our choice): fail every waiter, tell ``on_close`` once."""
@@ -532,12 +482,10 @@ class AriaClient:
                 log.exception("on_close callback failed")
 
     def _teardown(self, error: ClientError) -> None:
-        waiters, self._waiters = self._waiters, {}
-        for waiter in waiters.values():
-            waiter.fail(error)
+        self._inbox.fail_waiters(error)
         if self._conn is not None:
             self._conn.replies.clear()
-        self._handlers.clear()
+        self._inbox.handlers.clear()
         self._abort()
 
     def _abort(self) -> None:
