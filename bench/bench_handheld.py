@@ -18,8 +18,9 @@ from types import SimpleNamespace
 from bench.common import Result, best_time
 from rtmu.client.lease import DriveLease
 from rtmu.control.alarms import AlarmMonitor
-from rtmu.control.controller import Controller, NoView
+from rtmu.control.controller import Controller
 from rtmu.control.gamepad import AXIS_TRANS, DEADMAN, Gamepad
+from rtmu.control.ports import NoView
 from rtmu.model.observables import ConnectionState, LinkHealth, LinkLevel, OperatorState, Phase, RobotModel
 from rtmu.values.state import RobotState
 

@@ -16,7 +16,8 @@ import statistics
 import time
 
 from bench.common import Result, best_time
-from rtmu.client.connection import AriaClient, Packet
+from rtmu.client.call_values import Packet
+from rtmu.client.connection import AriaClient
 from rtmu.client.detached import DetachedContext
 from rtmu.client.ptz import PtzFeed
 from rtmu.client.server_strings import StringsFeed

@@ -235,14 +235,13 @@ def soak(seconds: float, *, seed: int = 1, progress: Callable[[str], None] | Non
                 )
         rss.append((time.monotonic() - start, _rss_mb()))
         client = runner.session.client if runner.session is not None else None
+        stats = client.handler_stats if client is not None else None
         return {
             **drive_figures(start, latencies, rss, warmup),
-            "max_handler_ms": (client.max_handler_seconds * 1e3) if client is not None else float("nan"),
-            "slow_handlers": client.slow_handlers if client is not None else -1,
-            "max_handler_cpu_ms": (client.max_handler_cpu_seconds * 1e3)
-            if client is not None
-            else float("nan"),
-            "slow_handlers_cpu": client.slow_handlers_cpu if client is not None else -1,
+            "max_handler_ms": (stats.max_seconds * 1e3) if stats is not None else float("nan"),
+            "slow_handlers": stats.slow if stats is not None else -1,
+            "max_handler_cpu_ms": (stats.max_cpu_seconds * 1e3) if stats is not None else float("nan"),
+            "slow_handlers_cpu": stats.slow_cpu if stats is not None else -1,
             "max_loop_lag_ms": max_lag * 1e3,
         }
     finally:

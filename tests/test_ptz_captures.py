@@ -8,7 +8,7 @@ details table would show it.
 
 from __future__ import annotations
 
-from rtmu.client.connection import Packet
+from rtmu.client.call_values import Packet
 from rtmu.client.detached import DetachedContext
 from rtmu.client.ptz import pick_camera
 from rtmu.client.server_strings import StringsFeed

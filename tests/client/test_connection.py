@@ -393,7 +393,7 @@ def test_a_stop_sent_while_the_server_is_slow_to_read_still_arrives_after_discon
     simulator lost it 1 time in 15). Now the client half-closes and reads on until the server
     has read everything and closed. The linger is made long so only the order of events counts.
     """
-    monkeypatch.setattr("rtmu.client.connection.LINGER_TIMEOUT", 30.0)
+    monkeypatch.setattr("rtmu.client.goodbye.LINGER_TIMEOUT", 30.0)
 
     async def go() -> None:
         server = TestServer()

@@ -9,7 +9,8 @@ import pytest
 from rtmu.base.notices import Kind, Level, Notice
 from rtmu.client.lease import DriveRatios, EndReason
 from rtmu.control.commands import Command, CommandRegistry, CommandTarget
-from rtmu.control.controller import Controller, ratios_for
+from rtmu.control.controller import Controller
+from rtmu.control.held_drive import ratios_for
 from rtmu.model.observables import (
     ConnectionState,
     LinkHealth,

@@ -7,7 +7,7 @@ from dataclasses import replace
 import pytest
 
 from rtmu.base.notices import Kind, Level, Notice
-from rtmu.client.connection import Packet
+from rtmu.client.call_values import Packet
 from rtmu.client.detached import DetachedContext
 from rtmu.client.nav_session import NavFeed
 from rtmu.client.nav_status import MAX_TEXT, path_remaining, read_status

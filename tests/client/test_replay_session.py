@@ -13,7 +13,8 @@ from __future__ import annotations
 import asyncio
 from collections.abc import Callable
 
-from rtmu.client.connection import Arg, AriaClient, Handler
+from rtmu.client.call_values import Arg, Handler
+from rtmu.client.connection import AriaClient
 from rtmu.client.errors import ClientError
 from rtmu.client.lease import DriveLease
 from rtmu.client.link import Chunk, Link, RecordingLink, ReplayLink, open_tcp

@@ -14,8 +14,9 @@ import time
 from collections.abc import AsyncIterator
 from typing import Any
 
+from rtmu.client.call_values import Packet
 from rtmu.client.central import list_robots
-from rtmu.client.connection import AriaClient, Packet
+from rtmu.client.connection import AriaClient
 from rtmu.client.errors import ClientError
 from rtmu.protocol.client_connection import ClientConnection
 from rtmu.protocol.events import DataListReady

@@ -30,7 +30,9 @@ from collections.abc import Callable
 from typing import Any
 
 from ..protocol.payloads.central import CentralEntry, ClientAdded, ClientList, ClientRemoved
-from .connection import CONNECT_TIMEOUT, DEFAULT_PORT, AriaClient, Packet
+from .call_values import Packet
+from .connection import AriaClient
+from .defaults import CONNECT_TIMEOUT, DEFAULT_PORT
 from .errors import ClientError
 from .reconnect import Backoff, worth_retrying
 from .roles import Role

@@ -24,8 +24,9 @@ from ..protocol.payloads.configcare import (
     SetConfigParam,
     SetConfigParamReply,
 )
+from .call_values import Packet
 from .config_feed import MAX_PARAMS, MAX_TEXT, ServerConfig, set_config
-from .connection import AriaClient, Packet
+from .connection import AriaClient
 from .errors import ClientTimeout, MalformedReply, NotSupported
 
 DEFAULTS = ConfigDefaultsRequest.DATA_NAME

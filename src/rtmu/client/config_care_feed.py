@@ -18,9 +18,10 @@ from typing import Any, ClassVar
 from ..protocol.payloads.config import SetConfigReply
 from ..protocol.payloads.configcare import CheckMap
 from ..values.intents import FetchConfigDefaults, Intent, ResetConfig, SwitchMap
+from .call_values import Packet
 from .config_care import MAP_PARAM, MAP_SECTION, fetch_defaults, map_param_problem, reset
 from .config_feed import fetch_config, set_config
-from .connection import AriaClient, Packet
+from .connection import AriaClient
 from .errors import NotSupported
 from .feed import Feed, FeedContext
 from .remote_files import Refused, remote_path

@@ -36,7 +36,8 @@ from ..protocol.payloads.config import (
 )
 from ..values.intents import FetchConfig, Intent
 from ..values.intents import SetConfig as SetConfigIntent
-from .connection import AriaClient, Packet
+from .call_values import Packet
+from .connection import AriaClient
 from .errors import ClientError, MalformedReply, NotSupported
 from .feed import Feed, FeedContext
 from .subscriptions import Subscription

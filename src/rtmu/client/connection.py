@@ -25,33 +25,17 @@ from __future__ import annotations
 
 import asyncio
 import contextlib
+import functools
 import logging
-import socket
 import sys
 import time
-from collections.abc import AsyncIterator, Callable, Iterable
-from dataclasses import dataclass, field
+from collections.abc import AsyncIterator, Callable
 
-from ..protocol.client_connection import ClientConnection, ClientState, named, protocol_advice
-from ..protocol.commands import RejectReason
+from ..protocol.client_connection import ClientConnection, ClientState
 from ..protocol.datalist import DataList
 from ..protocol.decoder import DropStats
 from ..protocol.errors import ProtocolError
-from ..protocol.events import (
-    DataListReady,
-    DataReceived,
-    Event,
-    PeerShutdown,
-    Rejected,
-    ReplyComplete,
-    ReplyError,
-    ReplyFailed,
-    ReplyId,
-    ReplyPacket,
-)
-from ..protocol.fields import FieldWriter
-from ..protocol.packet import MAX_LENGTH
-from ..protocol.payloads import Payload, Side, decode_payload
+from ..protocol.payloads import Payload
 from ..protocol.replies import (
     ABANDON_GRACE,
     MAX_PENDING_PER_DATA,
@@ -59,150 +43,28 @@ from ..protocol.replies import (
     MAX_REPLY_PACKETS,
     TooManyPending,
 )
+from .call_values import Arg, Handler, Reply, encode_args, request_parts
 from .defaults import CONNECT_TIMEOUT, DEFAULT_PORT
 from .errors import (
     ClientError,
     ClientTimeout,
-    ConnectionFailed,
-    ConnectionRefused,
-    HostNotFound,
-    LoginRejected,
-    MalformedReply,
     NotSupported,
     ProtocolFault,
-    ReplyTooLarge,
     ServerClosed,
 )
-from .link import Link, Opener, open_tcp
+from .goodbye import CLOSE_TIMEOUT, flushed, say_goodbye
+from .inbox import Inbox
+from .link import READ_CHUNK, Link, Opener, open_tcp
+from .login import log_in, open_link
+from .reply_waiter import ReplyWaiter
 from .roles import MotionGate, Role
 
 log = logging.getLogger(__name__)
 
 REPLY_TIMEOUT = 5.0
 """Default wait for a reply, and for each further packet of a multi-packet reply."""
-CLOSE_TIMEOUT = 0.2
-"""How long ``disconnect`` lets the goodbye flush before cutting the socket."""
-LINGER_TIMEOUT = 0.5
-"""How long ``disconnect`` reads on after its goodbye, waiting for the server to close first."""
 MAX_WRITE_BUFFER = 1 << 20
 """A server that stops reading is dropped once this much output is queued (it would grow forever)."""
-READ_CHUNK = 1 << 16
-SLOW_HANDLER = 0.01
-"""A subscription handler that runs longer than this on the loop is counted and logged (the soak's
-promise: no handler over 10 ms on the loop that sends the stops)."""
-NOT_ARIA_AFTER = 4096
-"""Bytes received during login without one valid packet after which the peer is not ArNetworking
-(a real server's introduction is one small packet, sent at once)."""
-TEXT_BANNERS = (b"HTTP/", b"SSH-", b"RFB ", b"220 ", b"220-", b"+OK", b"* OK")
-"""How other common servers open a connection: such a peer is reported at once, not after --timeout."""
-Arg = Payload | bytes | bytearray | str | float | int | bool
-
-
-def encode_args(args: tuple[Arg, ...]) -> bytes:
-    """Request arguments → payload bytes.
-
-    A typed :class:`Payload` encodes itself; ``bytes`` go as they are; ``str`` is an
-    ARIA string; ``bool`` a ubyte 0/1; other numbers an ARIA double (as text).
-    Integer fields of other sizes: pass bytes built with ``FieldWriter`` or a typed payload.
-    """
-    w = FieldWriter()
-    for arg in args:
-        if isinstance(arg, Payload):
-            w.raw(arg.encode())
-        elif isinstance(arg, (bytes, bytearray)):
-            w.raw(arg)
-        elif isinstance(arg, str):
-            w.string(arg)
-        elif isinstance(arg, bool):
-            w.ubyte(1 if arg else 0)
-        elif isinstance(arg, (int, float)):
-            w.double(float(arg))
-        else:
-            raise TypeError(f"cannot encode request argument {arg!r}")
-    return w.bytes()
-
-
-@dataclass(frozen=True, slots=True)
-class Reply:
-    """The packet(s) answering one request: ``payloads`` in arrival order (one for most data)."""
-
-    name: str
-    payloads: tuple[bytes, ...]
-    received_at: float = field(compare=False)
-
-    @property
-    def payload(self) -> bytes:
-        """The first (usually only) payload; ``b""`` if there was none."""
-        return self.payloads[0] if self.payloads else b""
-
-    def decode(self) -> Payload:
-        """The first payload as its typed reply class; :class:`MalformedReply` if it does not decode."""
-        return _decode_typed(self.name, self.payload, "replies")
-
-
-@dataclass(frozen=True, slots=True)
-class Packet:
-    """One reply or broadcast packet handed to a subscription handler."""
-
-    name: str
-    payload: bytes
-    received_at: float
-
-    def decode(self) -> Payload:
-        return _decode_typed(self.name, self.payload, "packets")
-
-
-def _decode_typed(name: str, payload: bytes, what: str) -> Payload:
-    try:
-        typed = decode_payload(name, Side.REPLY, payload)
-    except ProtocolError as exc:
-        raise MalformedReply(f"the server sent a malformed {name!r} packet: {exc}") from None
-    if typed is None:
-        raise NotSupported(name, f"RTMU has no decoder for {name!r} {what}")
-    return typed
-
-
-Handler = Callable[[Packet], None]
-
-
-class _Waiter:
-    """The asyncio side of one tracked request: what ``request_once`` or ``stream`` waits on."""
-
-    __slots__ = ("count", "error", "finished", "payloads", "progress", "queue", "reply")
-
-    def __init__(self, reply: ReplyId, streaming: bool, *, queued: bool = True) -> None:
-        self.reply = reply
-        self.queue: asyncio.Queue[bytes | None] | None = asyncio.Queue() if streaming and queued else None
-        self.progress = asyncio.Event()
-        self.payloads: tuple[bytes, ...] = ()
-        self.count = 0
-        self.finished = False
-        self.error: ClientError | None = None
-
-    def packet(self, payload: bytes) -> None:
-        self.count += 1
-        if self.queue is not None:
-            self.queue.put_nowait(payload)
-        self.progress.set()
-
-    def complete(self, payloads: tuple[bytes, ...]) -> None:
-        self.finished = True
-        self.payloads = payloads
-        if self.queue is not None:
-            self.queue.put_nowait(None)
-        self.progress.set()
-
-    def fail(self, error: ClientError, *, drop_unread: bool = False) -> None:
-        """The reply will not come; ``drop_unread``: a stream's reader gets the error before stale packets."""
-        if self.finished:
-            return
-        self.finished = True
-        self.error = error
-        if self.queue is not None:
-            while drop_unread and not self.queue.empty():
-                self.queue.get_nowait()
-            self.queue.put_nowait(None)
-        self.progress.set()
 
 
 class AriaClient:
@@ -232,22 +94,12 @@ class AriaClient:
         self._conn: ClientConnection | None = None
         self._link: Link | None = None
         self._read_task: asyncio.Task[None] | None = None
-        self._handlers: dict[int, Handler] = {}
-        self._waiters: dict[ReplyId, _Waiter] = {}
+        self._inbox = Inbox()
+        """Subscriptions and waiting requests, where each incoming event goes (``inbox``)."""
         self._closed_error: ClientError | None = None
         self._closing = False
-        self.handler_errors = 0
-        """Exceptions raised by subscription handlers (logged, never fatal)."""
-        self.slow_handlers = 0
-        """Handler calls that took longer than :data:`SLOW_HANDLER` (logged: they delay every packet)."""
-        self.max_handler_seconds = 0.0
-        """The longest one handler call has held the loop (soak and health figures)."""
-        self.max_handler_cpu_seconds = 0.0
-        """The most CPU one handler call used: its own work, without time the thread was descheduled."""
-        self.slow_handlers_cpu = 0
-        """Handler calls whose own CPU time went over :data:`SLOW_HANDLER`."""
-        self.last_packet_at: float | None = None
-        self.packets_received = 0
+        self.handler_stats = self._inbox.stats
+        """How the subscription handlers' calls went: errors, slow calls, the longest (``handler_stats``)."""
         self._gate = MotionGate(Role.OBSERVER)
         """Replaced at :meth:`connect` by the role asked for; never changed after."""
 
@@ -306,16 +158,14 @@ class AriaClient:
         going on behind it: the stream is alive and will be delivered within a few packets."""
         return self._conn is not None and self._conn.decoder.undecided > 0
 
-    def _no_reply(self, message: str) -> ClientError:
-        """A timeout, unless the server sent a packet over ARIA's limit: that is then why (dropped)."""
-        size = self.drops.largest_over_limit
-        if size:
-            limit = f"{MAX_LENGTH:,}".replace(",", " ")
-            return ProtocolFault(
-                f"{message}: the server sent a packet of {size} bytes, over ArNetworking's "
-                f"{limit}-byte limit, so it was dropped"
-            )
-        return ClientTimeout(message)
+    @property
+    def last_packet_at(self) -> float | None:
+        """When the last packet came (None before the first): the link's health reads it."""
+        return self._inbox.last_packet_at
+
+    @property
+    def packets_received(self) -> int:
+        return self._inbox.packets_received
 
     @property
     def closed_error(self) -> ClientError | None:
@@ -365,22 +215,11 @@ class AriaClient:
         self._conn.replies.abandon_grace = self._abandon_grace
         self._conn.replies.max_pending = self._max_pending
         deadline = asyncio.get_running_loop().time() + timeout
+        self._link = await open_link(self.opener, host, port, deadline, timeout)
         try:
             async with asyncio.timeout_at(deadline):
-                self._link = await self.opener(host, port)
-        except TimeoutError:
-            raise ClientTimeout(f"connecting to {host}:{port} timed out after {timeout:g} s") from None
-        except ConnectionRefusedError:
-            raise ConnectionRefused(
-                f"connection refused by {host}:{port} (is the robot server running on that port?)"
-            ) from None
-        except socket.gaierror as exc:
-            raise HostNotFound(f"cannot find host {host!r}: {exc.strerror or exc}") from None
-        except OSError as exc:
-            raise ConnectionFailed(f"cannot connect to {host}:{port}: {exc.strerror or exc}") from None
-        try:
-            async with asyncio.timeout_at(deadline):
-                await self._login()
+                peer = f"{host}:{port}"
+                await log_in(self._link, self._conn, peer, self.clock, self._flush, self._inbox.deliver)
         except TimeoutError:
             self._abort()
             raise ClientTimeout(
@@ -391,46 +230,6 @@ class AriaClient:
             raise
         self._read_task = asyncio.get_running_loop().create_task(self._read_loop(), name="aria-read")
         return self._conn.datalist
-
-    async def _login(self) -> None:
-        assert self._link is not None and self._conn is not None
-        received = 0
-        while True:
-            try:
-                data = await self._link.read(READ_CHUNK)
-            except OSError as exc:
-                raise ServerClosed(f"the connection broke during login: {exc.strerror or exc}") from None
-            if not data:
-                raise ServerClosed(f"{self.host}:{self.port} closed the connection during login")
-            if received == 0 and data.startswith(TEXT_BANNERS):
-                banner = data[:40].split(b"\n")[0].decode("ascii", "replace").strip()
-                raise ProtocolFault(
-                    f"{self.host}:{self.port} is not an ArNetworking server (it said {banner!r})"
-                )
-            received += len(data)
-            now = self.clock()
-            try:
-                events = self._conn.receive_data(data, now)
-            except ProtocolError as exc:
-                raise ProtocolFault(f"{self.host}:{self.port} is not an ArNetworking server: {exc}") from None
-            if received >= NOT_ARIA_AFTER and self._conn.decoder.stats.packets == 0:
-                raise ProtocolFault(
-                    f"{self.host}:{self.port} is not an ArNetworking server "
-                    f"({received} bytes without a single valid packet)"
-                )
-            self._flush()
-            ready = False
-            for event in events:
-                if isinstance(event, Rejected):
-                    raise login_rejected(self._conn, event)
-                if isinstance(event, PeerShutdown):
-                    raise ServerClosed(f"{self.host}:{self.port} shut the connection down during login")
-                if isinstance(event, DataListReady):
-                    ready = True
-                elif isinstance(event, DataReceived):
-                    self._deliver(event.command, event.name, event.payload, now)
-            if ready:
-                return
 
     # -- requests --------------------------------------------------------------------------
     def _number(self, name: str) -> int:
@@ -456,7 +255,7 @@ class AriaClient:
         number = self._number(name)
         payload = encode_args(args)
         self._gate.admit(name, payload)
-        self._handlers[number] = handler
+        self._inbox.handlers[number] = handler
         self._conn.request(name, interval_ms, payload)  # type: ignore[union-attr]
         self._flush()
 
@@ -468,9 +267,9 @@ class AriaClient:
         """
         number = self._number(name)
         if handler is None:
-            self._handlers.pop(number, None)
+            self._inbox.handlers.pop(number, None)
         else:
-            self._handlers[number] = handler
+            self._inbox.handlers[number] = handler
 
     async def drain(self, timeout: float = REPLY_TIMEOUT) -> None:
         """Wait until our output is back under the link's high-water mark (a bulk sender's pacing).
@@ -496,14 +295,14 @@ class AriaClient:
     def subscribed(self, name: str) -> bool:
         """True while a handler holds a subscription to ``name`` (another ``request`` would replace it)."""
         number = self._conn.datalist.number(name) if self._conn is not None else None
-        return number is not None and number in self._handlers
+        return number is not None and number in self._inbox.handlers
 
     def stop_request(self, name: str) -> None:
         """End a subscription (no reply). Unknown or unsubscribed names are ignored."""
         number = self._conn.datalist.number(name) if self._conn is not None else None
         if number is None or not self.connected:
             return
-        self._handlers.pop(number, None)
+        self._inbox.handlers.pop(number, None)
         self._conn.request_stop(name)  # type: ignore[union-attr]
         self._flush()
 
@@ -513,7 +312,7 @@ class AriaClient:
         ``send(RatioDrive(…))``: the typed payload names its data; ``send("stop")``,
         ``send("turnByAngle", 90)``: a name and arguments (see :func:`encode_args`).
         """
-        name, payload = _request(what, args)
+        name, payload = request_parts(what, args)
         self._number(name)
         self._gate.admit(name, payload)
         self._conn.request_once(name, payload)  # type: ignore[union-attr]
@@ -541,29 +340,12 @@ class AriaClient:
         than ``max_packets`` packets or ``max_bytes`` payload bytes fails with
         :class:`ReplyTooLarge` (for big maps use ``rtmu.client.mapload`` or :meth:`stream`).
         """
-        name, payload = _request(what, args)
+        name, payload = request_parts(what, args)
         waiter = self._start(name, payload, expect, until, False, max_packets, max_bytes)
         if waiter is None:
             return Reply(name, (), self.clock())
-        try:
-            while not waiter.finished:
-                waiter.progress.clear()
-                try:
-                    async with asyncio.timeout(timeout):
-                        await waiter.progress.wait()
-                except TimeoutError:
-                    got = waiter.count
-                    self._abandon(waiter)
-                    raise self._no_reply(
-                        f"no reply to {name!r} from {self.host}:{self.port} within {timeout:g} s"
-                        + (f" (after {got} packets)" if got else "")
-                    ) from None
-        finally:
-            if not waiter.finished:  # cancelled: the slot must not wait for ever either
-                self._abandon(waiter)
-        if waiter.error is not None:
-            raise waiter.error
-        return Reply(name, waiter.payloads, self.clock())
+        payloads = await waiter.collect(timeout)
+        return Reply(name, payloads, self.clock())
 
     async def stream(
         self,
@@ -580,35 +362,16 @@ class AriaClient:
         Nothing is kept after it is yielded; the bounds apply to packets received but not
         read yet (a reader that falls that far behind gets :class:`ReplyTooLarge`).
         """
-        name, payload = _request(what, args)
+        name, payload = request_parts(what, args)
         waiter = self._start(name, payload, expect, until, True, max_packets, max_bytes)
         if waiter is None:
             return
-        queue = waiter.queue
-        assert queue is not None
-        try:
-            while True:
-                try:
-                    if queue.empty():
-                        async with asyncio.timeout(timeout):
-                            item = await queue.get()
-                    else:  # already here: no timer per packet (a big map is millions of packets)
-                        item = queue.get_nowait()
-                except TimeoutError:
-                    raise self._no_reply(
-                        f"{name!r} from {self.host}:{self.port} stalled for {timeout:g} s "
-                        f"after {waiter.count} packets"
-                    ) from None
-                if item is None:
-                    if waiter.error is not None:
-                        raise waiter.error
-                    return
-                if self._conn is not None:
-                    self._conn.reply_taken(waiter.reply, item)
+        conn = self._conn  # set by connect, never unset
+        assert conn is not None
+        taken = functools.partial(conn.reply_taken, waiter.reply)  # the bounds count unread packets only
+        async with contextlib.aclosing(waiter.items(timeout, taken)) as items:
+            async for item in items:
                 yield item
-        finally:
-            if not waiter.finished:
-                self._abandon(waiter)
 
     async def follow(
         self,
@@ -622,32 +385,11 @@ class AriaClient:
         needs): nothing is queued or kept for the caller, so a million-packet map costs no queue
         and no wake-up per packet. Returns the packet count; ``progress(count)`` after each burst;
         ``timeout`` bounds the wait for each packet."""
-        name, payload = _request(what, args)
+        name, payload = request_parts(what, args)
         waiter = self._start(name, payload, None, until, True, sys.maxsize, sys.maxsize, queued=False)
         if waiter is None:
             return 0
-        try:
-            while not waiter.finished:
-                waiter.progress.clear()
-                got = waiter.count
-                try:
-                    async with asyncio.timeout(timeout):
-                        await waiter.progress.wait()
-                except TimeoutError:
-                    self._abandon(waiter)
-                    raise self._no_reply(
-                        f"{name!r} from {self.host}:{self.port} stalled for {timeout:g} s after {got} packets"
-                        if got
-                        else f"no reply to {name!r} from {self.host}:{self.port} within {timeout:g} s"
-                    ) from None
-                if progress is not None and waiter.count != got:
-                    progress(waiter.count)
-        finally:
-            if not waiter.finished:
-                self._abandon(waiter)
-        if waiter.error is not None:
-            raise waiter.error
-        return waiter.count
+        return await waiter.follow(timeout, progress)
 
     def _start(
         self,
@@ -660,7 +402,7 @@ class AriaClient:
         max_bytes: int = MAX_REPLY_BYTES,
         *,
         queued: bool = True,
-    ) -> _Waiter | None:
+    ) -> ReplyWaiter | None:
         self._number(name)
         self._gate.admit(name, payload)
         conn = self._conn
@@ -678,12 +420,19 @@ class AriaClient:
         self._flush()
         if reply is None:
             return None
-        waiter = self._waiters[reply] = _Waiter(reply, streaming, queued=queued)
+        waiter = self._inbox.waiters[reply] = ReplyWaiter(
+            reply,
+            streaming,
+            abandon=self._abandon,
+            drops=lambda: self.drops,
+            peer=f"{self.host}:{self.port}",
+            queued=queued,
+        )
         return waiter
 
-    def _abandon(self, waiter: _Waiter) -> None:
+    def _abandon(self, waiter: ReplyWaiter) -> None:
         """A waiter gave up: its slot stays so late packets still line up, but nobody waits on it."""
-        self._waiters.pop(waiter.reply, None)
+        self._inbox.waiters.pop(waiter.reply, None)
         waiter.fail(ClientTimeout(f"{waiter.reply.name!r} abandoned"))
         if self._conn is not None:
             self._conn.abandon_reply(waiter.reply, self.clock())
@@ -708,7 +457,7 @@ class AriaClient:
                     self._fail(ServerClosed(f"{self.host}:{self.port} closed the connection"))
                     return
                 now = self.clock()
-                if not self._on_events(self._conn.receive_data(data, now), now):
+                if not self._inbox.route(self._conn.receive_data(data, now), now):
                     self._fail(ServerClosed(f"{self.host}:{self.port} shut down"))
                     return
                 self._flush()
@@ -719,74 +468,6 @@ class AriaClient:
         except OSError as exc:
             reason = exc.strerror or exc
             self._fail(ServerClosed(f"the connection to {self.host}:{self.port} broke: {reason}"))
-
-    def _on_events(self, events: Iterable[Event], now: float) -> bool:
-        """Hand each event to its waiter and handler; False when the server shut down."""
-        handlers, waiters = self._handlers, self._waiters
-        woken: _Waiter | None = None
-        for event in events:
-            if isinstance(event, ReplyPacket):  # ahead of the rest: a map is a million of these
-                reply, payload, swallowed = event
-                if not swallowed:
-                    waiter = waiters.get(reply)
-                    if waiter is not None:  # _Waiter.packet, inlined: its wake-up once per read
-                        waiter.count += 1
-                        if waiter.queue is not None:
-                            waiter.queue.put_nowait(payload)
-                        if waiter is not woken:
-                            waiter.progress.set()
-                            woken = waiter
-                if reply.number in handlers:
-                    self._deliver(reply.number, reply.name, payload, now)
-                else:
-                    self.last_packet_at = now
-                    self.packets_received += 1
-            elif isinstance(event, DataReceived):
-                self._deliver(event.command, event.name, event.payload, now)
-            elif isinstance(event, ReplyComplete):
-                waiter = self._waiters.pop(event.reply, None)
-                if waiter is not None:
-                    waiter.complete(event.payloads)
-            elif isinstance(event, ReplyFailed):
-                waiter = self._waiters.pop(event.reply, None)
-                if waiter is not None:
-                    too_large = event.reason is ReplyError.TOO_LARGE
-                    error = ReplyTooLarge(event.message) if too_large else ProtocolFault(event.message)
-                    waiter.fail(error, drop_unread=too_large)
-            elif isinstance(event, PeerShutdown):
-                return False
-        return True
-
-    def _deliver(self, number: int, name: str | None, payload: bytes, now: float) -> None:
-        """One data packet: count it, and call the subscription handler of its data."""
-        self.last_packet_at = now
-        self.packets_received += 1
-        handler = self._handlers.get(number)
-        if handler is None:
-            return
-        started = time.perf_counter()
-        started_cpu = time.thread_time()
-        try:
-            handler(Packet(name or str(number), payload, now))
-        except Exception:
-            self.handler_errors += 1
-            log.exception("handler for %s failed", name)
-        spent = time.perf_counter() - started
-        cpu = time.thread_time() - started_cpu
-        self.max_handler_seconds = max(self.max_handler_seconds, spent)
-        self.max_handler_cpu_seconds = max(self.max_handler_cpu_seconds, cpu)
-        if cpu > SLOW_HANDLER:
-            self.slow_handlers_cpu += 1
-        if spent > SLOW_HANDLER:  # it held up the loop that sends the stops: say so
-            self.slow_handlers += 1
-            if self.slow_handlers <= 10 or self.slow_handlers % 1000 == 0:
-                # The CPU part tells slow work (ours to fix) from a machine that did not run us.
-                log.warning(
-                    "the handler for %s took %.0f ms on the network loop (%.0f ms of it on the CPU)",
-                    name,
-                    spent * 1e3,
-                    cpu * 1e3,
-                )
 
     def _fail(self, error: ClientError) -> None:
         """The connection is over (not by our choice): fail every waiter, tell ``on_close`` once."""
@@ -801,12 +482,10 @@ class AriaClient:
                 log.exception("on_close callback failed")
 
     def _teardown(self, error: ClientError) -> None:
-        waiters, self._waiters = self._waiters, {}
-        for waiter in waiters.values():
-            waiter.fail(error)
+        self._inbox.fail_waiters(error)
         if self._conn is not None:
             self._conn.replies.clear()
-        self._handlers.clear()
+        self._inbox.handlers.clear()
         self._abort()
 
     def _abort(self) -> None:
@@ -819,20 +498,11 @@ class AriaClient:
         True when nothing is left in our buffer (``rtmu drive`` checks that its stop has left
         before the process is suspended). Never raises.
         """
-        link = self._link
-        if link is None or link.is_closing():
-            return False
-        loop = asyncio.get_running_loop()
-        deadline = loop.time() + timeout
-        with contextlib.suppress(TimeoutError, OSError):
-            async with asyncio.timeout_at(deadline):
-                await link.drain()
-                while link.backlog() > 0:
-                    await asyncio.sleep(0.005)
-        return not link.is_closing() and link.backlog() == 0
+        return self._link is not None and await flushed(self._link, timeout)
 
     async def disconnect(self) -> None:
-        """Say goodbye and close within :data:`CLOSE_TIMEOUT` s. Safe to call twice, or unconnected."""
+        """Say goodbye and close within :data:`~rtmu.client.goodbye.CLOSE_TIMEOUT` s (``goodbye``).
+        Safe to call twice, or unconnected."""
         if self._closing:
             return
         self._closing = True
@@ -840,53 +510,8 @@ class AriaClient:
         if task is not None and task is not asyncio.current_task():
             task.cancel()
         if self._conn is not None and self._link is not None and self._closed_error is None:
-            self._conn.shutdown()
-            data = self._conn.data_to_send()
-            link = self._link
-            if not link.is_closing():
-                with contextlib.suppress(OSError):
-                    link.write(data)
-                    link.finish_writing()
-                if task is not None and task is not asyncio.current_task():
-                    await asyncio.wait({task}, timeout=CLOSE_TIMEOUT)  # the link has one reader at a time
-                await _read_until_closed(link, LINGER_TIMEOUT)
-                link.close()
-                with contextlib.suppress(Exception):
-                    await asyncio.wait_for(link.wait_closed(), CLOSE_TIMEOUT)
+            await say_goodbye(self._conn, self._link, task)
         self._teardown(ServerClosed("disconnected"))
         if task is not None and task is not asyncio.current_task() and not task.done():
             # Bounded: a reader that will not end must not keep the caller (a window closing) waiting.
             await asyncio.wait({task}, timeout=CLOSE_TIMEOUT)
-
-
-async def _read_until_closed(link: Link, timeout: float) -> None:
-    """Read and drop the peer's bytes until it closes (bounded): our socket then closes clean.
-
-    Closing with the server's status still unread would reset the connection, and a server
-    whose next write meets the reset can lose our goodbye unread — the stop with it.
-    """
-    with contextlib.suppress(Exception):
-        async with asyncio.timeout(timeout):
-            while await link.read(READ_CHUNK):
-                pass
-
-
-def _request(what: str | Payload, args: tuple[Arg, ...]) -> tuple[str, bytes]:
-    """(data name, argument bytes) from a call's arguments; a typed payload names its own data."""
-    if isinstance(what, Payload):
-        if args:
-            raise TypeError("a typed payload carries its own arguments")
-        try:
-            return named(what)
-        except ProtocolError as exc:
-            raise TypeError(str(exc)) from None
-    return what, encode_args(args)
-
-
-def login_rejected(conn: ClientConnection, event: Rejected) -> LoginRejected:
-    """The refusal as the operator's error; reason 4 names the protocol string the server wants."""
-    wanted = conn.wanted_protocol()
-    advice = ""
-    if event.reason == RejectReason.PROTOCOL_VERSION_MISMATCH and wanted is not None:
-        advice = protocol_advice(wanted, conn.sent_protocol_version or "")
-    return LoginRejected(event.reason, event.text, advice, wanted)

@@ -30,7 +30,8 @@ from typing import Any
 
 from ..base.exit_codes import EXIT_USAGE
 from ..protocol.datalist import DataEntry, DataList
-from .connection import AriaClient, Packet
+from .call_values import Packet
+from .connection import AriaClient
 from .console_effect import HELD_MOTION, Effect, classify
 from .console_layout import Layout, describe, parse_layout
 from .console_reply import PacketView, view_packet

@@ -37,7 +37,8 @@ from ..protocol.errors import ProtocolError
 from ..protocol.payloads.drawings import Drawing, Visibility
 from ..values.intents import DrawingChoices, Intent, ShowDrawing
 from ..values.state import DrawingLayer, DrawingsChanged, DrawingsState
-from .connection import AriaClient, Packet
+from .call_values import Packet
+from .connection import AriaClient
 from .drawing_budget import sample_array, thin
 from .drawing_list import LIST, drawing_list, drawing_sample
 from .errors import ClientError

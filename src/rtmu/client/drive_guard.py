@@ -23,7 +23,8 @@ from ..base.exit_codes import EXIT_TIMEOUT
 from ..protocol.errors import ProtocolError
 from ..protocol.payloads.robot import Update, UpdateNumbers
 from ..values.state import LinkLevel
-from .connection import AriaClient, Packet
+from .call_values import Packet
+from .connection import AriaClient
 from .errors import ClientError, ClientTimeout
 from .health import HealthMonitor, ping_data
 

@@ -22,7 +22,8 @@ from ..protocol.payloads.ld import Patrol as PatrolPayload
 from ..protocol.payloads.ld import Say as SayPayload
 from ..protocol.payloads.sensors import RangeDeviceReadings
 from ..values.intents import Intent, Patrol, Say
-from .connection import AriaClient, Packet
+from .call_values import Packet
+from .connection import AriaClient
 from .errors import ClientError
 from .feed import Feed, FeedContext
 from .ld_data import NAV_FIELDS, data_store_names, laser_names, store_fields

@@ -52,6 +52,9 @@ class Link(Protocol):
         ...
 
 
+READ_CHUNK = 1 << 16
+"""The most one read asks of a link."""
+
 Opener = Callable[[str, int], Awaitable[Link]]
 """``await opener(host, port)`` → a connected :class:`Link`; raises ``OSError`` like ``open_connection``."""
 

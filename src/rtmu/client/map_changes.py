@@ -38,7 +38,8 @@ from ..protocol.payloads.mapchange import (
     change_packets,
 )
 from ..protocol.payloads.server import IdleProcessingPending
-from .connection import REPLY_TIMEOUT, AriaClient, Packet
+from .call_values import Packet
+from .connection import REPLY_TIMEOUT, AriaClient
 from .errors import ClientError, ClientTimeout, MalformedReply, NotSupported
 
 PROCESS = MapChangePacket.DATA_NAME

@@ -18,7 +18,8 @@ from typing import ClassVar
 from ..base.notices import Kind, Notice
 from ..values.intents import Intent, LoadMap
 from ..values.state import MapChanged, MapModel, MapPhase
-from .connection import AriaClient, Packet
+from .call_values import Packet
+from .connection import AriaClient
 from .errors import ClientError, ProtocolFault, ServerClosed
 from .feed import Feed, FeedContext
 from .mapcache import MapCache, MapKey, content_key, map_key

@@ -16,7 +16,8 @@ from typing import ClassVar
 
 from ..mapedit import ObjectChanges
 from ..values.intents import ApplyMapChanges, Intent
-from .connection import AriaClient, Packet
+from .call_values import Packet
+from .connection import AriaClient
 from .feed import Feed, FeedContext
 from .map_changes import WATCHED, ChangeVerdict, ChangeWatch, map_id, object_change_set, send_changes
 from .subscriptions import Subscription

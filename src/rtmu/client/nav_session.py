@@ -27,7 +27,8 @@ from ..protocol.payloads.navigation import Home, LocalizationState, LocalizeToPo
 from ..protocol.payloads.navigation import TourGoals as TourGoalsPayload
 from ..values.intents import Dock, GoHome, GotoGoal, GotoPose, Intent, Localize, TourGoals
 from ..values.state import NavChanged, NavOutcome, NavState, RobotState
-from .connection import AriaClient, Packet
+from .call_values import Packet
+from .connection import AriaClient
 from .errors import ClientError
 from .feed import Feed, FeedContext
 from .map_feed import goal_pose

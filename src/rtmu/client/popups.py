@@ -21,7 +21,8 @@ from ..base.notices import Kind, Notice
 from ..protocol.payloads.popup import PopupClicked, PopupClose, PopupCreate
 from ..values.intents import AnswerPopup, Intent
 from ..values.state import PopupInfo, PopupsChanged, PopupsState
-from .connection import AriaClient, Packet
+from .call_values import Packet
+from .connection import AriaClient
 from .errors import ClientError
 from .feed import Feed, FeedContext
 from .subscriptions import Subscription

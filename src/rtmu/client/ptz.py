@@ -21,7 +21,8 @@ from ..protocol.errors import ProtocolError
 from ..protocol.payloads.camera import Camera, CameraData, CameraInfo, CameraList, SetCameraAbs, SetCameraRel
 from ..values.intents import Intent, PtzMove, WatchPtz
 from ..values.state import PtzState
-from .connection import AriaClient, Packet
+from .call_values import Packet
+from .connection import AriaClient
 from .errors import ClientError, NotSupported
 from .feed import Feed, FeedContext
 

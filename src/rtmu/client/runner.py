@@ -108,7 +108,7 @@ def call_directly(fn: Callable[[], None]) -> None:
 class ClientRunner:
     """Use as ``with ClientRunner(robot_model, post=GLib.idle_add) as runner:`` (or ``start()``/``close()``).
 
-    Implements ``rtmu.control.controller.ClientLink``. All public methods are thread-safe.
+    Implements ``rtmu.control.ports.ClientLink``. All public methods are thread-safe.
     """
 
     def __init__(
@@ -332,7 +332,7 @@ class ClientRunner:
         with contextlib.suppress(RuntimeError):  # loop already closed
             self.loop.call_soon_threadsafe(session.kick)
 
-    # -- the controller's link (rtmu.control.controller.ClientLink) -------------------------------
+    # -- the controller's link (rtmu.control.ports.ClientLink) -------------------------------
     def connect(
         self,
         host: str,

@@ -36,7 +36,8 @@ from ..protocol.payloads.mapping import (
     MappingStatusBroadcast,
     scan_file_name,
 )
-from .connection import REPLY_TIMEOUT, AriaClient, Packet
+from .call_values import Packet
+from .connection import REPLY_TIMEOUT, AriaClient
 from .custom_commands import taken
 from .errors import NotSupported
 from .remote_files import Refused, checked_name, malformed, name_problem

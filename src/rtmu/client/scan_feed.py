@@ -20,7 +20,8 @@ from ..protocol.payloads.mapping import MappingStatusBroadcast
 from ..values.commission import ScanState
 from ..values.intents import Intent, StartScan, StopScan, TagScanLoop
 from ..values.state import ScanChanged
-from .connection import AriaClient, Packet
+from .call_values import Packet
+from .connection import AriaClient
 from .errors import ClientError
 from .feed import Feed, FeedContext
 from .remote_files import UnsafeName

@@ -15,7 +15,8 @@ from typing import Any, ClassVar
 from ..protocol.errors import ProtocolError
 from ..protocol.payloads.strings import Strings, StringsInfo
 from ..values.intents import Intent, WatchStrings
-from .connection import AriaClient, Packet
+from .call_values import Packet
+from .connection import AriaClient
 from .errors import ClientError
 from .feed import Feed, FeedContext
 

@@ -16,7 +16,8 @@ from ..protocol.payloads.drive import SafeDrive
 from ..protocol.payloads.drive import SetSafeDrive as SetSafeDrivePayload
 from ..protocol.payloads.robot import BatteryInfo, ModeInfo, Update, UpdateNumbers, UpdateStrings
 from ..values.intents import Intent, SetSafeDrive
-from .connection import AriaClient, Packet
+from .call_values import Packet
+from .connection import AriaClient
 from .errors import ClientError
 from .feed import Feed, FeedContext
 from .subscriptions import Subscription

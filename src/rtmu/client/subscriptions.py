@@ -12,7 +12,7 @@ from __future__ import annotations
 from collections.abc import Callable, Iterable
 from dataclasses import dataclass
 
-from .connection import Packet
+from .call_values import Packet
 
 Handler = Callable[[Packet], None]
 

@@ -38,7 +38,8 @@ from ..protocol.payloads.files import (
     PutFileWithTimestampRequest,
     code_words,
 )
-from .connection import REPLY_TIMEOUT, AriaClient, Packet
+from .call_values import Packet
+from .connection import REPLY_TIMEOUT, AriaClient
 from .download import LocalFileError, Progress, Transfer
 from .errors import ClientTimeout, NotSupported
 from .remote_files import FEATURES, Refused, malformed, remote_path

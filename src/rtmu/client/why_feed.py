@@ -24,7 +24,8 @@ from ..base.notices import Kind, Notice
 from ..base.textsafe import visible
 from ..values.intents import ApplyFix, AskWhy, Intent
 from ..values.state import LinkLevel
-from .connection import AriaClient, Packet
+from .call_values import Packet
+from .connection import AriaClient
 from .drive_loop import DriveFeed
 from .feed import Feed, FeedContext
 from .subscriptions import Subscription

@@ -29,8 +29,9 @@ from ..protocol.payloads.robot import (
     UpdateStrings,
 )
 from ..protocol.payloads.sensors import RangeDeviceReadings, SensorList, SensorReadings
+from .call_values import Reply
 from .config_feed import ServerConfig, fetch_config, offers_config
-from .connection import AriaClient, Reply
+from .connection import AriaClient
 from .errors import ClientError, ServerClosed
 from .ld_data import LASER_NAMES
 from .why_values import (

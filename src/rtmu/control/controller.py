@@ -1,34 +1,19 @@
 """Operator intents → client calls, with the robot's safety rules in one place.
 
 The controller runs on the UI thread. It is GTK-free: it talks to the window
-through the small :class:`View` protocol and to the network through
-:class:`ClientLink` (implemented by ``rtmu.client.ClientRunner``), and reads
+through the small :class:`~rtmu.control.ports.View` protocol and to the network through
+:class:`~rtmu.control.ports.ClientLink` (implemented by ``rtmu.client.ClientRunner``), and reads
 time from an injected clock, so every rule below is tested without a display.
 
 Driving rules
 -------------
-* ``press(direction)`` / ``release(direction)``: move only **while held**. The
-  first press grants a drive lease (``rtmu.client.lease``); :meth:`tick`, called
-  by the UI's own timer every :data:`TICK` seconds, renews it while keys are
-  held; the network side resends ``ratioDrive`` at 10 Hz while the lease is
-  fresh. Two held directions combine into a curve (forward+left = forward with
-  half rotation); opposite directions cancel. Releasing the last key sends zero
-  ratios and ``stop``.
+* Held keys and a gamepad's stick drive on one lease, only while held (``held_drive``: the
+  press / release / stick rules, blocked keys, the curve, the throttle). :meth:`Controller.tick`,
+  called by the UI's own timer every :data:`~rtmu.control.held_drive.TICK` seconds, renews it.
 * :meth:`stop` always wins and is always sent, even when the link looks stale.
 * Focus loss, disconnect, a stale or lost link, and a lapsed lease (the UI froze
-  for more than 300 ms) stop the robot. Keys still held at that moment are
-  *blocked* until released: the robot stays still until a fresh key press —
-  also after a reconnect, and also after focus comes back: a key held through
-  the focus loss auto-repeats as presses, which must not restart motion. While
-  the window is unfocused no real key release can arrive, so releases then
-  (a window "releasing everything" on focus loss) do not unblock; the first
-  press after focus returns marks the window focused again (a key released
-  while unfocused therefore needs one press to clear it, then a fresh press).
-* ``analog(trans, rot)`` / ``analog_release()``: a gamepad's stick while its
-  dead-man button is held (``rtmu.control.gamepad`` turns pad events into these). It rides
-  the SAME lease as the keys (held keys win over the stick while both are held);
-  every stop above blocks the stick too, until the dead-man is released and
-  pressed again.
+  for more than 300 ms) stop the robot; keys (and the stick) held at that moment stay
+  blocked until released (``held_drive``).
 * Speed: 10…100 % in 10 % steps; it is the ``ratioDrive`` throttle and applies at
   once to a drive in progress. The operator's near-people cap (``OperatorState.near_people``)
   lowers that throttle so a full drive stays under it, from the robot's top speed
@@ -62,121 +47,28 @@ from __future__ import annotations
 
 import contextlib
 import time
-from collections.abc import Callable, Mapping
+from collections.abc import Callable
 from dataclasses import replace
-from typing import Any, Protocol
+from typing import Any
 
 from ..base.notices import Kind, Notice
-from ..client.lease import DriveLease, DriveRatios, EndReason
+from ..client.lease import EndReason
 from ..model.observables import OperatorState, RobotModel, SpeedSetting
 from ..settings.store import Profile
 from ..values.intents import GotoGoal, Intent, RequestPicture, StartVideo, Stop, picture_source
 from ..values.state import ConnectionState, LinkHealth, LinkLevel, NavState, Phase, RobotState
 from . import intent_rules
 from .commands import COMMANDS, CommandRegistry, CommandState
-from .motion_limits import RobotLimits, capped_throttle
+from .held_drive import HeldDrive
+from .motion_limits import RobotLimits
 from .motion_watch import MotionWatch
+from .password_lookup import PasswordLookup
+from .ports import ClientLink, NoView, SecretStore, View
 from .scan_rule import scan_refusal
-
-TICK = 0.1
-"""Seconds between :meth:`Controller.tick` calls the UI timer should make (10 Hz renewal)."""
-CURVE_ROT = 50.0
-"""Rotation ratio (%) used when a turn key is held together with forward or backward."""
-
-DIRECTIONS = ("forward", "backward", "left", "right")
-
-
-class View(Protocol):
-    """What the controller needs from a window (GTK, a test fake, or nothing at all)."""
-
-    def notify(self, notice: Notice) -> None:
-        """Show a short message (banner/toast) to the operator; its kind says where."""
-
-    def commands_changed(self, states: Mapping[str, CommandState]) -> None:
-        """Enable/disable commands; ``states`` holds every command whose state changed."""
-
-    def ask_password(self, profile: Profile, answer: Callable[[str | None], None]) -> None:
-        """Ask for the password of ``profile`` without blocking; call ``answer`` (None = cancelled)."""
-
-    def open_dialog(self, name: str) -> None:
-        """Open the dialog a command needs (``turn``: an angle, ``go``: a distance)."""
-
-    def driving(self) -> None:
-        """A held drive began (a lease was granted) or a jog is watched: from now while
-        :attr:`Controller.needs_tick`, call :meth:`Controller.tick` every :data:`TICK` s (a window runs
-        that timer only while something is driven)."""
-
-
-class ClientLink(Protocol):
-    """The network side as the controller sees it (``rtmu.client.ClientRunner``); every call returns at once
-    (what it returns — a Future in the runner — is not waited for here).
-
-    Results come back through the model (connection, robot, map, camera) on the
-    UI thread; problems the operator should hear about go to ``on_notice``.
-    """
-
-    lease: DriveLease
-    on_notice: Callable[[Notice], None] | None
-    """Set by the controller: the network side's messages for the operator."""
-
-    def connect(
-        self,
-        host: str,
-        port: int,
-        user: str = "",
-        password: str = "",
-        *,
-        profile: str = "",
-        auto_reconnect: bool = True,
-        protocol: str | None = None,
-    ) -> object: ...
-
-    def disconnect(self) -> object: ...
-
-    def send(self, intent: Intent) -> Any:
-        """The one way an intent crosses to the network thread (a Future of the feed's answer)."""
-
-    # Optional (the controller looks for it with getattr): ``run_blocking(fn, done)`` runs ``fn``
-    # off the UI thread and posts ``done(result)`` back; keyring lookups go through it.
-
-
-class SecretStore(Protocol):
-    """Where remembered passwords live (``rtmu.settings.store`` provides the keyring-backed one)."""
-
-    def get(self, profile: Profile) -> str | None: ...
-
 
 REPLAY_REASON = "Replay — nothing is sent to a robot"
 KEYBOARD_LOST = "the window lost the keyboard"
 """Why a held drive stops on a focus loss (a suspend names its own reason)."""
-
-
-def ratios_for(held: set[str] | frozenset[str], throttle: float) -> DriveRatios:
-    """The ``ratioDrive`` for a set of held directions (empty or cancelling → zero motion)."""
-    trans = 100.0 * (("forward" in held) - ("backward" in held))
-    rot = 100.0 * (("left" in held) - ("right" in held))
-    if trans and rot:
-        rot = CURVE_ROT if rot > 0 else -CURVE_ROT
-    return DriveRatios(trans, rot, float(throttle))
-
-
-class NoView:
-    """The view of a controller no window shows (yet): notices and command states go nowhere."""
-
-    def notify(self, notice: Notice) -> None:
-        pass
-
-    def commands_changed(self, states: Mapping[str, CommandState]) -> None:
-        pass
-
-    def ask_password(self, profile: Profile, answer: Callable[[str | None], None]) -> None:
-        answer(None)
-
-    def open_dialog(self, name: str) -> None:
-        pass
-
-    def driving(self) -> None:
-        pass
 
 
 class Controller:
@@ -206,26 +98,16 @@ class Controller:
         self.registry = registry
         self.secrets = secrets
         self.profile = profile or Profile()
-        self._held: set[str] = set()
-        self._blocked: set[str] = set()
-        """Keys that were held when motion was stopped for them; ignored until released."""
-        self._analog: tuple[float, float] | None = None
-        """The gamepad stick (trans, rot in %) while its dead-man is held; None when let go."""
-        self._analog_blocked = False
-        """The stick drove (or was held) when motion was stopped: ignored until the dead-man is released."""
-        self._generation: int | None = None
         self._states: dict[str, CommandState] = {}
-        self._lookup_pending = False
-        """A keyring lookup runs off the UI thread; connect() waits for its answer."""
-        self._unfocused = False
-        """Between focus loss and the next key press: releases seen then are not real key-ups."""
         self._nav_cancelled = False
         """We sent the stop that ends the current navigation; the server has not said so yet."""
         self.tap: Callable[[str, dict[str, Any]], None] | None = None
         """The flight recorder's tap: every intent sent, and every connect (without its password)."""
-        self.keys_reach = True
-        """The window has the keyboard, so the stop key reaches it (False from focus loss to focus gain)."""
-        self.motion = MotionWatch(link, lambda n: self.view.notify(n), self._reapply, clock)
+        self.drive = HeldDrive(self)
+        """The keys held, the stick and the lease they share (``held_drive``)."""
+        self.passwords = PasswordLookup(self, self._start_connect, self._busy_connecting)
+        """The password step of :meth:`connect` (``password_lookup``)."""
+        self.motion = MotionWatch(link, lambda n: self.view.notify(n), self.drive.reapply, clock)
         """The robot's limits (the cap, the stopping distance) and how each jog ended."""
         self.replay: str | None = None
         """Set to the recording's name while the window shows a replay: then nothing is sent at all
@@ -239,7 +121,7 @@ class Controller:
             robot.health.observe(self._on_health),
             robot.navigation.observe(self._on_navigation),
             robot.robot.observe(self._on_robot),
-            operator.near_people.observe(lambda _old, _new: self._reapply()),
+            operator.near_people.observe(lambda _old, _new: self.drive.reapply()),
         ]
         self.refresh_commands()
 
@@ -298,163 +180,54 @@ class Controller:
         if changed:
             self.view.commands_changed(changed)
 
-    # -- held motion -------------------------------------------------------------------------
+    # -- held motion (``held_drive``) ----------------------------------------------------------
     @property
     def held(self) -> frozenset[str]:
-        return frozenset(self._held)
+        return self.drive.held
 
     def press(self, direction: str) -> None:
-        if direction not in DIRECTIONS:
-            raise ValueError(f"unknown direction {direction!r}")
-        self._unfocused = False  # key presses reach a focused window only
-        self.keys_reach = True
-        if direction in self._held or direction in self._blocked:
-            return  # key auto-repeat, or a key held through a stop: wait for its release
-        if self.replay:
-            self._blocked.add(direction)
-            self._say_replay()
-            return
-        if not self.connected or not self.supports("ratioDrive"):
-            self._blocked.add(direction)
-            return
-        if self.navigating:  # the operator wins: this press only stops the navigation
-            self.stop()
-            self._blocked.add(direction)
-            self.view.notify(Notice.info(Kind.NAVIGATION, "Navigation cancelled. Press again to drive."))
-            return
-        if self._gate_refuses():
-            self._blocked.add(direction)
-            return
-        self._held.add(direction)
-        self._apply()
-
-    def _gate_refuses(self) -> bool:
-        """The drive gate says no: tell the operator why (the key must be pressed again)."""
-        gate = self.drive_gate
-        why = gate() if gate is not None else None
-        if why is not None:
-            self.view.notify(Notice.warning(Kind.SAFETY, f"Not driving: {why} Press again once it is armed."))
-        return why is not None
+        self.drive.press(direction)
 
     def release(self, direction: str) -> None:
-        if not self._unfocused:  # a real key-up: the key may drive again on its next press
-            self._blocked.discard(direction)
-        if direction not in self._held:
-            return
-        self._held.discard(direction)
-        self._apply()
+        self.drive.release(direction)
 
-    # -- analog motion (a gamepad's stick under its dead-man) ----------------------------------
     @property
     def analog_active(self) -> bool:
         """The stick is being listened to (dead-man held, not blocked by a stop)."""
-        return self._analog is not None
+        return self.drive.analog_active
 
     @property
     def analog_blocked(self) -> bool:
         """A stop ended the stick's drive: the dead-man must be released before it drives again."""
-        return self._analog_blocked
+        return self.drive.analog_blocked
 
     def analog(self, trans: float, rot: float) -> None:
-        """The stick while the dead-man is held: trans/rot in −100…100 % (rot positive = left).
-
-        The first call grants the lease like a key press; later ones change its ratios. Ignored
-        while blocked (after any stop) until :meth:`analog_release`."""
-        if self._analog_blocked:
-            return
-        if not self.connected or not self.supports("ratioDrive"):
-            self._analog_blocked = True
-            return
-        if self.navigating and (trans or rot):  # the operator wins: this only stops the navigation
-            self.stop()
-            self._analog_blocked = True
-            self.view.notify(Notice.info(Kind.NAVIGATION, "Navigation cancelled. Press again to drive."))
-            return
-        if self._analog is None and (trans or rot) and self._gate_refuses():
-            self._analog_blocked = True
-            return
-        self._analog = (max(-100.0, min(100.0, trans)), max(-100.0, min(100.0, rot)))
-        self._apply()
+        """The stick while the dead-man is held: trans/rot in −100…100 % (rot positive = left)."""
+        self.drive.analog(trans, rot)
 
     def analog_release(self) -> None:
         """The dead-man was let go (or the pad is gone): stop the stick's drive; it may drive again."""
-        self._analog_blocked = False
-        if self._analog is None:
-            return
-        self._analog = None
-        self._apply()
+        self.drive.analog_release()
+
+    @property
+    def keys_reach(self) -> bool:
+        """The window has the keyboard, so the stop key reaches it (False from focus loss to focus gain)."""
+        return self.drive.keys_reach
+
+    @keys_reach.setter
+    def keys_reach(self, reach: bool) -> None:
+        self.drive.keys_reach = reach
 
     @property
     def needs_tick(self) -> bool:
         """Keys, the stick or a live lease drive, or a jog is watched: :meth:`tick` is needed."""
-        live = self._held or self._analog is not None or self.link.lease.view().live
-        return bool(live) or self.motion.jogs.jog is not None
+        return self.drive.needs_renewal or self.motion.jogs.jog is not None
 
     def tick(self) -> None:
-        """Renew the lease while keys are held. Call every :data:`TICK` s from the UI thread's timer."""
+        """Renew the lease while keys are held; end a watched jog that is over. Call every
+        :data:`~rtmu.control.held_drive.TICK` s from the UI thread's timer."""
         self.motion.tick(self.robot.robot.value)
-        if not self._held and (self._analog is None or self._generation is None):
-            return
-        if not self.link.lease.renew():
-            reason = self.link.lease.ended or EndReason.LAPSED
-            self._halt_held(reason)
-
-    def _apply(self) -> None:
-        speed = capped_throttle(
-            self.operator.speed.value.percent, self.operator.near_people.value.cap, self.limits
-        )
-        if self._held or self._analog is None:
-            ratios = ratios_for(self._held, speed)
-        else:
-            ratios = DriveRatios(self._analog[0], self._analog[1], float(speed))
-        lease = self.link.lease
-        if not ratios.moving:
-            if self._generation is not None:
-                lease.release()
-                self._generation = None
-            return
-        if self._generation is None or not lease.change(ratios):
-            if self._generation is not None:
-                # The lease died under us (lapsed/stale); the keys pressed before are stale too.
-                self._halt_held(lease.ended or EndReason.LAPSED)
-                return
-            self._end_jog("a drive")
-            self._generation = lease.grant(ratios)
-            self.view.driving()
-
-    def _reapply(self) -> None:
-        """The cap or the robot's limits changed: a drive in progress takes the new throttle at once."""
-        if (self._held or self._analog is not None) and self._generation is not None:
-            self._apply()
-
-    def _halt_held(self, reason: EndReason, *, quiet: bool = False) -> None:
-        """Motion was stopped for ``reason`` while keys were held: block them until released.
-
-        A lease the network side ended for the link (its drive loop sees a stale link before the
-        model's health reaches this thread) is said here, so the operator hears it whichever
-        side noticed first; ``quiet`` where the caller says it itself."""
-        had = bool(self._held) or (self._analog is not None and self._generation is not None)
-        self._blocked |= self._held
-        self._held.clear()
-        if self._analog is not None:
-            self._analog = None
-            self._analog_blocked = True
-        if self._generation is not None:
-            self.link.lease.end(reason, self._generation)
-            self._generation = None
-        if had and reason is EndReason.LAPSED:
-            why = self.link.lease.why or "a busy computer?"
-            text = f"Stopped: the window did not respond in time ({why})"
-            self.view.notify(Notice.warning(Kind.SAFETY, f"{text}. Press again to drive."))
-        elif had and reason is EndReason.LINK and not quiet:
-            level = self.robot.health.value.level
-            self._say_link_stop(level if level in (LinkLevel.STALE, LinkLevel.LOST) else LinkLevel.STALE)
-
-    def _say_link_stop(self, level: LinkLevel) -> None:
-        """Said once per stop, with the network side's measured cause where it gave one."""
-        why = self.link.lease.why or self.robot.health.value.cause
-        said = f" — {why}" if why else ". Press again once it is back."
-        self.view.notify(Notice.warning(Kind.LINK, f"Stopped: the link is {level.value}{said}"))
+        self.drive.renew()
 
     def stop(self) -> None:
         """Stop now. Always sent, whatever the link looks like; held keys must be pressed again.
@@ -462,13 +235,13 @@ class Controller:
         Also ends a navigation: the server's ``stop`` mode takes over from its goal. A replay has no
         robot to stop: it says so and sends nothing."""
         if self.replay:
-            self._halt_held(EndReason.STOPPED)
-            self._say_replay()
+            self.drive.halt(EndReason.STOPPED)
+            self.say_replay()
             return
         if self.navigating:
             self._nav_cancelled = True
         self._end_jog("STOP")
-        self._halt_held(EndReason.STOPPED)
+        self.drive.halt(EndReason.STOPPED)
         self.link.lease.end(EndReason.STOPPED)
         if self.robot.connection.value.phase in (Phase.CONNECTED, Phase.RECONNECTING, Phase.CONNECTING):
             self._record(Stop())
@@ -482,23 +255,15 @@ class Controller:
         Keys held now stay blocked until a real release is seen after focus returns (see the
         module notes): auto-repeat of a key held all along must not start the robot again.
         """
-        driving = bool(self._held) or self._generation is not None
-        if driving:
+        if self.drive.driving:
             self.stop()
             then = "Click the map, then press again" if why == KEYBOARD_LOST else "Press again"
             self.view.notify(Notice.warning(Kind.SAFETY, f"Stopped: {why}. {then} to drive."))
-        if self._analog is not None:
-            self._analog = None
-            self._analog_blocked = True
-        self._blocked |= self._held
-        self._held.clear()
-        self._unfocused = True
-        self.keys_reach = False
+        self.drive.keys_lost()
 
     def focus_gained(self) -> None:
         """The window has the keyboard again: releases from now on are real (optional for a view)."""
-        self._unfocused = False
-        self.keys_reach = True
+        self.drive.keys_back()
 
     def pointer_may_drive(self) -> bool:
         """A D-pad (pointer, touch) hold may start only while the stop key reaches the window: else it
@@ -515,11 +280,11 @@ class Controller:
         drive ends, its keys blocked until released, and says so; a navigation goes on, and nothing is
         sent for it. ``keys_leave``: the keyboard goes to another surface of the window (a menu), so
         key-ups seen until the next press are not real ones (as after a focus loss)."""
-        if self._held or (self._analog is not None and self._generation is not None):
-            self._halt_held(EndReason.STOPPED)
+        if self.drive.holding:
+            self.drive.halt(EndReason.STOPPED)
             self.view.notify(Notice.info(Kind.SAFETY, f"Stopped for {what}. Press again to drive."))
         if keys_leave:
-            self._unfocused = True
+            self.drive.keys_left()
 
     # -- speed -------------------------------------------------------------------------------
     def speed_up(self) -> None:
@@ -535,7 +300,7 @@ class Controller:
             )
             return
         self.view.notify(Notice.info(Kind.SPEED, f"Speed {new.percent} %"))
-        self._reapply()
+        self.drive.reapply()
 
     # -- every other intent: the guard ---------------------------------------------------------
     def ask(self, intent: Intent) -> Any:
@@ -552,7 +317,7 @@ class Controller:
             self.stop()
             return None
         if self.replay:
-            self._say_replay()
+            self.say_replay()
             return None
         offers = self.robot.connection.value.offers
         if (intent.needs or intent.moves or not intent.offered(())) and not self.connected:
@@ -578,7 +343,7 @@ class Controller:
             return None
         moving = intent_rules.moves(intent)
         if moving:
-            self._halt_held(EndReason.STOPPED)  # the network side sends its stop before the intent
+            self.drive.halt(EndReason.STOPPED)  # the network side sends its stop before the intent
             self._nav_cancelled = False
         self._record(intent)
         sent = self.link.send(intent)
@@ -604,7 +369,8 @@ class Controller:
         if not new.navigating or (old.navigating and new.target != old.target):
             self._nav_cancelled = False  # it ended (or someone sent it elsewhere): keys drive again
 
-    def _say_replay(self) -> None:
+    def say_replay(self) -> None:
+        """Say that a replay sends nothing (the operator asked something of a recording)."""
         self.view.notify(Notice.warning(Kind.SAFETY, f"{REPLAY_REASON}: {self.replay}"))
 
     # -- connection --------------------------------------------------------------------------
@@ -639,47 +405,17 @@ class Controller:
         if self._busy_connecting():
             return
         if password is None and profile.user:
-            if profile.remember_password and self.secrets is not None:
-                self._look_up_password(profile, self.secrets)
-                return
-            self.view.ask_password(profile, self._password_answered)
+            self.passwords.find(profile)
             return
         self._start_connect(password or "")
 
     def _busy_connecting(self) -> bool:
         phase = self.robot.connection.value.phase
-        return self._lookup_pending or phase in (Phase.CONNECTING, Phase.CONNECTED, Phase.RECONNECTING)
-
-    def _look_up_password(self, profile: Profile, secrets: SecretStore) -> None:
-        run_blocking = getattr(self.link, "run_blocking", None)
-        if run_blocking is None:  # a link without a worker: look it up here
-            self._password_found(profile, secrets.get(profile))
-            return
-        self._lookup_pending = True
-
-        def found(password: str | None) -> None:
-            self._lookup_pending = False
-            self._password_found(profile, password)
-
-        run_blocking(lambda: secrets.get(profile), found)
-
-    def _password_found(self, profile: Profile, password: str | None) -> None:
-        if profile != self.profile or self._busy_connecting():
-            return  # another profile was chosen, or a connection started, while we looked
-        if password is None:
-            self.view.ask_password(profile, self._password_answered)
-            return
-        self._start_connect(password)
-
-    def _password_answered(self, password: str | None) -> None:
-        if password is None:
-            self.view.notify(Notice.info(Kind.CONNECTION, "Connection cancelled"))
-            return
-        self._start_connect(password)
+        return self.passwords.pending or phase in (Phase.CONNECTING, Phase.CONNECTED, Phase.RECONNECTING)
 
     def _start_connect(self, password: str) -> None:
         p = self.profile
-        self._halt_held(EndReason.DISCONNECTED)
+        self.drive.halt(EndReason.DISCONNECTED)
         tap = self.tap
         if tap is not None:
             with contextlib.suppress(Exception):
@@ -718,9 +454,7 @@ class Controller:
         return self.motion.limits
 
     def _on_robot(self, _old: RobotState, new: RobotState) -> None:
-        self.motion.robot_changed(
-            new, self.link.lease.view().ratios if self._generation is not None else None
-        )
+        self.motion.robot_changed(new, self.link.lease.view().ratios if self.drive.granted else None)
 
     def _end_jog(self, why: str) -> None:
         self.motion.end_jog(why, self.robot.robot.value)
@@ -732,7 +466,7 @@ class Controller:
         elif new.phase is not Phase.CONNECTED and old.phase is Phase.CONNECTED:
             self.motion.disconnected()
         if new.phase is not Phase.CONNECTED and old.phase is Phase.CONNECTED:
-            self._halt_held(EndReason.DISCONNECTED)
+            self.drive.halt(EndReason.DISCONNECTED)
         if new.phase is Phase.CONNECTED and old.phase is not Phase.CONNECTED:
             self.view.notify(Notice.info(Kind.CONNECTION, f"Connected to {new.host}:{new.port}"))
         elif new.phase is Phase.FAILED and new.error and new.error != old.error:
@@ -747,11 +481,11 @@ class Controller:
 
     def _on_health(self, old: LinkHealth, new: LinkHealth) -> None:
         if new.level in (LinkLevel.STALE, LinkLevel.LOST) and old.level is LinkLevel.OK:
-            moving = bool(self._held) or self._generation is not None
-            self._halt_held(EndReason.LINK, quiet=True)
+            moving = self.drive.driving
+            self.drive.halt(EndReason.LINK, quiet=True)
             if moving:
                 self.link.send(Stop("link " + new.level.value))
-                self._say_link_stop(new.level)
+                self.drive.say_link_stop(new.level)
 
     def _on_link_notice(self, notice: Notice) -> None:
         self.view.notify(notice)

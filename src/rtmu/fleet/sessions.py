@@ -49,7 +49,8 @@ from ..client.roster import (
 from ..client.runner import ClientRunner, Post, call_directly, settle
 from ..client.session import SessionConfig
 from ..control.commands import COMMANDS, CommandRegistry
-from ..control.controller import Controller, NoView, SecretStore, View
+from ..control.controller import Controller
+from ..control.ports import NoView, SecretStore, View
 from ..guardian.shared import GuardianSeat, SharedGuardian
 from ..model.observables import Observable, OperatorState, RobotModel
 from ..recorder import Recorder, RecorderConfig

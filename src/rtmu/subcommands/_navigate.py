@@ -30,7 +30,8 @@ from ..values.state import NavOutcome
 from ._common import Interrupted, current_interrupts, positive_float, print_json, signal_name
 
 if TYPE_CHECKING:
-    from ..client.connection import AriaClient, Packet
+    from ..client.call_values import Packet
+    from ..client.connection import AriaClient
 
 EXIT_NAV_FAILED = EXIT_REFUSED
 """The server could not get there (``Failed to get to …``, ``Failed to plan to …``, ``Failed dock``)."""

@@ -174,8 +174,8 @@ class Doctor:
         """The next events from the server, or the step fails (EOF, timeout, not ArNetworking)."""
         import asyncio
 
-        from ..client.connection import TEXT_BANNERS
         from ..client.diagnosis import ADVICE, Step
+        from ..client.login import TEXT_BANNERS
         from ..protocol.errors import ProtocolError
 
         assert self.reader is not None and self.conn is not None

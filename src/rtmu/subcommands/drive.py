@@ -45,7 +45,8 @@ from ._common import (
 from ._status import fetch_status, status_line
 
 if TYPE_CHECKING:
-    from ..client.connection import AriaClient, Packet
+    from ..client.call_values import Packet
+    from ..client.connection import AriaClient
     from ..client.drive_guard import DriveGuard
     from ..client.why_values import Answer, Facts, Motion
     from ..guardian.handle import GuardianHandle

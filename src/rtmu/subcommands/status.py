@@ -31,7 +31,8 @@ from ._status import battery_is_soc, fetch_status, no_status, status_line, statu
 if TYPE_CHECKING:
     import asyncio
 
-    from ..client.connection import AriaClient, Packet
+    from ..client.call_values import Packet
+    from ..client.connection import AriaClient
 
 HEARTBEAT = 1.0
 """Seconds: an unchanged status is printed again this often, so a reader knows the link is alive."""

@@ -25,7 +25,8 @@ from ..protocol.payloads.robot import ModeInfo, UpdateStrings
 from ._common import add_connection_arguments, positive_float, print_json, run_with_client
 
 if TYPE_CHECKING:
-    from ..client.connection import AriaClient, Packet
+    from ..client.call_values import Packet
+    from ..client.connection import AriaClient
 
 PLAIN_EVENTS = {
     "mapUpdated": ("map_updated", "map updated"),

@@ -23,8 +23,9 @@ import gi
 gi.require_version("Gtk", "4.0")
 from gi.repository import Gio, GLib  # noqa: E402
 
-from ..control.controller import TICK, Controller  # noqa: E402
+from ..control.controller import Controller  # noqa: E402
 from ..control.gamepad import Gamepad, PadState  # noqa: E402
+from ..control.held_drive import TICK  # noqa: E402
 from .alarm_view import AlarmView  # noqa: E402
 from .gamepad import ManettePads  # noqa: E402
 from .gamepad_status import GamepadStatus  # noqa: E402

@@ -24,7 +24,7 @@ from gi.repository import GLib  # noqa: E402
 
 from ..client.why import StillWhileHeld  # noqa: E402
 from ..client.why_values import Answer  # noqa: E402
-from ..control.controller import ratios_for  # noqa: E402
+from ..control.held_drive import ratios_for  # noqa: E402
 from ..fleet.selected import SelectedRobot  # noqa: E402
 from ..model.observables import Phase, RobotModel  # noqa: E402
 from ..values.intents import AskWhy  # noqa: E402

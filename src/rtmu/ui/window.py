@@ -10,7 +10,7 @@ still held drive asks why), ``commissioning`` (files, scanning, map edits), ``de
 goes into ``stack``, a new action into ``actions``, a new dialog into ``window_dialogs``.
 
 Its timers (``window_timers``) are the UI's heartbeat: while a drive is held they renew the drive
-lease every :data:`rtmu.control.controller.TICK` — if this loop ever stalls, the lease lapses and
+lease every :data:`rtmu.control.held_drive.TICK` — if this loop ever stalls, the lease lapses and
 the network side stops the robot — and beat for the guardian process; at rest one slow timer
 refreshes ages (stale values, picture age) once a second.
 """
@@ -28,7 +28,8 @@ from gi.repository import Gtk  # noqa: E402
 
 from ..base.notices import Notice  # noqa: E402
 from ..control.commands import CommandState  # noqa: E402
-from ..control.controller import Controller, SecretStore  # noqa: E402
+from ..control.controller import Controller  # noqa: E402
+from ..control.ports import SecretStore  # noqa: E402
 from ..fleet.selected import SelectedRobot  # noqa: E402
 from ..fleet.sessions import RobotSession  # noqa: E402
 from ..model.observables import ConnectionState, MapModel, OperatorState, Phase, RobotModel, SpeedSetting  # noqa: E402

@@ -1,7 +1,7 @@
 """The window's timers: a window at rest wakes once a second; a held drive adds the fast ones.
 
 The UI thread's heartbeat drives safety: while a drive is held, every
-:data:`rtmu.control.controller.TICK` the lease is renewed (``controller.tick``) — if this loop ever
+:data:`rtmu.control.held_drive.TICK` the lease is renewed (``controller.tick``) — if this loop ever
 stalls, the lease lapses and the network side stops the robot — and every
 :data:`GUARDIAN_BEAT` the guardian process hears that the UI lives. Both start when the controller
 says a drive began (its ``View.driving``) and end once the drive is over and the guardian is
@@ -19,7 +19,7 @@ import gi
 gi.require_version("Gtk", "4.0")
 from gi.repository import GLib  # noqa: E402
 
-from ..control.controller import TICK  # noqa: E402
+from ..control.held_drive import TICK  # noqa: E402
 from ..guardian.handle import BEAT_PERIOD as GUARDIAN_BEAT  # noqa: E402
 from ..model.observables import Phase  # noqa: E402
 

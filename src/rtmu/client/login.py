@@ -1,0 +1,107 @@
+"""The start of a connection: open the link, then log in until the data list is complete.
+
+Each failure is the client's own typed error, in words that say what the peer is: a refused or
+unreachable address, a peer that is not an ArNetworking server (a text banner, or bytes without one
+valid packet), a refused login (with the protocol string the server wants, where it says), a peer
+that closes or shuts down. The caller bounds both steps with one deadline.
+"""
+
+from __future__ import annotations
+
+import asyncio
+import socket
+from collections.abc import Callable
+
+from ..protocol.client_connection import ClientConnection, protocol_advice
+from ..protocol.commands import RejectReason
+from ..protocol.errors import ProtocolError
+from ..protocol.events import DataListReady, DataReceived, PeerShutdown, Rejected
+from .errors import (
+    ClientTimeout,
+    ConnectionFailed,
+    ConnectionRefused,
+    HostNotFound,
+    LoginRejected,
+    ProtocolFault,
+    ServerClosed,
+)
+from .link import READ_CHUNK, Link, Opener
+
+NOT_ARIA_AFTER = 4096
+"""Bytes received during login without one valid packet after which the peer is not ArNetworking
+(a real server's introduction is one small packet, sent at once)."""
+TEXT_BANNERS = (b"HTTP/", b"SSH-", b"RFB ", b"220 ", b"220-", b"+OK", b"* OK")
+"""How other common servers open a connection: such a peer is reported at once, not after --timeout."""
+
+
+async def open_link(opener: Opener, host: str, port: int, deadline: float, timeout: float) -> Link:
+    """``opener(host, port)`` by ``deadline`` (loop time; ``timeout`` its length, for the words)."""
+    try:
+        async with asyncio.timeout_at(deadline):
+            return await opener(host, port)
+    except TimeoutError:
+        raise ClientTimeout(f"connecting to {host}:{port} timed out after {timeout:g} s") from None
+    except ConnectionRefusedError:
+        raise ConnectionRefused(
+            f"connection refused by {host}:{port} (is the robot server running on that port?)"
+        ) from None
+    except socket.gaierror as exc:
+        raise HostNotFound(f"cannot find host {host!r}: {exc.strerror or exc}") from None
+    except OSError as exc:
+        raise ConnectionFailed(f"cannot connect to {host}:{port}: {exc.strerror or exc}") from None
+
+
+async def log_in(
+    link: Link,
+    conn: ClientConnection,
+    peer: str,
+    clock: Callable[[], float],
+    flush: Callable[[], None],
+    deliver: Callable[[int, str | None, bytes, float], None],
+) -> None:
+    """Read from ``link`` into ``conn`` until its data list is complete, sending its answers
+    (``flush``); data the server sends meanwhile goes to ``deliver(number, name, payload, now)``.
+    ``peer`` ("host:port") is for the words. Unbounded in time: the caller sets the deadline."""
+    received = 0
+    while True:
+        try:
+            data = await link.read(READ_CHUNK)
+        except OSError as exc:
+            raise ServerClosed(f"the connection broke during login: {exc.strerror or exc}") from None
+        if not data:
+            raise ServerClosed(f"{peer} closed the connection during login")
+        if received == 0 and data.startswith(TEXT_BANNERS):
+            banner = data[:40].split(b"\n")[0].decode("ascii", "replace").strip()
+            raise ProtocolFault(f"{peer} is not an ArNetworking server (it said {banner!r})")
+        received += len(data)
+        now = clock()
+        try:
+            events = conn.receive_data(data, now)
+        except ProtocolError as exc:
+            raise ProtocolFault(f"{peer} is not an ArNetworking server: {exc}") from None
+        if received >= NOT_ARIA_AFTER and conn.decoder.stats.packets == 0:
+            raise ProtocolFault(
+                f"{peer} is not an ArNetworking server ({received} bytes without a single valid packet)"
+            )
+        flush()
+        ready = False
+        for event in events:
+            if isinstance(event, Rejected):
+                raise login_rejected(conn, event)
+            if isinstance(event, PeerShutdown):
+                raise ServerClosed(f"{peer} shut the connection down during login")
+            if isinstance(event, DataListReady):
+                ready = True
+            elif isinstance(event, DataReceived):
+                deliver(event.command, event.name, event.payload, now)
+        if ready:
+            return
+
+
+def login_rejected(conn: ClientConnection, event: Rejected) -> LoginRejected:
+    """The refusal as the operator's error; reason 4 names the protocol string the server wants."""
+    wanted = conn.wanted_protocol()
+    advice = ""
+    if event.reason == RejectReason.PROTOCOL_VERSION_MISMATCH and wanted is not None:
+        advice = protocol_advice(wanted, conn.sent_protocol_version or "")
+    return LoginRejected(event.reason, event.text, advice, wanted)
