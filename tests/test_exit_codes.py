@@ -109,7 +109,7 @@ def sim() -> Iterator[SimThread]:
 
 
 def test_every_network_subcommand_is_covered() -> None:
-    from test_cli_contract import SUBPARSERS
+    from cli.test_cli_contract import SUBPARSERS
 
     offline = {"decode", "mapinfo", "replay", "sim"}
     assert set(SUBPARSERS.choices) == set(NETWORK_ARGS) | offline

@@ -129,7 +129,7 @@ OBSERVERS = (
 )
 """Each against the simulator that offers everything it looks at (routes, say, dock … or a camera)."""
 OPERATORS = {"drive", "goto", "home", "dock", "localize", "patrol", "run"}
-"""Subcommands that may command motion (a test of their own stops lives in test_nav_cli / test_cli)."""
+"""Subcommands that may command motion (a test of their own stops lives in tests/cli/test_nav_cli.py)."""
 OPERATOR_WITH = {"why": "--fix", "call": "--yes"}
 """Observers that become operators only with this option (a fix may send stop; a confirmed call may
 be a motion request): the option is the operator's explicit yes."""

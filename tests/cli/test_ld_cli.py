@@ -8,6 +8,7 @@ from collections.abc import Iterator
 
 import pytest
 
+from client.uiqueue import eventually
 from rtmu.base.exit_codes import EXIT_OK, EXIT_UNSUPPORTED, EXIT_USAGE
 from rtmu.cli import main
 from rtmu.client import ld_data
@@ -15,8 +16,6 @@ from rtmu.client.connection import AriaClient
 from rtmu.package_data import project_map
 from rtmu.sim import SimConfig, SimThread
 from rtmu.sim.ld_data import ROUTES, ld_state
-
-from .uiqueue import eventually
 
 OFFICE = project_map("office.map")
 

@@ -16,6 +16,9 @@ from collections.abc import Iterator
 
 import pytest
 
+from client.navsim import OFFICE, fast_sim, reset, robot
+from client.servers import SPECS, ServerThread, TestServer
+from client.uiqueue import eventually
 from rtmu.base.exit_codes import EXIT_OK, EXIT_TIMEOUT, EXIT_UNSUPPORTED, EXIT_USAGE
 from rtmu.cli import main
 from rtmu.protocol.payloads.robot import ModeInfo
@@ -23,10 +26,6 @@ from rtmu.sim import SimConfig, SimThread
 from rtmu.sim.ld_data import ld_state
 from rtmu.sim.profiles import PROFILES, SimProfile
 from rtmu.subcommands._navigate import EXIT_NAV_CANCELLED, EXIT_NAV_FAILED, EXIT_NAV_LOST
-
-from .navsim import OFFICE, fast_sim, reset, robot
-from .servers import SPECS, ServerThread, TestServer
-from .uiqueue import eventually
 
 
 @pytest.fixture(scope="module")

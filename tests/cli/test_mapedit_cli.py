@@ -12,6 +12,8 @@ from collections.abc import Iterator
 
 import pytest
 
+from client.servers import MAP_LINES, SPECS, ServerSide, ServerThread, TestServer
+from client.uiqueue import UiQueue
 from rtmu.base.exit_codes import EXIT_CONNECTION, EXIT_OK, EXIT_TIMEOUT, EXIT_UNSUPPORTED, EXIT_USAGE
 from rtmu.cli import main
 from rtmu.client.runner import ClientRunner
@@ -30,9 +32,6 @@ from rtmu.protocol.payloads.mapchange import (
 from rtmu.protocol.payloads.server import IdleProcessingPending
 from rtmu.sim import SimConfig, SimThread
 from rtmu.subcommands.mapedit import EXIT_NOT_HELD, EXIT_REFUSED
-
-from .servers import MAP_LINES, SPECS, ServerSide, ServerThread, TestServer
-from .uiqueue import UiQueue
 
 
 @pytest.fixture

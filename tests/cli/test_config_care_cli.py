@@ -9,6 +9,8 @@ from pathlib import Path
 
 import pytest
 
+from client.servers import SPECS, ServerThread, TestServer
+from client.uiqueue import UiQueue, eventually
 from rtmu.base.exit_codes import EXIT_CONNECTION, EXIT_OK, EXIT_UNSUPPORTED, EXIT_USAGE
 from rtmu.cli import main
 from rtmu.client.config_file import ConfigFileError, read_file
@@ -19,9 +21,6 @@ from rtmu.protocol.payloads.config import ConfigParam, ConfigSectionPacket, Para
 from rtmu.protocol.payloads.configcare import ConfigDefaults
 from rtmu.sim import SimConfig, SimThread
 from rtmu.subcommands.config import EXIT_REFUSED
-
-from .servers import SPECS, ServerThread, TestServer
-from .uiqueue import UiQueue, eventually
 
 
 @pytest.fixture

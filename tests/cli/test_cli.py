@@ -12,6 +12,9 @@ from pathlib import Path
 
 import pytest
 
+from client.servers import SPECS, ServerThread, TestServer
+from client.test_connection import free_port
+from client.uiqueue import eventually
 from rtmu import mapfile as maps
 from rtmu.base.exit_codes import (
     EXIT_CONNECTION,
@@ -26,10 +29,6 @@ from rtmu.cli import main
 from rtmu.package_data import project_map
 from rtmu.sim import SimConfig, SimThread
 from rtmu.subcommands._common import host_port
-
-from .servers import SPECS, ServerThread, TestServer
-from .test_connection import free_port
-from .uiqueue import eventually
 
 ARENA = project_map("arena.map")
 STATUS_KEYS = {"x", "y", "th", "vel", "rot_vel", "battery_v", "status", "mode"}

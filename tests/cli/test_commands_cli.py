@@ -9,13 +9,12 @@ from collections.abc import Iterator
 
 import pytest
 
+from client.servers import SPECS, ServerThread, TestServer
 from rtmu.base.exit_codes import EXIT_OK, EXIT_TIMEOUT, EXIT_UNSUPPORTED, EXIT_USAGE
 from rtmu.cli import main
 from rtmu.client.health import PING_CANDIDATES
 from rtmu.protocol.payloads.commands import CommandEntry, CommandList
 from rtmu.sim import SimConfig, SimThread
-
-from .servers import SPECS, ServerThread, TestServer
 
 
 @pytest.fixture(scope="module")

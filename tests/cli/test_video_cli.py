@@ -10,12 +10,11 @@ from collections.abc import Iterator
 import pytest
 from PIL import Image
 
+from client.servers import ServerSide, ServerThread, TestServer
 from rtmu.base.exit_codes import EXIT_CONNECTION, EXIT_OK
 from rtmu.cli import main
 from rtmu.package_data import project_map
 from rtmu.sim import SimConfig, SimThread
-
-from .servers import ServerSide, ServerThread, TestServer
 
 ARENA = project_map("arena.map")
 SUMMARY_KEYS = {"frames", "fps", "kbps", "width", "height", "age_ms_p50", "age_ms_p95"}

@@ -7,13 +7,12 @@ from collections.abc import Iterator
 
 import pytest
 
+from client.drawing_servers import MARKUP, MAX_POINTS_SENT, hostile_drawing_server
+from client.servers import SPECS, ServerThread, TestServer
 from rtmu.base.exit_codes import EXIT_OK, EXIT_UNSUPPORTED
 from rtmu.cli import main
 from rtmu.package_data import project_map
 from rtmu.sim import SimConfig, SimThread
-
-from .drawing_servers import MARKUP, MAX_POINTS_SENT, hostile_drawing_server
-from .servers import SPECS, ServerThread, TestServer
 
 ARENA = project_map("arena.map")
 
