@@ -4,7 +4,6 @@ from __future__ import annotations
 
 import json
 import os
-from collections.abc import Iterator
 from pathlib import Path
 
 import pytest
@@ -19,14 +18,11 @@ from rtmu.model.observables import RobotModel
 from rtmu.protocol.fields import FieldWriter
 from rtmu.protocol.payloads.config import ConfigParam, ConfigSectionPacket, ParamType, SetConfigReply
 from rtmu.protocol.payloads.configcare import ConfigDefaults
-from rtmu.sim import SimConfig, SimThread
+from rtmu.sim import SimThread
 from rtmu.subcommands.config import EXIT_REFUSED
+from simulators import simulator
 
-
-@pytest.fixture
-def sim() -> Iterator[SimThread]:
-    with SimThread(SimConfig(port=0)) as s:
-        yield s
+sim = simulator()
 
 
 def config(port: int, *argv: str) -> int:

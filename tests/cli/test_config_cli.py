@@ -4,7 +4,6 @@ from __future__ import annotations
 
 import asyncio
 import json
-from collections.abc import Iterator
 from pathlib import Path
 
 import pytest
@@ -20,12 +19,9 @@ from rtmu.client.runner import ClientRunner
 from rtmu.model.observables import RobotModel
 from rtmu.protocol.payloads.config import ConfigParam, ConfigSectionPacket, ParamType
 from rtmu.sim import SimConfig, SimThread
+from simulators import simulator
 
-
-@pytest.fixture
-def sim() -> Iterator[SimThread]:
-    with SimThread(SimConfig(port=0)) as s:
-        yield s
+sim = simulator()
 
 
 def addr(port: int) -> str:

@@ -8,7 +8,6 @@ from __future__ import annotations
 
 import asyncio
 import json
-from collections.abc import Iterator
 
 import pytest
 
@@ -30,14 +29,11 @@ from rtmu.protocol.payloads.mapchange import (
     MapChangeReply,
 )
 from rtmu.protocol.payloads.server import IdleProcessingPending
-from rtmu.sim import SimConfig, SimThread
+from rtmu.sim import SimThread
 from rtmu.subcommands.mapedit import EXIT_NOT_HELD, EXIT_REFUSED
+from simulators import simulator
 
-
-@pytest.fixture
-def sim() -> Iterator[SimThread]:
-    with SimThread(SimConfig(port=0, map_path=project_map("arena.map"))) as s:
-        yield s
+sim = simulator(map_path=project_map("arena.map"))
 
 
 def addr(port: int) -> str:

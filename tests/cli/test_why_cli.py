@@ -10,7 +10,6 @@ from __future__ import annotations
 
 import asyncio
 import json
-from collections.abc import Iterator
 from pathlib import Path
 
 import jsonschema
@@ -26,6 +25,7 @@ from rtmu.protocol.payloads.drive import RatioDrive
 from rtmu.sim import SimConfig, SimThread
 from rtmu.sim.ld_safety import safety_state
 from rtmu.subcommands.json_schemas import SCHEMAS
+from simulators import simulator
 
 USERS = """UserInfoVersion1
 user alice secret1 all
@@ -35,10 +35,7 @@ user viewer pw RobotInfo SensorInfo
 """
 
 
-@pytest.fixture
-def sim() -> Iterator[SimThread]:
-    with SimThread(SimConfig(port=0)) as s:
-        yield s
+sim = simulator()
 
 
 @pytest.fixture

@@ -41,6 +41,7 @@ from rtmu.protocol.motion import MOTION_REQUESTS
 from rtmu.protocol.payloads.drive import RatioDrive
 from rtmu.protocol.payloads.navigation import GotoGoal
 from rtmu.sim import SimConfig, SimThread
+from simulators import running
 
 from .navsim import OFFICE
 from .servers import SPECS, ServerThread, TestServer
@@ -188,8 +189,8 @@ class Navigation:
 @pytest.fixture(scope="module")
 def navigating() -> Iterator[dict[str, SimThread]]:
     with (
-        SimThread(SimConfig(port=0, map_path=OFFICE, seed=3, profile="aram")) as aram,
-        SimThread(SimConfig(port=0, map_path=OFFICE, seed=3)) as aria,
+        running(map_path=OFFICE, seed=3, profile="aram") as aram,
+        running(map_path=OFFICE, seed=3) as aria,
         Navigation(aram.port) as nav_aram,
         Navigation(aria.port) as nav_aria,
     ):
