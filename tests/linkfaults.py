@@ -139,7 +139,7 @@ class _Pipe:
                         self.cond.wait(0.1)
                 data = self.src.recv(READ_CHUNK)
                 if not data:
-                    self.ended = True
+                    self.ended = not self.done  # the peer's own close, not ours (reset, close)
                     break
                 self.put(data)
         except OSError:
