@@ -10,10 +10,14 @@ Put it between a client (the window, ``rtmu drive``) and a real server (the simu
         proxy.inject(FAKE_HEADER)          # bytes toward the client, in stream order
         proxy.reset()                      # RST to both ends (SO_LINGER 0)
 
+``FaultProxy(host, port, later_held=1.5)`` holds the server's bytes to every connection after the first
+for 1.5 s from its accept: a second login (the window's guardian, beside the window) comes late.
+
 Every fault method returns the ``time.monotonic()`` at which it took effect (``fault_at``), so a
 test or bench can measure how long the client took to react as seen by the server. Threads only
 (two per direction per connection, plus the acceptor); buffers are bounded (a full buffer stops
-reading, which is back-pressure as over TCP); :meth:`close` ends every thread within a second.
+reading, which is back-pressure as over TCP); a side that closes is seen closing once its last byte
+is through; :meth:`close` ends every thread within a second.
 
 Real Wi-Fi loses nothing a TCP stream can see, but holds it: 802.11 retries, background scans and
 contention stall a direction for tens to hundreds of ms now and then, and a lost segment costs a
@@ -84,8 +88,17 @@ PROFILES = {p.name: p for p in (GOOD_WIFI, BUSY_WIFI, LOSSY_WIFI)}
 class _Pipe:
     """One direction of one connection: a reader thread queues (due time, bytes), a writer sends them."""
 
-    def __init__(self, proxy: FaultProxy, direction: Direction, src: socket.socket, dst: socket.socket):
+    def __init__(
+        self,
+        proxy: FaultProxy,
+        direction: Direction,
+        src: socket.socket,
+        dst: socket.socket,
+        held_until: float = 0.0,
+    ):
         self.proxy = proxy
+        self.held_until = held_until
+        """This pipe's own hold (``time.monotonic()``), beside the proxy's for its direction."""
         self.direction = direction
         self.src = src
         self.dst = dst
@@ -93,6 +106,8 @@ class _Pipe:
         self.queued = 0
         self.cond = threading.Condition()
         self.done = False
+        self.ended = False
+        """The source closed its side (EOF): once every byte read is out, so does the destination."""
         self.threads = [
             threading.Thread(target=self._read, name=f"linkfaults-read-{direction}", daemon=True),
             threading.Thread(target=self._write, name=f"linkfaults-write-{direction}", daemon=True),
@@ -124,6 +139,7 @@ class _Pipe:
                         self.cond.wait(0.1)
                 data = self.src.recv(READ_CHUNK)
                 if not data:
+                    self.ended = not self.done  # the peer's own close, not ours (reset, close)
                     break
                 self.put(data)
         except OSError:
@@ -136,9 +152,12 @@ class _Pipe:
                 with self.cond:
                     while True:
                         if self.done and not self.queue:
+                            if self.ended:  # as TCP does: the peer's FIN after its last byte
+                                self.dst.shutdown(socket.SHUT_WR)
                             return
                         if self.queue and self.direction not in self.proxy.muted:
-                            due = max(self.queue[0][0], self.proxy.held_until[self.direction])
+                            held = max(self.proxy.held_until[self.direction], self.held_until)
+                            due = max(self.queue[0][0], held)
                             wait = due - time.monotonic()
                             if wait <= 0:
                                 _, data, clean = self.queue.popleft()
@@ -169,12 +188,14 @@ class _Pipe:
 
 
 class _Link:
-    def __init__(self, proxy: FaultProxy, client: socket.socket, server: socket.socket) -> None:
+    def __init__(
+        self, proxy: FaultProxy, client: socket.socket, server: socket.socket, held_until: float = 0.0
+    ) -> None:
         self.client = client
         self.server = server
         self.pipes = {
             TO_SERVER: _Pipe(proxy, TO_SERVER, client, server),
-            TO_CLIENT: _Pipe(proxy, TO_CLIENT, server, client),
+            TO_CLIENT: _Pipe(proxy, TO_CLIENT, server, client, held_until),
         }
 
     def close(self, *, rst: bool = False) -> None:
@@ -204,8 +225,13 @@ class _Link:
 class FaultProxy:
     """Listens on 127.0.0.1 (ephemeral port), forwards each connection to ``target``; see the module notes."""
 
-    def __init__(self, host: str, port: int, *, clock: Callable[[], float] = time.monotonic) -> None:
+    def __init__(
+        self, host: str, port: int, *, clock: Callable[[], float] = time.monotonic, later_held: float = 0.0
+    ) -> None:
         self.target = (host, port)
+        self.later_held = later_held
+        """Seconds the server's bytes to each connection after the first wait from its accept (its login
+        comes that much later; :meth:`restore` leaves this alone)."""
         self.clock = clock
         """Stamps :attr:`delivered_at` (a test passes the simulator's clock)."""
         self.delivered_at: dict[Direction, float | None] = {TO_CLIENT: None, TO_SERVER: None}
@@ -279,9 +305,12 @@ class FaultProxy:
                     return
                 self._links = [link for link in self._links if not all(p.done for p in link.pipes.values())]
                 # Counted before the link starts forwarding: a client whose echo came back must see it.
+                held_until = (
+                    time.monotonic() + self.later_held if self.connections and self.later_held else 0.0
+                )
                 self.connections += 1
                 self.server_ports.append(int(server.getsockname()[1]))
-                self._links.append(_Link(self, client, server))
+                self._links.append(_Link(self, client, server, held_until))
 
     def _applied(self) -> float:
         self._wake()

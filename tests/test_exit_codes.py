@@ -15,7 +15,6 @@ import socket
 import subprocess
 import sys
 import threading
-from collections.abc import Iterator
 from pathlib import Path
 
 import pytest
@@ -39,6 +38,7 @@ from rtmu.base.exit_codes import (
 from rtmu.cli import main
 from rtmu.package_data import project_map
 from rtmu.sim import SimConfig, SimThread
+from simulators import simulator
 
 REPO = Path(__file__).resolve().parents[1]
 ARENA = project_map("arena.map")
@@ -102,14 +102,11 @@ def free_port() -> int:
         return int(s.getsockname()[1])
 
 
-@pytest.fixture(scope="module")
-def sim() -> Iterator[SimThread]:
-    with SimThread(SimConfig(port=0, map_path=ARENA)) as s:
-        yield s
+sim = simulator(scope="module", map_path=ARENA)
 
 
 def test_every_network_subcommand_is_covered() -> None:
-    from test_cli_contract import SUBPARSERS
+    from cli.test_cli_contract import SUBPARSERS
 
     offline = {"decode", "mapinfo", "replay", "sim"}
     assert set(SUBPARSERS.choices) == set(NETWORK_ARGS) | offline

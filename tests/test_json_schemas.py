@@ -28,6 +28,7 @@ from rtmu.package_data import project_map
 from rtmu.sim import SimConfig, SimThread
 from rtmu.sim.central_thread import CentralThread
 from rtmu.subcommands.json_schemas import COMMAND_SCHEMA, SCHEMAS
+from simulators import running
 
 REPO = Path(__file__).resolve().parents[1]
 OFFICE = project_map("office.map")
@@ -76,8 +77,8 @@ RUNS: list[tuple[str, str, list[str]]] = [
 @pytest.fixture(scope="module")
 def sims() -> Iterator[dict[str, SimThread]]:
     with (
-        SimThread(SimConfig(port=0, map_path=OFFICE, profile="aram")) as aram,
-        SimThread(SimConfig(port=0, map_path=OFFICE)) as aria,
+        running(map_path=OFFICE, profile="aram") as aram,
+        running(map_path=OFFICE) as aria,
     ):
         yield {"aram": aram, "aria": aria}
 

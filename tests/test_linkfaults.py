@@ -70,6 +70,27 @@ def _quiet(sock: socket.socket, seconds: float = 0.3) -> bool:
     return False
 
 
+def test_a_side_that_closes_is_seen_closing_through_the_proxy(proxy: FaultProxy) -> None:
+    """The client's FIN reaches the echo server, which closes too: its FIN comes back (a client that
+    logs out is gone at the server, as over a plain link)."""
+    with _client(proxy) as sock:
+        sock.shutdown(socket.SHUT_WR)
+        assert sock.recv(16) == b""  # the server's close, within the socket's 5 s
+
+
+def test_later_held_holds_each_later_connection_and_never_the_first(proxy: FaultProxy) -> None:
+    proxy.later_held = 1.0
+    with (
+        _client(proxy) as first,  # the first flows at once (_client reads its echo)
+        socket.create_connection(("127.0.0.1", proxy.port), timeout=5) as later,
+    ):
+        later.sendall(b"hi")
+        assert _quiet(later, 0.5), "a later connection's bytes came before its hold ended"
+        first.sendall(b"go")
+        assert first.recv(16) == b"go", "the first connection was held too"
+        assert later.recv(16) == b"hi"  # then it flows (within recv's 5 s)
+
+
 @pytest.mark.parametrize("directions", [(TO_CLIENT,), (TO_SERVER,), (TO_CLIENT, TO_SERVER)])
 def test_mute_holds_bytes_and_restore_delivers_them_in_order(
     proxy: FaultProxy, directions: tuple[str, ...]

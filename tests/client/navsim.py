@@ -14,7 +14,8 @@ from contextlib import contextmanager
 from pathlib import Path
 
 from rtmu.package_data import project_map
-from rtmu.sim import SimConfig, SimThread
+from rtmu.sim import SimThread
+from simulators import running
 
 OFFICE = project_map("office.map")
 STEP = 0.05
@@ -46,7 +47,7 @@ class FastClock:
 @contextmanager
 def fast_sim(map_path: Path = OFFICE, **config: object) -> Iterator[SimThread]:
     """``with fast_sim() as sim:`` an office-map simulator whose clock runs fast."""
-    with SimThread(SimConfig(port=0, realtime=False, map_path=map_path, **config)) as sim:  # type: ignore[arg-type]
+    with running(realtime=False, map_path=map_path, **config) as sim:
         clock = FastClock(sim)
         clock.start()
         try:

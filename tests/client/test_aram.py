@@ -9,7 +9,6 @@ from __future__ import annotations
 import asyncio
 import json
 import socket
-from collections.abc import Iterator
 from pathlib import Path
 
 import pytest
@@ -23,24 +22,17 @@ from rtmu.package_data import project_map
 from rtmu.protocol.payloads.robot import BatteryInfo
 from rtmu.sim import SimConfig, SimThread
 from rtmu.sim.profiles import ARAM, ARAM_PROTOCOL
+from simulators import simulator
 
 OFFICE = project_map("office.map")
 ARAM_COUNT = len(ARAM.catalogue(camera=True))
 """The aram profile lists only what 6MTX robots list (and what the simulator serves of it)."""
 
 
-@pytest.fixture(scope="module")
-def aram() -> Iterator[SimThread]:
-    with SimThread(SimConfig(port=0, profile="aram", map_path=OFFICE)) as s:
-        yield s
+aram = simulator(scope="module", profile="aram", map_path=OFFICE)
 
 
-@pytest.fixture(scope="module")
-def plain(tmp_path_factory: pytest.TempPathFactory) -> Iterator[SimThread]:
-    users = tmp_path_factory.mktemp("users") / "users.txt"
-    users.write_text("UserInfoVersion1\nuser alice secret1 all\n")
-    with SimThread(SimConfig(port=0, users_path=users)) as s:
-        yield s
+plain = simulator(scope="module", users=("alice secret1 all",))
 
 
 def addr(sim: SimThread) -> str:

@@ -33,7 +33,7 @@ from rtmu.model.observables import (
     RobotModel,
 )
 from rtmu.package_data import project_map
-from rtmu.sim import SimConfig, SimThread
+from rtmu.sim import SimThread
 from rtmu.values.commission import ScanState
 from rtmu.values.intents import (
     ApplyMapChanges,
@@ -53,6 +53,7 @@ from rtmu.values.intents import (
     UploadFile,
 )
 from rtmu.values.state import StateChange, TransfersChanged
+from simulators import running
 
 from .fakeclock import FakeClock
 from .fakes import FakeView, RecordingLink
@@ -89,7 +90,7 @@ def files(tmp_path: Path) -> Path:
 
 @pytest.fixture
 def sim(files: Path) -> Iterator[SimThread]:
-    with SimThread(SimConfig(port=0, files_dir=files, map_path=project_map("office.map"))) as s:
+    with running(files_dir=files, map_path=project_map("office.map")) as s:
         yield s
 
 

@@ -7,7 +7,6 @@ never answers them.
 from __future__ import annotations
 
 import json
-from collections.abc import Iterator
 
 import pytest
 
@@ -20,16 +19,14 @@ from rtmu.package_data import project_map
 from rtmu.sim import SimConfig, SimThread
 from rtmu.sim.profiles import ARAM, DEFAULT
 from rtmu.values.intents import FetchConfig, SetConfig
+from simulators import simulator
 
 from .uiqueue import UiQueue
 
 OFFICE = project_map("office.map")
 
 
-@pytest.fixture(scope="module")
-def aram() -> Iterator[SimThread]:
-    with SimThread(SimConfig(port=0, profile="aram", map_path=OFFICE)) as s:
-        yield s
+aram = simulator(scope="module", profile="aram", map_path=OFFICE)
 
 
 def addr(port: int) -> str:

@@ -11,7 +11,6 @@ from __future__ import annotations
 
 import json
 import threading
-from collections.abc import Iterator
 
 import pytest
 
@@ -29,15 +28,12 @@ from rtmu.client.console import (
 from rtmu.client.console_reply import MAX_FIELDS_SHOWN
 from rtmu.protocol.fields import FieldWriter
 from rtmu.protocol.packet import encode_packet
-from rtmu.sim import SimConfig, SimThread
+from rtmu.sim import SimThread
+from simulators import simulator
 
 from .servers import SPECS, ServerSide, ServerThread, TestServer, run
 
-
-@pytest.fixture(scope="module")
-def sim() -> Iterator[SimThread]:
-    with SimThread(SimConfig(port=0, seed=3)) as s:
-        yield s
+sim = simulator(scope="module", seed=3)
 
 
 def addr(port: int) -> str:

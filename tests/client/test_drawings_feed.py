@@ -15,8 +15,9 @@ import pytest
 from rtmu.client.runner import ClientRunner
 from rtmu.model.observables import Phase, RobotModel
 from rtmu.package_data import project_map
-from rtmu.sim import SimConfig, SimThread
+from rtmu.sim import SimThread
 from rtmu.values.intents import DrawingChoices, ShowDrawing
+from simulators import simulator
 
 from .drawing_servers import BOLD_POINTS, MARKUP, MAX_POINTS_SENT, SONAR_POINTS, hostile_drawing_server
 from .servers import ServerThread
@@ -26,10 +27,7 @@ ARENA = project_map("arena.map")
 LASER = "sim_lms2xx_1Current"
 
 
-@pytest.fixture(scope="module")
-def sim() -> Iterator[SimThread]:
-    with SimThread(SimConfig(port=0, map_path=ARENA)) as s:
-        yield s
+sim = simulator(scope="module", map_path=ARENA)
 
 
 class Rig:

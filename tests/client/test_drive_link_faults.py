@@ -26,7 +26,8 @@ from rtmu.guardian.halt import IDENTIFIER
 from rtmu.package_data import project_map
 from rtmu.protocol.decoder import PacketDecoder
 from rtmu.protocol.packet import encode_packet
-from rtmu.sim import SimConfig, SimThread
+from rtmu.sim import SimThread
+from simulators import simulator
 
 from .uiqueue import eventually
 
@@ -38,10 +39,7 @@ resends until the fault is seen — at most 0.45 s of stale status (a new link's
 round trip); a blind drive sends ~10 a second until --seconds ends."""
 
 
-@pytest.fixture
-def sim() -> Iterator[SimThread]:
-    with SimThread(SimConfig(port=0, map_path=ARENA)) as s:
-        yield s
+sim = simulator(map_path=ARENA)
 
 
 STOP_AFTER_LAST_STATUS = 1.0

@@ -35,6 +35,7 @@ from rtmu.protocol.payloads.files import (
 )
 from rtmu.protocol.payloads.mapping import MappingEndReply
 from rtmu.sim import SimConfig, SimThread
+from simulators import running
 
 from .servers import run
 
@@ -51,7 +52,7 @@ def files(tmp_path: Path) -> Path:
 
 @pytest.fixture
 def sim(files: Path) -> Iterator[SimThread]:
-    with SimThread(SimConfig(port=0, files_dir=files, files_default_dir="maps")) as s:
+    with running(files_dir=files, files_default_dir="maps") as s:
         yield s
 
 

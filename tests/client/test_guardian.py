@@ -16,7 +16,6 @@ import signal
 import subprocess
 import sys
 import time
-from collections.abc import Iterator
 from pathlib import Path
 
 import pytest
@@ -32,6 +31,7 @@ from rtmu.guardian.shared import SeatState
 from rtmu.protocol.payloads.drive import RatioDrive
 from rtmu.protocol.payloads.server import SelfIdentifier
 from rtmu.sim import SimConfig, SimThread
+from simulators import simulator
 
 from .uiqueue import eventually
 
@@ -67,12 +67,7 @@ if sys.stdin.readline().strip() == "close":
 """
 
 
-@pytest.fixture
-def sim(tmp_path: Path) -> Iterator[SimThread]:
-    users = tmp_path / "users.txt"
-    users.write_text(f"UserInfoVersion1\nuser alice {PASSWORD} all\n")
-    with SimThread(SimConfig(port=0, seed=1, users_path=users)) as s:
-        yield s
+sim = simulator(seed=1, users=(f"alice {PASSWORD} all",))
 
 
 class Parent:

@@ -2,11 +2,12 @@
 
 A real driving process (``fleet_parent.py``: the window's fleet, controllers and one
 :class:`~rtmu.guardian.shared.SharedGuardian`, without GTK) drives real simulators over loopback. The
-guardian's own login is held back by a proxy (``SlowLogins``), so the window is connected well before
-its guardian is: exactly when a freeze used to go uncaught (the robot drove through it until ARIA's
-2 s watchdog). What is checked is what the simulators saw — who stopped the robot (the guardian's
-self identifier), that the watchdog did not have to, that no ``ratioDrive`` left before the guardian
-was armed — never how many ms anything took (``bench/bench_safety.py`` measures that).
+guardian's own login is held back by a proxy (``FaultProxy``'s ``later_held``), so the window is
+connected well before its guardian is: exactly when a freeze used to go uncaught (the robot drove
+through it until ARIA's 2 s watchdog). What is checked is what the simulators saw — who stopped the
+robot (the guardian's self identifier), that the watchdog did not have to, that no ``ratioDrive`` left
+before the guardian was armed — never how many ms anything took (``bench/bench_safety.py`` measures
+that).
 """
 
 from __future__ import annotations
@@ -20,10 +21,11 @@ from pathlib import Path
 
 import pytest
 
-from rtmu.guardian.halt import IDENTIFIER
-from rtmu.sim import SimConfig, SimThread
+from guardians import guardian_stops, guardians_of, logins
+from linkfaults import FaultProxy
+from rtmu.sim import SimThread
+from simulators import running
 
-from .slow_logins import SlowLogins
 from .uiqueue import eventually
 
 PARENT = Path(__file__).with_name("fleet_parent.py")
@@ -62,16 +64,8 @@ class Parent:
 
 @pytest.fixture
 def sims() -> Iterator[list[SimThread]]:
-    with SimThread(SimConfig(port=0, seed=1)) as one, SimThread(SimConfig(port=0, seed=2)) as two:
+    with running(seed=1) as one, running(seed=2) as two:
         yield [one, two]
-
-
-def guardian_stops(sim: SimThread) -> int:
-    return sum(1 for _t, _ident, who in sim.call(lambda: list(sim.server.stop_log)) if who == IDENTIFIER)
-
-
-def logins(sim: SimThread) -> int:
-    return len(sim.call(lambda: list(sim.server.sessions)))
 
 
 def drives(sim: SimThread) -> int:
@@ -82,27 +76,11 @@ def driving(sim: SimThread) -> bool:
     return abs(sim.snapshot().vel) > 1.0
 
 
-def guardians_of(pid: int) -> list[int]:
-    """Live guardian processes whose parent is ``pid``."""
-    found = []
-    for entry in Path("/proc").iterdir():
-        if not entry.name.isdigit():
-            continue
-        try:
-            ppid = int((entry / "stat").read_text().rsplit(")", 1)[1].split()[1])
-            cmdline = (entry / "cmdline").read_bytes()
-        except (OSError, ValueError, IndexError):
-            continue
-        if ppid == pid and b"rtmu.guardian" in cmdline:
-            found.append(int(entry.name))
-    return found
-
-
 def test_a_freeze_soon_after_connecting_is_caught_because_no_key_drives_before_the_guardian_is_armed(
     sims: list[SimThread],
 ) -> None:
     sim = sims[0]
-    with SlowLogins(sim.port, HOLD) as proxy:
+    with FaultProxy("127.0.0.1", sim.port, later_held=HOLD) as proxy:
         parent = Parent({"robot1": proxy.port})
         try:
             answer = parent.ask("press forward")  # the window is connected; its guardian not yet
@@ -126,7 +104,7 @@ def test_a_new_selection_arms_the_one_guardian_for_that_robot_before_it_drives_a
     sims: list[SimThread],
 ) -> None:
     first, second = sims
-    with SlowLogins(second.port, HOLD) as proxy:
+    with FaultProxy("127.0.0.1", second.port, later_held=HOLD) as proxy:
         parent = Parent({"robot1": first.port, "robot2": proxy.port})
         try:
             assert parent.ask("armed robot1") == "armed robot1"

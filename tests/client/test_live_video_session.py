@@ -3,9 +3,7 @@
 from __future__ import annotations
 
 import time
-from collections.abc import Iterator
-
-import pytest
+from typing import Any
 
 from rtmu.client.runner import ClientRunner
 from rtmu.client.session import SessionConfig
@@ -13,14 +11,19 @@ from rtmu.model.observables import CameraImage, Phase, RobotModel
 from rtmu.package_data import project_map
 from rtmu.sim import SimConfig, SimThread
 from rtmu.values.intents import StartVideo, StopVideo, VideoShown
+from simulators import simulator
 
 from .uiqueue import UiQueue
 
 ARENA = project_map("arena.map")
 
 
+TURNING_CAMERA: dict[str, Any] = {"map_path": ARENA, "camera_hz": 20.0, "drive_timeout": 0}
+"""Up to 20 new frames/s, and no drive watchdog to stop the robot that ``turn`` sets turning."""
+
+
 def sim_config(port: int = 0) -> SimConfig:
-    return SimConfig(port=port, map_path=ARENA, camera_hz=20.0, drive_timeout=0)
+    return SimConfig(port=port, **TURNING_CAMERA)
 
 
 def turn(sim: SimThread) -> None:
@@ -29,10 +32,7 @@ def turn(sim: SimThread) -> None:
     sim.call(lambda: world.ratio_drive(0, 40, 100))
 
 
-@pytest.fixture
-def sim() -> Iterator[SimThread]:
-    with SimThread(sim_config()) as s:
-        yield s
+sim = simulator(**TURNING_CAMERA)
 
 
 def start(port: int) -> tuple[ClientRunner, RobotModel, UiQueue, list[CameraImage]]:

@@ -41,6 +41,7 @@ from rtmu.protocol.motion import MOTION_REQUESTS
 from rtmu.protocol.payloads.drive import RatioDrive
 from rtmu.protocol.payloads.navigation import GotoGoal
 from rtmu.sim import SimConfig, SimThread
+from simulators import running
 
 from .navsim import OFFICE
 from .servers import SPECS, ServerThread, TestServer
@@ -129,7 +130,7 @@ OBSERVERS = (
 )
 """Each against the simulator that offers everything it looks at (routes, say, dock … or a camera)."""
 OPERATORS = {"drive", "goto", "home", "dock", "localize", "patrol", "run"}
-"""Subcommands that may command motion (a test of their own stops lives in test_nav_cli / test_cli)."""
+"""Subcommands that may command motion (a test of their own stops lives in tests/cli/test_nav_cli.py)."""
 OPERATOR_WITH = {"why": "--fix", "call": "--yes"}
 """Observers that become operators only with this option (a fix may send stop; a confirmed call may
 be a motion request): the option is the operator's explicit yes."""
@@ -188,8 +189,8 @@ class Navigation:
 @pytest.fixture(scope="module")
 def navigating() -> Iterator[dict[str, SimThread]]:
     with (
-        SimThread(SimConfig(port=0, map_path=OFFICE, seed=3, profile="aram")) as aram,
-        SimThread(SimConfig(port=0, map_path=OFFICE, seed=3)) as aria,
+        running(map_path=OFFICE, seed=3, profile="aram") as aram,
+        running(map_path=OFFICE, seed=3) as aria,
         Navigation(aram.port) as nav_aram,
         Navigation(aria.port) as nav_aria,
     ):

@@ -9,7 +9,6 @@ it whole; ``image`` writes what the file name asks for.
 from __future__ import annotations
 
 import socket
-from collections.abc import Iterator
 from pathlib import Path
 
 import pytest
@@ -18,16 +17,14 @@ from PIL import Image
 from rtmu.base.exit_codes import EXIT_OK, EXIT_UNSUPPORTED, EXIT_USAGE
 from rtmu.cli import main
 from rtmu.package_data import project_map
-from rtmu.sim import SimConfig, SimThread
+from rtmu.sim import SimThread
+from simulators import simulator
 
 REPO = Path(__file__).resolve().parents[2]
 ARENA = project_map("arena.map")
 
 
-@pytest.fixture(scope="module")
-def sim() -> Iterator[SimThread]:
-    with SimThread(SimConfig(port=0, map_path=ARENA)) as s:
-        yield s
+sim = simulator(scope="module", map_path=ARENA)
 
 
 def nowhere() -> str:

@@ -26,6 +26,7 @@ from rtmu.protocol.payloads.commands import CommandEntry, CommandList
 from rtmu.sim import SimConfig, SimThread
 from rtmu.values.intents import AnswerPopup, ListServerCommands, RunServerCommand
 from rtmu.values.state import PopupsChanged, StateChange
+from simulators import simulator
 
 from .uiqueue import UiQueue, eventually
 
@@ -59,10 +60,7 @@ class Rig:
         return [n.text for n in self.notices if n.kind is Kind.SERVER]
 
 
-@pytest.fixture(scope="module")
-def sim() -> Iterator[SimThread]:
-    with SimThread(SimConfig(port=0)) as s:
-        yield s
+sim = simulator(scope="module")
 
 
 @pytest.fixture

@@ -26,6 +26,7 @@ from rtmu.protocol.fields import FieldWriter
 from rtmu.protocol.payloads.camera import Camera, CameraCommand, CameraData, CameraInfo, CameraList
 from rtmu.sim import SimConfig, SimThread
 from rtmu.values.intents import PtzMove, WatchPtz
+from simulators import simulator
 
 from .servers import SPECS, ServerThread, TestServer
 from .uiqueue import UiQueue
@@ -54,10 +55,7 @@ class Rig:
         self.runner.close()
 
 
-@pytest.fixture(scope="module")
-def sim() -> Iterator[SimThread]:
-    with SimThread(SimConfig(port=0, map_path=OFFICE)) as s:
-        yield s
+sim = simulator(scope="module", map_path=OFFICE)
 
 
 @pytest.fixture

@@ -27,6 +27,7 @@ from typing import TYPE_CHECKING
 import pytest
 
 if TYPE_CHECKING:
+    from linkfaults import FaultProxy
     from rtmu.sim import SimThread
 
     from .harness import Gui
@@ -277,3 +278,23 @@ def gui(request: pytest.FixtureRequest, screenshots: Path, sim: SimThread) -> It
         yield g
     finally:
         g.close()
+
+
+@pytest.fixture
+def faulty_link(
+    request: pytest.FixtureRequest, screenshots: Path
+) -> Iterator[tuple[Gui, SimThread, FaultProxy]]:
+    """(window, simulator, proxy): the window connected to the office simulator through a
+    :class:`~linkfaults.FaultProxy` whose faults the test switches; Up is released at the end."""
+    from linkfaults import FaultProxy
+    from simulators import running
+
+    from .harness import OFFICE_MAP, Gui
+
+    with running(map_path=OFFICE_MAP, seed=1) as sim, FaultProxy("127.0.0.1", sim.port) as proxy:
+        g = Gui.start(screenshots, request.node.name, "127.0.0.1", proxy.port)
+        try:
+            yield g, sim, proxy
+        finally:
+            g.xdotool("keyup", "Up")
+            g.close()

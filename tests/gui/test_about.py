@@ -7,21 +7,15 @@ from __future__ import annotations
 import os
 import subprocess
 import sys
-from collections.abc import Iterator
-
-import pytest
 
 from rtmu import __version__
-from rtmu.sim import SimConfig, SimThread
+from rtmu.sim import SimThread
+from simulators import simulator
 
 from .harness import OFFICE_MAP, Gui, pump
 from .stop_paths import owned_windows
 
-
-@pytest.fixture
-def sim() -> Iterator[SimThread]:
-    with SimThread(SimConfig(port=0, map_path=OFFICE_MAP, camera=False, seed=1)) as s:
-        yield s
+sim = simulator(map_path=OFFICE_MAP, camera=False, seed=1)
 
 
 def test_about_shows_the_logo_reads_right_and_copies_the_debug_information(gui: Gui, sim: SimThread) -> None:

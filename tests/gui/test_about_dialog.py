@@ -3,29 +3,17 @@ MIT License" and a broken-image logo). Opened by its menu action; its pixels are
 
 from __future__ import annotations
 
-from collections.abc import Iterator
-from pathlib import Path
-
 import gi
-import pytest
+
+from simulators import simulator
 
 gi.require_version("Gdk", "4.0")
 gi.require_version("Gtk", "4.0")
 from gi.repository import Gdk, Gtk  # noqa: E402
 
-from rtmu.sim import SimConfig, SimThread  # noqa: E402
-
 from .harness import OFFICE_MAP, Gui, pump  # noqa: E402
 
-
-@pytest.fixture
-def gui(screenshots: Path) -> Iterator[Gui]:
-    with SimThread(SimConfig(port=0, map_path=OFFICE_MAP, camera=False, seed=1)) as sim:
-        gui = Gui.start(screenshots, "about", "127.0.0.1", sim.port)
-        try:
-            yield gui
-        finally:
-            gui.close()
+sim = simulator(map_path=OFFICE_MAP, camera=False, seed=1)
 
 
 def test_about_has_its_logo_and_says_its_licence_once(gui: Gui) -> None:

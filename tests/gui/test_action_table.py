@@ -9,16 +9,13 @@ Then a few keys go through the X server and their actions are seen to run, also 
 
 from __future__ import annotations
 
-from collections.abc import Iterator
-from pathlib import Path
 from xml.sax.saxutils import escape
 
 import gi
-import pytest
 
-from rtmu.sim import SimConfig, SimThread
 from rtmu.ui.keys import bindings, menu_accel
 from rtmu.ui.shortcuts import shortcuts_xml
+from simulators import simulator
 
 from .harness import OFFICE_MAP, Gui, pump
 from .stop_paths import menu_entries
@@ -26,15 +23,7 @@ from .stop_paths import menu_entries
 gi.require_version("Gtk", "4.0")
 from gi.repository import Gio, Gtk  # noqa: E402
 
-
-@pytest.fixture
-def gui(screenshots: Path) -> Iterator[Gui]:
-    with SimThread(SimConfig(port=0, map_path=OFFICE_MAP, seed=1)) as sim:
-        gui = Gui.start(screenshots, "action-table", "127.0.0.1", sim.port)
-        try:
-            yield gui
-        finally:
-            gui.close()
+sim = simulator(map_path=OFFICE_MAP, seed=1)
 
 
 def action_of(gui: Gui, detailed: str) -> Gio.Action | None:

@@ -4,13 +4,10 @@ camera page (its own pill) neither."""
 
 from __future__ import annotations
 
-from collections.abc import Callable, Iterator
-from pathlib import Path
-
-import pytest
+from collections.abc import Callable
 
 from rtmu.base.notices import Kind, Notice
-from rtmu.sim import SimConfig, SimThread
+from simulators import simulator
 
 from .harness import OFFICE_MAP, Gui, idle, pump
 
@@ -18,14 +15,7 @@ SIZES = ((360, 720), (800, 480), (1280, 800))
 LONG = "The server says something long enough to wrap onto a second line of the banner, as servers do"
 
 
-@pytest.fixture
-def gui(screenshots: Path) -> Iterator[Gui]:
-    with SimThread(SimConfig(port=0, map_path=OFFICE_MAP, camera=True, seed=1)) as sim:
-        gui = Gui.start(screenshots, "banner-layout", "127.0.0.1", sim.port)
-        try:
-            yield gui
-        finally:
-            gui.close()
+sim = simulator(map_path=OFFICE_MAP, camera=True, seed=1)
 
 
 def _bounds(gui: Gui, widget: object) -> tuple[float, float, float, float]:

@@ -7,30 +7,11 @@ between the window and the simulator; keys are real (xdotool).
 
 from __future__ import annotations
 
-from collections.abc import Iterator
-from pathlib import Path
-
-import pytest
-
 from linkfaults import TO_CLIENT, FaultProxy
 from rtmu.model.observables import LinkLevel, Phase
-from rtmu.sim import SimConfig, SimThread
+from rtmu.sim import SimThread
 
-from .harness import OFFICE_MAP, Gui, pump
-
-
-@pytest.fixture
-def rig(screenshots: Path) -> Iterator[tuple[Gui, SimThread, FaultProxy]]:
-    with (
-        SimThread(SimConfig(port=0, map_path=OFFICE_MAP, seed=1)) as sim,
-        FaultProxy("127.0.0.1", sim.port) as proxy,
-    ):
-        gui = Gui.start(screenshots, "banners-truthful", "127.0.0.1", proxy.port)
-        try:
-            yield gui, sim, proxy
-        finally:
-            gui.xdotool("keyup", "Up")
-            gui.close()
+from .harness import Gui, pump
 
 
 def _hold_up_until_driving(gui: Gui, sim: SimThread) -> None:
@@ -48,8 +29,10 @@ def _link_banner(gui: Gui) -> str:
     return gui.window.banners.text("link") or ""
 
 
-def test_a_link_stop_banner_goes_once_the_link_is_healthy(rig: tuple[Gui, SimThread, FaultProxy]) -> None:
-    gui, sim, proxy = rig
+def test_a_link_stop_banner_goes_once_the_link_is_healthy(
+    faulty_link: tuple[Gui, SimThread, FaultProxy],
+) -> None:
+    gui, sim, proxy = faulty_link
     _hold_up_until_driving(gui, sim)
     proxy.mute(TO_CLIENT)  # no status comes: the link goes stale, the window stops the robot
     pump(lambda: _link_banner(gui).startswith("Stopped: the link"), 5, "the link stop's banner")

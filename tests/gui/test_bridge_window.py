@@ -8,24 +8,20 @@ window. Unchecking it ends the server.
 
 from __future__ import annotations
 
-from collections.abc import Iterator
-
 import pytest
 
 from recorder.foxglove_client import FoxgloveClient
 from recorder.poses import _position
 from rtmu.recorder import topics
-from rtmu.sim import SimConfig, SimThread
+from rtmu.sim import SimThread
+from simulators import simulator
 
 from .harness import OFFICE_MAP, Gui, idle, pump
 
 pytestmark = pytest.mark.gui
 
 
-@pytest.fixture
-def sim() -> Iterator[SimThread]:
-    with SimThread(SimConfig(port=0, map_path=OFFICE_MAP, camera=False, seed=1)) as s:
-        yield s
+sim = simulator(map_path=OFFICE_MAP, camera=False, seed=1)
 
 
 def test_the_window_serves_its_robot_to_foxglove_and_never_lets_it_drive(gui: Gui, sim: SimThread) -> None:

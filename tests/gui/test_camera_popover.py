@@ -4,26 +4,14 @@ are looked at."""
 
 from __future__ import annotations
 
-from collections.abc import Iterator
-from pathlib import Path
-
 import numpy as np
-import pytest
 from PIL import Image
 
-from rtmu.sim import SimConfig, SimThread
+from simulators import simulator
 
 from .harness import OFFICE_MAP, Gui, pump
 
-
-@pytest.fixture
-def gui(screenshots: Path) -> Iterator[Gui]:
-    with SimThread(SimConfig(port=0, map_path=OFFICE_MAP, camera=True, seed=1)) as sim:
-        gui = Gui.start(screenshots, "camera-popover", "127.0.0.1", sim.port)
-        try:
-            yield gui
-        finally:
-            gui.close()
+sim = simulator(map_path=OFFICE_MAP, camera=True, seed=1)
 
 
 def test_the_gear_popover_is_dark_with_light_words(gui: Gui) -> None:

@@ -10,8 +10,8 @@ from typing import ClassVar
 import pytest
 
 from rtmu.control.commands import COMMANDS, Command, CommandTarget
-from rtmu.sim import SimConfig, SimThread
 from rtmu.ui.shortcuts import shortcuts_xml
+from simulators import running
 
 from .harness import OFFICE_MAP, Gui, pump
 
@@ -36,7 +36,7 @@ def gui(screenshots: Path) -> Iterator[Gui]:
     COMMANDS.register(Wave)
     Wave.ran.clear()
     try:
-        with SimThread(SimConfig(port=0, map_path=OFFICE_MAP, seed=1)) as sim:
+        with running(map_path=OFFICE_MAP, seed=1) as sim:
             gui = Gui.start(screenshots, "command-registry", "127.0.0.1", sim.port)
             try:
                 yield gui

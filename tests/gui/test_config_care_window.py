@@ -9,16 +9,15 @@ naming a parameter the server lacks refused whole, nothing sent.
 
 from __future__ import annotations
 
-from collections.abc import Iterator
 from pathlib import Path
 
 import gi
-import pytest
 
 from rtmu.client.config_file import FORMAT
-from rtmu.sim import SimConfig, SimThread
+from rtmu.sim import SimThread
 from rtmu.ui.config_care_view import DefaultsWindow
 from rtmu.ui.config_page import ConfigPage
+from simulators import simulator
 
 from .harness import Gui, idle, pump, scratch_dir
 
@@ -28,11 +27,7 @@ from gi.repository import Gtk  # noqa: E402
 from .stop_paths import owned_windows  # noqa: E402
 from .test_config_page import answer, click, open_page, type_into  # noqa: E402
 
-
-@pytest.fixture
-def sim() -> Iterator[SimThread]:
-    with SimThread(SimConfig(port=0, map_path=None, camera=False, seed=1)) as s:
-        yield s
+sim = simulator(map_path=None, camera=False, seed=1)
 
 
 def timeout(sim: SimThread) -> float:

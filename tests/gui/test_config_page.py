@@ -9,11 +9,9 @@ priority filter, keys typed in the page not driving the robot, and a hostile con
 
 from __future__ import annotations
 
-from collections.abc import Iterator
 from pathlib import Path
 
 import numpy as np
-import pytest
 from PIL import Image
 
 from rtmu.client.config_feed import set_config
@@ -23,14 +21,11 @@ from rtmu.protocol.payloads.config import ParamType
 from rtmu.sim import SimConfig, SimThread
 from rtmu.sim.arconfig import FILLER_CONTROL_SECTION
 from rtmu.ui.config_page import PAGE_SIZE, ConfigPage
+from simulators import simulator
 
 from .harness import Gui, LoopProbe, idle, pump, scratch_dir
 
-
-@pytest.fixture
-def sim() -> Iterator[SimThread]:
-    with SimThread(SimConfig(port=0, map_path=None, camera=False, seed=1)) as s:
-        yield s
+sim = simulator(map_path=None, camera=False, seed=1)
 
 
 def page(gui: Gui) -> ConfigPage | None:
@@ -309,10 +304,7 @@ def test_the_priority_filter_hides_expert_parameters(gui: Gui, sim: SimThread) -
     gui.shot("factory")
 
 
-@pytest.fixture
-def hostile() -> Iterator[SimThread]:
-    with SimThread(SimConfig(port=0, map_path=None, camera=False, config_filler=10_000)) as s:
-        yield s
+hostile = simulator(map_path=None, camera=False, config_filler=10_000)
 
 
 def test_ten_thousand_parameters_with_markup_open_bounded_and_responsive(

@@ -11,15 +11,13 @@ keeps running.
 
 from __future__ import annotations
 
-from collections.abc import Iterator
 from pathlib import Path
-
-import pytest
 
 from client.servers import ServerThread
 from client.test_console import FLOOD_PACKETS, hostile_server
-from rtmu.sim import SimConfig, SimThread
+from rtmu.sim import SimThread
 from rtmu.ui.console_page import MAX_LINES, ConsolePage
+from simulators import simulator
 
 from .harness import Gui, LoopProbe, idle, pump
 from .stop_paths import MenuEntry, MenuPicker, owned_windows
@@ -28,10 +26,7 @@ from .test_config_page import click, type_into
 CONSOLE_ROW = MenuEntry(("Server",), "Console…", "win.console")
 
 
-@pytest.fixture
-def sim() -> Iterator[SimThread]:
-    with SimThread(SimConfig(port=0, map_path=None, camera=False, seed=1)) as s:
-        yield s
+sim = simulator(map_path=None, camera=False, seed=1)
 
 
 def stops(sim: SimThread) -> int:

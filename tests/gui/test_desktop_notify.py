@@ -13,7 +13,8 @@ from collections.abc import Iterator
 
 import pytest
 
-from rtmu.sim import SimConfig, SimThread
+from rtmu.sim import SimThread
+from simulators import simulator
 
 from .desktop_side import Desktop, fake_desktop
 from .harness import OFFICE_MAP, Gui, idle, pump
@@ -25,10 +26,7 @@ def desktop() -> Iterator[Desktop]:
         yield d
 
 
-@pytest.fixture
-def sim() -> Iterator[SimThread]:
-    with SimThread(SimConfig(port=0, map_path=OFFICE_MAP, camera=False, seed=1)) as s:
-        yield s
+sim = simulator(map_path=OFFICE_MAP, camera=False, seed=1)
 
 
 def popup(sim: SimThread, title: str) -> None:

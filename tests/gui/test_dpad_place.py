@@ -16,7 +16,8 @@ from pathlib import Path
 import gi
 import pytest
 
-from rtmu.sim import SimConfig, SimThread
+from rtmu.sim import SimThread
+from simulators import running
 
 from .harness import OFFICE_MAP, Gui, idle, on_display, pump
 from .stop_paths import MenuPicker, StopCycle, menu_entries
@@ -30,7 +31,7 @@ Rect = tuple[float, float, float, float]
 @pytest.fixture
 def small(screenshots: Path, small_screen: str) -> Iterator[tuple[Gui, SimThread]]:
     with (
-        SimThread(SimConfig(port=0, map_path=OFFICE_MAP, camera=True, seed=1)) as sim,
+        running(map_path=OFFICE_MAP, camera=True, seed=1) as sim,
         on_display(small_screen),
     ):
         gui = Gui.start(screenshots, "dpad-place", "127.0.0.1", sim.port)

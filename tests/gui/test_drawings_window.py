@@ -11,15 +11,14 @@ count is named, and a flood of 3 998-point samples every 20 ms leaves the window
 from __future__ import annotations
 
 import time
-from collections.abc import Iterator
 
 import numpy as np
-import pytest
 
 from client.drawing_servers import MARKUP, hostile_drawing_server
 from client.servers import ServerThread
-from rtmu.sim import SimConfig, SimThread
+from rtmu.sim import SimThread
 from rtmu.ui.options import GuiOptions
+from simulators import simulator
 
 from .harness import OFFICE_MAP, Gui, LoopProbe, idle, pump, scratch_dir
 
@@ -27,10 +26,7 @@ LASER, SONAR = "sim_lms2xx_1Current", "sonarCurrent"
 BLUE, SKY = (0, 0, 255), (0x33, 0xCC, 0xFF)
 
 
-@pytest.fixture
-def sim() -> Iterator[SimThread]:
-    with SimThread(SimConfig(port=0, map_path=OFFICE_MAP, camera=False, seed=1)) as s:
-        yield s
+sim = simulator(map_path=OFFICE_MAP, camera=False, seed=1)
 
 
 def layer(gui: Gui, name: str):  # type: ignore[no-untyped-def]

@@ -20,6 +20,7 @@ from rtmu.sim import SimConfig, SimThread
 from rtmu.ui.confirm import Confirm
 from rtmu.ui.files_page import FilesPage
 from rtmu.values.commission import Direction, Transfer, TransfersState
+from simulators import running
 
 from .harness import Gui, LoopProbe, idle, pump, scratch_dir
 from .stop_paths import StopCycle, owned_windows
@@ -40,7 +41,7 @@ def robot_files() -> Path:
 
 @pytest.fixture
 def sim(robot_files: Path) -> Iterator[SimThread]:
-    with SimThread(SimConfig(port=0, map_path=project_map("office.map"), files_dir=robot_files, seed=1)) as s:
+    with running(map_path=project_map("office.map"), files_dir=robot_files, seed=1) as s:
         yield s
 
 

@@ -19,7 +19,8 @@ from rtmu.client.session import SessionConfig
 from rtmu.fleet.sessions import RobotSession
 from rtmu.model.observables import Phase
 from rtmu.settings.store import Profile
-from rtmu.sim import SimConfig, SimThread
+from rtmu.sim import SimThread
+from simulators import running
 
 from .harness import OFFICE_MAP, Gui, pump
 
@@ -35,8 +36,8 @@ def watchdog_stops(sim: SimThread) -> int:
 @pytest.fixture
 def sims() -> Iterator[tuple[SimThread, SimThread]]:
     with (
-        SimThread(SimConfig(port=0, map_path=OFFICE_MAP, seed=1)) as shown,
-        SimThread(SimConfig(port=0, map_path=OFFICE_MAP, seed=2)) as other,
+        running(map_path=OFFICE_MAP, seed=1) as shown,
+        running(map_path=OFFICE_MAP, seed=2) as other,
     ):
         yield shown, other
 

@@ -2,13 +2,9 @@
 
 from __future__ import annotations
 
-from collections.abc import Iterator
-from pathlib import Path
-
 import gi
-import pytest
 
-from rtmu.sim import SimConfig, SimThread
+from simulators import simulator
 
 from .harness import OFFICE_MAP, Gui, pump
 
@@ -16,15 +12,7 @@ gi.require_version("Gtk", "4.0")
 gi.require_version("GdkX11", "4.0")
 from gi.repository import GdkX11, Gtk  # noqa: E402
 
-
-@pytest.fixture
-def gui(request: pytest.FixtureRequest, screenshots: Path) -> Iterator[Gui]:
-    with SimThread(SimConfig(port=0, map_path=OFFICE_MAP, seed=1)) as sim:
-        g = Gui.start(screenshots, request.node.name, "127.0.0.1", sim.port)
-        try:
-            yield g
-        finally:
-            g.close()
+sim = simulator(map_path=OFFICE_MAP, seed=1)
 
 
 def test_a_release_after_focus_returns_is_real_and_the_next_press_drives(gui: Gui) -> None:

@@ -6,13 +6,12 @@ narrows to a beam."""
 from __future__ import annotations
 
 import math
-from collections.abc import Iterator
 
 import numpy as np
-import pytest
 
-from rtmu.sim import SimConfig, SimThread
+from rtmu.sim import SimThread
 from rtmu.ui.fov_draw import MIN_RANGE_PX, RANGE_MM
+from simulators import simulator
 
 from .harness import OFFICE_MAP, Gui, idle, pump
 
@@ -22,10 +21,7 @@ ZOOMS = 10
 """Page Up presses: 10 % each, so the head is at full zoom (a 4° view)."""
 
 
-@pytest.fixture
-def sim() -> Iterator[SimThread]:
-    with SimThread(SimConfig(port=0, map_path=OFFICE_MAP, camera=True, seed=1)) as s:
-        yield s
+sim = simulator(map_path=OFFICE_MAP, camera=True, seed=1)
 
 
 def head(sim: SimThread) -> tuple[float, float, float]:

@@ -14,7 +14,8 @@ from pathlib import Path
 import gi
 import pytest
 
-from rtmu.sim import SimConfig, SimThread
+from rtmu.sim import SimThread
+from simulators import running
 
 from .harness import OFFICE_MAP, Gui, on_display, pump
 from .stop_paths import StopCycle
@@ -27,7 +28,7 @@ from gi.repository import Gtk  # noqa: E402
 @pytest.fixture
 def wm_gui(screenshots: Path, wm_display: dict[str, str]) -> Iterator[tuple[Gui, SimThread]]:  # noqa: F811
     with (
-        SimThread(SimConfig(port=0, map_path=OFFICE_MAP, camera=True, seed=1)) as sim,
+        running(map_path=OFFICE_MAP, camera=True, seed=1) as sim,
         on_display(wm_display["DISPLAY"]),
     ):
         gui = Gui.start(screenshots, "fullscreen-buttons", "127.0.0.1", sim.port)

@@ -17,16 +17,12 @@ from pathlib import Path
 
 import pytest
 
-from rtmu.guardian.halt import IDENTIFIER
+from guardians import guardian_stops, guardians_of, logins
 from rtmu.settings.store import DirectRobot, Profile, Settings, save_settings
 from rtmu.sim import SimConfig, SimThread
 
 from .harness import OFFICE_MAP
 from .process import connect_and_hold_up, subscribed, wait, xdotool
-
-
-def guardian_stops(sim: SimThread) -> int:
-    return sum(1 for _t, _ident, who in sim.call(lambda: list(sim.server.stop_log)) if who == IDENTIFIER)
 
 
 @pytest.mark.parametrize("signum", [signal.SIGKILL, signal.SIGSTOP], ids=["SIGKILL", "SIGSTOP"])
@@ -45,7 +41,7 @@ def test_a_killed_or_frozen_window_is_stopped_by_its_guardian(signum: int, tmp_p
             connect_and_hold_up(proc, sim)
             held = True
             # The guardian logged in beside the window (two sessions), and has stopped nothing yet.
-            wait(lambda: len(sim.call(lambda: list(sim.server.sessions))) == 2, 10, "the guardian's login")
+            wait(lambda: logins(sim) == 2, 10, "the guardian's login")
             assert guardian_stops(sim) == 0
             watchdog = sim.call(lambda: sim.server.robot.watchdog_stops)
             proc.send_signal(signum)
@@ -60,26 +56,7 @@ def test_a_killed_or_frozen_window_is_stopped_by_its_guardian(signum: int, tmp_p
                 proc.kill()
             proc.wait(5)
         # With the window gone its guardian leaves too (EOF on its pipe).
-        wait(lambda: not sim.call(lambda: list(sim.server.sessions)), 10, "the guardian to log out")
-
-
-def logins(sim: SimThread) -> int:
-    return len(sim.call(lambda: list(sim.server.sessions)))
-
-
-def _guardians_of(pid: int) -> list[int]:
-    found = []
-    for entry in Path("/proc").iterdir():
-        if not entry.name.isdigit():
-            continue
-        try:
-            ppid = int((entry / "stat").read_text().rsplit(")", 1)[1].split()[1])
-            cmdline = (entry / "cmdline").read_bytes()
-        except (OSError, ValueError, IndexError):
-            continue
-        if ppid == pid and b"rtmu.guardian" in cmdline:
-            found.append(int(entry.name))
-    return found
+        wait(lambda: logins(sim) == 0, 10, "the guardian to log out")
 
 
 @pytest.mark.parametrize("signum", [signal.SIGKILL, signal.SIGSTOP], ids=["SIGKILL", "SIGSTOP"])
@@ -110,9 +87,9 @@ def test_a_fleet_window_killed_or_frozen_is_stopped_by_its_one_guardian_at_the_s
             wait(lambda: subscribed(one) and subscribed(two), 20, "both robots connected")
             xdotool("windowfocus", "--sync", window)
             xdotool("key", "alt+2")  # robot2: the guardian leaves robot1 for it
-            wait(lambda: len(two.call(lambda: list(two.server.sessions))) == 2, 15, "the guardian at robot2")
+            wait(lambda: logins(two) == 2, 15, "the guardian at robot2")
             wait(
-                lambda: len(one.call(lambda: list(one.server.sessions))) == 1,
+                lambda: logins(one) == 1,
                 15,
                 "the guardian to leave robot1",
             )
@@ -126,7 +103,7 @@ def test_a_fleet_window_killed_or_frozen_is_stopped_by_its_one_guardian_at_the_s
                     xdotool("keyup", "Up")
                     held = False
             assert held, "robot2 never drove"
-            assert _guardians_of(proc.pid) != [] and len(_guardians_of(proc.pid)) == 1, "not ONE guardian"
+            assert guardians_of(proc.pid) != [] and len(guardians_of(proc.pid)) == 1, "not ONE guardian"
             watchdog = two.call(lambda: two.server.robot.watchdog_stops)
             # Counted from here: on a busy machine the guardian may already have stopped a drive whose
             # heartbeats came late (then the test pressed again); checked is the stop after the signal.
@@ -142,4 +119,4 @@ def test_a_fleet_window_killed_or_frozen_is_stopped_by_its_one_guardian_at_the_s
                 proc.send_signal(signal.SIGCONT)
                 proc.kill()
             proc.wait(5)
-        wait(lambda: not two.call(lambda: list(two.server.sessions)), 10, "the guardian to log out")
+        wait(lambda: logins(two) == 0, 10, "the guardian to log out")

@@ -21,10 +21,11 @@ import pytest
 from rtmu.client.custom_commands import CustomCommand
 from rtmu.control.alarms import Alarm
 from rtmu.control.gamepad import AXIS_TRANS, DEADMAN, DeadMan
-from rtmu.sim import SimConfig, SimThread
+from rtmu.sim import SimThread
 from rtmu.sim.wifi import AccessPoint
 from rtmu.ui.alarm_view import AlarmView
 from rtmu.values.intents import RunServerCommand
+from simulators import running, simulator
 
 from .conftest import _spawn_xvfb, _terminate
 from .harness import OFFICE_MAP, Gui, idle, on_display, pump
@@ -46,16 +47,13 @@ def phone_screen() -> Iterator[str]:
         _terminate(proc)
 
 
-@pytest.fixture
-def sim() -> Iterator[SimThread]:
-    """The simulator of the ``gui`` fixture (the session's big screen)."""
-    with SimThread(SimConfig(port=0, map_path=OFFICE_MAP, seed=1)) as s:
-        yield s
+sim = simulator(map_path=OFFICE_MAP, seed=1)
+"""The simulator of the ``gui`` fixture (the session's big screen)."""
 
 
 def open_on(screen: str, shots: Path, name: str) -> Iterator[tuple[Gui, SimThread]]:
     with (
-        SimThread(SimConfig(port=0, map_path=OFFICE_MAP, camera=True, seed=1)) as sim,
+        running(map_path=OFFICE_MAP, camera=True, seed=1) as sim,
         on_display(screen),
     ):
         gui = Gui.start(shots, name, "127.0.0.1", sim.port)

@@ -14,8 +14,9 @@ from pathlib import Path
 
 import pytest
 
-from rtmu.sim import SimConfig, SimThread
+from rtmu.sim import SimThread
 from rtmu.ui import idle_inhibit
+from simulators import simulator
 
 from .desktop_side import Desktop, fake_desktop
 from .harness import OFFICE_MAP, Gui, idle, pump
@@ -30,10 +31,7 @@ def desktop() -> Iterator[Desktop]:
         yield d
 
 
-@pytest.fixture
-def sim() -> Iterator[SimThread]:
-    with SimThread(SimConfig(port=0, map_path=OFFICE_MAP, camera=False, seed=1)) as s:
-        yield s
+sim = simulator(map_path=OFFICE_MAP, camera=False, seed=1)
 
 
 def test_a_moving_robot_keeps_the_screen_on_and_the_window_says_so(

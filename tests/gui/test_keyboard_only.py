@@ -7,15 +7,15 @@ keyboard: test_stop_keys_states; Alt+1…9 in a fleet: test_stop_keys_states.)""
 from __future__ import annotations
 
 import math
-from collections.abc import Iterator
 
 import gi
 import pytest
 
 from rtmu.model.observables import Phase
-from rtmu.sim import SimConfig, SimThread
+from rtmu.sim import SimThread
 from rtmu.ui.shortcuts import shortcuts_xml
 from rtmu.ui.stop_keys import descendants
+from simulators import simulator
 
 from .harness import OFFICE_MAP, Gui, idle, pump
 from .stop_paths import StopCycle, back_to_map, owned_windows
@@ -24,11 +24,7 @@ from .test_stop_keys_states import focus_until
 gi.require_version("Gtk", "4.0")
 from gi.repository import Gtk  # noqa: E402
 
-
-@pytest.fixture
-def sim() -> Iterator[SimThread]:
-    with SimThread(SimConfig(port=0, map_path=OFFICE_MAP, seed=1)) as s:
-        yield s
+sim = simulator(map_path=OFFICE_MAP, seed=1)
 
 
 def test_tab_shows_the_focus_and_space_on_a_focused_button_stops_without_clicking_it(

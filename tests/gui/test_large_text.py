@@ -13,14 +13,14 @@ import os
 import re
 import subprocess
 import sys
-from collections.abc import Iterator
 from pathlib import Path
 
 import numpy as np
 import pytest
 from PIL import Image
 
-from rtmu.sim import SimConfig, SimThread
+from rtmu.sim import SimThread
+from simulators import simulator
 
 from .harness import OFFICE_MAP, Gui, idle, pump
 from .process import screenshot, subscribed, wait, xdotool
@@ -28,10 +28,7 @@ from .process import screenshot, subscribed, wait, xdotool
 LARGE_TEXT_DPI = int(96 * 1.5 * 1024)
 
 
-@pytest.fixture
-def sim() -> Iterator[SimThread]:
-    with SimThread(SimConfig(port=0, map_path=OFFICE_MAP, camera=True, seed=1)) as s:
-        yield s
+sim = simulator(map_path=OFFICE_MAP, camera=True, seed=1)
 
 
 def inside(gui: Gui, widget: object) -> bool:

@@ -9,13 +9,10 @@ Space and the STOP button still stop with both pages open.
 
 from __future__ import annotations
 
-from collections.abc import Iterator
-
-import pytest
-
-from rtmu.sim import SimConfig, SimThread
+from rtmu.sim import SimThread
 from rtmu.ui.config_page import ConfigPage
 from rtmu.ui.console_page import ConsolePage
+from simulators import simulator
 
 from .harness import Gui, pump
 from .stop_paths import MenuEntry, MenuPicker, menu_entries, owned_windows
@@ -25,10 +22,7 @@ LD_ROW = "Configuration… — Omron LD's: not editable yet, see Console"
 LD_DATA = ("getConfigValues", "setConfigValues", "updateConfigValues", "configExpandedSectionList")
 
 
-@pytest.fixture
-def sim() -> Iterator[SimThread]:
-    with SimThread(SimConfig(port=0, profile="aram", map_path=None, camera=False)) as s:
-        yield s
+sim = simulator(profile="aram", map_path=None, camera=False)
 
 
 def stops(sim: SimThread) -> int:

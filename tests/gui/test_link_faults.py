@@ -10,17 +10,16 @@ from __future__ import annotations
 
 import threading
 import time
-from collections.abc import Callable, Iterator
+from collections.abc import Callable
 from dataclasses import dataclass
-from pathlib import Path
 
 import pytest
 
 from linkfaults import FAKE_HEADER, GARBAGE, TO_CLIENT, TO_SERVER, FaultProxy, WifiProfile
 from rtmu.model.observables import LinkLevel, Phase
-from rtmu.sim import SimConfig, SimThread
+from rtmu.sim import SimThread
 
-from .harness import OFFICE_MAP, Gui, idle, pump
+from .harness import Gui, idle, pump
 
 OUR_STOP_WITHIN = 1.0
 """Simulator seconds from the fault to our stop, where the link carries it (documented: 0.5 s from the
@@ -43,20 +42,6 @@ FAULTS = {
     "delay_400ms_each_way": Fault(lambda p: p.delay(0.4), True),
     "reset": Fault(lambda p: p.reset(), True),  # reconnected at once, and a stop sent first
 }
-
-
-@pytest.fixture
-def rig(request: pytest.FixtureRequest, screenshots: Path) -> Iterator[tuple[Gui, SimThread, FaultProxy]]:
-    with (
-        SimThread(SimConfig(port=0, map_path=OFFICE_MAP, seed=1)) as sim,
-        FaultProxy("127.0.0.1", sim.port) as proxy,
-    ):
-        gui = Gui.start(screenshots, request.node.name, "127.0.0.1", proxy.port)
-        try:
-            yield gui, sim, proxy
-        finally:
-            gui.xdotool("keyup", "Up")
-            gui.close()
 
 
 class _StopWatch:
@@ -109,9 +94,9 @@ def _link_cell(gui: Gui) -> str:
 
 @pytest.mark.parametrize("name", list(FAULTS))
 def test_a_link_fault_stops_the_robot_and_a_held_key_does_not_drive_again(
-    rig: tuple[Gui, SimThread, FaultProxy], name: str
+    faulty_link: tuple[Gui, SimThread, FaultProxy], name: str
 ) -> None:
-    gui, sim, proxy = rig
+    gui, sim, proxy = faulty_link
     fault = FAULTS[name]
     _hold_up_until_driving(gui, sim)
     stop_seen = _StopWatch(sim)
@@ -168,10 +153,10 @@ def test_a_link_fault_stops_the_robot_and_a_held_key_does_not_drive_again(
 
 
 def test_garbage_bytes_are_dropped_and_shown_without_a_false_stop(
-    rig: tuple[Gui, SimThread, FaultProxy],
+    faulty_link: tuple[Gui, SimThread, FaultProxy],
 ) -> None:
     """Line noise between packets costs nothing: counted in the link cell's tooltip, no stop."""
-    gui, sim, proxy = rig
+    gui, sim, proxy = faulty_link
     _hold_up_until_driving(gui, sim)
     proxy.inject(GARBAGE)
     pump(lambda: gui.model.health.value.garbage_bytes >= len(GARBAGE) // 2, 5, "the garbage to be counted")
@@ -184,11 +169,11 @@ def test_garbage_bytes_are_dropped_and_shown_without_a_false_stop(
     pump(lambda: sim.snapshot().trans_ratio == 0, 3, "the release to stop the robot")
 
 
-def test_one_fake_packet_header_costs_no_reconnect(rig: tuple[Gui, SimThread, FaultProxy]) -> None:
+def test_one_fake_packet_header_costs_no_reconnect(faulty_link: tuple[Gui, SimThread, FaultProxy]) -> None:
     """A header announcing a 32 000-byte packet once held every real packet behind it until the
     link was called lost (a reconnect every time). Now the stream is seen going on without it:
     the window stays connected on its one connection, answers, and never reconnects."""
-    gui, sim, proxy = rig
+    gui, sim, proxy = faulty_link
     _hold_up_until_driving(gui, sim)
 
     def sessions() -> set[int]:
@@ -223,11 +208,11 @@ JITTERY = WifiProfile("jittery", stall_rate=1.0, stall_min=0.1, stall_max=0.3, j
 
 
 def test_wifi_jitter_within_the_ceiling_never_stops_a_held_drive(
-    rig: tuple[Gui, SimThread, FaultProxy],
+    faulty_link: tuple[Gui, SimThread, FaultProxy],
 ) -> None:
     """Eight seconds of stalls up to 300 ms (a status gap up to 0.4 s at 10 Hz): the learned limit
     rides them out — the same window with a fixed 300 ms limit stopped on the first long one."""
-    gui, sim, proxy = rig
+    gui, sim, proxy = faulty_link
     _hold_up_until_driving(gui, sim)
     stops = len(sim.server.stop_log)  # type: ignore[union-attr]
     levels: set[LinkLevel] = set()
@@ -252,12 +237,12 @@ def test_wifi_jitter_within_the_ceiling_never_stops_a_held_drive(
 
 
 def test_a_roam_stops_the_robot_and_the_held_key_does_not_restart_it(
-    rig: tuple[Gui, SimThread, FaultProxy],
+    faulty_link: tuple[Gui, SimThread, FaultProxy],
 ) -> None:
     """1.5 s with nothing in either direction (a robot moving between access points): our stop leaves
     within the limit and reaches the robot as the link returns — before the server's 2 s watchdog —
     the window says why, and Up, still held, does not drive again."""
-    gui, sim, proxy = rig
+    gui, sim, proxy = faulty_link
     _hold_up_until_driving(gui, sim)
     stop_seen = _StopWatch(sim)
     sim_at_fault = sim.snapshot().time

@@ -5,28 +5,22 @@ from __future__ import annotations
 
 import re
 import time
-from collections.abc import Iterator
 from pathlib import Path
 
 import gi
 import numpy as np
-import pytest
 from PIL import Image
 
-from rtmu.sim import SimConfig, SimThread
+from rtmu.sim import SimThread
+from simulators import simulator
 
 from .harness import OFFICE_MAP, Gui, idle, pump
 
 gi.require_version("Gdk", "4.0")
 from gi.repository import Gdk, GLib  # noqa: E402
 
-
-@pytest.fixture
-def sim() -> Iterator[SimThread]:
-    """A camera serving up to 20 new frames/s on a robot turning on the spot, so every frame is new."""
-    cfg = SimConfig(port=0, map_path=OFFICE_MAP, camera=True, seed=1, camera_hz=20.0, drive_timeout=0)
-    with SimThread(cfg) as s:
-        yield s
+sim = simulator(map_path=OFFICE_MAP, camera=True, seed=1, camera_hz=20.0, drive_timeout=0)
+"""A camera serving up to 20 new frames/s on a robot turning on the spot, so every frame is new."""
 
 
 def turn(sim: SimThread) -> None:

@@ -9,28 +9,21 @@ keys.
 
 from __future__ import annotations
 
-from collections.abc import Iterator
-
-import pytest
-
 from client.uiqueue import UiQueue
 from rtmu.client.runner import ClientRunner
 from rtmu.mapedit import MapDraft
 from rtmu.model.observables import MapPhase, RobotModel
 from rtmu.package_data import project_map
-from rtmu.sim import SimConfig, SimThread
+from rtmu.sim import SimThread
 from rtmu.ui.map_edit_window import MapEditWindow
 from rtmu.values.intents import ApplyMapChanges
+from simulators import simulator
 
 from .harness import Gui, idle, pump
 from .stop_paths import StopCycle
 from .test_config_page import click, type_into
 
-
-@pytest.fixture
-def sim() -> Iterator[SimThread]:
-    with SimThread(SimConfig(port=0, map_path=project_map("office.map"), seed=1)) as s:
-        yield s
+sim = simulator(map_path=project_map("office.map"), seed=1)
 
 
 class Other:

@@ -6,22 +6,18 @@ from __future__ import annotations
 
 import math
 import time
-from collections.abc import Iterator
 
 import numpy as np
 import pytest
 
 from rtmu.control.motion_limits import capped_throttle
-from rtmu.sim import SimConfig, SimThread
+from rtmu.sim import SimThread
+from simulators import simulator
 
 from .harness import OFFICE_MAP, Gui, idle, pump
 from .stop_paths import owned_windows
 
-
-@pytest.fixture
-def sim() -> Iterator[SimThread]:
-    with SimThread(SimConfig(port=0, map_path=OFFICE_MAP, seed=1)) as s:
-        yield s
+sim = simulator(map_path=OFFICE_MAP, seed=1)
 
 
 def red_pixels(pixels: np.ndarray) -> np.ndarray:

@@ -9,7 +9,6 @@ from __future__ import annotations
 
 import itertools
 import math
-from collections.abc import Iterator
 from pathlib import Path
 
 import gi
@@ -19,6 +18,7 @@ import pytest
 from rtmu.model.observables import Phase
 from rtmu.sim import SimConfig, SimThread
 from rtmu.ui.nav_draw import PATH_RGB, MarkerKind
+from simulators import simulator
 
 from .harness import OFFICE_MAP, Gui, idle, pump
 
@@ -33,10 +33,7 @@ ARRIVE_MM = 250.0
 TRIP_S = 60.0
 
 
-@pytest.fixture
-def sim() -> Iterator[SimThread]:
-    with SimThread(SimConfig(port=0, map_path=OFFICE_MAP, camera=False, seed=1)) as s:
-        yield s
+sim = simulator(map_path=OFFICE_MAP, camera=False, seed=1)
 
 
 # -- helpers --------------------------------------------------------------------------------------

@@ -7,27 +7,15 @@ that is under way. A real camera notice, through the same path, does.
 
 from __future__ import annotations
 
-from collections.abc import Iterator
-from pathlib import Path
-
-import pytest
-
 from rtmu.base.notices import Kind, Notice
-from rtmu.sim import SimConfig, SimThread
+from simulators import simulator
 
 from .harness import OFFICE_MAP, Gui, pump
 
 SERVER_TEXT = "The camera picture on the dock is dirty: please clean it"
 
 
-@pytest.fixture
-def gui(screenshots: Path) -> Iterator[Gui]:
-    with SimThread(SimConfig(port=0, map_path=OFFICE_MAP, seed=1)) as sim:
-        gui = Gui.start(screenshots, "notice-routing", "127.0.0.1", sim.port)
-        try:
-            yield gui
-        finally:
-            gui.close()
+sim = simulator(map_path=OFFICE_MAP, seed=1)
 
 
 def raise_from_network(gui: Gui, notice: Notice) -> None:

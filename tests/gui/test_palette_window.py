@@ -7,21 +7,14 @@ server took the command, and that the palette closes and gives the keyboard back
 
 from __future__ import annotations
 
-from collections.abc import Iterator
-
-import pytest
-
 from rtmu.control.commands import COMMANDS
-from rtmu.sim import SimConfig, SimThread
+from rtmu.sim import SimThread
 from rtmu.ui.palette import CommandPalette
+from simulators import simulator
 
 from .harness import Gui, pump
 
-
-@pytest.fixture
-def sim() -> Iterator[SimThread]:
-    with SimThread(SimConfig(port=0, map_path=None, camera=False, seed=1)) as s:
-        yield s
+sim = simulator(map_path=None, camera=False, seed=1)
 
 
 def palette() -> CommandPalette | None:

@@ -13,14 +13,12 @@ the handlers touch points, a small stand-in answers ``get_scale_delta`` and
 from __future__ import annotations
 
 import math
-from collections.abc import Iterator
-from pathlib import Path
 
 import gi
 import pytest
 
-from rtmu.sim import SimConfig, SimThread
 from rtmu.ui.viewport import ZOOM_MAX, ZOOM_MIN
+from simulators import simulator
 
 from .harness import OFFICE_MAP, Gui, idle
 
@@ -42,15 +40,15 @@ class TwoFingers:
         return True, *self.centre
 
 
+sim = simulator(map_path=OFFICE_MAP, seed=1)
+
+
 @pytest.fixture
-def gui(request: pytest.FixtureRequest, screenshots: Path) -> Iterator[Gui]:
-    with SimThread(SimConfig(port=0, map_path=OFFICE_MAP, seed=1)) as sim:
-        gui = Gui.start(screenshots, request.node.name, "127.0.0.1", sim.port)
-        try:
-            gui.stage.set_follow(False)  # with Follow on, the robot (not the fingers) is the zoom's centre
-            yield gui
-        finally:
-            gui.close()
+def gui(gui: Gui) -> Gui:
+    """The window of tests/gui/conftest.py with Follow off: with it on, the robot (not the fingers) is the
+    zoom's centre."""
+    gui.stage.set_follow(False)
+    return gui
 
 
 def pinch(stage, fingers: TwoFingers, *scales: float, end: bool = True) -> None:  # type: ignore[no-untyped-def]

@@ -11,21 +11,15 @@ from __future__ import annotations
 
 import resource
 import time
-from collections.abc import Iterator
 from typing import Any
 
-import pytest
-
-from rtmu.sim import SimConfig, SimThread
+from rtmu.sim import SimThread
 from rtmu.ui.popups import MAX_CARDS
+from simulators import simulator
 
 from .harness import OFFICE_MAP, Gui, idle, pump
 
-
-@pytest.fixture
-def sim() -> Iterator[SimThread]:
-    with SimThread(SimConfig(port=0, map_path=OFFICE_MAP, camera=False, seed=1)) as s:
-        yield s
+sim = simulator(map_path=OFFICE_MAP, camera=False, seed=1)
 
 
 def raise_popup(sim: SimThread, title: str, message: str, **kw: Any) -> int:

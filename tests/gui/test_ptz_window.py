@@ -11,7 +11,6 @@ server without a head greys the controls with the reason and a key says why.
 from __future__ import annotations
 
 import sys
-from collections.abc import Iterator
 from pathlib import Path
 
 import numpy as np
@@ -22,8 +21,9 @@ from rtmu.client.ptz import NO_LIST
 from rtmu.client.server_strings import MAX_ITEMS
 from rtmu.protocol.payloads.camera import Camera, CameraCommand, CameraData, CameraList
 from rtmu.protocol.payloads.strings import StringItem, Strings, StringsInfo
-from rtmu.sim import SimConfig, SimThread
+from rtmu.sim import SimThread
 from rtmu.sim.handlers import STRING_ITEMS
+from simulators import simulator
 
 from .harness import OFFICE_MAP, Gui, idle, pump, scratch_dir
 
@@ -36,10 +36,7 @@ STRING_SPECS = [
 ]
 
 
-@pytest.fixture(scope="module")
-def sim() -> Iterator[SimThread]:
-    with SimThread(SimConfig(port=0, map_path=OFFICE_MAP, seed=1)) as s:
-        yield s
+sim = simulator(scope="module", map_path=OFFICE_MAP, seed=1)
 
 
 def _head(sim: SimThread) -> tuple[float, float, float]:

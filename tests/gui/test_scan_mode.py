@@ -18,8 +18,9 @@ import pytest
 
 from client.scanlog_reader import Reading, Tag, read_scan_log
 from rtmu.package_data import project_map
-from rtmu.sim import SimConfig, SimThread
+from rtmu.sim import SimThread
 from rtmu.ui.scan_mode import ScanBar, ScanDialog
+from simulators import running
 
 from .harness import Gui, idle, pump, scratch_dir
 from .stop_paths import StopCycle, owned_windows
@@ -33,7 +34,7 @@ def robot_files() -> Path:
 
 @pytest.fixture
 def sim(robot_files: Path) -> Iterator[SimThread]:
-    with SimThread(SimConfig(port=0, map_path=project_map("office.map"), files_dir=robot_files, seed=1)) as s:
+    with running(map_path=project_map("office.map"), files_dir=robot_files, seed=1) as s:
         yield s
 
 

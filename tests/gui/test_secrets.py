@@ -10,7 +10,7 @@ from pathlib import Path
 import pytest
 
 from rtmu.settings.store import Profile
-from rtmu.sim import SimConfig, SimThread
+from simulators import running
 
 from .harness import OFFICE_MAP, Gui, LoopProbe, pump
 
@@ -38,7 +38,7 @@ class BlockingSecrets:
 
 @pytest.fixture
 def gui(request: pytest.FixtureRequest, screenshots: Path) -> Iterator[Gui]:
-    with SimThread(SimConfig(port=0, map_path=OFFICE_MAP, seed=1)) as sim:
+    with running(map_path=OFFICE_MAP, seed=1) as sim:
         g = Gui.start(screenshots, request.node.name, "127.0.0.1", sim.port, connect=False)
         try:
             yield g

@@ -7,21 +7,15 @@ names opens — and the window's banner says so.
 
 from __future__ import annotations
 
-from collections.abc import Iterator
 from pathlib import Path
 
-import pytest
-
-from rtmu.sim import SimConfig, SimThread
+from rtmu.sim import SimThread
 from rtmu.ui.options import GuiOptions
+from simulators import simulator
 
 from .harness import OFFICE_MAP, Gui, pump, scratch_dir
 
-
-@pytest.fixture
-def sim() -> Iterator[SimThread]:
-    with SimThread(SimConfig(port=0, map_path=OFFICE_MAP)) as s:
-        yield s
+sim = simulator(map_path=OFFICE_MAP)
 
 
 def test_a_fleet_file_without_its_version_line_opens_its_fleet_and_the_window_says_so(

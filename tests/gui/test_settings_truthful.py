@@ -8,22 +8,17 @@
 from __future__ import annotations
 
 import tomllib
-from collections.abc import Iterator
 from pathlib import Path
 
-import pytest
 from gi.repository import GdkX11
 
-from rtmu.sim import SimConfig, SimThread
+from rtmu.sim import SimThread
 from rtmu.ui.options import GuiOptions
+from simulators import simulator
 
 from .harness import OFFICE_MAP, Gui, pump, scratch_dir
 
-
-@pytest.fixture
-def sim() -> Iterator[SimThread]:
-    with SimThread(SimConfig(port=0, map_path=OFFICE_MAP, camera=False, seed=1)) as s:
-        yield s
+sim = simulator(map_path=OFFICE_MAP, camera=False, seed=1)
 
 
 def open_settings(gui: Gui):  # type: ignore[no-untyped-def]

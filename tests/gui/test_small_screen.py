@@ -13,7 +13,7 @@ from pathlib import Path
 
 import pytest
 
-from rtmu.sim import SimConfig, SimThread
+from simulators import running
 
 from .harness import OFFICE_MAP, Gui, on_display, pump
 
@@ -24,7 +24,7 @@ _HARMLESS = ("Unable to acquire session bus",)
 @pytest.fixture
 def small(screenshots: Path, small_screen: str, request: pytest.FixtureRequest) -> Iterator[Gui]:
     with (
-        SimThread(SimConfig(port=0, map_path=OFFICE_MAP, camera=True, seed=1)) as sim,
+        running(map_path=OFFICE_MAP, camera=True, seed=1) as sim,
         on_display(small_screen),
     ):
         gui = Gui.start(screenshots, request.node.name, "127.0.0.1", sim.port)

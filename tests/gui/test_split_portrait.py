@@ -12,7 +12,8 @@ import numpy as np
 import pytest
 from PIL import Image
 
-from rtmu.sim import SimConfig, SimThread
+from rtmu.sim import SimThread
+from simulators import running
 
 from .conftest import _spawn_xvfb, _terminate
 from .harness import OFFICE_MAP, Gui, idle, on_display, pump, scratch_dir
@@ -38,8 +39,10 @@ def phone_screen() -> Iterator[str]:
 def phone(
     screenshots: Path, phone_screen: str, request: pytest.FixtureRequest
 ) -> Iterator[tuple[Gui, SimThread]]:
-    cfg = SimConfig(port=0, map_path=OFFICE_MAP, camera=True, seed=1, camera_hz=20.0, drive_timeout=0)
-    with SimThread(cfg) as sim, on_display(phone_screen):
+    with (
+        running(map_path=OFFICE_MAP, camera=True, seed=1, camera_hz=20.0, drive_timeout=0) as sim,
+        on_display(phone_screen),
+    ):
         gui = Gui.start(screenshots, request.node.name, "127.0.0.1", sim.port)
         try:
             yield gui, sim

@@ -9,12 +9,10 @@ item of a test, put back on the map between items (its toggles set back as they 
 
 from __future__ import annotations
 
-from collections.abc import Iterator
-
 import gi
-import pytest
 
-from rtmu.sim import SimConfig, SimThread
+from rtmu.sim import SimThread
+from simulators import simulator
 
 from .harness import OFFICE_MAP, Gui, idle, pump
 from .stop_paths import MenuEntry, MenuPicker, StopCycle, back_to_map, menu_entries, owned_windows
@@ -26,10 +24,7 @@ LEAVES_THE_WINDOW = {"app.quit"}
 """Ends the window: its own test (the robot is stopped before the app quits)."""
 
 
-@pytest.fixture
-def sim() -> Iterator[SimThread]:
-    with SimThread(SimConfig(port=0, map_path=OFFICE_MAP, seed=1)) as s:
-        yield s
+sim = simulator(map_path=OFFICE_MAP, seed=1)
 
 
 def entries(gui: Gui) -> list[MenuEntry]:

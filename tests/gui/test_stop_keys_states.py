@@ -7,11 +7,9 @@ Real window, real simulator, real X input; the simulator's stop log says whether
 
 from __future__ import annotations
 
-from collections.abc import Iterator
 from pathlib import Path
 
 import gi
-import pytest
 
 from rtmu.control.key_rules import FIELD_HINT, KEYS_INACTIVE
 from rtmu.settings.store import DirectRobot
@@ -19,6 +17,7 @@ from rtmu.sim import SimConfig, SimThread
 from rtmu.sim.multi import SimFleetThreads, fleet_configs
 from rtmu.ui.options import GuiOptions
 from rtmu.ui.stop_keys import descendants, is_guarded
+from simulators import simulator
 
 from .harness import OFFICE_MAP, Gui, idle, pump, scratch_dir
 from .stop_paths import StopCycle, back_to_map, menu_entries, owned_windows
@@ -27,11 +26,7 @@ gi.require_version("Gtk", "4.0")
 gi.require_version("GdkX11", "4.0")
 from gi.repository import GdkX11, Gtk  # noqa: E402
 
-
-@pytest.fixture
-def sim() -> Iterator[SimThread]:
-    with SimThread(SimConfig(port=0, map_path=OFFICE_MAP, seed=1)) as s:
-        yield s
+sim = simulator(map_path=OFFICE_MAP, seed=1)
 
 
 def focus_until(gui: Gui, widget: Gtk.Widget, key: str = "Tab", limit: int = 60) -> None:

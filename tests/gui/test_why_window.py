@@ -11,16 +11,14 @@ confirmation open.
 
 from __future__ import annotations
 
-from collections.abc import Iterator
 from pathlib import Path
-
-import pytest
 
 from rtmu.base import exit_codes as codes
 from rtmu.cli import main
 from rtmu.sim import SimConfig, SimThread
 from rtmu.sim.ld_safety import safety_state
 from rtmu.ui.why_window import WhyWindow
+from simulators import simulator
 
 from .harness import Gui, idle, pump
 from .stop_paths import MenuEntry, MenuPicker, owned_windows
@@ -28,10 +26,7 @@ from .stop_paths import MenuEntry, MenuPicker, owned_windows
 WHY_ROW = MenuEntry((), "Why won't it move?…", "win.why")
 
 
-@pytest.fixture
-def sim() -> Iterator[SimThread]:
-    with SimThread(SimConfig(port=0, map_path=None, camera=False, seed=1)) as s:
-        yield s
+sim = simulator(map_path=None, camera=False, seed=1)
 
 
 def command(sim: SimThread, name: str) -> None:

@@ -10,21 +10,17 @@ from __future__ import annotations
 
 import math
 import re
-from collections.abc import Iterator
 
 import numpy as np
 import pytest
 
 from rtmu.model.observables import Phase
 from rtmu.sim import SimConfig, SimThread
+from simulators import simulator
 
 from .harness import OFFICE_MAP, Gui, LoopProbe, idle, pump
 
-
-@pytest.fixture
-def sim() -> Iterator[SimThread]:
-    with SimThread(SimConfig(port=0, map_path=OFFICE_MAP, camera=True, seed=1)) as s:
-        yield s
+sim = simulator(map_path=OFFICE_MAP, camera=True, seed=1)
 
 
 def received(sim: SimThread) -> tuple[float, float, float, float] | None:

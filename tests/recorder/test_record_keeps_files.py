@@ -10,7 +10,6 @@ import hashlib
 import socket
 import subprocess
 import sys
-from collections.abc import Iterator
 from pathlib import Path
 
 import pytest
@@ -22,7 +21,8 @@ from rtmu.protocol.commands import ClientCommand, ServerCommand
 from rtmu.protocol.decoder import PacketDecoder
 from rtmu.protocol.payloads.control import ClientIntroduction, ServerIntroduction
 from rtmu.recorder import topics
-from rtmu.sim import SimConfig, SimThread
+from rtmu.sim import SimThread
+from simulators import simulator
 
 from .mcapread import read, summary_counts
 from .simsession import ARENA
@@ -35,12 +35,7 @@ def rtmu(*args: str, timeout: float = 60) -> subprocess.CompletedProcess[str]:
     return subprocess.run([*RTMU, *args], capture_output=True, text=True, timeout=timeout)
 
 
-@pytest.fixture(scope="module")
-def sim(tmp_path_factory: pytest.TempPathFactory) -> Iterator[SimThread]:
-    users = tmp_path_factory.mktemp("users") / "users.txt"
-    users.write_text(f"UserInfoVersion1\nuser alice {PASSWORD} all\n")
-    with SimThread(SimConfig(port=0, map_path=ARENA, users_path=users, seed=1)) as s:
-        yield s
+sim = simulator(scope="module", map_path=ARENA, seed=1, users=(f"alice {PASSWORD} all",))
 
 
 @pytest.fixture

@@ -3,7 +3,6 @@
 from __future__ import annotations
 
 import asyncio
-from collections.abc import Iterator
 from pathlib import Path
 
 import pytest
@@ -15,14 +14,12 @@ from rtmu.protocol.payloads.robot import BatteryInfo, UpdateNumbers
 from rtmu.sim import SimConfig, SimThread
 from rtmu.sim.ld_data import CONFIG_API
 from rtmu.sim.profiles import ARAM, DEFAULT, EX4_HEADER, NOT_LISTED_BY_6MTX, get_profile
+from simulators import simulator
 
 OFFICE = project_map("office.map")
 
 
-@pytest.fixture(scope="module")
-def aram() -> Iterator[SimThread]:
-    with SimThread(SimConfig(port=0, profile="aram", map_path=OFFICE)) as s:
-        yield s
+aram = simulator(scope="module", profile="aram", map_path=OFFICE)
 
 
 async def _with_client(port: int, body):  # type: ignore[no-untyped-def]

@@ -8,10 +8,11 @@ from __future__ import annotations
 
 import asyncio
 import json
-from collections.abc import Iterator
 
 import pytest
 
+from client.servers import MAP_LINES, SPECS, ServerSide, ServerThread, TestServer
+from client.uiqueue import UiQueue
 from rtmu.base.exit_codes import EXIT_CONNECTION, EXIT_OK, EXIT_TIMEOUT, EXIT_UNSUPPORTED, EXIT_USAGE
 from rtmu.cli import main
 from rtmu.client.runner import ClientRunner
@@ -28,17 +29,11 @@ from rtmu.protocol.payloads.mapchange import (
     MapChangeReply,
 )
 from rtmu.protocol.payloads.server import IdleProcessingPending
-from rtmu.sim import SimConfig, SimThread
+from rtmu.sim import SimThread
 from rtmu.subcommands.mapedit import EXIT_NOT_HELD, EXIT_REFUSED
+from simulators import simulator
 
-from .servers import MAP_LINES, SPECS, ServerSide, ServerThread, TestServer
-from .uiqueue import UiQueue
-
-
-@pytest.fixture
-def sim() -> Iterator[SimThread]:
-    with SimThread(SimConfig(port=0, map_path=project_map("arena.map"))) as s:
-        yield s
+sim = simulator(map_path=project_map("arena.map"))
 
 
 def addr(port: int) -> str:

@@ -3,25 +3,21 @@
 from __future__ import annotations
 
 import json
-from collections.abc import Iterator
 
 import pytest
 
+from client.drawing_servers import MARKUP, MAX_POINTS_SENT, hostile_drawing_server
+from client.servers import SPECS, ServerThread, TestServer
 from rtmu.base.exit_codes import EXIT_OK, EXIT_UNSUPPORTED
 from rtmu.cli import main
 from rtmu.package_data import project_map
-from rtmu.sim import SimConfig, SimThread
-
-from .drawing_servers import MARKUP, MAX_POINTS_SENT, hostile_drawing_server
-from .servers import SPECS, ServerThread, TestServer
+from rtmu.sim import SimThread
+from simulators import simulator
 
 ARENA = project_map("arena.map")
 
 
-@pytest.fixture(scope="module")
-def sim() -> Iterator[SimThread]:
-    with SimThread(SimConfig(port=0, map_path=ARENA)) as s:
-        yield s
+sim = simulator(scope="module", map_path=ARENA)
 
 
 def test_the_simulators_sonar_and_laser_with_a_sample_each(

@@ -7,11 +7,13 @@ import json
 import signal
 import subprocess
 import sys
-from collections.abc import Iterator
 from pathlib import Path
 
 import pytest
 
+from client.servers import SPECS, ServerThread, TestServer
+from client.test_connection import free_port
+from client.uiqueue import eventually
 from rtmu import mapfile as maps
 from rtmu.base.exit_codes import (
     EXIT_CONNECTION,
@@ -24,23 +26,15 @@ from rtmu.base.exit_codes import (
 )
 from rtmu.cli import main
 from rtmu.package_data import project_map
-from rtmu.sim import SimConfig, SimThread
+from rtmu.sim import SimThread
 from rtmu.subcommands._common import host_port
-
-from .servers import SPECS, ServerThread, TestServer
-from .test_connection import free_port
-from .uiqueue import eventually
+from simulators import simulator
 
 ARENA = project_map("arena.map")
 STATUS_KEYS = {"x", "y", "th", "vel", "rot_vel", "battery_v", "status", "mode"}
 
 
-@pytest.fixture(scope="module")
-def sim(tmp_path_factory: pytest.TempPathFactory) -> Iterator[SimThread]:
-    users = tmp_path_factory.mktemp("users") / "users.txt"
-    users.write_text("UserInfoVersion1\nuser alice secret1 all\nuser bob pw2 RobotInfo\n")
-    with SimThread(SimConfig(port=0, map_path=ARENA, users_path=users)) as s:
-        yield s
+sim = simulator(scope="module", map_path=ARENA, users=("alice secret1 all", "bob pw2 RobotInfo"))
 
 
 @pytest.fixture

@@ -10,12 +10,12 @@ from collections.abc import Iterator
 import pytest
 from PIL import Image
 
+from client.servers import ServerSide, ServerThread, TestServer
 from rtmu.base.exit_codes import EXIT_CONNECTION, EXIT_OK
 from rtmu.cli import main
 from rtmu.package_data import project_map
 from rtmu.sim import SimConfig, SimThread
-
-from .servers import ServerSide, ServerThread, TestServer
+from simulators import running
 
 ARENA = project_map("arena.map")
 SUMMARY_KEYS = {"frames", "fps", "kbps", "width", "height", "age_ms_p50", "age_ms_p95"}
@@ -24,8 +24,7 @@ SUMMARY_KEYS = {"frames", "fps", "kbps", "width", "height", "age_ms_p50", "age_m
 @pytest.fixture(scope="module")
 def turning_sim() -> Iterator[SimThread]:
     """A 640x480 camera serving up to 20 new frames/s on a robot turning on the spot (every frame new)."""
-    cfg = SimConfig(port=0, map_path=ARENA, camera_size=(640, 480), camera_hz=20.0, drive_timeout=0)
-    with SimThread(cfg) as sim:
+    with running(map_path=ARENA, camera_size=(640, 480), camera_hz=20.0, drive_timeout=0) as sim:
         assert sim.server is not None
         world = sim.server.world
         sim.call(lambda: world.ratio_drive(0, 40, 100))

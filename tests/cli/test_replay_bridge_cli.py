@@ -9,12 +9,11 @@ import sys
 import time
 from pathlib import Path
 
+from recorder.foxglove_client import FoxgloveClient, twist
+from recorder.simsession import ARENA
 from rtmu.base.exit_codes import EXIT_BAD_FILE
 from rtmu.recorder import topics
 from rtmu.sim import SimConfig, SimThread
-
-from .foxglove_client import FoxgloveClient, twist
-from .simsession import ARENA
 
 RTMU = [sys.executable, "-m", "rtmu"]
 

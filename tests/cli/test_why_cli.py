@@ -10,12 +10,14 @@ from __future__ import annotations
 
 import asyncio
 import json
-from collections.abc import Iterator
 from pathlib import Path
 
 import jsonschema
 import pytest
 
+from client.navsim import fast_sim, reset, robot
+from client.servers import SPECS, ServerThread, TestServer
+from client.uiqueue import eventually
 from rtmu.base import exit_codes as codes
 from rtmu.cli import main
 from rtmu.client.connection import AriaClient
@@ -23,10 +25,7 @@ from rtmu.protocol.payloads.drive import RatioDrive
 from rtmu.sim import SimConfig, SimThread
 from rtmu.sim.ld_safety import safety_state
 from rtmu.subcommands.json_schemas import SCHEMAS
-
-from .navsim import fast_sim, reset, robot
-from .servers import SPECS, ServerThread, TestServer
-from .uiqueue import eventually
+from simulators import simulator
 
 USERS = """UserInfoVersion1
 user alice secret1 all
@@ -36,10 +35,7 @@ user viewer pw RobotInfo SensorInfo
 """
 
 
-@pytest.fixture
-def sim() -> Iterator[SimThread]:
-    with SimThread(SimConfig(port=0)) as s:
-        yield s
+sim = simulator()
 
 
 @pytest.fixture

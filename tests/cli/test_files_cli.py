@@ -14,7 +14,8 @@ import pytest
 
 from rtmu.base.exit_codes import EXIT_OK, EXIT_REFUSED, EXIT_USAGE
 from rtmu.cli import main
-from rtmu.sim import SimConfig, SimThread
+from rtmu.sim import SimThread
+from simulators import running
 
 REPO = Path(__file__).resolve().parents[2]
 
@@ -30,7 +31,7 @@ def robot(tmp_path: Path) -> Path:
 
 @pytest.fixture
 def sim(robot: Path) -> Iterator[SimThread]:
-    with SimThread(SimConfig(port=0, files_dir=robot, files_default_dir="maps")) as s:
+    with running(files_dir=robot, files_default_dir="maps") as s:
         yield s
 
 

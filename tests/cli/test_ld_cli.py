@@ -4,33 +4,26 @@ from __future__ import annotations
 
 import asyncio
 import json
-from collections.abc import Iterator
 
 import pytest
 
+from client.uiqueue import eventually
 from rtmu.base.exit_codes import EXIT_OK, EXIT_UNSUPPORTED, EXIT_USAGE
 from rtmu.cli import main
 from rtmu.client import ld_data
 from rtmu.client.connection import AriaClient
 from rtmu.package_data import project_map
-from rtmu.sim import SimConfig, SimThread
+from rtmu.sim import SimThread
 from rtmu.sim.ld_data import ROUTES, ld_state
-
-from .uiqueue import eventually
+from simulators import simulator
 
 OFFICE = project_map("office.map")
 
 
-@pytest.fixture(scope="module")
-def aram() -> Iterator[SimThread]:
-    with SimThread(SimConfig(port=0, profile="aram", map_path=OFFICE)) as s:
-        yield s
+aram = simulator(scope="module", profile="aram", map_path=OFFICE)
 
 
-@pytest.fixture(scope="module")
-def plain() -> Iterator[SimThread]:
-    with SimThread(SimConfig(port=0, map_path=OFFICE)) as s:
-        yield s
+plain = simulator(scope="module", map_path=OFFICE)
 
 
 def addr(sim: SimThread) -> str:

@@ -16,17 +16,17 @@ from collections.abc import Iterator
 
 import pytest
 
+from client.navsim import OFFICE, fast_sim, reset, robot
+from client.servers import SPECS, ServerThread, TestServer
+from client.uiqueue import eventually
 from rtmu.base.exit_codes import EXIT_OK, EXIT_TIMEOUT, EXIT_UNSUPPORTED, EXIT_USAGE
 from rtmu.cli import main
 from rtmu.protocol.payloads.robot import ModeInfo
-from rtmu.sim import SimConfig, SimThread
+from rtmu.sim import SimThread
 from rtmu.sim.ld_data import ld_state
 from rtmu.sim.profiles import PROFILES, SimProfile
 from rtmu.subcommands._navigate import EXIT_NAV_CANCELLED, EXIT_NAV_FAILED, EXIT_NAV_LOST
-
-from .navsim import OFFICE, fast_sim, reset, robot
-from .servers import SPECS, ServerThread, TestServer
-from .uiqueue import eventually
+from simulators import running
 
 
 @pytest.fixture(scope="module")
@@ -211,7 +211,7 @@ def ld_only() -> Iterator[SimThread]:
     """An LD robot that lists gotoRouteGoal but not ARNL's gotoGoal."""
     PROFILES["ld-only"] = SimProfile("ld-only", "LD data without ARNL's", modules=("rtmu.sim.ld_data",))
     try:
-        with SimThread(SimConfig(port=0, profile="ld-only", map_path=OFFICE)) as s:
+        with running(profile="ld-only", map_path=OFFICE) as s:
             yield s
     finally:
         del PROFILES["ld-only"]

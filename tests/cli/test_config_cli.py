@@ -4,11 +4,12 @@ from __future__ import annotations
 
 import asyncio
 import json
-from collections.abc import Iterator
 from pathlib import Path
 
 import pytest
 
+from client.servers import SPECS, ServerThread, TestServer
+from client.uiqueue import UiQueue, eventually
 from rtmu.base.exit_codes import EXIT_OK, EXIT_REFUSED, EXIT_UNSUPPORTED, EXIT_USAGE
 from rtmu.cli import main
 from rtmu.client.config_feed import MAX_TEXT, ConfigFeed, ServerConfig, check_value, fetch_config
@@ -18,15 +19,9 @@ from rtmu.client.runner import ClientRunner
 from rtmu.model.observables import RobotModel
 from rtmu.protocol.payloads.config import ConfigParam, ConfigSectionPacket, ParamType
 from rtmu.sim import SimConfig, SimThread
+from simulators import simulator
 
-from .servers import SPECS, ServerThread, TestServer
-from .uiqueue import UiQueue, eventually
-
-
-@pytest.fixture
-def sim() -> Iterator[SimThread]:
-    with SimThread(SimConfig(port=0)) as s:
-        yield s
+sim = simulator()
 
 
 def addr(port: int) -> str:

@@ -5,23 +5,18 @@ from __future__ import annotations
 import json
 import threading
 import time
-from collections.abc import Iterator
 
 import pytest
 
+from client.servers import SPECS, ServerThread, TestServer
 from rtmu.base.exit_codes import EXIT_OK, EXIT_TIMEOUT, EXIT_UNSUPPORTED, EXIT_USAGE
 from rtmu.cli import main
 from rtmu.client.health import PING_CANDIDATES
 from rtmu.protocol.payloads.commands import CommandEntry, CommandList
-from rtmu.sim import SimConfig, SimThread
+from rtmu.sim import SimThread
+from simulators import simulator
 
-from .servers import SPECS, ServerThread, TestServer
-
-
-@pytest.fixture(scope="module")
-def sim() -> Iterator[SimThread]:
-    with SimThread(SimConfig(port=0)) as s:
-        yield s
+sim = simulator(scope="module")
 
 
 def addr(port: int) -> str:

@@ -12,14 +12,13 @@ from collections.abc import Iterator
 
 import pytest
 
+from client.navsim import fast_sim, reset, robot
+from client.uiqueue import eventually
 from rtmu.base.exit_codes import EXIT_DOCTOR_STATUS, EXIT_LOST, EXIT_OK, EXIT_UNSUPPORTED, EXIT_USAGE
 from rtmu.cli import main
 from rtmu.sim import SimThread
 from rtmu.sim.central_thread import CentralThread
 from rtmu.sim.ld_data import ld_state
-
-from .navsim import fast_sim, reset, robot
-from .uiqueue import eventually
 
 
 @pytest.fixture(scope="module")

@@ -8,12 +8,11 @@ import subprocess
 import sys
 from pathlib import Path
 
+from recorder.mcapread import read, summary_counts
+from recorder.simsession import ARENA
 from rtmu.protocol.motion import MOTION_REQUESTS
 from rtmu.recorder import topics
 from rtmu.sim import SimConfig, SimThread
-
-from .mcapread import read, summary_counts
-from .simsession import ARENA
 
 RTMU = [sys.executable, "-m", "rtmu"]
 

@@ -4,11 +4,12 @@ from __future__ import annotations
 
 import json
 import os
-from collections.abc import Iterator
 from pathlib import Path
 
 import pytest
 
+from client.servers import SPECS, ServerThread, TestServer
+from client.uiqueue import UiQueue, eventually
 from rtmu.base.exit_codes import EXIT_CONNECTION, EXIT_OK, EXIT_UNSUPPORTED, EXIT_USAGE
 from rtmu.cli import main
 from rtmu.client.config_file import ConfigFileError, read_file
@@ -17,17 +18,11 @@ from rtmu.model.observables import RobotModel
 from rtmu.protocol.fields import FieldWriter
 from rtmu.protocol.payloads.config import ConfigParam, ConfigSectionPacket, ParamType, SetConfigReply
 from rtmu.protocol.payloads.configcare import ConfigDefaults
-from rtmu.sim import SimConfig, SimThread
+from rtmu.sim import SimThread
 from rtmu.subcommands.config import EXIT_REFUSED
+from simulators import simulator
 
-from .servers import SPECS, ServerThread, TestServer
-from .uiqueue import UiQueue, eventually
-
-
-@pytest.fixture
-def sim() -> Iterator[SimThread]:
-    with SimThread(SimConfig(port=0)) as s:
-        yield s
+sim = simulator()
 
 
 def config(port: int, *argv: str) -> int:
