@@ -154,3 +154,45 @@ def test_every_control_has_a_name_and_the_map_says_where_the_robot_is(tmp_path: 
         finally:
             proc.terminate()
             proc.wait(15)
+
+
+POPOVERS = {
+    "win.open-menu": ("menu item", "Connection settings…"),
+    "win.goto-panel": ("list item", "Corridor End"),
+    "win.layers": ("check box", "sonar"),
+}
+"""Each popover opened through its window action, and one control it must show by role and name.
+A popover is a surface of its own that exists only while open: the first walk of the tree (above)
+never sees one, so each is opened and read on its own."""
+
+
+def test_every_popover_is_read_with_named_controls(tmp_path: Path) -> None:
+    _skip_or_fail()
+    with (
+        SimThread(SimConfig(port=0, map_path=OFFICE_MAP, seed=1)) as sim,
+        accessibility_bus(tmp_path / "runtime") as env,
+    ):
+        env["XDG_CONFIG_HOME"] = str(tmp_path / "config")
+        proc = subprocess.Popen(
+            [sys.executable, "-m", "rtmu", "--host", "127.0.0.1", "--port", str(sim.port)],
+            env=env, stdout=subprocess.DEVNULL, stderr=subprocess.PIPE, text=True,
+        )  # fmt: skip
+        try:
+            xdotool("search", "--sync", "--onlyvisible", "--pid", str(proc.pid), "--name", "RTMU")
+            wait(
+                lambda: sim.call(lambda: any(s.subscriptions for s in sim.server.sessions)), 30, "subscribed"
+            )
+            for action, (role, name) in POPOVERS.items():
+                nodes = read_tree(proc.pid, env, action)
+                for _attempt in range(20):  # a busy machine: the popover may open a little later
+                    if any(n["role"] == role and n["name"].startswith(name) for n in nodes):
+                        break
+                    time.sleep(1.0)
+                    nodes = read_tree(proc.pid, env)
+                shown = sorted({(n["role"], n["name"]) for n in nodes if n["role"] in CONTROL_ROLES})
+                assert any(n["role"] == role and n["name"].startswith(name) for n in nodes), (action, shown)
+                assert not unnamed_controls(nodes), f"{action}: " + "\n".join(unnamed_controls(nodes))
+                assert not [n for n in nodes if n["role"] == "list item" and not n["name"].strip()], action
+        finally:
+            proc.terminate()
+            proc.wait(15)

@@ -68,11 +68,15 @@ class GoalsPanel(Gtk.MenuButton):
         for side in ("top", "bottom", "start", "end"):
             getattr(box, f"set_margin_{side}")(6)
         self.search = Gtk.SearchEntry(placeholder_text="Search goals")
+        accessible.name(
+            self.search, "Search goals"
+        )  # a placeholder is not a name: GTK 4.8 says "GtkSearchEntry"
         self.search.connect("search-changed", lambda _e: self._filter())
         self.search.connect("activate", lambda _e: self.choose_first())
         self.search.connect("stop-search", lambda _e: self.popdown())
         box.append(self.search)
         self.list = Gtk.ListBox(selection_mode=Gtk.SelectionMode.NONE)
+        accessible.name(self.list, "Goals")
         self.list.add_css_class("goal-list")
         self.list.set_activate_on_single_click(True)
         self.list.connect("row-activated", lambda _l, row: self.choose(row.goal))
@@ -188,6 +192,9 @@ class GoalsPanel(Gtk.MenuButton):
             label.set_ellipsize(Pango.EllipsizeMode.END)
             row.set_child(label)
             row.set_tooltip_text(f"Drive to {name} (the robot drives by itself; STOP ends it)")
+            accessible.name(
+                row, name
+            )  # GTK 4.8 does not name a row by its label: it would be read as nothing
             self.list.append(row)
             self.rows[name] = row
         self.empty.set_visible(not goals)

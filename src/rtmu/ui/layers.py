@@ -137,6 +137,7 @@ class LayersPanel(Gtk.Box):
             label = Gtk.Label(label=row_label(layer), xalign=0.0, use_markup=False, use_underline=False)
             label.set_ellipsize(Pango.EllipsizeMode.END)
             button.set_child(label)  # our own plain-text label: the server's name is never markup
+            accessible.name(button, row_label(layer))  # GTK 4.8 names no check button by a child label
             button.set_focusable(False)
             button.set_active(layer.shown)
             button.set_sensitive(layer.may_toggle)
