@@ -21,6 +21,7 @@ from rtmu.ui.options import GuiOptions
 from simulators import simulator
 
 from .harness import OFFICE_MAP, Gui, LoopProbe, idle, pump, scratch_dir
+from .process import PATIENCE
 
 LASER, SONAR = "sim_lms2xx_1Current", "sonarCurrent"
 BLUE, SKY = (0, 0, 255), (0x33, 0xCC, 0xFF)
@@ -76,7 +77,7 @@ def test_sonar_and_laser_in_their_colours_and_a_layer_switched_off_is_gone_and_n
     gui.screen_shot("layers-open")
     gui.click(panel.buttons[LASER])
     pump(lambda: not layer(gui, LASER).shown and layer(gui, LASER).points == (), 5, "the laser hidden")
-    deadline = time.monotonic() + 5
+    deadline = time.monotonic() + 5 * PATIENCE
     while LASER in requested_at(sim):
         assert time.monotonic() < deadline, "the simulator is still asked for the laser"
         idle(0.05)

@@ -15,7 +15,6 @@ the simulators did and what the window drew:
 from __future__ import annotations
 
 import math
-import time
 from collections.abc import Iterator
 from pathlib import Path
 
@@ -177,10 +176,9 @@ def test_switching_while_a_key_is_held_stops_the_first_and_the_second_waits(
         pump(lambda: mode(sims[0]) == "ratioDrive" and sims[0].snapshot().vel > 0, 5, "robot1 to drive")
         watchdog = watchdog_stops(sims[0])
         click_row(gui, "robot2")  # the key is still down
-        deadline = time.monotonic() + 1.0  # half ARIA's watchdog: only our stop is this fast
-        pump(lambda: mode(sims[0]) == "stop" or time.monotonic() > deadline, 3, "robot1's stop")
-        assert mode(sims[0]) == "stop", "the first robot was not stopped by the switch"
-        assert watchdog_stops(sims[0]) == watchdog
+        # Ours, not ARIA's 2 s watchdog: told by the watchdog's own count, not by a clock.
+        pump(lambda: mode(sims[0]) == "stop", 3, "robot1's stop")
+        assert watchdog_stops(sims[0]) == watchdog, "the watchdog stopped robot1, not the switch"
         start2 = pose(sims[1])
         idle(1.0)  # still held: auto-repeat must not reach the new robot
         gui.shot("switched-key-still-held")

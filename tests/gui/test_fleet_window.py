@@ -8,7 +8,6 @@ window, stops both before either server's 2 s watchdog.
 
 from __future__ import annotations
 
-import time
 from collections.abc import Iterator
 from pathlib import Path
 
@@ -77,9 +76,8 @@ def test_every_way_out_stops_every_robot(
             gui.key("ctrl+q")
         else:
             gui.window.close()
-        deadline = time.monotonic() + 1.0  # half the watchdog: only our stops can do it this fast
-        pump(lambda: all(mode(sim) == "stop" for sim in sims) or time.monotonic() > deadline, 3, "stops")
-        assert [mode(sim) for sim in sims] == ["stop", "stop"], "a robot of the fleet was left driving"
+        # Ours, not ARIA's 2 s watchdog: told by the watchdogs' own counts, not by a clock.
+        pump(lambda: all(mode(sim) == "stop" for sim in sims), 3, "every robot of the fleet to stop")
         assert [watchdog_stops(sim) for sim in sims] == before, "a watchdog stopped a robot, not us"
     finally:
         gui.keyup("Up")
