@@ -43,6 +43,8 @@ from .lease import DriveLease
 
 PERIOD = 0.05
 """Seconds between the keeper's looks (well under the lease's 0.3 s)."""
+IDLE_WAIT = 5.0
+"""Seconds a keeper with no lease sleeps between looks if nothing wakes it (a renewal always does)."""
 STARVED_LIMIT = 1.0
 """At most this many seconds after the renewing thread's last real renewal does the keeper credit it."""
 CREDITING = link_timing.LEARNING
@@ -145,7 +147,12 @@ class LeaseKeeper:
         self._lock = threading.Lock()
         """Its own thread and the network thread (``DriveGovernor.before_lapse``) both step it."""
         self._closed = threading.Event()
+        self._wake = threading.Event()
+        """Set by a grant or renewal (:meth:`renewed`) and by :meth:`close`: a keeper with no lease to
+        keep sleeps on it instead of looking 20 times a second at nothing (an idle window's wake-ups)."""
         self._thread: threading.Thread | None = None
+        lease.on_renew = self.renewed  # told of every grant and renewal, on the renewing thread
+        lease.before_lapse = self.step  # and asked before anyone acts on a lapse
 
     def start(self) -> LeaseKeeper:
         self._thread = threading.Thread(target=self._run, name="rtmu-lease-keeper", daemon=True)
@@ -154,13 +161,20 @@ class LeaseKeeper:
 
     def close(self) -> None:
         self._closed.set()
+        self._wake.set()
         thread = self._thread
         if thread is not None and thread is not threading.current_thread():
             thread.join(1.0)
 
     def _run(self) -> None:
         self.boosted = raise_priority()
-        while not self._closed.wait(self.period):
+        while not self._closed.is_set():
+            if self.lease.last_renewal() is None:  # no live lease: nothing to credit until a grant
+                self._wake.wait(IDLE_WAIT)
+                self._wake.clear()
+                continue
+            if self._closed.wait(self.period):
+                return
             try:
                 self.step(self.lease.clock())
             except Exception:  # never let a bad read end the thread that keeps leases fair
@@ -168,11 +182,12 @@ class LeaseKeeper:
 
     def renewed(self) -> None:
         """The renewing thread has just renewed (``DriveLease.on_renew``, on that thread): the wait it
-        has had so far is the account to measure its next wait from."""
+        has had so far is the account to measure its next wait from. Wakes a sleeping keeper."""
         with self._lock:
             renewed = self.lease.last_renewal()
             if renewed is not None:
                 self._seen_renewal, self._wait_then = renewed[0], self.wait_of(renewed[1])
+        self._wake.set()
 
     def step(self, now: float) -> None:
         """One look: every :data:`PERIOD` from its thread, and from whichever thread finds the lease

@@ -130,10 +130,7 @@ class ClientRunner:
         self.lease = DriveLease(ttl=lease_ttl, clock=clock)
         # Run-queue waits are real time: credited only to a lease on the real clock (not a test's).
         keep = clock is time.monotonic and lease_keeper.CREDITING
-        self.keeper = LeaseKeeper(self.lease, beat=self._beat_ui_at) if keep else None
-        if self.keeper is not None:
-            self.lease.on_renew = self.keeper.renewed
-            self.lease.before_lapse = self.keeper.step
+        self.keeper = LeaseKeeper(self.lease, beat=self._beat_ui_at) if keep else None  # hooks the lease
         self.on_notice: Callable[[Notice], None] | None = None
         """``on_notice(notice)``, called on the UI thread (through ``post``)."""
         self.on_publish: Callable[[StateChange], None] | None = None
