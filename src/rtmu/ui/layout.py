@@ -129,6 +129,7 @@ class PhoneLayout:
         if title_box is not None:
             title_box.set_visible(not narrow)
         w.fullscreen_bar.set_compact(narrow)
+        w.ptz.set_compact(narrow)
         for button in (w.connect_button, w.fullscreen_bar.connect_button):
             (button.remove_css_class if narrow else button.add_css_class)("connect-button")
         dpad = w.dpad
