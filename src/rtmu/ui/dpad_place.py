@@ -8,9 +8,10 @@ row: ``layout``). What this module keeps true, whatever the page and its width:
 * it never sits on the zoom row: a map narrower than the two side by side (split view, a fleet's
   list beside it) lifts the D-pad above the row;
 * the Go-to-point / Set-position bar keeps clear of it (beside it, or above it on a phone);
-* Fit keeps the robot and the D-pad apart: the map is fitted in what the D-pad leaves — beside it
-  or above it, whichever shows the map larger (:meth:`DPadPlacement.fit_room`) — unless that would
-  shrink the map below half its plain fit (``viewport.best_fit``: a split phone's small map).
+* Fit keeps the map clear of the D-pad and of the zoom row: the map is fitted in what they leave —
+  beside or above each, whichever shows the map larger (:meth:`DPadPlacement.fit_room`) — unless
+  that would shrink the map below half its plain fit (``viewport.best_fit``: a split phone's small
+  map); even then the zoom row keeps its room (:meth:`DPadPlacement.fit_floor`).
 """
 
 from __future__ import annotations
@@ -30,6 +31,10 @@ ABOVE_OSD = 64
 """The D-pad's bottom margin when it must sit above the zoom row (as a phone's: ``layout``)."""
 CORNER = 12
 """The D-pad's bottom margin in its corner."""
+
+
+def _larger(a: Insets, b: Insets) -> Insets:
+    return (max(a[0], b[0]), max(a[1], b[1]), max(a[2], b[2]), max(a[3], b[3]))
 
 
 class DPadPlacement:
@@ -87,15 +92,24 @@ class DPadPlacement:
             nat_h + d.get_margin_bottom() + d.get_margin_top(),
         )
 
-    def fit_room(self, _width: int, _height: int) -> tuple[Insets, ...]:
-        """The ways Fit may keep clear of the D-pad on the map: beside it (in its corner) or above it."""
-        if not (self.dpad.get_visible() and self.on_map()):
+    def fit_floor(self, _width: int, _height: int) -> tuple[Insets, ...]:
+        """The ways Fit always keeps clear of the zoom row: left of it or above it."""
+        if not self.osd.get_visible():
             return ()
-        w, h = self._size()
-        above = (0, 0, 0, h + GAP)
-        if self.dpad.get_halign() == Gtk.Align.CENTER:
-            return (above,)
-        return ((w + GAP, 0, 0, 0), above)
+        osd_w = self.osd.measure(Gtk.Orientation.HORIZONTAL, -1)[1] + self.osd.get_margin_end()
+        osd_h = self.osd.measure(Gtk.Orientation.VERTICAL, -1)[1] + self.osd.get_margin_bottom()
+        return ((0, 0, osd_w + GAP, 0), (0, 0, 0, osd_h + GAP))
+
+    def fit_room(self, width: int, height: int) -> tuple[Insets, ...]:
+        """The ways Fit may keep clear of the zoom row (:meth:`fit_floor`) and of the D-pad on the map
+        (beside it in its corner, or above it): every pairing, the larger inset of each edge."""
+        zoom_row = self.fit_floor(width, height) or ((0, 0, 0, 0),)
+        pad: tuple[Insets, ...] = ((0, 0, 0, 0),)
+        if self.dpad.get_visible() and self.on_map():
+            w, h = self._size()
+            above = (0, 0, 0, h + GAP)
+            pad = (above,) if self.dpad.get_halign() == Gtk.Align.CENTER else ((w + GAP, 0, 0, 0), above)
+        return tuple(_larger(a, b) for a in zoom_row for b in pad)
 
     def queue(self) -> None:
         """Place again after this layout (never inside a size allocation)."""

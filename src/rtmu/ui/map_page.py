@@ -110,6 +110,7 @@ class MapPage(Gtk.Overlay):
             self.dpad, self, osd=self.osd, pose_bar=self.pose_bar, refit=self.stage.refit
         )
         self.stage.fit_room = self.dpad_place.fit_room
+        self.stage.fit_floor = self.dpad_place.fit_floor
         self.stage.connect("resize", lambda *_a: self.dpad_place.queue())
         self.stage.connect("resize", lambda _s, width, _h: self.inset.fit_to(width))
 
