@@ -12,12 +12,14 @@ the map narrower, not the window): under :data:`NARROW` px the window is a phone
   the camera and Go to still fit 360 px: the title (the strip says the state), the
   window's minimise/maximise/close buttons (a phone's shell closes apps; Quit is in
   the menu), the Connect buttons' fixed minimum width and 20 px of STOP's (still
-  the first and the only red button);
+  the first and the only red button); the full-screen bar sheds its status line and leave button
+  (the menu leaves full screen) and the camera head's position takes a line above its buttons;
 
 and at :data:`NARROW` or more everything is exactly as the landscape window
 always was. Switching happens in an idle callback, never inside a size
 allocation. A window opened on a screen narrower than :data:`NARROW` (a
-phone) starts maximised at that screen's size instead of 800×480.
+phone) starts maximised at that screen's size instead of 800×480, and keeps
+the phone layout on that screen whatever its width (:meth:`PhoneLayout.wants_narrow`).
 """
 
 from __future__ import annotations
