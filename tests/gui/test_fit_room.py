@@ -4,9 +4,10 @@ Before, Fit kept the map clear of the D-pad only: the zoom row (bottom right) st
 corner of the map at 800×480 and 360×720. Now Fit fits the map in what the zoom row and the D-pad
 leave. On a screen of each size (the window fills it; 1280×800 on the session's screen), with the
 D-pad shown (picked from the menu with the mouse; a phone shows it by itself), Ctrl+0 fits, and the
-map's drawn extent is clear of the zoom row and of the D-pad. In split view the zoom row is clear
-(the D-pad, where its room would shrink the map below half, may lie over it: the known trade-off of
-``viewport.best_fit``). Space and STOP stop the robot there.
+map's drawn extent is clear of the zoom row and of the D-pad, in split view too (a 395 px map: the
+D-pad's pads are compact there, so the map fits above them at a legible size, where the 64 px pads
+left it so little room that Fit gave up and the D-pad lay over the robot). Space and STOP stop the
+robot there.
 """
 
 from __future__ import annotations
@@ -73,9 +74,7 @@ def fit_and_check(gui: Gui, sim: SimThread, label: str) -> None:
     if not window.handheld.layout.narrow:
         pick(gui, "win.split")  # split view: a narrower map beside the video
         pump(lambda: window.split.split and window.split.pane.get_mapped(), 5, "split view")
-        # A 395 px map beside a 236 px D-pad would be shown at a third of its fit: Fit keeps the
-        # map legible under the D-pad there (``viewport.FIT_ROOM_SHARE``), the zoom row still clear.
-        fit(gui, f"{label}-split", dpad_clear=False)
+        fit(gui, f"{label}-split")  # a narrow map: compact pads, the map above them
         pick(gui, "win.split")
         pump(lambda: not window.split.split, 5, "split view to end")
     space_and_stop_stop(gui, sim, window.stop_button, f"at Fit, {label}")

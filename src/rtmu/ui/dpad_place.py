@@ -6,7 +6,8 @@ row: ``layout``). What this module keeps true, whatever the page and its width:
 * it is on the page the operator looks at — the map, or the camera page (the one widget moves
   between them, so a finger held on it is one state);
 * it never sits on the zoom row: a map narrower than the two side by side (split view, a fleet's
-  list beside it) lifts the D-pad above the row;
+  list beside it) lifts the D-pad above the row, and a map under :data:`COMPACT_MAP` px gets the
+  compact pads, so that Fit can show the map above them;
 * the Go-to-point / Set-position bar keeps clear of it (beside it, or above it on a phone);
 * Fit keeps the map clear of the D-pad and of the zoom row: the map is fitted in what they leave —
   beside or above each, whichever shows the map larger (:meth:`DPadPlacement.fit_room`) — unless
@@ -23,6 +24,7 @@ import gi
 gi.require_version("Gtk", "4.0")
 from gi.repository import GLib, Gtk  # noqa: E402
 
+from .dpad import COMPACT_PAD_PX, PAD_PX, DPad  # noqa: E402
 from .viewport import Insets  # noqa: E402
 
 GAP = 8
@@ -31,6 +33,14 @@ ABOVE_OSD = 64
 """The D-pad's bottom margin when it must sit above the zoom row (as a phone's: ``layout``)."""
 CORNER = 12
 """The D-pad's bottom margin in its corner."""
+COMPACT_MAP = 600
+"""A map narrower than this (px: split view or a fleet's list at 800×480) gets the compact pads in its
+corner, so that Fit can keep the map clear of the D-pad (above it) and still show it at a legible size."""
+
+
+def _footprint(widget: Gtk.Widget) -> tuple[int, int]:
+    """A widget's natural width and height with its margins (``measure`` includes them)."""
+    return widget.measure(Gtk.Orientation.HORIZONTAL, -1)[1], widget.measure(Gtk.Orientation.VERTICAL, -1)[1]
 
 
 def _larger(a: Insets, b: Insets) -> Insets:
@@ -43,7 +53,7 @@ class DPadPlacement:
 
     def __init__(
         self,
-        dpad: Gtk.Widget,
+        dpad: DPad,
         map_page: Gtk.Overlay,
         *,
         osd: Gtk.Widget,
@@ -83,21 +93,15 @@ class DPadPlacement:
 
     # -- room ----------------------------------------------------------------------------------
     def _size(self) -> tuple[int, int]:
-        """The D-pad's width and height with its margins (px)."""
-        _min_w, nat_w, _b, _c = self.dpad.measure(Gtk.Orientation.HORIZONTAL, -1)
-        _min_h, nat_h, _b, _c = self.dpad.measure(Gtk.Orientation.VERTICAL, -1)
-        d = self.dpad
-        return (
-            nat_w + d.get_margin_start() + d.get_margin_end(),
-            nat_h + d.get_margin_bottom() + d.get_margin_top(),
-        )
+        """The D-pad's width and height with its margins (px): ``measure`` counts a widget's margins
+        already (adding them again kept 64 px too many above a lifted D-pad)."""
+        return _footprint(self.dpad)
 
     def fit_floor(self, _width: int, _height: int) -> tuple[Insets, ...]:
         """The ways Fit always keeps clear of the zoom row: left of it or above it."""
         if not self.osd.get_visible():
             return ()
-        osd_w = self.osd.measure(Gtk.Orientation.HORIZONTAL, -1)[1] + self.osd.get_margin_end()
-        osd_h = self.osd.measure(Gtk.Orientation.VERTICAL, -1)[1] + self.osd.get_margin_bottom()
+        osd_w, osd_h = _footprint(self.osd)
         return ((0, 0, osd_w + GAP, 0), (0, 0, 0, osd_h + GAP))
 
     def fit_room(self, width: int, height: int) -> tuple[Insets, ...]:
@@ -126,6 +130,8 @@ class DPadPlacement:
         d = self.dpad
         shown = d.get_visible()
         corner = d.get_halign() == Gtk.Align.START
+        compact = corner and self.on_map() and self.map_page.get_width() < COMPACT_MAP
+        d.set_pad_size(COMPACT_PAD_PX if compact else PAD_PX)
         w, h = self._size()
         if corner and self.on_map():
             osd_w = self.osd.measure(Gtk.Orientation.HORIZONTAL, -1)[1] + self.osd.get_margin_end()
