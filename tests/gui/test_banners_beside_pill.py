@@ -4,8 +4,9 @@ Before, where the centred banner column would have covered the pill it was pushe
 pill, over the map (and, at 800×480, over the robot). Where there is room beside the pill (800×480,
 1280×800) the column now sits beside it, on the same row; only a phone (360 px) puts the banners
 under the pill. Checked with the robot navigating and two banners up, on a screen of each size
-(the window fills it): no banner covers the pill or the robot as drawn, and beside the pill the
-first banner starts above the pill's bottom. Space and STOP still stop the robot.
+(the window fills it): no banner covers the pill or the robot as drawn (on a phone the column goes
+above the D-pad where under the pill it would cover the robot), and beside the pill the first banner
+starts above the pill's bottom. Space and STOP still stop the robot.
 """
 
 from __future__ import annotations
@@ -112,9 +113,9 @@ def test_banners_under_the_pill_on_a_phone(screenshots: Path, phone_screen: str,
     with on_display(phone_screen):
         gui = Gui.start(screenshots, "banners-360x720", "127.0.0.1", sim.port)
         try:
-            # A phone's Fit shows the whole map in a band that banners under the pill cover: the
-            # robot may be under one there (the pill and the banners are what is asked here).
-            check(gui, sim, "360x720", beside=False, robot_clear=False)
+            # A phone's Fit shows the whole map in a band that banners under the pill would cover:
+            # where the robot is under them, they go above the thumb's D-pad instead.
+            check(gui, sim, "360x720", beside=False)
             space_and_stop_stop(gui, sim, gui.window.stop_button, "on the phone with banners")
         finally:
             gui.close()

@@ -120,14 +120,21 @@ class BannerStack(Gtk.Box):
     def topics(self) -> list[str]:
         return list(self._order)
 
-    def keep_clear_of(self, *pills: Gtk.Widget) -> None:
+    def keep_clear_of(
+        self,
+        *pills: Gtk.Widget,
+        avoid: tuple[float, float, float, float] | None = None,
+        bottom: int = 0,
+    ) -> None:
         """Keep the column off the motion pills (the map's, the camera page's): a banner never hides
         what the robot is doing. Where the centred column would cover a pill it moves beside it, on
         the same row, when there is :data:`MIN_BESIDE` px of room (800×480 and up); only then under
-        it (a phone), which covers more of the map. Called by the window's timer; the margins are
+        it (a phone), which covers more of the map — unless the column would cover ``avoid`` there (the
+        robot as drawn, in the parent's terms) and ``bottom`` offers a place that ends that far above
+        the bottom (above a phone's D-pad) and is clear of it. Called by the window's timer; the margins are
         computed from the column's natural width, not its last place, so they hold steady, and only
         change when they must (no relayout otherwise)."""
-        top, start, end = MARGIN_TOP, 0, 0
+        top, start, end, low = MARGIN_TOP, 0, 0, 0
         parent = self.get_parent()
         width = parent.get_width() if parent is not None else 0
         if parent is not None and width > 0 and self._order:
@@ -148,10 +155,26 @@ class BannerStack(Gtk.Box):
                     end = round(width - x0 + GAP)
                 else:
                     top = max(top, round(box.get_y() + box.get_height()) + MARGIN_TOP // 2)
-        if (self.get_margin_top(), self.get_margin_start(), self.get_margin_end()) != (top, start, end):
+            height = self.measure(Gtk.Orientation.VERTICAL, natural)[1]
+            height -= self.get_margin_top() + self.get_margin_bottom()
+            if avoid is not None and bottom > 0 and top > MARGIN_TOP:
+                under = (left, top, right, top + height)
+                floor = parent.get_height() - bottom
+                low_place = (left, floor - height, right, floor)
+                if _overlap(under, avoid) and not _overlap(low_place, avoid) and floor - height > top:
+                    top, low = MARGIN_TOP, bottom
+        place = (top, start, end, low)
+        if (
+            self.get_margin_top(),
+            self.get_margin_start(),
+            self.get_margin_end(),
+            self.get_margin_bottom(),
+        ) != place:
             self.set_margin_top(top)
             self.set_margin_start(start)
             self.set_margin_end(end)
+            self.set_margin_bottom(low)
+            self.set_valign(Gtk.Align.END if low else Gtk.Align.START)
 
     # -- internals ---------------------------------------------------------------------------
     def _make(self, topic: str) -> _Banner:
@@ -193,6 +216,10 @@ class BannerStack(Gtk.Box):
             banner.timer = 0
             self.dismiss(topic)
         return False
+
+
+def _overlap(a: tuple[float, float, float, float], b: tuple[float, float, float, float]) -> bool:
+    return a[0] < b[2] and b[0] < a[2] and a[1] < b[3] and b[1] < a[3]
 
 
 def _one_paragraph(text: str) -> str:
