@@ -4,9 +4,12 @@
   session's strings feed while the details table is open — decoded, paired with 10 000 labels and
   bounded to the 200 rows the table keeps. Baseline: the simulator's own 7-item packet.
 * ``ptz.strings_kept_items.hostile``: rows the model holds after that packet (the bound, not the flood).
-* ``ptz.move_to_position_ms``: from ``setCameraRel`` sent to the new position read back
-  (``getCameraData`` answered with the moved head) against the real-time simulator over loopback,
-  median of 30 moves. Baseline: a bare ``getCameraData`` round trip on the same connection.
+* ``ptz.move_to_position_ms``: from ``setCameraRel`` (10°) sent to the head read back where it was
+  sent (``getCameraData`` asked again and again) against the real-time simulator over loopback, whose
+  head turns at the VC-C4's 90°/s, median of 10 moves. Baseline: a bare ``getCameraData`` round trip.
+* ``ptz.move_settled_ms``: from the same move to the feed calling it settled (``moving`` false: two
+  readings 250 ms apart agree, and a VC-C4 could have turned that far) — when the window's label
+  stops saying "moving". Baseline: ``ptz.move_to_position_ms`` (the price of being sure it stopped).
 """
 
 from __future__ import annotations
@@ -27,7 +30,7 @@ from rtmu.sim import SimConfig, SimThread
 from rtmu.sim.handlers import STRING_ITEMS
 
 OFFICE = project_map("office.map")
-MOVES = 30
+MOVES = 10
 
 
 def _feed(labels: tuple[str, ...]) -> tuple[StringsFeed, DetachedContext]:
@@ -53,7 +56,7 @@ def strings_update() -> list[Result]:
     ]
 
 
-async def _moves(port: int) -> tuple[float, float]:
+async def _moves(port: int) -> tuple[float, float, float]:
     client = AriaClient()
     await client.connect("127.0.0.1", port, timeout=10)
     try:
@@ -62,26 +65,35 @@ async def _moves(port: int) -> tuple[float, float]:
         name = "getCameraDataCam1"
         bare: list[float] = []
         moved: list[float] = []
+        settled: list[float] = []
         for i in range(MOVES):
             t0 = time.perf_counter()
             await client.request_once(name)
             bare.append(time.perf_counter() - t0)
+            await feed.wait_settled()
             before = feed.state.position
+            assert before is not None
+            step = 10.0 if i % 2 == 0 else -10.0
+            target = (before[0] + step, before[1], before[2])
             t0 = time.perf_counter()
-            feed.move_rel(10.0 if i % 2 == 0 else -10.0, 0.0)
-            await feed.refresh()
-            while feed.state.position == before:  # ARIA may answer before the head has turned
-                await feed.refresh()
+            feed.move_rel(step, 0.0)
+            while await feed.refresh() != target:  # the head turns at 90°/s: readings on the way
+                pass
             moved.append(time.perf_counter() - t0)
-        return statistics.median(moved), statistics.median(bare)
+            await feed.wait_settled()
+            settled.append(time.perf_counter() - t0)
+        return statistics.median(moved), statistics.median(bare), statistics.median(settled)
     finally:
         await client.disconnect()
 
 
 def move_to_position() -> list[Result]:
     with SimThread(SimConfig(port=0, map_path=OFFICE)) as sim:
-        moved, bare = asyncio.run(_moves(sim.port))
-    return [Result("ptz.move_to_position_ms", moved * 1000, "ms", bare * 1000)]
+        moved, bare, settled = asyncio.run(_moves(sim.port))
+    return [
+        Result("ptz.move_to_position_ms", moved * 1000, "ms", bare * 1000),
+        Result("ptz.move_settled_ms", settled * 1000, "ms", moved * 1000),
+    ]
 
 
 def run() -> list[Result]:

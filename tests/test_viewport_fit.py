@@ -32,3 +32,13 @@ def test_best_fit_takes_the_choice_that_shows_the_map_largest() -> None:
 def test_no_room_worth_taking_leaves_the_plain_fit() -> None:
     """A split phone's small map under a big D-pad: the plain fit, not a map a few pixels high."""
     assert best_fit(OFFICE, 350, 322, ((0, 0, 0, 276),)) == fit_view(OFFICE, 350, 322)
+
+
+def test_the_plain_fit_still_keeps_clear_of_the_floor() -> None:
+    """When the D-pad's room would shrink the map too far, the plain fit still leaves the zoom row
+    (``floor``) its room: left of it or above it, whichever shows the map larger."""
+    zoom_row = ((0, 0, 247, 0), (0, 0, 0, 68))
+    tight = ((236, 0, 0, 68), (0, 0, 0, 340))
+    view = best_fit(OFFICE, 395, 390, tight, zoom_row)
+    assert view == fit_view(OFFICE, 395, 390, insets=(0, 0, 0, 68))
+    assert view != fit_view(OFFICE, 395, 390)  # same zoom here, moved up off the row

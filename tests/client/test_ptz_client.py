@@ -72,6 +72,7 @@ def _reset(sim: SimThread) -> None:
     assert sim.server is not None
     p = sim.server.world.camera.ptz
     p.pan = p.tilt = p.zoom = 0.0
+    p.goal = None
 
 
 def _head(sim: SimThread) -> tuple[float, float, float]:
@@ -104,6 +105,22 @@ def test_moves_reach_the_simulated_head_and_come_back_as_position(rig: Rig, sim:
     rig.wait(lambda: rig.ptz.position == (98.0, 0.0, 60.0))
 
 
+def test_a_turning_head_is_moving_until_its_reading_settles(rig: Rig, sim: SimThread) -> None:
+    """The simulated head turns at the VC-C4's speeds: every reading taken before it stopped is
+    published as ``moving`` (never as where the head stopped), and the last one is the goal, settled."""
+    rig.wait(lambda: rig.ptz is not None and rig.ptz.position is not None)
+    seen: list[Any] = []
+    rig.model.robot.observe(lambda _old, new: seen.append(new.ptz))
+    rig.runner.send(PtzMove(-98, 30, 40, relative=False)).result(5)  # 98° of pan: over a second
+    rig.wait(lambda: rig.ptz.moving and rig.ptz.goal == (-98.0, 30.0, 40.0))
+    rig.wait(lambda: not rig.ptz.moving, timeout=20)
+    assert rig.ptz.position == (-98.0, 30.0, 40.0) and rig.ptz.goal is None
+    assert _head(sim) == (-98.0, 30.0, 40.0)
+    for state in seen:
+        if state is not None and state.position != (-98.0, 30.0, 40.0):
+            assert state.moving, f"a reading taken mid-turn was shown as settled: {state.position}"
+
+
 def test_position_is_polled_only_while_watched(rig: Rig, sim: SimThread) -> None:
     rig.wait(lambda: rig.ptz is not None and rig.ptz.position is not None)
     assert sim.server is not None
@@ -129,6 +146,7 @@ def test_position_is_polled_only_while_watched(rig: Rig, sim: SimThread) -> None
             sum(1 for h in sim.server.heard.all() if h.name.startswith("getCameraData") and h.once) > reads
         )
     )
+    rig.wait(lambda: not rig.ptz.moving)  # a move is read until it settles, watched or not
     rig.runner.send(WatchPtz(False)).result(5)
     rig.runner.sync()
     rig.ui.drain()

@@ -36,6 +36,11 @@ async def _head(c: WireClient) -> tuple[float, float, float]:
     return (d.pan, d.tilt, d.zoom)
 
 
+HEAD_TURNS = 2.5
+"""Simulated seconds for any move to end: the head turns at the VC-C4's speeds (180° of pan in 2 s),
+and the simulator renders at most one frame a frame period."""
+
+
 def test_pan_and_zoom_change_the_picture(tmp_path):
     path = tmp_path / "short-wall.map"
     path.write_text(SHORT_WALL)
@@ -47,7 +52,7 @@ def test_pan_and_zoom_change_the_picture(tmp_path):
 
         c.once("setCameraAbsCam1", SetCameraAbs(60, 0, 0).encode())
         await c.barrier()
-        await server.advance(0.5)  # the simulator renders at most one frame a frame period
+        await server.advance(HEAD_TURNS)
         assert await _head(c) == (60.0, 0.0, 0.0)
         left = await _picture(c)
         assert np.abs(left - ahead).mean() > 3  # the wall has left the picture
@@ -56,20 +61,20 @@ def test_pan_and_zoom_change_the_picture(tmp_path):
 
         c.once("setCameraRelCam1", SetCameraRel(-60, 0).encode())
         await c.barrier()
-        await server.advance(0.5)  # the simulator renders at most one frame a frame period
+        await server.advance(HEAD_TURNS)
         assert await _head(c) == (0.0, 0.0, 0.0)
         back = await _picture(c)
         assert np.abs(back - ahead).mean() < 2  # the same view again
 
         c.once("setCameraAbsCam1", SetCameraAbs(0, 0, 60).encode())
         await c.barrier()
-        await server.advance(0.5)  # the simulator renders at most one frame a frame period
+        await server.advance(HEAD_TURNS)
         zoomed = await _picture(c)
         assert _wall_rows(zoomed.astype(np.uint8)) > 2 * _wall_rows(ahead.astype(np.uint8))
 
         c.once("setCameraAbsCam1", SetCameraAbs(0, 20, 0).encode())
         await c.barrier()
-        await server.advance(0.5)  # the simulator renders at most one frame a frame period
+        await server.advance(HEAD_TURNS)
         up = await _picture(c)
         assert np.abs(up - ahead).mean() > 8  # tilting moves the horizon
         await c.close()
@@ -97,7 +102,7 @@ def test_a_positive_pan_turns_the_camera_right_as_arias_does(tmp_path):
         for pan in (90.0, -90.0):
             c.once("setCameraAbsCam1", SetCameraAbs(pan, 0, 0).encode())
             await c.barrier()
-            await server.advance(0.5)
+            await server.advance(HEAD_TURNS)
             rows[pan] = _wall_rows((await _picture(c)).astype(np.uint8))
         assert rows[90.0] > 40  # the wall on the robot's right fills the middle of the view
         assert rows[-90.0] < rows[90.0] / 4  # to the left there is nothing near

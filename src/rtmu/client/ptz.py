@@ -11,8 +11,10 @@ no drive lease. Every name and number comes from the server and is bounded befor
 
 from __future__ import annotations
 
+import asyncio
 import contextlib
 import math
+import time
 from collections.abc import Callable
 from dataclasses import replace
 from typing import ClassVar
@@ -28,6 +30,12 @@ from .feed import Feed, FeedContext
 
 POLL_MS = 250
 """``getCameraData`` period while watched (ARIA suggests 100 ms; 4 Hz is plenty for a label)."""
+HEAD_SPEEDS = (90.0, 69.0, 50.0)
+"""Pan and tilt in degrees per second, zoom in % of its range per second: the fastest a VC-C4 turns
+(ARIA's default slews for it). ARIA's VC-C4 driver reports the position it last asked for, not where
+the head is, so a move is called settled no sooner than the head could have got there."""
+FOLLOW_LIMIT_S = 15.0
+"""A move is followed (read every ``POLL_MS``) at most this long; then the last reading stands."""
 MAX_NAME = 64
 """Characters kept of a camera's name, type or display name."""
 NO_LIST = "the server lists no cameras (getCameraList)"
@@ -66,6 +74,8 @@ class PtzFeed(Feed):
         self._camera: Camera | None = None
         self._state = PtzState()
         self._polling = False
+        self._move_no = 0
+        """Counts moves: a newer move ends the following of an older one."""
         self.cameras: tuple[Camera, ...] = ()
         """Every camera the server listed (for ``rtmu ptz``), bounded by the packet."""
         self.read_error: ClientError | ProtocolError | None = None
@@ -139,6 +149,7 @@ class PtzFeed(Feed):
 
     def disconnected(self) -> None:
         self._client, self._camera, self._polling = None, None, False
+        self._move_no += 1
         self._state = PtzState()
         self.ctx.robot_update(ptz=None)  # unknown until the next login reads the list
 
@@ -155,14 +166,15 @@ class PtzFeed(Feed):
         self.watching = on
         self._sync()
 
-    async def refresh(self) -> None:
-        """Read the position once (after login, and after each move)."""
+    async def refresh(self) -> tuple[float, float, float] | None:
+        """Read the position once (after login, and while a move is followed); the reading."""
         client, name = self._client, self._name("getCameraData")
         if client is None or not name:
-            return
+            return None
         with contextlib.suppress(ClientError, ProtocolError):
             reply = await client.request_once(name, timeout=self._timeout)
             self._on_data(Packet(name, reply.payload, reply.received_at))
+        return self._state.position
 
     def _sync(self) -> None:
         client, name = self._client, self._name("getCameraData")
@@ -190,7 +202,7 @@ class PtzFeed(Feed):
         """Turn the head by (pan, tilt) degrees and zoom by ``zoom`` points of its range."""
         client, name = self._require("setCameraRel")
         client.send(name, SetCameraRel(_bound(pan), _bound(tilt), None if zoom is None else _bound(zoom)))
-        self._after_move()
+        self._after_move(None)
 
     def move_abs(self, pan: float, tilt: float, zoom: float | None = None) -> None:
         """Point the head at (pan, tilt) degrees, zoom % (None: keep the zoom as it is)."""
@@ -199,12 +211,50 @@ class PtzFeed(Feed):
             position = self._state.position
             zoom = position[2] if position is not None else 0.0  # ARIA reads a missing zoom as 0
         client.send(name, SetCameraAbs(_bound(pan), _bound(tilt), _bound(zoom)))
-        self._after_move()
+        self._after_move(self._clamped(pan, tilt, zoom))
 
-    def _after_move(self) -> None:
-        """Read where the head went at once, polled or not: the camera page's label follows the key
-        press, not the next poll (a head still moving is read again by the poll)."""
-        self.ctx.spawn(self.refresh(), "ptz-refresh")
+    def _clamped(self, pan: float, tilt: float, zoom: float) -> tuple[float, float, float] | None:
+        s = self._state
+        if s.pan_range == s.tilt_range == (0.0, 0.0):
+            return None  # limits unknown: where it stops is the server's to say
+
+        def within(value: float, limits: tuple[float, float]) -> float:
+            return min(max(value, limits[0]), limits[1])
+
+        zoom = within(zoom, s.zoom_range) if s.zoom_available else 0.0
+        return (within(pan, s.pan_range), within(tilt, s.tilt_range), zoom)
+
+    def _after_move(self, goal: tuple[float, float, float] | None) -> None:
+        """The head is moving: say so at once, and read it until it settles, polled or not (the
+        camera page's label follows the key press, and never shows a reading taken mid-turn as
+        where the head stopped)."""
+        self._move_no += 1
+        self._set(replace(self._state, moving=True, goal=goal))
+        self.ctx.spawn(self._follow(self._move_no, self._state.position), "ptz-follow")
+
+    async def wait_settled(self) -> None:
+        """Until the last move has settled (``rtmu ptz`` prints where the head stopped), bounded."""
+        deadline = time.monotonic() + FOLLOW_LIMIT_S + 2 * self._timeout
+        while self._state.moving and time.monotonic() < deadline:
+            await asyncio.sleep(POLL_MS / 4000)
+
+    async def _follow(self, move_no: int, before: tuple[float, float, float] | None) -> None:
+        """Read the position every ``POLL_MS`` until two readings in a row agree and the head could
+        have turned that far at :data:`HEAD_SPEEDS`; then the reading is where it stopped."""
+        started, last = time.monotonic(), None
+        while move_no == self._move_no:
+            position = await self.refresh()
+            if move_no != self._move_no:
+                return  # a newer move (or a new connection) follows its own
+            elapsed = time.monotonic() - started
+            if position is not None and position == last and elapsed >= turn_time(before, position):
+                break
+            if position is None or elapsed >= FOLLOW_LIMIT_S:
+                break
+            last = position
+            await asyncio.sleep(POLL_MS / 1000)
+        if move_no == self._move_no:
+            self._set(replace(self._state, moving=False, goal=None))
 
     def _require(self, command: str) -> tuple[AriaClient, str]:
         client, name = self._client, self._name(command)
@@ -223,6 +273,13 @@ class PtzFeed(Feed):
             return None
         name = cam.data_name(command)
         return name if name and client.supports(name) else None
+
+
+def turn_time(a: tuple[float, float, float] | None, b: tuple[float, float, float] | None) -> float:
+    """Seconds a head at :data:`HEAD_SPEEDS` needs from ``a`` to ``b`` (0 when either is unknown)."""
+    if a is None or b is None:
+        return 0.0
+    return max(abs(x - y) / speed for x, y, speed in zip(a, b, HEAD_SPEEDS, strict=True))
 
 
 def _bound(value: float) -> float:

@@ -40,19 +40,53 @@ TELE_FOV_DEG = 4.0
 PAN_RANGE = (-98.0, 98.0)
 TILT_RANGE = (-30.0, 88.0)
 ZOOM_RANGE = (0.0, 100.0)
+PAN_SPEED = 90.0
+TILT_SPEED = 69.0
+"""Degrees per second: the VC-C4's fastest pan and tilt slews, ARIA's defaults for that head."""
+ZOOM_SPEED = 50.0
+"""Percent of the zoom range per second (a whole range in 2 s: our choice, ARIA names no zoom speed)."""
+
+
+def _toward(now: float, goal: float, step: float) -> float:
+    return goal if abs(goal - now) <= step else now + math.copysign(step, goal - now)
 
 
 @dataclass
 class PanTiltZoom:
+    """The head as it is now; a move (:meth:`aim`) sets a goal that :meth:`slew` reaches at the head's
+    speeds, so a client reading the position sees it move, as a real head moves. Setting ``pan`` …
+    directly (tests: "someone else moved the head") moves it at once."""
+
     pan: float = 0.0
     tilt: float = 0.0
     zoom: float = 0.0
     """Percent of the zoom range."""
+    goal: tuple[float, float, float] | None = None
+    """Where the head is turning to (clamped), None when it is still."""
 
-    def clamp(self) -> None:
-        self.pan = min(max(self.pan, PAN_RANGE[0]), PAN_RANGE[1])
-        self.tilt = min(max(self.tilt, TILT_RANGE[0]), TILT_RANGE[1])
-        self.zoom = min(max(self.zoom, ZOOM_RANGE[0]), ZOOM_RANGE[1])
+    def target(self) -> tuple[float, float, float]:
+        """Where the head will be: its goal, or where it is (relative moves add to this, as ARIA's
+        VC-C4 driver adds to the position it last asked for)."""
+        return self.goal if self.goal is not None else (self.pan, self.tilt, self.zoom)
+
+    def aim(self, pan: float, tilt: float, zoom: float) -> None:
+        """Start turning to (pan, tilt, zoom), clamped to the head's limits."""
+        self.goal = (
+            min(max(pan, PAN_RANGE[0]), PAN_RANGE[1]),
+            min(max(tilt, TILT_RANGE[0]), TILT_RANGE[1]),
+            min(max(zoom, ZOOM_RANGE[0]), ZOOM_RANGE[1]),
+        )
+
+    def slew(self, dt: float) -> None:
+        """Move ``dt`` seconds' worth toward the goal; the goal is dropped once reached."""
+        if self.goal is None:
+            return
+        pan, tilt, zoom = self.goal
+        self.pan = _toward(self.pan, pan, PAN_SPEED * dt)
+        self.tilt = _toward(self.tilt, tilt, TILT_SPEED * dt)
+        self.zoom = _toward(self.zoom, zoom, ZOOM_SPEED * dt)
+        if (self.pan, self.tilt, self.zoom) == self.goal:
+            self.goal = None
 
     @property
     def fov_deg(self) -> float:

@@ -30,7 +30,7 @@ from rtmu.protocol.payloads.camera import (
     VideoSize,
 )
 
-from .camera import PAN_RANGE, TILT_RANGE, ZOOM_RANGE
+from .camera import PAN_RANGE, TILT_RANGE, ZOOM_RANGE, PanTiltZoom
 from .handlers import Call, Handler, Reply, decode_lenient, handles_into
 
 HANDLERS: dict[str, Handler] = {}
@@ -130,9 +130,7 @@ def _legacy_camera_info(call: Call) -> Iterable[Reply]:
 @handles("setCameraAbsCam1")
 def _set_camera_abs(call: Call) -> Iterable[Reply]:
     a = decode_lenient(SetCameraAbs, call.args)
-    p = call.world.camera.ptz
-    p.pan, p.tilt, p.zoom = a.pan, a.tilt, a.zoom or 0.0
-    p.clamp()
+    call.world.camera.ptz.aim(a.pan, a.tilt, a.zoom or 0.0)
     return ()
 
 
@@ -140,12 +138,11 @@ def _set_camera_abs(call: Call) -> Iterable[Reply]:
 def _set_camera_rel(call: Call) -> Iterable[Reply]:
     a = decode_lenient(SetCameraRel, call.args)
     p = call.world.camera.ptz
-    factor = max(1.0 - p.zoom / 100.0, 0.01)
-    p.pan += _away_from_zero(a.pan * factor)
-    p.tilt += _away_from_zero(a.tilt * factor)
-    if a.zoom is not None:
-        p.zoom += a.zoom
-    p.clamp()
+    pan, tilt, zoom = p.target()
+    factor = max(1.0 - zoom / 100.0, 0.01)
+    pan += _away_from_zero(a.pan * factor)
+    tilt += _away_from_zero(a.tilt * factor)
+    p.aim(pan, tilt, zoom + (a.zoom or 0.0))
     return ()
 
 
@@ -153,10 +150,9 @@ def _set_camera_rel(call: Call) -> Iterable[Reply]:
 def _set_camera_pct(call: Call) -> Iterable[Reply]:
     a = decode_lenient(SetCameraPct, call.args)
     p = call.world.camera.ptz
-    half = p.fov_deg / 2
-    p.pan += a.pan / 100.0 * half
-    p.tilt -= a.tilt / 100.0 * half * 0.75
-    p.clamp()
+    pan, tilt, zoom = p.target()
+    half = PanTiltZoom(zoom=zoom).fov_deg / 2
+    p.aim(pan + a.pan / 100.0 * half, tilt - a.tilt / 100.0 * half * 0.75, zoom)
     return ()
 
 
@@ -165,21 +161,20 @@ def _legacy_camera_move(call: Call) -> Iterable[Reply]:
     data = call.args + b"\x00\x00\x00"
     d_pan, d_tilt, d_zoom = (int.from_bytes(data[i : i + 1], "little", signed=True) for i in range(3))
     p = call.world.camera.ptz
+    pan, tilt, zoom = p.target()
+    fov = PanTiltZoom(zoom=zoom).fov_deg
     if call.name == "camera":
-        p.pan, p.tilt, p.zoom = p.pan + d_pan, p.tilt + d_tilt, p.zoom + d_zoom
+        p.aim(pan + d_pan, tilt + d_tilt, zoom + d_zoom)
     elif call.name == "cameraAbs":
-        p.pan, p.tilt, p.zoom = d_pan, d_tilt, d_zoom
+        p.aim(d_pan, d_tilt, d_zoom)
     else:
-        p.pan += d_pan / 100.0 * p.fov_deg / 2
-        p.tilt -= d_tilt / 100.0 * p.fov_deg * 0.375
-    p.clamp()
+        p.aim(pan + d_pan / 100.0 * fov / 2, tilt - d_tilt / 100.0 * fov * 0.375, zoom)
     return ()
 
 
 @handles("resetCameraCam1")
 def _reset_camera(call: Call) -> Iterable[Reply]:
-    p = call.world.camera.ptz
-    p.pan = p.tilt = p.zoom = 0.0
+    call.world.camera.ptz.aim(0.0, 0.0, 0.0)
     return ()
 
 

@@ -285,6 +285,7 @@ class World:
         self.time = round(self.time + dt, 9)  # no drift: 300 steps of 10 ms are exactly 3 s
         cmd = self.mode.command(self.body, self.time, dt)
         self.body.step(dt, cmd)
+        self.camera.ptz.slew(dt)
         if not self.body.is_stopped():
             self.last_activity = self.time
         charging = self.mode is self.dock_mode and self.dock_mode.docked

@@ -21,8 +21,6 @@ from ._common import UsageError, add_connection_arguments, fail, print_json, run
 if TYPE_CHECKING:
     from ..client.connection import AriaClient
 
-SETTLE_S = 0.5
-"""How long a real head gets to turn before its position is read back."""
 PTZ_COMMANDS = ("setCameraRel", "setCameraAbs", "setCameraPct", "getCameraData", "getCameraInfo")
 
 
@@ -71,8 +69,6 @@ def _ptz_object(state: PtzState) -> dict[str, Any]:
 
 
 def handle(args: argparse.Namespace) -> int:
-    import asyncio
-
     from ..client.detached import DetachedContext
     from ..client.ptz import PtzFeed
     from ..client.session_config import SessionConfig
@@ -95,8 +91,7 @@ def handle(args: argparse.Namespace) -> int:
                 tilt if args.tilt is None else args.tilt,
                 zoom if args.zoom is None else args.zoom,
             )
-            await asyncio.sleep(SETTLE_S)
-            await feed.refresh()
+            await feed.wait_settled()  # read until the head stops, not a guessed pause
             state = feed.state
         cameras = [
             {

@@ -22,6 +22,10 @@ from . import accessible  # noqa: E402
 MAX_BANNERS = 4
 MARGIN_TOP = 8
 """Pixels between the top of the pages and the first banner (more under the navigation pill)."""
+MIN_BESIDE = 300
+"""The least width (px) that banners beside a motion pill get; with less they go under it."""
+GAP = 8
+"""Pixels between a motion pill and the banners beside it."""
 HISTORY = 50
 MAX_CHARS = 300
 ICONS = {
@@ -116,22 +120,61 @@ class BannerStack(Gtk.Box):
     def topics(self) -> list[str]:
         return list(self._order)
 
-    def keep_clear_of(self, *pills: Gtk.Widget) -> None:
-        """Start the column under the motion pills (the map's, the camera page's) while one is shown
-        where the column would cover it: a banner never hides what the robot is doing. Called by the
-        window's timer; the margin only changes when it must (no relayout otherwise)."""
-        top = MARGIN_TOP
+    def keep_clear_of(
+        self,
+        *pills: Gtk.Widget,
+        avoid: tuple[float, float, float, float] | None = None,
+        bottom: int = 0,
+    ) -> None:
+        """Keep the column off the motion pills (the map's, the camera page's): a banner never hides
+        what the robot is doing. Where the centred column would cover a pill it moves beside it, on
+        the same row, when there is :data:`MIN_BESIDE` px of room (800×480 and up); only then under
+        it (a phone), which covers more of the map — unless the column would cover ``avoid`` there (the
+        robot as drawn, in the parent's terms) and ``bottom`` offers a place that ends that far above
+        the bottom (above a phone's D-pad) and is clear of it. Called by the window's timer; the margins are
+        computed from the column's natural width, not its last place, so they hold steady, and only
+        change when they must (no relayout otherwise)."""
+        top, start, end, low = MARGIN_TOP, 0, 0, 0
         parent = self.get_parent()
-        ok_own, own = self.compute_bounds(parent) if parent is not None else (False, None)
-        for pill in pills:
-            if parent is None or not ok_own or own is None or not pill.get_mapped() or not self._order:
-                continue
-            ok_pill, box = pill.compute_bounds(parent)
-            left, right = own.get_x(), own.get_x() + own.get_width()
-            if ok_pill and left < box.get_x() + box.get_width() and box.get_x() < right:
-                top = max(top, round(box.get_y() + box.get_height()) + MARGIN_TOP // 2)
-        if self.get_margin_top() != top:
+        width = parent.get_width() if parent is not None else 0
+        if parent is not None and width > 0 and self._order:
+            natural = self.measure(Gtk.Orientation.HORIZONTAL, -1)[1]
+            natural = min(natural - self.get_margin_start() - self.get_margin_end(), width)
+            left, right = (width - natural) / 2, (width + natural) / 2
+            for pill in pills:
+                ok, box = pill.compute_bounds(parent) if pill.get_mapped() else (False, None)
+                if not ok or box is None:
+                    continue
+                x0, x1 = box.get_x(), box.get_x() + box.get_width()
+                if right <= x0 - GAP or x1 + GAP <= left:
+                    continue  # the centred column is clear of it already
+                room_right, room_left = width - x1 - GAP, x0 - GAP
+                if room_right >= MIN_BESIDE and room_right >= room_left:
+                    start = round(x1 + GAP)
+                elif room_left >= MIN_BESIDE:
+                    end = round(width - x0 + GAP)
+                else:
+                    top = max(top, round(box.get_y() + box.get_height()) + MARGIN_TOP // 2)
+            height = self.measure(Gtk.Orientation.VERTICAL, natural)[1]
+            height -= self.get_margin_top() + self.get_margin_bottom()
+            if avoid is not None and bottom > 0 and top > MARGIN_TOP:
+                under = (left, top, right, top + height)
+                floor = parent.get_height() - bottom
+                low_place = (left, floor - height, right, floor)
+                if _overlap(under, avoid) and not _overlap(low_place, avoid) and floor - height > top:
+                    top, low = MARGIN_TOP, bottom
+        place = (top, start, end, low)
+        if (
+            self.get_margin_top(),
+            self.get_margin_start(),
+            self.get_margin_end(),
+            self.get_margin_bottom(),
+        ) != place:
             self.set_margin_top(top)
+            self.set_margin_start(start)
+            self.set_margin_end(end)
+            self.set_margin_bottom(low)
+            self.set_valign(Gtk.Align.END if low else Gtk.Align.START)
 
     # -- internals ---------------------------------------------------------------------------
     def _make(self, topic: str) -> _Banner:
@@ -173,6 +216,10 @@ class BannerStack(Gtk.Box):
             banner.timer = 0
             self.dismiss(topic)
         return False
+
+
+def _overlap(a: tuple[float, float, float, float], b: tuple[float, float, float, float]) -> bool:
+    return a[0] < b[2] and b[0] < a[2] and a[1] < b[3] and b[1] < a[3]
 
 
 def _one_paragraph(text: str) -> str:

@@ -161,6 +161,12 @@ class FullscreenBar(Gtk.Revealer):
                 header.pack_end(widget)
             self.borrowed = ()
 
+    def set_compact(self, on: bool) -> None:
+        """The phone layout: shed the status line (the strip says it) and the leave button (the menu's
+        "Full screen" leaves), so STOP, Connect, Go to, the camera and the menu fit a 360 px screen."""
+        self.status_label.set_visible(not on)
+        self.leave_button.set_visible(not on)
+
     def show_status(self, connected_ish: bool, status: str) -> None:
         """As the header bar's, which it stands in for."""
         show_connection(self.connect_button, connected_ish)

@@ -25,6 +25,9 @@ PADS = (
     ("drive_backward", "go-down-symbolic", 1, 2, "Backward (hold)"),
 )
 PAD_PX = 64
+COMPACT_PAD_PX = 48
+"""A pad on a narrow map in its corner (``dpad_place``): still a finger's width (48 px), and Fit can
+then show the map above the D-pad instead of under it."""
 
 
 class DPad(Gtk.Grid):
@@ -60,6 +63,12 @@ class DPad(Gtk.Grid):
         stop_pad.add_controller(click)
         self.attach(stop_pad, 1, 1, 1, 1)
         self.pads["stop"] = stop_pad
+
+    def set_pad_size(self, px: int) -> None:
+        """Every pad ``px`` square (a change only when it differs: no relayout otherwise)."""
+        for pad in self.pads.values():
+            if pad.get_size_request() != (px, px):
+                pad.set_size_request(px, px)
 
     @staticmethod
     def _pad(child: Gtk.Widget, tooltip: str) -> Gtk.Widget:

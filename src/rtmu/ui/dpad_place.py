@@ -6,11 +6,13 @@ row: ``layout``). What this module keeps true, whatever the page and its width:
 * it is on the page the operator looks at — the map, or the camera page (the one widget moves
   between them, so a finger held on it is one state);
 * it never sits on the zoom row: a map narrower than the two side by side (split view, a fleet's
-  list beside it) lifts the D-pad above the row;
+  list beside it) lifts the D-pad above the row, and a map under :data:`COMPACT_MAP` px gets the
+  compact pads, so that Fit can show the map above them;
 * the Go-to-point / Set-position bar keeps clear of it (beside it, or above it on a phone);
-* Fit keeps the robot and the D-pad apart: the map is fitted in what the D-pad leaves — beside it
-  or above it, whichever shows the map larger (:meth:`DPadPlacement.fit_room`) — unless that would
-  shrink the map below half its plain fit (``viewport.best_fit``: a split phone's small map).
+* Fit keeps the map clear of the D-pad and of the zoom row: the map is fitted in what they leave —
+  beside or above each, whichever shows the map larger (:meth:`DPadPlacement.fit_room`) — unless
+  that would shrink the map below half its plain fit (``viewport.best_fit``: a split phone's small
+  map); even then the zoom row keeps its room (:meth:`DPadPlacement.fit_floor`).
 """
 
 from __future__ import annotations
@@ -22,6 +24,7 @@ import gi
 gi.require_version("Gtk", "4.0")
 from gi.repository import GLib, Gtk  # noqa: E402
 
+from .dpad import COMPACT_PAD_PX, PAD_PX, DPad  # noqa: E402
 from .viewport import Insets  # noqa: E402
 
 GAP = 8
@@ -30,6 +33,18 @@ ABOVE_OSD = 64
 """The D-pad's bottom margin when it must sit above the zoom row (as a phone's: ``layout``)."""
 CORNER = 12
 """The D-pad's bottom margin in its corner."""
+COMPACT_MAP = 600
+"""A map narrower than this (px: split view or a fleet's list at 800×480) gets the compact pads in its
+corner, so that Fit can keep the map clear of the D-pad (above it) and still show it at a legible size."""
+
+
+def _footprint(widget: Gtk.Widget) -> tuple[int, int]:
+    """A widget's natural width and height with its margins (``measure`` includes them)."""
+    return widget.measure(Gtk.Orientation.HORIZONTAL, -1)[1], widget.measure(Gtk.Orientation.VERTICAL, -1)[1]
+
+
+def _larger(a: Insets, b: Insets) -> Insets:
+    return (max(a[0], b[0]), max(a[1], b[1]), max(a[2], b[2]), max(a[3], b[3]))
 
 
 class DPadPlacement:
@@ -38,7 +53,7 @@ class DPadPlacement:
 
     def __init__(
         self,
-        dpad: Gtk.Widget,
+        dpad: DPad,
         map_page: Gtk.Overlay,
         *,
         osd: Gtk.Widget,
@@ -78,24 +93,27 @@ class DPadPlacement:
 
     # -- room ----------------------------------------------------------------------------------
     def _size(self) -> tuple[int, int]:
-        """The D-pad's width and height with its margins (px)."""
-        _min_w, nat_w, _b, _c = self.dpad.measure(Gtk.Orientation.HORIZONTAL, -1)
-        _min_h, nat_h, _b, _c = self.dpad.measure(Gtk.Orientation.VERTICAL, -1)
-        d = self.dpad
-        return (
-            nat_w + d.get_margin_start() + d.get_margin_end(),
-            nat_h + d.get_margin_bottom() + d.get_margin_top(),
-        )
+        """The D-pad's width and height with its margins (px): ``measure`` counts a widget's margins
+        already (adding them again kept 64 px too many above a lifted D-pad)."""
+        return _footprint(self.dpad)
 
-    def fit_room(self, _width: int, _height: int) -> tuple[Insets, ...]:
-        """The ways Fit may keep clear of the D-pad on the map: beside it (in its corner) or above it."""
-        if not (self.dpad.get_visible() and self.on_map()):
+    def fit_floor(self, _width: int, _height: int) -> tuple[Insets, ...]:
+        """The ways Fit always keeps clear of the zoom row: left of it or above it."""
+        if not self.osd.get_visible():
             return ()
-        w, h = self._size()
-        above = (0, 0, 0, h + GAP)
-        if self.dpad.get_halign() == Gtk.Align.CENTER:
-            return (above,)
-        return ((w + GAP, 0, 0, 0), above)
+        osd_w, osd_h = _footprint(self.osd)
+        return ((0, 0, osd_w + GAP, 0), (0, 0, 0, osd_h + GAP))
+
+    def fit_room(self, width: int, height: int) -> tuple[Insets, ...]:
+        """The ways Fit may keep clear of the zoom row (:meth:`fit_floor`) and of the D-pad on the map
+        (beside it in its corner, or above it): every pairing, the larger inset of each edge."""
+        zoom_row = self.fit_floor(width, height) or ((0, 0, 0, 0),)
+        pad: tuple[Insets, ...] = ((0, 0, 0, 0),)
+        if self.dpad.get_visible() and self.on_map():
+            w, h = self._size()
+            above = (0, 0, 0, h + GAP)
+            pad = (above,) if self.dpad.get_halign() == Gtk.Align.CENTER else ((w + GAP, 0, 0, 0), above)
+        return tuple(_larger(a, b) for a in zoom_row for b in pad)
 
     def queue(self) -> None:
         """Place again after this layout (never inside a size allocation)."""
@@ -112,6 +130,8 @@ class DPadPlacement:
         d = self.dpad
         shown = d.get_visible()
         corner = d.get_halign() == Gtk.Align.START
+        compact = corner and self.on_map() and self.map_page.get_width() < COMPACT_MAP
+        d.set_pad_size(COMPACT_PAD_PX if compact else PAD_PX)
         w, h = self._size()
         if corner and self.on_map():
             osd_w = self.osd.measure(Gtk.Orientation.HORIZONTAL, -1)[1] + self.osd.get_margin_end()

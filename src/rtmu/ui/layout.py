@@ -12,12 +12,14 @@ the map narrower, not the window): under :data:`NARROW` px the window is a phone
   the camera and Go to still fit 360 px: the title (the strip says the state), the
   window's minimise/maximise/close buttons (a phone's shell closes apps; Quit is in
   the menu), the Connect buttons' fixed minimum width and 20 px of STOP's (still
-  the first and the only red button);
+  the first and the only red button); the full-screen bar sheds its status line and leave button
+  (the menu leaves full screen) and the camera head's position takes a line above its buttons;
 
 and at :data:`NARROW` or more everything is exactly as the landscape window
 always was. Switching happens in an idle callback, never inside a size
 allocation. A window opened on a screen narrower than :data:`NARROW` (a
-phone) starts maximised at that screen's size instead of 800×480.
+phone) starts maximised at that screen's size instead of 800×480, and keeps
+the phone layout on that screen whatever its width (:meth:`PhoneLayout.wants_narrow`).
 """
 
 from __future__ import annotations
@@ -55,6 +57,13 @@ def screen_size() -> tuple[int, int] | None:
     return geometry.width, geometry.height
 
 
+def monitor_width(window: Gtk.Window) -> int | None:
+    """The width (logical px) of the monitor ``window`` is on, or None before it has a surface."""
+    surface, display = window.get_surface(), window.get_display()
+    monitor = display.get_monitor_at_surface(surface) if surface is not None else None
+    return monitor.get_geometry().width if monitor is not None else None
+
+
 class PhoneLayout:
     """Owns the strip and the switch; ``on_change(narrow)`` is told after each switch."""
 
@@ -80,16 +89,29 @@ class PhoneLayout:
         # video or the robot list beside it is not a phone, and must keep the title bar's buttons.
         self._resize_handler = window.stage.connect("resize", lambda _s, _w, _h: self._queue())
 
-    def _queue(self) -> None:
+    def wants_narrow(self) -> bool | None:
+        """Phone layout or not, None while the window has no width yet.
+
+        A screen narrower than :data:`NARROW` always gets the phone layout, whatever the window's
+        width: the landscape layout needs 512 px, more than a phone's screen, so once chosen there (the
+        window made wider for a moment) a window manager that honours minimum sizes could never make
+        the window narrow enough to switch back, and it would overflow the screen."""
         width = self.window.get_width()
-        if width > 0 and (width < NARROW) != self.narrow and not self._idle:
+        if width <= 0:
+            return None
+        screen = monitor_width(self.window)
+        return width < NARROW or (screen is not None and screen < NARROW)
+
+    def _queue(self) -> None:
+        narrow = self.wants_narrow()
+        if narrow is not None and narrow != self.narrow and not self._idle:
             self._idle = GLib.idle_add(self._apply_idle)
 
     def _apply_idle(self) -> bool:
         self._idle = 0
-        width = self.window.get_width()
-        if width > 0:
-            self.apply(width < NARROW)
+        narrow = self.wants_narrow()
+        if narrow is not None:
+            self.apply(narrow)
         return False
 
     def apply(self, narrow: bool) -> None:
@@ -108,6 +130,8 @@ class PhoneLayout:
         title_box = w.title_label.get_parent()
         if title_box is not None:
             title_box.set_visible(not narrow)
+        w.fullscreen_bar.set_compact(narrow)
+        w.ptz.set_compact(narrow)
         for button in (w.connect_button, w.fullscreen_bar.connect_button):
             (button.remove_css_class if narrow else button.add_css_class)("connect-button")
         dpad = w.dpad

@@ -22,7 +22,8 @@ import gi
 
 gi.require_version("Gtk", "4.0")
 gi.require_version("Gdk", "4.0")
-from gi.repository import Gdk, Gtk  # noqa: E402
+gi.require_version("Graphene", "1.0")
+from gi.repository import Gdk, Graphene, Gtk  # noqa: E402
 
 from ..base.notices import Kind, Notice  # noqa: E402
 from ..control.commands import COMMANDS, CommandState  # noqa: E402
@@ -42,6 +43,10 @@ from .popups import PopupStack  # noqa: E402
 from .pose_bar import PoseBar, pose_words  # noqa: E402
 from .pose_pick import PosePicker  # noqa: E402
 from .viewport import zoom_label  # noqa: E402
+
+ROBOT_CLEAR_PX = 24
+"""Half the square around the robot's drawn centre that banners keep clear of (the body at Fit and a
+margin)."""
 
 
 def touch_only(display: Gdk.Display | None = None) -> bool:
@@ -110,6 +115,7 @@ class MapPage(Gtk.Overlay):
             self.dpad, self, osd=self.osd, pose_bar=self.pose_bar, refit=self.stage.refit
         )
         self.stage.fit_room = self.dpad_place.fit_room
+        self.stage.fit_floor = self.dpad_place.fit_floor
         self.stage.connect("resize", lambda *_a: self.dpad_place.queue())
         self.stage.connect("resize", lambda _s, width, _h: self.inset.fit_to(width))
 
@@ -171,6 +177,26 @@ class MapPage(Gtk.Overlay):
         if self.note.get_text() != text:
             self.note.set_text(text)
         self.note.set_visible(bool(text))
+
+    def banner_room(self, ancestor: Gtk.Widget) -> tuple[tuple[float, float, float, float] | None, int]:
+        """What the banners keep clear of on a phone, in ``ancestor``'s terms: the robot as drawn (None
+        when the map is not shown), and how far above the page's bottom a column may end instead —
+        above the thumb's D-pad and the server's cards (0 when there is no such place)."""
+        robot, box = self.model.robot.value, None
+        if self.get_mapped() and robot.numbers_at is not None:
+            sx, sy = self.stage.viewport.to_screen(robot.x, robot.y)
+            ok, point = self.stage.compute_point(ancestor, Graphene.Point().init(sx, sy))
+            if ok:
+                half = ROBOT_CLEAR_PX
+                box = (point.x - half, point.y - half, point.x + half, point.y + half)
+        bottom = 0
+        if self.get_mapped() and self.dpad.get_mapped() and self.dpad.get_halign() == Gtk.Align.CENTER:
+            cards = self.popup_stack
+            if cards.get_mapped():  # the server's cards sit above the D-pad: above them
+                bottom = cards.get_margin_bottom() + cards.get_height() + 8
+            else:  # just above the D-pad (its measure counts its margin above the zoom row)
+                bottom = self.dpad.measure(Gtk.Orientation.VERTICAL, -1)[1] + 8
+        return box, bottom
 
     def set_dpad(self, on: bool) -> None:
         self.dpad.set_visible(on)

@@ -83,6 +83,7 @@ class MapStage(Gtk.DrawingArea):
         self.fitted = operator.view.value.zoom == 0.0
         """The zoom is "fit the map" (re-fitted when the widget is resized or a map arrives)."""
         self.fit_room: Callable[[int, int], tuple[Insets, ...]] = lambda _w, _h: ()
+        self.fit_floor: Callable[[int, int], tuple[Insets, ...]] = lambda _w, _h: ()
         """Ways for Fit to keep clear of an overlay at this size (``dpad_place``): none by default."""
         self.on_view_changed: Callable[[], None] | None = None
         self.on_first_map_frame: Callable[[float], None] | None = None
@@ -287,9 +288,10 @@ class MapStage(Gtk.DrawingArea):
         self._view_moved()
 
     def _fit_view(self, bounds: tuple[float, float, float, float]) -> Viewport:
-        """Fit ``bounds`` clear of the overlays that ask for room (``fit_room``: the D-pad)."""
+        """Fit ``bounds`` clear of the overlays that ask for room (``fit_room``: the D-pad and the zoom
+        row; ``fit_floor``: the zoom row, kept even when the D-pad's room would shrink the map too far)."""
         width, height = self._size()
-        return best_fit(bounds, width, height, self.fit_room(width, height))
+        return best_fit(bounds, width, height, self.fit_room(width, height), self.fit_floor(width, height))
 
     def _view_moved(self) -> None:
         """Zoom or centre changed without the operator: let the window's zoom label follow."""

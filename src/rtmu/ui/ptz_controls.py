@@ -52,16 +52,22 @@ a look-at heading into ``-delta``), tilt positive up."""
 
 
 def position_text(state: PtzState | None) -> str:
+    """The head's settled position; while it turns, "moving" and where to (never a mid-turn reading
+    as if the head were there)."""
     if state is None or not state.camera:
         return "Camera head"
     name = state.display_name or state.camera
+    if state.moving:
+        return f"{name}: moving to {_angles(state, state.goal)}…" if state.goal else f"{name}: moving…"
     if state.position is None:
         return f"{name}: position not read yet"
-    pan, tilt, zoom = state.position
-    text = f"{name}: pan {pan:+.0f}°  tilt {tilt:+.0f}°"
-    if state.zoom_available:
-        text += f"  zoom {zoom:.0f} %"
-    return text
+    return f"{name}: {_angles(state, state.position)}"
+
+
+def _angles(state: PtzState, where: tuple[float, float, float]) -> str:
+    pan, tilt, zoom = where
+    text = f"pan {pan:+.0f}°  tilt {tilt:+.0f}°"
+    return text + f"  zoom {zoom:.0f} %" if state.zoom_available else text
 
 
 def disabled_reason(state: PtzState | None, connected: bool) -> str:
@@ -101,7 +107,11 @@ class PtzControls(Gtk.Box):
         self.label = Gtk.Label(xalign=0.0, hexpand=True)
         self.label.set_use_markup(False)
         self.label.set_ellipsize(Pango.EllipsizeMode.END)  # a long camera name must not widen the window
+        self.label.set_wrap_mode(Pango.WrapMode.WORD_CHAR)
         self.append(self.label)
+        self.row = Gtk.Box(spacing=4, halign=Gtk.Align.END)
+        """The buttons: beside the label, or under it on a phone (:meth:`set_compact`)."""
+        self.append(self.row)
         for intent, icon, tip in (
             ("ptz_left", "go-previous-symbolic", "Pan left (Ctrl+Left)"),
             ("ptz_up", "go-up-symbolic", "Tilt up (Ctrl+Up)"),
@@ -118,7 +128,7 @@ class PtzControls(Gtk.Box):
             # The window's action (``win.ptz-left`` …), as the key's: a refusal is said the same way.
             button.connect("clicked", lambda b, i=intent: b.activate_action(f"win.{action_name(i)}", None))
             self.buttons[intent] = button
-            self.append(button)
+            self.row.append(button)
         self._unobserve = [
             model.robot.observe(self._on_robot),
             model.connection.observe(lambda _o, _n: self._show(self.model.robot.value)),
@@ -135,6 +145,14 @@ class PtzControls(Gtk.Box):
     @property
     def reason(self) -> str:
         return disabled_reason(self.state, self.model.connection.value.connected)
+
+    def set_compact(self, on: bool) -> None:
+        """A phone: the position on a line of its own above the buttons, where it fits whole (beside
+        seven buttons on 360 px it was cut to "Ca…")."""
+        self.set_orientation(Gtk.Orientation.VERTICAL if on else Gtk.Orientation.HORIZONTAL)
+        # The whole width is the label's there: a longer text ("moving to …") wraps, never cut.
+        self.label.set_wrap(on)
+        self.label.set_ellipsize(Pango.EllipsizeMode.NONE if on else Pango.EllipsizeMode.END)
 
     def close(self) -> None:
         """The window is going: unhook, and ask the runner for nothing more (it may be closed)."""

@@ -143,12 +143,21 @@ def fit_view(
 
 
 def best_fit(
-    bounds: tuple[float, float, float, float], width: int, height: int, choices: tuple[Insets, ...]
+    bounds: tuple[float, float, float, float],
+    width: int,
+    height: int,
+    choices: tuple[Insets, ...],
+    floor: tuple[Insets, ...] = (),
 ) -> Viewport:
     """Of the ways to keep clear of an overlay (``choices``: beside it, above it …), the fit that
     shows the map largest — unless even that shows it at less than :data:`FIT_ROOM_SHARE` of the
-    plain fit (a split phone's small map under a big D-pad): then the plain fit, legible."""
-    plain = fit_view(bounds, width, height)
+    plain fit (a split phone's small map under a big D-pad): then the plain fit, legible. The plain
+    fit keeps clear of what ``floor`` names in any case (its best way: the small zoom row)."""
+    plain = max(
+        (fit_view(bounds, width, height, insets=i) for i in floor),
+        key=lambda v: v.zoom,
+        default=fit_view(bounds, width, height),
+    )
     views = [fit_view(bounds, width, height, insets=i) for i in choices]
     best = max(views, key=lambda v: v.zoom, default=plain)
     return best if best.zoom >= FIT_ROOM_SHARE * plain.zoom else plain

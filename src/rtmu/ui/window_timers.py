@@ -96,11 +96,18 @@ class WindowTimers:
         self.window.controller.tick()
         self.window.map_page.refresh()
         self.window.why_hint.tick()
-        self.window.banners.keep_clear_of(self.window.motion, self.window.camera_page.motion)
+        self._place_banners()
         if self._driving():
             return True
         self._drive = 0
         return False
+
+    def _place_banners(self) -> None:
+        """The banners off the motion pills, and on a phone off the robot (``MapPage.banner_room``)."""
+        w = self.window
+        parent = w.banners.get_parent()
+        avoid, bottom = w.map_page.banner_room(parent) if parent is not None else (None, 0)
+        w.banners.keep_clear_of(w.motion, w.camera_page.motion, avoid=avoid, bottom=bottom)
 
     def _beat_tick(self) -> bool:
         """The GTK thread's heartbeat to the guardian, until it is disarmed after the drive."""
@@ -116,7 +123,7 @@ class WindowTimers:
         w = self.window
         w.map_page.refresh()
         w.why_hint.tick()  # a key held that drives nothing (no lease, so no drive tick) is seen here
-        w.banners.keep_clear_of(w.motion, w.camera_page.motion)
+        self._place_banners()
         w.toolbar.refresh()
         w.desktop.refresh()  # no screen lock or suspend while the robot moves
         w.camera_page.tick()

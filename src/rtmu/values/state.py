@@ -141,6 +141,11 @@ class PtzState:
     zoom_available: bool = False
     position: tuple[float, float, float] | None = None
     """(pan, tilt, zoom) as last read: pan positive to the right, tilt positive up (ARIA's convention)."""
+    moving: bool = False
+    """A move was asked and the server's reading has not settled yet: ``position`` is not where the
+    head will stop."""
+    goal: tuple[float, float, float] | None = None
+    """Where a moving head was pointed (an absolute move, clamped to the limits); None for a turn by."""
 
     @property
     def movable(self) -> bool:
