@@ -239,9 +239,10 @@ _OWNER_COUNT = [0]
 @pytest.fixture(autouse=True)
 def every_test_leaves_a_clean_x_server_and_no_processes(request: pytest.FixtureRequest) -> Iterator[None]:
     """Reset what a test may leave behind, whether it passed, failed or timed out: the apps it left
-    open are closed, held keys and mouse buttons released, and every process it started (marked
-    through the environment, see ``isolation``) ends. A passing test that leaked a process fails:
-    each test owns and removes what it starts."""
+    open are closed, every window still on screen destroyed, held keys and mouse buttons released,
+    and every process it started (marked through the environment, see ``isolation``) ends. A passing
+    test that leaked a process or left a window on screen fails: each test owns and removes what it
+    starts."""
     from . import isolation
     from .harness import OPEN
 
@@ -257,13 +258,15 @@ def every_test_leaves_a_clean_x_server_and_no_processes(request: pytest.FixtureR
         else:
             os.environ[isolation.OWNER] = previous
         left_open = isolation.close_all(OPEN)
+        left_shown = isolation.destroy_windows()
         if not SKIP_REASON:
             isolation.release_input()
         killed = isolation.end_processes(mark)
         isolation.reap_children()
-    if request.node.stash.get(_CALL_PASSED, False) and (killed or left_open):
+    if request.node.stash.get(_CALL_PASSED, False) and (killed or left_open or left_shown):
         pytest.fail(
-            f"this test left {left_open} app(s) open and {len(killed)} process(es) running: {killed}",
+            f"this test left {left_open} app(s) open, windows on screen {left_shown} and "
+            f"{len(killed)} process(es) running: {killed}",
             pytrace=False,
         )
 

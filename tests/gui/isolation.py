@@ -110,3 +110,20 @@ def close_all(closers: dict[int, Callable[[], None]]) -> int:
         with contextlib.suppress(Exception):  # a broken app must not stop the reset of the next one
             close()
     return count
+
+
+def destroy_windows() -> list[str]:
+    """Destroy every toplevel window this process still has once a test's apps are closed; the titles
+    of those still on screen. A dialog left mapped stays above the next test's window on the shared X
+    screen (no window manager) and takes its clicks: every later click test would fail."""
+    if "gi.repository.Gtk" not in sys.modules:  # this process never opened a window
+        return []
+    from gi.repository import Gtk
+
+    shown = []
+    for window in list(Gtk.Window.list_toplevels()):
+        if isinstance(window, Gtk.Window):
+            if window.get_mapped():
+                shown.append(window.get_title() or type(window).__name__)
+            window.destroy()
+    return shown

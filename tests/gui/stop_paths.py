@@ -16,6 +16,7 @@ from dataclasses import dataclass
 import gi
 
 from rtmu.sim import SimThread
+from rtmu.ui.dialog_chain import dialogs_of
 from rtmu.ui.stop_keys import descendants
 from rtmu.values.intents import GotoGoal
 
@@ -83,14 +84,7 @@ def current_label(window: Gtk.Window, entry: MenuEntry) -> str:
 
 def owned_windows(window: Gtk.Window) -> list[Gtk.Window]:
     """The window's dialogs that are on screen (their transient-for chain leads to it)."""
-    out = []
-    for other in Gtk.Window.list_toplevels():
-        parent = other.get_transient_for() if isinstance(other, Gtk.Window) else None
-        while parent is not None and parent is not window:
-            parent = parent.get_transient_for()
-        if parent is window and other.get_mapped():
-            out.append(other)
-    return out
+    return [other for other in dialogs_of(window) if other.get_mapped()]
 
 
 class MenuPicker:

@@ -27,6 +27,7 @@ from gi.repository import GLib, Gtk  # noqa: E402
 
 from ..control.key_rules import keys_note  # noqa: E402
 from ..model.observables import Phase  # noqa: E402
+from .dialog_chain import dialogs_of  # noqa: E402
 
 MainWindow = Any
 """``ui.window.MainWindow`` (which imports this module): named, not imported."""
@@ -117,12 +118,7 @@ class KeyReach:
 
     def _dialog_title(self) -> str:
         """The title of one of this window's own windows that has the keyboard now ("" if none)."""
-        for other in Gtk.Window.list_toplevels():
-            if not isinstance(other, Gtk.Window) or other is self.window or not other.is_active():
-                continue
-            parent = other.get_transient_for()
-            while parent is not None and parent is not self.window:
-                parent = parent.get_transient_for()
-            if parent is self.window:
+        for other in dialogs_of(self.window):
+            if other.is_active():
                 return other.get_title() or "a dialog"
         return ""

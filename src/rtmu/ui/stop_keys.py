@@ -31,6 +31,7 @@ gi.require_version("Gdk", "4.0")
 from gi.repository import Gdk, GObject, Gtk  # noqa: E402
 
 from ..control.key_rules import FIELD_HINT, KeyAction, stop_key_action, stop_key_names  # noqa: E402
+from .dialog_chain import belongs_to  # noqa: E402
 
 GUARD_ATTR = "_rtmu_stop_keys"
 """Set on a surface once it carries the stop keys (a surface is guarded once, whichever window asks)."""
@@ -100,14 +101,7 @@ class StopKeys:
     # -- which surfaces --------------------------------------------------------------------
     def owns(self, native: Gtk.Widget) -> bool:
         """``native`` is the main window, one of its dialogs (``transient-for`` chain) or their popover."""
-        window = _owner_window(native)
-        seen = 0
-        while window is not None and seen < 32:
-            if window is self.window:
-                return True
-            window = window.get_transient_for()
-            seen += 1
-        return False
+        return belongs_to(self.window, _owner_window(native))
 
     def guard(self, native: Gtk.Widget) -> None:
         """Give ``native`` (a window or popover) the stop keys, once; mark its text fields."""
