@@ -121,3 +121,16 @@ def test_status_loads_no_numpy_gtk_or_recorder() -> None:
 
 def test_the_guardian_child_loads_no_numpy_gtk_or_recorder() -> None:
     assert check("import rtmu.guardian.child", network=False) == []
+
+
+def test_the_window_loads_no_replay_reader() -> None:
+    """The window's application module (all a live window needs) loads no MCAP reader: replay mode,
+    the only user of the replay bar, imports it when a recording is opened."""
+    modules = loaded_by("import rtmu.ui.application")
+    assert "rtmu.ui.application" in modules  # the probe imported what it meant to
+    late = [
+        m
+        for m in modules
+        if m.split(".")[0] == "mcap" or m.startswith(("rtmu.ui.replay", "rtmu.recorder.replay"))
+    ]
+    assert not late, f"{late} loaded with the window ({why(late[0], 'import rtmu.ui.application')})"

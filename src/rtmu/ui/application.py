@@ -21,6 +21,7 @@ import threading
 from collections.abc import Callable
 from dataclasses import replace
 from types import FrameType
+from typing import TYPE_CHECKING
 
 import gi
 
@@ -47,8 +48,10 @@ from ..settings.store import (  # noqa: E402
 from .fleet_bind import FleetBinding  # noqa: E402
 from .keys import accelerated  # noqa: E402
 from .options import APP_ID, GuiOptions  # noqa: E402
-from .replay_bar import ReplayBar  # noqa: E402
 from .selected_model import SelectedModel  # noqa: E402
+
+if TYPE_CHECKING:  # the replay bar (and the MCAP reader under it) is imported by replay mode only
+    from .replay_bar import ReplayBar
 from .style import install_css  # noqa: E402
 from .window import MainWindow  # noqa: E402
 
