@@ -27,6 +27,7 @@ import gi
 gi.require_version("Gtk", "4.0")
 from gi.repository import Gio, GLib, Gtk  # noqa: E402
 
+from ..base.i18n import _  # noqa: E402
 from ..client.central import CentralRoster  # noqa: E402
 from ..client.mapcache import SharedMaps  # noqa: E402
 from ..client.roster import RobotEndpoint, Roster  # noqa: E402
@@ -238,7 +239,7 @@ class RtmuApplication(Gtk.Application):
     def roster_for(self, profile: Profile) -> Roster | None:
         """Where a fleet profile's robots come from (None: a one-robot profile)."""
         if self.options.fleet:
-            return direct_roster(Profile("demo fleet", robots=self.options.fleet))
+            return direct_roster(Profile(_("demo fleet"), robots=self.options.fleet))
         if profile.central:
             host, port = parse_central(profile.central)
             password = self.secrets.get(profile) or "" if profile.user else ""
@@ -352,7 +353,9 @@ class RtmuApplication(Gtk.Application):
             self.window.banners.tell(
                 "notice:suspended",
                 "warning",
-                f"The window was suspended (pid {os.getpid()}): the robot was stopped. Press a key to drive.",
+                _(
+                    "The window was suspended (pid {getpid}): the robot was stopped. Press a key to drive."
+                ).format(getpid=os.getpid()),
                 timeout=6.0,
             )
 
@@ -362,9 +365,11 @@ class RtmuApplication(Gtk.Application):
         o = self.options
         s = self.settings
         if o.fleet:
-            return Profile("demo fleet", robots=o.fleet), True
+            return Profile(_("demo fleet"), robots=o.fleet), True
         if o.central:
-            return Profile(f"central {o.central}", central=o.central, user=o.user or ""), True
+            return Profile(
+                _("central {central}").format(central=o.central), central=o.central, user=o.user or ""
+            ), True
         if o.host:
             port = o.port or DEFAULT_PORT
             user = o.user or ""

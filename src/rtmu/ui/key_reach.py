@@ -25,6 +25,7 @@ import gi
 gi.require_version("Gtk", "4.0")
 from gi.repository import GLib, Gtk  # noqa: E402
 
+from ..base.i18n import _  # noqa: E402
 from ..control.key_rules import keys_note  # noqa: E402
 from ..model.observables import Phase  # noqa: E402
 
@@ -124,5 +125,5 @@ class KeyReach:
             while parent is not None and parent is not self.window:
                 parent = parent.get_transient_for()
             if parent is self.window:
-                return other.get_title() or "a dialog"
+                return other.get_title() or _("a dialog")
         return ""

@@ -30,6 +30,7 @@ gi.require_version("Gtk", "4.0")
 gi.require_version("Gdk", "4.0")
 from gi.repository import Gdk, GObject, Gtk  # noqa: E402
 
+from ..base.i18n import _  # noqa: E402
 from ..control.key_rules import FIELD_HINT, KeyAction, stop_key_action, stop_key_names  # noqa: E402
 
 GUARD_ATTR = "_rtmu_stop_keys"
@@ -148,7 +149,7 @@ class StopKeys:
         if isinstance(widget, Gtk.TextView):
             return
         placeholder = widget.get_property("placeholder-text") or ""
-        short = "Space stops"
+        short = _("Space stops")
         widget.set_property("placeholder-text", f"{placeholder} · {short}" if placeholder else FIELD_HINT)
 
     # -- keys ------------------------------------------------------------------------------

@@ -1,0 +1,132 @@
+"""The window in the pseudo-locale: no visible word escapes translation and nothing is pushed out.
+
+The pseudo-locale (``en_XA``) is made by the tooling (``scripts/i18n.py``) from the sources' marked
+strings now — every letter accented, every string 30 % or more longer and in brackets — compiled into a
+scratch directory and chosen for this test only. The real window is opened on the simulator on a
+screen of 800×480 and one of 360×720; every mapped widget's words (labels, buttons, tooltips, entry
+hints) and every row of the main menu are read: a plain ASCII letter outside the robot's own words
+(its mode and status, map, goals, commands, name and address: shown as sent) is a string that escaped
+translation. A widget the longer words push out of the window fails the test too.
+"""
+
+from __future__ import annotations
+
+import re
+from collections.abc import Iterator
+from pathlib import Path
+
+import gi
+import pytest
+
+from i18n_tooling import tooling
+from rtmu.base import i18n
+from rtmu.sim import SimThread
+
+from .conftest import _spawn_xvfb, _terminate
+from .harness import Gui, idle, pump
+from .test_handheld_window import clipped_widgets, open_on
+
+gi.require_version("Gtk", "4.0")
+from gi.repository import Gio, Gtk  # noqa: E402
+
+LETTER = re.compile(r"[A-Za-z]")
+
+
+@pytest.fixture(scope="module")
+def pseudo_locale(tmp_path_factory: pytest.TempPathFactory) -> Iterator[None]:
+    directory = tooling.compile_pseudo(tmp_path_factory.mktemp("pseudo-locale"))
+    i18n.use([tooling.PSEUDO], Path(directory))
+    assert i18n._("Battery") != "Battery", "the pseudo-locale does not translate"
+    try:
+        yield
+    finally:
+        i18n.use(["en"])
+
+
+@pytest.fixture(scope="module")
+def phone_screen() -> Iterator[str]:
+    proc, display = _spawn_xvfb("360x720")
+    if display is None:
+        pytest.fail("an Xvfb of 360x720 did not start")
+    try:
+        yield display
+    finally:
+        _terminate(proc)
+
+
+def widget_words(widget: Gtk.Widget) -> Iterator[tuple[str, str]]:
+    """(where, text) for every mapped widget under ``widget``: its text, its tooltip, its hint."""
+    child = widget.get_first_child()
+    while child is not None:
+        if child.get_mapped():
+            where = f"{type(child).__name__}.{'.'.join(child.get_css_classes())}"
+            if isinstance(child, Gtk.Label):
+                yield where, child.get_text()
+            if isinstance(child, Gtk.Text | Gtk.Entry):
+                yield where + " hint", child.get_placeholder_text() or ""
+            yield where + " tooltip", child.get_tooltip_text() or ""
+            yield from widget_words(child)
+        child = child.get_next_sibling()
+
+
+def menu_words(model: Gio.MenuModel) -> Iterator[tuple[str, str]]:
+    for i in range(model.get_n_items()):
+        label = model.get_item_attribute_value(i, "label", None)
+        if label is not None:
+            yield "menu row", label.get_string()
+        for link in (Gio.MENU_LINK_SECTION, Gio.MENU_LINK_SUBMENU):
+            inner = model.get_item_link(i, link)
+            if inner is not None:
+                yield from menu_words(inner)
+
+
+def server_words(gui: Gui, sim: SimThread) -> list[str]:
+    """What the robot's server says in its own words: shown as sent, never translated."""
+    robot = gui.model.robot.value
+    words = [robot.mode, robot.status, robot.extended_status or ""]
+    map_name = gui.model.map.value.name
+    words += [map_name, Path(map_name.replace("\\", "/")).name, sim.call(lambda: sim.server.robot.mode_name)]
+    words += ["127.0.0.1", str(sim.port), "ws://127.0.0.1:8765"]
+    return sorted({w for w in words if w}, key=len, reverse=True)
+
+
+def escaped(texts: Iterator[tuple[str, str]], allowed: list[str]) -> list[str]:
+    out = []
+    for where, text in texts:
+        rest = text
+        for word in allowed:
+            rest = rest.replace(word, "")
+        rest = re.sub(r"\d+(?:[.,]\d+)*", "", rest)
+        if LETTER.search(rest):
+            out.append(f"{where}: {text!r}")
+    return sorted(set(out))
+
+
+def check_window(gui: Gui, sim: SimThread, name: str) -> None:
+    window = gui.window
+    gui.wait_connected()
+    pump(lambda: gui.model.robot.value.numbers_at is not None, 10, "the robot's first status")
+    pump(lambda: bool(gui.model.map.value.name), 20, "the map")
+    idle(0.5)
+    gui.shot(name)
+    allowed = server_words(gui, sim)
+    problems = escaped(widget_words(window), allowed)
+    model = window.menu_button.get_menu_model()
+    assert model is not None
+    problems += escaped(menu_words(model), allowed)
+    assert problems == [], "words that escaped translation:\n" + "\n".join(problems)
+    assert clipped_widgets(window) == []
+
+
+def test_the_800x480_window_is_translated_everywhere_and_nothing_is_clipped(
+    pseudo_locale: None, screenshots: Path, small_screen: str, request: pytest.FixtureRequest
+) -> None:
+    for gui, sim in open_on(small_screen, screenshots, request.node.name):
+        check_window(gui, sim, "pseudo-800x480")
+
+
+def test_the_360x720_phone_window_is_translated_everywhere_and_nothing_is_clipped(
+    pseudo_locale: None, screenshots: Path, phone_screen: str, request: pytest.FixtureRequest
+) -> None:
+    for gui, sim in open_on(phone_screen, screenshots, request.node.name):
+        check_window(gui, sim, "pseudo-360x720")
