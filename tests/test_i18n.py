@@ -7,6 +7,7 @@ environment says; the pseudo-locale made by the tooling translates every marked 
 from __future__ import annotations
 
 import os
+import re
 import subprocess
 import sys
 from collections.abc import Iterator
@@ -93,3 +94,36 @@ def test_the_language_comes_from_the_environment_as_gettext_reads_it(tmp_path: P
 def test_numbers_for_people_follow_the_locale_and_machine_output_does_not() -> None:
     assert i18n.number(1234.5, 1) in ("1234.5", "1,234.5")  # the suite runs in C.UTF-8
     assert f"{1234.5:.1f}" == "1234.5"
+
+
+def test_german_is_complete() -> None:
+    assert list(tooling.untranslated("de")) == []
+
+
+PLACEHOLDER = re.compile(r"\{[^{}]*\}")
+
+
+@pytest.mark.parametrize("language", tooling.languages())
+def test_every_translation_keeps_its_placeholders(language: str) -> None:
+    """A translation that drops or renames ``{robot}`` would raise (or lie) where the window formats it."""
+    wrong = []
+    for message in tooling.read(tooling.PO_DIR / f"{language}.po", language):
+        if not message.id:
+            continue
+        ids = message.id if isinstance(message.id, tuple) else (message.id,)
+        strings = message.string if isinstance(message.string, tuple) else (message.string,)
+        wanted = set(PLACEHOLDER.findall(ids[0])) | set(PLACEHOLDER.findall(ids[-1]))
+        wrong += [(ids[0], s) for s in strings if s and set(PLACEHOLDER.findall(s)) != wanted]
+    assert wrong == []
+
+
+def test_german_is_read_from_the_package_when_the_environment_asks_for_it() -> None:
+    env = {k: v for k, v in os.environ.items() if k not in ("LANGUAGE", "LC_ALL", "LC_MESSAGES", "LANG")}
+    env["LANG"] = "de_DE.UTF-8"
+    script = (
+        "from rtmu.base.i18n import _, ngettext; print(_('Battery')); "
+        "print(ngettext('{count} value', '{count} values', 1)); "
+        "print(ngettext('{count} value', '{count} values', 3))"
+    )
+    out = subprocess.run([sys.executable, "-c", script], env=env, capture_output=True, text=True, check=True)
+    assert out.stdout.split("\n")[:3] == ["Akku", "{count} Wert", "{count} Werte"]

@@ -36,7 +36,7 @@ def stop_button(on_stop: Callable[[], None]) -> Gtk.Button:
     button.add_css_class("stop-button")
     button.set_focusable(False)
     button.connect("clicked", lambda _b: on_stop())
-    accessible.name(button, "STOP")  # GTK 4.8 does not name a button from a label inside a box
+    accessible.name(button, _("STOP"))  # GTK 4.8 does not name a button from a label inside a box
     return button
 
 

@@ -57,7 +57,7 @@ class DetailsWindow(Gtk.Window):
         self.say_entry.set_max_length(MAX_SAY)
         accessible.name(self.say_entry, _("Text for the robot to say"))
         self.say_entry.connect("activate", lambda _e: self.say())
-        self.say_button = accessible.mnemonic_button("_Say")
+        self.say_button = accessible.mnemonic_button(_("_Say"))
         self.say_button.connect("clicked", lambda _b: self.say())
         self.say_row.append(self.say_entry)
         self.say_row.append(self.say_button)

@@ -63,7 +63,20 @@ class BatteryGauge(Gtk.DrawingArea):
         if (fraction, state) != (self.fraction, self.state):
             self.fraction, self.state = fraction, state
             self.queue_draw()
-            accessible.value(self, round(fraction * 100), 0, 100, f"{fraction:.0%}, {state}")
+            words = {
+                "ok": _("ok"),
+                "low": _("low"),
+                "critical": _("at shutdown level"),
+                "unknown": _("unknown"),
+                "stale": _("stale"),
+            }.get(state, state)
+            accessible.value(
+                self,
+                round(fraction * 100),
+                0,
+                100,
+                _("{percent} %, {state}").format(percent=round(fraction * 100), state=words),
+            )
 
     def _draw(self, _a: Gtk.DrawingArea, ctx, width: int, height: int) -> None:
         colour = {"ok": GREEN, "low": AMBER, "critical": RED}.get(self.state, GREY)
