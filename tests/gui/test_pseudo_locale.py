@@ -30,6 +30,8 @@ gi.require_version("Gtk", "4.0")
 from gi.repository import Gio, Gtk  # noqa: E402
 
 LETTER = re.compile(r"[A-Za-z]")
+GTK_OWN = ["Show Text", "Hide Text"]
+"""GTK's own words (its password entry's eye), translated by GTK's catalogue, not RTMU's."""
 
 
 @pytest.fixture(scope="module")
@@ -37,6 +39,15 @@ def pseudo_locale(tmp_path_factory: pytest.TempPathFactory) -> Iterator[None]:
     directory = tooling.compile_pseudo(tmp_path_factory.mktemp("pseudo-locale"))
     i18n.use([tooling.PSEUDO], Path(directory))
     assert i18n._("Battery") != "Battery", "the pseudo-locale does not translate"
+    try:
+        yield
+    finally:
+        i18n.use(["en"])
+
+
+@pytest.fixture
+def german() -> Iterator[None]:
+    i18n.use(["de"])
     try:
         yield
     finally:
@@ -86,8 +97,15 @@ def server_words(gui: Gui, sim: SimThread) -> list[str]:
     words = [robot.mode, robot.status, robot.extended_status or ""]
     map_name = gui.model.map.value.name
     words += [map_name, Path(map_name.replace("\\", "/")).name, sim.call(lambda: sim.server.robot.mode_name)]
-    words += ["127.0.0.1", str(sim.port), "ws://127.0.0.1:8765"]
+    words += ["127.0.0.1", str(sim.port), "ws://127.0.0.1:8765", *GTK_OWN]
     return sorted({w for w in words if w}, key=len, reverse=True)
+
+
+def goal_names(gui: Gui) -> list[str]:
+    """The map's goals and routes: the server's names."""
+    data = gui.model.map.value.data
+    names = [o.name for o in data.objects if o.name] if data is not None else []
+    return sorted(set(names), key=len, reverse=True)
 
 
 def escaped(texts: Iterator[tuple[str, str]], allowed: list[str]) -> list[str]:
@@ -116,6 +134,31 @@ def check_window(gui: Gui, sim: SimThread, name: str) -> None:
     problems += escaped(menu_words(model), allowed)
     assert problems == [], "words that escaped translation:\n" + "\n".join(problems)
     assert clipped_widgets(window) == []
+    # The header's Go to list and the connection dialog: surfaces of their own.
+    goals = window.goals_panel
+    pump(goals.get_mapped, 5, "the Go to button (the simulator navigates)")
+    gui.click(goals)
+    popover = goals.get_popover()
+    pump(lambda: popover is not None and popover.get_mapped(), 3, "the Go to list")
+    idle(0.3)
+    gui.screen_shot(f"{name}-goto")
+    problems = escaped(widget_words(popover), allowed + goal_names(gui))
+    popover.popdown()
+    pump(lambda: not popover.get_mapped(), 3, "the Go to list to close")
+    assert problems == [], "words that escaped translation in the Go to list:\n" + "\n".join(problems)
+    window.activate_action("win.settings", None)
+    pump(
+        lambda: window.dialogs.settings is not None and window.dialogs.settings.get_mapped(), 5, "the dialog"
+    )
+    dialog = window.dialogs.settings
+    assert dialog is not None
+    idle(0.3)
+    gui.screen_shot(f"{name}-dialog")
+    problems = escaped(widget_words(dialog), allowed)
+    clipped = clipped_widgets(dialog)
+    dialog.close()
+    assert problems == [], "words that escaped translation in the dialog:\n" + "\n".join(problems)
+    assert clipped == []
 
 
 def test_the_800x480_window_is_translated_everywhere_and_nothing_is_clipped(
@@ -130,3 +173,22 @@ def test_the_360x720_phone_window_is_translated_everywhere_and_nothing_is_clippe
 ) -> None:
     for gui, sim in open_on(phone_screen, screenshots, request.node.name):
         check_window(gui, sim, "pseudo-360x720")
+
+
+def check_german(gui: Gui, name: str) -> None:
+    gui.wait_connected()
+    pump(lambda: gui.model.robot.value.numbers_at is not None, 10, "the robot's first status")
+    idle(0.5)
+    gui.shot(name)
+    shown = {text for _where, text in widget_words(gui.window)}
+    assert {"STOPP", "Trennen"} <= shown, sorted(shown)
+    assert clipped_widgets(gui.window) == []
+
+
+@pytest.mark.parametrize("screen", ["small_screen", "phone_screen"])
+def test_the_german_window_fits_both_screens(
+    german: None, screenshots: Path, screen: str, request: pytest.FixtureRequest
+) -> None:
+    """The shipped German, longer than English, on the two smallest screens: nothing pushed out."""
+    for gui, _sim in open_on(request.getfixturevalue(screen), screenshots, request.node.name):
+        check_german(gui, f"german-{screen}")

@@ -90,7 +90,7 @@ class ConnectionDialog(Gtk.Window):
         self.port = Gtk.Entry(placeholder_text=str(DEFAULT_PORT), input_purpose=Gtk.InputPurpose.DIGITS)
         self.user = Gtk.Entry(placeholder_text=_("(none)"))
         self.password = Gtk.PasswordEntry(show_peek_icon=True, hexpand=True)
-        self.password.set_property("placeholder-text", "(unchanged)")
+        self.password.set_property("placeholder-text", _("(unchanged)"))
         self.remember = Gtk.CheckButton(label=_("Remember the password in the keyring"))
         if not keyring_available:
             self.remember.set_label(_("Remember the password (this session only: no keyring)"))

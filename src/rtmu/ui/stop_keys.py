@@ -144,13 +144,13 @@ class StopKeys:
         if getattr(widget, GUARD_ATTR, False):
             return
         setattr(widget, GUARD_ATTR, True)
-        tip = widget.get_tooltip_text()
-        widget.set_tooltip_text(f"{tip}\n{FIELD_HINT}" if tip else FIELD_HINT)
+        tip, hint = widget.get_tooltip_text(), _(FIELD_HINT)
+        widget.set_tooltip_text(f"{tip}\n{hint}" if tip else hint)
         if isinstance(widget, Gtk.TextView):
             return
         placeholder = widget.get_property("placeholder-text") or ""
         short = _("Space stops")
-        widget.set_property("placeholder-text", f"{placeholder} · {short}" if placeholder else FIELD_HINT)
+        widget.set_property("placeholder-text", f"{placeholder} · {short}" if placeholder else hint)
 
     # -- keys ------------------------------------------------------------------------------
     def _pressed(
