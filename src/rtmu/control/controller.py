@@ -66,6 +66,7 @@ from collections.abc import Callable, Mapping
 from dataclasses import replace
 from typing import Any, Protocol
 
+from ..base.i18n import N_, _
 from ..base.notices import Kind, Notice
 from ..client.lease import DriveLease, DriveRatios, EndReason
 from ..model.observables import OperatorState, RobotModel, SpeedSetting
@@ -146,8 +147,8 @@ class SecretStore(Protocol):
     def get(self, profile: Profile) -> str | None: ...
 
 
-REPLAY_REASON = "Replay — nothing is sent to a robot"
-KEYBOARD_LOST = "the window lost the keyboard"
+REPLAY_REASON = N_("Replay — nothing is sent to a robot")
+KEYBOARD_LOST = N_("the window lost the keyboard")
 """Why a held drive stops on a focus loss (a suspend names its own reason)."""
 
 
@@ -273,7 +274,11 @@ class Controller:
         cmd = self.registry.get(name)
         reason = REPLAY_REASON if self.replay and cmd.needs_connection else cmd.unavailable(self)
         if reason is not None:
-            self.view.notify(Notice.warning(Kind.COMMAND, f"{cmd.label}: {reason}"))
+            self.view.notify(
+                Notice.warning(
+                    Kind.COMMAND, _("{command}: {reason}").format(command=_(cmd.label), reason=_(reason))
+                )
+            )
             return False
         cmd.activate(self)
         return True
@@ -320,7 +325,7 @@ class Controller:
         if self.navigating:  # the operator wins: this press only stops the navigation
             self.stop()
             self._blocked.add(direction)
-            self.view.notify(Notice.info(Kind.NAVIGATION, "Navigation cancelled. Press again to drive."))
+            self.view.notify(Notice.info(Kind.NAVIGATION, _("Navigation cancelled. Press again to drive.")))
             return
         if self._gate_refuses():
             self._blocked.add(direction)
@@ -333,7 +338,11 @@ class Controller:
         gate = self.drive_gate
         why = gate() if gate is not None else None
         if why is not None:
-            self.view.notify(Notice.warning(Kind.SAFETY, f"Not driving: {why} Press again once it is armed."))
+            self.view.notify(
+                Notice.warning(
+                    Kind.SAFETY, _("Not driving: {why} Press again once it is armed.").format(why=why)
+                )
+            )
         return why is not None
 
     def release(self, direction: str) -> None:
@@ -368,7 +377,7 @@ class Controller:
         if self.navigating and (trans or rot):  # the operator wins: this only stops the navigation
             self.stop()
             self._analog_blocked = True
-            self.view.notify(Notice.info(Kind.NAVIGATION, "Navigation cancelled. Press again to drive."))
+            self.view.notify(Notice.info(Kind.NAVIGATION, _("Navigation cancelled. Press again to drive.")))
             return
         if self._analog is None and (trans or rot) and self._gate_refuses():
             self._analog_blocked = True
@@ -418,7 +427,7 @@ class Controller:
                 # The lease died under us (lapsed/stale); the keys pressed before are stale too.
                 self._halt_held(lease.ended or EndReason.LAPSED)
                 return
-            self._end_jog("a drive")
+            self._end_jog(_("a drive"))
             self._generation = lease.grant(ratios)
             self.view.driving()
 
@@ -443,9 +452,11 @@ class Controller:
             self.link.lease.end(reason, self._generation)
             self._generation = None
         if had and reason is EndReason.LAPSED:
-            why = self.link.lease.why or "a busy computer?"
-            text = f"Stopped: the window did not respond in time ({why})"
-            self.view.notify(Notice.warning(Kind.SAFETY, f"{text}. Press again to drive."))
+            why = self.link.lease.why or _("a busy computer?")
+            text = _("Stopped: the window did not respond in time ({why})").format(why=why)
+            self.view.notify(
+                Notice.warning(Kind.SAFETY, _("{text}. Press again to drive.").format(text=text))
+            )
         elif had and reason is EndReason.LINK and not quiet:
             level = self.robot.health.value.level
             self._say_link_stop(level if level in (LinkLevel.STALE, LinkLevel.LOST) else LinkLevel.STALE)
@@ -453,8 +464,12 @@ class Controller:
     def _say_link_stop(self, level: LinkLevel) -> None:
         """Said once per stop, with the network side's measured cause where it gave one."""
         why = self.link.lease.why or self.robot.health.value.cause
-        said = f" — {why}" if why else ". Press again once it is back."
-        self.view.notify(Notice.warning(Kind.LINK, f"Stopped: the link is {level.value}{said}"))
+        said = f" — {why}" if why else _(". Press again once it is back.")
+        self.view.notify(
+            Notice.warning(
+                Kind.LINK, _("Stopped: the link is {value}{said}").format(value=level.value, said=said)
+            )
+        )
 
     def stop(self) -> None:
         """Stop now. Always sent, whatever the link looks like; held keys must be pressed again.
@@ -485,8 +500,12 @@ class Controller:
         driving = bool(self._held) or self._generation is not None
         if driving:
             self.stop()
-            then = "Click the map, then press again" if why == KEYBOARD_LOST else "Press again"
-            self.view.notify(Notice.warning(Kind.SAFETY, f"Stopped: {why}. {then} to drive."))
+            then = _("Click the map, then press again") if why == KEYBOARD_LOST else _("Press again")
+            self.view.notify(
+                Notice.warning(
+                    Kind.SAFETY, _("Stopped: {why}. {then} to drive.").format(why=_(why), then=then)
+                )
+            )
         if self._analog is not None:
             self._analog = None
             self._analog_blocked = True
@@ -504,7 +523,7 @@ class Controller:
         """A D-pad (pointer, touch) hold may start only while the stop key reaches the window: else it
         is refused, saying why (a key press proves the keyboard is here; a pointer press does not)."""
         if not self.keys_reach:
-            said = (
+            said = _(
                 "Not driving: Space could not stop it, the keyboard is elsewhere. Click the map, then drive."
             )
             self.view.notify(Notice.warning(Kind.SAFETY, said))
@@ -517,7 +536,9 @@ class Controller:
         key-ups seen until the next press are not real ones (as after a focus loss)."""
         if self._held or (self._analog is not None and self._generation is not None):
             self._halt_held(EndReason.STOPPED)
-            self.view.notify(Notice.info(Kind.SAFETY, f"Stopped for {what}. Press again to drive."))
+            self.view.notify(
+                Notice.info(Kind.SAFETY, _("Stopped for {what}. Press again to drive.").format(what=what))
+            )
         if keys_leave:
             self._unfocused = True
 
@@ -531,10 +552,17 @@ class Controller:
     def _set_speed(self, new: SpeedSetting, limit: str) -> None:
         if not self.operator.speed.set(new):
             self.view.notify(
-                Notice.info(Kind.SPEED_LIMIT, f"Speed is already at its {limit} ({new.percent} %)")
+                Notice.info(
+                    Kind.SPEED_LIMIT,
+                    (
+                        _("Speed is already at its maximum ({percent} %)")
+                        if limit == "maximum"
+                        else _("Speed is already at its minimum ({percent} %)")
+                    ).format(percent=new.percent),
+                )
             )
             return
-        self.view.notify(Notice.info(Kind.SPEED, f"Speed {new.percent} %"))
+        self.view.notify(Notice.info(Kind.SPEED, _("Speed {percent} %").format(percent=new.percent)))
         self._reapply()
 
     # -- every other intent: the guard ---------------------------------------------------------
@@ -556,13 +584,21 @@ class Controller:
             return None
         offers = self.robot.connection.value.offers
         if (intent.needs or intent.moves or not intent.offered(())) and not self.connected:
-            self.view.notify(Notice.warning(intent.kind, f"{intent.label}: not connected"))
+            self.view.notify(
+                Notice.warning(intent.kind, _("{label}: not connected").format(label=intent.label))
+            )
             return None
         if not intent.offered(offers):
-            missing = f"offer {intent.needs[0]}" if intent.needs else f"offer {intent.label.lower()}"
+            missing = (
+                _("offer {value}").format(value=intent.needs[0])
+                if intent.needs
+                else _("offer {lower}").format(lower=intent.label.lower())
+            )
             if isinstance(intent, (RequestPicture, StartVideo)):
-                missing = "offer camera pictures"
-            self.view.notify(Notice.warning(intent.kind, f"This server does not {missing}"))
+                missing = _("offer camera pictures")
+            self.view.notify(
+                Notice.warning(intent.kind, _("This server does not {missing}").format(missing=missing))
+            )
             return None
         refusal = scan_refusal(intent, self.robot.scan.value)  # while scanning: only held drives move it
         if refusal is not None:
@@ -570,7 +606,11 @@ class Controller:
             return None
         goals = self.robot.navigation.value.goals
         if isinstance(intent, GotoGoal) and goals and intent.name not in goals:
-            self.view.notify(Notice.warning(Kind.NAVIGATION, f"This map has no goal called {intent.name!r}"))
+            self.view.notify(
+                Notice.warning(
+                    Kind.NAVIGATION, _("This map has no goal called {name!r}").format(name=intent.name)
+                )
+            )
             return None
         refused = intent_rules.refusal(intent)  # a console call of a motion request, a fix, unconfirmed
         if refused is not None:
@@ -605,7 +645,7 @@ class Controller:
             self._nav_cancelled = False  # it ended (or someone sent it elsewhere): keys drive again
 
     def _say_replay(self) -> None:
-        self.view.notify(Notice.warning(Kind.SAFETY, f"{REPLAY_REASON}: {self.replay}"))
+        self.view.notify(Notice.warning(Kind.SAFETY, f"{_(REPLAY_REASON)}: {self.replay}"))
 
     # -- connection --------------------------------------------------------------------------
     def select_profile(self, profile: Profile) -> None:
@@ -673,7 +713,7 @@ class Controller:
 
     def _password_answered(self, password: str | None) -> None:
         if password is None:
-            self.view.notify(Notice.info(Kind.CONNECTION, "Connection cancelled"))
+            self.view.notify(Notice.info(Kind.CONNECTION, _("Connection cancelled")))
             return
         self._start_connect(password)
 
@@ -709,7 +749,7 @@ class Controller:
         Opening one is looking (:meth:`look`): it takes the keyboard, so a held drive ends — a Turn or
         Go jog would take over from it anyway — but a navigation goes on until the operator runs what
         the dialog asks, or presses STOP (the dialog carries the stop keys)."""
-        self.look("a dialog")
+        self.look(_("a dialog"))
         self.view.open_dialog(name)
 
     @property
@@ -734,13 +774,20 @@ class Controller:
         if new.phase is not Phase.CONNECTED and old.phase is Phase.CONNECTED:
             self._halt_held(EndReason.DISCONNECTED)
         if new.phase is Phase.CONNECTED and old.phase is not Phase.CONNECTED:
-            self.view.notify(Notice.info(Kind.CONNECTION, f"Connected to {new.host}:{new.port}"))
+            self.view.notify(
+                Notice.info(
+                    Kind.CONNECTION, _("Connected to {host}:{port}").format(host=new.host, port=new.port)
+                )
+            )
         elif new.phase is Phase.FAILED and new.error and new.error != old.error:
             self.view.notify(Notice.error(Kind.CONNECTION, new.error))
         elif new.phase is Phase.RECONNECTING and old.phase is Phase.CONNECTED:
             self.view.notify(
                 Notice.warning(
-                    Kind.CONNECTION, f"Link lost: reconnecting ({new.error})" if new.error else "Reconnecting"
+                    Kind.CONNECTION,
+                    _("Link lost: reconnecting ({error})").format(error=new.error)
+                    if new.error
+                    else _("Reconnecting"),
                 )
             )
         self.refresh_commands()

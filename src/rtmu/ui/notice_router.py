@@ -64,8 +64,11 @@ def route(notice: Notice, connection: ConnectionState, speed_percent: int) -> Ro
             return Route(Banner("link", level.value, text, None))
         return Route()
     if kind is Kind.SPEED_LIMIT:
-        limit = "maximum" if speed_percent >= SPEED_MAX else "minimum"
-        words = _("Speed at its {limit}: {speed_percent} %").format(limit=limit, speed_percent=speed_percent)
+        words = (
+            _("Speed at its maximum: {percent} %")
+            if speed_percent >= SPEED_MAX
+            else _("Speed at its minimum: {percent} %")
+        ).format(percent=speed_percent)
         return Route(Banner("speed", "warning", words, 2.5, speed_percent / SPEED_MAX))
     if kind is Kind.SPEED:
         return Route()  # the speed banner follows the model
@@ -144,7 +147,12 @@ only while it is true (a later healthy drive never runs under it)."""
 def link_back_banner(shown: str | None, ok_for: float | None) -> Banner | None:
     """The ``link`` banner once the link has been healthy for ``ok_for`` seconds (None: not healthy now)
     while it still says a link stop (``shown``): the stop is over, and the banner says how to go on."""
-    if shown is None or not shown.startswith(LINK_STOP_WORDS) or ok_for is None or ok_for < LINK_BACK_AFTER:
+    if (
+        shown is None
+        or not shown.startswith(_(LINK_STOP_WORDS))
+        or ok_for is None
+        or ok_for < LINK_BACK_AFTER
+    ):
         return None
     return Banner("link", "info", _("The link is back: press a key to drive again"), 4.0)
 
