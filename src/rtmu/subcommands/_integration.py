@@ -19,6 +19,7 @@ from pathlib import Path
 from typing import NamedTuple
 
 from .. import __version__
+from ..base.i18n import _
 from ..package_data import APP_ID, DESKTOP_DIR
 
 EXIT_CANNOT_WRITE = 1
@@ -58,13 +59,17 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
     g.add_argument(
         "--install-desktop",
         action="store_true",
-        help="put RTMU in the desktop's application menu and install its man page and shell completions "
-        "(under $XDG_DATA_HOME, ~/.local/share)",
+        help=_(
+            "put RTMU in the desktop's application menu and install its man page and shell completions "
+            "(under $XDG_DATA_HOME, ~/.local/share)"
+        ),
     )
-    g.add_argument("--uninstall-desktop", action="store_true", help="remove what --install-desktop installed")
-    g.add_argument("--man", action="store_true", help="print the man page (roff) and exit")
     g.add_argument(
-        "--completion", choices=SHELLS, metavar="SHELL", help="print a completion script for SHELL"
+        "--uninstall-desktop", action="store_true", help=_("remove what --install-desktop installed")
+    )
+    g.add_argument("--man", action="store_true", help=_("print the man page (roff) and exit"))
+    g.add_argument(
+        "--completion", choices=SHELLS, metavar="SHELL", help=_("print a completion script for SHELL")
     )
 
 

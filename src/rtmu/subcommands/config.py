@@ -18,6 +18,7 @@ from pathlib import Path
 from typing import TYPE_CHECKING, Any
 
 from ..base.exit_codes import EXIT_FOREIGN_CONFIG, EXIT_OK, EXIT_REFUSED, EXIT_USAGE, NETWORK
+from ..base.i18n import _
 from ..base.textsafe import visible
 from ..client.roles import Role
 from ..protocol.payloads.config import ConfigParam, ParamType, Priority
@@ -60,22 +61,26 @@ EXITS = (*NETWORK, EXIT_REFUSED, EXIT_FOREIGN_CONFIG)
 def register(subparsers: Any) -> None:
     p = subparsers.add_parser(
         "config",
-        help="show or change the server's configuration (ArConfig: getConfigBySections, setConfig)",
+        help=_("show or change the server's configuration (ArConfig: getConfigBySections, setConfig)"),
         description=(
-            "Print the server's configuration: sections, then parameters with value, type, limits "
-            "and priority. One action at most: --set SECTION/PARAM=VALUE (repeatable) changes values in "
-            "one setConfig; --defaults lists what differs from the factory values (getConfigDefaults); "
-            "--reset SECTION/PARAM or --reset SECTION puts factory values back; --export FILE writes "
-            "every value to a TOML file (an existing file only with --force); --import FILE checks the "
-            "whole file against the server's parameters and sends it in one setConfig, or nothing; "
-            "--reload makes the server read its configuration file again. A --reset target the server "
-            "does not have, or a file that exists or is not an export, is a usage error; an --import "
-            "that does not fit the server's parameters is refused and nothing is sent. An Omron LD "
-            "robot's configuration (getConfigValues) is named, not shown: rtmu call reads it raw."
+            _(
+                "Print the server's configuration: sections, then parameters with value, type, limits "
+                "and priority. One action at most: --set SECTION/PARAM=VALUE (repeatable) changes values in "
+                "one setConfig; --defaults lists what differs from the factory values (getConfigDefaults); "
+                "--reset SECTION/PARAM or --reset SECTION puts factory values back; --export FILE writes "
+                "every value to a TOML file (an existing file only with --force); --import FILE checks the "
+                "whole file against the server's parameters and sends it in one setConfig, or nothing; "
+                "--reload makes the server read its configuration file again. A --reset target the server "
+                "does not have, or a file that exists or is not an export, is a usage error; an --import "
+                "that does not fit the server's parameters is refused and nothing is sent. An Omron LD "
+                "robot's configuration (getConfigValues) is named, not shown: rtmu call reads it raw."
+            )
         ),
     )
     add_connection_arguments(p)
-    p.add_argument("--json", action="store_true", help="one JSON object (the configuration, or the answer)")
+    p.add_argument(
+        "--json", action="store_true", help=_("one JSON object (the configuration, or the answer)")
+    )
     actions = p.add_mutually_exclusive_group()
     actions.add_argument(
         "--set",
@@ -83,22 +88,30 @@ def register(subparsers: Any) -> None:
         nargs="+",
         action=Assignment,
         metavar="SECTION/PARAM=VALUE",
-        help="change these values (one setConfig)",
+        help=_("change these values (one setConfig)"),
     )
     actions.add_argument(
-        "--defaults", action="store_true", help="list the parameters that differ from their factory values"
+        "--defaults", action="store_true", help=_("list the parameters that differ from their factory values")
     )
     actions.add_argument(
         "--reset",
         metavar="SECTION/PARAM",
-        help="put one parameter, or a whole SECTION, back to factory values",
+        help=_("put one parameter, or a whole SECTION, back to factory values"),
     )
-    actions.add_argument("--export", type=Path, metavar="FILE", help="write the whole configuration to FILE")
     actions.add_argument(
-        "--import", dest="import_file", type=Path, metavar="FILE", help="set every value of an exported FILE"
+        "--export", type=Path, metavar="FILE", help=_("write the whole configuration to FILE")
     )
-    actions.add_argument("--reload", action="store_true", help="make the server read its configuration again")
-    p.add_argument("--force", action="store_true", help="with --export: replace FILE if it exists")
+    actions.add_argument(
+        "--import",
+        dest="import_file",
+        type=Path,
+        metavar="FILE",
+        help=_("set every value of an exported FILE"),
+    )
+    actions.add_argument(
+        "--reload", action="store_true", help=_("make the server read its configuration again")
+    )
+    p.add_argument("--force", action="store_true", help=_("with --export: replace FILE if it exists"))
     p.set_defaults(handler=handle)
 
 

@@ -14,6 +14,7 @@ import sys
 from typing import TYPE_CHECKING, Any
 
 from ..base.exit_codes import EXIT_OK
+from ..base.i18n import _
 from ..base.textsafe import visible
 from ..client.errors import ClientError
 from ..client.roles import Role
@@ -31,14 +32,19 @@ not once for each drawing."""
 def register(subparsers: Any) -> None:
     p = subparsers.add_parser(
         "drawings",
-        help="list the server's drawings (getDrawingList) with one current sample of each",
+        help=_("list the server's drawings (getDrawingList) with one current sample of each"),
         description=(
-            "Print each drawing the server lists (sonar, lasers, paths …): shape, colour, size, layer, "
-            "refresh period, visibility and the points one request returns now (exit 4 when it lists none)."
+            _(
+                "Print each drawing the server lists (sonar, lasers, paths …): shape, colour, size, layer, "
+                "refresh period, visibility and the points one request returns now (exit 4 when it "
+                "lists none)."
+            )
         ),
     )
     add_connection_arguments(p)
-    p.add_argument("--json", action="store_true", help="one JSON array: every field and the sampled points")
+    p.add_argument(
+        "--json", action="store_true", help=_("one JSON array: every field and the sampled points")
+    )
     p.set_defaults(handler=handle)
 
 

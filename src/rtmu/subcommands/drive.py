@@ -31,6 +31,7 @@ from collections.abc import Callable
 from typing import TYPE_CHECKING, Any
 
 from ..base.exit_codes import EXIT_OK, EXIT_SIGQUIT, EXIT_SIGTSTP, EXIT_USAGE, NETWORK, WHY_DRIVE
+from ..base.i18n import _
 from ..base.textsafe import visible
 from ._common import (
     Interrupted,
@@ -66,23 +67,25 @@ EXITS = (*NETWORK, EXIT_SIGQUIT, EXIT_SIGTSTP, *WHY_DRIVE)
 def register(subparsers: Any) -> None:
     p = subparsers.add_parser(
         "drive",
-        help="drive for some seconds, then stop",
-        description="Drive with ratioDrive for S seconds, then stop; print the pose before and after. "
-        "A drive that did not move the robot says why (as rtmu why does) and exits with the cause's code.",
+        help=_("drive for some seconds, then stop"),
+        description=_(
+            "Drive with ratioDrive for S seconds, then stop; print the pose before and after. "
+            "A drive that did not move the robot says why (as rtmu why does) and exits with the cause's code."
+        ),
     )
     add_connection_arguments(p)
     p.add_argument(
-        "--trans", type=float, default=0.0, metavar="PCT", help="−100…100 %% of max speed (+ forward)"
+        "--trans", type=float, default=0.0, metavar="PCT", help=_("−100…100 %% of max speed (+ forward)")
     )
     p.add_argument(
-        "--rot", type=float, default=0.0, metavar="PCT", help="−100…100 %% of max rotation (+ left)"
+        "--rot", type=float, default=0.0, metavar="PCT", help=_("−100…100 %% of max rotation (+ left)")
     )
-    p.add_argument("--throttle", type=float, default=50.0, metavar="PCT", help="0…100 %% (default 50)")
+    p.add_argument("--throttle", type=float, default=50.0, metavar="PCT", help=_("0…100 %% (default 50)"))
     p.add_argument("--seconds", type=float, required=True, metavar="S", help=f"0…{MAX_SECONDS:g}")
     p.add_argument(
         "--json",
         action="store_true",
-        help='one object {"before", "after", "seconds"}; asked to move, also "moved" (and "why" if not)',
+        help=_('one object {"before", "after", "seconds"}; asked to move, also "moved" (and "why" if not)'),
     )
     p.set_defaults(handler=handle)
 

@@ -17,6 +17,7 @@ from pathlib import Path
 from typing import TYPE_CHECKING, Any
 
 from ..base.exit_codes import EXIT_OK, EXIT_REFUSED, EXIT_USAGE, NETWORK
+from ..base.i18n import _
 from ..base.textsafe import visible
 from ..client.roles import Role
 from ..protocol.payloads.files import DirEntry
@@ -39,7 +40,7 @@ DESCRIPTION = (
 def register(subparsers: Any) -> None:
     p = subparsers.add_parser(
         "files",
-        help="list, download, upload and delete files on the robot (getDirListing, getFile, putFile …)",
+        help=_("list, download, upload and delete files on the robot (getDirListing, getFile, putFile …)"),
         description=DESCRIPTION,
     )
     add_connection_arguments(p)
@@ -47,13 +48,13 @@ def register(subparsers: Any) -> None:
     ls = action_parser(
         actions, "ls", "list a folder", "List a folder on the robot (default: its shared folder)."
     )
-    ls.add_argument("folder", nargs="?", default="", metavar="DIR", help="folder on the robot")
+    ls.add_argument("folder", nargs="?", default="", metavar="DIR", help=_("folder on the robot"))
     get = action_parser(
         actions, "get", "download a file", "Download REMOTE into LOCAL (default: its name, here)."
     )
-    get.add_argument("remote", metavar="REMOTE", help="file on the robot")
-    get.add_argument("--out", type=Path, metavar="LOCAL", help="file (or existing folder) to write")
-    get.add_argument("--force", action="store_true", help="replace LOCAL if it exists")
+    get.add_argument("remote", metavar="REMOTE", help=_("file on the robot"))
+    get.add_argument("--out", type=Path, metavar="LOCAL", help=_("file (or existing folder) to write"))
+    get.add_argument("--force", action="store_true", help=_("replace LOCAL if it exists"))
     put = action_parser(
         actions,
         "put",
@@ -61,15 +62,15 @@ def register(subparsers: Any) -> None:
         "Upload LOCAL as REMOTE (default: its own name, in the robot's default folder if it names one; "
         "a REMOTE ending in / is a folder).",
     )
-    put.add_argument("local", type=Path, metavar="LOCAL", help="file to upload")
-    put.add_argument("remote", nargs="?", default=None, metavar="REMOTE", help="where on the robot")
-    put.add_argument("--force", action="store_true", help="replace REMOTE if the robot has it")
+    put.add_argument("local", type=Path, metavar="LOCAL", help=_("file to upload"))
+    put.add_argument("remote", nargs="?", default=None, metavar="REMOTE", help=_("where on the robot"))
+    put.add_argument("--force", action="store_true", help=_("replace REMOTE if the robot has it"))
     put.add_argument(
-        "--interleaved", action="store_true", help="wait for the robot's answer to every packet (slower)"
+        "--interleaved", action="store_true", help=_("wait for the robot's answer to every packet (slower)")
     )
     rm = action_parser(actions, "rm", "delete a file", "Delete one file on the robot (asks first).")
-    rm.add_argument("remote", metavar="REMOTE", help="file on the robot")
-    rm.add_argument("--yes", action="store_true", help="do not ask")
+    rm.add_argument("remote", metavar="REMOTE", help=_("file on the robot"))
+    rm.add_argument("--yes", action="store_true", help=_("do not ask"))
     p.set_defaults(handler=handle)
 
 

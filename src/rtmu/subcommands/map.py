@@ -8,6 +8,7 @@ from pathlib import Path
 from typing import TYPE_CHECKING, Any
 
 from ..base.exit_codes import EXIT_OK, EXIT_UNSUPPORTED, EXIT_USAGE
+from ..base.i18n import _
 from ..base.textsafe import visible
 from ..client.errors import ProtocolFault
 from ..client.roles import Role
@@ -21,13 +22,15 @@ if TYPE_CHECKING:
 def register(subparsers: Any) -> None:
     p = subparsers.add_parser(
         "map",
-        help="download the robot's map to a .map file",
-        description="Download the server's map (getMapBinary when offered; --text forces getMap) "
-        "and write it in ARIA's .map format.",
+        help=_("download the robot's map to a .map file"),
+        description=_(
+            "Download the server's map (getMapBinary when offered; --text forces getMap) "
+            "and write it in ARIA's .map format."
+        ),
     )
     add_connection_arguments(p)
-    p.add_argument("--out", type=Path, required=True, metavar="FILE", help="where to write the map")
-    p.add_argument("--text", action="store_true", help="use getMap (one text line per packet)")
+    p.add_argument("--out", type=Path, required=True, metavar="FILE", help=_("where to write the map"))
+    p.add_argument("--text", action="store_true", help=_("use getMap (one text line per packet)"))
     add_force_option(p)
     p.set_defaults(handler=handle)
 

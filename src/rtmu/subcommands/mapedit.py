@@ -8,6 +8,7 @@ import sys
 from typing import TYPE_CHECKING, Any
 
 from ..base.exit_codes import EXIT_NOT_HELD, EXIT_OK, EXIT_REFUSED, EXIT_USAGE, NETWORK
+from ..base.i18n import _
 from ..base.textsafe import visible
 from ..client.errors import NotSupported
 from ..client.roles import Role
@@ -89,30 +90,39 @@ class _Coordinate(argparse.Action):
 def register(subparsers: Any) -> None:
     p = subparsers.add_parser(
         "mapedit",
-        help="change the server's map live: add or remove goals, docks, forbidden lines and areas",
+        help=_("change the server's map live: add or remove goals, docks, forbidden lines and areas"),
         description=DESCRIPTION,
     )
     add_connection_arguments(p)
     p.add_argument(
-        "--json", action="store_true", help="one JSON object: what was sent and what the server did"
+        "--json", action="store_true", help=_("one JSON object: what was sent and what the server did")
     )
     p.add_argument(
-        "--add-goal", dest="add_goal", action=_Edit, metavar="NAME", help="add a goal (then --x --y [--th])"
+        "--add-goal",
+        dest="add_goal",
+        action=_Edit,
+        metavar="NAME",
+        help=_("add a goal (then --x --y [--th])"),
     )
     p.add_argument(
-        "--add-dock", dest="add_dock", action=_Edit, metavar="NAME", help="add a dock (then --x --y --th)"
+        "--add-dock", dest="add_dock", action=_Edit, metavar="NAME", help=_("add a dock (then --x --y --th)")
     )
     p.add_argument(
-        "--x", dest="x", action=_Coordinate, type=_number, metavar="MM", help="x of the goal or dock"
+        "--x", dest="x", action=_Coordinate, type=_number, metavar="MM", help=_("x of the goal or dock")
     )
     p.add_argument(
-        "--y", dest="y", action=_Coordinate, type=_number, metavar="MM", help="y of the goal or dock"
+        "--y", dest="y", action=_Coordinate, type=_number, metavar="MM", help=_("y of the goal or dock")
     )
     p.add_argument(
-        "--th", dest="th", action=_Coordinate, type=_number, metavar="DEG", help="heading of the goal or dock"
+        "--th",
+        dest="th",
+        action=_Coordinate,
+        type=_number,
+        metavar="DEG",
+        help=_("heading of the goal or dock"),
     )
     p.add_argument(
-        "--remove", dest="remove", action=_Edit, metavar="NAME", help="delete the object of this name"
+        "--remove", dest="remove", action=_Edit, metavar="NAME", help=_("delete the object of this name")
     )
     p.add_argument(
         "--add-forbidden-line",
@@ -120,7 +130,7 @@ def register(subparsers: Any) -> None:
         action=_Edit,
         nargs=4,
         metavar=("X1", "Y1", "X2", "Y2"),
-        help="add a forbidden line from (X1, Y1) to (X2, Y2), in mm",
+        help=_("add a forbidden line from (X1, Y1) to (X2, Y2), in mm"),
     )
     p.add_argument(
         "--add-forbidden-area",
@@ -128,10 +138,12 @@ def register(subparsers: Any) -> None:
         action=_Edit,
         nargs=4,
         metavar=("X1", "Y1", "X2", "Y2"),
-        help="add a forbidden area between the corners (X1, Y1) and (X2, Y2), in mm",
+        help=_("add a forbidden area between the corners (X1, Y1) and (X2, Y2), in mm"),
     )
     p.add_argument(
-        "--check-map", action="store_true", help="ask the server to re-read its map file (checkMap) instead"
+        "--check-map",
+        action="store_true",
+        help=_("ask the server to re-read its map file (checkMap) instead"),
     )
     p.set_defaults(handler=handle, edits=[])
 

@@ -20,6 +20,7 @@ from pathlib import Path
 from typing import TYPE_CHECKING, Any
 
 from ..base.exit_codes import EXIT_CONNECTION, EXIT_OK, EXIT_SIZE_LIMIT, EXIT_USAGE, NETWORK
+from ..base.i18n import _
 from ..base.notices import Kind, Notice
 from ..base.textsafe import visible
 from ..client.errors import ClientError
@@ -40,17 +41,21 @@ EXITS = (*NETWORK, EXIT_SIZE_LIMIT)
 def register(subparsers: Any) -> None:
     p = subparsers.add_parser(
         "record",
-        help="record a session to an MCAP file (raw bytes + decoded channels), headless",
-        description="Connect, follow the robot as the window does and write everything to FILE.mcap: "
-        "the exact bytes both ways (rtmu decode FILE.mcap explains them; the login's password digest is "
-        "recorded as zeros), pose, status, sonar, map, camera, link health, notices and stops, readable "
-        "in Foxglove. It never moves or stops the robot. The file is written as FILE.mcap.partial and "
-        "renamed at the end.",
+        help=_("record a session to an MCAP file (raw bytes + decoded channels), headless"),
+        description=_(
+            "Connect, follow the robot as the window does and write everything to FILE.mcap: "
+            "the exact bytes both ways (rtmu decode FILE.mcap explains them; the login's password digest is "
+            "recorded as zeros), pose, status, sonar, map, camera, link health, notices and stops, readable "
+            "in Foxglove. It never moves or stops the robot. The file is written as FILE.mcap.partial and "
+            "renamed at the end."
+        ),
     )
     add_connection_arguments(p)
-    p.add_argument("--out", type=Path, required=True, metavar="FILE.mcap", help="the recording to write")
+    p.add_argument("--out", type=Path, required=True, metavar="FILE.mcap", help=_("the recording to write"))
     add_force_option(p, "an existing FILE.mcap")
-    p.add_argument("--seconds", type=positive_float, default=None, metavar="S", help="stop after S seconds")
+    p.add_argument(
+        "--seconds", type=positive_float, default=None, metavar="S", help=_("stop after S seconds")
+    )
     add_fps_option(p, default=0.0, none_means="no pictures")
     p.add_argument(
         "--max-mb",

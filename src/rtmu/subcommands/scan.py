@@ -12,6 +12,7 @@ from pathlib import Path
 from typing import TYPE_CHECKING, Any
 
 from ..base.exit_codes import EXIT_OK, EXIT_REFUSED, EXIT_TIMEOUT, EXIT_USAGE, NETWORK
+from ..base.i18n import _
 from ..base.textsafe import visible
 from ..client.errors import NotSupported
 from ..client.roles import Role
@@ -35,7 +36,7 @@ DESCRIPTION = (
 def register(subparsers: Any) -> None:
     p = subparsers.add_parser(
         "scan",
-        help="scan for a map: start, status, loop tags, stop and download the .2d (mappingStart …)",
+        help=_("scan for a map: start, status, loop tags, stop and download the .2d (mappingStart …)"),
         description=DESCRIPTION,
     )
     add_connection_arguments(p)
@@ -43,16 +44,16 @@ def register(subparsers: Any) -> None:
     start = action_parser(
         actions, "start", "start a scan", "Start a scan named NAME (the robot writes NAME.2d)."
     )
-    start.add_argument("name", metavar="NAME", help="the scan's name")
+    start.add_argument("name", metavar="NAME", help=_("the scan's name"))
     action_parser(actions, "status", "is a scan running?", "Say whether a scan runs, and which.")
     loop = action_parser(
         actions, "loop", "tag a loop", "Mark where a loop starts or ends in the running scan."
     )
-    loop.add_argument("edge", choices=("start", "end"), help="start or end of the loop")
-    loop.add_argument("tag", nargs="?", default="1", metavar="TAG", help="the loop's tag (default 1)")
+    loop.add_argument("edge", choices=("start", "end"), help=_("start or end of the loop"))
+    loop.add_argument("tag", nargs="?", default="1", metavar="TAG", help=_("the loop's tag (default 1)"))
     stop = action_parser(actions, "stop", "end the scan", "End the scan, and fetch its .2d with --download.")
-    stop.add_argument("--download", type=Path, metavar="DIR", help="fetch the scan into this folder")
-    stop.add_argument("--force", action="store_true", help="replace the file in DIR if it exists")
+    stop.add_argument("--download", type=Path, metavar="DIR", help=_("fetch the scan into this folder"))
+    stop.add_argument("--force", action="store_true", help=_("replace the file in DIR if it exists"))
     p.set_defaults(handler=handle)
 
 

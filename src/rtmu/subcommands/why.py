@@ -13,6 +13,7 @@ import sys
 from typing import TYPE_CHECKING, Any
 
 from ..base.exit_codes import EXIT_WHY_LOST, NETWORK, WHY_ASKED
+from ..base.i18n import _
 from ..base.textsafe import visible
 from ..client.roles import Role
 from ..client.why import diagnose
@@ -54,16 +55,20 @@ then asks again. Switching safe drive off, acknowledging and enabling need a yes
 def register(subparsers: Any) -> None:
     p = subparsers.add_parser(
         "why",
-        help="why won't the robot move? one sentence and its fix",
+        help=_("why won't the robot move? one sentence and its fix"),
         description=DESCRIPTION,
     )
     add_connection_arguments(p)
-    p.add_argument("--json", action="store_true", help="one JSON object: the answer, its reasons and fixes")
-    p.add_argument("--fix", action="store_true", help="carry out the fix where there is one, then ask again")
     p.add_argument(
-        "--yes", action="store_true", help="confirm fixes that need a yes (safe drive off, LD faults)"
+        "--json", action="store_true", help=_("one JSON object: the answer, its reasons and fixes")
     )
-    p.add_argument("--navigate", action="store_true", help="ask about navigation (a lost robot counts)")
+    p.add_argument(
+        "--fix", action="store_true", help=_("carry out the fix where there is one, then ask again")
+    )
+    p.add_argument(
+        "--yes", action="store_true", help=_("confirm fixes that need a yes (safe drive off, LD faults)")
+    )
+    p.add_argument("--navigate", action="store_true", help=_("ask about navigation (a lost robot counts)"))
     p.set_defaults(handler=handle)
 
 
@@ -102,7 +107,7 @@ async def fix_all(
 
     results: list[FixResult] = []
     tried: set[str] = set()
-    for _ in range(MAX_FIXES):
+    for _attempt in range(MAX_FIXES):
         reason = next((r for r in answer.reasons if r.fix is not None and r.fix.key not in tried), None)
         if reason is None or reason.fix is None:
             break
