@@ -30,8 +30,10 @@ gi.require_version("Gtk", "4.0")
 from gi.repository import Gio, Gtk  # noqa: E402
 
 LETTER = re.compile(r"[A-Za-z]")
-GTK_OWN = ["Show Text", "Hide Text"]
-"""GTK's own words (its password entry's eye), translated by GTK's catalogue, not RTMU's."""
+GTK_OWN = ["Show Text", "Hide Text", "About", "License", "System", "Website", "Credits"]
+"""GTK's own words (its password entry's eye, its About dialog's pages), translated by GTK's catalogue."""
+PRODUCT = ["RTMU"]
+"""The program's name, the same in every language."""
 
 
 @pytest.fixture(scope="module")
@@ -192,3 +194,65 @@ def test_the_german_window_fits_both_screens(
     """The shipped German, longer than English, on the two smallest screens: nothing pushed out."""
     for gui, _sim in open_on(request.getfixturevalue(screen), screenshots, request.node.name):
         check_german(gui, f"german-{screen}")
+
+
+SURFACES = ("why", "details", "server-config", "files", "console", "scan", "map-edit", "about")
+"""The window's own windows and dialogs, each opened by its action (Server ▸ …, View ▸ …, Help ▸ …)."""
+
+
+def surface_server_words(gui: Gui) -> list[str]:
+    """The server's own words a surface shows: its data list (names, groups, descriptions) in the
+    console, its configuration (sections, parameters, comments, values) in the configuration page."""
+    words: list[str] = [*PRODUCT]
+    robot = gui.model.robot.value
+    words += [str(part) for pair in robot.server_strings for part in pair]
+    words += [str(part) for pair in robot.data_store for part in pair]
+    dialogs = gui.window.dialogs
+    for entry in getattr(dialogs.console, "entries", None) or ():
+        d = entry.data
+        words += [d.name, d.command_group, d.description, d.argument_description, d.return_description]
+    config = getattr(getattr(dialogs, "config_page", None), "config", None)
+    for section in config.sections if config is not None else ():
+        words += [section.name, section.comment, section.category]
+        for param in section.params:
+            words += [param.name, param.description, str(param.value)]
+    return [w for w in words if w]
+
+
+def surfaces_words(gui: Gui, sim: SimThread) -> list[str]:
+    """Open each of ``SURFACES``, read what it shows, close it: the words that escaped translation."""
+    window = gui.window
+    gui.wait_connected()
+    pump(lambda: bool(gui.model.map.value.name), 20, "the map")
+    allowed = server_words(gui, sim) + goal_names(gui)
+    problems: list[str] = []
+    for action in SURFACES:
+        before = set(Gtk.Window.list_toplevels())
+
+        def opened(before: set[Gtk.Window] = before) -> list[Gtk.Window]:
+            return [w for w in Gtk.Window.list_toplevels() if w not in before and w.get_mapped()]
+
+        window.activate_action(f"win.{action}", None)
+        pump(lambda: bool(opened()), 5, f"win.{action} to open a window")
+        idle(0.5)
+        for surface in opened():
+            gui.screen_shot(f"pseudo-{action}")
+            own = sorted(set(allowed + surface_server_words(gui)), key=len, reverse=True)
+            problems += [f"{action}: {p}" for p in escaped(widget_words(surface), own)]
+            width, height = surface.get_width(), surface.get_height()
+            screen = surface.get_display().get_monitors().get_item(0).get_geometry()
+            if width > screen.width or height > screen.height:
+                problems.append(
+                    f"{action}: {width}x{height} does not fit the {screen.width}x{screen.height} screen"
+                )
+            surface.close()
+        pump(lambda: not opened(), 5, f"win.{action}'s window to close")
+    return problems
+
+
+def test_every_dialog_of_the_window_is_translated_at_800x480(
+    pseudo_locale: None, screenshots: Path, small_screen: str, request: pytest.FixtureRequest
+) -> None:
+    for gui, sim in open_on(small_screen, screenshots, request.node.name):
+        problems = surfaces_words(gui, sim)
+        assert problems == [], "words that escaped translation:\n" + "\n".join(problems)

@@ -18,6 +18,7 @@ from collections import Counter
 from collections.abc import Iterable, Sequence
 from dataclasses import dataclass, replace
 
+from ..base.i18n import N_, _
 from ..mapfile import MapObject, object_text
 
 MAX_COORD_MM = 1_000_000_000
@@ -51,19 +52,31 @@ def object_key(obj: MapObject) -> tuple[object, ...]:
     )
 
 
-def describe(obj: MapObject) -> str:
-    """An object in a few plain words: ``goal "Kitchen"``, ``forbidden line (0, 0)–(1000, 0)``."""
+def describe(obj: MapObject, *, translated: bool = False) -> str:
+    """An object in a few plain words: ``goal "Kitchen"``, ``forbidden line (0, 0)–(1000, 0)``.
+
+    ``translated``: in the operator's language (the window); machine output (``--json``) keeps English."""
+    say = _ if translated else str
     kind = {
-        "goalwithheading": "goal",
-        "forbiddenline": "forbidden line",
-        "forbiddenarea": "forbidden area",
+        "goal": N_("goal"),
+        "goalwithheading": N_("goal"),
+        "dock": N_("dock"),
+        "home": N_("home"),
+        "forbiddenline": N_("forbidden line"),
+        "forbiddenarea": N_("forbidden area"),
     }.get(obj.type.lower(), obj.type.lower())
+    kind = say(kind) if obj.type.lower() in _KNOWN_KINDS else kind
     if obj.name:
-        return f'{kind} "{obj.name}"'
+        return say(N_('{kind} "{name}"')).format(kind=kind, name=obj.name)
     if obj.from_xy is not None and obj.to_xy is not None:
         (x1, y1), (x2, y2) = obj.from_xy, obj.to_xy
-        return f"{kind} ({x1:g}, {y1:g})–({x2:g}, {y2:g})"
-    return f"{kind} at ({obj.x:g}, {obj.y:g})"
+        return say(N_("{kind} ({x1:g}, {y1:g})–({x2:g}, {y2:g})")).format(
+            kind=kind, x1=x1, y1=y1, x2=x2, y2=y2
+        )
+    return say(N_("{kind} at ({x:g}, {y:g})")).format(kind=kind, x=obj.x, y=obj.y)
+
+
+_KNOWN_KINDS = frozenset({"goal", "goalwithheading", "dock", "home", "forbiddenline", "forbiddenarea"})
 
 
 @dataclass(frozen=True, slots=True)

@@ -237,7 +237,7 @@ class ConsolePage(Gtk.Window):
         d = entry.data
         box = Gtk.Box(orientation=Gtk.Orientation.VERTICAL)
         name = Gtk.Label(xalign=0.0, label=visible(short(d.name, 80)))
-        kind = _("changes something") if entry.changes else "read"
+        kind = _("changes something") if entry.changes else _("read")
         info = Gtk.Label(xalign=0.0, label=f"{visible(short(d.command_group, 40))} · {kind}")
         info.add_css_class("dim-label")
         box.append(name)

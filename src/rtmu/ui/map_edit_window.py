@@ -96,8 +96,12 @@ class MapEditWindow(Gtk.Window):
         for side in ("top", "bottom", "start", "end"):
             getattr(box, f"set_margin_{side}")(8)
         bar = Gtk.Box(spacing=6)
-        self.state_label = Gtk.Label(xalign=0.0, hexpand=True, wrap=True)
+        # Wraps at a width of its own: a language with longer words must not widen the window past an
+        # 800 px screen (tests/gui/test_pseudo_locale.py); the buttons below wrap onto a second line.
+        self.state_label = Gtk.Label(xalign=0.0, hexpand=True, wrap=True, max_width_chars=24)
         bar.append(self.state_label)
+        buttons = _wrapping_row(at_least=4)
+        bar.append(buttons)
         self.undo_button = Gtk.Button(label=_("Undo"))
         self.undo_button.connect("clicked", lambda _b: self._step(undo=True))
         self.redo_button = Gtk.Button(label=_("Redo"))
@@ -108,7 +112,7 @@ class MapEditWindow(Gtk.Window):
         self.apply_button.add_css_class("suggested-action")
         self.apply_button.connect("clicked", lambda _b: self.apply())
         for b in (self.undo_button, self.redo_button, self.discard_button, self.apply_button):
-            bar.append(b)
+            buttons.append(b)
         box.append(bar)
         self.news = Gtk.Label(xalign=0.0, wrap=True, selectable=True)
         box.append(self.news)
@@ -155,7 +159,7 @@ class MapEditWindow(Gtk.Window):
             self.fields[name] = entry
             fields.attach(entry, i, 1, 1, 1)
         form.attach(fields, 0, 1, 4, 2)
-        actions = Gtk.Box(spacing=6)
+        actions = _wrapping_row(at_least=2)
         self.add_button = Gtk.Button(label=_("Add"))
         self.add_button.connect("clicked", lambda _b: self.add())
         self.move_button = Gtk.Button(label=_("Move selected here"))
@@ -380,7 +384,7 @@ class MapEditWindow(Gtk.Window):
         self.shown = list(draft.objects) if draft is not None else []
         added = {object_key(o) for o in (draft.change().added if draft is not None else ())}
         for obj in self.shown:
-            text = describe(obj) + (
+            text = describe(obj, translated=True) + (
                 ""
                 if obj.from_xy
                 else _(" at ({x:.0f}, {y:.0f}) {th:.0f}°").format(x=obj.x, y=obj.y, th=obj.th)
@@ -421,3 +425,13 @@ class MapEditWindow(Gtk.Window):
         self._unobserve = []
         self._unswitch()
         return False
+
+
+def _wrapping_row(at_least: int) -> Gtk.FlowBox:
+    """Buttons side by side (``at_least`` on a line) that wrap onto another line when the words are longer
+    than the room."""
+    row = Gtk.FlowBox(selection_mode=Gtk.SelectionMode.NONE, column_spacing=6, row_spacing=6, hexpand=True)
+    row.set_min_children_per_line(at_least)
+    row.set_max_children_per_line(4)
+    row.set_homogeneous(False)
+    return row

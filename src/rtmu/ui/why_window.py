@@ -145,7 +145,7 @@ class WhyWindow(Gtk.Window):
 
     def show_answer(self, answer: Answer) -> None:
         self.answer = answer
-        sentence = _short(answer.sentence())
+        sentence = _short(_(answer.sentence()))  # the one fixed sentence; a cause's words are the model's
         self.sentence.set_text(sentence[:1].upper() + sentence[1:])
         self.details.set_text(answer_details(answer))
         first = answer.primary
