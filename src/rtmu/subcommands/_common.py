@@ -401,7 +401,10 @@ class Interrupts:
                         async with asyncio.timeout(SUSPEND_HOOK_TIMEOUT):
                             await result
                 except Exception as exc:  # the suspension must happen anyway
-                    print(f"rtmu: before suspending: {exc or type(exc).__name__}", file=sys.stderr)
+                    print(
+                        _("rtmu: before suspending: {value}").format(value=exc or type(exc).__name__),
+                        file=sys.stderr,
+                    )
             # Suspend for real (the default action); we are back here after fg / SIGCONT.
             loop.remove_signal_handler(signal.SIGTSTP)
             os.kill(os.getpid(), signal.SIGTSTP)
@@ -439,7 +442,7 @@ def current_password() -> str:
 def fail(name: str, message: str, code: int) -> int:
     from ..base.textsafe import visible
 
-    print(f"rtmu {name}: {visible(message)}", file=sys.stderr)
+    print(_("rtmu {name}: {visible}").format(name=name, visible=visible(message)), file=sys.stderr)
     return code
 
 
@@ -555,6 +558,9 @@ def known_name(command: str, kind: str, name: str, known: tuple[str, ...]) -> st
 
     listed = visible(", ".join(known) or "none")
     print(
-        f"rtmu {command}: no {kind} {visible(repr(name))} on this server ({kind}s: {listed})", file=sys.stderr
+        _("rtmu {command}: no {kind} {visible} on this server ({kind}s: {listed})").format(
+            command=command, kind=kind, visible=visible(repr(name)), listed=listed
+        ),
+        file=sys.stderr,
     )
     return None

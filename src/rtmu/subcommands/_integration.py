@@ -164,20 +164,24 @@ def install(parser: argparse.ArgumentParser, home: Path, command: list[str]) -> 
         for item in files(parser, command):
             target = home / item.relative
             if target.is_file() and target.read_bytes() == item.content:
-                print(f"up to date  {target}")
+                print(_("up to date  {target}").format(target=target))
                 continue
             target.parent.mkdir(parents=True, exist_ok=True)
             partial = target.with_name(target.name + ".rtmu-new")
             partial.write_bytes(item.content)
             partial.chmod(0o644)
             partial.replace(target)  # atomic: a reader never sees half a file
-            print(f"installed   {target}")
+            print(_("installed   {target}").format(target=target))
     except BrokenPipeError:
         raise  # our reader went away: not a reason to blame the data folder
     except OSError as exc:
-        print(f"rtmu: cannot install into {home}: {exc}", file=sys.stderr)
+        print(_("rtmu: cannot install into {home}: {exc}").format(home=home, exc=exc), file=sys.stderr)
         return EXIT_CANNOT_WRITE
-    print(f"RTMU is in the application menu; zsh users add {home / 'zsh/site-functions'} to fpath.")
+    print(
+        _("RTMU is in the application menu; zsh users add {value} to fpath.").format(
+            value=home / "zsh/site-functions"
+        )
+    )
     return 0
 
 
@@ -191,10 +195,10 @@ def uninstall(parser: argparse.ArgumentParser, home: Path) -> int:
         except FileNotFoundError:
             continue
         except OSError as exc:
-            print(f"rtmu: cannot remove {target}: {exc}", file=sys.stderr)
+            print(_("rtmu: cannot remove {target}: {exc}").format(target=target, exc=exc), file=sys.stderr)
             return EXIT_CANNOT_WRITE
         removed += 1
-        print(f"removed     {target}")
+        print(_("removed     {target}").format(target=target))
     if not removed:
-        print(f"nothing of RTMU's was installed in {home}")
+        print(_("nothing of RTMU's was installed in {home}").format(home=home))
     return 0

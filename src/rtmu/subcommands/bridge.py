@@ -118,7 +118,7 @@ def handle(args: argparse.Namespace) -> int:
         return fail("bridge", "cancelled", EXIT_USAGE)
 
     def tell(notice: Notice) -> None:
-        print(f"rtmu bridge: {visible(notice.text)}", file=sys.stderr)
+        print(_("rtmu bridge: {visible}").format(visible=visible(notice.text)), file=sys.stderr)
 
     role = Role.OPERATOR if args.allow_drive else Role.OBSERVER  # read-only: it cannot command at all
     config = SessionConfig(connect_timeout=args.timeout, guardian=args.allow_drive, role=role)
@@ -140,7 +140,9 @@ def handle(args: argparse.Namespace) -> int:
         bridge.stopped(reason, sent)
         if reason.startswith("lease link"):  # a stream that paused is the operator's "release": not said
             print(
-                f"rtmu bridge: stopped the robot: {visible(reason.removeprefix('lease link: '))}",
+                _("rtmu bridge: stopped the robot: {visible}").format(
+                    visible=visible(reason.removeprefix("lease link: "))
+                ),
                 file=sys.stderr,
             )
 
@@ -182,15 +184,17 @@ def serve(
 def announce(bridge: Bridge) -> None:
     """The URL to open, printed once (with a drive bridge's token: it is shown nowhere else)."""
     if bridge.drive is None:
-        print(f"rtmu bridge: {bridge.url} (no drive)", file=sys.stderr, flush=True)
+        print(_("rtmu bridge: {url} (no drive)").format(url=bridge.url), file=sys.stderr, flush=True)
         return
     print(
-        f"rtmu bridge: {bridge.url} (drive allowed from /cmd_vel, one client at a time; the URL holds this "
-        "run's token: share it only with who may drive)",
+        _(
+            "rtmu bridge: {url} (drive allowed from /cmd_vel, one client at a time; the URL holds "
+            "this run's token: share it only with who may drive)"
+        ).format(url=bridge.url),
         file=sys.stderr,
     )
     app = APP + quote(bridge.url, safe="")
-    print(f"rtmu bridge: in Foxglove's web app: {app}", file=sys.stderr, flush=True)
+    print(_("rtmu bridge: in Foxglove's web app: {app}").format(app=app), file=sys.stderr, flush=True)
 
 
 def warn_exposure(bind: str, allow_drive: bool) -> None:
@@ -201,16 +205,20 @@ def warn_exposure(bind: str, allow_drive: bool) -> None:
         return
     if allow_drive:
         print(
-            f"rtmu bridge: WARNING: --allow-drive on {visible(bind)}, an address other hosts can reach: "
-            "anyone with the printed URL (its token) on the network can drive the robot. Bind 127.0.0.1 and "
-            "tunnel (ssh -L) unless the network is yours alone.",
+            _(
+                "rtmu bridge: WARNING: --allow-drive on {visible}, an address other hosts can reach: "
+                "anyone with the printed URL (its token) on the network can drive the robot. Bind "
+                "127.0.0.1 and tunnel (ssh -L) unless the network is yours alone."
+            ).format(visible=visible(bind)),
             file=sys.stderr,
             flush=True,
         )
     else:
         print(
-            f"rtmu bridge: serving on {visible(bind)}: other hosts on the network can watch the robot "
-            "(they cannot drive it)",
+            _(
+                "rtmu bridge: serving on {visible}: other hosts on the network can watch the robot "
+                "(they cannot drive it)"
+            ).format(visible=visible(bind)),
             file=sys.stderr,
             flush=True,
         )

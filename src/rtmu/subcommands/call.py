@@ -122,7 +122,7 @@ _NUMBER = re.compile(r"-\d+(\.\d*)?|-\.\d+")
 
 
 def usage(message: str) -> int:
-    print(f"rtmu call: {visible(message)}", file=sys.stderr)
+    print(_("rtmu call: {visible}").format(visible=visible(message)), file=sys.stderr)
     return EXIT_USAGE
 
 
@@ -185,7 +185,10 @@ async def follow(client: AriaClient, entry: ConsoleEntry, payload: bytes, args: 
     if client.closed_error is not None:  # the connection ended while following: exit 3, with why
         raise client.closed_error
     if not replies:
-        print(f"rtmu call: {visible(entry.name)}: no reply while following it", file=sys.stderr)
+        print(
+            _("rtmu call: {visible}: no reply while following it").format(visible=visible(entry.name)),
+            file=sys.stderr,
+        )
     return EXIT_OK if replies else EXIT_TIMEOUT
 
 
@@ -206,7 +209,7 @@ def print_list(entries: list[ConsoleEntry], as_json: bool) -> int:
     for e in entries:
         for line in entry_lines(e):
             print(line)
-    print(f"{len(entries)} data", flush=True)
+    print(_("{len} data").format(len=len(entries)), flush=True)
     return EXIT_OK
 
 

@@ -18,7 +18,7 @@ from pathlib import Path
 from typing import TYPE_CHECKING, Any
 
 from ..base.exit_codes import EXIT_FOREIGN_CONFIG, EXIT_OK, EXIT_REFUSED, EXIT_USAGE, NETWORK
-from ..base.i18n import _
+from ..base.i18n import _, ngettext
 from ..base.textsafe import visible
 from ..client.roles import Role
 from ..protocol.payloads.config import ConfigParam, ParamType, Priority
@@ -120,12 +120,17 @@ def handle(args: argparse.Namespace) -> int:
 
     assignments: list[tuple[str, str, str]] = args.assignments or []
     if len(assignments) > MAX_ASSIGNMENTS:
-        print(f"rtmu config: at most {MAX_ASSIGNMENTS} values at once", file=sys.stderr)
+        print(
+            _("rtmu config: at most {MAX_ASSIGNMENTS} values at once").format(
+                MAX_ASSIGNMENTS=MAX_ASSIGNMENTS
+            ),
+            file=sys.stderr,
+        )
         return EXIT_USAGE
 
     problem = _config_care.check_usage(args)
     if problem:
-        print(f"rtmu config: {problem}", file=sys.stderr)
+        print(_("rtmu config: {problem}").format(problem=problem), file=sys.stderr)
         return EXIT_USAGE
 
     async def body(client: AriaClient) -> int:
@@ -159,9 +164,17 @@ async def _set(client: AriaClient, assignments: list[tuple[str, str, str]], args
     if args.json:
         print_json({"accepted": answer.accepted, "error": answer.error})
     elif answer.accepted:
-        print(f"accepted: {len(assignments)} value{'s' if len(assignments) != 1 else ''}", flush=True)
+        print(
+            ngettext("accepted: {count} value", "accepted: {count} values", len(assignments)).format(
+                count=len(assignments)
+            ),
+            flush=True,
+        )
     if not answer.accepted:
-        print(f"rtmu config: the server refused: {visible(answer.error)}", file=sys.stderr)
+        print(
+            _("rtmu config: the server refused: {visible}").format(visible=visible(answer.error)),
+            file=sys.stderr,
+        )
         return EXIT_REFUSED
     return EXIT_OK
 
@@ -240,5 +253,5 @@ def print_text(config: ServerConfig) -> None:
             if p.description:
                 print(f"      {visible(p.description)}")
     if config.cut:
-        print(f"({config.cut} more parameters not shown: the configuration is too large)")
+        print(_("({cut} more parameters not shown: the configuration is too large)").format(cut=config.cut))
     sys.stdout.flush()

@@ -145,10 +145,10 @@ def run(args: argparse.Namespace) -> int:
     try:
         source = open_capture(args.file, args.format, args.direction)
     except UnreadableInput as exc:
-        print(f"rtmu decode: {visible(exc)}", file=sys.stderr)
+        print(_("rtmu decode: {visible}").format(visible=visible(exc)), file=sys.stderr)
         return EXIT_USAGE
     except CaptureError as exc:
-        print(f"rtmu decode: {visible(exc)}", file=sys.stderr)
+        print(_("rtmu decode: {visible}").format(visible=visible(exc)), file=sys.stderr)
         return EXIT_BAD_FILE
     decoder = CaptureDecoder(report_trailing_drops=args.json)
     summary = args.summary if args.summary is not None else not args.json
@@ -166,17 +166,17 @@ def run(args: argparse.Namespace) -> int:
                 _write_text_summary(out, decoder, source, full=args.all)
         out.flush()
     except UnreadableInput as exc:
-        print(f"rtmu decode: {visible(exc)}", file=sys.stderr)
+        print(_("rtmu decode: {visible}").format(visible=visible(exc)), file=sys.stderr)
         return EXIT_USAGE
     except CaptureError as exc:
-        print(f"rtmu decode: {visible(exc)}", file=sys.stderr)
+        print(_("rtmu decode: {visible}").format(visible=visible(exc)), file=sys.stderr)
         return EXIT_BAD_FILE
     except BrokenPipeError:  # `rtmu decode x | head`: the reader has seen enough (141, as every command)
         devnull = os.open(os.devnull, os.O_WRONLY)
         os.dup2(devnull, sys.stdout.fileno())
         return EXIT_SIGPIPE
     for warning in source.stats.warnings:
-        print(f"rtmu decode: warning: {visible(warning)}", file=sys.stderr)
+        print(_("rtmu decode: warning: {visible}").format(visible=visible(warning)), file=sys.stderr)
     return EXIT_OK
 
 

@@ -565,13 +565,13 @@ def handle(args: argparse.Namespace) -> int:
     try:
         password = read_password(args)
     except UsageError as exc:
-        print(f"rtmu doctor: {visible(exc)}", file=sys.stderr)
+        print(_("rtmu doctor: {visible}").format(visible=visible(exc)), file=sys.stderr)
         return EXIT_USAGE
     doctor = Doctor(host, port, args.user, password, args.protocol, args.timeout, max(0.0, args.link_seconds))
     try:
         code = run_interruptibly(doctor.run)
     except Interrupted as exc:
-        print(f"rtmu doctor: {exc}", file=sys.stderr)
+        print(_("rtmu doctor: {exc}").format(exc=exc), file=sys.stderr)
         return exc.exit_code
     failed = next((s for s in doctor.steps if s.result == "fail"), None)
     lines = report_lines(doctor.steps, host, port, args.user, failed, code)

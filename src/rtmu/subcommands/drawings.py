@@ -60,11 +60,16 @@ def handle(args: argparse.Namespace) -> int:
             batch = listed.drawings[start : start + SAMPLES_AT_ONCE]
             rows += await asyncio.gather(*(_sample(client, d, args.timeout) for d in batch))
         if listed.dropped:
-            print(f"rtmu drawings: {listed.dropped_text()} (not sampled, not shown)", file=sys.stderr)
+            print(
+                _("rtmu drawings: {dropped_text} (not sampled, not shown)").format(
+                    dropped_text=listed.dropped_text()
+                ),
+                file=sys.stderr,
+            )
         if args.json:
             print_json(rows)
         elif not rows:
-            print("the server lists no drawings", flush=True)
+            print(_("the server lists no drawings"), flush=True)
         else:
             for row in rows:
                 print(_line(row), flush=True)

@@ -144,7 +144,12 @@ def _get(args: argparse.Namespace) -> Any:
         note = ""
         if done.listed_size is not None and done.listed_size != done.size:
             note = f" (the robot listed {done.listed_size} bytes)"
-        print(f"wrote {local}: {done.size} bytes in {done.seconds:.2f} s{note}", file=sys.stderr)
+        print(
+            _("wrote {local}: {size} bytes in {seconds:.2f} s{note}").format(
+                local=local, size=done.size, seconds=done.seconds, note=note
+            ),
+            file=sys.stderr,
+        )
         return EXIT_OK
 
     return body
@@ -192,7 +197,9 @@ def _put(args: argparse.Namespace) -> Any:
                 {"local": str(local), "remote": target, "bytes": done.size, "seconds": round(done.seconds, 3)}
             )
         print(
-            f"uploaded {local} as {visible(target)}: {done.size} bytes in {done.seconds:.2f} s",
+            _("uploaded {local} as {visible}: {size} bytes in {seconds:.2f} s").format(
+                local=local, visible=visible(target), size=done.size, seconds=done.seconds
+            ),
             file=sys.stderr,
         )
         return EXIT_OK
@@ -212,7 +219,7 @@ def _rm(args: argparse.Namespace) -> Any:
             )
         answer = input(f"Delete {remote!r} on {host}:{port}? [y/N] ").strip().lower()
         if answer not in ("y", "yes"):
-            print("rtmu files: not deleted", file=sys.stderr)
+            print(_("rtmu files: not deleted"), file=sys.stderr)
             return EXIT_USAGE
 
     async def body(client: AriaClient) -> int:
@@ -220,7 +227,7 @@ def _rm(args: argparse.Namespace) -> Any:
         if args.json:
             print_json({"deleted": remote})
         else:
-            print(f"deleted {visible(remote)}", file=sys.stderr)
+            print(_("deleted {visible}").format(visible=visible(remote)), file=sys.stderr)
         return EXIT_OK
 
     return body

@@ -14,7 +14,7 @@ import argparse
 from typing import TYPE_CHECKING, Any
 
 from ..base.exit_codes import EXIT_CONNECTION, EXIT_OK, EXIT_USAGE
-from ..base.i18n import _
+from ..base.i18n import _, ngettext
 from ..base.textsafe import visible
 from ..client.errors import ClientError
 from ..client.roles import Role
@@ -94,7 +94,7 @@ def handle(args: argparse.Namespace) -> int:
         statuses: list[dict[str, Any] | None] = [None] * len(robots)
         if not args.no_status:
             statuses = list(
-                await asyncio.gather(*(_status(e.host, e.port, args, password, gate) for e, _ in robots))
+                await asyncio.gather(*(_status(e.host, e.port, args, password, gate) for e, _count in robots))
             )
         rows = []
         for (endpoint, entry), status in zip(robots, statuses, strict=True):
@@ -120,11 +120,20 @@ def handle(args: argparse.Namespace) -> int:
     if args.json:
         print_json({"central": f"{host}:{port}", "robots": rows})
         return EXIT_OK
-    print(f"{host}:{port}: {len(rows)} robot{'' if len(rows) == 1 else 's'}")
+    print(
+        ngettext("{host}:{port}: {count} robot", "{host}:{port}: {count} robots", len(rows)).format(
+            host=host, port=port, count=len(rows)
+        )
+    )
     for row in rows:
         status = row.get("status")
         shown = "" if status is None else status.get("error") or status_line(status)
-        print(f"  {visible(row['name'])}  port {row['port']}  {visible(shown)}", flush=True)
+        print(
+            _("  {visible}  port {value}  {visible2}").format(
+                visible=visible(row["name"]), value=row["port"], visible2=visible(shown)
+            ),
+            flush=True,
+        )
     return EXIT_OK
 
 

@@ -66,7 +66,7 @@ def handle(args: argparse.Namespace) -> int:
     try:
         check(args)
     except UsageError as exc:
-        print(f"rtmu goto: {exc}", file=sys.stderr)
+        print(_("rtmu goto: {exc}").format(exc=exc), file=sys.stderr)
         return EXIT_USAGE
 
     async def body(client: AriaClient) -> int:
@@ -87,7 +87,7 @@ def handle(args: argparse.Namespace) -> int:
             args.goal = goal  # as the map spells it: what the server's words will name
         if route:
             ld_data.goto_route_goal(client, args.goal)
-            print(f"going to {visible(args.goal)}", file=sys.stderr)
+            print(_("going to {visible}").format(visible=visible(args.goal)), file=sys.stderr)
             return EXIT_OK
         return await navigate(client, args, GotoGoal(args.goal), Expect(args.goal))
 

@@ -123,9 +123,19 @@ def handle(args: argparse.Namespace) -> int:
         data = converted(jpeg, fmt)
         written = write_whole(args.out, data, force=args.force)
         if written != args.out:
-            print(f"rtmu image: {args.out} appeared meanwhile; kept it, wrote {written}", file=sys.stderr)
+            print(
+                _("rtmu image: {out} appeared meanwhile; kept it, wrote {written}").format(
+                    out=args.out, written=written
+                ),
+                file=sys.stderr,
+            )
         size = f"{picture.width}x{picture.height}"  # type: ignore[attr-defined]
-        print(f"wrote {written}: {size} {fmt}, {len(data)} bytes from {visible(source)}", file=sys.stderr)
+        print(
+            _("wrote {written}: {size} {fmt}, {len} bytes from {visible}").format(
+                written=written, size=size, fmt=fmt, len=len(data), visible=visible(source)
+            ),
+            file=sys.stderr,
+        )
         return EXIT_OK
 
     return run_with_client("image", args, body, role=Role.OBSERVER)

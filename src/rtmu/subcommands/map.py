@@ -57,10 +57,24 @@ def handle(args: argparse.Namespace) -> int:
         written = write_whole(args.out, payload, force=args.force)
         name = f" ({visible(got.name)})" if got.name else ""
         if written != args.out:
-            print(f"rtmu map: {args.out} appeared meanwhile; kept it, wrote {written}", file=sys.stderr)
+            print(
+                _("rtmu map: {out} appeared meanwhile; kept it, wrote {written}").format(
+                    out=args.out, written=written
+                ),
+                file=sys.stderr,
+            )
         print(
-            f"wrote {written}{name}: {got.data.num_points} points, {got.data.num_lines} lines "
-            f"via {got.source} in {got.packets} packets",
+            _(
+                "wrote {written}{name}: {num_points} points, {num_lines} lines via {source} in "
+                "{packets} packets"
+            ).format(
+                written=written,
+                name=name,
+                num_points=got.data.num_points,
+                num_lines=got.data.num_lines,
+                source=got.source,
+                packets=got.packets,
+            ),
             file=sys.stderr,
         )
         return EXIT_OK

@@ -176,16 +176,18 @@ def handle(args: argparse.Namespace) -> int:
 
     edits: list[dict[str, Any]] = args.edits or []
     if args.check_map and edits:
-        print("rtmu mapedit: --check-map goes alone, without edits", file=sys.stderr)
+        print(_("rtmu mapedit: --check-map goes alone, without edits"), file=sys.stderr)
         return EXIT_USAGE
     if not args.check_map and not edits:
         print(
-            "rtmu mapedit: nothing to do: give an edit (--add-goal, --remove, …) or --check-map",
+            _("rtmu mapedit: nothing to do: give an edit (--add-goal, --remove, …) or --check-map"),
             file=sys.stderr,
         )
         return EXIT_USAGE
     if len(edits) > MAX_EDITS:
-        print(f"rtmu mapedit: at most {MAX_EDITS} edits at once", file=sys.stderr)
+        print(
+            _("rtmu mapedit: at most {MAX_EDITS} edits at once").format(MAX_EDITS=MAX_EDITS), file=sys.stderr
+        )
         return EXIT_USAGE
 
     async def body(client: AriaClient) -> int:
@@ -195,9 +197,9 @@ def handle(args: argparse.Namespace) -> int:
                 print_json({"map_updated": changed})
             else:
                 print(
-                    "the map was read again: it had changed"
+                    _("the map was read again: it had changed")
                     if changed
-                    else "no mapUpdated: the file had not changed"
+                    else _("no mapUpdated: the file had not changed")
                 )
             return EXIT_OK
         return await _edit(client, edits, args)
@@ -227,7 +229,7 @@ async def _edit(client: AriaClient, edits: list[dict[str, Any]], args: argparse.
     try:
         apply_edits(draft, edits)
     except DraftError as exc:
-        print(f"rtmu mapedit: {visible(str(exc))}", file=sys.stderr)
+        print(_("rtmu mapedit: {visible}").format(visible=visible(str(exc))), file=sys.stderr)
         return EXIT_USAGE
     change = draft.change()
     if change.empty:
@@ -240,7 +242,7 @@ async def _edit(client: AriaClient, edits: list[dict[str, Any]], args: argparse.
     )
     if not verdict.applied:
         _report(args, change, verdict, [], "")
-        print(f"rtmu mapedit: {visible(verdict.words)}", file=sys.stderr)
+        print(_("rtmu mapedit: {visible}").format(visible=visible(verdict.words)), file=sys.stderr)
         return EXIT_REFUSED
     after = await download_map(client, timeout=args.timeout)
     missing = not_holding(after.data.objects if after.data is not None else [], change)
@@ -280,7 +282,7 @@ def _report(
     if verdict is not None and verdict.applied and not missing:
         for obj in change.removed:
             if not any(o.name and o.name == obj.name for o in change.added):
-                print(f"removed {visible(describe(obj))}")
+                print(_("removed {visible}").format(visible=visible(describe(obj))))
         for obj in change.added:
-            print(f"added {visible(describe(obj))}")
+            print(_("added {visible}").format(visible=visible(describe(obj))))
         sys.stdout.flush()

@@ -39,7 +39,7 @@ def run(args: argparse.Namespace) -> int:
     try:
         data = read_map(args.file)
     except MapFormatError as exc:
-        print(f"rtmu mapinfo: {visible(str(exc))}", file=sys.stderr)
+        print(_("rtmu mapinfo: {visible}").format(visible=visible(str(exc))), file=sys.stderr)
         return EXIT_USAGE if isinstance(exc.__cause__, OSError) else EXIT_BAD_FILE  # missing, or not a map
     summary = summarise(data)
     if args.json:

@@ -37,7 +37,7 @@ def handle(args: argparse.Namespace) -> int:
             return EXIT_USAGE
         args.route = route
         ld_data.patrol(client, args.route)
-        print(f"patrolling {visible(args.route)}", file=sys.stderr)
+        print(_("patrolling {visible}").format(visible=visible(args.route)), file=sys.stderr)
         return EXIT_OK
 
     return run_with_client("patrol", args, body, role=Role.OPERATOR)

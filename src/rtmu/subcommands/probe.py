@@ -74,9 +74,9 @@ def handle(args: argparse.Namespace) -> int:
                 if e.description:
                     print(f"         {visible(e.description)}")
                 if e.argument_description and e.argument_description.lower() not in ("none", ""):
-                    print(f"         args:    {visible(e.argument_description)}")
+                    print(_("         args:    {visible}").format(visible=visible(e.argument_description)))
                 if e.return_description and e.return_description.lower() not in ("none", ""):
-                    print(f"         returns: {visible(e.return_description)}")
+                    print(_("         returns: {visible}").format(visible=visible(e.return_description)))
         return EXIT_OK
 
     return run_with_client("probe", args, body, role=Role.OBSERVER)

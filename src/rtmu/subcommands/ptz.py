@@ -150,9 +150,11 @@ def _outside_limits(args: argparse.Namespace, state: PtzState) -> str:
 def _print_head(state: PtzState) -> None:
     (p0, p1), (t0, t1), (z0, z1) = state.pan_range, state.tilt_range, state.zoom_range
     print(visible(f"head {state.camera}: pan {p0:g}…{p1:g}°, tilt {t0:g}…{t1:g}°"), end="")
-    print(f", zoom {z0:g}…{z1:g} %" if state.zoom_available else ", no zoom")
+    print(_(", zoom {z0:g}…{z1:g} %").format(z0=z0, z1=z1) if state.zoom_available else _(", no zoom"))
     if state.position is None:
-        print("position: not read")
+        print(_("position: not read"))
     else:
         pan, tilt, zoom = state.position
-        print(f"position: pan {pan:g}°, tilt {tilt:g}°, zoom {zoom:g} %")
+        print(
+            _("position: pan {pan:g}°, tilt {tilt:g}°, zoom {zoom:g} %").format(pan=pan, tilt=tilt, zoom=zoom)
+        )

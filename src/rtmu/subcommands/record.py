@@ -87,11 +87,14 @@ def handle(args: argparse.Namespace) -> int:
 
         def tell(notice: Notice) -> None:
             if notice.kind is not Kind.RECORDING:
-                print(f"rtmu record: {visible(notice.text)}", file=sys.stderr)
+                print(_("rtmu record: {visible}").format(visible=visible(notice.text)), file=sys.stderr)
             elif not stopped:  # its size limit, a full disk: said once, and the recording ends
                 why = next((r.stopped for r in recorder.recordings if r.stopped), None) or notice.text
                 stopped.append(why)
-                print(f"rtmu record: {visible(why)}; the recording ends here", file=sys.stderr)
+                print(
+                    _("rtmu record: {visible}; the recording ends here").format(visible=visible(why)),
+                    file=sys.stderr,
+                )
                 ending.event.set()
 
         config = RecorderConfig(out.parent, path=partial, max_bytes=int(args.max_mb * 1e6), keep_days=0)
@@ -137,7 +140,10 @@ def _record(
     except Exception as exc:
         return fail("record", f"could not connect: {exc}", EXIT_CONNECTION)
     shown = f"{visible(str(args.out))} (as {visible(partial.name)} until it ends)"
-    print(f"rtmu record: recording {host}:{port} to {shown}", file=sys.stderr)
+    print(
+        _("rtmu record: recording {host}:{port} to {shown}").format(host=host, port=port, shown=shown),
+        file=sys.stderr,
+    )
     follow(runner, ending.event, seconds=args.seconds, camera_hz=args.fps)
     return EXIT_OK
 
@@ -156,10 +162,17 @@ def _keep(recorder: Recorder, out: Path, *, force: bool, logged_in: bool) -> boo
         kept = True
         size = final.stat().st_size
         if final != out:
-            print(f"rtmu record: {visible(str(out))} appeared meanwhile and was kept", file=sys.stderr)
+            print(
+                _("rtmu record: {visible} appeared meanwhile and was kept").format(visible=visible(str(out))),
+                file=sys.stderr,
+            )
         print(
-            f"rtmu record: {visible(str(final))}: {size / 1e6:.2f} MB, "
-            f"{recording.written_items} items, {recording.dropped} dropped",
+            _("rtmu record: {visible}: {value:.2f} MB, {written_items} items, {dropped} dropped").format(
+                visible=visible(str(final)),
+                value=size / 1e6,
+                written_items=recording.written_items,
+                dropped=recording.dropped,
+            ),
             file=sys.stderr,
         )
     return kept

@@ -41,7 +41,7 @@ def register(subparsers: Any) -> None:
 
 
 def usage(message: str) -> int:
-    print(f"rtmu run: {visible(message)}", file=sys.stderr)
+    print(_("rtmu run: {visible}").format(visible=visible(message)), file=sys.stderr)
     return EXIT_USAGE
 
 
@@ -68,10 +68,13 @@ def handle(args: argparse.Namespace) -> int:
         if args.json:
             print_json({"command": command.name, "argument": args.argument, "taken": taken})
         elif taken:
-            print(f"{visible(command.name)}: taken by the server", flush=True)
+            print(_("{visible}: taken by the server").format(visible=visible(command.name)), flush=True)
         else:
             silent = f"sent, but the server did not answer within {args.timeout:g} s"
-            print(f"rtmu run: {visible(command.name)} {silent}", file=sys.stderr)
+            print(
+                _("rtmu run: {visible} {silent}").format(visible=visible(command.name), silent=silent),
+                file=sys.stderr,
+            )
         return EXIT_OK if taken else EXIT_TIMEOUT
 
     return run_with_client("run", args, body, role=Role.OPERATOR)

@@ -34,12 +34,16 @@ def handle(args: argparse.Namespace) -> int:
 
     text = args.text.strip()
     if not text or len(text) > MAX_TEXT:
-        print(f"rtmu say: give a text of 1…{MAX_TEXT} characters", file=sys.stderr)
+        print(
+            _("rtmu say: give a text of 1…{MAX_TEXT} characters").format(MAX_TEXT=MAX_TEXT), file=sys.stderr
+        )
         return EXIT_USAGE
     try:
         text.encode("latin-1")
     except UnicodeEncodeError:
-        print("rtmu say: the text has characters ARIA strings cannot carry (latin-1 only)", file=sys.stderr)
+        print(
+            _("rtmu say: the text has characters ARIA strings cannot carry (latin-1 only)"), file=sys.stderr
+        )
         return EXIT_USAGE
 
     async def body(client: AriaClient) -> int:

@@ -77,7 +77,11 @@ def _start(args: argparse.Namespace) -> Any:
         if args.json:
             print_json({"scanning": True, "file": file_name})
         else:
-            print(f"scanning: the robot writes {visible(file_name)}; drive it round the site, then 'stop'")
+            print(
+                _("scanning: the robot writes {visible}; drive it round the site, then 'stop'").format(
+                    visible=visible(file_name)
+                )
+            )
         return EXIT_OK
 
     return body
@@ -91,9 +95,13 @@ def _status(args: argparse.Namespace) -> Any:
         if args.json:
             print_json({"scanning": status.scanning, "name": status.name, "file": status.file_name})
         elif status.scanning:
-            print(f"scanning {visible(status.name)} (file {visible(status.file_name)})")
+            print(
+                _("scanning {visible} (file {visible2})").format(
+                    visible=visible(status.name), visible2=visible(status.file_name)
+                )
+            )
         else:
-            print("not scanning")
+            print(_("not scanning"))
         return EXIT_OK
 
     return body
@@ -120,7 +128,7 @@ def _loop(args: argparse.Namespace) -> Any:
                 "scan", f"the robot did not confirm the loop tag within {args.timeout:g} s", EXIT_TIMEOUT
             )
         if not args.json:
-            print(f"loop {args.edge} tagged {visible(args.tag)!r}")
+            print(_("loop {edge} tagged {visible!r}").format(edge=args.edge, visible=visible(args.tag)))
         return EXIT_OK
 
     return body
@@ -156,9 +164,13 @@ def _stop(args: argparse.Namespace) -> Any:
         if args.json:
             print_json(out)
         else:
-            print(f"scan ended: {visible(file_name) or '(the robot did not name its file)'}")
+            print(
+                _("scan ended: {value}").format(
+                    value=visible(file_name) or "(the robot did not name its file)"
+                )
+            )
             if local is not None:
-                print(f"downloaded to {local} ({out['bytes']} bytes)")
+                print(_("downloaded to {local} ({value} bytes)").format(local=local, value=out["bytes"]))
         sys.stdout.flush()
         return EXIT_OK
 

@@ -247,14 +247,16 @@ def run(args: argparse.Namespace) -> int:
     if args.central:
         args.robots = 0 if args.robots is None else args.robots
         if not 0 <= args.robots <= 100:
-            print("rtmu sim: with --central, --robots takes 0…100", file=sys.stderr)
+            print(_("rtmu sim: with --central, --robots takes 0…100"), file=sys.stderr)
             return EXIT_BAD_INPUT
     else:
         from ..sim.multi import MAX_ROBOTS
 
         args.robots = 1 if args.robots is None else args.robots
         if not 1 <= args.robots <= MAX_ROBOTS:
-            print(f"rtmu sim: --robots must be 1…{MAX_ROBOTS}", file=sys.stderr)
+            print(
+                _("rtmu sim: --robots must be 1…{MAX_ROBOTS}").format(MAX_ROBOTS=MAX_ROBOTS), file=sys.stderr
+            )
             return EXIT_BAD_INPUT
     from ..sim import SimConfig
 
@@ -264,13 +266,13 @@ def run(args: argparse.Namespace) -> int:
         else (args.map or project_map("office.map" if args.kind == "aram" else "arena.map"))
     )
     if map_path is not None and not map_path.is_file():
-        print(f"rtmu sim: no such map file: {map_path}", file=sys.stderr)
+        print(_("rtmu sim: no such map file: {map_path}").format(map_path=map_path), file=sys.stderr)
         return EXIT_BAD_INPUT
     if args.files is not None and not args.files.is_dir():
-        print(f"rtmu sim: no such folder: {args.files}", file=sys.stderr)
+        print(_("rtmu sim: no such folder: {files}").format(files=args.files), file=sys.stderr)
         return EXIT_BAD_INPUT
     if args.users is not None and not args.users.is_file():
-        print(f"rtmu sim: no such user file: {args.users}", file=sys.stderr)
+        print(_("rtmu sim: no such user file: {users}").format(users=args.users), file=sys.stderr)
         return EXIT_BAD_INPUT
     cfg = SimConfig(
         host=args.host,
@@ -301,7 +303,7 @@ def run(args: argparse.Namespace) -> int:
         try:
             parse_address(args.switch_to)
         except ValueError as exc:
-            print(f"rtmu sim: {exc}", file=sys.stderr)
+            print(_("rtmu sim: {exc}").format(exc=exc), file=sys.stderr)
             return EXIT_BAD_INPUT
         cfg.switch_to, cfg.switch_name = args.switch_to, args.name
     if args.verbose:
@@ -328,12 +330,17 @@ async def serve(cfg) -> int:
     try:
         server = SimServer(cfg)
     except (OSError, MapFormatError, ValueError) as exc:
-        print(f"rtmu sim: cannot load: {exc}", file=sys.stderr)
+        print(_("rtmu sim: cannot load: {exc}").format(exc=exc), file=sys.stderr)
         return EXIT_BAD_INPUT
     try:
         await server.start()
     except OSError as exc:
-        print(f"rtmu sim: cannot listen on {cfg.host}:{cfg.port}: {exc.strerror or exc}", file=sys.stderr)
+        print(
+            _("rtmu sim: cannot listen on {host}:{port}: {value}").format(
+                host=cfg.host, port=cfg.port, value=exc.strerror or exc
+            ),
+            file=sys.stderr,
+        )
         return EXIT_CANNOT_LISTEN
     served = f"map {cfg.map_path}" if cfg.map_path else "no map"
     home = server.home
@@ -348,13 +355,14 @@ async def serve(cfg) -> int:
 
     files = files_folder(server)
     extras += f"; files in {files.root}" + (" (temporary)" if files.temporary is not None else "")
+    # The start line is read by programs (the port of --port 0): it stays in English in every language.
     print(
         f"rtmu sim: ARIA robot server listening on {cfg.host}:{server.port}, serving {served}; "
         f"{get_profile(cfg.profile).robot} at ({home[0]:.0f}, {home[1]:.0f}) mm, {home[2]:.0f} deg{extras}",
         flush=True,
     )
     code = await until_stop_signal()
-    print("rtmu sim: stopping (telling clients SHUTDOWN)", flush=True)
+    print(_("rtmu sim: stopping (telling clients SHUTDOWN)"), flush=True)
     await server.stop()
     if files.temporary is not None:
         files.temporary.cleanup()
@@ -369,19 +377,19 @@ async def serve_fleet(cfg, count: int) -> int:
     try:
         fleet = SimFleet(fleet_configs(cfg, count))
     except (OSError, MapFormatError, ValueError) as exc:
-        print(f"rtmu sim: cannot load: {exc}", file=sys.stderr)
+        print(_("rtmu sim: cannot load: {exc}").format(exc=exc), file=sys.stderr)
         return EXIT_BAD_INPUT
     try:
         await fleet.start()
     except OSError as exc:
-        print(f"rtmu sim: cannot listen: {exc.strerror or exc}", file=sys.stderr)
+        print(_("rtmu sim: cannot listen: {value}").format(value=exc.strerror or exc), file=sys.stderr)
         return EXIT_CANNOT_LISTEN
     for robot, server in zip(fleet.robots, fleet.servers, strict=True):
         x, y, th = server.home
-        print(f"rtmu sim: {robot.name} listening on {cfg.host}:{server.port}, "
+        print(f"rtmu sim: {robot.name} listening on {cfg.host}:{server.port}, "  # read by programs: English
               f"at ({x:.0f}, {y:.0f}) mm, {th:.0f} deg", flush=True)  # fmt: skip
     code = await until_stop_signal()
-    print("rtmu sim: stopping every robot (telling clients SHUTDOWN)", flush=True)
+    print(_("rtmu sim: stopping every robot (telling clients SHUTDOWN)"), flush=True)
     await fleet.stop()
     return code
 
@@ -391,9 +399,13 @@ def make_map(args: argparse.Namespace) -> int:
     from ..sim.mapgen import generate_map
 
     if args.points < 0 or args.lines < 0:
-        print("rtmu sim: --points and --lines cannot be negative", file=sys.stderr)
+        print(_("rtmu sim: --points and --lines cannot be negative"), file=sys.stderr)
         return EXIT_BAD_INPUT
     data = generate_map(args.points, args.lines, seed=args.seed)
     write_map(data, args.make_map)
-    print(f"rtmu sim: wrote {args.make_map} ({data.num_points} points, {data.num_lines} lines)")
+    print(
+        _("rtmu sim: wrote {make_map} ({num_points} points, {num_lines} lines)").format(
+            make_map=args.make_map, num_points=data.num_points, num_lines=data.num_lines
+        )
+    )
     return EXIT_OK

@@ -91,7 +91,7 @@ def handle(args: argparse.Namespace) -> int:
 
 def say(message: str) -> None:
     """A note for the operator on stderr, apart from the status lines (or JSON) on stdout."""
-    print(f"rtmu status: {message}", file=sys.stderr, flush=True)
+    print(_("rtmu status: {message}").format(message=message), file=sys.stderr, flush=True)
 
 
 async def stream(client: AriaClient, args: argparse.Namespace, show: Any) -> int:

@@ -137,7 +137,7 @@ class _Player:
         if len(self.notes) < MAX_NOTES:
             self.notes.append(text)
         if not self.quiet:
-            print(f"rtmu video: {visible(text)}", file=sys.stderr)
+            print(_("rtmu video: {visible}").format(visible=visible(text)), file=sys.stderr)
 
     async def settle(self) -> None:
         import asyncio

@@ -90,7 +90,11 @@ def handle(args: argparse.Namespace) -> int:
             )
         else:
             for r in results:
-                print(f"fix: {visible(r.fix.label)}: {visible(r.message)}")
+                print(
+                    _("fix: {visible}: {visible2}").format(
+                        visible=visible(r.fix.label), visible2=visible(r.message)
+                    )
+                )
             print_answer(answer)
         return answer.exit_code
 
@@ -126,7 +130,12 @@ def confirm(question: str, yes: bool) -> bool:
     if yes:
         return True
     if not sys.stdin.isatty():
-        print(f"rtmu: {visible(question)} — not confirmed (no terminal to ask; add --yes)", file=sys.stderr)
+        print(
+            _("rtmu: {visible} — not confirmed (no terminal to ask; add --yes)").format(
+                visible=visible(question)
+            ),
+            file=sys.stderr,
+        )
         return False
     try:
         said = input(f"{visible(question)} [y/N] ")
@@ -147,18 +156,18 @@ def print_answer(answer: Answer, out: Any = None, lead: str = "") -> None:
         print(lead + answer.sentence(), file=out)
     else:
         print(f"{lead}{visible(p.problem)}", file=out)
-        print(f"  what to do: {visible(p.advice)}", file=out)
+        print(_("  what to do: {visible}").format(visible=visible(p.advice)), file=out)
         if p.fix is not None:
             print(
                 f"  rtmu why --fix can: {visible(p.fix.label)}" + (" (asks first)" if p.fix.confirm else ""),
                 file=out,
             )
         for e in p.evidence:
-            print(f"  from: {visible(e)}", file=out)
+            print(_("  from: {visible}").format(visible=visible(e)), file=out)
     for r in answer.reasons[1:]:
         mark = "WARNING" if r.loud else "also"
         print(f"{mark}: {visible(r.sentence())}", file=out)
     for note in answer.notes:
-        print(f"note: {visible(note)}", file=out)
+        print(_("note: {visible}").format(visible=visible(note)), file=out)
     for v in answer.raw:
-        print(f"raw: {visible(v.text())}", file=out)
+        print(_("raw: {visible}").format(visible=visible(v.text())), file=out)
