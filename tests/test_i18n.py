@@ -128,3 +128,17 @@ def test_german_is_read_from_the_package_when_the_environment_asks_for_it() -> N
     )
     out = subprocess.run([sys.executable, "-c", script], env=env, capture_output=True, text=True, check=True)
     assert out.stdout.split("\n")[:3] == ["Akku", "{count} Wert", "{count} Werte"]
+
+
+def test_a_connection_failure_is_said_in_german_and_the_host_as_it_is(english_after: None) -> None:
+    """The window's "Could not connect" sentence: each marked part of the client's problem — advice."""
+    from rtmu.client.diagnosis import ADVICE, login_finding
+    from rtmu.protocol.commands import RejectReason
+    from rtmu.ui.state_words import sentence_words
+
+    i18n.use(["de"])
+    finding = login_finding(RejectReason.BAD_USER_OR_PASSWORD)
+    said = sentence_words(finding.sentence())
+    assert said.startswith("falscher Benutzername oder falsches Passwort — ") and "--user" in said
+    refused = sentence_words(f"connecting to robot.local:7272: connection refused — {ADVICE['refused']}")
+    assert refused.startswith("connecting to robot.local:7272: connection refused — an diesem Port")

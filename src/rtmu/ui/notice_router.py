@@ -23,6 +23,7 @@ from ..base.i18n import N_, _
 from ..base.notices import Kind, Level, Notice
 from ..model.observables import SPEED_MAX, ConnectionState, LinkLevel, NavState, Phase
 from .nav_text import link_lost_note
+from .state_words import sentence_words
 
 
 @dataclass(frozen=True, slots=True)
@@ -105,7 +106,7 @@ def link_banner(old: ConnectionState, new: ConnectionState, navigation: NavState
         )
     if phase is Phase.FAILED and (new.error != old.error or old.phase is not Phase.FAILED):
         lost = old.phase in (Phase.CONNECTED, Phase.RECONNECTING)
-        reason = new.error or _("no reason given")
+        reason = sentence_words(new.error) if new.error else _("no reason given")
         note = link_lost_note(navigation)
         text = (
             _("Link lost: {reason}.{note}").format(reason=reason, note=note)

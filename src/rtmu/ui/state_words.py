@@ -43,3 +43,10 @@ def reason_words(reason: str) -> str:
     if reason.startswith(OFFERS_NONE):
         return _("this server does not offer {requests}").format(requests=reason.removeprefix(OFFERS_NONE))
     return _(reason) if reason else ""
+
+
+def sentence_words(sentence: str) -> str:
+    """A "<problem> — <advice>" sentence of the client's (``client.diagnosis``) in the operator's
+    language: each part its marked words translated, a part that names a host or a server's text as
+    it is."""
+    return " — ".join(_(part) for part in sentence.split(" — "))
