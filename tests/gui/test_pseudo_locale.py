@@ -37,9 +37,15 @@ PRODUCT = ["RTMU"]
 
 
 @pytest.fixture(scope="module")
-def pseudo_locale(tmp_path_factory: pytest.TempPathFactory) -> Iterator[None]:
-    directory = tooling.compile_pseudo(tmp_path_factory.mktemp("pseudo-locale"))
-    i18n.use([tooling.PSEUDO], Path(directory))
+def pseudo_catalogue(tmp_path_factory: pytest.TempPathFactory) -> Path:
+    """The pseudo-locale, made from the sources' strings once for this module."""
+    return Path(tooling.compile_pseudo(tmp_path_factory.mktemp("pseudo-locale")))
+
+
+@pytest.fixture
+def pseudo_locale(pseudo_catalogue: Path) -> Iterator[None]:
+    """This test reads the pseudo-locale (and the next one whatever it chooses)."""
+    i18n.use([tooling.PSEUDO], pseudo_catalogue)
     assert i18n._("Battery") != "Battery", "the pseudo-locale does not translate"
     try:
         yield
