@@ -31,6 +31,7 @@ from ..model.observables import Phase, RobotModel  # noqa: E402
 from ..values.intents import AskWhy  # noqa: E402
 from .banners import BannerStack  # noqa: E402
 from .keys import KeyRouter  # noqa: E402
+from .state_words import sentence_words  # noqa: E402
 
 TOPIC = "why"
 """The banner topic of the hint (one banner, replaced by the next hint)."""
@@ -104,7 +105,7 @@ class WhyHint:
             text = _("The robot does not move, and nothing RTMU can read says why. Why won't it move? (?)")
         else:
             text = _("Not moving: {sentence} — Why won't it move? (?) has the details.").format(
-                sentence=answer.sentence()
+                sentence=sentence_words(answer.sentence())
             )
         self.banners.tell(TOPIC, "warning", text, timeout=SHOWN_FOR)
         return False

@@ -31,6 +31,7 @@ from ..client.why_values import Answer, Fix  # noqa: E402
 from ..control.intent_rules import FIX_WORDS  # noqa: E402
 from ..values.intents import ApplyFix, AskWhy, Intent  # noqa: E402
 from .confirm_bar import ConfirmBar  # noqa: E402
+from .state_words import sentence_words  # noqa: E402
 
 Request = Callable[[Intent], "concurrent.futures.Future[Any]"]
 MAX_SHOWN = 600
@@ -57,7 +58,7 @@ def answer_details(answer: Answer) -> str:
     if first is not None and first.evidence:
         lines.append(_("Read from: ") + "; ".join(_short(e) for e in first.evidence[:6]))
     for reason in answer.reasons[1:6]:
-        lines.append(("⚠ " if reason.loud else _("Also: ")) + _short(reason.sentence()))
+        lines.append(("⚠ " if reason.loud else _("Also: ")) + _short(sentence_words(reason.sentence())))
     lines += [_("Note: {short}").format(short=_short(n)) for n in answer.notes[:6]]
     lines += [_short(v.text()) for v in answer.raw[:10]]
     return "\n".join(lines)
@@ -145,7 +146,7 @@ class WhyWindow(Gtk.Window):
 
     def show_answer(self, answer: Answer) -> None:
         self.answer = answer
-        sentence = _short(_(answer.sentence()))  # the one fixed sentence; a cause's words are the model's
+        sentence = _short(sentence_words(answer.sentence()))  # problem — advice, each part translated
         self.sentence.set_text(sentence[:1].upper() + sentence[1:])
         self.details.set_text(answer_details(answer))
         first = answer.primary
