@@ -60,12 +60,12 @@ def decode_jpeg(data: bytes) -> Decoded:
     from PIL import Image, UnidentifiedImageError
 
     if len(data) > MAX_JPEG_BYTES:
-        raise ValueError("the picture is too large")
+        raise ValueError(_("the picture is too large"))
     try:
         with Image.open(io.BytesIO(data)) as img:
             w, h = img.size
             if not (0 < w <= MAX_SIDE and 0 < h <= MAX_SIDE):
-                raise ValueError(f"a {w}×{h} picture is out of range")
+                raise ValueError(_("a {width}×{height} picture is out of range").format(width=w, height=h))
             img.draft("RGB", (DECODE_SIDE, DECODE_SIDE))  # a no-op for all but big JPEGs
             rgb = img.convert("RGB")
             w, h = rgb.size
@@ -76,11 +76,13 @@ def decode_jpeg(data: bytes) -> Decoded:
             return Decoded(w, h, rgb.tobytes(), thumb.width, thumb.height, thumb.tobytes())
     except UnidentifiedImageError:
         # Pillow's own text names a Python object ("<_io.BytesIO object at 0x…>"): say it plainly.
-        raise ValueError(f"the {len(data)} bytes received are not a picture") from None
+        raise ValueError(_("the {count} bytes received are not a picture").format(count=len(data))) from None
     except Image.DecompressionBombError:
-        raise ValueError("the picture claims too many pixels") from None
+        raise ValueError(_("the picture claims too many pixels")) from None
     except OSError:
-        raise ValueError(f"the picture is damaged or cut short ({len(data)} bytes)") from None
+        raise ValueError(
+            _("the picture is damaged or cut short ({count} bytes)").format(count=len(data))
+        ) from None
 
 
 HAND_OVER_PRIORITY = GLib.PRIORITY_HIGH_IDLE

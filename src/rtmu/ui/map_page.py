@@ -233,7 +233,9 @@ class MapPage(Gtk.Overlay):
             if self.robot.ask(Localize(marker.x, marker.y, th)) is not None:  # (a refusal is said)
                 placed = replace(marker, th=th)
                 self.robot.session.controller.view.notify(  # the operator sees the pick was taken
-                    Notice.info(Kind.NAVIGATION, f"Position set: {pose_words(placed).lower()}")
+                    Notice.info(
+                        Kind.NAVIGATION, _("Position set: {lower}").format(lower=pose_words(placed).lower())
+                    )
                 )
 
     def _answer_popup(self, popup_id: int, button: int) -> None:

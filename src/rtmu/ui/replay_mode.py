@@ -32,7 +32,9 @@ def open_replay(path: Path, conn: int = 1) -> Replayer:
 
 
 def replay_profile(path: Path) -> Profile:
-    return Profile(name=f"Replay of {path.name}", host=REPLAY_HOST, port=0, auto_reconnect=False)
+    return Profile(
+        name=_("Replay of {name}").format(name=path.name), host=REPLAY_HOST, port=0, auto_reconnect=False
+    )
 
 
 def show_replay(window: MainWindow, session: RobotSession, replayer: Replayer) -> ReplayBar:

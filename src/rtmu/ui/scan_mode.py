@@ -111,7 +111,7 @@ class ScanDialog(Gtk.Window):
         try:
             name = scan_name(self.name_entry.get_text().strip())
             if not name:
-                raise ValueError("give the scan a name")
+                raise ValueError(_("give the scan a name"))
         except ValueError as exc:
             self._say(str(exc), error=True)
             return

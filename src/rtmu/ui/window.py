@@ -26,7 +26,6 @@ import gi
 gi.require_version("Gtk", "4.0")
 from gi.repository import Gtk  # noqa: E402
 
-from ..base.i18n import _  # noqa: E402
 from ..base.notices import Notice  # noqa: E402
 from ..control.commands import CommandState  # noqa: E402
 from ..control.controller import Controller, SecretStore  # noqa: E402
@@ -106,7 +105,7 @@ class MainWindow(Gtk.ApplicationWindow):
         clock: Callable[[], float] = time.monotonic,
         model: RobotModel | None = None,
     ) -> None:
-        super().__init__(application=app, title=_("RTMU"))
+        super().__init__(application=app, title="RTMU")
         self.set_default_size(800, 480)
         self.set_size_request(360, 320)  # 360: a portrait phone (ui.layout)
         self.model = model = model or session.state  # a fleet's: the selected robot's (``selected_model``)
