@@ -262,3 +262,30 @@ def test_every_dialog_of_the_window_is_translated_at_800x480(
     for gui, sim in open_on(small_screen, screenshots, request.node.name):
         problems = surfaces_words(gui, sim)
         assert problems == [], "words that escaped translation:\n" + "\n".join(problems)
+
+
+def test_the_camera_page_is_translated_at_800x480(
+    pseudo_locale: None, screenshots: Path, small_screen: str, request: pytest.FixtureRequest
+) -> None:
+    """The camera page (Esc from the map): its picture, live video and camera head controls."""
+    for gui, sim in open_on(small_screen, screenshots, request.node.name):
+        check_camera_page(gui, sim)
+
+
+def check_camera_page(gui: Gui, sim: SimThread) -> None:
+    window = gui.window
+    gui.wait_connected()
+    pump(lambda: bool(gui.model.map.value.name), 20, "the map")
+    pump(lambda: window.camera_page.button.get_sensitive(), 10, "the camera to be offered")
+    window.activate_action("win.camera", None)
+    pump(lambda: window.camera_page.showing, 5, "the camera page")
+    pump(lambda: gui.model.camera.value is not None, 10, "a picture")
+    idle(0.5)
+    gui.shot("pseudo-camera")
+    image = gui.model.camera.value
+    ptz = gui.model.robot.value.ptz
+    heads = [ptz.display_name, ptz.camera, ptz.camera_type] if ptz is not None else []
+    allowed = [*server_words(gui, sim), image.source if image is not None else "", *(h for h in heads if h)]
+    problems = escaped(widget_words(window), allowed)
+    assert problems == [], "words that escaped translation:\n" + "\n".join(problems)
+    assert clipped_widgets(window) == []
