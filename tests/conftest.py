@@ -25,6 +25,11 @@ os.environ["XDG_DATA_HOME"] = _DATA_HOME = tempfile.mkdtemp(prefix="rtmu-test-da
 # Removed when the run ends (a GUI run must leave only its screenshots in /tmp: tests/gui/test_cleanup.py).
 atexit.register(shutil.rmtree, _DATA_HOME, ignore_errors=True)
 
+# The suite reads RTMU's English words (and GTK's): a fixed language, whatever the machine's, for this
+# process and every window and subprocess it starts (tests of other languages choose theirs explicitly).
+os.environ["LANGUAGE"] = "en"
+os.environ["LC_ALL"] = "C.UTF-8"
+
 # Hypothesis's own "ci" profile (deterministic, no deadline) loads itself when CI is set. Locally we
 # only drop the 200 ms deadline: other work shares these two cores, and speed is bench/'s business.
 if "CI" not in os.environ:

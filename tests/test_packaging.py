@@ -64,6 +64,7 @@ def test_the_wheel_holds_every_module_and_what_the_app_reads_at_run_time(
         "rtmu/data/desktop/io.github.rtmu.Rtmu.desktop",
         "rtmu/data/desktop/io.github.rtmu.Rtmu.svg",
         "rtmu/data/desktop/io.github.rtmu.Rtmu.metainfo.xml",
+        "rtmu/data/locale/de/LC_MESSAGES/rtmu.mo",
         "rtmu/py.typed",
     ):
         assert files[data] == (ROOT / "src" / data).read_bytes(), data

@@ -24,6 +24,7 @@ from typing import Any
 from . import subcommands
 from .base import exit_codes, logs
 from .base.exit_codes import EXIT_USAGE
+from .base.i18n import _
 from .subcommands import _integration
 from .versions import VersionAction
 
@@ -43,7 +44,7 @@ class HelpFormatter(argparse.HelpFormatter):
 
 def exits_epilog(codes: tuple[int, ...] | None) -> str:
     """The help's closing part: these codes' lines of the one table (all of them for ``rtmu --help``)."""
-    return "Exit codes (one table for every rtmu command):\n" + exit_codes.table_text(codes)
+    return _("Exit codes (one table for every rtmu command):") + "\n" + exit_codes.table_text(codes)
 
 
 def actions_of(command: argparse.ArgumentParser) -> list[argparse.ArgumentParser]:
@@ -148,12 +149,12 @@ def build_parser(*, lazy: bool = False) -> argparse.ArgumentParser:
     """The whole ``rtmu`` parser; ``lazy``: subcommand modules imported only when chosen."""
     parser = _Parser(
         prog="rtmu",
-        description="Teleoperate an ARIA (ArNetworking) robot; with no subcommand, open the window.",
+        description=_("Teleoperate an ARIA (ArNetworking) robot; with no subcommand, open the window."),
         epilog=exits_epilog(None),
         formatter_class=HelpFormatter,
     )
     parser.add_argument(
-        "--version", action=VersionAction, help="show the versions of rtmu, its protocol and toolkit; exit"
+        "--version", action=VersionAction, help=_("show the versions of rtmu, its protocol and toolkit; exit")
     )
     sub = parser.add_subparsers(
         dest="subcommand", metavar="SUBCOMMAND", action=LazySubcommands, parser_class=argparse.ArgumentParser

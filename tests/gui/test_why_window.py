@@ -179,7 +179,7 @@ def test_an_ld_fault_is_told_at_once_and_acknowledged_only_after_a_yes(screensho
         try:
             command(sim, "SimulatorFault")
             said = lambda: " ".join(text for _t, _l, text in gui.window.banners.history)  # noqa: E731
-            pump(lambda: "The robot reports 1 fault(s)" in said(), 10, "the fault notice")
+            pump(lambda: "The robot reports 1 fault:" in said(), 10, "the fault notice")
             gui.shot("fault-notice")
             gui.focus()
             gui.key("question")

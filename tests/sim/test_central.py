@@ -231,7 +231,7 @@ def test_rtmu_sim_central_with_robots_serves_a_fleet_and_stops_on_sigint() -> No
         first = proc.stdout.readline()
         assert first.startswith("rtmu sim: ARIA central server: operators on 127.0.0.1:")
         port = int(first.split("operators on 127.0.0.1:")[1].split(",")[0])
-        assert proc.stdout.readline().startswith("rtmu sim: 2 simulated robot(s)")
+        assert proc.stdout.readline().startswith("rtmu sim: 2 simulated robots")
 
         async def names() -> list[str]:
             deadline = time.monotonic() + 20

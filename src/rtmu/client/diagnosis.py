@@ -11,6 +11,7 @@ from __future__ import annotations
 from dataclasses import dataclass
 from enum import Enum
 
+from ..base.i18n import N_
 from ..protocol.commands import RejectReason
 from .errors import (
     ClientError,
@@ -74,29 +75,44 @@ class Finding:
 
 
 # -- the table ------------------------------------------------------------------------------------
-CENTRAL_ADVICE = (
+CENTRAL_ADVICE = N_(
     "this is ARIA's central server: use 'rtmu fleet', --robot NAME, or open its robots with 'rtmu --central'"
 )
 ADVICE = {
-    "resolve": "check the spelling, or use the robot's IP address instead of its name",
-    "refused": "nothing listens on that port: check that the robot's server (ARAM / the ARIA server) "
-    "is running and that the port is right (ARIA and Omron LD robots use 7272)",
-    "connect_timeout": "no answer at all: the robot may be off, on another network, or a firewall "
-    "drops the packets; check that this computer is on the robot's network (try ping)",
-    "unreachable": "there is no route to that address: check the network (Wi-Fi, cable, VPN) and "
-    "the robot's IP address",
-    "not_aria": "something answers on that port, but it is not an ARIA robot server: check the port "
-    "(ARIA and Omron LD robots use 7272)",
-    "no_introduction": "the server accepted the connection but never introduced itself: it may be "
-    "busy or hung; restart the robot's server software and try again",
-    "closed_early": "the server closed the connection before the login finished: it may be "
-    "restarting, or it drops clients it does not like; try again in a minute",
-    "login_timeout": "the server did not finish the login in time: it may be overloaded; try again",
-    "status_missing": "this server offers no robot status (updateNumbers/update): RTMU can connect "
-    "but will show no pose or battery",
+    "resolve": N_("check the spelling, or use the robot's IP address instead of its name"),
+    "refused": N_(
+        "nothing listens on that port: check that the robot's server (ARAM / the ARIA server) "
+        "is running and that the port is right (ARIA and Omron LD robots use 7272)"
+    ),
+    "connect_timeout": N_(
+        "no answer at all: the robot may be off, on another network, or a firewall "
+        "drops the packets; check that this computer is on the robot's network (try ping)"
+    ),
+    "unreachable": N_(
+        "there is no route to that address: check the network (Wi-Fi, cable, VPN) and the robot's IP address"
+    ),
+    "not_aria": N_(
+        "something answers on that port, but it is not an ARIA robot server: check the port "
+        "(ARIA and Omron LD robots use 7272)"
+    ),
+    "no_introduction": N_(
+        "the server accepted the connection but never introduced itself: it may be "
+        "busy or hung; restart the robot's server software and try again"
+    ),
+    "closed_early": N_(
+        "the server closed the connection before the login finished: it may be "
+        "restarting, or it drops clients it does not like; try again in a minute"
+    ),
+    "login_timeout": N_("the server did not finish the login in time: it may be overloaded; try again"),
+    "status_missing": N_(
+        "this server offers no robot status (updateNumbers/update): RTMU can connect "
+        "but will show no pose or battery"
+    ),
     "central_server": CENTRAL_ADVICE,
-    "status_timeout": "the server did not send a status in time: the robot's base may be "
-    "disconnected from its server; check the robot",
+    "status_timeout": N_(
+        "the server did not send a status in time: the robot's base may be "
+        "disconnected from its server; check the robot"
+    ),
 }
 
 
@@ -110,21 +126,23 @@ def central_server_words(where: str) -> str:
 
 REJECT_ADVICE = {
     RejectReason.BAD_USER_OR_PASSWORD: (
-        "wrong user name or password",
-        "check --user and the password (user names are letters and digits only, case-insensitive); "
-        "without a user name the server must have no user file",
+        N_("wrong user name or password"),
+        N_(
+            "check --user and the password (user names are letters and digits only, case-insensitive); "
+            "without a user name the server must have no user file"
+        ),
     ),
     RejectReason.USING_CENTRAL_SERVER: (
-        "this robot is managed by a central server",
-        "connect to the central server (its address is given above) instead of the robot",
+        N_("this robot is managed by a central server"),
+        N_("connect to the central server (its address is given above) instead of the robot"),
     ),
     RejectReason.TOO_MANY_CLIENTS: (
-        "the server has as many clients as it allows",
-        "close another client connected to this robot (MobilePlanner, another RTMU), then retry",
+        N_("the server has as many clients as it allows"),
+        N_("close another client connected to this robot (MobilePlanner, another RTMU), then retry"),
     ),
     RejectReason.CLIENT_TYPE_MISMATCH: (
-        "the server only accepts clients of another type (real vs simulated robot)",
-        "this server is set to refuse clients of RTMU's type; ask its administrator",
+        N_("the server only accepts clients of another type (real vs simulated robot)"),
+        N_("this server is set to refuse clients of RTMU's type; ask its administrator"),
     ),
 }
 

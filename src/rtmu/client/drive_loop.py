@@ -18,6 +18,7 @@ import time
 from collections.abc import Callable
 from typing import Any, ClassVar
 
+from ..base.i18n import _
 from ..base.notices import Kind, Notice
 from ..protocol.client_connection import payload_name
 from ..protocol.payloads import Payload
@@ -217,13 +218,17 @@ class DriveFeed(Feed):
         view = self.lease.view(now)
         if self.governor.driving:  # (a stop that ended it already — a new selection — said its own words)
             if self.lease.end(EndReason.STOPPED, view.generation):
-                self.ctx.notice(Notice.warning(Kind.SAFETY, f"Stopped: {why}. Press again once it is armed."))
+                self.ctx.notice(
+                    Notice.warning(
+                        Kind.SAFETY, _("Stopped: {why}. Press again once it is armed.").format(why=why)
+                    )
+                )
         elif view.live:
             if self._held_since is None:
                 self._held_since = now
             elif now - self._held_since >= HOLD_SAID_AFTER and self._held_said != view.generation:
                 self._held_said = view.generation
-                self.ctx.notice(Notice.warning(Kind.SAFETY, f"Not driving yet: {why}"))
+                self.ctx.notice(Notice.warning(Kind.SAFETY, _("Not driving yet: {why}").format(why=why)))
         return True
 
     def publish_health(self, now: float | None = None) -> None:

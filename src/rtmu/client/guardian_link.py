@@ -16,6 +16,7 @@ from __future__ import annotations
 import asyncio
 from collections.abc import Callable
 
+from ..base.i18n import _
 from ..base.notices import Kind, Notice
 from ..guardian.handle import BEAT_PERIOD
 from ..guardian.messages import Hello
@@ -111,7 +112,7 @@ class GuardianLink:
         for word, text in seat.take_reports():
             if word == "stopped":
                 stopped = True
-                said = f"The guardian stopped the robot: {text}. Press again to drive."
+                said = _("The guardian stopped the robot: {text}. Press again to drive.").format(text=text)
                 self._notice(Notice.error(Kind.SAFETY, said))
             elif word == "unavailable":
                 self.unavailable(text)
@@ -122,7 +123,9 @@ class GuardianLink:
         self._notice(
             Notice.warning(
                 Kind.SAFETY,
-                f"Guardian not available ({reason}): if this program is killed or frozen while driving, "
-                "only the server's own 2 s watchdog stops the robot",
+                _(
+                    "Guardian not available ({reason}): if this program is killed or frozen while driving, "
+                    "only the server's own 2 s watchdog stops the robot"
+                ).format(reason=reason),
             )
         )

@@ -15,6 +15,7 @@ from collections.abc import Iterable
 from dataclasses import replace
 from typing import ClassVar
 
+from ..base.i18n import _
 from ..base.notices import Kind, Notice
 from ..values.intents import Intent, LoadMap
 from ..values.state import MapChanged, MapModel, MapPhase
@@ -168,7 +169,9 @@ class MapFeed(Feed):
     def _failed(self, client: AriaClient, reason: str) -> MapModel:
         self._set(replace(self.value, state=MapPhase.FAILED, error=reason))
         if client.connected:
-            self.ctx.notice(Notice.warning(Kind.MAP, f"The map could not be loaded: {reason}"))
+            self.ctx.notice(
+                Notice.warning(Kind.MAP, _("The map could not be loaded: {value}").format(value=reason))
+            )
         return self.value
 
 

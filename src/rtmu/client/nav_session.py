@@ -15,6 +15,7 @@ from collections.abc import Iterable
 from dataclasses import replace
 from typing import Any, ClassVar
 
+from ..base.i18n import _
 from ..base.notices import Kind, Notice
 from ..protocol.errors import ProtocolError
 from ..protocol.payloads import Payload
@@ -205,7 +206,9 @@ class NavFeed(Feed):
         self._update(loc_state=label, loc_score=round(loc.score_fraction, 3))
         if label == LocalizationState.LOST.label and was is not None and was != label:
             self.ctx.notice(
-                Notice.warning(Kind.NAVIGATION, "The robot is lost: localize it before sending it anywhere")
+                Notice.warning(
+                    Kind.NAVIGATION, _("The robot is lost: localize it before sending it anywhere")
+                )
             )
 
     def _on_goals_updated(self, packet: Packet) -> None:

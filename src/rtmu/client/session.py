@@ -21,6 +21,7 @@ from collections.abc import Callable, Coroutine
 from dataclasses import replace
 from typing import Any, TypeVar
 
+from ..base.i18n import _
 from ..base.notices import Kind, Notice
 from ..guardian.shared import GuardianSeat
 from ..protocol.errors import ProtocolError
@@ -400,7 +401,10 @@ class Session:
                 continue
             self.notice(
                 Notice.info(
-                    Kind.LINK, f"Reconnected to {target.host}:{target.port}; press a key to drive again"
+                    Kind.LINK,
+                    _("Reconnected to {host}:{port}; press a key to drive again").format(
+                        host=target.host, port=target.port
+                    ),
                 )
             )
             return

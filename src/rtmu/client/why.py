@@ -23,6 +23,7 @@ from __future__ import annotations
 import math
 import re
 
+from ..base.i18n import N_
 from ..protocol.payloads.drive import RATIO_ROT_DEAD_ZONE, RATIO_TRANS_DEAD_ZONE, RatioDrive
 from ..protocol.payloads.robot import ModeInfo
 from ..values.state import LinkLevel, NavOutcome
@@ -90,7 +91,7 @@ def _our_side(facts: Facts, motion: Motion | None, navigate: bool) -> list[Reaso
             Reason(
                 Cause.LINK,
                 f"our link to the robot is {said}: RTMU sends no drive over it",
-                "check the network (Wi-Fi, cable); once the link is back, press the drive key again",
+                N_("check the network (Wi-Fi, cable); once the link is back, press the drive key again"),
                 (f"link: {ours.link.value}",),
             )
         )
@@ -98,32 +99,34 @@ def _our_side(facts: Facts, motion: Motion | None, navigate: bool) -> list[Reaso
         out.append(
             Reason(
                 Cause.LEASE,
-                "this is a replay: nothing is sent to a robot",
-                "connect to the robot to drive it",
+                N_("this is a replay: nothing is sent to a robot"),
+                N_("connect to the robot to drive it"),
             )
         )
     elif ours.keys_blocked:
         out.append(
             Reason(
                 Cause.LEASE,
-                "a drive key held through a stop is ignored until it is released",
-                "let go of the key and press it again",
+                N_("a drive key held through a stop is ignored until it is released"),
+                N_("let go of the key and press it again"),
             )
         )
     elif ours.lease_ended == "lapsed":
         out.append(
             Reason(
                 Cause.LEASE,
-                "the window did not renew the drive in time (it was busy or frozen), "
-                "so RTMU stopped the robot",
-                "press the drive key again",
+                N_(
+                    "the window did not renew the drive in time (it was busy or frozen), "
+                    "so RTMU stopped the robot"
+                ),
+                N_("press the drive key again"),
             )
         )
     return out
 
 
 def _rights(facts: Facts, motion: Motion | None, navigate: bool) -> list[Reason]:
-    who = f"user {facts.user!r}" if facts.user else "this login (no user name)"
+    who = f"user {facts.user!r}" if facts.user else N_("this login (no user name)")
     drive, stop = "ratioDrive" in facts.offers, "stop" in facts.offers
     out: list[Reason] = []
     if not drive:
@@ -131,19 +134,19 @@ def _rights(facts: Facts, motion: Motion | None, navigate: bool) -> list[Reason]
         if not stop:
             problem = f"{who} may neither drive nor stop the robot (no ratioDrive, no stop in its data list)"
         advice = (
-            "log in as a user whose groups include Movement (and Stop)"
+            N_("log in as a user whose groups include Movement (and Stop)")
             if facts.user
-            else "this server offers no driving without a login: log in as a user with Movement"
+            else N_("this server offers no driving without a login: log in as a user with Movement")
         )
-        out.append(Reason(Cause.NO_DRIVE, problem, advice, ("data list: no ratioDrive",)))
+        out.append(Reason(Cause.NO_DRIVE, problem, advice, (N_("data list: no ratioDrive"),)))
     if not stop:
         out.append(
             Reason(
                 Cause.NO_STOP,
                 f"SAFETY: {who} may not send stop (no stop in its data list): RTMU's STOP cannot stop the "
-                "robot from this login" + (" except by zero drive ratios" if drive else ""),
-                "do not drive from this login; use one whose groups include Stop",
-                ("data list: no stop",),
+                "robot from this login" + (N_(" except by zero drive ratios") if drive else ""),
+                N_("do not drive from this login; use one whose groups include Stop"),
+                (N_("data list: no stop"),),
                 loud=True,
             )
         )
@@ -180,7 +183,10 @@ def _safety_words(facts: Facts, motion: Motion | None, navigate: bool) -> list[R
             Reason(
                 Cause.ESTOP,
                 f"the robot's e-stop is pressed (the server says {_quote(estop)})",
-                "make it safe, release the e-stop button on the robot, then reset it as the robot requires",
+                N_(
+                    "make it safe, release the e-stop button on the robot, "
+                    "then reset it as the robot requires"
+                ),
                 (f"status: {_quote(estop)}",),
             )
         )
@@ -201,8 +207,10 @@ def _safety_words(facts: Facts, motion: Motion | None, navigate: bool) -> list[R
         if "acknowledgeFault" in facts.offers:
             fix = Fix(
                 "acknowledge_faults",
-                "acknowledge the listed faults on the robot (acknowledgeFault; "
-                "its layout is not public: RTMU builds it from the server's own description)",
+                N_(
+                    "acknowledge the listed faults on the robot (acknowledgeFault; "
+                    "its layout is not public: RTMU builds it from the server's own description)"
+                ),
                 "acknowledgeFault",
                 confirm=True,
             )
@@ -210,7 +218,7 @@ def _safety_words(facts: Facts, motion: Motion | None, navigate: bool) -> list[R
             Reason(
                 Cause.FAULTS,
                 f"the robot reports {len(facts.faults)} fault(s): {shown}",
-                "clear what caused them, then acknowledge them (with care: the robot may move on)",
+                N_("clear what caused them, then acknowledge them (with care: the robot may move on)"),
                 ("getFaults",),
                 fix,
             )
@@ -220,15 +228,18 @@ def _safety_words(facts: Facts, motion: Motion | None, navigate: bool) -> list[R
 
 def _motors_advice(facts: Facts) -> str:
     if "enableMotors" in facts.offers:
-        return "find out why they were disabled (e-stop, a fault), then enable them again (enableMotors)"
-    return "find out why they were disabled (e-stop, a fault) and enable them on the robot"
+        return N_("find out why they were disabled (e-stop, a fault), then enable them again (enableMotors)")
+    return N_("find out why they were disabled (e-stop, a fault) and enable them on the robot")
 
 
 def _enable_fix(facts: Facts) -> Fix | None:
     if "enableMotors" not in facts.offers:
         return None
     return Fix(
-        "enable_motors", "enable the motors (enableMotors; its layout is not public)", "enableMotors", True
+        "enable_motors",
+        N_("enable the motors (enableMotors; its layout is not public)"),
+        "enableMotors",
+        True,
     )
 
 
@@ -241,7 +252,7 @@ def _battery(facts: Facts, motion: Motion | None, navigate: bool) -> list[Reason
         Reason(
             Cause.BATTERY,
             f"the battery ({level:g} {unit}) is at or below the robot's shutdown level ({shutdown:g} {unit})",
-            "charge the robot (dock it or plug it in) before driving",
+            N_("charge the robot (dock it or plug it in) before driving"),
             (f"updateNumbers: battery {level:g} {unit}", f"batteryInfo: shutdown {shutdown:g} {unit}"),
         )
     ]
@@ -252,16 +263,18 @@ def _stalled(facts: Facts, motion: Motion | None, navigate: bool) -> list[Reason
     if word is None:
         return []
     what = (
-        "a motor is stalled"
+        N_("a motor is stalled")
         if word == "Stalled"
-        else "the robot is bumped (its stall or bumper flags are set)"
+        else N_("the robot is bumped (its stall or bumper flags are set)")
     )
     return [
         Reason(
             Cause.STALLED,
             f"{what} (the server says {_quote(word)})",
-            "the robot pushed against something or a wheel is blocked: drive away from it, "
-            "check the wheels and bumpers",
+            N_(
+                "the robot pushed against something or a wheel is blocked: drive away from it, "
+                "check the wheels and bumpers"
+            ),
             (f"status: {_quote(word)}",),
         )
     ]
@@ -280,16 +293,17 @@ def _modes(facts: Facts, motion: Motion | None, navigate: bool) -> list[Reason]:
             [f"dockInfo: {facts.dock_state}"] if facts.dock_state else [f"status: {_quote(facts.status)}"]
         )
         fix = (
-            Fix("undock", "undock (the robot backs out of its dock)", "undock", False)
+            Fix("undock", N_("undock (the robot backs out of its dock)"), "undock", False)
             if "undock" in facts.offers
             else None
         )
         out.append(
             Reason(
                 Cause.DOCKED,
-                "the robot is docked (charging)",
-                "undock it first" + (" (undock)" if fix else "") + "; a drive asks the dock to let go "
-                "and the robot backs out before it drives",
+                N_("the robot is docked (charging)"),
+                N_("undock it first")
+                + (" (undock)" if fix else "")
+                + N_("; a drive asks the dock to let go and the robot backs out before it drives"),
                 tuple(evidence),
                 fix,
             )
@@ -306,8 +320,8 @@ def _modes(facts: Facts, motion: Motion | None, navigate: bool) -> list[Reason]:
                 Reason(
                     Cause.LOCKED,
                     f"the {name!r} mode holds the robot locked (it will unlock if asked)",
-                    "ask it to unlock"
-                    + (f": {fix.label}" if fix else " (this login can send nothing that asks)"),
+                    N_("ask it to unlock")
+                    + (f": {fix.label}" if fix else N_(" (this login can send nothing that asks)")),
                     said,
                     fix,
                 )
@@ -325,7 +339,7 @@ def _modes(facts: Facts, motion: Motion | None, navigate: bool) -> list[Reason]:
     reading = read_status(facts.status, info.mode_name if info else "")
     if reading.phase is NavOutcome.GOING and not docked:
         fix = (
-            Fix("stop", "send stop (the server's own driving ends)", "stop", False)
+            Fix("stop", N_("send stop (the server's own driving ends)"), "stop", False)
             if "stop" in facts.offers
             else None
         )
@@ -334,7 +348,7 @@ def _modes(facts: Facts, motion: Motion | None, navigate: bool) -> list[Reason]:
             Reason(
                 Cause.NAVIGATING,
                 f"the server is driving the robot itself{target}: {_quote(reading.text)}",
-                "press STOP first; the next drive is then yours",
+                N_("press STOP first; the next drive is then yours"),
                 (f"status: {_quote(reading.text)}",),
                 fix,
             )
@@ -343,8 +357,8 @@ def _modes(facts: Facts, motion: Motion | None, navigate: bool) -> list[Reason]:
         out.append(
             Reason(
                 Cause.LOST,
-                "the robot is lost (its localization says Lost): it cannot navigate",
-                "tell it where it is (rtmu localize, or Set position in the window)",
+                N_("the robot is lost (its localization says Lost): it cannot navigate"),
+                N_("tell it where it is (rtmu localize, or Set position in the window)"),
                 ("getLocState: Lost",),
             )
         )
@@ -356,13 +370,18 @@ def _unlock_fix(facts: Facts, info: ModeInfo) -> Fix | None:
     A stop switches to the stop mode; when ``stop`` is the locked mode itself, a zero ratioDrive asks."""
     if info.mode_name != "stop" and "stop" in facts.offers:
         return Fix(
-            "unlock", "send stop: switching to the stop mode asks the locked mode to give way", "stop", False
+            "unlock",
+            N_("send stop: switching to the stop mode asks the locked mode to give way"),
+            "stop",
+            False,
         )
     if "ratioDrive" in facts.offers:
         return Fix(
             "unlock",
-            "send a zero ratioDrive: switching to the drive mode asks the locked mode to "
-            "give way (zero ratios never move the robot)",
+            N_(
+                "send a zero ratioDrive: switching to the drive mode asks the locked mode to "
+                "give way (zero ratios never move the robot)"
+            ),
             "ratioDrive",
             False,
         )
@@ -379,7 +398,10 @@ def _watchdog(facts: Facts, motion: Motion | None, navigate: bool) -> list[Reaso
             f"the server's drive watchdog is {t:g} s: shorter than twice the "
             f"{RESEND_PERIOD:g} s between RTMU's drive commands, so it stops the robot between them "
             "(jerky motion at best, none on a slow link)",
-            "raise the Teleop Timeout in the server's configuration (ARIA's default is 2 s; 0 turns it off)",
+            N_(
+                "raise the Teleop Timeout in the server's configuration "
+                "(ARIA's default is 2 s; 0 turns it off)"
+            ),
             (f"configuration: Teleop Timeout = {t:g} s",),
         )
     ]
@@ -402,7 +424,7 @@ def _safe_drive(facts: Facts, motion: Motion | None, navigate: bool) -> list[Rea
         clear = nearest(facts.obstacles, facts.footprint, facts.limits, not forward) is None
         fix = _safe_off_fix(facts)
         advice = f"drive away from it ({away}{': that way is clear' if clear else ''})" + (
-            ", or switch safe drive off (with care: the robot then drives into things)" if fix else ""
+            N_(", or switch safe drive off (with care: the robot then drives into things)") if fix else ""
         )
         out.append(
             Reason(
@@ -483,8 +505,8 @@ def unexplained(answer: Answer) -> Answer:
         return answer
     reason = Reason(
         Cause.UNEXPLAINED,
-        "the robot did not move, and nothing RTMU can read says why",
-        "look at the robot itself (e-stop, motors, faults on its own display) and at the server's log",
+        N_("the robot did not move, and nothing RTMU can read says why"),
+        N_("look at the robot itself (e-stop, motors, faults on its own display) and at the server's log"),
     )
     return Answer((reason, *answer.reasons), answer.notes, answer.raw)
 

@@ -20,6 +20,7 @@ from __future__ import annotations
 from dataclasses import dataclass
 from typing import ClassVar
 
+from ..base.i18n import _, ngettext
 from ..base.notices import Kind, Notice
 from ..base.textsafe import visible
 from ..values.intents import ApplyFix, AskWhy, Intent
@@ -132,14 +133,23 @@ class WhyFeed(Feed):
             return
         self._faults = faults
         if not faults:
-            self.ctx.notice(Notice.info(Kind.SAFETY, "The robot reports no faults any more."))
+            self.ctx.notice(Notice.info(Kind.SAFETY, _("The robot reports no faults any more.")))
             return
         shown = "; ".join(visible(f[:100]) for f in faults[:FAULTS_SHOWN])
-        more = f" (+{len(faults) - FAULTS_SHOWN} more)" if len(faults) > FAULTS_SHOWN else ""
+        more = (
+            _(" (+{count} more)").format(count=len(faults) - FAULTS_SHOWN)
+            if len(faults) > FAULTS_SHOWN
+            else ""
+        )
         self.ctx.notice(
             Notice.warning(
                 Kind.SAFETY,
-                f"The robot reports {len(faults)} fault(s): {shown}{more}. "
-                "Why won't it move? (key ?) says what to do.",
+                ngettext(
+                    "The robot reports {count} fault: {faults}{more}. "
+                    "Why won't it move? (key ?) says what to do.",
+                    "The robot reports {count} faults: {faults}{more}. "
+                    "Why won't it move? (key ?) says what to do.",
+                    len(faults),
+                ).format(count=len(faults), faults=shown, more=more),
             )
         )

@@ -12,8 +12,12 @@ from enum import Enum
 from typing import Any
 
 from ..base import exit_codes as codes
+from ..base.i18n import N_
 from ..protocol.payloads.robot import ModeInfo
 from ..values.state import LinkLevel
+
+NOTHING_STOPS_IT = N_("Nothing RTMU can read keeps the robot from moving.")
+"""The answer when no reason is found (the window says it in the operator's language)."""
 
 
 class Cause(Enum):
@@ -236,7 +240,7 @@ class Answer:
 
     def sentence(self) -> str:
         if not self.reasons:
-            return "Nothing RTMU can read keeps the robot from moving."
+            return NOTHING_STOPS_IT
         return self.reasons[0].sentence()
 
     def as_json(self) -> dict[str, Any]:

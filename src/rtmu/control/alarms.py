@@ -34,6 +34,7 @@ import math
 from dataclasses import dataclass
 from enum import Enum, IntEnum
 
+from ..base.i18n import _
 from ..client.nav_status import read_status
 from ..values.state import LinkHealth, LinkLevel, NavOutcome, RobotState
 
@@ -134,12 +135,12 @@ class AlarmMonitor:
             now = Severity.CLEAR
         shown = f"{value:.0f} %" if soc else f"{value:.1f} V"
         text = {
-            Severity.CRITICAL: f"Battery critical: {shown} — the robot is about to shut down",
-            Severity.WARNING: f"Battery low: {shown} — bring the robot to its charger",
-            Severity.CLEAR: f"Battery back to {shown}",
-        }[now]
+            Severity.CRITICAL: _("Battery critical: {shown} — the robot is about to shut down"),
+            Severity.WARNING: _("Battery low: {shown} — bring the robot to its charger"),
+            Severity.CLEAR: _("Battery back to {shown}"),
+        }[now].format(shown=shown)
         if now is Severity.WARNING and _docked(robot):
-            now, text = Severity.CLEAR, f"Battery low ({shown}), charging on its dock"
+            now, text = Severity.CLEAR, _("Battery low ({shown}), charging on its dock").format(shown=shown)
         self._change(Alarm.BATTERY, now, text, events)
 
     def _wifi(self, robot: RobotState, events: list[AlarmEvent]) -> None:
@@ -154,9 +155,9 @@ class AlarmMonitor:
         else:
             now = was
         text = (
-            f"Weak Wi-Fi on the robot: link quality {quality:.0f} %"
+            _("Weak Wi-Fi on the robot: link quality {quality:.0f} %").format(quality=quality)
             if now
-            else f"Wi-Fi back: link quality {quality:.0f} %"
+            else _("Wi-Fi back: link quality {quality:.0f} %").format(quality=quality)
         )
         self._change(Alarm.WIFI, now, text, events)
 
@@ -165,15 +166,18 @@ class AlarmMonitor:
         failures = health.ping_failures
         was = self._severity[Alarm.RTT]
         if failures >= self.t.ping_failures:
-            now, text = Severity.WARNING, f"Weak link: {failures} pings unanswered"
+            now, text = (
+                Severity.WARNING,
+                _("Weak link: {failures} pings unanswered").format(failures=failures),
+            )
         elif rtt is None:
             return
         elif rtt > self.t.rtt_high_ms:
-            now, text = Severity.WARNING, f"Weak link: round trip {rtt:.0f} ms"
+            now, text = Severity.WARNING, _("Weak link: round trip {rtt:.0f} ms").format(rtt=rtt)
         elif rtt < self.t.rtt_clear_ms and failures == 0:
-            now, text = Severity.CLEAR, f"Link back: round trip {rtt:.0f} ms"
+            now, text = Severity.CLEAR, _("Link back: round trip {rtt:.0f} ms").format(rtt=rtt)
         else:
-            now, text = was, f"Weak link: round trip {rtt:.0f} ms"
+            now, text = was, _("Weak link: round trip {rtt:.0f} ms").format(rtt=rtt)
         self._change(Alarm.RTT, now, text, events)
 
     def _change(self, alarm: Alarm, now: Severity, text: str, events: list[AlarmEvent]) -> None:

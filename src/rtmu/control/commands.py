@@ -20,6 +20,7 @@ from collections.abc import Iterator
 from dataclasses import dataclass
 from typing import ClassVar, Protocol
 
+from ..base.i18n import N_
 from ..values import intents
 from ..values.intents import Intent
 from ..values.state import Phase
@@ -94,7 +95,7 @@ class Command:
     def unavailable(self, ctx: CommandContext) -> str | None:
         """None when the command can run now, else a sentence saying why not."""
         if self.needs_connection and not ctx.connected:
-            return "not connected"
+            return N_("not connected")
         for need in self.needs:
             options = need if isinstance(need, tuple) else (need,)
             if not any(ctx.supports(n) for n in options):
@@ -183,7 +184,7 @@ class _HeldDrive(Command):
 @command
 class DriveForward(_HeldDrive):
     name = "drive_forward"
-    label = "Drive forward (hold)"
+    label = N_("Drive forward (hold)")
     keys = ("Up", "w")
     group = "Driving"
     direction = "forward"
@@ -192,7 +193,7 @@ class DriveForward(_HeldDrive):
 @command
 class DriveBackward(_HeldDrive):
     name = "drive_backward"
-    label = "Drive backward (hold)"
+    label = N_("Drive backward (hold)")
     keys = ("Down", "s")
     group = "Driving"
     direction = "backward"
@@ -201,7 +202,7 @@ class DriveBackward(_HeldDrive):
 @command
 class DriveLeft(_HeldDrive):
     name = "drive_left"
-    label = "Turn left (hold)"
+    label = N_("Turn left (hold)")
     keys = ("Left", "a")
     group = "Driving"
     direction = "left"
@@ -210,7 +211,7 @@ class DriveLeft(_HeldDrive):
 @command
 class DriveRight(_HeldDrive):
     name = "drive_right"
-    label = "Turn right (hold)"
+    label = N_("Turn right (hold)")
     keys = ("Right", "d")
     group = "Driving"
     direction = "right"
@@ -219,7 +220,7 @@ class DriveRight(_HeldDrive):
 @command
 class Stop(Command):
     name = "stop"
-    label = "Stop"
+    label = N_("Stop")
     keys = ("space", "KP_5")
     group = "Driving"
     needs = (("stop", "ratioDrive"),)
@@ -238,7 +239,7 @@ class Stop(Command):
 @command
 class SpeedUp(Command):
     name = "speed_up"
-    label = "Faster (+10 %)"
+    label = N_("Faster (+10 %)")
     keys = ("plus", "KP_Add", "equal")
     group = "Speed"
     needs_connection = False
@@ -250,7 +251,7 @@ class SpeedUp(Command):
 @command
 class SpeedDown(Command):
     name = "speed_down"
-    label = "Slower (−10 %)"
+    label = N_("Slower (−10 %)")
     keys = ("minus", "KP_Subtract")
     group = "Speed"
     needs_connection = False
@@ -273,7 +274,7 @@ class _TurnBy(Command):
 @command
 class TurnDialog(Command):
     name = "turn"
-    label = "Turn by an angle…"
+    label = N_("Turn by an angle…")
     keys = ("t",)
     group = "Moves"
     menu = True
@@ -286,7 +287,7 @@ class TurnDialog(Command):
 @command
 class GoDialog(Command):
     name = "go"
-    label = "Go a distance…"
+    label = N_("Go a distance…")
     keys = ("g",)
     group = "Moves"
     menu = True
@@ -299,7 +300,7 @@ class GoDialog(Command):
 @command
 class TurnLeft90(_TurnBy):
     name = "turn_left_90"
-    label = "Turn 90° left"
+    label = N_("Turn 90° left")
     keys = ("<Shift>Left",)
     group = "Moves"
     degrees = 90.0
@@ -308,7 +309,7 @@ class TurnLeft90(_TurnBy):
 @command
 class TurnRight90(_TurnBy):
     name = "turn_right_90"
-    label = "Turn 90° right"
+    label = N_("Turn 90° right")
     keys = ("<Shift>Right",)
     group = "Moves"
     degrees = -90.0
@@ -317,7 +318,7 @@ class TurnRight90(_TurnBy):
 @command
 class TurnAround(_TurnBy):
     name = "turn_around"
-    label = "Turn around"
+    label = N_("Turn around")
     keys = ("<Shift>Down",)
     group = "Moves"
     degrees = 180.0
@@ -326,7 +327,7 @@ class TurnAround(_TurnBy):
 @command
 class MoveForward1m(Command):
     name = "move_forward_1m"
-    label = "Go 1 m forward"
+    label = N_("Go 1 m forward")
     keys = ("<Shift>Up",)
     group = "Moves"
     needs = ("moveDist",)
@@ -341,15 +342,15 @@ class MoveForward1m(Command):
 @command
 class RequestImage(Command):
     name = "request_image"
-    label = "Camera picture"
+    label = N_("Camera picture")
     keys = ("i",)
     group = "Window"
 
     def unavailable(self, ctx: CommandContext) -> str | None:
         if not ctx.connected:
-            return "not connected"
+            return N_("not connected")
         if ctx.image_source() is None:
-            return "this server offers no camera pictures (getPicture… or sendVideo)"
+            return N_("this server offers no camera pictures (getPicture… or sendVideo)")
         return None
 
     def activate(self, target: CommandTarget) -> None:
@@ -359,7 +360,7 @@ class RequestImage(Command):
 @command
 class SafeDriveOn(Command):
     name = "safe_drive_on"
-    label = "Safe drive on"
+    label = N_("Safe drive on")
     needs = ("setSafeDrive",)
 
     def activate(self, target: CommandTarget) -> None:
@@ -369,7 +370,7 @@ class SafeDriveOn(Command):
 @command
 class SafeDriveOff(Command):
     name = "safe_drive_off"
-    label = "Safe drive off (no obstacle limits)"
+    label = N_("Safe drive off (no obstacle limits)")
     needs = ("setSafeDrive",)
 
     def activate(self, target: CommandTarget) -> None:
@@ -382,7 +383,7 @@ class SafeDriveOff(Command):
 @command
 class Home(Command):
     name = "home"
-    label = "Go home"
+    label = N_("Go home")
     group = "Navigation"
     menu = True
     needs = ("home",)
@@ -394,7 +395,7 @@ class Home(Command):
 @command
 class DockCommand(Command):
     name = "dock"
-    label = "Dock and charge"
+    label = N_("Dock and charge")
     group = "Navigation"
     menu = True
     needs = ("dock",)
@@ -406,7 +407,7 @@ class DockCommand(Command):
 @command
 class TourGoals(Command):
     name = "tour_goals"
-    label = "Tour the goals"
+    label = N_("Tour the goals")
     group = "Navigation"
     menu = True
     needs = ("tourGoals",)
@@ -423,7 +424,7 @@ class ServerCommands(Command):
     """The palette of the server's own commands (listCommands, listStringCommands)."""
 
     name = "server_commands"
-    label = "Server commands…"
+    label = N_("Server commands…")
     keys = ("<Control>k",)
     menu = True
     needs = (("listCommands", "listStringCommands", "customListCommands", "customListStringCommands"),)
@@ -438,13 +439,13 @@ class ServerCommands(Command):
 @command
 class Connect(Command):
     name = "connect"
-    label = "Connect"
+    label = N_("Connect")
     keys = ("<Control>o",)
     group = "Connection"
     needs_connection = False
 
     def unavailable(self, ctx: CommandContext) -> str | None:
-        return "already connected" if ctx.connected else None
+        return N_("already connected") if ctx.connected else None
 
     def activate(self, target: CommandTarget) -> None:
         target.connect()
@@ -453,7 +454,7 @@ class Connect(Command):
 @command
 class Disconnect(Command):
     name = "disconnect"
-    label = "Disconnect"
+    label = N_("Disconnect")
     keys = ("<Control>d",)
     group = "Connection"
 

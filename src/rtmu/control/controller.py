@@ -51,6 +51,7 @@ from collections.abc import Callable
 from dataclasses import replace
 from typing import Any
 
+from ..base.i18n import N_, _
 from ..base.notices import Kind, Notice
 from ..client.lease import EndReason
 from ..model.observables import OperatorState, RobotModel, SpeedSetting
@@ -66,8 +67,8 @@ from .password_lookup import PasswordLookup
 from .ports import ClientLink, NoView, SecretStore, View
 from .scan_rule import scan_refusal
 
-REPLAY_REASON = "Replay — nothing is sent to a robot"
-KEYBOARD_LOST = "the window lost the keyboard"
+REPLAY_REASON = N_("Replay — nothing is sent to a robot")
+KEYBOARD_LOST = N_("the window lost the keyboard")
 """Why a held drive stops on a focus loss (a suspend names its own reason)."""
 
 
@@ -155,7 +156,11 @@ class Controller:
         cmd = self.registry.get(name)
         reason = REPLAY_REASON if self.replay and cmd.needs_connection else cmd.unavailable(self)
         if reason is not None:
-            self.view.notify(Notice.warning(Kind.COMMAND, f"{cmd.label}: {reason}"))
+            self.view.notify(
+                Notice.warning(
+                    Kind.COMMAND, _("{command}: {reason}").format(command=_(cmd.label), reason=_(reason))
+                )
+            )
             return False
         cmd.activate(self)
         return True
@@ -257,8 +262,12 @@ class Controller:
         """
         if self.drive.driving:
             self.stop()
-            then = "Click the map, then press again" if why == KEYBOARD_LOST else "Press again"
-            self.view.notify(Notice.warning(Kind.SAFETY, f"Stopped: {why}. {then} to drive."))
+            then = _("Click the map, then press again") if why == KEYBOARD_LOST else _("Press again")
+            self.view.notify(
+                Notice.warning(
+                    Kind.SAFETY, _("Stopped: {why}. {then} to drive.").format(why=_(why), then=then)
+                )
+            )
         self.drive.keys_lost()
 
     def focus_gained(self) -> None:
@@ -269,7 +278,7 @@ class Controller:
         """A D-pad (pointer, touch) hold may start only while the stop key reaches the window: else it
         is refused, saying why (a key press proves the keyboard is here; a pointer press does not)."""
         if not self.keys_reach:
-            said = (
+            said = _(
                 "Not driving: Space could not stop it, the keyboard is elsewhere. Click the map, then drive."
             )
             self.view.notify(Notice.warning(Kind.SAFETY, said))
@@ -282,7 +291,9 @@ class Controller:
         key-ups seen until the next press are not real ones (as after a focus loss)."""
         if self.drive.holding:
             self.drive.halt(EndReason.STOPPED)
-            self.view.notify(Notice.info(Kind.SAFETY, f"Stopped for {what}. Press again to drive."))
+            self.view.notify(
+                Notice.info(Kind.SAFETY, _("Stopped for {what}. Press again to drive.").format(what=what))
+            )
         if keys_leave:
             self.drive.keys_left()
 
@@ -296,10 +307,17 @@ class Controller:
     def _set_speed(self, new: SpeedSetting, limit: str) -> None:
         if not self.operator.speed.set(new):
             self.view.notify(
-                Notice.info(Kind.SPEED_LIMIT, f"Speed is already at its {limit} ({new.percent} %)")
+                Notice.info(
+                    Kind.SPEED_LIMIT,
+                    (
+                        _("Speed is already at its maximum ({percent} %)")
+                        if limit == "maximum"
+                        else _("Speed is already at its minimum ({percent} %)")
+                    ).format(percent=new.percent),
+                )
             )
             return
-        self.view.notify(Notice.info(Kind.SPEED, f"Speed {new.percent} %"))
+        self.view.notify(Notice.info(Kind.SPEED, _("Speed {percent} %").format(percent=new.percent)))
         self.drive.reapply()
 
     # -- every other intent: the guard ---------------------------------------------------------
@@ -321,13 +339,21 @@ class Controller:
             return None
         offers = self.robot.connection.value.offers
         if (intent.needs or intent.moves or not intent.offered(())) and not self.connected:
-            self.view.notify(Notice.warning(intent.kind, f"{intent.label}: not connected"))
+            self.view.notify(
+                Notice.warning(intent.kind, _("{label}: not connected").format(label=intent.label))
+            )
             return None
         if not intent.offered(offers):
-            missing = f"offer {intent.needs[0]}" if intent.needs else f"offer {intent.label.lower()}"
+            missing = (
+                _("offer {value}").format(value=intent.needs[0])
+                if intent.needs
+                else _("offer {lower}").format(lower=intent.label.lower())
+            )
             if isinstance(intent, (RequestPicture, StartVideo)):
-                missing = "offer camera pictures"
-            self.view.notify(Notice.warning(intent.kind, f"This server does not {missing}"))
+                missing = _("offer camera pictures")
+            self.view.notify(
+                Notice.warning(intent.kind, _("This server does not {missing}").format(missing=missing))
+            )
             return None
         refusal = scan_refusal(intent, self.robot.scan.value)  # while scanning: only held drives move it
         if refusal is not None:
@@ -335,7 +361,11 @@ class Controller:
             return None
         goals = self.robot.navigation.value.goals
         if isinstance(intent, GotoGoal) and goals and intent.name not in goals:
-            self.view.notify(Notice.warning(Kind.NAVIGATION, f"This map has no goal called {intent.name!r}"))
+            self.view.notify(
+                Notice.warning(
+                    Kind.NAVIGATION, _("This map has no goal called {name!r}").format(name=intent.name)
+                )
+            )
             return None
         refused = intent_rules.refusal(intent)  # a console call of a motion request, a fix, unconfirmed
         if refused is not None:
@@ -371,7 +401,7 @@ class Controller:
 
     def say_replay(self) -> None:
         """Say that a replay sends nothing (the operator asked something of a recording)."""
-        self.view.notify(Notice.warning(Kind.SAFETY, f"{REPLAY_REASON}: {self.replay}"))
+        self.view.notify(Notice.warning(Kind.SAFETY, f"{_(REPLAY_REASON)}: {self.replay}"))
 
     # -- connection --------------------------------------------------------------------------
     def select_profile(self, profile: Profile) -> None:
@@ -445,7 +475,7 @@ class Controller:
         Opening one is looking (:meth:`look`): it takes the keyboard, so a held drive ends — a Turn or
         Go jog would take over from it anyway — but a navigation goes on until the operator runs what
         the dialog asks, or presses STOP (the dialog carries the stop keys)."""
-        self.look("a dialog")
+        self.look(_("a dialog"))
         self.view.open_dialog(name)
 
     @property
@@ -468,13 +498,20 @@ class Controller:
         if new.phase is not Phase.CONNECTED and old.phase is Phase.CONNECTED:
             self.drive.halt(EndReason.DISCONNECTED)
         if new.phase is Phase.CONNECTED and old.phase is not Phase.CONNECTED:
-            self.view.notify(Notice.info(Kind.CONNECTION, f"Connected to {new.host}:{new.port}"))
+            self.view.notify(
+                Notice.info(
+                    Kind.CONNECTION, _("Connected to {host}:{port}").format(host=new.host, port=new.port)
+                )
+            )
         elif new.phase is Phase.FAILED and new.error and new.error != old.error:
             self.view.notify(Notice.error(Kind.CONNECTION, new.error))
         elif new.phase is Phase.RECONNECTING and old.phase is Phase.CONNECTED:
             self.view.notify(
                 Notice.warning(
-                    Kind.CONNECTION, f"Link lost: reconnecting ({new.error})" if new.error else "Reconnecting"
+                    Kind.CONNECTION,
+                    _("Link lost: reconnecting ({error})").format(error=new.error)
+                    if new.error
+                    else _("Reconnecting"),
                 )
             )
         self.refresh_commands()

@@ -33,6 +33,7 @@ from __future__ import annotations
 from collections.abc import Callable
 from typing import Protocol
 
+from ..base.i18n import _
 from ..base.notices import Kind, Notice
 from ..client.lease import DriveRatios, EndReason
 from ..model.observables import OperatorState, RobotModel
@@ -155,7 +156,7 @@ class HeldDrive:
         if host.navigating:  # the operator wins: this press only stops the navigation
             host.stop()
             self._blocked.add(direction)
-            host.view.notify(Notice.info(Kind.NAVIGATION, "Navigation cancelled. Press again to drive."))
+            host.view.notify(Notice.info(Kind.NAVIGATION, _("Navigation cancelled. Press again to drive.")))
             return
         if self._gate_refuses():
             self._blocked.add(direction)
@@ -168,7 +169,7 @@ class HeldDrive:
         gate = self._host.drive_gate
         why = gate() if gate is not None else None
         if why is not None:
-            said = f"Not driving: {why} Press again once it is armed."
+            said = _("Not driving: {why} Press again once it is armed.").format(why=why)
             self._host.view.notify(Notice.warning(Kind.SAFETY, said))
         return why is not None
 
@@ -195,7 +196,7 @@ class HeldDrive:
         if host.navigating and (trans or rot):  # the operator wins: this only stops the navigation
             host.stop()
             self._analog_blocked = True
-            host.view.notify(Notice.info(Kind.NAVIGATION, "Navigation cancelled. Press again to drive."))
+            host.view.notify(Notice.info(Kind.NAVIGATION, _("Navigation cancelled. Press again to drive.")))
             return
         if self._analog is None and (trans or rot) and self._gate_refuses():
             self._analog_blocked = True
@@ -260,7 +261,7 @@ class HeldDrive:
                 # The lease died under us (lapsed/stale); the keys pressed before are stale too.
                 self.halt(lease.ended or EndReason.LAPSED)
                 return
-            host.motion.end_jog("a drive", host.robot.robot.value)
+            host.motion.end_jog(_("a drive"), host.robot.robot.value)
             self._generation = lease.grant(ratios)
             host.view.driving()
 
@@ -286,9 +287,11 @@ class HeldDrive:
             lease.end(reason, self._generation)
             self._generation = None
         if had and reason is EndReason.LAPSED:
-            why = lease.why or "a busy computer?"
-            text = f"Stopped: the window did not respond in time ({why})"
-            self._host.view.notify(Notice.warning(Kind.SAFETY, f"{text}. Press again to drive."))
+            why = lease.why or _("a busy computer?")
+            text = _("Stopped: the window did not respond in time ({why})").format(why=why)
+            self._host.view.notify(
+                Notice.warning(Kind.SAFETY, _("{text}. Press again to drive.").format(text=text))
+            )
         elif had and reason is EndReason.LINK and not quiet:
             level = self._host.robot.health.value.level
             self.say_link_stop(level if level in (LinkLevel.STALE, LinkLevel.LOST) else LinkLevel.STALE)
@@ -297,5 +300,9 @@ class HeldDrive:
         """Said once per stop, with the network side's measured cause where it gave one."""
         host = self._host
         why = host.link.lease.why or host.robot.health.value.cause
-        said = f" — {why}" if why else ". Press again once it is back."
-        host.view.notify(Notice.warning(Kind.LINK, f"Stopped: the link is {level.value}{said}"))
+        said = f" — {why}" if why else _(". Press again once it is back.")
+        host.view.notify(
+            Notice.warning(
+                Kind.LINK, _("Stopped: the link is {value}{said}").format(value=level.value, said=said)
+            )
+        )

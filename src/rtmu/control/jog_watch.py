@@ -15,6 +15,7 @@ from __future__ import annotations
 import math
 from dataclasses import dataclass
 
+from ..base.i18n import _
 from ..values.state import RobotState
 
 SETTLE_S = 0.5
@@ -46,7 +47,7 @@ class Jog:
 
 
 def _name(jog: Jog) -> str:
-    return "Go a distance" if jog.kind == "move" else "Turn"
+    return _("Go a distance") if jog.kind == "move" else _("Turn")
 
 
 def _metres(mm: float) -> str:
@@ -84,14 +85,20 @@ class JogWatch:
         if jog is None:
             return ""
         if jog.kind == "move":
-            return f"after {_metres(math.hypot(robot.x - jog.x, robot.y - jog.y))} of {_metres(jog.amount)}"
-        return f"after turning {abs(_turned(jog.th, robot.th)):.0f}° of {abs(jog.amount):.0f}°"
+            return _("after {metres} of {metres2}").format(
+                metres=_metres(math.hypot(robot.x - jog.x, robot.y - jog.y)), metres2=_metres(jog.amount)
+            )
+        return _("after turning {abs:.0f}° of {abs2:.0f}°").format(
+            abs=abs(_turned(jog.th, robot.th)), abs2=abs(jog.amount)
+        )
 
     def end(self, why: str, robot: RobotState) -> str | None:
         """Something else took over (``why``: "STOP", "a drive", "a navigation"): the outcome so far."""
         if self.jog is None:
             return None
-        text = f"{_name(self.jog)} ended by {why} {self.done_so_far(robot)}"
+        text = _("{name} ended by {why} {done_so_far}").format(
+            name=_name(self.jog), why=_(why), done_so_far=self.done_so_far(robot)
+        )
         self.jog = None
         return text
 
@@ -108,7 +115,9 @@ class JogWatch:
             if now - jog.started < START_S:
                 return None
             self.jog = None
-            return f"{_name(jog)} did not start: the robot did not move ({robot.status or 'no status'})"
+            return _("{name} did not start: the robot did not move ({value})").format(
+                name=_name(jog), value=robot.status or _("no status")
+            )
         if jog.still_since is None:
             self.jog = Jog(jog.kind, jog.amount, jog.x, jog.y, jog.th, jog.started, True, now)
             return None
@@ -121,15 +130,19 @@ class JogWatch:
         if jog.kind == "turn":
             turned = _turned(jog.th, robot.th)
             if abs(abs(turned) - abs(jog.amount)) <= DONE_DEG:
-                return f"Turned {abs(turned):.0f}°"
-            return f"Turn stopped after {abs(turned):.0f}° of {abs(jog.amount):.0f}°"
+                return _("Turned {abs:.0f}°").format(abs=abs(turned))
+            return _("Turn stopped after {abs:.0f}° of {abs2:.0f}°").format(
+                abs=abs(turned), abs2=abs(jog.amount)
+            )
         went = math.hypot(robot.x - jog.x, robot.y - jog.y)
         if abs(jog.amount) - went <= max(DONE_MM, 0.03 * abs(jog.amount)):
-            return f"Went {_metres(went)}"
-        where = f"after {_metres(went)} of {_metres(jog.amount)}"
+            return _("Went {metres}").format(metres=_metres(went))
+        where = _("after {metres} of {metres2}").format(metres=_metres(went), metres2=_metres(jog.amount))
         if robot.status.lower().startswith("stall"):
-            return f"Stopped: the robot stalled {where}. Look before driving on."
+            return _("Stopped: the robot stalled {where}. Look before driving on.").format(where=where)
         echo = obstacle_ahead(robot, jog.amount > 0)
         if echo is not None:
-            return f"Stopped by an obstacle {echo / 1000:.1f} m ahead {where}"
-        return f"Stopped short {where}"
+            return _("Stopped by an obstacle {value:.1f} m ahead {where}").format(
+                value=echo / 1000, where=where
+            )
+        return _("Stopped short {where}").format(where=where)

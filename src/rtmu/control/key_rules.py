@@ -16,6 +16,7 @@ from __future__ import annotations
 
 from enum import Enum
 
+from ..base.i18n import N_, _
 from .commands import COMMANDS, CommandRegistry
 
 
@@ -28,7 +29,7 @@ class KeyAction(Enum):
     """Not a stop key: whoever handles it next."""
 
 
-FIELD_HINT = "Space stops the robot · Shift+Space types a space"
+FIELD_HINT = N_("Space stops the robot · Shift+Space types a space")
 """What every text field says (placeholder and tooltip) while a stop key is one key away."""
 
 TYPING_KEYS = frozenset({"KP_5"})
@@ -60,7 +61,7 @@ def stop_key_action(
     return KeyAction.STOP
 
 
-KEYS_INACTIVE = "Keys inactive — click the map"
+KEYS_INACTIVE = N_("Keys inactive — click the map")
 """What the window says while the keyboard is elsewhere (another program, or nowhere)."""
 
 
@@ -73,5 +74,5 @@ def keys_note(*, window_active: bool, connected: bool, dialog: str = "") -> str:
     if window_active or not connected:
         return ""
     if dialog:
-        return f"Drive keys go to “{dialog}” · Space stops the robot there"
-    return KEYS_INACTIVE
+        return _("Drive keys go to “{dialog}” · Space stops the robot there").format(dialog=dialog)
+    return _(KEYS_INACTIVE)

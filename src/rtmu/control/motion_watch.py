@@ -12,6 +12,7 @@ from __future__ import annotations
 from collections.abc import Callable
 from typing import Any
 
+from ..base.i18n import N_
 from ..base.notices import Kind, Notice
 from ..client.config_feed import VERSIONS as CONFIG_DATA
 from ..client.lease import DriveRatios
@@ -90,7 +91,7 @@ class MotionWatch:
     def intent_sent(self, intent: Intent, robot: RobotState) -> None:
         """An intent that moves the robot went out: a jog is watched from here; anything else ends one."""
         if isinstance(intent, TurnBy | MoveDistance):
-            self.end_jog("another jog", robot)
+            self.end_jog(N_("another jog"), robot)
             kind, amount = ("turn", intent.degrees) if isinstance(intent, TurnBy) else ("move", intent.mm)
             self.jogs.start(kind, float(amount), robot, self._clock())
         else:

@@ -11,6 +11,7 @@ from __future__ import annotations
 from collections.abc import Callable
 from typing import Protocol
 
+from ..base.i18n import _
 from ..base.notices import Kind, Notice
 from ..settings.store import Profile
 from .ports import ClientLink, SecretStore, View
@@ -67,6 +68,6 @@ class PasswordLookup:
 
     def _answered(self, password: str | None) -> None:
         if password is None:
-            self._host.view.notify(Notice.info(Kind.CONNECTION, "Connection cancelled"))
+            self._host.view.notify(Notice.info(Kind.CONNECTION, _("Connection cancelled")))
             return
         self._start(password)

@@ -34,6 +34,7 @@ from dataclasses import replace
 from pathlib import Path
 from typing import Any
 
+from ..base.i18n import _
 from ..base.notices import Kind, Notice
 from ..client.link import Opener, open_tcp
 from ..client.roster import (
@@ -369,7 +370,9 @@ class Fleet:
             driving = bool(old.controller.held) or old.controller.analog_active
             old.controller.stop()  # also blocks its held keys until they are released
             if driving:  # a stop the operator did not press is said, with what to do
-                said = f"Stopped {old.name}: {session.name} is selected now. Press again to drive it."
+                said = _("Stopped {robot}: {selected} is selected now. Press again to drive it.").format(
+                    robot=old.name, selected=session.name
+                )
                 old.controller.view.notify(Notice.info(Kind.SAFETY, said))
         self.selected.set(session)
 

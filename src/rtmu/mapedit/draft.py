@@ -18,6 +18,7 @@ from collections import Counter
 from collections.abc import Iterable, Sequence
 from dataclasses import dataclass, replace
 
+from ..base.i18n import N_, _
 from ..mapfile import MapObject, object_text
 
 MAX_COORD_MM = 1_000_000_000
@@ -51,19 +52,31 @@ def object_key(obj: MapObject) -> tuple[object, ...]:
     )
 
 
-def describe(obj: MapObject) -> str:
-    """An object in a few plain words: ``goal "Kitchen"``, ``forbidden line (0, 0)–(1000, 0)``."""
+def describe(obj: MapObject, *, translated: bool = False) -> str:
+    """An object in a few plain words: ``goal "Kitchen"``, ``forbidden line (0, 0)–(1000, 0)``.
+
+    ``translated``: in the operator's language (the window); machine output (``--json``) keeps English."""
+    say = _ if translated else str
     kind = {
-        "goalwithheading": "goal",
-        "forbiddenline": "forbidden line",
-        "forbiddenarea": "forbidden area",
+        "goal": N_("goal"),
+        "goalwithheading": N_("goal"),
+        "dock": N_("dock"),
+        "home": N_("home"),
+        "forbiddenline": N_("forbidden line"),
+        "forbiddenarea": N_("forbidden area"),
     }.get(obj.type.lower(), obj.type.lower())
+    kind = say(kind) if obj.type.lower() in _KNOWN_KINDS else kind
     if obj.name:
-        return f'{kind} "{obj.name}"'
+        return say(N_('{kind} "{name}"')).format(kind=kind, name=obj.name)
     if obj.from_xy is not None and obj.to_xy is not None:
         (x1, y1), (x2, y2) = obj.from_xy, obj.to_xy
-        return f"{kind} ({x1:g}, {y1:g})–({x2:g}, {y2:g})"
-    return f"{kind} at ({obj.x:g}, {obj.y:g})"
+        return say(N_("{kind} ({x1:g}, {y1:g})–({x2:g}, {y2:g})")).format(
+            kind=kind, x1=x1, y1=y1, x2=x2, y2=y2
+        )
+    return say(N_("{kind} at ({x:g}, {y:g})")).format(kind=kind, x=obj.x, y=obj.y)
+
+
+_KNOWN_KINDS = frozenset({"goal", "goalwithheading", "dock", "home", "forbiddenline", "forbiddenarea"})
 
 
 @dataclass(frozen=True, slots=True)
@@ -116,16 +129,28 @@ class Underneath:
         """One plain sentence for the operator (empty when nothing changed)."""
         parts: list[str] = []
         if self.added:
-            parts.append("added " + ", ".join(describe(o) for o in self.added))
+            parts.append(
+                _("added {objects}").format(
+                    objects=", ".join(describe(o, translated=True) for o in self.added)
+                )
+            )
         if self.removed:
-            parts.append("deleted " + ", ".join(describe(o) for o in self.removed))
+            parts.append(
+                _("deleted {objects}").format(
+                    objects=", ".join(describe(o, translated=True) for o in self.removed)
+                )
+            )
         if self.changed:
-            parts.append("changed " + ", ".join(describe(after) for _, after in self.changed))
+            parts.append(
+                _("changed {objects}").format(
+                    objects=", ".join(describe(after, translated=True) for _before, after in self.changed)
+                )
+            )
         if not parts:
             return ""
-        text = "The map was changed on the robot: " + "; ".join(parts) + ". Your draft is kept."
+        text = _("The map was changed on the robot: ") + "; ".join(parts) + _(". Your draft is kept.")
         if self.conflicts:
-            text += " Conflicts: " + "; ".join(str(c) for c in self.conflicts) + "."
+            text += _(" Conflicts: {conflicts}.").format(conflicts="; ".join(str(c) for c in self.conflicts))
         return text
 
 
@@ -182,38 +207,54 @@ class MapDraft:
         """A goal; with a heading it is a ``GoalWithHeading`` (the robot turns to it on arrival)."""
         kind = GOAL if th is None else GOAL_WITH_HEADING
         obj = MapObject(kind, *_xy(x, y), _heading(th or 0.0), name=self._new_name(name))
-        return self._push(Edit(None, obj, f'add goal "{obj.name}"'))
+        return self._push(Edit(None, obj, _('add goal "{name}"').format(name=obj.name)))
 
     def add_dock(self, name: str, x: float, y: float, th: float) -> Edit:
         """A charging dock, facing ``th`` (the robot drives in along it)."""
         obj = MapObject(DOCK, *_xy(x, y), _heading(th), name=self._new_name(name))
-        return self._push(Edit(None, obj, f'add dock "{obj.name}"'))
+        return self._push(Edit(None, obj, _('add dock "{name}"').format(name=obj.name)))
 
     def add_forbidden_line(self, x1: float, y1: float, x2: float, y2: float) -> Edit:
         a, b = _xy(x1, y1), _xy(x2, y2)
         if a == b:
-            raise DraftError("a forbidden line needs two different ends")
+            raise DraftError(_("a forbidden line needs two different ends"))
         obj = MapObject(FORBIDDEN_LINE, *a, 0.0, from_xy=a, to_xy=b)
-        return self._push(Edit(None, obj, f"add {describe(obj)}"))
+        return self._push(
+            Edit(None, obj, _("add {describe}").format(describe=describe(obj, translated=True)))
+        )
 
     def add_forbidden_area(self, x1: float, y1: float, x2: float, y2: float) -> Edit:
         """An axis-aligned area between two opposite corners (stored lower-left, upper-right, as ARIA)."""
         (ax, ay), (bx, by) = _xy(x1, y1), _xy(x2, y2)
         if ax == bx or ay == by:
-            raise DraftError("a forbidden area needs two corners that differ in x and in y")
+            raise DraftError(_("a forbidden area needs two corners that differ in x and in y"))
         lo, hi = (min(ax, bx), min(ay, by)), (max(ax, bx), max(ay, by))
         obj = MapObject(FORBIDDEN_AREA, 0.0, 0.0, 0.0, from_xy=lo, to_xy=hi)
-        return self._push(Edit(None, obj, f"add {describe(obj)}"))
+        return self._push(
+            Edit(None, obj, _("add {describe}").format(describe=describe(obj, translated=True)))
+        )
 
     def move(self, name: str, x: float, y: float) -> Edit:
         obj = self._named(name)
-        return self._push(Edit(obj, replace(obj, x=_xy(x, y)[0], y=_xy(x, y)[1]), f"move {describe(obj)}"))
+        return self._push(
+            Edit(
+                obj,
+                replace(obj, x=_xy(x, y)[0], y=_xy(x, y)[1]),
+                _("move {describe}").format(describe=describe(obj, translated=True)),
+            )
+        )
 
     def turn(self, name: str, th: float) -> Edit:
         """Set a goal's or dock's heading (a plain goal becomes a goal with heading)."""
         obj = self._named(name)
         kind = GOAL_WITH_HEADING if obj.type.lower() == "goal" else obj.type
-        return self._push(Edit(obj, replace(obj, type=kind, th=_heading(th)), f"turn {describe(obj)}"))
+        return self._push(
+            Edit(
+                obj,
+                replace(obj, type=kind, th=_heading(th)),
+                _("turn {describe}").format(describe=describe(obj, translated=True)),
+            )
+        )
 
     def rename(self, name: str, new_name: str) -> Edit:
         obj = self._named(name)
@@ -221,17 +262,31 @@ class MapDraft:
             new = replace(obj, name=_checked_name(new_name))
         else:
             new = replace(obj, name=self._new_name(new_name))
-        return self._push(Edit(obj, new, f'rename {describe(obj)} to "{new.name}"'))
+        return self._push(
+            Edit(
+                obj,
+                new,
+                _('rename {describe} to "{name}"').format(
+                    describe=describe(obj, translated=True), name=new.name
+                ),
+            )
+        )
 
     def delete(self, name: str) -> Edit:
         obj = self._named(name)
-        return self._push(Edit(obj, None, f"delete {describe(obj)}"))
+        return self._push(
+            Edit(obj, None, _("delete {describe}").format(describe=describe(obj, translated=True)))
+        )
 
     def delete_object(self, obj: MapObject) -> Edit:
         """Delete an object as it is in the draft (an unnamed forbidden line or area)."""
         if obj not in self._objects:
-            raise DraftError(f"{describe(obj)} is not on the map")
-        return self._push(Edit(obj, None, f"delete {describe(obj)}"))
+            raise DraftError(
+                _("{describe} is not on the map").format(describe=describe(obj, translated=True))
+            )
+        return self._push(
+            Edit(obj, None, _("delete {describe}").format(describe=describe(obj, translated=True)))
+        )
 
     def undo(self) -> Edit | None:
         if not self._edits:
@@ -288,7 +343,11 @@ class MapDraft:
         obj = self.find(name)
         if obj is None:
             names = ", ".join(o.name for o in self._objects if o.name) or "none"
-            raise DraftError(f'no goal or dock named "{name}" on the map (named objects: {names})')
+            raise DraftError(
+                _('no goal or dock named "{name}" on the map (named objects: {names})').format(
+                    name=name, names=names
+                )
+            )
         return obj
 
     def _new_name(self, name: str) -> str:
@@ -296,7 +355,9 @@ class MapDraft:
         taken = self.find(name)
         if taken is not None:
             raise DraftError(
-                f"the map already has {describe(taken)}: names must differ (ARIA matches them by name)"
+                _("the map already has {describe}: names must differ (ARIA matches them by name)").format(
+                    describe=describe(taken, translated=True)
+                )
             )
         return name
 
@@ -304,13 +365,13 @@ class MapDraft:
 def _checked_name(name: str) -> str:
     name = name.strip()
     if not name:
-        raise DraftError("a goal or dock needs a name")
+        raise DraftError(_("a goal or dock needs a name"))
     if '"' in name or any(ord(c) < 32 for c in name):
-        raise DraftError(f"a name cannot hold quotes or control characters: {name!r}")
+        raise DraftError(_("a name cannot hold quotes or control characters: {name!r}").format(name=name))
     try:
         name.encode("latin-1")
     except UnicodeEncodeError:
-        raise DraftError(f"ARIA map names are latin-1 text: {name!r}") from None
+        raise DraftError(_("ARIA map names are latin-1 text: {name!r}").format(name=name)) from None
     return name
 
 
@@ -318,14 +379,18 @@ def _xy(x: float, y: float) -> tuple[float, float]:
     out = []
     for v in (x, y):
         if not math.isfinite(v) or abs(v) > MAX_COORD_MM:
-            raise DraftError(f"{v!r} is not a map coordinate (whole mm within ±{MAX_COORD_MM})")
+            raise DraftError(
+                _("{v!r} is not a map coordinate (whole mm within ±{MAX_COORD_MM})").format(
+                    v=v, MAX_COORD_MM=MAX_COORD_MM
+                )
+            )
         out.append(float(round(v)))
     return out[0], out[1]
 
 
 def _heading(th: float) -> float:
     if not math.isfinite(th):
-        raise DraftError(f"{th!r} is not a heading in degrees")
+        raise DraftError(_("{th!r} is not a heading in degrees").format(th=th))
     th = math.fmod(th, 360.0)
     if th > 180.0:
         th -= 360.0
@@ -346,7 +411,12 @@ def _replay(
             key = object_key(edit.after)
             if any(object_key(o) == key for o in objects):
                 conflicts.append(
-                    Conflict(edit, f"{describe(edit.after)} is already on the map (added by someone else)")
+                    Conflict(
+                        edit,
+                        _("{describe} is already on the map (added by someone else)").format(
+                            describe=describe(edit.after, translated=True)
+                        ),
+                    )
                 )
                 continue
             objects.append(edit.after)
@@ -357,16 +427,35 @@ def _replay(
             key = object_key(edit.before)
             at = next((i for i, o in enumerate(objects) if object_key(o) == key), -1)
             if at < 0:
-                conflicts.append(Conflict(edit, f"{describe(edit.before)} was deleted by someone else"))
+                conflicts.append(
+                    Conflict(
+                        edit,
+                        _("{describe} was deleted by someone else").format(
+                            describe=describe(edit.before, translated=True)
+                        ),
+                    )
+                )
                 continue
-            conflicts.append(Conflict(edit, f"{describe(edit.before)} was changed by someone else"))
+            conflicts.append(
+                Conflict(
+                    edit,
+                    _("{describe} was changed by someone else").format(
+                        describe=describe(edit.before, translated=True)
+                    ),
+                )
+            )
         if edit.after is None:
             del objects[at]
         else:
             clash = object_key(edit.after)
             if edit.after.name and any(object_key(o) == clash for i, o in enumerate(objects) if i != at):
                 conflicts.append(
-                    Conflict(edit, f"{describe(edit.after)} is already on the map (added by someone else)")
+                    Conflict(
+                        edit,
+                        _("{describe} is already on the map (added by someone else)").format(
+                            describe=describe(edit.after, translated=True)
+                        ),
+                    )
                 )
                 continue
             objects[at] = edit.after

@@ -19,6 +19,7 @@ from dataclasses import dataclass
 from functools import partial
 from pathlib import Path
 
+from ..base.i18n import _
 from ..base.notices import Kind, Notice
 from ..capture.recorded import CONNECTION_TOPIC, RAW_TOPICS, connection_record
 from . import topics
@@ -237,9 +238,12 @@ class Recording:
     def _stop(self, why: str, *, started: bool = True) -> None:
         self.stopped = why
         log.warning("recording %s stopped: %s", self.path, why)
-        after = f"; {self.path} keeps what came before" if started else ""
+        after = _("; {path} keeps what came before").format(path=self.path) if started else ""
         self.on_problem(
-            Notice.warning(Kind.RECORDING, f"Recording stopped: {why}. The session goes on{after}.")
+            Notice.warning(
+                Kind.RECORDING,
+                _("Recording stopped: {why}. The session goes on{after}.").format(why=why, after=after),
+            )
         )
 
 

@@ -14,6 +14,7 @@ from collections.abc import Callable
 from pathlib import Path
 from typing import Any
 
+from ..base.i18n import _
 from ._common import _RefusePassword, positive_float
 
 
@@ -21,28 +22,30 @@ def add_late_connection_options(parser: argparse.ArgumentParser) -> None:
     """The connection options again, for after the action word (unset unless given there)."""
     parser.allow_abbrev = False
     quiet = argparse.SUPPRESS
-    parser.add_argument("--user", default=quiet, help="user name, if the server has a user file")
+    parser.add_argument("--user", default=quiet, help=_("user name, if the server has a user file"))
     parser.add_argument("--password", nargs="?", action=_RefusePassword, help=quiet)
     parser.add_argument(
-        "--password-file", type=Path, metavar="FILE", default=quiet, help="read the password from FILE"
+        "--password-file", type=Path, metavar="FILE", default=quiet, help=_("read the password from FILE")
     )
     parser.add_argument(
         "--password-stdin",
         action="store_true",
         default=quiet,
-        help="read the password from the first line of standard input",
+        help=_("read the password from the first line of standard input"),
     )
-    parser.add_argument("--protocol", metavar="STRING", default=quiet, help="protocol string to log in with")
     parser.add_argument(
-        "--timeout", type=positive_float, metavar="S", default=quiet, help="seconds to wait at each step"
+        "--protocol", metavar="STRING", default=quiet, help=_("protocol string to log in with")
     )
-    parser.add_argument("--robot", metavar="NAME", default=quiet, help="a robot behind a central server")
+    parser.add_argument(
+        "--timeout", type=positive_float, metavar="S", default=quiet, help=_("seconds to wait at each step")
+    )
+    parser.add_argument("--robot", metavar="NAME", default=quiet, help=_("a robot behind a central server"))
 
 
 def action_parser(actions: Any, name: str, help_text: str, description: str) -> argparse.ArgumentParser:
     p: argparse.ArgumentParser = actions.add_parser(name, help=help_text, description=description)
     add_late_connection_options(p)
-    p.add_argument("--json", action="store_true", help="one JSON object on stdout")
+    p.add_argument("--json", action="store_true", help=_("one JSON object on stdout"))
     return p
 
 

@@ -28,6 +28,7 @@ from pathlib import Path
 from typing import TYPE_CHECKING, Any, TypeVar
 
 from ..base.exit_codes import EXIT_CONNECTION, EXIT_SIGPIPE, EXIT_USAGE
+from ..base.i18n import _
 from ..client.defaults import CONNECT_TIMEOUT, DEFAULT_PORT
 from ..client.errors import ClientError
 from ..client.roles import Role
@@ -117,29 +118,37 @@ def add_connection_arguments(parser: argparse.ArgumentParser, *, robot: bool = T
     _refuse_unknown_quietly(parser)
     _resolve_robot_first(parser)
     parser.add_argument(
-        "server", type=host_port, metavar="HOST[:PORT]", help="robot server (port 7272 by default)"
+        "server", type=host_port, metavar="HOST[:PORT]", help=_("robot server (port 7272 by default)")
     )
-    parser.add_argument("--user", default="", metavar="USER", help="user name, if the server has a user file")
+    parser.add_argument(
+        "--user", default="", metavar="USER", help=_("user name, if the server has a user file")
+    )
     parser.add_argument("--password", nargs="?", action=_RefusePassword, help=argparse.SUPPRESS)
     parser.add_argument(
         "--password-file",
         type=Path,
         metavar="FILE",
-        help="read the password from the first line of FILE (else it is asked for on the terminal when "
-        "--user is given)",
+        help=_(
+            "read the password from the first line of FILE (else it is asked for on the terminal when "
+            "--user is given)"
+        ),
     )
     parser.add_argument(
         "--password-stdin",
         action="store_true",
-        help="read the password from the first line of standard input (for scripts; nothing else reads "
-        "a password from a pipe)",
+        help=_(
+            "read the password from the first line of standard input (for scripts; nothing else reads "
+            "a password from a pipe)"
+        ),
     )
     parser.add_argument(
         "--protocol",
         metavar="STRING",
         default=None,
-        help="protocol string to log in with (default: the one the server advertises, e.g. 6MTX on "
-        "Omron LD robots)",
+        help=_(
+            "protocol string to log in with (default: the one the server advertises, e.g. 6MTX on "
+            "Omron LD robots)"
+        ),
     )
     parser.add_argument(
         "--timeout",
@@ -153,8 +162,10 @@ def add_connection_arguments(parser: argparse.ArgumentParser, *, robot: bool = T
             "--robot",
             metavar="NAME",
             default=None,
-            help="HOST[:PORT] is an ARIA central server: act on its robot NAME, through the port it "
-            "forwards that robot on ('rtmu fleet HOST' lists them)",
+            help=_(
+                "HOST[:PORT] is an ARIA central server: act on its robot NAME, through the port it "
+                "forwards that robot on ('rtmu fleet HOST' lists them)"
+            ),
         )
 
 
@@ -390,7 +401,10 @@ class Interrupts:
                         async with asyncio.timeout(SUSPEND_HOOK_TIMEOUT):
                             await result
                 except Exception as exc:  # the suspension must happen anyway
-                    print(f"rtmu: before suspending: {exc or type(exc).__name__}", file=sys.stderr)
+                    print(
+                        _("rtmu: before suspending: {value}").format(value=exc or type(exc).__name__),
+                        file=sys.stderr,
+                    )
             # Suspend for real (the default action); we are back here after fg / SIGCONT.
             loop.remove_signal_handler(signal.SIGTSTP)
             os.kill(os.getpid(), signal.SIGTSTP)
@@ -428,7 +442,7 @@ def current_password() -> str:
 def fail(name: str, message: str, code: int) -> int:
     from ..base.textsafe import visible
 
-    print(f"rtmu {name}: {visible(message)}", file=sys.stderr)
+    print(_("rtmu {name}: {visible}").format(name=name, visible=visible(message)), file=sys.stderr)
     return code
 
 
@@ -544,6 +558,9 @@ def known_name(command: str, kind: str, name: str, known: tuple[str, ...]) -> st
 
     listed = visible(", ".join(known) or "none")
     print(
-        f"rtmu {command}: no {kind} {visible(repr(name))} on this server ({kind}s: {listed})", file=sys.stderr
+        _("rtmu {command}: no {kind} {visible} on this server ({kind}s: {listed})").format(
+            command=command, kind=kind, visible=visible(repr(name)), listed=listed
+        ),
+        file=sys.stderr,
     )
     return None

@@ -8,6 +8,7 @@ from pathlib import Path
 from typing import TYPE_CHECKING
 
 from ..base.exit_codes import EXIT_OK, EXIT_REFUSED, EXIT_USAGE
+from ..base.i18n import _
 from ..base.textsafe import visible
 from ._common import UsageError, print_json
 
@@ -16,7 +17,7 @@ if TYPE_CHECKING:
 
 
 def _refused(words: str) -> int:
-    print(f"rtmu config: {visible(words)}", file=sys.stderr)
+    print(_("rtmu config: {visible}").format(visible=visible(words)), file=sys.stderr)
     return EXIT_REFUSED
 
 
@@ -41,13 +42,17 @@ async def show_defaults(client: AriaClient, args: argparse.Namespace) -> int:
         print_json({"differences": rows, "factory_values": len(factory.values), "cut": factory.cut})
         return EXIT_OK
     if not diffs:
-        print("every parameter has its factory value")
+        print(_("every parameter has its factory value"))
     for d in diffs:
         ro = "" if d.editable else "  (read-only)"
         where = f"{visible(d.section)}/{visible(d.name)}"
-        print(f"{where} = {visible(d.value)}    factory: {visible(d.default)}{ro}")
+        print(
+            _("{where} = {visible}    factory: {visible2}{ro}").format(
+                where=where, visible=visible(d.value), visible2=visible(d.default), ro=ro
+            )
+        )
     if factory.cut:
-        print(f"({factory.cut} factory values not read: too many or too long)")
+        print(_("({cut} factory values not read: too many or too long)").format(cut=factory.cut))
     sys.stdout.flush()
     return EXIT_OK
 
@@ -112,9 +117,12 @@ async def do_import(client: AriaClient, args: argparse.Namespace) -> int:
         if args.json:
             print_json({"accepted": False, "problems": list(plan.problems), "sent": 0})
         for problem in plan.problems[:50]:
-            print(f"rtmu config: {visible(problem)}", file=sys.stderr)
+            print(_("rtmu config: {visible}").format(visible=visible(problem)), file=sys.stderr)
         if len(plan.problems) > 50:
-            print(f"rtmu config: … and {len(plan.problems) - 50} more problems", file=sys.stderr)
+            print(
+                _("rtmu config: … and {value} more problems").format(value=len(plan.problems) - 50),
+                file=sys.stderr,
+            )
         return _refused("nothing was imported: the file does not fit this server's configuration")
     count = sum(len(v) for v in plan.changes.values())
     if not count:

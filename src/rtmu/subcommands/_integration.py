@@ -19,6 +19,7 @@ from pathlib import Path
 from typing import NamedTuple
 
 from .. import __version__
+from ..base.i18n import _
 from ..package_data import APP_ID, DESKTOP_DIR
 
 EXIT_CANNOT_WRITE = 1
@@ -58,13 +59,17 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
     g.add_argument(
         "--install-desktop",
         action="store_true",
-        help="put RTMU in the desktop's application menu and install its man page and shell completions "
-        "(under $XDG_DATA_HOME, ~/.local/share)",
+        help=_(
+            "put RTMU in the desktop's application menu and install its man page and shell completions "
+            "(under $XDG_DATA_HOME, ~/.local/share)"
+        ),
     )
-    g.add_argument("--uninstall-desktop", action="store_true", help="remove what --install-desktop installed")
-    g.add_argument("--man", action="store_true", help="print the man page (roff) and exit")
     g.add_argument(
-        "--completion", choices=SHELLS, metavar="SHELL", help="print a completion script for SHELL"
+        "--uninstall-desktop", action="store_true", help=_("remove what --install-desktop installed")
+    )
+    g.add_argument("--man", action="store_true", help=_("print the man page (roff) and exit"))
+    g.add_argument(
+        "--completion", choices=SHELLS, metavar="SHELL", help=_("print a completion script for SHELL")
     )
 
 
@@ -159,20 +164,24 @@ def install(parser: argparse.ArgumentParser, home: Path, command: list[str]) -> 
         for item in files(parser, command):
             target = home / item.relative
             if target.is_file() and target.read_bytes() == item.content:
-                print(f"up to date  {target}")
+                print(_("up to date  {target}").format(target=target))
                 continue
             target.parent.mkdir(parents=True, exist_ok=True)
             partial = target.with_name(target.name + ".rtmu-new")
             partial.write_bytes(item.content)
             partial.chmod(0o644)
             partial.replace(target)  # atomic: a reader never sees half a file
-            print(f"installed   {target}")
+            print(_("installed   {target}").format(target=target))
     except BrokenPipeError:
         raise  # our reader went away: not a reason to blame the data folder
     except OSError as exc:
-        print(f"rtmu: cannot install into {home}: {exc}", file=sys.stderr)
+        print(_("rtmu: cannot install into {home}: {exc}").format(home=home, exc=exc), file=sys.stderr)
         return EXIT_CANNOT_WRITE
-    print(f"RTMU is in the application menu; zsh users add {home / 'zsh/site-functions'} to fpath.")
+    print(
+        _("RTMU is in the application menu; zsh users add {value} to fpath.").format(
+            value=home / "zsh/site-functions"
+        )
+    )
     return 0
 
 
@@ -186,10 +195,10 @@ def uninstall(parser: argparse.ArgumentParser, home: Path) -> int:
         except FileNotFoundError:
             continue
         except OSError as exc:
-            print(f"rtmu: cannot remove {target}: {exc}", file=sys.stderr)
+            print(_("rtmu: cannot remove {target}: {exc}").format(target=target, exc=exc), file=sys.stderr)
             return EXIT_CANNOT_WRITE
         removed += 1
-        print(f"removed     {target}")
+        print(_("removed     {target}").format(target=target))
     if not removed:
-        print(f"nothing of RTMU's was installed in {home}")
+        print(_("nothing of RTMU's was installed in {home}").format(home=home))
     return 0

@@ -17,6 +17,7 @@ from dataclasses import dataclass
 from typing import TYPE_CHECKING, Any
 
 from ..base.exit_codes import EXIT_CANCELLED, EXIT_LOST, EXIT_OK, EXIT_REFUSED, EXIT_TIMEOUT, NETWORK
+from ..base.i18n import _
 from ..base.textsafe import visible
 from ..client.errors import ClientError, NotSupported
 from ..client.nav_status import NavReading, path_remaining, read_motion
@@ -264,7 +265,12 @@ async def _follow(
         stop_robot(client)
         await client.flush()
         _say(args, {"outcome": "timeout", **_pose_fields(watch)}, "no outcome in time: the robot was stopped")
-        print(f"rtmu {args.subcommand}: no outcome within {args.limit:g} s; stop sent", file=sys.stderr)
+        print(
+            _("rtmu {subcommand}: no outcome within {limit:g} s; stop sent").format(
+                subcommand=args.subcommand, limit=args.limit
+            ),
+            file=sys.stderr,
+        )
         return EXIT_TIMEOUT
     except asyncio.CancelledError:
         signum = interrupts.take()
@@ -291,7 +297,10 @@ def _ended(args: argparse.Namespace, watch: _Watch, r: NavReading, outcome: str,
         print_json(obj)
     elif code != EXIT_OK:
         why = r.sentence() or r.text or "it stopped before arriving"
-        print(f"rtmu {args.subcommand}: {visible(why)}", file=sys.stderr)
+        print(
+            _("rtmu {subcommand}: {visible}").format(subcommand=args.subcommand, visible=visible(why)),
+            file=sys.stderr,
+        )
     return code
 
 
@@ -330,7 +339,12 @@ async def localize(client: AriaClient, args: argparse.Namespace, payload: Payloa
                         line = f"localized (score {loc.score_fraction:.2f})" if good else "the robot is lost"
                         _say(args, obj, line)
                         if not good:
-                            print(f"rtmu {args.subcommand}: the robot is still lost", file=sys.stderr)
+                            print(
+                                _("rtmu {subcommand}: the robot is still lost").format(
+                                    subcommand=args.subcommand
+                                ),
+                                file=sys.stderr,
+                            )
                         return EXIT_OK if good else EXIT_NAV_LOST
                 watch.changed.clear()
                 with contextlib.suppress(TimeoutError):
@@ -338,7 +352,12 @@ async def localize(client: AriaClient, args: argparse.Namespace, payload: Payloa
                         await watch.changed.wait()
     except TimeoutError:
         _say(args, {"outcome": "timeout"}, "no answer in time")
-        print(f"rtmu {args.subcommand}: not localized within {args.limit:g} s", file=sys.stderr)
+        print(
+            _("rtmu {subcommand}: not localized within {limit:g} s").format(
+                subcommand=args.subcommand, limit=args.limit
+            ),
+            file=sys.stderr,
+        )
         return EXIT_TIMEOUT
     except asyncio.CancelledError:
         signum = interrupts.take()

@@ -7,6 +7,7 @@ import sys
 from typing import TYPE_CHECKING
 
 from ..base.exit_codes import EXIT_CONNECTION, EXIT_USAGE
+from ..base.i18n import _, ngettext
 from ._common import until_stop_signal
 
 if TYPE_CHECKING:
@@ -32,9 +33,12 @@ async def serve_central(cfg: SimConfig, robot_port: int, robots: int) -> int:
         await central.start()
     except OSError as exc:
         where = f"{cfg.host}:{cfg.port}/{robot_port}"
-        print(f"rtmu sim: cannot listen on {where}: {exc.strerror or exc}", file=sys.stderr)
+        print(
+            _("rtmu sim: cannot listen on {where}: {value}").format(where=where, value=exc.strerror or exc),
+            file=sys.stderr,
+        )
         return EXIT_CANNOT_LISTEN
-    print(
+    print(  # read by programs (the ports): in English in every language
         f"rtmu sim: ARIA central server: operators on {cfg.host}:{central.port}, robots switch to "
         f"{cfg.host}:{central.robot_port}",
         flush=True,
@@ -57,12 +61,19 @@ async def serve_central(cfg: SimConfig, robot_port: int, robots: int) -> int:
             await sim.start()
             sims.append(sim)
         if robots:
-            print(f"rtmu sim: {robots} simulated robot(s) switching to it: robot1…robot{robots}", flush=True)
+            print(
+                ngettext(
+                    "rtmu sim: {robots} simulated robot switching to it: robot1…robot{robots}",
+                    "rtmu sim: {robots} simulated robots switching to it: robot1…robot{robots}",
+                    robots,
+                ).format(robots=robots),
+                flush=True,
+            )
         code = await until_stop_signal()
-        print("rtmu sim: stopping (telling operators and robots SHUTDOWN)", flush=True)
+        print(_("rtmu sim: stopping (telling operators and robots SHUTDOWN)"), flush=True)
         return code
     except (OSError, MapFormatError, ValueError) as exc:
-        print(f"rtmu sim: cannot start the robots: {exc}", file=sys.stderr)
+        print(_("rtmu sim: cannot start the robots: {exc}").format(exc=exc), file=sys.stderr)
         return EXIT_BAD_INPUT
     finally:
         await central.stop()

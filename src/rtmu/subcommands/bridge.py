@@ -20,6 +20,7 @@ from typing import TYPE_CHECKING, Any
 from urllib.parse import quote
 
 from ..base.exit_codes import EXIT_CONNECTION, EXIT_OK, EXIT_USAGE
+from ..base.i18n import _
 from ..base.notices import Notice
 from ..base.textsafe import visible
 from ..client.errors import ClientError
@@ -45,13 +46,15 @@ def register(subparsers: Any) -> None:
 
     p = subparsers.add_parser(
         "bridge",
-        help="serve the robot live to Foxglove (WebSocket); --allow-drive lets its Teleop panel drive",
-        description="Connect, follow the robot as the window does and publish pose, TF, status, sonar, "
-        "laser, camera, map, link health, notices and stops on a Foxglove WebSocket server. Without "
-        "--allow-drive nothing a Foxglove client sends can move the robot.",
+        help=_("serve the robot live to Foxglove (WebSocket); --allow-drive lets its Teleop panel drive"),
+        description=_(
+            "Connect, follow the robot as the window does and publish pose, TF, status, sonar, "
+            "laser, camera, map, link health, notices and stops on a Foxglove WebSocket server. Without "
+            "--allow-drive nothing a Foxglove client sends can move the robot."
+        ),
     )
     add_connection_arguments(p)
-    p.add_argument("--foxglove", action="store_true", required=True, help="a Foxglove WebSocket server")
+    p.add_argument("--foxglove", action="store_true", required=True, help=_("a Foxglove WebSocket server"))
     p.add_argument("--ws-port", dest="ws_port", type=int, default=DEFAULT_PORT, metavar="PORT",
                    help=f"its port (default {DEFAULT_PORT}; 0: any free one, printed)")  # fmt: skip
     p.add_argument("--port", dest="ws_port", type=int, help=argparse.SUPPRESS)  # its old name
@@ -59,13 +62,15 @@ def register(subparsers: Any) -> None:
         "--bind",
         default="127.0.0.1",
         metavar="ADDR",
-        help="its address (default 127.0.0.1: this machine only; 0.0.0.0 lets the network in)",
+        help=_("its address (default 127.0.0.1: this machine only; 0.0.0.0 lets the network in)"),
     )
     p.add_argument(
         "--allow-drive",
         action="store_true",
-        help="let Twist messages from Foxglove clients (/cmd_vel, at 5 Hz or more) drive the robot, one "
-        "client at a time; every client must then open the URL printed at the start (it holds a token)",
+        help=_(
+            "let Twist messages from Foxglove clients (/cmd_vel, at 5 Hz or more) drive the robot, one "
+            "client at a time; every client must then open the URL printed at the start (it holds a token)"
+        ),
     )
     p.add_argument(
         "--allow-origin",
@@ -81,13 +86,17 @@ def register(subparsers: Any) -> None:
         action="append",
         default=[],
         metavar="NAME",
-        help="also accept requests for host NAME (repeatable; default: IP addresses, localhost and this "
-        "machine's names only)",
+        help=_(
+            "also accept requests for host NAME (repeatable; default: IP addresses, localhost and this "
+            "machine's names only)"
+        ),
     )
     p.add_argument("--throttle", type=positive_float, default=50.0, metavar="PCT",
-                   help="throttle of bridge drives, %% (default 50)")  # fmt: skip
+                   help=_("throttle of bridge drives, %% (default 50)"))  # fmt: skip
     add_fps_option(p, default=0.0, none_means="no pictures")
-    p.add_argument("--seconds", type=positive_float, default=None, metavar="S", help="stop after S seconds")
+    p.add_argument(
+        "--seconds", type=positive_float, default=None, metavar="S", help=_("stop after S seconds")
+    )
     p.set_defaults(handler=handle)
 
 
@@ -109,7 +118,7 @@ def handle(args: argparse.Namespace) -> int:
         return fail("bridge", "cancelled", EXIT_USAGE)
 
     def tell(notice: Notice) -> None:
-        print(f"rtmu bridge: {visible(notice.text)}", file=sys.stderr)
+        print(_("rtmu bridge: {visible}").format(visible=visible(notice.text)), file=sys.stderr)
 
     role = Role.OPERATOR if args.allow_drive else Role.OBSERVER  # read-only: it cannot command at all
     config = SessionConfig(connect_timeout=args.timeout, guardian=args.allow_drive, role=role)
@@ -131,7 +140,9 @@ def handle(args: argparse.Namespace) -> int:
         bridge.stopped(reason, sent)
         if reason.startswith("lease link"):  # a stream that paused is the operator's "release": not said
             print(
-                f"rtmu bridge: stopped the robot: {visible(reason.removeprefix('lease link: '))}",
+                _("rtmu bridge: stopped the robot: {visible}").format(
+                    visible=visible(reason.removeprefix("lease link: "))
+                ),
                 file=sys.stderr,
             )
 
@@ -173,15 +184,17 @@ def serve(
 def announce(bridge: Bridge) -> None:
     """The URL to open, printed once (with a drive bridge's token: it is shown nowhere else)."""
     if bridge.drive is None:
-        print(f"rtmu bridge: {bridge.url} (no drive)", file=sys.stderr, flush=True)
+        print(_("rtmu bridge: {url} (no drive)").format(url=bridge.url), file=sys.stderr, flush=True)
         return
     print(
-        f"rtmu bridge: {bridge.url} (drive allowed from /cmd_vel, one client at a time; the URL holds this "
-        "run's token: share it only with who may drive)",
+        _(
+            "rtmu bridge: {url} (drive allowed from /cmd_vel, one client at a time; the URL holds "
+            "this run's token: share it only with who may drive)"
+        ).format(url=bridge.url),
         file=sys.stderr,
     )
     app = APP + quote(bridge.url, safe="")
-    print(f"rtmu bridge: in Foxglove's web app: {app}", file=sys.stderr, flush=True)
+    print(_("rtmu bridge: in Foxglove's web app: {app}").format(app=app), file=sys.stderr, flush=True)
 
 
 def warn_exposure(bind: str, allow_drive: bool) -> None:
@@ -192,16 +205,20 @@ def warn_exposure(bind: str, allow_drive: bool) -> None:
         return
     if allow_drive:
         print(
-            f"rtmu bridge: WARNING: --allow-drive on {visible(bind)}, an address other hosts can reach: "
-            "anyone with the printed URL (its token) on the network can drive the robot. Bind 127.0.0.1 and "
-            "tunnel (ssh -L) unless the network is yours alone.",
+            _(
+                "rtmu bridge: WARNING: --allow-drive on {visible}, an address other hosts can reach: "
+                "anyone with the printed URL (its token) on the network can drive the robot. Bind "
+                "127.0.0.1 and tunnel (ssh -L) unless the network is yours alone."
+            ).format(visible=visible(bind)),
             file=sys.stderr,
             flush=True,
         )
     else:
         print(
-            f"rtmu bridge: serving on {visible(bind)}: other hosts on the network can watch the robot "
-            "(they cannot drive it)",
+            _(
+                "rtmu bridge: serving on {visible}: other hosts on the network can watch the robot "
+                "(they cannot drive it)"
+            ).format(visible=visible(bind)),
             file=sys.stderr,
             flush=True,
         )

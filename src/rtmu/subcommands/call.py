@@ -26,6 +26,7 @@ import time
 from typing import TYPE_CHECKING, Any
 
 from ..base.exit_codes import EXIT_OK, EXIT_TIMEOUT, EXIT_USAGE, NETWORK
+from ..base.i18n import _
 from ..base.textsafe import visible
 from ..client.console_layout import KINDS, ArgumentError, encode_arguments
 from ..client.roles import Role
@@ -43,19 +44,24 @@ FOLLOW_CHECK = 0.5
 def register(subparsers: Any) -> None:
     p = subparsers.add_parser(
         "call",
-        help="call any data the server lists (a console): once, or at an interval; --list shows them all",
-        description="Send data NAME once with ARGs (typed as its argument description says, or as "
-        "--type names) and print each reply as hex, fields and RTMU's own type where it has one. "
-        "--every MS follows it (-1: broadcasts only). A data that changes something needs --yes (without "
-        "it this command is an observer: it cannot send a motion request); ratioDrive is never sent. A data "
-        "this user's list does not have, arguments that do not fit, a call that needs --yes, or one the "
-        "console refuses are usage errors (nothing is sent); no reply within --timeout (none at all while "
-        "following), a reply that stalls, or a command the server does not confirm taking is a timeout.",
+        help=_("call any data the server lists (a console): once, or at an interval; --list shows them all"),
+        description=_(
+            "Send data NAME once with ARGs (typed as its argument description says, or as "
+            "--type names) and print each reply as hex, fields and RTMU's own type where it has one. "
+            "--every MS follows it (-1: broadcasts only). A data that changes something needs --yes (without "
+            "it this command is an observer: it cannot send a motion request); ratioDrive is never "
+            "sent. A data "
+            "this user's list does not have, arguments that do not fit, a call that needs --yes, or "
+            "one the "
+            "console refuses are usage errors (nothing is sent); no reply within --timeout (none at "
+            "all while "
+            "following), a reply that stalls, or a command the server does not confirm taking is a timeout."
+        ),
     )
     _positionals_anywhere(p)
     add_connection_arguments(p)
-    p.add_argument("name", metavar="NAME", nargs="?", help="the data's name, as --list prints it")
-    p.add_argument("arguments", metavar="ARG", nargs="*", help="its arguments, in order")
+    p.add_argument("name", metavar="NAME", nargs="?", help=_("the data's name, as --list prints it"))
+    p.add_argument("arguments", metavar="ARG", nargs="*", help=_("its arguments, in order"))
     p.add_argument(
         "--type",
         dest="types",
@@ -64,18 +70,25 @@ def register(subparsers: Any) -> None:
         help=f"the type of each ARG, in order ({', '.join(KINDS)}); repeat or separate with commas",
     )
     p.add_argument(
-        "--every", type=int, metavar="MS", help="follow the data: a reply every MS ms (-1: broadcasts only)"
+        "--every",
+        type=int,
+        metavar="MS",
+        help=_("follow the data: a reply every MS ms (-1: broadcasts only)"),
     )
-    p.add_argument("--seconds", type=positive_float, metavar="S", help="with --every: stop after S seconds")
-    p.add_argument("--json", action="store_true", help="one JSON object per reply (or one array for --list)")
-    p.add_argument("--yes", action="store_true", help="confirm a call that changes something on the robot")
+    p.add_argument(
+        "--seconds", type=positive_float, metavar="S", help=_("with --every: stop after S seconds")
+    )
+    p.add_argument(
+        "--json", action="store_true", help=_("one JSON object per reply (or one array for --list)")
+    )
+    p.add_argument("--yes", action="store_true", help=_("confirm a call that changes something on the robot"))
     p.add_argument(
         "--list",
         dest="list_filter",
         nargs="?",
         const="",
         metavar="FILTER",
-        help="list the server's data (those whose name, description or group contains FILTER)",
+        help=_("list the server's data (those whose name, description or group contains FILTER)"),
     )
     p.set_defaults(handler=handle)
 
@@ -109,7 +122,7 @@ _NUMBER = re.compile(r"-\d+(\.\d*)?|-\.\d+")
 
 
 def usage(message: str) -> int:
-    print(f"rtmu call: {visible(message)}", file=sys.stderr)
+    print(_("rtmu call: {visible}").format(visible=visible(message)), file=sys.stderr)
     return EXIT_USAGE
 
 
@@ -172,7 +185,10 @@ async def follow(client: AriaClient, entry: ConsoleEntry, payload: bytes, args: 
     if client.closed_error is not None:  # the connection ended while following: exit 3, with why
         raise client.closed_error
     if not replies:
-        print(f"rtmu call: {visible(entry.name)}: no reply while following it", file=sys.stderr)
+        print(
+            _("rtmu call: {visible}: no reply while following it").format(visible=visible(entry.name)),
+            file=sys.stderr,
+        )
     return EXIT_OK if replies else EXIT_TIMEOUT
 
 
@@ -193,7 +209,7 @@ def print_list(entries: list[ConsoleEntry], as_json: bool) -> int:
     for e in entries:
         for line in entry_lines(e):
             print(line)
-    print(f"{len(entries)} data", flush=True)
+    print(_("{len} data").format(len=len(entries)), flush=True)
     return EXIT_OK
 
 

@@ -6,6 +6,7 @@ import argparse
 from typing import TYPE_CHECKING, Any
 
 from ..base.exit_codes import EXIT_OK
+from ..base.i18n import _
 from ..base.textsafe import visible
 from ..client.roles import Role
 from ._common import add_connection_arguments, print_json, run_with_client
@@ -17,13 +18,15 @@ if TYPE_CHECKING:
 def register(subparsers: Any) -> None:
     p = subparsers.add_parser(
         "commands",
-        help="list the server's own commands (listCommands, listStringCommands) this user may run",
-        description="Print each command the server lists and this user may run, with its description; "
-        "ARG marks a command that takes one text argument (rtmu run NAME ARG). Exit 4 when the server "
-        "lists none.",
+        help=_("list the server's own commands (listCommands, listStringCommands) this user may run"),
+        description=_(
+            "Print each command the server lists and this user may run, with its description; "
+            "ARG marks a command that takes one text argument (rtmu run NAME ARG). Exit 4 when the server "
+            "lists none."
+        ),
     )
     add_connection_arguments(p)
-    p.add_argument("--json", action="store_true", help="one JSON array of {name, description, argument}")
+    p.add_argument("--json", action="store_true", help=_("one JSON array of {name, description, argument}"))
     p.set_defaults(handler=handle)
 
 

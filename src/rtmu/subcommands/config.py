@@ -18,6 +18,7 @@ from pathlib import Path
 from typing import TYPE_CHECKING, Any
 
 from ..base.exit_codes import EXIT_FOREIGN_CONFIG, EXIT_OK, EXIT_REFUSED, EXIT_USAGE, NETWORK
+from ..base.i18n import _, ngettext
 from ..base.textsafe import visible
 from ..client.roles import Role
 from ..protocol.payloads.config import ConfigParam, ParamType, Priority
@@ -60,22 +61,26 @@ EXITS = (*NETWORK, EXIT_REFUSED, EXIT_FOREIGN_CONFIG)
 def register(subparsers: Any) -> None:
     p = subparsers.add_parser(
         "config",
-        help="show or change the server's configuration (ArConfig: getConfigBySections, setConfig)",
+        help=_("show or change the server's configuration (ArConfig: getConfigBySections, setConfig)"),
         description=(
-            "Print the server's configuration: sections, then parameters with value, type, limits "
-            "and priority. One action at most: --set SECTION/PARAM=VALUE (repeatable) changes values in "
-            "one setConfig; --defaults lists what differs from the factory values (getConfigDefaults); "
-            "--reset SECTION/PARAM or --reset SECTION puts factory values back; --export FILE writes "
-            "every value to a TOML file (an existing file only with --force); --import FILE checks the "
-            "whole file against the server's parameters and sends it in one setConfig, or nothing; "
-            "--reload makes the server read its configuration file again. A --reset target the server "
-            "does not have, or a file that exists or is not an export, is a usage error; an --import "
-            "that does not fit the server's parameters is refused and nothing is sent. An Omron LD "
-            "robot's configuration (getConfigValues) is named, not shown: rtmu call reads it raw."
+            _(
+                "Print the server's configuration: sections, then parameters with value, type, limits "
+                "and priority. One action at most: --set SECTION/PARAM=VALUE (repeatable) changes values in "
+                "one setConfig; --defaults lists what differs from the factory values (getConfigDefaults); "
+                "--reset SECTION/PARAM or --reset SECTION puts factory values back; --export FILE writes "
+                "every value to a TOML file (an existing file only with --force); --import FILE checks the "
+                "whole file against the server's parameters and sends it in one setConfig, or nothing; "
+                "--reload makes the server read its configuration file again. A --reset target the server "
+                "does not have, or a file that exists or is not an export, is a usage error; an --import "
+                "that does not fit the server's parameters is refused and nothing is sent. An Omron LD "
+                "robot's configuration (getConfigValues) is named, not shown: rtmu call reads it raw."
+            )
         ),
     )
     add_connection_arguments(p)
-    p.add_argument("--json", action="store_true", help="one JSON object (the configuration, or the answer)")
+    p.add_argument(
+        "--json", action="store_true", help=_("one JSON object (the configuration, or the answer)")
+    )
     actions = p.add_mutually_exclusive_group()
     actions.add_argument(
         "--set",
@@ -83,22 +88,30 @@ def register(subparsers: Any) -> None:
         nargs="+",
         action=Assignment,
         metavar="SECTION/PARAM=VALUE",
-        help="change these values (one setConfig)",
+        help=_("change these values (one setConfig)"),
     )
     actions.add_argument(
-        "--defaults", action="store_true", help="list the parameters that differ from their factory values"
+        "--defaults", action="store_true", help=_("list the parameters that differ from their factory values")
     )
     actions.add_argument(
         "--reset",
         metavar="SECTION/PARAM",
-        help="put one parameter, or a whole SECTION, back to factory values",
+        help=_("put one parameter, or a whole SECTION, back to factory values"),
     )
-    actions.add_argument("--export", type=Path, metavar="FILE", help="write the whole configuration to FILE")
     actions.add_argument(
-        "--import", dest="import_file", type=Path, metavar="FILE", help="set every value of an exported FILE"
+        "--export", type=Path, metavar="FILE", help=_("write the whole configuration to FILE")
     )
-    actions.add_argument("--reload", action="store_true", help="make the server read its configuration again")
-    p.add_argument("--force", action="store_true", help="with --export: replace FILE if it exists")
+    actions.add_argument(
+        "--import",
+        dest="import_file",
+        type=Path,
+        metavar="FILE",
+        help=_("set every value of an exported FILE"),
+    )
+    actions.add_argument(
+        "--reload", action="store_true", help=_("make the server read its configuration again")
+    )
+    p.add_argument("--force", action="store_true", help=_("with --export: replace FILE if it exists"))
     p.set_defaults(handler=handle)
 
 
@@ -107,12 +120,17 @@ def handle(args: argparse.Namespace) -> int:
 
     assignments: list[tuple[str, str, str]] = args.assignments or []
     if len(assignments) > MAX_ASSIGNMENTS:
-        print(f"rtmu config: at most {MAX_ASSIGNMENTS} values at once", file=sys.stderr)
+        print(
+            _("rtmu config: at most {MAX_ASSIGNMENTS} values at once").format(
+                MAX_ASSIGNMENTS=MAX_ASSIGNMENTS
+            ),
+            file=sys.stderr,
+        )
         return EXIT_USAGE
 
     problem = _config_care.check_usage(args)
     if problem:
-        print(f"rtmu config: {problem}", file=sys.stderr)
+        print(_("rtmu config: {problem}").format(problem=problem), file=sys.stderr)
         return EXIT_USAGE
 
     async def body(client: AriaClient) -> int:
@@ -146,9 +164,17 @@ async def _set(client: AriaClient, assignments: list[tuple[str, str, str]], args
     if args.json:
         print_json({"accepted": answer.accepted, "error": answer.error})
     elif answer.accepted:
-        print(f"accepted: {len(assignments)} value{'s' if len(assignments) != 1 else ''}", flush=True)
+        print(
+            ngettext("accepted: {count} value", "accepted: {count} values", len(assignments)).format(
+                count=len(assignments)
+            ),
+            flush=True,
+        )
     if not answer.accepted:
-        print(f"rtmu config: the server refused: {visible(answer.error)}", file=sys.stderr)
+        print(
+            _("rtmu config: the server refused: {visible}").format(visible=visible(answer.error)),
+            file=sys.stderr,
+        )
         return EXIT_REFUSED
     return EXIT_OK
 
@@ -227,5 +253,5 @@ def print_text(config: ServerConfig) -> None:
             if p.description:
                 print(f"      {visible(p.description)}")
     if config.cut:
-        print(f"({config.cut} more parameters not shown: the configuration is too large)")
+        print(_("({cut} more parameters not shown: the configuration is too large)").format(cut=config.cut))
     sys.stdout.flush()

@@ -19,6 +19,7 @@ from collections.abc import Iterable
 from typing import TYPE_CHECKING, Any, TextIO
 
 from ..base.exit_codes import EXIT_BAD_FILE, EXIT_OK, EXIT_SIGPIPE, EXIT_USAGE
+from ..base.i18n import _
 from ..base.textsafe import json_safe, visible
 from ..capture import CaptureError, CaptureSource, UnreadableInput, open_capture
 from ..capture.conversation import (
@@ -103,38 +104,38 @@ def register(subparsers: argparse._SubParsersAction) -> None:
 
     parser = subparsers.add_parser(
         "decode",
-        help="decode ArNetworking traffic from a pcap/pcapng capture, a hex dump or raw bytes",
+        help=_("decode ArNetworking traffic from a pcap/pcapng capture, a hex dump or raw bytes"),
         description=_DESCRIPTION,
         epilog=_EPILOG,
         formatter_class=argparse.RawDescriptionHelpFormatter,
     )
     parser.add_argument(
-        "file", metavar="FILE", help="capture (pcap, pcapng), recording (.mcap), hex dump or raw bytes"
+        "file", metavar="FILE", help=_("capture (pcap, pcapng), recording (.mcap), hex dump or raw bytes")
     )
-    parser.add_argument("--format", choices=FORMATS, default="auto", help="input format (default: detect)")
+    parser.add_argument("--format", choices=FORMATS, default="auto", help=_("input format (default: detect)"))
     parser.add_argument(
         "--direction",
         choices=DIRECTIONS,
         default="auto",
-        help="hex/raw input: who sent the bytes (default: guess from the packets, else s2c)",
+        help=_("hex/raw input: who sent the bytes (default: guess from the packets, else s2c)"),
     )
-    parser.add_argument("--json", action="store_true", help="one JSON object per packet per line")
-    parser.add_argument("--all", action="store_true", help="print every packet and every field in full")
+    parser.add_argument("--json", action="store_true", help=_("one JSON object per packet per line"))
+    parser.add_argument("--all", action="store_true", help=_("print every packet and every field in full"))
     parser.add_argument(
-        "--conn", type=int, action="append", metavar="N", help="only connection N (repeatable)"
+        "--conn", type=int, action="append", metavar="N", help=_("only connection N (repeatable)")
     )
     parser.add_argument(
         "--name",
         action="append",
         metavar="NAME",
-        help="only packets with this name or command number (repeatable)",
+        help=_("only packets with this name or command number (repeatable)"),
     )
-    parser.add_argument("--payload", action="store_true", help="add each payload in hex")
+    parser.add_argument("--payload", action="store_true", help=_("add each payload in hex"))
     parser.add_argument(
         "--summary",
         action=argparse.BooleanOptionalAction,
         default=None,
-        help="per-connection summary at the end (default: on for text, off for --json)",
+        help=_("per-connection summary at the end (default: on for text, off for --json)"),
     )
     parser.set_defaults(handler=run)
 
@@ -144,10 +145,10 @@ def run(args: argparse.Namespace) -> int:
     try:
         source = open_capture(args.file, args.format, args.direction)
     except UnreadableInput as exc:
-        print(f"rtmu decode: {visible(exc)}", file=sys.stderr)
+        print(_("rtmu decode: {visible}").format(visible=visible(exc)), file=sys.stderr)
         return EXIT_USAGE
     except CaptureError as exc:
-        print(f"rtmu decode: {visible(exc)}", file=sys.stderr)
+        print(_("rtmu decode: {visible}").format(visible=visible(exc)), file=sys.stderr)
         return EXIT_BAD_FILE
     decoder = CaptureDecoder(report_trailing_drops=args.json)
     summary = args.summary if args.summary is not None else not args.json
@@ -165,17 +166,17 @@ def run(args: argparse.Namespace) -> int:
                 _write_text_summary(out, decoder, source, full=args.all)
         out.flush()
     except UnreadableInput as exc:
-        print(f"rtmu decode: {visible(exc)}", file=sys.stderr)
+        print(_("rtmu decode: {visible}").format(visible=visible(exc)), file=sys.stderr)
         return EXIT_USAGE
     except CaptureError as exc:
-        print(f"rtmu decode: {visible(exc)}", file=sys.stderr)
+        print(_("rtmu decode: {visible}").format(visible=visible(exc)), file=sys.stderr)
         return EXIT_BAD_FILE
     except BrokenPipeError:  # `rtmu decode x | head`: the reader has seen enough (141, as every command)
         devnull = os.open(os.devnull, os.O_WRONLY)
         os.dup2(devnull, sys.stdout.fileno())
         return EXIT_SIGPIPE
     for warning in source.stats.warnings:
-        print(f"rtmu decode: warning: {visible(warning)}", file=sys.stderr)
+        print(_("rtmu decode: warning: {visible}").format(visible=visible(warning)), file=sys.stderr)
     return EXIT_OK
 
 

@@ -5,6 +5,7 @@ from __future__ import annotations
 import argparse
 from typing import TYPE_CHECKING, Any
 
+from ..base.i18n import _
 from ..client.roles import Role
 from ..protocol.payloads.navigation import Dock
 from ._common import add_connection_arguments, run_with_client
@@ -19,9 +20,11 @@ EXITS = NAVIGATION_EXITS
 def register(subparsers: Any) -> None:
     p = subparsers.add_parser(
         "dock",
-        help="drive to the charger and dock (dock), and wait until docked",
-        description="Send dock: the server drives to its dock and says 'Docked' (LD robots: dockInfo says "
-        "Docked). A drive command undocks again. Ctrl-C, SIGTERM and SIGHUP stop the robot.",
+        help=_("drive to the charger and dock (dock), and wait until docked"),
+        description=_(
+            "Send dock: the server drives to its dock and says 'Docked' (LD robots: dockInfo says "
+            "Docked). A drive command undocks again. Ctrl-C, SIGTERM and SIGHUP stop the robot."
+        ),
     )
     add_connection_arguments(p)
     add_wait_arguments(p)

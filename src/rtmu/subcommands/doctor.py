@@ -33,6 +33,7 @@ from ..base.exit_codes import (
     EXIT_USAGE,
     WHY_ASKED,
 )
+from ..base.i18n import _
 from ..base.link_timing import STATUS_CEILING
 from ..base.textsafe import visible
 from ._common import (
@@ -527,21 +528,25 @@ class Doctor:
 def register(subparsers: Any) -> None:
     p = subparsers.add_parser(
         "doctor",
-        help="find out why a robot does not connect, step by step",
-        description="Walk the whole way to a robot and say, step by step, what worked: name resolution, "
-        "TCP connect, the server's introduction (its version tag and protocol string), the login, the "
-        "data list (and which RTMU features the server offers), UDP, the first status. For the first "
-        "step that fails it says in plain words what went wrong and what to do next (the words the "
-        "window uses), and stops there; the exit code names the step. UDP never fails it: RTMU uses TCP. "
-        "Connected, it asks last why the robot would not move (rtmu why's answer); that step fails with "
-        "the cause's own code.",
+        help=_("find out why a robot does not connect, step by step"),
+        description=_(
+            "Walk the whole way to a robot and say, step by step, what worked: name resolution, "
+            "TCP connect, the server's introduction (its version tag and protocol string), the login, the "
+            "data list (and which RTMU features the server offers), UDP, the first status. For the first "
+            "step that fails it says in plain words what went wrong and what to do next (the words the "
+            "window uses), and stops there; the exit code names the step. UDP never fails it: RTMU uses TCP. "
+            "Connected, it asks last why the robot would not move (rtmu why's answer); that step fails with "
+            "the cause's own code."
+        ),
     )
     add_connection_arguments(p)
     p.add_argument(
         "--json",
         action="store_true",
-        help='one JSON object: {"server", "ok", "failed_step", "exit_code", "features", "steps": '
-        '[{"step", "title", "result", "summary", "advice", ...}]}',
+        help=_(
+            'one JSON object: {"server", "ok", "failed_step", "exit_code", "features", "steps": '
+            '[{"step", "title", "result", "summary", "advice", ...}]}'
+        ),
     )
     p.add_argument(
         "--link-seconds",
@@ -560,13 +565,13 @@ def handle(args: argparse.Namespace) -> int:
     try:
         password = read_password(args)
     except UsageError as exc:
-        print(f"rtmu doctor: {visible(exc)}", file=sys.stderr)
+        print(_("rtmu doctor: {visible}").format(visible=visible(exc)), file=sys.stderr)
         return EXIT_USAGE
     doctor = Doctor(host, port, args.user, password, args.protocol, args.timeout, max(0.0, args.link_seconds))
     try:
         code = run_interruptibly(doctor.run)
     except Interrupted as exc:
-        print(f"rtmu doctor: {exc}", file=sys.stderr)
+        print(_("rtmu doctor: {exc}").format(exc=exc), file=sys.stderr)
         return exc.exit_code
     failed = next((s for s in doctor.steps if s.result == "fail"), None)
     lines = report_lines(doctor.steps, host, port, args.user, failed, code)

@@ -14,6 +14,7 @@ import sys
 from typing import TYPE_CHECKING, Any
 
 from ..base.exit_codes import EXIT_OK
+from ..base.i18n import _
 from ..base.textsafe import visible
 from ..client.errors import ClientError
 from ..client.roles import Role
@@ -31,14 +32,19 @@ not once for each drawing."""
 def register(subparsers: Any) -> None:
     p = subparsers.add_parser(
         "drawings",
-        help="list the server's drawings (getDrawingList) with one current sample of each",
+        help=_("list the server's drawings (getDrawingList) with one current sample of each"),
         description=(
-            "Print each drawing the server lists (sonar, lasers, paths …): shape, colour, size, layer, "
-            "refresh period, visibility and the points one request returns now (exit 4 when it lists none)."
+            _(
+                "Print each drawing the server lists (sonar, lasers, paths …): shape, colour, size, layer, "
+                "refresh period, visibility and the points one request returns now (exit 4 when it "
+                "lists none)."
+            )
         ),
     )
     add_connection_arguments(p)
-    p.add_argument("--json", action="store_true", help="one JSON array: every field and the sampled points")
+    p.add_argument(
+        "--json", action="store_true", help=_("one JSON array: every field and the sampled points")
+    )
     p.set_defaults(handler=handle)
 
 
@@ -54,11 +60,16 @@ def handle(args: argparse.Namespace) -> int:
             batch = listed.drawings[start : start + SAMPLES_AT_ONCE]
             rows += await asyncio.gather(*(_sample(client, d, args.timeout) for d in batch))
         if listed.dropped:
-            print(f"rtmu drawings: {listed.dropped_text()} (not sampled, not shown)", file=sys.stderr)
+            print(
+                _("rtmu drawings: {dropped_text} (not sampled, not shown)").format(
+                    dropped_text=listed.dropped_text()
+                ),
+                file=sys.stderr,
+            )
         if args.json:
             print_json(rows)
         elif not rows:
-            print("the server lists no drawings", flush=True)
+            print(_("the server lists no drawings"), flush=True)
         else:
             for row in rows:
                 print(_line(row), flush=True)

@@ -31,6 +31,7 @@ from collections.abc import Callable
 from typing import TYPE_CHECKING, Any
 
 from ..base.exit_codes import EXIT_OK, EXIT_SIGQUIT, EXIT_SIGTSTP, EXIT_USAGE, NETWORK, WHY_DRIVE
+from ..base.i18n import _
 from ..base.textsafe import visible
 from ._common import (
     Interrupted,
@@ -67,23 +68,25 @@ EXITS = (*NETWORK, EXIT_SIGQUIT, EXIT_SIGTSTP, *WHY_DRIVE)
 def register(subparsers: Any) -> None:
     p = subparsers.add_parser(
         "drive",
-        help="drive for some seconds, then stop",
-        description="Drive with ratioDrive for S seconds, then stop; print the pose before and after. "
-        "A drive that did not move the robot says why (as rtmu why does) and exits with the cause's code.",
+        help=_("drive for some seconds, then stop"),
+        description=_(
+            "Drive with ratioDrive for S seconds, then stop; print the pose before and after. "
+            "A drive that did not move the robot says why (as rtmu why does) and exits with the cause's code."
+        ),
     )
     add_connection_arguments(p)
     p.add_argument(
-        "--trans", type=float, default=0.0, metavar="PCT", help="−100…100 %% of max speed (+ forward)"
+        "--trans", type=float, default=0.0, metavar="PCT", help=_("−100…100 %% of max speed (+ forward)")
     )
     p.add_argument(
-        "--rot", type=float, default=0.0, metavar="PCT", help="−100…100 %% of max rotation (+ left)"
+        "--rot", type=float, default=0.0, metavar="PCT", help=_("−100…100 %% of max rotation (+ left)")
     )
-    p.add_argument("--throttle", type=float, default=50.0, metavar="PCT", help="0…100 %% (default 50)")
+    p.add_argument("--throttle", type=float, default=50.0, metavar="PCT", help=_("0…100 %% (default 50)"))
     p.add_argument("--seconds", type=float, required=True, metavar="S", help=f"0…{MAX_SECONDS:g}")
     p.add_argument(
         "--json",
         action="store_true",
-        help='one object {"before", "after", "seconds"}; asked to move, also "moved" (and "why" if not)',
+        help=_('one object {"before", "after", "seconds"}; asked to move, also "moved" (and "why" if not)'),
     )
     p.set_defaults(handler=handle)
 
@@ -121,13 +124,24 @@ def handle(args: argparse.Namespace) -> int:
             warning = diagnose(Facts(offers=frozenset(e.name for e in client.datalist), user=client.user))
             for reason in warning.reasons:
                 if reason.loud:
-                    print(f"rtmu drive: WARNING: {visible(reason.sentence())}", file=sys.stderr, flush=True)
+                    print(
+                        _("rtmu drive: WARNING: {visible}").format(visible=visible(reason.sentence())),
+                        file=sys.stderr,
+                        flush=True,
+                    )
         ratios = RatioDrive(args.trans, args.rot, args.throttle)
         if ratios.in_dead_zone:  # ARIA would take it and not move: say so rather than exit 0 silently
             print(
-                f"rtmu drive: warning: --trans {args.trans:g} --rot {args.rot:g} is inside ARIA's dead "
-                f"zone (translation up to ±{RATIO_TRANS_DEAD_ZONE:g} %, rotation under "
-                f"±{RATIO_ROT_DEAD_ZONE:g} %): the robot will not move",
+                _(
+                    "rtmu drive: warning: --trans {trans:g} --rot {rot:g} is inside ARIA's dead zone "
+                    "(translation up to ±{RATIO_TRANS_DEAD_ZONE:g} %, rotation under "
+                    "±{RATIO_ROT_DEAD_ZONE:g} %): the robot will not move"
+                ).format(
+                    trans=args.trans,
+                    rot=args.rot,
+                    RATIO_TRANS_DEAD_ZONE=RATIO_TRANS_DEAD_ZONE,
+                    RATIO_ROT_DEAD_ZONE=RATIO_ROT_DEAD_ZONE,
+                ),
                 file=sys.stderr,
                 flush=True,
             )
@@ -136,7 +150,7 @@ def handle(args: argparse.Namespace) -> int:
         guard.start()  # before the first status fetch, so the link is watched from the start
         before = await fetch_status(client, args.timeout)
         if not args.json:
-            print(f"before: {status_line(before)}", flush=True)
+            print(_("before: {status_line}").format(status_line=status_line(before)), flush=True)
         interrupts = current_interrupts()
 
         async def before_suspending() -> None:
@@ -207,7 +221,7 @@ def handle(args: argparse.Namespace) -> int:
     try:
         check(args)
     except UsageError as exc:
-        print(f"rtmu drive: {exc}", file=sys.stderr)
+        print(_("rtmu drive: {exc}").format(exc=exc), file=sys.stderr)
         return EXIT_USAGE
     return run_with_client("drive", args, body, role=Role.OPERATOR)
 
@@ -222,8 +236,10 @@ async def start_guardian(args: argparse.Namespace) -> GuardianHandle | None:
         return await start_ready(Hello(host, port, args.user, current_password(), args.timeout), args.timeout)
     except GuardianUnavailable as exc:
         print(
-            f"rtmu drive: warning: guardian not available ({visible(exc)}); if this process is killed "
-            "or frozen, only the server's 2 s watchdog stops the robot",
+            _(
+                "rtmu drive: warning: guardian not available ({visible}); if this process is killed "
+                "or frozen, only the server's 2 s watchdog stops the robot"
+            ).format(visible=visible(exc)),
             file=sys.stderr,
             flush=True,
         )
@@ -308,9 +324,9 @@ def report(
             obj["why"] = why.as_json()
         print_json(obj)
     elif after is not None:
-        print(f"after:  {status_line(after)}", flush=True)
+        print(_("after:  {status_line}").format(status_line=status_line(after)), flush=True)
     else:
-        print("after:  unknown (no status in time)", flush=True)
+        print(_("after:  unknown (no status in time)"), flush=True)
 
 
 async def drive(

@@ -17,6 +17,7 @@ from pathlib import Path
 from typing import TYPE_CHECKING, Any
 
 from ..base.exit_codes import EXIT_OK, EXIT_REFUSED, EXIT_USAGE, NETWORK
+from ..base.i18n import _
 from ..base.textsafe import visible
 from ..client.roles import Role
 from ..protocol.payloads.files import DirEntry
@@ -39,7 +40,7 @@ DESCRIPTION = (
 def register(subparsers: Any) -> None:
     p = subparsers.add_parser(
         "files",
-        help="list, download, upload and delete files on the robot (getDirListing, getFile, putFile …)",
+        help=_("list, download, upload and delete files on the robot (getDirListing, getFile, putFile …)"),
         description=DESCRIPTION,
     )
     add_connection_arguments(p)
@@ -47,13 +48,13 @@ def register(subparsers: Any) -> None:
     ls = action_parser(
         actions, "ls", "list a folder", "List a folder on the robot (default: its shared folder)."
     )
-    ls.add_argument("folder", nargs="?", default="", metavar="DIR", help="folder on the robot")
+    ls.add_argument("folder", nargs="?", default="", metavar="DIR", help=_("folder on the robot"))
     get = action_parser(
         actions, "get", "download a file", "Download REMOTE into LOCAL (default: its name, here)."
     )
-    get.add_argument("remote", metavar="REMOTE", help="file on the robot")
-    get.add_argument("--out", type=Path, metavar="LOCAL", help="file (or existing folder) to write")
-    get.add_argument("--force", action="store_true", help="replace LOCAL if it exists")
+    get.add_argument("remote", metavar="REMOTE", help=_("file on the robot"))
+    get.add_argument("--out", type=Path, metavar="LOCAL", help=_("file (or existing folder) to write"))
+    get.add_argument("--force", action="store_true", help=_("replace LOCAL if it exists"))
     put = action_parser(
         actions,
         "put",
@@ -61,15 +62,15 @@ def register(subparsers: Any) -> None:
         "Upload LOCAL as REMOTE (default: its own name, in the robot's default folder if it names one; "
         "a REMOTE ending in / is a folder).",
     )
-    put.add_argument("local", type=Path, metavar="LOCAL", help="file to upload")
-    put.add_argument("remote", nargs="?", default=None, metavar="REMOTE", help="where on the robot")
-    put.add_argument("--force", action="store_true", help="replace REMOTE if the robot has it")
+    put.add_argument("local", type=Path, metavar="LOCAL", help=_("file to upload"))
+    put.add_argument("remote", nargs="?", default=None, metavar="REMOTE", help=_("where on the robot"))
+    put.add_argument("--force", action="store_true", help=_("replace REMOTE if the robot has it"))
     put.add_argument(
-        "--interleaved", action="store_true", help="wait for the robot's answer to every packet (slower)"
+        "--interleaved", action="store_true", help=_("wait for the robot's answer to every packet (slower)")
     )
     rm = action_parser(actions, "rm", "delete a file", "Delete one file on the robot (asks first).")
-    rm.add_argument("remote", metavar="REMOTE", help="file on the robot")
-    rm.add_argument("--yes", action="store_true", help="do not ask")
+    rm.add_argument("remote", metavar="REMOTE", help=_("file on the robot"))
+    rm.add_argument("--yes", action="store_true", help=_("do not ask"))
     p.set_defaults(handler=handle)
 
 
@@ -143,7 +144,12 @@ def _get(args: argparse.Namespace) -> Any:
         note = ""
         if done.listed_size is not None and done.listed_size != done.size:
             note = f" (the robot listed {done.listed_size} bytes)"
-        print(f"wrote {local}: {done.size} bytes in {done.seconds:.2f} s{note}", file=sys.stderr)
+        print(
+            _("wrote {local}: {size} bytes in {seconds:.2f} s{note}").format(
+                local=local, size=done.size, seconds=done.seconds, note=note
+            ),
+            file=sys.stderr,
+        )
         return EXIT_OK
 
     return body
@@ -191,7 +197,9 @@ def _put(args: argparse.Namespace) -> Any:
                 {"local": str(local), "remote": target, "bytes": done.size, "seconds": round(done.seconds, 3)}
             )
         print(
-            f"uploaded {local} as {visible(target)}: {done.size} bytes in {done.seconds:.2f} s",
+            _("uploaded {local} as {visible}: {size} bytes in {seconds:.2f} s").format(
+                local=local, visible=visible(target), size=done.size, seconds=done.seconds
+            ),
             file=sys.stderr,
         )
         return EXIT_OK
@@ -211,7 +219,7 @@ def _rm(args: argparse.Namespace) -> Any:
             )
         answer = input(f"Delete {remote!r} on {host}:{port}? [y/N] ").strip().lower()
         if answer not in ("y", "yes"):
-            print("rtmu files: not deleted", file=sys.stderr)
+            print(_("rtmu files: not deleted"), file=sys.stderr)
             return EXIT_USAGE
 
     async def body(client: AriaClient) -> int:
@@ -219,7 +227,7 @@ def _rm(args: argparse.Namespace) -> Any:
         if args.json:
             print_json({"deleted": remote})
         else:
-            print(f"deleted {visible(remote)}", file=sys.stderr)
+            print(_("deleted {visible}").format(visible=visible(remote)), file=sys.stderr)
         return EXIT_OK
 
     return body

@@ -14,6 +14,7 @@ import argparse
 from typing import TYPE_CHECKING, Any
 
 from ..base.exit_codes import EXIT_CONNECTION, EXIT_OK, EXIT_USAGE
+from ..base.i18n import _, ngettext
 from ..base.textsafe import visible
 from ..client.errors import ClientError
 from ..client.roles import Role
@@ -39,17 +40,19 @@ MAX_AT_ONCE = 16
 def register(subparsers: Any) -> None:
     p = subparsers.add_parser(
         "fleet",
-        help="list the robots behind an ARIA central server, with their status",
-        description="Ask an ARIA central server (ARIA's switchServer, or rtmu sim --central) for its "
-        "robots and the port it forwards each on, then read one status from every robot through that "
-        "port (all at once, each within --timeout). --json prints one object: "
-        '{"central": "HOST:PORT", "robots": [{"name", "host", "port", "address", "status"}]} where '
-        'status is what rtmu status --json prints, or {"error": "..."} for a robot that did not answer. '
-        "Act on one of them with any other subcommand's --robot NAME.",
+        help=_("list the robots behind an ARIA central server, with their status"),
+        description=_(
+            "Ask an ARIA central server (ARIA's switchServer, or rtmu sim --central) for its "
+            "robots and the port it forwards each on, then read one status from every robot through that "
+            "port (all at once, each within --timeout). --json prints one object: "
+            '{"central": "HOST:PORT", "robots": [{"name", "host", "port", "address", "status"}]} where '
+            'status is what rtmu status --json prints, or {"error": "..."} for a robot that did not answer. '
+            "Act on one of them with any other subcommand's --robot NAME."
+        ),
     )
     add_connection_arguments(p, robot=False)  # it lists every robot: no --robot NAME
-    p.add_argument("--json", action="store_true", help="one JSON object (see above)")
-    p.add_argument("--no-status", action="store_true", help="list only; do not log in to each robot")
+    p.add_argument("--json", action="store_true", help=_("one JSON object (see above)"))
+    p.add_argument("--no-status", action="store_true", help=_("list only; do not log in to each robot"))
     p.set_defaults(handler=handle)
 
 
@@ -91,7 +94,7 @@ def handle(args: argparse.Namespace) -> int:
         statuses: list[dict[str, Any] | None] = [None] * len(robots)
         if not args.no_status:
             statuses = list(
-                await asyncio.gather(*(_status(e.host, e.port, args, password, gate) for e, _ in robots))
+                await asyncio.gather(*(_status(e.host, e.port, args, password, gate) for e, _count in robots))
             )
         rows = []
         for (endpoint, entry), status in zip(robots, statuses, strict=True):
@@ -117,11 +120,20 @@ def handle(args: argparse.Namespace) -> int:
     if args.json:
         print_json({"central": f"{host}:{port}", "robots": rows})
         return EXIT_OK
-    print(f"{host}:{port}: {len(rows)} robot{'' if len(rows) == 1 else 's'}")
+    print(
+        ngettext("{host}:{port}: {count} robot", "{host}:{port}: {count} robots", len(rows)).format(
+            host=host, port=port, count=len(rows)
+        )
+    )
     for row in rows:
         status = row.get("status")
         shown = "" if status is None else status.get("error") or status_line(status)
-        print(f"  {visible(row['name'])}  port {row['port']}  {visible(shown)}", flush=True)
+        print(
+            _("  {visible}  port {value}  {visible2}").format(
+                visible=visible(row["name"]), value=row["port"], visible2=visible(shown)
+            ),
+            flush=True,
+        )
     return EXIT_OK
 
 

@@ -6,6 +6,7 @@ import argparse
 from typing import TYPE_CHECKING, Any
 
 from ..base.exit_codes import EXIT_OK
+from ..base.i18n import _
 from ..base.textsafe import visible
 from ..client.roles import Role
 from ._common import add_connection_arguments, print_json, run_with_client
@@ -17,11 +18,11 @@ if TYPE_CHECKING:
 def register(subparsers: Any) -> None:
     p = subparsers.add_parser(
         "goals",
-        help="list the map's goals (getGoals), the names rtmu goto takes",
-        description="Print the goal names getGoals lists, one a line (exit 4 when the server lists none).",
+        help=_("list the map's goals (getGoals), the names rtmu goto takes"),
+        description=_("Print the goal names getGoals lists, one a line (exit 4 when the server lists none)."),
     )
     add_connection_arguments(p)
-    p.add_argument("--json", action="store_true", help="one JSON array of names")
+    p.add_argument("--json", action="store_true", help=_("one JSON array of names"))
     p.set_defaults(handler=handle)
 
 

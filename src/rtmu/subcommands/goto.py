@@ -13,6 +13,7 @@ import sys
 from typing import TYPE_CHECKING, Any
 
 from ..base.exit_codes import EXIT_OK, EXIT_USAGE
+from ..base.i18n import _
 from ..base.textsafe import visible
 from ..client.roles import Role
 from ..protocol.payloads.navigation import GotoGoal, GotoPose
@@ -36,15 +37,15 @@ EXITS = NAVIGATION_EXITS
 def register(subparsers: Any) -> None:
     p = subparsers.add_parser(
         "goto",
-        help="drive to a goal of the map or to a point (gotoGoal / gotoPose; LD robots: gotoRouteGoal)",
+        help=_("drive to a goal of the map or to a point (gotoGoal / gotoPose; LD robots: gotoRouteGoal)"),
         description=f"{RULE} Ctrl-C, SIGTERM and SIGHUP stop the robot.",
     )
     add_connection_arguments(p)
-    p.add_argument("goal", metavar="GOAL", nargs="?", help="goal name, as the map names it")
-    p.add_argument("--x", type=float, metavar="MM", help="drive to this point instead (map mm)")
-    p.add_argument("--y", type=float, metavar="MM", help="the point's y (map mm)")
-    p.add_argument("--th", type=float, metavar="DEG", help="and end facing this heading (degrees)")
-    p.add_argument("--route", action="store_true", help="send gotoRouteGoal even where gotoGoal is listed")
+    p.add_argument("goal", metavar="GOAL", nargs="?", help=_("goal name, as the map names it"))
+    p.add_argument("--x", type=float, metavar="MM", help=_("drive to this point instead (map mm)"))
+    p.add_argument("--y", type=float, metavar="MM", help=_("the point's y (map mm)"))
+    p.add_argument("--th", type=float, metavar="DEG", help=_("and end facing this heading (degrees)"))
+    p.add_argument("--route", action="store_true", help=_("send gotoRouteGoal even where gotoGoal is listed"))
     add_wait_arguments(p)
     p.set_defaults(handler=handle)
 
@@ -65,7 +66,7 @@ def handle(args: argparse.Namespace) -> int:
     try:
         check(args)
     except UsageError as exc:
-        print(f"rtmu goto: {exc}", file=sys.stderr)
+        print(_("rtmu goto: {exc}").format(exc=exc), file=sys.stderr)
         return EXIT_USAGE
 
     async def body(client: AriaClient) -> int:
@@ -86,7 +87,7 @@ def handle(args: argparse.Namespace) -> int:
             args.goal = goal  # as the map spells it: what the server's words will name
         if route:
             ld_data.goto_route_goal(client, args.goal)
-            print(f"going to {visible(args.goal)}", file=sys.stderr)
+            print(_("going to {visible}").format(visible=visible(args.goal)), file=sys.stderr)
             return EXIT_OK
         return await navigate(client, args, GotoGoal(args.goal), Expect(args.goal))
 

@@ -5,6 +5,7 @@ from __future__ import annotations
 import argparse
 from typing import TYPE_CHECKING, Any
 
+from ..base.i18n import _
 from ..client.roles import Role
 from ..protocol.payloads.navigation import Home
 from ._common import add_connection_arguments, run_with_client
@@ -19,9 +20,11 @@ EXITS = NAVIGATION_EXITS
 def register(subparsers: Any) -> None:
     p = subparsers.add_parser(
         "home",
-        help="drive home (ARNL: home), and wait until the robot is there",
-        description="Send home: the server drives to the map's home (or where the robot started) and says "
-        "'Returned home'. Ctrl-C, SIGTERM and SIGHUP stop the robot.",
+        help=_("drive home (ARNL: home), and wait until the robot is there"),
+        description=_(
+            "Send home: the server drives to the map's home (or where the robot started) and says "
+            "'Returned home'. Ctrl-C, SIGTERM and SIGHUP stop the robot."
+        ),
     )
     add_connection_arguments(p)
     add_wait_arguments(p)

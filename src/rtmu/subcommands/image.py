@@ -8,6 +8,7 @@ from pathlib import Path
 from typing import TYPE_CHECKING, Any
 
 from ..base.exit_codes import EXIT_CONNECTION, EXIT_OK, EXIT_USAGE
+from ..base.i18n import _
 from ..base.textsafe import visible
 from ..client.roles import Role
 from ._common import UsageError, add_connection_arguments, fail, run_with_client
@@ -45,8 +46,8 @@ def picture_problem(jpeg: bytes, width: int, height: int) -> str | None:
 def register(subparsers: Any) -> None:
     p = subparsers.add_parser(
         "image",
-        help="save one camera picture (JPEG)",
-        description="Request one picture (getPicture<camera>, else sendVideo) and save the JPEG.",
+        help=_("save one camera picture (JPEG)"),
+        description=_("Request one picture (getPicture<camera>, else sendVideo) and save the JPEG."),
     )
     add_connection_arguments(p)
     p.add_argument(
@@ -54,10 +55,12 @@ def register(subparsers: Any) -> None:
         type=Path,
         required=True,
         metavar="FILE",
-        help="where to write the picture: FILE.jpg as the camera sent it, or another format Pillow "
-        "writes (.png, .bmp, .tiff, .webp …), chosen by the name's ending",
+        help=_(
+            "where to write the picture: FILE.jpg as the camera sent it, or another format Pillow "
+            "writes (.png, .bmp, .tiff, .webp …), chosen by the name's ending"
+        ),
     )
-    p.add_argument("--camera", default=None, metavar="NAME", help="camera name (getPicture<NAME>)")
+    p.add_argument("--camera", default=None, metavar="NAME", help=_("camera name (getPicture<NAME>)"))
     add_quality_option(p)
     add_force_option(p)
     p.set_defaults(handler=handle)
@@ -120,9 +123,19 @@ def handle(args: argparse.Namespace) -> int:
         data = converted(jpeg, fmt)
         written = write_whole(args.out, data, force=args.force)
         if written != args.out:
-            print(f"rtmu image: {args.out} appeared meanwhile; kept it, wrote {written}", file=sys.stderr)
+            print(
+                _("rtmu image: {out} appeared meanwhile; kept it, wrote {written}").format(
+                    out=args.out, written=written
+                ),
+                file=sys.stderr,
+            )
         size = f"{picture.width}x{picture.height}"  # type: ignore[attr-defined]
-        print(f"wrote {written}: {size} {fmt}, {len(data)} bytes from {visible(source)}", file=sys.stderr)
+        print(
+            _("wrote {written}: {size} {fmt}, {len} bytes from {visible}").format(
+                written=written, size=size, fmt=fmt, len=len(data), visible=visible(source)
+            ),
+            file=sys.stderr,
+        )
         return EXIT_OK
 
     return run_with_client("image", args, body, role=Role.OBSERVER)

@@ -12,6 +12,7 @@ import json
 import sys
 from typing import Any
 
+from ..base.i18n import _
 from ..client.console_effect import Effect
 from ..client.why_values import Cause
 from ..protocol.payloads.config import ParamType, Priority
@@ -366,7 +367,10 @@ if tuple(SCHEMAS) != SCHEMA_NAMES:  # the command line's names (``_schema_names`
 def main(argv: list[str]) -> int:
     if len(argv) != 1 or argv[0] not in SCHEMAS:
         print(
-            f"usage: python -m rtmu.subcommands.json_schemas {{{','.join(sorted(SCHEMAS))}}}", file=sys.stderr
+            _("usage: python -m rtmu.subcommands.json_schemas {{{join}}}").format(
+                join=",".join(sorted(SCHEMAS))
+            ),
+            file=sys.stderr,
         )
         return 2
     print(

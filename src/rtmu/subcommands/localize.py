@@ -6,6 +6,7 @@ import argparse
 from typing import TYPE_CHECKING, Any
 
 from ..base.exit_codes import NETWORK
+from ..base.i18n import _
 from ..client.roles import Role
 from ..protocol.payloads.navigation import LocalizeToPose
 from ._common import add_connection_arguments, run_with_client
@@ -20,15 +21,15 @@ EXITS = (*NETWORK, EXIT_NAV_LOST)
 def register(subparsers: Any) -> None:
     p = subparsers.add_parser(
         "localize",
-        help="tell the robot where it is on the map (localizeToPose), and wait until it is localized",
+        help=_("tell the robot where it is on the map (localizeToPose), and wait until it is localized"),
         description="Send localizeToPose X Y TH; where the server offers getLocState, wait until it says "
         "localized (exit 0; also when it was only sent, where getLocState is not offered) or lost "
         f"(exit {EXIT_NAV_LOST}). It never moves the robot.",
     )
     add_connection_arguments(p)
-    p.add_argument("x", type=float, metavar="X", help="mm on the map")
-    p.add_argument("y", type=float, metavar="Y", help="mm on the map")
-    p.add_argument("th", type=float, metavar="TH", help="heading, degrees (counter-clockwise)")
+    p.add_argument("x", type=float, metavar="X", help=_("mm on the map"))
+    p.add_argument("y", type=float, metavar="Y", help=_("mm on the map"))
+    p.add_argument("th", type=float, metavar="TH", help=_("heading, degrees (counter-clockwise)"))
     add_wait_arguments(p, localizing=True)
     p.set_defaults(handler=handle)
 

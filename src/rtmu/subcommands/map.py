@@ -8,6 +8,7 @@ from pathlib import Path
 from typing import TYPE_CHECKING, Any
 
 from ..base.exit_codes import EXIT_OK, EXIT_UNSUPPORTED, EXIT_USAGE
+from ..base.i18n import _
 from ..base.textsafe import visible
 from ..client.errors import ProtocolFault
 from ..client.roles import Role
@@ -21,13 +22,15 @@ if TYPE_CHECKING:
 def register(subparsers: Any) -> None:
     p = subparsers.add_parser(
         "map",
-        help="download the robot's map to a .map file",
-        description="Download the server's map (getMapBinary when offered; --text forces getMap) "
-        "and write it in ARIA's .map format.",
+        help=_("download the robot's map to a .map file"),
+        description=_(
+            "Download the server's map (getMapBinary when offered; --text forces getMap) "
+            "and write it in ARIA's .map format."
+        ),
     )
     add_connection_arguments(p)
-    p.add_argument("--out", type=Path, required=True, metavar="FILE", help="where to write the map")
-    p.add_argument("--text", action="store_true", help="use getMap (one text line per packet)")
+    p.add_argument("--out", type=Path, required=True, metavar="FILE", help=_("where to write the map"))
+    p.add_argument("--text", action="store_true", help=_("use getMap (one text line per packet)"))
     add_force_option(p)
     p.set_defaults(handler=handle)
 
@@ -54,10 +57,24 @@ def handle(args: argparse.Namespace) -> int:
         written = write_whole(args.out, payload, force=args.force)
         name = f" ({visible(got.name)})" if got.name else ""
         if written != args.out:
-            print(f"rtmu map: {args.out} appeared meanwhile; kept it, wrote {written}", file=sys.stderr)
+            print(
+                _("rtmu map: {out} appeared meanwhile; kept it, wrote {written}").format(
+                    out=args.out, written=written
+                ),
+                file=sys.stderr,
+            )
         print(
-            f"wrote {written}{name}: {got.data.num_points} points, {got.data.num_lines} lines "
-            f"via {got.source} in {got.packets} packets",
+            _(
+                "wrote {written}{name}: {num_points} points, {num_lines} lines via {source} in "
+                "{packets} packets"
+            ).format(
+                written=written,
+                name=name,
+                num_points=got.data.num_points,
+                num_lines=got.data.num_lines,
+                source=got.source,
+                packets=got.packets,
+            ),
             file=sys.stderr,
         )
         return EXIT_OK

@@ -8,6 +8,7 @@ import sys
 from typing import TYPE_CHECKING, Any
 
 from ..base.exit_codes import EXIT_NOT_HELD, EXIT_OK, EXIT_REFUSED, EXIT_USAGE, NETWORK
+from ..base.i18n import _
 from ..base.textsafe import visible
 from ..client.errors import NotSupported
 from ..client.roles import Role
@@ -89,30 +90,39 @@ class _Coordinate(argparse.Action):
 def register(subparsers: Any) -> None:
     p = subparsers.add_parser(
         "mapedit",
-        help="change the server's map live: add or remove goals, docks, forbidden lines and areas",
+        help=_("change the server's map live: add or remove goals, docks, forbidden lines and areas"),
         description=DESCRIPTION,
     )
     add_connection_arguments(p)
     p.add_argument(
-        "--json", action="store_true", help="one JSON object: what was sent and what the server did"
+        "--json", action="store_true", help=_("one JSON object: what was sent and what the server did")
     )
     p.add_argument(
-        "--add-goal", dest="add_goal", action=_Edit, metavar="NAME", help="add a goal (then --x --y [--th])"
+        "--add-goal",
+        dest="add_goal",
+        action=_Edit,
+        metavar="NAME",
+        help=_("add a goal (then --x --y [--th])"),
     )
     p.add_argument(
-        "--add-dock", dest="add_dock", action=_Edit, metavar="NAME", help="add a dock (then --x --y --th)"
+        "--add-dock", dest="add_dock", action=_Edit, metavar="NAME", help=_("add a dock (then --x --y --th)")
     )
     p.add_argument(
-        "--x", dest="x", action=_Coordinate, type=_number, metavar="MM", help="x of the goal or dock"
+        "--x", dest="x", action=_Coordinate, type=_number, metavar="MM", help=_("x of the goal or dock")
     )
     p.add_argument(
-        "--y", dest="y", action=_Coordinate, type=_number, metavar="MM", help="y of the goal or dock"
+        "--y", dest="y", action=_Coordinate, type=_number, metavar="MM", help=_("y of the goal or dock")
     )
     p.add_argument(
-        "--th", dest="th", action=_Coordinate, type=_number, metavar="DEG", help="heading of the goal or dock"
+        "--th",
+        dest="th",
+        action=_Coordinate,
+        type=_number,
+        metavar="DEG",
+        help=_("heading of the goal or dock"),
     )
     p.add_argument(
-        "--remove", dest="remove", action=_Edit, metavar="NAME", help="delete the object of this name"
+        "--remove", dest="remove", action=_Edit, metavar="NAME", help=_("delete the object of this name")
     )
     p.add_argument(
         "--add-forbidden-line",
@@ -120,7 +130,7 @@ def register(subparsers: Any) -> None:
         action=_Edit,
         nargs=4,
         metavar=("X1", "Y1", "X2", "Y2"),
-        help="add a forbidden line from (X1, Y1) to (X2, Y2), in mm",
+        help=_("add a forbidden line from (X1, Y1) to (X2, Y2), in mm"),
     )
     p.add_argument(
         "--add-forbidden-area",
@@ -128,10 +138,12 @@ def register(subparsers: Any) -> None:
         action=_Edit,
         nargs=4,
         metavar=("X1", "Y1", "X2", "Y2"),
-        help="add a forbidden area between the corners (X1, Y1) and (X2, Y2), in mm",
+        help=_("add a forbidden area between the corners (X1, Y1) and (X2, Y2), in mm"),
     )
     p.add_argument(
-        "--check-map", action="store_true", help="ask the server to re-read its map file (checkMap) instead"
+        "--check-map",
+        action="store_true",
+        help=_("ask the server to re-read its map file (checkMap) instead"),
     )
     p.set_defaults(handler=handle, edits=[])
 
@@ -164,16 +176,18 @@ def handle(args: argparse.Namespace) -> int:
 
     edits: list[dict[str, Any]] = args.edits or []
     if args.check_map and edits:
-        print("rtmu mapedit: --check-map goes alone, without edits", file=sys.stderr)
+        print(_("rtmu mapedit: --check-map goes alone, without edits"), file=sys.stderr)
         return EXIT_USAGE
     if not args.check_map and not edits:
         print(
-            "rtmu mapedit: nothing to do: give an edit (--add-goal, --remove, …) or --check-map",
+            _("rtmu mapedit: nothing to do: give an edit (--add-goal, --remove, …) or --check-map"),
             file=sys.stderr,
         )
         return EXIT_USAGE
     if len(edits) > MAX_EDITS:
-        print(f"rtmu mapedit: at most {MAX_EDITS} edits at once", file=sys.stderr)
+        print(
+            _("rtmu mapedit: at most {MAX_EDITS} edits at once").format(MAX_EDITS=MAX_EDITS), file=sys.stderr
+        )
         return EXIT_USAGE
 
     async def body(client: AriaClient) -> int:
@@ -183,9 +197,9 @@ def handle(args: argparse.Namespace) -> int:
                 print_json({"map_updated": changed})
             else:
                 print(
-                    "the map was read again: it had changed"
+                    _("the map was read again: it had changed")
                     if changed
-                    else "no mapUpdated: the file had not changed"
+                    else _("no mapUpdated: the file had not changed")
                 )
             return EXIT_OK
         return await _edit(client, edits, args)
@@ -215,7 +229,7 @@ async def _edit(client: AriaClient, edits: list[dict[str, Any]], args: argparse.
     try:
         apply_edits(draft, edits)
     except DraftError as exc:
-        print(f"rtmu mapedit: {visible(str(exc))}", file=sys.stderr)
+        print(_("rtmu mapedit: {visible}").format(visible=visible(str(exc))), file=sys.stderr)
         return EXIT_USAGE
     change = draft.change()
     if change.empty:
@@ -228,7 +242,7 @@ async def _edit(client: AriaClient, edits: list[dict[str, Any]], args: argparse.
     )
     if not verdict.applied:
         _report(args, change, verdict, [], "")
-        print(f"rtmu mapedit: {visible(verdict.words)}", file=sys.stderr)
+        print(_("rtmu mapedit: {visible}").format(visible=visible(verdict.words)), file=sys.stderr)
         return EXIT_REFUSED
     after = await download_map(client, timeout=args.timeout)
     missing = not_holding(after.data.objects if after.data is not None else [], change)
@@ -268,7 +282,7 @@ def _report(
     if verdict is not None and verdict.applied and not missing:
         for obj in change.removed:
             if not any(o.name and o.name == obj.name for o in change.added):
-                print(f"removed {visible(describe(obj))}")
+                print(_("removed {visible}").format(visible=visible(describe(obj))))
         for obj in change.added:
-            print(f"added {visible(describe(obj))}")
+            print(_("added {visible}").format(visible=visible(describe(obj))))
         sys.stdout.flush()

@@ -11,6 +11,8 @@ from typing import TYPE_CHECKING, Any
 from rtmu.base.exit_codes import EXIT_BAD_FILE, EXIT_OK, EXIT_SIGPIPE, EXIT_USAGE
 from rtmu.base.textsafe import visible
 
+from ..base.i18n import _
+
 if TYPE_CHECKING:
     from rtmu.mapfile import Bounds, MapData
 
@@ -20,12 +22,14 @@ EXITS = (EXIT_OK, EXIT_USAGE, EXIT_BAD_FILE, EXIT_SIGPIPE)
 def register(subparsers: argparse._SubParsersAction) -> None:
     parser = subparsers.add_parser(
         "mapinfo",
-        help="summarise an ARIA .map file (counts, bounds, objects)",
-        description="Summarise an ARIA .map file: category, counts found and claimed by the header, bounds, "
-        "resolution, map objects by type, goal names and unknown header keywords.",
+        help=_("summarise an ARIA .map file (counts, bounds, objects)"),
+        description=_(
+            "Summarise an ARIA .map file: category, counts found and claimed by the header, bounds, "
+            "resolution, map objects by type, goal names and unknown header keywords."
+        ),
     )
-    parser.add_argument("file", metavar="FILE", help="the .map file")
-    parser.add_argument("--json", action="store_true", help="print one JSON object instead of text")
+    parser.add_argument("file", metavar="FILE", help=_("the .map file"))
+    parser.add_argument("--json", action="store_true", help=_("print one JSON object instead of text"))
     parser.set_defaults(handler=run)
 
 
@@ -35,7 +39,7 @@ def run(args: argparse.Namespace) -> int:
     try:
         data = read_map(args.file)
     except MapFormatError as exc:
-        print(f"rtmu mapinfo: {visible(str(exc))}", file=sys.stderr)
+        print(_("rtmu mapinfo: {visible}").format(visible=visible(str(exc))), file=sys.stderr)
         return EXIT_USAGE if isinstance(exc.__cause__, OSError) else EXIT_BAD_FILE  # missing, or not a map
     summary = summarise(data)
     if args.json:

@@ -7,6 +7,7 @@ import sys
 from typing import TYPE_CHECKING, Any
 
 from ..base.exit_codes import EXIT_OK, EXIT_USAGE
+from ..base.i18n import _
 from ..base.textsafe import visible
 from ..client.roles import Role
 from ._common import add_connection_arguments, known_name, run_with_client
@@ -18,11 +19,11 @@ if TYPE_CHECKING:
 def register(subparsers: Any) -> None:
     p = subparsers.add_parser(
         "patrol",
-        help="patrol one of the server's routes (LD robots)",
-        description="Send patrol ROUTE; the route must be one getRoutes lists (exit 2 otherwise).",
+        help=_("patrol one of the server's routes (LD robots)"),
+        description=_("Send patrol ROUTE; the route must be one getRoutes lists (exit 2 otherwise)."),
     )
     add_connection_arguments(p)
-    p.add_argument("route", metavar="ROUTE", help="route name, as `rtmu routes` lists it")
+    p.add_argument("route", metavar="ROUTE", help=_("route name, as `rtmu routes` lists it"))
     p.set_defaults(handler=handle)
 
 
@@ -36,7 +37,7 @@ def handle(args: argparse.Namespace) -> int:
             return EXIT_USAGE
         args.route = route
         ld_data.patrol(client, args.route)
-        print(f"patrolling {visible(args.route)}", file=sys.stderr)
+        print(_("patrolling {visible}").format(visible=visible(args.route)), file=sys.stderr)
         return EXIT_OK
 
     return run_with_client("patrol", args, body, role=Role.OPERATOR)

@@ -6,6 +6,7 @@ import argparse
 from typing import TYPE_CHECKING, Any
 
 from ..base.exit_codes import EXIT_OK
+from ..base.i18n import _
 from ..base.textsafe import visible
 from ..client.roles import Role
 from ._common import add_connection_arguments, print_json, run_with_client
@@ -17,16 +18,20 @@ if TYPE_CHECKING:
 def register(subparsers: Any) -> None:
     p = subparsers.add_parser(
         "probe",
-        help="log in and list the data a server offers",
-        description="Log in and list every data the server offers this user: number, name, group, "
-        "flags, description, argument and return descriptions.",
+        help=_("log in and list the data a server offers"),
+        description=_(
+            "Log in and list every data the server offers this user: number, name, group, "
+            "flags, description, argument and return descriptions."
+        ),
     )
     add_connection_arguments(p)
     p.add_argument(
         "--json",
         action="store_true",
-        help='one JSON object: {"server", "user", "count", "data": [{"number", "name", "group", '
-        '"flags", "description", "arguments", "returns"}]}',
+        help=_(
+            'one JSON object: {"server", "user", "count", "data": [{"number", "name", "group", '
+            '"flags", "description", "arguments", "returns"}]}'
+        ),
     )
     p.set_defaults(handler=handle)
 
@@ -69,9 +74,9 @@ def handle(args: argparse.Namespace) -> int:
                 if e.description:
                     print(f"         {visible(e.description)}")
                 if e.argument_description and e.argument_description.lower() not in ("none", ""):
-                    print(f"         args:    {visible(e.argument_description)}")
+                    print(_("         args:    {visible}").format(visible=visible(e.argument_description)))
                 if e.return_description and e.return_description.lower() not in ("none", ""):
-                    print(f"         returns: {visible(e.return_description)}")
+                    print(_("         returns: {visible}").format(visible=visible(e.return_description)))
         return EXIT_OK
 
     return run_with_client("probe", args, body, role=Role.OBSERVER)

@@ -13,6 +13,7 @@ import math
 from typing import TYPE_CHECKING, Any
 
 from ..base.exit_codes import EXIT_OK, EXIT_UNSUPPORTED
+from ..base.i18n import _
 from ..base.textsafe import visible
 from ..client.roles import Role
 from ..values.state import PtzState
@@ -37,20 +38,22 @@ def _angle(text: str) -> float:
 def register(subparsers: Any) -> None:
     p = subparsers.add_parser(
         "ptz",
-        help="the camera head: cameras, limits, position; --pan/--tilt/--zoom point it",
+        help=_("the camera head: cameras, limits, position; --pan/--tilt/--zoom point it"),
         description=(
-            "List the server's cameras (getCameraList) and show the pan-tilt-zoom head's limits and "
-            "position; with --pan/--tilt/--zoom point it there (setCameraAbs) and show where it went. "
-            "A value outside the head's own limits (as the server reports them) is refused with those "
-            "limits (exit 2). Exit 4 when the server has no movable camera head. Moving the head never "
-            "moves the robot."
+            _(
+                "List the server's cameras (getCameraList) and show the pan-tilt-zoom head's limits and "
+                "position; with --pan/--tilt/--zoom point it there (setCameraAbs) and show where it went. "
+                "A value outside the head's own limits (as the server reports them) is refused with those "
+                "limits (exit 2). Exit 4 when the server has no movable camera head. Moving the head never "
+                "moves the robot."
+            )
         ),
     )
     add_connection_arguments(p)
-    p.add_argument("--json", action="store_true", help="one JSON object: cameras, limits, position")
-    p.add_argument("--pan", type=_angle, metavar="DEG", help="pan to this angle (degrees, right positive)")
-    p.add_argument("--tilt", type=_angle, metavar="DEG", help="tilt to this angle (degrees, up positive)")
-    p.add_argument("--zoom", type=_angle, metavar="PCT", help="zoom to this point of its range (%%)")
+    p.add_argument("--json", action="store_true", help=_("one JSON object: cameras, limits, position"))
+    p.add_argument("--pan", type=_angle, metavar="DEG", help=_("pan to this angle (degrees, right positive)"))
+    p.add_argument("--tilt", type=_angle, metavar="DEG", help=_("tilt to this angle (degrees, up positive)"))
+    p.add_argument("--zoom", type=_angle, metavar="PCT", help=_("zoom to this point of its range (%%)"))
     p.set_defaults(handler=handle)
 
 
@@ -142,9 +145,11 @@ def _outside_limits(args: argparse.Namespace, state: PtzState) -> str:
 def _print_head(state: PtzState) -> None:
     (p0, p1), (t0, t1), (z0, z1) = state.pan_range, state.tilt_range, state.zoom_range
     print(visible(f"head {state.camera}: pan {p0:g}…{p1:g}°, tilt {t0:g}…{t1:g}°"), end="")
-    print(f", zoom {z0:g}…{z1:g} %" if state.zoom_available else ", no zoom")
+    print(_(", zoom {z0:g}…{z1:g} %").format(z0=z0, z1=z1) if state.zoom_available else _(", no zoom"))
     if state.position is None:
-        print("position: not read")
+        print(_("position: not read"))
     else:
         pan, tilt, zoom = state.position
-        print(f"position: pan {pan:g}°, tilt {tilt:g}°, zoom {zoom:g} %")
+        print(
+            _("position: pan {pan:g}°, tilt {tilt:g}°, zoom {zoom:g} %").format(pan=pan, tilt=tilt, zoom=zoom)
+        )

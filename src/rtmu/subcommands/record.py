@@ -20,6 +20,7 @@ from pathlib import Path
 from typing import TYPE_CHECKING, Any
 
 from ..base.exit_codes import EXIT_CONNECTION, EXIT_OK, EXIT_SIZE_LIMIT, EXIT_USAGE, NETWORK
+from ..base.i18n import _
 from ..base.notices import Kind, Notice
 from ..base.textsafe import visible
 from ..client.errors import ClientError
@@ -40,17 +41,21 @@ EXITS = (*NETWORK, EXIT_SIZE_LIMIT)
 def register(subparsers: Any) -> None:
     p = subparsers.add_parser(
         "record",
-        help="record a session to an MCAP file (raw bytes + decoded channels), headless",
-        description="Connect, follow the robot as the window does and write everything to FILE.mcap: "
-        "the exact bytes both ways (rtmu decode FILE.mcap explains them; the login's password digest is "
-        "recorded as zeros), pose, status, sonar, map, camera, link health, notices and stops, readable "
-        "in Foxglove. It never moves or stops the robot. The file is written as FILE.mcap.partial and "
-        "renamed at the end.",
+        help=_("record a session to an MCAP file (raw bytes + decoded channels), headless"),
+        description=_(
+            "Connect, follow the robot as the window does and write everything to FILE.mcap: "
+            "the exact bytes both ways (rtmu decode FILE.mcap explains them; the login's password digest is "
+            "recorded as zeros), pose, status, sonar, map, camera, link health, notices and stops, readable "
+            "in Foxglove. It never moves or stops the robot. The file is written as FILE.mcap.partial and "
+            "renamed at the end."
+        ),
     )
     add_connection_arguments(p)
-    p.add_argument("--out", type=Path, required=True, metavar="FILE.mcap", help="the recording to write")
+    p.add_argument("--out", type=Path, required=True, metavar="FILE.mcap", help=_("the recording to write"))
     add_force_option(p, "an existing FILE.mcap")
-    p.add_argument("--seconds", type=positive_float, default=None, metavar="S", help="stop after S seconds")
+    p.add_argument(
+        "--seconds", type=positive_float, default=None, metavar="S", help=_("stop after S seconds")
+    )
     add_fps_option(p, default=0.0, none_means="no pictures")
     p.add_argument(
         "--max-mb",
@@ -82,11 +87,14 @@ def handle(args: argparse.Namespace) -> int:
 
         def tell(notice: Notice) -> None:
             if notice.kind is not Kind.RECORDING:
-                print(f"rtmu record: {visible(notice.text)}", file=sys.stderr)
+                print(_("rtmu record: {visible}").format(visible=visible(notice.text)), file=sys.stderr)
             elif not stopped:  # its size limit, a full disk: said once, and the recording ends
                 why = next((r.stopped for r in recorder.recordings if r.stopped), None) or notice.text
                 stopped.append(why)
-                print(f"rtmu record: {visible(why)}; the recording ends here", file=sys.stderr)
+                print(
+                    _("rtmu record: {visible}; the recording ends here").format(visible=visible(why)),
+                    file=sys.stderr,
+                )
                 ending.event.set()
 
         config = RecorderConfig(out.parent, path=partial, max_bytes=int(args.max_mb * 1e6), keep_days=0)
@@ -132,7 +140,10 @@ def _record(
     except Exception as exc:
         return fail("record", f"could not connect: {exc}", EXIT_CONNECTION)
     shown = f"{visible(str(args.out))} (as {visible(partial.name)} until it ends)"
-    print(f"rtmu record: recording {host}:{port} to {shown}", file=sys.stderr)
+    print(
+        _("rtmu record: recording {host}:{port} to {shown}").format(host=host, port=port, shown=shown),
+        file=sys.stderr,
+    )
     follow(runner, ending.event, seconds=args.seconds, camera_hz=args.fps)
     return EXIT_OK
 
@@ -151,10 +162,17 @@ def _keep(recorder: Recorder, out: Path, *, force: bool, logged_in: bool) -> boo
         kept = True
         size = final.stat().st_size
         if final != out:
-            print(f"rtmu record: {visible(str(out))} appeared meanwhile and was kept", file=sys.stderr)
+            print(
+                _("rtmu record: {visible} appeared meanwhile and was kept").format(visible=visible(str(out))),
+                file=sys.stderr,
+            )
         print(
-            f"rtmu record: {visible(str(final))}: {size / 1e6:.2f} MB, "
-            f"{recording.written_items} items, {recording.dropped} dropped",
+            _("rtmu record: {visible}: {value:.2f} MB, {written_items} items, {dropped} dropped").format(
+                visible=visible(str(final)),
+                value=size / 1e6,
+                written_items=recording.written_items,
+                dropped=recording.dropped,
+            ),
             file=sys.stderr,
         )
     return kept

@@ -12,6 +12,7 @@ from pathlib import Path
 from typing import Any
 
 from ..base.exit_codes import EXIT_BAD_FILE, EXIT_NO_DISPLAY, EXIT_OK, EXIT_USAGE
+from ..base.i18n import _
 from ._common import fail
 from ._options import number_in
 
@@ -21,20 +22,22 @@ EXITS = (EXIT_OK, EXIT_USAGE, EXIT_NO_DISPLAY, EXIT_BAD_FILE)
 def register(subparsers: Any) -> None:
     p = subparsers.add_parser(
         "replay",
-        help="open the window on a recording (play, pause, speed, timeline); nothing drives",
-        description="Show a flight recording (rtmu record, or the window's own) in the operator window as "
-        "it was live: map, robot, trail, sonar, camera, banners. Play, pause, x0.25-x8, scrub and step. "
-        "Drive keys, the D-pad and STOP send nothing.",
+        help=_("open the window on a recording (play, pause, speed, timeline); nothing drives"),
+        description=_(
+            "Show a flight recording (rtmu record, or the window's own) in the operator window as "
+            "it was live: map, robot, trail, sonar, camera, banners. Play, pause, x0.25-x8, scrub and step. "
+            "Drive keys, the D-pad and STOP send nothing."
+        ),
     )
-    p.add_argument("file", type=Path, metavar="FILE.mcap", help="the recording")
+    p.add_argument("file", type=Path, metavar="FILE.mcap", help=_("the recording"))
     p.add_argument(
         "--conn",
         type=number_in(1, 1_000_000, integer=True),
         default=1,
         metavar="N",
-        help="which connection of the file, counted from 1 (default 1: the first)",
+        help=_("which connection of the file, counted from 1 (default 1: the first)"),
     )
-    p.add_argument("--fullscreen", action="store_true", help="start full screen (F11 toggles)")
+    p.add_argument("--fullscreen", action="store_true", help=_("start full screen (F11 toggles)"))
     p.set_defaults(handler=handle)
 
 

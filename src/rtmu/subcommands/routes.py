@@ -6,6 +6,7 @@ import argparse
 from typing import TYPE_CHECKING, Any
 
 from ..base.exit_codes import EXIT_OK
+from ..base.i18n import _
 from ..base.textsafe import visible
 from ..client.roles import Role
 from ._common import add_connection_arguments, print_json, run_with_client
@@ -17,11 +18,11 @@ if TYPE_CHECKING:
 def register(subparsers: Any) -> None:
     p = subparsers.add_parser(
         "routes",
-        help="list the server's routes (LD robots)",
-        description="List the routes the server offers (getRoutes), one per line; exit 4 if it has none.",
+        help=_("list the server's routes (LD robots)"),
+        description=_("List the routes the server offers (getRoutes), one per line; exit 4 if it has none."),
     )
     add_connection_arguments(p)
-    p.add_argument("--json", action="store_true", help="a JSON list of route names")
+    p.add_argument("--json", action="store_true", help=_("a JSON list of route names"))
     p.set_defaults(handler=handle)
 
 

@@ -14,6 +14,7 @@ import sys
 from typing import TYPE_CHECKING, Any
 
 from ..base.exit_codes import EXIT_OK, EXIT_TIMEOUT, EXIT_USAGE
+from ..base.i18n import _
 from ..base.textsafe import visible
 from ..client.roles import Role
 from ._common import add_connection_arguments, known_name, print_json, run_with_client
@@ -25,20 +26,22 @@ if TYPE_CHECKING:
 def register(subparsers: Any) -> None:
     p = subparsers.add_parser(
         "run",
-        help="run one of the server's own commands (rtmu commands lists them)",
-        description="Send the listed command NAME (with ARG for a string command) and wait until the "
-        "server has taken it. Exit 0 taken, 2 not a command this user may run or a wrong ARG, 4 the "
-        "server lists no commands, 5 no answer within --timeout.",
+        help=_("run one of the server's own commands (rtmu commands lists them)"),
+        description=_(
+            "Send the listed command NAME (with ARG for a string command) and wait until the "
+            "server has taken it. Exit 0 taken, 2 not a command this user may run or a wrong ARG, 4 the "
+            "server lists no commands, 5 no answer within --timeout."
+        ),
     )
     add_connection_arguments(p)
-    p.add_argument("name", metavar="NAME", help="the command's name, as rtmu commands prints it")
-    p.add_argument("argument", metavar="ARG", nargs="?", help="the text argument of a string command")
-    p.add_argument("--json", action="store_true", help="one JSON object {command, argument, taken}")
+    p.add_argument("name", metavar="NAME", help=_("the command's name, as rtmu commands prints it"))
+    p.add_argument("argument", metavar="ARG", nargs="?", help=_("the text argument of a string command"))
+    p.add_argument("--json", action="store_true", help=_("one JSON object {command, argument, taken}"))
     p.set_defaults(handler=handle)
 
 
 def usage(message: str) -> int:
-    print(f"rtmu run: {visible(message)}", file=sys.stderr)
+    print(_("rtmu run: {visible}").format(visible=visible(message)), file=sys.stderr)
     return EXIT_USAGE
 
 
@@ -65,10 +68,13 @@ def handle(args: argparse.Namespace) -> int:
         if args.json:
             print_json({"command": command.name, "argument": args.argument, "taken": taken})
         elif taken:
-            print(f"{visible(command.name)}: taken by the server", flush=True)
+            print(_("{visible}: taken by the server").format(visible=visible(command.name)), flush=True)
         else:
             silent = f"sent, but the server did not answer within {args.timeout:g} s"
-            print(f"rtmu run: {visible(command.name)} {silent}", file=sys.stderr)
+            print(
+                _("rtmu run: {visible} {silent}").format(visible=visible(command.name), silent=silent),
+                file=sys.stderr,
+            )
         return EXIT_OK if taken else EXIT_TIMEOUT
 
     return run_with_client("run", args, body, role=Role.OPERATOR)

@@ -7,6 +7,7 @@ import sys
 from typing import TYPE_CHECKING, Any
 
 from ..base.exit_codes import EXIT_OK, EXIT_USAGE
+from ..base.i18n import _
 from ..client.roles import Role
 from ._common import add_connection_arguments, run_with_client
 
@@ -20,11 +21,11 @@ MAX_TEXT = 1000
 def register(subparsers: Any) -> None:
     p = subparsers.add_parser(
         "say",
-        help="have the robot speak a text (LD robots)",
-        description="Send say TEXT (the robot's text-to-speech); exit 4 if the server cannot speak.",
+        help=_("have the robot speak a text (LD robots)"),
+        description=_("Send say TEXT (the robot's text-to-speech); exit 4 if the server cannot speak."),
     )
     add_connection_arguments(p)
-    p.add_argument("text", metavar="TEXT", help="what to say (latin-1, at most 1000 characters)")
+    p.add_argument("text", metavar="TEXT", help=_("what to say (latin-1, at most 1000 characters)"))
     p.set_defaults(handler=handle)
 
 
@@ -33,12 +34,16 @@ def handle(args: argparse.Namespace) -> int:
 
     text = args.text.strip()
     if not text or len(text) > MAX_TEXT:
-        print(f"rtmu say: give a text of 1…{MAX_TEXT} characters", file=sys.stderr)
+        print(
+            _("rtmu say: give a text of 1…{MAX_TEXT} characters").format(MAX_TEXT=MAX_TEXT), file=sys.stderr
+        )
         return EXIT_USAGE
     try:
         text.encode("latin-1")
     except UnicodeEncodeError:
-        print("rtmu say: the text has characters ARIA strings cannot carry (latin-1 only)", file=sys.stderr)
+        print(
+            _("rtmu say: the text has characters ARIA strings cannot carry (latin-1 only)"), file=sys.stderr
+        )
         return EXIT_USAGE
 
     async def body(client: AriaClient) -> int:

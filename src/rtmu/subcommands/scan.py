@@ -12,6 +12,7 @@ from pathlib import Path
 from typing import TYPE_CHECKING, Any
 
 from ..base.exit_codes import EXIT_OK, EXIT_REFUSED, EXIT_TIMEOUT, EXIT_USAGE, NETWORK
+from ..base.i18n import _
 from ..base.textsafe import visible
 from ..client.errors import NotSupported
 from ..client.roles import Role
@@ -35,7 +36,7 @@ DESCRIPTION = (
 def register(subparsers: Any) -> None:
     p = subparsers.add_parser(
         "scan",
-        help="scan for a map: start, status, loop tags, stop and download the .2d (mappingStart …)",
+        help=_("scan for a map: start, status, loop tags, stop and download the .2d (mappingStart …)"),
         description=DESCRIPTION,
     )
     add_connection_arguments(p)
@@ -43,16 +44,16 @@ def register(subparsers: Any) -> None:
     start = action_parser(
         actions, "start", "start a scan", "Start a scan named NAME (the robot writes NAME.2d)."
     )
-    start.add_argument("name", metavar="NAME", help="the scan's name")
+    start.add_argument("name", metavar="NAME", help=_("the scan's name"))
     action_parser(actions, "status", "is a scan running?", "Say whether a scan runs, and which.")
     loop = action_parser(
         actions, "loop", "tag a loop", "Mark where a loop starts or ends in the running scan."
     )
-    loop.add_argument("edge", choices=("start", "end"), help="start or end of the loop")
-    loop.add_argument("tag", nargs="?", default="1", metavar="TAG", help="the loop's tag (default 1)")
+    loop.add_argument("edge", choices=("start", "end"), help=_("start or end of the loop"))
+    loop.add_argument("tag", nargs="?", default="1", metavar="TAG", help=_("the loop's tag (default 1)"))
     stop = action_parser(actions, "stop", "end the scan", "End the scan, and fetch its .2d with --download.")
-    stop.add_argument("--download", type=Path, metavar="DIR", help="fetch the scan into this folder")
-    stop.add_argument("--force", action="store_true", help="replace the file in DIR if it exists")
+    stop.add_argument("--download", type=Path, metavar="DIR", help=_("fetch the scan into this folder"))
+    stop.add_argument("--force", action="store_true", help=_("replace the file in DIR if it exists"))
     p.set_defaults(handler=handle)
 
 
@@ -76,7 +77,11 @@ def _start(args: argparse.Namespace) -> Any:
         if args.json:
             print_json({"scanning": True, "file": file_name})
         else:
-            print(f"scanning: the robot writes {visible(file_name)}; drive it round the site, then 'stop'")
+            print(
+                _("scanning: the robot writes {visible}; drive it round the site, then 'stop'").format(
+                    visible=visible(file_name)
+                )
+            )
         return EXIT_OK
 
     return body
@@ -90,9 +95,13 @@ def _status(args: argparse.Namespace) -> Any:
         if args.json:
             print_json({"scanning": status.scanning, "name": status.name, "file": status.file_name})
         elif status.scanning:
-            print(f"scanning {visible(status.name)} (file {visible(status.file_name)})")
+            print(
+                _("scanning {visible} (file {visible2})").format(
+                    visible=visible(status.name), visible2=visible(status.file_name)
+                )
+            )
         else:
-            print("not scanning")
+            print(_("not scanning"))
         return EXIT_OK
 
     return body
@@ -119,7 +128,7 @@ def _loop(args: argparse.Namespace) -> Any:
                 "scan", f"the robot did not confirm the loop tag within {args.timeout:g} s", EXIT_TIMEOUT
             )
         if not args.json:
-            print(f"loop {args.edge} tagged {visible(args.tag)!r}")
+            print(_("loop {edge} tagged {visible!r}").format(edge=args.edge, visible=visible(args.tag)))
         return EXIT_OK
 
     return body
@@ -155,9 +164,13 @@ def _stop(args: argparse.Namespace) -> Any:
         if args.json:
             print_json(out)
         else:
-            print(f"scan ended: {visible(file_name) or '(the robot did not name its file)'}")
+            print(
+                _("scan ended: {value}").format(
+                    value=visible(file_name) or "(the robot did not name its file)"
+                )
+            )
             if local is not None:
-                print(f"downloaded to {local} ({out['bytes']} bytes)")
+                print(_("downloaded to {local} ({value} bytes)").format(local=local, value=out["bytes"]))
         sys.stdout.flush()
         return EXIT_OK
 

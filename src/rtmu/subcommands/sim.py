@@ -14,6 +14,7 @@ import sys
 from pathlib import Path
 
 from ..base.exit_codes import ENDED, EXIT_CONNECTION, EXIT_OK, EXIT_SIGINT, EXIT_USAGE
+from ..base.i18n import _
 from ..package_data import project_map
 from ._common import until_stop_signal
 from ._options import number_in
@@ -33,170 +34,196 @@ SIM_DESCRIPTION = (
 def register(subparsers: argparse._SubParsersAction) -> None:
     p = subparsers.add_parser(
         "sim",
-        help="run the bundled ARIA robot simulator (ArNetworking server, simulated Pioneer 3-DX)",
+        help=_("run the bundled ARIA robot simulator (ArNetworking server, simulated Pioneer 3-DX)"),
         description=SIM_DESCRIPTION,
     )
     p.add_argument(
-        "--host", default="127.0.0.1", metavar="ADDR", help="address to listen on (default 127.0.0.1)"
+        "--host", default="127.0.0.1", metavar="ADDR", help=_("address to listen on (default 127.0.0.1)")
     )
     p.add_argument(
         "--port",
         type=number_in(0, 65535, integer=True),
         default=7272,
         metavar="PORT",
-        help="the robot server's TCP port (default 7272, ARIA's; 0 = any free port)",
+        help=_("the robot server's TCP port (default 7272, ARIA's; 0 = any free port)"),
     )
     maps = p.add_mutually_exclusive_group()
     maps.add_argument(
-        "--map", type=Path, metavar="FILE", help="ARIA .map file to serve (default: the project's arena)"
+        "--map", type=Path, metavar="FILE", help=_("ARIA .map file to serve (default: the project's arena)")
     )
-    maps.add_argument("--no-map", action="store_true", help="serve no map (an empty world)")
+    maps.add_argument("--no-map", action="store_true", help=_("serve no map (an empty world)"))
     p.add_argument(
         "--users",
         type=Path,
         metavar="FILE",
-        help="ARIA user-info file (UserInfoVersion1); default: open to anyone",
+        help=_("ARIA user-info file (UserInfoVersion1); default: open to anyone"),
     )
     p.add_argument(
-        "--no-camera", action="store_true", help="no camera: video and camera data are not offered"
+        "--no-camera", action="store_true", help=_("no camera: video and camera data are not offered")
     )
     p.add_argument(
         "--camera-size",
         type=_size,
         default=(320, 240),
         metavar="WxH",
-        help="picture size at start (default 320x240; e.g. 640x480)",
+        help=_("picture size at start (default 320x240; e.g. 640x480)"),
     )
     p.add_argument(
         "--camera-hz",
         type=number_in(0.1, 60),
         default=10.0,
         metavar="HZ",
-        help="the simulated camera's own frame rate, 0.1…60 new frames/s (default 10, like ARIA's video "
-        "forwarder)",
+        help=_(
+            "the simulated camera's own frame rate, 0.1…60 new frames/s (default 10, like ARIA's video "
+            "forwarder)"
+        ),
     )
-    p.add_argument("--seed", type=int, default=1, metavar="N", help="seed for everything random (default 1)")
+    p.add_argument(
+        "--seed", type=int, default=1, metavar="N", help=_("seed for everything random (default 1)")
+    )
     p.add_argument(
         "--drive-timeout",
         type=number_in(0, 3600),
         default=2.0,
         metavar="S",
-        help="seconds without ratioDrive before a moving robot is stopped (default 2, ARIA's; 0 disables)",
+        help=_("seconds without ratioDrive before a moving robot is stopped (default 2, ARIA's; 0 disables)"),
     )
     p.add_argument(
-        "--battery", type=float, default=None, metavar="VOLTS", help="starting battery voltage (default 12.8)"
+        "--battery",
+        type=float,
+        default=None,
+        metavar="VOLTS",
+        help=_("starting battery voltage (default 12.8)"),
     )
     p.add_argument(
         "--server-key",
         default="",
         metavar="KEY",
-        help="ARIA server key mixed into password digests (default: none)",
+        help=_("ARIA server key mixed into password digests (default: none)"),
     )
     p.add_argument(
         "--max-clients",
         type=number_in(0, 100_000, integer=True),
         default=100,
         metavar="N",
-        help="refuse more clients than this, ARIA's reason 5 (default 100; 0 = no limit)",
+        help=_("refuse more clients than this, ARIA's reason 5 (default 100; 0 = no limit)"),
     )
     p.add_argument(
         "--kind",
         choices=("default", "aram"),
         default="default",
-        help="which server to be: default (serverDemo, Pioneer 3-DX) or aram (an Omron LD robot: "
-        "protocol 6MTX, state of charge, Ex4 map, only data 6MTX robots list); default: default",
+        help=_(
+            "which server to be: default (serverDemo, Pioneer 3-DX) or aram (an Omron LD robot: "
+            "protocol 6MTX, state of charge, Ex4 map, only data 6MTX robots list); default: default"
+        ),
     )
     p.add_argument(
         "--test-hooks",
         action="store_true",
         default=None,
-        help="list the simulator's own Simulator… commands (put it in a state: a fault, a locked mode, "
-        "a stall …) also on a kind that leaves them out to stay true to a real robot's list (aram)",
+        help=_(
+            "list the simulator's own Simulator… commands (put it in a state: a fault, a locked mode, "
+            "a stall …) also on a kind that leaves them out to stay true to a real robot's list (aram)"
+        ),
     )
     p.add_argument("--profile", dest="kind", choices=("default", "aram"), help=argparse.SUPPRESS)  # old name
     p.add_argument(
         "--protocol",
         metavar="STRING",
         default=None,
-        help="enforce and advertise this protocol string, refusing others with reason 4 "
-        "(default: the profile's — none, or 6MTX for aram)",
+        help=_(
+            "enforce and advertise this protocol string, refusing others with reason 4 "
+            "(default: the profile's — none, or 6MTX for aram)"
+        ),
     )
     p.add_argument(
         "--config-filler",
         type=int,
         default=0,
         metavar="N",
-        help="add N configuration parameters, markup in every text (try clients on a hostile ArConfig)",
+        help=_("add N configuration parameters, markup in every text (try clients on a hostile ArConfig)"),
     )
     p.add_argument(
         "--save-map-changes",
         action="store_true",
-        help="write live map changes (processMapChanges) into the --map file, as ARIA does "
-        "(default: they live in the simulator only)",
+        help=_(
+            "write live map changes (processMapChanges) into the --map file, as ARIA does "
+            "(default: they live in the simulator only)"
+        ),
     )
     p.add_argument(
         "--robots",
         type=int,
         default=None,
         metavar="N",
-        help="run N robots on the map, one server each on consecutive ports from --port, "
-        "named robot1…N (default 1); with --central: N simulated robots switched to it (default 0)",
+        help=_(
+            "run N robots on the map, one server each on consecutive ports from --port, "
+            "named robot1…N (default 1); with --central: N simulated robots switched to it (default 0)"
+        ),
     )
     p.add_argument(
         "--files",
         type=Path,
         metavar="DIR",
-        help="the folder served to getDirListing/getFile/putFile/deleteFile, where scans are written "
-        "(default: a temporary folder, removed when the simulator stops)",
+        help=_(
+            "the folder served to getDirListing/getFile/putFile/deleteFile, where scans are written "
+            "(default: a temporary folder, removed when the simulator stops)"
+        ),
     )
     p.add_argument(
         "--files-default-dir",
         metavar="NAME",
         default=None,
-        help="offer getDefaultUploadDownloadDir naming this folder (ARIA offers it only when given one)",
+        help=_("offer getDefaultUploadDownloadDir naming this folder (ARIA offers it only when given one)"),
     )
-    p.add_argument("-v", "--verbose", action="store_true", help="log connections and refusals")
+    p.add_argument("-v", "--verbose", action="store_true", help=_("log connections and refusals"))
     central = p.add_argument_group("ARIA central server (switchServer)")
     central.add_argument(
         "--central",
         action="store_true",
-        help="be a central server instead of a robot: operators on --port (7272) get the robot list, "
-        "robots switch to --robot-port (5000) and are each forwarded on a port of their own",
+        help=_(
+            "be a central server instead of a robot: operators on --port (7272) get the robot list, "
+            "robots switch to --robot-port (5000) and are each forwarded on a port of their own"
+        ),
     )
     central.add_argument(
         "--robot-port",
         type=number_in(0, 65535, integer=True),
         default=5000,
         metavar="PORT",
-        help="with --central: where robots switch to (default 5000)",
+        help=_("with --central: where robots switch to (default 5000)"),
     )
     central.add_argument(
         "--switch-to",
         metavar="HOST[:PORT]",
-        help="as a robot: connect out to this central server's robot port (default port 5000) and be "
-        "forwarded by it (ARIA's -centralServer); direct logins are then refused with reason 2",
+        help=_(
+            "as a robot: connect out to this central server's robot port (default port 5000) and be "
+            "forwarded by it (ARIA's -centralServer); direct logins are then refused with reason 2"
+        ),
     )
     central.add_argument(
         "--name",
         default="",
         metavar="NAME",
-        help="with --switch-to: the robot's name (ARIA's -identifier; default: its address)",
+        help=_("with --switch-to: the robot's name (ARIA's -identifier; default: its address)"),
     )
     gen = p.add_argument_group("map generator (writes a map and exits)")
-    gen.add_argument("--make-map", type=Path, metavar="FILE", help="write a generated building map to FILE")
+    gen.add_argument(
+        "--make-map", type=Path, metavar="FILE", help=_("write a generated building map to FILE")
+    )
     gen.add_argument(
         "--points",
         type=int,
         default=100_000,
         metavar="N",
-        help="points in the generated map (default 100000)",
+        help=_("points in the generated map (default 100000)"),
     )
     gen.add_argument(
         "--lines",
         type=int,
         default=5_000,
         metavar="N",
-        help="line segments in the generated map (default 5000)",
+        help=_("line segments in the generated map (default 5000)"),
     )
     p.set_defaults(handler=run)
 
@@ -220,14 +247,16 @@ def run(args: argparse.Namespace) -> int:
     if args.central:
         args.robots = 0 if args.robots is None else args.robots
         if not 0 <= args.robots <= 100:
-            print("rtmu sim: with --central, --robots takes 0…100", file=sys.stderr)
+            print(_("rtmu sim: with --central, --robots takes 0…100"), file=sys.stderr)
             return EXIT_BAD_INPUT
     else:
         from ..sim.multi import MAX_ROBOTS
 
         args.robots = 1 if args.robots is None else args.robots
         if not 1 <= args.robots <= MAX_ROBOTS:
-            print(f"rtmu sim: --robots must be 1…{MAX_ROBOTS}", file=sys.stderr)
+            print(
+                _("rtmu sim: --robots must be 1…{MAX_ROBOTS}").format(MAX_ROBOTS=MAX_ROBOTS), file=sys.stderr
+            )
             return EXIT_BAD_INPUT
     from ..sim import SimConfig
 
@@ -237,13 +266,13 @@ def run(args: argparse.Namespace) -> int:
         else (args.map or project_map("office.map" if args.kind == "aram" else "arena.map"))
     )
     if map_path is not None and not map_path.is_file():
-        print(f"rtmu sim: no such map file: {map_path}", file=sys.stderr)
+        print(_("rtmu sim: no such map file: {map_path}").format(map_path=map_path), file=sys.stderr)
         return EXIT_BAD_INPUT
     if args.files is not None and not args.files.is_dir():
-        print(f"rtmu sim: no such folder: {args.files}", file=sys.stderr)
+        print(_("rtmu sim: no such folder: {files}").format(files=args.files), file=sys.stderr)
         return EXIT_BAD_INPUT
     if args.users is not None and not args.users.is_file():
-        print(f"rtmu sim: no such user file: {args.users}", file=sys.stderr)
+        print(_("rtmu sim: no such user file: {users}").format(users=args.users), file=sys.stderr)
         return EXIT_BAD_INPUT
     cfg = SimConfig(
         host=args.host,
@@ -274,7 +303,7 @@ def run(args: argparse.Namespace) -> int:
         try:
             parse_address(args.switch_to)
         except ValueError as exc:
-            print(f"rtmu sim: {exc}", file=sys.stderr)
+            print(_("rtmu sim: {exc}").format(exc=exc), file=sys.stderr)
             return EXIT_BAD_INPUT
         cfg.switch_to, cfg.switch_name = args.switch_to, args.name
     if args.verbose:
@@ -301,12 +330,17 @@ async def serve(cfg) -> int:
     try:
         server = SimServer(cfg)
     except (OSError, MapFormatError, ValueError) as exc:
-        print(f"rtmu sim: cannot load: {exc}", file=sys.stderr)
+        print(_("rtmu sim: cannot load: {exc}").format(exc=exc), file=sys.stderr)
         return EXIT_BAD_INPUT
     try:
         await server.start()
     except OSError as exc:
-        print(f"rtmu sim: cannot listen on {cfg.host}:{cfg.port}: {exc.strerror or exc}", file=sys.stderr)
+        print(
+            _("rtmu sim: cannot listen on {host}:{port}: {value}").format(
+                host=cfg.host, port=cfg.port, value=exc.strerror or exc
+            ),
+            file=sys.stderr,
+        )
         return EXIT_CANNOT_LISTEN
     served = f"map {cfg.map_path}" if cfg.map_path else "no map"
     home = server.home
@@ -321,13 +355,14 @@ async def serve(cfg) -> int:
 
     files = files_folder(server)
     extras += f"; files in {files.root}" + (" (temporary)" if files.temporary is not None else "")
+    # The start line is read by programs (the port of --port 0): it stays in English in every language.
     print(
         f"rtmu sim: ARIA robot server listening on {cfg.host}:{server.port}, serving {served}; "
         f"{get_profile(cfg.profile).robot} at ({home[0]:.0f}, {home[1]:.0f}) mm, {home[2]:.0f} deg{extras}",
         flush=True,
     )
     code = await until_stop_signal()
-    print("rtmu sim: stopping (telling clients SHUTDOWN)", flush=True)
+    print(_("rtmu sim: stopping (telling clients SHUTDOWN)"), flush=True)
     await server.stop()
     if files.temporary is not None:
         files.temporary.cleanup()
@@ -342,19 +377,19 @@ async def serve_fleet(cfg, count: int) -> int:
     try:
         fleet = SimFleet(fleet_configs(cfg, count))
     except (OSError, MapFormatError, ValueError) as exc:
-        print(f"rtmu sim: cannot load: {exc}", file=sys.stderr)
+        print(_("rtmu sim: cannot load: {exc}").format(exc=exc), file=sys.stderr)
         return EXIT_BAD_INPUT
     try:
         await fleet.start()
     except OSError as exc:
-        print(f"rtmu sim: cannot listen: {exc.strerror or exc}", file=sys.stderr)
+        print(_("rtmu sim: cannot listen: {value}").format(value=exc.strerror or exc), file=sys.stderr)
         return EXIT_CANNOT_LISTEN
     for robot, server in zip(fleet.robots, fleet.servers, strict=True):
         x, y, th = server.home
-        print(f"rtmu sim: {robot.name} listening on {cfg.host}:{server.port}, "
+        print(f"rtmu sim: {robot.name} listening on {cfg.host}:{server.port}, "  # read by programs: English
               f"at ({x:.0f}, {y:.0f}) mm, {th:.0f} deg", flush=True)  # fmt: skip
     code = await until_stop_signal()
-    print("rtmu sim: stopping every robot (telling clients SHUTDOWN)", flush=True)
+    print(_("rtmu sim: stopping every robot (telling clients SHUTDOWN)"), flush=True)
     await fleet.stop()
     return code
 
@@ -364,9 +399,13 @@ def make_map(args: argparse.Namespace) -> int:
     from ..sim.mapgen import generate_map
 
     if args.points < 0 or args.lines < 0:
-        print("rtmu sim: --points and --lines cannot be negative", file=sys.stderr)
+        print(_("rtmu sim: --points and --lines cannot be negative"), file=sys.stderr)
         return EXIT_BAD_INPUT
     data = generate_map(args.points, args.lines, seed=args.seed)
     write_map(data, args.make_map)
-    print(f"rtmu sim: wrote {args.make_map} ({data.num_points} points, {data.num_lines} lines)")
+    print(
+        _("rtmu sim: wrote {make_map} ({num_points} points, {num_lines} lines)").format(
+            make_map=args.make_map, num_points=data.num_points, num_lines=data.num_lines
+        )
+    )
     return EXIT_OK

@@ -15,6 +15,7 @@ import sys
 from typing import TYPE_CHECKING, Any
 
 from ..base.exit_codes import EXIT_OK
+from ..base.i18n import _
 from ..client.errors import ClientTimeout, ProtocolFault
 from ..client.roles import Role
 from ..protocol.errors import ProtocolError
@@ -41,7 +42,7 @@ HEARTBEAT = 1.0
 def register(subparsers: Any) -> None:
     p = subparsers.add_parser(
         "status",
-        help="print or stream the robot status",
+        help=_("print or stream the robot status"),
         description="Print the robot status once (--once) or stream it until interrupted: a line whenever "
         f"the status changes, and the same line again at most every {HEARTBEAT:g} s while it does not "
         "(a heartbeat: the link is alive). JSON keys (schema status): x, y (mm), th (deg), vel (mm/s), "
@@ -49,21 +50,21 @@ def register(subparsers: Any) -> None:
         "where the server offers dockInfo.",
     )
     add_connection_arguments(p)
-    p.add_argument("--once", action="store_true", help="print one status and exit")
-    p.add_argument("--json", action="store_true", help="JSON: one object (one per line when streaming)")
+    p.add_argument("--once", action="store_true", help=_("print one status and exit"))
+    p.add_argument("--json", action="store_true", help=_("JSON: one object (one per line when streaming)"))
     p.add_argument(
         "--interval",
         type=number_in(10, 60_000, integer=True),
         default=100,
         metavar="MS",
-        help="how often the server is asked for the status when streaming, 10…60000 ms (default 100)",
+        help=_("how often the server is asked for the status when streaming, 10…60000 ms (default 100)"),
     )
     p.add_argument(
         "--count",
         type=number_in(0, 1e9, integer=True),
         default=0,
         metavar="N",
-        help="stop after N lines (default 0: never)",
+        help=_("stop after N lines (default 0: never)"),
     )
     p.set_defaults(handler=handle)
 
@@ -91,7 +92,7 @@ def handle(args: argparse.Namespace) -> int:
 
 def say(message: str) -> None:
     """A note for the operator on stderr, apart from the status lines (or JSON) on stdout."""
-    print(f"rtmu status: {message}", file=sys.stderr, flush=True)
+    print(_("rtmu status: {message}").format(message=message), file=sys.stderr, flush=True)
 
 
 async def stream(client: AriaClient, args: argparse.Namespace, show: Any) -> int:

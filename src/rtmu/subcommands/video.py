@@ -18,6 +18,7 @@ from pathlib import Path
 from typing import TYPE_CHECKING, Any
 
 from ..base.exit_codes import EXIT_CONNECTION, EXIT_OK, EXIT_USAGE
+from ..base.i18n import _
 from ..base.textsafe import visible
 from ..client.roles import Role
 from ._common import UsageError, add_connection_arguments, fail, run_with_client
@@ -41,24 +42,26 @@ FRAME_GLOB = "frame_*.jpg"
 def register(subparsers: Any) -> None:
     p = subparsers.add_parser(
         "video",
-        help="play the camera as live video and report frames/s, kB/s and frame age",
-        description="Ask for camera frames one at a time (getPicture<camera>, else sendVideo), the next "
-        "as soon as a frame arrives, capped by --fps; decode each, optionally save it, and report.",
+        help=_("play the camera as live video and report frames/s, kB/s and frame age"),
+        description=_(
+            "Ask for camera frames one at a time (getPicture<camera>, else sendVideo), the next "
+            "as soon as a frame arrives, capped by --fps; decode each, optionally save it, and report."
+        ),
     )
     add_connection_arguments(p)
-    p.add_argument("--seconds", type=float, default=5.0, metavar="S", help="how long to play (default 5)")
-    p.add_argument("--json", action="store_true", help="print one summary object (JSON) at the end")
+    p.add_argument("--seconds", type=float, default=5.0, metavar="S", help=_("how long to play (default 5)"))
+    p.add_argument("--json", action="store_true", help=_("print one summary object (JSON) at the end"))
     p.add_argument(
         "--out",
         type=Path,
         default=None,
         metavar="DIR",
-        help="save every decoded frame here as frame_NNNNNN.jpg (the folder is made if missing)",
+        help=_("save every decoded frame here as frame_NNNNNN.jpg (the folder is made if missing)"),
     )
     add_fps_option(p, default=15.0)
     add_quality_option(p)
     add_force_option(p, "frames saved in DIR by an earlier run")
-    p.add_argument("--camera", default=None, metavar="NAME", help="camera name (getPicture<NAME>)")
+    p.add_argument("--camera", default=None, metavar="NAME", help=_("camera name (getPicture<NAME>)"))
     p.set_defaults(handler=handle)
 
 
@@ -134,7 +137,7 @@ class _Player:
         if len(self.notes) < MAX_NOTES:
             self.notes.append(text)
         if not self.quiet:
-            print(f"rtmu video: {visible(text)}", file=sys.stderr)
+            print(_("rtmu video: {visible}").format(visible=visible(text)), file=sys.stderr)
 
     async def settle(self) -> None:
         import asyncio

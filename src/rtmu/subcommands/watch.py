@@ -16,6 +16,7 @@ from collections.abc import Callable
 from typing import TYPE_CHECKING, Any
 
 from ..base.exit_codes import EXIT_OK
+from ..base.i18n import _
 from ..base.textsafe import visible
 from ..client.errors import NotSupported
 from ..client.roles import Role
@@ -40,14 +41,18 @@ WATCHED = ("popupCreate", "popupClose", "getModeInfo", "updateStrings", *PLAIN_E
 def register(subparsers: Any) -> None:
     p = subparsers.add_parser(
         "watch",
-        help="follow the server's events: popups, mode and status changes, map/goals/config updates",
-        description="Print one line per server event as it happens (popups opened and closed, mode "
-        "and status changes, map, goals and configuration updated); the popups already open first. "
-        "Exit 0 after --seconds, 3 when the connection ends, 4 when the server broadcasts none of these.",
+        help=_("follow the server's events: popups, mode and status changes, map/goals/config updates"),
+        description=_(
+            "Print one line per server event as it happens (popups opened and closed, mode "
+            "and status changes, map, goals and configuration updated); the popups already open first. "
+            "Exit 0 after --seconds, 3 when the connection ends, 4 when the server broadcasts none of these."
+        ),
     )
     add_connection_arguments(p)
-    p.add_argument("--json", action="store_true", help="one JSON object per line (event, t, and its fields)")
-    p.add_argument("--seconds", type=positive_float, metavar="S", help="stop after S seconds (exit 0)")
+    p.add_argument(
+        "--json", action="store_true", help=_("one JSON object per line (event, t, and its fields)")
+    )
+    p.add_argument("--seconds", type=positive_float, metavar="S", help=_("stop after S seconds (exit 0)"))
     p.set_defaults(handler=handle)
 
 

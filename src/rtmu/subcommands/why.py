@@ -13,6 +13,7 @@ import sys
 from typing import TYPE_CHECKING, Any
 
 from ..base.exit_codes import EXIT_WHY_LOST, NETWORK, WHY_ASKED
+from ..base.i18n import _
 from ..base.textsafe import visible
 from ..client.roles import Role
 from ..client.why import diagnose
@@ -54,16 +55,20 @@ then asks again. Switching safe drive off, acknowledging and enabling need a yes
 def register(subparsers: Any) -> None:
     p = subparsers.add_parser(
         "why",
-        help="why won't the robot move? one sentence and its fix",
+        help=_("why won't the robot move? one sentence and its fix"),
         description=DESCRIPTION,
     )
     add_connection_arguments(p)
-    p.add_argument("--json", action="store_true", help="one JSON object: the answer, its reasons and fixes")
-    p.add_argument("--fix", action="store_true", help="carry out the fix where there is one, then ask again")
     p.add_argument(
-        "--yes", action="store_true", help="confirm fixes that need a yes (safe drive off, LD faults)"
+        "--json", action="store_true", help=_("one JSON object: the answer, its reasons and fixes")
     )
-    p.add_argument("--navigate", action="store_true", help="ask about navigation (a lost robot counts)")
+    p.add_argument(
+        "--fix", action="store_true", help=_("carry out the fix where there is one, then ask again")
+    )
+    p.add_argument(
+        "--yes", action="store_true", help=_("confirm fixes that need a yes (safe drive off, LD faults)")
+    )
+    p.add_argument("--navigate", action="store_true", help=_("ask about navigation (a lost robot counts)"))
     p.set_defaults(handler=handle)
 
 
@@ -85,7 +90,11 @@ def handle(args: argparse.Namespace) -> int:
             )
         else:
             for r in results:
-                print(f"fix: {visible(r.fix.label)}: {visible(r.message)}")
+                print(
+                    _("fix: {visible}: {visible2}").format(
+                        visible=visible(r.fix.label), visible2=visible(r.message)
+                    )
+                )
             print_answer(answer)
         return answer.exit_code
 
@@ -102,7 +111,7 @@ async def fix_all(
 
     results: list[FixResult] = []
     tried: set[str] = set()
-    for _ in range(MAX_FIXES):
+    for _attempt in range(MAX_FIXES):
         reason = next((r for r in answer.reasons if r.fix is not None and r.fix.key not in tried), None)
         if reason is None or reason.fix is None:
             break
@@ -121,7 +130,12 @@ def confirm(question: str, yes: bool) -> bool:
     if yes:
         return True
     if not sys.stdin.isatty():
-        print(f"rtmu: {visible(question)} — not confirmed (no terminal to ask; add --yes)", file=sys.stderr)
+        print(
+            _("rtmu: {visible} — not confirmed (no terminal to ask; add --yes)").format(
+                visible=visible(question)
+            ),
+            file=sys.stderr,
+        )
         return False
     try:
         said = input(f"{visible(question)} [y/N] ")
@@ -142,18 +156,18 @@ def print_answer(answer: Answer, out: Any = None, lead: str = "") -> None:
         print(lead + answer.sentence(), file=out)
     else:
         print(f"{lead}{visible(p.problem)}", file=out)
-        print(f"  what to do: {visible(p.advice)}", file=out)
+        print(_("  what to do: {visible}").format(visible=visible(p.advice)), file=out)
         if p.fix is not None:
             print(
                 f"  rtmu why --fix can: {visible(p.fix.label)}" + (" (asks first)" if p.fix.confirm else ""),
                 file=out,
             )
         for e in p.evidence:
-            print(f"  from: {visible(e)}", file=out)
+            print(_("  from: {visible}").format(visible=visible(e)), file=out)
     for r in answer.reasons[1:]:
         mark = "WARNING" if r.loud else "also"
         print(f"{mark}: {visible(r.sentence())}", file=out)
     for note in answer.notes:
-        print(f"note: {visible(note)}", file=out)
+        print(_("note: {visible}").format(visible=visible(note)), file=out)
     for v in answer.raw:
-        print(f"raw: {visible(v.text())}", file=out)
+        print(_("raw: {visible}").format(visible=visible(v.text())), file=out)

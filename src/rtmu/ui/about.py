@@ -19,6 +19,7 @@ gi.require_version("Gdk", "4.0")
 from gi.repository import Gdk, GLib, Gtk  # noqa: E402
 
 from .. import __version__  # noqa: E402
+from ..base.i18n import N_, _  # noqa: E402
 from ..base.textsafe import visible  # noqa: E402
 from ..model.observables import ConnectionState  # noqa: E402
 from ..package_data import APP_ID, DESKTOP_DIR  # noqa: E402
@@ -26,11 +27,11 @@ from ..settings.last_doctor import load_last_doctor  # noqa: E402
 from ..versions import version_lines  # noqa: E402
 from . import accessible  # noqa: E402
 
-LICENSE_TEXT = (
+LICENSE_TEXT = N_(
     "RTMU is free software under the MIT License: use, copy, change and share it, keeping the "
     "copyright notice. It comes with absolutely no warranty; the LICENSE file has the full text."
 )
-COMMENTS = (
+COMMENTS = N_(
     "Robot Teleoperation, Mobile User interface: drive an ARIA (ArNetworking) robot "
     "from a tablet or a laptop."
 )
@@ -78,10 +79,10 @@ def about_dialog(parent: Gtk.Window, conn: ConnectionState, profile: str) -> Gtk
         modal=True,
         program_name="RTMU",
         version=__version__,
-        comments=COMMENTS,
+        comments=_(COMMENTS),
         website=WEBSITE,
         license_type=Gtk.License.CUSTOM,
-        license=LICENSE_TEXT,
+        license=_(LICENSE_TEXT),
         wrap_license=True,
         system_information=info,
     )
@@ -89,9 +90,9 @@ def about_dialog(parent: Gtk.Window, conn: ConnectionState, profile: str) -> Gtk
     if paintable is not None:
         about.set_logo(paintable)
     copy = Gtk.Button(
-        label="Copy debug information", tooltip_text="Versions, the robot, the last rtmu doctor"
+        label=_("Copy debug information"), tooltip_text=_("Versions, the robot, the last rtmu doctor")
     )
-    accessible.name(copy, "Copy debug information")
+    accessible.name(copy, _("Copy debug information"))
     copy.connect("clicked", lambda b: _copy(b, info))
     header = about.get_titlebar()
     if isinstance(header, Gtk.HeaderBar):
@@ -102,4 +103,4 @@ def about_dialog(parent: Gtk.Window, conn: ConnectionState, profile: str) -> Gtk
 
 def _copy(button: Gtk.Button, text: str) -> None:
     button.get_clipboard().set(text)
-    button.set_label("Copied")
+    button.set_label(_("Copied"))

@@ -31,17 +31,19 @@ import gi
 gi.require_version("Gtk", "4.0")
 from gi.repository import Gio, GLib  # noqa: E402
 
+from ..base.i18n import N_, _  # noqa: E402
 from ..client.config_feed import ConfigApi, config_api  # noqa: E402
 from ..control.commands import COMMANDS, CommandState, action_name  # noqa: E402
 from ..model.observables import ConnectionState, RobotState  # noqa: E402
 from .keys import menu_item  # noqa: E402
+from .state_words import reason_words  # noqa: E402
 
 MainWindow = Any
 """``ui.window.MainWindow`` (which imports this module): named, not imported."""
 
 WINDOW_ROBOT_MENU = (
-    ("Camera picture", "win.camera", "request_image"),
-    ("Safe drive", "win.safe-drive", "safe_drive_on"),
+    (N_("Camera picture"), "win.camera", "request_image"),
+    (N_("Safe drive"), "win.safe-drive", "safe_drive_on"),
 )
 """The robot menu's window entries after the registry's menu commands: label, action, and the command
 whose state enables it (the camera page and the safe-drive switch are the window's, not commands)."""
@@ -49,14 +51,14 @@ PTZ_MOVES = ("ptz_left", "ptz_right", "ptz_up", "ptz_down", "ptz_zoom_in", "ptz_
 """The camera head's moves, each an action (``win.ptz-left`` …): its keys and the camera bar's buttons."""
 PICK_TURNS = ("ptz_left", "ptz_right")
 """In a pick mode these keys turn the picked heading instead of the camera head (``keyboard_nav``)."""
-UNKNOWN = CommandState(False, "unknown command")
+UNKNOWN = CommandState(False, N_("unknown command"))
 
 
 def short_reason(reason: str) -> str:
     """A reason short enough for a menu row ("this server does not offer X" → "not offered by the server")."""
     if reason.startswith(("this server does not offer", "this server offers no")):
-        return "not offered by the server"
-    return reason or "unavailable"
+        return _("not offered by the server")
+    return reason_words(reason) if reason else _("unavailable")
 
 
 def flag(action: Gio.SimpleAction) -> bool:
@@ -183,8 +185,13 @@ class WindowActions:
         """A command from a key, the menu or a button: refused with its reason while shown disabled."""
         state = self.states.get(name)
         if state is not None and not state.enabled:
-            label = COMMANDS.get(name).label.rstrip("…") if name in COMMANDS else name
-            self.window.banners.tell(f"notice:{name}", "warning", f"{label}: {state.reason}", timeout=4.0)
+            label = _(COMMANDS.get(name).label).rstrip("…") if name in COMMANDS else name
+            self.window.banners.tell(
+                f"notice:{name}",
+                "warning",
+                _("{command}: {reason}").format(command=label, reason=reason_words(state.reason)),
+                timeout=4.0,
+            )
             return
         self.window.controller.run(name)
 
@@ -270,52 +277,52 @@ class WindowActions:
         menu.append_section(None, self.robot_menu)
         self.view_menu = view = Gio.Menu()
         for label, action in (
-            ("Status toolbar", "win.toolbar"),
-            ("Full screen", "win.fullscreen"),
-            ("Touch D-pad", "win.dpad"),
-            ("Alarm sound", "win.alarm-sound"),
-            ("Camera inset on the map", "win.inset"),
-            ("Split view: map and video", "win.split"),
-            ("Camera field of view", "win.fov"),
-            ("Sonar readings", "win.sonar"),
-            ("Layers…", "win.layers"),
-            ("Robot details…", "win.details"),
-            ("Foxglove bridge (ws://127.0.0.1:8765)", "win.foxglove"),
+            (_("Status toolbar"), "win.toolbar"),
+            (_("Full screen"), "win.fullscreen"),
+            (_("Touch D-pad"), "win.dpad"),
+            (_("Alarm sound"), "win.alarm-sound"),
+            (_("Camera inset on the map"), "win.inset"),
+            (_("Split view: map and video"), "win.split"),
+            (_("Camera field of view"), "win.fov"),
+            (_("Sonar readings"), "win.sonar"),
+            (_("Layers…"), "win.layers"),
+            (_("Robot details…"), "win.details"),
+            (_("Foxglove bridge ({url})").format(url="ws://127.0.0.1:8765"), "win.foxglove"),
         ):
             view.append_item(menu_item(label, action))
         self.app_menu = app = Gio.Menu()
-        app.append_item(menu_item("Why won't it move?…", "win.why"))
+        app.append_item(menu_item(_("Why won't it move?…"), "win.why"))
         self.server_menu = server = Gio.Menu()  # the connection and the server's own settings: one row
         self.fill_server_menu(ConfigApi.ARCONFIG)
-        app.append_submenu("Server", server)
-        app.append_submenu("View", view)
+        app.append_submenu(_("Server"), server)
+        app.append_submenu(_("View"), view)
         helping = (
             Gio.Menu()
         )  # one row for both: "Why won't it move?" took a row, an 800×480 screen has no more
-        helping.append_item(menu_item("Keyboard shortcuts", "win.show-help-overlay"))
-        helping.append_item(menu_item("About RTMU", "win.about"))
-        app.append_submenu("Help", helping)
-        app.append_item(menu_item("Quit", "app.quit"))
+        helping.append_item(menu_item(_("Keyboard shortcuts"), "win.show-help-overlay"))
+        helping.append_item(menu_item(_("About RTMU"), "win.about"))
+        app.append_submenu(_("Help"), helping)
+        app.append_item(menu_item(_("Quit"), "app.quit"))
         menu.append_section(None, app)
         return menu
 
     def fill_server_menu(self, api: ConfigApi) -> None:
         """Server ▸ …: its Configuration row says which configuration API the robot has where RTMU
         cannot edit it yet (an Omron LD robot's), and that the console reads it."""
-        config = "Configuration…"
+        config = _("Configuration…")
         if api is ConfigApi.OMRON_LD:
-            config = f"Configuration… — {api.value}: not editable yet, see Console"
+            config = _("Configuration… — {api}: not editable yet, see Console").format(api=api.value)
         items = (
-            ("Connection settings…", "win.settings"),
+            (_("Connection settings…"), "win.settings"),
             (config, "win.server-config"),
-            ("Console…", "win.console"),
-            ("Files on the robot…", "win.files"),  # commissioning (``ui.commissioning``)
-            ("Scan a map…", "win.scan"),
-            ("Edit the map…", "win.map-edit"),
+            (_("Console…"), "win.console"),
+            (_("Files on the robot…"), "win.files"),  # commissioning (``ui.commissioning``)
+            (_("Scan a map…"), "win.scan"),
+            (_("Edit the map…"), "win.map-edit"),
         )
         menu = self.server_menu
         shown = [menu.get_item_attribute_value(i, "label", None) for i in range(menu.get_n_items())]
-        if [v.get_string() if v is not None else "" for v in shown] == [label for label, _ in items]:
+        if [v.get_string() if v is not None else "" for v in shown] == [label for label, _action in items]:
             return
         menu.remove_all()
         for label, action in items:
@@ -326,19 +333,19 @@ class WindowActions:
 
     def fill_robot_menu(self) -> None:
         """The robot's commands; a greyed one says why (GTK menus have no tooltips): "… — not connected"."""
-        entries = [(c.label, f"win.{action_name(c.name)}", c.name) for c in COMMANDS if c.menu]
+        entries = [(_(c.label), f"win.{action_name(c.name)}", c.name) for c in COMMANDS if c.menu]
         items = []
-        for label, action, command in (*entries, *WINDOW_ROBOT_MENU):
+        for label, action, command in (*entries, *((_(w), a, c) for w, a, c in WINDOW_ROBOT_MENU)):
             found = self.window.lookup_action(action.removeprefix("win."))
             state = self.states.get(command)
             if found is not None and not found.get_enabled() and state is not None:
-                label = f"{label} — {short_reason(state.reason)}"
+                label = _("{command} — {reason}").format(command=label, reason=short_reason(state.reason))
             items.append((label, action))
         shown = []
         for i in range(self.robot_menu.get_n_items()):
             value = self.robot_menu.get_item_attribute_value(i, "label", None)
             shown.append(value.get_string() if value is not None else "")
-        if shown == [label for label, _ in items]:
+        if shown == [label for label, _action in items]:
             return
         self.robot_menu.remove_all()
         for label, action in items:

@@ -12,6 +12,7 @@ import sys
 from typing import TYPE_CHECKING
 
 from ..base.exit_codes import EXIT_CONNECTION, EXIT_INTERNAL, EXIT_NO_DISPLAY, EXIT_USAGE
+from ..base.i18n import _
 from ..client.defaults import DEFAULT_PORT
 
 if TYPE_CHECKING:
@@ -23,36 +24,43 @@ if TYPE_CHECKING:
 
 def add_gui_arguments(parser: argparse.ArgumentParser) -> None:
     """The options of the window (``rtmu`` without a subcommand)."""
-    g = parser.add_argument_group("operator window (no subcommand)")
+    g = parser.add_argument_group(_("operator window (no subcommand)"))
     g.add_argument(
         "--demo",
         action="store_true",
-        help="run the bundled robot simulator (office map) on a free loopback port and connect to it",
+        help=_("run the bundled robot simulator (office map) on a free loopback port and connect to it"),
     )
     g.add_argument(
         "--robots",
         type=int,
         default=1,
         metavar="N",
-        help="with --demo: N simulated robots on one map (as rtmu sim --robots N), all in the window "
-        "(default 1)",
+        help=_(
+            "with --demo: N simulated robots on one map (as rtmu sim --robots N), all in the window "
+            "(default 1)"
+        ),
     )
     g.add_argument(
         "--central",
-        metavar="HOST[:PORT]",
-        help="ARIA's central server: every robot it lists in the window (as a profile's central = …)",
+        metavar=_("HOST[:PORT]"),
+        help=_("ARIA's central server: every robot it lists in the window (as a profile's central = …)"),
     )
-    g.add_argument("--host", metavar="HOST", help="robot server to connect to (default: the last profile)")
-    g.add_argument("--port", type=int, metavar="PORT", help=f"its port (default {DEFAULT_PORT})")
-    g.add_argument("--user", metavar="USER", help="user name for the server (asks for the password)")
-    g.add_argument("--profile", metavar="NAME", help="use this saved connection profile")
+    g.add_argument("--host", metavar="HOST", help=_("robot server to connect to (default: the last profile)"))
+    g.add_argument(
+        "--port",
+        type=int,
+        metavar="PORT",
+        help=_("its port (default {DEFAULT_PORT})").format(DEFAULT_PORT=DEFAULT_PORT),
+    )
+    g.add_argument("--user", metavar="USER", help=_("user name for the server (asks for the password)"))
+    g.add_argument("--profile", metavar="NAME", help=_("use this saved connection profile"))
     g.add_argument(
         "--protocol",
         metavar="STRING",
-        help="protocol string to log in with (default: the one the server advertises, e.g. 6MTX)",
+        help=_("protocol string to log in with (default: the one the server advertises, e.g. 6MTX)"),
     )
-    g.add_argument("--fullscreen", action="store_true", help="start full screen (F11 toggles)")
-    g.add_argument("--no-connect", action="store_true", help="open the window without connecting")
+    g.add_argument("--fullscreen", action="store_true", help=_("start full screen (F11 toggles)"))
+    g.add_argument("--no-connect", action="store_true", help=_("open the window without connecting"))
     g.add_argument("--report-first-frame", action="store_true", help=argparse.SUPPRESS)
     g.add_argument("--no-guardian", action="store_true", help=argparse.SUPPRESS)  # bench baselines only
 

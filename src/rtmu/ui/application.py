@@ -28,6 +28,7 @@ import gi
 gi.require_version("Gtk", "4.0")
 from gi.repository import Gio, GLib, Gtk  # noqa: E402
 
+from ..base.i18n import N_, _  # noqa: E402
 from ..client.central import CentralRoster  # noqa: E402
 from ..client.mapcache import SharedMaps  # noqa: E402
 from ..client.roster import RobotEndpoint, Roster  # noqa: E402
@@ -63,10 +64,12 @@ GLIB_SIGNALS = (signal.SIGINT, signal.SIGTERM, signal.SIGHUP, signal.SIGUSR1, si
 PYTHON_SIGNALS = (signal.SIGQUIT, signal.SIGALRM)
 """Signals that would kill the process by default and that GLib cannot watch: a Python handler."""
 _NO_BREAK = "\u2060"  # WORD JOINER: the line may not break here (not after the hyphens of "--demo")
-FIRST_RUN_HINT = (
-    "No robot set up yet: open the menu ☰ → Server → Connection settings (Ctrl+,) — or try the simulator: "
-    f"rtmu{_NO_BREAK}\u00a0-{_NO_BREAK}-{_NO_BREAK}demo"
+FIRST_RUN_WORDS = N_(
+    "No robot set up yet: open the menu ☰ → Server → Connection settings (Ctrl+,) — "
+    "or try the simulator: {demo}"
 )
+DEMO_COMMAND = f"rtmu{_NO_BREAK}\u00a0-{_NO_BREAK}-{_NO_BREAK}demo"
+FIRST_RUN_HINT = FIRST_RUN_WORDS.format(demo=DEMO_COMMAND)
 """Said on the first start; the menu button is on screen in a window and in full screen alike."""
 
 
@@ -236,12 +239,14 @@ class RtmuApplication(Gtk.Application):
         elif auto_connect:
             window.connect_now()
         elif not self.settings.profiles and not self.options.host and roster is None:
-            window.banners.tell("notice:hint", "info", FIRST_RUN_HINT, timeout=12.0)
+            window.banners.tell(
+                "notice:hint", "info", _(FIRST_RUN_WORDS).format(demo=DEMO_COMMAND), timeout=12.0
+            )
 
     def roster_for(self, profile: Profile) -> Roster | None:
         """Where a fleet profile's robots come from (None: a one-robot profile)."""
         if self.options.fleet:
-            return direct_roster(Profile("demo fleet", robots=self.options.fleet))
+            return direct_roster(Profile(_("demo fleet"), robots=self.options.fleet))
         if profile.central:
             host, port = parse_central(profile.central)
             password = self.secrets.get(profile) or "" if profile.user else ""
@@ -355,7 +360,9 @@ class RtmuApplication(Gtk.Application):
             self.window.banners.tell(
                 "notice:suspended",
                 "warning",
-                f"The window was suspended (pid {os.getpid()}): the robot was stopped. Press a key to drive.",
+                _(
+                    "The window was suspended (pid {getpid}): the robot was stopped. Press a key to drive."
+                ).format(getpid=os.getpid()),
                 timeout=6.0,
             )
 
@@ -365,9 +372,11 @@ class RtmuApplication(Gtk.Application):
         o = self.options
         s = self.settings
         if o.fleet:
-            return Profile("demo fleet", robots=o.fleet), True
+            return Profile(_("demo fleet"), robots=o.fleet), True
         if o.central:
-            return Profile(f"central {o.central}", central=o.central, user=o.user or ""), True
+            return Profile(
+                _("central {central}").format(central=o.central), central=o.central, user=o.user or ""
+            ), True
         if o.host:
             port = o.port or DEFAULT_PORT
             user = o.user or ""

@@ -17,6 +17,7 @@ import gi
 gi.require_version("Gtk", "4.0")
 from gi.repository import GLib, Gtk  # noqa: E402
 
+from ..base.i18n import _  # noqa: E402
 from . import accessible  # noqa: E402
 
 MAX_BANNERS = 4
@@ -194,8 +195,8 @@ class BannerStack(Gtk.Box):
         close.add_css_class("flat")
         close.add_css_class("circular")
         close.set_focusable(False)
-        close.set_tooltip_text("Dismiss")
-        accessible.name(close, "Dismiss")
+        close.set_tooltip_text(_("Dismiss"))
+        accessible.name(close, _("Dismiss"))
         close.connect("clicked", lambda _b: self.dismiss(topic))
         for child in (icon, label, bar, close):
             box.append(child)

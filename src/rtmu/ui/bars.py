@@ -22,6 +22,7 @@ gi.require_version("Gtk", "4.0")
 gi.require_version("Pango", "1.0")
 from gi.repository import Gio, Gtk, Pango  # noqa: E402
 
+from ..base.i18n import _  # noqa: E402
 from . import accessible  # noqa: E402
 
 
@@ -29,19 +30,19 @@ def stop_button(on_stop: Callable[[], None]) -> Gtk.Button:
     """A red STOP button (icon and word: readable at arm's length, not only by colour)."""
     box = Gtk.Box(spacing=6, halign=Gtk.Align.CENTER)
     box.append(Gtk.Image.new_from_icon_name("media-playback-stop-symbolic"))
-    box.append(Gtk.Label(label="STOP"))
-    button = Gtk.Button(child=box, tooltip_text="Stop the robot now (Space)")
+    box.append(Gtk.Label(label=_("STOP")))
+    button = Gtk.Button(child=box, tooltip_text=_("Stop the robot now (Space)"))
     button.add_css_class("destructive-action")
     button.add_css_class("stop-button")
     button.set_focusable(False)
     button.connect("clicked", lambda _b: on_stop())
-    accessible.name(button, "STOP")  # GTK 4.8 does not name a button from a label inside a box
+    accessible.name(button, _("STOP"))  # GTK 4.8 does not name a button from a label inside a box
     return button
 
 
 def connect_button(on_click: Callable[[], None]) -> Gtk.Button:
     """Connect ⇄ Disconnect: a plain button (the window sets its label from the connection phase)."""
-    button = Gtk.Button(label="Connect")
+    button = Gtk.Button(label=_("Connect"))
     button.add_css_class("connect-button")
     button.set_focusable(False)
     button.connect("clicked", lambda _b: on_click())
@@ -49,7 +50,7 @@ def connect_button(on_click: Callable[[], None]) -> Gtk.Button:
 
 
 def menu_button(menu: Gio.MenuModel) -> Gtk.MenuButton:
-    button = Gtk.MenuButton(icon_name="open-menu-symbolic", tooltip_text="Menu")
+    button = Gtk.MenuButton(icon_name="open-menu-symbolic", tooltip_text=_("Menu"))
     button.set_focusable(False)
     # The menu button's own inner toggle would take the window's first focus and then wear a focus
     # ring after any key press; keys go to the capture-phase router, so nothing here needs focus.
@@ -57,14 +58,14 @@ def menu_button(menu: Gio.MenuModel) -> Gtk.MenuButton:
     if inner is not None:
         inner.set_focusable(False)
     button.set_menu_model(menu)
-    accessible.name_menu_button(button, "Main menu")
+    accessible.name_menu_button(button, _("Main menu"))
     return button
 
 
 def show_connection(button: Gtk.Button, connected_ish: bool) -> None:
-    button.set_label("Disconnect" if connected_ish else "Connect")
+    button.set_label(_("Disconnect") if connected_ish else _("Connect"))
     button.set_tooltip_text(
-        "Disconnect (Ctrl+D); stops the robot first" if connected_ish else "Connect (Ctrl+O)"
+        _("Disconnect (Ctrl+D); stops the robot first") if connected_ish else _("Connect (Ctrl+O)")
     )
 
 
@@ -88,7 +89,7 @@ class HeaderBar(Gtk.HeaderBar):
         self.pack_start(self.connect_button)
         title_box = Gtk.Box(orientation=Gtk.Orientation.VERTICAL, valign=Gtk.Align.CENTER)
         title_box.add_css_class("title-box")
-        self.title_label = Gtk.Label(label="RTMU")
+        self.title_label = Gtk.Label(label=_("RTMU"))
         self.title_label.add_css_class("title")
         self.title_label.set_ellipsize(Pango.EllipsizeMode.END)  # a 560 px window keeps its buttons
         self.subtitle_label = Gtk.Label(label="")
@@ -133,10 +134,10 @@ class FullscreenBar(Gtk.Revealer):
         self.status_label.set_use_markup(False)
         self.menu_button = menu_button(menu)
         self.leave_button = Gtk.Button(
-            icon_name="view-restore-symbolic", tooltip_text="Leave full screen (F11)"
+            icon_name="view-restore-symbolic", tooltip_text=_("Leave full screen (F11)")
         )
         self.leave_button.set_focusable(False)
-        accessible.name(self.leave_button, "Leave full screen")
+        accessible.name(self.leave_button, _("Leave full screen"))
         self.leave_button.connect("clicked", lambda _b: on_leave())
         for child in (self.stop_button, self.connect_button, self.status_label, self.menu_button):
             box.append(child)

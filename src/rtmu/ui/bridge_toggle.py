@@ -12,6 +12,7 @@ from __future__ import annotations
 from collections.abc import Callable
 from typing import TYPE_CHECKING
 
+from ..base.i18n import _
 from ..base.notices import Kind, Notice
 from ..fleet.sessions import RobotSession
 from ..recorder.topics import BRIDGE_PORT
@@ -58,11 +59,16 @@ class BridgeToggle:
         try:
             bridge.start()
         except Exception as exc:
-            self.tell(Notice.error(Kind.RECORDING, f"Foxglove bridge not started: {exc}"))
+            self.tell(Notice.error(Kind.RECORDING, _("Foxglove bridge not started: {exc}").format(exc=exc)))
             return False
         self._attach(bridge)
         self.bridge = bridge
-        self.tell(Notice.info(Kind.RECORDING, f"Foxglove bridge on ws://{HOST}:{bridge.port} (no drive)"))
+        self.tell(
+            Notice.info(
+                Kind.RECORDING,
+                _("Foxglove bridge on ws://{HOST}:{port} (no drive)").format(HOST=HOST, port=bridge.port),
+            )
+        )
         return True
 
     def _attach(self, bridge: Bridge) -> None:
@@ -89,7 +95,7 @@ class BridgeToggle:
         self.session.runner.on_publish = self._before
         if bridge is not None:
             bridge.close()
-        self.tell(Notice.info(Kind.RECORDING, "Foxglove bridge stopped"))
+        self.tell(Notice.info(Kind.RECORDING, _("Foxglove bridge stopped")))
 
     def follow_selection(self, old: RobotSession, new: RobotSession) -> None:
         """The window shows another robot: the bridge publishes that one (it runs on, same port)."""
@@ -99,7 +105,7 @@ class BridgeToggle:
             return
         old.runner.on_publish = self._before
         self._attach(bridge)
-        self.tell(Notice.info(Kind.RECORDING, f"Foxglove bridge now shows {new.name}"))
+        self.tell(Notice.info(Kind.RECORDING, _("Foxglove bridge now shows {name}").format(name=new.name)))
 
     def close(self) -> None:
         if self.bridge is not None:

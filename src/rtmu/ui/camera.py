@@ -21,6 +21,7 @@ gi.require_version("Pango", "1.0")
 gi.require_version("Gdk", "4.0")
 from gi.repository import Gdk, GLib, Gtk, Pango  # noqa: E402
 
+from ..base.i18n import _  # noqa: E402
 from ..model.observables import CameraImage  # noqa: E402
 from .toolbar import age_text  # noqa: E402
 
@@ -59,12 +60,12 @@ def decode_jpeg(data: bytes) -> Decoded:
     from PIL import Image, UnidentifiedImageError
 
     if len(data) > MAX_JPEG_BYTES:
-        raise ValueError("the picture is too large")
+        raise ValueError(_("the picture is too large"))
     try:
         with Image.open(io.BytesIO(data)) as img:
             w, h = img.size
             if not (0 < w <= MAX_SIDE and 0 < h <= MAX_SIDE):
-                raise ValueError(f"a {w}×{h} picture is out of range")
+                raise ValueError(_("a {width}×{height} picture is out of range").format(width=w, height=h))
             img.draft("RGB", (DECODE_SIDE, DECODE_SIDE))  # a no-op for all but big JPEGs
             rgb = img.convert("RGB")
             w, h = rgb.size
@@ -75,11 +76,13 @@ def decode_jpeg(data: bytes) -> Decoded:
             return Decoded(w, h, rgb.tobytes(), thumb.width, thumb.height, thumb.tobytes())
     except UnidentifiedImageError:
         # Pillow's own text names a Python object ("<_io.BytesIO object at 0x…>"): say it plainly.
-        raise ValueError(f"the {len(data)} bytes received are not a picture") from None
+        raise ValueError(_("the {count} bytes received are not a picture").format(count=len(data))) from None
     except Image.DecompressionBombError:
-        raise ValueError("the picture claims too many pixels") from None
+        raise ValueError(_("the picture claims too many pixels")) from None
     except OSError:
-        raise ValueError(f"the picture is damaged or cut short ({len(data)} bytes)") from None
+        raise ValueError(
+            _("the picture is damaged or cut short ({count} bytes)").format(count=len(data))
+        ) from None
 
 
 HAND_OVER_PRIORITY = GLib.PRIORITY_HIGH_IDLE
@@ -205,20 +208,20 @@ class CameraView(Gtk.Box):
         self.info = Gtk.Label(xalign=0.0, hexpand=True)
         self.info.set_use_markup(False)
         self.info.set_ellipsize(Pango.EllipsizeMode.END)
-        self.refresh_button = Gtk.Button.new_with_label("New picture")
+        self.refresh_button = Gtk.Button.new_with_label(_("New picture"))
         self.refresh_button.set_focusable(False)
         self.refresh_button.connect("clicked", lambda _b: on_request())
-        back = Gtk.Button.new_with_label("Back to map (Esc)")
+        back = Gtk.Button.new_with_label(_("Back to map (Esc)"))
         back.set_focusable(False)
         back.connect("clicked", lambda _b: on_back())
         self.back_button = back
         self.compact = False
-        self._refresh_tip = "New picture"
+        self._refresh_tip = _("New picture")
         self._words_on_buttons()
         for w in (self.info, self.refresh_button, back):
             bar.append(w)
         self.append(bar)
-        self._show_status("No picture yet.", busy=False)
+        self._show_status(_("No picture yet."), busy=False)
 
     # -- state -------------------------------------------------------------------------------
     @property
@@ -240,12 +243,12 @@ class CameraView(Gtk.Box):
         self.requested_at = self.clock()
         self.error = ""
         self.picture.add_css_class("dimmed")
-        self._show_status("Requesting a picture…", busy=True)
+        self._show_status(_("Requesting a picture…"), busy=True)
         self.tick()
 
     def show_picture(self, image: CameraImage, texture: Gdk.Texture | None, error: str) -> None:
         if texture is None:
-            self.failed(f"The picture could not be shown: {error}")
+            self.failed(_("The picture could not be shown: {error}").format(error=error))
             return
         self.image, self.texture = image, texture
         self.requested_at = None
@@ -268,19 +271,21 @@ class CameraView(Gtk.Box):
         self.image = self.texture = None
         self.picture.set_paintable(None)
         self.requested_at = None
-        self._show_status("No picture yet.", busy=False)
+        self._show_status(_("No picture yet."), busy=False)
         self.tick()
 
     def set_available(self, enabled: bool, reason: str) -> None:
         self.refresh_button.set_sensitive(enabled)
-        self._refresh_tip = "New picture" if enabled else f"Camera picture: {reason}"
+        self._refresh_tip = (
+            _("New picture") if enabled else _("Camera picture: {reason}").format(reason=reason)
+        )
         self.refresh_button.set_tooltip_text(self._refresh_tip)
 
     def _buttons(self) -> tuple[tuple[Gtk.Button, str, str, str], ...]:
         """(button, its words, its icon, its tooltip)."""
         return (
-            (self.refresh_button, "New picture", "camera-photo-symbolic", self._refresh_tip),
-            (self.back_button, "Back to map (Esc)", "go-previous-symbolic", "Back to map (Esc)"),
+            (self.refresh_button, _("New picture"), "camera-photo-symbolic", self._refresh_tip),
+            (self.back_button, _("Back to map (Esc)"), "go-previous-symbolic", _("Back to map (Esc)")),
         )
 
     def _words_on_buttons(self) -> None:
@@ -310,17 +315,23 @@ class CameraView(Gtk.Box):
         self.fit_bar(self.get_width())
         now = self.clock()
         if self.requested_at is not None and now - self.requested_at > REQUEST_TIMEOUT:
-            self.failed(f"No picture arrived within {REQUEST_TIMEOUT:.0f} s.")
+            self.failed(
+                _("No picture arrived within {REQUEST_TIMEOUT:.0f} s.").format(
+                    REQUEST_TIMEOUT=REQUEST_TIMEOUT
+                )
+            )
             return
         if self.image is None:
-            self.info.set_text("Requesting…" if self.waiting else (self.error or "No picture"))
+            self.info.set_text(_("Requesting…") if self.waiting else (self.error or _("No picture")))
             return
         age = max(0.0, now - self.image.received_at)
-        text = f"{self.image.width}×{self.image.height} from {self.image.source}"
+        text = _("{width}×{height} from {source}").format(
+            width=self.image.width, height=self.image.height, source=self.image.source
+        )
         if not self.age_shown_elsewhere:  # live video's caption says the frame's age: one age, not two
-            text += f" · {age_text(age)} old"
+            text += _(" · {age_text} old").format(age_text=age_text(age))
         if self.waiting:
-            text += " · requesting a new one…"
+            text += _(" · requesting a new one…")
         if text != self.info.get_text():
             self.info.set_text(text)
 
@@ -401,12 +412,12 @@ class CameraInset(Gtk.Box):
             self._show_age("", None)
             return
         age = age_text(max(0.0, self.clock() - self.received_at))
-        fresh = f"old picture · {age}" if old else age
+        fresh = _("old picture · {age}").format(age=age) if old else age
         self._show_age(
-            fresh if self.live else f"{age} · link lost",
-            f"Camera picture taken {age} ago (click or Esc for the camera view)"
+            fresh if self.live else _("{age} · link lost").format(age=age),
+            _("Camera picture taken {age} ago (click or Esc for the camera view)").format(age=age)
             if self.live
-            else f"Camera picture taken {age} ago, before the link was lost",
+            else _("Camera picture taken {age} ago, before the link was lost").format(age=age),
         )
 
     def _show_age(self, text: str, tooltip: str | None) -> None:

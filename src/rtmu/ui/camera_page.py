@@ -21,6 +21,7 @@ gi.require_version("Gtk", "4.0")
 gi.require_version("Gdk", "4.0")
 from gi.repository import Gdk, Gtk  # noqa: E402
 
+from ..base.i18n import N_, _  # noqa: E402
 from ..control.commands import CommandState  # noqa: E402
 from ..fleet.selected import SelectedRobot  # noqa: E402
 from ..model.observables import CameraImage, ConnectionState, Phase, RobotModel  # noqa: E402
@@ -33,10 +34,11 @@ from .motion import MotionIndicator, held_by  # noqa: E402
 from .pip import PictureInPicture  # noqa: E402
 from .ptz_controls import PtzControls  # noqa: E402
 from .split_view import SplitView  # noqa: E402
+from .state_words import reason_words  # noqa: E402
 
 PAGE = "camera"
 """The camera page's name in the window's stack (the map's is ``map``)."""
-BUTTON_TIP = "Camera picture (Esc)"
+BUTTON_TIP = N_("Camera picture (Esc)")
 
 
 class CameraPage:
@@ -77,8 +79,8 @@ class CameraPage:
         self.button = Gtk.ToggleButton(icon_name="camera-photo-symbolic")
         """The header's camera button: pressed while the page shows."""
         self.button.set_focusable(False)
-        self.button.set_tooltip_text(BUTTON_TIP)
-        accessible.name(self.button, "Camera picture")
+        self.button.set_tooltip_text(_(BUTTON_TIP))
+        accessible.name(self.button, _("Camera picture"))
         self.button.connect("clicked", self._button_clicked)
         # What the page holds on a robot (the head polled, the video playing) moves with the selection.
         robot.on_switch(self.ptz.follow_selection)
@@ -95,10 +97,15 @@ class CameraPage:
         """Show the page (``request``: with a new picture); refused with the reason while no camera."""
         state = self._command_state("request_image")
         if request and not state.enabled:
-            self.banners.tell("camera", "warning", f"Camera picture: {state.reason}", timeout=4.0)
+            self.banners.tell(
+                "camera",
+                "warning",
+                _("Camera picture: {reason}").format(reason=reason_words(state.reason)),
+                timeout=4.0,
+            )
             self.button.set_active(False)
             return
-        self.robot.session.controller.look("the camera page")  # a held drive ends; a navigation goes on
+        self.robot.session.controller.look(_("the camera page"))  # a held drive ends; a navigation goes on
         self.stack.set_visible_child_name(PAGE)
         self.button.set_active(True)
         if (request or self.view.image is None) and not self.live.live:
@@ -130,20 +137,26 @@ class CameraPage:
         if state is None:
             return
         self.button.set_sensitive(state.enabled or self.showing)
-        self.button.set_tooltip_text(BUTTON_TIP if state.enabled else f"Camera picture: {state.reason}")
-        self.view.set_available(state.enabled, state.reason)
+        self.button.set_tooltip_text(
+            _(BUTTON_TIP)
+            if state.enabled
+            else _("Camera picture: {reason}").format(reason=reason_words(state.reason))
+        )
+        self.view.set_available(state.enabled, reason_words(state.reason))
 
     # -- keys ----------------------------------------------------------------------------------
     def live_key(self) -> None:
         """V: live video on (where the server has a camera) or off, from any page."""
         camera = self._command_state("request_image")
         if reason := self.live.toggle(camera.enabled, camera.reason):
-            self.banners.tell("camera", "warning", f"Live video: {reason}", timeout=4.0)
+            self.banners.tell(
+                "camera", "warning", _("Live video: {reason}").format(reason=reason), timeout=4.0
+            )
 
     def ptz_key(self, name: str) -> None:
         """A pan-tilt-zoom move (``ptz_left`` …); the reason it cannot go, as a banner."""
         if reason := self.ptz.key(name):
-            self.banners.tell("ptz", "warning", f"Camera head: {reason}", timeout=4.0)
+            self.banners.tell("ptz", "warning", _("Camera head: {reason}").format(reason=reason), timeout=4.0)
 
     def set_split(self, on: bool) -> None:
         """Map and video side by side: the split starts live video (the pane would show nothing else)."""

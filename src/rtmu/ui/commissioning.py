@@ -16,6 +16,7 @@ import gi
 gi.require_version("Gtk", "4.0")
 from gi.repository import Gtk  # noqa: E402
 
+from ..base.i18n import _, ngettext  # noqa: E402
 from ..fleet.selected import SelectedRobot  # noqa: E402
 from ..mapedit import MapObject  # noqa: E402
 from ..model.observables import RobotModel  # noqa: E402
@@ -32,7 +33,7 @@ DRAFT_TOPIC = "map-draft"
 def default_downloads() -> Path:
     """Where downloads go until the operator picks a folder: ~/Downloads where it exists, else ~."""
     home = Path.home()
-    downloads = home / "Downloads"
+    downloads = home / _("Downloads")
     return downloads if downloads.is_dir() else home
 
 
@@ -80,10 +81,11 @@ class Commissioning:
         if objects is None:
             self.banners.dismiss(DRAFT_TOPIC)
         else:
-            plural = "s" if edits != 1 else ""
-            text = (
-                f"The map shows a draft ({edits} edit{plural}), not applied: Apply or Discard in Edit the map"
-            )
+            text = ngettext(
+                "The map shows a draft ({edits} edit), not applied: Apply or Discard in Edit the map",
+                "The map shows a draft ({edits} edits), not applied: Apply or Discard in Edit the map",
+                edits,
+            ).format(edits=edits)
             self.banners.tell(DRAFT_TOPIC, "info", text, timeout=None)
 
     def scan(self) -> None:

@@ -29,6 +29,7 @@ gi.require_version("Gtk", "4.0")
 gi.require_version("Pango", "1.0")
 from gi.repository import Gdk, GLib, Gtk, Pango  # noqa: E402
 
+from ..base.i18n import N_, _, ngettext  # noqa: E402
 from ..base.textsafe import visible  # noqa: E402
 from ..client.config_care import DEFAULTS, Difference, FactoryValues, differences, same_value  # noqa: E402
 from ..client.config_feed import ServerConfig  # noqa: E402
@@ -39,14 +40,14 @@ from . import accessible  # noqa: E402
 from .confirm import Confirm  # noqa: E402
 
 Request = Callable[[Intent], "concurrent.futures.Future[Any]"]
-NO_DEFAULTS = (
+NO_DEFAULTS = N_(
     "this server keeps no factory values (getConfigDefaults: ARIA offers it only when started with a "
     "defaults file)"
 )
 
 
 def _values(count: int) -> str:
-    return f"{count} value" + ("" if count == 1 else "s")
+    return ngettext("{count} value", "{count} values", count).format(count=count)
 
 
 def _margins(box: Gtk.Widget, px: int) -> None:
@@ -71,7 +72,7 @@ class DefaultsWindow(Gtk.Window):
     """What differs from the factory values, with a reset per parameter and per section."""
 
     def __init__(self, parent: Gtk.Window, request: Request, changed: Callable[[], None]) -> None:
-        super().__init__(title="Changed from default", transient_for=parent, destroy_with_parent=True)
+        super().__init__(title=_("Changed from default"), transient_for=parent, destroy_with_parent=True)
         self.set_default_size(620, 380)
         self._request, self._changed = request, changed
         self.differences: list[Difference] = []
@@ -81,7 +82,7 @@ class DefaultsWindow(Gtk.Window):
         self.section_buttons: dict[str, Gtk.Button] = {}
         box = Gtk.Box(orientation=Gtk.Orientation.VERTICAL, spacing=6)
         _margins(box, 8)
-        self.status = Gtk.Label(label="Loading…", xalign=0.0, wrap=True)
+        self.status = Gtk.Label(label=_("Loading…"), xalign=0.0, wrap=True)
         box.append(self.status)
         self.grid = Gtk.Grid(column_spacing=12, row_spacing=6)
         scroller = Gtk.ScrolledWindow(vexpand=True, hscrollbar_policy=Gtk.PolicyType.NEVER)
@@ -119,7 +120,9 @@ class DefaultsWindow(Gtk.Window):
         for f in (config_f, factory_f):
             error = f.exception() if not f.cancelled() else concurrent.futures.CancelledError()
             if error is not None:
-                self.status.set_text(f"Could not compare with the factory values: {error}")
+                self.status.set_text(
+                    _("Could not compare with the factory values: {error}").format(error=error)
+                )
                 self.status.add_css_class("error")
                 return
         config: ServerConfig = config_f.result()
@@ -134,17 +137,25 @@ class DefaultsWindow(Gtk.Window):
         self.reset_buttons, self.section_buttons = {}, {}
         self.status.remove_css_class("error")
         if not self.differences:
-            self.status.set_text(f"Every parameter has its factory value ({known} known).")
+            self.status.set_text(
+                _("Every parameter has its factory value ({known} known).").format(known=known)
+            )
             return
         n = len(self.differences)
-        self.status.set_text(f"{n} parameter{'s differ' if n != 1 else ' differs'} from its factory value.")
+        self.status.set_text(
+            ngettext(
+                "{n} parameter differs from its factory value.",
+                "{n} parameters differ from their factory values.",
+                n,
+            ).format(n=n)
+        )
         row = 0
         for section in dict.fromkeys(d.section for d in self.differences):
             heading = Gtk.Label(label=visible(section), xalign=0.0, hexpand=True)
             heading.add_css_class("heading")
             self.grid.attach(heading, 0, row, 3, 1)
             mine = [d for d in self.differences if d.section == section]
-            whole = Gtk.Button(label="Reset section")
+            whole = Gtk.Button(label=_("Reset section"))
             whole.set_sensitive(any(d.editable for d in mine))
             whole.connect("clicked", lambda _b, m=mine: self._reset(m))
             self.grid.attach(whole, 3, row, 1, 1)
@@ -154,15 +165,29 @@ class DefaultsWindow(Gtk.Window):
                 end = Pango.EllipsizeMode.END
                 self.grid.attach(Gtk.Label(label=visible(d.name), xalign=0.0, ellipsize=end), 0, row, 1, 1)
                 self.grid.attach(
-                    Gtk.Label(label=f"now {visible(d.value)}", xalign=0.0, ellipsize=end), 1, row, 1, 1
+                    Gtk.Label(
+                        label=_("now {visible}").format(visible=visible(d.value)), xalign=0.0, ellipsize=end
+                    ),
+                    1,
+                    row,
+                    1,
+                    1,
                 )
                 self.grid.attach(
-                    Gtk.Label(label=f"factory {visible(d.default)}", xalign=0.0, ellipsize=end), 2, row, 1, 1
+                    Gtk.Label(
+                        label=_("factory {visible}").format(visible=visible(d.default)),
+                        xalign=0.0,
+                        ellipsize=end,
+                    ),
+                    2,
+                    row,
+                    1,
+                    1,
                 )
-                button = Gtk.Button(label="Reset to default")
+                button = Gtk.Button(label=_("Reset to default"))
                 if not d.editable:
                     button.set_sensitive(False)
-                    button.set_tooltip_text("Read-only: above the priority this server lets you edit")
+                    button.set_tooltip_text(_("Read-only: above the priority this server lets you edit"))
                 button.connect("clicked", lambda _b, one=d: self._reset([one]))
                 self.grid.attach(button, 3, row, 1, 1)
                 self.reset_buttons[(d.section, d.name)] = button
@@ -176,13 +201,15 @@ class DefaultsWindow(Gtk.Window):
         if not changes:
             return
         names = ", ".join(f"{s}/{n}" for s, params in changes.items() for n in params)
-        self.status.set_text(f"Resetting {names}…")
+        self.status.set_text(_("Resetting {names}…").format(names=names))
 
         def answered(reply: Any, error: BaseException | None) -> None:
             if error is None and reply is not None and not reply.accepted:
                 error = RuntimeError(reply.error)
             if error is not None:
-                self.status.set_text(f"The server did not reset {names}: {error}")
+                self.status.set_text(
+                    _("The server did not reset {names}: {error}").format(names=names, error=error)
+                )
                 self.status.add_css_class("error")
                 return
             self._changed()
@@ -203,11 +230,11 @@ class ConfigCare:
     ) -> None:
         self.page, self._request, self._offers, self._say = page, request, offers, say
         self.buttons = Gtk.Box(spacing=6)
-        self.defaults_button = Gtk.Button(label="Changed from default…")
+        self.defaults_button = Gtk.Button(label=_("Changed from default…"))
         self.defaults_button.connect("clicked", lambda _b: self.show_defaults())
-        self.export_button = Gtk.Button(label="Export…")
+        self.export_button = Gtk.Button(label=_("Export…"))
         self.export_button.connect("clicked", lambda _b: self._choose(export=True))
-        self.import_button = Gtk.Button(label="Import…")
+        self.import_button = Gtk.Button(label=_("Import…"))
         self.import_button.connect("clicked", lambda _b: self._choose(export=False))
         for b in (self.defaults_button, self.export_button, self.import_button):
             self.buttons.append(b)
@@ -229,7 +256,7 @@ class ConfigCare:
         if offered:
             self.defaults_button.set_has_tooltip(False)
         else:
-            self.defaults_button.set_tooltip_text(NO_DEFAULTS)
+            self.defaults_button.set_tooltip_text(_(NO_DEFAULTS))
         if offered and self.factory is None and not self._reading:
             self._reading = True
 
@@ -249,17 +276,27 @@ class ConfigCare:
         if default is None or same_value(param, default):
             return None
         button = Gtk.Button(icon_name="edit-undo-symbolic", valign=Gtk.Align.CENTER)
-        accessible.name(button, "Reset to default")
-        button.set_tooltip_text(f"Reset to default ({visible(default)})")
+        accessible.name(button, _("Reset to default"))
+        button.set_tooltip_text(_("Reset to default ({visible})").format(visible=visible(default)))
         button.set_sensitive(editable)
 
         def answered(reply: Any, error: BaseException | None) -> None:
             if error is None and reply is not None and not reply.accepted:
                 error = RuntimeError(reply.error)
             if error is not None:
-                self._say(f"{section}/{param.name} was not reset: {error}", True)
+                self._say(
+                    _("{section}/{name} was not reset: {error}").format(
+                        section=section, name=param.name, error=error
+                    ),
+                    True,
+                )
             else:
-                self._say(f"{section}/{param.name} is back to its factory value {default}", False)
+                self._say(
+                    _("{section}/{name} is back to its factory value {default}").format(
+                        section=section, name=param.name, default=default
+                    ),
+                    False,
+                )
             self._refresh_page()
 
         changes = {section: {param.name: default}}
@@ -283,13 +320,13 @@ class ConfigCare:
     # -- files ------------------------------------------------------------------------------------
     def _choose(self, *, export: bool) -> None:
         if self._config() is None:
-            self._say("Wait for the configuration to load first", True)
+            self._say(_("Wait for the configuration to load first"), True)
             return
         action = Gtk.FileChooserAction.SAVE if export else Gtk.FileChooserAction.OPEN
-        title = "Export the configuration" if export else "Import a configuration"
+        title = _("Export the configuration") if export else _("Import a configuration")
         chooser = Gtk.FileChooserDialog(title=title, transient_for=self.page, modal=True, action=action)
-        chooser.add_button("Cancel", Gtk.ResponseType.CANCEL)
-        chooser.add_button("Export" if export else "Import", Gtk.ResponseType.ACCEPT)
+        chooser.add_button(_("Cancel"), Gtk.ResponseType.CANCEL)
+        chooser.add_button(_("Export") if export else _("Import"), Gtk.ResponseType.ACCEPT)
         if export:
             chooser.set_current_name("robot-config.toml")
         chooser.connect("response", lambda c, r: self._chosen(c, r, export))
@@ -311,9 +348,13 @@ class ConfigCare:
         operator has already said Replace, as GTK 4's save chooser always asks)."""
         if (path.exists() or path.is_symlink()) and not replace_asked:
             self.confirm = Confirm(
-                self.page, f"“{path.name}” already exists in {path.parent}. Replace it?", "Replace",
+                self.page,
+                _("“{name}” already exists in {parent}. Replace it?").format(
+                    name=path.name, parent=path.parent
+                ),
+                _("Replace"),
                 lambda: self._write(path, force=True),
-            )  # fmt: skip
+            )
             self.confirm.present()
             return
         self._write(path, force=replace_asked)
@@ -325,9 +366,14 @@ class ConfigCare:
         try:
             write_export(path, export_text(config), force=force)
         except ConfigFileError as exc:
-            self._say(f"Not exported: {exc}", True)
+            self._say(_("Not exported: {exc}").format(exc=exc), True)
             return
-        self._say(f"Exported {config.param_count} parameters to {path}", False)
+        self._say(
+            _("Exported {param_count} parameters to {path}").format(
+                param_count=config.param_count, path=path
+            ),
+            False,
+        )
 
     def import_from(self, path: Path) -> None:
         """Check ``path`` against the server's configuration; ask, then send it in one ``setConfig``."""
@@ -337,24 +383,34 @@ class ConfigCare:
         try:
             plan = plan_import(config, read_file(path))
         except ConfigFileError as exc:
-            self._say(f"Not imported: {exc}", True)
+            self._say(_("Not imported: {exc}").format(exc=exc), True)
             return
         if plan.problems:
             shown = "; ".join(plan.problems[:5]) + (
-                f" (and {len(plan.problems) - 5} more)" if len(plan.problems) > 5 else ""
+                _(" (and {value} more)").format(value=len(plan.problems) - 5)
+                if len(plan.problems) > 5
+                else ""
             )
-            self._say(f"Not imported, nothing was sent: {shown}", True)
+            self._say(_("Not imported, nothing was sent: {shown}").format(shown=shown), True)
             return
         count = sum(len(v) for v in plan.changes.values())
         if not count:
-            self._say(f"Nothing to import: the robot already holds every value in {path.name}", False)
+            self._say(
+                _("Nothing to import: the robot already holds every value in {name}").format(name=path.name),
+                False,
+            )
             return
         send = lambda: self._send(plan.changes, path)  # noqa: E731
         self.confirm = Confirm(
-            self.page, f"Import {_values(count)} from “{path.name}”?", "Import", send,
-            detail=f"{plan.unchanged} more are already as the file says. The server takes all or none.",
+            self.page,
+            _("Import {values} from “{name}”?").format(values=_values(count), name=path.name),
+            _("Import"),
+            send,
+            detail=_("{unchanged} more are already as the file says. The server takes all or none.").format(
+                unchanged=plan.unchanged
+            ),
             destructive=False,
-        )  # fmt: skip
+        )
         self.confirm.present()
 
     def _send(self, changes: dict[str, dict[str, str]], path: Path) -> None:
@@ -362,10 +418,15 @@ class ConfigCare:
             if error is None and reply is not None and not reply.accepted:
                 error = RuntimeError(reply.error)
             if error is not None:
-                self._say(f"The server refused the import of {path.name}: {error}", True)
+                self._say(
+                    _("The server refused the import of {name}: {error}").format(name=path.name, error=error),
+                    True,
+                )
             else:
                 count = sum(len(v) for v in changes.values())
-                self._say(f"Imported {_values(count)} from {path.name}", False)
+                self._say(
+                    _("Imported {values} from {name}").format(values=_values(count), name=path.name), False
+                )
             self._refresh_page()
 
         _when_done(self._request(SetConfig(changes)), answered)

@@ -15,6 +15,7 @@ from __future__ import annotations
 
 from dataclasses import dataclass
 
+from ..base.i18n import _
 from ..client.config_feed import ServerConfig, changed_values, check_value, names_param
 from ..protocol.payloads.config import ConfigParam, ParamType, SetConfigReply
 from ..values.intents import SetConfig
@@ -85,16 +86,20 @@ class ConfigEdits:
         """What another client changed between ``old`` and ``new``, and which unsaved edits it touched."""
         changed = changed_values(old, new)
         if not changed:
-            return "Another client saved the configuration; no value changed."
-        names = [f"{s}/{n} (now {v})" for s, n, v in changed[:MAX_CHANGES_NAMED]]
-        more = f" and {len(changed) - MAX_CHANGES_NAMED} more" if len(changed) > MAX_CHANGES_NAMED else ""
-        text = "Another client changed " + ", ".join(names) + more + "."
-        clashes = [f"{s}/{n}" for s, n, _ in changed if (s, n) in self.edits]
+            return _("Another client saved the configuration; no value changed.")
+        names = [_("{s}/{n} (now {v})").format(s=s, n=n, v=v) for s, n, v in changed[:MAX_CHANGES_NAMED]]
+        more = (
+            _(" and {value} more").format(value=len(changed) - MAX_CHANGES_NAMED)
+            if len(changed) > MAX_CHANGES_NAMED
+            else ""
+        )
+        text = _("Another client changed ") + ", ".join(names) + more + "."
+        clashes = [f"{s}/{n}" for s, n, _now in changed if (s, n) in self.edits]
         if clashes:
             text += (
-                " Your unsaved edit of "
+                _(" Your unsaved edit of ")
                 + ", ".join(clashes[:MAX_CHANGES_NAMED])
-                + " is kept: Save would overwrite their value."
+                + _(" is kept: Save would overwrite their value.")
             )
         return text
 
@@ -109,7 +114,9 @@ class ConfigEdits:
             del self.edits[key]
             wrong = self._wrong.pop(key, None)
             if wrong:  # the editor put its value back rather than take a wrong one: said, not silent
-                self.refused[key] = f"✗ {wrong[0]} not taken: {wrong[1]} (still {param.value_text()})"
+                self.refused[key] = _("✗ {value} not taken: {value2} (still {value_text})").format(
+                    value=wrong[0], value2=wrong[1], value_text=param.value_text()
+                )
         elif was == text:
             return False
         else:
@@ -133,7 +140,7 @@ class ConfigEdits:
             return out
         for (section, name), text in self.edits.items():
             p = config.find(section, name)
-            why = "no longer offered by the server" if p is None else check_value(p, text)
+            why = _("no longer offered by the server") if p is None else check_value(p, text)
             if why:
                 out[(section, name)] = why
         return out
@@ -158,14 +165,16 @@ class ConfigEdits:
         config = self.config
         if config is None:
             return ""
-        parts = [f"{config.param_count} parameters"]  # separators are no parameters (param_count)
+        parts = [
+            _("{param_count} parameters").format(param_count=config.param_count)
+        ]  # separators are no parameters (param_count)
         if config.cut:
-            parts.append(f"{config.cut} not shown (too many)")
+            parts.append(_("{cut} not shown (too many)").format(cut=config.cut))
         if self.edits:
-            parts.append(f"{len(self.edits)} unsaved")
+            parts.append(_("{len} unsaved").format(len=len(self.edits)))
         bad = self.invalid()
         if bad:
-            parts.append(f"{len(bad)} invalid")
+            parts.append(_("{len} invalid").format(len=len(bad)))
         return ", ".join(parts)
 
     # -- saving --------------------------------------------------------------------------------
@@ -183,7 +192,7 @@ class ConfigEdits:
     def save_failed(self, sent: dict[Key, str], reason: str) -> None:
         """The set never got an answer (refused before sending, link lost): each edit says so and stays."""
         for key in sent:
-            self.answers[key] = (False, f"✗ not saved: {reason}")
+            self.answers[key] = (False, _("✗ not saved: {reason}").format(reason=reason))
 
     def saved(self, sent: dict[Key, str], reply: SetConfigReply) -> str:
         """The server's answer to ``sent``; the words for the whole page when it blamed no parameter."""
@@ -191,7 +200,7 @@ class ConfigEdits:
             for key, text in sent.items():
                 if self.edits.get(key) == text:  # typed again meanwhile: that edit is still to save
                     del self.edits[key]
-                self.answers[key] = (True, "✓ accepted")
+                self.answers[key] = (True, _("✓ accepted"))
                 self.accepted[key] = text
             return ""
         blamed = [k for k in sent if names_param(reply.error, *k)]
@@ -199,6 +208,6 @@ class ConfigEdits:
             self.answers[key] = (
                 (False, f"✗ {reply.error}")
                 if key in blamed
-                else (False, "not saved: the server refused the set")
+                else (False, _("not saved: the server refused the set"))
             )
-        return "" if blamed else f"The server refused: {reply.error}"
+        return "" if blamed else _("The server refused: {error}").format(error=reply.error)

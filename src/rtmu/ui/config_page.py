@@ -33,6 +33,7 @@ gi.require_version("Gtk", "4.0")
 gi.require_version("Pango", "1.0")
 from gi.repository import Gdk, GLib, Gtk, Pango  # noqa: E402
 
+from ..base.i18n import N_, _  # noqa: E402
 from ..base.textsafe import visible  # noqa: E402
 from ..client.config_feed import MAX_TEXT, ConfigSection, ForeignConfig, ServerConfig  # noqa: E402
 from ..protocol.payloads.config import ConfigParam, ParamType, Priority, SetConfigReply  # noqa: E402
@@ -51,7 +52,7 @@ PAGE_SIZE = 60
 MAX_SECTIONS_LISTED = 1000
 SPIN_LIMIT = 1e12
 """Unlimited numbers (ARIA's INT_MIN/INT_MAX, ±INF) are edited within ± this."""
-PRIORITY_LABELS = ("Basic", "Intermediate", "Advanced", "Expert", "Factory")
+PRIORITY_LABELS = (N_("Basic"), N_("Intermediate"), N_("Advanced"), N_("Expert"), N_("Factory"))
 
 
 class ConfigPage(Gtk.Window):
@@ -67,7 +68,7 @@ class ConfigPage(Gtk.Window):
         open_console: Callable[[str], None] | None = None,
     ) -> None:
         super().__init__(
-            title="Server configuration", transient_for=parent, modal=False, destroy_with_parent=True
+            title=_("Server configuration"), transient_for=parent, modal=False, destroy_with_parent=True
         )
         self.set_default_size(760, 440)
         self._request, self._follow, self._offers = request, follow, offers
@@ -108,18 +109,20 @@ class ConfigPage(Gtk.Window):
         for side in ("top", "bottom", "start", "end"):
             getattr(box, f"set_margin_{side}")(8)
         bar = Gtk.Box(spacing=8)
-        bar.append(Gtk.Label(label="Show up to"))
-        self.priority = Gtk.DropDown.new_from_strings(list(PRIORITY_LABELS))
-        accessible.name(self.priority, "Show up to")
+        bar.append(Gtk.Label(label=_("Show up to")))
+        self.priority = Gtk.DropDown.new_from_strings([_(p) for p in PRIORITY_LABELS])
+        accessible.name(self.priority, _("Show up to"))
         self.priority.set_selected(self.show_up_to)
         self.priority.connect("notify::selected", self._priority_chosen)
         bar.append(self.priority)
-        self.status = Gtk.Label(label="Loading…", xalign=0.0, hexpand=True, ellipsize=Pango.EllipsizeMode.END)
+        self.status = Gtk.Label(
+            label=_("Loading…"), xalign=0.0, hexpand=True, ellipsize=Pango.EllipsizeMode.END
+        )
         bar.append(self.status)
-        self.reload_button = Gtk.Button(label="Reload")
+        self.reload_button = Gtk.Button(label=_("Reload"))
         self.reload_button.connect("clicked", lambda _b: self.refresh())
         bar.append(self.reload_button)
-        self.save_button = Gtk.Button(label="Save")
+        self.save_button = Gtk.Button(label=_("Save"))
         self.save_button.add_css_class("suggested-action")
         self.save_button.set_sensitive(False)
         self.save_button.connect("clicked", lambda _b: self.save())
@@ -137,7 +140,7 @@ class ConfigPage(Gtk.Window):
         self.discard = DiscardQuestion(self._discard_and_close)
         box.append(self.discard)
         self.console_button = Gtk.Button(
-            label="Read it in the console…", halign=Gtk.Align.START, visible=False
+            label=_("Read it in the console…"), halign=Gtk.Align.START, visible=False
         )
         self.console_button.connect("clicked", lambda _b: self._console())
         box.append(self.console_button)
@@ -158,9 +161,9 @@ class ConfigPage(Gtk.Window):
         self.scroller.set_child(self.grid)
         right.append(self.scroller)
         pager = Gtk.Box(spacing=8)
-        self.prev_button = Gtk.Button(label="Previous")
+        self.prev_button = Gtk.Button(label=_("Previous"))
         self.prev_button.connect("clicked", lambda _b: self._turn(-1))
-        self.next_button = Gtk.Button(label="Next")
+        self.next_button = Gtk.Button(label=_("Next"))
         self.next_button.connect("clicked", lambda _b: self._turn(1))
         self.page_label = Gtk.Label(hexpand=True)
         pager.append(self.prev_button)
@@ -219,7 +222,7 @@ class ConfigPage(Gtk.Window):
             self._again = self._again or note or "again"
             return
         self.fetching = True
-        self.status.set_text("Loading…")
+        self.status.set_text(_("Loading…"))
         self.reload_button.set_sensitive(False)
         previous = self.config
         self._request(FetchConfig()).add_done_callback(
@@ -243,14 +246,16 @@ class ConfigPage(Gtk.Window):
             GLib.idle_add(self._refresh_later, "remote" if again == "remote" else "")
         error = None if future.cancelled() else future.exception()
         if isinstance(error, ForeignConfig):  # an answer, not a failure: its whole sentence, wrapped
-            self.status.set_text("No configuration RTMU can edit")
-            where = ". In this window, Server ▸ Console… reads it raw." if self._open_console else ""
+            self.status.set_text(_("No configuration RTMU can edit"))
+            where = _(". In this window, Server ▸ Console… reads it raw.") if self._open_console else ""
             self.banner.set_text(f"{str(error).rstrip('.')}{where}")
             self.banner.set_visible(True)
             self.console_button.set_visible(self._open_console is not None)
             return False
         if future.cancelled() or error is not None:
-            self.status.set_text(f"Could not load the configuration: {error or 'cancelled'}")
+            self.status.set_text(
+                _("Could not load the configuration: {value}").format(value=error or "cancelled")
+            )
             return False
         config: ServerConfig = future.result()
         self.care.update()
@@ -324,7 +329,7 @@ class ConfigPage(Gtk.Window):
             self.grid.remove(child)
         self.rows = {}
         if section is None:
-            self.comment.set_text("This server's configuration is empty.")
+            self.comment.set_text(_("This server's configuration is empty."))
             return
         self.comment.set_text(section.comment)
         params = self.shown_params()
@@ -334,9 +339,17 @@ class ConfigPage(Gtk.Window):
         for i, p in enumerate(params[first : first + PAGE_SIZE]):
             self._add_row(section, p, i)
         hidden = len(section.params) - len(params)
-        info = f"{first + 1}–{min(first + PAGE_SIZE, len(params))} of {len(params)}" if params else "nothing"
+        info = (
+            _("{value}–{min} of {len}").format(
+                value=first + 1, min=min(first + PAGE_SIZE, len(params)), len=len(params)
+            )
+            if params
+            else "nothing"
+        )
         if hidden:
-            info += f" ({hidden} above {PRIORITY_LABELS[self.show_up_to].lower()} hidden)"
+            info += _(" ({hidden} above {lower} hidden)").format(
+                hidden=hidden, lower=_(PRIORITY_LABELS[self.show_up_to]).lower()
+            )
         self.page_label.set_text(info)
         self.prev_button.set_sensitive(self.page > 0)
         self.next_button.set_sensitive(self.page < pages - 1)
@@ -413,10 +426,12 @@ class ConfigPage(Gtk.Window):
             entry.connect("changed", lambda e: self._edited(key, e.get_text()))
             widget = entry
         else:
-            widget = Gtk.Label(label=f"list of {len(p.children)} (read-only here)", xalign=0.0)
+            widget = Gtk.Label(
+                label=_("list of {len} (read-only here)").format(len=len(p.children)), xalign=0.0
+            )
         if not editable:
             widget.set_sensitive(False)
-            widget.set_tooltip_text("Read-only: above the priority this server lets you edit")
+            widget.set_tooltip_text(_("Read-only: above the priority this server lets you edit"))
         widget.set_valign(Gtk.Align.CENTER)
         return widget
 
@@ -459,7 +474,7 @@ class ConfigPage(Gtk.Window):
         sent, intent = found
         self.saving = True
         self._update_status()
-        self.status.set_text("Saving…")
+        self.status.set_text(_("Saving…"))
         self._request(intent).add_done_callback(lambda f: GLib.idle_add(self._saved, f, sent))
 
     def _saved(self, future: concurrent.futures.Future[Any], sent: dict[Key, str]) -> bool:

@@ -15,6 +15,8 @@ gi.require_version("Gdk", "4.0")
 gi.require_version("Gtk", "4.0")
 from gi.repository import Gdk, Gtk  # noqa: E402
 
+from ..base.i18n import _  # noqa: E402
+
 
 class Confirm(Gtk.Window):
     """``Confirm(parent, "Delete “x” from the robot?", "Delete", on_yes)``: ``on_yes()`` runs only on
@@ -44,7 +46,7 @@ class Confirm(Gtk.Window):
         if detail:
             box.append(Gtk.Label(label=detail, xalign=0.0, wrap=True, max_width_chars=50))
         buttons = Gtk.Box(spacing=8, halign=Gtk.Align.END)
-        self.cancel_button = Gtk.Button(label="Cancel")
+        self.cancel_button = Gtk.Button(label=_("Cancel"))
         self.cancel_button.connect("clicked", lambda _b: self.close())
         self.yes_button = Gtk.Button(label=action)
         self.yes_button.add_css_class("destructive-action" if destructive else "suggested-action")

@@ -15,6 +15,8 @@ import gi
 gi.require_version("Gtk", "4.0")
 from gi.repository import Gdk, Gtk  # noqa: E402
 
+from ..base.i18n import _  # noqa: E402
+
 
 class ConfirmBar(Gtk.Revealer):
     """Hidden until :meth:`ask`; ``yes`` runs only from its own button."""
@@ -28,8 +30,8 @@ class ConfirmBar(Gtk.Revealer):
         self.question = Gtk.Label(wrap=True, xalign=0.0, selectable=False)
         self.question.set_max_width_chars(60)
         buttons = Gtk.Box(spacing=6, halign=Gtk.Align.END)
-        self.cancel_button = Gtk.Button(label="Cancel")
-        self.yes_button = Gtk.Button(label="Send it")
+        self.cancel_button = Gtk.Button(label=_("Cancel"))
+        self.yes_button = Gtk.Button(label=_("Send it"))
         self.yes_button.add_css_class("destructive-action")
         self.cancel_button.connect("clicked", lambda _b: self.cancel())
         self.yes_button.connect("clicked", lambda _b: self._yes())

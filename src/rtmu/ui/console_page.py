@@ -30,6 +30,7 @@ import gi
 gi.require_version("Gtk", "4.0")
 from gi.repository import GLib, Gtk  # noqa: E402
 
+from ..base.i18n import _  # noqa: E402
 from ..base.textsafe import visible  # noqa: E402
 from ..client.console import ConsoleEntry, ConsoleReply  # noqa: E402
 from ..client.console_effect import HELD_MOTION  # noqa: E402
@@ -60,13 +61,17 @@ def entry_details(entry: ConsoleEntry) -> str:
     d = entry.data
     return "\n".join(
         (
-            f"{visible(short(d.name, 120))} (number {d.number}, group {visible(short(d.command_group, 60))})",
-            visible(short(d.description, 600)) or "(no description)",
-            f"Arguments: {visible(short(d.argument_description, 300)) or 'none'}",
-            f"  read as: {visible(short(describe(entry.arguments), 300))}",
-            f"Returns: {visible(short(d.return_description, 300)) or 'none'}",
-            f"Flags: {visible(short(d.flags, 120))}",
-            f"Effect: {visible(short(effect_words(entry), 200))}",
+            _("{visible} (number {number}, group {visible2})").format(
+                visible=visible(short(d.name, 120)),
+                number=d.number,
+                visible2=visible(short(d.command_group, 60)),
+            ),
+            visible(short(d.description, 600)) or _("(no description)"),
+            _("Arguments: {value}").format(value=visible(short(d.argument_description, 300)) or "none"),
+            _("  read as: {visible}").format(visible=visible(short(describe(entry.arguments), 300))),
+            _("Returns: {value}").format(value=visible(short(d.return_description, 300)) or "none"),
+            _("Flags: {visible}").format(visible=visible(short(d.flags, 120))),
+            _("Effect: {visible}").format(visible=visible(short(effect_words(entry), 200))),
         )
     )
 
@@ -80,7 +85,7 @@ def reply_text(reply: ConsoleReply) -> str:
     """The reply as ``rtmu call`` prints it, bounded in lines and in characters a line."""
     lines = [outcome_line(reply, waited(reply)), *packet_lines(reply)]
     if len(lines) > MAX_LINES:
-        lines = [*lines[:MAX_LINES], f"… {len(lines) - MAX_LINES} more lines not shown"]
+        lines = [*lines[:MAX_LINES], _("… {value} more lines not shown").format(value=len(lines) - MAX_LINES)]
     return "\n".join(
         line if len(line) <= MAX_LINE_CHARS else line[: MAX_LINE_CHARS - 1] + "…" for line in lines
     )
@@ -90,7 +95,7 @@ class ConsolePage(Gtk.Window):
     """See the module notes. ``request(intent)`` returns a Future completed on the network thread."""
 
     def __init__(self, parent: Gtk.Window | None, request: Request) -> None:
-        super().__init__(title="Console", transient_for=parent, modal=False, destroy_with_parent=True)
+        super().__init__(title=_("Console"), transient_for=parent, modal=False, destroy_with_parent=True)
         self.set_default_size(900, 520)
         self._request = request
         self.entries: list[ConsoleEntry] = []
@@ -116,9 +121,9 @@ class ConsolePage(Gtk.Window):
     # -- layout -------------------------------------------------------------------------------------
     def _build(self) -> None:
         left = Gtk.Box(orientation=Gtk.Orientation.VERTICAL, spacing=6)
-        self.search = Gtk.SearchEntry(placeholder_text="Filter: name, description or group")
+        self.search = Gtk.SearchEntry(placeholder_text=_("Filter: name, description or group"))
         self.search.connect("search-changed", lambda _e: self.refilter())
-        accessible.name(self.search, "Filter the data")
+        accessible.name(self.search, _("Filter the data"))
         self.count = Gtk.Label(xalign=0.0)
         self.count.add_css_class("dim-label")
         self.rows = Gtk.ListBox(selection_mode=Gtk.SelectionMode.SINGLE)
@@ -129,18 +134,18 @@ class ConsolePage(Gtk.Window):
         for widget in left_parts:
             left.append(widget)
         right = Gtk.Box(orientation=Gtk.Orientation.VERTICAL, spacing=6)
-        self.details = Gtk.Label(xalign=0.0, wrap=True, selectable=True, label="Pick a data on the left.")
+        self.details = Gtk.Label(xalign=0.0, wrap=True, selectable=True, label=_("Pick a data on the left."))
         self.details.set_max_width_chars(70)
         args = Gtk.Box(spacing=6)
-        self.arguments = Gtk.Entry(hexpand=True, placeholder_text="Arguments, separated by spaces")
+        self.arguments = Gtk.Entry(hexpand=True, placeholder_text=_("Arguments, separated by spaces"))
         self.arguments.connect("activate", lambda _e: self.call())
-        accessible.name(self.arguments, "Arguments")
-        self.types = Gtk.Entry(width_chars=14, placeholder_text="Types (byte4,…)")
-        accessible.name(self.types, "Argument types")
+        accessible.name(self.arguments, _("Arguments"))
+        self.types = Gtk.Entry(width_chars=14, placeholder_text=_("Types (byte4,…)"))
+        accessible.name(self.types, _("Argument types"))
         self.types.set_tooltip_text(
-            "Only where the description names no types: byte, byte2, byte4, double, string"
+            _("Only where the description names no types: byte, byte2, byte4, double, string")
         )
-        self.call_button = Gtk.Button(label="Call once", sensitive=False)
+        self.call_button = Gtk.Button(label=_("Call once"), sensitive=False)
         self.call_button.add_css_class("suggested-action")
         self.call_button.connect("clicked", lambda _b: self.call())
         arg_parts: tuple[Gtk.Widget, ...] = (self.arguments, self.types, self.call_button)
@@ -149,7 +154,7 @@ class ConsolePage(Gtk.Window):
         self.status = Gtk.Label(xalign=0.0, wrap=True)
         self.confirm = ConfirmBar()
         self.reply = Gtk.TextView(editable=False, monospace=True, wrap_mode=Gtk.WrapMode.CHAR, vexpand=True)
-        accessible.name(self.reply, "Reply")
+        accessible.name(self.reply, _("Reply"))
         reply_scroller = Gtk.ScrolledWindow(vexpand=True)
         reply_scroller.set_child(self.reply)
         right_parts: tuple[Gtk.Widget, ...] = (self.details, args, self.status, self.confirm, reply_scroller)
@@ -169,10 +174,10 @@ class ConsolePage(Gtk.Window):
         self.entries, self.shown, self.current = [], [], None
         self._built_for = None
         self.refilter()
-        self.details.set_text("Pick a data on the left.")
+        self.details.set_text(_("Pick a data on the left."))
         self.call_button.set_sensitive(False)
         self.reply.get_buffer().set_text("")
-        self.status.set_text("Another robot is selected: its data list is read.")
+        self.status.set_text(_("Another robot is selected: its data list is read."))
         self._stale = self.loading  # a list on its way is the robot's before: read again when it is in
         self._robot += 1  # a reply on its way is the robot's before: not shown as this one's
         self.reload()
@@ -182,7 +187,7 @@ class ConsolePage(Gtk.Window):
         if self.loading:
             return
         self.loading = True
-        self.count.set_text("Reading the data list…")
+        self.count.set_text(_("Reading the data list…"))
         future = self._request(ConsoleList())
         future.add_done_callback(lambda f: GLib.idle_add(self._loaded, f))
 
@@ -196,7 +201,9 @@ class ConsolePage(Gtk.Window):
             return False
         error = None if future.cancelled() else future.exception()
         if future.cancelled() or error is not None:
-            self.count.set_text(f"No data list: {visible(short(str(error or 'cancelled'), 200))}")
+            self.count.set_text(
+                _("No data list: {visible}").format(visible=visible(short(str(error or "cancelled"), 200)))
+            )
             return False
         self.entries = list(future.result())
         self._loads += 1
@@ -216,15 +223,21 @@ class ConsolePage(Gtk.Window):
             self.rows.remove(child)
         for entry in self.shown:
             self.rows.append(self._row(entry))
-        more = f"; the first {MAX_ROWS} shown, narrow the filter" if len(found) > MAX_ROWS else ""
-        self.count.set_text(f"{len(found)} of {len(self.entries)} data{more}")
+        more = (
+            _("; the first {MAX_ROWS} shown, narrow the filter").format(MAX_ROWS=MAX_ROWS)
+            if len(found) > MAX_ROWS
+            else ""
+        )
+        self.count.set_text(
+            _("{len} of {len2} data{more}").format(len=len(found), len2=len(self.entries), more=more)
+        )
 
     @staticmethod
     def _row(entry: ConsoleEntry) -> Gtk.Widget:
         d = entry.data
         box = Gtk.Box(orientation=Gtk.Orientation.VERTICAL)
         name = Gtk.Label(xalign=0.0, label=visible(short(d.name, 80)))
-        kind = "changes something" if entry.changes else "read"
+        kind = _("changes something") if entry.changes else _("read")
         info = Gtk.Label(xalign=0.0, label=f"{visible(short(d.command_group, 40))} · {kind}")
         info.add_css_class("dim-label")
         box.append(name)
@@ -241,9 +254,11 @@ class ConsolePage(Gtk.Window):
         self.details.set_text(entry_details(entry))
         held = entry.name in HELD_MOTION
         self.call_button.set_sensitive(not held)
-        self.call_button.set_label("Call once…" if entry.changes else "Call once")
+        self.call_button.set_label(_("Call once…") if entry.changes else _("Call once"))
         self.status.set_text(
-            f"{entry.name} is never sent from the console: held motion comes only from a held drive"
+            _("{name} is never sent from the console: held motion comes only from a held drive").format(
+                name=entry.name
+            )
             if held
             else ""
         )
@@ -265,22 +280,25 @@ class ConsolePage(Gtk.Window):
         try:
             arguments = tuple(shlex.split(self.arguments.get_text()))
         except ValueError as exc:
-            self.status.set_text(f"Arguments: {exc}")
+            self.status.set_text(_("Arguments: {exc}").format(exc=exc))
             return
         types = tuple(t.strip() for t in self.types.get_text().split(",") if t.strip())
         if not entry.changes:
             self._send(ConsoleCall(name=entry.name, arguments=arguments, types=types))
             return
-        question = (
-            f"{visible(short(entry.name, 80))} changes something ({visible(short(entry.why, 160))}). "
-            f"RTMU will send it once{' with ' + ' '.join(arguments) if arguments else ''}. Go ahead?"
+        question = _(
+            "{visible} changes something ({visible2}). RTMU will send it once{value}. Go ahead?"
+        ).format(
+            visible=visible(short(entry.name, 80)),
+            visible2=visible(short(entry.why, 160)),
+            value=" with " + " ".join(arguments) if arguments else "",
         )
         confirmed = ConsoleCall(name=entry.name, arguments=arguments, types=types, confirmed=True)
-        self.confirm.ask(question, "Yes, send it", lambda: self._send(confirmed))
+        self.confirm.ask(question, _("Yes, send it"), lambda: self._send(confirmed))
 
     def _send(self, intent: ConsoleCall) -> None:
         self.calling = True
-        self.status.set_text(f"Calling {intent.name}…")
+        self.status.set_text(_("Calling {name}…").format(name=intent.name))
         future = self._request(intent)
         robot = self._robot
         future.add_done_callback(lambda f: GLib.idle_add(self._replied, f, robot))
@@ -290,11 +308,15 @@ class ConsolePage(Gtk.Window):
         if self.closed:
             return False
         if robot != self._robot:
-            self.status.set_text("A reply came from the robot selected before: not shown here.")
+            self.status.set_text(_("A reply came from the robot selected before: not shown here."))
             return False
         error = None if future.cancelled() else future.exception()
         if future.cancelled() or error is not None:
-            self.status.set_text(f"Not sent or no reply: {visible(short(str(error or 'cancelled'), 300))}")
+            self.status.set_text(
+                _("Not sent or no reply: {visible}").format(
+                    visible=visible(short(str(error or "cancelled"), 300))
+                )
+            )
             return False
         reply: ConsoleReply = future.result()
         self.status.set_text(short(outcome_line(reply, waited(reply)), 300))

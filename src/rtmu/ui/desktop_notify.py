@@ -18,6 +18,7 @@ import gi
 gi.require_version("Gtk", "4.0")
 from gi.repository import Gio, GLib, Gtk  # noqa: E402
 
+from ..base.i18n import N_, _  # noqa: E402
 from ..base.textsafe import visible  # noqa: E402
 from ..model.observables import ConnectionState, NavState, Phase, PopupsState, RobotModel, RobotState  # noqa: E402
 from ..settings.notifications import NOTIFICATION_KINDS  # noqa: E402
@@ -25,12 +26,12 @@ from ..values.state import NavOutcome  # noqa: E402
 from .nav_text import where  # noqa: E402
 
 LABELS = {
-    "arrived": "Arrived",
-    "failed": "Did not arrive",
-    "docked": "Docked",
-    "battery_low": "Battery low",
-    "link_lost": "Link lost",
-    "popup": "Server message waiting",
+    "arrived": N_("Arrived"),
+    "failed": N_("Did not arrive"),
+    "docked": N_("Docked"),
+    "battery_low": N_("Battery low"),
+    "link_lost": N_("Link lost"),
+    "popup": N_("Server message waiting"),
 }
 URGENT = {"failed", "battery_low", "link_lost"}
 MAX_WORDS = 200
@@ -45,19 +46,27 @@ class Note:
 
 
 def robot_words(text: str) -> str:
-    return f"The robot says: “{visible(text)[:MAX_WORDS]}”"
+    return _("The robot says: “{value}”").format(value=visible(text)[:MAX_WORDS])
 
 
 def nav_note(old: NavState, new: NavState, robot: str) -> Note | None:
     if new.outcome == old.outcome:
         return None
     if new.outcome is NavOutcome.ARRIVED:
-        return Note("arrived", f"{robot} arrived", f"At {visible(where(new.target))}.")
+        return Note(
+            "arrived",
+            _("{robot} arrived").format(robot=robot),
+            _("At {visible}.").format(visible=visible(where(new.target))),
+        )
     if new.outcome is NavOutcome.DOCKED:
-        return Note("docked", f"{robot} docked", "It is on its charger.")
+        return Note("docked", _("{robot} docked").format(robot=robot), _("It is on its charger."))
     if new.outcome is NavOutcome.FAILED:
         why = new.outcome_text or new.reason
-        return Note("failed", f"{robot} did not arrive", robot_words(why) if why else "No reason given.")
+        return Note(
+            "failed",
+            _("{robot} did not arrive").format(robot=robot),
+            robot_words(why) if why else _("No reason given."),
+        )
     return None
 
 
@@ -65,16 +74,22 @@ def battery_note(old: RobotState, new: RobotState, robot: str) -> Note | None:
     low = ("low", "critical")
     if new.battery_state in low and old.battery_state not in low and old.battery_v is not None:
         unit = "%" if new.battery_is_soc else "V"
-        level = "at its shutdown level" if new.battery_state == "critical" else "low"
+        level = _("at its shutdown level") if new.battery_state == "critical" else "low"
         return Note(
-            "battery_low", f"{robot}: battery {level}", f"{new.battery_v:g} {unit}. Send it to charge."
+            "battery_low",
+            _("{robot}: battery {level}").format(robot=robot, level=level),
+            _("{battery_v:g} {unit}. Send it to charge.").format(battery_v=new.battery_v, unit=unit),
         )
     return None
 
 
 def link_note(old: ConnectionState, new: ConnectionState, robot: str) -> Note | None:
     if old.phase is Phase.CONNECTED and new.phase in (Phase.RECONNECTING, Phase.FAILED):
-        return Note("link_lost", f"{robot}: link lost", visible(new.error) or "The connection ended.")
+        return Note(
+            "link_lost",
+            _("{robot}: link lost").format(robot=robot),
+            visible(new.error) or _("The connection ended."),
+        )
     return None
 
 
@@ -84,7 +99,9 @@ def popup_note(old: PopupsState, new: PopupsState, robot: str) -> Note | None:
     if not fresh:
         return None
     return Note(
-        "popup", f"{robot}: a message waits for an answer", robot_words(fresh[-1].title or fresh[-1].message)
+        "popup",
+        _("{robot}: a message waits for an answer").format(robot=robot),
+        robot_words(fresh[-1].title or fresh[-1].message),
     )
 
 
@@ -106,8 +123,8 @@ class DesktopNotifier:
             action.connect("activate", lambda a, _p, k=kind: self.set(k, not a.get_state().get_boolean()))
             window.add_action(action)
             self.actions[kind] = action
-            submenu.append(LABELS[kind], f"win.{action.get_name()}")
-        view_menu.append_submenu("Desktop notifications", submenu)
+            submenu.append(_(LABELS[kind]), f"win.{action.get_name()}")
+        view_menu.append_submenu(_("Desktop notifications"), submenu)
         m = model
         self._unobserve = [
             m.navigation.observe(lambda o, n: self._maybe(nav_note(o, n, self._robot()))),
@@ -134,7 +151,7 @@ class DesktopNotifier:
 
     def _robot(self) -> str:
         conn = self.model.connection.value
-        return visible(conn.profile) if conn.profile and conn.profile != "default" else "The robot"
+        return visible(conn.profile) if conn.profile and conn.profile != "default" else _("The robot")
 
     def _maybe(self, note: Note | None) -> None:
         if note is None or not self.choices.get(note.kind, True) or self.window.is_active():

@@ -18,6 +18,7 @@ gi.require_version("Gtk", "4.0")
 gi.require_version("Pango", "1.0")
 from gi.repository import Gdk, Gtk, Pango  # noqa: E402
 
+from ..base.i18n import _  # noqa: E402
 from ..model.observables import ConnectionState, RobotModel, RobotState  # noqa: E402
 from ..protocol.payloads.ld import data_store_label  # noqa: E402
 from ..values.intents import Intent, Say  # noqa: E402
@@ -36,7 +37,7 @@ class DetailsWindow(Gtk.Window):
     """The details table and the Say field; follows the model while open."""
 
     def __init__(self, parent: Gtk.Window, model: RobotModel, ask: Ask, watch: Watch | None = None) -> None:
-        super().__init__(title="Robot details", transient_for=parent, modal=False)
+        super().__init__(title=_("Robot details"), transient_for=parent, modal=False)
         self.set_default_size(420, 360)
         self.model = model
         self._ask = ask
@@ -48,15 +49,15 @@ class DetailsWindow(Gtk.Window):
         scroller = Gtk.ScrolledWindow(vexpand=True)
         scroller.set_child(self.grid)
         box.append(scroller)
-        self.none_label = Gtk.Label(label="This server publishes no status strings", xalign=0.0)
+        self.none_label = Gtk.Label(label=_("This server publishes no status strings"), xalign=0.0)
         self.none_label.add_css_class("dim-label")
         box.append(self.none_label)
         self.say_row = Gtk.Box(spacing=8)
-        self.say_entry = Gtk.Entry(hexpand=True, placeholder_text="Text for the robot to say")
+        self.say_entry = Gtk.Entry(hexpand=True, placeholder_text=_("Text for the robot to say"))
         self.say_entry.set_max_length(MAX_SAY)
-        accessible.name(self.say_entry, "Text for the robot to say")
+        accessible.name(self.say_entry, _("Text for the robot to say"))
         self.say_entry.connect("activate", lambda _e: self.say())
-        self.say_button = accessible.mnemonic_button("_Say")
+        self.say_button = accessible.mnemonic_button(_("_Say"))
         self.say_button.connect("clicked", lambda _b: self.say())
         self.say_row.append(self.say_entry)
         self.say_row.append(self.say_button)
@@ -108,17 +109,19 @@ class DetailsWindow(Gtk.Window):
     def _fill(self, robot: RobotState) -> None:
         rows = [(data_store_label(name), value) for name, value in robot.data_store]
         if robot.dock_state is not None:
-            rows.insert(0, ("Docking", robot.dock_state))
+            rows.insert(0, (_("Docking"), robot.dock_state))
         rows = list(robot.server_strings) + rows
         more = robot.server_strings_more
-        self.more_label.set_text(f"… and {more} more the server publishes" if more else "")
+        self.more_label.set_text(
+            _("… and {more} more the server publishes").format(more=more) if more else ""
+        )
         self.more_label.set_visible(bool(more))
         self.none_label.set_visible(not rows)
         if rows == self.rows:
             return
-        if [k for k, _ in rows] == [k for k, _ in self.rows]:
+        if [k for k, _value in rows] == [k for k, _value in self.rows]:
             # The same items: change the values in place (once a second while open, no relayout storm).
-            for (_, value), shown in zip(rows, self._shown, strict=True):
+            for (_name, value), shown in zip(rows, self._shown, strict=True):
                 if shown.get_text() != value:
                     shown.set_text(value)
             self.rows = rows
@@ -155,7 +158,7 @@ class DetailsWindow(Gtk.Window):
             text.encode("latin-1")
         except UnicodeEncodeError:
             self.say_entry.add_css_class("error")
-            self.say_entry.set_tooltip_text("ARIA strings carry latin-1 characters only")
+            self.say_entry.set_tooltip_text(_("ARIA strings carry latin-1 characters only"))
             return
         self.say_entry.remove_css_class("error")
         self.say_entry.set_tooltip_text(None)

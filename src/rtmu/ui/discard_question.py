@@ -14,6 +14,8 @@ import gi
 gi.require_version("Gtk", "4.0")
 from gi.repository import Gtk  # noqa: E402
 
+from ..base.i18n import _  # noqa: E402
+
 
 class DiscardQuestion(Gtk.Box):
     """Asks before unsaved edits are lost; ``discard()`` is called only on "Discard and close"."""
@@ -22,9 +24,9 @@ class DiscardQuestion(Gtk.Box):
         super().__init__(spacing=8, visible=False)
         self.add_css_class("config-banner")
         self.label = Gtk.Label(xalign=0.0, wrap=True, hexpand=True)
-        self.keep_button = Gtk.Button(label="Keep editing")
+        self.keep_button = Gtk.Button(label=_("Keep editing"))
         self.keep_button.connect("clicked", lambda _b: self.dismiss())
-        self.discard_button = Gtk.Button(label="Discard and close")
+        self.discard_button = Gtk.Button(label=_("Discard and close"))
         self.discard_button.add_css_class("destructive-action")
         self.discard_button.connect("clicked", lambda _b: discard())
         for child in (self.label, self.keep_button, self.discard_button):
@@ -35,8 +37,8 @@ class DiscardQuestion(Gtk.Box):
         return self.get_visible()
 
     def ask(self, unsaved: int) -> None:
-        edits = "1 unsaved edit" if unsaved == 1 else f"{unsaved} unsaved edits"
-        self.label.set_text(f"Close and lose {edits}? Save keeps them.")
+        edits = _("1 unsaved edit") if unsaved == 1 else _("{unsaved} unsaved edits").format(unsaved=unsaved)
+        self.label.set_text(_("Close and lose {edits}? Save keeps them.").format(edits=edits))
         self.set_visible(True)
         self.keep_button.grab_focus()
 

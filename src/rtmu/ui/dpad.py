@@ -16,13 +16,14 @@ import gi
 gi.require_version("Gtk", "4.0")
 from gi.repository import Gtk  # noqa: E402
 
+from ..base.i18n import N_, _  # noqa: E402
 from . import accessible  # noqa: E402
 
 PADS = (
-    ("drive_forward", "go-up-symbolic", 1, 0, "Forward (hold)"),
-    ("drive_left", "go-previous-symbolic", 0, 1, "Turn left (hold)"),
-    ("drive_right", "go-next-symbolic", 2, 1, "Turn right (hold)"),
-    ("drive_backward", "go-down-symbolic", 1, 2, "Backward (hold)"),
+    ("drive_forward", "go-up-symbolic", 1, 0, N_("Forward (hold)")),
+    ("drive_left", "go-previous-symbolic", 0, 1, N_("Turn left (hold)")),
+    ("drive_right", "go-next-symbolic", 2, 1, N_("Turn right (hold)")),
+    ("drive_backward", "go-down-symbolic", 1, 2, N_("Backward (hold)")),
 )
 PAD_PX = 64
 COMPACT_PAD_PX = 48
@@ -47,7 +48,7 @@ class DPad(Gtk.Grid):
         self.pads: dict[str, Gtk.Widget] = {}
         self.held: set[str] = set()
         for name, icon, col, row, tip in PADS:
-            pad = self._pad(Gtk.Image.new_from_icon_name(icon), tip)
+            pad = self._pad(Gtk.Image.new_from_icon_name(icon), _(tip))
             drag = Gtk.GestureDrag()
             drag.set_button(0)
             drag.connect("begin", self._begin, name)
@@ -55,7 +56,7 @@ class DPad(Gtk.Grid):
             pad.add_controller(drag)
             self.attach(pad, col, row, 1, 1)
             self.pads[name] = pad
-        stop_pad = self._pad(Gtk.Label(label="STOP"), "Stop (Space)")
+        stop_pad = self._pad(Gtk.Label(label=_("STOP")), _("Stop (Space)"))
         stop_pad.add_css_class("stop")
         click = Gtk.GestureClick()
         click.set_button(0)

@@ -13,6 +13,7 @@ from __future__ import annotations
 
 from collections.abc import Callable
 
+from ..base.i18n import _
 from ..control.controller import KEYBOARD_LOST
 from ..fleet.selected import SelectedRobot
 from .keys import KeyRouter
@@ -54,7 +55,7 @@ class DriveInput:
 
     def popover_took_keys(self) -> None:
         """A menu or popover holds the keyboard now: held keys can no longer be seen let go."""
-        self.robot.session.controller.look("the menu", keys_leave=True)
+        self.robot.session.controller.look(_("the menu"), keys_leave=True)
         self.router.release_all()
         self.map_page.dpad.release_all()
 
@@ -71,7 +72,7 @@ class DriveInput:
         release seen afterwards is a real one and unblocks its key.
         """
         controller = self.robot.session.controller
-        controller.focus_lost("RTMU was suspended (Ctrl+Z)" if still_active else KEYBOARD_LOST)
+        controller.focus_lost(_("RTMU was suspended (Ctrl+Z)") if still_active else KEYBOARD_LOST)
         self.router.release_all()
         self.map_page.dpad.release_all()
         if still_active:

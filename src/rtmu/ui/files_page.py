@@ -29,6 +29,7 @@ gi.require_version("Gtk", "4.0")
 gi.require_version("Pango", "1.0")
 from gi.repository import GLib, Gtk, Pango  # noqa: E402
 
+from ..base.i18n import _  # noqa: E402
 from ..base.textsafe import visible  # noqa: E402
 from ..client.config_care import map_param_problem  # noqa: E402
 from ..client.remote_files import Listing, local_name, wire_name  # noqa: E402
@@ -53,7 +54,7 @@ class FilesPage(Gtk.Window):
         self, parent: Gtk.Window, robot: SelectedRobot, model: RobotModel, *, downloads: Path
     ) -> None:
         super().__init__(
-            title="Files on the robot", transient_for=parent, modal=False, destroy_with_parent=True
+            title=_("Files on the robot"), transient_for=parent, modal=False, destroy_with_parent=True
         )
         self.set_default_size(640, 460)
         self.robot, self.model = robot, model
@@ -86,13 +87,13 @@ class FilesPage(Gtk.Window):
         for side in ("top", "bottom", "start", "end"):
             getattr(box, f"set_margin_{side}")(8)
         bar = Gtk.Box(spacing=8)
-        self.up_button = Gtk.Button(icon_name="go-up-symbolic", tooltip_text="The folder above")
-        accessible.name(self.up_button, "The folder above")
+        self.up_button = Gtk.Button(icon_name="go-up-symbolic", tooltip_text=_("The folder above"))
+        accessible.name(self.up_button, _("The folder above"))
         self.up_button.connect("clicked", lambda _b: self.open_folder(parent_of(self.folder)))
         bar.append(self.up_button)
         self.path_label = Gtk.Label(xalign=0.0, hexpand=True, ellipsize=Pango.EllipsizeMode.START)
         bar.append(self.path_label)
-        self.refresh_button = Gtk.Button(label="Refresh")
+        self.refresh_button = Gtk.Button(label=_("Refresh"))
         self.refresh_button.connect("clicked", lambda _b: self.refresh())
         bar.append(self.refresh_button)
         box.append(bar)
@@ -106,21 +107,21 @@ class FilesPage(Gtk.Window):
         scroller.set_child(self.rows)
         box.append(scroller)
         local = Gtk.Box(spacing=8)
-        local.append(Gtk.Label(label="Downloads go to"))
+        local.append(Gtk.Label(label=_("Downloads go to")))
         self.local_entry = Gtk.Entry(text=str(downloads), hexpand=True)
         local.append(self.local_entry)
-        self.choose_button = Gtk.Button(label="Choose…")
+        self.choose_button = Gtk.Button(label=_("Choose…"))
         self.choose_button.connect("clicked", lambda _b: self._choose_folder())
         local.append(self.choose_button)
         box.append(local)
         actions = Gtk.Box(spacing=8)
-        self.download_button = Gtk.Button(label="Download")
+        self.download_button = Gtk.Button(label=_("Download"))
         self.download_button.connect("clicked", lambda _b: self.download_selected())
-        self.upload_button = Gtk.Button(label="Upload…")
+        self.upload_button = Gtk.Button(label=_("Upload…"))
         self.upload_button.connect("clicked", lambda _b: self._choose_upload())
-        self.delete_button = Gtk.Button(label="Delete…")
+        self.delete_button = Gtk.Button(label=_("Delete…"))
         self.delete_button.connect("clicked", lambda _b: self.delete_selected())
-        self.use_map_button = Gtk.Button(label="Use as the robot's map…")
+        self.use_map_button = Gtk.Button(label=_("Use as the robot's map…"))
         self.use_map_button.connect("clicked", lambda _b: self.use_selected_map())
         for button in (self.download_button, self.upload_button, self.delete_button, self.use_map_button):
             actions.append(button)
@@ -156,7 +157,7 @@ class FilesPage(Gtk.Window):
         self.delete_button.set_sensitive("delete" not in missing and entry is not None)
         switching = self._switch_problem(entry)
         self.use_map_button.set_sensitive(not switching)
-        self.use_map_button.set_tooltip_text(switching or "Make this map the robot's (ARNL's Files/Map)")
+        self.use_map_button.set_tooltip_text(switching or _("Make this map the robot's (ARNL's Files/Map)"))
         self.refresh_button.set_sensitive("list" not in missing)
         self.up_button.set_sensitive("list" not in missing and bool(self.folder))
         for button, feature in (
@@ -177,13 +178,13 @@ class FilesPage(Gtk.Window):
         """Why the selection cannot become the robot's map ("" when it can)."""
         conn = self.model.connection.value
         if conn.phase is not Phase.CONNECTED:
-            return "not connected to a robot"
+            return _("not connected to a robot")
         if not SwitchMap.offered(conn.offers):
-            return "this robot's configuration cannot be set (it offers no setConfig)"
+            return _("this robot's configuration cannot be set (it offers no setConfig)")
         if self.map_param:
             return self.map_param
         if entry is None or not entry.is_file or not entry.name.lower().endswith(".map"):
-            return "select a .map file"
+            return _("select a .map file")
         return ""
 
     def _check_map_param(self) -> None:
@@ -195,7 +196,9 @@ class FilesPage(Gtk.Window):
         def read(future: concurrent.futures.Future[Any]) -> bool:
             error = None if future.cancelled() else future.exception()
             if future.cancelled() or error is not None:
-                self.map_param = f"this robot's configuration could not be read ({error or 'cancelled'})"
+                self.map_param = _("this robot's configuration could not be read ({value})").format(
+                    value=error or "cancelled"
+                )
             else:
                 self.map_param = map_param_problem(future.result())
             if not self.closed:
@@ -213,12 +216,12 @@ class FilesPage(Gtk.Window):
     # -- listing ----------------------------------------------------------------------------------
     def refresh(self) -> None:
         """List the folder shown again (the selection is kept by name where it still is)."""
-        self.path_label.set_text("Robot files" + (f" / {visible(self.folder)}" if self.folder else ""))
+        self.path_label.set_text(_("Robot files") + (f" / {visible(self.folder)}" if self.folder else ""))
         if "list" in self._greyed():
             self._fill(None)
             return
         folder = self.folder
-        self._ask(ListFiles(folder), lambda answer: self._listed(folder, answer), "List")
+        self._ask(ListFiles(folder), lambda answer: self._listed(folder, answer), _("List"))
 
     def open_folder(self, folder: str) -> None:
         self.folder = folder
@@ -244,7 +247,12 @@ class FilesPage(Gtk.Window):
                 if entry.name == kept.name:
                     self.rows.select_row(self.rows.get_row_at_index(i))
         if listing is not None and len(entries) > MAX_ROWS:
-            self._say(f"Showing the first {MAX_ROWS} of {len(entries)} entries", error=False)
+            self._say(
+                _("Showing the first {MAX_ROWS} of {len} entries").format(
+                    MAX_ROWS=MAX_ROWS, len=len(entries)
+                ),
+                error=False,
+            )
         self._update_greyed()
 
     def _row_activated(self, _box: Gtk.ListBox, row: Gtk.ListBoxRow) -> None:
@@ -262,36 +270,49 @@ class FilesPage(Gtk.Window):
             return
         folder = Path(self.local_entry.get_text()).expanduser()
         if not folder.is_dir():
-            self._say(f"There is no folder {folder} on this computer to download into", error=True)
+            self._say(
+                _("There is no folder {folder} on this computer to download into").format(folder=folder),
+                error=True,
+            )
             return
         target = folder / local_name(entry.name)
         remote = remote_join(self.folder, entry.name)
         if target.exists() or target.is_symlink():
             self._confirm(
-                f"“{target.name}” already exists in {folder}. Replace it?",
-                "Replace",
+                _("“{name}” already exists in {folder}. Replace it?").format(name=target.name, folder=folder),
+                _("Replace"),
                 lambda: self._download(remote, target, entry.size, overwrite=True),
-                detail=f"The download from the robot ({human_size(entry.size)}) replaces it once complete.",
+                detail=_("The download from the robot ({human_size}) replaces it once complete.").format(
+                    human_size=human_size(entry.size)
+                ),
             )
             return
         self._download(remote, target, entry.size, overwrite=False)
 
     def _download(self, remote: str, target: Path, size: int, *, overwrite: bool) -> None:
-        self._say(f"Downloading {visible(remote)}…", error=False)
+        self._say(_("Downloading {visible}…").format(visible=visible(remote)), error=False)
         intent = DownloadFile(remote, str(target), size=size, overwrite=overwrite)
 
         def done(finished: Any) -> None:
             self.downloads += 1
-            self._say(f"Downloaded {visible(remote)} to {target} ({human_size(finished.size)})", error=False)
+            self._say(
+                _("Downloaded {visible} to {target} ({human_size})").format(
+                    visible=visible(remote), target=target, human_size=human_size(finished.size)
+                ),
+                error=False,
+            )
 
-        self._ask(intent, done, "Download")
+        self._ask(intent, done, _("Download"))
 
     def _choose_folder(self) -> None:
         chooser = Gtk.FileChooserDialog(
-            title="Download into", transient_for=self, modal=True, action=Gtk.FileChooserAction.SELECT_FOLDER
+            title=_("Download into"),
+            transient_for=self,
+            modal=True,
+            action=Gtk.FileChooserAction.SELECT_FOLDER,
         )
-        chooser.add_button("Cancel", Gtk.ResponseType.CANCEL)
-        chooser.add_button("Select", Gtk.ResponseType.ACCEPT)
+        chooser.add_button(_("Cancel"), Gtk.ResponseType.CANCEL)
+        chooser.add_button(_("Select"), Gtk.ResponseType.ACCEPT)
         chooser.connect("response", self._folder_chosen)
         chooser.present()
 
@@ -304,10 +325,10 @@ class FilesPage(Gtk.Window):
     # -- upload -----------------------------------------------------------------------------------
     def _choose_upload(self) -> None:
         chooser = Gtk.FileChooserDialog(
-            title="Upload to the robot", transient_for=self, modal=True, action=Gtk.FileChooserAction.OPEN
+            title=_("Upload to the robot"), transient_for=self, modal=True, action=Gtk.FileChooserAction.OPEN
         )
-        chooser.add_button("Cancel", Gtk.ResponseType.CANCEL)
-        chooser.add_button("Upload", Gtk.ResponseType.ACCEPT)
+        chooser.add_button(_("Cancel"), Gtk.ResponseType.CANCEL)
+        chooser.add_button(_("Upload"), Gtk.ResponseType.ACCEPT)
         chooser.connect("response", self._upload_chosen)
         self.chooser = chooser
         chooser.present()
@@ -327,21 +348,25 @@ class FilesPage(Gtk.Window):
         remote = remote_join(self.folder, name)
         if self.listing is not None and self.listing.find(name) is not None:
             self._confirm(
-                f"The robot already has “{visible(remote)}”. Replace it with {local}?",
-                "Replace",
+                _("The robot already has “{visible}”. Replace it with {local}?").format(
+                    visible=visible(remote), local=local
+                ),
+                _("Replace"),
                 lambda: self._upload(local, remote),
             )
             return
         self._upload(local, remote)
 
     def _upload(self, local: Path, remote: str) -> None:
-        self._say(f"Uploading {local.name}…", error=False)
+        self._say(_("Uploading {name}…").format(name=local.name), error=False)
 
         def done(_answer: Any) -> None:
-            self._say(f"Uploaded {local} to {visible(remote)}", error=False)
+            self._say(
+                _("Uploaded {local} to {visible}").format(local=local, visible=visible(remote)), error=False
+            )
             self.refresh()
 
-        self._ask(UploadFile(str(local), remote), done, "Upload")
+        self._ask(UploadFile(str(local), remote), done, _("Upload"))
 
     # -- delete -----------------------------------------------------------------------------------
     def delete_selected(self) -> None:
@@ -351,18 +376,18 @@ class FilesPage(Gtk.Window):
         remote = remote_join(self.folder, entry.name)
         what = "folder" if entry.is_folder else "file"
         self._confirm(
-            f"Delete the {what} “{visible(remote)}” from the robot?",
-            "Delete",
+            _("Delete the {what} “{visible}” from the robot?").format(what=what, visible=visible(remote)),
+            _("Delete"),
             lambda: self._delete(remote),
-            detail="It cannot be undone.",
+            detail=_("It cannot be undone."),
         )
 
     def _delete(self, remote: str) -> None:
         def done(_answer: Any) -> None:
-            self._say(f"Deleted {visible(remote)}", error=False)
+            self._say(_("Deleted {visible}").format(visible=visible(remote)), error=False)
             self.refresh()
 
-        self._ask(DeleteFile(remote), done, "Delete")
+        self._ask(DeleteFile(remote), done, _("Delete"))
 
     # -- switch map -------------------------------------------------------------------------------
     def use_selected_map(self) -> None:
@@ -372,24 +397,27 @@ class FilesPage(Gtk.Window):
             return
         remote = remote_join(self.folder, entry.name)
         self._confirm(
-            f"Make “{visible(remote)}” the robot's map?",
-            "Use this map",
+            _("Make “{visible}” the robot's map?").format(visible=visible(remote)),
+            _("Use this map"),
             lambda: self._switch(remote),
-            detail="The robot loads it at once (ARNL's Files/Map parameter).",
+            detail=_("The robot loads it at once (ARNL's Files/Map parameter)."),
         )
 
     def _switch(self, remote: str) -> None:
-        self._say(f"Switching the robot to {visible(remote)}…", error=False)
+        self._say(_("Switching the robot to {visible}…").format(visible=visible(remote)), error=False)
 
         def done(updated: Any) -> None:
             if updated:
-                self._say(f"The robot now uses {visible(remote)}", error=False)
+                self._say(_("The robot now uses {visible}").format(visible=visible(remote)), error=False)
             else:
                 self._say(
-                    f"The robot took {visible(remote)} but has not said its map changed yet", error=False
+                    _("The robot took {visible} but has not said its map changed yet").format(
+                        visible=visible(remote)
+                    ),
+                    error=False,
                 )
 
-        self._ask(SwitchMap(remote), done, "Switch map")
+        self._ask(SwitchMap(remote), done, _("Switch map"))
 
     # -- plumbing ---------------------------------------------------------------------------------
     def _confirm(self, question: str, action: str, on_yes: Any, *, detail: str = "") -> None:
@@ -409,7 +437,7 @@ class FilesPage(Gtk.Window):
             return False
         error = None if future.cancelled() else future.exception()
         if future.cancelled() or error is not None:
-            self._say(f"{what} failed: {error or 'cancelled'}", error=True)
+            self._say(_("{what} failed: {value}").format(what=what, value=error or "cancelled"), error=True)
             if isinstance(future.exception(), Exception) and what == "List":
                 self._fill(None)
             return False

@@ -10,6 +10,7 @@ from __future__ import annotations
 import datetime
 from collections.abc import Collection
 
+from ..base.i18n import _
 from ..client.remote_files import FEATURES
 from ..values.commission import Direction, Transfer
 
@@ -45,16 +46,16 @@ def greyed(offers: Collection[str], connected: bool) -> dict[str, str]:
     for feature in PAGE_FEATURES:
         names, reason = FEATURES[feature]
         if not connected:
-            out[feature] = "not connected to a robot"
+            out[feature] = _("not connected to a robot")
         elif not any(name in offers for name in names):
-            out[feature] = reason + " — or this user may not use it"
+            out[feature] = reason + _(" — or this user may not use it")
     return out
 
 
 def transfer_text(t: Transfer) -> str:
     """``Downloading maps/big.map — 1.2 of 50 MB`` (the total only when known)."""
-    verb = "Downloading" if t.direction is Direction.DOWNLOAD else "Uploading"
-    total = f" of {human_size(t.total)}" if t.total else ""
+    verb = _("Downloading") if t.direction is Direction.DOWNLOAD else _("Uploading")
+    total = _(" of {human_size}").format(human_size=human_size(t.total)) if t.total else ""
     return f"{verb} {t.remote} — {human_size(t.done)}{total}"
 
 

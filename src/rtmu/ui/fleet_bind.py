@@ -26,6 +26,7 @@ import numpy as np
 gi.require_version("Gtk", "4.0")
 from gi.repository import GLib, Gtk  # noqa: E402
 
+from ..base.i18n import _, ngettext  # noqa: E402
 from ..base.notices import Kind, Level, Notice  # noqa: E402
 from ..control.commands import CommandState  # noqa: E402
 from ..fleet.sessions import Fleet, RobotSession  # noqa: E402
@@ -220,11 +221,19 @@ class FleetBinding:
             return
         if len(self._lost) == 1:
             name, error = next(iter(self._lost.items()))
-            text = f"{name}: link lost" + (f" ({error})" if error else "")
+            text = (
+                _("{robot}: link lost ({error})").format(robot=name, error=error)
+                if error
+                else _("{robot}: link lost").format(robot=name)
+            )
         else:
-            text = f"{len(self._lost)} robots lost their link: {', '.join(self._lost)}"
+            text = ngettext(
+                "{count} robot lost its link: {robots}",
+                "{count} robots lost their link: {robots}",
+                len(self._lost),
+            ).format(count=len(self._lost), robots=", ".join(self._lost))
         self.window.banners.tell(
-            "fleet:links", "warning", text + " — the other robots carry on", timeout=None
+            "fleet:links", "warning", _("{what} — the other robots carry on").format(what=text), timeout=None
         )
 
     # -- the robot list --------------------------------------------------------------------------

@@ -15,6 +15,7 @@ from dataclasses import dataclass, field
 
 import cairo
 
+from ..base.i18n import _
 from ..values.state import DrawingLayer
 from . import drawings_draw, fleet_draw, fov_draw, nav_draw, overlays, stop_draw
 from .tiles import BACKGROUND_RGB, EMPTY, TILE, Overview, TileCache
@@ -64,7 +65,7 @@ def draw_frame(ctx: cairo.Context, vp: Viewport, scene: Scene) -> bool:
         complete = draw_tiles(ctx, vp, scene.tiles)  # type: ignore[arg-type]
     else:
         step = overlays.draw_grid(ctx, vp)
-        overlays.draw_scale_note(ctx, scene.labels, f"grid {overlays.metres(step)}")
+        overlays.draw_scale_note(ctx, scene.labels, _("grid {metres}").format(metres=overlays.metres(step)))
     if scene.objects:
         avoid = overlays.robot_box(vp, *scene.robot[:2]) if scene.robot is not None else None
         overlays.draw_cairns(ctx, vp, scene.objects, scene.labels, avoid)

@@ -14,13 +14,14 @@ gi.require_version("Gtk", "4.0")
 gi.require_version("Pango", "1.0")
 from gi.repository import Gtk, Pango  # noqa: E402
 
+from ..base.i18n import N_, _  # noqa: E402
 from ..control.gamepad import DeadMan, PadState  # noqa: E402
 
 TEXT = {
     DeadMan.NO_PAD: "",
-    DeadMan.RELEASED: "LB: hold to drive",
-    DeadMan.HELD: "LB held: stick drives",
-    DeadMan.LATCHED: "Release LB to drive again",
+    DeadMan.RELEASED: N_("LB: hold to drive"),
+    DeadMan.HELD: N_("LB held: stick drives"),
+    DeadMan.LATCHED: N_("Release LB to drive again"),
 }
 
 
@@ -48,7 +49,7 @@ class GamepadStatus(Gtk.Box):
         self.state = state
         self.set_visible(state.deadman is not DeadMan.NO_PAD)
         self.name_label.set_text(state.name)
-        self.state_label.set_text(TEXT[state.deadman])
+        self.state_label.set_text(_(TEXT[state.deadman]))
         for d in DeadMan:
             css = f"deadman-{d.name.lower()}"
             (self.add_css_class if d is state.deadman else self.remove_css_class)(css)

@@ -12,6 +12,7 @@ import gi
 gi.require_version("Gtk", "4.0")
 from gi.repository import Gtk  # noqa: E402
 
+from ..base.i18n import _  # noqa: E402
 from . import accessible  # noqa: E402
 
 GREEN = (0.18, 0.62, 0.27)
@@ -56,13 +57,26 @@ class BatteryGauge(Gtk.DrawingArea):
         self.state = "unknown"
         """``ok``, ``low`` (amber), ``critical`` (red), ``unknown`` or ``stale`` (grey)."""
         self.set_draw_func(self._draw)
-        accessible.name(self, "Battery level")
+        accessible.name(self, _("Battery level"))
 
     def set_level(self, fraction: float, state: str) -> None:
         if (fraction, state) != (self.fraction, self.state):
             self.fraction, self.state = fraction, state
             self.queue_draw()
-            accessible.value(self, round(fraction * 100), 0, 100, f"{fraction:.0%}, {state}")
+            words = {
+                "ok": _("ok"),
+                "low": _("low"),
+                "critical": _("at shutdown level"),
+                "unknown": _("unknown"),
+                "stale": _("stale"),
+            }.get(state, state)
+            accessible.value(
+                self,
+                round(fraction * 100),
+                0,
+                100,
+                _("{percent} %, {state}").format(percent=round(fraction * 100), state=words),
+            )
 
     def _draw(self, _a: Gtk.DrawingArea, ctx, width: int, height: int) -> None:
         colour = {"ok": GREEN, "low": AMBER, "critical": RED}.get(self.state, GREY)
@@ -87,13 +101,15 @@ class WifiGauge(Gtk.DrawingArea):
         self.bars = 0
         self.live = False
         self.set_draw_func(self._draw)
-        accessible.name(self, "Wi-Fi signal")
+        accessible.name(self, _("Wi-Fi signal"))
 
     def set_bars(self, bars: int, live: bool) -> None:
         if (bars, live) != (self.bars, self.live):
             self.bars, self.live = bars, live
             self.queue_draw()
-            accessible.value(self, bars, 0, 4, f"{bars} of 4 bars" if live else "no signal reading")
+            accessible.value(
+                self, bars, 0, 4, _("{bars} of 4 bars").format(bars=bars) if live else _("no signal reading")
+            )
 
     def _draw(self, _a: Gtk.DrawingArea, ctx, width: int, height: int) -> None:
         bar_w = (width - 3 * 2) / 4

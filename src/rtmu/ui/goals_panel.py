@@ -24,20 +24,22 @@ gi.require_version("Gtk", "4.0")
 gi.require_version("Pango", "1.0")
 from gi.repository import Gtk, Pango  # noqa: E402
 
+from ..base.i18n import N_, _  # noqa: E402
 from ..control.commands import COMMANDS, CommandState  # noqa: E402
 from ..model.observables import ConnectionState, NavState, Phase, RobotModel  # noqa: E402
 from . import accessible  # noqa: E402
 from .nav_draw import MarkerKind  # noqa: E402
+from .state_words import reason_words  # noqa: E402
 
 NAV_OFFERS = ("gotoGoal", "gotoRouteGoal", "gotoPose", "home", "dock", "tourGoals", "localizeToPose")
 """The panel shows while the server lists any of these."""
-COMMANDS_SHOWN = {"home": "Go home", "dock": "Dock", "tour_goals": "Tour goals"}
+COMMANDS_SHOWN = {"home": N_("Go home"), "dock": N_("Dock"), "tour_goals": N_("Tour goals")}
 """Registry commands shown as buttons, with the short label that keeps the popover within 800 px."""
 MODES = (
-    (MarkerKind.GOTO, "Go to point…", "gotoPose", "Click the map where the robot should go"),
-    (MarkerKind.LOCALIZE, "Set position…", "localizeToPose", "Tell the robot where it is on the map"),
+    (MarkerKind.GOTO, N_("Go to point…"), "gotoPose", N_("Click the map where the robot should go")),
+    (MarkerKind.LOCALIZE, N_("Set position…"), "localizeToPose", N_("Tell the robot where it is on the map")),
 )
-NOT_OFFERED = "not offered by the server"
+NOT_OFFERED = N_("not offered by the server")
 
 
 def _matches(query: str, name: str) -> bool:
@@ -56,9 +58,9 @@ class GoalsPanel(Gtk.MenuButton):
         run: Callable[[str], None],
         pick: Callable[[MarkerKind], None],
     ) -> None:
-        super().__init__(tooltip_text="Send the robot somewhere: goals, a point, home, the dock")
+        super().__init__(tooltip_text=_("Send the robot somewhere: goals, a point, home, the dock"))
         self.set_icon_name("go-jump-symbolic")  # an icon: the header must still fit a 560 px window
-        accessible.name_menu_button(self, "Go to")
+        accessible.name_menu_button(self, _("Go to"))
         self.add_css_class("goals-button")
         self.model = model
         self._goto, self._run, self._pick = goto, run, pick
@@ -67,16 +69,15 @@ class GoalsPanel(Gtk.MenuButton):
         box = Gtk.Box(orientation=Gtk.Orientation.VERTICAL, spacing=6)
         for side in ("top", "bottom", "start", "end"):
             getattr(box, f"set_margin_{side}")(6)
-        self.search = Gtk.SearchEntry(placeholder_text="Search goals")
-        accessible.name(
-            self.search, "Search goals"
-        )  # a placeholder is not a name: GTK 4.8 says "GtkSearchEntry"
+        self.search = Gtk.SearchEntry(placeholder_text=_("Search goals"))
+        # A placeholder is no name: GTK 4.8 would read the field as "GtkSearchEntry".
+        accessible.name(self.search, _("Search goals"))
         self.search.connect("search-changed", lambda _e: self._filter())
         self.search.connect("activate", lambda _e: self.choose_first())
         self.search.connect("stop-search", lambda _e: self.popdown())
         box.append(self.search)
         self.list = Gtk.ListBox(selection_mode=Gtk.SelectionMode.NONE)
-        accessible.name(self.list, "Goals")
+        accessible.name(self.list, _("Goals"))
         self.list.add_css_class("goal-list")
         self.list.set_activate_on_single_click(True)
         self.list.connect("row-activated", lambda _l, row: self.choose(row.goal))
@@ -87,7 +88,7 @@ class GoalsPanel(Gtk.MenuButton):
         scroller.set_min_content_width(220)
         scroller.set_child(self.list)
         box.append(scroller)
-        self.empty = Gtk.Label(label="This map has no goals", xalign=0.0)
+        self.empty = Gtk.Label(label=_("This map has no goals"), xalign=0.0)
         self.empty.add_css_class("dim-label")
         box.append(self.empty)
         self.rows: dict[str, Gtk.ListBoxRow] = {}
@@ -98,19 +99,19 @@ class GoalsPanel(Gtk.MenuButton):
         """Command or mode name (``home``, ``dock``, ``tour_goals``, ``goto``, ``localize``) → button."""
         commands = Gtk.Box(spacing=4, homogeneous=True)
         for name, short in COMMANDS_SHOWN.items():
-            button = Gtk.Button(label=short)
+            button = Gtk.Button(label=_(short))
             button.connect("clicked", lambda _b, n=name: self._command(n))
             commands.append(button)
             self.buttons[name] = button
-            full = COMMANDS.get(name).label if name in COMMANDS else short
-            self._tips[name] = f"{full}: the robot drives by itself; STOP ends it"
+            full = _(COMMANDS.get(name).label) if name in COMMANDS else short
+            self._tips[name] = _("{full}: the robot drives by itself; STOP ends it").format(full=full)
         modes = Gtk.Box(spacing=4, homogeneous=True)
         for kind, label, _data, tip in MODES:
-            button = Gtk.Button(label=label)
+            button = Gtk.Button(label=_(label))
             button.connect("clicked", lambda _b, k=kind: self._mode(k))
             modes.append(button)
             self.buttons[kind.value] = button
-            self._tips[kind.value] = tip
+            self._tips[kind.value] = _(tip)
         box.append(commands)
         box.append(modes)
         self.reasons = Gtk.Label(xalign=0.0, wrap=True, max_width_chars=36, visible=False)
@@ -191,10 +192,10 @@ class GoalsPanel(Gtk.MenuButton):
             label.set_use_markup(False)
             label.set_ellipsize(Pango.EllipsizeMode.END)
             row.set_child(label)
-            row.set_tooltip_text(f"Drive to {name} (the robot drives by itself; STOP ends it)")
-            accessible.name(
-                row, name
-            )  # GTK 4.8 does not name a row by its label: it would be read as nothing
+            row.set_tooltip_text(
+                _("Drive to {name} (the robot drives by itself; STOP ends it)").format(name=name)
+            )
+            accessible.name(row, name)  # GTK 4.8 names no row by its label: it would be read as nothing
             self.list.append(row)
             self.rows[name] = row
         self.empty.set_visible(not goals)
@@ -202,7 +203,7 @@ class GoalsPanel(Gtk.MenuButton):
     def _filter(self) -> None:
         self.list.invalidate_filter()
         shown = any(_matches(self.search.get_text(), n) for n in self.rows)
-        self.empty.set_text("No goal matches" if self.rows else "This map has no goals")
+        self.empty.set_text(_("No goal matches") if self.rows else _("This map has no goals"))
         self.empty.set_visible(not shown)
 
     def commands_changed(self, states: Mapping[str, CommandState]) -> None:
@@ -218,12 +219,16 @@ class GoalsPanel(Gtk.MenuButton):
         for name in COMMANDS_SHOWN:
             state = self._states.get(name)
             enabled = state is not None and state.enabled
-            reason = "" if enabled else _short(state.reason if state is not None else "not connected")
+            reason = (
+                ""
+                if enabled
+                else _short(reason_words(state.reason) if state is not None else _("not connected"))
+            )
             self._set(name, enabled, reason, why)
         for kind, label, data, _tip in MODES:
             offered = connected and data in conn.offers
-            reason = "" if offered else NOT_OFFERED if connected else "not connected"
-            self._set(kind.value, offered, reason, why, label.rstrip("…"))
+            reason = "" if offered else _(NOT_OFFERED) if connected else _("not connected")
+            self._set(kind.value, offered, reason, why, _(label).rstrip("…"))
         self.reasons.set_text("\n".join(why))
         self.reasons.set_visible(bool(why))
 
@@ -240,5 +245,5 @@ class GoalsPanel(Gtk.MenuButton):
 
 def _short(reason: str) -> str:
     if reason.startswith(("this server does not offer", "this server offers no")):
-        return NOT_OFFERED
+        return _(NOT_OFFERED)
     return reason or "unavailable"

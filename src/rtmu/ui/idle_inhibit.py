@@ -19,14 +19,15 @@ import gi
 gi.require_version("Gtk", "4.0")
 from gi.repository import Gtk  # noqa: E402
 
+from ..base.i18n import N_, _  # noqa: E402
 from ..model.observables import Phase, RobotModel  # noqa: E402
 
 RELEASE_AFTER = 10.0
 """Seconds at rest before the desktop may idle again."""
 MOVING_MM_S = 10.0
 TURNING_DEG_S = 2.0
-NOTE = "Screen kept on"
-REASON = "A robot is moving under RTMU's control: the operator must keep seeing it"
+NOTE = N_("Screen kept on")
+REASON = N_("A robot is moving under RTMU's control: the operator must keep seeing it")
 
 
 class IdleInhibit:
@@ -75,9 +76,9 @@ class IdleInhibit:
         if app is None:
             return
         flags = Gtk.ApplicationInhibitFlags.IDLE | Gtk.ApplicationInhibitFlags.SUSPEND
-        self.cookie = app.inhibit(self.window, flags, REASON)
+        self.cookie = app.inhibit(self.window, flags, _(REASON))
         self.asked = True
-        self.say(NOTE if self.cookie else "")
+        self.say(_(NOTE) if self.cookie else "")
 
     def release(self) -> None:
         app = self.window.get_application()

@@ -25,6 +25,7 @@ import gi
 gi.require_version("Gtk", "4.0")
 from gi.repository import GLib, Gtk  # noqa: E402
 
+from ..base.i18n import _  # noqa: E402
 from ..control.key_rules import keys_note  # noqa: E402
 from ..model.observables import Phase  # noqa: E402
 from .dialog_chain import dialogs_of  # noqa: E402
@@ -120,5 +121,5 @@ class KeyReach:
         """The title of one of this window's own windows that has the keyboard now ("" if none)."""
         for other in dialogs_of(self.window):
             if other.is_active():
-                return other.get_title() or "a dialog"
+                return other.get_title() or _("a dialog")
         return ""

@@ -26,6 +26,7 @@ gi.require_version("Gtk", "4.0")
 gi.require_version("Gdk", "4.0")
 from gi.repository import Gdk, Gio, GLib, Gtk  # noqa: E402
 
+from ..base.i18n import _  # noqa: E402
 from ..fleet.sessions import Fleet  # noqa: E402
 from .keys import menu_item  # noqa: E402
 from .nav_draw import Marker, MarkerKind  # noqa: E402
@@ -119,7 +120,7 @@ class KeyboardNav:
             panel.popup()
         else:
             self.window.banners.tell(
-                "notice:goto", "warning", "Go to: this server does not navigate", timeout=4.0
+                "notice:goto", "warning", _("Go to: this server does not navigate"), timeout=4.0
             )
 
     # -- the fleet -------------------------------------------------------------------------------
@@ -129,7 +130,10 @@ class KeyboardNav:
         sessions = fleet.sessions.value if fleet is not None else ()
         if not 1 <= number <= len(sessions) or fleet is None:
             self.window.banners.tell(
-                "notice:robot", "warning", f"There is no robot {number} in the list", timeout=3.0
+                "notice:robot",
+                "warning",
+                _("There is no robot {number} in the list").format(number=number),
+                timeout=3.0,
             )
             return
         fleet.select(sessions[number - 1])
@@ -139,7 +143,7 @@ class KeyboardNav:
         sessions = fleet.sessions.value if fleet is not None else ()
         if fleet is None or len(sessions) < 2:
             self.window.banners.tell(
-                "notice:robot", "warning", "Only one robot: nothing to switch to", timeout=3.0
+                "notice:robot", "warning", _("Only one robot: nothing to switch to"), timeout=3.0
             )
             return
         selected = fleet.selected.value
@@ -153,14 +157,14 @@ class KeyboardNav:
         self.robots_menu.remove_all()
         for number, session in enumerate(sessions[:ROBOT_KEYS], start=1):
             self.robots_menu.append_item(menu_item(session.name, f"win.select-robot({number})"))
-        self.robots_menu.append_item(menu_item("Next robot", "win.next-robot"))
-        self.robots_menu.append_item(menu_item("Previous robot", "win.previous-robot"))
+        self.robots_menu.append_item(menu_item(_("Next robot"), "win.next-robot"))
+        self.robots_menu.append_item(menu_item(_("Previous robot"), "win.previous-robot"))
         many = len(sessions) > 1
         if many != self._robots_shown:
             self._robots_shown = many
             app_section = self.window.app_menu
             if many:
-                app_section.insert_submenu(0, "Robots", self.robots_menu)
+                app_section.insert_submenu(0, _("Robots"), self.robots_menu)
             else:
                 app_section.remove(0)
 

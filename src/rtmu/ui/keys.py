@@ -27,6 +27,7 @@ gi.require_version("Gtk", "4.0")
 gi.require_version("Gdk", "4.0")
 from gi.repository import Gdk, Gio, GLib, Gtk  # noqa: E402
 
+from ..base.i18n import N_  # noqa: E402
 from ..control.commands import COMMANDS, CommandRegistry, action_name  # noqa: E402
 
 
@@ -50,48 +51,50 @@ class Binding:
 
 
 def _ptz(keys: str, title: str, move: str) -> Binding:
-    return Binding((keys,), title, "Camera head", f"win.{move}")
+    return Binding((keys,), title, N_("Camera head"), f"win.{move}")
 
 
 WINDOW_BINDINGS: tuple[Binding, ...] = (
-    Binding(("<Control>plus", "<Control>equal", "<Control>KP_Add"), "Zoom in", "Map", "win.zoom-in"),
-    Binding(("<Control>minus", "<Control>KP_Subtract"), "Zoom out", "Map", "win.zoom-out"),
-    Binding(("<Control>0",), "Fit map", "Map", "win.zoom-fit"),
-    Binding(("f",), "Follow the robot on/off", "Map", "win.follow"),
-    Binding(("Escape",), "Camera picture ⇄ map", "Window", "win.camera"),
-    Binding(("F10", "Menu", "<Shift>F10"), "Open the menu", "Window", "win.open-menu"),
-    Binding(("<Control>g",), "Go to: goals, a point, home, dock", "Navigation", "win.goto-panel"),
+    Binding(("<Control>plus", "<Control>equal", "<Control>KP_Add"), N_("Zoom in"), N_("Map"), "win.zoom-in"),
+    Binding(("<Control>minus", "<Control>KP_Subtract"), N_("Zoom out"), N_("Map"), "win.zoom-out"),
+    Binding(("<Control>0",), N_("Fit map"), N_("Map"), "win.zoom-fit"),
+    Binding(("f",), N_("Follow the robot on/off"), N_("Map"), "win.follow"),
+    Binding(("Escape",), N_("Camera picture ⇄ map"), N_("Window"), "win.camera"),
+    Binding(("F10", "Menu", "<Shift>F10"), N_("Open the menu"), N_("Window"), "win.open-menu"),
+    Binding(("<Control>g",), N_("Go to: goals, a point, home, dock"), N_("Navigation"), "win.goto-panel"),
     *(
         Binding(
             (f"<Alt>{n}",),
-            "Select robot 1 … 9 of the list",
-            "Fleet",
+            N_("Select robot 1 … 9 of the list"),
+            N_("Fleet"),
             f"win.select-robot({n})",
             help="<Alt>1...<Alt>9" if n == 1 else "",
         )
         for n in range(1, 10)
     ),
-    Binding(("<Alt>Page_Down",), "Next robot", "Fleet", "win.next-robot"),
-    Binding(("<Alt>Page_Up",), "Previous robot", "Fleet", "win.previous-robot"),
-    Binding(("v",), "Live video on/off", "Window", "win.live-video"),
-    Binding(("question",), "Why won't it move?", "Window", "win.why"),
-    _ptz("<Control>Left", "Pan the camera left", "ptz-left"),
-    _ptz("<Control>Right", "Pan the camera right", "ptz-right"),
-    _ptz("<Control>Up", "Tilt the camera up", "ptz-up"),
-    _ptz("<Control>Down", "Tilt the camera down", "ptz-down"),
-    _ptz("Page_Up", "Zoom the camera in", "ptz-zoom-in"),
-    _ptz("Page_Down", "Zoom the camera out", "ptz-zoom-out"),
-    Binding(("F11",), "Full screen", "Window", "win.fullscreen", accelerator=True),
-    Binding(("<Control>t",), "Status toolbar", "Window", "win.toolbar", accelerator=True),
-    Binding(("<Control>comma",), "Connection settings", "Connection", "win.settings", accelerator=True),
+    Binding(("<Alt>Page_Down",), N_("Next robot"), N_("Fleet"), "win.next-robot"),
+    Binding(("<Alt>Page_Up",), N_("Previous robot"), N_("Fleet"), "win.previous-robot"),
+    Binding(("v",), N_("Live video on/off"), N_("Window"), "win.live-video"),
+    Binding(("question",), N_("Why won't it move?"), N_("Window"), "win.why"),
+    _ptz("<Control>Left", N_("Pan the camera left"), "ptz-left"),
+    _ptz("<Control>Right", N_("Pan the camera right"), "ptz-right"),
+    _ptz("<Control>Up", N_("Tilt the camera up"), "ptz-up"),
+    _ptz("<Control>Down", N_("Tilt the camera down"), "ptz-down"),
+    _ptz("Page_Up", N_("Zoom the camera in"), "ptz-zoom-in"),
+    _ptz("Page_Down", N_("Zoom the camera out"), "ptz-zoom-out"),
+    Binding(("F11",), N_("Full screen"), N_("Window"), "win.fullscreen", accelerator=True),
+    Binding(("<Control>t",), N_("Status toolbar"), N_("Window"), "win.toolbar", accelerator=True),
+    Binding(
+        ("<Control>comma",), N_("Connection settings"), N_("Connection"), "win.settings", accelerator=True
+    ),
     Binding(
         ("<Control>question", "F1"),
-        "Keyboard shortcuts",
-        "Application",
+        N_("Keyboard shortcuts"),
+        N_("Application"),
         "win.show-help-overlay",
         accelerator=True,
     ),
-    Binding(("<Control>q",), "Quit", "Application", "app.quit", accelerator=True),
+    Binding(("<Control>q",), N_("Quit"), N_("Application"), "app.quit", accelerator=True),
 )
 """The window's own keys, each naming the action it activates (no robot command: those are the
 registry's)."""

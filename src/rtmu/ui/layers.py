@@ -19,6 +19,7 @@ import gi
 gi.require_version("Gtk", "4.0")
 from gi.repository import Gtk, Pango  # noqa: E402
 
+from ..base.i18n import _  # noqa: E402
 from ..model.observables import ConnectionState, DrawingsState, Observable, Phase  # noqa: E402
 from ..values.intents import DrawingChoices, Intent, ShowDrawing  # noqa: E402
 from ..values.state import DrawingLayer  # noqa: E402
@@ -36,11 +37,11 @@ def row_label(layer: DrawingLayer) -> str:
     """The name as sent (cut to :data:`MAX_LABEL`), and why it cannot be switched where that is so."""
     name = layer.name if len(layer.name) <= MAX_LABEL else layer.name[: MAX_LABEL - 1] + "…"
     if not layer.drawable:
-        return f"{name} — shape {layer.shape[:30]!r} not drawn"
+        return _("{name} — shape {value!r} not drawn").format(name=name, value=layer.shape[:30])
     if not layer.may_toggle:
-        return f"{name} — always {'on' if layer.shown else 'off'}"
+        return _("{name} — always {value}").format(name=name, value="on" if layer.shown else "off")
     if layer.problem:
-        return f"{name} — bad data"
+        return _("{name} — bad data").format(name=name)
     return name
 
 
@@ -74,19 +75,19 @@ class LayersPanel(Gtk.Box):
         self._server = ""
 
         head = Gtk.Box(spacing=6)
-        title = Gtk.Label(label="Layers", xalign=0.0, hexpand=True)
+        title = Gtk.Label(label=_("Layers"), xalign=0.0, hexpand=True)
         title.add_css_class("heading")
         head.append(title)
-        close = Gtk.Button(icon_name="window-close-symbolic", tooltip_text="Close")
+        close = Gtk.Button(icon_name="window-close-symbolic", tooltip_text=_("Close"))
         close.add_css_class("flat")
         close.set_focusable(False)
-        accessible.name(close, "Close layers")
+        accessible.name(close, _("Close layers"))
         close.connect("clicked", lambda _b: self.close())
         head.append(close)
         self.append(head)
         self.rows = Gtk.Box(orientation=Gtk.Orientation.VERTICAL, spacing=0)
         self.append(self.rows)
-        self.empty = Gtk.Label(label="This server lists no drawings", xalign=0.0)
+        self.empty = Gtk.Label(label=_("This server lists no drawings"), xalign=0.0)
         self.empty.add_css_class("dim-label")
         self.append(self.empty)
 

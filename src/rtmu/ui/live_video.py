@@ -21,6 +21,7 @@ gi.require_version("Pango", "1.0")
 gi.require_version("Gdk", "4.0")
 from gi.repository import Gdk, GLib, Gtk, Pango  # noqa: E402
 
+from ..base.i18n import N_, _  # noqa: E402
 from ..fleet.sessions import RobotSession  # noqa: E402
 from ..model.observables import CameraImage  # noqa: E402
 from ..values.intents import StopVideo  # noqa: E402
@@ -29,7 +30,7 @@ from .camera import CameraView  # noqa: E402
 
 FPS_CHOICES = (2, 5, 10, 15, 20, 30)
 DEFAULT_FPS = 15
-QUALITY_CHOICES = ("Server's", "30", "50", "75", "90")
+QUALITY_CHOICES = (N_("Server's"), "30", "50", "75", "90")
 
 
 def frames_dir() -> Path:
@@ -73,33 +74,33 @@ class LiveVideoControls:
 
         # Icons, and the rate and quality in a popover: the bar must still fit a 560 px window.
         self.live_button = Gtk.ToggleButton(icon_name="camera-video-symbolic")
-        self.live_button.set_tooltip_text("Live video: a new frame as soon as one arrives")
+        self.live_button.set_tooltip_text(_("Live video: a new frame as soon as one arrives"))
         self.pause_button = Gtk.ToggleButton(icon_name="media-playback-pause-symbolic")
-        self.pause_button.set_tooltip_text("Pause the video")
+        self.pause_button.set_tooltip_text(_("Pause the video"))
         self.pause_button.set_sensitive(False)
         self.save_button = Gtk.Button(icon_name="document-save-symbolic")
-        self.save_button.set_tooltip_text("Save the frame on screen (JPEG)")
+        self.save_button.set_tooltip_text(_("Save the frame on screen (JPEG)"))
         self.save_button.set_sensitive(False)
-        self.fps = Gtk.DropDown.new_from_strings([f"{n} fps" for n in FPS_CHOICES])
+        self.fps = Gtk.DropDown.new_from_strings([_("{n} fps").format(n=n) for n in FPS_CHOICES])
         self.fps.set_selected(FPS_CHOICES.index(DEFAULT_FPS))
-        self.fps.set_tooltip_text("Frames per second at most")
+        self.fps.set_tooltip_text(_("Frames per second at most"))
         self.quality = Gtk.DropDown.new_from_strings([f"Q {q}" for q in QUALITY_CHOICES])
-        self.quality.set_tooltip_text("JPEG quality to ask the server for")
+        self.quality.set_tooltip_text(_("JPEG quality to ask the server for"))
         settings = Gtk.Box(orientation=Gtk.Orientation.VERTICAL, spacing=6)
         settings.append(self.fps)
         settings.append(self.quality)
         popover = Gtk.Popover()
         popover.set_child(settings)
         self.settings_button = Gtk.MenuButton(icon_name="emblem-system-symbolic", popover=popover)
-        self.settings_button.set_tooltip_text("Video frame rate and JPEG quality")
+        self.settings_button.set_tooltip_text(_("Video frame rate and JPEG quality"))
         for w in (self.live_button, self.pause_button, self.save_button, self.settings_button):
             w.set_focusable(False)  # the arrow keys keep driving
-        accessible.name(self.live_button, "Live video")
-        accessible.name(self.pause_button, "Pause video")
-        accessible.name(self.save_button, "Save frame")
-        accessible.name(self.fps, "Frame rate")
-        accessible.name(self.quality, "JPEG quality")
-        accessible.name_menu_button(self.settings_button, "Video settings")
+        accessible.name(self.live_button, _("Live video"))
+        accessible.name(self.pause_button, _("Pause video"))
+        accessible.name(self.save_button, _("Save frame"))
+        accessible.name(self.fps, _("Frame rate"))
+        accessible.name(self.quality, _("JPEG quality"))
+        accessible.name_menu_button(self.settings_button, _("Video settings"))
         self.live_button.connect("toggled", self._live_toggled)
         self.pause_button.connect("toggled", lambda b: self._paused(b.get_active()))
         self.save_button.connect("clicked", lambda _b: self.save())
@@ -128,7 +129,7 @@ class LiveVideoControls:
     def toggle(self, available: bool, reason: str) -> str:
         """The Live key (V): on where the server has a camera, off always; why not, "" when done."""
         if not self.live and not available:
-            return reason or "no camera"
+            return reason or _("no camera")
         self.set_live(not self.live)
         return ""
 
@@ -170,7 +171,7 @@ class LiveVideoControls:
                 status = replace(status, age_ms=max(time.time_ns() - image.stamp_ns, 0) / 1e6)
             text = status.caption()
             if self.pause_button.get_active():
-                text += " · paused"
+                text += _(" · paused")
             self.caption.set_text(text)
             self.caption.set_visible(True)
 
@@ -217,8 +218,8 @@ class LiveVideoControls:
             folder.mkdir(parents=True, exist_ok=True)
             path.write_bytes(image.jpeg)
         except OSError as exc:
-            self._tell("error", f"Could not save the frame: {exc.strerror or exc}")
+            self._tell("error", _("Could not save the frame: {value}").format(value=exc.strerror or exc))
             return None
         self.saved.append(path)
-        self._tell("info", f"Frame saved: {path}")
+        self._tell("info", _("Frame saved: {path}").format(path=path))
         return path

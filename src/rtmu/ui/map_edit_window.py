@@ -28,6 +28,7 @@ gi.require_version("Gtk", "4.0")
 gi.require_version("Pango", "1.0")
 from gi.repository import Gdk, GLib, Gtk, Pango  # noqa: E402
 
+from ..base.i18n import N_, _, ngettext  # noqa: E402
 from ..base.textsafe import visible  # noqa: E402
 from ..client.map_changes import ChangeVerdict  # noqa: E402
 from ..fleet.selected import SelectedRobot  # noqa: E402
@@ -48,7 +49,7 @@ from ..values.intents import ApplyMapChanges  # noqa: E402
 from .map_point_pick import Picked  # noqa: E402
 
 EDITABLE = {t.lower() for t in (GOAL, GOAL_WITH_HEADING, DOCK, FORBIDDEN_LINE, FORBIDDEN_AREA)}
-KINDS = ("Goal", "Dock", "Forbidden line", "Forbidden area")
+KINDS = (N_("Goal"), N_("Dock"), N_("Forbidden line"), N_("Forbidden area"))
 
 
 def editable(objects: tuple[MapObject, ...] | list[MapObject]) -> list[MapObject]:
@@ -67,7 +68,7 @@ class MapEditWindow(Gtk.Window):
         show_draft: Callable[[tuple[MapObject, ...] | None, int], None] = lambda _o, _n: None,
         pick: Callable[[Picked], None] | None = None,
     ) -> None:
-        super().__init__(title="Edit the map (draft)", transient_for=parent, destroy_with_parent=True)
+        super().__init__(title=_("Edit the map (draft)"), transient_for=parent, destroy_with_parent=True)
         self.set_default_size(620, 520)
         self.robot, self.model = robot, model
         self._show_draft, self._pick = show_draft, pick
@@ -95,19 +96,23 @@ class MapEditWindow(Gtk.Window):
         for side in ("top", "bottom", "start", "end"):
             getattr(box, f"set_margin_{side}")(8)
         bar = Gtk.Box(spacing=6)
-        self.state_label = Gtk.Label(xalign=0.0, hexpand=True, wrap=True)
+        # Wraps at a width of its own: a language with longer words must not widen the window past an
+        # 800 px screen (tests/gui/test_pseudo_locale.py); the buttons below wrap onto a second line.
+        self.state_label = Gtk.Label(xalign=0.0, hexpand=True, wrap=True, max_width_chars=24)
         bar.append(self.state_label)
-        self.undo_button = Gtk.Button(label="Undo")
+        buttons = _wrapping_row(at_least=4)
+        bar.append(buttons)
+        self.undo_button = Gtk.Button(label=_("Undo"))
         self.undo_button.connect("clicked", lambda _b: self._step(undo=True))
-        self.redo_button = Gtk.Button(label="Redo")
+        self.redo_button = Gtk.Button(label=_("Redo"))
         self.redo_button.connect("clicked", lambda _b: self._step(undo=False))
-        self.discard_button = Gtk.Button(label="Discard")
+        self.discard_button = Gtk.Button(label=_("Discard"))
         self.discard_button.connect("clicked", lambda _b: self._discard())
-        self.apply_button = Gtk.Button(label="Apply")
+        self.apply_button = Gtk.Button(label=_("Apply"))
         self.apply_button.add_css_class("suggested-action")
         self.apply_button.connect("clicked", lambda _b: self.apply())
         for b in (self.undo_button, self.redo_button, self.discard_button, self.apply_button):
-            bar.append(b)
+            buttons.append(b)
         box.append(bar)
         self.news = Gtk.Label(xalign=0.0, wrap=True, selectable=True)
         box.append(self.news)
@@ -120,20 +125,20 @@ class MapEditWindow(Gtk.Window):
         self.edits_label.add_css_class("dim-label")
         box.append(self.edits_label)
         form = Gtk.Grid(column_spacing=6, row_spacing=6)
-        self.kind = Gtk.DropDown.new_from_strings(list(KINDS))
-        self.name_entry = Gtk.Entry(placeholder_text="name (goals, docks)")
+        self.kind = Gtk.DropDown.new_from_strings([_(k) for k in KINDS])
+        self.name_entry = Gtk.Entry(placeholder_text=_("name (goals, docks)"))
         self.fields: dict[str, Gtk.Entry] = {}
         form.attach(self.kind, 0, 0, 1, 1)
         form.attach(self.name_entry, 1, 0, 2, 1)
-        here = Gtk.Button(label="Robot's pose")
+        here = Gtk.Button(label=_("Robot's pose"))
         here.connect("clicked", lambda _b: self._fill_from_robot())
         form.attach(here, 3, 0, 1, 1)
         self.pick_button = Gtk.Button(
-            label="Pick on the map", tooltip_text="Click a point; drag for a heading"
+            label=_("Pick on the map"), tooltip_text=_("Click a point; drag for a heading")
         )
         self.pick_button.connect("clicked", lambda _b: self.pick_point(end=False))
         self.pick_end_button = Gtk.Button(
-            label="Pick the end", tooltip_text="The other end of a line or area"
+            label=_("Pick the end"), tooltip_text=_("The other end of a line or area")
         )
         self.pick_end_button.connect("clicked", lambda _b: self.pick_point(end=True))
         self.pick_button.set_sensitive(self._pick is not None)
@@ -142,11 +147,11 @@ class MapEditWindow(Gtk.Window):
         form.attach(self.pick_end_button, 4, 1, 1, 1)
         fields = Gtk.Grid(column_spacing=6, column_homogeneous=True)
         titles = {
-            "x": "x (mm)",
-            "y": "y (mm)",
-            "th": "heading (°)",
-            "x2": "x2 (mm, line / area)",
-            "y2": "y2 (mm)",
+            "x": _("x (mm)"),
+            "y": _("y (mm)"),
+            "th": _("heading (°)"),
+            "x2": _("x2 (mm, line / area)"),
+            "y2": _("y2 (mm)"),
         }
         for i, (name, title) in enumerate(titles.items()):
             fields.attach(Gtk.Label(label=title, xalign=0.0, ellipsize=Pango.EllipsizeMode.END), i, 0, 1, 1)
@@ -154,14 +159,14 @@ class MapEditWindow(Gtk.Window):
             self.fields[name] = entry
             fields.attach(entry, i, 1, 1, 1)
         form.attach(fields, 0, 1, 4, 2)
-        actions = Gtk.Box(spacing=6)
-        self.add_button = Gtk.Button(label="Add")
+        actions = _wrapping_row(at_least=2)
+        self.add_button = Gtk.Button(label=_("Add"))
         self.add_button.connect("clicked", lambda _b: self.add())
-        self.move_button = Gtk.Button(label="Move selected here")
+        self.move_button = Gtk.Button(label=_("Move selected here"))
         self.move_button.connect("clicked", lambda _b: self.move_selected())
-        self.rename_button = Gtk.Button(label="Rename selected")
+        self.rename_button = Gtk.Button(label=_("Rename selected"))
         self.rename_button.connect("clicked", lambda _b: self.rename_selected())
-        self.delete_button = Gtk.Button(label="Delete selected")
+        self.delete_button = Gtk.Button(label=_("Delete selected"))
         self.delete_button.connect("clicked", lambda _b: self.delete_selected())
         for b in (self.add_button, self.move_button, self.rename_button, self.delete_button):
             actions.append(b)
@@ -202,7 +207,9 @@ class MapEditWindow(Gtk.Window):
         self.draft, self.generation = None, -1
         self._map_changed(MapModel(), self.model.map.value)
         if dropped:
-            self._say("Another robot was selected: the draft made on the other map was dropped.", error=True)
+            self._say(
+                _("Another robot was selected: the draft made on the other map was dropped."), error=True
+            )
 
     # -- editing ----------------------------------------------------------------------------------
     def _number(self, name: str, *, required: bool = True) -> float | None:
@@ -212,12 +219,12 @@ class MapEditWindow(Gtk.Window):
         try:
             return float(text)
         except ValueError:
-            raise DraftError(f"{name}: {text!r} is not a number") from None
+            raise DraftError(_("{name}: {text!r} is not a number").format(name=name, text=text)) from None
 
     def _edit(self, what: Any) -> None:
         """Run one draft edit; a DraftError is said, and the draft stays as it was."""
         if self.draft is None:
-            self._say("There is no map to edit yet.", error=True)
+            self._say(_("There is no map to edit yet."), error=True)
             return
         try:
             what(self.draft)
@@ -253,7 +260,7 @@ class MapEditWindow(Gtk.Window):
         obj = self.selected()
         if obj is None or not obj.name:
             self._say(
-                "Select a goal or dock to move (a line or area is deleted and drawn again).", error=True
+                _("Select a goal or dock to move (a line or area is deleted and drawn again)."), error=True
             )
             return
 
@@ -270,7 +277,7 @@ class MapEditWindow(Gtk.Window):
     def rename_selected(self) -> None:
         obj = self.selected()
         if obj is None or not obj.name:
-            self._say("Select a goal or dock to rename.", error=True)
+            self._say(_("Select a goal or dock to rename."), error=True)
             return
         self._edit(lambda d: d.rename(obj.name, self.name_entry.get_text().strip()))
 
@@ -287,7 +294,7 @@ class MapEditWindow(Gtk.Window):
     def _discard(self) -> None:
         if self.draft is not None:
             self.draft.clear()
-            self._say("The draft was discarded; the robot's map is unchanged.", error=False)
+            self._say(_("The draft was discarded; the robot's map is unchanged."), error=False)
             self._show()
 
     def _fill_from_robot(self) -> None:
@@ -299,7 +306,9 @@ class MapEditWindow(Gtk.Window):
         """The next click on the map fills x, y (and a dragged heading) — or x2, y2 with ``end``."""
         if self._pick is None:
             return
-        self._say("Click the map" + ("" if end else " (drag from the point for a heading)"), error=False)
+        self._say(
+            _("Click the map") + ("" if end else _(" (drag from the point for a heading)")), error=False
+        )
 
         def picked(x: float, y: float, th: float | None) -> None:
             self.fields["x2" if end else "x"].set_text(f"{x:.0f}")
@@ -307,7 +316,9 @@ class MapEditWindow(Gtk.Window):
             if th is not None and not end:
                 self.fields["th"].set_text(f"{th:.0f}")
             self._say(
-                f"Picked ({x:.0f}, {y:.0f})" + (f", heading {th:.0f}°" if th is not None else ""), error=False
+                _("Picked ({x:.0f}, {y:.0f})").format(x=x, y=y)
+                + (_(", heading {th:.0f}°").format(th=th) if th is not None else ""),
+                error=False,
             )
 
         self._pick(picked)
@@ -329,7 +340,7 @@ class MapEditWindow(Gtk.Window):
             return
         change = draft.change()
         self.applying = True
-        self._say(f"Applying {len(draft.edits)} edits…", error=False)
+        self._say(_("Applying {len} edits…").format(len=len(draft.edits)), error=False)
         self._show()
         intent = ApplyMapChanges(change.removed, change.added, self.generation)
         self.robot.request(intent).add_done_callback(lambda f: GLib.idle_add(self._verdict, f))
@@ -340,16 +351,23 @@ class MapEditWindow(Gtk.Window):
             return False
         error = None if future.cancelled() else future.exception()
         if future.cancelled() or error is not None:
-            self._say(f"Not applied: {error or 'cancelled'}. The draft is kept.", error=True)
+            self._say(
+                _("Not applied: {value}. The draft is kept.").format(value=error or "cancelled"), error=True
+            )
         else:
             verdict: ChangeVerdict = future.result()
             if verdict.applied:
                 self.applied += 1
                 if self.draft is not None:
                     self.draft = MapDraft(self.draft.objects)  # the map now holds it: a fresh draft
-                self._say(f"Applied: {verdict.words}", error=False)
+                self._say(_("Applied: {words}").format(words=verdict.words), error=False)
             else:
-                self._say(f"The robot refused the change; its map is as it was. {verdict.words}", error=True)
+                self._say(
+                    _("The robot refused the change; its map is as it was. {words}").format(
+                        words=verdict.words
+                    ),
+                    error=True,
+                )
         self._show()
         return False
 
@@ -366,21 +384,27 @@ class MapEditWindow(Gtk.Window):
         self.shown = list(draft.objects) if draft is not None else []
         added = {object_key(o) for o in (draft.change().added if draft is not None else ())}
         for obj in self.shown:
-            text = describe(obj) + ("" if obj.from_xy else f" at ({obj.x:.0f}, {obj.y:.0f}) {obj.th:.0f}°")
+            text = describe(obj, translated=True) + (
+                ""
+                if obj.from_xy
+                else _(" at ({x:.0f}, {y:.0f}) {th:.0f}°").format(x=obj.x, y=obj.y, th=obj.th)
+            )
             if object_key(obj) in added:
-                text += "  — draft"
+                text += _("  — draft")
             label = Gtk.Label(label=visible(text), xalign=0.0, ellipsize=Pango.EllipsizeMode.END)
             self.rows.append(label)
         edits = draft.edits if draft is not None else ()
         dirty = draft is not None and draft.dirty
         if draft is None:
-            self.state_label.set_text("No map to edit" if connected else "Not connected")
+            self.state_label.set_text(_("No map to edit") if connected else _("Not connected"))
         elif dirty:
             self.state_label.set_text(
-                f"Draft: {len(edits)} edit{'s' if len(edits) != 1 else ''}, not applied"
+                ngettext(
+                    "Draft: {count} edit, not applied", "Draft: {count} edits, not applied", len(edits)
+                ).format(count=len(edits))
             )
         else:
-            self.state_label.set_text("No changes: the list is the robot's map")
+            self.state_label.set_text(_("No changes: the list is the robot's map"))
         self.edits_label.set_text("; ".join(e.label for e in edits))
         self.undo_button.set_sensitive(draft is not None and draft.can_undo)
         self.redo_button.set_sensitive(draft is not None and draft.can_redo)
@@ -401,3 +425,13 @@ class MapEditWindow(Gtk.Window):
         self._unobserve = []
         self._unswitch()
         return False
+
+
+def _wrapping_row(at_least: int) -> Gtk.FlowBox:
+    """Buttons side by side (``at_least`` on a line) that wrap onto another line when the words are longer
+    than the room."""
+    row = Gtk.FlowBox(selection_mode=Gtk.SelectionMode.NONE, column_spacing=6, row_spacing=6, hexpand=True)
+    row.set_min_children_per_line(at_least)
+    row.set_max_children_per_line(4)
+    row.set_homogeneous(False)
+    return row

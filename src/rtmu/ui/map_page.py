@@ -25,6 +25,7 @@ gi.require_version("Gdk", "4.0")
 gi.require_version("Graphene", "1.0")
 from gi.repository import Gdk, Graphene, Gtk  # noqa: E402
 
+from ..base.i18n import _  # noqa: E402
 from ..base.notices import Kind, Notice  # noqa: E402
 from ..control.commands import COMMANDS, CommandState  # noqa: E402
 from ..fleet.selected import SelectedRobot  # noqa: E402
@@ -42,6 +43,7 @@ from .pip import PictureInPicture  # noqa: E402
 from .popups import PopupStack  # noqa: E402
 from .pose_bar import PoseBar, pose_words  # noqa: E402
 from .pose_pick import PosePicker  # noqa: E402
+from .state_words import reason_words  # noqa: E402
 from .viewport import zoom_label  # noqa: E402
 
 ROBOT_CLEAR_PX = 24
@@ -134,14 +136,14 @@ class MapPage(Gtk.Overlay):
             accessible.name(b, accessible.spoken(tip))
             return b
 
-        osd.append(button("zoom-out-symbolic", "Zoom out (Ctrl+minus)", "win.zoom-out"))
+        osd.append(button("zoom-out-symbolic", _("Zoom out (Ctrl+minus)"), "win.zoom-out"))
         self.zoom_label = Gtk.Label(label="100 %")
         self.zoom_label.add_css_class("zoom-label")
         osd.append(self.zoom_label)
-        osd.append(button("zoom-in-symbolic", "Zoom in (Ctrl+plus)", "win.zoom-in"))
-        osd.append(button("zoom-fit-best-symbolic", "Fit map (Ctrl+0)", "win.zoom-fit"))
+        osd.append(button("zoom-in-symbolic", _("Zoom in (Ctrl+plus)"), "win.zoom-in"))
+        osd.append(button("zoom-fit-best-symbolic", _("Fit map (Ctrl+0)"), "win.zoom-fit"))
         self.follow_button = button(
-            "find-location-symbolic", "Follow the robot (F)", "win.follow", toggle=True
+            "find-location-symbolic", _("Follow the robot (F)"), "win.follow", toggle=True
         )
         osd.append(self.follow_button)
         return osd
@@ -162,7 +164,7 @@ class MapPage(Gtk.Overlay):
 
     # -- the view --------------------------------------------------------------------------------
     def _view_changed(self) -> None:
-        label = "Fit" if self.stage.fitted else ""
+        label = _("Fit") if self.stage.fitted else ""
         zoom = zoom_label(self.stage.viewport.zoom)
         self.zoom_label.set_text(f"{label} {zoom}" if label else zoom)
         self.on_follow(self.stage.follow)  # the follow action's check (a drag turns following off)
@@ -216,8 +218,8 @@ class MapPage(Gtk.Overlay):
     # -- the D-pad -------------------------------------------------------------------------------
     def commands_changed(self, states: Mapping[str, CommandState]) -> None:
         for name, state in states.items():
-            label = COMMANDS.get(name).label if name in COMMANDS else name
-            self.dpad.set_command_state(name, state.enabled, state.reason, label)
+            label = _(COMMANDS.get(name).label) if name in COMMANDS else name
+            self.dpad.set_command_state(name, state.enabled, reason_words(state.reason), label)
 
     def _hold(self, name: str) -> None:
         """A D-pad hold: only while Space can stop it (the controller says why not)."""
@@ -257,7 +259,9 @@ class MapPage(Gtk.Overlay):
             if self.robot.ask(Localize(marker.x, marker.y, th)) is not None:  # (a refusal is said)
                 placed = replace(marker, th=th)
                 self.robot.session.controller.view.notify(  # the operator sees the pick was taken
-                    Notice.info(Kind.NAVIGATION, f"Position set: {pose_words(placed).lower()}")
+                    Notice.info(
+                        Kind.NAVIGATION, _("Position set: {lower}").format(lower=pose_words(placed).lower())
+                    )
                 )
 
     def _answer_popup(self, popup_id: int, button: int) -> None:

@@ -10,8 +10,10 @@ from __future__ import annotations
 
 from collections.abc import Callable
 
+from ..base.i18n import _
 from ..model.observables import ConnectionState, NavState, Phase, RobotModel, RobotState
 from .nav_text import loc_level, where
+from .state_words import phase_word
 
 POSE_STEP_M = 0.5
 HEADING_STEP_DEG = 15
@@ -24,39 +26,51 @@ def _step(value: float, step: float) -> float:
 def battery_words(robot: RobotState) -> str:
     """``battery 12.8 volts, low``: the number and the state its colour shows."""
     if robot.battery_v is None:
-        return "battery unknown"
-    number = f"{robot.battery_v:.0f} percent" if robot.battery_is_soc else f"{robot.battery_v:.1f} volts"
-    state = {"low": ", low", "critical": ", at shutdown level"}.get(robot.battery_state, "")
-    return f"battery {number}{state}"
+        return _("battery unknown")
+    number = (
+        _("{battery_v:.0f} percent").format(battery_v=robot.battery_v)
+        if robot.battery_is_soc
+        else _("{battery_v:.1f} volts").format(battery_v=robot.battery_v)
+    )
+    state = {"low": _(", low"), "critical": _(", at shutdown level")}.get(robot.battery_state, "")
+    return _("battery {number}{state}").format(number=number, state=state)
 
 
 def activity_words(robot: RobotState, nav: NavState) -> str:
     """What the robot is doing, in words: going somewhere, driving, or standing."""
     if nav.navigating:
-        left = "" if nav.remaining_mm is None else f", {nav.remaining_mm / 1000:.0f} metres left"
-        return ("going home" if nav.target == "home" else f"going to {where(nav.target)}") + left
+        left = (
+            ""
+            if nav.remaining_mm is None
+            else _(", {value:.0f} metres left").format(value=nav.remaining_mm / 1000)
+        )
+        return (
+            _("going home") if nav.target == "home" else _("going to {where}").format(where=where(nav.target))
+        ) + left
     if abs(robot.vel) > 20 or abs(robot.rot_vel) > 3:
         return "moving"
-    return "standing still"
+    return _("standing still")
 
 
 def map_description(robot: RobotState, nav: NavState, connection: ConnectionState) -> str:
     """The map's accessible description (see the module notes)."""
     if connection.phase is not Phase.CONNECTED:
-        return f"Not connected ({connection.phase.value})"
+        return _("Not connected ({value})").format(value=phase_word(connection.phase))
     if robot.numbers_at is None:
-        return "Connected, no position from the robot yet"
+        return _("Connected, no position from the robot yet")
     x, y = _step(robot.x / 1000, POSE_STEP_M), _step(robot.y / 1000, POSE_STEP_M)
     heading = int(_step(robot.th, HEADING_STEP_DEG)) % 360
-    parts = [f"Robot at x {x:.1f}, y {y:.1f} metres, heading {heading} degrees"]
+    parts = [
+        _("Robot at x {x:.1f}, y {y:.1f} metres, heading {heading} degrees").format(x=x, y=y, heading=heading)
+    ]
     mode = robot.mode or robot.status
     if mode:
-        parts.append(f"mode {mode}")  # the server's own word
+        parts.append(_("mode {mode}").format(mode=mode))  # the server's own word
     parts.append(battery_words(robot))
     parts.append(activity_words(robot, nav))
     level = loc_level(nav.loc_state, nav.loc_score)
     if level is not None:
-        parts.append(f"localization {level}")
+        parts.append(_("localization {level}").format(level=level))
     return "; ".join(parts)
 
 

@@ -26,6 +26,7 @@ import gi
 gi.require_version("Gtk", "4.0")
 from gi.repository import GLib, Gtk  # noqa: E402
 
+from ..base.i18n import _  # noqa: E402
 from ..control.motion_limits import RobotLimits  # noqa: E402
 from ..model.observables import LinkHealth, LinkLevel, MapModel, OperatorState, RobotModel, RobotState  # noqa: E402
 from . import accessible, overlays  # noqa: E402
@@ -67,7 +68,7 @@ class MapStage(Gtk.DrawingArea):
         super().__init__(accessible_role=Gtk.AccessibleRole.IMG)  # a drawing: "image" to a screen reader
         self.model = model
         self.operator = operator
-        accessible.name(self, "Map")
+        accessible.name(self, _("Map"))
         self.words = MapDescription(model, lambda text: accessible.describe(self, text))
         """The map in words (``map_words``): its description, said again when it changes materially."""
         self.clock = clock

@@ -15,6 +15,7 @@ import gi
 gi.require_version("Gtk", "4.0")
 from gi.repository import Gdk, GLib, Gtk  # noqa: E402
 
+from ..base.i18n import _  # noqa: E402
 from . import accessible  # noqa: E402
 
 
@@ -58,9 +59,9 @@ class AmountDialog(Gtk.Window):
             quick_row.append(b)
         box.append(quick_row)
         buttons = Gtk.Box(spacing=8, halign=Gtk.Align.END)
-        cancel = accessible.mnemonic_button("_Cancel")
+        cancel = accessible.mnemonic_button(_("_Cancel"))
         cancel.connect("clicked", lambda _b: self.close())
-        go = accessible.mnemonic_button("_Go")
+        go = accessible.mnemonic_button(_("_Go"))
         go.add_css_class("suggested-action")
         go.connect("clicked", lambda _b: self._go(self.spin.get_value()))
         buttons.append(cancel)
@@ -105,15 +106,20 @@ class AmountDialog(Gtk.Window):
 def turn_dialog(parent: Gtk.Window, on_go: Callable[[float], None]) -> AmountDialog:
     return AmountDialog(
         parent,
-        title="Turn by an angle",
-        prompt="Turn on the spot (positive = left, counter-clockwise):",
+        title=_("Turn by an angle"),
+        prompt=_("Turn on the spot (positive = left, counter-clockwise):"),
         unit="degrees",
         lower=-180,
         upper=180,
         step=5,
         digits=0,
         initial=90,
-        quick=(("90° left", 90.0), ("90° right", -90.0), ("About turn", 180.0), ("45° left", 45.0)),
+        quick=(
+            (_("90° left"), 90.0),
+            (_("90° right"), -90.0),
+            (_("About turn"), 180.0),
+            (_("45° left"), 45.0),
+        ),
         on_go=on_go,
     )
 
@@ -121,14 +127,14 @@ def turn_dialog(parent: Gtk.Window, on_go: Callable[[float], None]) -> AmountDia
 def go_dialog(parent: Gtk.Window, on_go: Callable[[float], None]) -> AmountDialog:
     return AmountDialog(
         parent,
-        title="Go a distance",
-        prompt="Drive straight (negative = backwards):",
+        title=_("Go a distance"),
+        prompt=_("Drive straight (negative = backwards):"),
         unit="metres",
         lower=-5,
         upper=10,
         step=0.1,
         digits=2,
         initial=1.0,
-        quick=(("0.5 m", 0.5), ("1 m", 1.0), ("2 m", 2.0), ("0.5 m back", -0.5)),
+        quick=(("0.5 m", 0.5), ("1 m", 1.0), ("2 m", 2.0), (_("0.5 m back"), -0.5)),
         on_go=lambda metres: on_go(metres * 1000.0),
     )

@@ -7,6 +7,7 @@ in them come from the server and are shown as plain text by the labels that use 
 
 from __future__ import annotations
 
+from ..base.i18n import N_, _
 from ..model.observables import NavState
 
 POOR_SCORE = 0.6
@@ -33,22 +34,26 @@ def loc_text(state: str | None, score: float | None) -> str:
 
 def where(target: str) -> str:
     """A target in a sentence: ``Lab B``, ``the point``, ``home``, ``the dock``."""
-    return {"point": "the point", "dock": "the dock", "": "a goal"}.get(target, target)
+    return {"point": _("the point"), "dock": _("the dock"), "": _("a goal")}.get(target, target)
 
 
 def going_text(nav: NavState) -> str:
     """``Going to Lab B — 12.4 m left`` (``Going home``; no distance until a path is known)."""
     head = _head(nav)
     if nav.remaining_mm is not None:
-        head += f" — {nav.remaining_mm / 1000:.1f} m left"
+        head += _(" — {value:.1f} m left").format(value=nav.remaining_mm / 1000)
     return head
 
 
 def _head(nav: NavState) -> str:
-    return "Going home" if nav.target == "home" else f"Going to {where(nav.target)}"
+    return _("Going home") if nav.target == "home" else _("Going to {where}").format(where=where(nav.target))
 
 
-HELD_BY = {"keys": "Driving (held keys)", "dpad": "Driving (D-pad held)", "pad": "Driving (gamepad)"}
+HELD_BY = {
+    "keys": N_("Driving (held keys)"),
+    "dpad": N_("Driving (D-pad held)"),
+    "pad": N_("Driving (gamepad)"),
+}
 """The held drive's title by what holds it: the operator lets go of the thing named."""
 
 
@@ -65,11 +70,19 @@ def motion_text(nav: NavState, *, held: bool, link_up: bool, by: str = "keys") -
     if not link_up:
         return "", ()
     if nav.navigating:
-        dest = "Going home" if nav.target == "home" else f"To {where(nav.target)}"
-        left = "" if nav.remaining_mm is None else f"{nav.remaining_mm / 1000:.1f} m left · "
-        return "autonomous", ("Navigating (autonomous)", dest, f"{left}Space or STOP cancels")
+        dest = _("Going home") if nav.target == "home" else _("To {where}").format(where=where(nav.target))
+        left = (
+            ""
+            if nav.remaining_mm is None
+            else _("{value:.1f} m left · ").format(value=nav.remaining_mm / 1000)
+        )
+        return "autonomous", (
+            _("Navigating (autonomous)"),
+            dest,
+            _("{left}Space or STOP cancels").format(left=left),
+        )
     if held:
-        return "held", (HELD_BY.get(by, HELD_BY["keys"]), "Let go to stop")
+        return "held", (_(HELD_BY.get(by, HELD_BY["keys"])), _("Let go to stop"))
     return "", ()
 
 
@@ -78,7 +91,9 @@ def link_lost_note(nav: NavState) -> str:
     if not nav.navigating:
         return ""
     head = _head(nav)
-    return f" The robot is navigating on its own ({head[0].lower()}{head[1:]}); STOP stays available."
+    return _(" The robot is navigating on its own ({lower}{value}); STOP stays available.").format(
+        lower=head[0].lower(), value=head[1:]
+    )
 
 
 def outcome_status(nav: NavState) -> str:
@@ -86,5 +101,5 @@ def outcome_status(nav: NavState) -> str:
     if not nav.outcome_text:
         return ""
     if nav.reason and nav.reason not in nav.outcome_text:
-        return f"{nav.outcome_text} because {nav.reason}"
+        return _("{outcome_text} because {reason}").format(outcome_text=nav.outcome_text, reason=nav.reason)
     return nav.outcome_text

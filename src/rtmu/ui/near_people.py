@@ -18,6 +18,7 @@ import gi
 gi.require_version("Gtk", "4.0")
 from gi.repository import Gio, GLib  # noqa: E402
 
+from ..base.i18n import _  # noqa: E402
 from ..control.motion_limits import capped_throttle  # noqa: E402
 from ..model.observables import NearPeople  # noqa: E402
 
@@ -26,7 +27,7 @@ MainWindow = Any
 
 
 def label(setting: NearPeople) -> str:
-    return f"Near people: at most {setting.mm_s} mm/s"
+    return _("Near people: at most {mm_s} mm/s").format(mm_s=setting.mm_s)
 
 
 class NearPeopleSwitch:
@@ -68,8 +69,9 @@ class NearPeopleSwitch:
         if new.on:
             limits = self.window.controller.limits
             throttle = capped_throttle(100.0, new.mm_s, limits)
-            text = (f"{label(new)}: a full drive is {throttle:.0f} % of this robot's "
-                    f"{limits.max_speed / 1000:.1f} m/s — {limits.source}")  # fmt: skip
+            text = _(
+                "{label}: a full drive is {throttle:.0f} % of this robot's {value:.1f} m/s — {source}"
+            ).format(label=label(new), throttle=throttle, value=limits.max_speed / 1000, source=limits.source)
         else:
-            text = "Near-people cap off: the speed steps go up to the robot's full speed again"
+            text = _("Near-people cap off: the speed steps go up to the robot's full speed again")
         self.window.banners.tell("speed", "info", text, timeout=5.0)

@@ -10,10 +10,11 @@ drawn on the map (``grid 2 m``) is its one source of truth.
 
 from __future__ import annotations
 
+from ..base.i18n import N_, _
 from ..model.observables import ConnectionState, MapModel, Phase
 from ..settings.store import Profile
 
-CONNECT_HINT = "press Connect (Ctrl+O)"
+CONNECT_HINT = N_("press Connect (Ctrl+O)")
 
 
 def heading_text(degrees: float) -> str:
@@ -23,25 +24,31 @@ def heading_text(degrees: float) -> str:
 
 def map_note(conn: ConnectionState, m: MapModel) -> str:
     """What the map area should say now; "" when the map speaks for itself."""
-    where = f" to {conn.host}:{conn.port}" if conn.host else ""
+    where = _(" to {host}:{port}").format(host=conn.host, port=conn.port) if conn.host else ""
     phase = conn.phase
     if phase is Phase.DISCONNECTED:
-        return f"Not connected: {CONNECT_HINT}"
+        return _("Not connected: {CONNECT_HINT}").format(CONNECT_HINT=_(CONNECT_HINT))
     if phase is Phase.FAILED:
-        return f"Not connected (the last attempt failed): {CONNECT_HINT} to try again"
+        return _("Not connected (the last attempt failed): {CONNECT_HINT} to try again").format(
+            CONNECT_HINT=_(CONNECT_HINT)
+        )
     if phase is Phase.CONNECTING:
-        return f"Connecting{where}…"
+        return _("Connecting{where}…").format(where=where)
     if phase is Phase.RECONNECTING:
-        return "Link lost: the robot is shown where it was last seen"
+        return _("Link lost: the robot is shown where it was last seen")
     # Connected: the map's own state.
     if m.state == "loading":
-        return f"Loading the map… ({m.received} packets)" if m.received else "Loading the map…"
+        return (
+            _("Loading the map… ({received} packets)").format(received=m.received)
+            if m.received
+            else _("Loading the map…")
+        )
     if m.state in ("none", "unsupported"):
-        return "This server has no map: the robot on a metric grid (scale at the top left)"
+        return _("This server has no map: the robot on a metric grid (scale at the top left)")
     if m.state == "failed":
-        return f"The map could not be loaded: {m.error or 'no reason given'}"
+        return _("The map could not be loaded: {value}").format(value=m.error or _("no reason given"))
     if m.state == "unknown":
-        return "Connected; asking for the map…"
+        return _("Connected; asking for the map…")
     return ""
 
 
@@ -50,11 +57,13 @@ def status_line(conn: ConnectionState, profile: Profile, map_name: str) -> str:
     phase = conn.phase
     where = f"{conn.host}:{conn.port}" if conn.host else f"{profile.host}:{profile.port}"
     state = {
-        Phase.DISCONNECTED: "not connected",
-        Phase.CONNECTING: "connecting…",
-        Phase.CONNECTED: "connected",
-        Phase.RECONNECTING: f"reconnecting ({conn.error})" if conn.error else "reconnecting",
-        Phase.FAILED: f"failed: {conn.error}" if conn.error else "failed",
+        Phase.DISCONNECTED: _("not connected"),
+        Phase.CONNECTING: _("connecting…"),
+        Phase.CONNECTED: _("connected"),
+        Phase.RECONNECTING: _("reconnecting ({error})").format(error=conn.error)
+        if conn.error
+        else _("reconnecting"),
+        Phase.FAILED: _("failed: {error}").format(error=conn.error) if conn.error else _("failed"),
     }[phase]
     name = map_name.replace("\\", "/").rsplit("/", 1)[-1]
     parts = [profile.name, state] if where in profile.name else [profile.name, where, state]

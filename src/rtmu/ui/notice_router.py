@@ -19,9 +19,11 @@ from collections.abc import Callable
 from dataclasses import dataclass
 from typing import NamedTuple, Protocol
 
+from ..base.i18n import N_, _
 from ..base.notices import Kind, Level, Notice
 from ..model.observables import SPEED_MAX, ConnectionState, LinkLevel, NavState, Phase
 from .nav_text import link_lost_note
+from .state_words import sentence_words
 
 
 @dataclass(frozen=True, slots=True)
@@ -63,8 +65,11 @@ def route(notice: Notice, connection: ConnectionState, speed_percent: int) -> Ro
             return Route(Banner("link", level.value, text, None))
         return Route()
     if kind is Kind.SPEED_LIMIT:
-        limit = "maximum" if speed_percent >= SPEED_MAX else "minimum"
-        words = f"Speed at its {limit}: {speed_percent} %"
+        words = (
+            _("Speed at its maximum: {percent} %")
+            if speed_percent >= SPEED_MAX
+            else _("Speed at its minimum: {percent} %")
+        ).format(percent=speed_percent)
         return Route(Banner("speed", "warning", words, 2.5, speed_percent / SPEED_MAX))
     if kind is Kind.SPEED:
         return Route()  # the speed banner follows the model
@@ -80,20 +85,34 @@ def link_banner(old: ConnectionState, new: ConnectionState, navigation: NavState
     where = f"{new.host}:{new.port}" if new.host else ""
     phase = new.phase
     if phase is Phase.CONNECTING and old.phase is not Phase.CONNECTING:
-        return Banner("link", "info", f"Connecting to {where}…", None)
+        return Banner("link", "info", _("Connecting to {where}…").format(where=where), None)
     if phase is Phase.CONNECTED and old.phase is not Phase.CONNECTED:
         if old.phase is Phase.RECONNECTING:
-            return Banner("link", "info", f"Reconnected to {where}: press a key to drive again", 4.0)
-        return Banner("link", "info", f"Connected to {where}", 3.0)
+            return Banner(
+                "link",
+                "info",
+                _("Reconnected to {where}: press a key to drive again").format(where=where),
+                4.0,
+            )
+        return Banner("link", "info", _("Connected to {where}").format(where=where), 3.0)
     if phase is Phase.RECONNECTING:
         count = f" ({new.attempt})" if new.attempt else ""
         note = link_lost_note(navigation)
-        return Banner("link", "warning", f"Link lost — reconnecting{count}…{note}", None)
+        return Banner(
+            "link",
+            "warning",
+            _("Link lost — reconnecting{count}…{note}").format(count=count, note=note),
+            None,
+        )
     if phase is Phase.FAILED and (new.error != old.error or old.phase is not Phase.FAILED):
         lost = old.phase in (Phase.CONNECTED, Phase.RECONNECTING)
-        reason = new.error or "no reason given"
+        reason = sentence_words(new.error) if new.error else _("no reason given")
         note = link_lost_note(navigation)
-        text = f"Link lost: {reason}.{note}" if lost else f"Could not connect to {where}: {reason}"
+        text = (
+            _("Link lost: {reason}.{note}").format(reason=reason, note=note)
+            if lost
+            else _("Could not connect to {where}: {reason}").format(where=where, reason=reason)
+        )
         return Banner("link", "error", text, 10.0)
     if phase is Phase.DISCONNECTED and old.phase is not Phase.DISCONNECTED:
         return Dismiss("link")  # deliberate: no banner at all
@@ -109,17 +128,17 @@ def loop_lag_banner(lag: float | None, connected: bool, shown: bool) -> Banner |
     """The ``loop`` banner while the network thread is stalled: then even a stop cannot leave the
     process (``lag``: seconds since its last heartbeat; ``shown``: the banner is up now)."""
     if connected and lag is not None and lag > LOOP_LAG_WARN:
-        text = (
-            f"The network thread has not run for {lag:.1f} s: drive commands and stops are not going "
-            "out; the robot may keep moving until the server's watchdog stops it"
-        )
+        text = _(
+            "The network thread has not run for {lag:.1f} s: drive commands and stops are not going out; "
+            "the robot may keep moving until the server's watchdog stops it"
+        ).format(lag=lag)
         return Banner("loop", "error", text, None)
     if shown and (not connected or lag is None or lag < LOOP_LAG_WARN / 2):
         return Dismiss("loop")
     return None
 
 
-LINK_STOP_WORDS = "Stopped: the link"
+LINK_STOP_WORDS = N_("Stopped: the link")
 """How the controller's stop for a stale or lost link begins (``Controller._say_link_stop``)."""
 LINK_BACK_AFTER = 1.0
 """Seconds of a healthy link after which a "Stopped: the link is stale" banner gives way: it stays
@@ -129,14 +148,19 @@ only while it is true (a later healthy drive never runs under it)."""
 def link_back_banner(shown: str | None, ok_for: float | None) -> Banner | None:
     """The ``link`` banner once the link has been healthy for ``ok_for`` seconds (None: not healthy now)
     while it still says a link stop (``shown``): the stop is over, and the banner says how to go on."""
-    if shown is None or not shown.startswith(LINK_STOP_WORDS) or ok_for is None or ok_for < LINK_BACK_AFTER:
+    if (
+        shown is None
+        or not shown.startswith(_(LINK_STOP_WORDS))
+        or ok_for is None
+        or ok_for < LINK_BACK_AFTER
+    ):
         return None
-    return Banner("link", "info", "The link is back: press a key to drive again", 4.0)
+    return Banner("link", "info", _("The link is back: press a key to drive again"), 4.0)
 
 
 def speed_banner(percent: int) -> Banner:
     """The speed step the operator just chose, with its bar."""
-    return Banner("speed", "info", f"Speed {percent} %", 2.5, percent / SPEED_MAX)
+    return Banner("speed", "info", _("Speed {percent} %").format(percent=percent), 2.5, percent / SPEED_MAX)
 
 
 class Banners(Protocol):

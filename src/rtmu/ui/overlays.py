@@ -19,6 +19,7 @@ gi.require_version("Pango", "1.0")
 gi.require_version("PangoCairo", "1.0")
 from gi.repository import Pango, PangoCairo  # noqa: E402
 
+from ..base.i18n import _  # noqa: E402
 from .viewport import Viewport  # noqa: E402
 
 # A Pioneer 3-DX (ARIA's p3dx parameters): 511 mm long, 210 mm of it in front of the
@@ -121,7 +122,7 @@ def draw_grid(ctx: cairo.Context, vp: Viewport) -> float:
 def metres(mm: float) -> str:
     """``"1 m"``, ``"20 cm"``, ``"2.5 m"``."""
     if mm < 1000:
-        return f"{mm / 10:g} cm"
+        return _("{value:g} cm").format(value=mm / 10)
     return f"{mm / 1000:g} m"
 
 
@@ -185,7 +186,7 @@ def draw_cairns(
         th = float(getattr(obj, "th", 0.0))
         if kind in ("robothome", "home"):
             _marker(ctx, sx, sy, HOME_RGB, "house")
-            pending.append(_Label(0, name or "Home", sx, sy + 10, HOME_RGB))
+            pending.append(_Label(0, name or _("Home"), sx, sy + 10, HOME_RGB))
         elif kind.startswith("goal"):
             _marker(ctx, sx, sy, GOAL_RGB, "flag")
             if kind == "goalwithheading":
@@ -193,7 +194,7 @@ def draw_cairns(
             pending.append(_Label(1, name, sx, sy + 10, GOAL_RGB))
         elif kind.startswith("dock"):
             _marker(ctx, sx, sy, DOCK_RGB, "dock")
-            pending.append(_Label(2, name or "Dock", sx, sy + 10, DOCK_RGB))
+            pending.append(_Label(2, name or _("Dock"), sx, sy + 10, DOCK_RGB))
         else:
             _marker(ctx, sx, sy, AREA_RGB, "dot")
             if name:

@@ -20,6 +20,7 @@ gi.require_version("Pango", "1.0")
 gi.require_version("Gdk", "4.0")
 from gi.repository import Gdk, GLib, Gtk, Pango  # noqa: E402
 
+from ..base.i18n import _, ngettext  # noqa: E402
 from ..client.custom_commands import MAX_ARGUMENT, CommandCatalogue, CustomCommand  # noqa: E402
 from . import accessible  # noqa: E402
 
@@ -56,9 +57,9 @@ class _Row(Gtk.ListBoxRow):
             box.append(about)
         self.entry: Gtk.Entry | None = None
         if command.takes_argument:
-            self.entry = Gtk.Entry(placeholder_text="argument, then Enter")
+            self.entry = Gtk.Entry(placeholder_text=_("argument, then Enter"))
             self.entry.set_max_length(MAX_ARGUMENT)
-            accessible.name(self.entry, "Argument")
+            accessible.name(self.entry, _("Argument"))
             self.entry.connect("activate", lambda _e: run(self))
             box.append(self.entry)
         self.set_child(box)
@@ -67,16 +68,17 @@ class _Row(Gtk.ListBoxRow):
 def count_note(shown: int, total: int, hidden: int, search: str) -> str:
     """ "12 commands", "1 of 12 commands" while a search filters them, or why there are none."""
     if not total:
-        return "The server offers this user no commands."
-    plural = "s" if total != 1 else ""
+        return _("The server offers this user no commands.")
     if not search.strip():
-        note = f"{total} command{plural}"
+        note = ngettext("{total} command", "{total} commands", total).format(total=total)
     elif shown:
-        note = f"{shown} of {total} command{plural}"
+        note = ngettext("{shown} of {total} command", "{shown} of {total} commands", total).format(
+            shown=shown, total=total
+        )
     else:
-        note = f"No command matches “{search.strip()}” ({total} in all)"
+        note = _("No command matches “{strip}” ({total} in all)").format(strip=search.strip(), total=total)
     if hidden:
-        note += f" ({hidden} more the server has are not open to this user)"
+        note += _(" ({hidden} more the server has are not open to this user)").format(hidden=hidden)
     return note
 
 
@@ -84,7 +86,7 @@ class CommandPalette(Gtk.Window):
     """See the module notes. ``run(command, argument)`` is called once; the palette then closes."""
 
     def __init__(self, parent: Gtk.Window, list_commands: ListFn, run: RunFn) -> None:
-        super().__init__(title="Server commands", transient_for=parent, modal=True)
+        super().__init__(title=_("Server commands"), transient_for=parent, modal=True)
         self.set_default_size(520, 420)
         self.set_destroy_with_parent(True)
         self._run = run
@@ -94,12 +96,12 @@ class CommandPalette(Gtk.Window):
         box.set_margin_bottom(8)
         box.set_margin_start(8)
         box.set_margin_end(8)
-        self.search = Gtk.SearchEntry(placeholder_text="Search the server's commands")
+        self.search = Gtk.SearchEntry(placeholder_text=_("Search the server's commands"))
         self.search.connect("search-changed", lambda _s: self._filter_changed())
         self.search.connect("activate", lambda _s: self._activate_first())
         self.search.connect("stop-search", lambda _s: self.close())
         box.append(self.search)
-        self.note = Gtk.Label(label="Asking the server for its commands…", xalign=0.0, wrap=True)
+        self.note = Gtk.Label(label=_("Asking the server for its commands…"), xalign=0.0, wrap=True)
         self.note.add_css_class("dim-label")
         box.append(self.note)
         self.rows = Gtk.ListBox(selection_mode=Gtk.SelectionMode.SINGLE)
@@ -131,7 +133,9 @@ class CommandPalette(Gtk.Window):
     def _loaded(self, future: concurrent.futures.Future[Any]) -> bool:
         if future.cancelled() or future.exception() is not None:
             error = future.exception()
-            self.note.set_text(f"The server's commands could not be listed: {error or 'cancelled'}")
+            self.note.set_text(
+                _("The server's commands could not be listed: {value}").format(value=error or "cancelled")
+            )
             return False
         catalogue = future.result()
         self.show_catalogue(catalogue)

@@ -18,6 +18,7 @@ gi.require_version("Graphene", "1.0")
 gi.require_version("Gdk", "4.0")
 from gi.repository import Gdk, Graphene, Gtk  # noqa: E402
 
+from ..base.i18n import _  # noqa: E402
 from .camera import INSET_MIN_WIDTH, CameraInset  # noqa: E402
 
 MAX_WIDTH = 640
@@ -45,14 +46,14 @@ class PictureInPicture(CameraInset):
         close = Gtk.Button(label="×", halign=Gtk.Align.END, valign=Gtk.Align.START)
         close.add_css_class("pip-close")
         close.set_focusable(False)
-        close.set_tooltip_text("Hide the picture (View ▸ Camera inset on the map brings it back)")
+        close.set_tooltip_text(_("Hide the picture (View ▸ Camera inset on the map brings it back)"))
         close.connect("clicked", lambda _b: on_hide())
         overlay.add_overlay(close)
         self.close_button = close
 
         grip = Gtk.Label(label="◢", halign=Gtk.Align.END, valign=Gtk.Align.END)
         grip.add_css_class("pip-grip")
-        grip.set_tooltip_text("Drag to resize")
+        grip.set_tooltip_text(_("Drag to resize"))
         overlay.add_overlay(grip)
         self.grip = grip
         self.age_label.set_margin_end(18)  # clear of the grip

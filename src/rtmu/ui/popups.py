@@ -25,6 +25,7 @@ gi.require_version("Gdk", "4.0")
 gi.require_version("Pango", "1.0")
 from gi.repository import GLib, Gtk, Pango  # noqa: E402
 
+from ..base.i18n import _  # noqa: E402
 from ..model.observables import Observable, PopupsState  # noqa: E402
 from ..values.state import PopupInfo  # noqa: E402
 
@@ -60,7 +61,11 @@ def plain_label(text: str, css: str, *, wrap: bool = False) -> Gtk.Label:
 
 def age_text(seconds: float) -> str:
     s = max(0, int(seconds))
-    return f"open {s} s" if s < 60 else f"open {s // 60} min {s % 60:02d} s"
+    return (
+        _("open {s} s").format(s=s)
+        if s < 60
+        else _("open {value} min {value2:02d} s").format(value=s // 60, value2=s % 60)
+    )
 
 
 @dataclass
@@ -130,7 +135,7 @@ class PopupStack(Gtk.Box):
         for pid in [pid for pid in self.cards if pid not in wanted]:
             self.remove(self.cards.pop(pid).box)
         hidden = len(state.open) - len(shown) + state.dropped
-        self.more.set_text(f"+{hidden} more")
+        self.more.set_text(_("+{hidden} more").format(hidden=hidden))
         self.more.set_visible(hidden > 0)
         self.reorder_child_after(self.more, None)
         previous: Gtk.Widget | None = self.more

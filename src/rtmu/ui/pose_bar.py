@@ -15,22 +15,27 @@ gi.require_version("Gtk", "4.0")
 gi.require_version("Pango", "1.0")
 from gi.repository import Gtk, Pango  # noqa: E402
 
+from ..base.i18n import N_, _  # noqa: E402
 from .nav_draw import Marker, MarkerKind  # noqa: E402
 from .notes import heading_text  # noqa: E402
 from .pose_pick import PosePicker  # noqa: E402
 
 HINTS = {
-    MarkerKind.GOTO: "Click where the robot should go; drag for its heading",
-    MarkerKind.LOCALIZE: "Click where the robot is; drag the way it faces",
+    MarkerKind.GOTO: N_("Click where the robot should go; drag for its heading"),
+    MarkerKind.LOCALIZE: N_("Click where the robot is; drag the way it faces"),
 }
-CONFIRM = {MarkerKind.GOTO: "Go", MarkerKind.LOCALIZE: "Set here"}
+CONFIRM = {MarkerKind.GOTO: N_("Go"), MarkerKind.LOCALIZE: N_("Set here")}
 
 
 def pose_words(marker: Marker) -> str:
     """``Go to 12.30, 4.50 m facing 90°`` / ``Robot at 2.50, 6.00 m facing 0°``."""
     where = f"{marker.x / 1000:.2f}, {marker.y / 1000:.2f} m"
-    facing = "any heading" if marker.th is None else f"facing {heading_text(marker.th)}"
-    head = "Go to" if marker.kind is MarkerKind.GOTO else "Robot at"
+    facing = (
+        _("any heading")
+        if marker.th is None
+        else _("facing {heading_text}").format(heading_text=heading_text(marker.th))
+    )
+    head = _("Go to") if marker.kind is MarkerKind.GOTO else _("Robot at")
     return f"{head} {where}, {facing}"
 
 
@@ -48,13 +53,13 @@ class PoseBar(Gtk.Box):
         self.label = Gtk.Label(xalign=0.0, max_width_chars=56)
         self.label.set_use_markup(False)
         self.label.set_ellipsize(Pango.EllipsizeMode.END)
-        self.go_button = Gtk.Button(label="Go")
+        self.go_button = Gtk.Button(label=_("Go"))
         self.go_button.add_css_class("suggested-action")
         self.go_button.set_focusable(False)
         self.go_button.connect("clicked", lambda _b: self.confirm())
-        self.cancel_button = Gtk.Button(label="Cancel")
+        self.cancel_button = Gtk.Button(label=_("Cancel"))
         self.cancel_button.set_focusable(False)
-        self.cancel_button.set_tooltip_text("Leave this mode without sending anything (Esc)")
+        self.cancel_button.set_tooltip_text(_("Leave this mode without sending anything (Esc)"))
         self.cancel_button.connect("clicked", lambda _b: picker.cancel())
         for child in (self.label, self.go_button, self.cancel_button):
             self.append(child)
@@ -66,8 +71,8 @@ class PoseBar(Gtk.Box):
         self.set_visible(kind is not None)
         if kind is None:
             return
-        self.label.set_text(HINTS[kind] if marker is None else pose_words(marker))
-        self.go_button.set_label(CONFIRM[kind])
+        self.label.set_text(_(HINTS[kind]) if marker is None else pose_words(marker))
+        self.go_button.set_label(_(CONFIRM[kind]))
         self.go_button.set_sensitive(marker is not None)
 
     def confirm(self) -> None:

@@ -19,6 +19,7 @@ gi.require_version("Gtk", "4.0")
 gi.require_version("Pango", "1.0")
 from gi.repository import GLib, Gtk, Pango  # noqa: E402
 
+from ..base.i18n import _  # noqa: E402
 from ..control.commands import action_name  # noqa: E402
 from ..fleet.sessions import RobotSession  # noqa: E402
 from ..model.observables import RobotModel, RobotState  # noqa: E402
@@ -55,31 +56,33 @@ def position_text(state: PtzState | None) -> str:
     """The head's settled position; while it turns, "moving" and where to (never a mid-turn reading
     as if the head were there)."""
     if state is None or not state.camera:
-        return "Camera head"
+        return _("Camera head")
     name = state.display_name or state.camera
     if state.moving:
-        return f"{name}: moving to {_angles(state, state.goal)}…" if state.goal else f"{name}: moving…"
+        if state.goal:
+            return _("{name}: moving to {where}…").format(name=name, where=_angles(state, state.goal))
+        return _("{name}: moving…").format(name=name)
     if state.position is None:
-        return f"{name}: position not read yet"
+        return _("{name}: position not read yet").format(name=name)
     return f"{name}: {_angles(state, state.position)}"
 
 
 def _angles(state: PtzState, where: tuple[float, float, float]) -> str:
     pan, tilt, zoom = where
-    text = f"pan {pan:+.0f}°  tilt {tilt:+.0f}°"
-    return text + f"  zoom {zoom:.0f} %" if state.zoom_available else text
+    text = _("pan {pan:+.0f}°  tilt {tilt:+.0f}°").format(pan=pan, tilt=tilt)
+    return text + _("  zoom {zoom:.0f} %").format(zoom=zoom) if state.zoom_available else text
 
 
 def disabled_reason(state: PtzState | None, connected: bool) -> str:
     """Why the head cannot be moved now ("" when it can)."""
     if not connected:
-        return "not connected"
+        return _("not connected")
     if state is None:
-        return "reading the camera list…"
+        return _("reading the camera list…")
     if state.reason:
         return state.reason
     if not state.movable:
-        return "this camera cannot be moved"
+        return _("this camera cannot be moved")
     return ""
 
 
@@ -113,13 +116,13 @@ class PtzControls(Gtk.Box):
         """The buttons: beside the label, or under it on a phone (:meth:`set_compact`)."""
         self.append(self.row)
         for intent, icon, tip in (
-            ("ptz_left", "go-previous-symbolic", "Pan left (Ctrl+Left)"),
-            ("ptz_up", "go-up-symbolic", "Tilt up (Ctrl+Up)"),
-            ("ptz_down", "go-down-symbolic", "Tilt down (Ctrl+Down)"),
-            ("ptz_right", "go-next-symbolic", "Pan right (Ctrl+Right)"),
-            ("ptz_zoom_out", "zoom-out-symbolic", "Zoom out (Page Down)"),
-            ("ptz_zoom_in", "zoom-in-symbolic", "Zoom in (Page Up)"),
-            ("ptz_home", "go-home-symbolic", "Point straight ahead"),
+            ("ptz_left", "go-previous-symbolic", _("Pan left (Ctrl+Left)")),
+            ("ptz_up", "go-up-symbolic", _("Tilt up (Ctrl+Up)")),
+            ("ptz_down", "go-down-symbolic", _("Tilt down (Ctrl+Down)")),
+            ("ptz_right", "go-next-symbolic", _("Pan right (Ctrl+Right)")),
+            ("ptz_zoom_out", "zoom-out-symbolic", _("Zoom out (Page Down)")),
+            ("ptz_zoom_in", "zoom-in-symbolic", _("Zoom in (Page Up)")),
+            ("ptz_home", "go-home-symbolic", _("Point straight ahead")),
         ):
             button = Gtk.Button.new_from_icon_name(icon)
             button.set_focusable(False)
@@ -181,11 +184,13 @@ class PtzControls(Gtk.Box):
 
     def _show(self, robot: RobotState) -> None:
         state, reason = robot.ptz, self.reason
-        self.label.set_text(position_text(state) if not reason else f"Camera head: {reason}")
+        self.label.set_text(
+            position_text(state) if not reason else _("Camera head: {reason}").format(reason=reason)
+        )
         for intent, button in self.buttons.items():
             ok = not reason and self._can(intent)
             button.set_sensitive(ok)
-            why = f"Camera head: {reason or 'not offered by this camera'}"
+            why = _("Camera head: {value}").format(value=reason or _("not offered by this camera"))
             button.set_tooltip_text(self._tips[intent] if ok else why)
         self.label.set_tooltip_text(reason or None)
 
@@ -206,7 +211,7 @@ class PtzControls(Gtk.Box):
         if reason:
             return reason
         if not self._can(intent):
-            return "this camera does not offer that move"
+            return _("this camera does not offer that move")
         if intent == "ptz_home":
             self._ask(PtzMove(0.0, 0.0, None, relative=False))
         else:

@@ -15,6 +15,7 @@ import gi
 gi.require_version("Gtk", "4.0")
 from gi.repository import GLib, Gtk  # noqa: E402
 
+from ..base.i18n import _  # noqa: E402
 from ..recorder.replay import SPEEDS, ReplayClock  # noqa: E402
 from . import accessible  # noqa: E402
 
@@ -43,18 +44,22 @@ class ReplayBar(Gtk.Box):
         self._seek = seek
         self._pending: int | None = None
         self._settle: int | None = None
-        badge = Gtk.Label(label="REPLAY")
+        badge = Gtk.Label(label=_("REPLAY"))
         badge.add_css_class("replay-badge")
-        badge.set_tooltip_text(f"A recording is shown ({name}): nothing is sent to any robot")
+        badge.set_tooltip_text(
+            _("A recording is shown ({name}): nothing is sent to any robot").format(name=name)
+        )
         self.append(badge)
-        self.back = self._button("media-skip-backward-symbolic", "Back 1 s", lambda: self.step(-STEP_NS))
-        self.play_button = self._button("media-playback-pause-symbolic", "Play / pause", self.toggle)
-        self.forward = self._button("media-skip-forward-symbolic", "Forward 1 s", lambda: self.step(STEP_NS))
+        self.back = self._button("media-skip-backward-symbolic", _("Back 1 s"), lambda: self.step(-STEP_NS))
+        self.play_button = self._button("media-playback-pause-symbolic", _("Play / pause"), self.toggle)
+        self.forward = self._button(
+            "media-skip-forward-symbolic", _("Forward 1 s"), lambda: self.step(STEP_NS)
+        )
         self.speed = Gtk.DropDown.new_from_strings([f"x{s:g}" for s in SPEEDS])
         self.speed.set_focusable(False)
         self.speed.set_selected(SPEEDS.index(1.0))
-        self.speed.set_tooltip_text("Replay speed")
-        accessible.name(self.speed, "Replay speed")
+        self.speed.set_tooltip_text(_("Replay speed"))
+        accessible.name(self.speed, _("Replay speed"))
         self.speed.connect("notify::selected", self._speed_chosen)
         self.append(self.speed)
         seconds = max(0.1, (clock.end_ns - clock.start_ns) / 1e9)
@@ -62,8 +67,8 @@ class ReplayBar(Gtk.Box):
         self.timeline.set_draw_value(False)
         self.timeline.set_hexpand(True)
         self.timeline.set_focusable(False)
-        self.timeline.set_tooltip_text("Scrub through the recording")
-        accessible.name(self.timeline, "Recording position")
+        self.timeline.set_tooltip_text(_("Scrub through the recording"))
+        accessible.name(self.timeline, _("Recording position"))
         self.timeline.connect("change-value", self._scrubbed)
         self.append(self.timeline)
         self.time_label = Gtk.Label(label="")

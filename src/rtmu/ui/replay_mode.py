@@ -14,6 +14,7 @@ from typing import TYPE_CHECKING
 
 from gi.repository import GLib
 
+from ..base.i18n import _
 from ..fleet.sessions import RobotSession
 from ..recorder.replay import REPLAY_HOST, Replayer
 from ..recorder.replay_file import load
@@ -31,7 +32,9 @@ def open_replay(path: Path, conn: int = 1) -> Replayer:
 
 
 def replay_profile(path: Path) -> Profile:
-    return Profile(name=f"Replay of {path.name}", host=REPLAY_HOST, port=0, auto_reconnect=False)
+    return Profile(
+        name=_("Replay of {name}").format(name=path.name), host=REPLAY_HOST, port=0, auto_reconnect=False
+    )
 
 
 def show_replay(window: MainWindow, session: RobotSession, replayer: Replayer) -> ReplayBar:
@@ -56,13 +59,22 @@ def show_replay(window: MainWindow, session: RobotSession, replayer: Replayer) -
     window.stage.status_age = window.toolbar.status_age = replayer.status_age  # ages in recording time
     bar = ReplayBar(replayer.clock, seek, name)
     window.column.append(bar)
-    window.title_label.set_text("RTMU — REPLAY")
+    window.title_label.set_text(_("RTMU — REPLAY"))
     for button in (window.connect_button, window.fullscreen_bar.connect_button):
         button.set_visible(False)  # there is no robot to disconnect from; closing the window ends it
     more = replayer.recorded.connections
-    extra = f" (connection {replayer.recorded.conn} of {more}; --conn N picks another)" if more > 1 else ""
+    extra = (
+        _(" (connection {conn} of {more}; --conn N picks another)").format(
+            conn=replayer.recorded.conn, more=more
+        )
+        if more > 1
+        else ""
+    )
     window.banners.tell(
-        "replay", "info", f"Replay of {name}{extra}: nothing is sent to any robot", timeout=6.0
+        "replay",
+        "info",
+        _("Replay of {name}{extra}: nothing is sent to any robot").format(name=name, extra=extra),
+        timeout=6.0,
     )
     replayer.clock.play()
     runner.connect(REPLAY_HOST, 0, auto_reconnect=False)

@@ -24,6 +24,7 @@ import gi
 gi.require_version("Gtk", "4.0")
 from gi.repository import Gio, GObject, Gtk, Pango  # noqa: E402
 
+from ..base.i18n import N_, _, number  # noqa: E402
 from ..fleet.sessions import RobotSession  # noqa: E402
 from ..model.observables import LinkLevel, Phase, RobotState  # noqa: E402
 from .fleet_draw import RGB  # noqa: E402
@@ -33,7 +34,7 @@ NARROW_PX = 640
 MAX_TEXT = 60
 SIDEBAR_PX = 210
 UNCONNECTED_RGB: RGB = (0.6, 0.61, 0.64)
-NOT_CONNECTED = "not connected — select to connect"
+NOT_CONNECTED = N_("not connected — select to connect")
 
 
 def _short(text: str) -> str:
@@ -61,19 +62,21 @@ def row_text(session: RobotSession) -> RowText:
     if r.battery_v is None:
         battery = ""
     elif r.battery_is_soc:
-        battery = f"{r.battery_v:.0f} %"
+        battery = _("{percent} %").format(percent=number(r.battery_v))
     else:
-        battery = f"{r.battery_v:.1f} V"
+        battery = _("{volts} V").format(volts=number(r.battery_v, 1))
     if conn.phase is Phase.CONNECTED:
-        link = {LinkLevel.OK: "link ok", LinkLevel.STALE: "link stale", LinkLevel.LOST: "link lost"}.get(
-            health.level, "connected"
-        )
+        link = {
+            LinkLevel.OK: _("link ok"),
+            LinkLevel.STALE: _("link stale"),
+            LinkLevel.LOST: _("link lost"),
+        }.get(health.level, _("connected"))
     else:
         link = {
-            Phase.DISCONNECTED: "not connected",
-            Phase.CONNECTING: "connecting…",
-            Phase.RECONNECTING: "link lost — reconnecting",
-            Phase.FAILED: "link lost" if conn.error else "failed",
+            Phase.DISCONNECTED: _("not connected"),
+            Phase.CONNECTING: _("connecting…"),
+            Phase.RECONNECTING: _("link lost — reconnecting"),
+            Phase.FAILED: _("link lost") if conn.error else _("failed"),
         }[conn.phase]
     stale = conn.phase is not Phase.CONNECTED or health.level is not LinkLevel.OK
     return RowText(_short(session.name), " · ".join(words) or "—", battery, link, stale)
@@ -81,7 +84,7 @@ def row_text(session: RobotSession) -> RowText:
 
 def listed_row_text(name: str) -> RowText:
     """The row of a robot the roster lists but the window has not connected to."""
-    return RowText(_short(name), "—", "", NOT_CONNECTED, True)
+    return RowText(_short(name), "—", "", _(NOT_CONNECTED), True)
 
 
 class RobotItem(GObject.Object):
@@ -194,7 +197,7 @@ class RobotList(Gtk.Box):
         self._items: list[RobotItem] = []
         self.bound: set[_Row] = set()
         """The row widgets on screen now (the list view builds only those)."""
-        self.fold = Gtk.ToggleButton(label="Robots", active=True, visible=False)
+        self.fold = Gtk.ToggleButton(label=_("Robots"), active=True, visible=False)
         self.fold.set_focusable(False)
         self.fold.connect("toggled", lambda b: self.revealer.set_reveal_child(b.get_active()))
         self.append(self.fold)
@@ -249,7 +252,7 @@ class RobotList(Gtk.Box):
             self._items = [RobotItem(n) for n in names]
             self.store.splice(0, len(old), self._items)
         self.names = names
-        self.fold.set_label(f"Robots ({len(names)})")
+        self.fold.set_label(_("Robots ({len})").format(len=len(names)))
 
     def show_selected(self, name: str | None) -> None:
         self.selected_name = name

@@ -17,6 +17,7 @@ import gi
 gi.require_version("Gtk", "4.0")
 from gi.repository import Gtk  # noqa: E402
 
+from ..base.i18n import _  # noqa: E402
 from ..model.observables import ConnectionState, Phase, RobotModel  # noqa: E402
 from ..values.intents import GotoGoal, Intent, Patrol  # noqa: E402
 from . import accessible  # noqa: E402
@@ -29,8 +30,8 @@ class RoutesPanel(Gtk.MenuButton):
     """Header-bar button + popover listing routes, each with Patrol."""
 
     def __init__(self, model: RobotModel, ask: Ask) -> None:
-        super().__init__(icon_name="mark-location-symbolic", tooltip_text="Routes (patrol)")
-        accessible.name_menu_button(self, "Routes")
+        super().__init__(icon_name="mark-location-symbolic", tooltip_text=_("Routes (patrol)"))
+        accessible.name_menu_button(self, _("Routes"))
         self.set_focusable(False)
         inner = self.get_first_child()
         if inner is not None:
@@ -40,7 +41,7 @@ class RoutesPanel(Gtk.MenuButton):
         self.list = Gtk.Box(orientation=Gtk.Orientation.VERTICAL, spacing=4)
         for side in ("top", "bottom", "start", "end"):
             getattr(self.list, f"set_margin_{side}")(8)
-        self.empty = Gtk.Label(label="This map has no routes", xalign=0.0)
+        self.empty = Gtk.Label(label=_("This map has no routes"), xalign=0.0)
         self.empty.add_css_class("dim-label")
         self.rows: dict[str, Gtk.Button] = {}
         """Route name → its Patrol button (what is shown now)."""
@@ -94,8 +95,10 @@ class RoutesPanel(Gtk.MenuButton):
         for name in routes:
             row = Gtk.Box(spacing=8)
             label = Gtk.Label(label=name, xalign=0.0, hexpand=True)
-            button = Gtk.Button.new_with_label("Patrol")
-            button.set_tooltip_text(f"Patrol the route {name!r} (the robot drives by itself; STOP ends it)")
+            button = Gtk.Button.new_with_label(_("Patrol"))
+            button.set_tooltip_text(
+                _("Patrol the route {name!r} (the robot drives by itself; STOP ends it)").format(name=name)
+            )
             button.set_sensitive(can_patrol)
             button.connect("clicked", lambda _b, n=name: self.patrol(n))
             row.append(label)
@@ -106,21 +109,23 @@ class RoutesPanel(Gtk.MenuButton):
     def _fill_goals(self, goals: tuple[str, ...]) -> None:
         if not goals:
             return
-        title = Gtk.Label(label="Goals", xalign=0.0)
+        title = Gtk.Label(label=_("Goals"), xalign=0.0)
         title.add_css_class("heading")
         self.list.append(title)
         can_go = "gotoRouteGoal" in self.model.connection.value.offers
         for name in goals:
             row = Gtk.Box(spacing=8)
-            button = Gtk.Button.new_with_label("Go")
-            button.set_tooltip_text(f"Drive to the goal {name!r} (the robot drives by itself; STOP ends it)")
+            button = Gtk.Button.new_with_label(_("Go"))
+            button.set_tooltip_text(
+                _("Drive to the goal {name!r} (the robot drives by itself; STOP ends it)").format(name=name)
+            )
             button.set_sensitive(can_go)
             button.connect("clicked", lambda _b, n=name: self.go_to_goal(n))
             row.append(Gtk.Label(label=name, xalign=0.0, hexpand=True))
             row.append(button)
             self.list.append(row)
             self.goal_rows[name] = button
-        routes_title = Gtk.Label(label="Routes", xalign=0.0)
+        routes_title = Gtk.Label(label=_("Routes"), xalign=0.0)
         routes_title.add_css_class("heading")
         self.list.append(routes_title)
 

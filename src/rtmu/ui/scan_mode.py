@@ -26,6 +26,7 @@ gi.require_version("Gdk", "4.0")
 gi.require_version("Gtk", "4.0")
 from gi.repository import Gdk, GLib, Gtk  # noqa: E402
 
+from ..base.i18n import _  # noqa: E402
 from ..base.textsafe import visible  # noqa: E402
 from ..client.remote_files import local_name  # noqa: E402
 from ..client.scan import SCAN_FEATURES, ScanProgress, scan_name  # noqa: E402
@@ -46,11 +47,13 @@ def scan_greyed(model: RobotModel) -> str:
     """Why a scan cannot be started now ("" when it can)."""
     conn = model.connection.value
     if conn.phase is not Phase.CONNECTED:
-        return "not connected to a robot"
+        return _("not connected to a robot")
     if not model.scan.value.offered:
-        return SCAN_FEATURES["scan"][1] + " — or this user may not use it"
+        return SCAN_FEATURES["scan"][1] + _(" — or this user may not use it")
     if model.scan.value.scanning:
-        return f"a scan is already running ({model.scan.value.file_name or model.scan.value.name})"
+        return _("a scan is already running ({value})").format(
+            value=model.scan.value.file_name or model.scan.value.name
+        )
     return ""
 
 
@@ -60,23 +63,23 @@ class ScanDialog(Gtk.Window):
     def __init__(
         self, parent: Gtk.Window, model: RobotModel, start: Callable[[str], concurrent.futures.Future[Any]]
     ):
-        super().__init__(title="Scan a map", transient_for=parent, modal=False, destroy_with_parent=True)
+        super().__init__(title=_("Scan a map"), transient_for=parent, modal=False, destroy_with_parent=True)
         self.set_resizable(False)
         self._start = start
         box = Gtk.Box(orientation=Gtk.Orientation.VERTICAL, spacing=8)
         for side in ("top", "bottom", "start", "end"):
             getattr(box, f"set_margin_{side}")(12)
         box.append(
-            Gtk.Label(label="Name the scan, start it, then drive the robot round the place.", xalign=0.0)
+            Gtk.Label(label=_("Name the scan, start it, then drive the robot round the place."), xalign=0.0)
         )
-        self.name_entry = Gtk.Entry(placeholder_text="e.g. ground floor", activates_default=True)
+        self.name_entry = Gtk.Entry(placeholder_text=_("e.g. ground floor"), activates_default=True)
         box.append(self.name_entry)
         self.reason = Gtk.Label(xalign=0.0, wrap=True, max_width_chars=48)
         box.append(self.reason)
         buttons = Gtk.Box(spacing=8, halign=Gtk.Align.END)
-        cancel = Gtk.Button(label="Cancel")
+        cancel = Gtk.Button(label=_("Cancel"))
         cancel.connect("clicked", lambda _b: self.close())
-        self.start_button = Gtk.Button(label="Start")
+        self.start_button = Gtk.Button(label=_("Start"))
         self.start_button.add_css_class("suggested-action")
         self.start_button.connect("clicked", lambda _b: self.submit())
         buttons.append(cancel)
@@ -90,7 +93,7 @@ class ScanDialog(Gtk.Window):
         greyed = scan_greyed(model)
         if greyed:
             self.start_button.set_sensitive(False)
-            self._say(f"Cannot scan: {greyed}", error=False)
+            self._say(_("Cannot scan: {greyed}").format(greyed=greyed), error=False)
 
     def _key(self, _c: Gtk.EventControllerKey, keyval: int, _code: int, _state: object) -> bool:
         if keyval == Gdk.KEY_Escape:
@@ -108,19 +111,19 @@ class ScanDialog(Gtk.Window):
         try:
             name = scan_name(self.name_entry.get_text().strip())
             if not name:
-                raise ValueError("give the scan a name")
+                raise ValueError(_("give the scan a name"))
         except ValueError as exc:
             self._say(str(exc), error=True)
             return
         self.start_button.set_sensitive(False)
-        self._say("Starting…", error=False)
+        self._say(_("Starting…"), error=False)
         self._start(name).add_done_callback(lambda f: GLib.idle_add(self._started, f))
 
     def _started(self, future: concurrent.futures.Future[Any]) -> bool:
         error = None if future.cancelled() else future.exception()
         if future.cancelled() or error is not None:
             self.start_button.set_sensitive(True)
-            self._say(f"The scan did not start: {error or 'cancelled'}", error=True)
+            self._say(_("The scan did not start: {value}").format(value=error or "cancelled"), error=True)
         else:
             self.close()
         return False
@@ -153,19 +156,21 @@ class ScanBar(Gtk.Revealer):
         self.label = Gtk.Label(xalign=0.0, hexpand=True, wrap=True)
         buttons = Gtk.Box(spacing=8, halign=Gtk.Align.END, hexpand=True)
         self.loop_start = Gtk.Button(
-            label="Loop start", tooltip_text="Here a loop begins (the log is tagged)"
+            label=_("Loop start"), tooltip_text=_("Here a loop begins (the log is tagged)")
         )
         self.loop_start.connect("clicked", lambda _b: self._tag(True))
-        self.loop_end = Gtk.Button(label="Loop end", tooltip_text="Back where the loop began")
+        self.loop_end = Gtk.Button(label=_("Loop end"), tooltip_text=_("Back where the loop began"))
         self.loop_end.connect("clicked", lambda _b: self._tag(False))
         # Not red: STOP is the only red button near the header (ui.bars); this one ends the log, not motion.
-        self.stop_scan = Gtk.Button(label="Stop scan", tooltip_text="End the scan (the robot is not stopped)")
+        self.stop_scan = Gtk.Button(
+            label=_("Stop scan"), tooltip_text=_("End the scan (the robot is not stopped)")
+        )
         self.stop_scan.connect("clicked", lambda _b: self._stop())
-        self.download = Gtk.Button(label="Download the scan…")
+        self.download = Gtk.Button(label=_("Download the scan…"))
         self.download.add_css_class("suggested-action")
         self.download.connect("clicked", lambda _b: self._choose_folder())
-        self.dismiss = Gtk.Button(icon_name="window-close-symbolic", tooltip_text="Hide")
-        accessible.name(self.dismiss, "Hide the scan's panel")
+        self.dismiss = Gtk.Button(icon_name="window-close-symbolic", tooltip_text=_("Hide"))
+        accessible.name(self.dismiss, _("Hide the scan's panel"))
         self.dismiss.connect("clicked", lambda _b: self._dismiss())
         for button in (self.loop_start, self.loop_end, self.stop_scan, self.download, self.dismiss):
             buttons.append(button)
@@ -200,7 +205,7 @@ class ScanBar(Gtk.Revealer):
             self.progress = ScanProgress(self.clock())
             self.progress.now = self.clock()
             self.loop_open = False
-            self.note = "" if new.since is not None else "running before this connection; "
+            self.note = "" if new.since is not None else _("running before this connection; ")
             self.offer_file = self.message = ""
         elif not new.scanning and old.scanning:
             self.offer_file = new.last_file
@@ -228,10 +233,12 @@ class ScanBar(Gtk.Revealer):
         said = self.message
         if scanning:
             run = self.progress.text() if self.progress is not None else ""
-            text = f"Scanning {visible(scan.file_name or scan.name)}… {self.note}{run}"
+            text = _("Scanning {visible}… {note}{run}").format(
+                visible=visible(scan.file_name or scan.name), note=self.note, run=run
+            )
             text += f" — {said}" if said else ""
         elif self.offer_file:
-            text = said or f"The scan {visible(self.offer_file)} is on the robot."
+            text = said or _("The scan {visible} is on the robot.").format(visible=visible(self.offer_file))
         else:
             text = said
         if self.label.get_text() != text:
@@ -249,7 +256,7 @@ class ScanBar(Gtk.Revealer):
     def _tag(self, start: bool) -> None:
         def tagged(_answer: Any) -> None:
             self.loop_open = start
-            self.message = "loop start tagged" if start else "loop end tagged"
+            self.message = _("loop start tagged") if start else _("loop end tagged")
             self._show()
 
         self._ask(TagScanLoop(start=start), tagged)
@@ -263,11 +270,13 @@ class ScanBar(Gtk.Revealer):
 
     def _choose_folder(self) -> None:
         chooser = Gtk.FileChooserDialog(
-            title="Download the scan into", transient_for=self.parent, modal=True,
+            title=_("Download the scan into"),
+            transient_for=self.parent,
+            modal=True,
             action=Gtk.FileChooserAction.SELECT_FOLDER,
-        )  # fmt: skip
-        chooser.add_button("Cancel", Gtk.ResponseType.CANCEL)
-        chooser.add_button("Select", Gtk.ResponseType.ACCEPT)
+        )
+        chooser.add_button(_("Cancel"), Gtk.ResponseType.CANCEL)
+        chooser.add_button(_("Select"), Gtk.ResponseType.ACCEPT)
         chooser.connect("response", self._folder_chosen)
         self.chooser = chooser
         chooser.present()
@@ -288,9 +297,11 @@ class ScanBar(Gtk.Revealer):
         target = folder / local_name(remote)
         if target.exists() or target.is_symlink():
             self.confirm = Confirm(
-                self.parent, f"“{target.name}” already exists in {folder}. Replace it?", "Replace",
+                self.parent,
+                _("“{name}” already exists in {folder}. Replace it?").format(name=target.name, folder=folder),
+                _("Replace"),
                 lambda: self._download(remote, target, overwrite=True),
-            )  # fmt: skip
+            )
             self.confirm.present()
             return
         self._download(remote, target, overwrite=False)
@@ -298,7 +309,9 @@ class ScanBar(Gtk.Revealer):
     def _download(self, remote: str, target: Path, *, overwrite: bool) -> None:
         def done(finished: Any) -> None:
             self.downloads += 1
-            self.message = f"Saved the scan to {target} ({human_size(finished.size)})"
+            self.message = _("Saved the scan to {target} ({human_size})").format(
+                target=target, human_size=human_size(finished.size)
+            )
             self._show()
 
         self._ask(DownloadFile(remote, str(target), overwrite=overwrite), done)
@@ -319,7 +332,9 @@ class ScanBar(Gtk.Revealer):
         def answered(future: concurrent.futures.Future[Any]) -> bool:
             error = None if future.cancelled() else future.exception()
             if future.cancelled() or error is not None:
-                self.message = f"{intent.label} failed: {error or 'cancelled'}"
+                self.message = _("{label} failed: {value}").format(
+                    label=intent.label, value=error or "cancelled"
+                )
                 self._show()
             else:
                 on_answer(future.result())

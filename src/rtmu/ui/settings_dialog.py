@@ -19,6 +19,7 @@ import gi
 gi.require_version("Gtk", "4.0")
 from gi.repository import Gtk  # noqa: E402
 
+from ..base.i18n import _  # noqa: E402
 from ..settings.store import DEFAULT_PORT, Profile, address_name  # noqa: E402
 from . import accessible  # noqa: E402
 from .layout import screen_size  # noqa: E402
@@ -32,21 +33,23 @@ def validate(name: str, host: str, port: str, user: str, remember: bool) -> dict
     errors: dict[str, str] = {}
     name, host, port, user = name.strip(), host.strip(), port.strip(), user.strip()
     if not name:
-        errors["name"] = "Give the profile a name."
+        errors["name"] = _("Give the profile a name.")
     elif len(name) > 200 or not name.isprintable():
-        errors["name"] = "Use up to 200 printable characters."
+        errors["name"] = _("Use up to 200 printable characters.")
     if not host:
-        errors["host"] = "Enter the robot server's host name or address."
+        errors["host"] = _("Enter the robot server's host name or address.")
     elif len(host) > 255 or not (_HOST.match(host) or (":" in host and _IPV6.match(host))):
-        errors["host"] = "Not a host name or IP address (letters, digits, dots and dashes)."
+        errors["host"] = _("Not a host name or IP address (letters, digits, dots and dashes).")
     if not port:
-        errors["port"] = f"Enter a port (ARIA servers use {DEFAULT_PORT})."
+        errors["port"] = _("Enter a port (ARIA servers use {DEFAULT_PORT}).").format(
+            DEFAULT_PORT=DEFAULT_PORT
+        )
     elif not port.isdigit() or not 1 <= int(port) <= 65535:
-        errors["port"] = "The port is a number from 1 to 65535."
+        errors["port"] = _("The port is a number from 1 to 65535.")
     if len(user) > 200:
-        errors["user"] = "The user name is too long."
+        errors["user"] = _("The user name is too long.")
     if remember and not user:
-        errors["remember"] = "A password is remembered only together with a user name."
+        errors["remember"] = _("A password is remembered only together with a user name.")
     return errors
 
 
@@ -62,7 +65,7 @@ class ConnectionDialog(Gtk.Window):
         on_save: Callable[[Profile, str | None], None],
         keyring_available: bool,
     ) -> None:
-        super().__init__(title="Connection settings", modal=True, transient_for=parent)
+        super().__init__(title=_("Connection settings"), modal=True, transient_for=parent)
         screen = screen_size()  # a 360 px phone: the dialog takes its width, no more
         self.set_default_size(440 if screen is None else min(440, screen[0] - 16), -1)
         self.set_resizable(False)
@@ -81,37 +84,39 @@ class ConnectionDialog(Gtk.Window):
         for name in self._profiles:
             self.profile.append(name, name)
         self.profile_entry: Gtk.Entry = self.profile.get_child()  # type: ignore[assignment]
-        accessible.name(self.profile_entry, "Profile name")
-        accessible.name_inner_toggle(self.profile, "Profiles")
-        self.host = Gtk.Entry(placeholder_text="robot.local or 192.168.1.10", hexpand=True)
+        accessible.name(self.profile_entry, _("Profile name"))
+        accessible.name_inner_toggle(self.profile, _("Profiles"))
+        self.host = Gtk.Entry(placeholder_text=_("robot.local or 192.168.1.10"), hexpand=True)
         self.port = Gtk.Entry(placeholder_text=str(DEFAULT_PORT), input_purpose=Gtk.InputPurpose.DIGITS)
-        self.user = Gtk.Entry(placeholder_text="(none)")
+        self.user = Gtk.Entry(placeholder_text=_("(none)"))
         self.password = Gtk.PasswordEntry(show_peek_icon=True, hexpand=True)
-        self.password.set_property("placeholder-text", "(unchanged)")
-        self.remember = Gtk.CheckButton(label="Remember the password in the keyring")
+        self.password.set_property("placeholder-text", _("(unchanged)"))
+        self.remember = Gtk.CheckButton(label=_("Remember the password in the keyring"))
         if not keyring_available:
-            self.remember.set_label("Remember the password (this session only: no keyring)")
-        self.reconnect = Gtk.CheckButton(label="Reconnect automatically when the link is lost")
+            self.remember.set_label(_("Remember the password (this session only: no keyring)"))
+        self.reconnect = Gtk.CheckButton(label=_("Reconnect automatically when the link is lost"))
         for check in (self.remember, self.reconnect):  # long sentences wrap on a phone
             label = check.get_last_child()
             if isinstance(label, Gtk.Label):
                 label.set_wrap(True)
                 label.set_max_width_chars(30)
-        self.protocol = Gtk.Entry(placeholder_text="(the one the server asks for)", max_length=200)
+        self.protocol = Gtk.Entry(placeholder_text=_("(the one the server asks for)"), max_length=200)
         self.protocol.set_tooltip_text(
-            "Protocol string sent at login. Leave empty: RTMU answers with the string the server "
-            "advertises (Omron LD robots: 6MTX)."
+            _(
+                "Protocol string sent at login. Leave empty: RTMU answers with the string the server "
+                "advertises (Omron LD robots: 6MTX)."
+            )
         )
         self.errors: dict[str, Gtk.Label] = {}
         rows = (
-            ("name", "Profile", self.profile),
-            ("host", "Host", self.host),
-            ("port", "Port", self.port),
-            ("user", "User", self.user),
-            ("password", "Password", self.password),
+            ("name", _("Profile"), self.profile),
+            ("host", _("Host"), self.host),
+            ("port", _("Port"), self.port),
+            ("user", _("User"), self.user),
+            ("password", _("Password"), self.password),
             ("remember", "", self.remember),
             ("reconnect", "", self.reconnect),
-            ("protocol", "Protocol", self.protocol),
+            ("protocol", _("Protocol"), self.protocol),
         )
         for i, (key, caption, widget) in enumerate(rows):
             if caption:
@@ -131,9 +136,9 @@ class ConnectionDialog(Gtk.Window):
         buttons.set_margin_top(8)
         buttons.set_margin_bottom(16)
         buttons.set_margin_end(16)
-        cancel = accessible.mnemonic_button("_Cancel")
+        cancel = accessible.mnemonic_button(_("_Cancel"))
         cancel.connect("clicked", lambda _b: self.close())
-        self.save = accessible.mnemonic_button("_Save")
+        self.save = accessible.mnemonic_button(_("_Save"))
         self.save.add_css_class("suggested-action")
         self.save.connect("clicked", self._save)
         buttons.append(cancel)
@@ -245,22 +250,26 @@ class PasswordPrompt(Gtk.Window):
     """Asks for a profile's password at connect time; ``answer(None)`` when cancelled."""
 
     def __init__(self, parent: Gtk.Window, profile: Profile, answer: Callable[[str | None], None]) -> None:
-        super().__init__(title="Password", modal=True, transient_for=parent)
+        super().__init__(title=_("Password"), modal=True, transient_for=parent)
         self.set_resizable(False)
         self._answer: Callable[[str | None], None] | None = answer
         box = Gtk.Box(orientation=Gtk.Orientation.VERTICAL, spacing=10)
         for side in ("top", "bottom", "start", "end"):
             getattr(box, f"set_margin_{side}")(16)
         prompt = Gtk.Label(xalign=0.0, wrap=True, max_width_chars=40)
-        prompt.set_text(f"Password for {profile.user} on {profile.host}:{profile.port}")
+        prompt.set_text(
+            _("Password for {user} on {host}:{port}").format(
+                user=profile.user, host=profile.host, port=profile.port
+            )
+        )
         box.append(prompt)
         self.entry = Gtk.PasswordEntry(show_peek_icon=True)
         self.entry.set_property("activates-default", True)
         box.append(self.entry)
         buttons = Gtk.Box(spacing=8, halign=Gtk.Align.END)
-        cancel = accessible.mnemonic_button("_Cancel")
+        cancel = accessible.mnemonic_button(_("_Cancel"))
         cancel.connect("clicked", lambda _b: self.close())
-        ok = accessible.mnemonic_button("C_onnect")
+        ok = accessible.mnemonic_button(_("C_onnect"))
         ok.add_css_class("suggested-action")
         ok.connect("clicked", self._ok)
         buttons.append(cancel)

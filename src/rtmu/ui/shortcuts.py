@@ -18,14 +18,24 @@ import gi
 gi.require_version("Gtk", "4.0")
 from gi.repository import Gtk  # noqa: E402
 
+from ..base.i18n import N_, _  # noqa: E402
 from .keys import Binding, bindings  # noqa: E402
 
 COLUMN_LINES = 6
 """Lines per column of the shortcuts window: small enough for an 800×480 screen (pages of columns)."""
 GROUP_ORDER = (
-    "Map", "Camera head", "Window", "Navigation", "Moves", "Fleet", "Driving", "Connection", "Application",
-    "Robot", "Speed",
-)  # fmt: skip
+    N_("Map"),
+    N_("Camera head"),
+    N_("Window"),
+    N_("Navigation"),
+    N_("Moves"),
+    N_("Fleet"),
+    N_("Driving"),
+    N_("Connection"),
+    N_("Application"),
+    N_("Robot"),
+    N_("Speed"),
+)
 """The order the groups are written in. GTK 4.8's ``GtkShortcutsSection`` re-packs its groups into pages
 by their heights and not in the order given; written in this order it shows Driving (the drive keys
 and STOP) first on the first page, with the help, Quit and the speed keys (a GUI test checks it on the
@@ -63,7 +73,7 @@ def shortcuts_xml(table: tuple[Binding, ...] | None = None, column_lines: int = 
         out += [
             "<child>",
             '<object class="GtkShortcutsGroup">',
-            f'<property name="title">{escape(title)}</property>',
+            f'<property name="title">{escape(_(title))}</property>',
         ]
         for b in items:
             accels = " ".join(shown_accels(b)) if b.help is None else b.help
@@ -72,7 +82,7 @@ def shortcuts_xml(table: tuple[Binding, ...] | None = None, column_lines: int = 
             out += [
                 "<child>",
                 '<object class="GtkShortcutsShortcut">',
-                f'<property name="title">{escape(b.title)}</property>',
+                f'<property name="title">{escape(_(b.title))}</property>',
                 f'<property name="accelerator">{escape(accels)}</property>',
                 "</object>",
                 "</child>",

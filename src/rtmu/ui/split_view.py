@@ -17,6 +17,7 @@ gi.require_version("Gdk", "4.0")
 gi.require_version("Pango", "1.0")
 from gi.repository import Gdk, GLib, Gtk, Pango  # noqa: E402
 
+from ..base.i18n import _  # noqa: E402
 from ..model.observables import CameraImage  # noqa: E402
 
 
@@ -63,7 +64,7 @@ class SplitView(Gtk.Box):
         self.caption.set_margin_start(8)
         self.caption.set_margin_top(8)
         self.pane.add_overlay(self.caption)
-        self.placeholder = Gtk.Label(label="No picture yet: live video starts with the split view.")
+        self.placeholder = Gtk.Label(label=_("No picture yet: live video starts with the split view."))
         self.placeholder.set_wrap(True)
         self.placeholder.set_use_markup(False)
         self.pane.add_overlay(self.placeholder)

@@ -15,13 +15,19 @@ gi.require_version("Gtk", "4.0")
 gi.require_version("Pango", "1.0")
 from gi.repository import Gtk, Pango  # noqa: E402
 
+from ..base.i18n import N_, _  # noqa: E402
 from ..control.alarms import Thresholds  # noqa: E402
 from ..model.observables import LinkLevel, OperatorState, Phase, RobotModel  # noqa: E402
 from . import accessible  # noqa: E402
 
 DASH = "—"
 SLOW_MS = Thresholds().rtt_high_ms
-STATE_WORDS = {"low": "low", "critical": "at shutdown level", "stale": "slow or stale", "lost": "lost"}
+STATE_WORDS = {
+    "low": "low",
+    "critical": N_("at shutdown level"),
+    "stale": N_("slow or stale"),
+    "lost": "lost",
+}
 """The words for each colour of the strip (amber, red): a screen reader hears the state, too."""
 
 
@@ -38,6 +44,9 @@ class StatusStrip(Gtk.Box):
         for name, chars in (("battery", 6), ("wifi", 5), ("link", 5), ("speed", 4), ("mode", 3)):
             label = Gtk.Label(xalign=0.0, width_chars=chars)
             label.set_use_markup(False)
+            # A language with longer words must not push the strip out of a 360 px screen: each part
+            # gives way down to its own width (tests/gui/test_pseudo_locale.py).
+            label.set_ellipsize(Pango.EllipsizeMode.END)
             label.add_css_class(f"strip-{name}")
             self.labels[name] = label
             self.append(label)
@@ -64,21 +73,21 @@ class StatusStrip(Gtk.Box):
         robot, health = self.model.robot.value, self.model.health.value
         connected = self.model.connection.value.phase is Phase.CONNECTED
         if robot.battery_v is None or not connected:
-            battery = f"Bat {DASH}"
+            battery = _("Bat {DASH}").format(DASH=DASH)
         elif robot.battery_is_soc:
-            battery = f"Bat {robot.battery_v:.0f}%"
+            battery = _("Bat {battery_v:.0f}%").format(battery_v=robot.battery_v)
         else:
-            battery = f"Bat {robot.battery_v:.1f}V"
+            battery = _("Bat {battery_v:.1f}V").format(battery_v=robot.battery_v)
         self._set("battery", battery, robot.battery_state if connected else "unknown")
         quality = robot.wifi_quality
         wifi = DASH if quality is None or not connected else f"{max(0, min(100, quality))}%"  # (in %)
-        self._set("wifi", f"Wi-Fi {wifi}", "")
+        self._set("wifi", _("Wi-Fi {wifi}").format(wifi=wifi), "")
         if not connected:
             link, state = self.model.connection.value.phase.value, "lost"
         elif health.level is not LinkLevel.OK:
             link, state = health.level.value, "lost" if health.level is LinkLevel.LOST else "stale"
         else:
-            link = f"{health.rtt_ms:.0f} ms" if health.rtt_ms is not None else "ok"
+            link = _("{rtt_ms:.0f} ms").format(rtt_ms=health.rtt_ms) if health.rtt_ms is not None else "ok"
             slow = health.rtt_ms is not None and health.rtt_ms > SLOW_MS
             state = "stale" if slow else "ok"  # amber from where the round-trip alarm starts
         self._set("link", link, state)
@@ -91,7 +100,8 @@ class StatusStrip(Gtk.Box):
             label.set_text(text)
         for css in ("low", "critical", "ok", "stale", "lost"):
             (label.add_css_class if css == state else label.remove_css_class)(css)
-        words = STATE_WORDS.get(state, "")  # what the colour says, for a screen reader
+        # what the colour says, for a screen reader
+        words = _(STATE_WORDS[state]) if state in STATE_WORDS else ""
         if self._said.get(name, "") != words:  # said once per change, not at 10 Hz
             self._said[name] = words
             accessible.describe(label, f"{name} {words}" if words else "")

@@ -14,6 +14,7 @@ from dataclasses import dataclass
 
 import cairo
 
+from ..base.i18n import _
 from ..control.motion_limits import RobotLimits
 from . import overlays
 from .viewport import Viewport
@@ -38,7 +39,7 @@ class StopReach:
 
     @property
     def words(self) -> str:
-        return f"stops in {self.distance / 1000:.1f} m"
+        return _("stops in {value:.1f} m").format(value=self.distance / 1000)
 
 
 def stop_reach(x: float, y: float, th: float, speed: float, limits: RobotLimits) -> StopReach | None:

@@ -30,6 +30,7 @@ gi.require_version("Gtk", "4.0")
 gi.require_version("Gdk", "4.0")
 from gi.repository import Gdk, GObject, Gtk  # noqa: E402
 
+from ..base.i18n import _  # noqa: E402
 from ..control.key_rules import FIELD_HINT, KeyAction, stop_key_action, stop_key_names  # noqa: E402
 from .dialog_chain import belongs_to  # noqa: E402
 
@@ -137,13 +138,13 @@ class StopKeys:
         if getattr(widget, GUARD_ATTR, False):
             return
         setattr(widget, GUARD_ATTR, True)
-        tip = widget.get_tooltip_text()
-        widget.set_tooltip_text(f"{tip}\n{FIELD_HINT}" if tip else FIELD_HINT)
+        tip, hint = widget.get_tooltip_text(), _(FIELD_HINT)
+        widget.set_tooltip_text(f"{tip}\n{hint}" if tip else hint)
         if isinstance(widget, Gtk.TextView):
             return
         placeholder = widget.get_property("placeholder-text") or ""
-        short = "Space stops"
-        widget.set_property("placeholder-text", f"{placeholder} · {short}" if placeholder else FIELD_HINT)
+        short = _("Space stops")
+        widget.set_property("placeholder-text", f"{placeholder} · {short}" if placeholder else hint)
 
     # -- keys ------------------------------------------------------------------------------
     def _pressed(

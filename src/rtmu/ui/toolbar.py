@@ -27,6 +27,7 @@ gi.require_version("Gtk", "4.0")
 gi.require_version("Pango", "1.0")
 from gi.repository import GLib, Gtk, Pango  # noqa: E402
 
+from ..base.i18n import _, ngettext, number  # noqa: E402
 from ..base.link_timing import STATUS_CEILING  # noqa: E402
 from ..model.observables import ConnectionState, LinkLevel, OperatorState, Phase, RobotModel  # noqa: E402
 from . import accessible  # noqa: E402
@@ -34,6 +35,7 @@ from .gauges import BatteryGauge, WifiGauge, battery_fraction, wifi_bars  # noqa
 from .ld_status import details_lines, goal_suffix  # noqa: E402
 from .nav_text import loc_level, loc_text, outcome_status  # noqa: E402
 from .notes import heading_text  # noqa: E402
+from .state_words import level_word, phase_word  # noqa: E402
 
 STALE_AFTER = 1.0
 """Seconds after which a pose/battery value is shown as stale (status arrives at 10 Hz)."""
@@ -42,10 +44,10 @@ STALE_AFTER = 1.0
 def age_text(seconds: float) -> str:
     """An age as the window shows it: whole seconds, then minutes, then hours."""
     if seconds < 60:
-        return f"{int(seconds)} s"
+        return _("{seconds} s").format(seconds=int(seconds))
     if seconds < 3600:
-        return f"{seconds / 60:.0f} min"
-    return f"{seconds / 3600:.1f} h"
+        return _("{minutes} min").format(minutes=number(seconds / 60))
+    return _("{hours} h").format(hours=number(seconds / 3600, 1))
 
 
 DASH = "—"
@@ -101,7 +103,7 @@ class Cell(Gtk.Box):
         if mark != self.mark:
             self.mark = mark
             self.caption.set_text(f"{self._heading} · {mark}" if mark else self._heading)
-        said = ", ".join(w for w in (words, "not current" if stale else "") if w)
+        said = ", ".join(w for w in (words, _("not current") if stale else "") if w)
         if said != self._said:
             self._said = said
             accessible.describe(self.value, f"{self.caption.get_text()}: {said}" if said else "")
@@ -150,19 +152,19 @@ class StatusToolbar(Gtk.ScrolledWindow):
         self.battery_gauge = BatteryGauge()
         self.wifi_gauge = WifiGauge()
         self.cells: dict[str, Cell] = {
-            "x": Cell("X m", width_chars=6),
-            "y": Cell("Y m", width_chars=6),
-            "th": Cell("Heading", width_chars=5),
-            "vel": Cell("mm/s", width_chars=5),
-            "rot": Cell("deg/s", width_chars=4),
-            "battery": Cell("Battery", width_chars=6, gauge=self.battery_gauge),
-            "wifi": Cell("Wi-Fi", width_chars=5, gauge=self.wifi_gauge),
-            "mode": Cell("Mode · status", width_chars=6),
-            "safe": Cell("Safe", width_chars=3),
-            "speed": Cell("Throttle", width_chars=5),
-            "link": Cell("Link: rtt, age/limit", width_chars=14),
-            "dock": Cell("Dock", width_chars=9),
-            "loc": Cell("Localization", width_chars=9),
+            "x": Cell(_("X m"), width_chars=6),
+            "y": Cell(_("Y m"), width_chars=6),
+            "th": Cell(_("Heading"), width_chars=5),
+            "vel": Cell(_("mm/s"), width_chars=5),
+            "rot": Cell(_("deg/s"), width_chars=4),
+            "battery": Cell(_("Battery"), width_chars=6, gauge=self.battery_gauge),
+            "wifi": Cell(_("Wi-Fi"), width_chars=5, gauge=self.wifi_gauge),
+            "mode": Cell(_("Mode · status"), width_chars=6),
+            "safe": Cell(_("Safe"), width_chars=3),
+            "speed": Cell(_("Throttle"), width_chars=5),
+            "link": Cell(_("Link: rtt, age/limit"), width_chars=14),
+            "dock": Cell(_("Dock"), width_chars=9),
+            "loc": Cell(_("Localization"), width_chars=9),
         }
         for cell in self.cells.values():
             self.row.append(cell)
@@ -201,7 +203,7 @@ class StatusToolbar(Gtk.ScrolledWindow):
 
     def _fit_idle(self) -> bool:
         self._fit_source = 0
-        for _ in range(2 * len(HIDE_FIRST)):  # measuring is immediate: settle in one go
+        for _round in range(2 * len(HIDE_FIRST)):  # measuring is immediate: settle in one go
             if not self.fit():
                 break
         return False
@@ -251,11 +253,11 @@ class StatusToolbar(Gtk.ScrolledWindow):
         stale = not have or not link_ok or (age is not None and age > STALE_AFTER)
         why = _stale_reason(have, age, conn, health.level)
         c = self.cells
-        c["x"].show_value(f"{robot.x / 1000:.2f}" if have else DASH, stale=stale, tooltip=why)
-        c["y"].show_value(f"{robot.y / 1000:.2f}" if have else DASH, stale=stale, tooltip=why)
+        c["x"].show_value(number(robot.x / 1000, 2) if have else DASH, stale=stale, tooltip=why)
+        c["y"].show_value(number(robot.y / 1000, 2) if have else DASH, stale=stale, tooltip=why)
         c["th"].show_value(heading_text(robot.th) if have else DASH, stale=stale, tooltip=why)
-        c["vel"].show_value(f"{robot.vel:.0f}" if have else DASH, stale=stale, tooltip=why)
-        c["rot"].show_value(f"{robot.rot_vel:.0f}" if have else DASH, stale=stale, tooltip=why)
+        c["vel"].show_value(number(robot.vel) if have else DASH, stale=stale, tooltip=why)
+        c["rot"].show_value(number(robot.rot_vel) if have else DASH, stale=stale, tooltip=why)
         self._battery(robot, stale, why)
         self._wifi(robot, have and link_ok, why)
         strings_known = robot.strings_at is not None and (robot.mode or robot.status)
@@ -264,22 +266,26 @@ class StatusToolbar(Gtk.ScrolledWindow):
         mode_tip = "\n".join([robot.extended_status or mode, *details_lines(robot, nav)])
         mode += goal_suffix(nav)
         if outcome_status(nav) and not nav.navigating:
-            mode_tip += "\nLast navigation: " + outcome_status(nav)
+            mode_tip += "\n" + _("Last navigation: {outcome}").format(outcome=outcome_status(nav))
         c["mode"].show_value(
             mode if strings_known else DASH,
             stale=not strings_known or not link_ok,
             tooltip=(why + "\n" if why and strings_known else "") + mode_tip if strings_known else why,
         )
         if robot.safe_drive is None:
-            c["safe"].show_value(DASH, stale=True, tooltip="The server has not said whether safe drive is on")
+            c["safe"].show_value(
+                DASH, stale=True, tooltip=_("The server has not said whether safe drive is on")
+            )
         else:
-            c["safe"].show_value("On" if robot.safe_drive else "OFF", stale=not link_ok, tooltip=why)
+            c["safe"].show_value(_("On") if robot.safe_drive else _("OFF"), stale=not link_ok, tooltip=why)
             if robot.safe_drive:
                 c["safe"].remove_css_class("alarm")
             else:
                 c["safe"].add_css_class("alarm")
         c["speed"].show_value(
-            f"{self.operator.speed.value.percent} %", stale=False, tooltip="+ / − to change"
+            _("{percent} %").format(percent=self.operator.speed.value.percent),
+            stale=False,
+            tooltip=_("+ / − to change"),
         )
         self._link(conn, health, age)
         self._dock(robot.dock_state, link_ok)
@@ -298,9 +304,9 @@ class StatusToolbar(Gtk.ScrolledWindow):
             (cell.add_css_class if cls == level else cell.remove_css_class)(f"loc-{cls}")
         if level is not None:
             text = loc_text(state, score)
-            tip = f"Localization: {text} (getLocState)"
+            tip = _("Localization: {state} (getLocState)").format(state=text)
             if level == "lost":
-                tip += ": the robot does not know where it is — Go to › Set robot position"
+                tip += _(": the robot does not know where it is — Go to › Set robot position")
             cell.show_value(text, stale=not live, tooltip=tip, words=level)
 
     def _dock(self, state: str | None, live: bool) -> None:
@@ -310,7 +316,9 @@ class StatusToolbar(Gtk.ScrolledWindow):
             cell.set_visible(False)
             return
         cell.set_visible(True)
-        cell.show_value(state, stale=not live, tooltip=f"Docking state: {state} (dockInfo)")
+        cell.show_value(
+            state, stale=not live, tooltip=_("Docking state: {state} (dockInfo)").format(state=state)
+        )
 
     def _age(self, now: float) -> float | None:
         numbers_at = self.model.robot.value.numbers_at
@@ -322,21 +330,26 @@ class StatusToolbar(Gtk.ScrolledWindow):
     def _battery(self, robot, stale: bool, why: str | None) -> None:
         cell = self.cells["battery"]
         if robot.battery_v is None:
-            cell.show_value(DASH, stale=True, tooltip=why or "No battery reading")
+            cell.show_value(DASH, stale=True, tooltip=why or _("No battery reading"))
             self.battery_gauge.set_level(0.0, "unknown")
             return
-        unit = "%" if robot.battery_is_soc else "V"
-        text = f"{robot.battery_v:.0f} %" if robot.battery_is_soc else f"{robot.battery_v:.1f} V"
+        soc = robot.battery_is_soc
+        text = (
+            _("{percent} %").format(percent=number(robot.battery_v))
+            if soc
+            else _("{volts} V").format(volts=number(robot.battery_v, 1))
+        )
         state = robot.battery_state
         levels = []
         if robot.battery_low is not None:
-            levels.append(f"low at {robot.battery_low:g} {unit}")
+            low = _battery_value(robot.battery_low, soc)
+            levels.append(_("low at {value}").format(value=low))
         if robot.battery_shutdown is not None:
-            levels.append(f"shutdown at {robot.battery_shutdown:g} {unit}")
-        tip = {"low": "Battery LOW", "critical": "Battery at SHUTDOWN level"}.get(state, "Battery")
+            levels.append(_("shutdown at {value}").format(value=_battery_value(robot.battery_shutdown, soc)))
+        tip = {"low": _("Battery LOW"), "critical": _("Battery at SHUTDOWN level")}.get(state, _("Battery"))
         tip += f" ({', '.join(levels)})" if levels else ""
-        words = {"low": "low", "critical": "at shutdown level"}.get(state, "")
-        mark = "" if stale else {"low": "LOW", "critical": "SHUTDOWN"}.get(state, "")
+        words = {"low": _("low"), "critical": _("at shutdown level")}.get(state, "")
+        mark = "" if stale else {"low": _("LOW"), "critical": _("SHUTDOWN")}.get(state, "")
         cell.show_value(text, stale=stale, tooltip=(why + "\n" + tip) if why else tip, words=words, mark=mark)
         for cls in ("low", "critical"):
             if cls == state and not stale:
@@ -350,73 +363,104 @@ class StatusToolbar(Gtk.ScrolledWindow):
         cell = self.cells["wifi"]
         q, s = robot.wifi_quality, robot.wifi_signal
         if q is None and s is None:
-            cell.show_value(DASH, stale=True, tooltip="The server does not publish Wi-Fi quality or signal")
+            cell.show_value(
+                DASH, stale=True, tooltip=_("The server does not publish Wi-Fi quality or signal")
+            )
             self.wifi_gauge.set_bars(0, False)
             return
-        text = f"{q} %" if q is not None else f"{s} dBm"
-        parts = [f"quality {q} %" if q is not None else "", f"signal {s} dBm" if s is not None else ""]
-        tip = "Wi-Fi " + ", ".join(p for p in parts if p)
+        text = _("{percent} %").format(percent=q) if q is not None else _("{dbm} dBm").format(dbm=s)
+        parts = [
+            _("quality {percent} %").format(percent=q) if q is not None else "",
+            _("signal {dbm} dBm").format(dbm=s) if s is not None else "",
+        ]
+        tip = _("Wi-Fi {readings}").format(readings=", ".join(p for p in parts if p))
         cell.show_value(text, stale=not live, tooltip=(why + "\n" + tip) if why and not live else tip)
         self.wifi_gauge.set_bars(wifi_bars(q, s), live)
 
     def _link(self, conn: ConnectionState, health, age: float | None) -> None:
         cell = self.cells["link"]
         if conn.phase is not Phase.CONNECTED:
-            text = {Phase.CONNECTING: "connecting", Phase.RECONNECTING: "reconnecting"}.get(
-                conn.phase, "down"
+            text = (
+                phase_word(conn.phase)
+                if conn.phase in (Phase.CONNECTING, Phase.RECONNECTING)
+                else level_word(LinkLevel.DOWN)
             )
             cell.show_value(
-                text, stale=True, tooltip=f"Not connected ({conn.phase.value})", words="not connected"
+                text,
+                stale=True,
+                tooltip=_("Not connected ({phase})").format(phase=phase_word(conn.phase)),
+                words=_("not connected"),
             )
             cell.show_level(f"link-{LinkLevel.DOWN.value}")
             return
         rtt = (
             DASH
             if health.rtt_ms is None
-            else f"{health.rtt_ms:.1f} ms"
-            if health.rtt_ms < 10
-            else f"{health.rtt_ms:.0f} ms"
+            else _("{ms} ms").format(ms=number(health.rtt_ms, 1 if health.rtt_ms < 10 else 0))
         )
         age_shown = DASH if age is None else age_text(age)
-        tip = (
-            f"Link {health.level.value}: round trip {rtt}, last status {age_shown} ago, "
-            f"{health.dropped} bad packets dropped"
-        )
+        tip = _(
+            "Link {level}: round trip {rtt}, last status {age} ago, {dropped} bad packets dropped"
+        ).format(level=level_word(health.level), rtt=rtt, age=age_shown, dropped=health.dropped)
         text = f"{rtt} {age_shown}"
         if health.stale_limit is not None:  # the learned limit next to the age it is compared with
-            text = f"{rtt} {DASH if age is None else f'{age:.1f}'}/{health.stale_limit:.2f}"
-            tip += (
-                f"\nStale after {health.stale_limit:.2f} s without status: learned from this link's "
-                f"jitter ({health.jitter_ms or 0:.0f} ms), at most {STATUS_CEILING:.2f} s"
+            text = f"{rtt} {DASH if age is None else number(age, 1)}/{number(health.stale_limit, 2)}"
+            tip += "\n" + _(
+                "Stale after {limit} s without status: learned from this link's jitter ({jitter} ms), "
+                "at most {ceiling} s"
+            ).format(
+                limit=number(health.stale_limit, 2),
+                jitter=number(health.jitter_ms or 0),
+                ceiling=number(STATUS_CEILING, 2),
             )
         if health.ping_failures > 0:
             # The link may look alive (status still arriving) while the server no longer hears us.
-            text = f"no ping ×{health.ping_failures}"
+            text = _("no ping ×{count}").format(count=health.ping_failures)
             tip = (
-                f"Server not answering pings ({health.ping_failures} in a row): it may not hear our "
-                f"commands; driving is stopped\n{tip}"
+                ngettext(
+                    "Server not answering pings ({count} in a row): it may not hear our commands; "
+                    "driving is stopped",
+                    "Server not answering pings ({count} in a row): it may not hear our commands; "
+                    "driving is stopped",
+                    health.ping_failures,
+                ).format(count=health.ping_failures)
+                + "\n"
+                + tip
             )
         cell.show_value(
             text,
             stale=health.level is not LinkLevel.OK or health.ping_failures > 0,
             tooltip=tip,
-            words=f"link {health.level.value}",
-            mark="" if health.level is LinkLevel.OK else health.level.value.upper(),
+            words=_("link {level}").format(level=level_word(health.level)),
+            mark="" if health.level is LinkLevel.OK else level_word(health.level).upper(),
         )
         cell.show_level(f"link-{health.level.value}")
 
 
+def _battery_value(value: float, soc: bool) -> str:
+    """A battery threshold with its unit: a charge in per cent or a voltage."""
+    return (
+        _("{percent} %").format(percent=number(value))
+        if soc
+        else _("{volts} V").format(volts=number(value, 1))
+    )
+
+
 def _stale_reason(have: bool, age: float | None, conn: ConnectionState, level: LinkLevel) -> str | None:
     if conn.phase is not Phase.CONNECTED:
-        return f"Not connected: the last known values ({conn.phase.value})" if have else "Not connected"
+        return (
+            _("Not connected: the last known values ({phase})").format(phase=phase_word(conn.phase))
+            if have
+            else _("Not connected")
+        )
     if not have:
-        return "No status from the robot yet"
+        return _("No status from the robot yet")
     if level is not LinkLevel.OK:
         return (
-            f"Link {level.value}: no fresh status for {age_text(age)}"
+            _("Link {level}: no fresh status for {age}").format(level=level_word(level), age=age_text(age))
             if age is not None
-            else f"Link {level.value}"
+            else _("Link {level}").format(level=level_word(level))
         )
     if age is not None and age > STALE_AFTER:
-        return f"No update for {age_text(age)}"
+        return _("No update for {age}").format(age=age_text(age))
     return None

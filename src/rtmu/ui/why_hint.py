@@ -22,6 +22,7 @@ import gi
 gi.require_version("Gtk", "4.0")
 from gi.repository import GLib  # noqa: E402
 
+from ..base.i18n import _  # noqa: E402
 from ..client.why import StillWhileHeld  # noqa: E402
 from ..client.why_values import Answer  # noqa: E402
 from ..control.held_drive import ratios_for  # noqa: E402
@@ -30,6 +31,7 @@ from ..model.observables import Phase, RobotModel  # noqa: E402
 from ..values.intents import AskWhy  # noqa: E402
 from .banners import BannerStack  # noqa: E402
 from .keys import KeyRouter  # noqa: E402
+from .state_words import sentence_words  # noqa: E402
 
 TOPIC = "why"
 """The banner topic of the hint (one banner, replaced by the next hint)."""
@@ -100,8 +102,10 @@ class WhyHint:
         if self.context.model.robot.value.moving:
             return False  # it moves now: nothing to tell
         if answer.can_move:
-            text = "The robot does not move, and nothing RTMU can read says why. Why won't it move? (?)"
+            text = _("The robot does not move, and nothing RTMU can read says why. Why won't it move? (?)")
         else:
-            text = f"Not moving: {answer.sentence()} — Why won't it move? (?) has the details."
+            text = _("Not moving: {sentence} — Why won't it move? (?) has the details.").format(
+                sentence=sentence_words(answer.sentence())
+            )
         self.banners.tell(TOPIC, "warning", text, timeout=SHOWN_FOR)
         return False

@@ -25,22 +25,24 @@ import gi
 gi.require_version("Gtk", "4.0")
 from gi.repository import GLib, Gtk  # noqa: E402
 
+from ..base.i18n import N_, _  # noqa: E402
 from ..base.textsafe import visible  # noqa: E402
 from ..client.why_values import Answer, Fix  # noqa: E402
 from ..control.intent_rules import FIX_WORDS  # noqa: E402
 from ..values.intents import ApplyFix, AskWhy, Intent  # noqa: E402
 from .confirm_bar import ConfirmBar  # noqa: E402
+from .state_words import sentence_words  # noqa: E402
 
 Request = Callable[[Intent], "concurrent.futures.Future[Any]"]
 MAX_SHOWN = 600
 """Characters of one server-made text shown (a hostile server's words are bounded)."""
 FIX_BUTTONS = {
-    "unlock": "Ask the mode to unlock…",
-    "undock": "Undock…",
-    "stop": "Stop the navigation…",
-    "safe_drive_off": "Switch safe drive off…",
-    "acknowledge_faults": "Acknowledge the faults…",
-    "enable_motors": "Enable the motors…",
+    "unlock": N_("Ask the mode to unlock…"),
+    "undock": N_("Undock…"),
+    "stop": N_("Stop the navigation…"),
+    "safe_drive_off": N_("Switch safe drive off…"),
+    "acknowledge_faults": N_("Acknowledge the faults…"),
+    "enable_motors": N_("Enable the motors…"),
 }
 
 
@@ -54,10 +56,10 @@ def answer_details(answer: Answer) -> str:
     lines: list[str] = []
     first = answer.primary
     if first is not None and first.evidence:
-        lines.append("Read from: " + "; ".join(_short(e) for e in first.evidence[:6]))
+        lines.append(_("Read from: ") + "; ".join(_short(e) for e in first.evidence[:6]))
     for reason in answer.reasons[1:6]:
-        lines.append(("⚠ " if reason.loud else "Also: ") + _short(reason.sentence()))
-    lines += [f"Note: {_short(n)}" for n in answer.notes[:6]]
+        lines.append(("⚠ " if reason.loud else _("Also: ")) + _short(sentence_words(reason.sentence())))
+    lines += [_("Note: {short}").format(short=_short(n)) for n in answer.notes[:6]]
     lines += [_short(v.text()) for v in answer.raw[:10]]
     return "\n".join(lines)
 
@@ -65,8 +67,10 @@ def answer_details(answer: Answer) -> str:
 def confirm_question(fix: Fix) -> str:
     """What the confirmation says: the fix in words, what is sent, and why a yes is asked."""
     risk = FIX_WORDS.get(fix.key, "")
-    warn = f" Careful: {risk}." if risk else ""
-    return f"{_short(fix.label)}. RTMU will send {fix.sends} to the robot.{warn} Go ahead?"
+    warn = _(" Careful: {risk}.").format(risk=risk) if risk else ""
+    return _("{short}. RTMU will send {sends} to the robot.{warn} Go ahead?").format(
+        short=_short(fix.label), sends=fix.sends, warn=warn
+    )
 
 
 class WhyWindow(Gtk.Window):
@@ -74,7 +78,7 @@ class WhyWindow(Gtk.Window):
 
     def __init__(self, parent: Gtk.Window | None, request: Request, question: Callable[[], AskWhy]) -> None:
         super().__init__(
-            title="Why won't it move?", transient_for=parent, modal=False, destroy_with_parent=True
+            title=_("Why won't it move?"), transient_for=parent, modal=False, destroy_with_parent=True
         )
         self.set_default_size(560, 300)
         self._request, self._question = request, question
@@ -99,9 +103,9 @@ class WhyWindow(Gtk.Window):
         buttons = Gtk.Box(spacing=6, halign=Gtk.Align.END)
         self.fix_button = Gtk.Button(visible=False)
         self.fix_button.connect("clicked", lambda _b: self._offer_fix())
-        self.again_button = Gtk.Button(label="Ask again")
+        self.again_button = Gtk.Button(label=_("Ask again"))
         self.again_button.connect("clicked", lambda _b: self.ask())
-        close = Gtk.Button(label="Close")
+        close = Gtk.Button(label=_("Close"))
         close.connect("clicked", lambda _b: self.close())
         for button in (self.fix_button, self.again_button, close):
             buttons.append(button)
@@ -120,7 +124,7 @@ class WhyWindow(Gtk.Window):
             return
         self.asking = True
         self.confirm.cancel()
-        self.status.set_text("Asking the robot…")
+        self.status.set_text(_("Asking the robot…"))
         future = self._request(self._question())
         future.add_done_callback(lambda f: GLib.idle_add(self._answered, f))
 
@@ -134,7 +138,7 @@ class WhyWindow(Gtk.Window):
             return False
         error = None if future.cancelled() else future.exception()
         if future.cancelled() or error is not None:
-            self.status.set_text(f"No answer: {_short(str(error or 'cancelled'))}")
+            self.status.set_text(_("No answer: {short}").format(short=_short(str(error or "cancelled"))))
             return False
         self.show_answer(future.result())
         self.status.set_text("")
@@ -142,25 +146,27 @@ class WhyWindow(Gtk.Window):
 
     def show_answer(self, answer: Answer) -> None:
         self.answer = answer
-        sentence = _short(answer.sentence())
+        sentence = _short(sentence_words(answer.sentence()))  # problem — advice, each part translated
         self.sentence.set_text(sentence[:1].upper() + sentence[1:])
         self.details.set_text(answer_details(answer))
         first = answer.primary
         self.fix = first.fix if first is not None else None
         self.fix_button.set_visible(self.fix is not None)
         if self.fix is not None:
-            self.fix_button.set_label(FIX_BUTTONS.get(self.fix.key, f"{self.fix.key}…"))
+            self.fix_button.set_label(
+                _(FIX_BUTTONS[self.fix.key]) if self.fix.key in FIX_BUTTONS else f"{self.fix.key}…"
+            )
 
     # -- fixing -------------------------------------------------------------------------------------
     def _offer_fix(self) -> None:
         fix = self.fix
         if fix is None or self.asking:
             return
-        self.confirm.ask(confirm_question(fix), "Yes, send it", lambda: self._apply(fix))
+        self.confirm.ask(confirm_question(fix), _("Yes, send it"), lambda: self._apply(fix))
 
     def _apply(self, fix: Fix) -> None:
         self.asking = True
-        self.status.set_text(f"Sending {fix.sends}…")
+        self.status.set_text(_("Sending {sends}…").format(sends=fix.sends))
         navigate = self._question().navigate
         future = self._request(ApplyFix(key=fix.key, confirmed=True, navigate=navigate))
         future.add_done_callback(lambda f: GLib.idle_add(self._fixed, f))
@@ -171,7 +177,7 @@ class WhyWindow(Gtk.Window):
             return False
         error = None if future.cancelled() else future.exception()
         if future.cancelled() or error is not None:
-            self.status.set_text(f"Not done: {_short(str(error or 'cancelled'))}")
+            self.status.set_text(_("Not done: {short}").format(short=_short(str(error or "cancelled"))))
             return False
         report = future.result()
         self.show_answer(report.answer)

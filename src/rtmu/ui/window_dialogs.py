@@ -21,6 +21,7 @@ import gi
 gi.require_version("Gtk", "4.0")
 from gi.repository import GLib, Gtk  # noqa: E402
 
+from ..base.i18n import _  # noqa: E402
 from ..client.custom_commands import CustomCommand  # noqa: E402
 from ..fleet.selected import SelectedRobot  # noqa: E402
 from ..fleet.sessions import RobotSession  # noqa: E402
@@ -119,7 +120,10 @@ class WindowDialogs:
         self._profile_changed()
         if changed and self.model.connection.value.phase is not Phase.DISCONNECTED:
             self.banners.tell(
-                "notice:saved", "info", f"Saved “{profile.name}”: reconnect to use it", timeout=4.0
+                "notice:saved",
+                "info",
+                _("Saved “{name}”: reconnect to use it").format(name=profile.name),
+                timeout=4.0,
             )
 
     def ask_password(self, profile: Profile, answer: Callable[[str | None], None]) -> None:
@@ -230,7 +234,7 @@ class WindowDialogs:
         def done(future: concurrent.futures.Future[bool]) -> None:
             if future.cancelled() or future.exception() is not None:
                 return  # the runner already raised a Kind.COMMAND notice with the reason
-            said = "taken by the server" if future.result() else "sent; the server did not answer"
+            said = _("taken by the server") if future.result() else _("sent; the server did not answer")
             GLib.idle_add(self._tell_once, "server-command", f"{command.name}: {said}")
 
         self.request(RunServerCommand(command.name, argument, command.takes_argument)).add_done_callback(done)

@@ -1,0 +1,291 @@
+"""The window in the pseudo-locale: no visible word escapes translation and nothing is pushed out.
+
+The pseudo-locale (``en_XA``) is made by the tooling (``scripts/i18n.py``) from the sources' marked
+strings now — every letter accented, every string 30 % or more longer and in brackets — compiled into a
+scratch directory and chosen for this test only. The real window is opened on the simulator on a
+screen of 800×480 and one of 360×720; every mapped widget's words (labels, buttons, tooltips, entry
+hints) and every row of the main menu are read: a plain ASCII letter outside the robot's own words
+(its mode and status, map, goals, commands, name and address: shown as sent) is a string that escaped
+translation. A widget the longer words push out of the window fails the test too.
+"""
+
+from __future__ import annotations
+
+import re
+from collections.abc import Iterator
+from pathlib import Path
+
+import gi
+import pytest
+
+from i18n_tooling import tooling
+from rtmu.base import i18n
+from rtmu.sim import SimThread
+
+from .conftest import _spawn_xvfb, _terminate
+from .harness import Gui, idle, pump
+from .test_handheld_window import clipped_widgets, open_on
+
+gi.require_version("Gtk", "4.0")
+from gi.repository import Gio, Gtk  # noqa: E402
+
+LETTER = re.compile(r"[A-Za-z]")
+GTK_OWN = ["Show Text", "Hide Text", "About", "License", "System", "Website", "Credits"]
+"""GTK's own words (its password entry's eye, its About dialog's pages), translated by GTK's catalogue."""
+PRODUCT = ["RTMU"]
+"""The program's name, the same in every language."""
+
+
+@pytest.fixture(scope="module")
+def pseudo_catalogue(tmp_path_factory: pytest.TempPathFactory) -> Path:
+    """The pseudo-locale, made from the sources' strings once for this module."""
+    return Path(tooling.compile_pseudo(tmp_path_factory.mktemp("pseudo-locale")))
+
+
+@pytest.fixture
+def pseudo_locale(pseudo_catalogue: Path) -> Iterator[None]:
+    """This test reads the pseudo-locale (and the next one whatever it chooses)."""
+    i18n.use([tooling.PSEUDO], pseudo_catalogue)
+    assert i18n._("Battery") != "Battery", "the pseudo-locale does not translate"
+    try:
+        yield
+    finally:
+        i18n.use(["en"])
+
+
+@pytest.fixture
+def german() -> Iterator[None]:
+    i18n.use(["de"])
+    try:
+        yield
+    finally:
+        i18n.use(["en"])
+
+
+@pytest.fixture(scope="module")
+def phone_screen() -> Iterator[str]:
+    proc, display = _spawn_xvfb("360x720")
+    if display is None:
+        pytest.fail("an Xvfb of 360x720 did not start")
+    try:
+        yield display
+    finally:
+        _terminate(proc)
+
+
+def widget_words(widget: Gtk.Widget) -> Iterator[tuple[str, str]]:
+    """(where, text) for every mapped widget under ``widget``: its text, its tooltip, its hint."""
+    child = widget.get_first_child()
+    while child is not None:
+        if child.get_mapped():
+            where = f"{type(child).__name__}.{'.'.join(child.get_css_classes())}"
+            if isinstance(child, Gtk.Label):
+                yield where, child.get_text()
+            if isinstance(child, Gtk.Text | Gtk.Entry):
+                yield where + " hint", child.get_placeholder_text() or ""
+            yield where + " tooltip", child.get_tooltip_text() or ""
+            yield from widget_words(child)
+        child = child.get_next_sibling()
+
+
+def menu_words(model: Gio.MenuModel) -> Iterator[tuple[str, str]]:
+    for i in range(model.get_n_items()):
+        label = model.get_item_attribute_value(i, "label", None)
+        if label is not None:
+            yield "menu row", label.get_string()
+        for link in (Gio.MENU_LINK_SECTION, Gio.MENU_LINK_SUBMENU):
+            inner = model.get_item_link(i, link)
+            if inner is not None:
+                yield from menu_words(inner)
+
+
+def server_words(gui: Gui, sim: SimThread) -> list[str]:
+    """What the robot's server says in its own words: shown as sent, never translated."""
+    robot = gui.model.robot.value
+    words = [robot.mode, robot.status, robot.extended_status or ""]
+    map_name = gui.model.map.value.name
+    words += [map_name, Path(map_name.replace("\\", "/")).name, sim.call(lambda: sim.server.robot.mode_name)]
+    words += ["127.0.0.1", str(sim.port), "ws://127.0.0.1:8765", *GTK_OWN]
+    return sorted({w for w in words if w}, key=len, reverse=True)
+
+
+def goal_names(gui: Gui) -> list[str]:
+    """The map's goals and routes: the server's names."""
+    data = gui.model.map.value.data
+    names = [o.name for o in data.objects if o.name] if data is not None else []
+    return sorted(set(names), key=len, reverse=True)
+
+
+def escaped(texts: Iterator[tuple[str, str]], allowed: list[str]) -> list[str]:
+    out = []
+    for where, text in texts:
+        rest = text
+        for word in allowed:
+            rest = rest.replace(word, "")
+        rest = re.sub(r"\d+(?:[.,]\d+)*", "", rest)
+        if LETTER.search(rest):
+            out.append(f"{where}: {text!r}")
+    return sorted(set(out))
+
+
+def check_window(gui: Gui, sim: SimThread, name: str) -> None:
+    window = gui.window
+    gui.wait_connected()
+    pump(lambda: gui.model.robot.value.numbers_at is not None, 10, "the robot's first status")
+    pump(lambda: bool(gui.model.map.value.name), 20, "the map")
+    idle(0.5)
+    gui.shot(name)
+    allowed = server_words(gui, sim)
+    problems = escaped(widget_words(window), allowed)
+    model = window.menu_button.get_menu_model()
+    assert model is not None
+    problems += escaped(menu_words(model), allowed)
+    assert problems == [], "words that escaped translation:\n" + "\n".join(problems)
+    assert clipped_widgets(window) == []
+    # The header's Go to list and the connection dialog: surfaces of their own.
+    goals = window.goals_panel
+    pump(goals.get_mapped, 5, "the Go to button (the simulator navigates)")
+    gui.click(goals)
+    popover = goals.get_popover()
+    pump(lambda: popover is not None and popover.get_mapped(), 3, "the Go to list")
+    idle(0.3)
+    gui.screen_shot(f"{name}-goto")
+    problems = escaped(widget_words(popover), allowed + goal_names(gui))
+    popover.popdown()
+    pump(lambda: not popover.get_mapped(), 3, "the Go to list to close")
+    assert problems == [], "words that escaped translation in the Go to list:\n" + "\n".join(problems)
+    window.activate_action("win.settings", None)
+    pump(
+        lambda: window.dialogs.settings is not None and window.dialogs.settings.get_mapped(), 5, "the dialog"
+    )
+    dialog = window.dialogs.settings
+    assert dialog is not None
+    idle(0.3)
+    gui.screen_shot(f"{name}-dialog")
+    problems = escaped(widget_words(dialog), allowed)
+    clipped = clipped_widgets(dialog)
+    dialog.close()
+    assert problems == [], "words that escaped translation in the dialog:\n" + "\n".join(problems)
+    assert clipped == []
+
+
+def test_the_800x480_window_is_translated_everywhere_and_nothing_is_clipped(
+    pseudo_locale: None, screenshots: Path, small_screen: str, request: pytest.FixtureRequest
+) -> None:
+    for gui, sim in open_on(small_screen, screenshots, request.node.name):
+        check_window(gui, sim, "pseudo-800x480")
+
+
+def test_the_360x720_phone_window_is_translated_everywhere_and_nothing_is_clipped(
+    pseudo_locale: None, screenshots: Path, phone_screen: str, request: pytest.FixtureRequest
+) -> None:
+    for gui, sim in open_on(phone_screen, screenshots, request.node.name):
+        check_window(gui, sim, "pseudo-360x720")
+
+
+def check_german(gui: Gui, name: str) -> None:
+    gui.wait_connected()
+    pump(lambda: gui.model.robot.value.numbers_at is not None, 10, "the robot's first status")
+    idle(0.5)
+    gui.shot(name)
+    shown = {text for _where, text in widget_words(gui.window)}
+    assert {"STOPP", "Trennen"} <= shown, sorted(shown)
+    assert clipped_widgets(gui.window) == []
+
+
+@pytest.mark.parametrize("screen", ["small_screen", "phone_screen"])
+def test_the_german_window_fits_both_screens(
+    german: None, screenshots: Path, screen: str, request: pytest.FixtureRequest
+) -> None:
+    """The shipped German, longer than English, on the two smallest screens: nothing pushed out."""
+    for gui, _sim in open_on(request.getfixturevalue(screen), screenshots, request.node.name):
+        check_german(gui, f"german-{screen}")
+
+
+SURFACES = ("why", "details", "server-config", "files", "console", "scan", "map-edit", "about")
+"""The window's own windows and dialogs, each opened by its action (Server ▸ …, View ▸ …, Help ▸ …)."""
+
+
+def surface_server_words(gui: Gui) -> list[str]:
+    """The server's own words a surface shows: its data list (names, groups, descriptions) in the
+    console, its configuration (sections, parameters, comments, values) in the configuration page."""
+    words: list[str] = [*PRODUCT]
+    robot = gui.model.robot.value
+    words += [str(part) for pair in robot.server_strings for part in pair]
+    words += [str(part) for pair in robot.data_store for part in pair]
+    dialogs = gui.window.dialogs
+    for entry in getattr(dialogs.console, "entries", None) or ():
+        d = entry.data
+        words += [d.name, d.command_group, d.description, d.argument_description, d.return_description]
+    config = getattr(getattr(dialogs, "config_page", None), "config", None)
+    for section in config.sections if config is not None else ():
+        words += [section.name, section.comment, section.category]
+        for param in section.params:
+            words += [param.name, param.description, str(param.value)]
+    return [w for w in words if w]
+
+
+def surfaces_words(gui: Gui, sim: SimThread) -> list[str]:
+    """Open each of ``SURFACES``, read what it shows, close it: the words that escaped translation."""
+    window = gui.window
+    gui.wait_connected()
+    pump(lambda: bool(gui.model.map.value.name), 20, "the map")
+    allowed = server_words(gui, sim) + goal_names(gui)
+    problems: list[str] = []
+    for action in SURFACES:
+        before = set(Gtk.Window.list_toplevels())
+
+        def opened(before: set[Gtk.Window] = before) -> list[Gtk.Window]:
+            return [w for w in Gtk.Window.list_toplevels() if w not in before and w.get_mapped()]
+
+        window.activate_action(f"win.{action}", None)
+        pump(lambda: bool(opened()), 5, f"win.{action} to open a window")
+        idle(0.5)
+        for surface in opened():
+            gui.screen_shot(f"pseudo-{action}")
+            own = sorted(set(allowed + surface_server_words(gui)), key=len, reverse=True)
+            problems += [f"{action}: {p}" for p in escaped(widget_words(surface), own)]
+            width, height = surface.get_width(), surface.get_height()
+            screen = surface.get_display().get_monitors().get_item(0).get_geometry()
+            if width > screen.width or height > screen.height:
+                problems.append(
+                    f"{action}: {width}x{height} does not fit the {screen.width}x{screen.height} screen"
+                )
+            surface.close()
+        pump(lambda: not opened(), 5, f"win.{action}'s window to close")
+    return problems
+
+
+def test_every_dialog_of_the_window_is_translated_at_800x480(
+    pseudo_locale: None, screenshots: Path, small_screen: str, request: pytest.FixtureRequest
+) -> None:
+    for gui, sim in open_on(small_screen, screenshots, request.node.name):
+        problems = surfaces_words(gui, sim)
+        assert problems == [], "words that escaped translation:\n" + "\n".join(problems)
+
+
+def test_the_camera_page_is_translated_at_800x480(
+    pseudo_locale: None, screenshots: Path, small_screen: str, request: pytest.FixtureRequest
+) -> None:
+    """The camera page (Esc from the map): its picture, live video and camera head controls."""
+    for gui, sim in open_on(small_screen, screenshots, request.node.name):
+        check_camera_page(gui, sim)
+
+
+def check_camera_page(gui: Gui, sim: SimThread) -> None:
+    window = gui.window
+    gui.wait_connected()
+    pump(lambda: bool(gui.model.map.value.name), 20, "the map")
+    pump(lambda: window.camera_page.button.get_sensitive(), 10, "the camera to be offered")
+    window.activate_action("win.camera", None)
+    pump(lambda: window.camera_page.showing, 5, "the camera page")
+    pump(lambda: gui.model.camera.value is not None, 10, "a picture")
+    idle(0.5)
+    gui.shot("pseudo-camera")
+    image = gui.model.camera.value
+    ptz = gui.model.robot.value.ptz
+    heads = [ptz.display_name, ptz.camera, ptz.camera_type] if ptz is not None else []
+    allowed = [*server_words(gui, sim), image.source if image is not None else "", *(h for h in heads if h)]
+    problems = escaped(widget_words(window), allowed)
+    assert problems == [], "words that escaped translation:\n" + "\n".join(problems)
+    assert clipped_widgets(window) == []
