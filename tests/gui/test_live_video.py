@@ -175,9 +175,11 @@ def test_split_view_shows_map_and_live_video_side_by_side(gui: Gui, sim: SimThre
     assert ok and ok2
     assert pane.get_x() >= stage.get_x() + stage.get_width() - 2, "the video is beside the map"
     assert abs(pane.get_width() - stage.get_width()) < 0.1 * split.get_width()
+    assert not window.inset.get_visible(), "the map's inset repeats the picture shown beside it"
     gui.shot("split")
     window.activate_action("win.split", None)
     pump(lambda: not split.pane.get_visible(), 3, "the pane to close")
+    pump(lambda: window.inset.get_visible(), 3, "the map's inset back without the pane")
     gui.shot("split-off")
 
 

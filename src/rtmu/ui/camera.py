@@ -374,6 +374,9 @@ class CameraInset(Gtk.Box):
         click.connect("released", lambda *_a: on_open())
         self.add_controller(click)
         self.enabled = True
+        self.beside = False
+        """The same picture is on screen beside the map (split view): the inset would only repeat it
+        over a corner of the map."""
         self.set_visible(False)
         self.place(corner_free=True)
         self.fit_to(800)
@@ -384,12 +387,20 @@ class CameraInset(Gtk.Box):
         self.received_at = received_at if texture is not None else None
         if texture is not None:
             self.set_live(True)
-        self.set_visible(self.enabled and texture is not None)
+        self._show()
         self.tick()
 
     def set_enabled(self, on: bool) -> None:
         self.enabled = on
-        self.set_visible(on and self.picture.get_paintable() is not None)
+        self._show()
+
+    def set_beside(self, on: bool) -> None:
+        """Split view on or off: hidden while the picture is shown beside the map."""
+        self.beside = on
+        self._show()
+
+    def _show(self) -> None:
+        self.set_visible(self.enabled and not self.beside and self.picture.get_paintable() is not None)
 
     def set_live(self, live: bool) -> None:
         """False while the link is lost: the picture is greyed, and says so."""

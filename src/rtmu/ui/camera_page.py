@@ -161,6 +161,7 @@ class CameraPage:
     def set_split(self, on: bool) -> None:
         """Map and video side by side: the split starts live video (the pane would show nothing else)."""
         self.split.set_split(on)
+        self.inset.set_beside(on)
         if on and not self.live.live and self._command_state("request_image").enabled:
             self.live.set_live(True)
 
