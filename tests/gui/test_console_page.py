@@ -110,6 +110,40 @@ def test_a_change_asks_first_ratio_drive_never_and_stop_works(gui: Gui, sim: Sim
     gui.render(page, gui.shots / f"{gui.name}-sent.png")
 
 
+def followed_at(sim: SimThread) -> set[str]:
+    server = sim.server
+    assert server is not None
+    return sim.call(lambda: {sub.name for s in server.sessions for sub in s.subscriptions.values()})
+
+
+def test_a_read_is_followed_at_an_interval_until_switched_off_and_a_change_never(
+    gui: Gui, sim: SimThread
+) -> None:
+    page = open_console(gui)
+    pick(gui, page, "SimulatorStallMotors")
+    assert not page.follow_button.get_sensitive(), "a data that changes something must not be followed"
+    pick(gui, page, "update")
+    assert page.follow_button.get_sensitive()
+    type_into(gui, page.interval, "200")
+    pump(lambda: page.interval.get_value() == 200, 3, "the interval typed in")
+    click(gui, page.follow_button)
+    pump(lambda: page.followed >= 3, 10, "three replies of the followed data")
+    assert "update" in followed_at(sim) and not page.interval.get_sensitive()
+    assert " replies, the last at " in page.follow_status.get_text(), page.follow_status.get_text()
+    assert reply(page).startswith("update: "), reply(page)[:200]
+    gui.render(page, gui.shots / f"{gui.name}-following.png")
+    before = stops(sim)
+    gui.key("space")  # the stop key still stops while a data is followed
+    pump(lambda: stops(sim) > before, 5, "Space to stop while following")
+    click(gui, page.follow_button)  # off
+    pump(lambda: "update" not in followed_at(sim), 5, "the server to stop sending it")
+    idle(0.6)
+    seen = page.followed
+    idle(1.0)
+    assert page.followed == seen and page.follow_status.get_text() == "stopped following update"
+    assert page.interval.get_sensitive()
+
+
 def test_hostile_replies_are_shown_bounded(screenshots: Path) -> None:
     with ServerThread(hostile_server()) as server:
         gui = Gui.start(screenshots, "test_console_hostile", "127.0.0.1", server.port)

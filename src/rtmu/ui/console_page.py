@@ -16,27 +16,34 @@ data's name or description is shown), and the network side refuses it again with
 are built (the filter finds the rest), texts are shortened, a reply is at most what the model keeps
 (16 packets × 200 fields) and :data:`MAX_LINES` lines. Its own window, transient for the main one:
 typing here never drives, and Space still stops.
+
+Follow asks for the data picked every N ms (:class:`~rtmu.values.intents.ConsoleFollow`, as
+``rtmu call --every``) and shows each reply as it comes, with their count: the page asks for the next
+batch only when it has shown one (:class:`~rtmu.values.intents.ConsoleNext`), so a fast stream never
+piles up. Only a plain read can be followed; picking another data, another robot or closing the page
+ends the following.
 """
 
 from __future__ import annotations
 
 import concurrent.futures
 import shlex
+import time
 from collections.abc import Callable
 from typing import Any
 
 import gi
 
 gi.require_version("Gtk", "4.0")
-from gi.repository import GLib, Gtk  # noqa: E402
+from gi.repository import GLib, Gtk, Pango  # noqa: E402
 
-from ..base.i18n import _  # noqa: E402
+from ..base.i18n import _, ngettext  # noqa: E402
 from ..base.textsafe import visible  # noqa: E402
 from ..client.console import ConsoleEntry, ConsoleReply  # noqa: E402
 from ..client.console_effect import HELD_MOTION  # noqa: E402
 from ..client.console_layout import describe  # noqa: E402
 from ..client.console_text import effect_words, outcome_line, packet_lines, short  # noqa: E402
-from ..values.intents import ConsoleCall, ConsoleList, Intent  # noqa: E402
+from ..values.intents import ConsoleCall, ConsoleFollow, ConsoleList, ConsoleNext, Intent  # noqa: E402
 from . import accessible  # noqa: E402
 from .confirm_bar import ConfirmBar  # noqa: E402
 
@@ -114,6 +121,10 @@ class ConsolePage(Gtk.Window):
         self.closed = False
         self.replies = 0
         """Replies shown (for tests)."""
+        self.following: str | None = None
+        """The data followed now (its replies shown as they come), or None."""
+        self.followed = 0
+        """Replies of the data followed now."""
         self._build()
         self.connect("close-request", self._closing)
         self.reload()
@@ -151,13 +162,38 @@ class ConsolePage(Gtk.Window):
         arg_parts: tuple[Gtk.Widget, ...] = (self.arguments, self.types, self.call_button)
         for widget in arg_parts:
             args.append(widget)
+        follow = Gtk.Box(spacing=6)
+        self.follow_button = Gtk.ToggleButton(label=_("Follow"), sensitive=False)
+        self.follow_button.set_tooltip_text(
+            _("Ask again at this interval and show each reply (plain reads only)")
+        )
+        self.follow_button.connect("toggled", lambda _b: self._follow_toggled())
+        self.interval = Gtk.SpinButton.new_with_range(100, 60_000, 100)
+        self.interval.set_value(1000)
+        accessible.name(self.interval, _("Follow interval in milliseconds"))
+        every = Gtk.Label(label=_("every"))
+        unit = Gtk.Label(label=_("ms"))
+        self.follow_status = Gtk.Label(xalign=0.0, hexpand=True)
+        self.follow_status.add_css_class("dim-label")
+        self.follow_status.set_ellipsize(Pango.EllipsizeMode.END)  # never widens the page
+        follow_parts: tuple[Gtk.Widget, ...] = (
+            self.follow_button,
+            every,
+            self.interval,
+            unit,
+            self.follow_status,
+        )
+        for widget in follow_parts:
+            follow.append(widget)
         self.status = Gtk.Label(xalign=0.0, wrap=True)
         self.confirm = ConfirmBar()
         self.reply = Gtk.TextView(editable=False, monospace=True, wrap_mode=Gtk.WrapMode.CHAR, vexpand=True)
         accessible.name(self.reply, _("Reply"))
         reply_scroller = Gtk.ScrolledWindow(vexpand=True)
         reply_scroller.set_child(self.reply)
-        right_parts: tuple[Gtk.Widget, ...] = (self.details, args, self.status, self.confirm, reply_scroller)
+        right_parts: tuple[Gtk.Widget, ...] = (
+            self.details, args, follow, self.status, self.confirm, reply_scroller,
+        )  # fmt: skip
         for widget in right_parts:
             right.append(widget)
         paned = Gtk.Paned(orientation=Gtk.Orientation.HORIZONTAL, position=330)
@@ -171,6 +207,7 @@ class ConsolePage(Gtk.Window):
     def robot_switched(self) -> None:
         """Another robot is selected: forget the list, the pick and any question, and read its list."""
         self.confirm.cancel()
+        self.stop_following()
         self.entries, self.shown, self.current = [], [], None
         self._built_for = None
         self.refilter()
@@ -246,14 +283,21 @@ class ConsolePage(Gtk.Window):
 
     def _selected(self, _list: Gtk.ListBox, row: Gtk.ListBoxRow | None) -> None:
         self.confirm.cancel()
+        picked = row.get_index() if row is not None else -1
+        if self.following is not None and not (
+            0 <= picked < len(self.shown) and self.shown[picked].name == self.following
+        ):
+            self.stop_following()
         if row is None or not 0 <= row.get_index() < len(self.shown):
             self.current = None
             self.call_button.set_sensitive(False)
+            self.follow_button.set_sensitive(False)
             return
         self.current = entry = self.shown[row.get_index()]
         self.details.set_text(entry_details(entry))
         held = entry.name in HELD_MOTION
         self.call_button.set_sensitive(not held)
+        self.follow_button.set_sensitive(not held and not entry.changes)
         self.call_button.set_label(_("Call once…") if entry.changes else _("Call once"))
         self.status.set_text(
             _("{name} is never sent from the console: held motion comes only from a held drive").format(
@@ -324,6 +368,78 @@ class ConsolePage(Gtk.Window):
         self.replies += 1
         return False
 
+    # -- following -------------------------------------------------------------------------------------
+    def _follow_toggled(self) -> None:
+        on = self.follow_button.get_active()
+        entry = self.current
+        if not on:
+            self.stop_following()
+            return
+        if self.following is not None or entry is None or entry.changes or entry.name in HELD_MOTION:
+            return
+        try:
+            arguments = tuple(shlex.split(self.arguments.get_text()))
+        except ValueError as exc:
+            self.status.set_text(_("Arguments: {exc}").format(exc=exc))
+            self.follow_button.set_active(False)
+            return
+        types = tuple(t.strip() for t in self.types.get_text().split(",") if t.strip())
+        interval = int(self.interval.get_value())
+        self.following, self.followed = entry.name, 0
+        self.interval.set_sensitive(False)
+        self.follow_status.set_text(_("following {name} every {ms} ms…").format(name=entry.name, ms=interval))
+        intent = ConsoleFollow(name=entry.name, interval_ms=interval, arguments=arguments, types=types)
+        future = self._request(intent)
+        robot = self._robot
+        future.add_done_callback(lambda f: GLib.idle_add(self._follow_started, f, entry.name, robot))
+
+    def _follow_started(self, future: concurrent.futures.Future[Any], name: str, robot: int) -> bool:
+        if self.closed or self.following != name or robot != self._robot:
+            return False
+        error = None if future.cancelled() else future.exception()
+        if error is not None or future.cancelled() or future.result() != name:
+            why = visible(short(str(error or _("the server did not take it")), 300))
+            self.stop_following()
+            self.follow_status.set_text(_("Not followed: {why}").format(why=why))
+            return False
+        self._ask_next(name, robot)
+        return False
+
+    def _ask_next(self, name: str, robot: int) -> None:
+        future = self._request(ConsoleNext(name=name, wait=2.0))
+        future.add_done_callback(lambda f: GLib.idle_add(self._follow_replies, f, name, robot))
+
+    def _follow_replies(self, future: concurrent.futures.Future[Any], name: str, robot: int) -> bool:
+        if self.closed or self.following != name or robot != self._robot:
+            return False
+        if future.cancelled() or future.exception() is not None:
+            self.stop_following()
+            return False
+        batch: tuple[ConsoleReply, ...] = future.result()
+        if batch:
+            self.followed += len(batch)
+            self.replies += len(batch)
+            self.reply.get_buffer().set_text(reply_text(batch[-1]))
+            self.follow_status.set_text(
+                ngettext(
+                    "{count} reply, at {time}", "{count} replies, the last at {time}", self.followed
+                ).format(count=self.followed, time=time.strftime("%H:%M:%S"))
+            )
+        self._ask_next(name, robot)  # the next batch only now that this one is shown
+        return False
+
+    def stop_following(self) -> None:
+        """End the following (if any): the network side unsubscribes."""
+        name, self.following = self.following, None
+        self.interval.set_sensitive(True)
+        if self.follow_button.get_active():
+            self.follow_button.set_active(False)
+        if name is not None:
+            self.follow_status.set_text(_("stopped following {name}").format(name=name))
+            if not self.closed:
+                self._request(ConsoleFollow(name=name, on=False))
+
     def _closing(self, *_a: object) -> bool:
+        self.stop_following()
         self.closed = True
         return False
