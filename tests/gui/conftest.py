@@ -198,6 +198,18 @@ def screenshots() -> Path:
 
 
 @pytest.fixture(scope="session")
+def phone_screen() -> Iterator[str]:
+    """An X server whose only screen is a 360×720 portrait phone: ':N'."""
+    proc, display = _spawn_xvfb("360x720")
+    if display is None:
+        pytest.fail("an Xvfb of 360x720 did not start")
+    try:
+        yield display
+    finally:
+        _terminate(proc)
+
+
+@pytest.fixture(scope="session")
 def small_screen() -> Iterator[str]:
     """A second X server whose only screen is 800×480 (the smallest the window is made for): ':N'."""
     proc, display = _spawn_xvfb("800x480")

@@ -21,6 +21,8 @@ import re
 import subprocess
 import sys
 import time
+from collections.abc import Iterator
+from contextlib import contextmanager
 from pathlib import Path
 from typing import Any
 
@@ -96,7 +98,10 @@ def test_a_control_without_a_name_is_found(tmp_path: Path) -> None:
     assert any(n["role"] == "push button" and n["name"] == "Up" for n in nodes)
 
 
-def test_every_control_has_a_name_and_the_map_says_where_the_robot_is(tmp_path: Path) -> None:
+@contextmanager
+def window_on_its_bus(tmp_path: Path) -> Iterator[tuple[subprocess.Popen[str], dict[str, str], SimThread]]:
+    """``rtmu`` as a process on an accessibility bus of its own, connected to a simulator: (process,
+    the environment a reader needs, the simulator); all of it ended after."""
     _skip_or_fail()
     with (
         SimThread(SimConfig(port=0, map_path=OFFICE_MAP, seed=1)) as sim,
@@ -112,48 +117,51 @@ def test_every_control_has_a_name_and_the_map_says_where_the_robot_is(tmp_path: 
             wait(
                 lambda: sim.call(lambda: any(s.subscriptions for s in sim.server.sessions)), 30, "subscribed"
             )
-            nodes = read_tree(proc.pid, env, *OPENED)
-            for _attempt in range(20):  # a busy machine: the D-pad and the dialog may come a little later
-                shown = {n["name"] for n in nodes}
-                if {"Forward", "Host", "Show up to", "Call once"} <= shown and any(
-                    n["role"] == "spin button" for n in nodes
-                ):
-                    break
-                time.sleep(1.0)
-                nodes = read_tree(proc.pid, env)
-            assert len(nodes) > 100, f"a tree this small is not the window's: {nodes[:3]}"
-            assert not unnamed_controls(nodes), "\n".join(unnamed_controls(nodes))
-            names = {(n["role"], n["name"]) for n in nodes}
-            for pad in ("Forward", "Turn left", "Turn right", "Backward", "Stop"):
-                assert ("push button", pad) in names, f"the D-pad's {pad} is not a named button"
-            assert ("push button", "STOP") in names
-            assert ("level bar", "Battery level") in names
-            assert ("text", "Host") in names  # the settings dialog's fields say what they are
-            (stage,) = [n for n in nodes if n["role"] == "image" and n["name"] == "Map"]
-            before = stage["description"]
-            for words in ("Robot at x", "heading", "mode", "battery", "volts", "standing still"):
-                assert words in before, before
-
-            # The robot moves 2 m (put there in the simulator): a screen reader hears the map's new words.
-            listener = subprocess.Popen(
-                [sys.executable, str(READER), str(proc.pid), "--events", "8"],
-                env=env, stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True,
-            )  # fmt: skip
-            assert listener.stdout is not None
-            first = listener.stdout.readline()  # after the walk: {"listening": true}
-            assert json.loads(first or "{}").get("listening"), (
-                listener.stderr.read() if listener.stderr else ""
-            )
-            sim.call(lambda: setattr(sim.server.world.body, "x", sim.server.world.body.x + 2000.0))
-            out, err = listener.communicate(timeout=120)
-            assert listener.returncode == 0, err
-            heard = json.loads(out.splitlines()[-1])["events"]
-            said = [e["value"] for e in heard if e["name"] == "Map" and "description" in e["type"]]
-            assert any("Robot at x" in s and s != before for s in said), heard
-            assert len(said) <= 3, f"the map repeated itself: {said}"  # one material change, said once
+            yield proc, env, sim
         finally:
             proc.terminate()
             proc.wait(15)
+
+
+def test_every_control_has_a_name_and_the_map_says_where_the_robot_is(tmp_path: Path) -> None:
+    with window_on_its_bus(tmp_path) as (proc, env, sim):
+        nodes = read_tree(proc.pid, env, *OPENED)
+        for _attempt in range(20):  # a busy machine: the D-pad and the dialog may come a little later
+            shown = {n["name"] for n in nodes}
+            if {"Forward", "Host", "Show up to", "Call once"} <= shown and any(
+                n["role"] == "spin button" for n in nodes
+            ):
+                break
+            time.sleep(1.0)
+            nodes = read_tree(proc.pid, env)
+        assert len(nodes) > 100, f"a tree this small is not the window's: {nodes[:3]}"
+        assert not unnamed_controls(nodes), "\n".join(unnamed_controls(nodes))
+        names = {(n["role"], n["name"]) for n in nodes}
+        for pad in ("Forward", "Turn left", "Turn right", "Backward", "Stop"):
+            assert ("push button", pad) in names, f"the D-pad's {pad} is not a named button"
+        assert ("push button", "STOP") in names
+        assert ("level bar", "Battery level") in names
+        assert ("text", "Host") in names  # the settings dialog's fields say what they are
+        (stage,) = [n for n in nodes if n["role"] == "image" and n["name"] == "Map"]
+        before = stage["description"]
+        for words in ("Robot at x", "heading", "mode", "battery", "volts", "standing still"):
+            assert words in before, before
+
+        # The robot moves 2 m (put there in the simulator): a screen reader hears the map's new words.
+        listener = subprocess.Popen(
+            [sys.executable, str(READER), str(proc.pid), "--events", "8"],
+            env=env, stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True,
+        )  # fmt: skip
+        assert listener.stdout is not None
+        first = listener.stdout.readline()  # after the walk: {"listening": true}
+        assert json.loads(first or "{}").get("listening"), listener.stderr.read() if listener.stderr else ""
+        sim.call(lambda: setattr(sim.server.world.body, "x", sim.server.world.body.x + 2000.0))
+        out, err = listener.communicate(timeout=120)
+        assert listener.returncode == 0, err
+        heard = json.loads(out.splitlines()[-1])["events"]
+        said = [e["value"] for e in heard if e["name"] == "Map" and "description" in e["type"]]
+        assert any("Robot at x" in s and s != before for s in said), heard
+        assert len(said) <= 3, f"the map repeated itself: {said}"  # one material change, said once
 
 
 POPOVERS = {
@@ -167,32 +175,15 @@ never sees one, so each is opened and read on its own."""
 
 
 def test_every_popover_is_read_with_named_controls(tmp_path: Path) -> None:
-    _skip_or_fail()
-    with (
-        SimThread(SimConfig(port=0, map_path=OFFICE_MAP, seed=1)) as sim,
-        accessibility_bus(tmp_path / "runtime") as env,
-    ):
-        env["XDG_CONFIG_HOME"] = str(tmp_path / "config")
-        proc = subprocess.Popen(
-            [sys.executable, "-m", "rtmu", "--host", "127.0.0.1", "--port", str(sim.port)],
-            env=env, stdout=subprocess.DEVNULL, stderr=subprocess.PIPE, text=True,
-        )  # fmt: skip
-        try:
-            xdotool("search", "--sync", "--onlyvisible", "--pid", str(proc.pid), "--name", "RTMU")
-            wait(
-                lambda: sim.call(lambda: any(s.subscriptions for s in sim.server.sessions)), 30, "subscribed"
-            )
-            for action, (role, name) in POPOVERS.items():
-                nodes = read_tree(proc.pid, env, action)
-                for _attempt in range(20):  # a busy machine: the popover may open a little later
-                    if any(n["role"] == role and n["name"].startswith(name) for n in nodes):
-                        break
-                    time.sleep(1.0)
-                    nodes = read_tree(proc.pid, env)
-                shown = sorted({(n["role"], n["name"]) for n in nodes if n["role"] in CONTROL_ROLES})
-                assert any(n["role"] == role and n["name"].startswith(name) for n in nodes), (action, shown)
-                assert not unnamed_controls(nodes), f"{action}: " + "\n".join(unnamed_controls(nodes))
-                assert not [n for n in nodes if n["role"] == "list item" and not n["name"].strip()], action
-        finally:
-            proc.terminate()
-            proc.wait(15)
+    with window_on_its_bus(tmp_path) as (proc, env, _sim):
+        for action, (role, name) in POPOVERS.items():
+            nodes = read_tree(proc.pid, env, action)
+            for _attempt in range(20):  # a busy machine: the popover may open a little later
+                if any(n["role"] == role and n["name"].startswith(name) for n in nodes):
+                    break
+                time.sleep(1.0)
+                nodes = read_tree(proc.pid, env)
+            shown = sorted({(n["role"], n["name"]) for n in nodes if n["role"] in CONTROL_ROLES})
+            assert any(n["role"] == role and n["name"].startswith(name) for n in nodes), (action, shown)
+            assert not unnamed_controls(nodes), f"{action}: " + "\n".join(unnamed_controls(nodes))
+            assert not [n for n in nodes if n["role"] == "list item" and not n["name"].strip()], action

@@ -22,7 +22,6 @@ from rtmu.sim import SimConfig, SimThread
 
 from .harness import OFFICE_MAP, Gui, on_display, pump
 from .test_dpad_place import Rect, overlap, pick, rect, settled
-from .test_handheld_window import phone_screen as phone_screen
 from .test_phone_wm import space_and_stop_stop
 
 gi.require_version("Gtk", "4.0")

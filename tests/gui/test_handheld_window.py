@@ -27,25 +27,11 @@ from rtmu.ui.alarm_view import AlarmView
 from rtmu.values.intents import RunServerCommand
 from simulators import running, simulator
 
-from .conftest import _spawn_xvfb, _terminate
 from .harness import OFFICE_MAP, Gui, idle, on_display, pump
 
 gi.require_version("Gtk", "4.0")
 gi.require_version("Graphene", "1.0")
 from gi.repository import Graphene, Gtk  # noqa: E402
-
-
-@pytest.fixture(scope="module")
-def phone_screen() -> Iterator[str]:
-    """An X server whose only screen is a 360×720 portrait phone: ':N'."""
-    proc, display = _spawn_xvfb("360x720")
-    if display is None:
-        pytest.fail("an Xvfb of 360x720 did not start")
-    try:
-        yield display
-    finally:
-        _terminate(proc)
-
 
 sim = simulator(map_path=OFFICE_MAP, seed=1)
 """The simulator of the ``gui`` fixture (the session's big screen)."""

@@ -22,7 +22,6 @@ from i18n_tooling import tooling
 from rtmu.base import i18n
 from rtmu.sim import SimThread
 
-from .conftest import _spawn_xvfb, _terminate
 from .harness import Gui, idle, pump
 from .test_handheld_window import clipped_widgets, open_on
 
@@ -60,17 +59,6 @@ def german() -> Iterator[None]:
         yield
     finally:
         i18n.use(["en"])
-
-
-@pytest.fixture(scope="module")
-def phone_screen() -> Iterator[str]:
-    proc, display = _spawn_xvfb("360x720")
-    if display is None:
-        pytest.fail("an Xvfb of 360x720 did not start")
-    try:
-        yield display
-    finally:
-        _terminate(proc)
 
 
 def widget_words(widget: Gtk.Widget) -> Iterator[tuple[str, str]]:

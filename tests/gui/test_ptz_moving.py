@@ -21,7 +21,6 @@ from rtmu.sim import SimConfig, SimThread
 from .harness import OFFICE_MAP, Gui, idle, pump
 from .test_handheld_window import clipped_widgets
 from .test_handheld_window import phone as phone  # the fixture: a window on a 360×720 screen
-from .test_handheld_window import phone_screen as phone_screen
 from .test_phone_wm import space_and_stop_stop
 
 gi.require_version("Gtk", "4.0")

@@ -15,24 +15,12 @@ from PIL import Image
 from rtmu.sim import SimThread
 from simulators import running
 
-from .conftest import _spawn_xvfb, _terminate
 from .harness import OFFICE_MAP, Gui, idle, on_display, pump, scratch_dir
 
 gi.require_version("Gtk", "4.0")
 from gi.repository import Gtk  # noqa: E402
 
 W, H = 360, 720
-
-
-@pytest.fixture(scope="module")
-def phone_screen() -> Iterator[str]:
-    proc, display = _spawn_xvfb(f"{W}x{H}")
-    if display is None:
-        pytest.fail(f"an Xvfb of {W}x{H} did not start")
-    try:
-        yield display
-    finally:
-        _terminate(proc)
 
 
 @pytest.fixture
