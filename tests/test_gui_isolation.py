@@ -77,6 +77,15 @@ def test_a_gui_test_that_fails_while_driving_fails_alone(tmp_path: Path) -> None
 def test_a_passing_gui_test_that_leaks_a_process_fails(tmp_path: Path) -> None:
     run = uuid.uuid4().hex
     out = _probe(run, tmp_path, "test_3")
-    assert re.search(r"1 passed, 2 deselected, 1 error", out), out
-    assert "left 0 app(s) open and 1 process(es) running" in out and "time.sleep(120)" in out, out
+    assert re.search(r"1 passed, 3 deselected, 1 error", out), out
+    assert "left 0 app(s) open, windows on screen [] and 1 process(es) running" in out, out
+    assert "time.sleep(120)" in out, out
+    _nothing_left(run)
+
+
+def test_a_passing_gui_test_that_leaves_a_window_on_screen_fails(tmp_path: Path) -> None:
+    run = uuid.uuid4().hex
+    out = _probe(run, tmp_path, "test_4")
+    assert re.search(r"1 passed, 3 deselected, 1 error", out), out
+    assert "windows on screen ['Left on screen']" in out, out
     _nothing_left(run)

@@ -101,6 +101,22 @@ def pump(condition: Callable[[], bool], timeout: float = 5.0, what: str = "condi
         ctx.iteration(False) or time.sleep(0.004)
 
 
+def settle(widget: Gtk.Widget, quiet: float = 0.3, timeout: float = 5.0) -> None:
+    """Wait until ``widget``'s size has not changed for ``quiet`` seconds: a resize the X server does on
+    its own time (full screen without a window manager, a new default size) is over before a test
+    aims a pointer at what it laid out."""
+    last = [(-1, -1), time.monotonic()]
+
+    def quiet_now() -> bool:
+        size = (widget.get_width(), widget.get_height())
+        now = time.monotonic()
+        if size != last[0]:
+            last[0], last[1] = size, now
+        return now - last[1] >= quiet  # type: ignore[operator]
+
+    pump(quiet_now, timeout, "the layout to settle")
+
+
 def idle(seconds: float) -> None:
     """Let the main loop run for ``seconds`` (used only where the point is that time passes)."""
     end = time.monotonic() + seconds

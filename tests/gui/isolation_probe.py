@@ -99,3 +99,13 @@ def test_2_drives_and_passes(screenshots: Path) -> None:
 def test_3_passes_but_leaks_a_process() -> None:
     """Run alone by the isolation test: the conftest must end the process and fail this test."""
     subprocess.Popen([sys.executable, "-c", "import time; time.sleep(120)"])
+
+
+def test_4_passes_but_leaves_a_dialog_on_screen() -> None:
+    """Run alone by the isolation test: a dialog left mapped would take the next test's clicks; the
+    conftest must destroy it and fail this test."""
+    from gi.repository import Gtk
+
+    left = Gtk.Window(title="Left on screen")
+    left.present()
+    pump(left.get_mapped, 5, "the dialog on screen")

@@ -323,7 +323,8 @@ def test_robots_a_roster_names_later_appear_and_the_first_is_shown(
         pump(lambda: gui.window.session is first, 5, "the first robot to be shown")
         pump(lambda: first.state.connection.value.connected, 10, "robot1 to connect")
         pump(lambda: gui.model.robot.value.numbers_at is not None, 10, "robot1's status in the window")
-        assert binding(gui).robot_list.get_visible()
+        # The list follows the roster at its own pace (at most every 150 ms): waited for, not assumed.
+        pump(lambda: binding(gui).robot_list.get_visible(), 5, "the robot list to show the three")
         gui.shot("late-robots")
     finally:
         gui.close()

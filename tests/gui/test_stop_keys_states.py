@@ -19,7 +19,7 @@ from rtmu.ui.options import GuiOptions
 from rtmu.ui.stop_keys import descendants, is_guarded
 from simulators import simulator
 
-from .harness import OFFICE_MAP, Gui, idle, pump, scratch_dir
+from .harness import OFFICE_MAP, Gui, idle, pump, scratch_dir, settle
 from .stop_paths import StopCycle, back_to_map, menu_entries, owned_windows
 
 gi.require_version("Gtk", "4.0")
@@ -155,11 +155,13 @@ def test_space_stops_on_the_camera_page_in_split_view_full_screen_and_a_phone_si
     gui.key("F11")
     idle(0.5)  # without a window manager the server may ignore the request; the bar is revealed
     window.fullscreen_bar.set_reveal_child(True)
+    settle(window)  # GDK emulates full screen by a resize the X server does later: aim after it
     cycle.prove("full screen (F11)")
     window.leave_fullscreen()
     window.fullscreen_bar.set_reveal_child(False)
     window.set_default_size(360, 720)
     pump(lambda: window.handheld.layout.narrow, 5, "the phone layout")
+    settle(window)
     gui.shot("phone-sized")
     cycle.prove("a phone-sized window")
     window.set_default_size(800, 480)
