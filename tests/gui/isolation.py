@@ -120,9 +120,12 @@ def destroy_windows() -> list[str]:
         return []
     from gi.repository import Gtk
 
+    from rtmu.ui.dialog_chain import close_popovers
+
     shown = []
     for window in list(Gtk.Window.list_toplevels()):
         if isinstance(window, Gtk.Window):
+            close_popovers(window)  # an open popover's grab would outlive its window (X11)
             if window.get_mapped():
                 shown.append(window.get_title() or type(window).__name__)
             window.destroy()

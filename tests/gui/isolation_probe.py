@@ -109,3 +109,36 @@ def test_4_passes_but_leaves_a_dialog_on_screen() -> None:
     left = Gtk.Window(title="Left on screen")
     left.present()
     pump(left.get_mapped, 5, "the dialog on screen")
+
+
+def test_5_fails_with_the_menu_open(screenshots: Path) -> None:
+    """Run with test_6 by the isolation test: fails while the main menu (a popover, with its grab) is open."""
+    sim, port = _start_sim()
+    try:
+        gui = Gui.start(screenshots, "isolation-menu-open", "127.0.0.1", port)
+        gui.focus()
+        gui.window.actions.activate("win.open-menu")
+        pump(lambda: gui.window.menu_button.get_popover().get_visible(), 5, "the menu")
+        gui.shot("menu-open")
+        raise AssertionError("failing on purpose with the menu open")
+    finally:
+        sim.terminate()
+        sim.wait(10)
+
+
+def test_6_keys_reach_the_next_window(screenshots: Path) -> None:
+    sim, port = _start_sim()
+    try:
+        gui = Gui.start(screenshots, "isolation-keys-after", "127.0.0.1", port)
+        try:
+            gui.wait_connected()
+            gui.focus()
+            before = gui.operator.speed.value.percent
+            gui.key("plus")
+            pump(lambda: gui.operator.speed.value.percent == before + 10, 5, "the speed key")
+            gui.shot("keys-reach")
+        finally:
+            gui.close()
+    finally:
+        sim.terminate()
+        sim.wait(10)

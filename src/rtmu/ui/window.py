@@ -42,7 +42,7 @@ from .camera_page import CameraPage  # noqa: E402
 from .commissioning import Commissioning  # noqa: E402
 from .desktop_citizen import DesktopCitizen  # noqa: E402
 from .details import DetailsWindow  # noqa: E402
-from .dialog_chain import dialogs_of  # noqa: E402
+from .dialog_chain import close_popovers, dialogs_of  # noqa: E402
 from .drive_input import DriveInput  # noqa: E402
 from .goals_panel import GoalsPanel  # noqa: E402
 from .handheld import Handheld  # noqa: E402
@@ -373,4 +373,6 @@ class MainWindow(Gtk.ApplicationWindow):
         for part in (self.camera_page, self.foxglove, self.actions, self.commissioning):
             part.close()
         for dialog in dialogs_of(self):  # not left on screen for GTK to find when it disposes us
+            close_popovers(dialog)
             dialog.destroy()
+        close_popovers(self)
