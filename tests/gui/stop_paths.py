@@ -178,6 +178,10 @@ class StopCycle:
             window.activate_action("win.dpad", None)
         pad = window.dpad.pads["drive_forward"]
         x, y = self.gui.centre_on_surface(pad)
+        # The pointer may have rested on the pad since the last cycle: its tooltip ("Drive forward
+        # (hold)") is then a window of its own over the pad and would take the press. Away first.
+        self.gui.xdotool("mousemove", "--window", str(self.gui.xid()), "1", "1")
+        idle(0.3)
         self.gui.xdotool("mousemove", "--window", str(self.gui.xid()), str(x), str(y), "mousedown", "1")
         return x, y
 

@@ -49,12 +49,12 @@ def test_a_killed_or_frozen_window_is_stopped_by_its_guardian(signum: int, tmp_p
             assert sim.call(lambda: sim.server.robot.mode_name) == "stop"
             assert sim.call(lambda: sim.server.robot.watchdog_stops) == watchdog, "the watchdog fired"
         finally:
-            if held:
-                xdotool("keyup", "Up")
             if proc.poll() is None:
                 proc.send_signal(signal.SIGCONT)
                 proc.kill()
             proc.wait(5)
+            if held:  # after the window is gone: X calls can wait on a stopped client
+                xdotool("keyup", "Up")
         # With the window gone its guardian leaves too (EOF on its pipe).
         wait(lambda: logins(sim) == 0, 10, "the guardian to log out")
 
@@ -113,10 +113,10 @@ def test_a_fleet_window_killed_or_frozen_is_stopped_by_its_one_guardian_at_the_s
             assert two.call(lambda: two.server.robot.watchdog_stops) == watchdog, "the watchdog fired"
             assert guardian_stops(one) == 0 and abs(one.snapshot().vel) < 1.0
         finally:
-            if held:
-                xdotool("keyup", "Up")
             if proc.poll() is None:
                 proc.send_signal(signal.SIGCONT)
                 proc.kill()
             proc.wait(5)
+            if held:  # after the window is gone: X calls can wait on a stopped client
+                xdotool("keyup", "Up")
         wait(lambda: logins(two) == 0, 10, "the guardian to log out")
