@@ -46,6 +46,7 @@ from ..mapedit.draft import (  # noqa: E402
 )
 from ..model.observables import MapModel, MapPhase, Phase, RobotModel  # noqa: E402
 from ..values.intents import ApplyMapChanges  # noqa: E402
+from .map_canvas_edit import TOOL_TIPS, MapCanvasEdit, Tool  # noqa: E402
 from .map_point_pick import Picked  # noqa: E402
 
 EDITABLE = {t.lower() for t in (GOAL, GOAL_WITH_HEADING, DOCK, FORBIDDEN_LINE, FORBIDDEN_AREA)}
@@ -67,11 +68,12 @@ class MapEditWindow(Gtk.Window):
         model: RobotModel,
         show_draft: Callable[[tuple[MapObject, ...] | None, int], None] = lambda _o, _n: None,
         pick: Callable[[Picked], None] | None = None,
+        canvas: MapCanvasEdit | None = None,
     ) -> None:
         super().__init__(title=_("Edit the map (draft)"), transient_for=parent, destroy_with_parent=True)
         self.set_default_size(620, 520)
         self.robot, self.model = robot, model
-        self._show_draft, self._pick = show_draft, pick
+        self._show_draft, self._pick, self.canvas = show_draft, pick, canvas
         """Told the draft's objects to draw on the map (None: the map's own again) and its edit count."""
         self.draft: MapDraft | None = None
         self.generation = -1
@@ -89,6 +91,8 @@ class MapEditWindow(Gtk.Window):
         self._unswitch = robot.on_switch(self._switched)
         self.connect("close-request", self._closing)
         self._map_changed(MapModel(), model.map.value)
+        if canvas is not None:
+            canvas.attach(self)
 
     # -- layout -----------------------------------------------------------------------------------
     def _build(self) -> None:
@@ -114,6 +118,7 @@ class MapEditWindow(Gtk.Window):
         for b in (self.undo_button, self.redo_button, self.discard_button, self.apply_button):
             buttons.append(b)
         box.append(bar)
+        box.append(self._tool_row())
         self.news = Gtk.Label(xalign=0.0, wrap=True, selectable=True)
         box.append(self.news)
         self.rows = Gtk.ListBox()
@@ -177,6 +182,34 @@ class MapEditWindow(Gtk.Window):
         keys.connect("key-pressed", self._key)
         self.add_controller(keys)
 
+    def _tool_row(self) -> Gtk.Widget:
+        """What a press on the map does (``map_canvas_edit``): one of a group of toggles."""
+        row = _wrapping_row(at_least=3)
+        row.set_max_children_per_line(len(Tool))
+        self.tool_buttons: dict[Tool, Gtk.ToggleButton] = {}
+        first: Gtk.ToggleButton | None = None
+        for tool in Tool:
+            button = Gtk.ToggleButton(label=_(tool.value), tooltip_text=_(TOOL_TIPS[tool]))
+            button.set_group(first)
+            first = first or button
+            button.set_active(tool is Tool.PAN)
+            button.set_sensitive(self.canvas is not None)
+            button.connect("toggled", self._tool_toggled, tool)
+            self.tool_buttons[tool] = button
+            row.append(button)
+        return row
+
+    def _tool_toggled(self, button: Gtk.ToggleButton, tool: Tool) -> None:
+        if button.get_active():
+            self.set_tool(tool)
+
+    def set_tool(self, tool: Tool) -> None:
+        """What a press on the map does from now on (the toggles show it)."""
+        if self.canvas is not None:
+            self.canvas.set_tool(tool)
+        if not self.tool_buttons[tool].get_active():
+            self.tool_buttons[tool].set_active(True)
+
     def _key(self, _c: Gtk.EventControllerKey, keyval: int, _code: int, state: Gdk.ModifierType) -> bool:
         if keyval == Gdk.KEY_Escape:
             self.close()
@@ -221,17 +254,43 @@ class MapEditWindow(Gtk.Window):
         except ValueError:
             raise DraftError(_("{name}: {text!r} is not a number").format(name=name, text=text)) from None
 
-    def _edit(self, what: Any) -> None:
-        """Run one draft edit; a DraftError is said, and the draft stays as it was."""
+    def _edit(self, what: Any) -> bool:
+        """Run one draft edit; a DraftError is said, and the draft stays as it was (False)."""
         if self.draft is None:
             self._say(_("There is no map to edit yet."), error=True)
-            return
+            return False
         try:
             what(self.draft)
         except DraftError as exc:
             self._say(str(exc), error=True)
-            return
+            return False
         self._say("", error=False)
+        self._show()
+        return True
+
+    # -- what the map's tools ask (``map_canvas_edit.CanvasEditor``) ------------------------------
+    def run_edit(self, what: Callable[[MapDraft], object]) -> bool:
+        return self._edit(what)
+
+    def drawn_objects(self) -> tuple[MapObject, ...]:
+        data = self.model.map.value.data
+        kept = [o for o in (data.objects if data is not None else ()) if o.type.lower() not in EDITABLE]
+        return (*kept, *(self.draft.objects if self.draft is not None else ()))
+
+    def select_object(self, obj: MapObject) -> None:
+        low = obj.name.lower()
+        for i, shown in enumerate(self.shown):
+            if (shown.name.lower() == low) if obj.name else object_key(shown) == object_key(obj):
+                self.rows.select_row(self.rows.get_row_at_index(i))
+                return
+
+    def name_for(self, stem: str) -> str:
+        typed = self.name_entry.get_text().strip()
+        if typed and (self.draft is None or self.draft.find(typed) is None):
+            return typed
+        return self.draft.free_name(_(stem)) if self.draft is not None else _(stem)
+
+    def refresh(self) -> None:
         self._show()
 
     def add(self) -> None:
@@ -306,6 +365,7 @@ class MapEditWindow(Gtk.Window):
         """The next click on the map fills x, y (and a dragged heading) — or x2, y2 with ``end``."""
         if self._pick is None:
             return
+        self.set_tool(Tool.PAN)  # the next press is the pick's, not a tool's
         self._say(
             _("Click the map") + ("" if end else _(" (drag from the point for a heading)")), error=False
         )
@@ -420,6 +480,8 @@ class MapEditWindow(Gtk.Window):
     def _closing(self, _w: Gtk.Window) -> bool:
         self.closed = True
         self._show_draft(None, 0)  # the map shows the robot's map again
+        if self.canvas is not None:
+            self.canvas.attach(None)
         for remove in self._unobserve:
             remove()
         self._unobserve = []
