@@ -57,6 +57,25 @@ def screen_size() -> tuple[int, int] | None:
     return geometry.width, geometry.height
 
 
+def fit_default_size(window: Gtk.Window, width: int, height: int) -> None:
+    """``set_default_size``, but never larger than the screen: a window made for a laptop opens on a
+    phone at the phone's size, and its rows wrap (``wrapping_row``) instead of running off it."""
+    screen = screen_size()
+    if screen is not None:
+        width, height = min(width, screen[0]), min(height, screen[1])
+    window.set_default_size(width, height)
+
+
+def wrapping_row(at_least: int = 1, at_most: int = 4) -> Gtk.FlowBox:
+    """Buttons side by side (at least ``at_least`` on a line) that wrap onto another line when the room
+    is narrower than their words: a longer language or a phone never widens the window past its screen."""
+    row = Gtk.FlowBox(selection_mode=Gtk.SelectionMode.NONE, column_spacing=6, row_spacing=6, hexpand=True)
+    row.set_min_children_per_line(at_least)
+    row.set_max_children_per_line(at_most)
+    row.set_homogeneous(False)
+    return row
+
+
 def monitor_width(window: Gtk.Window) -> int | None:
     """The width (logical px) of the monitor ``window`` is on, or None before it has a surface."""
     surface, display = window.get_surface(), window.get_display()

@@ -70,7 +70,12 @@ class ScanDialog(Gtk.Window):
         for side in ("top", "bottom", "start", "end"):
             getattr(box, f"set_margin_{side}")(12)
         box.append(
-            Gtk.Label(label=_("Name the scan, start it, then drive the robot round the place."), xalign=0.0)
+            Gtk.Label(
+                label=_("Name the scan, start it, then drive the robot round the place."),
+                xalign=0.0,
+                wrap=True,
+                max_width_chars=40,
+            )
         )
         self.name_entry = Gtk.Entry(placeholder_text=_("e.g. ground floor"), activates_default=True)
         box.append(self.name_entry)
