@@ -57,12 +57,21 @@ def screen_size() -> tuple[int, int] | None:
     return geometry.width, geometry.height
 
 
-def fit_default_size(window: Gtk.Window, width: int, height: int) -> None:
+def fit_default_size(window: Gtk.Window, width: int, height: int, *, beside_map: bool = False) -> None:
     """``set_default_size``, but never larger than the screen: a window made for a laptop opens on a
-    phone at the phone's size, and its rows wrap (``wrapping_row``) instead of running off it."""
+    phone at the phone's size, and its rows wrap (``wrapping_row``) instead of running off it.
+
+    ``beside_map``: a window used together with the map under it (the map editor's tools) takes at
+    most half of a small screen — the upper half of a portrait one, the left half of a landscape one
+    under 1280 px — so the map stays in sight; it scrolls for the rest."""
     screen = screen_size()
     if screen is not None:
-        width, height = min(width, screen[0]), min(height, screen[1])
+        sw, sh = screen
+        width, height = min(width, sw), min(height, sh)
+        if beside_map and sh > sw:
+            height = min(height, sh // 2)
+        elif beside_map and sw < 1280:
+            width = min(width, sw // 2)
     window.set_default_size(width, height)
 
 

@@ -72,7 +72,7 @@ class MapEditWindow(Gtk.Window):
         canvas: MapCanvasEdit | None = None,
     ) -> None:
         super().__init__(title=_("Edit the map (draft)"), transient_for=parent, destroy_with_parent=True)
-        fit_default_size(self, 620, 520)
+        fit_default_size(self, 620, 520, beside_map=True)
         self.robot, self.model = robot, model
         self._show_draft, self._pick, self.canvas = show_draft, pick, canvas
         """Told the draft's objects to draw on the map (None: the map's own again) and its edit count."""
