@@ -11,21 +11,29 @@ open) and the stalled state (with the hint shown). The other causes each have a 
 from __future__ import annotations
 
 from dataclasses import dataclass
+from pathlib import Path
 
 import pytest
 
+from rtmu.base import exit_codes as codes
+from rtmu.cli import main
 from rtmu.client.why_values import Cause
-from rtmu.sim import SimThread
+from rtmu.sim import SimConfig, SimThread
+from rtmu.sim.ld_safety import safety_state
 from simulators import simulator
 
-from .harness import Gui
+from .harness import OFFICE_MAP, Gui, idle, pump
 from .why_steps import (
     ask_why,
     command,
+    free_again,
     hint,
     hold_up_for_the_hint,
+    offer_the_fix,
+    say_yes,
     space_stops,
     stop_button_stops,
+    stops,
 )
 
 sim = simulator(map_path=None, camera=False, seed=1)
@@ -106,3 +114,77 @@ def test_a_held_drive_against_the_robots_own_state_is_told_and_the_why_window_na
     if state.stop_checks:
         space_stops(gui, sim, f"with the {state.cause.key} why window holding the keys")
         stop_button_stops(gui, sim, f"with the {state.cause.key} why window open")
+
+
+# -- causes with a fix: offered, asked first, sent only after the yes -----------------------------------
+office = simulator(map_path=OFFICE_MAP, camera=False, seed=1)
+
+
+def test_navigating_is_named_and_its_stop_is_sent_only_after_a_yes(
+    screenshots: Path, office: SimThread
+) -> None:
+    gui = Gui.start(screenshots, "test_why_navigating", "127.0.0.1", office.port)
+    try:
+        addr = f"127.0.0.1:{office.port}"
+        assert main(["goto", addr, "Corridor End", "--no-wait", "--timeout", "5"]) == codes.EXIT_OK
+        pump(lambda: office.snapshot().status.startswith("Going to"), 10, "the robot to navigate")
+        why = ask_why(gui)
+        sentence = why.sentence.get_text()
+        assert "driving the robot itself (Corridor End)" in sentence and "press STOP first" in sentence
+        assert office.snapshot().status.startswith("Going to")  # looking never stops it
+        before = stops(office)
+        offer_the_fix(gui, why, "Stop the navigation…")
+        assert "RTMU will send stop" in why.confirm.question.get_text()
+        gui.render(why, gui.shots / f"{gui.name}-confirm.png")
+        idle(0.5)
+        assert stops(office) == before and office.snapshot().status.startswith("Going to")
+        say_yes(gui, why)
+        pump(lambda: stops(office) > before, 10, "the stop the yes sends")
+        free_again(why)
+        assert office.snapshot().mode_name == "stop" and "done" in why.status.get_text()
+    finally:
+        gui.close()
+
+
+def test_docked_is_named_and_undock_is_sent_only_after_a_yes(screenshots: Path, office: SimThread) -> None:
+    gui = Gui.start(screenshots, "test_why_docked", "127.0.0.1", office.port)
+    try:
+        addr = f"127.0.0.1:{office.port}"
+        assert main(["dock", addr, "--timeout", "5", "--limit", "60"]) == codes.EXIT_OK
+        why = ask_why(gui)
+        sentence = why.sentence.get_text()
+        assert sentence.startswith("The robot is docked (charging)") and "undock it first" in sentence
+        x0 = office.snapshot().x
+        offer_the_fix(gui, why, "Undock…")
+        assert "RTMU will send undock" in why.confirm.question.get_text()
+        idle(0.5)
+        assert office.snapshot().status == "Docked" and office.snapshot().x == x0  # nothing before the yes
+        say_yes(gui, why)
+        pump(lambda: office.snapshot().status != "Docked", 10, "the robot to undock")
+        free_again(why)
+        assert office.snapshot().x != x0 and "done" in why.status.get_text()  # it backed out
+        gui.render(why, gui.shots / f"{gui.name}-undocked.png")
+    finally:
+        gui.close()
+
+
+def test_an_ld_robots_motors_are_enabled_only_after_a_yes(screenshots: Path) -> None:
+    with SimThread(SimConfig(port=0, profile="aram", map_path=None, camera=False, test_hooks=True)) as aram:
+        assert aram.server is not None
+        state = safety_state(aram.server)
+        gui = Gui.start(screenshots, "test_why_ld_motors", "127.0.0.1", aram.port)
+        try:
+            command(aram, "SimulatorMotorsOff")
+            why = ask_why(gui)
+            assert "motors are disabled" in why.sentence.get_text(), why.sentence.get_text()
+            offer_the_fix(gui, why, "Enable the motors…")
+            question = why.confirm.question.get_text()
+            assert "enableMotors" in question and "powers the robot's wheels" in question
+            gui.render(why, gui.shots / f"{gui.name}-confirm.png")
+            idle(0.5)
+            assert state.enables == 0  # nothing enabled before the yes
+            say_yes(gui, why)
+            pump(lambda: state.enables == 1, 10, "enableMotors")
+            free_again(why)
+        finally:
+            gui.close()
