@@ -20,7 +20,7 @@ from rtmu.cli import main
 from rtmu.client.why_values import Cause
 from rtmu.sim import SimConfig, SimThread
 from rtmu.sim.ld_safety import safety_state
-from simulators import simulator
+from simulators import running, simulator, users_file
 
 from .harness import OFFICE_MAP, Gui, idle, pump
 from .why_steps import (
@@ -186,5 +186,32 @@ def test_an_ld_robots_motors_are_enabled_only_after_a_yes(screenshots: Path) -> 
             say_yes(gui, why)
             pump(lambda: state.enables == 1, 10, "enableMotors")
             free_again(why)
+        finally:
+            gui.close()
+
+
+# -- who is logged in -------------------------------------------------------------------------------------
+def test_a_user_without_stop_is_warned_loudly_at_login_and_by_the_why_window(
+    screenshots: Path, tmp_path: Path
+) -> None:
+    users = users_file(tmp_path, "carol pw RobotInfo SensorInfo Movement")
+    with running(map_path=None, camera=False, users_path=users, seed=1) as carol_sim:
+        gui = Gui.start(
+            screenshots, "test_why_no_stop", "127.0.0.1", carol_sim.port, connect=False, user="carol"
+        )
+        try:
+            gui.window.controller.connect(password="pw")
+            gui.wait_connected()
+            said = lambda: [(level, text) for _t, level, text in gui.window.banners.history]  # noqa: E731
+            pump(lambda: any("may not send stop" in text for _l, text in said()), 10, "the login's warning")
+            level, text = next((lv, t) for lv, t in said() if "may not send stop" in t)
+            assert level in ("warning", "error") and "SAFETY: user 'carol'" in text, (level, text)
+            gui.shot("warned")
+            why = ask_why(gui)
+            sentence = why.sentence.get_text()
+            assert sentence.startswith("⚠ SAFETY: user 'carol' may not send stop"), sentence
+            assert "use one whose groups include Stop" in sentence and why.sentence.has_css_class("error")
+            assert why.answer is not None and why.answer.exit_code == codes.EXIT_WHY_NO_STOP
+            gui.render(why, gui.shots / f"{gui.name}-why.png")
         finally:
             gui.close()

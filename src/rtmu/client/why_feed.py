@@ -12,7 +12,9 @@ robot does not show), carries it out with :func:`~rtmu.client.why_fix.apply` —
 yes is sent only when the intent says the operator gave it — and answers with the new answer.
 
 Where the robot lists ``faultsUpdate`` (an LD robot), a change of its faults is told to the
-operator at once, as a safety notice: a fault is a reason it will not move.
+operator at once, as a safety notice: a fault is a reason it will not move. So is a login that may
+not send ``stop`` (the loud reason of :func:`~rtmu.client.why.diagnose`), told on every login: the
+operator must know before the first drive, not only when asking why.
 """
 
 from __future__ import annotations
@@ -66,6 +68,10 @@ class WhyFeed(Feed):
 
     def connected(self, client: AriaClient) -> None:
         self._faults = None
+        rights = Facts(offers=frozenset(e.name for e in client.datalist), user=client.user)
+        for reason in diagnose(rights).reasons:
+            if reason.loud:
+                self.ctx.notice(Notice.warning(Kind.SAFETY, reason.sentence()))
 
     def handle(self, intent: Intent) -> object:
         if isinstance(intent, AskWhy):
