@@ -5,11 +5,17 @@ the simulator's own simple commands; a held drive key must raise the hint that n
 what to do, ``?`` must open the why window that does the same (all but a stall: see
 ``asked_after``), and nothing is offered that RTMU cannot do about it. Space and the STOP button
 still stop the robot (the simulator's stop log grows) in the e-stop state (with the why window
-open) and the stalled state (with the hint shown). The other causes each have a test below.
+open) and the stalled state (with the hint shown).
+
+Below, each other cause the simulator can be put into: navigating, docked and an LD robot's motors
+off (the fix offered, asked first, and nothing at the simulator before the yes); a login without
+Stop (warned at login and marked ⚠); a drive key held through a stop; a drive watchdog shorter
+than RTMU's resend; a link that is down.
 """
 
 from __future__ import annotations
 
+from contextlib import ExitStack
 from dataclasses import dataclass
 from pathlib import Path
 
@@ -18,6 +24,7 @@ import pytest
 from rtmu.base import exit_codes as codes
 from rtmu.cli import main
 from rtmu.client.why_values import Cause
+from rtmu.model.observables import Phase
 from rtmu.sim import SimConfig, SimThread
 from rtmu.sim.ld_safety import safety_state
 from simulators import running, simulator, users_file
@@ -212,6 +219,57 @@ def test_a_user_without_stop_is_warned_loudly_at_login_and_by_the_why_window(
             assert sentence.startswith("⚠ SAFETY: user 'carol' may not send stop"), sentence
             assert "use one whose groups include Stop" in sentence and why.sentence.has_css_class("error")
             assert why.answer is not None and why.answer.exit_code == codes.EXIT_WHY_NO_STOP
+            gui.render(why, gui.shots / f"{gui.name}-why.png")
+        finally:
+            gui.close()
+
+
+# -- our own side of the drive ------------------------------------------------------------------------------
+def test_a_drive_key_held_through_a_stop_is_told_to_be_let_go(gui: Gui, sim: SimThread) -> None:
+    gui.focus()
+    gui.keydown("Up")
+    try:
+        pump(lambda: sim.snapshot().vel > 50, 10, "the robot to drive")
+        space_stops(gui, sim, "with Up still held")
+        pump(lambda: bool(hint(gui)), 15, "the hint of a held key the stop made void")
+        said = hint(gui)
+        assert "held through a stop is ignored" in said and "let go of the key" in said, said
+        x = sim.snapshot().x
+        idle(0.5)
+        assert abs(sim.snapshot().x - x) < 10.0  # the held key still drives nothing
+        gui.shot("hint")
+    finally:
+        gui.keyup("Up")
+
+
+def test_a_server_watchdog_shorter_than_our_resend_is_named(screenshots: Path) -> None:
+    with running(map_path=None, camera=False, drive_timeout=0.05, seed=1) as quick:
+        gui = Gui.start(screenshots, "test_why_watchdog", "127.0.0.1", quick.port)
+        try:
+            why = ask_why(gui)
+            sentence = why.sentence.get_text()
+            assert why.answer is not None and why.answer.exit_code == codes.EXIT_WHY_WATCHDOG, sentence
+            assert "drive watchdog is 0.05 s" in sentence and "raise the Teleop Timeout" in sentence
+            assert (
+                not why.fix_button.get_visible()
+            )  # the server's configuration: RTMU does not change it here
+            gui.render(why, gui.shots / f"{gui.name}-why.png")
+        finally:
+            gui.close()
+
+
+def test_a_link_that_is_down_is_named(screenshots: Path) -> None:
+    with ExitStack() as server_side:
+        server = server_side.enter_context(running(map_path=None, camera=False, seed=1))
+        gui = Gui.start(screenshots, "test_why_link_down", "127.0.0.1", server.port)
+        try:
+            server_side.close()  # the server goes away under the window
+            pump(lambda: gui.phase is not Phase.CONNECTED, 15, "the window to see the link go")
+            why = ask_why(gui)
+            sentence = why.sentence.get_text()
+            assert sentence.startswith("Our link to the robot is down (not connected)"), sentence
+            assert "check the network" in sentence and not why.fix_button.get_visible()
+            assert why.answer is not None and why.answer.exit_code == codes.EXIT_WHY_LINK
             gui.render(why, gui.shots / f"{gui.name}-why.png")
         finally:
             gui.close()
