@@ -8,7 +8,8 @@ still stop the robot (the simulator's stop log grows) in the e-stop state (with 
 open) and the stalled state (with the hint shown).
 
 Below, each other cause the simulator can be put into: navigating, docked and an LD robot's motors
-off (the fix offered, asked first, and nothing at the simulator before the yes); a login without
+off (the fix offered, asked first, and nothing at the simulator before the yes); a lost robot
+(noted for navigation: driving by hand needs no localization); a login without
 Stop (warned at login and marked ⚠); a drive key held through a stop; a drive watchdog shorter
 than RTMU's resend; a link that is down.
 """
@@ -171,6 +172,21 @@ def test_docked_is_named_and_undock_is_sent_only_after_a_yes(screenshots: Path, 
         free_again(why)
         assert office.snapshot().x != x0 and "done" in why.status.get_text()  # it backed out
         gui.render(why, gui.shots / f"{gui.name}-undocked.png")
+    finally:
+        gui.close()
+
+
+def test_a_lost_robot_is_noted_for_navigation_while_driving_by_hand_stays_free(
+    screenshots: Path, office: SimThread
+) -> None:
+    gui = Gui.start(screenshots, "test_why_lost", "127.0.0.1", office.port)
+    try:
+        command(office, "SimulatorLoseLocalization")
+        why = ask_why(gui)
+        assert why.sentence.get_text().startswith("Nothing RTMU can read keeps the robot from moving")
+        details = why.details.get_text()
+        assert "but navigation is: the robot is lost" in details and "tell it where it is" in details, details
+        gui.render(why, gui.shots / f"{gui.name}-why.png")
     finally:
         gui.close()
 
