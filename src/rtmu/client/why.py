@@ -51,7 +51,7 @@ _STALL_WORDS = ("Stalled", "Bumped")
 """ArServerModeRatioDrive's / ArServerModeDrive's status when a motor stalls or the stall value
 (bumpers) is set."""
 DOCK_MODES = frozenset({"dock", "Dock"})
-NOT_FOR_NAVIGATION = N_("driving by hand is not held back, but navigation is: ")
+NOT_FOR_NAVIGATION = "driving by hand is not held back, but navigation is: "
 """How a cause that holds back only navigation (a lost localization) is noted in a hand-drive answer."""
 
 
