@@ -11,11 +11,12 @@ Below, each other cause the simulator can be put into: navigating, docked and an
 off (the fix offered, asked first, and nothing at the simulator before the yes); a lost robot
 (noted for navigation: driving by hand needs no localization); a login without
 Stop (warned at login and marked ⚠); a drive key held through a stop; a drive watchdog shorter
-than RTMU's resend; a link that is down.
+than RTMU's resend; a link that is down; a gamepad stick pushed so little that ARIA ignores it.
 """
 
 from __future__ import annotations
 
+import time
 from contextlib import ExitStack
 from dataclasses import dataclass
 from pathlib import Path
@@ -25,12 +26,14 @@ import pytest
 from rtmu.base import exit_codes as codes
 from rtmu.cli import main
 from rtmu.client.why_values import Cause
+from rtmu.control.gamepad import AXIS_TRANS, DEADMAN, stick_ratios
 from rtmu.model.observables import Phase
 from rtmu.sim import SimConfig, SimThread
 from rtmu.sim.ld_safety import safety_state
 from simulators import running, simulator, users_file
 
 from .harness import OFFICE_MAP, Gui, idle, pump
+from .process import PATIENCE
 from .why_steps import (
     ask_why,
     command,
@@ -45,6 +48,10 @@ from .why_steps import (
 )
 
 sim = simulator(map_path=None, camera=False, seed=1)
+PAD = object()
+GENTLE = 0.28
+"""A stick deflection just past the pad's own dead zone: 10 % translation, inside ARIA's."""
+assert stick_ratios(0.0, -GENTLE) == (10.0, 0.0)
 
 
 @dataclass(frozen=True)
@@ -289,3 +296,27 @@ def test_a_link_that_is_down_is_named(screenshots: Path) -> None:
             gui.render(why, gui.shots / f"{gui.name}-why.png")
         finally:
             gui.close()
+
+
+def test_a_gentle_stick_inside_arias_dead_zone_is_told(gui: Gui, sim: SimThread) -> None:
+    """A stick pushed a little drives 10 %, which ARIA ignores: the hint must name the dead zone (the
+    pad's events go to the window's own Gamepad as libmanette would give them, as test_fleet_gamepad)."""
+    pad = gui.window.handheld.pad
+    assert pad.connected(PAD, "Test pad")
+    gui.focus()
+    x0 = sim.snapshot().x
+    pad.button(PAD, DEADMAN, True)
+    try:
+        end = time.monotonic() + 15 * PATIENCE
+        while not hint(gui):  # the stick's noise keeps the pad talking, as a real one does
+            assert time.monotonic() < end, "no hint for a stick inside the dead zone"
+            pad.axis(PAD, AXIS_TRANS, -GENTLE)
+            idle(0.05)
+        said = hint(gui)
+        assert "inside ARIA's dead zone" in said and "ask for more than 10 % translation" in said, said
+        assert sim.call(lambda: sim.server.world.ratio_drives_received) > 0  # type: ignore[union-attr]
+        assert abs(sim.snapshot().x - x0) < 1.0  # sent, and ARIA's dead zone swallowed it
+        gui.shot("hint")
+    finally:
+        pad.button(PAD, DEADMAN, False)
+        pad.disconnected(PAD)
