@@ -19,7 +19,8 @@ operator must know before the first drive, not only when asking why.
 
 from __future__ import annotations
 
-from dataclasses import dataclass
+import time
+from dataclasses import dataclass, replace
 from typing import ClassVar
 
 from ..base.i18n import _, ngettext
@@ -40,6 +41,8 @@ from .why_values import Answer, Facts, Motion, OurSide
 
 FAULTS_SHOWN = 3
 """Faults named in the notice (the why answer lists up to five, the console all of them)."""
+HELD_ANSWER_KEPT = 60.0
+"""Seconds the answer asked while a drive was held is recalled when a later question finds nothing."""
 
 
 @dataclass(frozen=True, slots=True)
@@ -62,12 +65,14 @@ class WhyFeed(Feed):
         super().__init__(ctx)
         self._faults: tuple[str, ...] | None = None
         """The faults last heard on ``faultsUpdate`` (None: none heard on this connection)."""
+        self._held_answer: tuple[float, Answer] | None = None
+        """When and what the last question asked while a drive was held answered (None: it could move)."""
 
     def subscriptions(self, client: AriaClient) -> list[Subscription]:
         return [Subscription("faultsUpdate", -1, self._on_faults)]
 
     def connected(self, client: AriaClient) -> None:
-        self._faults = None
+        self._faults, self._held_answer = None, None
         rights = Facts(offers=frozenset(e.name for e in client.datalist), user=client.user)
         for reason in diagnose(rights).reasons:
             if reason.loud:
@@ -111,7 +116,22 @@ class WhyFeed(Feed):
             return diagnose(Facts(ours=ours), navigate=intent.navigate)
         facts = await gather_facts(client, self.ctx.config.reply_timeout, ours)
         motion = Motion(intent.trans, intent.rot) if intent.trans or intent.rot else None
-        return diagnose(facts, motion, navigate=intent.navigate)
+        return self._recall(diagnose(facts, motion, navigate=intent.navigate), held=motion is not None)
+
+    def _recall(self, answer: Answer, *, held: bool) -> Answer:
+        """Keep the answer asked while a drive was held; add it as a note to a later one that finds
+        nothing. Some causes show only while the drive is held — ARIA's drive mode says "Stalled",
+        and letting go switches to the stop mode, which does not — so the operator who lets go and
+        then asks is still told what the hint found (as what was read then, not as a cause now)."""
+        now = time.monotonic()
+        if held:
+            self._held_answer = None if answer.can_move else (now, answer)
+            return answer
+        earlier = self._held_answer
+        if earlier is None or not answer.can_move or now - earlier[0] > HELD_ANSWER_KEPT:
+            return answer
+        note = f"while the drive was held {now - earlier[0]:.0f} s ago: {earlier[1].sentence()}"
+        return replace(answer, notes=(*answer.notes, note))
 
     # -- fixing ------------------------------------------------------------------------------------
     async def fix(self, intent: ApplyFix) -> FixReport:
