@@ -10,7 +10,8 @@ states, with the why window open.
 Below, each other cause the simulator can be put into: navigating, docked and an LD robot's motors
 off (the fix offered, asked first, and nothing at the simulator before the yes); a lost robot
 (noted for navigation: driving by hand needs no localization); a login without
-Stop (warned at login and marked ⚠); a drive key held through a stop; a drive watchdog shorter
+Stop (warned at login and marked ⚠); a drive key held through a stop; a window that froze while
+driving (the lease lapsed); a drive watchdog shorter
 than RTMU's resend; a link that is down; a gamepad stick pushed so little that ARIA ignores it.
 """
 
@@ -52,6 +53,8 @@ PAD = object()
 GENTLE = 0.28
 """A stick deflection just past the pad's own dead zone: 10 % translation, inside ARIA's."""
 assert stick_ratios(0.0, -GENTLE) == (10.0, 0.0)
+FROZEN = 1.0
+"""Seconds the window's thread is stopped: over three times the drive lease's 0.3 s."""
 
 
 @dataclass(frozen=True)
@@ -320,3 +323,21 @@ def test_a_gentle_stick_inside_arias_dead_zone_is_told(gui: Gui, sim: SimThread)
     finally:
         pad.button(PAD, DEADMAN, False)
         pad.disconnected(PAD)
+
+
+def test_a_window_that_froze_while_driving_is_named_as_the_stop(gui: Gui, sim: SimThread) -> None:
+    """The window's own thread (this test's) stops for a second while Up is held: the lease lapses, RTMU
+    stops the robot, and the why window says it was our side, not the robot."""
+    gui.focus()
+    gui.keydown("Up")
+    try:
+        pump(lambda: sim.snapshot().vel > 50, 10, "the robot to drive")
+        time.sleep(FROZEN)  # the GTK thread is frozen: nothing renews the drive
+        pump(lambda: sim.snapshot().vel == 0, 10, "the lapsed drive to stop the robot")
+    finally:
+        gui.keyup("Up")
+    why = ask_why(gui)
+    sentence = why.sentence.get_text()
+    assert why.answer is not None and why.answer.exit_code == codes.EXIT_WHY_LEASE, sentence
+    assert "did not renew the drive in time" in sentence and "press the drive key again" in sentence
+    gui.render(why, gui.shots / f"{gui.name}-why.png")
