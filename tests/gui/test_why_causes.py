@@ -9,10 +9,10 @@ states, with the why window open.
 
 Below, each other cause the simulator can be put into: navigating, docked and an LD robot's motors
 off (the fix offered, asked first, and nothing at the simulator before the yes); a lost robot
-(noted for navigation: driving by hand needs no localization); a login without
-Stop (warned at login and marked ⚠); a drive key held through a stop; a window that froze while
-driving (the lease lapsed); a drive watchdog shorter
-than RTMU's resend; a link that is down; a gamepad stick pushed so little that ARIA ignores it.
+(noted for navigation: driving by hand needs no localization); a login without Stop (warned at
+login and marked ⚠); a drive key held through a stop; a window that froze while driving (the
+lease lapsed); a drive watchdog shorter than RTMU's resend; a link that is down, and one that
+carries nothing (answered without asking); a gamepad stick pushed so little that ARIA ignores it.
 """
 
 from __future__ import annotations
@@ -24,13 +24,16 @@ from pathlib import Path
 
 import pytest
 
+from linkfaults import FaultProxy
 from rtmu.base import exit_codes as codes
 from rtmu.cli import main
+from rtmu.client.why_feed import NOT_ASKED_OVER_A_BAD_LINK
 from rtmu.client.why_values import Cause
 from rtmu.control.gamepad import AXIS_TRANS, DEADMAN, stick_ratios
 from rtmu.model.observables import Phase
 from rtmu.sim import SimConfig, SimThread
 from rtmu.sim.ld_safety import safety_state
+from rtmu.values.state import LinkLevel
 from simulators import running, simulator, users_file
 
 from .harness import OFFICE_MAP, Gui, idle, pump
@@ -341,3 +344,20 @@ def test_a_window_that_froze_while_driving_is_named_as_the_stop(gui: Gui, sim: S
     assert why.answer is not None and why.answer.exit_code == codes.EXIT_WHY_LEASE, sentence
     assert "did not renew the drive in time" in sentence and "press the drive key again" in sentence
     gui.render(why, gui.shots / f"{gui.name}-why.png")
+
+
+def test_a_stale_link_is_named_at_once(faulty_link: tuple[Gui, SimThread, FaultProxy]) -> None:
+    """The server's bytes are held back (a dead Wi-Fi): the why window answers from our side without
+    asking the robot — over that link each reply would only be waited out (it hung "Asking the
+    robot…" for a minute before)."""
+    gui, _sim, proxy = faulty_link
+    proxy.mute()
+    pump(lambda: gui.model.health.value.level is not LinkLevel.OK, 10, "the window to see the link go bad")
+    why = ask_why(gui)
+    sentence = why.sentence.get_text()
+    assert sentence.startswith("Our link to the robot is "), sentence
+    assert "check the network" in sentence and not why.fix_button.get_visible()
+    assert why.answer is not None and why.answer.exit_code == codes.EXIT_WHY_LINK
+    assert NOT_ASKED_OVER_A_BAD_LINK in why.answer.notes  # nothing was asked over the dead link
+    gui.render(why, gui.shots / "test_why_stale_link-why.png")
+    proxy.restore()

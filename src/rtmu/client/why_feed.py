@@ -4,7 +4,8 @@
 the server's own data over the session's connection (:func:`~rtmu.client.why_gather.gather`, reads
 only: looking never moves the robot) and adds our own side — the link as the window shows it, why
 the last drive lease ended, whether the guardian watches, a key ignored after a stop — then
-:func:`~rtmu.client.why.diagnose` says it in one sentence. Not connected, the answer is our link.
+:func:`~rtmu.client.why.diagnose` says it in one sentence. Not connected, or over a link
+that carries nothing now (stale, lost), the answer is our link, at once: nothing is asked over it.
 
 :class:`~rtmu.values.intents.ApplyFix` finds the cause again from the server's data before it
 sends anything (so only a fix the robot still needs is made, and the window cannot name one the
@@ -41,6 +42,11 @@ from .why_values import Answer, Facts, Motion, OurSide
 
 FAULTS_SHOWN = 3
 """Faults named in the notice (the why answer lists up to five, the console all of them)."""
+LINK_CARRIES_NOTHING = frozenset({LinkLevel.STALE, LinkLevel.LOST})
+"""Link levels at which the robot is not asked: the answer is our link, from what the login already knows."""
+NOT_ASKED_OVER_A_BAD_LINK = (
+    "the robot was not asked: our link carries nothing now (the login's rights are shown)"
+)
 HELD_ANSWER_KEPT = 60.0
 """Seconds the answer asked while a drive was held is recalled when a later question finds nothing."""
 
@@ -73,8 +79,7 @@ class WhyFeed(Feed):
 
     def connected(self, client: AriaClient) -> None:
         self._faults, self._held_answer = None, None
-        rights = Facts(offers=frozenset(e.name for e in client.datalist), user=client.user)
-        for reason in diagnose(rights).reasons:
+        for reason in diagnose(_login_facts(client)).reasons:
             if reason.loud:
                 self.ctx.notice(Notice.warning(Kind.SAFETY, reason.sentence()))
 
@@ -114,6 +119,9 @@ class WhyFeed(Feed):
         client = self.ctx.client
         if client is None or not client.connected:
             return diagnose(Facts(ours=ours), navigate=intent.navigate)
+        if ours.link in LINK_CARRIES_NOTHING:  # asking over it would only wait out each reply's timeout
+            unasked = _login_facts(client, ours, NOT_ASKED_OVER_A_BAD_LINK)
+            return diagnose(unasked, navigate=intent.navigate)
         facts = await gather_facts(client, self.ctx.config.reply_timeout, ours)
         motion = Motion(intent.trans, intent.rot) if intent.trans or intent.rot else None
         return self._recall(diagnose(facts, motion, navigate=intent.navigate), held=motion is not None)
@@ -179,3 +187,9 @@ class WhyFeed(Feed):
                 ).format(count=len(faults), faults=shown, more=more),
             )
         )
+
+
+def _login_facts(client: AriaClient, ours: OurSide | None = None, *notes: str) -> Facts:
+    """What the login itself tells, with no request sent: this user's rights (its data list)."""
+    offers = frozenset(e.name for e in client.datalist)
+    return Facts(offers=offers, user=client.user, ours=ours or OurSide(), notes=notes)
