@@ -202,6 +202,11 @@ class Controller:
         return self.drive.analog_active
 
     @property
+    def analog_ratios(self) -> tuple[float, float] | None:
+        """The stick's (trans, rot) in % while its dead-man is held (what "why?" asks about)."""
+        return self.drive.analog_ratios
+
+    @property
     def analog_blocked(self) -> bool:
         """A stop ended the stick's drive: the dead-man must be released before it drives again."""
         return self.drive.analog_blocked

@@ -5,7 +5,8 @@ It asks the selected robot (:class:`~rtmu.values.intents.AskWhy`, reads only: as
 the robot) with what only the window knows — the drive held, the link as shown, a key ignored after
 a stop — and shows the answer ``rtmu why`` gives: the first cause as one sentence and its advice,
 the other causes, the server data each was read from, notes, and an LD robot's raw values (labelled
-raw: their layouts are not public).
+raw: their layouts are not public). A safety fact (a login that may not stop) is marked ⚠, and shown in
+the error colour when it is the answer.
 
 Where the cause has a fix (ask a locked mode to unlock, undock, end the server's navigation, switch
 safe drive off, acknowledge an LD robot's faults, enable its motors) a button offers it; the button
@@ -147,9 +148,14 @@ class WhyWindow(Gtk.Window):
     def show_answer(self, answer: Answer) -> None:
         self.answer = answer
         sentence = _short(sentence_words(answer.sentence()))  # problem — advice, each part translated
-        self.sentence.set_text(sentence[:1].upper() + sentence[1:])
-        self.details.set_text(answer_details(answer))
         first = answer.primary
+        loud = first is not None and first.loud  # a safety fact (a login that may not stop): said loudly
+        self.sentence.set_text(("⚠ " if loud else "") + sentence[:1].upper() + sentence[1:])
+        if loud:
+            self.sentence.add_css_class("error")
+        else:
+            self.sentence.remove_css_class("error")
+        self.details.set_text(answer_details(answer))
         self.fix = first.fix if first is not None else None
         self.fix_button.set_visible(self.fix is not None)
         if self.fix is not None:
