@@ -14,6 +14,11 @@ listed robot connected (``connect_at_most`` 1000).
   20-robot fleet until the window's guardian is armed for it (target 300 ms); baseline: a guardian
   process started from nothing until logged in (what a guardian per selection would cost).
   ``…arming_cpu_ms.p50`` (ms): the CPU time the window and its guardian spent on one arming.
+* ``fleet_scale.guardian_arming_100ms_rtt_ms.{p50,p95}`` (ms): the guardian process armed for a robot
+  behind a link of 100 ms round trip (``tests/linkfaults.py``'s proxy, as over a slow Wi-Fi), from
+  its LOGIN until it says ready, for a robot whose login it kept ready (the robot selected before or
+  beside the selection, named a second before) — baseline: a robot it had no login to (a new login:
+  connection, introduction, data list).
 
 Each window runs ``RTMU_BENCH_FLEET_SCALE_RUNS`` times (3) on the same simulators; a figure is the
 median of its runs (the machine is shared: one run says little).
@@ -40,19 +45,29 @@ import subprocess
 import sys
 import tempfile
 import time
+from dataclasses import replace
 from pathlib import Path
 
 import numpy as np
 
 from bench.bench_fleet import _display, _sims
 from bench.common import Result
+from rtmu.guardian.handle import GuardianHandle
+from rtmu.guardian.messages import Hello
+from rtmu.sim import SimConfig, SimThread
 from rtmu.sim.central_listing import ListingCentralThread
+
+REPO = Path(__file__).resolve().parents[1]
+sys.path.insert(0, str(REPO / "tests"))
+from linkfaults import FaultProxy  # noqa: E402
 
 SIZES = (1, 20, 50)
 SELECTIONS = 20
 CENTRAL_LISTED = (100, 10_000)
 KEY_SECONDS = 8.0
-REPO = Path(__file__).resolve().parents[1]
+ARMINGS = 10
+WIFI_DELAY = 0.05
+"""Seconds each way through the proxy: a 100 ms round trip."""
 OLD = os.environ.get("RTMU_BENCH_FLEET_SCALE_OLD", "1") != "0"
 RUNS = max(1, int(os.environ.get("RTMU_BENCH_FLEET_SCALE_RUNS", "3")))
 ISSUE_SIGTERM_S = 15.0
@@ -198,10 +213,57 @@ def central_results(display: str) -> list[Result]:
     return results
 
 
+def _armed_ms(handle: GuardianHandle, hello: Hello) -> float:
+    """LOGIN to ``hello``'s robot until the guardian says it is ready, in ms."""
+    t0 = time.monotonic()
+    handle.login(hello)
+    while True:
+        for word, serial, text in handle.poll():
+            if serial == hello.serial and word == "ready":
+                return (time.monotonic() - t0) * 1000.0
+            if serial == hello.serial:
+                raise RuntimeError(f"the guardian could not log in: {word} {text}")
+        if time.monotonic() - t0 > 30:
+            raise RuntimeError("the guardian did not log in within 30 s")
+        time.sleep(0.001)
+
+
+def arming_results() -> list[Result]:
+    """The guardian's arming over a 100 ms round trip: a login kept ready against a new one."""
+    kept: list[float] = []
+    cold: list[float] = []
+    with (
+        SimThread(SimConfig(port=0)) as a,
+        SimThread(SimConfig(port=0)) as b,
+        FaultProxy("127.0.0.1", a.port) as to_a,
+        FaultProxy("127.0.0.1", b.port) as to_b,
+    ):
+        to_a.delay(WIFI_DELAY)
+        to_b.delay(WIFI_DELAY)
+        handle = GuardianHandle.start()
+        try:
+            for serial in range(1, 2 * ARMINGS + 1):
+                robot = Hello("127.0.0.1", (to_a if serial % 2 else to_b).port)  # the two in turn
+                if serial <= ARMINGS:  # a new login each time: its kept login is let go of first (COLD)
+                    handle.cool(robot)
+                    cold.append(_armed_ms(handle, replace(robot, serial=serial)))
+                else:  # named a second before, as the window names the robots beside the selection
+                    handle.warm(robot)
+                    time.sleep(1.0)
+                    kept.append(_armed_ms(handle, replace(robot, serial=serial)))
+        finally:
+            handle.close(goodbye=True)
+    name = "fleet_scale.guardian_arming_100ms_rtt_ms"
+    return [
+        Result(f"{name}.{label}", _pct(kept, q), "ms", _pct(cold, q))
+        for label, q in (("p50", 50), ("p95", 95))
+    ]
+
+
 def run() -> list[Result]:
     try:
         with _display() as display:
-            return fleet_results(display) + central_results(display)
+            return fleet_results(display) + arming_results() + central_results(display)
     except FileNotFoundError:
         print("# fleet_scale: no Xvfb: figures skipped", file=sys.stderr)
         return []
