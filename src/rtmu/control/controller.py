@@ -58,6 +58,7 @@ from ..model.observables import OperatorState, RobotModel, SpeedSetting
 from ..settings.store import Profile
 from ..values.intents import GotoGoal, Intent, RequestPicture, StartVideo, Stop, picture_source
 from ..values.state import ConnectionState, LinkHealth, LinkLevel, NavState, Phase, RobotState
+from ..values.target import Target
 from . import intent_rules
 from .commands import COMMANDS, CommandRegistry, CommandState
 from .held_drive import HeldDrive
@@ -456,14 +457,9 @@ class Controller:
             with contextlib.suppress(Exception):
                 tap("connect", {"host": p.host, "port": p.port, "user": p.user, "profile": p.name})
         self.link.connect(
-            p.host,
-            p.port,
-            p.user,
-            password,
-            profile=p.name,
-            auto_reconnect=p.auto_reconnect,
-            protocol=p.protocol or None,
-        )
+            Target(p.host, p.port, p.user, password, profile=p.name, auto_reconnect=p.auto_reconnect,
+                   protocol=p.protocol or None)
+        )  # fmt: skip
 
     def disconnect(self) -> None:
         self.stop()
