@@ -23,7 +23,7 @@ import dataclasses
 import importlib
 import struct
 from enum import Enum
-from typing import Any, ClassVar, Self, TypeVar
+from typing import Any, ClassVar, Final, Self, TypeVar
 
 from ..errors import PayloadError
 from ..fields import FieldReader, FieldWriter
@@ -32,6 +32,11 @@ from ..fields import FieldReader, FieldWriter
 class Side(Enum):
     ARGS = "args"
     REPLY = "reply"
+
+    # Every packet's type lookup hashes a (name, side) key; Enum's own __hash__ is a Python call
+    # (hash of the member's name), a third of a status packet's decode. Members are singletons and
+    # compare by identity, so the identity hash is the same contract in C.
+    __hash__ = object.__hash__
 
 
 class NameMatch(Enum):
@@ -231,8 +236,13 @@ def _lookup(data_name: str, side: Side) -> type[Payload] | None:
 
 def decode_payload(data_name: str, side: Side, data: bytes) -> Payload | None:
     """Decode ``data`` with the type for ``data_name`` (see :func:`payload_type_for`); None if unknown."""
-    cls = payload_type_for(data_name, side)
+    cls = _LOOKUP_CACHE.get((data_name, side), _UNCACHED)  # payload_type_for's cache, inline: hot path
+    if cls is _UNCACHED:
+        cls = payload_type_for(data_name, side)
     return None if cls is None else cls.decode(data)
+
+
+_UNCACHED: Final[Any] = object()
 
 
 def registered() -> dict[tuple[str, Side], type[Payload]]:
