@@ -2,9 +2,10 @@
 
 Two fast paths are checked against a reference written the simple way:
 
-* framing: :func:`rtmu.protocol.decoder._take_run` (runs of one packet length, a status stream) against
-  the decoder's general loop alone (``_RUN_BELOW`` set to 0 turns runs off) — same packets, same
-  drop counts, whatever the bytes and however they are chunked;
+* framing: :func:`rtmu.protocol.runs.take_run` (runs of one packet length and command, a status
+  stream), one packet at a time and as numpy blocks, against the decoder's general loop alone
+  (``_RUN_BELOW`` set to 0 turns runs off) — same packets, same drop counts, whatever the bytes and
+  however they are chunked;
 * typed decode: ``UpdateNumbers.decode`` (one precompiled unpack, slot setters) and
   :func:`~rtmu.protocol.payloads.base.decode_payload` against a :class:`FieldReader` read field by field
   — same values, and the same error (the same field named) for a payload cut short.
@@ -24,6 +25,7 @@ from rtmu.capture.base import StreamData
 from rtmu.capture.conversation import DecodedPacket
 from rtmu.capture.session_decoder import CaptureDecoder
 from rtmu.protocol import decoder as decoder_module
+from rtmu.protocol import runs
 from rtmu.protocol.decoder import PacketDecoder
 from rtmu.protocol.errors import FieldUnderrun
 from rtmu.protocol.fields import FieldReader
@@ -51,11 +53,20 @@ def reference_numbers(payload: bytes) -> UpdateNumbers:
     )
 
 
-def frame(stream: bytes, sizes: list[int], *, runs: bool) -> tuple[list[Packet], dict[str, int]]:
-    """(packets, drop stats) of ``stream`` fed in ``sizes`` chunks, with or without the run path."""
+MODES = ("general", "one_by_one", "block")
+"""The general loop alone (runs off); runs one packet at a time; runs as numpy blocks from 2 packets."""
+
+
+def frame(stream: bytes, sizes: list[int], *, mode: str) -> tuple[list[Packet], dict[str, int]]:
+    """(packets, drop stats) of ``stream`` fed in ``sizes`` chunks, framed the ``mode`` way."""
     with pytest.MonkeyPatch.context() as patch:
-        if not runs:
+        if mode == "general":
             patch.setattr(decoder_module, "_RUN_BELOW", 0)
+        elif mode == "one_by_one":
+            patch.setattr(runs, "BLOCK_MIN", 1 << 30)
+        else:
+            patch.setattr(runs, "BLOCK_MIN", 2)
+            patch.setattr(runs, "IMPORT_AT", 2)
         decoder = PacketDecoder()
         packets: list[Packet] = []
         pos = 0
@@ -69,11 +80,11 @@ def frame(stream: bytes, sizes: list[int], *, runs: bool) -> tuple[list[Packet],
         return packets, decoder.stats.as_dict()
 
 
-def same_both_ways(stream: bytes, sizes: list[int]) -> list[Packet]:
-    fast = frame(stream, sizes, runs=True)
-    plain = frame(stream, sizes, runs=False)
-    assert fast == plain
-    return fast[0]
+def same_every_way(stream: bytes, sizes: list[int]) -> list[Packet]:
+    general, one_by_one, block = (frame(stream, sizes, mode=mode) for mode in MODES)
+    assert one_by_one == general
+    assert block == general
+    return general[0]
 
 
 def numbers(rng: random.Random) -> UpdateNumbers:
@@ -98,7 +109,7 @@ def status_stream(seed: int, count: int) -> list[bytes]:
 
 
 @pytest.mark.parametrize("name", CAPTURE_NAMES)
-def test_every_capture_stream_frames_the_same_with_and_without_runs(name: str) -> None:
+def test_every_capture_stream_frames_the_same_every_way(name: str) -> None:
     streams: dict[tuple[int, object], bytearray] = defaultdict(bytearray)
     for event in open_capture(CAPTURES / name).events():
         if isinstance(event, StreamData):
@@ -107,7 +118,7 @@ def test_every_capture_stream_frames_the_same_with_and_without_runs(name: str) -
     framed = 0
     for stream in streams.values():
         for sizes in ([1 << 20], [1448, 27, 4096, 1]):
-            framed += len(same_both_ways(bytes(stream), sizes))
+            framed += len(same_every_way(bytes(stream), sizes))
     assert framed > 0
 
 
@@ -161,13 +172,13 @@ HOSTILE = st.sampled_from(["flip", "lying_header", "short_same_head", "truncate"
 @settings(max_examples=150, deadline=None)
 @given(
     seed=st.integers(0, 2**32),
-    damage=st.dictionaries(st.integers(0, 59), HOSTILE, max_size=6),
-    sizes=st.lists(st.integers(1, 400), min_size=1, max_size=5),
+    damage=st.dictionaries(st.integers(0, 119), HOSTILE, max_size=8),
+    sizes=st.lists(st.integers(1, 2000), min_size=1, max_size=5),
 )
-def test_damaged_status_streams_frame_the_same_with_and_without_runs(
+def test_damaged_status_streams_frame_the_same_every_way(
     seed: int, damage: dict[int, str], sizes: list[int]
 ) -> None:
-    packets = status_stream(seed, 60)
+    packets = status_stream(seed, 120)
     rng = random.Random(seed)
     for at, kind in sorted(damage.items()):
         packet = bytearray(packets[at])
@@ -184,12 +195,12 @@ def test_damaged_status_streams_frame_the_same_with_and_without_runs(
         else:
             packet[:0] = rng.randbytes(rng.randrange(1, 9))
         packets[at] = bytes(packet)
-    same_both_ways(b"".join(packets), sizes)
+    same_every_way(b"".join(packets), sizes)
 
 
 def test_a_clean_status_stream_comes_out_whole_in_order() -> None:
     packets = status_stream(11, 500)
-    got = same_both_ways(b"".join(packets), [65536, 1448, 27, 4096])
+    got = same_every_way(b"".join(packets), [65536, 1448, 27, 4096])
     assert [p.encode() for p in got] == packets
 
 
@@ -198,6 +209,19 @@ def test_a_bad_checksum_inside_a_run_drops_that_packet_alone() -> None:
     bad = bytearray(packets[20])
     bad[-1] ^= 0xFF
     packets[20] = bytes(bad)
-    got, stats = frame(b"".join(packets), [1 << 16], runs=True)
+    got, stats = frame(b"".join(packets), [1 << 16], mode="block")
     assert [p.encode() for p in got] == packets[:20] + packets[21:]
     assert stats["bad_checksum"] == 1
+
+
+@pytest.mark.parametrize("block_min", [2, 1 << 30])
+def test_a_clean_run_is_taken_whole_by_the_run_path_itself(block_min: int) -> None:
+    packets = status_stream(13, 300)
+    stream = b"".join(packets) + packets[0][:10]  # and the start of one more, not yet whole
+    found: list[Packet] = []
+    with pytest.MonkeyPatch.context() as patch:
+        patch.setattr(runs, "BLOCK_MIN", block_min)
+        patch.setattr(runs, "IMPORT_AT", block_min)
+        stopped = runs.take_run(stream, 0, len(stream), len(packets[0]), found)
+    assert stopped == len(stream) - 10
+    assert [p.encode() for p in found] == packets

@@ -52,12 +52,12 @@ Nothing in here raises on network input; every dropped byte is counted.
 from __future__ import annotations
 
 import re
-import struct
 from dataclasses import dataclass, fields
 from typing import Final
 
 from .checksum import WORD_STRUCTS, SpanChecksums, checksum
 from .packet import MAX_LENGTH, MIN_LENGTH, SYNC, Packet
+from .runs import take_run
 
 _COMPACT_AT = 64 * 1024
 _INLINE_SUM_BELOW: Final = 6 + 2 * len(WORD_STRUCTS)
@@ -82,45 +82,7 @@ _CHAIN_START = re.compile(rb"\x0f\x0c[\x00-\xff][\x00-\x0f]")
 
 
 _RUN_BELOW: Final = 256
-"""Packets shorter than this, several of one length in a row, are framed by :func:`_take_run`."""
-_RUN_LAYOUTS: dict[int, tuple[struct.Struct, int]] = {}
-"""Packet length → its precompiled layout from byte 3 (the checksum's words, the byte XORed in,
-the checksum) and the index of that XORed byte in what it unpacks."""
-
-
-def _run_layout(length: int) -> tuple[struct.Struct, int]:
-    words = (length - 6) >> 1  # as checksum(): the words from byte 3, then one byte XORed in
-    skipped = length - 2 - (3 + 2 * words + 1)  # an odd payload's last byte is not summed
-    layout = _RUN_LAYOUTS[length] = (struct.Struct(f">{words}HB{skipped}xH"), words)
-    return layout
-
-
-def _take_run(buf: bytes, pos: int, end: int, length: int, found: list[Packet]) -> int:
-    """Frame the packets at ``pos`` that share its header (sync, ``length``, command) and are whole and
-    checksum-correct, into ``found``; return where the run stopped (``pos``: not even one).
-
-    A status stream is runs of one length. Here each packet costs one precompiled unpack of its
-    checksummed words, no per-byte Python and none of the general loop's branches; whatever breaks
-    the run (another length, garbage, a bad checksum, a packet not whole) is the general loop's."""
-    layout = _RUN_LAYOUTS.get(length) or _run_layout(length)
-    unpack = layout[0].unpack_from
-    odd_at = layout[1]
-    head = buf[pos : pos + 6]  # sync, length and command: one command's run (another starts anew)
-    command = buf[pos + 4] | buf[pos + 5] << 8
-    same_head = buf.startswith
-    append = found.append
-    new_packet = _new_tuple
-    last_start = end - length
-    body = length - 2
-    while pos <= last_start and same_head(head, pos):
-        t = unpack(buf, pos + 3)
-        odd = t[odd_at]
-        sent = t[-1]
-        if (sum(t) - odd - sent) & 0xFFFF ^ odd != sent:
-            break
-        append(new_packet(Packet, (command, buf[pos + 6 : pos + body])))
-        pos += length
-    return pos
+"""Packets shorter than this, several of one length in a row, are framed by :func:`take_run`."""
 
 
 @dataclass(slots=True)
@@ -324,7 +286,7 @@ class PacketDecoder:
         word_structs = WORD_STRUCTS
         garbage = 0
         last = -1
-        """The length of the packet before: one more of it in a row starts a run (:func:`_take_run`)."""
+        """The length of the packet before: one more of it in a row starts a run (:func:`~.runs.take_run`)."""
         while True:
             start = find(SYNC, pos)
             if start < 0:
@@ -355,7 +317,7 @@ class PacketDecoder:
                     continue
                 break
             if length == last and length < _RUN_BELOW:  # a run of one length: a status stream
-                after = _take_run(buf, pos, end, length, found)
+                after = take_run(buf, pos, end, length, found)
                 if after > pos:
                     pos = after
                     continue
