@@ -13,6 +13,9 @@ Two fast paths are checked against a reference written the simple way:
 
 from __future__ import annotations
 
+import copy
+import dataclasses
+import pickle
 import random
 from collections import defaultdict
 
@@ -31,7 +34,7 @@ from rtmu.protocol.errors import FieldUnderrun
 from rtmu.protocol.fields import FieldReader
 from rtmu.protocol.packet import Packet, encode_packet
 from rtmu.protocol.payloads.base import Side, decode_payload
-from rtmu.protocol.payloads.robot import UpdateNumbers
+from rtmu.protocol.payloads.robot import TEMPERATURE_UNKNOWN, UpdateNumbers
 from testdata import CAPTURES
 
 NUMBERS, STRINGS = 0x0108, 0x0109
@@ -164,6 +167,15 @@ def test_a_decoded_status_is_a_frozen_dataclass_like_any_other() -> None:
     assert decoded == built and hash(decoded) == hash(built) and repr(decoded) == repr(built)
     with pytest.raises(AttributeError):
         decoded.x = 1  # type: ignore[misc]
+    assert dataclasses.is_dataclass(decoded)
+    assert dataclasses.replace(decoded, x=5).x == 5 and dataclasses.replace(decoded, x=5).y == decoded.y
+    assert (
+        dataclasses.asdict(decoded)
+        == decoded.to_fields()
+        == {name: getattr(built, name) for name in (f.name for f in dataclasses.fields(built))}
+    )
+    assert pickle.loads(pickle.dumps(decoded)) == decoded == copy.deepcopy(decoded)
+    assert UpdateNumbers(1.0, 1, 2, 3, 4, 5, 6).temperature == TEMPERATURE_UNKNOWN
 
 
 HOSTILE = st.sampled_from(["flip", "lying_header", "short_same_head", "truncate", "other_command", "noise"])

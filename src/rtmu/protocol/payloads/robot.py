@@ -10,6 +10,7 @@ from __future__ import annotations
 import math
 import struct
 from dataclasses import dataclass
+from operator import itemgetter
 from typing import Final, Self
 
 from ..errors import FieldUnderrun
@@ -50,9 +51,17 @@ def battery_tenths(value: float) -> int:
 
 
 @register
-@dataclass(frozen=True, slots=True)
-class UpdateNumbers(Payload):
-    """``updateNumbers`` reply: the 19-byte status a client polls (e.g. every 100 ms)."""
+@dataclass(frozen=True, init=False)
+class UpdateNumbers(tuple, Payload):
+    """``updateNumbers`` reply: the 19-byte status a client polls (e.g. every 100 ms).
+
+    A frozen dataclass (fields, ``replace``, ``asdict``, equality with its own class only, repr)
+    whose values live in a tuple: the decoder makes one per status packet of every robot, and a
+    tuple is built in one C call where a slotted dataclass sets its fields one call each (half the
+    status path's cost). The fields are read-only properties over the tuple's items.
+    """
+
+    __slots__ = ()
 
     DATA_NAME = "updateNumbers"
     SIDE = Side.REPLY
@@ -74,6 +83,22 @@ class UpdateNumbers(Payload):
     """°C; −128 (or MobileSim's −127) = unknown."""
 
     SIZE = _NUMBERS.size
+
+    def __new__(
+        cls,
+        battery: float,
+        x: int,
+        y: int,
+        th: int,
+        vel: int,
+        rot_vel: int,
+        lat_vel: int,
+        temperature: int = TEMPERATURE_UNKNOWN,
+    ) -> Self:
+        return _new_tuple(cls, (battery, x, y, th, vel, rot_vel, lat_vel, temperature))
+
+    def __getnewargs__(self) -> tuple[float, int, int, int, int, int, int, int]:  # copy and pickle
+        return tuple(self)
 
     @property
     def temperature_known(self) -> bool:
@@ -100,21 +125,11 @@ class UpdateNumbers(Payload):
     @classmethod
     def decode(cls, data: bytes) -> Self:
         # Hot path (every status packet of every robot; a recording's by the hundred thousand): one
-        # precompiled unpack, and the instance filled through its slots' C setters — the frozen
-        # dataclass's __init__ costs a Python-level object.__setattr__ call per field, twice the rest.
+        # precompiled unpack, one tuple.
         if len(data) < 19:
             raise _numbers_underrun(len(data))
         b, x, y, th, v, rv, lv, t = _NUMBERS.unpack_from(data)
-        new = _new_object(cls)
-        _set_battery(new, b / 10)
-        _set_x(new, x)
-        _set_y(new, y)
-        _set_th(new, th)
-        _set_vel(new, v)
-        _set_rot_vel(new, rv)
-        _set_lat_vel(new, lv)
-        _set_temperature(new, t)
-        return new
+        return _new_tuple(cls, (b / 10, x, y, th, v, rv, lv, t))
 
     @classmethod
     def read_from(cls, reader: FieldReader) -> Self:
@@ -125,12 +140,9 @@ class UpdateNumbers(Payload):
         return cls.decode(reader.raw(cls.SIZE))
 
 
-_new_object = object.__new__
-(_set_battery, _set_x, _set_y, _set_th, _set_vel, _set_rot_vel, _set_lat_vel, _set_temperature) = (
-    getattr(UpdateNumbers, name).__set__ for name, _ in _NUMBER_FIELDS
-)
-"""Each field's slot setter (C): what :meth:`UpdateNumbers.decode` fills a new instance with. A slot
-written once, before the instance is handed out, keeps the frozen contract (no later writes)."""
+_new_tuple = tuple.__new__
+for _index, (_name, _) in enumerate(_NUMBER_FIELDS):  # each field reads its item (C, no frame)
+    setattr(UpdateNumbers, _name, property(itemgetter(_index), doc=f"``{_name}``, item {_index}."))
 
 
 @register
