@@ -126,9 +126,10 @@ class UpdateNumbers(tuple, Payload):
     def decode(cls, data: bytes) -> Self:
         # Hot path (every status packet of every robot; a recording's by the hundred thousand): one
         # precompiled unpack, one tuple.
-        if len(data) < 19:
-            raise _numbers_underrun(len(data))
-        b, x, y, th, v, rv, lv, t = _NUMBERS.unpack_from(data)
+        try:
+            b, x, y, th, v, rv, lv, t = _NUMBERS.unpack_from(data)
+        except struct.error:  # fewer than 19 bytes (a short payload costs nothing on the good path)
+            raise _numbers_underrun(len(data)) from None
         return _new_tuple(cls, (b / 10, x, y, th, v, rv, lv, t))
 
     @classmethod
