@@ -61,6 +61,9 @@ F = TypeVar("F", bound=Feed)
 
 TASK_END_TIMEOUT = 0.5
 """How long closing waits for a cancelled task to finish before leaving it behind."""
+DECODE_CACHE_BYTES = 16384
+"""Payloads up to this size are remembered with their value (a laser's 361 points take 2.9 kB);
+bigger ones — pictures, map chunks — are always decoded and never kept."""
 
 
 class Session:
@@ -97,6 +100,9 @@ class Session:
         """This connection's subscriptions (merged, where offered)."""
         self._held_subs: set[str] = set()
         """Conditional subscriptions (``only_while``) held now on this connection."""
+        self._decoded: dict[str, tuple[bytes, Any]] = {}
+        """Each data name's last small payload and its value: a stream that repeats itself (status,
+        sonar and lasers of a robot at rest) is not decoded again."""
         self.feeds: list[Feed] = [kind(self) for kind in (*FEEDS, *self.config.extra_feeds)]
         self._by_type = {type(feed): feed for feed in self.feeds}
         self._handlers: dict[type[Intent], Feed] = {}
@@ -147,7 +153,9 @@ class Session:
             log.exception("publishing %s failed", part.__name__)
 
     def robot_update(self, **changes: Any) -> None:
-        self._robot = replace(self._robot, **changes)
+        old, self._robot = self._robot, replace(self._robot, **changes)
+        if self._robot == old:  # only a reading's time moved (a robot at rest): nothing to tell anyone
+            return
         self.publish(RobotChanged(self._robot))
         for feed in self.feeds:
             feed.robot_changed(self._robot)
@@ -159,8 +167,11 @@ class Session:
             log.exception("notice callback failed")
 
     def decode(self, name: str, payload: bytes) -> Any:
+        last = self._decoded.get(name)
+        if last is not None and last[0] == payload:  # the same bytes again (a robot at rest): same value
+            return last[1]
         try:
-            return decode_payload(name, Side.REPLY, payload)
+            value = decode_payload(name, Side.REPLY, payload)
         except ProtocolError as exc:
             # Counted (the health shows it), logged sparingly: a 10 Hz stream of bad packets must
             # neither flood the log nor end the link; the next good packet is used as usual.
@@ -169,6 +180,9 @@ class Session:
             if health.bad_payloads <= 10 or health.bad_payloads % 1000 == 0:
                 log.warning("undecodable %s packet (%d so far): %s", name, health.bad_payloads, exc)
             return None
+        if len(payload) <= DECODE_CACHE_BYTES:
+            self._decoded[name] = (payload, value)
+        return value
 
     def spawn(self, coro: Coroutine[Any, Any, Any], name: str) -> None:
         task = asyncio.get_running_loop().create_task(coro, name=f"session-{name}")
