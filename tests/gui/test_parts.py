@@ -190,3 +190,22 @@ def test_colour_states_are_also_words_in_the_toolbar() -> None:
     toolbar.refresh()
     assert link.caption.get_text() == heading
     toolbar.close()
+
+
+def test_a_new_round_trip_waits_for_the_tick_and_a_level_shows_at_once() -> None:
+    """At rest the link cell changes once a second (issue 28): a new round trip or learned limit is
+    shown by the window's tick, a link that goes stale at once."""
+    model = RobotModel()
+    model.connection.set(ConnectionState(Phase.CONNECTED, "127.0.0.1", 7272))
+    model.health.set(LinkHealth(LinkLevel.OK, rtt_ms=1.5, stale_limit=0.33))
+    model.robot.set(replace(model.robot.value, numbers_at=1.0))
+    toolbar = StatusToolbar(model, OperatorState(), status_age=lambda: 0.1)
+    cell = toolbar.cells["link"]
+    assert cell.value.get_text() == "1.5 ms 0.1/0.33"
+    model.health.set(LinkHealth(LinkLevel.OK, rtt_ms=2.5, stale_limit=0.34))
+    assert cell.value.get_text() == "1.5 ms 0.1/0.33", "re-laid out before the tick"
+    toolbar.refresh()  # the window's once-a-second tick
+    assert cell.value.get_text() == "2.5 ms 0.1/0.34"
+    model.health.set(LinkHealth(LinkLevel.STALE, rtt_ms=2.5, stale_limit=0.34))
+    assert cell.stale and cell.caption.get_text().endswith("STALE")
+    toolbar.close()

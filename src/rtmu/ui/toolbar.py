@@ -29,7 +29,7 @@ from gi.repository import GLib, Gtk, Pango  # noqa: E402
 
 from ..base.i18n import _, ngettext, number  # noqa: E402
 from ..base.link_timing import STATUS_CEILING  # noqa: E402
-from ..model.observables import ConnectionState, LinkLevel, OperatorState, Phase, RobotModel  # noqa: E402
+from ..model.observables import ConnectionState, LinkHealth, LinkLevel, OperatorState, Phase, RobotModel  # noqa: E402
 from . import accessible  # noqa: E402
 from .gauges import BatteryGauge, WifiGauge, battery_fraction, wifi_bars  # noqa: E402
 from .ld_status import details_lines, goal_suffix  # noqa: E402
@@ -180,7 +180,9 @@ class StatusToolbar(Gtk.ScrolledWindow):
         self.get_hadjustment().connect("changed", lambda _a: self._queue_fit())
         self._unobserve = [
             model.robot.observe(lambda o, n: self.refresh()),
-            model.health.observe(lambda o, n: self.refresh()),
+            # A new round trip or learned limit waits for the next second's tick (one relayout a
+            # second at rest); a level or a ping unanswered shows at once.
+            model.health.observe(self._on_health),
             model.connection.observe(lambda o, n: self.refresh()),
             operator.speed.observe(lambda o, n: self.refresh()),
             model.navigation.observe(lambda o, n: self.refresh()),
@@ -240,6 +242,10 @@ class StatusToolbar(Gtk.ScrolledWindow):
     def hidden_columns(self) -> list[str]:
         """Columns given up for width (the dock column is absent, not given up, without dockInfo)."""
         return [n for n, c in self.cells.items() if not c.get_visible() and n not in ("dock", "loc")]
+
+    def _on_health(self, old: LinkHealth, new: LinkHealth) -> None:
+        if _health_news(old, new):
+            self.refresh()
 
     def refresh(self) -> None:
         """Show the model's values and how old they are (called on changes and by the window's timer)."""
@@ -435,6 +441,11 @@ class StatusToolbar(Gtk.ScrolledWindow):
             mark="" if health.level is LinkLevel.OK else level_word(health.level).upper(),
         )
         cell.show_level(f"link-{health.level.value}")
+
+
+def _health_news(old: LinkHealth, new: LinkHealth) -> bool:
+    """Whether a link health change must show before the next tick: its level or unanswered pings."""
+    return old.level is not new.level or old.ping_failures != new.ping_failures
 
 
 def _battery_value(value: float, soc: bool) -> str:
