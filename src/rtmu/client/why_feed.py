@@ -18,7 +18,7 @@ operator at once, as a safety notice: a fault is a reason it will not move.
 from __future__ import annotations
 
 from dataclasses import dataclass
-from typing import ClassVar
+from typing import TYPE_CHECKING, ClassVar
 
 from ..base.i18n import _, ngettext
 from ..base.notices import Kind, Notice
@@ -30,11 +30,9 @@ from .connection import AriaClient
 from .drive_loop import DriveFeed
 from .feed import Feed, FeedContext
 from .subscriptions import Subscription
-from .why import diagnose
-from .why_fix import apply
-from .why_gather import gather as gather_facts
-from .why_gather import split_fields
-from .why_values import Answer, Facts, Motion, OurSide
+
+if TYPE_CHECKING:  # the diagnosis is imported when first asked for: no launch pays for it (issue 28)
+    from .why_values import Answer, OurSide
 
 FAULTS_SHOWN = 3
 """Faults named in the notice (the why answer lists up to five, the console all of them)."""
@@ -81,6 +79,8 @@ class WhyFeed(Feed):
         shown = intent.link if intent is not None else ""
         link = LinkLevel(shown) if shown in {level.value for level in LinkLevel} else None
         ended = self.ctx.lease.ended
+        from .why_values import OurSide
+
         return OurSide(
             link=link if connected else LinkLevel.DOWN,
             lease_ended=ended.value if ended is not None else "",
@@ -99,6 +99,10 @@ class WhyFeed(Feed):
         return "" if reason is None else f"it is not running ({reason})"
 
     async def ask(self, intent: AskWhy) -> Answer:
+        from .why import diagnose
+        from .why_gather import gather as gather_facts
+        from .why_values import Facts, Motion
+
         ours = self.our_side(intent)
         client = self.ctx.client
         if client is None or not client.connected:
@@ -109,6 +113,10 @@ class WhyFeed(Feed):
 
     # -- fixing ------------------------------------------------------------------------------------
     async def fix(self, intent: ApplyFix) -> FixReport:
+        from .why import diagnose
+        from .why_fix import apply
+        from .why_gather import gather as gather_facts
+
         client = self.require()
         timeout = self.ctx.config.reply_timeout
         ours = self.our_side()
@@ -124,6 +132,8 @@ class WhyFeed(Feed):
 
     # -- an LD robot's faults ------------------------------------------------------------------------
     def _on_faults(self, packet: Packet) -> None:
+        from .why_gather import split_fields
+
         fields = split_fields(packet.payload)
         if packet.payload and not fields:
             return  # a layout RTMU cannot read safely: the why answer shows it raw

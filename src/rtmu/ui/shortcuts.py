@@ -11,8 +11,6 @@ columns); the window is built when it is first asked for.
 
 from __future__ import annotations
 
-from xml.sax.saxutils import escape
-
 import gi
 
 gi.require_version("Gtk", "4.0")
@@ -54,6 +52,8 @@ def shown_accels(b: Binding) -> list[str]:
 
 
 def shortcuts_xml(table: tuple[Binding, ...] | None = None, column_lines: int = COLUMN_LINES) -> str:
+    from xml.sax.saxutils import escape  # (it imports urllib: only when the shortcuts are built)
+
     found: dict[str, list[Binding]] = {}
     for b in table if table is not None else bindings():
         found.setdefault(b.group, []).append(b)
