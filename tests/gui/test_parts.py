@@ -209,3 +209,26 @@ def test_a_new_round_trip_waits_for_the_tick_and_a_level_shows_at_once() -> None
     model.health.set(LinkHealth(LinkLevel.STALE, rtt_ms=2.5, stale_limit=0.34))
     assert cell.stale and cell.caption.get_text().endswith("STALE")
     toolbar.close()
+
+
+def test_new_range_readings_alone_do_not_refresh_the_toolbar() -> None:
+    """A driving robot's laser and sonar change ten times a second; the toolbar shows neither, so only
+    a change it shows refreshes its dozen cells (issue 28: following a drive ≤ 5 % of a core)."""
+    model = RobotModel()
+    model.connection.set(ConnectionState(Phase.CONNECTED, "127.0.0.1", 7272))
+    model.robot.set(replace(model.robot.value, numbers_at=1.0, x=1000.0))
+    toolbar = StatusToolbar(model, OperatorState(), status_age=lambda: 0.1)
+    refreshes = [0]
+    shown = toolbar.refresh
+
+    def counted() -> None:
+        refreshes[0] += 1
+        shown()
+
+    toolbar.refresh = counted  # type: ignore[method-assign]
+    for i in range(5):
+        model.robot.set(replace(model.robot.value, laser=((i, 2 * i),), sonar=((i * 10, 0),)))
+    assert refreshes[0] == 0
+    model.robot.set(replace(model.robot.value, x=2000.0, laser=((9, 9),)))
+    assert refreshes[0] == 1 and toolbar.cells["x"].value.get_text() == "2.00"
+    toolbar.close()

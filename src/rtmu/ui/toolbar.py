@@ -20,6 +20,7 @@ from __future__ import annotations
 
 import time
 from collections.abc import Callable
+from dataclasses import replace
 
 import gi
 
@@ -29,7 +30,15 @@ from gi.repository import GLib, Gtk, Pango  # noqa: E402
 
 from ..base.i18n import _, ngettext, number  # noqa: E402
 from ..base.link_timing import STATUS_CEILING  # noqa: E402
-from ..model.observables import ConnectionState, LinkHealth, LinkLevel, OperatorState, Phase, RobotModel  # noqa: E402
+from ..model.observables import (  # noqa: E402
+    ConnectionState,
+    LinkHealth,
+    LinkLevel,
+    OperatorState,
+    Phase,
+    RobotModel,
+    RobotState,
+)
 from . import accessible  # noqa: E402
 from .gauges import BatteryGauge, WifiGauge, battery_fraction, wifi_bars  # noqa: E402
 from .ld_status import details_lines, goal_suffix  # noqa: E402
@@ -179,7 +188,7 @@ class StatusToolbar(Gtk.ScrolledWindow):
         self._fit_source = 0
         self.get_hadjustment().connect("changed", lambda _a: self._queue_fit())
         self._unobserve = [
-            model.robot.observe(lambda o, n: self.refresh()),
+            model.robot.observe(self._on_robot),
             # A new round trip or learned limit waits for the next second's tick (one relayout a
             # second at rest); a level or a ping unanswered shows at once.
             model.health.observe(self._on_health),
@@ -242,6 +251,10 @@ class StatusToolbar(Gtk.ScrolledWindow):
     def hidden_columns(self) -> list[str]:
         """Columns given up for width (the dock column is absent, not given up, without dockInfo)."""
         return [n for n, c in self.cells.items() if not c.get_visible() and n not in ("dock", "loc")]
+
+    def _on_robot(self, old: RobotState, new: RobotState) -> None:
+        if not _readings_only(old, new):  # a laser's or the sonar's new readings: nothing shown here
+            self.refresh()
 
     def _on_health(self, old: LinkHealth, new: LinkHealth) -> None:
         if _health_news(old, new):
@@ -441,6 +454,14 @@ class StatusToolbar(Gtk.ScrolledWindow):
             mark="" if health.level is LinkLevel.OK else level_word(health.level).upper(),
         )
         cell.show_level(f"link-{health.level.value}")
+
+
+def _readings_only(old: RobotState, new: RobotState) -> bool:
+    """Whether only the range readings differ (a driving robot's laser and sonar: 10 changes a second
+    the toolbar does not show, each a refresh of a dozen cells)."""
+    return (old.sonar, old.laser) != (new.sonar, new.laser) and replace(
+        new, sonar=old.sonar, laser=old.laser
+    ) == old
 
 
 def _health_news(old: LinkHealth, new: LinkHealth) -> bool:
