@@ -72,6 +72,9 @@ def test_a_still_robot_is_decoded_once_and_publishes_nothing(rig, sim: SimThread
     runner, model, ui, counts, published = rig
     ui.wait_for(lambda: counts.asked[STATUS] >= 5, 20)  # connected, settled
     asked, decoded = counts.asked[STATUS], counts.decoded[STATUS]
+    session = runner.session
+    assert session is not None
+    settled = session.clock()
     robots = sum(isinstance(c, RobotChanged) for c in published)
     drawings = sum(isinstance(c, DrawingsChanged) for c in published)
     ui.wait_for(lambda: counts.asked[STATUS] >= asked + 20, 30)  # 20 more status packets arrived
@@ -79,6 +82,9 @@ def test_a_still_robot_is_decoded_once_and_publishes_nothing(rig, sim: SimThread
     assert sum(isinstance(c, RobotChanged) for c in published) == robots, "a still robot was published"
     assert sum(isinstance(c, DrawingsChanged) for c in published) == drawings, "unchanged drawings published"
     assert runner.status_age() is not None and runner.status_age() < 5.0  # the stream is alive all along
+    # The session's own value still says when the newest status came (built when read).
+    numbers_at = runner.submit(lambda: session.robot.numbers_at).result(5)
+    assert numbers_at is not None and numbers_at > settled
 
     x0 = model.robot.value.x
     sim.call(lambda: sim.server.world.move_distance(500.0))

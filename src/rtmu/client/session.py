@@ -61,6 +61,8 @@ F = TypeVar("F", bound=Feed)
 
 TASK_END_TIMEOUT = 0.5
 """How long closing waits for a cancelled task to finish before leaving it behind."""
+READING_TIMES = frozenset({"numbers_at", "strings_at", "sonar_at", "laser_at"})
+"""``RobotState``'s fields that say when a reading came (not compared): alone they change nothing shown."""
 DECODE_CACHE_BYTES = 16384
 """Payloads up to this size are remembered with their value (a laser's 361 points take 2.9 kB);
 bigger ones — pictures, map chunks — are always decoded and never kept."""
@@ -92,6 +94,8 @@ class Session:
         self._target: Target | None = None
         self._published: dict[type, StateChange] = {}
         self._robot = RobotState()
+        self._times: dict[str, Any] = {}
+        """Reading times (:data:`READING_TIMES`) newer than ``_robot``'s, kept until it is next built."""
         self._connection = ConnectionState()
         self._tasks: set[asyncio.Task[Any]] = set()
         self._reconnect_task: asyncio.Task[None] | None = None
@@ -130,6 +134,9 @@ class Session:
 
     @property
     def robot(self) -> RobotState:
+        if self._times:
+            self._robot = replace(self._robot, **self._times)
+            self._times.clear()
         return self._robot
 
     @property
@@ -153,8 +160,15 @@ class Session:
             log.exception("publishing %s failed", part.__name__)
 
     def robot_update(self, **changes: Any) -> None:
-        old, self._robot = self._robot, replace(self._robot, **changes)
-        if self._robot == old:  # only a reading's time moved (a robot at rest): nothing to tell anyone
+        old = self._robot
+        if all(k in READING_TIMES or getattr(old, k) == v for k, v in changes.items()):
+            # Only a reading's time moved (a robot at rest): nothing to tell anyone, and no new value
+            # built until one is read (:attr:`robot`) or something else changes.
+            self._times.update((k, v) for k, v in changes.items() if k in READING_TIMES)
+            return
+        self._robot = replace(old, **{**self._times, **changes})
+        self._times.clear()
+        if self._robot == old:
             return
         self.publish(RobotChanged(self._robot))
         for feed in self.feeds:
@@ -350,6 +364,7 @@ class Session:
         self.lease.end(EndReason.DISCONNECTED)
         await self._drop_client()
         self._robot = RobotState()
+        self._times.clear()
         self.publish(RobotChanged(self._robot))
         for feed in self.feeds:
             feed.disconnected()
