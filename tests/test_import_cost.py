@@ -137,3 +137,24 @@ def test_the_window_loads_no_replay_reader() -> None:
         if m.split(".")[0] == "mcap" or m.startswith(("rtmu.ui.replay", "rtmu.recorder.replay"))
     ]
     assert not late, f"{late} loaded with the window ({why(late[0], 'import rtmu.ui.application')})"
+
+
+WINDOW_LATE = (
+    "rtmu.client.central",  # a central server's roster: for a central profile only
+    "rtmu.client.why_gather",  # why won't it move?: its questions and fixes when first asked
+    "rtmu.client.why_fix",
+    "xml.sax",  # the shortcuts window's escaping (xml.sax brings urllib and email): when it is built
+    "urllib.request",
+    "email",
+)
+"""What a launch to the first map frame does without (issue 28: launch ≤ 0.6 s); each is imported
+where it is first used."""
+
+
+def test_the_window_loads_what_its_first_frame_needs_and_not_these() -> None:
+    """Counted, never timed: each of these cost every launch milliseconds before the first map frame."""
+    code = "import rtmu.ui.application"
+    modules = loaded_by(code)
+    assert "rtmu.ui.application" in modules
+    late = [m for m in modules if m in WINDOW_LATE or m.startswith(tuple(f"{w}." for w in WINDOW_LATE))]
+    assert not late, f"{late} loaded with the window ({why(late[0], code)})"

@@ -11,7 +11,7 @@ import pytest
 from hypothesis import given
 from hypothesis import strategies as st
 
-from rtmu.ui.tiles import BACKGROUND, TILE, MapIndex, TileCache, render_region
+from rtmu.ui.tiles import BACKGROUND, OVERVIEW_MAX_PX, TILE, MapIndex, TileCache, render_region
 from rtmu.ui.viewport import ZOOM_MAX, ZOOM_MIN, ZOOM_STEPS, Viewport, fit_view, nearest_step, step_zoom
 
 coords = st.floats(-1e6, 1e6, allow_nan=False)
@@ -126,6 +126,32 @@ def test_tile_cache_renders_what_is_visible_off_the_calling_thread() -> None:
         assert ready.is_set() and cache.overview is not None
         cache.set_map(None, None)
         assert cache.bounds is None
+    finally:
+        cache.close()
+
+
+def test_tile_cache_keeps_the_tiles_of_one_zoom() -> None:
+    """A new zoom lets the old zoom's tiles go (issue 28: RSS): a launch's fit before the window had its
+    size used to leave a screenful of tiles no frame showed again."""
+    cache = TileCache(lambda: None)
+    try:
+        rng = np.random.default_rng(2)
+        cache.set_map(rng.integers(0, 30000, size=(5000, 2)).astype(np.int32), None)
+        assert cache.wait_idle(10)
+        small = fit_view(cache.bounds, 600, 400)  # type: ignore[arg-type]
+        cache.visible(small.scale, small.origin, small.width, small.height)
+        assert cache.wait_idle(10)
+        first = {key[1] for key in cache._tiles}
+        assert first == {small.scale}
+        big = fit_view(cache.bounds, 800, 480)  # type: ignore[arg-type]
+        assert big.scale != small.scale
+        spots = cache.visible(big.scale, big.origin, big.width, big.height)
+        assert cache.wait_idle(10)
+        assert {key[1] for key in cache._tiles} == {big.scale}, "the old zoom's tiles are kept"
+        spots = cache.visible(big.scale, big.origin, big.width, big.height)
+        assert all(s.surface is not None for s in spots)
+        ov = cache.overview
+        assert ov is not None and max(ov.surface.get_width(), ov.surface.get_height()) <= OVERVIEW_MAX_PX + 8
     finally:
         cache.close()
 

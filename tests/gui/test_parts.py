@@ -14,7 +14,7 @@ from rtmu.ui.gauges import battery_fraction, wifi_bars
 from rtmu.ui.keys import KeyRouter, bindings
 from rtmu.ui.settings_dialog import validate
 from rtmu.ui.shortcuts import shortcuts_xml
-from rtmu.ui.toolbar import StatusToolbar
+from rtmu.ui.toolbar import MOTION_REFRESH_S, StatusToolbar
 
 gi.require_version("Gdk", "4.0")
 gi.require_version("Gtk", "4.0")
@@ -189,4 +189,53 @@ def test_colour_states_are_also_words_in_the_toolbar() -> None:
     model.health.set(LinkHealth(LinkLevel.OK, rtt_ms=1.5))
     toolbar.refresh()
     assert link.caption.get_text() == heading
+    toolbar.close()
+
+
+def test_a_new_round_trip_waits_for_the_tick_and_a_level_shows_at_once() -> None:
+    """At rest the link cell changes once a second (issue 28): a new round trip or learned limit is
+    shown by the window's tick, a link that goes stale at once."""
+    model = RobotModel()
+    model.connection.set(ConnectionState(Phase.CONNECTED, "127.0.0.1", 7272))
+    model.health.set(LinkHealth(LinkLevel.OK, rtt_ms=1.5, stale_limit=0.33))
+    model.robot.set(replace(model.robot.value, numbers_at=1.0))
+    toolbar = StatusToolbar(model, OperatorState(), status_age=lambda: 0.1)
+    cell = toolbar.cells["link"]
+    assert cell.value.get_text() == "1.5 ms 0.1/0.33"
+    model.health.set(LinkHealth(LinkLevel.OK, rtt_ms=2.5, stale_limit=0.34))
+    assert cell.value.get_text() == "1.5 ms 0.1/0.33", "re-laid out before the tick"
+    toolbar.refresh()  # the window's once-a-second tick
+    assert cell.value.get_text() == "2.5 ms 0.1/0.34"
+    model.health.set(LinkHealth(LinkLevel.STALE, rtt_ms=2.5, stale_limit=0.34))
+    assert cell.stale and cell.caption.get_text().endswith("STALE")
+    toolbar.close()
+
+
+def test_range_readings_do_not_refresh_the_toolbar_and_motion_refreshes_it_four_times_a_second() -> None:
+    """A driving robot's laser and sonar change ten times a second and the toolbar shows neither; its
+    pose refreshes the toolbar's dozen cells at most every ``MOTION_REFRESH_S``; anything else at once
+    (issue 28: following a drive ≤ 5 % of a core)."""
+    model = RobotModel()
+    model.connection.set(ConnectionState(Phase.CONNECTED, "127.0.0.1", 7272))
+    model.robot.set(replace(model.robot.value, numbers_at=1.0, x=1000.0))
+    now = [100.0]
+    toolbar = StatusToolbar(model, OperatorState(), clock=lambda: now[0], status_age=lambda: 0.1)
+    refreshes = [0]
+    shown = toolbar.refresh
+
+    def counted() -> None:
+        refreshes[0] += 1
+        shown()
+
+    toolbar.refresh = counted  # type: ignore[method-assign]
+    for i in range(5):
+        model.robot.set(replace(model.robot.value, laser=((i, 2 * i),), sonar=((i * 10, 0),)))
+    assert refreshes[0] == 0
+    model.robot.set(replace(model.robot.value, x=2000.0, laser=((9, 9),)))
+    assert refreshes[0] == 0, "a pose right after the last refresh waits its turn"
+    now[0] += MOTION_REFRESH_S
+    model.robot.set(replace(model.robot.value, x=3000.0))
+    assert refreshes[0] == 1 and toolbar.cells["x"].value.get_text() == "3.00"
+    model.robot.set(replace(model.robot.value, battery_v=11.9))
+    assert refreshes[0] == 2 and toolbar.cells["battery"].value.get_text() == "11.9 V", "not motion: at once"
     toolbar.close()

@@ -212,6 +212,8 @@ class DrawingsFeed(Feed):
         if name not in self._requested:
             return
         self.samples += 1
+        if name not in self._raw and packet.payload == self._last_raw.get(name):
+            return  # the sample shown already (a laser at rest): nothing to decode, publish or draw
         self._raw[name] = packet.payload  # the newest only: decoded when published
         self._schedule_publish()
 

@@ -62,6 +62,11 @@ F = TypeVar("F", bound=Feed)
 
 TASK_END_TIMEOUT = 0.5
 """How long closing waits for a cancelled task to finish before leaving it behind."""
+READING_TIMES = frozenset({"numbers_at", "strings_at", "sonar_at", "laser_at"})
+"""``RobotState``'s fields that say when a reading came (not compared): alone they change nothing shown."""
+DECODE_CACHE_BYTES = 16384
+"""Payloads up to this size are remembered with their value (a laser's 361 points take 2.9 kB);
+bigger ones — pictures, map chunks — are always decoded and never kept."""
 
 
 class Session:
@@ -90,6 +95,8 @@ class Session:
         self._target: Target | None = None
         self._published: dict[type, StateChange] = {}
         self._robot = RobotState()
+        self._times: dict[str, Any] = {}
+        """Reading times (:data:`READING_TIMES`) newer than ``_robot``'s, kept until it is next built."""
         self._connection = ConnectionState()
         self._tasks: set[asyncio.Task[Any]] = set()
         self._reconnect_task: asyncio.Task[None] | None = None
@@ -98,6 +105,9 @@ class Session:
         """This connection's subscriptions (merged, where offered)."""
         self._held_subs: set[str] = set()
         """Conditional subscriptions (``only_while``) held now on this connection."""
+        self._decoded: dict[str, tuple[bytes, Any]] = {}
+        """Each data name's last small payload and its value: a stream that repeats itself (status,
+        sonar and lasers of a robot at rest) is not decoded again."""
         self.feeds: list[Feed] = [kind(self) for kind in (*FEEDS, *self.config.extra_feeds)]
         self._by_type = {type(feed): feed for feed in self.feeds}
         self._handlers: dict[type[Intent], Feed] = {}
@@ -125,6 +135,9 @@ class Session:
 
     @property
     def robot(self) -> RobotState:
+        if self._times:
+            self._robot = replace(self._robot, **self._times)
+            self._times.clear()
         return self._robot
 
     @property
@@ -148,7 +161,16 @@ class Session:
             log.exception("publishing %s failed", part.__name__)
 
     def robot_update(self, **changes: Any) -> None:
-        self._robot = replace(self._robot, **changes)
+        old = self._robot
+        if all(k in READING_TIMES or getattr(old, k) == v for k, v in changes.items()):
+            # Only a reading's time moved (a robot at rest): nothing to tell anyone, and no new value
+            # built until one is read (:attr:`robot`) or something else changes.
+            self._times.update((k, v) for k, v in changes.items() if k in READING_TIMES)
+            return
+        self._robot = replace(old, **{**self._times, **changes})
+        self._times.clear()
+        if self._robot == old:
+            return
         self.publish(RobotChanged(self._robot))
         for feed in self.feeds:
             feed.robot_changed(self._robot)
@@ -160,8 +182,11 @@ class Session:
             log.exception("notice callback failed")
 
     def decode(self, name: str, payload: bytes) -> Any:
+        last = self._decoded.get(name)
+        if last is not None and last[0] == payload:  # the same bytes again (a robot at rest): same value
+            return last[1]
         try:
-            return decode_payload(name, Side.REPLY, payload)
+            value = decode_payload(name, Side.REPLY, payload)
         except ProtocolError as exc:
             # Counted (the health shows it), logged sparingly: a 10 Hz stream of bad packets must
             # neither flood the log nor end the link; the next good packet is used as usual.
@@ -170,6 +195,9 @@ class Session:
             if health.bad_payloads <= 10 or health.bad_payloads % 1000 == 0:
                 log.warning("undecodable %s packet (%d so far): %s", name, health.bad_payloads, exc)
             return None
+        if len(payload) <= DECODE_CACHE_BYTES:
+            self._decoded[name] = (payload, value)
+        return value
 
     def spawn(self, coro: Coroutine[Any, Any, Any], name: str) -> None:
         task = asyncio.get_running_loop().create_task(coro, name=f"session-{name}")
@@ -326,6 +354,7 @@ class Session:
         self.lease.end(EndReason.DISCONNECTED)
         await self._drop_client()
         self._robot = RobotState()
+        self._times.clear()
         self.publish(RobotChanged(self._robot))
         for feed in self.feeds:
             feed.disconnected()

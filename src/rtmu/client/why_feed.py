@@ -22,7 +22,7 @@ from __future__ import annotations
 
 import time
 from dataclasses import dataclass, replace
-from typing import ClassVar
+from typing import TYPE_CHECKING, ClassVar
 
 from ..base.i18n import _, ngettext
 from ..base.notices import Kind, Notice
@@ -34,11 +34,9 @@ from .connection import AriaClient
 from .drive_loop import DriveFeed
 from .feed import Feed, FeedContext
 from .subscriptions import Subscription
-from .why import diagnose
-from .why_fix import apply
-from .why_gather import gather as gather_facts
-from .why_gather import split_fields
-from .why_values import Answer, Facts, Motion, OurSide
+
+if TYPE_CHECKING:  # the diagnosis is imported when first asked for: no launch pays for it (issue 28)
+    from .why_values import Answer, Facts, OurSide
 
 FAULTS_SHOWN = 3
 """Faults named in the notice (the why answer lists up to five, the console all of them)."""
@@ -79,6 +77,8 @@ class WhyFeed(Feed):
 
     def connected(self, client: AriaClient) -> None:
         self._faults, self._held_answer = None, None
+        from .why import diagnose  # at the login, not at launch (issue 28)
+
         for reason in diagnose(_login_facts(client)).reasons:
             if reason.loud:
                 self.ctx.notice(Notice.warning(Kind.SAFETY, reason.sentence()))
@@ -97,6 +97,8 @@ class WhyFeed(Feed):
         shown = intent.link if intent is not None else ""
         link = LinkLevel(shown) if shown in {level.value for level in LinkLevel} else None
         ended = self.ctx.lease.ended
+        from .why_values import OurSide
+
         return OurSide(
             link=link if connected else LinkLevel.DOWN,
             lease_ended=ended.value if ended is not None else "",
@@ -115,6 +117,10 @@ class WhyFeed(Feed):
         return "" if reason is None else f"it is not running ({reason})"
 
     async def ask(self, intent: AskWhy) -> Answer:
+        from .why import diagnose
+        from .why_gather import gather as gather_facts
+        from .why_values import Facts, Motion
+
         ours = self.our_side(intent)
         client = self.ctx.client
         if client is None or not client.connected:
@@ -143,6 +149,10 @@ class WhyFeed(Feed):
 
     # -- fixing ------------------------------------------------------------------------------------
     async def fix(self, intent: ApplyFix) -> FixReport:
+        from .why import diagnose
+        from .why_fix import apply
+        from .why_gather import gather as gather_facts
+
         client = self.require()
         timeout = self.ctx.config.reply_timeout
         ours = self.our_side()
@@ -158,6 +168,8 @@ class WhyFeed(Feed):
 
     # -- an LD robot's faults ------------------------------------------------------------------------
     def _on_faults(self, packet: Packet) -> None:
+        from .why_gather import split_fields
+
         fields = split_fields(packet.payload)
         if packet.payload and not fields:
             return  # a layout RTMU cannot read safely: the why answer shows it raw
@@ -191,5 +203,7 @@ class WhyFeed(Feed):
 
 def _login_facts(client: AriaClient, ours: OurSide | None = None, *notes: str) -> Facts:
     """What the login itself tells, with no request sent: this user's rights (its data list)."""
+    from .why_values import Facts, OurSide
+
     offers = frozenset(e.name for e in client.datalist)
     return Facts(offers=offers, user=client.user, ours=ours or OurSide(), notes=notes)

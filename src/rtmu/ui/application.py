@@ -29,7 +29,6 @@ gi.require_version("Gtk", "4.0")
 from gi.repository import Gio, GLib, Gtk  # noqa: E402
 
 from ..base.i18n import N_, _  # noqa: E402
-from ..client.central import CentralRoster  # noqa: E402
 from ..client.mapcache import SharedMaps  # noqa: E402
 from ..client.roster import RobotEndpoint, Roster  # noqa: E402
 from ..client.session import SessionConfig  # noqa: E402
@@ -250,6 +249,8 @@ class RtmuApplication(Gtk.Application):
         if profile.central:
             host, port = parse_central(profile.central)
             password = self.secrets.get(profile) or "" if profile.user else ""
+            from ..client.central import CentralRoster  # a central server's profile only
+
             return CentralRoster(host, port, user=profile.user, password=password, post=GLib.idle_add)
         return direct_roster(profile)
 

@@ -202,7 +202,8 @@ class ScanBar(Gtk.Revealer):
             model.transfers.observe(lambda _o, new: self._transfers(new)),
         ]
         self._unswitch = robot.on_switch(self._switched)
-        self._timer = GLib.timeout_add(REFRESH_MS, self._tick)
+        self._timer = 0
+        """The bar's clock while a scan runs; 0 otherwise (a window at rest does not wake for it)."""
         self._scan_changed(ScanState(), model.scan.value)
 
     # -- the dialog -------------------------------------------------------------------------------
@@ -223,6 +224,8 @@ class ScanBar(Gtk.Revealer):
         elif not new.scanning and old.scanning:
             self.offer_file = new.last_file
             self.note = self.message = ""
+        if new.scanning and not self._timer and self._unobserve:
+            self._timer = GLib.timeout_add(REFRESH_MS, self._tick)
         self._show()
 
     def _robot_moved(self, _old: RobotState, new: RobotState) -> None:
@@ -235,7 +238,10 @@ class ScanBar(Gtk.Revealer):
         self._scan_changed(ScanState(), self.model.scan.value)
 
     def _tick(self) -> bool:
-        if self.model.scan.value.scanning and self.progress is not None:
+        if not self.model.scan.value.scanning:
+            self._timer = 0
+            return False
+        if self.progress is not None:
             self.progress.now = max(self.progress.now, self.clock())
             self._show()
         return True

@@ -39,7 +39,9 @@ CAIRO_LINE_LIMIT = 4000
 """Segments per tile up to which cairo strokes them (antialiased); more are sampled with numpy."""
 MAX_SAMPLES = 6_000_000
 """Cap on line samples per tile (a pathological map must not eat the memory)."""
-OVERVIEW_MAX_PX = 2048
+OVERVIEW_MAX_PX = 1024
+"""The overview's longer side: shown only until a view's tiles arrive (ms), sharper than any fitted
+view of a window up to 1024 px wide; at 2048 px it held 6.5 MB of an office map for those moments."""
 DEFAULT_MAX_BYTES = 96 * 1024 * 1024
 TARGET_POINTS_PER_CELL = 64
 
@@ -289,6 +291,9 @@ class TileCache:
         self._overview: Overview | None = None
         self._overview_done = False
         self._wanted: list[tuple[float, int, int]] = []
+        self._scale = 0.0
+        """The scale the view last asked for: tiles of one scale are kept (a launch's first fit, made
+        before the window had its size, left 3.75 MB of tiles no frame showed again)."""
         self._notified = False
         self._closed = False
         self._busy = False
@@ -344,6 +349,11 @@ class TileCache:
         with self._lock:
             self._notified = False
             gen = self._generation
+            if scale != self._scale:  # a new zoom: the tiles of the old one go (re-rendered in ms)
+                self._scale = scale
+                for key in [k for k in self._tiles if k[1] != scale]:
+                    if self._tiles.pop(key) is not EMPTY:
+                        self._bytes -= TILE * TILE * 4
             for j in range(j0, j1 + 1):
                 for i in range(i0, i1 + 1):
                     key = (gen, scale, i, j)
@@ -434,7 +444,7 @@ class TileCache:
             blank = _is_blank(surface)
             with self._lock:
                 self.rendered += 1
-                if gen != self._generation:
+                if gen != self._generation or scale != self._scale:  # a map or a zoom gone meanwhile
                     return
                 key = (gen, scale, i, j)
                 self._tiles[key] = EMPTY if blank else surface

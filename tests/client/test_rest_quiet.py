@@ -1,0 +1,91 @@
+"""A robot at rest costs the window almost nothing (issue 28): its repeated packets are not decoded
+again, and nothing is published to the UI thread for them.
+
+Against the real simulator over loopback, the robot standing still: the status stream keeps coming
+(counted at ``Session.decode``), but each repeated payload is decoded once (counted at the payload
+codec) and no ``RobotChanged`` reaches the UI; once the robot moves, its new pose still does.
+Counting, never timing.
+"""
+
+from __future__ import annotations
+
+import collections
+from collections.abc import Iterator
+from typing import Any
+
+import pytest
+
+from rtmu.client import session as session_module
+from rtmu.client.runner import ClientRunner
+from rtmu.model.observables import Phase, RobotModel
+from rtmu.sim import SimThread
+from rtmu.values.state import DrawingsChanged, RobotChanged, StateChange
+from simulators import simulator
+
+from .uiqueue import UiQueue
+
+sim = simulator()
+
+STATUS = "updateNumbers"
+
+
+class Counts:
+    """Calls of ``Session.decode`` (packets handed to the feeds) and of the codec (real decodes)."""
+
+    def __init__(self, monkeypatch: pytest.MonkeyPatch) -> None:
+        self.asked: collections.Counter[str] = collections.Counter()
+        self.decoded: collections.Counter[str] = collections.Counter()
+        real_decode = session_module.decode_payload
+        real_method = session_module.Session.decode
+
+        def decode_payload(name: str, side: Any, payload: bytes) -> Any:
+            self.decoded[name] += 1
+            return real_decode(name, side, payload)
+
+        def decode(session: Any, name: str, payload: bytes) -> Any:
+            self.asked[name] += 1
+            return real_method(session, name, payload)
+
+        monkeypatch.setattr(session_module, "decode_payload", decode_payload)
+        monkeypatch.setattr(session_module.Session, "decode", decode)
+
+
+@pytest.fixture
+def rig(
+    sim: SimThread, monkeypatch: pytest.MonkeyPatch
+) -> Iterator[tuple[ClientRunner, RobotModel, UiQueue, Counts, list[StateChange]]]:
+    counts = Counts(monkeypatch)
+    model, ui = RobotModel(), UiQueue()
+    published: list[StateChange] = []
+    runner = ClientRunner(model, post=ui.post)
+    runner.on_publish = published.append
+    runner.start()
+    try:
+        runner.connect("127.0.0.1", sim.port, "", "", profile="t").result(10)
+        ui.wait_for(lambda: model.connection.value.phase is Phase.CONNECTED, 10)
+        yield runner, model, ui, counts, published
+    finally:
+        runner.close()
+
+
+def test_a_still_robot_is_decoded_once_and_publishes_nothing(rig, sim: SimThread) -> None:  # type: ignore[no-untyped-def]
+    runner, model, ui, counts, published = rig
+    ui.wait_for(lambda: counts.asked[STATUS] >= 5, 20)  # connected, settled
+    asked, decoded = counts.asked[STATUS], counts.decoded[STATUS]
+    session = runner.session
+    assert session is not None
+    settled = session.clock()
+    robots = sum(isinstance(c, RobotChanged) for c in published)
+    drawings = sum(isinstance(c, DrawingsChanged) for c in published)
+    ui.wait_for(lambda: counts.asked[STATUS] >= asked + 20, 30)  # 20 more status packets arrived
+    assert counts.decoded[STATUS] - decoded <= 1, "a repeated status payload was decoded again"
+    assert sum(isinstance(c, RobotChanged) for c in published) == robots, "a still robot was published"
+    assert sum(isinstance(c, DrawingsChanged) for c in published) == drawings, "unchanged drawings published"
+    assert runner.status_age() is not None and runner.status_age() < 5.0  # the stream is alive all along
+    # The session's own value still says when the newest status came (built when read).
+    numbers_at = runner.submit(lambda: session.robot.numbers_at).result(5)
+    assert numbers_at is not None and numbers_at > settled
+
+    x0 = model.robot.value.x
+    sim.call(lambda: sim.server.world.move_distance(500.0))
+    ui.wait_for(lambda: abs(model.robot.value.x - x0) > 100 or abs(model.robot.value.y) > 100, 30)
