@@ -20,6 +20,7 @@ from rtmu.client.runner import ClientRunner
 from rtmu.model.observables import Phase, RobotModel
 from rtmu.sim import SimThread
 from rtmu.values.state import DrawingsChanged, RobotChanged, StateChange
+from rtmu.values.target import Target
 from simulators import simulator
 
 from .uiqueue import UiQueue
@@ -61,7 +62,7 @@ def rig(
     runner.on_publish = published.append
     runner.start()
     try:
-        runner.connect("127.0.0.1", sim.port, "", "", profile="t").result(10)
+        runner.connect(Target("127.0.0.1", sim.port, profile="t")).result(10)
         ui.wait_for(lambda: model.connection.value.phase is Phase.CONNECTED, 10)
         yield runner, model, ui, counts, published
     finally:
