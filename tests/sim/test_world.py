@@ -84,6 +84,16 @@ def test_battery_drains_faster_when_driving_and_shutdown_stops_the_robot():
     assert low.changes.popups_created and low.changes.popups_created[0].title == "Low battery"
 
 
+def test_a_flat_battery_never_lets_a_drive_move_the_robot_even_one_step():
+    flat = World(Obstacles(np.zeros((0, 4))), drive_timeout=0)
+    flat.set_battery(p3dx.BATTERY_SHUTDOWN_V - 0.5)
+    flat.ratio_drive(100, 0, 100)
+    for _ in range(5):
+        flat.step()
+        assert flat.body.vel == 0.0 and flat.body.x == 0.0  # a status would show any step's speed
+    assert flat.mode is flat.stop_mode
+
+
 def test_map_points_are_obstacles_for_the_body_and_the_sonar():
     from rtmu.sim.sonar import sonar_ranges
 

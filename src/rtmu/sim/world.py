@@ -283,29 +283,37 @@ class World:
     # -- time -----------------------------------------------------------------
     def step(self, dt: float = PHYSICS_DT) -> None:
         self.time = round(self.time + dt, 9)  # no drift: 300 steps of 10 ms are exactly 3 s
+        # A pack at or below shutdown stops the robot before its motors turn: a drive asked of it
+        # must not move it for even one step (a status would show that step's speed).
+        self._stop_on_flat_battery()
         cmd = self.mode.command(self.body, self.time, dt)
         self.body.step(dt, cmd)
         self.camera.ptz.slew(dt)
         if not self.body.is_stopped():
             self.last_activity = self.time
-        charging = self.mode is self.dock_mode and self.dock_mode.docked
-        if charging:
+        if self._charging():
             charge(self, dt)
         self.localization.tick(self.time)
         if self.waiting_modes and not self.mode.locked:
             self.activate(self.waiting_modes.pop(0))
         self.check_mode_info()
-        if (
-            self.body.battery_v <= p3dx.BATTERY_SHUTDOWN_V
-            and self.mode is not self.stop_mode
-            and not charging
-        ):
-            self.stop()
+        self._stop_on_flat_battery()
         self._check_battery()
         self._check_popups()
         self.check_strings()
         for hook in self.step_hooks:
             hook()
+
+    def _charging(self) -> bool:
+        return self.mode is self.dock_mode and self.dock_mode.docked
+
+    def _stop_on_flat_battery(self) -> None:
+        if (
+            self.body.battery_v <= p3dx.BATTERY_SHUTDOWN_V
+            and self.mode is not self.stop_mode
+            and not self._charging()
+        ):
+            self.stop()
 
     def check_strings(self) -> None:
         now = self.strings()
