@@ -42,12 +42,20 @@ def addr(fleet: CentralThread) -> str:
 
 
 def place(fleet: CentralThread, name: str, x: float, y: float) -> None:
-    world = fleet.sims[name].world
+    """Put the robot at (x, y), then wait for its server's next cycle: a status asked before it would be
+    the cycle's cached one, from before (a busy machine runs the cycles late)."""
+    server = fleet.sims[name]
+    world = server.world
 
-    def put() -> None:
+    def put() -> int:
         world.body.x, world.body.y = x, y
+        return server.cycles
 
-    fleet.call(put)
+    placed_at = fleet.call(put)
+    deadline = time.monotonic() + 10.0
+    while fleet.call(lambda: server.cycles) <= placed_at:
+        assert time.monotonic() < deadline, f"{name}'s server ran no cycle in 10 s"
+        time.sleep(0.005)
 
 
 def pose(fleet: CentralThread, name: str) -> tuple[float, float]:
