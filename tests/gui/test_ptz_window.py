@@ -161,10 +161,16 @@ def test_ptz_buttons_keys_and_drag_move_the_simulated_head(gui: Gui, sim: SimThr
     x, y = gui.centre_on_surface(window.camera.picture)
     dx = window.camera.picture.get_width() // 4
     xid = str(gui.xid())
-    gui.xdotool("mousemove", "--window", xid, str(x), str(y), "mousedown", "1")
+    # The pointer rests on the picture before the press (the buttons' tooltip gone, the motion seen),
+    # and the release waits for the last move: on a busy machine a press sent with its move in one go
+    # was taken for nothing.
+    gui.xdotool("mousemove", "--window", xid, str(x), str(y))
+    idle(0.3)
+    gui.xdotool("mousedown", "1")
     for step in range(1, 5):
         gui.xdotool("mousemove", "--window", xid, str(x - dx * step // 4), str(y))
-        idle(0.03)
+        idle(0.05)
+    idle(0.1)
     gui.xdotool("mouseup", "1")
     pump(lambda: _head(sim)[0] < 0.0, 5, "the drag to pan the head left")
     gui.shot("camera-after-drag")
