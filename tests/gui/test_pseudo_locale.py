@@ -178,6 +178,9 @@ def check_german(gui: Gui, name: str) -> None:
     gui.shot(name)
     shown = {text for _where, text in widget_words(gui.window)}
     assert {"STOPP", "Trennen"} <= shown, sorted(shown)
+    # A distance as German writes it: the robot's x in metres with a decimal comma, never a point.
+    x = gui.window.toolbar.cells["x"].value.get_text()
+    assert re.fullmatch(r"-?\d{1,3}(?:\.\d{3})*,\d\d", x), x
     assert clipped_widgets(gui.window) == []
 
 

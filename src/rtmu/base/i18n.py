@@ -16,6 +16,7 @@ from __future__ import annotations
 import contextlib
 import gettext
 import locale
+import re
 from collections.abc import Sequence
 from pathlib import Path
 
@@ -57,11 +58,37 @@ def N_(message: str) -> str:
     return message
 
 
+# TRANSLATORS: 1234.5 as your language writes it, with its grouping mark (or none) and decimal mark.
+NUMBER_PATTERN = N_("1,234.5")
+"""Translators write one thousand two hundred thirty-four and a half as their language does (German:
+``1.234,5``): its grouping mark (or none) and decimal mark are read from it, so numbers follow the
+operator's language even where the C library lacks that locale."""
+
+_PATTERN = re.compile(r"1([^\d]?)234([^\d])5")
+
+
 def number(value: float, digits: int = 0) -> str:
-    """``value`` with ``digits`` decimals as the operator's locale writes numbers (its decimal mark and
-    grouping), for numbers shown to people; machine output (JSON, files) never goes through here."""
-    _numeric_locale()
-    return locale.format_string(f"%.{max(0, digits)}f", value, grouping=True)
+    """``value`` with ``digits`` decimals as the operator's language writes numbers (its decimal mark and
+    grouping), for numbers shown to people; machine output (JSON, files, the wire) never goes through here.
+
+    The marks come from the chosen catalogue's :data:`NUMBER_PATTERN`; with no catalogue (English, ``C``)
+    from the C library's ``LC_NUMERIC``."""
+    digits = max(0, digits)
+    marks = _catalogue_marks()
+    if marks is None:
+        _numeric_locale()
+        return locale.format_string(f"%.{digits}f", value, grouping=True)
+    group, decimal = marks
+    return f"{value:,.{digits}f}".translate({ord(","): group, ord("."): decimal})
+
+
+def _catalogue_marks() -> tuple[str, str] | None:
+    """(grouping mark, decimal mark) of the chosen catalogue, or None when it does not say."""
+    written = _(NUMBER_PATTERN)
+    if written == NUMBER_PATTERN:
+        return None
+    found = _PATTERN.search(written)
+    return (found.group(1), found.group(2)) if found else None
 
 
 _numeric_set: list[bool] = []

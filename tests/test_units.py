@@ -1,0 +1,106 @@
+"""Numbers with units for people (``rtmu.base.units``): the operator's language's decimal and grouping
+marks and its way of writing the unit, in German and in English/C; machine output stays plain."""
+
+from __future__ import annotations
+
+import json
+from collections.abc import Iterator
+from pathlib import Path
+
+import pytest
+
+from rtmu.base import i18n
+from rtmu.base.units import UNITS, coordinates, duration, file_size, metres, percent, quantity
+from rtmu.subcommands._status import status_line, status_object
+
+
+@pytest.fixture
+def german() -> Iterator[None]:
+    i18n.use(["de"])
+    try:
+        yield
+    finally:
+        i18n.use(["en"])
+
+
+@pytest.fixture
+def english() -> Iterator[None]:
+    i18n.use(["en"])
+    yield
+
+
+def test_german_writes_a_decimal_comma_and_groups_thousands_with_a_dot(german: None) -> None:
+    assert i18n.number(1234.5, 1) == "1.234,5"
+    assert quantity(1234.5, "m", 1) == "1.234,5 m"
+    assert metres(1500) == "1,5 m"
+    assert metres(-250, 2) == "-0,25 m"
+    assert quantity(12.5, "V", 1) == "12,5 V"
+    assert percent(2.4) == "2,4 %"
+    assert percent(60) == "60 %"
+    assert file_size(1_234_567) == "1,2 MB"
+    assert duration(12.6) == "13 s"
+    assert duration(5400) == "1,5 h"
+    assert quantity(90, "deg") == "90°"
+
+
+def test_english_and_c_write_a_decimal_point(english: None) -> None:
+    assert i18n.number(1234.5, 1) in ("1234.5", "1,234.5")  # the C library's LC_NUMERIC (C: no grouping)
+    assert quantity(1.5, "m", 1) == "1.5 m"
+    assert metres(1500) == "1.5 m"
+    assert percent(2.4) == "2.4 %"
+    assert file_size(999) == "999 B"
+    assert file_size(1_234_567) == "1.2 MB"
+    assert file_size(5 * 10**12) == "5000 GB"
+    assert duration(5.3) == "5.3 s"
+    assert duration(240) == "4 min"
+
+
+def test_coordinates_keep_the_two_numbers_apart_when_the_mark_is_a_comma(german: None) -> None:
+    assert coordinates(1500, -2000) == "1,50; -2,00 m"
+    i18n.use(["en"])
+    assert coordinates(1500, -2000) == "1.50, -2.00 m"
+
+
+def test_every_unit_is_translated_in_german_with_its_value_kept(german: None) -> None:
+    for unit in UNITS:
+        assert "{value}" in i18n._(UNITS[unit]), unit
+
+
+def test_a_catalogue_whose_number_pattern_is_unreadable_falls_back_to_the_c_library(
+    tmp_path: Path, english: None
+) -> None:
+    """A translator's slip ("1234" for the pattern) must not break every number in the window."""
+    from babel.messages.catalog import Catalog
+    from babel.messages.mofile import write_mo
+
+    catalog = Catalog(locale="xx", domain=i18n.DOMAIN)
+    catalog.add(i18n.NUMBER_PATTERN, "eintausend")
+    catalog.add(UNITS["m"], "{value} Meter")
+    mo = tmp_path / "xx" / "LC_MESSAGES" / f"{i18n.DOMAIN}.mo"
+    mo.parent.mkdir(parents=True)
+    with mo.open("wb") as out:
+        write_mo(out, catalog)
+    i18n.use(["xx"], tmp_path)
+    try:
+        assert quantity(2.5, "m", 1) == "2.5 Meter"
+    finally:
+        i18n.use(["en"])
+
+
+def test_the_status_line_is_german_and_the_json_object_stays_plain(german: None) -> None:
+    class Numbers:
+        x, y, th, vel, rot_vel, battery = 12345, -20, 90, 350, 5, 12.5
+
+    obj = status_object(Numbers(), "Stopped", "Ready")
+    line = status_line(obj)
+    assert "x=12.345 mm" in line and "Akku=12,5 V" in line and "v=350 mm/s" in line, line
+    assert json.loads(json.dumps(obj)) == {
+        "x": 12345,
+        "y": -20,
+        "th": 90,
+        "vel": 350,
+        "rot_vel": 5,
+        "battery_v": 12.5,
+        "status": "Stopped",
+        "mode": "Ready",
+    }
