@@ -104,3 +104,23 @@ def test_the_status_line_is_german_and_the_json_object_stays_plain(german: None)
         "status": "Stopped",
         "mode": "Ready",
     }
+
+
+def test_a_said_sentence_is_english_for_machines_and_german_for_people(german: None) -> None:
+    from rtmu.base.i18n import N_, Said, words
+    from rtmu.base.units import Quantity
+
+    said = Said(
+        N_("connected to {where} in {time}"), where="robot.local:7272", time=Quantity(1234.5, "ms", 1)
+    )
+    assert said == "connected to robot.local:7272 in 1234.5 ms"
+    assert json.loads(json.dumps({"summary": said})) == {
+        "summary": "connected to robot.local:7272 in 1234.5 ms"
+    }
+    assert words(said) == "verbunden mit robot.local:7272 in 1.234,5 ms"
+    nested = Said(N_("{what} — {advice}"), what=said, advice="x")
+    assert words(nested).startswith("verbunden mit")
+    assert words("robot.local") == "robot.local"
+    import pickle
+
+    assert words(pickle.loads(pickle.dumps(said))) == words(said)

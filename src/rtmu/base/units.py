@@ -8,6 +8,8 @@ to a server keep plain numbers and never come here.
 
 from __future__ import annotations
 
+from dataclasses import dataclass
+
 from .i18n import N_, _, number
 
 UNITS: dict[str, str] = {
@@ -35,8 +37,9 @@ UNITS: dict[str, str] = {
 
 def quantity(value: float, unit: str, digits: int = 0) -> str:
     """``value`` (already in ``unit``) with ``digits`` decimals and its unit: ``quantity(1234.5, "m", 1)``
-    → ``1,234.5 m`` in English, ``1.234,5 m`` in German."""
-    return _(UNITS[unit]).format(value=number(value, digits))
+    → ``1,234.5 m`` in English, ``1.234,5 m`` in German; unit ``""``: the number alone."""
+    shown = number(value, digits)
+    return _(UNITS[unit]).format(value=shown) if unit else shown
 
 
 def metres(mm: float, digits: int = 1) -> str:
@@ -75,3 +78,30 @@ def coordinates(x_mm: float, y_mm: float, digits: int = 2) -> str:
     decimal mark is the comma, so the two numbers stay apart)."""
     sep = "; " if number(0.5, 1)[1] == "," else ", "
     return _(UNITS["m"]).format(value=f"{number(x_mm / 1000, digits)}{sep}{number(y_mm / 1000, digits)}")
+
+
+@dataclass(frozen=True, slots=True)
+class Quantity:
+    """A number with its unit inside a :class:`rtmu.base.i18n.Said`: plain English where the sentence is
+    read by machines (``12.5 mm``), :func:`quantity` where it is shown to people (``12,5 mm``)."""
+
+    value: float
+    unit: str
+    digits: int | None = 0
+    """Decimals; None: as many as the value has (like ``:g``: ``5 s``, ``2.5 s``)."""
+
+    def _digits(self) -> int:
+        if self.digits is not None:
+            return max(0, self.digits)
+        text = f"{self.value:g}"
+        return len(text.split(".")[1]) if "." in text and "e" not in text else 0
+
+    def __str__(self) -> str:
+        plain = f"{self.value:.{self._digits()}f}"
+        return UNITS[self.unit].format(value=plain) if self.unit else plain
+
+    def __format__(self, spec: str) -> str:
+        return format(str(self), spec)
+
+    def words(self) -> str:
+        return quantity(self.value, self.unit, self._digits())
