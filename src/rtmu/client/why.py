@@ -23,7 +23,7 @@ from __future__ import annotations
 import math
 import re
 
-from ..base.i18n import N_, Said
+from ..base.i18n import N_, Said, as_said
 from ..base.units import Quantity
 from ..protocol.payloads.drive import RATIO_ROT_DEAD_ZONE, RATIO_TRANS_DEAD_ZONE, RatioDrive
 from ..protocol.payloads.robot import ModeInfo
@@ -503,10 +503,14 @@ def _safe_drive(facts: Facts, motion: Motion | None, navigate: bool) -> list[Rea
                 ),
                 advice,
                 (
-                    f"{obstacle.source}: reading at ({obstacle.x:.0f}, {obstacle.y:.0f}) mm in "
-                    f"the robot's frame",
-                    f"limits: {facts.limits.source}",
-                    "getSafeDrive: on",
+                    Said(
+                        N_("{sensor}: reading at ({x}, {y}) mm in the robot's frame"),
+                        sensor=obstacle.source,
+                        x=Quantity(obstacle.x, ""),
+                        y=Quantity(obstacle.y, ""),
+                    ),
+                    Said(N_("limits: {source}"), source=as_said(facts.limits.source)),
+                    Said(N_("{request}: on"), request="getSafeDrive"),
                 ),
                 fix,
             )
@@ -520,7 +524,9 @@ def _safe_off_fix(facts: Facts) -> Fix | None:
         if name in facts.offers:
             return Fix(
                 "safe_drive_off",
-                f"switch safe drive off ({name}); the robot then drives into things",
+                Said(
+                    N_("switch safe drive off ({request}); the robot then drives into things"), request=name
+                ),
                 name,
                 True,
             )

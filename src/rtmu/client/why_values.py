@@ -150,7 +150,7 @@ class SafeDriveLimits:
 
 
 ARIA_LIMITER_DEFAULTS = SafeDriveLimits(
-    150.0, 150.0, 50.0, "ARIA's defaults (Clearance 100 + PaddingAtSlowSpeed 50, side 50 mm)"
+    150.0, 150.0, 50.0, N_("ARIA's defaults (Clearance 100 + PaddingAtSlowSpeed 50, side 50 mm)")
 )
 """ArActionDeceleratingLimiter's defaults, used only when the server does not list its own."""
 
