@@ -96,3 +96,29 @@ def test_a_refused_connection_is_said_in_german(german: None, capsys: pytest.Cap
         assert main(["status", f"127.0.0.1:{port}", "--once", "--timeout", "5"]) != 0
     err = capsys.readouterr().err
     assert f"Verbindung von 127.0.0.1:{port} abgelehnt (läuft der Roboterserver an diesem Port?)" in err, err
+
+
+def test_a_wrong_password_is_said_in_german(
+    german: None, tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    from simulators import users_file
+
+    users = users_file(tmp_path, "teleop secret all")
+    wrong = tmp_path / "password"
+    wrong.write_text("not-it\n")
+    with SimThread(SimConfig(port=0, map_path=None, users_path=users)) as sim:
+        where = f"127.0.0.1:{sim.port}"
+        argv = [
+            "status",
+            where,
+            "--user",
+            "teleop",
+            "--password-file",
+            str(wrong),
+            "--once",
+            "--timeout",
+            "5",
+        ]
+        assert main(argv) != 0
+    err = capsys.readouterr().err
+    assert "Anmeldung abgelehnt: falscher Benutzername oder falsches Passwort" in err, err
