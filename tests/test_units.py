@@ -124,3 +124,12 @@ def test_a_said_sentence_is_english_for_machines_and_german_for_people(german: N
     import pickle
 
     assert words(pickle.loads(pickle.dumps(said))) == words(said)
+
+
+def test_the_link_timing_a_stop_names_is_english_in_logs_and_german_on_screen(german: None) -> None:
+    from rtmu.base.i18n import words
+    from rtmu.base.link_timing import Timing
+
+    timing = Timing(limit=0.33, jitter=0.09, mean=0.1, samples=50, learning=False).describe()
+    assert timing == "learned jitter 90 ms, limit 0.33 s"
+    assert words(timing) == "gelernter Jitter 90 ms, Grenze 0,33 s"
