@@ -133,3 +133,22 @@ def test_the_link_timing_a_stop_names_is_english_in_logs_and_german_on_screen(ge
     timing = Timing(limit=0.33, jitter=0.09, mean=0.1, samples=50, learning=False).describe()
     assert timing == "learned jitter 90 ms, limit 0.33 s"
     assert words(timing) == "gelernter Jitter 90 ms, Grenze 0,33 s"
+
+
+def test_live_videos_slow_down_and_the_speed_cap_source_read_german(german: None) -> None:
+    from dataclasses import replace
+
+    from rtmu.base.i18n import words
+    from rtmu.client.video_feed import RateGovernor
+    from rtmu.control.motion_limits import RobotLimits
+    from rtmu.values.state import VideoStatus
+
+    governor = RateGovernor(12.0, rtt_limit=0.2)
+    governor.observe(0.0, 1.5, None)
+    assert governor.reason == "slowed to 6.0 fps: round trip 1500 ms"  # --json and logs
+    status = VideoStatus(6.0, 310.0, 45.0, 12.0, 6.0, governor.reason, False, 0, "")
+    assert status.caption() == "6,0 fps · 310 kB/s · 45 ms alt · gedrosselt auf 6,0 fps: Umlaufzeit 1.500 ms"
+    seen = RobotLimits().seen(1200.0, 100.0, 50.0)
+    assert seen.source == "seen: 1200 mm/s at 50 % of full"
+    assert words(seen.source) == "beobachtet: 1.200 mm/s bei 50 % der vollen Fahrt"
+    assert words(replace(seen, source=RobotLimits().source).source) == "angenommen nach ARIAs P3-DX"

@@ -18,7 +18,7 @@ import gi
 gi.require_version("Gtk", "4.0")
 from gi.repository import Gio, GLib  # noqa: E402
 
-from ..base.i18n import _  # noqa: E402
+from ..base.i18n import _, words  # noqa: E402
 from ..base.units import quantity  # noqa: E402
 from ..control.motion_limits import capped_throttle  # noqa: E402
 from ..model.observables import NearPeople  # noqa: E402
@@ -74,7 +74,7 @@ class NearPeopleSwitch:
                 label=label(new),
                 throttle=quantity(throttle, "%"),
                 speed=quantity(limits.max_speed / 1000, "m/s", 1),
-                source=limits.source,
+                source=words(limits.source),
             )
         else:
             text = _("Near-people cap off: the speed steps go up to the robot's full speed again")

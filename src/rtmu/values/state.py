@@ -226,7 +226,7 @@ class VideoStatus:
 
     def caption(self) -> str:
         """One short line for the picture: "12.0 fps · 310 kB/s · 45 ms old"."""
-        from ..base.i18n import _
+        from ..base.i18n import _, words
         from ..base.units import quantity
 
         parts = [quantity(self.fps, "fps", 1), quantity(self.kbps, "kB/s")]
@@ -235,7 +235,7 @@ class VideoStatus:
         if self.paused:
             parts.append(_("paused"))
         if self.backoff:
-            parts.append(self.backoff)
+            parts.append(words(self.backoff))
         if self.dropped:
             dropped = _("{count} dropped").format(count=self.dropped)
             parts.append(dropped + (_(" (last: {note})").format(note=self.note) if self.note else ""))
