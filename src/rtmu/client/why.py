@@ -193,7 +193,13 @@ def _dead_zone(facts: Facts, motion: Motion | None, navigate: bool) -> list[Reas
                 trans_zone=Quantity(RATIO_TRANS_DEAD_ZONE, "%", None),
                 rot_zone=Quantity(RATIO_ROT_DEAD_ZONE, "%", None),
             ),
-            (f"our ratioDrive: {motion.trans:g} % translation, {motion.rot:g} % rotation",),
+            (
+                Said(
+                    N_("our ratioDrive: {trans} translation, {rot} rotation"),
+                    trans=Quantity(motion.trans, "%", None),
+                    rot=Quantity(motion.rot, "%", None),
+                ),
+            ),
         )
     ]
 
@@ -283,7 +289,10 @@ def _battery(facts: Facts, motion: Motion | None, navigate: bool) -> list[Reason
                 shutdown=Quantity(shutdown, unit, None),
             ),
             N_("charge the robot (dock it or plug it in) before driving"),
-            (f"updateNumbers: battery {level:g} {unit}", f"batteryInfo: shutdown {shutdown:g} {unit}"),
+            (
+                Said(N_("updateNumbers: battery {level}"), level=Quantity(level, unit, None)),
+                Said(N_("batteryInfo: shutdown {level}"), level=Quantity(shutdown, unit, None)),
+            ),
         )
     ]
 
@@ -345,8 +354,9 @@ def _modes(facts: Facts, motion: Motion | None, navigate: bool) -> list[Reason]:
     if info is not None and info.locked and not (docked and info.mode_name in DOCK_MODES):
         name = info.mode_name or "(unnamed)"
         said = (
-            f"getModeInfo: mode {name!r}, locked, "
-            f"{'will' if info.will_unlock_if_requested else 'will not'} unlock if asked",
+            Said(N_("getModeInfo: mode {mode}, locked, will unlock if asked"), mode=repr(name))
+            if info.will_unlock_if_requested
+            else Said(N_("getModeInfo: mode {mode}, locked, will not unlock if asked"), mode=repr(name)),
         )
         if info.will_unlock_if_requested:
             fix = _unlock_fix(facts, info)
@@ -458,7 +468,7 @@ def _watchdog(facts: Facts, motion: Motion | None, navigate: bool) -> list[Reaso
                 "raise the Teleop Timeout in the server's configuration "
                 "(ARIA's default is 2 s; 0 turns it off)"
             ),
-            (f"configuration: Teleop Timeout = {t:g} s",),
+            (Said(N_("configuration: Teleop Timeout = {timeout}"), timeout=Quantity(t, "s", None)),),
         )
     ]
 
