@@ -143,12 +143,19 @@ def number(value: float, digits: int = 0) -> str:
 
 
 def _catalogue_marks() -> tuple[str, str] | None:
-    """(grouping mark, decimal mark) of the chosen catalogue, or None when it does not say."""
-    written = _(NUMBER_PATTERN)
-    if written == NUMBER_PATTERN:
-        return None
-    found = _PATTERN.search(written)
-    return (found.group(1), found.group(2)) if found else None
+    """(grouping mark, decimal mark) of the chosen catalogue, or None when it does not say; read once
+    per catalogue (the toolbar writes numbers many times a second)."""
+    translation = _translation()
+    if _marks_read and _marks_read[0][0] is translation:
+        return _marks_read[0][1]
+    written = translation.gettext(NUMBER_PATTERN)
+    found = _PATTERN.search(written) if written != NUMBER_PATTERN else None
+    marks = (found.group(1), found.group(2)) if found else None
+    _marks_read[:] = [(translation, marks)]
+    return marks
+
+
+_marks_read: list[tuple[gettext.NullTranslations, tuple[str, str] | None]] = []
 
 
 _numeric_set: list[bool] = []
