@@ -97,7 +97,10 @@ class NotSupported(ClientError):
 
     def __init__(self, name: str, detail: str = "") -> None:
         self.name = name
-        super().__init__(detail or f"this server does not offer {name!r} (or this user may not use it)")
+        super().__init__(
+            detail
+            or Said(N_("this server does not offer {name} (or this user may not use it)"), name=repr(name))
+        )
 
 
 class MotionRefused(ClientError):
@@ -112,5 +115,8 @@ class MotionRefused(ClientError):
     def __init__(self, name: str) -> None:
         self.name = name
         super().__init__(
-            f"an observer never sends {name!r} (it changes how the robot moves); nothing was sent"
+            Said(
+                N_("an observer never sends {name} (it changes how the robot moves); nothing was sent"),
+                name=repr(name),
+            )
         )
