@@ -29,6 +29,7 @@ from rtmu.package_data import project_map
 from rtmu.recorder import topics
 from rtmu.recorder.bridge import LEASE_TTL, Bridge
 from rtmu.sim import SimConfig, SimThread
+from rtmu.values.target import Target
 
 ARENA = project_map("arena.map")
 WINDOW = 10.0
@@ -98,7 +99,7 @@ def session(with_bridge: bool, drive: bool = False) -> tuple[SimThread, ClientRu
         runner.on_publish = bridge.published
         bridge.start()
     runner.start()
-    runner.connect("127.0.0.1", sim.port, auto_reconnect=False).result(15)
+    runner.connect(Target("127.0.0.1", sim.port, auto_reconnect=False)).result(15)
     time.sleep(1.0)  # the map loads
     return sim, runner, bridge
 

@@ -43,6 +43,7 @@ from rtmu.protocol.payloads.drive import RatioDrive, SafeDrive
 from rtmu.protocol.payloads.robot import UpdateNumbers, UpdateStrings
 from rtmu.protocol.server_connection import ServerConnection
 from rtmu.values.state import RobotChanged, StateChange
+from rtmu.values.target import Target
 
 DRIVE_TRIALS = 400
 STATUS_SAMPLES = 600
@@ -162,7 +163,7 @@ def _connected_runner(
     port: int, model: RobotModel, post: Callable[[Callable[[], None]], Any], **cfg: Any
 ) -> ClientRunner:
     runner = ClientRunner(model, post=post, config=SessionConfig(fetch_map=False, **cfg)).start()
-    runner.connect("127.0.0.1", port).result(10)
+    runner.connect(Target("127.0.0.1", port)).result(10)
     deadline = time.monotonic() + 10
     while model.connection.value.phase is not Phase.CONNECTED:
         if time.monotonic() > deadline:
@@ -274,7 +275,7 @@ def status_latency() -> list[Result]:
     runner.on_publish = tap
     runner.start()
     try:
-        runner.connect("127.0.0.1", server.port).result(10)
+        runner.connect(Target("127.0.0.1", server.port)).result(10)
         time.sleep(0.3)
         to_model.clear()
         to_tap.clear()

@@ -53,8 +53,9 @@ def _display():  # type: ignore[no-untyped-def]
 
 
 @contextlib.contextmanager
-def _sims(count: int):  # type: ignore[no-untyped-def]
-    proc = subprocess.Popen([sys.executable, "-m", "bench.fleet_sims", str(count)], cwd=REPO,
+def _sims(count: int, *, wander: bool = True):  # type: ignore[no-untyped-def]
+    still = [] if wander else ["--still"]
+    proc = subprocess.Popen([sys.executable, "-m", "bench.fleet_sims", str(count), *still], cwd=REPO,
                             stdout=subprocess.PIPE, stderr=subprocess.DEVNULL, text=True)  # fmt: skip
     try:
         assert proc.stdout is not None

@@ -31,6 +31,7 @@ from rtmu.recorder.replay import REPLAY_CONFIG, PacedLink, Replayer
 from rtmu.recorder.replay_file import load
 from rtmu.sim import SimConfig, SimThread
 from rtmu.values.intents import RequestPicture
+from rtmu.values.target import Target
 
 ARENA = project_map("arena.map")
 SECONDS = float(os.environ.get("RTMU_REPLAY_BENCH_SECONDS", "30"))
@@ -43,7 +44,7 @@ def record(out: Path) -> None:
         recorder.attach(runner)
         runner.start()
         try:
-            runner.connect("127.0.0.1", sim.port, auto_reconnect=False).result(15)
+            runner.connect(Target("127.0.0.1", sim.port, auto_reconnect=False)).result(15)
             end = time.monotonic() + SECONDS
             next_picture = 0.0
             while time.monotonic() < end:
@@ -73,7 +74,7 @@ def rebuild(path: Path) -> tuple[float, PacedLink]:
     try:
         replayer.clock.seek(replayer.clock.end_ns)
         t0 = time.perf_counter()
-        runner.connect("replay", 0, auto_reconnect=False)
+        runner.connect(Target("replay", 0, auto_reconnect=False))
         while replayer.link is None or not replayer.link.exhausted:
             time.sleep(0.002)
         elapsed = time.perf_counter() - t0
@@ -90,7 +91,7 @@ def x1_lag(path: Path, seconds: float = 8.0) -> list[float]:
     runner.start()
     try:
         replayer.clock.play()
-        runner.connect("replay", 0, auto_reconnect=False)
+        runner.connect(Target("replay", 0, auto_reconnect=False))
         end = time.monotonic() + seconds
         seen = 0
         while time.monotonic() < end:

@@ -7,12 +7,15 @@ one JSON line:
 
 * ``ready_s``: from the application's start (after the imports, as ``bench_fleet``'s figure) until
   every robot has its status and its map and the robot that may drive (the selected one) is
-  guarded — its guardian armed;
+  guarded — its guardian armed; ``ready_cpu_s``: the CPU time this process and its guardians spent
+  meanwhile (on a busy machine the wall time grows, this does not: the two tell load from cost);
 * ``guardian_rss_mb`` / ``guardians``: the resident memory of the guardian processes (children of
   this one) and how many there are, once ready;
 * ``arming_ms``: for SELECTIONS selections in turn (shared mode), the time from ``Fleet.select`` until
-  the guardian is armed for the new robot; ``cold_ms``: the same robot's arming by a guardian process
-  started from nothing (what a guardian per selection would cost).
+  the guardian is armed for the new robot, and ``arming_cpu_ms`` the CPU time this process and its
+  guardian spent on each; ``cold_ms``: the same robot's arming by a guardian process started from
+  nothing (what a guardian per selection would cost);
+* ``load``: the machine's 1-minute load average at the start.
 """
 
 from __future__ import annotations
@@ -37,6 +40,7 @@ from rtmu.ui.application import RtmuApplication  # noqa: E402
 from rtmu.ui.options import GuiOptions  # noqa: E402
 
 PAGE = os.sysconf("SC_PAGE_SIZE")
+TICKS = os.sysconf("SC_CLK_TCK")
 
 
 def guardians() -> list[tuple[int, float]]:
@@ -55,6 +59,18 @@ def guardians() -> list[tuple[int, float]]:
             continue
         out.append((int(entry.name), pages * PAGE / 1e6))
     return out
+
+
+def cpu_s(pids: list[int]) -> float:
+    """CPU seconds of this process (every thread) and of the processes ``pids`` (gone ones count 0)."""
+    total = time.process_time()
+    for pid in pids:
+        try:
+            fields = Path(f"/proc/{pid}/stat").read_text().rsplit(")", 1)[1].split()
+        except OSError:
+            continue
+        total += (int(fields[11]) + int(fields[12])) / TICKS  # utime + stime
+    return total
 
 
 def pump_until(ready, timeout: float, what: str) -> None:  # type: ignore[no-untyped-def]
@@ -88,6 +104,8 @@ def cold_arming_ms(port: int) -> float:
 
 def main(mode: str, selections: int, ports: list[int]) -> None:
     started = time.monotonic()
+    cpu_started = time.process_time()
+    load = float(Path("/proc/loadavg").read_text().split()[0])
     robots = tuple(DirectRobot(f"robot{i + 1}", "127.0.0.1", p) for i, p in enumerate(ports))
     config = Path(tempfile.mkdtemp(prefix="rtmu-bench-scale-")) / "settings.toml"
     options = GuiOptions(
@@ -110,27 +128,35 @@ def main(mode: str, selections: int, ports: list[int]) -> None:
 
     pump_until(ready, 600, "the fleet to be ready")
     ready_s = time.monotonic() - started
+    ready_cpu_s = cpu_s([pid for pid, _mb in guardians()]) - cpu_started
     end = time.monotonic() + 1.0  # settle: the guardians' logins done, their memory as it stays
     pump_until(lambda: time.monotonic() > end, 10, "time")
     found = guardians()
     arming: list[float] = []
+    arming_cpu: list[float] = []
     cold: list[float] = []
     sessions = list(fleet)
+    pids = [pid for pid, _mb in found]
     for i in range(selections if mode == "shared" else 0):
         session = sessions[(i + 1) % len(sessions)]
+        c0 = cpu_s(pids)
         t0 = time.monotonic()
         fleet.select(session)
         pump_until(lambda s=session: guarded(s), 30, f"the guardian to be armed for {session.name}")
         arming.append((time.monotonic() - t0) * 1000.0)
+        arming_cpu.append((cpu_s(pids) - c0) * 1000.0)
     for i in range(min(5, selections) if mode == "shared" else 0):
         cold.append(cold_arming_ms(ports[i % len(ports)]))
     out = {
         "robots": len(ports),
         "mode": mode,
         "ready_s": ready_s,
+        "ready_cpu_s": ready_cpu_s,
+        "load": load,
         "guardians": len(found),
         "guardian_rss_mb": sum(mb for _pid, mb in found),
         "arming_ms": arming,
+        "arming_cpu_ms": arming_cpu,
         "cold_ms": cold,
     }
     print("RESULT " + json.dumps(out), flush=True)

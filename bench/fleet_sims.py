@@ -1,7 +1,10 @@
 """The simulators of ``bench_fleet``, in their own process: N robots on the office map, all wandering.
 
-``python -m bench.fleet_sims N`` prints one line ``PORTS p1 p2 …`` when every server listens,
-then serves until SIGTERM. Wandering keeps every pose changing, so each status is news to draw.
+``python -m bench.fleet_sims N [--still]`` prints one line ``PORTS p1 p2 …`` when every server
+listens, then serves until SIGTERM. Wandering keeps every pose changing, so each status is news to
+draw. ``--still`` robots stand (their status still comes at its rate): N wandering robots in one
+Python process keep a core busy casting rays, so a benchmark of the window's own start-up and logins
+would otherwise time the simulators — real robots' servers do not run on the operator's CPU.
 """
 
 from __future__ import annotations
@@ -18,10 +21,10 @@ from rtmu.sim.multi import SimFleet, fleet_configs
 OFFICE = project_map("office.map")
 
 
-async def main(count: int) -> None:
+async def main(count: int, wander: bool = True) -> None:
     fleet = SimFleet(fleet_configs(SimConfig(port=0, map_path=OFFICE, camera=False), count))
     await fleet.start()
-    for server in fleet.servers:
+    for server in fleet.servers if wander else ():
         server.world.wander()
     print("PORTS " + " ".join(str(s.port) for s in fleet.servers), flush=True)
     stop = asyncio.Event()
@@ -34,4 +37,4 @@ async def main(count: int) -> None:
 
 
 if __name__ == "__main__":
-    asyncio.run(main(int(sys.argv[1])))
+    asyncio.run(main(int(sys.argv[1]), wander="--still" not in sys.argv[2:]))

@@ -28,6 +28,7 @@ from rtmu.client.lease import DriveRatios
 from rtmu.client.runner import ClientRunner
 from rtmu.client.session import SessionConfig
 from rtmu.guardian.handle import BEAT_PERIOD
+from rtmu.values.target import Target
 
 DRIVE = DriveRatios(40.0, 0.0, 40.0)
 FRAME_WORK = 0.008
@@ -101,7 +102,7 @@ def main() -> int:
             say("guardian", f"{time.monotonic():.6f}", n.text.replace("\n", " "))
 
     runner.on_notice_sent = notice
-    runner.connect("127.0.0.1", port).result(15)
+    runner.connect(Target("127.0.0.1", port)).result(15)
     deadline = time.monotonic() + 15
     while time.monotonic() < deadline:  # drive once the guardian is up (or gave up)
         runner.sync()

@@ -21,6 +21,7 @@ from rtmu.client.lease import DriveRatios
 from rtmu.client.runner import ClientRunner
 from rtmu.client.session import SessionConfig
 from rtmu.recorder import Recorder, RecorderConfig
+from rtmu.values.target import Target
 
 CIRCLE = DriveRatios(30.0, 20.0, 40.0)
 
@@ -40,7 +41,7 @@ def main() -> int:
     if recorder is not None:
         recorder.attach(runner)
     runner.start()
-    runner.connect("127.0.0.1", port).result(10)
+    runner.connect(Target("127.0.0.1", port)).result(10)
     session = runner.session
     assert session is not None
     runner.call(session.load_map, timeout=30)  # the map is in the file once, before the measured part

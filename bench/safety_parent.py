@@ -20,6 +20,7 @@ from rtmu.client.session import SessionConfig
 from rtmu.fleet.sessions import Fleet
 from rtmu.guardian.handle import BEAT_PERIOD
 from rtmu.guardian.shared import SharedGuardian
+from rtmu.values.target import Target
 
 RATIOS = (DriveRatios(30.0, 20.0, 40.0), DriveRatios(30.0, -20.0, 40.0))
 
@@ -34,7 +35,7 @@ def main() -> int:
         runner = fleet.open(config=SessionConfig(fetch_map=False), guardian=fleet.guardian).runner
     else:
         runner = ClientRunner(config=SessionConfig(fetch_map=False, guardian=mode == "own")).start()
-    runner.connect("127.0.0.1", port).result(10)
+    runner.connect(Target("127.0.0.1", port)).result(10)
     deadline = time.monotonic() + 10
     while guardian and time.monotonic() < deadline:  # drive once the guardian is armed (or gave up)
         runner.sync()

@@ -42,6 +42,7 @@ from rtmu.client.lease import DriveRatios
 from rtmu.client.runner import LOOP_BEAT, ClientRunner
 from rtmu.client.session import SessionConfig
 from rtmu.model.observables import Phase, RobotModel
+from rtmu.values.target import Target
 
 HOLD = (0.3, 1.5)
 REST = (0.2, 1.0)
@@ -197,7 +198,7 @@ def soak(seconds: float, *, seed: int = 1, progress: Callable[[str], None] | Non
     model = RobotModel()
     runner = ClientRunner(model, post=ui.post, config=SessionConfig(fetch_map=True)).start()
     try:
-        runner.connect("127.0.0.1", server.port).result(15)
+        runner.connect(Target("127.0.0.1", server.port)).result(15)
         deadline = time.monotonic() + 15
         while model.connection.value.phase is not Phase.CONNECTED:
             if time.monotonic() > deadline:

@@ -114,7 +114,10 @@ def test_a_subcommand_help_loads_that_subcommand_only(name: str) -> None:
 
 def test_status_loads_no_numpy_gtk_or_recorder() -> None:
     """What ``rtmu status --once`` needs: the connection and the status payloads, nothing heavy."""
-    modules = ("subcommands.status", "client.connection", "client.ld_data", "protocol.payloads.robot")
+    modules = (
+        "subcommands.status", "client.connection", "client.ld_data", "client.robot_status",
+        "protocol.payloads.robot",
+    )  # fmt: skip
     code = "import " + ", ".join(f"rtmu.{m}" for m in modules)
     assert check(code, network=False) == []
 

@@ -88,10 +88,12 @@ def test_a_catalogue_whose_number_pattern_is_unreadable_falls_back_to_the_c_libr
 
 
 def test_the_status_line_is_german_and_the_json_object_stays_plain(german: None) -> None:
-    class Numbers:
-        x, y, th, vel, rot_vel, battery = 12345, -20, 90, 350, 5, 12.5
+    from rtmu.values.state import RobotState
 
-    obj = status_object(Numbers(), "Stopped", "Ready")
+    robot = RobotState(
+        x=12345, y=-20, th=90, vel=350, rot_vel=5, battery_v=12.5, status="Stopped", mode="Ready"
+    )
+    obj = status_object(robot)
     line = status_line(obj)
     assert "x=12.345 mm" in line and "Akku=12,5 V" in line and "v=350 mm/s" in line, line
     assert json.loads(json.dumps(obj)) == {

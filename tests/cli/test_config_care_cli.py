@@ -20,6 +20,7 @@ from rtmu.protocol.payloads.config import ConfigParam, ConfigSectionPacket, Para
 from rtmu.protocol.payloads.configcare import ConfigDefaults
 from rtmu.sim import SimThread
 from rtmu.subcommands.config import EXIT_REFUSED
+from rtmu.values.target import Target
 from simulators import simulator
 
 sim = simulator()
@@ -181,7 +182,7 @@ def test_reload_is_heard_by_every_client_and_set_config_param_resets_one(sim: Si
     calls: list[int] = []
     with ClientRunner(model, post=ui.post) as runner:
         runner.on_config_updated = lambda: calls.append(1)
-        runner.connect("127.0.0.1", sim.port).result(10)
+        runner.connect(Target("127.0.0.1", sim.port)).result(10)
         eventually(lambda: runner.session is not None and runner.session.client is not None, 10)
         assert config(sim.port, "--reload") == EXIT_OK
         ui.wait_for(lambda: bool(calls), 10)

@@ -19,6 +19,7 @@ from rtmu.client.runner import ClientRunner
 from rtmu.model.observables import RobotModel
 from rtmu.protocol.payloads.config import ConfigParam, ConfigSectionPacket, ParamType
 from rtmu.sim import SimConfig, SimThread
+from rtmu.values.target import Target
 from simulators import simulator
 
 sim = simulator()
@@ -202,7 +203,7 @@ def test_a_flood_of_config_updated_reaches_the_ui_as_a_few_posts() -> None:
     calls: list[int] = []
     with thread, ClientRunner(model, post=ui.post) as runner:
         runner.on_config_updated = lambda: calls.append(1)
-        runner.connect("127.0.0.1", server.port).result(10)
+        runner.connect(Target("127.0.0.1", server.port)).result(10)
         number = server.datalist.number("configUpdated")
         eventually(
             lambda: bool(thread.call(lambda: all(number in s.conn.subscriptions for s in server.sides)))

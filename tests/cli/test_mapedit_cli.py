@@ -31,6 +31,7 @@ from rtmu.protocol.payloads.mapchange import (
 from rtmu.protocol.payloads.server import IdleProcessingPending
 from rtmu.sim import SimThread
 from rtmu.subcommands.mapedit import EXIT_NOT_HELD, EXIT_REFUSED
+from rtmu.values.target import Target
 from simulators import simulator
 
 sim = simulator(map_path=project_map("arena.map"))
@@ -90,7 +91,7 @@ def test_json_says_what_was_sent_and_that_the_map_holds_it(
 def test_a_change_by_one_client_is_seen_by_another_clients_session(sim: SimThread) -> None:
     model, ui = RobotModel(), UiQueue()
     with ClientRunner(model, post=ui.post) as runner:
-        runner.connect("127.0.0.1", sim.port).result(10)
+        runner.connect(Target("127.0.0.1", sim.port)).result(10)
         ui.wait_for(lambda: model.map.value.data is not None, 15)
         first = model.map.value.generation
         assert mapedit(sim.port, "--add-goal", "Seen", "--x", "1200", "--y", "-800") == EXIT_OK

@@ -203,6 +203,37 @@ def test_a_drive_watchdog_shorter_than_our_resend(capsys) -> None:  # type: igno
     assert "0.05 s" in answer["sentence"] and "Timeout" in answer["reasons"][0]["advice"]
 
 
+# -- every state the simple commands make: the text, --json and a drive agree ---------------------------
+STATES = [
+    (("SimulatorEStop",), codes.EXIT_WHY_ESTOP, "estop", "e-stop is pressed", "release the e-stop"),
+    (("SimulatorMotorsOff",), codes.EXIT_WHY_MOTORS, "motors", "motors are disabled", "enable them"),
+    (("SimulatorSetBattery", "10.5"), codes.EXIT_WHY_BATTERY, "battery", "shutdown level (11 V)", "charge"),
+    (("SimulatorLockStopMode",), codes.EXIT_WHY_LOCKED, "locked", "will not unlock", "cannot release it"),
+    (("SimulatorObstacleAhead",), codes.EXIT_WHY_SAFE_DRIVE, "safe_drive", "safe drive holds", "drive away"),
+]
+
+
+@pytest.mark.parametrize(("args", "code", "key", "problem", "advice"), STATES, ids=[s[2] for s in STATES])
+def test_each_state_has_its_code_words_and_json_and_a_drive_against_it_never_exits_0(
+    sim: SimThread, capsys, args: tuple[str, ...], code: int, key: str, problem: str, advice: str
+) -> None:  # type: ignore[no-untyped-def]
+    command(sim, *args)
+    capsys.readouterr()
+    assert why(sim) == code
+    out = capsys.readouterr().out
+    assert problem in out and advice in out, out
+    got, answer = why_json(sim, capsys)
+    jsonschema.validate(answer, SCHEMAS["why"])
+    assert got == code and answer["exit_code"] == code and answer["cause"] == key
+    assert answer["can_move"] is False and problem in answer["sentence"]
+    x0 = x_of(sim)
+    assert drive(sim, "--trans", "50", "--json") == code
+    out, err = capsys.readouterr()
+    line = json.loads(out.splitlines()[-1])
+    assert line["moved"] is False and line["why"]["cause"] == key and problem in err
+    assert abs(x_of(sim) - x0) < 10.0
+
+
 # -- safe drive ---------------------------------------------------------------------------------------
 def test_an_obstacle_inside_safe_drive_and_switching_it_off_needs_a_yes(sim: SimThread, capsys) -> None:  # type: ignore[no-untyped-def]
     command(sim, "SimulatorObstacleAhead")

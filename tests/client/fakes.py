@@ -15,6 +15,7 @@ from rtmu.control.commands import CommandState
 from rtmu.settings.store import Profile
 from rtmu.values import intents
 from rtmu.values.intents import Intent
+from rtmu.values.target import Target
 
 
 class FakeView:
@@ -50,10 +51,12 @@ class RecordingLink:
         self.lease = DriveLease(clock=clock)
         self.on_notice: Callable[[Notice], None] | None = None
         self.calls: list[tuple[object, ...]] = []
+        self.targets: list[Target] = []
         self.blocking: list[tuple[Callable[[], object], Callable[[object], None]]] = []
 
-    def connect(self, host: str, port: int, user: str = "", password: str = "", **kw: object) -> None:
-        self.calls.append(("connect", host, port, user, password, kw.get("profile")))
+    def connect(self, target: Target) -> None:
+        self.targets.append(target)
+        self.calls.append(("connect", target.host, target.port, target.user, target.password, target.profile))
 
     def disconnect(self) -> None:
         self.calls.append(("disconnect",))

@@ -53,6 +53,7 @@ from rtmu.values.intents import (
     UploadFile,
 )
 from rtmu.values.state import StateChange, TransfersChanged
+from rtmu.values.target import Target
 from simulators import running
 
 from .fakeclock import FakeClock
@@ -69,7 +70,7 @@ class Rig:
         self.runner.on_notice = self.notices.append
         self.runner.on_publish = self.published.append
         self.runner.start()
-        self.runner.connect("127.0.0.1", port, "", "", profile="t").result(10)
+        self.runner.connect(Target("127.0.0.1", port, "", "", profile="t")).result(10)
         self.wait(lambda: self.model.connection.value.phase is Phase.CONNECTED)
 
     def wait(self, predicate: Any, timeout: float = 20.0) -> None:

@@ -19,6 +19,7 @@ from rtmu.package_data import project_map
 from rtmu.sim import SimConfig, SimThread
 from rtmu.sim.profiles import ARAM, DEFAULT
 from rtmu.values.intents import FetchConfig, SetConfig
+from rtmu.values.target import Target
 from simulators import simulator
 
 from .uiqueue import UiQueue
@@ -74,7 +75,7 @@ def test_the_windows_configuration_feed_gets_the_same_plain_words(aram: SimThrea
     runner = ClientRunner(RobotModel(), post=ui.post)
     runner.start()
     try:
-        runner.connect("127.0.0.1", aram.port).result(10)
+        runner.connect(Target("127.0.0.1", aram.port)).result(10)
         with pytest.raises(ForeignConfig) as info:
             runner.send(FetchConfig()).result(10)
         assert info.value.api is ConfigApi.OMRON_LD and "cannot show or edit it yet" in str(info.value)

@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import dataclasses
 import threading
 
 import pytest
@@ -30,6 +31,7 @@ from rtmu.values.intents import (
     SetSafeDrive,
     TurnBy,
 )
+from rtmu.values.target import Target
 
 from .fakeclock import FakeClock
 from .fakes import FakeView, RecordingLink
@@ -359,6 +361,22 @@ def test_connect_asks_for_the_password_and_uses_the_keyring_when_remembered() ->
     assert rig3.view.password_asks == []
     rig3.link.finish_blocking()
     assert len(rig3.view.password_asks) == 1
+
+
+def test_the_profile_reaches_the_link_as_one_target_whose_repr_hides_the_password() -> None:
+    rig = Rig(connected=False)
+    rig.ctl.select_profile(
+        Profile("lab", "10.0.0.5", 7272, user="alice", auto_reconnect=False, protocol="5MTX")
+    )
+    rig.ctl.connect(password="secret1")
+    want = Target("10.0.0.5", 7272, "alice", "secret1", profile="lab", auto_reconnect=False, protocol="5MTX")
+    assert rig.link.targets == [want]
+    assert "secret1" not in repr(want) and "alice" in repr(want)
+    with pytest.raises(dataclasses.FrozenInstanceError):
+        want.host = "elsewhere"  # type: ignore[misc]
+    rig.ctl.select_profile(Profile("any", "h", 1))  # no protocol string: the server's own is answered
+    rig.ctl.connect(password="")
+    assert rig.link.targets[-1].protocol is None and rig.link.targets[-1].auto_reconnect
 
 
 def test_a_keyring_answer_for_a_profile_left_meanwhile_is_dropped() -> None:

@@ -17,6 +17,7 @@ from rtmu.model.observables import Phase, RobotModel
 from rtmu.package_data import project_map
 from rtmu.sim import SimThread
 from rtmu.values.intents import DrawingChoices, ShowDrawing
+from rtmu.values.target import Target
 from simulators import simulator
 
 from .drawing_servers import BOLD_POINTS, MARKUP, MAX_POINTS_SENT, SONAR_POINTS, hostile_drawing_server
@@ -35,7 +36,7 @@ class Rig:
         self.model, self.ui = RobotModel(), UiQueue()
         self.runner = ClientRunner(self.model, post=self.ui.post)
         self.runner.start()
-        self.runner.connect("127.0.0.1", port, profile="test").result(10)
+        self.runner.connect(Target("127.0.0.1", port, profile="test")).result(10)
         self.wait(lambda: self.model.connection.value.phase is Phase.CONNECTED)
 
     def wait(self, predicate, timeout: float = 10.0) -> None:  # type: ignore[no-untyped-def]
@@ -98,7 +99,7 @@ def test_hiding_a_drawing_ends_its_request_and_showing_it_asks_again(rig: Rig, s
     eventually(lambda: "sonarCurrent" not in requested_at(sim))
     # A reconnect keeps the operator's choice: the session's own sonar subscription is ended again.
     rig.runner.disconnect().result(5)
-    rig.runner.connect("127.0.0.1", sim.port, profile="test").result(10)
+    rig.runner.connect(Target("127.0.0.1", sim.port, profile="test")).result(10)
     rig.wait(lambda: rig.model.connection.value.phase is Phase.CONNECTED and rig.layer(LASER) is not None)
     eventually(lambda: not {LASER, "sonarCurrent"} & set(requested_at(sim)), timeout=5)
     rig.runner.send(ShowDrawing(LASER, True)).result(5)
@@ -135,7 +136,7 @@ def test_a_remembered_choice_given_before_connecting_keeps_the_drawing_hidden_an
     runner.start()
     try:
         runner.send(DrawingChoices({LASER: False})).result(5)
-        runner.connect("127.0.0.1", sim.port, profile="test").result(10)
+        runner.connect(Target("127.0.0.1", sim.port, profile="test")).result(10)
         ui.wait_for(lambda: any(d.name == LASER for d in model.drawings.value.layers), 10)
         ui.wait_for(
             lambda: any(d.name == "sonarCurrent" and d.points for d in model.drawings.value.layers), 10

@@ -31,6 +31,7 @@ from rtmu.guardian.shared import SeatState
 from rtmu.protocol.payloads.drive import RatioDrive
 from rtmu.protocol.payloads.server import SelfIdentifier
 from rtmu.sim import SimConfig, SimThread
+from rtmu.values.target import Target
 from simulators import simulator
 
 from .uiqueue import eventually
@@ -43,9 +44,10 @@ import sys, threading, time
 from rtmu.client.lease import DriveRatios
 from rtmu.client.runner import ClientRunner
 from rtmu.client.session import SessionConfig
+from rtmu.values.target import Target
 port, user, password, guardian, drive = sys.stdin.readline().split()
 runner = ClientRunner(config=SessionConfig(fetch_map=False, guardian=guardian == "1")).start()
-runner.connect("127.0.0.1", int(port), user, password).result(10)
+runner.connect(Target("127.0.0.1", int(port), user, password)).result(10)
 deadline = time.monotonic() + 10
 seat = runner.session.guardian
 while seat is not None and seat.state.value in ("idle", "arming"):  # drive once it is armed (or refused)
@@ -205,7 +207,7 @@ def test_a_refused_second_login_is_said_plainly_and_driving_still_works() -> Non
         runner = ClientRunner(config=SessionConfig(fetch_map=False, guardian=True))
         runner.on_notice = lambda notice: notices.append((notice.level.value, notice.text))
         with runner:
-            runner.connect("127.0.0.1", sim.port).result(10)
+            runner.connect(Target("127.0.0.1", sim.port)).result(10)
 
             def told() -> bool:
                 runner.sync()

@@ -12,6 +12,7 @@ that).
 
 from __future__ import annotations
 
+import contextlib
 import os
 import signal
 import subprocess
@@ -23,6 +24,9 @@ import pytest
 
 from guardians import guardian_stops, guardians_of, logins
 from linkfaults import FaultProxy
+from rtmu.guardian.child import WARM_MAX
+from rtmu.guardian.handle import GuardianHandle
+from rtmu.guardian.messages import Hello
 from rtmu.sim import SimThread
 from simulators import running
 
@@ -104,19 +108,20 @@ def test_a_new_selection_arms_the_one_guardian_for_that_robot_before_it_drives_a
     sims: list[SimThread],
 ) -> None:
     first, second = sims
-    with FaultProxy("127.0.0.1", second.port, later_held=HOLD) as proxy:
-        parent = Parent({"robot1": first.port, "robot2": proxy.port})
+    # robot2, beside robot1 in the list, is kept ready by the guardian; robot3 is not, until chosen
+    with running(seed=3) as beside, FaultProxy("127.0.0.1", second.port, later_held=HOLD) as proxy:
+        parent = Parent({"robot1": first.port, "robot2": beside.port, "robot3": proxy.port})
         try:
             assert parent.ask("armed robot1") == "armed robot1"
-            assert logins(first) == 2 and logins(second) == 1  # the guardian is at robot1 only
-            assert parent.ask("select robot2") == "selected robot2"
+            assert logins(first) == 2 and logins(second) == 1  # the guardian is not at robot3
+            assert parent.ask("select robot3") == "selected robot3"
             answer = parent.ask("press forward")
-            assert answer.startswith("refused") and "arming the guardian for robot2" in answer, answer
+            assert answer.startswith("refused") and "arming the guardian for robot3" in answer, answer
             assert parent.ask("release forward") == "released"
-            assert drives(second) == 0, "robot2 drove before the guardian was armed for it"
-            assert parent.ask("armed robot2") == "armed robot2"
-            eventually(lambda: logins(first) == 1, timeout=5)  # it left robot1 for robot2
+            assert drives(second) == 0, "robot3 drove before the guardian was armed for it"
+            assert parent.ask("armed robot3") == "armed robot3"
             assert logins(second) == 2
+            assert logins(first) == 2  # robot1's login is kept ready (watched no more: see below)
             assert guardians_of(parent.proc.pid) == [parent.guardian_pid], "not ONE guardian process"
             assert parent.ask("press forward") == "pressed"
             eventually(lambda: driving(second), timeout=5)
@@ -125,7 +130,8 @@ def test_a_new_selection_arms_the_one_guardian_for_that_robot_before_it_drives_a
             eventually(lambda: guardian_stops(second) == 1, timeout=5)
             assert second.call(lambda: second.server.robot.watchdog_stops) == watchdog, "the watchdog fired"
             assert guardian_stops(first) == 0, "the robot not selected was stopped by the guardian"
-            assert not driving(first)  # (it got zero ratios and a stop when robot2 was selected)
+            assert guardian_stops(beside) == 0
+            assert not driving(first)  # (it got zero ratios and a stop when robot3 was selected)
         finally:
             parent.end()
         eventually(lambda: not guardians_of(parent.proc.pid) and logins(second) == 0, timeout=10)
@@ -145,6 +151,60 @@ def test_a_clean_close_says_goodbye_and_the_guardian_stops_nothing(sims: list[Si
         assert guardian_stops(first) == 0 and guardian_stops(second) == 0
     finally:
         parent.end()
+
+
+def test_the_robots_beside_the_selection_are_kept_ready_selecting_one_needs_no_new_login(
+    sims: list[SimThread],
+) -> None:
+    """Arming is a login, slow on a busy server: the guardian keeps logins to the robots beside the
+    selected one (and to the one selected before) ready. Selecting them opens no connection; the
+    guardian still stops only the robot it watches."""
+    first, second = sims
+    with (
+        FaultProxy("127.0.0.1", first.port) as one,
+        FaultProxy("127.0.0.1", second.port, later_held=HOLD) as two,
+    ):
+        parent = Parent({"robot1": one.port, "robot2": two.port})
+        try:
+            assert parent.ask("armed robot1") == "armed robot1"
+            eventually(lambda: two.connections == 2, timeout=10)  # the window's and the guardian's ready one
+            assert one.connections == 2
+            assert parent.ask("select robot2") == "selected robot2"
+            assert parent.ask("armed robot2") == "armed robot2"
+            assert parent.ask("select robot1") == "selected robot1"
+            assert parent.ask("armed robot1") == "armed robot1"
+            assert (one.connections, two.connections) == (2, 2), "an arming opened a new connection"
+            assert logins(first) == 2 and logins(second) == 2
+            assert parent.ask("press forward") == "pressed"
+            eventually(lambda: driving(first), timeout=5)
+            parent.proc.kill()
+            eventually(lambda: guardian_stops(first) == 1, timeout=5)
+            assert guardian_stops(second) == 0, "the guardian stopped a robot it only kept ready"
+            assert not driving(second)  # (zero ratios and a stop when robot1 was selected again)
+        finally:
+            parent.end()
+        eventually(lambda: logins(first) == 0 and logins(second) == 0, timeout=10)
+
+
+def test_the_guardian_keeps_at_most_three_logins_ready_lets_go_when_told_and_promotes_one() -> None:
+    """The ready logins are bounded (memory independent of the fleet's size): the newest
+    ``WARM_MAX`` are kept, COLD lets one go, and a LOGIN for a kept robot opens no new connection."""
+    assert WARM_MAX == 3
+    with contextlib.ExitStack() as stack:
+        robots = [stack.enter_context(running(seed=i)) for i in range(5)]
+        handle = GuardianHandle.start()
+        try:
+            for sim in robots:
+                handle.warm(Hello("127.0.0.1", sim.port))
+            eventually(lambda: [logins(sim) for sim in robots] == [0, 0, 1, 1, 1], timeout=10)
+            handle.cool(Hello("127.0.0.1", robots[3].port))
+            eventually(lambda: [logins(sim) for sim in robots] == [0, 0, 1, 0, 1], timeout=10)
+            handle.login(Hello("127.0.0.1", robots[4].port, serial=7))
+            eventually(lambda: handle.poll() is not None and handle.state == "ready", timeout=10)
+            assert [logins(sim) for sim in robots] == [0, 0, 1, 0, 1]
+        finally:
+            handle.close(goodbye=True)
+        eventually(lambda: sum(logins(sim) for sim in robots) == 0, timeout=10)
 
 
 def sim_mode(sim: SimThread) -> str:

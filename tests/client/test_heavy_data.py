@@ -22,6 +22,7 @@ from rtmu.client.runner import ClientRunner
 from rtmu.client.session import SessionConfig
 from rtmu.model.observables import RobotModel
 from rtmu.protocol.payloads.drawings import DrawingPoints
+from rtmu.values.target import Target
 
 from .heavy_servers import big_jpeg, drawing_flood_server, popup_storm_server
 from .servers import ServerThread, TestServer
@@ -37,7 +38,7 @@ def hold_a_drive(server: TestServer) -> tuple[ClientRunner, RobotModel, UiQueue,
     stops: list[str] = []
     runner.on_stop = lambda reason, sent: stops.append(reason)
     runner.start()
-    runner.connect("127.0.0.1", server.port).result(10)
+    runner.connect(Target("127.0.0.1", server.port)).result(10)
     ui.wait_for(lambda: model.health.value.rtt_ms is not None, timeout=10)
     runner.lease.grant(DriveRatios(30, 0, 30))
     before = len([r for r in server.received if r.name == "ratioDrive"])

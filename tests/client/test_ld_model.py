@@ -11,6 +11,7 @@ from rtmu.package_data import project_map
 from rtmu.sim import SimConfig, SimThread
 from rtmu.sim.ld_data import ROUTES
 from rtmu.values.intents import Dock
+from rtmu.values.target import Target
 
 from .uiqueue import UiQueue
 
@@ -21,7 +22,7 @@ def connected(port: int) -> tuple[ClientRunner, RobotModel, UiQueue]:
     model, ui = RobotModel(), UiQueue()
     runner = ClientRunner(model, post=ui.post, clock=time.monotonic, config=SessionConfig(fetch_map=False))
     runner.start()
-    runner.connect("127.0.0.1", port, profile="sim").result(10)
+    runner.connect(Target("127.0.0.1", port, profile="sim")).result(10)
     ui.wait_for(lambda: model.connection.value.phase is Phase.CONNECTED)
     return runner, model, ui
 

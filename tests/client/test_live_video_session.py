@@ -11,6 +11,7 @@ from rtmu.model.observables import CameraImage, Phase, RobotModel
 from rtmu.package_data import project_map
 from rtmu.sim import SimConfig, SimThread
 from rtmu.values.intents import StartVideo, StopVideo, VideoShown
+from rtmu.values.target import Target
 from simulators import simulator
 
 from .uiqueue import UiQueue
@@ -39,7 +40,7 @@ def start(port: int) -> tuple[ClientRunner, RobotModel, UiQueue, list[CameraImag
     model, ui = RobotModel(), UiQueue()
     runner = ClientRunner(model, post=ui.post, config=SessionConfig(guardian=False))
     runner.start()
-    runner.connect("127.0.0.1", port, profile="test").result(5)
+    runner.connect(Target("127.0.0.1", port, profile="test")).result(5)
     ui.wait_for(lambda: model.connection.value.phase is Phase.CONNECTED)
     frames: list[CameraImage] = []
     model.camera.observe(lambda _old, new: new is not None and new.video is not None and frames.append(new))

@@ -11,6 +11,7 @@ from rtmu.cli import main
 from rtmu.client.runner import ClientRunner
 from rtmu.client.session import SessionConfig
 from rtmu.model.observables import Phase, RobotModel
+from rtmu.values.target import Target
 
 from .servers import MAP_LINES, ServerThread, TestServer
 from .uiqueue import UiQueue
@@ -27,7 +28,7 @@ def _connected(server: TestServer, **config: object) -> Connected:
     notices: list[tuple[str, str]] = []
     runner.on_notice = lambda notice: notices.append((notice.level.value, notice.text))
     runner.start()
-    runner.connect("127.0.0.1", server.port).result(5)
+    runner.connect(Target("127.0.0.1", server.port)).result(5)
     ui.wait_for(lambda: model.connection.value.phase is Phase.CONNECTED)
     return runner, model, ui, notices
 
@@ -128,7 +129,7 @@ def test_a_bad_status_packet_is_counted_and_the_session_goes_on() -> None:
         )
         runner.start()
         try:
-            runner.connect("127.0.0.1", server.port).result(5)
+            runner.connect(Target("127.0.0.1", server.port)).result(5)
             ui.wait_for(lambda: model.connection.value.phase is Phase.CONNECTED)
             ui.wait_for(lambda: model.health.value.dropped >= 3 and model.robot.value.x >= 7)
             runner.sync()

@@ -19,6 +19,7 @@ from rtmu.model.observables import LinkHealth, LinkLevel
 from rtmu.protocol.payloads.mapstream import DEFAULT_MAX_POINTS, DEFAULT_MAX_TEXT_LINES
 from rtmu.values.intents import LoadMap
 from rtmu.values.state import HealthChanged, StateChange
+from rtmu.values.target import Target
 
 from .endless_maps import endless_map_server, run_watching_peak
 from .servers import ServerThread, TestServer, run
@@ -81,7 +82,7 @@ def test_a_session_fails_the_map_keeps_the_link_and_does_not_fetch_it_again(kind
         config = SessionConfig(lost_after=2.0, ping_timeout=30.0)
         session = Session(DriveLease(), publish, config=config)
         try:
-            await session.connect("127.0.0.1", server.port, auto_reconnect=True)
+            await session.connect(Target("127.0.0.1", server.port, auto_reconnect=True))
             got = await asyncio.wait_for(session.dispatch(LoadMap()), 60)
             assert got.state == "failed" and "too large" in got.error, got
             assert session.connected and len(server.sides) == 1  # the link was never called lost

@@ -13,6 +13,7 @@ from rtmu.client.lease import DriveLease
 from rtmu.client.mapcache import SharedMaps
 from rtmu.client.session import Session, SessionConfig
 from rtmu.values.intents import LoadMap
+from rtmu.values.target import Target
 
 from .endless_maps import map_id_server
 from .servers import TestServer, run
@@ -34,7 +35,7 @@ def test_reconnect_keeps_the_map_and_a_changed_map_is_loaded_again() -> None:
         await server.start()
         session = Session(DriveLease(), lambda change: None, config=SessionConfig())
         try:
-            await session.connect("127.0.0.1", server.port, auto_reconnect=True)
+            await session.connect(Target("127.0.0.1", server.port, auto_reconnect=True))
             first = await asyncio.wait_for(session.dispatch(LoadMap()), 10)
             assert first.state == "ready" and _count(server, "getMapBinary") == 1
 
@@ -65,7 +66,7 @@ def test_without_a_map_id_every_connection_loads_the_map() -> None:
         await server.start()
         session = Session(DriveLease(), lambda change: None, config=SessionConfig())
         try:
-            await session.connect("127.0.0.1", server.port, auto_reconnect=True)
+            await session.connect(Target("127.0.0.1", server.port, auto_reconnect=True))
             await asyncio.wait_for(session.dispatch(LoadMap()), 10)
             server.kill(server.sides[0])
             await _until(lambda: _count(server, "getMapBinary") == 2)
@@ -90,7 +91,7 @@ def test_sessions_sharing_a_map_download_it_once_and_a_different_map_is_not_shar
         sessions = [Session(DriveLease(), lambda change: None, config=config) for _ in servers]
         try:
             for session, server in zip(sessions, servers, strict=True):
-                await session.connect("127.0.0.1", server.port)
+                await session.connect(Target("127.0.0.1", server.port))
             maps = await asyncio.wait_for(asyncio.gather(*(s.dispatch(LoadMap()) for s in sessions)), 20)
             assert all(m.state == "ready" for m in maps)
             loads = [_count(server, "getMapBinary") for server in servers]
@@ -118,7 +119,7 @@ def test_a_failed_shared_download_lets_the_waiting_session_fetch_its_own() -> No
         assert shared.claim(key) == (None, None)  # a session elsewhere is downloading it …
         session = Session(DriveLease(), lambda change: None, config=SessionConfig(shared_maps=shared))
         try:
-            await session.connect("127.0.0.1", servers[0].port)
+            await session.connect(Target("127.0.0.1", servers[0].port))
             loading = asyncio.ensure_future(session.dispatch(LoadMap()))
             await asyncio.sleep(0.3)
             assert not loading.done() and _count(servers[0], "getMapBinary") == 0, "it did not wait"

@@ -8,6 +8,7 @@ from rtmu.client.lease import DriveLease
 from rtmu.client.session import Session, SessionConfig
 from rtmu.protocol.fields import FieldWriter
 from rtmu.values.intents import LoadMap
+from rtmu.values.target import Target
 
 from .servers import MAP_LINES, SPECS, ServerSide, TestServer, run
 
@@ -48,7 +49,7 @@ def test_a_long_map_without_status_does_not_reconnect() -> None:
         await server.start()
         session = Session(DriveLease(), lambda change: None, config=SessionConfig(lost_after=1.0))
         try:
-            await session.connect("127.0.0.1", server.port, auto_reconnect=True)
+            await session.connect(Target("127.0.0.1", server.port, auto_reconnect=True))
             got = await asyncio.wait_for(session.dispatch(LoadMap()), 20)
             assert got.state == "ready", got.error
             assert len(server.sides) == 1  # the link was never called lost

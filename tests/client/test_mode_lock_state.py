@@ -6,6 +6,7 @@ from rtmu.client.runner import ClientRunner
 from rtmu.model.observables import RobotModel
 from rtmu.sim import SimConfig, SimThread
 from rtmu.values.state import RobotState
+from rtmu.values.target import Target
 
 from .uiqueue import UiQueue
 
@@ -13,7 +14,7 @@ from .uiqueue import UiQueue
 def test_the_lock_flags_reach_the_robot_state_and_clear_again() -> None:
     model, ui = RobotModel(), UiQueue()
     with SimThread(SimConfig(port=0)) as sim, ClientRunner(model, post=ui.post) as runner:
-        runner.connect("127.0.0.1", sim.port).result(10)
+        runner.connect(Target("127.0.0.1", sim.port)).result(10)
         ui.wait_for(lambda: model.robot.value.mode_name == "stop", 10)
         assert model.robot.value.mode_lock == ""
         runner.call(lambda: runner.session.client.send("SimulatorLockStopMode"))  # type: ignore[union-attr]

@@ -27,6 +27,7 @@ from rtmu.protocol.payloads.robot import ModeInfo
 from rtmu.sim import SimThread
 from rtmu.sim.project_maps import office_map
 from rtmu.values.intents import GotoGoal, GotoPose, Localize
+from rtmu.values.target import Target
 
 from .fakes import FakeView
 from .navsim import OFFICE, fast_sim, reset, robot
@@ -42,7 +43,7 @@ class Rig:
         self.runner = ClientRunner(self.model, post=self.ui.post, config=SessionConfig(**config))  # type: ignore[arg-type]
         self.runner.start()
         self.ctl = Controller(self.model, OperatorState(), self.runner, self.view)
-        self.runner.connect("127.0.0.1", port, profile="test").result(10)
+        self.runner.connect(Target("127.0.0.1", port, profile="test")).result(10)
         self.wait(lambda: self.model.connection.value.phase is Phase.CONNECTED)
 
     def wait(self, predicate, timeout: float = 10.0) -> None:  # type: ignore[no-untyped-def]

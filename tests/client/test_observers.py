@@ -41,6 +41,7 @@ from rtmu.protocol.motion import MOTION_REQUESTS
 from rtmu.protocol.payloads.drive import RatioDrive
 from rtmu.protocol.payloads.navigation import GotoGoal
 from rtmu.sim import SimConfig, SimThread
+from rtmu.values.target import Target
 from simulators import running
 
 from .navsim import OFFICE
@@ -414,7 +415,7 @@ def test_an_operator_stops_only_its_own_drive_when_it_ends() -> None:
         assert sim.server is not None
         eventually(lambda: sim.snapshot().status.startswith("Going to"), timeout=30)
         with ClientRunner(config=SessionConfig(fetch_map=False)) as runner:
-            runner.connect("127.0.0.1", sim.port, auto_reconnect=False).result(20)
+            runner.connect(Target("127.0.0.1", sim.port, auto_reconnect=False)).result(20)
             runner.sync()
         time.sleep(0.5)
         navigators = sim.call(lambda: sim.server.heard.sessions_that_sent(frozenset({"gotoGoal"})))  # type: ignore[union-attr]

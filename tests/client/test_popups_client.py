@@ -26,6 +26,7 @@ from rtmu.protocol.payloads.commands import CommandEntry, CommandList
 from rtmu.sim import SimConfig, SimThread
 from rtmu.values.intents import AnswerPopup, ListServerCommands, RunServerCommand
 from rtmu.values.state import PopupsChanged, StateChange
+from rtmu.values.target import Target
 from simulators import simulator
 
 from .uiqueue import UiQueue, eventually
@@ -46,7 +47,7 @@ class Rig:
         self.connect()
 
     def connect(self) -> None:
-        self.runner.connect("127.0.0.1", self.port, self.user, self.password, profile="t").result(10)
+        self.runner.connect(Target("127.0.0.1", self.port, self.user, self.password, profile="t")).result(10)
         self.wait(lambda: self.model.connection.value.phase is Phase.CONNECTED)
 
     def wait(self, predicate: Any, timeout: float = 10.0) -> None:

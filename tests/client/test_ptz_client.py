@@ -26,6 +26,7 @@ from rtmu.protocol.fields import FieldWriter
 from rtmu.protocol.payloads.camera import Camera, CameraCommand, CameraData, CameraInfo, CameraList
 from rtmu.sim import SimConfig, SimThread
 from rtmu.values.intents import PtzMove, WatchPtz
+from rtmu.values.target import Target
 from simulators import simulator
 
 from .servers import SPECS, ServerThread, TestServer
@@ -41,7 +42,7 @@ class Rig:
         self.model, self.ui = RobotModel(), UiQueue()
         self.runner = ClientRunner(self.model, post=self.ui.post)
         self.runner.start()
-        self.runner.connect("127.0.0.1", port, "", "", profile="t").result(10)
+        self.runner.connect(Target("127.0.0.1", port, "", "", profile="t")).result(10)
         self.wait(lambda: self.model.connection.value.phase is Phase.CONNECTED)
 
     def wait(self, predicate: Any, timeout: float = 10.0) -> None:

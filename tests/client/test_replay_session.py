@@ -23,6 +23,7 @@ from rtmu.package_data import project_map
 from rtmu.protocol.payloads.drive import RatioDrive
 from rtmu.sim import SimConfig, SimThread
 from rtmu.values.state import MapChanged, MapModel, MapPhase, RobotChanged, RobotState, StateChange
+from rtmu.values.target import Target
 
 from .servers import run
 
@@ -89,7 +90,7 @@ async def record_live(port: int) -> tuple[list[Chunk], Seen]:
         return link
 
     session = session_over(asyncio.ensure_future(recorder()), changes)
-    await session.connect("127.0.0.1", port, auto_reconnect=False)
+    await session.connect(Target("127.0.0.1", port, auto_reconnect=False))
     link = recording.result()
     assert isinstance(link, RecordingLink)
     await until(lambda: any(isinstance(c, MapChanged) and c.value.state is MapPhase.READY for c in changes))
@@ -105,7 +106,7 @@ async def replay(chunks: list[Chunk]) -> tuple[ReplayLink, Seen]:
     changes: list[StateChange] = []
     link = ReplayLink(chunks)
     session = session_over(link, changes)
-    await session.connect("replay", 0, auto_reconnect=False)
+    await session.connect(Target("replay", 0, auto_reconnect=False))
     await until(lambda: link.exhausted)
     await asyncio.sleep(0.3)  # the last chunk's waiters and the map conversion finish
     seen = watched(changes)
@@ -174,7 +175,7 @@ def test_a_session_declares_its_subscriptions_as_data() -> None:
                 client_factory=lambda on_close: Watching(on_close=on_close),
             )
             try:
-                await session.connect("127.0.0.1", sim.port, auto_reconnect=False)
+                await session.connect(Target("127.0.0.1", sim.port, auto_reconnect=False))
             except ClientError:
                 raise
             finally:

@@ -13,6 +13,7 @@ from rtmu.client.runner import ClientRunner
 from rtmu.client.session import SessionConfig
 from rtmu.model.observables import LinkLevel, Phase, RobotModel
 from rtmu.protocol.payloads.drive import RatioDrive
+from rtmu.values.target import Target
 
 from .fakeclock import FakeClock
 from .servers import MAP_LINES, ServerSide, ServerThread, TestServer, binary_map_packets
@@ -64,7 +65,7 @@ def start(server: TestServer, clock=None, **config):  # type: ignore[no-untyped-
     model, ui = RobotModel(), UiQueue()
     runner = ClientRunner(model, post=ui.post, clock=clock or time.monotonic, config=SessionConfig(**config))
     runner.start()
-    runner.connect("127.0.0.1", server.port, profile="test").result(5)
+    runner.connect(Target("127.0.0.1", server.port, profile="test")).result(5)
     ui.wait_for(lambda: model.connection.value.phase is Phase.CONNECTED and model.robot.value.status != "")
     return runner, model, ui
 
@@ -191,7 +192,7 @@ def test_connect_failure_is_shown_in_the_model() -> None:
     model, ui = RobotModel(), UiQueue()
     with ClientRunner(model, post=ui.post) as runner:
         with pytest.raises(Exception):  # noqa: B017 -- the model is what we check
-            runner.connect("127.0.0.1", 1, profile="x").result(5)
+            runner.connect(Target("127.0.0.1", 1, profile="x")).result(5)
         ui.wait_for(lambda: model.connection.value.phase is Phase.FAILED)
         assert model.connection.value.error_kind == "refused"
         assert "refused" in model.connection.value.error
@@ -227,7 +228,7 @@ def test_disconnect_while_logging_in_cancels_the_attempt() -> None:
         ServerThread(TestServer(silent=True)) as server,
         ClientRunner(model, post=ui.post, config=config) as runner,
     ):
-        attempt = runner.connect("127.0.0.1", server.port)
+        attempt = runner.connect(Target("127.0.0.1", server.port))
         ui.wait_for(lambda: model.connection.value.phase is Phase.CONNECTING)
         runner.disconnect().result(5)
         ui.wait_for(lambda: model.connection.value.phase is Phase.DISCONNECTED)
@@ -320,7 +321,7 @@ def test_connecting_again_while_driving_stops_the_robot_on_the_old_link_first(se
         runner.lease.grant(DriveRatios(100, 0, 50))
         runner.sync()
         eventually(lambda: drive_names(server)[-1:] == ["ratioDrive"])
-        runner.connect("127.0.0.1", server.port, profile="other").result(5)
+        runner.connect(Target("127.0.0.1", server.port, profile="other")).result(5)
         ui.wait_for(
             lambda: (
                 model.connection.value.phase is Phase.CONNECTED and model.connection.value.profile == "other"

@@ -22,6 +22,7 @@ from rtmu.protocol.payloads.strings import StringItem, Strings, StringsInfo
 from rtmu.sim import SimConfig, SimThread
 from rtmu.sim.handlers import STRING_ITEMS
 from rtmu.values.intents import WatchStrings
+from rtmu.values.target import Target
 
 from .servers import SPECS, ServerThread, TestServer
 from .uiqueue import UiQueue
@@ -38,7 +39,7 @@ class Rig:
         self.model, self.ui = RobotModel(), UiQueue()
         self.runner = ClientRunner(self.model, post=self.ui.post)
         self.runner.start()
-        self.runner.connect("127.0.0.1", port, "", "", profile="t").result(10)
+        self.runner.connect(Target("127.0.0.1", port, "", "", profile="t")).result(10)
         self.wait(lambda: self.model.connection.value.phase is Phase.CONNECTED)
 
     def wait(self, predicate: Any, timeout: float = 10.0) -> None:

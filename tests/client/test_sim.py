@@ -19,6 +19,7 @@ from rtmu.model.observables import LinkLevel, OperatorState, Phase, RobotModel
 from rtmu.package_data import project_map
 from rtmu.sim import SimConfig, SimThread
 from rtmu.values.intents import RequestPicture, SetSafeDrive
+from rtmu.values.target import Target
 
 from .fakeclock import FakeClock
 from .fakes import FakeView
@@ -32,11 +33,11 @@ def sim_config(**kw: object) -> SimConfig:
     return SimConfig(port=0, map_path=ARENA, seed=1, **kw)  # type: ignore[arg-type]
 
 
-def connected_runner(port: int, clock=None, **config):  # type: ignore[no-untyped-def]
+def connected_runner(port: int, clock=None, *, auto_reconnect: bool = True, **config):  # type: ignore[no-untyped-def]
     model, ui = RobotModel(), UiQueue()
     runner = ClientRunner(model, post=ui.post, clock=clock or time.monotonic, config=SessionConfig(**config))
     runner.start()
-    runner.connect("127.0.0.1", port, profile="sim").result(10)
+    runner.connect(Target("127.0.0.1", port, profile="sim", auto_reconnect=auto_reconnect)).result(10)
     ui.wait_for(lambda: model.connection.value.phase is Phase.CONNECTED)
     return runner, model, ui
 
@@ -157,8 +158,7 @@ def test_reconnect_restores_status_and_map_but_never_motion() -> None:
 
 def test_lost_link_without_reconnect_is_shown_as_failed() -> None:
     with SimThread(sim_config()) as sim:
-        runner, model, ui = connected_runner(sim.port)
-        runner.call(lambda: setattr(runner.session._target, "auto_reconnect", False))  # type: ignore[union-attr]
+        runner, model, ui = connected_runner(sim.port, auto_reconnect=False)
         try:
             sim.kill()
             ui.wait_for(lambda: model.connection.value.phase is Phase.FAILED)

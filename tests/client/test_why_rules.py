@@ -87,6 +87,9 @@ def test_the_watchdog_counts_only_when_shorter_than_two_resends() -> None:
 def test_lost_counts_only_for_navigation() -> None:
     facts = Facts(offers=ALL, loc_state="Lost")
     assert causes(facts) == [] and causes(facts, navigate=True) == [Cause.LOST]
+    (note,) = diagnose(facts).notes  # said, not counted: the operator may mean to navigate next
+    assert note.startswith("driving by hand is not held back, but navigation is: the robot is lost")
+    assert diagnose(facts, navigate=True).notes == () and diagnose(Facts(offers=ALL)).notes == ()
 
 
 def safe(*obstacles: Obstacle, on: bool = True) -> Facts:

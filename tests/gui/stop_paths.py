@@ -9,6 +9,7 @@ What is checked is what the simulator received, not what the window believes.
 
 from __future__ import annotations
 
+import contextlib
 import time
 from collections.abc import Iterator
 from dataclasses import dataclass
@@ -129,10 +130,14 @@ class MenuPicker:
         pump(lambda: model_button(popover, label) is not None, 3, f"the row {label!r}")
         row = model_button(popover, label)
         for _ in range(40):
-            if gui.window.get_focus() is row:
+            focus = gui.window.get_focus()
+            if focus is row:
                 return
             gui.key("Down")
-            idle(0.02)
+            # One Down at a time: the next is pressed only once this one has moved the focus. Pressed
+            # blind every 20 ms, keys queued on a busy machine ran past the row and round again.
+            with contextlib.suppress(AssertionError):
+                pump(lambda f=focus: gui.window.get_focus() is not f, 2, "the focus to move")
         raise AssertionError(f"the keyboard never reached the row {label!r}")
 
 

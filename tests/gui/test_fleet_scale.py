@@ -22,6 +22,7 @@ from pathlib import Path
 import pytest
 
 from rtmu.fleet.sessions import RobotSession
+from rtmu.guardian.child import WARM_MAX
 from rtmu.settings.store import DirectRobot
 from rtmu.sim import SimConfig, SimThread
 from rtmu.sim.central_listing import ListingCentralThread
@@ -142,8 +143,9 @@ def test_a_central_server_listing_1000_robots_gets_20_connections_stop_still_wor
         try:
             found = xdotool("search", "--sync", "--onlyvisible", "--pid", str(proc.pid), "--name", "RTMU")
             window = found.split()[0]
-            # 20 robots (at the two simulators, whichever were named first) and the one guardian.
-            wait(lambda: connections() == BUDGET + 1, 90, "20 robot connections and the guardian's")
+            # 20 robots (at the two simulators, whichever were named first) and the one guardian — with
+            # at most WARM_MAX logins it keeps ready for the robots beside the selected one.
+            wait(lambda: connections() >= BUDGET + 1, 90, "20 robot connections and the guardian's")
             # A login is not yet a robot the window shows: Space stops a robot once its session is up.
             wait(lambda: subscribed(one) + subscribed(two) >= BUDGET, 60, "the 20 sessions set up")
             xdotool("windowfocus", "--sync", window)
@@ -163,7 +165,7 @@ def test_a_central_server_listing_1000_robots_gets_20_connections_stop_still_wor
                 connections()
                 time.sleep(0.05)
             screenshot(screenshots / "test_fleet_scale-1000-listed.png", window)
-            assert most == BUDGET + 1, f"{most} connections at once"
+            assert BUDGET + 1 <= most <= BUDGET + 1 + WARM_MAX, f"{most} connections at once"
             proc.send_signal(signal.SIGTERM)
             assert proc.wait(60) == 0, proc.stderr.read() if proc.stderr else ""
             wait(lambda: connections() == 0, 15, "every connection to close")

@@ -86,13 +86,9 @@ def test_a_fleet_window_killed_or_frozen_is_stopped_by_its_one_guardian_at_the_s
             window = window.split()[0]
             wait(lambda: subscribed(one) and subscribed(two), 20, "both robots connected")
             xdotool("windowfocus", "--sync", window)
-            xdotool("key", "alt+2")  # robot2: the guardian leaves robot1 for it
+            xdotool("key", "alt+2")  # robot2: the guardian watches it (robot1's login is only kept ready)
             wait(lambda: logins(two) == 2, 15, "the guardian at robot2")
-            wait(
-                lambda: logins(one) == 1,
-                15,
-                "the guardian to leave robot1",
-            )
+            assert logins(one) == 2  # kept ready for a selection back; never stopped (checked below)
             for _attempt in range(5):  # a press before it is armed is refused: press again
                 xdotool("keydown", "Up")
                 held = True

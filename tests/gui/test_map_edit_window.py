@@ -17,6 +17,7 @@ from rtmu.package_data import project_map
 from rtmu.sim import SimThread
 from rtmu.ui.map_edit_window import MapEditWindow
 from rtmu.values.intents import ApplyMapChanges
+from rtmu.values.target import Target
 from simulators import simulator
 
 from .harness import Gui, idle, pump
@@ -33,7 +34,7 @@ class Other:
         self.model, self.ui = RobotModel(), UiQueue()
         self.runner = ClientRunner(self.model, post=self.ui.post)
         self.runner.start()
-        self.runner.connect("127.0.0.1", port, "", "", profile="other").result(10)
+        self.runner.connect(Target("127.0.0.1", port, "", "", profile="other")).result(10)
         self.until(lambda: self.model.map.value.state is MapPhase.READY, "the other client's map")
 
     def until(self, condition, what: str, timeout: float = 15.0) -> None:  # type: ignore[no-untyped-def]

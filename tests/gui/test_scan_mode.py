@@ -159,6 +159,8 @@ def test_scan_drive_tag_stop_and_download_with_stop_working_throughout(
     click(gui, select)
     pump(lambda: bar.downloads == 1, 20, "the scan's download")
     assert "Saved the scan to" in bar.label.get_text()
+    assert bar.transfers_shown >= 1  # the download's progress bar showed while it lasted
+    pump(lambda: not bar.transfer_bar.get_parent().get_visible(), 5, "the progress bar gone once done")  # type: ignore[union-attr]
     gui.shot("scan-downloaded")
     log = read_scan_log((local / "hall-2.2d").read_text(encoding="latin-1"))
     readings = [r for r in log.order if isinstance(r, Reading)]

@@ -13,63 +13,25 @@ from __future__ import annotations
 
 from pathlib import Path
 
-from rtmu.base import exit_codes as codes
-from rtmu.cli import main
 from rtmu.sim import SimConfig, SimThread
 from rtmu.sim.ld_safety import safety_state
-from rtmu.ui.why_window import WhyWindow
 from simulators import simulator
 
 from .harness import Gui, idle, pump
-from .stop_paths import MenuEntry, MenuPicker, owned_windows
-
-WHY_ROW = MenuEntry((), "Why won't it move?…", "win.why")
-
+from .stop_paths import MenuPicker
+from .why_steps import (
+    WHY_ROW,
+    click_in,
+    command,
+    hint,
+    hold_up_for_the_hint,
+    space_stops,
+    stop_button_stops,
+    why_window,
+    xid,
+)
 
 sim = simulator(map_path=None, camera=False, seed=1)
-
-
-def command(sim: SimThread, name: str) -> None:
-    assert main(["run", f"127.0.0.1:{sim.port}", name, "--timeout", "5"]) == codes.EXIT_OK
-
-
-def stops(sim: SimThread) -> int:
-    return sim.call(lambda: len(sim.server.stop_log))  # type: ignore[union-attr]
-
-
-def why_window(gui: Gui) -> WhyWindow:
-    pump(lambda: any(isinstance(w, WhyWindow) for w in owned_windows(gui.window)), 5, "the why window")
-    found = next(w for w in owned_windows(gui.window) if isinstance(w, WhyWindow))
-    # No window manager places it: moved off the header bar, as an operator would, so STOP stays in reach.
-    gui.xdotool("windowmove", "--sync", str(_xid(found)), "420", "300")
-    pump(lambda: found.answer is not None and not found.asking, 15, "the robot's answer")
-    return found
-
-
-def hint(gui: Gui) -> str:
-    return gui.window.banners.text("why") or ""
-
-
-def space_stops(gui: Gui, sim: SimThread, what: str) -> None:
-    before = stops(sim)
-    gui.key("space")
-    pump(lambda: stops(sim) > before, 5, f"Space to stop the robot {what}")
-
-
-def stop_button_stops(gui: Gui, sim: SimThread, what: str) -> None:
-    before = stops(sim)
-    gui.click(gui.window.stop_button)
-    pump(lambda: stops(sim) > before, 5, f"the STOP button to stop the robot {what}")
-
-
-def hold_up_for_the_hint(gui: Gui) -> None:
-    gui.focus()
-    gui.keydown("Up")
-    try:
-        pump(lambda: bool(hint(gui)), 15, "the hint of a held drive that does not move")
-        gui.shot("hint")
-    finally:
-        gui.keyup("Up")
 
 
 def test_a_locked_mode_raises_the_hint_and_the_why_window_names_it(gui: Gui, sim: SimThread) -> None:
@@ -88,7 +50,7 @@ def test_a_locked_mode_raises_the_hint_and_the_why_window_names_it(gui: Gui, sim
     space_stops(gui, sim, "with the why window holding the keys")
     stop_button_stops(gui, sim, "with the why window open")
     command(sim, "SimulatorUnlockMode")
-    gui.xdotool("windowfocus", "--sync", str(_xid(why)))
+    gui.xdotool("windowfocus", "--sync", str(xid(why)))
     click_in(gui, why.again_button)
     pump(lambda: not why.asking and why.answer is not None and why.answer.can_move, 15, "the new answer")
     assert why.sentence.get_text().startswith("Nothing RTMU can read keeps the robot from moving")
@@ -102,7 +64,7 @@ def test_an_obstacle_inside_safe_drive_its_fix_asks_first_and_works(gui: Gui, si
     why = why_window(gui)
     assert "safe drive" in why.sentence.get_text().lower(), why.sentence.get_text()
     assert why.fix_button.get_visible() and why.fix_button.get_label() == "Switch safe drive off…"
-    gui.xdotool("windowfocus", "--sync", str(_xid(why)))
+    gui.xdotool("windowfocus", "--sync", str(xid(why)))
     pump(why.is_active, 5, "the why window to have the keyboard")
     why.fix_button.grab_focus()
     gui.key("Return")  # the keyboard reaches the fix: it only asks
@@ -113,7 +75,7 @@ def test_an_obstacle_inside_safe_drive_its_fix_asks_first_and_works(gui: Gui, si
     assert sim.snapshot().safe_drive is True  # nothing sent before the yes
     space_stops(gui, sim, "with the confirmation open")
     stop_button_stops(gui, sim, "with the confirmation open")
-    gui.xdotool("windowfocus", "--sync", str(_xid(why)))
+    gui.xdotool("windowfocus", "--sync", str(xid(why)))
     if not why.confirm.asking:
         click_in(gui, why.fix_button)
     pump(lambda: why.confirm.asking, 5, "the confirmation again")
@@ -140,19 +102,6 @@ def test_a_user_without_movement_is_told_by_the_hint(screenshots: Path, tmp_path
             gui.close()
 
 
-def _xid(window: object) -> int:
-    from gi.repository import GdkX11
-
-    return GdkX11.X11Surface.get_xid(window.get_surface())  # type: ignore[attr-defined]
-
-
-def click_in(gui: Gui, widget: object) -> None:
-    """A real click on a dialog's widget, the pointer moved onto its window first (as test_config_page)."""
-    from .test_config_page import click
-
-    click(gui, widget)
-
-
 def test_a_lock_that_gives_way_is_unlocked_by_its_fix_after_a_yes(gui: Gui, sim: SimThread) -> None:
     command(sim, "SimulatorLockStopModeUnlockable")
     gui.focus()
@@ -160,7 +109,7 @@ def test_a_lock_that_gives_way_is_unlocked_by_its_fix_after_a_yes(gui: Gui, sim:
     why = why_window(gui)
     assert "will unlock" in why.sentence.get_text(), why.sentence.get_text()
     assert why.fix_button.get_label() == "Ask the mode to unlock…"
-    gui.xdotool("windowfocus", "--sync", str(_xid(why)))
+    gui.xdotool("windowfocus", "--sync", str(xid(why)))
     click_in(gui, why.fix_button)
     pump(lambda: why.confirm.asking, 5, "the confirmation")  # a fix the CLI sends without a yes: asked here
     idle(0.3)
@@ -189,13 +138,13 @@ def test_an_ld_fault_is_told_at_once_and_acknowledged_only_after_a_yes(screensho
                 and "raw, layout not public" in why.details.get_text()
             )
             assert why.fix_button.get_label() == "Acknowledge the faults…"
-            gui.xdotool("windowfocus", "--sync", str(_xid(why)))
+            gui.xdotool("windowfocus", "--sync", str(xid(why)))
             click_in(gui, why.fix_button)
             pump(lambda: why.confirm.asking, 5, "the confirmation")
             assert "acknowledgeFault" in why.confirm.question.get_text()
             space_stops(gui, sim, "with the fault's confirmation open")
             assert state.acknowledged == []  # nothing acknowledged without the yes
-            gui.xdotool("windowfocus", "--sync", str(_xid(why)))
+            gui.xdotool("windowfocus", "--sync", str(xid(why)))
             if not why.confirm.asking:
                 click_in(gui, why.fix_button)
             pump(lambda: why.confirm.asking, 5, "the confirmation again")

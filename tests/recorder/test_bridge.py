@@ -30,6 +30,7 @@ from rtmu.values.state import (
     RobotState,
     StateChange,
 )
+from rtmu.values.target import Target
 
 from .foxglove_client import FoxgloveClient, twist
 from .poses import _position
@@ -59,7 +60,7 @@ def bridged(*, drive: bool) -> Iterator[tuple[SimThread, ClientRunner, Bridge, l
         bridge.start()
         runner.start()
         try:
-            runner.connect("127.0.0.1", sim.port, auto_reconnect=False).result(10)
+            runner.connect(Target("127.0.0.1", sim.port, auto_reconnect=False)).result(10)
             end = time.monotonic() + 15
             while not any(isinstance(c, MapChanged) and c.value.state is MapPhase.READY for c in ready):
                 assert time.monotonic() < end, "the map never loaded"

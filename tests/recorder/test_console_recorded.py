@@ -17,6 +17,7 @@ from rtmu.client.session import SessionConfig
 from rtmu.protocol.fields import FieldWriter
 from rtmu.recorder import Recorder, RecorderConfig
 from rtmu.sim import SimConfig, SimThread
+from rtmu.values.target import Target
 
 from .simsession import ARENA
 
@@ -28,7 +29,7 @@ def test_console_requests_and_replies_are_in_the_recording(tmp_path: Path) -> No
         runner = ClientRunner(config=SessionConfig(fetch_map=False), opener=recorder.opener())
         recorder.attach(runner)
         with runner:
-            runner.connect("127.0.0.1", sim.port).result(10)
+            runner.connect(Target("127.0.0.1", sim.port)).result(10)
             eventually(lambda: len(recorder.recordings) == 1)
             client = runner.session.client  # type: ignore[union-attr]
             assert client is not None

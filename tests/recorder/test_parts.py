@@ -21,6 +21,7 @@ from rtmu.recorder.items import Event
 from rtmu.recorder.mcapfile import McapFile
 from rtmu.settings.store import RecordingSettings, SettingsError, format_settings, parse_settings
 from rtmu.values.state import ConnectionChanged, ConnectionState, Phase, RobotChanged, RobotState
+from rtmu.values.target import Target
 
 from .mcapread import read
 
@@ -72,8 +73,8 @@ class Runner:
         self.calls: list[tuple[object, ...]] = []
         self.on_notice = None
 
-    def connect(self, host: str, port: int, user: str = "", password: str = "", *, profile: str = "") -> str:
-        self.calls.append(("connect", host, port, user, password, profile))
+    def connect(self, target: Target) -> str:
+        self.calls.append(("connect", target.host, target.port, target.user, target.password, target.profile))
         return "future"
 
     def command(self, name: str, *args: object) -> None:

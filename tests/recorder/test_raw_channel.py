@@ -24,6 +24,7 @@ from rtmu.protocol.commands import ClientCommand
 from rtmu.recorder import Recorder, RecorderConfig
 from rtmu.sim import SimConfig, SimThread
 from rtmu.values.intents import RequestPicture
+from rtmu.values.target import Target
 
 from .mcapread import read
 from .simsession import ARENA
@@ -96,10 +97,10 @@ def test_the_raw_channel_decodes_to_exactly_the_live_packets(tmp_path: Path) -> 
         runner = ClientRunner(config=SessionConfig(), opener=recorder.opener(spy_opener))
         recorder.attach(runner)
         with runner:
-            runner.connect("127.0.0.1", sim.port).result(10)
+            runner.connect(Target("127.0.0.1", sim.port)).result(10)
             runner.call(runner._session.dispatch, RequestPicture())
             time.sleep(0.5)
-            runner.connect("127.0.0.1", sim.port).result(10)  # the same robot again: a second connection
+            runner.connect(Target("127.0.0.1", sim.port)).result(10)  # the same robot: a second connection
             runner.call(runner._session.dispatch, RequestPicture())
             time.sleep(0.3)
         recorder.close()
@@ -145,12 +146,12 @@ def test_raw_chunks_after_a_reconnect_belong_to_the_new_connection(tmp_path: Pat
         runner = ClientRunner(config=SessionConfig(fetch_map=False), opener=recorder.opener())
         recorder.attach(runner)
         with runner:
-            runner.connect("127.0.0.1", sim.port).result(10)
+            runner.connect(Target("127.0.0.1", sim.port)).result(10)
             eventually(lambda: len(recorder.recordings) == 1)
             # Status must have flowed on the first connection before it is replaced (a loaded
             # machine once replaced it before its first updateNumbers).
             eventually(lambda: _subscribed_data_arrived(runner))
-            runner.connect("127.0.0.1", sim.port).result(10)
+            runner.connect(Target("127.0.0.1", sim.port)).result(10)
             eventually(lambda: _subscribed_data_arrived(runner))
             time.sleep(0.3)
         recorder.close()

@@ -27,6 +27,7 @@ from rtmu.sim import SimConfig, SimThread
 from rtmu.values import intents
 from rtmu.values.intents import RequestPicture
 from rtmu.values.state import CameraChanged, MapChanged, MapPhase, RobotChanged, StateChange
+from rtmu.values.target import Target
 
 from .poses import poses, recorded_pose_at
 from .simsession import hold, recorded_session
@@ -76,7 +77,7 @@ def test_a_replay_at_x8_ends_with_the_robot_where_the_recording_left_it(recordin
     try:
         replayer.clock.set_speed(8.0)
         replayer.clock.play()
-        runner.connect("replay", 0, auto_reconnect=False)
+        runner.connect(Target("replay", 0, auto_reconnect=False))
         until(lambda: replayer.link is not None and replayer.link.exhausted)
         runner.sync()
         time.sleep(0.3)
@@ -99,7 +100,7 @@ def test_seeking_back_rebuilds_from_the_start_and_forward_only_moves_the_clock(r
         recorded = poses(recording)
         middle = recorded[len(recorded) // 2][0]
         clock.seek(clock.end_ns)  # forward: everything is due at once, paused
-        runner.connect("replay", 0, auto_reconnect=False)
+        runner.connect(Target("replay", 0, auto_reconnect=False))
         until(lambda: replayer.link is not None and replayer.link.exhausted)
         runner.sync()
         end = replayer.link
@@ -109,7 +110,7 @@ def test_seeking_back_rebuilds_from_the_start_and_forward_only_moves_the_clock(r
         assert replayer.seek_needs_rebuild(middle)
         clock.seek(middle)
         seen.clear()
-        runner.connect("replay", 0, auto_reconnect=False)  # backward: a new connection from the start
+        runner.connect(Target("replay", 0, auto_reconnect=False))  # backward: a new connection from the start
         until(lambda: replayer.opened == 2)
         link = replayer.link
         assert link is not None
@@ -130,7 +131,7 @@ def test_a_replay_is_an_observer_and_its_link_refuses_drive_packets(recording: P
     runner, replayer, _seen = replaying(recording)
     try:
         replayer.clock.seek(replayer.clock.end_ns)
-        runner.connect("replay", 0, auto_reconnect=False)
+        runner.connect(Target("replay", 0, auto_reconnect=False))
         until(lambda: replayer.link is not None and replayer.link.exhausted)
         link = replayer.link
         assert link is not None and runner.session is not None and runner.session.client is not None
@@ -190,12 +191,12 @@ def test_a_recording_with_two_connections_replays_the_one_asked_for(tmp_path: Pa
         runner = ClientRunner(config=SessionConfig(fetch_map=False), opener=recorder.opener())
         recorder.attach(runner)
         with runner:
-            runner.connect("127.0.0.1", sim.port).result(10)
+            runner.connect(Target("127.0.0.1", sim.port)).result(10)
             until(lambda: runner.session is not None and runner.session.client is not None
                   and runner.session.client.packets_received >= 5)  # fmt: skip
             sim.call(lambda: sim.server.world.ratio_drive(50.0, 0.0, 50.0))  # type: ignore[union-attr]
             time.sleep(1.0)  # the second connection starts with the robot elsewhere
-            runner.connect("127.0.0.1", sim.port).result(10)
+            runner.connect(Target("127.0.0.1", sim.port)).result(10)
             until(lambda: runner.session is not None and runner.session.client is not None
                   and runner.session.client.packets_received >= 5)  # fmt: skip
             time.sleep(0.3)
@@ -210,7 +211,7 @@ def test_a_recording_with_two_connections_replays_the_one_asked_for(tmp_path: Pa
         runner.on_publish = seen.append
         with runner:
             replayer.clock.seek(replayer.clock.end_ns)
-            runner.connect("replay", 0, auto_reconnect=False)
+            runner.connect(Target("replay", 0, auto_reconnect=False))
             until(lambda r=replayer: r.link is not None and r.link.exhausted)
             runner.sync()
         assert any(isinstance(c, RobotChanged) for c in seen)

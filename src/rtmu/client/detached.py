@@ -18,10 +18,11 @@ from ..base.notices import Notice
 from ..protocol.errors import ProtocolError
 from ..protocol.payloads import Side, decode_payload
 from ..values.state import MapModel, RobotState, StateChange
+from ..values.target import Target
 from .connection import AriaClient
 from .feed import Feed
 from .lease import DriveLease
-from .session_config import SessionConfig, Target
+from .session_config import SessionConfig
 from .subscriptions import Handler
 
 F = TypeVar("F", bound=Feed)

@@ -20,10 +20,11 @@ from typing import Any, ClassVar, Protocol, TypeVar
 from ..base.notices import Notice
 from ..values.intents import Intent
 from ..values.state import MapModel, RobotState, StateChange
+from ..values.target import Target
 from .connection import AriaClient
 from .errors import NotSupported, ServerClosed
 from .lease import DriveLease
-from .session_config import SessionConfig, Target
+from .session_config import SessionConfig
 from .subscriptions import Handler, Subscription
 
 F = TypeVar("F", bound="Feed")

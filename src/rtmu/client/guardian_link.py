@@ -21,7 +21,8 @@ from ..base.notices import Kind, Notice
 from ..guardian.handle import BEAT_PERIOD
 from ..guardian.messages import Hello
 from ..guardian.shared import GuardianSeat, SharedGuardian
-from .session_config import SessionConfig, Target
+from ..values.target import Target
+from .session_config import SessionConfig
 
 OWN_NAME = "this robot"
 """How a script's own guardian names its one robot ("Arming the guardian for this robot …")."""

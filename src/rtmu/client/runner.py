@@ -71,6 +71,7 @@ from typing import Any, TypeVar, overload
 from ..base.notices import Kind, Notice
 from ..values.intents import Intent, Stop
 from ..values.state import StateChange, StateSink
+from ..values.target import Target
 from . import lease_keeper
 from .config_feed import ConfigFeed
 from .connection import AriaClient
@@ -330,24 +331,10 @@ class ClientRunner:
             self.loop.call_soon_threadsafe(session.kick)
 
     # -- the controller's link (rtmu.control.ports.ClientLink) -------------------------------
-    def connect(
-        self,
-        host: str,
-        port: int,
-        user: str = "",
-        password: str = "",
-        *,
-        profile: str = "",
-        auto_reconnect: bool = True,
-        protocol: str | None = None,
-    ) -> concurrent.futures.Future[None]:
+    def connect(self, target: Target) -> concurrent.futures.Future[None]:
         """Connect in the background; the model's ``connection`` shows progress and failure."""
         session = self._session
-        future = self.submit(
-            lambda: session.connect(
-                host, port, user, password, profile=profile, auto_reconnect=auto_reconnect, protocol=protocol
-            )
-        )
+        future = self.submit(lambda: session.connect(target))
         future.add_done_callback(lambda f: f.cancelled() or f.exception())  # failure is shown by the model
         return future
 

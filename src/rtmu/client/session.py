@@ -36,6 +36,7 @@ from ..values.state import (
     RobotState,
     StateChange,
 )
+from ..values.target import Target
 from .connection import AriaClient
 from .diagnosis import explain
 from .drive_loop import STEP_TIMEOUT, DriveFeed
@@ -45,7 +46,7 @@ from .feeds import FEEDS
 from .lease import DriveLease, EndReason
 from .map_feed import MapFeed
 from .reconnect import worth_retrying
-from .session_config import SessionConfig, Target
+from .session_config import SessionConfig
 from .status_feed import StatusFeed
 from .subscriptions import Handler, Subscription, applicable, merged
 
@@ -235,17 +236,7 @@ class Session:
         """This session's place at its guardian (None without one): ``state`` says if it is armed."""
         return self.drive.guardian.seat
 
-    async def connect(
-        self,
-        host: str,
-        port: int,
-        user: str = "",
-        password: str = "",
-        *,
-        profile: str = "",
-        auto_reconnect: bool = True,
-        protocol: str | None = None,
-    ) -> None:
+    async def connect(self, target: Target) -> None:
         """Connect and set up the session; raises the :class:`ClientError` after publishing FAILED.
 
         A :meth:`disconnect` (or another ``connect``) while this one is still logging in cancels it.
@@ -254,12 +245,11 @@ class Session:
         self._connecting = asyncio.current_task()
         if self.connected and self.client.drove:  # type: ignore[union-attr]  # our drive: stop it first
             self.drive.send_stop("connecting elsewhere")
-        target = Target(host, port, user, password, profile, auto_reconnect, protocol)
         await self._forget()
         self._target = target
         self._set_connection(
-            phase=Phase.CONNECTING, host=host, port=port, user=user, profile=profile,
-            offers=frozenset(), error="", error_kind="", attempt=0, retry_in=None,
+            phase=Phase.CONNECTING, host=target.host, port=target.port, user=target.user,
+            profile=target.profile, offers=frozenset(), error="", error_kind="", attempt=0, retry_in=None,
         )  # fmt: skip
         self.drive.ensure_heart()
         try:

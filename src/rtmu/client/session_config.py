@@ -1,4 +1,5 @@
-"""What a session is told when it is made (periods, timeouts, guardian, feeds), and where it connects."""
+"""What a session is told when it is made (periods, timeouts, guardian, feeds); where it connects is a
+:class:`~rtmu.values.target.Target`."""
 
 from __future__ import annotations
 
@@ -47,17 +48,3 @@ class SessionConfig:
     a new capability plugs in here."""
     role: Role = Role.OPERATOR
     """OBSERVER (a recorder, a read-only bridge, a replay): no motion request ever leaves (client.roles)."""
-
-
-@dataclass
-class Target:
-    """Where a session connects, and how (kept for reconnects and the guardian's own login)."""
-
-    host: str
-    port: int
-    user: str
-    password: str
-    profile: str
-    auto_reconnect: bool
-    protocol: str | None = None
-    """None: answer with the protocol string the server advertises."""

@@ -1,6 +1,7 @@
 """The robot's own status: pose, speeds, battery, status and mode words, safe drive and sonar.
 
-The status stream (``updateNumbers`` + ``updateStrings``, or the old ``update``) is also the
+The status stream (``updateNumbers`` + ``updateStrings``, or the old ``update``; read through
+:mod:`rtmu.client.robot_status`, as the command line reads it) is also the
 link's heartbeat: every status packet is told to the drive loop (:mod:`rtmu.client.drive_loop`),
 whose health monitor declares the link stale when they stop.
 """
@@ -20,6 +21,7 @@ from .call_values import Packet
 from .connection import AriaClient
 from .errors import ClientError
 from .feed import Feed, FeedContext
+from .robot_status import battery_fields, numbers_fields, strings_fields
 from .subscriptions import Subscription
 
 
@@ -69,11 +71,7 @@ class StatusFeed(Feed):
                         "batteryInfo", (await client.request_once("batteryInfo", timeout=timeout)).payload
                     )
                     if isinstance(info, BatteryInfo):
-                        self.ctx.robot_update(
-                            battery_low=info.low_battery,
-                            battery_shutdown=info.shutdown,
-                            battery_is_soc=info.state_of_charge,
-                        )
+                        self.ctx.robot_update(**battery_fields(info))
             finally:  # answered, refused or timed out: the number is shown, now and from then on
                 if self.ctx.client is client and not self._battery_unit_known:
                     self._battery_unit_known = True
@@ -100,24 +98,18 @@ class StatusFeed(Feed):
 
     def _apply_numbers(self, n: UpdateNumbers, at: float) -> None:
         self._battery_held = n.battery
-        self.ctx.robot_update(
-            x=float(n.x), y=float(n.y), th=float(n.th), vel=float(n.vel), rot_vel=float(n.rot_vel),
-            lat_vel=float(n.lat_vel), battery_v=n.battery if self._battery_unit_known else None,
-            temperature=float(n.temperature) if n.temperature_known else None, numbers_at=at,
-        )  # fmt: skip
+        self.ctx.robot_update(**numbers_fields(n, battery_known=self._battery_unit_known), numbers_at=at)
         self.on_status(at)
 
     def _on_strings(self, packet: Packet) -> None:
         s = self.ctx.decode(packet.name, packet.payload)
         if isinstance(s, UpdateStrings):
-            self.ctx.robot_update(
-                status=s.status, mode=s.mode, extended_status=s.extended_status, strings_at=packet.received_at
-            )
+            self.ctx.robot_update(**strings_fields(s), strings_at=packet.received_at)
 
     def _on_update(self, packet: Packet) -> None:
         u = self.ctx.decode(packet.name, packet.payload)
         if isinstance(u, Update):
-            self.ctx.robot_update(status=u.status, mode=u.mode, strings_at=packet.received_at)
+            self.ctx.robot_update(**strings_fields(u), strings_at=packet.received_at)
             self._apply_numbers(u.numbers, packet.received_at)
 
     def _on_mode_info(self, packet: Packet) -> None:

@@ -52,6 +52,8 @@ _STALL_WORDS = ("Stalled", "Bumped")
 """ArServerModeRatioDrive's / ArServerModeDrive's status when a motor stalls or the stall value
 (bumpers) is set."""
 DOCK_MODES = frozenset({"dock", "Dock"})
+NOT_FOR_NAVIGATION = "driving by hand is not held back, but navigation is: "
+"""How a cause that holds back only navigation (a lost localization) is noted in a hand-drive answer."""
 
 
 def diagnose(facts: Facts, motion: Motion | None = None, *, navigate: bool = False) -> Answer:
@@ -66,6 +68,10 @@ def diagnose(facts: Facts, motion: Motion | None = None, *, navigate: bool = Fal
     notes = list(facts.notes)
     if facts.ours.guardian:
         notes.append(Said(N_("the guardian is not watching this drive ({why})"), why=facts.ours.guardian))
+    if not navigate:  # driving by hand needs no localization, but the operator may mean to navigate next
+        notes += [
+            NOT_FOR_NAVIGATION + r.sentence() for r in _modes(facts, motion, True) if r.cause is Cause.LOST
+        ]
     return Answer(tuple(found), tuple(notes), facts.raw)
 
 

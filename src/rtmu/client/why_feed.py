@@ -4,7 +4,8 @@
 the server's own data over the session's connection (:func:`~rtmu.client.why_gather.gather`, reads
 only: looking never moves the robot) and adds our own side — the link as the window shows it, why
 the last drive lease ended, whether the guardian watches, a key ignored after a stop — then
-:func:`~rtmu.client.why.diagnose` says it in one sentence. Not connected, the answer is our link.
+:func:`~rtmu.client.why.diagnose` says it in one sentence. Not connected, or over a link
+that carries nothing now (stale, lost), the answer is our link, at once: nothing is asked over it.
 
 :class:`~rtmu.values.intents.ApplyFix` finds the cause again from the server's data before it
 sends anything (so only a fix the robot still needs is made, and the window cannot name one the
@@ -12,12 +13,15 @@ robot does not show), carries it out with :func:`~rtmu.client.why_fix.apply` —
 yes is sent only when the intent says the operator gave it — and answers with the new answer.
 
 Where the robot lists ``faultsUpdate`` (an LD robot), a change of its faults is told to the
-operator at once, as a safety notice: a fault is a reason it will not move.
+operator at once, as a safety notice: a fault is a reason it will not move. So is a login that may
+not send ``stop`` (the loud reason of :func:`~rtmu.client.why.diagnose`), told on every login: the
+operator must know before the first drive, not only when asking why.
 """
 
 from __future__ import annotations
 
-from dataclasses import dataclass
+import time
+from dataclasses import dataclass, replace
 from typing import ClassVar
 
 from ..base.i18n import _, ngettext
@@ -38,6 +42,13 @@ from .why_values import Answer, Facts, Motion, OurSide
 
 FAULTS_SHOWN = 3
 """Faults named in the notice (the why answer lists up to five, the console all of them)."""
+LINK_CARRIES_NOTHING = frozenset({LinkLevel.STALE, LinkLevel.LOST})
+"""Link levels at which the robot is not asked: the answer is our link, from what the login already knows."""
+NOT_ASKED_OVER_A_BAD_LINK = (
+    "the robot was not asked: our link carries nothing now (the login's rights are shown)"
+)
+HELD_ANSWER_KEPT = 60.0
+"""Seconds the answer asked while a drive was held is recalled when a later question finds nothing."""
 
 
 @dataclass(frozen=True, slots=True)
@@ -60,12 +71,17 @@ class WhyFeed(Feed):
         super().__init__(ctx)
         self._faults: tuple[str, ...] | None = None
         """The faults last heard on ``faultsUpdate`` (None: none heard on this connection)."""
+        self._held_answer: tuple[float, Answer] | None = None
+        """When and what the last question asked while a drive was held answered (None: it could move)."""
 
     def subscriptions(self, client: AriaClient) -> list[Subscription]:
         return [Subscription("faultsUpdate", -1, self._on_faults)]
 
     def connected(self, client: AriaClient) -> None:
-        self._faults = None
+        self._faults, self._held_answer = None, None
+        for reason in diagnose(_login_facts(client)).reasons:
+            if reason.loud:
+                self.ctx.notice(Notice.warning(Kind.SAFETY, reason.sentence()))
 
     def handle(self, intent: Intent) -> object:
         if isinstance(intent, AskWhy):
@@ -103,9 +119,27 @@ class WhyFeed(Feed):
         client = self.ctx.client
         if client is None or not client.connected:
             return diagnose(Facts(ours=ours), navigate=intent.navigate)
+        if ours.link in LINK_CARRIES_NOTHING:  # asking over it would only wait out each reply's timeout
+            unasked = _login_facts(client, ours, NOT_ASKED_OVER_A_BAD_LINK)
+            return diagnose(unasked, navigate=intent.navigate)
         facts = await gather_facts(client, self.ctx.config.reply_timeout, ours)
         motion = Motion(intent.trans, intent.rot) if intent.trans or intent.rot else None
-        return diagnose(facts, motion, navigate=intent.navigate)
+        return self._recall(diagnose(facts, motion, navigate=intent.navigate), held=motion is not None)
+
+    def _recall(self, answer: Answer, *, held: bool) -> Answer:
+        """Keep the answer asked while a drive was held; add it as a note to a later one that finds
+        nothing. Some causes show only while the drive is held — ARIA's drive mode says "Stalled",
+        and letting go switches to the stop mode, which does not — so the operator who lets go and
+        then asks is still told what the hint found (as what was read then, not as a cause now)."""
+        now = time.monotonic()
+        if held:
+            self._held_answer = None if answer.can_move else (now, answer)
+            return answer
+        earlier = self._held_answer
+        if earlier is None or not answer.can_move or now - earlier[0] > HELD_ANSWER_KEPT:
+            return answer
+        note = f"while the drive was held {now - earlier[0]:.0f} s ago: {earlier[1].sentence()}"
+        return replace(answer, notes=(*answer.notes, note))
 
     # -- fixing ------------------------------------------------------------------------------------
     async def fix(self, intent: ApplyFix) -> FixReport:
@@ -153,3 +187,9 @@ class WhyFeed(Feed):
                 ).format(count=len(faults), faults=shown, more=more),
             )
         )
+
+
+def _login_facts(client: AriaClient, ours: OurSide | None = None, *notes: str) -> Facts:
+    """What the login itself tells, with no request sent: this user's rights (its data list)."""
+    offers = frozenset(e.name for e in client.datalist)
+    return Facts(offers=offers, user=client.user, ours=ours or OurSide(), notes=notes)

@@ -58,6 +58,7 @@ from ..model.observables import OperatorState, RobotModel, SpeedSetting
 from ..settings.store import Profile
 from ..values.intents import GotoGoal, Intent, RequestPicture, StartVideo, Stop, picture_source
 from ..values.state import ConnectionState, LinkHealth, LinkLevel, NavState, Phase, RobotState
+from ..values.target import Target
 from . import intent_rules
 from .commands import COMMANDS, CommandRegistry, CommandState
 from .held_drive import HeldDrive
@@ -200,6 +201,11 @@ class Controller:
     def analog_active(self) -> bool:
         """The stick is being listened to (dead-man held, not blocked by a stop)."""
         return self.drive.analog_active
+
+    @property
+    def analog_ratios(self) -> tuple[float, float] | None:
+        """The stick's (trans, rot) in % while its dead-man is held (what "why?" asks about)."""
+        return self.drive.analog_ratios
 
     @property
     def analog_blocked(self) -> bool:
@@ -451,14 +457,9 @@ class Controller:
             with contextlib.suppress(Exception):
                 tap("connect", {"host": p.host, "port": p.port, "user": p.user, "profile": p.name})
         self.link.connect(
-            p.host,
-            p.port,
-            p.user,
-            password,
-            profile=p.name,
-            auto_reconnect=p.auto_reconnect,
-            protocol=p.protocol or None,
-        )
+            Target(p.host, p.port, p.user, password, profile=p.name, auto_reconnect=p.auto_reconnect,
+                   protocol=p.protocol or None)
+        )  # fmt: skip
 
     def disconnect(self) -> None:
         self.stop()

@@ -128,6 +128,11 @@ class HeldDrive:
         return self._analog is not None
 
     @property
+    def analog_ratios(self) -> tuple[float, float] | None:
+        """The stick's (trans, rot) in % while its dead-man is held; None when let go."""
+        return self._analog
+
+    @property
     def analog_blocked(self) -> bool:
         """A stop ended the stick's drive: the dead-man must be released before it drives again."""
         return self._analog_blocked

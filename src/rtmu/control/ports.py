@@ -11,6 +11,7 @@ from ..base.notices import Notice
 from ..client.lease import DriveLease
 from ..settings.store import Profile
 from ..values.intents import Intent
+from ..values.target import Target
 from .commands import CommandState
 
 
@@ -48,17 +49,7 @@ class ClientLink(Protocol):
     on_notice: Callable[[Notice], None] | None
     """Set by the controller: the network side's messages for the operator."""
 
-    def connect(
-        self,
-        host: str,
-        port: int,
-        user: str = "",
-        password: str = "",
-        *,
-        profile: str = "",
-        auto_reconnect: bool = True,
-        protocol: str | None = None,
-    ) -> object: ...
+    def connect(self, target: Target) -> object: ...
 
     def disconnect(self) -> object: ...
 

@@ -216,6 +216,7 @@ class Fleet:
         self.roster_lost: str | None = None
         """Why the roster went away (None while it is there): said once, every robot stopped."""
         self.selected.observe(self._selection_moved)
+        self.sessions.observe(lambda _old, _new: self._expect())
 
     # -- the roster ------------------------------------------------------------------------------
     def follow(self, roster: Roster, make: SessionMaker, announce: Announce | None = None) -> None:
@@ -381,6 +382,17 @@ class Fleet:
             self._used[id(new)] = time.monotonic()
         if self.guardian is not None:
             self.guardian.choose(new.seat if new is not None else None)
+        self._expect()
+
+    def _expect(self) -> None:
+        """Name the robots beside the selected one in the fleet's list — the likely next selections
+        (Up and Down in the robot list) — to the guardian, which keeps its logins to them ready."""
+        if self.guardian is None:
+            return
+        sessions, session = list(self.sessions.value), self.selected.value
+        i = sessions.index(session) if session in sessions else -1
+        beside = [sessions[j].seat for j in (i + 1, i - 1) if i >= 0 and 0 <= j < len(sessions)]
+        self.guardian.expect(beside)
 
     def remove(self, session: RobotSession) -> None:
         """Close ``session`` (its robot is stopped first) and forget it."""

@@ -31,7 +31,14 @@ itself starved of CPU judges by when beats were sent, not when it read them.
 After a stop it is disarmed until the parent arms it again (a new drive). A new login while
 armed first stops the robot watched so far (the parent switched robots in the middle of a drive,
 and its own stop for that robot may not have left yet). Disarmed, it sleeps on its pipe and its
-socket instead of waking 50 times a second.
+sockets instead of waking 50 times a second.
+
+Arming for a newly selected robot is a login (a connection, the server's introduction, the data
+list) and a busy server takes its time over it. So the guardian keeps up to :data:`WARM_MAX` ready
+logins beside the watched one — the robot watched before, and the ones the parent names in
+:data:`~.messages.WARM` records (a window: the robots beside the selected one in its list). A LOGIN
+for one of them is ready at once. It watches nothing and sends nothing on them; they only keep a
+connection open, and a failed or closed one is let go quietly.
 """
 
 from __future__ import annotations
@@ -60,6 +67,8 @@ CHECK_PERIOD = 0.02
 IDLE_PERIOD = 1.0
 """Seconds between looks while disarmed: nothing can call for a stop then, and a record on the pipe
 (ARM first of all) or a byte on the socket wakes the loop at once."""
+WARM_MAX = 3
+"""Ready logins kept beside the watched one (the robot watched before, and two the parent named)."""
 
 
 def parent_frozen(pid: int) -> bool:
@@ -191,6 +200,8 @@ class Guardian:
         self.reader = m.RecordReader()
         self.login: RobotLogin | None = None
         self.halter: Halter | None = None
+        self.spares: list[RobotLogin] = []
+        """Ready (or readying) logins to robots that may be watched next, oldest first."""
         self.serial = -1
         """The serial of the login asked for last (every word about it carries this number)."""
 
@@ -214,6 +225,10 @@ class Guardian:
             for kind, at, hello in records:
                 if kind == m.LOGIN and hello is not None:
                     self.log_in(hello)
+                elif kind == m.WARM and hello is not None:
+                    self.warm(hello)
+                elif kind == m.COLD and hello is not None:
+                    self.cool(hello)
                 elif kind == m.HALT:
                     self.stop("the program driving it lost its own link to the robot while driving")
                 else:
@@ -233,13 +248,51 @@ class Guardian:
         if login is not None and login.state is LoginState.READY and hello.same_robot(login.hello):
             say(m.READY, self.serial)  # logged in to that robot already
             return
-        self.leave()
-        self.login = RobotLogin(hello)
+        self.login, self.halter = None, None
+        if login is not None:
+            self._keep(login)  # the robot watched before is a likely next one
+        spare = self._take_spare(hello)
+        self.login = spare if spare is not None else RobotLogin(hello)  # a ready spare says READY at once
+
+    def warm(self, hello: m.Hello) -> None:
+        """Keep a login to ``hello``'s robot ready (the newest spare; the oldest beyond WARM_MAX goes)."""
+        login = self.login
+        if login is not None and login.active and hello.same_robot(login.hello):
+            return
+        spare = self._take_spare(hello)
+        self._keep(spare if spare is not None else RobotLogin(hello))
+
+    def cool(self, hello: m.Hello) -> None:
+        """Let go of the spare login to ``hello``'s robot, if one is kept."""
+        spare = self._take_spare(hello)
+        if spare is not None:
+            spare.close()
+
+    def _take_spare(self, hello: m.Hello) -> RobotLogin | None:
+        for i, spare in enumerate(self.spares):
+            if hello.same_robot(spare.hello):
+                return self.spares.pop(i)
+        return None
+
+    def _keep(self, login: RobotLogin) -> None:
+        if not login.active:
+            login.close()
+            return
+        self.spares.append(login)
+        while len(self.spares) > WARM_MAX:
+            self.spares.pop(0).close()
 
     def leave(self) -> None:
         login, self.login, self.halter = self.login, None, None
         if login is not None:
             login.close()
+
+    def leave_all(self) -> None:
+        """Log out of the watched robot and every spare (the guardian ends)."""
+        self.leave()
+        spares, self.spares = self.spares, []
+        for spare in spares:
+            spare.close()
 
     def halt(self) -> bool:
         halter = self.halter
@@ -255,7 +308,11 @@ class Guardian:
         self.watch.armed = False
 
     def progress(self, now: float) -> None:
-        """Say what the login did: ready, refused, or its connection ended."""
+        """Say what the login did: ready, refused, or its connection ended (spares go quietly)."""
+        for spare in self.spares:
+            spare.check_deadline(now)
+        if any(not spare.active for spare in self.spares):
+            self.spares = [spare for spare in self.spares if spare.active]
         login = self.login
         if login is None:
             return
@@ -272,12 +329,12 @@ class Guardian:
 
     # -- the loop ------------------------------------------------------------------------------
     def wait(self) -> None:
-        """Sleep until the pipe or the socket has something, or it is time to look again."""
-        login = self.login
+        """Sleep until the pipe or a socket has something, or it is time to look again."""
+        logins = [login for login in (self.login, *self.spares) if login is not None and login.active]
         readers: list[int] = [self.fd]
         writers: list[int] = []
         period = CHECK_PERIOD if self.watch.armed else IDLE_PERIOD
-        if login is not None and login.active:
+        for login in logins:
             readers.append(login.fileno())
             if login.wants_write():
                 writers.append(login.fileno())
@@ -287,10 +344,11 @@ class Guardian:
             readable, writable, _ = select.select(readers, writers, [], period)
         except (OSError, ValueError):
             return
-        if login is not None and login is self.login:
-            if login.fileno() in writable:
+        for login in logins:
+            fd = login.fileno()
+            if fd in writable:
                 login.on_writable()
-            if login.fileno() in readable:
+            if fd in readable:
                 login.on_readable(time.monotonic())
 
     def run(self) -> int:
@@ -306,7 +364,7 @@ class Guardian:
                     return 0
                 self.wait()
         finally:
-            self.leave()
+            self.leave_all()
 
 
 def run(fd: int = 0, limits: LimitFor | None = learned_limit) -> int:

@@ -90,6 +90,14 @@ class GuardianHandle:
                 self.state, self.reason = "starting", ""
         return self._write(m.login_record(hello, self.clock()))
 
+    def warm(self, hello: m.Hello) -> bool:
+        """Keep a login to ``hello``'s robot ready (it may be chosen next); nothing is watched there."""
+        return self._write(m.login_record(hello, self.clock(), m.WARM))
+
+    def cool(self, hello: m.Hello) -> bool:
+        """Let go of the ready login to ``hello``'s robot (its session disconnected)."""
+        return self._write(m.login_record(hello, self.clock(), m.COLD))
+
     def arm(self) -> None:
         """Before the first nonzero ``ratioDrive`` of a drive."""
         if not self.armed:

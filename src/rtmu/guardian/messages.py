@@ -3,8 +3,9 @@
 Parent → guardian (the guardian's stdin): records of :data:`RECORD` (a kind byte, the sender's
 ``time.monotonic()``). A :data:`LOGIN` record is followed by a 4-byte big-endian length and a JSON
 :class:`Hello` (host, port, user, password — never in argv or the environment — and the login's
-serial number): log out of the robot watched so far and log in to this one. The parent writes
-every record under one lock, so records from the UI and the network threads never interleave.
+serial number): log out of the robot watched so far and log in to this one. :data:`WARM` and
+:data:`COLD` records carry a hello the same way. The parent writes every record under one lock, so
+records from the UI and the network threads never interleave.
 
 Guardian → parent (its stdout): one line per event, ``<word> <serial> <text>``; the serial names
 the login the event is about, so a late word about a robot the guardian left is never taken for
@@ -34,7 +35,15 @@ LOGIN = b"l"
 first if a drive was armed on it). A hello with an empty host only leaves: nothing is watched."""
 BYE = b"b"
 """A clean exit: end without a stop."""
-KINDS = frozenset({BEAT_UI, BEAT_NET, ARM, DISARM, HALT, LOGIN, BYE})
+WARM = b"w"
+"""A :class:`Hello` follows: keep a login to this robot ready beside the watched one (nothing is
+watched or sent there), so a LOGIN for it later is ready at once. A bounded few are kept."""
+COLD = b"c"
+"""A :class:`Hello` follows: let go of the ready login to this robot, if one is kept (its session
+disconnected)."""
+WITH_HELLO = frozenset({LOGIN, WARM, COLD})
+"""The kinds of record a :class:`Hello` follows."""
+KINDS = frozenset({BEAT_UI, BEAT_NET, ARM, DISARM, HALT, BYE}) | WITH_HELLO
 MAX_HELLO = 64 * 1024
 
 # guardian → parent words
@@ -99,12 +108,14 @@ def record(kind: bytes, at: float) -> bytes:
     return RECORD.pack(kind, at)
 
 
-def login_record(hello: Hello, at: float) -> bytes:
-    return RECORD.pack(LOGIN, at) + hello.encode()
+def login_record(hello: Hello, at: float, kind: bytes = LOGIN) -> bytes:
+    """A record a hello follows (``kind``: :data:`LOGIN`, :data:`WARM` or :data:`COLD`)."""
+    assert kind in WITH_HELLO
+    return RECORD.pack(kind, at) + hello.encode()
 
 
 Record = tuple[bytes, float, Hello | None]
-"""(kind, the sender's time, the hello of a LOGIN record)."""
+"""(kind, the sender's time, the hello of a LOGIN, WARM or COLD record)."""
 
 
 class RecordReader:
@@ -123,7 +134,7 @@ class RecordReader:
         buf = self._buf
         while len(buf) - at >= RECORD.size:
             kind, when = RECORD.unpack_from(buf, at)
-            if kind != LOGIN:
+            if kind not in WITH_HELLO:
                 at += RECORD.size
                 if kind in KINDS:
                     out.append((kind, when, None))
@@ -141,7 +152,7 @@ class RecordReader:
                 hello = Hello.decode(body)
             except (ValueError, KeyError, TypeError) as exc:
                 raise ValueError(f"bad hello: {exc}") from None
-            out.append((LOGIN, when, hello))
+            out.append((kind, when, hello))
             at = head + LENGTH.size + size
         self._buf = buf[at:]
         return out

@@ -12,6 +12,12 @@ frozen a moment after selecting (or connecting to) a robot is still stopped by i
 robot the guardian could not log in to (the server refused a second login, the process could not
 start) may still be driven, with the "Guardian not available" warning as before.
 
+Arming is a login, and a busy robot server takes its time over one; so :meth:`~SharedGuardian.expect`
+names the robots likely to be selected next (a window: the ones beside the selected robot in its
+list), and the process keeps ready logins to them — and to the robot selected before — beside the
+one it watches (:data:`.child.WARM_MAX`, memory independent of the fleet's size). Selecting one of
+those arms at once; nothing is watched or sent on them.
+
 Only the chosen seat's records reach the process: a robot that was selected before cannot disarm
 (or arm) the guardian for the robot selected now. Threads: seats are offered and withdrawn by
 their session's network thread, chosen by the UI thread, and beaten by both; a reader thread
@@ -25,7 +31,7 @@ import select
 import threading
 import time
 from collections import deque
-from collections.abc import Callable
+from collections.abc import Callable, Sequence
 from dataclasses import replace
 from enum import Enum
 
@@ -147,6 +153,8 @@ class SharedGuardian:
         self._serial = 0
         self._seats_by_serial: dict[int, GuardianSeat] = {}
         self.chosen: GuardianSeat | None = None
+        self._likely: tuple[GuardianSeat, ...] = ()
+        """The seats named by the last :meth:`expect` (their logins are kept ready)."""
         self.logins = 0
         """LOGIN records sent (benchmarks and tests)."""
         self.processes = 0
@@ -175,6 +183,21 @@ class SharedGuardian:
                 old.state, old.reason = SeatState.IDLE, ""
             if seat is not None:
                 self._log_in(seat)
+
+    def expect(self, likely: Sequence[GuardianSeat | None]) -> None:
+        """The seats that may be chosen next: logins to their robots are kept ready (once connected)."""
+        with self._lock:
+            new = tuple(seat for seat in likely if seat is not None and seat is not self.chosen)
+            fresh = [seat for seat in new if seat not in self._likely]
+            self._likely = new
+            for seat in fresh:
+                self._warm(seat)
+
+    def _warm(self, seat: GuardianSeat) -> None:
+        """Keep a ready login to ``seat``'s robot, once it is connected (lock held)."""
+        handle = self._handle
+        if seat.hello is not None and handle is not None and handle.alive:
+            handle.warm(replace(seat.hello, serial=0))
 
     def _log_in(self, seat: GuardianSeat) -> None:
         """Send the chosen seat's login (lock held)."""
@@ -222,11 +245,16 @@ class SharedGuardian:
             seat.hello = hello
             if seat is self.chosen:
                 self._log_in(seat)
+            elif seat in self._likely:
+                self._warm(seat)
 
     def _withdraw(self, seat: GuardianSeat, leave: bool) -> None:
         with self._lock:
-            seat.hello = None
+            hello, seat.hello = seat.hello, None
             if seat is not self.chosen:
+                handle = self._handle
+                if leave and hello is not None and handle is not None and handle.alive:
+                    handle.cool(hello)  # no ready login kept to a robot the window let go of
                 return
             seat.state, seat.reason = SeatState.IDLE, ""
             handle = self._handle

@@ -198,6 +198,13 @@ class MapDraft:
         low = name.lower()
         return next((o for o in self._objects if o.name and o.name.lower() == low), None)
 
+    def free_name(self, stem: str) -> str:
+        """``stem 1``, ``stem 2`` …: the first name no object of the draft has (a goal placed by a click)."""
+        n = 1
+        while self.find(f"{stem} {n}") is not None:
+            n += 1
+        return f"{stem} {n}"
+
     def change(self) -> ObjectChanges:
         """Net objects to delete and to add: what differs between the base and the draft."""
         return _difference(self._base, self._objects)

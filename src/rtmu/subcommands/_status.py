@@ -1,5 +1,6 @@
-"""One robot status as ``rtmu status``, ``rtmu drive`` and ``rtmu fleet`` print it: its JSON object, its line,
-and the one request that fetches it (split from :mod:`._common`, which is about connecting and ending)."""
+"""One robot status as ``rtmu status``, ``rtmu drive`` and ``rtmu fleet`` print it: its JSON object and its
+line. The status itself is the client's :class:`~rtmu.values.state.RobotState`, read from the payloads by
+:mod:`rtmu.client.robot_status` as the window reads it; this module only formats it."""
 
 from __future__ import annotations
 
@@ -7,6 +8,7 @@ from typing import TYPE_CHECKING, Any
 
 if TYPE_CHECKING:
     from ..client.connection import AriaClient
+    from ..values.state import RobotState
 
 
 STATUS_KEYS = ("x", "y", "th", "vel", "rot_vel", "battery_v", "status", "mode")
@@ -14,20 +16,23 @@ STATUS_KEYS = ("x", "y", "th", "vel", "rot_vel", "battery_v", "status", "mode")
 that reports state of charge gives ``battery_pct`` (percent) in place of ``battery_v``."""
 
 
-def status_object(numbers: Any, status: str, mode: str, *, soc: bool = False) -> dict[str, Any]:
-    """One status as the JSON object ``rtmu status`` and ``rtmu drive`` print.
+def _whole(value: float) -> float | int:
+    """The wire's whole numbers stay whole in the JSON and the line (``x=1200 mm``, not ``1200.0``)."""
+    return int(value) if float(value).is_integer() else value
 
-    ``soc``: the server's ``batteryInfo`` says the battery figure is percent of charge, not volts.
-    """
+
+def status_object(robot: RobotState) -> dict[str, Any]:
+    """One status as the JSON object ``rtmu status`` and ``rtmu drive`` print (``battery_pct`` in place
+    of ``battery_v`` when the server's ``batteryInfo`` says the figure is a state of charge)."""
     return {
-        "x": numbers.x,
-        "y": numbers.y,
-        "th": numbers.th,
-        "vel": numbers.vel,
-        "rot_vel": numbers.rot_vel,
-        "battery_pct" if soc else "battery_v": numbers.battery,
-        "status": status,
-        "mode": mode,
+        "x": _whole(robot.x),
+        "y": _whole(robot.y),
+        "th": _whole(robot.th),
+        "vel": _whole(robot.vel),
+        "rot_vel": _whole(robot.rot_vel),
+        "battery_pct" if robot.battery_is_soc else "battery_v": robot.battery_v,
+        "status": robot.status,
+        "mode": robot.mode,
     }
 
 
@@ -52,42 +57,8 @@ def status_line(obj: dict[str, Any]) -> str:
     )
 
 
-async def battery_is_soc(client: AriaClient, timeout: float) -> bool:
-    """True when ``batteryInfo`` says the battery figures are state of charge (percent)."""
-    from ..protocol.payloads.robot import BatteryInfo
-
-    if not client.supports("batteryInfo"):
-        return False
-    info = (await client.request_once("batteryInfo", timeout=timeout)).decode()
-    return isinstance(info, BatteryInfo) and info.state_of_charge
-
-
 async def fetch_status(client: AriaClient, timeout: float) -> dict[str, Any]:
-    """One status from ``updateNumbers`` + ``updateStrings`` (or the old ``update``)."""
-    from ..protocol.payloads.robot import Update, UpdateNumbers, UpdateStrings
+    """One status, asked for at once (:func:`rtmu.client.robot_status.fetch_robot_state`), as its object."""
+    from ..client.robot_status import fetch_robot_state
 
-    if client.supports("updateNumbers"):
-        numbers = (await client.request_once("updateNumbers", timeout=timeout)).decode()
-        assert isinstance(numbers, UpdateNumbers)
-        status = mode = ""
-        if client.supports("updateStrings"):
-            strings = (await client.request_once("updateStrings", timeout=timeout)).decode()
-            assert isinstance(strings, UpdateStrings)
-            status, mode = strings.status, strings.mode
-        return status_object(numbers, status, mode, soc=await battery_is_soc(client, timeout))
-    if client.supports("update"):
-        update = (await client.request_once("update", timeout=timeout)).decode()
-        assert isinstance(update, Update)
-        soc = await battery_is_soc(client, timeout)
-        return status_object(update.numbers, update.status, update.mode, soc=soc)
-    raise no_status(client)
-
-
-def no_status(client: AriaClient) -> Exception:
-    """Why there is no robot status: ARIA's central server has robots, not a status of its own."""
-    from ..client.diagnosis import central_server_words
-    from ..client.errors import NotSupported
-
-    if client.supports("clientList"):
-        return NotSupported("updateNumbers", central_server_words(f"{client.host}:{client.port}"))
-    return NotSupported("updateNumbers", "this server offers no robot status (updateNumbers or update)")
+    return status_object(await fetch_robot_state(client, timeout))

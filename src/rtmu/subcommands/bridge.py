@@ -26,6 +26,7 @@ from ..base.textsafe import visible
 from ..client.errors import ClientError
 from ..client.roles import Role
 from ..recorder.topics import BRIDGE_PORT as DEFAULT_PORT
+from ..values.target import Target
 from ._common import UsageError, add_connection_arguments, fail, positive_float, read_password, signal_name
 from ._follow import EndingSignals, follow, until_connected
 from ._options import add_fps_option
@@ -165,7 +166,7 @@ def serve(
     host, port = args.server
     runner.start()
     try:
-        future = runner.connect(host, port, args.user, password, protocol=args.protocol)
+        future = runner.connect(Target(host, port, args.user, password, protocol=args.protocol))
         try:
             if not until_connected(future, ending.event, args.timeout + 1.0):
                 return EXIT_OK  # a signal came first: its code is the command's

@@ -27,6 +27,7 @@ from ..base.units import file_size
 from ..client.errors import ClientError
 from ..client.roles import Role
 from ..values.state import ConnectionChanged, Phase, StateChange
+from ..values.target import Target
 from ._common import UsageError, add_connection_arguments, fail, positive_float, read_password, signal_name
 from ._follow import EndingSignals, follow, until_connected
 from ._options import add_fps_option
@@ -132,7 +133,7 @@ def _record(
 ) -> int:
     host, port = args.server
     runner.start()
-    future = runner.connect(host, port, args.user, password, protocol=args.protocol)
+    future = runner.connect(Target(host, port, args.user, password, protocol=args.protocol))
     try:
         if not until_connected(future, ending.event, args.timeout + 1.0):
             return EXIT_OK  # a signal came first: its code is the command's

@@ -28,7 +28,7 @@ from ._common import (
     run_with_client,
 )
 from ._options import number_in
-from ._status import battery_is_soc, fetch_status, no_status, status_line, status_object
+from ._status import fetch_status, status_line, status_object
 
 if TYPE_CHECKING:
     import asyncio
@@ -98,11 +98,15 @@ def say(message: str) -> None:
 
 async def stream(client: AriaClient, args: argparse.Namespace, show: Any) -> int:
     import asyncio
+    from dataclasses import replace
 
     from ..client import ld_data
+    from ..client.robot_status import battery_fields, battery_info, no_status, numbers_fields, strings_fields
+    from ..values.state import RobotState
 
-    strings = {"status": "", "mode": ""}
-    soc = await battery_is_soc(client, args.timeout)
+    info = await battery_info(client, args.timeout)
+    robot = [RobotState() if info is None else RobotState(**battery_fields(info))]
+    """The status so far, read as the window reads it; each numbers packet prints it."""
     dock: dict[str, str] = {}
     """``{"dock": label}`` when the server offers dockInfo, kept current by dockInfoChanged."""
     first_dock = await ld_data.dock_info(client, args.timeout)
@@ -128,9 +132,12 @@ async def stream(client: AriaClient, args: argparse.Namespace, show: Any) -> int
             malformed[:] = [exc]
             return
         if isinstance(n, UpdateNumbers):
-            queue.put_nowait({**status_object(n, strings["status"], strings["mode"], soc=soc), **dock})
+            robot[0] = replace(robot[0], **numbers_fields(n))
         elif isinstance(n, Update):
-            queue.put_nowait({**status_object(n.numbers, n.status, n.mode, soc=soc), **dock})
+            robot[0] = replace(robot[0], **numbers_fields(n.numbers), **strings_fields(n))
+        else:
+            return
+        queue.put_nowait({**status_object(robot[0]), **dock})
 
     def on_strings(packet: Packet) -> None:
         try:
@@ -138,7 +145,7 @@ async def stream(client: AriaClient, args: argparse.Namespace, show: Any) -> int
         except ProtocolError:
             return
         if isinstance(s, UpdateStrings):
-            strings["status"], strings["mode"] = s.status, s.mode
+            robot[0] = replace(robot[0], **strings_fields(s))
 
     if client.supports("updateNumbers"):
         if client.supports("updateStrings"):

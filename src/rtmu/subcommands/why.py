@@ -24,17 +24,6 @@ if TYPE_CHECKING:
     from ..client.connection import AriaClient
     from ..client.why_fix import FixResult
 
-DESCRIPTION = """Why won't the robot move? Reads, never drives: the server's own data (its mode and
-lock, this login's rights, status words, safe drive and the obstacles its sonar and lasers see,
-battery, docking, localization, its drive watchdog, an LD robot's faults and safety data) told as
-one sentence with its fix. Exit 0 when nothing RTMU can read keeps the robot from moving, else the
-cause's own code (listed below).
-
---fix carries out the first cause's fix where there is one (unlock a mode that will unlock, undock,
-stop the server's own driving, switch safe drive off, acknowledge an LD robot's faults, enable its
-motors), then asks again. Switching safe drive off, acknowledging and enabling need a yes: typed at
-the prompt, or --yes; without one nothing is sent."""
-
 EXITS = (*NETWORK, *WHY_ASKED, EXIT_WHY_LOST)
 MAX_FIXES = 3
 """Fixes tried one after another (each reveals what the next cause is)."""

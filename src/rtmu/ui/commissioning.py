@@ -22,6 +22,7 @@ from ..mapedit import MapObject  # noqa: E402
 from ..model.observables import RobotModel  # noqa: E402
 from .banners import BannerStack  # noqa: E402
 from .files_page import FilesPage  # noqa: E402
+from .map_canvas_edit import MapCanvasEdit  # noqa: E402
 from .map_edit_window import MapEditWindow  # noqa: E402
 from .map_point_pick import MapPointPick  # noqa: E402
 from .mapview import MapStage  # noqa: E402
@@ -56,6 +57,8 @@ class Commissioning:
         self.stage, self.banners = stage, banners
         self.point_pick = MapPointPick(stage) if stage is not None else None
         """The map editor's one-point pick on the map (None without a map stage)."""
+        self.canvas_edit = MapCanvasEdit(stage) if stage is not None else None
+        """The map editor's tools on the map itself (None without a map stage)."""
         self.files_page: FilesPage | None = None
         """The files page last opened."""
         self.map_edit: MapEditWindow | None = None
@@ -68,7 +71,9 @@ class Commissioning:
         """Server ▸ Edit the map…: one draft window at a time."""
         if self.map_edit is None or self.map_edit.closed:
             pick = self.point_pick.start if self.point_pick is not None else None
-            self.map_edit = MapEditWindow(self.window, self.robot, self.model, self._show_draft, pick)
+            self.map_edit = MapEditWindow(
+                self.window, self.robot, self.model, self._show_draft, pick, self.canvas_edit
+            )
         self.map_edit.present()
 
     def _show_draft(self, objects: tuple[MapObject, ...] | None, edits: int) -> None:
@@ -104,6 +109,8 @@ class Commissioning:
         self.scan_bar.close()
         if self.point_pick is not None:
             self.point_pick.cancel()
+        if self.canvas_edit is not None:
+            self.canvas_edit.attach(None)
         for page in (self.files_page, self.map_edit):
             if page is not None and not page.closed:
                 page.close()

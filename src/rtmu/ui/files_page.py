@@ -42,6 +42,7 @@ from ..values.intents import DeleteFile, DownloadFile, FetchConfig, Intent, List
 from . import accessible  # noqa: E402
 from .confirm import Confirm  # noqa: E402
 from .files_text import greyed, human_size, parent_of, remote_join, transfer_text, when  # noqa: E402
+from .layout import fit_default_size, wrapping_row  # noqa: E402
 
 MAX_ROWS = 1000
 """Entries shown at once; the rest are counted in the status line."""
@@ -56,7 +57,7 @@ class FilesPage(Gtk.Window):
         super().__init__(
             title=_("Files on the robot"), transient_for=parent, modal=False, destroy_with_parent=True
         )
-        self.set_default_size(640, 460)
+        fit_default_size(self, 640, 460)
         self.robot, self.model = robot, model
         self.folder = ""
         """The folder shown, relative to the one the robot shares ("" is that one)."""
@@ -107,14 +108,14 @@ class FilesPage(Gtk.Window):
         scroller.set_child(self.rows)
         box.append(scroller)
         local = Gtk.Box(spacing=8)
-        local.append(Gtk.Label(label=_("Downloads go to")))
-        self.local_entry = Gtk.Entry(text=str(downloads), hexpand=True)
+        local.append(Gtk.Label(label=_("Downloads go to"), wrap=True, max_width_chars=10))
+        self.local_entry = Gtk.Entry(text=str(downloads), hexpand=True, width_chars=8)
         local.append(self.local_entry)
         self.choose_button = Gtk.Button(label=_("Choose…"))
         self.choose_button.connect("clicked", lambda _b: self._choose_folder())
         local.append(self.choose_button)
         box.append(local)
-        actions = Gtk.Box(spacing=8)
+        actions = wrapping_row(at_least=2)
         self.download_button = Gtk.Button(label=_("Download"))
         self.download_button.connect("clicked", lambda _b: self.download_selected())
         self.upload_button = Gtk.Button(label=_("Upload…"))

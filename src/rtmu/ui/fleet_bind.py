@@ -188,7 +188,9 @@ class FleetBinding:
 
     def _connection_changed(self, session: RobotSession, old: ConnectionState, new: ConnectionState) -> None:
         self._robot_changed(session)
-        self.robot_list.refresh()
+        row = self.robot_list.row_of(session)  # its row alone: 50 robots connecting, not 50² row updates
+        if row is not None:
+            row.update()
         lost = old.phase is Phase.CONNECTED and new.phase in (Phase.RECONNECTING, Phase.FAILED)
         if lost and session is not self.fleet.selected.value and len(self.fleet) > 1:
             self._lost[session.name] = new.error

@@ -57,6 +57,34 @@ def screen_size() -> tuple[int, int] | None:
     return geometry.width, geometry.height
 
 
+def fit_default_size(window: Gtk.Window, width: int, height: int, *, beside_map: bool = False) -> None:
+    """``set_default_size``, but never larger than the screen: a window made for a laptop opens on a
+    phone at the phone's size, and its rows wrap (``wrapping_row``) instead of running off it.
+
+    ``beside_map``: a window used together with the map under it (the map editor's tools) takes at
+    most half of a small screen — the upper half of a portrait one, the left half of a landscape one
+    under 1280 px — so the map stays in sight; it scrolls for the rest."""
+    screen = screen_size()
+    if screen is not None:
+        sw, sh = screen
+        width, height = min(width, sw), min(height, sh)
+        if beside_map and sh > sw:
+            height = min(height, sh // 2)
+        elif beside_map and sw < 1280:
+            width = min(width, sw // 2)
+    window.set_default_size(width, height)
+
+
+def wrapping_row(at_least: int = 1, at_most: int = 4) -> Gtk.FlowBox:
+    """Buttons side by side (at least ``at_least`` on a line) that wrap onto another line when the room
+    is narrower than their words: a longer language or a phone never widens the window past its screen."""
+    row = Gtk.FlowBox(selection_mode=Gtk.SelectionMode.NONE, column_spacing=6, row_spacing=6, hexpand=True)
+    row.set_min_children_per_line(at_least)
+    row.set_max_children_per_line(at_most)
+    row.set_homogeneous(False)
+    return row
+
+
 def monitor_width(window: Gtk.Window) -> int | None:
     """The width (logical px) of the monitor ``window`` is on, or None before it has a surface."""
     surface, display = window.get_surface(), window.get_display()

@@ -46,6 +46,8 @@ from ..mapedit.draft import (  # noqa: E402
 )
 from ..model.observables import MapModel, MapPhase, Phase, RobotModel  # noqa: E402
 from ..values.intents import ApplyMapChanges  # noqa: E402
+from .layout import fit_default_size, wrapping_row  # noqa: E402
+from .map_canvas_edit import TOOL_TIPS, MapCanvasEdit, Tool  # noqa: E402
 from .map_point_pick import Picked  # noqa: E402
 
 EDITABLE = {t.lower() for t in (GOAL, GOAL_WITH_HEADING, DOCK, FORBIDDEN_LINE, FORBIDDEN_AREA)}
@@ -67,11 +69,12 @@ class MapEditWindow(Gtk.Window):
         model: RobotModel,
         show_draft: Callable[[tuple[MapObject, ...] | None, int], None] = lambda _o, _n: None,
         pick: Callable[[Picked], None] | None = None,
+        canvas: MapCanvasEdit | None = None,
     ) -> None:
         super().__init__(title=_("Edit the map (draft)"), transient_for=parent, destroy_with_parent=True)
-        self.set_default_size(620, 520)
+        fit_default_size(self, 620, 520, beside_map=True)
         self.robot, self.model = robot, model
-        self._show_draft, self._pick = show_draft, pick
+        self._show_draft, self._pick, self.canvas = show_draft, pick, canvas
         """Told the draft's objects to draw on the map (None: the map's own again) and its edit count."""
         self.draft: MapDraft | None = None
         self.generation = -1
@@ -89,18 +92,21 @@ class MapEditWindow(Gtk.Window):
         self._unswitch = robot.on_switch(self._switched)
         self.connect("close-request", self._closing)
         self._map_changed(MapModel(), model.map.value)
+        if canvas is not None:
+            canvas.attach(self)
 
     # -- layout -----------------------------------------------------------------------------------
     def _build(self) -> None:
         box = Gtk.Box(orientation=Gtk.Orientation.VERTICAL, spacing=6)
         for side in ("top", "bottom", "start", "end"):
             getattr(box, f"set_margin_{side}")(8)
-        bar = Gtk.Box(spacing=6)
-        # Wraps at a width of its own: a language with longer words must not widen the window past an
-        # 800 px screen (tests/gui/test_pseudo_locale.py); the buttons below wrap onto a second line.
-        self.state_label = Gtk.Label(xalign=0.0, hexpand=True, wrap=True, max_width_chars=24)
+        # The state on a line of its own above the buttons, which wrap: a longer language or a phone's
+        # 360 px never widens the window past its screen (tests/gui/test_pseudo_locale.py,
+        # tests/gui/test_commissioning_phone.py).
+        bar = Gtk.Box(orientation=Gtk.Orientation.VERTICAL, spacing=6)
+        self.state_label = Gtk.Label(xalign=0.0, hexpand=True, wrap=True)
         bar.append(self.state_label)
-        buttons = _wrapping_row(at_least=4)
+        buttons = wrapping_row(at_least=2)
         bar.append(buttons)
         self.undo_button = Gtk.Button(label=_("Undo"))
         self.undo_button.connect("clicked", lambda _b: self._step(undo=True))
@@ -114,25 +120,29 @@ class MapEditWindow(Gtk.Window):
         for b in (self.undo_button, self.redo_button, self.discard_button, self.apply_button):
             buttons.append(b)
         box.append(bar)
+        box.append(self._tool_row())
         self.news = Gtk.Label(xalign=0.0, wrap=True, selectable=True)
         box.append(self.news)
         self.rows = Gtk.ListBox()
         self.rows.connect("row-selected", self._row_selected)
-        scroller = Gtk.ScrolledWindow(vexpand=True, hscrollbar_policy=Gtk.PolicyType.NEVER)
+        scroller = Gtk.ScrolledWindow(
+            vexpand=True, hscrollbar_policy=Gtk.PolicyType.NEVER, min_content_height=120
+        )
         scroller.set_child(self.rows)
         box.append(scroller)
         self.edits_label = Gtk.Label(xalign=0.0, wrap=True)
         self.edits_label.add_css_class("dim-label")
         box.append(self.edits_label)
-        form = Gtk.Grid(column_spacing=6, row_spacing=6)
+        form = Gtk.Box(orientation=Gtk.Orientation.VERTICAL, spacing=6)
+        what = wrapping_row(at_least=2, at_most=5)
         self.kind = Gtk.DropDown.new_from_strings([_(k) for k in KINDS])
-        self.name_entry = Gtk.Entry(placeholder_text=_("name (goals, docks)"))
+        self.name_entry = Gtk.Entry(placeholder_text=_("name (goals, docks)"), width_chars=12)
         self.fields: dict[str, Gtk.Entry] = {}
-        form.attach(self.kind, 0, 0, 1, 1)
-        form.attach(self.name_entry, 1, 0, 2, 1)
+        what.append(self.kind)
+        what.append(self.name_entry)
         here = Gtk.Button(label=_("Robot's pose"))
         here.connect("clicked", lambda _b: self._fill_from_robot())
-        form.attach(here, 3, 0, 1, 1)
+        what.append(here)
         self.pick_button = Gtk.Button(
             label=_("Pick on the map"), tooltip_text=_("Click a point; drag for a heading")
         )
@@ -143,8 +153,9 @@ class MapEditWindow(Gtk.Window):
         self.pick_end_button.connect("clicked", lambda _b: self.pick_point(end=True))
         self.pick_button.set_sensitive(self._pick is not None)
         self.pick_end_button.set_sensitive(self._pick is not None)
-        form.attach(self.pick_button, 4, 0, 1, 1)
-        form.attach(self.pick_end_button, 4, 1, 1, 1)
+        what.append(self.pick_button)
+        what.append(self.pick_end_button)
+        form.append(what)
         fields = Gtk.Grid(column_spacing=6, column_homogeneous=True)
         titles = {
             "x": _("x (mm)"),
@@ -155,11 +166,11 @@ class MapEditWindow(Gtk.Window):
         }
         for i, (name, title) in enumerate(titles.items()):
             fields.attach(Gtk.Label(label=title, xalign=0.0, ellipsize=Pango.EllipsizeMode.END), i, 0, 1, 1)
-            entry = Gtk.Entry(width_chars=6)
+            entry = Gtk.Entry(width_chars=5)
             self.fields[name] = entry
             fields.attach(entry, i, 1, 1, 1)
-        form.attach(fields, 0, 1, 4, 2)
-        actions = _wrapping_row(at_least=2)
+        form.append(fields)
+        actions = wrapping_row(at_least=2)
         self.add_button = Gtk.Button(label=_("Add"))
         self.add_button.connect("clicked", lambda _b: self.add())
         self.move_button = Gtk.Button(label=_("Move selected here"))
@@ -170,12 +181,44 @@ class MapEditWindow(Gtk.Window):
         self.delete_button.connect("clicked", lambda _b: self.delete_selected())
         for b in (self.add_button, self.move_button, self.rename_button, self.delete_button):
             actions.append(b)
-        form.attach(actions, 0, 3, 4, 1)
+        form.append(actions)
         box.append(form)
-        self.set_child(box)
+        # Scrolls as a whole where the screen is lower than the form (800x480, a phone held sideways):
+        # every control stays reachable and the window never grows past the screen.
+        page = Gtk.ScrolledWindow(hscrollbar_policy=Gtk.PolicyType.NEVER, propagate_natural_height=True)
+        page.set_child(box)
+        self.set_child(page)
         keys = Gtk.EventControllerKey()
         keys.connect("key-pressed", self._key)
         self.add_controller(keys)
+
+    def _tool_row(self) -> Gtk.Widget:
+        """What a press on the map does (``map_canvas_edit``): one of a group of toggles."""
+        row = wrapping_row(at_least=2)
+        row.set_max_children_per_line(len(Tool))
+        self.tool_buttons: dict[Tool, Gtk.ToggleButton] = {}
+        first: Gtk.ToggleButton | None = None
+        for tool in Tool:
+            button = Gtk.ToggleButton(label=_(tool.value), tooltip_text=_(TOOL_TIPS[tool]))
+            button.set_group(first)
+            first = first or button
+            button.set_active(tool is Tool.PAN)
+            button.set_sensitive(self.canvas is not None)
+            button.connect("toggled", self._tool_toggled, tool)
+            self.tool_buttons[tool] = button
+            row.append(button)
+        return row
+
+    def _tool_toggled(self, button: Gtk.ToggleButton, tool: Tool) -> None:
+        if button.get_active():
+            self.set_tool(tool)
+
+    def set_tool(self, tool: Tool) -> None:
+        """What a press on the map does from now on (the toggles show it)."""
+        if self.canvas is not None:
+            self.canvas.set_tool(tool)
+        if not self.tool_buttons[tool].get_active():
+            self.tool_buttons[tool].set_active(True)
 
     def _key(self, _c: Gtk.EventControllerKey, keyval: int, _code: int, state: Gdk.ModifierType) -> bool:
         if keyval == Gdk.KEY_Escape:
@@ -221,17 +264,43 @@ class MapEditWindow(Gtk.Window):
         except ValueError:
             raise DraftError(_("{name}: {text!r} is not a number").format(name=name, text=text)) from None
 
-    def _edit(self, what: Any) -> None:
-        """Run one draft edit; a DraftError is said, and the draft stays as it was."""
+    def _edit(self, what: Any) -> bool:
+        """Run one draft edit; a DraftError is said, and the draft stays as it was (False)."""
         if self.draft is None:
             self._say(_("There is no map to edit yet."), error=True)
-            return
+            return False
         try:
             what(self.draft)
         except DraftError as exc:
             self._say(str(exc), error=True)
-            return
+            return False
         self._say("", error=False)
+        self._show()
+        return True
+
+    # -- what the map's tools ask (``map_canvas_edit.CanvasEditor``) ------------------------------
+    def run_edit(self, what: Callable[[MapDraft], object]) -> bool:
+        return self._edit(what)
+
+    def drawn_objects(self) -> tuple[MapObject, ...]:
+        data = self.model.map.value.data
+        kept = [o for o in (data.objects if data is not None else ()) if o.type.lower() not in EDITABLE]
+        return (*kept, *(self.draft.objects if self.draft is not None else ()))
+
+    def select_object(self, obj: MapObject) -> None:
+        low = obj.name.lower()
+        for i, shown in enumerate(self.shown):
+            if (shown.name.lower() == low) if obj.name else object_key(shown) == object_key(obj):
+                self.rows.select_row(self.rows.get_row_at_index(i))
+                return
+
+    def name_for(self, stem: str) -> str:
+        typed = self.name_entry.get_text().strip()
+        if typed and (self.draft is None or self.draft.find(typed) is None):
+            return typed
+        return self.draft.free_name(_(stem)) if self.draft is not None else _(stem)
+
+    def refresh(self) -> None:
         self._show()
 
     def add(self) -> None:
@@ -306,6 +375,7 @@ class MapEditWindow(Gtk.Window):
         """The next click on the map fills x, y (and a dragged heading) — or x2, y2 with ``end``."""
         if self._pick is None:
             return
+        self.set_tool(Tool.PAN)  # the next press is the pick's, not a tool's
         self._say(
             _("Click the map") + ("" if end else _(" (drag from the point for a heading)")), error=False
         )
@@ -420,18 +490,10 @@ class MapEditWindow(Gtk.Window):
     def _closing(self, _w: Gtk.Window) -> bool:
         self.closed = True
         self._show_draft(None, 0)  # the map shows the robot's map again
+        if self.canvas is not None:
+            self.canvas.attach(None)
         for remove in self._unobserve:
             remove()
         self._unobserve = []
         self._unswitch()
         return False
-
-
-def _wrapping_row(at_least: int) -> Gtk.FlowBox:
-    """Buttons side by side (``at_least`` on a line) that wrap onto another line when the words are longer
-    than the room."""
-    row = Gtk.FlowBox(selection_mode=Gtk.SelectionMode.NONE, column_spacing=6, row_spacing=6, hexpand=True)
-    row.set_min_children_per_line(at_least)
-    row.set_max_children_per_line(4)
-    row.set_homogeneous(False)
-    return row

@@ -20,6 +20,7 @@ from ..recorder.replay import REPLAY_HOST, Replayer
 from ..recorder.replay_file import load
 from ..settings.store import Profile
 from ..values.state import StateChange
+from ..values.target import Target
 from .replay_bar import ReplayBar
 
 if TYPE_CHECKING:
@@ -54,7 +55,7 @@ def show_replay(window: MainWindow, session: RobotSession, replayer: Replayer) -
         rebuild = replayer.seek_needs_rebuild(at_ns)
         replayer.clock.seek(at_ns)
         if rebuild:  # back in time: the state is rebuilt from the first byte
-            runner.connect(REPLAY_HOST, 0, auto_reconnect=False)
+            runner.connect(Target(REPLAY_HOST, 0, auto_reconnect=False))
 
     window.stage.status_age = window.toolbar.status_age = replayer.status_age  # ages in recording time
     bar = ReplayBar(replayer.clock, seek, name)
@@ -77,5 +78,5 @@ def show_replay(window: MainWindow, session: RobotSession, replayer: Replayer) -
         timeout=6.0,
     )
     replayer.clock.play()
-    runner.connect(REPLAY_HOST, 0, auto_reconnect=False)
+    runner.connect(Target(REPLAY_HOST, 0, auto_reconnect=False))
     return bar

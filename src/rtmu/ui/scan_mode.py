@@ -70,7 +70,12 @@ class ScanDialog(Gtk.Window):
         for side in ("top", "bottom", "start", "end"):
             getattr(box, f"set_margin_{side}")(12)
         box.append(
-            Gtk.Label(label=_("Name the scan, start it, then drive the robot round the place."), xalign=0.0)
+            Gtk.Label(
+                label=_("Name the scan, start it, then drive the robot round the place."),
+                xalign=0.0,
+                wrap=True,
+                max_width_chars=40,
+            )
         )
         self.name_entry = Gtk.Entry(placeholder_text=_("e.g. ground floor"), activates_default=True)
         box.append(self.name_entry)
@@ -174,11 +179,19 @@ class ScanBar(Gtk.Revealer):
         self.dismiss.connect("clicked", lambda _b: self._dismiss())
         for button in (self.loop_start, self.loop_end, self.stop_scan, self.download, self.dismiss):
             buttons.append(button)
-        for part in (self.label, buttons):
+        # The scan's download as a bar on its own line: how far of how much (a pulse until its size is known).
+        self.transfer_bar = Gtk.ProgressBar(show_text=True, hexpand=True)
+        self.transfers_shown = 0
+        """Updates of the download's progress shown (tests wait for one)."""
+        for part in (self.label, buttons, self.transfer_bar):
             box.append(part)
             cell = part.get_parent()
             assert isinstance(cell, Gtk.FlowBoxChild)
             cell.set_focusable(False)  # Tab goes to the buttons, not to their cells
+        cell = self.transfer_bar.get_parent()
+        assert isinstance(cell, Gtk.FlowBoxChild)
+        self._transfer_cell: Gtk.FlowBoxChild = cell
+        cell.set_visible(False)
         self.set_child(box)
         self.note = ""
         self.message = ""
@@ -318,8 +331,13 @@ class ScanBar(Gtk.Revealer):
 
     def _transfers(self, state: TransfersState) -> None:
         mine = [t for t in state.active if self.offer_file and t.remote == self.offer_file]
+        self._transfer_cell.set_visible(bool(mine))
         if mine:
             self.message = transfer_text(mine[0])
+            self.transfer_bar.set_text(self.message)
+            fraction = mine[0].fraction
+            self.transfer_bar.pulse() if fraction is None else self.transfer_bar.set_fraction(fraction)
+            self.transfers_shown += 1
             self._show()
 
     # -- plumbing ---------------------------------------------------------------------------------

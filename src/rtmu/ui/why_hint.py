@@ -39,7 +39,8 @@ SHOWN_FOR = 12.0
 
 
 class WhyContext:
-    """What the window knows of the drive: the keys held, the link shown, a key ignored after a stop."""
+    """What the window knows of the drive: the keys held or the stick's ratios (a stick pushed a little
+    asks for a drive ARIA's dead zone swallows), the link shown, a key ignored after a stop."""
 
     def __init__(self, robot: SelectedRobot, model: RobotModel, router: KeyRouter) -> None:
         self.robot, self.model, self.router = robot, model, router
@@ -56,7 +57,9 @@ class WhyContext:
 
     def question(self, *, navigate: bool = False) -> AskWhy:
         controller = self.robot.session.controller
-        ratios = ratios_for(self.held_directions(), 100.0)
+        held, stick = self.held_directions(), controller.analog_ratios
+        ratios = ratios_for(held, 100.0)  # keys first, as the drive itself takes them
+        trans, rot = (ratios.trans, ratios.rot) if held or stick is None else stick
         connected = self.model.connection.value.phase is Phase.CONNECTED
         blocked = (
             bool(self.router.held)
@@ -67,8 +70,8 @@ class WhyContext:
         )
         return AskWhy(
             navigate=navigate,
-            trans=ratios.trans,
-            rot=ratios.rot,
+            trans=trans,
+            rot=rot,
             link=self.model.health.value.level.value if connected else "down",
             keys_blocked=blocked,
         )

@@ -5,7 +5,8 @@ It asks the selected robot (:class:`~rtmu.values.intents.AskWhy`, reads only: as
 the robot) with what only the window knows — the drive held, the link as shown, a key ignored after
 a stop — and shows the answer ``rtmu why`` gives: the first cause as one sentence and its advice,
 the other causes, the server data each was read from, notes, and an LD robot's raw values (labelled
-raw: their layouts are not public).
+raw: their layouts are not public). A safety fact (a login that may not stop) is marked ⚠, and shown in
+the error colour when it is the answer.
 
 Where the cause has a fix (ask a locked mode to unlock, undock, end the server's navigation, switch
 safe drive off, acknowledge an LD robot's faults, enable its motors) a button offers it; the button
@@ -31,7 +32,7 @@ from ..client.why_values import Answer, Fix  # noqa: E402
 from ..control.intent_rules import FIX_WORDS  # noqa: E402
 from ..values.intents import ApplyFix, AskWhy, Intent  # noqa: E402
 from .confirm_bar import ConfirmBar  # noqa: E402
-from .layout import NARROW, screen_size  # noqa: E402
+from .layout import fit_default_size, wrapping_row  # noqa: E402
 from .state_words import sentence_words  # noqa: E402
 
 Request = Callable[[Intent], "concurrent.futures.Future[Any]"]
@@ -86,8 +87,7 @@ class WhyWindow(Gtk.Window):
         super().__init__(
             title=_("Why won't it move?"), transient_for=parent, modal=False, destroy_with_parent=True
         )
-        screen = screen_size()  # a 360 px phone: the window takes its width, no more
-        self.set_default_size(560 if screen is None else min(560, screen[0] - 16), 300)
+        fit_default_size(self, 560, 300)  # a 360 px phone: the window takes its width, no more
         self._request, self._question = request, question
         self.answer: Answer | None = None
         self.asking = False
@@ -108,10 +108,7 @@ class WhyWindow(Gtk.Window):
         for label in (self.sentence, self.details, self.status):
             label.set_wrap_mode(Pango.WrapMode.WORD_CHAR)  # a word longer than the line (a path) breaks too
         self.confirm = ConfirmBar()
-        buttons = Gtk.Box(spacing=6, halign=Gtk.Align.END)
-        if screen is not None and screen[0] < NARROW:  # a phone: the three buttons one above the other
-            buttons.set_orientation(Gtk.Orientation.VERTICAL)
-            buttons.set_halign(Gtk.Align.FILL)
+        buttons = wrapping_row(at_most=3)  # on a phone, or in longer words, they wrap onto more lines
         self.fix_button = Gtk.Button(visible=False)
         self.fix_button.connect("clicked", lambda _b: self._offer_fix())
         self.again_button = Gtk.Button(label=_("Ask again"))
@@ -165,9 +162,14 @@ class WhyWindow(Gtk.Window):
     def show_answer(self, answer: Answer) -> None:
         self.answer = answer
         sentence = _short(sentence_words(answer.sentence()))  # problem — advice, each part translated
-        self.sentence.set_text(sentence[:1].upper() + sentence[1:])
-        self.details.set_text(answer_details(answer))
         first = answer.primary
+        loud = first is not None and first.loud  # a safety fact (a login that may not stop): said loudly
+        self.sentence.set_text(("⚠ " if loud else "") + sentence[:1].upper() + sentence[1:])
+        if loud:
+            self.sentence.add_css_class("error")
+        else:
+            self.sentence.remove_css_class("error")
+        self.details.set_text(answer_details(answer))
         self.fix = first.fix if first is not None else None
         self.fix_button.set_visible(self.fix is not None)
         if self.fix is not None:
