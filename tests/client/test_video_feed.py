@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import io
+import itertools
 
 import pytest
 from PIL import Image
@@ -211,3 +212,20 @@ def test_a_camera_that_slows_down_is_followed() -> None:
     requests, new, _ = play_camera(pacer, fps=30.0, seconds=20.0, ready_at=periodic(0.2), start=8.0)
     assert pacer.period == pytest.approx(0.2, rel=0.05)
     assert requests <= 1.25 * new and new >= 0.9 * 20 * 5
+
+
+def test_a_frame_held_up_costs_a_few_retries_not_one_every_3_ms() -> None:
+    """A camera (or a loaded robot computer) that holds a frame up for 40 ms: the retries start quick
+    and grow, so the wait costs five requests where eight 3 ms retries and more cost nine."""
+    from rtmu.client.video_feed import RETRY_MAX_S, RETRY_MIN_S, FramePacer
+
+    pacer = FramePacer()
+    sent, asked = 0.0, []
+    for _ in range(30):
+        sent = pacer.after(sent, "repeat", 1 / 30)
+        asked.append(sent)
+    gaps = [b - a for a, b in itertools.pairwise([0.0, *asked])]
+    assert gaps[0] == pytest.approx(RETRY_MIN_S)  # a frame just late is still found within 3 ms
+    assert all(b >= a - 1e-9 for a, b in itertools.pairwise(gaps))
+    assert sum(1 for t in asked if t <= 0.040) <= 5
+    assert gaps[-1] == pytest.approx(RETRY_MAX_S)  # a camera that stopped: asked once a second

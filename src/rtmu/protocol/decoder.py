@@ -57,6 +57,7 @@ from typing import Final
 
 from .checksum import WORD_STRUCTS, SpanChecksums, checksum
 from .packet import MAX_LENGTH, MIN_LENGTH, SYNC, Packet
+from .runs import take_run
 
 _COMPACT_AT = 64 * 1024
 _INLINE_SUM_BELOW: Final = 6 + 2 * len(WORD_STRUCTS)
@@ -78,6 +79,10 @@ _PROBE_AFTER: Final = 2 + STREAM_GOES_ON * MIN_LENGTH
 """Fewer bytes behind a waiting header cannot hold a proving chain: skip the look (hot path)."""
 
 _CHAIN_START = re.compile(rb"\x0f\x0c[\x00-\xff][\x00-\x0f]")
+
+
+_RUN_BELOW: Final = 256
+"""Packets shorter than this, several of one length in a row, are framed by :func:`take_run`."""
 
 
 @dataclass(slots=True)
@@ -280,6 +285,8 @@ class PacketDecoder:
         new_packet = _new_tuple
         word_structs = WORD_STRUCTS
         garbage = 0
+        last = -1
+        """The length of the packet before: one more of it in a row starts a run (:func:`~.runs.take_run`)."""
         while True:
             start = find(SYNC, pos)
             if start < 0:
@@ -309,6 +316,12 @@ class PacketDecoder:
                     pos += 2
                     continue
                 break
+            if length == last and length < _RUN_BELOW:  # a run of one length: a status stream
+                after = take_run(buf, pos, end, length, found)
+                if after > pos:
+                    pos = after
+                    continue
+            last = length
             body_end = pos + length - 2
             if spans_summed:
                 if sums.stop < end:

@@ -22,8 +22,9 @@ from __future__ import annotations
 import dataclasses
 import importlib
 import struct
+from collections.abc import Callable
 from enum import Enum
-from typing import Any, ClassVar, Self, TypeVar
+from typing import Any, ClassVar, Final, Self, TypeVar
 
 from ..errors import PayloadError
 from ..fields import FieldReader, FieldWriter
@@ -32,6 +33,11 @@ from ..fields import FieldReader, FieldWriter
 class Side(Enum):
     ARGS = "args"
     REPLY = "reply"
+
+    # Every packet's type lookup hashes a (name, side) key; Enum's own __hash__ is a Python call
+    # (hash of the member's name), a third of a status packet's decode. Members are singletons and
+    # compare by identity, so the identity hash is the same contract in C.
+    __hash__ = object.__hash__
 
 
 class NameMatch(Enum):
@@ -148,6 +154,7 @@ def register(cls: P) -> P:
         raise RuntimeError(f"two payload types for {key}")
     _REGISTRY[key] = cls
     _LOOKUP_CACHE.clear()
+    _DECODERS.clear()
     return cls
 
 
@@ -231,8 +238,19 @@ def _lookup(data_name: str, side: Side) -> type[Payload] | None:
 
 def decode_payload(data_name: str, side: Side, data: bytes) -> Payload | None:
     """Decode ``data`` with the type for ``data_name`` (see :func:`payload_type_for`); None if unknown."""
-    cls = payload_type_for(data_name, side)
-    return None if cls is None else cls.decode(data)
+    decode = _decoder_for((data_name, side), _UNCACHED)  # every packet: one lookup, no method binding
+    if decode is _UNCACHED:
+        cls = payload_type_for(data_name, side)
+        decode = None if cls is None else cls.decode
+        if len(_DECODERS) < 4096:  # names come from the server: keep the cache bounded
+            _DECODERS[(data_name, side)] = decode
+    return None if decode is None else decode(data)
+
+
+_UNCACHED: Final[Any] = object()
+_DECODERS: dict[tuple[str, Side], Callable[[bytes], Payload] | None] = {}
+"""(data name, side) → the bound ``decode`` of its type (None: no type), as :data:`_LOOKUP_CACHE`."""
+_decoder_for = _DECODERS.get
 
 
 def registered() -> dict[tuple[str, Side], type[Payload]]:
