@@ -95,6 +95,7 @@ def server_words(gui: Gui, sim: SimThread) -> list[str]:
     """What the robot's server says in its own words: shown as sent, never translated."""
     robot = gui.model.robot.value
     words = [robot.mode, robot.status, robot.extended_status or ""]
+    words.append(gui.model.navigation.value.loc_state or "")  # getLocState's word (ARNL's "Good", "Lost")
     map_name = gui.model.map.value.name
     words += [map_name, Path(map_name.replace("\\", "/")).name, sim.call(lambda: sim.server.robot.mode_name)]
     words += ["127.0.0.1", str(sim.port), "ws://127.0.0.1:8765", *GTK_OWN]
