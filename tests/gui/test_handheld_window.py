@@ -237,7 +237,8 @@ def test_battery_and_wifi_alarms_from_the_simulator_with_mute(phone: tuple[Gui, 
         3,
         "the banner to say the Wi-Fi value the strip shows",
     )
-    assert f"Wi-Fi {gui.model.robot.value.wifi_quality}%" in window.handheld.layout.strip.text, "strip"
+    # the same spacing too: the strip writes its units as the banner (and the language) does
+    assert f"Wi-Fi {gui.model.robot.value.wifi_quality} %" in window.handheld.layout.strip.text, "strip"
     gui.shot("alarm-wifi")
     assert clipped_widgets(window) == []
     # The simulator's own "Low battery" popup card sits above the thumb's D-pad, not under it.

@@ -16,6 +16,7 @@ from __future__ import annotations
 import contextlib
 import gettext
 import locale
+import re
 from collections.abc import Sequence
 from pathlib import Path
 
@@ -57,11 +58,104 @@ def N_(message: str) -> str:
     return message
 
 
+class Said(str):
+    """A sentence built from values that both machines and people read: as a ``str`` it is the English
+    (``--json``, logs, comparisons — stable whatever the operator's language); :meth:`words` says it in
+    the operator's language, numbers and all, when it is shown.
+
+    ``Said(N_("connected to {where} in {time}"), where=..., time=Quantity(12, "ms"))``: the template is
+    marked where it is written and translated at display time; a value with a ``words()`` method (a
+    :class:`Said`, a :class:`rtmu.base.units.Quantity`) is said in the operator's language too, any
+    other value is shown as it is (a host, the server's own words)."""
+
+    template: str
+    values: dict[str, object]
+
+    def __new__(cls, template: str, /, **values: object) -> Said:
+        said = super().__new__(cls, template.format(**values))
+        said.template = template
+        said.values = values
+        return said
+
+    def words(self) -> str:
+        """The sentence in the operator's language."""
+        shown = {k: _value_words(v) for k, v in self.values.items()}
+        try:
+            return _(self.template).format(**shown)
+        except (KeyError, IndexError, ValueError):  # a translation that broke its placeholders
+            return self.template.format(**shown)
+
+    def __reduce__(self) -> tuple[object, ...]:
+        return (_said, (self.template, self.values))
+
+
+def _value_words(value: object) -> object:
+    say = getattr(value, "words", None)
+    return say() if callable(say) else value
+
+
+def _said(template: str, values: dict[str, object]) -> Said:
+    return Said(template, **values)
+
+
+def as_said(text: str) -> Said:
+    """``text`` as a :class:`Said` (itself if it is one): a marked constant becomes one with no values,
+    so a sentence joined from parts still says each part in the operator's language."""
+    return text if isinstance(text, Said) else Said(text.replace("{", "{{").replace("}", "}}"))
+
+
+def error_words(error: BaseException) -> str:
+    """An exception's message for the operator: its :class:`Said` in their language, else as raised."""
+    said = error.args[0] if len(error.args) == 1 and isinstance(error.args[0], Said) else None
+    return said.words() if said is not None else str(error)
+
+
+def words(text: str) -> str:
+    """``text`` as the operator reads it: a :class:`Said` in their language, a marked constant
+    translated (an unmarked text — a host, the server's words — comes back as it is)."""
+    if isinstance(text, Said):
+        return text.words()
+    return _(text) if text else text
+
+
+# TRANSLATORS: 1234.5 as your language writes it, with its grouping mark (or none) and decimal mark.
+NUMBER_PATTERN = N_("1,234.5")
+"""Translators write one thousand two hundred thirty-four and a half as their language does (German:
+``1.234,5``): its grouping mark (or none) and decimal mark are read from it, so numbers follow the
+operator's language even where the C library lacks that locale."""
+
+_PATTERN = re.compile(r"1([^\d]?)234([^\d])5")
+
+
 def number(value: float, digits: int = 0) -> str:
-    """``value`` with ``digits`` decimals as the operator's locale writes numbers (its decimal mark and
-    grouping), for numbers shown to people; machine output (JSON, files) never goes through here."""
-    _numeric_locale()
-    return locale.format_string(f"%.{max(0, digits)}f", value, grouping=True)
+    """``value`` with ``digits`` decimals as the operator's language writes numbers (its decimal mark and
+    grouping), for numbers shown to people; machine output (JSON, files, the wire) never goes through here.
+
+    The marks come from the chosen catalogue's :data:`NUMBER_PATTERN`; with no catalogue (English, ``C``)
+    from the C library's ``LC_NUMERIC``."""
+    digits = max(0, digits)
+    marks = _catalogue_marks()
+    if marks is None:
+        _numeric_locale()
+        return locale.format_string(f"%.{digits}f", value, grouping=True)
+    group, decimal = marks
+    return f"{value:,.{digits}f}".translate({ord(","): group, ord("."): decimal})
+
+
+def _catalogue_marks() -> tuple[str, str] | None:
+    """(grouping mark, decimal mark) of the chosen catalogue, or None when it does not say; read once
+    per catalogue (the toolbar writes numbers many times a second)."""
+    translation = _translation()
+    if _marks_read and _marks_read[0][0] is translation:
+        return _marks_read[0][1]
+    written = translation.gettext(NUMBER_PATTERN)
+    found = _PATTERN.search(written) if written != NUMBER_PATTERN else None
+    marks = (found.group(1), found.group(2)) if found else None
+    _marks_read[:] = [(translation, marks)]
+    return marks
+
+
+_marks_read: list[tuple[gettext.NullTranslations, tuple[str, str] | None]] = []
 
 
 _numeric_set: list[bool] = []

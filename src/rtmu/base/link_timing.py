@@ -39,6 +39,9 @@ import math
 import os
 from dataclasses import dataclass
 
+from .i18n import N_, Said
+from .units import Quantity
+
 STATUS_PROMISE = 0.5
 """The safety promise: zero ratios and ``stop`` on the wire within this many seconds of the last status."""
 STATUS_CEILING = 0.45
@@ -110,11 +113,14 @@ class Timing:
     """The limit this link's own jitter gives, once the starting assumption has worn off."""
 
     def describe(self) -> str:
-        """``learned jitter 90 ms, limit 0.33 s`` — the words a stop and the HUD use."""
+        """``learned jitter 90 ms, limit 0.33 s`` — the words a stop and the HUD use (a :class:`Said`:
+        English for logs, the operator's language where shown)."""
+        jitter, limit = Quantity(self.jitter * 1000, "ms"), Quantity(self.limit, "s", 2)
         if self.fixed:
-            return f"jitter {self.jitter * 1000:.0f} ms, fixed limit {self.limit:.2f} s"
-        word = "jitter so far" if self.learning else "learned jitter"
-        return f"{word} {self.jitter * 1000:.0f} ms, limit {self.limit:.2f} s"
+            return Said(N_("jitter {jitter}, fixed limit {limit}"), jitter=jitter, limit=limit)
+        if self.learning:
+            return Said(N_("jitter so far {jitter}, limit {limit}"), jitter=jitter, limit=limit)
+        return Said(N_("learned jitter {jitter}, limit {limit}"), jitter=jitter, limit=limit)
 
 
 class Deadline:

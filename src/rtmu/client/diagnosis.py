@@ -11,7 +11,7 @@ from __future__ import annotations
 from dataclasses import dataclass
 from enum import Enum
 
-from ..base.i18n import N_
+from ..base.i18n import N_, Said, as_said
 from ..protocol.commands import RejectReason
 from .errors import (
     ClientError,
@@ -50,15 +50,16 @@ class Step(Enum):
 
 
 STEP_TITLES = {
-    Step.RESOLVE: "name resolution",
-    Step.TCP: "TCP connection",
-    Step.INTRODUCTION: "server introduction",
-    Step.LOGIN: "login",
-    Step.DATA_LIST: "data list",
-    Step.UDP: "UDP",
-    Step.STATUS: "first status",
-    Step.MOTION: "why won't it move",
+    Step.RESOLVE: N_("name resolution"),
+    Step.TCP: N_("TCP connection"),
+    Step.INTRODUCTION: N_("server introduction"),
+    Step.LOGIN: N_("login"),
+    Step.DATA_LIST: N_("data list"),
+    Step.UDP: N_("UDP"),
+    Step.STATUS: N_("first status"),
+    Step.MOTION: N_("why won't it move"),
 }
+"""English, as ``--json`` gives them; marked, and translated where a person reads them."""
 
 
 @dataclass(frozen=True)
@@ -71,7 +72,9 @@ class Finding:
 
     def sentence(self) -> str:
         """One line for a banner or a log: "<problem> — <advice>"."""
-        return f"{self.problem} — {self.advice}" if self.advice else self.problem
+        if not self.advice:
+            return self.problem
+        return Said("{problem} — {advice}", problem=as_said(self.problem), advice=as_said(self.advice))
 
 
 # -- the table ------------------------------------------------------------------------------------
@@ -153,29 +156,44 @@ def login_finding(reason: int, text: str = "", wanted: str | None = None, sent: 
         if wanted:
             return Finding(
                 Step.LOGIN,
-                f"the server wants protocol {wanted!r}; we sent {sent!r}",
-                f"use --protocol {wanted} (or leave --protocol out: RTMU then answers with the "
-                "string the server advertises)",
+                Said(
+                    N_("the server wants protocol {wanted}; we sent {sent}"),
+                    wanted=repr(wanted),
+                    sent=repr(sent),
+                ),
+                Said(
+                    N_(
+                        "use --protocol {wanted} (or leave --protocol out: RTMU then answers with the "
+                        "string the server advertises)"
+                    ),
+                    wanted=wanted,
+                ),
             )
         return Finding(
             Step.LOGIN,
-            f"the server refuses our protocol string {sent!r} and does not say which it wants",
-            "try --protocol 6MTX (Omron LD robots; older ones 5MTX)",
+            Said(
+                N_("the server refuses our protocol string {sent} and does not say which it wants"),
+                sent=repr(sent),
+            ),
+            N_("try --protocol 6MTX (Omron LD robots; older ones 5MTX)"),
         )
+    problem: str
     try:
         problem, advice = REJECT_ADVICE[RejectReason(reason)]
     except (ValueError, KeyError):
-        problem, advice = f"the server refused the login (reason {reason})", "ask the robot's administrator"
+        problem = Said(N_("the server refused the login (reason {reason})"), reason=reason)
+        advice = N_("ask the robot's administrator")
     if text and reason == RejectReason.USING_CENTRAL_SERVER:
-        problem += f" at {text}"
+        problem = Said(N_("{problem} at {where}"), problem=as_said(problem), where=text)
     elif text and reason not in (RejectReason.TOO_MANY_CLIENTS,):
-        problem += f" ({text})"
+        problem = Said("{problem} ({text})", problem=as_said(problem), text=text)
     return Finding(Step.LOGIN, problem, advice)
 
 
 def explain(error: ClientError) -> Finding:
     """The step and the plain words for a failed connection attempt (the window's banner text)."""
-    message = str(error)
+    said = error.args[0] if error.args and isinstance(error.args[0], Said) else None
+    message: str = said if said is not None else str(error)
     if isinstance(error, HostNotFound):
         return Finding(Step.RESOLVE, message, ADVICE["resolve"])
     if isinstance(error, ConnectionRefused):

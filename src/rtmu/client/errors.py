@@ -8,6 +8,7 @@ and the command line prints it on one line and exits with ``error.exit_code``.
 from __future__ import annotations
 
 from ..base.exit_codes import EXIT_CONNECTION, EXIT_INTERNAL, EXIT_TIMEOUT, EXIT_UNSUPPORTED
+from ..base.i18n import N_, Said, as_said
 from ..protocol.commands import RejectReason, describe_reject
 from ..protocol.errors import ProtocolError
 
@@ -55,7 +56,8 @@ class LoginRejected(ClientError):
         self.text = text
         self.wanted_protocol = wanted_protocol
         """Reason 4: the protocol string the server advertised (None: not known)."""
-        super().__init__(f"login refused: {advice or describe_reject(reason, text)}")
+        why = as_said(advice or describe_reject(reason, text))
+        super().__init__(Said(N_("login refused: {reason}"), reason=why))
 
     @property
     def bad_credentials(self) -> bool:
@@ -95,7 +97,10 @@ class NotSupported(ClientError):
 
     def __init__(self, name: str, detail: str = "") -> None:
         self.name = name
-        super().__init__(detail or f"this server does not offer {name!r} (or this user may not use it)")
+        super().__init__(
+            detail
+            or Said(N_("this server does not offer {name} (or this user may not use it)"), name=repr(name))
+        )
 
 
 class MotionRefused(ClientError):
@@ -110,5 +115,8 @@ class MotionRefused(ClientError):
     def __init__(self, name: str) -> None:
         self.name = name
         super().__init__(
-            f"an observer never sends {name!r} (it changes how the robot moves); nothing was sent"
+            Said(
+                N_("an observer never sends {name} (it changes how the robot moves); nothing was sent"),
+                name=repr(name),
+            )
         )

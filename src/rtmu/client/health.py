@@ -25,7 +25,9 @@ from __future__ import annotations
 
 from collections.abc import Callable
 
+from ..base.i18n import N_, Said
 from ..base.link_timing import STATUS_CEILING, WAKE_MEMORY, Deadline, Envelope, Timing, ceiling_for
+from ..base.units import Quantity
 from ..protocol.decoder import DropStats
 from ..values.state import LinkHealth, LinkLevel
 
@@ -214,7 +216,9 @@ class HealthMonitor:
             ping_failures=self.ping_failures,
             stale_limit=round(self.stale_limit(now), 2),
             jitter_ms=round(timing.jitter * 200.0) * 5.0,
-            cause="" if level in (LinkLevel.OK, LinkLevel.DOWN) else f"{self.cause(now)}. {self.advice()}",
+            cause=""
+            if level in (LinkLevel.OK, LinkLevel.DOWN)
+            else Said("{cause}. {advice}", cause=self.cause(now), advice=self.advice()),
         )
 
     def cause(self, now: float) -> str:
@@ -224,23 +228,34 @@ class HealthMonitor:
         """
         where = self.where
         if self.ping_failures:
-            return (
-                f"{where} did not answer a ping within {self.ping_deadline(now):.2f} s "
-                f"({self.ping_failures} in a row): it may not hear our commands"
+            return Said(
+                N_(
+                    "{where} did not answer a ping within {deadline} ({count} in a row): "
+                    "it may not hear our commands"
+                ),
+                where=where,
+                deadline=Quantity(self.ping_deadline(now), "s", 2),
+                count=self.ping_failures,
             )
         age = self.status_age(now) or 0.0
         last_packet_at = self.last_packet_at()
         if last_packet_at is not None and now - last_packet_at < age / 2:
-            what = "other data still arrives, so the server itself is slow or stopped sending status"
+            what = N_("other data still arrives, so the server itself is slow or stopped sending status")
         else:
-            what = "nothing at all arrived — Wi-Fi, network or the server"
-        return f"no status from {where} for {age:.2f} s ({self.timing(now).describe()}): {what}"
+            what = N_("nothing at all arrived — Wi-Fi, network or the server")
+        return Said(
+            N_("no status from {where} for {age} ({timing}): {what}"),
+            where=where,
+            age=Quantity(age, "s", 2),
+            timing=self.timing(now).describe(),
+            what=Said(what),
+        )
 
     def advice(self) -> str:
         """What the operator can do about :meth:`cause`."""
         if self.ping_failures:
-            return "Check the robot's Wi-Fi and that its server still runs, then drive again."
-        return "Check the robot's Wi-Fi (signal, roaming between access points), then drive again."
+            return Said(N_("Check the robot's Wi-Fi and that its server still runs, then drive again."))
+        return Said(N_("Check the robot's Wi-Fi (signal, roaming between access points), then drive again."))
 
 
 def _never() -> bool:

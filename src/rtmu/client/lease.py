@@ -23,6 +23,9 @@ from collections.abc import Callable
 from dataclasses import dataclass, field
 from enum import Enum
 
+from ..base.i18n import N_, Said
+from ..base.units import Quantity
+
 LEASE_TTL = 0.3
 """Seconds a grant or renewal keeps the robot driving (the issue's ~300 ms)."""
 RESEND_PERIOD = 0.1
@@ -305,7 +308,7 @@ class DriveGovernor:
         else:
             reason = EndReason.LAPSED
             silent = now - (view.expires_at - self.lease.ttl)
-            why = f"the drive was not renewed for {silent:.2f} s"
+            why = Said(N_("the drive was not renewed for {silent}"), silent=Quantity(silent, "s", 2))
         if not self.lease.end(reason, self._driving_generation, why):
             why = self.lease.why if view.ended is not None else why
         self._driving_generation = None

@@ -12,6 +12,8 @@ import asyncio
 import socket
 from collections.abc import Callable
 
+from ..base.i18n import N_, Said
+from ..base.units import Quantity
 from ..protocol.client_connection import ClientConnection, protocol_advice
 from ..protocol.commands import RejectReason
 from ..protocol.errors import ProtocolError
@@ -40,15 +42,28 @@ async def open_link(opener: Opener, host: str, port: int, deadline: float, timeo
         async with asyncio.timeout_at(deadline):
             return await opener(host, port)
     except TimeoutError:
-        raise ClientTimeout(f"connecting to {host}:{port} timed out after {timeout:g} s") from None
+        raise ClientTimeout(
+            Said(
+                N_("connecting to {where} timed out after {timeout}"),
+                where=f"{host}:{port}",
+                timeout=Quantity(timeout, "s", None),
+            )
+        ) from None
     except ConnectionRefusedError:
         raise ConnectionRefused(
-            f"connection refused by {host}:{port} (is the robot server running on that port?)"
+            Said(
+                N_("connection refused by {where} (is the robot server running on that port?)"),
+                where=f"{host}:{port}",
+            )
         ) from None
     except socket.gaierror as exc:
-        raise HostNotFound(f"cannot find host {host!r}: {exc.strerror or exc}") from None
+        raise HostNotFound(
+            Said(N_("cannot find host {host}: {error}"), host=repr(host), error=exc.strerror or exc)
+        ) from None
     except OSError as exc:
-        raise ConnectionFailed(f"cannot connect to {host}:{port}: {exc.strerror or exc}") from None
+        raise ConnectionFailed(
+            Said(N_("cannot connect to {where}: {error}"), where=f"{host}:{port}", error=exc.strerror or exc)
+        ) from None
 
 
 async def log_in(
@@ -67,21 +82,33 @@ async def log_in(
         try:
             data = await link.read(READ_CHUNK)
         except OSError as exc:
-            raise ServerClosed(f"the connection broke during login: {exc.strerror or exc}") from None
+            raise ServerClosed(
+                Said(N_("the connection broke during login: {error}"), error=exc.strerror or exc)
+            ) from None
         if not data:
-            raise ServerClosed(f"{peer} closed the connection during login")
+            raise ServerClosed(Said(N_("{peer} closed the connection during login"), peer=peer))
         if received == 0 and data.startswith(TEXT_BANNERS):
             banner = data[:40].split(b"\n")[0].decode("ascii", "replace").strip()
-            raise ProtocolFault(f"{peer} is not an ArNetworking server (it said {banner!r})")
+            raise ProtocolFault(
+                Said(
+                    N_("{peer} is not an ArNetworking server (it said {said})"), peer=peer, said=repr(banner)
+                )
+            )
         received += len(data)
         now = clock()
         try:
             events = conn.receive_data(data, now)
         except ProtocolError as exc:
-            raise ProtocolFault(f"{peer} is not an ArNetworking server: {exc}") from None
+            raise ProtocolFault(
+                Said(N_("{peer} is not an ArNetworking server: {error}"), peer=peer, error=exc)
+            ) from None
         if received >= NOT_ARIA_AFTER and conn.decoder.stats.packets == 0:
             raise ProtocolFault(
-                f"{peer} is not an ArNetworking server ({received} bytes without a single valid packet)"
+                Said(
+                    N_("{peer} is not an ArNetworking server ({count} bytes without a single valid packet)"),
+                    peer=peer,
+                    count=received,
+                )
             )
         flush()
         ready = False
@@ -89,7 +116,7 @@ async def log_in(
             if isinstance(event, Rejected):
                 raise login_rejected(conn, event)
             if isinstance(event, PeerShutdown):
-                raise ServerClosed(f"{peer} shut the connection down during login")
+                raise ServerClosed(Said(N_("{peer} shut the connection down during login"), peer=peer))
             if isinstance(event, DataListReady):
                 ready = True
             elif isinstance(event, DataReceived):

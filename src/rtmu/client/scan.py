@@ -218,4 +218,8 @@ class ScanProgress:
 
     def text(self) -> str:
         seconds = int(self.now - self.started_at)
-        return f"{seconds // 60}:{seconds % 60:02d}, {self.metres:.1f} m driven"
+        from ..base.i18n import _
+        from ..base.units import quantity
+
+        driven = _("{distance} driven").format(distance=quantity(self.metres, "m", 1))
+        return f"{seconds // 60}:{seconds % 60:02d}, {driven}"

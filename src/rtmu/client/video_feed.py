@@ -28,6 +28,8 @@ from collections import deque
 from collections.abc import Callable
 from dataclasses import dataclass, field
 
+from ..base.i18n import N_, Said
+from ..base.units import Quantity
 from ..protocol.errors import ProtocolError
 from ..protocol.payloads.camera import VideoFrame
 from ..values.intents import picture_source
@@ -167,16 +169,18 @@ class RateGovernor:
 
     def observe(self, now: float, rtt: float, age: float | None) -> None:
         """One frame's round trip and age (seconds); halve the rate when either is past its limit."""
-        slow = ""
+        slow: Said | None = None
         if rtt > self.rtt_limit:
-            slow = f"round trip {rtt * 1000:.0f} ms"
+            slow = Said(N_("round trip {time}"), time=Quantity(rtt * 1000, "ms"))
         elif age is not None and age > self.age_limit:
-            slow = f"frames {age * 1000:.0f} ms old"
+            slow = Said(N_("frames {time} old"), time=Quantity(age * 1000, "ms"))
         if slow:
             self._healthy_since = None
             if self.factor < 32 and self.rate_fps / 2 >= MIN_FPS / 2:
                 self.factor *= 2
-            self.reason = f"slowed to {self.rate_fps:.1f} fps: {slow}"
+            self.reason = Said(
+                N_("slowed to {rate}: {why}"), rate=Quantity(self.rate_fps, "fps", 1), why=slow
+            )
             return
         if self.factor == 1:
             self.reason = ""
@@ -186,7 +190,11 @@ class RateGovernor:
         elif now - self._healthy_since >= RECOVER_AFTER_S:
             self.factor //= 2
             self._healthy_since = now
-            self.reason = "" if self.factor == 1 else f"recovering: {self.rate_fps:.1f} fps"
+            self.reason = (
+                ""
+                if self.factor == 1
+                else Said(N_("recovering: {rate}"), rate=Quantity(self.rate_fps, "fps", 1))
+            )
 
     def set_fps(self, fps: float) -> None:
         self.target_fps = clamp_fps(fps)

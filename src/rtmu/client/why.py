@@ -23,7 +23,8 @@ from __future__ import annotations
 import math
 import re
 
-from ..base.i18n import N_
+from ..base.i18n import N_, Said, as_said
+from ..base.units import Quantity
 from ..protocol.payloads.drive import RATIO_ROT_DEAD_ZONE, RATIO_TRANS_DEAD_ZONE, RatioDrive
 from ..protocol.payloads.robot import ModeInfo
 from ..values.state import LinkLevel, NavOutcome
@@ -66,7 +67,7 @@ def diagnose(facts: Facts, motion: Motion | None = None, *, navigate: bool = Fal
     found.sort(key=lambda r: order.index(r.cause))
     notes = list(facts.notes)
     if facts.ours.guardian:
-        notes.append(f"the guardian is not watching this drive ({facts.ours.guardian})")
+        notes.append(Said(N_("the guardian is not watching this drive ({why})"), why=facts.ours.guardian))
     if not navigate:  # driving by hand needs no localization, but the operator may mean to navigate next
         notes += [
             NOT_FOR_NAVIGATION + r.sentence() for r in _modes(facts, motion, True) if r.cause is Cause.LOST
@@ -89,14 +90,14 @@ def _our_side(facts: Facts, motion: Motion | None, navigate: bool) -> list[Reaso
     out: list[Reason] = []
     if ours.link in (LinkLevel.STALE, LinkLevel.LOST, LinkLevel.DOWN):
         said = {
-            LinkLevel.STALE: "stale (no status in time)",
-            LinkLevel.LOST: "lost",
-            LinkLevel.DOWN: "down (not connected)",
+            LinkLevel.STALE: N_("stale (no status in time)"),
+            LinkLevel.LOST: N_("lost"),
+            LinkLevel.DOWN: N_("down (not connected)"),
         }[ours.link]
         out.append(
             Reason(
                 Cause.LINK,
-                f"our link to the robot is {said}: RTMU sends no drive over it",
+                Said(N_("our link to the robot is {state}: RTMU sends no drive over it"), state=Said(said)),
                 N_("check the network (Wi-Fi, cable); once the link is back, press the drive key again"),
                 (f"link: {ours.link.value}",),
             )
@@ -132,13 +133,20 @@ def _our_side(facts: Facts, motion: Motion | None, navigate: bool) -> list[Reaso
 
 
 def _rights(facts: Facts, motion: Motion | None, navigate: bool) -> list[Reason]:
-    who = f"user {facts.user!r}" if facts.user else N_("this login (no user name)")
+    who = (
+        Said(N_("user {user}"), user=repr(facts.user))
+        if facts.user
+        else Said(N_("this login (no user name)"))
+    )
     drive, stop = "ratioDrive" in facts.offers, "stop" in facts.offers
     out: list[Reason] = []
     if not drive:
-        problem = f"{who} may not drive the robot (no ratioDrive in its data list)"
+        problem = Said(N_("{who} may not drive the robot (no ratioDrive in its data list)"), who=who)
         if not stop:
-            problem = f"{who} may neither drive nor stop the robot (no ratioDrive, no stop in its data list)"
+            problem = Said(
+                N_("{who} may neither drive nor stop the robot (no ratioDrive, no stop in its data list)"),
+                who=who,
+            )
         advice = (
             N_("log in as a user whose groups include Movement (and Stop)")
             if facts.user
@@ -149,8 +157,14 @@ def _rights(facts: Facts, motion: Motion | None, navigate: bool) -> list[Reason]
         out.append(
             Reason(
                 Cause.NO_STOP,
-                f"SAFETY: {who} may not send stop (no stop in its data list): RTMU's STOP cannot stop the "
-                "robot from this login" + (N_(" except by zero drive ratios") if drive else ""),
+                Said(
+                    N_(
+                        "SAFETY: {who} may not send stop (no stop in its data list): RTMU's STOP cannot stop "
+                        "the robot from this login{but}"
+                    ),
+                    who=who,
+                    but=Said(N_(" except by zero drive ratios")) if drive else "",
+                ),
                 N_("do not drive from this login; use one whose groups include Stop"),
                 (N_("data list: no stop"),),
                 loud=True,
@@ -170,12 +184,28 @@ def _dead_zone(facts: Facts, motion: Motion | None, navigate: bool) -> list[Reas
     return [
         Reason(
             Cause.DEAD_ZONE,
-            f"the drive asked for (translation {motion.trans:g} %, rotation {motion.rot:g} %) is inside "
-            f"ARIA's dead zone (translation up to ±{RATIO_TRANS_DEAD_ZONE:g} %, rotation under "
-            f"±{RATIO_ROT_DEAD_ZONE:g} %): the server ignores it",
-            f"ask for more than {RATIO_TRANS_DEAD_ZONE:g} % translation or at least "
-            f"{RATIO_ROT_DEAD_ZONE:g} % rotation",
-            (f"our ratioDrive: {motion.trans:g} % translation, {motion.rot:g} % rotation",),
+            Said(
+                N_(
+                    "the drive asked for (translation {trans}, rotation {rot}) is inside ARIA's dead zone "
+                    "(translation up to ±{trans_zone}, rotation under ±{rot_zone}): the server ignores it"
+                ),
+                trans=Quantity(motion.trans, "%", None),
+                rot=Quantity(motion.rot, "%", None),
+                trans_zone=Quantity(RATIO_TRANS_DEAD_ZONE, "%", None),
+                rot_zone=Quantity(RATIO_ROT_DEAD_ZONE, "%", None),
+            ),
+            Said(
+                N_("ask for more than {trans_zone} translation or at least {rot_zone} rotation"),
+                trans_zone=Quantity(RATIO_TRANS_DEAD_ZONE, "%", None),
+                rot_zone=Quantity(RATIO_ROT_DEAD_ZONE, "%", None),
+            ),
+            (
+                Said(
+                    N_("our ratioDrive: {trans} translation, {rot} rotation"),
+                    trans=Quantity(motion.trans, "%", None),
+                    rot=Quantity(motion.rot, "%", None),
+                ),
+            ),
         )
     ]
 
@@ -188,7 +218,7 @@ def _safety_words(facts: Facts, motion: Motion | None, navigate: bool) -> list[R
         out.append(
             Reason(
                 Cause.ESTOP,
-                f"the robot's e-stop is pressed (the server says {_quote(estop)})",
+                Said(N_("the robot's e-stop is pressed (the server says {words})"), words=_quote(estop)),
                 N_(
                     "make it safe, release the e-stop button on the robot, "
                     "then reset it as the robot requires"
@@ -201,7 +231,7 @@ def _safety_words(facts: Facts, motion: Motion | None, navigate: bool) -> list[R
         out.append(
             Reason(
                 Cause.MOTORS,
-                f"the robot's motors are disabled (the server says {_quote(motors)})",
+                Said(N_("the robot's motors are disabled (the server says {words})"), words=_quote(motors)),
                 _motors_advice(facts),
                 (f"status: {_quote(motors)}",),
                 _enable_fix(facts),
@@ -223,7 +253,9 @@ def _safety_words(facts: Facts, motion: Motion | None, navigate: bool) -> list[R
         out.append(
             Reason(
                 Cause.FAULTS,
-                f"the robot reports {len(facts.faults)} fault(s): {shown}",
+                Said(
+                    N_("the robot reports {count} fault(s): {faults}"), count=len(facts.faults), faults=shown
+                ),
                 N_("clear what caused them, then acknowledge them (with care: the robot may move on)"),
                 ("getFaults",),
                 fix,
@@ -257,9 +289,16 @@ def _battery(facts: Facts, motion: Motion | None, navigate: bool) -> list[Reason
     return [
         Reason(
             Cause.BATTERY,
-            f"the battery ({level:g} {unit}) is at or below the robot's shutdown level ({shutdown:g} {unit})",
+            Said(
+                N_("the battery ({level}) is at or below the robot's shutdown level ({shutdown})"),
+                level=Quantity(level, unit, None),
+                shutdown=Quantity(shutdown, unit, None),
+            ),
             N_("charge the robot (dock it or plug it in) before driving"),
-            (f"updateNumbers: battery {level:g} {unit}", f"batteryInfo: shutdown {shutdown:g} {unit}"),
+            (
+                Said(N_("updateNumbers: battery {level}"), level=Quantity(level, unit, None)),
+                Said(N_("batteryInfo: shutdown {level}"), level=Quantity(shutdown, unit, None)),
+            ),
         )
     ]
 
@@ -276,7 +315,7 @@ def _stalled(facts: Facts, motion: Motion | None, navigate: bool) -> list[Reason
     return [
         Reason(
             Cause.STALLED,
-            f"{what} (the server says {_quote(word)})",
+            Said(N_("{what} (the server says {words})"), what=Said(what), words=_quote(word)),
             N_(
                 "the robot pushed against something or a wheel is blocked: drive away from it, "
                 "check the wheels and bumpers"
@@ -307,9 +346,13 @@ def _modes(facts: Facts, motion: Motion | None, navigate: bool) -> list[Reason]:
             Reason(
                 Cause.DOCKED,
                 N_("the robot is docked (charging)"),
-                N_("undock it first")
-                + (" (undock)" if fix else "")
-                + N_("; a drive asks the dock to let go and the robot backs out before it drives"),
+                Said(
+                    N_(
+                        "undock it first{command}; a drive asks the dock to let go and the robot backs out "
+                        "before it drives"
+                    ),
+                    command=" (undock)" if fix else "",
+                ),
                 tuple(evidence),
                 fix,
             )
@@ -317,17 +360,22 @@ def _modes(facts: Facts, motion: Motion | None, navigate: bool) -> list[Reason]:
     if info is not None and info.locked and not (docked and info.mode_name in DOCK_MODES):
         name = info.mode_name or "(unnamed)"
         said = (
-            f"getModeInfo: mode {name!r}, locked, "
-            f"{'will' if info.will_unlock_if_requested else 'will not'} unlock if asked",
+            Said(N_("getModeInfo: mode {mode}, locked, will unlock if asked"), mode=repr(name))
+            if info.will_unlock_if_requested
+            else Said(N_("getModeInfo: mode {mode}, locked, will not unlock if asked"), mode=repr(name)),
         )
         if info.will_unlock_if_requested:
             fix = _unlock_fix(facts, info)
             out.append(
                 Reason(
                     Cause.LOCKED,
-                    f"the {name!r} mode holds the robot locked (it will unlock if asked)",
-                    N_("ask it to unlock")
-                    + (f": {fix.label}" if fix else N_(" (this login can send nothing that asks)")),
+                    Said(
+                        N_("the {mode} mode holds the robot locked (it will unlock if asked)"),
+                        mode=repr(name),
+                    ),
+                    Said(N_("ask it to unlock: {fix}"), fix=Said(fix.label))
+                    if fix
+                    else Said(N_("ask it to unlock (this login can send nothing that asks)")),
                     said,
                     fix,
                 )
@@ -336,9 +384,17 @@ def _modes(facts: Facts, motion: Motion | None, navigate: bool) -> list[Reason]:
             out.append(
                 Reason(
                     Cause.LOCKED,
-                    f"the {name!r} mode holds the robot locked and will not unlock if asked",
-                    f"RTMU cannot release it: whatever locked the {name!r} mode (docking, a safety "
-                    "mode, a program on the server) must unlock it",
+                    Said(
+                        N_("the {mode} mode holds the robot locked and will not unlock if asked"),
+                        mode=repr(name),
+                    ),
+                    Said(
+                        N_(
+                            "RTMU cannot release it: whatever locked the {mode} mode (docking, a safety "
+                            "mode, a program on the server) must unlock it"
+                        ),
+                        mode=repr(name),
+                    ),
                     said,
                 )
             )
@@ -353,7 +409,11 @@ def _modes(facts: Facts, motion: Motion | None, navigate: bool) -> list[Reason]:
         out.append(
             Reason(
                 Cause.NAVIGATING,
-                f"the server is driving the robot itself{target}: {_quote(reading.text)}",
+                Said(
+                    N_("the server is driving the robot itself{target}: {words}"),
+                    target=target,
+                    words=_quote(reading.text),
+                ),
                 N_("press STOP first; the next drive is then yours"),
                 (f"status: {_quote(reading.text)}",),
                 fix,
@@ -401,14 +461,20 @@ def _watchdog(facts: Facts, motion: Motion | None, navigate: bool) -> list[Reaso
     return [
         Reason(
             Cause.WATCHDOG,
-            f"the server's drive watchdog is {t:g} s: shorter than twice the "
-            f"{RESEND_PERIOD:g} s between RTMU's drive commands, so it stops the robot between them "
-            "(jerky motion at best, none on a slow link)",
+            Said(
+                N_(
+                    "the server's drive watchdog is {timeout}: shorter than twice the {period} between "
+                    "RTMU's drive commands, so it stops the robot between them (jerky motion at best, "
+                    "none on a slow link)"
+                ),
+                timeout=Quantity(t, "s", None),
+                period=Quantity(RESEND_PERIOD, "s", None),
+            ),
             N_(
                 "raise the Teleop Timeout in the server's configuration "
                 "(ARIA's default is 2 s; 0 turns it off)"
             ),
-            (f"configuration: Teleop Timeout = {t:g} s",),
+            (Said(N_("configuration: Teleop Timeout = {timeout}"), timeout=Quantity(t, "s", None)),),
         )
     ]
 
@@ -426,24 +492,41 @@ def _safe_drive(facts: Facts, motion: Motion | None, navigate: bool) -> list[Rea
             continue
         obstacle, _ = hit
         limit = facts.limits.front if forward else facts.limits.rear
-        way, away = ("ahead of", "backwards") if forward else ("behind", "forwards")
+        way, away = (N_("ahead of"), N_("backwards")) if forward else (N_("behind"), N_("forwards"))
         clear = nearest(facts.obstacles, facts.footprint, facts.limits, not forward) is None
         fix = _safe_off_fix(facts)
-        advice = f"drive away from it ({away}{': that way is clear' if clear else ''})" + (
-            N_(", or switch safe drive off (with care: the robot then drives into things)") if fix else ""
+        advice = Said(
+            N_("drive away from it ({way}{clear}){or_off}"),
+            way=Said(away),
+            clear=Said(N_(": that way is clear")) if clear else "",
+            or_off=Said(N_(", or switch safe drive off (with care: the robot then drives into things)"))
+            if fix
+            else "",
         )
         out.append(
             Reason(
                 Cause.SAFE_DRIVE,
-                f"safe drive holds the robot back: an obstacle {abs(obstacle.x):.0f} mm {way} its centre "
-                f"{_side(obstacle)}, closer than safe drive allows (half the robot's length + "
-                f"{limit:.0f} mm = {facts.footprint.reach + limit:.0f} mm)",
+                Said(
+                    N_(
+                        "safe drive holds the robot back: an obstacle {distance} {way} its centre {side}, "
+                        "closer than safe drive allows (half the robot's length + {limit} = {reach})"
+                    ),
+                    distance=Quantity(abs(obstacle.x), "mm"),
+                    way=Said(way),
+                    side=_side(obstacle),
+                    limit=Quantity(limit, "mm"),
+                    reach=Quantity(facts.footprint.reach + limit, "mm"),
+                ),
                 advice,
                 (
-                    f"{obstacle.source}: reading at ({obstacle.x:.0f}, {obstacle.y:.0f}) mm in "
-                    f"the robot's frame",
-                    f"limits: {facts.limits.source}",
-                    "getSafeDrive: on",
+                    Said(
+                        N_("{sensor}: reading at ({x}, {y}) mm in the robot's frame"),
+                        sensor=obstacle.source,
+                        x=Quantity(obstacle.x, ""),
+                        y=Quantity(obstacle.y, ""),
+                    ),
+                    Said(N_("limits: {source}"), source=as_said(facts.limits.source)),
+                    Said(N_("{request}: on"), request="getSafeDrive"),
                 ),
                 fix,
             )
@@ -457,7 +540,9 @@ def _safe_off_fix(facts: Facts) -> Fix | None:
         if name in facts.offers:
             return Fix(
                 "safe_drive_off",
-                f"switch safe drive off ({name}); the robot then drives into things",
+                Said(
+                    N_("switch safe drive off ({request}); the robot then drives into things"), request=name
+                ),
                 name,
                 True,
             )
@@ -483,10 +568,12 @@ def nearest(
     return best
 
 
-def _side(o: Obstacle) -> str:
+def _side(o: Obstacle) -> Said:
     if abs(o.y) < 50:
-        return "(straight on)"
-    return f"({abs(o.y):.0f} mm to the {'left' if o.y > 0 else 'right'})"
+        return Said(N_("(straight on)"))
+    if o.y > 0:
+        return Said(N_("({distance} to the left)"), distance=Quantity(abs(o.y), "mm"))
+    return Said(N_("({distance} to the right)"), distance=Quantity(abs(o.y), "mm"))
 
 
 _RULES = (_our_side, _rights, _dead_zone, _safety_words, _battery, _stalled, _modes, _watchdog, _safe_drive)

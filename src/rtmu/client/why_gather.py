@@ -16,6 +16,7 @@ from __future__ import annotations
 import math
 from collections.abc import Iterable
 
+from ..base.i18n import N_, Said
 from ..protocol.datalist import DataEntry
 from ..protocol.payloads.drive import SafeDrive
 from ..protocol.payloads.ld import DATA_STORE_PREFIX, DockInfo
@@ -306,5 +307,12 @@ def limits_from(config: ServerConfig | None) -> SafeDriveLimits:
     rear = p.get("backwardclearance", 0.0) + p.get("backwardpaddingatslowspeed", 0.0)
     side = max(p.get("forwardsideclearanceatslowspeed", 0.0), p.get("backwardsideclearanceatslowspeed", 0.0))
     return SafeDriveLimits(
-        front, rear, side, "the server's configuration (Teleop: Clearance + PaddingAtSlowSpeed)"
+        front,
+        rear,
+        side,
+        Said(
+            N_("the server's configuration ({section}: {parameters})"),
+            section="Teleop",
+            parameters="Clearance + PaddingAtSlowSpeed",
+        ),
     )

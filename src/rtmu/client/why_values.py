@@ -12,7 +12,7 @@ from enum import Enum
 from typing import Any
 
 from ..base import exit_codes as codes
-from ..base.i18n import N_
+from ..base.i18n import N_, Said, as_said
 from ..protocol.payloads.robot import ModeInfo
 from ..values.state import LinkLevel
 
@@ -76,7 +76,11 @@ class Reason:
     """A safety fact: shown as a warning whatever else is found."""
 
     def sentence(self) -> str:
-        return f"{self.problem} — {self.advice}" if self.advice else self.problem
+        """ "<problem> — <advice>": English as a ``str`` (``--json``), each part in the operator's language
+        through :func:`rtmu.base.i18n.words`."""
+        if not self.advice:
+            return as_said(self.problem)
+        return Said("{problem} — {advice}", problem=as_said(self.problem), advice=as_said(self.advice))
 
     def as_json(self) -> dict[str, Any]:
         out: dict[str, Any] = {
@@ -146,7 +150,7 @@ class SafeDriveLimits:
 
 
 ARIA_LIMITER_DEFAULTS = SafeDriveLimits(
-    150.0, 150.0, 50.0, "ARIA's defaults (Clearance 100 + PaddingAtSlowSpeed 50, side 50 mm)"
+    150.0, 150.0, 50.0, N_("ARIA's defaults (Clearance 100 + PaddingAtSlowSpeed 50, side 50 mm)")
 )
 """ArActionDeceleratingLimiter's defaults, used only when the server does not list its own."""
 

@@ -35,6 +35,7 @@ from dataclasses import dataclass
 from enum import Enum, IntEnum
 
 from ..base.i18n import _
+from ..base.units import quantity
 from ..client.nav_status import read_status
 from ..values.state import LinkHealth, LinkLevel, NavOutcome, RobotState
 
@@ -133,7 +134,7 @@ class AlarmMonitor:
             now = Severity.WARNING
         else:
             now = Severity.CLEAR
-        shown = f"{value:.0f} %" if soc else f"{value:.1f} V"
+        shown = quantity(value, "%") if soc else quantity(value, "V", 1)
         text = {
             Severity.CRITICAL: _("Battery critical: {shown} — the robot is about to shut down"),
             Severity.WARNING: _("Battery low: {shown} — bring the robot to its charger"),
@@ -155,9 +156,9 @@ class AlarmMonitor:
         else:
             now = was
         text = (
-            _("Weak Wi-Fi on the robot: link quality {quality:.0f} %").format(quality=quality)
+            _("Weak Wi-Fi on the robot: link quality {quality}").format(quality=quantity(quality, "%"))
             if now
-            else _("Wi-Fi back: link quality {quality:.0f} %").format(quality=quality)
+            else _("Wi-Fi back: link quality {quality}").format(quality=quantity(quality, "%"))
         )
         self._change(Alarm.WIFI, now, text, events)
 
@@ -173,11 +174,11 @@ class AlarmMonitor:
         elif rtt is None:
             return
         elif rtt > self.t.rtt_high_ms:
-            now, text = Severity.WARNING, _("Weak link: round trip {rtt:.0f} ms").format(rtt=rtt)
+            now, text = Severity.WARNING, _("Weak link: round trip {rtt}").format(rtt=quantity(rtt, "ms"))
         elif rtt < self.t.rtt_clear_ms and failures == 0:
-            now, text = Severity.CLEAR, _("Link back: round trip {rtt:.0f} ms").format(rtt=rtt)
+            now, text = Severity.CLEAR, _("Link back: round trip {rtt}").format(rtt=quantity(rtt, "ms"))
         else:
-            now, text = was, _("Weak link: round trip {rtt:.0f} ms").format(rtt=rtt)
+            now, text = was, _("Weak link: round trip {rtt}").format(rtt=quantity(rtt, "ms"))
         self._change(Alarm.RTT, now, text, events)
 
     def _change(self, alarm: Alarm, now: Severity, text: str, events: list[AlarmEvent]) -> None:

@@ -33,7 +33,7 @@ from __future__ import annotations
 from collections.abc import Callable
 from typing import Protocol
 
-from ..base.i18n import _
+from ..base.i18n import _, words
 from ..base.notices import Kind, Notice
 from ..client.lease import DriveRatios, EndReason
 from ..model.observables import OperatorState, RobotModel
@@ -305,9 +305,9 @@ class HeldDrive:
         """Said once per stop, with the network side's measured cause where it gave one."""
         host = self._host
         why = host.link.lease.why or host.robot.health.value.cause
-        said = f" — {why}" if why else _(". Press again once it is back.")
+        said = f" — {words(why)}" if why else _(". Press again once it is back.")
         host.view.notify(
             Notice.warning(
-                Kind.LINK, _("Stopped: the link is {value}{said}").format(value=level.value, said=said)
+                Kind.LINK, _("Stopped: the link is {value}{said}").format(value=_(level.value), said=said)
             )
         )

@@ -16,14 +16,16 @@ asks before a fix that needs a yes): the window's word is never the only guard.
 
 from __future__ import annotations
 
+from ..base.i18n import N_
 from ..client.console_effect import HELD_MOTION, moves_robot
 from ..values.intents import FIXES_NEEDING_YES, ApplyFix, ConsoleCall, ConsoleFollow, Intent
 
 FIX_WORDS = {
-    "safe_drive_off": "switching safe drive off lets the robot drive into things",
-    "acknowledge_faults": "acknowledging the robot's faults may let it move on",
-    "enable_motors": "enabling the motors powers the robot's wheels",
+    "safe_drive_off": N_("switching safe drive off lets the robot drive into things"),
+    "acknowledge_faults": N_("acknowledging the robot's faults may let it move on"),
+    "enable_motors": N_("enabling the motors powers the robot's wheels"),
 }
+"""Why a fix asks first (English; marked, translated where the confirmation shows it)."""
 
 
 def moves(intent: Intent) -> bool:

@@ -16,6 +16,7 @@ import math
 from dataclasses import dataclass
 
 from ..base.i18n import _
+from ..base.units import metres, quantity
 from ..values.state import RobotState
 
 SETTLE_S = 0.5
@@ -50,8 +51,12 @@ def _name(jog: Jog) -> str:
     return _("Go a distance") if jog.kind == "move" else _("Turn")
 
 
+def _degrees(deg: float) -> str:
+    return quantity(abs(deg), "deg")
+
+
 def _metres(mm: float) -> str:
-    return f"{abs(mm) / 1000:.2f} m"
+    return metres(abs(mm), 2)
 
 
 def _turned(th0: float, th1: float) -> float:
@@ -88,8 +93,8 @@ class JogWatch:
             return _("after {metres} of {metres2}").format(
                 metres=_metres(math.hypot(robot.x - jog.x, robot.y - jog.y)), metres2=_metres(jog.amount)
             )
-        return _("after turning {abs:.0f}° of {abs2:.0f}°").format(
-            abs=abs(_turned(jog.th, robot.th)), abs2=abs(jog.amount)
+        return _("after turning {turned} of {amount}").format(
+            turned=_degrees(_turned(jog.th, robot.th)), amount=_degrees(jog.amount)
         )
 
     def end(self, why: str, robot: RobotState) -> str | None:
@@ -130,9 +135,9 @@ class JogWatch:
         if jog.kind == "turn":
             turned = _turned(jog.th, robot.th)
             if abs(abs(turned) - abs(jog.amount)) <= DONE_DEG:
-                return _("Turned {abs:.0f}°").format(abs=abs(turned))
-            return _("Turn stopped after {abs:.0f}° of {abs2:.0f}°").format(
-                abs=abs(turned), abs2=abs(jog.amount)
+                return _("Turned {turned}").format(turned=_degrees(turned))
+            return _("Turn stopped after {turned} of {amount}").format(
+                turned=_degrees(turned), amount=_degrees(jog.amount)
             )
         went = math.hypot(robot.x - jog.x, robot.y - jog.y)
         if abs(jog.amount) - went <= max(DONE_MM, 0.03 * abs(jog.amount)):
@@ -142,7 +147,7 @@ class JogWatch:
             return _("Stopped: the robot stalled {where}. Look before driving on.").format(where=where)
         echo = obstacle_ahead(robot, jog.amount > 0)
         if echo is not None:
-            return _("Stopped by an obstacle {value:.1f} m ahead {where}").format(
-                value=echo / 1000, where=where
+            return _("Stopped by an obstacle {distance} ahead {where}").format(
+                distance=metres(echo), where=where
             )
         return _("Stopped short {where}").format(where=where)

@@ -22,6 +22,8 @@ from __future__ import annotations
 
 from dataclasses import dataclass, replace
 
+from ..base.i18n import N_, Said
+from ..base.units import Quantity
 from ..client.config_feed import ServerConfig
 
 ASSUMED_MAX_MM_S = 2200.0
@@ -45,7 +47,8 @@ class RobotLimits:
 
     max_speed: float = ASSUMED_MAX_MM_S
     decel: float = ASSUMED_DECEL_MM_S2
-    source: str = "assumed from ARIA's P3-DX"
+    source: str = N_("assumed from ARIA's P3-DX")
+    """Where the figures come from: English (a :class:`Said` or a marked constant), said with ``words``."""
 
     def seen(self, speed: float, trans_pct: float, throttle_pct: float) -> RobotLimits:
         """The robot went ``speed`` mm/s at these ratios: a faster maximum than believed raises it."""
@@ -55,7 +58,12 @@ class RobotLimits:
         implied = abs(speed) / share
         if implied <= self.max_speed * 1.05:
             return self
-        return replace(self, max_speed=implied, source=f"seen: {abs(speed):.0f} mm/s at {share:.0%} of full")
+        source = Said(
+            N_("seen: {speed} at {share} of full"),
+            speed=Quantity(abs(speed), "mm/s"),
+            share=Quantity(share * 100, "%"),
+        )
+        return replace(self, max_speed=implied, source=source)
 
     def stopping_distance(self, speed: float, reaction: float = REACTION_S) -> float:
         """How far (mm) the robot goes at ``speed`` mm/s once told to stop: reaction, then braking."""
@@ -76,7 +84,7 @@ def limits_from_config(config: ServerConfig) -> RobotLimits:
         limits = replace(limits, decel=decel)
         found.append("TransDecel")
     if found:
-        limits = replace(limits, source=f"its server's {' and '.join(found)}")
+        limits = replace(limits, source=Said(N_("its server's {names}"), names=" and ".join(found)))
     return limits
 
 

@@ -15,6 +15,7 @@ from pathlib import Path
 from typing import Any
 
 from ..base.i18n import _
+from ..base.units import file_size, percent
 from ._common import _RefusePassword, positive_float
 
 
@@ -60,7 +61,11 @@ def progress_printer(what: str) -> Callable[[int, int | None], None] | None:
         if now - last[0] < 0.1 and done != total:
             return
         last[0] = now
-        part = f"{done / total:.0%} of {total / 1e6:.1f} MB" if total else f"{done / 1e6:.1f} MB"
+        part = (
+            _("{percent} of {total}").format(percent=percent(100 * done / total), total=file_size(total))
+            if total
+            else file_size(done)
+        )
         sys.stderr.write(f"\r{what}: {part}   ")
         sys.stderr.flush()
 

@@ -28,7 +28,7 @@ from pathlib import Path
 from typing import TYPE_CHECKING, Any, TypeVar
 
 from ..base.exit_codes import EXIT_CONNECTION, EXIT_SIGPIPE, EXIT_USAGE
-from ..base.i18n import _
+from ..base.i18n import _, error_words
 from ..client.defaults import CONNECT_TIMEOUT, DEFAULT_PORT
 from ..client.errors import ClientError
 from ..client.roles import Role
@@ -513,7 +513,7 @@ def run_with_client(
     except Interrupted as exc:
         return fail(name, str(exc), exc.exit_code)
     except ClientError as exc:
-        return fail(name, str(exc), exc.exit_code)
+        return fail(name, error_words(exc), exc.exit_code)
     except ProtocolError as exc:  # a reply that does not decode, wherever a command looked at it
         return fail(name, f"the server sent something malformed: {exc}", EXIT_CONNECTION)
     except UsageError as exc:

@@ -19,6 +19,7 @@ from typing import TYPE_CHECKING, Any
 from ..base.exit_codes import EXIT_CANCELLED, EXIT_LOST, EXIT_OK, EXIT_REFUSED, EXIT_TIMEOUT, NETWORK
 from ..base.i18n import _
 from ..base.textsafe import visible
+from ..base.units import metres
 from ..client.errors import ClientError, NotSupported
 from ..client.nav_status import NavReading, path_remaining, read_motion
 from ..protocol.errors import ProtocolError
@@ -249,7 +250,11 @@ async def _follow(
                         and (distance_shown is None or abs(left - distance_shown) >= DISTANCE_STEP_MM)
                     ):
                         distance_at, distance_shown = now, left
-                        _say(args, {"remaining_mm": round(left)}, f"  {left / 1000:.1f} m to go")
+                        _say(
+                            args,
+                            {"remaining_mm": round(left)},
+                            _("  {distance} to go").format(distance=metres(left)),
+                        )
                 elif r.finished and expect.answers(r):
                     fresh = seen_going or r.text != before.text or now - sent_at >= SETTLE
                     if fresh:

@@ -37,12 +37,23 @@ def status_object(robot: RobotState) -> dict[str, Any]:
 
 
 def status_line(obj: dict[str, Any]) -> str:
+    """The human line of one status: numbers as the operator's language writes them (the JSON object
+    keeps plain numbers)."""
+    from ..base.i18n import _
     from ..base.textsafe import visible
+    from ..base.units import quantity
 
-    battery = f"{obj['battery_pct']:.0f} %" if "battery_pct" in obj else f"{obj['battery_v']:.1f} V"
-    return (
-        f"x={obj['x']} mm  y={obj['y']} mm  th={obj['th']}°  vel={obj['vel']} mm/s  "
-        f"rot={obj['rot_vel']}°/s  battery={battery}  {visible(obj['status'])} ({visible(obj['mode'])})"
+    soc = "battery_pct" in obj
+    battery = quantity(obj["battery_pct"], "%") if soc else quantity(obj["battery_v"], "V", 1)
+    return _("x={x}  y={y}  th={th}  vel={vel}  rot={rot}  battery={battery}  {status} ({mode})").format(
+        x=quantity(obj["x"], "mm"),
+        y=quantity(obj["y"], "mm"),
+        th=quantity(obj["th"], "deg"),
+        vel=quantity(obj["vel"], "mm/s"),
+        rot=quantity(obj["rot_vel"], "deg/s"),
+        battery=battery,
+        status=visible(obj["status"]),
+        mode=visible(obj["mode"]),
     )
 
 

@@ -33,9 +33,10 @@ from ..base.exit_codes import (
     EXIT_USAGE,
     WHY_ASKED,
 )
-from ..base.i18n import _
+from ..base.i18n import N_, Said, _
 from ..base.link_timing import STATUS_CEILING
 from ..base.textsafe import visible
+from ..base.units import Quantity
 from ._common import (
     Interrupted,
     UsageError,
@@ -117,7 +118,9 @@ class Doctor:
             done = {s.step for s in self.steps}
             for step in Step:
                 if step not in done:
-                    self.steps.append(StepResult(step, "skipped", "not tried (an earlier step failed)"))
+                    self.steps.append(
+                        StepResult(step, "skipped", Said(N_("not tried (an earlier step failed)")))
+                    )
             return int(exc.result.details.get("exit_code", exc.result.step.value))
         finally:
             self._motion_password = ""
@@ -136,15 +139,27 @@ class Doctor:
                 infos = await loop.getaddrinfo(self.host, self.port, type=socket.SOCK_STREAM)
         except TimeoutError:
             raise fail(
-                Step.RESOLVE, f"looking up {self.host!r} took over {self.timeout:g} s", ADVICE["resolve"]
+                Step.RESOLVE,
+                Said(
+                    N_("looking up {host} took over {timeout}"),
+                    host=repr(self.host),
+                    timeout=Quantity(self.timeout, "s", None),
+                ),
+                ADVICE["resolve"],
             ) from None
         except socket.gaierror as exc:
             raise fail(
-                Step.RESOLVE, f"cannot find host {self.host!r}: {exc.strerror or exc}", ADVICE["resolve"]
+                Step.RESOLVE,
+                Said(N_("cannot find host {host}: {error}"), host=repr(self.host), error=exc.strerror or exc),
+                ADVICE["resolve"],
             ) from None
         addresses = sorted({str(info[4][0]) for info in infos})
         self.address = addresses[0]
-        self.ok(Step.RESOLVE, f"{self.host} is {', '.join(addresses)}", addresses=addresses)
+        self.ok(
+            Step.RESOLVE,
+            Said(N_("{host} is {addresses}"), host=self.host, addresses=", ".join(addresses)),
+            addresses=addresses,
+        )
 
     async def _connect(self) -> None:
         import asyncio
@@ -159,17 +174,26 @@ class Doctor:
         except TimeoutError:
             raise fail(
                 Step.TCP,
-                f"connecting to {where} timed out after {self.timeout:g} s",
+                Said(
+                    N_("connecting to {where} timed out after {timeout}"),
+                    where=where,
+                    timeout=Quantity(self.timeout, "s", None),
+                ),
                 ADVICE["connect_timeout"],
             ) from None
         except ConnectionRefusedError:
-            raise fail(Step.TCP, f"{where} refused the connection", ADVICE["refused"]) from None
+            raise fail(
+                Step.TCP, Said(N_("{where} refused the connection"), where=where), ADVICE["refused"]
+            ) from None
         except OSError as exc:
             raise fail(
-                Step.TCP, f"cannot connect to {where}: {exc.strerror or exc}", ADVICE["unreachable"]
+                Step.TCP,
+                Said(N_("cannot connect to {where}: {error}"), where=where, error=exc.strerror or exc),
+                ADVICE["unreachable"],
             ) from None
         ms = (time.monotonic() - started) * 1000.0
-        self.ok(Step.TCP, f"connected to {where} in {ms:.0f} ms", connect_ms=round(ms, 1))
+        said = Said(N_("connected to {where} in {time}"), where=where, time=Quantity(ms, "ms"))
+        self.ok(Step.TCP, said, connect_ms=round(ms, 1))
 
     async def _read_events(self, step: Step, what: str) -> list[Any]:
         """The next events from the server, or the step fails (EOF, timeout, not ArNetworking)."""
@@ -186,28 +210,46 @@ class Doctor:
                     data = await self.reader.read(READ_CHUNK)
             except TimeoutError:
                 advice = ADVICE["no_introduction"] if step is Step.INTRODUCTION else ADVICE["login_timeout"]
-                raise fail(step, f"no {what} within {self.timeout:g} s", advice) from None
+                raise fail(
+                    step,
+                    Said(
+                        N_("no {what} within {timeout}"), what=what, timeout=Quantity(self.timeout, "s", None)
+                    ),
+                    advice,
+                ) from None
             except OSError as exc:
                 raise fail(
-                    step, f"the connection broke: {exc.strerror or exc}", ADVICE["closed_early"]
+                    step,
+                    Said(N_("the connection broke: {error}"), error=exc.strerror or exc),
+                    ADVICE["closed_early"],
                 ) from None
             if not data:
                 raise fail(
-                    step, f"the server closed the connection before its {what}", ADVICE["closed_early"]
+                    step,
+                    Said(N_("the server closed the connection before its {what}"), what=what),
+                    ADVICE["closed_early"],
                 )
             if self._received == 0 and data.startswith(TEXT_BANNERS):
                 said = data[:40].split(b"\n")[0].decode("ascii", "replace").strip()
-                raise fail(step, f"the server said {said!r}: that is not ArNetworking", ADVICE["not_aria"])
+                raise fail(
+                    step,
+                    Said(N_("the server said {said}: that is not ArNetworking"), said=repr(said)),
+                    ADVICE["not_aria"],
+                )
             self._received += len(data)
             try:
                 events = self.conn.receive_data(data)
             except ProtocolError as exc:
                 raise fail(
-                    step, f"the server's {what} is not ArNetworking: {exc}", ADVICE["not_aria"]
+                    step,
+                    Said(N_("the server's {what} is not ArNetworking: {error}"), what=what, error=exc),
+                    ADVICE["not_aria"],
                 ) from None
             if self._received >= NOT_ARIA_AFTER and self.conn.decoder.stats.packets == 0:
                 raise fail(
-                    step, f"{self._received} bytes without a single ArNetworking packet", ADVICE["not_aria"]
+                    step,
+                    Said(N_("{count} bytes without a single ArNetworking packet"), count=self._received),
+                    ADVICE["not_aria"],
                 )
             self._flush()
             if events:
@@ -228,7 +270,7 @@ class Doctor:
         self._password = ""
         self._received = 0
         while True:
-            for event in await self._read_events(Step.INTRODUCTION, "introduction"):
+            for event in await self._read_events(Step.INTRODUCTION, Said(N_("introduction"))):
                 if isinstance(event, ServerIntroduction):
                     return self._describe_intro(event)
 
@@ -239,13 +281,26 @@ class Doctor:
         assert self.conn is not None
         sent = self.conn.sent_protocol_version or ""
         if wanted:
-            proto = f"protocol string {wanted!r} (enforced; we answer {sent!r})"
+            proto = Said(
+                N_("protocol string {wanted} (enforced; we answer {sent})"),
+                wanted=repr(wanted),
+                sent=repr(sent),
+            )
         else:
-            proto = "no protocol string (not enforced)"
-        udp = f"UDP port {intro.udp_port}" if intro.udp_port else "no UDP (TCP only)"
+            proto = Said(N_("no protocol string (not enforced)"))
+        udp = (
+            Said(N_("UDP port {port}"), port=intro.udp_port)
+            if intro.udp_port
+            else Said(N_("no UDP (TCP only)"))
+        )
         self.ok(
             Step.INTRODUCTION,
-            f"an ArNetworking server (tag {intro.version_tag!r}), {proto}, {udp}",
+            Said(
+                N_("an ArNetworking server (tag {tag}), {protocol}, {udp}"),
+                tag=repr(intro.version_tag),
+                protocol=proto,
+                udp=udp,
+            ),
             version_tag=intro.version_tag,
             protocol=wanted,
             sent_protocol=sent,
@@ -259,7 +314,7 @@ class Doctor:
 
         assert self.conn is not None
         while True:
-            for event in await self._read_events(Step.LOGIN, "answer to our login"):
+            for event in await self._read_events(Step.LOGIN, Said(N_("answer to our login"))):
                 if isinstance(event, Rejected):
                     finding = login_finding(
                         event.reason,
@@ -271,10 +326,16 @@ class Doctor:
                         Step.LOGIN, finding.problem, finding.advice, reason=event.reason, text=event.text
                     )
                 if isinstance(event, PeerShutdown):
-                    raise fail(Step.LOGIN, "the server shut the connection down", ADVICE["closed_early"])
+                    raise fail(
+                        Step.LOGIN, Said(N_("the server shut the connection down")), ADVICE["closed_early"]
+                    )
                 if isinstance(event, Connected):
-                    who = f"as {self.user!r}" if self.user else "without a user name"
-                    self.ok(Step.LOGIN, f"logged in {who}", user=self.user)
+                    said = (
+                        Said(N_("logged in as {user}"), user=repr(self.user))
+                        if self.user
+                        else Said(N_("logged in without a user name"))
+                    )
+                    self.ok(Step.LOGIN, said, user=self.user)
                     return
                 if isinstance(event, DataListReady):  # CONNECTED came in the same read
                     return
@@ -285,21 +346,28 @@ class Doctor:
 
         assert self.conn is not None
         while not self.conn.datalist.complete:
-            await self._read_events(Step.DATA_LIST, "data list")
+            await self._read_events(Step.DATA_LIST, Said(N_("data list")))
         entries = list(self.conn.datalist)
         names = {e.name for e in entries}
         self.features = features_of(names)
         groups = {e.command_group for e in entries}
         have = [k for k, v in self.features.items() if v]
         missing = [k for k, v in self.features.items() if not v]
-        summary = f"{len(entries)} data in {len(groups)} groups; RTMU can use: {', '.join(have) or 'nothing'}"
-        if missing:
-            summary += f"; not offered: {', '.join(missing)}"
-        if config_api(names) is ConfigApi.OMRON_LD:
-            summary += "; its configuration is Omron LD's (getConfigValues): RTMU cannot show or edit it yet"
+        summary = Said(
+            N_("{count} data in {groups} groups; RTMU can use: {have}{missing}{ld}"),
+            count=len(entries),
+            groups=len(groups),
+            have=", ".join(have) or Said(N_("nothing")),
+            missing=Said(N_("; not offered: {names}"), names=", ".join(missing)) if missing else "",
+            ld=Said(
+                N_("; its configuration is Omron LD's (getConfigValues): RTMU cannot show or edit it yet")
+            )
+            if config_api(names) is ConfigApi.OMRON_LD
+            else "",
+        )
         advice = ""
         if not self.features["teleop"] and self.user:
-            advice = "driving is not offered to this user: log in as a user whose groups include Movement"
+            advice = N_("driving is not offered to this user: log in as a user whose groups include Movement")
         self.ok(
             Step.DATA_LIST,
             summary,
@@ -320,7 +388,7 @@ class Doctor:
         from ..protocol.packet import encode_packet
 
         if intro.udp_port == 0:
-            self.ok(Step.UDP, "not used: the server is TCP-only (UDP port 0)", "not_checked")
+            self.ok(Step.UDP, Said(N_("not used: the server is TCP-only (UDP port 0)")), "not_checked")
             return
         loop = asyncio.get_running_loop()
         answered = loop.create_future()
@@ -346,16 +414,29 @@ class Doctor:
             except TimeoutError:
                 self.ok(
                     Step.UDP,
-                    f"no answer on UDP port {intro.udp_port} within {UDP_WAIT_S:g} s",
+                    Said(
+                        N_("no answer on UDP port {port} within {timeout}"),
+                        port=intro.udp_port,
+                        timeout=Quantity(UDP_WAIT_S, "s", None),
+                    ),
                     "warn",
-                    "UDP may be blocked between here and the robot; RTMU uses TCP only, so this does not "
-                    "stop RTMU (ARIA's own clients fall back to TCP after a few seconds)",
+                    N_(
+                        "UDP may be blocked between here and the robot; RTMU uses TCP only, so this does not "
+                        "stop RTMU (ARIA's own clients fall back to TCP after a few seconds)"
+                    ),
                 )
                 return
             if good:
-                self.ok(Step.UDP, f"UDP port {intro.udp_port} answers (the server knew our key)")
+                self.ok(
+                    Step.UDP,
+                    Said(N_("UDP port {port} answers (the server knew our key)"), port=intro.udp_port),
+                )
             else:
-                self.ok(Step.UDP, f"UDP port {intro.udp_port} answered with a wrong key", "warn")
+                self.ok(
+                    Step.UDP,
+                    Said(N_("UDP port {port} answered with a wrong key"), port=intro.udp_port),
+                    "warn",
+                )
         finally:
             transport.close()
 
@@ -370,7 +451,7 @@ class Doctor:
             if "clientList" in conn.datalist:  # it lists robots instead of being one
                 where = f"{self.host}:{self.port}"
                 raise fail(Step.STATUS, central_server_words(where), ADVICE["central_server"])
-            raise fail(Step.STATUS, "the server offers no robot status", ADVICE["status_missing"])
+            raise fail(Step.STATUS, Said(N_("the server offers no robot status")), ADVICE["status_missing"])
         soc = False
         if "batteryInfo" in conn.datalist:
             info = await self._once("batteryInfo")
@@ -384,21 +465,41 @@ class Doctor:
             if isinstance(strings, UpdateStrings):
                 status, mode = strings.status, strings.mode
         if not isinstance(numbers, UpdateNumbers):
-            raise fail(Step.STATUS, f"the server's {name} reply does not decode", ADVICE["status_timeout"])
-        battery = f"{numbers.battery:.0f} % charge" if soc else f"{numbers.battery:.1f} V"
-        text = f"robot at ({numbers.x}, {numbers.y}) mm, {numbers.th}°, battery {battery}"
-        if status:
-            text += f", {status} ({mode})"
+            raise fail(
+                Step.STATUS,
+                Said(N_("the server's {name} reply does not decode"), name=name),
+                ADVICE["status_timeout"],
+            )
+        battery = (
+            Said(N_("{percent} charge"), percent=Quantity(numbers.battery, "%"))
+            if soc
+            else Quantity(numbers.battery, "V", 1)
+        )
+        text = Said(
+            N_("robot at ({x}, {y}) mm, {th}, battery {battery}{status}"),
+            x=Quantity(numbers.x, ""),
+            y=Quantity(numbers.y, ""),
+            th=Quantity(numbers.th, "deg"),
+            battery=battery,
+            status=f", {status} ({mode})" if status else "",
+        )
         details: dict[str, Any] = {"x": numbers.x, "y": numbers.y, "th": numbers.th, "status": status}
         details["battery_pct" if soc else "battery_v"] = numbers.battery
         advice = ""
         if self.link_seconds > 0:
             link = await self._link_timing(name)
             details["link"] = link
-            text += (
-                f"; status every {link['status_every_ms']} ms for {self.link_seconds:g} s: longest gap "
-                f"{link['longest_gap_ms']} ms, learned jitter {link['jitter_ms']} ms, so driving stops "
-                f"after {link['stale_after_s']:.2f} s without status"
+            text = Said(
+                N_(
+                    "{status}; status every {every} for {watched}: longest gap {gap}, learned jitter "
+                    "{jitter}, so driving stops after {limit} without status"
+                ),
+                status=text,
+                every=Quantity(link["status_every_ms"], "ms", None),
+                watched=Quantity(self.link_seconds, "s", None),
+                gap=Quantity(link["longest_gap_ms"], "ms", None),
+                jitter=Quantity(link["jitter_ms"], "ms", None),
+                limit=Quantity(link["stale_after_s"], "s", 2),
             )
             if link["longest_gap_ms"] > STATUS_CEILING * 1000:
                 advice = ADVICE_LINK_STALLS
@@ -468,7 +569,7 @@ class Doctor:
             )
             answer = diagnose(await gather(client, self.timeout))
         except ClientError as exc:
-            self.ok(Step.MOTION, f"could not ask: {exc}", "warn")
+            self.ok(Step.MOTION, Said(N_("could not ask: {error}"), error=exc), "warn")
             return
         finally:
             self._motion_password = ""
@@ -499,14 +600,16 @@ class Doctor:
         conn.request_once(name)
         self._flush()
         while True:
-            for event in await self._read_events(Step.STATUS, f"{name} reply"):
+            for event in await self._read_events(Step.STATUS, Said(N_("{name} reply"), name=name)):
                 if isinstance(event, DataReceived) and event.command == number:
                     try:
                         return decode_payload(name, Side.REPLY, event.payload)
                     except (ProtocolError, ValueError) as exc:
                         raise fail(Step.STATUS, f"the server's {name} reply does not decode: {exc}") from None
                 if isinstance(event, PeerShutdown):
-                    raise fail(Step.STATUS, "the server shut the connection down", ADVICE["closed_early"])
+                    raise fail(
+                        Step.STATUS, Said(N_("the server shut the connection down")), ADVICE["closed_early"]
+                    )
 
     async def _close(self) -> None:
         import asyncio

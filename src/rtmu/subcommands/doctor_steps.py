@@ -7,6 +7,7 @@ from collections.abc import Sequence
 from dataclasses import dataclass, field
 from typing import TYPE_CHECKING, Any
 
+from ..base.i18n import _, words
 from ..base.textsafe import visible
 
 if TYPE_CHECKING:
@@ -75,14 +76,17 @@ MARKS = {"ok": "ok  ", "fail": "FAIL", "warn": "warn", "not_checked": "--  ", "s
 def report_lines(
     steps: Sequence[StepResult], host: str, port: int, user: str, failed: StepResult | None, code: int
 ) -> list[str]:
-    """The human report, step by step (printed, and kept as the last one)."""
-    lines = [f"rtmu doctor {host}:{port}" + (f" (user {user})" if user else "")]
+    """The human report, step by step (printed, and kept as the last one), in the operator's language;
+    the ``--json`` report keeps the English (:meth:`StepResult.as_json`)."""
+    lines = [f"rtmu doctor {host}:{port}" + (_(" (user {user})").format(user=user) if user else "")]
     for s in steps:
-        lines.append(f"  [{MARKS.get(s.result, s.result)}] {s.step.title}: {visible(s.summary)}")
+        lines.append(f"  [{MARKS.get(s.result, s.result)}] {_(s.step.title)}: {visible(words(s.summary))}")
         if s.advice:
-            lines.append(f"         what to do: {visible(s.advice)}")
+            lines.append("       " + _("  what to do: {visible}").format(visible=visible(words(s.advice))))
     if failed is None:
-        lines.append("All steps passed: RTMU can connect to this robot.")
+        lines.append(_("All steps passed: RTMU can connect to this robot."))
     else:
-        lines.append(f"Stopped at the {failed.step.title} step (exit {code}).")
+        lines.append(
+            _("Stopped at the {step} step (exit {code}).").format(step=_(failed.step.title), code=code)
+        )
     return lines

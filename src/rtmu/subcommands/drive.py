@@ -31,7 +31,7 @@ from collections.abc import Callable
 from typing import TYPE_CHECKING, Any
 
 from ..base.exit_codes import EXIT_OK, EXIT_SIGQUIT, EXIT_SIGTSTP, EXIT_USAGE, NETWORK, WHY_DRIVE
-from ..base.i18n import _
+from ..base.i18n import _, words
 from ..base.textsafe import visible
 from ._common import (
     Interrupted,
@@ -125,7 +125,7 @@ def handle(args: argparse.Namespace) -> int:
             for reason in warning.reasons:
                 if reason.loud:
                     print(
-                        _("rtmu drive: WARNING: {visible}").format(visible=visible(reason.sentence())),
+                        _("rtmu drive: WARNING: {visible}").format(visible=visible(words(reason.sentence()))),
                         file=sys.stderr,
                         flush=True,
                     )

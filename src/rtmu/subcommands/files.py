@@ -17,8 +17,9 @@ from pathlib import Path
 from typing import TYPE_CHECKING, Any
 
 from ..base.exit_codes import EXIT_OK, EXIT_REFUSED, EXIT_USAGE, NETWORK
-from ..base.i18n import _
+from ..base.i18n import _, number
 from ..base.textsafe import visible
+from ..base.units import quantity
 from ..client.roles import Role
 from ..protocol.payloads.files import DirEntry
 from ._actions import action_parser, end_progress, progress_printer
@@ -145,8 +146,8 @@ def _get(args: argparse.Namespace) -> Any:
         if done.listed_size is not None and done.listed_size != done.size:
             note = f" (the robot listed {done.listed_size} bytes)"
         print(
-            _("wrote {local}: {size} bytes in {seconds:.2f} s{note}").format(
-                local=local, size=done.size, seconds=done.seconds, note=note
+            _("wrote {local}: {size} bytes in {seconds}{note}").format(
+                local=local, size=number(done.size), seconds=quantity(done.seconds, "s", 2), note=note
             ),
             file=sys.stderr,
         )
@@ -197,8 +198,11 @@ def _put(args: argparse.Namespace) -> Any:
                 {"local": str(local), "remote": target, "bytes": done.size, "seconds": round(done.seconds, 3)}
             )
         print(
-            _("uploaded {local} as {visible}: {size} bytes in {seconds:.2f} s").format(
-                local=local, visible=visible(target), size=done.size, seconds=done.seconds
+            _("uploaded {local} as {visible}: {size} bytes in {seconds}").format(
+                local=local,
+                visible=visible(target),
+                size=number(done.size),
+                seconds=quantity(done.seconds, "s", 2),
             ),
             file=sys.stderr,
         )

@@ -23,6 +23,7 @@ from ..base.exit_codes import EXIT_CONNECTION, EXIT_OK, EXIT_SIZE_LIMIT, EXIT_US
 from ..base.i18n import _
 from ..base.notices import Kind, Notice
 from ..base.textsafe import visible
+from ..base.units import file_size
 from ..client.errors import ClientError
 from ..client.roles import Role
 from ..values.state import ConnectionChanged, Phase, StateChange
@@ -168,9 +169,9 @@ def _keep(recorder: Recorder, out: Path, *, force: bool, logged_in: bool) -> boo
                 file=sys.stderr,
             )
         print(
-            _("rtmu record: {visible}: {value:.2f} MB, {written_items} items, {dropped} dropped").format(
+            _("rtmu record: {visible}: {size}, {written_items} items, {dropped} dropped").format(
                 visible=visible(str(final)),
-                value=size / 1e6,
+                size=file_size(size),
                 written_items=recording.written_items,
                 dropped=recording.dropped,
             ),

@@ -16,6 +16,7 @@ from typing import TYPE_CHECKING, Any
 
 from ..base.exit_codes import EXIT_OK
 from ..base.i18n import _
+from ..base.units import quantity
 from ..client.errors import ClientTimeout, ProtocolFault
 from ..client.roles import Role
 from ..protocol.errors import ProtocolError
@@ -169,7 +170,8 @@ async def stream(client: AriaClient, args: argparse.Namespace, show: Any) -> int
         while queue.empty():
             if not quiet and loop.time() - last >= quiet_after:
                 quiet = True
-                say(f"no status for {loop.time() - last:.1f} s — the server has gone quiet")
+                quiet_for = quantity(loop.time() - last, "s", 1)
+                say(_("no status for {time} — the server has gone quiet").format(time=quiet_for))
             if client.closed_error is not None:
                 raise client.closed_error
             if loop.time() >= deadline:
@@ -181,7 +183,7 @@ async def stream(client: AriaClient, args: argparse.Namespace, show: Any) -> int
                     await queue.put(await queue.get())  # wait for one without taking it
         if quiet:
             quiet = False
-            say(f"status resumed after {loop.time() - last:.1f} s")
+            say(_("status resumed after {time}").format(time=quantity(loop.time() - last, "s", 1)))
         last = loop.time()
         current = queue.get_nowait()
         if current != printed or last - printed_at >= HEARTBEAT:  # a change, or the heartbeat is due

@@ -20,6 +20,7 @@ from typing import TYPE_CHECKING, Any
 from ..base.exit_codes import EXIT_CONNECTION, EXIT_OK, EXIT_USAGE
 from ..base.i18n import _
 from ..base.textsafe import visible
+from ..base.units import quantity
 from ..client.roles import Role
 from ._common import UsageError, add_connection_arguments, fail, run_with_client
 from ._options import add_fps_option, add_quality_option
@@ -180,7 +181,7 @@ def handle(args: argparse.Namespace) -> int:
         elapsed = time.monotonic() - started
         await player.settle()
         status = feed.status()
-        summary = {
+        summary: dict[str, Any] = {
             "source": source,
             "seconds": round(elapsed, 3),
             "frames": player.decoded,
@@ -205,16 +206,27 @@ def handle(args: argparse.Namespace) -> int:
             age = (
                 ""
                 if summary["age_ms_p50"] is None
-                else f", age p50 {summary['age_ms_p50']} ms p95 {summary['age_ms_p95']} ms"
+                else _(", age p50 {p50} p95 {p95}").format(
+                    p50=quantity(summary["age_ms_p50"], "ms"), p95=quantity(summary["age_ms_p95"], "ms")
+                )
             )
             print(
-                f"{summary['frames']} frames {summary['width']}x{summary['height']} "
-                f"from {visible(source)} in "
-                f"{elapsed:.1f} s: {summary['fps']} fps, {summary['kbps']} kB/s{age}"
-                + (f"; {summary['dropped']} dropped" if summary["dropped"] else "")
+                _("{frames} frames {width}x{height} from {source} in {elapsed}: {fps}, {kbps}{age}").format(
+                    frames=summary["frames"],
+                    width=summary["width"],
+                    height=summary["height"],
+                    source=visible(source),
+                    elapsed=quantity(elapsed, "s", 1),
+                    fps=quantity(summary["fps"], "fps", 1),
+                    kbps=quantity(summary["kbps"], "kB/s"),
+                    age=age,
+                )
+                + (_("; {count} dropped").format(count=summary["dropped"]) if summary["dropped"] else "")
                 + (
-                    f"; {summary['repeats']} repeats (the camera had no newer picture: it is slower than "
-                    "asked, not the link)"
+                    _(
+                        "; {count} repeats (the camera had no newer picture: it is slower than asked, "
+                        "not the link)"
+                    ).format(count=summary["repeats"])
                     if summary["repeats"]
                     else ""
                 )

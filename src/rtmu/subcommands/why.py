@@ -13,7 +13,7 @@ import sys
 from typing import TYPE_CHECKING, Any
 
 from ..base.exit_codes import EXIT_WHY_LOST, NETWORK, WHY_ASKED
-from ..base.i18n import _
+from ..base.i18n import _, words
 from ..base.textsafe import visible
 from ..client.roles import Role
 from ..client.why import diagnose
@@ -142,21 +142,19 @@ def print_answer(answer: Answer, out: Any = None, lead: str = "") -> None:
     out = out or sys.stdout
     p = answer.primary
     if p is None:
-        print(lead + answer.sentence(), file=out)
+        print(lead + words(answer.sentence()), file=out)
     else:
-        print(f"{lead}{visible(p.problem)}", file=out)
-        print(_("  what to do: {visible}").format(visible=visible(p.advice)), file=out)
+        print(f"{lead}{visible(words(p.problem))}", file=out)
+        print(_("  what to do: {visible}").format(visible=visible(words(p.advice))), file=out)
         if p.fix is not None:
-            print(
-                f"  rtmu why --fix can: {visible(p.fix.label)}" + (" (asks first)" if p.fix.confirm else ""),
-                file=out,
-            )
+            can = _("  rtmu why --fix can: {fix}").format(fix=visible(words(p.fix.label)))
+            print(can + (_(" (asks first)") if p.fix.confirm else ""), file=out)
         for e in p.evidence:
-            print(_("  from: {visible}").format(visible=visible(e)), file=out)
+            print(_("  from: {visible}").format(visible=visible(words(e))), file=out)
     for r in answer.reasons[1:]:
-        mark = "WARNING" if r.loud else "also"
-        print(f"{mark}: {visible(r.sentence())}", file=out)
+        mark = _("WARNING") if r.loud else _("also")
+        print(f"{mark}: {visible(words(r.sentence()))}", file=out)
     for note in answer.notes:
-        print(_("note: {visible}").format(visible=visible(note)), file=out)
+        print(_("note: {visible}").format(visible=visible(words(note))), file=out)
     for v in answer.raw:
         print(_("raw: {visible}").format(visible=visible(v.text())), file=out)

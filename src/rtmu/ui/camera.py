@@ -22,6 +22,7 @@ gi.require_version("Gdk", "4.0")
 from gi.repository import Gdk, GLib, Gtk, Pango  # noqa: E402
 
 from ..base.i18n import _  # noqa: E402
+from ..base.units import quantity  # noqa: E402
 from ..model.observables import CameraImage  # noqa: E402
 from .toolbar import age_text  # noqa: E402
 
@@ -316,9 +317,7 @@ class CameraView(Gtk.Box):
         now = self.clock()
         if self.requested_at is not None and now - self.requested_at > REQUEST_TIMEOUT:
             self.failed(
-                _("No picture arrived within {REQUEST_TIMEOUT:.0f} s.").format(
-                    REQUEST_TIMEOUT=REQUEST_TIMEOUT
-                )
+                _("No picture arrived within {timeout}.").format(timeout=quantity(REQUEST_TIMEOUT, "s"))
             )
             return
         if self.image is None:

@@ -13,7 +13,7 @@ import gi
 
 gi.require_version("Gdk", "4.0")
 gi.require_version("Gtk", "4.0")
-from gi.repository import Gdk, Gtk  # noqa: E402
+from gi.repository import Gdk, Gtk, Pango  # noqa: E402
 
 from ..base.i18n import _  # noqa: E402
 
@@ -41,6 +41,7 @@ class Confirm(Gtk.Window):
         for side in ("top", "bottom", "start", "end"):
             getattr(box, f"set_margin_{side}")(14)
         self.question = Gtk.Label(label=question, xalign=0.0, wrap=True, max_width_chars=50)
+        self.question.set_wrap_mode(Pango.WrapMode.WORD_CHAR)  # a long file name breaks, not the window
         self.question.add_css_class("heading")
         box.append(self.question)
         if detail:

@@ -13,7 +13,7 @@ from collections.abc import Callable
 import gi
 
 gi.require_version("Gtk", "4.0")
-from gi.repository import Gdk, Gtk  # noqa: E402
+from gi.repository import Gdk, Gtk, Pango  # noqa: E402
 
 from ..base.i18n import _  # noqa: E402
 
@@ -29,6 +29,7 @@ class ConfirmBar(Gtk.Revealer):
             getattr(box, f"set_margin_{side}")(6)
         self.question = Gtk.Label(wrap=True, xalign=0.0, selectable=False)
         self.question.set_max_width_chars(60)
+        self.question.set_wrap_mode(Pango.WrapMode.WORD_CHAR)  # a word longer than the line breaks too
         buttons = Gtk.Box(spacing=6, halign=Gtk.Align.END)
         self.cancel_button = Gtk.Button(label=_("Cancel"))
         self.yes_button = Gtk.Button(label=_("Send it"))

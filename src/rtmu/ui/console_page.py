@@ -37,7 +37,7 @@ import gi
 gi.require_version("Gtk", "4.0")
 from gi.repository import GLib, Gtk, Pango  # noqa: E402
 
-from ..base.i18n import _, ngettext  # noqa: E402
+from ..base.i18n import _, error_words, ngettext  # noqa: E402
 from ..base.textsafe import visible  # noqa: E402
 from ..client.console import ConsoleEntry, ConsoleReply  # noqa: E402
 from ..client.console_effect import HELD_MOTION  # noqa: E402
@@ -239,7 +239,9 @@ class ConsolePage(Gtk.Window):
         error = None if future.cancelled() else future.exception()
         if future.cancelled() or error is not None:
             self.count.set_text(
-                _("No data list: {visible}").format(visible=visible(short(str(error or "cancelled"), 200)))
+                _("No data list: {visible}").format(
+                    visible=visible(short(error_words(error) if error else _("cancelled"), 200))
+                )
             )
             return False
         self.entries = list(future.result())
@@ -358,7 +360,7 @@ class ConsolePage(Gtk.Window):
         if future.cancelled() or error is not None:
             self.status.set_text(
                 _("Not sent or no reply: {visible}").format(
-                    visible=visible(short(str(error or "cancelled"), 300))
+                    visible=visible(short(error_words(error) if error else _("cancelled"), 300))
                 )
             )
             return False

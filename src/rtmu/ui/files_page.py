@@ -375,9 +375,13 @@ class FilesPage(Gtk.Window):
         if entry is None or "delete" in self._greyed():
             return
         remote = remote_join(self.folder, entry.name)
-        what = "folder" if entry.is_folder else "file"
+        question = (
+            _("Delete the folder “{visible}” from the robot?")
+            if entry.is_folder
+            else _("Delete the file “{visible}” from the robot?")
+        )
         self._confirm(
-            _("Delete the {what} “{visible}” from the robot?").format(what=what, visible=visible(remote)),
+            question.format(visible=visible(remote)),
             _("Delete"),
             lambda: self._delete(remote),
             detail=_("It cannot be undone."),

@@ -11,6 +11,7 @@ import datetime
 from collections.abc import Collection
 
 from ..base.i18n import _
+from ..base.units import file_size
 from ..client.remote_files import FEATURES
 from ..values.commission import Direction, Transfer
 
@@ -20,14 +21,7 @@ PAGE_FEATURES = ("list", "download", "upload", "delete")
 
 def human_size(size: int) -> str:
     """``1234567`` → ``1.2 MB`` (decimal units, as file managers show them)."""
-    if size < 1000:
-        return f"{size} B"
-    value = float(size)
-    for unit in ("kB", "MB", "GB"):
-        value /= 1000.0
-        if value < 999.5 or unit == "GB":
-            return f"{value:.1f} {unit}" if value < 100 else f"{value:.0f} {unit}"
-    raise AssertionError("unreachable")
+    return file_size(size)
 
 
 def when(seconds: int) -> str:

@@ -11,6 +11,7 @@ from __future__ import annotations
 from collections.abc import Callable
 
 from ..base.i18n import _
+from ..base.i18n import number as i18n_number
 from ..model.observables import ConnectionState, NavState, Phase, RobotModel, RobotState
 from .nav_text import loc_level, where
 from .state_words import phase_word
@@ -28,9 +29,9 @@ def battery_words(robot: RobotState) -> str:
     if robot.battery_v is None:
         return _("battery unknown")
     number = (
-        _("{battery_v:.0f} percent").format(battery_v=robot.battery_v)
+        _("{battery_v} percent").format(battery_v=i18n_number(robot.battery_v))
         if robot.battery_is_soc
-        else _("{battery_v:.1f} volts").format(battery_v=robot.battery_v)
+        else _("{battery_v} volts").format(battery_v=i18n_number(robot.battery_v, 1))
     )
     state = {"low": _(", low"), "critical": _(", at shutdown level")}.get(robot.battery_state, "")
     return _("battery {number}{state}").format(number=number, state=state)
@@ -42,7 +43,7 @@ def activity_words(robot: RobotState, nav: NavState) -> str:
         left = (
             ""
             if nav.remaining_mm is None
-            else _(", {value:.0f} metres left").format(value=nav.remaining_mm / 1000)
+            else _(", {value} metres left").format(value=i18n_number(nav.remaining_mm / 1000))
         )
         return (
             _("going home") if nav.target == "home" else _("going to {where}").format(where=where(nav.target))
@@ -61,7 +62,9 @@ def map_description(robot: RobotState, nav: NavState, connection: ConnectionStat
     x, y = _step(robot.x / 1000, POSE_STEP_M), _step(robot.y / 1000, POSE_STEP_M)
     heading = int(_step(robot.th, HEADING_STEP_DEG)) % 360
     parts = [
-        _("Robot at x {x:.1f}, y {y:.1f} metres, heading {heading} degrees").format(x=x, y=y, heading=heading)
+        _("Robot at x {x}, y {y} metres, heading {heading} degrees").format(
+            x=i18n_number(x, 1), y=i18n_number(y, 1), heading=heading
+        )
     ]
     mode = robot.mode or robot.status
     if mode:

@@ -8,6 +8,7 @@ in them come from the server and are shown as plain text by the labels that use 
 from __future__ import annotations
 
 from ..base.i18n import N_, _
+from ..base.units import metres
 from ..model.observables import NavState
 
 POOR_SCORE = 0.6
@@ -41,7 +42,7 @@ def going_text(nav: NavState) -> str:
     """``Going to Lab B — 12.4 m left`` (``Going home``; no distance until a path is known)."""
     head = _head(nav)
     if nav.remaining_mm is not None:
-        head += _(" — {value:.1f} m left").format(value=nav.remaining_mm / 1000)
+        head += _(" — {distance} left").format(distance=metres(nav.remaining_mm))
     return head
 
 
@@ -74,7 +75,7 @@ def motion_text(nav: NavState, *, held: bool, link_up: bool, by: str = "keys") -
         left = (
             ""
             if nav.remaining_mm is None
-            else _("{value:.1f} m left · ").format(value=nav.remaining_mm / 1000)
+            else _("{distance} left · ").format(distance=metres(nav.remaining_mm))
         )
         return "autonomous", (
             _("Navigating (autonomous)"),

@@ -18,7 +18,8 @@ import gi
 gi.require_version("Gtk", "4.0")
 from gi.repository import Gio, GLib  # noqa: E402
 
-from ..base.i18n import _  # noqa: E402
+from ..base.i18n import _, words  # noqa: E402
+from ..base.units import quantity  # noqa: E402
 from ..control.motion_limits import capped_throttle  # noqa: E402
 from ..model.observables import NearPeople  # noqa: E402
 
@@ -69,9 +70,12 @@ class NearPeopleSwitch:
         if new.on:
             limits = self.window.controller.limits
             throttle = capped_throttle(100.0, new.mm_s, limits)
-            text = _(
-                "{label}: a full drive is {throttle:.0f} % of this robot's {value:.1f} m/s — {source}"
-            ).format(label=label(new), throttle=throttle, value=limits.max_speed / 1000, source=limits.source)
+            text = _("{label}: a full drive is {throttle} of this robot's {speed} — {source}").format(
+                label=label(new),
+                throttle=quantity(throttle, "%"),
+                speed=quantity(limits.max_speed / 1000, "m/s", 1),
+                source=words(limits.source),
+            )
         else:
             text = _("Near-people cap off: the speed steps go up to the robot's full speed again")
         self.window.banners.tell("speed", "info", text, timeout=5.0)

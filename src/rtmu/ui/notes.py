@@ -13,6 +13,7 @@ from __future__ import annotations
 from ..base.i18n import N_, _
 from ..model.observables import ConnectionState, MapModel, Phase
 from ..settings.store import Profile
+from .state_words import sentence_words
 
 CONNECT_HINT = N_("press Connect (Ctrl+O)")
 
@@ -60,10 +61,12 @@ def status_line(conn: ConnectionState, profile: Profile, map_name: str) -> str:
         Phase.DISCONNECTED: _("not connected"),
         Phase.CONNECTING: _("connecting…"),
         Phase.CONNECTED: _("connected"),
-        Phase.RECONNECTING: _("reconnecting ({error})").format(error=conn.error)
+        Phase.RECONNECTING: _("reconnecting ({error})").format(error=sentence_words(conn.error))
         if conn.error
         else _("reconnecting"),
-        Phase.FAILED: _("failed: {error}").format(error=conn.error) if conn.error else _("failed"),
+        Phase.FAILED: _("failed: {error}").format(error=sentence_words(conn.error))
+        if conn.error
+        else _("failed"),
     }[phase]
     name = map_name.replace("\\", "/").rsplit("/", 1)[-1]
     parts = [profile.name, state] if where in profile.name else [profile.name, where, state]

@@ -16,6 +16,7 @@ gi.require_version("Pango", "1.0")
 from gi.repository import Gtk, Pango  # noqa: E402
 
 from ..base.i18n import N_, _  # noqa: E402
+from ..base.units import coordinates  # noqa: E402
 from .nav_draw import Marker, MarkerKind  # noqa: E402
 from .notes import heading_text  # noqa: E402
 from .pose_pick import PosePicker  # noqa: E402
@@ -29,7 +30,7 @@ CONFIRM = {MarkerKind.GOTO: N_("Go"), MarkerKind.LOCALIZE: N_("Set here")}
 
 def pose_words(marker: Marker) -> str:
     """``Go to 12.30, 4.50 m facing 90°`` / ``Robot at 2.50, 6.00 m facing 0°``."""
-    where = f"{marker.x / 1000:.2f}, {marker.y / 1000:.2f} m"
+    where = coordinates(marker.x, marker.y)
     facing = (
         _("any heading")
         if marker.th is None

@@ -20,6 +20,7 @@ gi.require_version("Pango", "1.0")
 from gi.repository import GLib, Gtk, Pango  # noqa: E402
 
 from ..base.i18n import _  # noqa: E402
+from ..base.units import quantity  # noqa: E402
 from ..control.commands import action_name  # noqa: E402
 from ..fleet.sessions import RobotSession  # noqa: E402
 from ..model.observables import RobotModel, RobotState  # noqa: E402
@@ -67,10 +68,16 @@ def position_text(state: PtzState | None) -> str:
     return f"{name}: {_angles(state, state.position)}"
 
 
+def _signed_degrees(value: float) -> str:
+    """``+90°``, ``-10°``, ``+0°``: the sign always shown, as a head's pan and tilt are read."""
+    text = quantity(value, "deg")
+    return text if text.startswith("-") else "+" + text
+
+
 def _angles(state: PtzState, where: tuple[float, float, float]) -> str:
     pan, tilt, zoom = where
-    text = _("pan {pan:+.0f}°  tilt {tilt:+.0f}°").format(pan=pan, tilt=tilt)
-    return text + _("  zoom {zoom:.0f} %").format(zoom=zoom) if state.zoom_available else text
+    text = _("pan {pan}  tilt {tilt}").format(pan=_signed_degrees(pan), tilt=_signed_degrees(tilt))
+    return text + _("  zoom {zoom}").format(zoom=quantity(zoom, "%")) if state.zoom_available else text
 
 
 def disabled_reason(state: PtzState | None, connected: bool) -> str:

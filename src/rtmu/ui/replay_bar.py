@@ -15,7 +15,7 @@ import gi
 gi.require_version("Gtk", "4.0")
 from gi.repository import GLib, Gtk  # noqa: E402
 
-from ..base.i18n import _  # noqa: E402
+from ..base.i18n import _, number  # noqa: E402
 from ..recorder.replay import SPEEDS, ReplayClock  # noqa: E402
 from . import accessible  # noqa: E402
 
@@ -27,7 +27,7 @@ SCRUB_SETTLE_MS = 150
 
 def clock_text(ns: int) -> str:
     seconds = max(0.0, ns / 1e9)
-    return f"{int(seconds // 60)}:{seconds % 60:04.1f}"
+    return f"{int(seconds // 60)}:{number(seconds % 60, 1).zfill(4)}"
 
 
 class ReplayBar(Gtk.Box):

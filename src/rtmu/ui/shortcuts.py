@@ -96,6 +96,7 @@ def build_shortcuts_window() -> Gtk.ShortcutsWindow:
     builder = Gtk.Builder.new_from_string(shortcuts_xml(), -1)
     window = builder.get_object("shortcuts")
     assert isinstance(window, Gtk.ShortcutsWindow)
+    _wrap_titles(window)
     return window
 
 
@@ -114,3 +115,20 @@ def install_help_on_demand(window: Gtk.ApplicationWindow) -> None:
     action = Gio.SimpleAction.new("show-help-overlay", None)
     action.connect("activate", lambda _a, _p: help_overlay_of(window).present())
     window.add_action(action)
+
+
+TITLE_CHARS = 24
+"""A shortcut's title wraps at about this many characters: the two columns of a page then fit an
+800-pixel screen in a language whose words are longer than English's."""
+
+
+def _wrap_titles(widget: Gtk.Widget) -> None:
+    """GTK sizes each shortcut's title to its whole text; wrapped, a longer language keeps the page's
+    columns narrow."""
+    child = widget.get_first_child()
+    while child is not None:
+        if isinstance(child, Gtk.Label) and child.get_ancestor(Gtk.ShortcutsShortcut) is not None:
+            child.set_wrap(True)
+            child.set_max_width_chars(TITLE_CHARS)
+        _wrap_titles(child)
+        child = child.get_next_sibling()

@@ -6,7 +6,7 @@ window shows goes through here so that it is translated and the values stay as t
 
 from __future__ import annotations
 
-from ..base.i18n import N_, _
+from ..base.i18n import N_, Said, _
 from ..values.state import LinkLevel, Phase
 
 _PHASES = {
@@ -48,5 +48,7 @@ def reason_words(reason: str) -> str:
 def sentence_words(sentence: str) -> str:
     """A "<problem> — <advice>" sentence of the client's (``client.diagnosis``) in the operator's
     language: each part its marked words translated, a part that names a host or a server's text as
-    it is."""
+    it is. A :class:`Said` sentence says itself, its values (numbers, names) included."""
+    if isinstance(sentence, Said):
+        return sentence.words()
     return " — ".join(_(part) for part in sentence.split(" — "))

@@ -16,6 +16,7 @@ gi.require_version("Pango", "1.0")
 from gi.repository import Gtk, Pango  # noqa: E402
 
 from ..base.i18n import N_, _  # noqa: E402
+from ..base.units import quantity  # noqa: E402
 from ..control.alarms import Thresholds  # noqa: E402
 from ..model.observables import LinkLevel, OperatorState, Phase, RobotModel  # noqa: E402
 from . import accessible  # noqa: E402
@@ -75,23 +76,25 @@ class StatusStrip(Gtk.Box):
         if robot.battery_v is None or not connected:
             battery = _("Bat {DASH}").format(DASH=DASH)
         elif robot.battery_is_soc:
-            battery = _("Bat {battery_v:.0f}%").format(battery_v=robot.battery_v)
+            battery = _("Bat {battery}").format(battery=quantity(robot.battery_v, "%"))
         else:
-            battery = _("Bat {battery_v:.1f}V").format(battery_v=robot.battery_v)
+            battery = _("Bat {battery}").format(battery=quantity(robot.battery_v, "V", 1))
         self._set("battery", battery, robot.battery_state if connected else "unknown")
         quality = robot.wifi_quality
-        wifi = DASH if quality is None or not connected else f"{max(0, min(100, quality))}%"  # (in %)
+        wifi = (
+            DASH if quality is None or not connected else quantity(max(0, min(100, quality)), "%")
+        )  # (in %)
         self._set("wifi", _("Wi-Fi {wifi}").format(wifi=wifi), "")
         if not connected:
             link, state = self.model.connection.value.phase.value, "lost"
         elif health.level is not LinkLevel.OK:
             link, state = health.level.value, "lost" if health.level is LinkLevel.LOST else "stale"
         else:
-            link = _("{rtt_ms:.0f} ms").format(rtt_ms=health.rtt_ms) if health.rtt_ms is not None else "ok"
+            link = quantity(health.rtt_ms, "ms") if health.rtt_ms is not None else "ok"
             slow = health.rtt_ms is not None and health.rtt_ms > SLOW_MS
             state = "stale" if slow else "ok"  # amber from where the round-trip alarm starts
         self._set("link", link, state)
-        self._set("speed", f"{self.operator.speed.value.percent}%", "")
+        self._set("speed", quantity(self.operator.speed.value.percent, "%"), "")
         self._set("mode", robot.mode or robot.status or DASH, "")
 
     def _set(self, name: str, text: str, state: str) -> None:

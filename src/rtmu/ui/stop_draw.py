@@ -15,6 +15,7 @@ from dataclasses import dataclass
 import cairo
 
 from ..base.i18n import _
+from ..base.units import metres
 from ..control.motion_limits import RobotLimits
 from . import overlays
 from .viewport import Viewport
@@ -39,7 +40,7 @@ class StopReach:
 
     @property
     def words(self) -> str:
-        return _("stops in {value:.1f} m").format(value=self.distance / 1000)
+        return _("stops in {distance}").format(distance=metres(self.distance))
 
 
 def stop_reach(x: float, y: float, th: float, speed: float, limits: RobotLimits) -> StopReach | None:

@@ -15,6 +15,8 @@ from __future__ import annotations
 import math
 from dataclasses import dataclass, replace
 
+from ..base.units import percent
+
 PX_PER_MM_AT_100 = 0.1
 """Pixels per millimetre at zoom 1.0 (100 %)."""
 ZOOM_MIN = 0.1
@@ -165,5 +167,4 @@ def best_fit(
 
 def zoom_label(zoom: float) -> str:
     """``"60 %"``; below 10 % one decimal (``"2.4 %"``)."""
-    pct = zoom * 100
-    return f"{pct:.1f} %" if pct < 10 else f"{pct:.0f} %"
+    return percent(zoom * 100)

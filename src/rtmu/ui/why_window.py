@@ -24,14 +24,15 @@ from typing import Any
 import gi
 
 gi.require_version("Gtk", "4.0")
-from gi.repository import GLib, Gtk  # noqa: E402
+from gi.repository import GLib, Gtk, Pango  # noqa: E402
 
-from ..base.i18n import N_, _  # noqa: E402
+from ..base.i18n import N_, _, error_words, words  # noqa: E402
 from ..base.textsafe import visible  # noqa: E402
 from ..client.why_values import Answer, Fix  # noqa: E402
 from ..control.intent_rules import FIX_WORDS  # noqa: E402
 from ..values.intents import ApplyFix, AskWhy, Intent  # noqa: E402
 from .confirm_bar import ConfirmBar  # noqa: E402
+from .layout import fit_default_size, wrapping_row  # noqa: E402
 from .state_words import sentence_words  # noqa: E402
 
 Request = Callable[[Intent], "concurrent.futures.Future[Any]"]
@@ -57,20 +58,25 @@ def answer_details(answer: Answer) -> str:
     lines: list[str] = []
     first = answer.primary
     if first is not None and first.evidence:
-        lines.append(_("Read from: ") + "; ".join(_short(e) for e in first.evidence[:6]))
+        lines.append(_("Read from: ") + "; ".join(_short(words(e)) for e in first.evidence[:6]))
     for reason in answer.reasons[1:6]:
         lines.append(("⚠ " if reason.loud else _("Also: ")) + _short(sentence_words(reason.sentence())))
-    lines += [_("Note: {short}").format(short=_short(n)) for n in answer.notes[:6]]
+    lines += [_("Note: {short}").format(short=_short(words(n))) for n in answer.notes[:6]]
     lines += [_short(v.text()) for v in answer.raw[:10]]
     return "\n".join(lines)
+
+
+def _failure(error: BaseException | None) -> str:
+    """Why a request came to nothing, in the operator's language."""
+    return error_words(error) if error is not None else _("cancelled")
 
 
 def confirm_question(fix: Fix) -> str:
     """What the confirmation says: the fix in words, what is sent, and why a yes is asked."""
     risk = FIX_WORDS.get(fix.key, "")
-    warn = _(" Careful: {risk}.").format(risk=risk) if risk else ""
+    warn = _(" Careful: {risk}.").format(risk=_(risk)) if risk else ""
     return _("{short}. RTMU will send {sends} to the robot.{warn} Go ahead?").format(
-        short=_short(fix.label), sends=fix.sends, warn=warn
+        short=_short(words(fix.label)), sends=fix.sends, warn=warn
     )
 
 
@@ -81,7 +87,7 @@ class WhyWindow(Gtk.Window):
         super().__init__(
             title=_("Why won't it move?"), transient_for=parent, modal=False, destroy_with_parent=True
         )
-        self.set_default_size(560, 300)
+        fit_default_size(self, 560, 300)  # a 360 px phone: the window takes its width, no more
         self._request, self._question = request, question
         self.answer: Answer | None = None
         self.asking = False
@@ -97,11 +103,12 @@ class WhyWindow(Gtk.Window):
         self.details = Gtk.Label(wrap=True, xalign=0.0, selectable=True)
         self.details.add_css_class("dim-label")
         self.details.set_max_width_chars(70)
-        scroller = Gtk.ScrolledWindow(vexpand=True, hscrollbar_policy=Gtk.PolicyType.NEVER)
-        scroller.set_child(self.details)
         self.status = Gtk.Label(wrap=True, xalign=0.0)
+        self.status.set_max_width_chars(60)  # a long answer wraps: never wider than a small screen
+        for label in (self.sentence, self.details, self.status):
+            label.set_wrap_mode(Pango.WrapMode.WORD_CHAR)  # a word longer than the line (a path) breaks too
         self.confirm = ConfirmBar()
-        buttons = Gtk.Box(spacing=6, halign=Gtk.Align.END)
+        buttons = wrapping_row(at_most=3)  # on a phone, or in longer words, they wrap onto more lines
         self.fix_button = Gtk.Button(visible=False)
         self.fix_button.connect("clicked", lambda _b: self._offer_fix())
         self.again_button = Gtk.Button(label=_("Ask again"))
@@ -110,8 +117,15 @@ class WhyWindow(Gtk.Window):
         close.connect("clicked", lambda _b: self.close())
         for button in (self.fix_button, self.again_button, close):
             buttons.append(button)
-        for widget in (self.sentence, scroller, self.status, self.confirm, buttons):
-            box.append(widget)
+        # The answer scrolls, the confirmation and the buttons stay in view: on a small screen in a
+        # language with longer words the window still fits, and a question asked is never scrolled away.
+        answer = Gtk.Box(orientation=Gtk.Orientation.VERTICAL, spacing=8)
+        for label in (self.sentence, self.details, self.status):
+            answer.append(label)
+        scroller = Gtk.ScrolledWindow(vexpand=True, hscrollbar_policy=Gtk.PolicyType.NEVER)
+        scroller.set_child(answer)
+        for part in (scroller, self.confirm, buttons):
+            box.append(part)
         self.set_child(box)
         self.set_focus(self.again_button)  # not the selectable details: focused, their text is all selected
         self.connect("close-request", self._closing)
@@ -139,7 +153,7 @@ class WhyWindow(Gtk.Window):
             return False
         error = None if future.cancelled() else future.exception()
         if future.cancelled() or error is not None:
-            self.status.set_text(_("No answer: {short}").format(short=_short(str(error or "cancelled"))))
+            self.status.set_text(_("No answer: {short}").format(short=_short(_failure(error))))
             return False
         self.show_answer(future.result())
         self.status.set_text("")
@@ -183,7 +197,7 @@ class WhyWindow(Gtk.Window):
             return False
         error = None if future.cancelled() else future.exception()
         if future.cancelled() or error is not None:
-            self.status.set_text(_("Not done: {short}").format(short=_short(str(error or "cancelled"))))
+            self.status.set_text(_("Not done: {short}").format(short=_short(_failure(error))))
             return False
         report = future.result()
         self.show_answer(report.answer)

@@ -226,15 +226,19 @@ class VideoStatus:
 
     def caption(self) -> str:
         """One short line for the picture: "12.0 fps · 310 kB/s · 45 ms old"."""
-        parts = [f"{self.fps:.1f} fps", f"{self.kbps:.0f} kB/s"]
+        from ..base.i18n import _, words
+        from ..base.units import quantity
+
+        parts = [quantity(self.fps, "fps", 1), quantity(self.kbps, "kB/s")]
         if self.age_ms is not None:
-            parts.append(f"{self.age_ms:.0f} ms old")
+            parts.append(_("{age} old").format(age=quantity(self.age_ms, "ms")))
         if self.paused:
-            parts.append("paused")
+            parts.append(_("paused"))
         if self.backoff:
-            parts.append(self.backoff)
+            parts.append(words(self.backoff))
         if self.dropped:
-            parts.append(f"{self.dropped} dropped" + (f" (last: {self.note})" if self.note else ""))
+            dropped = _("{count} dropped").format(count=self.dropped)
+            parts.append(dropped + (_(" (last: {note})").format(note=self.note) if self.note else ""))
         return " · ".join(parts)
 
 
