@@ -27,6 +27,18 @@ def test_no_view_module_over_600_lines_and_the_window_well_under() -> None:
     )
 
 
+def test_no_module_anywhere_over_600_lines() -> None:
+    """Small modules with one job each, in the whole package, the tests and the benchmarks alike (two
+    grew past it unnoticed in one session: ``doctor`` to 696 lines and ``client/why`` to 630)."""
+    root = UI.parents[2]
+    sizes = {
+        str(p.relative_to(root)): len(p.read_text(encoding="utf-8").splitlines())
+        for folder in ("src", "tests", "bench")
+        for p in (root / folder).rglob("*.py")
+    }
+    assert {n: s for n, s in sizes.items() if s > MODULE_LINES} == {}
+
+
 def test_keys_name_actions_and_no_window_intent_goes_by_name() -> None:
     """View intents are ``win.*`` actions: a key names its action (no ``Binding.kind``), and no module
     of the view dispatches ``view_intent`` strings."""

@@ -45,6 +45,7 @@ from ._common import (
     read_password,
     run_interruptibly,
 )
+from .doctor_link import READ_CHUNK, check_udp, learn_link_timing
 from .doctor_steps import StepFailed, StepResult, fail, features_of, report_lines
 
 if TYPE_CHECKING:
@@ -58,10 +59,8 @@ EXITS = (
     EXIT_OK, EXIT_INTERNAL, EXIT_USAGE, EXIT_DOCTOR_RESOLVE, EXIT_DOCTOR_TCP, EXIT_DOCTOR_INTRODUCTION,
     EXIT_DOCTOR_LOGIN, EXIT_DOCTOR_DATALIST, EXIT_DOCTOR_STATUS, *WHY_ASKED, *ENDED,
 )  # fmt: skip
-READ_CHUNK = 65536
 NOT_ARIA_AFTER = 4096
 """Bytes without a single valid packet after which the peer is taken for something else."""
-UDP_WAIT_S = 2.0
 LINK_SECONDS = 3.0
 """How long the status step watches the status stream to learn the link's timing (``--link-seconds``)."""
 ADVICE_LINK_STALLS = (
@@ -109,7 +108,7 @@ class Doctor:
             intro = await self._introduction()
             await self._login(intro)
             await self._data_list()
-            await self._udp(intro)
+            await check_udp(self.address, intro, self.ok)
             await self._status()
             await self._close()  # one login at a time: a robot may take few clients
             await self._motion()
@@ -378,68 +377,6 @@ class Doctor:
             features=self.features,
         )
 
-    async def _udp(self, intro: ServerIntroduction) -> None:
-        import asyncio
-
-        from ..client.diagnosis import Step
-        from ..protocol.commands import ClientCommand, ServerCommand
-        from ..protocol.decoder import PacketDecoder
-        from ..protocol.fields import FieldReader, FieldWriter
-        from ..protocol.packet import encode_packet
-
-        if intro.udp_port == 0:
-            self.ok(Step.UDP, Said(N_("not used: the server is TCP-only (UDP port 0)")), "not_checked")
-            return
-        loop = asyncio.get_running_loop()
-        answered = loop.create_future()
-
-        class Listener(asyncio.DatagramProtocol):
-            def datagram_received(self, data: bytes, addr: Any) -> None:
-                for packet in PacketDecoder().feed(data):
-                    if packet.command == ServerCommand.UDP_INTRODUCTION and not answered.done():
-                        key = FieldReader(packet.payload).byte4("intro key", default=-1)
-                        answered.set_result(key == intro.intro_key)
-
-        transport, _ = await loop.create_datagram_endpoint(
-            Listener, remote_addr=(self.address, intro.udp_port)
-        )
-        try:
-            hello = encode_packet(
-                ClientCommand.UDP_INTRODUCTION, FieldWriter().ubyte4(intro.auth_key).bytes()
-            )
-            transport.sendto(hello)
-            try:
-                async with asyncio.timeout(UDP_WAIT_S):
-                    good = await answered
-            except TimeoutError:
-                self.ok(
-                    Step.UDP,
-                    Said(
-                        N_("no answer on UDP port {port} within {timeout}"),
-                        port=intro.udp_port,
-                        timeout=Quantity(UDP_WAIT_S, "s", None),
-                    ),
-                    "warn",
-                    N_(
-                        "UDP may be blocked between here and the robot; RTMU uses TCP only, so this does not "
-                        "stop RTMU (ARIA's own clients fall back to TCP after a few seconds)"
-                    ),
-                )
-                return
-            if good:
-                self.ok(
-                    Step.UDP,
-                    Said(N_("UDP port {port} answers (the server knew our key)"), port=intro.udp_port),
-                )
-            else:
-                self.ok(
-                    Step.UDP,
-                    Said(N_("UDP port {port} answered with a wrong key"), port=intro.udp_port),
-                    "warn",
-                )
-        finally:
-            transport.close()
-
     async def _status(self) -> None:
         from ..client.diagnosis import ADVICE, Step, central_server_words
         from ..protocol.payloads.robot import BatteryInfo, Update, UpdateNumbers, UpdateStrings
@@ -487,7 +424,8 @@ class Doctor:
         details["battery_pct" if soc else "battery_v"] = numbers.battery
         advice = ""
         if self.link_seconds > 0:
-            link = await self._link_timing(name)
+            assert self.conn is not None and self.reader is not None
+            link = await learn_link_timing(self.conn, self.reader, self._flush, name, self.link_seconds)
             details["link"] = link
             text = Said(
                 N_(
@@ -504,48 +442,6 @@ class Doctor:
             if link["longest_gap_ms"] > STATUS_CEILING * 1000:
                 advice = ADVICE_LINK_STALLS
         self.ok(Step.STATUS, text, advice=advice, **details)
-
-    async def _link_timing(self, name: str) -> dict[str, Any]:
-        """Subscribe to status at ``rtmu drive``'s rate for :attr:`link_seconds` and learn its timing
-        by the rule the window and ``rtmu drive`` use (``base.link_timing``)."""
-        import asyncio
-
-        from ..client.drive_guard import STALE_INTERVALS, STATUS_INTERVAL_MS
-        from ..client.health import HealthMonitor
-        from ..protocol.errors import ProtocolError
-        from ..protocol.events import DataReceived
-
-        conn, reader = self.conn, self.reader
-        assert conn is not None and reader is not None
-        number = conn.number_of(name)
-        health = HealthMonitor(STATUS_INTERVAL_MS / 1000.0, stale_intervals=STALE_INTERVALS)
-        loop = asyncio.get_running_loop()
-        start = loop.time()
-        health.start(start)
-        conn.request(name, STATUS_INTERVAL_MS)
-        self._flush()
-        last, longest = None, 0.0
-        with contextlib.suppress(TimeoutError, OSError):
-            async with asyncio.timeout(self.link_seconds):
-                while data := await reader.read(READ_CHUNK):
-                    now = loop.time()
-                    for event in conn.receive_data(data):
-                        if isinstance(event, DataReceived) and event.command == number:
-                            longest = max(longest, now - last) if last is not None else 0.0
-                            last = now
-                            health.note_status(now)
-                    self._flush()
-        with contextlib.suppress(ProtocolError, KeyError):
-            conn.request_stop(name)
-            self._flush()
-        timing = health.timing(loop.time())
-        return {
-            "status_every_ms": STATUS_INTERVAL_MS,
-            "arrived": timing.samples + (1 if last is not None else 0),
-            "longest_gap_ms": round(longest * 1000),
-            "jitter_ms": round(timing.jitter * 1000),
-            "stale_after_s": round(timing.settled, 2),
-        }
 
     async def _motion(self) -> None:
         """``rtmu why``'s answer, asked over a login of its own (the steps above use the bare codec)."""
