@@ -86,3 +86,15 @@ def pytest_runtest_protocol(item: pytest.Item) -> Iterator[None]:
 def built_dists(tmp_path_factory: pytest.TempPathFactory) -> tuple[Path, Path]:
     """The sdist and wheel ``python -m build`` makes of this checkout, built once per run."""
     return build_dists(tmp_path_factory.mktemp("dists"))
+
+
+@pytest.fixture
+def german() -> Iterator[None]:
+    """The window's and the CLI's words in German for one test (English again after it)."""
+    from rtmu.base import i18n
+
+    i18n.use(["de"])
+    try:
+        yield
+    finally:
+        i18n.use(["en"])

@@ -15,15 +15,6 @@ from rtmu.subcommands._status import status_line, status_object
 
 
 @pytest.fixture
-def german() -> Iterator[None]:
-    i18n.use(["de"])
-    try:
-        yield
-    finally:
-        i18n.use(["en"])
-
-
-@pytest.fixture
 def english() -> Iterator[None]:
     i18n.use(["en"])
     yield

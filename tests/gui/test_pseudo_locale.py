@@ -56,15 +56,6 @@ def pseudo_locale(pseudo_catalogue: Path) -> Iterator[None]:
         i18n.use(["en"])
 
 
-@pytest.fixture
-def german() -> Iterator[None]:
-    i18n.use(["de"])
-    try:
-        yield
-    finally:
-        i18n.use(["en"])
-
-
 def widget_words(widget: Gtk.Widget) -> Iterator[tuple[str, str]]:
     """(where, text) for every mapped widget under ``widget``: its text, its tooltip, its hint."""
     child = widget.get_first_child()
