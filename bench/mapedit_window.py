@@ -20,8 +20,8 @@ from typing import Any
 import gi
 
 gi.require_version("Gtk", "4.0")
-from gi.repository import GLib  # noqa: E402
 
+from bench import video_window  # noqa: E402
 from rtmu.model.observables import MapPhase, Phase  # noqa: E402
 from rtmu.ui.application import RtmuApplication  # noqa: E402
 from rtmu.ui.options import GuiOptions  # noqa: E402
@@ -30,12 +30,7 @@ TIMEOUT = 120.0
 
 
 def pump(condition: Any, timeout: float = TIMEOUT) -> None:
-    ctx = GLib.MainContext.default()
-    deadline = time.monotonic() + timeout
-    while not condition():
-        if time.monotonic() > deadline:
-            raise TimeoutError("the window did not get there in time")
-        ctx.iteration(True)
+    video_window.pump(condition, timeout)
 
 
 def main(argv: list[str]) -> int:
