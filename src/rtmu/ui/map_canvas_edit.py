@@ -35,7 +35,7 @@ from ..mapedit import MapDraft, MapObject  # noqa: E402
 from ..mapedit.draft import DOCK, FORBIDDEN_AREA, FORBIDDEN_LINE, GOAL, GOAL_WITH_HEADING  # noqa: E402
 from ..mapedit.hit import POINT_KINDS, object_at  # noqa: E402
 from .mapview import MapStage  # noqa: E402
-from .pose_pick import DRAG_MIN_PX  # noqa: E402
+from .pose_pick import DRAG_MIN_PX, capture_drag  # noqa: E402
 
 REACH_PX = 14.0
 """How near (screen pixels) a press must be to a goal, dock or line to take it: a fingertip's width."""
@@ -103,13 +103,7 @@ class MapCanvasEdit:
         self._dragged = False
         self._taken: MapObject | None = None
         self._turning = False
-        gesture = Gtk.GestureDrag()
-        gesture.set_propagation_phase(Gtk.PropagationPhase.CAPTURE)
-        gesture.connect("drag-begin", self._begin)
-        gesture.connect("drag-update", self._update)
-        gesture.connect("drag-end", self._end)
-        stage.add_controller(gesture)
-        self.gesture = gesture
+        self.gesture = capture_drag(stage, self._begin, self._update, self._end)
 
     def attach(self, editor: CanvasEditor | None) -> None:
         """The window whose draft the map edits (None: its window closed; back to panning)."""

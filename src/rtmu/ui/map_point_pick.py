@@ -16,7 +16,7 @@ gi.require_version("Gtk", "4.0")
 from gi.repository import Gtk  # noqa: E402
 
 from .mapview import MapStage  # noqa: E402
-from .pose_pick import DRAG_MIN_PX  # noqa: E402
+from .pose_pick import DRAG_MIN_PX, capture_drag  # noqa: E402
 
 Picked = Callable[[float, float, float | None], None]
 """``picked(x, y, heading)``: mm, mm, degrees (None: a click, no heading chosen)."""
@@ -29,12 +29,7 @@ class MapPointPick:
         self.stage = stage
         self._picked: Picked | None = None
         self._pose: tuple[float, float, float | None] | None = None
-        gesture = Gtk.GestureDrag()
-        gesture.set_propagation_phase(Gtk.PropagationPhase.CAPTURE)
-        gesture.connect("drag-begin", self._begin)
-        gesture.connect("drag-update", self._update)
-        gesture.connect("drag-end", self._end)
-        stage.add_controller(gesture)
+        self.gesture = capture_drag(stage, self._begin, self._update, self._end)
 
     @property
     def active(self) -> bool:

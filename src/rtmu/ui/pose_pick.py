@@ -25,6 +25,23 @@ DRAG_MIN_PX = 12.0
 """A press that moves less than this is a click (a point without a chosen heading)."""
 
 
+def capture_drag(
+    stage: MapStage,
+    begin: Callable[[Gtk.GestureDrag, float, float], None],
+    update: Callable[[Gtk.GestureDrag, float, float], None],
+    end: Callable[[Gtk.GestureDrag, float, float], None],
+) -> Gtk.GestureDrag:
+    """A drag on the map seen before the map's own pan (capture phase): each pick mode and map tool
+    claims a press it means and denies the rest, which the map then pans with."""
+    gesture = Gtk.GestureDrag()
+    gesture.set_propagation_phase(Gtk.PropagationPhase.CAPTURE)
+    gesture.connect("drag-begin", begin)
+    gesture.connect("drag-update", update)
+    gesture.connect("drag-end", end)
+    stage.add_controller(gesture)
+    return gesture
+
+
 class PosePicker:
     """The pick mode of one stage; ``changed()`` is called whenever the mode or the pose changes."""
 
@@ -36,13 +53,7 @@ class PosePicker:
         self.marker: Marker | None = None
         """The pose picked so far in this mode (None until the first click)."""
         self._press: tuple[float, float] | None = None
-        gesture = Gtk.GestureDrag()
-        gesture.set_propagation_phase(Gtk.PropagationPhase.CAPTURE)
-        gesture.connect("drag-begin", self._begin)
-        gesture.connect("drag-update", self._update)
-        gesture.connect("drag-end", self._update)
-        stage.add_controller(gesture)
-        self.gesture = gesture
+        self.gesture = capture_drag(stage, self._begin, self._update, self._update)
 
     @property
     def active(self) -> bool:
