@@ -37,6 +37,7 @@ from ..base.i18n import N_, Said, _
 from ..base.link_timing import STATUS_CEILING
 from ..base.textsafe import visible
 from ..base.units import Quantity
+from ..values.target import Target
 from ._common import (
     Interrupted,
     UsageError,
@@ -455,12 +456,8 @@ class Doctor:
         client = AriaClient()
         try:
             await client.connect(
-                self.host,
-                self.port,
-                self.user,
-                self._motion_password,
+                Target(self.host, self.port, self.user, self._motion_password, protocol=self.protocol),
                 timeout=self.timeout,
-                protocol=self.protocol,
                 role=Role.OBSERVER,
             )
             answer = diagnose(await gather(client, self.timeout))
