@@ -1,4 +1,4 @@
-"""``rtmu status`` and the window read a robot's status the same way (``client.robot_status``).
+"""``rtmu status``, ``doctor``, ``why`` and the window read a status the same way (``client.robot_status``).
 
 Against the simulator as a Pioneer (``updateNumbers`` + ``updateStrings``, volts) and as an LD robot
 (the old ``update``, ``batteryInfo`` saying state of charge): the status the CLI prints — once, and
