@@ -38,16 +38,16 @@ def _caps(chord: tuple[str, ...]) -> Gtk.Box:
     return box
 
 
-class Heading(Gtk.ListBoxRow):
+class Heading(Gtk.Label):
+    """A group's heading: the list's header above its first row shown (not a row, so the keyboard
+    moves from row to row)."""
+
     def __init__(self, group: str) -> None:
-        super().__init__(activatable=False, selectable=False, focusable=False)
+        super().__init__(label=group, xalign=0.0, wrap=True)
         self.group = group
-        label = Gtk.Label(label=group, xalign=0.0, wrap=True)
-        label.add_css_class("heading")
-        label.set_margin_top(10)
-        label.set_margin_bottom(2)
-        self.set_child(label)
-        accessible.name(self, group)
+        self.add_css_class("heading")
+        self.set_margin_top(10)
+        self.set_margin_bottom(2)
 
 
 class KeyLine(Gtk.ListBoxRow):
@@ -84,12 +84,12 @@ class KeysWindow(Gtk.Window):
     def __init__(self, parent: Gtk.Window, sheet: KeySheet) -> None:
         super().__init__(title=_("Keyboard shortcuts"), transient_for=parent, modal=True)
         self.add_css_class("keys-window")
+        self.set_titlebar(Gtk.HeaderBar())  # its close button, with or without a window manager (a phone)
         self.set_destroy_with_parent(True)
         self.set_hide_on_close(True)
         fit_default_size(self, 520, 680)
         self.sheet = sheet
         self._shown: set[KeyRow] = set(sheet.rows)
-        self._groups: set[str] = set(sheet.groups)
         box = Gtk.Box(orientation=Gtk.Orientation.VERTICAL, spacing=6)
         for side in ("top", "bottom", "start", "end"):
             getattr(box, f"set_margin_{side}")(8)
@@ -104,16 +104,11 @@ class KeysWindow(Gtk.Window):
         self.rows = Gtk.ListBox(selection_mode=Gtk.SelectionMode.NONE)
         self.rows.add_css_class("keys-list")
         accessible.name(self.rows, _("Keyboard shortcuts"))
-        self.lines: list[KeyLine] = []
-        group = None
-        for row in sheet.rows:
-            if row.group != group:
-                group = row.group
-                self.rows.append(Heading(group))
-            line = KeyLine(row)
-            self.lines.append(line)
+        self.lines = [KeyLine(row) for row in sheet.rows]
+        for line in self.lines:
             self.rows.append(line)
         self.rows.set_filter_func(self._keeps)
+        self.rows.set_header_func(self._heading)
         scroller = Gtk.ScrolledWindow(vexpand=True, hscrollbar_policy=Gtk.PolicyType.NEVER)
         scroller.set_child(self.rows)
         box.append(scroller)
@@ -128,7 +123,6 @@ class KeysWindow(Gtk.Window):
         """Show the rows the search leaves, and their headings; say how many when it hides some."""
         kept = self.sheet.matching(query)
         self._shown = set(kept)
-        self._groups = {r.group for r in kept}
         self.rows.invalidate_filter()
         note = count_note(len(kept), len(self.sheet.rows), query)
         self.note.set_text(note)
@@ -139,9 +133,18 @@ class KeysWindow(Gtk.Window):
         return [line for line in self.lines if line.row in self._shown]
 
     def _keeps(self, widget: Gtk.ListBoxRow) -> bool:
-        if isinstance(widget, Heading):
-            return widget.group in self._groups
         return isinstance(widget, KeyLine) and widget.row in self._shown
+
+    @staticmethod
+    def _heading(line: Gtk.ListBoxRow, before: Gtk.ListBoxRow | None) -> None:
+        """The first row shown of a group carries its heading (the list asks again after a search)."""
+        assert isinstance(line, KeyLine)
+        group = line.row.group
+        header = line.get_header()
+        if isinstance(before, KeyLine) and before.row.group == group:
+            line.set_header(None)
+        elif not (isinstance(header, Heading) and header.group == group):
+            line.set_header(Heading(group))
 
     def _key(self, _c: Gtk.EventControllerKey, keyval: int, _code: int, _state: Gdk.ModifierType) -> bool:
         if keyval != Gdk.KEY_Escape:
