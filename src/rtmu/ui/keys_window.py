@@ -82,7 +82,8 @@ class KeysWindow(Gtk.Window):
     """See the module notes. ``sheet``: the rows to list (the window's key table)."""
 
     def __init__(self, parent: Gtk.Window, sheet: KeySheet) -> None:
-        super().__init__(title=_("Keyboard shortcuts"), transient_for=parent, modal=True)
+        # Not modal: reading the keys never takes the STOP button away from the operator's hand.
+        super().__init__(title=_("Keyboard shortcuts"), transient_for=parent, modal=False)
         self.add_css_class("keys-window")
         self.set_titlebar(Gtk.HeaderBar())  # its close button, with or without a window manager (a phone)
         self.set_destroy_with_parent(True)
@@ -156,6 +157,7 @@ class KeysWindow(Gtk.Window):
         """Hidden, not destroyed: the search starts empty next time; the keyboard goes back to the
         window (driving). False: let GTK hide it."""
         self.search.set_text("")
+        self.filter("")  # now, not after the entry's search delay
 
         def present() -> bool:
             parent.present()
