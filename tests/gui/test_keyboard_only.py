@@ -130,6 +130,7 @@ def test_the_keys_window_opens_by_keyboard_stop_first_filtered_as_typed_and_esca
     keys = owned_windows(window)[0]
     assert isinstance(keys, KeysWindow)
     pump(lambda: in_search(keys), 3, "the search to have the keys")
+    pump(keys.is_active, 5, "the X server to give the keys window the keyboard")  # before typing
     headings = [w.group for w in descendants(keys.rows) if isinstance(w, Heading) and w.get_mapped()]
     assert headings[:2] == ["STOP", "Driving"], f"the list starts with {headings}"
     first = next(line for line in keys.lines if line.get_mapped())

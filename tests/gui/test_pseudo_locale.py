@@ -489,6 +489,7 @@ def check_keys_window(gui: Gui, name: str) -> list[str]:
     bottom.set_value(bottom.get_upper())
     idle(0.3)
     gui.screen_shot(f"{name}-keys-end")
+    pump(keys.is_active, 5, "the keys window to have the keyboard")
     gui.xdotool("type", "--delay", "30", keys.sheet.rows[0].title[:4])  # a few letters of STOP's words
     pump(lambda: len(keys.shown_lines()) < len(keys.lines), 5, "typing to filter")
     idle(0.3)

@@ -264,10 +264,11 @@ def test_space_and_the_keypad_5_stop_the_robot_while_the_keys_window_is_open(
     keys = owned_windows(window)[0]
     assert isinstance(keys, KeysWindow) and is_guarded(keys)
     pump(lambda: isinstance(keys.get_focus(), Gtk.Text), 3, "the search to have the keys")
+    pump(keys.is_active, 5, "the X server to give the keys window the keyboard")  # before typing
     assert FIELD_HINT in keys.search.get_tooltip_text()
     gui.xdotool("type", "--delay", "30", "turn")
     gui.key("shift+space")
-    pump(lambda: keys.search.get_text() == "turn ", 3, "Shift+Space to type a space")
+    pump(lambda: keys.search.get_text() == "turn ", 5, "Shift+Space to type a space")
     cycle.navigate()
     cycle.space_stops("with the keys window's search focused")
     assert keys.get_mapped() and keys.search.get_text() == "turn ", "Space stopped: it typed nothing"
@@ -283,4 +284,13 @@ def test_space_and_the_keypad_5_stop_the_robot_while_the_keys_window_is_open(
     gui.key("KP_5")
     pump(lambda: cycle.stops() > before, 5, "the keypad's 5 to stop the robot from a row")
     assert keys.get_mapped()
+    # Not modal: the window's STOP button takes a click while the keys window is open (moved off it:
+    # no window manager here places it).
+    gui.xdotool("windowmove", "--sync", str(GdkX11.X11Surface.get_xid(keys.get_surface())), "700", "300")
+    cycle.navigate()
+    before = cycle.stops()
+    gui.click(window.stop_button)
+    pump(lambda: cycle.stops() > before, 5, "a click on STOP with the keys window open")
+    assert keys.get_mapped()
+    gui.screen_shot("stop-clicked-beside-the-keys-window")
     cycle.prove("the keys window open")  # and the whole cycle: Space, the D-pad, a held Up after it
