@@ -143,7 +143,7 @@ WINDOW_LATE = (
     "rtmu.client.central",  # a central server's roster: for a central profile only
     "rtmu.client.why_gather",  # why won't it move?: its questions and fixes when first asked
     "rtmu.client.why_fix",
-    "xml.sax",  # the shortcuts window's escaping (xml.sax brings urllib and email): when it is built
+    "xml.sax",  # XML escaping brings urllib and email: no part of the first frame needs them
     "urllib.request",
     "email",
 )

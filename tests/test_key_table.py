@@ -39,7 +39,7 @@ def test_the_window_keys_name_window_actions_and_only_the_app_keys_are_accelerat
     names = [b.action for b in WINDOW_BINDINGS]
     assert len(names) == len(set(names)), "one binding per action"
     assert {b.action for b in accelerated()} == {
-        "win.fullscreen", "win.toolbar", "win.settings", "win.show-help-overlay", "app.quit",
+        "win.fullscreen", "win.toolbar", "win.settings", "win.show-keys", "app.quit",
     }  # fmt: skip
     assert not any(b.held for b in WINDOW_BINDINGS), "held drive keys are the registry's"
 

@@ -187,3 +187,26 @@ def test_every_popover_is_read_with_named_controls(tmp_path: Path) -> None:
             assert any(n["role"] == role and n["name"].startswith(name) for n in nodes), (action, shown)
             assert not unnamed_controls(nodes), f"{action}: " + "\n".join(unnamed_controls(nodes))
             assert not [n for n in nodes if n["role"] == "list item" and not n["name"].strip()], action
+
+
+def test_the_keys_window_is_read_row_by_row_each_row_saying_its_keys(tmp_path: Path) -> None:
+    """Help ▸ Keyboard shortcuts read as a screen reader does: its search is named, and every row of
+    the one key table is a list item whose name is its words and its keys."""
+    from rtmu.ui.keys import bindings
+    from rtmu.ui.keys_sheet import KeySheet
+
+    rows = KeySheet.of(bindings()).rows
+    with window_on_its_bus(tmp_path) as (proc, env, _sim):
+        nodes = read_tree(proc.pid, env, "win.show-keys")
+        for _attempt in range(20):  # a busy machine: the window may open a little later
+            if any(n["role"] == "list item" and n["name"] == rows[0].spoken() for n in nodes):
+                break
+            time.sleep(1.0)
+            nodes = read_tree(proc.pid, env)
+        items = [
+            n["name"] for n in nodes if n["role"] == "list item" and n["name"] in {r.spoken() for r in rows}
+        ]
+        assert sorted(items) == sorted(r.spoken() for r in rows), "a row of the table not read"
+        assert "Zoom in: Ctrl++ / Ctrl+= / Ctrl+Keypad +" in items
+        assert any(n["name"] == "Search the keys" for n in nodes), "the search is not named"
+        assert not unnamed_controls(nodes), "\n".join(unnamed_controls(nodes))

@@ -1,5 +1,5 @@
 """One definition per command: a command class added to the registry — and nothing else — shows up
-in the real window as an action, a key, a robot-menu row and a line of the shortcuts window."""
+in the real window as an action, a key, a robot-menu row and a row of the keys window."""
 
 from __future__ import annotations
 
@@ -10,7 +10,8 @@ from typing import ClassVar
 import pytest
 
 from rtmu.control.commands import COMMANDS, Command, CommandTarget
-from rtmu.ui.shortcuts import shortcuts_xml
+from rtmu.ui.keys import bindings
+from rtmu.ui.keys_sheet import KeySheet
 from simulators import running
 
 from .harness import OFFICE_MAP, Gui, pump
@@ -62,7 +63,7 @@ def test_a_new_command_class_is_an_action_a_key_a_menu_row_and_a_shortcut(gui: G
     assert action is not None, "no win.test-wave action"
     assert action.get_enabled(), "enabled: the simulator offers ratioDrive"
     assert robot_menu_labels(gui).get("win.test-wave") == "Wave the flag"
-    assert "Wave the flag" in shortcuts_xml()
+    assert "Wave the flag" in [r.title for r in KeySheet.of(bindings()).rows]
     gui.shot("registry-command")
 
     gui.key("ctrl+j")  # a real key press through the X server

@@ -1,8 +1,9 @@
 """Everything by keyboard, with real key events (issue 21): Tab moves a visible focus through the bars,
 Space on a focused button stops the robot and never clicks the button, F10 / Menu / Shift+F10 open the
-menu, Ctrl+G the Go-to panel, a pick mode takes arrows and Return, and the shortcuts window opens with
-driving and STOP on its first page. (Every menu item by keyboard: test_stop_keys; every Go-to item by
-keyboard: test_stop_keys_states; Alt+1…9 in a fleet: test_stop_keys_states.)"""
+menu, Ctrl+G the Go-to panel, a pick mode takes arrows and Return, and the keys window opens with
+STOP and driving first, filters as the operator types and closes on Escape. (Every menu item by
+keyboard: test_stop_keys; every Go-to item by keyboard: test_stop_keys_states; Alt+1…9 in a fleet:
+test_stop_keys_states.)"""
 
 from __future__ import annotations
 
@@ -13,7 +14,7 @@ import pytest
 
 from rtmu.model.observables import Phase
 from rtmu.sim import SimThread
-from rtmu.ui.shortcuts import shortcuts_xml
+from rtmu.ui.keys_window import Heading, KeysWindow
 from rtmu.ui.stop_keys import descendants
 from simulators import simulator
 
@@ -120,21 +121,43 @@ def test_go_to_point_and_set_position_by_keyboard_alone(gui: Gui, sim: SimThread
     back_to_map(gui)
 
 
-def test_configuration_and_about_open_from_the_keyboard_and_the_shortcuts_start_with_driving(
+def test_the_keys_window_opens_by_keyboard_stop_first_filtered_as_typed_and_escape_closes_it(
     gui: Gui,
 ) -> None:
     window = gui.window
-    xml = shortcuts_xml()
-    for words in ("Open the menu", "Go to: goals", "Select robot 1", "Next robot", "Stop"):
-        assert words in xml, words
     gui.key("ctrl+question")
-    pump(lambda: owned_windows(window), 5, "the shortcuts window")
-    shortcuts = owned_windows(window)[0]
-    assert isinstance(shortcuts, Gtk.ShortcutsWindow)
-    stack = next(w for w in descendants(shortcuts) if isinstance(w, Gtk.Stack) and w.get_mapped())
-    page = stack.get_visible_child()
-    assert page is not None
-    shown = [g.get_property("title") for g in descendants(page) if isinstance(g, Gtk.ShortcutsGroup)]
-    assert shown[0] == "Driving", f"the first page shows {shown}"  # drive keys and STOP, first
-    gui.screen_shot("shortcuts-first-page")
+    pump(lambda: owned_windows(window), 5, "the keys window")
+    keys = owned_windows(window)[0]
+    assert isinstance(keys, KeysWindow)
+    pump(lambda: in_search(keys), 3, "the search to have the keys")
+    pump(keys.is_active, 5, "the X server to give the keys window the keyboard")  # before typing
+    headings = [w.group for w in descendants(keys.rows) if isinstance(w, Heading) and w.get_mapped()]
+    assert headings[:2] == ["STOP", "Driving"], f"the list starts with {headings}"
+    first = next(line for line in keys.lines if line.get_mapped())
+    assert first.row.title == "Stop" and first.row.accels == ("space", "KP_5")
+    gui.screen_shot("keys-first")
+    gui.xdotool("type", "--delay", "30", "zoom")
+    zooms = ["Zoom in", "Zoom out", "Zoom the camera in", "Zoom the camera out"]
+    pump(lambda: [ln.row.title for ln in keys.lines if ln.get_mapped()] == zooms, 5, "typing to filter")
+    headings = [w.group for w in descendants(keys.rows) if isinstance(w, Heading) and w.get_mapped()]
+    assert headings == ["Map", "Camera head"], headings
+    assert keys.note.get_mapped() and keys.note.get_text() == "4 of 40 keys"
+    gui.screen_shot("keys-zoom")
+    gui.xdotool("type", "--delay", "30", "qq")
+    pump(lambda: not any(ln.get_mapped() for ln in keys.lines), 5, "no row for zoomqq")
+    assert keys.note.get_text() == "No key matches “zoomqq”"
+    gui.key("Escape")
+    pump(lambda: not keys.get_mapped(), 5, "Escape to close the keys window")
+    pump(window.is_active, 5, "the keyboard back on the window")
+    gui.key("F1")
+    pump(keys.get_mapped, 5, "F1 to open it again")
+    assert keys.search.get_text() == "" and all(ln.get_child_visible() for ln in keys.lines), "starts whole"
+    close = next(w for w in descendants(keys) if isinstance(w, Gtk.Button) and w.has_css_class("close"))
+    gui.click(close)  # its title bar's close button (a phone has no Escape key)
+    pump(lambda: not keys.get_mapped(), 5, "the close button to close the keys window")
     back_to_map(gui)
+
+
+def in_search(keys: KeysWindow) -> bool:
+    focus = keys.get_focus()
+    return focus is not None and focus.is_ancestor(keys.search)

@@ -1,8 +1,7 @@
-"""Small parts of the view on their own: form validation, gauges, the key table, the shortcuts XML."""
+"""Small parts of the view on their own: form validation, gauges, the key table."""
 
 from __future__ import annotations
 
-import xml.etree.ElementTree as ET
 from dataclasses import replace
 
 import gi
@@ -13,7 +12,6 @@ from rtmu.model.observables import ConnectionState, LinkHealth, LinkLevel, Opera
 from rtmu.ui.gauges import battery_fraction, wifi_bars
 from rtmu.ui.keys import KeyRouter, bindings
 from rtmu.ui.settings_dialog import validate
-from rtmu.ui.shortcuts import shortcuts_xml
 from rtmu.ui.toolbar import MOTION_REFRESH_S, StatusToolbar
 
 gi.require_version("Gdk", "4.0")
@@ -80,13 +78,6 @@ def test_every_bound_command_exists_and_keys_do_not_clash() -> None:
     assert router.lookup(Gdk.KEY_Up, shift).action == "win.move-forward-1m"  # type: ignore[union-attr]
     assert router.lookup(Gdk.KEY_space, Gdk.ModifierType(0)).action == "win.stop"  # type: ignore[union-attr]
     assert router.lookup(Gdk.KEY_q, Gdk.ModifierType.CONTROL_MASK) is None  # left to the app accelerator
-
-
-def test_shortcuts_xml_escapes_and_lists_every_binding() -> None:
-    root = ET.fromstring(shortcuts_xml())
-    titles = [p.text for p in root.iter("property") if p.get("name") == "title"]
-    for b in bindings():
-        assert b.title in titles
 
 
 def test_the_map_note_follows_the_connection_phase_then_the_map() -> None:

@@ -1,7 +1,7 @@
-"""On an 800×480 screen (a second Xvfb): the menu and the shortcuts window fit, the window goes narrower.
+"""On an 800×480 screen (a second Xvfb): the menu and the keys window fit, the window goes narrower.
 
 What is measured is the X windows themselves (``xwininfo``: popovers and the
-shortcuts window are surfaces of their own), and GTK's own complaints: a
+keys window are surfaces of their own), and GTK's own complaints: a
 layout that does not fit makes GTK print warnings, which fail the test.
 """
 
@@ -44,7 +44,7 @@ def inside_screen(rect: tuple[int, int, int, int]) -> bool:
     return x >= 0 and y >= 0 and x + w <= W and y + h <= H
 
 
-def test_menu_and_shortcuts_fit_an_800x480_screen(small: Gui, capfd: pytest.CaptureFixture[str]) -> None:
+def test_menu_and_keys_window_fit_an_800x480_screen(small: Gui, capfd: pytest.CaptureFixture[str]) -> None:
     gui = small
     window = gui.window
     assert inside_screen(gui.screen_rect(window)), gui.screen_rect(window)
@@ -58,13 +58,14 @@ def test_menu_and_shortcuts_fit_an_800x480_screen(small: Gui, capfd: pytest.Capt
     popover.popdown()
     pump(lambda: not popover.get_mapped(), 3, "the menu to close")
     # F1 itself is tested on the big screen; here the menu's keyboard grab may still be ending.
-    window.activate_action("win.show-help-overlay", None)
-    shortcuts = window.get_help_overlay()
-    pump(shortcuts.get_mapped, 5, "the shortcuts window")
-    rect = gui.screen_rect(shortcuts)
-    gui.screen_shot("shortcuts")
-    assert inside_screen(rect), f"the shortcuts window at {rect} leaves the 800×480 screen"
-    shortcuts.close()
+    window.activate_action("win.show-keys", None)
+    keys = window.keys_help.shown
+    assert keys is not None
+    pump(keys.get_mapped, 5, "the keys window")
+    rect = gui.screen_rect(keys)
+    gui.screen_shot("keys")
+    assert inside_screen(rect), f"the keys window at {rect} leaves the 800×480 screen"
+    keys.close()
     assert not gtk_complaints(capfd.readouterr().err)
 
 

@@ -62,7 +62,7 @@ def pick_each(gui: Gui, sim: SimThread, how: str) -> list[str]:
         idle(0.3)  # what the pick opens (a dialog, a page) comes up
         if entry.action in (
             "win.about",
-            "win.show-help-overlay",
+            "win.show-keys",
             "win.settings",
             "win.server-config",
             "win.files",

@@ -249,3 +249,48 @@ def test_in_the_fleet_view_space_stops_the_selected_robot_and_alt_keys_pick_robo
             gui.shot("fleet-robot2-selected")
         finally:
             gui.close()
+
+
+def test_space_and_the_keypad_5_stop_the_robot_while_the_keys_window_is_open(
+    gui: Gui, sim: SimThread
+) -> None:
+    """Help ▸ Keyboard shortcuts is a dialog of the window: its search types with Shift+Space, Space stops
+    there, the keypad's 5 stops from a row, and neither closes it nor types into the search."""
+    from rtmu.ui.keys_window import KeyLine, KeysWindow
+
+    window, cycle = gui.window, StopCycle(gui, sim)
+    gui.key("ctrl+question")
+    pump(lambda: owned_windows(window), 5, "the keys window")
+    keys = owned_windows(window)[0]
+    assert isinstance(keys, KeysWindow) and is_guarded(keys)
+    pump(lambda: isinstance(keys.get_focus(), Gtk.Text), 3, "the search to have the keys")
+    pump(keys.is_active, 5, "the X server to give the keys window the keyboard")  # before typing
+    assert FIELD_HINT in keys.search.get_tooltip_text()
+    gui.xdotool("type", "--delay", "30", "turn")
+    gui.key("shift+space")
+    pump(lambda: keys.search.get_text() == "turn ", 5, "Shift+Space to type a space")
+    cycle.navigate()
+    cycle.space_stops("with the keys window's search focused")
+    assert keys.get_mapped() and keys.search.get_text() == "turn ", "Space stopped: it typed nothing"
+    for _ in range(20):  # Tab to a row of the list
+        if isinstance(keys.get_focus(), KeyLine):
+            break
+        gui.key("Tab")
+        idle(0.05)
+    assert isinstance(keys.get_focus(), KeyLine), keys.get_focus()
+    gui.screen_shot("keys-window-row-focused")
+    cycle.navigate()
+    before = cycle.stops()
+    gui.key("KP_5")
+    pump(lambda: cycle.stops() > before, 5, "the keypad's 5 to stop the robot from a row")
+    assert keys.get_mapped()
+    # Not modal: the window's STOP button takes a click while the keys window is open (moved off it:
+    # no window manager here places it).
+    gui.xdotool("windowmove", "--sync", str(GdkX11.X11Surface.get_xid(keys.get_surface())), "700", "300")
+    cycle.navigate()
+    before = cycle.stops()
+    gui.click(window.stop_button)
+    pump(lambda: cycle.stops() > before, 5, "a click on STOP with the keys window open")
+    assert keys.get_mapped()
+    gui.screen_shot("stop-clicked-beside-the-keys-window")
+    cycle.prove("the keys window open")  # and the whole cycle: Space, the D-pad, a held Up after it

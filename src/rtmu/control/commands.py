@@ -1,11 +1,11 @@
 """The operator's commands: one small class each, in one registry — the only definition of a command.
 
 A command says what it is called (``name``, ``label``), which keys run it and
-under which heading the shortcuts window lists them (``keys``, ``group``),
+under which heading the keys window lists them (``keys``, ``group``),
 whether the robot menu offers it (``menu``), which server data it needs and when
 it is enabled, and what it does to its :class:`CommandTarget` (the controller).
 The window builds its actions (``win.<name>``, underscores as hyphens), its key
-table, the robot menu and the shortcuts window from :data:`COMMANDS`, and greys
+table, the robot menu and the keys window from :data:`COMMANDS`, and greys
 a command out with the reason :meth:`Command.unavailable` gives (e.g. "this
 server does not offer turnByAngle"). Adding a command = adding one class.
 
@@ -83,7 +83,7 @@ class Command:
     keys: ClassVar[tuple[str, ...]] = ()
     """GTK accelerator strings that run it (the window's key table is built from these)."""
     group: ClassVar[str] = "Robot"
-    """Heading in the shortcuts window."""
+    """Heading in the keys window."""
     menu: ClassVar[bool] = False
     """Offered in the window's robot menu (greyed with its reason when unavailable)."""
     needs: ClassVar[tuple[str | tuple[str, ...], ...]] = ()
@@ -222,7 +222,7 @@ class Stop(Command):
     name = "stop"
     label = N_("Stop")
     keys = ("space", "KP_5")
-    group = "Driving"
+    group = "STOP"
     needs = (("stop", "ratioDrive"),)
 
     def unavailable(self, ctx: CommandContext) -> str | None:

@@ -8,6 +8,6 @@ table and the capture-phase key router), ``toolbar`` + ``gauges`` (status),
 ``viewport`` (screen/world maths), ``tiles`` (the static map rendered off the
 GTK thread) and ``overlays`` (robot, trail, sonar, cairns), ``camera``,
 ``banners``, ``notes`` (the map note), ``settings_dialog``, ``move_dialogs``,
-``dpad``, ``shortcuts`` and ``style``. No module here touches a socket or a packet; ``viewport``, ``tiles``,
+``dpad``, ``keys_window`` and ``style``. No module here touches a socket or a packet; ``viewport``, ``tiles``,
 ``overlays`` and ``frame`` run without a display (the benchmark uses them).
 """

@@ -11,11 +11,11 @@ and which of them are enabled.
 * **Switches** (stateful, so the menu shows their check marks): the View menu's ``toolbar``,
   ``fullscreen``, ``dpad``, ``inset``, ``split``, ``fov``, ``sonar``, ``foxglove``, and ``safe-drive``.
 * **The menu**: the robot's commands first (a greyed row says why: GTK menus have no tooltips),
-  then "Why won't it move?", Server, View, Help (the shortcuts, About) and Quit; every row shows its key
+  then "Why won't it move?", Server, View, Help (the keys, About) and Quit; every row shows its key
   from the one key table (``keys.menu_item``).
 
 Keys reach an action through :meth:`WindowActions.activate` (``keys.KeyRouter``), the menu and the
-buttons through GTK's own activation: one table says key → action (``keys``), the shortcuts window
+buttons through GTK's own activation: one table says key → action (``keys``), the keys window
 and the menu read it. STOP is not here: Space is caught before any of this on every surface
 (``stop_keys``), and the STOP buttons call the window's ``stop_now`` directly.
 """
@@ -299,7 +299,7 @@ class WindowActions:
         helping = (
             Gio.Menu()
         )  # one row for both: "Why won't it move?" took a row, an 800×480 screen has no more
-        helping.append_item(menu_item(_("Keyboard shortcuts"), "win.show-help-overlay"))
+        helping.append_item(menu_item(_("Keyboard shortcuts"), "win.show-keys"))
         helping.append_item(menu_item(_("About RTMU"), "win.about"))
         app.append_submenu(_("Help"), helping)
         app.append_item(menu_item(_("Quit"), "app.quit"))

@@ -4,8 +4,8 @@ The commands' keys come from the command registry (``rtmu.control.commands``: th
 place a command is defined): a command's keys activate its ``win.<name>`` action, a held
 command's keys drive while held. This module adds only the window's own keys, each naming
 the ``win.*`` action it activates (zoom, follow, the camera page, live video, the camera
-head, the fleet …; ``ui.actions`` defines them). The shortcuts window (``ui.shortcuts``) and
-the menu's key labels (:func:`menu_item`) read the same table.
+head, the fleet …; ``ui.actions`` defines them). The keys window (``ui.keys_window``, through
+``ui.keys_sheet``) and the menu's key labels (:func:`menu_item`) read the same table.
 
 Why capture phase: GtkWindow consumes Space and Return (button activation) and
 the arrow keys (focus moves) before a normal bubble-phase controller sees them;
@@ -43,8 +43,6 @@ class Binding:
     ``win.select-robot(3)``, ``app.quit`` ("" for a held drive key)."""
     held: str = ""
     """A held drive command (``drive_forward`` …): it drives while the key is down, stops on release."""
-    help: str | None = None
-    """What the shortcuts window prints instead of the keys ("" leaves the line out)."""
     accelerator: bool = False
     """GTK's application accelerators carry these keys (``set_accels_for_action``); the router leaves
     them alone."""
@@ -68,7 +66,6 @@ WINDOW_BINDINGS: tuple[Binding, ...] = (
             N_("Select robot 1 … 9 of the list"),
             N_("Fleet"),
             f"win.select-robot({n})",
-            help="<Alt>1...<Alt>9" if n == 1 else "",
         )
         for n in range(1, 10)
     ),
@@ -91,7 +88,7 @@ WINDOW_BINDINGS: tuple[Binding, ...] = (
         ("<Control>question", "F1"),
         N_("Keyboard shortcuts"),
         N_("Application"),
-        "win.show-help-overlay",
+        "win.show-keys",
         accelerator=True,
     ),
     Binding(("<Control>q",), N_("Quit"), N_("Application"), "app.quit", accelerator=True),
@@ -104,7 +101,6 @@ def bindings(registry: CommandRegistry = COMMANDS) -> tuple[Binding, ...]:
     """The whole key table: every command's keys from the registry, then the window's own.
 
     A command's keys activate its action (``win.<name>``); a held command's keys drive while held.
-    Groups are small (at most 6) so the shortcuts window fits an 800×480 screen in pages of columns.
     """
     commands = tuple(
         Binding(c.keys, c.label, c.group, held=c.name)

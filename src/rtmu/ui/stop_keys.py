@@ -1,7 +1,7 @@
 """The stop keys on every surface of the window: wherever the keyboard is, Space stops the robot.
 
 GTK hands a key to the surface that holds the keyboard, and only to the widgets of that surface: a
-dialog (Turn, Go, the palette, the configuration page, settings, About, the shortcuts window) is a
+dialog (Turn, Go, the palette, the configuration page, settings, About, the keys window) is a
 window of its own, and an open menu or popover is a surface of its own too, so none of their keys
 ever reach the main window's key router. Rather than teach each of them about Space, every such
 surface gets the same capture-phase key controller when it first shows:

@@ -100,9 +100,11 @@ menubutton.goals-button > button { min-width: 20px; padding-left: 3px; padding-r
 .video-caption { background: alpha(black, 0.62); color: white; font-size: 9pt; padding: 1px 6px;
                  border-radius: 4px; }
 
-/* GTK's own theme gives the shortcuts window's page buttons (1 2 3) negative label margins:
-   "GtkLabel reported min width -4" warnings. Plain margins, same look. */
-stackswitcher.circular > button > label { margin: 0; padding: 0; }
+/* The keys window (keys_window): each key a cap */
+.keys-window .keycap { font-size: 9pt; min-width: 14px; padding: 1px 6px; border-radius: 5px;
+                       border: 1px solid alpha(currentColor, 0.3);
+                       box-shadow: inset 0 -2px alpha(currentColor, 0.15); }
+.keys-list { background: none; }
 
 .field-error { color: #c01c28; font-size: 9pt; margin-bottom: 4px; }
 entry.error { border-color: #c01c28; }

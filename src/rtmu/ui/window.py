@@ -48,6 +48,7 @@ from .goals_panel import GoalsPanel  # noqa: E402
 from .handheld import Handheld  # noqa: E402
 from .key_reach import KeyReach  # noqa: E402
 from .keyboard_nav import KeyboardNav  # noqa: E402
+from .keys_window import KeysHelp  # noqa: E402
 from .map_page import MapPage  # noqa: E402
 from .nav_draw import MarkerKind  # noqa: E402
 from .near_people import NearPeopleSwitch  # noqa: E402
@@ -55,7 +56,6 @@ from .notes import status_line  # noqa: E402
 from .notice_router import NoticeRouter, speed_banner  # noqa: E402
 from .routes_panel import RoutesPanel  # noqa: E402
 from .selected_model import SelectedModel  # noqa: E402
-from .shortcuts import help_overlay_of, install_help_on_demand  # noqa: E402
 from .split_view import SplitView  # noqa: E402
 from .stop_keys import StopKeys  # noqa: E402
 from .toolbar import StatusToolbar  # noqa: E402
@@ -173,7 +173,7 @@ class MainWindow(Gtk.ApplicationWindow):
         self.operator.speed.set(SpeedSetting.nearest(profile.speed))
         self.actions.install()
         self.inset_action = self.actions.inset_action
-        install_help_on_demand(self)
+        self.keys_help = KeysHelp(self)
         self._unobserve = [
             model.connection.observe(self._on_connection),
             operator.speed.observe(lambda _old, new: self.notices.apply(speed_banner(new.percent))),
@@ -330,9 +330,6 @@ class MainWindow(Gtk.ApplicationWindow):
             self.connect_now()
         else:
             self.controller.disconnect()
-
-    def get_help_overlay(self) -> Gtk.ShortcutsWindow:
-        return help_overlay_of(self)
 
     def connect_now(self) -> None:
         self.controller.connect(password=self.dialogs.password_for(self.controller.profile))
