@@ -17,6 +17,7 @@ from rtmu.base import i18n
 from rtmu.cli import main
 from rtmu.package_data import project_map
 from rtmu.sim import SimConfig, SimThread
+from rtmu.subcommands._navigate import EXIT_NAV_LOST
 
 
 @pytest.fixture(scope="module")
@@ -122,3 +123,26 @@ def test_a_wrong_password_is_said_in_german(
         assert main(argv) != 0
     err = capsys.readouterr().err
     assert "Anmeldung abgelehnt: falscher Benutzername oder falsches Passwort" in err, err
+
+
+def test_a_navigation_outcome_reads_german_and_its_json_stays_english(
+    german: None, capsys: pytest.CaptureFixture[str]
+) -> None:
+    """A lost robot's goto: the server's own words as sent, RTMU's reason and the localize lines in German."""
+    from client.navsim import fast_sim
+
+    with fast_sim() as sim:
+        assert sim.server is not None
+        sim.call(sim.server.lose_localization)
+        where = f"127.0.0.1:{sim.port}"
+        argv = ["goto", where, "Room 101", "--timeout", "5", "--limit", "60"]
+        assert main(argv) == EXIT_NAV_LOST
+        err = capsys.readouterr().err
+        said = "rtmu goto: Failed to get to Room 101 (Grund: der Roboter hat seine Position verloren)"
+        assert said in err, err
+        assert main([*argv, "--json"]) == EXIT_NAV_LOST
+        last = json.loads(capsys.readouterr().out.splitlines()[-1])
+        assert last["outcome"] == "failed" and last["reason"] == "the robot is lost", last
+        assert main(["localize", where, "2500", "6000", "0", "--timeout", "5", "--limit", "60"]) == 0
+        out = capsys.readouterr().out.splitlines()
+        assert re.fullmatch(r"lokalisiert \(Wert 0,\d\d\)", out[-1]), out

@@ -28,7 +28,7 @@ from pathlib import Path
 from typing import TYPE_CHECKING, Any, TypeVar
 
 from ..base.exit_codes import EXIT_CONNECTION, EXIT_SIGPIPE, EXIT_USAGE
-from ..base.i18n import _, error_words
+from ..base.i18n import N_, Said, _, as_said, error_words
 from ..client.defaults import CONNECT_TIMEOUT, DEFAULT_PORT
 from ..client.errors import ClientError
 from ..client.roles import Role
@@ -221,7 +221,7 @@ def resolve_robot(args: argparse.Namespace) -> int | None:
     except ProtocolError as exc:
         return fail(name, f"central server {host}:{port} sent a malformed robot list: {exc}", EXIT_CONNECTION)
     except Interrupted as exc:
-        return fail(name, str(exc), exc.exit_code)
+        return fail(name, error_words(exc), exc.exit_code)
     wanted = args.robot
     try:
         found = find_robot(robots, wanted)  # without case, as ARIA compares; several: refused
@@ -300,7 +300,13 @@ class Interrupted(Exception):
         self.signum = signum
         self.exit_code = 128 + signum
         self.detail = detail
-        super().__init__(f"interrupted by {signal_name(signum)}" + (f"; {detail}" if detail else ""))
+        name = signal_name(signum)
+        said = (
+            Said(N_("interrupted by {signal}; {detail}"), signal=name, detail=as_said(detail))
+            if detail
+            else Said(N_("interrupted by {signal}"), signal=name)
+        )
+        super().__init__(said)  # the operator reads it in their language (``error_words``)
 
 
 async def until_stop_signal() -> int:
@@ -511,11 +517,12 @@ def run_with_client(
     try:
         return run_interruptibly(main)
     except Interrupted as exc:
-        return fail(name, str(exc), exc.exit_code)
+        return fail(name, error_words(exc), exc.exit_code)
     except ClientError as exc:
         return fail(name, error_words(exc), exc.exit_code)
     except ProtocolError as exc:  # a reply that does not decode, wherever a command looked at it
-        return fail(name, f"the server sent something malformed: {exc}", EXIT_CONNECTION)
+        said = _("the server sent something malformed: {error}").format(error=exc)
+        return fail(name, said, EXIT_CONNECTION)
     except UsageError as exc:
         return fail(name, str(exc), EXIT_USAGE)
     except BrokenPipeError:  # e.g. piped into ``head``: the reader has what it wanted

@@ -13,7 +13,7 @@ import sys
 from typing import TYPE_CHECKING, Any
 
 from ..base.exit_codes import EXIT_OK, EXIT_USAGE
-from ..base.i18n import _
+from ..base.i18n import N_, _
 from ..base.textsafe import visible
 from ..client.roles import Role
 from ..protocol.payloads.navigation import GotoGoal, GotoPose
@@ -71,14 +71,19 @@ def handle(args: argparse.Namespace) -> int:
 
     async def body(client: AriaClient) -> int:
         if args.goal is None:
-            require(client, "gotoPose", "drive to points")
+            require(client, "gotoPose", N_("this server does not drive to points (it does not offer {name})"))
             th = None if args.th is None else round(args.th)
             return await navigate(client, args, GotoPose(round(args.x), round(args.y), th), Expect("point"))
         route = args.route or (not client.supports("gotoGoal") and client.supports("gotoRouteGoal"))
         if route:
-            require(client, "gotoRouteGoal", "drive to route goals")  # exit 4 before asking for goals
+            # exit 4 before asking for goals
+            require(
+                client,
+                "gotoRouteGoal",
+                N_("this server does not drive to route goals (it does not offer {name})"),
+            )
         else:
-            require(client, "gotoGoal", "drive to goals")
+            require(client, "gotoGoal", N_("this server does not drive to goals (it does not offer {name})"))
         if client.supports("getGoals"):
             known = await ld_data.goals(client, args.timeout)
             goal = known_name("goto", "goal", args.goal, known)

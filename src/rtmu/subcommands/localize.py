@@ -6,7 +6,7 @@ import argparse
 from typing import TYPE_CHECKING, Any
 
 from ..base.exit_codes import NETWORK
-from ..base.i18n import _
+from ..base.i18n import N_, _
 from ..client.roles import Role
 from ..protocol.payloads.navigation import LocalizeToPose
 from ._common import add_connection_arguments, run_with_client
@@ -36,7 +36,11 @@ def register(subparsers: Any) -> None:
 
 def handle(args: argparse.Namespace) -> int:
     async def body(client: AriaClient) -> int:
-        require(client, "localizeToPose", "take a pose to localize at")
+        require(
+            client,
+            "localizeToPose",
+            N_("this server does not take a pose to localize at (it does not offer {name})"),
+        )
         return await localize(client, args, LocalizeToPose(round(args.x), round(args.y), round(args.th)))
 
     return run_with_client("localize", args, body, role=Role.OPERATOR)
