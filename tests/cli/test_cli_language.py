@@ -6,6 +6,7 @@ the same runs with ``--json`` give the English sentences and plain numbers a scr
 
 from __future__ import annotations
 
+import contextlib
 import json
 import re
 from collections.abc import Iterator
@@ -146,3 +147,86 @@ def test_a_navigation_outcome_reads_german_and_its_json_stays_english(
         assert main(["localize", where, "2500", "6000", "0", "--timeout", "5", "--limit", "60"]) == 0
         out = capsys.readouterr().out.splitlines()
         assert re.fullmatch(r"lokalisiert \(Wert 0,\d\d\)", out[-1]), out
+
+
+def test_decode_reads_german_and_its_json_stays_english(
+    german: None, capsys: pytest.CaptureFixture[str]
+) -> None:
+    """A capture's header, folded runs, notes and summary in German; the packets' own names and fields
+    (the capture's words) as they are; --json's notes in English."""
+    from testdata import CAPTURES
+
+    assert main(["decode", str(CAPTURES / "map-binary-columbia.pcap")]) == 0
+    out = capsys.readouterr().out
+    assert out.startswith("# map-binary-columbia.pcap: pcap, Link-Typ "), out[:200]
+    assert "Felder (Prüfsumme in Ordnung, wo nicht markiert)" in out
+    assert re.search(r"… 63818 weitere getMap-Pakete über [\d.]+,\d{3} s \(--all zeigt sie\) …", out), out
+    assert "(Ende der Antwort)" in out and "line='2D-Map'" in out
+    assert "== Zusammenfassung" in out and "  verworfen: nichts" in out
+    assert re.search(r"Mitschnitt: [\d.]+ Frames, [\d.]+,\d{3} s", out), out
+    assert "more getMap" not in out and "summary" not in out
+    assert main(["decode", "--json", str(CAPTURES / "map-binary-columbia.pcap")]) == 0
+    notes = {json.loads(line).get("note") for line in capsys.readouterr().out.splitlines()}
+    assert "end of reply" in notes and "Ende der Antwort" not in notes
+
+
+def test_watch_reads_german_with_the_servers_words_as_sent(
+    sim: SimThread, german: None, capsys: pytest.CaptureFixture[str]
+) -> None:
+    world = sim.server.world  # type: ignore[union-attr]
+    sim.call(lambda: world.create_popup("Door open", "Close the door", buttons=("OK", "", "")))
+    where = f"127.0.0.1:{sim.port}"
+    assert main(["watch", where, "--seconds", "0.5", "--timeout", "5"]) == 0
+    out = capsys.readouterr().out
+    assert re.search(r"Meldung geöffnet #\d+ \(\w+\) Door open: Close the door \[OK\]", out), out
+    assert re.search(r"^ +\d+,\d{3}  Modus ", out, re.M), out  # the time with German's decimal comma
+    assert "popup opened" not in out and "mode " not in out, out
+    assert main(["watch", where, "--seconds", "0.5", "--timeout", "5", "--json"]) == 0
+    events = [json.loads(line) for line in capsys.readouterr().out.splitlines()]
+    assert {"popup_opened", "mode"} <= {e["event"] for e in events}
+
+
+def test_sim_says_where_it_listens_in_german_at_a_terminal_and_in_english_to_a_program() -> None:
+    """At a terminal (a pty) a person reads the start line in their language; through a pipe a program
+    reads the English it parses (the port of --port 0), whatever the language."""
+    import os
+    import pty
+    import signal
+    import subprocess
+    import sys
+
+    env = {**os.environ, "LANGUAGE": "de", "PYTHONUNBUFFERED": "1"}
+    argv = [sys.executable, "-m", "rtmu", "sim", "--port", "0", "--no-camera", "--no-map"]
+    main_end, tty_end = pty.openpty()
+    proc = subprocess.Popen(argv, stdin=subprocess.DEVNULL, stdout=tty_end, stderr=tty_end, env=env)
+    os.close(tty_end)
+    said = b""
+    try:
+        while b"\n" not in said:
+            chunk = os.read(main_end, 4096)  # blocks until the simulator writes (or ends: EOF / EIO)
+            assert chunk, said
+            said += chunk
+        proc.send_signal(signal.SIGINT)
+        proc.wait(timeout=60)
+        with contextlib.suppress(OSError):  # the pty's last words, then EIO once the process is gone
+            while chunk := os.read(main_end, 4096):
+                said += chunk
+    finally:
+        if proc.poll() is None:
+            proc.kill()
+            proc.wait(timeout=30)
+        os.close(main_end)
+    text = said.decode()
+    assert re.search(
+        r"rtmu sim: ARIA-Roboterserver lauscht auf 127\.0\.0\.1:\d+ und bietet keine Karte; ", text
+    ), text
+    assert "; keine Kamera; Dateien in " in text, text
+    assert "rtmu sim: wird beendet (Clients erhalten SHUTDOWN)" in text, text
+    piped = subprocess.Popen(argv, stdin=subprocess.DEVNULL, stdout=subprocess.PIPE, text=True, env=env)
+    try:
+        assert piped.stdout is not None
+        line = piped.stdout.readline()
+        assert re.search(r"ARIA robot server listening on 127\.0\.0\.1:\d+, serving no map; ", line), line
+    finally:
+        piped.send_signal(signal.SIGINT)
+        piped.wait(timeout=60)

@@ -9,10 +9,12 @@ line. ``--json`` (``decode.py``) never comes here and stays English.
 from __future__ import annotations
 
 from collections import deque
-from collections.abc import Iterable
+from collections.abc import Callable, Iterable
 from typing import TYPE_CHECKING, Any, TextIO
 
+from ..base.i18n import N_, _, ngettext, number
 from ..base.textsafe import visible
+from ..base.units import quantity
 from ..capture.conversation import (
     C2S,
     S2C,
@@ -46,18 +48,51 @@ LINK_NAMES = {
     229: "raw IPv6",
     276: "Linux cooked v2",
 }
-DROP_WORDS = {
-    "garbage_bytes": ("garbage byte", "garbage bytes"),
-    "bad_length": ("bad length field", "bad length fields"),
-    "bad_checksum": ("bad checksum", "bad checksums"),
-    "truncated_at_close": ("packet cut off at the end", "packets cut off at the end"),
-    "capture_gap_bytes": ("byte missing from the capture", "bytes missing from the capture"),
+DROP_WORDS: dict[str, Callable[[int], str]] = {
+    "garbage_bytes": lambda n: ngettext("{count} garbage byte", "{count} garbage bytes", n),
+    "bad_length": lambda n: ngettext("{count} bad length field", "{count} bad length fields", n),
+    "bad_checksum": lambda n: ngettext("{count} bad checksum", "{count} bad checksums", n),
+    "truncated_at_close": lambda n: ngettext(
+        "{count} packet cut off at the end", "{count} packets cut off at the end", n
+    ),
+    "capture_gap_bytes": lambda n: ngettext(
+        "{count} byte missing from the capture", "{count} bytes missing from the capture", n
+    ),
 }
+"""Each drop count's words (its key is the --json field), in the operator's language and plural."""
+CAPTURE_NOTES: tuple[Callable[[int], str], ...] = (
+    lambda n: ngettext("note: {count} frame was not TCP/UDP over IP (skipped)",
+                       "note: {count} frames were not TCP/UDP over IP (skipped)", n),
+    lambda n: ngettext("note: {count} IP fragment (not reassembled, skipped)",
+                       "note: {count} IP fragments (not reassembled, skipped)", n),
+    lambda n: ngettext("note: {count} frame cut by the snap length",
+                       "note: {count} frames cut by the snap length", n),
+    lambda n: ngettext("note: {count} TCP byte retransmitted (counted once)",
+                       "note: {count} TCP bytes retransmitted (counted once)", n),
+    lambda n: ngettext("note: {count} TCP segment arrived out of order (reordered)",
+                       "note: {count} TCP segments arrived out of order (reordered)", n),
+    lambda n: ngettext("note: {count} hole in TCP streams (bytes never captured)",
+                       "note: {count} holes in TCP streams (bytes never captured)", n),
+    lambda n: ngettext("note: {count} TCP connection carried no ArNetworking packet (ignored)",
+                       "note: {count} TCP connections carried no ArNetworking packet (ignored)", n),
+    lambda n: ngettext("note: {count} UDP datagram was not ArNetworking (ignored)",
+                       "note: {count} UDP datagrams were not ArNetworking (ignored)", n),
+)  # fmt: skip
+"""The summary's notes on the capture, in the order ``write_text_summary`` counts them."""
+NOTES = (
+    N_("checksum mismatch: dropped by the receiver"),
+    N_("end of reply"),
+    N_("empty"),
+    N_("unknown data number"),
+)
+"""The notes the capture decoder puts on a packet (English in --json), marked: the text says them
+translated."""
 
 
 def _drops_text(counts: dict[str, int]) -> str:
-    words = (DROP_WORDS.get(k, (k, k)) for k in counts)
-    return ", ".join(f"{n} {w[0] if n == 1 else w[1]}" for n, w in zip(counts.values(), words, strict=True))
+    return ", ".join(
+        DROP_WORDS[k](n).format(count=n) if k in DROP_WORDS else f"{n} {k}" for k, n in counts.items()
+    )
 
 
 def relative(time: float | None, source: CaptureSource) -> float | None:
@@ -118,12 +153,14 @@ class _TextWriter:
             start = relative(self.run_first_time, self.source)
             end = relative(last.time, self.source)
             if start is not None and end is not None:
-                span = f" over {end - start:.3f} s"
-            label = last.name or f"command {last.command}"
-            self._emit(
-                f"{'':>10} {last.conn:>3} {last.direction} {last.transport:<6}"
-                f" … {self.hidden} more {label} packets{span} (--all shows them) …"
-            )
+                span = " " + _("over {duration}").format(duration=quantity(end - start, "s", 3))
+            label = last.name or _("command {number}").format(number=last.command)
+            more = ngettext(
+                "… {count} more {label} packet{span} (--all shows it) …",
+                "… {count} more {label} packets{span} (--all shows them) …",
+                self.hidden,
+            ).format(count=self.hidden, label=label, span=span)
+            self._emit(f"{'':>10} {last.conn:>3} {last.direction} {last.transport:<6} {more}")
         for packet in self.tail:
             self._emit(self._packet_line(packet))
         self.tail.clear()
@@ -150,22 +187,20 @@ class _TextWriter:
         return f"{rel:>10.6f}" if rel is not None else f"{'-':>10}"
 
     def _drop_line(self, drop: DropReport) -> str:
-        what = _drops_text(drop.counts)
-        return (
-            f"{self._time(drop.time)} {drop.conn:>3} {drop.direction} {drop.transport:<6} !! dropped: {what}"
-        )
+        what = _("!! dropped: {what}").format(what=_drops_text(drop.counts))
+        return f"{self._time(drop.time)} {drop.conn:>3} {drop.direction} {drop.transport:<6} {what}"
 
     def _packet_line(self, p: DecodedPacket) -> str:
-        name = p.name if p.name else ("?" if p.is_data else "(unknown control)")
+        name = p.name if p.name else ("?" if p.is_data else _("(unknown control)"))
         where = f"{self._time(p.time)} {p.conn:>3} {p.direction} {p.transport:<6}"
         head = f"{where} {p.command:>5} {name:<22} {p.length:>5}"
         parts: list[str] = []
         if not p.checksum_ok:
-            parts.append("BAD CHECKSUM")
+            parts.append(_("BAD CHECKSUM"))
         if p.fields:
             parts.append(format_fields(p.fields, self.full))
         if p.note:
-            parts.append(f"({p.note})")
+            parts.append(f"({_(p.note)})")
         if p.error:
             parts.append(f"!! {p.error}")
         if p.payload and (
@@ -181,10 +216,10 @@ def write_text(
     writer = _TextWriter(out, source, full, payload)
     kind = source.kind
     out.write(f"# {visible(source.path.name)}: {kind}{_link(source)}\n")
-    out.write(
-        f"# {'time':>8} {'conn':>3} dir transport cmd name{' ' * 21}length  "
-        "fields (checksum ok unless marked)\n"
-    )
+    # TRANSLATORS: the column heads of rtmu decode's packet lines (each over its column; keep them short).
+    time, name, length = _("time"), _("name"), _("length")
+    fields = _("fields (checksum ok unless marked)")
+    out.write(f"# {time:>8} {'conn':>3} dir transport cmd {name:<22} {length:>5}  {fields}\n")
     for item in items:
         writer.item(item)
     writer.finish()
@@ -194,12 +229,17 @@ def _link(source: CaptureSource) -> str:
     lt = source.stats.link_type
     if lt is None:
         return ""
-    return f", link type {lt} ({LINK_NAMES.get(lt, 'unsupported')})"
+    return ", " + _("link type {number} ({name})").format(
+        number=lt, name=LINK_NAMES.get(lt) or _("unsupported")
+    )
 
 
 def _preview(payload: bytes, full: bool) -> str:
     shown = payload if full else payload[:PREVIEW_BYTES]
-    more = "" if len(shown) == len(payload) else f" …(+{len(payload) - len(shown)} bytes)"
+    hidden = len(payload) - len(shown)
+    more = (
+        " " + ngettext("…(+{count} byte)", "…(+{count} bytes)", hidden).format(count=hidden) if hidden else ""
+    )
     text = "".join(chr(b) if 32 <= b < 127 else "." for b in shown)
     return f"[{shown.hex(' ')}{more}] |{text}|"
 
@@ -213,7 +253,9 @@ def format_fields(fields: dict[str, Any], full: bool = False) -> str:
         text = ", ".join(_entry(e, full) for e in shown)
         if len(shown) < len(entries):
             text += f", … +{len(entries) - len(shown)}"
-        return (format_fields(rest, full) + " " if rest else "") + f"entries: {text}"
+        return (format_fields(rest, full) + " " if rest else "") + _("entries: {entries}").format(
+            entries=text
+        )
     return " ".join(f"{k}={_value(v, full)}" for k, v in fields.items())
 
 
@@ -252,49 +294,58 @@ def _value(value: Any, full: bool) -> str:
 
 def write_text_summary(out: TextIO, decoder: CaptureDecoder, source: CaptureSource, *, full: bool) -> None:
     stats = source.stats
-    lines = ["", "== summary"]
-    span = ""
-    if stats.first_time is not None and stats.last_time is not None:
-        span = f", {stats.last_time - stats.first_time:.3f} s"
+    lines = ["", _("== summary")]
     if stats.kind in ("pcap", "pcapng"):
-        lines.append(f"capture: {stats.frames} frames{span}")
+        frames = ngettext("capture: {count} frame", "capture: {count} frames", stats.frames)
+        frames = frames.format(count=stats.frames)
+        if stats.first_time is not None and stats.last_time is not None:
+            frames += ", " + quantity(stats.last_time - stats.first_time, "s", 3)
+        lines.append(frames)
     if not decoder.sessions:
-        lines.append("no ArNetworking packets found")
+        lines.append(_("no ArNetworking packets found"))
     for session in decoder.sessions:
         lines.extend(_session_lines(session, source, full))
-    notes = [
-        (stats.not_ip, "frames were not TCP/UDP over IP (skipped)"),
-        (stats.ip_fragments, "IP fragments (not reassembled, skipped)"),
-        (stats.truncated_frames, "frames cut by the snap length"),
-        (stats.retransmitted_bytes, "TCP bytes retransmitted (counted once)"),
-        (stats.out_of_order_segments, "TCP segments arrived out of order (reordered)"),
-        (stats.tcp_gaps, "holes in TCP streams (bytes never captured)"),
-        (decoder.ignored_tcp_flows, "TCP connections carried no ArNetworking packet (ignored)"),
-        (decoder.ignored_datagrams, "UDP datagrams were not ArNetworking (ignored)"),
-    ]
-    lines.extend(f"note: {n} {text}" for n, text in notes if n)
+    counts = (
+        stats.not_ip, stats.ip_fragments, stats.truncated_frames, stats.retransmitted_bytes,
+        stats.out_of_order_segments, stats.tcp_gaps, decoder.ignored_tcp_flows, decoder.ignored_datagrams,
+    )  # fmt: skip
+    lines.extend(say(n).format(count=n) for n, say in zip(counts, CAPTURE_NOTES, strict=True) if n)
     out.write("\n".join(visible(line) for line in lines) + "\n")
 
 
 def _session_lines(session: Conversation, source: CaptureSource, full: bool) -> list[str]:
     start = relative(session.first_time, source)
     end = relative(session.last_time, source)
-    when = f"  {start:.3f}–{end:.3f} s" if start is not None and end is not None else ""
+    when = ""
+    if start is not None and end is not None:
+        when = "  " + _("{start}–{end} s").format(start=number(start, 3), end=number(end, 3))
     if session.transport == "stream":
-        who = f"bytes sent by the {'server' if session.server == session.ends[0] else 'client'}"
+        by_server = session.server == session.ends[0]
+        who = _("bytes sent by the server") if by_server else _("bytes sent by the client")
         if session.server_guessed:
-            who += " (guessed; use --direction to say)"
+            who += " " + _("(guessed; use --direction to say)")
     else:
-        guess = " (guessed)" if session.server_guessed else ""
-        who = f"client {session.client}  server {session.server}{guess}"
-    lines = [f"conn {session.id}: {session.transport} {who}{when}"]
+        who = (
+            _("client {client}  server {server} (guessed)")
+            if session.server_guessed
+            else _("client {client}  server {server}")
+        )
+        who = who.format(client=session.client, server=session.server)
+    head = _("conn {number}: {transport} {who}{when}")
+    lines = [head.format(number=session.id, transport=session.transport, who=who, when=when)]
     if session.udp_datagrams and session.transport != "udp":
-        flows = sorted({" ↔ ".join(sorted((str(a), str(b)))) for a, b in session.udp_flows})
-        lines.append(f"  + {session.udp_datagrams} UDP datagrams ({'; '.join(flows)})")
+        flows = "; ".join(sorted({" ↔ ".join(sorted((str(a), str(b)))) for a, b in session.udp_flows}))
+        udp = ngettext(
+            "  + {count} UDP datagram ({flows})", "  + {count} UDP datagrams ({flows})", session.udp_datagrams
+        )
+        lines.append(udp.format(count=session.udp_datagrams, flows=flows))
     if session.rejected:
-        lines.append(f"  rejected: {session.rejected}")
+        lines.append(_("  rejected: {reason}").format(reason=_(session.rejected)))
     if session.datalist.have_list:
-        lines.append(f"  data list: {len(session.datalist)} names")
+        count = len(session.datalist)
+        lines.append(
+            ngettext("  data list: {count} name", "  data list: {count} names", count).format(count=count)
+        )
     for direction in (C2S, S2C):
         totals = session.totals[direction]
         if not totals.packets and not totals.drops:
@@ -303,10 +354,19 @@ def _session_lines(session: Conversation, source: CaptureSource, full: bool) -> 
         shown = names if full else names[:10]
         text = ", ".join(f"{n} ×{c}" for n, c in shown)
         if len(shown) < len(names):
-            text += f", … +{len(names) - len(shown)} names"
-        lines.append(f"  {direction} {totals.packets} packets, {totals.bytes} bytes: {text}")
+            hidden = len(names) - len(shown)
+            text += ", " + ngettext("… +{count} name", "… +{count} names", hidden).format(count=hidden)
+        packets = ngettext("{count} packet", "{count} packets", totals.packets).format(count=totals.packets)
+        size = ngettext("{count} byte", "{count} bytes", totals.bytes).format(count=totals.bytes)
+        lines.append(f"  {direction} {packets}, {size}: {text}")
     drops = [f"{d} " + _drops_text(session.totals[d].drops) for d in (C2S, S2C) if session.totals[d].drops]
-    lines.append("  dropped: " + ("; ".join(drops) if drops else "nothing"))
+    lines.append(_("  dropped: {what}").format(what="; ".join(drops) if drops else _("nothing")))
     if session.held_overflow:
-        lines.append(f"  ({session.held_overflow} bad packets before the first good one were not shown)")
+        held = session.held_overflow
+        held_words = ngettext(
+            "  ({count} bad packet before the first good one was not shown)",
+            "  ({count} bad packets before the first good one were not shown)",
+            held,
+        )
+        lines.append(held_words.format(count=held))
     return lines

@@ -18,7 +18,7 @@ from collections.abc import Iterable
 from typing import TYPE_CHECKING, Any, TextIO
 
 from ..base.exit_codes import EXIT_BAD_FILE, EXIT_OK, EXIT_SIGPIPE, EXIT_USAGE
-from ..base.i18n import _
+from ..base.i18n import N_, _
 from ..base.textsafe import json_safe, visible
 from ..capture import CaptureError, CaptureSource, UnreadableInput, open_capture
 from ..capture.conversation import (
@@ -35,7 +35,7 @@ if TYPE_CHECKING:
     from ..capture import CaptureSource
 
 EXITS = (EXIT_OK, EXIT_USAGE, EXIT_BAD_FILE, EXIT_SIGPIPE)
-_DESCRIPTION = """\
+_DESCRIPTION = N_("""\
 Show every ArNetworking packet of a capture: which end sent it, its command and
 name (control commands by direction, data names from that connection's own
 LIST), length, checksum, decoded fields, and what a receiver would drop.
@@ -43,9 +43,9 @@ LIST), length, checksum, decoded fields, and what a receiver would drop.
 Inputs: pcap or pcapng (TCP reassembled on any port, UDP datagrams attributed
 to their connection), an RTMU recording (FILE.mcap from the window or rtmu
 record: its raw channel, every connection in it), a hex dump (xxd, hexdump, od, tshark, plain hex) or raw
-bytes (one stream; --direction says who sent it when the packets do not)."""
+bytes (one stream; --direction says who sent it when the packets do not).""")
 
-_EPILOG = """\
+_EPILOG = N_("""\
 text output folds runs of one packet kind to their first 3 and last 2 lines;
 --all prints everything. --json prints one object per packet and line:
   conn dir transport time command name length checksum_ok fields
@@ -61,7 +61,7 @@ examples:
   rtmu decode ~/.local/share/rtmu/recordings/20261125T041500Z_lab_7272.mcap
   rtmu decode --json session.pcap | jq 'select(.name == "ratioDrive") | .fields'
   rtmu decode --name getMapBinary --all session.pcap
-  xxd bytes.bin > dump.txt && rtmu decode --direction c2s dump.txt"""
+  xxd bytes.bin > dump.txt && rtmu decode --direction c2s dump.txt""")
 
 
 def register(subparsers: argparse._SubParsersAction) -> None:
@@ -69,8 +69,8 @@ def register(subparsers: argparse._SubParsersAction) -> None:
     parser = subparsers.add_parser(
         "decode",
         help=_("decode ArNetworking traffic from a pcap/pcapng capture, a hex dump or raw bytes"),
-        description=_DESCRIPTION,
-        epilog=_EPILOG,
+        description=_(_DESCRIPTION),
+        epilog=_(_EPILOG),
         formatter_class=argparse.RawDescriptionHelpFormatter,
     )
     parser.add_argument(

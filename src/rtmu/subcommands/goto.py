@@ -23,7 +23,7 @@ from ._navigate import NAVIGATION_EXITS, Expect, add_wait_arguments, navigate, r
 if TYPE_CHECKING:
     from ..client.connection import AriaClient
 
-RULE = (
+RULE = N_(
     "GOAL goes as ARNL's gotoGoal wherever the server lists it, and the command follows the robot to "
     "the end; a server with gotoRouteGoal but no gotoGoal (Omron LD robots), or --route, gets "
     "gotoRouteGoal instead and the command ends once it is sent. --x/--y go as gotoPose. The goal "
@@ -38,7 +38,7 @@ def register(subparsers: Any) -> None:
     p = subparsers.add_parser(
         "goto",
         help=_("drive to a goal of the map or to a point (gotoGoal / gotoPose; LD robots: gotoRouteGoal)"),
-        description=f"{RULE} Ctrl-C, SIGTERM and SIGHUP stop the robot.",
+        description=_(RULE) + " " + _("Ctrl-C, SIGTERM and SIGHUP stop the robot."),
     )
     add_connection_arguments(p)
     p.add_argument("goal", metavar="GOAL", nargs="?", help=_("goal name, as the map names it"))

@@ -22,9 +22,11 @@ def register(subparsers: Any) -> None:
     p = subparsers.add_parser(
         "localize",
         help=_("tell the robot where it is on the map (localizeToPose), and wait until it is localized"),
-        description="Send localizeToPose X Y TH; where the server offers getLocState, wait until it says "
-        "localized (exit 0; also when it was only sent, where getLocState is not offered) or lost "
-        f"(exit {EXIT_NAV_LOST}). It never moves the robot.",
+        description=_(
+            "Send localizeToPose X Y TH; where the server offers getLocState, wait until it says "
+            "localized (exit 0; also when it was only sent, where getLocState is not offered) or lost "
+            "(exit {code}). It never moves the robot."
+        ).format(code=EXIT_NAV_LOST),
     )
     add_connection_arguments(p)
     p.add_argument("x", type=float, metavar="X", help=_("mm on the map"))
