@@ -6,7 +6,6 @@ the same runs with ``--json`` give the English sentences and plain numbers a scr
 
 from __future__ import annotations
 
-import contextlib
 import json
 import re
 from collections.abc import Iterator
@@ -191,7 +190,9 @@ def test_sim_says_where_it_listens_in_german_at_a_terminal_and_in_english_to_a_p
     reads the English it parses (the port of --port 0), whatever the language."""
     import os
     import pty
+    import select
     import signal
+    import socket
     import subprocess
     import sys
 
@@ -201,16 +202,27 @@ def test_sim_says_where_it_listens_in_german_at_a_terminal_and_in_english_to_a_p
     proc = subprocess.Popen(argv, stdin=subprocess.DEVNULL, stdout=tty_end, stderr=tty_end, env=env)
     os.close(tty_end)
     said = b""
-    try:
-        while b"\n" not in said:
-            chunk = os.read(main_end, 4096)  # blocks until the simulator writes (or ends: EOF / EIO)
+
+    def read_until(wanted: bytes) -> None:
+        nonlocal said
+        while wanted not in said:
+            ready, _, _ = select.select([main_end], [], [], 60)
+            assert ready, said  # nothing for a minute
+            try:
+                chunk = os.read(main_end, 4096)
+            except OSError:  # EIO: every writer is gone
+                chunk = b""
             assert chunk, said
             said += chunk
+
+    try:
+        read_until(b"\n")
+        port = int(re.search(rb"127\.0\.0\.1:(\d+)", said).group(1))  # type: ignore[union-attr]
+        with socket.create_connection(("127.0.0.1", port), timeout=30) as client:
+            assert client.recv(64)  # its introduction: it serves, its signal handlers are in place
         proc.send_signal(signal.SIGINT)
+        read_until(b"SHUTDOWN")
         proc.wait(timeout=60)
-        with contextlib.suppress(OSError):  # the pty's last words, then EIO once the process is gone
-            while chunk := os.read(main_end, 4096):
-                said += chunk
     finally:
         if proc.poll() is None:
             proc.kill()
@@ -230,3 +242,18 @@ def test_sim_says_where_it_listens_in_german_at_a_terminal_and_in_english_to_a_p
     finally:
         piped.send_signal(signal.SIGINT)
         piped.wait(timeout=60)
+
+
+def test_the_guardians_refusal_reaches_the_operator_in_german(
+    german: None, capsys: pytest.CaptureFixture[str]
+) -> None:
+    """The guardian is a process of its own: it speaks the language chosen here (``child_environment``),
+    its refusal and the server's own words inside RTMU's German warning."""
+    with SimThread(SimConfig(port=0, seed=1, max_clients=1)) as sim:  # the drive's own login takes the slot
+        argv = ["drive", f"127.0.0.1:{sim.port}", "--trans", "50", "--seconds", "0.3", "--timeout", "5"]
+        assert main(argv) == 0
+    err = capsys.readouterr().err
+    assert (
+        "rtmu drive: Warnung: Wächter nicht verfügbar (Anmeldung abgelehnt: am Server sind zu viele " in err
+    )
+    assert "angemeldet: Server rejecting connection since it would exceed the maximum number" in err, err

@@ -16,6 +16,7 @@ from __future__ import annotations
 import contextlib
 import gettext
 import locale
+import os
 import re
 from collections.abc import Sequence
 from pathlib import Path
@@ -24,17 +25,38 @@ from rtmu.package_data import LOCALE_DIR
 
 DOMAIN = "rtmu"
 
+LOCALE_DIR_VARIABLE = "RTMU_LOCALE_DIR"
+"""Where to read the catalogues instead of the package (set by :func:`child_environment` for the
+processes RTMU starts when this one reads other catalogues: the tests' pseudo-locale)."""
+
 _active: list[gettext.NullTranslations] = []
+_chosen: list[tuple[tuple[str, ...], Path | None]] = []
 
 
 def use(languages: Sequence[str] | None = None, localedir: Path | None = None) -> gettext.NullTranslations:
     """Choose the catalogue every later ``_()`` reads: ``languages`` in order of preference (``None``:
-    the environment's), from ``localedir`` (the package's by default; tests give the pseudo-locale's)."""
+    the environment's), from ``localedir`` (``$RTMU_LOCALE_DIR``, else the package's; tests give the
+    pseudo-locale's)."""
+    folder = localedir or Path(os.environ.get(LOCALE_DIR_VARIABLE) or LOCALE_DIR)
     translation = gettext.translation(
-        DOMAIN, str(localedir or LOCALE_DIR), languages=list(languages) if languages else None, fallback=True
+        DOMAIN, str(folder), languages=list(languages) if languages else None, fallback=True
     )
     _active[:] = [translation]
+    _chosen[:] = [(tuple(languages), localedir)] if languages else []
     return translation
+
+
+def child_environment() -> dict[str, str]:
+    """What a process RTMU starts (the guardian) needs in its environment to speak the language this
+    one speaks: ``LANGUAGE`` (and where the catalogues are) when the language was chosen here rather
+    than by the environment — a child inherits the environment, not a choice made in this process."""
+    if not _chosen:
+        return {}
+    languages, localedir = _chosen[0]
+    env = {"LANGUAGE": ":".join(languages)}
+    if localedir is not None:
+        env[LOCALE_DIR_VARIABLE] = str(localedir)
+    return env
 
 
 def _translation() -> gettext.NullTranslations:

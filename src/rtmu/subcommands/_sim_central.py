@@ -9,7 +9,7 @@ from typing import TYPE_CHECKING
 from ..base.exit_codes import EXIT_CONNECTION, EXIT_USAGE
 from ..base.i18n import N_, Said, _, ngettext
 from ._common import until_stop_signal
-from .sim import start_line
+from ._sim_lines import start_line
 
 if TYPE_CHECKING:
     from ..sim import SimConfig

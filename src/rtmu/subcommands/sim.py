@@ -15,10 +15,10 @@ from pathlib import Path
 
 from ..base.exit_codes import ENDED, EXIT_CONNECTION, EXIT_OK, EXIT_SIGINT, EXIT_USAGE
 from ..base.i18n import N_, Said, _
-from ..base.units import Quantity
 from ..package_data import project_map
 from ._common import until_stop_signal
 from ._options import number_in
+from ._sim_lines import joined, plain, start_line
 
 EXIT_BAD_INPUT = EXIT_USAGE
 EXIT_CANNOT_LISTEN = EXIT_CONNECTION
@@ -227,24 +227,6 @@ def register(subparsers: argparse._SubParsersAction) -> None:
         help=_("line segments in the generated map (default 5000)"),
     )
     p.set_defaults(handler=run)
-
-
-def start_line(said: Said) -> str:
-    """A line that says where the simulator listens: read by programs when stdout is a pipe or a file
-    (the port of ``--port 0``), so then its English, the same in every language; at a terminal a person
-    reads it, in their language."""
-    return said.words() if sys.stdout.isatty() else str(said)
-
-
-def plain(value: float) -> Quantity:
-    """A whole number in a start line: as it is for programs, the language's digits for people."""
-    return Quantity(round(value), "")
-
-
-def joined(parts: list[Said]) -> Said:
-    """``; a; b`` of ``parts``, each said in the operator's language where the line is."""
-    template = "".join(f"; {{part{i}}}" for i in range(len(parts)))
-    return Said(template, **{f"part{i}": part for i, part in enumerate(parts)})
 
 
 def _size(text: str) -> tuple[int, int]:
