@@ -257,3 +257,13 @@ def test_the_guardians_refusal_reaches_the_operator_in_german(
         "rtmu drive: Warnung: Wächter nicht verfügbar (Anmeldung abgelehnt: am Server sind zu viele " in err
     )
     assert "angemeldet: Server rejecting connection since it would exceed the maximum number" in err, err
+
+
+def test_a_missing_password_file_is_said_in_german(
+    sim: SimThread, german: None, tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    where = f"127.0.0.1:{sim.port}"
+    argv = ["status", where, "--user", "teleop", "--password-file", str(tmp_path / "nope"), "--once"]
+    assert main(argv) != 0
+    err = capsys.readouterr().err
+    assert "die mit --password-file angegebene Passwortdatei ist nicht lesbar: keine solche Datei" in err, err

@@ -259,24 +259,31 @@ def _read_password(args: argparse.Namespace) -> str:
         except FileNotFoundError:
             # Not named: what was typed there may be the password itself rather than a file name.
             raise UsageError(
-                "cannot read the password file given with --password-file: no such file "
-                "(its name is not shown, in case a password was typed there)"
+                _(
+                    "cannot read the password file given with --password-file: no such file "
+                    "(its name is not shown, in case a password was typed there)"
+                )
             ) from None
         except OSError as exc:
-            raise UsageError(f"cannot read the password file {path}: {exc.strerror or exc}") from None
+            said = _("cannot read the password file {path}: {error}").format(
+                path=path, error=exc.strerror or exc
+            )
+            raise UsageError(said) from None
         return data.decode("utf-8", "replace").splitlines()[0] if data else ""
     if getattr(args, "password_stdin", False):
         line = sys.stdin.readline() if sys.stdin is not None else ""
         if not line:
-            raise UsageError("--password-stdin: standard input ended without a password line")
+            raise UsageError(_("--password-stdin: standard input ended without a password line"))
         return line.rstrip("\r\n")
     if not args.user:
         return ""
     if sys.stdin is not None and sys.stdin.isatty():
-        return getpass.getpass(f"Password for {args.user}@{args.server[0]}: ")
+        return getpass.getpass(_("Password for {user}@{host}: ").format(user=args.user, host=args.server[0]))
     raise UsageError(
-        f"--user {args.user} needs a password and there is no terminal to ask on: give --password-file "
-        "FILE or --password-stdin (one line on standard input)"
+        _(
+            "--user {user} needs a password and there is no terminal to ask on: give --password-file "
+            "FILE or --password-stdin (one line on standard input)"
+        ).format(user=args.user)
     )
 
 
