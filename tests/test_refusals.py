@@ -2,22 +2,10 @@
 
 from __future__ import annotations
 
-from collections.abc import Iterator
-
 import pytest
 
-from rtmu.base import i18n
 from rtmu.base.refusals import REFUSALS, protocol_refusal, refusal
 from rtmu.protocol.commands import RejectReason, describe_reject
-
-
-@pytest.fixture
-def german() -> Iterator[None]:
-    i18n.use(["de"])
-    try:
-        yield
-    finally:
-        i18n.use(["en"])
 
 
 @pytest.mark.parametrize("reason", [*RejectReason, 9])

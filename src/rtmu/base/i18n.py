@@ -16,6 +16,7 @@ from __future__ import annotations
 import contextlib
 import gettext
 import locale
+import math
 import os
 import re
 from collections.abc import Sequence
@@ -162,6 +163,32 @@ def number(value: float, digits: int = 0) -> str:
         return locale.format_string(f"%.{digits}f", value, grouping=True)
     group, decimal = marks
     return f"{value:,.{digits}f}".translate({ord(","): group, ord("."): decimal})
+
+
+def parse_number(text: str) -> float:
+    """A number a person typed as their language writes numbers (German ``1.234,5``; English
+    ``1,234.5`` or ``1234.5``): its grouping marks dropped, its decimal mark read as the point. A field
+    that shows what :func:`number` wrote reads it back. ValueError when ``text`` is no finite number."""
+    group, decimal = _marks()
+    plain = text.strip().replace("\u2212", "-")  # the minus sign a typographer (or GTK) may use
+    if "_" in plain:
+        raise ValueError(f"not a number: {text!r}")
+    for mark in {group, "\u00a0", "\u202f"} - {"", decimal}:  # the group mark, and spaces used as one
+        plain = plain.replace(mark, "")
+    value = float(plain.replace(decimal, ".") if decimal != "." else plain)
+    if not math.isfinite(value):
+        raise ValueError(f"not a number: {text!r}")
+    return value
+
+
+def _marks() -> tuple[str, str]:
+    """(grouping mark, decimal mark) of the operator's language: the catalogue's, else the C library's."""
+    marks = _catalogue_marks()
+    if marks is not None:
+        return marks
+    _numeric_locale()
+    conventions = locale.localeconv()
+    return str(conventions["thousands_sep"]), str(conventions["decimal_point"]) or "."
 
 
 def _catalogue_marks() -> tuple[str, str] | None:

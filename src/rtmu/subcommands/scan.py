@@ -12,7 +12,7 @@ from pathlib import Path
 from typing import TYPE_CHECKING, Any
 
 from ..base.exit_codes import EXIT_OK, EXIT_REFUSED, EXIT_TIMEOUT, EXIT_USAGE, NETWORK
-from ..base.i18n import _
+from ..base.i18n import _, error_words
 from ..base.textsafe import visible
 from ..client.errors import NotSupported
 from ..client.roles import Role
@@ -63,7 +63,7 @@ def handle(args: argparse.Namespace) -> int:
     try:
         body = {"start": _start, "status": _status, "loop": _loop, "stop": _stop}[args.action](args)
     except (ValueError, LocalFileError) as exc:
-        return fail("scan", str(exc), EXIT_USAGE)
+        return fail("scan", error_words(exc), EXIT_USAGE)
     return run_with_client("scan", args, body, role=Role.OBSERVER)  # a scan logs; the operator drives
 
 
