@@ -14,6 +14,7 @@ from pathlib import Path
 import pytest
 
 from rtmu.base import i18n
+from rtmu.base.exit_codes import EXIT_USAGE
 from rtmu.cli import main
 from rtmu.package_data import project_map
 from rtmu.sim import SimConfig, SimThread
@@ -167,6 +168,9 @@ def test_decode_reads_german_and_its_json_stays_english(
     assert main(["decode", "--json", str(CAPTURES / "map-binary-columbia.pcap")]) == 0
     notes = {json.loads(line).get("note") for line in capsys.readouterr().out.splitlines()}
     assert "end of reply" in notes and "Ende der Antwort" not in notes
+    assert main(["decode", str(CAPTURES / "no-such.pcap")]) == EXIT_USAGE
+    err = capsys.readouterr().err
+    assert err.startswith("rtmu decode: die Datei ist nicht lesbar (cannot read "), err  # reader: English
 
 
 def test_watch_reads_german_with_the_servers_words_as_sent(

@@ -109,11 +109,9 @@ def run(args: argparse.Namespace) -> int:
     try:
         source = open_capture(args.file, args.format, args.direction)
     except UnreadableInput as exc:
-        print(_("rtmu decode: {visible}").format(visible=visible(exc)), file=sys.stderr)
-        return EXIT_USAGE
+        return _failed(_("rtmu decode: the file cannot be read ({detail})"), exc, EXIT_USAGE)
     except CaptureError as exc:
-        print(_("rtmu decode: {visible}").format(visible=visible(exc)), file=sys.stderr)
-        return EXIT_BAD_FILE
+        return _failed(_("rtmu decode: the file cannot be decoded ({detail})"), exc, EXIT_BAD_FILE)
     decoder = CaptureDecoder(report_trailing_drops=args.json)
     summary = args.summary if args.summary is not None else not args.json
     out = sys.stdout
@@ -130,11 +128,9 @@ def run(args: argparse.Namespace) -> int:
                 write_text_summary(out, decoder, source, full=args.all)
         out.flush()
     except UnreadableInput as exc:
-        print(_("rtmu decode: {visible}").format(visible=visible(exc)), file=sys.stderr)
-        return EXIT_USAGE
+        return _failed(_("rtmu decode: the file cannot be read ({detail})"), exc, EXIT_USAGE)
     except CaptureError as exc:
-        print(_("rtmu decode: {visible}").format(visible=visible(exc)), file=sys.stderr)
-        return EXIT_BAD_FILE
+        return _failed(_("rtmu decode: the file cannot be decoded ({detail})"), exc, EXIT_BAD_FILE)
     except BrokenPipeError:  # `rtmu decode x | head`: the reader has seen enough (141, as every command)
         devnull = os.open(os.devnull, os.O_WRONLY)
         os.dup2(devnull, sys.stdout.fileno())
@@ -142,6 +138,12 @@ def run(args: argparse.Namespace) -> int:
     for warning in source.stats.warnings:
         print(_("rtmu decode: warning: {visible}").format(visible=visible(warning)), file=sys.stderr)
     return EXIT_OK
+
+
+def _failed(sentence: str, error: Exception, code: int) -> int:
+    """One line on stderr: RTMU's sentence, the capture reader's own words (English) as its detail."""
+    print(sentence.format(detail=visible(error)), file=sys.stderr)
+    return code
 
 
 def _filtered(items: Iterable[DecodeItem], args: argparse.Namespace) -> Iterable[DecodeItem]:
