@@ -271,3 +271,14 @@ def test_a_missing_password_file_is_said_in_german(
     assert main(argv) != 0
     err = capsys.readouterr().err
     assert "die mit --password-file angegebene Passwortdatei ist nicht lesbar: keine solche Datei" in err, err
+
+
+def test_an_unknown_goal_and_a_wrong_usage_are_said_in_german(
+    sim: SimThread, german: None, capsys: pytest.CaptureFixture[str]
+) -> None:
+    where = f"127.0.0.1:{sim.port}"
+    assert main(["goto", where, "Nowhere", "--timeout", "5"]) == EXIT_USAGE
+    err = capsys.readouterr().err
+    assert "rtmu goto: kein Ziel 'Nowhere' auf diesem Server (Ziele: " in err and "Room 101" in err, err
+    assert main(["goto", where, "Lab B", "--x", "1", "--y", "2", "--timeout", "5"]) == EXIT_USAGE
+    assert "entweder ZIEL oder --x/--y angeben, nicht beides" in capsys.readouterr().err

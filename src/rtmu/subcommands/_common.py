@@ -570,11 +570,18 @@ def known_name(command: str, kind: str, name: str, known: tuple[str, ...]) -> st
         return folded[0]
     from ..base.textsafe import visible
 
-    listed = visible(", ".join(known) or "none")
+    listed = visible(", ".join(known)) if known else _("none")
     print(
-        _("rtmu {command}: no {kind} {visible} on this server ({kind}s: {listed})").format(
-            command=command, kind=kind, visible=visible(repr(name)), listed=listed
-        ),
+        _(UNKNOWN_NAME[kind]).format(command=command, visible=visible(repr(name)), listed=listed),
         file=sys.stderr,
     )
     return None
+
+
+UNKNOWN_NAME = {
+    "goal": N_("rtmu {command}: no goal {visible} on this server (goals: {listed})"),
+    "route": N_("rtmu {command}: no route {visible} on this server (routes: {listed})"),
+    "command": N_("rtmu {command}: no command {visible} on this server (commands: {listed})"),
+}
+"""What :func:`known_name` says for each kind of name (marked: a whole sentence per kind, so each language
+can say it with its own words and grammar)."""

@@ -53,11 +53,11 @@ def register(subparsers: Any) -> None:
 def check(args: argparse.Namespace) -> None:
     point = args.x is not None or args.y is not None or args.th is not None
     if args.goal is not None and point:
-        raise UsageError("give either GOAL or --x/--y, not both")
+        raise UsageError(_("give either GOAL or --x/--y, not both"))
     if args.goal is None and (args.x is None or args.y is None):
-        raise UsageError("give a GOAL, or a point with --x MM --y MM [--th DEG]")
+        raise UsageError(_("give a GOAL, or a point with --x MM --y MM [--th DEG]"))
     if point and args.route:
-        raise UsageError("--route takes a GOAL, not a point")
+        raise UsageError(_("--route takes a GOAL, not a point"))
 
 
 def handle(args: argparse.Namespace) -> int:

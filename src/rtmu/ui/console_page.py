@@ -75,9 +75,9 @@ def entry_details(entry: ConsoleEntry) -> str:
                 visible2=visible(short(d.command_group, 60)),
             ),
             visible(short(d.description, 600)) or _("(no description)"),
-            _("Arguments: {value}").format(value=visible(short(d.argument_description, 300)) or "none"),
+            _("Arguments: {value}").format(value=visible(short(d.argument_description, 300)) or _("none")),
             _("  read as: {visible}").format(visible=visible(short(describe(entry.arguments), 300))),
-            _("Returns: {value}").format(value=visible(short(d.return_description, 300)) or "none"),
+            _("Returns: {value}").format(value=visible(short(d.return_description, 300)) or _("none")),
             _("Flags: {visible}").format(visible=visible(short(d.flags, 120))),
             _("Effect: {visible}").format(visible=visible(short(effect_words(entry), 200))),
         )
