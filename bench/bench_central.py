@@ -20,6 +20,7 @@ import time
 
 from rtmu.client.central import list_robots
 from rtmu.client.connection import AriaClient
+from rtmu.values.target import Target
 
 from .common import Result, end_process
 
@@ -32,7 +33,7 @@ async def _latencies(*ports: int) -> list[list[float]]:
     (so a burst of load on the shared machine falls on both alike)."""
     clients = [AriaClient() for _ in ports]
     for client, port in zip(clients, ports, strict=True):
-        await client.connect("127.0.0.1", port, timeout=10)
+        await client.connect(Target("127.0.0.1", port), timeout=10)
     try:
         out: list[list[float]] = [[] for _ in ports]
         for i in range(WARMUP + SAMPLES):

@@ -22,6 +22,7 @@ from rtmu.client.config_feed import assemble, fetch_config
 from rtmu.client.connection import AriaClient
 from rtmu.protocol.payloads.config import ConfigRequest, ConfigSectionPacket, Priority
 from rtmu.sim import SimConfig, SimServer, SimThread
+from rtmu.values.target import Target
 
 FILLER = 10_000
 
@@ -42,7 +43,7 @@ def _fetch_ms(filler: int, rounds: int = 5) -> float:
         async def once() -> float:
             client = AriaClient()
             started = time.perf_counter()
-            await client.connect("127.0.0.1", sim.port, timeout=10)
+            await client.connect(Target("127.0.0.1", sim.port), timeout=10)
             try:
                 config = await fetch_config(client, 30)
                 assert config.param_count == filler + 15  # the simulator's own 14 and a hostile name

@@ -56,6 +56,7 @@ from rtmu.guardian.handle import GuardianHandle
 from rtmu.guardian.messages import Hello
 from rtmu.sim import SimConfig, SimThread
 from rtmu.sim.central_listing import ListingCentralThread
+from rtmu.values.target import Target
 
 REPO = Path(__file__).resolve().parents[1]
 sys.path.insert(0, str(REPO / "tests"))
@@ -243,7 +244,7 @@ def arming_results() -> list[Result]:
         handle = GuardianHandle.start()
         try:
             for serial in range(1, 2 * ARMINGS + 1):
-                robot = Hello("127.0.0.1", (to_a if serial % 2 else to_b).port)  # the two in turn
+                robot = Hello(Target("127.0.0.1", (to_a if serial % 2 else to_b).port))  # the two in turn
                 if serial <= ARMINGS:  # a new login each time: its kept login is let go of first (COLD)
                     handle.cool(robot)
                     cold.append(_armed_ms(handle, replace(robot, serial=serial)))

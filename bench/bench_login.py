@@ -21,6 +21,7 @@ from rtmu.client.connection import AriaClient
 from rtmu.protocol.datalist import DataList
 from rtmu.protocol.server_connection import ServerConnection
 from rtmu.sim.catalogue import build_catalogue
+from rtmu.values.target import Target
 
 NAMES = 1000
 LOGINS = 15
@@ -69,7 +70,7 @@ async def _login_ms(datalist: DataList) -> tuple[float, int]:
         for _ in range(LOGINS):
             client = AriaClient()
             start = time.perf_counter()
-            got = await client.connect("127.0.0.1", port, timeout=10)
+            got = await client.connect(Target("127.0.0.1", port), timeout=10)
             times.append((time.perf_counter() - start) * 1000)
             names = len(got)
             await client.disconnect()

@@ -39,6 +39,7 @@ from rtmu.mapedit import MapDraft
 from rtmu.mapfile import write_map
 from rtmu.sim import SimConfig, SimThread
 from rtmu.sim.mapgen import generate_map
+from rtmu.values.target import Target
 
 REPEAT = 3
 TIMEOUT = 60.0
@@ -46,7 +47,7 @@ TIMEOUT = 60.0
 
 async def _measure(port: int) -> tuple[list[float], list[float], list[float]]:
     client = AriaClient()
-    await client.connect("127.0.0.1", port, timeout=TIMEOUT)
+    await client.connect(Target("127.0.0.1", port), timeout=TIMEOUT)
     try:
         downloads: list[float] = []
         for _ in range(REPEAT):

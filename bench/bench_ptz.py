@@ -28,6 +28,7 @@ from rtmu.package_data import project_map
 from rtmu.protocol.payloads.strings import StringItem, Strings, StringsInfo
 from rtmu.sim import SimConfig, SimThread
 from rtmu.sim.handlers import STRING_ITEMS
+from rtmu.values.target import Target
 
 OFFICE = project_map("office.map")
 MOVES = 10
@@ -58,7 +59,7 @@ def strings_update() -> list[Result]:
 
 async def _moves(port: int) -> tuple[float, float, float]:
     client = AriaClient()
-    await client.connect("127.0.0.1", port, timeout=10)
+    await client.connect(Target("127.0.0.1", port), timeout=10)
     try:
         feed = PtzFeed(DetachedContext(client))
         await feed.read_head(client)

@@ -35,6 +35,7 @@ from pathlib import Path
 
 from bench.common import Result, as_installed, cache_bytecode, end_process
 from rtmu.package_data import project_map
+from rtmu.values.target import Target
 
 RUNS = 5
 HELP_RUNS = 2
@@ -132,7 +133,7 @@ def guardian_start(port: int) -> tuple[float, float]:
 
     kept = os.environ.pop("PYTHONDONTWRITEBYTECODE", None)  # the guardian inherits our environment
     try:
-        handle = GuardianHandle.start(Hello("127.0.0.1", port))
+        handle = GuardianHandle.start(Hello(Target("127.0.0.1", port)))
     finally:
         if kept is not None:
             os.environ["PYTHONDONTWRITEBYTECODE"] = kept

@@ -45,6 +45,7 @@ from bench.common import Result, best_time, end_process, start_xvfb
 from rtmu.client.connection import AriaClient
 from rtmu.client.video_feed import LiveFrame, VideoFeed, frame_stamp, parse_frame, video_source
 from rtmu.package_data import project_map
+from rtmu.values.target import Target
 
 SIZE = "640x480"
 SERVER_HZ = 25.0
@@ -85,7 +86,7 @@ class Figures:
 async def headless(port: int, serial: bool) -> tuple[Figures, float, float]:
     """(figures, seconds, cpu seconds) of one headless run."""
     client = AriaClient()
-    await client.connect("127.0.0.1", port)
+    await client.connect(Target("127.0.0.1", port))
     pool = concurrent.futures.ThreadPoolExecutor(max_workers=1)
     loop = asyncio.get_running_loop()
     figures = Figures()

@@ -28,6 +28,7 @@ from pathlib import Path
 from bench.common import Result, end_process
 from rtmu.client.connection import AriaClient
 from rtmu.client.video_feed import FramePacer, LiveFrame, VideoFeed, video_source
+from rtmu.values.target import Target
 
 CAMERA_HZ = 10.0
 SIZE = "320x240"
@@ -50,7 +51,7 @@ class QuarterRetry(FramePacer):
 
 async def play(port: int, fps: float, pacer: FramePacer) -> dict[str, float]:
     client = AriaClient()
-    await client.connect("127.0.0.1", port)
+    await client.connect(Target("127.0.0.1", port))
     sizes: list[int] = []
     try:
         source = video_source(client)

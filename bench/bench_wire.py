@@ -60,11 +60,12 @@ ARIA_UPDATE = 0x0100
 _MAP_SCRIPT = """
 import asyncio, sys, time
 from rtmu.client.connection import AriaClient
+from rtmu.values.target import Target
 from rtmu.client.mapload import download_map
 
 async def main(port):
     client = AriaClient()
-    await client.connect("127.0.0.1", port)
+    await client.connect(Target("127.0.0.1", port))
     start = time.process_time()
     got = await download_map(client, prefer_binary=False, timeout=60)
     spent = time.process_time() - start

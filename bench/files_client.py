@@ -25,6 +25,7 @@ from rtmu.protocol.payloads.files import (
     PutFileCommand,
     PutFileRequest,
 )
+from rtmu.values.target import Target
 
 
 def peak_mb() -> float:
@@ -55,7 +56,7 @@ async def put_simple(c: AriaClient, remote: str, local: Path) -> None:
 
 async def main(mode: str, port: int, remote: str, local: Path) -> None:
     c = AriaClient()
-    await c.connect("127.0.0.1", port, timeout=30)
+    await c.connect(Target("127.0.0.1", port), timeout=30)
     try:
         started = time.perf_counter()
         if mode == "get":

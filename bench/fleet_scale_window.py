@@ -38,6 +38,7 @@ from rtmu.guardian.messages import Hello  # noqa: E402
 from rtmu.settings.store import DirectRobot  # noqa: E402
 from rtmu.ui.application import RtmuApplication  # noqa: E402
 from rtmu.ui.options import GuiOptions  # noqa: E402
+from rtmu.values.target import Target  # noqa: E402
 
 PAGE = os.sysconf("SC_PAGE_SIZE")
 TICKS = os.sysconf("SC_CLK_TCK")
@@ -90,7 +91,7 @@ def guarded(session: RobotSession) -> bool:
 def cold_arming_ms(port: int) -> float:
     """A guardian process started from nothing, until logged in to the robot at ``port``."""
     t0 = time.monotonic()
-    handle = GuardianHandle.start(Hello("127.0.0.1", port, serial=1))
+    handle = GuardianHandle.start(Hello(Target("127.0.0.1", port), serial=1))
     try:
         while handle.state == "starting":
             handle.poll()

@@ -16,8 +16,8 @@ for 1.5 s from its accept: a second login (the window's guardian, beside the win
 Every fault method returns the ``time.monotonic()`` at which it took effect (``fault_at``), so a
 test or bench can measure how long the client took to react as seen by the server. Threads only
 (two per direction per connection, plus the acceptor); buffers are bounded (a full buffer stops
-reading, which is back-pressure as over TCP); a side that closes is seen closing once its last byte
-is through; :meth:`close` ends every thread within a second.
+reading, which is back-pressure as over TCP); a side that closes (or resets) is seen closing once its
+last byte is through; :meth:`close` ends every thread within a second.
 
 Real Wi-Fi loses nothing a TCP stream can see, but holds it: 802.11 retries, background scans and
 contention stall a direction for tens to hundreds of ms now and then, and a lost segment costs a
@@ -137,7 +137,10 @@ class _Pipe:
                 with self.cond:
                     while self.queued > MAX_BUFFER and not self.done:
                         self.cond.wait(0.1)
-                data = self.src.recv(READ_CHUNK)
+                try:
+                    data = self.src.recv(READ_CHUNK)
+                except ConnectionResetError:
+                    data = b""  # the peer's reset (a killed process with bytes unread) ends it too
                 if not data:
                     self.ended = not self.done  # the peer's own close, not ours (reset, close)
                     break

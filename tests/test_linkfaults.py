@@ -4,6 +4,7 @@ profile does what it says — and the CPU-load generator (tests/cpuload.py)."""
 from __future__ import annotations
 
 import socket
+import struct
 import threading
 import time
 from collections.abc import Iterator
@@ -76,6 +77,35 @@ def test_a_side_that_closes_is_seen_closing_through_the_proxy(proxy: FaultProxy)
     with _client(proxy) as sock:
         sock.shutdown(socket.SHUT_WR)
         assert sock.recv(16) == b""  # the server's close, within the socket's 5 s
+
+
+def test_a_side_that_resets_is_seen_closing_through_the_proxy() -> None:
+    """A peer that ends with an RST — a killed process with unread bytes, as a killed window with the
+    robot's status waiting — is gone at the server too: before, the proxy's reader took the reset for an
+    error of its own and the server kept that login for as long as the proxy lived."""
+    server = socket.create_server(("127.0.0.1", 0))
+    ended = threading.Event()
+
+    def serve() -> None:
+        conn, _ = server.accept()
+        with conn:
+            conn.settimeout(10)
+            try:
+                conn.sendall(b"status that nobody reads")
+                while conn.recv(4096):
+                    pass
+            except OSError:
+                pass
+            ended.set()
+
+    threading.Thread(target=serve, daemon=True).start()
+    with FaultProxy("127.0.0.1", server.getsockname()[1]) as proxy:
+        sock = socket.create_connection(("127.0.0.1", proxy.port), timeout=5)
+        assert sock.recv(6, socket.MSG_PEEK) == b"status"  # bytes wait unread: a close is a reset
+        sock.setsockopt(socket.SOL_SOCKET, socket.SO_LINGER, struct.pack("ii", 1, 0))
+        sock.close()
+        assert ended.wait(5), "the server still holds the connection its client reset"
+    server.close()
 
 
 def test_later_held_holds_each_later_connection_and_never_the_first(proxy: FaultProxy) -> None:

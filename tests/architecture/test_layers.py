@@ -44,8 +44,9 @@ MAY_IMPORT: dict[str, frozenset[str]] = {
     "about": frozenset({"codec", "base"}),
     # The stop process: its halt and its login go through the codec on a plain socket. It never imports
     # the client it guards against (nor asyncio, numpy or GTK: it starts light). From base it takes the
-    # one rule for how late a stream may be (base.link_timing), shared with the client's link health.
-    "guardian": frozenset({"codec", "base"}),
+    # one rule for how late a stream may be (base.link_timing), shared with the client's link health;
+    # from values the one Target its parent connected with (its login is the parent's, field for field).
+    "guardian": frozenset({"values", "codec", "base"}),
     # The network side knows the values it publishes, never the UI thread's state above it.
     "client": frozenset({"guardian", "values", "codec", "maps", "base"}),
     "simulator": frozenset({"codec", "maps", "base"}),

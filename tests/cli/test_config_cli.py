@@ -138,7 +138,7 @@ CONFIG_SPECS = [
 def _fetch(port: int) -> ServerConfig:
     async def go() -> ServerConfig:
         client = AriaClient()
-        await client.connect("127.0.0.1", port, timeout=5)
+        await client.connect(Target("127.0.0.1", port), timeout=5)
         try:
             return await fetch_config(client, 10)
         finally:

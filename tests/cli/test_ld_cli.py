@@ -15,6 +15,7 @@ from rtmu.client.connection import AriaClient
 from rtmu.package_data import project_map
 from rtmu.sim import SimThread
 from rtmu.sim.ld_data import ROUTES, ld_state
+from rtmu.values.target import Target
 from simulators import simulator
 
 OFFICE = project_map("office.map")
@@ -103,7 +104,7 @@ def test_status_says_the_dock_state(aram: SimThread, capsys: pytest.CaptureFixtu
 def test_data_store_strings_are_read_by_name(aram: SimThread) -> None:
     async def go() -> dict[str, str]:
         client = AriaClient()
-        await client.connect("127.0.0.1", aram.port, timeout=5.0)
+        await client.connect(Target("127.0.0.1", aram.port), timeout=5.0)
         try:
             return await ld_data.data_store(client, 5.0)
         finally:

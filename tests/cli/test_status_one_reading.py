@@ -1,4 +1,4 @@
-"""``rtmu status`` and the window read a robot's status the same way (``client.robot_status``).
+"""``rtmu status``, ``doctor``, ``why`` and the window read a status the same way (``client.robot_status``).
 
 Against the simulator as a Pioneer (``updateNumbers`` + ``updateStrings``, volts) and as an LD robot
 (the old ``update``, ``batteryInfo`` saying state of charge): the status the CLI prints — once, and
@@ -67,3 +67,38 @@ def test_the_cli_prints_the_status_the_window_reads(
         assert obj.get("dock") == (seen.dock_state if dock else None)
         assert obj[battery] == pytest.approx(seen.battery_v, abs=0.5)  # the simulated battery drains
         assert all(isinstance(obj[k], int) for k in ("x", "y", "th"))  # the wire's whole numbers stay whole
+
+
+@pytest.mark.parametrize("robot", ["pioneer", "ld"])
+def test_doctor_and_why_read_the_status_the_window_reads(
+    robot: str, request: pytest.FixtureRequest, capsys: pytest.CaptureFixture[str]
+) -> None:
+    """``rtmu doctor``'s status step and ``rtmu why``'s facts take the same reading
+    (``robot_status.read_status``): the same pose, words and battery figure in the same unit."""
+    import asyncio
+
+    from rtmu.client.connection import AriaClient
+    from rtmu.client.why_gather import gather
+    from rtmu.client.why_values import Facts
+
+    sim: SimThread = request.getfixturevalue(robot)
+    seen = window_reading(sim)
+    assert main(["doctor", f"127.0.0.1:{sim.port}", "--timeout", "5", "--json"]) == EXIT_OK
+    report = json.loads(capsys.readouterr().out)
+    step = next(s for s in report["steps"] if s["step"] == "status")
+    assert (step["x"], step["y"], step["th"], step["status"]) == (seen.x, seen.y, seen.th, seen.status)
+    battery = "battery_pct" if seen.battery_is_soc else "battery_v"
+    assert step[battery] == pytest.approx(seen.battery_v, abs=0.5)
+
+    async def facts() -> Facts:
+        client = AriaClient()
+        await client.connect(Target("127.0.0.1", sim.port), timeout=5)
+        try:
+            return await gather(client, 5)
+        finally:
+            await client.disconnect()
+
+    why = asyncio.run(facts())
+    assert (why.status, why.mode, why.vel, why.rot_vel) == (seen.status, seen.mode, 0, 0)
+    assert why.battery_soc is seen.battery_is_soc
+    assert why.battery == pytest.approx(seen.battery_v, abs=0.5)

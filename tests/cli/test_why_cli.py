@@ -25,6 +25,7 @@ from rtmu.protocol.payloads.drive import RatioDrive
 from rtmu.sim import SimConfig, SimThread
 from rtmu.sim.ld_safety import safety_state
 from rtmu.subcommands.json_schemas import SCHEMAS
+from rtmu.values.target import Target
 from simulators import simulator
 
 USERS = """UserInfoVersion1
@@ -81,7 +82,7 @@ def zero_drive(sim: SimThread) -> None:
 
     async def go() -> None:
         client = AriaClient()
-        await client.connect("127.0.0.1", sim.port, timeout=5)
+        await client.connect(Target("127.0.0.1", sim.port), timeout=5)
         try:
             client.send(RatioDrive(0.0, 0.0, 0.0))
             await client.flush()

@@ -22,6 +22,7 @@ from rtmu.package_data import project_map
 from rtmu.protocol.payloads.robot import BatteryInfo
 from rtmu.sim import SimConfig, SimThread
 from rtmu.sim.profiles import ARAM, ARAM_PROTOCOL
+from rtmu.values.target import Target
 from simulators import simulator
 
 OFFICE = project_map("office.map")
@@ -41,7 +42,7 @@ def addr(sim: SimThread) -> str:
 
 async def _login(port: int, protocol: str | None) -> AriaClient:
     client = AriaClient()
-    await client.connect("127.0.0.1", port, timeout=5.0, protocol=protocol)
+    await client.connect(Target("127.0.0.1", port, protocol=protocol), timeout=5.0)
     return client
 
 

@@ -13,6 +13,7 @@ from rtmu.client.errors import ClientTimeout
 from rtmu.client.lease import DriveLease
 from rtmu.client.runner import ClientRunner
 from rtmu.client.session import Session
+from rtmu.values.target import Target
 
 from .servers import TestServer, run
 
@@ -45,7 +46,7 @@ def test_disconnect_returns_even_if_the_reader_will_not_end() -> None:
         server = TestServer()
         await server.start()
         client = AriaClient()
-        await client.connect("127.0.0.1", server.port, timeout=5)
+        await client.connect(Target("127.0.0.1", server.port), timeout=5)
         real = client._read_task
         assert real is not None
         real.cancel()
@@ -88,7 +89,7 @@ def test_a_map_conversion_that_hangs_is_a_timeout(monkeypatch: pytest.MonkeyPatc
         server = TestServer()
         await server.start()
         client = AriaClient()
-        await client.connect("127.0.0.1", server.port, timeout=5)
+        await client.connect(Target("127.0.0.1", server.port), timeout=5)
         try:
             with pytest.raises(ClientTimeout, match="converting the map"):
                 await mapload.download_map(client, convert_timeout=0.05)

@@ -24,6 +24,7 @@ from rtmu.protocol.fields import FieldReader
 from rtmu.protocol.packet import encode_packet
 from rtmu.protocol.payloads.drive import TurnByAngle
 from rtmu.protocol.payloads.robot import UpdateNumbers
+from rtmu.values.target import Target
 
 from .servers import MAP_LINES, TestServer, run, text_map_packets
 
@@ -43,9 +44,9 @@ async def until(predicate: Callable[[], bool], timeout: float = 3.0) -> None:
             await asyncio.sleep(0.002)
 
 
-async def connected(server: TestServer, **kw: object) -> AriaClient:
+async def connected(server: TestServer, user: str = "", password: str = "") -> AriaClient:
     client = AriaClient()
-    await client.connect("127.0.0.1", server.port, timeout=5, **kw)  # type: ignore[arg-type]
+    await client.connect(Target("127.0.0.1", server.port, user, password), timeout=5)
     return client
 
 
@@ -198,7 +199,7 @@ def test_not_supported_is_typed() -> None:
 def test_connection_refused() -> None:
     async def go() -> None:
         with pytest.raises(ConnectionRefused) as info:
-            await AriaClient().connect("127.0.0.1", free_port(), timeout=2)
+            await AriaClient().connect(Target("127.0.0.1", free_port()), timeout=2)
         assert info.value.exit_code == 3 and "refused" in str(info.value)
 
     run(go())
@@ -210,7 +211,7 @@ def test_wrong_password_and_unknown_user_carry_arias_reason() -> None:
         await server.start()
         for user, password in (("alice", "wrong"), ("mallory", "x"), ("", "")):
             with pytest.raises(LoginRejected) as info:
-                await AriaClient().connect("127.0.0.1", server.port, user, password, timeout=2)
+                await AriaClient().connect(Target("127.0.0.1", server.port, user, password), timeout=2)
             assert info.value.reason == 1 and info.value.bad_credentials
             assert "wrong user name or password" in str(info.value)
         client = await connected(server, user="ALICE", password="secret1")
@@ -229,7 +230,7 @@ def test_server_that_accepts_but_never_answers_times_out() -> None:
         server = TestServer(silent=True)
         await server.start()
         with pytest.raises(ClientTimeout) as info:
-            await AriaClient().connect("127.0.0.1", server.port, timeout=0.3)
+            await AriaClient().connect(Target("127.0.0.1", server.port), timeout=0.3)
         assert info.value.exit_code == 5 and "did not complete the login within 0.3 s" in str(info.value)
         await server.stop()
 
@@ -258,7 +259,7 @@ def test_server_killed_mid_request() -> None:
         await server.start()
         closed: list[Exception] = []
         client = AriaClient(on_close=closed.append)
-        await client.connect("127.0.0.1", server.port, timeout=2)
+        await client.connect(Target("127.0.0.1", server.port), timeout=2)
         waiting = asyncio.create_task(client.request_once("getMapName", timeout=5))
         await until(lambda: "getMapName" in server.names())  # the request is at the server
         server.kill(server.sides[0])
@@ -329,7 +330,7 @@ def test_not_arnetworking_is_a_protocol_error() -> None:
         srv = await asyncio.start_server(bad, "127.0.0.1", 0)
         port = srv.sockets[0].getsockname()[1]
         with pytest.raises(ProtocolFault):
-            await AriaClient().connect("127.0.0.1", port, timeout=2)
+            await AriaClient().connect(Target("127.0.0.1", port), timeout=2)
         srv.close()
 
     run(go())
@@ -360,7 +361,7 @@ def test_a_server_that_is_not_arnetworking_is_named_at_once(opening: bytes, repe
         srv = await _garbage_server(opening, repeat)
         port = srv.sockets[0].getsockname()[1]
         with pytest.raises(ProtocolFault) as info:  # long before the 60 s login timeout
-            await AriaClient().connect("127.0.0.1", port, timeout=60)
+            await AriaClient().connect(Target("127.0.0.1", port), timeout=60)
         assert "not an ArNetworking server" in str(info.value) and said in str(info.value)
         assert info.value.exit_code == 3
         srv.close()
@@ -527,7 +528,7 @@ def test_a_map_that_stalled_half_way_is_given_up_after_the_grace() -> None:
         await server.start()
         clock = FakeClock()
         client = AriaClient(clock=clock)
-        await client.connect("127.0.0.1", server.port, timeout=5)
+        await client.connect(Target("127.0.0.1", server.port), timeout=5)
         with pytest.raises(ClientTimeout):
             await client.request_once("getMap", timeout=0.1)
         clock.advance(client.abandon_grace)

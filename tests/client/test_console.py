@@ -29,6 +29,7 @@ from rtmu.client.console_reply import MAX_FIELDS_SHOWN
 from rtmu.protocol.fields import FieldWriter
 from rtmu.protocol.packet import encode_packet
 from rtmu.sim import SimThread
+from rtmu.values.target import Target
 from simulators import simulator
 
 from .servers import SPECS, ServerSide, ServerThread, TestServer, run
@@ -42,7 +43,7 @@ def addr(port: int) -> str:
 
 async def connected(port: int) -> AriaClient:
     client = AriaClient()
-    await client.connect("127.0.0.1", port, timeout=10)
+    await client.connect(Target("127.0.0.1", port), timeout=10)
     return client
 
 

@@ -15,6 +15,7 @@ from rtmu.client.console import ConsoleEntry, ConsoleRefusal, ConsoleReply, call
 from rtmu.client.console_layout import encode_arguments
 from rtmu.package_data import project_map
 from rtmu.sim import SimConfig, SimThread
+from rtmu.values.target import Target
 
 from .servers import run
 
@@ -33,7 +34,7 @@ def sample_arguments(entry: ConsoleEntry) -> bytes:
 
 async def call_all(port: int) -> tuple[dict[str, ConsoleReply | str], bool]:
     client = AriaClient()
-    await client.connect("127.0.0.1", port, timeout=10)
+    await client.connect(Target("127.0.0.1", port), timeout=10)
     try:
         entries = console_entries(client.datalist)
 

@@ -25,6 +25,7 @@ from rtmu.client.errors import ClientTimeout, MalformedReply, NotSupported
 from rtmu.client.remote_files import ListingTooLarge, Refused, UnsafeName, default_folder, list_folder
 from rtmu.client.upload import upload_file
 from rtmu.protocol.payloads.files import DirEntry, DirListingPacket, FileChunk, PutFileReply, PutFileRequest
+from rtmu.values.target import Target
 
 from .servers import SPECS, ServerSide, ServerThread, TestServer, run
 
@@ -74,7 +75,7 @@ def with_client(server: TestServer, body: Callable[[AriaClient], Awaitable[Any]]
 
         async def go() -> Any:
             client = AriaClient()
-            await client.connect("127.0.0.1", running.port, timeout=5)
+            await client.connect(Target("127.0.0.1", running.port), timeout=5)
             try:
                 return await body(client)
             finally:

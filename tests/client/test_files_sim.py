@@ -35,6 +35,7 @@ from rtmu.protocol.payloads.files import (
 )
 from rtmu.protocol.payloads.mapping import MappingEndReply
 from rtmu.sim import SimConfig, SimThread
+from rtmu.values.target import Target
 from simulators import running
 
 from .servers import run
@@ -59,7 +60,7 @@ def sim(files: Path) -> Iterator[SimThread]:
 def with_client(sim: SimThread, body: Callable[[AriaClient], Awaitable[Any]], timeout: float = 60.0) -> Any:
     async def main() -> Any:
         client = AriaClient()
-        await client.connect("127.0.0.1", sim.port, timeout=10)
+        await client.connect(Target("127.0.0.1", sim.port), timeout=10)
         try:
             return await body(client)
         finally:
@@ -245,7 +246,7 @@ def test_another_client_uploading_the_same_file_is_refused_with_7(sim: SimThread
         reply = await first.request_once(PutFileInterleavedRequest(PutFileCommand.START, "maps/same.bin"))
         assert PutFileReply.decode(reply.payload) == PutFileReply(10, "maps/same.bin")
         second = AriaClient()
-        await second.connect("127.0.0.1", sim.port)
+        await second.connect(Target("127.0.0.1", sim.port))
         try:
             with pytest.raises(Refused, match="another client is uploading") as refused:
                 await upload_file(second, local, "MAPS/same.bin")

@@ -28,6 +28,7 @@ from rtmu.guardian.child import WARM_MAX
 from rtmu.guardian.handle import GuardianHandle
 from rtmu.guardian.messages import Hello
 from rtmu.sim import SimThread
+from rtmu.values.target import Target
 from simulators import running
 
 from .uiqueue import eventually
@@ -195,11 +196,11 @@ def test_the_guardian_keeps_at_most_three_logins_ready_lets_go_when_told_and_pro
         handle = GuardianHandle.start()
         try:
             for sim in robots:
-                handle.warm(Hello("127.0.0.1", sim.port))
+                handle.warm(Hello(Target("127.0.0.1", sim.port)))
             eventually(lambda: [logins(sim) for sim in robots] == [0, 0, 1, 1, 1], timeout=10)
-            handle.cool(Hello("127.0.0.1", robots[3].port))
+            handle.cool(Hello(Target("127.0.0.1", robots[3].port)))
             eventually(lambda: [logins(sim) for sim in robots] == [0, 0, 1, 0, 1], timeout=10)
-            handle.login(Hello("127.0.0.1", robots[4].port, serial=7))
+            handle.login(Hello(Target("127.0.0.1", robots[4].port), serial=7))
             eventually(lambda: handle.poll() is not None and handle.state == "ready", timeout=10)
             assert [logins(sim) for sim in robots] == [0, 0, 1, 0, 1]
         finally:

@@ -8,6 +8,7 @@ from __future__ import annotations
 
 from rtmu.client.connection import AriaClient
 from rtmu.protocol.datalist import DataList
+from rtmu.values.target import Target
 
 from .servers import SPECS, ServerThread, TestServer, run
 
@@ -42,7 +43,7 @@ def test_a_thousand_names_with_16_kb_descriptions_load_without_truncation() -> N
     async def go() -> DataList:
         with ServerThread(TestServer(long_specs())) as server:
             client = AriaClient()
-            got = await client.connect("127.0.0.1", server.port, timeout=10)
+            got = await client.connect(Target("127.0.0.1", server.port), timeout=10)
             await client.disconnect()
             return got
 

@@ -163,7 +163,7 @@ class Navigation:
 
     async def _run(self) -> None:
         client = AriaClient()
-        await client.connect("127.0.0.1", self.port, timeout=10, role=Role.OPERATOR)
+        await client.connect(Target("127.0.0.1", self.port), timeout=10, role=Role.OPERATOR)
         self._ready.set()
         goal = 0
         try:
@@ -384,7 +384,7 @@ def test_an_observers_client_refuses_motion_before_the_wire() -> None:
 
         async def go() -> None:
             client = AriaClient()
-            await client.connect("127.0.0.1", sim.port, timeout=10, role=Role.OBSERVER)
+            await client.connect(Target("127.0.0.1", sim.port), timeout=10, role=Role.OBSERVER)
             try:
                 for attempt in (
                     lambda: client.send("stop"),

@@ -13,6 +13,7 @@ from rtmu.cli import main
 from rtmu.client.connection import AriaClient
 from rtmu.client.errors import ClientTimeout, ProtocolFault
 from rtmu.protocol.checksum import checksum
+from rtmu.values.target import Target
 
 from .servers import ServerSide, ServerThread, TestServer, run
 
@@ -39,7 +40,7 @@ def test_the_client_names_the_oversized_packet() -> None:
     async def go() -> str:
         with ServerThread(hostile()) as server:
             client = AriaClient()
-            await client.connect("127.0.0.1", server.port, timeout=5)
+            await client.connect(Target("127.0.0.1", server.port), timeout=5)
             try:
                 with pytest.raises(ProtocolFault) as caught:
                     await client.request_once("getPictureCam1", timeout=1.0)
@@ -59,7 +60,7 @@ def test_a_plain_silence_is_still_a_timeout() -> None:
     async def go() -> None:
         with ServerThread(server) as running:
             client = AriaClient()
-            await client.connect("127.0.0.1", running.port, timeout=5)
+            await client.connect(Target("127.0.0.1", running.port), timeout=5)
             try:
                 with pytest.raises(ClientTimeout):
                     await client.request_once("getPictureCam1", timeout=0.5)

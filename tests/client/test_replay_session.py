@@ -62,7 +62,7 @@ def session_over(link_for: asyncio.Future[Link] | Link, changes: list[StateChang
 async def drive(port: int, seconds: float) -> None:
     """Another operator drives the robot in a slow arc, then stops (the watched session only watches)."""
     driver = AriaClient()
-    await driver.connect("127.0.0.1", port, timeout=5)
+    await driver.connect(Target("127.0.0.1", port), timeout=5)
     try:
         for _ in range(int(seconds / 0.1)):
             driver.send(RatioDrive(40.0, 20.0, 50.0))

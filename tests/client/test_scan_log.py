@@ -17,6 +17,7 @@ from rtmu.client.scan import start_scan, stop_scan, tag_loop
 from rtmu.package_data import project_map
 from rtmu.protocol.payloads.drive import RatioDrive
 from rtmu.sim import SimConfig, SimThread
+from rtmu.values.target import Target
 
 from .scanlog_reader import Reading, Tag, read_scan_log
 from .servers import run
@@ -34,7 +35,7 @@ def test_a_scan_driven_round_a_loop_parses_with_poses_and_readings_in_order(tmp_
 
         async def main() -> None:
             c = AriaClient()
-            await c.connect("127.0.0.1", sim.port)
+            await c.connect(Target("127.0.0.1", sim.port))
             try:
                 assert await start_scan(c, "Office Loop") == "office loop.2d"
                 sim.advance(0.2)

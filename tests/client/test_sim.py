@@ -175,10 +175,10 @@ def test_wrong_password_against_the_simulator(tmp_path: Path) -> None:
     async def go() -> None:
         with SimThread(sim_config(users_path=users)) as sim:
             with pytest.raises(LoginRejected) as info:
-                await AriaClient().connect("127.0.0.1", sim.port, "alice", "nope", timeout=5)
+                await AriaClient().connect(Target("127.0.0.1", sim.port, "alice", "nope"), timeout=5)
             assert info.value.reason == 1
             client = AriaClient()
-            await client.connect("127.0.0.1", sim.port, "alice", "secret1", timeout=5)
+            await client.connect(Target("127.0.0.1", sim.port, "alice", "secret1"), timeout=5)
             assert client.supports("ratioDrive")
             await client.disconnect()
 

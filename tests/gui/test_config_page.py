@@ -21,6 +21,7 @@ from rtmu.protocol.payloads.config import ParamType
 from rtmu.sim import SimConfig, SimThread
 from rtmu.sim.arconfig import FILLER_CONTROL_SECTION
 from rtmu.ui.config_page import PAGE_SIZE, ConfigPage
+from rtmu.values.target import Target
 from simulators import simulator
 
 from .harness import Gui, LoopProbe, idle, pump, scratch_dir
@@ -180,7 +181,7 @@ def _change_from_another_client(sim: SimThread, changes: dict[str, dict[str, str
 
     async def other() -> str:
         client = AriaClient()
-        await client.connect("127.0.0.1", sim.port, timeout=5)
+        await client.connect(Target("127.0.0.1", sim.port), timeout=5)
         try:
             return (await set_config(client, changes, 5)).error
         finally:
@@ -253,7 +254,7 @@ def test_another_clients_change_refreshes_without_losing_an_edit(gui: Gui, sim: 
 
     async def other() -> str:
         client = AriaClient()
-        await client.connect("127.0.0.1", sim.port, timeout=5)
+        await client.connect(Target("127.0.0.1", sim.port), timeout=5)
         try:
             reply = await set_config(
                 client, {"Camera": {"FrameSize": "320x240"}, "Teleop": {"Timeout": "3"}}, 5
@@ -276,7 +277,7 @@ def test_another_clients_change_refreshes_without_losing_an_edit(gui: Gui, sim: 
 
     async def clash() -> str:
         client = AriaClient()
-        await client.connect("127.0.0.1", sim.port, timeout=5)
+        await client.connect(Target("127.0.0.1", sim.port), timeout=5)
         try:
             return (await set_config(client, {"Camera": {"FrameSize": "640x480"}}, 5)).error
         finally:

@@ -20,6 +20,7 @@ from client.scanlog_reader import Reading, Tag, read_scan_log
 from rtmu.package_data import project_map
 from rtmu.sim import SimThread
 from rtmu.ui.scan_mode import ScanBar, ScanDialog
+from rtmu.values.target import Target
 from simulators import running
 
 from .harness import Gui, idle, pump, scratch_dir
@@ -197,7 +198,7 @@ def test_a_scan_started_elsewhere_shows_its_bar_and_guards_motion(
 
     async def begin() -> None:
         c = AriaClient()
-        await c.connect("127.0.0.1", sim.port, timeout=10)
+        await c.connect(Target("127.0.0.1", sim.port), timeout=10)
         try:
             await start_scan(c, "early")
         finally:
@@ -218,7 +219,7 @@ def test_a_scan_started_elsewhere_shows_its_bar_and_guards_motion(
 
         async def end() -> None:
             c = AriaClient()
-            await c.connect("127.0.0.1", sim.port, timeout=10)
+            await c.connect(Target("127.0.0.1", sim.port), timeout=10)
             try:
                 await stop_scan(c)
             finally:

@@ -23,6 +23,7 @@ from rtmu.protocol.events import DataListReady
 from rtmu.protocol.payloads.robot import UpdateNumbers
 from rtmu.sim import SimConfig, SimServer
 from rtmu.sim.central import CentralConfig, CentralServer
+from rtmu.values.target import Target
 
 from .wire import run
 
@@ -73,9 +74,9 @@ def test_two_operators_share_one_forwarded_robot_and_the_last_stop_stops_it() ->
         async with central_with("solo") as (central, sims):
             port = port_of(central, "solo")
             a, b, idle = AriaClient(), AriaClient(), AriaClient()
-            await a.connect("127.0.0.1", port, timeout=5)
-            await b.connect("127.0.0.1", port, timeout=5)
-            await idle.connect("127.0.0.1", port, timeout=5)  # asks for nothing, so hears nothing
+            await a.connect(Target("127.0.0.1", port), timeout=5)
+            await b.connect(Target("127.0.0.1", port), timeout=5)
+            await idle.connect(Target("127.0.0.1", port), timeout=5)  # asks for nothing, so hears nothing
             idle_before = idle.packets_received
             got: dict[str, int] = {"a": 0, "b": 0}
 
@@ -112,7 +113,7 @@ def test_an_operator_of_a_robot_that_leaves_is_told_shutdown_and_the_robot_is_un
         async with central_with("goner", "stayer") as (central, sims):
             closed: list[ClientError] = []
             op = AriaClient(on_close=closed.append)
-            await op.connect("127.0.0.1", port_of(central, "goner"), timeout=5)
+            await op.connect(Target("127.0.0.1", port_of(central, "goner")), timeout=5)
             await sims.pop("goner").stop()
             await until(lambda: bool(closed))
             assert "shut" in str(closed[0]) or "closed" in str(closed[0])
@@ -126,11 +127,11 @@ def test_the_robot_port_speaks_arias_switch_and_a_plain_client_can_list_it() -> 
     async def main() -> None:
         async with central_with() as (central, _):
             client = AriaClient()
-            datalist = await client.connect("127.0.0.1", central.robot_port, timeout=5)
+            datalist = await client.connect(Target("127.0.0.1", central.robot_port), timeout=5)
             assert "switch" in datalist and "centralServerHeartbeat" in datalist
             await client.disconnect()
             ops = AriaClient()
-            listed = await ops.connect("127.0.0.1", central.port, timeout=5)
+            listed = await ops.connect(Target("127.0.0.1", central.port), timeout=5)
             assert [e.name for e in listed] == ["clientList", "clientAdded", "clientRemoved"]
             await ops.disconnect()
 
@@ -247,7 +248,7 @@ def test_rtmu_sim_central_with_robots_serves_a_fleet_and_stops_on_sigint() -> No
             seen = set()
             for endpoint, _ in await list_robots("127.0.0.1", port, timeout=5):
                 client = AriaClient()
-                await client.connect(endpoint.host, endpoint.port, timeout=5)
+                await client.connect(Target(endpoint.host, endpoint.port), timeout=5)
                 try:
                     numbers = UpdateNumbers.decode((await client.request_once("updateNumbers")).payload)
                     seen.add((numbers.x, numbers.y))
@@ -285,7 +286,7 @@ def test_request_onces_from_two_operators_each_get_their_own_reply() -> None:
             port = port_of(central, "shared")
             ops = [AriaClient() for _ in range(3)]
             for op in ops:
-                await op.connect("127.0.0.1", port, timeout=5)
+                await op.connect(Target("127.0.0.1", port), timeout=5)
             for _ in range(5):  # all at once: the forwarder's queue hands each reply to its asker
                 replies = await asyncio.gather(
                     *(
@@ -325,12 +326,12 @@ def test_a_user_file_guards_the_central_port_and_every_forwarder(tmp_path) -> No
             for port in (central.port, port_of(central, "guarded")):
                 stranger = AriaClient()
                 try:
-                    await stranger.connect("127.0.0.1", port, "mallory", "guess", timeout=5)
+                    await stranger.connect(Target("127.0.0.1", port, "mallory", "guess"), timeout=5)
                     raise AssertionError("a wrong password was let in")
                 except ClientError as exc:
                     assert "password" in str(exc).lower() or "refused" in str(exc).lower()
                 alice = AriaClient()
-                await alice.connect("127.0.0.1", port, "alice", "secret1", timeout=5)
+                await alice.connect(Target("127.0.0.1", port, "alice", "secret1"), timeout=5)
                 await alice.disconnect()
             robots = await list_robots("127.0.0.1", central.port, "alice", "secret1", timeout=5)
             assert [e.name for e, _ in robots] == ["guarded"]
@@ -384,9 +385,9 @@ def test_an_operator_flooding_requests_cannot_cost_the_robot_or_the_other_operat
         async with central_with("busy") as (central, sims):
             port = port_of(central, "busy")
             calm = AriaClient()
-            await calm.connect("127.0.0.1", port, timeout=5)
+            await calm.connect(Target("127.0.0.1", port), timeout=5)
             flooder = AriaClient()
-            await flooder.connect("127.0.0.1", port, timeout=5)
+            await flooder.connect(Target("127.0.0.1", port), timeout=5)
             number = flooder.datalist.number("getMapName")
             assert number is not None
             _, writer = await asyncio.open_connection("127.0.0.1", port)  # and a raw one, never logging in

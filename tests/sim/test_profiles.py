@@ -14,6 +14,7 @@ from rtmu.protocol.payloads.robot import BatteryInfo, UpdateNumbers
 from rtmu.sim import SimConfig, SimThread
 from rtmu.sim.ld_data import CONFIG_API
 from rtmu.sim.profiles import ARAM, DEFAULT, EX4_HEADER, NOT_LISTED_BY_6MTX, get_profile
+from rtmu.values.target import Target
 from simulators import simulator
 
 OFFICE = project_map("office.map")
@@ -24,7 +25,7 @@ aram = simulator(scope="module", profile="aram", map_path=OFFICE)
 
 async def _with_client(port: int, body):  # type: ignore[no-untyped-def]
     client = AriaClient()
-    await client.connect("127.0.0.1", port, timeout=5.0)
+    await client.connect(Target("127.0.0.1", port), timeout=5.0)
     try:
         return await body(client)
     finally:

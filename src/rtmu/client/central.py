@@ -30,6 +30,7 @@ from collections.abc import Callable
 from typing import Any
 
 from ..protocol.payloads.central import CentralEntry, ClientAdded, ClientList, ClientRemoved
+from ..values.target import Target
 from .call_values import Packet
 from .connection import AriaClient
 from .defaults import CONNECT_TIMEOUT, DEFAULT_PORT
@@ -117,8 +118,8 @@ async def list_robots(
     """
     client = AriaClient()
     try:
-        login = (user, password)
-        await client.connect(host, port, *login, timeout=timeout, protocol=protocol, role=Role.OBSERVER)
+        target = Target(host, port, user, password, protocol=protocol)
+        await client.connect(target, timeout=timeout, role=Role.OBSERVER)
         reply = await client.request_once(ClientList.DATA_NAME, timeout=timeout)
         listed = ClientList.decode(reply.payload)
     finally:
@@ -246,9 +247,8 @@ class CentralRoster:
         client = AriaClient(on_close=on_close)
         try:
             # The password stays while the roster lives: a lost central server is logged in to again.
-            await client.connect(
-                self.host, self.port, self._user, self._password, timeout=self.timeout, role=Role.OBSERVER
-            )
+            target = Target(self.host, self.port, self._user, self._password)
+            await client.connect(target, timeout=self.timeout, role=Role.OBSERVER)
             self.backoff.reset()
             if self._lost_sent:  # before any robot: a broadcast may come ahead of the list
                 self._lost_sent = False

@@ -45,8 +45,9 @@ from ..protocol.replies import (
     MAX_REPLY_PACKETS,
     TooManyPending,
 )
+from ..values.target import Target
 from .call_values import Arg, Handler, Reply, encode_args, request_parts
-from .defaults import CONNECT_TIMEOUT, DEFAULT_PORT
+from .defaults import CONNECT_TIMEOUT
 from .errors import (
     ClientError,
     ClientTimeout,
@@ -191,18 +192,9 @@ class AriaClient:
 
     # -- connect ---------------------------------------------------------------------------
     async def connect(
-        self,
-        host: str,
-        port: int = DEFAULT_PORT,
-        user: str | None = None,
-        password: str | None = None,
-        *,
-        timeout: float = CONNECT_TIMEOUT,
-        server_key: str = "",
-        protocol: str | None = None,
-        role: Role = Role.OPERATOR,
+        self, target: Target, *, timeout: float = CONNECT_TIMEOUT, role: Role = Role.OPERATOR
     ) -> DataList:
-        """Open the link, log in and wait for the complete data list, all within ``timeout`` s.
+        """Open the link to ``target``, log in and wait for the complete data list, all within ``timeout`` s.
 
         ``role`` is fixed for the connection's life: an OBSERVER's motion requests are refused
         (:class:`~rtmu.client.errors.MotionRefused`) before anything is put on the wire.
@@ -210,9 +202,10 @@ class AriaClient:
         if self._conn is not None:
             raise RuntimeError("AriaClient objects are single-use: make a new one to connect again")
         self._gate = MotionGate(role)
-        self.host, self.port, self.user = host, port, user or ""
+        host, port = target.host, target.port
+        self.host, self.port, self.user = host, port, target.user
         self._conn = ClientConnection(
-            user or "", password or "", server_key=server_key, protocol_version=protocol
+            target.user, target.password, server_key=target.server_key, protocol_version=target.protocol
         )
         self._conn.replies.abandon_grace = self._abandon_grace
         self._conn.replies.max_pending = self._max_pending

@@ -50,10 +50,7 @@ class GuardianLink:
     def start(self, target: Target) -> None:
         """Connected to ``target`` (which offers ``ratioDrive``): the guardian may log in to it."""
         if self.seat is not None:
-            self.seat.offer(
-                Hello(target.host, target.port, target.user, target.password, self._timeout,
-                      protocol=target.protocol)
-            )  # fmt: skip
+            self.seat.offer(Hello(target, self._timeout))
 
     def waiting_reason(self) -> str | None:
         """Why a drive may not start now (the guardian is still logging in to this robot), or None."""

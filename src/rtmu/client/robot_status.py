@@ -8,12 +8,13 @@ means the same in both; the command line only formats the resulting ``RobotState
 
 from __future__ import annotations
 
+from collections.abc import Awaitable, Callable, Container
 from dataclasses import replace
 from typing import TYPE_CHECKING, Any
 
 from ..protocol.payloads.robot import BatteryInfo, Update, UpdateNumbers, UpdateStrings
 from ..values.state import RobotState
-from .errors import NotSupported
+from .errors import MalformedReply, NotSupported
 
 if TYPE_CHECKING:
     from .connection import AriaClient
@@ -61,26 +62,49 @@ async def battery_info(client: AriaClient, timeout: float) -> BatteryInfo | None
     return info if isinstance(info, BatteryInfo) else None
 
 
-async def fetch_robot_state(client: AriaClient, timeout: float) -> RobotState:
-    """One status asked for at once: ``batteryInfo``, then ``updateNumbers`` + ``updateStrings`` (or
-    the old ``update``). :class:`NotSupported` (:func:`no_status`) from a server with no status."""
+StatusAsk = Callable[[str], Awaitable[object]]
+"""One reply asked for now and decoded; whatever is not the data's payload type counts as unread."""
+
+
+async def read_status(ask: StatusAsk, offers: Container[str]) -> RobotState | None:
+    """One status from what the server lists: ``batteryInfo``, then ``updateNumbers`` +
+    ``updateStrings``, or the old ``update`` — the one choice ``rtmu status``, ``doctor`` and ``why``
+    make alike. None when no pose could be read (not listed, or its reply did not decode): each
+    caller says that its own way (doctor a failed step, why a note, status an error)."""
     robot = RobotState()
-    info = await battery_info(client, timeout)
-    if info is not None:
-        robot = replace(robot, **battery_fields(info))
-    if client.supports("updateNumbers"):
-        numbers = (await client.request_once("updateNumbers", timeout=timeout)).decode()
-        assert isinstance(numbers, UpdateNumbers)
+    if "batteryInfo" in offers:
+        info = await ask("batteryInfo")
+        if isinstance(info, BatteryInfo):
+            robot = replace(robot, **battery_fields(info))
+    if "updateNumbers" in offers:
+        numbers = await ask("updateNumbers")
+        if not isinstance(numbers, UpdateNumbers):
+            return None
         robot = replace(robot, **numbers_fields(numbers))
-        if client.supports("updateStrings"):
-            strings = (await client.request_once("updateStrings", timeout=timeout)).decode()
-            assert isinstance(strings, UpdateStrings)
-            robot = replace(robot, **strings_fields(strings))
+        if "updateStrings" in offers:
+            strings = await ask("updateStrings")
+            if isinstance(strings, UpdateStrings):
+                robot = replace(robot, **strings_fields(strings))
         return robot
-    if client.supports("update"):
-        update = (await client.request_once("update", timeout=timeout)).decode()
-        assert isinstance(update, Update)
-        return replace(robot, **numbers_fields(update.numbers), **strings_fields(update))
+    if "update" in offers:
+        update = await ask("update")
+        if isinstance(update, Update):
+            return replace(robot, **numbers_fields(update.numbers), **strings_fields(update))
+    return None
+
+
+async def fetch_robot_state(client: AriaClient, timeout: float) -> RobotState:
+    """One status asked for at once (:func:`read_status`). :class:`NotSupported` (:func:`no_status`)
+    from a server with no status; :class:`MalformedReply` when its status does not decode."""
+
+    async def ask(name: str) -> object:
+        return (await client.request_once(name, timeout=timeout)).decode()
+
+    robot = await read_status(ask, client.datalist)
+    if robot is not None:
+        return robot
+    if client.supports("updateNumbers") or client.supports("update"):
+        raise MalformedReply("the server's status reply does not decode as a robot status")
     raise no_status(client)
 
 

@@ -298,15 +298,7 @@ class Session:
 
     async def _open(self, target: Target) -> None:
         client = self.client_factory(lambda error: self._on_client_closed(client, error))
-        await client.connect(
-            target.host,
-            target.port,
-            target.user,
-            target.password,
-            timeout=self.config.connect_timeout,
-            protocol=target.protocol,
-            role=self.config.role,
-        )
+        await client.connect(target, timeout=self.config.connect_timeout, role=self.config.role)
         if self._target is not target:  # disconnected (or re-targeted) meanwhile
             await client.disconnect()
             raise ServerClosed("the connection attempt was cancelled")

@@ -21,20 +21,14 @@ from ..protocol.datalist import DataEntry
 from ..protocol.payloads.drive import SafeDrive
 from ..protocol.payloads.ld import DATA_STORE_PREFIX, DockInfo
 from ..protocol.payloads.navigation import LocState
-from ..protocol.payloads.robot import (
-    BatteryInfo,
-    ModeInfo,
-    PhysicalInfo,
-    Update,
-    UpdateNumbers,
-    UpdateStrings,
-)
+from ..protocol.payloads.robot import ModeInfo, PhysicalInfo
 from ..protocol.payloads.sensors import RangeDeviceReadings, SensorList, SensorReadings
 from .call_values import Reply
 from .config_feed import ServerConfig, fetch_config, offers_config
 from .connection import AriaClient
 from .errors import ClientError, ServerClosed
 from .ld_data import LASER_NAMES
+from .robot_status import read_status
 from .why_values import (
     ARIA_LIMITER_DEFAULTS,
     Facts,
@@ -113,30 +107,29 @@ class _Gatherer:
         return value if isinstance(value, cls) else None
 
     async def run(self, ours: OurSide) -> Facts:
-        numbers, status, mode, extended = await self.status()
+        robot = await read_status(lambda name: self.typed(name, object), self.offers)
         info = await self.typed("getModeInfo", ModeInfo)
         safe = await self.typed("getSafeDrive", SafeDrive)
-        battery = await self.typed("batteryInfo", BatteryInfo)
         physical = await self.typed("physicalInfo", PhysicalInfo)
         dock = await self.typed("dockInfo", DockInfo)
         loc = await self.typed("getLocState", LocState)
         config = await self.config()
-        pose = (numbers.x, numbers.y, numbers.th) if numbers is not None else None
+        pose = (int(robot.x), int(robot.y), int(robot.th)) if robot is not None else None
         sensors, obstacles = await self.obstacles(pose)
         faults, raw = await self.ld_reads()
         return Facts(
             offers=self.offers,
             user=self.client.user,
-            status=status,
-            mode=mode,
-            extended_status=extended,
+            status=robot.status if robot is not None else "",
+            mode=robot.mode if robot is not None else "",
+            extended_status=robot.extended_status if robot is not None else "",
             mode_info=info if isinstance(info, ModeInfo) else None,
             safe_drive=safe.safe if isinstance(safe, SafeDrive) else None,
-            battery=numbers.battery if numbers is not None else None,
-            battery_shutdown=battery.shutdown if isinstance(battery, BatteryInfo) else None,
-            battery_soc=isinstance(battery, BatteryInfo) and battery.state_of_charge,
-            vel=numbers.vel if numbers is not None else None,
-            rot_vel=numbers.rot_vel if numbers is not None else None,
+            battery=robot.battery_v if robot is not None else None,
+            battery_shutdown=robot.battery_shutdown if robot is not None else None,
+            battery_soc=robot is not None and robot.battery_is_soc,
+            vel=robot.vel if robot is not None else None,
+            rot_vel=robot.rot_vel if robot is not None else None,
             footprint=(
                 Footprint(physical.width, physical.length_front, physical.length_rear)
                 if isinstance(physical, PhysicalInfo) and physical.width > 0
@@ -153,19 +146,6 @@ class _Gatherer:
             ours=ours,
             notes=tuple(self.notes),
         )
-
-    async def status(self) -> tuple[UpdateNumbers | None, str, str, str]:
-        if "updateNumbers" in self.offers:
-            numbers = await self.typed("updateNumbers", UpdateNumbers)
-            strings = await self.typed("updateStrings", UpdateStrings)
-            if isinstance(strings, UpdateStrings):
-                n = numbers if isinstance(numbers, UpdateNumbers) else None
-                return n, strings.status, strings.mode, strings.extended_status
-            return (numbers if isinstance(numbers, UpdateNumbers) else None), "", "", ""
-        update = await self.typed("update", Update)
-        if isinstance(update, Update):
-            return update.numbers, update.status, update.mode, ""
-        return None, "", "", ""
 
     async def config(self) -> ServerConfig | None:
         if offers_config(self.client) is None:

@@ -257,7 +257,7 @@ class Guardian:
             self.halt()
         self.watch.armed = False
         self.serial = hello.serial
-        if not hello.host:  # log out: the parent's robot is gone and no other is to be watched yet
+        if not hello.target.host:  # log out: the parent's robot is gone and no other is to be watched yet
             self.leave()
             return
         login = self.login

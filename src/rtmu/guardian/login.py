@@ -47,9 +47,12 @@ class RobotLogin:
 
     def __init__(self, hello: Hello, now: float | None = None) -> None:
         self.hello = hello
-        self.where = f"{hello.host}:{hello.port}"
+        self.where = f"{hello.target.host}:{hello.target.port}"
         self.deadline = (time.monotonic() if now is None else now) + hello.timeout
-        self.conn = ClientConnection(hello.user, hello.password, protocol_version=hello.protocol)
+        target = hello.target
+        self.conn = ClientConnection(
+            target.user, target.password, server_key=target.server_key, protocol_version=target.protocol
+        )
         self.state = LoginState.CONNECTING
         self.error: Said | str = ""
         """Why the login failed or its connection ended: a :class:`Said` (English as a str, the
@@ -59,7 +62,7 @@ class RobotLogin:
         self.sock: socket.socket | None = None
         try:
             family, kind, proto, _name, address = socket.getaddrinfo(
-                hello.host, hello.port, type=socket.SOCK_STREAM
+                hello.target.host, hello.target.port, type=socket.SOCK_STREAM
             )[0]
             self.sock = socket.socket(family, kind, proto)
             self.sock.setblocking(False)

@@ -18,6 +18,8 @@ import json
 import struct
 from dataclasses import dataclass
 
+from ..values.target import Target
+
 RECORD = struct.Struct(">cd")
 LENGTH = struct.Struct(">I")
 BEAT_UI = b"u"
@@ -58,50 +60,43 @@ LOST = "lost"
 
 @dataclass(frozen=True)
 class Hello:
-    host: str
-    port: int
-    user: str = ""
-    password: str = ""
+    """Log in to this robot, as the parent did (its own :class:`Target`, password and all)."""
+
+    target: Target
     timeout: float = 10.0
     serial: int = 0
     """Which login this is (the parent counts them); every word about it carries this number."""
-    protocol: str | None = None
-    """The protocol string to answer with (None: the one the server advertises), as the parent's."""
 
     def encode(self) -> bytes:
-        body = json.dumps(
-            {
-                "host": self.host,
-                "port": self.port,
-                "user": self.user,
-                "password": self.password,
-                "timeout": self.timeout,
-                "serial": self.serial,
-                "protocol": self.protocol,
-            }
-        ).encode()
+        t = self.target
+        login = {"host": t.host, "port": t.port, "user": t.user, "password": t.password}
+        keys = {"protocol": t.protocol, "server_key": t.server_key}
+        body = json.dumps({**login, **keys, "timeout": self.timeout, "serial": self.serial}).encode()
         return LENGTH.pack(len(body)) + body
 
     @classmethod
     def decode(cls, body: bytes) -> Hello:
         d = json.loads(body.decode())
         protocol = d.get("protocol")
-        return cls(
+        target = Target(
             str(d["host"]),
             int(d["port"]),
             str(d["user"]),
             str(d["password"]),
-            float(d["timeout"]),
-            int(d.get("serial", 0)),
-            None if protocol is None else str(protocol),
+            protocol=None if protocol is None else str(protocol),
+            server_key=str(d.get("server_key", "")),
         )
+        return cls(target, float(d["timeout"]), int(d.get("serial", 0)))
 
     def same_robot(self, other: Hello | None) -> bool:
-        """The same login (address, user, password, protocol): logged in to one is logged in to both."""
+        """The same login (address, user, password, protocol strings): logged in to one is logged in to
+        both — whichever profile or reconnect rule the parent's session has."""
         if other is None:
             return False
-        mine = (self.host, self.port, self.user, self.password, self.protocol)
-        return mine == (other.host, other.port, other.user, other.password, other.protocol)
+        mine, theirs = self.target, other.target
+        return (mine.host, mine.port, mine.user, mine.password, mine.protocol, mine.server_key) == (
+            theirs.host, theirs.port, theirs.user, theirs.password, theirs.protocol, theirs.server_key
+        )  # fmt: skip
 
 
 def record(kind: bytes, at: float) -> bytes:

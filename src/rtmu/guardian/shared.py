@@ -36,6 +36,7 @@ from dataclasses import replace
 from enum import Enum
 
 from ..base.i18n import _
+from ..values.target import Target
 from . import messages as m
 from .handle import GuardianHandle
 
@@ -262,7 +263,9 @@ class SharedGuardian:
             if leave and handle is not None and handle.alive:
                 self._serial += 1
                 self._seats_by_serial = {}
-                handle.login(m.Hello("", 0, serial=self._serial))  # an empty address: log out, watch nothing
+                handle.login(
+                    m.Hello(Target("", 0), serial=self._serial)
+                )  # an empty address: log out, watch nothing
 
     def _pass(self, seat: GuardianSeat, what: str, at: float | None = None) -> None:
         """A record from ``seat``: only the chosen seat's, and only once armed for it, reach the process."""

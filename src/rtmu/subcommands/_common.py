@@ -33,6 +33,7 @@ from ..client.defaults import CONNECT_TIMEOUT, DEFAULT_PORT
 from ..client.errors import ClientError
 from ..client.roles import Role
 from ..protocol.errors import ProtocolError
+from ..values.target import Target
 
 if TYPE_CHECKING:
     import asyncio
@@ -509,9 +510,8 @@ def run_with_client(
         client = AriaClient()
         _PASSWORD.set(password)
         try:
-            await client.connect(
-                host, port, args.user, password, timeout=args.timeout, protocol=args.protocol, role=role
-            )
+            target = Target(host, port, args.user, password, protocol=args.protocol)
+            await client.connect(target, timeout=args.timeout, role=role)
             return await body(client)
         except asyncio.CancelledError:
             signum = current_interrupts().take()

@@ -37,6 +37,7 @@ from ..base.i18n import N_, Said, _
 from ..base.link_timing import STATUS_CEILING
 from ..base.textsafe import visible
 from ..base.units import Quantity
+from ..values.target import Target
 from ._common import (
     Interrupted,
     UsageError,
@@ -379,7 +380,7 @@ class Doctor:
 
     async def _status(self) -> None:
         from ..client.diagnosis import ADVICE, Step, central_server_words
-        from ..protocol.payloads.robot import BatteryInfo, Update, UpdateNumbers, UpdateStrings
+        from ..client.robot_status import read_status
 
         conn = self.conn
         assert conn is not None
@@ -389,39 +390,28 @@ class Doctor:
                 where = f"{self.host}:{self.port}"
                 raise fail(Step.STATUS, central_server_words(where), ADVICE["central_server"])
             raise fail(Step.STATUS, Said(N_("the server offers no robot status")), ADVICE["status_missing"])
-        soc = False
-        if "batteryInfo" in conn.datalist:
-            info = await self._once("batteryInfo")
-            soc = isinstance(info, BatteryInfo) and info.state_of_charge
-        numbers = await self._once(name)
-        status = mode = ""
-        if isinstance(numbers, Update):
-            status, mode, numbers = numbers.status, numbers.mode, numbers.numbers
-        elif "updateStrings" in conn.datalist:
-            strings = await self._once("updateStrings")
-            if isinstance(strings, UpdateStrings):
-                status, mode = strings.status, strings.mode
-        if not isinstance(numbers, UpdateNumbers):
+        robot = await read_status(self._once, conn.datalist)
+        if robot is None:
             raise fail(
                 Step.STATUS,
                 Said(N_("the server's {name} reply does not decode"), name=name),
                 ADVICE["status_timeout"],
             )
+        soc, status, mode = robot.battery_is_soc, robot.status, robot.mode
+        x, y, th, level = int(robot.x), int(robot.y), int(robot.th), robot.battery_v or 0.0
         battery = (
-            Said(N_("{percent} charge"), percent=Quantity(numbers.battery, "%"))
-            if soc
-            else Quantity(numbers.battery, "V", 1)
+            Said(N_("{percent} charge"), percent=Quantity(level, "%")) if soc else Quantity(level, "V", 1)
         )
         text = Said(
             N_("robot at ({x}, {y}) mm, {th}, battery {battery}{status}"),
-            x=Quantity(numbers.x, ""),
-            y=Quantity(numbers.y, ""),
-            th=Quantity(numbers.th, "deg"),
+            x=Quantity(x, ""),
+            y=Quantity(y, ""),
+            th=Quantity(th, "deg"),
             battery=battery,
             status=f", {status} ({mode})" if status else "",
         )
-        details: dict[str, Any] = {"x": numbers.x, "y": numbers.y, "th": numbers.th, "status": status}
-        details["battery_pct" if soc else "battery_v"] = numbers.battery
+        details: dict[str, Any] = {"x": x, "y": y, "th": th, "status": status}
+        details["battery_pct" if soc else "battery_v"] = level
         advice = ""
         if self.link_seconds > 0:
             assert self.conn is not None and self.reader is not None
@@ -455,12 +445,8 @@ class Doctor:
         client = AriaClient()
         try:
             await client.connect(
-                self.host,
-                self.port,
-                self.user,
-                self._motion_password,
+                Target(self.host, self.port, self.user, self._motion_password, protocol=self.protocol),
                 timeout=self.timeout,
-                protocol=self.protocol,
                 role=Role.OBSERVER,
             )
             answer = diagnose(await gather(client, self.timeout))

@@ -33,6 +33,7 @@ from typing import TYPE_CHECKING, Any
 from ..base.exit_codes import EXIT_OK, EXIT_SIGQUIT, EXIT_SIGTSTP, EXIT_USAGE, NETWORK, WHY_DRIVE
 from ..base.i18n import N_, Said, _, words
 from ..base.textsafe import visible
+from ..values.target import Target
 from ._common import (
     Interrupted,
     UsageError,
@@ -233,7 +234,8 @@ async def start_guardian(args: argparse.Namespace) -> GuardianHandle | None:
 
     host, port = args.server
     try:
-        return await start_ready(Hello(host, port, args.user, current_password(), args.timeout), args.timeout)
+        target = Target(host, port, args.user, current_password(), protocol=args.protocol)
+        return await start_ready(Hello(target, args.timeout), args.timeout)
     except GuardianUnavailable as exc:
         print(
             _(
@@ -391,12 +393,8 @@ async def stop_on_a_new_connection(args: argparse.Namespace) -> bool:
     fresh = AriaClient()
     try:
         await fresh.connect(
-            host,
-            port,
-            args.user,
-            current_password(),
+            Target(host, port, args.user, current_password(), protocol=args.protocol),
             timeout=RECONNECT_FOR_STOP,
-            protocol=args.protocol,
             role=Role.OPERATOR,  # it sends only zero ratios and stop
         )
         stop(fresh)

@@ -19,6 +19,7 @@ from ..base.textsafe import visible
 from ..client.errors import ClientError
 from ..client.roles import Role
 from ..protocol.errors import ProtocolError
+from ..values.target import Target
 from ._common import (
     Interrupted,
     UsageError,
@@ -64,10 +65,8 @@ async def _status(
     async with gate:
         client = AriaClient()
         try:
-            login = (args.user, password)
-            await client.connect(
-                host, port, *login, timeout=args.timeout, protocol=args.protocol, role=Role.OBSERVER
-            )
+            target = Target(host, port, args.user, password, protocol=args.protocol)
+            await client.connect(target, timeout=args.timeout, role=Role.OBSERVER)
             return await fetch_status(client, args.timeout)
         except (ClientError, ProtocolError) as exc:
             return {"error": str(exc)}

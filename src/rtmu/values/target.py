@@ -25,3 +25,5 @@ class Target:
     """Connect again, backing off, when the link is lost (a replay or a one-shot script: False)."""
     protocol: str | None = None
     """The protocol string to log in with; None: answer with the one the server advertises."""
+    server_key: str = field(default="", repr=False)
+    """ARIA's optional server key, mixed into the password's digest (a server started with one)."""
