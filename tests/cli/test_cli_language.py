@@ -177,11 +177,11 @@ def test_watch_reads_german_with_the_servers_words_as_sent(
     sim: SimThread, german: None, capsys: pytest.CaptureFixture[str]
 ) -> None:
     world = sim.server.world  # type: ignore[union-attr]
-    sim.call(lambda: world.create_popup("Door open", "Close the door", buttons=("OK", "", "")))
+    sim.call(lambda: world.create_popup("Door open", "Close the door", kind=2, buttons=("OK", "", "")))
     where = f"127.0.0.1:{sim.port}"
     assert main(["watch", where, "--seconds", "0.5", "--timeout", "5"]) == 0
     out = capsys.readouterr().out
-    assert re.search(r"Meldung geöffnet #\d+ \(\w+\) Door open: Close the door \[OK\]", out), out
+    assert re.search(r"Meldung geöffnet #\d+ \(Warnung\) Door open: Close the door \[OK\]", out), out
     assert re.search(r"^ +\d+,\d{3}  Modus ", out, re.M), out  # the time with German's decimal comma
     assert "popup opened" not in out and "mode " not in out, out
     assert main(["watch", where, "--seconds", "0.5", "--timeout", "5", "--json"]) == 0

@@ -56,6 +56,16 @@ def register(subparsers: Any) -> None:
     p.set_defaults(handler=handle)
 
 
+POPUP_TYPE_WORDS = {
+    "none": N_("none"),
+    "information": N_("information"),
+    "warning": N_("warning"),
+    "critical": N_("critical"),
+    "question": N_("question"),
+}
+"""A popup's type (ARIA's ``PopupType``, its JSON name) as the text line says it (marked)."""
+
+
 def popup_type(number: int) -> str:
     with contextlib.suppress(ValueError):
         return PopupType(number).name.lower()
@@ -68,14 +78,15 @@ def describe(name: str, payload: Any) -> tuple[dict[str, Any], str] | None:
     as sent, escaped; the JSON keeps the exact strings and English names."""
     if isinstance(payload, PopupCreate):
         buttons = [b for b in payload.buttons if b]
+        kind = popup_type(payload.popup_type)
         obj = {
-            "event": "popup_opened", "id": payload.popup_id, "type": popup_type(payload.popup_type),
+            "event": "popup_opened", "id": payload.popup_id, "type": kind,
             "title": payload.title, "message": payload.message, "buttons": buttons,
         }  # fmt: skip
         labels = "|".join(visible(b) for b in buttons)
         text = _("popup opened #{id} ({type}) {title}: {message} [{buttons}]").format(
             id=payload.popup_id,
-            type=obj["type"],
+            type=_(POPUP_TYPE_WORDS.get(kind, kind)),
             title=visible(payload.title),
             message=visible(payload.message),
             buttons=labels,
