@@ -10,6 +10,7 @@ from __future__ import annotations
 import cairo
 import numpy as np
 
+from rtmu.client.nav_status import LOST
 from rtmu.model.observables import NavOutcome, NavState
 from rtmu.ui import overlays
 from rtmu.ui.frame import Scene, draw_frame
@@ -57,6 +58,13 @@ def test_outcome_status_adds_the_reason_once() -> None:
     )
     assert outcome_status(said) == "Failed to get to X (path blocked)"
     assert outcome_status(NavState()) == ""
+
+
+def test_outcome_status_says_rtmus_own_reason_in_german_and_the_servers_words_as_sent(german: None) -> None:
+    lost = NavState(outcome=NavOutcome.FAILED, outcome_text="Failed to get to Lab B", reason=LOST)
+    assert outcome_status(lost) == "Failed to get to Lab B (Grund: der Roboter hat seine Position verloren)"
+    blocked = NavState(outcome=NavOutcome.FAILED, outcome_text="Failed to get to Lab B", reason="blocked")
+    assert outcome_status(blocked) == "Failed to get to Lab B (Grund: blocked)"
 
 
 def _render(scene: Scene, vp: Viewport) -> np.ndarray:

@@ -145,3 +145,22 @@ def test_live_videos_slow_down_and_the_speed_cap_source_read_german(german: None
     assert seen.source == "seen: 1200 mm/s at 50 % of full"
     assert words(seen.source) == "beobachtet: 1.200 mm/s bei 50 % der vollen Fahrt"
     assert words(replace(seen, source=RobotLimits().source).source) == "angenommen nach ARIAs P3-DX"
+
+
+def test_a_number_typed_as_german_writes_it_is_read_back(german: None) -> None:
+    """The map editor's fields read what the operator types in their language's way."""
+    assert i18n.parse_number("1.234,5") == 1234.5
+    assert i18n.parse_number(" −2,5 ") == -2.5
+    assert i18n.parse_number(i18n.number(-12345.6, 1)) == -12345.6
+    assert i18n.parse_number("2500") == 2500.0
+    for wrong in ("", "zwei", "1_000", "nan", "inf", "1,2,3"):
+        with pytest.raises(ValueError):
+            i18n.parse_number(wrong)
+
+
+def test_a_number_typed_in_english_or_c_is_read_back(english: None) -> None:
+    assert i18n.parse_number("1234.5") == 1234.5
+    assert i18n.parse_number(i18n.number(1234.5, 1)) == 1234.5
+    assert i18n.parse_number("-0.25") == -0.25
+    with pytest.raises(ValueError):
+        i18n.parse_number("1,5.5.5")

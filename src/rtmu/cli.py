@@ -184,7 +184,7 @@ def main(argv: Sequence[str] | None = None) -> int:
         return installing
     if handler is None:
         if importlib.util.find_spec("rtmu.ui.app") is None:
-            print("rtmu: the operator window is not built yet; try 'rtmu --help'", file=sys.stderr)
+            print(_("rtmu: the operator window is not built yet; try 'rtmu --help'"), file=sys.stderr)
             return EXIT_USAGE
         from .ui import app as gui_app
 

@@ -9,6 +9,10 @@ keys.
 
 from __future__ import annotations
 
+import re
+
+import gi
+
 from client.uiqueue import UiQueue
 from rtmu.client.runner import ClientRunner
 from rtmu.mapedit import MapDraft
@@ -23,6 +27,9 @@ from simulators import simulator
 from .harness import Gui, idle, pump
 from .stop_paths import StopCycle
 from .test_config_page import click, type_into
+
+gi.require_version("Gtk", "4.0")
+from gi.repository import Gtk  # noqa: E402
 
 sim = simulator(map_path=project_map("office.map"), seed=1)
 
@@ -43,6 +50,21 @@ class Other:
     @property
     def goals(self) -> tuple[str, ...]:
         return tuple(self.model.navigation.value.goals)
+
+
+def press(gui: Gui, button: Gtk.Button) -> None:
+    """Activate ``button`` from the keyboard (focus, then a real Return), wherever it is scrolled to."""
+    button.grab_focus()
+    pump(button.has_focus, 3, "the button to have the focus")
+    gui.key("Return")
+
+
+def labels_under(widget: Gtk.Widget) -> list[Gtk.Label]:
+    found, child = [], widget.get_first_child()
+    while child is not None:
+        found += [child] if isinstance(child, Gtk.Label) else labels_under(child)
+        child = child.get_next_sibling()
+    return found
 
 
 def open_window(gui: Gui) -> MapEditWindow:
@@ -172,3 +194,46 @@ def test_a_goal_placed_by_a_click_and_a_drag_on_the_map(gui: Gui, sim: SimThread
     )
     gui.shot("picked-goal-drawn")
     assert "Picked" not in gui.model.navigation.value.goals
+
+
+def test_in_german_a_picked_point_and_typed_numbers_read_as_german_writes_them(
+    german: None, gui: Gui, sim: SimThread
+) -> None:
+    """The map editor in the operator's language: the picked point said with German's decimal comma
+    (base.units), a number typed with one read as meant, the row saying where in German too."""
+    from gi.repository import GdkX11, Graphene
+
+    w = open_window(gui)
+    stage = gui.stage
+    sx, sy = stage.viewport.to_screen(6500, 6000)
+    ok, point = stage.compute_point(stage.get_native(), Graphene.Point().init(sx, sy))
+    assert ok
+    dx, dy = stage.get_native().get_surface_transform()
+    x, y = round(point.x + dx), round(point.y + dy)
+    edit_xid = str(GdkX11.X11Surface.get_xid(w.get_surface()))
+    gui.xdotool("windowmove", "--sync", edit_xid, "640", "0")  # off the map's left half
+    idle(0.3)
+    click(gui, w.pick_button)
+    pump(lambda: gui.window.commissioning.point_pick.active, 3, "the pick mode")  # type: ignore[union-attr]
+    xid = str(GdkX11.X11Surface.get_xid(gui.window.get_surface()))
+    gui.xdotool("mousemove", "--window", xid, str(x), str(y))
+    idle(0.2)
+    gui.xdotool("click", "1")
+    pump(lambda: w.fields["x"].get_text() != "", 5, "the picked point in the fields")
+    pump(lambda: "Gewählt: 6," in w.news.get_text(), 5, "the pick said in German")
+    assert re.search(r"Gewählt: 6,\d\d; 6,\d\d m", w.news.get_text()), w.news.get_text()
+    for name, typed in (("x", "2500,5"), ("y", "3.000"), ("th", "45,4")):  # German: 3.000 is three thousand
+        type_into(gui, w.fields[name], typed)
+    type_into(gui, w.name_entry, "Deutsch")
+    press(
+        gui, w.add_button
+    )  # German's longer words scroll it below the window's fold: the keyboard reaches it
+    pump(lambda: w.draft is not None and w.draft.find("Deutsch") is not None, 5, "the typed goal")
+    goal = w.draft.find("Deutsch")  # type: ignore[union-attr]
+    assert goal is not None and abs(goal.x - 2500.5) <= 0.5 and goal.y == 3000 and abs(goal.th - 45.4) <= 0.4
+    gui.screen_shot("map-editor-in-german")  # the editor is a window of its own: the screen shows it
+    rows = [label.get_text() for label in labels_under(w.rows)]
+    assert any(re.search(r"Deutsch.* bei 2,50; 3,00 m 45°", text) for text in rows), rows
+    type_into(gui, w.fields["x"], "zwei")
+    press(gui, w.add_button)
+    pump(lambda: "keine Zahl" in w.news.get_text(), 5, "a word that is no number, said in German")

@@ -16,6 +16,8 @@ from __future__ import annotations
 import contextlib
 import gettext
 import locale
+import math
+import os
 import re
 from collections.abc import Sequence
 from pathlib import Path
@@ -24,17 +26,38 @@ from rtmu.package_data import LOCALE_DIR
 
 DOMAIN = "rtmu"
 
+LOCALE_DIR_VARIABLE = "RTMU_LOCALE_DIR"
+"""Where to read the catalogues instead of the package (set by :func:`child_environment` for the
+processes RTMU starts when this one reads other catalogues: the tests' pseudo-locale)."""
+
 _active: list[gettext.NullTranslations] = []
+_chosen: list[tuple[tuple[str, ...], Path | None]] = []
 
 
 def use(languages: Sequence[str] | None = None, localedir: Path | None = None) -> gettext.NullTranslations:
     """Choose the catalogue every later ``_()`` reads: ``languages`` in order of preference (``None``:
-    the environment's), from ``localedir`` (the package's by default; tests give the pseudo-locale's)."""
+    the environment's), from ``localedir`` (``$RTMU_LOCALE_DIR``, else the package's; tests give the
+    pseudo-locale's)."""
+    folder = localedir or Path(os.environ.get(LOCALE_DIR_VARIABLE) or LOCALE_DIR)
     translation = gettext.translation(
-        DOMAIN, str(localedir or LOCALE_DIR), languages=list(languages) if languages else None, fallback=True
+        DOMAIN, str(folder), languages=list(languages) if languages else None, fallback=True
     )
     _active[:] = [translation]
+    _chosen[:] = [(tuple(languages), localedir)] if languages else []
     return translation
+
+
+def child_environment() -> dict[str, str]:
+    """What a process RTMU starts (the guardian) needs in its environment to speak the language this
+    one speaks: ``LANGUAGE`` (and where the catalogues are) when the language was chosen here rather
+    than by the environment — a child inherits the environment, not a choice made in this process."""
+    if not _chosen:
+        return {}
+    languages, localedir = _chosen[0]
+    env = {"LANGUAGE": ":".join(languages)}
+    if localedir is not None:
+        env[LOCALE_DIR_VARIABLE] = str(localedir)
+    return env
 
 
 def _translation() -> gettext.NullTranslations:
@@ -140,6 +163,32 @@ def number(value: float, digits: int = 0) -> str:
         return locale.format_string(f"%.{digits}f", value, grouping=True)
     group, decimal = marks
     return f"{value:,.{digits}f}".translate({ord(","): group, ord("."): decimal})
+
+
+def parse_number(text: str) -> float:
+    """A number a person typed as their language writes numbers (German ``1.234,5``; English
+    ``1,234.5`` or ``1234.5``): its grouping marks dropped, its decimal mark read as the point. A field
+    that shows what :func:`number` wrote reads it back. ValueError when ``text`` is no finite number."""
+    group, decimal = _marks()
+    plain = text.strip().replace("\u2212", "-")  # the minus sign a typographer (or GTK) may use
+    if "_" in plain:
+        raise ValueError(f"not a number: {text!r}")
+    for mark in {group, "\u00a0", "\u202f"} - {"", decimal}:  # the group mark, and spaces used as one
+        plain = plain.replace(mark, "")
+    value = float(plain.replace(decimal, ".") if decimal != "." else plain)
+    if not math.isfinite(value):
+        raise ValueError(f"not a number: {text!r}")
+    return value
+
+
+def _marks() -> tuple[str, str]:
+    """(grouping mark, decimal mark) of the operator's language: the catalogue's, else the C library's."""
+    marks = _catalogue_marks()
+    if marks is not None:
+        return marks
+    _numeric_locale()
+    conventions = locale.localeconv()
+    return str(conventions["thousands_sep"]), str(conventions["decimal_point"]) or "."
 
 
 def _catalogue_marks() -> tuple[str, str] | None:

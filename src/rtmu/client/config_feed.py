@@ -22,6 +22,7 @@ from enum import Enum
 from typing import Any, ClassVar
 
 from ..base.exit_codes import EXIT_FOREIGN_CONFIG
+from ..base.i18n import N_, Said
 from ..protocol.errors import ProtocolError
 from ..protocol.payloads.base import Side, payload_type_for
 from ..protocol.payloads.config import (
@@ -147,8 +148,15 @@ class ForeignConfig(ClientError):
         self.listed = listed
         first = listed[0] if listed else "getConfigValues"
         super().__init__(
-            f"this robot's configuration is {api.value} ({', '.join(listed)}), whose layouts are not "
-            f"public: RTMU cannot show or edit it yet (rtmu call HOST {first} shows the robot's raw reply)"
+            Said(
+                N_(
+                    "this robot's configuration is {api} ({listed}), whose layouts are not public: RTMU "
+                    "cannot show or edit it yet (rtmu call HOST {first} shows the robot's raw reply)"
+                ),
+                api=api.value,
+                listed=", ".join(listed),
+                first=first,
+            )
         )
 
 

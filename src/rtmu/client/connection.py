@@ -31,6 +31,8 @@ import sys
 import time
 from collections.abc import AsyncIterator, Callable
 
+from ..base.i18n import N_, Said
+from ..base.units import Quantity
 from ..protocol.client_connection import ClientConnection, ClientState
 from ..protocol.datalist import DataList
 from ..protocol.decoder import DropStats
@@ -216,7 +218,11 @@ class AriaClient:
         except TimeoutError:
             self._abort()
             raise ClientTimeout(
-                f"{host}:{port} accepted the connection but did not complete the login within {timeout:g} s"
+                Said(
+                    N_("{where} accepted the connection but did not complete the login within {timeout}"),
+                    where=f"{host}:{port}",
+                    timeout=Quantity(timeout, "s", None),
+                )
             ) from None
         except BaseException:
             self._abort()

@@ -9,7 +9,8 @@ from __future__ import annotations
 
 from ..base.exit_codes import EXIT_CONNECTION, EXIT_INTERNAL, EXIT_TIMEOUT, EXIT_UNSUPPORTED
 from ..base.i18n import N_, Said, as_said
-from ..protocol.commands import RejectReason, describe_reject
+from ..base.refusals import refusal
+from ..protocol.commands import RejectReason
 from ..protocol.errors import ProtocolError
 
 
@@ -56,7 +57,7 @@ class LoginRejected(ClientError):
         self.text = text
         self.wanted_protocol = wanted_protocol
         """Reason 4: the protocol string the server advertised (None: not known)."""
-        why = as_said(advice or describe_reject(reason, text))
+        why = as_said(advice) if advice else refusal(reason, text)
         super().__init__(Said(N_("login refused: {reason}"), reason=why))
 
     @property

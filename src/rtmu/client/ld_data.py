@@ -9,6 +9,7 @@ from __future__ import annotations
 
 import re
 
+from ..base.i18n import N_, Said
 from ..protocol.payloads.ld import (
     DATA_STORE_PREFIX,
     DataStoreValue,
@@ -43,48 +44,49 @@ async def dock_info(client: AriaClient, timeout: float) -> DockInfo | None:
         return None
     info = (await client.request_once("dockInfo", timeout=timeout)).decode()
     if not isinstance(info, DockInfo):
-        raise MalformedReply("dockInfo did not decode as a docking state")
+        raise MalformedReply(Said(N_("dockInfo did not decode as a docking state")))
     return info
 
 
 async def routes(client: AriaClient, timeout: float) -> tuple[str, ...]:
     """The server's route names (``getRoutes``); NotSupported when it has none."""
     if not client.supports("getRoutes"):
-        raise NotSupported("getRoutes", "this server offers no routes (getRoutes)")
+        raise NotSupported("getRoutes", Said(N_("this server offers no routes (getRoutes)")))
     reply = (await client.request_once("getRoutes", timeout=timeout)).decode()
     if not isinstance(reply, Routes):
-        raise MalformedReply("getRoutes did not decode as route names")
+        raise MalformedReply(Said(N_("getRoutes did not decode as route names")))
     return reply.routes
 
 
 async def goals(client: AriaClient, timeout: float) -> tuple[str, ...]:
     """The map's goal names (``getGoals``); NotSupported when the server lists none."""
     if not client.supports("getGoals"):
-        raise NotSupported("getGoals", "this server offers no goal list (getGoals)")
+        raise NotSupported("getGoals", Said(N_("this server offers no goal list (getGoals)")))
     reply = (await client.request_once("getGoals", timeout=timeout)).decode()
     if not isinstance(reply, Goals):
-        raise MalformedReply("getGoals did not decode as goal names")
+        raise MalformedReply(Said(N_("getGoals did not decode as goal names")))
     return reply.goals
 
 
 def goto_route_goal(client: AriaClient, goal: str) -> None:
     """Drive to ``goal`` (LD robots); NotSupported when the server has no ``gotoRouteGoal``."""
     if not client.supports("gotoRouteGoal"):
-        raise NotSupported("gotoRouteGoal", "this server cannot drive to route goals (gotoRouteGoal)")
+        said = Said(N_("this server cannot drive to route goals (gotoRouteGoal)"))
+        raise NotSupported("gotoRouteGoal", said)
     client.send(GotoRouteGoal(goal))
 
 
 def patrol(client: AriaClient, route: str) -> None:
     """Start patrolling ``route``; NotSupported when the server has no ``patrol``."""
     if not client.supports("patrol"):
-        raise NotSupported("patrol", "this server cannot patrol routes (patrol)")
+        raise NotSupported("patrol", Said(N_("this server cannot patrol routes (patrol)")))
     client.send(Patrol(route))
 
 
 def say(client: AriaClient, text: str) -> None:
     """Have the robot speak ``text``; NotSupported when the server has no ``say``."""
     if not client.supports("say"):
-        raise NotSupported("say", "this server cannot speak (say)")
+        raise NotSupported("say", Said(N_("this server cannot speak (say)")))
     client.send(Say(text))
 
 

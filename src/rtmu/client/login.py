@@ -13,8 +13,9 @@ import socket
 from collections.abc import Callable
 
 from ..base.i18n import N_, Said
+from ..base.refusals import protocol_refusal
 from ..base.units import Quantity
-from ..protocol.client_connection import ClientConnection, protocol_advice
+from ..protocol.client_connection import ClientConnection
 from ..protocol.commands import RejectReason
 from ..protocol.errors import ProtocolError
 from ..protocol.events import DataListReady, DataReceived, PeerShutdown, Rejected
@@ -130,5 +131,5 @@ def login_rejected(conn: ClientConnection, event: Rejected) -> LoginRejected:
     wanted = conn.wanted_protocol()
     advice = ""
     if event.reason == RejectReason.PROTOCOL_VERSION_MISMATCH and wanted is not None:
-        advice = protocol_advice(wanted, conn.sent_protocol_version or "")
+        advice = protocol_refusal(wanted, conn.sent_protocol_version or "")
     return LoginRejected(event.reason, event.text, advice, wanted)

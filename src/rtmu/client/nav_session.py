@@ -172,7 +172,9 @@ class NavFeed(Feed):
                 reason=reading.reason,
             )
             if news and not self._history:
-                sentence = reading.sentence()[:MAX_TEXT]
+                sentence = reading.sentence()
+                if len(sentence) > MAX_TEXT:  # a short one keeps its Said: the window says it translated
+                    sentence = sentence[:MAX_TEXT]
                 if outcome is NavOutcome.FAILED:
                     self.ctx.notice(Notice.warning(Kind.NAVIGATION, sentence))
                 else:

@@ -16,6 +16,7 @@ import math
 from collections.abc import Sequence
 from dataclasses import dataclass
 
+from ..base.i18n import N_, Said, as_said
 from ..values.state import NavOutcome
 
 MAX_TEXT = 200
@@ -43,6 +44,13 @@ NAV_DATA = (
 )
 """The data navigation uses, where listed (the session's ``NavState.offered`` is these)."""
 
+LOST = N_("the robot is lost")
+"""ARNL's ``because robot lost``, in plain words."""
+NO_PATH = N_("no path could be planned")
+"""ARNL's ``Failed to plan to …``, which gives no reason of its own."""
+OWN_REASONS = frozenset({LOST, NO_PATH})
+"""Reasons in RTMU's words (said in the operator's language); any other reason is the server's."""
+
 _GOING = ("Going to ", "Returning home", "Touring to ", "Driving into dock", "Docking")
 _FAILED = ("Failed", "Unable to dock", "Cannot drive to dock")
 
@@ -63,12 +71,17 @@ class NavReading:
 
     def sentence(self) -> str:
         """The outcome for the operator: ``Arrived at Lab B``, ``Failed to get to Lab B because the
-        robot is lost``, ``Docked``; "" while not finished."""
+        robot is lost``, ``Docked``; "" while not finished. The server's words are kept as sent; a
+        reason of RTMU's own (:data:`LOST`, :data:`NO_PATH`) joins them as a :class:`Said`, so the
+        operator reads it in their language and ``--json`` in English."""
         if not self.finished:
             return ""
         if self.phase is NavOutcome.FAILED:
             head = _failure_head(self.text)
-            return f"{head} because {self.reason}" if self.reason and self.reason not in head else head
+            if self.reason and self.reason not in head:
+                reason = as_said(self.reason) if self.reason in OWN_REASONS else self.reason
+                return Said(N_("{outcome_text} because {reason}"), outcome_text=head, reason=reason)
+            return head
         return self.text
 
 
@@ -142,11 +155,11 @@ def _failure_reason(text: str) -> str:
     """Why, in plain words: ARNL's ``because robot lost`` reads as ``the robot is lost``."""
     if " because " in text:
         why = text.split(" because ", 1)[1].strip().rstrip(".")
-        return "the robot is lost" if why == "robot lost" else why
+        return LOST if why == "robot lost" else why
     if text.endswith(")") and " (" in text:
         return text.rsplit(" (", 1)[1][:-1].strip()
     if text.startswith("Failed to plan to "):
-        return "no path could be planned"
+        return NO_PATH
     if text.startswith("Failed touring goals:"):
         return text.split(":", 1)[1].strip().rstrip(".")
     return ""

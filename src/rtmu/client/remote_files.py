@@ -20,6 +20,7 @@ from dataclasses import dataclass
 from typing import Final, cast
 
 from ..base.exit_codes import EXIT_REFUSED
+from ..base.i18n import N_, Said
 from ..base.textsafe import visible
 from ..protocol.errors import ProtocolError
 from ..protocol.payloads.files import (
@@ -122,19 +123,20 @@ def data_for(client: AriaClient, feature: str) -> str:
 
 
 def name_problem(name: str) -> str:
-    """Why ``name`` cannot be one plain file name that a robot lists ("" when it can be)."""
+    """Why ``name`` cannot be one plain file name that a robot lists ("" when it can be): English, marked
+    (``as_said`` says it in the operator's language)."""
     if not name:
-        return "it is empty"
+        return N_("it is empty")
     if name in (".", ".."):
-        return "it names a folder above or the folder itself"
+        return N_("it names a folder above or the folder itself")
     if "/" in name or "\\" in name:
-        return "it holds a slash"
+        return N_("it holds a slash")
     if visible(name) != name:
-        return "it holds a control character"
+        return N_("it holds a control character")
     if name.startswith("."):
-        return "it starts with a dot (ARIA lists no such names)"
+        return N_("it starts with a dot (ARIA lists no such names)")
     if len(name) > MAX_ENTRY_NAME:
-        return f"it is longer than {MAX_ENTRY_NAME} characters"
+        return Said(N_("it is longer than {count} characters"), count=MAX_ENTRY_NAME)
     return ""
 
 

@@ -17,6 +17,7 @@ from collections.abc import Callable
 from dataclasses import dataclass
 from typing import Final
 
+from ..base.i18n import N_, Said, as_said
 from ..base.textsafe import visible
 from ..protocol.errors import ProtocolError
 from ..protocol.payloads.commands import StringCommandArgs
@@ -79,10 +80,14 @@ def _require(client: AriaClient, feature: str) -> None:
 def scan_name(name: str) -> str:
     """``name`` if a robot can make a scan file of it, else ValueError saying why (nothing is sent)."""
     if len(name) > MAX_SCAN_NAME:
-        raise ValueError(f"a scan name is at most {MAX_SCAN_NAME} characters")
+        raise ValueError(Said(N_("a scan name is at most {count} characters"), count=MAX_SCAN_NAME))
     problem = name_problem(scan_file_name(name))
     if problem:
-        raise ValueError(f"{visible(repr(name))} cannot name a scan: {problem}")
+        raise ValueError(
+            Said(
+                N_("{name} cannot name a scan: {problem}"), name=visible(repr(name)), problem=as_said(problem)
+            )
+        )
     return name
 
 

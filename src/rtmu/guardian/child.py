@@ -52,7 +52,9 @@ from collections.abc import Callable
 from pathlib import Path
 from typing import Protocol
 
+from ..base.i18n import N_, Said
 from ..base.link_timing import Deadline
+from ..base.units import Quantity
 from . import messages as m
 from .halt import Halter
 from .handle import BEAT_PERIOD
@@ -89,8 +91,10 @@ def parent_frozen(pid: int) -> bool:
 
 
 def say(word: str, serial: int, text: str = "") -> None:
+    """One word to the parent; its text in the operator's language (the parent shows it as it comes)."""
+    shown = text.words() if isinstance(text, Said) else text
     try:
-        sys.stdout.write(m.report(word, serial, text) + "\n")
+        sys.stdout.write(m.report(word, serial, shown) + "\n")
         sys.stdout.flush()
     except (OSError, ValueError):
         _parent_stopped_listening()
@@ -176,17 +180,29 @@ class Watch:
         if not self.armed:
             return None
         if self.eof:
-            return "the process driving the robot ended without saying goodbye"
+            return Said(N_("the process driving the robot ended without saying goodbye"))
         late = now - min(self.last.values()) if self.last else 0.0
         if late > QUICK_LATE and parent_frozen(self.parent):
-            return f"the process driving the robot is stopped or gone (no heartbeat for {late * 1000:.0f} ms)"
+            return Said(
+                N_("the process driving the robot is stopped or gone (no heartbeat for {late})"),
+                late=Quantity(late * 1000, "ms"),
+            )
         for kind, at in self.last.items():
             limit = self.limit(kind, now)
             if now - at > limit:
-                thread = "UI" if kind == m.BEAT_UI else "network"
-                return (
-                    f"no heartbeat from the {thread} thread of the process driving the robot for "
-                    f"{(now - at) * 1000:.0f} ms (its beats normally come within {limit * 1000:.0f} ms)"
+                silent = (
+                    N_(
+                        "no heartbeat from the UI thread of the process driving the robot for {late} "
+                        "(its beats normally come within {limit})"
+                    )
+                    if kind == m.BEAT_UI
+                    else N_(
+                        "no heartbeat from the network thread of the process driving the robot for {late} "
+                        "(its beats normally come within {limit})"
+                    )
+                )
+                return Said(
+                    silent, late=Quantity((now - at) * 1000, "ms"), limit=Quantity(limit * 1000, "ms")
                 )
         return None
 
@@ -230,7 +246,7 @@ class Guardian:
                 elif kind == m.COLD and hello is not None:
                     self.cool(hello)
                 elif kind == m.HALT:
-                    self.stop("the program driving it lost its own link to the robot while driving")
+                    self.stop(Said(N_("the program driving it lost its own link to the robot while driving")))
                 else:
                     self.watch.take(kind, at)
 
@@ -324,7 +340,7 @@ class Guardian:
             say(m.UNAVAILABLE, self.serial, login.error)
             self.login = None
         elif login.state is LoginState.CLOSED:
-            say(m.LOST, self.serial, login.error or "the guardian's connection closed")
+            say(m.LOST, self.serial, login.error or Said(N_("the guardian's connection closed")))
             self.login, self.halter = None, None
 
     # -- the loop ------------------------------------------------------------------------------

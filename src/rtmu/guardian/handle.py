@@ -16,6 +16,8 @@ import threading
 import time
 from collections.abc import Callable
 
+from ..base import i18n
+from ..base.i18n import _
 from . import messages as m
 
 BEAT_PERIOD = 0.04
@@ -51,6 +53,7 @@ class GuardianHandle:
             stdin=subprocess.PIPE,
             stdout=subprocess.PIPE,
             start_new_session=True,
+            env={**os.environ, **i18n.child_environment()},  # it says why it stopped in our language
         )
         handle = cls(proc)
         if hello is not None:
@@ -75,7 +78,7 @@ class GuardianHandle:
                 stuck = True
             except OSError:
                 stuck = False
-        self._gone("ended", "the guardian stopped reading its pipe" if stuck else "the guardian ended")
+        self._gone("ended", _("the guardian stopped reading its pipe") if stuck else _("the guardian ended"))
         return False
 
     def _send(self, kind: bytes, at: float | None = None) -> bool:
@@ -146,7 +149,9 @@ class GuardianHandle:
                 self._out = -1
                 if self.state != "ended":
                     code = self.proc.poll()
-                    self._gone("ended", f"the guardian ended unexpectedly (exit code {code})")
+                    self._gone(
+                        "ended", _("the guardian ended unexpectedly (exit code {code})").format(code=code)
+                    )
                     out.append(("ended", -1, self.reason))
                 break
             self._partial += data
@@ -212,17 +217,19 @@ async def start_ready(hello: m.Hello, timeout: float) -> GuardianHandle:
     try:
         handle = GuardianHandle.start(hello)
     except OSError as exc:
-        raise GuardianUnavailable(f"it could not be started: {exc.strerror or exc}") from None
+        raise GuardianUnavailable(
+            _("it could not be started: {error}").format(error=exc.strerror or exc)
+        ) from None
     deadline = time.monotonic() + timeout + 5.0  # its own login has ``timeout``; plus its start-up
     while handle.state == "starting":
         handle.poll()
         if time.monotonic() > deadline:
             handle.close(goodbye=True)
-            raise GuardianUnavailable("it did not log in in time")
+            raise GuardianUnavailable(_("it did not log in in time"))
         await asyncio.sleep(0.02)
     if handle.state != "ready":
         handle.close(goodbye=True)
-        raise GuardianUnavailable(handle.reason or "it ended")
+        raise GuardianUnavailable(handle.reason or _("it ended"))
     return handle
 
 

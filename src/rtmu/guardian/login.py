@@ -18,6 +18,9 @@ import socket
 import time
 from enum import Enum
 
+from ..base.i18n import N_, Said
+from ..base.refusals import refusal
+from ..base.units import Quantity
 from ..protocol.client_connection import ClientConnection
 from ..protocol.errors import ProtocolError
 from ..protocol.events import DataListReady, PeerShutdown, Rejected
@@ -51,7 +54,9 @@ class RobotLogin:
             target.user, target.password, server_key=target.server_key, protocol_version=target.protocol
         )
         self.state = LoginState.CONNECTING
-        self.error = ""
+        self.error: Said | str = ""
+        """Why the login failed or its connection ended: a :class:`Said` (English as a str, the
+        operator's language through ``words()``)."""
         self._received = 0
         self._out = bytearray()
         self.sock: socket.socket | None = None
@@ -63,10 +68,14 @@ class RobotLogin:
             self.sock.setblocking(False)
             code = self.sock.connect_ex(address)
         except OSError as exc:
-            self._fail(f"cannot connect to {self.where}: {exc.strerror or exc}")
+            self._fail(
+                Said(N_("cannot connect to {where}: {error}"), where=self.where, error=exc.strerror or exc)
+            )
             return
         if code not in (0, errno.EINPROGRESS, errno.EWOULDBLOCK):
-            self._fail(f"cannot connect to {self.where}: {_describe(code)}")
+            self._fail(
+                Said(N_("cannot connect to {where}: {error}"), where=self.where, error=_describe(code))
+            )
 
     # -- what the select loop asks -------------------------------------------------------------
     @property
@@ -83,7 +92,9 @@ class RobotLogin:
         if self.state is LoginState.CONNECTING and self.sock is not None:
             code = self.sock.getsockopt(socket.SOL_SOCKET, socket.SO_ERROR)
             if code:
-                self._fail(f"cannot connect to {self.where}: {_describe(code)}")
+                self._fail(
+                    Said(N_("cannot connect to {where}: {error}"), where=self.where, error=_describe(code))
+                )
                 return
             self.state = LoginState.LOGGING_IN
         self._send_some()
@@ -96,26 +107,32 @@ class RobotLogin:
         except BlockingIOError:
             return
         except OSError as exc:
-            self._end(f"the connection to {self.where} broke: {exc.strerror or exc}")
+            self._end(
+                Said(
+                    N_("the connection to {where} broke: {error}"),
+                    where=self.where,
+                    error=exc.strerror or exc,
+                )
+            )
             return
         if not data:
-            self._end(f"{self.where} closed the connection")
+            self._end(Said(N_("{where} closed the connection"), where=self.where))
             return
         self._received += len(data)
         try:
             events = self.conn.receive_data(data, now)
         except ProtocolError as exc:
-            self._end(f"{self.where} is not an ArNetworking server: {exc}")
+            self._end(Said(N_("{peer} is not an ArNetworking server: {error}"), peer=self.where, error=exc))
             return
         if self._received >= NOT_ARIA_AFTER and self.conn.decoder.stats.packets == 0:
-            self._end(f"{self.where} is not an ArNetworking server")
+            self._end(Said(N_("{where} is not an ArNetworking server"), where=self.where))
             return
         for event in events:
             if isinstance(event, Rejected):
-                self._fail(f"login refused: {event.message}")
+                self._fail(Said(N_("login refused: {reason}"), reason=refusal(event.reason, event.text)))
                 return
             if isinstance(event, PeerShutdown):
-                self._end(f"{self.where} shut the connection down")
+                self._end(Said(N_("{where} shut the connection down"), where=self.where))
                 return
             if isinstance(event, DataListReady) and self.state is LoginState.LOGGING_IN:
                 self.state = LoginState.READY
@@ -123,7 +140,13 @@ class RobotLogin:
 
     def check_deadline(self, now: float) -> None:
         if self.state in (LoginState.CONNECTING, LoginState.LOGGING_IN) and now > self.deadline:
-            self._fail(f"{self.where} did not complete the login within {self.hello.timeout:g} s")
+            self._fail(
+                Said(
+                    N_("{where} did not complete the login within {timeout}"),
+                    where=self.where,
+                    timeout=Quantity(self.hello.timeout, "s", None),
+                )
+            )
 
     def supports(self, name: str) -> bool:
         return self.state is LoginState.READY and self.conn.datalist.number(name) is not None
@@ -141,7 +164,13 @@ class RobotLogin:
         except BlockingIOError:
             return
         except OSError as exc:
-            self._end(f"the connection to {self.where} broke: {exc.strerror or exc}")
+            self._end(
+                Said(
+                    N_("the connection to {where} broke: {error}"),
+                    where=self.where,
+                    error=exc.strerror or exc,
+                )
+            )
             return
         del self._out[:sent]
 
@@ -168,11 +197,17 @@ class RobotLogin:
         if self.active:
             self.state = LoginState.CLOSED
 
-    def _fail(self, why: str) -> None:
+    def _cannot_connect(self, error: object) -> None:
+        self._fail(Said(N_("cannot connect to {where}: {error}"), where=self.where, error=error))
+
+    def _broke(self, error: object) -> None:
+        self._end(Said(N_("the connection to {where} broke: {error}"), where=self.where, error=error))
+
+    def _fail(self, why: Said) -> None:
         self.state, self.error = LoginState.FAILED, why
         self._close_socket()
 
-    def _end(self, why: str) -> None:
+    def _end(self, why: Said) -> None:
         if self.state is LoginState.READY:
             self.state, self.error = LoginState.CLOSED, why
             self._close_socket()
@@ -186,7 +221,7 @@ class RobotLogin:
                 sock.close()
 
 
-def _describe(code: int) -> str:
+def _describe(code: int) -> str | Said:
     if code == errno.ECONNREFUSED:
-        return "connection refused (is the robot server running on that port?)"
-    return os.strerror(code) if code else "unknown error"
+        return Said(N_("connection refused (is the robot server running on that port?)"))
+    return os.strerror(code) if code else Said(N_("unknown error"))

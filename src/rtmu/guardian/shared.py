@@ -35,6 +35,7 @@ from collections.abc import Callable, Sequence
 from dataclasses import replace
 from enum import Enum
 
+from ..base.i18n import _
 from ..values.target import Target
 from . import messages as m
 from .handle import GuardianHandle
@@ -113,10 +114,10 @@ class GuardianSeat:
     def waiting_reason(self) -> str | None:
         """Why this robot may not start a drive now (None: it may — guarded, or with the warning)."""
         if not self.chosen:
-            return f"{self.name} is not the robot that may drive"
+            return _("{name} is not the robot that may drive").format(name=self.name)
         if self.state in (SeatState.READY, SeatState.UNAVAILABLE):
             return None
-        return f"arming the guardian for {self.name} …"
+        return _("arming the guardian for {name} …").format(name=self.name)
 
     @property
     def armed(self) -> bool:
@@ -208,7 +209,7 @@ class SharedGuardian:
             return
         handle = self._ensure_process()
         if handle is None:
-            self._unavailable(seat, self._broken or "it could not be started")
+            self._unavailable(seat, self._broken or _("it could not be started"))
             return
         self._serial += 1
         seat.serial = self._serial
@@ -216,7 +217,7 @@ class SharedGuardian:
         seat.state, seat.reason = SeatState.ARMING, ""
         self.logins += 1
         if not handle.login(replace(hello, serial=self._serial)):
-            self._unavailable(seat, handle.reason or "it ended")
+            self._unavailable(seat, handle.reason or _("it ended"))
 
     def _unavailable(self, seat: GuardianSeat, reason: str) -> None:
         seat.state, seat.reason = SeatState.UNAVAILABLE, reason
@@ -232,7 +233,7 @@ class SharedGuardian:
         try:
             handle = self._start()
         except OSError as exc:
-            self._broken = f"it could not be started: {exc.strerror or exc}"
+            self._broken = _("it could not be started: {error}").format(error=exc.strerror or exc)
             return None
         self._broken = ""
         self._handle = handle

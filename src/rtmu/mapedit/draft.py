@@ -337,7 +337,8 @@ class MapDraft:
             try:
                 object_text(edit.after)
             except ValueError as exc:
-                raise DraftError(str(exc)) from None
+                said = _("this cannot be written into an ARIA map: {error}").format(error=exc)
+                raise DraftError(said) from None
         self._edits.append(edit)
         self._undone.clear()
         self._refresh()

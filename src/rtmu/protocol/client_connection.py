@@ -27,7 +27,6 @@ from .commands import (
     FIRST_DATA_NUMBER,
     ClientCommand,
     ClientType,
-    RejectReason,
     ServerCommand,
     is_control_command,
 )
@@ -275,14 +274,3 @@ def named(what: str | Payload, args: bytes = b"") -> tuple[str, bytes]:
             raise TypeError("a typed payload carries its own arguments")
         return payload_name(what), what.encode()
     return what, args
-
-
-def protocol_advice(wanted: str, sent: str) -> str:
-    """What a reason-4 refusal means, and what to do about it (the client's error text)."""
-    base = RejectReason.PROTOCOL_VERSION_MISMATCH.explanation
-    if wanted:
-        return f"{base}: it wants protocol {wanted!r}; we sent {sent!r}. Use --protocol {wanted}"
-    return (
-        f"{base}: we sent {sent!r} and it does not say which it wants; "
-        "try --protocol 6MTX (Omron LD robots; older ones 5MTX)"
-    )

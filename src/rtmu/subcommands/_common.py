@@ -28,7 +28,7 @@ from pathlib import Path
 from typing import TYPE_CHECKING, Any, TypeVar
 
 from ..base.exit_codes import EXIT_CONNECTION, EXIT_SIGPIPE, EXIT_USAGE
-from ..base.i18n import _, error_words
+from ..base.i18n import N_, Said, _, as_said, error_words
 from ..client.defaults import CONNECT_TIMEOUT, DEFAULT_PORT
 from ..client.errors import ClientError
 from ..client.roles import Role
@@ -222,7 +222,7 @@ def resolve_robot(args: argparse.Namespace) -> int | None:
     except ProtocolError as exc:
         return fail(name, f"central server {host}:{port} sent a malformed robot list: {exc}", EXIT_CONNECTION)
     except Interrupted as exc:
-        return fail(name, str(exc), exc.exit_code)
+        return fail(name, error_words(exc), exc.exit_code)
     wanted = args.robot
     try:
         found = find_robot(robots, wanted)  # without case, as ARIA compares; several: refused
@@ -260,24 +260,31 @@ def _read_password(args: argparse.Namespace) -> str:
         except FileNotFoundError:
             # Not named: what was typed there may be the password itself rather than a file name.
             raise UsageError(
-                "cannot read the password file given with --password-file: no such file "
-                "(its name is not shown, in case a password was typed there)"
+                _(
+                    "cannot read the password file given with --password-file: no such file "
+                    "(its name is not shown, in case a password was typed there)"
+                )
             ) from None
         except OSError as exc:
-            raise UsageError(f"cannot read the password file {path}: {exc.strerror or exc}") from None
+            said = _("cannot read the password file {path}: {error}").format(
+                path=path, error=exc.strerror or exc
+            )
+            raise UsageError(said) from None
         return data.decode("utf-8", "replace").splitlines()[0] if data else ""
     if getattr(args, "password_stdin", False):
         line = sys.stdin.readline() if sys.stdin is not None else ""
         if not line:
-            raise UsageError("--password-stdin: standard input ended without a password line")
+            raise UsageError(_("--password-stdin: standard input ended without a password line"))
         return line.rstrip("\r\n")
     if not args.user:
         return ""
     if sys.stdin is not None and sys.stdin.isatty():
-        return getpass.getpass(f"Password for {args.user}@{args.server[0]}: ")
+        return getpass.getpass(_("Password for {user}@{host}: ").format(user=args.user, host=args.server[0]))
     raise UsageError(
-        f"--user {args.user} needs a password and there is no terminal to ask on: give --password-file "
-        "FILE or --password-stdin (one line on standard input)"
+        _(
+            "--user {user} needs a password and there is no terminal to ask on: give --password-file "
+            "FILE or --password-stdin (one line on standard input)"
+        ).format(user=args.user)
     )
 
 
@@ -301,7 +308,13 @@ class Interrupted(Exception):
         self.signum = signum
         self.exit_code = 128 + signum
         self.detail = detail
-        super().__init__(f"interrupted by {signal_name(signum)}" + (f"; {detail}" if detail else ""))
+        name = signal_name(signum)
+        said = (
+            Said(N_("interrupted by {signal}; {detail}"), signal=name, detail=as_said(detail))
+            if detail
+            else Said(N_("interrupted by {signal}"), signal=name)
+        )
+        super().__init__(said)  # the operator reads it in their language (``error_words``)
 
 
 async def until_stop_signal() -> int:
@@ -511,11 +524,12 @@ def run_with_client(
     try:
         return run_interruptibly(main)
     except Interrupted as exc:
-        return fail(name, str(exc), exc.exit_code)
+        return fail(name, error_words(exc), exc.exit_code)
     except ClientError as exc:
         return fail(name, error_words(exc), exc.exit_code)
     except ProtocolError as exc:  # a reply that does not decode, wherever a command looked at it
-        return fail(name, f"the server sent something malformed: {exc}", EXIT_CONNECTION)
+        said = _("the server sent something malformed: {error}").format(error=exc)
+        return fail(name, said, EXIT_CONNECTION)
     except UsageError as exc:
         return fail(name, str(exc), EXIT_USAGE)
     except BrokenPipeError:  # e.g. piped into ``head``: the reader has what it wanted
@@ -556,11 +570,18 @@ def known_name(command: str, kind: str, name: str, known: tuple[str, ...]) -> st
         return folded[0]
     from ..base.textsafe import visible
 
-    listed = visible(", ".join(known) or "none")
+    listed = visible(", ".join(known)) if known else _("none")
     print(
-        _("rtmu {command}: no {kind} {visible} on this server ({kind}s: {listed})").format(
-            command=command, kind=kind, visible=visible(repr(name)), listed=listed
-        ),
+        _(UNKNOWN_NAME[kind]).format(command=command, visible=visible(repr(name)), listed=listed),
         file=sys.stderr,
     )
     return None
+
+
+UNKNOWN_NAME = {
+    "goal": N_("rtmu {command}: no goal {visible} on this server (goals: {listed})"),
+    "route": N_("rtmu {command}: no route {visible} on this server (routes: {listed})"),
+    "command": N_("rtmu {command}: no command {visible} on this server (commands: {listed})"),
+}
+"""What :func:`known_name` says for each kind of name (marked: a whole sentence per kind, so each language
+can say it with its own words and grammar)."""

@@ -17,11 +17,11 @@ from dataclasses import dataclass
 from typing import TYPE_CHECKING, Any
 
 from ..base.exit_codes import EXIT_CANCELLED, EXIT_LOST, EXIT_OK, EXIT_REFUSED, EXIT_TIMEOUT, NETWORK
-from ..base.i18n import _
+from ..base.i18n import N_, Said, _, number
 from ..base.textsafe import visible
 from ..base.units import metres
 from ..client.errors import ClientError, NotSupported
-from ..client.nav_status import NavReading, path_remaining, read_motion
+from ..client.nav_status import LOST, NavReading, path_remaining, read_motion
 from ..protocol.errors import ProtocolError
 from ..protocol.payloads import Payload, Side, decode_payload
 from ..protocol.payloads.drive import RatioDrive
@@ -57,29 +57,32 @@ DISTANCE_EVERY = 2.0
 def add_wait_arguments(parser: argparse.ArgumentParser, *, localizing: bool = False) -> None:
     """``--limit``, ``--no-wait``, ``--json``: how long to follow the server's words, how to print them."""
     if localizing:
-        limit = f"give up waiting for the server's answer after S seconds, exit 5 (default {DEFAULT_LIMIT:g})"
-        no_wait = "send localizeToPose and exit 0 without waiting for the server to confirm it"
-        lines = (
+        limit = _("give up waiting for the server's answer after S seconds, exit 5 (default {limit})")
+        no_wait = _("send localizeToPose and exit 0 without waiting for the server to confirm it")
+        lines = _(
             'one object per line: {"localization": "initializing"} while it '
             'localizes, then {"outcome": "localized" | "lost" | "timeout", "score"}; --no-wait: {"sent"}'
         )
     else:
-        limit = f"give up after S seconds: stop the robot, exit 5 (default {DEFAULT_LIMIT:g})"
-        no_wait = "send the command and exit 0; the robot drives on by itself"
-        lines = (
+        limit = _("give up after S seconds: stop the robot, exit 5 (default {limit})")
+        no_wait = _("send the command and exit 0; the robot drives on by itself")
+        lines = _(
             'one object per line: {"status", "phase"} as the server reports, '
-            '{"remaining_mm"} every metre or so, and a last {"outcome", "text", "reason", "x", "y", "th"} '
+            '{"remaining_mm"} every metre or so, and a last '
+            '{"outcome", "text", "reason", "x", "y", "th"} '
             '(also after Ctrl-C: outcome "interrupted", with "signal"); --no-wait: {"sent"}'
         )
+    limit = limit.format(limit=f"{DEFAULT_LIMIT:g}")
     parser.add_argument("--limit", type=positive_float, default=DEFAULT_LIMIT, metavar="S", help=limit)
     parser.add_argument("--no-wait", action="store_true", help=no_wait)
     parser.add_argument("--json", action="store_true", help=lines)
 
 
-def require(client: AriaClient, name: str, what: str) -> None:
-    """NotSupported (exit 4) with plain words when the server does not list ``name``."""
+def require(client: AriaClient, name: str, sentence: str) -> None:
+    """NotSupported (exit 4) with plain words when the server does not list ``name``: ``sentence``, a
+    marked template (``N_("this server does not drive home (it does not offer {name})")``)."""
     if not client.supports(name):
-        raise NotSupported(name, f"this server does not {what} (it does not offer {name})")
+        raise NotSupported(name, Said(sentence, name=name))
 
 
 def stop_robot(client: AriaClient) -> None:
@@ -216,7 +219,7 @@ async def navigate(client: AriaClient, args: argparse.Namespace, payload: Payloa
     before = watch.reading()
     client.send(payload)
     if args.no_wait:
-        _say(args, {"sent": type(payload).DATA_NAME}, f"sent {type(payload).DATA_NAME}")
+        _say(args, {"sent": type(payload).DATA_NAME}, _("sent {name}").format(name=type(payload).DATA_NAME))
         await client.flush()
         return EXIT_OK
     return await _follow(client, args, watch, before, expect)
@@ -269,7 +272,8 @@ async def _follow(
     except TimeoutError:
         stop_robot(client)
         await client.flush()
-        _say(args, {"outcome": "timeout", **_pose_fields(watch)}, "no outcome in time: the robot was stopped")
+        line = _("no outcome in time: the robot was stopped")
+        _say(args, {"outcome": "timeout", **_pose_fields(watch)}, line)
         print(
             _("rtmu {subcommand}: no outcome within {limit:g} s; stop sent").format(
                 subcommand=args.subcommand, limit=args.limit
@@ -285,12 +289,12 @@ async def _follow(
         await client.flush()
         if args.json:  # the promised last line: how it ended, and where the robot was
             print_json({"outcome": "interrupted", "signal": signal_name(signum), **_pose_fields(watch)})
-        raise Interrupted(signum, "the robot was stopped") from None
+        raise Interrupted(signum, Said(N_("the robot was stopped"))) from None
 
 
 def _outcome(args: argparse.Namespace, watch: _Watch, r: NavReading) -> int:
     if r.phase is NavOutcome.FAILED:
-        lost = r.reason == "the robot is lost"
+        lost = r.reason == LOST
         code = EXIT_NAV_LOST if lost else EXIT_NAV_FAILED
         return _ended(args, watch, r, "failed", code)
     return _ended(args, watch, r, r.phase.value, EXIT_OK)
@@ -301,7 +305,9 @@ def _ended(args: argparse.Namespace, watch: _Watch, r: NavReading, outcome: str,
     if args.json:
         print_json(obj)
     elif code != EXIT_OK:
-        why = r.sentence() or r.text or "it stopped before arriving"
+        sentence = r.sentence()  # a failure's reason of RTMU's own is a Said; the server's words as sent
+        why = (sentence.words() if isinstance(sentence, Said) else sentence) or r.text
+        why = why or _("it stopped before arriving")
         print(
             _("rtmu {subcommand}: {visible}").format(subcommand=args.subcommand, visible=visible(why)),
             file=sys.stderr,
@@ -319,8 +325,12 @@ async def localize(client: AriaClient, args: argparse.Namespace, payload: Payloa
         client.request("getLocState", STATUS_MS, watch.handler(watch.on_loc))
     client.send(payload)
     if args.no_wait or not client.supports("getLocState"):
-        note = "" if args.no_wait else " (the server offers no getLocState to confirm it)"
-        _say(args, {"sent": "localizeToPose"}, f"sent localizeToPose{note}")
+        line = (
+            _("sent {name}")
+            if args.no_wait
+            else _("sent {name} (the server offers no getLocState to confirm it)")
+        ).format(name="localizeToPose")
+        _say(args, {"sent": "localizeToPose"}, line)
         await client.flush()
         return EXIT_OK
     loop = asyncio.get_running_loop()
@@ -336,12 +346,16 @@ async def localize(client: AriaClient, args: argparse.Namespace, payload: Payloa
                     state = loc.state
                     if state == LocalizationState.INITIALIZING and not seen_initializing:
                         seen_initializing = True
-                        _say(args, {"localization": loc.state_label}, "localizing")
+                        _say(args, {"localization": loc.state_label}, _("localizing"))
                     settled = seen_initializing or now - sent_at >= SETTLE
                     if settled and state in (LocalizationState.GOOD, LocalizationState.LOST):
                         good = state == LocalizationState.GOOD
                         obj = {"outcome": "localized" if good else "lost", "score": loc.score_fraction}
-                        line = f"localized (score {loc.score_fraction:.2f})" if good else "the robot is lost"
+                        line = (
+                            _("localized (score {score})").format(score=number(loc.score_fraction, 2))
+                            if good
+                            else _(LOST)
+                        )
                         _say(args, obj, line)
                         if not good:
                             print(
@@ -356,7 +370,7 @@ async def localize(client: AriaClient, args: argparse.Namespace, payload: Payloa
                     async with asyncio.timeout(SETTLE / 3):
                         await watch.changed.wait()
     except TimeoutError:
-        _say(args, {"outcome": "timeout"}, "no answer in time")
+        _say(args, {"outcome": "timeout"}, _("no answer in time"))
         print(
             _("rtmu {subcommand}: not localized within {limit:g} s").format(
                 subcommand=args.subcommand, limit=args.limit

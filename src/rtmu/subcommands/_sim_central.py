@@ -7,8 +7,9 @@ import sys
 from typing import TYPE_CHECKING
 
 from ..base.exit_codes import EXIT_CONNECTION, EXIT_USAGE
-from ..base.i18n import _, ngettext
+from ..base.i18n import N_, Said, _, ngettext
 from ._common import until_stop_signal
+from ._sim_lines import start_line
 
 if TYPE_CHECKING:
     from ..sim import SimConfig
@@ -38,11 +39,12 @@ async def serve_central(cfg: SimConfig, robot_port: int, robots: int) -> int:
             file=sys.stderr,
         )
         return EXIT_CANNOT_LISTEN
-    print(  # read by programs (the ports): in English in every language
-        f"rtmu sim: ARIA central server: operators on {cfg.host}:{central.port}, robots switch to "
-        f"{cfg.host}:{central.robot_port}",
-        flush=True,
+    line = Said(
+        N_("rtmu sim: ARIA central server: operators on {operators}, robots switch to {robots}"),
+        operators=f"{cfg.host}:{central.port}",
+        robots=f"{cfg.host}:{central.robot_port}",
     )
+    print(start_line(line), flush=True)  # read by programs (the ports): English unless at a terminal
     sims: list[SimServer] = []
     try:
         # Start poses apart, as `rtmu sim --robots N` gives them (not all on the map's home).

@@ -14,64 +14,28 @@ import json
 import math
 import os
 import sys
-from collections import deque
 from collections.abc import Iterable
 from typing import TYPE_CHECKING, Any, TextIO
 
 from ..base.exit_codes import EXIT_BAD_FILE, EXIT_OK, EXIT_SIGPIPE, EXIT_USAGE
-from ..base.i18n import _
+from ..base.i18n import N_, _
 from ..base.textsafe import json_safe, visible
 from ..capture import CaptureError, CaptureSource, UnreadableInput, open_capture
 from ..capture.conversation import (
-    C2S,
-    S2C,
     Conversation,
     DecodedPacket,
     DecodeItem,
-    DropReport,
     TrailingDrops,
 )
 from ..capture.reader import DIRECTIONS, FORMATS
 from ..capture.session_decoder import CaptureDecoder
+from ._decode_text import relative, write_text, write_text_summary
 
 if TYPE_CHECKING:
     from ..capture import CaptureSource
 
 EXITS = (EXIT_OK, EXIT_USAGE, EXIT_BAD_FILE, EXIT_SIGPIPE)
-RUN_HEAD = 3
-RUN_TAIL = 2
-SHORT_TEXT = 72
-SHORT_LIST = 6
-SHORT_ENTRIES = 12
-SHORT_ENTRY = 40
-PREVIEW_BYTES = 24
-LINK_NAMES = {
-    0: "BSD loopback",
-    1: "Ethernet",
-    12: "raw IP",
-    14: "raw IP",
-    101: "raw IP",
-    108: "OpenBSD loopback",
-    113: "Linux cooked",
-    228: "raw IPv4",
-    229: "raw IPv6",
-    276: "Linux cooked v2",
-}
-DROP_WORDS = {
-    "garbage_bytes": ("garbage byte", "garbage bytes"),
-    "bad_length": ("bad length field", "bad length fields"),
-    "bad_checksum": ("bad checksum", "bad checksums"),
-    "truncated_at_close": ("packet cut off at the end", "packets cut off at the end"),
-    "capture_gap_bytes": ("byte missing from the capture", "bytes missing from the capture"),
-}
-
-
-def _drops_text(counts: dict[str, int]) -> str:
-    words = (DROP_WORDS.get(k, (k, k)) for k in counts)
-    return ", ".join(f"{n} {w[0] if n == 1 else w[1]}" for n, w in zip(counts.values(), words, strict=True))
-
-
-_DESCRIPTION = """\
+_DESCRIPTION = N_("""\
 Show every ArNetworking packet of a capture: which end sent it, its command and
 name (control commands by direction, data names from that connection's own
 LIST), length, checksum, decoded fields, and what a receiver would drop.
@@ -79,9 +43,9 @@ LIST), length, checksum, decoded fields, and what a receiver would drop.
 Inputs: pcap or pcapng (TCP reassembled on any port, UDP datagrams attributed
 to their connection), an RTMU recording (FILE.mcap from the window or rtmu
 record: its raw channel, every connection in it), a hex dump (xxd, hexdump, od, tshark, plain hex) or raw
-bytes (one stream; --direction says who sent it when the packets do not)."""
+bytes (one stream; --direction says who sent it when the packets do not).""")
 
-_EPILOG = """\
+_EPILOG = N_("""\
 text output folds runs of one packet kind to their first 3 and last 2 lines;
 --all prints everything. --json prints one object per packet and line:
   conn dir transport time command name length checksum_ok fields
@@ -97,7 +61,7 @@ examples:
   rtmu decode ~/.local/share/rtmu/recordings/20261125T041500Z_lab_7272.mcap
   rtmu decode --json session.pcap | jq 'select(.name == "ratioDrive") | .fields'
   rtmu decode --name getMapBinary --all session.pcap
-  xxd bytes.bin > dump.txt && rtmu decode --direction c2s dump.txt"""
+  xxd bytes.bin > dump.txt && rtmu decode --direction c2s dump.txt""")
 
 
 def register(subparsers: argparse._SubParsersAction) -> None:
@@ -105,8 +69,8 @@ def register(subparsers: argparse._SubParsersAction) -> None:
     parser = subparsers.add_parser(
         "decode",
         help=_("decode ArNetworking traffic from a pcap/pcapng capture, a hex dump or raw bytes"),
-        description=_DESCRIPTION,
-        epilog=_EPILOG,
+        description=_(_DESCRIPTION),
+        epilog=_(_EPILOG),
         formatter_class=argparse.RawDescriptionHelpFormatter,
     )
     parser.add_argument(
@@ -145,11 +109,9 @@ def run(args: argparse.Namespace) -> int:
     try:
         source = open_capture(args.file, args.format, args.direction)
     except UnreadableInput as exc:
-        print(_("rtmu decode: {visible}").format(visible=visible(exc)), file=sys.stderr)
-        return EXIT_USAGE
+        return _failed(_("rtmu decode: the file cannot be read ({detail})"), exc, EXIT_USAGE)
     except CaptureError as exc:
-        print(_("rtmu decode: {visible}").format(visible=visible(exc)), file=sys.stderr)
-        return EXIT_BAD_FILE
+        return _failed(_("rtmu decode: the file cannot be decoded ({detail})"), exc, EXIT_BAD_FILE)
     decoder = CaptureDecoder(report_trailing_drops=args.json)
     summary = args.summary if args.summary is not None else not args.json
     out = sys.stdout
@@ -158,19 +120,17 @@ def run(args: argparse.Namespace) -> int:
         if args.json:
             _write_json(out, items, source, args.payload)
         else:
-            _write_text(out, items, source, full=args.all, payload=args.payload)
+            write_text(out, items, source, full=args.all, payload=args.payload)
         if summary:
             if args.json:
                 _write_json_summary(out, decoder, source)
             else:
-                _write_text_summary(out, decoder, source, full=args.all)
+                write_text_summary(out, decoder, source, full=args.all)
         out.flush()
     except UnreadableInput as exc:
-        print(_("rtmu decode: {visible}").format(visible=visible(exc)), file=sys.stderr)
-        return EXIT_USAGE
+        return _failed(_("rtmu decode: the file cannot be read ({detail})"), exc, EXIT_USAGE)
     except CaptureError as exc:
-        print(_("rtmu decode: {visible}").format(visible=visible(exc)), file=sys.stderr)
-        return EXIT_BAD_FILE
+        return _failed(_("rtmu decode: the file cannot be decoded ({detail})"), exc, EXIT_BAD_FILE)
     except BrokenPipeError:  # `rtmu decode x | head`: the reader has seen enough (141, as every command)
         devnull = os.open(os.devnull, os.O_WRONLY)
         os.dup2(devnull, sys.stdout.fileno())
@@ -178,6 +138,12 @@ def run(args: argparse.Namespace) -> int:
     for warning in source.stats.warnings:
         print(_("rtmu decode: warning: {visible}").format(visible=visible(warning)), file=sys.stderr)
     return EXIT_OK
+
+
+def _failed(sentence: str, error: Exception, code: int) -> int:
+    """One line on stderr: RTMU's sentence, the capture reader's own words (English) as its detail."""
+    print(sentence.format(detail=visible(error)), file=sys.stderr)
+    return code
 
 
 def _filtered(items: Iterable[DecodeItem], args: argparse.Namespace) -> Iterable[DecodeItem]:
@@ -196,20 +162,13 @@ def _filtered(items: Iterable[DecodeItem], args: argparse.Namespace) -> Iterable
     )
 
 
-def _relative(time: float | None, source: CaptureSource) -> float | None:
-    base = source.stats.first_time
-    if time is None or base is None:
-        return None
-    return round(time - base, 6)
-
-
 # -- JSON -------------------------------------------------------------------
 def packet_json(packet: DecodedPacket, source: CaptureSource, payload: bool = False) -> dict[str, Any]:
     record: dict[str, Any] = {
         "conn": packet.conn,
         "dir": packet.direction,
         "transport": packet.transport,
-        "time": _relative(packet.time, source),
+        "time": relative(packet.time, source),
         "command": packet.command,
         "name": packet.name,
         "length": packet.length,
@@ -233,7 +192,7 @@ def trailing_drops_json(drops: TrailingDrops, source: CaptureSource) -> dict[str
         "conn": drops.conn,
         "dir": drops.direction,
         "transport": drops.transport,
-        "time": _relative(drops.time, source),
+        "time": relative(drops.time, source),
         "kind": "dropped",
         "command": None,
         "name": None,
@@ -321,8 +280,8 @@ def _session_facts(session: Conversation, source: CaptureSource) -> dict[str, An
         "client": str(session.client) if session.client else None,
         "server": str(session.server) if session.server else None,
         "server_guessed": session.server_guessed,
-        "start": _relative(session.first_time, source),
-        "end": _relative(session.last_time, source),
+        "start": relative(session.first_time, source),
+        "end": relative(session.last_time, source),
         "udp_datagrams": session.udp_datagrams,
         "data_names": len(session.datalist),
         "rejected": session.rejected,
@@ -336,249 +295,3 @@ def _session_facts(session: Conversation, source: CaptureSource) -> dict[str, An
             for d, t in session.totals.items()
         },
     }
-
-
-# -- text -----------------------------------------------------------------------
-class _TextWriter:
-    """Prints packets; folds runs of one (conn, dir, transport, command) to head and tail."""
-
-    def __init__(self, out: TextIO, source: CaptureSource, full: bool, payload: bool) -> None:
-        self.out = out
-        self.source = source
-        self.full = full
-        self.payload = payload
-        self.lines: list[str] = []
-        self.run_key: tuple[Any, ...] | None = None
-        self.run_count = 0
-        self.run_first_time: float | None = None
-        self.tail: deque[DecodedPacket] = deque(maxlen=RUN_TAIL)
-        self.hidden = 0
-        self.hidden_last: DecodedPacket | None = None
-
-    def item(self, item: DecodeItem) -> None:
-        if isinstance(item, TrailingDrops):
-            return  # its drops were printed as they happened
-        if isinstance(item, DropReport):
-            self._end_run()
-            self._emit(self._drop_line(item))
-            return
-        if self.full:
-            self._emit(self._packet_line(item))
-            return
-        plain = item.checksum_ok and not item.error
-        key = (item.conn, item.direction, item.transport, item.command) if plain else None
-        if key is None or key != self.run_key:
-            self._end_run()
-            self.run_key = key
-            self.run_count = 0
-        self.run_count += 1
-        if self.run_count <= RUN_HEAD or key is None:
-            self._emit(self._packet_line(item))
-            return
-        if len(self.tail) == RUN_TAIL:
-            self.hidden += 1
-            self.hidden_last = self.tail[0]
-            if self.hidden == 1:
-                self.run_first_time = self.tail[0].time
-        self.tail.append(item)
-
-    def _end_run(self) -> None:
-        if self.hidden:
-            last = self.hidden_last
-            assert last is not None
-            span = ""
-            start = _relative(self.run_first_time, self.source)
-            end = _relative(last.time, self.source)
-            if start is not None and end is not None:
-                span = f" over {end - start:.3f} s"
-            label = last.name or f"command {last.command}"
-            self._emit(
-                f"{'':>10} {last.conn:>3} {last.direction} {last.transport:<6}"
-                f" … {self.hidden} more {label} packets{span} (--all shows them) …"
-            )
-        for packet in self.tail:
-            self._emit(self._packet_line(packet))
-        self.tail.clear()
-        self.hidden = 0
-        self.hidden_last = None
-        self.run_key = None
-
-    def finish(self) -> None:
-        self._end_run()
-        self.flush()
-
-    def _emit(self, line: str) -> None:
-        self.lines.append(visible(line))  # packet strings come from the capture: untrusted text
-        if len(self.lines) >= 2048:
-            self.flush()
-
-    def flush(self) -> None:
-        if self.lines:
-            self.out.write("\n".join(self.lines) + "\n")
-            self.lines.clear()
-
-    def _time(self, time: float | None) -> str:
-        rel = _relative(time, self.source)
-        return f"{rel:>10.6f}" if rel is not None else f"{'-':>10}"
-
-    def _drop_line(self, drop: DropReport) -> str:
-        what = _drops_text(drop.counts)
-        return (
-            f"{self._time(drop.time)} {drop.conn:>3} {drop.direction} {drop.transport:<6} !! dropped: {what}"
-        )
-
-    def _packet_line(self, p: DecodedPacket) -> str:
-        name = p.name if p.name else ("?" if p.is_data else "(unknown control)")
-        where = f"{self._time(p.time)} {p.conn:>3} {p.direction} {p.transport:<6}"
-        head = f"{where} {p.command:>5} {name:<22} {p.length:>5}"
-        parts: list[str] = []
-        if not p.checksum_ok:
-            parts.append("BAD CHECKSUM")
-        if p.fields:
-            parts.append(format_fields(p.fields, self.full))
-        if p.note:
-            parts.append(f"({p.note})")
-        if p.error:
-            parts.append(f"!! {p.error}")
-        if p.payload and (
-            self.payload or (not p.fields and not p.error and p.note is None) or not p.checksum_ok
-        ):
-            parts.append(_preview(p.payload, self.full or self.payload))
-        return f"{head}  {' '.join(parts)}" if parts else head
-
-
-def _write_text(
-    out: TextIO, items: Iterable[DecodeItem], source: CaptureSource, *, full: bool, payload: bool
-) -> None:
-    writer = _TextWriter(out, source, full, payload)
-    kind = source.kind
-    out.write(f"# {visible(source.path.name)}: {kind}{_link(source)}\n")
-    out.write(
-        f"# {'time':>8} {'conn':>3} dir transport cmd name{' ' * 21}length  "
-        "fields (checksum ok unless marked)\n"
-    )
-    for item in items:
-        writer.item(item)
-    writer.finish()
-
-
-def _link(source: CaptureSource) -> str:
-    lt = source.stats.link_type
-    if lt is None:
-        return ""
-    return f", link type {lt} ({LINK_NAMES.get(lt, 'unsupported')})"
-
-
-def _preview(payload: bytes, full: bool) -> str:
-    shown = payload if full else payload[:PREVIEW_BYTES]
-    more = "" if len(shown) == len(payload) else f" …(+{len(payload) - len(shown)} bytes)"
-    text = "".join(chr(b) if 32 <= b < 127 else "." for b in shown)
-    return f"[{shown.hex(' ')}{more}] |{text}|"
-
-
-def format_fields(fields: dict[str, Any], full: bool = False) -> str:
-    """``key=value`` pairs; long strings and lists are shortened unless ``full``."""
-    entries = fields.get("entries")
-    if isinstance(entries, list) and entries and isinstance(entries[0], dict) and "number" in entries[0]:
-        rest = {k: v for k, v in fields.items() if k != "entries"}
-        shown = entries if full else entries[:SHORT_ENTRIES]
-        text = ", ".join(_entry(e, full) for e in shown)
-        if len(shown) < len(entries):
-            text += f", … +{len(entries) - len(shown)}"
-        return (format_fields(rest, full) + " " if rest else "") + f"entries: {text}"
-    return " ".join(f"{k}={_value(v, full)}" for k, v in fields.items())
-
-
-def _entry(entry: dict[str, Any], full: bool) -> str:
-    """One list entry: its number and texts (only the name, or the group and flags, when short)."""
-    values = [str(v) for k, v in entry.items() if k != "number" and v != ""]
-    if not full and "name" in entry:
-        values = [str(entry["name"])]
-    text = "/".join(values)
-    if not full and len(text) > SHORT_ENTRY:
-        text = text[:SHORT_ENTRY] + "…"
-    return f"{entry['number']} {text}" if text else str(entry["number"])
-
-
-def _value(value: Any, full: bool) -> str:
-    """A field's value as text. A string is quoted and NOT escaped here: every text line is escaped
-    once, whole, when it is written (``visible``: control characters, so one packet stays one line,
-    and backslashes) — escaping here too showed a ``\\`` in a password key as four."""
-    if isinstance(value, str):
-        if not full and len(value) > SHORT_TEXT:
-            value = value[:SHORT_TEXT] + "…"
-        quote = '"' if "'" in value and '"' not in value else "'"
-        return f"{quote}{value}{quote}"
-    if isinstance(value, float):
-        return f"{value:g}"
-    if isinstance(value, dict):
-        return "{" + " ".join(f"{k}={_value(v, full)}" for k, v in value.items()) + "}"
-    if isinstance(value, (list, tuple)):
-        shown = value if full else value[:SHORT_LIST]
-        inner = ", ".join(_value(v, full) for v in shown)
-        if len(shown) < len(value):
-            inner += f", … +{len(value) - len(shown)} (n={len(value)})"
-        return f"[{inner}]"
-    return str(value)
-
-
-def _write_text_summary(out: TextIO, decoder: CaptureDecoder, source: CaptureSource, *, full: bool) -> None:
-    stats = source.stats
-    lines = ["", "== summary"]
-    span = ""
-    if stats.first_time is not None and stats.last_time is not None:
-        span = f", {stats.last_time - stats.first_time:.3f} s"
-    if stats.kind in ("pcap", "pcapng"):
-        lines.append(f"capture: {stats.frames} frames{span}")
-    if not decoder.sessions:
-        lines.append("no ArNetworking packets found")
-    for session in decoder.sessions:
-        lines.extend(_session_lines(session, source, full))
-    notes = [
-        (stats.not_ip, "frames were not TCP/UDP over IP (skipped)"),
-        (stats.ip_fragments, "IP fragments (not reassembled, skipped)"),
-        (stats.truncated_frames, "frames cut by the snap length"),
-        (stats.retransmitted_bytes, "TCP bytes retransmitted (counted once)"),
-        (stats.out_of_order_segments, "TCP segments arrived out of order (reordered)"),
-        (stats.tcp_gaps, "holes in TCP streams (bytes never captured)"),
-        (decoder.ignored_tcp_flows, "TCP connections carried no ArNetworking packet (ignored)"),
-        (decoder.ignored_datagrams, "UDP datagrams were not ArNetworking (ignored)"),
-    ]
-    lines.extend(f"note: {n} {text}" for n, text in notes if n)
-    out.write("\n".join(visible(line) for line in lines) + "\n")
-
-
-def _session_lines(session: Conversation, source: CaptureSource, full: bool) -> list[str]:
-    start = _relative(session.first_time, source)
-    end = _relative(session.last_time, source)
-    when = f"  {start:.3f}–{end:.3f} s" if start is not None and end is not None else ""
-    if session.transport == "stream":
-        who = f"bytes sent by the {'server' if session.server == session.ends[0] else 'client'}"
-        if session.server_guessed:
-            who += " (guessed; use --direction to say)"
-    else:
-        guess = " (guessed)" if session.server_guessed else ""
-        who = f"client {session.client}  server {session.server}{guess}"
-    lines = [f"conn {session.id}: {session.transport} {who}{when}"]
-    if session.udp_datagrams and session.transport != "udp":
-        flows = sorted({" ↔ ".join(sorted((str(a), str(b)))) for a, b in session.udp_flows})
-        lines.append(f"  + {session.udp_datagrams} UDP datagrams ({'; '.join(flows)})")
-    if session.rejected:
-        lines.append(f"  rejected: {session.rejected}")
-    if session.datalist.have_list:
-        lines.append(f"  data list: {len(session.datalist)} names")
-    for direction in (C2S, S2C):
-        totals = session.totals[direction]
-        if not totals.packets and not totals.drops:
-            continue
-        names = totals.by_name.most_common()
-        shown = names if full else names[:10]
-        text = ", ".join(f"{n} ×{c}" for n, c in shown)
-        if len(shown) < len(names):
-            text += f", … +{len(names) - len(shown)} names"
-        lines.append(f"  {direction} {totals.packets} packets, {totals.bytes} bytes: {text}")
-    drops = [f"{d} " + _drops_text(session.totals[d].drops) for d in (C2S, S2C) if session.totals[d].drops]
-    lines.append("  dropped: " + ("; ".join(drops) if drops else "nothing"))
-    if session.held_overflow:
-        lines.append(f"  ({session.held_overflow} bad packets before the first good one were not shown)")
-    return lines

@@ -5,7 +5,7 @@ from __future__ import annotations
 import argparse
 from typing import TYPE_CHECKING, Any
 
-from ..base.i18n import _
+from ..base.i18n import N_, _
 from ..client.roles import Role
 from ..protocol.payloads.navigation import Dock
 from ._common import add_connection_arguments, run_with_client
@@ -33,7 +33,7 @@ def register(subparsers: Any) -> None:
 
 def handle(args: argparse.Namespace) -> int:
     async def body(client: AriaClient) -> int:
-        require(client, "dock", "dock")
+        require(client, "dock", N_("this server does not dock (it does not offer {name})"))
         return await navigate(client, args, Dock(), Expect(docked=True))
 
     return run_with_client("dock", args, body, role=Role.OPERATOR)

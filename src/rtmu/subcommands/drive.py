@@ -31,7 +31,7 @@ from collections.abc import Callable
 from typing import TYPE_CHECKING, Any
 
 from ..base.exit_codes import EXIT_OK, EXIT_SIGQUIT, EXIT_SIGTSTP, EXIT_USAGE, NETWORK, WHY_DRIVE
-from ..base.i18n import _, words
+from ..base.i18n import N_, Said, _, words
 from ..base.textsafe import visible
 from ..values.target import Target
 from ._common import (
@@ -217,7 +217,7 @@ def handle(args: argparse.Namespace) -> int:
             async with asyncio.timeout(AFTER_INTERRUPT):
                 after = await settle(client, min(args.timeout, AFTER_INTERRUPT))
         report(args, before, after, interrupted=signal_name(signum))
-        raise Interrupted(signum, "the robot was stopped")
+        raise Interrupted(signum, Said(N_("the robot was stopped")))
 
     try:
         check(args)

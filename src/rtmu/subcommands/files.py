@@ -17,7 +17,7 @@ from pathlib import Path
 from typing import TYPE_CHECKING, Any
 
 from ..base.exit_codes import EXIT_OK, EXIT_REFUSED, EXIT_USAGE, NETWORK
-from ..base.i18n import _, number
+from ..base.i18n import N_, _, number
 from ..base.textsafe import visible
 from ..base.units import quantity
 from ..client.roles import Role
@@ -29,7 +29,7 @@ if TYPE_CHECKING:
     from ..client.connection import AriaClient
 
 EXITS = (*NETWORK, EXIT_REFUSED)
-DESCRIPTION = (
+DESCRIPTION = N_(
     "Files in the folder the robot shares (paths relative to it). A bad path, a local file that exists "
     "without --force, or rm without --yes and no terminal to ask on are usage errors, found before "
     "connecting; a reply that cannot be trusted (a listing entry with a hostile name, a file longer than "
@@ -42,7 +42,7 @@ def register(subparsers: Any) -> None:
     p = subparsers.add_parser(
         "files",
         help=_("list, download, upload and delete files on the robot (getDirListing, getFile, putFile …)"),
-        description=DESCRIPTION,
+        description=_(DESCRIPTION),
     )
     add_connection_arguments(p)
     actions = p.add_subparsers(dest="action", metavar="ls|get|put|rm", required=True)

@@ -13,7 +13,7 @@ import sys
 from typing import TYPE_CHECKING, Any
 
 from ..base.exit_codes import EXIT_OK, EXIT_USAGE
-from ..base.i18n import _
+from ..base.i18n import N_, _
 from ..base.textsafe import visible
 from ..client.roles import Role
 from ..protocol.payloads.navigation import GotoGoal, GotoPose
@@ -23,7 +23,7 @@ from ._navigate import NAVIGATION_EXITS, Expect, add_wait_arguments, navigate, r
 if TYPE_CHECKING:
     from ..client.connection import AriaClient
 
-RULE = (
+RULE = N_(
     "GOAL goes as ARNL's gotoGoal wherever the server lists it, and the command follows the robot to "
     "the end; a server with gotoRouteGoal but no gotoGoal (Omron LD robots), or --route, gets "
     "gotoRouteGoal instead and the command ends once it is sent. --x/--y go as gotoPose. The goal "
@@ -38,7 +38,7 @@ def register(subparsers: Any) -> None:
     p = subparsers.add_parser(
         "goto",
         help=_("drive to a goal of the map or to a point (gotoGoal / gotoPose; LD robots: gotoRouteGoal)"),
-        description=f"{RULE} Ctrl-C, SIGTERM and SIGHUP stop the robot.",
+        description=_(RULE) + " " + _("Ctrl-C, SIGTERM and SIGHUP stop the robot."),
     )
     add_connection_arguments(p)
     p.add_argument("goal", metavar="GOAL", nargs="?", help=_("goal name, as the map names it"))
@@ -53,11 +53,11 @@ def register(subparsers: Any) -> None:
 def check(args: argparse.Namespace) -> None:
     point = args.x is not None or args.y is not None or args.th is not None
     if args.goal is not None and point:
-        raise UsageError("give either GOAL or --x/--y, not both")
+        raise UsageError(_("give either GOAL or --x/--y, not both"))
     if args.goal is None and (args.x is None or args.y is None):
-        raise UsageError("give a GOAL, or a point with --x MM --y MM [--th DEG]")
+        raise UsageError(_("give a GOAL, or a point with --x MM --y MM [--th DEG]"))
     if point and args.route:
-        raise UsageError("--route takes a GOAL, not a point")
+        raise UsageError(_("--route takes a GOAL, not a point"))
 
 
 def handle(args: argparse.Namespace) -> int:
@@ -71,14 +71,19 @@ def handle(args: argparse.Namespace) -> int:
 
     async def body(client: AriaClient) -> int:
         if args.goal is None:
-            require(client, "gotoPose", "drive to points")
+            require(client, "gotoPose", N_("this server does not drive to points (it does not offer {name})"))
             th = None if args.th is None else round(args.th)
             return await navigate(client, args, GotoPose(round(args.x), round(args.y), th), Expect("point"))
         route = args.route or (not client.supports("gotoGoal") and client.supports("gotoRouteGoal"))
         if route:
-            require(client, "gotoRouteGoal", "drive to route goals")  # exit 4 before asking for goals
+            # exit 4 before asking for goals
+            require(
+                client,
+                "gotoRouteGoal",
+                N_("this server does not drive to route goals (it does not offer {name})"),
+            )
         else:
-            require(client, "gotoGoal", "drive to goals")
+            require(client, "gotoGoal", N_("this server does not drive to goals (it does not offer {name})"))
         if client.supports("getGoals"):
             known = await ld_data.goals(client, args.timeout)
             goal = known_name("goto", "goal", args.goal, known)

@@ -6,7 +6,7 @@ import argparse
 from typing import TYPE_CHECKING, Any
 
 from ..base.exit_codes import NETWORK
-from ..base.i18n import _
+from ..base.i18n import N_, _
 from ..client.roles import Role
 from ..protocol.payloads.navigation import LocalizeToPose
 from ._common import add_connection_arguments, run_with_client
@@ -22,9 +22,11 @@ def register(subparsers: Any) -> None:
     p = subparsers.add_parser(
         "localize",
         help=_("tell the robot where it is on the map (localizeToPose), and wait until it is localized"),
-        description="Send localizeToPose X Y TH; where the server offers getLocState, wait until it says "
-        "localized (exit 0; also when it was only sent, where getLocState is not offered) or lost "
-        f"(exit {EXIT_NAV_LOST}). It never moves the robot.",
+        description=_(
+            "Send localizeToPose X Y TH; where the server offers getLocState, wait until it says "
+            "localized (exit 0; also when it was only sent, where getLocState is not offered) or lost "
+            "(exit {code}). It never moves the robot."
+        ).format(code=EXIT_NAV_LOST),
     )
     add_connection_arguments(p)
     p.add_argument("x", type=float, metavar="X", help=_("mm on the map"))
@@ -36,7 +38,11 @@ def register(subparsers: Any) -> None:
 
 def handle(args: argparse.Namespace) -> int:
     async def body(client: AriaClient) -> int:
-        require(client, "localizeToPose", "take a pose to localize at")
+        require(
+            client,
+            "localizeToPose",
+            N_("this server does not take a pose to localize at (it does not offer {name})"),
+        )
         return await localize(client, args, LocalizeToPose(round(args.x), round(args.y), round(args.th)))
 
     return run_with_client("localize", args, body, role=Role.OPERATOR)

@@ -8,7 +8,7 @@ import sys
 from typing import TYPE_CHECKING, Any
 
 from ..base.exit_codes import EXIT_NOT_HELD, EXIT_OK, EXIT_REFUSED, EXIT_USAGE, NETWORK
-from ..base.i18n import _
+from ..base.i18n import N_, _
 from ..base.textsafe import visible
 from ..client.errors import NotSupported
 from ..client.roles import Role
@@ -18,7 +18,7 @@ if TYPE_CHECKING:
     from ..client.connection import AriaClient
     from ..mapedit import MapDraft, ObjectChanges
 
-DESCRIPTION = """Change the server's map live, in one change set (ARIA's ArMapChanger).
+DESCRIPTION = N_("""Change the server's map live, in one change set (ARIA's ArMapChanger).
 
 Edits, in any number and order (all go in ONE processMapChanges):
 
@@ -36,7 +36,7 @@ guarded by the map's id, and the map is read again afterwards to check that it h
 Exit 0 only when the server's map, read again, holds the change. An edit that does not fit the map
 is a usage error (nothing is sent); a refused change leaves the map as it was (the server's words
 are printed); a server that takes no map changes, or has no map, does not offer it.
-"""
+""")
 
 EXITS = (*NETWORK, EXIT_REFUSED, EXIT_NOT_HELD)
 MAX_EDITS = 10_000
@@ -91,7 +91,7 @@ def register(subparsers: Any) -> None:
     p = subparsers.add_parser(
         "mapedit",
         help=_("change the server's map live: add or remove goals, docks, forbidden lines and areas"),
-        description=DESCRIPTION,
+        description=_(DESCRIPTION),
     )
     add_connection_arguments(p)
     p.add_argument(

@@ -12,7 +12,7 @@ from pathlib import Path
 from typing import TYPE_CHECKING, Any
 
 from ..base.exit_codes import EXIT_OK, EXIT_REFUSED, EXIT_TIMEOUT, EXIT_USAGE, NETWORK
-from ..base.i18n import _
+from ..base.i18n import N_, _, error_words
 from ..base.textsafe import visible
 from ..client.errors import NotSupported
 from ..client.roles import Role
@@ -23,7 +23,7 @@ if TYPE_CHECKING:
     from ..client.connection import AriaClient
 
 EXITS = (*NETWORK, EXIT_REFUSED)
-DESCRIPTION = (
+DESCRIPTION = N_(
     "Scan for a map. The robot logs its laser and its path into NAME.2d (lower case) in its files folder "
     "while it is driven round the site (rtmu drive, the window); Mapper3 or MobilePlanner turn the log "
     "into a map. Loop tags mark where a loop starts and ends. stop --download DIR ends the scan and "
@@ -37,7 +37,7 @@ def register(subparsers: Any) -> None:
     p = subparsers.add_parser(
         "scan",
         help=_("scan for a map: start, status, loop tags, stop and download the .2d (mappingStart …)"),
-        description=DESCRIPTION,
+        description=_(DESCRIPTION),
     )
     add_connection_arguments(p)
     actions = p.add_subparsers(dest="action", metavar="start|status|loop|stop", required=True)
@@ -63,7 +63,7 @@ def handle(args: argparse.Namespace) -> int:
     try:
         body = {"start": _start, "status": _status, "loop": _loop, "stop": _stop}[args.action](args)
     except (ValueError, LocalFileError) as exc:
-        return fail("scan", str(exc), EXIT_USAGE)
+        return fail("scan", error_words(exc), EXIT_USAGE)
     return run_with_client("scan", args, body, role=Role.OBSERVER)  # a scan logs; the operator drives
 
 

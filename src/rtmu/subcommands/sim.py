@@ -14,15 +14,16 @@ import sys
 from pathlib import Path
 
 from ..base.exit_codes import ENDED, EXIT_CONNECTION, EXIT_OK, EXIT_SIGINT, EXIT_USAGE
-from ..base.i18n import _
+from ..base.i18n import N_, Said, _
 from ..package_data import project_map
 from ._common import until_stop_signal
 from ._options import number_in
+from ._sim_lines import joined, plain, start_line
 
 EXIT_BAD_INPUT = EXIT_USAGE
 EXIT_CANNOT_LISTEN = EXIT_CONNECTION
 EXITS = (EXIT_OK, EXIT_USAGE, EXIT_CONNECTION, *ENDED)
-SIM_DESCRIPTION = (
+SIM_DESCRIPTION = N_(
     "Run the bundled ARIA robot simulator: an ArNetworking server that behaves on the wire like ARIA's "
     "serverDemo driving MobileSim (--kind aram: an Omron LD robot), so the RTMU window, ARIA's own example "
     "clients and MobileEyes-style tools can connect to it. It listens on 127.0.0.1 unless told otherwise; "
@@ -35,7 +36,7 @@ def register(subparsers: argparse._SubParsersAction) -> None:
     p = subparsers.add_parser(
         "sim",
         help=_("run the bundled ARIA robot simulator (ArNetworking server, simulated Pioneer 3-DX)"),
-        description=SIM_DESCRIPTION,
+        description=_(SIM_DESCRIPTION),
     )
     p.add_argument(
         "--host", default="127.0.0.1", metavar="ADDR", help=_("address to listen on (default 127.0.0.1)")
@@ -233,9 +234,13 @@ def _size(text: str) -> tuple[int, int]:
     try:
         w, h = (int(v) for v in text.lower().split("x"))
     except ValueError:
-        raise argparse.ArgumentTypeError(f"{text!r} is not WxH (e.g. 640x480)") from None
+        raise argparse.ArgumentTypeError(
+            _("{text} is not WxH (e.g. 640x480)").format(text=repr(text))
+        ) from None
     if not (16 <= w <= 1920 and 16 <= h <= 1920):
-        raise argparse.ArgumentTypeError(f"{text!r}: each side must be 16…1920 pixels")
+        raise argparse.ArgumentTypeError(
+            _("{text}: each side must be 16…1920 pixels").format(text=repr(text))
+        )
     return w, h
 
 
@@ -342,25 +347,36 @@ async def serve(cfg) -> int:
             file=sys.stderr,
         )
         return EXIT_CANNOT_LISTEN
-    served = f"map {cfg.map_path}" if cfg.map_path else "no map"
-    home = server.home
-    extras = "" if cfg.camera else "; no camera"
-    if cfg.users_path:
-        extras += f"; users from {cfg.users_path}"
-    if cfg.profile != "default":
-        extras += f"; profile {cfg.profile}"
-    if cfg.protocol_version:
-        extras += f"; protocol {cfg.protocol_version!r} enforced"
     from ..sim.files_folder import files_folder
 
     files = files_folder(server)
-    extras += f"; files in {files.root}" + (" (temporary)" if files.temporary is not None else "")
-    # The start line is read by programs (the port of --port 0): it stays in English in every language.
-    print(
-        f"rtmu sim: ARIA robot server listening on {cfg.host}:{server.port}, serving {served}; "
-        f"{get_profile(cfg.profile).robot} at ({home[0]:.0f}, {home[1]:.0f}) mm, {home[2]:.0f} deg{extras}",
-        flush=True,
+    served = Said(N_("map {path}"), path=str(cfg.map_path)) if cfg.map_path else Said(N_("no map"))
+    extras = [] if cfg.camera else [Said(N_("no camera"))]
+    if cfg.users_path:
+        extras.append(Said(N_("users from {path}"), path=str(cfg.users_path)))
+    if cfg.profile != "default":
+        extras.append(Said(N_("profile {name}"), name=cfg.profile))
+    if cfg.protocol_version:
+        extras.append(Said(N_("protocol {version} enforced"), version=repr(cfg.protocol_version)))
+    temporary = files.temporary is not None
+    extras.append(
+        Said(N_("files in {path} (temporary)") if temporary else N_("files in {path}"), path=str(files.root))
     )
+    x, y, th = server.home
+    line = Said(
+        N_(
+            "rtmu sim: ARIA robot server listening on {where}, serving {served}; "
+            "{robot} at ({x}, {y}) mm, {th} deg{extras}"
+        ),
+        where=f"{cfg.host}:{server.port}",
+        served=served,
+        robot=get_profile(cfg.profile).robot,
+        x=plain(x),
+        y=plain(y),
+        th=plain(th),
+        extras=joined(extras),
+    )
+    print(start_line(line), flush=True)
     code = await until_stop_signal()
     print(_("rtmu sim: stopping (telling clients SHUTDOWN)"), flush=True)
     await server.stop()
@@ -386,8 +402,15 @@ async def serve_fleet(cfg, count: int) -> int:
         return EXIT_CANNOT_LISTEN
     for robot, server in zip(fleet.robots, fleet.servers, strict=True):
         x, y, th = server.home
-        print(f"rtmu sim: {robot.name} listening on {cfg.host}:{server.port}, "  # read by programs: English
-              f"at ({x:.0f}, {y:.0f}) mm, {th:.0f} deg", flush=True)  # fmt: skip
+        line = Said(
+            N_("rtmu sim: {name} listening on {where}, at ({x}, {y}) mm, {th} deg"),
+            name=robot.name,
+            where=f"{cfg.host}:{server.port}",
+            x=plain(x),
+            y=plain(y),
+            th=plain(th),
+        )
+        print(start_line(line), flush=True)
     code = await until_stop_signal()
     print(_("rtmu sim: stopping every robot (telling clients SHUTDOWN)"), flush=True)
     await fleet.stop()

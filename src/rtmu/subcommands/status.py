@@ -44,11 +44,13 @@ def register(subparsers: Any) -> None:
     p = subparsers.add_parser(
         "status",
         help=_("print or stream the robot status"),
-        description="Print the robot status once (--once) or stream it until interrupted: a line whenever "
-        f"the status changes, and the same line again at most every {HEARTBEAT:g} s while it does not "
-        "(a heartbeat: the link is alive). JSON keys (schema status): x, y (mm), th (deg), vel (mm/s), "
-        "rot_vel (deg/s), battery_v (volts) or battery_pct (state of charge), status, mode, and dock "
-        "where the server offers dockInfo.",
+        description=_(
+            "Print the robot status once (--once) or stream it until interrupted: a line whenever "
+            "the status changes, and the same line again at most every {heartbeat} s while it does not "
+            "(a heartbeat: the link is alive). JSON keys (schema status): x, y (mm), th (deg), vel (mm/s), "
+            "rot_vel (deg/s), battery_v (volts) or battery_pct (state of charge), status, mode, and dock "
+            "where the server offers dockInfo."
+        ).format(heartbeat=f"{HEARTBEAT:g}"),
     )
     add_connection_arguments(p)
     p.add_argument("--once", action="store_true", help=_("print one status and exit"))

@@ -16,7 +16,7 @@ from collections.abc import Callable
 from typing import TYPE_CHECKING, Any
 
 from ..base.exit_codes import EXIT_OK
-from ..base.i18n import _
+from ..base.i18n import N_, Said, _, number
 from ..base.textsafe import visible
 from ..client.errors import NotSupported
 from ..client.roles import Role
@@ -30,11 +30,11 @@ if TYPE_CHECKING:
     from ..client.connection import AriaClient
 
 PLAIN_EVENTS = {
-    "mapUpdated": ("map_updated", "map updated"),
-    "goalsUpdated": ("goals_updated", "goals updated"),
-    "configUpdated": ("config_updated", "configuration updated"),
+    "mapUpdated": ("map_updated", N_("map updated")),
+    "goalsUpdated": ("goals_updated", N_("goals updated")),
+    "configUpdated": ("config_updated", N_("configuration updated")),
 }
-"""Broadcasts that carry nothing worth printing beyond "it happened": (JSON event, text line)."""
+"""Broadcasts that carry nothing worth printing beyond "it happened": (JSON event, text line, marked)."""
 WATCHED = ("popupCreate", "popupClose", "getModeInfo", "updateStrings", *PLAIN_EVENTS)
 
 
@@ -56,6 +56,16 @@ def register(subparsers: Any) -> None:
     p.set_defaults(handler=handle)
 
 
+POPUP_TYPE_WORDS = {
+    "none": N_("none"),
+    "information": N_("information"),
+    "warning": N_("warning"),
+    "critical": N_("critical"),
+    "question": N_("question"),
+}
+"""A popup's type (ARIA's ``PopupType``, its JSON name) as the text line says it (marked)."""
+
+
 def popup_type(number: int) -> str:
     with contextlib.suppress(ValueError):
         return PopupType(number).name.lower()
@@ -63,28 +73,43 @@ def popup_type(number: int) -> str:
 
 
 def describe(name: str, payload: Any) -> tuple[dict[str, Any], str] | None:
-    """(JSON object without ``t``, text line) for one broadcast; None for one not worth a line."""
+    """(JSON object without ``t``, text line) for one broadcast; None for one not worth a line. The line
+    is in the operator's language; the server's words in it (titles, messages, buttons, mode and status)
+    as sent, escaped; the JSON keeps the exact strings and English names."""
     if isinstance(payload, PopupCreate):
         buttons = [b for b in payload.buttons if b]
+        kind = popup_type(payload.popup_type)
         obj = {
-            "event": "popup_opened", "id": payload.popup_id, "type": popup_type(payload.popup_type),
+            "event": "popup_opened", "id": payload.popup_id, "type": kind,
             "title": payload.title, "message": payload.message, "buttons": buttons,
         }  # fmt: skip
         labels = "|".join(visible(b) for b in buttons)
-        text = f"popup opened #{payload.popup_id} ({obj['type']}) {visible(payload.title)}: "
-        return obj, text + f"{visible(payload.message)} [{labels}]"
+        text = _("popup opened #{id} ({type}) {title}: {message} [{buttons}]").format(
+            id=payload.popup_id,
+            type=_(POPUP_TYPE_WORDS.get(kind, kind)),
+            title=visible(payload.title),
+            message=visible(payload.message),
+            buttons=labels,
+        )
+        return obj, text
     if isinstance(payload, PopupClose):
         obj = {"event": "popup_closed", "id": payload.popup_id, "message": payload.message}
-        return obj, f"popup closed #{payload.popup_id}: {visible(payload.message)}"
+        return obj, _("popup closed #{id}: {message}").format(
+            id=payload.popup_id, message=visible(payload.message)
+        )
     if isinstance(payload, ModeInfo):
         obj = {"event": "mode", "mode": payload.mode_name, "locked": payload.locked}
-        return obj, f"mode {visible(payload.mode_name) or '(none)'}" + (" (locked)" if payload.locked else "")
+        mode = visible(payload.mode_name) or _("(none)")
+        return obj, (_("mode {mode} (locked)") if payload.locked else _("mode {mode}")).format(mode=mode)
     if isinstance(payload, UpdateStrings):
         obj = {"event": "status", "status": payload.status, "mode": payload.mode}
-        return obj, f"status {visible(payload.status)} ({visible(payload.mode)})"
+        line = _("status {status} ({mode})").format(
+            status=visible(payload.status), mode=visible(payload.mode)
+        )
+        return obj, line
     if name in PLAIN_EVENTS:
         event, text = PLAIN_EVENTS[name]
-        return {"event": event}, text
+        return {"event": event}, _(text)
     return None
 
 
@@ -102,7 +127,7 @@ def handle(args: argparse.Namespace) -> int:
         if args.json:
             print_json({"t": t, **obj})
         else:
-            print(f"{t:8.3f}  {text}", flush=True)
+            print(f"{number(t, 3):>8}  {text}", flush=True)
 
     def handler(name: str) -> Callable[[Packet], None]:
         def on_packet(packet: Packet) -> None:
@@ -120,7 +145,9 @@ def handle(args: argparse.Namespace) -> int:
     async def body(client: AriaClient) -> int:
         offered = [name for name in WATCHED if client.supports(name)]
         if not offered:
-            raise NotSupported("popupCreate", "this server broadcasts none of the events rtmu watch follows")
+            raise NotSupported(
+                "popupCreate", Said(N_("this server broadcasts none of the events rtmu watch follows"))
+            )
         for name in offered:
             client.request(name, -1, handler(name))
         if client.supports("popupCreate") and client.supports("popupList"):

@@ -13,7 +13,7 @@ import sys
 from typing import TYPE_CHECKING, Any
 
 from ..base.exit_codes import EXIT_WHY_LOST, NETWORK, WHY_ASKED
-from ..base.i18n import _, words
+from ..base.i18n import N_, _, words
 from ..base.textsafe import visible
 from ..client.roles import Role
 from ..client.why import diagnose
@@ -27,7 +27,7 @@ if TYPE_CHECKING:
 EXITS = (*NETWORK, *WHY_ASKED, EXIT_WHY_LOST)
 MAX_FIXES = 3
 """Fixes tried one after another (each reveals what the next cause is)."""
-DESCRIPTION = """Why won't the robot move? Reads, never drives: the server's own data (its mode and lock,
+DESCRIPTION = N_("""Why won't the robot move? Reads, never drives: the server's own data (its mode and lock,
 this login's rights, status words, safe drive and the obstacles its sonar and lasers see, battery,
 docking, localization, its drive watchdog, an LD robot's faults and safety data), told as one sentence
 with its fix. Exit 0 when nothing RTMU can read keeps the robot from moving, else the cause's own code
@@ -38,14 +38,14 @@ with its fix. Exit 0 when nothing RTMU can read keeps the robot from moving, els
 --fix carries out the first cause's fix where there is one (unlock a mode that will unlock, undock, stop
 the server's own driving, switch safe drive off, acknowledge an LD robot's faults, enable its motors),
 then asks again. Switching safe drive off, acknowledging and enabling need a yes: typed at the prompt, or
---yes; without one nothing is sent."""
+--yes; without one nothing is sent.""")
 
 
 def register(subparsers: Any) -> None:
     p = subparsers.add_parser(
         "why",
         help=_("why won't the robot move? one sentence and its fix"),
-        description=DESCRIPTION,
+        description=_(DESCRIPTION),
     )
     add_connection_arguments(p)
     p.add_argument(

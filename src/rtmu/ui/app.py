@@ -91,28 +91,30 @@ def run_gui(args: argparse.Namespace) -> int:
 
     options = options_from_args(args)
     if options.port is not None and not 1 <= options.port <= 65535:
-        print(f"rtmu: --port {options.port} is not 1…65535", file=sys.stderr)
+        print(_("rtmu: --port {port} is not 1…65535").format(port=options.port), file=sys.stderr)
         return EXIT_USAGE
     if options.central is not None:
         try:
             parse_central(options.central)
         except ValueError as exc:
-            print(f"rtmu: --central: {exc}", file=sys.stderr)
+            print(_("rtmu: --central: {error}").format(error=exc), file=sys.stderr)
             return EXIT_USAGE
         if options.host or options.demo:
-            print("rtmu: --central goes without --host and --demo", file=sys.stderr)
+            print(_("rtmu: --central goes without --host and --demo"), file=sys.stderr)
             return EXIT_USAGE
     robots = getattr(args, "robots", 1)
     if robots != 1 and not options.demo:
-        print("rtmu: --robots N goes with --demo (a fleet profile names real robots)", file=sys.stderr)
+        print(_("rtmu: --robots N goes with --demo (a fleet profile names real robots)"), file=sys.stderr)
         return EXIT_USAGE
     if not 1 <= robots <= 50:
-        print(f"rtmu: --robots {robots} is not 1…50", file=sys.stderr)
+        print(_("rtmu: --robots {robots} is not 1…50").format(robots=robots), file=sys.stderr)
         return EXIT_USAGE
     if not display_available():
         print(
-            "rtmu: cannot open a display (is DISPLAY or WAYLAND_DISPLAY set?); "
-            "without one, use the headless subcommands (rtmu status, rtmu drive, rtmu sim …)",
+            _(
+                "rtmu: cannot open a display (is DISPLAY or WAYLAND_DISPLAY set?); "
+                "without one, use the headless subcommands (rtmu status, rtmu drive, rtmu sim …)"
+            ),
             file=sys.stderr,
         )
         return EXIT_NO_DISPLAY
@@ -123,7 +125,7 @@ def run_gui(args: argparse.Namespace) -> int:
         try:
             options, sim = start_demo(options, robots)
         except Exception as exc:  # the window is useless without it: say why and stop
-            print(f"rtmu: the demo simulator did not start: {exc}", file=sys.stderr)
+            print(_("rtmu: the demo simulator did not start: {error}").format(error=exc), file=sys.stderr)
             return EXIT_CONNECTION
     try:
         from .application import RtmuApplication

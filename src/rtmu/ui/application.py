@@ -482,7 +482,7 @@ class RtmuApplication(Gtk.Application):
             try:
                 save_settings(snapshot, path)
             except (OSError, ValueError) as exc:
-                print(f"rtmu: could not save the settings: {exc}", file=sys.stderr)
+                print(_("rtmu: could not save the settings: {error}").format(error=exc), file=sys.stderr)
 
         if background:
             threading.Thread(target=write, name="rtmu-save-settings", daemon=True).start()

@@ -12,7 +12,7 @@ from __future__ import annotations
 from collections.abc import Callable
 from typing import TYPE_CHECKING
 
-from ..base.i18n import _
+from ..base.i18n import _, error_words
 from ..base.notices import Kind, Notice
 from ..fleet.sessions import RobotSession
 from ..recorder.topics import BRIDGE_PORT
@@ -59,7 +59,11 @@ class BridgeToggle:
         try:
             bridge.start()
         except Exception as exc:
-            self.tell(Notice.error(Kind.RECORDING, _("Foxglove bridge not started: {exc}").format(exc=exc)))
+            self.tell(
+                Notice.error(
+                    Kind.RECORDING, _("Foxglove bridge not started: {exc}").format(exc=error_words(exc))
+                )
+            )
             return False
         self._attach(bridge)
         self.bridge = bridge

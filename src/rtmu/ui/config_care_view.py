@@ -29,7 +29,7 @@ gi.require_version("Gtk", "4.0")
 gi.require_version("Pango", "1.0")
 from gi.repository import Gdk, GLib, Gtk, Pango  # noqa: E402
 
-from ..base.i18n import N_, _, ngettext  # noqa: E402
+from ..base.i18n import N_, _, error_words, ngettext  # noqa: E402
 from ..base.textsafe import visible  # noqa: E402
 from ..client.config_care import DEFAULTS, Difference, FactoryValues, differences, same_value  # noqa: E402
 from ..client.config_feed import ServerConfig  # noqa: E402
@@ -38,6 +38,7 @@ from ..protocol.payloads.config import ConfigParam  # noqa: E402
 from ..values.intents import FetchConfig, FetchConfigDefaults, Intent, ResetConfig, SetConfig  # noqa: E402
 from . import accessible  # noqa: E402
 from .confirm import Confirm  # noqa: E402
+from .state_words import failure_words  # noqa: E402
 
 Request = Callable[[Intent], "concurrent.futures.Future[Any]"]
 NO_DEFAULTS = N_(
@@ -121,7 +122,7 @@ class DefaultsWindow(Gtk.Window):
             error = f.exception() if not f.cancelled() else concurrent.futures.CancelledError()
             if error is not None:
                 self.status.set_text(
-                    _("Could not compare with the factory values: {error}").format(error=error)
+                    _("Could not compare with the factory values: {error}").format(error=failure_words(error))
                 )
                 self.status.add_css_class("error")
                 return
@@ -208,7 +209,9 @@ class DefaultsWindow(Gtk.Window):
                 error = RuntimeError(reply.error)
             if error is not None:
                 self.status.set_text(
-                    _("The server did not reset {names}: {error}").format(names=names, error=error)
+                    _("The server did not reset {names}: {error}").format(
+                        names=names, error=failure_words(error)
+                    )
                 )
                 self.status.add_css_class("error")
                 return
@@ -286,7 +289,7 @@ class ConfigCare:
             if error is not None:
                 self._say(
                     _("{section}/{name} was not reset: {error}").format(
-                        section=section, name=param.name, error=error
+                        section=section, name=param.name, error=failure_words(error)
                     ),
                     True,
                 )
@@ -366,7 +369,7 @@ class ConfigCare:
         try:
             write_export(path, export_text(config), force=force)
         except ConfigFileError as exc:
-            self._say(_("Not exported: {exc}").format(exc=exc), True)
+            self._say(_("Not exported: {exc}").format(exc=error_words(exc)), True)
             return
         self._say(
             _("Exported {param_count} parameters to {path}").format(
@@ -383,7 +386,7 @@ class ConfigCare:
         try:
             plan = plan_import(config, read_file(path))
         except ConfigFileError as exc:
-            self._say(_("Not imported: {exc}").format(exc=exc), True)
+            self._say(_("Not imported: {exc}").format(exc=error_words(exc)), True)
             return
         if plan.problems:
             shown = "; ".join(plan.problems[:5]) + (
@@ -419,7 +422,9 @@ class ConfigCare:
                 error = RuntimeError(reply.error)
             if error is not None:
                 self._say(
-                    _("The server refused the import of {name}: {error}").format(name=path.name, error=error),
+                    _("The server refused the import of {name}: {error}").format(
+                        name=path.name, error=failure_words(error)
+                    ),
                     True,
                 )
             else:

@@ -33,7 +33,7 @@ gi.require_version("Gtk", "4.0")
 gi.require_version("Pango", "1.0")
 from gi.repository import Gdk, GLib, Gtk, Pango  # noqa: E402
 
-from ..base.i18n import N_, _  # noqa: E402
+from ..base.i18n import N_, _, error_words  # noqa: E402
 from ..base.textsafe import visible  # noqa: E402
 from ..client.config_feed import MAX_TEXT, ConfigSection, ForeignConfig, ServerConfig  # noqa: E402
 from ..protocol.payloads.config import ConfigParam, ParamType, Priority, SetConfigReply  # noqa: E402
@@ -42,6 +42,7 @@ from . import accessible  # noqa: E402
 from .config_care_view import ConfigCare  # noqa: E402
 from .config_edits import ConfigEdits, Key  # noqa: E402
 from .discard_question import DiscardQuestion  # noqa: E402
+from .state_words import failure_words  # noqa: E402
 
 Request = Callable[[Intent], "concurrent.futures.Future[Any]"]
 """The window's ``request``: an intent to the selected robot, its answer as a Future."""
@@ -248,13 +249,13 @@ class ConfigPage(Gtk.Window):
         if isinstance(error, ForeignConfig):  # an answer, not a failure: its whole sentence, wrapped
             self.status.set_text(_("No configuration RTMU can edit"))
             where = _(". In this window, Server ▸ Console… reads it raw.") if self._open_console else ""
-            self.banner.set_text(f"{str(error).rstrip('.')}{where}")
+            self.banner.set_text(f"{error_words(error).rstrip('.')}{where}")
             self.banner.set_visible(True)
             self.console_button.set_visible(self._open_console is not None)
             return False
         if future.cancelled() or error is not None:
             self.status.set_text(
-                _("Could not load the configuration: {value}").format(value=error or "cancelled")
+                _("Could not load the configuration: {value}").format(value=failure_words(error))
             )
             return False
         config: ServerConfig = future.result()
@@ -483,7 +484,7 @@ class ConfigPage(Gtk.Window):
         self.saving = False
         error = None if future.cancelled() else future.exception()
         if future.cancelled() or error is not None:
-            self.state.save_failed(sent, str(error or "cancelled"))
+            self.state.save_failed(sent, failure_words(error))
             for key in sent:
                 self._show_answer(key)
             self._update_status()

@@ -46,6 +46,7 @@ from ..client.console_text import effect_words, outcome_line, packet_lines, shor
 from ..values.intents import ConsoleCall, ConsoleFollow, ConsoleList, ConsoleNext, Intent  # noqa: E402
 from . import accessible  # noqa: E402
 from .confirm_bar import ConfirmBar  # noqa: E402
+from .state_words import failure_words  # noqa: E402
 
 Request = Callable[[Intent], "concurrent.futures.Future[Any]"]
 MAX_ROWS = 300
@@ -74,9 +75,9 @@ def entry_details(entry: ConsoleEntry) -> str:
                 visible2=visible(short(d.command_group, 60)),
             ),
             visible(short(d.description, 600)) or _("(no description)"),
-            _("Arguments: {value}").format(value=visible(short(d.argument_description, 300)) or "none"),
+            _("Arguments: {value}").format(value=visible(short(d.argument_description, 300)) or _("none")),
             _("  read as: {visible}").format(visible=visible(short(describe(entry.arguments), 300))),
-            _("Returns: {value}").format(value=visible(short(d.return_description, 300)) or "none"),
+            _("Returns: {value}").format(value=visible(short(d.return_description, 300)) or _("none")),
             _("Flags: {visible}").format(visible=visible(short(d.flags, 120))),
             _("Effect: {visible}").format(visible=visible(short(effect_words(entry), 200))),
         )
@@ -239,9 +240,7 @@ class ConsolePage(Gtk.Window):
         error = None if future.cancelled() else future.exception()
         if future.cancelled() or error is not None:
             self.count.set_text(
-                _("No data list: {visible}").format(
-                    visible=visible(short(error_words(error) if error else _("cancelled"), 200))
-                )
+                _("No data list: {visible}").format(visible=visible(short(failure_words(error), 200)))
             )
             return False
         self.entries = list(future.result())
@@ -326,7 +325,7 @@ class ConsolePage(Gtk.Window):
         try:
             arguments = tuple(shlex.split(self.arguments.get_text()))
         except ValueError as exc:
-            self.status.set_text(_("Arguments: {exc}").format(exc=exc))
+            self.status.set_text(_("Arguments: {exc}").format(exc=error_words(exc)))
             return
         types = tuple(t.strip() for t in self.types.get_text().split(",") if t.strip())
         if not entry.changes:
@@ -359,9 +358,7 @@ class ConsolePage(Gtk.Window):
         error = None if future.cancelled() else future.exception()
         if future.cancelled() or error is not None:
             self.status.set_text(
-                _("Not sent or no reply: {visible}").format(
-                    visible=visible(short(error_words(error) if error else _("cancelled"), 300))
-                )
+                _("Not sent or no reply: {visible}").format(visible=visible(short(failure_words(error), 300)))
             )
             return False
         reply: ConsoleReply = future.result()
@@ -382,7 +379,7 @@ class ConsolePage(Gtk.Window):
         try:
             arguments = tuple(shlex.split(self.arguments.get_text()))
         except ValueError as exc:
-            self.status.set_text(_("Arguments: {exc}").format(exc=exc))
+            self.status.set_text(_("Arguments: {exc}").format(exc=error_words(exc)))
             self.follow_button.set_active(False)
             return
         types = tuple(t.strip() for t in self.types.get_text().split(",") if t.strip())
@@ -400,7 +397,7 @@ class ConsolePage(Gtk.Window):
             return False
         error = None if future.cancelled() else future.exception()
         if error is not None or future.cancelled() or future.result() != name:
-            why = visible(short(str(error or _("the server did not take it")), 300))
+            why = visible(short(error_words(error) if error else _("the server did not take it"), 300))
             self.stop_following()
             self.follow_status.set_text(_("Not followed: {why}").format(why=why))
             return False

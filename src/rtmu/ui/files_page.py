@@ -43,6 +43,7 @@ from . import accessible  # noqa: E402
 from .confirm import Confirm  # noqa: E402
 from .files_text import greyed, human_size, parent_of, remote_join, transfer_text, when  # noqa: E402
 from .layout import fit_default_size, wrapping_row  # noqa: E402
+from .state_words import failure_words  # noqa: E402
 
 MAX_ROWS = 1000
 """Entries shown at once; the rest are counted in the status line."""
@@ -198,7 +199,7 @@ class FilesPage(Gtk.Window):
             error = None if future.cancelled() else future.exception()
             if future.cancelled() or error is not None:
                 self.map_param = _("this robot's configuration could not be read ({value})").format(
-                    value=error or "cancelled"
+                    value=failure_words(error)
                 )
             else:
                 self.map_param = map_param_problem(future.result())
@@ -442,7 +443,7 @@ class FilesPage(Gtk.Window):
             return False
         error = None if future.cancelled() else future.exception()
         if future.cancelled() or error is not None:
-            self._say(_("{what} failed: {value}").format(what=what, value=error or "cancelled"), error=True)
+            self._say(_("{what} failed: {value}").format(what=what, value=failure_words(error)), error=True)
             if isinstance(future.exception(), Exception) and what == "List":
                 self._fill(None)
             return False

@@ -36,6 +36,7 @@ from .fleet_draw import RGB, FleetMark, fleet_colour  # noqa: E402
 from .mapview import STALE_AFTER  # noqa: E402
 from .overlays import ROBOT_RGB  # noqa: E402
 from .robot_list import NARROW_PX, RobotList  # noqa: E402
+from .state_words import sentence_words  # noqa: E402
 from .window import MainWindow  # noqa: E402
 
 OTHER_TRAIL = 300
@@ -224,7 +225,7 @@ class FleetBinding:
         if len(self._lost) == 1:
             name, error = next(iter(self._lost.items()))
             text = (
-                _("{robot}: link lost ({error})").format(robot=name, error=error)
+                _("{robot}: link lost ({error})").format(robot=name, error=sentence_words(error))
                 if error
                 else _("{robot}: link lost").format(robot=name)
             )

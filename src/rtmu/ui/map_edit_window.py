@@ -28,8 +28,9 @@ gi.require_version("Gtk", "4.0")
 gi.require_version("Pango", "1.0")
 from gi.repository import Gdk, GLib, Gtk, Pango  # noqa: E402
 
-from ..base.i18n import N_, _, ngettext  # noqa: E402
+from ..base.i18n import N_, _, ngettext, parse_number  # noqa: E402
 from ..base.textsafe import visible  # noqa: E402
+from ..base.units import coordinates, quantity  # noqa: E402
 from ..client.map_changes import ChangeVerdict  # noqa: E402
 from ..fleet.selected import SelectedRobot  # noqa: E402
 from ..fleet.sessions import RobotSession  # noqa: E402
@@ -49,9 +50,16 @@ from ..values.intents import ApplyMapChanges  # noqa: E402
 from .layout import fit_default_size, wrapping_row  # noqa: E402
 from .map_canvas_edit import TOOL_TIPS, MapCanvasEdit, Tool  # noqa: E402
 from .map_point_pick import Picked  # noqa: E402
+from .state_words import failure_words  # noqa: E402
 
 EDITABLE = {t.lower() for t in (GOAL, GOAL_WITH_HEADING, DOCK, FORBIDDEN_LINE, FORBIDDEN_AREA)}
 KINDS = (N_("Goal"), N_("Dock"), N_("Forbidden line"), N_("Forbidden area"))
+
+
+def field_text(value: float) -> str:
+    """A whole mm or degree for a field: no grouping mark and no decimal one, so it reads back in every
+    language (what is typed is read by ``parse_number``: German ``2,5`` too)."""
+    return str(round(value))
 
 
 def editable(objects: tuple[MapObject, ...] | list[MapObject]) -> list[MapObject]:
@@ -260,7 +268,7 @@ class MapEditWindow(Gtk.Window):
         if not text and not required:
             return None
         try:
-            return float(text)
+            return parse_number(text)  # as the operator's language writes it (German: 2,5)
         except ValueError:
             raise DraftError(_("{name}: {text!r} is not a number").format(name=name, text=text)) from None
 
@@ -369,7 +377,7 @@ class MapEditWindow(Gtk.Window):
     def _fill_from_robot(self) -> None:
         pose = self.model.robot.value
         for name, value in (("x", pose.x), ("y", pose.y), ("th", pose.th)):
-            self.fields[name].set_text(f"{value:.0f}")
+            self.fields[name].set_text(field_text(value))
 
     def pick_point(self, *, end: bool) -> None:
         """The next click on the map fills x, y (and a dragged heading) — or x2, y2 with ``end``."""
@@ -381,13 +389,13 @@ class MapEditWindow(Gtk.Window):
         )
 
         def picked(x: float, y: float, th: float | None) -> None:
-            self.fields["x2" if end else "x"].set_text(f"{x:.0f}")
-            self.fields["y2" if end else "y"].set_text(f"{y:.0f}")
+            self.fields["x2" if end else "x"].set_text(field_text(x))
+            self.fields["y2" if end else "y"].set_text(field_text(y))
             if th is not None and not end:
-                self.fields["th"].set_text(f"{th:.0f}")
+                self.fields["th"].set_text(field_text(th))
             self._say(
-                _("Picked ({x:.0f}, {y:.0f})").format(x=x, y=y)
-                + (_(", heading {th:.0f}°").format(th=th) if th is not None else ""),
+                _("Picked {where}").format(where=coordinates(x, y))
+                + (_(", heading {heading}").format(heading=quantity(th, "deg")) if th is not None else ""),
                 error=False,
             )
 
@@ -398,9 +406,9 @@ class MapEditWindow(Gtk.Window):
         if obj is None:
             return
         self.name_entry.set_text(obj.name)
-        self.fields["x"].set_text(f"{obj.x:.0f}")
-        self.fields["y"].set_text(f"{obj.y:.0f}")
-        self.fields["th"].set_text(f"{obj.th:.0f}")
+        self.fields["x"].set_text(field_text(obj.x))
+        self.fields["y"].set_text(field_text(obj.y))
+        self.fields["th"].set_text(field_text(obj.th))
 
     # -- applying ---------------------------------------------------------------------------------
     def apply(self) -> None:
@@ -422,7 +430,7 @@ class MapEditWindow(Gtk.Window):
         error = None if future.cancelled() else future.exception()
         if future.cancelled() or error is not None:
             self._say(
-                _("Not applied: {value}. The draft is kept.").format(value=error or "cancelled"), error=True
+                _("Not applied: {value}. The draft is kept.").format(value=failure_words(error)), error=True
             )
         else:
             verdict: ChangeVerdict = future.result()
@@ -457,7 +465,9 @@ class MapEditWindow(Gtk.Window):
             text = describe(obj, translated=True) + (
                 ""
                 if obj.from_xy
-                else _(" at ({x:.0f}, {y:.0f}) {th:.0f}°").format(x=obj.x, y=obj.y, th=obj.th)
+                else _(" at {where} {heading}").format(
+                    where=coordinates(obj.x, obj.y), heading=quantity(obj.th, "deg")
+                )
             )
             if object_key(obj) in added:
                 text += _("  — draft")

@@ -9,6 +9,7 @@ from __future__ import annotations
 
 from ..base.i18n import N_, _
 from ..base.units import metres
+from ..client.nav_status import OWN_REASONS
 from ..model.observables import NavState
 
 POOR_SCORE = 0.6
@@ -102,5 +103,6 @@ def outcome_status(nav: NavState) -> str:
     if not nav.outcome_text:
         return ""
     if nav.reason and nav.reason not in nav.outcome_text:
-        return _("{outcome_text} because {reason}").format(outcome_text=nav.outcome_text, reason=nav.reason)
+        reason = _(nav.reason) if nav.reason in OWN_REASONS else nav.reason  # ours: translated
+        return _("{outcome_text} because {reason}").format(outcome_text=nav.outcome_text, reason=reason)
     return nav.outcome_text

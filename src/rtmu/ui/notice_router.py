@@ -19,7 +19,7 @@ from collections.abc import Callable
 from dataclasses import dataclass
 from typing import NamedTuple, Protocol
 
-from ..base.i18n import N_, _
+from ..base.i18n import N_, Said, _
 from ..base.notices import Kind, Level, Notice
 from ..model.observables import SPEED_MAX, ConnectionState, LinkLevel, NavState, Phase
 from .nav_text import link_lost_note
@@ -58,6 +58,8 @@ def route(notice: Notice, connection: ConnectionState, speed_percent: int) -> Ro
     kind, level, text = notice.kind, notice.level, notice.text
     if kind is Kind.CONNECTION or (text and text == connection.error):
         return Route()  # the link banner shows the connection's life from the model
+    if isinstance(text, Said):  # a sentence built from values (a navigation outcome): in the operator's words
+        text = text.words()
     if kind is Kind.LINK:
         if level is Level.INFO:
             return Route(Banner("link", "info", text, 4.0))

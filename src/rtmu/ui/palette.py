@@ -23,6 +23,7 @@ from gi.repository import Gdk, GLib, Gtk, Pango  # noqa: E402
 from ..base.i18n import _, ngettext  # noqa: E402
 from ..client.custom_commands import MAX_ARGUMENT, CommandCatalogue, CustomCommand  # noqa: E402
 from . import accessible  # noqa: E402
+from .state_words import failure_words  # noqa: E402
 
 ListFn = Callable[[], "concurrent.futures.Future[Any]"]
 """Asks the network thread for the :class:`CommandCatalogue` (``ClientRunner.list_commands``)."""
@@ -134,7 +135,7 @@ class CommandPalette(Gtk.Window):
         if future.cancelled() or future.exception() is not None:
             error = future.exception()
             self.note.set_text(
-                _("The server's commands could not be listed: {value}").format(value=error or "cancelled")
+                _("The server's commands could not be listed: {value}").format(value=failure_words(error))
             )
             return False
         catalogue = future.result()

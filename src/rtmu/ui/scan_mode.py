@@ -26,7 +26,7 @@ gi.require_version("Gdk", "4.0")
 gi.require_version("Gtk", "4.0")
 from gi.repository import Gdk, GLib, Gtk  # noqa: E402
 
-from ..base.i18n import _  # noqa: E402
+from ..base.i18n import _, error_words  # noqa: E402
 from ..base.textsafe import visible  # noqa: E402
 from ..client.remote_files import local_name  # noqa: E402
 from ..client.scan import SCAN_FEATURES, ScanProgress, scan_name  # noqa: E402
@@ -38,6 +38,7 @@ from ..values.intents import DownloadFile, Intent, StartScan, StopScan, TagScanL
 from . import accessible  # noqa: E402
 from .confirm import Confirm  # noqa: E402
 from .files_text import human_size, transfer_text  # noqa: E402
+from .state_words import failure_words  # noqa: E402
 
 REFRESH_MS = 500
 """How often the running time is redrawn while scanning."""
@@ -118,7 +119,7 @@ class ScanDialog(Gtk.Window):
             if not name:
                 raise ValueError(_("give the scan a name"))
         except ValueError as exc:
-            self._say(str(exc), error=True)
+            self._say(error_words(exc), error=True)
             return
         self.start_button.set_sensitive(False)
         self._say(_("Starting…"), error=False)
@@ -128,7 +129,7 @@ class ScanDialog(Gtk.Window):
         error = None if future.cancelled() else future.exception()
         if future.cancelled() or error is not None:
             self.start_button.set_sensitive(True)
-            self._say(_("The scan did not start: {value}").format(value=error or "cancelled"), error=True)
+            self._say(_("The scan did not start: {value}").format(value=failure_words(error)), error=True)
         else:
             self.close()
         return False
@@ -357,7 +358,7 @@ class ScanBar(Gtk.Revealer):
             error = None if future.cancelled() else future.exception()
             if future.cancelled() or error is not None:
                 self.message = _("{label} failed: {value}").format(
-                    label=intent.label, value=error or "cancelled"
+                    label=intent.label, value=failure_words(error)
                 )
                 self._show()
             else:

@@ -6,7 +6,7 @@ window shows goes through here so that it is translated and the values stay as t
 
 from __future__ import annotations
 
-from ..base.i18n import N_, Said, _
+from ..base.i18n import N_, Said, _, error_words
 from ..values.state import LinkLevel, Phase
 
 _PHASES = {
@@ -43,6 +43,12 @@ def reason_words(reason: str) -> str:
     if reason.startswith(OFFERS_NONE):
         return _("this server does not offer {requests}").format(requests=reason.removeprefix(OFFERS_NONE))
     return _(reason) if reason else ""
+
+
+def failure_words(error: BaseException | None) -> str:
+    """Why a request came to nothing, in the operator's language: the error's own sentence (its
+    :class:`Said` said in their language, else as raised), or "cancelled" when there is none."""
+    return error_words(error) if error is not None else _("cancelled")
 
 
 def sentence_words(sentence: str) -> str:

@@ -26,14 +26,14 @@ import gi
 gi.require_version("Gtk", "4.0")
 from gi.repository import GLib, Gtk, Pango  # noqa: E402
 
-from ..base.i18n import N_, _, error_words, words  # noqa: E402
+from ..base.i18n import N_, _, words  # noqa: E402
 from ..base.textsafe import visible  # noqa: E402
 from ..client.why_values import Answer, Fix  # noqa: E402
 from ..control.intent_rules import FIX_WORDS  # noqa: E402
 from ..values.intents import ApplyFix, AskWhy, Intent  # noqa: E402
 from .confirm_bar import ConfirmBar  # noqa: E402
 from .layout import fit_default_size, wrapping_row  # noqa: E402
-from .state_words import sentence_words  # noqa: E402
+from .state_words import failure_words, sentence_words  # noqa: E402
 
 Request = Callable[[Intent], "concurrent.futures.Future[Any]"]
 MAX_SHOWN = 600
@@ -64,11 +64,6 @@ def answer_details(answer: Answer) -> str:
     lines += [_("Note: {short}").format(short=_short(words(n))) for n in answer.notes[:6]]
     lines += [_short(v.text()) for v in answer.raw[:10]]
     return "\n".join(lines)
-
-
-def _failure(error: BaseException | None) -> str:
-    """Why a request came to nothing, in the operator's language."""
-    return error_words(error) if error is not None else _("cancelled")
 
 
 def confirm_question(fix: Fix) -> str:
@@ -153,7 +148,7 @@ class WhyWindow(Gtk.Window):
             return False
         error = None if future.cancelled() else future.exception()
         if future.cancelled() or error is not None:
-            self.status.set_text(_("No answer: {short}").format(short=_short(_failure(error))))
+            self.status.set_text(_("No answer: {short}").format(short=_short(failure_words(error))))
             return False
         self.show_answer(future.result())
         self.status.set_text("")
@@ -197,7 +192,7 @@ class WhyWindow(Gtk.Window):
             return False
         error = None if future.cancelled() else future.exception()
         if future.cancelled() or error is not None:
-            self.status.set_text(_("Not done: {short}").format(short=_short(_failure(error))))
+            self.status.set_text(_("Not done: {short}").format(short=_short(failure_words(error))))
             return False
         report = future.result()
         self.show_answer(report.answer)
