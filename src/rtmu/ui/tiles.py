@@ -329,6 +329,12 @@ class TileCache:
             return self._index is not None
 
     @property
+    def generation(self) -> int:
+        """Counts the maps set: a picture made of this map's tiles is stale once it changes."""
+        with self._lock:
+            return self._generation
+
+    @property
     def bounds(self) -> tuple[float, float, float, float] | None:
         with self._lock:
             return None if self._index is None else self._index.bounds
