@@ -67,7 +67,7 @@ def draw_frame(ctx: cairo.Context, vp: Viewport, scene: Scene) -> bool:
     robot_xy = scene.robot[:2] if scene.robot is not None else None
     layered = False
     if tiles is not None and scene.layer is not None:
-        base = lambda c, v, names: draw_base(c, v, scene, None, names)  # noqa: E731 - the layer's picture
+        base = lambda c, v, avoided, names: draw_base(c, v, scene, avoided, names)  # noqa: E731 - the picture
         layered = scene.layer.paint(ctx, vp, tiles, scene.objects, robot_xy, base)
     complete = layered or draw_base(ctx, vp, scene, robot_xy)
     if scene.goal is not None:

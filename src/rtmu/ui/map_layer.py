@@ -8,8 +8,9 @@ shown — and a frame paints it with one call, then draws the robot and its over
 
 It draws exactly what the direct path would (``frame.draw_base`` both ways) and steps aside — the
 caller draws directly — while a visible tile is still missing (the picture would freeze the
-overview's blur) and while the robot stands where a name would sit: a name moves out from under the
-robot, so that frame's names are not the stored ones. GTK-free, like ``frame``.
+overview's blur). A name moves out from under the robot: while the robot stands on one (at Home, at
+a dock), the picture is made for that pose, and made again only when the robot moves on such a name.
+GTK-free, like ``frame``.
 """
 
 from __future__ import annotations
@@ -23,8 +24,10 @@ from .overlays import Box
 from .tiles import TileCache
 from .viewport import Viewport
 
-DrawBase = Callable[[cairo.Context, Viewport, list[Box]], bool]
-"""Draws the static part at a viewport; fills the list with every name's box; True when complete."""
+XY = tuple[float, float]
+DrawBase = Callable[[cairo.Context, Viewport, XY | None, list[Box]], bool]
+"""Draws the static part at a viewport, names moved from under a robot there (None: no robot);
+fills the list with every name's box; True when complete."""
 
 
 class MapLayer:
@@ -40,10 +43,12 @@ class MapLayer:
         self._key: tuple[object, ...] | None = None
         self._surface: cairo.ImageSurface | None = None
         self._names: list[Box] = []
+        self._avoided: XY | None = None
+        """The robot's place the stored names were moved from (None: no name was under it)."""
 
     def forget(self) -> None:
         """Drop the picture (a new map, or the stage closed): its memory goes at once."""
-        self._key, self._surface, self._names = None, None, []
+        self._key, self._surface, self._names, self._avoided = None, None, [], None
 
     def paint(
         self,
@@ -51,7 +56,7 @@ class MapLayer:
         vp: Viewport,
         tiles: TileCache,
         objects: Sequence[object],
-        robot: tuple[float, float] | None,
+        robot: XY | None,
         draw_base: DrawBase,
     ) -> bool:
         """Paint the stored picture of this view (made now if needed); False: draw directly instead."""
@@ -61,12 +66,15 @@ class MapLayer:
             spots = tiles.visible(vp.scale, vp.origin, vp.width, vp.height)
             if any(spot.surface is None for spot in spots):
                 return False  # tiles still coming: the direct path shows the overview meanwhile
-            self._surface, self._names = self._build(vp, draw_base)
+            self._surface, self._names = self._build(vp, None, draw_base)
             self._key = key
+        avoided = None
         if robot is not None and self._names:
-            avoid = overlays.robot_box(vp, *robot)
-            if any(overlays.overlap(name, avoid) for name in self._names):
-                return False  # a name moves out from under the robot this frame
+            box = overlays.robot_box(vp, *robot)
+            avoided = robot if any(overlays.overlap(name, box) for name in self._names) else None
+        if avoided != self._avoided:  # the robot came onto a name, moved on it, or left it
+            self._surface, self._names = self._build(vp, avoided, draw_base)
+            self._avoided = avoided
         assert self._surface is not None
         ctx.save()
         ctx.new_path()
@@ -77,12 +85,14 @@ class MapLayer:
         self.uses += 1
         return True
 
-    def _build(self, vp: Viewport, draw_base: DrawBase) -> tuple[cairo.ImageSurface, list[Box]]:
+    def _build(
+        self, vp: Viewport, avoided: XY | None, draw_base: DrawBase
+    ) -> tuple[cairo.ImageSurface, list[Box]]:
         scale = max(1, int(self.scale))
         surface = cairo.ImageSurface(cairo.FORMAT_RGB24, vp.width * scale, vp.height * scale)
         surface.set_device_scale(scale, scale)
         names: list[Box] = []
-        draw_base(cairo.Context(surface), vp, names)
+        draw_base(cairo.Context(surface), vp, avoided, names)
         surface.flush()
         self.builds += 1
         return surface, names
