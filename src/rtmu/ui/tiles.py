@@ -30,6 +30,8 @@ from typing import cast
 import cairo
 import numpy as np
 
+from ..base.memory import give_back
+
 TILE = 256
 """Tile edge in pixels."""
 BACKGROUND_RGB = (0.961, 0.957, 0.949)
@@ -420,6 +422,9 @@ class TileCache:
                 with self._lock:
                     self._busy = False
                     self._lock.notify_all()
+                    drained = not self._has_work()
+            if drained:  # the burst's numpy temporaries (and the map decode's) go back to the system
+                give_back()
 
     def _has_work(self) -> bool:
         if self._map_arrays is None:
