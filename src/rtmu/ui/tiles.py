@@ -45,6 +45,10 @@ OVERVIEW_MAX_PX = 1024
 """The overview's longer side: shown only until a view's tiles arrive (ms), sharper than any fitted
 view of a window up to 1024 px wide; at 2048 px it held 6.5 MB of an office map for those moments."""
 DEFAULT_MAX_BYTES = 96 * 1024 * 1024
+GIVE_BACK_AFTER_S = 1.0
+"""Idle this long after rendering, the worker gives the burst's freed memory (the map decode's and
+the tiles' numpy temporaries) back to the system: not at once, so a launch's first frame never
+waits on the C heap's lock while it is trimmed."""
 TARGET_POINTS_PER_CELL = 64
 
 
@@ -396,9 +400,20 @@ class TileCache:
 
     # -- worker ------------------------------------------------------------------------------
     def _work(self) -> None:
+        trim_due = False
         while True:
             with self._lock:
-                self._lock.wait_for(lambda: self._closed or self._has_work())
+                woken = self._lock.wait_for(
+                    lambda: self._closed or self._has_work(), GIVE_BACK_AFTER_S if trim_due else None
+                )
+                if not woken:  # idle a while after a burst: its freed memory goes back to the system
+                    trim_due = False
+                    self._lock.release()  # not held while the C heap is trimmed (a few ms)
+                    try:
+                        give_back()
+                    finally:
+                        self._lock.acquire()
+                    continue
                 if self._closed:
                     return
                 gen = self._generation
@@ -422,9 +437,7 @@ class TileCache:
                 with self._lock:
                     self._busy = False
                     self._lock.notify_all()
-                    drained = not self._has_work()
-            if drained:  # the burst's numpy temporaries (and the map decode's) go back to the system
-                give_back()
+                    trim_due = True
 
     def _has_work(self) -> bool:
         if self._map_arrays is None:
