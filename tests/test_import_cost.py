@@ -146,6 +146,16 @@ WINDOW_LATE = (
     "xml.sax",  # XML escaping brings urllib and email: no part of the first frame needs them
     "urllib.request",
     "email",
+    "rtmu.ui.about",  # the dialogs and pages a menu opens: each imported when it first opens
+    "rtmu.ui.config_page",
+    "rtmu.ui.console_page",
+    "rtmu.ui.details",
+    "rtmu.ui.files_page",
+    "rtmu.ui.map_edit_window",
+    "rtmu.ui.move_dialogs",
+    "rtmu.ui.palette",
+    "rtmu.ui.settings_dialog",
+    "rtmu.ui.why_window",
 )
 """What a launch to the first map frame does without (issue 28: launch ≤ 0.6 s); each is imported
 where it is first used."""

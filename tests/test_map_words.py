@@ -43,3 +43,34 @@ def test_going_somewhere_and_not_connected() -> None:
     nav = NavState(navigating=True, target="Lab B", remaining_mm=12_400.0)
     assert "going to Lab B, 12 metres left" in map_description(robot(vel=300.0), nav, CONNECTED)
     assert map_description(robot(), NavState(), ConnectionState()).startswith("Not connected")
+
+
+def test_the_description_is_worded_again_only_when_what_it_says_changed() -> None:
+    """A status restating the pose (10 a second while driving) words nothing (issue 28: the GTK
+    thread's cost while following); a material change still says the new words at once."""
+    from rtmu.model.observables import RobotModel
+    from rtmu.ui import map_words
+    from rtmu.ui.map_words import MapDescription
+
+    model = RobotModel()
+    model.connection.set(CONNECTED)
+    model.robot.set(robot())
+    said: list[str] = []
+    worded = [0]
+    real = map_words.map_description
+
+    def counting(*args: object) -> str:
+        worded[0] += 1
+        return real(*args)  # type: ignore[arg-type]
+
+    map_words.map_description = counting  # type: ignore[assignment]
+    try:
+        words = MapDescription(model, said.append)
+        for step in range(10):  # a few centimetres and a degree each, readings timed anew
+            model.robot.set(robot(x=2000.0 + 3 * step, th=0.5 * step, numbers_at=2.0 + step))
+        assert worded[0] == 1 and said == [words.text]
+        model.robot.set(robot(x=2000.0, th=0.0, battery_v=11.4, numbers_at=20.0))
+        assert worded[0] == 2 and "low" in said[-1]
+        words.close()
+    finally:
+        map_words.map_description = real  # type: ignore[assignment]

@@ -46,6 +46,16 @@ def test_english_and_c_write_a_decimal_point(english: None) -> None:
     assert duration(240) == "4 min"
 
 
+def test_without_a_catalogue_numbers_read_as_the_c_library_writes_them(english: None) -> None:
+    """The marks are read from LC_NUMERIC once (issue 28: ``locale.format_string`` per number was most of
+    the toolbar's cost while driving); every number still comes out as the C library formats it."""
+    import locale
+
+    for value in (0.0, -0.4, 0.5, 12.25, 999.999, 1234.5, -98765.4321, 1e9, 123456789.987):
+        for digits in (0, 1, 2, 3):
+            assert i18n.number(value, digits) == locale.format_string(f"%.{digits}f", value, grouping=True)
+
+
 def test_coordinates_keep_the_two_numbers_apart_when_the_mark_is_a_comma(german: None) -> None:
     assert coordinates(1500, -2000) == "1,50; -2,00 m"
     i18n.use(["en"])

@@ -10,6 +10,7 @@ from __future__ import annotations
 
 from collections.abc import Callable
 from pathlib import Path
+from typing import TYPE_CHECKING
 
 import gi
 
@@ -18,15 +19,17 @@ from gi.repository import Gtk  # noqa: E402
 
 from ..base.i18n import _, ngettext  # noqa: E402
 from ..fleet.selected import SelectedRobot  # noqa: E402
-from ..mapedit import MapObject  # noqa: E402
 from ..model.observables import RobotModel  # noqa: E402
 from .banners import BannerStack  # noqa: E402
-from .files_page import FilesPage  # noqa: E402
 from .map_canvas_edit import MapCanvasEdit  # noqa: E402
-from .map_edit_window import MapEditWindow  # noqa: E402
 from .map_point_pick import MapPointPick  # noqa: E402
 from .mapview import MapStage  # noqa: E402
 from .scan_mode import ScanBar  # noqa: E402
+
+if TYPE_CHECKING:  # the files page and the map editor are imported when first opened (issue 28)
+    from ..mapedit import MapObject
+    from .files_page import FilesPage
+    from .map_edit_window import MapEditWindow
 
 DRAFT_TOPIC = "map-draft"
 
@@ -71,6 +74,8 @@ class Commissioning:
         """Server ▸ Edit the map…: one draft window at a time."""
         if self.map_edit is None or self.map_edit.closed:
             pick = self.point_pick.start if self.point_pick is not None else None
+            from .map_edit_window import MapEditWindow
+
             self.map_edit = MapEditWindow(
                 self.window, self.robot, self.model, self._show_draft, pick, self.canvas_edit
             )
@@ -102,6 +107,8 @@ class Commissioning:
         page = self.files_page
         if page is None or page.closed:
             downloads = default_downloads()
+            from .files_page import FilesPage
+
             page = self.files_page = FilesPage(self.window, self.robot, self.model, downloads=downloads)
         page.present()
 

@@ -5,7 +5,8 @@ cache (a blit per visible tile, or the stretched overview while a tile is still
 being rendered), then the overlays — cairns, trail, sonar, robot — are drawn on
 top (the fleet's other robots, ``fleet_draw``, under the selected one), with navigation
 (``nav_draw``: planned path, goal ring, a picked pose) between the cairns and the robot.
-Without a map: a metric grid and its legend.
+Without a map: a metric grid and its legend. The static part — background, tiles, cairns — comes
+from the stage's :class:`~rtmu.ui.map_layer.MapLayer` when it has one for this view.
 """
 
 from __future__ import annotations
@@ -18,6 +19,8 @@ import cairo
 from ..base.i18n import _
 from ..values.state import DrawingLayer
 from . import drawings_draw, fleet_draw, fov_draw, nav_draw, overlays, stop_draw
+from .map_layer import MapLayer
+from .overlays import Box
 from .tiles import BACKGROUND_RGB, EMPTY, TILE, Overview, TileCache
 from .viewport import Viewport
 
@@ -52,23 +55,21 @@ class Scene:
     """The server's drawings (``drawings_draw``) in their shapes and colours, under or over the robot."""
     stop_reach: stop_draw.StopReach | None = None
     """While the robot moves: the strip it sweeps before it can stand still (``stop_draw``)."""
+    layer: MapLayer | None = None
+    """The stored picture of the static map (None: draw it every frame)."""
 
 
 def draw_frame(ctx: cairo.Context, vp: Viewport, scene: Scene) -> bool:
     """Draw one frame; True when a map is shown with every visible tile ready."""
     ctx.new_path()  # every helper starts its own path too; a frame never inherits one
-    ctx.set_source_rgb(*BACKGROUND_RGB)
-    ctx.paint()
-    complete = False
-    has_map = scene.tiles is not None and scene.tiles.ready
-    if has_map:
-        complete = draw_tiles(ctx, vp, scene.tiles)  # type: ignore[arg-type]
-    else:
-        step = overlays.draw_grid(ctx, vp)
-        overlays.draw_scale_note(ctx, scene.labels, _("grid {metres}").format(metres=overlays.metres(step)))
-    if scene.objects:
-        avoid = overlays.robot_box(vp, *scene.robot[:2]) if scene.robot is not None else None
-        overlays.draw_cairns(ctx, vp, scene.objects, scene.labels, avoid)
+    tiles = scene.tiles if scene.tiles is not None and scene.tiles.ready else None
+    has_map = tiles is not None
+    robot_xy = scene.robot[:2] if scene.robot is not None else None
+    layered = False
+    if tiles is not None and scene.layer is not None:
+        base = lambda c, v, avoided, names: draw_base(c, v, scene, avoided, names)  # noqa: E731 - the picture
+        layered = scene.layer.paint(ctx, vp, tiles, scene.objects, robot_xy, base)
+    complete = layered or draw_base(ctx, vp, scene, robot_xy)
     if scene.goal is not None:
         nav_draw.draw_goal_highlight(ctx, vp, *scene.goal)
     nav_draw.draw_path(ctx, vp, scene.robot[:2] if scene.robot is not None else None, scene.path)
@@ -92,6 +93,30 @@ def draw_frame(ctx: cairo.Context, vp: Viewport, scene: Scene) -> bool:
         overlays.draw_robot(ctx, vp, x, y, th, stale=scene.stale, footprint=has_map, rgb=scene.robot_rgb)
         if not scene.stale:
             drawings_draw.draw_layers(ctx, vp, scene.drawings, (x, y), above_robot=True)
+    return complete
+
+
+def draw_base(
+    ctx: cairo.Context,
+    vp: Viewport,
+    scene: Scene,
+    robot_xy: tuple[float, float] | None,
+    names: list[Box] | None = None,
+) -> bool:
+    """The static part: background, tiles (or the grid) and cairns, names moved from under ``robot_xy``.
+
+    True when a map is shown with every visible tile ready."""
+    ctx.set_source_rgb(*BACKGROUND_RGB)
+    ctx.paint()
+    complete = False
+    if scene.tiles is not None and scene.tiles.ready:
+        complete = draw_tiles(ctx, vp, scene.tiles)
+    else:
+        step = overlays.draw_grid(ctx, vp)
+        overlays.draw_scale_note(ctx, scene.labels, _("grid {metres}").format(metres=overlays.metres(step)))
+    if scene.objects:
+        avoid = overlays.robot_box(vp, *robot_xy) if robot_xy is not None else None
+        overlays.draw_cairns(ctx, vp, scene.objects, scene.labels, avoid, names)
     return complete
 
 

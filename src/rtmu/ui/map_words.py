@@ -77,6 +77,23 @@ def map_description(robot: RobotState, nav: NavState, connection: ConnectionStat
     return "; ".join(parts)
 
 
+def _said_of(robot: RobotState, nav: NavState, connection: ConnectionState) -> tuple[object, ...]:
+    """Everything :func:`map_description` reads, rounded as it rounds: equal tuples, equal words."""
+    return (
+        connection.phase,
+        robot.numbers_at is None,
+        _step(robot.x / 1000, POSE_STEP_M),
+        _step(robot.y / 1000, POSE_STEP_M),
+        int(_step(robot.th, HEADING_STEP_DEG)) % 360,
+        robot.mode or robot.status,
+        robot.battery_v,
+        robot.battery_is_soc,
+        robot.battery_state,
+        abs(robot.vel) > 20 or abs(robot.rot_vel) > 3,
+        nav,
+    )
+
+
 class MapDescription:
     """Keeps ``describe(text)`` (the map widget's description) in step with the model, only on change."""
 
@@ -84,6 +101,7 @@ class MapDescription:
         self.model = model
         self._describe = describe
         self.text = ""
+        self._said: tuple[object, ...] | None = None
         self._unobserve = [
             model.robot.observe(self._changed),
             model.navigation.observe(self._changed),
@@ -93,7 +111,12 @@ class MapDescription:
 
     def _changed(self, _old: object, _new: object) -> None:
         m = self.model
-        text = map_description(m.robot.value, m.navigation.value, m.connection.value)
+        robot, nav, connection = m.robot.value, m.navigation.value, m.connection.value
+        said = _said_of(robot, nav, connection)
+        if said == self._said:
+            return  # nothing the words say changed (a status a second restates a pose, ten while driving)
+        self._said = said
+        text = map_description(robot, nav, connection)
         if text != self.text:
             self.text = text
             self._describe(text)

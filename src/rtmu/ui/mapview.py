@@ -33,6 +33,7 @@ from . import accessible, overlays  # noqa: E402
 from .fleet_draw import FleetMark  # noqa: E402
 from .fov_draw import Wedge, camera_aim  # noqa: E402
 from .frame import Scene, draw_frame  # noqa: E402
+from .map_layer import MapLayer  # noqa: E402
 from .map_words import MapDescription  # noqa: E402
 from .nav_draw import Marker, MarkerKind  # noqa: E402
 from .stop_draw import stop_reach  # noqa: E402
@@ -99,6 +100,8 @@ class MapStage(Gtk.DrawingArea):
         :meth:`robot_is_stale` no longer says the same."""
         self.labels = overlays.LabelCache()
         self.tiles = TileCache(self._tiles_ready_from_worker)
+        self.layer = MapLayer()
+        """The static map's picture for the current view: a frame that only moves the robot paints it."""
         self._tiles_pending = False
         self._map_shown_generation = -1
         self._objects: list[object] = []
@@ -141,6 +144,7 @@ class MapStage(Gtk.DrawingArea):
         self.words.close()
         self._cancel_drawings_redraw()
         self.tiles.close()
+        self.layer.forget()
 
     # -- model -------------------------------------------------------------------------------
     @property
@@ -163,6 +167,7 @@ class MapStage(Gtk.DrawingArea):
                 self._map_generation = -1
                 self.tiles.set_map(None, None)
                 self._objects = []
+                self.layer.forget()
             if new.state in ("none", "unsupported", "unknown") and self.fitted:
                 self._fit_no_map()
         self.queue_draw()
@@ -388,7 +393,9 @@ class MapStage(Gtk.DrawingArea):
             sonar=r.sonar if self.operator.view.value.show_sonar and not drawings.offered else (),
             laser=r.laser if self.operator.view.value.show_sonar and not drawings.offered else (),
             drawings=drawings.layers,  # the server's own sonar/laser drawings replace RTMU's colours
+            layer=self.layer,
         )
+        self.layer.scale = self.get_scale_factor()
         if self.fleet is not None:  # the fleet's other robots and the selected one's colour
             scene.others, scene.robot_rgb = self.fleet()
         self._add_navigation(scene)

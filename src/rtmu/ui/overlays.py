@@ -155,11 +155,13 @@ def draw_cairns(
     objects: Sequence[object],
     labels: LabelCache,
     avoid: Box | None = None,
+    names: list[Box] | None = None,
 ) -> list[tuple[str, Box]]:
     """Home, goals (with names), docks, forbidden lines and areas, other areas; off-screen ones skipped.
 
     A name that would sit under ``avoid`` (the robot, drawn later on top) is moved below it.
-    Returns the names drawn and their boxes.
+    Returns the names drawn and their boxes; ``names`` gets the box of every name placed, drawn or
+    not (``map_layer`` tells from them whether the robot would move one).
     """
     wx0, wy0, wx1, wy1 = vp.visible_world(margin_px=120)
     pending: list[_Label] = []
@@ -199,7 +201,7 @@ def draw_cairns(
             _marker(ctx, sx, sy, AREA_RGB, "dot")
             if name:
                 pending.append(_Label(4, name, sx, sy + 8, AREA_RGB))
-    return _draw_labels(ctx, labels, pending, avoid)
+    return _draw_labels(ctx, labels, pending, avoid, names)
 
 
 def region_corners(
@@ -310,12 +312,17 @@ class _Label(NamedTuple):
     rgb: tuple[float, float, float]
 
 
-def _overlap(a: Box, b: Box) -> bool:
+def overlap(a: Box, b: Box) -> bool:
+    """Two screen boxes (x0, y0, x1, y1) share some area."""
     return a[0] < b[2] and b[0] < a[2] and a[1] < b[3] and b[1] < a[3]
 
 
 def _draw_labels(
-    ctx: cairo.Context, labels: LabelCache, pending: list[_Label], avoid: Box | None = None
+    ctx: cairo.Context,
+    labels: LabelCache,
+    pending: list[_Label],
+    avoid: Box | None = None,
+    names: list[Box] | None = None,
 ) -> list[tuple[str, Box]]:
     """Names under their marks on a light halo; one that would overlap a more important one is left out."""
     taken: list[Box] = []
@@ -328,10 +335,12 @@ def _draw_labels(
         w, h = logical.width, logical.height
         x, y = round(item.sx - w / 2), round(item.sy)
         box = (x - 3, y - 1, x + w + 3, y + h + 1)
-        if avoid is not None and _overlap(box, avoid):
+        if names is not None:
+            names.append(box)
+        if avoid is not None and overlap(box, avoid):
             y = round(avoid[3]) + 2  # under the robot instead of hidden by it
             box = (x - 3, y - 1, x + w + 3, y + h + 1)
-        if any(_overlap(box, b) for b in taken):
+        if any(overlap(box, b) for b in taken):
             continue
         taken.append(box)
         drawn.append((item.text, box))

@@ -30,6 +30,8 @@ from typing import cast
 import cairo
 import numpy as np
 
+from ..base.memory import give_back
+
 TILE = 256
 """Tile edge in pixels."""
 BACKGROUND_RGB = (0.961, 0.957, 0.949)
@@ -43,6 +45,10 @@ OVERVIEW_MAX_PX = 1024
 """The overview's longer side: shown only until a view's tiles arrive (ms), sharper than any fitted
 view of a window up to 1024 px wide; at 2048 px it held 6.5 MB of an office map for those moments."""
 DEFAULT_MAX_BYTES = 96 * 1024 * 1024
+GIVE_BACK_AFTER_S = 1.0
+"""Idle this long after rendering, the worker gives the burst's freed memory (the map decode's and
+the tiles' numpy temporaries) back to the system: not at once, so a launch's first frame never
+waits on the C heap's lock while it is trimmed."""
 TARGET_POINTS_PER_CELL = 64
 
 
@@ -329,6 +335,12 @@ class TileCache:
             return self._index is not None
 
     @property
+    def generation(self) -> int:
+        """Counts the maps set: a picture made of this map's tiles is stale once it changes."""
+        with self._lock:
+            return self._generation
+
+    @property
     def bounds(self) -> tuple[float, float, float, float] | None:
         with self._lock:
             return None if self._index is None else self._index.bounds
@@ -388,9 +400,20 @@ class TileCache:
 
     # -- worker ------------------------------------------------------------------------------
     def _work(self) -> None:
+        trim_due = False
         while True:
             with self._lock:
-                self._lock.wait_for(lambda: self._closed or self._has_work())
+                woken = self._lock.wait_for(
+                    lambda: self._closed or self._has_work(), GIVE_BACK_AFTER_S if trim_due else None
+                )
+                if not woken:  # idle a while after a burst: its freed memory goes back to the system
+                    trim_due = False
+                    self._lock.release()  # not held while the C heap is trimmed (a few ms)
+                    try:
+                        give_back()
+                    finally:
+                        self._lock.acquire()
+                    continue
                 if self._closed:
                     return
                 gen = self._generation
@@ -414,6 +437,7 @@ class TileCache:
                 with self._lock:
                     self._busy = False
                     self._lock.notify_all()
+                    trim_due = True
 
     def _has_work(self) -> bool:
         if self._map_arrays is None:

@@ -19,7 +19,7 @@ from __future__ import annotations
 
 import time
 from collections.abc import Callable, Mapping
-from typing import Protocol
+from typing import TYPE_CHECKING, Protocol
 
 import gi
 
@@ -41,7 +41,6 @@ from .bridge_toggle import BridgeToggle  # noqa: E402
 from .camera_page import CameraPage  # noqa: E402
 from .commissioning import Commissioning  # noqa: E402
 from .desktop_citizen import DesktopCitizen  # noqa: E402
-from .details import DetailsWindow  # noqa: E402
 from .dialog_chain import close_popovers, dialogs_of  # noqa: E402
 from .drive_input import DriveInput  # noqa: E402
 from .goals_panel import GoalsPanel  # noqa: E402
@@ -62,6 +61,9 @@ from .toolbar import StatusToolbar  # noqa: E402
 from .why_hint import WhyContext, WhyHint  # noqa: E402
 from .window_dialogs import WindowDialogs  # noqa: E402
 from .window_timers import WindowTimers  # noqa: E402
+
+if TYPE_CHECKING:
+    from .details import DetailsWindow
 
 
 class _Part(Protocol):

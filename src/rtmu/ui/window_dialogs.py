@@ -14,7 +14,7 @@ from __future__ import annotations
 
 import concurrent.futures
 from collections.abc import Callable, Mapping
-from typing import Any
+from typing import TYPE_CHECKING, Any
 
 import gi
 
@@ -36,15 +36,14 @@ from ..values.intents import (  # noqa: E402
     TurnBy,
     WatchStrings,
 )
-from .about import about_dialog  # noqa: E402
 from .banners import BannerStack  # noqa: E402
-from .config_page import ConfigPage  # noqa: E402
-from .console_page import ConsolePage  # noqa: E402
-from .details import DetailsWindow  # noqa: E402
-from .move_dialogs import go_dialog, turn_dialog  # noqa: E402
-from .palette import CommandPalette  # noqa: E402
-from .settings_dialog import ConnectionDialog, PasswordPrompt  # noqa: E402
-from .why_window import WhyWindow  # noqa: E402
+
+if TYPE_CHECKING:  # each dialog's module is imported when it first opens (issue 28: launch ≤ 0.6 s)
+    from .config_page import ConfigPage
+    from .console_page import ConsolePage
+    from .details import DetailsWindow
+    from .settings_dialog import ConnectionDialog
+    from .why_window import WhyWindow
 
 Request = Callable[[Intent], "concurrent.futures.Future[Any]"]
 
@@ -99,6 +98,8 @@ class WindowDialogs:
         current = self.robot.session.controller.current_profile()  # the speed and view as they are now:
         profiles[current.name] = current  # Save keeps them (never the speed the profile was opened with)
         known = self.keyring_available
+        from .settings_dialog import ConnectionDialog
+
         self.settings = ConnectionDialog(
             self.window,
             profiles,
@@ -132,6 +133,8 @@ class WindowDialogs:
         if remembered is not None:
             answer(remembered)
             return
+        from .settings_dialog import PasswordPrompt
+
         PasswordPrompt(self.window, profile, answer).present()
 
     # -- the server's configuration ------------------------------------------------------------
@@ -140,6 +143,8 @@ class WindowDialogs:
         page = self.config_page
         if page is None or page.closed:
             offers = lambda: self.model.connection.value.offers  # noqa: E731 - the shown robot's, always
+            from .config_page import ConfigPage
+
             page = self.config_page = ConfigPage(
                 self.window,
                 self.request,
@@ -168,6 +173,8 @@ class WindowDialogs:
         ``filter_text`` narrows it (the configuration page points at the robot's config data)."""
         console = self.console
         if console is None or console.closed:
+            from .console_page import ConsolePage
+
             console = self.console = ConsolePage(self.window, self.request)
         if filter_text:
             console.search.set_text(filter_text)
@@ -187,6 +194,8 @@ class WindowDialogs:
         """Why won't it move? (``why_window``): one at a time; opened again, it asks again."""
         why = self.why
         if why is None or why.closed:
+            from .why_window import WhyWindow
+
             why = self.why = WhyWindow(self.window, self.request, self._why_question)
         else:
             why.ask()
@@ -198,6 +207,8 @@ class WindowDialogs:
         details = self.details
         if details is None or not details.get_visible():
             robot = self.robot
+            from .details import DetailsWindow
+
             details = self.details = DetailsWindow(
                 self.window, self.model, robot.ask, lambda on: robot.ask(WatchStrings(on))
             )
@@ -213,12 +224,17 @@ class WindowDialogs:
     def show_about(self) -> None:
         """Help ▸ About, with the debug information of the robot shown (``about``)."""
         conn = self.model.connection.value
+        from .about import about_dialog
+
         about_dialog(self.window, conn, self.robot.session.controller.profile.name).present()
 
     # -- the controller's dialogs: Turn, Go, the palette -----------------------------------------
     def open_dialog(self, name: str) -> None:
         """The dialog a command asked for (the controller stopped the robot first)."""
         ask = self.robot.ask
+        from .move_dialogs import go_dialog, turn_dialog
+        from .palette import CommandPalette
+
         makers: dict[str, Callable[[], Gtk.Window]] = {
             "turn": lambda: turn_dialog(self.window, lambda degrees: ask(TurnBy(degrees))),
             "go": lambda: go_dialog(self.window, lambda mm: ask(MoveDistance(mm))),

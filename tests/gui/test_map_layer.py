@@ -1,0 +1,161 @@
+"""The stored map picture (``rtmu.ui.map_layer``) draws what the direct path draws, pixel by pixel.
+
+Frames of the office map, drawn without a window by the window's own frame function: once with the
+static map drawn directly and once painted from the stored picture, at the fitted view and zoomed in
+while the robot moves. The picture is made once per view, not once per frame (the gain of issue 28's
+follow target), and steps aside — the direct path draws — while a tile is missing or the robot
+stands where a name sits (the name then moves from under it).
+"""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+import cairo
+import numpy as np
+import pytest
+
+from rtmu.mapfile.reader import read_map
+from rtmu.package_data import project_map
+from rtmu.ui import overlays
+from rtmu.ui.frame import Scene, draw_frame
+from rtmu.ui.map_layer import MapLayer
+from rtmu.ui.tiles import TileCache
+from rtmu.ui.viewport import Viewport, fit_view
+
+W, H = 900, 560
+TOLERANCE = 2
+"""Largest difference of one colour channel allowed between the two ways (antialiasing rounding)."""
+
+
+@pytest.fixture(scope="module")
+def office() -> object:
+    return read_map(project_map("office.map"))
+
+
+@pytest.fixture()
+def tiles(office: object) -> object:
+    cache = TileCache(lambda: None)
+    cache.set_map(office.points, office.segments)  # type: ignore[attr-defined]
+    assert cache.wait_idle(30), "the tile worker never finished the index"
+    yield cache
+    cache.close()
+
+
+def ready(cache: TileCache, vp: Viewport) -> None:
+    """Every tile of ``vp`` rendered (the worker runs on its own thread)."""
+    for _ in range(20):
+        if all(s.surface is not None for s in cache.visible(vp.scale, vp.origin, vp.width, vp.height)):
+            return
+        assert cache.wait_idle(30)
+    raise AssertionError("the visible tiles never arrived")
+
+
+def frame(scene: Scene, vp: Viewport, path: Path | None = None) -> np.ndarray:
+    surface = cairo.ImageSurface(cairo.FORMAT_RGB24, vp.width, vp.height)
+    draw_frame(cairo.Context(surface), vp, scene)
+    surface.flush()
+    if path is not None:
+        surface.write_to_png(str(path))
+    data = np.ndarray(
+        (vp.height, vp.width, 4), np.uint8, surface.get_data(), strides=(surface.get_stride(), 4, 1)
+    )
+    return data[..., :3].astype(int).copy()
+
+
+def scene_of(
+    office: object, cache: TileCache, robot: tuple[float, float, float], layer: MapLayer | None
+) -> Scene:
+    return Scene(
+        labels=overlays.LabelCache(),
+        tiles=cache,
+        objects=office.objects,  # type: ignore[attr-defined]
+        robot=robot,
+        trail=[(robot[0] - 800.0, robot[1]), robot[:2]],
+        layer=layer,
+    )
+
+
+def named(office: object) -> list[object]:
+    return [o for o in office.objects if getattr(o, "name", "") and getattr(o, "from_xy", None) is None]  # type: ignore[attr-defined]
+
+
+def views(cache: TileCache, office: object) -> dict[str, tuple[Viewport, tuple[float, float, float]]]:
+    fitted = fit_view(cache.bounds, W, H)  # type: ignore[arg-type]
+    goal = named(office)[0]
+    gx, gy = float(goal.x), float(goal.y)  # type: ignore[attr-defined]
+    near = Viewport(W, H, 1.0, gx + 2500.0, gy + 1500.0)  # 100 %: the cairn and its name in view
+    return {
+        "fitted": (fitted, (gx + 3000.0, gy - 2000.0, 30.0)),
+        "zoomed": (near, (gx + 2500.0, gy + 1500.0, 90.0)),
+    }
+
+
+@pytest.mark.parametrize("view", ["fitted", "zoomed"])
+def test_the_stored_picture_draws_the_same_map_as_drawing_it_directly(
+    screenshots: Path, office: object, tiles: TileCache, view: str
+) -> None:
+    vp, robot = views(tiles, office)[view]
+    ready(tiles, vp)
+    direct = frame(scene_of(office, tiles, robot, None), vp, screenshots / f"map-layer-{view}-direct.png")
+    layer = MapLayer()
+    frame(scene_of(office, tiles, robot, layer), vp)  # makes the picture
+    stored = frame(scene_of(office, tiles, robot, layer), vp, screenshots / f"map-layer-{view}-stored.png")
+    assert layer.builds == 1 and layer.uses == 2, "both frames painted the one stored picture"
+    assert (direct != stored).any(axis=-1).sum() <= W * H // 1000, "more than 0.1 % of the pixels differ"
+    assert np.abs(direct - stored).max() <= TOLERANCE
+    assert (direct != 245).any(axis=-1).sum() > W * H // 200, "control: the frame shows a map, not background"
+
+
+def test_the_picture_is_made_once_per_view_while_the_robot_moves(office: object, tiles: TileCache) -> None:
+    vp, (x, y, th) = views(tiles, office)["zoomed"]
+    ready(tiles, vp)
+    layer = MapLayer()
+    for step in range(10):  # a drive along the view: only the robot, its trail and heading change
+        frame(scene_of(office, tiles, (x + 40.0 * step, y, th + step), layer), vp)
+    assert (layer.builds, layer.uses) == (1, 10)
+    moved = vp.panned(300, 0)  # follow re-centres: a new view, a new picture
+    ready(tiles, moved)
+    frame(scene_of(office, tiles, (x, y, th), layer), moved)
+    assert (layer.builds, layer.uses) == (2, 11)
+
+
+def test_the_robot_on_a_name_moves_it_in_a_picture_made_for_that_pose(
+    screenshots: Path, office: object, tiles: TileCache
+) -> None:
+    """At Home or a dock the robot stands on a name: the name moves from under it in the picture too,
+    and turning there (the same pose's place) makes no new picture."""
+    goal = named(office)[0]
+    vp = Viewport(W, H, 1.0, float(goal.x), float(goal.y))  # type: ignore[attr-defined]
+    ready(tiles, vp)
+    x, y = float(goal.x), float(goal.y) - 200.0  # type: ignore[attr-defined]  # on its name
+    layer = MapLayer()
+    on_name = frame(
+        scene_of(office, tiles, (x, y, 0.0), layer), vp, screenshots / "map-layer-robot-on-a-name.png"
+    )
+    direct = frame(scene_of(office, tiles, (x, y, 0.0), None), vp)
+    assert np.abs(on_name - direct).max() <= TOLERANCE
+    clear = frame(scene_of(office, tiles, (x + 3000.0, y + 2000.0, 0.0), None), vp)
+    assert (on_name != clear).any(axis=-1).sum() > 400, "control: the name did move (and the robot)"
+    builds = layer.builds
+    for th in (30.0, 60.0, 90.0):  # turning in place
+        frame(scene_of(office, tiles, (x, y, th), layer), vp)
+    assert layer.builds == builds and layer.uses == 4
+    frame(scene_of(office, tiles, (x + 3000.0, y + 2000.0, 0.0), layer), vp)  # off the name again
+    assert layer.builds == builds + 1
+
+
+def test_missing_tiles_make_no_picture(office: object) -> None:
+    cache = TileCache(lambda: None)
+    try:
+        cache.set_map(office.points, office.segments)  # type: ignore[attr-defined]
+        assert cache.wait_idle(30)
+        vp = fit_view(cache.bounds, W, H)  # type: ignore[arg-type]
+        layer = MapLayer()
+        frame(scene_of(office, cache, (0.0, 0.0, 0.0), layer), vp)  # asks for the tiles: none ready yet
+        assert (layer.builds, layer.uses) == (0, 0), "a picture with the overview's blur would stay"
+        ready(cache, vp)
+        frame(scene_of(office, cache, (0.0, 0.0, 0.0), layer), vp)
+        assert layer.builds == 1
+    finally:
+        cache.close()
