@@ -3,7 +3,9 @@
 from __future__ import annotations
 
 import atexit
+import contextlib
 import faulthandler
+import fcntl
 import functools
 import importlib
 import importlib.util
@@ -11,6 +13,7 @@ import os
 import shutil
 import sys
 import tempfile
+import time
 from collections.abc import Iterator, Sequence
 from pathlib import Path
 
@@ -24,6 +27,15 @@ from checkout import build_dists
 os.environ["XDG_DATA_HOME"] = _DATA_HOME = tempfile.mkdtemp(prefix="rtmu-test-data-")
 # Removed when the run ends (a GUI run must leave only its screenshots in /tmp: tests/gui/test_cleanup.py).
 atexit.register(shutil.rmtree, _DATA_HOME, ignore_errors=True)
+
+# One folder for the GUI tests' screenshots, named once by the run that starts here: the workers of a
+# parallel run (pytest-xdist) and the pytest runs a test starts inherit it, so a run's pictures are in one
+# place and no worker removes a folder another still fills. Only the run that named it removes it (empty).
+_NAMED_SCREENSHOTS = "RTMU_SCREENSHOTS" not in os.environ
+os.environ.setdefault(
+    "RTMU_SCREENSHOTS",
+    str(Path(tempfile.gettempdir()) / f"rtmu-gui-screens-{time.strftime('%Y%m%d-%H%M%S')}"),
+)
 
 # The suite reads RTMU's English words (and GTK's): a fixed language, whatever the machine's, for this
 # process and every window and subprocess it starts (tests of other languages choose theirs explicitly).
@@ -82,10 +94,38 @@ def pytest_runtest_protocol(item: pytest.Item) -> Iterator[None]:
             faulthandler.cancel_dump_traceback_later()
 
 
+def pytest_terminal_summary(terminalreporter, exitstatus: int, config: pytest.Config) -> None:  # type: ignore[no-untyped-def]
+    screenshots = Path(os.environ["RTMU_SCREENSHOTS"])
+    if screenshots.is_dir():
+        shots = sorted(screenshots.glob("*.png"))
+        terminalreporter.write_line(f"rtmu gui: {len(shots)} screenshots in {screenshots}")
+
+
+def pytest_sessionfinish(session: pytest.Session, exitstatus: int) -> None:
+    """The screenshot folder stays only when it holds pictures (removed by the run that named it)."""
+    screenshots = Path(os.environ["RTMU_SCREENSHOTS"])
+    if _NAMED_SCREENSHOTS and screenshots.is_dir() and not any(screenshots.iterdir()):
+        with contextlib.suppress(OSError):
+            screenshots.rmdir()
+
+
 @pytest.fixture(scope="session")
 def built_dists(tmp_path_factory: pytest.TempPathFactory) -> tuple[Path, Path]:
-    """The sdist and wheel ``python -m build`` makes of this checkout, built once per run."""
-    return build_dists(tmp_path_factory.mktemp("dists"))
+    """The sdist and wheel ``python -m build`` makes of this checkout, built once per run: in a parallel
+    run the first worker that needs them builds them into the run's shared temp folder while the others
+    wait on a lock, then all use them (a build is tens of seconds of CPU)."""
+    root = tmp_path_factory.getbasetemp()
+    if os.environ.get("PYTEST_XDIST_WORKER"):
+        root = root.parent  # the folder all workers' temp folders are in
+    dest, done = root / "dists", root / "dists.done"
+    with open(root / "dists.lock", "w") as lock:
+        fcntl.flock(lock, fcntl.LOCK_EX)
+        if not done.exists():
+            shutil.rmtree(dest, ignore_errors=True)  # what a failed build of another worker left
+            sdist, wheel = build_dists(dest)
+            done.write_text(f"{sdist}\n{wheel}\n")
+        sdist_name, wheel_name = done.read_text().split()
+    return Path(sdist_name), Path(wheel_name)
 
 
 @pytest.fixture
