@@ -94,6 +94,21 @@ def pytest_runtest_protocol(item: pytest.Item) -> Iterator[None]:
             faulthandler.cancel_dump_traceback_later()
 
 
+def pytest_configure(config: pytest.Config) -> None:
+    if config.getoption("numprocesses", None) and not hasattr(config, "workerinput"):
+        _glib_warnings_can_reach_the_controller()
+
+
+def _glib_warnings_can_reach_the_controller() -> None:
+    """A GLib warning a test caught (a GTK critical) is of class ``gobject.Warning``, whose module
+    PyGObject keeps as a guard that refuses every name: pytest-xdist's controller, which re-imports a
+    worker's warning class by its module's name to report it, ended the whole run with an internal error
+    on it. The guard is given that one class; every other name still fails as PyGObject means it to."""
+    from gi import _gi
+
+    importlib.import_module("gobject").Warning = _gi.Warning
+
+
 def pytest_terminal_summary(terminalreporter, exitstatus: int, config: pytest.Config) -> None:  # type: ignore[no-untyped-def]
     screenshots = Path(os.environ["RTMU_SCREENSHOTS"])
     if screenshots.is_dir():
