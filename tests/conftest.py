@@ -5,7 +5,6 @@ from __future__ import annotations
 import atexit
 import contextlib
 import faulthandler
-import fcntl
 import functools
 import importlib
 import importlib.util
@@ -21,6 +20,7 @@ import pytest
 from hypothesis import settings
 
 from checkout import build_dists
+from run_once import run_once
 
 # The window records every session (rtmu.recorder) under $XDG_DATA_HOME: never into the real home
 # from a test, nor from the windows and subprocesses tests start (they inherit this environment).
@@ -126,21 +126,10 @@ def pytest_sessionfinish(session: pytest.Session, exitstatus: int) -> None:
 
 @pytest.fixture(scope="session")
 def built_dists(tmp_path_factory: pytest.TempPathFactory) -> tuple[Path, Path]:
-    """The sdist and wheel ``python -m build`` makes of this checkout, built once per run: in a parallel
-    run the first worker that needs them builds them into the run's shared temp folder while the others
-    wait on a lock, then all use them (a build is tens of seconds of CPU)."""
-    root = tmp_path_factory.getbasetemp()
-    if os.environ.get("PYTEST_XDIST_WORKER"):
-        root = root.parent  # the folder all workers' temp folders are in
-    dest, done = root / "dists", root / "dists.done"
-    with open(root / "dists.lock", "w") as lock:
-        fcntl.flock(lock, fcntl.LOCK_EX)
-        if not done.exists():
-            shutil.rmtree(dest, ignore_errors=True)  # what a failed build of another worker left
-            sdist, wheel = build_dists(dest)
-            done.write_text(f"{sdist}\n{wheel}\n")
-        sdist_name, wheel_name = done.read_text().split()
-    return Path(sdist_name), Path(wheel_name)
+    """The sdist and wheel ``python -m build`` makes of this checkout, built once per run (``run_once``:
+    also when the run is spread over workers)."""
+    sdist, wheel = run_once(tmp_path_factory, "dists", lambda folder: list(build_dists(folder)))
+    return sdist, wheel
 
 
 @pytest.fixture
