@@ -145,8 +145,8 @@ class _Pipe:
                     self.ended = not self.done  # the peer's own close, not ours (reset, close)
                     break
                 self.put(data)
-        except OSError:
-            pass
+        except OSError:  # a reset (a peer that closed with bytes unread) is the peer's close too: passed
+            self.ended = not self.done  # on, else the far end kept a session nobody was behind
         self.finish()
 
     def _write(self) -> None:

@@ -147,10 +147,8 @@ else:
         os.environ["GSETTINGS_BACKEND"] = "memory"
         os.environ["XDG_CONFIG_HOME"] = str(Path(TMP_ROOT) / "config")
 
-SCREENSHOTS = Path(
-    os.environ.get("RTMU_SCREENSHOTS")
-    or Path(tempfile.gettempdir()) / f"rtmu-gui-screens-{time.strftime('%Y%m%d-%H%M%S')}"
-)
+SCREENSHOTS = Path(os.environ["RTMU_SCREENSHOTS"])
+"""The run's one screenshot folder (named in ``tests/conftest.py``, which also reports and removes it)."""
 
 
 def pytest_report_header(config: pytest.Config) -> list[str]:
@@ -178,17 +176,9 @@ def pytest_runtest_setup(item: pytest.Item) -> None:
         pytest.fail(f"CI=true but the GUI cannot be tested: {SKIP_REASON}", pytrace=False)
 
 
-def pytest_terminal_summary(terminalreporter, exitstatus: int, config: pytest.Config) -> None:  # type: ignore[no-untyped-def]
-    if SCREENSHOTS.is_dir():
-        shots = sorted(SCREENSHOTS.glob("*.png"))
-        terminalreporter.write_line(f"rtmu gui: {len(shots)} screenshots in {SCREENSHOTS}")
-
-
 def pytest_sessionfinish(session: pytest.Session, exitstatus: int) -> None:
-    """Leave only the screenshot folder behind (and not even that when it is empty)."""
+    """Leave only the screenshot folder behind (``tests/conftest.py`` removes it too when it is empty)."""
     shutil.rmtree(TMP_ROOT, ignore_errors=True)
-    if SCREENSHOTS.is_dir() and not any(SCREENSHOTS.iterdir()):
-        SCREENSHOTS.rmdir()
 
 
 @pytest.fixture(scope="session")

@@ -28,8 +28,12 @@ def wait(condition: Callable[[], bool], timeout: float, what: str, *, poll: floa
         time.sleep(poll)
 
 
-def xdotool(*args: str) -> str:
-    return subprocess.run(["xdotool", *args], capture_output=True, text=True, timeout=15, check=True).stdout
+def xdotool(*args: str, display: str | None = None) -> str:
+    """xdotool on the tests' screen, or on ``display`` (':N') when given."""
+    env = None if display is None else dict(os.environ, DISPLAY=display)
+    return subprocess.run(
+        ["xdotool", *args], capture_output=True, text=True, timeout=15, check=True, env=env
+    ).stdout
 
 
 def screenshot(path: Path, window: str | None = None, display: str | None = None) -> Path:

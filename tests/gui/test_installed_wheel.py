@@ -19,6 +19,7 @@ from pathlib import Path
 import pytest
 
 from rtmu import __version__
+from run_once import run_once
 
 from .process import screenshot, wait
 
@@ -36,9 +37,16 @@ def clean_env(**extra: str) -> dict[str, str]:
 
 @pytest.fixture(scope="module")
 def installed(built_dists: tuple[Path, Path], tmp_path_factory: pytest.TempPathFactory) -> Path:
-    """A fresh ``--system-site-packages`` venv with the wheel installed: its ``bin`` folder."""
+    """A fresh ``--system-site-packages`` venv with the wheel installed: its ``bin`` folder (made once a
+    run, ``run_once``: this module's tests may run in different workers)."""
     _, wheel = built_dists
-    venv = tmp_path_factory.mktemp("wheel-venv") / "venv"
+    (bin_dir,) = run_once(tmp_path_factory, "wheel-venv", lambda folder: [install_wheel(wheel, folder)])
+    return bin_dir
+
+
+def install_wheel(wheel: Path, folder: Path) -> Path:
+    """A ``--system-site-packages`` venv in ``folder`` with ``wheel`` installed: its ``bin`` folder."""
+    venv = folder / "venv"
     base = getattr(sys, "_base_executable", sys.executable)
     make = subprocess.run(
         [base, "-m", "venv", "--system-site-packages", str(venv)], capture_output=True, text=True, timeout=300

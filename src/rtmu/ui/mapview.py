@@ -132,6 +132,8 @@ class MapStage(Gtk.DrawingArea):
             model.drawings.observe(self._on_drawings),
         ]
         self._drawings_source = 0
+        self.drawings_wait_ms = DRAWINGS_WAIT_MS
+        """How long new drawings wait for another frame (a test on a busy machine sets it longer)."""
         self.drawings_redraws = 0
         """Frames asked for by new drawings alone (none while status frames show them)."""
         self.connect("resize", self._on_resize)
@@ -196,7 +198,7 @@ class MapStage(Gtk.DrawingArea):
     def _on_drawings(self, old: object, new: object) -> None:
         """Show new drawings with the next frame; ask for one only if none comes in time."""
         if not self._drawings_source:
-            self._drawings_source = GLib.timeout_add(DRAWINGS_WAIT_MS, self._drawings_due)
+            self._drawings_source = GLib.timeout_add(self.drawings_wait_ms, self._drawings_due)
 
     def _drawings_due(self) -> bool:
         self._drawings_source = 0
