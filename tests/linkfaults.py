@@ -137,10 +137,7 @@ class _Pipe:
                 with self.cond:
                     while self.queued > MAX_BUFFER and not self.done:
                         self.cond.wait(0.1)
-                try:
-                    data = self.src.recv(READ_CHUNK)
-                except ConnectionResetError:
-                    data = b""  # the peer's reset (a killed process with bytes unread) ends it too
+                data = self.src.recv(READ_CHUNK)
                 if not data:
                     self.ended = not self.done  # the peer's own close, not ours (reset, close)
                     break
