@@ -36,7 +36,7 @@ def test_stale_header_is_pointed_out(tmp_path: Path, capsys: pytest.CaptureFixtu
     assert main(["mapinfo", str(path)]) == 0
     out = capsys.readouterr().out
     assert "10 (header: 9)  <- header is stale" in out
-    assert "1 data line(s) skipped" in out
+    assert "(1 data line skipped)" in out
 
 
 def test_json(capsys: pytest.CaptureFixture[str]) -> None:

@@ -282,3 +282,26 @@ def test_an_unknown_goal_and_a_wrong_usage_are_said_in_german(
     assert "rtmu goto: kein Ziel 'Nowhere' auf diesem Server (Ziele: " in err and "Room 101" in err, err
     assert main(["goto", where, "Lab B", "--x", "1", "--y", "2", "--timeout", "5"]) == EXIT_USAGE
     assert "entweder ZIEL oder --x/--y angeben, nicht beides" in capsys.readouterr().err
+
+
+def test_mapinfo_reads_german_and_its_json_stays_english(
+    german: None, tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    """The summary's labels, the stale header's note and the plural in German with German numbers; the
+    map's own words (category, object types, goal names) as written; --json's keys and numbers plain."""
+    from testdata import ARIA_MAPS
+
+    assert main(["mapinfo", str(ARIA_MAPS / "columbia.map")]) == 0
+    out = capsys.readouterr().out
+    assert "Kategorie:" in out and "2D-Map" in out and "category" not in out
+    assert "63.311 (Kopf: 63.311)" in out  # German groups thousands with a point
+    assert "(-4.780, -27.000) .. (19.560, 24.680)" in out and "20 mm" in out
+    assert "ForbiddenLine 12" in out and '"Hallway 1"' in out
+    stale = tmp_path / "stale.map"
+    stale.write_text("2D-Map\nNumLines: 9\nLINES\n" + "0 0 1 1\n" * 10 + "DATA\nnot a point\nnor this\n")
+    assert main(["mapinfo", str(stale)]) == 0
+    out = capsys.readouterr().out
+    assert "10 (Kopf: 9)  <- Kopf ist veraltet" in out and "(2 Datenzeilen übersprungen)" in out
+    assert main(["mapinfo", str(ARIA_MAPS / "columbia.map"), "--json"]) == 0
+    summary = json.loads(capsys.readouterr().out)
+    assert summary["points"] == 63311 and summary["category"] == "2D-Map"

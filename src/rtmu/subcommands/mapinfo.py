@@ -95,48 +95,70 @@ def summarise(data: MapData) -> dict[str, Any]:
 
 
 def render_text(summary: dict[str, Any]) -> str:
+    """The summary for people, in the operator's language and numbers (``--json`` keeps the plain form);
+    the map's own words — its file name, category, goal and object type names — as written in it."""
+    from ..base.i18n import ngettext, number
+    from ..base.units import quantity
+
     def claim(found: int, claimed: int | None) -> str:
         if claimed is None:
-            return f"{found} (header: none)"
-        note = "" if claimed == found else "  <- header is stale"
-        return f"{found} (header: {claimed}){note}"
+            return _("{found} (header: none)").format(found=number(found))
+        if claimed == found:
+            return _("{found} (header: {claimed})").format(found=number(found), claimed=number(claimed))
+        return _("{found} (header: {claimed})  <- header is stale").format(
+            found=number(found), claimed=number(claimed)
+        )
 
     def box(value: list[int] | None) -> str:
-        return "none" if value is None else f"({value[0]}, {value[1]}) .. ({value[2]}, {value[3]})"
+        if value is None:
+            return _("none")
+        x1, y1, x2, y2 = (number(v) for v in value)
+        return f"({x1}, {y1}) .. ({x2}, {y2})"
 
-    rows: list[tuple[str, str]] = [("file", summary["file"]), ("category", summary["category"])]
+    def header(value: list[int] | None) -> str:
+        return _("(header: {bounds})").format(bounds=box(value))
+
+    rows: list[tuple[str, str]] = [(_("file"), summary["file"]), (_("category"), summary["category"])]
     for scan in summary["scans"]:
         title = f" [{scan['name']}]" if scan["name"] else ""
-        resolution = "none" if scan["resolution"] is None else f"{scan['resolution']} mm"
+        resolution = _("none") if scan["resolution"] is None else quantity(scan["resolution"], "mm")
         rows += [
-            (f"points{title}", claim(scan["points"], scan["claimed_points"])),
-            (f"lines{title}", claim(scan["lines"], scan["claimed_lines"])),
+            (_("points") + title, claim(scan["points"], scan["claimed_points"])),
+            (_("lines") + title, claim(scan["lines"], scan["claimed_lines"])),
             (
-                f"point bounds{title}",
-                f"{box(scan['point_bounds'])}  (header: {box(scan['claimed_point_bounds'])})",
+                _("point bounds") + title,
+                f"{box(scan['point_bounds'])}  {header(scan['claimed_point_bounds'])}",
             ),
-            (
-                f"line bounds{title}",
-                f"{box(scan['line_bounds'])}  (header: {box(scan['claimed_line_bounds'])})",
-            ),
-            (f"resolution{title}", resolution),
+            (_("line bounds") + title, f"{box(scan['line_bounds'])}  {header(scan['claimed_line_bounds'])}"),
+            (_("resolution") + title, resolution),
         ]
-    rows.append(("bounds", box(summary["bounds"])))
-    by_type = ", ".join(f"{name} {count}" for name, count in sorted(summary["objects_by_type"].items()))
-    rows.append(("objects", f"{summary['objects']}" + (f" ({by_type})" if by_type else "")))
+    rows.append((_("bounds"), box(summary["bounds"])))
+    by_type = ", ".join(
+        f"{name} {number(count)}" for name, count in sorted(summary["objects_by_type"].items())
+    )
+    rows.append((_("objects"), number(summary["objects"]) + (f" ({by_type})" if by_type else "")))
     goals = summary["goals"]
     rows.append(
-        ("goals", f"{len(goals)}" + (": " + ", ".join(json.dumps(g) for g in goals) if goals else ""))
+        (_("goals"), number(len(goals)) + (": " + ", ".join(json.dumps(g) for g in goals) if goals else ""))
     )
     home = summary["home"]
-    rows.append(("home", "none" if home is None else f"x={home['x']:g} y={home['y']:g} th={home['th']:g}"))
-    unknown = summary["unknown_keywords"]
-    rows.append(
-        ("unknown lines", f"{summary['unknown_lines']}" + (f": {' '.join(unknown)}" if unknown else ""))
+    where = (
+        _("none")
+        if home is None
+        else "x={x} y={y} th={th}".format(x=number(home["x"]), y=number(home["y"]), th=number(home["th"]))
     )
+    rows.append((_("home"), where))
+    unknown = summary["unknown_keywords"]
+    listed = f": {' '.join(unknown)}" if unknown else ""
+    rows.append((_("unknown lines"), number(summary["unknown_lines"]) + listed))
     if summary["skipped_lines"] or summary["warnings"]:
-        rows.append(("warnings", f"{summary['warnings']} ({summary['skipped_lines']} data line(s) skipped)"))
-    width = max(len(label) for label, _ in rows) + 1
+        skipped = ngettext(
+            "{warnings} ({count} data line skipped)",
+            "{warnings} ({count} data lines skipped)",
+            summary["skipped_lines"],
+        ).format(warnings=number(summary["warnings"]), count=number(summary["skipped_lines"]))
+        rows.append((_("warnings"), skipped))
+    width = max(len(label) for label, _value in rows) + 1
     lines = [f"{label + ':':<{width}} {value}" for label, value in rows]
     return "\n".join(lines)
 
