@@ -101,7 +101,11 @@ def core_false_stops(condition: str, seconds: float, fixed: bool, seed: int) -> 
             held = time.monotonic() - start
             said = [(t, why) for t, why in parent.stops + parent.guardian if start <= t <= start + held]
             for t, why in said:
-                print(f"# links core/{condition} fixed={fixed}: stop at {t - start:.1f} s: {why}", flush=True)
+                logged = " | ".join(text for at, text in parent.logs if abs(at - t) < 0.3)
+                print(
+                    f"# links core/{condition} fixed={fixed}: stop at {t - start:.1f} s: {why} [{logged}]",
+                    flush=True,
+                )
             return _events([t for t, _ in said]), held
         finally:
             parent.close()
@@ -122,7 +126,11 @@ def drive_false_stops(condition: str, seconds: float, fixed: bool, seed: int) ->
             driven += (rig.drives() - before) * 0.1  # sent every 100 ms while driving
             if code != 0:
                 stops += 1
-                print(f"# links drive/{condition} fixed={fixed}: {err.strip()[:300]}", flush=True)
+                load = os.getloadavg()[0]
+                print(
+                    f"# links drive/{condition} fixed={fixed}: {err.strip()[:300]} (load {load:.1f})",
+                    flush=True,
+                )
         return stops, driven
     finally:
         rig.close()
@@ -135,8 +143,8 @@ def window_false_stops(condition: str, seconds: float, fixed: bool, seed: int) -
         if condition in PROFILES:
             rig.play(condition, seed)
         count, held, who = window_false_stops_in(rig, seconds, fixed)
-        if who:
-            print(f"# links window/{condition} fixed={fixed}: stops by {who}", flush=True)
+        for stop in who:
+            print(f"# links window/{condition} fixed={fixed}: stop by {stop}", flush=True)
         return count, held
     finally:
         rig.close()
