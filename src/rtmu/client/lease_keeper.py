@@ -24,21 +24,20 @@ UI thread waits for a core is seen only when it runs, so the robot may drive up 
 longer — is measured by ``bench/bench_links.py`` (``links.release_during_freeze_mm``).
 
 The keeper also beats for that thread to the guardian with the same credited time, so the
-guardian judges the UI by the same rule (``rtmu.guardian``). Where the system allows it (root,
-or ``RLIMIT_NICE``), :func:`raise_priority` gives the keeper and the network thread a few nice
+guardian judges the UI by the same rule (``rtmu.guardian``). Where the system allows it,
+:func:`~rtmu.base.priority.raise_priority` gives the keeper and the network thread a few nice
 levels over the UI: they do little, and must do it on time.
 """
 
 from __future__ import annotations
 
-import contextlib
-import os
 import threading
 import time
 from collections.abc import Callable
 from dataclasses import dataclass
 
 from ..base import link_timing
+from ..base.priority import raise_priority
 from .lease import DriveLease
 
 PERIOD = 0.05
@@ -49,8 +48,6 @@ STARVED_LIMIT = 1.0
 """At most this many seconds after the renewing thread's last real renewal does the keeper credit it."""
 CREDITING = link_timing.LEARNING
 """False under ``RTMU_LINK_TIMING=fixed``: no keeper, the lease lapses as it did before."""
-PRIORITY_BOOST = 5
-"""Nice levels :func:`raise_priority` asks for (granted only where the system allows)."""
 
 
 @dataclass(frozen=True, slots=True)
@@ -108,16 +105,6 @@ class RunQueueMeter:
                 pending += now - last[0]  # runnable at both looks, never ran: waiting all along
         self._pending[tid] = pending
         return got.delayed - first + pending
-
-
-def raise_priority(boost: int = PRIORITY_BOOST) -> bool:
-    """Lower the calling thread's nice value by ``boost`` where allowed; True if it was."""
-    tid = threading.get_native_id()
-    with contextlib.suppress(OSError, AttributeError):
-        current = os.getpriority(os.PRIO_PROCESS, tid)
-        os.setpriority(os.PRIO_PROCESS, tid, max(-20, current - boost))
-        return True
-    return False
 
 
 class LeaseKeeper:

@@ -53,6 +53,7 @@ from pathlib import Path
 from typing import Protocol
 
 from ..base.link_timing import Deadline
+from ..base.priority import GUARDIAN_BOOST, raise_priority
 from . import messages as m
 from .halt import Halter
 from .handle import BEAT_PERIOD
@@ -369,6 +370,7 @@ class Guardian:
 
 def run(fd: int = 0, limits: LimitFor | None = learned_limit) -> int:
     os.set_blocking(fd, False)
+    raise_priority(GUARDIAN_BOOST)  # where allowed: a killed parent's stop must not wait for a core
     return Guardian(fd, Watch(os.getppid(), limits)).run()
 
 

@@ -105,6 +105,7 @@ def check(args: argparse.Namespace) -> None:
 def handle(args: argparse.Namespace) -> int:
     import asyncio
 
+    from ..base.priority import raise_priority
     from ..client.drive_guard import DriveGuard, LinkFault
     from ..client.errors import ClientError
     from ..client.roles import Role
@@ -117,6 +118,7 @@ def handle(args: argparse.Namespace) -> int:
 
     async def body(client: AriaClient) -> int:
         check(args)
+        raise_priority()  # where allowed: the loop that resends, watches the link and stops runs on time
         motion = Motion(args.trans, args.rot)
         if not client.supports("ratioDrive"):
             return await refuse(args, client, motion)
