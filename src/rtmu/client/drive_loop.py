@@ -185,7 +185,7 @@ class DriveFeed(Feed):
         age = health.status_age(now)
         aged = "-" if age is None else f"{age * 1000:.0f} ms"
         jitter = health.timing(now).jitter * 1000
-        late = health.wake_lateness.value(now) * 1000
+        late = health.wake_lateness.value() * 1000
         return (
             f"status age {aged}, limit {health.stale_limit(now) * 1000:.0f} ms, jitter {jitter:.0f} ms, "
             f"wake late {late:.0f} ms, load {os.getloadavg()[0]:.1f}"
@@ -301,7 +301,7 @@ class DriveFeed(Feed):
                 async with asyncio.timeout(delay):
                     await self._kick.wait()
             if not self._kick.is_set():  # woke by its timer: how late this machine ran it
-                self.health.note_wake(self.ctx.clock() - due, self.ctx.clock())
+                self.health.note_wake(self.ctx.clock() - due)
 
     def _beat(self, now: float) -> None:
         if self.guardian.poll():

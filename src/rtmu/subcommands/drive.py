@@ -376,7 +376,7 @@ async def drive(
             async with asyncio.timeout(max(0.0, wake - clock())):
                 await guard.changed.wait()
         if not guard.changed.is_set():  # woke by its timer: how late this machine ran it
-            guard.health.note_wake(clock() - wake, clock())
+            guard.health.note_wake(clock() - wake)
 
 
 RECONNECT_FOR_STOP = 1.0
