@@ -31,6 +31,7 @@ levels over the UI: they do little, and must do it on time.
 
 from __future__ import annotations
 
+import logging
 import threading
 import time
 from collections.abc import Callable
@@ -39,6 +40,8 @@ from dataclasses import dataclass
 from ..base import link_timing
 from ..base.priority import raise_priority
 from .lease import DriveLease
+
+log = logging.getLogger(__name__)
 
 PERIOD = 0.05
 """Seconds between the keeper's looks (well under the lease's 0.3 s)."""
@@ -138,8 +141,10 @@ class LeaseKeeper:
         """Set by a grant or renewal (:meth:`renewed`) and by :meth:`close`: a keeper with no lease to
         keep sleeps on it instead of looking 20 times a second at nothing (an idle window's wake-ups)."""
         self._thread: threading.Thread | None = None
+        self._told: float | None = None
+        """The renewal whose lapse :meth:`before_lapse` last logged (once per lapse)."""
         lease.on_renew = self.renewed  # told of every grant and renewal, on the renewing thread
-        lease.before_lapse = self.step  # and asked before anyone acts on a lapse
+        lease.before_lapse = self.before_lapse  # and asked before anyone acts on a lapse
 
     def start(self) -> LeaseKeeper:
         self._thread = threading.Thread(target=self._run, name="rtmu-lease-keeper", daemon=True)
@@ -182,6 +187,29 @@ class LeaseKeeper:
         waited behind a starved one catches up first."""
         with self._lock:
             self._step(now)
+
+    def before_lapse(self, now: float) -> None:
+        """The lease was found past its time: credit what is due first (:meth:`step`); if it still
+        lapses, log what the renewing thread did meanwhile (a false stop's cause, at info level)."""
+        self.step(now)
+        renewed = self.lease.last_renewal()
+        if renewed is None or renewed[0] == self._told:
+            return
+        self._told = renewed[0]  # (before asking the lease again: its view calls this hook)
+        if self.lease.view(now).live:
+            self._told = None
+            return
+        at, tid = renewed
+        sample = _thread_sample(tid)
+        state = "gone" if sample is None else ("runnable" if sample.runnable else "not runnable")
+        with self._lock:
+            wait, then = self.wait_of(tid), self._wait_then
+        waited = "?" if wait is None or then is None else f"{(wait - then) * 1000:.0f} ms"
+        log.info(
+            "lease past its time: the renewing thread %d last renewed %.0f ms ago, has waited %s for a "
+            "CPU since, and is %s now",
+            tid, (now - at) * 1000, waited, state,
+        )  # fmt: skip
 
     def _step(self, now: float) -> None:
         renewed = self.lease.last_renewal()
