@@ -152,6 +152,9 @@ class RigProcess:
     def play(self, profile: str, seed: int) -> None:
         self._send(f"play {profile} {seed}")
 
+    def reset_pose(self) -> None:
+        self._send("reset")
+
     def state(self) -> tuple[float, float, int]:
         """(commanded trans ratio, rot ratio, ratioDrive packets so far), asked now."""
         with self._cond:

@@ -25,7 +25,8 @@ KEY = "Left"
 
 
 class StopLog:
-    """The app's stderr read as it comes; the stop lines (sent, or the guardian's) kept until taken."""
+    """The app's stderr read as it comes; the stop lines (sent, or the guardian's) and the lease keeper's
+    account of a lapse kept until taken."""
 
     def __init__(self, stream: IO[str] | None) -> None:
         self._lines: list[str] = []
@@ -35,7 +36,7 @@ class StopLog:
 
     def _read(self, stream: IO[str]) -> None:
         for line in stream:
-            if "stop" in line:
+            if "stop" in line or "lease" in line:
                 with self._lock:
                     self._lines.append(line.strip())
 
