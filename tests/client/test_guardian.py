@@ -25,7 +25,14 @@ from rtmu.client.runner import ClientRunner
 from rtmu.client.session import SessionConfig
 from rtmu.guardian import halt
 from rtmu.guardian import messages as m
-from rtmu.guardian.child import SILENT_CEILING, SILENT_LATE, SILENT_LATE_NETWORK, Watch, learned_limit
+from rtmu.guardian.child import (
+    SILENT_CEILING,
+    SILENT_LATE,
+    SILENT_LATE_NETWORK,
+    Watch,
+    learned_limit,
+    parent_frozen,
+)
 from rtmu.guardian.halt import IDENTIFIER, IDENTIFIER_ARGS, ZERO_RATIO_DRIVE
 from rtmu.guardian.shared import SeatState
 from rtmu.protocol.payloads.drive import RatioDrive
@@ -375,3 +382,24 @@ def test_the_guardians_reasons_name_no_window_it_may_not_have() -> None:
     gone = watch.why_stop(10.0)
     for reason in (late, gone):
         assert reason is not None and "window" not in reason and "process driving the robot" in reason
+
+
+def test_a_stopped_parent_is_looked_for_once_a_beat_is_20_ms_late() -> None:
+    """bench_safety: a SIGSTOPped window drove on 85 ms (p50) while the guardian waited for a beat
+    0.1 s late before it looked in /proc. Beats come every 40 ms: 60 ms is enough to look, and a
+    running parent is never found stopped however late its beats (the silent limits judge it)."""
+    parent = subprocess.Popen([sys.executable, "-c", "import time; time.sleep(60)"])
+    try:
+        watch = Watch(parent.pid, learned_limit)
+        watch.take(m.ARM, 0.0)
+        watch.take(m.BEAT_NET, 0.0)
+        watch.take(m.BEAT_UI, 0.0)
+        assert watch.why_stop(0.07) is None  # running: late, not stopped
+        parent.send_signal(signal.SIGSTOP)
+        eventually(lambda: parent_frozen(parent.pid), timeout=10)
+        assert "stopped or gone" in (watch.why_stop(0.07) or "")
+        assert watch.why_stop(0.05) is None  # not yet late: no look
+    finally:
+        parent.send_signal(signal.SIGCONT)
+        parent.kill()
+        parent.wait(10)
