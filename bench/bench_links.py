@@ -46,6 +46,7 @@ from typing import Any
 from bench.common import Result
 from bench.links_rig import REPO, CoreParent, Rig, RigProcess, drive
 from bench.links_window import window_false_stops as window_false_stops_in
+from rtmu.base.exit_codes import EXIT_TIMEOUT
 
 sys.path.insert(0, str(REPO / "tests"))
 from cpuload import CpuLoad, wait_busy
@@ -101,7 +102,11 @@ def core_false_stops(condition: str, seconds: float, fixed: bool, seed: int) -> 
             held = time.monotonic() - start
             said = [(t, why) for t, why in parent.stops + parent.guardian if start <= t <= start + held]
             for t, why in said:
-                print(f"# links core/{condition} fixed={fixed}: stop at {t - start:.1f} s: {why}", flush=True)
+                logged = " | ".join(text for at, text in parent.logs if abs(at - t) < 0.3)
+                print(
+                    f"# links core/{condition} fixed={fixed}: stop at {t - start:.1f} s: {why} [{logged}]",
+                    flush=True,
+                )
             return _events([t for t, _ in said]), held
         finally:
             parent.close()
@@ -120,9 +125,15 @@ def drive_false_stops(condition: str, seconds: float, fixed: bool, seed: int) ->
             before = rig.drives()
             code, err = drive(rig.port, seconds - driven, fixed=fixed)
             driven += (rig.drives() - before) * 0.1  # sent every 100 ms while driving
-            if code != 0:
+            load = os.getloadavg()[0]
+            if code == EXIT_TIMEOUT:  # a link fault (rtmu drive's LinkFault): every one is false here
                 stops += 1
-                print(f"# links drive/{condition} fixed={fixed}: {err.strip()[:300]}", flush=True)
+                said = f"{err.strip()[:300]} (load {load:.1f})"
+                print(f"# links drive/{condition} fixed={fixed}: {said}", flush=True)
+            elif code != 0:  # not the link's: a wall reached after minutes of driving ahead, say
+                rig.reset_pose()
+                print(f"# links drive/{condition} fixed={fixed}: not a link stop, not counted (exit {code}): "
+                      f"{err.strip()[:200]}", flush=True)  # fmt: skip
         return stops, driven
     finally:
         rig.close()
@@ -135,8 +146,8 @@ def window_false_stops(condition: str, seconds: float, fixed: bool, seed: int) -
         if condition in PROFILES:
             rig.play(condition, seed)
         count, held, who = window_false_stops_in(rig, seconds, fixed)
-        if who:
-            print(f"# links window/{condition} fixed={fixed}: stops by {who}", flush=True)
+        for stop in who:
+            print(f"# links window/{condition} fixed={fixed}: stop by {stop}", flush=True)
         return count, held
     finally:
         rig.close()

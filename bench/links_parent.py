@@ -9,7 +9,9 @@ is held from the start. It prints ``ui TID`` (so a bench can pin or starve that 
 
 * ``stop T REASON`` — zero ratios + ``stop`` handed to the socket (``T``: ``time.monotonic()``,
   one clock for every process), with the session's reason;
-* ``guardian T TEXT`` — a notice of the safety kind (the guardian stopped the robot).
+* ``guardian T TEXT`` — a notice of the safety kind (the guardian stopped the robot);
+* ``log T TEXT`` — an ``rtmu`` log line at info level (each stop's measured account: status age,
+  learned limit, jitter, wake lateness, load).
 
 Commands on stdin: ``press`` (a fresh key press), ``release T`` (the operator lets go at monotonic
 ``T``; the UI thread acts on it when it next runs, as GTK handles a queued key-up), ``freeze S``
@@ -19,6 +21,7 @@ Commands on stdin: ``press`` (a fresh key press), ``release T`` (the operator le
 from __future__ import annotations
 
 import hashlib
+import logging
 import sys
 import threading
 import time
@@ -92,8 +95,18 @@ class Ui:
         self.runner.lease.grant(DRIVE)
 
 
+class SayLog(logging.Handler):
+    """``rtmu`` log lines (a stop's measured account) as ``log T TEXT`` lines for the bench."""
+
+    def emit(self, record: logging.LogRecord) -> None:
+        say("log", f"{time.monotonic():.6f}", self.format(record).replace("\n", " "))
+
+
 def main() -> int:
     port = int(sys.argv[1])
+    logger = logging.getLogger("rtmu")
+    logger.addHandler(SayLog(logging.INFO))
+    logger.setLevel(logging.INFO)
     runner = ClientRunner(config=SessionConfig(fetch_map=False, guardian=True)).start()
     runner.on_stop = lambda reason, sent: say("stop", f"{time.monotonic():.6f}", reason.replace("\n", " "))
 

@@ -152,6 +152,9 @@ class RigProcess:
     def play(self, profile: str, seed: int) -> None:
         self._send(f"play {profile} {seed}")
 
+    def reset_pose(self) -> None:
+        self._send("reset")
+
     def state(self) -> tuple[float, float, int]:
         """(commanded trans ratio, rot ratio, ratioDrive packets so far), asked now."""
         with self._cond:
@@ -202,6 +205,8 @@ class CoreParent:
         )
         self.stops: list[tuple[float, str]] = []
         self.guardian: list[tuple[float, str]] = []
+        self.logs: list[tuple[float, str]] = []
+        """Its ``rtmu`` log lines (each stop's measured account), timestamped."""
         self.ui_tid = 0
         self._driving = threading.Event()
         threading.Thread(target=self._read, daemon=True).start()
@@ -217,6 +222,9 @@ class CoreParent:
                 self.ui_tid = int(rest)
             elif word == "driving":
                 self._driving.set()
+            elif word == "log":
+                at, _, text = rest.partition(" ")
+                self.logs.append((float(at), text))
             elif word in ("stop", "guardian"):
                 at, _, text = rest.partition(" ")
                 (self.stops if word == "stop" else self.guardian).append((float(at), text))

@@ -6,7 +6,8 @@ interpreter lock, and the harness's own delays would pass for the link's. So eac
 every stop that reaches the simulator (``T``: ``time.monotonic()``, one clock for every process;
 ``WHO``: the sender's identifier, ``client`` without one, ``watchdog`` for the server's own).
 Commands on stdin: ``play PROFILE SEED`` (a Wi-Fi profile of ``tests/linkfaults.py``), ``state``
-(answers ``state TRANS ROT DRIVES``: the commanded ratios and ratioDrive packets so far).
+(answers ``state TRANS ROT DRIVES``: the commanded ratios and ratioDrive packets so far), ``reset``
+(the robot back where it started: a drive that went on for minutes reached a wall).
 """
 
 from __future__ import annotations
@@ -54,6 +55,8 @@ def main() -> int:
                 continue
             if words[0] == "play":
                 rig.proxy.play(PROFILES[words[1]], seed=int(words[2]))
+            elif words[0] == "reset":
+                rig.sim.call(rig.sim.server.reset_pose)
             elif words[0] == "state":
                 snap = rig.sim.snapshot()
                 drives = rig.sim.server.world.ratio_drives_received

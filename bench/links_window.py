@@ -12,14 +12,38 @@ from __future__ import annotations
 import subprocess
 import sys
 import tempfile
+import threading
 import time
 from pathlib import Path
+from typing import IO
 
 from bench.common import end_process, start_xvfb
 from bench.links_rig import RigProcess, env_for
 from bench.soak_window import _xdotool
 
 KEY = "Left"
+
+
+class StopLog:
+    """The app's stderr read as it comes; the stop lines (sent, or the guardian's) and the lease keeper's
+    account of a lapse kept until taken."""
+
+    def __init__(self, stream: IO[str] | None) -> None:
+        self._lines: list[str] = []
+        self._lock = threading.Lock()
+        if stream is not None:
+            threading.Thread(target=self._read, args=(stream,), daemon=True).start()
+
+    def _read(self, stream: IO[str]) -> None:
+        for line in stream:
+            if "stop" in line or "lease" in line:
+                with self._lock:
+                    self._lines.append(line.strip())
+
+    def take(self) -> list[str]:
+        with self._lock:
+            lines, self._lines = self._lines, []
+        return lines
 
 
 def window_false_stops(rig: RigProcess, seconds: float, fixed: bool) -> tuple[int, float, list[str]]:
@@ -30,12 +54,15 @@ def window_false_stops(rig: RigProcess, seconds: float, fixed: bool) -> tuple[in
     env.update(DISPLAY=display, GDK_BACKEND="x11", GSK_RENDERER="cairo", NO_AT_BRIDGE="1")
     env.update(GSETTINGS_BACKEND="memory", XDG_CONFIG_HOME=config, XDG_DATA_HOME=config)
     env.pop("WAYLAND_DISPLAY", None)
+    env["RTMU_LOG"] = "info"  # each stop's measured cause (``DriveFeed.send_stop``) on its stderr
     app = subprocess.Popen(
         [sys.executable, "-m", "rtmu", "--host", "127.0.0.1", "--port", str(rig.port)],
         env=env,
         stdout=subprocess.DEVNULL,
-        stderr=subprocess.DEVNULL,
+        stderr=subprocess.PIPE,
+        text=True,
     )
+    said = StopLog(app.stderr)
     try:
         window = _xdotool(env, "search", "--sync", "--onlyvisible", "--pid", str(app.pid), "--name", "RTMU")
         _xdotool(env, "windowfocus", "--sync", window.split()[0])
@@ -51,6 +78,7 @@ def window_false_stops(rig: RigProcess, seconds: float, fixed: bool) -> tuple[in
 
         if not press():
             raise RuntimeError("the window never drove the robot")
+        said.take()
         start = time.monotonic()
         seen = len(rig.stops)
         false: list[str] = []
@@ -58,10 +86,16 @@ def window_false_stops(rig: RigProcess, seconds: float, fixed: bool) -> tuple[in
         while time.monotonic() - start < seconds:
             if len(rig.stops) > seen:
                 events += 1
-                false.append(",".join(who for _t, who in rig.stops[seen:]))
+                time.sleep(0.2)  # its log line follows the stop
+                why = " | ".join(said.take()) or "no cause logged"
+                false.append(
+                    ",".join(who for _t, who in rig.stops[seen:])
+                    + f" at {time.monotonic() - start:.1f} s: {why}"
+                )
                 _xdotool(env, "keyup", KEY)
                 time.sleep(0.5)
                 seen = len(rig.stops)  # the release's own stop is not counted
+                said.take()
                 if not press():
                     break
             time.sleep(0.05)

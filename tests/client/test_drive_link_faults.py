@@ -27,6 +27,7 @@ from rtmu.package_data import project_map
 from rtmu.protocol.decoder import PacketDecoder
 from rtmu.protocol.packet import encode_packet
 from rtmu.sim import SimThread
+from rtmu.subcommands.drive import RESEND, next_resend, timer_due
 from simulators import simulator
 
 from .uiqueue import eventually
@@ -208,3 +209,21 @@ def test_doctor_shows_what_the_link_taught_it(sim: SimThread, proxy: FaultProxy)
     assert link["longest_gap_ms"] >= 450 and link["jitter_ms"] >= 350
     assert link["stale_after_s"] == STATUS_CEILING
     assert "driving stops after 0.45 s without status" in status["summary"] and "Wi-Fi" in status["advice"]
+
+
+def test_a_stalled_drive_loop_counts_its_stall_once_and_does_not_burst() -> None:
+    """Measured cause (bench_links, rtmu drive on "good" Wi-Fi at a load of 9–13): after the
+    process stalled, the resends it had missed were each counted as a late wake (0.3, 0.2, 0.1 s)
+    and the ceiling fell to the floor. Replayed here as the loop's own arithmetic after a 0.45 s
+    stall: the missed resends go as one, and no wait is due before it begins."""
+    start, stalled = 10.0, 0.45
+    due, now, sent = start, start + stalled, 0
+    waits: list[float] = []
+    while now < start + 1.0:  # the loop after the stall, as ``drive`` runs it, ~2 ms per pass
+        if now >= due:
+            sent += 1
+            due = next_resend(due, now)
+        waits.append(timer_due(due, now) - now)
+        now = max(now + 0.002, min(due, now + 0.05))
+    assert min(waits) >= 0.0  # never a wait due in the past: its lateness would be the stall again
+    assert sent <= round((1.0 - stalled) / RESEND) + 1  # the missed resends are not sent back to back

@@ -150,15 +150,39 @@ def test_traffic_during_a_download_keeps_the_link_from_lost_but_not_from_stale()
 
 def test_a_machine_that_wakes_us_late_gets_a_lower_ceiling_so_the_promise_holds() -> None:
     """The stop must be on the wire within 0.5 s of the last status: when the loop that sends it
-    has lately woken 150 ms late, the limit keeps that from the promise (0.35 s)."""
+    wakes 150 ms late, wake after wake, the limit keeps that from the promise (0.35 s)."""
     h = HealthMonitor(0.05, stale_intervals=4)
     h.start(0.0)
     assert h.stale_limit(0.0) == pytest.approx(0.45)
-    h.note_wake(0.15, 0.0)
-    assert h.stale_limit(0.0) == pytest.approx(0.35)
-    h.note_wake(0.4, 0.0)  # never below the floor
+    for _ in range(60):
+        h.note_wake(0.15)
+    assert h.stale_limit(0.0) == pytest.approx(0.35, abs=0.005)
+    for _ in range(60):
+        h.note_wake(0.4)  # never below the floor
     assert h.stale_limit(0.0) == pytest.approx(0.2)
-    assert h.stale_limit(300.0) == pytest.approx(0.45)  # forgotten as the machine calms down
+    for _ in range(100):
+        h.note_wake(-0.001)  # on time again (a timer may fire a hair early): the room comes back
+    assert h.stale_limit(0.0) == pytest.approx(0.45, abs=0.005)
+
+
+def test_one_scheduling_hiccup_does_not_pin_a_jittery_links_limit_to_its_floor() -> None:
+    """Measured cause of false stops (bench_links, load 13–25): one 0.3 s late wake kept the ceiling
+    at the floor for half a minute, and the next Wi-Fi stall the link had taught it stopped the robot
+    ("learned jitter 301 ms, limit 0.30 s"). A second of on-time wakes later the link has its room
+    again — and a link that really goes silent is still stale within the ceiling."""
+    h = HealthMonitor(0.1)
+    h.start(0.0)
+    t = 0.0
+    for i in range(1, 400):  # 40 s of status with a 0.3 s stall every 3 s: jitter ~0.3 s learned
+        t += 0.4 if i % 30 == 0 else 0.1
+        h.note_status(t)
+        h.note_wake(0.002)
+    h.note_wake(0.3)  # the machine ran the loop 0.3 s late, once
+    for _ in range(10):  # a second of wakes on time
+        h.note_wake(0.002)
+    assert h.timing(t).jitter > 0.25
+    assert h.level(t + 0.42) is LinkLevel.OK  # a stall like the ones it taught us rides through
+    assert h.level(t + 0.46) is LinkLevel.STALE  # a silent link is still stale within the ceiling
 
 
 def test_unanswered_pings_during_a_download_stop_driving_but_do_not_lose_the_link() -> None:

@@ -34,7 +34,7 @@ def rig() -> tuple[FakeClock, DriveLease, LeaseKeeper, Waits, list[float]]:
     clock, waits, beats = FakeClock(), Waits(), []
     lease = DriveLease(clock=clock)
     keeper = LeaseKeeper(lease, beat=beats.append, wait_of=waits)
-    assert (lease.on_renew, lease.before_lapse) == (keeper.renewed, keeper.step)  # it hooks the lease
+    assert (lease.on_renew, lease.before_lapse) == (keeper.renewed, keeper.before_lapse)  # it hooks the lease
     return clock, lease, keeper, waits, beats
 
 

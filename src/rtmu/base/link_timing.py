@@ -22,10 +22,14 @@ trip — three figures:
 ``limit = clamp(mean + MARGIN × max(jitter, prior) + PAD, floor, ceiling)``. ``MARGIN`` 2 lets the
 next stall be twice the longest one remembered; ``PAD`` covers where in the status period it falls.
 
-The ceiling itself knows the machine: the loop that would send the stop measures how late it wakes
-(an :class:`Envelope` of its lateness), and :func:`ceiling_for` keeps the worst of it between the
-limit and the 0.5 s promise — a laptop that lately ran us 150 ms late stops a silent link at
-0.35 s, so the stop is still on the wire within 0.5 s.
+The ceiling itself knows the machine: the loop that would send the stop measures how late each of
+its timed wake-ups comes (:class:`WakeLateness`: the smoothed lateness and its spread, as the
+round trip's), and :func:`ceiling_for` keeps that between the limit and the 0.5 s promise — a
+laptop that runs us 150 ms late stops a silent link at 0.35 s, so the stop is still on the wire
+within 0.5 s. What the machine *normally* does, not its single worst hiccup: keeping the worst
+late wake of the last half minute pinned the limit to its floor for that long after one 0.3 s
+scheduling hiccup, and a Wi-Fi stall the link had taught it (jitter 0.2–0.3 s) then stopped the
+robot — five of the eight false stops of a 7-minute soak at a load average of 13–25.
 
 While the link is *undecided* — the decoder holds a header whose body has not come but sees
 valid packets going on behind it (``PacketDecoder.undecided``) — the limit is the ceiling: the
@@ -47,11 +51,12 @@ STATUS_PROMISE = 0.5
 STATUS_CEILING = 0.45
 """The status limit's ceiling on a machine that runs us on time: 50 ms under the promise for the
 wake-up and the send. On a machine that wakes us late it is lower (:func:`ceiling_for`)."""
-WAKE_MARGIN = 1.0
-"""The ceiling keeps the worst recent wake-up lateness of the loop that stops the robot under the
-promise (twice that collapsed the limit to its floor on a busy laptop for minutes after one hiccup)."""
-WAKE_MEMORY = 30.0
-"""Seconds for that remembered lateness to halve: a machine that calmed down gets its room back."""
+WAKE_SPREAD = 2.0
+"""The ceiling keeps the stopping loop's smoothed lateness plus this many of its smoothed deviations
+under the promise (RFC 6298's ``SRTT + K × RTTVAR``, with the smaller K the wake-ups' own steadiness
+allows: they come ten times a second, a round trip's once)."""
+DEVIATION_GAIN = 1.0 / 4.0
+"""RFC 6298's beta: the weight of a new sample in the smoothed deviation."""
 MARGIN = 2.0
 PAD = 0.1
 """Added to every learned limit: a stall's lateness is measured from the mean gap, but it may start
@@ -73,25 +78,29 @@ LEARNING = os.environ.get(FIXED_ENV, "") != "fixed"
 """False: every :class:`Deadline` built from now on keeps its floor (status) or its ceiling (pings)."""
 
 
-class Envelope:
-    """The worst recent value of something: rises at once, halves every ``memory`` seconds."""
+class WakeLateness:
+    """How late the loop that stops the robot wakes from its timers: every timed wake-up is a sample
+    (an on-time one is 0), smoothed as RFC 6298 smooths a round trip; :meth:`value` is what the
+    status limit's ceiling keeps room for (:func:`ceiling_for`)."""
 
-    def __init__(self, memory: float = JITTER_MEMORY) -> None:
-        self.memory = memory
-        self._value = 0.0
-        self._at = 0.0
+    def __init__(self) -> None:
+        self.mean = 0.0
+        self.deviation = 0.0
+        self.samples = 0
 
-    def note(self, value: float, now: float) -> None:
-        self._value = max(self.value(now), value)
-        self._at = now
+    def note(self, late: float) -> None:
+        late = max(0.0, late)
+        self.deviation += DEVIATION_GAIN * (abs(late - self.mean) - self.deviation)
+        self.mean += GAIN * (late - self.mean)
+        self.samples += 1
 
-    def value(self, now: float) -> float:
-        return self._value * 0.5 ** (max(0.0, now - self._at) / self.memory)
+    def value(self) -> float:
+        return self.mean + WAKE_SPREAD * self.deviation
 
 
 def ceiling_for(wake_lateness: float, floor: float, ceiling: float = STATUS_CEILING) -> float:
     """The status limit's ceiling on a machine whose stopping loop wakes ``wake_lateness`` s late."""
-    return max(floor, min(ceiling, STATUS_PROMISE - WAKE_MARGIN * wake_lateness))
+    return max(floor, min(ceiling, STATUS_PROMISE - wake_lateness))
 
 
 @dataclass(frozen=True, slots=True)

@@ -14,6 +14,7 @@ from __future__ import annotations
 import asyncio
 import contextlib
 import logging
+import os
 import time
 from collections.abc import Callable
 from typing import Any, ClassVar
@@ -170,11 +171,25 @@ class DriveFeed(Feed):
         """Zero ratios, then ``stop`` — whatever the link health looks like. ``reason`` is for ``on_stop``."""
         sent = self.send(RatioDrive(0.0, 0.0, 0.0))
         sent = self.send("stop") or sent
+        log.info("stop %s: %s (%s)", "sent" if sent else "not sent", reason or "stop", self._link_account())
         tap = self.on_stop
         if tap is not None:
             with contextlib.suppress(Exception):
                 tap(reason or "stop", sent)
         self.guardian.disarm()
+
+    def _link_account(self) -> str:
+        """The link's figures at a stop, for the log: a false stop's cause is read from them."""
+        now = self.ctx.clock()
+        health = self.health
+        age = health.status_age(now)
+        aged = "-" if age is None else f"{age * 1000:.0f} ms"
+        jitter = health.timing(now).jitter * 1000
+        late = health.wake_lateness.value() * 1000
+        return (
+            f"status age {aged}, limit {health.stale_limit(now) * 1000:.0f} ms, jitter {jitter:.0f} ms, "
+            f"wake late {late:.0f} ms, load {os.getloadavg()[0]:.1f}"
+        )
 
     # -- status and pings ----------------------------------------------------------------------
     def note_status(self, at: float) -> None:
@@ -286,7 +301,7 @@ class DriveFeed(Feed):
                 async with asyncio.timeout(delay):
                     await self._kick.wait()
             if not self._kick.is_set():  # woke by its timer: how late this machine ran it
-                self.health.note_wake(self.ctx.clock() - due, self.ctx.clock())
+                self.health.note_wake(self.ctx.clock() - due)
 
     def _beat(self, now: float) -> None:
         if self.guardian.poll():

@@ -14,6 +14,7 @@ window's GTK timer through ``ClientRunner.ui_heartbeat``.
 from __future__ import annotations
 
 import asyncio
+import logging
 from collections.abc import Callable
 
 from ..base.i18n import _
@@ -23,6 +24,8 @@ from ..guardian.messages import Hello
 from ..guardian.shared import GuardianSeat, SharedGuardian
 from ..values.target import Target
 from .session_config import SessionConfig
+
+log = logging.getLogger(__name__)
 
 OWN_NAME = "this robot"
 """How a script's own guardian names its one robot ("Arming the guardian for this robot …")."""
@@ -110,6 +113,7 @@ class GuardianLink:
         for word, text in seat.take_reports():
             if word == "stopped":
                 stopped = True
+                log.info("the guardian stopped the robot: %s", text)
                 said = _("The guardian stopped the robot: {text}. Press again to drive.").format(text=text)
                 self._notice(Notice.error(Kind.SAFETY, said))
             elif word == "unavailable":

@@ -26,7 +26,7 @@ from __future__ import annotations
 from collections.abc import Callable
 
 from ..base.i18n import N_, Said
-from ..base.link_timing import STATUS_CEILING, WAKE_MEMORY, Deadline, Envelope, Timing, ceiling_for
+from ..base.link_timing import STATUS_CEILING, Deadline, Timing, WakeLateness, ceiling_for
 from ..base.units import Quantity
 from ..protocol.decoder import DropStats
 from ..values.state import LinkHealth, LinkLevel
@@ -62,7 +62,7 @@ class HealthMonitor:
         floor = stale_intervals * status_interval
         self.status_timing = Deadline(status_interval, floor, max(floor, stale_ceiling))
         """Gaps between status packets → the stale limit (``base.link_timing``)."""
-        self.wake_lateness = Envelope(WAKE_MEMORY)
+        self.wake_lateness = WakeLateness()
         """How late the loop that stops the robot wakes (:meth:`note_wake`): lowers the ceiling."""
         self.lost_after = max(lost_after, self.status_timing.ceiling)
         ping_ceiling = PING_CEILING if ping_ceiling is None else ping_ceiling
@@ -117,15 +117,14 @@ class HealthMonitor:
             self.status_timing.note(now - last, now)
         self._last_status = now
 
-    def note_wake(self, late: float, now: float) -> None:
-        """The stopping loop woke ``late`` s after it meant to (a busy machine): keep room for that."""
-        if late > 0.0:
-            self.wake_lateness.note(late, now)
+    def note_wake(self, late: float) -> None:
+        """The stopping loop woke from its timer ``late`` s after it meant to (0 or less: on time)."""
+        self.wake_lateness.note(late)
 
     def ceiling(self, now: float) -> float:
         """The stale limit's ceiling now: under the promise by the loop's worst recent lateness."""
         timing = self.status_timing
-        return ceiling_for(self.wake_lateness.value(now), timing.floor, timing.ceiling)
+        return ceiling_for(self.wake_lateness.value(), timing.floor, timing.ceiling)
 
     def stale_limit(self, now: float) -> float:
         """Seconds without status after which the link is stale, now (learned; see ``base.link_timing``)."""

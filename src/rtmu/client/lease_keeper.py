@@ -24,22 +24,24 @@ UI thread waits for a core is seen only when it runs, so the robot may drive up 
 longer — is measured by ``bench/bench_links.py`` (``links.release_during_freeze_mm``).
 
 The keeper also beats for that thread to the guardian with the same credited time, so the
-guardian judges the UI by the same rule (``rtmu.guardian``). Where the system allows it (root,
-or ``RLIMIT_NICE``), :func:`raise_priority` gives the keeper and the network thread a few nice
+guardian judges the UI by the same rule (``rtmu.guardian``). Where the system allows it,
+:func:`~rtmu.base.priority.raise_priority` gives the keeper and the network thread a few nice
 levels over the UI: they do little, and must do it on time.
 """
 
 from __future__ import annotations
 
-import contextlib
-import os
+import logging
 import threading
 import time
 from collections.abc import Callable
 from dataclasses import dataclass
 
 from ..base import link_timing
+from ..base.priority import raise_priority
 from .lease import DriveLease
+
+log = logging.getLogger(__name__)
 
 PERIOD = 0.05
 """Seconds between the keeper's looks (well under the lease's 0.3 s)."""
@@ -49,8 +51,6 @@ STARVED_LIMIT = 1.0
 """At most this many seconds after the renewing thread's last real renewal does the keeper credit it."""
 CREDITING = link_timing.LEARNING
 """False under ``RTMU_LINK_TIMING=fixed``: no keeper, the lease lapses as it did before."""
-PRIORITY_BOOST = 5
-"""Nice levels :func:`raise_priority` asks for (granted only where the system allows)."""
 
 
 @dataclass(frozen=True, slots=True)
@@ -110,16 +110,6 @@ class RunQueueMeter:
         return got.delayed - first + pending
 
 
-def raise_priority(boost: int = PRIORITY_BOOST) -> bool:
-    """Lower the calling thread's nice value by ``boost`` where allowed; True if it was."""
-    tid = threading.get_native_id()
-    with contextlib.suppress(OSError, AttributeError):
-        current = os.getpriority(os.PRIO_PROCESS, tid)
-        os.setpriority(os.PRIO_PROCESS, tid, max(-20, current - boost))
-        return True
-    return False
-
-
 class LeaseKeeper:
     """Credits the lease's renewing thread with its run-queue waits; see the module notes."""
 
@@ -151,8 +141,10 @@ class LeaseKeeper:
         """Set by a grant or renewal (:meth:`renewed`) and by :meth:`close`: a keeper with no lease to
         keep sleeps on it instead of looking 20 times a second at nothing (an idle window's wake-ups)."""
         self._thread: threading.Thread | None = None
+        self._told: float | None = None
+        """The renewal whose lapse :meth:`before_lapse` last logged (once per lapse)."""
         lease.on_renew = self.renewed  # told of every grant and renewal, on the renewing thread
-        lease.before_lapse = self.step  # and asked before anyone acts on a lapse
+        lease.before_lapse = self.before_lapse  # and asked before anyone acts on a lapse
 
     def start(self) -> LeaseKeeper:
         self._thread = threading.Thread(target=self._run, name="rtmu-lease-keeper", daemon=True)
@@ -195,6 +187,29 @@ class LeaseKeeper:
         waited behind a starved one catches up first."""
         with self._lock:
             self._step(now)
+
+    def before_lapse(self, now: float) -> None:
+        """The lease was found past its time: credit what is due first (:meth:`step`); if it still
+        lapses, log what the renewing thread did meanwhile (a false stop's cause, at info level)."""
+        self.step(now)
+        renewed = self.lease.last_renewal()
+        if renewed is None or renewed[0] == self._told:
+            return
+        self._told = renewed[0]  # (before asking the lease again: its view calls this hook)
+        if self.lease.view(now).live:
+            self._told = None
+            return
+        at, tid = renewed
+        sample = _thread_sample(tid)
+        state = "gone" if sample is None else ("runnable" if sample.runnable else "not runnable")
+        with self._lock:
+            wait, then = self.wait_of(tid), self._wait_then
+        waited = "?" if wait is None or then is None else f"{(wait - then) * 1000:.0f} ms"
+        log.info(
+            "lease past its time: the renewing thread %d last renewed %.0f ms ago, has waited %s for a "
+            "CPU since, and is %s now",
+            tid, (now - at) * 1000, waited, state,
+        )  # fmt: skip
 
     def _step(self, now: float) -> None:
         renewed = self.lease.last_renewal()

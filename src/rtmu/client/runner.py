@@ -69,6 +69,7 @@ from collections.abc import Awaitable, Callable
 from typing import Any, TypeVar, overload
 
 from ..base.notices import Kind, Notice
+from ..base.priority import raise_priority
 from ..values.intents import Intent, Stop
 from ..values.state import StateChange, StateSink
 from ..values.target import Target
@@ -77,7 +78,7 @@ from .config_feed import ConfigFeed
 from .connection import AriaClient
 from .errors import ClientError, ClientTimeout
 from .lease import LEASE_TTL, DriveLease, EndReason
-from .lease_keeper import LeaseKeeper, raise_priority
+from .lease_keeper import LeaseKeeper
 from .link import Opener
 from .session import Session
 from .session_config import SessionConfig

@@ -15,9 +15,11 @@ Thresholds, and why they cannot cause a false stop:
   is gone: stop at once. A running process is never in that state, however
   busy, slow or starved it is, so GC pauses and CPU contention cannot trip it.
 * **a heartbeat late past its source's limit while armed** from a parent that
-  still runs: stop. The limit is at least :data:`SILENT_LATE` s: the parent's own drive
-  lease lapses 0.3 s after its UI last renewed it, so by then the parent would stop the robot
-  itself when it runs again — the guardian never ends a drive the parent would have continued.
+  still runs: stop. The limit is at least :data:`SILENT_LATE` s for the UI thread — the parent's
+  own drive lease lapses 0.3 s after its UI last renewed it — and :data:`SILENT_LATE_NETWORK` for
+  the network thread, which stops a drive itself once status is 0.45 s old: by then the parent
+  would stop the robot itself when it runs again — the guardian never ends a drive the parent
+  would have continued.
   How late each source may be is asked of a :class:`BeatLimit` per source (the ``limits`` of
   :class:`Watch`). The process learns it (:func:`learned_limit`) by the link's own rule
   (:mod:`rtmu.base.link_timing`): at most :data:`SILENT_CEILING` s on a parent whose threads a busy
@@ -53,15 +55,24 @@ from pathlib import Path
 from typing import Protocol
 
 from ..base.i18n import N_, Said
-from ..base.link_timing import Deadline
+from ..base.link_timing import STATUS_PROMISE, Deadline
+from ..base.priority import GUARDIAN_BOOST, raise_priority
 from ..base.units import Quantity
 from . import messages as m
 from .halt import Halter
 from .handle import BEAT_PERIOD
 from .login import LoginState, RobotLogin
 
-QUICK_LATE = 0.1
+QUICK_LATE = 0.06
+"""Beats come every 40 ms: one 20 ms late is enough to look whether the parent is stopped (a few
+``/proc`` reads, only then). 0.1 s kept a SIGSTOPped window driving 85 ms (p50) before the look."""
 SILENT_LATE = 0.4
+SILENT_LATE_NETWORK = STATUS_PROMISE
+"""The network thread's floor: it is the thread that stops a drive on a stale link, after up to
+0.45 s without status (``base.link_timing``) — silent for less, it has ended nothing it would not
+continue. Measured with a floor of :data:`SILENT_LATE` (bench_links, "good" Wi-Fi at a load of 9–13):
+"no heartbeat from the network thread … for 419 ms (its beats normally come within 400 ms)" while the
+parent's own stale limit was 450 ms."""
 SILENT_CEILING = 1.0
 """The learned silent limit's ceiling (:func:`learned_limit`): a busy machine may delay a beat this much."""
 CHECK_PERIOD = 0.02
@@ -130,10 +141,12 @@ class FixedLimit:
         return self.seconds
 
 
-def learned_limit(_source: bytes) -> BeatLimit:
-    """How late one source's beats come, learned as a link's status is (``base.link_timing``):
-    :data:`SILENT_LATE` for a calm parent, up to :data:`SILENT_CEILING` for one a busy machine delays."""
-    return Deadline(BEAT_PERIOD, SILENT_LATE, SILENT_CEILING)
+def learned_limit(source: bytes) -> BeatLimit:
+    """How late one source's beats come, learned as a link's status is (``base.link_timing``): from
+    its floor (:data:`SILENT_LATE`, the network thread's :data:`SILENT_LATE_NETWORK`) for a calm
+    parent up to :data:`SILENT_CEILING` for one a busy machine delays."""
+    floor = SILENT_LATE_NETWORK if source == m.BEAT_NET else SILENT_LATE
+    return Deadline(BEAT_PERIOD, floor, SILENT_CEILING)
 
 
 LimitFor = Callable[[bytes], BeatLimit]
@@ -385,6 +398,7 @@ class Guardian:
 
 def run(fd: int = 0, limits: LimitFor | None = learned_limit) -> int:
     os.set_blocking(fd, False)
+    raise_priority(GUARDIAN_BOOST)  # where allowed: a killed parent's stop must not wait for a core
     return Guardian(fd, Watch(os.getppid(), limits)).run()
 
 

@@ -106,6 +106,7 @@ def check(args: argparse.Namespace) -> None:
 def handle(args: argparse.Namespace) -> int:
     import asyncio
 
+    from ..base.priority import raise_priority
     from ..client.drive_guard import DriveGuard, LinkFault
     from ..client.errors import ClientError
     from ..client.roles import Role
@@ -118,6 +119,7 @@ def handle(args: argparse.Namespace) -> int:
 
     async def body(client: AriaClient) -> int:
         check(args)
+        raise_priority()  # where allowed: the loop that resends, watches the link and stops runs on time
         motion = Motion(args.trans, args.rot)
         if not client.supports("ratioDrive"):
             return await refuse(args, client, motion)
@@ -361,7 +363,7 @@ async def drive(
         if now >= next_send:
             if not held():
                 client.send("ratioDrive", ratios)
-            next_send += RESEND
+            next_send = next_resend(next_send, now)
         if client.closed_error is not None:
             if guard is not None:
                 raise LinkFault(f"lost the link: {client.closed_error}")
@@ -371,12 +373,31 @@ async def drive(
             await asyncio.sleep(max(0.0, wake - clock()))
             continue
         guard.changed.clear()
-        wake = min(wake, guard.next_check(now))
+        slept_at = clock()
+        due = timer_due(min(wake, guard.next_check(now)), slept_at)
         with contextlib.suppress(TimeoutError):
-            async with asyncio.timeout(max(0.0, wake - clock())):
+            async with asyncio.timeout(due - slept_at):
                 await guard.changed.wait()
         if not guard.changed.is_set():  # woke by its timer: how late this machine ran it
-            guard.health.note_wake(clock() - wake, clock())
+            guard.health.note_wake(clock() - due)
+
+
+def next_resend(due: float, now: float) -> float:
+    """When to resend after a ``ratioDrive`` that was due at ``due`` went out at ``now``: every
+    :data:`RESEND` s — but a loop that fell behind (the machine did not run it) starts again from
+    now rather than sending the missed ones back to back."""
+    return due + RESEND if due + RESEND > now else now + RESEND
+
+
+def timer_due(wake: float, now: float) -> float:
+    """When a wait that begins at ``now`` for ``wake`` is due: never before it begins.
+
+    Its lateness (``HealthMonitor.note_wake``) lowers the stale limit's ceiling, so it must be the
+    machine's lateness in running this wait — a deadline already past when the wait began is not.
+    Measured as that (a resend due 0.3 s ago after a stall counted as 0.3, 0.2, 0.1 s late), one
+    stall of the process looked like several and pinned the limit to its floor; rtmu drive then
+    stopped on "good" Wi-Fi ("learned jitter 280 ms, limit 0.25 s")."""
+    return max(wake, now)
 
 
 RECONNECT_FOR_STOP = 1.0

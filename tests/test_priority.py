@@ -1,0 +1,63 @@
+"""The threads that stop the robot run a few nice levels up where the system allows it.
+
+On a laptop whose other programs keep both cores busy, a stop sent by a thread at the default
+niceness waits its turn behind them; measured in ``bench/bench_safety.py`` (a killed window's
+stop) and ``bench/bench_links.py`` (false stops under load). Here: that the levels are asked
+for and, where allowed (root or ``RLIMIT_NICE``), granted — never how fast anything ran.
+"""
+
+from __future__ import annotations
+
+import os
+import resource
+import threading
+import time
+
+from rtmu.base.priority import GUARDIAN_BOOST, NETWORK_BOOST, raise_priority
+from rtmu.guardian.handle import GuardianHandle
+
+
+def _may_lower_to(nice: int) -> bool:
+    """Whether this process may set a nice value as low as ``nice`` (what the kernel checks)."""
+    if os.geteuid() == 0:
+        return True
+    soft, _hard = resource.getrlimit(resource.RLIMIT_NICE)
+    return soft == resource.RLIM_INFINITY or 20 - soft <= nice
+
+
+def _nice_of(pid: int) -> int:
+    with open(f"/proc/{pid}/stat") as f:
+        return int(f.read().rsplit(")", 1)[1].split()[16])
+
+
+def test_a_thread_raises_only_itself() -> None:
+    before = os.getpriority(os.PRIO_PROCESS, 0)
+    seen: dict[str, object] = {}
+
+    def body() -> None:
+        seen["granted"] = raise_priority()
+        seen["nice"] = os.getpriority(os.PRIO_PROCESS, threading.get_native_id())
+
+    thread = threading.Thread(target=body)
+    thread.start()
+    thread.join()
+    wanted = max(-20, before - NETWORK_BOOST)
+    if _may_lower_to(wanted):
+        assert seen == {"granted": True, "nice": wanted}
+    else:
+        assert seen == {"granted": False, "nice": before}
+    assert os.getpriority(os.PRIO_PROCESS, 0) == before  # the calling thread only, not the process
+
+
+def test_the_guardian_runs_above_its_parent_where_allowed() -> None:
+    before = os.getpriority(os.PRIO_PROCESS, 0)
+    wanted = max(-20, before - GUARDIAN_BOOST) if _may_lower_to(before - GUARDIAN_BOOST) else before
+    handle = GuardianHandle.start()
+    try:
+        deadline = time.monotonic() + 30.0  # it raises itself once its interpreter has started
+        while _nice_of(handle.proc.pid) != wanted and time.monotonic() < deadline:
+            time.sleep(0.05)
+        assert _nice_of(handle.proc.pid) == wanted
+    finally:
+        handle.close()
+        handle.proc.wait(10)
