@@ -185,7 +185,7 @@ def test_the_pacer_asks_about_once_per_new_frame_and_soon_after_it(fps: float, c
     pacer = FramePacer()
     requests, new, ages = play_camera(pacer, fps=fps, seconds=20.0, ready_at=ready)
     assert new >= 0.95 * 20 * 10 * (0.95 if camera == "on_request" else 1.0)  # no frame left out
-    assert requests <= 1.2 * new, (requests, new)
+    assert requests <= 1.1 * new, (requests, new)  # ≤ 1.2 against a real server's timing (bench)
     assert pacer.period == pytest.approx(0.1, rel=0.05)
     assert sorted(ages)[int(0.95 * len(ages))] < 0.015  # each picture fetched soon after it was made
 

@@ -53,19 +53,20 @@ PERIOD_SAMPLES = 9
 """Periods measured between repeats the pacer keeps; their median is the camera's period."""
 MARGIN_S = 0.003
 """A request for a new frame goes this long after the moment the frame is expected, at least."""
-DRIFT_S = 0.0005
+DRIFT_S = 0.00025
 """Each new frame got as aimed moves the expected moment this much earlier: after about
 ``margin / DRIFT_S`` frames a request comes too soon, and the repeat it gets pins the moment down
-again — about one repeat in eight frames, so a camera whose clock wanders is followed."""
-PATIENCE = 8
+again — about one repeat in twelve frames, so a camera whose clock wanders is followed (a repeat every
+eight frames, with half a millisecond, cost about 1.2 requests a new picture against a real server)."""
+PATIENCE = 16
 """New frames got as aimed in a row after which the drift doubles with each further one: a period
 learned a little long must not leave the requests later and later (no repeat would say so)."""
 AIMED_WINDOW = 20
 """Aimed requests over which the share of repeats is watched: above :data:`REPEATS_HIGH` the margin
 widens by :data:`MARGIN_STEP_S` (a server whose clock ticks coarsely, a loaded machine), below
 :data:`REPEATS_LOW` it narrows by a quarter of that, down to :data:`MARGIN_S`."""
-REPEATS_HIGH = 0.2
-REPEATS_LOW = 0.1
+REPEATS_HIGH = 0.1
+REPEATS_LOW = 0.05
 MARGIN_STEP_S = 0.001
 RETRY_MIN_S = 0.003
 """After a repeat, ask again this soon, then :data:`RETRY_GROWTH` times longer after each further
