@@ -173,6 +173,20 @@ def test_decode_reads_german_and_its_json_stays_english(
     assert err.startswith("rtmu decode: die Datei ist nicht lesbar (cannot read "), err  # reader: English
 
 
+def test_a_packet_that_does_not_decode_is_said_in_german(
+    german: None, tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    """A login packet cut short: decode says so in German, the codec's own detail after it as it is."""
+    from rtmu.protocol.packet import encode_packet
+
+    raw = tmp_path / "short-login.bin"
+    raw.write_bytes(encode_packet(2, b"\x07\x00\x00"))  # INTRODUCTION without its password digest
+    assert main(["decode", str(raw)]) == 0
+    out = capsys.readouterr().out
+    assert "INTRODUCTION" in out and "!! nicht dekodierbar: FieldUnderrun: " in out, out
+    assert "does not decode" not in out
+
+
 def test_watch_reads_german_with_the_servers_words_as_sent(
     sim: SimThread, german: None, capsys: pytest.CaptureFixture[str]
 ) -> None:

@@ -202,7 +202,8 @@ class _TextWriter:
         if p.note:
             parts.append(f"({_(p.note)})")
         if p.error:
-            parts.append(f"!! {p.error}")
+            # the codec's own detail stays as it says it (it imports nothing of the operator's language)
+            parts.append(_("!! does not decode: {error}").format(error=p.error))
         if p.payload and (
             self.payload or (not p.fields and not p.error and p.note is None) or not p.checksum_ok
         ):
