@@ -257,7 +257,9 @@ def test_an_upload_refused_half_way_is_a_clear_error(tmp_path: Path, capsys) -> 
 
     with_client(server, body)
     sent = [PutFileRequest.decode(r.args).command for r in server.received if r.name == "putFile"]
-    assert sent[-1] == 3 and 2 not in sent  # never said "done": cancelled
+    # Cancelled: the last word is "cancel". (A streamed upload's "done" may already be in the loopback
+    # socket's megabytes of buffer when a busy server's refusal arrives, so it is not asserted absent.)
+    assert sent[-1] == 3, sent[-3:]
     with ServerThread(file_server()) as running:
         running.handlers["putFile"] = refuse_after(5, 9)
         code = main(["files", f"127.0.0.1:{running.port}", "put", str(local), "big.bin", "--force"])
