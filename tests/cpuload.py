@@ -21,7 +21,7 @@ import time
 
 SPIN = """
 import os, sys, time
-os.nice(int(sys.argv[2]))
+os.setpriority(os.PRIO_PROCESS, 0, int(sys.argv[2]))  # that niceness, whatever the parent's thread had
 if sys.argv[3]:
     os.sched_setaffinity(0, {int(c) for c in sys.argv[3].split(",")})
 end = time.monotonic() + float(sys.argv[1])

@@ -61,3 +61,28 @@ def test_the_guardian_runs_above_its_parent_where_allowed() -> None:
     finally:
         handle.close()
         handle.proc.wait(10)
+
+
+def test_a_raised_job_gives_its_thread_its_level_back() -> None:
+    """``rtmu drive`` runs its loop on the caller's thread: called twice in one process, the levels
+    must not pile up (once they did: a test's load spinners, started after two in-process drives,
+    inherited -20 from the main thread and could no longer be niced to 19 by an increment)."""
+    from rtmu.base.priority import raised_priority
+
+    def body() -> None:
+        tid = threading.get_native_id()
+        start.append(os.getpriority(os.PRIO_PROCESS, tid))
+        for _ in range(5):
+            with raised_priority() as granted:
+                inside = os.getpriority(os.PRIO_PROCESS, tid)
+                raised.append(inside == (max(-20, start[0] - NETWORK_BOOST) if granted else start[0]))
+            seen.append(os.getpriority(os.PRIO_PROCESS, tid))
+
+    start: list[int] = []
+    raised: list[bool] = []
+    seen: list[int] = []
+    thread = threading.Thread(target=body)
+    thread.start()
+    thread.join()
+    assert raised == [True] * 5  # raised (where allowed) inside each job…
+    assert seen == start * 5  # …and given back after each

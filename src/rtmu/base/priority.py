@@ -13,6 +13,7 @@ from __future__ import annotations
 import contextlib
 import os
 import threading
+from collections.abc import Iterator
 
 NETWORK_BOOST = 5
 """Nice levels for the client's network thread and the lease keeper (above the UI thread)."""
@@ -21,10 +22,30 @@ GUARDIAN_BOOST = 10
 
 
 def raise_priority(boost: int = NETWORK_BOOST) -> bool:
-    """Lower the calling thread's nice value by ``boost`` where allowed; True if it was."""
+    """Lower the calling thread's nice value by ``boost`` where allowed; True if it was. For a thread
+    that lives as long as its job (the network thread, the keeper, the guardian's process)."""
     tid = threading.get_native_id()
     with contextlib.suppress(OSError, AttributeError):
         current = os.getpriority(os.PRIO_PROCESS, tid)
         os.setpriority(os.PRIO_PROCESS, tid, max(-20, current - boost))
         return True
     return False
+
+
+@contextlib.contextmanager
+def raised_priority(boost: int = NETWORK_BOOST) -> Iterator[bool]:
+    """:func:`raise_priority` for one job on a thread that goes on after it (``rtmu drive``'s loop runs on
+    the caller's thread): its nice value is given back after, so calls in one process never pile up
+    (a nice value may always be raised again without privileges)."""
+    tid = threading.get_native_id()
+    try:
+        before: int | None = os.getpriority(os.PRIO_PROCESS, tid)
+    except (OSError, AttributeError):
+        before = None
+    raised = raise_priority(boost)
+    try:
+        yield raised
+    finally:
+        if raised and before is not None:
+            with contextlib.suppress(OSError):
+                os.setpriority(os.PRIO_PROCESS, tid, before)

@@ -106,7 +106,7 @@ def check(args: argparse.Namespace) -> None:
 def handle(args: argparse.Namespace) -> int:
     import asyncio
 
-    from ..base.priority import raise_priority
+    from ..base.priority import raised_priority
     from ..client.drive_guard import DriveGuard, LinkFault
     from ..client.errors import ClientError
     from ..client.roles import Role
@@ -118,8 +118,13 @@ def handle(args: argparse.Namespace) -> int:
     from .why import print_answer
 
     async def body(client: AriaClient) -> int:
+        # where allowed: the loop that resends, watches the link and stops runs on time (given back after:
+        # the caller's thread goes on, e.g. a script calling rtmu's main more than once)
+        with raised_priority():
+            return await drive_body(client)
+
+    async def drive_body(client: AriaClient) -> int:
         check(args)
-        raise_priority()  # where allowed: the loop that resends, watches the link and stops runs on time
         motion = Motion(args.trans, args.rot)
         if not client.supports("ratioDrive"):
             return await refuse(args, client, motion)
