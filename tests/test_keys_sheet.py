@@ -3,12 +3,10 @@ it binds listed and none it does not, STOP first, key caps in words, a search th
 
 from __future__ import annotations
 
-from collections.abc import Iterator
 from dataclasses import dataclass
 
 import pytest
 
-from rtmu.base import i18n
 from rtmu.control.commands import COMMANDS
 from rtmu.ui.keys import KeyRouter, bindings
 from rtmu.ui.keys_sheet import GROUP_ORDER, KeySheet, count_note, key_caps
@@ -119,15 +117,6 @@ def test_the_note_says_how_many_match_or_that_none_does() -> None:
     assert count_note(40, 40, "") == "" and count_note(40, 40, "a") == ""
     assert count_note(2, 40, "zoom") == "2 of 40 keys"
     assert count_note(0, 40, " xyz ") == "No key matches “xyz”"
-
-
-@pytest.fixture
-def german() -> Iterator[None]:
-    i18n.use(["de"])
-    try:
-        yield
-    finally:
-        i18n.use(["en"])
 
 
 def test_in_german_the_words_and_the_key_names_are_german(german: None) -> None:

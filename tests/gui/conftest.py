@@ -15,6 +15,7 @@ each app is shut down and its window destroyed after its test.
 from __future__ import annotations
 
 import atexit
+import contextlib
 import os
 import shutil
 import subprocess
@@ -187,16 +188,23 @@ def screenshots() -> Path:
     return SCREENSHOTS
 
 
-@pytest.fixture(scope="session")
-def phone_screen() -> Iterator[str]:
-    """An X server whose only screen is a 360×720 portrait phone: ':N'."""
-    proc, display = _spawn_xvfb("360x720")
+@contextlib.contextmanager
+def screen_of(size: str) -> Iterator[str]:
+    """An X server of its own whose only screen is ``size`` (e.g. ``360x720``): ':N', ended after."""
+    proc, display = _spawn_xvfb(size)
     if display is None:
-        pytest.fail("an Xvfb of 360x720 did not start")
+        pytest.fail(f"an Xvfb of {size} did not start")
     try:
         yield display
     finally:
         _terminate(proc)
+
+
+@pytest.fixture(scope="session")
+def phone_screen() -> Iterator[str]:
+    """An X server whose only screen is a 360×720 portrait phone: ':N'."""
+    with screen_of("360x720") as display:
+        yield display
 
 
 @pytest.fixture(scope="session")
@@ -204,13 +212,8 @@ def laptop_screen() -> Iterator[str]:
     """An X server whose only screen is a 1280×800 laptop (640×400 at ``GDK_SCALE=2``): ':N'. (Once this
     process has had a window there, a window of another process there never got the keyboard — seen,
     not yet explained: a test that starts another process on it runs first.)"""
-    proc, display = _spawn_xvfb("1280x800")
-    if display is None:
-        pytest.fail("an Xvfb of 1280x800 did not start")
-    try:
+    with screen_of("1280x800") as display:
         yield display
-    finally:
-        _terminate(proc)
 
 
 @pytest.fixture(scope="session")

@@ -16,6 +16,7 @@ screen of its own the test passes in any order, so the suite can run in parallel
 
 from __future__ import annotations
 
+import contextlib
 import json
 import os
 import re
@@ -32,7 +33,7 @@ import pytest
 from rtmu.sim import SimConfig, SimThread
 
 from .a11y_bus import accessibility_bus, missing
-from .conftest import _spawn_xvfb, _terminate
+from .conftest import screen_of
 from .harness import OFFICE_MAP
 from .process import wait, xdotool
 
@@ -100,18 +101,11 @@ def test_a_control_without_a_name_is_found(tmp_path: Path) -> None:
     assert any(n["role"] == "push button" and n["name"] == "Up" for n in nodes)
 
 
-@contextmanager
-def own_screen() -> Iterator[str]:
+def own_screen() -> contextlib.AbstractContextManager[str]:
     """An X server for this window alone (':N'): the window is the only client on it, so what GUI tests
     before it left on the shared screen cannot reach it (after an About dialog shown in the test
     process, the reader lost the window's application on a shared screen)."""
-    proc, display = _spawn_xvfb("1280x1024")
-    if display is None:
-        pytest.fail("an Xvfb of its own did not start")
-    try:
-        yield display
-    finally:
-        _terminate(proc)
+    return screen_of("1280x1024")
 
 
 @contextmanager
