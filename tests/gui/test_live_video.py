@@ -119,7 +119,11 @@ def drag(gui: Gui, widget, dx: int, dy: int) -> None:  # type: ignore[no-untyped
     """A real pointer drag through the X server from the middle of ``widget`` by (dx, dy), in steps."""
     x, y = gui.centre_on_surface(widget)
     xid = str(gui.xid())
-    args = ["mousemove", "--window", xid, str(x), str(y), "mousedown", "1"]
+    # The pointer rests on the widget before the press (as in the PTZ drag): pressed in the same xdotool
+    # call as the move, a busy window could take the press before it had seen the pointer arrive.
+    gui.xdotool("mousemove", "--window", xid, str(x), str(y))
+    idle(0.3)
+    args = ["mousedown", "1"]
     for i in range(1, 9):
         args += ["sleep", "0.03", "mousemove", "--window", xid, str(x + dx * i // 8), str(y + dy * i // 8)]
     args += ["sleep", "0.05", "mouseup", "1"]
