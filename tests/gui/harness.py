@@ -230,7 +230,16 @@ class Gui:
         self.run_tool("xdotool", *args, timeout=timeout)
 
     def focus(self) -> None:
-        self.xdotool("windowfocus", "--sync", str(self.xid()))
+        for attempt in range(5):
+            try:
+                self.xdotool("windowfocus", "--sync", str(self.xid()))
+                break
+            except AssertionError as error:
+                # Under a window manager a window it is mapping again (leaving full screen) is not
+                # viewable for a moment, and X refuses its focus (BadMatch): ask again once it is.
+                if "BadMatch" not in str(error) or attempt == 4:
+                    raise
+                idle(0.3)
         pump(self.window.is_active, 5, "the window to have the keyboard focus")
 
     def key(self, *names: str) -> None:
