@@ -6,11 +6,14 @@ server codec) whose ``getDrawingList`` lists, beside an honest sonar:
 * ``<b>bold</b> & _under_`` — markup and an underscore in a name (must be shown literally);
 * ``blob`` — a shape nobody knows (``polyHexagons``): listed, never drawn, never asked for;
 * ``huge`` — says it has 1 000 000 points but carries the bytes of only 3 998 (refused);
-* ``max`` — the honest maximum, 3 998 points in one packet, every 20 ms (a flood).
+* ``max`` — the honest maximum, 3 998 points in one packet, every 20 ms (a flood); each sample moves
+  its points (as a real sensor's do), so every one is news the window must show, never an unchanged
+  repeat it may rightly skip.
 """
 
 from __future__ import annotations
 
+import itertools
 import struct
 
 from rtmu.protocol.payloads.drawings import MAX_POINTS, Drawing, DrawingListPacket, DrawingPoints
@@ -28,6 +31,8 @@ DRAWINGS = (SONAR, BOLD, BLOB, HUGE, MAX)
 SONAR_POINTS = ((1500, 2000), (1000, 2600))
 BOLD_POINTS = ((600, 2000), (1400, 2000))
 MAX_POINTS_SENT = tuple((1000 + (i % 400) * 5, 2000 + (i // 400) * 50) for i in range(MAX_POINTS))
+MAX_SHIFTS_MM = (0, 20, 40, 60)
+"""The flood's samples take turns among these shifts in x: consecutive samples always differ."""
 
 
 def _row(name: str) -> tuple[str, str, str, str, str, str]:
@@ -40,6 +45,9 @@ def hostile_drawing_server() -> TestServer:
     server = TestServer(specs)
     listing = [DrawingListPacket(d).encode() for d in DRAWINGS] + [DrawingListPacket(None).encode()]
     honest_max = DrawingPoints(MAX_POINTS_SENT).encode()
+    moving_max = itertools.cycle(
+        [DrawingPoints(tuple((x + dx, y) for x, y in MAX_POINTS_SENT)).encode() for dx in MAX_SHIFTS_MM]
+    )
     lying = struct.pack("<i", 1_000_000) + honest_max[4:]
     server.handlers.update(
         {
@@ -48,7 +56,7 @@ def hostile_drawing_server() -> TestServer:
             BOLD.name: lambda s, a: [DrawingPoints(BOLD_POINTS).encode()],
             BLOB.name: lambda s, a: [DrawingPoints(((0, 0),)).encode()],
             HUGE.name: lambda s, a: [lying],
-            MAX.name: lambda s, a: [honest_max],
+            MAX.name: lambda s, a: [next(moving_max)],
         }
     )
     return server

@@ -131,7 +131,8 @@ def test_a_hostile_servers_drawings_leave_the_window_answering(screenshots) -> N
             gui.focus()
             gui.key("plus")
             pump(lambda: gui.operator.speed.value.percent == before + 10, 5, "the speed key")
-            # New samples keep being drawn (waited for: a busy machine may take longer than a second).
+            # New samples (each one moved) keep being drawn (waited for: a busy machine may take longer
+            # than a second).
             pump(lambda: gui.stage.frames > frames, 5, "a frame drawn during the flood")
             idle(1.0)
             probe.close()
