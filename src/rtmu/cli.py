@@ -193,6 +193,10 @@ def main(argv: Sequence[str] | None = None) -> int:
         code = int(handler(args) or 0)
         sys.stdout.flush()  # a block-buffered pipe fails here, not at exit (exit 120 and a warning)
         return code
+    except KeyboardInterrupt:
+        # Ctrl-C after the command's own event loop had ended (its finally blocks, a drive's stop,
+        # have run): exit as every interrupted command does, not killed by the signal mid-teardown.
+        return 128 + signal.SIGINT
     except BrokenPipeError:
         # Whoever read our output went away (`rtmu mapinfo … | head`): no traceback for that. The
         # handler's own finally blocks (a drive's stop) have run; nothing more will be printed.

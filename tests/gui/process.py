@@ -10,13 +10,8 @@ from pathlib import Path
 
 from PIL import ImageGrab
 
+from patience import PATIENCE
 from rtmu.sim import SimThread
-
-_ON_CI = os.environ.get("CI", "").lower() in ("true", "1")
-PATIENCE = float(os.environ.get("RTMU_TEST_PATIENCE") or (3.0 if _ON_CI else 1.0))
-"""Every GUI wait's bound is multiplied by this (3 on CI, whose machine is shared and often busy; 1 here,
-so a developer still sees a slow step). A bound is only how long a test waits for what it means before it
-fails: a passing wait returns as soon as the thing happens, so a larger bound slows only failures."""
 
 
 def wait(condition: Callable[[], bool], timeout: float, what: str, *, poll: float = 0.02) -> None:

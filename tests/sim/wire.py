@@ -11,6 +11,7 @@ import contextlib
 from collections import defaultdict
 from pathlib import Path
 
+from patience import PATIENCE
 from rtmu.protocol.client_connection import ClientConnection, ClientState
 from rtmu.protocol.events import DataListReady, DataReceived, PeerShutdown, Rejected
 
@@ -18,8 +19,9 @@ TIMEOUT = 10.0
 
 
 def run(coro, timeout: float = 60.0):
-    """Run a scenario with an overall deadline, so a broken server fails the test instead of hanging it."""
-    return asyncio.run(asyncio.wait_for(coro, timeout))
+    """Run a scenario with an overall deadline (× PATIENCE), so a broken server fails the test instead
+    of hanging it. The scenarios run simulated time flat out: on a busy machine they need more wall time."""
+    return asyncio.run(asyncio.wait_for(coro, timeout * PATIENCE))
 
 
 async def eventually(predicate, timeout: float = TIMEOUT, what: str = "the condition") -> None:
