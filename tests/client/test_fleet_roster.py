@@ -12,6 +12,7 @@ import time
 from collections.abc import Iterator
 from contextlib import contextmanager
 
+from patience import PATIENCE
 from rtmu.client.roster import (
     DirectRoster,
     Emit,
@@ -99,7 +100,7 @@ def hold(ui: UiQueue, session: RobotSession, seconds: float, *more: RobotSession
 
 def wait_mode(sim: SimThread, wanted: str, within: float = 5.0) -> None:
     """Generous for a loaded machine; a test that means *our* stop also checks the watchdog did not act."""
-    deadline = time.monotonic() + within
+    deadline = time.monotonic() + within * PATIENCE
     while mode(sim) != wanted:
         assert time.monotonic() < deadline, f"the robot's mode is {mode(sim)!r}, not {wanted!r}"
         time.sleep(0.02)

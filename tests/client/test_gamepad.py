@@ -12,6 +12,7 @@ from contextlib import contextmanager
 
 import pytest
 
+from patience import PATIENCE
 from rtmu.client.lease import EndReason
 from rtmu.client.session import SessionConfig
 from rtmu.control.gamepad import (
@@ -259,9 +260,9 @@ def mode(sim: SimThread) -> str:
 
 
 def wait_mode(sim: SimThread, name: str, within: float = 1.0) -> None:
-    deadline = time.monotonic() + within
-    while mode(sim) != name:
-        assert time.monotonic() < deadline, f"the robot is in {mode(sim)!r}, not {name!r}"
+    deadline = time.monotonic() + within * PATIENCE
+    while (now := mode(sim)) != name:
+        assert time.monotonic() < deadline, f"the robot is in {now!r}, not {name!r}"
         time.sleep(0.02)
 
 

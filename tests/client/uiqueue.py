@@ -6,6 +6,8 @@ import queue
 import time
 from collections.abc import Callable
 
+from patience import PATIENCE
+
 
 class UiQueue:
     def __init__(self) -> None:
@@ -25,8 +27,8 @@ class UiQueue:
             n += 1
 
     def wait_for(self, predicate: Callable[[], bool], timeout: float = 5.0) -> None:
-        """Run posted callbacks until ``predicate()`` holds; fail after ``timeout`` s."""
-        deadline = time.monotonic() + timeout
+        """Run posted callbacks until ``predicate()`` holds; fail after ``timeout`` s (× PATIENCE)."""
+        deadline = time.monotonic() + timeout * PATIENCE
         while True:
             self.drain()
             if predicate():
@@ -42,8 +44,9 @@ class UiQueue:
 
 
 def eventually(predicate: Callable[[], bool], timeout: float = 3.0) -> None:
-    """Poll ``predicate`` until it holds (bytes still in flight between threads); fail after ``timeout``."""
-    deadline = time.monotonic() + timeout
+    """Poll ``predicate`` until it holds (bytes still in flight between threads); fail after ``timeout``
+    seconds (× PATIENCE)."""
+    deadline = time.monotonic() + timeout * PATIENCE
     while not predicate():
         if time.monotonic() > deadline:
             raise AssertionError("condition not reached in time")

@@ -19,6 +19,7 @@ from pathlib import Path
 import pytest
 from mcap.exceptions import McapError
 
+from patience import PATIENCE
 from rtmu.base.exit_codes import EXIT_SIZE_LIMIT
 from rtmu.base.notices import Kind
 from rtmu.capture.recorded import RAW_TOPICS
@@ -41,7 +42,7 @@ def sim_bytes_in(sim: SimThread) -> int:
 
 
 def wait_growing(path: Path, size: int, timeout: float = 15.0) -> None:
-    deadline = time.monotonic() + timeout
+    deadline = time.monotonic() + timeout * PATIENCE
     while not (path.exists() and path.stat().st_size > size):
         assert time.monotonic() < deadline, f"{path} did not grow past {size} bytes"
         time.sleep(0.05)

@@ -14,6 +14,7 @@ import time
 from collections.abc import AsyncIterator
 from typing import Any
 
+from patience import PATIENCE
 from rtmu.client.call_values import Packet
 from rtmu.client.central import list_robots
 from rtmu.client.connection import AriaClient
@@ -31,7 +32,7 @@ FAST = dict(port=0, camera=False, switch_retry=0.1)
 
 
 async def until(predicate: Any, timeout: float = 10.0) -> None:
-    deadline = time.monotonic() + timeout
+    deadline = time.monotonic() + timeout * PATIENCE
     while not predicate():
         if time.monotonic() > deadline:
             raise AssertionError("condition not reached in time")

@@ -32,7 +32,7 @@ async def eventually(predicate, timeout: float = TIMEOUT, what: str = "the condi
             await asyncio.sleep(0.005)
 
     try:
-        await asyncio.wait_for(poll(), timeout)
+        await asyncio.wait_for(poll(), timeout * PATIENCE)
     except TimeoutError:
         raise AssertionError(f"timed out waiting for {what}") from None
 
