@@ -19,10 +19,13 @@ from ..protocol.payloads.robot import BatteryInfo, ModeInfo, Update, UpdateNumbe
 from ..values.intents import Intent, SetSafeDrive
 from .call_values import Packet
 from .connection import AriaClient
-from .errors import ClientError
+from .errors import ClientError, ClientTimeout
 from .feed import Feed, FeedContext
 from .robot_status import battery_fields, numbers_fields, strings_fields
 from .subscriptions import Subscription
+
+BATTERY_INFO_ATTEMPTS = 3
+"""How many times ``batteryInfo`` is asked before the battery number is shown without its unit known."""
 
 
 class StatusFeed(Feed):
@@ -67,18 +70,24 @@ class StatusFeed(Feed):
         with contextlib.suppress(ClientError, ProtocolError):
             try:
                 if client.supports("batteryInfo"):
-                    info = self.ctx.decode(
-                        "batteryInfo", (await client.request_once("batteryInfo", timeout=timeout)).payload
-                    )
+                    info = self.ctx.decode("batteryInfo", await self._ask_battery_info(client, timeout))
                     if isinstance(info, BatteryInfo):
                         self.ctx.robot_update(**battery_fields(info))
-            finally:  # answered, refused or timed out: the number is shown, now and from then on
+            finally:  # answered, refused or never answered: the number is shown, now and from then on
                 if self.ctx.client is client and not self._battery_unit_known:
                     self._battery_unit_known = True
                     if self._battery_held is not None:
                         self.ctx.robot_update(battery_v=self._battery_held)
             if client.supports("getSafeDrive"):
                 await self._refresh_safe_drive(client)
+
+    async def _ask_battery_info(self, client: AriaClient, timeout: float) -> bytes:
+        """``batteryInfo``'s reply, asked again after a timeout (a busy robot or laptop): an LD robot's
+        state of charge shown as volts until the link ends is worse than a number shown late."""
+        for _attempt in range(BATTERY_INFO_ATTEMPTS - 1):
+            with contextlib.suppress(ClientTimeout):
+                return (await client.request_once("batteryInfo", timeout=timeout)).payload
+        return (await client.request_once("batteryInfo", timeout=timeout)).payload
 
     async def _refresh_safe_drive(self, client: AriaClient) -> None:
         reply = await client.request_once("getSafeDrive", timeout=self.ctx.config.reply_timeout)
