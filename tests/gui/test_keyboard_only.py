@@ -121,7 +121,7 @@ def test_go_to_point_and_set_position_by_keyboard_alone(gui: Gui, sim: SimThread
     back_to_map(gui)
 
 
-def test_the_keys_window_opens_by_keyboard_stop_first_filtered_as_typed_and_escape_closes_it(
+def test_the_keys_window_opens_by_keyboard_stop_first_filtered_as_typed_and_escape_empties_then_closes(
     gui: Gui,
 ) -> None:
     window = gui.window
@@ -146,6 +146,13 @@ def test_the_keys_window_opens_by_keyboard_stop_first_filtered_as_typed_and_esca
     gui.xdotool("type", "--delay", "30", "qq")
     pump(lambda: not any(ln.get_mapped() for ln in keys.lines), 5, "no row for zoomqq")
     assert keys.note.get_text() == "No key matches “zoomqq”"
+    gui.key("Escape")  # first it empties the search: the whole list again, the window stays
+    pump(
+        lambda: keys.search.get_text() == "" and all(ln.get_mapped() for ln in keys.lines),
+        5,
+        "Escape to empty the search",
+    )
+    assert keys.get_mapped() and not keys.note.get_mapped()
     gui.key("Escape")
     pump(lambda: not keys.get_mapped(), 5, "Escape to close the keys window")
     pump(window.is_active, 5, "the keyboard back on the window")

@@ -4,9 +4,10 @@ column that fits a phone, searchable.
 GTK 4.8's ``GtkShortcutsWindow`` lays its pages out in two columns (600 px in English, 700 px in a
 longer language), so RTMU draws its own: a search field over one scrolled list of groups, each row the
 action's words and its keys as key caps, made from ``keys_sheet.KeySheet`` — the one key table. Typing
-anywhere goes to the search; Escape closes. The window belongs to the main window (transient for it),
-so the stop keys guard it like every dialog (``stop_keys``): Space stops the robot here too, Shift+Space
-types a space in the search. It is built the first time it is asked for and kept, hidden, after.
+anywhere goes to the search; Escape empties the search, or closes the window when the search is empty.
+The window belongs to the main window (transient for it), so the stop keys guard it like every dialog
+(``stop_keys``): Space stops the robot here too, Shift+Space types a space in the search. It is built
+the first time it is asked for and kept, hidden, after.
 """
 
 from __future__ import annotations
@@ -150,6 +151,10 @@ class KeysWindow(Gtk.Window):
     def _key(self, _c: Gtk.EventControllerKey, keyval: int, _code: int, _state: Gdk.ModifierType) -> bool:
         if keyval != Gdk.KEY_Escape:
             return False
+        if self.search.get_text():  # first the search (what was typed is easy to lose), then the window
+            self.search.set_text("")
+            self.filter("")
+            return True
         self.close()
         return True
 
