@@ -37,6 +37,9 @@ MainWindow = Any
 
 FOCUSABLE = (Gtk.Button, Gtk.CheckButton, Gtk.DropDown, Gtk.Switch, Gtk.Scale)
 NUDGE_PX = 20.0
+_TAB, _SHIFT = Gdk.KEY_Tab, Gdk.ModifierType.SHIFT_MASK
+"""Looked up once: every key press (a held drive key repeats 25 times a second) passes the first-Tab
+check, and each lookup through PyGObject's module proxy costs more than the check itself."""
 """A pick mode's arrow key moves the picked point this far on screen (at least 100 mm)."""
 NUDGE_MIN_MM = 100.0
 TURN_DEG = 15.0
@@ -89,7 +92,7 @@ class KeyboardNav:
         self, _c: Gtk.EventControllerKey, keyval: int, _code: int, state: Gdk.ModifierType
     ) -> bool:
         window = self.window
-        if keyval != Gdk.KEY_Tab or state & Gdk.ModifierType.SHIFT_MASK or window.get_focus() is not None:
+        if keyval != _TAB or state & _SHIFT or window.get_focus() is not None:
             return False
         bar = window.fullscreen_bar
         stop = bar.stop_button if bar.get_reveal_child() else window.stop_button

@@ -106,7 +106,12 @@ class WindowTimers:
         """The banners off the motion pills, and on a phone off the robot (``MapPage.banner_room``)."""
         w = self.window
         parent = w.banners.get_parent()
-        avoid, bottom = w.map_page.banner_room(parent) if parent is not None else (None, 0)
+        # With no banner up there is nothing to keep off the robot: the robot's place on screen is not
+        # worked out 10 times a second while driving for an empty column (only its margins reset).
+        avoid: tuple[float, float, float, float] | None = None
+        bottom = 0
+        if parent is not None and w.banners.topics():
+            avoid, bottom = w.map_page.banner_room(parent)
         w.banners.keep_clear_of(w.motion, w.camera_page.motion, avoid=avoid, bottom=bottom)
 
     def _beat_tick(self) -> bool:
