@@ -156,6 +156,13 @@ WINDOW_LATE = (
     "rtmu.ui.palette",
     "rtmu.ui.settings_dialog",
     "rtmu.ui.why_window",
+    "rtmu.client.files_feed",  # the feeds that only answer the operator: with their first intent
+    "rtmu.client.console_feed",
+    "rtmu.client.console",
+    "rtmu.client.download",
+    "rtmu.client.upload",
+    "rtmu.client.remote_files",  # the files' rules and payloads: a file, a scan named, a map switched
+    "rtmu.protocol.payloads.files",
 )
 """What a launch to the first map frame does without (issue 28: launch ≤ 0.6 s); each is imported
 where it is first used."""

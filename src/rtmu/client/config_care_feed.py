@@ -24,7 +24,6 @@ from .config_feed import fetch_config, set_config
 from .connection import AriaClient
 from .errors import NotSupported
 from .feed import Feed, FeedContext
-from .remote_files import Refused, remote_path
 from .subscriptions import Subscription
 
 
@@ -58,6 +57,8 @@ class ConfigCareFeed(Feed):
 
     async def _switch(self, client: AriaClient, path: str, timeout: float) -> bool:
         """Set ``Files/Map`` to ``path`` (a file the robot lists); True once ``mapUpdated`` came."""
+        from .remote_files import Refused, remote_path  # with the first switch, not at launch
+
         path = remote_path(path)
         config = await fetch_config(client, timeout)
         problem = map_param_problem(config)

@@ -92,6 +92,10 @@ class Feed:
     def __init__(self, ctx: FeedContext) -> None:
         self.ctx = ctx
 
+    def intent_types(self) -> tuple[type[Intent], ...]:
+        """:attr:`handles` (a stand-in for a feed not imported yet names its feed's: ``lazy_feed``)."""
+        return self.handles
+
     def subscriptions(self, client: AriaClient) -> Iterable[Subscription]:
         """What to subscribe to on every connection, where the server offers it."""
         return ()

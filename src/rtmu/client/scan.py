@@ -21,7 +21,6 @@ from ..base.i18n import N_, Said, as_said
 from ..base.textsafe import visible
 from ..protocol.errors import ProtocolError
 from ..protocol.payloads.commands import StringCommandArgs
-from ..protocol.payloads.files import code_words
 from ..protocol.payloads.mapping import (
     MAPPING_END_WORDS,
     MAPPING_START_WORDS,
@@ -41,7 +40,6 @@ from .call_values import Packet
 from .connection import REPLY_TIMEOUT, AriaClient
 from .custom_commands import taken
 from .errors import NotSupported
-from .remote_files import Refused, checked_name, malformed, name_problem
 
 SCAN_FEATURES: Final[dict[str, tuple[tuple[str, ...], str]]] = {
     "scan": (
@@ -79,6 +77,8 @@ def _require(client: AriaClient, feature: str) -> None:
 
 def scan_name(name: str) -> str:
     """``name`` if a robot can make a scan file of it, else ValueError saying why (nothing is sent)."""
+    from .remote_files import name_problem  # the files' rules load when a scan is named, not at launch
+
     if len(name) > MAX_SCAN_NAME:
         raise ValueError(Said(N_("a scan name is at most {count} characters"), count=MAX_SCAN_NAME))
     problem = name_problem(scan_file_name(name))
@@ -103,11 +103,18 @@ class ScanStatus:
     @property
     def file_name(self) -> str:
         """The ``.2d`` file the scan is written to (checked: one plain name); ``""`` when none."""
-        return checked_name(scan_file_name(self.name), "a scan named") if self.name else ""
+        if not self.name:
+            return ""
+        from .remote_files import checked_name
+
+        return checked_name(scan_file_name(self.name), "a scan named")
 
 
 async def start_scan(client: AriaClient, name: str, *, timeout: float = REPLY_TIMEOUT) -> str:
     """Start a scan named ``name``; the file it is written to. Refused (exit 6) with the robot's words."""
+    from ..protocol.payloads.files import code_words
+    from .remote_files import Refused, malformed
+
     name = scan_name(name)
     _require(client, "scan")
     reply = await client.request_once(MappingStart(name), timeout=timeout)
@@ -128,6 +135,8 @@ async def scan_status(client: AriaClient, *, timeout: float = REPLY_TIMEOUT) -> 
     try:
         status = ScanStatus(MappingStatus.decode(reply.payload).name)
     except ProtocolError as exc:
+        from .remote_files import malformed
+
         raise malformed(f"answer to {name}", exc) from None
     status.file_name  # noqa: B018 -- refuses a name that is no plain file name, now rather than later
     return status
@@ -135,6 +144,9 @@ async def scan_status(client: AriaClient, *, timeout: float = REPLY_TIMEOUT) -> 
 
 async def stop_scan(client: AriaClient, *, timeout: float = REPLY_TIMEOUT) -> str:
     """End the scan; the file it was written to ("" when the robot does not say). Refused with its words."""
+    from ..protocol.payloads.files import code_words
+    from .remote_files import Refused, malformed
+
     _require(client, "scan")
     file_name = ""
     if not scan_unavailable(client).get("scan_status"):

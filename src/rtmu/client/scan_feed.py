@@ -24,7 +24,6 @@ from .call_values import Packet
 from .connection import AriaClient
 from .errors import ClientError
 from .feed import Feed, FeedContext
-from .remote_files import UnsafeName
 from .scan import ScanStatus, scan_status, scan_unavailable, start_scan, stop_scan, tag_loop
 from .subscriptions import Subscription
 
@@ -60,10 +59,17 @@ class ScanFeed(Feed):
     def _heard(self, packet: Packet) -> None:
         try:
             status = ScanStatus(MappingStatusBroadcast.decode(packet.payload).name)
-            status.file_name  # noqa: B018 -- a name that cannot be a file is not taken
-        except (ProtocolError, UnsafeName):
+        except ProtocolError:
             self.bad_names += 1
             return
+        if status.name:  # the files' rules load with the first scan named, not with every launch
+            from .remote_files import UnsafeName
+
+            try:
+                status.file_name  # noqa: B018 -- a name that cannot be a file is not taken
+            except UnsafeName:
+                self.bad_names += 1
+                return
         self._status(status)
 
     def _status(self, status: ScanStatus, *, at_login: bool = False) -> None:

@@ -43,6 +43,7 @@ from .drive_loop import STEP_TIMEOUT, DriveFeed
 from .errors import ClientError, NotSupported, ServerClosed
 from .feed import Feed
 from .feeds import FEEDS
+from .lazy_feed import DeferredFeed
 from .lease import DriveLease, EndReason
 from .map_feed import MapFeed
 from .reconnect import worth_retrying
@@ -109,10 +110,10 @@ class Session:
         """Each data name's last small payload and its value: a stream that repeats itself (status,
         sonar and lasers of a robot at rest) is not decoded again."""
         self.feeds: list[Feed] = [kind(self) for kind in (*FEEDS, *self.config.extra_feeds)]
-        self._by_type = {type(feed): feed for feed in self.feeds}
+        self._by_type = {type(feed): feed for feed in self.feeds if not isinstance(feed, DeferredFeed)}
         self._handlers: dict[type[Intent], Feed] = {}
         for feed in self.feeds:
-            for intent_type in feed.handles:
+            for intent_type in feed.intent_types():
                 if intent_type in self._handlers:
                     raise ValueError(f"{intent_type.__name__} is handled by two feeds")
                 self._handlers[intent_type] = feed
@@ -147,7 +148,11 @@ class Session:
     def feed(self, kind: type[F]) -> F:
         found = self._by_type.get(kind)
         if found is None:
-            raise LookupError(f"this session has no {kind.__name__}")
+            deferred = (f for f in self.feeds if isinstance(f, DeferredFeed) and f.entry.names(kind))
+            stand_in = next(deferred, None)
+            if stand_in is None:
+                raise LookupError(f"this session has no {kind.__name__}")
+            found = self._by_type[kind] = stand_in.loaded()
         return found  # type: ignore[return-value]
 
     def publish(self, change: StateChange) -> None:

@@ -12,7 +12,6 @@ from collections.abc import Collection
 
 from ..base.i18n import _
 from ..base.units import file_size
-from ..client.remote_files import FEATURES
 from ..values.commission import Direction, Transfer
 
 PAGE_FEATURES = ("list", "download", "upload", "delete")
@@ -36,6 +35,8 @@ def when(seconds: int) -> str:
 
 def greyed(offers: Collection[str], connected: bool) -> dict[str, str]:
     """Feature → why it cannot be used now (absent: it can), for each of :data:`PAGE_FEATURES`."""
+    from ..client.remote_files import FEATURES  # with the files page, not at every launch
+
     out: dict[str, str] = {}
     for feature in PAGE_FEATURES:
         names, reason = FEATURES[feature]

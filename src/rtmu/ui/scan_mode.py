@@ -28,7 +28,6 @@ from gi.repository import Gdk, GLib, Gtk  # noqa: E402
 
 from ..base.i18n import _, error_words  # noqa: E402
 from ..base.textsafe import visible  # noqa: E402
-from ..client.remote_files import local_name  # noqa: E402
 from ..client.scan import SCAN_FEATURES, ScanProgress, scan_name  # noqa: E402
 from ..fleet.selected import SelectedRobot  # noqa: E402
 from ..fleet.sessions import RobotSession  # noqa: E402
@@ -314,6 +313,8 @@ class ScanBar(Gtk.Revealer):
         remote = self.offer_file
         if not remote:
             return
+        from ..client.remote_files import local_name  # the files' rules load with the first download
+
         target = folder / local_name(remote)
         if target.exists() or target.is_symlink():
             self.confirm = Confirm(
