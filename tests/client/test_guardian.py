@@ -26,9 +26,12 @@ from rtmu.client.session import SessionConfig
 from rtmu.guardian import halt
 from rtmu.guardian import messages as m
 from rtmu.guardian.child import (
+    CHECK_PERIOD,
+    QUICK_LATE,
     SILENT_CEILING,
     SILENT_LATE,
     SILENT_LATE_NETWORK,
+    FixedLimit,
     Watch,
     learned_limit,
     parent_frozen,
@@ -365,6 +368,26 @@ def test_the_network_thread_may_be_as_late_as_its_own_stale_limit_the_ui_thread_
         assert watch.why_stop(t + floor - 0.01) is None
         assert watch.why_stop(t + floor + 0.01) is not None
     assert SILENT_LATE < 0.45 < SILENT_LATE_NETWORK <= 0.5  # (the status ceiling sits between them)
+
+
+def test_an_armed_guardian_sleeps_until_a_beat_is_late_then_looks_every_20_ms() -> None:
+    """Between beats that come every 40 ms nothing but the pipe can call for a stop, so the armed loop
+    sleeps until the oldest beat is QUICK_LATE late (it looked every 20 ms: 75 wake-ups a second while
+    a window drove, 25 of them beats); from then on every CHECK_PERIOD, as before, until a limit says
+    stop. Never later than any look that could find a reason to stop."""
+    watch = Watch(os.getpid(), learned_limit)
+    watch.take(m.ARM, 0.0)
+    t = _beats(watch, m.BEAT_NET, 0.0, 10.0, 0.04)
+    t = _beats(watch, m.BEAT_UI, t - 0.04, 0.04, 0.04)  # both sources beat; the UI's last came last
+    oldest = min(watch.last.values())
+    assert watch.next_look(oldest + 0.01) == pytest.approx(QUICK_LATE - 0.01)
+    assert watch.next_look(oldest + QUICK_LATE + 0.001) == CHECK_PERIOD
+    for now in (oldest + step / 1000 for step in range(0, int(QUICK_LATE * 1000))):
+        assert watch.why_stop(now) is None  # nothing it slept through could have stopped
+    short = Watch(os.getpid(), lambda _source: FixedLimit(QUICK_LATE / 2))  # a limit below QUICK_LATE:
+    short.take(m.ARM, 0.0)
+    short.take(m.BEAT_NET, 0.0)
+    assert short.next_look(0.001) == CHECK_PERIOD  # the old way, every 20 ms
 
 
 def test_the_guardians_reasons_name_no_window_it_may_not_have() -> None:
