@@ -70,10 +70,18 @@ def _spawn_session_bus() -> str | None:
 def _spawn_telling(argv: Callable[[int], list[str]]) -> tuple[subprocess.Popen[bytes] | None, str | None]:
     """Start a server that writes one line (its display number, its address) to the descriptor it is
     given when it is ready; (process, that line), or (None, None) when it said nothing within 15 s.
-    It is ended when the test run ends."""
+    It is ended when the test run ends. Never marked as the running test's own (``isolation.OWNER``):
+    a session's screen first asked for inside a test (``request.getfixturevalue``) outlives that test,
+    and was killed at its end as a leak, leaving the next tests of the worker a dead display."""
+    from .isolation import OWNER
+
     read_fd, write_fd = os.pipe()
     proc = subprocess.Popen(
-        argv(write_fd), pass_fds=(write_fd,), stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL
+        argv(write_fd),
+        pass_fds=(write_fd,),
+        stdout=subprocess.DEVNULL,
+        stderr=subprocess.DEVNULL,
+        env={name: value for name, value in os.environ.items() if name != OWNER},
     )
     os.close(write_fd)
     deadline = time.monotonic() + 15
