@@ -12,7 +12,8 @@ Commands on stdin: ``play PROFILE SEED`` (a Wi-Fi profile of ``tests/linkfaults.
 ``RTMU_LINKS_TRACE=DIR`` in its environment: at exit it writes ``DIR/rig-SEED-PID.json`` with the
 three clocks of every status on its way to a client — ``sim``: (when the simulator wrote it, the
 client's port as the simulator sees it, the data's name, the simulated time, the simulator thread's
-CPU time and run-queue wait so far: the kernel's account of a late one); ``proxy``: the proxy's
+CPU time and run-queue wait so far: the kernel's account of a late one); ``gc``: the process's
+garbage collections over 5 ms (each holds every thread); ``proxy``: the proxy's
 :attr:`~linkfaults.FaultProxy.trace` (read, due, written); ``stops`` — so a false stop's cause can be
 read: a late ``sim`` (its send loop was starved), a proxy that wrote after its due time (the lab's
 own stall), or neither (the client read late). ``bench/links_trace.py`` reads them.
@@ -21,6 +22,7 @@ own stall), or neither (the client read late). ``bench/links_trace.py`` reads th
 from __future__ import annotations
 
 import contextlib
+import gc
 import json
 import os
 import sys
@@ -35,6 +37,18 @@ ROBOT_PRIORITY = -10
 """The simulator stands for the robot, which does not share the laptop's CPUs: where allowed (root,
 ``RLIMIT_NICE``), its process runs this many nice levels up, so the laptop's load (other engineers'
 work, the bench's spinners) delays the client, not the status the client is waiting for."""
+
+
+GC_PAUSES: list[tuple[float, float, int]] = []
+"""(start, seconds, generation) of every collection over 5 ms: it holds every thread of the process."""
+_GC_STARTED = [0.0]
+
+
+def _gc_pause(phase: str, info: dict[str, int]) -> None:
+    if phase == "start":
+        _GC_STARTED[0] = time.monotonic()
+    elif time.monotonic() - _GC_STARTED[0] > 0.005:
+        GC_PAUSES.append((_GC_STARTED[0], time.monotonic() - _GC_STARTED[0], info["generation"]))
 
 
 def _schedstat() -> tuple[float, float]:
@@ -66,6 +80,7 @@ def main() -> int:
             invoke(session, number, name, args, once=once)
 
         server.invoke = traced  # type: ignore[method-assign]
+        gc.callbacks.append(_gc_pause)
     lock = threading.Lock()
 
     def say(line: str) -> None:
@@ -102,7 +117,7 @@ def main() -> int:
         rig.close()
         if trace_dir:
             out = Path(trace_dir) / f"rig-{sys.argv[1]}-{os.getpid()}.json"
-            record = {"sim": sent, "proxy": rig.proxy.trace, "stops": rig.stops}
+            record = {"sim": sent, "proxy": rig.proxy.trace, "stops": rig.stops, "gc": GC_PAUSES}
             out.write_text(json.dumps(record))
     return 0
 

@@ -56,12 +56,14 @@ def explain(record: dict, verbose: bool) -> list[str]:
             outs = [c[2] for c in got if c[2] <= t]
             late_out = max((c[2] - c[1] for c in got if c[2] <= t), default=0.0)
             last_out = t - max(outs, default=t - WINDOW)
+            gc_ms = sum(d for at, d, _g in record.get("gc", []) if t - WINDOW <= at <= t) * 1000
             out.append(
                 f"stop {t:.3f} by {who} port {port}: sim gap {_gaps(sim_times) * 1000:.0f} ms "
                 f"(behind {(max(offsets) - min(offsets)) * 1000:.0f} ms; its thread ran {ran * 1000:.0f} ms, "
                 f"waited for a CPU {waited * 1000:.0f} ms), proxy read gap "
                 f"{_gaps(reads) * 1000:.0f} ms, out gap {_gaps(outs) * 1000:.0f} ms, out late "
-                f"{late_out * 1000:.0f} ms, nothing out for {last_out * 1000:.0f} ms before the stop"
+                f"{late_out * 1000:.0f} ms, nothing out for {last_out * 1000:.0f} ms before the stop; "
+                f"garbage collection {gc_ms:.0f} ms"
             )
             if verbose:
                 for read, due, written in got:
