@@ -32,6 +32,7 @@ from pathlib import Path
 
 from bench.links_rig import Rig
 from linkfaults import PROFILES
+from rtmu.base.heap import settle
 
 ROBOT_PRIORITY = -10
 """The simulator stands for the robot, which does not share the laptop's CPUs: where allowed (root,
@@ -65,6 +66,7 @@ def main() -> int:
     with contextlib.suppress(OSError):
         os.setpriority(os.PRIO_PROCESS, 0, ROBOT_PRIORITY)
     rig = Rig(int(sys.argv[1]))
+    settle()  # as ``rtmu sim`` does: the world's objects out of the collector's full passes
     trace_dir = os.environ.get("RTMU_LINKS_TRACE")
     sent: list[tuple[float, str, str, float, float, float]] = []
     if trace_dir:
