@@ -27,6 +27,9 @@ before (``RTMU_LINK_TIMING=fixed``: stale after 3 status intervals in the window
   counts the 0.8 s starvations that stopped a drive the operator kept holding
   (``RTMU_LINKS_FREEZE_TRIALS``, 10).
 
+``RTMU_LINKS_TRACE=DIR`` keeps every simulator's clocks and a machine-wide stall probe for the
+false-stop soaks; ``python -m bench.links_trace DIR`` then names the late clock of each stop.
+
 Run alone: ``python -m bench.bench_links``.
 """
 
@@ -37,6 +40,7 @@ import math
 import os
 import signal
 import statistics
+import subprocess
 import sys
 import threading
 import time
@@ -181,12 +185,20 @@ def false_stop_rows() -> list[Result]:
         for j in jobs:
             j.join()
 
+    trace = os.environ.get("RTMU_LINKS_TRACE")  # each rig writes its clocks there (``bench.links_trace``)
+    probe = None
+    if trace:
+        total = 3 * (SOAK_S + BASELINE_S) + 600
+        argv = [sys.executable, "-m", "bench.stall_probe", f"{trace}/probe.json", str(total)]
+        probe = subprocess.Popen(argv, cwd=REPO)
     for fixed, seconds in ((False, SOAK_S), (True, BASELINE_S)):
         phase(("good",), seconds, fixed)
         phase(("busy",), seconds, fixed)
         with CpuLoad(count=4, nice=0, seconds=seconds + 300) as load:
             wait_busy(load)
             phase(("load4",), seconds, fixed)
+    if probe is not None:
+        probe.terminate()
     out = []
     for who in ("window", "core", "drive"):
         for condition in ("good", "busy", "load4"):

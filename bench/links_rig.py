@@ -122,6 +122,7 @@ class RigProcess:
             stdin=subprocess.PIPE,
             stdout=subprocess.PIPE,
             text=True,
+            start_new_session=True,  # a scheduling group of its own (base.priority.raise_group_priority)
         )
         assert self.proc.stdout is not None
         word, port = self.proc.stdout.readline().split()

@@ -101,8 +101,11 @@ class _Pipe:
         """This pipe's own hold (``time.monotonic()``), beside the proxy's for its direction."""
         self.direction = direction
         self.src = src
+        server_side = src if direction == TO_CLIENT else dst
+        self.server_port = int(server_side.getsockname()[1])
+        """Our port toward the server: the client's address as the server sees it (for the trace)."""
         self.dst = dst
-        self.queue: collections.deque[tuple[float, bytes, bool]] = collections.deque()
+        self.queue: collections.deque[tuple[float, bytes, bool, float]] = collections.deque()
         self.queued = 0
         self.cond = threading.Condition()
         self.done = False
@@ -124,10 +127,11 @@ class _Pipe:
             data = self.proxy.noise(len(data))
             clean = False
         with self.cond:
-            due = time.monotonic() + self.proxy.delays[self.direction] + self.proxy.chunk_jitter()
+            read_at = time.monotonic()
+            due = read_at + self.proxy.delays[self.direction] + self.proxy.chunk_jitter()
             if self.queue:
                 due = max(due, self.queue[-1][0])  # jitter never reorders a stream
-            self.queue.append((due, data, clean))
+            self.queue.append((due, data, clean, read_at))
             self.queued += len(data)
             self.cond.notify_all()
 
@@ -160,7 +164,7 @@ class _Pipe:
                             due = max(self.queue[0][0], held)
                             wait = due - time.monotonic()
                             if wait <= 0:
-                                _, data, clean = self.queue.popleft()
+                                _, data, clean, read_at = self.queue.popleft()
                                 self.queued -= len(data)
                                 self.cond.notify_all()
                                 break
@@ -172,6 +176,10 @@ class _Pipe:
                 self.dst.sendall(data)
                 if clean:
                     self.proxy.delivered_at[self.direction] = self.proxy.clock()
+                trace = self.proxy.trace
+                if trace is not None:
+                    written = time.monotonic()
+                    trace.append((self.direction, self.server_port, read_at, due, written, len(data)))
         except OSError:
             pass
         finally:
@@ -255,6 +263,10 @@ class FaultProxy:
         """Connections accepted so far (a reconnect shows up here)."""
         self.server_ports: list[int] = []
         """Our local port of each connection to the target: the client's address as the server sees it."""
+        self.trace: list[tuple[Direction, int, float, float, float, int]] | None = None
+        """A list to fill (None: no tracing): per chunk forwarded, (direction, :attr:`server_ports` entry,
+        read, due, written, bytes) — ``time.monotonic()`` times: when the proxy read it, when the profile
+        meant it to go, when it went. ``written - due`` is the proxy's own lateness."""
         self.tap: Callable[[Direction, bytes], None] | None = None
         """``tap(direction, data)`` for every chunk read, before it is forwarded (its reader's thread)."""
         self._links: list[_Link] = []

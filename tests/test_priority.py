@@ -10,6 +10,8 @@ from __future__ import annotations
 
 import os
 import resource
+import subprocess
+import sys
 import threading
 import time
 
@@ -86,3 +88,25 @@ def test_a_raised_job_gives_its_thread_its_level_back() -> None:
     thread.join()
     assert raised == [True] * 5  # raised (where allowed) inside each job…
     assert seen == start * 5  # …and given back after each
+
+
+GROUP_CHILD = """
+import os, sys
+from rtmu.base.priority import raise_group_priority
+granted = raise_group_priority(5)
+path = "/proc/self/autogroup"
+print(granted, open(path).read().split()[-1] if os.path.exists(path) else "-")
+"""
+
+
+def test_a_session_leader_raises_its_session_group_where_allowed() -> None:
+    """A process in a session of its own (``start_new_session``) lowers its group's nice value; a
+    process without the rights, or a kernel without autogroup, changes nothing and fails nothing."""
+    argv = [sys.executable, "-c", GROUP_CHILD]
+    out = subprocess.run(argv, start_new_session=True, capture_output=True, text=True, timeout=60)
+    assert out.returncode == 0, out.stderr
+    granted, nice = out.stdout.split()
+    if not os.path.exists("/proc/self/autogroup"):
+        assert (granted, nice) == ("False", "-")
+    elif os.geteuid() == 0:
+        assert (granted, nice) == ("True", "-5")

@@ -1,11 +1,14 @@
 """The lease keeper: a renewing thread that only waited for a CPU keeps its lease; a busy, blocked
 or frozen one does not, and nothing dead comes back. First on a fake clock with made-up run-queue
-waits, then with the kernel's real account of a thread starved behind spinning processes."""
+waits, then with the kernel's real account of a thread starved behind spinning processes (the starving
+set by its scheduling class, so the figures hold on a busy machine as on an idle one)."""
 
 from __future__ import annotations
 
+import contextlib
 import hashlib
 import os
+import signal
 import threading
 import time
 
@@ -116,49 +119,104 @@ def test_unknown_waits_give_no_credit() -> None:
 def _gil_free_work(cpu_seconds: float) -> None:
     """CPU work that does not hold the GIL (hashing releases it), as GTK's rendering in C does."""
     start = time.thread_time()
-    block = bytes(1 << 20)
+    block = bytes(1 << 16)
     while time.thread_time() - start < cpu_seconds:
         hashlib.sha256(block).digest()
 
 
-def _starved_renewer(lease: DriveLease, cpu: int, seconds: float) -> list[float]:
-    """A "UI" thread pinned to ``cpu`` that renews after every 50 ms of its own work; returns when
-    its lease lapsed (empty: never)."""
-    lapsed: list[float] = []
+STARVE = 0.6
+"""Seconds the renewer is starved: past the lease's 0.3 s, well inside the keeper's 1 s limit."""
 
-    def ui() -> None:
-        os.sched_setaffinity(0, {cpu})  # this thread only (Linux: 0 is the caller)
-        lease.grant(FWD)
-        end = time.monotonic() + seconds
-        while time.monotonic() < end:
-            _gil_free_work(0.05)
-            if not lease.renew():
-                lapsed.append(time.monotonic())
+
+class Renewer:
+    """A "UI" thread pinned to one CPU that renews its lease every few ms of its own work, until told
+    to stop or its lease lapses; :meth:`starve` makes it wait for that CPU and nothing else.
+
+    Starved by the scheduling class, not by the machine's mood: for :data:`STARVE` s it is put in
+    ``SCHED_IDLE`` behind six spinners pinned to its CPU (they run only meanwhile), so it is runnable
+    and waits for the CPU the whole time — however busy or idle the rest of the machine is. Before and
+    after, it is an ordinary thread that renews ~50 times a second."""
+
+    def __init__(self, lease: DriveLease, cpu: int, spinners: CpuLoad) -> None:
+        self.lease = lease
+        self.cpu = cpu
+        self.spinners = spinners
+        self.lapsed: list[float] = []
+        self.tid = 0
+        self._ready = threading.Event()
+        self._done = threading.Event()
+        self._thread = threading.Thread(target=self._run, daemon=True)
+        self._thread.start()
+        assert self._ready.wait(30)
+
+    def _run(self) -> None:
+        os.sched_setaffinity(0, {self.cpu})  # this thread only (Linux: 0 is the caller)
+        self.tid = threading.get_native_id()
+        self.lease.grant(FWD)
+        self._ready.set()
+        while not self._done.is_set():
+            _gil_free_work(0.002)
+            if not self.lease.renew():
+                self.lapsed.append(time.monotonic())
                 return
+            time.sleep(0.01)
 
-    thread = threading.Thread(target=ui, daemon=True)
-    thread.start()
-    thread.join(seconds + 30)
-    return lapsed
+    def starve(self) -> None:
+        _signal(self.spinners, signal.SIGCONT)
+        os.sched_setscheduler(self.tid, os.SCHED_IDLE, os.sched_param(0))
+        time.sleep(STARVE)
+        _signal(self.spinners, signal.SIGSTOP)
+        os.sched_setscheduler(self.tid, os.SCHED_OTHER, os.sched_param(0))
+
+    def finish(self) -> list[float]:
+        """Let it renew a little longer (the first renewal after the starving decides), then end it."""
+        time.sleep(0.3)
+        self._done.set()
+        self._thread.join(30)
+        return self.lapsed
+
+
+def _signal(load: CpuLoad, signum: int) -> None:
+    for p in load.procs:
+        with contextlib.suppress(ProcessLookupError):
+            os.kill(p.pid, signum)
+
+
+def _can_starve() -> bool:
+    try:
+        os.sched_setscheduler(0, os.SCHED_IDLE, os.sched_param(0))  # only lowers: always allowed
+        os.sched_setscheduler(0, os.SCHED_OTHER, os.sched_param(0))  # back: needs RLIMIT_NICE or root
+    except (OSError, AttributeError):
+        return False
+    return True
 
 
 def test_the_kernel_account_tells_a_starved_thread_from_a_frozen_one() -> None:
-    """Real threads on the real clock: a renewer sharing its CPU with six spinning processes waits
-    ~6/7 of the time for it (50 ms of work take ~0.35 s or more) — without a keeper its lease
-    lapses, with one it lives; a renewer that simply stops (blocked, not runnable) lapses either way."""
-    if len(os.sched_getaffinity(0)) < 2 or RunQueueMeter()(threading.get_native_id()) is None:
-        pytest.skip("needs two CPUs and /proc/self/task/*/schedstat")
-    cpu = sorted(os.sched_getaffinity(0))[0]
-    with CpuLoad(count=6, nice=0, seconds=60, cpus=(cpu,)) as load:
-        assert wait_busy(load)
-        without = _starved_renewer(DriveLease(), cpu, 3.0)
-        assert without, "the renewer was never starved past the lease: the setup proves nothing"
-        lease = DriveLease()
-        keeper = LeaseKeeper(lease).start()
+    """Real threads on the real clock: a renewer that waits :data:`STARVE` s for its CPU — and only
+    waits — lapses without a keeper and keeps its lease with one; a renewer that simply stops (blocked,
+    not runnable) lapses either way. No figure here depends on how busy the machine is: the starving
+    is the scheduling class's, and the keeper's 1 s limit leaves 0.4 s for a late wake."""
+    affinity = sorted(os.sched_getaffinity(0))
+    if len(affinity) < 2 or RunQueueMeter()(threading.get_native_id()) is None or not _can_starve():
+        pytest.skip("needs two CPUs, /proc/self/task/*/schedstat and SCHED_IDLE")
+    cpu = affinity[0]
+    with CpuLoad(count=6, nice=0, seconds=60, cpus=(cpu,)) as spinners:
+        assert wait_busy(spinners)
+        _signal(spinners, signal.SIGSTOP)
         try:
-            lapsed = _starved_renewer(lease, cpu, 3.0)
+            alone = Renewer(DriveLease(), cpu, spinners)
+            alone.starve()
+            assert alone.finish(), "the renewer was never starved past the lease: the setup proves nothing"
+            lease = DriveLease()
+            keeper = LeaseKeeper(lease).start()
+            try:
+                kept = Renewer(lease, cpu, spinners)
+                kept.starve()
+                lapsed = kept.finish()
+            finally:
+                keeper.close()
         finally:
-            keeper.close()
+            _signal(spinners, signal.SIGCONT)
     assert lapsed == [], f"a starved renewer lost its lease (longest credit {keeper.credited:.2f} s)"
     assert keeper.credited > 0.25
     keeper = LeaseKeeper(lease).start()

@@ -3,7 +3,9 @@
 The threads that produce (the network loop that sends the stops, the UI thread) only
 ``put_nowait`` a small item: they never encode, compress, write or wait. When the
 writer falls behind and the queue is full, the item is dropped and counted (the file
-says how many) — a slow disk can cost recorded data, never a late stop. A full disk,
+says how many) — a slow disk can cost recorded data, never a late stop. The writer itself
+takes at most a fifth of a CPU (:mod:`.duty`): foxglove-sdk holds the interpreter lock while
+it compresses, and a flood recorded at full speed starved every other Python thread of it. A full disk,
 a failed write or the size cap ends the recording with one notice; the session goes on.
 """
 
@@ -24,6 +26,7 @@ from ..base.notices import Kind, Notice
 from ..capture.recorded import CONNECTION_TOPIC, RAW_TOPICS, connection_record
 from . import topics
 from .convert import REPEAT_EVERY, Converter
+from .duty import DutyCycle
 from .files import variant
 from .items import Event, Item, LinkOpened, Published, RawChunk
 from .mcapfile import McapFile
@@ -32,6 +35,9 @@ log = logging.getLogger(__name__)
 
 QUEUE_ITEMS = 4096
 """Items waiting for the writer; at 10 Hz status plus 10 camera frames/s that is minutes of slack."""
+QUEUE_BYTES = 32 << 20
+"""…and at most this many bytes of raw chunks among them: a flood's 64 KB reads filled 4 096 items
+with 256 MB while the writer kept to its share of the CPU."""
 FLUSH_SECONDS = 1.0
 """A chunk is closed (and handed to the OS) at least this often: a crash loses at most this much."""
 SYNC_SECONDS = 5.0
@@ -53,6 +59,7 @@ class Limits:
     flush_seconds: float = FLUSH_SECONDS
     sync_seconds: float = SYNC_SECONDS
     queue_items: int = QUEUE_ITEMS
+    queue_bytes: int = QUEUE_BYTES
 
 
 class Recording:
@@ -78,6 +85,10 @@ class Recording:
         self.prune: Callable[[], object] | None = None
         """Run on the writer thread before the file is made (forgetting old recordings)."""
         self._queue: queue.Queue[object] = queue.Queue(self.limits.queue_items)
+        self._bytes_in = 0
+        """Raw bytes queued so far (under ``_count``; the writer counts what it took in ``_bytes_out``)."""
+        self._bytes_out = 0
+        self._count = threading.Lock()
         self._ending = threading.Event()
         self._thread = threading.Thread(target=self._run, name="rtmu-recorder", daemon=True)
         self._file: McapFile | None = None
@@ -86,6 +97,8 @@ class Recording:
         self._targets: dict[int, tuple[str, int]] = {}
         self._closed = False
         self._converter = Converter()
+        self.duty = DutyCycle()
+        """Keeps the writer's share of the CPU (and of the interpreter lock) bounded (``duty``)."""
 
     # -- any thread ----------------------------------------------------------------------------
     def start(self) -> Recording:
@@ -97,11 +110,17 @@ class Recording:
         """Queue ``item`` without waiting; False (and counted) when the writer is behind or stopped."""
         if self.stopped is not None or self._ending.is_set():
             return False
-        try:
-            self._queue.put_nowait(item)
-        except queue.Full:
-            self.dropped += 1
-            return False
+        size = len(item.data) if isinstance(item, RawChunk) else 0
+        with self._count:
+            if size and self._bytes_in - self._bytes_out + size > self.limits.queue_bytes:
+                self.dropped += 1
+                return False
+            try:
+                self._queue.put_nowait(item)
+            except queue.Full:
+                self.dropped += 1
+                return False
+            self._bytes_in += size
         return True
 
     def end(self) -> None:
@@ -143,7 +162,11 @@ class Recording:
                 continue
             wrote = self.stopped is None and item is not None
             if wrote:
+                started = time.thread_time()
                 self._write(file, item)  # type: ignore[arg-type]
+                rest = self.duty.worked(time.thread_time() - started)
+                if rest and not self._ending.is_set():  # (closing drains at full speed)
+                    self._ending.wait(rest)
             if self.stopped is not None:
                 self._finish(file)  # keep what was written readable at once; drain the rest
                 continue
@@ -198,6 +221,8 @@ class Recording:
 
     def _write(self, file: McapFile, item: Item) -> None:
         if isinstance(item, RawChunk):
+            with self._count:
+                self._bytes_out += len(item.data)
             if item.conn != self._conn and item.conn in self._targets:  # another connection's chunks
                 self._conn = item.conn
                 host, port = self._targets[item.conn]

@@ -347,7 +347,10 @@ async def serve(cfg) -> int:
             file=sys.stderr,
         )
         return EXIT_CANNOT_LISTEN
+    from ..base.heap import settle
     from ..sim.files_folder import files_folder
+
+    settle()  # the world and map are built: later full collections do not walk them (base.heap)
 
     files = files_folder(server)
     served = Said(N_("map {path}"), path=str(cfg.map_path)) if cfg.map_path else Said(N_("no map"))
@@ -400,6 +403,9 @@ async def serve_fleet(cfg, count: int) -> int:
     except OSError as exc:
         print(_("rtmu sim: cannot listen: {value}").format(value=exc.strerror or exc), file=sys.stderr)
         return EXIT_CANNOT_LISTEN
+    from ..base.heap import settle
+
+    settle()  # every robot's world and map are built (base.heap)
     for robot, server in zip(fleet.robots, fleet.servers, strict=True):
         x, y, th = server.home
         line = Said(

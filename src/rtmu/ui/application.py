@@ -28,6 +28,7 @@ import gi
 gi.require_version("Gtk", "4.0")
 from gi.repository import Gio, GLib, Gtk  # noqa: E402
 
+from ..base.heap import settle  # noqa: E402
 from ..base.i18n import N_, _  # noqa: E402
 from ..client.mapcache import SharedMaps  # noqa: E402
 from ..client.roster import RobotEndpoint, Roster  # noqa: E402
@@ -57,6 +58,8 @@ from .window import MainWindow  # noqa: E402
 
 RUNNER_CLOSE_TIMEOUT = 1.5
 SUSPEND_STOP_TIMEOUT = 0.5
+SETTLE_AFTER_MS = 3000
+"""The window's start-up objects are settled (``base.heap``) this long after it is first shown."""
 """How long Ctrl+Z (SIGTSTP) waits for the stop to leave the process before the process freezes anyway."""
 GLIB_SIGNALS = (signal.SIGINT, signal.SIGTERM, signal.SIGHUP, signal.SIGUSR1, signal.SIGUSR2)
 """Signals GLib's main loop can watch (``GLib.unix_signal_add``); the others are handled in Python."""
@@ -138,6 +141,12 @@ class RtmuApplication(Gtk.Application):
             self._old_handlers[signum] = signal.signal(signum, self._on_python_signal)
         # Ctrl+Z freezes the process, network thread included: stop the robot before that happens.
         self._old_sigtstp = signal.signal(signal.SIGTSTP, self._on_suspend)
+
+    def _settle_heap(self) -> bool:
+        """Once the window is built and shown: later full collections skip what it built (``base.heap``),
+        so one does not hold every thread — the network loop's stops too — for 100 ms and more."""
+        settle()
+        return False
 
     def do_activate(self) -> None:
         if self.window is not None:
@@ -227,6 +236,7 @@ class RtmuApplication(Gtk.Application):
         if self.options.fullscreen:
             window.fullscreen()
         window.present()
+        GLib.timeout_add(SETTLE_AFTER_MS, self._settle_heap)
         if loaded.warning:
             window.banners.tell("notice:settings", "warning", loaded.warning, timeout=10.0)
         for note in self._fleet_notes:
