@@ -84,10 +84,14 @@ class StatusFeed(Feed):
     async def _ask_battery_info(self, client: AriaClient, timeout: float) -> bytes:
         """``batteryInfo``'s reply, asked again after a timeout (a busy robot or laptop): an LD robot's
         state of charge shown as volts until the link ends is worse than a number shown late."""
-        for _attempt in range(BATTERY_INFO_ATTEMPTS - 1):
-            with contextlib.suppress(ClientTimeout):
+        left = BATTERY_INFO_ATTEMPTS
+        while True:
+            try:
                 return (await client.request_once("batteryInfo", timeout=timeout)).payload
-        return (await client.request_once("batteryInfo", timeout=timeout)).payload
+            except ClientTimeout:
+                left -= 1
+                if not left:
+                    raise
 
     async def _refresh_safe_drive(self, client: AriaClient) -> None:
         reply = await client.request_once("getSafeDrive", timeout=self.ctx.config.reply_timeout)
