@@ -8,6 +8,7 @@ from dataclasses import dataclass
 import pytest
 
 from rtmu.control.commands import COMMANDS
+from rtmu.control.key_rules import KeyAction, stop_key_action
 from rtmu.ui.keys import KeyRouter, bindings
 from rtmu.ui.keys_sheet import GROUP_ORDER, KeySheet, count_note, key_caps
 
@@ -66,7 +67,9 @@ def test_stop_comes_first_then_driving_and_groups_keep_their_order() -> None:
     sheet = KeySheet.of(bindings())
     assert sheet.groups[:2] == ("STOP", "Driving")
     stop = sheet.rows[0]
-    assert stop.title == "Stop" and stop.chords == (("Space",), ("Keypad 5",))
+    assert stop.title == "Stop" and stop.chords == (("Space",), ("Keypad 5",), ("Ctrl", "Space"))
+    ctrl_space = stop_key_action("space", ctrl=True, in_text=True)
+    assert ctrl_space is KeyAction.STOP, "the sheet lists Ctrl+Space because the stop-key rule stops on it"
     known = [g for g in sheet.groups if g in GROUP_ORDER]
     assert known == sorted(known, key=GROUP_ORDER.index)
     rows = KeySheet.of([Entry(("x",), "Odd one", "Elsewhere"), Entry(("space",), "Stop", "STOP")]).rows
@@ -123,7 +126,7 @@ def test_in_german_the_words_and_the_key_names_are_german(german: None) -> None:
     sheet = KeySheet.of(bindings())
     assert sheet.groups[:2] == ("STOPP", "Fahren")
     stop = sheet.rows[0]
-    assert stop.chords == (("Leertaste",), ("Ziffernblock 5",))
+    assert stop.chords == (("Leertaste",), ("Ziffernblock 5",), ("Strg", "Leertaste"))
     zoom = next(r for r in sheet.rows if r.accels[0] == "<Control>plus")
     assert zoom.chords[0] == ("Strg", "+") and zoom.title == "Vergrößern"
     assert key_caps("<Shift>Page_Up") == ("Umschalt", "Bild ↑")

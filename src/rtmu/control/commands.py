@@ -221,7 +221,8 @@ class DriveRight(_HeldDrive):
 class Stop(Command):
     name = "stop"
     label = N_("Stop")
-    keys = ("space", "KP_5")
+    keys = ("space", "KP_5", "<Control>space")
+    """Ctrl+Space stops too, in a text field as well (``key_rules``); listed so the keys window says so."""
     group = "STOP"
     needs = (("stop", "ratioDrive"),)
 
