@@ -12,3 +12,9 @@ import os
 
 _ON_CI = os.environ.get("CI", "").lower() in ("true", "1")
 PATIENCE = float(os.environ.get("RTMU_TEST_PATIENCE") or (3.0 if _ON_CI else 1.0))
+
+
+def cli_timeout(seconds: float) -> str:
+    """A CLI's ``--timeout`` argument given as a generous bound (not a timeout the test waits for),
+    with the suite's patience: a reply the busy machine sends late is still a reply."""
+    return f"{seconds * PATIENCE:g}"

@@ -19,6 +19,7 @@ from pathlib import Path
 
 import pytest
 
+from patience import cli_timeout
 from rtmu.base import exit_codes
 from rtmu.base.exit_codes import (
     EXIT_BAD_FILE,
@@ -134,11 +135,15 @@ def test_a_server_that_never_answers_is_a_timeout(name: str, tmp_path: Path) -> 
 
 def test_server_side_failures_have_their_codes(sim: SimThread, tmp_path: Path) -> None:
     where = f"127.0.0.1:{sim.port}"
-    check("routes", run("routes", where, "--timeout", "5"), EXIT_UNSUPPORTED)  # an LD robot's data
-    check("goto", run("goto", where, "Nowhere", "--timeout", "5"), EXIT_USAGE)  # not a goal of the map
-    refused = run("config", where, "--set", "Teleop/Timeout=-1", "--timeout", "5")
+    check("routes", run("routes", where, "--timeout", cli_timeout(5)), EXIT_UNSUPPORTED)  # an LD robot's data
+    check(
+        "goto", run("goto", where, "Nowhere", "--timeout", cli_timeout(5)), EXIT_USAGE
+    )  # not a goal of the map
+    refused = run("config", where, "--set", "Teleop/Timeout=-1", "--timeout", cli_timeout(5))
     check("config", refused, EXIT_REFUSED)
-    check("ptz", run("ptz", where, "--pan", "200", "--timeout", "5"), EXIT_USAGE)  # the head's own limits
+    check(
+        "ptz", run("ptz", where, "--pan", "200", "--timeout", cli_timeout(5)), EXIT_USAGE
+    )  # the head's own limits
     check("status", run("status", where, "--interval", "5"), EXIT_USAGE)
     check("image", run("image", where, "--out", str(tmp_path / "x.jpg"), "--quality", "0"), EXIT_USAGE)
 
@@ -147,50 +152,66 @@ def test_the_commissioning_and_console_commands_failures(sim: SimThread, tmp_pat
     """files, scan, mapedit, config's care and call: each failure has the code its help lists."""
     where = f"127.0.0.1:{sim.port}"
     missing = ["get", "no/such.txt", "--out", str(tmp_path / "x.bin")]
-    check("files", run("files", where, *missing, "--timeout", "5"), EXIT_REFUSED)  # the robot's words
+    check(
+        "files", run("files", where, *missing, "--timeout", cli_timeout(5)), EXIT_REFUSED
+    )  # the robot's words
     assert not (tmp_path / "x.bin").exists()
-    check("files", run("files", where, "ls", "../etc", "--timeout", "5"), EXIT_USAGE)  # before connecting
-    check("files", run("files", where, "rm", "x.txt", "--timeout", "5"), EXIT_USAGE)  # no --yes, no terminal
-    check("scan", run("scan", where, "stop", "--timeout", "5"), EXIT_REFUSED)  # no scan is running
-    check("scan", run("scan", where, "loop", "start", "--timeout", "5"), EXIT_REFUSED)
-    check("mapedit", run("mapedit", where, "--remove", "No Such Goal", "--timeout", "5"), EXIT_USAGE)
-    check("mapedit", run("mapedit", where, "--add-goal", "X", "--timeout", "5"), EXIT_USAGE)  # no --x --y
-    check("config", run("config", where, "--reset", "No/Such", "--timeout", "5"), EXIT_USAGE)
-    check("call", run("call", where, "noSuchData", "--timeout", "5"), EXIT_USAGE)
-    check("call", run("call", where, "gotoGoal", "Goal", "--timeout", "5"), EXIT_USAGE)  # needs --yes
-    check("call", run("call", where, "updateNumbers", "--timeout", "5"), EXIT_OK)
+    check(
+        "files", run("files", where, "ls", "../etc", "--timeout", cli_timeout(5)), EXIT_USAGE
+    )  # before connecting
+    check(
+        "files", run("files", where, "rm", "x.txt", "--timeout", cli_timeout(5)), EXIT_USAGE
+    )  # no --yes, no terminal
+    check("scan", run("scan", where, "stop", "--timeout", cli_timeout(5)), EXIT_REFUSED)  # no scan is running
+    check("scan", run("scan", where, "loop", "start", "--timeout", cli_timeout(5)), EXIT_REFUSED)
+    check(
+        "mapedit", run("mapedit", where, "--remove", "No Such Goal", "--timeout", cli_timeout(5)), EXIT_USAGE
+    )
+    check(
+        "mapedit", run("mapedit", where, "--add-goal", "X", "--timeout", cli_timeout(5)), EXIT_USAGE
+    )  # no --x --y
+    check("config", run("config", where, "--reset", "No/Such", "--timeout", cli_timeout(5)), EXIT_USAGE)
+    check("call", run("call", where, "noSuchData", "--timeout", cli_timeout(5)), EXIT_USAGE)
+    check(
+        "call", run("call", where, "gotoGoal", "Goal", "--timeout", cli_timeout(5)), EXIT_USAGE
+    )  # needs --yes
+    check("call", run("call", where, "updateNumbers", "--timeout", cli_timeout(5)), EXIT_OK)
 
 
 def test_why_and_a_drive_that_did_not_move_exit_with_the_causes_code(tmp_path: Path) -> None:
     """Asked to move and not moved is never 0: the cause's code, each one its help lists."""
     with SimThread(SimConfig(port=0, map_path=ARENA)) as sim:
         where = f"127.0.0.1:{sim.port}"
-        check("why", run("why", where, "--timeout", "5"), EXIT_OK)
+        check("why", run("why", where, "--timeout", cli_timeout(5)), EXIT_OK)
         check(
             "drive",
-            run("drive", where, "--trans", "5", "--seconds", "0.3", "--timeout", "5"),
+            run("drive", where, "--trans", "5", "--seconds", "0.3", "--timeout", cli_timeout(5)),
             EXIT_WHY_DEAD_ZONE,
         )
-        check("run", run("run", where, "SimulatorStallMotors", "--timeout", "5"), EXIT_OK)
+        check("run", run("run", where, "SimulatorStallMotors", "--timeout", cli_timeout(5)), EXIT_OK)
         check(
             "drive",
-            run("drive", where, "--trans", "50", "--seconds", "0.3", "--timeout", "5"),
+            run("drive", where, "--trans", "50", "--seconds", "0.3", "--timeout", cli_timeout(5)),
             EXIT_WHY_STALLED,
         )
-        check("run", run("run", where, "SimulatorClearStall", "--timeout", "5"), EXIT_OK)
-        check("run", run("run", where, "SimulatorEStop", "--timeout", "5"), EXIT_OK)
-        check("why", run("why", where, "--timeout", "5"), EXIT_WHY_ESTOP)
-        check("doctor", run("doctor", where, "--timeout", "5"), EXIT_WHY_ESTOP)  # its last step asks why
+        check("run", run("run", where, "SimulatorClearStall", "--timeout", cli_timeout(5)), EXIT_OK)
+        check("run", run("run", where, "SimulatorEStop", "--timeout", cli_timeout(5)), EXIT_OK)
+        check("why", run("why", where, "--timeout", cli_timeout(5)), EXIT_WHY_ESTOP)
+        check(
+            "doctor", run("doctor", where, "--timeout", cli_timeout(5)), EXIT_WHY_ESTOP
+        )  # its last step asks why
 
 
 def test_an_ld_robots_configuration_and_camera(tmp_path: Path) -> None:
     """An Omron LD robot (aram): a configuration RTMU cannot edit yet is 18, no camera is 4."""
     with SimThread(SimConfig(port=0, map_path=ARENA, profile="aram")) as aram:
         where = f"127.0.0.1:{aram.port}"
-        check("config", run("config", where, "--timeout", "5"), EXIT_FOREIGN_CONFIG)
-        check("config", run("config", where, "--defaults", "--timeout", "5"), EXIT_FOREIGN_CONFIG)
-        check("video", run("video", where, "--seconds", "1", "--timeout", "5"), EXIT_UNSUPPORTED)
-        check("scan", run("scan", where, "loop", "start", "--timeout", "5"), EXIT_UNSUPPORTED)  # not on 6MTX
+        check("config", run("config", where, "--timeout", cli_timeout(5)), EXIT_FOREIGN_CONFIG)
+        check("config", run("config", where, "--defaults", "--timeout", cli_timeout(5)), EXIT_FOREIGN_CONFIG)
+        check("video", run("video", where, "--seconds", "1", "--timeout", cli_timeout(5)), EXIT_UNSUPPORTED)
+        check(
+            "scan", run("scan", where, "loop", "start", "--timeout", cli_timeout(5)), EXIT_UNSUPPORTED
+        )  # not on 6MTX
 
 
 def test_files_named_on_the_command_line(tmp_path: Path) -> None:

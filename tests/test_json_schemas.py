@@ -22,6 +22,7 @@ from pathlib import Path
 import jsonschema
 import pytest
 
+from patience import cli_timeout
 from rtmu.base.exit_codes import EXIT_REFUSED, EXIT_WHY_NO_DRIVE
 from rtmu.cli import actions_of, build_parser
 from rtmu.package_data import project_map
@@ -85,7 +86,7 @@ def sims() -> Iterator[dict[str, SimThread]]:
 
 def rtmu(sim: SimThread, name: str, *argv: str) -> subprocess.CompletedProcess[str]:
     return subprocess.run(
-        [*RTMU, name, f"127.0.0.1:{sim.port}", *argv, "--json", "--timeout", "5"],
+        [*RTMU, name, f"127.0.0.1:{sim.port}", *argv, "--json", "--timeout", cli_timeout(5)],
         capture_output=True,
         text=True,
         timeout=120,
@@ -235,7 +236,7 @@ def test_config_care_lines(tmp_path: Path) -> None:
 def test_an_interrupted_navigation_ends_with_its_outcome_line(sims: dict[str, SimThread]) -> None:
     sim = sims["aram"]
     proc = subprocess.Popen(
-        [*RTMU, "goto", f"127.0.0.1:{sim.port}", "Corridor End", "--json", "--timeout", "5"],
+        [*RTMU, "goto", f"127.0.0.1:{sim.port}", "Corridor End", "--json", "--timeout", cli_timeout(5)],
         stdout=subprocess.PIPE,
         stderr=subprocess.PIPE,
         text=True,
@@ -259,7 +260,7 @@ def test_an_interrupted_navigation_ends_with_its_outcome_line(sims: dict[str, Si
 def test_fleet_json_follows_its_schema() -> None:
     with CentralThread(robots=2) as fleet:
         done = subprocess.run(
-            [*RTMU, "fleet", f"127.0.0.1:{fleet.port}", "--json", "--timeout", "5"],
+            [*RTMU, "fleet", f"127.0.0.1:{fleet.port}", "--json", "--timeout", cli_timeout(5)],
             capture_output=True,
             text=True,
             timeout=60,

@@ -13,6 +13,7 @@ from pathlib import Path
 
 import pytest
 
+from patience import cli_timeout
 from rtmu.base.exit_codes import EXIT_OK
 from rtmu.cli import main
 from rtmu.mapfile import read_map, write_map
@@ -113,7 +114,7 @@ def test_an_ex4_map_downloads_from_the_simulator(
 ) -> None:
     out = tmp_path / "down.map"
     with SimThread(SimConfig(port=0, map_path=ex4_file, profile=profile)) as sim:
-        args = ["map", f"127.0.0.1:{sim.port}", "--out", str(out), "--timeout", "10"]
+        args = ["map", f"127.0.0.1:{sim.port}", "--out", str(out), "--timeout", cli_timeout(10)]
         assert main([*args, "--text"] if text else args) == EXIT_OK
     data = read_map(out)
     if text or profile == "aram":

@@ -14,6 +14,7 @@ import pytest
 from client.servers import SPECS, ServerThread, TestServer
 from client.test_connection import free_port
 from client.uiqueue import eventually
+from patience import cli_timeout
 from rtmu import mapfile as maps
 from rtmu.base.exit_codes import (
     EXIT_CONNECTION,
@@ -49,7 +50,7 @@ def addr(sim: SimThread) -> str:
 
 
 def login(sim: SimThread, pwfile: Path) -> list[str]:
-    return [addr(sim), "--user", "alice", "--password-file", str(pwfile), "--timeout", "5"]
+    return [addr(sim), "--user", "alice", "--password-file", str(pwfile), "--timeout", cli_timeout(5)]
 
 
 def test_host_port_forms() -> None:
@@ -224,7 +225,7 @@ def test_a_web_server_is_named_with_3_not_timed_out(capsys: pytest.CaptureFixtur
     thread = threading.Thread(target=serve, daemon=True)
     thread.start()
     try:
-        assert main(["probe", f"127.0.0.1:{port}", "--timeout", "30"]) == EXIT_CONNECTION
+        assert main(["probe", f"127.0.0.1:{port}", "--timeout", cli_timeout(30)]) == EXIT_CONNECTION
     finally:
         thread.join(5)
         for conn in held:

@@ -13,6 +13,7 @@ from pathlib import Path
 
 import pytest
 
+from patience import cli_timeout
 from rtmu.base import i18n
 from rtmu.base.exit_codes import EXIT_USAGE
 from rtmu.cli import main
@@ -41,13 +42,13 @@ def test_doctor_reads_german_and_its_json_stays_english(
     sim: SimThread, german: None, capsys: pytest.CaptureFixture[str]
 ) -> None:
     where = f"127.0.0.1:{sim.port}"
-    main(["doctor", where, "--timeout", "5", "--link-seconds", "0"])
+    main(["doctor", where, "--timeout", cli_timeout(5), "--link-seconds", "0"])
     out = capsys.readouterr().out
     assert f"TCP-Verbindung: verbunden mit {where} in " in out, out
     assert "Vorstellung des Servers: ein ArNetworking-Server" in out, out
     assert re.search(r"erster Status: Roboter bei \(-?[\d.]+; -?[\d.]+\) mm, -?\d+°, Akku \d+,\d V", out), out
     assert "connected to" not in out and "robot at" not in out, out
-    main(["doctor", where, "--timeout", "5", "--link-seconds", "0", "--json"])
+    main(["doctor", where, "--timeout", cli_timeout(5), "--link-seconds", "0", "--json"])
     report = json.loads(capsys.readouterr().out)
     steps = {s["step"]: s for s in report["steps"]}
     assert steps["tcp"]["title"] == "TCP connection"
@@ -61,10 +62,10 @@ def test_status_line_reads_german_and_json_keeps_plain_numbers(
     sim: SimThread, german: None, capsys: pytest.CaptureFixture[str]
 ) -> None:
     where = f"127.0.0.1:{sim.port}"
-    assert main(["status", where, "--once", "--timeout", "5"]) == 0
+    assert main(["status", where, "--once", "--timeout", cli_timeout(5)]) == 0
     line = capsys.readouterr().out
     assert re.search(r"Akku=\d+,\d V", line), line
-    assert main(["status", where, "--once", "--timeout", "5", "--json"]) == 0
+    assert main(["status", where, "--once", "--timeout", cli_timeout(5), "--json"]) == 0
     obj = json.loads(capsys.readouterr().out.splitlines()[-1])
     assert isinstance(obj["battery_v"], float | int) and isinstance(obj["x"], int)
 
@@ -75,16 +76,16 @@ def test_why_reads_german_with_its_numbers_and_its_json_stays_english(
     """A drive inside ARIA's dead zone: its sentence carries percentages, said as German writes them."""
     with SimThread(SimConfig(port=0, map_path=project_map("office.map"))) as sim:
         where = f"127.0.0.1:{sim.port}"
-        main(["drive", where, "--trans", "2.5", "--seconds", "0.3", "--timeout", "5"])
+        main(["drive", where, "--trans", "2.5", "--seconds", "0.3", "--timeout", cli_timeout(5)])
         err = capsys.readouterr().err
         assert "Totzone" in err and "2,5 %" in err, err
-        main(["run", where, "SimulatorEStop", "--timeout", "5"])
+        main(["run", where, "SimulatorEStop", "--timeout", cli_timeout(5)])
         capsys.readouterr()
-        main(["why", where, "--timeout", "5"])
+        main(["why", where, "--timeout", cli_timeout(5)])
         out = capsys.readouterr().out
         assert "der Not-Halt des Roboters ist gedrückt (der Server sagt" in out, out
         assert "  was zu tun ist: " in out, out
-        main(["why", where, "--timeout", "5", "--json"])
+        main(["why", where, "--timeout", cli_timeout(5), "--json"])
         answer = json.loads(capsys.readouterr().out)
         assert answer["reasons"][0]["problem"].startswith("the robot's e-stop is pressed (the server says")
 
@@ -95,7 +96,7 @@ def test_a_refused_connection_is_said_in_german(german: None, capsys: pytest.Cap
     with socket.socket() as s:  # a port nothing listens on: bound, never listening
         s.bind(("127.0.0.1", 0))
         port = s.getsockname()[1]
-        assert main(["status", f"127.0.0.1:{port}", "--once", "--timeout", "5"]) != 0
+        assert main(["status", f"127.0.0.1:{port}", "--once", "--timeout", cli_timeout(5)]) != 0
     err = capsys.readouterr().err
     assert f"Verbindung von 127.0.0.1:{port} abgelehnt (läuft der Roboterserver an diesem Port?)" in err, err
 
@@ -136,7 +137,7 @@ def test_a_navigation_outcome_reads_german_and_its_json_stays_english(
         assert sim.server is not None
         sim.call(sim.server.lose_localization)
         where = f"127.0.0.1:{sim.port}"
-        argv = ["goto", where, "Room 101", "--timeout", "5", "--limit", "60"]
+        argv = ["goto", where, "Room 101", "--timeout", cli_timeout(5), "--limit", "60"]
         assert main(argv) == EXIT_NAV_LOST
         err = capsys.readouterr().err
         said = "rtmu goto: Failed to get to Room 101 (Grund: der Roboter hat seine Position verloren)"
@@ -144,7 +145,9 @@ def test_a_navigation_outcome_reads_german_and_its_json_stays_english(
         assert main([*argv, "--json"]) == EXIT_NAV_LOST
         last = json.loads(capsys.readouterr().out.splitlines()[-1])
         assert last["outcome"] == "failed" and last["reason"] == "the robot is lost", last
-        assert main(["localize", where, "2500", "6000", "0", "--timeout", "5", "--limit", "60"]) == 0
+        assert (
+            main(["localize", where, "2500", "6000", "0", "--timeout", cli_timeout(5), "--limit", "60"]) == 0
+        )
         out = capsys.readouterr().out.splitlines()
         assert re.fullmatch(r"lokalisiert \(Wert 0,\d\d\)", out[-1]), out
 
@@ -193,12 +196,12 @@ def test_watch_reads_german_with_the_servers_words_as_sent(
     world = sim.server.world  # type: ignore[union-attr]
     sim.call(lambda: world.create_popup("Door open", "Close the door", kind=2, buttons=("OK", "", "")))
     where = f"127.0.0.1:{sim.port}"
-    assert main(["watch", where, "--seconds", "0.5", "--timeout", "5"]) == 0
+    assert main(["watch", where, "--seconds", "0.5", "--timeout", cli_timeout(5)]) == 0
     out = capsys.readouterr().out
     assert re.search(r"Meldung geöffnet #\d+ \(Warnung\) Door open: Close the door \[OK\]", out), out
     assert re.search(r"^ +\d+,\d{3}  Modus ", out, re.M), out  # the time with German's decimal comma
     assert "popup opened" not in out and "mode " not in out, out
-    assert main(["watch", where, "--seconds", "0.5", "--timeout", "5", "--json"]) == 0
+    assert main(["watch", where, "--seconds", "0.5", "--timeout", cli_timeout(5), "--json"]) == 0
     events = [json.loads(line) for line in capsys.readouterr().out.splitlines()]
     assert {"popup_opened", "mode"} <= {e["event"] for e in events}
 
@@ -268,7 +271,16 @@ def test_the_guardians_refusal_reaches_the_operator_in_german(
     """The guardian is a process of its own: it speaks the language chosen here (``child_environment``),
     its refusal and the server's own words inside RTMU's German warning."""
     with SimThread(SimConfig(port=0, seed=1, max_clients=1)) as sim:  # the drive's own login takes the slot
-        argv = ["drive", f"127.0.0.1:{sim.port}", "--trans", "50", "--seconds", "0.3", "--timeout", "5"]
+        argv = [
+            "drive",
+            f"127.0.0.1:{sim.port}",
+            "--trans",
+            "50",
+            "--seconds",
+            "0.3",
+            "--timeout",
+            cli_timeout(5),
+        ]
         assert main(argv) == 0
     err = capsys.readouterr().err
     assert (
@@ -291,10 +303,10 @@ def test_an_unknown_goal_and_a_wrong_usage_are_said_in_german(
     sim: SimThread, german: None, capsys: pytest.CaptureFixture[str]
 ) -> None:
     where = f"127.0.0.1:{sim.port}"
-    assert main(["goto", where, "Nowhere", "--timeout", "5"]) == EXIT_USAGE
+    assert main(["goto", where, "Nowhere", "--timeout", cli_timeout(5)]) == EXIT_USAGE
     err = capsys.readouterr().err
     assert "rtmu goto: kein Ziel 'Nowhere' auf diesem Server (Ziele: " in err and "Room 101" in err, err
-    assert main(["goto", where, "Lab B", "--x", "1", "--y", "2", "--timeout", "5"]) == EXIT_USAGE
+    assert main(["goto", where, "Lab B", "--x", "1", "--y", "2", "--timeout", cli_timeout(5)]) == EXIT_USAGE
     assert "entweder ZIEL oder --x/--y angeben, nicht beides" in capsys.readouterr().err
 
 

@@ -14,6 +14,7 @@ import pytest
 
 from client.navsim import fast_sim, reset, robot
 from client.uiqueue import eventually
+from patience import cli_timeout
 from rtmu.base.exit_codes import EXIT_DOCTOR_STATUS, EXIT_LOST, EXIT_OK, EXIT_UNSUPPORTED, EXIT_USAGE
 from rtmu.cli import main
 from rtmu.sim import SimThread
@@ -32,13 +33,17 @@ def test_goal_route_and_command_names_compare_case_insensitively(
 ) -> None:
     where = f"127.0.0.1:{aram.port}"
     reset(aram)
-    assert main(["goto", where, "room 101", "--json", "--timeout", "5", "--limit", "60"]) == EXIT_OK
+    assert (
+        main(["goto", where, "room 101", "--json", "--timeout", cli_timeout(5), "--limit", "60"]) == EXIT_OK
+    )
     last = json.loads(capsys.readouterr().out.splitlines()[-1])
     assert last["outcome"] == "arrived" and last["text"] == "Arrived at Room 101"  # the map's spelling
-    assert main(["patrol", where, "NIGHT PATROL", "--timeout", "5"]) == EXIT_OK
+    assert main(["patrol", where, "NIGHT PATROL", "--timeout", cli_timeout(5)]) == EXIT_OK
     assert ld_state(aram.server).patrols[-1] == "Night patrol"  # type: ignore[arg-type]
-    assert main(["run", where, "resettripodometer", "--timeout", "5"]) == EXIT_OK
-    assert main(["goto", where, "room 1O1", "--timeout", "5"]) == EXIT_USAGE  # still refused when absent
+    assert main(["run", where, "resettripodometer", "--timeout", cli_timeout(5)]) == EXIT_OK
+    assert (
+        main(["goto", where, "room 1O1", "--timeout", cli_timeout(5)]) == EXIT_USAGE
+    )  # still refused when absent
     assert "no goal 'room 1O1'" in capsys.readouterr().err
     eventually(lambda: robot(aram).status != "", timeout=5)
 
@@ -46,11 +51,11 @@ def test_goal_route_and_command_names_compare_case_insensitively(
 def test_status_and_doctor_name_a_central_server(capsys: pytest.CaptureFixture[str]) -> None:
     with CentralThread(robots=1) as fleet:
         where = f"127.0.0.1:{fleet.port}"
-        assert main(["status", where, "--once", "--timeout", "5"]) == EXIT_UNSUPPORTED
+        assert main(["status", where, "--once", "--timeout", cli_timeout(5)]) == EXIT_UNSUPPORTED
         err = capsys.readouterr().err
         assert "ARIA's central server" in err and f"rtmu fleet {where}" in err and "--robot NAME" in err
         assert "offers no robot status" not in err
-        assert main(["doctor", where, "--timeout", "5"]) == EXIT_DOCTOR_STATUS
+        assert main(["doctor", where, "--timeout", cli_timeout(5)]) == EXIT_DOCTOR_STATUS
         out = capsys.readouterr().out
         assert "ARIA's central server" in out and "rtmu --central" in out
 
@@ -59,8 +64,8 @@ def test_dock_after_a_goto_on_an_ld_robot_ends_docked_not_at_the_limit(aram: Sim
     """The status still reads "Arrived at …" while dockInfo says Docked: the dock state answers."""
     where = f"127.0.0.1:{aram.port}"
     reset(aram)
-    assert main(["goto", where, "Room 101", "--timeout", "5", "--limit", "60"]) == EXIT_OK
-    assert main(["dock", where, "--timeout", "5", "--limit", "60"]) == EXIT_OK
+    assert main(["goto", where, "Room 101", "--timeout", cli_timeout(5), "--limit", "60"]) == EXIT_OK
+    assert main(["dock", where, "--timeout", cli_timeout(5), "--limit", "60"]) == EXIT_OK
     snap = robot(aram)
     assert aram.call(lambda: aram.server.world.dock_mode.state.name) == "DOCKED"  # type: ignore[union-attr]
     assert abs(snap.x - 800) < 300 and abs(snap.y - 6000) < 300, "it drove to the charger"
@@ -70,10 +75,10 @@ def test_an_ld_robots_patrol_and_route_goal_drive_it(aram: SimThread) -> None:
     where = f"127.0.0.1:{aram.port}"
     reset(aram)
     before = robot(aram)
-    assert main(["patrol", where, "Loop", "--timeout", "5"]) == EXIT_OK
+    assert main(["patrol", where, "Loop", "--timeout", cli_timeout(5)]) == EXIT_OK
     eventually(lambda: robot(aram).status.startswith("Touring to"), timeout=10)
     eventually(lambda: abs(robot(aram).x - before.x) + abs(robot(aram).y - before.y) > 500, timeout=30)
-    assert main(["goto", where, "Lab A", "--route", "--timeout", "5"]) == EXIT_OK
+    assert main(["goto", where, "Lab A", "--route", "--timeout", cli_timeout(5)]) == EXIT_OK
     eventually(lambda: robot(aram).status == "Arrived at Lab A", timeout=60)
 
 
@@ -81,7 +86,7 @@ def test_localizing_off_the_map_leaves_the_robot_lost_where_it_was(aram: SimThre
     where = f"127.0.0.1:{aram.port}"
     reset(aram)
     before = robot(aram)
-    code = main(["localize", where, "999999", "999999", "0", "--timeout", "5", "--limit", "30"])
+    code = main(["localize", where, "999999", "999999", "0", "--timeout", cli_timeout(5), "--limit", "30"])
     assert code == EXIT_LOST
     after = robot(aram)
     assert (after.x, after.y) == (before.x, before.y), "not teleported off the map"

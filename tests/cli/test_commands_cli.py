@@ -9,6 +9,7 @@ import time
 import pytest
 
 from client.servers import SPECS, ServerThread, TestServer
+from patience import cli_timeout
 from rtmu.base.exit_codes import EXIT_OK, EXIT_TIMEOUT, EXIT_UNSUPPORTED, EXIT_USAGE
 from rtmu.cli import main
 from rtmu.client.health import PING_CANDIDATES
@@ -26,13 +27,13 @@ def addr(port: int) -> str:
 def test_commands_lists_names_descriptions_and_which_take_an_argument(
     sim: SimThread, capsys: pytest.CaptureFixture[str]
 ) -> None:
-    assert main(["commands", addr(sim.port), "--timeout", "5"]) == EXIT_OK
+    assert main(["commands", addr(sim.port), "--timeout", cli_timeout(5)]) == EXIT_OK
     lines = capsys.readouterr().out.splitlines()
     battery = next(line for line in lines if line.startswith("SimulatorSetBattery"))
     assert " ARG " in battery and "battery voltage" in battery
     reset = next(line for line in lines if line.startswith("ResetTripOdometer"))
     assert " ARG " not in reset
-    assert main(["commands", addr(sim.port), "--json", "--timeout", "5"]) == EXIT_OK
+    assert main(["commands", addr(sim.port), "--json", "--timeout", cli_timeout(5)]) == EXIT_OK
     listed = {c["name"]: c for c in json.loads(capsys.readouterr().out)}
     assert listed["SimulatorSetBattery"]["argument"] is True
     assert listed["ResetTripOdometer"] == {
@@ -43,10 +44,14 @@ def test_commands_lists_names_descriptions_and_which_take_an_argument(
 def test_run_sends_a_string_command_and_says_it_was_taken(
     sim: SimThread, capsys: pytest.CaptureFixture[str]
 ) -> None:
-    assert main(["run", addr(sim.port), "SimulatorSetBattery", "12.25", "--timeout", "5"]) == EXIT_OK
+    assert (
+        main(["run", addr(sim.port), "SimulatorSetBattery", "12.25", "--timeout", cli_timeout(5)]) == EXIT_OK
+    )
     assert "taken by the server" in capsys.readouterr().out
     assert sim.call(lambda: sim.server.world.body.battery_v) == pytest.approx(12.25)  # type: ignore[union-attr]
-    assert main(["run", addr(sim.port), "SimulatorRecharge", "--json", "--timeout", "5"]) == EXIT_OK
+    assert (
+        main(["run", addr(sim.port), "SimulatorRecharge", "--json", "--timeout", cli_timeout(5)]) == EXIT_OK
+    )
     ran = json.loads(capsys.readouterr().out)
     assert ran == {"command": "SimulatorRecharge", "argument": None, "taken": True}
 
@@ -54,12 +59,12 @@ def test_run_sends_a_string_command_and_says_it_was_taken(
 def test_run_refuses_unknown_names_and_wrong_arguments(
     sim: SimThread, capsys: pytest.CaptureFixture[str]
 ) -> None:
-    assert main(["run", addr(sim.port), "Nope\x1b[2J", "--timeout", "5"]) == EXIT_USAGE
+    assert main(["run", addr(sim.port), "Nope\x1b[2J", "--timeout", cli_timeout(5)]) == EXIT_USAGE
     err = capsys.readouterr().err
     assert "no command" in err and "\x1b" not in err and "\\x1b" in err
-    assert main(["run", addr(sim.port), "SimulatorSetBattery", "--timeout", "5"]) == EXIT_USAGE
+    assert main(["run", addr(sim.port), "SimulatorSetBattery", "--timeout", cli_timeout(5)]) == EXIT_USAGE
     assert "takes an argument" in capsys.readouterr().err
-    assert main(["run", addr(sim.port), "SimulatorRecharge", "x", "--timeout", "5"]) == EXIT_USAGE
+    assert main(["run", addr(sim.port), "SimulatorRecharge", "x", "--timeout", cli_timeout(5)]) == EXIT_USAGE
     assert "takes no argument" in capsys.readouterr().err
 
 
@@ -81,7 +86,7 @@ def test_run_exits_5_when_the_server_stays_silent(capsys: pytest.CaptureFixture[
 
 def test_commands_exits_4_where_the_server_lists_none(capsys: pytest.CaptureFixture[str]) -> None:
     with ServerThread(TestServer()) as srv:
-        assert main(["commands", addr(srv.port), "--timeout", "5"]) == EXIT_UNSUPPORTED
+        assert main(["commands", addr(srv.port), "--timeout", cli_timeout(5)]) == EXIT_UNSUPPORTED
 
 
 def test_watch_prints_popups_mode_and_status_as_they_happen(
@@ -97,7 +102,10 @@ def test_watch_prints_popups_mode_and_status_as_they_happen(
     helper = threading.Thread(target=later)
     helper.start()
     try:
-        assert main(["watch", addr(sim.port), "--json", "--seconds", "2.5", "--timeout", "5"]) == EXIT_OK
+        assert (
+            main(["watch", addr(sim.port), "--json", "--seconds", "2.5", "--timeout", cli_timeout(5)])
+            == EXIT_OK
+        )
     finally:
         helper.join()
     out = capsys.readouterr().out
@@ -115,6 +123,6 @@ def test_watch_prints_popups_mode_and_status_as_they_happen(
 def test_watch_text_lines_escape_server_text(sim: SimThread, capsys: pytest.CaptureFixture[str]) -> None:
     world = sim.server.world  # type: ignore[union-attr]
     sim.call(lambda: world.create_popup("Bell\x07", "x", buttons=("OK", "", "")))
-    assert main(["watch", addr(sim.port), "--seconds", "0.5", "--timeout", "5"]) == EXIT_OK
+    assert main(["watch", addr(sim.port), "--seconds", "0.5", "--timeout", cli_timeout(5)]) == EXIT_OK
     out = capsys.readouterr().out
     assert "popup opened" in out and "Bell\\x07" in out and "\x07" not in out

@@ -10,6 +10,7 @@ import pytest
 
 from client.servers import SPECS, ServerThread, TestServer
 from client.uiqueue import UiQueue, eventually
+from patience import cli_timeout
 from rtmu.base.exit_codes import EXIT_CONNECTION, EXIT_OK, EXIT_UNSUPPORTED, EXIT_USAGE
 from rtmu.cli import main
 from rtmu.client.config_file import ConfigFileError, read_file
@@ -27,7 +28,7 @@ sim = simulator()
 
 
 def config(port: int, *argv: str) -> int:
-    return main(["config", f"127.0.0.1:{port}", "--timeout", "5", *argv])
+    return main(["config", f"127.0.0.1:{port}", "--timeout", cli_timeout(5), *argv])
 
 
 def test_defaults_list_only_what_differs_from_the_factory_values(

@@ -10,6 +10,7 @@ import pytest
 
 from client.servers import SPECS, ServerThread, TestServer
 from client.uiqueue import UiQueue, eventually
+from patience import cli_timeout
 from rtmu.base.exit_codes import EXIT_OK, EXIT_REFUSED, EXIT_UNSUPPORTED, EXIT_USAGE
 from rtmu.cli import main
 from rtmu.client.config_feed import MAX_TEXT, ConfigFeed, ServerConfig, check_value, fetch_config
@@ -30,7 +31,7 @@ def addr(port: int) -> str:
 
 
 def test_config_lists_sections_and_parameters(sim: SimThread, capsys: pytest.CaptureFixture[str]) -> None:
-    assert main(["config", addr(sim.port), "--timeout", "5"]) == EXIT_OK
+    assert main(["config", addr(sim.port), "--timeout", cli_timeout(5)]) == EXIT_OK
     out = capsys.readouterr().out
     assert "[Teleop]" in out and "Timeout = 2    [double 0…60, intermediate]" in out
     assert "FrameSize = 320x240    [string one of 320x240, 640x480, intermediate]" in out
@@ -40,7 +41,7 @@ def test_config_lists_sections_and_parameters(sim: SimThread, capsys: pytest.Cap
 def test_config_json_has_types_limits_and_editability(
     sim: SimThread, capsys: pytest.CaptureFixture[str]
 ) -> None:
-    assert main(["config", addr(sim.port), "--json", "--timeout", "5"]) == EXIT_OK
+    assert main(["config", addr(sim.port), "--json", "--timeout", cli_timeout(5)]) == EXIT_OK
     doc = json.loads(capsys.readouterr().out)
     assert doc["source"] == "getConfigBySectionsV4" and doc["last_editable"] == "expert"
     params = {f"{s['name']}/{p['name']}": p for s in doc["sections"] for p in s["params"]}
@@ -79,7 +80,7 @@ def test_config_set_changes_the_simulation(sim: SimThread, capsys: pytest.Captur
         0.75,
         400,
     )
-    assert main(["config", addr(sim.port), "--json", "--timeout", "5"]) == EXIT_OK
+    assert main(["config", addr(sim.port), "--json", "--timeout", cli_timeout(5)]) == EXIT_OK
     doc = json.loads(capsys.readouterr().out)
     assert doc["sections"][0]["params"][0]["value"] == 0.75
 
@@ -88,7 +89,15 @@ def test_a_refused_value_exits_6_with_the_servers_words(
     sim: SimThread, capsys: pytest.CaptureFixture[str]
 ) -> None:
     code = main(
-        ["config", addr(sim.port), "--timeout", "5", "--set", "Teleop/Timeout=1", "Camera/FrameSize=1x1"]
+        [
+            "config",
+            addr(sim.port),
+            "--timeout",
+            cli_timeout(5),
+            "--set",
+            "Teleop/Timeout=1",
+            "Camera/FrameSize=1x1",
+        ]
     )
     assert code == EXIT_REFUSED
     err = capsys.readouterr().err
@@ -97,7 +106,9 @@ def test_a_refused_value_exits_6_with_the_servers_words(
         == "rtmu config: the server refused: Camera/FrameSize: '1x1' is not one of 320x240, 640x480"
     )
     assert sim.call(lambda: sim.server.world.ratio_mode.timeout) == 2.0  # all or nothing
-    code = main(["config", addr(sim.port), "--json", "--timeout", "5", "--set", "Teleop/Timeout=-1"])
+    code = main(
+        ["config", addr(sim.port), "--json", "--timeout", cli_timeout(5), "--set", "Teleop/Timeout=-1"]
+    )
     assert code == EXIT_REFUSED
     assert json.loads(capsys.readouterr().out) == {
         "accepted": False,
@@ -109,7 +120,7 @@ def test_markup_and_control_characters_from_the_server_are_printed_harmlessly(
     capsys: pytest.CaptureFixture[str],
 ) -> None:
     with SimThread(SimConfig(port=0, config_filler=40)) as s:
-        assert main(["config", addr(s.port), "--timeout", "5"]) == EXIT_OK
+        assert main(["config", addr(s.port), "--timeout", cli_timeout(5)]) == EXIT_OK
     out = capsys.readouterr().out
     assert "[<b>Extra</b> & 0]" in out and "P1<i>&amp; = 0.1" in out  # literal, as the server sent it
 
@@ -123,9 +134,12 @@ def test_bad_assignments_fail_before_connecting(capsys: pytest.CaptureFixture[st
 
 def test_a_server_without_configuration_exits_4(capsys: pytest.CaptureFixture[str]) -> None:
     with ServerThread(TestServer()) as server:
-        assert main(["config", addr(server.port), "--timeout", "5"]) == EXIT_UNSUPPORTED
+        assert main(["config", addr(server.port), "--timeout", cli_timeout(5)]) == EXIT_UNSUPPORTED
         assert "offers no configuration" in capsys.readouterr().err
-        assert main(["config", addr(server.port), "--timeout", "5", "--set", "A/b=1"]) == EXIT_UNSUPPORTED
+        assert (
+            main(["config", addr(server.port), "--timeout", cli_timeout(5), "--set", "A/b=1"])
+            == EXIT_UNSUPPORTED
+        )
 
 
 # -- the client module on its own: big, hostile and malformed configurations -----------------------
@@ -225,7 +239,16 @@ def test_a_user_without_config_editing_is_offered_no_configuration(
     pw_bob.write_text("pw2\n")
     pw_alice.write_text("secret1\n")
     with SimThread(SimConfig(port=0, camera=False, users_path=users)) as s:
-        bob = ["config", addr(s.port), "--user", "bob", "--password-file", str(pw_bob), "--timeout", "5"]
+        bob = [
+            "config",
+            addr(s.port),
+            "--user",
+            "bob",
+            "--password-file",
+            str(pw_bob),
+            "--timeout",
+            cli_timeout(5),
+        ]
         assert main(bob) == EXIT_UNSUPPORTED
         assert main([*bob, "--set", "Teleop/Timeout=1"]) == EXIT_UNSUPPORTED
         assert s.call(lambda: s.server.world.ratio_mode.timeout) == 2.0  # type: ignore[union-attr]

@@ -8,6 +8,7 @@ import pytest
 
 from client.drawing_servers import MARKUP, MAX_POINTS_SENT, hostile_drawing_server
 from client.servers import SPECS, ServerThread, TestServer
+from patience import cli_timeout
 from rtmu.base.exit_codes import EXIT_OK, EXIT_UNSUPPORTED
 from rtmu.cli import main
 from rtmu.package_data import project_map
@@ -24,7 +25,7 @@ def test_the_simulators_sonar_and_laser_with_a_sample_each(
     sim: SimThread, capsys: pytest.CaptureFixture[str]
 ) -> None:
     target = f"127.0.0.1:{sim.port}"
-    assert main(["drawings", target, "--json", "--timeout", "5"]) == EXIT_OK
+    assert main(["drawings", target, "--json", "--timeout", cli_timeout(5)]) == EXIT_OK
     rows = {r["name"]: r for r in json.loads(capsys.readouterr().out)}
     assert set(rows) == {"sim_lms2xx_1Current", "sonarCurrent"}
     laser, sonar = rows["sim_lms2xx_1Current"], rows["sonarCurrent"]
@@ -43,7 +44,7 @@ def test_the_simulators_sonar_and_laser_with_a_sample_each(
     assert laser["refresh_ms"] == 200 and laser["visibility"] == "DefaultOn" and laser["drawn"]
     assert 0 < len(laser["points"]) <= 181 and len(sonar["points"]) <= 16
     assert all(len(p) == 2 for p in laser["points"]) and laser["error"] == ""
-    assert main(["drawings", target, "--timeout", "5"]) == EXIT_OK
+    assert main(["drawings", target, "--timeout", cli_timeout(5)]) == EXIT_OK
     lines = capsys.readouterr().out.splitlines()
     assert len(lines) == 2
     assert lines[0].startswith(

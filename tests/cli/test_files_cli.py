@@ -12,6 +12,7 @@ from pathlib import Path
 
 import pytest
 
+from patience import cli_timeout
 from rtmu.base.exit_codes import EXIT_OK, EXIT_REFUSED, EXIT_USAGE
 from rtmu.cli import main
 from rtmu.sim import SimThread
@@ -49,7 +50,7 @@ def test_ls_text_and_json(sim: SimThread, capsys: pytest.CaptureFixture[str]) ->
     assert main(["files", addr(sim), "ls"]) == EXIT_OK
     lines = capsys.readouterr().out.splitlines()
     assert lines[0].split()[0] == "-" and lines[0].endswith("maps/") and lines[1].endswith("notes.txt")
-    assert main(["files", addr(sim), "ls", "maps", "--json", "--timeout", "5"]) == EXIT_OK
+    assert main(["files", addr(sim), "ls", "maps", "--json", "--timeout", cli_timeout(5)]) == EXIT_OK
     doc = json.loads(capsys.readouterr().out)
     assert doc["folder"] == "maps" and [(e["name"], e["type"], e["size"]) for e in doc["entries"]] == [
         ("office.map", "file", 700)
@@ -155,7 +156,10 @@ def test_scan_start_status_loop_stop_download(
     assert capsys.readouterr().out == "loop end tagged '7'\n"
     down = tmp_path / "scans"
     down.mkdir()
-    assert main(["scan", addr(sim), "stop", "--download", str(down), "--json", "--timeout", "5"]) == EXIT_OK
+    assert (
+        main(["scan", addr(sim), "stop", "--download", str(down), "--json", "--timeout", cli_timeout(5)])
+        == EXIT_OK
+    )
     doc = json.loads(capsys.readouterr().out)
     assert doc["file"] == "hall.2d" and doc["downloaded"] == str(down / "hall.2d")
     assert (down / "hall.2d").read_bytes() == (robot / "hall.2d").read_bytes()

@@ -8,6 +8,7 @@ import json
 import pytest
 
 from client.uiqueue import eventually
+from patience import cli_timeout
 from rtmu.base.exit_codes import EXIT_OK, EXIT_UNSUPPORTED, EXIT_USAGE
 from rtmu.cli import main
 from rtmu.client import ld_data
@@ -37,9 +38,9 @@ def _state(sim: SimThread):  # type: ignore[no-untyped-def]
 
 
 def test_routes_lists_the_servers_routes(aram: SimThread, capsys: pytest.CaptureFixture[str]) -> None:
-    assert main(["routes", addr(aram), "--timeout", "5"]) == EXIT_OK
+    assert main(["routes", addr(aram), "--timeout", cli_timeout(5)]) == EXIT_OK
     assert capsys.readouterr().out.splitlines() == list(ROUTES)
-    assert main(["routes", addr(aram), "--json", "--timeout", "5"]) == EXIT_OK
+    assert main(["routes", addr(aram), "--json", "--timeout", cli_timeout(5)]) == EXIT_OK
     assert json.loads(capsys.readouterr().out) == list(ROUTES)
 
 
@@ -47,9 +48,9 @@ def test_patrol_sends_the_route_and_refuses_an_unknown_one(
     aram: SimThread, capsys: pytest.CaptureFixture[str]
 ) -> None:
     before = len(_state(aram).patrols)
-    assert main(["patrol", addr(aram), ROUTES[2], "--timeout", "5"]) == EXIT_OK
+    assert main(["patrol", addr(aram), ROUTES[2], "--timeout", cli_timeout(5)]) == EXIT_OK
     eventually(lambda: _state(aram).patrols[before:] == [ROUTES[2]])
-    assert main(["patrol", addr(aram), "Nowhere", "--timeout", "5"]) == EXIT_USAGE
+    assert main(["patrol", addr(aram), "Nowhere", "--timeout", cli_timeout(5)]) == EXIT_USAGE
     assert "no route 'Nowhere'" in capsys.readouterr().err
     assert _state(aram).patrols[before:] == [ROUTES[2]]
 
@@ -59,9 +60,9 @@ def test_goto_sends_a_route_goal_and_refuses_an_unknown_one(
 ) -> None:
     before = len(_state(aram).route_goals)
     # The aram profile lists ARNL's gotoGoal too: --route asks for the LD command by name.
-    assert main(["goto", addr(aram), "Lab A", "--route", "--timeout", "5"]) == EXIT_OK
+    assert main(["goto", addr(aram), "Lab A", "--route", "--timeout", cli_timeout(5)]) == EXIT_OK
     eventually(lambda: _state(aram).route_goals[before:] == ["Lab A"])
-    assert main(["goto", addr(aram), "Nowhere", "--route", "--timeout", "5"]) == EXIT_USAGE
+    assert main(["goto", addr(aram), "Nowhere", "--route", "--timeout", cli_timeout(5)]) == EXIT_USAGE
     err = capsys.readouterr().err
     assert "no goal 'Nowhere'" in err and "Lab A" in err
     assert _state(aram).route_goals[before:] == ["Lab A"]
@@ -89,15 +90,15 @@ def test_data_store_values_become_toolbar_fields() -> None:
 
 
 def test_say_sends_the_text(aram: SimThread) -> None:
-    assert main(["say", addr(aram), "Mind the gap", "--timeout", "5"]) == EXIT_OK
+    assert main(["say", addr(aram), "Mind the gap", "--timeout", cli_timeout(5)]) == EXIT_OK
     eventually(lambda: "Mind the gap" in _state(aram).said)
-    assert main(["say", addr(aram), "   ", "--timeout", "5"]) == EXIT_USAGE
+    assert main(["say", addr(aram), "   ", "--timeout", cli_timeout(5)]) == EXIT_USAGE
 
 
 def test_status_says_the_dock_state(aram: SimThread, capsys: pytest.CaptureFixture[str]) -> None:
-    assert main(["status", addr(aram), "--once", "--json", "--timeout", "5"]) == EXIT_OK
+    assert main(["status", addr(aram), "--once", "--json", "--timeout", cli_timeout(5)]) == EXIT_OK
     assert json.loads(capsys.readouterr().out)["dock"] == "Undocked"
-    assert main(["status", addr(aram), "--once", "--timeout", "5"]) == EXIT_OK
+    assert main(["status", addr(aram), "--once", "--timeout", cli_timeout(5)]) == EXIT_OK
     assert "dock=Undocked" in capsys.readouterr().out
 
 
@@ -120,10 +121,10 @@ def test_data_store_strings_are_read_by_name(aram: SimThread) -> None:
 
 
 def test_default_profile_offers_none_of_it(plain: SimThread, capsys: pytest.CaptureFixture[str]) -> None:
-    assert main(["routes", addr(plain), "--timeout", "5"]) == EXIT_UNSUPPORTED
-    assert main(["patrol", addr(plain), "Loop", "--timeout", "5"]) == EXIT_UNSUPPORTED
-    assert main(["say", addr(plain), "hello", "--timeout", "5"]) == EXIT_UNSUPPORTED
-    assert main(["goto", addr(plain), "Lab A", "--route", "--timeout", "5"]) == EXIT_UNSUPPORTED
+    assert main(["routes", addr(plain), "--timeout", cli_timeout(5)]) == EXIT_UNSUPPORTED
+    assert main(["patrol", addr(plain), "Loop", "--timeout", cli_timeout(5)]) == EXIT_UNSUPPORTED
+    assert main(["say", addr(plain), "hello", "--timeout", cli_timeout(5)]) == EXIT_UNSUPPORTED
+    assert main(["goto", addr(plain), "Lab A", "--route", "--timeout", cli_timeout(5)]) == EXIT_UNSUPPORTED
     capsys.readouterr()
-    assert main(["status", addr(plain), "--once", "--json", "--timeout", "5"]) == EXIT_OK
+    assert main(["status", addr(plain), "--once", "--json", "--timeout", cli_timeout(5)]) == EXIT_OK
     assert "dock" not in json.loads(capsys.readouterr().out)

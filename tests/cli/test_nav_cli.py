@@ -19,6 +19,7 @@ import pytest
 from client.navsim import OFFICE, fast_sim, reset, robot
 from client.servers import SPECS, ServerThread, TestServer
 from client.uiqueue import eventually
+from patience import cli_timeout
 from rtmu.base.exit_codes import EXIT_OK, EXIT_TIMEOUT, EXIT_UNSUPPORTED, EXIT_USAGE
 from rtmu.cli import main
 from rtmu.protocol.payloads.robot import ModeInfo
@@ -47,14 +48,14 @@ def addr(sim: SimThread | TestServer) -> str:
 
 
 def run(sim: SimThread, *argv: str) -> int:
-    return main([argv[0], addr(sim), *argv[1:], "--timeout", "5", "--limit", "60"])
+    return main([argv[0], addr(sim), *argv[1:], "--timeout", cli_timeout(5), "--limit", "60"])
 
 
 def test_goals_lists_the_maps_goals(sim: SimThread, capsys: pytest.CaptureFixture[str]) -> None:
-    assert main(["goals", addr(sim), "--timeout", "5"]) == EXIT_OK
+    assert main(["goals", addr(sim), "--timeout", cli_timeout(5)]) == EXIT_OK
     names = capsys.readouterr().out.splitlines()
     assert {"Room 101", "Lab B", "Kitchen", "Corridor End"} <= set(names)
-    assert main(["goals", addr(sim), "--json", "--timeout", "5"]) == EXIT_OK
+    assert main(["goals", addr(sim), "--json", "--timeout", cli_timeout(5)]) == EXIT_OK
     assert json.loads(capsys.readouterr().out) == names
 
 
@@ -138,7 +139,7 @@ def test_another_client_stopping_the_robot_exits_7(home: SimThread) -> None:
 
 
 def test_limit_stops_the_robot_and_exits_5(home: SimThread, capsys: pytest.CaptureFixture[str]) -> None:
-    code = main(["goto", addr(home), "Corridor End", "--timeout", "5", "--limit", "0.5"])
+    code = main(["goto", addr(home), "Corridor End", "--timeout", cli_timeout(5), "--limit", "0.5"])
     assert code == EXIT_TIMEOUT
     assert "stop sent" in capsys.readouterr().err
     eventually(lambda: robot(home).mode_name == "stop", timeout=5)
@@ -154,7 +155,7 @@ def test_no_wait_sends_and_leaves_it_driving(home: SimThread, capsys: pytest.Cap
 
 
 def test_ctrl_c_sends_stop_before_exiting(home: SimThread) -> None:
-    args = [sys.executable, "-m", "rtmu", "goto", addr(home), "Corridor End", "--timeout", "5"]
+    args = [sys.executable, "-m", "rtmu", "goto", addr(home), "Corridor End", "--timeout", cli_timeout(5)]
     proc = subprocess.Popen(args, stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True, process_group=0)
     try:
         assert proc.stdout is not None and proc.stdout.readline() == "Going to Corridor End\n"
@@ -174,7 +175,7 @@ def test_ctrl_c_sends_stop_before_exiting(home: SimThread) -> None:
 
 @pytest.mark.parametrize("sig", [signal.SIGTERM, signal.SIGHUP])
 def test_sigterm_and_sighup_stop_the_robot_too(home: SimThread, sig: signal.Signals) -> None:
-    args = [sys.executable, "-m", "rtmu", "home", addr(home), "--timeout", "5"]
+    args = [sys.executable, "-m", "rtmu", "home", addr(home), "--timeout", cli_timeout(5)]
     assert home.server is not None
     home.call(lambda: home.server.world.goto_mode.goto_point(8000, 6000, None))  # type: ignore[union-attr]
     eventually(lambda: robot(home).status == "Arrived at point", timeout=20)
@@ -200,7 +201,9 @@ def test_a_server_without_navigation_exits_4(capsys: pytest.CaptureFixture[str])
             ["dock"],
             ["localize", "1", "2", "3"],
         ):
-            assert main([argv[0], addr(server), *argv[1:], "--timeout", "5"]) == EXIT_UNSUPPORTED, argv
+            assert (
+                main([argv[0], addr(server), *argv[1:], "--timeout", cli_timeout(5)]) == EXIT_UNSUPPORTED
+            ), argv
         err = capsys.readouterr().err
         assert "this server does not drive to goals (it does not offer gotoGoal)" in err
         assert "rtmu home: this server does not drive home (it does not offer home)" in err
@@ -229,10 +232,12 @@ def test_ld_robots_without_goto_goal_get_goto_route_goal(
 ) -> None:
     assert ld_only.server is not None
     server = ld_only.server
-    assert main(["goto", addr(ld_only), "Lab A", "--timeout", "5"]) == EXIT_OK
+    assert main(["goto", addr(ld_only), "Lab A", "--timeout", cli_timeout(5)]) == EXIT_OK
     assert capsys.readouterr().err == "going to Lab A\n"
     eventually(lambda: ld_only.call(lambda: ld_state(server).route_goals) == ["Lab A"])  # type: ignore[arg-type]
-    assert main(["goto", addr(ld_only), "--x", "1", "--y", "2", "--timeout", "5"]) == EXIT_UNSUPPORTED
+    assert (
+        main(["goto", addr(ld_only), "--x", "1", "--y", "2", "--timeout", cli_timeout(5)]) == EXIT_UNSUPPORTED
+    )
 
 
 def test_hostile_status_text_is_escaped_and_bounded(capsys: pytest.CaptureFixture[str]) -> None:
@@ -256,7 +261,9 @@ def test_hostile_status_text_is_escaped_and_bounded(capsys: pytest.CaptureFixtur
         thread = threading.Thread(target=fail_later)
         thread.start()
         try:
-            code = main(["goto", addr(server), "--x", "1", "--y", "2", "--timeout", "5", "--limit", "20"])
+            code = main(
+                ["goto", addr(server), "--x", "1", "--y", "2", "--timeout", cli_timeout(5), "--limit", "20"]
+            )
         finally:
             thread.join(10)
     assert code == EXIT_NAV_FAILED
@@ -269,6 +276,6 @@ def test_hostile_status_text_is_escaped_and_bounded(capsys: pytest.CaptureFixtur
 
 def test_an_ld_robots_dock_is_followed_through_dock_info(capsys: pytest.CaptureFixture[str]) -> None:
     with fast_sim(profile="aram") as aram:
-        assert main(["dock", addr(aram), "--timeout", "5", "--limit", "60"]) == EXIT_OK
+        assert main(["dock", addr(aram), "--timeout", cli_timeout(5), "--limit", "60"]) == EXIT_OK
         lines = capsys.readouterr().out.splitlines()  # it drives there, as the server says, to Docked
         assert lines[0] == "Going to dock at Charger" and lines[-1] == "Docked", lines

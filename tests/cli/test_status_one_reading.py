@@ -12,6 +12,7 @@ import json
 import pytest
 
 from client.uiqueue import UiQueue
+from patience import cli_timeout
 from rtmu.base.exit_codes import EXIT_OK
 from rtmu.cli import main
 from rtmu.client.runner import ClientRunner
@@ -44,7 +45,7 @@ def window_reading(sim: SimThread) -> RobotState:
 
 
 def cli_lines(sim: SimThread, *more: str, capsys: pytest.CaptureFixture[str]) -> list[dict[str, object]]:
-    assert main(["status", f"127.0.0.1:{sim.port}", "--timeout", "5", "--json", *more]) == EXIT_OK
+    assert main(["status", f"127.0.0.1:{sim.port}", "--timeout", cli_timeout(5), "--json", *more]) == EXIT_OK
     return [json.loads(line) for line in capsys.readouterr().out.splitlines()]
 
 
@@ -83,7 +84,7 @@ def test_doctor_and_why_read_the_status_the_window_reads(
 
     sim: SimThread = request.getfixturevalue(robot)
     seen = window_reading(sim)
-    assert main(["doctor", f"127.0.0.1:{sim.port}", "--timeout", "5", "--json"]) == EXIT_OK
+    assert main(["doctor", f"127.0.0.1:{sim.port}", "--timeout", cli_timeout(5), "--json"]) == EXIT_OK
     report = json.loads(capsys.readouterr().out)
     step = next(s for s in report["steps"] if s["step"] == "status")
     assert (step["x"], step["y"], step["th"], step["status"]) == (seen.x, seen.y, seen.th, seen.status)

@@ -11,6 +11,7 @@ import pytest
 from PIL import Image
 
 from client.servers import ServerSide, ServerThread, TestServer
+from patience import cli_timeout
 from rtmu.base.exit_codes import EXIT_CONNECTION, EXIT_OK
 from rtmu.cli import main
 from rtmu.package_data import project_map
@@ -162,10 +163,13 @@ def test_a_parked_robots_camera_plays_as_video_and_repeats_are_told_apart(capsys
     a repeated frame — the camera had nothing newer — is named as such, not taken for a slow link."""
     with SimThread(SimConfig(port=0, map_path=ARENA, camera_hz=10.0)) as sim:
         where = f"127.0.0.1:{sim.port}"
-        assert main(["video", where, "--seconds", "2", "--fps", "10", "--json", "--timeout", "5"]) == EXIT_OK
+        assert (
+            main(["video", where, "--seconds", "2", "--fps", "10", "--json", "--timeout", cli_timeout(5)])
+            == EXIT_OK
+        )
         summary = json.loads(capsys.readouterr().out)
         assert summary["frames"] >= 4, summary  # a camera that renews its picture: not one frame in 2 s
         assert summary["backoff"] == "", "fresh frames are young: nothing to slow down for"
-        assert main(["video", where, "--seconds", "1", "--fps", "30", "--timeout", "5"]) == EXIT_OK
+        assert main(["video", where, "--seconds", "1", "--fps", "30", "--timeout", cli_timeout(5)]) == EXIT_OK
         line = capsys.readouterr().out
         assert "repeats (the camera had no newer picture" in line, line  # asked 30/s of a 10/s camera

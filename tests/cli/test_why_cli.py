@@ -18,6 +18,7 @@ import pytest
 from client.navsim import fast_sim, reset, robot
 from client.servers import SPECS, ServerThread, TestServer
 from client.uiqueue import eventually
+from patience import cli_timeout
 from rtmu.base import exit_codes as codes
 from rtmu.cli import main
 from rtmu.client.connection import AriaClient
@@ -51,7 +52,7 @@ def addr(server: SimThread | TestServer) -> str:
 
 
 def why(server: SimThread | TestServer, *extra: str) -> int:
-    return main(["why", addr(server), "--timeout", "5", *extra])
+    return main(["why", addr(server), "--timeout", cli_timeout(5), *extra])
 
 
 def why_json(server: SimThread, capsys: pytest.CaptureFixture[str], *extra: str) -> tuple[int, dict]:
@@ -60,11 +61,11 @@ def why_json(server: SimThread, capsys: pytest.CaptureFixture[str], *extra: str)
 
 
 def command(server: SimThread, name: str, *arg: str) -> None:
-    assert main(["run", addr(server), name, *arg, "--timeout", "5"]) == codes.EXIT_OK
+    assert main(["run", addr(server), name, *arg, "--timeout", cli_timeout(5)]) == codes.EXIT_OK
 
 
 def drive(server: SimThread | TestServer, *extra: str) -> int:
-    return main(["drive", addr(server), "--timeout", "5", "--seconds", "0.6", *extra])
+    return main(["drive", addr(server), "--timeout", cli_timeout(5), "--seconds", "0.6", *extra])
 
 
 def x_of(sim: SimThread) -> float:
@@ -266,7 +267,9 @@ def test_navigating_docked_and_lost_with_their_fixes(capsys) -> None:  # type: i
     with fast_sim() as s:
         reset(s)
         eventually(lambda: robot(s).status == "Stopped", timeout=5)
-        assert main(["goto", addr(s), "Corridor End", "--no-wait", "--timeout", "5"]) == codes.EXIT_OK
+        assert (
+            main(["goto", addr(s), "Corridor End", "--no-wait", "--timeout", cli_timeout(5)]) == codes.EXIT_OK
+        )
         eventually(lambda: robot(s).status.startswith("Going to"), timeout=10)
         capsys.readouterr()
         code, answer = why_json(s, capsys)
@@ -275,7 +278,7 @@ def test_navigating_docked_and_lost_with_their_fixes(capsys) -> None:  # type: i
         assert answer["fixes"][0]["worked"] is True and code == codes.EXIT_OK
         assert robot(s).mode_name == "stop"
 
-        assert main(["dock", addr(s), "--timeout", "5", "--limit", "60"]) == codes.EXIT_OK
+        assert main(["dock", addr(s), "--timeout", cli_timeout(5), "--limit", "60"]) == codes.EXIT_OK
         capsys.readouterr()
         code, answer = why_json(s, capsys)
         assert code == codes.EXIT_WHY_DOCKED == 29 and answer["reasons"][0]["fix"]["key"] == "undock"
@@ -335,12 +338,12 @@ def test_a_drive_that_moves_nothing_and_nothing_explains_exits_39(capsys) -> Non
 
 
 def test_the_doctor_asks_why_it_wont_move(sim: SimThread, capsys) -> None:  # type: ignore[no-untyped-def]
-    assert main(["doctor", addr(sim), "--json", "--timeout", "5"]) == codes.EXIT_OK
+    assert main(["doctor", addr(sim), "--json", "--timeout", cli_timeout(5)]) == codes.EXIT_OK
     report = json.loads(capsys.readouterr().out)
     assert report["steps"][-1]["step"] == "motion" and report["steps"][-1]["result"] == "ok"
     command(sim, "SimulatorLockStopMode")
     capsys.readouterr()
-    assert main(["doctor", addr(sim), "--json", "--timeout", "5"]) == codes.EXIT_WHY_LOCKED
+    assert main(["doctor", addr(sim), "--json", "--timeout", cli_timeout(5)]) == codes.EXIT_WHY_LOCKED
     report = json.loads(capsys.readouterr().out)
     assert report["failed_step"] == "motion" and report["steps"][-1]["cause"] == "locked"
 

@@ -13,6 +13,7 @@ from pathlib import Path
 
 import pytest
 
+from patience import cli_timeout
 from rtmu.base.exit_codes import EXIT_CONNECTION, EXIT_OK
 from rtmu.cli import main
 from rtmu.client.connection import AriaClient
@@ -70,14 +71,14 @@ def test_wrong_protocol_names_the_wanted_string(aram: SimThread) -> None:
 def test_cli_wrong_protocol_exits_3_with_the_wanted_string(
     aram: SimThread, capsys: pytest.CaptureFixture[str]
 ) -> None:
-    code = main(["probe", addr(aram), "--protocol", "wrong", "--timeout", "5"])
+    code = main(["probe", addr(aram), "--protocol", "wrong", "--timeout", cli_timeout(5)])
     err = capsys.readouterr().err
     assert code == EXIT_CONNECTION
     assert "wants protocol '6MTX'; we sent 'wrong'" in err and "--protocol 6MTX" in err
 
 
 def test_cli_explicit_right_protocol_logs_in(aram: SimThread, capsys: pytest.CaptureFixture[str]) -> None:
-    assert main(["probe", addr(aram), "--protocol", "6MTX", "--json", "--timeout", "5"]) == EXIT_OK
+    assert main(["probe", addr(aram), "--protocol", "6MTX", "--json", "--timeout", cli_timeout(5)]) == EXIT_OK
     assert json.loads(capsys.readouterr().out)["count"] == ARAM_COUNT
 
 
@@ -95,7 +96,7 @@ def test_sim_protocol_option_enforces_and_advertises() -> None:
 
 
 def test_status_json_has_battery_pct_on_aram(aram: SimThread, capsys: pytest.CaptureFixture[str]) -> None:
-    assert main(["status", addr(aram), "--once", "--json", "--timeout", "5"]) == EXIT_OK
+    assert main(["status", addr(aram), "--once", "--json", "--timeout", cli_timeout(5)]) == EXIT_OK
     obj = json.loads(capsys.readouterr().out)
     assert "battery_v" not in obj
     assert 0.0 <= obj["battery_pct"] <= 100.0
@@ -112,7 +113,7 @@ def test_status_json_has_battery_v_on_default(plain: SimThread, tmp_path: Path, 
 
 
 def test_status_text_line_says_percent(aram: SimThread, capsys: pytest.CaptureFixture[str]) -> None:
-    assert main(["status", addr(aram), "--once", "--timeout", "5"]) == EXIT_OK
+    assert main(["status", addr(aram), "--once", "--timeout", cli_timeout(5)]) == EXIT_OK
     assert "battery=100 %" in capsys.readouterr().out
 
 
@@ -124,7 +125,7 @@ def test_battery_info_without_the_flag_means_volts() -> None:
 
 # -- rtmu doctor ---------------------------------------------------------------------------------------
 def doctor_json(capsys: pytest.CaptureFixture[str], *args: str) -> tuple[int, dict]:
-    code = main(["doctor", *args, "--json", "--timeout", "5"])
+    code = main(["doctor", *args, "--json", "--timeout", cli_timeout(5)])
     return code, json.loads(capsys.readouterr().out)
 
 
@@ -184,7 +185,7 @@ def test_doctor_enforcing_sim_wrong_protocol(aram: SimThread, capsys: pytest.Cap
 
 
 def test_doctor_text_output(aram: SimThread, capsys: pytest.CaptureFixture[str]) -> None:
-    assert main(["doctor", addr(aram), "--protocol", "x", "--timeout", "5"]) == 13
+    assert main(["doctor", addr(aram), "--protocol", "x", "--timeout", cli_timeout(5)]) == 13
     out = capsys.readouterr().out
     assert "[FAIL] login: the server wants protocol '6MTX'" in out
     assert "what to do: use --protocol 6MTX" in out

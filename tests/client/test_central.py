@@ -16,6 +16,7 @@ from pathlib import Path
 
 import pytest
 
+from patience import cli_timeout
 from rtmu import mapfile as maps
 from rtmu.base.exit_codes import EXIT_CONNECTION, EXIT_OK, EXIT_USAGE
 from rtmu.cli import main
@@ -90,7 +91,7 @@ def test_a_robot_switched_to_a_central_server_refuses_direct_logins(
     fleet: CentralThread, capsys: pytest.CaptureFixture[str]
 ) -> None:
     port = fleet.sims["robot1"].port
-    assert main(["status", f"127.0.0.1:{port}", "--once", "--timeout", "5"]) == EXIT_CONNECTION
+    assert main(["status", f"127.0.0.1:{port}", "--once", "--timeout", cli_timeout(5)]) == EXIT_CONNECTION
     assert "central server" in capsys.readouterr().err
 
 
@@ -99,7 +100,7 @@ def test_fleet_json_lists_every_robot_with_its_port_and_status(
     fleet: CentralThread, capsys: pytest.CaptureFixture[str]
 ) -> None:
     place(fleet, "robot2", 1234, -567)
-    assert main(["fleet", addr(fleet), "--json", "--timeout", "5"]) == EXIT_OK
+    assert main(["fleet", addr(fleet), "--json", "--timeout", cli_timeout(5)]) == EXIT_OK
     obj = json.loads(capsys.readouterr().out)
     assert obj["central"] == addr(fleet)
     rows = {r["name"]: r for r in obj["robots"]}
@@ -114,7 +115,7 @@ def test_fleet_json_lists_every_robot_with_its_port_and_status(
 def test_fleet_plain_lists_names_ports_and_status_lines(
     fleet: CentralThread, capsys: pytest.CaptureFixture[str]
 ) -> None:
-    assert main(["fleet", addr(fleet), "--timeout", "5"]) == EXIT_OK
+    assert main(["fleet", addr(fleet), "--timeout", cli_timeout(5)]) == EXIT_OK
     out = capsys.readouterr().out.splitlines()
     assert out[0] == f"{addr(fleet)}: 3 robots"
     for name, line in zip(NAMES, out[1:], strict=True):
@@ -125,7 +126,7 @@ def test_status_with_robot_reads_that_robot(fleet: CentralThread, capsys: pytest
     for i, name in enumerate(NAMES):
         place(fleet, name, 1000 * (i + 1), 0)
     for i, name in enumerate(NAMES):
-        code = main(["status", addr(fleet), "--robot", name, "--once", "--json", "--timeout", "5"])
+        code = main(["status", addr(fleet), "--robot", name, "--once", "--json", "--timeout", cli_timeout(5)])
         assert code == EXIT_OK
         assert json.loads(capsys.readouterr().out)["x"] == 1000 * (i + 1)
 
@@ -134,14 +135,20 @@ def test_robot_names_match_case_insensitively_as_in_aria(
     fleet: CentralThread, capsys: pytest.CaptureFixture[str]
 ) -> None:
     place(fleet, "robot3", 3210, 0)
-    assert main(["status", addr(fleet), "--robot", "ROBOT3", "--once", "--json", "--timeout", "5"]) == EXIT_OK
+    assert (
+        main(["status", addr(fleet), "--robot", "ROBOT3", "--once", "--json", "--timeout", cli_timeout(5)])
+        == EXIT_OK
+    )
     assert json.loads(capsys.readouterr().out)["x"] == 3210
 
 
 def test_unknown_robot_exits_2_naming_the_robots(
     fleet: CentralThread, capsys: pytest.CaptureFixture[str]
 ) -> None:
-    assert main(["status", addr(fleet), "--robot", "nobody", "--once", "--timeout", "5"]) == EXIT_USAGE
+    assert (
+        main(["status", addr(fleet), "--robot", "nobody", "--once", "--timeout", cli_timeout(5)])
+        == EXIT_USAGE
+    )
     err = capsys.readouterr().err
     assert err.startswith("rtmu status: no robot 'nobody' behind the central server")
     assert "robots: robot1, robot2, robot3" in err
@@ -151,7 +158,9 @@ def test_robot_on_a_plain_robot_server_says_it_is_not_a_central_server(
     fleet: CentralThread, capsys: pytest.CaptureFixture[str]
 ) -> None:
     forwarded = fleet.robots()["robot1"]  # a robot server, which offers no clientList
-    code = main(["status", f"127.0.0.1:{forwarded}", "--robot", "robot1", "--once", "--timeout", "5"])
+    code = main(
+        ["status", f"127.0.0.1:{forwarded}", "--robot", "robot1", "--once", "--timeout", cli_timeout(5)]
+    )
     assert code not in (EXIT_OK, EXIT_USAGE)
     assert "clientList" in capsys.readouterr().err
 
@@ -163,7 +172,7 @@ def test_drive_with_robot_moves_only_that_robot(
         place(fleet, name, 0, 2000 * i)
     before = {name: pose(fleet, name) for name in NAMES}
     argv = ["drive", addr(fleet), "--robot", "robot2", "--trans", "60", "--seconds", "0.6", "--json"]
-    assert main([*argv, "--timeout", "5"]) == EXIT_OK
+    assert main([*argv, "--timeout", cli_timeout(5)]) == EXIT_OK
     obj = json.loads(capsys.readouterr().out)
     after = {name: pose(fleet, name) for name in NAMES}
     moved = {
@@ -180,7 +189,17 @@ def test_map_with_robot_downloads_through_the_forwarder(fleet: CentralThread, tm
     expected = maps.read_map(ARENA)  # a map is many packets: the forwarder relays them to the asker
     for extra, name in (([], "bin.map"), (["--text"], "text.map")):
         out = tmp_path / name
-        argv = ["map", addr(fleet), "--robot", "robot3", "--out", str(out), "--timeout", "10", *extra]
+        argv = [
+            "map",
+            addr(fleet),
+            "--robot",
+            "robot3",
+            "--out",
+            str(out),
+            "--timeout",
+            cli_timeout(10),
+            *extra,
+        ]
         assert main(argv) == EXIT_OK
         got = maps.read_map(out)
         assert (got.num_points, got.num_lines) == (expected.num_points, expected.num_lines)
@@ -377,7 +396,10 @@ def test_a_robot_started_with_switch_to_on_the_command_line_joins_the_fleet(
         )
         try:
             assert fl.wait_for_robots(1, timeout=30) == {"cli-bot": fl.robots()["cli-bot"]}
-            assert main(["status", addr(fl), "--robot", "cli-bot", "--once", "--timeout", "5"]) == EXIT_OK
+            assert (
+                main(["status", addr(fl), "--robot", "cli-bot", "--once", "--timeout", cli_timeout(5)])
+                == EXIT_OK
+            )
             assert "battery=" in capsys.readouterr().out
         finally:
             proc.terminate()
@@ -392,7 +414,18 @@ def test_a_drive_through_a_central_server_that_dies_ends_and_the_robot_stops() -
     with CentralThread(robots=2, template=SimConfig(port=0, camera=False)) as fl:
         robot = fl.sims["robot1"].robot
         other = fl.sims["robot2"].robot
-        argv = ["drive", addr(fl), "--robot", "robot1", "--trans", "60", "--seconds", "30", "--timeout", "5"]
+        argv = [
+            "drive",
+            addr(fl),
+            "--robot",
+            "robot1",
+            "--trans",
+            "60",
+            "--seconds",
+            "30",
+            "--timeout",
+            cli_timeout(5),
+        ]
         proc = subprocess.Popen(
             [sys.executable, "-m", "rtmu", *argv], stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True
         )
@@ -447,7 +480,10 @@ def test_image_with_robot_comes_through_the_forwarder_as_return_video(
     try:
         fleet.wait_for_robots(4)
         out = tmp_path / "cam.jpg"
-        assert main(["image", addr(fleet), "--robot", "cam", "--out", str(out), "--timeout", "10"]) == EXIT_OK
+        assert (
+            main(["image", addr(fleet), "--robot", "cam", "--out", str(out), "--timeout", cli_timeout(10)])
+            == EXIT_OK
+        )
         assert out.read_bytes()[:2] == b"\xff\xd8"
     finally:
         fleet.stop_robot("cam")  # the module's fleet is three robots again for whoever comes next

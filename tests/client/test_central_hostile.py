@@ -12,6 +12,7 @@ from collections.abc import Iterator
 
 import pytest
 
+from patience import cli_timeout
 from rtmu.base.exit_codes import EXIT_CONNECTION, EXIT_OK, EXIT_USAGE
 from rtmu.cli import main
 from rtmu.client.central import MAX_NAME, CentralRoster
@@ -62,7 +63,7 @@ def test_a_list_claiming_10000_robots_in_a_few_bytes_is_refused_with_a_clear_err
     one = CentralEntry("", 7273, "robot1", "", "10.0.0.1")
     lie = FieldWriter().ubyte2(10_000).bytes() + ClientList((one,)).encode()[2:]
     listing(server, lie)
-    assert main(["fleet", f"127.0.0.1:{server.port}", "--timeout", "5"]) == EXIT_CONNECTION
+    assert main(["fleet", f"127.0.0.1:{server.port}", "--timeout", cli_timeout(5)]) == EXIT_CONNECTION
     err = capsys.readouterr().err
     assert "malformed robot list" in err and "robot count claims 10000" in err
 
@@ -142,13 +143,16 @@ def test_markup_and_escapes_in_names_stay_plain_text_and_never_reach_the_termina
     finally:
         roster.close()
 
-    assert main(["fleet", f"127.0.0.1:{server.port}", "--no-status", "--timeout", "5"]) == EXIT_OK
+    assert main(["fleet", f"127.0.0.1:{server.port}", "--no-status", "--timeout", cli_timeout(5)]) == EXIT_OK
     out = capsys.readouterr().out
     assert "\x1b" not in out and "\x07" not in out and "\r" not in out
     assert MARKUP in out  # plain text for a terminal: nothing to interpret there
     assert out.count("\n") == 3  # the header and one line per robot: the newline in a name is escaped
 
-    assert main(["fleet", f"127.0.0.1:{server.port}", "--no-status", "--json", "--timeout", "5"]) == EXIT_OK
+    assert (
+        main(["fleet", f"127.0.0.1:{server.port}", "--no-status", "--json", "--timeout", cli_timeout(5)])
+        == EXIT_OK
+    )
     raw = capsys.readouterr().out
     assert "\x1b" not in raw and raw.count("\n") == 1
     assert [r["name"] for r in json.loads(raw)["robots"]] == [MARKUP, ESCAPES]
@@ -159,7 +163,7 @@ def test_unknown_robot_list_names_are_escaped_too(
 ) -> None:
     server, _ = central
     listing(server, ClientList((CentralEntry("", 7301, ESCAPES),)).encode())
-    code = main(["status", f"127.0.0.1:{server.port}", "--robot", "x", "--once", "--timeout", "5"])
+    code = main(["status", f"127.0.0.1:{server.port}", "--robot", "x", "--once", "--timeout", cli_timeout(5)])
     assert code == 2
     err = capsys.readouterr().err
     assert "\x1b" not in err and err.count("\n") == 1
@@ -205,7 +209,10 @@ def test_robot_names_differing_in_case_are_one_robot_the_last_one_listed(
         assert {e.name for e in roster.robots.values()} == {"Robot", "other"}
     finally:
         roster.close()
-    assert main(["fleet", f"127.0.0.1:{server.port}", "--no-status", "--json", "--timeout", "5"]) == EXIT_OK
+    assert (
+        main(["fleet", f"127.0.0.1:{server.port}", "--no-status", "--json", "--timeout", cli_timeout(5)])
+        == EXIT_OK
+    )
     rows = json.loads(capsys.readouterr().out)["robots"]
     assert [(r["name"], r["port"]) for r in rows] == [("Robot", 7403)]
 
@@ -215,7 +222,9 @@ def test_robot_that_fits_several_listed_names_is_refused_with_the_candidates(
 ) -> None:
     server, _ = central
     listing(server, ClientList(CASES).encode())
-    code = main(["status", f"127.0.0.1:{server.port}", "--robot", "ROBOT", "--once", "--timeout", "5"])
+    code = main(
+        ["status", f"127.0.0.1:{server.port}", "--robot", "ROBOT", "--once", "--timeout", cli_timeout(5)]
+    )
     assert code == EXIT_USAGE
     err = capsys.readouterr().err
     assert "'ROBOT' is ambiguous" in err and err.count("\n") == 1

@@ -10,6 +10,7 @@ import json
 
 import pytest
 
+from patience import cli_timeout
 from rtmu.base.exit_codes import EXIT_FOREIGN_CONFIG, EXIT_OK, EXIT_TIMEOUT
 from rtmu.cli import main
 from rtmu.client.config_feed import ConfigApi, ForeignConfig, config_api
@@ -44,13 +45,13 @@ def test_the_api_is_named_from_the_data_list() -> None:
 def test_rtmu_config_says_which_api_and_exits_with_its_own_code(
     aram: SimThread, capsys: pytest.CaptureFixture[str]
 ) -> None:
-    assert main(["config", addr(aram.port), "--timeout", "5"]) == EXIT_FOREIGN_CONFIG
+    assert main(["config", addr(aram.port), "--timeout", cli_timeout(5)]) == EXIT_FOREIGN_CONFIG
     out, err = capsys.readouterr()
     assert out == ""
     assert "configuration is Omron LD's (getConfigValues, setConfigValues, updateConfigValues" in err
     assert "cannot show or edit it yet" in err and "rtmu call HOST getConfigValues" in err
     assert "none offered" not in err and "offers no configuration" not in err
-    assert main(["config", addr(aram.port), "--json", "--timeout", "5"]) == EXIT_FOREIGN_CONFIG
+    assert main(["config", addr(aram.port), "--json", "--timeout", cli_timeout(5)]) == EXIT_FOREIGN_CONFIG
     said = json.loads(capsys.readouterr().out)
     assert said == {
         "api": "omron-ld",
@@ -58,7 +59,7 @@ def test_rtmu_config_says_which_api_and_exits_with_its_own_code(
         "editable": False,
     }
     assert (
-        main(["config", addr(aram.port), "--set", "Teleop/Timeout=3", "--timeout", "5"])
+        main(["config", addr(aram.port), "--set", "Teleop/Timeout=3", "--timeout", cli_timeout(5)])
         == EXIT_FOREIGN_CONFIG
     )
     assert "cannot show or edit it yet" in capsys.readouterr().err
@@ -66,7 +67,7 @@ def test_rtmu_config_says_which_api_and_exits_with_its_own_code(
 
 def test_an_arconfig_robot_says_its_api_in_json(capsys: pytest.CaptureFixture[str]) -> None:
     with SimThread(SimConfig(port=0)) as sim:
-        assert main(["config", addr(sim.port), "--json", "--timeout", "5"]) == EXIT_OK
+        assert main(["config", addr(sim.port), "--json", "--timeout", cli_timeout(5)]) == EXIT_OK
     assert json.loads(capsys.readouterr().out)["api"] == "arconfig"
 
 
@@ -88,7 +89,9 @@ def test_the_windows_configuration_feed_gets_the_same_plain_words(aram: SimThrea
 def test_the_console_reads_it_and_says_when_the_robot_is_silent(
     aram: SimThread, capsys: pytest.CaptureFixture[str]
 ) -> None:
-    assert main(["call", addr(aram.port), "--list", "config", "--json", "--timeout", "5"]) == EXIT_OK
+    assert (
+        main(["call", addr(aram.port), "--list", "config", "--json", "--timeout", cli_timeout(5)]) == EXIT_OK
+    )
     listed = {e["name"]: e for e in json.loads(capsys.readouterr().out)}
     assert listed["getConfigValues"]["effect"] == "read"
     assert listed["setConfigValues"]["effect"] == "changes something"

@@ -14,6 +14,7 @@ import threading
 
 import pytest
 
+from patience import cli_timeout
 from rtmu.base.exit_codes import EXIT_CONNECTION, EXIT_OK, EXIT_TIMEOUT, EXIT_USAGE
 from rtmu.cli import main
 from rtmu.client.connection import AriaClient
@@ -51,7 +52,7 @@ async def connected(port: int) -> AriaClient:
 def test_list_shows_every_data_with_its_texts_and_effect(
     sim: SimThread, capsys: pytest.CaptureFixture[str]
 ) -> None:
-    assert main(["call", addr(sim.port), "--list", "--json", "--timeout", "10"]) == EXIT_OK
+    assert main(["call", addr(sim.port), "--list", "--json", "--timeout", cli_timeout(10)]) == EXIT_OK
     listed = {e["name"]: e for e in json.loads(capsys.readouterr().out)}
     served = sim.server.datalist  # type: ignore[union-attr]
     assert set(listed) == {e.name for e in served}
@@ -66,7 +67,7 @@ def test_list_shows_every_data_with_its_texts_and_effect(
         entry.flags,
     )
     assert goto["effect"] == "changes something" and listed["getGoals"]["effect"] == "read"
-    assert main(["call", addr(sim.port), "--list", "battery", "--timeout", "10"]) == EXIT_OK
+    assert main(["call", addr(sim.port), "--list", "battery", "--timeout", cli_timeout(10)]) == EXIT_OK
     out = capsys.readouterr().out
     assert "batteryInfo" in out and "gotoPose" not in out
 
@@ -74,12 +75,12 @@ def test_list_shows_every_data_with_its_texts_and_effect(
 def test_a_read_prints_bytes_fields_and_the_known_type(
     sim: SimThread, capsys: pytest.CaptureFixture[str]
 ) -> None:
-    assert main(["call", addr(sim.port), "getModeInfo", "--timeout", "10"]) == EXIT_OK
+    assert main(["call", addr(sim.port), "getModeInfo", "--timeout", cli_timeout(10)]) == EXIT_OK
     out = capsys.readouterr().out
     assert "getModeInfo: replied: 1 packet" in out
     assert 'string "stop"  (mode)' in out
     assert "as ModeInfo:" in out and '"mode_name":"stop"' in out
-    assert main(["call", addr(sim.port), "getMapName", "--json", "--timeout", "10"]) == EXIT_OK
+    assert main(["call", addr(sim.port), "getMapName", "--json", "--timeout", cli_timeout(10)]) == EXIT_OK
     reply = json.loads(capsys.readouterr().out)
     assert reply["outcome"] == "replied" and reply["packets"][0]["fields"][0]["kind"] == "string"
 
@@ -99,35 +100,43 @@ def test_a_change_needs_yes_and_nothing_is_sent_without_it(
     sim: SimThread, capsys: pytest.CaptureFixture[str]
 ) -> None:
     before = sim.call(lambda: sim.server.world.body.battery_v)  # type: ignore[union-attr]
-    code = main(["call", addr(sim.port), "SimulatorSetBattery", "11.75", "--timeout", "10"])
+    code = main(["call", addr(sim.port), "SimulatorSetBattery", "11.75", "--timeout", cli_timeout(10)])
     assert code == EXIT_USAGE
     err = capsys.readouterr().err
     assert "changes something" in err and "--yes" in err
     assert sim.call(lambda: sim.server.world.body.battery_v) == pytest.approx(before, abs=0.05)  # type: ignore[union-attr]
-    code = main(["call", addr(sim.port), "SimulatorSetBattery", "11.75", "--yes", "--timeout", "10"])
+    code = main(
+        ["call", addr(sim.port), "SimulatorSetBattery", "11.75", "--yes", "--timeout", cli_timeout(10)]
+    )
     assert code == EXIT_OK
     assert "taken" in capsys.readouterr().out
     assert sim.call(lambda: sim.server.world.body.battery_v) == pytest.approx(11.75)  # type: ignore[union-attr]
 
 
 def test_arguments_are_typed_from_the_description(sim: SimThread, capsys: pytest.CaptureFixture[str]) -> None:
-    code = main(["call", addr(sim.port), "gotoPose", "1000", "-500", "--yes", "--timeout", "10"])
+    code = main(["call", addr(sim.port), "gotoPose", "1000", "-500", "--yes", "--timeout", cli_timeout(10)])
     assert code == EXIT_OK
-    assert main(["call", addr(sim.port), "stop", "--yes", "--timeout", "10"]) == EXIT_OK
+    assert main(["call", addr(sim.port), "stop", "--yes", "--timeout", cli_timeout(10)]) == EXIT_OK
     capsys.readouterr()
-    assert main(["call", addr(sim.port), "gotoPose", "1000", "--yes", "--timeout", "10"]) == EXIT_USAGE
+    assert (
+        main(["call", addr(sim.port), "gotoPose", "1000", "--yes", "--timeout", cli_timeout(10)])
+        == EXIT_USAGE
+    )
     assert "takes 2 arguments" in capsys.readouterr().err
-    assert main(["call", addr(sim.port), "gotoPose", "x", "1", "--yes", "--timeout", "10"]) == EXIT_USAGE
+    assert (
+        main(["call", addr(sim.port), "gotoPose", "x", "1", "--yes", "--timeout", cli_timeout(10)])
+        == EXIT_USAGE
+    )
     assert "not a whole number" in capsys.readouterr().err
 
 
 def test_name_and_arguments_may_follow_options(sim: SimThread, capsys: pytest.CaptureFixture[str]) -> None:
     """Found against ARIA's own server: ``HOST --user U --password-file F NAME`` must call NAME."""
-    assert main(["call", addr(sim.port), "--timeout", "10", "getMapName"]) == EXIT_OK
+    assert main(["call", addr(sim.port), "--timeout", cli_timeout(10), "getMapName"]) == EXIT_OK
     assert "getMapName: replied" in capsys.readouterr().out
-    code = main(["call", addr(sim.port), "--timeout", "10", "gotoPose", "1500", "--yes", "-700"])
+    code = main(["call", addr(sim.port), "--timeout", cli_timeout(10), "gotoPose", "1500", "--yes", "-700"])
     assert code == EXIT_OK
-    assert main(["call", addr(sim.port), "stop", "--yes", "--timeout", "10"]) == EXIT_OK
+    assert main(["call", addr(sim.port), "stop", "--yes", "--timeout", cli_timeout(10)]) == EXIT_OK
     with pytest.raises(SystemExit) as info:
         main(["call", addr(sim.port), "getMapName", "--bogus", "x"])
     assert info.value.code == EXIT_USAGE
@@ -139,7 +148,7 @@ def test_refusals_and_unknown_names(sim: SimThread, capsys: pytest.CaptureFixtur
     assert "held drive" in capsys.readouterr().err
     assert main(["call", addr(sim.port), "stop", "--every", "100", "--seconds", "1"]) == EXIT_USAGE
     assert "only sends it once" in capsys.readouterr().err
-    assert main(["call", addr(sim.port), "getGoal", "--timeout", "10"]) == EXIT_USAGE
+    assert main(["call", addr(sim.port), "getGoal", "--timeout", cli_timeout(10)]) == EXIT_USAGE
     assert "did you mean getGoals" in capsys.readouterr().err
     assert main(["call", addr(sim.port)]) == EXIT_USAGE
     assert sim.call(lambda: sim.server.world.body.vel) == 0  # type: ignore[union-attr]
@@ -177,7 +186,9 @@ def test_following_ends_with_the_connection(capsys: pytest.CaptureFixture[str]) 
         end = threading.Timer(1.0, lambda: thread.call(lambda: [server.kill(s) for s in server.sides]))
         end.start()
         try:
-            code = main(["call", addr(server.port), "updateNumbers", "--every", "100", "--timeout", "5"])
+            code = main(
+                ["call", addr(server.port), "updateNumbers", "--every", "100", "--timeout", cli_timeout(5)]
+            )
         finally:
             end.join()
     assert code == EXIT_CONNECTION

@@ -20,6 +20,7 @@ from collections.abc import Callable, Iterator
 import pytest
 
 from linkfaults import FAKE_HEADER, GARBAGE, TO_CLIENT, TO_SERVER, FaultProxy, WifiProfile
+from patience import cli_timeout
 from rtmu.base.exit_codes import EXIT_TIMEOUT
 from rtmu.base.link_timing import STATUS_CEILING
 from rtmu.guardian.halt import IDENTIFIER
@@ -62,7 +63,7 @@ def _received(sim: SimThread) -> int:
 
 def _start_drive(sim: SimThread, proxy: FaultProxy) -> subprocess.Popen[str]:
     args = [sys.executable, "-m", "rtmu", "drive", f"127.0.0.1:{proxy.port}", "--trans", "60"]
-    args += ["--seconds", "20", "--timeout", "5"]
+    args += ["--seconds", "20", "--timeout", cli_timeout(5)]
     proc = subprocess.Popen(args, stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
     assert proc.stdout is not None and proc.stdout.readline().startswith("before:")
     eventually(lambda: sim.snapshot().trans_ratio == 60, timeout=5)
@@ -162,7 +163,7 @@ def test_wifi_jitter_within_the_ceiling_never_stops_the_drive(sim: SimThread, pr
     200 ms limit stopped such a drive within seconds)."""
     proxy.play(JITTERY, seed=4)
     args = [sys.executable, "-m", "rtmu", "drive", f"127.0.0.1:{proxy.port}", "--trans", "40"]
-    args += ["--seconds", "10", "--timeout", "5"]
+    args += ["--seconds", "10", "--timeout", cli_timeout(5)]
     proc = subprocess.Popen(args, stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
     code, err = _finish(proc, 40)
     stalls = [seconds for _at, seconds, _d in proxy.stalls]

@@ -18,6 +18,7 @@ from pathlib import Path
 import pytest
 from PIL import Image
 
+from patience import cli_timeout
 from rtmu.base.exit_codes import EXIT_CONNECTION
 from rtmu.cli import main
 from rtmu.client.jpeg_bounds import fill_problem, read_header
@@ -62,7 +63,7 @@ def whole_grey(side: int = SIDE) -> bytes:
 
 
 def image_measured(port: int, out: Path) -> tuple[int, float, str]:
-    args = ["image", f"127.0.0.1:{port}", "--out", str(out), "--timeout", "5"]
+    args = ["image", f"127.0.0.1:{port}", "--out", str(out), "--timeout", cli_timeout(5)]
     done = subprocess.run([sys.executable, "-c", PEAK, *args], capture_output=True, text=True, timeout=120)
     code, hwm = done.stderr.split()[-2:]
     return int(code), int(hwm) / 1024, done.stderr

@@ -6,6 +6,7 @@ from pathlib import Path
 
 import pytest
 
+from patience import cli_timeout
 from rtmu.base.exit_codes import EXIT_CONNECTION
 from rtmu.cli import main
 from rtmu.client.runner import ClientRunner
@@ -74,7 +75,9 @@ def test_rtmu_map_with_a_bad_map_exits_3_with_one_line(
 ) -> None:
     out = tmp_path / "x.map"
     with ServerThread(TestServer(map_lines=BAD_HEADER_MAP)) as server:
-        code = main(["map", f"127.0.0.1:{server.port}", "--out", str(out), "--timeout", "5", *extra])
+        code = main(
+            ["map", f"127.0.0.1:{server.port}", "--out", str(out), "--timeout", cli_timeout(5), *extra]
+        )
     err = capsys.readouterr().err
     assert code == EXIT_CONNECTION
     assert err.count("\n") == 1 and err.startswith("rtmu map: ") and "NumPoints" in err

@@ -14,7 +14,7 @@ from pathlib import Path
 
 import pytest
 
-from patience import PATIENCE
+from patience import PATIENCE, cli_timeout
 from rtmu.client.lease import DriveLease
 from rtmu.client.session import Session, SessionConfig
 from rtmu.model.observables import LinkHealth, LinkLevel
@@ -32,7 +32,17 @@ BOUND_MB = 150
 
 def _rtmu_map(port: int, out: Path) -> tuple[int, float, str]:
     """Exit code, peak resident MB (the program's own VmHWM) and stderr of one ``rtmu map`` run."""
-    argv = [sys.executable, "-m", "rtmu", "map", f"127.0.0.1:{port}", "--out", str(out), "--timeout", "5"]
+    argv = [
+        sys.executable,
+        "-m",
+        "rtmu",
+        "map",
+        f"127.0.0.1:{port}",
+        "--out",
+        str(out),
+        "--timeout",
+        cli_timeout(5),
+    ]
     return run_watching_peak(argv)
 
 

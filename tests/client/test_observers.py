@@ -29,6 +29,7 @@ from pathlib import Path
 import pytest
 
 from linkfaults import TO_CLIENT, TO_SERVER, Direction, FaultProxy
+from patience import cli_timeout
 from rtmu.base import exit_codes
 from rtmu.base.exit_codes import EXIT_CONNECTION, EXIT_OK, EXIT_USAGE, EXIT_WHY_NAVIGATING
 from rtmu.cli import build_parser, main
@@ -240,7 +241,7 @@ def start(observer: Observer, port: int, tmp: Path, *, running: bool) -> Run:
     where = tmp / observer.name
     where.mkdir(exist_ok=True)
     args = [a.format(addr=f"127.0.0.1:{proxy.port}", tmp=where) for a in argv]
-    timeout = [] if "--timeout" in args else ["--timeout", "30"]
+    timeout = [] if "--timeout" in args else ["--timeout", cli_timeout(30)]
     process = subprocess.Popen(
         [sys.executable, "-m", "rtmu", *args, *timeout],
         stdin=subprocess.DEVNULL,
@@ -354,11 +355,15 @@ def test_the_console_never_sends_a_motion_request_without_yes_whatever_its_descr
     ]
     with ServerThread(TestServer(specs)) as server:
         where = f"127.0.0.1:{server.port}"
-        assert main(["call", where, "tourGoalsInList", "--timeout", "5"]) == EXIT_USAGE
-        assert main(["call", where, "stop", "--timeout", "5"]) == EXIT_USAGE
-        assert main(["call", where, "updateNumbers", "--timeout", "5"]) == EXIT_OK  # a read needs no yes
+        assert main(["call", where, "tourGoalsInList", "--timeout", cli_timeout(5)]) == EXIT_USAGE
+        assert main(["call", where, "stop", "--timeout", cli_timeout(5)]) == EXIT_USAGE
+        assert (
+            main(["call", where, "updateNumbers", "--timeout", cli_timeout(5)]) == EXIT_OK
+        )  # a read needs no yes
         assert not [n for n in server.names() if n in MOTION_REQUESTS]
-        assert main(["call", where, "stop", "--yes", "--timeout", "5"]) == EXIT_OK  # an operator now
+        assert (
+            main(["call", where, "stop", "--yes", "--timeout", cli_timeout(5)]) == EXIT_OK
+        )  # an operator now
         assert "stop" in server.names()
 
 
@@ -373,7 +378,7 @@ def test_a_lost_link_while_waiting_for_a_broadcast_is_a_connection_failure() -> 
 
     server.handlers["checkMap"] = crash_on_check_map
     with ServerThread(server):
-        code = main(["mapedit", f"127.0.0.1:{server.port}", "--check-map", "--timeout", "20"])
+        code = main(["mapedit", f"127.0.0.1:{server.port}", "--check-map", "--timeout", cli_timeout(20)])
     assert code == EXIT_CONNECTION
     assert "checkMap" in server.names()
 

@@ -14,6 +14,7 @@ from pathlib import Path
 import pytest
 from PIL import Image
 
+from patience import cli_timeout
 from rtmu.base.exit_codes import EXIT_OK, EXIT_UNSUPPORTED, EXIT_USAGE
 from rtmu.cli import main
 from rtmu.package_data import project_map
@@ -77,9 +78,14 @@ def test_map_keeps_an_existing_file_unless_forced_then_writes_it_whole(
 ) -> None:
     out = tmp_path / "arena.map"
     out.write_text("an older map\n")
-    assert main(["map", f"127.0.0.1:{sim.port}", "--out", str(out), "--timeout", "5"]) == EXIT_USAGE
+    assert (
+        main(["map", f"127.0.0.1:{sim.port}", "--out", str(out), "--timeout", cli_timeout(5)]) == EXIT_USAGE
+    )
     assert out.read_text() == "an older map\n"
-    assert main(["map", f"127.0.0.1:{sim.port}", "--out", str(out), "--force", "--timeout", "5"]) == EXIT_OK
+    assert (
+        main(["map", f"127.0.0.1:{sim.port}", "--out", str(out), "--force", "--timeout", cli_timeout(5)])
+        == EXIT_OK
+    )
     assert out.read_text().startswith("2D-Map")
     assert [p.name for p in tmp_path.iterdir()] == ["arena.map"], "no temporary file left behind"
 
@@ -89,7 +95,7 @@ def test_image_writes_the_format_its_name_asks_for(
     sim: SimThread, tmp_path: Path, name: str, fmt: str
 ) -> None:
     out = tmp_path / name
-    assert main(["image", f"127.0.0.1:{sim.port}", "--out", str(out), "--timeout", "5"]) == EXIT_OK
+    assert main(["image", f"127.0.0.1:{sim.port}", "--out", str(out), "--timeout", cli_timeout(5)]) == EXIT_OK
     with Image.open(out) as img:
         assert img.format == fmt and img.size == (320, 240)
 
@@ -125,7 +131,9 @@ def test_out_of_range_camera_values_are_refused_with_the_limits(
 
 def test_a_quality_in_range_reaches_the_camera(sim: SimThread, tmp_path: Path) -> None:
     out = tmp_path / "q.jpg"
-    code = main(["image", f"127.0.0.1:{sim.port}", "--out", str(out), "--quality", "30", "--timeout", "5"])
+    code = main(
+        ["image", f"127.0.0.1:{sim.port}", "--out", str(out), "--quality", "30", "--timeout", cli_timeout(5)]
+    )
     assert code == EXIT_OK
     code = main(["image", f"127.0.0.1:{sim.port}", "--out", str(out), "--camera", "Nope", "--force"])
     assert code == EXIT_UNSUPPORTED

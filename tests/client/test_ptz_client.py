@@ -16,6 +16,7 @@ from typing import Any
 
 import pytest
 
+from patience import cli_timeout
 from rtmu.base.exit_codes import EXIT_CONNECTION, EXIT_OK, EXIT_TIMEOUT, EXIT_UNSUPPORTED, EXIT_USAGE
 from rtmu.cli import main
 from rtmu.client.ptz import MAX_NAME, NO_HEAD, NO_LIST, POLL_MS
@@ -244,24 +245,26 @@ def test_hostile_limits_and_positions_are_ignored() -> None:
 def test_cli_shows_and_points_the_head(sim: SimThread, capsys: pytest.CaptureFixture[str]) -> None:
     sim.call(lambda: _reset(sim))
     where = f"127.0.0.1:{sim.port}"
-    assert main(["ptz", where, "--timeout", "5"]) == EXIT_OK
+    assert main(["ptz", where, "--timeout", cli_timeout(5)]) == EXIT_OK
     out = capsys.readouterr().out
     assert "Cam1 (VCC4): setCameraRel, setCameraAbs, setCameraPct, getCameraData, getCameraInfo" in out
     assert "pan -98…98°, tilt -30…88°, zoom 0…100 %" in out and "position: pan 0°, tilt 0°, zoom 0 %" in out
-    assert main(["ptz", where, "--pan", "25", "--zoom", "40", "--json", "--timeout", "5"]) == EXIT_OK
+    assert (
+        main(["ptz", where, "--pan", "25", "--zoom", "40", "--json", "--timeout", cli_timeout(5)]) == EXIT_OK
+    )
     obj = json.loads(capsys.readouterr().out)
     assert obj["ptz"]["position"] == {"pan": 25.0, "tilt": 0.0, "zoom": 40.0}
     assert _head(sim) == (25.0, 0.0, 40.0)
-    assert main(["ptz", where, "--tilt", "-7.5", "--timeout", "5"]) == EXIT_OK  # the others stay
+    assert main(["ptz", where, "--tilt", "-7.5", "--timeout", cli_timeout(5)]) == EXIT_OK  # the others stay
     assert "position: pan 25°, tilt -7.5°, zoom 40 %" in capsys.readouterr().out
     with pytest.raises(SystemExit) as exited:
-        main(["ptz", where, "--pan", "nan", "--timeout", "5"])
+        main(["ptz", where, "--pan", "nan", "--timeout", cli_timeout(5)])
     assert exited.value.code == EXIT_USAGE and "out of range" in capsys.readouterr().err
 
 
 def test_cli_without_a_camera_exits_4() -> None:
     with SimThread(SimConfig(port=0, map_path=OFFICE, camera=False)) as s:
-        assert main(["ptz", f"127.0.0.1:{s.port}", "--timeout", "5"]) == EXIT_UNSUPPORTED
+        assert main(["ptz", f"127.0.0.1:{s.port}", "--timeout", cli_timeout(5)]) == EXIT_UNSUPPORTED
 
 
 def test_cli_with_a_camera_list_that_never_comes_is_a_timeout_not_no_head(
@@ -275,7 +278,7 @@ def test_cli_with_a_camera_list_that_never_comes_is_a_timeout_not_no_head(
     server = TestServer([*SPECS, *CAMERA_SPECS])
     server.handlers["getCameraList"] = lambda s, a: [b"\x05\x00"]  # five cameras, then nothing
     with ServerThread(server):
-        assert main(["ptz", f"127.0.0.1:{server.port}", "--timeout", "5"]) == EXIT_CONNECTION
+        assert main(["ptz", f"127.0.0.1:{server.port}", "--timeout", cli_timeout(5)]) == EXIT_CONNECTION
 
 
 def test_a_watched_position_is_polled_again_after_a_reconnect() -> None:

@@ -11,6 +11,7 @@ from __future__ import annotations
 
 import time
 
+from patience import cli_timeout
 from rtmu.base.exit_codes import EXIT_OK
 from rtmu.cli import main
 
@@ -40,7 +41,16 @@ def test_silence_and_resumption_are_announced(capsys) -> None:  # type: ignore[n
     with ServerThread(server) as running:
         count = str(2 * BEFORE)
         code = main(
-            ["status", f"127.0.0.1:{running.port}", "--interval", "100", "--timeout", "10", "--count", count]
+            [
+                "status",
+                f"127.0.0.1:{running.port}",
+                "--interval",
+                "100",
+                "--timeout",
+                cli_timeout(10),
+                "--count",
+                count,
+            ]
         )
     err = capsys.readouterr().err
     assert code == EXIT_OK, err

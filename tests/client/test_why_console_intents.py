@@ -15,6 +15,7 @@ from typing import Any
 import pytest
 
 from client.navsim import robot
+from patience import cli_timeout
 from recorder.mcapread import read
 from recorder.simsession import recorded_session
 from rtmu.base import exit_codes as codes
@@ -28,7 +29,7 @@ WAIT = 20.0
 
 
 def command(sim: SimThread, name: str) -> None:
-    assert main(["run", f"127.0.0.1:{sim.port}", name, "--timeout", "5"]) == codes.EXIT_OK
+    assert main(["run", f"127.0.0.1:{sim.port}", name, "--timeout", cli_timeout(5)]) == codes.EXIT_OK
 
 
 def answer(future: concurrent.futures.Future[Any] | None) -> Any:

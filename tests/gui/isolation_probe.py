@@ -19,6 +19,8 @@ from pathlib import Path
 
 import pytest
 
+from patience import cli_timeout
+
 from .harness import Gui, pump
 from .process import xdotool
 
@@ -28,7 +30,17 @@ if os.environ.get("RTMU_ISOLATION_PROBE") != "1":  # pragma: no cover - only the
 
 def _vel(port: int) -> float:
     out = subprocess.run(
-        [sys.executable, "-m", "rtmu", "status", f"127.0.0.1:{port}", "--once", "--json", "--timeout", "5"],
+        [
+            sys.executable,
+            "-m",
+            "rtmu",
+            "status",
+            f"127.0.0.1:{port}",
+            "--once",
+            "--json",
+            "--timeout",
+            cli_timeout(5),
+        ],
         capture_output=True,
         text=True,
         timeout=20,

@@ -32,6 +32,8 @@ from .test_handheld_window import clipped_widgets, open_on
 gi.require_version("Gtk", "4.0")
 from gi.repository import Gio, Gtk  # noqa: E402
 
+from patience import cli_timeout  # noqa: E402
+
 LETTER = re.compile(r"[A-Za-z]")
 GTK_OWN = ["Show Text", "Hide Text", "About", "License", "System", "Website", "Credits", "Clear entry"]
 """GTK's own words (its password entry's eye, its About dialog's pages, a search entry's clear icon),
@@ -398,7 +400,7 @@ def check_palette_keys_and_confirmations(gui: Gui, sim: SimThread, name: str) ->
     problems += check_keys_window(gui, name)
 
     # The safe-drive-off confirmation: an obstacle ahead, why won't it move?, its fix asks first.
-    assert main(["run", f"127.0.0.1:{sim.port}", "SimulatorObstacleAhead", "--timeout", "5"]) == 0
+    assert main(["run", f"127.0.0.1:{sim.port}", "SimulatorObstacleAhead", "--timeout", cli_timeout(5)]) == 0
     before = set(Gtk.Window.list_toplevels())
     window.activate_action("win.why", None)
     why = new_window(before, WhyWindow, "the why window")

@@ -25,6 +25,7 @@ from pathlib import Path
 import pytest
 
 from linkfaults import FaultProxy
+from patience import cli_timeout
 from rtmu.base import exit_codes as codes
 from rtmu.cli import main
 from rtmu.client.why_feed import NOT_ASKED_OVER_A_BAD_LINK
@@ -147,7 +148,7 @@ def test_navigating_is_named_and_its_stop_is_sent_only_after_a_yes(
     gui = Gui.start(screenshots, "test_why_navigating", "127.0.0.1", office.port)
     try:
         addr = f"127.0.0.1:{office.port}"
-        assert main(["goto", addr, "Corridor End", "--no-wait", "--timeout", "5"]) == codes.EXIT_OK
+        assert main(["goto", addr, "Corridor End", "--no-wait", "--timeout", cli_timeout(5)]) == codes.EXIT_OK
         pump(lambda: office.snapshot().status.startswith("Going to"), 10, "the robot to navigate")
         why = ask_why(gui)
         sentence = why.sentence.get_text()
@@ -171,7 +172,7 @@ def test_docked_is_named_and_undock_is_sent_only_after_a_yes(screenshots: Path, 
     gui = Gui.start(screenshots, "test_why_docked", "127.0.0.1", office.port)
     try:
         addr = f"127.0.0.1:{office.port}"
-        assert main(["dock", addr, "--timeout", "5", "--limit", "60"]) == codes.EXIT_OK
+        assert main(["dock", addr, "--timeout", cli_timeout(5), "--limit", "60"]) == codes.EXIT_OK
         why = ask_why(gui)
         sentence = why.sentence.get_text()
         assert sentence.startswith("The robot is docked (charging)") and "undock it first" in sentence

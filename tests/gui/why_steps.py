@@ -6,6 +6,7 @@ Real X input throughout (xdotool under the harness's Xvfb), the simulator checke
 
 from __future__ import annotations
 
+from patience import cli_timeout
 from rtmu.base import exit_codes as codes
 from rtmu.cli import main
 from rtmu.sim import SimThread
@@ -19,7 +20,7 @@ WHY_ROW = MenuEntry((), "Why won't it move?…", "win.why")
 
 def command(sim: SimThread, name: str, *args: str) -> None:
     """One of the simulator's own simple commands, sent as an operator would (``rtmu run``)."""
-    assert main(["run", f"127.0.0.1:{sim.port}", name, *args, "--timeout", "5"]) == codes.EXIT_OK
+    assert main(["run", f"127.0.0.1:{sim.port}", name, *args, "--timeout", cli_timeout(5)]) == codes.EXIT_OK
 
 
 def stops(sim: SimThread) -> int:

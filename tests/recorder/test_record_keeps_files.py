@@ -15,6 +15,7 @@ from pathlib import Path
 import pytest
 from mcap.reader import make_reader
 
+from patience import cli_timeout
 from rtmu.base.exit_codes import EXIT_CONNECTION, EXIT_OK, EXIT_SIZE_LIMIT, EXIT_USAGE
 from rtmu.capture.recorded import RAW_TOPICS
 from rtmu.protocol.commands import ClientCommand, ServerCommand
@@ -52,7 +53,7 @@ def free_port() -> int:
 
 
 def record(sim_port: int, out: Path, secret: Path, *more: str) -> subprocess.CompletedProcess[str]:
-    login = ("--user", "alice", "--password-file", str(secret), "--timeout", "5")
+    login = ("--user", "alice", "--password-file", str(secret), "--timeout", cli_timeout(5))
     return rtmu("record", f"127.0.0.1:{sim_port}", "--out", str(out), *login, *more)
 
 
