@@ -94,7 +94,7 @@ def _link_cell(gui: Gui) -> str:
 
 @pytest.mark.parametrize("name", list(FAULTS))
 def test_a_link_fault_stops_the_robot_and_a_held_key_does_not_drive_again(
-    faulty_link: tuple[Gui, SimThread, FaultProxy], name: str
+    faulty_link: tuple[Gui, SimThread, FaultProxy], name: str, capsys: pytest.CaptureFixture[str]
 ) -> None:
     gui, sim, proxy = faulty_link
     fault = FAULTS[name]
@@ -128,6 +128,8 @@ def test_a_link_fault_stops_the_robot_and_a_held_key_does_not_drive_again(
     if name == "mute_to_client":  # explained with its measured cause and what to do
         stop_words = next(t for t in said() if t.startswith("Stopped: the link"))
         assert "— no status from " in stop_words and "limit 0." in stop_words and "Wi-Fi" in stop_words
+        said_on_stderr = capsys.readouterr().err.splitlines()
+        assert said_on_stderr.count(f"rtmu: {stop_words}") == 1, said_on_stderr  # and on stderr, once
     if fault.stop_reaches_server:
         assert stopped_after <= OUR_STOP_WITHIN, f"stopped {stopped_after:.2f} s after the fault"
         assert _robot(sim, "watchdog_stops") == 0

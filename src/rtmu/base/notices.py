@@ -49,6 +49,9 @@ class Notice:
     kind: Kind
     level: Level
     text: str
+    stop: bool = False
+    """It explains a stop of the robot (the link, a lapse, lost focus, the guardian): the window also
+    writes it, once, on stderr — the operator's terminal and a site's log keep every stop's words."""
 
     @classmethod
     def info(cls, kind: Kind, text: str) -> Notice:
@@ -61,3 +64,8 @@ class Notice:
     @classmethod
     def error(cls, kind: Kind, text: str) -> Notice:
         return cls(kind, Level.ERROR, text)
+
+    @classmethod
+    def stopped(cls, kind: Kind, text: str, level: Level = Level.WARNING) -> Notice:
+        """A notice that explains why the robot was just stopped (``stop``)."""
+        return cls(kind, level, text, stop=True)

@@ -234,7 +234,7 @@ class DriveFeed(Feed):
         if self.governor.driving:  # (a stop that ended it already — a new selection — said its own words)
             if self.lease.end(EndReason.STOPPED, view.generation):
                 self.ctx.notice(
-                    Notice.warning(
+                    Notice.stopped(
                         Kind.SAFETY, _("Stopped: {why}. Press again once it is armed.").format(why=why)
                     )
                 )

@@ -18,7 +18,7 @@ import logging
 from collections.abc import Callable
 
 from ..base.i18n import _
-from ..base.notices import Kind, Notice
+from ..base.notices import Kind, Level, Notice
 from ..guardian.handle import BEAT_PERIOD
 from ..guardian.messages import Hello
 from ..guardian.shared import GuardianSeat, SharedGuardian
@@ -115,7 +115,7 @@ class GuardianLink:
                 stopped = True
                 log.info("the guardian stopped the robot: %s", text)
                 said = _("The guardian stopped the robot: {text}. Press again to drive.").format(text=text)
-                self._notice(Notice.error(Kind.SAFETY, said))
+                self._notice(Notice.stopped(Kind.SAFETY, said, Level.ERROR))
             elif word == "unavailable":
                 self.unavailable(text)
         return stopped

@@ -52,7 +52,7 @@ from dataclasses import replace
 from typing import Any
 
 from ..base.i18n import N_, _
-from ..base.notices import Kind, Notice
+from ..base.notices import Kind, Level, Notice
 from ..client.lease import EndReason
 from ..model.observables import OperatorState, RobotModel, SpeedSetting
 from ..settings.store import Profile
@@ -270,7 +270,7 @@ class Controller:
             self.stop()
             then = _("Click the map, then press again") if why == KEYBOARD_LOST else _("Press again")
             self.view.notify(
-                Notice.warning(
+                Notice.stopped(
                     Kind.SAFETY, _("Stopped: {why}. {then} to drive.").format(why=_(why), then=then)
                 )
             )
@@ -298,7 +298,9 @@ class Controller:
         if self.drive.holding:
             self.drive.halt(EndReason.STOPPED)
             self.view.notify(
-                Notice.info(Kind.SAFETY, _("Stopped for {what}. Press again to drive.").format(what=what))
+                Notice.stopped(
+                    Kind.SAFETY, _("Stopped for {what}. Press again to drive.").format(what=what), Level.INFO
+                )
             )
         if keys_leave:
             self.drive.keys_left()

@@ -295,7 +295,7 @@ class HeldDrive:
             why = lease.why or _("a busy computer?")
             text = _("Stopped: the window did not respond in time ({why})").format(why=why)
             self._host.view.notify(
-                Notice.warning(Kind.SAFETY, _("{text}. Press again to drive.").format(text=text))
+                Notice.stopped(Kind.SAFETY, _("{text}. Press again to drive.").format(text=text))
             )
         elif had and reason is EndReason.LINK and not quiet:
             level = self._host.robot.health.value.level
@@ -307,7 +307,7 @@ class HeldDrive:
         why = host.link.lease.why or host.robot.health.value.cause
         said = f" — {words(why)}" if why else _(". Press again once it is back.")
         host.view.notify(
-            Notice.warning(
+            Notice.stopped(
                 Kind.LINK, _("Stopped: the link is {value}{said}").format(value=_(level.value), said=said)
             )
         )

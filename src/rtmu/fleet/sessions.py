@@ -35,7 +35,7 @@ from pathlib import Path
 from typing import Any
 
 from ..base.i18n import _
-from ..base.notices import Kind, Notice
+from ..base.notices import Kind, Level, Notice
 from ..client.link import Opener, open_tcp
 from ..client.roster import (
     DirectRoster,
@@ -374,7 +374,7 @@ class Fleet:
                 said = _("Stopped {robot}: {selected} is selected now. Press again to drive it.").format(
                     robot=old.name, selected=session.name
                 )
-                old.controller.view.notify(Notice.info(Kind.SAFETY, said))
+                old.controller.view.notify(Notice.stopped(Kind.SAFETY, said, Level.INFO))
         self.selected.set(session)
 
     def _selection_moved(self, _old: RobotSession | None, new: RobotSession | None) -> None:

@@ -34,6 +34,7 @@ from ..model.observables import ConnectionState, LinkLevel, Phase  # noqa: E402
 from ..settings.store import Profile  # noqa: E402
 from .fleet_draw import RGB, FleetMark, fleet_colour  # noqa: E402
 from .mapview import STALE_AFTER  # noqa: E402
+from .notice_router import say_stop  # noqa: E402
 from .overlays import ROBOT_RGB  # noqa: E402
 from .robot_list import NARROW_PX, RobotList  # noqa: E402
 from .state_words import sentence_words  # noqa: E402
@@ -62,6 +63,7 @@ class BackgroundView:
         self.name = name
 
     def notify(self, notice: Notice) -> None:
+        say_stop(notice, self.name)
         if notice.level is Level.INFO or notice.kind in QUIET_KINDS:
             return
         self.window.banners.tell(f"fleet:{self.name}", notice.level.value, f"{self.name}: {notice.text}",

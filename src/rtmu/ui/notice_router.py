@@ -14,6 +14,7 @@ display; :class:`NoticeRouter` applies them to the window's banners.
 
 from __future__ import annotations
 
+import sys
 import time
 from collections.abc import Callable
 from dataclasses import dataclass
@@ -119,6 +120,14 @@ def link_banner(old: ConnectionState, new: ConnectionState, navigation: NavState
     if phase is Phase.DISCONNECTED and old.phase is not Phase.DISCONNECTED:
         return Dismiss("link")  # deliberate: no banner at all
     return None
+
+
+def say_stop(notice: Notice, robot: str | None = None) -> None:
+    """A stop's explanation goes to stderr too, once, as the window shows it (``Notice.stop``): the
+    terminal the window was started from, or a site's journal, keeps every stop's measured cause."""
+    if notice.stop:
+        where = f"{robot}: " if robot else ""
+        print(f"rtmu: {where}{notice.text}", file=sys.stderr, flush=True)
 
 
 LOOP_LAG_WARN = 0.5

@@ -52,7 +52,7 @@ from .map_page import MapPage  # noqa: E402
 from .nav_draw import MarkerKind  # noqa: E402
 from .near_people import NearPeopleSwitch  # noqa: E402
 from .notes import status_line  # noqa: E402
-from .notice_router import NoticeRouter, speed_banner  # noqa: E402
+from .notice_router import NoticeRouter, say_stop, speed_banner  # noqa: E402
 from .routes_panel import RoutesPanel  # noqa: E402
 from .selected_model import SelectedModel  # noqa: E402
 from .split_view import SplitView  # noqa: E402
@@ -77,6 +77,7 @@ class _View:
         self.window = window
 
     def notify(self, notice: Notice) -> None:
+        say_stop(notice)
         self.window.show_notice(notice)
 
     def commands_changed(self, states: Mapping[str, CommandState]) -> None:
