@@ -106,6 +106,9 @@ def test_ctrl_z_stops_the_robot_then_the_process_and_nothing_drives_after_resume
             held = False
             proc.send_signal(signal.SIGTERM)
             assert proc.wait(10) == 0, proc.stderr.read() if proc.stderr else ""
+            said = (proc.stderr.read() if proc.stderr else "").splitlines()
+            said = [line for line in said if "suspended" in line]  # each suspension's stop, once
+            assert said == ["rtmu: Stopped: RTMU was suspended (Ctrl+Z). Press again to drive."] * 2, said
         finally:
             if held:
                 xdotool("keyup", "Up")
