@@ -7,13 +7,11 @@ import sys
 import time
 from pathlib import Path
 
-import numpy as np
 import pytest
 
 import rtmu
 from rtmu.ui import tiles
-from rtmu.ui.tiles import TileCache
-from rtmu.ui.viewport import fit_view
+from tile_maps import fitted, random_map_tiles
 
 SRC = Path(rtmu.__file__).resolve().parents[1]
 
@@ -54,12 +52,8 @@ def test_a_burst_freed_on_a_helper_thread_leaves_the_process_after_give_back() -
 def test_the_tile_worker_gives_memory_back_once_idle_after_a_burst(monkeypatch: pytest.MonkeyPatch) -> None:
     calls: list[int] = []
     monkeypatch.setattr(tiles, "give_back", lambda: calls.append(1) or True)
-    cache = TileCache(lambda: None)
-    try:
-        rng = np.random.default_rng(3)
-        cache.set_map(rng.integers(0, 30000, size=(5000, 2)).astype(np.int32), None)
-        assert cache.wait_idle(10)
-        vp = fit_view(cache.bounds, 800, 480)  # type: ignore[arg-type]
+    with random_map_tiles(3) as cache:
+        vp = fitted(cache, 800, 480)
         cache.visible(vp.scale, vp.origin, vp.width, vp.height)
         assert cache.wait_idle(10)
         rendered = cache.rendered
@@ -69,5 +63,3 @@ def test_the_tile_worker_gives_memory_back_once_idle_after_a_burst(monkeypatch: 
             time.sleep(0.01)
         time.sleep(2 * tiles.GIVE_BACK_AFTER_S)
         assert 1 <= len(calls) <= 2, f"{len(calls)} trims for the index and {rendered} tiles: one per burst"
-    finally:
-        cache.close()

@@ -13,6 +13,7 @@ from hypothesis import strategies as st
 
 from rtmu.ui.tiles import BACKGROUND, OVERVIEW_MAX_PX, TILE, MapIndex, TileCache, render_region
 from rtmu.ui.viewport import ZOOM_MAX, ZOOM_MIN, ZOOM_STEPS, Viewport, fit_view, nearest_step, step_zoom
+from tile_maps import fitted, random_map_tiles
 
 coords = st.floats(-1e6, 1e6, allow_nan=False)
 zooms = st.floats(0.005, 4.0)
@@ -110,14 +111,8 @@ def test_segments_are_drawn_by_cairo_or_numpy_along_the_same_line(count: int) ->
 
 def test_tile_cache_renders_what_is_visible_off_the_calling_thread() -> None:
     ready = threading.Event()
-    cache = TileCache(ready.set)
-    try:
-        rng = np.random.default_rng(1)
-        cache.set_map(
-            rng.integers(0, 30000, size=(5000, 2)).astype(np.int32), np.array([[0, 0, 30000, 0]], np.int32)
-        )
-        assert cache.wait_idle(10)
-        vp = fit_view(cache.bounds, 800, 480)  # type: ignore[arg-type]
+    with random_map_tiles(1, ready.set, np.array([[0, 0, 30000, 0]], np.int32)) as cache:
+        vp = fitted(cache, 800, 480)
         spots = cache.visible(vp.scale, vp.origin, vp.width, vp.height)
         assert spots and any(s.surface is None for s in spots)
         assert cache.wait_idle(10)
@@ -126,24 +121,18 @@ def test_tile_cache_renders_what_is_visible_off_the_calling_thread() -> None:
         assert ready.is_set() and cache.overview is not None
         cache.set_map(None, None)
         assert cache.bounds is None
-    finally:
-        cache.close()
 
 
 def test_tile_cache_keeps_the_tiles_of_one_zoom() -> None:
     """A new zoom lets the old zoom's tiles go (issue 28: RSS): a launch's fit before the window had its
     size used to leave a screenful of tiles no frame showed again."""
-    cache = TileCache(lambda: None)
-    try:
-        rng = np.random.default_rng(2)
-        cache.set_map(rng.integers(0, 30000, size=(5000, 2)).astype(np.int32), None)
-        assert cache.wait_idle(10)
-        small = fit_view(cache.bounds, 600, 400)  # type: ignore[arg-type]
+    with random_map_tiles(2) as cache:
+        small = fitted(cache, 600, 400)
         cache.visible(small.scale, small.origin, small.width, small.height)
         assert cache.wait_idle(10)
         first = {key[1] for key in cache._tiles}
         assert first == {small.scale}
-        big = fit_view(cache.bounds, 800, 480)  # type: ignore[arg-type]
+        big = fitted(cache, 800, 480)
         assert big.scale != small.scale
         spots = cache.visible(big.scale, big.origin, big.width, big.height)
         assert cache.wait_idle(10)
@@ -152,8 +141,6 @@ def test_tile_cache_keeps_the_tiles_of_one_zoom() -> None:
         assert all(s.surface is not None for s in spots)
         ov = cache.overview
         assert ov is not None and max(ov.surface.get_width(), ov.surface.get_height()) <= OVERVIEW_MAX_PX + 8
-    finally:
-        cache.close()
 
 
 def test_a_broken_map_does_not_kill_the_worker() -> None:
