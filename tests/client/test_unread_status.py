@@ -11,6 +11,7 @@ verdict read-time judging gives is the pattern that used to stop, and ``judged_f
 from __future__ import annotations
 
 import asyncio
+import sys
 import time
 from collections.abc import Awaitable, Callable, Iterator
 from typing import Any
@@ -20,12 +21,17 @@ import pytest
 from linkfaults import TO_CLIENT, FaultProxy
 from rtmu.client.connection import AriaClient
 from rtmu.client.drive_guard import DriveGuard
+from rtmu.client.lease import DriveRatios
+from rtmu.client.runner import ClientRunner
+from rtmu.client.session import SessionConfig
+from rtmu.model.observables import RobotModel
 from rtmu.package_data import project_map
 from rtmu.sim import SimThread
 from rtmu.values.target import Target
 from simulators import simulator
 
 from .servers import run
+from .uiqueue import UiQueue
 
 sim = simulator(map_path=project_map("arena.map"))
 
@@ -111,3 +117,74 @@ def test_nothing_unread_costs_no_round() -> None:
         return await AriaClient().catch_up()
 
     assert run(go()) == 0
+
+
+def _hold_through_a_late_loop(
+    port: int, before: Callable[[], object], after: Callable[[], object]
+) -> list[str]:
+    """The window's core holds a drive (the test renews the lease as the UI's 10 Hz timer does);
+    ``before()``, then its network loop is not run for :data:`NOT_RUN`, then ``after()`` while still
+    held; the stops it sent."""
+    model, ui = RobotModel(), UiQueue()
+    runner = ClientRunner(model, post=ui.post, config=SessionConfig(fetch_map=False))
+    stops: list[str] = []
+    runner.on_stop = lambda reason, sent: stops.append(reason)
+    runner.start()
+    try:
+        runner.connect(Target("127.0.0.1", port)).result(10)
+        ui.wait_for(lambda: model.health.value.rtt_ms is not None, timeout=10)
+        runner.lease.grant(DriveRatios(30, 0, 30))
+        _renew_for(runner, ui, 1.0)
+        assert stops == []  # driving
+        session = runner.session
+        assert session is not None
+        late = LateHeart(session.clock)
+        session.clock = late  # (read by the drive loop's heart at each beat)
+        before()
+        late.armed = True
+        _renew_for(runner, ui, 1.5)
+        after()
+        return list(stops)
+    finally:
+        runner.lease.release()
+        runner.close()
+
+
+class LateHeart:
+    """The session's clock, but the heart's first look after :attr:`armed` finds its thread not run
+    for :data:`NOT_RUN` — as a loaded laptop runs a loop woken by its timer: ``select`` has returned
+    (the socket was quiet then), the statuses land in the kernel before the heart's step runs."""
+
+    def __init__(self, clock: Callable[[], float]) -> None:
+        self.clock = clock
+        self.armed = False
+
+    def __call__(self) -> float:
+        if self.armed and sys._getframe(1).f_code.co_name in ("_judged_now", "_heart"):
+            self.armed = False
+            _not_run()
+        return self.clock()
+
+
+def _renew_for(runner: ClientRunner, ui: UiQueue, seconds: float) -> None:
+    end = time.monotonic() + seconds
+    while time.monotonic() < end:
+        runner.lease.renew()
+        ui.drain()
+        time.sleep(0.04)
+
+
+def test_a_held_drive_survives_a_network_loop_run_late(sim: SimThread, proxy: FaultProxy) -> None:
+    """Statuses came while the loop was not run: the heart reads them and drives on (judged on the
+    reads alone — "no status for 0.7 s" — it stopped)."""
+    held: list[float] = []
+    stops = _hold_through_a_late_loop(
+        proxy.port, lambda: None, lambda: held.append(sim.snapshot().trans_ratio)
+    )
+    assert stops == [], stops
+    assert held == [30]  # still driving at the end
+
+
+def test_a_muted_link_still_stops_a_held_drive_run_late(sim: SimThread, proxy: FaultProxy) -> None:
+    stops = _hold_through_a_late_loop(proxy.port, lambda: proxy.mute(TO_CLIENT), lambda: None)
+    assert stops and "no status" in stops[0], stops
