@@ -27,6 +27,8 @@ before (``RTMU_LINK_TIMING=fixed``: stale after 3 status intervals in the window
   counts the 0.8 s starvations that stopped a drive the operator kept holding
   (``RTMU_LINKS_FREEZE_TRIALS``, 10).
 
+``RTMU_LINKS_CONDITIONS=load4`` (comma-separated) soaks only those conditions and
+``RTMU_LINKS_BASELINE_S=0`` skips the baseline, while diagnosing one of them.
 ``RTMU_LINKS_TRACE=DIR`` keeps every simulator's clocks and a machine-wide stall probe for the
 false-stop soaks; ``python -m bench.links_trace DIR`` then names the late clock of each stop.
 
@@ -61,6 +63,8 @@ BASELINE_S = float(os.environ.get("RTMU_LINKS_BASELINE_S", str(min(SOAK_S, 120.0
 TRIALS = int(os.environ.get("RTMU_LINKS_TRIALS", "20"))
 FREEZE_TRIALS = int(os.environ.get("RTMU_LINKS_FREEZE_TRIALS", "10"))
 PROFILES = {"good": GOOD_WIFI, "busy": BUSY_WIFI}
+CONDITIONS = os.environ.get("RTMU_LINKS_CONDITIONS", "good,busy,load4").split(",")
+"""The false-stop soak's conditions (all three by default; one alone while diagnosing it)."""
 SAME_STOP = 0.5
 """Stops (and guardian reports) closer than this are one event."""
 
@@ -192,11 +196,15 @@ def false_stop_rows() -> list[Result]:
         argv = [sys.executable, "-m", "bench.stall_probe", f"{trace}/probe.json", str(total)]
         probe = subprocess.Popen(argv, cwd=REPO)
     for fixed, seconds in ((False, SOAK_S), (True, BASELINE_S)):
-        phase(("good",), seconds, fixed)
-        phase(("busy",), seconds, fixed)
-        with CpuLoad(count=4, nice=0, seconds=seconds + 300) as load:
-            wait_busy(load)
-            phase(("load4",), seconds, fixed)
+        if seconds <= 0:
+            continue  # (RTMU_LINKS_BASELINE_S=0: no baseline, while diagnosing)
+        for profile in ("good", "busy"):
+            if profile in CONDITIONS:
+                phase((profile,), seconds, fixed)
+        if "load4" in CONDITIONS:
+            with CpuLoad(count=4, nice=0, seconds=seconds + 300) as load:
+                wait_busy(load)
+                phase(("load4",), seconds, fixed)
     if probe is not None:
         probe.terminate()
     out = []

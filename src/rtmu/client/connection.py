@@ -66,6 +66,8 @@ log = logging.getLogger(__name__)
 
 REPLY_TIMEOUT = 5.0
 """Default wait for a reply, and for each further packet of a multi-packet reply."""
+CATCH_UP_ROUNDS = 8
+"""Loop rounds :meth:`AriaClient.catch_up` gives the read loop at most (a flood must not hold a verdict)."""
 MAX_WRITE_BUFFER = 1 << 20
 """A server that stops reading is dropped once this much output is queued (it would grow forever)."""
 
@@ -490,6 +492,26 @@ class AriaClient:
     def _abort(self) -> None:
         if self._link is not None:
             self._link.abort()
+
+    def unread(self) -> int:
+        """Bytes that have arrived from the server but not yet been read (kernel and stream buffer)."""
+        link = self._link
+        return 0 if link is None or self._closed_error is not None else link.unread()
+
+    async def catch_up(self) -> int:
+        """Before a verdict of silence: let the read loop take in what has already arrived.
+
+        A busy laptop may run this thread 150–300 ms late; a status that came meanwhile sits unread
+        in the socket, and the link would be called stale on a status the kernel already holds.
+        This yields to the loop (a few rounds at most, however much keeps coming) until nothing is
+        left unread. Returns the bytes that were waiting — 0, at no cost, when the silence is real.
+        """
+        waiting = self.unread()
+        for _ in range(CATCH_UP_ROUNDS if waiting else 0):
+            await asyncio.sleep(0)  # the selector reports the socket, then the read task routes it
+            if not self.unread():  # (the read task routes what it takes from the buffer at once)
+                break
+        return waiting
 
     async def flush(self, timeout: float = CLOSE_TIMEOUT) -> bool:
         """Wait, at most ``timeout`` s, until everything sent has been handed to the kernel.

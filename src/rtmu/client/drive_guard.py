@@ -115,6 +115,14 @@ class DriveGuard:
             return None
         return self.health.cause(now)
 
+    async def judged_fault(self, now: float) -> str | None:
+        """:meth:`fault`, but silence is judged on what has *arrived*: status the kernel already
+        holds, unread because the machine ran us late, is read first (``AriaClient.catch_up``)."""
+        why = self.fault(now)
+        if why is None or self.client.closed_error is not None or not await self.client.catch_up():
+            return why
+        return self.fault(self.client.clock())
+
     def advice(self) -> str:
         """What to do about the last :meth:`fault`."""
         return self.health.advice()

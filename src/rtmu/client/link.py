@@ -9,9 +9,12 @@ recorded session and a test feed all run through the same client code.
 
 from __future__ import annotations
 
+import array
 import asyncio
 import contextlib
+import fcntl
 import socket
+import termios
 from collections.abc import Awaitable, Callable, Iterable
 from dataclasses import dataclass
 from typing import Protocol
@@ -26,6 +29,11 @@ class Link(Protocol):
 
     def backlog(self) -> int:
         """Bytes written but not yet handed to the OS (a peer that stops reading makes this grow)."""
+        ...
+
+    def unread(self) -> int:
+        """Bytes that have arrived but not yet been read: in the kernel's socket and in the stream's
+        buffer. A status among them is not late, however long the machine took to run us."""
         ...
 
     def is_closing(self) -> bool: ...
@@ -83,6 +91,13 @@ class StreamLink:
     def backlog(self) -> int:
         return self.writer.transport.get_write_buffer_size()
 
+    def unread(self) -> int:
+        buffered = len(getattr(self.reader, "_buffer", b""))  # (asyncio keeps it private; 0 if renamed)
+        sock = self.writer.get_extra_info("socket")
+        if sock is None or self.writer.is_closing():
+            return buffered
+        return buffered + kernel_unread(sock.fileno())
+
     def is_closing(self) -> bool:
         return self.writer.is_closing()
 
@@ -104,6 +119,16 @@ class StreamLink:
         transport = self.writer.transport
         if not transport.is_closing():
             transport.abort()
+
+
+def kernel_unread(fd: int) -> int:
+    """Bytes waiting in socket ``fd``'s receive queue (``FIONREAD``); 0 if the kernel will not say."""
+    count = array.array("i", [0])
+    try:
+        fcntl.ioctl(fd, termios.FIONREAD, count, True)
+    except OSError:
+        return 0
+    return count[0]
 
 
 async def open_tcp(host: str, port: int) -> Link:
@@ -141,6 +166,9 @@ class LinkWrapper:
 
     def backlog(self) -> int:
         return self.inner.backlog()
+
+    def unread(self) -> int:
+        return self.inner.unread()
 
     def is_closing(self) -> bool:
         return self.inner.is_closing()
@@ -192,6 +220,9 @@ class RecordedLink:
         self._changed = asyncio.Event()
 
     def backlog(self) -> int:
+        return 0
+
+    def unread(self) -> int:
         return 0
 
     def is_closing(self) -> bool:

@@ -362,7 +362,7 @@ async def drive(
         if now >= end:
             return
         if guard is not None and not held():
-            why = guard.fault(now)
+            why = await guard.judged_fault(now)
             if why is not None:
                 raise LinkFault(why)
         if now >= next_send:
