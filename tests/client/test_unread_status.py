@@ -19,8 +19,12 @@ from typing import Any
 import pytest
 
 from linkfaults import TO_CLIENT, FaultProxy
+from patience import PATIENCE
+from rtmu.client.call_values import Reply
 from rtmu.client.connection import AriaClient
 from rtmu.client.drive_guard import DriveGuard
+from rtmu.client.errors import ClientTimeout
+from rtmu.client.health import ping_data
 from rtmu.client.lease import DriveRatios
 from rtmu.client.runner import ClientRunner
 from rtmu.client.session import SessionConfig
@@ -37,6 +41,8 @@ sim = simulator(map_path=project_map("arena.map"))
 
 NOT_RUN = 0.7
 """Seconds the loop's thread is kept from running: longer than any stale limit (ceiling 0.45 s)."""
+PING_DEADLINE = 0.3
+"""A ping's deadline in the ping tests: well under the time the loop is not run."""
 
 
 @pytest.fixture
@@ -108,6 +114,36 @@ def test_a_garbage_flood_cannot_hold_the_verdict_off(sim: SimThread, proxy: Faul
     why, waiting = _guarded(proxy.port, body)
     assert waiting > 0  # the garbage was there to read
     assert why is not None and "no status" in why
+
+
+def test_a_ping_answered_while_the_loop_was_not_run_is_answered(sim: SimThread, proxy: FaultProxy) -> None:
+    """The ping's answer came while the loop was not run: its timer and the answer wake the loop
+    together, and a plain request's timer wins (the pattern that used to count a ping failure and
+    stop the robot); ``ask_in_time`` reads what arrived first. A muted link still times out."""
+
+    async def late(call: Awaitable[Any]) -> Any:
+        task = asyncio.ensure_future(call)
+        for _ in range(3):  # the request is written (ask_in_time's own request task runs one round later)
+            await asyncio.sleep(0)
+        _not_run(NOT_RUN * PATIENCE)  # the answer arrives meanwhile; the deadline passes
+        try:
+            return await task
+        except ClientTimeout as exc:
+            return exc
+
+    async def body(client: AriaClient, _guard: DriveGuard) -> tuple[Any, Any, Any]:
+        name = ping_data(client.datalist)
+        assert name is not None
+        plain = await late(client.request_once(name, timeout=PING_DEADLINE))
+        judged = await late(client.ask_in_time(name, PING_DEADLINE))
+        proxy.mute(TO_CLIENT)
+        muted = await late(client.ask_in_time(name, PING_DEADLINE))
+        return plain, judged, muted
+
+    plain, judged, muted = _guarded(proxy.port, body)
+    assert isinstance(plain, ClientTimeout), plain  # judged by the timer alone: a failure
+    assert isinstance(judged, Reply), judged  # read first: answered
+    assert isinstance(muted, ClientTimeout), muted
 
 
 def test_nothing_unread_costs_no_round() -> None:

@@ -348,6 +348,32 @@ class AriaClient:
         payloads = await waiter.collect(timeout)
         return Reply(name, payloads, self.clock())
 
+    async def ask_in_time(self, name: str, deadline: float) -> Reply:
+        """``request_once`` judged on what *arrived*: a ping's answer.
+
+        A reply that came within ``deadline`` s counts even when this loop was run too late to read
+        it in time: the timer and the answer wake the loop together, and the timer would win. So the
+        request waits far longer (``REPLY_TIMEOUT`` more), and when the deadline passes, what the
+        kernel already holds is read first (:meth:`catch_up`). No answer then: :class:`ClientTimeout`.
+        """
+        task = asyncio.ensure_future(self.request_once(name, timeout=deadline + REPLY_TIMEOUT))
+        try:
+            done, _ = await asyncio.wait({task}, timeout=deadline)
+            if not done:
+                await self.catch_up()
+                for _ in range(CATCH_UP_ROUNDS):  # (the reply routed: its request finishes in a round)
+                    if task.done():
+                        break
+                    await asyncio.sleep(0)
+            if not task.done():
+                raise ClientTimeout(f"no reply to {name!r} within {deadline:g} s")
+            return task.result()
+        finally:
+            if not task.done():
+                task.cancel()
+                with contextlib.suppress(asyncio.CancelledError, ClientError):
+                    await task
+
     async def stream(
         self,
         what: str | Payload,

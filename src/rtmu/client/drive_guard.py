@@ -91,7 +91,7 @@ class DriveGuard:
         while self.client.connected:
             started = time.perf_counter()
             try:
-                await self.client.request_once(name, timeout=self.health.ping_deadline(self.client.clock()))
+                await self.client.ask_in_time(name, self.health.ping_deadline(self.client.clock()))
             except ClientTimeout:
                 self.health.note_ping_timeout()
                 self.changed.set()

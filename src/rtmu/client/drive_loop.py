@@ -209,7 +209,7 @@ class DriveFeed(Feed):
         while client.connected:
             started = time.perf_counter()
             try:
-                reply = await client.request_once(name, timeout=self.health.ping_deadline(self.ctx.clock()))
+                reply = await client.ask_in_time(name, self.health.ping_deadline(self.ctx.clock()))
             except ClientTimeout:
                 # The server may have stopped reading: it would not hear a stop either.
                 self.health.note_ping_timeout()
