@@ -356,7 +356,10 @@ class AriaClient:
         request waits far longer (``REPLY_TIMEOUT`` more), and when the deadline passes, what the
         kernel already holds is read first (:meth:`catch_up`). No answer then: :class:`ClientTimeout`.
         """
-        task = asyncio.ensure_future(self.request_once(name, timeout=deadline + REPLY_TIMEOUT))
+        waiter = self._start(name, b"", None, None, False, MAX_REPLY_PACKETS, MAX_REPLY_BYTES)  # sent now
+        if waiter is None:
+            return Reply(name, (), self.clock())
+        task = asyncio.ensure_future(waiter.collect(deadline + REPLY_TIMEOUT))
         try:
             done, _ = await asyncio.wait({task}, timeout=deadline)
             if not done:
@@ -367,7 +370,7 @@ class AriaClient:
                     await asyncio.sleep(0)
             if not task.done():
                 raise ClientTimeout(f"no reply to {name!r} within {deadline:g} s")
-            return task.result()
+            return Reply(name, task.result(), self.clock())
         finally:
             if not task.done():
                 task.cancel()
