@@ -352,30 +352,22 @@ class AriaClient:
         """``request_once`` judged on what *arrived*: a ping's answer.
 
         A reply that came within ``deadline`` s counts even when this loop was run too late to read
-        it in time: the timer and the answer wake the loop together, and the timer would win. So the
-        request waits far longer (``REPLY_TIMEOUT`` more), and when the deadline passes, what the
-        kernel already holds is read first (:meth:`catch_up`). No answer then: :class:`ClientTimeout`.
+        it in time: the timer and the answer wake the loop together, and the timer runs first. So
+        when the deadline passes, what the kernel already holds is read (:meth:`catch_up`) before it
+        is called missed. No answer then: :class:`ClientTimeout`. (The request and its wait are
+        ``request_once``'s own: a ping answered in time takes exactly the same path.)
         """
-        waiter = self._start(name, b"", None, None, False, MAX_REPLY_PACKETS, MAX_REPLY_BYTES)  # sent now
+        waiter = self._start(name, b"", None, None, False, MAX_REPLY_PACKETS, MAX_REPLY_BYTES)
         if waiter is None:
             return Reply(name, (), self.clock())
-        task = asyncio.ensure_future(waiter.collect(deadline + REPLY_TIMEOUT))
-        try:
-            done, _ = await asyncio.wait({task}, timeout=deadline)
-            if not done:
-                await self.catch_up()
-                for _ in range(CATCH_UP_ROUNDS):  # (the reply routed: its request finishes in a round)
-                    if task.done():
-                        break
-                    await asyncio.sleep(0)
-            if not task.done():
-                raise ClientTimeout(f"no reply to {name!r} within {deadline:g} s")
-            return Reply(name, task.result(), self.clock())
-        finally:
-            if not task.done():
-                task.cancel()
-                with contextlib.suppress(asyncio.CancelledError, ClientError):
-                    await task
+        payloads = await waiter.collect(deadline, arrived=self._take_in_arrived)
+        return Reply(name, payloads, self.clock())
+
+    async def _take_in_arrived(self) -> None:
+        """:meth:`catch_up`, then the rounds a routed reply needs to wake its waiter."""
+        await self.catch_up()
+        for _ in range(2):
+            await asyncio.sleep(0)
 
     async def stream(
         self,

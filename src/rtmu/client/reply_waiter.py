@@ -10,7 +10,7 @@ still line up — and the timeout's error says how far the reply came.
 from __future__ import annotations
 
 import asyncio
-from collections.abc import AsyncGenerator, Callable
+from collections.abc import AsyncGenerator, Awaitable, Callable
 
 from ..protocol.decoder import DropStats
 from ..protocol.events import ReplyId
@@ -86,8 +86,14 @@ class ReplyWaiter:
         self.progress.set()
 
     # -- how a caller waits --------------------------------------------------------------------
-    async def collect(self, timeout: float) -> tuple[bytes, ...]:
-        """Every payload of the reply, once it has ended; ``timeout`` bounds the wait for each packet."""
+    async def collect(
+        self, timeout: float, arrived: Callable[[], Awaitable[object]] | None = None
+    ) -> tuple[bytes, ...]:
+        """Every payload of the reply, once it has ended; ``timeout`` bounds the wait for each packet.
+
+        ``arrived()``: before a timeout is final, take in what has already arrived (a loop run late
+        finds its timer and the answer due together, and the timer runs first); a packet it brings
+        means the wait goes on."""
         name = self.reply.name
         try:
             while not self.finished:
@@ -96,6 +102,10 @@ class ReplyWaiter:
                     async with asyncio.timeout(timeout):
                         await self.progress.wait()
                 except TimeoutError:
+                    if arrived is not None:
+                        await arrived()
+                        if self.progress.is_set():
+                            continue
                     got = self.count
                     self._abandon(self)
                     raise no_reply(
