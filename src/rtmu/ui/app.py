@@ -12,6 +12,7 @@ import sys
 from typing import TYPE_CHECKING
 
 from ..base.exit_codes import EXIT_CONNECTION, EXIT_INTERNAL, EXIT_NO_DISPLAY, EXIT_USAGE
+from ..base.heap import hold, resume
 from ..base.i18n import _
 from ..client.defaults import DEFAULT_PORT
 
@@ -109,6 +110,15 @@ def run_gui(args: argparse.Namespace) -> int:
     if not 1 <= robots <= 50:
         print(_("rtmu: --robots {robots} is not 1…50").format(robots=robots), file=sys.stderr)
         return EXIT_USAGE
+    hold()  # no collector passes while the window's modules and widgets are built (base.heap)
+    try:
+        return _open_window(options, robots)
+    finally:
+        resume()  # the window settles (and collects again) 3 s after it shows; it may have closed sooner
+
+
+def _open_window(options: GuiOptions, robots: int) -> int:
+    """The display, the demo's simulator if asked for, the window until it closes: the exit status."""
     if not display_available():
         print(
             _(
