@@ -42,12 +42,19 @@ _HOOK: list[int] = []
 
 
 def descendants(widget: Gtk.Widget) -> Iterator[Gtk.Widget]:
-    """Every widget below ``widget``, depth first (its popovers included: they are children too)."""
+    """Every widget below ``widget``, depth first (its popovers included: they are children too).
+
+    One stack, not a generator per level: a nested ``yield from`` passes each widget up through every
+    level above it, and the window's 860 widgets took 40 000 steps on every launch."""
+    stack: list[Gtk.Widget] = []
     child = widget.get_first_child()
-    while child is not None:
+    while child is not None or stack:
+        if child is None:
+            child = stack.pop().get_next_sibling()
+            continue
         yield child
-        yield from descendants(child)
-        child = child.get_next_sibling()
+        stack.append(child)
+        child = child.get_first_child()
 
 
 def in_text_field(focus: Gtk.Widget | None) -> bool:
@@ -94,7 +101,7 @@ class StopKeys:
         self.guard(window)
         for widget in descendants(window):  # popovers built with the window (menus, Go to, the gear)
             if isinstance(widget, Gtk.Popover):
-                self.guard(widget)
+                self.guard(widget, fields=False)  # their fields were marked with the window's
 
     def close(self) -> None:
         _INSTANCES.discard(self)
@@ -104,7 +111,7 @@ class StopKeys:
         """``native`` is the main window, one of its dialogs (``transient-for`` chain) or their popover."""
         return belongs_to(self.window, _owner_window(native))
 
-    def guard(self, native: Gtk.Widget) -> None:
+    def guard(self, native: Gtk.Widget, *, fields: bool = True) -> None:
         """Give ``native`` (a window or popover) the stop keys, once; mark its text fields."""
         if not is_guarded(native):
             keys = Gtk.EventControllerKey()
@@ -114,7 +121,8 @@ class StopKeys:
             setattr(native, GUARD_ATTR, True)
             if isinstance(native, Gtk.Window):  # fields built later (the configuration's editors)
                 native.connect("notify::focus-widget", lambda w, _p: self.mark_field(w.get_focus()))
-        self.mark_fields(native)
+        if fields:
+            self.mark_fields(native)
 
     def shown(self, native: Gtk.Widget) -> None:
         """A surface of this window showed (the emission hook): guard it; a popover ends a held drive."""
