@@ -49,7 +49,9 @@ def connect_button(on_click: Callable[[], None]) -> Gtk.Button:
     return button
 
 
-def menu_button(menu: Gio.MenuModel) -> Gtk.MenuButton:
+def menu_button(menu: Gio.MenuModel, *, built_when_opened: bool = False) -> Gtk.MenuButton:
+    """The main menu's button. ``built_when_opened``: its ~200 widgets are made the first time it opens
+    (the full-screen bar's, hidden until full screen: building it made every launch slower)."""
     button = Gtk.MenuButton(icon_name="open-menu-symbolic", tooltip_text=_("Menu"))
     button.set_focusable(False)
     # The menu button's own inner toggle would take the window's first focus and then wear a focus
@@ -57,9 +59,18 @@ def menu_button(menu: Gio.MenuModel) -> Gtk.MenuButton:
     inner = button.get_first_child()
     if inner is not None:
         inner.set_focusable(False)
-    button.set_menu_model(menu)
+    if built_when_opened:
+        button.set_create_popup_func(_build_menu, menu)
+    else:
+        button.set_menu_model(menu)
     accessible.name_menu_button(button, _("Main menu"))
     return button
+
+
+def _build_menu(button: Gtk.MenuButton, menu: Gio.MenuModel) -> None:
+    """GTK asks before the popup shows: the menu is made once, the first time."""
+    if button.get_menu_model() is None:
+        button.set_menu_model(menu)
 
 
 def show_connection(button: Gtk.Button, connected_ish: bool) -> None:
@@ -132,7 +143,7 @@ class FullscreenBar(Gtk.Revealer):
         self.status_label.add_css_class("subtitle")
         self.status_label.set_ellipsize(Pango.EllipsizeMode.END)
         self.status_label.set_use_markup(False)
-        self.menu_button = menu_button(menu)
+        self.menu_button = menu_button(menu, built_when_opened=True)
         self.leave_button = Gtk.Button(
             icon_name="view-restore-symbolic", tooltip_text=_("Leave full screen (F11)")
         )
