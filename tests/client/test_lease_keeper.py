@@ -246,3 +246,35 @@ def test_the_kernel_account_tells_a_starved_thread_from_a_frozen_one() -> None:
         assert not lease.view().live
     finally:
         keeper.close()
+
+
+def test_a_look_reads_the_thread_anew_and_an_ended_thread_is_forgotten() -> None:
+    """The /proc files stay open between looks: each look must still see the thread as it is now."""
+    from rtmu.client.lease_keeper import _PROC_FILES, _thread_sample
+
+    me = threading.get_native_id()
+    first = _thread_sample(me)
+    assert first is not None and first.runnable  # this thread is running as it looks at itself
+    busy_until = time.thread_time() + 0.05
+    while time.thread_time() < busy_until:
+        pass
+    second = _thread_sample(me)
+    assert second is not None and second.ran > first.ran  # read anew, not the first read again
+    assert me in _PROC_FILES
+
+    release = threading.Event()
+    worker = threading.Thread(target=release.wait)
+    worker.start()
+    other = worker.native_id
+    assert other is not None
+    try:
+        assert _thread_sample(other) is not None
+        assert other in _PROC_FILES  # its files are open now
+    finally:
+        release.set()
+        worker.join()
+    deadline = time.monotonic() + 10.0  # join() returns a moment before the kernel's thread is gone
+    while _thread_sample(other) is not None:
+        assert time.monotonic() < deadline, "an ended thread still reads as alive"
+        time.sleep(0.01)
+    assert other not in _PROC_FILES  # its files are closed, not kept
