@@ -7,6 +7,7 @@ from __future__ import annotations
 import numpy as np
 from PIL import Image
 
+from rtmu.ui.live_video import FPS_CHOICES, QUALITY_CHOICES
 from simulators import simulator
 
 from .harness import OFFICE_MAP, Gui, pump
@@ -33,6 +34,17 @@ def test_the_gear_popover_is_dark_with_light_words(gui: Gui) -> None:
         grey = np.asarray(crop.convert("L")).astype(int)
     assert grey.mean() < 110, f"a light popover under the bar's white words (mean {grey.mean():.0f})"
     assert (grey > 200).sum() > 30, "no light words on it"
+    # The drop-downs are made as the gear first opens: what they choose is what the next request asks.
+    assert controls.fps is not None and controls.quality is not None
+    assert controls.target_fps() == FPS_CHOICES[controls.fps.get_selected()]
+    controls.fps.set_selected(0)
+    controls.quality.set_selected(len(QUALITY_CHOICES) - 1)
+    assert controls.target_fps() == FPS_CHOICES[0]
+    assert controls.target_quality() == int(QUALITY_CHOICES[-1])
+    popover.popdown()
+    gui.click(controls.settings_button)  # opened again: the same drop-downs, the choice kept
+    pump(lambda: popover.get_mapped(), 3, "the gear popover again")
+    assert controls.fps.get_selected() == 0 and controls.target_fps() == FPS_CHOICES[0]
     popover.popdown()
     gui.key("space")  # Space still stops from the camera page
     pump(lambda: window.stack.get_visible_child_name() == "camera", 3, "the page kept")

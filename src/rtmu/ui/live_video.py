@@ -81,31 +81,24 @@ class LiveVideoControls:
         self.save_button = Gtk.Button(icon_name="document-save-symbolic")
         self.save_button.set_tooltip_text(_("Save the frame on screen (JPEG)"))
         self.save_button.set_sensitive(False)
-        self.fps = Gtk.DropDown.new_from_strings([_("{n} fps").format(n=n) for n in FPS_CHOICES])
-        self.fps.set_selected(FPS_CHOICES.index(DEFAULT_FPS))
-        self.fps.set_tooltip_text(_("Frames per second at most"))
-        self.quality = Gtk.DropDown.new_from_strings([f"Q {q}" for q in QUALITY_CHOICES])
-        self.quality.set_tooltip_text(_("JPEG quality to ask the server for"))
-        settings = Gtk.Box(orientation=Gtk.Orientation.VERTICAL, spacing=6)
-        settings.append(self.fps)
-        settings.append(self.quality)
-        popover = Gtk.Popover()
-        popover.set_child(settings)
-        self.settings_button = Gtk.MenuButton(icon_name="emblem-system-symbolic", popover=popover)
+        self._fps_choice = FPS_CHOICES.index(DEFAULT_FPS)
+        self._quality_choice = 0
+        self.fps: Gtk.DropDown | None = None
+        """The rate's and quality's drop-downs, made the first time the gear opens (``_settings_popup``):
+        each carries a list and popover of its own, a sixth of the window's widgets at every launch."""
+        self.quality: Gtk.DropDown | None = None
+        self.settings_button = Gtk.MenuButton(icon_name="emblem-system-symbolic", popover=Gtk.Popover())
+        self.settings_button.set_create_popup_func(self._settings_popup)
         self.settings_button.set_tooltip_text(_("Video frame rate and JPEG quality"))
         for w in (self.live_button, self.pause_button, self.save_button, self.settings_button):
             w.set_focusable(False)  # the arrow keys keep driving
         accessible.name(self.live_button, _("Live video"))
         accessible.name(self.pause_button, _("Pause video"))
         accessible.name(self.save_button, _("Save frame"))
-        accessible.name(self.fps, _("Frame rate"))
-        accessible.name(self.quality, _("JPEG quality"))
         accessible.name_menu_button(self.settings_button, _("Video settings"))
         self.live_button.connect("toggled", self._live_toggled)
         self.pause_button.connect("toggled", lambda b: self._paused(b.get_active()))
         self.save_button.connect("clicked", lambda _b: self.save())
-        self.fps.connect("notify::selected", lambda *_a: self._settings_changed())
-        self.quality.connect("notify::selected", lambda *_a: self._settings_changed())
         anchor: Gtk.Widget = camera.info
         for w in (self.live_button, self.pause_button, self.save_button, self.settings_button):
             camera.bar.insert_child_after(w, anchor)
@@ -117,11 +110,38 @@ class LiveVideoControls:
         return self.live_button.get_active()
 
     def target_fps(self) -> float:
-        return float(FPS_CHOICES[min(self.fps.get_selected(), len(FPS_CHOICES) - 1)])
+        return float(FPS_CHOICES[min(self._fps_choice, len(FPS_CHOICES) - 1)])
 
     def target_quality(self) -> int | None:
-        choice = QUALITY_CHOICES[min(self.quality.get_selected(), len(QUALITY_CHOICES) - 1)]
+        choice = QUALITY_CHOICES[min(self._quality_choice, len(QUALITY_CHOICES) - 1)]
         return int(choice) if choice.isdigit() else None
+
+    def _settings_popup(self, button: Gtk.MenuButton) -> None:
+        """GTK asks before the gear's popover shows: its drop-downs are made once, the first time."""
+        popover = button.get_popover()
+        if self.fps is not None or popover is None:
+            return
+        self.fps = Gtk.DropDown.new_from_strings([_("{n} fps").format(n=n) for n in FPS_CHOICES])
+        self.fps.set_selected(self._fps_choice)
+        self.fps.set_tooltip_text(_("Frames per second at most"))
+        self.quality = Gtk.DropDown.new_from_strings([f"Q {q}" for q in QUALITY_CHOICES])
+        self.quality.set_selected(self._quality_choice)
+        self.quality.set_tooltip_text(_("JPEG quality to ask the server for"))
+        accessible.name(self.fps, _("Frame rate"))
+        accessible.name(self.quality, _("JPEG quality"))
+        self.fps.connect("notify::selected", lambda d, _p: self._chosen(fps=d.get_selected()))
+        self.quality.connect("notify::selected", lambda d, _p: self._chosen(quality=d.get_selected()))
+        settings = Gtk.Box(orientation=Gtk.Orientation.VERTICAL, spacing=6)
+        settings.append(self.fps)
+        settings.append(self.quality)
+        popover.set_child(settings)
+
+    def _chosen(self, *, fps: int | None = None, quality: int | None = None) -> None:
+        if fps is not None:
+            self._fps_choice = fps
+        if quality is not None:
+            self._quality_choice = quality
+        self._settings_changed()
 
     def set_live(self, on: bool) -> None:
         self.live_button.set_active(on)
