@@ -14,6 +14,7 @@ from rtmu.base.notices import Kind, Notice
 from rtmu.mapfile import MapObject, new_map, write_map
 from rtmu.model.observables import Phase
 from rtmu.sim import SimConfig, SimThread
+from rtmu.ui.stop_keys import is_guarded
 
 from .harness import OFFICE_MAP, Gui, idle, pump
 from .test_window import moving, robot_blue, stopped
@@ -500,6 +501,11 @@ def test_full_screen_keeps_stop_connect_the_menu_and_a_way_out(screenshots: Path
             popover = bar.menu_button.get_popover()
             pump(lambda: popover is not None and popover.get_mapped(), 3, "the menu")
             gui.screen_shot("fullscreen-menu")
+            # The bar's menu is made on this first open: it carries the stop keys all the same.
+            assert popover is not None and is_guarded(popover)
+            stops = window.stop_keys.stops
+            gui.key("space")
+            pump(lambda: window.stop_keys.stops == stops + 1, 3, "Space to stop from the bar's menu")
             popover.popdown()
             pump(lambda: not popover.get_mapped(), 3, "the menu to close")
             # Xvfb has no window manager: once mapped, the window's full-screen state cannot change,
