@@ -68,6 +68,9 @@ _PROC_FILES: dict[int, tuple[int, int]] = {}
 """Per thread id, its ``stat`` and ``schedstat`` files, kept open: a look re-reads them from the start
 (``pread``; the kernel writes them anew), where opening both 30 times a second while driving was
 most of a look's cost. A thread that ended fails its read and is forgotten (its id may come back)."""
+_PROC_LOCK = threading.Lock()
+"""The UI thread and the keeper both look: one look at a time, so no file is closed under a read
+(its number could already name another file of the process)."""
 
 
 def _proc_files(tid: int) -> tuple[int, int]:
@@ -90,13 +93,14 @@ def _forget(tid: int) -> None:
 
 
 def _thread_sample(tid: int) -> ThreadSample | None:
-    try:
-        stat, sched = _proc_files(tid)
-        state = os.pread(stat, 1024, 0).rsplit(b")", 1)[1].split()[0]
-        ran, delayed = os.pread(sched, 256, 0).split()[:2]
-    except (OSError, IndexError, ValueError):
-        _forget(tid)
-        return None
+    with _PROC_LOCK:
+        try:
+            stat, sched = _proc_files(tid)
+            state = os.pread(stat, 1024, 0).rsplit(b")", 1)[1].split()[0]
+            ran, delayed = os.pread(sched, 256, 0).split()[:2]
+        except (OSError, IndexError, ValueError):
+            _forget(tid)
+            return None
     return ThreadSample(state == b"R", int(ran) / 1e9, int(delayed) / 1e9)
 
 
