@@ -141,8 +141,12 @@ def test_the_window_loads_no_replay_reader() -> None:
 
 WINDOW_LATE = (
     "rtmu.client.central",  # a central server's roster: for a central profile only
-    "rtmu.client.why_gather",  # why won't it move?: its questions and fixes when first asked
+    "rtmu.client.why_gather",  # why won't it move?: its questions, rules and fixes when first asked
     "rtmu.client.why_fix",
+    "rtmu.client.why",
+    "rtmu.client.why_values",
+    "rtmu.client.config_care",  # configuration care (factory values, reset, map switch): first used
+    "rtmu.protocol.payloads.configcare",
     "xml.sax",  # XML escaping brings urllib and email: no part of the first frame needs them
     "urllib.request",
     "email",

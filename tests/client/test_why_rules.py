@@ -3,9 +3,10 @@ geometry, the watchdog, words, and reading replies of unknown layout."""
 
 from __future__ import annotations
 
-from rtmu.client.why import StillWhileHeld, diagnose, moved, unexplained
+from rtmu.client.why import diagnose, moved, unexplained
 from rtmu.client.why_gather import ld_entries, limits_from, split_fields
 from rtmu.client.why_safe_drive import nearest
+from rtmu.client.why_still import StillWhileHeld
 from rtmu.client.why_values import (
     ARIA_LIMITER_DEFAULTS,
     Cause,

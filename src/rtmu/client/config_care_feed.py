@@ -13,18 +13,18 @@ from __future__ import annotations
 
 import asyncio
 from collections.abc import Iterable
-from typing import Any, ClassVar
+from typing import TYPE_CHECKING, Any, ClassVar
 
-from ..protocol.payloads.config import SetConfigReply
-from ..protocol.payloads.configcare import CheckMap
 from ..values.intents import FetchConfigDefaults, Intent, ResetConfig, SwitchMap
 from .call_values import Packet
-from .config_care import MAP_PARAM, MAP_SECTION, fetch_defaults, map_param_problem, reset
 from .config_feed import fetch_config, set_config
 from .connection import AriaClient
 from .errors import NotSupported
 from .feed import Feed, FeedContext
 from .subscriptions import Subscription
+
+if TYPE_CHECKING:
+    from ..protocol.payloads.config import SetConfigReply
 
 
 class ConfigCareFeed(Feed):
@@ -46,6 +46,8 @@ class ConfigCareFeed(Feed):
             self._updated.set()
 
     def handle(self, intent: Intent) -> Any:
+        from .config_care import fetch_defaults, reset  # with the first intent, not at launch (issue 28)
+
         client = self.require()
         timeout = self.ctx.config.reply_timeout
         if isinstance(intent, FetchConfigDefaults):
@@ -57,6 +59,8 @@ class ConfigCareFeed(Feed):
 
     async def _switch(self, client: AriaClient, path: str, timeout: float) -> bool:
         """Set ``Files/Map`` to ``path`` (a file the robot lists); True once ``mapUpdated`` came."""
+        from ..protocol.payloads.configcare import CheckMap
+        from .config_care import MAP_PARAM, MAP_SECTION, map_param_problem
         from .remote_files import Refused, remote_path  # with the first switch, not at launch
 
         path = remote_path(path)

@@ -513,29 +513,3 @@ def unexplained(answer: Answer) -> Answer:
         N_("look at the robot itself (e-stop, motors, faults on its own display) and at the server's log"),
     )
     return Answer((reason, *answer.reasons), answer.notes, answer.raw)
-
-
-HINT_AFTER = 1.0
-"""Seconds a held drive may produce no motion before the window offers its answer."""
-
-
-class StillWhileHeld:
-    """When to offer "why won't it move?" on its own: a drive held :data:`HINT_AFTER` s without the
-    robot moving. Fed by the window on its own clock; says True once per held drive."""
-
-    def __init__(self, after: float = HINT_AFTER) -> None:
-        self.after = after
-        self._since: float | None = None
-        self._said = False
-
-    def update(self, now: float, driving: bool, moving: bool) -> bool:
-        """``driving``: a drive is held now; ``moving``: the last status shows the robot moving."""
-        if not driving or moving:
-            self._since, self._said = None, False
-            return False
-        if self._since is None:
-            self._since = now
-        if self._said or now - self._since < self.after:
-            return False
-        self._said = True
-        return True

@@ -1,8 +1,8 @@
-"""The hint a still drive raises: a drive held for :data:`~rtmu.client.why.HINT_AFTER` s and no motion.
+"""The hint a still drive raises: a drive held for :data:`~rtmu.client.why_still.HINT_AFTER` s and no motion.
 
 Fed on every tick of the window's timer: a drive is held (a drive key down in the key router, the
 controller driving, or the gamepad's stick) and the robot's last status shows no speed. When
-:class:`~rtmu.client.why.StillWhileHeld` says so — once per held drive — the selected robot is asked
+:class:`~rtmu.client.why_still.StillWhileHeld` says so — once per held drive — the selected robot is asked
 "why won't it move?" (reads only) with the drive asked for, and the answer is told as a warning
 banner that names the window item (``?``) where the fix is. A robot that started moving while the
 answer came back is not told anything.
@@ -15,7 +15,7 @@ from __future__ import annotations
 
 import concurrent.futures
 from collections.abc import Callable
-from typing import Any
+from typing import TYPE_CHECKING, Any
 
 import gi
 
@@ -23,8 +23,7 @@ gi.require_version("Gtk", "4.0")
 from gi.repository import GLib  # noqa: E402
 
 from ..base.i18n import _  # noqa: E402
-from ..client.why import StillWhileHeld  # noqa: E402
-from ..client.why_values import Answer  # noqa: E402
+from ..client.why_still import StillWhileHeld  # noqa: E402
 from ..control.held_drive import ratios_for  # noqa: E402
 from ..fleet.selected import SelectedRobot  # noqa: E402
 from ..model.observables import Phase, RobotModel  # noqa: E402
@@ -32,6 +31,9 @@ from ..values.intents import AskWhy  # noqa: E402
 from .banners import BannerStack  # noqa: E402
 from .keys import KeyRouter  # noqa: E402
 from .state_words import sentence_words  # noqa: E402
+
+if TYPE_CHECKING:  # the rules and their answer load with the first question (client.why_still)
+    from ..client.why_values import Answer
 
 TOPIC = "why"
 """The banner topic of the hint (one banner, replaced by the next hint)."""
