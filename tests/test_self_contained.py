@@ -20,8 +20,8 @@ OUTSIDE = re.compile(
     r"""\.\./shared\b|/work/shared\b|["']\.\.["']\s*/\s*["']shared["']|\bparent\s*/\s*["']shared["']"""
     r"""|/\s*["']shared["']\s*/"""
 )
-"""The sibling folder by path, ``/work/shared``, ``.. / "shared"``, ``REPO.parent / "shared"``,
-``X / "shared" / …``."""
+"""The sibling folder by path: the absolute one under ``/work``, ``..`` joined to it, a root's parent
+joined to it, ``X / <it> / …`` (the examples below are written in pieces: this file names no such folder)."""
 
 SHARED_DATA_USERS = [
     "tests/test_maps_aria.py",
@@ -50,9 +50,9 @@ def test_no_source_names_a_folder_outside_the_repository() -> None:
 
 def test_the_pattern_sees_each_way_of_naming_shared() -> None:
     for line in (
-        'SHARED = Path(__file__).resolve().parents[1].parent / "shared"',
+        'SHARED = Path(__file__).resolve().parents[1].parent / "' + 'shared"',
         'Path("/work/shared/aria-maps")',
-        "see .." + "/shared/captures",  # (written in two pieces: this file names no such folder)
+        "see .." + "/shared/captures",
         'Path(__file__).parents[2] / ".." / "shared"',
         'REPO / "shared" / "captures"',
     ):
