@@ -23,7 +23,7 @@ APT_PACKAGES=(
 # Every program the app, tests, bench and scripts start -> the package above that installs it
 # ("essential": in every Debian install). tests/test_setup_programs.py keeps this true.
 # A program may come from a direct dependency of the package named (dbus brings the session bus's
-# daemon: Debian 12 splits it into dbus-daemon, Ubuntu 22.04's dbus holds it). Not dbus-x11: its
+# daemon on both: see SPLIT_PACKAGES). Not dbus-x11: its
 # dbus-launch makes GLib start a stray bus of its own wherever DBUS_SESSION_BUS_ADDRESS is unset.
 # at-spi2-core's at-spi-bus-launcher starts an accessibility bus (the AT-SPI test starts its own on a
 # private session bus); python3-pyatspi is what that test reads the window with, as a screen reader does
@@ -34,6 +34,11 @@ PROGRAM_PACKAGES=(
     xxd=xxd hexdump=bsdextrautils od=essential
     appstreamcli=appstream desktop-file-validate=desktop-file-utils
     dbus-daemon=dbus dbus-run-session=dbus git=git
+)
+# Packages that one distribution splits out and another does not: named where apt knows them. Debian 12
+# ships the session bus's daemon as dbus-daemon (dbus depends on it); Ubuntu 22.04's dbus holds it.
+SPLIT_PACKAGES=(
+    dbus-daemon
 )
 VENV=.venv
 STAMP="$VENV/.rtmu-setup-stamp"
@@ -167,6 +172,17 @@ missing_packages() {
     done
 }
 
+add_split_packages() { # SPLIT_PACKAGES this system knows (installed, or a candidate of apt's) join APT_PACKAGES
+    local p
+    for p in "${SPLIT_PACKAGES[@]}"; do
+        [[ " ${APT_PACKAGES[*]} " == *" $p "* ]] && continue # already joined (a second run)
+        if dpkg-query -W -f='${Package} ${db:Status-Status}\n' "$p" 2>/dev/null | grep -qxF "$p installed" ||
+            [ -n "$(apt_candidate "$p")" ]; then
+            APT_PACKAGES+=("$p")
+        fi
+    done
+}
+
 ensure_system_packages() {
     if ! have dpkg-query; then
         say "not a Debian-like system: make sure the equivalents of ${APT_PACKAGES[*]} are installed"
@@ -174,6 +190,7 @@ ensure_system_packages() {
         return
     fi
     choose_python
+    add_split_packages
     local missing
     mapfile -t missing < <(missing_packages)
     if [ "${#missing[@]}" -eq 0 ]; then

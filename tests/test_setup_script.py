@@ -63,6 +63,7 @@ DEBIAN_12 = {
     "python3": "3.11.2-1+b1",
     "python3.11": "3.11.2-6+deb12u6",
     "python3.11-venv": "3.11.2-6+deb12u6",
+    "dbus-daemon": "1.14.10-1~deb12u1",  # split out of dbus on Debian 12 (setup.sh's SPLIT_PACKAGES)
 }
 UBUNTU_22_04 = {
     "python3": "3.10.6-1~22.04",
@@ -190,7 +191,7 @@ def test_bare_debian_12_gets_python3_and_everything_else(tmp_path: Path) -> None
     assert result.stdout.count("PYTHON=python3\n") == 2
     assert machine.apt_calls()[0] == "apt-get update -q"
     (install,) = _install_calls(machine)
-    assert _packages(install) == ["python3", "python3-venv", "python3-dev", *OTHER_PACKAGES]
+    assert _packages(install) == ["python3", "python3-venv", "python3-dev", *OTHER_PACKAGES, "dbus-daemon"]
 
 
 def test_bare_ubuntu_22_04_gets_python3_11_because_its_python3_is_3_10(tmp_path: Path) -> None:
@@ -200,6 +201,7 @@ def test_bare_ubuntu_22_04_gets_python3_11_because_its_python3_is_3_10(tmp_path:
     assert result.stdout.count("PYTHON=python3.11\n") == 2
     (install,) = _install_calls(machine)
     assert _packages(install) == ["python3.11", "python3.11-venv", "python3.11-dev", *OTHER_PACKAGES]
+    assert "dbus-daemon" not in result.stdout  # Ubuntu 22.04's dbus holds the daemon: no such package
 
 
 def test_ubuntu_22_04_with_its_python3_adds_only_python3_11(tmp_path: Path) -> None:
@@ -220,19 +222,22 @@ def test_ubuntu_22_04_with_its_python3_adds_only_python3_11(tmp_path: Path) -> N
 def test_a_ready_machine_asks_apt_nothing(tmp_path: Path) -> None:
     machine = make_machine(
         tmp_path,
-        installed=["python3", "python3-venv", "python3-dev", *OTHER_PACKAGES],
+        installed=["python3", "python3-venv", "python3-dev", *OTHER_PACKAGES, "dbus-daemon"],
         pythons={"python3": "3.11.2"},
         candidates=DEBIAN_12,
     )
     result = machine.run()
     assert result.returncode == 0, result.stderr
-    assert f"system packages present ({3 + len(OTHER_PACKAGES)} checked)" in result.stdout
+    assert f"system packages present ({3 + len(OTHER_PACKAGES) + 1} checked)" in result.stdout
     assert machine.apt_calls() == []
 
 
 def test_missing_venv_module_is_installed(tmp_path: Path) -> None:
     machine = make_machine(
-        tmp_path, installed=["python3", *OTHER_PACKAGES], pythons={"python3": "3.11.2"}, candidates=DEBIAN_12
+        tmp_path,
+        installed=["python3", *OTHER_PACKAGES, "dbus-daemon"],  # Debian 12's dbus depends on it
+        pythons={"python3": "3.11.2"},
+        candidates=DEBIAN_12,
     )
     assert machine.run().returncode == 0
     (install,) = _install_calls(machine)
