@@ -328,6 +328,7 @@ class AriaClient:
         until: Callable[[bytes], bool] | None = None,
         max_packets: int = MAX_REPLY_PACKETS,
         max_bytes: int = MAX_REPLY_BYTES,
+        read_arrived: bool = False,
     ) -> Reply:
         """Run ``what`` (a data name, or a typed payload naming its data) once and await its reply.
 
@@ -340,12 +341,14 @@ class AriaClient:
         (RETURN_NONE) is sent and an empty :class:`Reply` returned at once. A reply longer
         than ``max_packets`` packets or ``max_bytes`` payload bytes fails with
         :class:`ReplyTooLarge` (for big maps use ``rtmu.client.mapload`` or :meth:`stream`).
+        ``read_arrived``: a timeout is final only once what has already arrived is read (see
+        :meth:`ask_in_time`).
         """
         name, payload = request_parts(what, args)
         waiter = self._start(name, payload, expect, until, False, max_packets, max_bytes)
         if waiter is None:
             return Reply(name, (), self.clock())
-        payloads = await waiter.collect(timeout)
+        payloads = await waiter.collect(timeout, arrived=self._take_in_arrived if read_arrived else None)
         return Reply(name, payloads, self.clock())
 
     async def ask_in_time(self, name: str, deadline: float) -> Reply:
@@ -354,14 +357,10 @@ class AriaClient:
         A reply that came within ``deadline`` s counts even when this loop was run too late to read
         it in time: the timer and the answer wake the loop together, and the timer runs first. So
         when the deadline passes, what the kernel already holds is read (:meth:`catch_up`) before it
-        is called missed. No answer then: :class:`ClientTimeout`. (The request and its wait are
-        ``request_once``'s own: a ping answered in time takes exactly the same path.)
+        is called missed. No answer then: :class:`ClientTimeout`. A ping answered in time takes
+        ``request_once``'s path exactly.
         """
-        waiter = self._start(name, b"", None, None, False, MAX_REPLY_PACKETS, MAX_REPLY_BYTES)
-        if waiter is None:
-            return Reply(name, (), self.clock())
-        payloads = await waiter.collect(deadline, arrived=self._take_in_arrived)
-        return Reply(name, payloads, self.clock())
+        return await self.request_once(name, timeout=deadline, read_arrived=True)
 
     async def _take_in_arrived(self) -> None:
         """:meth:`catch_up`, then the rounds a routed reply needs to wake its waiter."""
