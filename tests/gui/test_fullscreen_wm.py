@@ -9,12 +9,9 @@ simulator, and reads what the X server says about the window: its geometry and
 
 from __future__ import annotations
 
-import os
-import shutil
 import signal
 import subprocess
 import sys
-import time
 from collections.abc import Iterator
 from pathlib import Path
 
@@ -24,72 +21,17 @@ from rtmu.sim import SimConfig, SimThread
 
 from .harness import OFFICE_MAP
 from .process import screenshot, subscribed, wait
+from .window_manager import managed_screen, require_openbox
 
 SCREEN = (1024, 768)
-OPENBOX = shutil.which("openbox")
-CI = os.environ.get("CI", "").lower() in ("true", "1")  # as in conftest: on CI a missing tool fails
-
-
-def _stop(proc: subprocess.Popen[bytes]) -> None:
-    if proc.poll() is None:
-        proc.terminate()
-        try:
-            proc.wait(5)
-        except subprocess.TimeoutExpired:
-            proc.kill()
-            proc.wait(5)
-
-
-def _xvfb(size: str) -> tuple[subprocess.Popen[bytes], str]:
-    """An Xvfb of its own on a free display number (it reports the number on a pipe): (process, ':N')."""
-    read_fd, write_fd = os.pipe()
-    proc = subprocess.Popen(
-        ["Xvfb", "-displayfd", str(write_fd), "-screen", "0", f"{size}x24", "-nolisten", "tcp"],
-        pass_fds=(write_fd,),
-        stdout=subprocess.DEVNULL,
-        stderr=subprocess.DEVNULL,
-    )
-    os.close(write_fd)
-    os.set_blocking(read_fd, False)
-    data = b""
-    deadline = time.monotonic() + 15
-    try:
-        while not data.endswith(b"\n") and time.monotonic() < deadline and proc.poll() is None:
-            try:
-                data += os.read(read_fd, 16)
-            except BlockingIOError:
-                time.sleep(0.02)
-    finally:
-        os.close(read_fd)
-    if not data.strip():
-        _stop(proc)
-        pytest.fail("the test's own Xvfb did not start")
-    return proc, f":{data.strip().decode()}"
 
 
 @pytest.fixture
 def wm_display() -> Iterator[dict[str, str]]:
     """A 1024×768 Xvfb with openbox running on it: the environment for X clients on that display."""
-    if OPENBOX is None:
-        message = "openbox is needed to test full screen (apt-get install openbox)"
-        if CI:
-            pytest.fail(f"CI=true but {message}", pytrace=False)
-        pytest.skip(message)
-    xvfb, display = _xvfb(f"{SCREEN[0]}x{SCREEN[1]}")
-    env = dict(os.environ, DISPLAY=display)
-    wm = subprocess.Popen([OPENBOX], env=env, stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL)
-    try:
-
-        def wm_running() -> bool:
-            assert wm.poll() is None, "openbox exited"
-            out = _x(env, "xprop", "-root", "_NET_SUPPORTING_WM_CHECK")
-            return "window id" in out
-
-        wait(wm_running, 15, "openbox to manage the screen")
+    require_openbox("test full screen")
+    with managed_screen(f"{SCREEN[0]}x{SCREEN[1]}") as env:
         yield env
-    finally:
-        _stop(wm)
-        _stop(xvfb)
 
 
 def _x(env: dict[str, str], *argv: str) -> str:

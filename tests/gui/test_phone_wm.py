@@ -13,8 +13,6 @@ STOP stop the robot (the simulator's stop log).
 
 from __future__ import annotations
 
-import os
-import subprocess
 from collections.abc import Iterator
 from pathlib import Path
 
@@ -23,12 +21,10 @@ import pytest
 
 from rtmu.sim import SimConfig, SimThread
 
-from .conftest import _spawn_xvfb, _terminate
 from .harness import OFFICE_MAP, Gui, idle, on_display, pump
-from .process import wait
 from .stop_paths import StopCycle
-from .test_fullscreen_wm import CI, OPENBOX, _stop
 from .test_handheld_window import clipped_widgets
+from .window_manager import managed_screen, require_openbox
 
 gi.require_version("Gtk", "4.0")
 from gi.repository import Gtk  # noqa: E402
@@ -39,30 +35,9 @@ PHONE = (360, 720)
 @pytest.fixture
 def phone_wm() -> Iterator[str]:
     """A 360×720 X server with openbox managing it: ':N'."""
-    if OPENBOX is None:
-        message = "openbox is needed to test the phone under a window manager (apt-get install openbox)"
-        if CI:
-            pytest.fail(f"CI=true but {message}", pytrace=False)
-        pytest.skip(message)
-    xvfb, display = _spawn_xvfb(f"{PHONE[0]}x{PHONE[1]}")
-    if display is None:
-        pytest.fail("an Xvfb of 360x720 did not start")
-    env = dict(os.environ, DISPLAY=display)
-    wm = subprocess.Popen([OPENBOX], env=env, stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL)
-    try:
-
-        def managed() -> bool:
-            assert wm.poll() is None, "openbox exited"
-            out = subprocess.run(
-                ["xprop", "-root", "_NET_SUPPORTING_WM_CHECK"], env=env, capture_output=True, text=True
-            ).stdout
-            return "window id" in out
-
-        wait(managed, 15, "openbox to manage the screen")
-        yield display
-    finally:
-        _stop(wm)
-        _terminate(xvfb)
+    require_openbox("test the phone under a window manager")
+    with managed_screen(f"{PHONE[0]}x{PHONE[1]}") as env:
+        yield env["DISPLAY"]
 
 
 def fits(gui: Gui) -> bool:
