@@ -16,7 +16,7 @@ from pathlib import Path
 from client.servers import ServerThread
 from client.test_console import FLOOD_PACKETS, hostile_server
 from rtmu.sim import SimThread
-from rtmu.ui.console_page import MAX_LINES, ConsolePage
+from rtmu.ui.console_page import MAX_LINES, MAX_ROWS, ConsolePage, matches
 from simulators import simulator
 
 from .harness import Gui, LoopProbe, idle, pump
@@ -48,7 +48,14 @@ def pick(gui: Gui, page: ConsolePage, name: str) -> None:
     """Type ``name`` into the filter with real keys, then click its row."""
     type_into(gui, page.search, name, leave=False)
     names = lambda: [e.name for e in page.shown]  # noqa: E731
-    pump(lambda: name in names() and len(names()) < len(page.entries), 5, f"the filter to find {name}")
+    # The entry filters a moment after each key: a list of the first letters can hold the row too,
+    # and is rebuilt under the pointer. Only the list of the whole name is clicked in.
+    whole = [e.name for e in page.entries if matches(e, name)][:MAX_ROWS]
+    pump(
+        lambda: page.search.get_text() == name and names() == whole and len(whole) < len(page.entries),
+        5,
+        f"the filter to find {name}",
+    )
     click(gui, page.rows.get_row_at_index(names().index(name)))
     pump(lambda: page.current is not None and page.current.name == name, 3, f"{name} to be picked")
 
