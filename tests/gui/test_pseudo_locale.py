@@ -471,6 +471,7 @@ def test_the_palette_keys_and_confirmations_are_translated_at_360x720(
 def check_keys_window(gui: Gui, name: str) -> list[str]:
     """The keys window opened by its key (Ctrl+?): every row's words and caps translated, the window
     inside the screen, no row clipped — each scrolled into view and looked at — and a search typed."""
+    from rtmu.ui.keys_sheet import folded
     from rtmu.ui.keys_window import KeysWindow
 
     window = gui.window
@@ -492,7 +493,12 @@ def check_keys_window(gui: Gui, name: str) -> list[str]:
     idle(0.3)
     gui.screen_shot(f"{name}-keys-end")
     pump(keys.is_active, 5, "the keys window to have the keyboard")
-    gui.xdotool("type", "--delay", "30", keys.sheet.rows[0].title[:4])  # a few letters of STOP's words
+    # A few letters of STOP's words, typed plain as on a keyboard without those accents (the search
+    # folds them). Also why: xdotool types a letter missing from the keymap by mapping it for a moment,
+    # and a loaded window reads the keymap after it is taken back: the letters were lost in CI.
+    typed = folded(keys.sheet.rows[0].title)[:4]
+    assert typed.isascii() and typed != keys.sheet.rows[0].title[:4], typed
+    gui.xdotool("type", "--delay", "30", typed)
     pump(lambda: len(keys.shown_lines()) < len(keys.lines), 5, "typing to filter")
     idle(0.3)
     gui.screen_shot(f"{name}-keys-search")

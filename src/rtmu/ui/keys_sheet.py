@@ -154,7 +154,7 @@ class KeyRow:
         return _("{title}: {keys}").format(title=self.title, keys=self.keys_words())
 
 
-def _plain(text: str) -> str:
+def folded(text: str) -> str:
     """``text`` folded for searching: no case, no accents (a search for "zoom" finds "Zóóm")."""
     decomposed = unicodedata.normalize("NFKD", text.casefold())
     return "".join(c for c in decomposed if not unicodedata.combining(c))
@@ -194,12 +194,12 @@ class KeySheet:
 
     def matching(self, query: str) -> tuple[KeyRow, ...]:
         """The rows whose words, heading or keys hold every word of ``query`` (all rows for none)."""
-        words = _plain(query).split()
+        words = folded(query).split()
         if not words:
             return self.rows
         found = []
         for row in self.rows:
-            haystack = _plain(f"{row.group} {row.title} {' '.join(' '.join(c) for c in row.chords)}")
+            haystack = folded(f"{row.group} {row.title} {' '.join(' '.join(c) for c in row.chords)}")
             if all(w in haystack for w in words):
                 found.append(row)
         return tuple(found)
