@@ -125,7 +125,7 @@ class MenuPicker:
         gui.key("Return")
 
     def _focus_row(self, label: str) -> None:
-        """Down until the row showing ``label`` has the focus (the menu wraps round)."""
+        """Down or Up, towards the row showing ``label``, until it has the focus."""
         gui, popover = self.gui, self.popover
         pump(lambda: model_button(popover, label) is not None, 3, f"the row {label!r}")
         row = model_button(popover, label)
@@ -133,7 +133,11 @@ class MenuPicker:
             focus = gui.window.get_focus()
             if focus is row:
                 return
-            gui.key("Down")
+            # Towards the row from where the focus is: a key a busy machine ran late, and the next one
+            # with it, moves past the row; the next key comes back (Down alone went round the menu).
+            rows = [w for w in descendants(popover) if w.get_css_name() == "modelbutton" and w.get_mapped()]
+            above = focus in rows and row in rows and rows.index(focus) > rows.index(row)
+            gui.key("Up" if above else "Down")
             # One Down at a time: the next is pressed only once this one has moved the focus. Pressed
             # blind every 20 ms, keys queued on a busy machine ran past the row and round again.
             with contextlib.suppress(AssertionError):
