@@ -96,6 +96,16 @@ class Cell(Gtk.Box):
         """A word the caption carries for a state its colour shows (``LOW``): not by colour alone."""
         self._tooltip: str | None = None
         self._level: str | None = None
+        # The tooltip is answered when GTK asks (pointer over the cell): setting GTK's own text made it
+        # query the tooltip under the pointer each time, and the link cell's words change every second
+        # (its age): 2–10 ms of a still window's second on a small machine (issue 28).
+        self.connect("query-tooltip", self._answer_tooltip)
+        self._pointer_in = False
+        self._tip: Gtk.Tooltip | None = None
+        hover = Gtk.EventControllerMotion()
+        hover.connect("enter", lambda *_a: setattr(self, "_pointer_in", True))
+        hover.connect("leave", lambda *_a: setattr(self, "_pointer_in", False))
+        self.add_controller(hover)
 
     def show_level(self, css_class: str | None) -> None:
         """One style class of a family (``link-ok``, ``link-stale`` …) in place of the one before."""
@@ -126,9 +136,24 @@ class Cell(Gtk.Box):
                 self.add_css_class("stale")
             else:
                 self.remove_css_class("stale")
-        if tooltip != self._tooltip:  # setting it, even unchanged, costs GTK a tooltip query (~0.25 ms)
+        if tooltip != self._tooltip:
             self._tooltip = tooltip
-            self.set_tooltip_text(tooltip)
+            if (tooltip is not None) != self.get_has_tooltip():
+                self.set_has_tooltip(tooltip is not None)
+            if self._pointer_in and self._tip is not None and tooltip:
+                self._tip.set_text(tooltip)  # the tooltip on screen says it now, not at the next motion
+
+    def get_tooltip_text(self) -> str | None:
+        """The words the cell's tooltip shows (GTK's own tooltip text stays empty: they are given
+        when it asks, :meth:`_answer_tooltip`)."""
+        return self._tooltip
+
+    def _answer_tooltip(self, _cell: Gtk.Widget, _x: int, _y: int, _keyboard: bool, tip: Gtk.Tooltip) -> bool:
+        if not self._tooltip:
+            return False
+        tip.set_text(self._tooltip)
+        self._tip = tip  # the display's one tooltip: while the pointer is in this cell, it is this cell's
+        return True
 
 
 class StatusToolbar(Gtk.ScrolledWindow):
