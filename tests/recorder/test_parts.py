@@ -148,26 +148,37 @@ def test_a_parked_robots_pose_and_status_are_repeated_so_every_second_holds_them
 
 
 def test_producers_never_wait_for_a_stuck_writer(tmp_path: Path, monkeypatch: pytest.MonkeyPatch) -> None:
-    """A writer stuck on a dead disk: submit stays a non-blocking put, the surplus is dropped and counted."""
+    """A writer stuck on a dead disk: submit stays a non-blocking put, the surplus is dropped and counted.
+
+    Not timed (a loaded machine is no failure): the writer stays stuck until every submit has
+    returned, so one submit that waited for it would never return while it is stuck."""
     stuck = threading.Event()
     real_log = McapFile.log
 
     def slow_log(self: McapFile, topic: str, message: object, at_ns: int) -> None:
         if topic == topics.NOTICES:
-            stuck.wait(10)
+            stuck.wait(120)
         real_log(self, topic, message, at_ns)
 
     monkeypatch.setattr(McapFile, "log", slow_log)
     recording = Recording(tmp_path / "stuck.mcap", limits=Limits(queue_items=100)).start()
-    worst = 0.0
-    for n in range(1000):
-        started = time.perf_counter()
-        recording.submit(Event(topics.NOTICES, {"n": n}, time.time_ns()))
-        worst = max(worst, time.perf_counter() - started)
-    assert worst < 0.01, f"a submit waited {worst * 1000:.1f} ms"
-    assert recording.dropped >= 1000 - 100 - 1
-    stuck.set()
-    recording.close()
+    submitted = threading.Event()
+
+    def produce() -> None:
+        for n in range(1000):
+            recording.submit(Event(topics.NOTICES, {"n": n}, time.time_ns()))
+        submitted.set()
+
+    producer = threading.Thread(target=produce, daemon=True)
+    producer.start()
+    try:
+        assert submitted.wait(60), "a submit waited for the stuck writer"
+        assert not stuck.is_set()
+        assert recording.dropped >= 1000 - 100 - 1
+    finally:
+        stuck.set()
+        producer.join(10)
+        recording.close()
     got = read(recording.path)
     assert got.records(topics.RECORDER)[-1] == {"event": "dropped", "items": recording.dropped}
 
