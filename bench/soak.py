@@ -39,7 +39,7 @@ from typing import Any
 
 from bench.common import Result
 from rtmu.client.lease import DriveRatios
-from rtmu.client.runner import LOOP_BEAT, ClientRunner
+from rtmu.client.runner import ClientRunner
 from rtmu.client.session import SessionConfig
 from rtmu.model.observables import Phase, RobotModel
 from rtmu.values.target import Target
@@ -221,13 +221,13 @@ def soak(seconds: float, *, seed: int = 1, progress: Callable[[str], None] | Non
             while time.monotonic() < hold_end:
                 time.sleep(RENEW)
                 runner.lease.renew()
-                max_lag = max(max_lag, (runner.loop_lag() or 0.0) - LOOP_BEAT)
+                max_lag = max(max_lag, runner.loop_lag() or 0.0)
             released = time.monotonic()
             runner.lease.release()
             stopped = server.first_stop_after(released, STOP_WAIT)
             latencies.append(STOP_WAIT if stopped is None else stopped - released)
             time.sleep(rng.uniform(*REST))
-            max_lag = max(max_lag, (runner.loop_lag() or 0.0) - LOOP_BEAT)
+            max_lag = max(max_lag, runner.loop_lag() or 0.0)
             if progress is not None and time.monotonic() >= next_report:
                 next_report += 60
                 progress(

@@ -399,12 +399,40 @@ def test_loop_lag_shows_a_blocked_network_loop() -> None:
         runner.submit(block_the_loop)
         assert blocked.wait(5)
         clock.advance(1.5)
-        assert runner.loop_lag() == 1.5  # no beat can run while the loop is blocked
+        assert runner.loop_lag() == 1.5  # working, not waiting, since the block began
         release.set()
-        eventually(lambda: runner.loop_lag() == 0.0)  # the next beat, once the loop runs again
+        eventually(lambda: runner.loop_lag() == 0.0)  # waiting again once the handler returned
     finally:
         runner.close()
     assert runner.loop_lag() is None
+
+
+def test_a_loop_waiting_long_for_the_network_has_no_lag_and_no_timer_of_the_runners() -> None:
+    """Waiting is no lag, however long: the lag is read off the loop's selector, and nothing the
+    runner scheduled wakes a loop that has nothing to do (a heartbeat woke it 10 times a second)."""
+    import threading
+
+    clock = FakeClock()
+    runner = ClientRunner(clock=clock)
+    runner.start()
+    try:
+        eventually(lambda: runner.loop_lag() == 0.0)
+        clock.advance(60.0)
+        assert runner.loop_lag() == 0.0
+        scheduled: list[object] = []
+        done = threading.Event()
+
+        def look() -> None:
+            timers = runner.loop._scheduled  # type: ignore[attr-defined]
+            scheduled.extend(h._callback for h in timers if not h.cancelled())
+            done.set()
+
+        runner.loop.call_soon_threadsafe(look)
+        assert done.wait(30)
+        owners = [getattr(callback, "__self__", None) for callback in scheduled]
+        assert runner not in owners, f"the runner keeps a timer: {scheduled}"
+    finally:
+        runner.close()
 
 
 def test_stop_and_wait_returns_once_the_stop_has_left(server: TestServer) -> None:

@@ -43,10 +43,11 @@ fail has something behind it:
    resends nor the stop: a release or a stop waits until the loop runs again. So
    the loop must never run slow work: map packets → arrays runs in an executor
    (:mod:`~rtmu.client.mapload`), payload decoding is a few microseconds, and the
-   feeds' handlers only update a shadow and ``post`` to the UI. The loop beats
-   every :data:`LOOP_BEAT` s; :meth:`ClientRunner.loop_lag` says how long ago it
-   last did, so a window can warn (e.g. above 0.5 s) that driving commands may
-   not be getting out.
+   feeds' handlers only update a shadow and ``post`` to the UI.
+   :meth:`ClientRunner.loop_lag` says how long the loop has been working without
+   going back to wait for the network (:mod:`~rtmu.client.loop_watch` watches its
+   selector), so a window can warn (e.g. above 0.5 s) that driving commands may
+   not be getting out — with no timer waking a still loop to tell.
 4. **The guardian** (``SessionConfig(guardian=True)``, :mod:`rtmu.guardian`): a
    separate process with its own login that stops the robot when this process
    is killed, stopped by a signal, or silent past its lease while driving; the
@@ -80,14 +81,13 @@ from .errors import ClientError, ClientTimeout
 from .lease import LEASE_TTL, DriveLease, EndReason
 from .lease_keeper import LeaseKeeper
 from .link import Opener
+from .loop_watch import WatchedSelector
 from .session import Session
 from .session_config import SessionConfig
 
 log = logging.getLogger(__name__)
 
 T = TypeVar("T")
-LOOP_BEAT = 0.1
-"""Seconds between the network loop's heartbeats (see :meth:`ClientRunner.loop_lag`)."""
 SHUTDOWN_TIMEOUT = 0.5
 """How long the network thread waits for its cancelled tasks to finish before it ends anyway."""
 Post = Callable[[Callable[[], None]], Any]
@@ -144,12 +144,12 @@ class ClientRunner:
         self.on_config_updated: Callable[[], None] | None = None
         """Called on the UI thread when another client changed the server's configuration."""
         self._config_post_pending = threading.Event()
-        self.loop = asyncio.new_event_loop()
+        self._watch = WatchedSelector(clock)
+        self.loop = asyncio.SelectorEventLoop(self._watch)
         self.session: Session | None = None
         self._thread = threading.Thread(target=self._run, name="rtmu-network", daemon=True)
         self._ready = threading.Event()
         self._closed = False
-        self._beat_at: float | None = None
         self._blocking = concurrent.futures.ThreadPoolExecutor(1, thread_name_prefix="rtmu-blocking")
         """One worker for :meth:`run_blocking` (keyring calls), apart from the network loop."""
 
@@ -189,7 +189,6 @@ class ClientRunner:
         self.session.drive.on_stop = self._stopped
         self.session.feed(ConfigFeed).listener = self._config_updated
         self.lease.on_change = self._lease_changed
-        self._beat()
         self._ready.set()
         try:
             self.loop.run_forever()
@@ -218,22 +217,16 @@ class ClientRunner:
         self._thread.join(timeout)
         self._blocking.shutdown(wait=False, cancel_futures=True)
 
-    def _beat(self) -> None:
-        """The loop's heartbeat: a plain timestamp, rescheduled; it only runs if the loop does."""
-        self._beat_at = self.clock()
-        self.loop.call_later(LOOP_BEAT, self._beat)
-
     def loop_lag(self) -> float | None:
-        """Seconds since the network loop last ran its heartbeat; None before start or after close.
+        """Seconds the network loop has been working since it last waited for the network (0 while it
+        waits); None before start or after close. Any thread may ask (two plain reads).
 
-        Normally at most :data:`LOOP_BEAT` (plus scheduling noise). Much more means the loop
-        is blocked: drive resends and stops are not going out either — a window should say
-        so. Any thread may call it (a plain read of one float).
+        A loop that runs its callbacks goes back to waiting within milliseconds. Much more means it
+        is blocked: drive resends and stops are not going out either — a window says so.
         """
-        beat = self._beat_at
-        if beat is None or self._closed or not self._thread.is_alive():
+        if self._closed or not self._thread.is_alive():
             return None
-        return max(0.0, self.clock() - beat)
+        return self._watch.busy_for()
 
     @property
     def _session(self) -> Session:
