@@ -120,9 +120,11 @@ OBSERVERS = (
     Observer("doctor", ("doctor", "{addr}"), ended=DURING_NAVIGATION, lost=DOCTOR_STEPS),
     Observer("files", ("files", "{addr}", "ls")),
     Observer("scan", ("scan", "{addr}", "status")),
-    Observer(  # re-reading an unchanged map file changes nothing; no mapUpdated comes, so it waits
+    # Re-reading an unchanged map file changes nothing; no mapUpdated comes, so it waits (its timeout
+    # with the suite's patience: it bounds the login too, which a loaded machine ran past 3 s).
+    Observer(
         "mapedit",
-        ("mapedit", "{addr}", "--check-map", "--timeout", "3"),
+        ("mapedit", "{addr}", "--check-map", "--timeout", cli_timeout(3)),
         ("mapedit", "{addr}", "--check-map"),
     ),
     Observer("why", ("why", "{addr}"), ended=DURING_NAVIGATION),
