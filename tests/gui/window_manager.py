@@ -73,7 +73,11 @@ def _start_openbox(env: dict[str, str]) -> subprocess.Popen[bytes]:
             def running_and_managing(wm: subprocess.Popen[bytes] = wm) -> bool:
                 return wm.poll() is not None or managing(env)
 
-            wait(running_and_managing, 15, "openbox to manage the screen")
+            try:
+                wait(running_and_managing, 15, "openbox to manage the screen")
+            except AssertionError:
+                _terminate(wm)  # alive but never managing: not left behind
+                raise
             if wm.poll() is None:
                 return wm
             log.seek(0)
