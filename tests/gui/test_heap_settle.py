@@ -12,12 +12,16 @@ from __future__ import annotations
 
 from pathlib import Path
 
+import gi
 import pytest
 
 from rtmu.sim import SimConfig, SimThread
 from rtmu.ui import application
 
 from .harness import OFFICE_MAP, Gui, idle, pump
+
+gi.require_version("GLib", "2.0")
+from gi.repository import GLib  # noqa: E402
 
 
 def test_the_heap_settles_once_the_held_drive_is_released(
@@ -63,3 +67,20 @@ def test_the_heap_settles_once_the_held_drive_is_released(
             assert held_when_settled == [False]
         finally:
             gui.close()
+
+
+def test_a_closed_window_leaves_no_settling_behind(
+    screenshots: Path, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    """A window closed before its settling came due cancels it: another window of the same process
+    (tests open many) must not have a full collection run under its held drive by one long gone."""
+    monkeypatch.setattr(application, "SETTLE_AFTER_MS", 10 * 60 * 1000)
+    with SimThread(SimConfig(port=0, map_path=OFFICE_MAP, seed=1)) as sim:
+        gui = Gui.start(screenshots, "heap-settle-closed", "127.0.0.1", sim.port)
+        gui.shot("before-closing")
+        due = gui.app._settle_source
+        assert due and GLib.MainContext.default().find_source_by_id(due) is not None, "settling is due"
+        gui.close()
+        assert GLib.MainContext.default().find_source_by_id(due) is None, (
+            "a closed window's settling stays due"
+        )

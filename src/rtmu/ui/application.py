@@ -120,6 +120,8 @@ class RtmuApplication(Gtk.Application):
         """The replay's controls (``rtmu replay``), None for a robot."""
         self.suspensions = 0
         """Times the process was suspended (Ctrl+Z) and resumed."""
+        self._settle_source = 0
+        """The pending settling's timer (``_settle_heap``), 0 once it ran or the window closed."""
 
     # -- lifecycle -----------------------------------------------------------------------------
     def do_startup(self) -> None:
@@ -154,9 +156,11 @@ class RtmuApplication(Gtk.Application):
         every :data:`SETTLE_RETRY_MS`, until the operator's keys are released."""
         window = self.window
         if window is not None and window.controller.needs_tick:
-            GLib.timeout_add(SETTLE_RETRY_MS, self._settle_heap)
+            self._settle_source = GLib.timeout_add(SETTLE_RETRY_MS, self._settle_heap)
             return False
-        settle()
+        self._settle_source = 0
+        if window is not None:  # closed meanwhile: nothing of it to settle
+            settle()
         return False
 
     def do_activate(self) -> None:
@@ -247,7 +251,7 @@ class RtmuApplication(Gtk.Application):
         if self.options.fullscreen:
             window.fullscreen()
         window.present()
-        GLib.timeout_add(SETTLE_AFTER_MS, self._settle_heap)
+        self._settle_source = GLib.timeout_add(SETTLE_AFTER_MS, self._settle_heap)
         if loaded.warning:
             window.banners.tell("notice:settings", "warning", loaded.warning, timeout=10.0)
         for note in self._fleet_notes:
@@ -331,6 +335,9 @@ class RtmuApplication(Gtk.Application):
             self._stand_in = None
         if self.options.persist and window is not None:
             self._save(background=False)
+        if self._settle_source:  # a closed window settles nothing (another may live in this process)
+            GLib.source_remove(self._settle_source)
+            self._settle_source = 0
         for source in self._signal_sources:
             GLib.source_remove(source)
         self._signal_sources = []
