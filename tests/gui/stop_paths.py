@@ -138,7 +138,7 @@ class MenuPicker:
             rows = [w for w in descendants(popover) if w.get_css_name() == "modelbutton" and w.get_mapped()]
             above = focus in rows and row in rows and rows.index(focus) > rows.index(row)
             gui.key("Up" if above else "Down")
-            # One Down at a time: the next is pressed only once this one has moved the focus. Pressed
+            # One key at a time: the next is pressed only once this one has moved the focus. Pressed
             # blind every 20 ms, keys queued on a busy machine ran past the row and round again.
             with contextlib.suppress(AssertionError):
                 pump(lambda f=focus: gui.window.get_focus() is not f, 2, "the focus to move")
