@@ -151,9 +151,9 @@ class RtmuApplication(Gtk.Application):
         so one does not hold every thread — the network loop's stops too — for 100 ms and more.
 
         Never while a drive is held: settling is itself one such pass over everything the start-up
-        built, on this thread, and a loaded machine made it longer than the lease (CI: "the drive
-        was not renewed for 0.34 s" three seconds after the window showed). It waits, looking again
-        every :data:`SETTLE_RETRY_MS`, until the operator's keys are released."""
+        built, on this thread, and on a loaded machine it can outlast the lease (the likely cause of
+        CI's "the drive was not renewed for 0.34 s" early in a window's life). It waits, looking
+        again every :data:`SETTLE_RETRY_MS`, until the operator's keys are released."""
         window = self.window
         if window is not None and window.controller.needs_tick:
             self._settle_source = GLib.timeout_add(SETTLE_RETRY_MS, self._settle_heap)
