@@ -179,3 +179,20 @@ def test_the_window_loads_what_its_first_frame_needs_and_not_these() -> None:
     assert "rtmu.ui.application" in modules
     late = [m for m in modules if m in WINDOW_LATE or m.startswith(tuple(f"{w}." for w in WINDOW_LATE))]
     assert not late, f"{late} loaded with the window ({why(late[0], code)})"
+
+
+def test_numpy_starts_no_blas_threads_under_the_rtmu_command() -> None:
+    """numpy's OpenBLAS starts a thread per core at import unless told not to; every ``rtmu`` entry
+    tells it (``cli.SINGLE_BLAS_THREAD``), so a command that loads numpy stays one thread. Counted in
+    ``/proc/self/task`` (Linux), in a fresh interpreter without the variable set."""
+    code = (
+        "import os\nfrom rtmu.cli import main\ntry:\n    main(['--version'])\nexcept SystemExit:\n    pass\n"
+        "import numpy\n"
+        "print('threads', len(os.listdir('/proc/self/task')))\n"
+    )
+    env = {k: v for k, v in os.environ.items() if not k.startswith(("OPENBLAS", "OMP_"))}
+    env["PYTHONPATH"] = str(SRC)
+    out = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, env=env, timeout=120)
+    assert out.returncode == 0, out.stderr[-2000:]
+    threads = int(out.stdout.split("threads")[-1])
+    assert threads == 1, f"{threads} threads after numpy loaded under rtmu (OpenBLAS threads not held)"

@@ -28,6 +28,11 @@ from .base.i18n import _
 from .subcommands import _integration
 from .versions import VersionAction
 
+SINGLE_BLAS_THREAD = {"OPENBLAS_NUM_THREADS": "1"}
+"""Set (unless the user set them) before numpy loads: RTMU's arrays are small, and numpy's OpenBLAS
+otherwise starts a thread per core at import, 0.1 s of CPU in every launch of the window, spinning
+for work that never comes."""
+
 
 class HelpFormatter(argparse.HelpFormatter):
     """argparse's own wrapping, except that indented lines (the exit-code table) are kept as written."""
@@ -175,6 +180,8 @@ def build_parser(*, lazy: bool = False) -> argparse.ArgumentParser:
 
 
 def main(argv: Sequence[str] | None = None) -> int:
+    for name, value in SINGLE_BLAS_THREAD.items():
+        os.environ.setdefault(name, value)
     logs.configure()  # developer notices off the operator's terminal (RTMU_LOG=warning shows them)
     parser = build_parser(lazy=True)
     args = parser.parse_args(argv)
