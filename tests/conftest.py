@@ -27,6 +27,9 @@ from run_once import run_once
 os.environ["XDG_DATA_HOME"] = _DATA_HOME = tempfile.mkdtemp(prefix="rtmu-test-data-")
 # Removed when the run ends (a GUI run must leave only its screenshots in /tmp: tests/gui/test_cleanup.py).
 atexit.register(shutil.rmtree, _DATA_HOME, ignore_errors=True)
+# The same for the user's cache (rtmu.base.dataclass_code keeps compiled dataclass methods there).
+os.environ["XDG_CACHE_HOME"] = _CACHE_HOME = tempfile.mkdtemp(prefix="rtmu-test-cache-")
+atexit.register(shutil.rmtree, _CACHE_HOME, ignore_errors=True)
 
 # One folder for the GUI tests' screenshots, named once by the run that starts here: the workers of a
 # parallel run (pytest-xdist) and the pytest runs a test starts inherit it, so a run's pictures are in one

@@ -22,7 +22,7 @@ from collections.abc import Sequence
 from typing import Any
 
 from . import subcommands
-from .base import exit_codes, logs
+from .base import dataclass_code, exit_codes, logs
 from .base.exit_codes import EXIT_USAGE
 from .base.i18n import _
 from .subcommands import _integration
@@ -182,6 +182,7 @@ def build_parser(*, lazy: bool = False) -> argparse.ArgumentParser:
 def main(argv: Sequence[str] | None = None) -> int:
     for name, value in SINGLE_BLAS_THREAD.items():
         os.environ.setdefault(name, value)
+    dataclass_code.install()  # before the command's modules define their dataclasses
     logs.configure()  # developer notices off the operator's terminal (RTMU_LOG=warning shows them)
     parser = build_parser(lazy=True)
     args = parser.parse_args(argv)

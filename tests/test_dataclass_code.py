@@ -1,0 +1,91 @@
+"""base.dataclass_code: a second start compiles no dataclass method, and the classes are the same.
+
+Each case runs fresh interpreters (the cache is read once per process) with a cache folder of its
+own; compilations are counted, never timed.
+"""
+
+from __future__ import annotations
+
+import json
+import os
+import subprocess
+import sys
+from pathlib import Path
+
+import rtmu
+
+SRC = Path(rtmu.__file__).resolve().parents[1]
+
+PROBE = """
+import dataclasses, json
+from rtmu.base import dataclass_code
+dataclass_code.install()
+import rtmu.values.intents as intents
+
+@dataclasses.dataclass(frozen=True, slots=True)
+class Probe:
+    a: int
+    b: tuple[str, ...] = ()
+
+p = Probe(1, ("x",))
+try:
+    p.a = 2
+    frozen = False
+except dataclasses.FrozenInstanceError:
+    frozen = True
+print(json.dumps({
+    "new": dataclass_code._state["new"],
+    "repr": repr(p),
+    "eq": p == Probe(1, ("x",)) and p != Probe(2),
+    "hash": hash(p) == hash(Probe(1, ("x",))),
+    "frozen": frozen,
+    "fields": [f.name for f in dataclasses.fields(intents.GotoPose)],
+    "default": repr(Probe(3)),
+}))
+"""
+
+
+def run_probe(cache: Path) -> dict[str, object]:
+    env = {**os.environ, "PYTHONPATH": str(SRC), "XDG_CACHE_HOME": str(cache)}
+    out = subprocess.run([sys.executable, "-c", PROBE], capture_output=True, text=True, env=env, timeout=120)
+    assert out.returncode == 0, out.stderr[-2000:]
+    return dict(json.loads(out.stdout.splitlines()[-1]))
+
+
+def test_a_second_start_compiles_nothing_and_makes_the_same_classes(tmp_path: Path) -> None:
+    first = run_probe(tmp_path)
+    assert isinstance(first["new"], int) and first["new"] > 20  # intents alone makes dozens of methods
+    assert list((tmp_path / "rtmu").glob("dataclass-code-*.marshal"))
+    second = run_probe(tmp_path)
+    assert second["new"] == 0
+    assert {k: v for k, v in second.items() if k != "new"} == {k: v for k, v in first.items() if k != "new"}
+    assert first["repr"] == "Probe(a=1, b=('x',))" and first["default"] == "Probe(a=3, b=())"
+    assert first["eq"] and first["hash"] and first["frozen"]
+
+
+def test_a_damaged_cache_costs_compilations_only_and_is_written_again(tmp_path: Path) -> None:
+    run_probe(tmp_path)
+    (cached,) = (tmp_path / "rtmu").glob("dataclass-code-*.marshal")
+    cached.write_bytes(b"\x00not marshal at all" * 100)
+    again = run_probe(tmp_path)
+    assert isinstance(again["new"], int) and again["new"] > 20
+    assert again["frozen"] and again["eq"]
+    assert run_probe(tmp_path)["new"] == 0  # the damaged file was replaced by a good one
+
+
+def test_an_unwritable_cache_is_skipped_quietly(tmp_path: Path) -> None:
+    blocker = tmp_path / "not-a-folder"
+    blocker.write_text("a file where the cache folder would go")
+    result = run_probe(blocker)
+    assert result["frozen"] and result["eq"]
+    assert blocker.read_text() == "a file where the cache folder would go"
+
+
+def test_the_rtmu_command_installs_it(tmp_path: Path) -> None:
+    """``rtmu`` (cli.main) installs the cache before a command's modules load: ``rtmu status --help``
+    leaves a cache file behind."""
+    env = {**os.environ, "PYTHONPATH": str(SRC), "XDG_CACHE_HOME": str(tmp_path)}
+    code = "from rtmu.cli import main\ntry:\n    main(['sim', '--help'])\nexcept SystemExit:\n    pass\n"
+    out = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, env=env, timeout=120)
+    assert out.returncode == 0, out.stderr[-2000:]
+    assert list((tmp_path / "rtmu").glob("dataclass-code-*.marshal"))
