@@ -34,7 +34,7 @@ try:
 except dataclasses.FrozenInstanceError:
     frozen = True
 print(json.dumps({
-    "new": dataclass_code._state["new"],
+    "new": dataclass_code.compiled_this_run(),
     "repr": repr(p),
     "eq": p == Probe(1, ("x",)) and p != Probe(2),
     "hash": hash(p) == hash(Probe(1, ("x",))),
@@ -89,3 +89,19 @@ def test_the_rtmu_command_installs_it(tmp_path: Path) -> None:
     out = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, env=env, timeout=120)
     assert out.returncode == 0, out.stderr[-2000:]
     assert list((tmp_path / "rtmu").glob("dataclass-code-*.marshal"))
+
+
+def test_release_saves_lets_go_of_the_table_and_later_classes_still_work(tmp_path: Path) -> None:
+    run_probe(tmp_path)  # a cache to read
+    code = (
+        "import dataclasses, json\nfrom rtmu.base import dataclass_code as d\nd.install()\n"
+        "import rtmu.values.intents\nheld = len(d._stored)\nd.release()\n"
+        "@dataclasses.dataclass(frozen=True)\nclass Late:\n    x: int = 4\n"
+        "print(json.dumps([held, len(d._stored), repr(Late()), Late() == Late(4)]))\n"
+    )
+    env = {**os.environ, "PYTHONPATH": str(SRC), "XDG_CACHE_HOME": str(tmp_path)}
+    out = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, env=env, timeout=120)
+    assert out.returncode == 0, out.stderr[-2000:]
+    held, after, late_repr, late_eq = json.loads(out.stdout.splitlines()[-1])
+    assert held > 20 and after == 0
+    assert late_repr == "Late(x=4)" and late_eq

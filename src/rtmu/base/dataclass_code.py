@@ -14,6 +14,7 @@ from __future__ import annotations
 
 import atexit
 import dataclasses
+import hashlib
 import importlib.util
 import marshal
 import os
@@ -22,15 +23,16 @@ from pathlib import Path
 from types import CodeType
 from typing import Any
 
-MAX_ENTRIES = 20_000
+MAX_ENTRIES = 6_000
 """More than that on disk (a long history of edited classes), and a save keeps this run's only."""
 
-_stored: dict[str, bytes] = {}
-"""Method text → its code, marshalled: read from the cache at the first class, unmarshalled per hit
-(a command that makes 30 classes reads the table, not 1 400 code objects)."""
-_compiled: dict[str, CodeType] = {}
-_used: set[str] = set()
-_state = {"installed": False, "loaded": False, "new": 0}
+_stored: dict[bytes, bytes] = {}
+"""Digest of a method text → its code, marshalled, as read from the cache at the first class
+(dropped by :func:`release` once a long-lived process has built its classes)."""
+_new: dict[bytes, bytes] = {}
+"""What this run compiled, marshalled, for :func:`save`."""
+_used: set[bytes] = set()
+_state = {"installed": False, "loaded": False, "released": False}
 
 
 def cache_file() -> Path:
@@ -40,23 +42,29 @@ def cache_file() -> Path:
     return Path(root) / "rtmu" / f"dataclass-code-{tag}.marshal"
 
 
+def compiled_this_run() -> int:
+    """How many method texts this process compiled (what the cache did not hold)."""
+    return len(_new)
+
+
+def _digest(source: str) -> bytes:
+    return hashlib.blake2b(source.encode(), digest_size=20).digest()
+
+
 def _cached_exec(source: Any, globals_: Any = None, locals_: Any = None) -> None:
     """``exec`` as ``dataclasses`` calls it (text, globals, namespace), with the compilation kept."""
     if not isinstance(source, str):
         exec(source, globals_, locals_)  # only the dataclasses module calls this
         return
-    if not _state["loaded"]:
+    if not _state["loaded"] and not _state["released"]:
         _state["loaded"] = True
-        _load(cache_file())
-    code = _compiled.get(source)
+        _stored.update(_read(cache_file()))
+    key = _digest(source)
+    _used.add(key)
+    code = _unmarshalled(_stored.get(key) or _new.get(key))
     if code is None:
-        code = _unmarshalled(_stored.get(source))
-        if code is None:
-            code = compile(source, "<string>", "exec")
-            _stored[source] = marshal.dumps(code)
-            _state["new"] += 1
-        _compiled[source] = code
-    _used.add(source)
+        code = compile(source, "<string>", "exec")
+        _new[key] = marshal.dumps(code)
     exec(code, globals_, locals_)  # compiled from dataclasses' own text
 
 
@@ -70,13 +78,14 @@ def _unmarshalled(data: bytes | None) -> CodeType | None:
     return code if isinstance(code, CodeType) else None
 
 
-def _load(path: Path) -> None:
+def _read(path: Path) -> dict[bytes, bytes]:
     try:
         table = marshal.loads(path.read_bytes())
     except (OSError, ValueError, EOFError, TypeError):
-        return  # none yet, or damaged: compile as usual
-    if isinstance(table, dict):
-        _stored.update((k, v) for k, v in table.items() if isinstance(k, str) and isinstance(v, bytes))
+        return {}  # none yet, or damaged: compile as usual
+    if not isinstance(table, dict):
+        return {}
+    return {k: v for k, v in table.items() if isinstance(k, bytes) and isinstance(v, bytes)}
 
 
 def install(*, save_at_exit: bool = True) -> None:
@@ -90,13 +99,23 @@ def install(*, save_at_exit: bool = True) -> None:
         atexit.register(save)
 
 
+def release() -> None:
+    """Save now and let go of the table (1–2 MiB): for a process that has built its classes — the
+    window once it settles. A class made later compiles as without the cache."""
+    save()
+    _state["released"] = True
+    _stored.clear()
+
+
 def save() -> bool:
-    """Write the kept compilations when this run made new ones (atomically: a parallel run loses
-    nothing but its own additions). True when written; a cache that cannot be written is skipped."""
-    if not _state["new"]:
+    """Add what this run compiled to the cache file (read again, so entries another run wrote
+    meanwhile stay; written atomically). True when written; a cache that cannot be written is skipped."""
+    if not _new:
         return False
     path = cache_file()
-    table = _stored if len(_stored) <= MAX_ENTRIES else {k: _stored[k] for k in _used}
+    table = {**_read(path), **_new}
+    if len(table) > MAX_ENTRIES:
+        table = {k: v for k, v in table.items() if k in _used}
     import tempfile  # only a run that compiled something pays for it
 
     try:
@@ -111,5 +130,5 @@ def save() -> bool:
             raise
     except OSError:
         return False
-    _state["new"] = 0
+    _new.clear()
     return True

@@ -28,6 +28,7 @@ import gi
 gi.require_version("Gtk", "4.0")
 from gi.repository import Gio, GLib, Gtk  # noqa: E402
 
+from ..base import dataclass_code  # noqa: E402
 from ..base.heap import settle  # noqa: E402
 from ..base.i18n import N_, _  # noqa: E402
 from ..client.mapcache import SharedMaps  # noqa: E402
@@ -160,6 +161,7 @@ class RtmuApplication(Gtk.Application):
             return False
         self._settle_source = 0
         if window is not None:  # closed meanwhile: nothing of it to settle
+            dataclass_code.release()  # its classes are made: the cached compilations are done with
             settle()
         return False
 
