@@ -95,9 +95,9 @@ def test_release_saves_lets_go_of_the_table_and_later_classes_still_work(tmp_pat
     run_probe(tmp_path)  # a cache to read
     code = (
         "import dataclasses, json\nfrom rtmu.base import dataclass_code as d\nd.install()\n"
-        "import rtmu.values.intents\nheld = len(d._stored)\nd.release()\n"
+        "import rtmu.values.intents\nheld = d.held_entries()\nd.release()\n"
         "@dataclasses.dataclass(frozen=True)\nclass Late:\n    x: int = 4\n"
-        "print(json.dumps([held, len(d._stored), repr(Late()), Late() == Late(4)]))\n"
+        "print(json.dumps([held, d.held_entries(), repr(Late()), Late() == Late(4)]))\n"
     )
     env = {**os.environ, "PYTHONPATH": str(SRC), "XDG_CACHE_HOME": str(tmp_path)}
     out = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, env=env, timeout=120)

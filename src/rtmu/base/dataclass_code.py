@@ -26,13 +26,66 @@ from typing import Any
 MAX_ENTRIES = 6_000
 """More than that on disk (a long history of edited classes), and a save keeps this run's only."""
 
-_stored: dict[bytes, bytes] = {}
-"""Digest of a method text → its code, marshalled, as read from the cache at the first class
-(dropped by :func:`release` once a long-lived process has built its classes)."""
-_new: dict[bytes, bytes] = {}
-"""What this run compiled, marshalled, for :func:`save`."""
-_used: set[bytes] = set()
-_state = {"installed": False, "loaded": False, "released": False}
+
+class Table:
+    """The cache as read: digest of a method text → (offset, length) of its marshalled code in one
+    blob. One large buffer, not 1 400 small ones among the modules being imported, so letting go
+    of it (:func:`release`) gives its memory back rather than leaving holes in the heap."""
+
+    def __init__(self, index: dict[bytes, tuple[int, int]] | None = None, blob: bytes = b"") -> None:
+        self.index = index or {}
+        self.blob = blob
+
+    def get(self, key: bytes) -> bytes | None:
+        where = self.index.get(key)
+        return None if where is None else self.blob[where[0] : where[0] + where[1]]
+
+    def entries(self) -> dict[bytes, bytes]:
+        return {k: self.blob[o : o + n] for k, (o, n) in self.index.items()}
+
+    def dumps(self) -> bytes:
+        return marshal.dumps((self.index, self.blob))
+
+    @classmethod
+    def of(cls, entries: dict[bytes, bytes]) -> Table:
+        index: dict[bytes, tuple[int, int]] = {}
+        offset = 0
+        for key, data in entries.items():
+            index[key] = (offset, len(data))
+            offset += len(data)
+        return cls(index, b"".join(entries.values()))
+
+    @classmethod
+    def read(cls, path: Path) -> Table:
+        """The file's table; an empty one when there is none or it is damaged (compile as usual)."""
+        try:
+            index, blob = marshal.loads(path.read_bytes())
+        except (OSError, ValueError, EOFError, TypeError):
+            return cls()
+        if not isinstance(index, dict) or not isinstance(blob, bytes):
+            return cls()
+        good = {
+            k: (o, n)
+            for k, (o, n) in index.items()
+            if isinstance(k, bytes)
+            and isinstance(o, int)
+            and isinstance(n, int)
+            and 0 <= o <= o + n <= len(blob)
+        }
+        return cls(good, blob)
+
+
+class _Cache:
+    """This process's state: the table read (once, at the first class), what it compiled."""
+
+    def __init__(self) -> None:
+        self.stored = Table()
+        self.new: dict[bytes, bytes] = {}
+        self.used: set[bytes] = set()
+        self.installed = self.loaded = self.released = False
+
+
+_cache = _Cache()
 
 
 def cache_file() -> Path:
@@ -44,11 +97,12 @@ def cache_file() -> Path:
 
 def compiled_this_run() -> int:
     """How many method texts this process compiled (what the cache did not hold)."""
-    return len(_new)
+    return len(_cache.new)
 
 
-def _digest(source: str) -> bytes:
-    return hashlib.blake2b(source.encode(), digest_size=20).digest()
+def held_entries() -> int:
+    """How many compilations the table read from the cache holds now (0 after :func:`release`)."""
+    return len(_cache.stored.index)
 
 
 def _cached_exec(source: Any, globals_: Any = None, locals_: Any = None) -> None:
@@ -56,15 +110,16 @@ def _cached_exec(source: Any, globals_: Any = None, locals_: Any = None) -> None
     if not isinstance(source, str):
         exec(source, globals_, locals_)  # only the dataclasses module calls this
         return
-    if not _state["loaded"] and not _state["released"]:
-        _state["loaded"] = True
-        _stored.update(_read(cache_file()))
-    key = _digest(source)
-    _used.add(key)
-    code = _unmarshalled(_stored.get(key) or _new.get(key))
+    c = _cache
+    if not c.loaded and not c.released:
+        c.loaded = True
+        c.stored = Table.read(cache_file())
+    key = hashlib.blake2b(source.encode(), digest_size=20).digest()
+    c.used.add(key)
+    code = _unmarshalled(c.stored.get(key) or c.new.get(key))
     if code is None:
         code = compile(source, "<string>", "exec")
-        _new[key] = marshal.dumps(code)
+        c.new[key] = marshal.dumps(code)
     exec(code, globals_, locals_)  # compiled from dataclasses' own text
 
 
@@ -78,22 +133,12 @@ def _unmarshalled(data: bytes | None) -> CodeType | None:
     return code if isinstance(code, CodeType) else None
 
 
-def _read(path: Path) -> dict[bytes, bytes]:
-    try:
-        table = marshal.loads(path.read_bytes())
-    except (OSError, ValueError, EOFError, TypeError):
-        return {}  # none yet, or damaged: compile as usual
-    if not isinstance(table, dict):
-        return {}
-    return {k: v for k, v in table.items() if isinstance(k, bytes) and isinstance(v, bytes)}
-
-
 def install(*, save_at_exit: bool = True) -> None:
     """Compile each dataclass method text once per user rather than once per start (idempotent).
     Call before the modules with the dataclasses are imported."""
-    if _state["installed"]:
+    if _cache.installed:
         return
-    _state["installed"] = True
+    _cache.installed = True
     dataclasses.exec = _cached_exec  # type: ignore[attr-defined]  # shadows the builtin there only
     if save_at_exit:
         atexit.register(save)
@@ -103,19 +148,20 @@ def release() -> None:
     """Save now and let go of the table (1–2 MiB): for a process that has built its classes — the
     window once it settles. A class made later compiles as without the cache."""
     save()
-    _state["released"] = True
-    _stored.clear()
+    _cache.released = True
+    _cache.stored = Table()
 
 
 def save() -> bool:
     """Add what this run compiled to the cache file (read again, so entries another run wrote
     meanwhile stay; written atomically). True when written; a cache that cannot be written is skipped."""
-    if not _new:
+    c = _cache
+    if not c.new:
         return False
     path = cache_file()
-    table = {**_read(path), **_new}
-    if len(table) > MAX_ENTRIES:
-        table = {k: v for k, v in table.items() if k in _used}
+    entries = {**Table.read(path).entries(), **c.new}
+    if len(entries) > MAX_ENTRIES:
+        entries = {k: v for k, v in entries.items() if k in c.used}
     import tempfile  # only a run that compiled something pays for it
 
     try:
@@ -123,12 +169,12 @@ def save() -> bool:
         fd, temporary = tempfile.mkstemp(prefix=".dataclass-code-", dir=path.parent)
         try:
             with os.fdopen(fd, "wb") as out:
-                marshal.dump(table, out)
+                out.write(Table.of(entries).dumps())
             os.replace(temporary, path)
         except BaseException:
             os.unlink(temporary)
             raise
     except OSError:
         return False
-    _new.clear()
+    c.new.clear()
     return True

@@ -31,6 +31,7 @@ from gi.repository import Gio, GLib, Gtk  # noqa: E402
 from ..base import dataclass_code  # noqa: E402
 from ..base.heap import settle  # noqa: E402
 from ..base.i18n import N_, _  # noqa: E402
+from ..base.memory import give_back  # noqa: E402
 from ..client.mapcache import SharedMaps  # noqa: E402
 from ..client.roster import RobotEndpoint, Roster  # noqa: E402
 from ..client.session import SessionConfig  # noqa: E402
@@ -163,6 +164,7 @@ class RtmuApplication(Gtk.Application):
         if window is not None:  # closed meanwhile: nothing of it to settle
             dataclass_code.release()  # its classes are made: the cached compilations are done with
             settle()
+            give_back()  # what the start-up freed (the table, the build's temporaries) to the system
         return False
 
     def do_activate(self) -> None:
