@@ -14,7 +14,6 @@ from __future__ import annotations
 
 import atexit
 import dataclasses
-import hashlib
 import importlib.util
 import marshal
 import os
@@ -114,13 +113,19 @@ def _cached_exec(source: Any, globals_: Any = None, locals_: Any = None) -> None
     if not c.loaded and not c.released:
         c.loaded = True
         c.stored = Table.read(cache_file())
-    key = hashlib.blake2b(source.encode(), digest_size=20).digest()
+    key = _blake2b(source.encode(), digest_size=20).digest()
     c.used.add(key)
     code = _unmarshalled(c.stored.get(key) or c.new.get(key))
     if code is None:
         code = compile(source, "<string>", "exec")
         c.new[key] = marshal.dumps(code)
     exec(code, globals_, locals_)  # compiled from dataclasses' own text
+
+
+try:
+    from _blake2 import blake2b as _blake2b  # hashlib's own blake2b, without loading OpenSSL (9 ms)
+except ImportError:  # pragma: no cover - an interpreter built without it
+    from hashlib import blake2b as _blake2b
 
 
 def _unmarshalled(data: bytes | None) -> CodeType | None:

@@ -21,7 +21,6 @@ and says why; it climbs back once the link is healthy again.
 from __future__ import annotations
 
 import asyncio
-import statistics
 import time
 import zlib
 from collections import deque
@@ -301,6 +300,8 @@ class FramePacer:
         if before is None or ready <= before[0]:
             return
         sample, slack = (ready - before[0]) / frames, (error + before[1]) / frames
+        import statistics  # here, not at the top: the window's launch skips it (and fractions, decimal)
+
         if slack <= PRECISE_S:
             self._periods.append(sample)
             self._rough.clear()
@@ -363,6 +364,8 @@ class FrameStats:
             return None
         if len(self.ages_ms) == 1:
             return self.ages_ms[0]
+        import statistics
+
         cuts = statistics.quantiles(self.ages_ms, n=100, method="inclusive")
         return cuts[min(max(int(p) - 1, 0), 98)]
 
