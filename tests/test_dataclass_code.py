@@ -17,10 +17,27 @@ import rtmu
 SRC = Path(rtmu.__file__).resolve().parents[1]
 
 PROBE = """
-import dataclasses, json
+import dataclasses, json, os
 from rtmu.base import dataclass_code
-dataclass_code.install()
+if not os.environ.get("STOCK"):
+    dataclass_code.install()
 import rtmu.values.intents as intents
+import rtmu.values.state as state
+
+
+def fingerprint(cls):
+    out = {}
+    for name in ("__init__", "__repr__", "__eq__", "__hash__", "__setattr__", "__delattr__"):
+        fn = cls.__dict__.get(name)
+        code = getattr(fn, "__code__", None) or getattr(getattr(fn, "__wrapped__", None), "__code__", None)
+        if code is not None:
+            notes = {k: repr(v) for k, v in getattr(fn, "__annotations__", {}).items()}
+            out[name] = [code.co_code.hex(), repr(code.co_consts), code.co_names, code.co_flags, notes]
+    return out
+
+
+classes = [c for m in (intents, state) for c in vars(m).values()
+           if isinstance(c, type) and dataclasses.is_dataclass(c) and c.__module__ == m.__name__]
 
 @dataclasses.dataclass(frozen=True, slots=True)
 class Probe:
@@ -41,12 +58,14 @@ print(json.dumps({
     "frozen": frozen,
     "fields": [f.name for f in dataclasses.fields(intents.GotoPose)],
     "default": repr(Probe(3)),
+    "annotations": {k: getattr(v, "__name__", repr(v)) for k, v in Probe.__init__.__annotations__.items()},
+    "methods": {c.__qualname__: fingerprint(c) for c in classes},
 }))
 """
 
 
-def run_probe(cache: Path) -> dict[str, object]:
-    env = {**os.environ, "PYTHONPATH": str(SRC), "XDG_CACHE_HOME": str(cache)}
+def run_probe(cache: Path, *, stock: bool = False) -> dict[str, object]:
+    env = {**os.environ, "PYTHONPATH": str(SRC), "XDG_CACHE_HOME": str(cache), "STOCK": "1" if stock else ""}
     out = subprocess.run([sys.executable, "-c", PROBE], capture_output=True, text=True, env=env, timeout=120)
     assert out.returncode == 0, out.stderr[-2000:]
     return dict(json.loads(out.stdout.splitlines()[-1]))
@@ -61,6 +80,17 @@ def test_a_second_start_compiles_nothing_and_makes_the_same_classes(tmp_path: Pa
     assert {k: v for k, v in second.items() if k != "new"} == {k: v for k, v in first.items() if k != "new"}
     assert first["repr"] == "Probe(a=1, b=('x',))" and first["default"] == "Probe(a=3, b=())"
     assert first["eq"] and first["hash"] and first["frozen"]
+    # __init__'s annotations are the types, as the stock dataclasses makes them (not strings)
+    assert first["annotations"] == second["annotations"] == {"a": "int", "b": "tuple", "return": "None"}
+
+
+def test_the_methods_are_those_the_stock_dataclasses_makes(tmp_path: Path) -> None:
+    """Bytecode, constants, names, flags and annotations of every generated method of the intents
+    and the state, compiled (first run) and read back (second), equal a run without the cache."""
+    stock = run_probe(tmp_path / "unused", stock=True)["methods"]
+    assert isinstance(stock, dict) and len(stock) > 40
+    assert run_probe(tmp_path)["methods"] == stock
+    assert run_probe(tmp_path)["methods"] == stock
 
 
 def test_a_damaged_cache_costs_compilations_only_and_is_written_again(tmp_path: Path) -> None:

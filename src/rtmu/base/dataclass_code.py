@@ -22,6 +22,9 @@ from pathlib import Path
 from types import CodeType
 from typing import Any
 
+FORMAT = "v2"
+"""In the file's name: a cache written by an earlier RTMU (v1 compiled with the wrong flags) is
+never read."""
 MAX_ENTRIES = 6_000
 """More than that on disk (a long history of edited classes), and a save keeps this run's only."""
 
@@ -88,10 +91,10 @@ _cache = _Cache()
 
 
 def cache_file() -> Path:
-    """``$XDG_CACHE_HOME/rtmu/dataclass-code-<interpreter>-<bytecode magic>.marshal``."""
+    """``$XDG_CACHE_HOME/rtmu/dataclass-code-<format>-<interpreter>-<bytecode magic>.marshal``."""
     root = os.environ.get("XDG_CACHE_HOME") or str(Path.home() / ".cache")
     tag = f"{sys.implementation.cache_tag}-{importlib.util.MAGIC_NUMBER.hex()}"
-    return Path(root) / "rtmu" / f"dataclass-code-{tag}.marshal"
+    return Path(root) / "rtmu" / f"dataclass-code-{FORMAT}-{tag}.marshal"
 
 
 def compiled_this_run() -> int:
@@ -117,7 +120,9 @@ def _cached_exec(source: Any, globals_: Any = None, locals_: Any = None) -> None
     c.used.add(key)
     code = _unmarshalled(c.stored.get(key) or c.new.get(key))
     if code is None:
-        code = compile(source, "<string>", "exec")
+        # As dataclasses' own exec compiles it: without this module's ``from __future__`` flags
+        # (inherited, they would leave ``__init__``'s annotations as strings).
+        code = compile(source, "<string>", "exec", dont_inherit=True)
         c.new[key] = marshal.dumps(code)
     exec(code, globals_, locals_)  # compiled from dataclasses' own text
 
