@@ -17,6 +17,10 @@ runs in a process of its own (office map, no camera).
 * ``startup.guardian_cpu_s`` (s): a guardian process (``python -m rtmu.guardian``, as the window and
   ``rtmu drive`` start one) from exec until it has logged in and said ``ready``. Baseline: as for
   status. Target ≤ 0.2 s.
+* ``startup.window_modules_cpu_s`` (s): a fresh interpreter importing everything the window needs
+  (``rtmu.ui.application``), the compiled dataclass methods read from a warm cache
+  (``base.dataclass_code``, as after the window's first start). Baseline: the same import without the
+  cache (every dataclass compiles its methods again, as before it).
 * ``startup.guardian_rss_mib`` (MiB): the guardian's peak resident memory by then. Baseline: the peak
   of ``python -c pass``.
 """
@@ -29,6 +33,7 @@ import re
 import statistics
 import subprocess
 import sys
+import tempfile
 import time
 from collections.abc import Iterator, Sequence
 from pathlib import Path
@@ -44,10 +49,12 @@ ARIA = Path("/work/realpeer/aria")
 COMMAND_LISTER = ARIA / "ArNetworking/examples/clientCommandLister"
 PYTHON = sys.executable
 TICKS = os.sysconf("SC_CLK_TCK")
+INSTALL_CACHE = "from rtmu.base import dataclass_code\ndataclass_code.install()"
 
 
-def _env() -> dict[str, str]:
+def _env(**extra: str) -> dict[str, str]:
     env = as_installed(dict(os.environ))
+    env.update(extra)
     env["PYTHONPATH"] = os.pathsep.join(p for p in (str(REPO / "src"), env.get("PYTHONPATH", "")) if p)
     env["LD_LIBRARY_PATH"] = os.pathsep.join(
         p for p in (str(ARIA / "lib"), env.get("LD_LIBRARY_PATH", "")) if p
@@ -55,10 +62,14 @@ def _env() -> dict[str, str]:
     return env
 
 
-def cpu_of(argv: Sequence[str]) -> tuple[float, float]:
+def cpu_of(argv: Sequence[str], env: dict[str, str] | None = None) -> tuple[float, float]:
     """(user + system CPU seconds, peak RSS in MiB) of one run of ``argv``, output thrown away."""
     proc = subprocess.Popen(
-        argv, stdin=subprocess.DEVNULL, stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL, env=_env()
+        argv,
+        stdin=subprocess.DEVNULL,
+        stdout=subprocess.DEVNULL,
+        stderr=subprocess.DEVNULL,
+        env=env or _env(),
     )
     _, status, usage = os.wait4(proc.pid, 0)
     proc.returncode = os.waitstatus_to_exitcode(status)
@@ -77,6 +88,25 @@ def interleaved(a: Sequence[str], b: Sequence[str], runs: int = RUNS) -> tuple[f
         ta.append(cpu_of(a)[0])
         tb.append(cpu_of(b)[0])
     return statistics.median(ta), statistics.median(tb)
+
+
+def window_modules() -> tuple[float, float]:
+    """(CPU of importing the window's modules with a warm dataclass cache, the same without it)."""
+    with tempfile.TemporaryDirectory(prefix="rtmu-bench-cache-") as cache:
+        env = _env(XDG_CACHE_HOME=cache, OPENBLAS_NUM_THREADS="1")
+        cached = [
+            PYTHON,
+            "-c",
+            "from rtmu.base import dataclass_code as d\nd.install()\nimport rtmu.ui.application",
+        ]
+        stock = [PYTHON, "-c", "import rtmu.ui.application"]
+        cpu_of(cached, env)  # the first start fills the cache
+        ours: list[float] = []
+        theirs: list[float] = []
+        for _ in range(RUNS):
+            ours.append(cpu_of(cached, env)[0])
+            theirs.append(cpu_of(stock, env)[0])
+    return statistics.median(ours), statistics.median(theirs)
 
 
 @contextlib.contextmanager
@@ -166,6 +196,8 @@ def run() -> list[Result]:
         Result("startup.help_cpu_s.max", helps[worst], "s", bare_cpu),
         Result("startup.help_cpu_s.median", statistics.median(helps.values()), "s", bare_cpu),
     ]
+    modules, modules_stock = window_modules()
+    results.append(Result("startup.window_modules_cpu_s", modules, "s", modules_stock))
     aria = COMMAND_LISTER.exists()
     with simulator() as port:
         lister = [str(COMMAND_LISTER), "-host", "127.0.0.1", "-port", str(port)]

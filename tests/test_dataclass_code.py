@@ -13,6 +13,7 @@ import sys
 from pathlib import Path
 
 import rtmu
+from rtmu.package_data import project_map
 
 SRC = Path(rtmu.__file__).resolve().parents[1]
 
@@ -112,10 +113,19 @@ def test_an_unwritable_cache_is_skipped_quietly(tmp_path: Path) -> None:
 
 
 def test_the_rtmu_command_installs_it(tmp_path: Path) -> None:
-    """``rtmu`` (cli.main) installs the cache before a command's modules load: ``rtmu status --help``
-    leaves a cache file behind."""
+    """``rtmu`` (cli.main) installs the cache before a command's handler loads its modules:
+    ``rtmu mapinfo`` leaves a cache file behind; ``rtmu --version`` neither loads ``dataclasses`` nor
+    writes one."""
     env = {**os.environ, "PYTHONPATH": str(SRC), "XDG_CACHE_HOME": str(tmp_path)}
-    code = "from rtmu.cli import main\ntry:\n    main(['sim', '--help'])\nexcept SystemExit:\n    pass\n"
+    version = (
+        "import sys\nfrom rtmu.cli import main\ntry:\n    main(['--version'])\nexcept SystemExit:\n    pass\n"
+        "assert 'dataclasses' not in sys.modules, 'dataclasses loaded by --version'\n"
+    )
+    out = subprocess.run([sys.executable, "-c", version], capture_output=True, text=True, env=env, timeout=60)
+    assert out.returncode == 0, out.stderr[-2000:]
+    assert not (tmp_path / "rtmu").exists()
+    office = project_map("office.map")
+    code = f"from rtmu.cli import main\nmain(['mapinfo', {str(office)!r}])\n"
     out = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, env=env, timeout=120)
     assert out.returncode == 0, out.stderr[-2000:]
     assert list((tmp_path / "rtmu").glob("dataclass-code-*.marshal"))

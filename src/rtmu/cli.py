@@ -182,10 +182,12 @@ def build_parser(*, lazy: bool = False) -> argparse.ArgumentParser:
 def main(argv: Sequence[str] | None = None) -> int:
     for name, value in SINGLE_BLAS_THREAD.items():
         os.environ.setdefault(name, value)
-    dataclass_code.install()  # before the command's modules define their dataclasses
     logs.configure()  # developer notices off the operator's terminal (RTMU_LOG=warning shows them)
     parser = build_parser(lazy=True)
     args = parser.parse_args(argv)
+    # Past --version and --help (which exit above and need no dataclass); before the modules a
+    # command's handler or the window imports define theirs.
+    dataclass_code.install()
     handler = getattr(args, "handler", None)
     installing = _integration.handle(args, build_parser) if handler is None else None
     if installing is not None:

@@ -13,7 +13,6 @@ difference in the classes made (the text, not the class, is the key).
 from __future__ import annotations
 
 import atexit
-import dataclasses
 import importlib.util
 import marshal
 import os
@@ -149,6 +148,8 @@ def install(*, save_at_exit: bool = True) -> None:
     if _cache.installed:
         return
     _cache.installed = True
+    import dataclasses  # here: ``rtmu --version`` and ``--help`` load cli (and this module) but no dataclass
+
     dataclasses.exec = _cached_exec  # type: ignore[attr-defined]  # shadows the builtin there only
     if save_at_exit:
         atexit.register(save)
