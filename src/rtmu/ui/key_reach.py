@@ -7,9 +7,11 @@ Two ways keys went missing:
   page's scrolled window the window's focus. The window then keeps a focus widget that is not mapped,
   and GTK delivers every key to it: no controller — not even the window's capture-phase key router —
   sees Space, Up or Escape until the menu is opened and closed again. :class:`KeyReach` watches the
-  window's focus and, as soon as it lands on a widget that is not on screen, moves it back (to the
-  popover's button when it can take it, else to the window itself) before the next event is
-  handled; a 100 ms check catches any other way a focus could be left behind (a page switched away).
+  window's focus and, as soon as it lands on a widget that is not on screen — or the widget holding
+  it leaves the screen (its ``unmap``: a page switched away, a popover closed) — moves it back (to
+  the popover's button when it can take it, else to the window itself) before the next event is
+  handled. Those two events are the only ways a focus can be stranded, so nothing polls for it; a
+  once-a-second check stays as a backstop (at 10 Hz it was the idle window's most frequent wake-up).
 * **The keyboard is elsewhere** (another program, one of the window's dialogs): the drive keys
   cannot reach the window. The controller already ends held drives and refuses D-pad drives then;
   here a banner (topic ``keys``, kept while it lasts) says so ("Keys inactive — click the map", or
@@ -33,7 +35,11 @@ from .dialog_chain import dialogs_of  # noqa: E402
 MainWindow = Any
 """``ui.window.MainWindow`` (which imports this module): named, not imported."""
 
-CHECK_MS = 100
+CHECK_MS = 1000
+"""The backstop: a stranded focus or a stale note is caught by events first (see the module notes)."""
+SETTLE_MS = 200
+"""After the window's activity changes, the note is made again once this later: the dialog that took
+the keyboard is not always active yet when the window hears it lost it."""
 TOPIC = "keys"
 
 
@@ -61,23 +67,48 @@ class KeyReach:
         """What the window says about its keys now ("" while they reach it)."""
         self._handlers = [
             window.connect("notify::focus-widget", lambda *_a: self._focus_moved()),
-            window.connect("notify::is-active", lambda *_a: self.refresh()),
+            window.connect("notify::is-active", lambda *_a: self._activity_changed()),
         ]
+        self._watched: tuple[Gtk.Widget, int] | None = None
+        """The focus widget and its ``unmap`` handler."""
         self._timer = GLib.timeout_add(CHECK_MS, self._check)
+        self._settle = 0
+        self._unwatch_connection = window.model.connection.observe(lambda *_a: self.refresh())
         self.refresh()
+        self._watch(window.get_focus())
 
     def close(self) -> None:
-        if self._timer:
-            GLib.source_remove(self._timer)
-            self._timer = 0
+        for source in (self._timer, self._settle):
+            if source:
+                GLib.source_remove(source)
+        self._timer = self._settle = 0
+        self._watch(None)
+        self._unwatch_connection()
         for handler in self._handlers:
             self.window.disconnect(handler)
         self._handlers = []
 
     # -- stranded focus ----------------------------------------------------------------------
     def _focus_moved(self) -> None:
+        self._watch(self.window.get_focus())
         if stranded(self.window) is not None:
-            GLib.idle_add(self._repair_once, priority=GLib.PRIORITY_HIGH)  # type: ignore[call-arg]
+            self._repair_soon()
+
+    def _watch(self, focus: Gtk.Widget | None) -> None:
+        """Hear when ``focus`` (the window's focus widget) leaves the screen."""
+        if self._watched is not None:
+            widget, handler = self._watched
+            if widget is focus:
+                return
+            widget.disconnect(handler)
+            self._watched = None
+        if focus is not None:
+            self._watched = (focus, focus.connect("unmap", lambda *_a: self._repair_soon()))
+
+    def _repair_soon(self) -> None:
+        """Repair once the current emission is over (an ``unmap`` handler runs before the widget is
+        marked unmapped), before the next input event."""
+        GLib.idle_add(self._repair_once, priority=GLib.PRIORITY_HIGH)  # type: ignore[call-arg]
 
     def _repair_once(self) -> bool:
         self.repair()
@@ -100,6 +131,17 @@ class KeyReach:
         self.repair()
         self.refresh()
         return True
+
+    def _activity_changed(self) -> None:
+        self.refresh()
+        if self._settle:
+            GLib.source_remove(self._settle)
+        self._settle = GLib.timeout_add(SETTLE_MS, self._settled)
+
+    def _settled(self) -> bool:
+        self._settle = 0
+        self.refresh()
+        return False
 
     # -- the note ------------------------------------------------------------------------------
     def refresh(self) -> None:
