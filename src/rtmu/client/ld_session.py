@@ -13,6 +13,7 @@ is navigation's (:class:`~rtmu.client.nav_session.NavFeed`): one ``getGoals`` pe
 from __future__ import annotations
 
 import contextlib
+import itertools
 from collections.abc import Iterable
 from typing import ClassVar
 
@@ -89,8 +90,12 @@ class LdFeed(Feed):
         """A laser's ``…Current`` packet (also handed on by the drawings feed when it holds that request)."""
         readings = self.ctx.decode(packet.name, packet.payload)
         if isinstance(readings, RangeDeviceReadings):
-            self._lasers[packet.name] = readings.readings
-            points = tuple(p for name in sorted(self._lasers) for p in self._lasers[name])
+            lasers = self._lasers
+            lasers[packet.name] = readings.readings
+            if len(lasers) == 1:  # one laser (most robots): its readings as they are, not rebuilt
+                points = tuple(readings.readings)  # the same tuple: no copy
+            else:
+                points = tuple(itertools.chain.from_iterable(lasers[name] for name in sorted(lasers)))
             self.ctx.robot_update(laser=points, laser_at=packet.received_at)
 
     def _on_dock(self, packet: Packet) -> None:
