@@ -104,6 +104,33 @@ def test_a_damaged_cache_costs_compilations_only_and_is_written_again(tmp_path: 
     assert run_probe(tmp_path)["new"] == 0  # the damaged file was replaced by a good one
 
 
+def test_a_cache_of_the_wrong_shape_costs_compilations_only(tmp_path: Path) -> None:
+    """Files marshal reads but RTMU never wrote: each is ignored (entry by entry where it can)."""
+    import marshal
+
+    cached = cache_path(tmp_path)
+    cached.parent.mkdir(parents=True)
+    for table in (
+        ({b"k" * 20: 5, b"j" * 20: (1, 2, 3), b"i" * 20: ("a", 1), 7: (0, 1), b"h" * 20: (4, 99)}, b"blob"),
+        ([1, 2], b""),
+        ("text", 3),
+        (1, 2, 3),
+        {"a": 1},
+    ):
+        cached.write_bytes(marshal.dumps(table))
+        result = run_probe(tmp_path)
+        assert result["frozen"] and result["eq"], table
+        assert isinstance(result["new"], int) and result["new"] > 20
+
+
+def cache_path(cache_home: Path) -> Path:
+    """The cache file a probe run with ``XDG_CACHE_HOME=cache_home`` reads (named as the module says)."""
+    env = {**os.environ, "PYTHONPATH": str(SRC), "XDG_CACHE_HOME": str(cache_home)}
+    code = "from rtmu.base import dataclass_code\nprint(dataclass_code.cache_file())"
+    out = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, env=env, timeout=60)
+    return Path(out.stdout.strip())
+
+
 def test_an_unwritable_cache_is_skipped_quietly(tmp_path: Path) -> None:
     blocker = tmp_path / "not-a-folder"
     blocker.write_text("a file where the cache folder would go")

@@ -65,14 +65,17 @@ class Table:
             return cls()
         if not isinstance(index, dict) or not isinstance(blob, bytes):
             return cls()
-        good = {
-            k: (o, n)
-            for k, (o, n) in index.items()
-            if isinstance(k, bytes)
-            and isinstance(o, int)
-            and isinstance(n, int)
-            and 0 <= o <= o + n <= len(blob)
-        }
+        size = len(blob)
+        good: dict[bytes, tuple[int, int]] = {}
+        for key, where in index.items():  # a damaged file may hold anything that marshal can
+            if isinstance(key, bytes) and isinstance(where, tuple) and len(where) == 2:
+                offset, length = where
+                if (
+                    isinstance(offset, int)
+                    and isinstance(length, int)
+                    and 0 <= offset <= offset + length <= size
+                ):
+                    good[key] = (offset, length)
         return cls(good, blob)
 
 
