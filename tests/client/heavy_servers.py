@@ -24,8 +24,11 @@ import asyncio
 import contextlib
 import io
 import itertools
+import subprocess
 import sys
+import threading
 import time
+from pathlib import Path
 
 from rtmu.protocol.events import RequestReceived
 from rtmu.protocol.fields import FieldWriter
@@ -40,6 +43,7 @@ FLOOD_PERIOD = 0.001
 POPUPS_PER_S = 200
 POPUP_TEXT = 31_800
 FLOOD_TASK = "(flood)"
+TESTS = Path(__file__).resolve().parents[1]
 
 
 def _row(name: str, returns: str = "RETURN_SINGLE") -> tuple[str, str, str, str, str, str]:
@@ -155,3 +159,43 @@ def main(kind: str) -> int:
         print(f"port {server.port}", flush=True)
         sys.stdin.read()
     return 0
+
+
+class FloodProcess:
+    """:func:`main` (``kind``) in a process of its own — a robot's server is never in the client's
+    process, and an in-process flood would take the client's interpreter lock; the drive packets it
+    reports, on the shared monotonic clock."""
+
+    def __init__(self, kind: str) -> None:
+        code = f"import sys; sys.path.insert(0, {str(TESTS)!r}); from client.heavy_servers import main; "
+        code += f"main({kind!r})"
+        self.proc = subprocess.Popen(
+            [sys.executable, "-c", code], stdin=subprocess.PIPE, stdout=subprocess.PIPE, text=True
+        )
+        assert self.proc.stdout is not None
+        word, port = self.proc.stdout.readline().split()
+        assert word == "port"
+        self.port = int(port)
+        self.events: list[tuple[str, float]] = []
+        threading.Thread(target=self._read, daemon=True).start()
+
+    def _read(self) -> None:
+        assert self.proc.stdout is not None
+        for line in self.proc.stdout:
+            parts = line.split()
+            if parts and parts[0] in ("drive", "stop"):
+                stop = parts[0] == "stop" or (float(parts[2]) == 0 and float(parts[3]) == 0)
+                self.events.append(("stop" if stop else "drive", float(parts[1])))
+
+    def since(self, kind: str, t0: float) -> list[float]:
+        """When each ``kind`` packet (``drive`` or ``stop``) came at or after ``t0``."""
+        return [t for k, t in list(self.events) if k == kind and t >= t0]
+
+    def close(self) -> None:
+        if self.proc.stdin is not None:
+            self.proc.stdin.close()
+        try:
+            self.proc.wait(10)
+        except subprocess.TimeoutExpired:
+            self.proc.kill()
+            self.proc.wait(5)

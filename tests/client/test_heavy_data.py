@@ -1,7 +1,9 @@
 """The heaviest well-formed data a server may send must not take driving away.
 
 Against the scripted servers of ``heavy_servers`` (real loopback sockets): 256 drawings of 3 998
-points resent every millisecond, a popup storm, and 632-byte pictures that declare 4096×4096 pixels.
+points resent every millisecond (from a process of its own, as a robot's server is: in this one its
+flood took the client's interpreter lock, and on a loaded machine delayed its own status past the
+link's limit), a popup storm, and 632-byte pictures that declare 4096×4096 pixels.
 A held drive is never stopped by them and ``ratioDrive`` keeps flowing; what reaches the window is
 bounded (points per state, states per second, decoded picture size). Rates are not timed here —
 ``bench/bench_heavy.py`` measures them — only counted with generous bounds.
@@ -10,6 +12,7 @@ bounded (points per state, states per second, decoded picture size). Rates are n
 from __future__ import annotations
 
 import time
+from collections.abc import Callable
 
 import numpy as np
 import pytest
@@ -24,39 +27,47 @@ from rtmu.model.observables import RobotModel
 from rtmu.protocol.payloads.drawings import DrawingPoints
 from rtmu.values.target import Target
 
-from .heavy_servers import big_jpeg, drawing_flood_server, popup_storm_server
+from .heavy_servers import FloodProcess, big_jpeg, drawing_flood_server, popup_storm_server
 from .servers import ServerThread, TestServer
 from .uiqueue import UiQueue
 
 HOLD = 3.0
 
 
-def hold_a_drive(server: TestServer) -> tuple[ClientRunner, RobotModel, UiQueue, list[str], int]:
-    """Connect, hold a drive for HOLD s renewing it as the window's timer does; (…, stops, drives)."""
+def received_drives(server: TestServer) -> Callable[[], int]:
+    """How many ``ratioDrive`` an in-process server has heard so far."""
+    return lambda: len([r for r in server.received if r.name == "ratioDrive"])
+
+
+def hold_a_drive(
+    port: int, heard: Callable[[], int]
+) -> tuple[ClientRunner, RobotModel, UiQueue, list[str], int]:
+    """Connect, hold a drive for HOLD s renewing it as the window's timer does; (…, stops, drives):
+    ``heard()`` counts the ``ratioDrive`` the server has heard."""
     model, ui = RobotModel(), UiQueue()
     runner = ClientRunner(model, post=ui.post, config=SessionConfig(fetch_map=False))
     stops: list[str] = []
     runner.on_stop = lambda reason, sent: stops.append(reason)
     runner.start()
-    runner.connect(Target("127.0.0.1", server.port)).result(10)
+    runner.connect(Target("127.0.0.1", port)).result(10)
     ui.wait_for(lambda: model.health.value.rtt_ms is not None, timeout=10)
     runner.lease.grant(DriveRatios(30, 0, 30))
-    before = len([r for r in server.received if r.name == "ratioDrive"])
+    before = heard()
     end = time.monotonic() + HOLD
     while time.monotonic() < end:
         runner.lease.renew()
         ui.drain()
         time.sleep(0.04)
-    drives = len([r for r in server.received if r.name == "ratioDrive"]) - before
+    drives = heard() - before
     stopped = list(stops)  # before our own release's stop
     runner.lease.release()
     return runner, model, ui, stopped, drives
 
 
 def test_a_drawing_flood_neither_stops_a_held_drive_nor_swamps_the_window() -> None:
-    server = drawing_flood_server()
-    with ServerThread(server):
-        runner, model, _ui, stops, drives = hold_a_drive(server)
+    server = FloodProcess("drawings")
+    try:
+        runner, model, _ui, stops, drives = hold_a_drive(server.port, lambda: len(server.since("drive", 0.0)))
         try:
             assert runner.session is not None
             feed = runner.session.feed(DrawingsFeed)
@@ -68,13 +79,15 @@ def test_a_drawing_flood_neither_stops_a_held_drive_nor_swamps_the_window() -> N
             assert len(shown) == 256 and all(d.total_points == 3998 for d in shown if d.points)
         finally:
             runner.close()
+    finally:
+        server.close()
 
 
 def test_a_popup_storm_neither_stops_a_held_drive_nor_floods_the_ui_thread() -> None:
     server = popup_storm_server()
     with ServerThread(server):
         changes: list[int] = []
-        runner, model, ui, stops, drives = hold_a_drive(server)
+        runner, model, ui, stops, drives = hold_a_drive(server.port, received_drives(server))
         try:
             model.popups.observe(lambda old, new: changes.append(1))
             sent = server.sent

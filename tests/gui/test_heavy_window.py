@@ -10,64 +10,24 @@ in ``bench/bench_heavy.py``.
 
 from __future__ import annotations
 
-import subprocess
-import sys
-import threading
 import time
 from collections.abc import Iterator
 from pathlib import Path
 
 import pytest
 
+from client.heavy_servers import FloodProcess
 from rtmu.client.drawing_budget import MAX_SHOWN_POINTS
 from rtmu.client.video_session import CameraFeed
 
 from .harness import Gui, idle, pump
 
-TESTS = Path(__file__).resolve().parents[1]
 HOLD = 3.0
 
 
-class FloodServer:
-    """``client.heavy_servers.main(KIND)`` in its own process; the drive packets it reports."""
-
-    def __init__(self, kind: str) -> None:
-        code = f"import sys; sys.path.insert(0, {str(TESTS)!r}); from client.heavy_servers import main; "
-        code += f"main({kind!r})"
-        self.proc = subprocess.Popen(
-            [sys.executable, "-c", code], stdin=subprocess.PIPE, stdout=subprocess.PIPE, text=True
-        )
-        assert self.proc.stdout is not None
-        word, port = self.proc.stdout.readline().split()
-        assert word == "port"
-        self.port = int(port)
-        self.events: list[tuple[str, float]] = []
-        threading.Thread(target=self._read, daemon=True).start()
-
-    def _read(self) -> None:
-        assert self.proc.stdout is not None
-        for line in self.proc.stdout:
-            parts = line.split()
-            if parts and parts[0] in ("drive", "stop"):
-                stop = parts[0] == "stop" or (float(parts[2]) == 0 and float(parts[3]) == 0)
-                self.events.append(("stop" if stop else "drive", float(parts[1])))
-
-    def since(self, kind: str, t0: float) -> list[float]:
-        return [t for k, t in list(self.events) if k == kind and t >= t0]
-
-    def close(self) -> None:
-        if self.proc.stdin is not None:
-            self.proc.stdin.close()
-        try:
-            self.proc.wait(10)
-        except subprocess.TimeoutExpired:
-            self.proc.kill()
-            self.proc.wait(5)
-
-
 @pytest.fixture
-def flood(request: pytest.FixtureRequest, screenshots: Path) -> Iterator[tuple[Gui, FloodServer]]:
-    server = FloodServer(request.param)
+def flood(request: pytest.FixtureRequest, screenshots: Path) -> Iterator[tuple[Gui, FloodProcess]]:
+    server = FloodProcess(request.param)
     try:
         gui = Gui.start(screenshots, request.node.name, "127.0.0.1", server.port)
         try:
@@ -79,7 +39,7 @@ def flood(request: pytest.FixtureRequest, screenshots: Path) -> Iterator[tuple[G
         server.close()
 
 
-def _hold_up(gui: Gui, server: FloodServer) -> tuple[int, int]:
+def _hold_up(gui: Gui, server: FloodProcess) -> tuple[int, int]:
     """Hold Up for HOLD s (pressing again until the window drives): (drives heard, stops heard)."""
     for _attempt in range(5):
         gui.keydown("Up")
@@ -94,14 +54,14 @@ def _hold_up(gui: Gui, server: FloodServer) -> tuple[int, int]:
     return len(server.since("drive", start)), len(server.since("stop", start))
 
 
-def _release_stops(gui: Gui, server: FloodServer) -> None:
+def _release_stops(gui: Gui, server: FloodProcess) -> None:
     up = time.monotonic()
     gui.keyup("Up")
     pump(lambda: bool(server.since("stop", up)), 5, "the release to stop the robot")
 
 
 @pytest.mark.parametrize("flood", ["drawings"], indirect=True)
-def test_a_drawing_flood_leaves_the_window_driving(flood: tuple[Gui, FloodServer]) -> None:
+def test_a_drawing_flood_leaves_the_window_driving(flood: tuple[Gui, FloodProcess]) -> None:
     gui, server = flood
     pump(lambda: len(gui.model.drawings.value.layers) == 256, 10, "the 256 drawings listed")
     pump(lambda: any(d.points for d in gui.model.drawings.value.layers), 10, "drawings to arrive")
@@ -113,7 +73,7 @@ def test_a_drawing_flood_leaves_the_window_driving(flood: tuple[Gui, FloodServer
 
 
 @pytest.mark.parametrize("flood", ["popups"], indirect=True)
-def test_a_popup_storm_leaves_the_window_driving(flood: tuple[Gui, FloodServer]) -> None:
+def test_a_popup_storm_leaves_the_window_driving(flood: tuple[Gui, FloodProcess]) -> None:
     gui, server = flood
     stack = gui.window.popup_stack
     pump(lambda: gui.model.popups.value.dropped > 0, 10, "the storm to overflow the kept popups")
@@ -126,7 +86,7 @@ def test_a_popup_storm_leaves_the_window_driving(flood: tuple[Gui, FloodServer])
 
 
 @pytest.mark.parametrize("flood", ["frames"], indirect=True)
-def test_4096_squared_frames_leave_the_window_driving(flood: tuple[Gui, FloodServer]) -> None:
+def test_4096_squared_frames_leave_the_window_driving(flood: tuple[Gui, FloodProcess]) -> None:
     gui, server = flood
     gui.key("v")  # live video: one 632-byte frame declaring 4096×4096 after another
     session = gui.window.session.runner.session
