@@ -53,7 +53,7 @@ MAY_IMPORT: dict[str, frozenset[str]] = {
     # The flight recorder taps the client's links and values; the raw channel's layout is capture's.
     "recorder": frozenset({"client", "values", "capture", "codec", "base"}),
     "ui-state": frozenset({"values"}),
-    "settings": frozenset(),
+    "settings": frozenset({"base"}),
     "control": frozenset({"client", "ui-state", "values", "settings", "base"}),
     "fleet": frozenset(
         {"control", "client", "guardian", "recorder", "ui-state", "values", "settings", "base"}

@@ -21,6 +21,8 @@ from pathlib import Path
 from types import CodeType
 from typing import Any
 
+from .xdg import CACHE, xdg_home
+
 FORMAT = "v2"
 """In the file's name: a cache written by an earlier RTMU (v1 compiled with the wrong flags) is
 never read."""
@@ -94,7 +96,7 @@ _cache = _Cache()
 
 def cache_file() -> Path:
     """``$XDG_CACHE_HOME/rtmu/dataclass-code-<format>-<interpreter>-<bytecode magic>.marshal``."""
-    root = os.environ.get("XDG_CACHE_HOME") or str(Path.home() / ".cache")
+    root = xdg_home(CACHE)
     tag = f"{sys.implementation.cache_tag}-{importlib.util.MAGIC_NUMBER.hex()}"
     return Path(root) / "rtmu" / f"dataclass-code-{FORMAT}-{tag}.marshal"
 

@@ -7,12 +7,13 @@ session named by its UTC start and its robot: ``20261125T041500Z_lab-robot_7272.
 from __future__ import annotations
 
 import contextlib
-import os
 import re
 import time
 from collections.abc import Mapping
 from datetime import UTC, datetime
 from pathlib import Path
+
+from ..base.xdg import DATA, xdg_home
 
 SUFFIX = ".mcap"
 _UNSAFE = re.compile(r"[^A-Za-z0-9._-]+")
@@ -20,10 +21,7 @@ _UNSAFE = re.compile(r"[^A-Za-z0-9._-]+")
 
 def recordings_dir(env: Mapping[str, str] | None = None) -> Path:
     """``$XDG_DATA_HOME/rtmu/recordings`` (an unset or relative value means ``~/.local/share``)."""
-    env = os.environ if env is None else env
-    base = env.get("XDG_DATA_HOME", "")
-    root = Path(base) if base and os.path.isabs(base) else Path.home() / ".local" / "share"
-    return root / "rtmu" / "recordings"
+    return xdg_home(DATA, env) / "rtmu" / "recordings"
 
 
 def file_name(robot: str, when: float | None = None) -> str:

@@ -8,20 +8,18 @@ home the test suite keeps out of the real home), replaced whole on every run; no
 from __future__ import annotations
 
 import contextlib
-import os
 import time
 from collections.abc import Mapping
 from pathlib import Path
+
+from ..base.xdg import DATA, xdg_home
 
 MAX_BYTES = 16_000
 """A report is a few hundred bytes; a file grown past this is not ours and is not shown whole."""
 
 
 def last_doctor_path(env: Mapping[str, str] | None = None) -> Path:
-    env = os.environ if env is None else env
-    base = env.get("XDG_DATA_HOME", "")
-    root = Path(base) if base and os.path.isabs(base) else Path.home() / ".local" / "share"
-    return root / "rtmu" / "last-doctor.txt"
+    return xdg_home(DATA, env) / "rtmu" / "last-doctor.txt"
 
 
 def save_last_doctor(lines: list[str], env: Mapping[str, str] | None = None) -> None:

@@ -61,6 +61,7 @@ from dataclasses import dataclass, field, fields, replace
 from pathlib import Path
 from typing import Any
 
+from ..base.xdg import CONFIG, xdg_home
 from .notifications import notification_lines, parse_notifications
 
 log = logging.getLogger(__name__)
@@ -277,10 +278,7 @@ class Settings:
 
 def config_dir(env: Mapping[str, str] | None = None) -> Path:
     """``$XDG_CONFIG_HOME/rtmu`` (an unset or relative value means ``~/.config``, as the spec says)."""
-    env = os.environ if env is None else env
-    base = env.get("XDG_CONFIG_HOME", "")
-    root = Path(base) if base and os.path.isabs(base) else Path.home() / ".config"
-    return root / "rtmu"
+    return xdg_home(CONFIG, env) / "rtmu"
 
 
 def settings_path(env: Mapping[str, str] | None = None) -> Path:

@@ -12,7 +12,6 @@ uses (argparse-manpage, shtab), so they cannot drift from it.
 from __future__ import annotations
 
 import argparse
-import os
 import sys
 from collections.abc import Callable
 from pathlib import Path
@@ -20,6 +19,7 @@ from typing import NamedTuple
 
 from .. import __version__
 from ..base.i18n import _
+from ..base.xdg import DATA, xdg_home
 from ..package_data import APP_ID, DESKTOP_DIR
 
 EXIT_CANNOT_WRITE = 1
@@ -97,8 +97,7 @@ def handle(args: argparse.Namespace, full_parser: Callable[[], argparse.Argument
 
 def data_home() -> Path:
     """``$XDG_DATA_HOME`` (an absolute path, as the spec demands), else ``~/.local/share``."""
-    configured = os.environ.get("XDG_DATA_HOME", "")
-    return Path(configured) if os.path.isabs(configured) else Path.home() / ".local" / "share"
+    return xdg_home(DATA)
 
 
 def rtmu_command() -> list[str]:
