@@ -7,6 +7,7 @@ table and writes ``bench/results.json``.
 
 from __future__ import annotations
 
+import contextlib
 import os
 import subprocess
 import sys
@@ -67,6 +68,19 @@ def best_time(fn: Callable[[], object], *, repeat: int = 5, min_seconds: float =
 def end_process(proc: subprocess.Popen[Any], grace: float = 10.0) -> None:
     """SIGTERM, then SIGKILL if it has not ended within ``grace`` seconds; always reaped."""
     proc.terminate()
+    try:
+        proc.wait(grace)
+    except subprocess.TimeoutExpired:
+        proc.kill()
+        proc.wait(5)
+
+
+def end_by_stdin(proc: subprocess.Popen[Any], grace: float = 10.0) -> None:
+    """End a helper whose life is its stdin (it serves until stdin closes): close it, wait ``grace``
+    seconds, then SIGKILL; always reaped."""
+    if proc.stdin is not None:
+        with contextlib.suppress(OSError):
+            proc.stdin.close()
     try:
         proc.wait(grace)
     except subprocess.TimeoutExpired:

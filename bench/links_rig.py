@@ -21,6 +21,7 @@ import threading
 import time
 from pathlib import Path
 
+from bench.common import end_by_stdin
 from rtmu.base.link_timing import FIXED_ENV
 from rtmu.package_data import project_map
 from rtmu.sim import SimConfig, SimThread
@@ -182,14 +183,7 @@ class RigProcess:
         return True
 
     def close(self) -> None:
-        if self.proc.stdin is not None:
-            with contextlib.suppress(OSError):
-                self.proc.stdin.close()
-        try:
-            self.proc.wait(10)
-        except subprocess.TimeoutExpired:
-            self.proc.kill()
-            self.proc.wait(5)
+        end_by_stdin(self.proc)
 
 
 class CoreParent:

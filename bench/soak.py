@@ -37,7 +37,7 @@ from collections.abc import Callable
 from pathlib import Path
 from typing import Any
 
-from bench.common import Result
+from bench.common import Result, end_by_stdin
 from rtmu.client.lease import DriveRatios
 from rtmu.client.runner import ClientRunner
 from rtmu.client.session import SessionConfig
@@ -112,13 +112,7 @@ class _Server:
                 self._cond.wait(left)
 
     def close(self) -> None:
-        if self.proc.stdin is not None:
-            self.proc.stdin.close()
-        try:
-            self.proc.wait(10)
-        except subprocess.TimeoutExpired:
-            self.proc.kill()
-            self.proc.wait(5)
+        end_by_stdin(self.proc)
 
 
 class _UiThread:

@@ -192,10 +192,6 @@ class FloodProcess:
         return [t for k, t in list(self.events) if k == kind and t >= t0]
 
     def close(self) -> None:
-        if self.proc.stdin is not None:
-            self.proc.stdin.close()
-        try:
-            self.proc.wait(10)
-        except subprocess.TimeoutExpired:
-            self.proc.kill()
-            self.proc.wait(5)
+        from bench.common import end_by_stdin  # here: the served process imports this module without bench
+
+        end_by_stdin(self.proc)
