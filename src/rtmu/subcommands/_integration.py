@@ -89,15 +89,10 @@ def handle(args: argparse.Namespace, full_parser: Callable[[], argparse.Argument
         sys.stdout.write(completion(parser, shell))
         return 0
     if getattr(args, "install_desktop", False):
-        return install(parser, data_home(), rtmu_command())
+        return install(parser, xdg_home(DATA), rtmu_command())
     if getattr(args, "uninstall_desktop", False):
-        return uninstall(parser, data_home())
+        return uninstall(parser, xdg_home(DATA))
     return None
-
-
-def data_home() -> Path:
-    """``$XDG_DATA_HOME`` (an absolute path, as the spec demands), else ``~/.local/share``."""
-    return xdg_home(DATA)
 
 
 def rtmu_command() -> list[str]:
