@@ -128,7 +128,10 @@ DEEP_BYTES = 64 << 20
 """Hashed in one call while starved: ~0.1 s of CPU (hashlib lets the GIL go for it), which a thread in
 ``SCHED_IDLE`` behind six spinners does not get within :data:`STARVE`."""
 STARVE = 0.6
-"""Seconds the renewer is starved: past the lease's 0.3 s, well inside the keeper's 1 s limit."""
+"""Seconds the renewer is starved (at least): past the lease's 0.3 s."""
+LATE_WAKE_LIMIT = 10.0
+"""The starved-credit limit of the real-clock test's keeper: past any late wake of the thread that ends
+the starving, so only the kernel's account decides there."""
 
 
 class Renewer:
@@ -215,7 +218,10 @@ def test_the_kernel_account_tells_a_starved_thread_from_a_frozen_one() -> None:
     """Real threads on the real clock: a renewer that waits :data:`STARVE` s for its CPU — and only
     waits — lapses without a keeper and keeps its lease with one; a renewer that simply stops (blocked,
     not runnable) lapses either way. No figure here depends on how busy the machine is: the starving
-    is the scheduling class's, and the keeper's 1 s limit leaves 0.4 s for a late wake."""
+    is the scheduling class's, and the keeper here credits up to :data:`LATE_WAKE_LIMIT` s, not its
+    1 s, because how long the starving lasts is this test thread's sleep, whose end comes late on a
+    busy machine (the official CI's renewer waited 0.91 s for a 0.6 s starving and then passed the
+    1 s limit). That limit is the fake clock's test above, where no wake is late."""
     affinity = sorted(os.sched_getaffinity(0))
     if len(affinity) < 2 or RunQueueMeter()(threading.get_native_id()) is None or not _can_starve():
         pytest.skip("needs two CPUs, /proc/self/task/*/schedstat and SCHED_IDLE")
@@ -228,7 +234,7 @@ def test_the_kernel_account_tells_a_starved_thread_from_a_frozen_one() -> None:
             alone.starve()
             assert alone.finish(), "the renewer was never starved past the lease: the setup proves nothing"
             lease = DriveLease()
-            keeper = LeaseKeeper(lease).start()
+            keeper = LeaseKeeper(lease, starved_limit=LATE_WAKE_LIMIT).start()
             try:
                 kept = Renewer(lease, cpu, spinners)
                 kept.starve()
