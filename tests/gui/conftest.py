@@ -328,3 +328,24 @@ def faulty_link(
         finally:
             g.xdotool("keyup", "Up")
             g.close()
+
+
+@pytest.fixture(scope="module")
+def office() -> object:
+    """The bundled office map, read (for frames drawn without a window: ``office_frames``)."""
+    from rtmu.mapfile.reader import read_map
+    from rtmu.package_data import project_map
+
+    return read_map(project_map("office.map"))
+
+
+@pytest.fixture()
+def tiles(office: object) -> Iterator[object]:
+    """A tile cache of the office map with its index built (tiles render on its own thread)."""
+    from rtmu.ui.tiles import TileCache
+
+    cache = TileCache(lambda: None)
+    cache.set_map(office.points, office.segments)  # type: ignore[attr-defined]
+    assert cache.wait_idle(30), "the tile worker never finished the index"
+    yield cache
+    cache.close()

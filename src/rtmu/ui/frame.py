@@ -19,7 +19,7 @@ import cairo
 from ..base.i18n import _
 from ..values.state import DrawingLayer
 from . import drawings_draw, fleet_draw, fov_draw, nav_draw, overlays, stop_draw
-from .map_layer import MapLayer
+from .map_layer import DrawBase, MapLayer
 from .overlays import Box
 from .tiles import BACKGROUND_RGB, EMPTY, TILE, Overview, TileCache
 from .viewport import Viewport
@@ -62,14 +62,39 @@ class Scene:
 def draw_frame(ctx: cairo.Context, vp: Viewport, scene: Scene) -> bool:
     """Draw one frame; True when a map is shown with every visible tile ready."""
     ctx.new_path()  # every helper starts its own path too; a frame never inherits one
-    tiles = scene.tiles if scene.tiles is not None and scene.tiles.ready else None
-    has_map = tiles is not None
+    complete = draw_static(ctx, vp, scene)
+    draw_overlays(ctx, vp, scene)
+    return complete
+
+
+def shown_tiles(scene: Scene) -> TileCache | None:
+    """The scene's tile cache when it has a map ready to show (None: the grid is drawn)."""
+    return scene.tiles if scene.tiles is not None and scene.tiles.ready else None
+
+
+def draw_static(ctx: cairo.Context, vp: Viewport, scene: Scene) -> bool:
+    """The static part — from the stored picture where there is one for this view, else directly."""
+    tiles = shown_tiles(scene)
     robot_xy = scene.robot[:2] if scene.robot is not None else None
-    layered = False
-    if tiles is not None and scene.layer is not None:
-        base = lambda c, v, avoided, names: draw_base(c, v, scene, avoided, names)  # noqa: E731 - the picture
-        layered = scene.layer.paint(ctx, vp, tiles, scene.objects, robot_xy, base)
-    complete = layered or draw_base(ctx, vp, scene, robot_xy)
+    layer = scene.layer
+    if (
+        tiles is not None
+        and layer is not None
+        and layer.paint(ctx, vp, tiles, scene.objects, robot_xy, base_drawer(scene))
+    ):
+        return True
+    return draw_base(ctx, vp, scene, robot_xy)
+
+
+def base_drawer(scene: Scene) -> DrawBase:
+    """How a :class:`MapLayer` makes its picture of ``scene``'s static part."""
+    return lambda ctx, vp, avoided, names: draw_base(ctx, vp, scene, avoided, names)
+
+
+def draw_overlays(ctx: cairo.Context, vp: Viewport, scene: Scene) -> None:
+    """Everything over the static map: navigation, the fleet, the field of view, the stopping strip,
+    the trail, sonar, laser, the server's drawings and the robot (what changes as the robot moves)."""
+    has_map = shown_tiles(scene) is not None
     if scene.goal is not None:
         nav_draw.draw_goal_highlight(ctx, vp, *scene.goal)
     nav_draw.draw_path(ctx, vp, scene.robot[:2] if scene.robot is not None else None, scene.path)
@@ -93,7 +118,6 @@ def draw_frame(ctx: cairo.Context, vp: Viewport, scene: Scene) -> bool:
         overlays.draw_robot(ctx, vp, x, y, th, stale=scene.stale, footprint=has_map, rgb=scene.robot_rgb)
         if not scene.stale:
             drawings_draw.draw_layers(ctx, vp, scene.drawings, (x, y), above_robot=True)
-    return complete
 
 
 def draw_base(

@@ -60,12 +60,33 @@ class MapLayer:
         draw_base: DrawBase,
     ) -> bool:
         """Paint the stored picture of this view (made now if needed); False: draw directly instead."""
+        surface = self.picture(vp, tiles, objects, robot, draw_base)
+        if surface is None:
+            return False
+        ctx.save()
+        ctx.new_path()
+        ctx.set_source_surface(surface, 0, 0)
+        ctx.rectangle(0, 0, vp.width, vp.height)
+        ctx.fill()
+        ctx.restore()
+        return True
+
+    def picture(
+        self,
+        vp: Viewport,
+        tiles: TileCache,
+        objects: Sequence[object],
+        robot: XY | None,
+        draw_base: DrawBase,
+    ) -> cairo.ImageSurface | None:
+        """The stored picture of this view, made now if needed — the same object for as long as it
+        stays right, so a caller may keep what it made of it; None: draw directly instead."""
         key = (vp, tiles.generation, id(objects), len(objects), self.scale)
         if key != self._key:
             self.forget()
             spots = tiles.visible(vp.scale, vp.origin, vp.width, vp.height)
             if any(spot.surface is None for spot in spots):
-                return False  # tiles still coming: the direct path shows the overview meanwhile
+                return None  # tiles still coming: the direct path shows the overview meanwhile
             self._surface, self._names = self._build(vp, None, draw_base)
             self._key = key
         avoided = None
@@ -75,15 +96,8 @@ class MapLayer:
         if avoided != self._avoided:  # the robot came onto a name, moved on it, or left it
             self._surface, self._names = self._build(vp, avoided, draw_base)
             self._avoided = avoided
-        assert self._surface is not None
-        ctx.save()
-        ctx.new_path()
-        ctx.set_source_surface(self._surface, 0, 0)
-        ctx.rectangle(0, 0, vp.width, vp.height)
-        ctx.fill()
-        ctx.restore()
         self.uses += 1
-        return True
+        return self._surface
 
     def _build(
         self, vp: Viewport, avoided: XY | None, draw_base: DrawBase

@@ -1,11 +1,13 @@
-"""The map stage: a ``Gtk.DrawingArea`` that blits cached map tiles and draws the robot on top.
+"""The map stage: a ``Gtk.DrawingArea`` that shows cached map tiles and draws the robot on top.
 
-Per frame it paints the background, the visible tiles from :class:`TileCache`
+Per frame it shows the background, the visible tiles from :class:`TileCache`
 (or the stretched overview where a tile is still being rendered, or a metric
 grid when the server has no map), then cairns, trail, sonar and the robot —
-nothing that scales with the map's size. It reads the model and never writes
-the network; zoom and follow are view state, remembered in the operator's ``view``;
-the trail is the robot's (``RobotModel.trail``), so it survives the view.
+nothing that scales with the map's size — as render nodes (``stage_nodes``) in
+place of the drawing area's own picture, so GTK repaints only where they changed.
+It reads the model and never writes the network; zoom and follow are view state,
+remembered in the operator's ``view``; the trail is the robot's (``RobotModel.trail``),
+so it survives the view.
 
 Input: drag to pan (turns Follow off), scroll or pinch to zoom about the
 pointer, and the zoom/fit/follow methods the window binds to keys and buttons.
@@ -20,7 +22,6 @@ import time
 from collections import deque
 from collections.abc import Callable, Sequence
 
-import cairo
 import gi
 
 gi.require_version("Gtk", "4.0")
@@ -32,10 +33,11 @@ from ..model.observables import LinkHealth, LinkLevel, MapModel, OperatorState, 
 from . import accessible, overlays  # noqa: E402
 from .fleet_draw import FleetMark  # noqa: E402
 from .fov_draw import Wedge, camera_aim  # noqa: E402
-from .frame import Scene, draw_frame  # noqa: E402
+from .frame import Scene  # noqa: E402
 from .map_layer import MapLayer  # noqa: E402
 from .map_words import MapDescription  # noqa: E402
 from .nav_draw import Marker, MarkerKind  # noqa: E402
+from .stage_nodes import StageNodes  # noqa: E402
 from .stop_draw import stop_reach  # noqa: E402
 from .tiles import TileCache  # noqa: E402
 from .viewport import ZOOM_MAX, ZOOM_MIN, Insets, Viewport, best_fit, nearest_step, step_zoom  # noqa: E402
@@ -102,6 +104,8 @@ class MapStage(Gtk.DrawingArea):
         self.tiles = TileCache(self._tiles_ready_from_worker)
         self.layer = MapLayer()
         """The static map's picture for the current view: a frame that only moves the robot paints it."""
+        self.nodes = StageNodes()
+        """The frame's render nodes: the static map's node kept while its picture is (``stage_nodes``)."""
         self._tiles_pending = False
         self._map_shown_generation = -1
         self._objects: list[object] = []
@@ -120,7 +124,6 @@ class MapStage(Gtk.DrawingArea):
         self.limits: Callable[[], RobotLimits] = RobotLimits
         """The shown robot's speed and braking (the window hands over its controller's)."""
         """In a fleet (``fleet_bind``): the other robots to draw and the selected robot's colour."""
-        self.set_draw_func(self._draw)
         self._install_input()
         self._unobserve = [
             model.robot.observe(self._on_robot),
@@ -147,6 +150,7 @@ class MapStage(Gtk.DrawingArea):
         self._cancel_drawings_redraw()
         self.tiles.close()
         self.layer.forget()
+        self.nodes.forget()
 
     # -- model -------------------------------------------------------------------------------
     @property
@@ -170,6 +174,7 @@ class MapStage(Gtk.DrawingArea):
                 self.tiles.set_map(None, None)
                 self._objects = []
                 self.layer.forget()
+                self.nodes.forget()
             if new.state in ("none", "unsupported", "unknown") and self.fitted:
                 self._fit_no_map()
         self.queue_draw()
@@ -364,12 +369,14 @@ class MapStage(Gtk.DrawingArea):
         return False
 
     # -- drawing -----------------------------------------------------------------------------
-    def _draw(self, _area: Gtk.DrawingArea, ctx: cairo.Context, width: int, height: int) -> None:
+    def do_snapshot(self, snapshot: Gtk.Snapshot) -> None:
+        """The frame as render nodes (``stage_nodes``): GTK repaints only where they changed."""
         started = time.perf_counter()
         self._cancel_drawings_redraw()  # this frame shows the latest drawings
+        width, height = self.get_width(), self.get_height()
         if (width, height) != self._size():
             self.viewport = self.viewport.sized(width, height)
-        complete = self.draw_frame(ctx, self.viewport)
+        complete = self.nodes.snapshot(snapshot, self.viewport, self.scene())
         elapsed = time.perf_counter() - started
         self.frame_times.append(elapsed)
         self.frames += 1
@@ -379,8 +386,8 @@ class MapStage(Gtk.DrawingArea):
             if self.on_first_map_frame is not None:
                 self.on_first_map_frame(time.perf_counter())
 
-    def draw_frame(self, ctx: cairo.Context, vp: Viewport) -> bool:
-        """Draw one frame; True when a map is shown with every visible tile ready."""
+    def scene(self) -> Scene:
+        """What the next frame shows, read from the model and the view options."""
         r = self.model.robot.value
         has_map = self.model.map.value.state == "ready"
         stale = self.drawn_stale = self.robot_is_stale()
@@ -405,7 +412,7 @@ class MapStage(Gtk.DrawingArea):
             scene.fov = Wedge(*scene.robot, *camera_aim(self.model.robot.value.ptz))
         if scene.robot is not None:
             scene.stop_reach = stop_reach(r.x, r.y, r.th, r.vel, self.limits())
-        return draw_frame(ctx, vp, scene)
+        return scene
 
     def _has_camera(self) -> bool:
         offers = self.model.connection.value.offers
