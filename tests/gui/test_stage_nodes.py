@@ -97,3 +97,11 @@ def test_without_a_stored_picture_one_node_covers_the_stage(office: object) -> N
         assert complete and nodes.static_nodes == 1
     finally:
         cache.close()
+
+
+def test_a_stage_not_laid_out_yet_appends_nothing(office: object, tiles: TileCache) -> None:
+    snapshot = Gtk.Snapshot()
+    complete = StageNodes().snapshot(
+        snapshot, Viewport(0, 0, 1.0, 0.0, 0.0), scene_of(office, tiles, (0.0, 0.0, 0.0), MapLayer())
+    )
+    assert not complete and snapshot.to_node() is None

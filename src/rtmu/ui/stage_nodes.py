@@ -51,6 +51,8 @@ class StageNodes:
 
     def snapshot(self, snapshot: Gtk.Snapshot, vp: Viewport, scene: Scene) -> bool:
         """Append one frame of ``scene`` at ``vp``; True when a map is shown with every visible tile ready."""
+        if vp.width <= 0 or vp.height <= 0:  # not laid out yet: nothing to show
+            return False
         tiles = shown_tiles(scene)
         robot_xy = scene.robot[:2] if scene.robot is not None else None
         picture = None
