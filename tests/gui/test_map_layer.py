@@ -75,17 +75,12 @@ def test_the_robot_on_a_name_moves_it_in_a_picture_made_for_that_pose(
     assert layer.builds == builds + 1
 
 
-def test_missing_tiles_make_no_picture(office: object) -> None:
-    cache = TileCache(lambda: None)
-    try:
-        cache.set_map(office.points, office.segments)  # type: ignore[attr-defined]
-        assert cache.wait_idle(30)
-        vp = fit_view(cache.bounds, W, H)  # type: ignore[arg-type]
-        layer = MapLayer()
-        frame(scene_of(office, cache, (0.0, 0.0, 0.0), layer), vp)  # asks for the tiles: none ready yet
-        assert (layer.builds, layer.uses) == (0, 0), "a picture with the overview's blur would stay"
-        ready(cache, vp)
-        frame(scene_of(office, cache, (0.0, 0.0, 0.0), layer), vp)
-        assert layer.builds == 1
-    finally:
-        cache.close()
+def test_missing_tiles_make_no_picture(office: object, tiles: TileCache) -> None:
+    """A fresh cache has its index, no tile yet (``tiles`` renders them only when asked)."""
+    vp = fit_view(tiles.bounds, W, H)  # type: ignore[arg-type]
+    layer = MapLayer()
+    frame(scene_of(office, tiles, (0.0, 0.0, 0.0), layer), vp)  # asks for the tiles: none ready yet
+    assert (layer.builds, layer.uses) == (0, 0), "a picture with the overview's blur would stay"
+    ready(tiles, vp)
+    frame(scene_of(office, tiles, (0.0, 0.0, 0.0), layer), vp)
+    assert layer.builds == 1

@@ -82,21 +82,16 @@ def test_a_moving_robot_keeps_the_static_node_and_its_overlays_stay_small(
     assert nodes.static_nodes == 2
 
 
-def test_without_a_stored_picture_one_node_covers_the_stage(office: object) -> None:
-    cache = TileCache(lambda: None)
-    try:
-        cache.set_map(office.points, office.segments)  # type: ignore[attr-defined]
-        assert cache.wait_idle(30)
-        vp = fit_view(cache.bounds, W, H)  # type: ignore[arg-type]
-        nodes = StageNodes()
-        pixels, complete = shown(nodes, scene_of(office, cache, (0.0, 0.0, 0.0), MapLayer()), vp)
-        assert not complete and nodes.static_nodes == 0 and nodes.overlay_area == W * H
-        assert not ((pixels == (255, 0, 255)).all(axis=-1)).any(), "a hole in the frame"
-        ready(cache, vp)
-        _pixels, complete = shown(nodes, scene_of(office, cache, (0.0, 0.0, 0.0), MapLayer()), vp)
-        assert complete and nodes.static_nodes == 1
-    finally:
-        cache.close()
+def test_without_a_stored_picture_one_node_covers_the_stage(office: object, tiles: TileCache) -> None:
+    """A fresh cache has its index, no tile yet (``tiles`` renders them only when asked)."""
+    vp = fit_view(tiles.bounds, W, H)  # type: ignore[arg-type]
+    nodes = StageNodes()
+    pixels, complete = shown(nodes, scene_of(office, tiles, (0.0, 0.0, 0.0), MapLayer()), vp)
+    assert not complete and nodes.static_nodes == 0 and nodes.overlay_area == W * H
+    assert not ((pixels == (255, 0, 255)).all(axis=-1)).any(), "a hole in the frame"
+    ready(tiles, vp)
+    _pixels, complete = shown(nodes, scene_of(office, tiles, (0.0, 0.0, 0.0), MapLayer()), vp)
+    assert complete and nodes.static_nodes == 1
 
 
 def test_a_stage_not_laid_out_yet_appends_nothing(office: object, tiles: TileCache) -> None:
