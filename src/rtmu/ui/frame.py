@@ -1,4 +1,6 @@
-"""One frame of the map stage, GTK-free: the window and the benchmark draw with the same function.
+"""One frame of the map stage, GTK-free: the window and the benchmark draw with the same functions
+(``draw_frame`` here; the window, through ``stage_nodes``, the same static part — the layer's picture
+or ``draw_base`` — and ``draw_overlays``, each into render nodes of their own).
 
 Cost per frame does not grow with the map: the static map comes from the tile
 cache (a blit per visible tile, or the stretched overview while a tile is still
