@@ -38,6 +38,8 @@ class ScanFeed(Feed):
         self.value = ScanState()
         self.bad_names = 0
         self._login = False
+        self._heard_count = 0
+        """Statuses heard on the subscription so far: an answer asked for before one of them is older news."""
 
     def subscriptions(self, client: AriaClient) -> Iterable[Subscription]:
         return (Subscription(MappingStatusBroadcast.DATA_NAME, -1, self._heard),)
@@ -53,8 +55,14 @@ class ScanFeed(Feed):
         self._set(ScanState())
 
     async def _ask(self, client: AriaClient) -> None:
+        heard = self._heard_count
         with contextlib.suppress(ClientError):  # the broadcast still tells us later; no status is no scan
-            self._status(await scan_status(client, timeout=self.ctx.config.reply_timeout), at_login=True)
+            status = await scan_status(client, timeout=self.ctx.config.reply_timeout)
+            # A status heard on the subscription while this waited is newer news, not older: it came
+            # after the question on the same link — and may have been read with this very answer, which
+            # only reaches here a turn of the loop later. Every change after it is broadcast.
+            if self._heard_count == heard:
+                self._status(status, at_login=True)
 
     def _heard(self, packet: Packet) -> None:
         try:
@@ -70,6 +78,7 @@ class ScanFeed(Feed):
             except UnsafeName:
                 self.bad_names += 1
                 return
+        self._heard_count += 1
         self._status(status)
 
     def _status(self, status: ScanStatus, *, at_login: bool = False) -> None:
