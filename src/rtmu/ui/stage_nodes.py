@@ -84,7 +84,10 @@ class StageNodes:
         return self._static
 
     def _append_overlays(self, snapshot: Gtk.Snapshot, vp: Viewport, scene: Scene) -> None:
-        recording = cairo.RecordingSurface(cairo.CONTENT_COLOR_ALPHA, None)
+        # Bounded by the stage, as the window's own surface is: geometry far outside (a hostile pose, a
+        # trail across the building) is clipped as it is recorded, and the ink is measured inside only.
+        stage = cairo.Rectangle(0, 0, vp.width, vp.height)
+        recording = cairo.RecordingSurface(cairo.CONTENT_COLOR_ALPHA, stage)
         ctx = cairo.Context(recording)
         draw_overlays(ctx, vp, scene)
         del ctx
