@@ -15,9 +15,13 @@ from typing import Any
 
 import pytest
 
+from linkfaults import TO_CLIENT, FaultProxy
+from rtmu.client import drive_loop as drive_loop_module
 from rtmu.client import session as session_module
+from rtmu.client.drive_loop import DriveFeed
 from rtmu.client.runner import ClientRunner
-from rtmu.model.observables import Phase, RobotModel
+from rtmu.client.session_config import SessionConfig
+from rtmu.model.observables import LinkLevel, Phase, RobotModel
 from rtmu.sim import SimThread
 from rtmu.values.state import DrawingsChanged, RobotChanged, StateChange
 from rtmu.values.target import Target
@@ -90,3 +94,64 @@ def test_a_still_robot_is_decoded_once_and_publishes_nothing(rig, sim: SimThread
     x0 = model.robot.value.x
     sim.call(lambda: sim.server.world.move_distance(500.0))
     ui.wait_for(lambda: abs(model.robot.value.x - x0) > 100 or abs(model.robot.value.y) > 100, 30)
+
+
+class HeartCounts:
+    """Runs of the drive loop's heart, and status packets noted by it."""
+
+    def __init__(self, monkeypatch: pytest.MonkeyPatch) -> None:
+        self.beats = 0
+        self.statuses = 0
+        real_beat, real_note = DriveFeed._beat, DriveFeed.note_status
+
+        def beat(loop: DriveFeed, now: float) -> None:
+            self.beats += 1
+            real_beat(loop, now)
+
+        def note_status(loop: DriveFeed, at: float) -> None:
+            self.statuses += 1
+            real_note(loop, at)
+
+        monkeypatch.setattr(DriveFeed, "_beat", beat)
+        monkeypatch.setattr(DriveFeed, "note_status", note_status)
+
+
+def test_at_rest_the_heart_wakes_for_its_second_not_for_each_status(
+    sim: SimThread, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    """Each status moves the link's next deadline; at rest the heart no longer wakes at each deadline
+    a status then moves (3 a second for nothing): a timer moved on by the status wakes it instead."""
+    counts = HeartCounts(monkeypatch)
+    model, ui = RobotModel(), UiQueue()
+    runner = ClientRunner(model, post=ui.post)
+    runner.start()
+    try:
+        runner.connect(Target("127.0.0.1", sim.port, profile="t")).result(10)
+        ui.wait_for(lambda: counts.statuses >= 10, 20)  # connected, settled
+        beats, statuses = counts.beats, counts.statuses
+        ui.wait_for(lambda: counts.statuses >= statuses + 60, 60)  # ~6 s of status at 10 Hz
+        woken = counts.beats - beats
+        assert woken <= 12, f"the heart ran {woken} times for 60 status packets at rest"
+    finally:
+        runner.close()
+
+
+def test_at_rest_a_silent_link_is_still_judged_on_time(
+    sim: SimThread, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    """The level timer, not the heart's own sleep, says a silent link is stale: with that sleep and the
+    pings' interval (a ping's answer publishes the link's health too) made a minute long, the silence
+    is still published as stale."""
+    monkeypatch.setattr(drive_loop_module, "HEART_IDLE_SLEEP", 60.0)
+    counts = HeartCounts(monkeypatch)
+    model, ui = RobotModel(), UiQueue()
+    runner = ClientRunner(model, post=ui.post, config=SessionConfig(ping_interval=60.0))
+    runner.start()
+    with FaultProxy("127.0.0.1", sim.port) as proxy:
+        try:
+            runner.connect(Target("127.0.0.1", proxy.port, profile="t")).result(10)
+            ui.wait_for(lambda: counts.statuses >= 10 and model.health.value.level is LinkLevel.OK, 20)
+            proxy.mute(TO_CLIENT)
+            ui.wait_for(lambda: model.health.value.level is not LinkLevel.OK, 20)
+        finally:
+            runner.close()

@@ -37,9 +37,9 @@ log = logging.getLogger(__name__)
 
 HEART_MAX_SLEEP = 0.25
 HEART_IDLE_SLEEP = 1.0
-"""Longest sleep while nothing is driven: a grant, a stop, a returning link and status wake the heart
-at once, and the link's next change of level is its own deadline — so at rest it wakes once a second
-(a guardian's reports, the health published) rather than ten times."""
+"""Longest sleep while nothing is driven: a grant, a stop and a returning link wake the heart at once,
+and the link's next change of level comes by a timer each status moves on (``_level_watch``) — so at
+rest it wakes once a second (a guardian's reports, the health published), not at each deadline."""
 HOLD_SAID_AFTER = 1.0
 """A drive held back this long for the guardian (its login is slow) is said, once."""
 STEP_TIMEOUT = 2.0
@@ -75,6 +75,10 @@ class DriveFeed(Feed):
         self._kick = asyncio.Event()
         self._stepped = asyncio.Event()
         self._heart_task: asyncio.Task[None] | None = None
+        self._level_watch: asyncio.TimerHandle | None = None
+        """At rest: the timer that wakes the heart when the link's level would next change — moved on
+        by every status (:meth:`note_status`) rather than waking the heart at each deadline a status
+        then moves (three times a second at rest; None while driving, where the heart wakes often)."""
         self.stop_on_connect = False
         """The link was lost while driving: the next connection (made at once) begins with a stop."""
 
@@ -200,6 +204,8 @@ class DriveFeed(Feed):
         self.health.note_status(at)
         if not was_ok:
             self.kick()  # the link came back: re-evaluate at once
+        elif self._level_watch is not None:
+            self._watch_level()  # at rest: the deadline moves on with the status, nothing wakes
 
     async def _ping_loop(self, client: AriaClient) -> None:
         name = ping_data(client.datalist)
@@ -265,7 +271,26 @@ class DriveFeed(Feed):
         if self._heart_task is None or self._heart_task.done():
             self._heart_task = asyncio.get_running_loop().create_task(self._heart(), name="session-heart")
 
+    def _watch_level(self) -> None:
+        """(Re)arm the rest timer that kicks the heart when the link's level would next change."""
+        self._unwatch_level()
+        now = self.ctx.clock()
+        delay = self.health.next_change(now) - now
+        if delay == float("inf"):
+            return
+        try:
+            loop = asyncio.get_running_loop()
+        except RuntimeError:  # a status handed over outside the loop (a test by hand): the heart looks itself
+            return
+        self._level_watch = loop.call_later(max(0.0, delay), self.kick)
+
+    def _unwatch_level(self) -> None:
+        if self._level_watch is not None:
+            self._level_watch.cancel()
+            self._level_watch = None
+
     async def end_heart(self, timeout: float) -> None:
+        self._unwatch_level()
         task, self._heart_task = self._heart_task, None
         if task is not None:
             task.cancel()
@@ -295,8 +320,12 @@ class DriveFeed(Feed):
                 log.exception("session heart step failed")
             self._stepped.set()
             idle = not self.governor.driving and not self.lease.view(now).live
-            wake = min(now + HEART_IDLE_SLEEP if idle else self.governor.next_wakeup(now),
-                       self.health.next_change(now))  # fmt: skip
+            if idle:  # the link's next change of level comes by the rest timer, which statuses move on
+                self._watch_level()
+                wake = now + HEART_IDLE_SLEEP
+            else:
+                self._unwatch_level()
+                wake = min(self.governor.next_wakeup(now), self.health.next_change(now))
             delay = min(HEART_IDLE_SLEEP if idle else HEART_MAX_SLEEP, max(0.0, wake - self.ctx.clock()))
             due = self.ctx.clock() + delay
             with contextlib.suppress(TimeoutError):
