@@ -39,7 +39,6 @@ class StageNodes:
     def __init__(self) -> None:
         self._picture: cairo.ImageSurface | None = None
         self._static: Gsk.RenderNode | None = None
-        self._size = (0, 0)
         self.static_nodes = 0
         """Static-map nodes made so far (a test reads it: one per stored picture, not per frame)."""
         self.overlay_area = 0
@@ -47,7 +46,7 @@ class StageNodes:
 
     def forget(self) -> None:
         """Drop the kept node (and with it the picture it shows)."""
-        self._picture, self._static, self._size = None, None, (0, 0)
+        self._picture, self._static = None, None
 
     def snapshot(self, snapshot: Gtk.Snapshot, vp: Viewport, scene: Scene) -> bool:
         """Append one frame of ``scene`` at ``vp``; True when a map is shown with every visible tile ready."""
@@ -71,15 +70,14 @@ class StageNodes:
         return True
 
     def _static_node(self, picture: cairo.ImageSurface, vp: Viewport) -> Gsk.RenderNode:
-        size = (vp.width, vp.height)
-        if self._static is None or picture is not self._picture or size != self._size:
+        if self._static is None or picture is not self._picture:  # a new view is a new picture (its size too)
             node = Gsk.CairoNode.new(_rect(0, 0, vp.width, vp.height))
             ctx = node.get_draw_context()  # records: replayed at the display's scale, sharp on HiDPI
             ctx.set_source_surface(picture, 0, 0)
             ctx.rectangle(0, 0, vp.width, vp.height)
             ctx.fill()
             del ctx
-            self._picture, self._static, self._size = picture, node, size
+            self._picture, self._static = picture, node
             self.static_nodes += 1
         return self._static
 
