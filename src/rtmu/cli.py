@@ -114,6 +114,10 @@ class LazySubcommands(argparse._SubParsersAction):
         if module is None:
             return
         del self._name_parser_map[name]
+        # A command's module is imported here, while the arguments are parsed (``SUB --help`` too):
+        # its dataclasses' methods come from the cache, as the window's do. (The bare ``--version``
+        # and ``--help`` import no command and pay nothing for it.)
+        dataclass_code.install()
         loaded = importlib.import_module(module)
         register = getattr(loaded, "register", None)
         if register is not None:
@@ -186,7 +190,7 @@ def main(argv: Sequence[str] | None = None) -> int:
     parser = build_parser(lazy=True)
     args = parser.parse_args(argv)
     # Past --version and --help (which exit above and need no dataclass); before the modules a
-    # command's handler or the window imports define theirs.
+    # command's handler or the window imports define theirs (a command's own module installed it).
     dataclass_code.install()
     handler = getattr(args, "handler", None)
     installing = _integration.handle(args, build_parser) if handler is None else None

@@ -19,7 +19,7 @@ from rtmu.base.exit_codes import EXIT_USAGE
 from rtmu.cli import main
 from rtmu.package_data import project_map
 from rtmu.sim import SimConfig, SimThread
-from rtmu.subcommands._navigate import EXIT_NAV_LOST
+from rtmu.subcommands._nav_args import EXIT_NAV_LOST
 
 
 @pytest.fixture(scope="module")

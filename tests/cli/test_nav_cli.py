@@ -26,7 +26,7 @@ from rtmu.protocol.payloads.robot import ModeInfo
 from rtmu.sim import SimThread
 from rtmu.sim.ld_data import ld_state
 from rtmu.sim.profiles import PROFILES, SimProfile
-from rtmu.subcommands._navigate import EXIT_NAV_CANCELLED, EXIT_NAV_FAILED, EXIT_NAV_LOST
+from rtmu.subcommands._nav_args import EXIT_NAV_CANCELLED, EXIT_NAV_FAILED, EXIT_NAV_LOST
 from simulators import running
 
 

@@ -14,7 +14,8 @@ Used by the client's role check (:mod:`rtmu.client.roles`), the replay link and 
 from __future__ import annotations
 
 from .errors import ProtocolError
-from .payloads.drive import RatioDrive
+
+RATIO_DRIVE = "ratioDrive"
 
 MOTION_REQUESTS = frozenset(
     {
@@ -44,8 +45,10 @@ def is_stopping(name: str, args: bytes) -> bool:
     """
     if name in STOPPING_REQUESTS:
         return True
-    if name != RatioDrive.DATA_NAME:
+    if name != RATIO_DRIVE:
         return False
+    from .payloads.drive import RatioDrive  # here: every command's parser loads this module (roles)
+
     try:
         return not RatioDrive.decode(args).moving
     except ProtocolError:

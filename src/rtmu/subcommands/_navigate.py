@@ -16,11 +16,11 @@ from collections.abc import Callable
 from dataclasses import dataclass
 from typing import TYPE_CHECKING, Any
 
-from ..base.exit_codes import EXIT_CANCELLED, EXIT_LOST, EXIT_OK, EXIT_REFUSED, EXIT_TIMEOUT, NETWORK
+from ..base.exit_codes import EXIT_OK, EXIT_TIMEOUT
 from ..base.i18n import N_, Said, _, number
 from ..base.textsafe import visible
 from ..base.units import metres
-from ..client.errors import ClientError, NotSupported
+from ..client.errors import ClientError
 from ..client.nav_status import LOST, NavReading, path_remaining, read_motion
 from ..protocol.errors import ProtocolError
 from ..protocol.payloads import Payload, Side, decode_payload
@@ -29,21 +29,13 @@ from ..protocol.payloads.ld import DockInfo
 from ..protocol.payloads.navigation import LocalizationState, LocState, PlannedPath
 from ..protocol.payloads.robot import ModeInfo, Update, UpdateNumbers, UpdateStrings
 from ..values.state import NavOutcome
-from ._common import Interrupted, current_interrupts, positive_float, print_json, signal_name
+from ._common import Interrupted, current_interrupts, print_json, signal_name
+from ._nav_args import EXIT_NAV_CANCELLED, EXIT_NAV_FAILED, EXIT_NAV_LOST
 
 if TYPE_CHECKING:
     from ..client.call_values import Packet
     from ..client.connection import AriaClient
 
-EXIT_NAV_FAILED = EXIT_REFUSED
-"""The server could not get there (``Failed to get to …``, ``Failed to plan to …``, ``Failed dock``)."""
-EXIT_NAV_CANCELLED = EXIT_CANCELLED
-"""It stopped before arriving: someone pressed STOP, drove, or sent the robot elsewhere."""
-EXIT_NAV_LOST = EXIT_LOST
-"""The robot is lost: navigation failed for that, or ``rtmu localize`` ended lost. Localize it first."""
-NAVIGATION_EXITS = (*NETWORK, EXIT_REFUSED, EXIT_CANCELLED, EXIT_LOST)
-
-DEFAULT_LIMIT = 600.0
 SETTLE = 1.5
 """After this many seconds an outcome the server already showed before our command counts as the
 answer (it repeated it: e.g. a second ``goto`` to an unreachable goal fails with the same words)."""
@@ -52,37 +44,6 @@ PATH_MS = 1000
 DISTANCE_STEP_MM = 1000.0
 """Print the distance left when it changed by this much (and no oftener than DISTANCE_EVERY s)."""
 DISTANCE_EVERY = 2.0
-
-
-def add_wait_arguments(parser: argparse.ArgumentParser, *, localizing: bool = False) -> None:
-    """``--limit``, ``--no-wait``, ``--json``: how long to follow the server's words, how to print them."""
-    if localizing:
-        limit = _("give up waiting for the server's answer after S seconds, exit 5 (default {limit})")
-        no_wait = _("send localizeToPose and exit 0 without waiting for the server to confirm it")
-        lines = _(
-            'one object per line: {"localization": "initializing"} while it '
-            'localizes, then {"outcome": "localized" | "lost" | "timeout", "score"}; --no-wait: {"sent"}'
-        )
-    else:
-        limit = _("give up after S seconds: stop the robot, exit 5 (default {limit})")
-        no_wait = _("send the command and exit 0; the robot drives on by itself")
-        lines = _(
-            'one object per line: {"status", "phase"} as the server reports, '
-            '{"remaining_mm"} every metre or so, and a last '
-            '{"outcome", "text", "reason", "x", "y", "th"} '
-            '(also after Ctrl-C: outcome "interrupted", with "signal"); --no-wait: {"sent"}'
-        )
-    limit = limit.format(limit=f"{DEFAULT_LIMIT:g}")
-    parser.add_argument("--limit", type=positive_float, default=DEFAULT_LIMIT, metavar="S", help=limit)
-    parser.add_argument("--no-wait", action="store_true", help=no_wait)
-    parser.add_argument("--json", action="store_true", help=lines)
-
-
-def require(client: AriaClient, name: str, sentence: str) -> None:
-    """NotSupported (exit 4) with plain words when the server does not list ``name``: ``sentence``, a
-    marked template (``N_("this server does not drive home (it does not offer {name})")``)."""
-    if not client.supports(name):
-        raise NotSupported(name, Said(sentence, name=name))
 
 
 def stop_robot(client: AriaClient) -> None:

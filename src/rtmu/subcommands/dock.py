@@ -7,9 +7,8 @@ from typing import TYPE_CHECKING, Any
 
 from ..base.i18n import N_, _
 from ..client.roles import Role
-from ..protocol.payloads.navigation import Dock
 from ._common import add_connection_arguments, run_with_client
-from ._navigate import NAVIGATION_EXITS, Expect, add_wait_arguments, navigate, require
+from ._nav_args import NAVIGATION_EXITS, add_wait_arguments, require
 
 if TYPE_CHECKING:
     from ..client.connection import AriaClient
@@ -32,6 +31,9 @@ def register(subparsers: Any) -> None:
 
 
 def handle(args: argparse.Namespace) -> int:
+    from ..protocol.payloads.navigation import Dock
+    from ._navigate import Expect, navigate
+
     async def body(client: AriaClient) -> int:
         require(client, "dock", N_("this server does not dock (it does not offer {name})"))
         return await navigate(client, args, Dock(), Expect(docked=True))

@@ -16,9 +16,8 @@ from ..base.exit_codes import EXIT_OK, EXIT_USAGE
 from ..base.i18n import N_, _
 from ..base.textsafe import visible
 from ..client.roles import Role
-from ..protocol.payloads.navigation import GotoGoal, GotoPose
 from ._common import UsageError, add_connection_arguments, known_name, run_with_client
-from ._navigate import NAVIGATION_EXITS, Expect, add_wait_arguments, navigate, require
+from ._nav_args import NAVIGATION_EXITS, add_wait_arguments, require
 
 if TYPE_CHECKING:
     from ..client.connection import AriaClient
@@ -62,6 +61,8 @@ def check(args: argparse.Namespace) -> None:
 
 def handle(args: argparse.Namespace) -> int:
     from ..client import ld_data
+    from ..protocol.payloads.navigation import GotoGoal, GotoPose
+    from ._navigate import Expect, navigate
 
     try:
         check(args)

@@ -8,9 +8,8 @@ from typing import TYPE_CHECKING, Any
 from ..base.exit_codes import NETWORK
 from ..base.i18n import N_, _
 from ..client.roles import Role
-from ..protocol.payloads.navigation import LocalizeToPose
 from ._common import add_connection_arguments, run_with_client
-from ._navigate import EXIT_NAV_LOST, add_wait_arguments, localize, require
+from ._nav_args import EXIT_NAV_LOST, add_wait_arguments, require
 
 if TYPE_CHECKING:
     from ..client.connection import AriaClient
@@ -37,6 +36,9 @@ def register(subparsers: Any) -> None:
 
 
 def handle(args: argparse.Namespace) -> int:
+    from ..protocol.payloads.navigation import LocalizeToPose
+    from ._navigate import localize
+
     async def body(client: AriaClient) -> int:
         require(
             client,

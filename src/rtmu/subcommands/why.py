@@ -16,13 +16,12 @@ from ..base.exit_codes import EXIT_WHY_LOST, NETWORK, WHY_ASKED
 from ..base.i18n import N_, _, words
 from ..base.textsafe import visible
 from ..client.roles import Role
-from ..client.why import diagnose
-from ..client.why_values import Answer
 from ._common import add_connection_arguments, print_json, run_with_client
 
 if TYPE_CHECKING:
     from ..client.connection import AriaClient
     from ..client.why_fix import FixResult
+    from ..client.why_values import Answer
 
 EXITS = (*NETWORK, *WHY_ASKED, EXIT_WHY_LOST)
 MAX_FIXES = 3
@@ -62,6 +61,7 @@ def register(subparsers: Any) -> None:
 
 
 def handle(args: argparse.Namespace) -> int:
+    from ..client.why import diagnose
     from ..client.why_gather import gather
 
     async def body(client: AriaClient) -> int:
@@ -95,6 +95,7 @@ def handle(args: argparse.Namespace) -> int:
 async def fix_all(
     client: AriaClient, answer: Answer, args: argparse.Namespace
 ) -> tuple[Answer, list[FixResult]]:
+    from ..client.why import diagnose
     from ..client.why_fix import apply
     from ..client.why_gather import gather
 
