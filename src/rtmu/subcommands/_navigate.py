@@ -21,7 +21,7 @@ from ..base.i18n import N_, Said, _, number
 from ..base.textsafe import visible
 from ..base.units import metres
 from ..client.errors import ClientError
-from ..client.nav_status import LOST, NavReading, path_remaining, read_motion
+from ..client.nav_status import LOST, NAV_MODES, NavReading, path_remaining, read_motion
 from ..protocol.errors import ProtocolError
 from ..protocol.payloads import Payload, Side, decode_payload
 from ..protocol.payloads.drive import RatioDrive
@@ -83,10 +83,19 @@ class _Watch:
         self.pose: tuple[float, float, float] | None = None
         self.path: tuple[tuple[int, int], ...] = ()
         self.loc: LocState | None = None
+        self.navigated = False
+        """The server entered a navigation mode since this was last cleared (``getModeInfo`` is sent
+        on each change: a drive that started and was stopped between two status packets, or before
+        the loop looked, still shows)."""
         self.changed = asyncio.Event()
 
     def reading(self) -> NavReading:
         return read_motion(self.status, self.mode_name, self.dock_state)
+
+    @property
+    def navigation_ended(self) -> bool:
+        """A navigation mode began since :attr:`navigated` was cleared, and the server has left it."""
+        return self.navigated and self.mode_name not in NAV_MODES
 
     def handler(self, apply: Callable[[Any], None]) -> Callable[[Packet], None]:
         def on_packet(packet: Packet) -> None:
@@ -116,6 +125,7 @@ class _Watch:
     def on_mode(self, m: Any) -> None:
         if isinstance(m, ModeInfo):
             self.mode_name = m.mode_name
+            self.navigated = self.navigated or m.mode_name in NAV_MODES
 
     def on_path(self, p: Any) -> None:
         if isinstance(p, PlannedPath):
@@ -178,6 +188,7 @@ async def navigate(client: AriaClient, args: argparse.Namespace, payload: Payloa
     watch.subscribe(client)
     await watch.first(client, args.timeout)
     before = watch.reading()
+    watch.navigated = False  # (a navigation going before ours shows in the status it sends)
     client.send(payload)
     if args.no_wait:
         _say(args, {"sent": type(payload).DATA_NAME}, _("sent {name}").format(name=type(payload).DATA_NAME))
@@ -223,8 +234,9 @@ async def _follow(
                     fresh = seen_going or r.text != before.text or now - sent_at >= SETTLE
                     if fresh:
                         return _outcome(args, watch, r)
-                elif seen_going and (r.phase is NavOutcome.NONE or r.finished):
-                    # Stopped, driven, or finished somewhere else: someone took the robot over.
+                elif (seen_going or watch.navigation_ended) and (r.phase is NavOutcome.NONE or r.finished):
+                    # Stopped, driven, or finished somewhere else: someone took the robot over (perhaps
+                    # before a status saying "Going to" reached us: the mode's change says it went).
                     return _ended(args, watch, r, "cancelled", EXIT_NAV_CANCELLED)
                 watch.changed.clear()
                 with contextlib.suppress(TimeoutError):
