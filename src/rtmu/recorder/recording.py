@@ -1,7 +1,7 @@
 """One recording: one MCAP file, filled by its own writer thread from a bounded queue.
 
 The threads that produce (the network loop that sends the stops, the UI thread) only
-``put_nowait`` a small item: they never encode, compress, write or wait. When the
+append a small item: they never encode, compress, write, wait or wake the writer. When the
 writer falls behind and the queue is full, the item is dropped and counted (the file
 says how many) — a slow disk can cost recorded data, never a late stop. The writer itself
 takes at most a fifth of a CPU (:mod:`.duty`): foxglove-sdk holds the interpreter lock while
@@ -11,11 +11,10 @@ a failed write or the size cap ends the recording with one notice; the session g
 
 from __future__ import annotations
 
-import contextlib
 import logging
-import queue
 import threading
 import time
+from collections import deque
 from collections.abc import Callable
 from dataclasses import dataclass
 from functools import partial
@@ -46,10 +45,10 @@ CLOSE_TIMEOUT = 5.0
 GATHER_SECONDS = 0.25
 """The writer sleeps this long after emptying its queue: a still robot's dozen packets a second
 wake it four times a second rather than at each packet (a thread switch each, on the network
-loop's side too); closing wakes it at once."""
+loop's side too); closing wakes it at once. Nothing else wakes it: an item waits at most this long
+(or until the next repeat), and the producers pay a plain append, with no lock handed over."""
 IDLE_WAIT = 1.0
 """A stopped recording only drains its queue until it is closed: it waits this long per look."""
-_CLOSE = object()
 
 
 @dataclass(frozen=True, slots=True)
@@ -84,7 +83,8 @@ class Recording:
         """Why the recording ended early (full disk, size cap); None while it records."""
         self.prune: Callable[[], object] | None = None
         """Run on the writer thread before the file is made (forgetting old recordings)."""
-        self._queue: queue.Queue[object] = queue.Queue(self.limits.queue_items)
+        self._items: deque[object] = deque()
+        """Waiting for the writer (at most ``limits.queue_items``, counted under ``_count``)."""
         self._bytes_in = 0
         """Raw bytes queued so far (under ``_count``; the writer counts what it took in ``_bytes_out``)."""
         self._bytes_out = 0
@@ -112,22 +112,18 @@ class Recording:
             return False
         size = len(item.data) if isinstance(item, RawChunk) else 0
         with self._count:
-            if size and self._bytes_in - self._bytes_out + size > self.limits.queue_bytes:
+            if len(self._items) >= self.limits.queue_items or (
+                size and self._bytes_in - self._bytes_out + size > self.limits.queue_bytes
+            ):
                 self.dropped += 1
                 return False
-            try:
-                self._queue.put_nowait(item)
-            except queue.Full:
-                self.dropped += 1
-                return False
+            self._items.append(item)
             self._bytes_in += size
         return True
 
     def end(self) -> None:
         """Finish soon, without waiting (the network loop's way): what is queued is still written."""
         self._ending.set()
-        with contextlib.suppress(queue.Full):
-            self._queue.put_nowait(_CLOSE)
 
     def close(self, timeout: float = CLOSE_TIMEOUT) -> None:
         """:meth:`end`, then wait (bounded) until the file is finished (its summary written)."""
@@ -149,17 +145,14 @@ class Recording:
         flush_at, sync_at = now + self.limits.flush_seconds, now + self.limits.sync_seconds
         repeat_at = now + REPEAT_EVERY
         reported_drops = 0
+        items = self._items
         while True:
-            due = min(flush_at, repeat_at)
-            wait = IDLE_WAIT if self.stopped is not None else max(0.0, due - time.monotonic())
-            try:
-                item = self._queue.get(timeout=wait)
-            except queue.Empty:
-                item = None
-            if item is _CLOSE or (item is None and self._ending.is_set()):
-                if self._queue.empty():
-                    break
-                continue
+            if not items:
+                if self._ending.is_set():
+                    break  # closing, and everything queued is written
+                due = min(flush_at, repeat_at)
+                self._ending.wait(IDLE_WAIT if self.stopped is not None else max(0.0, due - time.monotonic()))
+            item = items.popleft() if items else None
             wrote = self.stopped is None and item is not None
             if wrote:
                 started = time.thread_time()
@@ -173,7 +166,7 @@ class Recording:
             now = time.monotonic()
             # A parked robot: its pose in every second — only once the writer has caught up, so a
             # repeat never stamps "now" on a pose older than ones still waiting in the queue.
-            if self.stopped is None and now >= repeat_at and self._queue.empty():
+            if self.stopped is None and now >= repeat_at and not items:
                 repeat_at = now + REPEAT_EVERY
                 at_ns = time.time_ns()
                 for topic, message in self._converter.repeat(at_ns):
@@ -189,7 +182,7 @@ class Recording:
                 flush_at = now + self.limits.flush_seconds
                 if sync:
                     sync_at = now + self.limits.sync_seconds
-            if wrote and self._queue.empty():  # let the next items gather: one wake-up for many, not one each
+            if wrote and not items:  # let the next items gather: one wake-up for many, not one each
                 # (after the repeat above: a repeat is due only while the writer has caught up, and a
                 # still robot's raw packets keep the queue from being empty after a gathering wait)
                 self._ending.wait(min(GATHER_SECONDS, max(0.0, flush_at - time.monotonic())))
