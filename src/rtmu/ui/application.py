@@ -221,6 +221,12 @@ class RtmuApplication(Gtk.Application):
                     recording=self.settings.recording,
                     guardian=self.fleet.guardian,
                 )
+        # Nothing to ask (no login): the link opens while the window is built, and the map is on its
+        # way when the window first draws. What the network side learns waits in the main loop's
+        # queue until the window is there to show it.
+        early = replay is None and roster is None and auto_connect and not session.controller.profile.user
+        if early:
+            session.controller.connect()
         try:
             window = MainWindow(
                 self,
@@ -265,7 +271,8 @@ class RtmuApplication(Gtk.Application):
 
             self.replay_bar = show_replay(window, session, replay)
         elif auto_connect:
-            window.connect_now()
+            if not early:
+                window.connect_now()
         elif not self.settings.profiles and not self.options.host and roster is None:
             window.banners.tell(
                 "notice:hint", "info", _(FIRST_RUN_WORDS).format(demo=DEMO_COMMAND), timeout=12.0
