@@ -16,6 +16,8 @@ from __future__ import annotations
 from .errors import ProtocolError
 
 RATIO_DRIVE = "ratioDrive"
+"""``RatioDrive.DATA_NAME``, named here so that loading the role gate loads no payload (a test holds
+the two equal)."""
 
 MOTION_REQUESTS = frozenset(
     {
