@@ -15,26 +15,23 @@ from collections.abc import Iterator
 
 import pytest
 
-from client.servers import SPECS, ServerSide, ServerThread, TestServer
+from client.servers import SPECS, ServerThread, TestServer, in_one_write
 from patience import cli_timeout
 from rtmu.cli import main
 from rtmu.protocol.payloads.robot import ModeInfo
 from rtmu.subcommands._nav_args import EXIT_NAV_CANCELLED
 
 GOTO_POSE = ("gotoPose", "go to a point", "byte4 byte4 byte4", "none", "Navigation", "RETURN_NONE")
-
-
-def went_and_stopped(side: ServerSide, _args: bytes) -> list[bytes]:
-    """The navigation starts and is stopped at once: two mode changes, no status between them."""
-    side.conn.send_data("getModeInfo", ModeInfo("Goto").encode())
-    side.conn.send_data("getModeInfo", ModeInfo("stop").encode())
-    return []  # both are in the connection's buffer: ``reply`` writes them in one write
+WENT_AND_STOPPED = in_one_write(  # the navigation starts and is stopped at once: no status between
+    ("getModeInfo", ModeInfo("Goto").encode()),
+    ("getModeInfo", ModeInfo("stop").encode()),
+)
 
 
 @pytest.fixture
 def server() -> Iterator[TestServer]:
     srv = TestServer([*SPECS, GOTO_POSE])
-    srv.handlers["gotoPose"] = went_and_stopped
+    srv.handlers["gotoPose"] = WENT_AND_STOPPED
     with ServerThread(srv) as running:
         yield running
 

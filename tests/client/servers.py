@@ -75,6 +75,18 @@ def run(coro: Coroutine[Any, Any, T], timeout: float = 15.0) -> T:
 OnceHandler = Callable[["ServerSide", bytes], Reply]
 
 
+def in_one_write(*packets: tuple[str, bytes]) -> OnceHandler:
+    """A handler answering with ``packets`` — any data names, in this order — in one write, so the client
+    reads them together: for the races between an answer and the broadcast right behind it."""
+
+    def answer(side: ServerSide, _args: bytes) -> Reply:
+        for name, payload in packets:
+            side.conn.send_data(name, payload)
+        return []  # all in the connection's buffer: ``TestServer.reply`` writes them in one write
+
+    return answer
+
+
 def _numbers(state: dict[str, float]) -> bytes:
     return UpdateNumbers(
         state.get("battery", 12.5),

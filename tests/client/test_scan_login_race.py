@@ -19,7 +19,7 @@ from rtmu.model.observables import Phase, RobotModel
 from rtmu.protocol.payloads.mapping import MappingStatus, MappingStatusBroadcast
 from rtmu.values.target import Target
 
-from .servers import SPECS, ServerSide, ServerThread, TestServer
+from .servers import SPECS, ServerThread, TestServer, in_one_write
 from .uiqueue import UiQueue
 
 MAPPING_SPECS = [
@@ -30,17 +30,16 @@ MAPPING_SPECS = [
 ]
 
 
-def answer_then_broadcast(side: ServerSide, _args: bytes) -> list[bytes]:
-    """ "No scan" — and, written with it, the broadcast that a scan has just started."""
-    side.conn.send_data("mappingStatus", MappingStatus("").encode())
-    side.conn.send_data("mappingStatusBroadcast", MappingStatusBroadcast("hall.2d").encode())
-    return []  # both are in the connection's buffer: ``reply`` writes them in one write
+ANSWER_THEN_BROADCAST = in_one_write(
+    ("mappingStatus", MappingStatus("").encode()),  # "no scan" — and, written with it,
+    ("mappingStatusBroadcast", MappingStatusBroadcast("hall.2d").encode()),  # a scan has just started
+)
 
 
 @pytest.fixture
 def server() -> Iterator[TestServer]:
     srv = TestServer([*SPECS, *MAPPING_SPECS])
-    srv.handlers["mappingStatus"] = answer_then_broadcast
+    srv.handlers["mappingStatus"] = ANSWER_THEN_BROADCAST
     srv.handlers["mappingStatusBroadcast"] = lambda side, args: []  # a subscription: no answer now
     with ServerThread(srv) as running:
         yield running
