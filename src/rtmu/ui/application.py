@@ -224,7 +224,7 @@ class RtmuApplication(Gtk.Application):
         # Nothing to ask (no login): the link opens while the window is built, and the map is on its
         # way when the window first draws. What the network side learns waits in the main loop's
         # queue until the window is there to show it.
-        early = replay is None and roster is None and auto_connect and not session.controller.profile.user
+        early = auto_connect and not session.controller.profile.user  # (a replay or a roster: never auto)
         if early:
             session.controller.connect()
         try:
