@@ -54,10 +54,12 @@ from . import topics
 MAP_FRAME = "map"
 ROBOT_FRAME = "base_link"
 CAMERA_FRAME = "camera"
-REPEAT_NS = 500_000_000
+REPEAT_NS = 250_000_000
 """The pose (with its transform) and the status are written again after this long unchanged
 (:meth:`Converter.repeat`, called every :data:`REPEAT_EVERY` s): never a second of the file without them."""
-REPEAT_EVERY = 0.25
+REPEAT_EVERY = 0.5
+"""As long as the writer gathers (``recording.GATHER_SECONDS``): a parked robot's repeats come with
+the writer's gathering wakes, not with wakes of their own."""
 MAX_SCENE_LINES = 200_000
 """Map lines beyond this are left out of the SceneUpdate (the raw channel still has them all)."""
 _XYZ = [
