@@ -21,6 +21,7 @@ from rtmu.client.lease import DriveRatios
 from rtmu.client.runner import ClientRunner
 from rtmu.client.session import SessionConfig
 from rtmu.recorder import Recorder, RecorderConfig
+from rtmu.values.intents import LoadMap, RequestPicture
 from rtmu.values.target import Target
 
 CIRCLE = DriveRatios(30.0, 20.0, 40.0)
@@ -42,9 +43,7 @@ def main() -> int:
         recorder.attach(runner)
     runner.start()
     runner.connect(Target("127.0.0.1", port)).result(10)
-    session = runner.session
-    assert session is not None
-    runner.call(session.load_map, timeout=30)  # the map is in the file once, before the measured part
+    runner.send(LoadMap()).result(30)  # the map is in the file once, before the measured part
     time.sleep(1.5)  # …and flushed: the measured part's bytes are what a longer session adds
     start_bytes = recorder.recordings[0].path.stat().st_size if recorder is not None else 0
     pictures = picture_bytes = 0
@@ -64,7 +63,7 @@ def main() -> int:
     while (now := time.monotonic()) < t0 + seconds:
         if camera_hz > 0 and now >= next_picture:
             try:
-                picture_bytes += len(runner.call(session.request_image, timeout=2.0).jpeg)
+                picture_bytes += len(runner.send(RequestPicture()).result(2.0).jpeg)
                 pictures += 1
             except Exception:
                 pass
