@@ -60,12 +60,15 @@ ARIA_UPDATE = 0x0100
 _MAP_SCRIPT = """
 import asyncio, sys, time
 from rtmu.client.connection import AriaClient
-from rtmu.values.target import Target
 from rtmu.client.mapload import download_map
+try:  # (the baseline's tree predates Target: its connect took the host and port)
+    from rtmu.values.target import Target
+except ImportError:
+    Target = None
 
 async def main(port):
     client = AriaClient()
-    await client.connect(Target("127.0.0.1", port))
+    await client.connect(*((Target("127.0.0.1", port),) if Target else ("127.0.0.1", port)))
     start = time.process_time()
     got = await download_map(client, prefer_binary=False, timeout=60)
     spent = time.process_time() - start
@@ -186,7 +189,8 @@ def _before_tree(into: Path) -> Path | None:
     if done.returncode != 0:
         return None
     with tarfile.open(fileobj=BytesIO(done.stdout)) as tar:
-        tar.extractall(into, filter="data")
+        # (our own tree from git; the "data" filter where this Python has it — 3.11.4 and later)
+        tar.extractall(into, **({"filter": "data"} if hasattr(tarfile, "data_filter") else {}))
     compile_all = [sys.executable, "-m", "compileall", "-q", str(into / "src")]
     subprocess.run(compile_all, check=False, stdout=subprocess.DEVNULL)
     return into / "src"

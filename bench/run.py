@@ -1,6 +1,7 @@
 """Run every benchmark, print a table, write ``bench/results.json``.
 
-Usage: ``python -m bench.run [substring ...]`` (only modules whose name contains a substring).
+Usage: ``python -m bench.run [substring ...]`` (only modules whose name contains a substring; a
+whole module name — ``bench_fleet`` — picks that module alone, not ``bench_fleet_scale`` too).
 """
 
 from __future__ import annotations
@@ -17,12 +18,16 @@ from bench.common import Result
 HERE = Path(__file__).resolve().parent
 
 
+def _picks(wanted: str, module: str) -> bool:
+    return wanted == module if wanted.startswith("bench_") else wanted in module
+
+
 def main(argv: list[str]) -> int:
     wanted = argv[1:]
     results: list[Result] = []
     failed: list[str] = []
     for info in sorted(pkgutil.iter_modules([str(HERE)]), key=lambda m: m.name):
-        if not info.name.startswith("bench_") or (wanted and not any(w in info.name for w in wanted)):
+        if not info.name.startswith("bench_") or (wanted and not any(_picks(w, info.name) for w in wanted)):
             continue
         print(f"# {info.name}", file=sys.stderr, flush=True)
         try:

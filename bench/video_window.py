@@ -203,7 +203,10 @@ def main(argv: list[str]) -> int:
     clock.connect("after-paint", after_paint)
 
     if mode == "live":
-        window.live.fps.set_selected(window.live.fps.get_model().get_n_items() - 2)  # 20 fps
+        live = window.live
+        live._settings_popup(live.settings_button)  # what opening the gear does: its drop-downs are made then
+        assert live.fps is not None
+        live.fps.set_selected(live.fps.get_model().get_n_items() - 2)  # 20 fps
         window.live.set_live(True)
     else:
         window.session.runner.send(RequestPicture())
