@@ -15,14 +15,13 @@ from collections.abc import Iterator
 from pathlib import Path
 
 from .base import CaptureError, CaptureEvent, CaptureStats, Datagram, Endpoint, Flow, StreamData, StreamEnd
+from .choices import DIRECTIONS, FORMATS
 from .hexdump import parse_hex
 from .net import SUPPORTED_LINK_TYPES, TCP, NotTcpUdp, ip_payload, parse_ip
 from .pcap import PCAP_MAGICS, PCAPNG_MAGIC, FrameReader, PcapngReader, PcapReader
 from .recorded import MCAP_MAGIC, recorded_events
 from .tcp import TcpReassembler
 
-FORMATS = ("auto", "pcap", "hex", "raw")
-DIRECTIONS = ("auto", "c2s", "s2c")
 CHUNK = 64 * 1024
 _TEXT_BYTES = frozenset(range(0x20, 0x7F)) | frozenset(b"\t\n\r\f\v")
 SYNC = b"\x0f\x0c"
