@@ -196,3 +196,18 @@ def test_numpy_starts_no_blas_threads_under_the_rtmu_command() -> None:
     assert out.returncode == 0, out.stderr[-2000:]
     threads = int(out.stdout.split("threads")[-1])
     assert threads == 1, f"{threads} threads after numpy loaded under rtmu (OpenBLAS threads not held)"
+
+
+@pytest.mark.parametrize(
+    ("name", "running_only"),
+    [
+        ("decode", ("rtmu.capture.reader", "rtmu.capture.session_decoder", "rtmu.subcommands._decode_run")),
+        ("why", ("rtmu.client.why", "rtmu.client.why_gather")),
+        ("goto", ("rtmu.subcommands._navigate",)),
+        ("localize", ("rtmu.subcommands._navigate",)),
+    ],
+)
+def test_a_help_loads_nothing_only_running_needs(name: str, running_only: tuple[str, ...]) -> None:
+    """What only a running command needs is imported in its handler (issue 28: ``--help`` ≤ 0.15 s)."""
+    modules = set(loaded_by(run_main([name, "--help"])))
+    assert sorted(modules & set(running_only)) == [], f"rtmu {name} --help loads what only running needs"
